@@ -1,0 +1,42 @@
+"""geardyn: nonlinear dynamics of gear trains.
+
+The public API::
+
+    import geardyn
+    p = geardyn.PlanetaryParams.paper(xi1=0.05, xi2=0.05)
+    m = geardyn.CATTDevice(p, interpretation="consistent")
+    ds = geardyn.simulate(m, omega=1.1, transient=4000.0, periods=64)
+"""
+
+from geardyn.errors import GeardynError, ParameterError, StudyError
+from geardyn.models.base import Model
+from geardyn.models.catt import CATTDevice, DimensionalCATT
+from geardyn.models.derived import INTERPRETATIONS
+from geardyn.models.gear_pair import GearPair
+from geardyn.models.params import Carrier, Gear, Loads, Mesh, PlanetaryParams, PlanetOverride
+from geardyn.models.user import UserModel
+from geardyn.solvers.reference import reference_solution
+from geardyn.solvers.simulate import default_steps_per_period, simulate
+
+__version__ = "0.1.0"
+
+__all__ = [
+    "INTERPRETATIONS",
+    "CATTDevice",
+    "Carrier",
+    "DimensionalCATT",
+    "GearPair",
+    "GeardynError",
+    "Gear",
+    "Loads",
+    "Mesh",
+    "Model",
+    "ParameterError",
+    "PlanetOverride",
+    "PlanetaryParams",
+    "StudyError",
+    "UserModel",
+    "default_steps_per_period",
+    "reference_solution",
+    "simulate",
+]

@@ -1,0 +1,25 @@
+"""Exceptions raised by geardyn, each naming the field or parameter value at fault."""
+
+from __future__ import annotations
+
+
+class GeardynError(Exception):
+    """Base class of every error geardyn raises on purpose."""
+
+
+class ParameterError(GeardynError, ValueError):
+    """A parameter is missing, of the wrong kind or outside its physical range.
+
+    ``field`` is the dotted path of the offending field (``"sun_mesh.mean_stiffness"``) and
+    ``value`` the value that was given.
+    """
+
+    def __init__(self, field: str, value: object, reason: str):
+        self.field = field
+        self.value = value
+        self.reason = reason
+        super().__init__(f"{field}: {reason} (got {value!r})")
+
+
+class StudyError(GeardynError, ValueError):
+    """A study file cannot be read or holds something geardyn does not understand."""

@@ -1,0 +1,104 @@
+"""The one interface every solver and analysis accepts: a model is data plus compiled functions.
+
+A model has a state vector (``state_names``), a coefficient vector (``params``, named by
+``param_names``) and compiled functions in the kernel interface (:class:`KernelSource`):
+
+* ``rhs(t, y, dy, p, s, c)`` writes dy/dt at time t; ``s, c`` are sin and cos of the forcing
+  phase Omega t, supplied by the solver (``Omega = p[omega_index]``; 0 for autonomous models).
+* ``events(t, y, g, p)`` (optional) writes switching functions whose zero crossings are kinks of
+  the right-hand side; the solver locates them inside a step.
+* ``observe(t, y, o, p, s, c)`` (optional) writes derived outputs, e.g. mesh forces.
+
+Built-in models (:class:`~geardyn.CATTDevice`, :class:`~geardyn.GearPair`) and a user's own
+(:class:`~geardyn.UserModel`) all subclass :class:`Model`.
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+from collections.abc import Sequence
+
+import numpy as np
+
+from geardyn.solvers.kernels import KernelSource
+
+
+class Model:
+    """Base class of geardyn models. Subclasses set the attributes in ``__init__``."""
+
+    name: str = "model"
+    state_names: tuple[str, ...] = ()
+    state_units: str = "1"
+    time_unit: str = "1"
+    param_names: tuple[str, ...] = ()
+    params: np.ndarray
+    event_names: tuple[str, ...] = ()
+    observable_names: tuple[str, ...] = ()
+    observable_units: str = "1"
+    omega_index: int | None = None
+    kernel: KernelSource
+
+    # ------------------------------------------------------------------ sizes
+    @property
+    def n_states(self) -> int:
+        return len(self.state_names)
+
+    @property
+    def n_events(self) -> int:
+        return len(self.event_names)
+
+    @property
+    def n_observables(self) -> int:
+        return len(self.observable_names)
+
+    # ------------------------------------------------------------------ forcing
+    @property
+    def omega(self) -> float:
+        """Forcing frequency (0 for an autonomous model)."""
+        return 0.0 if self.omega_index is None else float(self.params[self.omega_index])
+
+    @property
+    def period(self) -> float | None:
+        """Forcing period 2 pi / Omega, or None for an autonomous model."""
+        return None if self.omega == 0.0 else 2.0 * math.pi / self.omega
+
+    # ------------------------------------------------------------------ parameters
+    def initial_state(self) -> np.ndarray:
+        """Default initial state (zeros; models override with something physical)."""
+        return np.zeros(self.n_states)
+
+    def _param_index(self, name: str) -> int:
+        if name == "Omega" and self.omega_index is not None:
+            return self.omega_index
+        if name in self.param_names:
+            return self.param_names.index(name)
+        known = ", ".join(self.param_names) or "none"
+        raise KeyError(f"{self.name} has no parameter {name!r}; known: {known}")
+
+    def lane_params(self, name: str, values: Sequence[float] | np.ndarray) -> np.ndarray:
+        """Coefficient vectors (lanes x n_params) with the parameter ``name`` set to ``values``.
+
+        The base implementation sets one entry of ``params`` by name (``"Omega"`` is the forcing
+        frequency); physical models override it to re-derive every coefficient.
+        """
+        values = np.asarray(values, dtype=float).ravel()
+        P = np.tile(self.params, (values.size, 1))
+        P[:, self._param_index(name)] = values
+        return P
+
+    def with_params(self, **values: float) -> Model:
+        """A copy of the model with parameters changed by name."""
+        out = copy.copy(self)
+        p = self.params.copy()
+        for name, value in values.items():
+            p[self._param_index(name)] = float(value)
+        out.params = p
+        return out
+
+    def with_omega(self, omega: float) -> Model:
+        """A copy with the forcing frequency set to ``omega``."""
+        return self.with_params(Omega=omega)
+
+    def __repr__(self) -> str:
+        return f"{type(self).__name__}(states={list(self.state_names)}, omega={self.omega:g})"

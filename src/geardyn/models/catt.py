@@ -1,0 +1,381 @@
+"""The CATT planetary gear train processing device (fixed sun, N inside and N outside planets,
+carrier): the dimensionless mesh-coordinate model of Eq. (10), corrected, and the dimensional
+body-angle model of Eq. (1).
+
+Mesh coordinates (Eq. 8), per planet set i::
+
+    X_sq_i = theta_c r_c1 - theta_q_i r_bq_i - e_sq_i(t)
+    X_pq_i = theta_q_i r_bq_i - theta_p_i r_bp_i - e_pq_i(t)
+
+made dimensionless by X = X / b_c and tau = omega_n t (Eq. 9). Differentiating twice and
+substituting Eq. (1) gives, with k(tau) = K(tau)/Km the relative stiffness and g the dead zone::
+
+    X_sq_i'' = f_c(tau) - sum_j [k_sq_c_j k_sq_j(tau) g(X_sq_j, b_sq_j) + c_sq_c_j X_sq_j']
+               - [k_sq_q_i k_sq_i g(X_sq_i) + c_sq_q_i X_sq_i']
+               + [k_pq_q_i k_pq_i g(X_pq_i) + c_pq_q_i X_pq_i']
+               + E_sq_i Omega^2 sin(Omega tau + phi)
+    X_pq_i'' = [k_sq_q_i k_sq_i g(X_sq_i) + c_sq_q_i X_sq_i']
+               - [(k_pq_q_i + k_pq_p_i) k_pq_i g(X_pq_i) + (c_pq_q_i + c_pq_p_i) X_pq_i']
+               + f_p_i(tau) + E_pq_i Omega^2 sin(Omega tau + phi)
+
+with the coefficients of :data:`geardyn.models.derived.COEFFICIENT_FORMULAS`. With identical
+planet sets every set moves alike (from a symmetric initial state) and the model reduces to four
+states; :class:`CATTDevice` picks that form automatically.
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+from collections.abc import Sequence
+
+import numpy as np
+
+from geardyn.models import catt_kernels as ck
+from geardyn.models.base import Model
+from geardyn.models.derived import (
+    INTERPRETATIONS,
+    Derived,
+    Interpretation,
+    coefficients,
+    derive,
+)
+from geardyn.models.params import PAPER_NAMES, PlanetaryParams
+from geardyn.models.stiffness import fourier_coefficients, harmonics_needed
+from geardyn.solvers.kernels import KernelSource
+
+_KERNEL = KernelSource(ck.catt_rhs, ck.catt_events, ck.catt_observe)
+_THETA_KERNEL = KernelSource(ck.theta_rhs)
+
+
+class CATTDevice(Model):
+    """The paper's device as a geardyn model (dimensionless, time tau = omega_n t).
+
+    Parameters
+    ----------
+    params
+        Validated device parameters (:meth:`PlanetaryParams.paper` for the paper's).
+    interpretation
+        How to read the paper's ambiguous formulas: ``"consistent"`` (default),
+        ``"carrier-only"`` or ``"as-printed"`` (see :mod:`geardyn.models.derived`).
+    reduced
+        Use the 4-state form for identical planet sets. ``None`` (default) chooses it whenever
+        the planet sets are identical; ``False`` forces the general 4N-state form.
+    omega
+        Dimensionless mesh frequency Omega = omega / omega_n stored in the model (solvers and
+        sweeps set it).
+    """
+
+    time_unit = "1"
+    state_units = "1"
+    observable_units = "N"
+
+    def __init__(
+        self,
+        params: PlanetaryParams,
+        interpretation: Interpretation = "consistent",
+        reduced: bool | None = None,
+        omega: float = 1.0,
+    ):
+        if interpretation not in INTERPRETATIONS:
+            raise ValueError(
+                f"interpretation must be one of {', '.join(INTERPRETATIONS)};"
+                f" got {interpretation!r}"
+            )
+        identical = params.identical_planets
+        if reduced and not identical:
+            raise ValueError("reduced=True needs identical planet sets; these differ")
+        self.params_in = params
+        self.interpretation = interpretation
+        self.reduced = identical if reduced is None else bool(reduced)
+        self.derived: Derived = derive(params, interpretation)
+        self.coefficients = coefficients(params, self.derived)
+        n_sets = 1 if self.reduced else params.n_planets
+        self.n_sets = n_sets
+        if self.reduced:
+            self.state_names = ("X_sq", "V_sq", "X_pq", "V_pq")
+            self.observable_names = ("F_sq", "F_pq")
+            self.event_names = ("X_sq-b_sq", "X_sq+b_sq", "X_pq-b_pq", "X_pq+b_pq")
+        else:
+            self.state_names = tuple(
+                f"{v}_{m}{i + 1}" for i in range(n_sets) for m, v in
+                (("sq", "X"), ("sq", "V"), ("pq", "X"), ("pq", "V"))
+            )
+            self.observable_names = tuple(
+                f"F_{m}{i + 1}" for i in range(n_sets) for m in ("sq", "pq")
+            )
+            self.event_names = tuple(
+                f"X_{m}{i + 1}{sign}b_{m}{i + 1}" for i in range(n_sets) for m in ("sq", "pq")
+                for sign in ("-", "+")
+            )
+        self.name = "CATTDevice"
+        self.kernel = _KERNEL
+        self.omega_index = ck.OMEGA
+        self.params = self._coefficient_vector(omega)
+        self.param_names = self._names()
+
+    # ------------------------------------------------------------------ coefficient vector
+    def _n_harmonics(self) -> int:
+        sets = [self.params_in.planet_set(i) for i in range(self.params_in.n_planets)]
+        return max(max(harmonics_needed(s[0]), harmonics_needed(s[1])) for s in sets)
+
+    def _coefficient_vector(self, omega: float) -> np.ndarray:
+        prm = self.params_in
+        co = self.coefficients
+        d = self.derived
+        nh = self._n_harmonics()
+        bs = ck.block_size(nh)
+        p = np.zeros(ck.HEADER + self.n_sets * bs)
+        p[ck.OMEGA] = omega
+        p[ck.LAMBDA] = prm.loads.Lambda
+        p[ck.N_BLOCKS] = self.n_sets
+        p[ck.N_HARM] = nh
+        p[ck.F_C0] = co["f_c0"]
+        p[ck.F_C1] = co["f_c1"]
+        p[ck.PSI1] = prm.loads.psi1
+        p[ck.PSI2] = prm.loads.psi2
+        mult = prm.n_planets if self.reduced else 1
+        for i in range(self.n_sets):
+            o = ck.HEADER + i * bs
+            sq, pq, _, _ = prm.planet_set(i)
+            blk = p[o : o + bs]
+            blk[ck.K_SQ_C] = mult * co["k_sq_c"][i]
+            blk[ck.C_SQ_C] = mult * co["c_sq_c"][i]
+            for name, idx in (
+                ("k_sq_q", ck.K_SQ_Q), ("c_sq_q", ck.C_SQ_Q), ("k_pq_q", ck.K_PQ_Q),
+                ("c_pq_q", ck.C_PQ_Q), ("k_pq_p", ck.K_PQ_P), ("c_pq_p", ck.C_PQ_P),
+                ("b_sq", ck.B_SQ), ("b_pq", ck.B_PQ),
+            ):
+                blk[idx] = co[name][i]
+            blk[ck.E_SQ_S] = co["E_sq"][i] * math.cos(sq.error_phase)
+            blk[ck.E_SQ_C] = co["E_sq"][i] * math.sin(sq.error_phase)
+            blk[ck.E_PQ_S] = co["E_pq"][i] * math.cos(pq.error_phase)
+            blk[ck.E_PQ_C] = co["E_pq"][i] * math.sin(pq.error_phase)
+            blk[ck.F_P0] = co["f_p0"][i]
+            blk[ck.F_P1] = co["f_p1"][i]
+            blk[ck.FORCE_SCALE] = prm.b_c * d.omega_n**2 * d.M_q[i]
+            for mesh, off in ((sq, 0), (pq, 2 * nh)):
+                a, b = fourier_coefficients(mesh, nh)
+                blk[ck.BLOCK_FIXED + off : ck.BLOCK_FIXED + off + 2 * nh : 2] = a
+                blk[ck.BLOCK_FIXED + off + 1 : ck.BLOCK_FIXED + off + 2 * nh : 2] = b
+        return p
+
+    def _names(self) -> tuple[str, ...]:
+        head = ["Omega", "Lambda", "n_blocks", "n_harmonics", "f_c0", "f_c1", "psi1", "psi2"]
+        fixed = ["k_sq_c", "c_sq_c", "k_sq_q", "c_sq_q", "k_pq_q", "c_pq_q", "k_pq_p", "c_pq_p",
+                 "b_sq", "b_pq", "E_sq_s", "E_sq_c", "E_pq_s", "E_pq_c", "f_p0", "f_p1",
+                 "force_scale", "spare"]
+        nh = int(self.params[ck.N_HARM])
+        four = [f"{m}_{ab}{h}" for m in ("ksq", "kpq") for h in range(1, nh + 1) for ab in "ab"]
+        names = list(head)
+        for i in range(self.n_sets):
+            suffix = "" if self.reduced else str(i + 1)
+            names += [f"{n}{suffix}" for n in fixed + four]
+        return tuple(names)
+
+    # ------------------------------------------------------------------ parameters by name
+    @property
+    def omega_n(self) -> float:
+        """omega_n [rad/s]: the unit of dimensionless time (interpretation-dependent)."""
+        return float(self.derived.omega_n)
+
+    def replace(self, **changes) -> CATTDevice:
+        """A new device with physical parameters changed by the paper's names (``xi1``,
+        ``backlash``, ``B1``, ...) and/or ``Omega``."""
+        omega = float(changes.pop("Omega", self.omega))
+        params = self.params_in.replace(**changes) if changes else self.params_in
+        reduced = None if params.identical_planets else False
+        if not self.reduced:
+            reduced = False
+        return CATTDevice(params, self.interpretation, reduced=reduced, omega=omega)
+
+    def with_params(self, **values: float) -> CATTDevice:
+        physical = {k: v for k, v in values.items() if k in PAPER_NAMES or k == "Omega"}
+        rest = {k: v for k, v in values.items() if k not in physical}
+        out = self.replace(**physical) if physical else copy.copy(self)
+        return Model.with_params(out, **rest) if rest else out
+
+    def lane_params(self, name: str, values: Sequence[float] | np.ndarray) -> np.ndarray:
+        values = np.asarray(values, dtype=float).ravel()
+        if name in PAPER_NAMES:
+            rows = [self.replace(**{name: float(v)}).params for v in values]
+            if len({r.size for r in rows}) != 1:
+                raise ValueError(f"sweeping {name!r} changes the model's size; sweep N separately")
+            return np.array(rows)
+        return Model.lane_params(self, name, values)
+
+    # ------------------------------------------------------------------ linear analysis
+    def stiffness_matrix(self) -> np.ndarray:
+        """Dimensionless mean stiffness matrix A of the general 2N-coordinate model, such that the
+        linearised undamped motion (b = 0, Ka = 0) is X'' = -A X + forcing."""
+        co = self.coefficients
+        n = self.params_in.n_planets
+        A = np.zeros((2 * n, 2 * n))
+        for i in range(n):
+            s, q = 2 * i, 2 * i + 1
+            for j in range(n):
+                A[s, 2 * j] += co["k_sq_c"][j]
+            A[s, s] += co["k_sq_q"][i]
+            A[s, q] -= co["k_pq_q"][i]
+            A[q, s] -= co["k_sq_q"][i]
+            A[q, q] += co["k_pq_q"][i] + co["k_pq_p"][i]
+        return A
+
+    def natural_frequencies(self) -> np.ndarray:
+        """Natural frequencies of the linearised device (mean stiffness, no backlash), ascending,
+        in units of omega_n: all 2N modes of the general model."""
+        lam = np.linalg.eigvals(self.stiffness_matrix())
+        if np.max(np.abs(lam.imag)) > 1e-9 * np.max(np.abs(lam.real)):
+            raise ValueError("the linearised stiffness matrix has complex eigenvalues")
+        return np.sort(np.sqrt(lam.real))
+
+    def static_forces(self) -> np.ndarray:
+        """Mean-load mesh forces of the quasi-static state in mesh coordinates (dimensionless
+        k g(X) products, one (sq, pq) pair per modelled planet set), from the mean torques."""
+        co = self.coefficients
+        n = self.n_sets
+        mult = self.params_in.n_planets if self.reduced else 1
+        A = np.zeros((2 * n, 2 * n))
+        rhs = np.zeros(2 * n)
+        for i in range(n):
+            s, q = 2 * i, 2 * i + 1
+            for j in range(n):
+                A[s, 2 * j] += mult * co["k_sq_c"][j]
+            A[s, s] += co["k_sq_q"][i]
+            A[s, q] -= co["k_pq_q"][i]
+            A[q, s] -= co["k_sq_q"][i]
+            A[q, q] += co["k_pq_q"][i] + co["k_pq_p"][i]
+            rhs[s] = co["f_c0"]
+            rhs[q] = co["f_p0"][i]
+        return np.linalg.solve(A, rhs)
+
+    def initial_state(self) -> np.ndarray:
+        """The quasi-static state under the mean loads (mean stiffness, no error), at rest: the
+        deflection g = F/K added to the backlash on the loaded flank."""
+        g = self.static_forces()
+        co = self.coefficients
+        y = np.zeros(self.n_states)
+        for i in range(self.n_sets):
+            for k, b in ((0, co["b_sq"][i]), (1, co["b_pq"][i])):
+                gi = g[2 * i + k]
+                y[4 * i + 2 * k] = gi + math.copysign(b, gi) if gi != 0.0 else 0.0
+        return y
+
+    def static_mesh_forces(self) -> np.ndarray:
+        """Static mesh forces [N] under the mean loads, in the order of ``observable_names``."""
+        g = self.static_forces()
+        d = self.derived
+        bc = self.params_in.b_c
+        out = np.empty(2 * self.n_sets)
+        for i in range(self.n_sets):
+            out[2 * i] = g[2 * i] * d.M_q[i] * d.omega_n**2 * bc
+            out[2 * i + 1] = g[2 * i + 1] * d.M_q[i] * d.omega_n**2 * bc
+        return out
+
+    def general(self) -> CATTDevice:
+        """The same device in the general 4N-state form."""
+        return CATTDevice(self.params_in, self.interpretation, reduced=False, omega=self.omega)
+
+    def expand_state(self, y: np.ndarray) -> np.ndarray:
+        """A reduced state repeated for every planet set (the general model's symmetric state)."""
+        if not self.reduced:
+            return np.asarray(y, dtype=float).copy()
+        return np.tile(np.asarray(y, dtype=float), self.params_in.n_planets)
+
+    def dimensional(self) -> DimensionalCATT:
+        """The dimensional body-angle model of Eq. (1) with the same parameters."""
+        return DimensionalCATT(self)
+
+    def __repr__(self) -> str:
+        form = "reduced" if self.reduced else "general"
+        return (f"CATTDevice(N={self.params_in.n_planets}, {form}, "
+                f"interpretation={self.interpretation!r}, Omega={self.omega:g})")
+
+
+class DimensionalCATT(Model):
+    """Eq. (1) in the body angles (2N + 1 rotational degrees of freedom), SI units.
+
+    State: theta_c, theta_c', then theta_q_i, theta_q_i', theta_p_i, theta_p_i' per planet set
+    [rad, rad/s]; time in seconds; ``params[0]`` is the mesh frequency omega = Omega omega_n.
+    Written independently of the mesh-coordinate form, to verify it.
+    """
+
+    time_unit = "s"
+    state_units = "rad, rad/s"
+
+    def __init__(self, device: CATTDevice):
+        prm = device.params_in
+        d = device.derived
+        n = prm.n_planets
+        nh = int(device.params[ck.N_HARM])
+        bs = ck.T_BLOCK_FIXED + 4 * nh
+        p = np.zeros(ck.T_HEADER + n * bs)
+        loads = prm.loads
+        p[ck.T_OMEGA] = device.omega * d.omega_n
+        p[ck.T_OMEGA_L] = loads.Lambda * d.omega_n
+        p[ck.T_N] = n
+        p[ck.T_NH] = nh
+        p[ck.T_TD] = loads.T_D
+        p[ck.T_A1] = loads.A1
+        p[ck.T_B1] = loads.B1
+        p[ck.T_PSI1] = loads.psi1
+        p[ck.T_A2] = loads.A2
+        p[ck.T_B2] = loads.B2
+        p[ck.T_PSI2] = loads.psi2
+        p[ck.T_JC] = d.J_c_eff
+        p[ck.T_RC1] = prm.carrier.r_c1
+        p[ck.T_ARM] = d.arm
+        for i in range(n):
+            o = ck.T_HEADER + i * bs
+            sq, pq, _, _ = prm.planet_set(i)
+            p[o + ck.T_JQ] = d.J_q[i]
+            p[o + ck.T_JP] = d.J_p[i]
+            p[o + ck.T_RBQ] = d.r_bq[i]
+            p[o + ck.T_RBP] = d.r_bp[i]
+            p[o + ck.T_KM_SQ] = sq.mean_stiffness
+            p[o + ck.T_KM_PQ] = pq.mean_stiffness
+            p[o + ck.T_C_SQ] = d.C_sq[i]
+            p[o + ck.T_C_PQ] = d.C_pq[i]
+            p[o + ck.T_B_SQ] = sq.backlash
+            p[o + ck.T_B_PQ] = pq.backlash
+            p[o + ck.T_E_SQ_S] = sq.error * math.cos(sq.error_phase)
+            p[o + ck.T_E_SQ_C] = sq.error * math.sin(sq.error_phase)
+            p[o + ck.T_E_PQ_S] = pq.error * math.cos(pq.error_phase)
+            p[o + ck.T_E_PQ_C] = pq.error * math.sin(pq.error_phase)
+            for mesh, off in ((sq, 0), (pq, 2 * nh)):
+                a, b = fourier_coefficients(mesh, nh)
+                p[o + ck.T_BLOCK_FIXED + off : o + ck.T_BLOCK_FIXED + off + 2 * nh : 2] = a
+                p[o + ck.T_BLOCK_FIXED + off + 1 : o + ck.T_BLOCK_FIXED + off + 2 * nh : 2] = b
+        self.device = device
+        self.params = p
+        self.name = "DimensionalCATT"
+        self.kernel = _THETA_KERNEL
+        self.omega_index = ck.T_OMEGA
+        self.param_names = ("omega",) + tuple(f"p{k}" for k in range(1, p.size))
+        self.state_names = ("theta_c", "dtheta_c") + tuple(
+            f"{v}{i + 1}" for i in range(n)
+            for v in ("theta_q", "dtheta_q", "theta_p", "dtheta_p")
+        )
+
+    def mesh_coordinates(self, t: np.ndarray, y: np.ndarray) -> np.ndarray:
+        """Dimensionless mesh coordinates and their tau-derivatives (Eq. 8, 9) of body-angle states
+        y[..., state] at times t [s], in the general CATTDevice state order."""
+        prm = self.device.params_in
+        d = self.device.derived
+        w = self.omega
+        t = np.asarray(t, dtype=float)[..., None]
+        out = []
+        for i in range(prm.n_planets):
+            sq, pq, _, _ = prm.planet_set(i)
+            j = 2 + 4 * i
+            e_sq = sq.error * np.sin(w * t[..., 0] + sq.error_phase)
+            de_sq = sq.error * w * np.cos(w * t[..., 0] + sq.error_phase)
+            e_pq = pq.error * np.sin(w * t[..., 0] + pq.error_phase)
+            de_pq = pq.error * w * np.cos(w * t[..., 0] + pq.error_phase)
+            x_sq = y[..., 0] * prm.carrier.r_c1 - y[..., j] * d.r_bq[i] - e_sq
+            v_sq = y[..., 1] * prm.carrier.r_c1 - y[..., j + 1] * d.r_bq[i] - de_sq
+            x_pq = y[..., j] * d.r_bq[i] - y[..., j + 2] * d.r_bp[i] - e_pq
+            v_pq = y[..., j + 1] * d.r_bq[i] - y[..., j + 3] * d.r_bp[i] - de_pq
+            out += [x_sq / prm.b_c, v_sq / (prm.b_c * d.omega_n), x_pq / prm.b_c,
+                    v_pq / (prm.b_c * d.omega_n)]
+        return np.stack(out, axis=-1)

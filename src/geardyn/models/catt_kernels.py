@@ -1,0 +1,181 @@
+"""Compiled right-hand sides of the CATT device (numba).
+
+Kernel interface shared by every geardyn model (see :mod:`geardyn.models.base`):
+
+``rhs(t, y, dy, p, s, c)``
+    writes dy/dt; ``s, c = sin(Omega t), cos(Omega t)`` are supplied by the solver (from a table on
+    the period-aligned grid), ``p`` is the coefficient vector.
+``events(t, y, g, p)``
+    switching functions whose zero crossings are the kinks of the right-hand side.
+``observe(t, y, o, p, s, c)``
+    derived outputs (here: the dynamic mesh forces in newtons).
+
+Mesh-coordinate form (Eq. 10 corrected), state per planet set i: X_sq, X_sq', X_pq, X_pq'.
+The coefficient vector is a header followed by one block per planet set. The reduced model for N
+identical planet sets is the same right-hand side with one block whose carrier-coupling
+coefficients are multiplied by N.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba as nb
+
+# header
+OMEGA, LAMBDA, N_BLOCKS, N_HARM, F_C0, F_C1, PSI1, PSI2 = range(8)
+HEADER = 8
+# block
+(K_SQ_C, C_SQ_C, K_SQ_Q, C_SQ_Q, K_PQ_Q, C_PQ_Q, K_PQ_P, C_PQ_P, B_SQ, B_PQ,
+ E_SQ_S, E_SQ_C, E_PQ_S, E_PQ_C, F_P0, F_P1, FORCE_SCALE, SPARE) = range(18)
+BLOCK_FIXED = 18
+
+
+def block_size(n_harmonics: int) -> int:
+    """Length of one planet-set block for the given number of stiffness harmonics."""
+    return BLOCK_FIXED + 4 * n_harmonics
+
+
+_JIT = {"cache": True, "error_model": "numpy", "boundscheck": False}
+
+
+@nb.njit(inline="always", **_JIT)
+def dead_zone(x, b):
+    """g(x, b) of Eq. (3)."""
+    if x > b:
+        return x - b
+    if x < -b:
+        return x + b
+    return 0.0
+
+
+@nb.njit(inline="always", **_JIT)
+def fourier(p, o, nh, s, c):
+    """sum_h p[o+2h] cos(h theta) + p[o+2h+1] sin(h theta) for theta with sin s, cos c."""
+    acc = p[o] * c + p[o + 1] * s
+    ch = c
+    sh = s
+    for h in range(1, nh):
+        ch, sh = ch * c - sh * s, sh * c + ch * s
+        acc += p[o + 2 * h] * ch + p[o + 2 * h + 1] * sh
+    return acc
+
+
+@nb.njit(**_JIT)
+def catt_rhs(t, y, dy, p, s, c):
+    om2 = p[OMEGA] * p[OMEGA]
+    nb_ = int(p[N_BLOCKS])
+    nh = int(p[N_HARM])
+    bs = BLOCK_FIXED + 4 * nh
+    lp_phase = 0.0
+    if p[F_C1] != 0.0 or p[HEADER + F_P1] != 0.0:
+        lp_phase = 1.0
+    carrier = 0.0
+    for i in range(nb_):
+        o = HEADER + i * bs
+        j = 4 * i
+        xs = y[j]
+        vs = y[j + 1]
+        xp = y[j + 2]
+        vp = y[j + 3]
+        ks = 1.0 + fourier(p, o + BLOCK_FIXED, nh, s, c)
+        kp = 1.0 + fourier(p, o + BLOCK_FIXED + 2 * nh, nh, s, c)
+        gs = ks * dead_zone(xs, p[o + B_SQ])
+        gp = kp * dead_zone(xp, p[o + B_PQ])
+        carrier += p[o + K_SQ_C] * gs + p[o + C_SQ_C] * vs
+        f_sq = p[o + K_SQ_Q] * gs + p[o + C_SQ_Q] * vs
+        f_pq = p[o + K_PQ_Q] * gp + p[o + C_PQ_Q] * vp
+        f_pp = p[o + K_PQ_P] * gp + p[o + C_PQ_P] * vp
+        load_p = p[o + F_P0]
+        if lp_phase != 0.0:
+            load_p += p[o + F_P1] * math.sin(p[LAMBDA] * t + p[PSI1])
+        dy[j] = vs
+        dy[j + 1] = -f_sq + f_pq + om2 * (p[o + E_SQ_S] * s + p[o + E_SQ_C] * c)
+        dy[j + 2] = vp
+        dy[j + 3] = f_sq - f_pq - f_pp + load_p + om2 * (p[o + E_PQ_S] * s + p[o + E_PQ_C] * c)
+    load_c = p[F_C0]
+    if lp_phase != 0.0:
+        load_c += p[F_C1] * math.sin(p[LAMBDA] * t + p[PSI2])
+    for i in range(nb_):
+        dy[4 * i + 1] += load_c - carrier
+
+
+@nb.njit(**_JIT)
+def catt_events(t, y, g, p):
+    nb_ = int(p[N_BLOCKS])
+    bs = BLOCK_FIXED + 4 * int(p[N_HARM])
+    for i in range(nb_):
+        o = HEADER + i * bs
+        g[4 * i] = y[4 * i] - p[o + B_SQ]
+        g[4 * i + 1] = y[4 * i] + p[o + B_SQ]
+        g[4 * i + 2] = y[4 * i + 2] - p[o + B_PQ]
+        g[4 * i + 3] = y[4 * i + 2] + p[o + B_PQ]
+
+
+@nb.njit(**_JIT)
+def catt_observe(t, y, out, p, s, c):
+    nb_ = int(p[N_BLOCKS])
+    nh = int(p[N_HARM])
+    bs = BLOCK_FIXED + 4 * nh
+    for i in range(nb_):
+        o = HEADER + i * bs
+        j = 4 * i
+        ks = 1.0 + fourier(p, o + BLOCK_FIXED, nh, s, c)
+        kp = 1.0 + fourier(p, o + BLOCK_FIXED + 2 * nh, nh, s, c)
+        scale = p[o + FORCE_SCALE]
+        gs = ks * dead_zone(y[j], p[o + B_SQ])
+        gp = kp * dead_zone(y[j + 2], p[o + B_PQ])
+        out[2 * i] = scale * (p[o + K_SQ_Q] * gs + p[o + C_SQ_Q] * y[j + 1])
+        out[2 * i + 1] = scale * (p[o + K_PQ_Q] * gp + p[o + C_PQ_Q] * y[j + 3])
+
+
+# ---------------------------------------------------------------------------------------------
+# Dimensional form, Eq. (1), in the body angles (SI units, time in seconds).
+# State: theta_c, theta_c', then per planet set theta_q, theta_q', theta_p, theta_p'.
+T_OMEGA, T_OMEGA_L, T_N, T_NH, T_TD, T_A1, T_B1, T_PSI1, T_A2, T_B2, T_PSI2, T_JC, T_RC1, T_ARM = (
+    range(14)
+)
+T_HEADER = 14
+(T_JQ, T_JP, T_RBQ, T_RBP, T_KM_SQ, T_KM_PQ, T_C_SQ, T_C_PQ, T_B_SQ, T_B_PQ,
+ T_E_SQ_S, T_E_SQ_C, T_E_PQ_S, T_E_PQ_C) = range(14)
+T_BLOCK_FIXED = 14
+
+
+@nb.njit(**_JIT)
+def theta_rhs(t, y, dy, p, s, c):
+    w = p[T_OMEGA]
+    n = int(p[T_N])
+    nh = int(p[T_NH])
+    bs = T_BLOCK_FIXED + 4 * nh
+    tl1 = p[T_A1] + p[T_B1] * math.sin(p[T_OMEGA_L] * t + p[T_PSI1])
+    tl2 = p[T_A2] + p[T_B2] * math.sin(p[T_OMEGA_L] * t + p[T_PSI2])
+    th_c = y[0]
+    w_c = y[1]
+    carrier_torque = p[T_TD] - tl2
+    for i in range(n):
+        o = T_HEADER + i * bs
+        j = 2 + 4 * i
+        th_q = y[j]
+        w_q = y[j + 1]
+        th_p = y[j + 2]
+        w_p = y[j + 3]
+        # meshing errors e = E sin(w t + phi) and their rates
+        e_sq = p[o + T_E_SQ_S] * s + p[o + T_E_SQ_C] * c
+        de_sq = w * (p[o + T_E_SQ_S] * c - p[o + T_E_SQ_C] * s)
+        e_pq = p[o + T_E_PQ_S] * s + p[o + T_E_PQ_C] * c
+        de_pq = w * (p[o + T_E_PQ_S] * c - p[o + T_E_PQ_C] * s)
+        x_sq = th_c * p[T_RC1] - th_q * p[o + T_RBQ] - e_sq
+        dx_sq = w_c * p[T_RC1] - w_q * p[o + T_RBQ] - de_sq
+        x_pq = th_q * p[o + T_RBQ] - th_p * p[o + T_RBP] - e_pq
+        dx_pq = w_q * p[o + T_RBQ] - w_p * p[o + T_RBP] - de_pq
+        k_sq = p[o + T_KM_SQ] * (1.0 + fourier(p, o + T_BLOCK_FIXED, nh, s, c))
+        k_pq = p[o + T_KM_PQ] * (1.0 + fourier(p, o + T_BLOCK_FIXED + 2 * nh, nh, s, c))
+        f_sq = k_sq * dead_zone(x_sq, p[o + T_B_SQ]) + p[o + T_C_SQ] * dx_sq
+        f_pq = k_pq * dead_zone(x_pq, p[o + T_B_PQ]) + p[o + T_C_PQ] * dx_pq
+        dy[j] = w_q
+        dy[j + 1] = (f_sq - f_pq) * p[o + T_RBQ] / p[o + T_JQ]
+        dy[j + 2] = w_p
+        dy[j + 3] = (f_pq * p[o + T_RBP] - tl1) / p[o + T_JP]
+        carrier_torque -= f_sq * p[T_ARM]
+    dy[0] = w_c
+    dy[1] = carrier_torque / p[T_JC]

@@ -1,0 +1,223 @@
+"""Derived quantities of the CATT device and the dimensionless coefficients of Eq. (10).
+
+The paper leaves some quantities undisclosed and prints others wrongly (``shared/model-notes.md``).
+Three *interpretations* resolve this, each a documented choice:
+
+``consistent`` (default)
+    omega_n = sqrt(Km_sq (1/M_s + 1/M_c)) (a frequency); carrier inertia
+    J_c + sum(m_p r_c2^2 + m_q r_c1^2); carrier damping term with 1/omega_n.
+``carrier-only``
+    as ``consistent`` but the carrier's effective inertia is J_c alone.
+``as-printed``
+    every formula exactly as printed: omega_n = sqrt(Km_sq / (1/M_s + 1/M_c)) (units kg/s, used as
+    if rad/s), J_c + sum(m_p r_c2 + m_q r_c1) (SI numbers, dimensionally inconsistent), and the
+    carrier damping term of Eq. (10) with 1/omega_n^2 instead of 1/omega_n.
+
+Every quantity in :data:`DERIVED_FORMULAS` can be overridden by name through
+``PlanetaryParams.derived``; per-planet quantities then take the value for every planet.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, fields
+from typing import Literal
+
+import numpy as np
+
+from geardyn.models.params import PlanetaryParams
+
+Interpretation = Literal["consistent", "carrier-only", "as-printed"]
+INTERPRETATIONS: tuple[str, ...] = ("consistent", "carrier-only", "as-printed")
+
+#: Every derived quantity: (unit, formula). Per-planet ones are arrays of length N.
+DERIVED_FORMULAS: dict[str, tuple[str, str]] = {
+    "r_bs": ("m", "sun base radius: given, else m z cos(alpha) / 2"),
+    "r_bq": ("m", "inside planet base radius: given, else m z cos(alpha) / 2"),
+    "r_bp": ("m", "outside planet base radius: given, else m z cos(alpha) / 2"),
+    "m_s": ("kg", "sun mass: given, else density pi (m z/2)^2 face_width (solid disc)"),
+    "m_q": ("kg", "inside planet mass: given, else solid disc at the pitch radius"),
+    "m_p": ("kg", "outside planet mass: given, else solid disc at the pitch radius"),
+    "J_s": ("kg m^2", "sun inertia: given, else J_p (same 40-tooth blank as the outside planet)"),
+    "J_q": ("kg m^2", "inside planet inertia (Table 1)"),
+    "J_p": ("kg m^2", "outside planet inertia (Table 1)"),
+    "M_s": ("kg", "M_s = J_s / r_bs^2 (Eq. 11)"),
+    "M_q": ("kg", "M_q = J_q / r_bq^2 (Eq. 11)"),
+    "M_p": ("kg", "M_p = J_p / r_bp^2 (Eq. 11)"),
+    "r_bc": ("m", "carrier reference radius: given, else r_c1"),
+    "J_c_eff": (
+        "kg m^2",
+        "consistent: J_c + sum(m_p r_c2^2 + m_q r_c1^2); carrier-only: J_c;"
+        " as-printed: J_c + sum(m_p r_c2 + m_q r_c1) (Eq. 1)",
+    ),
+    "M_c": ("kg", "M_c = J_c_eff / r_bc^2 (Eq. 11)"),
+    "arm": ("m", "moment arm of each sun-planet mesh force on the carrier: r_bs cos(alpha)"),
+    "omega_n": (
+        "rad/s",
+        "consistent, carrier-only: sqrt(Km_sq (1/M_s + 1/M_c));"
+        " as-printed: sqrt(Km_sq / (1/M_s + 1/M_c)) (Eq. 9); Km_sq of planet set 1",
+    ),
+    "C_sq": ("N s/m", "C_sq = 2 xi1 sqrt(Km_sq / (1/M_s + 1/M_q)) (Eq. 6)"),
+    "C_pq": ("N s/m", "C_pq = 2 xi2 sqrt(Km_pq / (1/M_p + 1/M_q)) (Eq. 6)"),
+    "gamma": (
+        "1",
+        "factor on the carrier damping term of Eq. (10): 1; as-printed 1/omega_n (the typo)",
+    ),
+}
+
+#: The dimensionless coefficients of Eq. (10), per planet set i, with their formulas.
+COEFFICIENT_FORMULAS: dict[str, str] = {
+    "k_sq_c": "r_c1 arm Km_sq / (M_c r_bc^2 omega_n^2)  (sun mesh stiffness on the carrier)",
+    "c_sq_c": "gamma r_c1 arm C_sq / (M_c r_bc^2 omega_n)  (sun mesh damping on the carrier)",
+    "k_sq_q": "Km_sq / (M_q omega_n^2)",
+    "c_sq_q": "C_sq / (M_q omega_n)",
+    "k_pq_q": "Km_pq / (M_q omega_n^2)",
+    "c_pq_q": "C_pq / (M_q omega_n)",
+    "k_pq_p": "Km_pq / (M_p omega_n^2)",
+    "c_pq_p": "C_pq / (M_p omega_n)",
+    "b_sq": "b_sq / b_c  (dimensionless backlash)",
+    "b_pq": "b_pq / b_c",
+    "E_sq": "E_sq / b_c  (dimensionless meshing error)",
+    "E_pq": "E_pq / b_c",
+    "f_p0": "A1 / (M_p r_bp omega_n^2 b_c)  (mean load on the outside planet)",
+    "f_p1": "B1 / (M_p r_bp omega_n^2 b_c)",
+    "f_c0": "r_c1 (T_D - A2) / (M_c r_bc^2 omega_n^2 b_c)  (net mean torque on the carrier)",
+    "f_c1": "-r_c1 B2 / (M_c r_bc^2 omega_n^2 b_c)",
+}
+
+_PER_PLANET = {"r_bq", "r_bp", "m_q", "m_p", "J_q", "J_p", "M_q", "M_p", "C_sq", "C_pq"}
+
+
+@dataclass(frozen=True)
+class Derived:
+    """Derived quantities (SI); per-planet ones are arrays of length N."""
+
+    r_bs: float
+    r_bq: np.ndarray
+    r_bp: np.ndarray
+    m_s: float
+    m_q: np.ndarray
+    m_p: np.ndarray
+    J_s: float
+    J_q: np.ndarray
+    J_p: np.ndarray
+    M_s: float
+    M_q: np.ndarray
+    M_p: np.ndarray
+    r_bc: float
+    J_c_eff: float
+    M_c: float
+    arm: float
+    omega_n: float
+    C_sq: np.ndarray
+    C_pq: np.ndarray
+    gamma: float
+
+    def as_dict(self) -> dict[str, float | np.ndarray]:
+        return {f.name: getattr(self, f.name) for f in fields(self)}
+
+
+def _disc_mass(gear) -> float:
+    return gear.density * math.pi * gear.pitch_radius**2 * gear.face_width
+
+
+def _base_radius(gear) -> float:
+    if gear.base_radius is not None:
+        return gear.base_radius
+    return gear.pitch_radius * math.cos(gear.pressure_angle)
+
+
+def derive(params: PlanetaryParams, interpretation: Interpretation = "consistent") -> Derived:
+    """Compute every derived quantity, applying ``params.derived`` overrides on the way."""
+    if interpretation not in INTERPRETATIONS:
+        raise ValueError(
+            f"interpretation must be one of {', '.join(INTERPRETATIONS)}; got {interpretation!r}"
+        )
+    n = params.n_planets
+    sets = [params.planet_set(i) for i in range(n)]
+    ov = params.derived
+    values: dict[str, float | np.ndarray] = {}
+
+    def put(name: str, value):
+        if name in ov:
+            value = np.full(n, ov[name]) if name in _PER_PLANET else float(ov[name])
+        values[name] = value
+        return value
+
+    def per_planet(fn) -> np.ndarray:
+        return np.array([fn(*s) for s in sets], dtype=float)
+
+    sun = params.sun
+    r_bs = put("r_bs", _base_radius(sun))
+    r_bq = put("r_bq", per_planet(lambda sq, pq, q, p: _base_radius(q)))
+    r_bp = put("r_bp", per_planet(lambda sq, pq, q, p: _base_radius(p)))
+    put("m_s", sun.mass if sun.mass is not None else _disc_mass(sun))
+    m_q = put("m_q", per_planet(lambda sq, pq, q, p: q.mass if q.mass else _disc_mass(q)))
+    m_p = put("m_p", per_planet(lambda sq, pq, q, p: p.mass if p.mass else _disc_mass(p)))
+    for label, gear in (("J_q", "inside planet"), ("J_p", "outside planet")):
+        missing = [i for i, s in enumerate(sets) if s[2 if label == "J_q" else 3].inertia is None]
+        if missing and label not in ov:
+            raise ValueError(f"{gear} inertia is not given (planet set {missing[0] + 1})")
+    J_q = put("J_q", per_planet(lambda sq, pq, q, p: q.inertia or math.nan))
+    J_p = put("J_p", per_planet(lambda sq, pq, q, p: p.inertia or math.nan))
+    J_s = put("J_s", sun.inertia if sun.inertia is not None else float(J_p[0]))
+    M_s = put("M_s", J_s / r_bs**2)
+    M_q = put("M_q", J_q / r_bq**2)
+    M_p = put("M_p", J_p / r_bp**2)
+    car = params.carrier
+    r_bc = put("r_bc", car.r_bc if car.r_bc is not None else car.r_c1)
+    if interpretation == "consistent":
+        J_c_eff = car.inertia + float(np.sum(m_p * car.r_c2**2 + m_q * car.r_c1**2))
+    elif interpretation == "carrier-only":
+        J_c_eff = car.inertia
+    else:
+        J_c_eff = car.inertia + float(np.sum(m_p * car.r_c2 + m_q * car.r_c1))
+    J_c_eff = put("J_c_eff", J_c_eff)
+    M_c = put("M_c", J_c_eff / r_bc**2)
+    put("arm", r_bs * math.cos(sun.pressure_angle))
+    km_sq = np.array([s[0].mean_stiffness for s in sets])
+    km_pq = np.array([s[1].mean_stiffness for s in sets])
+    inv = 1.0 / M_s + 1.0 / M_c
+    omega_n = math.sqrt(km_sq[0] * inv) if interpretation != "as-printed" else math.sqrt(
+        km_sq[0] / inv
+    )
+    omega_n = put("omega_n", omega_n)
+    xi1 = np.array([s[0].damping_ratio for s in sets])
+    xi2 = np.array([s[1].damping_ratio for s in sets])
+    put("C_sq", 2.0 * xi1 * np.sqrt(km_sq / (1.0 / M_s + 1.0 / M_q)))
+    put("C_pq", 2.0 * xi2 * np.sqrt(km_pq / (1.0 / M_p + 1.0 / M_q)))
+    put("gamma", 1.0 / omega_n if interpretation == "as-printed" else 1.0)
+    return Derived(**values)  # type: ignore[arg-type]
+
+
+def coefficients(params: PlanetaryParams, d: Derived) -> dict[str, np.ndarray | float]:
+    """The dimensionless coefficients of Eq. (10) (see :data:`COEFFICIENT_FORMULAS`)."""
+    n = params.n_planets
+    sets = [params.planet_set(i) for i in range(n)]
+    wn2 = d.omega_n**2
+    car = params.carrier
+    lever = car.r_c1 * d.arm / (d.M_c * d.r_bc**2)
+    km_sq = np.array([s[0].mean_stiffness for s in sets])
+    km_pq = np.array([s[1].mean_stiffness for s in sets])
+    loads = params.loads
+    bc = params.b_c
+    torque_c = car.r_c1 / (d.M_c * d.r_bc**2 * wn2 * bc)
+    torque_p = 1.0 / (d.M_p * d.r_bp * wn2 * bc)
+    return {
+        "k_sq_c": lever * km_sq / wn2,
+        "c_sq_c": d.gamma * lever * d.C_sq / d.omega_n,
+        "k_sq_q": km_sq / (d.M_q * wn2),
+        "c_sq_q": d.C_sq / (d.M_q * d.omega_n),
+        "k_pq_q": km_pq / (d.M_q * wn2),
+        "c_pq_q": d.C_pq / (d.M_q * d.omega_n),
+        "k_pq_p": km_pq / (d.M_p * wn2),
+        "c_pq_p": d.C_pq / (d.M_p * d.omega_n),
+        "b_sq": np.array([s[0].backlash for s in sets]) / bc,
+        "b_pq": np.array([s[1].backlash for s in sets]) / bc,
+        "E_sq": np.array([s[0].error for s in sets]) / bc,
+        "E_pq": np.array([s[1].error for s in sets]) / bc,
+        "f_p0": loads.A1 * torque_p,
+        "f_p1": loads.B1 * torque_p,
+        "f_c0": (loads.T_D - loads.A2) * torque_c,
+        "f_c1": -loads.B2 * torque_c,
+    }

@@ -1,0 +1,161 @@
+"""Per-model compiled kernels: the RK4 template specialised to a model's right-hand side.
+
+numba cannot cache a kernel that receives the right-hand side as an argument (the function's type
+is tied to the process), so geardyn writes, once per model, a copy of
+:mod:`geardyn.solvers._kernel_template` whose import line names the model's functions, into
+``$GEARDYN_CACHE_DIR/kernels`` (default ``~/.cache/geardyn/kernels``), and imports it. The file name
+is a hash of the template and of the model's source, so an edited model gets a new kernel; numba
+caches the compiled code beside it, and a second run does not recompile. Functions that cannot be
+imported by name (defined in ``__main__`` or a notebook) get an in-memory kernel, compiled once per
+process.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import importlib.util
+import inspect
+import os
+import sys
+import tempfile
+import types
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numba
+
+from geardyn.solvers import _noop
+
+_IMPORT_MARK = "# MODEL-IMPORT"
+_PLAIN_ADAPTERS = """
+
+@nb.njit(**_JIT)
+def rhs(t, y, dy, p, s, c):
+    user_rhs(t, y, dy, p)
+
+
+@nb.njit(**_JIT)
+def observe(t, y, out, p, s, c):
+    user_observe(t, y, out, p)
+"""
+
+_LOADED: dict[tuple, types.ModuleType] = {}
+
+
+@dataclass(frozen=True)
+class KernelSource:
+    """A model's compiled functions (numba dispatchers) in the kernel interface."""
+
+    rhs: Any
+    events: Any = None
+    observe: Any = None
+    #: True for a user's ``rhs(t, y, dy, p)`` / ``observe(t, y, out, p)`` without the forcing
+    #: phase arguments; the generated kernel adapts them.
+    plain: bool = False
+
+    def functions(self) -> dict[str, Any]:
+        prefix = "user_" if self.plain else ""
+        return {
+            f"{prefix}rhs": self.rhs,
+            "events": self.events if self.events is not None else _noop.no_events,
+            f"{prefix}observe": (
+                self.observe if self.observe is not None
+                else (_noop.no_observables_plain if self.plain else _noop.no_observables)
+            ),
+        }
+
+
+def cache_dir() -> Path:
+    """Where generated kernels live: $GEARDYN_CACHE_DIR, else $XDG_CACHE_HOME/geardyn."""
+    root = os.environ.get("GEARDYN_CACHE_DIR")
+    if not root:
+        root = os.path.join(os.environ.get("XDG_CACHE_HOME", os.path.expanduser("~/.cache")),
+                            "geardyn")
+    return Path(root) / "kernels"
+
+
+def _importable(fn: Any) -> bool:
+    py = getattr(fn, "py_func", fn)
+    mod = sys.modules.get(py.__module__)
+    return (
+        mod is not None
+        and py.__module__ != "__main__"
+        and getattr(mod, "__file__", None) is not None
+        and getattr(mod, py.__name__, None) is fn
+    )
+
+
+#: Kernel templates by name: module path of a file with a ``MODEL-IMPORT`` line.
+TEMPLATES: dict[str, str] = {
+    "rk4": "geardyn.solvers._kernel_template",
+}
+
+
+def _template_text(template: str) -> str:
+    if template not in TEMPLATES:
+        raise KeyError(f"unknown kernel template {template!r}; known: {', '.join(TEMPLATES)}")
+    return inspect.getsource(importlib.import_module(TEMPLATES[template]))
+
+
+def _import_line(funcs: dict[str, Any]) -> str:
+    parts = []
+    for alias, fn in funcs.items():
+        py = fn.py_func
+        parts.append(f"from {py.__module__} import {py.__name__} as {alias}")
+    return "; ".join(parts) + "  " + _IMPORT_MARK
+
+
+def _source_digest(text: str, funcs: dict[str, Any]) -> str:
+    h = hashlib.sha256(text.encode())
+    h.update(numba.__version__.encode())
+    for fn in funcs.values():
+        path = sys.modules[fn.py_func.__module__].__file__
+        h.update(Path(path).read_bytes())
+    return h.hexdigest()[:20]
+
+
+def _replace_import(text: str, new_line: str) -> str:
+    lines = text.splitlines()
+    for k, line in enumerate(lines):
+        if line.rstrip().endswith(_IMPORT_MARK):
+            lines[k] = new_line
+            return "\n".join(lines) + "\n"
+    raise RuntimeError("kernel template has lost its MODEL-IMPORT line")
+
+
+def kernels_for(source: KernelSource, template: str = "rk4") -> types.ModuleType:
+    """The kernel module of ``template`` for a model's functions (built, written and imported on
+    first use, then kept for the process)."""
+    funcs = source.functions()
+    key = (template, source.plain, *(id(f) for f in funcs.values()))
+    if key in _LOADED:
+        return _LOADED[key]
+    text = _template_text(template)
+    if source.plain:
+        text += _PLAIN_ADAPTERS
+    if all(_importable(f) for f in funcs.values()):
+        code = _replace_import(text, _import_line(funcs))
+        digest = _source_digest(code, funcs)
+        name = f"geardyn_{template}_{digest}"
+        folder = cache_dir()
+        folder.mkdir(parents=True, exist_ok=True)
+        path = folder / f"{name}.py"
+        if not path.exists():
+            fd, tmp = tempfile.mkstemp(dir=folder, suffix=".tmp")
+            with os.fdopen(fd, "w") as fh:
+                fh.write(code)
+            os.replace(tmp, path)  # atomic: concurrent processes never see half a file
+        spec = importlib.util.spec_from_file_location(name, path)
+        module = importlib.util.module_from_spec(spec)
+        sys.modules[name] = module
+        spec.loader.exec_module(module)
+    else:
+        code = _replace_import(text, "pass  " + _IMPORT_MARK).replace(
+            "_CACHE = True", "_CACHE = False"
+        )
+        module = types.ModuleType(f"geardyn_{template}_inmemory_{len(_LOADED)}")
+        module.__dict__.update(funcs)
+        exec(compile(code, module.__name__, "exec"), module.__dict__)
+    _LOADED[key] = module
+    return module
