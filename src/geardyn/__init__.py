@@ -8,6 +8,8 @@ The public API::
     ds = geardyn.simulate(m, omega=1.1, transient=4000.0, periods=64)
 """
 
+from geardyn.analysis.bifurcation import bifurcation
+from geardyn.analysis.periodicity import classify_period
 from geardyn.errors import GeardynError, ParameterError, StudyError
 from geardyn.models.base import Model
 from geardyn.models.catt import CATTDevice, DimensionalCATT
@@ -36,6 +38,8 @@ __all__ = [
     "PlanetaryParams",
     "StudyError",
     "UserModel",
+    "bifurcation",
+    "classify_period",
     "default_steps_per_period",
     "reference_solution",
     "simulate",

@@ -1,0 +1,1 @@
+"""The ``geardyn`` command line (typer): ``geardyn --help``."""

@@ -38,6 +38,8 @@ class Model:
     observable_units: str = "1"
     omega_index: int | None = None
     kernel: KernelSource
+    #: Meshes with a backlash dead zone: (name, index of event X - b, index of event X + b).
+    meshes: tuple[tuple[str, int, int], ...] = ()
 
     # ------------------------------------------------------------------ sizes
     @property
@@ -99,6 +101,10 @@ class Model:
     def with_omega(self, omega: float) -> Model:
         """A copy with the forcing frequency set to ``omega``."""
         return self.with_params(Omega=omega)
+
+    def static_mesh_forces(self) -> np.ndarray | None:
+        """Static mesh forces (one per mesh, in observable units) for the dynamic factor, or None."""
+        return None
 
     def __repr__(self) -> str:
         return f"{type(self).__name__}(states={list(self.state_names)}, omega={self.omega:g})"

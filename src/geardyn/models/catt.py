@@ -108,6 +108,13 @@ class CATTDevice(Model):
                 f"X_{m}{i + 1}{sign}b_{m}{i + 1}" for i in range(n_sets) for m in ("sq", "pq")
                 for sign in ("-", "+")
             )
+        if self.reduced:
+            self.meshes = (("sq", 0, 1), ("pq", 2, 3))
+        else:
+            self.meshes = tuple(
+                (f"{m}{i + 1}", 4 * i + 2 * k, 4 * i + 2 * k + 1)
+                for i in range(n_sets) for k, m in enumerate(("sq", "pq"))
+            )
         self.name = "CATTDevice"
         self.kernel = _KERNEL
         self.omega_index = ck.OMEGA

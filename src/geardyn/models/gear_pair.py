@@ -62,6 +62,7 @@ class GearPair(Model):
     state_names = ("x", "v")
     event_names = ("x-b", "x+b")
     observable_names = ("F",)
+    meshes = (("mesh", 0, 1),)
     param_names = ("Omega", "zeta", "kappa", "Fm", "Fa", "kappa_phase", "error_phase", "backlash")
 
     def __init__(self, zeta: float = 0.05, kappa: float = 0.0, Fm: float = 0.1, Fa: float = 0.05,
@@ -89,6 +90,10 @@ class GearPair(Model):
         """Static deflection under the mean load, at rest."""
         fm, b = self.params[FM], self.params[BACKLASH]
         return np.array([fm + math.copysign(b, fm) if fm else 0.0, 0.0])
+
+    def static_mesh_forces(self) -> np.ndarray:
+        """Static mesh force: the mean load Fm."""
+        return np.array([self.params[FM]])
 
     def natural_frequencies(self) -> np.ndarray:
         """Linear natural frequency in contact (1 in units of the time scale)."""

@@ -126,7 +126,7 @@ def _locate(j, side_j, g0j, g1j, y0, f0, y1, f1, dt, t, p, ybuf, gbuf):
 
 
 @nb.njit(**_JIT)
-def _split_step(i, y, y_trial, p, h, omega, n_per, side, g1, ncross, work, ybuf, gbuf):
+def _split_step(i, t0, y, y_trial, p, h, omega, n_per, side, g1, ncross, work, ybuf, gbuf):
     """Finish grid step i of one lane with edge crossings located; y holds the start, and
     y_trial/g1 the unsplit trial step. Returns 1 if the split limit was reached, else 0."""
     k1 = work[0]
@@ -140,11 +140,11 @@ def _split_step(i, y, y_trial, p, h, omega, n_per, side, g1, ncross, work, ybuf,
     u = 0.0  # fraction of the grid step done
     i_mod = i % n_per
     wh = omega * h
-    t_end = (i + 1) * h
+    t_end = t0 + (i + 1) * h
     s_end = math.sin(wh * (i_mod + 1))
     c_end = math.cos(wh * (i_mod + 1))
     for _ in range(MAX_SPLITS):
-        t = (i + u) * h
+        t = t0 + (i + u) * h
         dt = (1.0 - u) * h
         s0 = math.sin(wh * (i_mod + u))
         c0 = math.cos(wh * (i_mod + u))
@@ -192,7 +192,7 @@ def _split_step(i, y, y_trial, p, h, omega, n_per, side, g1, ncross, work, ybuf,
 
 
 @nb.njit(**_JIT)
-def _block_step(i, lanes, nl, Y, Y1, K1, K2, K3, K4, TMP, P, H, OMEGA, n_per, s_tab, c_tab,
+def _block_step(i, lanes, nl, Y, Y1, K1, K2, K3, K4, TMP, P, H, OMEGA, T0, n_per, s_tab, c_tab,
                 locate, SIDE, G, NCROSS, UNRES, work, ybuf, gbuf):
     """Advance lanes[0:nl] of a block by grid step i: a lockstep RK4 trial for all lanes, then,
     for a lane whose trial crossed an edge, the step redone with the crossing located."""
@@ -206,39 +206,39 @@ def _block_step(i, lanes, nl, Y, Y1, K1, K2, K3, K4, TMP, P, H, OMEGA, n_per, s_
     ce = c_tab[j0 + 2]
     for k in range(nl):
         lane = lanes[k]
-        rhs(i * H[lane], Y[k], K1[k], P[lane], sa, ca)
+        rhs(T0[lane] + i * H[lane], Y[k], K1[k], P[lane], sa, ca)
     for k in range(nl):
         lane = lanes[k]
         hh = 0.5 * H[lane]
         for q in range(ns):
             TMP[k, q] = Y[k, q] + hh * K1[k, q]
-        rhs(i * H[lane] + hh, TMP[k], K2[k], P[lane], sb, cb)
+        rhs(T0[lane] + i * H[lane] + hh, TMP[k], K2[k], P[lane], sb, cb)
     for k in range(nl):
         lane = lanes[k]
         hh = 0.5 * H[lane]
         for q in range(ns):
             TMP[k, q] = Y[k, q] + hh * K2[k, q]
-        rhs(i * H[lane] + hh, TMP[k], K3[k], P[lane], sb, cb)
+        rhs(T0[lane] + i * H[lane] + hh, TMP[k], K3[k], P[lane], sb, cb)
     for k in range(nl):
         lane = lanes[k]
         h = H[lane]
         for q in range(ns):
             TMP[k, q] = Y[k, q] + h * K3[k, q]
-        rhs((i + 1) * h, TMP[k], K4[k], P[lane], se, ce)
+        rhs(T0[lane] + (i + 1) * h, TMP[k], K4[k], P[lane], se, ce)
     for k in range(nl):
         lane = lanes[k]
         h6 = H[lane] / 6.0
         for q in range(ns):
             Y1[k, q] = Y[k, q] + h6 * (K1[k, q] + 2.0 * K2[k, q] + 2.0 * K3[k, q] + K4[k, q])
         g = G[k]
-        events((i + 1) * H[lane], Y1[k], g, P[lane])
+        events(T0[lane] + (i + 1) * H[lane], Y1[k], g, P[lane])
         crossed = False
         for j in range(g.size):
             if _side(g[j]) != SIDE[k, j]:
                 crossed = True
         if crossed and locate:
-            UNRES[lane] += _split_step(i, Y[k], Y1[k], P[lane], H[lane], OMEGA[lane], n_per,
-                                       SIDE[k], g, NCROSS[lane], work, ybuf, gbuf)
+            UNRES[lane] += _split_step(i, T0[lane], Y[k], Y1[k], P[lane], H[lane], OMEGA[lane],
+                                       n_per, SIDE[k], g, NCROSS[lane], work, ybuf, gbuf)
         else:
             if crossed:
                 for j in range(g.size):
@@ -282,6 +282,7 @@ def trajectory(p, y0, h, omega, n_per, i0, n_steps, stride, locate, bound, n_ev,
     P = p.reshape((1, p.size))
     H = np.array([h])
     OM = np.array([omega])
+    T0 = np.zeros(1)
     lanes = np.zeros(1, np.int64)
     NCROSS = np.zeros((1, max(n_ev, 1)), np.int64)
     UNRES = np.zeros(1, np.int64)
@@ -314,7 +315,7 @@ def trajectory(p, y0, h, omega, n_per, i0, n_steps, stride, locate, bound, n_ev,
                     out_g[r, q] = gbuf[0, q]
         if i == i0 + n_steps:
             break
-        _block_step(i, lanes, 1, Y, Y1, K1, K2, K3, K4, TMP, P, H, OM, n_per, s_tab, c_tab,
+        _block_step(i, lanes, 1, Y, Y1, K1, K2, K3, K4, TMP, P, H, OM, T0, n_per, s_tab, c_tab,
                     locate, SIDE, G, NCROSS, UNRES, work, ybuf, gbuf)
         done = i + 1 - i0
         if not _healthy(Y[0], bound):
@@ -324,10 +325,11 @@ def trajectory(p, y0, h, omega, n_per, i0, n_steps, stride, locate, bound, n_ev,
 
 
 @nb.njit(parallel=True, **_JIT)
-def sweep(P, Y0, H, OMEGA, n_per, n_transient, n_samples, sample_every, locate, bound, n_ev,
+def sweep(P, Y0, H, OMEGA, T0, n_per, n_transient, n_samples, sample_every, locate, bound, n_ev,
           n_obs, samples, final, status, gmin, gmax, ncross, omax, omin, orms, unresolved):
-    """Integrate every lane: ``n_transient[lane]`` grid steps, then ``n_samples`` section samples,
-    one every ``sample_every`` grid steps, with statistics over the sampled stretch.
+    """Integrate every lane from time T0[lane] (a whole number of forcing periods):
+    ``n_transient[lane]`` grid steps, then ``n_samples`` section samples, one every
+    ``sample_every`` grid steps, with statistics over the sampled stretch.
 
     Outputs (preallocated, filled here): samples[L, n_samples, ns] (NaN where diverged),
     final[L, ns], status[L], gmin/gmax[L, n_ev] (extremes of the events at grid points),
@@ -356,7 +358,7 @@ def sweep(P, Y0, H, OMEGA, n_per, n_transient, n_samples, sample_every, locate, 
             lane = first + k
             for q in range(ns):
                 Y[k, q] = Y0[lane, q]
-            events(0.0, Y[k], G[k], P[lane])
+            events(T0[lane], Y[k], G[k], P[lane])
             for j in range(n_ev):
                 SIDE[k, j] = _side(G[k, j])
                 gmin[lane, j] = np.inf
@@ -371,7 +373,7 @@ def sweep(P, Y0, H, OMEGA, n_per, n_transient, n_samples, sample_every, locate, 
             n_end[k] = n_transient[lane] + n_samples * sample_every
             max_end = max(max_end, n_end[k])
         for i in range(max_end):
-            _block_step(i, lanes, nl, Y, Y1, K1, K2, K3, K4, TMP, P, H, OMEGA, n_per, s_tab,
+            _block_step(i, lanes, nl, Y, Y1, K1, K2, K3, K4, TMP, P, H, OMEGA, T0, n_per, s_tab,
                         c_tab, locate, SIDE, G, ncross, unresolved, work, ybuf, gbuf)
             step = i + 1
             for k in range(nl):
@@ -397,7 +399,7 @@ def sweep(P, Y0, H, OMEGA, n_per, n_transient, n_samples, sample_every, locate, 
                     gmax[lane, j] = max(gmax[lane, j], G[k, j])
                 if n_obs > 0:
                     j0 = 2 * (step % n_per)
-                    observe(step * H[lane], Y[k], obuf, P[lane], s_tab[j0], c_tab[j0])
+                    observe(T0[lane] + step * H[lane], Y[k], obuf, P[lane], s_tab[j0], c_tab[j0])
                     for j in range(n_obs):
                         omax[lane, j] = max(omax[lane, j], obuf[j])
                         omin[lane, j] = min(omin[lane, j], obuf[j])

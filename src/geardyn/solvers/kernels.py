@@ -89,6 +89,7 @@ def _importable(fn: Any) -> bool:
 #: Kernel templates by name: module path of a file with a ``MODEL-IMPORT`` line.
 TEMPLATES: dict[str, str] = {
     "rk4": "geardyn.solvers._kernel_template",
+    "lyapunov": "geardyn.solvers._lyapunov_template",
 }
 
 

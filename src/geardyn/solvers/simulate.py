@@ -13,7 +13,7 @@ from geardyn.solvers.kernels import kernels_for
 #: Fewest RK4 steps per forcing period.
 MIN_STEPS_PER_PERIOD = 64
 #: Default largest step as a fraction of the period of the model's fastest natural mode.
-STEPS_PER_FASTEST_MODE = 48
+STEPS_PER_FASTEST_MODE = 100
 #: States beyond this magnitude count as diverged.
 DEFAULT_BOUND = 1.0e6
 

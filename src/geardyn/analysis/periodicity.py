@@ -1,0 +1,56 @@
+"""Period classification of stroboscopic (Poincare) samples.
+
+A lane is period-k when its samples repeat after k forcing periods: for the smallest k <= max_period,
+max_i |x[i + k] - x[i]| <= tol * max(1, max_i |x[i]|) over the recorded samples (every state). Motion
+that repeats for no such k is labelled 0 (quasi-periodic or chaotic: the Lyapunov exponent separates
+the two); a diverged lane (NaN samples) is -1.
+
+The tolerance must exceed what is left of the transient (at xi = 0.05 the slowest mode of the CATT
+device decays as exp(-0.015 tau)) and the integration noise; it must stay below the distance between
+the points of a genuine period-k orbit. The default 1e-5 (relative) is tested on synthetic orbits and
+on the gear pair.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+DEFAULT_TOL = 1.0e-5
+DEFAULT_MAX_PERIOD = 16
+UNBOUNDED = -1
+APERIODIC = 0
+
+
+def classify_period(samples: np.ndarray, max_period: int = DEFAULT_MAX_PERIOD,
+                    tol: float = DEFAULT_TOL) -> np.ndarray:
+    """Period of each lane of ``samples`` (lanes, samples, states): k >= 1, 0 or -1 (see module)."""
+    x = np.asarray(samples, dtype=float)
+    if x.ndim == 2:
+        return classify_period(x[None], max_period, tol)[0]
+    lanes, n, _ = x.shape
+    if n < 2:
+        raise ValueError("period classification needs at least 2 samples per lane")
+    k_max = min(max_period, n - 1)
+    out = np.full(lanes, APERIODIC, dtype=np.int64)
+    for lane in range(lanes):
+        xl = x[lane]
+        if not np.all(np.isfinite(xl)):
+            out[lane] = UNBOUNDED
+            continue
+        scale = tol * max(1.0, float(np.max(np.abs(xl))))
+        for k in range(1, k_max + 1):
+            if np.max(np.abs(xl[k:] - xl[:-k])) <= scale:
+                out[lane] = k
+                break
+    return out
+
+
+def distinct_points(samples: np.ndarray, tol: float = DEFAULT_TOL) -> int:
+    """Number of distinct points among the samples of one lane (samples, states)."""
+    x = np.asarray(samples, dtype=float)
+    scale = tol * max(1.0, float(np.max(np.abs(x))))
+    kept: list[np.ndarray] = []
+    for row in x:
+        if not any(np.max(np.abs(row - k)) <= scale for k in kept):
+            kept.append(row)
+    return len(kept)

@@ -1,0 +1,327 @@
+"""The ``geardyn`` command line.
+
+::
+
+    geardyn params show [STUDY.toml] [--interpretation consistent|carrier-only|as-printed]
+    geardyn params save OUT.toml
+    geardyn simulate STUDY.toml --omega 1.1 [--transient T] [--periods P]
+                     [--steps-per-period N] [--out run.nc] [--plot run.png]
+
+A STUDY argument is a TOML file or the name of a built-in study (``paper_fig3``). Every expected
+error (bad parameters, missing files, invalid TOML, bad values) ends the program with one line
+``error: ...`` on stderr and exit status 2.
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+import tomllib
+from enum import StrEnum
+from pathlib import Path
+from typing import Annotated
+
+import typer
+from pydantic import ValidationError
+from rich.console import Console
+from rich.markup import escape
+from rich.table import Table
+
+from geardyn.errors import GeardynError, ParameterError, StudyError
+
+EXIT_ERROR = 2
+#: Exceptions that are the user's input, not a bug: one line on stderr, exit status 2.
+EXPECTED_ERRORS: tuple[type[BaseException], ...] = (
+    ValidationError,
+    GeardynError,
+    ValueError,
+    KeyError,
+    OSError,
+    tomllib.TOMLDecodeError,
+)
+
+app = typer.Typer(
+    name="geardyn",
+    help="Nonlinear dynamics of gear trains: the CATT planetary gear train processing device.",
+    add_completion=False,
+    no_args_is_help=True,
+    pretty_exceptions_enable=False,
+)
+params_app = typer.Typer(
+    help="Show the device's derived quantities, or write its parameters to a TOML file.",
+    no_args_is_help=True,
+)
+app.add_typer(params_app, name="params")
+
+
+class Interpretation(StrEnum):
+    consistent = "consistent"
+    carrier_only = "carrier-only"
+    as_printed = "as-printed"
+
+
+def _stdout() -> Console:
+    # Wide tables when writing to a file or pipe; the terminal's width otherwise.
+    return Console() if sys.stdout.isatty() else Console(width=130)
+
+
+def _stderr() -> Console:
+    return Console(stderr=True)
+
+
+def _version(value: bool) -> None:
+    if value:
+        from geardyn import __version__
+
+        typer.echo(f"geardyn {__version__}")
+        raise typer.Exit()
+
+
+@app.callback()
+def _root(
+    version: Annotated[
+        bool,
+        typer.Option("--version", callback=_version, is_eager=True, help="Print the version."),
+    ] = False,
+) -> None:
+    """Nonlinear dynamics of gear trains: backlash, time-varying mesh stiffness, bifurcation and
+    chaos (the CATT planetary gear train processing device, and a single gear pair)."""
+
+
+# ---------------------------------------------------------------------------- helpers
+def _load_study(source: str | None):
+    """A study from a file, a built-in study name, or (None) the paper's device."""
+    from geardyn.io.toml import builtin_study, builtin_study_names, load_study, paper_study
+
+    if source is None:
+        return paper_study()
+    path = Path(source)
+    if path.exists() or path.suffix == ".toml" or "/" in source:
+        return load_study(path)
+    if source in builtin_study_names():
+        return builtin_study(source)
+    raise FileNotFoundError(2, "No such file or built-in study", source)
+
+
+def _fmt(value: float) -> str:
+    return f"{value + 0.0:.6g}"  # + 0.0 turns -0.0 into 0.0
+
+
+def _fmt_value(value) -> str:
+    import numpy as np
+
+    arr = np.atleast_1d(np.asarray(value, dtype=float))
+    if arr.size == 1:
+        return _fmt(float(arr[0]))
+    if np.all(arr == arr[0]):
+        return f"{_fmt(float(arr[0]))} (each of {arr.size})"
+    return ", ".join(_fmt(float(v)) for v in arr)
+
+
+# ---------------------------------------------------------------------------- params
+@params_app.command("show")
+def params_show(
+    study: Annotated[
+        str | None,
+        typer.Argument(help="Study TOML file or built-in study name (default: the paper's)."),
+    ] = None,
+    interpretation: Annotated[
+        Interpretation | None,
+        typer.Option(help="How to read the paper's ambiguous formulas (default: the study's)."),
+    ] = None,
+) -> None:
+    """Print every derived quantity and dimensionless coefficient, omega_n and the natural
+    frequencies."""
+    from geardyn.models.derived import COEFFICIENT_FORMULAS, DERIVED_FORMULAS
+
+    s = _load_study(study)
+    interp = interpretation.value if interpretation is not None else None
+    model = s.build_model(interpretation=interp)
+    out = _stdout()
+    out.print(f"[bold]study[/bold] {escape(s.study.name)}: "
+              f"{escape(s.study.description or s.study.model)}")
+    if s.study.model == "gear_pair":
+        table = Table(title="GearPair parameters (dimensionless)")
+        table.add_column("name")
+        table.add_column("value", justify="right")
+        for name, value in zip(model.param_names, model.params, strict=True):
+            table.add_row(name, _fmt(float(value)))
+        out.print(table)
+        out.print("natural frequency (in contact): 1 (unit of dimensionless time)")
+        return
+
+    out.print(f"[bold]interpretation[/bold] {model.interpretation}")
+    table = Table(title="Derived quantities (SI)")
+    table.add_column("name", no_wrap=True)
+    table.add_column("value", justify="right")
+    table.add_column("unit", no_wrap=True)
+    table.add_column("formula")
+    values = model.derived.as_dict()
+    overridden = set(s.planetary_params.derived)
+    for name, (unit, formula) in DERIVED_FORMULAS.items():
+        note = " [overridden]" if name in overridden else ""
+        table.add_row(name, _fmt_value(values[name]), escape(unit), escape(formula + note))
+    out.print(table)
+
+    table = Table(title="Dimensionless coefficients of Eq. (10)")
+    table.add_column("name", no_wrap=True)
+    table.add_column("value", justify="right")
+    table.add_column("formula")
+    for name, formula in COEFFICIENT_FORMULAS.items():
+        table.add_row(name, _fmt_value(model.coefficients[name]), escape(formula))
+    out.print(table)
+
+    omega_n = model.omega_n
+    out.print(
+        f"omega_n = {_fmt(omega_n)} rad/s  (f_n = {_fmt(omega_n / (2 * math.pi))} Hz;"
+        " the unit of dimensionless time tau = omega_n t)"
+    )
+    table = Table(title="Natural frequencies of the linearised device (mean stiffness, b = 0)")
+    table.add_column("mode", justify="right")
+    table.add_column("omega / omega_n", justify="right")
+    table.add_column(escape("omega [rad/s]"), justify="right")
+    table.add_column(escape("f [Hz]"), justify="right")
+    for k, w in enumerate(model.natural_frequencies(), start=1):
+        table.add_row(str(k), _fmt(w), _fmt(w * omega_n), _fmt(w * omega_n / (2 * math.pi)))
+    out.print(table)
+    forces = model.static_mesh_forces()
+    names = ", ".join(
+        f"{n} = {_fmt(f)} N" for n, f in zip(model.observable_names, forces, strict=True)
+    )
+    out.print(f"static mesh forces under the mean loads: {names}")
+
+
+@params_app.command("save")
+def params_save(
+    out: Annotated[Path, typer.Argument(help="The TOML file to write.")],
+    force: Annotated[bool, typer.Option("--force", help="Overwrite an existing file.")] = False,
+) -> None:
+    """Write the paper's parameters in full form (SI units) as a study file: a template."""
+    from geardyn.io.toml import paper_study, save_study
+
+    if out.exists() and not force:
+        raise ParameterError("OUT", str(out), "file exists (use --force to overwrite)")
+    save_study(paper_study(), out)
+    typer.echo(f"wrote {out}")
+
+
+# ---------------------------------------------------------------------------- simulate
+_PLOT_SUFFIXES = (".png", ".pdf", ".svg")
+
+
+@app.command()
+def simulate(
+    study: Annotated[str, typer.Argument(help="Study TOML file or built-in study name.")],
+    omega: Annotated[
+        float | None,
+        typer.Option(help="Mesh frequency Omega = omega/omega_n (default: the study's run.omega)."),
+    ] = None,
+    transient: Annotated[
+        float | None, typer.Option(help="Discarded time, dimensionless (default: run.transient).")
+    ] = None,
+    periods: Annotated[
+        int | None, typer.Option(help="Forcing periods recorded (default: run.periods).")
+    ] = None,
+    steps_per_period: Annotated[
+        int | None, typer.Option(help="RK4 steps per forcing period (default: automatic).")
+    ] = None,
+    interpretation: Annotated[
+        Interpretation | None, typer.Option(help="Interpretation (default: the study's).")
+    ] = None,
+    state: Annotated[
+        str | None, typer.Option(help="Coordinate to plot (default: the study's plot_state).")
+    ] = None,
+    out: Annotated[Path | None, typer.Option(help="NetCDF file to write (.nc).")] = None,
+    plot: Annotated[Path | None, typer.Option(help="Figure to write (.png, .pdf or .svg).")] = None,
+) -> None:
+    """Simulate a study at one mesh frequency; save the time history and a figure."""
+    from geardyn.io.netcdf import save_dataset
+    from geardyn.plotting.simulation import count_distinct
+    from geardyn.solvers.simulate import simulate as run_simulation
+
+    s = _load_study(study)
+    om = omega if omega is not None else s.run.omega
+    if om is None:
+        raise StudyError("--omega: not given, and the study has no run.omega")
+    if not (math.isfinite(om) and om > 0):
+        raise ParameterError("--omega", om, "must be a positive finite number")
+    if plot is not None and plot.suffix.lower() not in _PLOT_SUFFIXES:
+        raise ParameterError("--plot", str(plot), f"suffix must be one of {_PLOT_SUFFIXES}")
+    tr = s.run.transient if transient is None else transient
+    n_periods = s.run.periods if periods is None else periods
+    spp = s.run.steps_per_period if steps_per_period is None else steps_per_period
+    plot_state = state or s.plot_state
+    interp = interpretation.value if interpretation is not None else None
+    model = s.build_model(interpretation=interp, omega=om)
+    for path in (out, plot):
+        if path is not None:
+            path.parent.mkdir(parents=True, exist_ok=True)
+
+    err = _stderr()
+    with err.status(f"simulating {s.study.name} at Omega = {om:g} (the first run compiles)"):
+        ds = run_simulation(model, omega=om, transient=tr, periods=n_periods,
+                            steps_per_period=spp)
+    if plot is not None:
+        from geardyn.plotting.simulation import resolve_state
+
+        try:
+            resolve_state(ds, plot_state)
+        except ValueError as exc:
+            raise ParameterError("study.plot_state", plot_state, str(exc)) from None
+    ds.attrs["study"] = s.study.name
+    written = []
+    if out is not None:
+        save_dataset(ds, out)
+        written.append(str(out))
+    if plot is not None:
+        from geardyn.plotting.simulation import plot_simulation
+
+        with err.status("plotting"):
+            plot_simulation(ds, state=plot_state, path=plot)
+        written.append(str(plot))
+
+    status = int(ds.attrs["status"])
+    distinct = count_distinct(ds["poincare"].values, tol=1e-6)
+    n_points = ds.sizes["sample"]
+    summary = (
+        f"{s.study.name}: Omega = {om:g}, status {'ok' if status == 0 else 'diverged'}, "
+        f"{distinct} distinct Poincaré point{'s' if distinct != 1 else ''} of {n_points} "
+        f"(tol 1e-6), {ds.attrs['steps_per_period']} steps/period"
+    )
+    summary += f"; wrote {', '.join(written)}" if written else "; nothing written"
+    typer.echo(summary)
+
+
+# ---------------------------------------------------------------------------- entry point
+def main(argv: list[str] | None = None) -> int:
+    """Run the command line; expected errors print one line ``error: ...`` and exit with 2."""
+    from geardyn.io.toml import format_error
+
+    args = sys.argv[1:] if argv is None else list(argv)
+    if not args:
+        args = ["--help"]
+    try:
+        rv = app(args=args, prog_name="geardyn", standalone_mode=False)
+        code = rv if isinstance(rv, int) else 0
+    except typer.Exit as exc:
+        code = exc.exit_code
+    except typer.Abort:
+        print("error: aborted", file=sys.stderr)
+        code = 1
+    except KeyboardInterrupt:
+        print("error: interrupted", file=sys.stderr)
+        code = 130
+    except typer.TyperException as exc:  # usage errors: bad options or arguments
+        ctx = getattr(exc, "ctx", None)
+        hint = f" (try '{ctx.command_path} --help')" if ctx is not None else ""
+        message = " ".join(exc.format_message().split())
+        print(f"error: {message}{hint}", file=sys.stderr)
+        code = getattr(exc, "exit_code", EXIT_ERROR) or EXIT_ERROR
+    except EXPECTED_ERRORS as exc:
+        print(f"error: {format_error(exc)}", file=sys.stderr)
+        code = EXIT_ERROR
+    sys.exit(code)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,501 @@
+"""Parameter and study files in TOML.
+
+A *parameter file* holds the fields of :class:`~geardyn.PlanetaryParams` as nested tables (SI
+floats, angles in rad; unit strings such as ``"50 um"`` are accepted on input).
+:func:`save_params` writes floats with ``repr`` precision, so a load-save round trip is lossless.
+
+A *study file* holds the device parameters plus run settings::
+
+    [study]
+    name = "fig3"
+    description = "Paper Fig. 3"
+    model = "catt"                  # or "gear_pair"
+    interpretation = "consistent"   # consistent | carrier-only | as-printed
+    plot_state = "X_sq"             # the coordinate figures show
+    [params]                        # PlanetaryParams fields (nested tables), or:
+    base = "paper"                  # PlanetaryParams.paper() ...
+    [params.changes]                # ... with changes by the paper's names (xi1, backlash, B1, ...)
+    xi1 = 0.05
+    [run]                           # optional: omega, transient, periods, steps_per_period
+    transient = 4000.0
+    [sweep]                         # optional: param, start, stop, num, continuation
+
+For ``model = "gear_pair"`` the ``[params]`` table holds :class:`~geardyn.GearPair` arguments
+(``zeta``, ``kappa``, ``Fm``, ``Fa``, ``Omega``, ``kappa_phase``, ``error_phase``, ``backlash``).
+
+Every error names the field path and the value; :func:`format_error` renders any expected error
+as one line.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import tempfile
+import tomllib
+from importlib import resources
+from pathlib import Path
+from typing import Any, Literal
+
+import tomli_w
+from pydantic import (
+    BaseModel,
+    ConfigDict,
+    Field,
+    PrivateAttr,
+    ValidationError,
+    model_validator,
+)
+from pydantic_core import InitErrorDetails, PydanticCustomError
+
+from geardyn.errors import ParameterError, StudyError
+from geardyn.models.derived import INTERPRETATIONS
+from geardyn.models.params import PAPER_NAMES, Angle, PlanetaryParams
+
+__all__ = [
+    "GearPairParams",
+    "PaperBase",
+    "RunSettings",
+    "Study",
+    "StudyInfo",
+    "SweepSettings",
+    "builtin_study",
+    "builtin_study_names",
+    "format_error",
+    "load_params",
+    "load_study",
+    "save_params",
+    "save_study",
+]
+
+_CONFIG = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
+
+_HEADER = (
+    "# geardyn {what} (TOML). Plain numbers are SI: m, kg, kg m^2, N/m, N m; angles in rad.\n"
+    "# Unit strings such as \"50 um\" or \"20 deg\" are accepted on input.\n\n"
+)
+
+Model = Literal["catt", "gear_pair"]
+DEFAULT_PLOT_STATE: dict[str, str] = {"catt": "X_sq", "gear_pair": "x"}
+
+
+# --------------------------------------------------------------------------- study schema
+class StudyInfo(BaseModel):
+    """The ``[study]`` table: what the study is and how to read the model."""
+
+    model_config = _CONFIG
+
+    name: str = Field("unnamed", min_length=1, description="short name")
+    description: str = Field("", description="one-line description")
+    model: Model = Field("catt", description="catt (the paper's device) or gear_pair")
+    interpretation: Literal["consistent", "carrier-only", "as-printed"] = Field(
+        "consistent", description="how to read the paper's ambiguous formulas (catt only)"
+    )
+    plot_state: str | None = Field(
+        None, description="coordinate shown in figures; default X_sq (catt) or x (gear_pair)"
+    )
+
+
+class RunSettings(BaseModel):
+    """The ``[run]`` table: defaults of ``geardyn simulate`` (command-line options win)."""
+
+    model_config = _CONFIG
+
+    omega: float | None = Field(None, gt=0, description="mesh frequency Omega = omega/omega_n")
+    transient: float = Field(4000.0, ge=0, description="discarded time, dimensionless tau")
+    periods: int = Field(64, ge=1, description="forcing periods recorded")
+    steps_per_period: int | None = Field(None, ge=4, description="RK4 steps per period")
+
+
+class SweepSettings(BaseModel):
+    """The ``[sweep]`` table: a parameter sweep for bifurcation diagrams."""
+
+    model_config = _CONFIG
+
+    param: str = Field("Omega", min_length=1, description="swept parameter (Omega or paper name)")
+    start: float
+    stop: float
+    num: int = Field(ge=2, description="number of parameter values")
+    continuation: bool = Field(
+        False, description="start each point from the previous point's final state"
+    )
+
+
+class PaperBase(BaseModel):
+    """``[params]`` as ``base = "paper"`` plus ``[params.changes]`` by the paper's names."""
+
+    model_config = _CONFIG
+
+    base: Literal["paper"]
+    changes: dict[str, Any] = Field(default_factory=dict)
+
+    def resolve(self) -> PlanetaryParams:
+        return PlanetaryParams.paper(**self.changes)
+
+
+class GearPairParams(BaseModel):
+    """``[params]`` of a ``gear_pair`` study: the arguments of :class:`~geardyn.GearPair`."""
+
+    model_config = _CONFIG
+
+    zeta: float = Field(0.05, ge=0, description="damping ratio")
+    kappa: float = Field(0.0, gt=-1, lt=1, description="relative stiffness variation")
+    Fm: float = Field(0.1, description="mean load")
+    Fa: float = Field(0.05, description="transmission-error amplitude")
+    Omega: float = Field(1.0, ge=0, description="mesh frequency")
+    kappa_phase: Angle = 0.0
+    error_phase: Angle = 0.0
+    backlash: float = Field(1.0, ge=0, description="backlash half-width")
+
+
+def _relocated(exc: ValidationError, loc_of) -> ValidationError:
+    """``exc`` with every error's location mapped by ``loc_of(loc) -> loc``."""
+    details: list[InitErrorDetails] = []
+    seen: set[tuple] = set()
+    for err in exc.errors(include_url=False):
+        loc = tuple(loc_of(tuple(err["loc"])))
+        if (loc, err["msg"]) in seen:  # one change can set several fields alike
+            continue
+        seen.add((loc, err["msg"]))
+        details.append(
+            InitErrorDetails(
+                type=PydanticCustomError(err["type"], "{msg}", {"msg": err["msg"]}),
+                loc=loc,
+                input=err.get("input"),
+            )
+        )
+    return ValidationError.from_exception_data(exc.title, details)
+
+
+def _resolve_paper(data: dict[str, Any]) -> tuple[PaperBase, PlanetaryParams]:
+    try:
+        spec = PaperBase.model_validate(data)
+    except ValidationError as exc:
+        raise _relocated(exc, lambda loc: ("params", *loc)) from None
+    known = set(PAPER_NAMES) | set(PlanetaryParams.model_fields)
+    unknown = [k for k in spec.changes if k not in known]
+    if unknown:
+        details = [
+            InitErrorDetails(
+                type=PydanticCustomError(
+                    "unknown_name",
+                    "unknown parameter name; known: {known}",
+                    {"known": ", ".join(sorted(PAPER_NAMES))},
+                ),
+                loc=("params", "changes", k),
+                input=spec.changes[k],
+            )
+            for k in unknown
+        ]
+        raise ValidationError.from_exception_data("Study", details)
+    try:
+        params = spec.resolve()
+    except ValidationError as exc:
+
+        def loc_of(loc: tuple) -> tuple:
+            for name in spec.changes:
+                for path in PAPER_NAMES.get(name, ((name,),)):
+                    if loc[: len(path)] == path:
+                        return ("params", "changes", name, *loc[len(path):])
+            return ("params", *loc)
+
+        raise _relocated(exc, loc_of) from None
+    return spec, params
+
+
+class Study(BaseModel):
+    """A study: device parameters plus run and sweep settings (one TOML file).
+
+    ``params`` is a :class:`PlanetaryParams` (full form), a :class:`PaperBase` (paper values plus
+    changes) or, for ``model = "gear_pair"``, a :class:`GearPairParams`.
+    """
+
+    model_config = _CONFIG
+
+    study: StudyInfo = Field(default_factory=StudyInfo)
+    params: PlanetaryParams | PaperBase | GearPairParams
+    run: RunSettings = Field(default_factory=RunSettings)
+    sweep: SweepSettings | None = None
+
+    _planetary: PlanetaryParams | None = PrivateAttr(None)
+
+    @model_validator(mode="before")
+    @classmethod
+    def _dispatch_params(cls, data: Any) -> Any:
+        """Validate ``params`` with the class the model kind calls for, so that errors name
+        ``params.<field path>`` rather than every member of the union."""
+        if not isinstance(data, dict) or "params" not in data:
+            return data
+        raw = data["params"]
+        info = data.get("study", {})
+        kind = info.get("model", "catt") if isinstance(info, dict) else getattr(info, "model", "")
+        if isinstance(raw, BaseModel):
+            return data
+        if not isinstance(raw, dict):
+            return data  # pydantic reports the wrong type
+        out = dict(data)
+        if kind == "gear_pair":
+            target: type[BaseModel] = GearPairParams
+        elif "base" in raw:
+            out["params"] = _resolve_paper(raw)[0]
+            return out
+        else:
+            target = PlanetaryParams
+        try:
+            out["params"] = target.model_validate(raw)
+        except ValidationError as exc:
+            raise _relocated(exc, lambda loc: ("params", *loc)) from None
+        return out
+
+    @model_validator(mode="after")
+    def _check_consistency(self) -> Study:
+        gear_pair = isinstance(self.params, GearPairParams)
+        if gear_pair != (self.study.model == "gear_pair"):
+            raise ValueError(
+                f"study.model is {self.study.model!r} but [params] holds "
+                f"{'GearPair' if gear_pair else 'PlanetaryParams'} parameters"
+            )
+        if isinstance(self.params, PaperBase):
+            self._planetary = _resolve_paper(self.params.model_dump())[1]
+        elif isinstance(self.params, PlanetaryParams):
+            self._planetary = self.params
+        return self
+
+    # ------------------------------------------------------------------ accessors
+    @property
+    def planetary_params(self) -> PlanetaryParams:
+        """The resolved device parameters (catt studies)."""
+        if self._planetary is None:
+            raise StudyError(f"study {self.study.name!r} is a gear_pair study: no device params")
+        return self._planetary
+
+    @property
+    def plot_state(self) -> str:
+        return self.study.plot_state or DEFAULT_PLOT_STATE[self.study.model]
+
+    def build_model(self, interpretation: str | None = None, omega: float | None = None):
+        """The study's model: a :class:`~geardyn.CATTDevice` or a :class:`~geardyn.GearPair`.
+
+        ``interpretation`` and ``omega`` override the study's (``omega`` defaults to
+        ``run.omega``, else 1).
+        """
+        from geardyn.models.catt import CATTDevice
+        from geardyn.models.gear_pair import GearPair
+
+        if interpretation is not None and interpretation not in INTERPRETATIONS:
+            raise ParameterError(
+                "interpretation", interpretation, f"must be one of {', '.join(INTERPRETATIONS)}"
+            )
+        om = omega if omega is not None else self.run.omega
+        if isinstance(self.params, GearPairParams):
+            kwargs = self.params.model_dump()
+            if om is not None:
+                kwargs["Omega"] = float(om)
+            return GearPair(**kwargs)
+        return CATTDevice(
+            self.planetary_params,
+            interpretation or self.study.interpretation,  # type: ignore[arg-type]
+            omega=1.0 if om is None else float(om),
+        )
+
+    def to_toml_dict(self) -> dict[str, Any]:
+        """The study as TOML-ready tables (``None`` values left out)."""
+        return self.model_dump(exclude_none=True)
+
+
+# --------------------------------------------------------------------------- reading
+def _is_text(source: object) -> bool:
+    return isinstance(source, str) and ("\n" in source or source.lstrip().startswith("["))
+
+
+def _read_toml(source: str | os.PathLike[str]) -> tuple[dict[str, Any], str]:
+    """Parse TOML text or a file; returns the document and a label for error messages."""
+    if _is_text(source):
+        text, label = str(source), "<text>"
+    else:
+        path = Path(source)
+        label = str(path)
+        if path.is_dir():
+            raise StudyError(f"{label}: is a directory, not a TOML file")
+        text = path.read_text(encoding="utf-8")  # FileNotFoundError names the file
+    try:
+        return tomllib.loads(text), label
+    except tomllib.TOMLDecodeError as exc:
+        raise StudyError(f"{label}: invalid TOML: {exc}") from None
+
+
+_STUDY_KEYS = {"study", "params", "run", "sweep"}
+
+
+def load_params(path_or_text: str | os.PathLike[str]) -> PlanetaryParams:
+    """Read :class:`PlanetaryParams` from a TOML file or TOML text.
+
+    The document holds the parameter fields at the top level, or a ``[params]`` table as in a
+    study file (full form or ``base = "paper"`` plus changes).
+    """
+    doc, _ = _read_toml(path_or_text)
+    if "params" in doc:
+        return load_study_dict({"params": doc["params"]}).planetary_params
+    return PlanetaryParams.model_validate(doc)
+
+
+def load_study_dict(doc: dict[str, Any]) -> Study:
+    """A :class:`Study` from a parsed document; a bare parameter document becomes ``[params]``."""
+    if doc and not (set(doc) & _STUDY_KEYS):
+        doc = {"params": doc}
+    return Study.model_validate(doc)
+
+
+def load_study(path_or_text: str | os.PathLike[str]) -> Study:
+    """Read a study from a TOML file or TOML text (see the module docs for the format).
+
+    A file without ``[study]`` gets the file's stem as its name; a bare parameter file (fields at
+    the top level) is read as a study of the paper's device with those parameters.
+    """
+    doc, label = _read_toml(path_or_text)
+    if not doc:
+        raise StudyError(f"{label}: empty study file (needs at least a [params] table)")
+    if doc and not (set(doc) & _STUDY_KEYS):
+        doc = {"params": doc}
+    if not _is_text(path_or_text) and isinstance(doc.get("study", {}), dict):
+        doc.setdefault("study", {}).setdefault("name", Path(path_or_text).stem)
+    return Study.model_validate(doc)
+
+
+# --------------------------------------------------------------------------- writing
+def _write_atomic(path: str | os.PathLike[str], text: str) -> Path:
+    path = Path(path)
+    folder = path.parent if str(path.parent) else Path(".")
+    fd, tmp = tempfile.mkstemp(dir=folder, prefix=f".{path.name}.", suffix=".tmp")
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8") as fh:
+            fh.write(text)
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(tmp, 0o666 & ~umask)
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
+    return path
+
+
+def _check_finite(obj: Any, where: str = "") -> None:
+    if isinstance(obj, float) and not math.isfinite(obj):
+        raise ParameterError(where or "value", obj, "TOML files hold finite numbers only")
+    if isinstance(obj, dict):
+        for k, v in obj.items():
+            _check_finite(v, f"{where}.{k}" if where else str(k))
+    elif isinstance(obj, list | tuple):
+        for i, v in enumerate(obj):
+            _check_finite(v, f"{where}[{i}]")
+
+
+def params_to_toml(params: PlanetaryParams) -> str:
+    """TOML text of ``params`` in full form (SI floats with repr precision, angles in rad)."""
+    data = params.model_dump(exclude_none=True)
+    _check_finite(data)
+    return _HEADER.format(what="device parameters") + tomli_w.dumps(data)
+
+
+def save_params(params: PlanetaryParams, path: str | os.PathLike[str]) -> Path:
+    """Write ``params`` to a TOML file (atomically); :func:`load_params` reads it back equal."""
+    return _write_atomic(path, params_to_toml(params))
+
+
+def study_to_toml(study: Study) -> str:
+    data = study.to_toml_dict()
+    _check_finite(data)
+    return _HEADER.format(what="study") + tomli_w.dumps(data)
+
+
+def save_study(study: Study, path: str | os.PathLike[str]) -> Path:
+    """Write ``study`` to a TOML file (atomically); :func:`load_study` reads it back equal."""
+    return _write_atomic(path, study_to_toml(study))
+
+
+def paper_study(name: str = "paper") -> Study:
+    """A study of the paper's device (Tables 1 and 2) in full form, e.g. as a template."""
+    return Study(
+        study=StudyInfo(
+            name=name,
+            description="The paper's device, Tables 1 and 2 (xi1 = xi2 = 0.05)",
+            plot_state="X_sq",
+        ),
+        params=PlanetaryParams.paper(),
+    )
+
+
+# --------------------------------------------------------------------------- built-in studies
+def builtin_study_names() -> list[str]:
+    """Names of the studies shipped in :mod:`geardyn.studies`."""
+    root = resources.files("geardyn.studies")
+    return sorted(p.name[:-5] for p in root.iterdir() if p.name.endswith(".toml"))
+
+
+def builtin_study_text(name: str) -> str:
+    res = resources.files("geardyn.studies") / f"{name}.toml"
+    if not res.is_file():
+        known = ", ".join(builtin_study_names()) or "none"
+        raise StudyError(f"no built-in study {name!r}; known: {known}")
+    return res.read_text(encoding="utf-8")
+
+
+def builtin_study(name: str) -> Study:
+    """A study shipped with geardyn, by name (``"paper_fig3"``)."""
+    return load_study(builtin_study_text(name))
+
+
+# --------------------------------------------------------------------------- errors
+def _loc_text(loc: tuple) -> str:
+    out = ""
+    for part in loc:
+        if isinstance(part, int):
+            out += f"[{part}]"
+        else:
+            out += ("." if out else "") + str(part)
+    return out
+
+
+def _one_validation_error(err: dict[str, Any]) -> str:
+    msg = str(err.get("msg", "invalid value"))
+    for prefix in ("Value error, ", "Assertion failed, "):
+        if msg.startswith(prefix):
+            msg = msg[len(prefix):]
+    if err.get("type") == "extra_forbidden":
+        msg = "unknown key (not a field of this table)"
+    where = _loc_text(tuple(err.get("loc", ())))
+    text = f"{where}: {msg}" if where else msg
+    value = err.get("input")
+    if err.get("type") != "missing" and not isinstance(value, dict | list | BaseModel) and (
+        "(got " not in msg
+    ):
+        text += f" (got {value!r})"
+    return text
+
+
+def format_error(exc: BaseException) -> str:
+    """One line describing an expected error: the field path and the value where known.
+
+    >>> format_error(ParameterError("sun_mesh.mean_stiffness", -1.0, "must be > 0"))
+    'sun_mesh.mean_stiffness: must be > 0 (got -1.0)'
+    """
+    if isinstance(exc, ValidationError):
+        errors = exc.errors(include_url=False)
+        text = _one_validation_error(errors[0]) if errors else str(exc)
+        if len(errors) > 1:
+            text += f" (and {len(errors) - 1} more error{'s' if len(errors) > 2 else ''})"
+    elif isinstance(exc, tomllib.TOMLDecodeError):
+        text = f"invalid TOML: {exc}"
+    elif isinstance(exc, KeyError):
+        text = str(exc.args[0]) if exc.args else "unknown key"
+    elif isinstance(exc, FileNotFoundError):
+        text = f"file not found: {exc.filename}" if exc.filename else str(exc)
+    elif isinstance(exc, IsADirectoryError | PermissionError | NotADirectoryError):
+        text = f"{exc.strerror}: {exc.filename}" if exc.filename else str(exc)
+    elif isinstance(exc, OSError):
+        text = f"{exc.strerror or exc}: {exc.filename}" if exc.filename else str(exc)
+    else:
+        text = str(exc) or type(exc).__name__
+    return " ".join(text.split())

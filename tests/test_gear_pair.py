@@ -1,0 +1,82 @@
+"""The single-mesh gear pair: onset of tooth separation against linear theory, and RK4 against
+the adaptive reference."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from scipy.optimize import brentq
+
+import geardyn
+
+ZETA, FM, FA, B = 0.05, 0.1, 0.05, 1.0
+
+
+def linear_response(omega: float) -> complex:
+    """Complex amplitude H of the steady response u = x - b = Fm + Re(H e^{i Omega tau}) of
+    u'' + 2 zeta u' + u = Fm + Fa Omega^2 cos(Omega tau) (teeth in contact, kappa = 0)."""
+    return FA * omega**2 / (1.0 - omega**2 + 2j * ZETA * omega)
+
+
+def onset() -> float:
+    """Lowest Omega where the linear amplitude |H| reaches the mean deflection Fm, solved here
+    from |H| = Fm, cross-checked against GearPair.separation_onset."""
+    g = geardyn.GearPair(zeta=ZETA, kappa=0.0, Fm=FM, Fa=FA)
+    w = brentq(lambda om: abs(linear_response(om)) - FM, 0.3, 1.0, xtol=1e-14)
+    w_lib = brentq(lambda om: float(g.separation_onset(np.array([om]))[0]), 0.3, 1.0,
+                   xtol=1e-14)
+    assert w_lib == pytest.approx(w, rel=1e-10)
+    return w
+
+
+def test_separation_onset_closed_form():
+    # Fa Omega^2 = Fm |1 - Omega^2 + 2 i zeta Omega|: a quadratic in Omega^2
+    # (Fa^2 - Fm^2) W^2 - Fm^2 (4 zeta^2 - 2) W - Fm^2 = 0, W = Omega^2
+    a, b, c = FA**2 - FM**2, -(FM**2) * (4 * ZETA**2 - 2), -(FM**2)
+    roots = np.roots([a, b, c])
+    w_closed = math.sqrt(min(r.real for r in roots if r.real > 0))
+    assert onset() == pytest.approx(w_closed, rel=1e-10)
+
+
+@pytest.mark.parametrize("side", [-1, 1])
+def test_separation_onset_matches_linear_theory(side):
+    w_star = onset()
+    om = w_star * (1.0 + 0.02 * side)
+    g = geardyn.GearPair(zeta=ZETA, kappa=0.0, Fm=FM, Fa=FA, backlash=B, Omega=om)
+    H = linear_response(om)
+    # start on the linear steady state (phase 0 at tau = 0), so that below the onset the
+    # transient cannot knock the pair onto a coexisting impacting branch
+    y0 = np.array([B + FM + H.real, -om * H.imag])
+    ds = geardyn.simulate(g, transient=600.0, periods=8, y0=y0)
+    x = ds["x"].values
+    gap = x.min() - B
+    crossed = int(ds["edge_crossings"].sel(event="x-b"))
+    if side < 0:
+        # stays in contact, on the linear solution: min x - b = Fm - |H| (grid-sampled min)
+        n = ds.attrs["steps_per_period"]
+        assert gap >= 0.0 and crossed == 0
+        assert gap == pytest.approx(FM - abs(H), abs=abs(H) * (1 - math.cos(math.pi / n)) + 1e-7)
+        assert 0.5 * np.ptp(x) == pytest.approx(abs(H), rel=2e-3)
+    else:
+        assert gap < 0.0 and crossed > 0
+
+
+@pytest.mark.parametrize(("kappa", "omega"), [(0.0, 1.0), (0.2, 0.9), (0.2, 2.0)])
+def test_gear_pair_rk4_matches_reference(kappa, omega):
+    g = geardyn.GearPair(zeta=ZETA, kappa=kappa, Fm=FM, Fa=FA, Omega=omega)
+    y0 = geardyn.simulate(g, transient=1000.0, periods=1, steps_per_period=1024)[
+        "poincare"].values[-1]
+    T = 2 * math.pi / omega
+    ref = [y0]
+    for k in range(10):  # segment by segment: every sample is a step end of DOP853
+        ref.append(geardyn.reference_solution(g, ref[-1], [(k + 1) * T], t0=k * T, rtol=1e-13,
+                                              atol=1e-14)[0])
+    ref = np.array(ref)
+    ds = geardyn.simulate(g, periods=10, y0=y0)
+    assert np.max(np.abs(ds["poincare"].values - ref)) < 1e-6
+    errs = [np.max(np.abs(geardyn.simulate(g, periods=10, y0=y0, steps_per_period=n)[
+        "poincare"].values - ref)) for n in (32, 64, 128, 256)]
+    p = -np.polyfit(np.log([32, 64, 128, 256]), np.log(errs), 1)[0]
+    assert p > 3.7

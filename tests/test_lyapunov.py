@@ -1,0 +1,200 @@
+"""Lyapunov exponents from the tangent equations (geardyn.analysis.lyapunov)."""
+
+from __future__ import annotations
+
+import math
+
+import numba as nb
+import numpy as np
+import pytest
+
+import geardyn
+from geardyn.analysis.lyapunov import lyapunov, lyapunov_lanes
+
+
+@nb.njit(cache=True)
+def lorenz_rhs(t, y, dy, p):
+    dy[0] = p[0] * (y[1] - y[0])
+    dy[1] = y[0] * (p[1] - y[2]) - y[1]
+    dy[2] = y[0] * y[1] - p[2] * y[2]
+
+
+@nb.njit(cache=True)
+def forced_oscillator_rhs(t, y, dy, p):
+    # x'' + 2 zeta x' + x = F cos(Omega t); p = (zeta, F, Omega)
+    dy[0] = y[1]
+    dy[1] = -2.0 * p[0] * y[1] - y[0] + p[1] * math.cos(p[2] * t)
+
+
+LORENZ = np.array([10.0, 28.0, 8.0 / 3.0])
+#: Largest Lorenz exponent at sigma=10, rho=28, beta=8/3 (Viswanath 1998: 0.9056).
+LORENZ_LAMBDA1 = 0.9056
+#: A chaotic gear pair with backlash (found by a scan with lyapunov_lanes; chaos confirmed
+#: independently in test_gear_pair_chaotic_positive by the divergence of nearby trajectories).
+CHAOTIC = dict(zeta=0.02, kappa=0.2, Fm=0.1, Fa=0.3, Omega=0.92)
+#: A period-1 orbit with contact loss (two edge crossings per period) and real Floquet
+#: multipliers, so its largest exponent (-0.0167) differs from -zeta and depends on the impacts.
+IMPACTING = dict(zeta=0.1, kappa=0.2, Fm=0.1, Fa=0.15, Omega=1.15)
+
+
+def lorenz_model():
+    return geardyn.UserModel(lorenz_rhs, n_states=3, params=LORENZ, period=None,
+                             state_names=["x", "y", "z"])
+
+
+def rk4_polynomial(Z):
+    """The RK4 stability function R(Z) = I + Z + Z^2/2 + Z^3/6 + Z^4/24 (the exact step map of
+    a linear system)."""
+    out = np.eye(Z.shape[0])
+    term = np.eye(Z.shape[0])
+    for k in range(1, 5):
+        term = term @ Z / k
+        out = out + term
+    return out
+
+
+# ----------------------------------------------------------------------------- Lorenz
+def test_lorenz_largest_exponent():
+    lam = lyapunov(lorenz_model(), y0=[1.0, 1.0, 1.0], transient=100.0, duration=2000.0)
+    assert abs(lam - LORENZ_LAMBDA1) < 0.01 * LORENZ_LAMBDA1
+
+
+def test_lorenz_spectrum():
+    sigma, _rho, beta = LORENZ
+    lam = lyapunov(lorenz_model(), y0=[1.0, 1.0, 1.0], transient=100.0, duration=2000.0,
+                   spectrum=True)
+    assert lam.shape == (3,)
+    assert np.all(np.diff(lam) < 0)
+    assert abs(lam[0] - LORENZ_LAMBDA1) < 0.01 * LORENZ_LAMBDA1
+    assert abs(lam[1]) < 0.01  # the flow direction
+    trace = -(sigma + 1.0 + beta)  # divergence of the Lorenz field, constant
+    assert abs(lam.sum() - trace) < 0.01 * abs(trace)
+
+
+# ----------------------------------------------------------------------------- linear
+@pytest.mark.parametrize("which", ["gear_pair", "user"])
+def test_linear_oscillator_spectrum(which):
+    zeta, omega, n = 0.1, 0.7, 64
+    if which == "gear_pair":  # backlash 0 makes the dead zone g(x) = x: linear
+        model = geardyn.GearPair(zeta=zeta, kappa=0.0, backlash=0.0, Fm=0.1, Fa=0.05,
+                                 Omega=omega)
+    else:
+        model = geardyn.UserModel(forced_oscillator_rhs, 2, params=[zeta, 0.3, omega],
+                                  period=2.0 * math.pi / omega)
+    lam = lyapunov(model, y0=[0.3, 0.0], spectrum=True, steps_per_period=n)
+    # the sum is log|det| of the step map per unit time: exactly that of the RK4 polynomial of
+    # h A, and -2 zeta (the trace) up to the O(h^4) error of RK4
+    A = np.array([[0.0, 1.0], [-1.0, -2.0 * zeta]])
+    h = 2.0 * math.pi / omega / n
+    discrete = math.log(abs(np.linalg.det(rk4_polynomial(h * A)))) / h
+    assert abs(lam.sum() - discrete) < 1e-9
+    assert abs(lam.sum() + 2.0 * zeta) < 1e-5
+    # underdamped: complex eigenvalues, both exponents -zeta (finite-time error ~ log(cond)/T)
+    assert np.all(np.abs(lam + zeta) < 1e-4)
+
+
+# ----------------------------------------------------------------------------- gear pair
+def test_gear_pair_periodic_negative():
+    model = geardyn.GearPair(zeta=0.05, Fm=0.1, Fa=0.05, Omega=0.5)
+    lam = lyapunov(model)
+    assert lam < -0.01
+    # a 2-state forced model: the exponents sum to the trace of J, -2 zeta, whatever the contact
+    spec = lyapunov(model, spectrum=True)
+    assert abs(spec.sum() + 2 * 0.05) < 1e-5
+    assert abs(spec[0] - lam) < 1e-9
+
+
+def test_gear_pair_chaotic_positive():
+    model = geardyn.GearPair(**CHAOTIC)
+    lam = lyapunov(model, transient=500.0, duration=5000.0)
+    assert 0.04 < lam < 0.12
+    spec = lyapunov(model, transient=500.0, duration=5000.0, spectrum=True)
+    assert abs(spec.sum() + 2 * CHAOTIC["zeta"]) < 1e-5  # trace of J, with impacts
+    # independent signal: two trajectories started 1e-9 apart on the attractor separate to O(1)
+    y_att = geardyn.simulate(model, transient=500.0, periods=1)["poincare"].values[-1]
+    a = geardyn.simulate(model, y0=y_att, periods=200)
+    b = geardyn.simulate(model, y0=y_att + np.array([1e-9, 0.0]), periods=200)
+    sep = np.abs(a["poincare"].values[:, 0] - b["poincare"].values[:, 0])
+    assert sep[:5].max() < 1e-6
+    assert sep.max() > 0.1
+
+
+def test_gear_pair_periodic_reference_not_diverging():
+    # the opposite signal for the periodic case: nearby trajectories approach each other
+    model = geardyn.GearPair(zeta=0.05, Fm=0.1, Fa=0.05, Omega=0.5)
+    y_att = geardyn.simulate(model, transient=500.0, periods=1)["poincare"].values[-1]
+    t = model.period * np.arange(40)
+    a = geardyn.reference_solution(model, y_att, t)
+    b = geardyn.reference_solution(model, y_att + np.array([1e-6, 0.0]), t)
+    sep = np.abs(a - b).max(axis=1)
+    assert sep[-1] < 1e-6 * 0.5
+
+
+# ----------------------------------------------------------------------------- steps
+def test_step_convergence_impacting_orbit():
+    # with the edge crossings located inside a step, the exponent of an impacting periodic
+    # orbit converges fast: steps_per_period 64 and 128 agree to 1e-3 relative (measured: ~1e-6)
+    model = geardyn.GearPair(**IMPACTING)
+    l1 = lyapunov(model, transient=3000.0, duration=1000.0, steps_per_period=64)
+    l2 = lyapunov(model, transient=3000.0, duration=1000.0, steps_per_period=128)
+    assert -0.1 < l1 < -0.005
+    assert abs(l1 + IMPACTING["zeta"]) > 0.05  # real multipliers: not the contact value -zeta
+    assert abs(l1 - l2) < 1e-3 * abs(l2)
+
+
+def test_step_convergence_chaotic():
+    # a chaotic exponent is a long-time average: at n and 2n the trajectories differ, so the
+    # estimates agree only to their statistical error (~2% at duration 20000, measured)
+    model = geardyn.GearPair(**CHAOTIC)
+    l1 = lyapunov(model, transient=500.0, duration=20000.0, steps_per_period=64)
+    l2 = lyapunov(model, transient=500.0, duration=20000.0, steps_per_period=128)
+    assert abs(l1 - l2) < 0.06 * abs(l2)
+
+
+# ----------------------------------------------------------------------------- lanes
+def test_lanes_match_single():
+    model = geardyn.GearPair(zeta=0.02, kappa=0.2, Fm=0.1, Fa=0.3)
+    omegas = np.array([0.5, 0.92, 1.15])
+    P = model.lane_params("Omega", omegas)
+    out = lyapunov_lanes(model, P, transient=300.0, duration=600.0, steps_per_period=64)
+    assert out.shape == (3,)
+    for om, lam in zip(omegas, out, strict=True):
+        single = lyapunov(model.with_omega(om), transient=300.0, duration=600.0,
+                          steps_per_period=64)
+        assert lam == pytest.approx(single, rel=1e-12, abs=1e-14)
+    assert out[0] < 0 < out[1]
+
+
+def test_lanes_diverged_is_nan():
+    model = geardyn.GearPair(zeta=0.05, Fm=0.1, Fa=0.05)
+    P = model.lane_params("Omega", [0.5, 0.6])
+    out = lyapunov_lanes(model, P, y0=np.array([[1.1, 0.0], [1e9, 0.0]]), transient=10.0,
+                         duration=20.0)
+    assert np.isfinite(out[0]) and np.isnan(out[1])
+
+
+def test_lanes_autonomous():
+    u = lorenz_model()
+    P = np.tile(LORENZ, (2, 1))
+    P[1, 1] = 0.5  # rho < 1: the origin is a stable node
+    out = lyapunov_lanes(u, P, y0=[1.0, 1.0, 1.0], transient=50.0, duration=500.0)
+    assert abs(out[0] - LORENZ_LAMBDA1) < 0.05
+    # largest eigenvalue of the Jacobian at the origin: the slowest decay
+    sigma, rho = LORENZ[0], 0.5
+    slow = 0.5 * (-(sigma + 1.0) + math.sqrt((sigma + 1.0) ** 2 - 4.0 * sigma * (1.0 - rho)))
+    assert abs(out[1] - slow) < 1e-3
+
+
+# ----------------------------------------------------------------------------- errors
+def test_bad_arguments():
+    g = geardyn.GearPair()
+    with pytest.raises(ValueError):
+        lyapunov(g, duration=0.0)
+    with pytest.raises(ValueError):
+        lyapunov(g, dt=0.01)
+    with pytest.raises(ValueError):
+        lyapunov(lorenz_model(), steps_per_period=64)
+    with pytest.raises(ValueError):
+        lyapunov(g, y0=[1.0, 2.0, 3.0])
+    with pytest.raises(ValueError):
+        lyapunov(g, renorm_every=0)

@@ -1,0 +1,112 @@
+"""Accuracy of the fixed-step RK4 integrator against the adaptive DOP853 reference.
+
+Order of convergence with and without located dead-zone edge crossings, and the accuracy of the
+default step choice on periodic attractors with contact loss (see docs/numerics.md).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import geardyn
+
+K_PERIODS = 10
+
+
+def ref_at(model, y0, times, t0=0.0, **kw):
+    """Reference states at ``times``, integrating segment by segment so that every requested
+    time is a step end of the adaptive integrator (its dense output is less accurate)."""
+    out = []
+    y = np.asarray(y0, dtype=float)
+    t = float(t0)
+    for tn in times:
+        if tn > t:
+            y = geardyn.reference_solution(model, y, [tn], t0=t, **kw)[0]
+            t = float(tn)
+        out.append(y.copy())
+    return np.array(out)
+
+
+def order(ns, errors) -> float:
+    """Least-squares order p of errors ~ n^-p."""
+    return -float(np.polyfit(np.log(ns), np.log(errors), 1)[0])
+
+
+def dense(lo, hi):
+    """Step counts between lo and hi, four per octave (the error without edge location depends
+    on where the crossings fall in a step, so a fit needs many step sizes)."""
+    k = np.arange(round(4 * math.log2(lo)), round(4 * math.log2(hi)) + 1)
+    return np.unique(np.round(2.0 ** (k / 4)).astype(int))
+
+
+def trajectory_errors(model, y0, ns, locate):
+    """Max Poincare-point error over K_PERIODS periods from y0, for each steps per period."""
+    T = 2 * math.pi / model.omega
+    ref = ref_at(model, y0, np.arange(K_PERIODS + 1) * T, rtol=1e-13, atol=1e-14)
+    errs = []
+    for n in ns:
+        ds = geardyn.simulate(model, periods=K_PERIODS, steps_per_period=int(n), y0=y0,
+                              locate_edges=locate)
+        errs.append(np.max(np.abs(ds["poincare"].values - ref)))
+    return np.array(errs)
+
+
+def on_attractor(model, n=1024):
+    ds = geardyn.simulate(model, transient=3000.0, periods=1, steps_per_period=n)
+    return ds["poincare"].values[-1], ds
+
+
+def test_rk4_is_fourth_order_while_teeth_stay_in_contact():
+    m = geardyn.CATTDevice(geardyn.PlanetaryParams.paper(error="0.1 um")).with_omega(1.1)
+    y0, _ = on_attractor(m, 512)
+    ds = geardyn.simulate(m, periods=K_PERIODS, y0=y0)
+    assert int(ds["edge_crossings"].sum()) == 0
+    ns = np.array([32, 64, 128, 256])
+    for locate in (True, False):
+        errs = trajectory_errors(m, y0, ns, locate)
+        assert errs[-1] < 1e-7
+        assert order(ns, errs) > 3.7
+
+
+@pytest.mark.parametrize("omega", [0.6, 1.1, 3.5])
+def test_edge_location_keeps_fourth_order_with_contact_loss(omega):
+    m = geardyn.CATTDevice(geardyn.PlanetaryParams.paper()).with_omega(omega)
+    y0, _ = on_attractor(m)
+    ds = geardyn.simulate(m, periods=K_PERIODS, y0=y0)
+    assert int(ds["edge_crossings"].sum()) >= K_PERIODS  # the teeth separate every period
+    ns_loc = dense(32, 256)
+    p_loc = order(ns_loc, trajectory_errors(m, y0, ns_loc, True))
+    ns_raw = dense(64, 1024)
+    e_raw = trajectory_errors(m, y0, ns_raw, False)
+    p_raw = order(ns_raw, e_raw)
+    assert p_loc > 3.7
+    assert 1.4 < p_raw < 2.6
+    # at 256 steps, locating the edges gains at least two orders of magnitude
+    e_loc_256 = trajectory_errors(m, y0, [256], True)[0]
+    assert e_loc_256 * 100 < e_raw[ns_raw == 256][0]
+
+
+def _poincare_distance(A, B):
+    """Largest distance from a point of B to the nearest point of A (max norm)."""
+    return max(float(np.min(np.max(np.abs(A - b), axis=1))) for b in B)
+
+
+@pytest.mark.parametrize(("omega", "loss"), [(0.5, False), (0.6, True), (1.1, True),
+                                             (3.5, True)])
+def test_default_steps_reach_1e6_on_periodic_attractors(omega, loss):
+    """The default steps per period put the Poincare points of a periodic attractor within 1e-6
+    of the reference orbit (regimes with and without tooth separation)."""
+    m = geardyn.CATTDevice(geardyn.PlanetaryParams.paper()).with_omega(omega)
+    T = 2 * math.pi / omega
+    y_fine, fine = on_attractor(m)
+    assert (int(fine["edge_crossings"].sum()) > 0) == loss
+    # the reference's own attractor: run it on from the fine RK4 point, keep the last points
+    ref = ref_at(m, y_fine, np.arange(25) * T, rtol=1e-12, atol=1e-13)[-4:]
+    assert np.max(np.abs(ref[2:] - ref[:2])) < 1e-9  # period 1 or 2, converged
+    ds = geardyn.simulate(m, transient=4000.0, periods=4)
+    assert ds.attrs["steps_per_period"] == geardyn.default_steps_per_period(m)
+    assert _poincare_distance(ref, ds["poincare"].values) < 1e-6
+    assert _poincare_distance(ds["poincare"].values, ref) < 1e-6
