@@ -142,6 +142,9 @@ def test_bad_input_to_simulate(tmp_path, capsys):
     assert_one_line_error(run("paper_fig3", "--omega", "1", "--plot", "a.jpg"), "--plot", "a.jpg")
     assert_one_line_error(run("paper_fig3", "--omega", "1", "--interpretation", "x"),
                           "--interpretation")
+    assert_one_line_error(run("paper_fig3", "--omega", "1", "--plot", tmp_path / "a.png",
+                              "--state", "Y_sq"), "--state", "'Y_sq'", "X_sq")
+    assert not (tmp_path / "a.png").exists()
     assert_one_line_error(geardyn_here(capsys, "frobnicate"), "frobnicate")
 
 

@@ -1,14 +1,14 @@
 """Period classification of stroboscopic (Poincare) samples.
 
-A lane is period-k when its samples repeat after k forcing periods: for the smallest k <= max_period,
-max_i |x[i + k] - x[i]| <= tol * max(1, max_i |x[i]|) over the recorded samples (every state). Motion
-that repeats for no such k is labelled 0 (quasi-periodic or chaotic: the Lyapunov exponent separates
-the two); a diverged lane (NaN samples) is -1.
+A lane is period-k when its samples repeat after k forcing periods: for the smallest
+k <= max_period, max_i |x[i + k] - x[i]| <= tol * max(1, max_i |x[i]|) over the recorded samples
+(every state). Motion that repeats for no such k is labelled 0 (quasi-periodic or chaotic: the
+Lyapunov exponent separates the two); a diverged lane (NaN samples) is -1.
 
-The tolerance must exceed what is left of the transient (at xi = 0.05 the slowest mode of the CATT
-device decays as exp(-0.015 tau)) and the integration noise; it must stay below the distance between
-the points of a genuine period-k orbit. The default 1e-5 (relative) is tested on synthetic orbits and
-on the gear pair.
+The tolerance must exceed what is left of the transient (at xi = 0.05 the slowest mode of the
+CATT device decays as exp(-0.015 tau)) and the integration noise; it must stay below the distance
+between the points of a genuine period-k orbit. The default 1e-5 (relative) is tested on
+synthetic orbits and on the gear pair.
 """
 
 from __future__ import annotations

@@ -253,6 +253,10 @@ def simulate(
     plot_state = state or s.plot_state
     interp = interpretation.value if interpretation is not None else None
     model = s.build_model(interpretation=interp, omega=om)
+    known = (*model.state_names, *model.observable_names)
+    if plot is not None and plot_state not in known and f"{plot_state}1" not in known:
+        raise ParameterError("--state" if state else "study.plot_state", plot_state,
+                             f"not a coordinate of {model.name}; known: {', '.join(known)}")
     for path in (out, plot):
         if path is not None:
             path.parent.mkdir(parents=True, exist_ok=True)
@@ -261,13 +265,6 @@ def simulate(
     with err.status(f"simulating {s.study.name} at Omega = {om:g} (the first run compiles)"):
         ds = run_simulation(model, omega=om, transient=tr, periods=n_periods,
                             steps_per_period=spp)
-    if plot is not None:
-        from geardyn.plotting.simulation import resolve_state
-
-        try:
-            resolve_state(ds, plot_state)
-        except ValueError as exc:
-            raise ParameterError("study.plot_state", plot_state, str(exc)) from None
     ds.attrs["study"] = s.study.name
     written = []
     if out is not None:

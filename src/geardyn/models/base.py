@@ -103,7 +103,7 @@ class Model:
         return self.with_params(Omega=omega)
 
     def static_mesh_forces(self) -> np.ndarray | None:
-        """Static mesh forces (one per mesh, in observable units) for the dynamic factor, or None."""
+        """Static mesh forces (one per mesh, observable units) for the dynamic factor, or None."""
         return None
 
     def __repr__(self) -> str:

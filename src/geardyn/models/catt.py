@@ -237,8 +237,8 @@ class CATTDevice(Model):
         return np.sort(np.sqrt(lam.real))
 
     def static_forces(self) -> np.ndarray:
-        """Mean-load mesh forces of the quasi-static state in mesh coordinates (dimensionless
-        k g(X) products, one (sq, pq) pair per modelled planet set), from the mean torques."""
+        """Dimensionless static mesh deflections g(X) = X - b of the quasi-static state under the
+        mean torques (mean stiffness, no error), one (sq, pq) pair per modelled planet set."""
         co = self.coefficients
         n = self.n_sets
         mult = self.params_in.n_planets if self.reduced else 1
@@ -271,12 +271,12 @@ class CATTDevice(Model):
     def static_mesh_forces(self) -> np.ndarray:
         """Static mesh forces [N] under the mean loads, in the order of ``observable_names``."""
         g = self.static_forces()
-        d = self.derived
         bc = self.params_in.b_c
         out = np.empty(2 * self.n_sets)
         for i in range(self.n_sets):
-            out[2 * i] = g[2 * i] * d.M_q[i] * d.omega_n**2 * bc
-            out[2 * i + 1] = g[2 * i + 1] * d.M_q[i] * d.omega_n**2 * bc
+            sq, pq, _, _ = self.params_in.planet_set(i)
+            out[2 * i] = g[2 * i] * sq.mean_stiffness * bc
+            out[2 * i + 1] = g[2 * i + 1] * pq.mean_stiffness * bc
         return out
 
     def general(self) -> CATTDevice:

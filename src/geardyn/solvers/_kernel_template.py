@@ -35,7 +35,10 @@ from geardyn.solvers._template_model import events, observe, rhs  # MODEL-IMPORT
 _CACHE = True
 _JIT = {"cache": _CACHE, "error_model": "numpy", "boundscheck": False}
 BLOCK = 8
-MAX_SPLITS = 8
+MAX_SPLITS = 16
+#: Crossings located within this fraction of a step of the earliest are taken together (identical
+#: planet sets cross their edges at the same instant).
+SIMULTANEOUS = 1e-9
 STATUS_OK = 0
 STATUS_DIVERGED = 1
 
@@ -162,9 +165,11 @@ def _split_step(i, t0, y, y_trial, p, h, omega, n_per, side, g1, ncross, work, y
             ystart[q] = y[q]
         events(t, y, gbuf[0], p)
         for j in range(n_ev):
+            gbuf[2, j] = 2.0
             if _side(g1[j]) != side[j]:
                 th = _locate(j, side[j], gbuf[0, j], g1[j], ystart, k1, y_trial, f1, dt, t, p,
                              ybuf, gbuf[1])
+                gbuf[2, j] = th
                 if th < theta:
                     theta = th
                     first = j
@@ -178,8 +183,10 @@ def _split_step(i, t0, y, y_trial, p, h, omega, n_per, side, g1, ncross, work, y
         _rk4(t, ystart, dts, p, s0, c0, math.sin(wh * (i_mod + tm)), math.cos(wh * (i_mod + tm)),
              math.sin(wh * (i_mod + tu)), math.cos(wh * (i_mod + tu)), k1, k2, k3, k4, tmp, y,
              True)
-        side[first] = -side[first]
-        ncross[first] += 1
+        for j in range(n_ev):
+            if gbuf[2, j] <= theta + SIMULTANEOUS:
+                side[j] = -side[j]
+                ncross[j] += 1
         u = tu
         if u >= 1.0:
             events(t_end, y, g1, p)
@@ -265,7 +272,7 @@ def _alloc(nb_lanes, ns, n_ev):
     work = np.zeros((7, ns))
     return (Y, Y.copy(), Y.copy(), Y.copy(), Y.copy(), Y.copy(), Y.copy(),
             np.zeros((nb_lanes, max(n_ev, 1))), np.ones((nb_lanes, max(n_ev, 1)), np.int64),
-            work, np.zeros(ns), np.zeros((2, max(n_ev, 1))))
+            work, np.zeros(ns), np.zeros((3, max(n_ev, 1))))
 
 
 @nb.njit(**_JIT)

@@ -7,25 +7,26 @@ module bound to the small test oscillator of :mod:`geardyn.solvers._template_mod
 
 Numerics
 --------
-* The state y and k tangent vectors v_1..v_k are advanced together by classic RK4 on the same
-  grid as the main solver (``n_per`` steps of ``h`` per forcing period, forcing phase from the
-  same half-step table; an autonomous model has ``omega = 0`` and any ``h``). Applying RK4 to the
-  augmented system (y' = f, v' = J v) gives the exact derivative of the RK4 step map of y, so the
-  exponents are those of the discrete map the solver iterates.
-* J(t, y) v is the directional derivative of the model's ``rhs`` by a central difference,
-  ``(f(y + e v) - f(y - e v)) / (2 e)`` with ``e |v| = FD_DELTA (1 + |y|)`` (Euclidean norms).
-  It is exact for a piecewise-linear field inside one linear piece and for quadratic fields
-  (Lorenz); the rounding error is about ``eps |f| / (FD_DELTA (1 + |y|))``, ~1e-10 relative.
-* Every ``renorm_every`` steps (and at the end) the tangent vectors are re-orthonormalised by
-  modified Gram-Schmidt (a QR factorisation); the logs of the diagonal of R are summed over the
-  measuring window (Benettin et al. 1980; Shimada & Nagashima 1979). The transient advances the
-  tangent vectors too (renormalised, not summed) so that they are aligned when measuring starts.
-* Dead-zone edge crossings are NOT located inside a step here (the state follows the plain RK4
-  grid, as the main solver does with ``locate_edges=False``). The vector field is continuous, so
-  no saltation matrix is needed; the step error near an edge is the only cost, and the exponent
-  converges with the step (tested in ``tests/test_lyapunov.py``).
-* A lane whose state leaves ``|y| <= bound`` or whose tangent norm stops being finite is marked
-  diverged (status 1) and its exponents are NaN.
+* The state y is advanced on the main solver's grid (``n_per`` RK4 steps of ``h`` per forcing
+  period, forcing phase from the same half-step table; an autonomous model has ``omega = 0`` and
+  any ``h``), with the crossings of the ``n_ev`` switching functions located inside a step and
+  the step split there, as in :mod:`geardyn.solvers._kernel_template` (``_grid_step``).
+* Each tangent vector v is advanced by the derivative of that step map Phi, by a central
+  difference: ``(Phi(y + e v) - Phi(y - e v)) / (2 e)`` with ``e |v| = FD_DELTA (1 + |y|)``
+  (Euclidean norms, FD_DELTA = 2^-20 ~ 1e-6). For a smooth field this is RK4 applied to the
+  variational equation v' = J(t, y) v (to O(e^2)); the perturbed states locate their own edge
+  crossings, so a step in which one of them crosses an edge is differentiated correctly and the
+  exponent keeps the solver's order. It is exact for affine step maps (linear models) up to
+  rounding (~ eps / FD_DELTA ~ 1e-10 relative per step). The vector field is continuous across
+  the dead-zone edges, so the flow is C^1 there and no saltation matrix is needed.
+* Every ``renorm_every`` steps (and at the end of the transient and of the run) the tangent
+  vectors are re-orthonormalised by modified Gram-Schmidt (a QR factorisation); the logs of the
+  diagonal of R are summed over the measuring window (Benettin et al. 1980; Shimada & Nagashima
+  1979). The transient advances the tangent vectors too (renormalised, not summed) so that they
+  are aligned when measuring starts.
+* A lane whose state leaves ``|y| <= bound`` (checked at each renormalisation) or whose tangent
+  vectors stop being finite is marked diverged (status 1) and its exponents are NaN.
+* Cost per step: (2 k + 1) RK4 steps for k tangent vectors.
 """
 
 from __future__ import annotations
@@ -40,7 +41,7 @@ from geardyn.solvers._template_model import events, observe, rhs  # MODEL-IMPORT
 _CACHE = True
 _JIT = {"cache": _CACHE, "error_model": "numpy", "boundscheck": False}
 #: Relative size of the finite-difference perturbation: e |v| = FD_DELTA (1 + |y|).
-FD_DELTA = 2.0**-3
+FD_DELTA = 2.0**-20
 #: Most located edge crossings inside one grid step (then the step is taken unsplit).
 MAX_SPLITS = 8
 STATUS_OK = 0
