@@ -6,7 +6,7 @@ STAMP := $(VENV)/.installed
 export NUMBA_CACHE_DIR ?= $(CURDIR)/.geardyn-cache/numba
 export GEARDYN_CACHE_DIR ?= $(CURDIR)/.geardyn-cache
 
-.PHONY: venv demo test test-slow lint bench clean
+.PHONY: venv demo test test-slow lint clean
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -21,17 +21,14 @@ demo: $(STAMP)
 	$(BIN)/geardyn simulate src/geardyn/studies/paper_fig3.toml --omega 1.1 --out out/demo.nc --plot out/demo.png
 
 test: $(STAMP)
-	$(BIN)/ruff check src tests bench
+	$(BIN)/ruff check src tests
 	$(BIN)/python -m pytest -n 2 -q
 
 test-slow: $(STAMP)
 	$(BIN)/python -m pytest -q -m slow
 
 lint: $(STAMP)
-	$(BIN)/ruff check src tests bench
-
-bench: $(STAMP)
-	$(BIN)/python bench/bifurcation.py
+	$(BIN)/ruff check src tests
 
 clean:
 	rm -rf $(VENV) out .geardyn-cache

@@ -116,3 +116,13 @@ def test_physical_parameter_sweeps(param, values):
         one = geardyn.simulate(m.with_params(**{param: v}), transient=300.0, periods=4,
                                steps_per_period=64)
         np.testing.assert_array_equal(ds["poincare"].values[j], one["poincare"].values[1:])
+
+
+def test_bifurcation_lyapunov_separates_periodic_from_chaotic():
+    """Omega = 0.92 is chaotic for this gear pair (tests/test_lyapunov.py shows nearby
+    trajectories separating); Omega = 0.5 is period-1."""
+    g = geardyn.GearPair(zeta=0.02, kappa=0.2, Fm=0.1, Fa=0.3)
+    ds = bifurcation(g, values=[0.5, 0.92], transient=500.0, samples=50, lyapunov=True)
+    np.testing.assert_array_equal(ds["period"].values, [1, 0])
+    lam = ds["lyapunov"].values
+    assert lam[0] < -0.005 and lam[1] > 0.02

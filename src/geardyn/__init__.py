@@ -9,6 +9,7 @@ The public API::
 """
 
 from geardyn.analysis.bifurcation import bifurcation
+from geardyn.analysis.lyapunov import lyapunov, lyapunov_lanes
 from geardyn.analysis.periodicity import classify_period
 from geardyn.errors import GeardynError, ParameterError, StudyError
 from geardyn.models.base import Model
@@ -40,6 +41,8 @@ __all__ = [
     "UserModel",
     "bifurcation",
     "classify_period",
+    "lyapunov",
+    "lyapunov_lanes",
     "default_steps_per_period",
     "reference_solution",
     "simulate",
