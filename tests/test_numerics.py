@@ -16,20 +16,6 @@ import geardyn
 K_PERIODS = 10
 
 
-def ref_at(model, y0, times, t0=0.0, **kw):
-    """Reference states at ``times``, integrating segment by segment so that every requested
-    time is a step end of the adaptive integrator (its dense output is less accurate)."""
-    out = []
-    y = np.asarray(y0, dtype=float)
-    t = float(t0)
-    for tn in times:
-        if tn > t:
-            y = geardyn.reference_solution(model, y, [tn], t0=t, **kw)[0]
-            t = float(tn)
-        out.append(y.copy())
-    return np.array(out)
-
-
 def order(ns, errors) -> float:
     """Least-squares order p of errors ~ n^-p."""
     return -float(np.polyfit(np.log(ns), np.log(errors), 1)[0])
@@ -45,7 +31,8 @@ def dense(lo, hi):
 def trajectory_errors(model, y0, ns, locate):
     """Max Poincare-point error over K_PERIODS periods from y0, for each steps per period."""
     T = 2 * math.pi / model.omega
-    ref = ref_at(model, y0, np.arange(K_PERIODS + 1) * T, rtol=1e-13, atol=1e-14)
+    times = np.arange(K_PERIODS + 1) * T
+    ref = geardyn.reference_solution(model, y0, times, rtol=1e-13, atol=1e-14)
     errs = []
     for n in ns:
         ds = geardyn.simulate(model, periods=K_PERIODS, steps_per_period=int(n), y0=y0,
@@ -104,7 +91,7 @@ def test_default_steps_reach_1e6_on_periodic_attractors(omega, loss):
     y_fine, fine = on_attractor(m)
     assert (int(fine["edge_crossings"].sum()) > 0) == loss
     # the reference's own attractor: run it on from the fine RK4 point, keep the last points
-    ref = ref_at(m, y_fine, np.arange(25) * T, rtol=1e-12, atol=1e-13)[-4:]
+    ref = geardyn.reference_solution(m, y_fine, np.arange(25) * T, rtol=1e-12, atol=1e-13)[-4:]
     assert np.max(np.abs(ref[2:] - ref[:2])) < 1e-9  # period 1 or 2, converged
     ds = geardyn.simulate(m, transient=4000.0, periods=4)
     assert ds.attrs["steps_per_period"] == geardyn.default_steps_per_period(m)

@@ -19,20 +19,6 @@ import geardyn
 # helpers
 
 
-def ref_at(model, y0, times, t0=0.0, **kw):
-    """Reference states at ``times``, integrating segment by segment so that every requested
-    time is a step end of the adaptive integrator (its dense output is less accurate)."""
-    out = []
-    y = np.asarray(y0, dtype=float)
-    t = float(t0)
-    for tn in times:
-        if tn > t:
-            y = geardyn.reference_solution(model, y, [tn], t0=t, **kw)[0]
-            t = float(tn)
-        out.append(y.copy())
-    return np.array(out)
-
-
 def theta_from_mesh(m: geardyn.CATTDevice, x0: np.ndarray) -> np.ndarray:
     """Body angles (Eq. 1 state: theta_c, theta_c', then theta_q, theta_q', theta_p, theta_p'
     per set) at t = 0 whose mesh coordinates (Eq. 8, 9) are x0; carrier at rest at angle 0."""
@@ -60,9 +46,9 @@ def compare_theta_and_mesh(m: geardyn.CATTDevice, x0: np.ndarray, tau: np.ndarra
     y0 = theta_from_mesh(m, x0)
     # the library's map back to mesh coordinates must invert ours
     np.testing.assert_allclose(dm.mesh_coordinates(0.0, y0), x0, rtol=0, atol=1e-11)
-    x_ref = ref_at(m, x0, tau, rtol=1e-13, atol=1e-13)
+    x_ref = geardyn.reference_solution(m, x0, tau, rtol=1e-13, atol=1e-13)
     t = tau / m.omega_n
-    th = ref_at(dm, y0, t, rtol=1e-13, atol=1e-16)
+    th = geardyn.reference_solution(dm, y0, t, rtol=1e-13, atol=1e-16)
     return x_ref, dm.mesh_coordinates(t, th)
 
 
