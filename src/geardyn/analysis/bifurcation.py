@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 
 import numpy as np
 import xarray as xr
@@ -21,10 +21,12 @@ def _concat(parts: list[LaneResults]) -> LaneResults:
 
 
 def _continuation(model, P, order, y0, transient, samples, steps_per_period, locate_edges,
-                  bound) -> LaneResults:
+                  bound, progress=None) -> LaneResults:
     parts: list[LaneResults | None] = [None] * len(order)
     y, t0 = np.asarray(y0, dtype=float), 0.0
-    for pos in order:
+    for done, pos in enumerate(order):
+        if progress is not None:
+            progress(done, len(order))
         r = run_lanes(model, P[pos : pos + 1], y, transient, samples, steps_per_period,
                       locate_edges=locate_edges, bound=bound, t0=np.array([t0]))
         parts[pos] = r
@@ -32,7 +34,25 @@ def _continuation(model, P, order, y0, transient, samples, steps_per_period, loc
             y, t0 = r.final[0], float(r.final_time[0])
         else:  # lost the branch: restart from the model's initial state
             y, t0 = np.asarray(y0, dtype=float), 0.0
+    if progress is not None:
+        progress(len(order), len(order))
     return _concat(parts)  # type: ignore[arg-type]
+
+
+def _chunked(model, P, y0, transient, samples, steps_per_period, locate_edges, bound, chunk,
+             progress, offset, total) -> LaneResults:
+    """run_lanes over consecutive chunks of lanes, reporting progress after each."""
+    L = P.shape[0]
+    size = chunk or max(64, -(-L // 20))
+    Y0 = np.broadcast_to(np.asarray(y0, dtype=float), (L, model.n_states))
+    parts = []
+    for a in range(0, L, size):
+        b = min(L, a + size)
+        parts.append(run_lanes(model, P[a:b], Y0[a:b], transient, samples, steps_per_period,
+                               locate_edges=locate_edges, bound=bound))
+        if progress is not None:
+            progress(offset + b, total)
+    return parts[0] if len(parts) == 1 else _concat(parts)
 
 
 def bifurcation(
@@ -52,6 +72,8 @@ def bifurcation(
     spread: float = 1.0,
     locate_edges: bool = True,
     bound: float = DEFAULT_BOUND,
+    progress: Callable[[int, int], None] | None = None,
+    chunk: int | None = None,
 ) -> xr.Dataset:
     """Sweep ``param`` over ``values`` and classify the steady motion at every point.
 
@@ -72,6 +94,11 @@ def bifurcation(
         Independent starts per point (``continuation=None`` only): the first from ``y0``, the
         others from ``y0`` plus uniform noise of half-width ``spread`` on each state (``seed``).
         Their Poincare points are stacked along ``sample``; ``period_by_start`` keeps each.
+    progress
+        Called as ``progress(done, total)`` (integrations finished, of all) after each chunk.
+    chunk
+        Lanes per kernel call (default: about a twentieth of the sweep, at least 64). Lanes are
+        independent, so the result does not depend on it.
 
     Returns
     -------
@@ -104,14 +131,15 @@ def bifurcation(
         if continuation == "down":
             order = order[::-1]
         runs = [_continuation(model, P, order, base_y0 if base_y0.ndim == 1 else base_y0[0],
-                              transient, samples, steps_per_period, locate_edges, bound)]
+                              transient, samples, steps_per_period, locate_edges, bound,
+                              progress)]
     else:
         rng = np.random.default_rng(seed)
         runs = []
         for s in range(starts):
             y_s = base_y0 if s == 0 else base_y0 + rng.uniform(-spread, spread, (L, ns))
-            runs.append(run_lanes(model, P, y_s, transient, samples, steps_per_period,
-                                  locate_edges=locate_edges, bound=bound))
+            runs.append(_chunked(model, P, y_s, transient, samples, steps_per_period,
+                                 locate_edges, bound, chunk, progress, s * L, starts * L))
     first = runs[0]
     poincare = np.concatenate([r.samples for r in runs], axis=1)
     periods = np.stack([classify_period(r.samples, max_period, tol) for r in runs], axis=1)
