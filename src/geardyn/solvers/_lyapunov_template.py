@@ -10,7 +10,8 @@ Numerics
 * The state y is advanced on the main solver's grid (``n_per`` RK4 steps of ``h`` per forcing
   period, forcing phase from the same half-step table; an autonomous model has ``omega = 0`` and
   any ``h``), with the crossings of the ``n_ev`` switching functions located inside a step and
-  the step split there, as in :mod:`geardyn.solvers._kernel_template` (``_grid_step``).
+  the step split there, as in :mod:`geardyn.solvers._kernel_template` (shared
+  :mod:`._step_core`).
 * Each tangent vector v is advanced by the derivative of that step map Phi, by a central
   difference: ``(Phi(y + e v) - Phi(y - e v)) / (2 e)`` with ``e |v| = FD_DELTA (1 + |y|)``
   (Euclidean norms, FD_DELTA = 2^-20 ~ 1e-6). For a smooth field this is RK4 applied to the
@@ -36,184 +37,55 @@ import math
 import numba as nb
 import numpy as np
 
+from geardyn.solvers._step_core import (  # CORE-IMPORT
+    _JIT,
+    STATUS_DIVERGED,
+    STATUS_OK,
+    _healthy,
+    _rk4,
+    _side,
+    _split_step,
+    phase_table,
+)
 from geardyn.solvers._template_model import events, observe, rhs  # MODEL-IMPORT
 
-_CACHE = True
-_JIT = {"cache": _CACHE, "error_model": "numpy", "boundscheck": False}
 #: Relative size of the finite-difference perturbation: e |v| = FD_DELTA (1 + |y|).
 FD_DELTA = 2.0**-20
-#: Most located edge crossings inside one grid step (then the step is taken unsplit).
-MAX_SPLITS = 8
-STATUS_OK = 0
-STATUS_DIVERGED = 1
 
 # the model interface names are part of the template's namespace (the generated copy re-binds
-# them); only rhs is used here
+# them); only rhs and events are used here
 __all__ = ["events", "lyapunov_lanes", "lyapunov_single", "observe", "phase_table", "rhs"]
 
 
 @nb.njit(**_JIT)
-def phase_table(n_per, forced):
-    """sin and cos of the forcing phase at the 2 n_per + 1 half-step points of one period."""
-    s = np.zeros(2 * n_per + 1)
-    c = np.ones(2 * n_per + 1)
-    if forced:
-        for k in range(1, 2 * n_per):
-            a = math.pi * k / n_per
-            s[k] = math.sin(a)
-            c[k] = math.cos(a)
-    return s, c
-
-
-@nb.njit(inline="always", **_JIT)
-def _side(x):
-    return 1 if x > 0.0 else -1
-
-
-@nb.njit(**_JIT)
-def _rk4(t, y, h, p, s0, c0, s1, c1, s2, c2, k1, k2, k3, k4, tmp, out, have_k1):
-    """One RK4 step of size h from (t, y) into out; k1 holds f(t, y) if have_k1."""
-    ns = y.size
-    if not have_k1:
-        rhs(t, y, k1, p, s0, c0)
-    hh = 0.5 * h
-    for q in range(ns):
-        tmp[q] = y[q] + hh * k1[q]
-    rhs(t + hh, tmp, k2, p, s1, c1)
-    for q in range(ns):
-        tmp[q] = y[q] + hh * k2[q]
-    rhs(t + hh, tmp, k3, p, s1, c1)
-    for q in range(ns):
-        tmp[q] = y[q] + h * k3[q]
-    rhs(t + h, tmp, k4, p, s2, c2)
-    h6 = h / 6.0
-    for q in range(ns):
-        out[q] = y[q] + h6 * (k1[q] + 2.0 * k2[q] + 2.0 * k3[q] + k4[q])
-
-
-@nb.njit(**_JIT)
-def _hermite(y0, f0, y1, f1, dt, theta, out):
-    """Cubic Hermite interpolant of a step of length dt at fraction theta."""
-    t2 = theta * theta
-    t3 = t2 * theta
-    h00 = 2.0 * t3 - 3.0 * t2 + 1.0
-    h10 = (t3 - 2.0 * t2 + theta) * dt
-    h01 = -2.0 * t3 + 3.0 * t2
-    h11 = (t3 - t2) * dt
-    for q in range(y0.size):
-        out[q] = h00 * y0[q] + h10 * f0[q] + h01 * y1[q] + h11 * f1[q]
-
-
-@nb.njit(**_JIT)
-def _locate(j, side_j, g0j, g1j, y0, f0, y1, f1, dt, t, p, ybuf, gbuf):
-    """Fraction in (0, 1] of the step where event j leaves side side_j (Illinois method)."""
-    a = 0.0
-    fa = g0j if _side(g0j) == side_j else (1e-300 if side_j > 0 else 0.0)
-    b = 1.0
-    fb = g1j
-    last = 0
-    for _ in range(60):
-        denom = fb - fa
-        x = (a * fb - b * fa) / denom if denom != 0.0 else 0.5 * (a + b)
-        if not (a < x < b):
-            x = 0.5 * (a + b)
-        _hermite(y0, f0, y1, f1, dt, x, ybuf)
-        events(t + x * dt, ybuf, gbuf, p)
-        fx = gbuf[j]
-        if _side(fx) == side_j:
-            a = x
-            fa = fx
-            if last == -1:
-                fb *= 0.5
-            last = -1
-        else:
-            b = x
-            fb = fx
-            if last == 1:
-                fa *= 0.5
-            last = 1
-        if b - a < 1e-13:
-            break
-    return b
-
-
-@nb.njit(**_JIT)
-def _grid_step(i, y, p, h, omega, n_per, sa, ca, sb, cb, se, ce, n_ev, W, side, g0, g1, gbuf):
+def _grid_step(i, y, p, h, omega, n_per, sa, ca, sb, cb, se, ce, n_ev, W, side, g0, g1, gbuf,
+               ncross):
     """Advance y (in place) by grid step i (time i h to (i + 1) h): one RK4 step, or, with
     ``n_ev`` switching functions of which one changes side, the step split at the located
-    crossings (at most MAX_SPLITS times), as the main solver does."""
-    k1 = W[0]
-    k2 = W[1]
-    k3 = W[2]
-    k4 = W[3]
-    tmp = W[4]
-    f1 = W[5]
-    ystart = W[6]
-    ytrial = W[7]
-    ybuf = W[8]
+    crossings, as the main solver does (:func:`_split_step`)."""
     t = i * h
-    t_end = (i + 1) * h
     if n_ev > 0:
         events(t, y, g0, p)
         for j in range(n_ev):
             side[j] = _side(g0[j])
-    _rk4(t, y, h, p, sa, ca, sb, cb, se, ce, k1, k2, k3, k4, tmp, ytrial, False)
+    ytrial = W[7]
+    _rk4(t, y, h, p, sa, ca, sb, cb, se, ce, W[0], W[1], W[2], W[3], W[4], ytrial, False)
     crossed = False
     if n_ev > 0:
-        events(t_end, ytrial, g1, p)
+        events(t + h, ytrial, g1, p)
         for j in range(n_ev):
             if _side(g1[j]) != side[j]:
                 crossed = True
-    if not crossed:
+    if crossed:
+        _split_step(i, 0.0, y, ytrial, p, h, omega, n_per, side, g1, ncross, W, W[8], gbuf)
+    else:
         for q in range(y.size):
             y[q] = ytrial[q]
-        return
-    # k1 holds f(t, y); locate and split (the forcing phase at fractions of the step by sin/cos)
-    u = 0.0
-    i_mod = i % n_per
-    wh = omega * h
-    for _ in range(MAX_SPLITS):
-        tu0 = t + u * h
-        dt = (1.0 - u) * h
-        s0 = math.sin(wh * (i_mod + u))
-        c0 = math.cos(wh * (i_mod + u))
-        if u > 0.0:
-            sm = math.sin(wh * (i_mod + 0.5 * (1.0 + u)))
-            cm = math.cos(wh * (i_mod + 0.5 * (1.0 + u)))
-            _rk4(tu0, y, dt, p, s0, c0, sm, cm, se, ce, k1, k2, k3, k4, tmp, ytrial, False)
-            events(t_end, ytrial, g1, p)
-        rhs(t_end, ytrial, f1, p, se, ce)
-        for q in range(y.size):
-            ystart[q] = y[q]
-        events(tu0, y, gbuf[0], p)
-        first = -1
-        theta = 2.0
-        for j in range(n_ev):
-            if _side(g1[j]) != side[j]:
-                th = _locate(j, side[j], gbuf[0, j], g1[j], ystart, k1, ytrial, f1, dt, tu0, p,
-                             ybuf, gbuf[1])
-                if th < theta:
-                    theta = th
-                    first = j
-        if first < 0:
-            for q in range(y.size):
-                y[q] = ytrial[q]
-            return
-        tm = u + 0.5 * theta * (1.0 - u)
-        tu = u + theta * (1.0 - u)
-        _rk4(tu0, ystart, theta * dt, p, s0, c0, math.sin(wh * (i_mod + tm)),
-             math.cos(wh * (i_mod + tm)), math.sin(wh * (i_mod + tu)),
-             math.cos(wh * (i_mod + tu)), k1, k2, k3, k4, tmp, y, True)
-        side[first] = -side[first]
-        u = tu
-        if u >= 1.0:
-            return
-    for q in range(y.size):
-        y[q] = ytrial[q]
 
 
 @nb.njit(**_JIT)
-def _tangent_step(i, Z, p, h, omega, n_per, s_tab, c_tab, n_ev, W, YP, side, g0, g1, gbuf):
+def _tangent_step(i, Z, p, h, omega, n_per, s_tab, c_tab, n_ev, W, YP, side, g0, g1, gbuf,
+                  ncross):
     """Advance the state (row 0 of Z) by one grid step and each tangent vector v (rows 1..) by
     the derivative of that step map: (Phi(y + e v) - Phi(y - e v)) / (2 e)."""
     m, ns = Z.shape
@@ -242,13 +114,14 @@ def _tangent_step(i, Z, p, h, omega, n_per, s_tab, c_tab, n_ev, W, YP, side, g0,
             YP[0, q] = Z[0, q] + e * Z[j, q]
             YP[1, q] = Z[0, q] - e * Z[j, q]
         _grid_step(i, YP[0], p, h, omega, n_per, sa, ca, sb, cb, se, ce, n_ev, W, side, g0, g1,
-                   gbuf)
+                   gbuf, ncross)
         _grid_step(i, YP[1], p, h, omega, n_per, sa, ca, sb, cb, se, ce, n_ev, W, side, g0, g1,
-                   gbuf)
+                   gbuf, ncross)
         inv = 0.5 / e
         for q in range(ns):
             Z[j, q] = (YP[0, q] - YP[1, q]) * inv
-    _grid_step(i, Z[0], p, h, omega, n_per, sa, ca, sb, cb, se, ce, n_ev, W, side, g0, g1, gbuf)
+    _grid_step(i, Z[0], p, h, omega, n_per, sa, ca, sb, cb, se, ce, n_ev, W, side, g0, g1, gbuf,
+               ncross)
 
 
 @nb.njit(**_JIT)
@@ -278,14 +151,6 @@ def _orthonormalise(Z, acc, add):
 
 
 @nb.njit(**_JIT)
-def _healthy(y, bound):
-    for q in range(y.size):
-        if not (abs(y[q]) <= bound):  # False for NaN too
-            return False
-    return True
-
-
-@nb.njit(**_JIT)
 def _run(p, y0, h, omega, n_per, s_tab, c_tab, n_transient, n_steps, renorm_every, k, bound,
          n_ev):
     """Exponents (sum of logs / measured time) and status of one lane."""
@@ -298,7 +163,8 @@ def _run(p, y0, h, omega, n_per, s_tab, c_tab, n_transient, n_steps, renorm_ever
     side = np.ones(ne, np.int64)
     g0 = np.zeros(ne)
     g1 = np.zeros(ne)
-    gbuf = np.zeros((2, ne))
+    gbuf = np.zeros((3, ne))
+    ncross = np.zeros(ne, np.int64)
     acc = np.zeros(k)
     out = np.full(k, np.nan)
     for q in range(ns):
@@ -312,7 +178,8 @@ def _run(p, y0, h, omega, n_per, s_tab, c_tab, n_transient, n_steps, renorm_ever
     total = n_transient + n_steps
     since = 0
     for i in range(total):
-        _tangent_step(i, Z, p, h, omega, n_per, s_tab, c_tab, n_ev, W, YP, side, g0, g1, gbuf)
+        _tangent_step(i, Z, p, h, omega, n_per, s_tab, c_tab, n_ev, W, YP, side, g0, g1, gbuf,
+                      ncross)
         since += 1
         step = i + 1
         if since == renorm or step == n_transient or step == total:

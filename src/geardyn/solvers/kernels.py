@@ -28,6 +28,7 @@ import numba
 from geardyn.solvers import _noop
 
 _IMPORT_MARK = "# MODEL-IMPORT"
+_CORE_MARK = "# CORE-IMPORT"
 _PLAIN_ADAPTERS = """
 
 @nb.njit(**_JIT)
@@ -93,10 +94,33 @@ TEMPLATES: dict[str, str] = {
 }
 
 
-def _template_text(template: str) -> str:
+def _core_text() -> str:
+    """The shared step machinery (:mod:`._step_core`) as text to splice into a template."""
+    lines = inspect.getsource(importlib.import_module("geardyn.solvers._step_core")).splitlines()
+    return "\n".join(line for line in lines
+                     if not line.startswith("from __future__")
+                     and not line.rstrip().endswith(_IMPORT_MARK))
+
+
+def _splice_core(text: str, extra: str = "") -> str:
+    """Replace the template's ``CORE-IMPORT`` statement (one line, or a parenthesised import
+    starting on the marked line) by the shared core's text, followed by ``extra``."""
+    lines = text.splitlines()
+    for k, line in enumerate(lines):
+        if line.rstrip().endswith(_CORE_MARK):
+            end = k
+            if "(" in line and ")" not in line:
+                while ")" not in lines[end]:
+                    end += 1
+            return "\n".join([*lines[:k], _core_text(), extra, *lines[end + 1 :]]) + "\n"
+    raise RuntimeError("kernel template has lost its CORE-IMPORT line")
+
+
+def _template_text(template: str, plain: bool = False) -> str:
     if template not in TEMPLATES:
         raise KeyError(f"unknown kernel template {template!r}; known: {', '.join(TEMPLATES)}")
-    return inspect.getsource(importlib.import_module(TEMPLATES[template]))
+    text = inspect.getsource(importlib.import_module(TEMPLATES[template]))
+    return _splice_core(text, _PLAIN_ADAPTERS if plain else "")
 
 
 def _import_line(funcs: dict[str, Any]) -> str:
@@ -132,9 +156,7 @@ def kernels_for(source: KernelSource, template: str = "rk4") -> types.ModuleType
     key = (template, source.plain, *(id(f) for f in funcs.values()))
     if key in _LOADED:
         return _LOADED[key]
-    text = _template_text(template)
-    if source.plain:
-        text += _PLAIN_ADAPTERS
+    text = _template_text(template, source.plain)
     if all(_importable(f) for f in funcs.values()):
         code = _replace_import(text, _import_line(funcs))
         digest = _source_digest(code, funcs)
