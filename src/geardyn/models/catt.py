@@ -45,6 +45,8 @@ from geardyn.models.stiffness import fourier_coefficients, harmonics_needed
 from geardyn.solvers.kernels import KernelSource
 
 _KERNEL = KernelSource(ck.catt_rhs, ck.catt_events, ck.catt_observe)
+#: The reduced model's kernel: the same functions compiled for one planet set.
+_KERNEL_ONE = KernelSource(ck.catt_rhs_one, ck.catt_events_one, ck.catt_observe_one)
 _THETA_KERNEL = KernelSource(ck.theta_rhs)
 
 
@@ -116,7 +118,7 @@ class CATTDevice(Model):
                 for i in range(n_sets) for k, m in enumerate(("sq", "pq"))
             )
         self.name = "CATTDevice"
-        self.kernel = _KERNEL
+        self.kernel = _KERNEL_ONE if n_sets == 1 else _KERNEL
         self.omega_index = ck.OMEGA
         self.params = self._coefficient_vector(omega)
         self.param_names = self._names()

@@ -41,12 +41,8 @@ _JIT = {"cache": True, "error_model": "numpy", "boundscheck": False}
 
 @nb.njit(inline="always", **_JIT)
 def dead_zone(x, b):
-    """g(x, b) of Eq. (3)."""
-    if x > b:
-        return x - b
-    if x < -b:
-        return x + b
-    return 0.0
+    """g(x, b) of Eq. (3): x - b above b, x + b below -b, 0 between (branch-free, exact)."""
+    return x - min(max(x, -b), b)
 
 
 @nb.njit(inline="always", **_JIT)
@@ -61,50 +57,62 @@ def fourier(p, o, nh, s, c):
     return acc
 
 
-@nb.njit(**_JIT)
-def catt_rhs(t, y, dy, p, s, c):
+@nb.njit(inline="always", **_JIT)
+def _stiffness(p, f, nh, s, c):
+    """1 + the stiffness variation whose Fourier coefficients start at p[f]."""
+    acc = p[f] * c + p[f + 1] * s
+    if nh > 1:
+        ch = c
+        sh = s
+        for h in range(1, nh):
+            ch, sh = ch * c - sh * s, sh * c + ch * s
+            acc += p[f + 2 * h] * ch + p[f + 2 * h + 1] * sh
+    return 1.0 + acc
+
+
+# Each function below is written once, inline, for n_sets planet sets, and compiled twice: for
+# the general model (n_sets read from p) and for the reduced model (n_sets = 1, a constant, so the
+# loop over sets disappears: twice as fast). Helpers take arrays only when inlined.
+
+
+@nb.njit(inline="always", **_JIT)
+def _rhs(t, y, dy, p, s, c, n_sets):
     om2 = p[OMEGA] * p[OMEGA]
-    nb_ = int(p[N_BLOCKS])
     nh = int(p[N_HARM])
     bs = BLOCK_FIXED + 4 * nh
-    lp_phase = 0.0
+    load_c = p[F_C0]
+    sin_l1 = 0.0
     if p[F_C1] != 0.0 or p[HEADER + F_P1] != 0.0:
-        lp_phase = 1.0
+        load_c += p[F_C1] * math.sin(p[LAMBDA] * t + p[PSI2])
+        sin_l1 = math.sin(p[LAMBDA] * t + p[PSI1])
     carrier = 0.0
-    for i in range(nb_):
+    for i in range(n_sets):
         o = HEADER + i * bs
         j = 4 * i
         xs = y[j]
         vs = y[j + 1]
         xp = y[j + 2]
         vp = y[j + 3]
-        ks = 1.0 + fourier(p, o + BLOCK_FIXED, nh, s, c)
-        kp = 1.0 + fourier(p, o + BLOCK_FIXED + 2 * nh, nh, s, c)
-        gs = ks * dead_zone(xs, p[o + B_SQ])
-        gp = kp * dead_zone(xp, p[o + B_PQ])
+        gs = _stiffness(p, o + BLOCK_FIXED, nh, s, c) * dead_zone(xs, p[o + B_SQ])
+        gp = _stiffness(p, o + BLOCK_FIXED + 2 * nh, nh, s, c) * dead_zone(xp, p[o + B_PQ])
         carrier += p[o + K_SQ_C] * gs + p[o + C_SQ_C] * vs
         f_sq = p[o + K_SQ_Q] * gs + p[o + C_SQ_Q] * vs
         f_pq = p[o + K_PQ_Q] * gp + p[o + C_PQ_Q] * vp
         f_pp = p[o + K_PQ_P] * gp + p[o + C_PQ_P] * vp
-        load_p = p[o + F_P0]
-        if lp_phase != 0.0:
-            load_p += p[o + F_P1] * math.sin(p[LAMBDA] * t + p[PSI1])
+        load_p = p[o + F_P0] + p[o + F_P1] * sin_l1
         dy[j] = vs
         dy[j + 1] = -f_sq + f_pq + om2 * (p[o + E_SQ_S] * s + p[o + E_SQ_C] * c)
         dy[j + 2] = vp
-        dy[j + 3] = f_sq - f_pq - f_pp + load_p + om2 * (p[o + E_PQ_S] * s + p[o + E_PQ_C] * c)
-    load_c = p[F_C0]
-    if lp_phase != 0.0:
-        load_c += p[F_C1] * math.sin(p[LAMBDA] * t + p[PSI2])
-    for i in range(nb_):
+        dy[j + 3] = (f_sq - f_pq - f_pp + load_p
+                     + om2 * (p[o + E_PQ_S] * s + p[o + E_PQ_C] * c))
+    for i in range(n_sets):
         dy[4 * i + 1] += load_c - carrier
 
 
-@nb.njit(**_JIT)
-def catt_events(t, y, g, p):
-    nb_ = int(p[N_BLOCKS])
+@nb.njit(inline="always", **_JIT)
+def _events(y, g, p, n_sets):
     bs = BLOCK_FIXED + 4 * int(p[N_HARM])
-    for i in range(nb_):
+    for i in range(n_sets):
         o = HEADER + i * bs
         g[4 * i] = y[4 * i] - p[o + B_SQ]
         g[4 * i + 1] = y[4 * i] + p[o + B_SQ]
@@ -112,21 +120,52 @@ def catt_events(t, y, g, p):
         g[4 * i + 3] = y[4 * i + 2] + p[o + B_PQ]
 
 
-@nb.njit(**_JIT)
-def catt_observe(t, y, out, p, s, c):
-    nb_ = int(p[N_BLOCKS])
+@nb.njit(inline="always", **_JIT)
+def _observe(y, out, p, s, c, n_sets):
     nh = int(p[N_HARM])
     bs = BLOCK_FIXED + 4 * nh
-    for i in range(nb_):
+    for i in range(n_sets):
         o = HEADER + i * bs
         j = 4 * i
-        ks = 1.0 + fourier(p, o + BLOCK_FIXED, nh, s, c)
-        kp = 1.0 + fourier(p, o + BLOCK_FIXED + 2 * nh, nh, s, c)
+        gs = _stiffness(p, o + BLOCK_FIXED, nh, s, c) * dead_zone(y[j], p[o + B_SQ])
+        gp = _stiffness(p, o + BLOCK_FIXED + 2 * nh, nh, s, c) * dead_zone(y[j + 2], p[o + B_PQ])
         scale = p[o + FORCE_SCALE]
-        gs = ks * dead_zone(y[j], p[o + B_SQ])
-        gp = kp * dead_zone(y[j + 2], p[o + B_PQ])
         out[2 * i] = scale * (p[o + K_SQ_Q] * gs + p[o + C_SQ_Q] * y[j + 1])
         out[2 * i + 1] = scale * (p[o + K_PQ_Q] * gp + p[o + C_PQ_Q] * y[j + 3])
+
+
+@nb.njit(**_JIT)
+def catt_rhs(t, y, dy, p, s, c):
+    """dy/dt of the CATT device with p[N_BLOCKS] planet sets."""
+    _rhs(t, y, dy, p, s, c, int(p[N_BLOCKS]))
+
+
+@nb.njit(**_JIT)
+def catt_events(t, y, g, p):
+    """Dead-zone edges: X - b and X + b of every mesh."""
+    _events(y, g, p, int(p[N_BLOCKS]))
+
+
+@nb.njit(**_JIT)
+def catt_observe(t, y, out, p, s, c):
+    """Dynamic mesh forces [N] (sun-inside, inside-outside per planet set)."""
+    _observe(y, out, p, s, c, int(p[N_BLOCKS]))
+
+
+@nb.njit(**_JIT)
+def catt_rhs_one(t, y, dy, p, s, c):
+    """:func:`catt_rhs` for one (equivalent) planet set: the reduced model."""
+    _rhs(t, y, dy, p, s, c, 1)
+
+
+@nb.njit(**_JIT)
+def catt_events_one(t, y, g, p):
+    _events(y, g, p, 1)
+
+
+@nb.njit(**_JIT)
+def catt_observe_one(t, y, out, p, s, c):
+    _observe(y, out, p, s, c, 1)
 
 
 # ---------------------------------------------------------------------------------------------

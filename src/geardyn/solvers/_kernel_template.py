@@ -29,33 +29,51 @@ import numba as nb
 import numpy as np
 
 from geardyn.solvers._step_core import (  # CORE-IMPORT
+    _INLINE,
     _JIT,
     MAX_SPLITS,
     SIMULTANEOUS,
     STATUS_DIVERGED,
     STATUS_OK,
+    _events_i,
     _healthy,
+    _rhs_i,
     _side,
     _split_step,
     phase_table,
 )
 from geardyn.solvers._template_model import events, observe, rhs  # MODEL-IMPORT
 
+_observe_i = nb.njit(**_INLINE)(observe.py_func)
+
 __all__ = ["BLOCK", "MAX_SPLITS", "SIMULTANEOUS", "events", "observe", "phase_table", "rhs",
            "sweep", "trajectory"]
 
 BLOCK = 8
-# The hot loop calls the model's functions inlined (numba IR inlining): a call with array
-# arguments would otherwise cost reference counting on every stage of every step.
-_INLINE = {"inline": "always", "error_model": "numpy", "boundscheck": False}
-_rhs_i = nb.njit(**_INLINE)(rhs.py_func)
-_events_i = nb.njit(**_INLINE)(events.py_func)
-_observe_i = nb.njit(**_INLINE)(observe.py_func)
 
 
-@nb.njit(inline="always", **_JIT)
-def _block_step(i, first, nl, Y, Y1, K1, K2, K3, K4, TMP, G, SIDE, P, H, OMEGA, T0, n_per, sa,
-                ca, sb, cb, se, ce, locate, NCROSS, UNRES, work, ybuf, gbuf):
+@nb.njit(**_JIT)
+def _rhs_block(T, Y, DY, P, first, nl, s, c):
+    """rhs of rows 0..nl-1 (lanes first..) at times T; the model's rhs inlined, once per block."""
+    for k in range(nl):
+        _rhs_i(T[k], Y[k], DY[k], P[first + k], s, c)
+
+
+@nb.njit(**_JIT)
+def _events_block(T, Y, G, P, first, nl):
+    for k in range(nl):
+        _events_i(T[k], Y[k], G[k], P[first + k])
+
+
+@nb.njit(**_JIT)
+def _observe_block(T, Y, O, P, first, nl, s, c):
+    for k in range(nl):
+        _observe_i(T[k], Y[k], O[k], P[first + k], s, c)
+
+
+@nb.njit(**_JIT)
+def _block_step(i, first, nl, Y, Y1, K1, K2, K3, K4, TMP, TT, G, SIDE, P, H, OMEGA, T0, n_per,
+                sa, ca, sb, cb, se, ce, locate, NCROSS, UNRES, work, ybuf, gbuf):
     """Advance lanes first..first+nl-1 (rows 0..nl-1 of the block arrays) by grid step i: a
     lockstep RK4 trial for all lanes, then, for a lane whose trial crossed an edge, the step
     redone with the crossing located. G holds the events at the new states afterwards."""
@@ -63,31 +81,32 @@ def _block_step(i, first, nl, Y, Y1, K1, K2, K3, K4, TMP, G, SIDE, P, H, OMEGA, 
     n_ev = G.shape[1]
     for k in range(nl):
         lane = first + k
-        _rhs_i(T0[lane] + i * H[lane], Y[k], K1[k], P[lane], sa, ca)
+        TT[k] = T0[lane] + i * H[lane]
+    _rhs_block(TT, Y, K1, P, first, nl, sa, ca)
     for k in range(nl):
         lane = first + k
         hh = 0.5 * H[lane]
         for q in range(ns):
             TMP[k, q] = Y[k, q] + hh * K1[k, q]
-        _rhs_i(T0[lane] + i * H[lane] + hh, TMP[k], K2[k], P[lane], sb, cb)
+        TT[k] = T0[lane] + i * H[lane] + hh
+    _rhs_block(TT, TMP, K2, P, first, nl, sb, cb)
     for k in range(nl):
-        lane = first + k
-        hh = 0.5 * H[lane]
+        hh = 0.5 * H[first + k]
         for q in range(ns):
             TMP[k, q] = Y[k, q] + hh * K2[k, q]
-        _rhs_i(T0[lane] + i * H[lane] + hh, TMP[k], K3[k], P[lane], sb, cb)
+    _rhs_block(TT, TMP, K3, P, first, nl, sb, cb)
     for k in range(nl):
         lane = first + k
         h = H[lane]
         for q in range(ns):
             TMP[k, q] = Y[k, q] + h * K3[k, q]
-        _rhs_i(T0[lane] + (i + 1) * h, TMP[k], K4[k], P[lane], se, ce)
+        TT[k] = T0[lane] + (i + 1) * h
+    _rhs_block(TT, TMP, K4, P, first, nl, se, ce)
     for k in range(nl):
-        lane = first + k
-        h6 = H[lane] / 6.0
+        h6 = H[first + k] / 6.0
         for q in range(ns):
             Y1[k, q] = Y[k, q] + h6 * (K1[k, q] + 2.0 * K2[k, q] + 2.0 * K3[k, q] + K4[k, q])
-        _events_i(T0[lane] + (i + 1) * H[lane], Y1[k], G[k], P[lane])
+    _events_block(TT, Y1, G, P, first, nl)
     for k in range(nl):
         crossed = False
         for j in range(n_ev):
@@ -112,7 +131,7 @@ def _block_step(i, first, nl, Y, Y1, K1, K2, K3, K4, TMP, G, SIDE, P, H, OMEGA, 
 def _alloc(nb_lanes, ns, n_ev):
     Y = np.zeros((nb_lanes, ns))
     work = np.zeros((7, ns))
-    return (Y, Y.copy(), Y.copy(), Y.copy(), Y.copy(), Y.copy(), Y.copy(),
+    return (Y, Y.copy(), Y.copy(), Y.copy(), Y.copy(), Y.copy(), Y.copy(), np.zeros(nb_lanes),
             np.zeros((nb_lanes, n_ev)), np.ones((nb_lanes, n_ev), np.int64),
             work, np.zeros(ns), np.zeros((3, max(n_ev, 1))))
 
@@ -127,7 +146,7 @@ def trajectory(p, y0, h, omega, n_per, i0, n_steps, stride, locate, bound, n_ev,
     """
     ns = y0.size
     s_tab, c_tab = phase_table(n_per, omega != 0.0)
-    Y, Y1, K1, K2, K3, K4, TMP, G, SIDE, work, ybuf, gbuf = _alloc(1, ns, n_ev)
+    Y, Y1, K1, K2, K3, K4, TMP, TT, G, SIDE, work, ybuf, gbuf = _alloc(1, ns, n_ev)
     P = p.reshape((1, p.size))
     H = np.array([h])
     OM = np.array([omega])
@@ -163,7 +182,7 @@ def trajectory(p, y0, h, omega, n_per, i0, n_steps, stride, locate, bound, n_ev,
                     out_g[r, q] = gbuf[0, q]
         if i == i0 + n_steps:
             break
-        _block_step(i, 0, 1, Y, Y1, K1, K2, K3, K4, TMP, G, SIDE, P, H, OM, T0, n_per,
+        _block_step(i, 0, 1, Y, Y1, K1, K2, K3, K4, TMP, TT, G, SIDE, P, H, OM, T0, n_per,
                     s_tab[j0], c_tab[j0], s_tab[j0 + 1], c_tab[j0 + 1], s_tab[j0 + 2],
                     c_tab[j0 + 2], locate, NCROSS, UNRES, work, ybuf, gbuf)
         done = i + 1 - i0
@@ -173,12 +192,116 @@ def trajectory(p, y0, h, omega, n_per, i0, n_steps, stride, locate, bound, n_ev,
     return out_y, out_o[:, :n_obs], out_g[:, :n_ev], NCROSS[0, :n_ev], status, UNRES[0], done
 
 
+@nb.njit(**_JIT)
+def _sweep_block(first, nl, n_per, s_tab, c_tab, P, Y0, H, OMEGA, T0, n_transient, n_samples,
+                 sample_every, locate, bound, n_ev, n_obs, samples, final, status, gmin, gmax,
+                 ncross, omax, omin, orms, unresolved):
+    """One lockstep block of :func:`sweep`: lanes first..first+nl-1, all with n_per steps per
+    period (phase table s_tab, c_tab)."""
+    ns = Y0.shape[1]
+    Y, Y1, K1, K2, K3, K4, TMP, TT, G, SIDE, work, ybuf, gbuf = _alloc(BLOCK, ns, n_ev)
+    O = np.zeros((BLOCK, n_obs))
+    n_end = np.zeros(nl, np.int64)
+    n_tr = np.zeros(nl, np.int64)
+    next_sample = np.zeros(nl, np.int64)
+    n_stat = np.zeros(nl, np.int64)
+    max_end = 0
+    for k in range(nl):
+        lane = first + k
+        for q in range(ns):
+            Y[k, q] = Y0[lane, q]
+        events(T0[lane], Y[k], G[k], P[lane])
+        for j in range(n_ev):
+            SIDE[k, j] = _side(G[k, j])
+            gmin[lane, j] = np.inf
+            gmax[lane, j] = -np.inf
+            ncross[lane, j] = 0
+        for j in range(n_obs):
+            omax[lane, j] = -np.inf
+            omin[lane, j] = np.inf
+            orms[lane, j] = 0.0
+        status[lane] = STATUS_OK
+        unresolved[lane] = 0
+        n_tr[k] = n_transient[lane]
+        n_end[k] = n_transient[lane] + n_samples * sample_every[lane]
+        next_sample[k] = n_transient[lane] + sample_every[lane]
+        max_end = max(max_end, n_end[k])
+    min_tr = n_tr[0]
+    for k in range(nl):
+        min_tr = min(min_tr, n_tr[k])
+    phase = 0  # grid point index within the period
+    for i in range(max_end):
+        j0 = 2 * phase
+        _block_step(i, first, nl, Y, Y1, K1, K2, K3, K4, TMP, TT, G, SIDE, P, H, OMEGA, T0, n_per,
+                    s_tab[j0], c_tab[j0], s_tab[j0 + 1], c_tab[j0 + 1], s_tab[j0 + 2],
+                    c_tab[j0 + 2], locate, ncross, unresolved, work, ybuf, gbuf)
+        step = i + 1
+        phase += 1
+        if phase == n_per:
+            phase = 0
+        if n_obs > 0 and step > min_tr:
+            for k in range(nl):
+                TT[k] = T0[first + k] + step * H[first + k]
+            _observe_block(TT, Y, O, P, first, nl, s_tab[2 * phase], c_tab[2 * phase])
+        for k in range(nl):
+            if step > n_end[k]:
+                continue
+            lane = first + k
+            if status[lane] != STATUS_OK:
+                continue
+            if (phase == 0 or step == n_end[k]) and not _healthy(Y[k], bound):
+                status[lane] = STATUS_DIVERGED
+                for r in range(n_samples):
+                    for q in range(ns):
+                        samples[lane, r, q] = np.nan
+                for q in range(ns):
+                    final[lane, q] = np.nan
+                    Y[k, q] = 0.0
+                continue
+            if step <= n_tr[k]:
+                if step == n_tr[k]:
+                    for j in range(n_ev):
+                        ncross[lane, j] = 0
+                continue
+            for j in range(n_ev):
+                gmin[lane, j] = min(gmin[lane, j], G[k, j])
+                gmax[lane, j] = max(gmax[lane, j], G[k, j])
+            for j in range(n_obs):
+                omax[lane, j] = max(omax[lane, j], O[k, j])
+                omin[lane, j] = min(omin[lane, j], O[k, j])
+                orms[lane, j] += O[k, j] * O[k, j]
+            n_stat[k] += 1
+            if step == next_sample[k]:
+                r = (step - n_tr[k]) // sample_every[lane] - 1
+                for q in range(ns):
+                    samples[lane, r, q] = Y[k, q]
+                next_sample[k] += sample_every[lane]
+            if step == n_end[k]:
+                for q in range(ns):
+                    final[lane, q] = Y[k, q]
+    for k in range(nl):
+        lane = first + k
+        for j in range(n_obs):
+            if n_stat[k] > 0 and status[lane] == STATUS_OK:
+                orms[lane, j] = np.sqrt(orms[lane, j] / n_stat[k])
+            else:
+                orms[lane, j] = np.nan
+
+
 @nb.njit(parallel=True, **_JIT)
-def sweep(P, Y0, H, OMEGA, T0, n_per, n_transient, n_samples, sample_every, locate, bound, n_ev,
-          n_obs, samples, final, status, gmin, gmax, ncross, omax, omin, orms, unresolved):
+def sweep(P, Y0, H, OMEGA, T0, n_transient, n_samples, sample_every, locate, bound, n_ev, n_obs,
+          block_first, block_nl, block_nper, block_tab, S_TAB, C_TAB, worker_start,
+          worker_blocks, samples, final, status, gmin, gmax, ncross, omax, omin, orms,
+          unresolved):
     """Integrate every lane from time T0[lane] (a whole number of forcing periods):
     ``n_transient[lane]`` grid steps, then ``n_samples`` section samples, one every
-    ``sample_every`` grid steps, with statistics over the sampled stretch.
+    ``sample_every[lane]`` grid steps, with statistics over the sampled stretch.
+
+    Lanes are grouped in lockstep blocks (block b: lanes block_first[b] ... + block_nl[b], all
+    with block_nper[b] steps per period and the phase table S_TAB/C_TAB[block_tab[b]:]); worker
+    w runs blocks worker_blocks[worker_start[w]:worker_start[w + 1]] (a static, cost-balanced
+    schedule made by the caller). Lanes are independent, so results do not depend on blocking,
+    order or threads.
 
     Outputs (preallocated, filled here): samples[L, n_samples, ns] (NaN where diverged),
     final[L, ns], status[L], gmin/gmax[L, n_ev] (extremes of the events at grid points),
@@ -187,96 +310,13 @@ def sweep(P, Y0, H, OMEGA, T0, n_per, n_transient, n_samples, sample_every, loca
     A block runs in lockstep to its longest lane; a lane past its end keeps integrating
     harmlessly (its results are already stored), a diverged lane is reset to zero.
     """
-    L, ns = Y0.shape
-    forced = False
-    for lane in range(L):
-        if OMEGA[lane] != 0.0:
-            forced = True
-    s_tab, c_tab = phase_table(n_per, forced)
-    n_blocks = (L + BLOCK - 1) // BLOCK
-    for blk in nb.prange(n_blocks):
-        first = blk * BLOCK
-        nl = min(BLOCK, L - first)
-        Y, Y1, K1, K2, K3, K4, TMP, G, SIDE, work, ybuf, gbuf = _alloc(BLOCK, ns, n_ev)
-        obuf = np.zeros(max(n_obs, 1))
-        n_end = np.zeros(nl, np.int64)
-        n_tr = np.zeros(nl, np.int64)
-        next_sample = np.zeros(nl, np.int64)
-        n_stat = np.zeros(nl, np.int64)
-        max_end = 0
-        for k in range(nl):
-            lane = first + k
-            for q in range(ns):
-                Y[k, q] = Y0[lane, q]
-            events(T0[lane], Y[k], G[k], P[lane])
-            for j in range(n_ev):
-                SIDE[k, j] = _side(G[k, j])
-                gmin[lane, j] = np.inf
-                gmax[lane, j] = -np.inf
-                ncross[lane, j] = 0
-            for j in range(n_obs):
-                omax[lane, j] = -np.inf
-                omin[lane, j] = np.inf
-                orms[lane, j] = 0.0
-            status[lane] = STATUS_OK
-            unresolved[lane] = 0
-            n_tr[k] = n_transient[lane]
-            n_end[k] = n_transient[lane] + n_samples * sample_every
-            next_sample[k] = n_transient[lane] + sample_every
-            max_end = max(max_end, n_end[k])
-        phase = 0  # grid point index within the period
-        for i in range(max_end):
-            j0 = 2 * phase
-            _block_step(i, first, nl, Y, Y1, K1, K2, K3, K4, TMP, G, SIDE, P, H, OMEGA, T0, n_per,
-                        s_tab[j0], c_tab[j0], s_tab[j0 + 1], c_tab[j0 + 1], s_tab[j0 + 2],
-                        c_tab[j0 + 2], locate, ncross, unresolved, work, ybuf, gbuf)
-            step = i + 1
-            phase += 1
-            if phase == n_per:
-                phase = 0
-            for k in range(nl):
-                if step > n_end[k]:
-                    continue
-                lane = first + k
-                if status[lane] != STATUS_OK:
-                    continue
-                if (phase == 0 or step == n_end[k]) and not _healthy(Y[k], bound):
-                    status[lane] = STATUS_DIVERGED
-                    for r in range(n_samples):
-                        for q in range(ns):
-                            samples[lane, r, q] = np.nan
-                    for q in range(ns):
-                        final[lane, q] = np.nan
-                        Y[k, q] = 0.0
-                    continue
-                if step <= n_tr[k]:
-                    if step == n_tr[k]:
-                        for j in range(n_ev):
-                            ncross[lane, j] = 0
-                    continue
-                for j in range(n_ev):
-                    gmin[lane, j] = min(gmin[lane, j], G[k, j])
-                    gmax[lane, j] = max(gmax[lane, j], G[k, j])
-                if n_obs > 0:
-                    _observe_i(T0[lane] + step * H[lane], Y[k], obuf, P[lane], s_tab[2 * phase],
-                               c_tab[2 * phase])
-                    for j in range(n_obs):
-                        omax[lane, j] = max(omax[lane, j], obuf[j])
-                        omin[lane, j] = min(omin[lane, j], obuf[j])
-                        orms[lane, j] += obuf[j] * obuf[j]
-                n_stat[k] += 1
-                if step == next_sample[k]:
-                    r = (step - n_tr[k]) // sample_every - 1
-                    for q in range(ns):
-                        samples[lane, r, q] = Y[k, q]
-                    next_sample[k] += sample_every
-                if step == n_end[k]:
-                    for q in range(ns):
-                        final[lane, q] = Y[k, q]
-        for k in range(nl):
-            lane = first + k
-            for j in range(n_obs):
-                if n_stat[k] > 0 and status[lane] == STATUS_OK:
-                    orms[lane, j] = np.sqrt(orms[lane, j] / n_stat[k])
-                else:
-                    orms[lane, j] = np.nan
+    n_workers = worker_start.size - 1
+    for w in nb.prange(n_workers):
+        for b in range(worker_start[w], worker_start[w + 1]):
+            blk = worker_blocks[b]
+            n_per = block_nper[blk]
+            o = block_tab[blk]
+            _sweep_block(block_first[blk], block_nl[blk], n_per, S_TAB[o : o + 2 * n_per + 1],
+                         C_TAB[o : o + 2 * n_per + 1], P, Y0, H, OMEGA, T0, n_transient,
+                         n_samples, sample_every, locate, bound, n_ev, n_obs, samples, final,
+                         status, gmin, gmax, ncross, omax, omin, orms, unresolved)

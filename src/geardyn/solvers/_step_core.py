@@ -30,6 +30,12 @@ MAX_SPLITS = 16
 SIMULTANEOUS = 1e-9
 STATUS_OK = 0
 STATUS_DIVERGED = 1
+# MODEL-ADAPTERS (a user's plain functions are adapted to the kernel interface here)
+# The model's functions inlined (numba IR inlining) where they are called in a loop: a call with
+# array arguments would otherwise cost reference counting on every stage of every step.
+_INLINE = {"inline": "always", "error_model": "numpy", "boundscheck": False}
+_rhs_i = nb.njit(**_INLINE)(rhs.py_func)
+_events_i = nb.njit(**_INLINE)(events.py_func)
 
 
 @nb.njit(**_JIT)
@@ -71,7 +77,7 @@ def _rk4(t, y, h, p, s0, c0, s1, c1, s2, c2, k1, k2, k3, k4, tmp, out, have_k1):
         out[q] = y[q] + h6 * (k1[q] + 2.0 * k2[q] + 2.0 * k3[q] + k4[q])
 
 
-@nb.njit(**_JIT)
+@nb.njit(inline="always", **_JIT)
 def _hermite(y0, f0, y1, f1, dt, theta, out):
     """Cubic Hermite interpolant of a step of length dt at fraction theta."""
     t2 = theta * theta

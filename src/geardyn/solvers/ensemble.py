@@ -55,14 +55,15 @@ def run_lanes(
     transient: float,
     samples: int,
     steps_per_period: int | None = None,
-    sample_every: int = 1,
+    sample_every: int | np.ndarray = 1,
     locate_edges: bool = True,
     bound: float = DEFAULT_BOUND,
     t0: np.ndarray | None = None,
 ) -> LaneResults:
     """Integrate one lane per row of ``P`` (coefficient vectors) from ``y0`` (one state, or one
     per lane) and return stroboscopic samples (one every ``sample_every`` forcing periods) and
-    statistics over the sampled stretch. ``t0``: per-lane start times (whole periods)."""
+    statistics over the sampled stretch. ``t0``: per-lane start times (whole periods);
+    ``sample_every`` may differ per lane (a common period of two forcings)."""
     P = np.ascontiguousarray(np.atleast_2d(P), dtype=float)
     L = P.shape[0]
     ns = model.n_states
@@ -73,7 +74,7 @@ def run_lanes(
     if np.any(~np.isfinite(omega)) or np.any(omega <= 0):
         bad = omega[~(np.isfinite(omega) & (omega > 0))][0]
         raise ValueError(f"Omega must be positive and finite in every lane (got {bad!r})")
-    if samples < 1 or sample_every < 1:
+    if samples < 1 or np.any(np.asarray(sample_every) < 1):
         raise ValueError("samples and sample_every must be >= 1")
     if steps_per_period is None:
         n_lane = np.array([ladder_steps(default_steps_per_period(model, w)) for w in omega])
@@ -99,35 +100,83 @@ def run_lanes(
         steps_per_period=n_lane,
         transient_periods=n_tr_periods,
     )
-    for n in np.unique(n_lane):
-        # lanes of one group, sorted by period so lockstep blocks hold similar step counts
-        idx = np.nonzero(n_lane == n)[0]
-        idx = idx[np.argsort(period[idx], kind="stable")]
-        m = idx.size
-        smp = np.empty((m, samples, ns))
-        fin = np.empty((m, ns))
-        st = np.empty(m, np.int64)
-        gmin = np.empty((m, max(n_ev, 1)))
-        gmax = np.empty((m, max(n_ev, 1)))
-        nc = np.empty((m, max(n_ev, 1)), np.int64)
-        omax = np.empty((m, max(n_obs, 1)))
-        omin = np.empty((m, max(n_obs, 1)))
-        orms = np.empty((m, max(n_obs, 1)))
-        unres = np.empty(m, np.int64)
-        H = period[idx] / n
-        k.sweep(P[idx], Y0[idx], H, omega[idx], T0[idx], int(n),
-                (n_tr_periods[idx] * n).astype(np.int64), int(samples), int(sample_every * n),
-                bool(locate_edges), float(bound), n_ev, n_obs, smp, fin, st, gmin, gmax, nc,
-                omax, omin, orms, unres)
-        out.samples[idx] = smp
-        out.final[idx] = fin
-        out.status[idx] = st
-        out.event_min[idx] = gmin[:, :n_ev]
-        out.event_max[idx] = gmax[:, :n_ev]
-        out.crossings[idx] = nc[:, :n_ev]
-        out.obs_max[idx] = omax[:, :n_obs]
-        out.obs_min[idx] = omin[:, :n_obs]
-        out.obs_rms[idx] = orms[:, :n_obs]
-        out.unresolved[idx] = unres
-    out.final_time = T0 + (n_tr_periods + samples * sample_every) * period
+    every = np.broadcast_to(np.asarray(sample_every, dtype=np.int64), (L,))
+    # lanes sorted by steps per period, then period: a lockstep block holds lanes of one step
+    # count and similar length
+    order = np.lexsort((period, n_lane))
+    sched = _schedule(n_lane[order], n_tr_periods[order] + samples * every[order], k.BLOCK)
+    s_tab, c_tab, tab_of = _phase_tables(k, n_lane)
+    m = L
+    smp = np.empty((m, samples, ns))
+    fin = np.empty((m, ns))
+    st = np.empty(m, np.int64)
+    gmin = np.empty((m, n_ev))
+    gmax = np.empty((m, n_ev))
+    nc = np.empty((m, n_ev), np.int64)
+    omax = np.empty((m, n_obs))
+    omin = np.empty((m, n_obs))
+    orms = np.empty((m, n_obs))
+    unres = np.empty(m, np.int64)
+    first, nl, nper, w_start, w_blocks = sched
+    k.sweep(P[order], Y0[order], (period / n_lane)[order], omega[order], T0[order],
+            (n_tr_periods * n_lane)[order].astype(np.int64), int(samples),
+            (every * n_lane)[order].astype(np.int64), bool(locate_edges), float(bound), n_ev,
+            n_obs, first, nl, nper, np.array([tab_of[int(n)] for n in nper], np.int64),
+            s_tab, c_tab, w_start, w_blocks, smp, fin, st, gmin, gmax, nc, omax, omin, orms,
+            unres)
+    out.samples[order] = smp
+    out.final[order] = fin
+    out.status[order] = st
+    out.event_min[order] = gmin
+    out.event_max[order] = gmax
+    out.crossings[order] = nc
+    out.obs_max[order] = omax
+    out.obs_min[order] = omin
+    out.obs_rms[order] = orms
+    out.unresolved[order] = unres
+    out.final_time = T0 + (n_tr_periods + samples * every) * period
     return out
+
+
+def _phase_tables(k, n_lane: np.ndarray):
+    """Concatenated forcing-phase tables of every distinct step count, and their offsets."""
+    s_parts, c_parts, offset, pos = [], [], {}, 0
+    for n in np.unique(n_lane):
+        s, c = k.phase_table(int(n), True)
+        offset[int(n)] = pos
+        s_parts.append(s)
+        c_parts.append(c)
+        pos += s.size
+    return np.concatenate(s_parts), np.concatenate(c_parts), offset
+
+
+def _schedule(n_per: np.ndarray, periods: np.ndarray, block: int, workers: int | None = None):
+    """Lockstep blocks over lanes (already sorted by step count) and a cost-balanced static
+    assignment of blocks to workers (longest block first to the least loaded worker).
+
+    Returns (block_first, block_nl, block_nper, worker_start, worker_blocks)."""
+    import numba
+
+    workers = workers or numba.get_num_threads()
+    first, nl, nper, cost = [], [], [], []
+    L = n_per.size
+    a = 0
+    while a < L:
+        b = a + 1
+        while b < L and b - a < block and n_per[b] == n_per[a]:
+            b += 1
+        first.append(a)
+        nl.append(b - a)
+        nper.append(int(n_per[a]))
+        cost.append(float(np.max(periods[a:b])) * int(n_per[a]) * (b - a + block) / 2)
+        a = b
+    load = np.zeros(workers)
+    assigned: list[list[int]] = [[] for _ in range(workers)]
+    for blk in np.argsort(cost, kind="stable")[::-1]:
+        w = int(np.argmin(load))
+        assigned[w].append(int(blk))
+        load[w] += cost[blk]
+    start = np.cumsum([0] + [len(x) for x in assigned]).astype(np.int64)
+    blocks = np.array([b for x in assigned for b in x], dtype=np.int64)
+    return (np.array(first, np.int64), np.array(nl, np.int64), np.array(nper, np.int64), start,
+            blocks)

@@ -94,17 +94,23 @@ TEMPLATES: dict[str, str] = {
 }
 
 
-def _core_text() -> str:
-    """The shared step machinery (:mod:`._step_core`) as text to splice into a template."""
+def _core_text(adapters: str) -> str:
+    """The shared step machinery (:mod:`._step_core`) as text to splice into a template, with
+    ``adapters`` (definitions of the model interface names) at its ``MODEL-ADAPTERS`` line."""
     lines = inspect.getsource(importlib.import_module("geardyn.solvers._step_core")).splitlines()
-    return "\n".join(line for line in lines
-                     if not line.startswith("from __future__")
-                     and not line.rstrip().endswith(_IMPORT_MARK))
+    out = []
+    for line in lines:
+        if line.startswith("from __future__"):
+            continue
+        if line.startswith("# MODEL-ADAPTERS"):
+            out.append(adapters)
+        out.append(line)
+    return "\n".join(out)
 
 
-def _splice_core(text: str, extra: str = "") -> str:
+def _splice_core(text: str, adapters: str = "") -> str:
     """Replace the template's ``CORE-IMPORT`` statement (one line, or a parenthesised import
-    starting on the marked line) by the shared core's text, followed by ``extra``."""
+    starting on the marked line) by the shared core's text (see :func:`_core_text`)."""
     lines = text.splitlines()
     for k, line in enumerate(lines):
         if line.rstrip().endswith(_CORE_MARK):
@@ -112,7 +118,7 @@ def _splice_core(text: str, extra: str = "") -> str:
             if "(" in line and ")" not in line:
                 while ")" not in lines[end]:
                     end += 1
-            return "\n".join([*lines[:k], _core_text(), extra, *lines[end + 1 :]]) + "\n"
+            return "\n".join([*lines[:k], _core_text(adapters), *lines[end + 1 :]]) + "\n"
     raise RuntimeError("kernel template has lost its CORE-IMPORT line")
 
 
@@ -141,12 +147,14 @@ def _source_digest(text: str, funcs: dict[str, Any]) -> str:
 
 
 def _replace_import(text: str, new_line: str) -> str:
+    """Replace every ``MODEL-IMPORT`` line (the spliced core's and the template's)."""
     lines = text.splitlines()
-    for k, line in enumerate(lines):
-        if line.rstrip().endswith(_IMPORT_MARK):
-            lines[k] = new_line
-            return "\n".join(lines) + "\n"
-    raise RuntimeError("kernel template has lost its MODEL-IMPORT line")
+    marked = [k for k, line in enumerate(lines) if line.rstrip().endswith(_IMPORT_MARK)]
+    if not marked:
+        raise RuntimeError("kernel template has lost its MODEL-IMPORT line")
+    for k in marked:
+        lines[k] = new_line
+    return "\n".join(lines) + "\n"
 
 
 def kernels_for(source: KernelSource, template: str = "rk4") -> types.ModuleType:
