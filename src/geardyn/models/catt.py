@@ -214,6 +214,14 @@ class CATTDevice(Model):
         return Model.lane_params(self, name, values)
 
     # ------------------------------------------------------------------ linear analysis
+    def other_frequencies(self, P: np.ndarray) -> np.ndarray:
+        """The load fluctuation's Lambda in every lane where B1 or B2 is nonzero (else NaN)."""
+        P = np.atleast_2d(P)
+        acts = (P[:, ck.F_C1] != 0.0) | np.any(
+            P[:, ck.HEADER + ck.F_P1 :: ck.block_size(self._n_harmonics())][:, : self.n_sets]
+            != 0.0, axis=1)
+        return np.where(acts & (P[:, ck.LAMBDA] != 0.0), P[:, ck.LAMBDA], np.nan)[:, None]
+
     def stiffness_matrix(self) -> np.ndarray:
         """Dimensionless mean stiffness matrix A of the general 2N-coordinate model, such that the
         linearised undamped motion (b = 0, Ka = 0) is X'' = -A X + forcing."""

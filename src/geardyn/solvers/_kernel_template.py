@@ -193,12 +193,34 @@ def trajectory(p, y0, h, omega, n_per, i0, n_steps, stride, locate, bound, n_ev,
 
 
 @nb.njit(**_JIT)
-def _sweep_block(first, nl, n_per, s_tab, c_tab, P, Y0, H, OMEGA, T0, n_transient, n_samples,
-                 sample_every, locate, bound, n_ev, n_obs, samples, final, status, gmin, gmax,
-                 ncross, omax, omin, orms, unresolved):
+def _repeats(y, R, n, tol):
+    """True if y equals one of the first min(n, len(R)) rows of R to within
+    tol (1 + max |row|) in every component: the section has come back to an earlier point."""
+    for m in range(min(n, R.shape[0])):
+        scale = 0.0
+        for q in range(y.size):
+            scale = max(scale, abs(R[m, q]))
+        lim = tol * (1.0 + scale)
+        same = True
+        for q in range(y.size):
+            if not (abs(y[q] - R[m, q]) <= lim):
+                same = False
+                break
+        if same:
+            return True
+    return False
+
+
+@nb.njit(**_JIT)
+def _sweep_block(first, nl, n_per, s_tab, c_tab, P, Y0, H, OMEGA, T0, n_transient,
+                 n_transient_max, conv_tol, conv_depth, n_samples, sample_every, locate, bound,
+                 n_ev, n_obs, samples, final, status, gmin, gmax, ncross, omax, omin, orms,
+                 unresolved, transient_steps, converged):
     """One lockstep block of :func:`sweep`: lanes first..first+nl-1, all with n_per steps per
     period (phase table s_tab, c_tab)."""
     ns = Y0.shape[1]
+    R = np.zeros((nl, max(conv_depth, 1), ns))  # the last section points of the transient
+    n_ring = np.zeros(nl, np.int64)
     Y, Y1, K1, K2, K3, K4, TMP, TT, G, SIDE, work, ybuf, gbuf = _alloc(BLOCK, ns, n_ev)
     O = np.zeros((BLOCK, n_obs))
     n_end = np.zeros(nl, np.int64)
@@ -222,6 +244,7 @@ def _sweep_block(first, nl, n_per, s_tab, c_tab, P, Y0, H, OMEGA, T0, n_transien
             orms[lane, j] = 0.0
         status[lane] = STATUS_OK
         unresolved[lane] = 0
+        converged[lane] = 0 if conv_tol > 0.0 else -1
         n_tr[k] = n_transient[lane]
         n_end[k] = n_transient[lane] + n_samples * sample_every[lane]
         next_sample[k] = n_transient[lane] + sample_every[lane]
@@ -230,7 +253,9 @@ def _sweep_block(first, nl, n_per, s_tab, c_tab, P, Y0, H, OMEGA, T0, n_transien
     for k in range(nl):
         min_tr = min(min_tr, n_tr[k])
     phase = 0  # grid point index within the period
-    for i in range(max_end):
+    i = -1
+    while i + 1 < max_end:
+        i += 1
         j0 = 2 * phase
         _block_step(i, first, nl, Y, Y1, K1, K2, K3, K4, TMP, TT, G, SIDE, P, H, OMEGA, T0, n_per,
                     s_tab[j0], c_tab[j0], s_tab[j0 + 1], c_tab[j0 + 1], s_tab[j0 + 2],
@@ -259,9 +284,25 @@ def _sweep_block(first, nl, n_per, s_tab, c_tab, P, Y0, H, OMEGA, T0, n_transien
                     Y[k, q] = 0.0
                 continue
             if step <= n_tr[k]:
-                if step == n_tr[k]:
-                    for j in range(n_ev):
-                        ncross[lane, j] = 0
+                if step < n_tr[k]:
+                    continue
+                if conv_tol > 0.0 and converged[lane] == 0:
+                    every = sample_every[lane]
+                    if _repeats(Y[k], R[k], n_ring[k], conv_tol):
+                        converged[lane] = 1
+                    elif n_tr[k] + every <= n_transient_max[lane]:
+                        # not settled yet: one more section period of transient
+                        slot = n_ring[k] % R.shape[1]
+                        for q in range(ns):
+                            R[k, slot, q] = Y[k, q]
+                        n_ring[k] += 1
+                        n_tr[k] += every
+                        n_end[k] += every
+                        next_sample[k] += every
+                        max_end = max(max_end, n_end[k])
+                        continue
+                for j in range(n_ev):
+                    ncross[lane, j] = 0
                 continue
             for j in range(n_ev):
                 gmin[lane, j] = min(gmin[lane, j], G[k, j])
@@ -281,6 +322,7 @@ def _sweep_block(first, nl, n_per, s_tab, c_tab, P, Y0, H, OMEGA, T0, n_transien
                     final[lane, q] = Y[k, q]
     for k in range(nl):
         lane = first + k
+        transient_steps[lane] = n_tr[k]
         for j in range(n_obs):
             if n_stat[k] > 0 and status[lane] == STATUS_OK:
                 orms[lane, j] = np.sqrt(orms[lane, j] / n_stat[k])
@@ -289,13 +331,19 @@ def _sweep_block(first, nl, n_per, s_tab, c_tab, P, Y0, H, OMEGA, T0, n_transien
 
 
 @nb.njit(parallel=True, **_JIT)
-def sweep(P, Y0, H, OMEGA, T0, n_transient, n_samples, sample_every, locate, bound, n_ev, n_obs,
-          block_first, block_nl, block_nper, block_tab, S_TAB, C_TAB, worker_start,
-          worker_blocks, samples, final, status, gmin, gmax, ncross, omax, omin, orms,
-          unresolved):
+def sweep(P, Y0, H, OMEGA, T0, n_transient, n_transient_max, conv_tol, conv_depth, n_samples,
+          sample_every, locate, bound, n_ev, n_obs, block_first, block_nl, block_nper,
+          block_tab, S_TAB, C_TAB, worker_start, worker_blocks, samples, final, status, gmin,
+          gmax, ncross, omax, omin, orms, unresolved, transient_steps, converged):
     """Integrate every lane from time T0[lane] (a whole number of forcing periods):
     ``n_transient[lane]`` grid steps, then ``n_samples`` section samples, one every
     ``sample_every[lane]`` grid steps, with statistics over the sampled stretch.
+
+    With ``conv_tol > 0`` the transient goes on, one section period at a time up to
+    ``n_transient_max[lane]`` steps, until the section point repeats one of the last
+    ``conv_depth`` ones to within conv_tol (1 + |point|) (a periodic attractor reached);
+    converged[lane] is 1 then, 0 if the limit came first, -1 without the test;
+    transient_steps[lane] is the transient used.
 
     Lanes are grouped in lockstep blocks (block b: lanes block_first[b] ... + block_nl[b], all
     with block_nper[b] steps per period and the phase table S_TAB/C_TAB[block_tab[b]:]); worker
@@ -318,5 +366,6 @@ def sweep(P, Y0, H, OMEGA, T0, n_transient, n_samples, sample_every, locate, bou
             o = block_tab[blk]
             _sweep_block(block_first[blk], block_nl[blk], n_per, S_TAB[o : o + 2 * n_per + 1],
                          C_TAB[o : o + 2 * n_per + 1], P, Y0, H, OMEGA, T0, n_transient,
-                         n_samples, sample_every, locate, bound, n_ev, n_obs, samples, final,
-                         status, gmin, gmax, ncross, omax, omin, orms, unresolved)
+                         n_transient_max, conv_tol, conv_depth, n_samples, sample_every, locate,
+                         bound, n_ev, n_obs, samples, final, status, gmin, gmax, ncross, omax,
+                         omin, orms, unresolved, transient_steps, converged)

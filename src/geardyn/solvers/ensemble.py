@@ -45,7 +45,8 @@ class LaneResults:
     obs_rms: np.ndarray
     unresolved: np.ndarray  # (L,) steps that reached the split limit
     steps_per_period: np.ndarray  # (L,)
-    transient_periods: np.ndarray  # (L,)
+    transient_periods: np.ndarray  # (L,) transient used, in forcing periods
+    converged: np.ndarray  # (L,) transient by convergence: 1 settled, 0 hit the limit, -1 off
 
 
 def run_lanes(
@@ -59,11 +60,20 @@ def run_lanes(
     locate_edges: bool = True,
     bound: float = DEFAULT_BOUND,
     t0: np.ndarray | None = None,
+    transient_max: float | None = None,
+    converge_tol: float = 0.0,
+    converge_depth: int = 16,
 ) -> LaneResults:
     """Integrate one lane per row of ``P`` (coefficient vectors) from ``y0`` (one state, or one
     per lane) and return stroboscopic samples (one every ``sample_every`` forcing periods) and
     statistics over the sampled stretch. ``t0``: per-lane start times (whole periods);
-    ``sample_every`` may differ per lane (a common period of two forcings)."""
+    ``sample_every`` may differ per lane (a common period of two forcings); the transient is
+    rounded up to whole sampling intervals.
+
+    Transient by convergence: with ``converge_tol > 0`` the transient (then a minimum) goes on,
+    one sampling interval at a time up to ``transient_max`` (default 10 x transient), until the
+    section point repeats one of the last ``converge_depth`` to within
+    ``converge_tol (1 + |point|)``; ``converged`` tells per lane whether it did."""
     P = np.ascontiguousarray(np.atleast_2d(P), dtype=float)
     L = P.shape[0]
     ns = model.n_states
@@ -81,7 +91,14 @@ def run_lanes(
     else:
         n_lane = np.full(L, int(steps_per_period))
     period = 2.0 * math.pi / omega
-    n_tr_periods = np.ceil(transient / period - 1e-9).astype(np.int64)
+    every = np.broadcast_to(np.asarray(sample_every, dtype=np.int64), (L,))
+    n_tr_periods = _whole(np.ceil(transient / period - 1e-9), every)
+    if transient_max is None:
+        transient_max = 10.0 * transient
+    n_max_periods = np.maximum(_whole(np.floor(transient_max / period + 1e-9), every),
+                               n_tr_periods)
+    if converge_tol < 0 or converge_depth < 1:
+        raise ValueError("converge_tol must be >= 0 and converge_depth >= 1")
     T0 = np.zeros(L) if t0 is None else np.broadcast_to(np.asarray(t0, float), (L,)).copy()
     n_ev, n_obs = model.n_events, model.n_observables
     k = kernels_for(model.kernel)
@@ -99,12 +116,14 @@ def run_lanes(
         unresolved=np.zeros(L, np.int64),
         steps_per_period=n_lane,
         transient_periods=n_tr_periods,
+        converged=np.full(L, -1, np.int64),
     )
-    every = np.broadcast_to(np.asarray(sample_every, dtype=np.int64), (L,))
     # lanes sorted by steps per period, then period: a lockstep block holds lanes of one step
     # count and similar length
     order = np.lexsort((period, n_lane))
     sched = _schedule(n_lane[order], n_tr_periods[order] + samples * every[order], k.BLOCK)
+    tr_steps = np.empty(L, np.int64)
+    conv = np.empty(L, np.int64)
     s_tab, c_tab, tab_of = _phase_tables(k, n_lane)
     m = L
     smp = np.empty((m, samples, ns))
@@ -119,11 +138,13 @@ def run_lanes(
     unres = np.empty(m, np.int64)
     first, nl, nper, w_start, w_blocks = sched
     k.sweep(P[order], Y0[order], (period / n_lane)[order], omega[order], T0[order],
-            (n_tr_periods * n_lane)[order].astype(np.int64), int(samples),
+            (n_tr_periods * n_lane)[order].astype(np.int64),
+            (n_max_periods * n_lane)[order].astype(np.int64), float(converge_tol),
+            int(converge_depth), int(samples),
             (every * n_lane)[order].astype(np.int64), bool(locate_edges), float(bound), n_ev,
             n_obs, first, nl, nper, np.array([tab_of[int(n)] for n in nper], np.int64),
             s_tab, c_tab, w_start, w_blocks, smp, fin, st, gmin, gmax, nc, omax, omin, orms,
-            unres)
+            unres, tr_steps, conv)
     out.samples[order] = smp
     out.final[order] = fin
     out.status[order] = st
@@ -134,8 +155,15 @@ def run_lanes(
     out.obs_min[order] = omin
     out.obs_rms[order] = orms
     out.unresolved[order] = unres
-    out.final_time = T0 + (n_tr_periods + samples * every) * period
+    out.converged[order] = conv
+    out.transient_periods[order] = tr_steps // n_lane[order]
+    out.final_time = T0 + (out.transient_periods + samples * every) * period
     return out
+
+
+def _whole(periods: np.ndarray, every: np.ndarray) -> np.ndarray:
+    """Periods rounded up to whole multiples of ``every``."""
+    return (np.ceil(periods / every) * every).astype(np.int64)
 
 
 def _phase_tables(k, n_lane: np.ndarray):

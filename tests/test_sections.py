@@ -1,0 +1,79 @@
+"""Poincare sections: the common period of two forcings, and the transient set by convergence."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import geardyn
+from geardyn.analysis.periodicity import classify_period, common_section
+from geardyn.solvers.ensemble import run_lanes
+
+
+def test_common_section_of_rational_and_irrational_ratios():
+    omega = np.array([1.0, 1.0, 1.5, 2.0, 1.0, 1.0])
+    others = np.array([[0.5, np.nan], [1 / 3, 0.25], [1.0, np.nan], [np.nan, np.nan],
+                       [math.sqrt(2), np.nan], [1 / 97, np.nan]])
+    every, ok = common_section(omega, others)
+    # 1/2 -> 2 periods; 1/3 and 1/4 -> lcm 12; 1/1.5 = 2/3 -> 3; none -> 1; sqrt 2 and a
+    # denominator beyond the limit are not commensurate
+    assert every.tolist() == [2, 12, 3, 1, 1, 1]
+    assert ok.tolist() == [True, True, True, True, False, False]
+
+
+@pytest.fixture(scope="module")
+def noisy_device():
+    # load fluctuation at Lambda = Omega / 2: the forcing repeats every two mesh periods
+    p = geardyn.PlanetaryParams.paper(xi1=0.1, xi2=0.1, B1=0.2, B2=0.2, Lambda=0.3)
+    return geardyn.CATTDevice(p, omega=0.6)
+
+
+def test_model_reports_the_load_fluctuation(noisy_device):
+    P = noisy_device.lane_params("Omega", [0.6, 0.9])
+    every, ok = common_section(P[:, noisy_device.omega_index],
+                               noisy_device.other_frequencies(P))
+    assert every.tolist() == [2, 3] and ok.all()
+    quiet = geardyn.CATTDevice(geardyn.PlanetaryParams.paper())
+    assert np.isnan(quiet.other_frequencies(quiet.lane_params("Omega", [1.0]))).all()
+
+
+def test_samples_every_common_period_match_reference(noisy_device):
+    m = noisy_device
+    P = m.lane_params("Omega", [0.6])
+    r = run_lanes(m, P, m.initial_state(), 150.0, 4, sample_every=2)
+    T = 2 * math.pi / 0.6
+    n_tr = int(r.transient_periods[0])
+    assert n_tr % 2 == 0  # the transient is whole common periods
+    t_eval = (n_tr + 2 * np.arange(1, 5)) * T
+    ref = geardyn.reference_solution(m, m.initial_state(), t_eval)
+    assert np.max(np.abs(r.samples[0] - ref)) < 1e-6 * np.max(np.abs(ref))
+
+
+def test_transient_by_convergence_stops_early_on_a_periodic_attractor():
+    m = geardyn.CATTDevice(geardyn.PlanetaryParams.paper(xi1=0.05, xi2=0.05))
+    P = m.lane_params("Omega", [0.6, 1.1])
+    long = run_lanes(m, P, m.initial_state(), 3000.0, 8)
+    auto = run_lanes(m, P, m.initial_state(), 100.0, 8, transient_max=3000.0,
+                     converge_tol=1e-8)
+    assert auto.converged.tolist() == [1, 1]
+    assert np.all(auto.transient_periods < long.transient_periods)
+    assert classify_period(auto.samples).tolist() == classify_period(long.samples).tolist()
+    # the points agree with those after the long transient (to the tolerance's order), up to
+    # the phase along a period-k orbit
+    scale = np.max(np.abs(long.samples))
+    for lane, k in enumerate(classify_period(long.samples)):
+        a, b = auto.samples[lane], long.samples[lane]
+        err = min(np.max(np.abs(np.roll(a, s, axis=0) - b)) for s in range(k))
+        assert err < 1e-6 * scale
+    assert long.converged.tolist() == [-1, -1]
+
+
+def test_transient_by_convergence_gives_up_on_chaos():
+    m = geardyn.CATTDevice(geardyn.PlanetaryParams.paper(xi1=0.05, xi2=0.05))
+    P = m.lane_params("Omega", [2.5])  # chaotic (Fig. 3 band 2.3-2.7)
+    r = run_lanes(m, P, m.initial_state(), 100.0, 8, transient_max=600.0, converge_tol=1e-8)
+    T = 2 * math.pi / 2.5
+    assert r.converged[0] == 0
+    assert r.transient_periods[0] == math.floor(600.0 / T)
