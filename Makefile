@@ -16,9 +16,13 @@ $(STAMP): pyproject.toml
 
 venv: $(STAMP)
 
+# Paper Fig. 3 (consistent interpretation): the full 1000-point bifurcation diagram, then one
+# point of it (Omega = 1.1, period 2) in detail: time history, phase portrait, Poincare section,
+# labelled amplitude spectrum.
 demo: $(STAMP)
 	mkdir -p out
-	$(BIN)/geardyn simulate src/geardyn/studies/paper_fig3.toml --omega 1.1 --out out/demo.nc --plot out/demo.png
+	$(BIN)/geardyn bifurcation paper_fig3 --interpretation consistent --out out/fig3.nc --plot out/fig3.png
+	$(BIN)/geardyn simulate paper_fig3 --interpretation consistent --omega 1.1 --out out/fig3_omega1.1.nc --plot out/fig3_omega1.1.png
 
 test: $(STAMP)
 	$(BIN)/ruff check src tests

@@ -2,17 +2,22 @@
 
 from __future__ import annotations
 
+import contextlib
 import subprocess
 import sys
 import tomllib
 from pathlib import Path
 
+import numpy as np
 import pytest
+import xarray as xr
+from typer.testing import CliRunner
 
-from geardyn import PlanetaryParams
-from geardyn.cli.main import main
-from geardyn.io.netcdf import load_dataset
-from geardyn.io.toml import load_study, paper_study, study_to_toml
+from geardyn import GearPair, PlanetaryParams, bifurcation, simulate
+from geardyn.cli import bifurcation as cli_bifurcation
+from geardyn.cli.main import app, main
+from geardyn.io.netcdf import load_dataset, save_dataset
+from geardyn.io.toml import builtin_study, load_study, paper_study, study_to_toml
 
 
 def _command(*args) -> list[str]:
@@ -61,6 +66,7 @@ def test_help_and_version(capsys):
     r = geardyn("--help")
     assert r.returncode == 0, r.stderr
     assert "simulate" in r.stdout and "params" in r.stdout
+    assert "bifurcation" in r.stdout and "plot" in r.stdout
     r = geardyn_here(capsys, "--version")
     assert r.returncode == 0 and r.stdout.strip() == "geardyn 0.1.0"
     r = geardyn_here(capsys, "params", "--help")
@@ -162,3 +168,185 @@ def test_simulate_writes_netcdf_and_figure(tmp_path):
     assert ds.attrs["study"] == "fig3"
     assert ds.sizes["sample"] == 5
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+
+# --------------------------------------------------------------------------- bifurcation, plot
+# In this process through typer's CliRunner: the root group itself turns errors into one line.
+PNG = b"\x89PNG\r\n\x1a\n"
+PDF = b"%PDF-"
+
+
+def invoke(*args) -> subprocess.CompletedProcess:
+    result = CliRunner().invoke(app, [str(a) for a in args])
+    if result.exception is not None and not isinstance(result.exception, SystemExit):
+        raise result.exception
+    return subprocess.CompletedProcess(args, result.exit_code, result.stdout, result.stderr)
+
+
+TINY = ("--transient", "60", "--samples", "6", "--steps-per-period", "64", "--quiet")
+
+
+def test_bifurcation_writes_what_the_api_computes(tmp_path):
+    nc, png = tmp_path / "out" / "fig3.nc", tmp_path / "out" / "fig3.png"
+    r = invoke("bifurcation", "paper_fig3", "--range", "0.6:2.6:5", *TINY, "--out", nc,
+               "--plot", png)
+    assert r.returncode == 0, r.stderr
+    assert "fig3: 5 values of Omega in [0.6, 2.6], continuation none" in r.stdout
+    assert str(nc) in r.stdout and str(png) in r.stdout
+    assert png.read_bytes()[:8] == PNG
+    saved = load_dataset(nc)
+    study = builtin_study("paper_fig3")
+    direct = bifurcation(study.build_model(), param="Omega",
+                                 values=np.linspace(0.6, 2.6, 5), transient=60.0, samples=6,
+                                 steps_per_period=64)
+    np.testing.assert_array_equal(saved["period"].values, direct["period"].values)
+    np.testing.assert_array_equal(saved["poincare"].values, direct["poincare"].values)
+    np.testing.assert_array_equal(saved["contact"].values, direct["contact"].values)
+    assert saved.attrs["study"] == "fig3" and saved.attrs["plot_state"] == "X_sq"
+    assert saved.attrs["interpretation"] == "consistent" and saved.attrs["samples"] == 6
+    # the summary counts what the file holds
+    n1 = int(np.sum(saved["period"].values == 1))
+    assert (f"period-1 {n1}" in r.stdout) == (n1 > 0)
+
+
+GEAR_PAIR_STUDY = """
+[study]
+name = "gp"
+model = "gear_pair"
+[params]
+zeta = 0.05
+kappa = 0.2
+Fa = 0.2
+[run]
+transient = 150.0
+[sweep]
+param = "Omega"
+start = 0.6
+stop = 1.4
+num = 5
+continuation = "down"
+samples = 8
+lyapunov = true
+"""
+
+
+def test_bifurcation_defaults_come_from_the_study(tmp_path):
+    study = tmp_path / "gp.toml"
+    study.write_text(GEAR_PAIR_STUDY)
+    nc, pdf = tmp_path / "gp.nc", tmp_path / "gp.pdf"
+    r = invoke("bifurcation", study, "--quiet", "--out", nc, "--plot", pdf)
+    assert r.returncode == 0, r.stderr
+    assert "continuation down" in r.stdout
+    assert pdf.read_bytes()[:5] == PDF
+    saved = load_dataset(nc)
+    g = GearPair(zeta=0.05, kappa=0.2, Fa=0.2)
+    direct = bifurcation(g, values=np.linspace(0.6, 1.4, 5), transient=150.0, samples=8,
+                                 continuation="down", lyapunov=True)
+    np.testing.assert_array_equal(saved["period"].values, direct["period"].values)
+    np.testing.assert_array_equal(saved["lyapunov"].values, direct["lyapunov"].values)
+    assert saved.attrs["continuation"] == "down" and saved.sizes["sample"] == 8
+    # options win over the study: another parameter at a fixed Omega, no Lyapunov exponent
+    r = invoke("bifurcation", study, "--param", "Fa", "--range", "0.1:0.3:3", "--omega", "0.9",
+               "--continuation", "none", "--no-lyapunov", "--samples", "4", "--quiet",
+               "--out", nc)
+    assert r.returncode == 0, r.stderr
+    saved = load_dataset(nc)
+    direct = bifurcation(g.with_omega(0.9), param="Fa", values=[0.1, 0.2, 0.3],
+                                 transient=150.0, samples=4)
+    np.testing.assert_array_equal(saved["poincare"].values, direct["poincare"].values)
+    assert "lyapunov" not in saved and list(saved["Fa"].values) == [0.1, 0.2, 0.3]
+
+
+def test_bifurcation_progress_reaches_the_total(tmp_path, monkeypatch):
+    calls: list[tuple[int, int]] = []
+    real_bar = cli_bifurcation._progress_bar
+
+    @contextlib.contextmanager
+    def recording_bar(show, label):
+        with real_bar(show, label) as callback:  # the rich bar itself, on the captured stderr
+            def record(done, total):
+                calls.append((done, total))
+                callback(done, total)
+
+            yield None if callback is None else record
+
+    monkeypatch.setattr(cli_bifurcation, "_stderr_is_terminal", lambda: True)
+    monkeypatch.setattr(cli_bifurcation, "_progress_bar", recording_bar)
+    r = invoke("bifurcation", "paper_fig3", "--range", "0.6:2.6:3", *TINY[:-1])
+    assert r.returncode == 0, r.stderr
+    assert calls and calls[-1] == (3, 3)
+    assert all(a <= b for (a, _), (b, _) in zip(calls, calls[1:], strict=False))
+    # --quiet: no bar, no callback
+    calls.clear()
+    r = invoke("bifurcation", "paper_fig3", "--range", "0.6:2.6:3", *TINY)
+    assert r.returncode == 0 and calls == []
+
+
+@pytest.mark.parametrize(("args", "fragments"), [
+    (("--range", "0.1:4"), ("--range", "START:STOP:NUM", "'0.1:4'")),
+    (("--range", "a:4:10"), ("--range", "numbers", "'a:4:10'")),
+    (("--range", "0.1:4:1"), ("--range", "NUM must be >= 2")),
+    (("--range", "0.1:4:2.5"), ("--range", "whole number")),
+    (("--range", "1:1:5"), ("--range", "differ")),
+    (("--range", "0.1:inf:5"), ("--range", "finite")),
+    (("--param", "xi9"), ("--param", "'xi9'", "known: Omega, xi1")),
+    (("--param", "xi1"), ("--range", "not given")),
+    (("--param", "xi1", "--range", "0.01:0.1:3"), ("--omega", "not given")),
+    (("--param", "xi1", "--range", "-0.1:0.1:3", "--omega", "1"), ("--range", "-0.1")),
+    (("--continuation", "sideways"), ("--continuation", "sideways")),
+    (("--samples", "1"), ("--samples", "1")),
+    (("--transient", "-5"), ("--transient", "-5")),
+    (("--omega", "0"), ("--omega",)),
+    (("--plot", "fig.jpg"), ("--plot", "fig.jpg")),
+    (("--out", "sweep.zarr"), ("--out", ".nc")),
+    (("--state", "Q_sq"), ("--state", "'Q_sq'", "X_sq")),
+    (("--interpretation", "printed"), ("--interpretation",)),
+])
+def test_bifurcation_bad_input_is_one_line_error(tmp_path, args, fragments):
+    files = [] if "--out" in args else ["--out", tmp_path / "x.nc"]
+    files += [] if "--plot" in args else ["--plot", tmp_path / "x.png"]
+    r = invoke("bifurcation", "paper_fig3", *TINY, *args, *files)
+    assert_one_line_error(r, *fragments)
+    assert not list(tmp_path.iterdir())  # checked before anything runs or is written
+
+
+def test_bifurcation_bad_study_is_one_line_error(tmp_path):
+    assert_one_line_error(invoke("bifurcation", "no_such_study"), "no_such_study")
+    path, fragments = _bad_study(tmp_path, "negative-stiffness")
+    assert_one_line_error(invoke("bifurcation", path, "--range", "1:2:3"), *fragments)
+    r = invoke("bifurcation", path.with_name("no_sweep.toml").as_posix())
+    assert_one_line_error(r, "no_sweep.toml")
+    plain = tmp_path / "plain.toml"
+    plain.write_text('[params]\nbase = "paper"\n')
+    assert_one_line_error(invoke("bifurcation", plain), "--range", "no [sweep]")
+
+
+def test_plot_redraws_saved_results(tmp_path):
+    g = GearPair(zeta=0.05, kappa=0.2, Fa=0.2)
+    bif = save_dataset(bifurcation(g, values=[0.8, 0.95, 1.2], transient=100.0,
+                                           samples=8), tmp_path / "bif.nc")
+    sim = save_dataset(simulate(g, omega=0.95, transient=100.0, periods=8),
+                       tmp_path / "sim.nc")
+    r = invoke("plot", bif, "--out", tmp_path / "figs" / "bif.pdf")
+    assert r.returncode == 0, r.stderr
+    assert "bifurcation dataset" in r.stdout
+    assert (tmp_path / "figs" / "bif.pdf").read_bytes()[:5] == PDF
+    r = invoke("plot", sim, "--state", "v")
+    assert r.returncode == 0 and "simulation dataset" in r.stdout, r.stderr
+    assert (tmp_path / "sim.png").read_bytes()[:8] == PNG  # default: RESULT with .png
+    assert_one_line_error(invoke("plot", bif, "--state", "X_sq"), "--state", "'X_sq'", "x, v")
+    assert_one_line_error(invoke("plot", bif, "--out", tmp_path / "a.gif"), "--out", "a.gif")
+    assert_one_line_error(invoke("plot", tmp_path / "none.nc"), "none.nc")
+    other = save_dataset(xr.Dataset({"a": ("t", [1.0, 2.0])}), tmp_path / "other.nc")
+    assert_one_line_error(invoke("plot", other), "RESULT", "not a geardyn")
+
+
+def test_simulate_records_plot_state_and_labels_spectrum(tmp_path):
+    nc = tmp_path / "run.nc"
+    r = invoke("simulate", "paper_fig3", "--omega", "1.1", "--periods", "4", "--transient",
+               "50", "--state", "X_pq", "--out", nc)
+    assert r.returncode == 0, r.stderr
+    saved = load_dataset(nc)
+    # no load fluctuation in Fig. 3: no second excitation frequency is recorded
+    assert saved.attrs["plot_state"] == "X_pq" and "Lambda" not in saved.attrs

@@ -151,7 +151,8 @@ def test_study_full_params_and_gear_pair():
             study=StudyInfo(name="a", description="d", plot_state="X_pq"),
             params=PaperBase(base="paper", changes={"xi1": 0.1, "backlash": "30 um", "N": 3}),
             run=RunSettings(omega=1.1, transient=123.5, periods=7, steps_per_period=200),
-            sweep=SweepSettings(start=0.1, stop=4.0, num=1000, continuation=True),
+            sweep=SweepSettings(start=0.1, stop=4.0, num=1000, continuation="down",
+                                samples=100, lyapunov=True),
         ),
         Study(study=StudyInfo(name="b", interpretation="as-printed"), params=_odd_params()),
         Study(study=StudyInfo(name="c", model="gear_pair"), params=GearPairParams(kappa=0.2)),
@@ -186,6 +187,13 @@ def test_study_round_trip_is_lossless(tmp_path, study):
         ('[study]\nmodel = "gear_pair"\n[params]\nbase = "paper"\n', "params.base: unknown key"),
         ('[params]\nbase = "paper"\n[sweep]\nstart = 0.1\nstop = 4.0\nnum = 1\n',
          "sweep.num: Input should be greater than or equal to 2 (got 1)"),
+        ('[params]\nbase = "paper"\n[sweep]\nstart = 1\nstop = 4\nnum = 3\n'
+         'continuation = "sideways"\n',
+         "sweep.continuation: Input should be 'none', 'up' or 'down' (got 'sideways')"),
+        ('[params]\nbase = "paper"\n[sweep]\nstart = 1\nstop = 4\nnum = 3\nsamples = 1\n',
+         "sweep.samples: Input should be greater than or equal to 2 (got 1)"),
+        ('[params]\nbase = "paper"\n[sweep]\nstart = 1\nstop = 1\nnum = 3\n',
+         "sweep: start and stop must differ (got 1.0 twice)"),
     ],
 )
 def test_bad_study_errors_name_field(text, start):
@@ -194,6 +202,17 @@ def test_bad_study_errors_name_field(text, start):
     line = format_error(info.value)
     assert line.startswith(start), line
     assert "\n" not in line
+
+
+@pytest.mark.parametrize(("value", "expected"), [
+    ('"none"', "none"), ('"up"', "up"), ('"down"', "down"), ("true", "up"), ("false", "none"),
+])
+def test_sweep_continuation_choices(value, expected):
+    text = ('[params]\nbase = "paper"\n[sweep]\nstart = 1\nstop = 4\nnum = 3\n'
+            f"continuation = {value}\n")
+    sweep = load_study(text).sweep
+    assert sweep.continuation == expected
+    assert (sweep.samples, sweep.lyapunov) == (None, False)
 
 
 def test_full_study_error_names_nested_field(tmp_path):
@@ -217,6 +236,7 @@ def test_builtin_fig3_study():
     assert (s.run.transient, s.run.periods) == (4000.0, 64)
     assert s.sweep is not None
     assert (s.sweep.param, s.sweep.start, s.sweep.stop, s.sweep.num) == ("Omega", 0.1, 4.0, 1000)
+    assert s.sweep.continuation == "none"
     with pytest.raises(StudyError, match="no built-in study"):
         builtin_study("fig99")
 
@@ -286,3 +306,25 @@ def test_netcdf_missing_file(tmp_path):
         load_dataset(tmp_path / "none.nc")
     with pytest.raises(FileNotFoundError):
         save_dataset(_dataset(), tmp_path / "no" / "dir" / "x.nc")
+
+
+@pytest.mark.parametrize("kind", ["catt", "gear-pair-starts-lyapunov"])
+def test_netcdf_bifurcation_round_trip_identical(tmp_path, kind):
+    """A real sweep, with the string variable ``contact``, the sample/state/mesh coordinates,
+    the attributes the CLI adds and (gear pair) several starts and Lyapunov exponents."""
+    import geardyn
+
+    if kind == "catt":
+        m = CATTDevice(PlanetaryParams.paper(xi1=0.05, xi2=0.05))
+        ds = geardyn.bifurcation(m, values=[0.6, 1.1, 2.5], transient=50.0, samples=4,
+                                 steps_per_period=64)
+    else:
+        g = GearPair(zeta=0.05, kappa=0.2, Fa=0.2)
+        ds = geardyn.bifurcation(g, values=[0.5, 0.95, 1.3], transient=50.0, samples=4,
+                                 starts=2, lyapunov=True)
+    ds.attrs.update(study="fig3", plot_state=str(ds["state"].values[0]), wall_time_s=1.25)
+    back = load_dataset(save_dataset(ds, tmp_path / "bif.nc"))
+    xr.testing.assert_identical(back, ds)
+    assert back["contact"].dtype.kind == "U" and back["state"].dtype.kind == "U"
+    assert set(np.unique(back["contact"].values)) <= {"none", "single", "double", "unbounded"}
+    assert back.attrs["continuation"] == "none" and back.attrs["param"] == "Omega"

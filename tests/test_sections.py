@@ -77,3 +77,29 @@ def test_transient_by_convergence_gives_up_on_chaos():
     T = 2 * math.pi / 2.5
     assert r.converged[0] == 0
     assert r.transient_periods[0] == math.floor(600.0 / T)
+
+
+def test_simulation_records_the_second_excitation(noisy_device):
+    ds = geardyn.simulate(noisy_device, transient=0.0, periods=1, steps_per_period=64)
+    assert ds.attrs["Lambda"] == 0.3
+
+
+def test_bifurcation_reports_sections_and_convergence(noisy_device):
+    # Lambda = 0.3: Omega = 0.6 is commensurate (2 periods), 0.3 * sqrt(5) is not
+    values = [0.6, 0.3 * math.sqrt(5)]
+    ds = geardyn.bifurcation(noisy_device, "Omega", values, transient=300.0, samples=8,
+                             converge=1e-8, transient_max=3000.0)
+    assert ds["section_periods"].values.tolist() == [2, 1]
+    # heavily damped: the common-period orbit is period-1 in the section, 2 forcing periods;
+    # the quasi-periodically forced point has no period
+    assert ds["period"].values.tolist() == [2, 0]
+    assert ds["converged"].values[0] == 1 and ds["converged"].values[1] == 0
+    assert ds.attrs["converge"] == 1e-8
+    # the section samples really are two forcing periods apart: compare with the reference
+    T = 2 * math.pi / 0.6
+    n_tr = int(ds["transient_periods"].values[0])
+    t_eval = (n_tr + 2 * np.arange(1, 4)) * T
+    ref = geardyn.reference_solution(noisy_device.with_omega(0.6), noisy_device.initial_state(),
+                                     t_eval)
+    got = ds["poincare"].values[0, :3]
+    assert np.max(np.abs(got - ref)) < 1e-6 * np.max(np.abs(ref))

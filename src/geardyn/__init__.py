@@ -10,7 +10,9 @@ The public API::
 
 from geardyn.analysis.bifurcation import bifurcation
 from geardyn.analysis.lyapunov import lyapunov, lyapunov_lanes
-from geardyn.analysis.periodicity import classify_period
+from geardyn.analysis.map2d import map2d
+from geardyn.analysis.periodicity import classify_period, common_section
+from geardyn.analysis.spectrum import amplitude_spectrum, label_peaks
 from geardyn.errors import GeardynError, ParameterError, StudyError
 from geardyn.models.base import Model
 from geardyn.models.catt import CATTDevice, DimensionalCATT
@@ -39,10 +41,14 @@ __all__ = [
     "PlanetaryParams",
     "StudyError",
     "UserModel",
+    "amplitude_spectrum",
     "bifurcation",
     "classify_period",
+    "common_section",
+    "label_peaks",
     "lyapunov",
     "lyapunov_lanes",
+    "map2d",
     "default_steps_per_period",
     "reference_solution",
     "simulate",

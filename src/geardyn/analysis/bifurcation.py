@@ -2,16 +2,26 @@
 
 from __future__ import annotations
 
+import functools
 import math
+import os
 from collections.abc import Callable, Sequence
+from typing import Any
 
 import numpy as np
 import xarray as xr
 
-from geardyn.analysis.contact import contact_regime
-from geardyn.analysis.periodicity import DEFAULT_MAX_PERIOD, DEFAULT_TOL, classify_period
+from geardyn.analysis.lanes import (
+    has_mesh_forces,
+    lane_periods,
+    lane_variables,
+    variable_attrs,
+    variable_dims,
+)
+from geardyn.analysis.periodicity import DEFAULT_MAX_PERIOD, DEFAULT_TOL
 from geardyn.models.base import Model
 from geardyn.solvers.ensemble import LaneResults, run_lanes
+from geardyn.solvers.executor import lane_results, run_chunks, run_lanes_task
 from geardyn.solvers.simulate import DEFAULT_BOUND
 
 
@@ -20,15 +30,18 @@ def _concat(parts: list[LaneResults]) -> LaneResults:
     return LaneResults(**{f: np.concatenate([getattr(r, f) for r in parts]) for f in fields})
 
 
-def _continuation(model, P, order, y0, transient, samples, steps_per_period, locate_edges,
-                  bound, progress=None) -> LaneResults:
+def _lanes_slice(r: LaneResults, a: int, b: int) -> LaneResults:
+    return LaneResults(**{f: getattr(r, f)[a:b] for f in LaneResults.__dataclass_fields__})
+
+
+def _continuation(model, P, order, y0, progress, **opts) -> LaneResults:
+    """One lane at a time in ``order``, each from the previous lane's final state and time."""
     parts: list[LaneResults | None] = [None] * len(order)
     y, t0 = np.asarray(y0, dtype=float), 0.0
     for done, pos in enumerate(order):
         if progress is not None:
             progress(done, len(order))
-        r = run_lanes(model, P[pos : pos + 1], y, transient, samples, steps_per_period,
-                      locate_edges=locate_edges, bound=bound, t0=np.array([t0]))
+        r = run_lanes(model, P[pos : pos + 1], y, t0=np.array([t0]), **opts)
         parts[pos] = r
         if r.status[0] == 0:
             y, t0 = r.final[0], float(r.final_time[0])
@@ -39,20 +52,13 @@ def _continuation(model, P, order, y0, transient, samples, steps_per_period, loc
     return _concat(parts)  # type: ignore[arg-type]
 
 
-def _chunked(model, P, y0, transient, samples, steps_per_period, locate_edges, bound, chunk,
-             progress, offset, total) -> LaneResults:
-    """run_lanes over consecutive chunks of lanes, reporting progress after each."""
-    L = P.shape[0]
-    size = chunk or max(64, -(-L // 20))
-    Y0 = np.broadcast_to(np.asarray(y0, dtype=float), (L, model.n_states))
-    parts = []
-    for a in range(0, L, size):
-        b = min(L, a + size)
-        parts.append(run_lanes(model, P[a:b], Y0[a:b], transient, samples, steps_per_period,
-                               locate_edges=locate_edges, bound=bound))
-        if progress is not None:
-            progress(offset + b, total)
-    return parts[0] if len(parts) == 1 else _concat(parts)
+def _independent(model, P, Y0, chunk, progress, client, store, **opts) -> LaneResults:
+    """run_lanes over chunks of lanes through the executor (here or on a Dask cluster, resumable
+    with a store), reporting progress after each chunk."""
+    out = run_chunks(functools.partial(run_lanes_task, **opts), model,
+                     {"P": P, "y0": Y0}, chunk=chunk, client=client, store=store,
+                     progress=progress, meta={"analysis": "bifurcation"})
+    return lane_results(out)
 
 
 def bifurcation(
@@ -74,6 +80,10 @@ def bifurcation(
     bound: float = DEFAULT_BOUND,
     progress: Callable[[int, int], None] | None = None,
     chunk: int | None = None,
+    client: Any = None,
+    store: str | os.PathLike[str] | None = None,
+    converge: float | None = None,
+    transient_max: float | None = None,
 ) -> xr.Dataset:
     """Sweep ``param`` over ``values`` and classify the steady motion at every point.
 
@@ -84,9 +94,17 @@ def bifurcation(
         ``lane_params`` (for :class:`~geardyn.CATTDevice`: ``xi1``, ``xi``, ``backlash``,
         ``error``, ``B1``, ``T_D``, ...).
     transient
-        Time discarded at every point, in model time units (tau), rounded up to whole periods.
+        Time discarded at every point, in model time units (tau), rounded up to whole periods
+        (whole common periods when a second excitation is commensurate with Omega).
+    converge, transient_max
+        Transient by convergence: with a tolerance ``converge`` (e.g. 1e-8), ``transient`` is a
+        minimum and each point runs on, up to ``transient_max`` (default 10 x transient), until
+        its Poincare point repeats one of the last 16 to ``converge (1 + |point|)``; the
+        variable ``converged`` says where that happened and ``transient_periods`` what it took.
     samples
-        Forcing periods recorded (one Poincare point each) after the transient.
+        Poincare points recorded after the transient: one per forcing period, or per common
+        period of the excitations when the model has a second one at a commensurate frequency
+        (``section_periods``; see :func:`geardyn.analysis.periodicity.common_section`).
     continuation
         ``None``: every point starts from ``y0``; ``"up"``/``"down"``: each point starts from the
         final state of the previous one in ascending/descending order (shows hysteresis).
@@ -99,6 +117,11 @@ def bifurcation(
     chunk
         Lanes per kernel call (default: about a twentieth of the sweep, at least 64). Lanes are
         independent, so the result does not depend on it.
+    client, store
+        Independent starts only: a ``dask.distributed.Client`` runs the chunks on its cluster,
+        and a Zarr ``store`` path keeps finished chunks so that a rerun resumes (see
+        :func:`geardyn.solvers.executor.run_chunks` and ``docs/scaling.md``). Either way the
+        result is bitwise that of a local run.
 
     Returns
     -------
@@ -117,6 +140,14 @@ def bifurcation(
         raise ValueError(f"continuation must be None, 'up' or 'down' (got {continuation!r})")
     if starts < 1 or (starts > 1 and continuation):
         raise ValueError("starts must be >= 1, and 1 with continuation")
+    if converge is not None and not converge > 0:
+        raise ValueError(f"converge must be a positive tolerance or None (got {converge!r})")
+    opts = dict(transient=float(transient), samples=int(samples),
+                steps_per_period=steps_per_period, locate_edges=bool(locate_edges),
+                bound=float(bound), transient_max=transient_max,
+                converge_tol=float(converge or 0.0))
+    if continuation and (client is not None or store is not None):
+        raise ValueError("client and store apply to independent starts, not to continuation")
     P = model.lane_params(param, values)
     if y0 is not None:
         base_y0 = np.asarray(y0, dtype=float)
@@ -131,54 +162,37 @@ def bifurcation(
         if continuation == "down":
             order = order[::-1]
         runs = [_continuation(model, P, order, base_y0 if base_y0.ndim == 1 else base_y0[0],
-                              transient, samples, steps_per_period, locate_edges, bound,
-                              progress)]
+                              progress, **opts)]
     else:
         rng = np.random.default_rng(seed)
-        runs = []
-        for s in range(starts):
-            y_s = base_y0 if s == 0 else base_y0 + rng.uniform(-spread, spread, (L, ns))
-            runs.append(_chunked(model, P, y_s, transient, samples, steps_per_period,
-                                 locate_edges, bound, chunk, progress, s * L, starts * L))
+        Y0 = [np.broadcast_to(base_y0, (L, ns))]
+        Y0 += [base_y0 + rng.uniform(-spread, spread, (L, ns)) for _ in range(1, starts)]
+        every = _independent(model, np.tile(P, (starts, 1)), np.concatenate(Y0), chunk,
+                             progress, client, store, **opts)
+        runs = [_lanes_slice(every, s * L, (s + 1) * L) for s in range(starts)]
     first = runs[0]
     poincare = np.concatenate([r.samples for r in runs], axis=1)
-    periods = np.stack([classify_period(r.samples, max_period, tol) for r in runs], axis=1)
+    static = _static_forces(model, param, values) if has_mesh_forces(model) else None
+    per_lane = lane_variables(model, first, static, max_period, tol)
     status = np.max(np.stack([r.status for r in runs], axis=1), axis=1)
     ds = xr.Dataset(coords={
         param: (param, values),
         "sample": ("sample", np.arange(poincare.shape[1])),
         "state": ("state", list(model.state_names)),
     })
+    if model.meshes:
+        ds = ds.assign_coords(mesh=("mesh", [m[0] for m in model.meshes]))
     ds["poincare"] = ((param, "sample", "state"), poincare, {
         "long_name": "Poincare points (states once per forcing period after the transient)"})
-    ds["period"] = (param, periods[:, 0], {
-        "long_name": "period in forcing periods", "meaning": "k>=1 period-k, 0 quasi-periodic "
-        "or chaotic, -1 unbounded", "tolerance": tol, "max_period": max_period})
+    dims, attrs = variable_dims(model), variable_attrs(model, max_period, tol)
+    for name, data in per_lane.items():
+        ds[name] = ((param, *dims[name]), data, attrs[name])
     if starts > 1:
+        periods = np.stack([per_lane["period"]] + [lane_periods(r, max_period, tol)
+                                                   for r in runs[1:]], axis=1)
         ds["period_by_start"] = ((param, "start"), periods)
         ds["start_of_sample"] = ("sample", np.repeat(np.arange(starts), samples))
     ds["status"] = (param, status, {"meaning": "0 ok, 1 diverged in at least one start"})
-    ds["steps_per_period"] = (param, first.steps_per_period)
-    ds["transient_periods"] = (param, first.transient_periods)
-    ds["unresolved_steps"] = (param, first.unresolved)
-    if model.meshes:
-        names = [m[0] for m in model.meshes]
-        ds = ds.assign_coords(mesh=("mesh", names))
-        regimes = np.stack([contact_regime(first.event_min, first.event_max, first.crossings,
-                                           d, b, first.status) for _, d, b in model.meshes],
-                           axis=1)
-        ds["contact"] = ((param, "mesh"), regimes, {
-            "meaning": "none: teeth never separate; single: separation, no back-flank contact; "
-                       "double: back-flank contact; unbounded: diverged"})
-        if model.n_observables == len(names):
-            peak = np.maximum(np.abs(first.obs_max), np.abs(first.obs_min))
-            ds["force_peak"] = ((param, "mesh"), peak, {"units": model.observable_units})
-            ds["force_rms"] = ((param, "mesh"), first.obs_rms, {"units": model.observable_units})
-            static = _static_forces(model, param, values)
-            if static is not None:
-                with np.errstate(divide="ignore", invalid="ignore"):
-                    ds["dynamic_factor"] = ((param, "mesh"), peak / np.abs(static), {
-                        "long_name": "peak dynamic mesh force / static mesh force"})
     if lyapunov:
         from geardyn.analysis.lyapunov import lyapunov_lanes
 
@@ -189,6 +203,8 @@ def bifurcation(
     ds.attrs.update(
         model=model.name, param=param, transient=float(transient), samples=int(samples),
         continuation=continuation or "none", starts=int(starts),
+        converge=float(converge or 0.0),
+        transient_max=float(transient_max if transient_max is not None else 10 * transient),
         integrator="RK4, fixed step aligned to the forcing period",
         locate_edges=int(bool(locate_edges)), bound=float(bound), period_tol=float(tol),
         max_period=int(max_period), time_unit=model.time_unit,

@@ -6,42 +6,46 @@
     geardyn params save OUT.toml
     geardyn simulate STUDY.toml --omega 1.1 [--transient T] [--periods P]
                      [--steps-per-period N] [--out run.nc] [--plot run.png]
+    geardyn bifurcation STUDY.toml [--param Omega] [--range 0.1:4:1000]
+                     [--continuation none|up|down] [--lyapunov] [--out out.nc] [--plot out.png]
+    geardyn plot RESULT.nc [--out fig.png|fig.pdf] [--state X_sq]
 
 A STUDY argument is a TOML file or the name of a built-in study (``paper_fig3``). Every expected
-error (bad parameters, missing files, invalid TOML, bad values) ends the program with one line
-``error: ...`` on stderr and exit status 2.
+error (bad parameters, missing files, invalid TOML, bad values) and every usage error ends the
+program with one line ``error: ...`` on stderr and exit status 2 (:class:`OneLineErrorGroup`),
+however it is invoked. Shared helpers live in :mod:`geardyn.cli.common`.
 """
 
 from __future__ import annotations
 
 import math
 import sys
-import tomllib
-from enum import StrEnum
 from pathlib import Path
 from typing import Annotated
 
 import typer
-from pydantic import ValidationError
 from rich.console import Console
 from rich.markup import escape
 from rich.table import Table
 
-from geardyn.errors import GeardynError, ParameterError, StudyError
-
-EXIT_ERROR = 2
-#: Exceptions that are the user's input, not a bug: one line on stderr, exit status 2.
-EXPECTED_ERRORS: tuple[type[BaseException], ...] = (
-    ValidationError,
-    GeardynError,
-    ValueError,
-    KeyError,
-    OSError,
-    tomllib.TOMLDecodeError,
+from geardyn.cli.bifurcation import register as _register_bifurcation
+from geardyn.cli.common import (
+    EXIT_ERROR,
+    EXPECTED_ERRORS,
+    Interpretation,
+    OneLineErrorGroup,
+    check_plot_path,
+    load_study_source,
+    make_parents,
+    stderr_console,
 )
+from geardyn.errors import ParameterError, StudyError
+
+__all__ = ["EXIT_ERROR", "EXPECTED_ERRORS", "app", "main"]
 
 app = typer.Typer(
     name="geardyn",
+    cls=OneLineErrorGroup,
     help="Nonlinear dynamics of gear trains: the CATT planetary gear train processing device.",
     add_completion=False,
     no_args_is_help=True,
@@ -54,19 +58,14 @@ params_app = typer.Typer(
 app.add_typer(params_app, name="params")
 
 
-class Interpretation(StrEnum):
-    consistent = "consistent"
-    carrier_only = "carrier-only"
-    as_printed = "as-printed"
-
-
 def _stdout() -> Console:
     # Wide tables when writing to a file or pipe; the terminal's width otherwise.
     return Console() if sys.stdout.isatty() else Console(width=130)
 
 
-def _stderr() -> Console:
-    return Console(stderr=True)
+_stderr = stderr_console
+#: A STUDY argument: a file, a built-in study name, or None for the paper's device.
+_load_study = load_study_source
 
 
 def _version(value: bool) -> None:
@@ -89,20 +88,6 @@ def _root(
 
 
 # ---------------------------------------------------------------------------- helpers
-def _load_study(source: str | None):
-    """A study from a file, a built-in study name, or (None) the paper's device."""
-    from geardyn.io.toml import builtin_study, builtin_study_names, load_study, paper_study
-
-    if source is None:
-        return paper_study()
-    path = Path(source)
-    if path.exists() or path.suffix == ".toml" or "/" in source:
-        return load_study(path)
-    if source in builtin_study_names():
-        return builtin_study(source)
-    raise FileNotFoundError(2, "No such file or built-in study", source)
-
-
 def _fmt(value: float) -> str:
     return f"{value + 0.0:.6g}"  # + 0.0 turns -0.0 into 0.0
 
@@ -206,8 +191,6 @@ def params_save(
 
 
 # ---------------------------------------------------------------------------- simulate
-_PLOT_SUFFIXES = (".png", ".pdf", ".svg")
-
 
 @app.command()
 def simulate(
@@ -245,8 +228,7 @@ def simulate(
         raise StudyError("--omega: not given, and the study has no run.omega")
     if not (math.isfinite(om) and om > 0):
         raise ParameterError("--omega", om, "must be a positive finite number")
-    if plot is not None and plot.suffix.lower() not in _PLOT_SUFFIXES:
-        raise ParameterError("--plot", str(plot), f"suffix must be one of {_PLOT_SUFFIXES}")
+    check_plot_path("--plot", plot)
     tr = s.run.transient if transient is None else transient
     n_periods = s.run.periods if periods is None else periods
     spp = s.run.steps_per_period if steps_per_period is None else steps_per_period
@@ -257,15 +239,14 @@ def simulate(
     if plot is not None and plot_state not in known and f"{plot_state}1" not in known:
         raise ParameterError("--state" if state else "study.plot_state", plot_state,
                              f"not a coordinate of {model.name}; known: {', '.join(known)}")
-    for path in (out, plot):
-        if path is not None:
-            path.parent.mkdir(parents=True, exist_ok=True)
+    make_parents(out, plot)
 
     err = _stderr()
     with err.status(f"simulating {s.study.name} at Omega = {om:g} (the first run compiles)"):
         ds = run_simulation(model, omega=om, transient=tr, periods=n_periods,
                             steps_per_period=spp)
     ds.attrs["study"] = s.study.name
+    ds.attrs["plot_state"] = plot_state
     written = []
     if out is not None:
         save_dataset(ds, out)
@@ -289,36 +270,20 @@ def simulate(
     typer.echo(summary)
 
 
+# ---------------------------------------------------------------------------- bifurcation, plot
+_register_bifurcation(app)  # geardyn bifurcation, geardyn plot (cli/bifurcation.py)
+
+
 # ---------------------------------------------------------------------------- entry point
 def main(argv: list[str] | None = None) -> int:
     """Run the command line; expected errors print one line ``error: ...`` and exit with 2."""
-    from geardyn.io.toml import format_error
-
     args = sys.argv[1:] if argv is None else list(argv)
-    if not args:
-        args = ["--help"]
-    try:
-        rv = app(args=args, prog_name="geardyn", standalone_mode=False)
-        code = rv if isinstance(rv, int) else 0
-    except typer.Exit as exc:
-        code = exc.exit_code
-    except typer.Abort:
-        print("error: aborted", file=sys.stderr)
-        code = 1
-    except KeyboardInterrupt:
-        print("error: interrupted", file=sys.stderr)
-        code = 130
-    except typer.TyperException as exc:  # usage errors: bad options or arguments
-        ctx = getattr(exc, "ctx", None)
-        hint = f" (try '{ctx.command_path} --help')" if ctx is not None else ""
-        message = " ".join(exc.format_message().split())
-        print(f"error: {message}{hint}", file=sys.stderr)
-        code = getattr(exc, "exit_code", EXIT_ERROR) or EXIT_ERROR
-    except EXPECTED_ERRORS as exc:
-        print(f"error: {format_error(exc)}", file=sys.stderr)
-        code = EXIT_ERROR
-    sys.exit(code)
+    app(args=args or ["--help"], prog_name="geardyn")  # exits (OneLineErrorGroup)
+    return 0
 
+
+__import__("geardyn.cli.map", fromlist=["register"]).register(app)  # geardyn map (cli/map.py)
+__import__("geardyn.cli.reproduce", fromlist=["register"]).register(app)  # cli/reproduce.py
 
 if __name__ == "__main__":
     main()

@@ -18,7 +18,8 @@ A *study file* holds the device parameters plus run settings::
     xi1 = 0.05
     [run]                           # optional: omega, transient, periods, steps_per_period
     transient = 4000.0
-    [sweep]                         # optional: param, start, stop, num, continuation
+    [sweep]                         # optional: param, start, stop, num, continuation,
+                                    # samples, lyapunov (see SweepSettings)
 
 For ``model = "gear_pair"`` the ``[params]`` table holds :class:`~geardyn.GearPair` arguments
 (``zeta``, ``kappa``, ``Fm``, ``Fa``, ``Omega``, ``kappa_phase``, ``error_phase``, ``backlash``).
@@ -44,6 +45,7 @@ from pydantic import (
     Field,
     PrivateAttr,
     ValidationError,
+    field_validator,
     model_validator,
 )
 from pydantic_core import InitErrorDetails, PydanticCustomError
@@ -97,7 +99,9 @@ class StudyInfo(BaseModel):
 
 
 class RunSettings(BaseModel):
-    """The ``[run]`` table: defaults of ``geardyn simulate`` (command-line options win)."""
+    """The ``[run]`` table: defaults of ``geardyn simulate`` and ``geardyn bifurcation``
+    (command-line options win). ``omega`` is also the fixed Omega of a sweep of another
+    parameter; ``transient`` and ``steps_per_period`` apply to sweeps too."""
 
     model_config = _CONFIG
 
@@ -108,7 +112,13 @@ class RunSettings(BaseModel):
 
 
 class SweepSettings(BaseModel):
-    """The ``[sweep]`` table: a parameter sweep for bifurcation diagrams."""
+    """The ``[sweep]`` table: defaults of ``geardyn bifurcation`` (command-line options win).
+
+    ``continuation``: ``"none"`` (every point starts from the model's initial state), ``"up"`` or
+    ``"down"`` (each point starts from the previous point's final state, in ascending or
+    descending order). The old boolean form is read as ``true`` -> ``"up"``, ``false`` ->
+    ``"none"``. ``samples`` (Poincare points per value) defaults to ``[run].periods``.
+    """
 
     model_config = _CONFIG
 
@@ -116,9 +126,24 @@ class SweepSettings(BaseModel):
     start: float
     stop: float
     num: int = Field(ge=2, description="number of parameter values")
-    continuation: bool = Field(
-        False, description="start each point from the previous point's final state"
+    continuation: Literal["none", "up", "down"] = Field(
+        "none", description="none, up or down: start each point from the previous one's state"
     )
+    samples: int | None = Field(None, ge=2, description="forcing periods recorded per value")
+    lyapunov: bool = Field(False, description="also compute the largest Lyapunov exponent")
+
+    @field_validator("continuation", mode="before")
+    @classmethod
+    def _boolean_continuation(cls, value: Any) -> Any:
+        if isinstance(value, bool):
+            return "up" if value else "none"
+        return value
+
+    @model_validator(mode="after")
+    def _distinct_ends(self) -> SweepSettings:
+        if self.start == self.stop:
+            raise ValueError(f"start and stop must differ (got {self.start!r} twice)")
+        return self
 
 
 class PaperBase(BaseModel):

@@ -89,6 +89,37 @@ class Model:
         P[:, self._param_index(name)] = values
         return P
 
+    def lane_params_grid(self, x: str, x_values: Sequence[float] | np.ndarray, y: str,
+                         y_values: Sequence[float] | np.ndarray) -> np.ndarray:
+        """Coefficient vectors of a two-parameter grid, ``(len(y_values) * len(x_values),
+        n_params)``, row-major over (y, x): lane ``j * nx + i`` has ``y = y_values[j]`` and
+        ``x = x_values[i]``.
+
+        Row j is ``self.with_params(y=y_values[j]).lane_params(x, x_values)``, so each name means
+        what it means to ``with_params`` and ``lane_params`` (a physical parameter re-derives every
+        coefficient). Raises ValueError when the x sweep would undo the y setting (a raw
+        coefficient as ``y`` with a physical parameter as ``x``: swap the axes).
+        """
+        if x == y:
+            raise ValueError(f"x and y must be different parameters (both {x!r})")
+        xv = np.asarray(x_values, dtype=float).ravel()
+        yv = np.asarray(y_values, dtype=float).ravel()
+        if y == "Omega":  # the frequency is one entry of every vector: set it on the x rows
+            row = self.lane_params(x, xv)
+            P = np.tile(row, (yv.size, 1))
+            P[:, self._param_index("Omega")] = np.repeat(yv, xv.size)
+            return P
+        P = np.concatenate([self.with_params(**{y: float(v)}).lane_params(x, xv) for v in yv])
+        # the coefficients y moves (and x does not) must keep y's values in every row
+        Py, Px = self.lane_params(y, yv), self.lane_params(x, xv)
+        only_y = np.any(Py != Py[:1], axis=0) & ~np.any(Px != Px[:1], axis=0)
+        blocks = P.reshape(yv.size, xv.size, -1)
+        lost = any(not np.array_equal(Py[j], Py[0]) and np.array_equal(blocks[j], blocks[0])
+                   for j in range(1, yv.size))
+        if lost or not np.array_equal(P[:, only_y], np.repeat(Py[:, only_y], xv.size, axis=0)):
+            raise ValueError(f"sweeping x={x!r} undoes y={y!r} in this model; swap the axes")
+        return P
+
     def with_params(self, **values: float) -> Model:
         """A copy of the model with parameters changed by name."""
         out = copy.copy(self)
@@ -97,6 +128,14 @@ class Model:
             p[self._param_index(name)] = float(value)
         out.params = p
         return out
+
+    def other_frequencies(self, P: np.ndarray) -> np.ndarray:
+        """Frequencies (rad per model time unit) of forcings other than Omega that act in each
+        lane of ``P``, shape ``(lanes, m)``; NaN where one does not act. None here; a model with
+        a second excitation (the CATT device's load fluctuation Lambda) overrides it, so that
+        sweeps can sample at the common period (see
+        :func:`geardyn.analysis.periodicity.common_section`)."""
+        return np.zeros((np.atleast_2d(P).shape[0], 0))
 
     def with_omega(self, omega: float) -> Model:
         """A copy with the forcing frequency set to ``omega``."""

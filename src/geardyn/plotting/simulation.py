@@ -17,12 +17,9 @@ __all__ = ["plot_simulation", "resolve_state", "velocity_of"]
 def resolve_state(ds: xr.Dataset, state: str) -> str:
     """The variable of ``ds`` that shows ``state``: itself, or the first planet set's
     (``X_sq`` -> ``X_sq1``) in a general (4N-state) simulation."""
-    if state in ds.data_vars and ds[state].dims == ("time",):
-        return state
-    if f"{state}1" in ds.data_vars:
-        return f"{state}1"
-    known = [str(v) for v in ds.data_vars if ds[v].dims == ("time",)]
-    raise ValueError(f"state: {state!r} is not in the simulation; known: {', '.join(known)}")
+    from geardyn.analysis.spectrum import time_series
+
+    return str(time_series(ds, state).name)
 
 
 def velocity_of(ds: xr.Dataset, name: str) -> str | None:
@@ -65,28 +62,40 @@ def _poincare(ds: xr.Dataset, name: str) -> np.ndarray:
     return np.array([])
 
 
-def _spectrum(ds: xr.Dataset, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Single-sided amplitude spectrum of x over whole forcing periods; frequency in multiples
-    of the forcing (mesh) frequency Omega."""
-    t = ds["time"].values
-    period = float(ds.attrs.get("period", np.nan))
-    n_periods = int(ds.attrs.get("periods", 0))
-    if not n_periods and np.isfinite(period) and t.size > 1:
-        n_periods = int(round((t[-1] - t[0]) / period))
-    if t.size > 1 and np.isfinite(period) and n_periods:
-        per = (t.size - 1) // n_periods if (t.size - 1) % n_periods == 0 else None
-        x = x[: n_periods * per] if per else x[:-1]
-    else:
-        x = x[:-1]
-    if x.size < 4 or not np.all(np.isfinite(x)):
-        return np.array([]), np.array([])
-    amp = 2.0 * np.abs(np.fft.rfft(x - x.mean())) / x.size
-    harmonics = np.arange(amp.size) / max(n_periods, 1)
-    return harmonics, amp
+def _draw_spectrum(ax, ds: xr.Dataset, name: str, ylabel: str, max_order: float = 8.0,
+                   n_labels: int = 8) -> None:
+    """Amplitude spectrum of ``name`` (log scale, up to ``max_order`` Omega) with its largest
+    peaks named (mesh harmonics, subharmonics, load-fluctuation lines and sidebands)."""
+    from geardyn.analysis.spectrum import amplitude_spectrum, label_peaks
+
+    ax.set_xlabel(r"frequency / $\Omega$ (multiples of the mesh frequency)")
+    ax.set_ylabel(ylabel)
+    ax.set_title("amplitude spectrum (Hann window, mean removed)")
+    try:
+        spec = amplitude_spectrum(ds, name)
+    except ValueError:  # a diverged run, or too few samples
+        ax.set_title("amplitude spectrum (not available: diverged or too short)")
+        return
+    spec = spec.sel(frequency=slice(0.0, max_order))
+    f, amp = spec["frequency"].values[1:], spec.values[1:]
+    if not f.size:
+        return
+    top = float(np.max(amp))
+    ax.semilogy(f, np.maximum(amp, 1e-300), color="C0")
+    ax.set_xlim(0.0, float(f[-1]))
+    if top > 0:
+        ax.set_ylim(top * 1e-8, top * 10.0)
+    peaks = label_peaks(spec, threshold=1e-3, max_peaks=n_labels)
+    for fp, ap, label, kind in zip(peaks["frequency"].values, peaks["amplitude"].values,
+                                   peaks["label"].values, peaks["kind"].values, strict=True):
+        ax.annotate(str(label), (fp, ap), xytext=(0, 3), textcoords="offset points",
+                    ha="center", va="bottom", fontsize=7,
+                    color="0.4" if kind == "other" else "k")
 
 
 def plot_simulation(ds: xr.Dataset, state: str = "X_sq", path: str | os.PathLike | None = None):
-    """Time history, phase portrait, Poincaré points and amplitude spectrum of ``state``.
+    """Time history, phase portrait, Poincaré points and amplitude spectrum of ``state``; the
+    largest spectral peaks are named (kΩ, jΩ/n, mΛ, kΩ±mΛ; Λ from the ``Lambda`` attribute).
 
     Parameters
     ----------
@@ -152,18 +161,8 @@ def plot_simulation(ds: xr.Dataset, state: str = "X_sq", path: str | os.PathLike
         ax_s.set_xlabel(xlabel)
         ax_s.set_ylabel(vlabel)
 
-        harm, amp = _spectrum(ds, x)
-        if harm.size:
-            keep = harm <= min(8.0, harm[-1])
-            shown = np.maximum(amp[keep][1:], 1e-300)
-            ax_f.semilogy(harm[keep][1:], shown, color="C0")
-            ax_f.set_xlim(0.0, float(harm[keep][-1]))
-            top = float(np.max(shown))
-            if top > 0:
-                ax_f.set_ylim(top * 1e-10, top * 3.0)
-        ax_f.set_xlabel(r"frequency / $\Omega$ (multiples of the mesh frequency)")
-        ax_f.set_ylabel(f"amplitude of {state_label(name)} {unit_text(_units(ds, name, 0))}")
-        ax_f.set_title("amplitude spectrum (mean removed)")
+        _draw_spectrum(ax_f, ds, name,
+                       f"amplitude of {state_label(name)} {unit_text(_units(ds, name, 0))}")
 
         model = a.get("model", "model")
         interp = f", {a['interpretation']}" if "interpretation" in a else ""

@@ -53,61 +53,68 @@ BLOCK = 8
 
 
 @nb.njit(**_JIT)
-def _rhs_block(T, Y, DY, P, first, nl, s, c):
-    """rhs of rows 0..nl-1 (lanes first..) at times T; the model's rhs inlined, once per block."""
+def _rhs_block(T, Y, DY, P, first, nl, active, s, c):
+    """rhs of the active rows of 0..nl-1 (lanes first..) at times T; the model's rhs inlined,
+    once per block."""
     for k in range(nl):
-        _rhs_i(T[k], Y[k], DY[k], P[first + k], s, c)
+        if active[k]:
+            _rhs_i(T[k], Y[k], DY[k], P[first + k], s, c)
 
 
 @nb.njit(**_JIT)
-def _events_block(T, Y, G, P, first, nl):
+def _events_block(T, Y, G, P, first, nl, active):
     for k in range(nl):
-        _events_i(T[k], Y[k], G[k], P[first + k])
+        if active[k]:
+            _events_i(T[k], Y[k], G[k], P[first + k])
 
 
 @nb.njit(**_JIT)
-def _observe_block(T, Y, O, P, first, nl, s, c):
+def _observe_block(T, Y, O, P, first, nl, active, s, c):
     for k in range(nl):
-        _observe_i(T[k], Y[k], O[k], P[first + k], s, c)
+        if active[k]:
+            _observe_i(T[k], Y[k], O[k], P[first + k], s, c)
 
 
 @nb.njit(**_JIT)
-def _block_step(i, first, nl, Y, Y1, K1, K2, K3, K4, TMP, TT, G, SIDE, P, H, OMEGA, T0, n_per,
-                sa, ca, sb, cb, se, ce, locate, NCROSS, UNRES, work, ybuf, gbuf):
-    """Advance lanes first..first+nl-1 (rows 0..nl-1 of the block arrays) by grid step i: a
-    lockstep RK4 trial for all lanes, then, for a lane whose trial crossed an edge, the step
-    redone with the crossing located. G holds the events at the new states afterwards."""
+def _block_step(i, first, nl, active, Y, Y1, K1, K2, K3, K4, TMP, TT, G, SIDE, P, H, OMEGA, T0,
+                n_per, sa, ca, sb, cb, se, ce, locate, NCROSS, UNRES, work, ybuf, gbuf):
+    """Advance the active lanes of first..first+nl-1 (rows 0..nl-1 of the block arrays) by grid
+    step i: a lockstep RK4 trial, then, for a lane whose trial crossed an edge, the step redone
+    with the crossing located. G holds the events at the new states afterwards; inactive lanes
+    (finished or diverged) stay as they are."""
     ns = Y.shape[1]
     n_ev = G.shape[1]
     for k in range(nl):
         lane = first + k
         TT[k] = T0[lane] + i * H[lane]
-    _rhs_block(TT, Y, K1, P, first, nl, sa, ca)
+    _rhs_block(TT, Y, K1, P, first, nl, active, sa, ca)
     for k in range(nl):
         lane = first + k
         hh = 0.5 * H[lane]
         for q in range(ns):
             TMP[k, q] = Y[k, q] + hh * K1[k, q]
         TT[k] = T0[lane] + i * H[lane] + hh
-    _rhs_block(TT, TMP, K2, P, first, nl, sb, cb)
+    _rhs_block(TT, TMP, K2, P, first, nl, active, sb, cb)
     for k in range(nl):
         hh = 0.5 * H[first + k]
         for q in range(ns):
             TMP[k, q] = Y[k, q] + hh * K2[k, q]
-    _rhs_block(TT, TMP, K3, P, first, nl, sb, cb)
+    _rhs_block(TT, TMP, K3, P, first, nl, active, sb, cb)
     for k in range(nl):
         lane = first + k
         h = H[lane]
         for q in range(ns):
             TMP[k, q] = Y[k, q] + h * K3[k, q]
         TT[k] = T0[lane] + (i + 1) * h
-    _rhs_block(TT, TMP, K4, P, first, nl, se, ce)
+    _rhs_block(TT, TMP, K4, P, first, nl, active, se, ce)
     for k in range(nl):
         h6 = H[first + k] / 6.0
         for q in range(ns):
             Y1[k, q] = Y[k, q] + h6 * (K1[k, q] + 2.0 * K2[k, q] + 2.0 * K3[k, q] + K4[k, q])
-    _events_block(TT, Y1, G, P, first, nl)
+    _events_block(TT, Y1, G, P, first, nl, active)
     for k in range(nl):
+        if not active[k]:
+            continue
         crossed = False
         for j in range(n_ev):
             if _side(G[k, j]) != SIDE[k, j]:
@@ -153,6 +160,7 @@ def trajectory(p, y0, h, omega, n_per, i0, n_steps, stride, locate, bound, n_ev,
     T0 = np.zeros(1)
     NCROSS = np.zeros((1, max(n_ev, 1)), np.int64)
     UNRES = np.zeros(1, np.int64)
+    ACTIVE = np.ones(1, np.bool_)
     n_rec = n_steps // stride + 1
     out_y = np.full((n_rec, ns), np.nan)
     out_o = np.full((n_rec, max(n_obs, 1)), np.nan)
@@ -182,7 +190,7 @@ def trajectory(p, y0, h, omega, n_per, i0, n_steps, stride, locate, bound, n_ev,
                     out_g[r, q] = gbuf[0, q]
         if i == i0 + n_steps:
             break
-        _block_step(i, 0, 1, Y, Y1, K1, K2, K3, K4, TMP, TT, G, SIDE, P, H, OM, T0, n_per,
+        _block_step(i, 0, 1, ACTIVE, Y, Y1, K1, K2, K3, K4, TMP, TT, G, SIDE, P, H, OM, T0, n_per,
                     s_tab[j0], c_tab[j0], s_tab[j0 + 1], c_tab[j0 + 1], s_tab[j0 + 2],
                     c_tab[j0 + 2], locate, NCROSS, UNRES, work, ybuf, gbuf)
         done = i + 1 - i0
@@ -223,6 +231,7 @@ def _sweep_block(first, nl, n_per, s_tab, c_tab, P, Y0, H, OMEGA, T0, n_transien
     n_ring = np.zeros(nl, np.int64)
     Y, Y1, K1, K2, K3, K4, TMP, TT, G, SIDE, work, ybuf, gbuf = _alloc(BLOCK, ns, n_ev)
     O = np.zeros((BLOCK, n_obs))
+    active = np.ones(nl, np.bool_)
     n_end = np.zeros(nl, np.int64)
     n_tr = np.zeros(nl, np.int64)
     next_sample = np.zeros(nl, np.int64)
@@ -257,9 +266,9 @@ def _sweep_block(first, nl, n_per, s_tab, c_tab, P, Y0, H, OMEGA, T0, n_transien
     while i + 1 < max_end:
         i += 1
         j0 = 2 * phase
-        _block_step(i, first, nl, Y, Y1, K1, K2, K3, K4, TMP, TT, G, SIDE, P, H, OMEGA, T0, n_per,
-                    s_tab[j0], c_tab[j0], s_tab[j0 + 1], c_tab[j0 + 1], s_tab[j0 + 2],
-                    c_tab[j0 + 2], locate, ncross, unresolved, work, ybuf, gbuf)
+        _block_step(i, first, nl, active, Y, Y1, K1, K2, K3, K4, TMP, TT, G, SIDE, P, H, OMEGA,
+                    T0, n_per, s_tab[j0], c_tab[j0], s_tab[j0 + 1], c_tab[j0 + 1],
+                    s_tab[j0 + 2], c_tab[j0 + 2], locate, ncross, unresolved, work, ybuf, gbuf)
         step = i + 1
         phase += 1
         if phase == n_per:
@@ -267,21 +276,20 @@ def _sweep_block(first, nl, n_per, s_tab, c_tab, P, Y0, H, OMEGA, T0, n_transien
         if n_obs > 0 and step > min_tr:
             for k in range(nl):
                 TT[k] = T0[first + k] + step * H[first + k]
-            _observe_block(TT, Y, O, P, first, nl, s_tab[2 * phase], c_tab[2 * phase])
+            _observe_block(TT, Y, O, P, first, nl, active, s_tab[2 * phase],
+                           c_tab[2 * phase])
         for k in range(nl):
-            if step > n_end[k]:
+            if not active[k]:
                 continue
             lane = first + k
-            if status[lane] != STATUS_OK:
-                continue
             if (phase == 0 or step == n_end[k]) and not _healthy(Y[k], bound):
                 status[lane] = STATUS_DIVERGED
+                active[k] = False
                 for r in range(n_samples):
                     for q in range(ns):
                         samples[lane, r, q] = np.nan
                 for q in range(ns):
                     final[lane, q] = np.nan
-                    Y[k, q] = 0.0
                 continue
             if step <= n_tr[k]:
                 if step < n_tr[k]:
@@ -318,6 +326,7 @@ def _sweep_block(first, nl, n_per, s_tab, c_tab, P, Y0, H, OMEGA, T0, n_transien
                     samples[lane, r, q] = Y[k, q]
                 next_sample[k] += sample_every[lane]
             if step == n_end[k]:
+                active[k] = False
                 for q in range(ns):
                     final[lane, q] = Y[k, q]
     for k in range(nl):
@@ -355,8 +364,8 @@ def sweep(P, Y0, H, OMEGA, T0, n_transient, n_transient_max, conv_tol, conv_dept
     final[L, ns], status[L], gmin/gmax[L, n_ev] (extremes of the events at grid points),
     ncross[L, n_ev] (edge crossings while sampling), omax/omin/orms[L, n_obs] (extremes and RMS
     of the observables at grid points), unresolved[L] (steps that reached the split limit).
-    A block runs in lockstep to its longest lane; a lane past its end keeps integrating
-    harmlessly (its results are already stored), a diverged lane is reset to zero.
+    A block runs in lockstep to its longest lane; a lane that has ended or diverged is frozen
+    (no further steps, crossings or statistics).
     """
     n_workers = worker_start.size - 1
     for w in nb.prange(n_workers):

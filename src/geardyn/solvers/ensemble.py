@@ -47,6 +47,8 @@ class LaneResults:
     steps_per_period: np.ndarray  # (L,)
     transient_periods: np.ndarray  # (L,) transient used, in forcing periods
     converged: np.ndarray  # (L,) transient by convergence: 1 settled, 0 hit the limit, -1 off
+    sample_every: np.ndarray  # (L,) forcing periods between samples (the section's period)
+    commensurate: np.ndarray  # (L,) False: a second excitation at an irrational frequency ratio
 
 
 def run_lanes(
@@ -56,7 +58,7 @@ def run_lanes(
     transient: float,
     samples: int,
     steps_per_period: int | None = None,
-    sample_every: int | np.ndarray = 1,
+    sample_every: int | np.ndarray | str = "auto",
     locate_edges: bool = True,
     bound: float = DEFAULT_BOUND,
     t0: np.ndarray | None = None,
@@ -67,7 +69,9 @@ def run_lanes(
     """Integrate one lane per row of ``P`` (coefficient vectors) from ``y0`` (one state, or one
     per lane) and return stroboscopic samples (one every ``sample_every`` forcing periods) and
     statistics over the sampled stretch. ``t0``: per-lane start times (whole periods);
-    ``sample_every`` may differ per lane (a common period of two forcings); the transient is
+    ``sample_every`` may differ per lane; ``"auto"`` samples at the common period of the
+    forcings when the model has a second, commensurate excitation
+    (:func:`~geardyn.analysis.periodicity.common_section`), else every period. The transient is
     rounded up to whole sampling intervals.
 
     Transient by convergence: with ``converge_tol > 0`` the transient (then a minimum) goes on,
@@ -84,6 +88,14 @@ def run_lanes(
     if np.any(~np.isfinite(omega)) or np.any(omega <= 0):
         bad = omega[~(np.isfinite(omega) & (omega > 0))][0]
         raise ValueError(f"Omega must be positive and finite in every lane (got {bad!r})")
+    if isinstance(sample_every, str):
+        if sample_every != "auto":
+            raise ValueError(f"sample_every must be 'auto' or >= 1 (got {sample_every!r})")
+        from geardyn.analysis.periodicity import common_section
+
+        sample_every, commensurate = common_section(omega, model.other_frequencies(P))
+    else:
+        commensurate = np.ones(L, bool)
     if samples < 1 or np.any(np.asarray(sample_every) < 1):
         raise ValueError("samples and sample_every must be >= 1")
     if steps_per_period is None:
@@ -117,6 +129,8 @@ def run_lanes(
         steps_per_period=n_lane,
         transient_periods=n_tr_periods,
         converged=np.full(L, -1, np.int64),
+        sample_every=every.copy(),
+        commensurate=np.asarray(commensurate, bool),
     )
     # lanes sorted by steps per period, then period: a lockstep block holds lanes of one step
     # count and similar length

@@ -174,4 +174,7 @@ def simulate(
     if hasattr(model, "omega_n"):
         ds.attrs["omega_n"] = float(model.omega_n)
         ds.attrs["omega_n_units"] = "rad/s"
+    other = model.other_frequencies(np.atleast_2d(model.params))[0]
+    if other.size and np.isfinite(other[0]):  # a second excitation (the load fluctuation)
+        ds.attrs["Lambda"] = float(other[0])
     return ds

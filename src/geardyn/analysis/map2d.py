@@ -1,0 +1,327 @@
+"""Two-parameter maps: the steady motion over a grid of two parameters (e.g. Omega x damping).
+
+Every grid point is one lane (its own coefficient vector, from
+:meth:`~geardyn.Model.lane_params_grid`) integrated from the model's initial state, as in a
+bifurcation sweep with independent starts; the per-lane analysis is the same
+(:func:`geardyn.analysis.lanes.lane_variables`). Chunks of lanes run through
+:func:`geardyn.solvers.executor.run_chunks`: locally, on a Dask cluster, and resumable with a Zarr
+store. :func:`estimate_map` tells the cost of a grid before it is built.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+import os
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import xarray as xr
+
+from geardyn.analysis.lanes import (
+    CONTACT_LABELS,
+    has_mesh_forces,
+    lane_variables,
+    variable_attrs,
+    variable_dims,
+)
+from geardyn.analysis.periodicity import DEFAULT_MAX_PERIOD, DEFAULT_TOL
+from geardyn.models.base import Model
+from geardyn.solvers.ensemble import ladder_steps, run_lanes
+from geardyn.solvers.executor import default_chunk, run_chunks
+from geardyn.solvers.simulate import DEFAULT_BOUND, default_steps_per_period
+
+__all__ = ["MapEstimate", "check_steps", "estimate_map", "map2d", "measure_ns_per_lane_step"]
+
+Axis = tuple[str, Sequence[float] | np.ndarray]
+
+#: Assumed cost of a Lyapunov lane-step (state plus tangent vector, finite-difference Jacobian)
+#: relative to a plain RK4 lane-step.
+LYAPUNOV_COST = 3.0
+
+
+# ---------------------------------------------------------------------------- the chunk task
+def _map_task(model: Model, P: np.ndarray, y0: np.ndarray, static: np.ndarray | None = None, *,
+              run: dict[str, Any], max_period: int, tol: float,
+              lyapunov: dict[str, Any] | None) -> dict[str, np.ndarray]:
+    """One chunk of a map: run_lanes, the per-lane analysis, optionally Lyapunov exponents.
+    Returns numeric lane-first arrays only (``contact`` as codes into ``CONTACT_LABELS``)."""
+    r = run_lanes(model, P, y0, **run)
+    out = lane_variables(model, r, static, max_period, tol)
+    if "contact" in out:
+        codes = {label: k for k, label in enumerate(CONTACT_LABELS)}
+        out["contact"] = np.vectorize(codes.__getitem__, otypes=[np.int8])(out["contact"])
+    out["status"] = r.status
+    if lyapunov is not None:
+        from geardyn.analysis.lyapunov import lyapunov_lanes
+
+        exps = lyapunov_lanes(model, P, y0, **lyapunov)
+        out["lyapunov"] = np.where(r.status == 0, exps, np.nan)
+    return out
+
+
+# ---------------------------------------------------------------------------- lanes of a grid
+def _axis(axis: Axis, label: str) -> tuple[str, np.ndarray]:
+    try:
+        name, values = axis
+    except (TypeError, ValueError):
+        raise ValueError(f"{label}: give (parameter name, values)") from None
+    if not isinstance(name, str) or not name:
+        raise ValueError(f"{label}: the parameter name must be a non-empty string (got {name!r})")
+    v = np.asarray(values, dtype=float).ravel()
+    if v.size == 0:
+        raise ValueError(f"{label}: give at least one value of {name}")
+    if not np.all(np.isfinite(v)):
+        raise ValueError(f"{label}: values of {name} must be finite "
+                         f"(got {v[~np.isfinite(v)][0]!r})")
+    return name, v
+
+
+def _per_lane(model: Model, xn: str, xv: np.ndarray, yn: str, yv: np.ndarray,
+              fn: Callable[[Model], np.ndarray]) -> np.ndarray:
+    """``fn`` of each grid point's model, (ny * nx, ...); Omega changes no model property here
+    (the forcing frequency is a lane setting), so a model is built per row, column or point."""
+    def at(name: str, value: float, m: Model) -> Model:
+        return m if name == "Omega" else m.with_params(**{name: float(value)})
+
+    if xn == "Omega":
+        rows = [fn(at(yn, v, model)) for v in yv]
+        return np.repeat(np.array(rows), xv.size, axis=0)
+    if yn == "Omega":
+        row = np.array([fn(at(xn, u, model)) for u in xv])
+        return np.tile(row, (yv.size,) + (1,) * (row.ndim - 1))
+    return np.array([fn(at(xn, u, at(yn, v, model))) for v in yv for u in xv])
+
+
+# ---------------------------------------------------------------------------- the map
+def map2d(
+    model: Model,
+    x: Axis,
+    y: Axis,
+    transient: float = 4000.0,
+    samples: int = 200,
+    lyapunov: bool = False,
+    client: Any = None,
+    store: str | os.PathLike[str] | None = None,
+    chunk: int | None = None,
+    progress: Callable[[int, int], None] | None = None,
+    steps_per_period: int | None = None,
+    max_period: int = DEFAULT_MAX_PERIOD,
+    tol: float = DEFAULT_TOL,
+    locate_edges: bool = True,
+    bound: float = DEFAULT_BOUND,
+) -> xr.Dataset:
+    """Classify the steady motion over the grid ``y x x`` of two model parameters.
+
+    Parameters
+    ----------
+    x, y
+        ``(name, values)``: ``"Omega"`` or any parameter the model accepts in ``lane_params``
+        (for :class:`~geardyn.CATTDevice`: ``xi``, ``xi1``, ``backlash``, ``error``, ``B1``, ...).
+    transient, samples, steps_per_period, max_period, tol, locate_edges, bound
+        As for :func:`~geardyn.bifurcation` (independent starts from each point's own initial
+        state).
+    lyapunov
+        Also compute the largest Lyapunov exponent per point (over ``samples`` mean forcing
+        periods, on a grid of ``steps_per_period`` steps, default that of the smallest Omega).
+    client
+        A ``dask.distributed.Client``: chunks run as tasks on its cluster. The result is bitwise
+        that of the local run.
+    store
+        Path of a Zarr store: finished chunks are written there as they complete, and a rerun
+        with the same inputs computes only the missing ones (see ``docs/scaling.md``).
+    chunk
+        Lanes (grid points) per task; default about a twentieth of the grid, at least 64.
+    progress
+        Called as ``progress(points_done, points_total)`` after every chunk.
+
+    Returns
+    -------
+    xarray.Dataset with dimensions (y name, x name[, mesh]) and variables ``period`` (k >= 1
+    period-k, 0 quasi-periodic or chaotic, -1 unbounded), ``contact`` (none/single/double/
+    unbounded per mesh), ``force_peak``, ``force_rms``, ``dynamic_factor``, ``status``, step
+    counts, and ``lyapunov`` when asked; the settings in ``attrs`` (``x``, ``y``, ...).
+    """
+    xn, xv = _axis(x, "x")
+    yn, yv = _axis(y, "y")
+    if model.omega_index is None:
+        raise ValueError(f"{model.name} is not periodically forced: a map samples once a period")
+    if samples < 2:
+        raise ValueError(f"samples must be >= 2 to classify periods (got {samples})")
+    if not (math.isfinite(transient) and transient >= 0):
+        raise ValueError(f"transient must be a finite time >= 0 (got {transient!r})")
+    P = model.lane_params_grid(xn, xv, yn, yv)
+    check_steps(model, P[:, model.omega_index], transient, samples, steps_per_period)
+    Y0 = _per_lane(model, xn, xv, yn, yv, lambda m: m.initial_state())
+    inputs = {"P": P, "y0": Y0}
+    if has_mesh_forces(model) and model.static_mesh_forces() is not None:
+        inputs["static"] = _per_lane(model, xn, xv, yn, yv, lambda m: m.static_mesh_forces())
+    run = dict(transient=float(transient), samples=int(samples),
+               steps_per_period=steps_per_period, locate_edges=bool(locate_edges),
+               bound=float(bound))
+    lyap = None
+    if lyapunov:
+        omega = P[:, model.omega_index]
+        duration = float(samples * np.mean(2.0 * math.pi / omega))
+        n_lyap = int(steps_per_period or default_steps_per_period(model, float(omega.min())))
+        lyap = dict(transient=float(transient), duration=duration, steps_per_period=n_lyap,
+                    bound=float(bound))
+    task = functools.partial(_map_task, run=run, max_period=int(max_period), tol=float(tol),
+                             lyapunov=lyap)
+    size = int(chunk) if chunk else default_chunk(P.shape[0])
+    meta = {"analysis": "map2d", "model": model.name, "x": xn, "y": yn}
+    out = run_chunks(task, model, inputs, chunk=size, client=client, store=store,
+                     progress=progress, meta=meta)
+
+    ny, nx = yv.size, xv.size
+    ds = xr.Dataset(coords={yn: (yn, yv), xn: (xn, xv)})
+    if model.meshes:
+        ds = ds.assign_coords(mesh=("mesh", [m[0] for m in model.meshes]))
+    dims, attrs = variable_dims(model), variable_attrs(model, max_period, tol)
+    dims.update(status=(), lyapunov=())
+    attrs.update(status={"meaning": "0 ok, 1 diverged"},
+                 lyapunov={"long_name": "largest Lyapunov exponent",
+                           "units": f"1/{model.time_unit}"})
+    for name in (*variable_dims(model), "status", "lyapunov"):
+        if name not in out:
+            continue
+        data = out[name].reshape(ny, nx, *out[name].shape[1:])
+        if name == "contact":
+            data = np.array(CONTACT_LABELS)[data]
+        ds[name] = ((yn, xn, *dims[name]), data, attrs[name])
+    ds.attrs.update(
+        model=model.name, x=xn, y=yn, transient=float(transient), samples=int(samples),
+        steps_per_period_setting=int(steps_per_period or 0), lyapunov=int(bool(lyapunov)),
+        integrator="RK4, fixed step aligned to the forcing period",
+        locate_edges=int(bool(locate_edges)), bound=float(bound), period_tol=float(tol),
+        max_period=int(max_period), time_unit=model.time_unit, chunk=size,
+        start="each point from its own model's initial state",
+    )
+    if lyap is not None:
+        ds.attrs.update(lyapunov_duration=lyap["duration"],
+                        lyapunov_steps_per_period=lyap["steps_per_period"])
+    if hasattr(model, "interpretation"):
+        ds.attrs["interpretation"] = model.interpretation
+    if hasattr(model, "omega_n"):
+        ds.attrs["omega_n"] = float(model.omega_n)
+    return ds
+
+
+# ---------------------------------------------------------------------------- cost estimate
+@dataclass(frozen=True)
+class MapEstimate:
+    """What a map will cost (before it is built)."""
+
+    lanes: int
+    lane_steps: float  # RK4 steps over all lanes (Lyapunov steps weighted by LYAPUNOV_COST)
+    memory_bytes: float  # peak memory of this process
+    seconds: float  # wall time at ``ns_per_lane_step``
+    ns_per_lane_step: float
+
+    def describe(self) -> str:
+        return (f"{self.lanes} points, {self.lane_steps:.3g} lane-steps, about "
+                f"{_bytes_text(self.memory_bytes)} of memory and {_time_text(self.seconds)} "
+                f"(at {self.ns_per_lane_step:.3g} ns per lane-step)")
+
+
+def _bytes_text(n: float) -> str:
+    for unit, size in (("TiB", 2**40), ("GiB", 2**30), ("MiB", 2**20)):
+        if n >= size:
+            return f"{n / size:.3g} {unit}"
+    return f"{n / 2**10:.3g} KiB"
+
+
+def _time_text(s: float) -> str:
+    if s >= 86400:
+        return f"{s / 86400:.3g} days"
+    if s >= 3600:
+        return f"{s / 3600:.3g} h"
+    if s >= 60:
+        return f"{s / 60:.3g} min"
+    return f"{s:.3g} s"
+
+
+#: More RK4 steps than this in one lane is refused as a mistake (years of computing).
+MAX_STEPS_PER_LANE = 1e13
+
+
+def _steps_per_lane(model: Model, omegas: np.ndarray, transient: float, samples: int,
+                    steps_per_period: int | None) -> np.ndarray:
+    """RK4 steps of one lane (transient plus samples) at each Omega, as floats (inf where the
+    count overflows)."""
+    out = np.empty(len(omegas))
+    with np.errstate(over="ignore", invalid="ignore"):
+        for k, w in enumerate(omegas):
+            n = float(steps_per_period) if steps_per_period else float(
+                ladder_steps(default_steps_per_period(model, float(w))))
+            out[k] = n * (np.ceil(np.float64(transient) * w / (2 * math.pi) - 1e-9) + samples)
+    return out
+
+
+def check_steps(model: Model, omegas: np.ndarray, transient: float, samples: int,
+                steps_per_period: int | None) -> None:
+    """Raise ValueError when a lane would need more than :data:`MAX_STEPS_PER_LANE` steps."""
+    steps = _steps_per_lane(model, np.unique(omegas), transient, samples, steps_per_period)
+    worst = float(np.max(steps)) if np.all(np.isfinite(steps)) else math.inf
+    if worst > MAX_STEPS_PER_LANE:
+        raise ValueError(f"Omega/transient: a point would need {worst:.3g} RK4 steps (more than "
+                         f"{MAX_STEPS_PER_LANE:.0e}); check Omega, transient and samples")
+
+
+def estimate_map(model: Model, lanes: int, omegas: Sequence[float] | np.ndarray,
+                 transient: float, samples: int, steps_per_period: int | None = None,
+                 lyapunov: bool = False, chunk: int | None = None,
+                 ns_per_lane_step: float = 300.0, parallel: float = 1.0) -> MapEstimate:
+    """Cost of a map of ``lanes`` points, from a few representative forcing frequencies
+    ``omegas`` (the Omega axis subsampled, or the model's one Omega) — nothing of the size of the
+    grid is allocated.
+
+    Memory: the coefficient vectors, initial states and per-point results of all points (twice,
+    for assembly), plus one chunk's Poincare samples (``chunk x samples x states x 8`` bytes,
+    twice). Time: lane-steps x ``ns_per_lane_step`` (wall time per lane-step of this machine with
+    every core busy, e.g. :func:`measure_ns_per_lane_step`) / ``parallel`` (how many such
+    machines a cluster is worth).
+    """
+    om = np.asarray(omegas, dtype=float).ravel()
+    if om.size == 0 or not np.all(np.isfinite(om) & (om > 0)):
+        raise ValueError("Omega must be positive and finite")
+    per_lane = float(np.mean(_steps_per_lane(model, om, transient, samples, steps_per_period)))
+    steps = lanes * per_lane
+    if lyapunov:
+        n = int(steps_per_period or default_steps_per_period(model, float(om.min())))
+        duration = samples * float(np.mean(2 * math.pi / om))
+        per = np.mean([n * (math.ceil(transient * w / (2 * math.pi) - 1e-9)
+                            + max(1, math.ceil(duration * w / (2 * math.pi) - 1e-9)))
+                       for w in om])
+        steps += LYAPUNOV_COST * lanes * per
+    ns, n_par = model.n_states, model.params.size
+    n_mesh = len(model.meshes)
+    per_point = 8.0 * (n_par + ns + n_mesh + 2 * (6 + 5 * n_mesh + int(lyapunov)))
+    size = chunk or default_chunk(lanes)
+    memory = lanes * per_point + 2 * 8.0 * min(size, lanes) * samples * ns
+    return MapEstimate(lanes=int(lanes), lane_steps=float(steps), memory_bytes=float(memory),
+                       seconds=float(steps * ns_per_lane_step * 1e-9 / max(parallel, 1e-9)),
+                       ns_per_lane_step=float(ns_per_lane_step))
+
+
+def measure_ns_per_lane_step(model: Model, omega: float, steps_per_period: int | None = None,
+                             steps: int = 20000) -> float:
+    """Wall time per lane-step (ns) of :func:`run_lanes` on this machine with every core busy:
+    a short run of 8 lanes per thread, timed after a first call that compiles or loads the
+    kernel."""
+    import numba
+
+    lanes = 8 * numba.get_num_threads()
+    n = int(steps_per_period) if steps_per_period else ladder_steps(
+        default_steps_per_period(model, omega))
+    n = min(n, steps // 2)  # the cost of a step hardly depends on the steps per period
+    periods = max(2, steps // n)
+    P = model.lane_params("Omega", np.full(lanes, float(omega)))
+    y0 = model.initial_state()
+    run_lanes(model, P[:1], y0, 0.0, 2, n)
+    t0 = time.perf_counter()
+    run_lanes(model, P, y0, 0.0, periods, n)
+    return (time.perf_counter() - t0) * 1e9 / (lanes * periods * n)

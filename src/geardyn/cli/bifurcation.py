@@ -1,0 +1,333 @@
+"""``geardyn bifurcation`` (a study's sweep, saved and drawn) and ``geardyn plot`` (redraws a
+saved result).
+
+::
+
+    geardyn bifurcation STUDY.toml [--param Omega] [--range 0.1:4:1000]
+                        [--continuation none|up|down] [--lyapunov] [--transient T] [--samples N]
+                        [--steps-per-period N] [--omega W] [--interpretation ...] [--state X_sq]
+                        [--quiet] [--out out.nc] [--plot out.png]
+    geardyn plot RESULT.nc [--out fig.png|fig.pdf] [--state X_sq]
+
+Unset options come from the study's ``[sweep]`` table (param, range, continuation, samples,
+lyapunov) and ``[run]`` table (transient, steps_per_period, omega, and periods as the default
+number of samples). A progress bar is drawn when stderr is a terminal (``--quiet``: never).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import math
+import sys
+import time
+from enum import StrEnum
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from geardyn.cli.common import (
+    Interpretation,
+    check_plot_path,
+    load_study_source,
+    make_parents,
+    stderr_console,
+)
+from geardyn.errors import ParameterError, StudyError
+
+__all__ = ["bifurcation_command", "parse_range", "plot_command", "register"]
+
+
+class Continuation(StrEnum):
+    none = "none"
+    up = "up"
+    down = "down"
+
+
+def parse_range(text: str, option: str = "--range") -> tuple[float, float, int]:
+    """``START:STOP:NUM`` -> (start, stop, num): NUM >= 2 evenly spaced values, START != STOP."""
+    parts = [p.strip() for p in text.split(":")]
+    if len(parts) != 3:
+        raise ParameterError(option, text, "expected START:STOP:NUM, e.g. 0.1:4:1000")
+    try:
+        start, stop = float(parts[0]), float(parts[1])
+    except ValueError:
+        raise ParameterError(option, text, "START and STOP must be numbers") from None
+    if not (math.isfinite(start) and math.isfinite(stop)):
+        raise ParameterError(option, text, "START and STOP must be finite")
+    if start == stop:
+        raise ParameterError(option, text, "START and STOP must differ")
+    try:
+        num = int(parts[2])
+    except ValueError:
+        raise ParameterError(option, text, "NUM must be a whole number of values") from None
+    if num < 2:
+        raise ParameterError(option, text, "NUM must be >= 2")
+    return start, stop, num
+
+
+def _sweepable(model) -> list[str]:
+    """Names a sweep of ``model`` accepts, for error messages."""
+    from geardyn.models.catt import CATTDevice
+    from geardyn.models.params import PAPER_NAMES
+
+    if isinstance(model, CATTDevice):
+        return ["Omega", *(n for n in PAPER_NAMES if n != "waveform")]
+    return ["Omega", *(n for n in model.param_names if n != "Omega")]
+
+
+def _check_param_name(model, param: str) -> None:
+    """A one-line error naming ``--param`` unless ``model`` can sweep ``param``."""
+    known = _sweepable(model)
+    try:
+        ok = param in known or model.lane_params(param, [1.0]).shape[0] == 1
+    except KeyError:
+        ok = False
+    if not ok:
+        raise ParameterError("--param", param,
+                             f"not a parameter of {model.name}; known: {', '.join(known)}")
+
+
+def _check_param_values(model, param: str, values, range_text: str) -> None:
+    """A one-line error naming ``--range`` unless ``param`` accepts both ends of the range."""
+    from pydantic import ValidationError
+
+    from geardyn.io.toml import format_error
+
+    for value in (values[0], values[-1]):
+        try:
+            model.lane_params(param, [value])
+        except (ValidationError, ValueError) as exc:
+            raise StudyError(f"--range: {param} = {value:g} in {range_text!r}: "
+                             f"{format_error(exc)}") from None
+
+
+def _check_state(names, state: str, option: str) -> str:
+    for candidate in (state, f"{state}1"):
+        if candidate in names:
+            return candidate
+    raise ParameterError(option, state, f"not a state of the model; known: {', '.join(names)}")
+
+
+def _stderr_is_terminal() -> bool:
+    return sys.stderr.isatty()
+
+
+@contextlib.contextmanager
+def _progress_bar(show: bool, label: str):
+    """A rich progress bar on stderr fed by ``callback(done, total)``; None when not shown."""
+    if not show:
+        yield None
+        return
+    from rich.progress import (
+        BarColumn,
+        MofNCompleteColumn,
+        Progress,
+        TextColumn,
+        TimeElapsedColumn,
+        TimeRemainingColumn,
+    )
+
+    columns = (TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
+               TimeElapsedColumn(), TimeRemainingColumn())
+    with Progress(*columns, console=stderr_console(), transient=True) as bar:
+        task = bar.add_task(label, total=None)
+
+        def callback(done: int, total: int) -> None:
+            bar.update(task, completed=done, total=total)
+
+        yield callback
+
+
+def _summary(ds) -> str:
+    import numpy as np
+
+    period = ds["period"].values
+    parts = [f"period-{k} {int(np.sum(period == k))}" for k in (1, 2, 3, 4)
+             if np.any(period == k)]
+    if np.any(period >= 5):
+        parts.append(f"period>=5 {int(np.sum(period >= 5))}")
+    parts.append(f"quasi-periodic/chaotic {int(np.sum(period == 0))}")
+    parts.append(f"unbounded {int(np.sum(period == -1))}")
+    return ", ".join(parts)
+
+
+def bifurcation_command(
+    study: Annotated[str, typer.Argument(help="Study TOML file or built-in study name.")],
+    param: Annotated[
+        str | None, typer.Option(help="Swept parameter: Omega or a paper name (default: "
+                                      "sweep.param).")
+    ] = None,
+    range_: Annotated[
+        str | None,
+        typer.Option("--range", help="START:STOP:NUM, NUM evenly spaced values (default: the "
+                                     "study's sweep table); SI units for the device's parameters."),
+    ] = None,
+    continuation: Annotated[
+        Continuation | None,
+        typer.Option(help="none: every point from the same start; up/down: each from the "
+                          "previous point's final state (default: sweep.continuation)."),
+    ] = None,
+    lyapunov: Annotated[
+        bool | None,
+        typer.Option("--lyapunov/--no-lyapunov", help="Largest Lyapunov exponent per point "
+                                                      "(default: sweep.lyapunov)."),
+    ] = None,
+    transient: Annotated[
+        float | None, typer.Option(help="Discarded time per point, dimensionless tau "
+                                        "(default: run.transient).")
+    ] = None,
+    samples: Annotated[
+        int | None, typer.Option(help="Forcing periods sampled per point (default: "
+                                      "sweep.samples, else run.periods).")
+    ] = None,
+    steps_per_period: Annotated[
+        int | None, typer.Option(help="RK4 steps per forcing period (default: automatic).")
+    ] = None,
+    omega: Annotated[
+        float | None, typer.Option(help="The fixed Omega when sweeping another parameter "
+                                        "(default: run.omega).")
+    ] = None,
+    interpretation: Annotated[
+        Interpretation | None, typer.Option(help="Interpretation (default: the study's).")
+    ] = None,
+    state: Annotated[
+        str | None, typer.Option(help="State drawn (default: the study's plot_state).")
+    ] = None,
+    quiet: Annotated[
+        bool, typer.Option("--quiet", "-q", help="No progress bar.")
+    ] = False,
+    out: Annotated[Path | None, typer.Option(help="NetCDF file to write (.nc).")] = None,
+    plot: Annotated[Path | None, typer.Option(help="Figure to write (.png, .pdf or .svg).")] = None,
+) -> None:
+    """Sweep one parameter of a study: bifurcation diagram, periods, contact loss.
+
+    At every value: the Poincaré points, the period, the contact-loss regime of every mesh, the
+    dynamic factor and, with --lyapunov, the largest Lyapunov exponent; saved as NetCDF and drawn.
+    """
+    import numpy as np
+
+    s = load_study_source(study)
+    sweep = s.sweep
+    name = param or (sweep.param if sweep is not None else "Omega")
+    om = omega if omega is not None else s.run.omega
+    if om is not None and not (math.isfinite(om) and om > 0):
+        raise ParameterError("--omega", om, "must be a positive finite number")
+    interp = interpretation.value if interpretation is not None else None
+    model = s.build_model(interpretation=interp, omega=om)
+    _check_param_name(model, name)
+    if range_ is not None:
+        start, stop, num = parse_range(range_)
+        range_text = range_
+    elif sweep is not None and sweep.param == name:
+        start, stop, num = sweep.start, sweep.stop, sweep.num
+        range_text = f"{start:g}:{stop:g}:{num}"
+    else:
+        why = "the study has no [sweep]" if sweep is None else f"the study sweeps {sweep.param}"
+        raise StudyError(f"--range: not given, and {why}")
+    if name != "Omega" and om is None:
+        raise StudyError(f"--omega: not given, and a sweep of {name} needs a fixed Omega "
+                         "(or [run].omega in the study)")
+    values = np.linspace(start, stop, num)
+    _check_param_values(model, name, values, range_text)
+    cont = (continuation.value if continuation is not None
+            else sweep.continuation if sweep is not None else "none")
+    lyap = lyapunov if lyapunov is not None else bool(sweep is not None and sweep.lyapunov)
+    tr = s.run.transient if transient is None else transient
+    n_samples = samples if samples is not None else (
+        sweep.samples if sweep is not None and sweep.samples is not None else s.run.periods)
+    spp = s.run.steps_per_period if steps_per_period is None else steps_per_period
+    if not (math.isfinite(tr) and tr >= 0):
+        raise ParameterError("--transient", tr, "must be a finite time >= 0")
+    if n_samples < 2:
+        raise ParameterError("--samples", n_samples, "must be >= 2 (the period needs two)")
+    if spp is not None and spp < 4:
+        raise ParameterError("--steps-per-period", spp, "must be >= 4")
+    if out is not None and out.suffix.lower() != ".nc":
+        raise ParameterError("--out", str(out), "suffix must be .nc (NetCDF)")
+    check_plot_path("--plot", plot)
+    plot_state = _check_state(model.state_names, state or s.plot_state,
+                              "--state" if state else "study.plot_state")
+    make_parents(out, plot)
+
+    from geardyn.analysis.bifurcation import bifurcation
+
+    show_bar = not quiet and _stderr_is_terminal()
+    t0 = time.perf_counter()
+    with _progress_bar(show_bar, f"{s.study.name}: {name}") as callback:
+        ds = bifurcation(model, param=name, values=values, transient=tr, samples=n_samples,
+                         continuation=None if cont == "none" else cont, steps_per_period=spp,
+                         lyapunov=lyap, progress=callback)
+    elapsed = time.perf_counter() - t0
+    ds.attrs["study"] = s.study.name
+    ds.attrs["plot_state"] = plot_state
+    ds.attrs["wall_time_s"] = round(elapsed, 3)
+
+    written = []
+    if out is not None:
+        from geardyn.io.netcdf import save_dataset
+
+        save_dataset(ds, out)
+        written.append(str(out))
+    if plot is not None:
+        from geardyn.plotting.bifurcation import plot_bifurcation
+
+        plot_bifurcation(ds, state=plot_state, path=plot)
+        written.append(str(plot))
+    typer.echo(
+        f"{s.study.name}: {num} values of {name} in [{start:g}, {stop:g}], continuation {cont}, "
+        f"{elapsed:.1f} s: {_summary(ds)}"
+        + (f"; wrote {', '.join(written)}" if written else "; nothing written")
+    )
+
+
+def _dataset_kind(ds) -> str:
+    """``"simulation"`` or ``"bifurcation"`` (what :func:`geardyn.simulate` or
+    :func:`geardyn.bifurcation` returned), else a one-line error."""
+    if "poincare" in ds and "time" in ds.dims:
+        return "simulation"
+    param = ds.attrs.get("param")
+    if "poincare" in ds and "period" in ds and param in ds.dims:
+        return "bifurcation"
+    raise ParameterError("RESULT", ds.encoding.get("source", "?"),
+                         "not a geardyn simulation or bifurcation dataset")
+
+
+def plot_command(
+    result: Annotated[Path, typer.Argument(help="A NetCDF file written by geardyn simulate or "
+                                                "geardyn bifurcation.")],
+    out: Annotated[
+        Path | None, typer.Option(help="Figure to write, .png, .pdf or .svg (default: RESULT "
+                                       "with .png).")
+    ] = None,
+    state: Annotated[
+        str | None, typer.Option(help="State drawn (default: the one saved with the result).")
+    ] = None,
+) -> None:
+    """Redraw the figure of a saved simulation or bifurcation result."""
+    from geardyn.io.netcdf import load_dataset
+
+    target = out if out is not None else result.with_suffix(".png")
+    check_plot_path("--out", target)
+    ds = load_dataset(result)
+    kind = _dataset_kind(ds)
+    names = [str(v) for v in ds["state"].values]
+    default = ds.attrs.get("plot_state") or next((n for n in ("X_sq", "x") if n in names),
+                                                 names[0])
+    shown = _check_state(names, state or default, "--state")
+    make_parents(target)
+    if kind == "bifurcation":
+        from geardyn.plotting.bifurcation import plot_bifurcation
+
+        plot_bifurcation(ds, state=shown, path=target)
+    else:
+        from geardyn.plotting.simulation import plot_simulation
+
+        plot_simulation(ds, state=shown, path=target)
+    typer.echo(f"{result}: {kind} dataset; wrote {target}")
+
+
+def register(app: typer.Typer) -> None:
+    """Add ``geardyn bifurcation`` and ``geardyn plot`` to the command line ``app``."""
+    app.command("bifurcation")(bifurcation_command)
+    app.command("plot")(plot_command)

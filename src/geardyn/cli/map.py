@@ -1,0 +1,238 @@
+"""``geardyn map``: a two-parameter map of a study, locally or on a Dask cluster, resumable.
+
+::
+
+    geardyn map STUDY.toml --x Omega:0.1:4:400 --y xi:0.01:0.3:200 [--lyapunov]
+                [--scheduler tcp://host:8786] [--chunk N] [--yes] --out map.nc|map.zarr
+                [--plot map.png]
+
+An axis is ``NAME:START:STOP:NUM`` (NUM evenly spaced values, SI units for the device's physical
+parameters). Before anything is built the command estimates memory and run time; a map above
+:data:`MEMORY_FRACTION` of this machine's memory or :data:`TIME_LIMIT_S` is refused with the
+estimate unless ``--yes`` is given. With ``--out map.zarr`` finished chunks are kept in the store
+as they complete and the same command, run again after an interruption, computes only the rest.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from pathlib import Path
+from typing import Annotated
+
+import numpy as np
+import typer
+
+from geardyn.errors import ParameterError
+
+__all__ = ["map_command", "parse_axis", "register"]
+
+#: A map whose estimated memory exceeds this fraction of the machine's memory is refused.
+MEMORY_FRACTION = 0.5
+#: A map whose estimated run time exceeds this is refused (seconds).
+TIME_LIMIT_S = 3600.0
+#: Values kept per axis to estimate the cost (the Omega axis is subsampled to this many).
+ESTIMATE_POINTS = 257
+
+_OUT_SUFFIXES = (".nc", ".zarr")
+_PLOT_SUFFIXES = (".png", ".pdf", ".svg")
+
+
+def parse_axis(text: str, option: str) -> tuple[str, float, float, int]:
+    """``NAME:START:STOP:NUM`` -> (name, start, stop, num); a one-line error otherwise."""
+    parts = text.split(":")
+    if len(parts) != 4 or not parts[0].strip():
+        raise ParameterError(option, text, "expected NAME:START:STOP:NUM, e.g. Omega:0.1:4:400")
+    name = parts[0].strip()
+    try:
+        start, stop = float(parts[1]), float(parts[2])
+    except ValueError:
+        raise ParameterError(option, text, "START and STOP must be numbers") from None
+    if not (math.isfinite(start) and math.isfinite(stop)):
+        raise ParameterError(option, text, "START and STOP must be finite")
+    try:
+        num = int(parts[3])
+    except ValueError:
+        raise ParameterError(option, text, "NUM must be a whole number of values") from None
+    if num < 1:
+        raise ParameterError(option, text, "NUM must be >= 1")
+    return name, start, stop, num
+
+
+def _memory_limit() -> float:
+    try:
+        total = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+    except (ValueError, OSError, AttributeError):
+        total = 8 * 2**30
+    return MEMORY_FRACTION * total
+
+
+def _connect(address: str):
+    try:
+        from dask.distributed import Client
+    except ImportError:
+        raise ParameterError("--scheduler", address, "needs dask[distributed] installed") from None
+    try:
+        return Client(address, timeout="10s")
+    except (OSError, TimeoutError, ValueError) as exc:
+        reason = " ".join(str(exc).split()) or type(exc).__name__
+        raise ParameterError("--scheduler", address, f"cannot connect: {reason}") from None
+
+
+def map_command(
+    study: Annotated[str, typer.Argument(help="Study TOML file or built-in study name.")],
+    x: Annotated[str, typer.Option("--x", help="x axis NAME:START:STOP:NUM, e.g. Omega:0.1:4:400")],
+    y: Annotated[str, typer.Option("--y", help="y axis NAME:START:STOP:NUM, e.g. xi:0.01:0.3:200")],
+    out: Annotated[Path, typer.Option(help="Result: map.nc (NetCDF) or map.zarr (resumable).")],
+    plot: Annotated[Path | None, typer.Option(help="Figure (.png, .pdf or .svg).")] = None,
+    transient: Annotated[
+        float | None, typer.Option(help="Discarded time per point (default: run.transient).")
+    ] = None,
+    samples: Annotated[
+        int | None, typer.Option(help="Forcing periods sampled per point (default: run.periods).")
+    ] = None,
+    steps_per_period: Annotated[
+        int | None, typer.Option(help="RK4 steps per forcing period (default: automatic).")
+    ] = None,
+    lyapunov: Annotated[
+        bool, typer.Option("--lyapunov", help="Also the largest Lyapunov exponent per point.")
+    ] = False,
+    interpretation: Annotated[
+        str | None, typer.Option(help="consistent, carrier-only or as-printed (default: study's).")
+    ] = None,
+    scheduler: Annotated[
+        str | None, typer.Option(help="Dask scheduler address (tcp://host:port): run there.")
+    ] = None,
+    chunk: Annotated[int | None, typer.Option(help="Grid points per task (default: auto).")] = None,
+    yes: Annotated[
+        bool, typer.Option("--yes", help="Run even when the estimate exceeds the limits.")
+    ] = False,
+) -> None:
+    """Map the steady motion (period, contact-loss regime, Lyapunov exponent) over two
+    parameters; save it (NetCDF, or a resumable Zarr store) and plot it."""
+    from rich.console import Console
+
+    from geardyn.analysis.map2d import check_steps, estimate_map, map2d, measure_ns_per_lane_step
+    from geardyn.cli.main import _load_study
+
+    x_axis, y_axis = parse_axis(x, "--x"), parse_axis(y, "--y")
+    if x_axis[0] == y_axis[0]:
+        raise ParameterError("--y", y, "must name another parameter than --x")
+    if out.suffix.lower() not in _OUT_SUFFIXES:
+        raise ParameterError("--out", str(out), f"suffix must be one of {_OUT_SUFFIXES}")
+    if plot is not None and plot.suffix.lower() not in _PLOT_SUFFIXES:
+        raise ParameterError("--plot", str(plot), f"suffix must be one of {_PLOT_SUFFIXES}")
+    if chunk is not None and chunk < 1:
+        raise ParameterError("--chunk", chunk, "must be >= 1")
+    if samples is not None and samples < 2:
+        raise ParameterError("--samples", samples, "must be >= 2")
+    if steps_per_period is not None and steps_per_period < 4:
+        raise ParameterError("--steps-per-period", steps_per_period, "must be >= 4")
+    if transient is not None and not (math.isfinite(transient) and transient >= 0):
+        raise ParameterError("--transient", transient, "must be a finite time >= 0")
+    s = _load_study(study)
+    model = s.build_model(interpretation=interpretation)
+    tr = s.run.transient if transient is None else transient
+    n_samples = s.run.periods if samples is None else samples
+    spp = s.run.steps_per_period if steps_per_period is None else steps_per_period
+    if n_samples < 2:
+        raise ParameterError("run.periods", n_samples, "a map needs >= 2 samples per point")
+    # the names and both ends of each axis must be valid before anything grid-sized is built
+    for (name, start, stop, _), option in ((x_axis, "--x"), (y_axis, "--y")):
+        try:
+            ends = model.lane_params(name, [start, stop])
+        except KeyError as exc:
+            raise ParameterError(option, name, str(exc.args[0]) if exc.args else "unknown") \
+                from None
+        if model.omega_index is None:
+            raise ParameterError("study", s.study.name, "a map needs a forced model")
+        if name == "Omega" and not np.all(ends[:, model.omega_index] > 0):
+            raise ParameterError(option, f"{start}:{stop}", "Omega must be > 0")
+
+    lanes = x_axis[3] * y_axis[3]
+    omega_axis = next((a for a in (x_axis, y_axis) if a[0] == "Omega"), None)
+    omegas = (np.linspace(omega_axis[1], omega_axis[2], min(omega_axis[3], ESTIMATE_POINTS))
+              if omega_axis else np.array([model.omega]))
+    check_steps(model, omegas, tr, n_samples, spp)
+    err = Console(stderr=True)
+    estimate = estimate_map(model, lanes, omegas, tr, n_samples, spp, lyapunov, chunk)
+    memory_limit = _memory_limit()
+    if estimate.memory_bytes > memory_limit and not yes:
+        raise ParameterError("--x/--y", f"{x} x {y}", f"map too large: {estimate.describe()}; "
+                             f"limit {memory_limit / 2**30:.3g} GiB (pass --yes to run anyway)")
+    client = _connect(scheduler) if scheduler else None
+    try:
+        parallel = 1.0
+        if client is not None:
+            threads = sum(client.nthreads().values())
+            parallel = max(threads, 1) / (os.cpu_count() or 1)
+        with err.status("estimating the run time (the first run compiles the kernels)"):
+            ns = measure_ns_per_lane_step(model, float(np.median(omegas)), spp)
+        estimate = estimate_map(model, lanes, omegas, tr, n_samples, spp, lyapunov, chunk,
+                                ns_per_lane_step=ns, parallel=parallel)
+        if estimate.seconds > TIME_LIMIT_S and not yes:
+            raise ParameterError("--x/--y", f"{x} x {y}", f"map too long: {estimate.describe()};"
+                                 f" limit {TIME_LIMIT_S / 60:.3g} min (pass --yes to run anyway)")
+        err.print(f"map: {estimate.describe()}")
+        ds = _run(map2d, model, x_axis, y_axis, tr, n_samples, spp, lyapunov, client, out,
+                  chunk, err)
+    finally:
+        if client is not None:
+            client.close()
+    ds.attrs["study"] = s.study.name
+    _save(ds, out, plot, err)
+
+
+def _run(map2d, model, x_axis, y_axis, transient, samples, spp, lyapunov, client, out, chunk,
+         err):
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TimeRemainingColumn
+
+    xv = np.linspace(x_axis[1], x_axis[2], x_axis[3])
+    yv = np.linspace(y_axis[1], y_axis[2], y_axis[3])
+    store = out if out.suffix.lower() == ".zarr" else None
+    if store is not None:
+        out.parent.mkdir(parents=True, exist_ok=True)
+    columns = ("[progress.description]{task.description}", BarColumn(), MofNCompleteColumn(),
+               TimeRemainingColumn())
+    with Progress(*columns, console=err, transient=False) as bar:
+        task = bar.add_task("points", total=xv.size * yv.size)
+
+        def progress(done: int, total: int) -> None:
+            bar.update(task, completed=done, total=total)
+
+        return map2d(model, x=(x_axis[0], xv), y=(y_axis[0], yv), transient=transient,
+                     samples=samples, steps_per_period=spp, lyapunov=lyapunov, client=client,
+                     store=store, chunk=chunk, progress=progress)
+
+
+def _save(ds, out: Path, plot: Path | None, err) -> None:
+    from geardyn.analysis.periodicity import APERIODIC, UNBOUNDED
+    from geardyn.io.netcdf import save_dataset
+    from geardyn.io.zarr_store import save_zarr_dataset
+
+    for path in (out, plot):
+        if path is not None:
+            path.parent.mkdir(parents=True, exist_ok=True)
+    if out.suffix.lower() == ".zarr":
+        save_zarr_dataset(ds, out)
+    else:
+        save_dataset(ds, out)
+    written = [str(out)]
+    if plot is not None:
+        from geardyn.plotting.map2d import plot_map
+
+        with err.status("plotting"):
+            plot_map(ds, path=plot)
+        written.append(str(plot))
+    p = ds["period"].values
+    n = p.size
+    typer.echo(
+        f"{ds.attrs['study']}: {ds.attrs['y']} x {ds.attrs['x']} map of {n} points: "
+        f"{np.sum(p >= 1)} periodic, {np.sum(p == APERIODIC)} quasi-periodic or chaotic, "
+        f"{np.sum(p == UNBOUNDED)} unbounded; wrote {', '.join(written)}"
+    )
+
+
+def register(app: typer.Typer) -> None:
+    """Add ``geardyn map`` to the command line ``app``."""
+    app.command("map")(map_command)

@@ -1,0 +1,123 @@
+"""``geardyn reproduce``: the seed paper's figure cases, swept up and down, and the claims report.
+
+::
+
+    geardyn reproduce fig3 [--interpretation ...] [--resolution N] [--out out/reproduce]
+    geardyn reproduce --all [--interpretation consistent|carrier-only|as-printed|all]
+                      [--resolution N] [--transient T] [--samples S] [--out out/reproduce]
+
+Writes, under ``--out``, ``CASE-INTERPRETATION.nc`` (data), ``CASE-INTERPRETATION.png`` and
+``...-down.png`` (the diagrams swept up and down), ``report.md`` and a self-contained
+``report.html``. See ``docs/reproduction.md``.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import time
+from enum import StrEnum
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from geardyn.cli.common import stderr_console
+from geardyn.errors import ParameterError
+
+__all__ = ["register", "reproduce_command"]
+
+
+class InterpretationChoice(StrEnum):
+    consistent = "consistent"
+    carrier_only = "carrier-only"
+    as_printed = "as-printed"
+    all = "all"
+
+
+@contextlib.contextmanager
+def _progress(show: bool):
+    """A rich progress bar on stderr fed by ``callback(stage, done, total)``."""
+    if not show:
+        yield None
+        return
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+
+    columns = (TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
+               TimeElapsedColumn())
+    with Progress(*columns, console=stderr_console(), transient=True) as bar:
+        task = bar.add_task("starting (the first run compiles)", total=None)
+
+        def callback(stage: str, done: int, total: int) -> None:
+            bar.update(task, description=stage, completed=done, total=total)
+
+        yield callback
+
+
+def reproduce_command(
+    case: Annotated[str | None, typer.Argument(
+        help="A figure case: fig3 ... fig14, fig15a ... fig15d (or give --all).")] = None,
+    all_cases: Annotated[bool, typer.Option("--all", help="Run every figure case.")] = False,
+    interpretation: Annotated[InterpretationChoice, typer.Option(
+        help="How to read the paper's ambiguous formulas, or all three.")] = (
+        InterpretationChoice.consistent),
+    resolution: Annotated[int | None, typer.Option(
+        help="Omega points per sweep (default: the study's, the paper's resolution).")] = None,
+    transient: Annotated[float | None, typer.Option(
+        help="Transient per point, dimensionless time (default: the study's).")] = None,
+    samples: Annotated[int | None, typer.Option(
+        help="Mesh periods sampled per point (default: the study's).")] = None,
+    out: Annotated[Path, typer.Option(help="Output folder.")] = Path("out/reproduce"),
+    quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No progress bar.")] = False,
+) -> None:
+    """Recompute the paper's bifurcation diagrams (swept up and down) and write a report that
+    checks every claim of the paper against the data."""
+    import sys
+
+    from geardyn.models.derived import INTERPRETATIONS
+    from geardyn.reproduction import (
+        ReproductionSettings,
+        evaluate,
+        get_case,
+        paper_cases,
+        run_cases,
+        write_report,
+    )
+
+    if all_cases == (case is not None):
+        raise ParameterError("CASE", case, "give one figure case or --all, not both or neither")
+    cases = paper_cases() if all_cases else [get_case(case)]  # type: ignore[arg-type]
+    interps = (list(INTERPRETATIONS) if interpretation == InterpretationChoice.all
+               else [interpretation.value])
+    if resolution is not None and resolution < 2:
+        raise ParameterError("--resolution", resolution, "must be >= 2")
+    if samples is not None and samples < 2:
+        raise ParameterError("--samples", samples, "must be >= 2")
+    if transient is not None and not transient >= 0:
+        raise ParameterError("--transient", transient, "must be >= 0")
+    settings = ReproductionSettings(num=resolution, transient=transient, samples=samples)
+    out.mkdir(parents=True, exist_ok=True)
+
+    start = time.perf_counter()
+    with _progress(not quiet and sys.stderr.isatty()) as callback:
+        results = run_cases(cases, interps, settings, callback)
+    swept = time.perf_counter() - start
+    command = "geardyn reproduce " + ("--all" if all_cases else cases[0].name) + (
+        f" --interpretation {interpretation.value}"
+        + (f" --resolution {resolution}" if resolution else "")
+        + (f" --transient {transient:g}" if transient is not None else "")
+        + (f" --samples {samples}" if samples else ""))
+    with stderr_console().status("writing figures, data and the report"):
+        paths = write_report(results, out, command=command)
+    for interp in interps:
+        verdicts = evaluate({c: ds for (c, i), ds in results.items() if i == interp})
+        counts: dict[str, int] = {}
+        for v in verdicts.values():
+            counts[v.status] = counts.get(v.status, 0) + 1
+        typer.echo(f"{interp}: " + ", ".join(f"{n} {s}" for s, n in counts.items()))
+    typer.echo(f"{len(results)} case results in {swept:.1f} s of sweeps; wrote "
+               f"{paths['markdown']}, {paths['html']}")
+
+
+def register(app: typer.Typer) -> None:
+    """Add ``geardyn reproduce`` to the command line ``app``."""
+    app.command("reproduce")(reproduce_command)

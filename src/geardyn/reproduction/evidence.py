@@ -1,0 +1,176 @@
+"""Measurements on case results that the claim checks are built from.
+
+A :class:`Branch` is one sweep direction of one case: the Omega grid, the motion label of every
+point (:mod:`geardyn.reproduction.motion`) and the stroboscopic samples of the case's plotted
+coordinate. :class:`Evidence` holds the branches of every case run under one interpretation.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+
+import numpy as np
+import xarray as xr
+
+from geardyn.reproduction.motion import CHAOTIC, intervals, is_nonperiodic, period_label
+
+__all__ = ["Branch", "Evidence", "MissingCase", "format_intervals"]
+
+
+class MissingCase(LookupError):
+    """A claim needs a case that was not run."""
+
+
+def format_intervals(runs: list[tuple[float, float, int]], limit: int = 6) -> str:
+    """``"1.02-1.28 (14 pts), 2.27-2.69 (22 pts)"``; "none" when empty."""
+    if not runs:
+        return "none"
+    text = [f"{a:.3g}" if n == 1 else f"{a:.3g}-{b:.3g}" for a, b, n in runs[:limit]]
+    text = [f"{t} ({n} pt{'s' if n > 1 else ''})" for t, (_, _, n) in zip(text, runs, strict=False)]
+    more = f", ... ({len(runs) - limit} more)" if len(runs) > limit else ""
+    return ", ".join(text) + more
+
+
+@dataclass(frozen=True)
+class Branch:
+    """One sweep direction of one case (Omega ascending)."""
+
+    case: str
+    omega: np.ndarray
+    motion: np.ndarray
+    x: np.ndarray  # (Omega, sample): stroboscopic samples of the plotted coordinate
+    contact: np.ndarray  # (Omega, mesh)
+    mesh: tuple[str, ...]
+    static_deflection: float  # dimensionless static mesh deflection of the plotted mesh
+    state: str
+
+    @classmethod
+    def from_dataset(cls, ds: xr.Dataset, direction: str = "up") -> Branch:
+        d = ds.sel(sweep=direction)
+        order = np.argsort(d["Omega"].values, kind="stable")
+        state = str(ds.attrs.get("plot_state", "X_sq"))
+        names = [str(s) for s in ds["state"].values]
+        state = state if state in names else f"{state}1"
+        mesh = tuple(str(m) for m in ds["mesh"].values)
+        static = np.atleast_1d(ds.attrs.get("static_deflection", [np.nan] * len(mesh)))
+        which = 1 if "pq" in state else 0
+        return cls(
+            case=str(ds.attrs.get("case", "?")),
+            omega=d["Omega"].values[order],
+            motion=d["motion"].values[order].astype(str),
+            x=d["poincare"].sel(state=state).transpose("Omega", "sample").values[order],
+            contact=d["contact"].transpose("Omega", "mesh").values[order].astype(str),
+            mesh=mesh,
+            static_deflection=float(static[min(which, static.size - 1)]),
+            state=state,
+        )
+
+    # ------------------------------------------------------------------ masks
+    @property
+    def step(self) -> float:
+        """Grid spacing in Omega."""
+        return float(np.median(np.diff(self.omega))) if self.omega.size > 1 else 0.0
+
+    def period(self, k: int) -> np.ndarray:
+        return self.motion == period_label(k)
+
+    @property
+    def chaotic(self) -> np.ndarray:
+        return self.motion == CHAOTIC
+
+    @property
+    def nonperiodic(self) -> np.ndarray:
+        return is_nonperiodic(self.motion)
+
+    @property
+    def bifurcated(self) -> np.ndarray:
+        """Anything but period-1 motion."""
+        return ~self.period(1)
+
+    def within(self, lo: float, hi: float) -> np.ndarray:
+        return (self.omega >= lo - 1e-12) & (self.omega <= hi + 1e-12)
+
+    # ------------------------------------------------------------------ measures
+    def share(self, mask: np.ndarray, lo: float, hi: float) -> tuple[float, int]:
+        """Share of the grid points in [lo, hi] where ``mask`` holds, and their number."""
+        inside = self.within(lo, hi)
+        n = int(np.count_nonzero(inside))
+        return (float(np.mean(mask[inside])) if n else float("nan")), n
+
+    def runs(self, mask: np.ndarray, min_points: int = 1) -> list[tuple[float, float, int]]:
+        return [r for r in intervals(self.omega, mask) if r[2] >= min_points]
+
+    def length(self, mask: np.ndarray) -> float:
+        """Omega-length covered by ``mask`` (points times the grid spacing)."""
+        return float(np.count_nonzero(mask)) * self.step
+
+    def first(self, mask: np.ndarray) -> float | None:
+        """The lowest Omega where ``mask`` holds."""
+        idx = np.flatnonzero(mask)
+        return float(self.omega[idx[0]]) if idx.size else None
+
+    def describe(self, mask: np.ndarray) -> str:
+        return format_intervals(self.runs(mask))
+
+    @property
+    def top(self) -> np.ndarray:
+        """Largest stroboscopic value of the plotted coordinate at each Omega."""
+        return np.nanmax(self.x, axis=1)
+
+    @property
+    def spread(self) -> np.ndarray:
+        """Peak-to-peak of the stroboscopic values at each Omega."""
+        return np.nanmax(self.x, axis=1) - np.nanmin(self.x, axis=1)
+
+    @property
+    def extent(self) -> float:
+        """Peak-to-peak of every stroboscopic value of the whole diagram."""
+        return float(np.nanmax(self.x) - np.nanmin(self.x))
+
+
+class Evidence:
+    """Branches of the cases run under one interpretation, for one sweep direction."""
+
+    def __init__(self, results: Mapping[str, xr.Dataset], direction: str = "up"):
+        self.results = dict(results)
+        self.direction = direction
+        self._cache: dict[str, Branch] = {}
+
+    def has(self, *cases: str) -> bool:
+        return all(c in self.results for c in cases)
+
+    def __getitem__(self, case: str) -> Branch:
+        if case not in self.results:
+            raise MissingCase(case)
+        if case not in self._cache:
+            self._cache[case] = Branch.from_dataset(self.results[case], self.direction)
+        return self._cache[case]
+
+
+#: Relative distance above which two period-k orbits of the same k count as different.
+ORBIT_TOL = 1.0e-3
+
+
+def hysteresis(ds: xr.Dataset) -> dict[str, list[tuple[float, float, int]] | None]:
+    """Where the up and down sweeps of a case result disagree: ``"class"`` (the motion labels
+    differ: coexisting attractors of different kinds, jumps) and ``"orbit"`` (both period-k
+    with the same k, but on different orbits: the sorted stroboscopic values of the plotted
+    coordinate differ by more than :data:`ORBIT_TOL` relative). Orbits are not compared under a
+    load fluctuation (``"orbit"`` is then None): the two sweeps sample the load at different
+    phases, so the same attractor shows different points."""
+    up, down = Branch.from_dataset(ds, "up"), Branch.from_dataset(ds, "down")
+    differ = up.motion != down.motion
+    noise = float(ds.attrs.get("Lambda", 0.0)) > 0 and (
+        float(ds.attrs.get("B1", 0.0)) != 0 or float(ds.attrs.get("B2", 0.0)) != 0)
+    if noise:
+        return {"class": up.runs(differ), "orbit": None}
+    orbit = np.zeros(up.omega.size, dtype=bool)
+    for i, label in enumerate(up.motion):
+        if differ[i] or not label.startswith("period-"):
+            continue
+        k = int(label.split("-")[1])
+        a, b = np.sort(up.x[i, :k]), np.sort(down.x[i, :k])
+        scale = ORBIT_TOL * max(1.0, float(np.max(np.abs(a))))
+        orbit[i] = bool(np.max(np.abs(a - b)) > scale)
+    return {"class": up.runs(differ), "orbit": up.runs(orbit)}

@@ -1,0 +1,203 @@
+"""Run the paper's figure cases: each a bifurcation sweep in Omega, continued up and down, with
+the largest Lyapunov exponent wherever the period classifier finds no period.
+
+The result of one case under one interpretation is an :class:`xarray.Dataset` with a ``sweep``
+dimension (``"up"``, ``"down"``) in front of the variables of :func:`geardyn.bifurcation`, plus
+``lyapunov`` (NaN where not computed) and ``motion`` (the labels of
+:mod:`geardyn.reproduction.motion`).
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Iterable
+from dataclasses import asdict, dataclass
+
+import numpy as np
+import xarray as xr
+
+from geardyn.analysis.bifurcation import bifurcation
+from geardyn.analysis.lyapunov import lyapunov_lanes
+from geardyn.models.base import Model
+from geardyn.reproduction.cases import Case
+from geardyn.reproduction.motion import LYAPUNOV_CHAOS, motion_labels
+from geardyn.solvers.simulate import default_steps_per_period
+
+__all__ = ["DIRECTIONS", "ReproductionSettings", "branch_lyapunov", "run_case", "run_cases",
+           "sweep_values"]
+
+DIRECTIONS: tuple[str, str] = ("up", "down")
+
+#: progress(stage, done, total): ``stage`` names the case, interpretation and sweep direction.
+Progress = Callable[[str, int, int], None]
+
+
+@dataclass(frozen=True)
+class ReproductionSettings:
+    """How finely to reproduce. ``None`` takes the study's value: ``num`` Omega points
+    ([sweep] num), ``transient`` (tau, [run] transient), ``samples`` (mesh periods recorded
+    per point, [sweep] samples else [run] periods). The Lyapunov exponent is measured over
+    ``lyapunov_duration`` (tau) after ``lyapunov_transient`` (tau), starting from the sweep's
+    last stroboscopic sample at that point; ``lyapunov_threshold`` separates chaos."""
+
+    num: int | None = None
+    transient: float | None = None
+    samples: int | None = None
+    lyapunov_transient: float = 300.0
+    lyapunov_duration: float = 1500.0
+    lyapunov_threshold: float = LYAPUNOV_CHAOS
+
+    def __post_init__(self) -> None:
+        checks = (("num", self.num, 2), ("samples", self.samples, 2))
+        for name, value, least in checks:
+            if value is not None and value < least:
+                raise ValueError(f"{name}: must be >= {least} (got {value!r})")
+        for name in ("transient", "lyapunov_transient"):
+            value = getattr(self, name)
+            if value is not None and not (np.isfinite(value) and value >= 0):
+                raise ValueError(f"{name}: must be a finite time >= 0 (got {value!r})")
+        if not (np.isfinite(self.lyapunov_duration) and self.lyapunov_duration > 0):
+            raise ValueError(f"lyapunov_duration: must be > 0 (got {self.lyapunov_duration!r})")
+
+    def resolve(self, case: Case) -> dict[str, float | int]:
+        """The settings for ``case`` with the study's defaults filled in."""
+        s = case.study
+        if s.sweep is None or s.sweep.param != "Omega":
+            raise ValueError(f"{case.study_name}: needs a [sweep] over Omega")
+        samples = self.samples or s.sweep.samples or s.run.periods
+        return {
+            "start": float(s.sweep.start),
+            "stop": float(s.sweep.stop),
+            "num": int(self.num or s.sweep.num),
+            "transient": float(s.run.transient if self.transient is None else self.transient),
+            "samples": int(samples),
+            "lyapunov_transient": float(self.lyapunov_transient),
+            "lyapunov_duration": float(self.lyapunov_duration),
+            "lyapunov_threshold": float(self.lyapunov_threshold),
+        }
+
+
+def sweep_values(case: Case, settings: ReproductionSettings) -> np.ndarray:
+    r = settings.resolve(case)
+    return np.linspace(r["start"], r["stop"], int(r["num"]))
+
+
+def branch_lyapunov(model: Model, values: np.ndarray, y0: np.ndarray, need: np.ndarray,
+                    transient: float, duration: float,
+                    steps_per_period: int | None = None) -> np.ndarray:
+    """Largest Lyapunov exponent [1/tau] at the Omega ``values`` where ``need`` is true, each
+    started from its own state ``y0[i]`` (NaN elsewhere, and where the integration diverged).
+
+    Lanes are grouped by their default step count (within a factor 1.25) so that a low Omega
+    does not impose its fine step on the whole sweep; each group runs in parallel."""
+    values = np.asarray(values, dtype=float)
+    out = np.full(values.size, np.nan)
+    idx = np.flatnonzero(need)
+    if idx.size == 0:
+        return out
+    idx = idx[np.argsort(values[idx], kind="stable")]
+    steps = np.array([steps_per_period or default_steps_per_period(model, float(values[i]))
+                      for i in idx])
+    groups: list[list[int]] = []
+    for j in range(idx.size):
+        if not groups or steps[groups[-1][0]] > 1.25 * steps[j] or len(groups[-1]) >= 64:
+            groups.append([])
+        groups[-1].append(j)
+    for g in groups:
+        lanes = idx[g]
+        out[lanes] = lyapunov_lanes(
+            model, model.lane_params("Omega", values[lanes]), np.asarray(y0)[lanes],
+            transient=transient, duration=duration, steps_per_period=int(max(steps[g])))
+    return out
+
+
+def _one_direction(model: Model, values: np.ndarray, direction: str, r: dict,
+                   steps_per_period: int | None, progress: Callable[[int, int], None] | None
+                   ) -> xr.Dataset:
+    start = time.perf_counter()
+    ds = bifurcation(model, "Omega", values, transient=r["transient"], samples=r["samples"],
+                     continuation=direction, steps_per_period=steps_per_period,
+                     progress=progress)
+    period = ds["period"].values
+    final = ds["poincare"].values[:, -1, :]
+    lam = branch_lyapunov(model, values, final, period == 0, r["lyapunov_transient"],
+                          r["lyapunov_duration"], steps_per_period)
+    ds["lyapunov"] = ("Omega", lam, {
+        "long_name": "largest Lyapunov exponent", "units": "1/tau",
+        "computed_where": "no period found (period == 0)",
+        "start": "last stroboscopic sample of this sweep at this Omega"})
+    ds["motion"] = ("Omega", motion_labels(period, lam, r["lyapunov_threshold"]), {
+        "long_name": "motion class", "meaning": "period-k, chaotic, quasi-periodic, "
+        "non-periodic (no exponent), unbounded; see geardyn.reproduction.motion"})
+    ds.attrs["wall_time_s"] = time.perf_counter() - start
+    return ds
+
+
+def run_case(case: Case, interpretation: str = "consistent",
+             settings: ReproductionSettings | None = None,
+             progress: Progress | None = None) -> xr.Dataset:
+    """Sweep ``case`` in Omega, continued up and down, and classify every point.
+
+    Returns the dataset described in the module docs; its attributes name the case, the
+    interpretation, the settings used, whether the stroboscopic section suits the case
+    (``section``) and the wall time of each direction."""
+    settings = settings or ReproductionSettings()
+    r = settings.resolve(case)
+    values = sweep_values(case, settings)
+    model = case.study.build_model(interpretation=interpretation)
+    spp = case.study.run.steps_per_period
+    parts, walls = [], {}
+    for direction in DIRECTIONS:
+        stage = f"{case.name} {interpretation} {direction}"
+
+        def tick(done: int, total: int, stage: str = stage) -> None:
+            if progress is not None:
+                progress(stage, done, total)
+
+        ds = _one_direction(model, values, direction, r, spp, tick)
+        walls[direction] = float(ds.attrs.pop("wall_time_s"))
+        ds.attrs.pop("continuation", None)
+        parts.append(ds)
+    out = xr.concat(parts, dim="sweep", combine_attrs="drop_conflicts")
+    out = out.assign_coords(sweep=("sweep", list(DIRECTIONS)))
+    loads = case.params.loads
+    out.attrs.update(
+        {f"setting_{k}": v for k, v in r.items()},
+        interpretation=interpretation, wall_time_up_s=walls["up"],
+        wall_time_down_s=walls["down"], B1=float(loads.B1), B2=float(loads.B2),
+        Lambda=float(loads.Lambda),
+        section="unsuitable (load fluctuation at Lambda): chaos from the Lyapunov exponent"
+        if case.load_noise else "stroboscopic, once per mesh period",
+        params_json=case.params.model_dump_json(),
+        static_deflection=[float(g) for g in model.static_forces()[:2]],
+    )
+    return label_case(out, case)
+
+
+def label_case(ds: xr.Dataset, case: Case) -> xr.Dataset:
+    """``ds`` (a case result) relabelled as ``case``: name, figure and plotted coordinate."""
+    out = ds.copy()
+    out.attrs.update(case=case.name, figure=case.figure, study=case.name,
+                     description=case.study.study.description, plot_state=case.plot_state)
+    return out
+
+
+def run_cases(cases: Iterable[Case], interpretations: Iterable[str],
+              settings: ReproductionSettings | None = None,
+              progress: Progress | None = None) -> dict[tuple[str, str], xr.Dataset]:
+    """:func:`run_case` for every case and interpretation, keyed ``(case name,
+    interpretation)``; cases with the same dynamics (Figs. 3 and 6, ...) run once."""
+    settings = settings or ReproductionSettings()
+    done: dict[str, xr.Dataset] = {}
+    out: dict[tuple[str, str], xr.Dataset] = {}
+    for interp in interpretations:
+        for case in cases:
+            key = case.dynamics_key(interp) + repr(asdict(settings))
+            if key in done:
+                ds = label_case(done[key], case)
+                ds.attrs["shared_with"] = done[key].attrs["case"]
+            else:
+                ds = run_case(case, interp, settings, progress)
+                done[key] = ds
+            out[(case.name, interp)] = ds
+    return out
