@@ -6,7 +6,7 @@ STAMP := $(VENV)/.installed
 export NUMBA_CACHE_DIR ?= $(CURDIR)/.geardyn-cache/numba
 export GEARDYN_CACHE_DIR ?= $(CURDIR)/.geardyn-cache
 
-.PHONY: venv demo test test-slow lint clean
+.PHONY: venv demo test test-slow bench lint clean
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -30,6 +30,10 @@ test: $(STAMP)
 
 test-slow: $(STAMP)
 	$(BIN)/python -m pytest -q -m slow
+
+bench: $(STAMP)
+	$(BIN)/python bench/bifurcation.py
+	$(BIN)/python bench/map.py --write
 
 lint: $(STAMP)
 	$(BIN)/ruff check src tests

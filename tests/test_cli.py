@@ -350,3 +350,19 @@ def test_simulate_records_plot_state_and_labels_spectrum(tmp_path):
     saved = load_dataset(nc)
     # no load fluctuation in Fig. 3: no second excitation frequency is recorded
     assert saved.attrs["plot_state"] == "X_pq" and "Lambda" not in saved.attrs
+
+
+def test_bifurcation_transient_by_convergence(tmp_path):
+    nc = tmp_path / "conv.nc"
+    r = invoke("bifurcation", "paper_fig3", "--range", "0.6:0.7:2", "--transient", "300",
+               "--samples", "4", "--converge", "1e-8", "--quiet", "--out", nc)
+    assert r.returncode == 0, r.stderr
+    saved = load_dataset(nc)
+    assert saved.attrs["converge"] == 1e-8
+    assert saved["converged"].values.tolist() == [1, 1]  # periodic there: it settles
+    # the transient used is longer than the minimum and shorter than the limit (10x)
+    T = 2 * np.pi / saved["Omega"].values
+    used = saved["transient_periods"].values * T
+    assert np.all(used >= 300.0) and np.all(used < 3000.0)
+    assert_one_line_error(invoke("bifurcation", "paper_fig3", "--converge", "-1", "--quiet"),
+                          "--converge")

@@ -176,7 +176,7 @@ def test_motion_labels_and_hysteresis():
 
 
 # --------------------------------------------------------------------------- the pipeline
-TINY = ("--resolution", 3, "--transient", 300, "--samples", 8)
+TINY = ("--resolution", 3, "--transient", 300, "--samples", 8, "--jobs", 1)
 
 
 def _reference_periods(case_name: str, omegas, transient: float, samples: int) -> list[int]:
@@ -242,11 +242,27 @@ def test_pipeline_at_tiny_resolution(tmp_path, capsys):
     assert evaluate({"fig5": ds})["C10"].status == expected
 
 
+def test_worker_processes_give_the_serial_result():
+    from geardyn.reproduction import ReproductionSettings, run_cases
+
+    settings = ReproductionSettings(num=3, transient=200.0, samples=6)
+    cases = [get_case("fig5"), get_case("fig8")]
+    serial = run_cases(cases, ["consistent"], settings)
+    parallel = run_cases(cases, ["consistent"], settings, workers=2)
+    assert set(serial) == set(parallel) == {("fig5", "consistent"), ("fig8", "consistent")}
+    for key, ds in serial.items():
+        other = parallel[key]
+        np.testing.assert_array_equal(ds["poincare"].values, other["poincare"].values)
+        np.testing.assert_array_equal(ds["motion"].values, other["motion"].values)
+        assert ds.attrs["plot_state"] == other.attrs["plot_state"] == get_case(key[0]).plot_state
+    assert parallel[("fig8", "consistent")].attrs["shared_with"] == "fig5"
+
+
 def test_reproduce_refuses_bad_input(capsys):
     from geardyn.cli.main import main
 
     for args in (["reproduce", "fig99"], ["reproduce"], ["reproduce", "fig3", "--all"],
-                 ["reproduce", "fig3", "--resolution", "1"],
+                 ["reproduce", "fig3", "--resolution", "1"], ["reproduce", "fig3", "--jobs", "0"],
                  ["reproduce", "fig3", "--interpretation", "wrong"]):
         with pytest.raises(SystemExit) as info:
             main(args)

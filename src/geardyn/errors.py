@@ -23,3 +23,10 @@ class ParameterError(GeardynError, ValueError):
 
 class StudyError(GeardynError, ValueError):
     """A study file cannot be read or holds something geardyn does not understand."""
+
+
+class UnknownParameterError(ParameterError, KeyError):
+    """A parameter name that is not known; also a ``KeyError`` (a lookup by name failed)."""
+
+    def __str__(self) -> str:  # KeyError would quote the message
+        return Exception.__str__(self)

@@ -7,6 +7,7 @@ and ``1500`` are the same input torque.
 
 from __future__ import annotations
 
+import re
 from functools import lru_cache
 
 import pint
@@ -25,6 +26,31 @@ SI_UNITS: dict[str, str] = {
 }
 
 
+#: Longest quantity string accepted (longer input is a mistake, or an attack on the parser).
+MAX_QUANTITY_CHARS = 100
+#: Most powers (``**`` or ``^``) in one quantity string; each exponent is a literal of at most
+#: two digits, so the parser's exact integer arithmetic cannot explode ("10**10**10 m").
+MAX_POWERS = 2
+_ALLOWED = re.compile(r"[\w\s.+\-*/^()%°]*")
+_POWER = re.compile(r"(\*\*|\^)\s*")
+_SMALL_EXPONENT = re.compile(r"[+-]?\d{1,2}(\.\d{1,2})?(?![\d.eE]|\s*(\*\*|\^))")
+
+
+def _check_quantity_text(text: str) -> None:
+    """Refuse strings the unit parser would need unbounded time or memory for."""
+    if len(text) > MAX_QUANTITY_CHARS:
+        raise ValueError(f"quantity string longer than {MAX_QUANTITY_CHARS} characters")
+    if not _ALLOWED.fullmatch(text):
+        raise ValueError(f"cannot read {text!r} as a quantity (unexpected characters)")
+    powers = list(_POWER.finditer(text))
+    if len(powers) > MAX_POWERS:
+        raise ValueError(f"cannot read {text!r} as a quantity (more than {MAX_POWERS} powers)")
+    for match in powers:
+        if not _SMALL_EXPONENT.match(text, match.end()):
+            raise ValueError(f"cannot read {text!r} as a quantity (an exponent must be a number"
+                             " of at most two digits, e.g. m**2)")
+
+
 @lru_cache(maxsize=1)
 def registry() -> pint.UnitRegistry:
     """The unit registry shared by geardyn (created once, on first use)."""
@@ -41,25 +67,42 @@ def to_si(value: object, kind: str) -> float:
     if isinstance(value, bool):
         raise ValueError(f"expected a number or a quantity in {unit or 'no unit'}, not a boolean")
     if isinstance(value, int | float):
-        return float(value)
+        try:
+            return float(value)
+        except OverflowError:  # an int beyond the float range
+            raise ValueError("an integer too large for a float") from None
     if not isinstance(value, str):
         raise ValueError(f"expected a number or a quantity string in {unit or 'no unit'}")
     text = value.strip()
     if not text:
         raise ValueError("empty quantity string")
+    _check_quantity_text(text)
     ureg = registry()
     try:
         q = ureg.Quantity(text)
     except Exception as exc:  # pint raises several types for bad strings
         raise ValueError(f"cannot read {text!r} as a quantity ({type(exc).__name__})") from None
-    if not isinstance(q, pint.Quantity):  # a bare number parsed from a string
-        return float(q)
+    if not isinstance(q, pint.Quantity):  # a bare number parsed from a string: as it is
+        return _real(q, text, unit)
     try:
-        magnitude = q.to(unit).magnitude if unit else q.to("dimensionless").magnitude
+        magnitude = _real(q.to(unit or "dimensionless").magnitude, text, unit)
     except pint.DimensionalityError:
-        raise ValueError(
-            f"{text!r} has units of {q.units:~} but {unit or 'a dimensionless number'} is needed"
-        ) from None
+        has = f"units of {q.units:~}" if f"{q.units:~}" else "no unit"
+        raise ValueError(f"{text!r} has {has} but {unit or 'a dimensionless number'} is"
+                         " needed") from None
+    except ValueError:
+        raise
+    except Exception as exc:  # offset units (degC) and the like
+        raise ValueError(f"cannot convert {text!r} to {unit or 'a dimensionless number'}"
+                         f" ({type(exc).__name__})") from None
     # Unit conversion multiplies by powers of ten; rounding to 15 significant digits removes the
     # last-bit noise ("50 um" -> 5e-05, not 4.9999999999999996e-05).
-    return float(f"{float(magnitude):.15g}")
+    return float(f"{magnitude:.15g}")
+
+
+def _real(value: object, text: str, unit: str) -> float:
+    try:
+        return float(value)  # type: ignore[arg-type]
+    except (TypeError, ValueError, OverflowError):
+        raise ValueError(f"cannot read {text!r} as a real number in {unit or 'no unit'}") \
+            from None

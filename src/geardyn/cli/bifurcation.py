@@ -25,13 +25,19 @@ from pathlib import Path
 from typing import Annotated
 
 import typer
+from rich.markup import escape
 
 from geardyn.cli.common import (
+    ESTIMATE_POINTS,
+    MAX_COUNT,
     Interpretation,
+    check_count,
     check_plot_path,
+    check_run_cost,
     load_study_source,
     make_parents,
     stderr_console,
+    usable_omega,
 )
 from geardyn.errors import ParameterError, StudyError
 
@@ -61,8 +67,8 @@ def parse_range(text: str, option: str = "--range") -> tuple[float, float, int]:
         num = int(parts[2])
     except ValueError:
         raise ParameterError(option, text, "NUM must be a whole number of values") from None
-    if num < 2:
-        raise ParameterError(option, text, "NUM must be >= 2")
+    if not 2 <= num <= MAX_COUNT:
+        raise ParameterError(option, text, f"NUM must be >= 2 and <= 2**53 = {MAX_COUNT}")
     return start, stop, num
 
 
@@ -88,18 +94,26 @@ def _check_param_name(model, param: str) -> None:
                              f"not a parameter of {model.name}; known: {', '.join(known)}")
 
 
-def _check_param_values(model, param: str, values, range_text: str) -> None:
-    """A one-line error naming ``--range`` unless ``param`` accepts both ends of the range."""
-    from pydantic import ValidationError
+def _check_param_values(model, param: str, ends: tuple[float, float], range_text: str) -> None:
+    """A one-line error naming ``--range`` unless ``param`` accepts both ends of the range and
+    they give finite coefficients (and a positive Omega)."""
+    import numpy as np
 
     from geardyn.io.toml import format_error
 
-    for value in (values[0], values[-1]):
+    for value in ends:
         try:
-            model.lane_params(param, [value])
-        except (ValidationError, ValueError) as exc:
+            with np.errstate(all="ignore"):
+                P = model.lane_params(param, [value])
+        except (ArithmeticError, ValueError) as exc:  # pydantic's ValidationError included
             raise StudyError(f"--range: {param} = {value:g} in {range_text!r}: "
                              f"{format_error(exc)}") from None
+        if not np.all(np.isfinite(P)):
+            raise StudyError(f"--range: {param} = {value:g} in {range_text!r} makes the model's"
+                             " coefficients infinite (the value is too extreme)")
+        if model.omega_index is not None and not usable_omega(P[0, model.omega_index]):
+            raise StudyError(f"--range: Omega = {value:g} in {range_text!r}: must be > 0 (with "
+                             "a finite period)")
 
 
 def _check_state(names, state: str, option: str) -> str:
@@ -177,6 +191,11 @@ def bifurcation_command(
         float | None, typer.Option(help="Discarded time per point, dimensionless tau "
                                         "(default: run.transient).")
     ] = None,
+    converge: Annotated[
+        float | None, typer.Option(help="Transient by convergence: run on past --transient "
+                                        "(a minimum), up to 10x it, until the Poincare point "
+                                        "repeats to this relative tolerance (e.g. 1e-8).")
+    ] = None,
     samples: Annotated[
         int | None, typer.Option(help="Forcing periods sampled per point (default: "
                                       "sweep.samples, else run.periods).")
@@ -197,6 +216,10 @@ def bifurcation_command(
     quiet: Annotated[
         bool, typer.Option("--quiet", "-q", help="No progress bar.")
     ] = False,
+    yes: Annotated[
+        bool, typer.Option("--yes", help="Run even when the estimated memory or time exceeds "
+                                         "the limits.")
+    ] = False,
     out: Annotated[Path | None, typer.Option(help="NetCDF file to write (.nc).")] = None,
     plot: Annotated[Path | None, typer.Option(help="Figure to write (.png, .pdf or .svg).")] = None,
 ) -> None:
@@ -211,8 +234,9 @@ def bifurcation_command(
     sweep = s.sweep
     name = param or (sweep.param if sweep is not None else "Omega")
     om = omega if omega is not None else s.run.omega
-    if om is not None and not (math.isfinite(om) and om > 0):
-        raise ParameterError("--omega", om, "must be a positive finite number")
+    if om is not None and not usable_omega(om):
+        raise ParameterError("--omega", om, "must be a positive finite number (with a finite "
+                             "period)")
     interp = interpretation.value if interpretation is not None else None
     model = s.build_model(interpretation=interp, omega=om)
     _check_param_name(model, name)
@@ -228,8 +252,7 @@ def bifurcation_command(
     if name != "Omega" and om is None:
         raise StudyError(f"--omega: not given, and a sweep of {name} needs a fixed Omega "
                          "(or [run].omega in the study)")
-    values = np.linspace(start, stop, num)
-    _check_param_values(model, name, values, range_text)
+    _check_param_values(model, name, (start, stop), range_text)
     cont = (continuation.value if continuation is not None
             else sweep.continuation if sweep is not None else "none")
     lyap = lyapunov if lyapunov is not None else bool(sweep is not None and sweep.lyapunov)
@@ -241,23 +264,37 @@ def bifurcation_command(
         raise ParameterError("--transient", tr, "must be a finite time >= 0")
     if n_samples < 2:
         raise ParameterError("--samples", n_samples, "must be >= 2 (the period needs two)")
+    if converge is not None and not (math.isfinite(converge) and 0 < converge < 1):
+        raise ParameterError("--converge", converge, "must be a tolerance in (0, 1)")
     if spp is not None and spp < 4:
         raise ParameterError("--steps-per-period", spp, "must be >= 4")
+    check_count("--samples", n_samples)
+    if spp is not None:
+        check_count("--steps-per-period", spp)
     if out is not None and out.suffix.lower() != ".nc":
         raise ParameterError("--out", str(out), "suffix must be .nc (NetCDF)")
     check_plot_path("--plot", plot)
     plot_state = _check_state(model.state_names, state or s.plot_state,
                               "--state" if state else "study.plot_state")
+    # the cost is estimated before anything of the sweep's size is built; with --converge the
+    # transient may run to 10x --transient
+    omegas = (np.linspace(start, stop, min(num, ESTIMATE_POINTS)) if name == "Omega"
+              else [model.omega])
+    check_run_cost(model, num, omegas, tr if converge is None else 10 * tr, n_samples, spp, lyap,
+                   chunk=num, yes=yes, option="--range/--samples/--transient/--steps-per-period",
+                   value=f"{range_text}, {n_samples} samples, transient {tr:g}, "
+                         f"{spp or 'automatic'} steps/period", what="sweep")
+    values = np.linspace(start, stop, num)
     make_parents(out, plot)
 
     from geardyn.analysis.bifurcation import bifurcation
 
     show_bar = not quiet and _stderr_is_terminal()
     t0 = time.perf_counter()
-    with _progress_bar(show_bar, f"{s.study.name}: {name}") as callback:
+    with _progress_bar(show_bar, escape(f"{s.study.name}: {name}")) as callback:
         ds = bifurcation(model, param=name, values=values, transient=tr, samples=n_samples,
                          continuation=None if cont == "none" else cont, steps_per_period=spp,
-                         lyapunov=lyap, progress=callback)
+                         lyapunov=lyap, progress=callback, converge=converge)
     elapsed = time.perf_counter() - t0
     ds.attrs["study"] = s.study.name
     ds.attrs["plot_state"] = plot_state
@@ -309,7 +346,14 @@ def plot_command(
 
     target = out if out is not None else result.with_suffix(".png")
     check_plot_path("--out", target)
-    ds = load_dataset(result)
+    try:
+        ds = load_dataset(result)
+    except FileNotFoundError:
+        raise
+    except (OSError, ValueError) as exc:  # not NetCDF: name the file, not only the reason
+        reason = " ".join(str(exc).split()) or type(exc).__name__
+        raise ParameterError("RESULT", str(result), f"cannot read it as NetCDF ({reason})") \
+            from None
     kind = _dataset_kind(ds)
     names = [str(v) for v in ds["state"].values]
     default = ds.attrs.get("plot_state") or next((n for n in ("X_sq", "x") if n in names),

@@ -7,8 +7,11 @@ fast; command modules import it instead of :mod:`geardyn.cli.main`.
 
 from __future__ import annotations
 
+import math
+import os
 import sys
 import tomllib
+import warnings
 from collections.abc import Callable
 from enum import StrEnum
 from pathlib import Path
@@ -32,6 +35,15 @@ EXPECTED_ERRORS: tuple[type[BaseException], ...] = (
     tomllib.TOMLDecodeError,
 )
 PLOT_SUFFIXES = (".png", ".pdf", ".svg")
+#: A run whose estimated memory exceeds this fraction of the machine's memory is refused.
+MEMORY_FRACTION = 0.5
+#: A run whose estimated run time exceeds this is refused (seconds).
+TIME_LIMIT_S = 3600.0
+#: Values of Omega a run's cost is estimated from (an Omega axis or range subsampled).
+ESTIMATE_POINTS = 257
+#: The largest count an option takes (grid points, samples, steps): 2**53, beyond which a float
+#: no longer holds every whole number (and far beyond anything that could run).
+MAX_COUNT = 2**53
 
 
 class Interpretation(StrEnum):
@@ -46,6 +58,8 @@ def load_study_source(source: str | None):
 
     if source is None:
         return paper_study()
+    if "\x00" in source or not source.strip():
+        raise ParameterError("STUDY", source, "not a file name or built-in study name")
     path = Path(source)
     if path.exists() or path.suffix == ".toml" or "/" in source:
         return load_study(path)
@@ -64,6 +78,84 @@ def check_plot_path(option: str, path: Path | None) -> None:
         raise ParameterError(option, str(path), f"suffix must be one of {PLOT_SUFFIXES}")
 
 
+def usable_omega(value: float) -> bool:
+    """True for a forcing frequency that is positive, finite, and whose period 2 pi / Omega is
+    finite too (5e-324 is positive, but its period overflows)."""
+    return math.isfinite(value) and value > 0 and math.isfinite(2 * math.pi / value)
+
+
+def check_count(option: str, value: int) -> None:
+    """A one-line error naming ``option`` when ``value`` exceeds :data:`MAX_COUNT`."""
+    if value > MAX_COUNT:
+        raise ParameterError(option, value, f"must be at most 2**53 = {MAX_COUNT}")
+
+
+def memory_limit() -> float:
+    """Bytes a run may take: :data:`MEMORY_FRACTION` of this machine's memory."""
+    try:
+        total = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+    except (ValueError, OSError, AttributeError):
+        total = 8 * 2**30
+    return MEMORY_FRACTION * total
+
+
+def refuse_if_costly(estimate, option: str, value: object, yes: bool, what: str,
+                     time_too: bool = True) -> None:
+    """A one-line error naming ``option`` and ``value`` and quoting ``estimate`` (a
+    :class:`~geardyn.analysis.map2d.MapEstimate`) when it exceeds :func:`memory_limit` or (with
+    ``time_too``) :data:`TIME_LIMIT_S`, unless ``yes``."""
+    if yes:
+        return
+    limit = memory_limit()
+    if estimate.memory_bytes > limit:
+        raise ParameterError(option, value, f"{what} too large: {estimate.describe()}; limit "
+                             f"{limit / 2**30:.3g} GiB (pass --yes to run anyway)")
+    if time_too and estimate.seconds > TIME_LIMIT_S:
+        raise ParameterError(option, value, f"{what} too long: {estimate.describe()}; limit "
+                             f"{TIME_LIMIT_S / 60:.3g} min (pass --yes to run anyway)")
+
+
+def check_run_cost(model, lanes: int, omegas, transient: float, samples: int,
+                   steps_per_period: int | None, lyapunov: bool, *, option: str, value: object,
+                   yes: bool, what: str, chunk: int | None = None, record_columns: int = 0):
+    """Estimate a run of ``lanes`` integrations with :func:`~geardyn.analysis.map2d.estimate_map`
+    before anything of its size is built, and refuse it (:func:`refuse_if_costly`) when it is
+    too large or too long. The time is first estimated at a default speed and, only when that
+    exceeds the limit, at this machine's measured speed. ``record_columns``: values kept per
+    step over the ``samples`` periods (a time history at ``omegas[0]``), which the estimate adds
+    to its memory. Returns the estimate."""
+    import dataclasses
+
+    import numpy as np
+
+    from geardyn.analysis.map2d import check_steps, estimate_map, measure_ns_per_lane_step
+    from geardyn.solvers.simulate import default_steps_per_period
+
+    omegas = np.asarray(omegas, dtype=float)
+    try:
+        check_steps(model, omegas, transient, samples, steps_per_period)
+        n = steps_per_period or default_steps_per_period(model, float(omegas[0]))
+    except OverflowError:  # more steps per period than a float holds
+        raise ParameterError(option, value, "a point would need more RK4 steps than can be "
+                             "counted; check Omega, transient and samples") from None
+    except ValueError as exc:  # too many steps: name the options, not only the quantities
+        raise ParameterError(option, value, str(exc)) from None
+    history = 2 * 8.0 * record_columns * (float(samples) * n + 1)
+
+    def estimate(**speed):
+        est = estimate_map(model, lanes, omegas, transient, samples, steps_per_period, lyapunov,
+                           chunk, **speed)
+        return dataclasses.replace(est, memory_bytes=est.memory_bytes + history)
+
+    est = estimate()
+    refuse_if_costly(est, option, value, yes, what, time_too=False)
+    if est.seconds > TIME_LIMIT_S and not yes:
+        ns = measure_ns_per_lane_step(model, float(np.median(omegas)), steps_per_period)
+        est = estimate(ns_per_lane_step=ns)
+        refuse_if_costly(est, option, value, yes, what)
+    return est
+
+
 def make_parents(*paths: Path | None) -> None:
     for path in paths:
         if path is not None:
@@ -75,6 +167,23 @@ def run_reporting_errors(call: Callable[[], Any]) -> int:
     errors print one line ``error: ...`` on stderr and give status 2."""
     from geardyn.io.toml import format_error
 
+    with warnings.catch_warnings(record=True) as caught:
+        try:
+            rv = _run_reporting_errors(call, format_error)
+        except BaseException:
+            _replay(caught)
+            raise
+    if rv in (0, None):  # floating-point or other warnings of a successful run are shown;
+        _replay(caught)  # an error is one line, without them
+    return rv
+
+
+def _replay(caught: list[warnings.WarningMessage]) -> None:
+    for w in caught:
+        warnings.showwarning(w.message, w.category, w.filename, w.lineno, w.file, w.line)
+
+
+def _run_reporting_errors(call: Callable[[], Any], format_error: Callable) -> int:
     try:
         rv = call()
         return rv if isinstance(rv, int) else 0

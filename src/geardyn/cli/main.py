@@ -32,12 +32,16 @@ from geardyn.cli.bifurcation import register as _register_bifurcation
 from geardyn.cli.common import (
     EXIT_ERROR,
     EXPECTED_ERRORS,
+    MAX_COUNT,
     Interpretation,
     OneLineErrorGroup,
+    check_count,
     check_plot_path,
+    check_run_cost,
     load_study_source,
     make_parents,
     stderr_console,
+    usable_omega,
 )
 from geardyn.errors import ParameterError, StudyError
 
@@ -214,6 +218,10 @@ def simulate(
     state: Annotated[
         str | None, typer.Option(help="Coordinate to plot (default: the study's plot_state).")
     ] = None,
+    yes: Annotated[
+        bool, typer.Option("--yes", help="Run even when the estimated memory or time exceeds "
+                                         "the limits.")
+    ] = False,
     out: Annotated[Path | None, typer.Option(help="NetCDF file to write (.nc).")] = None,
     plot: Annotated[Path | None, typer.Option(help="Figure to write (.png, .pdf or .svg).")] = None,
 ) -> None:
@@ -226,12 +234,21 @@ def simulate(
     om = omega if omega is not None else s.run.omega
     if om is None:
         raise StudyError("--omega: not given, and the study has no run.omega")
-    if not (math.isfinite(om) and om > 0):
-        raise ParameterError("--omega", om, "must be a positive finite number")
+    if not usable_omega(om):
+        raise ParameterError("--omega", om, "must be a positive finite number (with a finite "
+                             "period)")
     check_plot_path("--plot", plot)
     tr = s.run.transient if transient is None else transient
     n_periods = s.run.periods if periods is None else periods
     spp = s.run.steps_per_period if steps_per_period is None else steps_per_period
+    if not (math.isfinite(tr) and tr >= 0):
+        raise ParameterError("--transient", tr, "must be a finite time >= 0")
+    if not 1 <= n_periods <= MAX_COUNT:
+        raise ParameterError("--periods", n_periods, f"must be >= 1 and <= {MAX_COUNT}")
+    if spp is not None and spp < 4:
+        raise ParameterError("--steps-per-period", spp, "must be >= 4")
+    if spp is not None:
+        check_count("--steps-per-period", spp)
     plot_state = state or s.plot_state
     interp = interpretation.value if interpretation is not None else None
     model = s.build_model(interpretation=interp, omega=om)
@@ -239,10 +256,16 @@ def simulate(
     if plot is not None and plot_state not in known and f"{plot_state}1" not in known:
         raise ParameterError("--state" if state else "study.plot_state", plot_state,
                              f"not a coordinate of {model.name}; known: {', '.join(known)}")
+    check_run_cost(model, 1, [om], tr, n_periods, spp, False, yes=yes,
+                   option="--omega/--periods/--transient/--steps-per-period",
+                   value=f"Omega {om:g}, {n_periods} periods, transient {tr:g}, "
+                         f"{spp or 'automatic'} steps/period",
+                   what="simulation", record_columns=1 + len(known))
     make_parents(out, plot)
 
     err = _stderr()
-    with err.status(f"simulating {s.study.name} at Omega = {om:g} (the first run compiles)"):
+    with err.status(f"simulating {escape(s.study.name)} at Omega = {om:g} (the first run "
+                    "compiles)"):
         ds = run_simulation(model, omega=om, transient=tr, periods=n_periods,
                             steps_per_period=spp)
     ds.attrs["study"] = s.study.name

@@ -23,16 +23,18 @@ from typing import Annotated
 import numpy as np
 import typer
 
-from geardyn.errors import ParameterError
+from geardyn.cli.common import (
+    ESTIMATE_POINTS,
+    MAX_COUNT,
+    MEMORY_FRACTION,  # noqa: F401 (documented here: the limits a map is refused above)
+    TIME_LIMIT_S,  # noqa: F401
+    check_count,
+    refuse_if_costly,
+    usable_omega,
+)
+from geardyn.errors import ParameterError, StudyError
 
 __all__ = ["map_command", "parse_axis", "register"]
-
-#: A map whose estimated memory exceeds this fraction of the machine's memory is refused.
-MEMORY_FRACTION = 0.5
-#: A map whose estimated run time exceeds this is refused (seconds).
-TIME_LIMIT_S = 3600.0
-#: Values kept per axis to estimate the cost (the Omega axis is subsampled to this many).
-ESTIMATE_POINTS = 257
 
 _OUT_SUFFIXES = (".nc", ".zarr")
 _PLOT_SUFFIXES = (".png", ".pdf", ".svg")
@@ -54,17 +56,9 @@ def parse_axis(text: str, option: str) -> tuple[str, float, float, int]:
         num = int(parts[3])
     except ValueError:
         raise ParameterError(option, text, "NUM must be a whole number of values") from None
-    if num < 1:
-        raise ParameterError(option, text, "NUM must be >= 1")
+    if not 1 <= num <= MAX_COUNT:
+        raise ParameterError(option, text, f"NUM must be >= 1 and <= 2**53 = {MAX_COUNT}")
     return name, start, stop, num
-
-
-def _memory_limit() -> float:
-    try:
-        total = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
-    except (ValueError, OSError, AttributeError):
-        total = 8 * 2**30
-    return MEMORY_FRACTION * total
 
 
 def _connect(address: str):
@@ -114,6 +108,7 @@ def map_command(
 
     from geardyn.analysis.map2d import check_steps, estimate_map, map2d, measure_ns_per_lane_step
     from geardyn.cli.main import _load_study
+    from geardyn.io.toml import format_error
 
     x_axis, y_axis = parse_axis(x, "--x"), parse_axis(y, "--y")
     if x_axis[0] == y_axis[0]:
@@ -124,6 +119,10 @@ def map_command(
         raise ParameterError("--plot", str(plot), f"suffix must be one of {_PLOT_SUFFIXES}")
     if chunk is not None and chunk < 1:
         raise ParameterError("--chunk", chunk, "must be >= 1")
+    for option, count in (("--chunk", chunk), ("--samples", samples),
+                          ("--steps-per-period", steps_per_period)):
+        if count is not None:
+            check_count(option, count)
     if samples is not None and samples < 2:
         raise ParameterError("--samples", samples, "must be >= 2")
     if steps_per_period is not None and steps_per_period < 4:
@@ -140,26 +139,35 @@ def map_command(
     # the names and both ends of each axis must be valid before anything grid-sized is built
     for (name, start, stop, _), option in ((x_axis, "--x"), (y_axis, "--y")):
         try:
-            ends = model.lane_params(name, [start, stop])
+            with np.errstate(all="ignore"):
+                ends = model.lane_params(name, [start, stop])
         except KeyError as exc:
             raise ParameterError(option, name, str(exc.args[0]) if exc.args else "unknown") \
                 from None
+        except (ArithmeticError, ValueError) as exc:
+            raise ParameterError(option, f"{name}:{start}:{stop}", format_error(exc)) from None
         if model.omega_index is None:
             raise ParameterError("study", s.study.name, "a map needs a forced model")
-        if name == "Omega" and not np.all(ends[:, model.omega_index] > 0):
-            raise ParameterError(option, f"{start}:{stop}", "Omega must be > 0")
+        if name == "Omega" and not all(usable_omega(w) for w in ends[:, model.omega_index]):
+            raise ParameterError(option, f"{start}:{stop}", "Omega must be > 0 (with a finite "
+                                 "period)")
+        if not np.all(np.isfinite(ends)):
+            raise ParameterError(option, f"{name}:{start}:{stop}", "an end of the axis makes the"
+                                 " model's coefficients infinite (a value is too extreme)")
 
     lanes = x_axis[3] * y_axis[3]
     omega_axis = next((a for a in (x_axis, y_axis) if a[0] == "Omega"), None)
     omegas = (np.linspace(omega_axis[1], omega_axis[2], min(omega_axis[3], ESTIMATE_POINTS))
               if omega_axis else np.array([model.omega]))
-    check_steps(model, omegas, tr, n_samples, spp)
+    try:
+        check_steps(model, omegas, tr, n_samples, spp)
+    except (ValueError, OverflowError) as exc:  # add the settings given to the quantities named
+        raise StudyError(f"{exc or 'Omega/transient: too many steps per point'} (--transient "
+                         f"{tr:g}, --samples {n_samples}, --steps-per-period "
+                         f"{spp or 'automatic'})") from None
     err = Console(stderr=True)
     estimate = estimate_map(model, lanes, omegas, tr, n_samples, spp, lyapunov, chunk)
-    memory_limit = _memory_limit()
-    if estimate.memory_bytes > memory_limit and not yes:
-        raise ParameterError("--x/--y", f"{x} x {y}", f"map too large: {estimate.describe()}; "
-                             f"limit {memory_limit / 2**30:.3g} GiB (pass --yes to run anyway)")
+    refuse_if_costly(estimate, "--x/--y", f"{x} x {y}", yes, "map", time_too=False)
     client = _connect(scheduler) if scheduler else None
     try:
         parallel = 1.0
@@ -170,9 +178,7 @@ def map_command(
             ns = measure_ns_per_lane_step(model, float(np.median(omegas)), spp)
         estimate = estimate_map(model, lanes, omegas, tr, n_samples, spp, lyapunov, chunk,
                                 ns_per_lane_step=ns, parallel=parallel)
-        if estimate.seconds > TIME_LIMIT_S and not yes:
-            raise ParameterError("--x/--y", f"{x} x {y}", f"map too long: {estimate.describe()};"
-                                 f" limit {TIME_LIMIT_S / 60:.3g} min (pass --yes to run anyway)")
+        refuse_if_costly(estimate, "--x/--y", f"{x} x {y}", yes, "map")
         err.print(f"map: {estimate.describe()}")
         ds = _run(map2d, model, x_axis, y_axis, tr, n_samples, spp, lyapunov, client, out,
                   chunk, err)

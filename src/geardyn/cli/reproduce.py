@@ -4,7 +4,8 @@
 
     geardyn reproduce fig3 [--interpretation ...] [--resolution N] [--out out/reproduce]
     geardyn reproduce --all [--interpretation consistent|carrier-only|as-printed|all]
-                      [--resolution N] [--transient T] [--samples S] [--out out/reproduce]
+                      [--resolution N] [--transient T] [--samples S] [--jobs N]
+                      [--out out/reproduce]
 
 Writes, under ``--out``, ``CASE-INTERPRETATION.nc`` (data), ``CASE-INTERPRETATION.png`` and
 ``...-down.png`` (the diagrams swept up and down), ``report.md`` and a self-contained
@@ -63,14 +64,18 @@ def reproduce_command(
     resolution: Annotated[int | None, typer.Option(
         help="Omega points per sweep (default: the study's, the paper's resolution).")] = None,
     transient: Annotated[float | None, typer.Option(
-        help="Transient per point, dimensionless time (default: the study's).")] = None,
+        help="Longest transient per point, dimensionless time; each point stops earlier once "
+        "its Poincare point repeats (default: the study's).")] = None,
     samples: Annotated[int | None, typer.Option(
         help="Mesh periods sampled per point (default: the study's).")] = None,
+    jobs: Annotated[int | None, typer.Option(
+        help="Worker processes for the sweeps (default: one per core).")] = None,
     out: Annotated[Path, typer.Option(help="Output folder.")] = Path("out/reproduce"),
     quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No progress bar.")] = False,
 ) -> None:
     """Recompute the paper's bifurcation diagrams (swept up and down) and write a report that
     checks every claim of the paper against the data."""
+    import os
     import sys
 
     from geardyn.models.derived import INTERPRETATIONS
@@ -94,12 +99,15 @@ def reproduce_command(
         raise ParameterError("--samples", samples, "must be >= 2")
     if transient is not None and not transient >= 0:
         raise ParameterError("--transient", transient, "must be >= 0")
+    if jobs is not None and jobs < 1:
+        raise ParameterError("--jobs", jobs, "must be >= 1")
+    workers = jobs or os.cpu_count() or 1
     settings = ReproductionSettings(num=resolution, transient=transient, samples=samples)
     out.mkdir(parents=True, exist_ok=True)
 
     start = time.perf_counter()
     with _progress(not quiet and sys.stderr.isatty()) as callback:
-        results = run_cases(cases, interps, settings, callback)
+        results = run_cases(cases, interps, settings, callback, workers=workers)
     swept = time.perf_counter() - start
     command = "geardyn reproduce " + ("--all" if all_cases else cases[0].name) + (
         f" --interpretation {interpretation.value}"
@@ -114,7 +122,7 @@ def reproduce_command(
         for v in verdicts.values():
             counts[v.status] = counts.get(v.status, 0) + 1
         typer.echo(f"{interp}: " + ", ".join(f"{n} {s}" for s, n in counts.items()))
-    typer.echo(f"{len(results)} case results in {swept:.1f} s of sweeps; wrote "
+    typer.echo(f"{len(results)} case results in {swept:.1f} s ({workers} processes); wrote "
                f"{paths['markdown']}, {paths['html']}")
 
 

@@ -52,7 +52,7 @@ from pydantic_core import InitErrorDetails, PydanticCustomError
 
 from geardyn.errors import ParameterError, StudyError
 from geardyn.models.derived import INTERPRETATIONS
-from geardyn.models.params import PAPER_NAMES, Angle, PlanetaryParams
+from geardyn.models.params import PAPER_NAMES, Angle, PlanetaryParams, Real, Whole
 
 __all__ = [
     "GearPairParams",
@@ -105,10 +105,10 @@ class RunSettings(BaseModel):
 
     model_config = _CONFIG
 
-    omega: float | None = Field(None, gt=0, description="mesh frequency Omega = omega/omega_n")
-    transient: float = Field(4000.0, ge=0, description="discarded time, dimensionless tau")
-    periods: int = Field(64, ge=1, description="forcing periods recorded")
-    steps_per_period: int | None = Field(None, ge=4, description="RK4 steps per period")
+    omega: Real | None = Field(None, gt=0, description="mesh frequency Omega = omega/omega_n")
+    transient: Real = Field(4000.0, ge=0, description="discarded time, dimensionless tau")
+    periods: Whole = Field(64, ge=1, description="forcing periods recorded")
+    steps_per_period: Whole | None = Field(None, ge=4, description="RK4 steps per period")
 
 
 class SweepSettings(BaseModel):
@@ -123,13 +123,13 @@ class SweepSettings(BaseModel):
     model_config = _CONFIG
 
     param: str = Field("Omega", min_length=1, description="swept parameter (Omega or paper name)")
-    start: float
-    stop: float
-    num: int = Field(ge=2, description="number of parameter values")
+    start: Real
+    stop: Real
+    num: Whole = Field(ge=2, description="number of parameter values")
     continuation: Literal["none", "up", "down"] = Field(
         "none", description="none, up or down: start each point from the previous one's state"
     )
-    samples: int | None = Field(None, ge=2, description="forcing periods recorded per value")
+    samples: Whole | None = Field(None, ge=2, description="forcing periods recorded per value")
     lyapunov: bool = Field(False, description="also compute the largest Lyapunov exponent")
 
     @field_validator("continuation", mode="before")
@@ -163,14 +163,14 @@ class GearPairParams(BaseModel):
 
     model_config = _CONFIG
 
-    zeta: float = Field(0.05, ge=0, description="damping ratio")
-    kappa: float = Field(0.0, gt=-1, lt=1, description="relative stiffness variation")
-    Fm: float = Field(0.1, description="mean load")
-    Fa: float = Field(0.05, description="transmission-error amplitude")
-    Omega: float = Field(1.0, ge=0, description="mesh frequency")
+    zeta: Real = Field(0.05, ge=0, description="damping ratio")
+    kappa: Real = Field(0.0, gt=-1, lt=1, description="relative stiffness variation")
+    Fm: Real = Field(0.1, description="mean load")
+    Fa: Real = Field(0.05, description="transmission-error amplitude")
+    Omega: Real = Field(1.0, ge=0, description="mesh frequency")
     kappa_phase: Angle = 0.0
     error_phase: Angle = 0.0
-    backlash: float = Field(1.0, ge=0, description="backlash half-width")
+    backlash: Real = Field(1.0, ge=0, description="backlash half-width")
 
 
 def _relocated(exc: ValidationError, loc_of) -> ValidationError:
@@ -256,8 +256,10 @@ class Study(BaseModel):
         kind = info.get("model", "catt") if isinstance(info, dict) else getattr(info, "model", "")
         if isinstance(raw, BaseModel):
             return data
-        if not isinstance(raw, dict):
-            return data  # pydantic reports the wrong type
+        if not isinstance(raw, dict):  # one error naming params, not one per union member
+            raise ValidationError.from_exception_data("Study", [InitErrorDetails(
+                type=PydanticCustomError("dict_type", "must be a table of parameters"),
+                loc=("params",), input=raw)])
         out = dict(data)
         if kind == "gear_pair":
             target: type[BaseModel] = GearPairParams
@@ -316,21 +318,58 @@ class Study(BaseModel):
             kwargs = self.params.model_dump()
             if om is not None:
                 kwargs["Omega"] = float(om)
-            return GearPair(**kwargs)
-        return CATTDevice(
+            return check_usable(lambda: GearPair(**kwargs))
+        return check_usable(lambda: CATTDevice(
             self.planetary_params,
             interpretation or self.study.interpretation,  # type: ignore[arg-type]
             omega=1.0 if om is None else float(om),
-        )
+        ))
 
     def to_toml_dict(self) -> dict[str, Any]:
         """The study as TOML-ready tables (``None`` values left out)."""
         return self.model_dump(exclude_none=True)
 
 
+def check_usable(build):
+    """The model ``build()`` returns, if its coefficients, natural frequencies and initial state
+    are finite; else a :class:`ParameterError` naming the first quantity that is not.
+
+    Values that each pass validation can still overflow together (a module of 1e200 m, an inertia
+    of 1e-308 kg m^2): the model would then integrate NaNs. Floating-point warnings raised while
+    building are silenced, as the error replaces them.
+    """
+    import numpy as np
+
+    with np.errstate(all="ignore"):
+        try:
+            model = build()
+            checks = [(f"coefficient {n}", v) for n, v in zip(model.param_names, model.params,
+                                                                strict=True)]
+            if hasattr(model, "natural_frequencies"):
+                checks += [("natural frequency", w) for w in model.natural_frequencies()]
+            checks += [(f"initial state {n}", v)
+                       for n, v in zip(model.state_names, model.initial_state(), strict=True)]
+        except (ArithmeticError, ValueError) as exc:  # overflow, singular matrix, ...
+            if isinstance(exc, ParameterError | ValidationError):
+                raise
+            reason = exc.args[-1] if isinstance(exc, OverflowError) and exc.args else str(exc)
+            reason = " ".join(str(reason).split()) or type(exc).__name__
+            raise ParameterError("params", reason, "the parameters give no usable model (a value"
+                                 " is too extreme)") from None
+    for what, value in checks:
+        if not math.isfinite(float(value)):
+            raise ParameterError("params", float(value), f"the model's {what} is not finite (a"
+                                 " parameter value is too extreme)")
+    return model
+
+
 # --------------------------------------------------------------------------- reading
 def _is_text(source: object) -> bool:
-    return isinstance(source, str) and ("\n" in source or source.lstrip().startswith("["))
+    """A string is TOML text, not a file name, when it has a newline, starts with a table or is
+    blank (an empty document, not the current directory)."""
+    return isinstance(source, str) and (
+        "\n" in source or source.lstrip().startswith("[") or not source.strip()
+    )
 
 
 def _read_toml(source: str | os.PathLike[str]) -> tuple[dict[str, Any], str]:
@@ -340,9 +379,15 @@ def _read_toml(source: str | os.PathLike[str]) -> tuple[dict[str, Any], str]:
     else:
         path = Path(source)
         label = str(path)
+        if "\x00" in label:
+            raise StudyError(f"{label!r}: not a valid file name (holds a NUL character)")
         if path.is_dir():
             raise StudyError(f"{label}: is a directory, not a TOML file")
-        text = path.read_text(encoding="utf-8")  # FileNotFoundError names the file
+        try:
+            text = path.read_text(encoding="utf-8")  # FileNotFoundError names the file
+        except UnicodeDecodeError as exc:
+            raise StudyError(f"{label}: not a UTF-8 text file ({exc.reason} at byte "
+                             f"{exc.start})") from None
     try:
         return tomllib.loads(text), label
     except tomllib.TOMLDecodeError as exc:
@@ -358,17 +403,29 @@ def load_params(path_or_text: str | os.PathLike[str]) -> PlanetaryParams:
     The document holds the parameter fields at the top level, or a ``[params]`` table as in a
     study file (full form or ``base = "paper"`` plus changes).
     """
-    doc, _ = _read_toml(path_or_text)
-    if "params" in doc:
-        return load_study_dict({"params": doc["params"]}).planetary_params
+    doc, label = _read_toml(path_or_text)
+    if not doc:
+        raise StudyError(f"{label}: empty parameter file (needs the parameter tables)")
+    if set(doc) & _STUDY_KEYS:
+        return load_study_dict(doc).planetary_params  # every table checked, not only [params]
     return PlanetaryParams.model_validate(doc)
+
+
+def _study_document(doc: dict[str, Any]) -> dict[str, Any]:
+    """``doc`` with a bare parameter document (PlanetaryParams fields at the top level) moved
+    into ``[params]``; a document of neither kind is refused naming its first key."""
+    if not doc or set(doc) & _STUDY_KEYS:
+        return doc
+    if not set(doc) & set(PlanetaryParams.model_fields):
+        first = next(iter(doc))
+        raise StudyError(f"{first}: unknown key; a study file holds the tables "
+                         f"{', '.join(f'[{k}]' for k in sorted(_STUDY_KEYS))}")
+    return {"params": doc}
 
 
 def load_study_dict(doc: dict[str, Any]) -> Study:
     """A :class:`Study` from a parsed document; a bare parameter document becomes ``[params]``."""
-    if doc and not (set(doc) & _STUDY_KEYS):
-        doc = {"params": doc}
-    return Study.model_validate(doc)
+    return Study.model_validate(_study_document(doc))
 
 
 def load_study(path_or_text: str | os.PathLike[str]) -> Study:
@@ -380,8 +437,7 @@ def load_study(path_or_text: str | os.PathLike[str]) -> Study:
     doc, label = _read_toml(path_or_text)
     if not doc:
         raise StudyError(f"{label}: empty study file (needs at least a [params] table)")
-    if doc and not (set(doc) & _STUDY_KEYS):
-        doc = {"params": doc}
+    doc = _study_document(doc)
     if not _is_text(path_or_text) and isinstance(doc.get("study", {}), dict):
         doc.setdefault("study", {}).setdefault("name", Path(path_or_text).stem)
     return Study.model_validate(doc)
@@ -391,7 +447,12 @@ def load_study(path_or_text: str | os.PathLike[str]) -> Study:
 def _write_atomic(path: str | os.PathLike[str], text: str) -> Path:
     path = Path(path)
     folder = path.parent if str(path.parent) else Path(".")
-    fd, tmp = tempfile.mkstemp(dir=folder, prefix=f".{path.name}.", suffix=".tmp")
+    if path.is_dir():
+        raise StudyError(f"{path}: is a directory, not a file to write")
+    try:
+        fd, tmp = tempfile.mkstemp(dir=folder, prefix=f".{path.name}.", suffix=".tmp")
+    except OSError as exc:  # name the file asked for, not the temporary one
+        raise StudyError(f"{path}: cannot write ({exc.strerror or exc})") from None
     try:
         with os.fdopen(fd, "w", encoding="utf-8") as fh:
             fh.write(text)
@@ -507,7 +568,9 @@ def format_error(exc: BaseException) -> str:
     'sun_mesh.mean_stiffness: must be > 0 (got -1.0)'
     """
     if isinstance(exc, ValidationError):
-        errors = exc.errors(include_url=False)
+        # an unknown key is usually the cause of the "Field required" errors beside it
+        errors = sorted(exc.errors(include_url=False),
+                        key=lambda e: e.get("type") != "extra_forbidden")
         text = _one_validation_error(errors[0]) if errors else str(exc)
         if len(errors) > 1:
             text += f" (and {len(errors) - 1} more error{'s' if len(errors) > 2 else ''})"

@@ -31,6 +31,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from geardyn.errors import ParameterError
 from geardyn.models import catt_kernels as ck
 from geardyn.models.base import Model
 from geardyn.models.derived import (
@@ -122,6 +123,10 @@ class CATTDevice(Model):
         self.omega_index = ck.OMEGA
         self.params = self._coefficient_vector(omega)
         self.param_names = self._names()
+        if not np.all(np.isfinite(self.params)):
+            bad = self.param_names[int(np.argmax(~np.isfinite(self.params)))]
+            raise ParameterError("params", bad, "the parameters give a dimensionless "
+                                 "coefficient that is not finite (extreme magnitudes)")
 
     # ------------------------------------------------------------------ coefficient vector
     def _n_harmonics(self) -> int:

@@ -24,6 +24,7 @@ from pydantic import (
     model_validator,
 )
 
+from geardyn.errors import ParameterError, UnknownParameterError
 from geardyn.units import to_si
 
 _CONFIG = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False, validate_default=True)
@@ -31,6 +32,18 @@ _CONFIG = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False, validate_
 
 def _quantity(kind: str) -> BeforeValidator:
     return BeforeValidator(lambda v: to_si(v, kind) if v is not None else None)
+
+
+def _not_boolean(v: Any) -> Any:
+    if isinstance(v, bool):
+        raise ValueError("expected a number, not a boolean")
+    return v
+
+
+#: Refuses ``true``/``false`` where a number is meant (pydantic would read them as 1 and 0).
+NotBoolean = BeforeValidator(_not_boolean)
+Whole = Annotated[int, NotBoolean]
+Real = Annotated[float, NotBoolean]
 
 
 def _acute(v: float) -> float:
@@ -59,7 +72,7 @@ class Gear(BaseModel):
 
     model_config = _CONFIG
 
-    teeth: int = Field(gt=0, description="number of teeth z")
+    teeth: Whole = Field(gt=0, description="number of teeth z")
     module: Length = Field(description="module m [m]")
     pressure_angle: Annotated[Angle, AfterValidator(_acute)] = Field(
         description="pressure angle alpha [rad]"
@@ -103,8 +116,8 @@ class Mesh(BaseModel):
     stiffness_amplitude: StiffnessAmplitude = Field(description="alternating stiffness Ka [N/m]")
     stiffness_phase: Angle = Field(0.0, description="stiffness phase varphi [rad]")
     waveform: Literal["sine", "rectangular"] = "sine"
-    contact_ratio: float = Field(1.6, gt=1.0, lt=2.0, description="contact ratio (rectangular)")
-    harmonics: int = Field(25, ge=1, le=200, description="Fourier terms of the rectangular wave")
+    contact_ratio: Real = Field(1.6, gt=1.0, lt=2.0, description="contact ratio (rectangular)")
+    harmonics: Whole = Field(25, ge=1, le=200, description="Fourier terms of the rectangular wave")
     backlash: Clearance = Field(description="backlash half-width b [m]")
     error: Clearance = Field(description="meshing error amplitude E [m]")
     error_phase: Angle = Field(0.0, description="meshing error phase phi [rad]")
@@ -206,7 +219,7 @@ class PlanetaryParams(BaseModel):
 
     model_config = _CONFIG
 
-    n_planets: int = Field(4, ge=1, le=64, description="number of planet sets N")
+    n_planets: Whole = Field(4, ge=1, le=64, description="number of planet sets N")
     sun: Gear
     inside_planet: Gear
     outside_planet: Gear
@@ -216,7 +229,7 @@ class PlanetaryParams(BaseModel):
     loads: Loads
     b_c: Length = Field(1.0e-5, description="nominal displacement b_c [m]")
     planets: list[PlanetOverride] = Field(default_factory=list)
-    derived: dict[str, Annotated[float, Field(gt=0)]] = Field(default_factory=dict)
+    derived: dict[str, Annotated[Real, Field(gt=0)]] = Field(default_factory=dict)
 
     @model_validator(mode="after")
     def _check_planets_and_overrides(self) -> PlanetaryParams:
@@ -273,11 +286,14 @@ class PlanetaryParams(BaseModel):
                 paths = ((name,),)
             else:
                 known = ", ".join(sorted(PAPER_NAMES))
-                raise KeyError(f"unknown parameter {name!r}; known names: {known}")
+                raise UnknownParameterError(name, value, f"unknown parameter; known names: {known}")
             for path in paths:
                 target = data
                 for key in path[:-1]:
                     target = target[key]
+                if not isinstance(target, dict):  # the table itself was changed to a non-table
+                    raise ParameterError(name, value, f"cannot change it when {path[0]} is "
+                                         f"{target!r}, not a table")
                 target[path[-1]] = value
         return type(self).model_validate(data)
 

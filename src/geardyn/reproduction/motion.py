@@ -2,8 +2,9 @@
 
 Every swept point gets one label:
 
-``period-k``        the stroboscopic (once per mesh period) samples repeat after k periods
-                    (:func:`geardyn.classify_period`, k <= its ``max_period``);
+``period-k``        the motion repeats after k mesh periods: ``ds["period"]`` of
+                    :func:`geardyn.bifurcation` (its Poincare section is once per mesh period, or
+                    once per common period when a load fluctuation at Lambda is commensurate);
 ``chaotic``         no period found and the largest Lyapunov exponent exceeds
                     :data:`LYAPUNOV_CHAOS` (per unit tau);
 ``quasi-periodic``  no period found and the exponent does not exceed it: motion on a torus, the
@@ -13,8 +14,8 @@ Every swept point gets one label:
 ``non-periodic``    no period found and no Lyapunov exponent available.
 
 The Lyapunov exponent is only needed (and only computed) where the period classifier finds no
-period. With a load fluctuation at a Lambda incommensurate with Omega the stroboscopic section
-shows a closed curve even for regular motion, so there the exponent alone separates chaos from
+period. With a load fluctuation at a Lambda incommensurate with Omega no stroboscopic section
+shows the motion's period (``period`` is 0 there), so the exponent alone separates chaos from
 quasi-periodic motion.
 """
 

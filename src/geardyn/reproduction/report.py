@@ -100,11 +100,17 @@ def build_report(results: Results, figures: Mapping[tuple[str, str], dict[str, P
         f"Omega grid: {a['setting_num']} points from {a['setting_start']:g} to "
         f"{a['setting_stop']:g}; every case swept up and down by continuation (each point "
         "starts from the previous point's final state)",
-        f"transient {a['setting_transient']:g} tau per point, then {a['setting_samples']} mesh "
-        "periods sampled once per period (stroboscopic section)",
+        (f"transient per point: until the Poincare point repeats to {a['setting_converge']:g} "
+         f"(at least {min(a['setting_min_transient'], a['setting_transient']):g}, at most "
+         f"{a['setting_transient']:g} tau)" if a.get("setting_converge")
+         else f"transient {a['setting_transient']:g} tau per point")
+        + f", then {a['setting_samples']} Poincare points (once per mesh period, or per common "
+        "period of Omega and Lambda under load noise)",
         f"largest Lyapunov exponent where no period is found: {a['setting_lyapunov_transient']:g}"
-        f" tau transient, {a['setting_lyapunov_duration']:g} tau measured, from the sweep's last "
-        f"sample; chaotic above {a['setting_lyapunov_threshold']:g} per tau",
+        f" tau transient, {a['setting_lyapunov_duration']:g} tau measured (a first "
+        f"{a['setting_lyapunov_screen']:g} tau settle exponents below the threshold by more "
+        f"than {a['setting_lyapunov_margin']:g}), from the sweep's last sample; chaotic above "
+        f"{a['setting_lyapunov_threshold']:g} per tau",
         f"interpretations: {', '.join(interps)} (see docs/model.md)",
         "cases run: " + ", ".join(c for c in CASE_NAMES
                                   if any(c in r for r in per_interp.values())),
@@ -128,10 +134,11 @@ def build_report(results: Results, figures: Mapping[tuple[str, str], dict[str, P
         f"{a['setting_lyapunov_threshold']:g} per tau, else `quasi-periodic` (a torus, the "
         "two-frequency response to the load noise, or a period too long for the classifier); "
         "`unbounded` if the integration diverged",
-        "load noise (Figs. 13-15, B1 = B2 != 0 at Lambda): the once-per-mesh-period section is "
-        "unsuitable there (a second frequency Lambda: regular motion shows as a closed curve "
-        "unless Lambda/Omega is a simple ratio), so the report separates chaos from "
-        "quasi-periodic motion by the Lyapunov exponent alone",
+        "load noise (Figs. 13-15, B1 = B2 != 0 at Lambda): a second forcing frequency. Where "
+        "Lambda/Omega is a simple ratio p/q the section is taken every q mesh periods (the common "
+        "period) and the period classifier applies; elsewhere no stroboscopic section shows the "
+        "motion's period (regular motion shows as a closed curve), the classifier reports none "
+        "and the Lyapunov exponent alone separates chaos from quasi-periodic motion",
         f"'Omega ~ a-b': share of the grid points in [a, b] (holds >= {cl.SHARE_HOLDS:.0%}, "
         f"partly >= {cl.SHARE_PARTLY:.0%} or within {cl.APPROX:g} of the range); a window needs "
         f"{cl.MIN_RUN} consecutive points",

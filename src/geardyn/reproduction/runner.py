@@ -36,28 +36,42 @@ Progress = Callable[[str, int, int], None]
 class ReproductionSettings:
     """How finely to reproduce. ``None`` takes the study's value: ``num`` Omega points
     ([sweep] num), ``transient`` (tau, [run] transient), ``samples`` (mesh periods recorded
-    per point, [sweep] samples else [run] periods). The Lyapunov exponent is measured over
+    per point, [sweep] samples else [run] periods). With ``converge`` (a tolerance; None: a fixed
+    transient) ``transient`` is the longest transient and each point stops as soon as its
+    Poincare point repeats to ``converge`` after at least ``min_transient`` (tau): a continued
+    point starts next to its attractor and needs far less. The Lyapunov exponent is measured over
     ``lyapunov_duration`` (tau) after ``lyapunov_transient`` (tau), starting from the sweep's
-    last stroboscopic sample at that point; ``lyapunov_threshold`` separates chaos."""
+    last stroboscopic sample at that point; ``lyapunov_threshold`` separates chaos. A first
+    estimate over ``lyapunov_screen`` (tau) settles the points whose exponent is clearly
+    negative (below the threshold by more than ``lyapunov_margin``); only the others, among
+    them every chaotic one, are measured over the full duration."""
 
     num: int | None = None
     transient: float | None = None
     samples: int | None = None
+    converge: float | None = 1.0e-8
+    min_transient: float = 1000.0
     lyapunov_transient: float = 300.0
     lyapunov_duration: float = 1500.0
     lyapunov_threshold: float = LYAPUNOV_CHAOS
+    lyapunov_screen: float = 500.0
+    lyapunov_margin: float = 0.01
 
     def __post_init__(self) -> None:
         checks = (("num", self.num, 2), ("samples", self.samples, 2))
         for name, value, least in checks:
             if value is not None and value < least:
                 raise ValueError(f"{name}: must be >= {least} (got {value!r})")
-        for name in ("transient", "lyapunov_transient"):
+        if self.converge is not None and not (np.isfinite(self.converge) and self.converge > 0):
+            raise ValueError(f"converge: must be a tolerance > 0 or None (got {self.converge!r})")
+        for name in ("transient", "min_transient", "lyapunov_transient"):
             value = getattr(self, name)
             if value is not None and not (np.isfinite(value) and value >= 0):
                 raise ValueError(f"{name}: must be a finite time >= 0 (got {value!r})")
-        if not (np.isfinite(self.lyapunov_duration) and self.lyapunov_duration > 0):
-            raise ValueError(f"lyapunov_duration: must be > 0 (got {self.lyapunov_duration!r})")
+        for name in ("lyapunov_duration", "lyapunov_screen"):
+            value = getattr(self, name)
+            if not (np.isfinite(value) and value > 0):
+                raise ValueError(f"{name}: must be a finite time > 0 (got {value!r})")
 
     def resolve(self, case: Case) -> dict[str, float | int]:
         """The settings for ``case`` with the study's defaults filled in."""
@@ -71,9 +85,13 @@ class ReproductionSettings:
             "num": int(self.num or s.sweep.num),
             "transient": float(s.run.transient if self.transient is None else self.transient),
             "samples": int(samples),
+            "converge": float(self.converge or 0.0),
+            "min_transient": float(self.min_transient),
             "lyapunov_transient": float(self.lyapunov_transient),
             "lyapunov_duration": float(self.lyapunov_duration),
             "lyapunov_threshold": float(self.lyapunov_threshold),
+            "lyapunov_screen": float(self.lyapunov_screen),
+            "lyapunov_margin": float(self.lyapunov_margin),
         }
 
 
@@ -115,16 +133,26 @@ def _one_direction(model: Model, values: np.ndarray, direction: str, r: dict,
                    steps_per_period: int | None, progress: Callable[[int, int], None] | None
                    ) -> xr.Dataset:
     start = time.perf_counter()
-    ds = bifurcation(model, "Omega", values, transient=r["transient"], samples=r["samples"],
-                     continuation=direction, steps_per_period=steps_per_period,
-                     progress=progress)
+    if r["converge"] > 0:
+        transient = {"transient": min(r["min_transient"], r["transient"]),
+                     "transient_max": r["transient"], "converge": r["converge"]}
+    else:
+        transient = {"transient": r["transient"]}
+    ds = bifurcation(model, "Omega", values, samples=r["samples"], continuation=direction,
+                     steps_per_period=steps_per_period, progress=progress, **transient)
     period = ds["period"].values
     final = ds["poincare"].values[:, -1, :]
-    lam = branch_lyapunov(model, values, final, period == 0, r["lyapunov_transient"],
-                          r["lyapunov_duration"], steps_per_period)
+    need = period == 0
+    lam = branch_lyapunov(model, values, final, need, r["lyapunov_transient"],
+                          min(r["lyapunov_screen"], r["lyapunov_duration"]), steps_per_period)
+    again = need & ~(lam < r["lyapunov_threshold"] - r["lyapunov_margin"])
+    if r["lyapunov_screen"] < r["lyapunov_duration"] and again.any():
+        lam[again] = branch_lyapunov(model, values, final, again, r["lyapunov_transient"],
+                                     r["lyapunov_duration"], steps_per_period)[again]
     ds["lyapunov"] = ("Omega", lam, {
         "long_name": "largest Lyapunov exponent", "units": "1/tau",
-        "computed_where": "no period found (period == 0)",
+        "computed_where": "no period found (period == 0); clearly negative ones over the "
+        "screening duration only",
         "start": "last stroboscopic sample of this sweep at this Omega"})
     ds["motion"] = ("Omega", motion_labels(period, lam, r["lyapunov_threshold"]), {
         "long_name": "motion class", "meaning": "period-k, chaotic, quasi-periodic, "
@@ -133,45 +161,59 @@ def _one_direction(model: Model, values: np.ndarray, direction: str, r: dict,
     return ds
 
 
+def _sweep(case: Case, interpretation: str, direction: str, settings: ReproductionSettings,
+           progress: Progress | None = None) -> xr.Dataset:
+    """One direction of one case (a unit of work; picklable arguments for worker processes)."""
+    model = case.study.build_model(interpretation=interpretation)
+    stage = f"{case.name} {interpretation} {direction}"
+
+    def tick(done: int, total: int) -> None:
+        if progress is not None:
+            progress(stage, done, total)
+
+    return _one_direction(model, sweep_values(case, settings), direction,
+                          settings.resolve(case), case.study.run.steps_per_period, tick)
+
+
+def _assemble(case: Case, interpretation: str, settings: ReproductionSettings,
+              parts: dict[str, xr.Dataset]) -> xr.Dataset:
+    """The up and down sweeps of ``case`` as one case result (see the module docs)."""
+    walls = {}
+    ordered = []
+    for direction in DIRECTIONS:
+        ds = parts[direction].copy()
+        walls[direction] = float(ds.attrs.pop("wall_time_s"))
+        ds.attrs.pop("continuation", None)
+        ordered.append(ds)
+    out = xr.concat(ordered, dim="sweep", combine_attrs="drop_conflicts")
+    out = out.assign_coords(sweep=("sweep", list(DIRECTIONS)))
+    model = case.study.build_model(interpretation=interpretation)
+    loads = case.params.loads
+    out.attrs.update(
+        {f"setting_{k}": v for k, v in settings.resolve(case).items()},
+        interpretation=interpretation, wall_time_up_s=walls["up"],
+        wall_time_down_s=walls["down"], B1=float(loads.B1), B2=float(loads.B2),
+        Lambda=float(loads.Lambda),
+        section="load fluctuation at Lambda: every common period where Lambda/Omega is a "
+        "simple ratio (section_periods), elsewhere no section: the Lyapunov exponent decides"
+        if case.load_noise else "stroboscopic, once per mesh period",
+        params_json=case.params.model_dump_json(),
+        static_deflection=[float(g) for g in model.static_forces()[:2]],
+    )
+    return label_case(out, case)
+
+
 def run_case(case: Case, interpretation: str = "consistent",
              settings: ReproductionSettings | None = None,
              progress: Progress | None = None) -> xr.Dataset:
     """Sweep ``case`` in Omega, continued up and down, and classify every point.
 
     Returns the dataset described in the module docs; its attributes name the case, the
-    interpretation, the settings used, whether the stroboscopic section suits the case
-    (``section``) and the wall time of each direction."""
+    interpretation, the settings used, how the Poincare section is taken (``section``) and the
+    wall time of each direction."""
     settings = settings or ReproductionSettings()
-    r = settings.resolve(case)
-    values = sweep_values(case, settings)
-    model = case.study.build_model(interpretation=interpretation)
-    spp = case.study.run.steps_per_period
-    parts, walls = [], {}
-    for direction in DIRECTIONS:
-        stage = f"{case.name} {interpretation} {direction}"
-
-        def tick(done: int, total: int, stage: str = stage) -> None:
-            if progress is not None:
-                progress(stage, done, total)
-
-        ds = _one_direction(model, values, direction, r, spp, tick)
-        walls[direction] = float(ds.attrs.pop("wall_time_s"))
-        ds.attrs.pop("continuation", None)
-        parts.append(ds)
-    out = xr.concat(parts, dim="sweep", combine_attrs="drop_conflicts")
-    out = out.assign_coords(sweep=("sweep", list(DIRECTIONS)))
-    loads = case.params.loads
-    out.attrs.update(
-        {f"setting_{k}": v for k, v in r.items()},
-        interpretation=interpretation, wall_time_up_s=walls["up"],
-        wall_time_down_s=walls["down"], B1=float(loads.B1), B2=float(loads.B2),
-        Lambda=float(loads.Lambda),
-        section="unsuitable (load fluctuation at Lambda): chaos from the Lyapunov exponent"
-        if case.load_noise else "stroboscopic, once per mesh period",
-        params_json=case.params.model_dump_json(),
-        static_deflection=[float(g) for g in model.static_forces()[:2]],
-    )
-    return label_case(out, case)
+    parts = {d: _sweep(case, interpretation, d, settings, progress) for d in DIRECTIONS}
+    return _assemble(case, interpretation, settings, parts)
 
 
 def label_case(ds: xr.Dataset, case: Case) -> xr.Dataset:
@@ -182,22 +224,57 @@ def label_case(ds: xr.Dataset, case: Case) -> xr.Dataset:
     return out
 
 
+def _one_thread() -> None:
+    """Worker-process set-up: one numba thread each (the processes share the cores)."""
+    import numba
+
+    numba.set_num_threads(1)
+
+
 def run_cases(cases: Iterable[Case], interpretations: Iterable[str],
               settings: ReproductionSettings | None = None,
-              progress: Progress | None = None) -> dict[tuple[str, str], xr.Dataset]:
+              progress: Progress | None = None, workers: int = 1
+              ) -> dict[tuple[str, str], xr.Dataset]:
     """:func:`run_case` for every case and interpretation, keyed ``(case name,
-    interpretation)``; cases with the same dynamics (Figs. 3 and 6, ...) run once."""
+    interpretation)``; cases with the same dynamics (Figs. 3 and 6, ...) run once.
+
+    ``workers`` > 1 runs the sweeps (two per distinct case: a continuation is one lane after
+    another, so one sweep keeps one core busy) in that many worker processes; the results are
+    those of a serial run. ``progress`` then reports finished sweeps."""
     settings = settings or ReproductionSettings()
-    done: dict[str, xr.Dataset] = {}
-    out: dict[tuple[str, str], xr.Dataset] = {}
+    cases = list(cases)
+    first: dict[str, tuple[Case, str]] = {}
+    owner: dict[tuple[str, str], str] = {}
     for interp in interpretations:
         for case in cases:
             key = case.dynamics_key(interp) + repr(asdict(settings))
-            if key in done:
-                ds = label_case(done[key], case)
-                ds.attrs["shared_with"] = done[key].attrs["case"]
-            else:
-                ds = run_case(case, interp, settings, progress)
-                done[key] = ds
-            out[(case.name, interp)] = ds
+            first.setdefault(key, (case, interp))
+            owner[(case.name, interp)] = key
+    tasks = [(key, d) for key in first for d in DIRECTIONS]
+    parts: dict[tuple[str, str], xr.Dataset] = {}
+    if workers <= 1:
+        for key, d in tasks:
+            parts[(key, d)] = _sweep(*first[key], d, settings, progress)
+    else:
+        import multiprocessing
+        from concurrent.futures import ProcessPoolExecutor, as_completed
+
+        ctx = multiprocessing.get_context("spawn")  # no fork of numba's thread pool
+        with ProcessPoolExecutor(max_workers=workers, mp_context=ctx,
+                                 initializer=_one_thread) as pool:
+            futures = {pool.submit(_sweep, *first[key], d, settings): (key, d)
+                       for key, d in tasks}
+            for n, fut in enumerate(as_completed(futures), start=1):
+                parts[futures[fut]] = fut.result()
+                if progress is not None:
+                    progress(f"sweeps in {workers} processes", n, len(tasks))
+    done = {key: _assemble(*first[key], settings, {d: parts[(key, d)] for d in DIRECTIONS})
+            for key in first}
+    out: dict[tuple[str, str], xr.Dataset] = {}
+    for (name, interp), key in owner.items():
+        ds = done[key]
+        if ds.attrs["case"] != name:
+            ds = label_case(ds, Case(name))
+            ds.attrs["shared_with"] = done[key].attrs["case"]
+        out[(name, interp)] = ds
     return out
