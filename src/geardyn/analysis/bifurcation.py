@@ -52,6 +52,11 @@ def _continuation(model, P, order, y0, progress, **opts) -> LaneResults:
     return _concat(parts)  # type: ignore[arg-type]
 
 
+#: Time (model units) the tangent vectors run before the exponent is measured, when it starts from
+#: a point's final (already settled) state.
+LYAPUNOV_ALIGN = 200.0
+
+
 def _independent(model, P, Y0, chunk, progress, client, store, **opts) -> LaneResults:
     """run_lanes over chunks of lanes through the executor (here or on a Dask cluster, resumable
     with a store), reporting progress after each chunk."""
@@ -196,10 +201,16 @@ def bifurcation(
     if lyapunov:
         from geardyn.analysis.lyapunov import lyapunov_lanes
 
-        exps = lyapunov_lanes(model, P, base_y0, transient, samples * _mean_period(model, P),
-                              steps_per_period)
+        # from each point's own final state (on the attractor the Poincare points show, also
+        # in continuation), with each lane's own step; a short run aligns the tangent vectors
+        start = np.where(np.isfinite(first.final), first.final,
+                         np.broadcast_to(base_y0, first.final.shape))
+        exps = lyapunov_lanes(model, P, start, min(transient, LYAPUNOV_ALIGN),
+                              samples * _mean_period(model, P), steps_per_period)
         ds["lyapunov"] = (param, np.where(status == 0, exps, np.nan), {
-            "long_name": "largest Lyapunov exponent", "units": f"1/{model.time_unit}"})
+            "long_name": "largest Lyapunov exponent", "units": f"1/{model.time_unit}",
+            "method": "tangent-map QR (Benettin), from the point's final state, "
+                      f"{LYAPUNOV_ALIGN:g} time units to align, then as long as the sampling"})
     ds.attrs.update(
         model=model.name, param=param, transient=float(transient), samples=int(samples),
         continuation=continuation or "none", starts=int(starts),

@@ -14,6 +14,7 @@ import math
 import numpy as np
 
 from geardyn.models.base import Model
+from geardyn.solvers.ensemble import ladder_steps
 from geardyn.solvers.kernels import kernels_for
 from geardyn.solvers.simulate import DEFAULT_BOUND, default_steps_per_period
 
@@ -138,8 +139,10 @@ def lyapunov_lanes(
     ``y0``: one initial state for all lanes, or one per lane (lanes x n_states); default
     ``model.initial_state()``. ``transient`` and ``duration`` are times, rounded up to whole
     forcing periods of each lane (lanes differ in Omega, so their step counts differ). The grid has
-    ``steps_per_period`` steps per period (default: :func:`default_steps_per_period` at the
-    smallest Omega of the lanes); an autonomous model uses the step ``dt`` (default 0.01).
+    ``steps_per_period`` steps per period (default: each lane's own
+    :func:`default_steps_per_period`, rounded up to the sweep's step ladder, as in
+    :func:`~geardyn.solvers.ensemble.run_lanes`); an autonomous model uses the step ``dt``
+    (default 0.01).
     """
     P = np.ascontiguousarray(np.atleast_2d(np.asarray(P, dtype=float)))
     L = P.shape[0]
@@ -174,14 +177,19 @@ def lyapunov_lanes(
         OMEGA = np.ascontiguousarray(P[:, model.omega_index])
         if not np.all(OMEGA > 0):
             raise ValueError("every lane needs a forcing frequency Omega > 0")
-        n_per = int(steps_per_period or default_steps_per_period(model, float(OMEGA.min())))
-        if n_per < 4:
-            raise ValueError(f"steps_per_period must be >= 4 (got {n_per})")
+        if steps_per_period is None:
+            n_lane = np.array([ladder_steps(default_steps_per_period(model, float(w)))
+                               for w in OMEGA], dtype=np.int64)
+        else:
+            n_lane = np.full(L, int(steps_per_period), dtype=np.int64)
+        if np.any(n_lane < 4):
+            raise ValueError(f"steps_per_period must be >= 4 (got {steps_per_period})")
         periods = 2.0 * np.pi / OMEGA
-        H = periods / n_per
-        n_tr = np.array([_whole_periods(transient, T) * n_per for T in periods], dtype=np.int64)
-        n_st = np.array([max(1, _whole_periods(duration, T)) * n_per for T in periods],
-                        dtype=np.int64)
+        H = periods / n_lane
+        n_tr = np.array([_whole_periods(transient, T) * n
+                         for T, n in zip(periods, n_lane, strict=True)], dtype=np.int64)
+        n_st = np.array([max(1, _whole_periods(duration, T)) * n
+                         for T, n in zip(periods, n_lane, strict=True)], dtype=np.int64)
     renorm = int(DEFAULT_RENORM_EVERY if renorm_every is None else renorm_every)
     if renorm < 1:
         raise ValueError(f"renorm_every must be >= 1 (got {renorm_every!r})")
@@ -189,6 +197,14 @@ def lyapunov_lanes(
     if L == 0:
         return out
     kern = kernels_for(model.kernel, "lyapunov")
-    kern.lyapunov_lanes(P, Y0, H, OMEGA, n_per, n_tr, n_st, renorm, float(bound), out,
-                        model.n_events)
+    if model.omega_index is None:
+        kern.lyapunov_lanes(P, Y0, H, OMEGA, n_per, n_tr, n_st, renorm, float(bound), out,
+                            model.n_events)
+        return out
+    for n in np.unique(n_lane):  # one kernel call per step count (one phase table)
+        idx = np.nonzero(n_lane == n)[0]
+        part = np.full(idx.size, np.nan)
+        kern.lyapunov_lanes(P[idx], Y0[idx], H[idx], OMEGA[idx], int(n), n_tr[idx], n_st[idx],
+                            renorm, float(bound), part, model.n_events)
+        out[idx] = part
     return out

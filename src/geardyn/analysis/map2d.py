@@ -58,7 +58,10 @@ def _map_task(model: Model, P: np.ndarray, y0: np.ndarray, static: np.ndarray | 
     if lyapunov is not None:
         from geardyn.analysis.lyapunov import lyapunov_lanes
 
-        exps = lyapunov_lanes(model, P, y0, **lyapunov)
+        # from each point's final state: the attractor its period and contact describe
+        start = np.where(np.isfinite(r.final), r.final,
+                         np.broadcast_to(np.asarray(y0, dtype=float), r.final.shape))
+        exps = lyapunov_lanes(model, P, start, **lyapunov)
         out["lyapunov"] = np.where(r.status == 0, exps, np.nan)
     return out
 
