@@ -30,7 +30,11 @@ from rich.markup import escape
 from geardyn.cli.common import (
     ESTIMATE_POINTS,
     MAX_COUNT,
-    Interpretation,
+    InterpretationOption,
+    NetCDFOutOption,
+    PlotOption,
+    StepsOption,
+    YesOption,
     check_count,
     check_plot_path,
     check_run_cost,
@@ -200,28 +204,21 @@ def bifurcation_command(
         int | None, typer.Option(help="Forcing periods sampled per point (default: "
                                       "sweep.samples, else run.periods).")
     ] = None,
-    steps_per_period: Annotated[
-        int | None, typer.Option(help="RK4 steps per forcing period (default: automatic).")
-    ] = None,
+    steps_per_period: StepsOption = None,
     omega: Annotated[
         float | None, typer.Option(help="The fixed Omega when sweeping another parameter "
                                         "(default: run.omega).")
     ] = None,
-    interpretation: Annotated[
-        Interpretation | None, typer.Option(help="Interpretation (default: the study's).")
-    ] = None,
+    interpretation: InterpretationOption = None,
     state: Annotated[
         str | None, typer.Option(help="State drawn (default: the study's plot_state).")
     ] = None,
     quiet: Annotated[
         bool, typer.Option("--quiet", "-q", help="No progress bar.")
     ] = False,
-    yes: Annotated[
-        bool, typer.Option("--yes", help="Run even when the estimated memory or time exceeds "
-                                         "the limits.")
-    ] = False,
-    out: Annotated[Path | None, typer.Option(help="NetCDF file to write (.nc).")] = None,
-    plot: Annotated[Path | None, typer.Option(help="Figure to write (.png, .pdf or .svg).")] = None,
+    yes: YesOption = False,
+    out: NetCDFOutOption = None,
+    plot: PlotOption = None,
 ) -> None:
     """Sweep one parameter of a study: bifurcation diagram, periods, contact loss.
 

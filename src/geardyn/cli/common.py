@@ -15,7 +15,7 @@ import warnings
 from collections.abc import Callable
 from enum import StrEnum
 from pathlib import Path
-from typing import Any
+from typing import Annotated, Any
 
 import typer
 from pydantic import ValidationError
@@ -50,6 +50,21 @@ class Interpretation(StrEnum):
     consistent = "consistent"
     carrier_only = "carrier-only"
     as_printed = "as-printed"
+
+
+# Options that several commands share, declared once.
+InterpretationOption = Annotated[
+    Interpretation | None, typer.Option(help="Interpretation (default: the study's).")
+]
+StepsOption = Annotated[
+    int | None, typer.Option(help="RK4 steps per forcing period (default: automatic).")
+]
+YesOption = Annotated[
+    bool, typer.Option("--yes", help="Run even when the estimated memory or time exceeds the "
+                                      "limits.")
+]
+NetCDFOutOption = Annotated[Path | None, typer.Option(help="NetCDF file to write (.nc).")]
+PlotOption = Annotated[Path | None, typer.Option(help="Figure to write (.png, .pdf or .svg).")]
 
 
 def load_study_source(source: str | None):

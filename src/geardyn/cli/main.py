@@ -34,7 +34,12 @@ from geardyn.cli.common import (
     EXPECTED_ERRORS,
     MAX_COUNT,
     Interpretation,
+    InterpretationOption,
+    NetCDFOutOption,
     OneLineErrorGroup,
+    PlotOption,
+    StepsOption,
+    YesOption,
     check_count,
     check_plot_path,
     check_run_cost,
@@ -69,7 +74,6 @@ def _stdout() -> Console:
 
 _stderr = stderr_console
 #: A STUDY argument: a file, a built-in study name, or None for the paper's device.
-_load_study = load_study_source
 
 
 def _version(value: bool) -> None:
@@ -123,7 +127,7 @@ def params_show(
     frequencies."""
     from geardyn.models.derived import COEFFICIENT_FORMULAS, DERIVED_FORMULAS
 
-    s = _load_study(study)
+    s = load_study_source(study)
     interp = interpretation.value if interpretation is not None else None
     model = s.build_model(interpretation=interp)
     out = _stdout()
@@ -209,28 +213,21 @@ def simulate(
     periods: Annotated[
         int | None, typer.Option(help="Forcing periods recorded (default: run.periods).")
     ] = None,
-    steps_per_period: Annotated[
-        int | None, typer.Option(help="RK4 steps per forcing period (default: automatic).")
-    ] = None,
-    interpretation: Annotated[
-        Interpretation | None, typer.Option(help="Interpretation (default: the study's).")
-    ] = None,
+    steps_per_period: StepsOption = None,
+    interpretation: InterpretationOption = None,
     state: Annotated[
         str | None, typer.Option(help="Coordinate to plot (default: the study's plot_state).")
     ] = None,
-    yes: Annotated[
-        bool, typer.Option("--yes", help="Run even when the estimated memory or time exceeds "
-                                         "the limits.")
-    ] = False,
-    out: Annotated[Path | None, typer.Option(help="NetCDF file to write (.nc).")] = None,
-    plot: Annotated[Path | None, typer.Option(help="Figure to write (.png, .pdf or .svg).")] = None,
+    yes: YesOption = False,
+    out: NetCDFOutOption = None,
+    plot: PlotOption = None,
 ) -> None:
     """Simulate a study at one mesh frequency; save the time history and a figure."""
     from geardyn.io.netcdf import save_dataset
     from geardyn.plotting.simulation import count_distinct
     from geardyn.solvers.simulate import simulate as run_simulation
 
-    s = _load_study(study)
+    s = load_study_source(study)
     om = omega if omega is not None else s.run.omega
     if om is None:
         raise StudyError("--omega: not given, and the study has no run.omega")

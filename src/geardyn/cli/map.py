@@ -28,7 +28,9 @@ from geardyn.cli.common import (
     MAX_COUNT,
     MEMORY_FRACTION,  # noqa: F401 (documented here: the limits a map is refused above)
     TIME_LIMIT_S,  # noqa: F401
+    StepsOption,
     check_count,
+    load_study_source,
     refuse_if_costly,
     usable_omega,
 )
@@ -85,9 +87,7 @@ def map_command(
     samples: Annotated[
         int | None, typer.Option(help="Forcing periods sampled per point (default: run.periods).")
     ] = None,
-    steps_per_period: Annotated[
-        int | None, typer.Option(help="RK4 steps per forcing period (default: automatic).")
-    ] = None,
+    steps_per_period: StepsOption = None,
     lyapunov: Annotated[
         bool, typer.Option("--lyapunov", help="Also the largest Lyapunov exponent per point.")
     ] = False,
@@ -107,7 +107,6 @@ def map_command(
     from rich.console import Console
 
     from geardyn.analysis.map2d import check_steps, estimate_map, map2d, measure_ns_per_lane_step
-    from geardyn.cli.main import _load_study
     from geardyn.io.toml import format_error
 
     x_axis, y_axis = parse_axis(x, "--x"), parse_axis(y, "--y")
@@ -129,7 +128,7 @@ def map_command(
         raise ParameterError("--steps-per-period", steps_per_period, "must be >= 4")
     if transient is not None and not (math.isfinite(transient) and transient >= 0):
         raise ParameterError("--transient", transient, "must be a finite time >= 0")
-    s = _load_study(study)
+    s = load_study_source(study)
     model = s.build_model(interpretation=interpretation)
     tr = s.run.transient if transient is None else transient
     n_samples = s.run.periods if samples is None else samples

@@ -32,7 +32,6 @@ from __future__ import annotations
 
 import math
 import os
-import tempfile
 import tomllib
 from importlib import resources
 from pathlib import Path
@@ -51,6 +50,7 @@ from pydantic import (
 from pydantic_core import InitErrorDetails, PydanticCustomError
 
 from geardyn.errors import ParameterError, StudyError
+from geardyn.io.atomic import atomic_replace
 from geardyn.models.derived import INTERPRETATIONS
 from geardyn.models.params import PAPER_NAMES, Angle, PlanetaryParams, Real, Whole
 
@@ -66,6 +66,7 @@ __all__ = [
     "format_error",
     "load_params",
     "load_study",
+    "paper_study",
     "save_params",
     "save_study",
 ]
@@ -446,24 +447,13 @@ def load_study(path_or_text: str | os.PathLike[str]) -> Study:
 # --------------------------------------------------------------------------- writing
 def _write_atomic(path: str | os.PathLike[str], text: str) -> Path:
     path = Path(path)
-    folder = path.parent if str(path.parent) else Path(".")
     if path.is_dir():
         raise StudyError(f"{path}: is a directory, not a file to write")
     try:
-        fd, tmp = tempfile.mkstemp(dir=folder, prefix=f".{path.name}.", suffix=".tmp")
+        with atomic_replace(path) as tmp:
+            Path(tmp).write_text(text, encoding="utf-8")
     except OSError as exc:  # name the file asked for, not the temporary one
         raise StudyError(f"{path}: cannot write ({exc.strerror or exc})") from None
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as fh:
-            fh.write(text)
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(tmp, 0o666 & ~umask)
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
     return path
 
 

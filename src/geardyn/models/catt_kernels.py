@@ -46,27 +46,15 @@ def dead_zone(x, b):
 
 
 @nb.njit(inline="always", **_JIT)
-def fourier(p, o, nh, s, c):
-    """sum_h p[o+2h] cos(h theta) + p[o+2h+1] sin(h theta) for theta with sin s, cos c."""
-    acc = p[o] * c + p[o + 1] * s
+def _stiffness(p, f, nh, s, c):
+    """1 + the stiffness variation sum_h p[f+2h] cos(h theta) + p[f+2h+1] sin(h theta), h < nh,
+    for the mesh phase theta with sin s, cos c (harmonics by the angle-addition recurrence)."""
+    acc = p[f] * c + p[f + 1] * s
     ch = c
     sh = s
     for h in range(1, nh):
         ch, sh = ch * c - sh * s, sh * c + ch * s
-        acc += p[o + 2 * h] * ch + p[o + 2 * h + 1] * sh
-    return acc
-
-
-@nb.njit(inline="always", **_JIT)
-def _stiffness(p, f, nh, s, c):
-    """1 + the stiffness variation whose Fourier coefficients start at p[f]."""
-    acc = p[f] * c + p[f + 1] * s
-    if nh > 1:
-        ch = c
-        sh = s
-        for h in range(1, nh):
-            ch, sh = ch * c - sh * s, sh * c + ch * s
-            acc += p[f + 2 * h] * ch + p[f + 2 * h + 1] * sh
+        acc += p[f + 2 * h] * ch + p[f + 2 * h + 1] * sh
     return 1.0 + acc
 
 
@@ -207,8 +195,8 @@ def theta_rhs(t, y, dy, p, s, c):
         dx_sq = w_c * p[T_RC1] - w_q * p[o + T_RBQ] - de_sq
         x_pq = th_q * p[o + T_RBQ] - th_p * p[o + T_RBP] - e_pq
         dx_pq = w_q * p[o + T_RBQ] - w_p * p[o + T_RBP] - de_pq
-        k_sq = p[o + T_KM_SQ] * (1.0 + fourier(p, o + T_BLOCK_FIXED, nh, s, c))
-        k_pq = p[o + T_KM_PQ] * (1.0 + fourier(p, o + T_BLOCK_FIXED + 2 * nh, nh, s, c))
+        k_sq = p[o + T_KM_SQ] * _stiffness(p, o + T_BLOCK_FIXED, nh, s, c)
+        k_pq = p[o + T_KM_PQ] * _stiffness(p, o + T_BLOCK_FIXED + 2 * nh, nh, s, c)
         f_sq = k_sq * dead_zone(x_sq, p[o + T_B_SQ]) + p[o + T_C_SQ] * dx_sq
         f_pq = k_pq * dead_zone(x_pq, p[o + T_B_PQ]) + p[o + T_C_PQ] * dx_pq
         dy[j] = w_q

@@ -139,17 +139,16 @@ def run_lanes(
     tr_steps = np.empty(L, np.int64)
     conv = np.empty(L, np.int64)
     s_tab, c_tab, tab_of = _phase_tables(k, n_lane)
-    m = L
-    smp = np.empty((m, samples, ns))
-    fin = np.empty((m, ns))
-    st = np.empty(m, np.int64)
-    gmin = np.empty((m, n_ev))
-    gmax = np.empty((m, n_ev))
-    nc = np.empty((m, n_ev), np.int64)
-    omax = np.empty((m, n_obs))
-    omin = np.empty((m, n_obs))
-    orms = np.empty((m, n_obs))
-    unres = np.empty(m, np.int64)
+    smp = np.empty((L, samples, ns))
+    fin = np.empty((L, ns))
+    st = np.empty(L, np.int64)
+    gmin = np.empty((L, n_ev))
+    gmax = np.empty((L, n_ev))
+    nc = np.empty((L, n_ev), np.int64)
+    omax = np.empty((L, n_obs))
+    omin = np.empty((L, n_obs))
+    orms = np.empty((L, n_obs))
+    unres = np.empty(L, np.int64)
     first, nl, nper, w_start, w_blocks = sched
     k.sweep(P[order], Y0[order], (period / n_lane)[order], omega[order], T0[order],
             (n_tr_periods * n_lane)[order].astype(np.int64),
