@@ -8,7 +8,7 @@ The public API::
     ds = geardyn.simulate(m, omega=1.1, transient=4000.0, periods=64)
 """
 
-from geardyn.analysis.bifurcation import bifurcation
+from geardyn.analysis.bifurcation import ContinuedSweep, bifurcation, continued_sweeps
 from geardyn.analysis.lyapunov import lyapunov, lyapunov_lanes
 from geardyn.analysis.map2d import map2d
 from geardyn.analysis.periodicity import classify_period, common_section
@@ -29,6 +29,7 @@ __all__ = [
     "INTERPRETATIONS",
     "CATTDevice",
     "Carrier",
+    "ContinuedSweep",
     "DimensionalCATT",
     "GearPair",
     "GeardynError",
@@ -45,6 +46,7 @@ __all__ = [
     "bifurcation",
     "classify_period",
     "common_section",
+    "continued_sweeps",
     "label_peaks",
     "lyapunov",
     "lyapunov_lanes",

@@ -6,11 +6,13 @@ import functools
 import math
 import os
 from collections.abc import Callable, Sequence
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 import xarray as xr
 
+from geardyn.analysis.continuation import Branch, continue_branches
 from geardyn.analysis.lanes import (
     has_mesh_forces,
     lane_periods,
@@ -20,37 +22,10 @@ from geardyn.analysis.lanes import (
 )
 from geardyn.analysis.periodicity import DEFAULT_MAX_PERIOD, DEFAULT_TOL
 from geardyn.models.base import Model
-from geardyn.solvers.ensemble import LaneResults, run_lanes
+from geardyn.solvers.ensemble import LaneResults
 from geardyn.solvers.executor import lane_results, run_chunks, run_lanes_task
+from geardyn.solvers.kernels import kernels_for
 from geardyn.solvers.simulate import DEFAULT_BOUND
-
-
-def _concat(parts: list[LaneResults]) -> LaneResults:
-    fields = LaneResults.__dataclass_fields__
-    return LaneResults(**{f: np.concatenate([getattr(r, f) for r in parts]) for f in fields})
-
-
-def _lanes_slice(r: LaneResults, a: int, b: int) -> LaneResults:
-    return LaneResults(**{f: getattr(r, f)[a:b] for f in LaneResults.__dataclass_fields__})
-
-
-def _continuation(model, P, order, y0, progress, **opts) -> LaneResults:
-    """One lane at a time in ``order``, each from the previous lane's final state and time."""
-    parts: list[LaneResults | None] = [None] * len(order)
-    y, t0 = np.asarray(y0, dtype=float), 0.0
-    for done, pos in enumerate(order):
-        if progress is not None:
-            progress(done, len(order))
-        r = run_lanes(model, P[pos : pos + 1], y, t0=np.array([t0]), **opts)
-        parts[pos] = r
-        if r.status[0] == 0:
-            y, t0 = r.final[0], float(r.final_time[0])
-        else:  # lost the branch: restart from the model's initial state
-            y, t0 = np.asarray(y0, dtype=float), 0.0
-    if progress is not None:
-        progress(len(order), len(order))
-    return _concat(parts)  # type: ignore[arg-type]
-
 
 #: Time (model units) the tangent vectors run before the exponent is measured, when it starts from
 #: a point's final (already settled) state.
@@ -89,6 +64,7 @@ def bifurcation(
     store: str | os.PathLike[str] | None = None,
     converge: float | None = None,
     transient_max: float | None = None,
+    continued_transient: float | None = None,
 ) -> xr.Dataset:
     """Sweep ``param`` over ``values`` and classify the steady motion at every point.
 
@@ -112,7 +88,13 @@ def bifurcation(
         (``section_periods``; see :func:`geardyn.analysis.periodicity.common_section`).
     continuation
         ``None``: every point starts from ``y0``; ``"up"``/``"down"``: each point starts from the
-        final state of the previous one in ascending/descending order (shows hysteresis).
+        final state of the previous one in ascending/descending order (shows hysteresis; see
+        :mod:`geardyn.analysis.continuation`).
+    continued_transient
+        With continuation: the (minimum) transient of a continued point, which starts next to
+        its attractor (default ``transient``; the first point always gets ``transient``).
+        A continued point whose second excitation is incommensurate with Omega cannot be tested
+        for convergence and runs exactly this long.
     starts
         Independent starts per point (``continuation=None`` only): the first from ``y0``, the
         others from ``y0`` plus uniform noise of half-width ``spread`` on each state (``seed``).
@@ -136,45 +118,189 @@ def bifurcation(
     ``force_peak``, ``force_rms``, ``dynamic_factor`` (param, mesh), ``status``, and
     ``lyapunov`` (param) when asked.
     """
-    values = np.asarray(values, dtype=float).ravel()
-    if values.size == 0:
-        raise ValueError("values: give at least one parameter value")
-    if not np.all(np.isfinite(values)):
-        raise ValueError(f"values: must be finite (got {values[~np.isfinite(values)][0]!r})")
+    values = _check_values(values)
     if continuation not in (None, "up", "down"):
         raise ValueError(f"continuation must be None, 'up' or 'down' (got {continuation!r})")
     if starts < 1 or (starts > 1 and continuation):
         raise ValueError("starts must be >= 1, and 1 with continuation")
-    if converge is not None and not converge > 0:
-        raise ValueError(f"converge must be a positive tolerance or None (got {converge!r})")
-    opts = dict(transient=float(transient), samples=int(samples),
-                steps_per_period=steps_per_period, locate_edges=bool(locate_edges),
-                bound=float(bound), transient_max=transient_max,
-                converge_tol=float(converge or 0.0))
+    _check_converge(converge)
     if continuation and (client is not None or store is not None):
         raise ValueError("client and store apply to independent starts, not to continuation")
-    P = model.lane_params(param, values)
-    if y0 is not None:
-        base_y0 = np.asarray(y0, dtype=float)
-    elif param == "Omega":
-        base_y0 = model.initial_state()
-    else:  # each point starts from its own model's initial (static) state
-        base_y0 = np.array([model.with_params(**{param: float(v)}).initial_state()
-                            for v in values])
-    L, ns = values.size, model.n_states
     if continuation:
-        order = np.argsort(values, kind="stable")
-        if continuation == "down":
-            order = order[::-1]
-        runs = [_continuation(model, P, order, base_y0 if base_y0.ndim == 1 else base_y0[0],
-                              progress, **opts)]
+        sweep = ContinuedSweep(model, param, values, continuation, transient=transient,
+                               continued_transient=continued_transient,
+                               transient_max=transient_max, steps_per_period=steps_per_period,
+                               y0=y0)
+        ((ds, final),) = _continued([sweep], samples, converge, max_period, tol, locate_edges,
+                                    bound, progress)
     else:
+        opts = dict(transient=float(transient), samples=int(samples),
+                    steps_per_period=steps_per_period, locate_edges=bool(locate_edges),
+                    bound=float(bound), transient_max=transient_max,
+                    converge_tol=float(converge or 0.0))
+        P = model.lane_params(param, values)
+        base_y0 = _initial_states(model, param, values, y0)
+        L, ns = values.size, model.n_states
         rng = np.random.default_rng(seed)
         Y0 = [np.broadcast_to(base_y0, (L, ns))]
         Y0 += [base_y0 + rng.uniform(-spread, spread, (L, ns)) for _ in range(1, starts)]
         every = _independent(model, np.tile(P, (starts, 1)), np.concatenate(Y0), chunk,
                              progress, client, store, **opts)
         runs = [_lanes_slice(every, s * L, (s + 1) * L) for s in range(starts)]
+        final = runs[0].final
+        ds = _dataset(model, param, values, runs, max_period, tol)
+        ds.attrs.update(_settings(transient, samples, converge, transient_max, locate_edges,
+                                  bound, tol, max_period), continuation="none",
+                        starts=int(starts))
+    if lyapunov:
+        from geardyn.analysis.lyapunov import lyapunov_lanes
+
+        # from each point's own final state (on the attractor the Poincare points show, also
+        # in continuation), with each lane's own step; a short run aligns the tangent vectors
+        P = model.lane_params(param, values)
+        base_y0 = _initial_states(model, param, values, y0)
+        start = np.where(np.isfinite(final), final, np.broadcast_to(base_y0, final.shape))
+        exps = lyapunov_lanes(model, P, start, min(transient, LYAPUNOV_ALIGN),
+                              samples * _mean_period(model, P), steps_per_period)
+        ds["lyapunov"] = (param, np.where(ds["status"].values == 0, exps, np.nan), {
+            "long_name": "largest Lyapunov exponent", "units": f"1/{model.time_unit}",
+            "method": "tangent-map QR (Benettin), from the point's final state, "
+                      f"{LYAPUNOV_ALIGN:g} time units to align, then as long as the sampling"})
+    return ds
+
+
+@dataclass(frozen=True)
+class ContinuedSweep:
+    """One sweep by continuation for :func:`continued_sweeps`: ``model`` swept in ``param``
+    over ``values`` in the ``direction`` "up" (ascending) or "down", with the transients and
+    step of :func:`bifurcation` (``y0``: the cold start's state, default the model's
+    initial state)."""
+
+    model: Model
+    param: str
+    values: np.ndarray
+    direction: str = "up"
+    transient: float = 4000.0
+    continued_transient: float | None = None
+    transient_max: float | None = None
+    steps_per_period: int | None = None
+    y0: np.ndarray | None = None
+
+
+def continued_sweeps(
+    sweeps: Sequence[ContinuedSweep],
+    samples: int = 200,
+    converge: float | None = None,
+    max_period: int = DEFAULT_MAX_PERIOD,
+    tol: float = DEFAULT_TOL,
+    locate_edges: bool = True,
+    bound: float = DEFAULT_BOUND,
+    progress: Callable[[int, int], None] | None = None,
+    max_section_periods: int | None = None,
+) -> list[xr.Dataset]:
+    """Several sweeps by continuation at once (up and down, several studies): the datasets of
+    :func:`bifurcation` with ``continuation=direction``, each bitwise what it gets alone, but
+    their points advance together as lanes of one kernel call (see
+    :mod:`geardyn.analysis.continuation`). Sweeps whose models compile to different kernels
+    run one group after another. ``max_section_periods``: the longest common period of two
+    forcings taken as a section (see :func:`~geardyn.solvers.ensemble.run_lanes`)."""
+    return [ds for ds, _ in _continued(sweeps, samples, converge, max_period, tol,
+                                       locate_edges, bound, progress, max_section_periods)]
+
+
+def _continued(sweeps, samples, converge, max_period, tol, locate_edges, bound, progress,
+               max_section_periods=None) -> list[tuple[xr.Dataset, np.ndarray]]:
+    """continued_sweeps, with each sweep's final states (in value order)."""
+    _check_converge(converge)
+    prepared = []
+    for sw in sweeps:
+        if sw.direction not in ("up", "down"):
+            raise ValueError(f"direction must be 'up' or 'down' (got {sw.direction!r})")
+        values = _check_values(sw.values)
+        order = np.argsort(values, kind="stable")
+        if sw.direction == "down":
+            order = order[::-1]
+        start = _initial_states(sw.model, sw.param, values, sw.y0)
+        start = start if start.ndim == 1 else start[order[0]]
+        branch = Branch(sw.model, sw.model.lane_params(sw.param, values)[order], start,
+                        float(sw.transient), sw.continued_transient, sw.transient_max,
+                        sw.steps_per_period, max_section_periods)
+        prepared.append((sw, values, order, branch))
+    groups: dict[int, list[int]] = {}
+    for i, (sw, *_rest) in enumerate(prepared):
+        groups.setdefault(id(kernels_for(sw.model.kernel)), []).append(i)
+    total = sum(p[3].P.shape[0] for p in prepared)
+    results: dict[int, LaneResults] = {}
+    done = 0
+    for members in groups.values():
+        offset = done
+
+        def tick(d: int, _t: int, offset: int = offset) -> None:
+            if progress is not None:
+                progress(offset + d, total)
+
+        runs = continue_branches([prepared[i][3] for i in members], samples, converge,
+                                 locate_edges, bound, tick)
+        for i, r in zip(members, runs, strict=True):
+            results[i] = r
+            done += r.status.size
+    out = []
+    for i, (sw, values, order, _branch) in enumerate(prepared):
+        r = results[i]
+        back = np.empty_like(order)
+        back[order] = np.arange(order.size)
+        r = LaneResults(**{f: getattr(r, f)[back] for f in LaneResults.__dataclass_fields__})
+        ds = _dataset(sw.model, sw.param, values, [r], max_period, tol)
+        ds.attrs.update(_settings(sw.transient, samples, converge, sw.transient_max,
+                                  locate_edges, bound, tol, max_period),
+                        continuation=sw.direction, starts=1)
+        if sw.continued_transient is not None:
+            ds.attrs["continued_transient"] = float(sw.continued_transient)
+        out.append((ds, r.final))
+    return out
+
+
+def _check_values(values: Sequence[float] | np.ndarray) -> np.ndarray:
+    values = np.asarray(values, dtype=float).ravel()
+    if values.size == 0:
+        raise ValueError("values: give at least one parameter value")
+    if not np.all(np.isfinite(values)):
+        raise ValueError(f"values: must be finite (got {values[~np.isfinite(values)][0]!r})")
+    return values
+
+
+def _check_converge(converge: float | None) -> None:
+    if converge is not None and not converge > 0:
+        raise ValueError(f"converge must be a positive tolerance or None (got {converge!r})")
+
+
+def _initial_states(model: Model, param: str, values: np.ndarray, y0: np.ndarray | None
+                    ) -> np.ndarray:
+    """``y0``, or the model's initial state (one per value when ``param`` changes it)."""
+    if y0 is not None:
+        return np.asarray(y0, dtype=float)
+    if param == "Omega":
+        return model.initial_state()
+    return np.array([model.with_params(**{param: float(v)}).initial_state() for v in values])
+
+
+def _lanes_slice(r: LaneResults, a: int, b: int) -> LaneResults:
+    return LaneResults(**{f: getattr(r, f)[a:b] for f in LaneResults.__dataclass_fields__})
+
+
+def _settings(transient, samples, converge, transient_max, locate_edges, bound, tol,
+              max_period) -> dict[str, Any]:
+    return dict(
+        transient=float(transient), samples=int(samples), converge=float(converge or 0.0),
+        transient_max=float(transient_max if transient_max is not None else 10 * transient),
+        integrator="RK4, fixed step aligned to the forcing period",
+        locate_edges=int(bool(locate_edges)), bound=float(bound), period_tol=float(tol),
+        max_period=int(max_period))
+
+
+def _dataset(model: Model, param: str, values: np.ndarray, runs: list[LaneResults],
+             max_period: int, tol: float) -> xr.Dataset:
+    """The sweep dataset of one or more starts' lane results (without the settings)."""
     first = runs[0]
     poincare = np.concatenate([r.samples for r in runs], axis=1)
     static = _static_forces(model, param, values) if has_mesh_forces(model) else None
@@ -192,34 +318,14 @@ def bifurcation(
     dims, attrs = variable_dims(model), variable_attrs(model, max_period, tol)
     for name, data in per_lane.items():
         ds[name] = ((param, *dims[name]), data, attrs[name])
-    if starts > 1:
+    if len(runs) > 1:
+        samples = first.samples.shape[1]
         periods = np.stack([per_lane["period"]] + [lane_periods(r, max_period, tol)
                                                    for r in runs[1:]], axis=1)
         ds["period_by_start"] = ((param, "start"), periods)
-        ds["start_of_sample"] = ("sample", np.repeat(np.arange(starts), samples))
+        ds["start_of_sample"] = ("sample", np.repeat(np.arange(len(runs)), samples))
     ds["status"] = (param, status, {"meaning": "0 ok, 1 diverged in at least one start"})
-    if lyapunov:
-        from geardyn.analysis.lyapunov import lyapunov_lanes
-
-        # from each point's own final state (on the attractor the Poincare points show, also
-        # in continuation), with each lane's own step; a short run aligns the tangent vectors
-        start = np.where(np.isfinite(first.final), first.final,
-                         np.broadcast_to(base_y0, first.final.shape))
-        exps = lyapunov_lanes(model, P, start, min(transient, LYAPUNOV_ALIGN),
-                              samples * _mean_period(model, P), steps_per_period)
-        ds["lyapunov"] = (param, np.where(status == 0, exps, np.nan), {
-            "long_name": "largest Lyapunov exponent", "units": f"1/{model.time_unit}",
-            "method": "tangent-map QR (Benettin), from the point's final state, "
-                      f"{LYAPUNOV_ALIGN:g} time units to align, then as long as the sampling"})
-    ds.attrs.update(
-        model=model.name, param=param, transient=float(transient), samples=int(samples),
-        continuation=continuation or "none", starts=int(starts),
-        converge=float(converge or 0.0),
-        transient_max=float(transient_max if transient_max is not None else 10 * transient),
-        integrator="RK4, fixed step aligned to the forcing period",
-        locate_edges=int(bool(locate_edges)), bound=float(bound), period_tol=float(tol),
-        max_period=int(max_period), time_unit=model.time_unit,
-    )
+    ds.attrs.update(model=model.name, param=param, time_unit=model.time_unit)
     for key in ("interpretation",):
         if hasattr(model, key):
             ds.attrs[key] = getattr(model, key)

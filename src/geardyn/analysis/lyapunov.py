@@ -14,7 +14,7 @@ import math
 import numpy as np
 
 from geardyn.models.base import Model
-from geardyn.solvers.ensemble import ladder_steps
+from geardyn.solvers.ensemble import lane_steps_per_period
 from geardyn.solvers.kernels import kernels_for
 from geardyn.solvers.simulate import DEFAULT_BOUND, default_steps_per_period
 
@@ -178,8 +178,7 @@ def lyapunov_lanes(
         if not np.all(OMEGA > 0):
             raise ValueError("every lane needs a forcing frequency Omega > 0")
         if steps_per_period is None:
-            n_lane = np.array([ladder_steps(default_steps_per_period(model, float(w)))
-                               for w in OMEGA], dtype=np.int64)
+            n_lane = lane_steps_per_period(model, P)
         else:
             n_lane = np.full(L, int(steps_per_period), dtype=np.int64)
         if np.any(n_lane < 4):

@@ -69,7 +69,8 @@ def reproduce_command(
     samples: Annotated[int | None, typer.Option(
         help="Mesh periods sampled per point (default: the study's).")] = None,
     jobs: Annotated[int | None, typer.Option(
-        help="Worker processes for the sweeps (default: one per core).")] = None,
+        help="Worker processes, each continuing its share of the sweeps with one thread "
+        "(default: one per core; 1: all sweeps together in this process, on every core).")] = None,
     out: Annotated[Path, typer.Option(help="Output folder.")] = Path("out/reproduce"),
     quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No progress bar.")] = False,
 ) -> None:

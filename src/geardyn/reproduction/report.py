@@ -101,9 +101,12 @@ def build_report(results: Results, figures: Mapping[tuple[str, str], dict[str, P
         f"{a['setting_stop']:g}; every case swept up and down by continuation (each point "
         "starts from the previous point's final state)",
         (f"transient per point: until the Poincare point repeats to {a['setting_converge']:g} "
-         f"(at least {min(a['setting_min_transient'], a['setting_transient']):g}, at most "
-         f"{a['setting_transient']:g} tau)" if a.get("setting_converge")
-         else f"transient {a['setting_transient']:g} tau per point")
+         f"(a continued point: at least {min(a['setting_min_transient'], a['setting_transient']):g}"
+         f" tau, at most {a['setting_transient']:g} tau; the first point of a sweep, a cold "
+         f"start: at least {a['setting_transient']:g} tau; a continued point under load noise "
+         "at an Omega incommensurate with Lambda has no section to test and runs "
+         f"{min(a['setting_min_transient'], a['setting_transient']):g} tau)"
+         if a.get("setting_converge") else f"transient {a['setting_transient']:g} tau per point")
         + f", then {a['setting_samples']} Poincare points (once per mesh period, or per common "
         "period of Omega and Lambda under load noise)",
         f"largest Lyapunov exponent where no period is found: {a['setting_lyapunov_transient']:g}"
@@ -181,8 +184,7 @@ def build_report(results: Results, figures: Mapping[tuple[str, str], dict[str, P
             hyst = hysteresis(ds)
             shared = ds.attrs.get("shared_with")
             doc.para(f"**{i}**" + (f" (same motion as {shared}, computed once)" if shared
-                                   else f" (up {ds.attrs['wall_time_up_s']:.1f} s, down "
-                                        f"{ds.attrs['wall_time_down_s']:.1f} s)"))
+                                   else ""))
             doc.bullets(["up sweep: " + "; ".join(_motion_summary(up)),
                          "hysteresis (up and down sweeps differ in motion class): Omega = "
                          + format_intervals(hyst["class"], limit=8),
@@ -197,16 +199,29 @@ def build_report(results: Results, figures: Mapping[tuple[str, str], dict[str, P
 
     doc.heading("Run time")
     rows = []
-    total = 0.0
+    steps = 0
+    lyap = 0.0
+    joint: set[tuple[float, int]] = set()
     for (case_name, i), ds in results.items():
         if ds.attrs.get("shared_with"):
             rows.append([case_name, i, "-", "-", f"shared with {ds.attrs['shared_with']}"])
             continue
-        up_s, down_s = ds.attrs["wall_time_up_s"], ds.attrs["wall_time_down_s"]
-        total += up_s + down_s
-        rows.append([case_name, i, f"{up_s:.1f}", f"{down_s:.1f}", ""])
-    doc.table(["case", "interpretation", "up [s]", "down [s]", "note"], rows)
-    doc.para(f"Total sweep time {total:.1f} s (figures and files not included).")
+        a_ = ds.attrs
+        steps += a_["lane_steps_up"] + a_["lane_steps_down"]
+        lyap += a_["lyapunov_time_up_s"] + a_["lyapunov_time_down_s"]
+        joint |= {(a_[f"continuation_time_{d}_s"], a_[f"continued_with_{d}"])
+                  for d in DIRECTIONS}
+        rows.append([case_name, i, f"{(a_['lane_steps_up'] + a_['lane_steps_down']) / 1e6:.1f}",
+                     f"{a_['lyapunov_time_up_s'] + a_['lyapunov_time_down_s']:.1f}", ""])
+    doc.table(["case", "interpretation", "sweep work up + down [1e6 RK4 steps]",
+               "Lyapunov up + down [s]", "note"], rows)
+    groups = sorted(joint, reverse=True)
+    doc.para(f"The sweeps were continued together, in {len(groups)} group(s) (of "
+             f"{', '.join(str(n) for _, n in groups)} sweeps; a group's points advance as the "
+             "lanes of one kernel call, groups run in parallel processes): continuation "
+             + ", ".join(f"{t:.1f} s" for t, _ in groups) + f" wall for {steps / 1e6:.0f}e6 "
+             f"RK4 steps in all; Lyapunov exponents {lyap:.1f} s of computing (figures and "
+             "files not included).")
     return doc
 
 

@@ -16,7 +16,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 import xarray as xr
 
-from geardyn.analysis.bifurcation import bifurcation
+from geardyn.analysis.bifurcation import ContinuedSweep, continued_sweeps
 from geardyn.analysis.lyapunov import lyapunov_lanes
 from geardyn.models.base import Model
 from geardyn.reproduction.cases import Case
@@ -44,18 +44,22 @@ class ReproductionSettings:
     last stroboscopic sample at that point; ``lyapunov_threshold`` separates chaos. A first
     estimate over ``lyapunov_screen`` (tau) settles the points whose exponent is clearly
     negative (below the threshold by more than ``lyapunov_margin``); only the others, among
-    them every chaotic one, are measured over the full duration."""
+    them every chaotic one, are measured over the full duration. Under load noise a Poincare
+    section is taken where Lambda/Omega = p/q with q <= ``max_section_periods`` (sampling every
+    q mesh periods); at every other Omega the exponent decides (a section every 9-32 periods,
+    which the grid hits by accident at a few points, would cost 64 x q periods per point)."""
 
     num: int | None = None
     transient: float | None = None
     samples: int | None = None
     converge: float | None = 1.0e-8
-    min_transient: float = 1000.0
-    lyapunov_transient: float = 300.0
+    min_transient: float = 200.0
+    lyapunov_transient: float = 100.0
     lyapunov_duration: float = 1500.0
     lyapunov_threshold: float = LYAPUNOV_CHAOS
-    lyapunov_screen: float = 500.0
+    lyapunov_screen: float = 200.0
     lyapunov_margin: float = 0.01
+    max_section_periods: int = 8
 
     def __post_init__(self) -> None:
         checks = (("num", self.num, 2), ("samples", self.samples, 2))
@@ -92,6 +96,7 @@ class ReproductionSettings:
             "lyapunov_threshold": float(self.lyapunov_threshold),
             "lyapunov_screen": float(self.lyapunov_screen),
             "lyapunov_margin": float(self.lyapunov_margin),
+            "max_section_periods": int(self.max_section_periods),
         }
 
 
@@ -129,26 +134,63 @@ def branch_lyapunov(model: Model, values: np.ndarray, y0: np.ndarray, need: np.n
     return out
 
 
-def _one_direction(model: Model, values: np.ndarray, direction: str, r: dict,
-                   steps_per_period: int | None, progress: Callable[[int, int], None] | None
-                   ) -> xr.Dataset:
+def _sweeps(tasks: list[tuple[Case, str, str]], settings: ReproductionSettings,
+            progress: Progress | None = None) -> list[xr.Dataset]:
+    """The sweeps ``(case, interpretation, direction)``, continued together (their points
+    advance as lanes of one kernel call; see :func:`geardyn.analysis.bifurcation.continued_sweeps`),
+    then each classified, with Lyapunov exponents where no period is found. A unit of work:
+    the arguments pickle, for worker processes."""
     start = time.perf_counter()
-    if r["converge"] > 0:
-        transient = {"transient": min(r["min_transient"], r["transient"]),
-                     "transient_max": r["transient"], "converge": r["converge"]}
-    else:
-        transient = {"transient": r["transient"]}
-    ds = bifurcation(model, "Omega", values, samples=r["samples"], continuation=direction,
-                     steps_per_period=steps_per_period, progress=progress, **transient)
+    plans = []
+    for case, interp, direction in tasks:
+        r = settings.resolve(case)
+        model = case.study.build_model(interpretation=interp)
+        sweep = ContinuedSweep(
+            model, "Omega", sweep_values(case, settings), direction, transient=r["transient"],
+            continued_transient=min(r["min_transient"], r["transient"]),
+            transient_max=r["transient"], steps_per_period=case.study.run.steps_per_period)
+        plans.append((sweep, r))
+    case0, interp0, _ = tasks[0]
+    label = (f"{case0.name} {interp0} up and down" if len(tasks) == 2
+             else f"{len(tasks)} sweeps together")
+
+    def tick(done: int, total: int) -> None:
+        if progress is not None:
+            progress(label, done, total)
+
+    swept: list[xr.Dataset] = [xr.Dataset()] * len(tasks)
+    groups: dict[tuple[int, float], list[int]] = {}
+    for i, (_, r) in enumerate(plans):
+        groups.setdefault((r["samples"], r["converge"]), []).append(i)
+    for (samples, converge), members in groups.items():
+        done = continued_sweeps([plans[i][0] for i in members], samples=samples,
+                                converge=converge or None, progress=tick,
+                                max_section_periods=settings.max_section_periods)
+        for i, ds in zip(members, done, strict=True):
+            swept[i] = ds
+    joint = time.perf_counter() - start
+    out = []
+    for ds, (sweep, r) in zip(swept, plans, strict=True):
+        ds = _classify(ds, sweep, r)
+        ds.attrs.update(continuation_wall_time_s=joint, continued_with=len(tasks))
+        out.append(ds)
+    return out
+
+
+def _classify(ds: xr.Dataset, sweep: ContinuedSweep, r: dict) -> xr.Dataset:
+    """``ds`` with the Lyapunov exponent where no period is found, and the motion class."""
+    start = time.perf_counter()
+    model, values = sweep.model, np.asarray(sweep.values, dtype=float)
     period = ds["period"].values
     final = ds["poincare"].values[:, -1, :]
     need = period == 0
     lam = branch_lyapunov(model, values, final, need, r["lyapunov_transient"],
-                          min(r["lyapunov_screen"], r["lyapunov_duration"]), steps_per_period)
+                          min(r["lyapunov_screen"], r["lyapunov_duration"]),
+                          sweep.steps_per_period)
     again = need & ~(lam < r["lyapunov_threshold"] - r["lyapunov_margin"])
     if r["lyapunov_screen"] < r["lyapunov_duration"] and again.any():
         lam[again] = branch_lyapunov(model, values, final, again, r["lyapunov_transient"],
-                                     r["lyapunov_duration"], steps_per_period)[again]
+                                     r["lyapunov_duration"], sweep.steps_per_period)[again]
     ds["lyapunov"] = ("Omega", lam, {
         "long_name": "largest Lyapunov exponent", "units": "1/tau",
         "computed_where": "no period found (period == 0); clearly negative ones over the "
@@ -157,45 +199,44 @@ def _one_direction(model: Model, values: np.ndarray, direction: str, r: dict,
     ds["motion"] = ("Omega", motion_labels(period, lam, r["lyapunov_threshold"]), {
         "long_name": "motion class", "meaning": "period-k, chaotic, quasi-periodic, "
         "non-periodic (no exponent), unbounded; see geardyn.reproduction.motion"})
-    ds.attrs["wall_time_s"] = time.perf_counter() - start
+    ds.attrs["lyapunov_wall_time_s"] = time.perf_counter() - start
+    steps = ds["steps_per_period"].values * (ds["transient_periods"].values
+                                             + r["samples"] * ds["section_periods"].values)
+    ds.attrs["lane_steps"] = int(np.sum(steps))
     return ds
-
-
-def _sweep(case: Case, interpretation: str, direction: str, settings: ReproductionSettings,
-           progress: Progress | None = None) -> xr.Dataset:
-    """One direction of one case (a unit of work; picklable arguments for worker processes)."""
-    model = case.study.build_model(interpretation=interpretation)
-    stage = f"{case.name} {interpretation} {direction}"
-
-    def tick(done: int, total: int) -> None:
-        if progress is not None:
-            progress(stage, done, total)
-
-    return _one_direction(model, sweep_values(case, settings), direction,
-                          settings.resolve(case), case.study.run.steps_per_period, tick)
 
 
 def _assemble(case: Case, interpretation: str, settings: ReproductionSettings,
               parts: dict[str, xr.Dataset]) -> xr.Dataset:
     """The up and down sweeps of ``case`` as one case result (see the module docs)."""
-    walls = {}
+    per_direction: dict[str, dict] = {}
     ordered = []
     for direction in DIRECTIONS:
         ds = parts[direction].copy()
-        walls[direction] = float(ds.attrs.pop("wall_time_s"))
+        per_direction[direction] = {k: ds.attrs.pop(k) for k in (
+            "lyapunov_wall_time_s", "lane_steps", "continuation_wall_time_s",
+            "continued_with")}
         ds.attrs.pop("continuation", None)
         ordered.append(ds)
     out = xr.concat(ordered, dim="sweep", combine_attrs="drop_conflicts")
     out = out.assign_coords(sweep=("sweep", list(DIRECTIONS)))
     model = case.study.build_model(interpretation=interpretation)
     loads = case.params.loads
+    up, down = per_direction["up"], per_direction["down"]
     out.attrs.update(
         {f"setting_{k}": v for k, v in settings.resolve(case).items()},
-        interpretation=interpretation, wall_time_up_s=walls["up"],
-        wall_time_down_s=walls["down"], B1=float(loads.B1), B2=float(loads.B2),
-        Lambda=float(loads.Lambda),
-        section="load fluctuation at Lambda: every common period where Lambda/Omega is a "
-        "simple ratio (section_periods), elsewhere no section: the Lyapunov exponent decides"
+        interpretation=interpretation,
+        lane_steps_up=up["lane_steps"], lane_steps_down=down["lane_steps"],
+        lyapunov_time_up_s=float(up["lyapunov_wall_time_s"]),
+        lyapunov_time_down_s=float(down["lyapunov_wall_time_s"]),
+        continuation_time_up_s=float(up["continuation_wall_time_s"]),
+        continuation_time_down_s=float(down["continuation_wall_time_s"]),
+        continued_with_up=int(up["continued_with"]),
+        continued_with_down=int(down["continued_with"]),
+        B1=float(loads.B1), B2=float(loads.B2), Lambda=float(loads.Lambda),
+        section="load fluctuation at Lambda: every common period where Lambda/Omega = p/q with "
+        f"q <= {settings.max_section_periods} (section_periods), elsewhere no section: the "
+        "Lyapunov exponent decides"
         if case.load_noise else "stroboscopic, once per mesh period",
         params_json=case.params.model_dump_json(),
         static_deflection=[float(g) for g in model.static_forces()[:2]],
@@ -206,14 +247,15 @@ def _assemble(case: Case, interpretation: str, settings: ReproductionSettings,
 def run_case(case: Case, interpretation: str = "consistent",
              settings: ReproductionSettings | None = None,
              progress: Progress | None = None) -> xr.Dataset:
-    """Sweep ``case`` in Omega, continued up and down, and classify every point.
+    """Sweep ``case`` in Omega, continued up and down (both together), and classify every
+    point.
 
     Returns the dataset described in the module docs; its attributes name the case, the
-    interpretation, the settings used, how the Poincare section is taken (``section``) and the
-    wall time of each direction."""
+    interpretation, the settings used, how the Poincare section is taken (``section``), the
+    integration work of each direction and the wall times."""
     settings = settings or ReproductionSettings()
-    parts = {d: _sweep(case, interpretation, d, settings, progress) for d in DIRECTIONS}
-    return _assemble(case, interpretation, settings, parts)
+    parts = _sweeps([(case, interpretation, d) for d in DIRECTIONS], settings, progress)
+    return _assemble(case, interpretation, settings, dict(zip(DIRECTIONS, parts, strict=True)))
 
 
 def label_case(ds: xr.Dataset, case: Case) -> xr.Dataset:
@@ -238,9 +280,11 @@ def run_cases(cases: Iterable[Case], interpretations: Iterable[str],
     """:func:`run_case` for every case and interpretation, keyed ``(case name,
     interpretation)``; cases with the same dynamics (Figs. 3 and 6, ...) run once.
 
-    ``workers`` > 1 runs the sweeps (two per distinct case: a continuation is one lane after
-    another, so one sweep keeps one core busy) in that many worker processes; the results are
-    those of a serial run. ``progress`` then reports finished sweeps."""
+    All sweeps (two per distinct case) are continued together, their points advancing as the
+    lanes of one kernel call on all numba threads. ``workers`` > 1 splits them into that many
+    groups, each continued in its own worker process with one thread (a group waits at each
+    point for its slowest lane, so a few independent groups keep the cores busier). Lanes do not
+    interact, so the results are bitwise those of a serial run, whatever the grouping."""
     settings = settings or ReproductionSettings()
     cases = list(cases)
     first: dict[str, tuple[Case, str]] = {}
@@ -251,23 +295,28 @@ def run_cases(cases: Iterable[Case], interpretations: Iterable[str],
             first.setdefault(key, (case, interp))
             owner[(case.name, interp)] = key
     tasks = [(key, d) for key in first for d in DIRECTIONS]
+    groups = _split(tasks, first, workers)
     parts: dict[tuple[str, str], xr.Dataset] = {}
-    if workers <= 1:
-        for key, d in tasks:
-            parts[(key, d)] = _sweep(*first[key], d, settings, progress)
+    if len(groups) <= 1:
+        for ds, task in zip(_sweeps([(*first[k], d) for k, d in tasks], settings, progress),
+                            tasks, strict=True):
+            parts[task] = ds
     else:
         import multiprocessing
         from concurrent.futures import ProcessPoolExecutor, as_completed
 
         ctx = multiprocessing.get_context("spawn")  # no fork of numba's thread pool
-        with ProcessPoolExecutor(max_workers=workers, mp_context=ctx,
+        with ProcessPoolExecutor(max_workers=len(groups), mp_context=ctx,
                                  initializer=_one_thread) as pool:
-            futures = {pool.submit(_sweep, *first[key], d, settings): (key, d)
-                       for key, d in tasks}
-            for n, fut in enumerate(as_completed(futures), start=1):
-                parts[futures[fut]] = fut.result()
+            futures = {pool.submit(_sweeps, [(*first[k], d) for k, d in g], settings): g
+                       for g in groups}
+            finished = 0
+            for fut in as_completed(futures):
+                for task, ds in zip(futures[fut], fut.result(), strict=True):
+                    parts[task] = ds
+                finished += len(futures[fut])
                 if progress is not None:
-                    progress(f"sweeps in {workers} processes", n, len(tasks))
+                    progress(f"sweeps in {len(groups)} processes", finished, len(tasks))
     done = {key: _assemble(*first[key], settings, {d: parts[(key, d)] for d in DIRECTIONS})
             for key in first}
     out: dict[tuple[str, str], xr.Dataset] = {}
@@ -278,3 +327,18 @@ def run_cases(cases: Iterable[Case], interpretations: Iterable[str],
             ds.attrs["shared_with"] = done[key].attrs["case"]
         out[(name, interp)] = ds
     return out
+
+
+def _split(tasks: list[tuple[str, str]], first: dict[str, tuple[Case, str]], workers: int
+           ) -> list[list[tuple[str, str]]]:
+    """``tasks`` in at most ``workers`` groups of about equal estimated cost (a load-noise case
+    needs Lyapunov exponents almost everywhere: counted three times), longest first."""
+    n = max(1, min(workers, len(tasks)))
+    cost = [3.0 if first[k][0].load_noise else 1.0 for k, _ in tasks]
+    load = [0.0] * n
+    groups: list[list[tuple[str, str]]] = [[] for _ in range(n)]
+    for i in sorted(range(len(tasks)), key=lambda i: -cost[i]):
+        g = load.index(min(load))
+        groups[g].append(tasks[i])
+        load[g] += cost[i]
+    return [g for g in groups if g]

@@ -27,7 +27,10 @@ Numerics
   are aligned when measuring starts.
 * A lane whose state leaves ``|y| <= bound`` (checked at each renormalisation) or whose tangent
   vectors stop being finite is marked diverged (status 1) and its exponents are NaN.
-* Cost per step: (2 k + 1) RK4 steps for k tangent vectors.
+* Cost per step: (2 k + 1) RK4 steps for k tangent vectors. They are independent integrations
+  of one grid step, so they run as the rows of one lockstep block (their RK4 stages interleaved,
+  the model's functions inlined once), which overlaps their dependency chains; each row's
+  arithmetic is that of a lone step, so the result does not depend on it.
 """
 
 from __future__ import annotations
@@ -41,8 +44,9 @@ from geardyn.solvers._step_core import (  # CORE-IMPORT
     _JIT,
     STATUS_DIVERGED,
     STATUS_OK,
+    _events_i,
     _healthy,
-    _rk4,
+    _rhs_i,
     _side,
     _split_step,
     phase_table,
@@ -58,70 +62,100 @@ __all__ = ["events", "lyapunov_lanes", "lyapunov_single", "observe", "phase_tabl
 
 
 @nb.njit(**_JIT)
-def _grid_step(i, y, p, h, omega, n_per, sa, ca, sb, cb, se, ce, n_ev, W, side, g0, g1, gbuf,
-               ncross):
-    """Advance y (in place) by grid step i (time i h to (i + 1) h): one RK4 step, or, with
-    ``n_ev`` switching functions of which one changes side, the step split at the located
-    crossings, as the main solver does (:func:`_split_step`)."""
+def _grid_step_rows(i, Y, p, h, omega, n_per, s_tab, c_tab, n_ev, K, TMP, Y1, SIDE, G0, G1, W,
+                    gbuf, ncross):
+    """Advance every row of Y (independent states of one lane) by grid step i (time i h to
+    (i + 1) h): one RK4 step per row, the rows' stages interleaved; a row whose trial step
+    changes the side of a switching function is redone with the crossings located
+    (:func:`_split_step`), as the main solver does."""
+    nr, ns = Y.shape
     t = i * h
+    hh = 0.5 * h
+    j0 = 2 * (i % n_per)
     if n_ev > 0:
-        events(t, y, g0, p)
-        for j in range(n_ev):
-            side[j] = _side(g0[j])
-    ytrial = W[7]
-    _rk4(t, y, h, p, sa, ca, sb, cb, se, ce, W[0], W[1], W[2], W[3], W[4], ytrial, False)
-    crossed = False
-    if n_ev > 0:
-        events(t + h, ytrial, g1, p)
-        for j in range(n_ev):
-            if _side(g1[j]) != side[j]:
-                crossed = True
-    if crossed:
-        _split_step(i, 0.0, y, ytrial, p, h, omega, n_per, side, g1, ncross, W, W[8], gbuf)
-    else:
-        for q in range(y.size):
-            y[q] = ytrial[q]
+        for r in range(nr):
+            _events_i(t, Y[r], G0[r], p)
+            for j in range(n_ev):
+                SIDE[r, j] = _side(G0[r, j])
+    for st in range(4):
+        if st == 0:
+            ts = t
+            jj = j0
+        elif st < 3:
+            ts = t + hh
+            jj = j0 + 1
+        else:
+            ts = t + h
+            jj = j0 + 2
+        a = h if st == 3 else hh
+        for r in range(nr):
+            if st > 0:
+                for q in range(ns):
+                    TMP[r, q] = Y[r, q] + a * K[st - 1, r, q]
+            _rhs_i(ts, Y[r] if st == 0 else TMP[r], K[st, r], p, s_tab[jj], c_tab[jj])
+    h6 = h / 6.0
+    for r in range(nr):
+        for q in range(ns):
+            Y1[r, q] = Y[r, q] + h6 * (K[0, r, q] + 2.0 * K[1, r, q] + 2.0 * K[2, r, q]
+                                       + K[3, r, q])
+    for r in range(nr):
+        crossed = False
+        if n_ev > 0:
+            _events_i(t + h, Y1[r], G1[r], p)
+            for j in range(n_ev):
+                if _side(G1[r, j]) != SIDE[r, j]:
+                    crossed = True
+        if crossed:
+            _split_step(i, 0.0, Y[r], Y1[r], p, h, omega, n_per, SIDE[r], G1[r], ncross, W,
+                        W[8], gbuf)
+        else:
+            for q in range(ns):
+                Y[r, q] = Y1[r, q]
 
 
 @nb.njit(**_JIT)
-def _tangent_step(i, Z, p, h, omega, n_per, s_tab, c_tab, n_ev, W, YP, side, g0, g1, gbuf,
-                  ncross):
+def _tangent_step(i, Z, p, h, omega, n_per, s_tab, c_tab, n_ev, YP, K, TMP, Y1, SIDE, G0, G1, W,
+                  gbuf, ncross):
     """Advance the state (row 0 of Z) by one grid step and each tangent vector v (rows 1..) by
-    the derivative of that step map: (Phi(y + e v) - Phi(y - e v)) / (2 e)."""
+    the derivative of that step map: (Phi(y + e v) - Phi(y - e v)) / (2 e). The 2 k + 1 states
+    are the rows of YP (tangent j: rows 2 j - 2 and 2 j - 1; the state: the last row)."""
     m, ns = Z.shape
-    j0 = 2 * (i % n_per)
-    sa = s_tab[j0]
-    ca = c_tab[j0]
-    sb = s_tab[j0 + 1]
-    cb = c_tab[j0 + 1]
-    se = s_tab[j0 + 2]
-    ce = c_tab[j0 + 2]
     ny = 0.0
     for q in range(ns):
         ny += Z[0, q] * Z[0, q]
     scale = FD_DELTA * (1.0 + math.sqrt(ny))
+    last = 2 * (m - 1)
+    for q in range(ns):
+        YP[last, q] = Z[0, q]
+    E = np.empty(m)
     for j in range(1, m):
         nv = 0.0
         for q in range(ns):
             nv += Z[j, q] * Z[j, q]
         nv = math.sqrt(nv)
         if not (nv > 0.0 and math.isfinite(nv)):
+            E[j] = np.nan  # lost: its rows just follow the state
+            for q in range(ns):
+                YP[2 * j - 2, q] = Z[0, q]
+                YP[2 * j - 1, q] = Z[0, q]
+            continue
+        e = scale / nv
+        E[j] = e
+        for q in range(ns):
+            YP[2 * j - 2, q] = Z[0, q] + e * Z[j, q]
+            YP[2 * j - 1, q] = Z[0, q] - e * Z[j, q]
+    _grid_step_rows(i, YP, p, h, omega, n_per, s_tab, c_tab, n_ev, K, TMP, Y1, SIDE, G0, G1, W,
+                    gbuf, ncross)
+    for j in range(1, m):
+        if not math.isfinite(E[j]):
             for q in range(ns):
                 Z[j, q] = np.nan
             continue
-        e = scale / nv
+        inv = 0.5 / E[j]
         for q in range(ns):
-            YP[0, q] = Z[0, q] + e * Z[j, q]
-            YP[1, q] = Z[0, q] - e * Z[j, q]
-        _grid_step(i, YP[0], p, h, omega, n_per, sa, ca, sb, cb, se, ce, n_ev, W, side, g0, g1,
-                   gbuf, ncross)
-        _grid_step(i, YP[1], p, h, omega, n_per, sa, ca, sb, cb, se, ce, n_ev, W, side, g0, g1,
-                   gbuf, ncross)
-        inv = 0.5 / e
-        for q in range(ns):
-            Z[j, q] = (YP[0, q] - YP[1, q]) * inv
-    _grid_step(i, Z[0], p, h, omega, n_per, sa, ca, sb, cb, se, ce, n_ev, W, side, g0, g1, gbuf,
-               ncross)
+            Z[j, q] = (YP[2 * j - 2, q] - YP[2 * j - 1, q]) * inv
+    for q in range(ns):
+        Z[0, q] = YP[last, q]
 
 
 @nb.njit(**_JIT)
@@ -158,11 +192,15 @@ def _run(p, y0, h, omega, n_per, s_tab, c_tab, n_transient, n_steps, renorm_ever
     m = k + 1
     Z = np.zeros((m, ns))
     W = np.zeros((9, ns))
-    YP = np.zeros((2, ns))
+    nr = 2 * k + 1
+    YP = np.zeros((nr, ns))
+    K = np.zeros((4, nr, ns))
+    TMP = np.zeros((nr, ns))
+    Y1 = np.zeros((nr, ns))
     ne = max(n_ev, 1)
-    side = np.ones(ne, np.int64)
-    g0 = np.zeros(ne)
-    g1 = np.zeros(ne)
+    SIDE = np.ones((nr, ne), np.int64)
+    G0 = np.zeros((nr, ne))
+    G1 = np.zeros((nr, ne))
     gbuf = np.zeros((3, ne))
     ncross = np.zeros(ne, np.int64)
     acc = np.zeros(k)
@@ -178,8 +216,8 @@ def _run(p, y0, h, omega, n_per, s_tab, c_tab, n_transient, n_steps, renorm_ever
     total = n_transient + n_steps
     since = 0
     for i in range(total):
-        _tangent_step(i, Z, p, h, omega, n_per, s_tab, c_tab, n_ev, W, YP, side, g0, g1, gbuf,
-                      ncross)
+        _tangent_step(i, Z, p, h, omega, n_per, s_tab, c_tab, n_ev, YP, K, TMP, Y1, SIDE, G0, G1,
+                      W, gbuf, ncross)
         since += 1
         step = i + 1
         if since == renorm or step == n_transient or step == total:

@@ -29,6 +29,17 @@ def ladder_steps(n: int) -> int:
     return int(_LADDER[min(idx, _LADDER.size - 1)]) if idx < _LADDER.size else int(n)
 
 
+def lane_steps_per_period(model: Model, P: np.ndarray) -> np.ndarray:
+    """Default steps per forcing period of each lane (row of ``P``), rounded up to the ladder:
+    :func:`~geardyn.solvers.simulate.default_steps_per_period` at the lane's Omega and with the
+    lane's other forcings."""
+    P = np.atleast_2d(P)
+    omega = P[:, model.omega_index]
+    others = model.other_frequencies(P)
+    return np.array([ladder_steps(default_steps_per_period(model, float(w), o))
+                     for w, o in zip(omega, others, strict=True)], dtype=np.int64)
+
+
 @dataclass
 class LaneResults:
     """Raw per-lane results of :func:`run_lanes` (arrays indexed by lane)."""
@@ -55,20 +66,22 @@ def run_lanes(
     model: Model,
     P: np.ndarray,
     y0: np.ndarray,
-    transient: float,
+    transient: float | np.ndarray,
     samples: int,
-    steps_per_period: int | None = None,
+    steps_per_period: int | np.ndarray | None = None,
     sample_every: int | np.ndarray | str = "auto",
     locate_edges: bool = True,
     bound: float = DEFAULT_BOUND,
     t0: np.ndarray | None = None,
-    transient_max: float | None = None,
+    transient_max: float | np.ndarray | None = None,
     converge_tol: float = 0.0,
     converge_depth: int = 16,
+    max_section_periods: int | None = None,
 ) -> LaneResults:
     """Integrate one lane per row of ``P`` (coefficient vectors) from ``y0`` (one state, or one
     per lane) and return stroboscopic samples (one every ``sample_every`` forcing periods) and
     statistics over the sampled stretch. ``t0``: per-lane start times (whole periods);
+    ``transient``, ``transient_max``, ``steps_per_period`` (<= 0: automatic) and
     ``sample_every`` may differ per lane; ``"auto"`` samples at the common period of the
     forcings when the model has a second, commensurate excitation
     (:func:`~geardyn.analysis.periodicity.common_section`), else every period. The transient is
@@ -77,7 +90,11 @@ def run_lanes(
     Transient by convergence: with ``converge_tol > 0`` the transient (then a minimum) goes on,
     one sampling interval at a time up to ``transient_max`` (default 10 x transient), until the
     section point repeats one of the last ``converge_depth`` to within
-    ``converge_tol (1 + |point|)``; ``converged`` tells per lane whether it did."""
+    ``converge_tol (1 + |point|)``; ``converged`` tells per lane whether it did.
+
+    ``max_section_periods``: with ``"auto"``, the longest common period (in forcing periods)
+    taken as a section (default that of :func:`~geardyn.analysis.periodicity.common_section`,
+    32); a lane whose forcings repeat only over more is treated as incommensurate."""
     P = np.ascontiguousarray(np.atleast_2d(P), dtype=float)
     L = P.shape[0]
     ns = model.n_states
@@ -93,20 +110,25 @@ def run_lanes(
             raise ValueError(f"sample_every must be 'auto' or >= 1 (got {sample_every!r})")
         from geardyn.analysis.periodicity import common_section
 
-        sample_every, commensurate = common_section(omega, model.other_frequencies(P))
+        limit = {} if max_section_periods is None else {"max_periods": int(max_section_periods)}
+        sample_every, commensurate = common_section(omega, model.other_frequencies(P), **limit)
     else:
         commensurate = np.ones(L, bool)
     if samples < 1 or np.any(np.asarray(sample_every) < 1):
         raise ValueError("samples and sample_every must be >= 1")
-    if steps_per_period is None:
-        n_lane = np.array([ladder_steps(default_steps_per_period(model, w)) for w in omega])
-    else:
-        n_lane = np.full(L, int(steps_per_period))
+    given = np.broadcast_to(np.asarray(0 if steps_per_period is None else steps_per_period,
+                                       dtype=np.int64), (L,))
+    n_lane = given.copy()
+    auto = n_lane <= 0
+    if np.any(auto):
+        n_lane[auto] = lane_steps_per_period(model, P[auto])
     period = 2.0 * math.pi / omega
     every = np.broadcast_to(np.asarray(sample_every, dtype=np.int64), (L,))
+    transient = np.broadcast_to(np.asarray(transient, dtype=float), (L,))
     n_tr_periods = _whole(np.ceil(transient / period - 1e-9), every)
     if transient_max is None:
         transient_max = 10.0 * transient
+    transient_max = np.broadcast_to(np.asarray(transient_max, dtype=float), (L,))
     n_max_periods = np.maximum(_whole(np.floor(transient_max / period + 1e-9), every),
                                n_tr_periods)
     if converge_tol < 0 or converge_depth < 1:

@@ -14,19 +14,32 @@ from geardyn.solvers.kernels import kernels_for
 MIN_STEPS_PER_PERIOD = 64
 #: Default largest step as a fraction of the period of the model's fastest natural mode.
 STEPS_PER_FASTEST_MODE = 100
+#: Fewest steps per period of a forcing other than Omega (the CATT load fluctuation Lambda):
+#: at 8 the error of a response forced at Lambda = 40 (far above every natural frequency) is
+#: about 1e-7 of the motion, like that of the natural-mode rule (docs/numerics.md).
+STEPS_PER_OTHER_FORCING = 8
 #: States beyond this magnitude count as diverged.
 DEFAULT_BOUND = 1.0e6
 
 
-def default_steps_per_period(model: Model, omega: float | None = None) -> int:
-    """Steps per forcing period: at least ``MIN_STEPS_PER_PERIOD``, and enough that a step is at
+def default_steps_per_period(model: Model, omega: float | None = None,
+                             others: np.ndarray | None = None) -> int:
+    """Steps per forcing period: at least ``MIN_STEPS_PER_PERIOD``, enough that a step is at
     most 1/``STEPS_PER_FASTEST_MODE`` of the fastest natural period (when the model knows its
-    natural frequencies). See ``docs/numerics.md`` for the resulting accuracy."""
+    natural frequencies), and at least ``STEPS_PER_OTHER_FORCING`` per period of every other
+    forcing acting (``others``, rad per time unit; default the model's own,
+    :meth:`~geardyn.Model.other_frequencies`). See ``docs/numerics.md`` for the accuracy."""
     omega = model.omega if omega is None else omega
     n = MIN_STEPS_PER_PERIOD
     w_max = _fastest_mode(model)
     if omega and w_max:
         n = max(n, math.ceil(STEPS_PER_FASTEST_MODE * w_max / omega))
+    if omega:
+        f = (model.other_frequencies(model.params[None, :])[0] if others is None
+             else np.asarray(others, dtype=float).ravel())
+        f = np.abs(f[np.isfinite(f)])
+        if f.size and f.max() > 0:
+            n = max(n, math.ceil(STEPS_PER_OTHER_FORCING * float(f.max()) / omega))
     return int(n)
 
 

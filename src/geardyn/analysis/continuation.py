@@ -1,0 +1,143 @@
+"""Sequential continuation: each point of a branch starts from the final state (and time) of
+the previous one, so a sweep follows one attractor and shows hysteresis.
+
+A branch is inherently sequential, but several branches (a sweep up and one down, or the
+sweeps of several studies) are independent of each other: :func:`continue_branches` advances
+all of them together, point ``j`` of every branch as one lane of one
+:func:`~geardyn.solvers.ensemble.run_lanes` call. The lanes then share lockstep blocks and
+threads instead of running one after another; each branch's result is bitwise the one it gets
+alone (lanes do not interact).
+
+A continued point starts next to its attractor, so it needs a far shorter transient than a cold
+start: ``continued_transient`` is its minimum, and the transient goes on until the Poincare
+point repeats (``converge``), up to ``transient_max``. A point with a second excitation at an
+incommensurate frequency has no stroboscopic section that could repeat, so it cannot be tested:
+it runs ``continued_transient`` only when continued, ``transient_max`` when cold. A cold start is
+the first point of a branch, and any point after one whose integration diverged (the branch
+restarts from its initial state).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from geardyn.analysis.periodicity import common_section
+from geardyn.models.base import Model
+from geardyn.solvers.ensemble import LaneResults, lane_steps_per_period, run_lanes
+from geardyn.solvers.kernels import kernels_for
+from geardyn.solvers.simulate import DEFAULT_BOUND
+
+__all__ = ["Branch", "concat_lanes", "continue_branches"]
+
+
+@dataclass(frozen=True)
+class Branch:
+    """One continuation branch: ``P`` (points, coefficients), the model's lane coefficient
+    vectors in the order the branch visits them; ``y0`` the initial state of a cold start;
+    transients in model time units (see the module docs); ``steps_per_period`` None: the
+    model's default at each point; ``max_section_periods`` as in
+    :func:`~geardyn.solvers.ensemble.run_lanes`."""
+
+    model: Model
+    P: np.ndarray
+    y0: np.ndarray
+    transient: float
+    continued_transient: float | None = None
+    transient_max: float | None = None
+    steps_per_period: int | None = None
+    max_section_periods: int | None = None
+    commensurate: np.ndarray = field(init=False, repr=False)
+    steps: np.ndarray = field(init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        P = np.atleast_2d(np.asarray(self.P, dtype=float))
+        object.__setattr__(self, "P", P)
+        object.__setattr__(self, "y0", np.asarray(self.y0, dtype=float))
+        omega = P[:, self.model.omega_index]
+        limit = ({} if self.max_section_periods is None
+                 else {"max_periods": int(self.max_section_periods)})
+        object.__setattr__(self, "commensurate",
+                           common_section(omega, self.model.other_frequencies(P), **limit)[1])
+        steps = (np.full(omega.size, int(self.steps_per_period), dtype=np.int64)
+                 if self.steps_per_period else lane_steps_per_period(self.model, P))
+        object.__setattr__(self, "steps", steps)
+
+    def transients(self, j: int, cold: bool, converge: bool) -> tuple[float, float]:
+        """(minimum, maximum) transient of point ``j``."""
+        longest = (self.transient_max if self.transient_max is not None
+                   else 10.0 * self.transient) if converge else self.transient
+        if cold:
+            return (self.transient if self.commensurate[j] else longest), longest
+        short = self.transient if self.continued_transient is None else self.continued_transient
+        if not converge or not self.commensurate[j]:
+            return short, short
+        return short, max(short, longest)
+
+
+def concat_lanes(parts: Sequence[LaneResults]) -> LaneResults:
+    """Lane results one after another."""
+    fields = LaneResults.__dataclass_fields__
+    return LaneResults(**{f: np.concatenate([getattr(r, f) for r in parts]) for f in fields})
+
+
+def _lane(r: LaneResults, i: int) -> LaneResults:
+    return LaneResults(**{f: getattr(r, f)[i : i + 1] for f in LaneResults.__dataclass_fields__})
+
+
+def continue_branches(
+    branches: Sequence[Branch],
+    samples: int,
+    converge: float | None = None,
+    locate_edges: bool = True,
+    bound: float = DEFAULT_BOUND,
+    progress: Callable[[int, int], None] | None = None,
+) -> list[LaneResults]:
+    """Run every branch by continuation, all branches together (see the module docs); the
+    branches must share the model's compiled kernel. Returns one
+    :class:`~geardyn.solvers.ensemble.LaneResults` per branch, its lanes in the branch's
+    order. ``progress(done, total)`` counts points of all branches."""
+    if not branches:
+        return []
+    kernel = kernels_for(branches[0].model.kernel)
+    if any(kernels_for(b.model.kernel) is not kernel for b in branches):
+        raise ValueError("continue_branches: the branches must share one model kernel")
+    sections = {b.max_section_periods for b in branches}
+    if len(sections) > 1:
+        raise ValueError("continue_branches: the branches must share max_section_periods")
+    converge = float(converge or 0.0)
+    n = [b.P.shape[0] for b in branches]
+    total = sum(n)
+    parts: list[list[LaneResults]] = [[] for _ in branches]
+    y = [b.y0 for b in branches]
+    t0 = [0.0 for _ in branches]
+    cold = [True for _ in branches]
+    done = 0
+    for j in range(max(n)):
+        if progress is not None:
+            progress(done, total)
+        live = [i for i, b in enumerate(branches) if j < n[i]]
+        lims = [branches[i].transients(j, cold[i], converge > 0) for i in live]
+        r = run_lanes(branches[live[0]].model, np.stack([branches[i].P[j] for i in live]),
+                      np.stack([np.broadcast_to(y[i], branches[i].y0.shape[-1:]) for i in live]),
+                      transient=np.array([a for a, _ in lims]), samples=samples,
+                      steps_per_period=np.array([branches[i].steps[j] for i in live]),
+                      locate_edges=locate_edges, bound=bound,
+                      t0=np.array([t0[i] for i in live]),
+                      transient_max=np.array([b for _, b in lims]),
+                      converge_tol=converge,
+                      max_section_periods=branches[0].max_section_periods)
+        for k, i in enumerate(live):
+            parts[i].append(_lane(r, k))
+            if converge > 0 and not branches[i].commensurate[j]:
+                parts[i][-1].converged[:] = -1  # no section to test: a fixed transient
+            if r.status[k] == 0:
+                y[i], t0[i], cold[i] = r.final[k], float(r.final_time[k]), False
+            else:  # lost the branch: restart from the initial state
+                y[i], t0[i], cold[i] = branches[i].y0, 0.0, True
+        done += len(live)
+    if progress is not None:
+        progress(total, total)
+    return [concat_lanes(p) for p in parts]

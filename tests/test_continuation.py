@@ -1,0 +1,103 @@
+"""Continuation: several branches continued together, short transients for continued points,
+and the step rule for a fast second forcing."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import geardyn
+from geardyn import ContinuedSweep, continued_sweeps
+from geardyn.analysis.continuation import Branch
+from geardyn.solvers.ensemble import run_lanes
+from geardyn.solvers.simulate import STEPS_PER_OTHER_FORCING, default_steps_per_period
+
+VARIABLES = ("poincare", "period", "converged", "transient_periods", "contact", "force_peak",
+             "status")
+
+
+@pytest.fixture(scope="module")
+def device():
+    return geardyn.CATTDevice(geardyn.PlanetaryParams.paper(xi1=0.1, xi2=0.1))
+
+
+def test_branches_continued_together_equal_each_alone(device):
+    om = np.linspace(0.6, 1.6, 7)
+    stiffer = geardyn.CATTDevice(geardyn.PlanetaryParams.paper(xi1=0.2, xi2=0.2))
+    pair = geardyn.GearPair(zeta=0.05)  # another kernel: its own group
+    sweeps = [ContinuedSweep(device, "Omega", om, "up", transient=300.0,
+                             continued_transient=30.0, transient_max=300.0),
+              ContinuedSweep(device, "Omega", om, "down", transient=300.0,
+                             continued_transient=30.0, transient_max=300.0),
+              ContinuedSweep(stiffer, "Omega", om[:4], "down", transient=200.0),
+              ContinuedSweep(pair, "Omega", om, "up", transient=100.0)]
+    together = continued_sweeps(sweeps, samples=6, converge=1e-8)
+    for sw, ds in zip(sweeps, together, strict=True):
+        alone = geardyn.bifurcation(sw.model, "Omega", sw.values, transient=sw.transient,
+                                    samples=6, continuation=sw.direction, converge=1e-8,
+                                    transient_max=sw.transient_max,
+                                    continued_transient=sw.continued_transient)
+        assert ds.attrs["continuation"] == sw.direction
+        for name in VARIABLES:
+            if name in alone:
+                a, b = ds[name].values, alone[name].values
+                assert np.array_equal(a, b, equal_nan=a.dtype.kind == "f"), name
+    # the points come back in value order, whatever the direction
+    assert together[1]["Omega"].values.tolist() == om.tolist()
+
+
+def test_continued_points_with_short_transients_match_cold_starts(device):
+    # period-1 region with one attractor: every continued point, after a short transient
+    # ended by convergence, sits where a cold start ends after a long fixed transient
+    om = np.linspace(0.3, 0.6, 6)
+    cont = geardyn.bifurcation(device, "Omega", om, transient=1500.0, samples=4,
+                               continuation="up", converge=1e-9, transient_max=1500.0,
+                               continued_transient=20.0)
+    cold = geardyn.bifurcation(device, "Omega", om, transient=1500.0, samples=4)
+    assert cont["converged"].values[1:].tolist() == [1] * 5  # the cold start: no room left
+    periods = 2 * math.pi / om
+    used = cont["transient_periods"].values * periods
+    assert np.all(used[1:] < 1000.0)  # continued: shorter than the cold start's 1500
+    assert used[0] >= 1500.0 - periods[0]
+    scale = float(np.max(np.abs(cold["poincare"].values)))
+    err = np.max(np.abs(cont["poincare"].values - cold["poincare"].values))
+    assert err < 1e-6 * scale
+
+
+def test_incommensurate_continued_points_run_the_short_transient():
+    p = geardyn.PlanetaryParams.paper(xi1=0.1, xi2=0.1, B1=10.0, B2=10.0, Lambda=0.3)
+    m = geardyn.CATTDevice(p)
+    om = np.array([0.3, 0.3 * math.sqrt(2.0), 0.6])  # Lambda/Omega = 1, irrational, 1/2
+    P = m.lane_params("Omega", om)
+    b = Branch(m, P, m.initial_state(), transient=400.0, continued_transient=50.0,
+               transient_max=800.0)
+    assert b.commensurate.tolist() == [True, False, True]
+    assert b.transients(0, cold=True, converge=True) == (400.0, 800.0)
+    assert b.transients(1, cold=True, converge=True) == (800.0, 800.0)  # untestable, cold
+    assert b.transients(1, cold=False, converge=True) == (50.0, 50.0)
+    assert b.transients(2, cold=False, converge=True) == (50.0, 800.0)
+    ds = geardyn.bifurcation(m, "Omega", om, transient=400.0, samples=4, continuation="up",
+                             converge=1e-8, transient_max=800.0, continued_transient=50.0)
+    conv = ds["converged"].values
+    assert conv[1] == -1  # no section to test
+    used = ds["transient_periods"].values[1] * 2 * math.pi / om[1]
+    assert 50.0 <= used < 50.0 + 2 * math.pi / om[1]
+    assert ds["period"].values[1] == 0
+
+
+def test_fast_load_fluctuation_sets_the_step():
+    p = geardyn.PlanetaryParams.paper(xi1=0.1, xi2=0.1, B1=100.0, B2=100.0, Lambda=40.0)
+    m = geardyn.CATTDevice(p, omega=1.0)
+    quiet = geardyn.CATTDevice(geardyn.PlanetaryParams.paper(xi1=0.1, xi2=0.1), omega=1.0)
+    n = default_steps_per_period(m, 1.0)
+    assert n >= STEPS_PER_OTHER_FORCING * 40.0
+    assert n > default_steps_per_period(quiet, 1.0)
+    # the default step against DOP853 at rtol 1e-12: the response to the fast forcing is
+    # resolved to the accuracy the natural-mode rule gives elsewhere
+    r = run_lanes(m, m.lane_params("Omega", [1.0]), m.initial_state(), 60.0, 3)
+    T = 2 * math.pi
+    t_eval = (r.transient_periods[0] + np.arange(1, 4)) * T
+    ref = geardyn.reference_solution(m, m.initial_state(), t_eval)
+    assert np.max(np.abs(r.samples[0] - ref)) < 1e-6 * np.max(np.abs(ref))
