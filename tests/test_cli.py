@@ -342,6 +342,33 @@ def test_plot_redraws_saved_results(tmp_path):
     assert_one_line_error(invoke("plot", other), "RESULT", "not a geardyn")
 
 
+def test_plot_redraws_maps_and_reproduction_cases(tmp_path):
+    from geardyn import map2d
+    from geardyn.io.zarr_store import save_zarr_dataset
+
+    g = GearPair(zeta=0.05, kappa=0.2, Fa=0.2)
+    m = map2d(g, x=("Omega", [0.8, 1.2]), y=("zeta", [0.05, 0.1]), transient=50.0, samples=4)
+    nc = save_dataset(m, tmp_path / "map.nc")
+    save_zarr_dataset(m, tmp_path / "map.zarr")
+    for path in (nc, tmp_path / "map.zarr"):
+        r = invoke("plot", path, "--out", tmp_path / f"{path.suffix[1:]}.png")
+        assert r.returncode == 0, r.stderr
+        assert "map dataset" in r.stdout
+        assert (tmp_path / f"{path.suffix[1:]}.png").read_bytes()[:8] == PNG
+    assert_one_line_error(invoke("plot", nc, "--state", "x"), "--state", "map")
+    # a reproduction case file: the sweeps up and down along "sweep"
+    parts = [bifurcation(g, values=[0.8, 0.95, 1.2], transient=50.0, samples=4,
+                         continuation=d) for d in ("up", "down")]
+    case = xr.concat(parts, dim="sweep", combine_attrs="drop_conflicts")
+    case = case.assign_coords(sweep=("sweep", ["up", "down"]))
+    path = save_dataset(case, tmp_path / "case.nc")
+    r = invoke("plot", path, "--sweep", "down", "--out", tmp_path / "case-down.png")
+    assert r.returncode == 0, r.stderr
+    assert "reproduction dataset" in r.stdout
+    assert (tmp_path / "case-down.png").read_bytes()[:8] == PNG
+    assert_one_line_error(invoke("plot", path, "--sweep", "sideways"), "--sweep")
+
+
 def test_simulate_records_plot_state_and_labels_spectrum(tmp_path):
     nc = tmp_path / "run.nc"
     r = invoke("simulate", "paper_fig3", "--omega", "1.1", "--periods", "4", "--transient",

@@ -54,6 +54,11 @@ class Continuation(StrEnum):
     down = "down"
 
 
+class SweepDirection(StrEnum):
+    up = "up"
+    down = "down"
+
+
 def parse_range(text: str, option: str = "--range") -> tuple[float, float, int]:
     """``START:STOP:NUM`` -> (start, stop, num): NUM >= 2 evenly spaced values, START != STOP."""
     parts = [p.strip() for p in text.split(":")]
@@ -316,20 +321,44 @@ def bifurcation_command(
 
 
 def _dataset_kind(ds) -> str:
-    """``"simulation"`` or ``"bifurcation"`` (what :func:`geardyn.simulate` or
-    :func:`geardyn.bifurcation` returned), else a one-line error."""
+    """``"simulation"``, ``"bifurcation"``, ``"map"`` or ``"reproduction"`` (what
+    :func:`geardyn.simulate`, :func:`geardyn.bifurcation`, :func:`geardyn.map2d` or
+    ``geardyn reproduce`` wrote), else a one-line error."""
     if "poincare" in ds and "time" in ds.dims:
         return "simulation"
     param = ds.attrs.get("param")
     if "poincare" in ds and "period" in ds and param in ds.dims:
-        return "bifurcation"
+        return "reproduction" if "sweep" in ds.dims else "bifurcation"
+    if "period" in ds and "x" in ds.attrs and "y" in ds.attrs:
+        return "map"
     raise ParameterError("RESULT", ds.encoding.get("source", "?"),
-                         "not a geardyn simulation or bifurcation dataset")
+                         "not a geardyn simulation, bifurcation, map or reproduction dataset")
+
+
+def _load_result(result: Path):
+    """A saved result: a NetCDF file, or a map's Zarr store (a folder ending in .zarr)."""
+    from geardyn.io.netcdf import load_dataset
+
+    if result.suffix.lower() == ".zarr" and result.is_dir():
+        from geardyn.io.zarr_store import load_zarr_dataset
+
+        reader, what = load_zarr_dataset, "a finished map's Zarr store"
+    else:
+        reader, what = load_dataset, "NetCDF"
+    try:
+        return reader(result)
+    except FileNotFoundError:
+        raise
+    except (OSError, ValueError, KeyError) as exc:  # name the file, not only the reason
+        reason = " ".join(str(exc).split()) or type(exc).__name__
+        raise ParameterError("RESULT", str(result), f"cannot read it as {what} ({reason})") \
+            from None
 
 
 def plot_command(
-    result: Annotated[Path, typer.Argument(help="A NetCDF file written by geardyn simulate or "
-                                                "geardyn bifurcation.")],
+    result: Annotated[Path, typer.Argument(help="A NetCDF file written by geardyn simulate, "
+                                                "bifurcation, map or reproduce, or a map's "
+                                                ".zarr store.")],
     out: Annotated[
         Path | None, typer.Option(help="Figure to write, .png, .pdf or .svg (default: RESULT "
                                        "with .png).")
@@ -337,27 +366,34 @@ def plot_command(
     state: Annotated[
         str | None, typer.Option(help="State drawn (default: the one saved with the result).")
     ] = None,
+    sweep: Annotated[
+        SweepDirection, typer.Option(help="A reproduction case file: the sweep drawn.")
+    ] = SweepDirection.up,
 ) -> None:
-    """Redraw the figure of a saved simulation or bifurcation result."""
-    from geardyn.io.netcdf import load_dataset
-
+    """Redraw the figure of a saved simulation, bifurcation, map or reproduction case."""
     target = out if out is not None else result.with_suffix(".png")
     check_plot_path("--out", target)
-    try:
-        ds = load_dataset(result)
-    except FileNotFoundError:
-        raise
-    except (OSError, ValueError) as exc:  # not NetCDF: name the file, not only the reason
-        reason = " ".join(str(exc).split()) or type(exc).__name__
-        raise ParameterError("RESULT", str(result), f"cannot read it as NetCDF ({reason})") \
-            from None
+    ds = _load_result(result)
     kind = _dataset_kind(ds)
+    if kind == "map":
+        if state is not None:
+            raise ParameterError("--state", state, "a map shows no state; leave it out")
+        from geardyn.plotting.map2d import plot_map
+
+        make_parents(target)
+        plot_map(ds, path=target)
+        typer.echo(f"{result}: map dataset; wrote {target}")
+        return
+    if kind == "reproduction":
+        attrs = dict(ds.attrs, continuation=sweep.value)
+        ds = ds.sel(sweep=sweep.value, drop=True)
+        ds.attrs = attrs
     names = [str(v) for v in ds["state"].values]
     default = ds.attrs.get("plot_state") or next((n for n in ("X_sq", "x") if n in names),
                                                  names[0])
     shown = _check_state(names, state or default, "--state")
     make_parents(target)
-    if kind == "bifurcation":
+    if kind in ("bifurcation", "reproduction"):
         from geardyn.plotting.bifurcation import plot_bifurcation
 
         plot_bifurcation(ds, state=shown, path=target)

@@ -216,9 +216,11 @@ def build_report(results: Results, figures: Mapping[tuple[str, str], dict[str, P
     doc.table(["case", "interpretation", "sweep work up + down [1e6 RK4 steps]",
                "Lyapunov up + down [s]", "note"], rows)
     groups = sorted(joint, reverse=True)
-    doc.para(f"The sweeps were continued together, in {len(groups)} group(s) (of "
+    where = ("in one group" if len(groups) == 1 else
+             f"in {len(groups)} groups run in parallel processes")
+    doc.para(f"The sweeps were continued together {where} (of "
              f"{', '.join(str(n) for _, n in groups)} sweeps; a group's points advance as the "
-             "lanes of one kernel call, groups run in parallel processes): continuation "
+             "lanes of one kernel call): continuation "
              + ", ".join(f"{t:.1f} s" for t, _ in groups) + f" wall for {steps / 1e6:.0f}e6 "
              f"RK4 steps in all; Lyapunov exponents {lyap:.1f} s of computing (figures and "
              "files not included).")
