@@ -6,7 +6,7 @@ STAMP := $(VENV)/.installed
 export NUMBA_CACHE_DIR ?= $(CURDIR)/.geardyn-cache/numba
 export GEARDYN_CACHE_DIR ?= $(CURDIR)/.geardyn-cache
 
-.PHONY: venv demo test test-slow bench lint clean
+.PHONY: venv demo test test-slow bench reproduce lint clean
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -34,6 +34,10 @@ test-slow: $(STAMP)
 bench: $(STAMP)
 	$(BIN)/python bench/bifurcation.py
 	$(BIN)/python bench/map.py --write
+
+# The paper's whole study at its resolution (about 4 min on 2 cores): out/reproduce/report.html
+reproduce: $(STAMP)
+	$(BIN)/geardyn reproduce --all --out out/reproduce
 
 lint: $(STAMP)
 	$(BIN)/ruff check src tests
