@@ -101,3 +101,18 @@ def test_fast_load_fluctuation_sets_the_step():
     t_eval = (r.transient_periods[0] + np.arange(1, 4)) * T
     ref = geardyn.reference_solution(m, m.initial_state(), t_eval)
     assert np.max(np.abs(r.samples[0] - ref)) < 1e-6 * np.max(np.abs(ref))
+
+
+@pytest.mark.parametrize("sweep,message", [
+    (dict(direction="sideways"), "direction must be 'up' or 'down'"),
+    (dict(values=[]), "values: give at least one"),
+    (dict(values=[0.5, float("nan")]), "values: must be finite"),
+])
+def test_continued_sweeps_bad_input_names_the_field(device, sweep, message):
+    spec = dict(model=device, param="Omega", values=[0.5, 0.6], direction="up", transient=10.0)
+    spec.update(sweep)
+    with pytest.raises(ValueError, match=message):
+        continued_sweeps([ContinuedSweep(**spec)], samples=2)
+    with pytest.raises(ValueError, match="converge must be a positive tolerance"):
+        continued_sweeps([ContinuedSweep(device, "Omega", [0.5], transient=10.0)], samples=2,
+                         converge=-1.0)
