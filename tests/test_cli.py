@@ -322,6 +322,28 @@ def test_bifurcation_bad_study_is_one_line_error(tmp_path):
     assert_one_line_error(invoke("bifurcation", plain), "--range", "no [sweep]")
 
 
+def test_bifurcation_continued_transient(tmp_path):
+    study = tmp_path / "gp.toml"
+    study.write_text(GEAR_PAIR_STUDY)
+    nc = tmp_path / "gp.nc"
+    r = invoke("bifurcation", study, "--continued-transient", "20", "--converge", "1e-8",
+               "--no-lyapunov", "--quiet", "--out", nc)
+    assert r.returncode == 0, r.stderr
+    saved = load_dataset(nc)
+    g = GearPair(zeta=0.05, kappa=0.2, Fa=0.2)
+    direct = bifurcation(g, values=np.linspace(0.6, 1.4, 5), transient=150.0, samples=8,
+                         continuation="down", converge=1e-8, continued_transient=20.0)
+    np.testing.assert_array_equal(saved["poincare"].values, direct["poincare"].values)
+    assert saved.attrs["continued_transient"] == 20.0
+    np.testing.assert_array_equal(saved["transient_periods"].values,
+                                  direct["transient_periods"].values)
+    assert_one_line_error(invoke("bifurcation", study, "--continuation", "none",
+                                 "--continued-transient", "20"), "--continued-transient",
+                          "continuation")
+    assert_one_line_error(invoke("bifurcation", study, "--continued-transient", "-1"),
+                          "--continued-transient", "-1")
+
+
 def test_plot_redraws_saved_results(tmp_path):
     g = GearPair(zeta=0.05, kappa=0.2, Fa=0.2)
     bif = save_dataset(bifurcation(g, values=[0.8, 0.95, 1.2], transient=100.0,

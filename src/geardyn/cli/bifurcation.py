@@ -5,9 +5,10 @@ saved result).
 
     geardyn bifurcation STUDY.toml [--param Omega] [--range 0.1:4:1000]
                         [--continuation none|up|down] [--lyapunov] [--transient T] [--samples N]
-                        [--steps-per-period N] [--omega W] [--interpretation ...] [--state X_sq]
-                        [--quiet] [--out out.nc] [--plot out.png]
-    geardyn plot RESULT.nc [--out fig.png|fig.pdf] [--state X_sq]
+                        [--converge TOL] [--continued-transient T] [--steps-per-period N]
+                        [--omega W] [--interpretation ...] [--state X_sq] [--quiet]
+                        [--yes] [--out out.nc] [--plot out.png]
+    geardyn plot RESULT.nc|map.zarr [--out fig.png|fig.pdf] [--state X_sq] [--sweep up|down]
 
 Unset options come from the study's ``[sweep]`` table (param, range, continuation, samples,
 lyapunov) and ``[run]`` table (transient, steps_per_period, omega, and periods as the default
@@ -205,6 +206,12 @@ def bifurcation_command(
                                         "(a minimum), up to 10x it, until the Poincare point "
                                         "repeats to this relative tolerance (e.g. 1e-8).")
     ] = None,
+    continued_transient: Annotated[
+        float | None, typer.Option(help="With --continuation: the discarded time of a continued "
+                                        "point, which starts next to its attractor (a minimum "
+                                        "with --converge; default: --transient). The first "
+                                        "point gets --transient.")
+    ] = None,
     samples: Annotated[
         int | None, typer.Option(help="Forcing periods sampled per point (default: "
                                       "sweep.samples, else run.periods).")
@@ -268,6 +275,13 @@ def bifurcation_command(
         raise ParameterError("--samples", n_samples, "must be >= 2 (the period needs two)")
     if converge is not None and not (math.isfinite(converge) and 0 < converge < 1):
         raise ParameterError("--converge", converge, "must be a tolerance in (0, 1)")
+    if continued_transient is not None:
+        if not (math.isfinite(continued_transient) and continued_transient >= 0):
+            raise ParameterError("--continued-transient", continued_transient,
+                                 "must be a finite time >= 0")
+        if cont == "none":
+            raise ParameterError("--continued-transient", continued_transient,
+                                 "applies to --continuation up or down")
     if spp is not None and spp < 4:
         raise ParameterError("--steps-per-period", spp, "must be >= 4")
     check_count("--samples", n_samples)
@@ -296,7 +310,8 @@ def bifurcation_command(
     with _progress_bar(show_bar, escape(f"{s.study.name}: {name}")) as callback:
         ds = bifurcation(model, param=name, values=values, transient=tr, samples=n_samples,
                          continuation=None if cont == "none" else cont, steps_per_period=spp,
-                         lyapunov=lyap, progress=callback, converge=converge)
+                         lyapunov=lyap, progress=callback, converge=converge,
+                         continued_transient=continued_transient)
     elapsed = time.perf_counter() - t0
     ds.attrs["study"] = s.study.name
     ds.attrs["plot_state"] = plot_state
