@@ -126,11 +126,13 @@ def bifurcation(
     _check_converge(converge)
     if continuation and (client is not None or store is not None):
         raise ValueError("client and store apply to independent starts, not to continuation")
+    P = model.lane_params(param, values)
+    base_y0 = _initial_states(model, param, values, y0)
     if continuation:
         sweep = ContinuedSweep(model, param, values, continuation, transient=transient,
                                continued_transient=continued_transient,
                                transient_max=transient_max, steps_per_period=steps_per_period,
-                               y0=y0)
+                               y0=base_y0)
         ((ds, final),) = _continued([sweep], samples, converge, max_period, tol, locate_edges,
                                     bound, progress)
     else:
@@ -138,15 +140,13 @@ def bifurcation(
                     steps_per_period=steps_per_period, locate_edges=bool(locate_edges),
                     bound=float(bound), transient_max=transient_max,
                     converge_tol=float(converge or 0.0))
-        P = model.lane_params(param, values)
-        base_y0 = _initial_states(model, param, values, y0)
         L, ns = values.size, model.n_states
         rng = np.random.default_rng(seed)
         Y0 = [np.broadcast_to(base_y0, (L, ns))]
         Y0 += [base_y0 + rng.uniform(-spread, spread, (L, ns)) for _ in range(1, starts)]
         every = _independent(model, np.tile(P, (starts, 1)), np.concatenate(Y0), chunk,
                              progress, client, store, **opts)
-        runs = [_lanes_slice(every, s * L, (s + 1) * L) for s in range(starts)]
+        runs = [every.take(slice(s * L, (s + 1) * L)) for s in range(starts)]
         final = runs[0].final
         ds = _dataset(model, param, values, runs, max_period, tol)
         ds.attrs.update(_settings(transient, samples, converge, transient_max, locate_edges,
@@ -157,8 +157,6 @@ def bifurcation(
 
         # from each point's own final state (on the attractor the Poincare points show, also
         # in continuation), with each lane's own step; a short run aligns the tangent vectors
-        P = model.lane_params(param, values)
-        base_y0 = _initial_states(model, param, values, y0)
         start = np.where(np.isfinite(final), final, np.broadcast_to(base_y0, final.shape))
         exps = lyapunov_lanes(model, P, start, min(transient, LYAPUNOV_ALIGN),
                               samples * _mean_period(model, P), steps_per_period)
@@ -249,7 +247,7 @@ def _continued(sweeps, samples, converge, max_period, tol, locate_edges, bound, 
         r = results[i]
         back = np.empty_like(order)
         back[order] = np.arange(order.size)
-        r = LaneResults(**{f: getattr(r, f)[back] for f in LaneResults.__dataclass_fields__})
+        r = r.take(back)
         ds = _dataset(sw.model, sw.param, values, [r], max_period, tol)
         ds.attrs.update(_settings(sw.transient, samples, converge, sw.transient_max,
                                   locate_edges, bound, tol, max_period),
@@ -282,10 +280,6 @@ def _initial_states(model: Model, param: str, values: np.ndarray, y0: np.ndarray
     if param == "Omega":
         return model.initial_state()
     return np.array([model.with_params(**{param: float(v)}).initial_state() for v in values])
-
-
-def _lanes_slice(r: LaneResults, a: int, b: int) -> LaneResults:
-    return LaneResults(**{f: getattr(r, f)[a:b] for f in LaneResults.__dataclass_fields__})
 
 
 def _settings(transient, samples, converge, transient_max, locate_edges, bound, tol,

@@ -30,7 +30,7 @@ from geardyn.solvers.ensemble import LaneResults, lane_steps_per_period, run_lan
 from geardyn.solvers.kernels import kernels_for
 from geardyn.solvers.simulate import DEFAULT_BOUND
 
-__all__ = ["Branch", "concat_lanes", "continue_branches"]
+__all__ = ["Branch", "continue_branches"]
 
 
 @dataclass(frozen=True)
@@ -77,16 +77,6 @@ class Branch:
         return short, max(short, longest)
 
 
-def concat_lanes(parts: Sequence[LaneResults]) -> LaneResults:
-    """Lane results one after another."""
-    fields = LaneResults.__dataclass_fields__
-    return LaneResults(**{f: np.concatenate([getattr(r, f) for r in parts]) for f in fields})
-
-
-def _lane(r: LaneResults, i: int) -> LaneResults:
-    return LaneResults(**{f: getattr(r, f)[i : i + 1] for f in LaneResults.__dataclass_fields__})
-
-
 def continue_branches(
     branches: Sequence[Branch],
     samples: int,
@@ -130,7 +120,7 @@ def continue_branches(
                       converge_tol=converge,
                       max_section_periods=branches[0].max_section_periods)
         for k, i in enumerate(live):
-            parts[i].append(_lane(r, k))
+            parts[i].append(r.take(slice(k, k + 1)))
             if converge > 0 and not branches[i].commensurate[j]:
                 parts[i][-1].converged[:] = -1  # no section to test: a fixed transient
             if r.status[k] == 0:
@@ -140,4 +130,4 @@ def continue_branches(
         done += len(live)
     if progress is not None:
         progress(total, total)
-    return [concat_lanes(p) for p in parts]
+    return [LaneResults.concat(p) for p in parts]

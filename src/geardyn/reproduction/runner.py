@@ -159,12 +159,12 @@ def _sweeps(tasks: list[tuple[Case, str, str]], settings: ReproductionSettings,
             progress(label, done, total)
 
     swept: list[xr.Dataset] = [xr.Dataset()] * len(tasks)
-    groups: dict[tuple[int, float], list[int]] = {}
+    groups: dict[int, list[int]] = {}  # one continuation per number of samples
     for i, (_, r) in enumerate(plans):
-        groups.setdefault((r["samples"], r["converge"]), []).append(i)
-    for (samples, converge), members in groups.items():
+        groups.setdefault(r["samples"], []).append(i)
+    for samples, members in groups.items():
         done = continued_sweeps([plans[i][0] for i in members], samples=samples,
-                                converge=converge or None, progress=tick,
+                                converge=settings.converge, progress=tick,
                                 max_section_periods=settings.max_section_periods)
         for i, ds in zip(members, done, strict=True):
             swept[i] = ds

@@ -114,8 +114,8 @@ def _grid_step_rows(i, Y, p, h, omega, n_per, s_tab, c_tab, n_ev, K, TMP, Y1, SI
 
 
 @nb.njit(**_JIT)
-def _tangent_step(i, Z, p, h, omega, n_per, s_tab, c_tab, n_ev, YP, K, TMP, Y1, SIDE, G0, G1, W,
-                  gbuf, ncross):
+def _tangent_step(i, Z, p, h, omega, n_per, s_tab, c_tab, n_ev, YP, E, K, TMP, Y1, SIDE, G0, G1,
+                  W, gbuf, ncross):
     """Advance the state (row 0 of Z) by one grid step and each tangent vector v (rows 1..) by
     the derivative of that step map: (Phi(y + e v) - Phi(y - e v)) / (2 e). The 2 k + 1 states
     are the rows of YP (tangent j: rows 2 j - 2 and 2 j - 1; the state: the last row)."""
@@ -127,7 +127,6 @@ def _tangent_step(i, Z, p, h, omega, n_per, s_tab, c_tab, n_ev, YP, K, TMP, Y1, 
     last = 2 * (m - 1)
     for q in range(ns):
         YP[last, q] = Z[0, q]
-    E = np.empty(m)
     for j in range(1, m):
         nv = 0.0
         for q in range(ns):
@@ -194,6 +193,7 @@ def _run(p, y0, h, omega, n_per, s_tab, c_tab, n_transient, n_steps, renorm_ever
     W = np.zeros((9, ns))
     nr = 2 * k + 1
     YP = np.zeros((nr, ns))
+    E = np.zeros(m)  # the perturbation size of each tangent vector in this step
     K = np.zeros((4, nr, ns))
     TMP = np.zeros((nr, ns))
     Y1 = np.zeros((nr, ns))
@@ -216,8 +216,8 @@ def _run(p, y0, h, omega, n_per, s_tab, c_tab, n_transient, n_steps, renorm_ever
     total = n_transient + n_steps
     since = 0
     for i in range(total):
-        _tangent_step(i, Z, p, h, omega, n_per, s_tab, c_tab, n_ev, YP, K, TMP, Y1, SIDE, G0, G1,
-                      W, gbuf, ncross)
+        _tangent_step(i, Z, p, h, omega, n_per, s_tab, c_tab, n_ev, YP, E, K, TMP, Y1, SIDE, G0,
+                      G1, W, gbuf, ncross)
         since += 1
         step = i + 1
         if since == renorm or step == n_transient or step == total:

@@ -61,6 +61,16 @@ class LaneResults:
     sample_every: np.ndarray  # (L,) forcing periods between samples (the section's period)
     commensurate: np.ndarray  # (L,) False: a second excitation at an irrational frequency ratio
 
+    def take(self, index: slice | np.ndarray) -> LaneResults:
+        """The lanes ``index`` (a slice or an index array) of every field."""
+        return LaneResults(**{f: getattr(self, f)[index] for f in self.__dataclass_fields__})
+
+    @staticmethod
+    def concat(parts: list[LaneResults]) -> LaneResults:
+        """Lane results one after another."""
+        return LaneResults(**{f: np.concatenate([getattr(r, f) for r in parts])
+                              for f in LaneResults.__dataclass_fields__})
+
 
 def run_lanes(
     model: Model,
