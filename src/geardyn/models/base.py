@@ -137,6 +137,32 @@ class Model:
         :func:`geardyn.analysis.periodicity.common_section`)."""
         return np.zeros((np.atleast_2d(P).shape[0], 0))
 
+    def fastest_natural_frequency(self, P: np.ndarray | None = None) -> np.ndarray:
+        """Fastest natural frequency (rad per model time unit) of the linearised model (mean
+        stiffness, no backlash) in each lane of the coefficient matrix ``P`` (default: this
+        model's own coefficients), shape ``(lanes,)``; NaN where it is not known.
+
+        The default step (:func:`~geardyn.solvers.simulate.default_steps_per_period`) resolves
+        this frequency in every lane. The default here: a model that defines
+        ``natural_frequencies()`` is asked once per distinct row of ``P`` (a copy of the model
+        holding that row), so it must compute them from ``self.params``; any other model gets
+        NaN (unknown: the step then follows only the forcing frequencies, at least
+        ``MIN_STEPS_PER_PERIOD`` per period). Built-in models override it with a vectorised
+        computation from the coefficients.
+        """
+        P = np.atleast_2d(self.params if P is None else np.asarray(P, dtype=float))
+        fn = getattr(type(self), "natural_frequencies", None)
+        if fn is None:
+            return np.full(P.shape[0], np.nan)
+        rows, inverse = np.unique(P, axis=0, return_inverse=True)
+        out = np.empty(rows.shape[0])
+        for k, row in enumerate(rows):
+            lane = copy.copy(self)
+            lane.params = row.copy()
+            w = np.asarray(fn(lane), dtype=float)
+            out[k] = float(np.max(w)) if w.size else np.nan
+        return out[np.ravel(inverse)]
+
     def with_omega(self, omega: float) -> Model:
         """A copy with the forcing frequency set to ``omega``."""
         return self.with_params(Omega=omega)

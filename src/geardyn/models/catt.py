@@ -49,6 +49,13 @@ _KERNEL = KernelSource(ck.catt_rhs, ck.catt_events, ck.catt_observe)
 #: The reduced model's kernel: the same functions compiled for one planet set.
 _KERNEL_ONE = KernelSource(ck.catt_rhs_one, ck.catt_events_one, ck.catt_observe_one)
 _THETA_KERNEL = KernelSource(ck.theta_rhs)
+#: Coefficients that fix the layout of the vector: a raw override of them is refused.
+_STRUCTURAL = {
+    "n_blocks": "the number of planet-set blocks fixes the vector's layout; change N instead",
+    "n_harmonics": "the number of stiffness harmonics fixes the vector's layout; change the "
+                   "waveform or harmonics of the meshes instead",
+    "spare": "an unused slot of the coefficient vector",
+}
 
 
 class CATTDevice(Model):
@@ -123,6 +130,9 @@ class CATTDevice(Model):
         self.omega_index = ck.OMEGA
         self.params = self._coefficient_vector(omega)
         self.param_names = self._names()
+        #: Raw coefficients set by name through ``with_params`` (name -> value), applied on top
+        #: of the coefficients derived from ``params_in``.
+        self.raw_overrides: dict[str, float] = {}
         if not np.all(np.isfinite(self.params)):
             bad = self.param_names[int(np.argmax(~np.isfinite(self.params)))]
             raise ParameterError("params", bad, "the parameters give a dimensionless "
@@ -195,19 +205,82 @@ class CATTDevice(Model):
 
     def replace(self, **changes) -> CATTDevice:
         """A new device with physical parameters changed by the paper's names (``xi1``,
-        ``backlash``, ``B1``, ...) and/or ``Omega``."""
+        ``backlash``, ``B1``, ...) and/or ``Omega``. Raw coefficients set before
+        (:attr:`raw_overrides`) are kept when the change leaves them alone, and refused
+        (:class:`~geardyn.errors.ParameterError`) when it would re-derive them."""
         omega = float(changes.pop("Omega", self.omega))
         params = self.params_in.replace(**changes) if changes else self.params_in
         reduced = None if params.identical_planets else False
         if not self.reduced:
             reduced = False
-        return CATTDevice(params, self.interpretation, reduced=reduced, omega=omega)
+        out = CATTDevice(params, self.interpretation, reduced=reduced, omega=omega)
+        if self.raw_overrides:
+            plain = CATTDevice(self.params_in, self.interpretation, reduced=self.reduced,
+                               omega=omega).params
+            moved = [n for n in self.raw_overrides if out.params.size != plain.size
+                     or out.params[out._param_index(n)] != plain[self._param_index(n)]]
+            if moved:
+                name = moved[0]
+                raise ParameterError(
+                    name, self.raw_overrides[name],
+                    f"set as a raw coefficient, but changing {', '.join(sorted(changes))} "
+                    "re-derives it from the physical parameters, which would undo the "
+                    "override; change the physical parameters first, then the raw coefficient"
+                    " (in a map: swap the axes)")
+            out = out._override(self.raw_overrides)
+        return out
 
     def with_params(self, **values: float) -> CATTDevice:
+        """A copy with parameters changed by name: physical ones (the paper's names, see
+        :data:`~geardyn.models.params.PAPER_NAMES`, and ``Omega``) re-derive every coefficient;
+        any other name sets that raw coefficient of the vector (e.g. ``k_pq_q``, ``f_c0``;
+        dimensionless, in units of this device's omega_n, which stays). Everything derived
+        (natural frequencies, static forces, initial state, default step) then follows the
+        coefficients. Raises :class:`~geardyn.errors.ParameterError` for a coefficient that
+        fixes the vector's layout (``n_blocks``, ``n_harmonics``, ``spare``) and for a physical
+        change that would undo an earlier raw one."""
         physical = {k: v for k, v in values.items() if k in PAPER_NAMES or k == "Omega"}
-        rest = {k: v for k, v in values.items() if k not in physical}
-        out = self.replace(**physical) if physical else copy.copy(self)
-        return Model.with_params(out, **rest) if rest else out
+        rest = {k: float(v) for k, v in values.items() if k not in physical}
+        out = self.replace(**physical) if physical else self
+        return out._override(rest) if rest else (out if physical else copy.copy(self))
+
+    def _override(self, raw: dict[str, float]) -> CATTDevice:
+        """A copy with raw coefficients set (checked: known, not structural, finite)."""
+        out = copy.copy(self)
+        p = self.params.copy()
+        for name, value in raw.items():
+            idx = self._param_index(name)
+            base = self.param_names[idx].rstrip("0123456789")
+            if base in _STRUCTURAL:
+                raise ParameterError(name, value, _STRUCTURAL[base])
+            if not math.isfinite(value):
+                raise ParameterError(name, value, "a raw coefficient must be finite")
+            p[idx] = value
+        out.params = p
+        out.raw_overrides = {**self.raw_overrides, **raw}
+        out.coefficients = self._coefficients_of(p)
+        return out
+
+    def _coefficients_of(self, p: np.ndarray) -> dict[str, np.ndarray | float]:
+        """The Eq. (10) coefficients (as :attr:`coefficients`) read back from a vector."""
+        co = dict(self.coefficients)
+        blk = self._blocks(p[None, :])[0]
+        mult = self.params_in.n_planets if self.reduced else 1
+        n = self.params_in.n_planets
+        for name, idx in (("k_sq_c", ck.K_SQ_C), ("c_sq_c", ck.C_SQ_C), ("k_sq_q", ck.K_SQ_Q),
+                          ("c_sq_q", ck.C_SQ_Q), ("k_pq_q", ck.K_PQ_Q), ("c_pq_q", ck.C_PQ_Q),
+                          ("k_pq_p", ck.K_PQ_P), ("c_pq_p", ck.C_PQ_P), ("b_sq", ck.B_SQ),
+                          ("b_pq", ck.B_PQ), ("f_p0", ck.F_P0), ("f_p1", ck.F_P1)):
+            v = blk[:, idx] / (mult if name in ("k_sq_c", "c_sq_c") else 1)
+            co[name] = np.broadcast_to(v, (n,)).copy() if v.size == 1 else v.copy()
+        for name, s_idx, c_idx in (("E_sq", ck.E_SQ_S, ck.E_SQ_C), ("E_pq", ck.E_PQ_S, ck.E_PQ_C)):
+            changed = [k for k in self.raw_overrides if k.rstrip("0123456789") in
+                       (f"{name}_s", f"{name}_c")]
+            if changed:
+                v = np.hypot(blk[:, s_idx], blk[:, c_idx])
+                co[name] = np.broadcast_to(v, (n,)).copy() if v.size == 1 else v.copy()
+        co["f_c0"], co["f_c1"] = float(p[ck.F_C0]), float(p[ck.F_C1])
+        return co
 
     def lane_params(self, name: str, values: Sequence[float] | np.ndarray) -> np.ndarray:
         values = np.asarray(values, dtype=float).ravel()
@@ -216,6 +289,8 @@ class CATTDevice(Model):
             if len({r.size for r in rows}) != 1:
                 raise ValueError(f"sweeping {name!r} changes the model's size; sweep N separately")
             return np.array(rows)
+        if name != "Omega" and values.size:
+            self._override({name: float(values[0])})  # refuses a structural coefficient
         return Model.lane_params(self, name, values)
 
     # ------------------------------------------------------------------ linear analysis
@@ -227,76 +302,110 @@ class CATTDevice(Model):
             != 0.0, axis=1)
         return np.where(acts & (P[:, ck.LAMBDA] != 0.0), P[:, ck.LAMBDA], np.nan)[:, None]
 
+    def _blocks(self, P: np.ndarray) -> np.ndarray:
+        """The planet-set blocks of coefficient vectors ``P`` (lanes x n_params), shape
+        (lanes, n_sets, block size)."""
+        P = np.atleast_2d(P)
+        bs = ck.block_size(int(P[0, ck.N_HARM]))
+        return P[:, ck.HEADER : ck.HEADER + self.n_sets * bs].reshape(P.shape[0], self.n_sets, bs)
+
+    def _mean_stiffness(self, P: np.ndarray, carrier: bool = True) -> np.ndarray:
+        """Dimensionless mean stiffness matrices (lanes, 2 n_sets, 2 n_sets) of the modelled
+        coordinates (X_sq1, X_pq1, ...): linearised undamped motion X'' = -A X + forcing. The
+        reduced form's carrier coupling is N times a set's (its in-phase modes); with
+        ``carrier=False`` the carrier coupling is left out (the reduced form's out-of-phase
+        modes, which the carrier does not feel)."""
+        blk = self._blocks(P)
+        L, n = blk.shape[0], self.n_sets
+        A = np.zeros((L, 2 * n, 2 * n))
+        s, q = np.arange(0, 2 * n, 2), np.arange(1, 2 * n, 2)
+        if carrier:
+            A[:, s[:, None], s[None, :]] += blk[:, None, :, ck.K_SQ_C]
+        A[:, s, s] += blk[:, :, ck.K_SQ_Q]
+        A[:, s, q] -= blk[:, :, ck.K_PQ_Q]
+        A[:, q, s] -= blk[:, :, ck.K_SQ_Q]
+        A[:, q, q] += blk[:, :, ck.K_PQ_Q] + blk[:, :, ck.K_PQ_P]
+        return A
+
+    def _mode_eigenvalues(self, P: np.ndarray) -> np.ndarray:
+        """Eigenvalues (lanes, 2N) of the linearised general model's stiffness matrix for every
+        lane of ``P``; the reduced form adds its N - 1 out-of-phase pairs."""
+        lam = np.linalg.eigvals(self._mean_stiffness(P))
+        if self.reduced and self.params_in.n_planets > 1:
+            out = np.linalg.eigvals(self._mean_stiffness(P, carrier=False))
+            lam = np.concatenate([lam] + [out] * (self.params_in.n_planets - 1), axis=1)
+        return lam
+
     def stiffness_matrix(self) -> np.ndarray:
         """Dimensionless mean stiffness matrix A of the general 2N-coordinate model, such that the
-        linearised undamped motion (b = 0, Ka = 0) is X'' = -A X + forcing."""
-        co = self.coefficients
-        n = self.params_in.n_planets
-        A = np.zeros((2 * n, 2 * n))
-        for i in range(n):
-            s, q = 2 * i, 2 * i + 1
-            for j in range(n):
-                A[s, 2 * j] += co["k_sq_c"][j]
-            A[s, s] += co["k_sq_q"][i]
-            A[s, q] -= co["k_pq_q"][i]
-            A[q, s] -= co["k_sq_q"][i]
-            A[q, q] += co["k_pq_q"][i] + co["k_pq_p"][i]
-        return A
+        linearised undamped motion (b = 0, Ka = 0) is X'' = -A X + forcing (from the coefficient
+        vector, so raw overrides count)."""
+        g = self.general() if self.reduced else self
+        return g._mean_stiffness(g.params)[0]
 
     def natural_frequencies(self) -> np.ndarray:
         """Natural frequencies of the linearised device (mean stiffness, no backlash), ascending,
-        in units of omega_n: all 2N modes of the general model."""
-        lam = np.linalg.eigvals(self.stiffness_matrix())
+        in units of omega_n: all 2N modes of the general model, from the coefficient vector."""
+        lam = self._mode_eigenvalues(self.params)[0]
         if np.max(np.abs(lam.imag)) > 1e-9 * np.max(np.abs(lam.real)):
             raise ValueError("the linearised stiffness matrix has complex eigenvalues")
         return np.sort(np.sqrt(lam.real))
 
+    def fastest_natural_frequency(self, P: np.ndarray | None = None) -> np.ndarray:
+        """Fastest natural frequency [omega_n] of the linearised device in every lane of ``P``
+        (default: this device's coefficients), from the lane's own mean stiffness coefficients:
+        sqrt of the largest eigenvalue magnitude of the stiffness matrix (vectorised)."""
+        P = np.atleast_2d(self.params if P is None else np.asarray(P, dtype=float))
+        return np.sqrt(np.max(np.abs(self._mode_eigenvalues(P)), axis=1))
+
     def static_forces(self) -> np.ndarray:
         """Dimensionless static mesh deflections g(X) = X - b of the quasi-static state under the
-        mean torques (mean stiffness, no error), one (sq, pq) pair per modelled planet set."""
-        co = self.coefficients
-        n = self.n_sets
-        mult = self.params_in.n_planets if self.reduced else 1
-        A = np.zeros((2 * n, 2 * n))
-        rhs = np.zeros(2 * n)
-        for i in range(n):
-            s, q = 2 * i, 2 * i + 1
-            for j in range(n):
-                A[s, 2 * j] += mult * co["k_sq_c"][j]
-            A[s, s] += co["k_sq_q"][i]
-            A[s, q] -= co["k_pq_q"][i]
-            A[q, s] -= co["k_sq_q"][i]
-            A[q, q] += co["k_pq_q"][i] + co["k_pq_p"][i]
-            rhs[s] = co["f_c0"]
-            rhs[q] = co["f_p0"][i]
-        return np.linalg.solve(A, rhs)
+        mean torques (mean stiffness, no error), one (sq, pq) pair per modelled planet set
+        (from the coefficient vector, so raw overrides count)."""
+        blk = self._blocks(self.params)[0]
+        rhs = np.zeros(2 * self.n_sets)
+        rhs[0::2] = self.params[ck.F_C0]
+        rhs[1::2] = blk[:, ck.F_P0]
+        return np.linalg.solve(self._mean_stiffness(self.params)[0], rhs)
 
     def initial_state(self) -> np.ndarray:
         """The quasi-static state under the mean loads (mean stiffness, no error), at rest: the
         deflection g = F/K added to the backlash on the loaded flank."""
         g = self.static_forces()
-        co = self.coefficients
+        blk = self._blocks(self.params)[0]
         y = np.zeros(self.n_states)
         for i in range(self.n_sets):
-            for k, b in ((0, co["b_sq"][i]), (1, co["b_pq"][i])):
+            for k, b in ((0, blk[i, ck.B_SQ]), (1, blk[i, ck.B_PQ])):
                 gi = g[2 * i + k]
                 y[4 * i + 2 * k] = gi + math.copysign(b, gi) if gi != 0.0 else 0.0
         return y
 
     def static_mesh_forces(self) -> np.ndarray:
-        """Static mesh forces [N] under the mean loads, in the order of ``observable_names``."""
+        """Static mesh forces [N] under the mean loads, in the order of ``observable_names``:
+        the deflection times the mean stiffness coefficient times the force scale, as the
+        dynamic forces are observed."""
         g = self.static_forces()
-        bc = self.params_in.b_c
+        blk = self._blocks(self.params)[0]
+        scale = blk[:, ck.FORCE_SCALE]
         out = np.empty(2 * self.n_sets)
-        for i in range(self.n_sets):
-            sq, pq, _, _ = self.params_in.planet_set(i)
-            out[2 * i] = g[2 * i] * sq.mean_stiffness * bc
-            out[2 * i + 1] = g[2 * i + 1] * pq.mean_stiffness * bc
+        out[0::2] = g[0::2] * blk[:, ck.K_SQ_Q] * scale
+        out[1::2] = g[1::2] * blk[:, ck.K_PQ_Q] * scale
         return out
 
     def general(self) -> CATTDevice:
         """The same device in the general 4N-state form."""
-        return CATTDevice(self.params_in, self.interpretation, reduced=False, omega=self.omega)
+        out = CATTDevice(self.params_in, self.interpretation, reduced=False, omega=self.omega)
+        if not self.raw_overrides:
+            return out
+        n = self.params_in.n_planets
+        raw: dict[str, float] = {}
+        for name, value in self.raw_overrides.items():
+            if name in out.param_names[: ck.HEADER] or not self.reduced:
+                raw[name] = value
+            else:  # a reduced block coefficient: the same in every set (carrier coupling / N)
+                per = value / n if name in ("k_sq_c", "c_sq_c") else value
+                raw.update({f"{name}{i + 1}": per for i in range(n)})
+        return out._override(raw)
 
     def expand_state(self, y: np.ndarray) -> np.ndarray:
         """A reduced state repeated for every planet set (the general model's symmetric state)."""
@@ -305,7 +414,14 @@ class CATTDevice(Model):
         return np.tile(np.asarray(y, dtype=float), self.params_in.n_planets)
 
     def dimensional(self) -> DimensionalCATT:
-        """The dimensional body-angle model of Eq. (1) with the same parameters."""
+        """The dimensional body-angle model of Eq. (1) with the same parameters. Raises
+        :class:`~geardyn.errors.ParameterError` when raw coefficients were set: the body-angle
+        model is built from the physical parameters and has no place for them."""
+        if self.raw_overrides:
+            name = next(iter(self.raw_overrides))
+            raise ParameterError(name, self.raw_overrides[name],
+                                 "a raw coefficient has no counterpart in the dimensional "
+                                 "body-angle model; set the physical parameters instead")
         return DimensionalCATT(self)
 
     def __repr__(self) -> str:
@@ -378,6 +494,30 @@ class DimensionalCATT(Model):
             f"{v}{i + 1}" for i in range(n)
             for v in ("theta_q", "dtheta_q", "theta_p", "dtheta_p")
         )
+
+    def fastest_natural_frequency(self, P: np.ndarray | None = None) -> np.ndarray:
+        """Fastest natural frequency [rad/s] of Eq. (1) linearised (mean stiffness, no backlash)
+        in every lane of ``P`` (default: this model's coefficients): sqrt of the largest
+        eigenvalue magnitude of J^-1 K in the body angles, from each lane's inertias, radii and
+        stiffnesses (vectorised; the rigid-body rotation gives a zero eigenvalue)."""
+        P = np.atleast_2d(self.params if P is None else np.asarray(P, dtype=float))
+        L, n = P.shape[0], int(P[0, ck.T_N])
+        bs = ck.T_BLOCK_FIXED + 4 * int(P[0, ck.T_NH])
+        blk = P[:, ck.T_HEADER : ck.T_HEADER + n * bs].reshape(L, n, bs)
+        jq, jp = blk[:, :, ck.T_JQ], blk[:, :, ck.T_JP]
+        rq, rp = blk[:, :, ck.T_RBQ], blk[:, :, ck.T_RBP]
+        ks, kp = blk[:, :, ck.T_KM_SQ], blk[:, :, ck.T_KM_PQ]
+        rc1, arm, jc = P[:, ck.T_RC1, None], P[:, ck.T_ARM, None], P[:, ck.T_JC]
+        A = np.zeros((L, 2 * n + 1, 2 * n + 1))  # J^-1 K, angles (theta_c, theta_q1, theta_p1..)
+        q, pp = np.arange(1, 2 * n + 1, 2), np.arange(2, 2 * n + 2, 2)
+        A[:, 0, 0] = np.sum(arm * ks * rc1, axis=1) / jc
+        A[:, 0, q] = -arm * ks * rq / jc[:, None]
+        A[:, q, 0] = -rq * ks * rc1 / jq
+        A[:, q, q] = rq * rq * (ks + kp) / jq
+        A[:, q, pp] = -rq * kp * rp / jq
+        A[:, pp, q] = -rp * kp * rq / jp
+        A[:, pp, pp] = rp * kp * rp / jp
+        return np.sqrt(np.max(np.abs(np.linalg.eigvals(A)), axis=1))
 
     def mesh_coordinates(self, t: np.ndarray, y: np.ndarray) -> np.ndarray:
         """Dimensionless mesh coordinates and their tau-derivatives (Eq. 8, 9) of body-angle states

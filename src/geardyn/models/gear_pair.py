@@ -86,6 +86,18 @@ class GearPair(Model):
         self.omega_index = OMEGA
         self.kernel = KernelSource(gear_pair_rhs, gear_pair_events, gear_pair_observe)
 
+    def with_params(self, **values: float) -> GearPair:
+        """A copy with parameters changed by name, validated as in the constructor (every
+        derived quantity reads the coefficient vector, so it follows)."""
+        current = dict(zip(self.param_names, (float(v) for v in self.params), strict=True))
+        for name in values:
+            self._param_index(name)  # unknown names: KeyError naming the known ones
+        return type(self)(**{**current, **{k: float(v) for k, v in values.items()}})
+
+    def fastest_natural_frequency(self, P: np.ndarray | None = None) -> np.ndarray:
+        """The linear natural frequency in contact, 1 in every lane (time is scaled by it)."""
+        return np.ones(np.atleast_2d(self.params if P is None else P).shape[0])
+
     def initial_state(self) -> np.ndarray:
         """Static deflection under the mean load, at rest."""
         fm, b = self.params[FM], self.params[BACKLASH]

@@ -31,6 +31,14 @@ class UserModel(Model):
         kinks of ``rhs`` (e.g. ``x - b`` and ``x + b`` for a dead zone); the solvers locate them.
     n_events, observe, observable_names
         Number of switching functions; optional compiled ``observe(t, y, out, p)``.
+    natural_frequency
+        The fastest natural frequency of the linearised model (rad per time unit), which the
+        default step resolves (``STEPS_PER_FASTEST_MODE`` steps per its period): a number, or a
+        function of the coefficient vector ``p`` giving it (called once per distinct lane of a
+        sweep, so that a sweep over a stiffness refines the step where it is stiffer). Default
+        None: unknown, and the default step is ``MIN_STEPS_PER_PERIOD`` per forcing period,
+        which is accurate only for modes slower than about Omega / 1.5; give it (or
+        ``steps_per_period``) for a stiffer model.
     """
 
     def __init__(
@@ -46,6 +54,7 @@ class UserModel(Model):
         observe: Callable | None = None,
         observable_names: Sequence[str] = (),
         name: str = "UserModel",
+        natural_frequency: float | Callable[[np.ndarray], float] | None = None,
     ):
         for fn, label in ((rhs, "rhs"), (events, "events"), (observe, "observe")):
             if fn is not None and not hasattr(fn, "py_func"):
@@ -78,4 +87,21 @@ class UserModel(Model):
             self.omega_index = None
         self.param_names = tuple(names)
         self.params = p
+        if natural_frequency is not None and not callable(natural_frequency) and not (
+                math.isfinite(natural_frequency) and natural_frequency > 0):
+            raise ValueError(f"natural_frequency must be > 0 or a function of p "
+                             f"(got {natural_frequency!r})")
+        self.natural_frequency = natural_frequency
         self.kernel = KernelSource(rhs, events, observe, plain=True)
+
+    def fastest_natural_frequency(self, P: np.ndarray | None = None) -> np.ndarray:
+        """``natural_frequency`` in every lane of ``P`` (NaN when it was not given; see the
+        class docstring)."""
+        P = np.atleast_2d(self.params if P is None else np.asarray(P, dtype=float))
+        w = self.natural_frequency
+        if w is None:
+            return Model.fastest_natural_frequency(self, P)
+        if not callable(w):
+            return np.full(P.shape[0], float(w))
+        rows, inverse = np.unique(P, axis=0, return_inverse=True)
+        return np.array([float(w(r)) for r in rows])[np.ravel(inverse)]

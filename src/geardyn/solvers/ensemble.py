@@ -16,7 +16,7 @@ import numpy as np
 
 from geardyn.models.base import Model
 from geardyn.solvers.kernels import kernels_for
-from geardyn.solvers.simulate import DEFAULT_BOUND, default_steps_per_period
+from geardyn.solvers.simulate import DEFAULT_BOUND, steps_per_period_rule
 
 #: Automatic steps per period are rounded up to this geometric ladder (ratio 2^(1/4)), so that a
 #: sweep over Omega needs only a few kernel calls.
@@ -31,13 +31,16 @@ def ladder_steps(n: int) -> int:
 
 def lane_steps_per_period(model: Model, P: np.ndarray) -> np.ndarray:
     """Default steps per forcing period of each lane (row of ``P``), rounded up to the ladder:
-    :func:`~geardyn.solvers.simulate.default_steps_per_period` at the lane's Omega and with the
-    lane's other forcings."""
+    the rule of :func:`~geardyn.solvers.simulate.default_steps_per_period` with the lane's own
+    Omega, other forcings and fastest natural frequency (from the lane's coefficients, so a
+    sweep over a stiffness or a mass refines the step where the device is stiffer)."""
     P = np.atleast_2d(P)
-    omega = P[:, model.omega_index]
-    others = model.other_frequencies(P)
-    return np.array([ladder_steps(default_steps_per_period(model, float(w), o))
-                     for w, o in zip(omega, others, strict=True)], dtype=np.int64)
+    n = steps_per_period_rule(model, P, P[:, model.omega_index])
+    if not np.all(np.isfinite(n)) or np.any(n >= 2.0**62):
+        raise OverflowError("steps per period do not fit an integer; check Omega")
+    idx = np.searchsorted(_LADDER, n)  # as ladder_steps, for every lane at once
+    return np.where(idx < _LADDER.size, _LADDER[np.minimum(idx, _LADDER.size - 1)],
+                    n).astype(np.int64)
 
 
 @dataclass

@@ -23,38 +23,46 @@ DEFAULT_BOUND = 1.0e6
 
 
 def default_steps_per_period(model: Model, omega: float | None = None,
-                             others: np.ndarray | None = None) -> int:
+                             others: np.ndarray | None = None,
+                             params: np.ndarray | None = None) -> int:
     """Steps per forcing period: at least ``MIN_STEPS_PER_PERIOD``, enough that a step is at
-    most 1/``STEPS_PER_FASTEST_MODE`` of the fastest natural period (when the model knows its
-    natural frequencies), and at least ``STEPS_PER_OTHER_FORCING`` per period of every other
-    forcing acting (``others``, rad per time unit; default the model's own,
+    most 1/``STEPS_PER_FASTEST_MODE`` of the fastest natural period
+    (:meth:`~geardyn.Model.fastest_natural_frequency` of the coefficients ``params``, default the
+    model's own, when the model knows it), and at least ``STEPS_PER_OTHER_FORCING`` per period
+    of every other forcing acting (``others``, rad per time unit; default the model's own,
     :meth:`~geardyn.Model.other_frequencies`). See ``docs/numerics.md`` for the accuracy."""
-    omega = model.omega if omega is None else omega
-    n = MIN_STEPS_PER_PERIOD
-    w_max = _fastest_mode(model)
-    if omega and w_max:
-        n = max(n, math.ceil(STEPS_PER_FASTEST_MODE * w_max / omega))
-    if omega:
-        f = (model.other_frequencies(model.params[None, :])[0] if others is None
-             else np.asarray(others, dtype=float).ravel())
-        f = np.abs(f[np.isfinite(f)])
-        if f.size and f.max() > 0:
-            n = max(n, math.ceil(STEPS_PER_OTHER_FORCING * float(f.max()) / omega))
-    return int(n)
+    p = np.array(model.params if params is None else params, dtype=float).ravel()
+    omega = (float(p[model.omega_index]) if model.omega_index is not None else 0.0) \
+        if omega is None else float(omega)
+    if model.omega_index is not None:
+        p[model.omega_index] = omega
+    f = model.other_frequencies(p[None, :]) if others is None else others
+    n = float(steps_per_period_rule(model, p[None, :], np.array([omega]), f)[0])
+    return math.ceil(n)  # an OverflowError when it is not finite
 
 
-def _fastest_mode(model: Model) -> float | None:
-    fn = getattr(model, "natural_frequencies", None)
-    if fn is None:
-        return None
-    cached = getattr(model, "_fastest_mode_cache", None)
-    if cached is None:
-        cached = float(np.max(fn()))
-        try:
-            model._fastest_mode_cache = cached  # type: ignore[attr-defined]
-        except AttributeError:
-            pass
-    return cached
+def steps_per_period_rule(model: Model, P: np.ndarray, omega: np.ndarray,
+                          others: np.ndarray | None = None) -> np.ndarray:
+    """The rule of :func:`default_steps_per_period` for every lane (row) of the coefficient
+    matrix ``P`` at the forcing frequencies ``omega`` (one per lane), vectorised: each lane's
+    step follows its own fastest natural frequency and other forcings (``others``, shape
+    ``(lanes, m)``, NaN where one does not act; default ``model.other_frequencies(P)``).
+    Returns whole numbers as floats (inf where Omega is too small for any count)."""
+    P = np.atleast_2d(np.asarray(P, dtype=float))
+    om = np.broadcast_to(np.asarray(omega, dtype=float), (P.shape[0],))
+    n = np.full(P.shape[0], float(MIN_STEPS_PER_PERIOD))
+    forced = np.isfinite(om) & (om != 0.0)
+    w = np.asarray(model.fastest_natural_frequency(P), dtype=float)
+    ok = forced & np.isfinite(w) & (w > 0)
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        n = np.where(ok, np.maximum(n, np.ceil(STEPS_PER_FASTEST_MODE * w / om)), n)
+        f = model.other_frequencies(P) if others is None else others
+        f = np.abs(np.asarray(f, dtype=float).reshape(P.shape[0], -1))
+        f = np.where(np.isfinite(f), f, 0.0)
+        fmax = f.max(axis=1) if f.shape[1] else np.zeros(P.shape[0])
+        act = forced & (fmax > 0)
+        n = np.where(act, np.maximum(n, np.ceil(STEPS_PER_OTHER_FORCING * fmax / om)), n)
+    return n
 
 
 def simulate(
