@@ -65,6 +65,7 @@ def bifurcation(
     converge: float | None = None,
     transient_max: float | None = None,
     continued_transient: float | None = None,
+    hold: str = "Omega",
 ) -> xr.Dataset:
     """Sweep ``param`` over ``values`` and classify the steady motion at every point.
 
@@ -109,6 +110,13 @@ def bifurcation(
         and a Zarr ``store`` path keeps finished chunks so that a rerun resumes (see
         :func:`geardyn.solvers.executor.run_chunks` and ``docs/scaling.md``). Either way the
         result is bitwise that of a local run.
+    hold
+        What stays fixed along a sweep of another parameter: ``"Omega"`` (default) the
+        dimensionless frequency, or ``"speed"`` the physical mesh frequency omega = Omega omega_n
+        of ``model`` (and the load fluctuation's likewise): each point then runs at
+        Omega = omega / omega_n(point) (Lambda likewise), for a parameter that moves omega_n
+        (``Km_sq``, the carrier's mass). Needs a model with a physical ``omega_n``; the dataset
+        records ``hold`` and the per-point ``Omega`` (and ``Lambda``) as coordinates.
 
     Returns
     -------
@@ -126,13 +134,13 @@ def bifurcation(
     _check_converge(converge)
     if continuation and (client is not None or store is not None):
         raise ValueError("client and store apply to independent starts, not to continuation")
-    P = model.lane_params(param, values)
+    P = lane_params_held(model, param, values, hold)
     base_y0 = _initial_states(model, param, values, y0)
     if continuation:
         sweep = ContinuedSweep(model, param, values, continuation, transient=transient,
                                continued_transient=continued_transient,
                                transient_max=transient_max, steps_per_period=steps_per_period,
-                               y0=base_y0)
+                               y0=base_y0, hold=hold)
         ((ds, final),) = _continued([sweep], samples, converge, max_period, tol, locate_edges,
                                     bound, progress)
     else:
@@ -152,6 +160,7 @@ def bifurcation(
         ds.attrs.update(_settings(transient, samples, converge, transient_max, locate_edges,
                                   bound, tol, max_period), continuation="none",
                         starts=int(starts))
+        ds = _record_hold(ds, model, param, P, hold)
     if lyapunov:
         from geardyn.analysis.lyapunov import lyapunov_lanes
 
@@ -183,6 +192,7 @@ class ContinuedSweep:
     transient_max: float | None = None
     steps_per_period: int | None = None
     y0: np.ndarray | None = None
+    hold: str = "Omega"
 
 
 def continued_sweeps(
@@ -220,7 +230,8 @@ def _continued(sweeps, samples, converge, max_period, tol, locate_edges, bound, 
             order = order[::-1]
         start = _initial_states(sw.model, sw.param, values, sw.y0)
         start = start if start.ndim == 1 else start[order[0]]
-        branch = Branch(sw.model, sw.model.lane_params(sw.param, values)[order], start,
+        branch = Branch(sw.model, lane_params_held(sw.model, sw.param, values, sw.hold)[order],
+                        start,
                         float(sw.transient), sw.continued_transient, sw.transient_max,
                         sw.steps_per_period, max_section_periods)
         prepared.append((sw, values, order, branch))
@@ -243,7 +254,7 @@ def _continued(sweeps, samples, converge, max_period, tol, locate_edges, bound, 
             results[i] = r
             done += r.status.size
     out = []
-    for i, (sw, values, order, _branch) in enumerate(prepared):
+    for i, (sw, values, order, branch) in enumerate(prepared):
         r = results[i]
         back = np.empty_like(order)
         back[order] = np.arange(order.size)
@@ -254,8 +265,68 @@ def _continued(sweeps, samples, converge, max_period, tol, locate_edges, bound, 
                         continuation=sw.direction, starts=1)
         if sw.continued_transient is not None:
             ds.attrs["continued_transient"] = float(sw.continued_transient)
+        ds = _record_hold(ds, sw.model, sw.param, branch.P[back], sw.hold)
         out.append((ds, r.final))
     return out
+
+
+#: What a sweep of a parameter other than Omega holds fixed (see :func:`bifurcation`).
+HOLDS = ("Omega", "speed")
+
+
+def lane_params_held(model: Model, param: str, values: np.ndarray | Sequence[float],
+                     hold: str = "Omega") -> np.ndarray:
+    """Coefficient vectors of a sweep of ``param`` over ``values``: ``model.lane_params`` with
+    ``hold="Omega"``; with ``hold="speed"`` each point's model, with Omega (and Lambda, where
+    the model has one) rescaled by omega_n(model) / omega_n(point), so that the physical mesh
+    (and load) frequency is that of ``model``. Raises ValueError for an unknown mode, for
+    ``param`` Omega or Lambda, or for a model without a physical ``omega_n``."""
+    if hold not in HOLDS:
+        raise ValueError(f"hold must be one of {', '.join(HOLDS)} (got {hold!r})")
+    if hold == "Omega":
+        return model.lane_params(param, values)
+    if param in ("Omega", "Lambda"):
+        raise ValueError(f"hold='speed' sweeps another parameter at a fixed physical speed; "
+                         f"param {param!r} is a speed itself")
+    if not hasattr(model, "omega_n"):
+        raise ValueError(f"hold='speed' needs a model whose time unit is a physical frequency "
+                         f"omega_n; {model.name} has none")
+    base = float(model.omega_n)
+    lam = _lambda(model)
+    rows = []
+    for v in np.asarray(values, dtype=float).ravel():
+        lane = model.with_params(**{param: float(v)})
+        ratio = base / float(lane.omega_n)
+        changes = {"Omega": model.omega * ratio}
+        if lam:
+            changes["Lambda"] = lam * ratio
+        rows.append(lane.with_params(**changes).params)
+    return np.array(rows)
+
+
+def _lambda(model: Model) -> float:
+    """The model's Lambda parameter (0 when it has none)."""
+    if "Lambda" not in model.param_names:
+        return 0.0
+    return float(model.params[model.param_names.index("Lambda")])
+
+
+def _record_hold(ds: xr.Dataset, model: Model, param: str, P: np.ndarray,
+                 hold: str) -> xr.Dataset:
+    """Record the hold mode and, at a fixed speed, each point's Omega (and Lambda)."""
+    ds.attrs["hold"] = hold
+    if hold != "speed":
+        return ds
+    wn = float(model.omega_n)  # type: ignore[attr-defined]
+    ds.attrs["omega_phys"] = model.omega * wn
+    ds.attrs["omega_phys_units"] = "rad/s"
+    coords = {"Omega": (param, P[:, model.omega_index], {
+        "long_name": "dimensionless mesh frequency of each point (fixed physical speed)"})}
+    if _lambda(model):
+        k = model.param_names.index("Lambda")
+        coords["Lambda"] = (param, P[:, k], {
+            "long_name": "dimensionless load frequency of each point (fixed physical speed)"})
+    return ds.assign_coords(coords)
 
 
 def _check_values(values: Sequence[float] | np.ndarray) -> np.ndarray:

@@ -221,6 +221,12 @@ def bifurcation_command(
         float | None, typer.Option(help="The fixed Omega when sweeping another parameter "
                                         "(default: run.omega).")
     ] = None,
+    hold: Annotated[
+        str, typer.Option(help="What a sweep of another parameter holds fixed: Omega (the "
+                               "dimensionless frequency) or speed (the physical mesh frequency "
+                               "Omega omega_n of the study's device: each point runs at "
+                               "Omega omega_n / omega_n(point), e.g. for Km_sq).")
+    ] = "Omega",
     interpretation: InterpretationOption = None,
     state: Annotated[
         str | None, typer.Option(help="State drawn (default: the study's plot_state).")
@@ -284,6 +290,13 @@ def bifurcation_command(
                                  "applies to --continuation up or down")
     if spp is not None and spp < 4:
         raise ParameterError("--steps-per-period", spp, "must be >= 4")
+    if hold not in ("Omega", "speed"):
+        raise ParameterError("--hold", hold, "must be Omega or speed")
+    if hold == "speed" and name in ("Omega", "Lambda"):
+        raise ParameterError("--hold", hold, f"speed holds the physical speed while another "
+                             f"parameter is swept; {name} is a speed itself")
+    if hold == "speed" and not hasattr(model, "omega_n"):
+        raise ParameterError("--hold", hold, f"{model.name} has no physical frequency omega_n")
     check_count("--samples", n_samples)
     if spp is not None:
         check_count("--steps-per-period", spp)
@@ -311,7 +324,7 @@ def bifurcation_command(
         ds = bifurcation(model, param=name, values=values, transient=tr, samples=n_samples,
                          continuation=None if cont == "none" else cont, steps_per_period=spp,
                          lyapunov=lyap, progress=callback, converge=converge,
-                         continued_transient=continued_transient)
+                         continued_transient=continued_transient, hold=hold)
     elapsed = time.perf_counter() - t0
     ds.attrs["study"] = s.study.name
     ds.attrs["plot_state"] = plot_state
