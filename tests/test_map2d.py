@@ -42,10 +42,14 @@ def test_lane_params_grid_of_a_raw_coefficient_model():
 
 
 def test_lane_params_grid_refuses_an_order_that_loses_a_setting(device):
-    # a raw coefficient as y is undone by re-deriving the coefficients for a physical x
-    for raw in ("k_sq_q", "c_sq_q"):  # a coefficient xi leaves alone, and one it sets
-        with pytest.raises(ValueError, match="swap the axes"):
-            device.lane_params_grid("xi", [0.02, 0.1], raw, [0.1, 0.2])
+    # a raw coefficient as y would be undone by re-deriving the coefficients for a physical x
+    # that sets it: refused; one that x leaves alone is kept (raw overrides survive changes
+    # that commute with them), so both orders give the same grid
+    with pytest.raises(ValueError, match="swap the axes"):
+        device.lane_params_grid("xi", [0.02, 0.1], "c_sq_q", [0.1, 0.2])
+    P = device.lane_params_grid("xi", [0.02, 0.1], "k_sq_q", [0.1, 0.2])
+    Q = device.lane_params_grid("k_sq_q", [0.1, 0.2], "xi", [0.02, 0.1])
+    np.testing.assert_array_equal(P.reshape(2, 2, -1), Q.reshape(2, 2, -1).transpose(1, 0, 2))
     P = device.lane_params_grid("c_sq_q", [0.1, 0.2], "xi", [0.02, 0.1])  # the working order
     np.testing.assert_array_equal(P[:, device.param_names.index("c_sq_q")], [0.1, 0.2] * 2)
     with pytest.raises(ValueError, match="different parameters"):
