@@ -392,6 +392,26 @@ class CATTDevice(Model):
         out[1::2] = g[1::2] * blk[:, ck.K_PQ_Q] * scale
         return out
 
+    def carrier_acceleration(self) -> float:
+        """Angular acceleration [rad/s^2] of the carrier (of the whole device: the mesh
+        coordinates are constant) in the quasi-static state under the mean torques: the
+        Eq. (1) body-angle equations evaluated at the state :meth:`initial_state` gives (mean
+        stiffness, no error, no load fluctuation). Zero iff T_D, T_L1 and T_L2 balance; the
+        paper's Table 2 does not (``docs/model.md``)."""
+        quiet = self.replace(Ka=0.0, error=0.0, B1=0.0, B2=0.0)
+        theta = quiet.dimensional()
+        d, prm = quiet.derived, quiet.params_in
+        x = quiet.general().initial_state() * prm.b_c  # X_sq1, V, X_pq1, V, ... [m]
+        y = np.zeros(theta.n_states)  # theta_c = 0; every planet angle from its deflections
+        for i in range(prm.n_planets):
+            y[2 + 4 * i] = -x[4 * i] / d.r_bq[i]
+            y[4 + 4 * i] = (y[2 + 4 * i] * d.r_bq[i] - x[4 * i + 2]) / d.r_bp[i]
+        dy = np.empty(theta.n_states)
+        from geardyn.solvers.kernels import kernels_for
+
+        kernels_for(theta.kernel).rhs(0.0, y, dy, np.ascontiguousarray(theta.params), 0.0, 1.0)
+        return float(dy[1])
+
     def general(self) -> CATTDevice:
         """The same device in the general 4N-state form."""
         out = CATTDevice(self.params_in, self.interpretation, reduced=False, omega=self.omega)
