@@ -24,6 +24,20 @@ import numpy as np
 from geardyn.solvers.kernels import KernelSource
 
 
+def unique_rows(A: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The distinct rows of a 2-D array and, per row, the index of its distinct row (as
+    ``np.unique(A, axis=0, return_inverse=True)``, by a lexicographic sort: much faster)."""
+    A = np.atleast_2d(A)
+    if A.shape[0] == 0 or A.shape[1] == 0:
+        return A[:1], np.zeros(A.shape[0], np.int64)
+    order = np.lexsort(A.T[::-1])
+    S = A[order]
+    new = np.concatenate([[True], np.any(S[1:] != S[:-1], axis=1)])
+    inverse = np.empty(A.shape[0], np.int64)
+    inverse[order] = np.cumsum(new) - 1
+    return S[new], inverse
+
+
 class Model:
     """Base class of geardyn models. Subclasses set the attributes in ``__init__``."""
 
@@ -154,14 +168,14 @@ class Model:
         fn = getattr(type(self), "natural_frequencies", None)
         if fn is None:
             return np.full(P.shape[0], np.nan)
-        rows, inverse = np.unique(P, axis=0, return_inverse=True)
+        rows, inverse = unique_rows(P)
         out = np.empty(rows.shape[0])
         for k, row in enumerate(rows):
             lane = copy.copy(self)
             lane.params = row.copy()
             w = np.asarray(fn(lane), dtype=float)
             out[k] = float(np.max(w)) if w.size else np.nan
-        return out[np.ravel(inverse)]
+        return out[inverse]
 
     def with_omega(self, omega: float) -> Model:
         """A copy with the forcing frequency set to ``omega``."""

@@ -33,7 +33,7 @@ import numpy as np
 
 from geardyn.errors import ParameterError
 from geardyn.models import catt_kernels as ck
-from geardyn.models.base import Model
+from geardyn.models.base import Model, unique_rows
 from geardyn.models.derived import (
     INTERPRETATIONS,
     Derived,
@@ -356,7 +356,15 @@ class CATTDevice(Model):
         (default: this device's coefficients), from the lane's own mean stiffness coefficients:
         sqrt of the largest eigenvalue magnitude of the stiffness matrix (vectorised)."""
         P = np.atleast_2d(self.params if P is None else np.asarray(P, dtype=float))
-        return np.sqrt(np.max(np.abs(self._mode_eigenvalues(P)), axis=1))
+        cols = [ck.HEADER + i * ck.block_size(int(P[0, ck.N_HARM])) + k
+                for i in range(self.n_sets) for k in (ck.K_SQ_C, ck.K_SQ_Q, ck.K_PQ_Q, ck.K_PQ_P)]
+        # only the stiffness coefficients matter: one eigenproblem per distinct set of them
+        keys, inverse = unique_rows(P[:, cols])
+        Q = np.zeros((keys.shape[0], P.shape[1]))
+        Q[:, ck.N_HARM] = P[0, ck.N_HARM]
+        Q[:, cols] = keys
+        w = np.sqrt(np.max(np.abs(self._mode_eigenvalues(Q)), axis=1))
+        return w[inverse]
 
     def static_forces(self) -> np.ndarray:
         """Dimensionless static mesh deflections g(X) = X - b of the quasi-static state under the

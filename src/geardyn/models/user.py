@@ -7,7 +7,7 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
-from geardyn.models.base import Model
+from geardyn.models.base import Model, unique_rows
 from geardyn.solvers.kernels import KernelSource
 
 
@@ -103,5 +103,5 @@ class UserModel(Model):
             return Model.fastest_natural_frequency(self, P)
         if not callable(w):
             return np.full(P.shape[0], float(w))
-        rows, inverse = np.unique(P, axis=0, return_inverse=True)
-        return np.array([float(w(r)) for r in rows])[np.ravel(inverse)]
+        rows, inverse = unique_rows(P)
+        return np.array([float(w(r)) for r in rows])[inverse]
