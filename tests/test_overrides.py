@@ -99,6 +99,11 @@ def test_raw_overrides_survive_changes_that_leave_them_alone(device):
                                device.with_params(k_sq_c=0.1, k_pq_q=2.5).natural_frequencies(),
                                rtol=1e-10)
     assert g.params[g.param_names.index("k_sq_c2")] == pytest.approx(0.1 / 4)
+    one = device.general().with_params(k_sq_c2=0.5)
+    assert one.coefficients["k_sq_c"].tolist()[1] == 0.5
+    assert one.coefficients["k_sq_c"][0] == device.coefficients["k_sq_c"][0]
+    with pytest.raises(ParameterError, match="^spare3: "):
+        device.general().with_params(spare3=1.0)
 
 
 @pytest.mark.parametrize("first,then,field", [

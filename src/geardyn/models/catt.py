@@ -234,7 +234,8 @@ class CATTDevice(Model):
         """A copy with parameters changed by name: physical ones (the paper's names, see
         :data:`~geardyn.models.params.PAPER_NAMES`, and ``Omega``) re-derive every coefficient;
         any other name sets that raw coefficient of the vector (e.g. ``k_pq_q``, ``f_c0``;
-        dimensionless, in units of this device's omega_n, which stays). Everything derived
+        dimensionless, in units of this device's omega_n, which stays; the reduced form's
+        ``k_sq_c`` and ``c_sq_c`` are the N planet sets' together). Everything derived
         (natural frequencies, static forces, initial state, default step) then follows the
         coefficients. Raises :class:`~geardyn.errors.ParameterError` for a coefficient that
         fixes the vector's layout (``n_blocks``, ``n_harmonics``, ``spare``) and for a physical
@@ -244,13 +245,22 @@ class CATTDevice(Model):
         out = self.replace(**physical) if physical else self
         return out._override(rest) if rest else (out if physical else copy.copy(self))
 
+    def _kind(self, name: str) -> str:
+        """The coefficient ``name`` without its planet-set suffix (the reduced form's name)."""
+        idx = self._param_index(name)
+        if idx < ck.HEADER:
+            return self.param_names[idx]
+        bs = ck.block_size(int(self.params[ck.N_HARM]))
+        suffix = "" if self.reduced else str((idx - ck.HEADER) // bs + 1)
+        return self.param_names[idx].removesuffix(suffix)
+
     def _override(self, raw: dict[str, float]) -> CATTDevice:
         """A copy with raw coefficients set (checked: known, not structural, finite)."""
         out = copy.copy(self)
         p = self.params.copy()
         for name, value in raw.items():
             idx = self._param_index(name)
-            base = self.param_names[idx].rstrip("0123456789")
+            base = self._kind(name)
             if base in _STRUCTURAL:
                 raise ParameterError(name, value, _STRUCTURAL[base])
             if not math.isfinite(value):
@@ -258,28 +268,32 @@ class CATTDevice(Model):
             p[idx] = value
         out.params = p
         out.raw_overrides = {**self.raw_overrides, **raw}
-        out.coefficients = self._coefficients_of(p)
+        out.coefficients = out._coefficients_of(p)
         return out
 
     def _coefficients_of(self, p: np.ndarray) -> dict[str, np.ndarray | float]:
-        """The Eq. (10) coefficients (as :attr:`coefficients`) read back from a vector."""
+        """:attr:`coefficients` with the raw-overridden ones read back from the vector ``p``
+        (the reduced form's carrier coupling is N sets' together: divided by N)."""
         co = dict(self.coefficients)
+        touched = {self._kind(k) for k in self.raw_overrides}
         blk = self._blocks(p[None, :])[0]
-        mult = self.params_in.n_planets if self.reduced else 1
         n = self.params_in.n_planets
+
+        def put(name: str, v: np.ndarray) -> None:
+            co[name] = np.broadcast_to(v, (n,)).copy() if v.size == 1 else v.copy()
+
         for name, idx in (("k_sq_c", ck.K_SQ_C), ("c_sq_c", ck.C_SQ_C), ("k_sq_q", ck.K_SQ_Q),
                           ("c_sq_q", ck.C_SQ_Q), ("k_pq_q", ck.K_PQ_Q), ("c_pq_q", ck.C_PQ_Q),
                           ("k_pq_p", ck.K_PQ_P), ("c_pq_p", ck.C_PQ_P), ("b_sq", ck.B_SQ),
                           ("b_pq", ck.B_PQ), ("f_p0", ck.F_P0), ("f_p1", ck.F_P1)):
-            v = blk[:, idx] / (mult if name in ("k_sq_c", "c_sq_c") else 1)
-            co[name] = np.broadcast_to(v, (n,)).copy() if v.size == 1 else v.copy()
+            if name in touched:
+                put(name, blk[:, idx] / (n if self.reduced and name[2:] == "_sq_c" else 1))
         for name, s_idx, c_idx in (("E_sq", ck.E_SQ_S, ck.E_SQ_C), ("E_pq", ck.E_PQ_S, ck.E_PQ_C)):
-            changed = [k for k in self.raw_overrides if k.rstrip("0123456789") in
-                       (f"{name}_s", f"{name}_c")]
-            if changed:
-                v = np.hypot(blk[:, s_idx], blk[:, c_idx])
-                co[name] = np.broadcast_to(v, (n,)).copy() if v.size == 1 else v.copy()
-        co["f_c0"], co["f_c1"] = float(p[ck.F_C0]), float(p[ck.F_C1])
+            if touched & {f"{name}_s", f"{name}_c"}:
+                put(name, np.hypot(blk[:, s_idx], blk[:, c_idx]))
+        for name, idx in (("f_c0", ck.F_C0), ("f_c1", ck.F_C1)):
+            if name in touched:
+                co[name] = float(p[idx])
         return co
 
     def lane_params(self, name: str, values: Sequence[float] | np.ndarray) -> np.ndarray:
