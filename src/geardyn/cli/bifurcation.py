@@ -6,8 +6,8 @@ saved result).
     geardyn bifurcation STUDY.toml [--param Omega] [--range 0.1:4:1000]
                         [--continuation none|up|down] [--lyapunov] [--transient T] [--samples N]
                         [--converge TOL] [--continued-transient T] [--steps-per-period N]
-                        [--omega W] [--interpretation ...] [--state X_sq] [--quiet]
-                        [--yes] [--out out.nc] [--plot out.png]
+                        [--omega W] [--hold Omega|speed] [--interpretation ...] [--state X_sq]
+                        [--quiet] [--yes] [--out out.nc] [--plot out.png]
     geardyn plot RESULT.nc|map.zarr [--out fig.png|fig.pdf] [--state X_sq] [--sweep up|down]
 
 Unset options come from the study's ``[sweep]`` table (param, range, continuation, samples,
