@@ -10,6 +10,8 @@ import pytest
 
 import geardyn
 from geardyn.analysis.lyapunov import lyapunov, lyapunov_lanes
+from geardyn.io.toml import builtin_study
+from geardyn.models import catt_kernels
 
 
 @nb.njit(cache=True)
@@ -200,3 +202,40 @@ def test_bad_arguments():
         lyapunov(g, y0=[1.0, 2.0, 3.0])
     with pytest.raises(ValueError):
         lyapunov(g, renorm_every=0)
+
+
+# ----------------------------------------------------------------------------- start time
+def test_sweep_exponent_continues_its_lane_in_both_forcing_phases():
+    """Fig. 14's load fluctuation (Lambda = 2) at Omega = 2: the mesh and load forcings share one
+    period, so the motion depends on their relative phase. A continued sweep restarts the mesh
+    phase at each point but keeps the absolute time of the load, so the point Omega = 2 reached
+    from Omega = 2 + d runs at the relative phase Lambda T0 of its start time T0. Its exponent
+    must be that of this system: equal (bitwise) to geardyn.lyapunov from the same state at the
+    same time, equal within the errors to an independent run of that system from the model's
+    initial state (long transient), and clearly unlike the restart at time 0 (load phase 0),
+    which the sweep's exponent used to be."""
+    model = builtin_study("paper_fig14").build_model()
+    lam_load = model.params[catt_kernels.LAMBDA]
+    assert lam_load == 2.0
+    samples = 512
+    for first in 2.0 + 0.002 * np.arange(1, 12):  # find a start whose load phase is far from 0
+        values = np.array([first, 2.0])
+        ds = geardyn.bifurcation(model, "Omega", values, transient=600.0, samples=samples,
+                                 continuation="down", lyapunov=True)
+        t_final = float(ds["final_time"].values[1])
+        if 2.6 < (lam_load * t_final) % (2.0 * math.pi) < 5.8:
+            break
+    else:
+        pytest.fail("no continued sweep reached Omega = 2 at a load phase in (2.6, 5.8)")
+    m = model.with_omega(2.0)
+    # as bifurcation does: 200 time units to align, then as long as the sampling (mean period)
+    kw = dict(transient=200.0, duration=samples * float(np.mean(2.0 * math.pi / values)),
+              steps_per_period=int(ds["steps_per_period"].values[1]), with_error=True)
+    same = geardyn.lyapunov(m, y0=ds["poincare"].values[1, -1], t0=t_final, **kw)
+    assert ds["lyapunov"].values[1] == same.value
+    assert ds["lyapunov_err"].values[1] == same.stderr
+    fresh = geardyn.lyapunov(m, t0=t_final, transient=1000.0, duration=kw["duration"],
+                             with_error=True)
+    assert abs(fresh.value - same.value) < 3.0 * (fresh.stderr + same.stderr)
+    zero = geardyn.lyapunov(m, y0=ds["poincare"].values[1, -1], t0=0.0, **kw)
+    assert abs(zero.value - same.value) > 3.0 * (zero.stderr + same.stderr)

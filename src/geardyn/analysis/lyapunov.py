@@ -26,10 +26,8 @@ DEFAULT_DT = 0.01
 DEFAULT_RENORM_EVERY = 10
 #: Default number of blocks the measuring window is cut into for the standard error.
 DEFAULT_BLOCKS = 16
-#: A start time t0 counts as on the integration grid when t0 / h is within this of an integer.
-GRID_TOL = 1e-6
 
-__all__ = ["DEFAULT_BLOCKS", "DEFAULT_DT", "DEFAULT_RENORM_EVERY", "GRID_TOL", "LyapunovEstimate",
+__all__ = ["DEFAULT_BLOCKS", "DEFAULT_DT", "DEFAULT_RENORM_EVERY", "LyapunovEstimate",
            "lyapunov", "lyapunov_err_attrs", "lyapunov_lanes"]
 
 
@@ -38,8 +36,9 @@ class LyapunovEstimate:
     """A finite-time Lyapunov exponent with its statistical uncertainty.
 
     ``value``: the exponent (per unit model time; an array, descending, for a spectrum);
-    ``stderr``: its 1-sigma standard error, std(block rates) / sqrt(n_blocks) over the blocks
-    of the measuring window (same shape; NaN with fewer than 2 blocks or when diverged);
+    ``stderr``: its 1-sigma standard error, std(block rates) / sqrt(n_blocks) over blocks of
+    whole forcing periods of the measuring window (same shape; NaN with fewer than 2 blocks or
+    when diverged);
     ``n_blocks``: the number of blocks used."""
 
     value: float | np.ndarray
@@ -54,22 +53,9 @@ def lyapunov_err_attrs(time_unit: str) -> dict[str, str]:
         "units": f"1/{time_unit}",
         "meaning": "1-sigma statistical error of the finite-time exponent per unit model time; "
                    "NaN where lyapunov is NaN",
-        "method": f"std(block rates, ddof=1) / sqrt(n) over n = {DEFAULT_BLOCKS} blocks of "
-                  "equal length (to a renormalisation interval) of the measuring window; "
-                  "see docs/lyapunov.md, Uncertainty"}
-
-
-def _grid_start(t0: float, h: float, n_per: int) -> int:
-    """The grid step (mod ``n_per``) of the start time t0 on a grid of step h whose step 0 is a
-    forcing-phase zero; ValueError if t0 is not on that grid (within GRID_TOL steps)."""
-    x = t0 / h
-    i = round(x)
-    if abs(x - i) > GRID_TOL:
-        raise ValueError(
-            f"t0 = {t0!r} is not on the integration grid (t0 / h = {x!r}, h = 2 pi / (Omega "
-            f"{n_per})): the forcing phase is tabulated at grid points only; give a whole "
-            "number of steps (a sweep's final time is a whole number of forcing periods)")
-    return int(i % n_per)
+        "method": f"batch means: the measuring window cut into n = {DEFAULT_BLOCKS} blocks of "
+                  "whole forcing periods (fewer if shorter), std(block rates, ddof=1) / "
+                  "sqrt(n); see docs/lyapunov.md, Uncertainty"}
 
 
 def _check_blocks(n_blocks: int) -> int:
@@ -122,11 +108,13 @@ def lyapunov(
     y0
         Initial state (default: ``model.initial_state()``), at time ``t0``.
     t0
-        Start time, in the model's time unit (default 0): the time-dependent forcings (mesh phase
-        Omega t, load phase Lambda t) continue from there, so a state taken from a run at time t
-        is continued on its own attractor with ``t0=t``. For a forced model t0 must lie on the
-        integration grid, a whole number of steps h = 2 pi / (Omega steps_per_period) (to
-        ``GRID_TOL`` steps), else ValueError; whole forcing periods always are.
+        Time of ``y0``, in the model's time unit (default 0). The forcing phase (Omega) is zero
+        at t0, as in every solver of the package (a lane started at T0 samples its Poincare
+        points at T0 + whole periods); every other time-dependent term, e.g. a load fluctuation
+        sin(Lambda t), sees the absolute time, from t0 on. So a Poincare point of a run and
+        its time (a sweep's ``final_time``) continue that run in both forcing phases, on its own
+        attractor. A state at another forcing phase cannot be started (the phase is tabulated
+        on the period-aligned grid from zero).
     transient, duration
         Time discarded first and time averaged over, in the model's time unit. For a forced model
         both are rounded up to whole forcing periods.
@@ -178,14 +166,13 @@ def lyapunov(
         h = period / n_per
         n_tr = _whole_periods(transient, period) * n_per
         n_st = max(1, _whole_periods(duration, period)) * n_per
-    i0 = 0 if om == 0.0 else _grid_start(t0, h, n_per)
     renorm = int(DEFAULT_RENORM_EVERY if renorm_every is None else renorm_every)
     if renorm < 1:
         raise ValueError(f"renorm_every must be >= 1 (got {renorm_every!r})")
     k = model.n_states if spectrum else 1
     kern = kernels_for(model.kernel, "lyapunov")
     p = np.ascontiguousarray(model.params, dtype=float)
-    ex, er, used, _status = kern.lyapunov_single(p, y, t0, i0, h, om, n_per, n_tr, n_st, renorm,
+    ex, er, used, _status = kern.lyapunov_single(p, y, t0, h, om, n_per, n_tr, n_st, renorm,
                                                  k, float(bound), model.n_events, n_blk)
     ex = np.asarray(ex, dtype=float)
     er = np.asarray(er, dtype=float)
@@ -224,9 +211,9 @@ def lyapunov_lanes(
     :func:`~geardyn.solvers.ensemble.run_lanes`); an autonomous model uses the step ``dt``
     (default 0.01).
 
-    ``t0``: the time of ``y0``, one for all lanes or one per lane (model time units; on each
-    lane's grid, as in :func:`lyapunov`): a sweep's ``LaneResults.final_time`` continues each
-    lane in both forcing phases. ``with_error``: return ``(exponents, stderr)``, the standard
+    ``t0``: the time of ``y0``, one for all lanes or one per lane (model time units; forcing
+    phase zero there, as in :func:`lyapunov`): a sweep's ``LaneResults.final_time`` continues
+    each lane in both forcing phases. ``with_error``: return ``(exponents, stderr)``, the standard
     errors from ``n_blocks`` blocks as in :func:`lyapunov` (NaN where the exponent is NaN).
     """
     P = np.ascontiguousarray(np.atleast_2d(np.asarray(P, dtype=float)))
@@ -259,7 +246,6 @@ def lyapunov_lanes(
         H = np.full(L, h)
         n_tr = np.full(L, math.ceil(transient / h - 1e-9), dtype=np.int64)
         n_st = np.full(L, max(1, math.ceil(duration / h - 1e-9)), dtype=np.int64)
-        I0 = np.zeros(L, dtype=np.int64)
     else:
         if dt is not None:
             raise ValueError("dt applies to autonomous models; give steps_per_period instead")
@@ -278,8 +264,6 @@ def lyapunov_lanes(
                          for T, n in zip(periods, n_lane, strict=True)], dtype=np.int64)
         n_st = np.array([max(1, _whole_periods(duration, T)) * n
                          for T, n in zip(periods, n_lane, strict=True)], dtype=np.int64)
-        I0 = np.array([_grid_start(float(t), float(hh), int(n))
-                       for t, hh, n in zip(T0, H, n_lane, strict=True)], dtype=np.int64)
     renorm = int(DEFAULT_RENORM_EVERY if renorm_every is None else renorm_every)
     if renorm < 1:
         raise ValueError(f"renorm_every must be >= 1 (got {renorm_every!r})")
@@ -291,7 +275,7 @@ def lyapunov_lanes(
                   else [(int(n), np.nonzero(n_lane == n)[0]) for n in np.unique(n_lane)])
         for n, idx in groups:
             part, part_err = np.full(idx.size, np.nan), np.full(idx.size, np.nan)
-            kern.lyapunov_lanes(P[idx], Y0[idx], T0[idx], I0[idx], H[idx], OMEGA[idx], n,
+            kern.lyapunov_lanes(P[idx], Y0[idx], T0[idx], H[idx], OMEGA[idx], n,
                                 n_tr[idx], n_st[idx], renorm, float(bound), part, part_err,
                                 model.n_events, n_blk)
             out[idx], err[idx] = part, part_err

@@ -25,15 +25,16 @@ Numerics
   diagonal of R are summed over the measuring window (Benettin et al. 1980; Shimada & Nagashima
   1979). The transient advances the tangent vectors too (renormalised, not summed) so that they
   are aligned when measuring starts.
-* Start time: the state y0 is given at time t0 = tb + i0 h, i0 a grid step (the forcing phase
-  from the table at step i0 mod n_per); the time passed to ``rhs`` (e.g. the load phase
-  Lambda t) is tb + i h. A sweep's final time is a whole number of forcing periods, i0 = 0 and
-  tb = t0, so an exponent continues the sweep's lane in both forcing phases.
-* Uncertainty: the measuring window is cut into ``n_blocks`` blocks of (nearly) equal length,
-  each ending at a renormalisation (block b holds the renormalisations at measured steps s with
-  floor((s - 1) n_blocks / n_steps) = b); the log sums per block over the block's time give
-  block rates, whose standard deviation over sqrt(n) is the standard error. This only adds
-  per-block sums next to the total: the exponent itself is unchanged.
+* Start time: the state y0 is given at time t0, where the forcing phase is zero (grid step i
+  runs from t0 + i h, forcing phase from the table at i mod n_per; the time passed to ``rhs``,
+  e.g. for a load fluctuation at Lambda, is t0 + i h), exactly as the sweep kernel runs a lane
+  started at T0. A sweep's final state lies at forcing phase zero of its lane, so started at
+  the lane's final time the exponent continues the lane in both forcing phases.
+* Uncertainty: the measuring window is cut into up to ``n_blocks`` blocks of whole forcing
+  periods (as equal as they divide); the log stretch of each block (the renormalisations in it,
+  plus, where a block ends between two, the stretch so far, taken from a copy of the tangent
+  vectors) over its time gives a block rate, and the spread of the rates the standard error
+  (:func:`_block_stderr`). The exponent itself is summed as before, untouched.
 * A lane whose state leaves ``|y| <= bound`` (checked at each renormalisation) or whose tangent
   vectors stop being finite is marked diverged (status 1) and its exponents are NaN.
 * Cost per step: (2 k + 1) RK4 steps for k tangent vectors. They are independent integrations
@@ -71,14 +72,14 @@ __all__ = ["events", "lyapunov_lanes", "lyapunov_single", "observe", "phase_tabl
 
 
 @nb.njit(**_JIT)
-def _grid_step_rows(i, tb, Y, p, h, omega, n_per, s_tab, c_tab, n_ev, K, TMP, Y1, SIDE, G0, G1, W,
+def _grid_step_rows(i, t0, Y, p, h, omega, n_per, s_tab, c_tab, n_ev, K, TMP, Y1, SIDE, G0, G1, W,
                     gbuf, ncross):
-    """Advance every row of Y (independent states of one lane) by grid step i (time tb + i h to
-    tb + (i + 1) h, forcing phase from the table at i mod n_per): one RK4 step per row, the
+    """Advance every row of Y (independent states of one lane) by grid step i (time t0 + i h to
+    t0 + (i + 1) h, forcing phase from the table at i mod n_per): one RK4 step per row, the
     rows' stages interleaved; a row whose trial step changes the side of a switching function is
     redone with the crossings located (:func:`_split_step`), as the main solver does."""
     nr, ns = Y.shape
-    t = tb + i * h
+    t = t0 + i * h
     hh = 0.5 * h
     j0 = 2 * (i % n_per)
     if n_ev > 0:
@@ -115,7 +116,7 @@ def _grid_step_rows(i, tb, Y, p, h, omega, n_per, s_tab, c_tab, n_ev, K, TMP, Y1
                 if _side(G1[r, j]) != SIDE[r, j]:
                     crossed = True
         if crossed:
-            _split_step(i, tb, Y[r], Y1[r], p, h, omega, n_per, SIDE[r], G1[r], ncross, W,
+            _split_step(i, t0, Y[r], Y1[r], p, h, omega, n_per, SIDE[r], G1[r], ncross, W,
                         W[8], gbuf)
         else:
             for q in range(ns):
@@ -123,7 +124,7 @@ def _grid_step_rows(i, tb, Y, p, h, omega, n_per, s_tab, c_tab, n_ev, K, TMP, Y1
 
 
 @nb.njit(**_JIT)
-def _tangent_step(i, tb, Z, p, h, omega, n_per, s_tab, c_tab, n_ev, YP, E, K, TMP, Y1, SIDE, G0, G1,
+def _tangent_step(i, t0, Z, p, h, omega, n_per, s_tab, c_tab, n_ev, YP, E, K, TMP, Y1, SIDE, G0, G1,
                   W, gbuf, ncross):
     """Advance the state (row 0 of Z) by one grid step and each tangent vector v (rows 1..) by
     the derivative of that step map: (Phi(y + e v) - Phi(y - e v)) / (2 e). The 2 k + 1 states
@@ -152,7 +153,7 @@ def _tangent_step(i, tb, Z, p, h, omega, n_per, s_tab, c_tab, n_ev, YP, E, K, TM
         for q in range(ns):
             YP[2 * j - 2, q] = Z[0, q] + e * Z[j, q]
             YP[2 * j - 1, q] = Z[0, q] - e * Z[j, q]
-    _grid_step_rows(i, tb, YP, p, h, omega, n_per, s_tab, c_tab, n_ev, K, TMP, Y1, SIDE, G0, G1, W,
+    _grid_step_rows(i, t0, YP, p, h, omega, n_per, s_tab, c_tab, n_ev, K, TMP, Y1, SIDE, G0, G1, W,
                     gbuf, ncross)
     for j in range(1, m):
         if not math.isfinite(E[j]):
@@ -193,42 +194,65 @@ def _orthonormalise(Z, logs, add):
 
 
 @nb.njit(**_JIT)
-def _block_stderr(blk, bend, h, err):
-    """Standard error of each exponent from its block rates: blk[b, j] (sum of logs in block b)
-    over the block's measured time (bend[b] - the previous block's end, in steps of h; a block
-    without a renormalisation, bend[b] = 0, is skipped): std(rates, ddof=1) / sqrt(n). Writes
-    err[j] (NaN with fewer than 2 blocks) and returns n, the number of blocks used."""
-    nb_, k = blk.shape
-    n = 0
-    for b in range(nb_):
-        if bend[b] > 0:
-            n += 1
-    for j in range(k):
-        err[j] = np.nan
-    if n < 2:
-        return n
-    for j in range(k):
-        s1 = 0.0
-        s2 = 0.0
-        prev = 0
-        for b in range(nb_):
-            if bend[b] > 0:
-                rate = blk[b, j] / ((bend[b] - prev) * h)
-                prev = bend[b]
-                s1 += rate
-                s2 += rate * rate
-        mean = s1 / n
-        var = max(s2 - n * mean * mean, 0.0) / (n - 1)
-        err[j] = math.sqrt(var / n)
-    return n
+def _stretch_logs(Z, C, logs):
+    """The logs of R's diagonal that orthonormalising Z's tangent rows would give now (the
+    stretch since the last renormalisation), computed on the copy C: Z is left as it is."""
+    m, ns = Z.shape
+    for j in range(m):
+        for q in range(ns):
+            C[j, q] = Z[j, q]
+    for j in range(1, m):
+        logs[j - 1] = np.nan
+    _orthonormalise(C, logs, True)
 
 
 @nb.njit(**_JIT)
-def _run(p, y0, tb, i0, h, omega, n_per, s_tab, c_tab, n_transient, n_steps, renorm_every, k,
+def _block_bounds(n_steps, n_per, n_blocks):
+    """Ends of the blocks of the measuring window (measured steps): whole forcing periods
+    (``n_per`` steps; one step for an autonomous model, n_per = 1), as equal as they divide, at
+    most ``n_blocks`` and at most one per period."""
+    units = n_steps // n_per
+    nbk = max(min(n_blocks, units), 1)
+    ends = np.zeros(nbk, np.int64)
+    for b in range(nbk):
+        ends[b] = ((b + 1) * units // nbk) * n_per
+    ends[nbk - 1] = n_steps
+    return ends
+
+
+@nb.njit(**_JIT)
+def _block_stderr(blk, ends, h, err):
+    """Standard error of each exponent from its blocks: blk[b, j] (log stretch in block b),
+    block b ending at measured step ends[b]. With rates r_b = blk[b] / T_b, weights T_b and
+    lambda = sum(blk) / sum(T_b): err^2 = n / (n - 1) sum(T_b^2 (r_b - lambda)^2) / T^2 (for
+    equal blocks std(r, ddof=1)^2 / n). Writes err[j] (NaN with fewer than 2 blocks)."""
+    n, k = blk.shape
+    for j in range(k):
+        err[j] = np.nan
+    if n < 2:
+        return
+    tt = ends[n - 1] * h
+    for j in range(k):
+        lam = 0.0
+        for b in range(n):
+            lam += blk[b, j]
+        lam /= tt
+        ss = 0.0
+        prev = 0
+        for b in range(n):
+            tb = (ends[b] - prev) * h
+            prev = ends[b]
+            d = blk[b, j] - lam * tb  # = T_b (r_b - lambda)
+            ss += d * d
+        err[j] = math.sqrt(ss * n / (n - 1)) / tt
+
+
+@nb.njit(**_JIT)
+def _run(p, y0, t0, h, omega, n_per, s_tab, c_tab, n_transient, n_steps, renorm_every, k,
          bound, n_ev, n_blocks):
-    """Exponents (sum of logs / measured time), their standard errors (from ``n_blocks`` blocks
-    of the measuring window), the number of blocks used and the status of one lane. The lane
-    starts at grid step i0 (time tb + i0 h, forcing phase from the table at i0 mod n_per)."""
+    """Exponents (sum of logs / measured time), their standard errors (from up to ``n_blocks``
+    blocks of whole forcing periods of the measuring window), the number of blocks and the
+    status of one lane, started at time t0 (forcing phase zero there)."""
     ns = y0.size
     m = k + 1
     Z = np.zeros((m, ns))
@@ -247,9 +271,10 @@ def _run(p, y0, tb, i0, h, omega, n_per, s_tab, c_tab, n_transient, n_steps, ren
     ncross = np.zeros(ne, np.int64)
     acc = np.zeros(k)
     logs = np.zeros(k)
-    nbk = max(n_blocks, 1)
-    blk = np.zeros((nbk, k))  # sum of logs per block of the measuring window
-    bend = np.zeros(nbk, np.int64)  # last renormalisation of each block (measured steps)
+    ends = _block_bounds(max(n_steps, 1), n_per, n_blocks)
+    nbk = ends.size
+    blk = np.zeros((nbk, k))  # log stretch per block of the measuring window
+    C = np.zeros((m, ns))
     out = np.full(k, np.nan)
     err = np.full(k, np.nan)
     for q in range(ns):
@@ -262,58 +287,65 @@ def _run(p, y0, tb, i0, h, omega, n_per, s_tab, c_tab, n_transient, n_steps, ren
     renorm = max(renorm_every, 1)
     total = n_transient + n_steps
     since = 0
+    cur = 0  # the block being measured
     for i in range(total):
-        _tangent_step(i0 + i, tb, Z, p, h, omega, n_per, s_tab, c_tab, n_ev, YP, E, K, TMP, Y1,
-                      SIDE, G0, G1, W, gbuf, ncross)
+        _tangent_step(i, t0, Z, p, h, omega, n_per, s_tab, c_tab, n_ev, YP, E, K, TMP, Y1, SIDE,
+                      G0, G1, W, gbuf, ncross)
         since += 1
         step = i + 1
+        measure = step > n_transient
         if since == renorm or step == n_transient or step == total:
             since = 0
             if not _healthy(Z[0], bound):
                 return out, err, 0, STATUS_DIVERGED
-            measure = step > n_transient
             if not _orthonormalise(Z, logs, measure):
                 return out, err, 0, STATUS_DIVERGED
             if measure:
-                s = step - n_transient
-                b = ((s - 1) * nbk) // n_steps
-                bend[b] = s
                 for j in range(k):
                     acc[j] += logs[j]
-                    blk[b, j] += logs[j]
+                    blk[cur, j] += logs[j]
+            if measure and step - n_transient == ends[cur]:
+                cur += 1
+        elif measure and step - n_transient == ends[cur]:
+            # a block ends between renormalisations: its share of the running stretch, on a
+            # copy (the exponent's own arithmetic is untouched)
+            _stretch_logs(Z, C, logs)
+            for j in range(k):
+                blk[cur, j] += logs[j]
+                blk[cur + 1, j] -= logs[j]
+            cur += 1
     if n_steps <= 0:
         return out, err, 0, STATUS_OK
     tm = n_steps * h
     for j in range(k):
         out[j] = acc[j] / tm
-    n_used = _block_stderr(blk, bend, h, err)
-    return out, err, n_used, STATUS_OK
+    _block_stderr(blk, ends, h, err)
+    return out, err, nbk, STATUS_OK
 
 
 @nb.njit(**_JIT)
-def lyapunov_single(p, y0, t0, i0, h, omega, n_per, n_transient, n_steps, renorm_every, k,
+def lyapunov_single(p, y0, t0, h, omega, n_per, n_transient, n_steps, renorm_every, k,
                     bound, n_ev=0, n_blocks=16):
     """The k leading Lyapunov exponents (per unit time of the model) of one parameter set.
 
     Grid: step h (= 2 pi / (omega n_per) for a forced model); the state y0 is given at time t0,
-    which is grid step i0 (0 <= i0 < n_per: the forcing phase there is that of step i0 of the
-    phase table; t0 = i0 h + whole periods); ``n_transient`` steps are discarded and ``n_steps``
+    where the forcing phase is zero; ``n_transient`` steps are discarded and ``n_steps``
     measured. ``n_ev``: the model's number of switching functions, whose crossings are located
     inside a step (0: none located). Returns (exponents[k], stderr[k], blocks, status): the
     standard errors from ``n_blocks`` blocks of the measuring window (:func:`_block_stderr`;
     ``blocks`` of them used); exponents are NaN if diverged.
     """
     s_tab, c_tab = phase_table(n_per, omega != 0.0)
-    return _run(p, y0, t0 - i0 * h, i0, h, omega, n_per, s_tab, c_tab, n_transient, n_steps,
+    return _run(p, y0, t0, h, omega, n_per, s_tab, c_tab, n_transient, n_steps,
                 renorm_every, k, bound, n_ev, n_blocks)
 
 
 @nb.njit(parallel=True, **_JIT)
-def lyapunov_lanes(P, Y0, T0, I0, H, OMEGA, n_per, n_transient, n_steps, renorm_every, bound,
+def lyapunov_lanes(P, Y0, T0, H, OMEGA, n_per, n_transient, n_steps, renorm_every, bound,
                    out, err, n_ev=0, n_blocks=16):
     """Largest exponent of every lane (row of P, Y0), in parallel over lanes.
 
-    T0, I0: start time and its grid step (as in :func:`lyapunov_single`) per lane; H, OMEGA:
+    T0: start time (forcing phase zero there, as in :func:`lyapunov_single`) per lane; H, OMEGA:
     step and forcing frequency per lane; n_transient, n_steps: per-lane step counts (int
     arrays); n_ev and n_blocks as in :func:`lyapunov_single`. Fills out[L] and err[L] (the
     standard error; NaN for diverged lanes).
@@ -325,9 +357,8 @@ def lyapunov_lanes(P, Y0, T0, I0, H, OMEGA, n_per, n_transient, n_steps, renorm_
             forced = True
     s_tab, c_tab = phase_table(n_per, forced)
     for lane in nb.prange(L):
-        h = H[lane]
-        ex, er, _nb, st = _run(P[lane], Y0[lane], T0[lane] - I0[lane] * h, I0[lane], h,
-                               OMEGA[lane], n_per, s_tab, c_tab, n_transient[lane],
-                               n_steps[lane], renorm_every, 1, bound, n_ev, n_blocks)
+        ex, er, _nb, st = _run(P[lane], Y0[lane], T0[lane], H[lane], OMEGA[lane], n_per, s_tab,
+                               c_tab, n_transient[lane], n_steps[lane], renorm_every, 1, bound,
+                               n_ev, n_blocks)
         out[lane] = ex[0] if st == STATUS_OK else np.nan
         err[lane] = er[0] if st == STATUS_OK else np.nan
