@@ -116,8 +116,11 @@ def bifurcation(
     xarray.Dataset with coordinates ``param``, ``sample``, ``state``, ``mesh`` and variables
     ``poincare`` (param, sample, state), ``period`` (param; k >= 1 period-k, 0 quasi-periodic or
     chaotic, -1 unbounded), ``contact`` (param, mesh: none/single/double/unbounded),
-    ``force_peak``, ``force_rms``, ``dynamic_factor`` (param, mesh), ``status``, and
-    ``lyapunov`` (param) when asked.
+    ``force_peak``, ``force_rms``, ``dynamic_factor`` (param, mesh), ``status``,
+    ``final_time`` (param: the model time of the final state, the last Poincare point), and
+    ``lyapunov`` with its standard error ``lyapunov_err`` (param) when asked: started from each
+    point's final state at its final time, so both forcing phases continue (see
+    ``docs/lyapunov.md``).
     """
     values = _check_values(values)
     if continuation not in (None, "up", "down"):

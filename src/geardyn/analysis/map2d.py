@@ -133,7 +133,9 @@ def map2d(
         state).
     lyapunov
         Also compute the largest Lyapunov exponent per point (over ``samples`` mean forcing
-        periods, on a grid of ``steps_per_period`` steps, default that of the smallest Omega).
+        periods, on a grid of ``steps_per_period`` steps, default that of the smallest Omega),
+        from the point's final state at its final time, with its standard error
+        (``lyapunov_err``).
     client
         A ``dask.distributed.Client``: chunks run as tasks on its cluster. The result is bitwise
         that of the local run.
@@ -150,7 +152,8 @@ def map2d(
     xarray.Dataset with dimensions (y name, x name[, mesh]) and variables ``period`` (k >= 1
     period-k, 0 quasi-periodic or chaotic, -1 unbounded), ``contact`` (none/single/double/
     unbounded per mesh), ``force_peak``, ``force_rms``, ``dynamic_factor``, ``status``, step
-    counts, and ``lyapunov`` when asked; the settings in ``attrs`` (``x``, ``y``, ...).
+    counts, and ``lyapunov`` and ``lyapunov_err`` when asked; the settings in ``attrs``
+    (``x``, ``y``, ...).
     """
     xn, xv = _axis(x, "x")
     yn, yv = _axis(y, "y")
