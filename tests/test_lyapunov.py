@@ -188,6 +188,29 @@ def test_impacting_orbit_matches_floquet_reference():
         assert abs(est.value - ref) < 3.0 * est.stderr + 2.0 * disc + 2.0 * ref_err + 1e-9
 
 
+def test_contact_orbit_within_error_and_rotation_bias_of_floquet_reference():
+    # a period-1 orbit in permanent contact has a complex pair of Floquet multipliers of modulus
+    # exp(-zeta T) (two states, trace -2 zeta): one tangent vector never aligns but rotates,
+    # its stretch over N periods lying within a factor kappa (condition number of the
+    # eigenvectors of the monodromy matrix M) of |mu|^N. So the finite-time exponent may be off
+    # by the bias log(kappa) / D on top of its statistical error (docs/lyapunov.md, Uncertainty).
+    model = geardyn.GearPair(zeta=0.05, Fm=0.1, Fa=0.05, Omega=0.5)
+    T = model.period
+    guess = geardyn.simulate(model, transient=400.0, periods=1)["poincare"].values[-1]
+    y, mu = reference_floquet(model, guess)
+    assert np.all(mu.imag != 0)
+    ref = math.log(np.abs(mu).max()) / T
+    assert abs(ref + 0.05) < 1e-8  # the reference integrator agrees with the trace
+    M = np.column_stack([(geardyn.reference_solution(model, y + d, [T])[0]
+                          - geardyn.reference_solution(model, y - d, [T])[0]) / 2e-4
+                         for d in 1e-4 * np.eye(2)])
+    kappa = np.linalg.cond(np.linalg.eig(M)[1])
+    for duration in (100.0, 300.0, 1000.0):
+        est = lyapunov(model, y0=y, transient=100.0, duration=duration, with_error=True)
+        bias = math.log(kappa) / (math.ceil(duration / T - 1e-9) * T)
+        assert abs(est.value - ref) < 3.0 * est.stderr + bias
+
+
 def test_stderr_of_chaotic_exponent_matches_spread_of_repeats():
     # the standard error of one run (batch means over 16 blocks) must describe how much
     # independent runs of the same length scatter: 8 repeats started at points of one long
