@@ -9,7 +9,7 @@ The public API::
 """
 
 from geardyn.analysis.bifurcation import ContinuedSweep, bifurcation, continued_sweeps
-from geardyn.analysis.lyapunov import lyapunov, lyapunov_lanes
+from geardyn.analysis.lyapunov import LyapunovEstimate, lyapunov, lyapunov_lanes
 from geardyn.analysis.map2d import map2d
 from geardyn.analysis.periodicity import classify_period, common_section
 from geardyn.analysis.spectrum import amplitude_spectrum, label_peaks
@@ -35,6 +35,7 @@ __all__ = [
     "GeardynError",
     "Gear",
     "Loads",
+    "LyapunovEstimate",
     "Mesh",
     "Model",
     "ParameterError",

@@ -20,6 +20,7 @@ from geardyn.analysis.lanes import (
     variable_attrs,
     variable_dims,
 )
+from geardyn.analysis.lyapunov import lyapunov_err_attrs
 from geardyn.analysis.periodicity import DEFAULT_MAX_PERIOD, DEFAULT_TOL
 from geardyn.models.base import Model
 from geardyn.solvers.ensemble import LaneResults
@@ -123,8 +124,11 @@ def bifurcation(
     xarray.Dataset with coordinates ``param``, ``sample``, ``state``, ``mesh`` and variables
     ``poincare`` (param, sample, state), ``period`` (param; k >= 1 period-k, 0 quasi-periodic or
     chaotic, -1 unbounded), ``contact`` (param, mesh: none/single/double/unbounded),
-    ``force_peak``, ``force_rms``, ``dynamic_factor`` (param, mesh), ``status``, and
-    ``lyapunov`` (param) when asked.
+    ``force_peak``, ``force_rms``, ``dynamic_factor`` (param, mesh), ``status``,
+    ``final_time`` (param: the model time of the final state, the last Poincare point), and
+    ``lyapunov`` with its standard error ``lyapunov_err`` (param) when asked: started from each
+    point's final state at its final time, so both forcing phases continue (see
+    ``docs/lyapunov.md``).
     """
     values = _check_values(values)
     if continuation not in (None, "up", "down"):
@@ -141,8 +145,8 @@ def bifurcation(
                                continued_transient=continued_transient,
                                transient_max=transient_max, steps_per_period=steps_per_period,
                                y0=base_y0, hold=hold)
-        ((ds, final),) = _continued([sweep], samples, converge, max_period, tol, locate_edges,
-                                    bound, progress)
+        ((ds, last),) = _continued([sweep], samples, converge, max_period, tol, locate_edges,
+                                   bound, progress)
     else:
         opts = dict(transient=float(transient), samples=int(samples),
                     steps_per_period=steps_per_period, locate_edges=bool(locate_edges),
@@ -155,7 +159,7 @@ def bifurcation(
         every = _independent(model, np.tile(P, (starts, 1)), np.concatenate(Y0), chunk,
                              progress, client, store, **opts)
         runs = [every.take(slice(s * L, (s + 1) * L)) for s in range(starts)]
-        final = runs[0].final
+        last = runs[0]
         ds = _dataset(model, param, values, runs, max_period, tol)
         ds.attrs.update(_settings(transient, samples, converge, transient_max, locate_edges,
                                   bound, tol, max_period), continuation="none",
@@ -164,15 +168,22 @@ def bifurcation(
     if lyapunov:
         from geardyn.analysis.lyapunov import lyapunov_lanes
 
-        # from each point's own final state (on the attractor the Poincare points show, also
-        # in continuation), with each lane's own step; a short run aligns the tangent vectors
+        # from each point's own final state at its final time (on the attractor the Poincare
+        # points show, also in continuation, both forcing phases continued), with each lane's
+        # own step; a short run aligns the tangent vectors
+        final = last.final
         start = np.where(np.isfinite(final), final, np.broadcast_to(base_y0, final.shape))
-        exps = lyapunov_lanes(model, P, start, min(transient, LYAPUNOV_ALIGN),
-                              samples * _mean_period(model, P), steps_per_period)
-        ds["lyapunov"] = (param, np.where(ds["status"].values == 0, exps, np.nan), {
+        exps, errs = lyapunov_lanes(model, P, start, min(transient, LYAPUNOV_ALIGN),
+                                    samples * _mean_period(model, P), steps_per_period,
+                                    t0=last.final_time, with_error=True)
+        ok = ds["status"].values == 0
+        method = ("tangent-map QR (Benettin), from the point's final state at its final time, "
+                  f"{LYAPUNOV_ALIGN:g} time units to align, then as long as the sampling")
+        ds["lyapunov"] = (param, np.where(ok, exps, np.nan), {
             "long_name": "largest Lyapunov exponent", "units": f"1/{model.time_unit}",
-            "method": "tangent-map QR (Benettin), from the point's final state, "
-                      f"{LYAPUNOV_ALIGN:g} time units to align, then as long as the sampling"})
+            "method": method})
+        ds["lyapunov_err"] = (param, np.where(ok & np.isfinite(exps), errs, np.nan),
+                              lyapunov_err_attrs(model.time_unit))
     return ds
 
 
@@ -217,8 +228,9 @@ def continued_sweeps(
 
 
 def _continued(sweeps, samples, converge, max_period, tol, locate_edges, bound, progress,
-               max_section_periods=None) -> list[tuple[xr.Dataset, np.ndarray]]:
-    """continued_sweeps, with each sweep's final states (in value order)."""
+               max_section_periods=None) -> list[tuple[xr.Dataset, LaneResults]]:
+    """continued_sweeps, with each sweep's lane results (in value order: final states and
+    times)."""
     _check_converge(converge)
     prepared = []
     for sw in sweeps:
@@ -266,7 +278,7 @@ def _continued(sweeps, samples, converge, max_period, tol, locate_edges, bound, 
         if sw.continued_transient is not None:
             ds.attrs["continued_transient"] = float(sw.continued_transient)
         ds = _record_hold(ds, sw.model, sw.param, branch.P[back], sw.hold)
-        out.append((ds, r.final))
+        out.append((ds, r))
     return out
 
 
@@ -390,6 +402,9 @@ def _dataset(model: Model, param: str, values: np.ndarray, runs: list[LaneResult
         ds["period_by_start"] = ((param, "start"), periods)
         ds["start_of_sample"] = ("sample", np.repeat(np.arange(len(runs)), samples))
     ds["status"] = (param, status, {"meaning": "0 ok, 1 diverged in at least one start"})
+    ds["final_time"] = (param, first.final_time, {
+        "long_name": "model time at the last Poincare sample (the final state)",
+        "units": model.time_unit})
     ds.attrs.update(model=model.name, param=param, time_unit=model.time_unit)
     for key in ("interpretation",):
         if hasattr(model, key):

@@ -3,13 +3,15 @@
 The state and k tangent vectors are integrated by fixed-step RK4 on the main solver's grid, the
 tangent dynamics J(t, y) v coming from a central finite difference of the model's ``rhs``; the
 vectors are re-orthonormalised (modified Gram-Schmidt) every ``renorm_every`` steps and the logs
-of the stretching factors averaged (Benettin et al. 1980). See ``docs/lyapunov.md`` and the kernel
-template :mod:`geardyn.solvers._lyapunov_template`.
+of the stretching factors averaged (Benettin et al. 1980). Each exponent has a standard error from
+the spread of its block averages over the run. See ``docs/lyapunov.md`` and the kernel template
+:mod:`geardyn.solvers._lyapunov_template`.
 """
 
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -22,8 +24,45 @@ from geardyn.solvers.simulate import DEFAULT_BOUND, default_steps_per_period
 DEFAULT_DT = 0.01
 #: Default number of RK4 steps between re-orthonormalisations.
 DEFAULT_RENORM_EVERY = 10
+#: Default number of blocks the measuring window is cut into for the standard error.
+DEFAULT_BLOCKS = 16
 
-__all__ = ["DEFAULT_DT", "DEFAULT_RENORM_EVERY", "lyapunov", "lyapunov_lanes"]
+__all__ = ["DEFAULT_BLOCKS", "DEFAULT_DT", "DEFAULT_RENORM_EVERY", "LyapunovEstimate",
+           "lyapunov", "lyapunov_err_attrs", "lyapunov_lanes"]
+
+
+@dataclass(frozen=True)
+class LyapunovEstimate:
+    """A finite-time Lyapunov exponent with its statistical uncertainty.
+
+    ``value``: the exponent (per unit model time; an array, descending, for a spectrum);
+    ``stderr``: its 1-sigma standard error, std(block rates) / sqrt(n_blocks) over blocks of
+    whole forcing periods of the measuring window (same shape; NaN with fewer than 2 blocks or
+    when diverged);
+    ``n_blocks``: the number of blocks used."""
+
+    value: float | np.ndarray
+    stderr: float | np.ndarray
+    n_blocks: int
+
+
+def lyapunov_err_attrs(time_unit: str) -> dict[str, str]:
+    """Attributes of a dataset's ``lyapunov_err`` variable (the standard error of ``lyapunov``)."""
+    return {
+        "long_name": "standard error of the largest Lyapunov exponent",
+        "units": f"1/{time_unit}",
+        "meaning": "1-sigma statistical error of the finite-time exponent per unit model time; "
+                   "NaN where lyapunov is NaN",
+        "method": f"batch means: the measuring window cut into n = {DEFAULT_BLOCKS} blocks of "
+                  "whole forcing periods (fewer if shorter), std(block rates, ddof=1) / "
+                  "sqrt(n); see docs/lyapunov.md, Uncertainty"}
+
+
+def _check_blocks(n_blocks: int) -> int:
+    n = int(n_blocks)
+    if n < 2:
+        raise ValueError(f"n_blocks must be >= 2 (got {n_blocks!r})")
+    return n
 
 
 def _check_time(name: str, value: float, positive: bool) -> float:
@@ -58,13 +97,24 @@ def lyapunov(
     steps_per_period: int | None = None,
     renorm_every: int | None = None,
     bound: float = DEFAULT_BOUND,
-) -> float | np.ndarray:
+    t0: float = 0.0,
+    with_error: bool = False,
+    n_blocks: int = DEFAULT_BLOCKS,
+) -> float | np.ndarray | LyapunovEstimate:
     """Largest Lyapunov exponent of ``model`` (or the whole spectrum), per unit model time.
 
     Parameters
     ----------
     y0
-        Initial state (default: ``model.initial_state()``).
+        Initial state (default: ``model.initial_state()``), at time ``t0``.
+    t0
+        Time of ``y0``, in the model's time unit (default 0). The forcing phase (Omega) is zero
+        at t0, as in every solver of the package (a lane started at T0 samples its Poincare
+        points at T0 + whole periods); every other time-dependent term, e.g. a load fluctuation
+        sin(Lambda t), sees the absolute time, from t0 on. So a Poincare point of a run and
+        its time (a sweep's ``final_time``) continue that run in both forcing phases, on its own
+        attractor. A state at another forcing phase cannot be started (the phase is tabulated
+        on the period-aligned grid from zero).
     transient, duration
         Time discarded first and time averaged over, in the model's time unit. For a forced model
         both are rounded up to whole forcing periods.
@@ -79,6 +129,10 @@ def lyapunov(
         RK4 steps between re-orthonormalisations (default 10).
     bound
         A state beyond this magnitude counts as diverged; the result is then NaN.
+    with_error, n_blocks
+        True: return a :class:`LyapunovEstimate` (value, stderr, n_blocks) instead, the standard
+        error from the spread of the rates over ``n_blocks`` blocks of the measuring window (see
+        ``docs/lyapunov.md``, "Uncertainty").
 
     For a forced model the exponent of the flow's zero direction (along the forcing phase) is not
     included: the phase is not a state, so a forced model with n states has n exponents.
@@ -86,6 +140,10 @@ def lyapunov(
     transient = _check_time("transient", transient, False)
     duration = _check_time("duration", duration, True)
     y = _initial(model, y0)
+    t0 = float(t0)
+    if not math.isfinite(t0):
+        raise ValueError(f"t0 must be finite (got {t0!r})")
+    n_blk = _check_blocks(n_blocks)
     om = model.omega
     if om == 0.0:
         if steps_per_period is not None:
@@ -114,12 +172,18 @@ def lyapunov(
     k = model.n_states if spectrum else 1
     kern = kernels_for(model.kernel, "lyapunov")
     p = np.ascontiguousarray(model.params, dtype=float)
-    ex, _status = kern.lyapunov_single(p, y, h, om, n_per, n_tr, n_st, renorm, k, float(bound),
-                                         model.n_events)
+    ex, er, used, _status = kern.lyapunov_single(p, y, t0, h, om, n_per, n_tr, n_st, renorm,
+                                                 k, float(bound), model.n_events, n_blk)
     ex = np.asarray(ex, dtype=float)
+    er = np.asarray(er, dtype=float)
     if spectrum:
-        return np.sort(ex)[::-1].copy()
-    return float(ex[0])
+        order = np.argsort(ex, kind="stable")[::-1]
+        value, err = ex[order].copy(), er[order].copy()
+    else:
+        value, err = float(ex[0]), float(er[0])
+    if with_error:
+        return LyapunovEstimate(value, err, int(used))
+    return value
 
 
 def lyapunov_lanes(
@@ -132,7 +196,10 @@ def lyapunov_lanes(
     dt: float | None = None,
     renorm_every: int | None = None,
     bound: float = DEFAULT_BOUND,
-) -> np.ndarray:
+    t0: float | np.ndarray = 0.0,
+    with_error: bool = False,
+    n_blocks: int = DEFAULT_BLOCKS,
+) -> np.ndarray | tuple[np.ndarray, np.ndarray]:
     """Largest Lyapunov exponent for each row of the coefficient matrix ``P`` (lanes x n_params,
     e.g. from ``model.lane_params``), computed in parallel; NaN for diverged lanes.
 
@@ -143,6 +210,11 @@ def lyapunov_lanes(
     :func:`default_steps_per_period`, rounded up to the sweep's step ladder, as in
     :func:`~geardyn.solvers.ensemble.run_lanes`); an autonomous model uses the step ``dt``
     (default 0.01).
+
+    ``t0``: the time of ``y0``, one for all lanes or one per lane (model time units; forcing
+    phase zero there, as in :func:`lyapunov`): a sweep's ``LaneResults.final_time`` continues
+    each lane in both forcing phases. ``with_error``: return ``(exponents, stderr)``, the standard
+    errors from ``n_blocks`` blocks as in :func:`lyapunov` (NaN where the exponent is NaN).
     """
     P = np.ascontiguousarray(np.atleast_2d(np.asarray(P, dtype=float)))
     L = P.shape[0]
@@ -160,6 +232,10 @@ def lyapunov_lanes(
     if Y0.shape != (L, model.n_states):
         raise ValueError(f"y0 must have {model.n_states} entries or shape ({L}, {model.n_states})")
     Y0 = np.ascontiguousarray(Y0)
+    T0 = np.ascontiguousarray(np.broadcast_to(np.asarray(t0, dtype=float), (L,)))
+    if not np.all(np.isfinite(T0)):
+        raise ValueError("t0 must be finite")
+    n_blk = _check_blocks(n_blocks)
     if model.omega_index is None:
         if steps_per_period is not None:
             raise ValueError("steps_per_period applies to forced models; give dt instead")
@@ -168,7 +244,6 @@ def lyapunov_lanes(
             raise ValueError(f"dt must be > 0 (got {dt!r})")
         OMEGA = np.zeros(L)
         H = np.full(L, h)
-        n_per = 1
         n_tr = np.full(L, math.ceil(transient / h - 1e-9), dtype=np.int64)
         n_st = np.full(L, max(1, math.ceil(duration / h - 1e-9)), dtype=np.int64)
     else:
@@ -193,17 +268,15 @@ def lyapunov_lanes(
     if renorm < 1:
         raise ValueError(f"renorm_every must be >= 1 (got {renorm_every!r})")
     out = np.full(L, np.nan)
-    if L == 0:
-        return out
-    kern = kernels_for(model.kernel, "lyapunov")
-    if model.omega_index is None:
-        kern.lyapunov_lanes(P, Y0, H, OMEGA, n_per, n_tr, n_st, renorm, float(bound), out,
-                            model.n_events)
-        return out
-    for n in np.unique(n_lane):  # one kernel call per step count (one phase table)
-        idx = np.nonzero(n_lane == n)[0]
-        part = np.full(idx.size, np.nan)
-        kern.lyapunov_lanes(P[idx], Y0[idx], H[idx], OMEGA[idx], int(n), n_tr[idx], n_st[idx],
-                            renorm, float(bound), part, model.n_events)
-        out[idx] = part
-    return out
+    err = np.full(L, np.nan)
+    if L > 0:
+        kern = kernels_for(model.kernel, "lyapunov")
+        groups = ([(1, np.arange(L))] if model.omega_index is None  # one phase table each
+                  else [(int(n), np.nonzero(n_lane == n)[0]) for n in np.unique(n_lane)])
+        for n, idx in groups:
+            part, part_err = np.full(idx.size, np.nan), np.full(idx.size, np.nan)
+            kern.lyapunov_lanes(P[idx], Y0[idx], T0[idx], H[idx], OMEGA[idx], n,
+                                n_tr[idx], n_st[idx], renorm, float(bound), part, part_err,
+                                model.n_events, n_blk)
+            out[idx], err[idx] = part, part_err
+    return (out, err) if with_error else out

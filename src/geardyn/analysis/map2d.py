@@ -28,6 +28,7 @@ from geardyn.analysis.lanes import (
     variable_attrs,
     variable_dims,
 )
+from geardyn.analysis.lyapunov import lyapunov_err_attrs
 from geardyn.analysis.periodicity import DEFAULT_MAX_PERIOD, DEFAULT_TOL
 from geardyn.models.base import Model
 from geardyn.solvers.ensemble import ladder_steps, run_lanes
@@ -58,11 +59,14 @@ def _map_task(model: Model, P: np.ndarray, y0: np.ndarray, static: np.ndarray | 
     if lyapunov is not None:
         from geardyn.analysis.lyapunov import lyapunov_lanes
 
-        # from each point's final state: the attractor its period and contact describe
+        # from each point's final state at its final time (both forcing phases continue): the
+        # attractor its period and contact describe
         start = np.where(np.isfinite(r.final), r.final,
                          np.broadcast_to(np.asarray(y0, dtype=float), r.final.shape))
-        exps = lyapunov_lanes(model, P, start, **lyapunov)
+        exps, errs = lyapunov_lanes(model, P, start, t0=r.final_time, with_error=True,
+                                    **lyapunov)
         out["lyapunov"] = np.where(r.status == 0, exps, np.nan)
+        out["lyapunov_err"] = np.where(np.isfinite(out["lyapunov"]), errs, np.nan)
     return out
 
 
@@ -129,7 +133,9 @@ def map2d(
         state).
     lyapunov
         Also compute the largest Lyapunov exponent per point (over ``samples`` mean forcing
-        periods, on a grid of ``steps_per_period`` steps, default that of the smallest Omega).
+        periods, on a grid of ``steps_per_period`` steps, default that of the smallest Omega),
+        from the point's final state at its final time, with its standard error
+        (``lyapunov_err``).
     client
         A ``dask.distributed.Client``: chunks run as tasks on its cluster. The result is bitwise
         that of the local run.
@@ -146,7 +152,8 @@ def map2d(
     xarray.Dataset with dimensions (y name, x name[, mesh]) and variables ``period`` (k >= 1
     period-k, 0 quasi-periodic or chaotic, -1 unbounded), ``contact`` (none/single/double/
     unbounded per mesh), ``force_peak``, ``force_rms``, ``dynamic_factor``, ``status``, step
-    counts, and ``lyapunov`` when asked; the settings in ``attrs`` (``x``, ``y``, ...).
+    counts, and ``lyapunov`` and ``lyapunov_err`` when asked; the settings in ``attrs``
+    (``x``, ``y``, ...).
     """
     xn, xv = _axis(x, "x")
     yn, yv = _axis(y, "y")
@@ -184,11 +191,13 @@ def map2d(
     if model.meshes:
         ds = ds.assign_coords(mesh=("mesh", [m[0] for m in model.meshes]))
     dims, attrs = variable_dims(model), variable_attrs(model, max_period, tol)
-    dims.update(status=(), lyapunov=())
+    dims.update(status=(), lyapunov=(), lyapunov_err=())
     attrs.update(status={"meaning": "0 ok, 1 diverged"},
                  lyapunov={"long_name": "largest Lyapunov exponent",
-                           "units": f"1/{model.time_unit}"})
-    for name in (*variable_dims(model), "status", "lyapunov"):
+                           "units": f"1/{model.time_unit}",
+                           "start": "each point's final state at its final time"},
+                 lyapunov_err=lyapunov_err_attrs(model.time_unit))
+    for name in (*variable_dims(model), "status", "lyapunov", "lyapunov_err"):
         if name not in out:
             continue
         data = out[name].reshape(ny, nx, *out[name].shape[1:])
@@ -302,7 +311,7 @@ def estimate_map(model: Model, lanes: int, omegas: Sequence[float] | np.ndarray,
         steps += LYAPUNOV_COST * lanes * per
     ns, n_par = model.n_states, model.params.size
     n_mesh = len(model.meshes)
-    per_point = 8.0 * (n_par + ns + n_mesh + 2 * (6 + 5 * n_mesh + int(lyapunov)))
+    per_point = 8.0 * (n_par + ns + n_mesh + 2 * (6 + 5 * n_mesh + 2 * int(lyapunov)))
     size = chunk or default_chunk(lanes)
     memory = lanes * per_point + 2 * 8.0 * min(size, lanes) * samples * ns
     return MapEstimate(lanes=int(lanes), lane_steps=float(steps), memory_bytes=float(memory),

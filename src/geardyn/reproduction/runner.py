@@ -3,8 +3,8 @@ the largest Lyapunov exponent wherever the period classifier finds no period.
 
 The result of one case under one interpretation is an :class:`xarray.Dataset` with a ``sweep``
 dimension (``"up"``, ``"down"``) in front of the variables of :func:`geardyn.bifurcation`, plus
-``lyapunov`` (NaN where not computed) and ``motion`` (the labels of
-:mod:`geardyn.reproduction.motion`).
+``lyapunov`` (NaN where not computed), its standard error ``lyapunov_err`` and ``motion`` (the
+labels of :mod:`geardyn.reproduction.motion`).
 """
 
 from __future__ import annotations
@@ -17,7 +17,7 @@ import numpy as np
 import xarray as xr
 
 from geardyn.analysis.bifurcation import ContinuedSweep, continued_sweeps
-from geardyn.analysis.lyapunov import lyapunov_lanes
+from geardyn.analysis.lyapunov import lyapunov_err_attrs, lyapunov_lanes
 from geardyn.models.base import Model
 from geardyn.reproduction.cases import Case
 from geardyn.reproduction.motion import LYAPUNOV_CHAOS, motion_labels
@@ -107,17 +107,22 @@ def sweep_values(case: Case, settings: ReproductionSettings) -> np.ndarray:
 
 def branch_lyapunov(model: Model, values: np.ndarray, y0: np.ndarray, need: np.ndarray,
                     transient: float, duration: float,
-                    steps_per_period: int | None = None) -> np.ndarray:
-    """Largest Lyapunov exponent [1/tau] at the Omega ``values`` where ``need`` is true, each
-    started from its own state ``y0[i]`` (NaN elsewhere, and where the integration diverged).
+                    steps_per_period: int | None = None,
+                    t0: np.ndarray | float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+    """Largest Lyapunov exponent [1/tau] and its standard error at the Omega ``values`` where
+    ``need`` is true, each started from its own state ``y0[i]`` at its own time ``t0[i]`` (the
+    sweep's final time, so both forcing phases continue); NaN elsewhere, and where the
+    integration diverged.
 
     Lanes are grouped by their default step count (within a factor 1.25) so that a low Omega
     does not impose its fine step on the whole sweep; each group runs in parallel."""
     values = np.asarray(values, dtype=float)
+    t0 = np.broadcast_to(np.asarray(t0, dtype=float), values.shape)
     out = np.full(values.size, np.nan)
+    err = np.full(values.size, np.nan)
     idx = np.flatnonzero(need)
     if idx.size == 0:
-        return out
+        return out, err
     idx = idx[np.argsort(values[idx], kind="stable")]
     steps = np.array([steps_per_period or default_steps_per_period(model, float(values[i]))
                       for i in idx])
@@ -128,10 +133,11 @@ def branch_lyapunov(model: Model, values: np.ndarray, y0: np.ndarray, need: np.n
         groups[-1].append(j)
     for g in groups:
         lanes = idx[g]
-        out[lanes] = lyapunov_lanes(
+        out[lanes], err[lanes] = lyapunov_lanes(
             model, model.lane_params("Omega", values[lanes]), np.asarray(y0)[lanes],
-            transient=transient, duration=duration, steps_per_period=int(max(steps[g])))
-    return out
+            transient=transient, duration=duration, steps_per_period=int(max(steps[g])),
+            t0=t0[lanes], with_error=True)
+    return out, np.where(np.isfinite(out), err, np.nan)
 
 
 def _sweeps(tasks: list[tuple[Case, str, str]], settings: ReproductionSettings,
@@ -183,19 +189,23 @@ def _classify(ds: xr.Dataset, sweep: ContinuedSweep, r: dict) -> xr.Dataset:
     model, values = sweep.model, np.asarray(sweep.values, dtype=float)
     period = ds["period"].values
     final = ds["poincare"].values[:, -1, :]
+    t_final = ds["final_time"].values
     need = period == 0
-    lam = branch_lyapunov(model, values, final, need, r["lyapunov_transient"],
-                          min(r["lyapunov_screen"], r["lyapunov_duration"]),
-                          sweep.steps_per_period)
+    lam, err = branch_lyapunov(model, values, final, need, r["lyapunov_transient"],
+                               min(r["lyapunov_screen"], r["lyapunov_duration"]),
+                               sweep.steps_per_period, t_final)
     again = need & ~(lam < r["lyapunov_threshold"] - r["lyapunov_margin"])
     if r["lyapunov_screen"] < r["lyapunov_duration"] and again.any():
-        lam[again] = branch_lyapunov(model, values, final, again, r["lyapunov_transient"],
-                                     r["lyapunov_duration"], sweep.steps_per_period)[again]
+        lam2, err2 = branch_lyapunov(model, values, final, again, r["lyapunov_transient"],
+                                     r["lyapunov_duration"], sweep.steps_per_period, t_final)
+        lam[again], err[again] = lam2[again], err2[again]
     ds["lyapunov"] = ("Omega", lam, {
         "long_name": "largest Lyapunov exponent", "units": "1/tau",
         "computed_where": "no period found (period == 0); clearly negative ones over the "
         "screening duration only",
-        "start": "last stroboscopic sample of this sweep at this Omega"})
+        "start": "last stroboscopic sample of this sweep at this Omega, at its time "
+                 "(final_time: both forcing phases continue)"})
+    ds["lyapunov_err"] = ("Omega", err, lyapunov_err_attrs("tau"))
     ds["motion"] = ("Omega", motion_labels(period, lam, r["lyapunov_threshold"]), {
         "long_name": "motion class", "meaning": "period-k, chaotic, quasi-periodic, "
         "non-periodic (no exponent), unbounded; see geardyn.reproduction.motion"})

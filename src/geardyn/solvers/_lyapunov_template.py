@@ -25,6 +25,16 @@ Numerics
   diagonal of R are summed over the measuring window (Benettin et al. 1980; Shimada & Nagashima
   1979). The transient advances the tangent vectors too (renormalised, not summed) so that they
   are aligned when measuring starts.
+* Start time: the state y0 is given at time t0, where the forcing phase is zero (grid step i
+  runs from t0 + i h, forcing phase from the table at i mod n_per; the time passed to ``rhs``,
+  e.g. for a load fluctuation at Lambda, is t0 + i h), exactly as the sweep kernel runs a lane
+  started at T0. A sweep's final state lies at forcing phase zero of its lane, so started at
+  the lane's final time the exponent continues the lane in both forcing phases.
+* Uncertainty: the measuring window is cut into up to ``n_blocks`` blocks of whole forcing
+  periods (as equal as they divide); the log stretch of each block (the renormalisations in it,
+  plus, where a block ends between two, the stretch so far, taken from a copy of the tangent
+  vectors) over its time gives a block rate, and the spread of the rates the standard error
+  (:func:`_block_stderr`). The exponent itself is summed as before, untouched.
 * A lane whose state leaves ``|y| <= bound`` (checked at each renormalisation) or whose tangent
   vectors stop being finite is marked diverged (status 1) and its exponents are NaN.
 * Cost per step: (2 k + 1) RK4 steps for k tangent vectors. They are independent integrations
@@ -62,14 +72,14 @@ __all__ = ["events", "lyapunov_lanes", "lyapunov_single", "observe", "phase_tabl
 
 
 @nb.njit(**_JIT)
-def _grid_step_rows(i, Y, p, h, omega, n_per, s_tab, c_tab, n_ev, K, TMP, Y1, SIDE, G0, G1, W,
+def _grid_step_rows(i, t0, Y, p, h, omega, n_per, s_tab, c_tab, n_ev, K, TMP, Y1, SIDE, G0, G1, W,
                     gbuf, ncross):
-    """Advance every row of Y (independent states of one lane) by grid step i (time i h to
-    (i + 1) h): one RK4 step per row, the rows' stages interleaved; a row whose trial step
-    changes the side of a switching function is redone with the crossings located
-    (:func:`_split_step`), as the main solver does."""
+    """Advance every row of Y (independent states of one lane) by grid step i (time t0 + i h to
+    t0 + (i + 1) h, forcing phase from the table at i mod n_per): one RK4 step per row, the
+    rows' stages interleaved; a row whose trial step changes the side of a switching function is
+    redone with the crossings located (:func:`_split_step`), as the main solver does."""
     nr, ns = Y.shape
-    t = i * h
+    t = t0 + i * h
     hh = 0.5 * h
     j0 = 2 * (i % n_per)
     if n_ev > 0:
@@ -106,7 +116,7 @@ def _grid_step_rows(i, Y, p, h, omega, n_per, s_tab, c_tab, n_ev, K, TMP, Y1, SI
                 if _side(G1[r, j]) != SIDE[r, j]:
                     crossed = True
         if crossed:
-            _split_step(i, 0.0, Y[r], Y1[r], p, h, omega, n_per, SIDE[r], G1[r], ncross, W,
+            _split_step(i, t0, Y[r], Y1[r], p, h, omega, n_per, SIDE[r], G1[r], ncross, W,
                         W[8], gbuf)
         else:
             for q in range(ns):
@@ -114,7 +124,7 @@ def _grid_step_rows(i, Y, p, h, omega, n_per, s_tab, c_tab, n_ev, K, TMP, Y1, SI
 
 
 @nb.njit(**_JIT)
-def _tangent_step(i, Z, p, h, omega, n_per, s_tab, c_tab, n_ev, YP, E, K, TMP, Y1, SIDE, G0, G1,
+def _tangent_step(i, t0, Z, p, h, omega, n_per, s_tab, c_tab, n_ev, YP, E, K, TMP, Y1, SIDE, G0, G1,
                   W, gbuf, ncross):
     """Advance the state (row 0 of Z) by one grid step and each tangent vector v (rows 1..) by
     the derivative of that step map: (Phi(y + e v) - Phi(y - e v)) / (2 e). The 2 k + 1 states
@@ -143,7 +153,7 @@ def _tangent_step(i, Z, p, h, omega, n_per, s_tab, c_tab, n_ev, YP, E, K, TMP, Y
         for q in range(ns):
             YP[2 * j - 2, q] = Z[0, q] + e * Z[j, q]
             YP[2 * j - 1, q] = Z[0, q] - e * Z[j, q]
-    _grid_step_rows(i, YP, p, h, omega, n_per, s_tab, c_tab, n_ev, K, TMP, Y1, SIDE, G0, G1, W,
+    _grid_step_rows(i, t0, YP, p, h, omega, n_per, s_tab, c_tab, n_ev, K, TMP, Y1, SIDE, G0, G1, W,
                     gbuf, ncross)
     for j in range(1, m):
         if not math.isfinite(E[j]):
@@ -158,9 +168,9 @@ def _tangent_step(i, Z, p, h, omega, n_per, s_tab, c_tab, n_ev, YP, E, K, TMP, Y
 
 
 @nb.njit(**_JIT)
-def _orthonormalise(Z, acc, add):
-    """Modified Gram-Schmidt on the tangent rows 1.. of Z; adds log of R's diagonal to acc when
-    ``add``. Returns False if a vector vanished or is not finite."""
+def _orthonormalise(Z, logs, add):
+    """Modified Gram-Schmidt on the tangent rows 1.. of Z; writes the log of R's diagonal to logs
+    when ``add``. Returns False if a vector vanished or is not finite."""
     m, ns = Z.shape
     for j in range(1, m):
         for i in range(1, j):
@@ -176,7 +186,7 @@ def _orthonormalise(Z, acc, add):
         if not (r > 0.0 and math.isfinite(r)):
             return False
         if add:
-            acc[j - 1] += math.log(r)
+            logs[j - 1] = math.log(r)
         inv = 1.0 / r
         for q in range(ns):
             Z[j, q] *= inv
@@ -184,9 +194,65 @@ def _orthonormalise(Z, acc, add):
 
 
 @nb.njit(**_JIT)
-def _run(p, y0, h, omega, n_per, s_tab, c_tab, n_transient, n_steps, renorm_every, k, bound,
-         n_ev):
-    """Exponents (sum of logs / measured time) and status of one lane."""
+def _stretch_logs(Z, C, logs):
+    """The logs of R's diagonal that orthonormalising Z's tangent rows would give now (the
+    stretch since the last renormalisation), computed on the copy C: Z is left as it is."""
+    m, ns = Z.shape
+    for j in range(m):
+        for q in range(ns):
+            C[j, q] = Z[j, q]
+    for j in range(1, m):
+        logs[j - 1] = np.nan
+    _orthonormalise(C, logs, True)
+
+
+@nb.njit(**_JIT)
+def _block_bounds(n_steps, n_per, n_blocks):
+    """Ends of the blocks of the measuring window (measured steps): whole forcing periods
+    (``n_per`` steps; one step for an autonomous model, n_per = 1), as equal as they divide, at
+    most ``n_blocks`` and at most one per period."""
+    units = n_steps // n_per
+    nbk = max(min(n_blocks, units), 1)
+    ends = np.zeros(nbk, np.int64)
+    for b in range(nbk):
+        ends[b] = ((b + 1) * units // nbk) * n_per
+    ends[nbk - 1] = n_steps
+    return ends
+
+
+@nb.njit(**_JIT)
+def _block_stderr(blk, ends, h, err):
+    """Standard error of each exponent from its blocks: blk[b, j] (log stretch in block b),
+    block b ending at measured step ends[b]. With rates r_b = blk[b] / T_b, weights T_b and
+    lambda = sum(blk) / sum(T_b): err^2 = n / (n - 1) sum(T_b^2 (r_b - lambda)^2) / T^2 (for
+    equal blocks std(r, ddof=1)^2 / n). Writes err[j] (NaN with fewer than 2 blocks)."""
+    n, k = blk.shape
+    for j in range(k):
+        err[j] = np.nan
+    if n < 2:
+        return
+    tt = ends[n - 1] * h
+    for j in range(k):
+        lam = 0.0
+        for b in range(n):
+            lam += blk[b, j]
+        lam /= tt
+        ss = 0.0
+        prev = 0
+        for b in range(n):
+            tb = (ends[b] - prev) * h
+            prev = ends[b]
+            d = blk[b, j] - lam * tb  # = T_b (r_b - lambda)
+            ss += d * d
+        err[j] = math.sqrt(ss * n / (n - 1)) / tt
+
+
+@nb.njit(**_JIT)
+def _run(p, y0, t0, h, omega, n_per, s_tab, c_tab, n_transient, n_steps, renorm_every, k,
+         bound, n_ev, n_blocks):
+    """Exponents (sum of logs / measured time), their standard errors (from up to ``n_blocks``
+    blocks of whole forcing periods of the measuring window), the number of blocks and the
+    status of one lane, started at time t0 (forcing phase zero there)."""
     ns = y0.size
     m = k + 1
     Z = np.zeros((m, ns))
@@ -204,58 +270,85 @@ def _run(p, y0, h, omega, n_per, s_tab, c_tab, n_transient, n_steps, renorm_ever
     gbuf = np.zeros((3, ne))
     ncross = np.zeros(ne, np.int64)
     acc = np.zeros(k)
+    logs = np.zeros(k)
+    ends = _block_bounds(max(n_steps, 1), n_per, n_blocks)
+    nbk = ends.size
+    blk = np.zeros((nbk, k))  # log stretch per block of the measuring window
+    C = np.zeros((m, ns))
     out = np.full(k, np.nan)
+    err = np.full(k, np.nan)
     for q in range(ns):
         Z[0, q] = y0[q]
     # generic, orthonormalised start vectors: e_j + 0.1 (1, ..., 1)
     for j in range(1, m):
         for q in range(ns):
             Z[j, q] = 0.1 + (1.0 if q == j - 1 else 0.0)
-    _orthonormalise(Z, acc, False)
+    _orthonormalise(Z, logs, False)
     renorm = max(renorm_every, 1)
     total = n_transient + n_steps
     since = 0
+    cur = 0  # the block being measured
     for i in range(total):
-        _tangent_step(i, Z, p, h, omega, n_per, s_tab, c_tab, n_ev, YP, E, K, TMP, Y1, SIDE, G0,
-                      G1, W, gbuf, ncross)
+        _tangent_step(i, t0, Z, p, h, omega, n_per, s_tab, c_tab, n_ev, YP, E, K, TMP, Y1, SIDE,
+                      G0, G1, W, gbuf, ncross)
         since += 1
         step = i + 1
+        measure = step > n_transient
         if since == renorm or step == n_transient or step == total:
             since = 0
             if not _healthy(Z[0], bound):
-                return out, STATUS_DIVERGED
-            if not _orthonormalise(Z, acc, step > n_transient):
-                return out, STATUS_DIVERGED
+                return out, err, 0, STATUS_DIVERGED
+            if not _orthonormalise(Z, logs, measure):
+                return out, err, 0, STATUS_DIVERGED
+            if measure:
+                for j in range(k):
+                    acc[j] += logs[j]
+                    blk[cur, j] += logs[j]
+            if measure and step - n_transient == ends[cur]:
+                cur += 1
+        elif measure and step - n_transient == ends[cur]:
+            # a block ends between renormalisations: its share of the running stretch, on a
+            # copy (the exponent's own arithmetic is untouched)
+            _stretch_logs(Z, C, logs)
+            for j in range(k):
+                blk[cur, j] += logs[j]
+                blk[cur + 1, j] -= logs[j]
+            cur += 1
     if n_steps <= 0:
-        return out, STATUS_OK
+        return out, err, 0, STATUS_OK
     tm = n_steps * h
     for j in range(k):
         out[j] = acc[j] / tm
-    return out, STATUS_OK
+    _block_stderr(blk, ends, h, err)
+    return out, err, nbk, STATUS_OK
 
 
 @nb.njit(**_JIT)
-def lyapunov_single(p, y0, h, omega, n_per, n_transient, n_steps, renorm_every, k, bound,
-                    n_ev=0):
+def lyapunov_single(p, y0, t0, h, omega, n_per, n_transient, n_steps, renorm_every, k,
+                    bound, n_ev=0, n_blocks=16):
     """The k leading Lyapunov exponents (per unit time of the model) of one parameter set.
 
-    Grid: step h (= 2 pi / (omega n_per) for a forced model); ``n_transient`` steps are discarded
-    and ``n_steps`` measured. ``n_ev``: the model's number of switching functions, whose
-    crossings are located inside a step (0: none located). Returns (exponents[k], status);
-    exponents are NaN if diverged.
+    Grid: step h (= 2 pi / (omega n_per) for a forced model); the state y0 is given at time t0,
+    where the forcing phase is zero; ``n_transient`` steps are discarded and ``n_steps``
+    measured. ``n_ev``: the model's number of switching functions, whose crossings are located
+    inside a step (0: none located). Returns (exponents[k], stderr[k], blocks, status): the
+    standard errors from ``n_blocks`` blocks of the measuring window (:func:`_block_stderr`;
+    ``blocks`` of them used); exponents are NaN if diverged.
     """
     s_tab, c_tab = phase_table(n_per, omega != 0.0)
-    return _run(p, y0, h, omega, n_per, s_tab, c_tab, n_transient, n_steps, renorm_every, k,
-                bound, n_ev)
+    return _run(p, y0, t0, h, omega, n_per, s_tab, c_tab, n_transient, n_steps,
+                renorm_every, k, bound, n_ev, n_blocks)
 
 
 @nb.njit(parallel=True, **_JIT)
-def lyapunov_lanes(P, Y0, H, OMEGA, n_per, n_transient, n_steps, renorm_every, bound, out,
-                   n_ev=0):
+def lyapunov_lanes(P, Y0, T0, H, OMEGA, n_per, n_transient, n_steps, renorm_every, bound,
+                   out, err, n_ev=0, n_blocks=16):
     """Largest exponent of every lane (row of P, Y0), in parallel over lanes.
 
-    H, OMEGA: step and forcing frequency per lane; n_transient, n_steps: per-lane step counts
-    (int arrays); n_ev as in :func:`lyapunov_single`. Fills out[L] (NaN for diverged lanes).
+    T0: start time (forcing phase zero there, as in :func:`lyapunov_single`) per lane; H, OMEGA:
+    step and forcing frequency per lane; n_transient, n_steps: per-lane step counts (int
+    arrays); n_ev and n_blocks as in :func:`lyapunov_single`. Fills out[L] and err[L] (the
+    standard error; NaN for diverged lanes).
     """
     L, ns = Y0.shape
     forced = False
@@ -264,6 +357,8 @@ def lyapunov_lanes(P, Y0, H, OMEGA, n_per, n_transient, n_steps, renorm_every, b
             forced = True
     s_tab, c_tab = phase_table(n_per, forced)
     for lane in nb.prange(L):
-        ex, st = _run(P[lane], Y0[lane], H[lane], OMEGA[lane], n_per, s_tab, c_tab,
-                      n_transient[lane], n_steps[lane], renorm_every, 1, bound, n_ev)
+        ex, er, _nb, st = _run(P[lane], Y0[lane], T0[lane], H[lane], OMEGA[lane], n_per, s_tab,
+                               c_tab, n_transient[lane], n_steps[lane], renorm_every, 1, bound,
+                               n_ev, n_blocks)
         out[lane] = ex[0] if st == STATUS_OK else np.nan
+        err[lane] = er[0] if st == STATUS_OK else np.nan
