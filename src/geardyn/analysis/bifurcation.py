@@ -113,8 +113,8 @@ def bifurcation(
     Returns
     -------
     xarray.Dataset with coordinates ``param``, ``sample``, ``state``, ``mesh`` and variables
-    ``poincare`` (param, sample, state), ``period`` (param; k >= 1 period-k, 0 quasi-periodic or
-    chaotic, -1 unbounded), ``contact`` (param, mesh: none/single/double/unbounded),
+    ``poincare`` (param, sample, state), ``period`` (param; k >= 1 period-k, 0 no period <=
+    max_period found, -1 unbounded), ``contact`` (param, mesh: none/single/double/unbounded),
     ``force_peak``, ``force_rms``, ``dynamic_factor`` (param, mesh), ``status``, and
     ``lyapunov`` (param) when asked.
     """

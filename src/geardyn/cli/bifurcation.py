@@ -171,7 +171,8 @@ def _summary(ds) -> str:
              if np.any(period == k)]
     if np.any(period >= 5):
         parts.append(f"period>=5 {int(np.sum(period >= 5))}")
-    parts.append(f"quasi-periodic/chaotic {int(np.sum(period == 0))}")
+    parts.append(f"no period <= {ds['period'].attrs.get('max_period', 16)} "
+                 f"{int(np.sum(period == 0))}")
     parts.append(f"unbounded {int(np.sum(period == -1))}")
     return ", ".join(parts)
 
