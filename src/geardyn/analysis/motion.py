@@ -28,8 +28,8 @@ the finite-time bias of a zero exponent: on a torus the measured exponent is
 (ln|v(T)| - ln|v(0)|) / T for a tangent vector v that stays bounded but whose length varies
 around the torus (and with what is left of its alignment), so |lambda_T| <= (range of ln|v|) / T,
 an O(1/T) bias that the block spread need not show (a nearly uniform torus has a tiny
-statistical error). c = 5 allows a length ratio e^5 ~ 150 (see docs/lyapunov.md for the
-measured ranges: forced van der Pol torus 0.6, the CATT device's torus under load noise ...).
+statistical error). c = 5 allows a length ratio e^5 ~ 150; measured ranges of ln|v| on forced
+van der Pol tori are 0.6-1.7 (docs/lyapunov.md, classification).
 A statistical error alone can therefore not make a torus chaotic, and a weakly attracting long
 period orbit (lambda > -c/T) reads quasi-periodic: at a finite T the two cannot be told apart.
 """
