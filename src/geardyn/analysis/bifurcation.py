@@ -80,7 +80,8 @@ def bifurcation(
     converge, transient_max
         Transient by convergence: with a tolerance ``converge`` (e.g. 1e-8), ``transient`` is a
         minimum and each point runs on, up to ``transient_max`` (default 10 x transient), until
-        its Poincare point repeats one of the last 16 to ``converge (1 + |point|)``; the
+        its Poincare point is estimated within ``converge (1 + |point|)`` of a periodic orbit of
+        period <= 16 (from the contraction of successive differences; docs/numerics.md); the
         variable ``converged`` says where that happened and ``transient_periods`` what it took.
     samples
         Poincare points recorded after the transient: one per forcing period, or per common

@@ -205,7 +205,8 @@ def bifurcation_command(
     converge: Annotated[
         float | None, typer.Option(help="Transient by convergence: run on past --transient "
                                         "(a minimum), up to 10x it, until the Poincare point "
-                                        "repeats to this relative tolerance (e.g. 1e-8).")
+                                        "is estimated within this relative tolerance of its "
+                                        "orbit (e.g. 1e-8).")
     ] = None,
     continued_transient: Annotated[
         float | None, typer.Option(help="With --continuation: the discarded time of a continued "

@@ -110,7 +110,8 @@ def build_report(results: Results, figures: Mapping[tuple[str, str], dict[str, P
         f"Omega grid: {a['setting_num']} points from {a['setting_start']:g} to "
         f"{a['setting_stop']:g}; every case swept up and down by continuation (each point "
         "starts from the previous point's final state)",
-        (f"transient per point: until the Poincare point repeats to {a['setting_converge']:g} "
+        (f"transient per point: until the Poincare point is estimated within "
+         f"{a['setting_converge']:g} of its orbit "
          f"(a continued point: at least {min(a['setting_min_transient'], a['setting_transient']):g}"
          f" tau, at most {a['setting_transient']:g} tau; the first point of a sweep, a cold "
          f"start: at least {a['setting_transient']:g} tau; a continued point under load noise "

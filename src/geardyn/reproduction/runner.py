@@ -36,22 +36,22 @@ Progress = Callable[[str, int, int], None]
 
 @dataclass(frozen=True)
 class ReproductionSettings:
-    """How finely to reproduce. ``None`` takes the study's value: ``num`` Omega points
-    ([sweep] num), ``transient`` (tau, [run] transient), ``samples`` (mesh periods recorded
-    per point, [sweep] samples else [run] periods). With ``converge`` (a tolerance; None: a fixed
+    """How finely to reproduce. ``None`` takes the study's value: ``num`` Omega points ([sweep]
+    num), ``transient`` (tau, [run] transient), ``samples`` (mesh periods recorded per point,
+    [sweep] samples else [run] periods). With ``converge`` (a tolerance; None: a fixed
     transient) ``transient`` is the longest transient and each point stops as soon as its
-    Poincare point repeats to ``converge`` after at least ``min_transient`` (tau): a continued
-    point starts next to its attractor and needs far less. The Lyapunov exponent is measured over
-    ``lyapunov_duration`` (tau) after ``lyapunov_transient`` (tau), starting from the sweep's
-    last stroboscopic sample at that point; it is positive or negative only beyond its
-    uncertainty max(``lyapunov_z`` x standard error, ``lyapunov_floor`` / duration) (see
-    :mod:`geardyn.analysis.motion`). A first estimate over ``lyapunov_screen`` (tau) settles the
-    points whose exponent is clearly negative by that rule at the screening duration; only the
-    others, among them every chaotic one, are measured over the full duration. Under load noise
-    a Poincare section is taken where Lambda/Omega = p/q with q <= ``max_section_periods``
-    (sampling every q mesh periods); at every other Omega the exponent decides (a section every
-    9-32 periods, which the grid hits by accident at a few points, would cost 64 x q periods per
-    point)."""
+    Poincare point is estimated within ``converge`` of its orbit after at least
+    ``min_transient`` (tau): a continued point starts next to its attractor and needs far less.
+    The Lyapunov exponent is measured over ``lyapunov_duration`` (tau) after
+    ``lyapunov_transient`` (tau), starting from the sweep's last stroboscopic sample at that
+    point; it is positive or negative only beyond its uncertainty max(``lyapunov_z`` x standard
+    error, ``lyapunov_floor`` / duration) (see :mod:`geardyn.analysis.motion`). A first estimate
+    over ``lyapunov_screen`` (tau) settles the points whose exponent is clearly negative by that
+    rule at the screening duration; only the others, among them every chaotic one, are measured
+    over the full duration. Under load noise a Poincare section is taken where Lambda/Omega =
+    p/q with q <= ``max_section_periods`` (sampling every q mesh periods); at every other Omega
+    the exponent decides (a section every 9-32 periods, which the grid hits by accident at a few
+    points, would cost 64 x q periods per point)."""
 
     num: int | None = None
     transient: float | None = None
