@@ -1,7 +1,7 @@
 """Transient by convergence and the period classifier's resolution next to a period doubling.
 
 The gear pair (zeta 0.05, kappa 0.2, Fm 0.1, Fa 0.2) has a period-1 orbit whose Floquet
-multiplier crosses -1 near Omega = 0.9007 (a period doubling). The multipliers, orbits and the
+multiplier crosses -1 at Omega = 0.90081 (a period doubling). The multipliers, orbits and the
 flip are computed independently here: Newton on the period map of the reference integrator
 (DOP853, rtol 1e-12, edges located) with a finite-difference monodromy matrix.
 """
