@@ -224,27 +224,32 @@ def _section_diffs(y, R, n, D):
 def _settled(y, D, n, tol):
     """True when the section point y (the n-th) is estimated within tol (1 + max |y|) of a
     period-k orbit for some k <= depth = D.shape[1]: with the differences d_j = |x_j - x_{j-k}|
-    (recorded by :func:`_section_diffs`), Dn = max over j = n-k+1..n and Dp = max over the k
-    before, the contraction per k sections is r = Dn / Dp and the distance left to the orbit
-    is about Dn r / (1 - r) (a geometric series). Needs 3k points; Dn below CONV_ROUNDOFF tol
-    counts as settled."""
+    (recorded by :func:`_section_diffs`), D0 = max over j = n-k+1..n, D1 over the k before and
+    D2 over the k before those, the contraction per k sections is r = max(D0 / D1, D1 / D2)
+    (two windows: the rate is confirmed, not read off one ratio) and the distance left to the
+    orbit is about D0 r / (1 - r) (a geometric series). Needs 4k points; D0 below
+    CONV_ROUNDOFF tol counts as settled."""
     scale = 0.0
     for q in range(y.size):
         scale = max(scale, abs(y[q]))
     lim = tol * (1.0 + scale)
     rows = D.shape[0]
     for k in range(1, D.shape[1] + 1):
-        if n < 3 * k - 1:
+        if n < 4 * k - 1:
             break
-        dn = 0.0
-        dp = 0.0
+        d0 = 0.0
+        d1 = 0.0
+        d2 = 0.0
         for i in range(k):
-            dn = max(dn, D[(n - i) % rows, k - 1])
-            dp = max(dp, D[(n - k - i) % rows, k - 1])
-        if dn <= CONV_ROUNDOFF * lim:
+            d0 = max(d0, D[(n - i) % rows, k - 1])
+            d1 = max(d1, D[(n - k - i) % rows, k - 1])
+            d2 = max(d2, D[(n - 2 * k - i) % rows, k - 1])
+        if d0 <= CONV_ROUNDOFF * lim:
             return True
-        if dn < dp and dn * dn <= lim * (dp - dn):  # dn r / (1 - r) <= lim, r = dn / dp
-            return True
+        if d0 < d1 and d1 < d2:
+            r = max(d0 / d1, d1 / d2)
+            if d0 * r <= lim * (1.0 - r):  # d0 r / (1 - r) <= lim
+                return True
     return False
 
 
@@ -258,7 +263,7 @@ def _sweep_block(first, nl, n_per, s_tab, c_tab, P, Y0, H, OMEGA, T0, n_transien
     ns = Y0.shape[1]
     depth = max(conv_depth, 1)
     R = np.zeros((nl, depth, ns))  # the last section points of the transient
-    D = np.zeros((nl, 2 * depth, depth))  # their differences, per candidate period
+    D = np.zeros((nl, 3 * depth, depth))  # their differences, per candidate period
     n_ring = np.zeros(nl, np.int64)
     Y, Y1, K1, K2, K3, K4, TMP, TT, G, SIDE, work, ybuf, gbuf = _alloc(BLOCK, ns, n_ev)
     O = np.zeros((BLOCK, n_obs))
