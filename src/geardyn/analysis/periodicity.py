@@ -11,9 +11,10 @@ over the orbit, between x[i + k] and x[i]) is read as period-2k exactly when
 s > tol * max(1, max |x|), and as period-k when s <= that. Past a period doubling s grows as
 sqrt(|Omega - Omega_flip|), so a band of Omega next to the flip, where s is still below
 tol * max(1, |x|), reads period-k: for the gear pair of tests/test_convergence.py
-(s = 3.0 sqrt(Omega - 0.90081), |x| < 1) a band of 1.1e-11 in Omega at the default tol. The samples themselves must be settled to well below that
-splitting: the transient by convergence (``converge``) stops only when the estimated distance
-to the orbit is below its tolerance (docs/numerics.md), which must be smaller than tol.
+(s = 3.0 sqrt(Omega - 0.90081), |x| < 1) a band of 1.1e-11 in Omega at the default tol. The
+samples themselves must be settled to well below that splitting: the transient by convergence
+(``converge``) stops only when the estimated distance to the orbit is below its tolerance
+(docs/numerics.md), which must be smaller than tol.
 
 The tolerance must exceed what is left of the transient (at xi = 0.05 the slowest mode of the
 CATT device decays as exp(-0.015 tau)) and the integration noise; it must stay below the distance
