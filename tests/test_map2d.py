@@ -125,7 +125,7 @@ def test_plot_map_legend_lists_the_classes_present(tmp_path):
     period_ax, contact_ax = fig.axes[:2]
     legend = [t.get_text() for t in period_ax.get_legend().get_texts()]
     p = ds["period"].values
-    assert ("quasi-periodic or chaotic" in legend) == bool(np.any(p == 0))
+    assert ("no period found" in legend) == bool(np.any(p == 0))
     assert ("period 1" in legend) == bool(np.any(p == 1))
     regimes = {t.get_text() for t in contact_ax.get_legend().get_texts()}
     assert regimes == set(np.unique(ds["contact"].values))

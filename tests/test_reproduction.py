@@ -23,7 +23,7 @@ from geardyn.io.netcdf import load_dataset
 from geardyn.reproduction import CASE_NAMES, CLAIMS, evaluate, get_case
 from geardyn.reproduction.claims import STATUSES
 from geardyn.reproduction.evidence import hysteresis
-from geardyn.reproduction.motion import LYAPUNOV_CHAOS, motion_labels
+from geardyn.reproduction.motion import motion_labels
 from geardyn.reproduction.tables import BEGIN, END, generated_section
 from geardyn.solvers.reference import reference_solution
 
@@ -163,10 +163,13 @@ def test_noise_and_backlash_claims_follow_the_data():
 
 
 def test_motion_labels_and_hysteresis():
-    lam = np.array([np.nan, -0.02, 0.0001, 5 * LYAPUNOV_CHAOS, np.nan, np.nan])
-    period = np.array([1, 0, 0, 0, -1, 0])
-    assert list(motion_labels(period, lam)) == [
-        "period-1", "quasi-periodic", "quasi-periodic", "chaotic", "unbounded", "non-periodic"]
+    # T = 1000: floor 5e-3; the last point's error (2e-3, z = 3) widens its band to 6e-3
+    lam = np.array([np.nan, -0.02, 0.0001, 0.01, np.nan, np.nan, 0.005])
+    err = np.array([np.nan, 1e-4, 1e-4, 1e-3, np.nan, np.nan, 2e-3])
+    period = np.array([1, 0, 0, 0, -1, 0, 0])
+    assert list(motion_labels(period, lam, lyapunov_err=err, duration=1000.0)) == [
+        "period-1", "unresolved", "quasi-periodic", "chaotic", "unbounded", "non-periodic",
+        "quasi-periodic"]
     up = labels_where({"period-2": (1.0, 1.2)})
     down = labels_where({"period-2": (1.0, 1.3)})
     h = hysteresis(fake("fig4", GRID, up, down=down))

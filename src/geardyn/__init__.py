@@ -11,6 +11,7 @@ The public API::
 from geardyn.analysis.bifurcation import ContinuedSweep, bifurcation, continued_sweeps
 from geardyn.analysis.lyapunov import LyapunovEstimate, lyapunov, lyapunov_lanes
 from geardyn.analysis.map2d import map2d
+from geardyn.analysis.motion import motion_classes
 from geardyn.analysis.periodicity import classify_period, common_section
 from geardyn.analysis.spectrum import amplitude_spectrum, label_peaks
 from geardyn.errors import GeardynError, ParameterError, StudyError
@@ -52,6 +53,7 @@ __all__ = [
     "lyapunov",
     "lyapunov_lanes",
     "map2d",
+    "motion_classes",
     "default_steps_per_period",
     "reference_solution",
     "simulate",

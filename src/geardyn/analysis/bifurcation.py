@@ -82,7 +82,8 @@ def bifurcation(
     converge, transient_max
         Transient by convergence: with a tolerance ``converge`` (e.g. 1e-8), ``transient`` is a
         minimum and each point runs on, up to ``transient_max`` (default 10 x transient), until
-        its Poincare point repeats one of the last 16 to ``converge (1 + |point|)``; the
+        its Poincare point is estimated within ``converge (1 + |point|)`` of a periodic orbit of
+        period <= 16 (from the contraction of successive differences; docs/numerics.md); the
         variable ``converged`` says where that happened and ``transient_periods`` what it took.
     samples
         Poincare points recorded after the transient: one per forcing period, or per common
@@ -122,8 +123,8 @@ def bifurcation(
     Returns
     -------
     xarray.Dataset with coordinates ``param``, ``sample``, ``state``, ``mesh`` and variables
-    ``poincare`` (param, sample, state), ``period`` (param; k >= 1 period-k, 0 quasi-periodic or
-    chaotic, -1 unbounded), ``contact`` (param, mesh: none/single/double/unbounded),
+    ``poincare`` (param, sample, state), ``period`` (param; k >= 1 period-k, 0 no period <=
+    max_period found, -1 unbounded), ``contact`` (param, mesh: none/single/double/unbounded),
     ``force_peak``, ``force_rms``, ``dynamic_factor`` (param, mesh), ``status``,
     ``final_time`` (param: the model time of the final state, the last Poincare point), and
     ``lyapunov`` with its standard error ``lyapunov_err`` (param) when asked: started from each

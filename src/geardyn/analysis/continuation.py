@@ -10,7 +10,7 @@ alone (lanes do not interact).
 
 A continued point starts next to its attractor, so it needs a far shorter transient than a cold
 start: ``continued_transient`` is its minimum, and the transient goes on until the Poincare
-point repeats (``converge``), up to ``transient_max``. A point with a second excitation at an
+point settles (``converge``), up to ``transient_max``. A point with a second excitation at an
 incommensurate frequency has no stroboscopic section that could repeat, so it cannot be tested:
 it runs ``continued_transient`` only when continued, ``transient_max`` when cold. A cold start is
 the first point of a branch, and any point after one whose integration diverged (the branch

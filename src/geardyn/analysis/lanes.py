@@ -44,9 +44,11 @@ def variable_attrs(model: Model, max_period: int = DEFAULT_MAX_PERIOD, tol: floa
     """Attributes (meaning, units) of each variable :func:`lane_variables` returns."""
     return {
         "period": {"long_name": "period in forcing periods",
-                   "meaning": "k>=1 period-k, 0 quasi-periodic or chaotic, -1 unbounded; with a "
-                              "second excitation at an irrational frequency ratio, 0 (no "
-                              "periodic motion exists)",
+                   "meaning": "k>=1 period-k, 0 no period <= max_period found (chaotic, "
+                              "quasi-periodic, a longer period or not settled: see "
+                              "geardyn.analysis.motion), -1 unbounded; with a second "
+                              "excitation at an irrational frequency ratio, 0 (no periodic "
+                              "motion exists)",
                    "tolerance": tol, "max_period": max_period},
         "section_periods": {"long_name": "forcing periods between Poincare samples",
                             "meaning": "the common period of the excitations when their "

@@ -150,7 +150,7 @@ def map2d(
     Returns
     -------
     xarray.Dataset with dimensions (y name, x name[, mesh]) and variables ``period`` (k >= 1
-    period-k, 0 quasi-periodic or chaotic, -1 unbounded), ``contact`` (none/single/double/
+    period-k, 0 no period <= max_period found, -1 unbounded), ``contact`` (none/single/double/
     unbounded per mesh), ``force_peak``, ``force_rms``, ``dynamic_factor``, ``status``, step
     counts, and ``lyapunov`` and ``lyapunov_err`` when asked; the settings in ``attrs``
     (``x``, ``y``, ...).

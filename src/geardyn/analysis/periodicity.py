@@ -2,13 +2,24 @@
 
 A lane is period-k when its samples repeat after k forcing periods: for the smallest
 k <= max_period, max_i |x[i + k] - x[i]| <= tol * max(1, max_i |x[i]|) over the recorded samples
-(every state). Motion that repeats for no such k is labelled 0 (quasi-periodic or chaotic: the
-Lyapunov exponent separates the two); a diverged lane (NaN samples) is -1.
+(every state). Motion that repeats for no such k is labelled 0 (no period <= max_period found:
+chaotic, quasi-periodic, a longer period or not settled; :mod:`geardyn.analysis.motion` tells
+them apart with the Lyapunov exponent); a diverged lane (NaN samples) is -1.
+
+Resolution: a period-2k orbit whose points split by s (the largest difference, over states and
+over the orbit, between x[i + k] and x[i]) is read as period-2k exactly when
+s > tol * max(1, max |x|), and as period-k when s <= that. Past a period doubling s grows as
+sqrt(|Omega - Omega_flip|), so a band of Omega next to the flip, where s is still below
+tol * max(1, |x|), reads period-k: for the gear pair of tests/test_convergence.py
+(s = 3.0 sqrt(Omega - 0.90081), |x| < 1) a band of 1.1e-11 in Omega at the default tol. The
+samples themselves must be settled to well below that splitting: the transient by convergence
+(``converge``) stops only when the estimated distance to the orbit is below its tolerance
+(docs/numerics.md), which must be smaller than tol.
 
 The tolerance must exceed what is left of the transient (at xi = 0.05 the slowest mode of the
 CATT device decays as exp(-0.015 tau)) and the integration noise; it must stay below the distance
 between the points of a genuine period-k orbit. The default 1e-5 (relative) is tested on
-synthetic orbits and on the gear pair.
+synthetic orbits, on the gear pair and just past a period doubling (tests/test_convergence.py).
 """
 
 from __future__ import annotations

@@ -171,7 +171,8 @@ def _summary(ds) -> str:
              if np.any(period == k)]
     if np.any(period >= 5):
         parts.append(f"period>=5 {int(np.sum(period >= 5))}")
-    parts.append(f"quasi-periodic/chaotic {int(np.sum(period == 0))}")
+    parts.append(f"no period <= {ds['period'].attrs.get('max_period', 16)} "
+                 f"{int(np.sum(period == 0))}")
     parts.append(f"unbounded {int(np.sum(period == -1))}")
     return ", ".join(parts)
 
@@ -204,7 +205,8 @@ def bifurcation_command(
     converge: Annotated[
         float | None, typer.Option(help="Transient by convergence: run on past --transient "
                                         "(a minimum), up to 10x it, until the Poincare point "
-                                        "repeats to this relative tolerance (e.g. 1e-8).")
+                                        "is estimated within this relative tolerance of its "
+                                        "orbit (e.g. 1e-8).")
     ] = None,
     continued_transient: Annotated[
         float | None, typer.Option(help="With --continuation: the discarded time of a continued "

@@ -233,7 +233,8 @@ def _save(ds, out: Path, plot: Path | None, err) -> None:
     n = p.size
     typer.echo(
         f"{ds.attrs['study']}: {ds.attrs['y']} x {ds.attrs['x']} map of {n} points: "
-        f"{np.sum(p >= 1)} periodic, {np.sum(p == APERIODIC)} quasi-periodic or chaotic, "
+        f"{np.sum(p >= 1)} periodic, {np.sum(p == APERIODIC)} without a period <= "
+        f"{ds['period'].attrs.get('max_period', 16)}, "
         f"{np.sum(p == UNBOUNDED)} unbounded; wrote {', '.join(written)}"
     )
 

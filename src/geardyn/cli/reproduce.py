@@ -65,7 +65,7 @@ def reproduce_command(
         help="Omega points per sweep (default: the study's, the paper's resolution).")] = None,
     transient: Annotated[float | None, typer.Option(
         help="Longest transient per point, dimensionless time; each point stops earlier once "
-        "its Poincare point repeats (default: the study's).")] = None,
+        "its Poincare point settles (default: the study's).")] = None,
     samples: Annotated[int | None, typer.Option(
         help="Mesh periods sampled per point (default: the study's).")] = None,
     jobs: Annotated[int | None, typer.Option(

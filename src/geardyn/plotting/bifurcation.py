@@ -15,14 +15,15 @@ from geardyn.plotting.style import RC, param_label, state_label, time_unit_label
 __all__ = ["PERIOD_CLASSES", "REGIME_COLORS", "period_class", "plot_bifurcation",
            "resolve_sweep_state"]
 
-#: Period classes of the legend: (class, label, colour). Class 5 stands for every period >= 5.
+#: Period classes of the legend: (class, label, colour). Class 5 stands for every period >= 5;
+#: class 0 is "no period <= max_period found" (chaotic, quasi-periodic, longer or unsettled).
 PERIOD_CLASSES: tuple[tuple[int, str, str], ...] = (
     (1, "period 1", "#1f77b4"),
     (2, "period 2", "#2ca02c"),
     (3, "period 3", "#9467bd"),
     (4, "period 4", "#ff7f0e"),
     (5, "other periodic (≥ 5)", "#8c564b"),
-    (0, "quasi-periodic or chaotic", "#7f7f7f"),
+    (0, "no period found", "#7f7f7f"),
     (-1, "unbounded", "#d62728"),
 )
 OTHER_PERIODIC = 5

@@ -18,9 +18,11 @@ import xarray as xr
 
 from geardyn.analysis.bifurcation import ContinuedSweep, continued_sweeps
 from geardyn.analysis.lyapunov import lyapunov_err_attrs, lyapunov_lanes
+from geardyn.analysis.motion import LYAPUNOV_FLOOR, LYAPUNOV_Z, exponent_sign, rule_text
+from geardyn.analysis.periodicity import common_section
 from geardyn.models.base import Model
 from geardyn.reproduction.cases import Case
-from geardyn.reproduction.motion import LYAPUNOV_CHAOS, motion_labels
+from geardyn.reproduction.motion import motion_labels
 from geardyn.solvers.simulate import default_steps_per_period
 
 __all__ = ["DIRECTIONS", "ReproductionSettings", "branch_lyapunov", "run_case", "run_cases",
@@ -34,20 +36,22 @@ Progress = Callable[[str, int, int], None]
 
 @dataclass(frozen=True)
 class ReproductionSettings:
-    """How finely to reproduce. ``None`` takes the study's value: ``num`` Omega points
-    ([sweep] num), ``transient`` (tau, [run] transient), ``samples`` (mesh periods recorded
-    per point, [sweep] samples else [run] periods). With ``converge`` (a tolerance; None: a fixed
+    """How finely to reproduce. ``None`` takes the study's value: ``num`` Omega points ([sweep]
+    num), ``transient`` (tau, [run] transient), ``samples`` (mesh periods recorded per point,
+    [sweep] samples else [run] periods). With ``converge`` (a tolerance; None: a fixed
     transient) ``transient`` is the longest transient and each point stops as soon as its
-    Poincare point repeats to ``converge`` after at least ``min_transient`` (tau): a continued
-    point starts next to its attractor and needs far less. The Lyapunov exponent is measured over
-    ``lyapunov_duration`` (tau) after ``lyapunov_transient`` (tau), starting from the sweep's
-    last stroboscopic sample at that point; ``lyapunov_threshold`` separates chaos. A first
-    estimate over ``lyapunov_screen`` (tau) settles the points whose exponent is clearly
-    negative (below the threshold by more than ``lyapunov_margin``); only the others, among
-    them every chaotic one, are measured over the full duration. Under load noise a Poincare
-    section is taken where Lambda/Omega = p/q with q <= ``max_section_periods`` (sampling every
-    q mesh periods); at every other Omega the exponent decides (a section every 9-32 periods,
-    which the grid hits by accident at a few points, would cost 64 x q periods per point)."""
+    Poincare point is estimated within ``converge`` of its orbit after at least
+    ``min_transient`` (tau): a continued point starts next to its attractor and needs far less.
+    The Lyapunov exponent is measured over ``lyapunov_duration`` (tau) after
+    ``lyapunov_transient`` (tau), starting from the sweep's last stroboscopic sample at that
+    point; it is positive or negative only beyond its uncertainty max(``lyapunov_z`` x standard
+    error, ``lyapunov_floor`` / duration) (see :mod:`geardyn.analysis.motion`). A first estimate
+    over ``lyapunov_screen`` (tau) settles the points whose exponent is clearly negative by that
+    rule at the screening duration; only the others, among them every chaotic one, are measured
+    over the full duration. Under load noise a Poincare section is taken where Lambda/Omega =
+    p/q with q <= ``max_section_periods`` (sampling every q mesh periods); at every other Omega
+    the exponent decides (a section every 9-32 periods, which the grid hits by accident at a few
+    points, would cost 64 x q periods per point)."""
 
     num: int | None = None
     transient: float | None = None
@@ -56,9 +60,9 @@ class ReproductionSettings:
     min_transient: float = 200.0
     lyapunov_transient: float = 100.0
     lyapunov_duration: float = 1500.0
-    lyapunov_threshold: float = LYAPUNOV_CHAOS
+    lyapunov_z: float = LYAPUNOV_Z
+    lyapunov_floor: float = LYAPUNOV_FLOOR
     lyapunov_screen: float = 200.0
-    lyapunov_margin: float = 0.01
     max_section_periods: int = 8
 
     def __post_init__(self) -> None:
@@ -72,6 +76,10 @@ class ReproductionSettings:
             value = getattr(self, name)
             if value is not None and not (np.isfinite(value) and value >= 0):
                 raise ValueError(f"{name}: must be a finite time >= 0 (got {value!r})")
+        for name in ("lyapunov_z", "lyapunov_floor"):
+            value = getattr(self, name)
+            if not (np.isfinite(value) and value >= 0):
+                raise ValueError(f"{name}: must be finite and >= 0 (got {value!r})")
         for name in ("lyapunov_duration", "lyapunov_screen"):
             value = getattr(self, name)
             if not (np.isfinite(value) and value > 0):
@@ -93,9 +101,9 @@ class ReproductionSettings:
             "min_transient": float(self.min_transient),
             "lyapunov_transient": float(self.lyapunov_transient),
             "lyapunov_duration": float(self.lyapunov_duration),
-            "lyapunov_threshold": float(self.lyapunov_threshold),
+            "lyapunov_z": float(self.lyapunov_z),
+            "lyapunov_floor": float(self.lyapunov_floor),
             "lyapunov_screen": float(self.lyapunov_screen),
-            "lyapunov_margin": float(self.lyapunov_margin),
             "max_section_periods": int(self.max_section_periods),
         }
 
@@ -191,14 +199,17 @@ def _classify(ds: xr.Dataset, sweep: ContinuedSweep, r: dict) -> xr.Dataset:
     final = ds["poincare"].values[:, -1, :]
     t_final = ds["final_time"].values
     need = period == 0
-    lam, err = branch_lyapunov(model, values, final, need, r["lyapunov_transient"],
-                               min(r["lyapunov_screen"], r["lyapunov_duration"]),
+    screen = min(r["lyapunov_screen"], r["lyapunov_duration"])
+    lam, err = branch_lyapunov(model, values, final, need, r["lyapunov_transient"], screen,
                                sweep.steps_per_period, t_final)
-    again = need & ~(lam < r["lyapunov_threshold"] - r["lyapunov_margin"])
+    duration = np.full(lam.shape, screen)
+    rule = {"z": r["lyapunov_z"], "floor": r["lyapunov_floor"]}
+    again = need & ~(exponent_sign(lam, err, duration, **rule) < 0)
     if r["lyapunov_screen"] < r["lyapunov_duration"] and again.any():
         lam2, err2 = branch_lyapunov(model, values, final, again, r["lyapunov_transient"],
                                      r["lyapunov_duration"], sweep.steps_per_period, t_final)
         lam[again], err[again] = lam2[again], err2[again]
+        duration[again] = r["lyapunov_duration"]
     ds["lyapunov"] = ("Omega", lam, {
         "long_name": "largest Lyapunov exponent", "units": "1/tau",
         "computed_where": "no period found (period == 0); clearly negative ones over the "
@@ -206,9 +217,15 @@ def _classify(ds: xr.Dataset, sweep: ContinuedSweep, r: dict) -> xr.Dataset:
         "start": "last stroboscopic sample of this sweep at this Omega, at its time "
                  "(final_time: both forcing phases continue)"})
     ds["lyapunov_err"] = ("Omega", err, lyapunov_err_attrs("tau"))
-    ds["motion"] = ("Omega", motion_labels(period, lam, r["lyapunov_threshold"]), {
+    ds["lyapunov_duration"] = ("Omega", np.where(need, duration, np.nan), {
+        "long_name": "time the Lyapunov exponent was averaged over", "units": "tau"})
+    section = common_section(values, model.other_frequencies(model.lane_params("Omega", values)),
+                             max_periods=r["max_section_periods"])[1]
+    ds["motion"] = ("Omega", motion_labels(period, lam, lyapunov_err=err, duration=duration,
+                                           section=section, **rule), {
         "long_name": "motion class", "meaning": "period-k, chaotic, quasi-periodic, "
-        "non-periodic (no exponent), unbounded; see geardyn.reproduction.motion"})
+        "unresolved (no period <= max_period, exponent clearly negative), non-periodic (no "
+        "exponent), unbounded; see geardyn.analysis.motion", "rule": rule_text(**rule)})
     ds.attrs["lyapunov_wall_time_s"] = time.perf_counter() - start
     steps = ds["steps_per_period"].values * (ds["transient_periods"].values
                                              + r["samples"] * ds["section_periods"].values)

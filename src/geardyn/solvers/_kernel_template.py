@@ -200,22 +200,56 @@ def trajectory(p, y0, h, omega, n_per, i0, n_steps, stride, locate, bound, n_ev,
     return out_y, out_o[:, :n_obs], out_g[:, :n_ev], NCROSS[0, :n_ev], status, UNRES[0], done
 
 
+#: A difference of section points below this fraction of the tolerance counts as settled
+#: whatever its contraction rate (the rate of differences at round-off level is noise).
+CONV_ROUNDOFF = 1.0e-3
+
+
 @nb.njit(**_JIT)
-def _repeats(y, R, n, tol):
-    """True if y equals one of the first min(n, len(R)) rows of R to within
-    tol (1 + max |row|) in every component: the section has come back to an earlier point."""
-    for m in range(min(n, R.shape[0])):
-        scale = 0.0
+def _section_diffs(y, R, n, D):
+    """Record the differences of the new section point y (the n-th, counting from 0) to the
+    ring R of earlier ones: D[n % len(D), k - 1] = max_q |y_q - x_{n-k,q}| for k = 1 ..
+    min(n, len(R)) (x_{n-k} in row (n - k) % len(R) of R)."""
+    depth = R.shape[0]
+    row = n % D.shape[0]
+    for k in range(1, min(n, depth) + 1):
+        m = (n - k) % depth
+        d = 0.0
         for q in range(y.size):
-            scale = max(scale, abs(R[m, q]))
-        lim = tol * (1.0 + scale)
-        same = True
-        for q in range(y.size):
-            if not (abs(y[q] - R[m, q]) <= lim):
-                same = False
-                break
-        if same:
+            d = max(d, abs(y[q] - R[m, q]))
+        D[row, k - 1] = d
+
+
+@nb.njit(**_JIT)
+def _settled(y, D, n, tol):
+    """True when the section point y (the n-th) is estimated within tol (1 + max |y|) of a
+    period-k orbit for some k <= depth = D.shape[1]: with the differences d_j = |x_j - x_{j-k}|
+    (recorded by :func:`_section_diffs`), D0 = max over j = n-k+1..n, D1 over the k before and
+    D2 over the k before those, the contraction per k sections is r = max(D0 / D1, D1 / D2)
+    (two windows: the rate is confirmed, not read off one ratio) and the distance left to the
+    orbit is about D0 r / (1 - r) (a geometric series). Needs 4k points; D0 below
+    CONV_ROUNDOFF tol counts as settled."""
+    scale = 0.0
+    for q in range(y.size):
+        scale = max(scale, abs(y[q]))
+    lim = tol * (1.0 + scale)
+    rows = D.shape[0]
+    for k in range(1, D.shape[1] + 1):
+        if n < 4 * k - 1:
+            break
+        d0 = 0.0
+        d1 = 0.0
+        d2 = 0.0
+        for i in range(k):
+            d0 = max(d0, D[(n - i) % rows, k - 1])
+            d1 = max(d1, D[(n - k - i) % rows, k - 1])
+            d2 = max(d2, D[(n - 2 * k - i) % rows, k - 1])
+        if d0 <= CONV_ROUNDOFF * lim:
             return True
+        if d0 < d1 and d1 < d2:
+            r = max(d0 / d1, d1 / d2)
+            if d0 * r <= lim * (1.0 - r):  # d0 r / (1 - r) <= lim
+                return True
     return False
 
 
@@ -227,7 +261,9 @@ def _sweep_block(first, nl, n_per, s_tab, c_tab, P, Y0, H, OMEGA, T0, n_transien
     """One lockstep block of :func:`sweep`: lanes first..first+nl-1, all with n_per steps per
     period (phase table s_tab, c_tab)."""
     ns = Y0.shape[1]
-    R = np.zeros((nl, max(conv_depth, 1), ns))  # the last section points of the transient
+    depth = max(conv_depth, 1)
+    R = np.zeros((nl, depth, ns))  # the last section points of the transient
+    D = np.zeros((nl, 3 * depth, depth))  # their differences, per candidate period
     n_ring = np.zeros(nl, np.int64)
     Y, Y1, K1, K2, K3, K4, TMP, TT, G, SIDE, work, ybuf, gbuf = _alloc(BLOCK, ns, n_ev)
     O = np.zeros((BLOCK, n_obs))
@@ -296,7 +332,8 @@ def _sweep_block(first, nl, n_per, s_tab, c_tab, P, Y0, H, OMEGA, T0, n_transien
                     continue
                 if conv_tol > 0.0 and converged[lane] == 0:
                     every = sample_every[lane]
-                    if _repeats(Y[k], R[k], n_ring[k], conv_tol):
+                    _section_diffs(Y[k], R[k], n_ring[k], D[k])
+                    if _settled(Y[k], D[k], n_ring[k], conv_tol):
                         converged[lane] = 1
                     elif n_tr[k] + every <= n_transient_max[lane]:
                         # not settled yet: one more section period of transient
@@ -349,10 +386,12 @@ def sweep(P, Y0, H, OMEGA, T0, n_transient, n_transient_max, conv_tol, conv_dept
     ``sample_every[lane]`` grid steps, with statistics over the sampled stretch.
 
     With ``conv_tol > 0`` the transient goes on, one section period at a time up to
-    ``n_transient_max[lane]`` steps, until the section point repeats one of the last
-    ``conv_depth`` ones to within conv_tol (1 + |point|) (a periodic attractor reached);
-    converged[lane] is 1 then, 0 if the limit came first, -1 without the test;
-    transient_steps[lane] is the transient used.
+    ``n_transient_max[lane]`` steps, until the section point is estimated within
+    conv_tol (1 + |point|) of a periodic orbit of period k <= ``conv_depth`` sections: from the
+    contraction of the differences |x_n - x_{n-k}| over successive k sections (see
+    :func:`_settled`; a slowly attracting orbit, Floquet multiplier near +-1, needs the longer
+    transient it takes); converged[lane] is 1 then, 0 if the limit came first, -1 without the
+    test; transient_steps[lane] is the transient used.
 
     Lanes are grouped in lockstep blocks (block b: lanes block_first[b] ... + block_nl[b], all
     with block_nper[b] steps per period and the phase table S_TAB/C_TAB[block_tab[b]:]); worker

@@ -102,8 +102,9 @@ def run_lanes(
 
     Transient by convergence: with ``converge_tol > 0`` the transient (then a minimum) goes on,
     one sampling interval at a time up to ``transient_max`` (default 10 x transient), until the
-    section point repeats one of the last ``converge_depth`` to within
-    ``converge_tol (1 + |point|)``; ``converged`` tells per lane whether it did.
+    section point is estimated within ``converge_tol (1 + |point|)`` of a periodic orbit of
+    period <= ``converge_depth`` sections (from the contraction of successive differences,
+    docs/numerics.md); ``converged`` tells per lane whether it was.
 
     ``max_section_periods``: with ``"auto"``, the longest common period (in forcing periods)
     taken as a section (default that of :func:`~geardyn.analysis.periodicity.common_section`,
