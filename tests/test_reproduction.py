@@ -216,6 +216,7 @@ def test_backlash_claims_say_they_hold_by_construction():
         assert v[cid].status == "holds" and v[cid].basis == BY_CONSTRUCTION, cid
         assert "shifted by 2 b_c" in v[cid].details[-1], cid
     assert "the backlash is 2 b_c smaller" in v["C15"].measured
+    assert "agree to 1e-06 (relative) at 100% of the points" in v["C14"].details[-1]
     assert v["C2"].basis == "" and v["C19"].basis == ""  # other claims: the dynamics decide
     # the back flanks touch at two points of fig9: no longer a pure shift, and the report says
     # where

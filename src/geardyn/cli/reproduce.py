@@ -6,6 +6,7 @@
     geardyn reproduce --all [--interpretation consistent|carrier-only|as-printed|all]
                       [--resolution N] [--transient T] [--samples S] [--jobs N]
                       [--out out/reproduce] [--verdicts docs/reproduction-verdicts.md]
+                      [--no-figures]
 
 Writes, under ``--out``, ``CASE-INTERPRETATION.nc`` (data), ``CASE-INTERPRETATION.png`` and
 ``...-down.png`` (the diagrams swept up and down), ``report.md``, a self-contained
@@ -77,6 +78,9 @@ def reproduce_command(
     verdicts: Annotated[Path | None, typer.Option(
         help="Also write the verdict table (verdicts.md) to this file, e.g. "
         "docs/reproduction-verdicts.md (with --all --interpretation all).")] = None,
+    figures: Annotated[bool, typer.Option(
+        "--figures/--no-figures", help="Draw the diagrams (PNG, embedded in report.html); "
+        "without them only the data, the report and the verdict table are written.")] = True,
     quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No progress bar.")] = False,
 ) -> None:
     """Recompute the paper's bifurcation diagrams (swept up and down) and write a report that
@@ -119,9 +123,10 @@ def reproduce_command(
         f" --interpretation {interpretation.value}"
         + (f" --resolution {resolution}" if resolution else "")
         + (f" --transient {transient:g}" if transient is not None else "")
-        + (f" --samples {samples}" if samples else ""))
+        + (f" --samples {samples}" if samples else "")
+        + (f" --verdicts {verdicts}" if verdicts is not None else ""))
     with stderr_console().status("writing figures, data and the report"):
-        paths = write_report(results, out, command=command)
+        paths = write_report(results, out, command=command, figures=figures)
     for interp in interps:
         found = evaluate({c: ds for (c, i), ds in results.items() if i == interp})
         counts: dict[str, int] = {}

@@ -170,8 +170,9 @@ def build_report(results: Results, figures: Mapping[tuple[str, str], dict[str, P
         "the lowest natural frequency (Lambda = 0.1) the load fluctuation acts quasi-statically: "
         "the loads A +- B through the static stiffness move the coordinate by a peak-to-peak "
         "that linear statics give. Where that estimate and the measured growth of the spread "
-        "fall on the same side of the 'obvious' threshold, linear statics alone decide that "
-        "case's part of the verdict, and the basis names the case; both numbers are listed",
+        "fall on the same side of the 'obvious' threshold and agree to "
+        f"{cl.STATICS_AGREE:.0%}, linear statics alone decide that case's part of the verdict, "
+        "and the basis names the case; both numbers are listed",
         "each claim's own rule is listed with it below",
     ])
 

@@ -75,19 +75,23 @@ def verdict_table(verdicts: Verdicts, interpretations: Sequence[str] | None = No
 def run_settings(results: Mapping[tuple[str, str], xr.Dataset]) -> tuple[str, bool]:
     """A line naming the resolution and transients of a run, and whether the run is coarser
     than the studies' own settings (a provisional table)."""
-    nums, coarse = set(), False
-    attrs = {}
+    seen: dict[str, set] = {"num": set(), "transient": set(), "samples": set()}
+    coarse = False
+    attrs: Mapping = {}
     for (case, _), ds in results.items():
         attrs = ds.attrs
-        num = int(ds.attrs.get("setting_num", 0))
-        nums.add(num)
+        for key, found in seen.items():
+            found.add(attrs.get(f"setting_{key}", "?"))
         sweep = Case(case).study.sweep
-        coarse |= sweep is not None and num < int(sweep.num)
-    num_text = ", ".join(str(n) for n in sorted(nums))
-    text = (f"{num_text} Omega points per sweep from {attrs.get('setting_start', '?')} to "
-            f"{attrs.get('setting_stop', '?')}, longest transient "
-            f"{attrs.get('setting_transient', '?')} tau, {attrs.get('setting_samples', '?')} "
-            "Poincare points per point")
+        coarse |= sweep is not None and int(attrs.get("setting_num", 0)) < int(sweep.num)
+
+    def values(key: str) -> str:
+        return ", ".join(f"{v:g}" if isinstance(v, int | float) else str(v)
+                         for v in sorted(seen[key], key=str))
+
+    text = (f"{values('num')} Omega points per sweep from {attrs.get('setting_start', '?')} to "
+            f"{attrs.get('setting_stop', '?')}, longest transient {values('transient')} tau "
+            f"(per study), {values('samples')} Poincare points per point")
     return text, coarse
 
 
