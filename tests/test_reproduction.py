@@ -2,7 +2,10 @@
 
 * the figure studies hold the values the paper's captions and text state (typed here from the
   paper, not from the study files);
-* the claim checks turn hand-made sweeps with known answers into the right verdicts;
+* the claim checks turn hand-made sweeps with known answers into the right verdicts, and say
+  when a verdict holds by construction (backlash: a coordinate shift) or by linear statics;
+* the verdict table (docs/reproduction-verdicts.md) is written from evaluated verdicts and
+  agrees with the claims list;
 * the whole pipeline at a tiny resolution writes the files and a report whose structure is
   checked, and whose period classes and Fig. 5 verdict match an independent DOP853 integration
   (`reference_solution`, rtol 1e-12) classified by its own rule;
@@ -20,11 +23,20 @@ import pytest
 import xarray as xr
 
 from geardyn.io.netcdf import load_dataset
+from geardyn.models.derived import INTERPRETATIONS
 from geardyn.reproduction import CASE_NAMES, CLAIMS, evaluate, get_case
-from geardyn.reproduction.claims import STATUSES
+from geardyn.reproduction.claims import (
+    BACK_CONTACT,
+    BY_CONSTRUCTION,
+    LINEAR_STATICS,
+    MIN_WIDTH,
+    STATUSES,
+    Verdict,
+)
 from geardyn.reproduction.evidence import hysteresis
 from geardyn.reproduction.motion import motion_labels
 from geardyn.reproduction.tables import BEGIN, END, generated_section
+from geardyn.reproduction.verdicts import MARKER, read_verdicts, verdict_document
 from geardyn.solvers.reference import reference_solution
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -162,6 +174,127 @@ def test_noise_and_backlash_claims_follow_the_data():
     assert v["C18"].status == "fails"  # no chaos left to avoid
 
 
+def test_regions_need_a_width_and_partly_needs_more_than_one_point():
+    step = float(GRID[1] - GRID[0])
+    assert step <= MIN_WIDTH  # on this grid a region needs two points or more
+    lone = fake("fig3", GRID, labels_where({"chaotic": (0.8, 0.8), "period-2": (0.9, 0.9)}))
+    v = evaluate({"fig3": lone})
+    assert v["C2"].status == "fails"  # one chaotic point is not a window
+    assert v["C3"].status == "fails"  # one period-2 point within 0.1 of 1-1.2 is not "partly"
+    pair = fake("fig3", GRID, labels_where({"chaotic": (0.8, 0.85), "period-2": (0.9, 0.95)}))
+    v = evaluate({"fig3": pair})
+    assert v["C2"].status == "holds" and v["C3"].status == "partly holds"
+    # on a fine grid the same two points are too narrow a region
+    fine = np.round(np.arange(0.1, 4.0001, 0.01), 10)
+    two = np.full(fine.size, "period-1", dtype=object)
+    two[(fine > 0.795) & (fine < 0.815)] = "chaotic"
+    v = evaluate({"fig3": fake("fig3", fine, two.astype(str))})
+    assert v["C2"].status == "fails"
+    two[(fine > 0.795) & (fine < 0.855)] = "chaotic"  # 0.80-0.85: width 0.05
+    assert evaluate({"fig3": fake("fig3", fine, two.astype(str))})["C2"].status == "holds"
+
+
+def with_params(ds: xr.Dataset, case: str) -> xr.Dataset:
+    """``ds`` with the attributes the runner writes: the case's parameters, interpretation and
+    static deflections."""
+    from geardyn import CATTDevice
+
+    params = get_case(case).params
+    static = CATTDevice(params, "consistent").static_forces()[:2]
+    return ds.assign_attrs(params_json=params.model_dump_json(), interpretation="consistent",
+                           static_deflection=[float(g) for g in static])
+
+
+def test_backlash_claims_say_they_hold_by_construction():
+    base = with_params(fake("fig4", GRID, labels_where({"chaotic": (1.0, 1.2)}),
+                            contact="single"), "fig4")
+    x = base["poincare"].values[0, :, :, 0]
+    shifted = with_params(fake("fig9", GRID, labels_where({"chaotic": (1.0, 1.2)}), x=x - 2.0,
+                               contact="single"), "fig9")
+    v = evaluate({"fig4": base, "fig9": shifted})
+    for cid in ("C14", "C15", "C18"):
+        assert v[cid].status == "holds" and v[cid].basis == BY_CONSTRUCTION, cid
+        assert "shifted by 2 b_c" in v[cid].details[-1], cid
+    assert "the backlash is 2 b_c smaller" in v["C15"].measured
+    assert "agree to 1e-06 (relative) at 100% of the points" in v["C14"].details[-1]
+    assert v["C2"].basis == "" and v["C19"].basis == ""  # other claims: the dynamics decide
+    # the back flanks touch at two points of fig9: no longer a pure shift, and the report says
+    # where
+    contact = np.where(np.isin(GRID, (2.0, 2.05)), "double", "single")
+    touching = shifted.copy()
+    touching["contact"] = (("sweep", "Omega", "mesh"),
+                           np.broadcast_to(contact[None, :, None], (2, GRID.size, 2)).copy())
+    v = evaluate({"fig4": base, "fig9": touching})
+    assert v["C14"].basis == BACK_CONTACT and "fig9 at Omega = 2-2.05" in v["C14"].details[-1]
+    # always on the back flank (regime "none", coordinate below zero) counts as contact too
+    behind = fake("fig9", GRID, labels_where({}), x=np.full_like(x, -6.0))
+    assert evaluate({"fig4": base, "fig9": behind})["C15"].basis == BACK_CONTACT
+    # without fig4 the shift cannot be checked: C18 says so
+    alone = evaluate({"fig9": shifted})["C18"]
+    assert alone.basis == "" and "not checked" in alone.details[-1]
+
+
+def test_slow_load_noise_verdicts_say_linear_statics_decide():
+    from geardyn import CATTDevice
+
+    base = with_params(fake("fig4", GRID, labels_where({})), "fig4")
+    spread = np.linspace(-0.5, 0.5, 4)[None, :]
+    cases = {}
+    for name in ("fig13", "fig14", "fig15a", "fig15b", "fig15c", "fig15d"):
+        p = get_case(name).params
+        loads = p.loads
+        # the quasi-static peak-to-peak computed here from two static solutions
+        g = [CATTDevice(p.replace(A1=loads.A1 + s * loads.B1, A2=loads.A2 + s * loads.B2),
+                        "consistent").static_forces()[0] for s in (-1.0, 1.0)]
+        width = (g[1] - g[0]) * (1.0 if loads.Lambda < 1 else 0.2)
+        cases[name] = with_params(fake(name, GRID, labels_where({"quasi-periodic": (0.2, 4.0)}),
+                                       x=5.5 + width * spread + 0 * GRID[:, None]), name)
+    v = evaluate({"fig4": base, **cases})
+    assert v["C25"].basis == f"{LINEAR_STATICS}: fig13"
+    assert v["C27"].basis == f"{LINEAR_STATICS}: fig15b"
+    assert v["C26"].basis == f"{LINEAR_STATICS}: fig13"
+    note = next(d for d in v["C25"].details if d.startswith("fig13:"))
+    measured = float(re.search(r"measured growth of ([0-9.e+-]+)", note).group(1))
+    static = float(re.search(r"peak-to-peak, ([0-9.e+-]+) static", note).group(1))
+    assert measured == pytest.approx(static, rel=1e-3)
+    assert not any(d.startswith("fig14:") for d in v["C25"].details)  # Lambda = 2: dynamic
+    assert v["C24"].basis == ""
+
+
+def test_verdict_table_is_written_from_verdicts(tmp_path):
+    statuses = {"consistent": "holds", "carrier-only": "partly holds", "as-printed": "fails"}
+    verdicts = {i: {d: {c.id: Verdict(s, "m") for c in CLAIMS} for d in ("up", "down")}
+                for i, s in statuses.items()}
+    verdicts["as-printed"]["down"]["C3"] = Verdict("holds", "m")
+    verdicts["consistent"]["up"]["C14"] = Verdict("holds", "m", ("why",), BY_CONSTRUCTION)
+    text = verdict_document(verdicts, "geardyn reproduce --all", "20 Omega points",
+                            provisional=True, when="now", version="x")
+    path = tmp_path / "v.md"
+    path.write_text(text)
+    interps, rows = read_verdicts(path)
+    assert interps == list(statuses)
+    assert list(rows) == [c.id for c in CLAIMS]
+    for c in CLAIMS:
+        assert rows[c.id]["claim"] == c.statement
+        assert {i: rows[c.id][i] for i in interps} == statuses
+    assert "| fails (down sweep: holds) |" in text.splitlines()[
+        [c.id for c in CLAIMS].index("C3") + 10]
+    assert BY_CONSTRUCTION in next(line for line in text.splitlines() if line.startswith("| C14"))
+    assert "`geardyn reproduce --all`" in text and "**Provisional**" in text
+    assert text.startswith(MARKER)
+
+
+def test_verdict_table_in_docs_matches_the_claims():
+    path = ROOT / "docs" / "reproduction-verdicts.md"
+    interps, rows = read_verdicts(path)
+    assert interps == list(INTERPRETATIONS), "regenerate: make reproduce-verdicts"
+    assert list(rows) == [c.id for c in CLAIMS], "regenerate: make reproduce-verdicts"
+    for c in CLAIMS:
+        assert rows[c.id]["claim"] == c.statement, (c.id, "regenerate: make reproduce-verdicts")
+        assert all(rows[c.id][i] in STATUSES for i in interps), c.id
+    assert "reproduction-verdicts.md" in (ROOT / "docs" / "reproduction.md").read_text()
+
+
 def test_motion_labels_and_hysteresis():
     # T = 1000: floor 5e-3; the last point's error (2e-3, z = 3) widens its band to 6e-3
     lam = np.array([np.nan, -0.02, 0.0001, 0.01, np.nan, np.nan, 0.005])
@@ -211,13 +344,14 @@ def test_pipeline_at_tiny_resolution(tmp_path, capsys):
 
     out = tmp_path / "rep"
     with pytest.raises(SystemExit) as info:
-        main(["reproduce", "fig5", *map(str, TINY), "--out", str(out), "--quiet"])
+        main(["reproduce", "fig5", *map(str, TINY), "--out", str(out), "--quiet",
+              "--verdicts", str(tmp_path / "docs" / "verdicts.md")])
     captured = capsys.readouterr()
     assert info.value.code == 0, captured.err
     assert "consistent:" in captured.out
     files = {p.name for p in out.iterdir()}
     assert {"fig5-consistent.nc", "fig5-consistent.png", "fig5-consistent-down.png",
-            "report.md", "report.html"} <= files
+            "report.md", "report.html", "verdicts.md"} <= files
     ds = load_dataset(out / "fig5-consistent.nc")
     assert list(ds["sweep"].values) == ["up", "down"] and ds.sizes["Omega"] == 3
 
@@ -227,10 +361,15 @@ def test_pipeline_at_tiny_resolution(tmp_path, capsys):
                     "## How the verdicts are decided", "## Claims", "## Cases", "## Run time"):
         assert heading in md
     rows = {m.group(1): m.group(2) for m in
-            re.finditer(r"^\| (C\d+) \|.*\| \*\*([a-z ]+)\*\*[^|]*\|$", md, re.M)}
+            re.finditer(r"^\| (C\d+) \|[^*]*\| \*\*([a-z ]+)\*\*[^|]*\|.*$", md, re.M)}
     assert set(rows) == {c.id for c in CLAIMS}
     assert set(rows.values()) <= set(STATUSES)
     assert rows["C3"] == "not assessed"  # needs fig3, which was not run
+    interps, table = read_verdicts(tmp_path / "docs" / "verdicts.md")
+    assert (out / "verdicts.md").read_text() == (tmp_path / "docs" / "verdicts.md").read_text()
+    assert interps == ["consistent"]
+    assert {c: r["consistent"] for c, r in table.items()} == rows
+    assert "--resolution 3" in (out / "verdicts.md").read_text()
     html = (out / "report.html").read_text()
     assert html.count("data:image/png;base64,") == 2 and "<table>" in html
 

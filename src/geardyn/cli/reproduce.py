@@ -5,16 +5,19 @@
     geardyn reproduce fig3 [--interpretation ...] [--resolution N] [--out out/reproduce]
     geardyn reproduce --all [--interpretation consistent|carrier-only|as-printed|all]
                       [--resolution N] [--transient T] [--samples S] [--jobs N]
-                      [--out out/reproduce]
+                      [--out out/reproduce] [--verdicts docs/reproduction-verdicts.md]
+                      [--no-figures]
 
 Writes, under ``--out``, ``CASE-INTERPRETATION.nc`` (data), ``CASE-INTERPRETATION.png`` and
-``...-down.png`` (the diagrams swept up and down), ``report.md`` and a self-contained
-``report.html``. See ``docs/reproduction.md``.
+``...-down.png`` (the diagrams swept up and down), ``report.md``, a self-contained
+``report.html`` and ``verdicts.md`` (every claim's verdict per interpretation; ``--verdicts``
+writes it to another path too). See ``docs/reproduction.md``.
 """
 
 from __future__ import annotations
 
 import contextlib
+import shutil
 import time
 from enum import StrEnum
 from pathlib import Path
@@ -72,6 +75,12 @@ def reproduce_command(
         help="Worker processes, each continuing its share of the sweeps with one thread "
         "(default: one per core; 1: all sweeps together in this process, on every core).")] = None,
     out: Annotated[Path, typer.Option(help="Output folder.")] = Path("out/reproduce"),
+    verdicts: Annotated[Path | None, typer.Option(
+        help="Also write the verdict table (verdicts.md) to this file, e.g. "
+        "docs/reproduction-verdicts.md (with --all --interpretation all).")] = None,
+    figures: Annotated[bool, typer.Option(
+        "--figures/--no-figures", help="Draw the diagrams (PNG, embedded in report.html); "
+        "without them only the data, the report and the verdict table are written.")] = True,
     quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No progress bar.")] = False,
 ) -> None:
     """Recompute the paper's bifurcation diagrams (swept up and down) and write a report that
@@ -114,17 +123,23 @@ def reproduce_command(
         f" --interpretation {interpretation.value}"
         + (f" --resolution {resolution}" if resolution else "")
         + (f" --transient {transient:g}" if transient is not None else "")
-        + (f" --samples {samples}" if samples else ""))
+        + (f" --samples {samples}" if samples else "")
+        + (f" --verdicts {verdicts}" if verdicts is not None else ""))
     with stderr_console().status("writing figures, data and the report"):
-        paths = write_report(results, out, command=command)
+        paths = write_report(results, out, command=command, figures=figures)
     for interp in interps:
-        verdicts = evaluate({c: ds for (c, i), ds in results.items() if i == interp})
+        found = evaluate({c: ds for (c, i), ds in results.items() if i == interp})
         counts: dict[str, int] = {}
-        for v in verdicts.values():
+        for v in found.values():
             counts[v.status] = counts.get(v.status, 0) + 1
         typer.echo(f"{interp}: " + ", ".join(f"{n} {s}" for s, n in counts.items()))
+    written = [paths["markdown"], paths["html"], paths["verdicts"]]
+    if verdicts is not None:
+        verdicts.parent.mkdir(parents=True, exist_ok=True)
+        shutil.copyfile(paths["verdicts"], verdicts)
+        written.append(verdicts)
     typer.echo(f"{len(results)} case results in {swept:.1f} s ({workers} processes); wrote "
-               f"{paths['markdown']}, {paths['html']}")
+               + ", ".join(str(p) for p in written))
 
 
 def register(app: typer.Typer) -> None:

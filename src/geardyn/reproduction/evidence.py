@@ -1,21 +1,28 @@
 """Measurements on case results that the claim checks are built from.
 
 A :class:`Branch` is one sweep direction of one case: the Omega grid, the motion label of every
-point (:mod:`geardyn.reproduction.motion`) and the stroboscopic samples of the case's plotted
-coordinate. :class:`Evidence` holds the branches of every case run under one interpretation.
+point (:mod:`geardyn.reproduction.motion`), the stroboscopic samples of the case's plotted
+coordinate, the contact regimes and where the back flanks touch. :class:`Evidence` holds the
+branches of every case run under one interpretation.
 """
 
 from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 import xarray as xr
 
 from geardyn.reproduction.motion import CHAOTIC, intervals, is_nonperiodic, period_label
 
-__all__ = ["Branch", "Evidence", "MissingCase", "format_intervals"]
+__all__ = ["QUASI_STATIC", "Branch", "Evidence", "MissingCase", "back_flank_contact",
+           "format_intervals"]
+
+#: A load fluctuation counts as quasi-static when Lambda is at most this share of the lowest
+#: natural frequency (dynamic amplification 1 / (1 - 0.25^2) = 1.07 at most).
+QUASI_STATIC = 0.25
 
 
 class MissingCase(LookupError):
@@ -44,6 +51,9 @@ class Branch:
     mesh: tuple[str, ...]
     static_deflection: float  # dimensionless static mesh deflection of the plotted mesh
     state: str
+    back: np.ndarray | None = None  # (Omega,): the back flanks touch (any mesh); see below
+    params_json: str = ""  # the case's parameters (PlanetaryParams JSON), "" if unknown
+    interpretation: str = ""
 
     @classmethod
     def from_dataset(cls, ds: xr.Dataset, direction: str = "up") -> Branch:
@@ -64,6 +74,9 @@ class Branch:
             mesh=mesh,
             static_deflection=float(static[min(which, static.size - 1)]),
             state=state,
+            back=back_flank_contact(d),
+            params_json=str(ds.attrs.get("params_json", "")),
+            interpretation=str(ds.attrs.get("interpretation", "")),
         )
 
     # ------------------------------------------------------------------ masks
@@ -101,6 +114,17 @@ class Branch:
     def runs(self, mask: np.ndarray, min_points: int = 1) -> list[tuple[float, float, int]]:
         return [r for r in intervals(self.omega, mask) if r[2] >= min_points]
 
+    def regions(self, mask: np.ndarray, min_width: float) -> list[tuple[float, float, int]]:
+        """Runs of consecutive points where ``mask`` holds that span at least ``min_width`` in
+        Omega (last minus first point; so never a single point)."""
+        return [r for r in intervals(self.omega, mask)
+                if r[2] > 1 and r[1] - r[0] >= min_width - 1e-9]
+
+    def first_region(self, mask: np.ndarray, min_width: float) -> float | None:
+        """The lowest Omega of a region (:meth:`regions`) where ``mask`` holds."""
+        found = self.regions(mask, min_width)
+        return found[0][0] if found else None
+
     def length(self, mask: np.ndarray) -> float:
         """Omega-length covered by ``mask`` (points times the grid spacing)."""
         return float(np.count_nonzero(mask)) * self.step
@@ -124,9 +148,80 @@ class Branch:
         return np.nanmax(self.x, axis=1) - np.nanmin(self.x, axis=1)
 
     @property
+    def diverged(self) -> np.ndarray:
+        """The integration diverged (contact regime ``unbounded`` in some mesh)."""
+        return np.any(self.contact == "unbounded", axis=1)
+
+    @property
+    def back_contact(self) -> np.ndarray:
+        """The back flanks touch at this Omega (see :func:`back_flank_contact`)."""
+        if self.back is None:
+            return np.any(self.contact == "double", axis=1)
+        return self.back
+
+    @cached_property
+    def backlash(self) -> float:
+        """Backlash of the plotted mesh in units of b_c (NaN when the parameters are unknown)."""
+        p = self._params()
+        if p is None:
+            return float("nan")
+        mesh = p.planet_mesh if "pq" in self.state else p.sun_mesh
+        return float(mesh.backlash / p.b_c)
+
+    @cached_property
+    def quasi_static(self) -> tuple[float, float, float]:
+        """The linear static response to the load fluctuation B1, B2 (loads A +- B through the
+        static stiffness): ``(spread, Lambda, lowest natural frequency)``, where ``spread`` is
+        the quasi-static peak-to-peak of the plotted coordinate [b_c] (NaN when the parameters
+        are unknown). A fair estimate of the measured growth of the point spread only when
+        Lambda <= :data:`QUASI_STATIC` x the lowest natural frequency."""
+        p = self._params()
+        if p is None or not self.interpretation:
+            return float("nan"), float("nan"), float("nan")
+        from geardyn.models.catt import CATTDevice
+
+        loads = p.loads
+        base = CATTDevice(p, self.interpretation)
+        moved = CATTDevice(p.replace(A1=loads.A1 + loads.B1, A2=loads.A2 + loads.B2),
+                           self.interpretation)
+        which = 1 if "pq" in self.state else 0
+        shift = float(moved.static_forces()[which] - base.static_forces()[which])
+        lowest = float(np.min(base.natural_frequencies()))
+        return 2.0 * abs(shift), float(loads.Lambda), lowest
+
+    def _params(self):
+        if not self.params_json:
+            return None
+        from geardyn.models.params import PlanetaryParams
+
+        return PlanetaryParams.model_validate_json(self.params_json)
+
+    @property
     def extent(self) -> float:
         """Peak-to-peak of every stroboscopic value of the whole diagram."""
         return float(np.nanmax(self.x) - np.nanmin(self.x))
+
+
+def back_flank_contact(d: xr.Dataset) -> np.ndarray | None:
+    """Where the back flanks touch, per point of one sweep ``d`` (dims Omega, mesh): the contact
+    regime ``double`` (both flanks hit: the back-flank switching function X + b changed sign or
+    crossed zero while sampling), or ``none`` with the mesh coordinate below zero (always on the
+    back flank). None when ``d`` has no contact regimes. Read on the sampled motion of every
+    point, after its transient."""
+    if "contact" not in d or "mesh" not in d.dims:
+        return None
+    regime = d["contact"].transpose("Omega", "mesh").values.astype(str)
+    order = np.argsort(d["Omega"].values, kind="stable")
+    out = np.any(regime == "double", axis=1)
+    names = [str(s) for s in d["state"].values] if "state" in d.coords else []
+    for j, mesh in enumerate(str(m) for m in d["mesh"].values):
+        state = f"X_{mesh}"
+        if state not in names or "poincare" not in d:
+            continue
+        x = d["poincare"].sel(state=state).transpose("Omega", "sample").values
+        behind = np.all(x < 0.0, axis=1)
+        out |= (regime[:, j] == "none") & behind
+    return out[order]
 
 
 class Evidence:
