@@ -226,6 +226,7 @@ def _axis(spec):
     return name, np.linspace(float(a), float(b), int(n))
 
 
+@pytest.mark.slow  # ~25 s of subprocesses; the fast tests above interrupt in-process
 def test_killed_cli_run_resumes_to_the_uninterrupted_result(tmp_path):
     study = tmp_path / "study.toml"
     study.write_text(STUDY)
