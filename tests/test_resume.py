@@ -169,6 +169,19 @@ def test_saving_again_replaces_the_dataset_and_keeps_the_lane_store(tmp_path):
         save_zarr_dataset(xr.Dataset({"lanes": ("t", [1.0])}), path)
 
 
+def test_a_zarr_store_geardyn_did_not_write_is_left_alone(tmp_path):
+    path = tmp_path / "theirs.zarr"
+    theirs = xr.Dataset({"a": ("t", [1.0, 2.0])})
+    theirs.to_zarr(path, zarr_format=3, consolidated=False)
+    for call in (lambda: geardyn.map2d(GEAR, store=path, **MAP),
+                 lambda: save_zarr_dataset(theirs, path)):
+        with pytest.raises(StoreMismatchError, match="did not write") as err:
+            call()
+        assert str(path) in str(err.value)
+    assert xr.open_zarr(path, consolidated=False).load().identical(theirs)
+    assert not (path / "lanes").exists()
+
+
 def _legacy_store(path, ds: xr.Dataset) -> None:
     """A store as geardyn wrote it before the dataset moved to the root: lane store at the
     root, dataset in group "result" with strings as flag codes."""

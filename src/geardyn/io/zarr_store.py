@@ -103,8 +103,9 @@ def _legacy_message(path: Path) -> str:
 
 
 def _prepare_root(path: Path) -> None:
-    """Create the store's root group (no dataset yet) unless it is there; refuse a path that is
-    not a store of the current layout."""
+    """Create the store's root group (no dataset yet) and its ``lanes`` group unless they are
+    there; refuse a path that is not a geardyn store of the current layout (another Zarr store's
+    arrays would be replaced by the dataset)."""
     if path.exists() and not path.is_dir():
         raise StoreMismatchError(f"{path}: exists and is not a Zarr store")
     meta = _read_meta(path) if path.is_dir() else None
@@ -117,6 +118,14 @@ def _prepare_root(path: Path) -> None:
         raise StoreMismatchError(_legacy_message(path))
     elif meta.get("node_type") != "group":
         raise StoreMismatchError(f"{path}: a Zarr array, not a store")
+    elif (_UNFINISHED not in meta.get("attributes", {}) and _read_meta(path / LANES_GROUP) is None
+          and any(p.name != "zarr.json" for p in path.iterdir())):
+        raise StoreMismatchError(f"{path}: a Zarr store that geardyn did not write (its data "
+                                 "would be replaced); choose another path")
+    if _read_meta(path / LANES_GROUP) is None:  # marks the store as geardyn's
+        (path / LANES_GROUP).mkdir(exist_ok=True)
+        _write_meta(path / LANES_GROUP, {"zarr_format": 3, "node_type": "group",
+                                         "attributes": {}})
 
 
 class LaneStore:
@@ -147,10 +156,7 @@ class LaneStore:
         number (1 for a fresh store). Raises :class:`StoreMismatchError` when the store holds a
         run with other inputs, or is not a store of the current layout."""
         _prepare_root(self.path)
-        lanes = self.lanes_path
-        if lanes.exists() and any(lanes.iterdir()) and _read_meta(lanes) is None:
-            raise StoreMismatchError(f"{lanes}: exists and is not a lane store")
-        group = _open_group(lanes, "a")
+        group = _open_group(self.lanes_path, "a")
         n_chunks = -(-n_lanes // chunk)
         info = group.attrs.get(_ATTR)
         if info is None:  # fresh (or interrupted before it was initialised)
