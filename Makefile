@@ -28,8 +28,11 @@ test: $(STAMP)
 	$(BIN)/ruff check src tests
 	$(BIN)/python -m pytest -n 2 -q
 
+# The long studies only (marked @pytest.mark.slow; pyproject's addopts keep them out of
+# `make test`, and this -m replaces that selection): a whole Fig. 3 diagram at the default
+# step against DOP853 orbits, a real `geardyn map` killed with SIGKILL and resumed.
 test-slow: $(STAMP)
-	$(BIN)/python -m pytest -q -m slow
+	$(BIN)/python -m pytest -n 2 -q -m slow
 
 bench: $(STAMP)
 	$(BIN)/python bench/bifurcation.py

@@ -73,19 +73,6 @@ def test_help_and_version(capsys):
     assert r.returncode == 0 and "show" in r.stdout and "save" in r.stdout
 
 
-def test_params_show_default_lists_derived_quantities(capsys):
-    r = geardyn("params", "show")
-    assert r.returncode == 0, r.stderr
-    out = r.stdout
-    for name in ("omega_n", "M_c", "J_c_eff", "C_sq", "k_sq_c", "f_c0", "Natural frequencies"):
-        assert name in out
-    assert "24.9914" in out  # M_c, consistent interpretation
-    r = geardyn_here(capsys, "params", "show", "--interpretation", "as-printed")
-    assert r.returncode == 0 and "130.689" in r.stdout
-    r = geardyn_here(capsys, "params", "show", "paper_fig3", "--interpretation", "carrier-only")
-    assert r.returncode == 0 and "0.687528" in r.stdout
-
-
 def test_params_save_writes_loadable_template(tmp_path, capsys):
     out = tmp_path / "paper.toml"
     r = geardyn_here(capsys, "params", "save", out)

@@ -31,13 +31,52 @@ def onset() -> float:
     return w
 
 
-def test_separation_onset_closed_form():
-    # Fa Omega^2 = Fm |1 - Omega^2 + 2 i zeta Omega|: a quadratic in Omega^2
-    # (Fa^2 - Fm^2) W^2 - Fm^2 (4 zeta^2 - 2) W - Fm^2 = 0, W = Omega^2
+def _closed_form_onset() -> float:
+    """The onset from the linear in-contact solution, in closed form: Fa Omega^2 =
+    Fm |1 - Omega^2 + 2 i zeta Omega| is a quadratic in W = Omega^2,
+    (Fa^2 - Fm^2) W^2 - Fm^2 (4 zeta^2 - 2) W - Fm^2 = 0."""
     a, b, c = FA**2 - FM**2, -(FM**2) * (4 * ZETA**2 - 2), -(FM**2)
     roots = np.roots([a, b, c])
-    w_closed = math.sqrt(min(r.real for r in roots if r.real > 0))
-    assert onset() == pytest.approx(w_closed, rel=1e-10)
+    return math.sqrt(min(r.real for r in roots if r.real > 0))
+
+
+def _loses_contact(omega: float, steps_per_period: int | None) -> tuple[bool, int]:
+    """Whether the gear pair, started on the linear in-contact steady state at Omega, leaves the
+    contact edge x = b within 4 periods (an edge crossing, or a grid point past the edge), by
+    simulate(); and the steps per period it used."""
+    g = geardyn.GearPair(zeta=ZETA, kappa=0.0, Fm=FM, Fa=FA, backlash=B, Omega=omega)
+    H = linear_response(omega)
+    y0 = np.array([B + FM + H.real, -omega * H.imag])
+    ds = geardyn.simulate(g, periods=4, steps_per_period=steps_per_period, y0=y0)
+    lost = int(ds["edge_crossings"].sel(event="x-b")) > 0 or float(ds["x"].min()) < B
+    return lost, int(ds.attrs["steps_per_period"])
+
+
+@pytest.mark.parametrize("steps_per_period", [None, 1024])
+def test_separation_onset_found_by_simulation_matches_the_closed_form(steps_per_period):
+    """Bisect Omega on whether simulate() loses contact, and compare the bracket with the closed
+    form. A dip past the edge shorter than one step can hide between two grid points (a graze):
+    the orbit u = Fm - |H| + |H| (1 - cos) dips below the edge by at most
+    |H| pi^2 / (2 n^2) then, so the simulated onset may lie later than the closed form by that
+    depth over d|H|/dOmega, never earlier (beyond round-off and the 4th-order RK4 error)."""
+    w_closed = _closed_form_onset()
+    assert w_closed == pytest.approx(onset(), rel=1e-10)  # the quadratic is |H| = Fm
+    lo, hi = 0.9 * w_closed, 1.1 * w_closed
+    assert not _loses_contact(lo, steps_per_period)[0]
+    lost, n = _loses_contact(hi, steps_per_period)
+    assert lost
+    resolution = 1e-7
+    while hi - lo > resolution:
+        mid = 0.5 * (lo + hi)
+        if _loses_contact(mid, steps_per_period)[0]:
+            hi = mid
+        else:
+            lo = mid
+    dh = 1e-6
+    slope = (abs(linear_response(w_closed + dh)) - abs(linear_response(w_closed - dh))) / (2 * dh)
+    graze = FM * math.pi**2 / (2 * n**2) / slope  # |H| = Fm at the onset
+    assert hi >= w_closed - 1e-9, (lo, hi, w_closed)
+    assert lo <= w_closed + graze + 1e-9, (lo, hi, w_closed, graze)
 
 
 @pytest.mark.parametrize("side", [-1, 1])

@@ -187,6 +187,40 @@ def test_cli_map_writes_the_map_and_its_figure(tmp_path, capsys):
     np.testing.assert_array_equal(got["contact"].values, want["contact"].values)
 
 
+def test_cli_map_zarr_output_opens_with_plain_xarray_and_redraws(tmp_path, capsys):
+    """``--out m.zarr``: the store's root is the map (plain ``xarray.open_zarr``, no warning),
+    the same as the API's; ``geardyn plot`` redraws it; a rerun computes nothing again."""
+    import warnings
+
+    import xarray as xr
+
+    from geardyn.cli.main import main
+    from geardyn.io.zarr_store import LaneStore
+
+    study = tmp_path / "gp.toml"
+    study.write_text(GEAR_STUDY)
+    out = tmp_path / "m.zarr"
+    args = [str(study), "--x", "Omega:0.5:3:4", "--y", "zeta:0.02:0.1:2", "--out", str(out),
+            "--chunk", "3"]
+    for run in (1, 2):
+        code, _, err = _cli(args, capsys)
+        assert code == 0, err
+        np.testing.assert_array_equal(LaneStore(out).chunk_runs(), [1, 1, 1])
+        assert LaneStore(out).info["runs"] == run
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with xr.open_zarr(out) as opened:
+            opened = opened.load()
+    model = geardyn.GearPair(zeta=0.05, kappa=0.2, Fm=0.1, Fa=0.2)
+    want = geardyn.map2d(model, x=("Omega", np.linspace(0.5, 3, 4)),
+                         y=("zeta", np.linspace(0.02, 0.1, 2)), transient=100.0, samples=8,
+                         chunk=3)
+    xr.testing.assert_identical(opened, want.assign_attrs(study="gp"))
+    with pytest.raises(SystemExit) as exc:
+        main(["plot", str(out), "--out", str(tmp_path / "m.png")])
+    assert exc.value.code == 0 and (tmp_path / "m.png").stat().st_size > 5000
+
+
 @pytest.mark.parametrize("axes,field", [
     (["--x", "Omega:0.5:3", "--y", "zeta:0.1:0.2:2"], "--x"),
     (["--x", "Omega:0.5:3:4", "--y", "zeta:a:0.2:2"], "--y"),

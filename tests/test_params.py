@@ -4,6 +4,7 @@ paper's names, per-planet and derived overrides, and the three interpretations."
 from __future__ import annotations
 
 import math
+import re
 
 import numpy as np
 import pytest
@@ -273,3 +274,92 @@ def test_interpretations_omega_n():
 def test_unknown_interpretation_rejected():
     with pytest.raises(ValueError, match="interpretation"):
         CATTDevice(PlanetaryParams.paper(), interpretation="printed")  # type: ignore[arg-type]
+
+
+# --------------------------------------------------------------------------- derived, by hand
+def _paper_by_hand(interpretation: str) -> dict[str, float]:
+    """Every quantity ``geardyn params show`` lists for the paper's device, from Tables 1 and 2
+    and the model notes (Eqs. 6, 9, 10, 11; solid steel discs, 7850 kg/m^3, 15 mm wide, at the
+    pitch radii m z / 2; J_s = J_p; r_bc = r_c1 = 60 + 45 mm, r_c2 = 105 + 45 + 60 mm; carrier
+    arm of a sun-planet force r_bs cos 20 deg), computed here without the library."""
+    n, xi1, xi2, b_c = 4, 0.05, 0.05, 1e-5
+    km_sq, km_pq, t_d, a1, a2 = 0.825e9, 1.0e9, 1500.0, 600.0, 900.0
+    r_bs, r_bq, r_bp = 0.05638, 0.04229, 0.05638
+    j_q, j_p, j_c = 7.13e-4, 0.002, 7.58e-3
+    j_s = j_p
+    r_c1, r_c2 = 0.105, 0.210
+    r_bc, arm = r_c1, r_bs * math.cos(math.radians(20.0))
+    m_s, m_q, m_p = (7850.0 * math.pi * (3e-3 * z / 2) ** 2 * 0.015 for z in (40, 30, 40))
+    M_s, M_q, M_p = j_s / r_bs**2, j_q / r_bq**2, j_p / r_bp**2
+    j_c_eff = {"consistent": j_c + n * (m_p * r_c2**2 + m_q * r_c1**2),
+               "carrier-only": j_c,
+               "as-printed": j_c + n * (m_p * r_c2 + m_q * r_c1)}[interpretation]
+    M_c = j_c_eff / r_bc**2
+    inv = 1 / M_s + 1 / M_c
+    printed = interpretation == "as-printed"
+    w_n = math.sqrt(km_sq / inv) if printed else math.sqrt(km_sq * inv)
+    gamma = 1 / w_n if printed else 1.0  # Eq. (10)'s carrier damping typo, as printed
+    c_sq = 2 * xi1 * math.sqrt(km_sq / (1 / M_s + 1 / M_q))
+    c_pq = 2 * xi2 * math.sqrt(km_pq / (1 / M_p + 1 / M_q))
+    k = {"k_sq_c": r_c1 * arm * km_sq / (M_c * r_bc**2 * w_n**2),
+         "k_sq_q": km_sq / (M_q * w_n**2), "k_pq_q": km_pq / (M_q * w_n**2),
+         "k_pq_p": km_pq / (M_p * w_n**2)}
+    out = dict(m_s=m_s, m_q=m_q, m_p=m_p, J_s=j_s, M_s=M_s, M_q=M_q, M_p=M_p, r_bc=r_bc,
+               J_c_eff=j_c_eff, M_c=M_c, arm=arm, omega_n=w_n, C_sq=c_sq, C_pq=c_pq, **k,
+               c_sq_c=gamma * r_c1 * arm * c_sq / (M_c * r_bc**2 * w_n),
+               c_sq_q=c_sq / (M_q * w_n), c_pq_q=c_pq / (M_q * w_n), c_pq_p=c_pq / (M_p * w_n),
+               b_sq=5e-5 / b_c, E_sq=1e-5 / b_c,
+               f_p0=a1 / (M_p * r_bp * w_n**2 * b_c),
+               f_c0=r_c1 * (t_d - a2) / (M_c * r_bc**2 * w_n**2 * b_c))
+    # Eq. (10) linearised, every planet set alike: N - 1 sets move against each other (the
+    # carrier sees no net force), one in phase (the carrier term counts N times)
+    modes = []
+    for carrier in (0.0, n * k["k_sq_c"]):
+        K = np.array([[k["k_sq_q"] + carrier, -k["k_pq_q"]],
+                      [-k["k_sq_q"], k["k_pq_q"] + k["k_pq_p"]]])
+        modes.append(np.sqrt(np.sort(np.linalg.eigvals(K).real)))
+    out["modes"] = np.sort(np.concatenate([np.repeat(modes[0], n - 1), modes[1]]))
+    # statics under the mean loads: the mesh deflections beyond the backlash, dimensionless
+    K = np.array([[k["k_sq_q"] + n * k["k_sq_c"], -k["k_pq_q"]],
+                  [-k["k_sq_q"], k["k_pq_q"] + k["k_pq_p"]]])
+    u_sq, u_pq = np.linalg.solve(K, [out["f_c0"], out["f_p0"]])
+    out["F_sq"], out["F_pq"] = km_sq * b_c * u_sq, km_pq * b_c * u_pq
+    return out
+
+
+def _shown(text: str) -> dict[str, float]:
+    """First number of every named row of the tables ``geardyn params show`` prints."""
+    rows = {}
+    for line in text.splitlines():
+        cells = [c.strip() for c in line.split("│")]
+        if len(cells) > 3 and cells[1] and cells[2]:
+            try:
+                rows[cells[1]] = float(cells[2].split()[0])
+            except ValueError:
+                continue
+    return rows
+
+
+@pytest.mark.parametrize("study,interpretation", [
+    (None, "consistent"), (None, "as-printed"), ("paper_fig3", "carrier-only")])
+def test_params_show_default_lists_derived_quantities(capsys, study, interpretation):
+    """Every derived quantity ``geardyn params show`` prints (6 significant digits) equals the
+    hand computation from the paper's tables, for each interpretation."""
+    from geardyn.cli.main import main
+
+    with pytest.raises(SystemExit) as info:
+        main(["params", "show", *([study] if study else []), "--interpretation", interpretation])
+    out = capsys.readouterr().out
+    assert info.value.code == 0, out
+    want = _paper_by_hand(interpretation)
+    got = _shown(out)
+    names = [k for k in want if k not in ("modes", "F_sq", "F_pq")]
+    assert set(names) <= set(got), sorted(set(names) - set(got))
+    for name in names:
+        assert got[name] == pytest.approx(want[name], rel=1e-5), name
+    modes = np.array([float(v) for v in re.findall(r"│\s+\d+ │\s+([\d.e+-]+) │", out)])
+    np.testing.assert_allclose(modes, want["modes"], rtol=1e-5)
+    forces = re.search(r"F_sq = ([\d.e+-]+) N, F_pq = ([\d.e+-]+) N", out)
+    assert forces is not None, out
+    np.testing.assert_allclose([float(forces[1]), float(forces[2])],
+                               [want["F_sq"], want["F_pq"]], rtol=1e-5)

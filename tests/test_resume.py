@@ -1,5 +1,6 @@
 """Resumable runs: finished chunks in a Zarr store survive interruption (SIGKILL included), a
-rerun computes only the rest, and the result is that of an uninterrupted run."""
+rerun computes only the rest, and the result is that of an uninterrupted run. The finished
+dataset sits at the store's root, where plain ``xarray.open_zarr`` finds it."""
 
 from __future__ import annotations
 
@@ -9,13 +10,20 @@ import signal
 import subprocess
 import sys
 import time
+import warnings
 
 import numpy as np
 import pytest
+import xarray as xr
 
 import geardyn
 from geardyn.io.toml import load_study
-from geardyn.io.zarr_store import LaneStore, StoreMismatchError, load_zarr_dataset
+from geardyn.io.zarr_store import (
+    LaneStore,
+    StoreMismatchError,
+    load_zarr_dataset,
+    save_zarr_dataset,
+)
 from geardyn.solvers.executor import lane_results, run_chunks, run_lanes_task
 
 GEAR = geardyn.GearPair(zeta=0.05, kappa=0.2, Fm=0.1, Fa=0.2)
@@ -75,7 +83,7 @@ def test_half_written_chunk_is_recomputed(tmp_path):
     store = LaneStore(path)
     store.begin(store.info["digest"], OMEGAS.size, 3, {})
     # simulate a kill between a chunk's data and its marker: garbage data, marker cleared
-    store._group["lanes"]["samples"][3:6] = -7.0
+    store._group["outputs"]["samples"][3:6] = -7.0
     store._group["done"][1] = 0
     CALLS.clear()
     resumed = _run(path)
@@ -102,6 +110,113 @@ def test_resumable_sweep_equals_the_plain_sweep(tmp_path):
     np.testing.assert_array_equal(LaneStore(tmp_path / "sweep.zarr").chunk_runs(), [1, 1, 1])
 
 
+# ------------------------------------------------------------------ the dataset at the root
+MAP = dict(x=("Omega", np.linspace(0.5, 3.0, 5)), y=("zeta", [0.03, 0.08]), transient=50.0,
+           samples=8, chunk=3)
+
+
+def _open_quietly(path) -> xr.Dataset:
+    """``xarray.open_zarr(path)`` with every warning an error, loaded."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with xr.open_zarr(path) as ds:
+            return ds.load()
+
+
+class _Interrupt(Exception):
+    pass
+
+
+def test_map_store_opens_with_plain_xarray_before_and_after_resuming(tmp_path):
+    whole = geardyn.map2d(GEAR, **MAP)
+    path = tmp_path / "m.zarr"
+    reports: list[int] = []
+
+    def stop_after_two_chunks(done: int, total: int) -> None:
+        reports.append(done)
+        if len(reports) == 3:  # the start, then two finished chunks
+            raise _Interrupt
+
+    with pytest.raises(_Interrupt):
+        geardyn.map2d(GEAR, store=path, progress=stop_after_two_chunks, **MAP)
+    np.testing.assert_array_equal(LaneStore(path).chunk_runs(), [1, 1, 0, 0])
+    unfinished = _open_quietly(path)  # no dataset yet: empty, and says why
+    assert not unfinished.variables and "geardyn_unfinished" in unfinished.attrs
+    with pytest.raises(FileNotFoundError, match="no finished dataset"):
+        load_zarr_dataset(path)
+
+    resumed = geardyn.map2d(GEAR, store=path, **MAP)
+    np.testing.assert_array_equal(LaneStore(path).chunk_runs(), [1, 1, 2, 2])
+    assert resumed.identical(whole)
+    assert _open_quietly(path).identical(whole)
+    assert load_zarr_dataset(path).identical(whole)
+    assert geardyn.map2d(GEAR, store=path, **MAP).identical(whole)  # again: read, rewritten
+    assert _open_quietly(path).identical(whole)
+    assert sorted(p.name for p in path.iterdir() if p.is_dir()) == sorted(
+        [*map(str, whole.variables), "lanes"])
+
+
+def test_saving_again_replaces_the_dataset_and_keeps_the_lane_store(tmp_path):
+    path = tmp_path / "m.zarr"
+    ds = geardyn.map2d(GEAR, store=path, **MAP)
+    other = xr.Dataset({"a": ("t", [1.0, 2.0])}, attrs={"note": "other"})
+    save_zarr_dataset(other, path)
+    assert _open_quietly(path).identical(other)
+    assert not (path / "period").exists()
+    assert geardyn.map2d(GEAR, store=path, **MAP).identical(ds)  # lanes kept: nothing rerun
+    assert LaneStore(path).info["runs"] == 2
+    with pytest.raises(ValueError, match="reserved"):
+        save_zarr_dataset(xr.Dataset({"lanes": ("t", [1.0])}), path)
+
+
+def test_a_zarr_store_geardyn_did_not_write_is_left_alone(tmp_path):
+    path = tmp_path / "theirs.zarr"
+    theirs = xr.Dataset({"a": ("t", [1.0, 2.0])})
+    theirs.to_zarr(path, zarr_format=3, consolidated=False)
+    for call in (lambda: geardyn.map2d(GEAR, store=path, **MAP),
+                 lambda: save_zarr_dataset(theirs, path)):
+        with pytest.raises(StoreMismatchError, match="did not write") as err:
+            call()
+        assert str(path) in str(err.value)
+    assert xr.open_zarr(path, consolidated=False).load().identical(theirs)
+    assert not (path / "lanes").exists()
+
+
+def _legacy_store(path, ds: xr.Dataset) -> None:
+    """A store as geardyn wrote it before the dataset moved to the root: lane store at the
+    root, dataset in group "result" with strings as flag codes."""
+    import zarr
+
+    root = zarr.open_group(str(path), mode="w", zarr_format=3)
+    root.attrs["geardyn_lanes"] = {"format": 1, "digest": "0" * 64, "n_lanes": 10, "chunk": 10,
+                                   "n_chunks": 1, "meta": {}, "runs": 1}
+    root.create_array("done", shape=(1,), chunks=(1,), dtype="int32", fill_value=0)[:] = 1
+    root.create_group("lanes")
+    enc = ds.copy()
+    for name in ("contact", "mesh"):  # strings as flag codes, as the earlier layout kept them
+        var = ds[name].variable
+        labels = sorted(set(var.values.ravel().tolist()))
+        codes = np.searchsorted(labels, var.values).astype(np.int16)
+        enc[name] = xr.Variable(var.dims, codes, dict(
+            var.attrs, flag_values=list(range(len(labels))), flag_meanings=" ".join(labels),
+            geardyn_categorical=1))
+    enc.to_zarr(str(path), group="result", mode="w", consolidated=False, zarr_format=3)
+
+
+def test_store_of_the_earlier_layout_is_read_but_not_resumed(tmp_path):
+    path = tmp_path / "old.zarr"
+    ds = geardyn.map2d(GEAR, **MAP)
+    _legacy_store(path, ds)
+    got = load_zarr_dataset(path)  # what geardyn plot reads
+    np.testing.assert_array_equal(got["contact"].values, ds["contact"].values)
+    np.testing.assert_array_equal(got["period"].values, ds["period"].values)
+    for call in (lambda: geardyn.map2d(GEAR, store=path, **MAP),
+                 lambda: save_zarr_dataset(ds, path), lambda: LaneStore(path).chunk_runs()):
+        with pytest.raises(StoreMismatchError, match="earlier geardyn layout") as err:
+            call()
+        assert str(path) in str(err.value) and "delete it" in str(err.value)
+
+
 # ------------------------------------------------------------------ a real run, SIGKILLed
 STUDY = """
 [study]
@@ -124,6 +239,7 @@ def _axis(spec):
     return name, np.linspace(float(a), float(b), int(n))
 
 
+@pytest.mark.slow  # ~25 s of subprocesses; the fast tests above interrupt in-process
 def test_killed_cli_run_resumes_to_the_uninterrupted_result(tmp_path):
     study = tmp_path / "study.toml"
     study.write_text(STUDY)
@@ -151,7 +267,8 @@ def test_killed_cli_run_resumes_to_the_uninterrupted_result(tmp_path):
     killed = LaneStore(out).chunk_runs()
     n_chunks = killed.size
     assert 5 <= np.count_nonzero(killed) < n_chunks
-    assert not (out / "result").exists()
+    with pytest.raises(FileNotFoundError, match="no finished dataset"):
+        load_zarr_dataset(out)
 
     rerun = subprocess.run(cmd, capture_output=True, text=True, env=os.environ.copy(),
                            timeout=300)
@@ -164,6 +281,11 @@ def test_killed_cli_run_resumes_to_the_uninterrupted_result(tmp_path):
     model = load_study(study).build_model()
     whole = geardyn.map2d(model, x=_axis(X), y=_axis(Y), transient=300.0, samples=16,
                           chunk=CHUNK)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        opened = xr.open_zarr(out).load()  # plain xarray, quietly
+    xr.testing.assert_identical(opened.drop_attrs(), whole.drop_attrs())
+    assert opened.attrs == dict(whole.attrs, study="resume")
     got = load_zarr_dataset(out)
     assert set(got.data_vars) == set(whole.data_vars)
     for name in whole.data_vars:

@@ -140,8 +140,10 @@ def map2d(
         A ``dask.distributed.Client``: chunks run as tasks on its cluster. The result is bitwise
         that of the local run.
     store
-        Path of a Zarr store: finished chunks are written there as they complete, and a rerun
-        with the same inputs computes only the missing ones (see ``docs/scaling.md``).
+        Path of a Zarr store: finished chunks are written there (group ``lanes``) as they
+        complete, and a rerun with the same inputs computes only the missing ones; the finished
+        map is written at its root, so ``xarray.open_zarr(store)`` opens it (see
+        ``docs/scaling.md``).
     chunk
         Lanes (grid points) per task; default about a twentieth of the grid, at least 64.
     progress
@@ -219,7 +221,16 @@ def map2d(
         ds.attrs["interpretation"] = model.interpretation
     if hasattr(model, "omega_n"):
         ds.attrs["omega_n"] = float(model.omega_n)
+    if store is not None:
+        _save_store(ds, store)
     return ds
+
+
+def _save_store(ds: xr.Dataset, store: Any) -> None:
+    """Write the finished map at the root of its Zarr store (beside the lane store)."""
+    from geardyn.io.zarr_store import LaneStore, save_zarr_dataset
+
+    save_zarr_dataset(ds, store.path if isinstance(store, LaneStore) else store)
 
 
 # ---------------------------------------------------------------------------- cost estimate

@@ -10,7 +10,8 @@ An axis is ``NAME:START:STOP:NUM`` (NUM evenly spaced values, SI units for the d
 parameters). Before anything is built the command estimates memory and run time; a map above
 :data:`MEMORY_FRACTION` of this machine's memory or :data:`TIME_LIMIT_S` is refused with the
 estimate unless ``--yes`` is given. With ``--out map.zarr`` finished chunks are kept in the store
-as they complete and the same command, run again after an interruption, computes only the rest.
+as they complete and the same command, run again after an interruption, computes only the rest;
+the finished map is at the store's root (``xarray.open_zarr("map.zarr")`` opens it).
 """
 
 from __future__ import annotations

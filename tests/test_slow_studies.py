@@ -1,0 +1,67 @@
+"""Long studies (``make test-slow``): whole diagrams at the default step against DOP853.
+
+The fast suite checks the default step at a few points (``tests/test_numerics.py``); here every
+periodic point of a whole Fig. 3 diagram is compared with the periodic orbit that the adaptive
+reference (DOP853, rtol 1e-12, edges located) finds by shooting from it.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import geardyn
+
+#: docs/numerics.md: the default step keeps the Poincare points of periodic attractors with
+#: contact loss within 1e-6 (dimensionless, max norm) of the exact orbit.
+POINT_TOL = 1e-6
+
+
+def _flow(model: geardyn.Model, y: np.ndarray, periods: int) -> np.ndarray:
+    """The reference state ``periods`` forcing periods after ``y`` (taken at phase 0)."""
+    T = 2 * math.pi / model.omega
+    return geardyn.reference_solution(model, y, [periods * T], rtol=1e-12, atol=1e-12)[-1]
+
+
+def _shoot(model: geardyn.Model, y: np.ndarray, periods: int, iterations: int = 4
+           ) -> tuple[np.ndarray, float]:
+    """Newton on Phi(y) - y = 0 (Phi: the reference flow over ``periods`` periods, Jacobian by
+    forward differences): the exact periodic point nearest ``y``, and its closure |Phi(y*) - y*|."""
+    y = np.asarray(y, dtype=float).copy()
+    eye = np.eye(y.size)
+    for _ in range(iterations):
+        phi = _flow(model, y, periods)
+        J = np.empty((y.size, y.size))
+        for j in range(y.size):
+            h = 1e-7 * (1.0 + abs(y[j]))
+            J[:, j] = (_flow(model, y + h * eye[j], periods) - phi) / h
+        step = np.linalg.solve(J - eye, -(phi - y))
+        y = y + step
+        if np.max(np.abs(step)) < 1e-11:
+            break
+    return y, float(np.max(np.abs(_flow(model, y, periods) - y)))
+
+
+@pytest.mark.slow
+def test_fig3_diagram_at_the_default_step_is_within_1e6_of_the_dop853_orbits():
+    """Every periodic point (period <= 4) of the Fig. 3 diagram, 0.5 <= Omega <= 4 every 0.05,
+    at the default step: its Poincare point is within 1e-6 of the DOP853 periodic orbit."""
+    model = geardyn.CATTDevice(geardyn.PlanetaryParams.paper())  # consistent, xi = 0.05
+    omegas = np.round(np.arange(0.5, 4.0001, 0.05), 10)
+    ds = geardyn.bifurcation(model, values=omegas, transient=4000.0, samples=16)
+    period = ds["period"].values
+    errors = {}
+    for i, om in enumerate(omegas):
+        k = int(period[i])
+        if not 1 <= k <= 4:
+            continue
+        y = ds["poincare"].values[i, -1]
+        exact, closure = _shoot(model.with_omega(float(om)), y, k)
+        assert closure < 1e-9, (om, closure)  # shooting converged onto a periodic orbit
+        errors[float(om)] = float(np.max(np.abs(y - exact)))
+    assert len(errors) >= 50, period  # most of the diagram is periodic: all of it checked
+    over = {om: f"{e:.2e} ({ds['contact'].values[list(omegas).index(om)].tolist()})"
+            for om, e in errors.items() if e >= POINT_TOL}
+    assert not over, f"Poincare point error >= {POINT_TOL} at Omega: {over}"
