@@ -126,3 +126,6 @@ def test_bifurcation_lyapunov_separates_periodic_from_chaotic():
     np.testing.assert_array_equal(ds["period"].values, [1, 0])
     lam = ds["lyapunov"].values
     assert lam[0] < -0.005 and lam[1] > 0.02
+    # the motion class decides against each exponent's uncertainty (analysis.motion)
+    assert list(ds["motion"].values) == ["period-1", "chaotic"]
+    assert np.all(ds["lyapunov_err"].values > 0) and lam[1] > 3 * ds["lyapunov_err"].values[1]

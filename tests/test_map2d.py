@@ -99,6 +99,7 @@ def test_map_lyapunov_separates_chaos_from_periodic_motion():
     np.testing.assert_array_equal(ds["period"].values, [[1, 0]])
     lam = ds["lyapunov"].values[0]
     assert lam[0] < -0.005 and lam[1] > 0.02
+    assert ds["motion"].values.tolist() == [["period-1", "chaotic"]]
     assert ds.attrs["lyapunov"] == 1 and ds.attrs["x"] == "Omega" and ds.attrs["y"] == "zeta"
 
 

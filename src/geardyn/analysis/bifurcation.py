@@ -21,6 +21,7 @@ from geardyn.analysis.lanes import (
     variable_dims,
 )
 from geardyn.analysis.lyapunov import lyapunov_err_attrs
+from geardyn.analysis.motion import averaging_time, motion_variable
 from geardyn.analysis.periodicity import DEFAULT_MAX_PERIOD, DEFAULT_TOL
 from geardyn.models.base import Model
 from geardyn.solvers.ensemble import LaneResults
@@ -129,7 +130,8 @@ def bifurcation(
     ``final_time`` (param: the model time of the final state, the last Poincare point), and
     ``lyapunov`` with its standard error ``lyapunov_err`` (param) when asked: started from each
     point's final state at its final time, so both forcing phases continue (see
-    ``docs/lyapunov.md``).
+    ``docs/lyapunov.md``), and then ``motion`` (param: the motion class of
+    :func:`geardyn.analysis.motion.motion_classes`).
     """
     values = _check_values(values)
     if continuation not in (None, "up", "down"):
@@ -185,6 +187,10 @@ def bifurcation(
             "method": method})
         ds["lyapunov_err"] = (param, np.where(ok & np.isfinite(exps), errs, np.nan),
                               lyapunov_err_attrs(model.time_unit))
+        duration = averaging_time(samples * _mean_period(model, P), P[:, model.omega_index])
+        ds["motion"] = (param, *motion_variable(ds["period"].values, ds["lyapunov"].values,
+                                                ds["lyapunov_err"].values, duration,
+                                                last.commensurate))
     return ds
 
 

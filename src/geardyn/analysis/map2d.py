@@ -29,7 +29,8 @@ from geardyn.analysis.lanes import (
     variable_dims,
 )
 from geardyn.analysis.lyapunov import lyapunov_err_attrs
-from geardyn.analysis.periodicity import DEFAULT_MAX_PERIOD, DEFAULT_TOL
+from geardyn.analysis.motion import averaging_time, motion_variable
+from geardyn.analysis.periodicity import DEFAULT_MAX_PERIOD, DEFAULT_TOL, common_section
 from geardyn.models.base import Model
 from geardyn.solvers.ensemble import ladder_steps, run_lanes
 from geardyn.solvers.executor import default_chunk, run_chunks
@@ -133,9 +134,9 @@ def map2d(
         state).
     lyapunov
         Also compute the largest Lyapunov exponent per point (over ``samples`` mean forcing
-        periods, on a grid of ``steps_per_period`` steps, default that of the smallest Omega),
+        periods, on a grid of ``steps_per_period`` steps, default each point's own step rule),
         from the point's final state at its final time, with its standard error
-        (``lyapunov_err``).
+        (``lyapunov_err``) and the motion class (``motion``, see :mod:`geardyn.analysis.motion`).
     client
         A ``dask.distributed.Client``: chunks run as tasks on its cluster. The result is bitwise
         that of the local run.
@@ -178,9 +179,9 @@ def map2d(
     if lyapunov:
         omega = P[:, model.omega_index]
         duration = float(samples * np.mean(2.0 * math.pi / omega))
-        n_lyap = int(steps_per_period or default_steps_per_period(model, float(omega.min())))
-        lyap = dict(transient=float(transient), duration=duration, steps_per_period=n_lyap,
-                    bound=float(bound))
+        # each lane's own step (lyapunov_lanes: the step rule on the lane's coefficients)
+        lyap = dict(transient=float(transient), duration=duration,
+                    steps_per_period=steps_per_period, bound=float(bound))
     task = functools.partial(_map_task, run=run, max_period=int(max_period), tol=float(tol),
                              lyapunov=lyap)
     size = int(chunk) if chunk else default_chunk(P.shape[0])
@@ -206,6 +207,13 @@ def map2d(
         if name == "contact":
             data = np.array(CONTACT_LABELS)[data]
         ds[name] = ((yn, xn, *dims[name]), data, attrs[name])
+    if lyap is not None:
+        period = ds["period"].values.ravel()
+        section = common_section(P[:, model.omega_index], model.other_frequencies(P))[1]
+        labels, motion_attrs = motion_variable(
+            period, ds["lyapunov"].values.ravel(), ds["lyapunov_err"].values.ravel(),
+            averaging_time(lyap["duration"], P[:, model.omega_index]), section)
+        ds["motion"] = ((yn, xn), labels.reshape(ny, nx), motion_attrs)
     ds.attrs.update(
         model=model.name, x=xn, y=yn, transient=float(transient), samples=int(samples),
         steps_per_period_setting=int(steps_per_period or 0), lyapunov=int(bool(lyapunov)),
@@ -216,7 +224,7 @@ def map2d(
     )
     if lyap is not None:
         ds.attrs.update(lyapunov_duration=lyap["duration"],
-                        lyapunov_steps_per_period=lyap["steps_per_period"])
+                        lyapunov_steps_per_period=int(steps_per_period or 0))
     if hasattr(model, "interpretation"):
         ds.attrs["interpretation"] = model.interpretation
     if hasattr(model, "omega_n"):

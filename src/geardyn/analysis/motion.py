@@ -51,6 +51,8 @@ __all__ = [
     "lyapunov_uncertainty",
     "motion_classes",
     "period_label",
+    "averaging_time",
+    "motion_variable",
     "rule_text",
 ]
 
@@ -154,3 +156,25 @@ def rule_text(z: float = LYAPUNOV_Z, floor: float = LYAPUNOV_FLOOR) -> str:
     return (f"no period found: chaotic if lambda > u, quasi-periodic if |lambda| <= u (or "
             f"lambda < -u without a true section), unresolved if lambda < -u, with "
             f"u = max({z:g} x standard error, {floor:g} / T) and T the averaging time")
+
+
+def averaging_time(duration: float, omega: np.ndarray) -> np.ndarray:
+    """Time each lane's exponent is averaged over when ``duration`` is asked for: whole forcing
+    periods 2 pi / omega, rounded up, at least one (as :func:`geardyn.lyapunov` does) [time]."""
+    period = 2.0 * np.pi / np.asarray(omega, dtype=float)
+    return np.maximum(1.0, np.ceil(duration / period - 1e-9)) * period
+
+
+def motion_variable(period: np.ndarray, lyapunov: np.ndarray, lyapunov_err: np.ndarray,
+                    duration: np.ndarray, section: np.ndarray, z: float = LYAPUNOV_Z,
+                    floor: float = LYAPUNOV_FLOOR) -> tuple[np.ndarray, dict[str, str]]:
+    """Labels of :func:`motion_classes` with the attributes a dataset's ``motion`` carries."""
+    labels = motion_classes(period, lyapunov, lyapunov_err, duration, section, z, floor)
+    return labels, {
+        "long_name": "motion class",
+        "meaning": "period-k; chaotic (exponent positive beyond its uncertainty); "
+                   "quasi-periodic (exponent zero within it, or a response locked to "
+                   "incommensurate forcings); unresolved (no period <= max_period found and the "
+                   "exponent clearly negative: a longer period or not settled); non-periodic "
+                   "(no exponent); unbounded. See geardyn.analysis.motion",
+        "rule": rule_text(z, floor)}
