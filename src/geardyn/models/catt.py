@@ -48,7 +48,7 @@ from geardyn.solvers.kernels import KernelSource
 _KERNEL = KernelSource(ck.catt_rhs, ck.catt_events, ck.catt_observe)
 #: The reduced model's kernel: the same functions compiled for one planet set.
 _KERNEL_ONE = KernelSource(ck.catt_rhs_one, ck.catt_events_one, ck.catt_observe_one)
-_THETA_KERNEL = KernelSource(ck.theta_rhs)
+_THETA_KERNEL = KernelSource(ck.theta_rhs, ck.theta_events)
 #: Coefficients that fix the layout of the vector: a raw override of them is refused.
 _STRUCTURAL = {
     "n_blocks": "the number of planet-set blocks fixes the vector's layout; change N instead",
@@ -477,7 +477,9 @@ class DimensionalCATT(Model):
 
     State: theta_c, theta_c', then theta_q_i, theta_q_i', theta_p_i, theta_p_i' per planet set
     [rad, rad/s]; time in seconds; ``params[0]`` is the mesh frequency omega = Omega omega_n.
-    Written independently of the mesh-coordinate form, to verify it.
+    Written independently of the mesh-coordinate form, to verify it. Switching functions: the
+    dead-zone edges x - b and x + b of every mesh deflection [m] (``event_names``), located by
+    the solvers as in the mesh-coordinate form.
     """
 
     time_unit = "s"
@@ -535,6 +537,16 @@ class DimensionalCATT(Model):
         self.state_names = ("theta_c", "dtheta_c") + tuple(
             f"{v}{i + 1}" for i in range(n)
             for v in ("theta_q", "dtheta_q", "theta_p", "dtheta_p")
+        )
+        # the dead-zone edges of every mesh deflection (switching functions, metres), as in
+        # the mesh-coordinate form, so that steps are split there
+        self.event_names = tuple(
+            f"x_{m}{i + 1}{sign}b_{m}{i + 1}" for i in range(n) for m in ("sq", "pq")
+            for sign in ("-", "+")
+        )
+        self.meshes = tuple(
+            (f"{m}{i + 1}", 4 * i + 2 * k, 4 * i + 2 * k + 1)
+            for i in range(n) for k, m in enumerate(("sq", "pq"))
         )
 
     def fastest_natural_frequency(self, P: np.ndarray | None = None) -> np.ndarray:

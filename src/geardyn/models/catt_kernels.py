@@ -206,3 +206,24 @@ def theta_rhs(t, y, dy, p, s, c):
         carrier_torque -= f_sq * p[T_ARM]
     dy[0] = w_c
     dy[1] = carrier_torque / p[T_JC]
+
+
+@nb.njit(**_JIT)
+def theta_events(t, y, g, p):
+    """Dead-zone edges of Eq. (1): x - b and x + b of every mesh deflection [m] (sun-inside,
+    inside-outside per planet set), the deflections written as in :func:`theta_rhs`."""
+    n = int(p[T_N])
+    bs = T_BLOCK_FIXED + 4 * int(p[T_NH])
+    s = math.sin(p[T_OMEGA] * t)
+    c = math.cos(p[T_OMEGA] * t)
+    for i in range(n):
+        o = T_HEADER + i * bs
+        j = 2 + 4 * i
+        e_sq = p[o + T_E_SQ_S] * s + p[o + T_E_SQ_C] * c
+        e_pq = p[o + T_E_PQ_S] * s + p[o + T_E_PQ_C] * c
+        x_sq = y[0] * p[T_RC1] - y[j] * p[o + T_RBQ] - e_sq
+        x_pq = y[j] * p[o + T_RBQ] - y[j + 2] * p[o + T_RBP] - e_pq
+        g[4 * i] = x_sq - p[o + T_B_SQ]
+        g[4 * i + 1] = x_sq + p[o + T_B_SQ]
+        g[4 * i + 2] = x_pq - p[o + T_B_PQ]
+        g[4 * i + 3] = x_pq + p[o + T_B_PQ]
