@@ -10,7 +10,8 @@ A model has a state vector (``state_names``), a coefficient vector (``params``, 
 * ``observe(t, y, o, p, s, c)`` (optional) writes derived outputs, e.g. mesh forces.
 
 Built-in models (:class:`~geardyn.CATTDevice`, :class:`~geardyn.GearPair`) and a user's own
-(:class:`~geardyn.UserModel`) all subclass :class:`Model`.
+(:class:`~geardyn.UserModel`) all subclass :class:`Model`. The rules a model keeps are numbered in
+:class:`Model`'s docstring (the model contract); :func:`geardyn.testing.check_model` checks them.
 """
 
 from __future__ import annotations
@@ -39,7 +40,52 @@ def unique_rows(A: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 class Model:
-    """Base class of geardyn models. Subclasses set the attributes in ``__init__``."""
+    """Base class of geardyn models. Subclasses set the attributes in ``__init__``.
+
+    The model contract
+    ------------------
+    Every solver, sweep and analysis relies on these rules, and
+    :func:`geardyn.testing.check_model` checks each (one check per number; a broken rule is
+    reported by its number and name). ``n_states = len(state_names)``; the compiled functions
+    are those of :attr:`kernel` (:class:`~geardyn.solvers.kernels.KernelSource`).
+
+    1. **names** -- ``state_names`` is a non-empty tuple of distinct strings, one per state;
+       ``event_names``, ``observable_names`` and ``param_names`` are tuples of distinct strings;
+       every entry ``(name, i, j)`` of ``meshes`` names two events that exist.
+    2. **coefficients** -- ``params`` is a 1-D float64 array of finite numbers, one per entry of
+       ``param_names``; ``omega_index`` is None (an autonomous model) or the index of the forcing
+       frequency Omega >= 0 in ``params``.
+    3. **initial state** -- ``initial_state()`` is a finite float vector of ``n_states`` entries.
+    4. **kernel functions** -- ``kernel.rhs``, ``kernel.events`` and ``kernel.observe`` are
+       ``numba.njit`` functions with the interface's arguments: ``rhs(t, y, dy, p, s, c)``,
+       ``events(t, y, g, p)``, ``observe(t, y, o, p, s, c)`` (``rhs(t, y, dy, p)`` and
+       ``observe(t, y, o, p)`` when ``kernel.plain``); ``s, c`` are sin and cos of the forcing
+       phase Omega t, supplied by the solver (0 and 1 for an autonomous model). ``events`` is
+       given exactly when ``event_names`` is non-empty, ``observe`` exactly when
+       ``observable_names`` is, and every kernel template
+       (:data:`~geardyn.solvers.kernels.TEMPLATES`) builds for them.
+    5. **outputs filled** -- ``rhs`` writes every entry of ``dy`` (dy/dt, ``n_states``
+       entries), ``events`` every entry of ``g`` (``n_events``), ``observe`` every entry of
+       ``o`` (``n_observables``): the kernels reuse these arrays and never clear them.
+    6. **confined and pure** -- each function writes only its output array, leaves ``y`` and
+       ``p`` untouched, reads nothing beyond ``y`` and ``p`` (the kernels hand it rows of larger
+       arrays and skip bounds checks), and gives the same output for the same inputs (no hidden
+       state, no randomness): lanes must not depend on one another.
+    7. **finite** -- ``rhs``, ``events`` and ``observe`` give finite values near the initial
+       state (a non-finite state counts as diverged, never as a result).
+    8. **kinks on event zeros** -- the right-hand side is smooth (at least four times
+       differentiable) in ``t`` and ``y`` wherever no switching function changes sign: every
+       kink or jump (a dead-zone edge) lies on a zero of an event, so that the solver, which
+       splits a step at every located zero, keeps RK4's 4th order.
+    9. **copies and lanes** -- ``with_omega`` and ``lane_params`` set Omega in a copy and leave
+       the model alone; ``fastest_natural_frequency(P)`` gives one value per lane (row of
+       ``P``), > 0 or NaN (unknown), and ``other_frequencies(P)`` one row per lane.
+    10. **run matches reference** -- a short run of the compiled RK4 kernel at the default step
+        (:func:`~geardyn.solvers.simulate.default_steps_per_period`, which resolves
+        ``fastest_natural_frequency``), with edges located, ends ok and matches the reference
+        integrator (:func:`~geardyn.reference_solution`, DOP853 at rtol 1e-12) in the states
+        and the observables.
+    """
 
     name: str = "model"
     state_names: tuple[str, ...] = ()
