@@ -8,6 +8,7 @@ The public API::
     ds = geardyn.simulate(m, omega=1.1, transient=4000.0, periods=64)
 """
 
+from geardyn import testing
 from geardyn.analysis.bifurcation import ContinuedSweep, bifurcation, continued_sweeps
 from geardyn.analysis.lyapunov import LyapunovEstimate, lyapunov, lyapunov_lanes
 from geardyn.analysis.map2d import map2d
@@ -57,4 +58,5 @@ __all__ = [
     "default_steps_per_period",
     "reference_solution",
     "simulate",
+    "testing",
 ]
