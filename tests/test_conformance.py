@@ -239,3 +239,20 @@ def test_smooth_nonlinear_model_has_no_kinks():
                               param_names=("zeta", "k3", "Omega", "F"), natural_frequency=4.0)
     report = check_model(model, y0=np.array([1.5, 0.0]), run=False)
     assert report.ok
+
+
+def test_autonomous_model_keeps_the_contract():
+    """A model without forcing frequency (omega_index None): no Omega to set, and the run is
+    checked over two time units."""
+    model = user_model(params=[0.5, 0.05, 0.0, 1.0, 0.0], param_names=("b", "zeta", "F", "k", "w"))
+    assert model.omega_index is None
+    report = check_model(model, y0=np.array([1.5, 0.0]))
+    assert report.ok, str(report)
+
+
+def test_rectangular_stiffness_is_smooth_to_the_kink_scan():
+    """The rectangular mesh stiffness (25 Fourier harmonics with Lanczos factors) is smooth in
+    time: the scan over a forcing period does not take its steep flanks for kinks."""
+    m = geardyn.CATTDevice(geardyn.PlanetaryParams.paper(waveform="rectangular")).with_omega(0.9)
+    assert int(m.params[3]) > 10  # n_harmonics
+    assert check_model(m, run=False).ok

@@ -177,6 +177,7 @@ class _Call:
     y_buf: np.ndarray
     p_buf: np.ndarray
     fill: float
+    guard: float
 
 
 def _call(fn: _Fn, t: float, y: np.ndarray, p: np.ndarray, k: int) -> _Call:
@@ -185,13 +186,13 @@ def _call(fn: _Fn, t: float, y: np.ndarray, p: np.ndarray, k: int) -> _Call:
     p_buf, pv = _guarded(p, _IN_GUARDS[k])
     out_buf, ov = _guarded(np.full(fn.size, _SENTINELS[k]), _SENTINELS[1 - k])
     fn.call(float(t), yv, ov, pv)
-    return _Call(ov, out_buf, y_buf, p_buf, _SENTINELS[k])
+    return _Call(ov, out_buf, y_buf, p_buf, _SENTINELS[k], _SENTINELS[1 - k])
 
 
 def _probe_points(model: Model, y0: np.ndarray) -> list[tuple[float, np.ndarray]]:
     """(t, y) points near the initial state for the pointwise rules."""
     rng = np.random.default_rng(12345)
-    scale = np.maximum(np.abs(y0), 1e-3 * max(float(np.max(np.abs(y0))), 1e-300))
+    scale = np.maximum(np.abs(y0), 1e-3 * max(float(np.max(np.abs(y0))), 1.0))
     t1 = 0.37 * (model.period or 1.0)
     pts = [(0.0, y0), (t1, y0)]
     for _ in range(2):
@@ -297,8 +298,7 @@ def _pointwise(model: Model, y0: np.ndarray) -> dict[int, list[str]]:
                                 f"its {fn.size}-entry output unset")
             for c in (a, b):
                 guards = np.concatenate([c.out_buf[:_GUARD], c.out_buf[-_GUARD:]])
-                if np.any(guards != _SENTINELS[1] if c.fill == _SENTINELS[0] else
-                          guards != _SENTINELS[0]):
+                if np.any(guards != c.guard):
                     found[6].append(f"{where} writes outside its {fn.size}-entry output")
                     break
             for c in (a, b):
