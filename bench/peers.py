@@ -297,7 +297,7 @@ def geardyn_rows(wl: Workload, ref: np.ndarray, repeat: int) -> list[Row]:
         note = "edges located"
         if n is None:
             note += f"; {int(spp.min())}-{int(spp.max())} steps/period"
-        bad = int(np.sum(ds["status"].values != 0))
+        bad = int(np.sum(ds["status"].values != 0))  # the status attribute: 0 means ok
         if bad:
             note += f"; {bad} lanes not ok"
         rows.append(Row("geardyn.bifurcation", label, wall, times,
@@ -482,7 +482,7 @@ def peer_rows(wl: Workload, ref: np.ndarray, repeat: int, skip: set[str],
             note = "adaptive, no event location"
             row = tolerance_row(name, solve, wl, ref, repeat, tolerances, note, every)
         except Exception as exc:  # a peer that breaks is a row that says so, not a crash
-            row = Row(name, "-", note=f"failed: {type(exc).__name__}: {exc}")
+            row = Row(name, "-", note=f"failed: {type(exc).__name__}: {str(exc)[:200]}")
         row.key = key
         rows.append(row)
         print(_line(rows[-1]), flush=True)
@@ -510,7 +510,7 @@ def table(rows: list[Row], base: Row | None) -> str:
         ratio = (r.wall / base.wall) if (base and base.wall and r.wall) else None
         lines.append(f"| {r.method} | {r.setting} | {_fmt(r.wall, '.3f')} | "
                      f"{_fmt(r.ns_per_lane_step, '.1f')} | {_fmt(r.error, '.1e')} | "
-                     f"{_fmt(ratio, '.2f')} | {r.note} |")
+                     f"{_fmt(ratio, '.2f')} | {' '.join(r.note.replace('|', '/').split())} |")
     return "\n".join(lines)
 
 
@@ -565,25 +565,53 @@ def write_section(text: str, path: Path = RESULTS) -> None:
 
 
 def section(rows: list[Row], base: Row | None, wl: Workload, command: str) -> str:
+    """The ``## Peers`` section of RESULTS.md."""
     sub = ", ".join(f"{w:.3f}" for w in wl.omega[wl.subset])
     steps = float(np.sum(wl.periods)) * STEPS
+    notes = [
+        "The plain numba RK4 kernel (`bench/peers.py`: `rk4_lanes`, `rk4_lanes_table`) writes "
+        "the gear pair's equations out independently of geardyn; `tests/test_bench_peers.py` "
+        "checks it against the reference integrator. Its lanes go to the threads one at a time "
+        "(`parallel_chunksize(1)`), as their lengths differ 15-fold. Without edge location its "
+        "error falls only at about second order in the step (the kinks of the backlash "
+        "function).",
+        "geardyn and the plain kernel use both cores (2 numba threads). LSODA and diffrax run "
+        "one lane after another in one process (a process pool would at best halve their times "
+        "on 2 cores); they are timed on a uniform part of the sweep (the chaotic band included) "
+        "and extrapolated to all points by the number of points. Their tolerance is the loosest "
+        f"decade (rtol = atol) whose points on the error subset are within {TARGET:g}; the "
+        "points come from the solver's dense output at the sample times (SciPy's `t_eval`, "
+        "diffrax's `SaveAt(ts=...)`).",
+    ]
+    by = {r.key: r for r in rows}
+    if by.get("numbalsoda") and by["numbalsoda"].note.startswith("not installed"):
+        notes.append("numbalsoda: this machine's package index has only its source "
+                     "distribution, which needs a Fortran compiler that is not installed, so "
+                     "its row says \"not installed\" (the script runs it where it imports). "
+                     "`make bench-peers` installs `.[bench]` (jax, diffrax) and tries "
+                     "numbalsoda.")
     return f"""## Peers
 
-Workload: `GearPair(zeta=0.05, kappa=0.2, Fm=0.1, Fa=0.2)`, {wl.omega.size} Omega in
-[{OMEGA_RANGE[0]:g}, {OMEGA_RANGE[1]:g}], from the initial state at t = 0, transient
-tau = {TRANSIENT:.1f} (500 pi) rounded up to whole periods per lane ({int(wl.n_tr.min())} to
-{int(wl.n_tr.max())} periods, {int(wl.n_tr.sum())} in all: 400 per lane on average), then
-{wl.samples} sampled periods; {steps:.3e} lane-steps at {STEPS} steps per period.
-Command: `{command}`, {datetime.date.today().isoformat()}.
-Machine: {machine()}. **Shared machine**: other jobs ran at the same time, so absolute times
-are noisy; every row was measured in the same run (median of the warm repeats where the row
-says nothing else), and the ratios are the figures to read.
+Workload: `GearPair(zeta=0.05, kappa=0.2, Fm=0.1, Fa=0.2)`, {wl.omega.size} Omega in \
+[{OMEGA_RANGE[0]:g}, {OMEGA_RANGE[1]:g}], from the initial state at t = 0; transient \
+tau = {TRANSIENT:.1f} (500 pi) rounded up to whole periods in every lane \
+({int(wl.n_tr.min())} to {int(wl.n_tr.max())} periods, {int(wl.n_tr.sum())} in all, \
+{wl.n_tr.mean():.0f} per lane on average), then {wl.samples} sampled periods: \
+{steps:.3e} lane-steps at {STEPS} steps per period.
 
-Error: the largest absolute deviation of the row's Poincare points (x and v, in backlash
-units, all {wl.samples} samples) from `geardyn.solvers.reference` (DOP853, rtol = atol = 1e-12,
-restarted at every located edge crossing) on the same {wl.subset.size} Omega for every row
-({sub}: periodic motions; the chaotic band 1.2 < Omega < 1.63 is left out because no two
-integrators agree there after hundreds of periods). ns per lane-step: wall time / (lanes x
+Command: `{command}`, {datetime.date.today().isoformat()}.
+
+Machine: {machine()}.
+
+**Shared machine**: other jobs ran at the same time, so the absolute times are noisy (up to \
+~3x between runs); every row was measured in the same run (median of the warm repeats unless \
+the row says otherwise), and the ratios are the figures to read.
+
+Error: the largest absolute deviation of the row's Poincare points (x and v, in backlash \
+units, all {wl.samples} samples) from `geardyn.solvers.reference` (DOP853, rtol = atol = \
+1e-12, restarted at every located edge crossing), on the same {wl.subset.size} Omega for every \
+row ({sub}: periodic motions; the chaotic band 1.2 < Omega < 1.63 is left out, as no two \
+integrators agree there after hundreds of periods). ns per lane-step: wall time / (lanes x \
 periods x steps per period), all threads together (fixed-step rows only).
 
 {table(rows, base)}
@@ -592,19 +620,7 @@ Against the issue's targets (ratios of this run):
 {chr(10).join("- " + t for t in targets(rows))}
 
 Notes:
-- The plain numba RK4 kernel (`bench/peers.py`: `rk4_lanes`, `rk4_lanes_table`) writes the gear
-  pair's equations out independently of geardyn; `tests/test_bench_peers.py` checks it against
-  the reference integrator. Its lanes go to the threads one at a time (`parallel_chunksize(1)`),
-  as their lengths differ 15-fold. It has no edge location, so its error falls only at second
-  order in the step (the kinks of the backlash function).
-- LSODA and diffrax run one lane after another (one core); they are timed on every 10th point
-  of the sweep (40 points, the chaotic band included) and extrapolated to the 400 points by the
-  number of points. Their tolerance is the loosest decade (rtol = atol) whose points on the
-  error subset are within {TARGET:g}. Their points come from the solver's dense output at the
-  sample times (SciPy's `t_eval`, diffrax's `SaveAt(ts=...)`).
-- numbalsoda: on this machine's package index only a source distribution exists, and it needs a
-  Fortran compiler that is not installed, so its row is "not installed" (the script runs it when
-  it imports). `make bench-peers` installs `.[bench]` (jax, diffrax) and tries numbalsoda.
+{chr(10).join("- " + n for n in notes)}
 """
 
 

@@ -48,3 +48,16 @@ def test_plain_rk4_matches_reference(peers):
     assert errs[1024] < errs[128] / 8  # it converges (second order or better)
     table = points(1024, peers.rk4_lanes_table)
     assert np.max(np.abs(table - ref)) < 1e-6
+
+
+def test_write_section_replaces_only_peers(peers, tmp_path):
+    path = tmp_path / "RESULTS.md"
+    path.write_text("# Benchmark results\n\n## bifurcation\n\nkeep 1\n\n## Peers\n\nold\n\n"
+                    "## map\n\nkeep 2\n")
+    peers.write_section("## Peers\n\nnew table\n", path)
+    text = path.read_text()
+    assert "old" not in text and "new table" in text
+    assert text.index("keep 1") < text.index("new table") < text.index("## map")
+    assert "keep 2" in text
+    peers.write_section("## Peers\n\nnewer\n", path)  # replaces again, appends nothing
+    assert path.read_text().count("## Peers") == 1 and "newer" in path.read_text()
