@@ -6,7 +6,8 @@ units rounded up to whole forcing periods in every lane (geardyn's rule; 500 pi 
 at the middle of the range, 160 000 transient periods in all, 50 to 750 per lane), then 100
 sampled periods (one Poincare point at the end of each).
 
-Rows (wall time: median of ``--repeat`` warm runs unless the row says otherwise):
+Rows (wall time: median of ``--repeat`` warm runs unless the row says otherwise; the full-sweep
+rows 1-3 are timed round-robin, one run of each per round):
 
 1. ``geardyn.bifurcation`` at 128 steps per period and at its default step (edges located);
 2. a plain numba RK4 kernel written here (``rk4_lanes``: ``prange`` over Omega, no edge
@@ -15,7 +16,8 @@ Rows (wall time: median of ``--repeat`` warm runs unless the row says otherwise)
 3. the plain kernel at the step it needs for an error of ``TARGET`` (doubling from 128);
 4. SciPy LSODA (``solve_ivp``) with a numba-compiled right-hand side at the loosest tolerance
    (rtol = atol, decades) that reaches ``TARGET``;
-5. diffrax (JAX, CPU, Tsit5 + PID controller) likewise, and numbalsoda when it is installed.
+5. diffrax (JAX, CPU, Tsit5 and Dopri8 with a PID controller) likewise, and numbalsoda when
+   it is installed.
 
 Rows 4-5 are timed on every ``--every``-th point (40 of 400) and extrapolated to the 400 points
 by the number of points (stated in the table). The error of every row: the largest absolute
@@ -277,48 +279,80 @@ def timed(fn: Callable[[], object], repeat: int) -> tuple[float, tuple[float, ..
     return statistics.median(times), tuple(times), result
 
 
-def geardyn_rows(wl: Workload, ref: np.ndarray, repeat: int) -> list[Row]:
-    """geardyn.bifurcation at 128 steps per period and at its default step."""
+@dataclass
+class Sweep:
+    """A full-sweep row to be timed: ``run()`` does the work, ``finish(row, result)`` fills in
+    the error and notes from the last result."""
+
+    row: Row
+    run: Callable[[], object]
+    finish: Callable[[Row, object], None]
+
+
+def measure(sweeps: list[Sweep], repeat: int) -> list[Row]:
+    """Time every sweep ``repeat`` times, round-robin (one call of each per round, so that a
+    change of the machine's load hits every row alike); the rows with medians filled in."""
+    times: list[list[float]] = [[] for _ in sweeps]
+    last: list[object] = [None] * len(sweeps)
+    for _ in range(repeat):
+        for k, sw in enumerate(sweeps):
+            t = time.perf_counter()
+            last[k] = sw.run()
+            times[k].append(time.perf_counter() - t)
+    for k, sw in enumerate(sweeps):
+        sw.row.wall, sw.row.times = statistics.median(times[k]), tuple(times[k])
+        sw.finish(sw.row, last[k])
+    return [sw.row for sw in sweeps]
+
+
+def geardyn_sweeps(wl: Workload, ref: np.ndarray) -> list[Sweep]:
+    """geardyn.bifurcation at 128 steps per period and at its default step (warmed)."""
     import geardyn
 
     m = model()
-    rows = []
+    out = []
     for n, label in ((STEPS, f"{STEPS} steps/period"), (None, "default step")):
         def run(n=n):
             return geardyn.bifurcation(m, "Omega", wl.omega, transient=TRANSIENT,
                                        samples=wl.samples, steps_per_period=n)
 
+        def finish(row: Row, ds, n=n) -> None:
+            if not np.array_equal(ds["transient_periods"].values, wl.n_tr):
+                raise RuntimeError("geardyn's transient periods differ from the workload's")
+            spp = ds["steps_per_period"].values.astype(float)
+            row.lane_steps = float(np.sum(wl.periods * spp))
+            row.error = max_error(ds["poincare"].values[wl.subset], ref)
+            if n is None:
+                row.note += f"; {int(spp.min())}-{int(spp.max())} steps/period"
+            bad = int(np.sum(ds["status"].values != 0))  # the status attribute: 0 means ok
+            if bad:
+                row.note += f"; {bad} lanes not ok"
+
         geardyn.bifurcation(m, "Omega", wl.omega[:4], transient=10.0, samples=2,
                             steps_per_period=n)  # compile or load the kernel
-        wall, times, ds = timed(run, repeat)
-        if not np.array_equal(ds["transient_periods"].values, wl.n_tr):
-            raise RuntimeError("geardyn's transient periods differ from the workload's")
-        spp = ds["steps_per_period"].values.astype(float)
-        note = "edges located"
-        if n is None:
-            note += f"; {int(spp.min())}-{int(spp.max())} steps/period"
-        bad = int(np.sum(ds["status"].values != 0))  # the status attribute: 0 means ok
-        if bad:
-            note += f"; {bad} lanes not ok"
-        rows.append(Row("geardyn.bifurcation", label, wall, times,
-                        float(np.sum(wl.periods * spp)),
-                        max_error(ds["poincare"].values[wl.subset], ref), note,
-                        "g128" if n else "gdef"))
-    return rows
+        out.append(Sweep(Row("geardyn.bifurcation", label, note="edges located",
+                             key="g128" if n else "gdef"), run, finish))
+    return out
 
 
-def rk4_rows(wl: Workload, ref: np.ndarray, repeat: int, max_steps: int) -> list[Row]:
+def rk4_sweeps(wl: Workload, ref: np.ndarray, max_steps: int) -> tuple[list[Sweep], list[Row]]:
     """The plain kernel at 128 steps (with and without a phase table) and at the step that
-    reaches TARGET."""
+    reaches TARGET (found by doubling on the subset); a row without timing when none does."""
     sub = wl.take(wl.subset)
     run_rk4(sub, 8)  # compile or load
     run_rk4(sub, 8, table=True)
-    rows = []
-    for table, name in ((False, "numba RK4, prange"), (True, "numba RK4, prange, phase table")):
-        wall, times, pts = timed(lambda table=table: run_rk4(wl, STEPS, table), repeat)
-        rows.append(Row(name, f"{STEPS} steps/period", wall, times,
-                        float(np.sum(wl.periods) * STEPS), max_error(pts[wl.subset], ref),
-                        "no edge location", "rk4tab" if table else "rk4"))
+
+    def finish_for(n: int) -> Callable[[Row, object], None]:
+        def finish(row: Row, pts) -> None:
+            row.lane_steps = float(np.sum(wl.periods) * n)
+            row.error = max_error(pts[wl.subset], ref)
+        return finish
+
+    sweeps = [Sweep(Row(name, f"{STEPS} steps/period", note="no edge location",
+                        key="rk4tab" if table else "rk4"),
+                    lambda table=table: run_rk4(wl, STEPS, table), finish_for(STEPS))
+              for table, name in ((False, "numba RK4, prange"),
+                                  (True, "numba RK4, prange, phase table"))]
     n, errs = STEPS, {}
     while True:
         errs[n] = max_error(run_rk4(sub, n, table=True), ref)
@@ -326,16 +360,15 @@ def rk4_rows(wl: Workload, ref: np.ndarray, repeat: int, max_steps: int) -> list
             break
         n *= 2
     trail = ", ".join(f"{k}: {e:.1e}" for k, e in errs.items())
+    name = "numba RK4, prange, phase table"
     if errs[n] > TARGET:
-        rows.append(Row("numba RK4, prange, phase table", f"{n} steps/period",
-                        error=errs[n], note=f"{TARGET:g} not reached by {max_steps} steps/period"
-                        f" ({trail})", key="rk4acc"))
-        return rows
-    wall, times, pts = timed(lambda: run_rk4(wl, n, table=True), repeat)
-    rows.append(Row("numba RK4, prange, phase table", f"{n} steps/period (for {TARGET:g})",
-                    wall, times, float(np.sum(wl.periods) * n), max_error(pts[wl.subset], ref),
-                    f"doubling from {STEPS} on the subset: {trail}", "rk4acc"))
-    return rows
+        return sweeps, [Row(name, f"{n} steps/period", error=errs[n], key="rk4acc",
+                            note=f"{TARGET:g} not reached by {max_steps} steps/period "
+                                 f"({trail})")]
+    sweeps.append(Sweep(Row(name, f"{n} steps/period (for {TARGET:g})", key="rk4acc",
+                            note=f"doubling from {STEPS} on the subset: {trail}"),
+                        lambda: run_rk4(wl, n, table=True), finish_for(n)))
+    return sweeps, []
 
 
 def tolerance_row(name: str, solve: Callable[[Workload, float], np.ndarray], wl: Workload,
@@ -385,9 +418,10 @@ def solve_lsoda(wl: Workload, tol: float) -> np.ndarray:
     return out
 
 
-def diffrax_solver() -> Callable[[Workload, float], np.ndarray]:
-    """A function (workload, tol) -> Poincare points from diffrax (Tsit5, PID controller,
-    float64, one jitted solve per lane, points from the solver's interpolant at ``ts``)."""
+def diffrax_solver(method: str = "Tsit5") -> Callable[[Workload, float], np.ndarray]:
+    """A function (workload, tol) -> Poincare points from diffrax (``method``: a diffrax
+    solver's name; PID controller, float64, one jitted solve per lane, points from the
+    solver's interpolant at ``ts``)."""
     import jax
 
     jax.config.update("jax_enable_x64", True)
@@ -395,6 +429,7 @@ def diffrax_solver() -> Callable[[Workload, float], np.ndarray]:
     import jax.numpy as jnp
 
     coef = tuple(float(c) for c in coefficients())
+    solver = getattr(diffrax, method)()
 
     def field(t, y, om):
         zeta, kappa, fm, fa, b = coef
@@ -406,7 +441,7 @@ def diffrax_solver() -> Callable[[Workload, float], np.ndarray]:
     @jax.jit
     def one(om, ts, y0, tol):
         ctrl = diffrax.PIDController(rtol=tol, atol=tol)
-        sol = diffrax.diffeqsolve(diffrax.ODETerm(field), diffrax.Tsit5(), 0.0, ts[-1], None,
+        sol = diffrax.diffeqsolve(diffrax.ODETerm(field), solver, 0.0, ts[-1], None,
                                   y0, args=om, saveat=diffrax.SaveAt(ts=ts),
                                   stepsize_controller=ctrl, max_steps=2**22,
                                   adjoint=diffrax.ForwardMode(), throw=False)
@@ -457,6 +492,7 @@ def numbalsoda_solver() -> Callable[[Workload, float], np.ndarray]:
 PEERS = {
     "lsoda": ("SciPy LSODA, numba rhs", lambda: solve_lsoda, "scipy"),
     "diffrax": ("diffrax Tsit5 (JAX, CPU)", diffrax_solver, "diffrax"),
+    "diffrax8": ("diffrax Dopri8 (JAX, CPU)", lambda: diffrax_solver("Dopri8"), "diffrax"),
     "numbalsoda": ("numbalsoda LSODA, cfunc rhs", numbalsoda_solver, "numbalsoda"),
 }
 
@@ -605,7 +641,8 @@ Machine: {machine()}.
 
 **Shared machine**: other jobs ran at the same time, so the absolute times are noisy (up to \
 ~3x between runs); every row was measured in the same run (median of the warm repeats unless \
-the row says otherwise), and the ratios are the figures to read.
+the row says otherwise; the full-sweep rows round-robin, one run of each per round, so that a \
+change of load hits them alike), and the ratios are the figures to read.
 
 Error: the largest absolute deviation of the row's Poincare points (x and v, in backlash \
 units, all {wl.samples} samples) from `geardyn.solvers.reference` (DOP853, rtol = atol = \
@@ -634,7 +671,7 @@ def main() -> None:
                     help="largest steps per period tried for the plain kernel's TARGET")
     ap.add_argument("--every", type=int, default=10,
                     help="the adaptive peers are timed on every N-th point and extrapolated")
-    ap.add_argument("--skip", default="", help="comma-separated: lsoda,diffrax,numbalsoda")
+    ap.add_argument("--skip", default="", help="comma-separated: " + ",".join(PEERS))
     ap.add_argument("--write", action="store_true", help="replace '## Peers' in RESULTS.md")
     args = ap.parse_args()
     skip = {s.strip() for s in args.skip.split(",") if s.strip()}
@@ -642,14 +679,13 @@ def main() -> None:
     t0 = time.perf_counter()
     ref = reference(wl)
     print(f"reference on {wl.subset.size} Omega: {time.perf_counter() - t0:.1f} s", flush=True)
-    rows = geardyn_rows(wl, ref, args.repeat)
+    sweeps = geardyn_sweeps(wl, ref)
+    more, untimed = rk4_sweeps(wl, ref, args.max_steps)
+    rows = measure(sweeps + more, args.repeat) + untimed
     for r in rows:
         print(_line(r), flush=True)
-    rows += rk4_rows(wl, ref, args.repeat, args.max_steps)
-    for r in rows[2:]:
-        print(_line(r), flush=True)
     rows += peer_rows(wl, ref, args.peer_repeat, skip, args.every)
-    base = rows[1]
+    base = next(r for r in rows if r.key == "gdef")
     print()
     print(table(rows, base))
     print()
