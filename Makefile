@@ -6,7 +6,7 @@ STAMP := $(VENV)/.installed
 export NUMBA_CACHE_DIR ?= $(CURDIR)/.geardyn-cache/numba
 export GEARDYN_CACHE_DIR ?= $(CURDIR)/.geardyn-cache
 
-.PHONY: venv demo test test-slow bench reproduce reproduce-verdicts lint clean
+.PHONY: venv demo test test-slow bench bench-peers reproduce reproduce-verdicts lint clean
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -37,6 +37,15 @@ test-slow: $(STAMP)
 bench: $(STAMP)
 	$(BIN)/python bench/bifurcation.py
 	$(BIN)/python bench/map.py --write
+
+# geardyn against plain numba RK4, SciPy LSODA, diffrax and numbalsoda on the gear-pair workload,
+# all in one run (about 1-2 min on 2 cores); replaces the "## Peers" section of bench/RESULTS.md.
+# numbalsoda has only a source distribution that needs a Fortran compiler: when it does not
+# install, its row says "not installed".
+bench-peers: $(STAMP)
+	$(BIN)/python -m pip install --quiet -e ".[bench]"
+	$(BIN)/python -m pip install --quiet numbalsoda || echo "numbalsoda did not install: its row is skipped"
+	$(BIN)/python bench/peers.py --write
 
 # The paper's whole study at its resolution (about 4 min on 2 cores): out/reproduce/report.html
 reproduce: $(STAMP)

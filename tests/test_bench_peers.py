@@ -1,0 +1,63 @@
+"""The plain numba RK4 peer of bench/peers.py integrates the same equations as geardyn's
+GearPair: checked against the reference integrator (DOP853, rtol 1e-12, edges located)."""
+
+from __future__ import annotations
+
+import importlib.util
+import math
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import geardyn
+from geardyn.solvers.reference import reference_solution
+
+PEERS = Path(__file__).resolve().parents[1] / "bench" / "peers.py"
+
+
+@pytest.fixture(scope="module")
+def peers():
+    spec = importlib.util.spec_from_file_location("bench_peers", PEERS)
+    module = importlib.util.module_from_spec(spec)
+    sys.modules["bench_peers"] = module
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_plain_rk4_matches_reference(peers):
+    # coefficients other than the benchmark's (backlash not 1) and a period-2 impacting motion
+    model = geardyn.GearPair(zeta=0.08, kappa=0.3, Fm=0.15, Fa=0.2, backlash=0.8, Omega=1.06)
+    coef = np.array([0.08, 0.3, 0.15, 0.2, 0.8])
+    y0 = np.asarray(model.initial_state(), float)
+    om, n_tr, samples = 1.06, 6, 4
+    T = 2.0 * math.pi / om
+    times = (n_tr + np.arange(1, samples + 1)) * T
+    ref = reference_solution(model, y0, times)
+    fine = reference_solution(model, y0, np.linspace(T, times[-1], 400))
+    assert fine[:, 0].min() < 0.8 < fine[:, 0].max()  # the teeth separate: both branches of g
+
+    def points(n, kernel):
+        out = np.full((1, samples, 2), np.nan)
+        kernel(np.array([om]), np.array([n_tr]), samples, n, coef, y0, out)
+        return out[0]
+
+    errs = {n: np.max(np.abs(points(n, peers.rk4_lanes) - ref)) for n in (128, 1024)}
+    assert errs[1024] < 1e-6
+    assert errs[1024] < errs[128] / 8  # it converges (second order or better)
+    table = points(1024, peers.rk4_lanes_table)
+    assert np.max(np.abs(table - ref)) < 1e-6
+
+
+def test_write_section_replaces_only_peers(peers, tmp_path):
+    path = tmp_path / "RESULTS.md"
+    path.write_text("# Benchmark results\n\n## bifurcation\n\nkeep 1\n\n## Peers\n\nold\n\n"
+                    "## map\n\nkeep 2\n")
+    peers.write_section("## Peers\n\nnew table\n", path)
+    text = path.read_text()
+    assert "old" not in text and "new table" in text
+    assert text.index("keep 1") < text.index("new table") < text.index("## map")
+    assert "keep 2" in text
+    peers.write_section("## Peers\n\nnewer\n", path)  # replaces again, appends nothing
+    assert path.read_text().count("## Peers") == 1 and "newer" in path.read_text()
