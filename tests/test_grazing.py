@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import math
 
+import numba as nb
 import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
@@ -187,3 +188,39 @@ def test_grazing_crossings_and_contact_agree_with_dop853(grazing_sweep):
     ds = geardyn.bifurcation(model, "Fa", fas, transient=0.0, samples=PERIODS, y0=Y0)
     np.testing.assert_array_equal(ds["contact"].values[:, 0], regime)
     assert np.all(ds["unresolved_steps"].values == 0)
+
+
+# --- a step the split limit cannot resolve shows in every result ---------------------------------
+
+N_EDGES = 2 * core.MAX_SPLITS
+
+
+@nb.njit(cache=True)
+def _ramp_rhs(t, y, dy, p):
+    dy[0] = 1.0
+
+
+@nb.njit(cache=True)
+def _ramp_events(t, y, g, p):
+    for j in range(g.size):
+        g[j] = y[0] - p[1] * (j + 1)
+
+
+def test_unresolved_steps_reach_every_result():
+    """x' = 1 runs through N_EDGES edges x = c (j + 1) within its first step: more crossings
+    than the split limit, so that step falls back unsplit; every result must say so."""
+    h = 1.0 / 64
+    model = geardyn.UserModel(_ramp_rhs, 1, [2 * math.pi, 0.5 * h / N_EDGES],
+                              param_names=["Omega", "c"], events=_ramp_events,
+                              n_events=N_EDGES)
+    ds = geardyn.simulate(model, periods=1, steps_per_period=64)
+    assert ds.attrs["unresolved_steps"] == 1
+    sw = geardyn.bifurcation(model, "c", [0.5 * h / N_EDGES, 2 * h], transient=0.0, samples=2,
+                             steps_per_period=64)
+    np.testing.assert_array_equal(sw["unresolved_steps"].values, [1, 0])
+    two = geardyn.bifurcation(model, "c", [0.5 * h / N_EDGES], transient=0.0, samples=2,
+                              steps_per_period=64, starts=2, spread=0.0)
+    assert int(two["unresolved_steps"].values[0]) == 2  # both starts
+    mp = geardyn.map2d(model, ("c", [0.5 * h / N_EDGES, 2 * h]), ("Omega", [2 * math.pi]),
+                       transient=0.0, samples=2, steps_per_period=64)
+    np.testing.assert_array_equal(mp["unresolved_steps"].values, [[1, 0]])

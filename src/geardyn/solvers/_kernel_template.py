@@ -32,17 +32,18 @@ import numpy as np
 from geardyn.solvers._step_core import (  # CORE-IMPORT
     _INLINE,
     _JIT,
-    GBUF_ROWS,
     MAX_SPLITS,
     SIMULTANEOUS,
     STATUS_DIVERGED,
     STATUS_OK,
     _events_i,
     _healthy,
+    _keep_start,
     _leaves_side,
     _rhs_i,
     _side,
     _split_step,
+    event_buffer,
     phase_table,
 )
 from geardyn.solvers._template_model import events, observe, rhs  # MODEL-IMPORT
@@ -114,13 +115,13 @@ def _block_step(i, first, nl, active, Y, Y1, K1, K2, K3, K4, TMP, TT, G, SIDE, P
         h6 = H[first + k] / 6.0
         for q in range(ns):
             Y1[k, q] = Y[k, q] + h6 * (K1[k, q] + 2.0 * K2[k, q] + 2.0 * K3[k, q] + K4[k, q])
+    _keep_start(i, nl, active, G, gbuf)
     _events_block(TT, Y1, G, P, first, nl, active)
     for k in range(nl):
         if not active[k]:
             continue
         lane = first + k
-        crossed = _leaves_side(k, T0[lane] + i * H[lane], TT[k], Y, K1, Y1, G, SIDE, P[lane],
-                               locate, ybuf, gbuf)
+        crossed = _leaves_side(i, k, G, SIDE, locate, gbuf)
         if crossed and locate:
             UNRES[lane] += _split_step(i, T0[lane], Y[k], Y1[k], P[lane], H[lane], OMEGA[lane],
                                        n_per, SIDE[k], G[k], NCROSS[lane], work, ybuf, gbuf)
@@ -141,7 +142,7 @@ def _alloc(nb_lanes, ns, n_ev):
     work = np.zeros((7, ns))
     return (Y, Y.copy(), Y.copy(), Y.copy(), Y.copy(), Y.copy(), Y.copy(), np.zeros(nb_lanes),
             np.zeros((nb_lanes, n_ev)), np.ones((nb_lanes, n_ev), np.int64),
-            work, np.zeros(ns), np.zeros((GBUF_ROWS, max(n_ev, 1))))
+            work, np.zeros(ns), event_buffer(nb_lanes, n_ev))
 
 
 @nb.njit(**_JIT)

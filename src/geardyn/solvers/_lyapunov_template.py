@@ -47,7 +47,7 @@ from geardyn.solvers._step_core import (  # CORE-IMPORT
     STATUS_OK,
     _events_i,
     _healthy,
-    _leaves_side,
+    _leaves_side_step,
     _rhs_i,
     _side,
     _split_step,
@@ -104,7 +104,7 @@ def _grid_step_rows(i, Y, p, h, omega, n_per, s_tab, c_tab, n_ev, K, TMP, Y1, SI
         crossed = 0
         if n_ev > 0:
             _events_i(t + h, Y1[r], G1[r], p)
-            crossed = _leaves_side(r, t, t + h, Y, K[0], Y1, G1, SIDE, p, True, W[8], gbuf)
+            crossed = _leaves_side_step(r, t, t + h, Y, K[0], G0, G1, SIDE, p, W[8], gbuf)
         if crossed:
             _split_step(i, 0.0, Y[r], Y1[r], p, h, omega, n_per, SIDE[r], G1[r], ncross, W,
                         W[8], gbuf)

@@ -19,9 +19,9 @@ counted (``unresolved_steps`` in every result). Crossings located within ``SIMUL
 step of the earliest are taken together (identical planet sets cross their edges at the same
 instant).
 
-Cost: the check of an ordinary step (:func:`_leaves_side`) is the sign test at the step's end and,
-for a possible graze, two more evaluations of ``events`` (at the start and at the Euler point
-y + h f); only steps that can graze by that bound are redone (:func:`_split_step`).
+Cost: the check of an ordinary step (:func:`_leaves_side`) is the sign test at the step's end
+and a bound on the dip of each edge function from its last three grid values (no evaluation of
+the model); only steps that can graze by that bound are redone (:func:`_split_step`).
 """
 
 from __future__ import annotations
@@ -40,10 +40,15 @@ SIMULTANEOUS = 1e-9
 #: Rows of the events scratch buffer ``gbuf`` that :func:`_split_step` needs (events at the start,
 #: at the root finder's point, located fractions, and at two interior points of the step).
 GBUF_ROWS = 5
-#: A step may graze an edge when min(|g(start)|, |g(end)|) <= GRAZE_BOUND |a|, a = h g'(start) -
-#: (g(end) - g(start)) (the quadratic part of g over the step; the dip of a quadratic is |a|/4,
-#: of a cubic at most 4/27 (|a| + |b|), b the same at the end; 0.6 admits |b| up to 3 |a|).
-GRAZE_BOUND = 0.6
+#: Prefilter of the sweep (history of grid values g_{i-1}, g_i, g_{i+1} of an edge function): a
+#: step may graze the edge only if min(|g_i|, |g_{i+1}|) <= GRAZE_BOUND |g_{i+1} - 2 g_i +
+#: g_{i-1}|. The dip of the parabola through the three values below min(g_i, g_{i+1}) is at most
+#: an eighth of that second difference, so 1 leaves a margin of 8 for the cubic terms.
+GRAZE_BOUND = 1.0
+#: Prefilter of a lone step (no history): min(|g(t0)|, |g(t1)|) <= GRAZE_BOUND_STEP |a|,
+#: a = h g'(t0) - (g(t1) - g(t0)), the quadratic part of g over the step; its dip is |a| / 4, that
+#: of a cubic at most 4/27 (|a| + |b|) (b: the same at the end), so 0.6 admits |b| up to 3 |a|.
+GRAZE_BOUND_STEP = 0.6
 #: An interior extremum of an edge function counts as a crossing only beyond the edge by more than
 #: this fraction of the function's size over the step (shallower dips are touching, not crossing).
 GRAZE_TOL = 1e-9
@@ -238,30 +243,69 @@ def first_crossing(j, side_j, g1j, y0, f0, y1, f1, dt, t, p, ybuf, gbuf):
     return _locate(j, side_j, v0, b, gb, y0, f0, y1, f1, dt, t, p, ybuf, gbuf[1])
 
 
+@nb.njit(**_JIT)
+def event_buffer(nb_lanes, n_ev):
+    """The events scratch buffer of a block of nb_lanes lanes: GBUF_ROWS rows for
+    :func:`_split_step`, then two rows per lane for the grid values of the events at even and at
+    odd grid points (:func:`_keep_start`; NaN: none yet)."""
+    g = np.zeros((GBUF_ROWS + 2 * nb_lanes, max(n_ev, 1)))
+    g[GBUF_ROWS:] = np.nan
+    return g
+
+
 @nb.njit(inline="always", **_JIT)
-def _leaves_side(r, t0, t1, Y, K1, Y1, G1, SIDE, p, locate, ybuf, gbuf):
-    """Whether the trial step of row r (Y[r] at time t0 to Y1[r] at t1, K1[r] = f(t0, Y[r]), G1[r]
-    the events at the end, SIDE[r] the sides at the start) may leave a side of an edge: 1 if an
-    end lies on the other side; with ``locate``, 2 if it may graze one, min(|g(t0)|, |g(t1)|)
-    <= GRAZE_BOUND |a| with a = events(y + h f) - events(y1) = h g'(t0) - (g(t1) - g(t0)) (exact
-    for events linear in the state), so the step must be checked (:func:`_split_step`); else 0.
-    ybuf, gbuf rows 0-1: scratch."""
+def _keep_start(i, nl, active, G, gbuf):
+    """Before grid step i: keep the events at its start (G, rows 0..nl-1) in gbuf's history."""
+    nb_lanes = (gbuf.shape[0] - GBUF_ROWS) // 2
+    row = GBUF_ROWS + (i % 2) * nb_lanes
+    for k in range(nl):
+        if active[k]:
+            for j in range(G.shape[1]):
+                gbuf[row + k, j] = G[k, j]
+
+
+@nb.njit(inline="always", **_JIT)
+def _leaves_side(i, k, G, SIDE, locate, gbuf):
+    """Whether the trial grid step i of block row k may leave a side of an edge: 1 if its end
+    (events G[k]) lies on another side than its start (SIDE[k]); with ``locate``, 2 if it may
+    graze an edge by the GRAZE_BOUND test on the grid values g_{i-1}, g_i kept in gbuf's
+    history (:func:`_keep_start`; no history yet: it may), so that the step must be checked
+    (:func:`_split_step`); else 0. No evaluations of the model: the common step stays cheap."""
+    n_ev = G.shape[1]
+    for j in range(n_ev):
+        if _side(G[k, j]) != SIDE[k, j]:
+            return 1
+    if not locate:
+        return 0
+    nb_lanes = (gbuf.shape[0] - GBUF_ROWS) // 2
+    r0 = GBUF_ROWS + (i % 2) * nb_lanes + k
+    rp = GBUF_ROWS + ((i + 1) % 2) * nb_lanes + k
+    for j in range(n_ev):
+        g0 = gbuf[r0, j]
+        g1 = G[k, j]
+        if not min(abs(g0), abs(g1)) > GRAZE_BOUND * abs(g1 - 2.0 * g0 + gbuf[rp, j]):
+            return 2
+    return 0
+
+
+@nb.njit(inline="always", **_JIT)
+def _leaves_side_step(r, t0, t1, Y, K1, G0, G1, SIDE, p, ybuf, gbuf):
+    """:func:`_leaves_side` for a lone step without history (row r: Y[r] at time t0 to the trial
+    end at t1, K1[r] = f(t0, Y[r]), events G0[r], G1[r] at the ends, sides SIDE[r]): 2 if
+    min(|g(t0)|, |g(t1)|) <= GRAZE_BOUND_STEP |a|, a = events(y + h f) - events(y1) = h g'(t0) -
+    (g(t1) - g(t0)) (exact for events linear in the state); one evaluation of ``events``. ybuf,
+    gbuf row 1: scratch."""
     n_ev = G1.shape[1]
     for j in range(n_ev):
         if _side(G1[r, j]) != SIDE[r, j]:
             return 1
-    if not locate or n_ev == 0:
-        return 0
     h = t1 - t0
-    ns = Y.shape[1]
-    for q in range(ns):
+    for q in range(Y.shape[1]):
         ybuf[q] = Y[r, q] + h * K1[r, q]
     _events_i(t1, ybuf, gbuf[1], p)
-    for q in range(ns):
-        ybuf[q] = Y[r, q]
-    _events_i(t0, ybuf, gbuf[0], p)
     for j in range(n_ev):
-        if min(abs(gbuf[0, j]), abs(G1[r, j])) <= GRAZE_BOUND * abs(gbuf[1, j] - G1[r, j]):
+        if not (min(abs(G0[r, j]), abs(G1[r, j]))
+                > GRAZE_BOUND_STEP * abs(gbuf[1, j] - G1[r, j])):
             return 2
     return 0
 
