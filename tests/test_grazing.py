@@ -224,3 +224,24 @@ def test_unresolved_steps_reach_every_result():
     mp = geardyn.map2d(model, ("c", [0.5 * h / N_EDGES, 2 * h]), ("Omega", [2 * math.pi]),
                        transient=0.0, samples=2, steps_per_period=64)
     np.testing.assert_array_equal(mp["unresolved_steps"].values, [[1, 0]])
+
+
+def test_reproduction_report_counts_unresolved_steps(tmp_path):
+    """The case file carries ``unresolved_steps``; the report gives it per case and warns when
+    it is not 0."""
+    from geardyn.reproduction import ReproductionSettings, get_case, run_case
+    from geardyn.reproduction.report import build_report
+
+    settings = ReproductionSettings(num=2, transient=20.0, samples=2, lyapunov_duration=5.0,
+                                    lyapunov_screen=5.0, lyapunov_transient=1.0)
+    ds = run_case(get_case("fig5"), "consistent", settings)
+    assert ds["unresolved_steps"].dims == ("sweep", "Omega")
+    assert ds.attrs["unresolved_steps"] == int(ds["unresolved_steps"].sum())
+    clean = build_report({("fig5", "consistent"): ds}, {}, tmp_path).markdown(tmp_path)
+    assert "unresolved steps" in clean and "Warning: unresolved steps" not in clean
+    bad = ds.copy(deep=True)
+    bad["unresolved_steps"][0, 1] = 3
+    text = build_report({("fig5", "consistent"): bad}, {}, tmp_path).markdown(tmp_path)
+    assert "**Warning: unresolved steps.** In fig5 (consistent): 3 grid steps" in text
+    row = next(line for line in text.splitlines() if line.startswith("| fig5 | consistent |"))
+    assert row.split("|")[5].strip() == "3"

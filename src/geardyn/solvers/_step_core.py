@@ -38,8 +38,10 @@ _JIT = {"cache": _CACHE, "error_model": "numpy", "boundscheck": False}
 MAX_SPLITS = 16
 SIMULTANEOUS = 1e-9
 #: Rows of the events scratch buffer ``gbuf`` that :func:`_split_step` needs (events at the start,
-#: at the root finder's point, located fractions, and at two interior points of the step).
-GBUF_ROWS = 5
+#: at the root finder's point, located fractions, at two interior points of the step, and the
+#: events that may graze: row GRAZE_ROW, set by the prefilters).
+GBUF_ROWS = 6
+GRAZE_ROW = 5
 #: Prefilter of the sweep (history of grid values g_{i-1}, g_i, g_{i+1} of an edge function): a
 #: step may graze the edge only if min(|g_i|, |g_{i+1}|) <= GRAZE_BOUND |g_{i+1} - 2 g_i +
 #: g_{i-1}|. The dip of the parabola through the three values below min(g_i, g_{i+1}) is at most
@@ -268,52 +270,63 @@ def _keep_start(i, nl, active, G, gbuf):
 def _leaves_side(i, k, G, SIDE, locate, gbuf):
     """Whether the trial grid step i of block row k may leave a side of an edge: 1 if its end
     (events G[k]) lies on another side than its start (SIDE[k]); with ``locate``, 2 if it may
-    graze an edge by the GRAZE_BOUND test on the grid values g_{i-1}, g_i kept in gbuf's
-    history (:func:`_keep_start`; no history yet: it may), so that the step must be checked
-    (:func:`_split_step`); else 0. No evaluations of the model: the common step stays cheap."""
-    n_ev = G.shape[1]
-    for j in range(n_ev):
-        if _side(G[k, j]) != SIDE[k, j]:
-            return 1
-    if not locate:
-        return 0
+    graze an edge, so that the step must be checked (:func:`_split_step`); else 0. An event may
+    graze (flag in gbuf row GRAZE_ROW) when min(|g_i|, |g_{i+1}|) <= GRAZE_BOUND |d2|, d2 =
+    g_{i+1} - 2 g_i + g_{i-1}, from the grid values kept in gbuf's history (:func:`_keep_start`;
+    none yet: it may), and, unless the end crossed, d2 does not bend away from the edge. No
+    evaluations of the model: the common step stays cheap."""
+    out = 0
     nb_lanes = (gbuf.shape[0] - GBUF_ROWS) // 2
     r0 = GBUF_ROWS + (i % 2) * nb_lanes + k
     rp = GBUF_ROWS + ((i + 1) % 2) * nb_lanes + k
-    for j in range(n_ev):
-        g0 = gbuf[r0, j]
+    for j in range(G.shape[1]):
         g1 = G[k, j]
-        if not min(abs(g0), abs(g1)) > GRAZE_BOUND * abs(g1 - 2.0 * g0 + gbuf[rp, j]):
-            return 2
-    return 0
+        s = SIDE[k, j]
+        crossed = _side(g1) != s
+        graze = 0.0
+        if locate:
+            g0 = gbuf[r0, j]
+            d2 = g1 - 2.0 * g0 + gbuf[rp, j]
+            # a dip across the edge bends towards it (curvature of the sign of the side)
+            if (crossed or not s * d2 < 0.0) and not min(abs(g0), abs(g1)) > GRAZE_BOUND * abs(d2):
+                graze = 1.0
+                out = 2
+        gbuf[GRAZE_ROW, j] = graze
+        if crossed:
+            out = 1 if out == 0 else out
+    return out
 
 
 @nb.njit(inline="always", **_JIT)
 def _leaves_side_step(r, t0, t1, Y, K1, G0, G1, SIDE, p, ybuf, gbuf):
     """:func:`_leaves_side` for a lone step without history (row r: Y[r] at time t0 to the trial
-    end at t1, K1[r] = f(t0, Y[r]), events G0[r], G1[r] at the ends, sides SIDE[r]): 2 if
-    min(|g(t0)|, |g(t1)|) <= GRAZE_BOUND_STEP |a|, a = events(y + h f) - events(y1) = h g'(t0) -
-    (g(t1) - g(t0)) (exact for events linear in the state); one evaluation of ``events``. ybuf,
-    gbuf row 1: scratch."""
-    n_ev = G1.shape[1]
-    for j in range(n_ev):
-        if _side(G1[r, j]) != SIDE[r, j]:
-            return 1
+    end at t1, K1[r] = f(t0, Y[r]), events G0[r], G1[r] at the ends, sides SIDE[r]): an event may
+    graze when min(|g(t0)|, |g(t1)|) <= GRAZE_BOUND_STEP |a|, a = events(y + h f) - events(y1)
+    = h g'(t0) - (g(t1) - g(t0)) (exact for events linear in the state); one evaluation of
+    ``events``. ybuf, gbuf row 1: scratch."""
     h = t1 - t0
     for q in range(Y.shape[1]):
         ybuf[q] = Y[r, q] + h * K1[r, q]
     _events_i(t1, ybuf, gbuf[1], p)
-    for j in range(n_ev):
-        if not (min(abs(G0[r, j]), abs(G1[r, j]))
-                > GRAZE_BOUND_STEP * abs(gbuf[1, j] - G1[r, j])):
-            return 2
-    return 0
+    out = 0
+    for j in range(G1.shape[1]):
+        g1 = G1[r, j]
+        if _side(g1) != SIDE[r, j]:
+            out = 1
+        graze = 0.0
+        if not min(abs(G0[r, j]), abs(g1)) > GRAZE_BOUND_STEP * abs(gbuf[1, j] - g1):
+            graze = 1.0
+            out = max(out, 2)
+        gbuf[GRAZE_ROW, j] = graze
+    return out
 
 
 @nb.njit(**_JIT)
 def _split_step(i, t0, y, y_trial, p, h, omega, n_per, side, g1, ncross, work, ybuf, gbuf):
     """Finish grid step i of one lane with edge crossings located; y holds the start, and
-    y_trial/g1 the unsplit trial step; gbuf has GBUF_ROWS rows. Returns 1 if the split limit was
+    y_trial/g1 the unsplit trial step; gbuf has GBUF_ROWS rows, row GRAZE_ROW flagging the
+    events that may graze (set by the caller's prefilter: those get :func:`first_crossing`,
+    the others a crossing only where the end's side differs). Returns 1 if the split limit was
     reached, else 0."""
     k1 = work[0]
     k2 = work[1]
@@ -346,9 +359,22 @@ def _split_step(i, t0, y, y_trial, p, h, omega, n_per, side, g1, ncross, work, y
         rhs(t_end, y_trial, f1, p, s_end, c_end)
         for q in range(y.size):
             ystart[q] = y[q]
-        interpolant_events(ystart, k1, y_trial, f1, dt, t, p, ybuf, gbuf)
+        graze = False
         for j in range(n_ev):
-            th = first_crossing(j, side[j], g1[j], ystart, k1, y_trial, f1, dt, t, p, ybuf, gbuf)
+            graze = graze or gbuf[GRAZE_ROW, j] != 0.0
+        if graze:
+            interpolant_events(ystart, k1, y_trial, f1, dt, t, p, ybuf, gbuf)
+        else:
+            events(t, y, gbuf[0], p)
+        for j in range(n_ev):
+            if gbuf[GRAZE_ROW, j] != 0.0:  # may graze, or cross more than once
+                th = first_crossing(j, side[j], g1[j], ystart, k1, y_trial, f1, dt, t, p, ybuf,
+                                    gbuf)
+            elif _side(g1[j]) != side[j]:  # one crossing
+                th = _locate(j, side[j], gbuf[0, j], 1.0, g1[j], ystart, k1, y_trial, f1, dt, t,
+                             p, ybuf, gbuf[1])
+            else:
+                th = 2.0
             gbuf[2, j] = th
             if th < theta:
                 theta = th
