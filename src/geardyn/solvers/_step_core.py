@@ -257,13 +257,13 @@ def event_buffer(nb_lanes, n_ev):
 
 @nb.njit(inline="always", **_JIT)
 def _keep_start(i, nl, active, G, gbuf):
-    """Before grid step i: keep the events at its start (G, rows 0..nl-1) in gbuf's history."""
+    """Before grid step i: keep the events at its start (G, rows 0..nl-1) in gbuf's history
+    (an inactive lane's too: it takes no more steps)."""
     nb_lanes = (gbuf.shape[0] - GBUF_ROWS) // 2
     row = GBUF_ROWS + (i % 2) * nb_lanes
     for k in range(nl):
-        if active[k]:
-            for j in range(G.shape[1]):
-                gbuf[row + k, j] = G[k, j]
+        for j in range(G.shape[1]):
+            gbuf[row + k, j] = G[k, j]
 
 
 @nb.njit(inline="always", **_JIT)
