@@ -389,6 +389,7 @@ def _dataset(model: Model, param: str, values: np.ndarray, runs: list[LaneResult
     poincare = np.concatenate([r.samples for r in runs], axis=1)
     static = _static_forces(model, param, values) if has_mesh_forces(model) else None
     per_lane = lane_variables(model, first, static, max_period, tol)
+    per_lane["unresolved_steps"] = np.sum([r.unresolved for r in runs], axis=0)  # every start
     status = np.max(np.stack([r.status for r in runs], axis=1), axis=1)
     ds = xr.Dataset(coords={
         param: (param, values),

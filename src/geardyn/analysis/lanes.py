@@ -57,7 +57,11 @@ def variable_attrs(model: Model, max_period: int = DEFAULT_MAX_PERIOD, tol: floa
         "converged": {"long_name": "transient ended by convergence of the Poincare points",
                       "meaning": "1 converged, 0 reached the longest transient, -1 fixed "
                                  "transient"},
-        "steps_per_period": {}, "transient_periods": {}, "unresolved_steps": {},
+        "steps_per_period": {}, "transient_periods": {},
+        "unresolved_steps": {"long_name": "grid steps that reached the edge-split limit",
+                             "meaning": "steps with more dead-zone edge crossings than the "
+                                        "split limit (MAX_SPLITS), integrated unsplit there "
+                                        "(every start; 0 expected)"},
         "contact": {"meaning": "none: teeth never separate; single: separation, no back-flank "
                                "contact; double: back-flank contact; unbounded: diverged"},
         "force_peak": {"units": model.observable_units},

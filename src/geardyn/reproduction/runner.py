@@ -267,6 +267,7 @@ def _assemble(case: Case, interpretation: str, settings: ReproductionSettings,
         if case.load_noise else "stroboscopic, once per mesh period",
         params_json=case.params.model_dump_json(),
         static_deflection=[float(g) for g in model.static_forces()[:2]],
+        unresolved_steps=int(out["unresolved_steps"].sum()),
     )
     return label_case(out, case)
 

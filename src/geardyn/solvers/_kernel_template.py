@@ -11,11 +11,12 @@ Numerics
   ``h = T / n_per``; the forcing phase ``sin/cos(Omega t)`` at the grid and half-grid points comes
   from a table, so it is exact and periodic.
 * Kinks of the right-hand side (the edges of the backlash dead zone) are the zero crossings of the
-  model's ``events``. With ``locate`` on, a step whose end lies on another side of an edge than its
-  start is split at the crossing, located by root-finding on the cubic Hermite interpolant of the
-  step (error O(h^4) in the crossing time), and integrated in sub-steps. Every RK4 stage then sees
-  a smooth right-hand side and the method keeps 4th order. A step is split at most
-  ``MAX_SPLITS`` times (grazing contacts); the count of steps that hit the limit is returned.
+  model's ``events``. With ``locate`` on, a step that leaves a side of an edge (its end on the
+  other side, or a graze: two crossings inside the step) is split at the first crossing, located
+  by root-finding on the cubic Hermite interpolant of the step (error O(h^4) in the crossing
+  time), and integrated in sub-steps. Every RK4 stage then sees a smooth right-hand side and the
+  method keeps 4th order. A step is split at most ``MAX_SPLITS`` times (chattering); the count of
+  steps that hit the limit is returned (see :mod:`._step_core`).
 * Lanes (parameter sets) are advanced in lockstep blocks of ``BLOCK`` lanes so the CPU overlaps
   their independent dependency chains; blocks run in parallel (``prange``). A lane's arithmetic
   does not depend on its neighbours, so results are bitwise independent of blocking and threads.
@@ -37,9 +38,12 @@ from geardyn.solvers._step_core import (  # CORE-IMPORT
     STATUS_OK,
     _events_i,
     _healthy,
+    _keep_start,
+    _leaves_side,
     _rhs_i,
     _side,
     _split_step,
+    event_buffer,
     phase_table,
 )
 from geardyn.solvers._template_model import events, observe, rhs  # MODEL-IMPORT
@@ -111,16 +115,14 @@ def _block_step(i, first, nl, active, Y, Y1, K1, K2, K3, K4, TMP, TT, G, SIDE, P
         h6 = H[first + k] / 6.0
         for q in range(ns):
             Y1[k, q] = Y[k, q] + h6 * (K1[k, q] + 2.0 * K2[k, q] + 2.0 * K3[k, q] + K4[k, q])
+    _keep_start(i, nl, active, G, gbuf)
     _events_block(TT, Y1, G, P, first, nl, active)
     for k in range(nl):
         if not active[k]:
             continue
-        crossed = False
-        for j in range(n_ev):
-            if _side(G[k, j]) != SIDE[k, j]:
-                crossed = True
+        lane = first + k
+        crossed = _leaves_side(i, k, G, SIDE, locate, gbuf)
         if crossed and locate:
-            lane = first + k
             UNRES[lane] += _split_step(i, T0[lane], Y[k], Y1[k], P[lane], H[lane], OMEGA[lane],
                                        n_per, SIDE[k], G[k], NCROSS[lane], work, ybuf, gbuf)
             continue
@@ -140,7 +142,7 @@ def _alloc(nb_lanes, ns, n_ev):
     work = np.zeros((7, ns))
     return (Y, Y.copy(), Y.copy(), Y.copy(), Y.copy(), Y.copy(), Y.copy(), np.zeros(nb_lanes),
             np.zeros((nb_lanes, n_ev)), np.ones((nb_lanes, n_ev), np.int64),
-            work, np.zeros(ns), np.zeros((3, max(n_ev, 1))))
+            work, np.zeros(ns), event_buffer(nb_lanes, n_ev))
 
 
 @nb.njit(**_JIT)

@@ -52,10 +52,12 @@ import numpy as np
 
 from geardyn.solvers._step_core import (  # CORE-IMPORT
     _JIT,
+    GBUF_ROWS,
     STATUS_DIVERGED,
     STATUS_OK,
     _events_i,
     _healthy,
+    _leaves_side_step,
     _rhs_i,
     _side,
     _split_step,
@@ -109,12 +111,10 @@ def _grid_step_rows(i, t0, Y, p, h, omega, n_per, s_tab, c_tab, n_ev, K, TMP, Y1
             Y1[r, q] = Y[r, q] + h6 * (K[0, r, q] + 2.0 * K[1, r, q] + 2.0 * K[2, r, q]
                                        + K[3, r, q])
     for r in range(nr):
-        crossed = False
+        crossed = 0
         if n_ev > 0:
             _events_i(t + h, Y1[r], G1[r], p)
-            for j in range(n_ev):
-                if _side(G1[r, j]) != SIDE[r, j]:
-                    crossed = True
+            crossed = _leaves_side_step(r, t, t + h, Y, K[0], G0, G1, SIDE, p, W[8], gbuf)
         if crossed:
             _split_step(i, t0, Y[r], Y1[r], p, h, omega, n_per, SIDE[r], G1[r], ncross, W,
                         W[8], gbuf)
@@ -267,7 +267,7 @@ def _run(p, y0, t0, h, omega, n_per, s_tab, c_tab, n_transient, n_steps, renorm_
     SIDE = np.ones((nr, ne), np.int64)
     G0 = np.zeros((nr, ne))
     G1 = np.zeros((nr, ne))
-    gbuf = np.zeros((3, ne))
+    gbuf = np.zeros((GBUF_ROWS, ne))
     ncross = np.zeros(ne, np.int64)
     acc = np.zeros(k)
     logs = np.zeros(k)

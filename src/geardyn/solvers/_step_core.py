@@ -7,12 +7,21 @@ into a generated kernel module in place of the template's ``CORE-IMPORT`` line, 
 model's ``rhs`` and ``events``. As it stands it is a valid module bound to the test oscillator of
 :mod:`geardyn.solvers._template_model`.
 
-Edge location: a step whose end lies on another side of an edge (a zero of ``events``) than its
-start is split at the crossing, located by root-finding (Illinois) on the cubic Hermite
-interpolant of the step (error O(h^4) in the crossing time), and integrated in sub-steps, so every
-RK4 stage sees a smooth right-hand side and the method keeps 4th order. A step is split at most
-``MAX_SPLITS`` times (grazing contacts); crossings located within ``SIMULTANEOUS`` of a step of
-the earliest are taken together (identical planet sets cross their edges at the same instant).
+Edge location: a step that leaves a side of an edge (a zero of ``events``) is split at the
+crossing, located by root-finding (Illinois) on the cubic Hermite interpolant of the step (error
+O(h^4) in the crossing time), and integrated in sub-steps, so every RK4 stage sees a smooth
+right-hand side and the method keeps 4th order. A step leaves a side when its end lies on the
+other side, or when it grazes the edge: crosses it twice (or any even number of times) inside the
+step. A graze is found from the interior extrema of the edge function along the interpolant
+(:func:`first_crossing`); the first crossing of a step is always the one located. A step is split
+at most ``MAX_SPLITS`` times (chattering); a step that reaches the limit falls back unsplit and is
+counted (``unresolved_steps`` in every result). Crossings located within ``SIMULTANEOUS`` of a
+step of the earliest are taken together (identical planet sets cross their edges at the same
+instant).
+
+Cost: the check of an ordinary step (:func:`_leaves_side`) is the sign test at the step's end
+and a bound on the dip of each edge function from its last three grid values (no evaluation of
+the model); only steps that can graze by that bound are redone (:func:`_split_step`).
 """
 
 from __future__ import annotations
@@ -28,6 +37,23 @@ _CACHE = True
 _JIT = {"cache": _CACHE, "error_model": "numpy", "boundscheck": False}
 MAX_SPLITS = 16
 SIMULTANEOUS = 1e-9
+#: Rows of the events scratch buffer ``gbuf`` that :func:`_split_step` needs (events at the start,
+#: at the root finder's point, located fractions, at two interior points of the step, and the
+#: events that may graze: row GRAZE_ROW, set by the prefilters).
+GBUF_ROWS = 6
+GRAZE_ROW = 5
+#: Prefilter of the sweep (history of grid values g_{i-1}, g_i, g_{i+1} of an edge function): a
+#: step may graze the edge only if min(|g_i|, |g_{i+1}|) <= GRAZE_BOUND |g_{i+1} - 2 g_i +
+#: g_{i-1}|. The dip of the parabola through the three values below min(g_i, g_{i+1}) is at most
+#: an eighth of that second difference, so 1 leaves a margin of 8 for the cubic terms.
+GRAZE_BOUND = 1.0
+#: Prefilter of a lone step (no history): min(|g(t0)|, |g(t1)|) <= GRAZE_BOUND_STEP |a|,
+#: a = h g'(t0) - (g(t1) - g(t0)), the quadratic part of g over the step; its dip is |a| / 4, that
+#: of a cubic at most 4/27 (|a| + |b|) (b: the same at the end), so 0.6 admits |b| up to 3 |a|.
+GRAZE_BOUND_STEP = 0.6
+#: An interior extremum of an edge function counts as a crossing only beyond the edge by more than
+#: this fraction of the function's size over the step (shallower dips are touching, not crossing).
+GRAZE_TOL = 1e-9
 STATUS_OK = 0
 STATUS_DIVERGED = 1
 # MODEL-ADAPTERS (a user's plain functions are adapted to the kernel interface here)
@@ -91,12 +117,12 @@ def _hermite(y0, f0, y1, f1, dt, theta, out):
 
 
 @nb.njit(**_JIT)
-def _locate(j, side_j, g0j, g1j, y0, f0, y1, f1, dt, t, p, ybuf, gbuf):
-    """Fraction in (0, 1] of the step where event j leaves side side_j (Illinois method)."""
+def _locate(j, side_j, g0j, b, fb, y0, f0, y1, f1, dt, t, p, ybuf, gbuf):
+    """Fraction in (0, b] of the step where event j leaves side side_j (Illinois method on the
+    step's interpolant), given a bracket [0, b] that holds exactly one crossing: g0j the event at
+    the start (taken as on side side_j), fb its value at b (on the other side)."""
     a = 0.0
     fa = g0j if _side(g0j) == side_j else (1e-300 if side_j > 0 else 0.0)
-    b = 1.0
-    fb = g1j
     last = 0
     for _ in range(60):
         denom = fb - fa
@@ -123,10 +149,185 @@ def _locate(j, side_j, g0j, g1j, y0, f0, y1, f1, dt, t, p, ybuf, gbuf):
     return b
 
 
+@nb.njit(inline="always", **_JIT)
+def _quadratic_roots(a, b, c):
+    """Real roots r1 <= r2 of a s^2 + b s + c (NaN where there is none; r2 NaN for a linear
+    equation), by the cancellation-free formula."""
+    if a == 0.0:
+        if b == 0.0:
+            return np.nan, np.nan
+        return -c / b, np.nan
+    disc = b * b - 4.0 * a * c
+    if disc < 0.0:
+        return np.nan, np.nan
+    q = -0.5 * (b + math.copysign(math.sqrt(disc), b))
+    if q == 0.0:
+        return 0.0, 0.0
+    r1 = q / a
+    r2 = c / q
+    return (r1, r2) if r1 <= r2 else (r2, r1)
+
+
+@nb.njit(inline="always", **_JIT)
+def _cubic_at(s, v0, d1, d2, d3):
+    """Newton form of the cubic through 4 equally spaced values, at s (in spacings from v0)."""
+    return v0 + s * (d1 + (s - 1.0) * (0.5 * d2 + (s - 2.0) / 6.0 * d3))
+
+
+@nb.njit(**_JIT)
+def cubic_extrema(v0, v1, v2, v3):
+    """The cubic through (0, v0), (1/3, v1), (2/3, v2), (1, v3): its stationary points in (0, 1)
+    and its values there, as (theta1, value1, theta2, value2), theta1 < theta2; NaN for a point
+    that does not exist."""
+    d1 = v1 - v0
+    d2 = v2 - 2.0 * v1 + v0
+    d3 = v3 - 3.0 * v2 + 3.0 * v1 - v0
+    # dP/ds of P(s) = v0 + s d1 + s (s - 1) / 2 d2 + s (s - 1) (s - 2) / 6 d3, s = 3 theta
+    r1, r2 = _quadratic_roots(0.5 * d3, d2 - d3, d1 - 0.5 * d2 + d3 / 3.0)
+    if not 0.0 < r2 < 3.0:
+        r2 = np.nan
+    if not 0.0 < r1 < 3.0:
+        r1, r2 = r2, np.nan
+    return (r1 / 3.0, _cubic_at(r1, v0, d1, d2, d3), r2 / 3.0, _cubic_at(r2, v0, d1, d2, d3))
+
+
+@nb.njit(inline="always", **_JIT)
+def _beyond(th, e, j, side_j, tol, y0, f0, y1, f1, dt, t, p, ybuf, gbuf):
+    """The event j on the interpolant at th if the cubic's value e there and it both lie beyond
+    the edge (off side side_j, by more than tol); else NaN."""
+    if not (th > 0.0 and side_j * e < 0.0 and abs(e) > tol):
+        return np.nan
+    _hermite(y0, f0, y1, f1, dt, th, ybuf)
+    events(t + th * dt, ybuf, gbuf[1], p)
+    ge = gbuf[1, j]
+    return ge if _side(ge) != side_j and abs(ge) > tol else np.nan
+
+
+@nb.njit(**_JIT)
+def interpolant_events(y0, f0, y1, f1, dt, t, p, ybuf, gbuf):
+    """The events along a step's cubic Hermite interpolant (start y0, end y1, derivatives f0, f1,
+    length dt, from time t) at theta = 0, 1/3, 2/3 into rows 0, 3, 4 of gbuf (GBUF_ROWS rows)."""
+    events(t, y0, gbuf[0], p)
+    for m in range(1, 3):
+        _hermite(y0, f0, y1, f1, dt, m / 3.0, ybuf)
+        events(t + m / 3.0 * dt, ybuf, gbuf[2 + m], p)
+
+
+@nb.njit(**_JIT)
+def first_crossing(j, side_j, g1j, y0, f0, y1, f1, dt, t, p, ybuf, gbuf):
+    """Fraction in (0, 1] of the step where event j first leaves side side_j along the step's
+    cubic Hermite interpolant, or 2.0 if it stays on its side. g1j: the event at the end; gbuf
+    rows 0, 3, 4: the events at theta = 0, 1/3, 2/3 (:func:`interpolant_events`); row 1 is
+    scratch.
+
+    Along the interpolant an event that is linear in the state is exactly the cubic through
+    those four values (in general: to the interpolant's O(h^4)). An interior extremum of that
+    cubic beyond the edge (by more than GRAZE_TOL of the event's size over the step), confirmed
+    by the event on the interpolant there, has a crossing before it: the orbit grazes the edge
+    (an even number of crossings in the step) or crosses it several times. Otherwise the end's
+    side decides. The bracket [0, b] handed to the root finder ends at the first such extremum
+    (or the end), so it holds exactly one crossing, the first."""
+    v0 = gbuf[0, j]
+    v1 = gbuf[3, j]
+    v2 = gbuf[4, j]
+    tol = GRAZE_TOL * max(max(abs(v0), abs(v1)), max(abs(v2), abs(g1j)))
+    th1, e1, th2, e2 = cubic_extrema(v0, v1, v2, g1j)
+    b = th1
+    gb = _beyond(th1, e1, j, side_j, tol, y0, f0, y1, f1, dt, t, p, ybuf, gbuf)
+    if gb != gb:
+        b = th2
+        gb = _beyond(th2, e2, j, side_j, tol, y0, f0, y1, f1, dt, t, p, ybuf, gbuf)
+    if gb != gb:
+        if _side(g1j) == side_j:
+            return 2.0
+        b = 1.0
+        gb = g1j
+    return _locate(j, side_j, v0, b, gb, y0, f0, y1, f1, dt, t, p, ybuf, gbuf[1])
+
+
+@nb.njit(**_JIT)
+def event_buffer(nb_lanes, n_ev):
+    """The events scratch buffer of a block of nb_lanes lanes: GBUF_ROWS rows for
+    :func:`_split_step`, then two rows per lane for the grid values of the events at even and at
+    odd grid points (:func:`_keep_start`; NaN: none yet)."""
+    g = np.zeros((GBUF_ROWS + 2 * nb_lanes, max(n_ev, 1)))
+    g[GBUF_ROWS:] = np.nan
+    return g
+
+
+@nb.njit(inline="always", **_JIT)
+def _keep_start(i, nl, active, G, gbuf):
+    """Before grid step i: keep the events at its start (G, rows 0..nl-1) in gbuf's history
+    (an inactive lane's too: it takes no more steps)."""
+    nb_lanes = (gbuf.shape[0] - GBUF_ROWS) // 2
+    row = GBUF_ROWS + (i % 2) * nb_lanes
+    for k in range(nl):
+        for j in range(G.shape[1]):
+            gbuf[row + k, j] = G[k, j]
+
+
+@nb.njit(inline="always", **_JIT)
+def _leaves_side(i, k, G, SIDE, locate, gbuf):
+    """Whether the trial grid step i of block row k may leave a side of an edge: 1 if its end
+    (events G[k]) lies on another side than its start (SIDE[k]); with ``locate``, 2 if it may
+    graze an edge, so that the step must be checked (:func:`_split_step`); else 0. An event may
+    graze (flag in gbuf row GRAZE_ROW) when min(|g_i|, |g_{i+1}|) <= GRAZE_BOUND |d2|, d2 =
+    g_{i+1} - 2 g_i + g_{i-1}, from the grid values kept in gbuf's history (:func:`_keep_start`;
+    none yet: it may), and, unless the end crossed, d2 does not bend away from the edge. No
+    evaluations of the model: the common step stays cheap."""
+    out = 0
+    nb_lanes = (gbuf.shape[0] - GBUF_ROWS) // 2
+    r0 = GBUF_ROWS + (i % 2) * nb_lanes + k
+    rp = GBUF_ROWS + ((i + 1) % 2) * nb_lanes + k
+    for j in range(G.shape[1]):
+        g1 = G[k, j]
+        s = SIDE[k, j]
+        crossed = _side(g1) != s
+        graze = 0.0
+        if locate:
+            g0 = gbuf[r0, j]
+            d2 = g1 - 2.0 * g0 + gbuf[rp, j]
+            # a dip across the edge bends towards it (curvature of the sign of the side)
+            if (crossed or not s * d2 < 0.0) and not min(abs(g0), abs(g1)) > GRAZE_BOUND * abs(d2):
+                graze = 1.0
+                out = 2
+        gbuf[GRAZE_ROW, j] = graze
+        if crossed:
+            out = 1 if out == 0 else out
+    return out
+
+
+@nb.njit(inline="always", **_JIT)
+def _leaves_side_step(r, t0, t1, Y, K1, G0, G1, SIDE, p, ybuf, gbuf):
+    """:func:`_leaves_side` for a lone step without history (row r: Y[r] at time t0 to the trial
+    end at t1, K1[r] = f(t0, Y[r]), events G0[r], G1[r] at the ends, sides SIDE[r]): an event may
+    graze when min(|g(t0)|, |g(t1)|) <= GRAZE_BOUND_STEP |a|, a = events(y + h f) - events(y1)
+    = h g'(t0) - (g(t1) - g(t0)) (exact for events linear in the state); one evaluation of
+    ``events``. ybuf, gbuf row 1: scratch."""
+    h = t1 - t0
+    for q in range(Y.shape[1]):
+        ybuf[q] = Y[r, q] + h * K1[r, q]
+    _events_i(t1, ybuf, gbuf[1], p)
+    out = 0
+    for j in range(G1.shape[1]):
+        g1 = G1[r, j]
+        if _side(g1) != SIDE[r, j]:
+            out = 1
+        graze = 0.0
+        if not min(abs(G0[r, j]), abs(g1)) > GRAZE_BOUND_STEP * abs(gbuf[1, j] - g1):
+            graze = 1.0
+            out = max(out, 2)
+        gbuf[GRAZE_ROW, j] = graze
+    return out
+
+
 @nb.njit(**_JIT)
 def _split_step(i, t0, y, y_trial, p, h, omega, n_per, side, g1, ncross, work, ybuf, gbuf):
     """Finish grid step i of one lane with edge crossings located; y holds the start, and
-    y_trial/g1 the unsplit trial step. Returns 1 if the split limit was reached, else 0."""
+    y_trial/g1 the unsplit trial step; gbuf has GBUF_ROWS rows, row GRAZE_ROW flagging the
+    events that may graze (set by the caller's prefilter: those get :func:`first_crossing`,
+    the others a crossing only where the end's side differs). Returns 1 if the split limit was
+    reached, else 0."""
     k1 = work[0]
     k2 = work[1]
     k3 = work[2]
@@ -158,16 +359,26 @@ def _split_step(i, t0, y, y_trial, p, h, omega, n_per, side, g1, ncross, work, y
         rhs(t_end, y_trial, f1, p, s_end, c_end)
         for q in range(y.size):
             ystart[q] = y[q]
-        events(t, y, gbuf[0], p)
+        graze = False
         for j in range(n_ev):
-            gbuf[2, j] = 2.0
-            if _side(g1[j]) != side[j]:
-                th = _locate(j, side[j], gbuf[0, j], g1[j], ystart, k1, y_trial, f1, dt, t, p,
-                             ybuf, gbuf[1])
-                gbuf[2, j] = th
-                if th < theta:
-                    theta = th
-                    first = j
+            graze = graze or gbuf[GRAZE_ROW, j] != 0.0
+        if graze:
+            interpolant_events(ystart, k1, y_trial, f1, dt, t, p, ybuf, gbuf)
+        else:
+            events(t, y, gbuf[0], p)
+        for j in range(n_ev):
+            if gbuf[GRAZE_ROW, j] != 0.0:  # may graze, or cross more than once
+                th = first_crossing(j, side[j], g1[j], ystart, k1, y_trial, f1, dt, t, p, ybuf,
+                                    gbuf)
+            elif _side(g1[j]) != side[j]:  # one crossing
+                th = _locate(j, side[j], gbuf[0, j], 1.0, g1[j], ystart, k1, y_trial, f1, dt, t,
+                             p, ybuf, gbuf[1])
+            else:
+                th = 2.0
+            gbuf[2, j] = th
+            if th < theta:
+                theta = th
+                first = j
         if first < 0:
             for q in range(y.size):
                 y[q] = y_trial[q]
