@@ -49,6 +49,7 @@ from geardyn.cli.common import (
     stderr_console,
     usable_omega,
 )
+from geardyn.core.status import Status
 from geardyn.errors import ParameterError, StudyError
 
 __all__ = ["EXIT_ERROR", "EXPECTED_ERRORS", "app", "main"]
@@ -280,7 +281,7 @@ def simulate(
     distinct = count_distinct(ds["poincare"].values, tol=1e-6)
     n_points = ds.sizes["sample"]
     summary = (
-        f"{s.study.name}: Omega = {om:g}, status {'ok' if status == 0 else 'diverged'}, "
+        f"{s.study.name}: Omega = {om:g}, status {Status(status).name.lower()}, "
         f"{distinct} distinct Poincaré point{'s' if distinct != 1 else ''} of {n_points} "
         f"(tol 1e-6), {ds.attrs['steps_per_period']} steps/period"
     )
