@@ -15,6 +15,7 @@ import xarray as xr
 import geardyn
 from geardyn import RunSettings, Status
 from geardyn.core.plan import LanePlan, default_steps_per_period
+from geardyn.core.settings import SettingsError
 from geardyn.core.status import status_meaning
 from geardyn.solvers.ensemble import run_lanes
 
@@ -47,8 +48,9 @@ CORE = Path(geardyn.__file__).parent / "core"
     ("max_section_periods", 0, ValueError, r"max_section_periods must be >= 1 \(got 0\)"),
 ])
 def test_run_settings_name_the_bad_field(field, value, error, message):
-    with pytest.raises(error, match=message):
+    with pytest.raises(error, match=message) as info:
         RunSettings(**{field: value})
+    assert isinstance(info.value, SettingsError)  # a ValueError, for the API's error handling
     with pytest.raises(error, match=message):  # replace validates anew
         RunSettings().replace(**{field: value})
 

@@ -5,7 +5,7 @@ modules above (models, solvers, analysis, io, cli) build on these, never the oth
 """
 
 from geardyn.core.plan import LanePlan
-from geardyn.core.settings import RunSettings
+from geardyn.core.settings import RunSettings, SettingsError
 from geardyn.core.status import Status
 
-__all__ = ["LanePlan", "RunSettings", "Status"]
+__all__ = ["LanePlan", "RunSettings", "SettingsError", "Status"]

@@ -26,19 +26,27 @@ MIN_STEPS = 4
 INTEGRATOR = "RK4, fixed step aligned to the forcing period"
 
 
+class SettingsError(ValueError):
+    """An invalid run setting; the message names the field and the value."""
+
+
+class SettingsTypeError(SettingsError, TypeError):
+    """A run setting of the wrong type (also a ValueError, like every invalid setting)."""
+
+
 def _real(name: str, value: Any) -> float:
     if isinstance(value, bool) or not isinstance(value, numbers.Real):
-        raise TypeError(f"{name} must be a number (got {value!r})")
+        raise SettingsTypeError(f"{name} must be a number (got {value!r})")
     value = float(value)
     if math.isnan(value):
-        raise ValueError(f"{name} must be a number, not NaN (got {value!r})")
+        raise SettingsError(f"{name} must be a number, not NaN (got {value!r})")
     return value
 
 
 def _time(name: str, value: Any) -> float:
     value = _real(name, value)
     if not (math.isfinite(value) and value >= 0):
-        raise ValueError(f"{name} must be a finite time >= 0 (got {value!r})")
+        raise SettingsError(f"{name} must be a finite time >= 0 (got {value!r})")
     return value
 
 
@@ -47,17 +55,17 @@ def _whole(name: str, value: Any, least: int) -> int:
         if isinstance(value, float) and value.is_integer():
             value = int(value)
         else:
-            raise TypeError(f"{name} must be a whole number (got {value!r})")
+            raise SettingsTypeError(f"{name} must be a whole number (got {value!r})")
     value = int(value)
     if value < least:
-        raise ValueError(f"{name} must be >= {least} (got {value!r})")
+        raise SettingsError(f"{name} must be >= {least} (got {value!r})")
     return value
 
 
 def _flag(name: str, value: Any) -> bool:
     if isinstance(value, bool) or (isinstance(value, numbers.Integral) and value in (0, 1)):
         return bool(value)
-    raise TypeError(f"{name} must be True or False (got {value!r})")
+    raise SettingsTypeError(f"{name} must be True or False (got {value!r})")
 
 
 @dataclass(frozen=True)
@@ -115,12 +123,13 @@ class RunSettings:
         put(self, "locate_edges", _flag("locate_edges", self.locate_edges))
         bound = _real("bound", self.bound)
         if not bound > 0:
-            raise ValueError(f"bound must be > 0 (got {bound!r})")
+            raise SettingsError(f"bound must be > 0 (got {bound!r})")
         put(self, "bound", bound)
         if self.converge is not None:
             tol = _real("converge", self.converge)
             if not (math.isfinite(tol) and tol > 0):
-                raise ValueError(f"converge must be a positive tolerance or None (got {tol!r})")
+                raise SettingsError(
+                    f"converge must be a positive tolerance or None (got {tol!r})")
             put(self, "converge", tol)
         for name in ("transient_max", "continued_transient"):
             if getattr(self, name) is not None:
@@ -128,7 +137,7 @@ class RunSettings:
         put(self, "max_period", _whole("max_period", self.max_period, 1))
         ptol = _real("period_tol", self.period_tol)
         if not (math.isfinite(ptol) and ptol > 0):
-            raise ValueError(f"period_tol must be a finite tolerance > 0 (got {ptol!r})")
+            raise SettingsError(f"period_tol must be a finite tolerance > 0 (got {ptol!r})")
         put(self, "period_tol", ptol)
         if self.max_section_periods is not None:
             put(self, "max_section_periods",
