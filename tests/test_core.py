@@ -210,3 +210,26 @@ def test_core_imports_nothing_above_it():
         for name in _geardyn_imports(path):
             assert name == "geardyn.core" or name.startswith("geardyn.core."), (
                 f"{path.name} imports {name}")
+
+
+def test_continued_sweeps_run_equals_keywords(device):
+    sweep = geardyn.ContinuedSweep(device, "Omega", [0.8, 1.0, 1.2], "down", transient=80.0,
+                                   continued_transient=20.0)
+    (old,) = geardyn.continued_sweeps([sweep], samples=3, converge=1e-8, tol=1e-4)
+    (new,) = geardyn.continued_sweeps([sweep], RunSettings(samples=3, converge=1e-8,
+                                                           period_tol=1e-4))
+    xr.testing.assert_identical(old, new)
+    assert new.attrs["continued_transient"] == 20.0 and new.attrs["transient"] == 80.0
+
+
+def test_study_run_table_builds_run_settings():
+    from geardyn.io import builtin_study
+
+    study = builtin_study("paper_fig3")
+    run = study.run_settings(sweep=True, converge=1e-8, transient=None)
+    assert isinstance(run, RunSettings)
+    assert run.transient == study.run.transient and run.converge == 1e-8
+    assert run.samples == (study.sweep.samples or study.run.periods)
+    assert study.run_settings().samples == study.run.periods
+    with pytest.raises(SettingsError, match=r"samples must be >= 1 \(got 0\)"):
+        study.run_settings(samples=0)

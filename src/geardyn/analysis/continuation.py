@@ -21,11 +21,12 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
 from geardyn.core.plan import lane_omega, lane_section, lane_steps
-from geardyn.core.settings import RunSettings
+from geardyn.core.settings import RunSettings, resolve_run
 from geardyn.core.status import Status
 from geardyn.models.base import Model
 from geardyn.solvers.ensemble import LaneResults, run_lanes
@@ -76,13 +77,14 @@ class Branch:
 
 def continue_branches(
     branches: Sequence[Branch],
-    run: RunSettings | int,
+    run: RunSettings | int | None = None,
     progress: Callable[[int, int], None] | None = None,
+    **settings: Any,
 ) -> list[LaneResults]:
     """Run every branch by continuation, all branches together (see the module docs), with the
     ``samples``, ``converge``, ``locate_edges`` and ``bound`` of ``run`` (the branches' own
-    transients and steps apply; an int: the samples, every other setting at its default); the
-    branches must share the model's compiled kernel. Returns one
+    transients and steps apply; an int: the samples), or of the keyword arguments of those
+    names; the branches must share the model's compiled kernel. Returns one
     :class:`~geardyn.solvers.ensemble.LaneResults` per branch, its lanes in the branch's
     order. ``progress(done, total)`` counts points of all branches."""
     if not branches:
@@ -93,8 +95,10 @@ def continue_branches(
     sections = {b.max_section_periods for b in branches}
     if len(sections) > 1:
         raise ValueError("continue_branches: the branches must share max_section_periods")
-    if not isinstance(run, RunSettings):
-        run = RunSettings(samples=run)
+    if isinstance(run, (int, np.integer)):
+        settings["samples"] = run
+        run = None
+    run = resolve_run(run, settings)
     # the branches' transients, steps and section are per lane (below)
     run = run.replace(max_section_periods=branches[0].max_section_periods)
     converge = run.converge_tol
