@@ -5,6 +5,8 @@ coefficient vector for a transient (a time, rounded up to whole forcing periods 
 then records stroboscopic samples and statistics. Lanes sharing a number of steps per period run
 in one parallel kernel call; within it, lanes are advanced in lockstep blocks (see
 ``_kernel_template``). Results do not depend on how lanes are grouped or on the thread count.
+The settings come as one :class:`~geardyn.core.settings.RunSettings`; every step count is
+derived once by :class:`~geardyn.core.plan.LanePlan` (:func:`run_plan` runs a given plan).
 """
 
 from __future__ import annotations
