@@ -233,3 +233,14 @@ def test_study_run_table_builds_run_settings():
     assert study.run_settings().samples == study.run.periods
     with pytest.raises(SettingsError, match=r"samples must be >= 1 \(got 0\)"):
         study.run_settings(samples=0)
+
+
+def test_cli_run_settings_name_the_option():
+    from geardyn.cli.common import run_settings
+    from geardyn.errors import ParameterError
+
+    with pytest.raises(ParameterError, match=r"^--steps-per-period: must be >= 4 \(got 2\)$"):
+        run_settings({"transient": ("--transient", 10.0),
+                      "steps_per_period": ("--steps-per-period", 2)})
+    run = run_settings({"transient": ("--transient", 10.0), "converge": ("--converge", None)})
+    assert run == RunSettings(transient=10.0)
