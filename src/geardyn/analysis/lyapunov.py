@@ -15,10 +15,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from geardyn.core.plan import (
+    default_steps_per_period,
+    forcing_period,
+    lane_steps,
+    periods_covering,
+)
+from geardyn.core.settings import DEFAULT_BOUND, MIN_STEPS
 from geardyn.models.base import Model
-from geardyn.solvers.ensemble import lane_steps_per_period
 from geardyn.solvers.kernels import kernels_for
-from geardyn.solvers.simulate import DEFAULT_BOUND, default_steps_per_period
 
 #: Default step of an autonomous model.
 DEFAULT_DT = 0.01
@@ -71,11 +76,6 @@ def _check_time(name: str, value: float, positive: bool) -> float:
         need = "> 0" if positive else ">= 0"
         raise ValueError(f"{name} must be a finite time {need} (got {value!r})")
     return value
-
-
-def _whole_periods(time: float, period: float) -> int:
-    """Whole periods covering ``time`` (rounded up, tolerant of rounding error)."""
-    return math.ceil(time / period - 1e-9)
 
 
 def _initial(model: Model, y0) -> np.ndarray:
@@ -160,12 +160,12 @@ def lyapunov(
         if dt is not None:
             raise ValueError("dt applies to autonomous models; give steps_per_period instead")
         n_per = int(steps_per_period or default_steps_per_period(model, om))
-        if n_per < 4:
-            raise ValueError(f"steps_per_period must be >= 4 (got {n_per})")
-        period = 2.0 * math.pi / om
+        if n_per < MIN_STEPS:
+            raise ValueError(f"steps_per_period must be >= {MIN_STEPS} (got {n_per})")
+        period = forcing_period(om)
         h = period / n_per
-        n_tr = _whole_periods(transient, period) * n_per
-        n_st = max(1, _whole_periods(duration, period)) * n_per
+        n_tr = periods_covering(transient, period) * n_per
+        n_st = max(1, periods_covering(duration, period)) * n_per
     renorm = int(DEFAULT_RENORM_EVERY if renorm_every is None else renorm_every)
     if renorm < 1:
         raise ValueError(f"renorm_every must be >= 1 (got {renorm_every!r})")
@@ -252,17 +252,12 @@ def lyapunov_lanes(
         OMEGA = np.ascontiguousarray(P[:, model.omega_index])
         if not np.all(OMEGA > 0):
             raise ValueError("every lane needs a forcing frequency Omega > 0")
-        if steps_per_period is None:
-            n_lane = lane_steps_per_period(model, P)
-        else:
-            n_lane = np.full(L, int(steps_per_period), dtype=np.int64)
-        if np.any(n_lane < 4):
-            raise ValueError(f"steps_per_period must be >= 4 (got {steps_per_period})")
-        periods = 2.0 * np.pi / OMEGA
+        n_lane = lane_steps(model, P, steps_per_period)
+        periods = forcing_period(OMEGA)
         H = periods / n_lane
-        n_tr = np.array([_whole_periods(transient, T) * n
+        n_tr = np.array([periods_covering(transient, T) * n
                          for T, n in zip(periods, n_lane, strict=True)], dtype=np.int64)
-        n_st = np.array([max(1, _whole_periods(duration, T)) * n
+        n_st = np.array([max(1, periods_covering(duration, T)) * n
                          for T, n in zip(periods, n_lane, strict=True)], dtype=np.int64)
     renorm = int(DEFAULT_RENORM_EVERY if renorm_every is None else renorm_every)
     if renorm < 1:

@@ -17,11 +17,11 @@ Built-in models (:class:`~geardyn.CATTDevice`, :class:`~geardyn.GearPair`) and a
 from __future__ import annotations
 
 import copy
-import math
 from collections.abc import Sequence
 
 import numpy as np
 
+from geardyn.core.plan import forcing_period
 from geardyn.solvers.kernels import KernelSource
 
 
@@ -123,7 +123,7 @@ class Model:
     @property
     def period(self) -> float | None:
         """Forcing period 2 pi / Omega, or None for an autonomous model."""
-        return None if self.omega == 0.0 else 2.0 * math.pi / self.omega
+        return None if self.omega == 0.0 else forcing_period(self.omega)
 
     # ------------------------------------------------------------------ parameters
     def initial_state(self) -> np.ndarray:
