@@ -16,14 +16,19 @@ Numerics
   scale of each state (:attr:`geardyn.Model.state_scale`, ones by default): a tangent vector v
   (in z) is advanced by the derivative of that step map Phi, by a central difference:
   ``(Phi(y + e s v) - Phi(y - e s v)) / (2 e s)`` (componentwise products and quotient) with
-  ``e |v| = FD_DELTA (1 + |y / s|)`` (Euclidean norms, FD_DELTA = 2^-20 ~ 1e-6), so that the
-  perturbation is ~1e-6 of each state's own scale, not of its unit (in SI body angles 1e-6 rad
-  would be ~0.1 % of a backlash). Exponents do not change under a constant linear change of
-  coordinates, and with s = 1 every operation is the unscaled one (multiplying by 1.0 is
-  exact): results are bitwise those of the unscaled kernel. For a smooth field this is RK4
-  applied to the variational equation v' = J(t, y) v (to O(e^2)); the perturbed states locate
-  their own edge crossings, so a step in which one of them crosses an edge is differentiated
-  correctly and the exponent keeps the solver's order. It is exact for affine step maps
+  ``e |v| = FD_DELTA (1 + min(|y / s|, FD_NORM_CAP))`` (Euclidean norms, FD_DELTA = 2^-20 ~
+  1e-6, FD_NORM_CAP = 2^10), so that the perturbation is ~1e-6 of each state's own scale, not
+  of its unit (in SI body angles 1e-6 rad would be ~0.1 % of a backlash). The term |y / s|
+  keeps the perturbation above the rounding of y (relative error ~ eps / FD_DELTA); the cap
+  keeps it small where a state drifts far from its scale without changing the dynamics (the
+  rigid rotation of a device in body angles: |y / s| ~ 1e5 after 4000 tau of an unbalanced
+  carrier), at a rounding error ~ eps |y / s| / (FD_DELTA FD_NORM_CAP) (2e-7 at 1e6).
+  Exponents do not change under a constant linear change of coordinates, and with s = 1 every
+  operation is the unscaled one (multiplying by 1.0 is exact): below the cap results are
+  bitwise those of the unscaled kernel. For a smooth field this is RK4 applied to the
+  variational equation v' = J(t, y) v (to O(e^2)); the perturbed states locate their own edge
+  crossings, so a step in which one of them crosses an edge is differentiated correctly and the
+  exponent keeps the solver's order. It is exact for affine step maps
   (linear models) up to rounding (~ eps / FD_DELTA ~ 1e-10 relative per step). The vector
   field is continuous across the dead-zone edges, so the flow is C^1 there and no saltation
   matrix is needed.
@@ -72,9 +77,13 @@ from geardyn.solvers._step_core import (  # CORE-IMPORT
 )
 from geardyn.solvers._template_model import events, observe, rhs  # MODEL-IMPORT
 
-#: Relative size of the finite-difference perturbation: e |v| = FD_DELTA (1 + |y / s|), in the
-#: scaled coordinates z = y / s (s: the model's ``state_scale``).
+#: Relative size of the finite-difference perturbation: e |v| = FD_DELTA (1 + min(|y / s|,
+#: FD_NORM_CAP)), in the scaled coordinates z = y / s (s: the model's ``state_scale``).
 FD_DELTA = 2.0**-20
+
+#: Cap on |y / s| in the perturbation size (see the module docstring; no built-in model's
+#: dimensionless state comes near it, so for them it changes nothing).
+FD_NORM_CAP = 2.0**10
 
 # the model interface names are part of the template's namespace (the generated copy re-binds
 # them); only rhs and events are used here
@@ -143,7 +152,7 @@ def _tangent_step(i, t0, Z, S, IS, p, h, omega, n_per, s_tab, c_tab, n_ev, YP, E
     for q in range(ns):
         zq = Z[0, q] * IS[q]
         ny += zq * zq
-    scale = FD_DELTA * (1.0 + math.sqrt(ny))
+    scale = FD_DELTA * (1.0 + min(math.sqrt(ny), FD_NORM_CAP))
     last = 2 * (m - 1)
     for q in range(ns):
         YP[last, q] = Z[0, q]
