@@ -87,6 +87,16 @@ def _initial(model: Model, y0) -> np.ndarray:
     return y
 
 
+def _state_scale(model: Model) -> np.ndarray:
+    """The model's characteristic state scale (:attr:`Model.state_scale`), checked: the
+    tangent vectors of the Lyapunov kernel live in y / scale."""
+    s = np.ascontiguousarray(np.asarray(model.state_scale, dtype=float).ravel())
+    if s.shape != (model.n_states,) or not np.all(np.isfinite(s) & (s > 0)):
+        raise ValueError(f"{type(model).__name__}.state_scale must hold {model.n_states} finite "
+                         f"positive numbers (got {model.state_scale!r})")
+    return s
+
+
 def lyapunov(
     model: Model,
     y0=None,
@@ -172,8 +182,9 @@ def lyapunov(
     k = model.n_states if spectrum else 1
     kern = kernels_for(model.kernel, "lyapunov")
     p = np.ascontiguousarray(model.params, dtype=float)
-    ex, er, used, _status = kern.lyapunov_single(p, y, t0, h, om, n_per, n_tr, n_st, renorm,
-                                                 k, float(bound), model.n_events, n_blk)
+    ex, er, used, _status = kern.lyapunov_single(p, y, _state_scale(model), t0, h, om, n_per,
+                                                 n_tr, n_st, renorm, k, float(bound),
+                                                 model.n_events, n_blk)
     ex = np.asarray(ex, dtype=float)
     er = np.asarray(er, dtype=float)
     if spectrum:
@@ -265,12 +276,13 @@ def lyapunov_lanes(
     out = np.full(L, np.nan)
     err = np.full(L, np.nan)
     if L > 0:
+        scale = _state_scale(model)
         kern = kernels_for(model.kernel, "lyapunov")
         groups = ([(1, np.arange(L))] if model.omega_index is None  # one phase table each
                   else [(int(n), np.nonzero(n_lane == n)[0]) for n in np.unique(n_lane)])
         for n, idx in groups:
             part, part_err = np.full(idx.size, np.nan), np.full(idx.size, np.nan)
-            kern.lyapunov_lanes(P[idx], Y0[idx], T0[idx], H[idx], OMEGA[idx], n,
+            kern.lyapunov_lanes(P[idx], Y0[idx], scale, T0[idx], H[idx], OMEGA[idx], n,
                                 n_tr[idx], n_st[idx], renorm, float(bound), part, part_err,
                                 model.n_events, n_blk)
             out[idx], err[idx] = part, part_err
