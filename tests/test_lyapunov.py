@@ -12,6 +12,7 @@ import geardyn
 from geardyn.analysis.lyapunov import lyapunov, lyapunov_lanes
 from geardyn.io.toml import builtin_study
 from geardyn.models import catt_kernels
+from test_verification_catt import theta_from_mesh
 
 
 @nb.njit(cache=True)
@@ -130,6 +131,133 @@ def test_gear_pair_periodic_reference_not_diverging():
     b = geardyn.reference_solution(model, y_att + np.array([1e-6, 0.0]), t)
     sep = np.abs(a - b).max(axis=1)
     assert sep[-1] < 1e-6 * 0.5
+
+
+# ----------------------------------------------------------------------------- state scale
+#: A chaotic CATT device (N = 4, light damping, large error; found by a scan of Omega with
+#: lyapunov_lanes): exponents well above their errors, so the body-angle model's must match.
+CHAOTIC_CATT = dict(error="30 um", xi1=0.02, xi2=0.02)
+
+
+class _Scaled(geardyn.GearPair):
+    """The gear pair with a chosen state scale."""
+
+    def __init__(self, scale, **kw):
+        super().__init__(**kw)
+        self._scale = np.asarray(scale, dtype=float)
+
+    @property
+    def state_scale(self):
+        return self._scale
+
+
+def test_state_scale_default_and_checked():
+    assert np.array_equal(geardyn.GearPair().state_scale, np.ones(2))
+    assert np.array_equal(lorenz_model().state_scale, np.ones(3))
+    for bad in ([1.0], [1.0, 0.0], [1.0, -2.0], [1.0, np.inf], [1.0, np.nan]):
+        m = _Scaled(bad, **IMPACTING)
+        with pytest.raises(ValueError, match="state_scale"):
+            lyapunov(m, transient=1.0, duration=10.0)
+        with pytest.raises(ValueError, match="state_scale"):
+            lyapunov_lanes(m, m.lane_params("Omega", [1.0]), transient=1.0, duration=10.0)
+
+
+def test_exponent_does_not_depend_on_the_state_scale():
+    # a constant linear change of coordinates z = y / s changes the norm by at most the factor
+    # kappa = max(s) / min(s), so the finite-time exponent by at most 2 log(kappa) / duration
+    # (both measured from aligned vectors), and the limit not at all
+    scale, run = np.array([3.0, 0.25]), dict(transient=200.0, duration=500.0, steps_per_period=64)
+    a = lyapunov(geardyn.GearPair(**IMPACTING), **run)
+    b = lyapunov(_Scaled(scale, **IMPACTING), **run)
+    assert a != b  # the scale reaches the kernel
+    assert abs(a - b) < 2.0 * math.log(scale.max() / scale.min()) / run["duration"]
+    P = geardyn.GearPair(**IMPACTING).params
+    la = lyapunov_lanes(geardyn.GearPair(**IMPACTING), P, **run)
+    lb = lyapunov_lanes(_Scaled(scale, **IMPACTING), P, **run)
+    assert la[0] == pytest.approx(a, rel=1e-12) and lb[0] == pytest.approx(b, rel=1e-12)
+
+
+def test_dimensional_catt_state_scale_is_the_mesh_coordinate_unit():
+    # each body-angle state moved by its scale moves a mesh coordinate (Eq. 8, 9: X = x / b_c,
+    # X' = dX/dtau) by exactly 1 and none by more
+    dm = geardyn.CATTDevice(geardyn.PlanetaryParams.paper()).dimensional()
+    s = dm.state_scale
+    assert s.shape == (dm.n_states,) and np.all(s > 0)
+    y0 = np.zeros(dm.n_states)
+    base = dm.mesh_coordinates(0.0, y0)
+    for q in range(dm.n_states):
+        y = y0.copy()
+        y[q] = s[q]
+        np.testing.assert_allclose(np.max(np.abs(dm.mesh_coordinates(0.0, y) - base)), 1.0,
+                                   rtol=1e-12)
+
+
+def test_dimensional_catt_exponents_match_the_mesh_form():
+    """Eq. (1) in SI body angles and the dimensionless mesh-coordinate form are one physics: the
+    exponents per second are those per unit tau times omega_n. The body-angle model has two more
+    states, the rigid rotation of the whole device (the mesh coordinates do not see it: two zero
+    exponents), and with N = 4 identical planet sets the mesh form's spectrum is that of the
+    general 16-state model, whose in-phase part is the reduced model's. Before the tangent
+    vectors were measured in the state scale, the perturbation (1e-6 rad) was ~0.1 % of the
+    backlash and the lower half of this spectrum was wrong (its sum +0.25 omega_n instead of the
+    divergence -0.44 omega_n)."""
+    c = geardyn.CATTDevice(geardyn.PlanetaryParams.paper(**CHAOTIC_CATT)).with_omega(0.95)
+    wn = c.omega_n
+    x0 = c.expand_state(c.initial_state())
+    dm = c.dimensional()
+    y0 = theta_from_mesh(c, x0)
+    np.testing.assert_allclose(dm.mesh_coordinates(0.0, y0), x0, atol=1e-11)
+    run = dict(transient=1000.0, duration=1000.0, with_error=True)
+    red = lyapunov(c, **run)
+    gen = lyapunov(c.general(), y0=x0, spectrum=True, **run)
+    run = dict(transient=1000.0 / wn, duration=1000.0 / wn, with_error=True)  # seconds
+    dim1 = lyapunov(dm, y0=y0, **run)
+    dim = lyapunov(dm, y0=y0, spectrum=True, **run)
+    # the largest exponent: chaotic, and the same per unit tau within the stated errors
+    assert red.value > 5.0 * red.stderr
+    for d in (dim1, dim):
+        lam, err = np.atleast_1d(d.value)[0] / wn, np.atleast_1d(d.stderr)[0] / wn
+        assert abs(lam - red.value) < 4.0 * math.hypot(err, red.stderr), (lam, red)
+    # the whole spectrum: the general model's and the two rigid-body zeros (their finite-time
+    # values ~ log(1 + duration / transient) / duration ~ 7e-4)
+    expected = np.sort(np.concatenate([gen.value, [0.0, 0.0]]))[::-1]
+    expected_err = np.concatenate([gen.stderr, [0.0, 0.0]])[
+        np.argsort(np.concatenate([gen.value, [0.0, 0.0]]), kind="stable")[::-1]]
+    tol = 4.0 * np.hypot(dim.stderr / wn, expected_err) + 2e-3
+    assert np.all(np.abs(dim.value / wn - expected) < tol), (dim.value / wn, expected, tol)
+
+
+def _divergence(model, y) -> float:
+    """Trace of the Jacobian of the model's rhs at y (t = 0) by central differences (exact for
+    the CATT models: every derivative is linear in the velocities, which carry the damping)."""
+    from geardyn.solvers.kernels import kernels_for
+
+    rhs = kernels_for(model.kernel, "rk4").rhs
+    p = np.ascontiguousarray(model.params)
+    tr, f1, f2 = 0.0, np.empty(model.n_states), np.empty(model.n_states)
+    for q in range(model.n_states):
+        e = 1e-3 * max(abs(y[q]), 1.0)
+        for f, d in ((f1, e), (f2, -e)):
+            yy = y.copy()
+            yy[q] += d
+            rhs(0.0, yy, f, p, 0.0, 1.0)
+        tr += (f1[q] - f2[q]) / (2 * e)
+    return tr
+
+
+def test_dimensional_catt_spectrum_sums_to_the_divergence_after_the_carrier_drifted():
+    """Table 2's torques do not balance: the carrier accelerates (~5.5e3 rad/s^2), and after
+    4000 tau its angle is ~1e5 of its scale b_c / r_c1. The rigid rotation does not change the
+    dynamics, so the perturbation must not grow with it (the cap on |y / s|): the exponents
+    still sum to the divergence of the field (without the cap: off by 6 %, with it 2e-7)."""
+    c = geardyn.CATTDevice(geardyn.PlanetaryParams.paper()).with_omega(1.1)
+    dm = c.dimensional()
+    wn = c.omega_n
+    assert abs(c.carrier_acceleration()) > 1e3
+    y0 = theta_from_mesh(c, c.expand_state(c.initial_state()))
+    lam = lyapunov(dm, y0=y0, transient=4000.0 / wn, duration=200.0 / wn, spectrum=True)
+    tr = _divergence(dm, y0)
+    assert abs(lam.sum() - tr) < 1e-5 * abs(tr), (lam.sum(), tr)  # measured 2.3e-7
 
 
 # ----------------------------------------------------------------------------- steps

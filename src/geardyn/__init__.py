@@ -15,6 +15,8 @@ from geardyn.analysis.map2d import map2d
 from geardyn.analysis.motion import motion_classes
 from geardyn.analysis.periodicity import classify_period, common_section
 from geardyn.analysis.spectrum import amplitude_spectrum, label_peaks
+from geardyn.core.settings import RunSettings
+from geardyn.core.status import Status
 from geardyn.errors import GeardynError, ParameterError, StudyError
 from geardyn.models.base import Model
 from geardyn.models.catt import CATTDevice, DimensionalCATT
@@ -43,6 +45,8 @@ __all__ = [
     "ParameterError",
     "PlanetOverride",
     "PlanetaryParams",
+    "RunSettings",
+    "Status",
     "StudyError",
     "UserModel",
     "amplitude_spectrum",

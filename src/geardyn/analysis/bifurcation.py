@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import functools
-import math
 import os
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
@@ -22,12 +21,16 @@ from geardyn.analysis.lanes import (
 )
 from geardyn.analysis.lyapunov import lyapunov_err_attrs
 from geardyn.analysis.motion import averaging_time, motion_variable
-from geardyn.analysis.periodicity import DEFAULT_MAX_PERIOD, DEFAULT_TOL
+from geardyn.core.plan import forcing_period
+from geardyn.core.settings import RunSettings, resolve_run
+from geardyn.core.status import Status, status_attrs
 from geardyn.models.base import Model
 from geardyn.solvers.ensemble import LaneResults
 from geardyn.solvers.executor import lane_results, run_chunks, run_lanes_task
 from geardyn.solvers.kernels import kernels_for
-from geardyn.solvers.simulate import DEFAULT_BOUND
+
+#: Old keyword names of run settings and the RunSettings field each maps onto.
+ALIASES = {"tol": "period_tol"}
 
 #: Time (model units) the tangent vectors run before the exponent is measured, when it starts from
 #: a point's final (already settled) state.
@@ -47,27 +50,20 @@ def bifurcation(
     model: Model,
     param: str = "Omega",
     values: Sequence[float] | np.ndarray = (),
-    transient: float = 4000.0,
-    samples: int = 200,
+    run: RunSettings | None = None,
+    *,
     continuation: str | None = None,
-    steps_per_period: int | None = None,
     lyapunov: bool = False,
-    max_period: int = DEFAULT_MAX_PERIOD,
-    tol: float = DEFAULT_TOL,
-    y0: np.ndarray | None = None,
     starts: int = 1,
+    y0: np.ndarray | None = None,
     seed: int = 0,
     spread: float = 1.0,
-    locate_edges: bool = True,
-    bound: float = DEFAULT_BOUND,
     progress: Callable[[int, int], None] | None = None,
     chunk: int | None = None,
     client: Any = None,
     store: str | os.PathLike[str] | None = None,
-    converge: float | None = None,
-    transient_max: float | None = None,
-    continued_transient: float | None = None,
     hold: str = "Omega",
+    **settings: Any,
 ) -> xr.Dataset:
     """Sweep ``param`` over ``values`` and classify the steady motion at every point.
 
@@ -77,6 +73,12 @@ def bifurcation(
         ``"Omega"`` (the forcing frequency) or any parameter name the model accepts in
         ``lane_params`` (for :class:`~geardyn.CATTDevice`: ``xi1``, ``xi``, ``backlash``,
         ``error``, ``B1``, ``T_D``, ...).
+    run
+        The run settings, :class:`~geardyn.RunSettings` (default ``RunSettings()``). The old
+        keyword arguments ``transient``, ``samples``, ``steps_per_period``, ``converge``,
+        ``transient_max``, ``continued_transient``, ``max_period``, ``tol`` (the field
+        ``period_tol``), ``locate_edges``, ``bound`` and ``max_section_periods`` still work and
+        build it (not together with ``run``). The settings:
     transient
         Time discarded at every point, in model time units (tau), rounded up to whole periods
         (whole common periods when a second excitation is commensurate with Omega).
@@ -133,40 +135,33 @@ def bifurcation(
     ``docs/lyapunov.md``), and then ``motion`` (param: the motion class of
     :func:`geardyn.analysis.motion.motion_classes`).
     """
+    run = resolve_run(run, settings, aliases=ALIASES)
     values = _check_values(values)
     if continuation not in (None, "up", "down"):
         raise ValueError(f"continuation must be None, 'up' or 'down' (got {continuation!r})")
     if starts < 1 or (starts > 1 and continuation):
         raise ValueError("starts must be >= 1, and 1 with continuation")
-    _check_converge(converge)
     if continuation and (client is not None or store is not None):
         raise ValueError("client and store apply to independent starts, not to continuation")
     P = lane_params_held(model, param, values, hold)
     base_y0 = _initial_states(model, param, values, y0)
     if continuation:
-        sweep = ContinuedSweep(model, param, values, continuation, transient=transient,
-                               continued_transient=continued_transient,
-                               transient_max=transient_max, steps_per_period=steps_per_period,
-                               y0=base_y0, hold=hold)
-        ((ds, last),) = _continued([sweep], samples, converge, max_period, tol, locate_edges,
-                                   bound, progress)
+        sweep = ContinuedSweep(model, param, values, continuation, transient=run.transient,
+                               continued_transient=run.continued_transient,
+                               transient_max=run.transient_max,
+                               steps_per_period=run.steps_per_period, y0=base_y0, hold=hold)
+        ((ds, last),) = _continued([sweep], run, progress)
     else:
-        opts = dict(transient=float(transient), samples=int(samples),
-                    steps_per_period=steps_per_period, locate_edges=bool(locate_edges),
-                    bound=float(bound), transient_max=transient_max,
-                    converge_tol=float(converge or 0.0))
         L, ns = values.size, model.n_states
         rng = np.random.default_rng(seed)
         Y0 = [np.broadcast_to(base_y0, (L, ns))]
         Y0 += [base_y0 + rng.uniform(-spread, spread, (L, ns)) for _ in range(1, starts)]
         every = _independent(model, np.tile(P, (starts, 1)), np.concatenate(Y0), chunk,
-                             progress, client, store, **opts)
+                             progress, client, store, run=run)
         runs = [every.take(slice(s * L, (s + 1) * L)) for s in range(starts)]
         last = runs[0]
-        ds = _dataset(model, param, values, runs, max_period, tol)
-        ds.attrs.update(_settings(transient, samples, converge, transient_max, locate_edges,
-                                  bound, tol, max_period), continuation="none",
-                        starts=int(starts))
+        ds = _dataset(model, param, values, runs, run.max_period, run.period_tol)
+        ds.attrs.update(run.attrs(), continuation="none", starts=int(starts))
         ds = _record_hold(ds, model, param, P, hold)
     if lyapunov:
         from geardyn.analysis.lyapunov import lyapunov_lanes
@@ -176,10 +171,10 @@ def bifurcation(
         # own step; a short run aligns the tangent vectors
         final = last.final
         start = np.where(np.isfinite(final), final, np.broadcast_to(base_y0, final.shape))
-        exps, errs = lyapunov_lanes(model, P, start, min(transient, LYAPUNOV_ALIGN),
-                                    samples * _mean_period(model, P), steps_per_period,
+        exps, errs = lyapunov_lanes(model, P, start, min(run.transient, LYAPUNOV_ALIGN),
+                                    run.samples * _mean_period(model, P), run.steps_per_period,
                                     t0=last.final_time, with_error=True)
-        ok = ds["status"].values == 0
+        ok = ds["status"].values == Status.OK
         method = ("tangent-map QR (Benettin), from the point's final state at its final time, "
                   f"{LYAPUNOV_ALIGN:g} time units to align, then as long as the sampling")
         ds["lyapunov"] = (param, np.where(ok, exps, np.nan), {
@@ -187,7 +182,8 @@ def bifurcation(
             "method": method})
         ds["lyapunov_err"] = (param, np.where(ok & np.isfinite(exps), errs, np.nan),
                               lyapunov_err_attrs(model.time_unit))
-        duration = averaging_time(samples * _mean_period(model, P), P[:, model.omega_index])
+        duration = averaging_time(run.samples * _mean_period(model, P),
+                                  P[:, model.omega_index])
         ds["motion"] = (param, *motion_variable(ds["period"].values, ds["lyapunov"].values,
                                                 ds["lyapunov_err"].values, duration,
                                                 last.commensurate))
@@ -215,30 +211,34 @@ class ContinuedSweep:
 
 def continued_sweeps(
     sweeps: Sequence[ContinuedSweep],
-    samples: int = 200,
-    converge: float | None = None,
-    max_period: int = DEFAULT_MAX_PERIOD,
-    tol: float = DEFAULT_TOL,
-    locate_edges: bool = True,
-    bound: float = DEFAULT_BOUND,
+    run: RunSettings | None = None,
+    *,
     progress: Callable[[int, int], None] | None = None,
-    max_section_periods: int | None = None,
+    **settings: Any,
 ) -> list[xr.Dataset]:
     """Several sweeps by continuation at once (up and down, several studies): the datasets of
     :func:`bifurcation` with ``continuation=direction``, each bitwise what it gets alone, but
     their points advance together as lanes of one kernel call (see
     :mod:`geardyn.analysis.continuation`). Sweeps whose models compile to different kernels
-    run one group after another. ``max_section_periods``: the longest common period of two
-    forcings taken as a section (see :func:`~geardyn.solvers.ensemble.run_lanes`)."""
-    return [ds for ds, _ in _continued(sweeps, samples, converge, max_period, tol,
-                                       locate_edges, bound, progress, max_section_periods)]
+    run one group after another. ``run``: the :class:`~geardyn.RunSettings` shared by the
+    sweeps (samples, converge, max_period, period_tol, locate_edges, bound,
+    max_section_periods; each sweep's transients and step come from the sweep), or the old
+    keyword arguments of those (``tol`` for period_tol)."""
+    run = resolve_run(run, settings, aliases=ALIASES)
+    return [ds for ds, _ in _continued(sweeps, run, progress)]
 
 
-def _continued(sweeps, samples, converge, max_period, tol, locate_edges, bound, progress,
-               max_section_periods=None) -> list[tuple[xr.Dataset, LaneResults]]:
+def _sweep_run(sw: ContinuedSweep, run: RunSettings) -> RunSettings:
+    """``run`` with the transients and step of the sweep ``sw`` (validated there)."""
+    return run.replace(transient=sw.transient, continued_transient=sw.continued_transient,
+                       transient_max=sw.transient_max, steps_per_period=sw.steps_per_period)
+
+
+def _continued(sweeps: Sequence[ContinuedSweep], run: RunSettings,
+               progress: Callable[[int, int], None] | None
+               ) -> list[tuple[xr.Dataset, LaneResults]]:
     """continued_sweeps, with each sweep's lane results (in value order: final states and
     times)."""
-    _check_converge(converge)
     prepared = []
     for sw in sweeps:
         if sw.direction not in ("up", "down"):
@@ -249,10 +249,10 @@ def _continued(sweeps, samples, converge, max_period, tol, locate_edges, bound, 
             order = order[::-1]
         start = _initial_states(sw.model, sw.param, values, sw.y0)
         start = start if start.ndim == 1 else start[order[0]]
+        sr = _sweep_run(sw, run)
         branch = Branch(sw.model, lane_params_held(sw.model, sw.param, values, sw.hold)[order],
-                        start,
-                        float(sw.transient), sw.continued_transient, sw.transient_max,
-                        sw.steps_per_period, max_section_periods)
+                        start, sr.transient, sr.continued_transient, sr.transient_max,
+                        sr.steps_per_period, run.max_section_periods)
         prepared.append((sw, values, order, branch))
     groups: dict[int, list[int]] = {}
     for i, (sw, *_rest) in enumerate(prepared):
@@ -267,8 +267,7 @@ def _continued(sweeps, samples, converge, max_period, tol, locate_edges, bound, 
             if progress is not None:
                 progress(offset + d, total)
 
-        runs = continue_branches([prepared[i][3] for i in members], samples, converge,
-                                 locate_edges, bound, tick)
+        runs = continue_branches([prepared[i][3] for i in members], run, tick)
         for i, r in zip(members, runs, strict=True):
             results[i] = r
             done += r.status.size
@@ -278,12 +277,11 @@ def _continued(sweeps, samples, converge, max_period, tol, locate_edges, bound, 
         back = np.empty_like(order)
         back[order] = np.arange(order.size)
         r = r.take(back)
-        ds = _dataset(sw.model, sw.param, values, [r], max_period, tol)
-        ds.attrs.update(_settings(sw.transient, samples, converge, sw.transient_max,
-                                  locate_edges, bound, tol, max_period),
-                        continuation=sw.direction, starts=1)
-        if sw.continued_transient is not None:
-            ds.attrs["continued_transient"] = float(sw.continued_transient)
+        ds = _dataset(sw.model, sw.param, values, [r], run.max_period, run.period_tol)
+        sr = _sweep_run(sw, run)
+        ds.attrs.update(sr.attrs(), continuation=sw.direction, starts=1)
+        if sr.continued_transient is not None:
+            ds.attrs["continued_transient"] = sr.continued_transient
         ds = _record_hold(ds, sw.model, sw.param, branch.P[back], sw.hold)
         out.append((ds, r))
     return out
@@ -357,11 +355,6 @@ def _check_values(values: Sequence[float] | np.ndarray) -> np.ndarray:
     return values
 
 
-def _check_converge(converge: float | None) -> None:
-    if converge is not None and not converge > 0:
-        raise ValueError(f"converge must be a positive tolerance or None (got {converge!r})")
-
-
 def _initial_states(model: Model, param: str, values: np.ndarray, y0: np.ndarray | None
                     ) -> np.ndarray:
     """``y0``, or the model's initial state (one per value when ``param`` changes it)."""
@@ -370,16 +363,6 @@ def _initial_states(model: Model, param: str, values: np.ndarray, y0: np.ndarray
     if param == "Omega":
         return model.initial_state()
     return np.array([model.with_params(**{param: float(v)}).initial_state() for v in values])
-
-
-def _settings(transient, samples, converge, transient_max, locate_edges, bound, tol,
-              max_period) -> dict[str, Any]:
-    return dict(
-        transient=float(transient), samples=int(samples), converge=float(converge or 0.0),
-        transient_max=float(transient_max if transient_max is not None else 10 * transient),
-        integrator="RK4, fixed step aligned to the forcing period",
-        locate_edges=int(bool(locate_edges)), bound=float(bound), period_tol=float(tol),
-        max_period=int(max_period))
 
 
 def _dataset(model: Model, param: str, values: np.ndarray, runs: list[LaneResults],
@@ -409,7 +392,7 @@ def _dataset(model: Model, param: str, values: np.ndarray, runs: list[LaneResult
                                                    for r in runs[1:]], axis=1)
         ds["period_by_start"] = ((param, "start"), periods)
         ds["start_of_sample"] = ("sample", np.repeat(np.arange(len(runs)), samples))
-    ds["status"] = (param, status, {"meaning": "0 ok, 1 diverged in at least one start"})
+    ds["status"] = (param, status, status_attrs(" in at least one start"))
     ds["final_time"] = (param, first.final_time, {
         "long_name": "model time at the last Poincare sample (the final state)",
         "units": model.time_unit})
@@ -423,7 +406,7 @@ def _dataset(model: Model, param: str, values: np.ndarray, runs: list[LaneResult
 
 
 def _mean_period(model: Model, P: np.ndarray) -> float:
-    return float(np.mean(2.0 * math.pi / P[:, model.omega_index]))
+    return float(np.mean(forcing_period(P[:, model.omega_index])))
 
 
 def _static_forces(model: Model, param: str, values: np.ndarray) -> np.ndarray | None:

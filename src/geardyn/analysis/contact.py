@@ -13,6 +13,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from geardyn.core.status import Status
+
 REGIMES = ("none", "single", "double")
 UNBOUNDED_LABEL = "unbounded"
 
@@ -31,5 +33,5 @@ def contact_regime(event_min: np.ndarray, event_max: np.ndarray, crossings: np.n
     out = np.where(on_drive & on_back, "double", "single").astype(object)
     out[on_drive & ~leaves_drive] = "none"
     out[on_back & ~leaves_back & ~on_drive] = "none"
-    out[np.asarray(status) != 0] = UNBOUNDED_LABEL
+    out[np.asarray(status) != Status.OK] = UNBOUNDED_LABEL
     return out.astype(str)

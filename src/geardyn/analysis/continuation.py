@@ -21,14 +21,16 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
-from geardyn.analysis.periodicity import common_section
+from geardyn.core.plan import lane_omega, lane_section, lane_steps
+from geardyn.core.settings import RunSettings, resolve_run
+from geardyn.core.status import Status
 from geardyn.models.base import Model
-from geardyn.solvers.ensemble import LaneResults, lane_steps_per_period, run_lanes
+from geardyn.solvers.ensemble import LaneResults, run_lanes
 from geardyn.solvers.kernels import kernels_for
-from geardyn.solvers.simulate import DEFAULT_BOUND
 
 __all__ = ["Branch", "continue_branches"]
 
@@ -56,14 +58,10 @@ class Branch:
         P = np.atleast_2d(np.asarray(self.P, dtype=float))
         object.__setattr__(self, "P", P)
         object.__setattr__(self, "y0", np.asarray(self.y0, dtype=float))
-        omega = P[:, self.model.omega_index]
-        limit = ({} if self.max_section_periods is None
-                 else {"max_periods": int(self.max_section_periods)})
-        object.__setattr__(self, "commensurate",
-                           common_section(omega, self.model.other_frequencies(P), **limit)[1])
-        steps = (np.full(omega.size, int(self.steps_per_period), dtype=np.int64)
-                 if self.steps_per_period else lane_steps_per_period(self.model, P))
-        object.__setattr__(self, "steps", steps)
+        omega = lane_omega(self.model, P)
+        object.__setattr__(self, "commensurate", lane_section(
+            self.model, P, omega, self.max_section_periods)[1])
+        object.__setattr__(self, "steps", lane_steps(self.model, P, self.steps_per_period))
 
     def transients(self, j: int, cold: bool, converge: bool) -> tuple[float, float]:
         """(minimum, maximum) transient of point ``j``."""
@@ -79,14 +77,14 @@ class Branch:
 
 def continue_branches(
     branches: Sequence[Branch],
-    samples: int,
-    converge: float | None = None,
-    locate_edges: bool = True,
-    bound: float = DEFAULT_BOUND,
+    run: RunSettings | int | None = None,
     progress: Callable[[int, int], None] | None = None,
+    **settings: Any,
 ) -> list[LaneResults]:
-    """Run every branch by continuation, all branches together (see the module docs); the
-    branches must share the model's compiled kernel. Returns one
+    """Run every branch by continuation, all branches together (see the module docs), with the
+    ``samples``, ``converge``, ``locate_edges`` and ``bound`` of ``run`` (the branches' own
+    transients and steps apply; an int: the samples), or of the keyword arguments of those
+    names; the branches must share the model's compiled kernel. Returns one
     :class:`~geardyn.solvers.ensemble.LaneResults` per branch, its lanes in the branch's
     order. ``progress(done, total)`` counts points of all branches."""
     if not branches:
@@ -97,7 +95,13 @@ def continue_branches(
     sections = {b.max_section_periods for b in branches}
     if len(sections) > 1:
         raise ValueError("continue_branches: the branches must share max_section_periods")
-    converge = float(converge or 0.0)
+    if isinstance(run, (int, np.integer)):
+        settings["samples"] = run
+        run = None
+    run = resolve_run(run, settings)
+    # the branches' transients, steps and section are per lane (below)
+    run = run.replace(max_section_periods=branches[0].max_section_periods)
+    converge = run.converge_tol
     n = [b.P.shape[0] for b in branches]
     total = sum(n)
     parts: list[list[LaneResults]] = [[] for _ in branches]
@@ -112,18 +116,15 @@ def continue_branches(
         lims = [branches[i].transients(j, cold[i], converge > 0) for i in live]
         r = run_lanes(branches[live[0]].model, np.stack([branches[i].P[j] for i in live]),
                       np.stack([np.broadcast_to(y[i], branches[i].y0.shape[-1:]) for i in live]),
-                      transient=np.array([a for a, _ in lims]), samples=samples,
+                      transient=np.array([a for a, _ in lims]),
                       steps_per_period=np.array([branches[i].steps[j] for i in live]),
-                      locate_edges=locate_edges, bound=bound,
                       t0=np.array([t0[i] for i in live]),
-                      transient_max=np.array([b for _, b in lims]),
-                      converge_tol=converge,
-                      max_section_periods=branches[0].max_section_periods)
+                      transient_max=np.array([b for _, b in lims]), run=run)
         for k, i in enumerate(live):
             parts[i].append(r.take(slice(k, k + 1)))
             if converge > 0 and not branches[i].commensurate[j]:
                 parts[i][-1].converged[:] = -1  # no section to test: a fixed transient
-            if r.status[k] == 0:
+            if r.status[k] == Status.OK:
                 y[i], t0[i], cold[i] = r.final[k], float(r.final_time[k]), False
             else:  # lost the branch: restart from the initial state
                 y[i], t0[i], cold[i] = branches[i].y0, 0.0, True

@@ -15,10 +15,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from geardyn.core.plan import (
+    default_steps_per_period,
+    forcing_period,
+    lane_steps,
+    periods_covering,
+)
+from geardyn.core.settings import DEFAULT_BOUND, MIN_STEPS
 from geardyn.models.base import Model
-from geardyn.solvers.ensemble import lane_steps_per_period
 from geardyn.solvers.kernels import kernels_for
-from geardyn.solvers.simulate import DEFAULT_BOUND, default_steps_per_period
 
 #: Default step of an autonomous model.
 DEFAULT_DT = 0.01
@@ -73,11 +78,6 @@ def _check_time(name: str, value: float, positive: bool) -> float:
     return value
 
 
-def _whole_periods(time: float, period: float) -> int:
-    """Whole periods covering ``time`` (rounded up, tolerant of rounding error)."""
-    return math.ceil(time / period - 1e-9)
-
-
 def _initial(model: Model, y0) -> np.ndarray:
     y = np.asarray(model.initial_state() if y0 is None else y0, dtype=float).ravel().copy()
     if y.shape != (model.n_states,):
@@ -85,6 +85,16 @@ def _initial(model: Model, y0) -> np.ndarray:
     if not np.all(np.isfinite(y)):
         raise ValueError("y0 must be finite")
     return y
+
+
+def _state_scale(model: Model) -> np.ndarray:
+    """The model's characteristic state scale (:attr:`Model.state_scale`), checked: the
+    tangent vectors of the Lyapunov kernel live in y / scale."""
+    s = np.ascontiguousarray(np.asarray(model.state_scale, dtype=float).ravel())
+    if s.shape != (model.n_states,) or not np.all(np.isfinite(s) & (s > 0)):
+        raise ValueError(f"{type(model).__name__}.state_scale must hold {model.n_states} finite "
+                         f"positive numbers (got {model.state_scale!r})")
+    return s
 
 
 def lyapunov(
@@ -160,20 +170,21 @@ def lyapunov(
         if dt is not None:
             raise ValueError("dt applies to autonomous models; give steps_per_period instead")
         n_per = int(steps_per_period or default_steps_per_period(model, om))
-        if n_per < 4:
-            raise ValueError(f"steps_per_period must be >= 4 (got {n_per})")
-        period = 2.0 * math.pi / om
+        if n_per < MIN_STEPS:
+            raise ValueError(f"steps_per_period must be >= {MIN_STEPS} (got {n_per})")
+        period = forcing_period(om)
         h = period / n_per
-        n_tr = _whole_periods(transient, period) * n_per
-        n_st = max(1, _whole_periods(duration, period)) * n_per
+        n_tr = periods_covering(transient, period) * n_per
+        n_st = max(1, periods_covering(duration, period)) * n_per
     renorm = int(DEFAULT_RENORM_EVERY if renorm_every is None else renorm_every)
     if renorm < 1:
         raise ValueError(f"renorm_every must be >= 1 (got {renorm_every!r})")
     k = model.n_states if spectrum else 1
     kern = kernels_for(model.kernel, "lyapunov")
     p = np.ascontiguousarray(model.params, dtype=float)
-    ex, er, used, _status = kern.lyapunov_single(p, y, t0, h, om, n_per, n_tr, n_st, renorm,
-                                                 k, float(bound), model.n_events, n_blk)
+    ex, er, used, _status = kern.lyapunov_single(p, y, _state_scale(model), t0, h, om, n_per,
+                                                 n_tr, n_st, renorm, k, float(bound),
+                                                 model.n_events, n_blk)
     ex = np.asarray(ex, dtype=float)
     er = np.asarray(er, dtype=float)
     if spectrum:
@@ -252,17 +263,12 @@ def lyapunov_lanes(
         OMEGA = np.ascontiguousarray(P[:, model.omega_index])
         if not np.all(OMEGA > 0):
             raise ValueError("every lane needs a forcing frequency Omega > 0")
-        if steps_per_period is None:
-            n_lane = lane_steps_per_period(model, P)
-        else:
-            n_lane = np.full(L, int(steps_per_period), dtype=np.int64)
-        if np.any(n_lane < 4):
-            raise ValueError(f"steps_per_period must be >= 4 (got {steps_per_period})")
-        periods = 2.0 * np.pi / OMEGA
+        n_lane = lane_steps(model, P, steps_per_period)
+        periods = forcing_period(OMEGA)
         H = periods / n_lane
-        n_tr = np.array([_whole_periods(transient, T) * n
+        n_tr = np.array([periods_covering(transient, T) * n
                          for T, n in zip(periods, n_lane, strict=True)], dtype=np.int64)
-        n_st = np.array([max(1, _whole_periods(duration, T)) * n
+        n_st = np.array([max(1, periods_covering(duration, T)) * n
                          for T, n in zip(periods, n_lane, strict=True)], dtype=np.int64)
     renorm = int(DEFAULT_RENORM_EVERY if renorm_every is None else renorm_every)
     if renorm < 1:
@@ -270,12 +276,13 @@ def lyapunov_lanes(
     out = np.full(L, np.nan)
     err = np.full(L, np.nan)
     if L > 0:
+        scale = _state_scale(model)
         kern = kernels_for(model.kernel, "lyapunov")
         groups = ([(1, np.arange(L))] if model.omega_index is None  # one phase table each
                   else [(int(n), np.nonzero(n_lane == n)[0]) for n in np.unique(n_lane)])
         for n, idx in groups:
             part, part_err = np.full(idx.size, np.nan), np.full(idx.size, np.nan)
-            kern.lyapunov_lanes(P[idx], Y0[idx], T0[idx], H[idx], OMEGA[idx], n,
+            kern.lyapunov_lanes(P[idx], Y0[idx], scale, T0[idx], H[idx], OMEGA[idx], n,
                                 n_tr[idx], n_st[idx], renorm, float(bound), part, part_err,
                                 model.n_events, n_blk)
             out[idx], err[idx] = part, part_err

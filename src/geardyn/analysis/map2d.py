@@ -30,11 +30,18 @@ from geardyn.analysis.lanes import (
 )
 from geardyn.analysis.lyapunov import lyapunov_err_attrs
 from geardyn.analysis.motion import averaging_time, motion_variable
-from geardyn.analysis.periodicity import DEFAULT_MAX_PERIOD, DEFAULT_TOL, common_section
+from geardyn.core.plan import (
+    default_steps_per_period,
+    forcing_period,
+    ladder_steps,
+    lane_section,
+    periods_covering,
+)
+from geardyn.core.settings import RunSettings, resolve_run
+from geardyn.core.status import Status, status_attrs
 from geardyn.models.base import Model
-from geardyn.solvers.ensemble import ladder_steps, run_lanes
+from geardyn.solvers.ensemble import run_lanes
 from geardyn.solvers.executor import default_chunk, run_chunks
-from geardyn.solvers.simulate import DEFAULT_BOUND, default_steps_per_period
 
 __all__ = ["MapEstimate", "check_steps", "estimate_map", "map2d", "measure_ns_per_lane_step"]
 
@@ -47,12 +54,11 @@ LYAPUNOV_COST = 3.0
 
 # ---------------------------------------------------------------------------- the chunk task
 def _map_task(model: Model, P: np.ndarray, y0: np.ndarray, static: np.ndarray | None = None, *,
-              run: dict[str, Any], max_period: int, tol: float,
-              lyapunov: dict[str, Any] | None) -> dict[str, np.ndarray]:
+              run: RunSettings, lyapunov: dict[str, Any] | None) -> dict[str, np.ndarray]:
     """One chunk of a map: run_lanes, the per-lane analysis, optionally Lyapunov exponents.
     Returns numeric lane-first arrays only (``contact`` as codes into ``CONTACT_LABELS``)."""
-    r = run_lanes(model, P, y0, **run)
-    out = lane_variables(model, r, static, max_period, tol)
+    r = run_lanes(model, P, y0, run=run)
+    out = lane_variables(model, r, static, run.max_period, run.period_tol)
     if "contact" in out:
         codes = {label: k for k, label in enumerate(CONTACT_LABELS)}
         out["contact"] = np.vectorize(codes.__getitem__, otypes=[np.int8])(out["contact"])
@@ -66,7 +72,7 @@ def _map_task(model: Model, P: np.ndarray, y0: np.ndarray, static: np.ndarray | 
                          np.broadcast_to(np.asarray(y0, dtype=float), r.final.shape))
         exps, errs = lyapunov_lanes(model, P, start, t0=r.final_time, with_error=True,
                                     **lyapunov)
-        out["lyapunov"] = np.where(r.status == 0, exps, np.nan)
+        out["lyapunov"] = np.where(r.status == Status.OK, exps, np.nan)
         out["lyapunov_err"] = np.where(np.isfinite(out["lyapunov"]), errs, np.nan)
     return out
 
@@ -109,18 +115,14 @@ def map2d(
     model: Model,
     x: Axis,
     y: Axis,
-    transient: float = 4000.0,
-    samples: int = 200,
+    run: RunSettings | None = None,
+    *,
     lyapunov: bool = False,
     client: Any = None,
     store: str | os.PathLike[str] | None = None,
     chunk: int | None = None,
     progress: Callable[[int, int], None] | None = None,
-    steps_per_period: int | None = None,
-    max_period: int = DEFAULT_MAX_PERIOD,
-    tol: float = DEFAULT_TOL,
-    locate_edges: bool = True,
-    bound: float = DEFAULT_BOUND,
+    **settings: Any,
 ) -> xr.Dataset:
     """Classify the steady motion over the grid ``y x x`` of two model parameters.
 
@@ -129,9 +131,11 @@ def map2d(
     x, y
         ``(name, values)``: ``"Omega"`` or any parameter the model accepts in ``lane_params``
         (for :class:`~geardyn.CATTDevice`: ``xi``, ``xi1``, ``backlash``, ``error``, ``B1``, ...).
-    transient, samples, steps_per_period, max_period, tol, locate_edges, bound
-        As for :func:`~geardyn.bifurcation` (independent starts from each point's own initial
-        state).
+    run
+        :class:`~geardyn.RunSettings`, as for :func:`~geardyn.bifurcation` (independent
+        starts from each point's own initial state; ``samples`` >= 2), or its fields as the
+        old keyword arguments (``transient``, ``samples``, ``steps_per_period``,
+        ``max_period``, ``tol``, ``locate_edges``, ``bound``, ...).
     lyapunov
         Also compute the largest Lyapunov exponent per point (over ``samples`` mean forcing
         periods, on a grid of ``steps_per_period`` steps, default each point's own step rule),
@@ -158,32 +162,28 @@ def map2d(
     counts, and ``lyapunov`` and ``lyapunov_err`` when asked; the settings in ``attrs``
     (``x``, ``y``, ...).
     """
+    run = resolve_run(run, settings, aliases={"tol": "period_tol"})
+    transient, samples, steps_per_period = run.transient, run.samples, run.steps_per_period
     xn, xv = _axis(x, "x")
     yn, yv = _axis(y, "y")
     if model.omega_index is None:
         raise ValueError(f"{model.name} is not periodically forced: a map samples once a period")
     if samples < 2:
         raise ValueError(f"samples must be >= 2 to classify periods (got {samples})")
-    if not (math.isfinite(transient) and transient >= 0):
-        raise ValueError(f"transient must be a finite time >= 0 (got {transient!r})")
     P = model.lane_params_grid(xn, xv, yn, yv)
     check_steps(model, P[:, model.omega_index], transient, samples, steps_per_period)
     Y0 = _per_lane(model, xn, xv, yn, yv, lambda m: m.initial_state())
     inputs = {"P": P, "y0": Y0}
     if has_mesh_forces(model) and model.static_mesh_forces() is not None:
         inputs["static"] = _per_lane(model, xn, xv, yn, yv, lambda m: m.static_mesh_forces())
-    run = dict(transient=float(transient), samples=int(samples),
-               steps_per_period=steps_per_period, locate_edges=bool(locate_edges),
-               bound=float(bound))
     lyap = None
     if lyapunov:
         omega = P[:, model.omega_index]
-        duration = float(samples * np.mean(2.0 * math.pi / omega))
+        duration = float(samples * np.mean(forcing_period(omega)))
         # each lane's own step (lyapunov_lanes: the step rule on the lane's coefficients)
-        lyap = dict(transient=float(transient), duration=duration,
-                    steps_per_period=steps_per_period, bound=float(bound))
-    task = functools.partial(_map_task, run=run, max_period=int(max_period), tol=float(tol),
-                             lyapunov=lyap)
+        lyap = dict(transient=transient, duration=duration,
+                    steps_per_period=steps_per_period, bound=run.bound)
+    task = functools.partial(_map_task, run=run, lyapunov=lyap)
     size = int(chunk) if chunk else default_chunk(P.shape[0])
     meta = {"analysis": "map2d", "model": model.name, "x": xn, "y": yn}
     out = run_chunks(task, model, inputs, chunk=size, client=client, store=store,
@@ -193,9 +193,9 @@ def map2d(
     ds = xr.Dataset(coords={yn: (yn, yv), xn: (xn, xv)})
     if model.meshes:
         ds = ds.assign_coords(mesh=("mesh", [m[0] for m in model.meshes]))
-    dims, attrs = variable_dims(model), variable_attrs(model, max_period, tol)
+    dims, attrs = variable_dims(model), variable_attrs(model, run.max_period, run.period_tol)
     dims.update(status=(), lyapunov=(), lyapunov_err=())
-    attrs.update(status={"meaning": "0 ok, 1 diverged"},
+    attrs.update(status=status_attrs(),
                  lyapunov={"long_name": "largest Lyapunov exponent",
                            "units": f"1/{model.time_unit}",
                            "start": "each point's final state at its final time"},
@@ -209,18 +209,15 @@ def map2d(
         ds[name] = ((yn, xn, *dims[name]), data, attrs[name])
     if lyap is not None:
         period = ds["period"].values.ravel()
-        section = common_section(P[:, model.omega_index], model.other_frequencies(P))[1]
+        section = lane_section(model, P, P[:, model.omega_index], run.max_section_periods)[1]
         labels, motion_attrs = motion_variable(
             period, ds["lyapunov"].values.ravel(), ds["lyapunov_err"].values.ravel(),
             averaging_time(lyap["duration"], P[:, model.omega_index]), section)
         ds["motion"] = ((yn, xn), labels.reshape(ny, nx), motion_attrs)
+    ds.attrs.update(run.attrs())
     ds.attrs.update(
-        model=model.name, x=xn, y=yn, transient=float(transient), samples=int(samples),
-        steps_per_period_setting=int(steps_per_period or 0), lyapunov=int(bool(lyapunov)),
-        integrator="RK4, fixed step aligned to the forcing period",
-        locate_edges=int(bool(locate_edges)), bound=float(bound), period_tol=float(tol),
-        max_period=int(max_period), time_unit=model.time_unit, chunk=size,
-        start="each point from its own model's initial state",
+        model=model.name, x=xn, y=yn, lyapunov=int(bool(lyapunov)), time_unit=model.time_unit,
+        chunk=size, start="each point from its own model's initial state",
     )
     if lyap is not None:
         ds.attrs.update(lyapunov_duration=lyap["duration"],
@@ -283,12 +280,14 @@ def _steps_per_lane(model: Model, omegas: np.ndarray, transient: float, samples:
                     steps_per_period: int | None) -> np.ndarray:
     """RK4 steps of one lane (transient plus samples) at each Omega, as floats (inf where the
     count overflows)."""
-    out = np.empty(len(omegas))
-    with np.errstate(over="ignore", invalid="ignore"):
-        for k, w in enumerate(omegas):
+    om = np.asarray(omegas, dtype=float).ravel()
+    out = np.empty(om.size)
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+        periods = periods_covering(np.full(om.size, float(transient)), forcing_period(om))
+        for k, w in enumerate(om):
             n = float(steps_per_period) if steps_per_period else float(
                 ladder_steps(default_steps_per_period(model, float(w))))
-            out[k] = n * (np.ceil(np.float64(transient) * w / (2 * math.pi) - 1e-9) + samples)
+            out[k] = n * (periods[k] + samples)
     return out
 
 
@@ -323,9 +322,9 @@ def estimate_map(model: Model, lanes: int, omegas: Sequence[float] | np.ndarray,
     steps = lanes * per_lane
     if lyapunov:
         n = int(steps_per_period or default_steps_per_period(model, float(om.min())))
-        duration = samples * float(np.mean(2 * math.pi / om))
-        per = np.mean([n * (math.ceil(transient * w / (2 * math.pi) - 1e-9)
-                            + max(1, math.ceil(duration * w / (2 * math.pi) - 1e-9)))
+        duration = samples * float(np.mean(forcing_period(om)))
+        per = np.mean([n * (periods_covering(transient, forcing_period(float(w)))
+                            + max(1, periods_covering(duration, forcing_period(float(w)))))
                        for w in om])
         steps += LYAPUNOV_COST * lanes * per
     ns, n_par = model.n_states, model.params.size

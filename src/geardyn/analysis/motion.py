@@ -38,6 +38,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from geardyn.core.plan import forcing_period, periods_covering
+
 __all__ = [
     "CHAOTIC",
     "LYAPUNOV_FLOOR",
@@ -161,8 +163,8 @@ def rule_text(z: float = LYAPUNOV_Z, floor: float = LYAPUNOV_FLOOR) -> str:
 def averaging_time(duration: float, omega: np.ndarray) -> np.ndarray:
     """Time each lane's exponent is averaged over when ``duration`` is asked for: whole forcing
     periods 2 pi / omega, rounded up, at least one (as :func:`geardyn.lyapunov` does) [time]."""
-    period = 2.0 * np.pi / np.asarray(omega, dtype=float)
-    return np.maximum(1.0, np.ceil(duration / period - 1e-9)) * period
+    period = forcing_period(np.asarray(omega, dtype=float))
+    return np.maximum(1.0, periods_covering(duration, period)) * period
 
 
 def motion_variable(period: np.ndarray, lyapunov: np.ndarray, lyapunov_err: np.ndarray,

@@ -41,6 +41,7 @@ from geardyn.cli.common import (
     check_run_cost,
     load_study_source,
     make_parents,
+    run_settings,
     stderr_console,
     usable_omega,
 )
@@ -277,21 +278,17 @@ def bifurcation_command(
     n_samples = samples if samples is not None else (
         sweep.samples if sweep is not None and sweep.samples is not None else s.run.periods)
     spp = s.run.steps_per_period if steps_per_period is None else steps_per_period
-    if not (math.isfinite(tr) and tr >= 0):
-        raise ParameterError("--transient", tr, "must be a finite time >= 0")
+    run = run_settings({"transient": ("--transient", tr), "samples": ("--samples", n_samples),
+                        "steps_per_period": ("--steps-per-period", spp),
+                        "converge": ("--converge", converge),
+                        "continued_transient": ("--continued-transient", continued_transient)})
     if n_samples < 2:
         raise ParameterError("--samples", n_samples, "must be >= 2 (the period needs two)")
-    if converge is not None and not (math.isfinite(converge) and 0 < converge < 1):
+    if converge is not None and not converge < 1:
         raise ParameterError("--converge", converge, "must be a tolerance in (0, 1)")
-    if continued_transient is not None:
-        if not (math.isfinite(continued_transient) and continued_transient >= 0):
-            raise ParameterError("--continued-transient", continued_transient,
-                                 "must be a finite time >= 0")
-        if cont == "none":
-            raise ParameterError("--continued-transient", continued_transient,
-                                 "applies to --continuation up or down")
-    if spp is not None and spp < 4:
-        raise ParameterError("--steps-per-period", spp, "must be >= 4")
+    if continued_transient is not None and cont == "none":
+        raise ParameterError("--continued-transient", continued_transient,
+                             "applies to --continuation up or down")
     if hold not in ("Omega", "speed"):
         raise ParameterError("--hold", hold, "must be Omega or speed")
     if hold == "speed" and name in ("Omega", "Lambda"):
@@ -323,10 +320,9 @@ def bifurcation_command(
     show_bar = not quiet and _stderr_is_terminal()
     t0 = time.perf_counter()
     with _progress_bar(show_bar, escape(f"{s.study.name}: {name}")) as callback:
-        ds = bifurcation(model, param=name, values=values, transient=tr, samples=n_samples,
-                         continuation=None if cont == "none" else cont, steps_per_period=spp,
-                         lyapunov=lyap, progress=callback, converge=converge,
-                         continued_transient=continued_transient, hold=hold)
+        ds = bifurcation(model, name, values, run,
+                         continuation=None if cont == "none" else cont,
+                         lyapunov=lyap, progress=callback, hold=hold)
     elapsed = time.perf_counter() - t0
     ds.attrs["study"] = s.study.name
     ds.attrs["plot_state"] = plot_state

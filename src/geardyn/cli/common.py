@@ -99,6 +99,24 @@ def usable_omega(value: float) -> bool:
     return math.isfinite(value) and value > 0 and math.isfinite(2 * math.pi / value)
 
 
+def run_settings(options: dict[str, tuple[str, Any]]):
+    """The :class:`~geardyn.RunSettings` of a command, built once from ``options`` (field ->
+    (option name, value); ``None`` values take the default); an invalid value is a one-line
+    :class:`ParameterError` naming the option."""
+    from geardyn.core.settings import RunSettings
+
+    given = {field: value for field, (_, value) in options.items() if value is not None}
+    try:
+        return RunSettings(**given)
+    except (TypeError, ValueError) as exc:
+        text = str(exc)
+        field, _, reason = text.partition(" ")
+        if field not in options:
+            raise
+        option, value = options[field]
+        raise ParameterError(option, value, reason.rsplit(" (got ", 1)[0]) from None
+
+
 def check_count(option: str, value: int) -> None:
     """A one-line error naming ``option`` when ``value`` exceeds :data:`MAX_COUNT`."""
     if value > MAX_COUNT:

@@ -45,9 +45,11 @@ from geardyn.cli.common import (
     check_run_cost,
     load_study_source,
     make_parents,
+    run_settings,
     stderr_console,
     usable_omega,
 )
+from geardyn.core.status import Status
 from geardyn.errors import ParameterError, StudyError
 
 __all__ = ["EXIT_ERROR", "EXPECTED_ERRORS", "app", "main"]
@@ -238,12 +240,10 @@ def simulate(
     tr = s.run.transient if transient is None else transient
     n_periods = s.run.periods if periods is None else periods
     spp = s.run.steps_per_period if steps_per_period is None else steps_per_period
-    if not (math.isfinite(tr) and tr >= 0):
-        raise ParameterError("--transient", tr, "must be a finite time >= 0")
-    if not 1 <= n_periods <= MAX_COUNT:
+    run = run_settings({"transient": ("--transient", tr), "samples": ("--periods", n_periods),
+                        "steps_per_period": ("--steps-per-period", spp)})
+    if n_periods > MAX_COUNT:
         raise ParameterError("--periods", n_periods, f"must be >= 1 and <= {MAX_COUNT}")
-    if spp is not None and spp < 4:
-        raise ParameterError("--steps-per-period", spp, "must be >= 4")
     if spp is not None:
         check_count("--steps-per-period", spp)
     plot_state = state or s.plot_state
@@ -263,8 +263,7 @@ def simulate(
     err = _stderr()
     with err.status(f"simulating {escape(s.study.name)} at Omega = {om:g} (the first run "
                     "compiles)"):
-        ds = run_simulation(model, omega=om, transient=tr, periods=n_periods,
-                            steps_per_period=spp)
+        ds = run_simulation(model, omega=om, run=run)
     ds.attrs["study"] = s.study.name
     ds.attrs["plot_state"] = plot_state
     written = []
@@ -282,7 +281,7 @@ def simulate(
     distinct = count_distinct(ds["poincare"].values, tol=1e-6)
     n_points = ds.sizes["sample"]
     summary = (
-        f"{s.study.name}: Omega = {om:g}, status {'ok' if status == 0 else 'diverged'}, "
+        f"{s.study.name}: Omega = {om:g}, status {Status(status).name.lower()}, "
         f"{distinct} distinct Poincaré point{'s' if distinct != 1 else ''} of {n_points} "
         f"(tol 1e-6), {ds.attrs['steps_per_period']} steps/period"
     )

@@ -33,6 +33,7 @@ from geardyn.cli.common import (
     check_count,
     load_study_source,
     refuse_if_costly,
+    run_settings,
     usable_omega,
 )
 from geardyn.errors import ParameterError, StudyError
@@ -125,10 +126,8 @@ def map_command(
             check_count(option, count)
     if samples is not None and samples < 2:
         raise ParameterError("--samples", samples, "must be >= 2")
-    if steps_per_period is not None and steps_per_period < 4:
-        raise ParameterError("--steps-per-period", steps_per_period, "must be >= 4")
-    if transient is not None and not (math.isfinite(transient) and transient >= 0):
-        raise ParameterError("--transient", transient, "must be a finite time >= 0")
+    run_settings({"transient": ("--transient", transient),
+                  "steps_per_period": ("--steps-per-period", steps_per_period)})
     s = load_study_source(study)
     model = s.build_model(interpretation=interpretation)
     tr = s.run.transient if transient is None else transient
@@ -180,7 +179,10 @@ def map_command(
                                 ns_per_lane_step=ns, parallel=parallel)
         refuse_if_costly(estimate, "--x/--y", f"{x} x {y}", yes, "map")
         err.print(f"map: {estimate.describe()}")
-        ds = _run(map2d, model, x_axis, y_axis, tr, n_samples, spp, lyapunov, client, out,
+        run = run_settings({"transient": ("--transient", tr),
+                            "samples": ("--samples", n_samples),
+                            "steps_per_period": ("--steps-per-period", spp)})
+        ds = _run(map2d, model, x_axis, y_axis, run, lyapunov, client, out,
                   chunk, err)
     finally:
         if client is not None:
@@ -189,8 +191,7 @@ def map_command(
     _save(ds, out, plot, err)
 
 
-def _run(map2d, model, x_axis, y_axis, transient, samples, spp, lyapunov, client, out, chunk,
-         err):
+def _run(map2d, model, x_axis, y_axis, run, lyapunov, client, out, chunk, err):
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TimeRemainingColumn
 
     xv = np.linspace(x_axis[1], x_axis[2], x_axis[3])
@@ -206,9 +207,8 @@ def _run(map2d, model, x_axis, y_axis, transient, samples, spp, lyapunov, client
         def progress(done: int, total: int) -> None:
             bar.update(task, completed=done, total=total)
 
-        return map2d(model, x=(x_axis[0], xv), y=(y_axis[0], yv), transient=transient,
-                     samples=samples, steps_per_period=spp, lyapunov=lyapunov, client=client,
-                     store=store, chunk=chunk, progress=progress)
+        return map2d(model, (x_axis[0], xv), (y_axis[0], yv), run, lyapunov=lyapunov,
+                     client=client, store=store, chunk=chunk, progress=progress)
 
 
 def _save(ds, out: Path, plot: Path | None, err) -> None:

@@ -58,6 +58,7 @@ __all__ = [
     "GearPairParams",
     "PaperBase",
     "RunSettings",
+    "RunTable",
     "Study",
     "StudyInfo",
     "SweepSettings",
@@ -99,10 +100,11 @@ class StudyInfo(BaseModel):
     )
 
 
-class RunSettings(BaseModel):
+class RunTable(BaseModel):
     """The ``[run]`` table: defaults of ``geardyn simulate`` and ``geardyn bifurcation``
     (command-line options win). ``omega`` is also the fixed Omega of a sweep of another
-    parameter; ``transient`` and ``steps_per_period`` apply to sweeps too."""
+    parameter; ``transient`` and ``steps_per_period`` apply to sweeps too.
+    :meth:`Study.run_settings` turns it into the :class:`geardyn.RunSettings` of a run."""
 
     model_config = _CONFIG
 
@@ -110,6 +112,10 @@ class RunSettings(BaseModel):
     transient: Real = Field(4000.0, ge=0, description="discarded time, dimensionless tau")
     periods: Whole = Field(64, ge=1, description="forcing periods recorded")
     steps_per_period: Whole | None = Field(None, ge=4, description="RK4 steps per period")
+
+
+#: The old name of :class:`RunTable` (not :class:`geardyn.RunSettings`, which it builds).
+RunSettings = RunTable
 
 
 class SweepSettings(BaseModel):
@@ -240,10 +246,25 @@ class Study(BaseModel):
 
     study: StudyInfo = Field(default_factory=StudyInfo)
     params: PlanetaryParams | PaperBase | GearPairParams
-    run: RunSettings = Field(default_factory=RunSettings)
+    run: RunTable = Field(default_factory=RunTable)
     sweep: SweepSettings | None = None
 
     _planetary: PlanetaryParams | None = PrivateAttr(None)
+
+    def run_settings(self, sweep: bool = False, **options: Any):
+        """The :class:`geardyn.RunSettings` of this study: ``transient`` and
+        ``steps_per_period`` of ``[run]``, the samples ``[run].periods`` (with ``sweep``:
+        ``[sweep].samples`` where given), and ``options`` (RunSettings fields; ``None`` keeps
+        the study's value) over them."""
+        from geardyn.core.settings import RunSettings as Settings
+
+        samples = self.run.periods
+        if sweep and self.sweep is not None and self.sweep.samples is not None:
+            samples = self.sweep.samples
+        base = {"transient": self.run.transient, "samples": samples,
+                "steps_per_period": self.run.steps_per_period}
+        base.update({k: v for k, v in options.items() if v is not None})
+        return Settings(**base)
 
     @model_validator(mode="before")
     @classmethod

@@ -17,11 +17,11 @@ Built-in models (:class:`~geardyn.CATTDevice`, :class:`~geardyn.GearPair`) and a
 from __future__ import annotations
 
 import copy
-import math
 from collections.abc import Sequence
 
 import numpy as np
 
+from geardyn.core.plan import forcing_period
 from geardyn.solvers.kernels import KernelSource
 
 
@@ -85,6 +85,14 @@ class Model:
         ``fastest_natural_frequency``), with edges located, ends ok and matches the reference
         integrator (:func:`~geardyn.reference_solution`, DOP853 at rtol 1e-12) in the states
         and the observables.
+
+    Characteristic scales (not a numbered rule; optional): :attr:`state_scale` gives, per
+    state, the size of a physically significant change of that state, in the state's own units
+    (e.g. the rad that moves a mesh by the nominal displacement b_c). It must be a float vector
+    of ``n_states`` finite positive entries (default: ones, for a model whose states are already
+    of order one in its units). The Lyapunov kernel measures tangent vectors in y / state_scale
+    and sizes its finite-difference perturbation there (``docs/lyapunov.md``): exponents do not
+    depend on it, but their accuracy does when states have very different units.
     """
 
     name: str = "model"
@@ -114,6 +122,13 @@ class Model:
     def n_observables(self) -> int:
         return len(self.observable_names)
 
+    @property
+    def state_scale(self) -> np.ndarray:
+        """Characteristic scale of each state, in the state's own units (``state_units``):
+        ``n_states`` positive numbers, the size of a significant change of that state. Default
+        ones. The Lyapunov kernel works in the coordinates y / state_scale (see the contract)."""
+        return np.ones(self.n_states)
+
     # ------------------------------------------------------------------ forcing
     @property
     def omega(self) -> float:
@@ -123,7 +138,7 @@ class Model:
     @property
     def period(self) -> float | None:
         """Forcing period 2 pi / Omega, or None for an autonomous model."""
-        return None if self.omega == 0.0 else 2.0 * math.pi / self.omega
+        return None if self.omega == 0.0 else forcing_period(self.omega)
 
     # ------------------------------------------------------------------ parameters
     def initial_state(self) -> np.ndarray:

@@ -573,6 +573,20 @@ class DimensionalCATT(Model):
         A[:, pp, pp] = rp * kp * rp / jp
         return np.sqrt(np.max(np.abs(np.linalg.eigvals(A)), axis=1))
 
+    @property
+    def state_scale(self) -> np.ndarray:
+        """Characteristic scale of each body-angle state [rad, rad/s]: the angle that moves its
+        mesh by the nominal displacement b_c (b_c / r_c1 for the carrier, b_c / r_bq_i and
+        b_c / r_bp_i for the planets), and for a rate that angle times omega_n, so that y / scale
+        is of the size of the dimensionless mesh coordinates X = x / b_c and X' = dX/dtau."""
+        prm = self.device.params_in
+        d = self.device.derived
+        radii = [prm.carrier.r_c1]
+        for i in range(prm.n_planets):
+            radii += [d.r_bq[i], d.r_bp[i]]
+        angle = prm.b_c / np.asarray(radii, dtype=float)
+        return np.stack([angle, angle * d.omega_n], axis=1).ravel()
+
     def mesh_coordinates(self, t: np.ndarray, y: np.ndarray) -> np.ndarray:
         """Dimensionless mesh coordinates and their tau-derivatives (Eq. 8, 9) of body-angle states
         y[..., state] at times t [s], in the general CATTDevice state order."""

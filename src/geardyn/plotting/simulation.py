@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
+from geardyn.core.status import Status
 from geardyn.plotting.style import RC, state_label, unit_text
 
 __all__ = ["plot_simulation", "resolve_state", "velocity_of"]
@@ -130,7 +131,7 @@ def plot_simulation(ds: xr.Dataset, state: str = "X_sq", path: str | os.PathLike
     pc_v = _poincare(ds, vname) if vname is not None else np.array([])
     a = ds.attrs
     omega = a.get("Omega", float("nan"))
-    status = int(a.get("status", 0))
+    status = Status(int(a.get("status", Status.OK)))
 
     with matplotlib.rc_context(RC):
         fig = Figure(figsize=(10.0, 7.0), layout="constrained")
@@ -170,7 +171,7 @@ def plot_simulation(ds: xr.Dataset, state: str = "X_sq", path: str | os.PathLike
             f"{model}{interp}: $\\Omega$ = {omega:.6g}; {a.get('integrator', 'integrator ?')}, "
             f"{a.get('steps_per_period', '?')} steps per period"
         )
-        if status != 0:
+        if status != Status.OK:
             title += "  [DIVERGED]"
         fig.suptitle(title)
         if path is not None:

@@ -20,6 +20,7 @@ from geardyn.analysis.bifurcation import ContinuedSweep, continued_sweeps
 from geardyn.analysis.lyapunov import lyapunov_err_attrs, lyapunov_lanes
 from geardyn.analysis.motion import LYAPUNOV_FLOOR, LYAPUNOV_Z, exponent_sign, rule_text
 from geardyn.analysis.periodicity import common_section
+from geardyn.core.settings import RunSettings
 from geardyn.models.base import Model
 from geardyn.reproduction.cases import Case
 from geardyn.reproduction.motion import motion_labels
@@ -84,6 +85,15 @@ class ReproductionSettings:
             value = getattr(self, name)
             if not (np.isfinite(value) and value > 0):
                 raise ValueError(f"{name}: must be a finite time > 0 (got {value!r})")
+
+    def run_settings(self, case: Case) -> RunSettings:
+        """The :class:`~geardyn.RunSettings` of ``case``'s sweeps (by continuation:
+        ``transient`` is the longest transient, ``continued_transient`` the shortest)."""
+        r = self.resolve(case)
+        return case.study.run_settings(
+            transient=r["transient"], samples=r["samples"], converge=self.converge,
+            continued_transient=min(r["min_transient"], r["transient"]),
+            transient_max=r["transient"], max_section_periods=self.max_section_periods)
 
     def resolve(self, case: Case) -> dict[str, float | int]:
         """The settings for ``case`` with the study's defaults filled in."""
@@ -158,12 +168,13 @@ def _sweeps(tasks: list[tuple[Case, str, str]], settings: ReproductionSettings,
     plans = []
     for case, interp, direction in tasks:
         r = settings.resolve(case)
+        run = settings.run_settings(case)
         model = case.study.build_model(interpretation=interp)
         sweep = ContinuedSweep(
-            model, "Omega", sweep_values(case, settings), direction, transient=r["transient"],
-            continued_transient=min(r["min_transient"], r["transient"]),
-            transient_max=r["transient"], steps_per_period=case.study.run.steps_per_period)
-        plans.append((sweep, r))
+            model, "Omega", sweep_values(case, settings), direction, transient=run.transient,
+            continued_transient=run.continued_transient, transient_max=run.transient_max,
+            steps_per_period=run.steps_per_period)
+        plans.append((sweep, r, run))
     case0, interp0, _ = tasks[0]
     label = (f"{case0.name} {interp0} up and down" if len(tasks) == 2
              else f"{len(tasks)} sweeps together")
@@ -174,17 +185,16 @@ def _sweeps(tasks: list[tuple[Case, str, str]], settings: ReproductionSettings,
 
     swept: list[xr.Dataset] = [xr.Dataset()] * len(tasks)
     groups: dict[int, list[int]] = {}  # one continuation per number of samples
-    for i, (_, r) in enumerate(plans):
-        groups.setdefault(r["samples"], []).append(i)
-    for samples, members in groups.items():
-        done = continued_sweeps([plans[i][0] for i in members], samples=samples,
-                                converge=settings.converge, progress=tick,
-                                max_section_periods=settings.max_section_periods)
+    for i, (_, _r, run) in enumerate(plans):
+        groups.setdefault(run.samples, []).append(i)
+    for members in groups.values():
+        done = continued_sweeps([plans[i][0] for i in members], plans[members[0]][2],
+                                progress=tick)
         for i, ds in zip(members, done, strict=True):
             swept[i] = ds
     joint = time.perf_counter() - start
     out = []
-    for ds, (sweep, r) in zip(swept, plans, strict=True):
+    for ds, (sweep, r, _run) in zip(swept, plans, strict=True):
         ds = _classify(ds, sweep, r)
         ds.attrs.update(continuation_wall_time_s=joint, continued_with=len(tasks))
         out.append(ds)

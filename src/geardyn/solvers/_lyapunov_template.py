@@ -12,14 +12,26 @@ Numerics
   any ``h``), with the crossings of the ``n_ev`` switching functions located inside a step and
   the step split there, as in :mod:`geardyn.solvers._kernel_template` (shared
   :mod:`._step_core`).
-* Each tangent vector v is advanced by the derivative of that step map Phi, by a central
-  difference: ``(Phi(y + e v) - Phi(y - e v)) / (2 e)`` with ``e |v| = FD_DELTA (1 + |y|)``
-  (Euclidean norms, FD_DELTA = 2^-20 ~ 1e-6). For a smooth field this is RK4 applied to the
+* The tangent vectors live in the scaled coordinates z = y / s, s the model's characteristic
+  scale of each state (:attr:`geardyn.Model.state_scale`, ones by default): a tangent vector v
+  (in z) is advanced by the derivative of that step map Phi, by a central difference:
+  ``(Phi(y + e s v) - Phi(y - e s v)) / (2 e s)`` (componentwise products and quotient) with
+  ``e |v| = FD_DELTA (1 + min(|y / s|, FD_NORM_CAP))`` (Euclidean norms, FD_DELTA = 2^-20 ~
+  1e-6, FD_NORM_CAP = 2^10), so that the perturbation is ~1e-6 of each state's own scale, not
+  of its unit (in SI body angles 1e-6 rad would be ~0.1 % of a backlash). The term |y / s|
+  keeps the perturbation above the rounding of y (relative error ~ eps / FD_DELTA); the cap
+  keeps it small where a state drifts far from its scale without changing the dynamics (the
+  rigid rotation of a device in body angles: |y / s| ~ 1e5 after 4000 tau of an unbalanced
+  carrier), at a rounding error ~ eps |y / s| / (FD_DELTA FD_NORM_CAP) (2e-7 at 1e6).
+  Exponents do not change under a constant linear change of coordinates, and with s = 1 every
+  operation is the unscaled one (multiplying by 1.0 is exact): below the cap results are
+  bitwise those of the unscaled kernel. For a smooth field this is RK4 applied to the
   variational equation v' = J(t, y) v (to O(e^2)); the perturbed states locate their own edge
   crossings, so a step in which one of them crosses an edge is differentiated correctly and the
-  exponent keeps the solver's order. It is exact for affine step maps (linear models) up to
-  rounding (~ eps / FD_DELTA ~ 1e-10 relative per step). The vector field is continuous across
-  the dead-zone edges, so the flow is C^1 there and no saltation matrix is needed.
+  exponent keeps the solver's order. It is exact for affine step maps
+  (linear models) up to rounding (~ eps / FD_DELTA ~ 1e-10 relative per step). The vector
+  field is continuous across the dead-zone edges, so the flow is C^1 there and no saltation
+  matrix is needed.
 * Every ``renorm_every`` steps (and at the end of the transient and of the run) the tangent
   vectors are re-orthonormalised by modified Gram-Schmidt (a QR factorisation); the logs of the
   diagonal of R are summed over the measuring window (Benettin et al. 1980; Shimada & Nagashima
@@ -65,8 +77,13 @@ from geardyn.solvers._step_core import (  # CORE-IMPORT
 )
 from geardyn.solvers._template_model import events, observe, rhs  # MODEL-IMPORT
 
-#: Relative size of the finite-difference perturbation: e |v| = FD_DELTA (1 + |y|).
+#: Relative size of the finite-difference perturbation: e |v| = FD_DELTA (1 + min(|y / s|,
+#: FD_NORM_CAP)), in the scaled coordinates z = y / s (s: the model's ``state_scale``).
 FD_DELTA = 2.0**-20
+
+#: Cap on |y / s| in the perturbation size (see the module docstring; no built-in model's
+#: dimensionless state comes near it, so for them it changes nothing).
+FD_NORM_CAP = 2.0**10
 
 # the model interface names are part of the template's namespace (the generated copy re-binds
 # them); only rhs and events are used here
@@ -124,16 +141,18 @@ def _grid_step_rows(i, t0, Y, p, h, omega, n_per, s_tab, c_tab, n_ev, K, TMP, Y1
 
 
 @nb.njit(**_JIT)
-def _tangent_step(i, t0, Z, p, h, omega, n_per, s_tab, c_tab, n_ev, YP, E, K, TMP, Y1, SIDE, G0, G1,
-                  W, gbuf, ncross):
-    """Advance the state (row 0 of Z) by one grid step and each tangent vector v (rows 1..) by
-    the derivative of that step map: (Phi(y + e v) - Phi(y - e v)) / (2 e). The 2 k + 1 states
-    are the rows of YP (tangent j: rows 2 j - 2 and 2 j - 1; the state: the last row)."""
+def _tangent_step(i, t0, Z, S, IS, p, h, omega, n_per, s_tab, c_tab, n_ev, YP, E, K, TMP, Y1,
+                  SIDE, G0, G1, W, gbuf, ncross):
+    """Advance the state y (row 0 of Z) by one grid step and each tangent vector v (rows 1..,
+    in the scaled coordinates z = y / S; IS = 1 / S) by the derivative of that step map:
+    (Phi(y + e S v) - Phi(y - e S v)) / (2 e S). The 2 k + 1 states are the rows of YP
+    (tangent j: rows 2 j - 2 and 2 j - 1; the state: the last row)."""
     m, ns = Z.shape
     ny = 0.0
     for q in range(ns):
-        ny += Z[0, q] * Z[0, q]
-    scale = FD_DELTA * (1.0 + math.sqrt(ny))
+        zq = Z[0, q] * IS[q]
+        ny += zq * zq
+    scale = FD_DELTA * (1.0 + min(math.sqrt(ny), FD_NORM_CAP))
     last = 2 * (m - 1)
     for q in range(ns):
         YP[last, q] = Z[0, q]
@@ -151,8 +170,9 @@ def _tangent_step(i, t0, Z, p, h, omega, n_per, s_tab, c_tab, n_ev, YP, E, K, TM
         e = scale / nv
         E[j] = e
         for q in range(ns):
-            YP[2 * j - 2, q] = Z[0, q] + e * Z[j, q]
-            YP[2 * j - 1, q] = Z[0, q] - e * Z[j, q]
+            d = e * (S[q] * Z[j, q])
+            YP[2 * j - 2, q] = Z[0, q] + d
+            YP[2 * j - 1, q] = Z[0, q] - d
     _grid_step_rows(i, t0, YP, p, h, omega, n_per, s_tab, c_tab, n_ev, K, TMP, Y1, SIDE, G0, G1, W,
                     gbuf, ncross)
     for j in range(1, m):
@@ -162,7 +182,7 @@ def _tangent_step(i, t0, Z, p, h, omega, n_per, s_tab, c_tab, n_ev, YP, E, K, TM
             continue
         inv = 0.5 / E[j]
         for q in range(ns):
-            Z[j, q] = (YP[2 * j - 2, q] - YP[2 * j - 1, q]) * inv
+            Z[j, q] = ((YP[2 * j - 2, q] - YP[2 * j - 1, q]) * inv) * IS[q]
     for q in range(ns):
         Z[0, q] = YP[last, q]
 
@@ -248,12 +268,16 @@ def _block_stderr(blk, ends, h, err):
 
 
 @nb.njit(**_JIT)
-def _run(p, y0, t0, h, omega, n_per, s_tab, c_tab, n_transient, n_steps, renorm_every, k,
+def _run(p, y0, S, t0, h, omega, n_per, s_tab, c_tab, n_transient, n_steps, renorm_every, k,
          bound, n_ev, n_blocks):
     """Exponents (sum of logs / measured time), their standard errors (from up to ``n_blocks``
     blocks of whole forcing periods of the measuring window), the number of blocks and the
-    status of one lane, started at time t0 (forcing phase zero there)."""
+    status of one lane, started at time t0 (forcing phase zero there); tangent vectors in the
+    coordinates y / S (S: the state scale)."""
     ns = y0.size
+    IS = np.empty(ns)
+    for q in range(ns):
+        IS[q] = 1.0 / S[q]
     m = k + 1
     Z = np.zeros((m, ns))
     W = np.zeros((9, ns))
@@ -289,8 +313,8 @@ def _run(p, y0, t0, h, omega, n_per, s_tab, c_tab, n_transient, n_steps, renorm_
     since = 0
     cur = 0  # the block being measured
     for i in range(total):
-        _tangent_step(i, t0, Z, p, h, omega, n_per, s_tab, c_tab, n_ev, YP, E, K, TMP, Y1, SIDE,
-                      G0, G1, W, gbuf, ncross)
+        _tangent_step(i, t0, Z, S, IS, p, h, omega, n_per, s_tab, c_tab, n_ev, YP, E, K, TMP, Y1,
+                      SIDE, G0, G1, W, gbuf, ncross)
         since += 1
         step = i + 1
         measure = step > n_transient
@@ -324,11 +348,13 @@ def _run(p, y0, t0, h, omega, n_per, s_tab, c_tab, n_transient, n_steps, renorm_
 
 
 @nb.njit(**_JIT)
-def lyapunov_single(p, y0, t0, h, omega, n_per, n_transient, n_steps, renorm_every, k,
+def lyapunov_single(p, y0, scale, t0, h, omega, n_per, n_transient, n_steps, renorm_every, k,
                     bound, n_ev=0, n_blocks=16):
     """The k leading Lyapunov exponents (per unit time of the model) of one parameter set.
 
-    Grid: step h (= 2 pi / (omega n_per) for a forced model); the state y0 is given at time t0,
+    ``scale``: the characteristic scale of each state (``Model.state_scale``, positive; ones give
+    the unscaled kernel); the tangent vectors live in y / scale. Grid: step h (= 2 pi /
+    (omega n_per) for a forced model); the state y0 is given at time t0,
     where the forcing phase is zero; ``n_transient`` steps are discarded and ``n_steps``
     measured. ``n_ev``: the model's number of switching functions, whose crossings are located
     inside a step (0: none located). Returns (exponents[k], stderr[k], blocks, status): the
@@ -336,16 +362,17 @@ def lyapunov_single(p, y0, t0, h, omega, n_per, n_transient, n_steps, renorm_eve
     ``blocks`` of them used); exponents are NaN if diverged.
     """
     s_tab, c_tab = phase_table(n_per, omega != 0.0)
-    return _run(p, y0, t0, h, omega, n_per, s_tab, c_tab, n_transient, n_steps,
+    return _run(p, y0, scale, t0, h, omega, n_per, s_tab, c_tab, n_transient, n_steps,
                 renorm_every, k, bound, n_ev, n_blocks)
 
 
 @nb.njit(parallel=True, **_JIT)
-def lyapunov_lanes(P, Y0, T0, H, OMEGA, n_per, n_transient, n_steps, renorm_every, bound,
+def lyapunov_lanes(P, Y0, scale, T0, H, OMEGA, n_per, n_transient, n_steps, renorm_every, bound,
                    out, err, n_ev=0, n_blocks=16):
     """Largest exponent of every lane (row of P, Y0), in parallel over lanes.
 
-    T0: start time (forcing phase zero there, as in :func:`lyapunov_single`) per lane; H, OMEGA:
+    scale: the state scale (one vector for all lanes, as in :func:`lyapunov_single`); T0: start
+    time (forcing phase zero there, as in :func:`lyapunov_single`) per lane; H, OMEGA:
     step and forcing frequency per lane; n_transient, n_steps: per-lane step counts (int
     arrays); n_ev and n_blocks as in :func:`lyapunov_single`. Fills out[L] and err[L] (the
     standard error; NaN for diverged lanes).
@@ -357,8 +384,8 @@ def lyapunov_lanes(P, Y0, T0, H, OMEGA, n_per, n_transient, n_steps, renorm_ever
             forced = True
     s_tab, c_tab = phase_table(n_per, forced)
     for lane in nb.prange(L):
-        ex, er, _nb, st = _run(P[lane], Y0[lane], T0[lane], H[lane], OMEGA[lane], n_per, s_tab,
-                               c_tab, n_transient[lane], n_steps[lane], renorm_every, 1, bound,
-                               n_ev, n_blocks)
+        ex, er, _nb, st = _run(P[lane], Y0[lane], scale, T0[lane], H[lane], OMEGA[lane], n_per,
+                               s_tab, c_tab, n_transient[lane], n_steps[lane], renorm_every, 1,
+                               bound, n_ev, n_blocks)
         out[lane] = ex[0] if st == STATUS_OK else np.nan
         err[lane] = er[0] if st == STATUS_OK else np.nan

@@ -5,42 +5,25 @@ coefficient vector for a transient (a time, rounded up to whole forcing periods 
 then records stroboscopic samples and statistics. Lanes sharing a number of steps per period run
 in one parallel kernel call; within it, lanes are advanced in lockstep blocks (see
 ``_kernel_template``). Results do not depend on how lanes are grouped or on the thread count.
+The settings come as one :class:`~geardyn.core.settings.RunSettings`; every step count is
+derived once by :class:`~geardyn.core.plan.LanePlan` (:func:`run_plan` runs a given plan).
 """
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
 
+from geardyn.core.plan import (  # noqa: F401  (the step rule's old home)
+    _LADDER,
+    LanePlan,
+    ladder_steps,
+    lane_steps_per_period,
+)
+from geardyn.core.settings import RunSettings
 from geardyn.models.base import Model
 from geardyn.solvers.kernels import kernels_for
-from geardyn.solvers.simulate import DEFAULT_BOUND, steps_per_period_rule
-
-#: Automatic steps per period are rounded up to this geometric ladder (ratio 2^(1/4)), so that a
-#: sweep over Omega needs only a few kernel calls.
-_LADDER = np.unique(np.ceil(8 * 2.0 ** (np.arange(0, 60) / 4.0)).astype(int) * 2)
-
-
-def ladder_steps(n: int) -> int:
-    """The smallest value of the step ladder that is >= n."""
-    idx = np.searchsorted(_LADDER, n)
-    return int(_LADDER[min(idx, _LADDER.size - 1)]) if idx < _LADDER.size else int(n)
-
-
-def lane_steps_per_period(model: Model, P: np.ndarray) -> np.ndarray:
-    """Default steps per forcing period of each lane (row of ``P``), rounded up to the ladder:
-    the rule of :func:`~geardyn.solvers.simulate.default_steps_per_period` with the lane's own
-    Omega, other forcings and fastest natural frequency (from the lane's coefficients, so a
-    sweep over a stiffness or a mass refines the step where the device is stiffer)."""
-    P = np.atleast_2d(P)
-    n = steps_per_period_rule(model, P, P[:, model.omega_index])
-    if not np.all(np.isfinite(n)) or np.any(n >= 2.0**62):
-        raise OverflowError("steps per period do not fit an integer; check Omega")
-    idx = np.searchsorted(_LADDER, n)  # as ladder_steps, for every lane at once
-    return np.where(idx < _LADDER.size, _LADDER[np.minimum(idx, _LADDER.size - 1)],
-                    n).astype(np.int64)
 
 
 @dataclass
@@ -50,7 +33,7 @@ class LaneResults:
     samples: np.ndarray  # (L, n_samples, n_states); NaN for diverged lanes
     final: np.ndarray  # (L, n_states) state at the end
     final_time: np.ndarray  # (L,) model time at the end
-    status: np.ndarray  # (L,) 0 ok, 1 diverged
+    status: np.ndarray  # (L,) geardyn.core.status.Status codes
     event_min: np.ndarray  # (L, n_events) over the sampled stretch
     event_max: np.ndarray
     crossings: np.ndarray  # (L, n_events) located edge crossings while sampling
@@ -79,75 +62,72 @@ def run_lanes(
     model: Model,
     P: np.ndarray,
     y0: np.ndarray,
-    transient: float | np.ndarray,
-    samples: int,
+    transient: float | np.ndarray | None = None,
+    samples: int | None = None,
     steps_per_period: int | np.ndarray | None = None,
     sample_every: int | np.ndarray | str = "auto",
-    locate_edges: bool = True,
-    bound: float = DEFAULT_BOUND,
+    locate_edges: bool | None = None,
+    bound: float | None = None,
     t0: np.ndarray | None = None,
     transient_max: float | np.ndarray | None = None,
-    converge_tol: float = 0.0,
+    converge_tol: float | None = None,
     converge_depth: int = 16,
     max_section_periods: int | None = None,
+    *,
+    run: RunSettings | None = None,
 ) -> LaneResults:
     """Integrate one lane per row of ``P`` (coefficient vectors) from ``y0`` (one state, or one
     per lane) and return stroboscopic samples (one every ``sample_every`` forcing periods) and
-    statistics over the sampled stretch. ``t0``: per-lane start times (whole periods);
-    ``transient``, ``transient_max``, ``steps_per_period`` (<= 0: automatic) and
-    ``sample_every`` may differ per lane; ``"auto"`` samples at the common period of the
-    forcings when the model has a second, commensurate excitation
-    (:func:`~geardyn.analysis.periodicity.common_section`), else every period. The transient is
-    rounded up to whole sampling intervals.
+    statistics over the sampled stretch, under the settings ``run``
+    (:class:`~geardyn.core.settings.RunSettings`) or, for compatibility, the same settings as
+    keyword arguments (``converge_tol``: ``converge``, 0 off). ``t0``: per-lane start times
+    (whole periods); ``transient``, ``transient_max`` and ``steps_per_period`` (<= 0:
+    automatic) may be arrays, one value per lane (then they override ``run``'s), and so may
+    ``sample_every``; ``"auto"`` samples at the common period of the forcings when the model has
+    a second, commensurate excitation (:func:`~geardyn.core.section.common_section`, up to
+    ``max_section_periods``), else every period. The transient is rounded up to whole sampling
+    intervals. Everything is planned once by :class:`~geardyn.core.plan.LanePlan`.
 
-    Transient by convergence: with ``converge_tol > 0`` the transient (then a minimum) goes on,
-    one sampling interval at a time up to ``transient_max`` (default 10 x transient), until the
-    section point is estimated within ``converge_tol (1 + |point|)`` of a periodic orbit of
+    Transient by convergence: with a tolerance ``converge`` the transient (then a minimum) goes
+    on, one sampling interval at a time up to ``transient_max`` (default 10 x transient), until
+    the section point is estimated within ``converge (1 + |point|)`` of a periodic orbit of
     period <= ``converge_depth`` sections (from the contraction of successive differences,
-    docs/numerics.md); ``converged`` tells per lane whether it was.
+    docs/numerics.md); ``converged`` tells per lane whether it was."""
+    per_lane = {"transient": transient, "transient_max": transient_max,
+                "steps_per_period": steps_per_period}
+    scalars = {k: v for k, v in per_lane.items() if v is not None and np.ndim(v) == 0}
+    overrides = {k: v for k, v in per_lane.items() if v is not None and np.ndim(v) > 0}
+    legacy = dict(scalars, samples=samples, locate_edges=locate_edges, bound=bound,
+                  max_section_periods=max_section_periods)
+    if converge_tol is not None:
+        legacy["converge"] = float(converge_tol) if converge_tol > 0 else None
+        if converge_tol < 0:
+            raise ValueError(f"converge_tol must be >= 0 (got {converge_tol!r})")
+    legacy = {k: v for k, v in legacy.items() if v is not None or k == "converge"}
+    if "steps_per_period" in legacy and int(legacy["steps_per_period"]) <= 0:
+        overrides["steps_per_period"] = legacy.pop("steps_per_period")  # <= 0: automatic
+    if run is None:
+        run = RunSettings(**legacy)
+    elif legacy:
+        raise TypeError(f"run_lanes: give the settings as run= or as keywords, not both "
+                        f"(got run= and {next(iter(legacy))}=)")
+    plan = LanePlan.build(model, np.ascontiguousarray(np.atleast_2d(P), dtype=float), run,
+                          sample_every=sample_every, t0=t0, **overrides)
+    return run_plan(model, P, y0, plan, converge_depth)
 
-    ``max_section_periods``: with ``"auto"``, the longest common period (in forcing periods)
-    taken as a section (default that of :func:`~geardyn.analysis.periodicity.common_section`,
-    32); a lane whose forcings repeat only over more is treated as incommensurate."""
+
+def run_plan(model: Model, P: np.ndarray, y0: np.ndarray, plan: LanePlan,
+             converge_depth: int = 16) -> LaneResults:
+    """Run the lanes ``P`` from ``y0`` as ``plan`` says (see :func:`run_lanes`)."""
+    if converge_depth < 1:
+        raise ValueError(f"converge_depth must be >= 1 (got {converge_depth!r})")
     P = np.ascontiguousarray(np.atleast_2d(P), dtype=float)
     L = P.shape[0]
     ns = model.n_states
     Y0 = np.ascontiguousarray(np.broadcast_to(np.asarray(y0, dtype=float), (L, ns)))
-    if model.omega_index is None:
-        raise ValueError("run_lanes needs a periodically forced model (it samples once a period)")
-    omega = P[:, model.omega_index].copy()
-    if np.any(~np.isfinite(omega)) or np.any(omega <= 0):
-        bad = omega[~(np.isfinite(omega) & (omega > 0))][0]
-        raise ValueError(f"Omega must be positive and finite in every lane (got {bad!r})")
-    if isinstance(sample_every, str):
-        if sample_every != "auto":
-            raise ValueError(f"sample_every must be 'auto' or >= 1 (got {sample_every!r})")
-        from geardyn.analysis.periodicity import common_section
-
-        limit = {} if max_section_periods is None else {"max_periods": int(max_section_periods)}
-        sample_every, commensurate = common_section(omega, model.other_frequencies(P), **limit)
-    else:
-        commensurate = np.ones(L, bool)
-    if samples < 1 or np.any(np.asarray(sample_every) < 1):
-        raise ValueError("samples and sample_every must be >= 1")
-    given = np.broadcast_to(np.asarray(0 if steps_per_period is None else steps_per_period,
-                                       dtype=np.int64), (L,))
-    n_lane = given.copy()
-    auto = n_lane <= 0
-    if np.any(auto):
-        n_lane[auto] = lane_steps_per_period(model, P[auto])
-    period = 2.0 * math.pi / omega
-    every = np.broadcast_to(np.asarray(sample_every, dtype=np.int64), (L,))
-    transient = np.broadcast_to(np.asarray(transient, dtype=float), (L,))
-    n_tr_periods = _whole(np.ceil(transient / period - 1e-9), every)
-    if transient_max is None:
-        transient_max = 10.0 * transient
-    transient_max = np.broadcast_to(np.asarray(transient_max, dtype=float), (L,))
-    n_max_periods = np.maximum(_whole(np.floor(transient_max / period + 1e-9), every),
-                               n_tr_periods)
-    if converge_tol < 0 or converge_depth < 1:
-        raise ValueError("converge_tol must be >= 0 and converge_depth >= 1")
-    T0 = np.zeros(L) if t0 is None else np.broadcast_to(np.asarray(t0, float), (L,)).copy()
+    run = plan.settings
+    samples = run.samples
+    n_lane, period, every = plan.steps_per_period, plan.period, plan.sample_every
     n_ev, n_obs = model.n_events, model.n_observables
     k = kernels_for(model.kernel)
     out = LaneResults(
@@ -163,15 +143,15 @@ def run_lanes(
         obs_rms=np.zeros((L, n_obs)),
         unresolved=np.zeros(L, np.int64),
         steps_per_period=n_lane,
-        transient_periods=n_tr_periods,
+        transient_periods=plan.transient_periods.copy(),
         converged=np.full(L, -1, np.int64),
         sample_every=every.copy(),
-        commensurate=np.asarray(commensurate, bool),
+        commensurate=plan.commensurate.copy(),
     )
     # lanes sorted by steps per period, then period: a lockstep block holds lanes of one step
     # count and similar length
     order = np.lexsort((period, n_lane))
-    sched = _schedule(n_lane[order], n_tr_periods[order] + samples * every[order], k.BLOCK)
+    sched = _schedule(n_lane[order], plan.total_periods[order], k.BLOCK)
     tr_steps = np.empty(L, np.int64)
     conv = np.empty(L, np.int64)
     s_tab, c_tab, tab_of = _phase_tables(k, n_lane)
@@ -186,11 +166,10 @@ def run_lanes(
     orms = np.empty((L, n_obs))
     unres = np.empty(L, np.int64)
     first, nl, nper, w_start, w_blocks = sched
-    k.sweep(P[order], Y0[order], (period / n_lane)[order], omega[order], T0[order],
-            (n_tr_periods * n_lane)[order].astype(np.int64),
-            (n_max_periods * n_lane)[order].astype(np.int64), float(converge_tol),
-            int(converge_depth), int(samples),
-            (every * n_lane)[order].astype(np.int64), bool(locate_edges), float(bound), n_ev,
+    k.sweep(P[order], Y0[order], plan.step[order], plan.omega[order], plan.t0[order],
+            plan.transient_steps[order], plan.transient_max_steps[order],
+            float(run.converge_tol), int(converge_depth), int(samples),
+            plan.sample_steps[order], bool(run.locate_edges), float(run.bound), n_ev,
             n_obs, first, nl, nper, np.array([tab_of[int(n)] for n in nper], np.int64),
             s_tab, c_tab, w_start, w_blocks, smp, fin, st, gmin, gmax, nc, omax, omin, orms,
             unres, tr_steps, conv)
@@ -206,13 +185,8 @@ def run_lanes(
     out.unresolved[order] = unres
     out.converged[order] = conv
     out.transient_periods[order] = tr_steps // n_lane[order]
-    out.final_time = T0 + (out.transient_periods + samples * every) * period
+    out.final_time = plan.final_time(out.transient_periods)
     return out
-
-
-def _whole(periods: np.ndarray, every: np.ndarray) -> np.ndarray:
-    """Periods rounded up to whole multiples of ``every``."""
-    return (np.ceil(periods / every) * every).astype(np.int64)
 
 
 def _phase_tables(k, n_lane: np.ndarray):

@@ -153,13 +153,14 @@ def _task_text(task: LaneTask) -> str:
 
 @functools.lru_cache(maxsize=32)
 def _code_digest(modules: tuple[str, ...]) -> str:
-    """SHA-256 of the source of geardyn's solvers and analyses and of ``modules`` (the model's):
-    the code that computes what a store keeps."""
+    """SHA-256 of the source of geardyn's core, solvers and analyses and of ``modules`` (the
+    model's): the code that computes what a store keeps."""
     import geardyn.analysis
+    import geardyn.core
     import geardyn.solvers
 
     files: list[Path] = []
-    for pkg in (geardyn.solvers, geardyn.analysis):
+    for pkg in (geardyn.core, geardyn.solvers, geardyn.analysis):
         files += sorted(Path(next(iter(pkg.__path__))).glob("*.py"))
     for name in modules:
         origin = getattr(importlib.import_module(name), "__file__", None)

@@ -3,79 +3,43 @@
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 import xarray as xr
 
+from geardyn.core.plan import (  # noqa: F401  (the step rule's old home)
+    MIN_STEPS_PER_PERIOD,
+    STEPS_PER_FASTEST_MODE,
+    STEPS_PER_OTHER_FORCING,
+    default_steps_per_period,
+    forcing_period,
+    periods_covering,
+    steps_per_period_rule,
+)
+from geardyn.core.settings import (  # noqa: F401  (DEFAULT_BOUND: its old home)
+    DEFAULT_BOUND,
+    INTEGRATOR,
+    RunSettings,
+    resolve_run,
+)
+from geardyn.core.status import Status, status_meaning
 from geardyn.models.base import Model
 from geardyn.solvers.kernels import kernels_for
 
-#: Fewest RK4 steps per forcing period.
-MIN_STEPS_PER_PERIOD = 64
-#: Default largest step as a fraction of the period of the model's fastest natural mode.
-STEPS_PER_FASTEST_MODE = 100
-#: Fewest steps per period of a forcing other than Omega (the CATT load fluctuation Lambda):
-#: at 8 the error of a response forced at Lambda = 40 (far above every natural frequency) is
-#: about 1e-7 of the motion, like that of the natural-mode rule (docs/numerics.md).
-STEPS_PER_OTHER_FORCING = 8
-#: States beyond this magnitude count as diverged.
-DEFAULT_BOUND = 1.0e6
-
-
-def default_steps_per_period(model: Model, omega: float | None = None,
-                             others: np.ndarray | None = None,
-                             params: np.ndarray | None = None) -> int:
-    """Steps per forcing period: at least ``MIN_STEPS_PER_PERIOD``, enough that a step is at
-    most 1/``STEPS_PER_FASTEST_MODE`` of the fastest natural period
-    (:meth:`~geardyn.Model.fastest_natural_frequency` of the coefficients ``params``, default the
-    model's own, when the model knows it), and at least ``STEPS_PER_OTHER_FORCING`` per period
-    of every other forcing acting (``others``, rad per time unit; default the model's own,
-    :meth:`~geardyn.Model.other_frequencies`). See ``docs/numerics.md`` for the accuracy."""
-    p = np.array(model.params if params is None else params, dtype=float).ravel()
-    omega = (float(p[model.omega_index]) if model.omega_index is not None else 0.0) \
-        if omega is None else float(omega)
-    if model.omega_index is not None:
-        p[model.omega_index] = omega
-    f = model.other_frequencies(p[None, :]) if others is None else others
-    n = float(steps_per_period_rule(model, p[None, :], np.array([omega]), f)[0])
-    return math.ceil(n)  # an OverflowError when it is not finite
-
-
-def steps_per_period_rule(model: Model, P: np.ndarray, omega: np.ndarray,
-                          others: np.ndarray | None = None) -> np.ndarray:
-    """The rule of :func:`default_steps_per_period` for every lane (row) of the coefficient
-    matrix ``P`` at the forcing frequencies ``omega`` (one per lane), vectorised: each lane's
-    step follows its own fastest natural frequency and other forcings (``others``, shape
-    ``(lanes, m)``, NaN where one does not act; default ``model.other_frequencies(P)``).
-    Returns whole numbers as floats (inf where Omega is too small for any count)."""
-    P = np.atleast_2d(np.asarray(P, dtype=float))
-    om = np.broadcast_to(np.asarray(omega, dtype=float), (P.shape[0],))
-    n = np.full(P.shape[0], float(MIN_STEPS_PER_PERIOD))
-    forced = np.isfinite(om) & (om != 0.0)
-    w = np.asarray(model.fastest_natural_frequency(P), dtype=float)
-    ok = forced & np.isfinite(w) & (w > 0)
-    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        n = np.where(ok, np.maximum(n, np.ceil(STEPS_PER_FASTEST_MODE * w / om)), n)
-        f = model.other_frequencies(P) if others is None else others
-        f = np.abs(np.asarray(f, dtype=float).reshape(P.shape[0], -1))
-        f = np.where(np.isfinite(f), f, 0.0)
-        fmax = f.max(axis=1) if f.shape[1] else np.zeros(P.shape[0])
-        act = forced & (fmax > 0)
-        n = np.where(act, np.maximum(n, np.ceil(STEPS_PER_OTHER_FORCING * fmax / om)), n)
-    return n
+#: simulate's own defaults of the run settings (a time history from the start, 64 periods).
+SIMULATE_DEFAULTS = {"transient": 0.0, "samples": 64}
 
 
 def simulate(
     model: Model,
     omega: float | None = None,
-    transient: float = 0.0,
-    periods: int = 64,
-    steps_per_period: int | None = None,
+    run: RunSettings | None = None,
+    *,
     y0: np.ndarray | None = None,
     record_every: int = 1,
-    locate_edges: bool = True,
-    bound: float = DEFAULT_BOUND,
     sample_interval: float | None = None,
+    **settings: Any,
 ) -> xr.Dataset:
     """Integrate ``model`` and return its time history.
 
@@ -83,17 +47,14 @@ def simulate(
     ----------
     omega
         Forcing frequency (dimensionless Omega for the built-in models); default: the model's.
-    transient
-        Time discarded first, in the model's time unit (tau for dimensionless models), rounded
-        up to whole forcing periods.
-    periods
-        Forcing periods recorded after the transient.
-    steps_per_period
-        RK4 steps per period (default :func:`default_steps_per_period`).
+    run
+        :class:`~geardyn.RunSettings`: ``transient`` (time discarded first, in the model's time
+        unit, rounded up to whole forcing periods), ``samples`` (forcing periods recorded),
+        ``steps_per_period`` (default :func:`default_steps_per_period`), ``locate_edges``,
+        ``bound``. Or, as before, the keywords ``transient`` (default 0), ``periods`` (the
+        samples, default 64), ``steps_per_period``, ``locate_edges`` and ``bound``.
     record_every
         Record every n-th grid point (must divide ``steps_per_period``).
-    locate_edges
-        Locate dead-zone edge crossings inside steps (keeps 4th order; see the kernel docs).
     sample_interval
         For autonomous models only: the time between Poincare (stroboscopic) samples.
 
@@ -101,8 +62,11 @@ def simulate(
     -------
     xarray.Dataset with dims ``time``, ``sample``, ``state``: one variable per state and per
     observable (mesh forces) over ``time``; ``poincare`` (sample, state), the states once per
-    forcing period; ``status`` (0 ok, 1 diverged). Attributes record the integrator settings.
+    forcing period; ``status`` (:class:`~geardyn.Status`). Attributes record the settings.
     """
+    run = resolve_run(run, settings, SIMULATE_DEFAULTS, aliases={"periods": "samples"})
+    transient, periods, bound = run.transient, run.samples, run.bound
+    locate_edges = run.locate_edges
     if omega is not None:
         model = model.with_omega(float(omega))
     om = model.omega
@@ -113,25 +77,19 @@ def simulate(
     else:
         if not math.isfinite(om) or om < 0:
             raise ValueError(f"omega must be a positive finite number (got {om!r})")
-        period = 2.0 * math.pi / om
-    n = int(steps_per_period or default_steps_per_period(model, om))
-    if n < 4:
-        raise ValueError(f"steps_per_period must be >= 4 (got {n})")
+        period = forcing_period(om)
+    n = int(run.steps_per_period or default_steps_per_period(model, om))
     if record_every < 1 or n % record_every:
         raise ValueError(f"record_every ({record_every}) must divide steps_per_period ({n})")
-    if periods < 1:
-        raise ValueError(f"periods must be >= 1 (got {periods})")
-    if transient < 0 or not math.isfinite(transient):
-        raise ValueError(f"transient must be a finite time >= 0 (got {transient!r})")
     h = period / n
-    n_tr = math.ceil(transient / period - 1e-9)
+    n_tr = periods_covering(transient, period)
     y = np.asarray(model.initial_state() if y0 is None else y0, dtype=float).copy()
     if y.shape != (model.n_states,):
         raise ValueError(f"y0 must have {model.n_states} entries ({', '.join(model.state_names)})")
     k = kernels_for(model.kernel)
     p = np.ascontiguousarray(model.params, dtype=float)
     n_ev, n_obs = model.n_events, model.n_observables
-    status = 0
+    status = Status.OK
     unresolved = 0
     if n_tr:
         Yt, _, _, _, status, u, _ = k.trajectory(p, y, h, om, n, 0, n_tr * n, n_tr * n,
@@ -139,7 +97,7 @@ def simulate(
         unresolved += u
         y = Yt[-1].copy()
     i0 = n_tr * n
-    if status == 0:
+    if status == Status.OK:
         Y, O, G, ncross, status, u, _ = k.trajectory(p, y, h, om, n, i0, periods * n,
                                                       record_every, locate_edges, bound, n_ev,
                                                       n_obs)
@@ -175,7 +133,7 @@ def simulate(
         model=model.name,
         Omega=om,
         period=period,
-        integrator="RK4, fixed step aligned to the forcing period",
+        integrator=INTEGRATOR,
         steps_per_period=n,
         step=h,
         locate_edges=int(bool(locate_edges)),
@@ -185,7 +143,7 @@ def simulate(
         record_every=record_every,
         bound=bound,
         status=int(status),
-        status_meaning="0 ok, 1 diverged (|state| > bound or not finite)",
+        status_meaning=status_meaning(),
         unresolved_steps=int(unresolved),
         time_unit=model.time_unit,
     )

@@ -1,0 +1,257 @@
+"""The lane plan: every lane's forcing frequency, step and step counts, derived once.
+
+This module is the one place that converts time to forcing periods to steps, and the one place
+with the step rule (how many RK4 steps a forcing period gets). :class:`LanePlan` holds the
+result for the lanes of a run; the kernels are fed from it.
+
+The model is duck-typed: the plan calls only ``model.omega_index``, ``model.params``,
+``model.other_frequencies(P)`` and ``model.fastest_natural_frequency(P)``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from geardyn.core.section import MAX_COMMON_PERIODS, common_section
+from geardyn.core.settings import MIN_STEPS, RunSettings
+
+#: Fewest RK4 steps per forcing period of the step rule.
+MIN_STEPS_PER_PERIOD = 64
+#: Default largest step as a fraction of the period of the model's fastest natural mode.
+STEPS_PER_FASTEST_MODE = 100
+#: Fewest steps per period of a forcing other than Omega (the CATT load fluctuation Lambda):
+#: at 8 the error of a response forced at Lambda = 40 (far above every natural frequency) is
+#: about 1e-7 of the motion, like that of the natural-mode rule (docs/numerics.md).
+STEPS_PER_OTHER_FORCING = 8
+#: Slack of the rounding of a time to whole periods (a time of exactly k periods is k periods).
+ROUNDING_SLACK = 1e-9
+
+#: Automatic steps per period of a lane run are rounded up to this geometric ladder (ratio
+#: 2^(1/4)), so that a sweep over Omega needs only a few kernel calls.
+_LADDER = np.unique(np.ceil(8 * 2.0 ** (np.arange(0, 60) / 4.0)).astype(int) * 2)
+
+
+# ---------------------------------------------------------------------------- time -> periods
+def forcing_period(omega: Any) -> Any:
+    """The forcing period 2 pi / Omega (a float, or an array for an array of frequencies)."""
+    return 2.0 * math.pi / omega
+
+
+def periods_covering(time: Any, period: Any) -> Any:
+    """Whole periods that cover ``time`` (rounded up; an array for arrays, else an int)."""
+    if np.ndim(time) or np.ndim(period):
+        return np.ceil(time / period - ROUNDING_SLACK)
+    return math.ceil(time / period - ROUNDING_SLACK)
+
+
+def periods_within(time: Any, period: Any) -> Any:
+    """Whole periods that fit in ``time`` (rounded down; as :func:`periods_covering`)."""
+    if np.ndim(time) or np.ndim(period):
+        return np.floor(time / period + ROUNDING_SLACK)
+    return math.floor(time / period + ROUNDING_SLACK)
+
+
+def whole_multiples(periods: np.ndarray, every: np.ndarray) -> np.ndarray:
+    """Periods rounded up to whole multiples of ``every`` (int64)."""
+    return (np.ceil(periods / every) * every).astype(np.int64)
+
+
+# ---------------------------------------------------------------------------- the step rule
+def ladder_steps(n: int) -> int:
+    """The smallest value of the step ladder that is >= n."""
+    idx = np.searchsorted(_LADDER, n)
+    return int(_LADDER[min(idx, _LADDER.size - 1)]) if idx < _LADDER.size else int(n)
+
+
+def steps_per_period_rule(model: Any, P: np.ndarray, omega: np.ndarray,
+                          others: np.ndarray | None = None) -> np.ndarray:
+    """The step rule for every lane (row) of the coefficient matrix ``P`` at the forcing
+    frequencies ``omega`` (one per lane), vectorised: at least ``MIN_STEPS_PER_PERIOD``, a step
+    at most 1/``STEPS_PER_FASTEST_MODE`` of the lane's fastest natural period, and at least
+    ``STEPS_PER_OTHER_FORCING`` per period of every other forcing acting (``others``, shape
+    ``(lanes, m)``, NaN where one does not act; default ``model.other_frequencies(P)``).
+    Returns whole numbers as floats (inf where Omega is too small for any count)."""
+    P = np.atleast_2d(np.asarray(P, dtype=float))
+    om = np.broadcast_to(np.asarray(omega, dtype=float), (P.shape[0],))
+    n = np.full(P.shape[0], float(MIN_STEPS_PER_PERIOD))
+    forced = np.isfinite(om) & (om != 0.0)
+    w = np.asarray(model.fastest_natural_frequency(P), dtype=float)
+    ok = forced & np.isfinite(w) & (w > 0)
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        n = np.where(ok, np.maximum(n, np.ceil(STEPS_PER_FASTEST_MODE * w / om)), n)
+        f = model.other_frequencies(P) if others is None else others
+        f = np.abs(np.asarray(f, dtype=float).reshape(P.shape[0], -1))
+        f = np.where(np.isfinite(f), f, 0.0)
+        fmax = f.max(axis=1) if f.shape[1] else np.zeros(P.shape[0])
+        act = forced & (fmax > 0)
+        n = np.where(act, np.maximum(n, np.ceil(STEPS_PER_OTHER_FORCING * fmax / om)), n)
+    return n
+
+
+def default_steps_per_period(model: Any, omega: float | None = None,
+                             others: np.ndarray | None = None,
+                             params: np.ndarray | None = None) -> int:
+    """Steps per forcing period of one run by the step rule
+    (:func:`steps_per_period_rule`), for the coefficients ``params`` (default the model's own)
+    at ``omega`` (default the model's), ``others``: the other forcings (default the model's).
+    See ``docs/numerics.md`` for the accuracy."""
+    p = np.array(model.params if params is None else params, dtype=float).ravel()
+    omega = (float(p[model.omega_index]) if model.omega_index is not None else 0.0) \
+        if omega is None else float(omega)
+    if model.omega_index is not None:
+        p[model.omega_index] = omega
+    f = model.other_frequencies(p[None, :]) if others is None else others
+    n = float(steps_per_period_rule(model, p[None, :], np.array([omega]), f)[0])
+    return math.ceil(n)  # an OverflowError when it is not finite
+
+
+def lane_steps_per_period(model: Any, P: np.ndarray) -> np.ndarray:
+    """Default steps per forcing period of each lane (row of ``P``), rounded up to the ladder:
+    the step rule with the lane's own Omega, other forcings and fastest natural frequency (from
+    the lane's coefficients, so a sweep over a stiffness or a mass refines the step where the
+    device is stiffer)."""
+    P = np.atleast_2d(P)
+    n = steps_per_period_rule(model, P, P[:, model.omega_index])
+    if not np.all(np.isfinite(n)) or np.any(n >= 2.0**62):
+        raise OverflowError("steps per period do not fit an integer; check Omega")
+    idx = np.searchsorted(_LADDER, n)  # as ladder_steps, for every lane at once
+    return np.where(idx < _LADDER.size, _LADDER[np.minimum(idx, _LADDER.size - 1)],
+                    n).astype(np.int64)
+
+
+def lane_steps(model: Any, P: np.ndarray, steps_per_period: Any = None) -> np.ndarray:
+    """Steps per period of each lane: ``steps_per_period`` (one, or one per lane; None or
+    <= 0: the lane's step rule, :func:`lane_steps_per_period`)."""
+    L = P.shape[0]
+    given = np.broadcast_to(np.asarray(0 if steps_per_period is None else steps_per_period,
+                                       dtype=np.int64), (L,))
+    small = (given > 0) & (given < MIN_STEPS)
+    if np.any(small):
+        raise ValueError(f"steps_per_period must be >= {MIN_STEPS} (got {given[small][0]})")
+    n = given.copy()
+    auto = n <= 0
+    if np.any(auto):
+        n[auto] = lane_steps_per_period(model, P[auto])
+    return n
+
+
+def lane_section(model: Any, P: np.ndarray, omega: np.ndarray,
+                 max_section_periods: int | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """The section of each lane: (forcing periods between samples, commensurate) of
+    :func:`~geardyn.core.section.common_section` over the model's forcings."""
+    limit = MAX_COMMON_PERIODS if max_section_periods is None else int(max_section_periods)
+    return common_section(omega, model.other_frequencies(P), max_periods=limit)
+
+
+def lane_omega(model: Any, P: np.ndarray) -> np.ndarray:
+    """Omega of each lane (a copy of its column of ``P``); ValueError unless every lane is
+    periodically forced at a positive, finite frequency."""
+    if model.omega_index is None:
+        raise ValueError("run_lanes needs a periodically forced model (it samples once a period)")
+    omega = P[:, model.omega_index].copy()
+    good = np.isfinite(omega) & (omega > 0)
+    if not np.all(good):
+        raise ValueError(f"Omega must be positive and finite in every lane "
+                         f"(got {omega[~good][0]!r})")
+    return omega
+
+
+def _lane_times(name: str, value: Any, L: int) -> np.ndarray:
+    times = np.broadcast_to(np.asarray(value, dtype=float), (L,))
+    bad = ~(np.isfinite(times) & (times >= 0))
+    if np.any(bad):
+        raise ValueError(f"{name} must be a finite time >= 0 in every lane (got {times[bad][0]!r})")
+    return times
+
+
+# ---------------------------------------------------------------------------- the plan
+@dataclass(frozen=True)
+class LanePlan:
+    """Every lane's integration, in steps: derived once by :meth:`build`, read by the kernels.
+
+    Arrays are per lane (index = row of ``P``); periods are forcing periods of the lane."""
+
+    settings: RunSettings
+    omega: np.ndarray  # (L,) forcing frequency
+    period: np.ndarray  # (L,) forcing period 2 pi / Omega
+    steps_per_period: np.ndarray  # (L,) int64
+    step: np.ndarray  # (L,) RK4 step h = period / steps_per_period
+    sample_every: np.ndarray  # (L,) int64 forcing periods between samples (the section)
+    commensurate: np.ndarray  # (L,) bool; False: a second forcing at an irrational ratio
+    transient_periods: np.ndarray  # (L,) int64 (minimum) transient, whole sections
+    transient_max_periods: np.ndarray  # (L,) int64 longest transient by convergence
+    t0: np.ndarray  # (L,) start time
+
+    @classmethod
+    def build(cls, model: Any, P: np.ndarray, settings: RunSettings, *,
+              transient: Any = None, transient_max: Any = None, steps_per_period: Any = None,
+              sample_every: Any = "auto", t0: Any = None) -> LanePlan:
+        """The plan of the lanes ``P`` (coefficient vectors, one row per lane) under
+        ``settings``. Per-lane overrides (one value, or one per lane): ``transient`` and
+        ``transient_max`` (times), ``steps_per_period`` (<= 0: the step rule), ``sample_every``
+        (forcing periods; ``"auto"``: the common period of the forcings, see
+        :func:`lane_section`), ``t0`` (start times, whole periods)."""
+        P = np.atleast_2d(P)
+        L = P.shape[0]
+        omega = lane_omega(model, P)
+        if isinstance(sample_every, str):
+            if sample_every != "auto":
+                raise ValueError(f"sample_every must be 'auto' or >= 1 (got {sample_every!r})")
+            sample_every, commensurate = lane_section(model, P, omega,
+                                                      settings.max_section_periods)
+        else:
+            commensurate = np.ones(L, bool)
+        every = np.broadcast_to(np.asarray(sample_every, dtype=np.int64), (L,)).copy()
+        if np.any(every < 1):
+            raise ValueError(f"sample_every must be >= 1 (got {every[every < 1][0]})")
+        n = lane_steps(model, P, settings.steps_per_period if steps_per_period is None
+                       else steps_per_period)
+        period = forcing_period(omega)
+        tr = _lane_times("transient", settings.transient if transient is None else transient, L)
+        n_tr = whole_multiples(periods_covering(tr, period), every)
+        if transient_max is None:
+            tmax = (10.0 * tr if settings.transient_max is None
+                    else np.full(L, settings.transient_max))
+        else:
+            tmax = _lane_times("transient_max", transient_max, L)
+        n_max = np.maximum(whole_multiples(periods_within(tmax, period), every), n_tr)
+        start = np.zeros(L) if t0 is None else np.broadcast_to(np.asarray(t0, float), (L,)).copy()
+        return cls(settings=settings, omega=omega, period=period, steps_per_period=n,
+                   step=period / n, sample_every=every, commensurate=np.asarray(commensurate,
+                                                                                bool),
+                   transient_periods=n_tr, transient_max_periods=n_max, t0=start)
+
+    # ------------------------------------------------------------------ in steps
+    @property
+    def lanes(self) -> int:
+        return int(self.omega.size)
+
+    @property
+    def samples(self) -> int:
+        return self.settings.samples
+
+    @property
+    def transient_steps(self) -> np.ndarray:
+        return (self.transient_periods * self.steps_per_period).astype(np.int64)
+
+    @property
+    def transient_max_steps(self) -> np.ndarray:
+        return (self.transient_max_periods * self.steps_per_period).astype(np.int64)
+
+    @property
+    def sample_steps(self) -> np.ndarray:
+        """Steps between two samples (a section period)."""
+        return (self.sample_every * self.steps_per_period).astype(np.int64)
+
+    @property
+    def total_periods(self) -> np.ndarray:
+        """Forcing periods of the (minimum) transient plus the sampled stretch."""
+        return self.transient_periods + self.samples * self.sample_every
+
+    def final_time(self, transient_periods: np.ndarray) -> np.ndarray:
+        """Model time at the last sample, given the transient each lane used (in periods)."""
+        return self.t0 + (transient_periods + self.samples * self.sample_every) * self.period

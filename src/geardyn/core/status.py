@@ -1,0 +1,49 @@
+"""Numerical outcomes of an integration, as one enumeration shared by the kernels and Python.
+
+The compiled kernels write these codes (their constants ``STATUS_OK`` and ``STATUS_DIVERGED``
+in ``solvers/_step_core.py`` equal the values here; a test checks it). Steps that reached the
+edge-location split limit are not a lane status but a count (``unresolved``), since a lane
+with a few of them is still a valid result.
+"""
+
+from __future__ import annotations
+
+from enum import IntEnum
+
+import numpy as np
+
+
+class Status(IntEnum):
+    """Outcome of one integration (one lane)."""
+
+    OK = 0
+    DIVERGED = 1
+
+    @property
+    def message(self) -> str:
+        """What the code means, in words."""
+        return _MESSAGES[self]
+
+
+_MESSAGES = {
+    Status.OK: "ok",
+    Status.DIVERGED: "diverged (|state| > bound or not finite)",
+}
+
+
+def status_meaning(suffix: str = "") -> str:
+    """The codes and their messages as one attribute string, e.g. ``"0 ok, 1 diverged (...)"``;
+    ``suffix`` is appended to the last message (e.g. ``" in at least one start"``)."""
+    text = ", ".join(f"{int(s)} {s.message}" for s in Status)
+    return text + suffix
+
+
+def status_attrs(suffix: str = "") -> dict[str, str]:
+    """Attributes of a ``status`` variable: ``{"meaning": status_meaning(suffix)}`` (not CF
+    ``flag_meanings``, which the Zarr store reads as a categorical variable's labels)."""
+    return {"meaning": status_meaning(suffix)}
+
+
+def is_ok(status: np.ndarray | int) -> np.ndarray:
+    """True where ``status`` is :attr:`Status.OK` (element-wise)."""
+    return np.asarray(status) == Status.OK
