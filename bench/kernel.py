@@ -18,10 +18,12 @@ from __future__ import annotations
 import argparse
 import hashlib
 import importlib.util
+import re
 import statistics
 import subprocess
 import sys
 import time
+import types
 from pathlib import Path
 
 import numba
@@ -128,12 +130,43 @@ def paper_workload(mod, repeat: int) -> float:
     return t
 
 
+def fresh_kernels(source: kmod.KernelSource) -> types.ModuleType:
+    """The working tree's sweep kernel module compiled in memory (numba does not show the
+    assembly of cached code)."""
+    code = kmod._replace_import(kmod._template_text("rk4"), "pass  " + kmod._IMPORT_MARK)
+    module = types.ModuleType("geardyn_rk4_fresh")
+    module.__dict__.update(source.functions())
+    exec(compile(code.replace("_CACHE = True", "_CACHE = False"), module.__name__, "exec"),
+         module.__dict__)
+    return module
+
+
+def vector_report(w: Workload) -> str:
+    """Packed double-precision instructions in the compiled sweep kernel (zmm: 8 doubles, ymm:
+    4), scalar ones (sd), and packed fused multiply-adds (none: no contraction)."""
+    mod = fresh_kernels(w.model.kernel)
+    ens.kernels_for = lambda src, template="rk4": mod
+    try:
+        ens.run_lanes(w.model, w.P[:8], w.model.initial_state(), 1.0, 1, steps_per_period=64)
+    finally:
+        ens.kernels_for = kmod.kernels_for
+    asm = mod.sweep.inspect_asm(mod.sweep.signatures[0])
+    z, y, sd = (len(re.findall(r"\n\s+v\w+" + r, asm))
+                for r in (r"pd\s+[^\n]*%zmm", r"pd\s+[^\n]*%ymm", r"sd\s"))
+    fma = len(re.findall(r"vfmadd\w*pd", asm))
+    ops = sorted({m for m in re.findall(r"\n\s+(v\w+pd)\s+[^\n]*%zmm", asm)})
+    return (f"{w.name}: {z} zmm / {y} ymm packed-double and {sd} scalar-double instructions, "
+            f"{fma} packed FMA; "
+            f"zmm ops: {' '.join(ops)}")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--paper", action="store_true", help="also the paper's reference workload")
     ap.add_argument("--old", default=OLD_REV, help="git revision of the old kernel")
     ap.add_argument("--lanes", type=int, default=256)
+    ap.add_argument("--asm", action="store_true", help="also inspect the new kernel's assembly")
     args = ap.parse_args()
     catt = geardyn.CATTDevice(geardyn.PlanetaryParams.paper(xi1=0.05, xi2=0.05))
     gp = geardyn.GearPair(zeta=0.05, kappa=0.2, Fm=0.1, Fa=0.2)
@@ -165,6 +198,9 @@ def main() -> None:
               f"{res['new']['ns'] / res['old']['ns']:.3f} | "
               f"{res['new']['ns_off'] / res['old']['ns_off']:.3f} | max rel. diff of the "
               f"section points {diff:.1e}, crossings equal: {same_cross} | |")
+    if args.asm:
+        for w in works:
+            print(vector_report(w))
     if args.paper:
         model = catt
         old = old_kernels(model.kernel, args.old)

@@ -238,7 +238,7 @@ def theta_events(t, y, g, p):
 # the block). The kernel generator picks them up by name (``<function>_lanes``).
 
 
-@nb.njit(**_JIT)
+@nb.njit(inline="always", **_JIT)
 def _lane_forcing(T, PT, nl, s, c, SC):
     """Per-lane stiffness factors (rows 0, 1: sun-inside, inside-outside) and the load terms
     (rows 2, 3: load_c, sin_l1) of :func:`_rhs` for one planet set, into SC."""
@@ -255,11 +255,15 @@ def _lane_forcing(T, PT, nl, s, c, SC):
         for k in range(nl):
             SC[0, k] += PT[fs + 2 * h, k] * ch + PT[fs + 2 * h + 1, k] * sh
             SC[1, k] += PT[fp + 2 * h, k] * ch + PT[fp + 2 * h + 1, k] * sh
+    fluctuates = False
     for k in range(nl):
         SC[0, k] = 1.0 + SC[0, k]
         SC[1, k] = 1.0 + SC[1, k]
         SC[2, k] = PT[F_C0, k]
         SC[3, k] = 0.0
+        fluctuates |= (PT[F_C1, k] != 0.0) | (PT[HEADER + F_P1, k] != 0.0)
+    if not fluctuates:  # no libm call in the common case (a guarded call may be speculated)
+        return
     for k in range(nl):
         if PT[F_C1, k] != 0.0 or PT[HEADER + F_P1, k] != 0.0:
             SC[2, k] += PT[F_C1, k] * math.sin(PT[LAMBDA, k] * T[k] + PT[PSI2, k])

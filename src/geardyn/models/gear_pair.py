@@ -55,15 +55,19 @@ def gear_pair_observe(t, y, out, p, s, c):
 # the lane loops vectorise. SC: scratch rows (>= 4) of the block's width.
 
 
-@nb.njit(**_JIT)
+@nb.njit(inline="always", **_JIT)
 def _phase_factors(PT, nl, SC):
     """cos and sin of the stiffness and error phases of every lane into SC rows 0-3 (no libm
     call when a phase is 0: cos 0 = 1 and sin 0 = 0 exactly)."""
+    phased = False
     for k in range(nl):
         SC[0, k] = 1.0
         SC[1, k] = 0.0
         SC[2, k] = 1.0
         SC[3, k] = 0.0
+        phased |= (PT[PHI_K, k] != 0.0) | (PT[PHI_E, k] != 0.0)
+    if not phased:  # no libm call in the common case (a guarded call may be speculated)
+        return
     for k in range(nl):
         if PT[PHI_K, k] != 0.0:
             SC[0, k] = math.cos(PT[PHI_K, k])

@@ -17,9 +17,13 @@ Numerics
   time), and integrated in sub-steps. Every RK4 stage then sees a smooth right-hand side and the
   method keeps 4th order. A step is split at most ``MAX_SPLITS`` times (chattering); the count of
   steps that hit the limit is returned (see :mod:`._step_core`).
-* Lanes (parameter sets) are advanced in lockstep blocks of ``BLOCK`` lanes so the CPU overlaps
-  their independent dependency chains; blocks run in parallel (``prange``). A lane's arithmetic
-  does not depend on its neighbours, so results are bitwise independent of blocking and threads.
+* The sweep advances lanes (parameter sets) in lockstep blocks of up to ``BLOCK`` lanes with one
+  step count, in structure-of-arrays layout (lane index innermost, block width a runtime value),
+  so that the RK4 stages, the model's lane-block functions where it has them, the side test and
+  the statistics vectorise over lanes; lanes that leave a side of an edge finish on the scalar
+  path. Blocks run in parallel (``prange``). A lane's arithmetic does not depend on its
+  neighbours (no fastmath), so results are bitwise independent of blocking and threads.
+  ``trajectory`` (one lane) keeps the row layout of ``_block_step``.
 * A lane whose state leaves ``|y| <= bound`` or stops being finite is marked diverged (status 1)
   and frozen; the others go on.
 """
@@ -270,7 +274,7 @@ def _settled(y, D, n, tol):
 # result does not depend on its block, its position or the thread.
 
 
-@nb.njit(**_JIT)
+@nb.njit(inline="always", **_JIT)
 def _rhs_lanes_generic(T, Y, DY, PT, P, first, nl, s, c, SC, ybuf, dbuf):
     ns = Y.shape[0]
     for k in range(nl):
@@ -281,7 +285,7 @@ def _rhs_lanes_generic(T, Y, DY, PT, P, first, nl, s, c, SC, ybuf, dbuf):
             DY[q, k] = dbuf[q]
 
 
-@nb.njit(**_JIT)
+@nb.njit(inline="always", **_JIT)
 def _events_lanes_generic(T, Y, G, PT, P, first, nl, ybuf, gb):
     ns = Y.shape[0]
     for k in range(nl):
@@ -292,7 +296,7 @@ def _events_lanes_generic(T, Y, G, PT, P, first, nl, ybuf, gb):
             G[j, k] = gb[j]
 
 
-@nb.njit(**_JIT)
+@nb.njit(inline="always", **_JIT)
 def _observe_lanes_generic(T, Y, O, PT, P, first, nl, s, c, SC, ybuf, ob):
     ns = Y.shape[0]
     for k in range(nl):
@@ -303,19 +307,22 @@ def _observe_lanes_generic(T, Y, O, PT, P, first, nl, s, c, SC, ybuf, ob):
             O[j, k] = ob[j]
 
 
-if "rhs_lanes" in globals():  # the model's lane-block functions (see .kernels)
+if "rhs_lanes" in globals():  # the model's lane-block functions (see .kernels), inlined
+    _rhs_lm = nb.njit(**_INLINE)(rhs_lanes.py_func)  # noqa: F821
+    _events_lm = nb.njit(**_INLINE)(events_lanes.py_func)  # noqa: F821
+    _observe_lm = nb.njit(**_INLINE)(observe_lanes.py_func)  # noqa: F821
 
-    @nb.njit(**_JIT)
+    @nb.njit(inline="always", **_JIT)
     def _rhs_lanes(T, Y, DY, PT, P, first, nl, s, c, SC, ybuf, dbuf):
-        rhs_lanes(T, Y, DY, PT, nl, s, c, SC)  # noqa: F821
+        _rhs_lm(T, Y, DY, PT, nl, s, c, SC)
 
-    @nb.njit(**_JIT)
+    @nb.njit(inline="always", **_JIT)
     def _events_lanes(T, Y, G, PT, P, first, nl, ybuf, gb):
-        events_lanes(T, Y, G, PT, nl)  # noqa: F821
+        _events_lm(T, Y, G, PT, nl)
 
-    @nb.njit(**_JIT)
+    @nb.njit(inline="always", **_JIT)
     def _observe_lanes(T, Y, O, PT, P, first, nl, s, c, SC, ybuf, ob):
-        observe_lanes(T, Y, O, PT, nl, s, c, SC)  # noqa: F821
+        _observe_lm(T, Y, O, PT, nl, s, c, SC)
 
 else:
     _rhs_lanes = _rhs_lanes_generic
@@ -323,7 +330,7 @@ else:
     _observe_lanes = _observe_lanes_generic
 
 
-@nb.njit(**_JIT)
+@nb.njit(inline="always", **_JIT)
 def _lanes_rk4(i, first, nl, Y, Y1, K1, K2, K3, K4, TMP, TT, HB, T0B, PT, P, sa, ca, sb, cb, se,
                ce, SC, ybuf, dbuf):
     """The RK4 trial of grid step i for lanes 0..nl-1 of a block into Y1; TT holds the step's
@@ -354,7 +361,7 @@ def _lanes_rk4(i, first, nl, Y, Y1, K1, K2, K3, K4, TMP, TT, HB, T0B, PT, P, sa,
                                                  + K4[q, k])
 
 
-@nb.njit(**_JIT)
+@nb.njit(inline="always", **_JIT)
 def _lanes_screen(nl, G1, GS, GP, SIDE, GR, FLAG, locate):
     """The side test of a block's trial step, vectorised over lanes (:func:`_leaves_side` for
     every lane): FLAG[k] != 0 where lane k's step ends on another side of an edge or, with
@@ -375,7 +382,7 @@ def _lanes_screen(nl, G1, GS, GP, SIDE, GR, FLAG, locate):
             FLAG[k] += 1.0 if (crossed | graze) else 0.0
 
 
-@nb.njit(**_JIT)
+@nb.njit(inline="always", **_JIT)
 def _lanes_finish(i, first, nl, n_per, Y, Y1, G1, GR, SIDE, FLAG, ACT, P, HB, T0B, OMEGA,
                   locate, NCROSS, UNRES, ys, y1s, sides, g1s, work, ybuf, gbuf):
     """Commit the trial step of the active lanes: the unflagged ones vectorised, the flagged
@@ -415,7 +422,7 @@ def _lanes_finish(i, first, nl, n_per, Y, Y1, G1, GR, SIDE, FLAG, ACT, P, HB, T0
             G1[j, k] = g1s[j]
 
 
-@nb.njit(**_JIT)
+@nb.njit(inline="always", **_JIT)
 def _healthy_lane(Y, k, bound):
     for q in range(Y.shape[0]):
         if not (abs(Y[q, k]) <= bound):  # False for NaN too
@@ -423,7 +430,7 @@ def _healthy_lane(Y, k, bound):
     return True
 
 
-@nb.njit(**_JIT)
+@nb.njit(inline="always", **_JIT)
 def _next_due(step, nl, ACT, n_tr, next_sample):
     """The next step at which some active lane of the block ends its transient, takes a
     sample or ends (the per-lane bookkeeping runs only then and once a period)."""
