@@ -245,6 +245,17 @@ def _lane_forcing(T, PT, nl, s, c, SC):
     nh = int(PT[N_HARM, 0])  # the same in every lane: it fixes the vector's layout
     fs = HEADER + BLOCK_FIXED
     fp = fs + 2 * nh
+    fluctuates = False
+    if nh == 1:  # one loop (the same arithmetic as below)
+        for k in range(nl):
+            SC[0, k] = 1.0 + (PT[fs, k] * c + PT[fs + 1, k] * s)
+            SC[1, k] = 1.0 + (PT[fp, k] * c + PT[fp + 1, k] * s)
+            SC[2, k] = PT[F_C0, k]
+            SC[3, k] = 0.0
+            fluctuates |= (PT[F_C1, k] != 0.0) | (PT[HEADER + F_P1, k] != 0.0)
+        if fluctuates:
+            _load_terms(T, PT, nl, SC)
+        return
     for k in range(nl):
         SC[0, k] = PT[fs, k] * c + PT[fs + 1, k] * s
         SC[1, k] = PT[fp, k] * c + PT[fp + 1, k] * s
@@ -255,15 +266,19 @@ def _lane_forcing(T, PT, nl, s, c, SC):
         for k in range(nl):
             SC[0, k] += PT[fs + 2 * h, k] * ch + PT[fs + 2 * h + 1, k] * sh
             SC[1, k] += PT[fp + 2 * h, k] * ch + PT[fp + 2 * h + 1, k] * sh
-    fluctuates = False
     for k in range(nl):
         SC[0, k] = 1.0 + SC[0, k]
         SC[1, k] = 1.0 + SC[1, k]
         SC[2, k] = PT[F_C0, k]
         SC[3, k] = 0.0
         fluctuates |= (PT[F_C1, k] != 0.0) | (PT[HEADER + F_P1, k] != 0.0)
-    if not fluctuates:  # no libm call in the common case (a guarded call may be speculated)
-        return
+    if fluctuates:  # no libm call in the common case (a guarded call may be speculated)
+        _load_terms(T, PT, nl, SC)
+
+
+@nb.njit(inline="always", **_JIT)
+def _load_terms(T, PT, nl, SC):
+    """The load fluctuation of :func:`_rhs` (rows 2, 3 of SC: load_c, sin_l1) where it is on."""
     for k in range(nl):
         if PT[F_C1, k] != 0.0 or PT[HEADER + F_P1, k] != 0.0:
             SC[2, k] += PT[F_C1, k] * math.sin(PT[LAMBDA, k] * T[k] + PT[PSI2, k])

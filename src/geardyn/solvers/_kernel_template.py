@@ -331,34 +331,32 @@ else:
 
 
 @nb.njit(inline="always", **_JIT)
-def _lanes_rk4(i, first, nl, Y, Y1, K1, K2, K3, K4, TMP, TT, HB, T0B, PT, P, sa, ca, sb, cb, se,
-               ce, SC, ybuf, dbuf):
+def _lanes_rk4(i, first, nl, Y, Y1, K1, K2, K3, K4, TMP, FL, HW, TT, HB, T0B, PT, P, sa, ca, sb,
+               cb, se, ce, SC, ybuf, dbuf):
     """The RK4 trial of grid step i for lanes 0..nl-1 of a block into Y1; TT holds the step's
-    end times afterwards."""
-    ns = Y.shape[0]
+    end times afterwards. FL: flat views (state and lane in one index) of Y, Y1, K1..K4, TMP;
+    HW: flat rows of h/2, h and h/6 per (state, lane), so the stage updates are one loop each."""
+    Yf, Y1f, K1f, K2f, K3f, K4f, TMPf = FL
+    HHf, HFf, H6f = HW
+    m_all = Yf.size
     for k in range(nl):
         TT[k] = T0B[k] + i * HB[k]
     _rhs_lanes(TT, Y, K1, PT, P, first, nl, sa, ca, SC, ybuf, dbuf)
-    for q in range(ns):
-        for k in range(nl):
-            TMP[q, k] = Y[q, k] + 0.5 * HB[k] * K1[q, k]
+    for m in range(m_all):
+        TMPf[m] = Yf[m] + HHf[m] * K1f[m]
     for k in range(nl):
         TT[k] = T0B[k] + i * HB[k] + 0.5 * HB[k]
     _rhs_lanes(TT, TMP, K2, PT, P, first, nl, sb, cb, SC, ybuf, dbuf)
-    for q in range(ns):
-        for k in range(nl):
-            TMP[q, k] = Y[q, k] + 0.5 * HB[k] * K2[q, k]
+    for m in range(m_all):
+        TMPf[m] = Yf[m] + HHf[m] * K2f[m]
     _rhs_lanes(TT, TMP, K3, PT, P, first, nl, sb, cb, SC, ybuf, dbuf)
-    for q in range(ns):
-        for k in range(nl):
-            TMP[q, k] = Y[q, k] + HB[k] * K3[q, k]
+    for m in range(m_all):
+        TMPf[m] = Yf[m] + HFf[m] * K3f[m]
     for k in range(nl):
         TT[k] = T0B[k] + (i + 1) * HB[k]
     _rhs_lanes(TT, TMP, K4, PT, P, first, nl, se, ce, SC, ybuf, dbuf)
-    for q in range(ns):
-        for k in range(nl):
-            Y1[q, k] = Y[q, k] + HB[k] / 6.0 * (K1[q, k] + 2.0 * K2[q, k] + 2.0 * K3[q, k]
-                                                 + K4[q, k])
+    for m in range(m_all):
+        Y1f[m] = Yf[m] + H6f[m] * (K1f[m] + 2.0 * K2f[m] + 2.0 * K3f[m] + K4f[m])
 
 
 @nb.njit(inline="always", **_JIT)
@@ -495,9 +493,14 @@ def _sweep_block(first, nl, n_per, s_tab, c_tab, P, Y0, H, OMEGA, T0, n_transien
     work = np.zeros((7, ns))
     ybuf = np.zeros(ns)
     gbuf = event_buffer(0, n_ev)
+    HW3 = np.empty((3, ns, nl))  # h/2, h, h/6 per (state, lane)
     max_end = 0
     for k in range(nl):
         lane = first + k
+        for q in range(ns):
+            HW3[0, q, k] = 0.5 * H[lane]
+            HW3[1, q, k] = H[lane]
+            HW3[2, q, k] = H[lane] / 6.0
         for j in range(P.shape[1]):
             PT[j, k] = P[lane, j]
         for q in range(ns):
@@ -514,6 +517,9 @@ def _sweep_block(first, nl, n_per, s_tab, c_tab, P, Y0, H, OMEGA, T0, n_transien
         n_end[k] = n_transient[lane] + n_samples * sample_every[lane]
         next_sample[k] = n_transient[lane] + sample_every[lane]
         max_end = max(max_end, n_end[k])
+    FL = (Y.reshape(ns * nl), Y1.reshape(ns * nl), K1.reshape(ns * nl), K2.reshape(ns * nl),
+          K3.reshape(ns * nl), K4.reshape(ns * nl), TMP.reshape(ns * nl))
+    HW = (HW3[0].reshape(ns * nl), HW3[1].reshape(ns * nl), HW3[2].reshape(ns * nl))
     if n_ev > 0:
         _events_lanes(TT, Y, GS, PT, P, first, nl, ybuf, gb)
         for j in range(n_ev):
@@ -528,7 +534,7 @@ def _sweep_block(first, nl, n_per, s_tab, c_tab, P, Y0, H, OMEGA, T0, n_transien
     while i + 1 < max_end:
         i += 1
         j0 = 2 * phase
-        _lanes_rk4(i, first, nl, Y, Y1, K1, K2, K3, K4, TMP, TT, HB, T0B, PT, P, s_tab[j0],
+        _lanes_rk4(i, first, nl, Y, Y1, K1, K2, K3, K4, TMP, FL, HW, TT, HB, T0B, PT, P, s_tab[j0],
                    c_tab[j0], s_tab[j0 + 1], c_tab[j0 + 1], s_tab[j0 + 2], c_tab[j0 + 2], SC,
                    ybuf, dbuf)
         if n_ev > 0:
