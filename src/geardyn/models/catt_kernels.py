@@ -227,3 +227,110 @@ def theta_events(t, y, g, p):
         g[4 * i + 1] = x_sq + p[o + T_B_SQ]
         g[4 * i + 2] = x_pq - p[o + T_B_PQ]
         g[4 * i + 3] = x_pq + p[o + T_B_PQ]
+
+
+# ---------------------------------------------------------------------------------------------
+# Lane-block forms of the reduced model (one planet set) for the sweep kernel: the same
+# arithmetic as catt_rhs_one / catt_events_one / catt_observe_one, operation for operation (so
+# results are bitwise equal), on a block of lanes in structure-of-arrays layout: state Y[q, k],
+# coefficients PT[j, k] (lane k of the block innermost), nl lanes, one forcing phase (s, c)
+# for the block. The lane loops have no calls and vectorise. SC: scratch rows (>= 4, width of
+# the block). The kernel generator picks them up by name (``<function>_lanes``).
+
+
+@nb.njit(inline="always", **_JIT)
+def _lane_forcing(T, PT, nl, s, c, SC):
+    """Per-lane stiffness factors (rows 0, 1: sun-inside, inside-outside) and the load terms
+    (rows 2, 3: load_c, sin_l1) of :func:`_rhs` for one planet set, into SC."""
+    nh = int(PT[N_HARM, 0])  # the same in every lane: it fixes the vector's layout
+    fs = HEADER + BLOCK_FIXED
+    fp = fs + 2 * nh
+    fluctuates = False
+    if nh == 1:  # one loop (the same arithmetic as below)
+        for k in range(nl):
+            SC[0, k] = 1.0 + (PT[fs, k] * c + PT[fs + 1, k] * s)
+            SC[1, k] = 1.0 + (PT[fp, k] * c + PT[fp + 1, k] * s)
+            SC[2, k] = PT[F_C0, k]
+            SC[3, k] = 0.0
+            fluctuates |= (PT[F_C1, k] != 0.0) | (PT[HEADER + F_P1, k] != 0.0)
+        if fluctuates:
+            _load_terms(T, PT, nl, SC)
+        return
+    for k in range(nl):
+        SC[0, k] = PT[fs, k] * c + PT[fs + 1, k] * s
+        SC[1, k] = PT[fp, k] * c + PT[fp + 1, k] * s
+    ch = c
+    sh = s
+    for h in range(1, nh):
+        ch, sh = ch * c - sh * s, sh * c + ch * s
+        for k in range(nl):
+            SC[0, k] += PT[fs + 2 * h, k] * ch + PT[fs + 2 * h + 1, k] * sh
+            SC[1, k] += PT[fp + 2 * h, k] * ch + PT[fp + 2 * h + 1, k] * sh
+    for k in range(nl):
+        SC[0, k] = 1.0 + SC[0, k]
+        SC[1, k] = 1.0 + SC[1, k]
+        SC[2, k] = PT[F_C0, k]
+        SC[3, k] = 0.0
+        fluctuates |= (PT[F_C1, k] != 0.0) | (PT[HEADER + F_P1, k] != 0.0)
+    if fluctuates:  # no libm call in the common case (a guarded call may be speculated)
+        _load_terms(T, PT, nl, SC)
+
+
+@nb.njit(inline="always", **_JIT)
+def _load_terms(T, PT, nl, SC):
+    """The load fluctuation of :func:`_rhs` (rows 2, 3 of SC: load_c, sin_l1) where it is on."""
+    for k in range(nl):
+        if PT[F_C1, k] != 0.0 or PT[HEADER + F_P1, k] != 0.0:
+            SC[2, k] += PT[F_C1, k] * math.sin(PT[LAMBDA, k] * T[k] + PT[PSI2, k])
+            SC[3, k] = math.sin(PT[LAMBDA, k] * T[k] + PT[PSI1, k])
+
+
+@nb.njit(**_JIT)
+def catt_rhs_one_lanes(T, Y, DY, PT, nl, s, c, SC):
+    """:func:`catt_rhs_one` for lanes 0..nl-1 of a block (see above)."""
+    _lane_forcing(T, PT, nl, s, c, SC)
+    o = HEADER
+    for k in range(nl):
+        om2 = PT[OMEGA, k] * PT[OMEGA, k]
+        xs = Y[0, k]
+        vs = Y[1, k]
+        xp = Y[2, k]
+        vp = Y[3, k]
+        gs = SC[0, k] * dead_zone(xs, PT[o + B_SQ, k])
+        gp = SC[1, k] * dead_zone(xp, PT[o + B_PQ, k])
+        carrier = 0.0
+        carrier += PT[o + K_SQ_C, k] * gs + PT[o + C_SQ_C, k] * vs
+        f_sq = PT[o + K_SQ_Q, k] * gs + PT[o + C_SQ_Q, k] * vs
+        f_pq = PT[o + K_PQ_Q, k] * gp + PT[o + C_PQ_Q, k] * vp
+        f_pp = PT[o + K_PQ_P, k] * gp + PT[o + C_PQ_P, k] * vp
+        load_p = PT[o + F_P0, k] + PT[o + F_P1, k] * SC[3, k]
+        d1 = -f_sq + f_pq + om2 * (PT[o + E_SQ_S, k] * s + PT[o + E_SQ_C, k] * c)
+        DY[0, k] = vs
+        DY[1, k] = d1 + (SC[2, k] - carrier)
+        DY[2, k] = vp
+        DY[3, k] = (f_sq - f_pq - f_pp + load_p
+                    + om2 * (PT[o + E_PQ_S, k] * s + PT[o + E_PQ_C, k] * c))
+
+
+@nb.njit(**_JIT)
+def catt_events_one_lanes(T, Y, G, PT, nl):
+    """:func:`catt_events_one` for lanes 0..nl-1 of a block."""
+    o = HEADER
+    for k in range(nl):
+        G[0, k] = Y[0, k] - PT[o + B_SQ, k]
+        G[1, k] = Y[0, k] + PT[o + B_SQ, k]
+        G[2, k] = Y[2, k] - PT[o + B_PQ, k]
+        G[3, k] = Y[2, k] + PT[o + B_PQ, k]
+
+
+@nb.njit(**_JIT)
+def catt_observe_one_lanes(T, Y, O, PT, nl, s, c, SC):
+    """:func:`catt_observe_one` for lanes 0..nl-1 of a block."""
+    _lane_forcing(T, PT, nl, s, c, SC)
+    o = HEADER
+    for k in range(nl):
+        gs = SC[0, k] * dead_zone(Y[0, k], PT[o + B_SQ, k])
+        gp = SC[1, k] * dead_zone(Y[2, k], PT[o + B_PQ, k])
+        scale = PT[o + FORCE_SCALE, k]
+        O[0, k] = scale * (PT[o + K_SQ_Q, k] * gs + PT[o + C_SQ_Q, k] * Y[1, k])
+        O[1, k] = scale * (PT[o + K_PQ_Q, k] * gp + PT[o + C_PQ_Q, k] * Y[3, k])

@@ -49,6 +49,70 @@ def gear_pair_observe(t, y, out, p, s, c):
     out[0] = (1.0 + p[KAPPA] * ck) * g + 2.0 * p[ZETA] * y[1]
 
 
+# Lane-block forms for the sweep kernel (picked up by name, ``<function>_lanes``): the same
+# arithmetic as the functions above, operation for operation, on lanes 0..nl-1 of a block in
+# structure-of-arrays layout (state Y[q, k], coefficients PT[j, k], one forcing phase s, c);
+# the lane loops vectorise. SC: scratch rows (>= 4) of the block's width.
+
+
+@nb.njit(inline="always", **_JIT)
+def _phase_factors(PT, nl, SC):
+    """cos and sin of the stiffness and error phases of every lane into SC rows 0-3 (no libm
+    call when a phase is 0: cos 0 = 1 and sin 0 = 0 exactly)."""
+    phased = False
+    for k in range(nl):
+        SC[0, k] = 1.0
+        SC[1, k] = 0.0
+        SC[2, k] = 1.0
+        SC[3, k] = 0.0
+        phased |= (PT[PHI_K, k] != 0.0) | (PT[PHI_E, k] != 0.0)
+    if not phased:  # no libm call in the common case (a guarded call may be speculated)
+        return
+    for k in range(nl):
+        if PT[PHI_K, k] != 0.0:
+            SC[0, k] = math.cos(PT[PHI_K, k])
+            SC[1, k] = math.sin(PT[PHI_K, k])
+        if PT[PHI_E, k] != 0.0:
+            SC[2, k] = math.cos(PT[PHI_E, k])
+            SC[3, k] = math.sin(PT[PHI_E, k])
+
+
+@nb.njit(**_JIT)
+def gear_pair_rhs_lanes(T, Y, DY, PT, nl, s, c, SC):
+    """:func:`gear_pair_rhs` for lanes 0..nl-1 of a block."""
+    _phase_factors(PT, nl, SC)
+    for k in range(nl):
+        x = Y[0, k]
+        b = PT[BACKLASH, k]
+        g = x - b if x > b else (x + b if x < -b else 0.0)
+        ck = c * SC[0, k] - s * SC[1, k]
+        ce = c * SC[2, k] - s * SC[3, k]
+        om = PT[OMEGA, k]
+        DY[0, k] = Y[1, k]
+        DY[1, k] = (PT[FM, k] + PT[FA, k] * om * om * ce - 2.0 * PT[ZETA, k] * Y[1, k]
+                    - (1.0 + PT[KAPPA, k] * ck) * g)
+
+
+@nb.njit(**_JIT)
+def gear_pair_events_lanes(T, Y, G, PT, nl):
+    """:func:`gear_pair_events` for lanes 0..nl-1 of a block."""
+    for k in range(nl):
+        G[0, k] = Y[0, k] - PT[BACKLASH, k]
+        G[1, k] = Y[0, k] + PT[BACKLASH, k]
+
+
+@nb.njit(**_JIT)
+def gear_pair_observe_lanes(T, Y, O, PT, nl, s, c, SC):
+    """:func:`gear_pair_observe` for lanes 0..nl-1 of a block."""
+    _phase_factors(PT, nl, SC)
+    for k in range(nl):
+        x = Y[0, k]
+        b = PT[BACKLASH, k]
+        g = x - b if x > b else (x + b if x < -b else 0.0)
+        ck = c * SC[0, k] - s * SC[1, k]
+        O[0, k] = (1.0 + PT[KAPPA, k] * ck) * g + 2.0 * PT[ZETA, k] * Y[1, k]
+
+
 class GearPair(Model):
     """Single spur gear pair with backlash, time-varying stiffness and transmission error.
 

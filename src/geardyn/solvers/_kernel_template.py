@@ -17,9 +17,13 @@ Numerics
   time), and integrated in sub-steps. Every RK4 stage then sees a smooth right-hand side and the
   method keeps 4th order. A step is split at most ``MAX_SPLITS`` times (chattering); the count of
   steps that hit the limit is returned (see :mod:`._step_core`).
-* Lanes (parameter sets) are advanced in lockstep blocks of ``BLOCK`` lanes so the CPU overlaps
-  their independent dependency chains; blocks run in parallel (``prange``). A lane's arithmetic
-  does not depend on its neighbours, so results are bitwise independent of blocking and threads.
+* The sweep advances lanes (parameter sets) in lockstep blocks of up to ``BLOCK`` lanes with one
+  step count, in structure-of-arrays layout (lane index innermost, block width a runtime value),
+  so that the RK4 stages, the model's lane-block functions where it has them, the side test and
+  the statistics vectorise over lanes; lanes that leave a side of an edge finish on the scalar
+  path. Blocks run in parallel (``prange``). A lane's arithmetic does not depend on its
+  neighbours (no fastmath), so results are bitwise independent of blocking and threads.
+  ``trajectory`` (one lane) keeps the row layout of ``_block_step``.
 * A lane whose state leaves ``|y| <= bound`` or stops being finite is marked diverged (status 1)
   and frozen; the others go on.
 """
@@ -32,6 +36,8 @@ import numpy as np
 from geardyn.solvers._step_core import (  # CORE-IMPORT
     _INLINE,
     _JIT,
+    GRAZE_BOUND,
+    GRAZE_ROW,
     MAX_SPLITS,
     SIMULTANEOUS,
     STATUS_DIVERGED,
@@ -53,7 +59,7 @@ _observe_i = nb.njit(**_INLINE)(observe.py_func)
 __all__ = ["BLOCK", "MAX_SPLITS", "SIMULTANEOUS", "events", "observe", "phase_table", "rhs",
            "sweep", "trajectory"]
 
-BLOCK = 8
+BLOCK = 64
 
 
 @nb.njit(**_JIT)
@@ -255,93 +261,320 @@ def _settled(y, D, n, tol):
     return False
 
 
+# ---------------------------------------------------------------------------------------------
+# The sweep's lane blocks, structure of arrays: a block of nl lanes (all with the same steps per
+# period, so one forcing phase for the block) holds its state as Y[q, k], its events as G[j, k],
+# its coefficients transposed as PT[j, k]: the lane index is innermost and contiguous, and the
+# block width nl is a runtime value. The RK4 stages, the side test and the statistics are loops
+# over lanes without calls, which LLVM vectorises; a built-in model's ``*_lanes`` functions
+# (generated module: ``rhs_lanes``, ``events_lanes``, ``observe_lanes``) evaluate the model the
+# same way. A model without them is evaluated lane by lane (the per-lane functions, gathered).
+# Lanes that leave a side of an edge are finished one by one on the scalar path
+# (:func:`_split_step`). No fastmath: each lane's arithmetic is the scalar kernel's, so a lane's
+# result does not depend on its block, its position or the thread.
+
+
+@nb.njit(inline="always", **_JIT)
+def _rhs_lanes_generic(T, Y, DY, PT, P, first, nl, s, c, SC, ybuf, dbuf):
+    ns = Y.shape[0]
+    for k in range(nl):
+        for q in range(ns):
+            ybuf[q] = Y[q, k]
+        _rhs_i(T[k], ybuf, dbuf, P[first + k], s, c)
+        for q in range(ns):
+            DY[q, k] = dbuf[q]
+
+
+@nb.njit(inline="always", **_JIT)
+def _events_lanes_generic(T, Y, G, PT, P, first, nl, ybuf, gb):
+    ns = Y.shape[0]
+    for k in range(nl):
+        for q in range(ns):
+            ybuf[q] = Y[q, k]
+        _events_i(T[k], ybuf, gb, P[first + k])
+        for j in range(G.shape[0]):
+            G[j, k] = gb[j]
+
+
+@nb.njit(inline="always", **_JIT)
+def _observe_lanes_generic(T, Y, O, PT, P, first, nl, s, c, SC, ybuf, ob):
+    ns = Y.shape[0]
+    for k in range(nl):
+        for q in range(ns):
+            ybuf[q] = Y[q, k]
+        _observe_i(T[k], ybuf, ob, P[first + k], s, c)
+        for j in range(O.shape[0]):
+            O[j, k] = ob[j]
+
+
+if "rhs_lanes" in globals():  # the model's lane-block functions (see .kernels), inlined
+    _rhs_lm = nb.njit(**_INLINE)(rhs_lanes.py_func)  # noqa: F821
+    _events_lm = nb.njit(**_INLINE)(events_lanes.py_func)  # noqa: F821
+    _observe_lm = nb.njit(**_INLINE)(observe_lanes.py_func)  # noqa: F821
+
+    @nb.njit(inline="always", **_JIT)
+    def _rhs_lanes(T, Y, DY, PT, P, first, nl, s, c, SC, ybuf, dbuf):
+        _rhs_lm(T, Y, DY, PT, nl, s, c, SC)
+
+    @nb.njit(inline="always", **_JIT)
+    def _events_lanes(T, Y, G, PT, P, first, nl, ybuf, gb):
+        _events_lm(T, Y, G, PT, nl)
+
+    @nb.njit(inline="always", **_JIT)
+    def _observe_lanes(T, Y, O, PT, P, first, nl, s, c, SC, ybuf, ob):
+        _observe_lm(T, Y, O, PT, nl, s, c, SC)
+
+else:
+    _rhs_lanes = _rhs_lanes_generic
+    _events_lanes = _events_lanes_generic
+    _observe_lanes = _observe_lanes_generic
+
+
+@nb.njit(inline="always", **_JIT)
+def _lanes_rk4(i, first, nl, Y, Y1, K1, K2, K3, K4, TMP, FL, HW, TT, HB, T0B, PT, P, sa, ca, sb,
+               cb, se, ce, SC, ybuf, dbuf):
+    """The RK4 trial of grid step i for lanes 0..nl-1 of a block into Y1; TT holds the step's
+    end times afterwards. FL: flat views (state and lane in one index) of Y, Y1, K1..K4, TMP;
+    HW: flat rows of h/2, h and h/6 per (state, lane), so the stage updates are one loop each."""
+    Yf, Y1f, K1f, K2f, K3f, K4f, TMPf = FL
+    HHf, HFf, H6f = HW
+    m_all = Yf.size
+    for k in range(nl):
+        TT[k] = T0B[k] + i * HB[k]
+    _rhs_lanes(TT, Y, K1, PT, P, first, nl, sa, ca, SC, ybuf, dbuf)
+    for m in range(m_all):
+        TMPf[m] = Yf[m] + HHf[m] * K1f[m]
+    for k in range(nl):
+        TT[k] = T0B[k] + i * HB[k] + 0.5 * HB[k]
+    _rhs_lanes(TT, TMP, K2, PT, P, first, nl, sb, cb, SC, ybuf, dbuf)
+    for m in range(m_all):
+        TMPf[m] = Yf[m] + HHf[m] * K2f[m]
+    _rhs_lanes(TT, TMP, K3, PT, P, first, nl, sb, cb, SC, ybuf, dbuf)
+    for m in range(m_all):
+        TMPf[m] = Yf[m] + HFf[m] * K3f[m]
+    for k in range(nl):
+        TT[k] = T0B[k] + (i + 1) * HB[k]
+    _rhs_lanes(TT, TMP, K4, PT, P, first, nl, se, ce, SC, ybuf, dbuf)
+    for m in range(m_all):
+        Y1f[m] = Yf[m] + H6f[m] * (K1f[m] + 2.0 * K2f[m] + 2.0 * K3f[m] + K4f[m])
+
+
+@nb.njit(inline="always", **_JIT)
+def _lanes_screen(nl, G1, GS, GP, SIDE, GR, FLAG, locate):
+    """The side test of a block's trial step, vectorised over lanes (:func:`_leaves_side` for
+    every lane): FLAG[k] != 0 where lane k's step ends on another side of an edge or, with
+    ``locate``, may graze one (GR[j, k] = 1: edge j may; from the grid values g_{i-1} = GP,
+    g_i = GS, g_{i+1} = G1)."""
+    for k in range(nl):
+        FLAG[k] = 0.0
+    for j in range(G1.shape[0]):
+        for k in range(nl):
+            g1 = G1[j, k]
+            s = SIDE[j, k]
+            g0 = GS[j, k]
+            d2 = g1 - 2.0 * g0 + GP[j, k]
+            crossed = (1.0 if g1 > 0.0 else -1.0) != s
+            near = not min(abs(g0), abs(g1)) > GRAZE_BOUND * abs(d2)
+            graze = locate & (crossed | (not s * d2 < 0.0)) & near
+            GR[j, k] = 1.0 if graze else 0.0
+            FLAG[k] += 1.0 if (crossed | graze) else 0.0
+
+
+@nb.njit(inline="always", **_JIT)
+def _lanes_finish(i, first, nl, n_per, Y, Y1, G1, GR, SIDE, FLAG, ACT, P, HB, T0B, OMEGA,
+                  locate, NCROSS, UNRES, ys, y1s, sides, g1s, work, ybuf, gbuf):
+    """Commit the trial step of the active lanes: the unflagged ones vectorised, the flagged
+    ones (a side left or a possible graze) one by one, with the crossings located
+    (:func:`_split_step`) or, without ``locate``, counted at the step's end."""
+    ns = Y.shape[0]
+    n_ev = G1.shape[0]
+    for q in range(ns):
+        for k in range(nl):
+            Y[q, k] = Y1[q, k] if ACT[k] and FLAG[k] == 0.0 else Y[q, k]
+    for k in range(nl):
+        if FLAG[k] == 0.0 or not ACT[k]:
+            continue
+        lane = first + k
+        if not locate:
+            for j in range(n_ev):
+                s_new = 1.0 if G1[j, k] > 0.0 else -1.0
+                if s_new != SIDE[j, k]:
+                    SIDE[j, k] = s_new
+                    NCROSS[lane, j] += 1
+            for q in range(ns):
+                Y[q, k] = Y1[q, k]
+            continue
+        for q in range(ns):
+            ys[q] = Y[q, k]
+            y1s[q] = Y1[q, k]
+        for j in range(n_ev):
+            sides[j] = 1 if SIDE[j, k] > 0.0 else -1
+            g1s[j] = G1[j, k]
+            gbuf[GRAZE_ROW, j] = GR[j, k]
+        UNRES[lane] += _split_step(i, T0B[k], ys, y1s, P[lane], HB[k], OMEGA[lane], n_per,
+                                   sides, g1s, NCROSS[lane], work, ybuf, gbuf)
+        for q in range(ns):
+            Y[q, k] = ys[q]
+        for j in range(n_ev):
+            SIDE[j, k] = float(sides[j])
+            G1[j, k] = g1s[j]
+
+
+@nb.njit(inline="always", **_JIT)
+def _healthy_lane(Y, k, bound):
+    for q in range(Y.shape[0]):
+        if not (abs(Y[q, k]) <= bound):  # False for NaN too
+            return False
+    return True
+
+
+@nb.njit(inline="always", **_JIT)
+def _next_due(step, nl, ACT, n_tr, next_sample):
+    """The next step at which some active lane of the block ends its transient, takes a
+    sample or ends (the per-lane bookkeeping runs only then and once a period)."""
+    due = np.iinfo(np.int64).max
+    for k in range(nl):
+        if ACT[k]:
+            due = min(due, n_tr[k] if n_tr[k] > step else next_sample[k])
+    return due
+
+
 @nb.njit(**_JIT)
 def _sweep_block(first, nl, n_per, s_tab, c_tab, P, Y0, H, OMEGA, T0, n_transient,
                  n_transient_max, conv_tol, conv_depth, n_samples, sample_every, locate, bound,
                  n_ev, n_obs, samples, final, status, gmin, gmax, ncross, omax, omin, orms,
                  unresolved, transient_steps, converged):
     """One lockstep block of :func:`sweep`: lanes first..first+nl-1, all with n_per steps per
-    period (phase table s_tab, c_tab)."""
+    period (phase table s_tab, c_tab), in structure-of-arrays layout (see above)."""
     ns = Y0.shape[1]
+    n_g = max(n_ev, 1)
     depth = max(conv_depth, 1)
     R = np.zeros((nl, depth, ns))  # the last section points of the transient
     D = np.zeros((nl, 3 * depth, depth))  # their differences, per candidate period
     n_ring = np.zeros(nl, np.int64)
-    Y, Y1, K1, K2, K3, K4, TMP, TT, G, SIDE, work, ybuf, gbuf = _alloc(BLOCK, ns, n_ev)
-    O = np.zeros((BLOCK, n_obs))
-    active = np.ones(nl, np.bool_)
+    Y = np.empty((ns, nl))
+    Y1 = np.empty((ns, nl))
+    K1 = np.empty((ns, nl))
+    K2 = np.empty((ns, nl))
+    K3 = np.empty((ns, nl))
+    K4 = np.empty((ns, nl))
+    TMP = np.empty((ns, nl))
+    PT = np.empty((P.shape[1], nl))
+    SC = np.zeros((8, nl))
+    TT = np.empty(nl)
+    HB = np.empty(nl)
+    T0B = np.empty(nl)
+    GP = np.full((n_g, nl), np.nan)  # events at the grid points i - 1, i, i + 1
+    GS = np.zeros((n_g, nl))
+    G1 = np.zeros((n_g, nl))
+    GR = np.zeros((n_g, nl))
+    SIDE = np.ones((n_g, nl))
+    FLAG = np.zeros(nl)
+    GMIN = np.full((n_g, nl), np.inf)
+    GMAX = np.full((n_g, nl), -np.inf)
+    O = np.zeros((max(n_obs, 1), nl))
+    OMAX = np.full((max(n_obs, 1), nl), -np.inf)
+    OMIN = np.full((max(n_obs, 1), nl), np.inf)
+    OSQ = np.zeros((max(n_obs, 1), nl))
+    STAT = np.zeros(nl, np.bool_)
+    ACT = np.ones(nl, np.bool_)
     n_end = np.zeros(nl, np.int64)
     n_tr = np.zeros(nl, np.int64)
     next_sample = np.zeros(nl, np.int64)
     n_stat = np.zeros(nl, np.int64)
+    # the scalar path's scratch
+    ys = np.zeros(ns)
+    y1s = np.zeros(ns)
+    dbuf = np.zeros(ns)
+    sides = np.ones(n_g, np.int64)
+    g1s = np.zeros(n_g)
+    gb = np.zeros(n_g)
+    ob = np.zeros(max(n_obs, 1))
+    work = np.zeros((7, ns))
+    ybuf = np.zeros(ns)
+    gbuf = event_buffer(0, n_ev)
+    HW3 = np.empty((3, ns, nl))  # h/2, h, h/6 per (state, lane)
     max_end = 0
     for k in range(nl):
         lane = first + k
         for q in range(ns):
-            Y[k, q] = Y0[lane, q]
-        events(T0[lane], Y[k], G[k], P[lane])
-        for j in range(n_ev):
-            SIDE[k, j] = _side(G[k, j])
-            gmin[lane, j] = np.inf
-            gmax[lane, j] = -np.inf
-            ncross[lane, j] = 0
-        for j in range(n_obs):
-            omax[lane, j] = -np.inf
-            omin[lane, j] = np.inf
-            orms[lane, j] = 0.0
+            HW3[0, q, k] = 0.5 * H[lane]
+            HW3[1, q, k] = H[lane]
+            HW3[2, q, k] = H[lane] / 6.0
+        for j in range(P.shape[1]):
+            PT[j, k] = P[lane, j]
+        for q in range(ns):
+            Y[q, k] = Y0[lane, q]
+        HB[k] = H[lane]
+        T0B[k] = T0[lane]
+        TT[k] = T0[lane]
         status[lane] = STATUS_OK
         unresolved[lane] = 0
         converged[lane] = 0 if conv_tol > 0.0 else -1
+        for j in range(n_ev):
+            ncross[lane, j] = 0
         n_tr[k] = n_transient[lane]
         n_end[k] = n_transient[lane] + n_samples * sample_every[lane]
         next_sample[k] = n_transient[lane] + sample_every[lane]
         max_end = max(max_end, n_end[k])
+    FL = (Y.reshape(ns * nl), Y1.reshape(ns * nl), K1.reshape(ns * nl), K2.reshape(ns * nl),
+          K3.reshape(ns * nl), K4.reshape(ns * nl), TMP.reshape(ns * nl))
+    HW = (HW3[0].reshape(ns * nl), HW3[1].reshape(ns * nl), HW3[2].reshape(ns * nl))
+    if n_ev > 0:
+        _events_lanes(TT, Y, GS, PT, P, first, nl, ybuf, gb)
+        for j in range(n_ev):
+            for k in range(nl):
+                SIDE[j, k] = 1.0 if GS[j, k] > 0.0 else -1.0
     min_tr = n_tr[0]
     for k in range(nl):
         min_tr = min(min_tr, n_tr[k])
+    due = _next_due(0, nl, ACT, n_tr, next_sample)
     phase = 0  # grid point index within the period
     i = -1
     while i + 1 < max_end:
         i += 1
         j0 = 2 * phase
-        _block_step(i, first, nl, active, Y, Y1, K1, K2, K3, K4, TMP, TT, G, SIDE, P, H, OMEGA,
-                    T0, n_per, s_tab[j0], c_tab[j0], s_tab[j0 + 1], c_tab[j0 + 1],
-                    s_tab[j0 + 2], c_tab[j0 + 2], locate, ncross, unresolved, work, ybuf, gbuf)
+        _lanes_rk4(i, first, nl, Y, Y1, K1, K2, K3, K4, TMP, FL, HW, TT, HB, T0B, PT, P, s_tab[j0],
+                   c_tab[j0], s_tab[j0 + 1], c_tab[j0 + 1], s_tab[j0 + 2], c_tab[j0 + 2], SC,
+                   ybuf, dbuf)
+        if n_ev > 0:
+            _events_lanes(TT, Y1, G1, PT, P, first, nl, ybuf, gb)
+            _lanes_screen(nl, G1, GS, GP, SIDE, GR, FLAG, locate)
+        _lanes_finish(i, first, nl, n_per, Y, Y1, G1, GR, SIDE, FLAG, ACT, P, HB, T0B, OMEGA,
+                      locate, ncross, unresolved, ys, y1s, sides, g1s, work, ybuf, gbuf)
+        GP, GS, G1 = GS, G1, GP  # history of the grid values: g_{i}, g_{i+1}
         step = i + 1
         phase += 1
         if phase == n_per:
             phase = 0
-        if n_obs > 0 and step > min_tr:
-            for k in range(nl):
-                TT[k] = T0[first + k] + step * H[first + k]
-            _observe_block(TT, Y, O, P, first, nl, active, s_tab[2 * phase],
-                           c_tab[2 * phase])
-        for k in range(nl):
-            if not active[k]:
-                continue
-            lane = first + k
-            if (phase == 0 or step == n_end[k]) and not _healthy(Y[k], bound):
-                status[lane] = STATUS_DIVERGED
-                active[k] = False
-                for r in range(n_samples):
+        if phase == 0 or step >= due:
+            for k in range(nl):  # health, end of the transient
+                if not ACT[k]:
+                    continue
+                lane = first + k
+                if (phase == 0 or step == n_end[k]) and not _healthy_lane(Y, k, bound):
+                    status[lane] = STATUS_DIVERGED
+                    ACT[k] = False
+                    for r in range(n_samples):
+                        for q in range(ns):
+                            samples[lane, r, q] = np.nan
                     for q in range(ns):
-                        samples[lane, r, q] = np.nan
-                for q in range(ns):
-                    final[lane, q] = np.nan
-                continue
-            if step <= n_tr[k]:
-                if step < n_tr[k]:
+                        final[lane, q] = np.nan
+                    continue
+                if step != n_tr[k]:
                     continue
                 if conv_tol > 0.0 and converged[lane] == 0:
                     every = sample_every[lane]
-                    _section_diffs(Y[k], R[k], n_ring[k], D[k])
-                    if _settled(Y[k], D[k], n_ring[k], conv_tol):
+                    for q in range(ns):
+                        ys[q] = Y[q, k]
+                    _section_diffs(ys, R[k], n_ring[k], D[k])
+                    if _settled(ys, D[k], n_ring[k], conv_tol):
                         converged[lane] = 1
                     elif n_tr[k] + every <= n_transient_max[lane]:
                         # not settled yet: one more section period of transient
                         slot = n_ring[k] % R.shape[1]
                         for q in range(ns):
-                            R[k, slot, q] = Y[k, q]
+                            R[k, slot, q] = ys[q]
                         n_ring[k] += 1
                         n_tr[k] += every
                         n_end[k] += every
@@ -350,30 +583,55 @@ def _sweep_block(first, nl, n_per, s_tab, c_tab, P, Y0, H, OMEGA, T0, n_transien
                         continue
                 for j in range(n_ev):
                     ncross[lane, j] = 0
-                continue
-            for j in range(n_ev):
-                gmin[lane, j] = min(gmin[lane, j], G[k, j])
-                gmax[lane, j] = max(gmax[lane, j], G[k, j])
+            due = _next_due(step, nl, ACT, n_tr, next_sample)
+        if step <= min_tr:
+            continue
+        # statistics over the sampled stretch, vectorised over the block's lanes
+        for k in range(nl):
+            STAT[k] = ACT[k] and step > n_tr[k]
+            n_stat[k] += 1 if STAT[k] else 0
+        for j in range(n_ev):
+            for k in range(nl):
+                g = GS[j, k]
+                GMIN[j, k] = min(GMIN[j, k], g) if STAT[k] else GMIN[j, k]
+                GMAX[j, k] = max(GMAX[j, k], g) if STAT[k] else GMAX[j, k]
+        if n_obs > 0:
+            for k in range(nl):
+                TT[k] = T0B[k] + step * HB[k]
+            _observe_lanes(TT, Y, O, PT, P, first, nl, s_tab[2 * phase], c_tab[2 * phase], SC,
+                           ybuf, ob)
             for j in range(n_obs):
-                omax[lane, j] = max(omax[lane, j], O[k, j])
-                omin[lane, j] = min(omin[lane, j], O[k, j])
-                orms[lane, j] += O[k, j] * O[k, j]
-            n_stat[k] += 1
-            if step == next_sample[k]:
-                r = (step - n_tr[k]) // sample_every[lane] - 1
-                for q in range(ns):
-                    samples[lane, r, q] = Y[k, q]
-                next_sample[k] += sample_every[lane]
-            if step == n_end[k]:
-                active[k] = False
-                for q in range(ns):
-                    final[lane, q] = Y[k, q]
+                for k in range(nl):
+                    v = O[j, k]
+                    OMAX[j, k] = max(OMAX[j, k], v) if STAT[k] else OMAX[j, k]
+                    OMIN[j, k] = min(OMIN[j, k], v) if STAT[k] else OMIN[j, k]
+                    OSQ[j, k] = OSQ[j, k] + v * v if STAT[k] else OSQ[j, k]
+        if step >= due:
+            for k in range(nl):  # samples, end
+                if not STAT[k]:
+                    continue
+                lane = first + k
+                if step == next_sample[k]:
+                    r = (step - n_tr[k]) // sample_every[lane] - 1
+                    for q in range(ns):
+                        samples[lane, r, q] = Y[q, k]
+                    next_sample[k] += sample_every[lane]
+                if step == n_end[k]:
+                    ACT[k] = False
+                    for q in range(ns):
+                        final[lane, q] = Y[q, k]
+            due = _next_due(step, nl, ACT, n_tr, next_sample)
     for k in range(nl):
         lane = first + k
         transient_steps[lane] = n_tr[k]
+        for j in range(n_ev):
+            gmin[lane, j] = GMIN[j, k]
+            gmax[lane, j] = GMAX[j, k]
         for j in range(n_obs):
+            omax[lane, j] = OMAX[j, k]
+            omin[lane, j] = OMIN[j, k]
             if n_stat[k] > 0 and status[lane] == STATUS_OK:
-                orms[lane, j] = np.sqrt(orms[lane, j] / n_stat[k])
+                orms[lane, j] = np.sqrt(OSQ[j, k] / n_stat[k])
             else:
                 orms[lane, j] = np.nan
 

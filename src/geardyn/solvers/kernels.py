@@ -57,7 +57,7 @@ class KernelSource:
 
     def functions(self) -> dict[str, Any]:
         prefix = "user_" if self.plain else ""
-        return {
+        funcs = {
             f"{prefix}rhs": self.rhs,
             "events": self.events if self.events is not None else _noop.no_events,
             f"{prefix}observe": (
@@ -65,6 +65,26 @@ class KernelSource:
                 else (_noop.no_observables_plain if self.plain else _noop.no_observables)
             ),
         }
+        if not self.plain:
+            funcs.update(_lane_functions(funcs))
+        return funcs
+
+
+def _lane_functions(funcs: dict[str, Any]) -> dict[str, Any]:
+    """The lane-block forms of a model's functions, where its module defines them: for ``rhs``
+    named ``f``, a compiled ``f_lanes`` beside it becomes ``rhs_lanes`` (and so for ``events``
+    and ``observe``). The sweep kernel runs them on a block of lanes in structure-of-arrays
+    layout (see :mod:`._kernel_template`); without them it calls the per-lane functions."""
+    out = {}
+    for alias in ("rhs", "events", "observe"):
+        py = getattr(funcs[alias], "py_func", None)
+        mod = sys.modules.get(getattr(py, "__module__", ""), None)
+        fn = getattr(mod, f"{py.__name__}_lanes", None) if py is not None else None
+        if fn is not None and hasattr(fn, "py_func"):
+            out[f"{alias}_lanes"] = fn
+    if out and len(out) < 3:
+        return {}  # all three or none: the kernel mixes no layouts
+    return out
 
 
 def cache_dir() -> Path:

@@ -1,0 +1,215 @@
+"""Sweep kernel benchmark, old against new in one run (issue 11, "Engine 2").
+
+The old kernel is the sweep template and step core of git revision ``--old`` (default the
+commit before the Engine 2 kernel), spliced and compiled exactly as ``geardyn.solvers.kernels``
+does; the new one is the working tree's. Both run the same lanes through
+``geardyn.solvers.ensemble.run_lanes`` (its ``kernels_for`` swapped), one after the other, in
+this process, so the ratios are fair on a shared machine. Reports, per kernel and workload:
+warm wall time (median of ``--repeat``), ns per lane-step per thread, located edge crossings
+per lane-step (counted while sampling) and the cost per located crossing (time with edge
+location minus time without, over the crossings of the whole run, estimated from the sampled
+rate), and the largest difference of the section points, old against new.
+
+    .venv/bin/python bench/kernel.py [--repeat 3] [--paper] [--old REV]
+"""
+
+from __future__ import annotations
+
+import argparse
+import hashlib
+import importlib.util
+import re
+import statistics
+import subprocess
+import sys
+import time
+import types
+from pathlib import Path
+
+import numba
+import numpy as np
+
+import geardyn
+import geardyn.solvers.ensemble as ens
+from geardyn.solvers import kernels as kmod
+
+ROOT = Path(__file__).resolve().parents[1]
+OLD_REV = "47fa68e"
+
+
+def _git_show(rev: str, path: str) -> str:
+    return subprocess.run(["git", "show", f"{rev}:{path}"], cwd=ROOT, check=True,
+                          capture_output=True, text=True).stdout
+
+
+def old_kernels(source: kmod.KernelSource, rev: str):
+    """The sweep kernel module of revision ``rev`` for a model (compiled, cached on disk)."""
+    tmpl = _git_show(rev, "src/geardyn/solvers/_kernel_template.py")
+    core = [ln for ln in _git_show(rev, "src/geardyn/solvers/_step_core.py").splitlines()
+            if not ln.startswith("from __future__")]
+    lines = tmpl.splitlines()
+    k = next(i for i, ln in enumerate(lines) if ln.rstrip().endswith(kmod._CORE_MARK))
+    end = k
+    while ")" not in lines[end]:
+        end += 1
+    text = "\n".join([*lines[:k], *core, *lines[end + 1:]]) + "\n"
+    funcs = source.functions()
+    code = kmod._replace_import(text, kmod._import_line(funcs))
+    name = "geardyn_rk4old_" + hashlib.sha256(code.encode()).hexdigest()[:16]
+    folder = kmod.cache_dir()
+    folder.mkdir(parents=True, exist_ok=True)
+    path = folder / f"{name}.py"
+    if not path.exists():
+        path.write_text(code)
+    spec = importlib.util.spec_from_file_location(name, path)
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[name] = module
+    spec.loader.exec_module(module)
+    return module
+
+
+class Workload:
+    def __init__(self, name, model, omegas, transient_periods, samples, n_per):
+        self.name = name
+        self.model = model
+        self.P = model.lane_params("Omega", omegas)
+        self.omegas = np.asarray(omegas, float)
+        self.transient = transient_periods * 2 * np.pi / self.omegas  # whole periods per lane
+        self.samples = samples
+        self.n_per = n_per  # None: automatic
+
+    def run(self, locate: bool = True):
+        return ens.run_lanes(self.model, self.P, self.model.initial_state(), self.transient,
+                             self.samples, steps_per_period=self.n_per, sample_every=1,
+                             locate_edges=locate)
+
+
+def lane_steps(r) -> tuple[int, int]:
+    """(all lane-steps, lane-steps while sampling) of a run_lanes result."""
+    n = r.steps_per_period.astype(np.int64)
+    samp = int(np.sum(r.samples.shape[1] * r.sample_every * n))
+    return int(np.sum(r.transient_periods * n)) + samp, samp
+
+
+def timed(fn, repeat):
+    times, out = [], None
+    for _ in range(repeat):
+        t = time.perf_counter()
+        out = fn()
+        times.append(time.perf_counter() - t)
+    return statistics.median(times), out
+
+
+def measure(w: Workload, mod, repeat: int) -> dict:
+    ens.kernels_for = lambda src, template="rk4": mod
+    try:
+        w.run()  # compile / load
+        t_on, r = timed(w.run, repeat)
+        t_off, _ = timed(lambda: w.run(False), repeat)
+    finally:
+        ens.kernels_for = kmod.kernels_for
+    steps, samp = lane_steps(r)
+    threads = numba.get_num_threads()
+    rate = float(np.sum(r.crossings)) / samp
+    n_cross = rate * steps
+    return dict(t=t_on, t_off=t_off, steps=steps, rate=rate,
+                ns=t_on * threads / steps * 1e9, ns_off=t_off * threads / steps * 1e9,
+                ns_cross=(t_on - t_off) * threads / max(n_cross, 1.0) * 1e9, r=r)
+
+
+def paper_workload(mod, repeat: int) -> float:
+    model = geardyn.CATTDevice(geardyn.PlanetaryParams.paper(xi1=0.05, xi2=0.05))
+    values = np.linspace(0.1, 4.0, 1000)
+    ens.kernels_for = lambda src, template="rk4": mod
+    try:
+        geardyn.bifurcation(model, "Omega", values[:4], transient=20.0, samples=2)
+        t, _ = timed(lambda: geardyn.bifurcation(model, "Omega", values, transient=2000.0,
+                                                 samples=200), repeat)
+    finally:
+        ens.kernels_for = kmod.kernels_for
+    return t
+
+
+def fresh_kernels(source: kmod.KernelSource) -> types.ModuleType:
+    """The working tree's sweep kernel module compiled in memory (numba does not show the
+    assembly of cached code)."""
+    code = kmod._replace_import(kmod._template_text("rk4"), "pass  " + kmod._IMPORT_MARK)
+    module = types.ModuleType("geardyn_rk4_fresh")
+    module.__dict__.update(source.functions())
+    exec(compile(code.replace("_CACHE = True", "_CACHE = False"), module.__name__, "exec"),
+         module.__dict__)
+    return module
+
+
+def vector_report(w: Workload) -> str:
+    """Packed double-precision instructions in the compiled sweep kernel (zmm: 8 doubles, ymm:
+    4), scalar ones (sd), and packed fused multiply-adds (none: no contraction)."""
+    mod = fresh_kernels(w.model.kernel)
+    ens.kernels_for = lambda src, template="rk4": mod
+    try:
+        ens.run_lanes(w.model, w.P[:8], w.model.initial_state(), 1.0, 1, steps_per_period=64)
+    finally:
+        ens.kernels_for = kmod.kernels_for
+    asm = mod.sweep.inspect_asm(mod.sweep.signatures[0])
+    z, y, sd = (len(re.findall(r"\n\s+v\w+" + r, asm))
+                for r in (r"pd\s+[^\n]*%zmm", r"pd\s+[^\n]*%ymm", r"sd\s"))
+    fma = len(re.findall(r"vfmadd\w*pd", asm))
+    ops = sorted({m for m in re.findall(r"\n\s+(v\w+pd)\s+[^\n]*%zmm", asm)})
+    return (f"{w.name}: {z} zmm / {y} ymm packed-double and {sd} scalar-double instructions, "
+            f"{fma} packed FMA; "
+            f"zmm ops: {' '.join(ops)}")
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--paper", action="store_true", help="also the paper's reference workload")
+    ap.add_argument("--old", default=OLD_REV, help="git revision of the old kernel")
+    ap.add_argument("--lanes", type=int, default=256)
+    ap.add_argument("--asm", action="store_true", help="also inspect the new kernel's assembly")
+    args = ap.parse_args()
+    catt = geardyn.CATTDevice(geardyn.PlanetaryParams.paper(xi1=0.05, xi2=0.05))
+    gp = geardyn.GearPair(zeta=0.05, kappa=0.2, Fm=0.1, Fa=0.2)
+    works = [
+        Workload("reduced CATT (4 states, 4 edges), default steps", catt,
+                 np.linspace(0.1, 4.0, args.lanes), 100, 50, None),
+        Workload("gear pair (2 states, 2 edges), 128 steps/period", gp,
+                 np.linspace(0.2, 3.0, args.lanes), 400, 100, 128),
+    ]
+    print(f"# geardyn {geardyn.__version__}, numba {numba.__version__}, "
+          f"{numba.get_num_threads()} threads; old kernel: {args.old}; median of {args.repeat}")
+    print("| workload | kernel | wall [s] | ns/lane-step/thread | same, no edge location "
+          "| crossings/lane-step | ns/located crossing |")
+    print("|---|---|---|---|---|---|---|")
+    for w in works:
+        old = old_kernels(w.model.kernel, args.old)
+        new = kmod.kernels_for(w.model.kernel)
+        res = {}
+        for label, mod in (("old", old), ("new", new)):
+            m = measure(w, mod, args.repeat)
+            res[label] = m
+            print(f"| {w.name} | {label} | {m['t']:.3f} | {m['ns']:.1f} | {m['ns_off']:.1f} | "
+                  f"{m['rate']:.2e} | {m['ns_cross']:.0f} |")
+        a, b = res["old"]["r"], res["new"]["r"]
+        scale = np.nanmax(np.abs(a.samples))
+        diff = np.nanmax(np.abs(a.samples - b.samples)) / scale
+        same_cross = np.array_equal(a.crossings, b.crossings)
+        print(f"|  | new/old | {res['new']['t'] / res['old']['t']:.3f} | "
+              f"{res['new']['ns'] / res['old']['ns']:.3f} | "
+              f"{res['new']['ns_off'] / res['old']['ns_off']:.3f} | max rel. diff of the "
+              f"section points {diff:.1e}, crossings equal: {same_cross} | |")
+    if args.asm:
+        for w in works:
+            print(vector_report(w))
+    if args.paper:
+        model = catt
+        old = old_kernels(model.kernel, args.old)
+        new = kmod.kernels_for(model.kernel)
+        t_old = paper_workload(old, args.repeat)
+        t_new = paper_workload(new, args.repeat)
+        print(f"\npaper reference workload (1000 Omega in [0.1, 4], transient 2000, 200 samples, "
+              f"xi = 0.05): old {t_old:.2f} s, new {t_new:.2f} s, new/old {t_new / t_old:.3f}")
+
+
+if __name__ == "__main__":
+    main()
