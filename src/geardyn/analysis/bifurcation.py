@@ -396,7 +396,8 @@ def _dataset(model: Model, param: str, values: np.ndarray, runs: list[LaneResult
     ds["final_time"] = (param, first.final_time, {
         "long_name": "model time at the last Poincare sample (the final state)",
         "units": model.time_unit})
-    ds.attrs.update(model=model.name, param=param, time_unit=model.time_unit)
+    ds.attrs.update(geardyn_kind="bifurcation", model=model.name, param=param,
+                    time_unit=model.time_unit)
     for key in ("interpretation",):
         if hasattr(model, key):
             ds.attrs[key] = getattr(model, key)
