@@ -216,7 +216,8 @@ def map2d(
         ds["motion"] = ((yn, xn), labels.reshape(ny, nx), motion_attrs)
     ds.attrs.update(run.attrs())
     ds.attrs.update(
-        geardyn_kind="map2d", model=model.name, x=xn, y=yn, lyapunov=int(bool(lyapunov)), time_unit=model.time_unit,
+        geardyn_kind="map2d", model=model.name, x=xn, y=yn, lyapunov=int(bool(lyapunov)),
+        time_unit=model.time_unit,
         chunk=size, start="each point from its own model's initial state",
     )
     if lyap is not None:
