@@ -12,6 +12,7 @@ import geardyn
 from geardyn.analysis.bifurcation import bifurcation
 from geardyn.analysis.periodicity import classify_period
 from geardyn.solvers.ensemble import run_lanes
+from geardyn.testing import assert_result
 
 
 @nb.njit(cache=True)
@@ -64,6 +65,7 @@ def test_diverging_lane_is_marked_and_sweep_goes_on():
                           param_names=["c", "Omega"])
     ds = bifurcation(u, param="c", values=[-0.2, 0.05, 0.1], transient=500.0, samples=8,
                      bound=1e3, steps_per_period=256)
+    assert_result(ds, "bifurcation")
     np.testing.assert_array_equal(ds["status"].values, [1, 0, 0])
     np.testing.assert_array_equal(ds["period"].values, [-1, 1, 1])
     assert np.all(np.isnan(ds["poincare"].values[0]))

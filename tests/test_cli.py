@@ -18,6 +18,7 @@ from geardyn.cli import bifurcation as cli_bifurcation
 from geardyn.cli.main import app, main
 from geardyn.io.netcdf import load_dataset, save_dataset
 from geardyn.io.toml import builtin_study, load_study, paper_study, study_to_toml
+from geardyn.testing import assert_result
 
 
 def _command(*args) -> list[str]:
@@ -337,6 +338,8 @@ def test_plot_redraws_saved_results(tmp_path):
                                            samples=8), tmp_path / "bif.nc")
     sim = save_dataset(simulate(g, omega=0.95, transient=100.0, periods=8),
                        tmp_path / "sim.nc")
+    assert_result(load_dataset(sim), "simulation")
+    assert_result(load_dataset(bif), "bifurcation")
     r = invoke("plot", bif, "--out", tmp_path / "figs" / "bif.pdf")
     assert r.returncode == 0, r.stderr
     assert "bifurcation dataset" in r.stdout
@@ -349,6 +352,15 @@ def test_plot_redraws_saved_results(tmp_path):
     assert_one_line_error(invoke("plot", tmp_path / "none.nc"), "none.nc")
     other = save_dataset(xr.Dataset({"a": ("t", [1.0, 2.0])}), tmp_path / "other.nc")
     assert_one_line_error(invoke("plot", other), "RESULT", "not a geardyn")
+    # the recorded kind decides, checked by assert_result: a variable missing is named ...
+    broken = load_dataset(bif).drop_vars("period")
+    assert_one_line_error(invoke("plot", save_dataset(broken, tmp_path / "broken.nc")),
+                          "RESULT", "'period' missing")
+    # ... and a file written before the kind was recorded is still recognised
+    old = load_dataset(sim)
+    del old.attrs["geardyn_kind"]
+    r = invoke("plot", save_dataset(old, tmp_path / "old.nc"), "--state", "v")
+    assert r.returncode == 0 and "simulation dataset" in r.stdout, r.stderr
 
 
 def test_plot_redraws_maps_and_reproduction_cases(tmp_path):
@@ -370,6 +382,8 @@ def test_plot_redraws_maps_and_reproduction_cases(tmp_path):
                          continuation=d) for d in ("up", "down")]
     case = xr.concat(parts, dim="sweep", combine_attrs="drop_conflicts")
     case = case.assign_coords(sweep=("sweep", ["up", "down"]))
+    case.attrs["geardyn_kind"] = "reproduction-case"  # as geardyn reproduce writes it
+    assert_result(case, "reproduction-case")
     path = save_dataset(case, tmp_path / "case.nc")
     r = invoke("plot", path, "--sweep", "down", "--out", tmp_path / "case-down.png")
     assert r.returncode == 0, r.stderr

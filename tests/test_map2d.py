@@ -11,6 +11,7 @@ import geardyn
 from geardyn.analysis.map2d import estimate_map
 from geardyn.analysis.periodicity import classify_period
 from geardyn.plotting.map2d import plot_map
+from geardyn.testing import assert_result
 
 
 @pytest.fixture(scope="module")
@@ -81,12 +82,14 @@ def test_map_points_equal_single_simulations(device):
     om, xi = np.array([0.6, 1.1, 2.2]), np.array([0.03, 0.12])
     kw = dict(transient=300.0, samples=6, steps_per_period=64)
     ds = geardyn.map2d(device, x=("Omega", om), y=("xi", xi), **kw)
+    assert_result(ds, "map2d")
     for j, v in enumerate(xi):
         row = geardyn.bifurcation(device.with_params(xi=v), values=om, **kw)
         for name in ("period", "contact", "force_peak", "force_rms", "dynamic_factor"):
             np.testing.assert_array_equal(ds[name].values[j], row[name].values, err_msg=name)
     one = geardyn.simulate(device.with_params(xi=xi[1]), omega=om[2], transient=300.0,
                            periods=6, steps_per_period=64)
+    assert_result(one, "simulation")
     assert ds["period"].values[1, 2] == classify_period(one["poincare"].values[1:])
 
 

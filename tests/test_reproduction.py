@@ -38,6 +38,7 @@ from geardyn.reproduction.motion import motion_labels
 from geardyn.reproduction.tables import BEGIN, END, generated_section
 from geardyn.reproduction.verdicts import MARKER, read_verdicts, verdict_document
 from geardyn.solvers.reference import reference_solution
+from geardyn.testing import assert_result
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -353,6 +354,7 @@ def test_pipeline_at_tiny_resolution(tmp_path, capsys):
     assert {"fig5-consistent.nc", "fig5-consistent.png", "fig5-consistent-down.png",
             "report.md", "report.html", "verdicts.md"} <= files
     ds = load_dataset(out / "fig5-consistent.nc")
+    assert_result(ds, "reproduction-case")
     assert list(ds["sweep"].values) == ["up", "down"] and ds.sizes["Omega"] == 3
 
     # structure: one summary row per claim, each with a known status

@@ -1,4 +1,10 @@
-"""Checks for geardyn's own tests and for users: does a model keep the model contract?
+"""Checks for geardyn's own tests and for users: does a model keep the model contract, and is a
+dataset a well-formed geardyn result?
+
+:func:`assert_result` checks a result dataset against what its kind (``attrs["geardyn_kind"]``,
+one of :data:`KINDS`) promises: coordinates, variables and their dimensions, units and meaning
+attributes, and status codes among :class:`geardyn.Status`. It raises :class:`AssertionError`
+naming everything missing.
 
 :func:`check_model` runs one check per numbered rule of the model contract (the rules are
 written out in :class:`geardyn.Model`'s docstring and listed in :data:`RULES`) and raises
@@ -30,11 +36,13 @@ from geardyn.models.base import Model
 from geardyn.solvers.kernels import TEMPLATES, KernelSource, kernels_for
 
 __all__ = [
+    "KINDS",
     "RULES",
     "ModelContractError",
     "ModelReport",
     "Rule",
     "RuleResult",
+    "assert_result",
     "check_model",
 ]
 
@@ -597,3 +605,94 @@ def check_model(
     if raise_on_failure and not report.ok:
         raise ModelContractError(report)
     return report
+
+
+# ------------------------------------------------------------------------------ result datasets
+#: The kinds of result dataset, as recorded in ``attrs["geardyn_kind"]``: what
+#: :func:`geardyn.simulate`, :func:`geardyn.bifurcation`, :func:`geardyn.map2d` and the
+#: reproduction (``geardyn reproduce``, one case under one interpretation) return.
+KINDS = ("simulation", "bifurcation", "map2d", "reproduction-case")
+
+
+def _result_spec(ds: Any, kind: str) -> tuple[list[str], dict[str, tuple[str, ...]],
+                                              dict[str, tuple[str, ...]], list[str]]:
+    """(required attributes, coordinates with their dims, variables with their dims (any
+    order), the status variables) of a dataset of ``kind``; the dims name the attributes'
+    values where they depend on them (``param``, ``x``, ``y``)."""
+    a = ds.attrs
+    if kind == "simulation":
+        states = [str(s) for s in ds["state"].values] if "state" in ds.coords else []
+        variables = {"poincare": ("sample", "state"), "poincare_time": ("sample",)}
+        variables.update({s: ("time",) for s in states})
+        return (["status", "status_meaning", "steps_per_period", "time_unit"],
+                {"time": ("time",), "sample": ("sample",), "state": ("state",)}, variables, [])
+    if kind in ("bifurcation", "reproduction-case"):
+        p = str(a.get("param", "Omega"))
+        lead = (p,) if kind == "bifurcation" else ("sweep", p)
+        coords = {p: (p,), "sample": ("sample",), "state": ("state",)}
+        if kind == "reproduction-case":
+            coords["sweep"] = ("sweep",)
+        variables = {"poincare": (*lead, "sample", "state"), "period": lead, "status": lead,
+                     "final_time": lead}
+        return ["param", "time_unit"], coords, variables, ["status"]
+    if kind == "map2d":
+        x, y = str(a.get("x", "x")), str(a.get("y", "y"))
+        return (["x", "y", "time_unit"], {y: (y,), x: (x,)},
+                {"period": (y, x), "status": (y, x)}, ["status"])
+    raise AssertionError(f"unknown result kind {kind!r}: one of {', '.join(KINDS)}")
+
+
+#: Attributes a variable of each name must carry (its units or the meaning of its codes).
+_VARIABLE_ATTRS = {"period": ("meaning",), "status": ("meaning",), "final_time": ("units",),
+                   "poincare_time": ("units",), "time": ("units",)}
+
+
+def _status_problems(name: str, values: np.ndarray) -> list[str]:
+    """What is wrong with the status codes ``values`` of ``name`` (empty when all are known)."""
+    from geardyn.core.status import Status
+
+    codes = np.asarray(values)
+    if codes.dtype.kind not in "iuf" or np.any(~np.isfinite(codes.astype(float))):
+        return [f"{name}: not integer status codes (dtype {codes.dtype})"]
+    bad = np.setdiff1d(codes.astype(np.int64), [int(s) for s in Status])
+    if bad.size:
+        return [f"{name}: codes {bad.tolist()} are not geardyn.Status codes "
+                f"{[int(s) for s in Status]}"]
+    return []
+
+
+def assert_result(ds: Any, kind: str) -> None:
+    """Assert that ``ds`` is a well-formed geardyn result of ``kind`` (one of :data:`KINDS`).
+
+    Checks ``attrs["geardyn_kind"] == kind``; the kind's required attributes, coordinates and
+    variables, each with its dimensions; the units or meaning attributes the kind promises
+    (``status`` and ``period`` a ``meaning``, times their ``units``); and that every status
+    code is a :class:`geardyn.Status` code. Raises :class:`AssertionError` naming every
+    problem found."""
+    if kind not in KINDS:
+        raise AssertionError(f"unknown result kind {kind!r}: one of {', '.join(KINDS)}")
+    problems: list[str] = []
+    recorded = ds.attrs.get("geardyn_kind")
+    if recorded != kind:
+        problems.append(f"attrs['geardyn_kind'] is {recorded!r}, expected {kind!r}")
+    attrs, coords, variables, statuses = _result_spec(ds, kind)
+    problems += [f"attribute {a!r} missing" for a in attrs if a not in ds.attrs]
+    for group, wanted, ordered in (("coordinate", coords, True), ("variable", variables, False)):
+        for name, dims in wanted.items():
+            if name not in (ds.coords if group == "coordinate" else ds.variables):
+                problems.append(f"{group} {name!r} missing")
+                continue
+            have = tuple(ds[name].dims)
+            if (have != dims) if ordered else (sorted(have) != sorted(dims)):
+                problems.append(f"{group} {name!r} has dims {have}, expected {dims}")
+    for name, keys in _VARIABLE_ATTRS.items():
+        if name in ds.variables:
+            problems += [f"{name!r} has no {k!r} attribute" for k in keys
+                         if k not in ds[name].attrs]
+    for name in statuses:
+        if name in ds.variables:
+            problems += _status_problems(name, ds[name].values)
+    if kind == "simulation" and "status" in ds.attrs:
+        problems += _status_problems("attrs['status']", ds.attrs["status"])
+    if problems:
+        raise AssertionError(f"not a geardyn {kind} result: " + "; ".join(problems))

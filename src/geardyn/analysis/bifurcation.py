@@ -12,18 +12,15 @@ import numpy as np
 import xarray as xr
 
 from geardyn.analysis.continuation import Branch, continue_branches
+from geardyn.analysis.dataset import sweep_dataset
 from geardyn.analysis.lanes import (
     has_mesh_forces,
-    lane_periods,
-    lane_variables,
-    variable_attrs,
-    variable_dims,
 )
 from geardyn.analysis.lyapunov import lyapunov_err_attrs
 from geardyn.analysis.motion import averaging_time, motion_variable
 from geardyn.core.plan import forcing_period
 from geardyn.core.settings import RunSettings, resolve_run
-from geardyn.core.status import Status, status_attrs
+from geardyn.core.status import Status
 from geardyn.models.base import Model
 from geardyn.solvers.ensemble import LaneResults
 from geardyn.solvers.executor import lane_results, run_chunks, run_lanes_task
@@ -368,41 +365,8 @@ def _initial_states(model: Model, param: str, values: np.ndarray, y0: np.ndarray
 def _dataset(model: Model, param: str, values: np.ndarray, runs: list[LaneResults],
              max_period: int, tol: float) -> xr.Dataset:
     """The sweep dataset of one or more starts' lane results (without the settings)."""
-    first = runs[0]
-    poincare = np.concatenate([r.samples for r in runs], axis=1)
     static = _static_forces(model, param, values) if has_mesh_forces(model) else None
-    per_lane = lane_variables(model, first, static, max_period, tol)
-    per_lane["unresolved_steps"] = np.sum([r.unresolved for r in runs], axis=0)  # every start
-    status = np.max(np.stack([r.status for r in runs], axis=1), axis=1)
-    ds = xr.Dataset(coords={
-        param: (param, values),
-        "sample": ("sample", np.arange(poincare.shape[1])),
-        "state": ("state", list(model.state_names)),
-    })
-    if model.meshes:
-        ds = ds.assign_coords(mesh=("mesh", [m[0] for m in model.meshes]))
-    ds["poincare"] = ((param, "sample", "state"), poincare, {
-        "long_name": "Poincare points (states once per forcing period after the transient)"})
-    dims, attrs = variable_dims(model), variable_attrs(model, max_period, tol)
-    for name, data in per_lane.items():
-        ds[name] = ((param, *dims[name]), data, attrs[name])
-    if len(runs) > 1:
-        samples = first.samples.shape[1]
-        periods = np.stack([per_lane["period"]] + [lane_periods(r, max_period, tol)
-                                                   for r in runs[1:]], axis=1)
-        ds["period_by_start"] = ((param, "start"), periods)
-        ds["start_of_sample"] = ("sample", np.repeat(np.arange(len(runs)), samples))
-    ds["status"] = (param, status, status_attrs(" in at least one start"))
-    ds["final_time"] = (param, first.final_time, {
-        "long_name": "model time at the last Poincare sample (the final state)",
-        "units": model.time_unit})
-    ds.attrs.update(model=model.name, param=param, time_unit=model.time_unit)
-    for key in ("interpretation",):
-        if hasattr(model, key):
-            ds.attrs[key] = getattr(model, key)
-    if hasattr(model, "omega_n"):
-        ds.attrs["omega_n"] = float(model.omega_n)
-    return ds
+    return sweep_dataset(model, param, values, runs, max_period, tol, static)
 
 
 def _mean_period(model: Model, P: np.ndarray) -> float:

@@ -21,14 +21,12 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
+from geardyn.analysis.dataset import map_dataset, model_attrs
 from geardyn.analysis.lanes import (
     CONTACT_LABELS,
     has_mesh_forces,
     lane_variables,
-    variable_attrs,
-    variable_dims,
 )
-from geardyn.analysis.lyapunov import lyapunov_err_attrs
 from geardyn.analysis.motion import averaging_time, motion_variable
 from geardyn.core.plan import (
     default_steps_per_period,
@@ -38,7 +36,7 @@ from geardyn.core.plan import (
     periods_covering,
 )
 from geardyn.core.settings import RunSettings, resolve_run
-from geardyn.core.status import Status, status_attrs
+from geardyn.core.status import Status
 from geardyn.models.base import Model
 from geardyn.solvers.ensemble import run_lanes
 from geardyn.solvers.executor import default_chunk, run_chunks
@@ -189,24 +187,8 @@ def map2d(
     out = run_chunks(task, model, inputs, chunk=size, client=client, store=store,
                      progress=progress, meta=meta)
 
+    ds = map_dataset(model, (yn, yv), (xn, xv), out, run.max_period, run.period_tol)
     ny, nx = yv.size, xv.size
-    ds = xr.Dataset(coords={yn: (yn, yv), xn: (xn, xv)})
-    if model.meshes:
-        ds = ds.assign_coords(mesh=("mesh", [m[0] for m in model.meshes]))
-    dims, attrs = variable_dims(model), variable_attrs(model, run.max_period, run.period_tol)
-    dims.update(status=(), lyapunov=(), lyapunov_err=())
-    attrs.update(status=status_attrs(),
-                 lyapunov={"long_name": "largest Lyapunov exponent",
-                           "units": f"1/{model.time_unit}",
-                           "start": "each point's final state at its final time"},
-                 lyapunov_err=lyapunov_err_attrs(model.time_unit))
-    for name in (*variable_dims(model), "status", "lyapunov", "lyapunov_err"):
-        if name not in out:
-            continue
-        data = out[name].reshape(ny, nx, *out[name].shape[1:])
-        if name == "contact":
-            data = np.array(CONTACT_LABELS)[data]
-        ds[name] = ((yn, xn, *dims[name]), data, attrs[name])
     if lyap is not None:
         period = ds["period"].values.ravel()
         section = lane_section(model, P, P[:, model.omega_index], run.max_section_periods)[1]
@@ -216,16 +198,14 @@ def map2d(
         ds["motion"] = ((yn, xn), labels.reshape(ny, nx), motion_attrs)
     ds.attrs.update(run.attrs())
     ds.attrs.update(
-        model=model.name, x=xn, y=yn, lyapunov=int(bool(lyapunov)), time_unit=model.time_unit,
+        geardyn_kind="map2d", model=model.name, x=xn, y=yn, lyapunov=int(bool(lyapunov)),
+        time_unit=model.time_unit,
         chunk=size, start="each point from its own model's initial state",
     )
     if lyap is not None:
         ds.attrs.update(lyapunov_duration=lyap["duration"],
                         lyapunov_steps_per_period=int(steps_per_period or 0))
-    if hasattr(model, "interpretation"):
-        ds.attrs["interpretation"] = model.interpretation
-    if hasattr(model, "omega_n"):
-        ds.attrs["omega_n"] = float(model.omega_n)
+    ds.attrs.update(model_attrs(model))
     if store is not None:
         _save_store(ds, store)
     return ds

@@ -346,10 +346,34 @@ def bifurcation_command(
     )
 
 
+#: What ``geardyn plot`` calls each result kind (``attrs["geardyn_kind"]``).
+_PLOT_KIND = {"simulation": "simulation", "bifurcation": "bifurcation", "map2d": "map",
+              "reproduction-case": "reproduction"}
+
+
 def _dataset_kind(ds) -> str:
     """``"simulation"``, ``"bifurcation"``, ``"map"`` or ``"reproduction"`` (what
     :func:`geardyn.simulate`, :func:`geardyn.bifurcation`, :func:`geardyn.map2d` or
-    ``geardyn reproduce`` wrote), else a one-line error."""
+    ``geardyn reproduce`` wrote): the kind the dataset records (``attrs["geardyn_kind"]``),
+    checked by :func:`geardyn.testing.assert_result`; for a file written before the kind was
+    recorded, guessed from its variables; else a one-line error."""
+    from geardyn.testing import assert_result
+
+    source = ds.encoding.get("source", "?")
+    kind = ds.attrs.get("geardyn_kind")
+    if kind is None:
+        return _guess_kind(ds, source)
+    if kind not in _PLOT_KIND:
+        raise ParameterError("RESULT", source, f"unknown result kind {kind!r}")
+    try:
+        assert_result(ds, kind)
+    except AssertionError as exc:
+        raise ParameterError("RESULT", source, str(exc)) from None
+    return _PLOT_KIND[kind]
+
+
+def _guess_kind(ds, source: str) -> str:
+    """The kind of a result saved without ``attrs["geardyn_kind"]``, from its variables."""
     if "poincare" in ds and "time" in ds.dims:
         return "simulation"
     param = ds.attrs.get("param")
@@ -357,8 +381,9 @@ def _dataset_kind(ds) -> str:
         return "reproduction" if "sweep" in ds.dims else "bifurcation"
     if "period" in ds and "x" in ds.attrs and "y" in ds.attrs:
         return "map"
-    raise ParameterError("RESULT", ds.encoding.get("source", "?"),
-                         "not a geardyn simulation, bifurcation, map or reproduction dataset")
+    raise ParameterError("RESULT", source, "not a geardyn simulation, bifurcation, map or "
+                         "reproduction dataset (no attrs['geardyn_kind'], and its variables "
+                         "match none)")
 
 
 def _load_result(result: Path):

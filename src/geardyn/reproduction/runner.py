@@ -262,6 +262,7 @@ def _assemble(case: Case, interpretation: str, settings: ReproductionSettings,
     up, down = per_direction["up"], per_direction["down"]
     out.attrs.update(
         {f"setting_{k}": v for k, v in settings.resolve(case).items()},
+        geardyn_kind="reproduction-case",
         interpretation=interpretation,
         lane_steps_up=up["lane_steps"], lane_steps_down=down["lane_steps"],
         lyapunov_time_up_s=float(up["lyapunov_wall_time_s"]),

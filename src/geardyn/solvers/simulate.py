@@ -130,6 +130,7 @@ def simulate(
             "long_name": "dead-zone edge crossings while recording"})
         ds = ds.assign_coords(event=("event", list(model.event_names)))
     ds.attrs.update(
+        geardyn_kind="simulation",
         model=model.name,
         Omega=om,
         period=period,

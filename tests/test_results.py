@@ -1,0 +1,105 @@
+"""geardyn.testing.assert_result: a result dataset checked against what its kind promises.
+
+Cheap synthetic datasets (no kernel compiled) shaped like geardyn's results; the tests that
+build real results call assert_result on them (test_bifurcation, test_map2d, test_reproduction,
+test_cli)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import xarray as xr
+
+from geardyn.core.status import status_attrs
+from geardyn.testing import KINDS, assert_result
+
+PERIOD = {"meaning": "k>=1 period-k"}
+
+
+def _sweep(kind: str = "bifurcation") -> xr.Dataset:
+    n = 3
+    ds = xr.Dataset(coords={"Omega": ("Omega", [0.5, 1.0, 1.5]), "sample": ("sample", [0, 1]),
+                            "state": ("state", ["x", "v"])})
+    ds["poincare"] = (("Omega", "sample", "state"), np.zeros((n, 2, 2)))
+    ds["period"] = ("Omega", np.ones(n, dtype=int), PERIOD)
+    ds["status"] = ("Omega", np.array([0, 1, 0]), status_attrs())
+    ds["final_time"] = ("Omega", np.ones(n), {"units": "tau"})
+    ds.attrs.update(geardyn_kind=kind, param="Omega", time_unit="tau")
+    return ds
+
+
+def _map() -> xr.Dataset:
+    ds = xr.Dataset(coords={"xi": ("xi", [0.1, 0.2]), "Omega": ("Omega", [1.0, 2.0, 3.0])})
+    ds["period"] = (("xi", "Omega"), np.ones((2, 3), dtype=int), PERIOD)
+    ds["status"] = (("xi", "Omega"), np.zeros((2, 3), dtype=int), status_attrs())
+    ds.attrs.update(geardyn_kind="map2d", x="Omega", y="xi", time_unit="tau")
+    return ds
+
+
+def _simulation() -> xr.Dataset:
+    t = np.arange(5.0)
+    ds = xr.Dataset(coords={"time": ("time", t, {"units": "tau"}), "sample": ("sample", [0, 1]),
+                            "state": ("state", ["x", "v"])})
+    ds["x"] = ("time", np.sin(t), {"units": "1"})
+    ds["v"] = ("time", np.cos(t), {"units": "1"})
+    ds["poincare"] = (("sample", "state"), np.zeros((2, 2)))
+    ds["poincare_time"] = ("sample", [0.0, 4.0], {"units": "tau"})
+    ds.attrs.update(geardyn_kind="simulation", status=0, status_meaning="0 ok",
+                    steps_per_period=4, time_unit="tau")
+    return ds
+
+
+def _case() -> xr.Dataset:
+    ds = xr.concat([_sweep(), _sweep()], dim="sweep").assign_coords(sweep=["up", "down"])
+    ds.attrs["geardyn_kind"] = "reproduction-case"
+    return ds
+
+
+BUILD = {"simulation": _simulation, "bifurcation": _sweep, "map2d": _map,
+         "reproduction-case": _case}
+
+
+@pytest.mark.parametrize("kind", KINDS)
+def test_well_formed_results_pass(kind):
+    assert_result(BUILD[kind](), kind)
+
+
+@pytest.mark.parametrize("kind,name", [("simulation", "poincare"), ("simulation", "v"),
+                                       ("bifurcation", "period"), ("bifurcation", "status"),
+                                       ("map2d", "status"), ("reproduction-case", "poincare")])
+def test_a_removed_variable_is_named(kind, name):
+    ds = BUILD[kind]().drop_vars(name)
+    with pytest.raises(AssertionError, match=f"'{name}' missing"):
+        assert_result(ds, kind)
+
+
+@pytest.mark.parametrize("kind", KINDS)
+def test_the_wrong_kind_fails(kind):
+    other = next(k for k in KINDS if k != kind)
+    with pytest.raises(AssertionError, match="geardyn_kind"):
+        assert_result(BUILD[kind](), other)
+
+
+def test_a_missing_kind_attribute_fails():
+    ds = _sweep()
+    del ds.attrs["geardyn_kind"]
+    with pytest.raises(AssertionError, match="attrs\\['geardyn_kind'\\] is None"):
+        assert_result(ds, "bifurcation")
+
+
+def test_wrong_dims_missing_meaning_and_unknown_status_are_named():
+    ds = _sweep()
+    ds["final_time"] = ("sample", [1.0, 2.0], {"units": "tau"})
+    ds["period"].attrs.clear()
+    ds["status"].values[1] = 7
+    with pytest.raises(AssertionError) as info:
+        assert_result(ds, "bifurcation")
+    text = str(info.value)
+    assert "'final_time' has dims ('sample',)" in text
+    assert "'period' has no 'meaning'" in text
+    assert "codes [7]" in text
+
+
+def test_an_unknown_kind_is_refused():
+    with pytest.raises(AssertionError, match="unknown result kind"):
+        assert_result(_sweep(), "sweep")
