@@ -168,9 +168,9 @@ def bifurcation(
         # own step; a short run aligns the tangent vectors
         final = last.final
         start = np.where(np.isfinite(final), final, np.broadcast_to(base_y0, final.shape))
-        exps, errs = lyapunov_lanes(model, P, start, min(run.transient, LYAPUNOV_ALIGN),
-                                    run.samples * _mean_period(model, P), run.steps_per_period,
-                                    t0=last.final_time, with_error=True)
+        asked = run.samples * _mean_period(model, P)  # averaging time asked for
+        exps, errs = lyapunov_lanes(model, P, start, min(run.transient, LYAPUNOV_ALIGN), asked,
+                                    run.steps_per_period, t0=last.final_time, with_error=True)
         ok = ds["status"].values == Status.OK
         method = ("tangent-map QR (Benettin), from the point's final state at its final time, "
                   f"{LYAPUNOV_ALIGN:g} time units to align, then as long as the sampling")
@@ -179,10 +179,9 @@ def bifurcation(
             "method": method})
         ds["lyapunov_err"] = (param, np.where(ok & np.isfinite(exps), errs, np.nan),
                               lyapunov_err_attrs(model.time_unit))
-        duration = averaging_time(run.samples * _mean_period(model, P),
-                                  P[:, model.omega_index])
         ds["motion"] = (param, *motion_variable(ds["period"].values, ds["lyapunov"].values,
-                                                ds["lyapunov_err"].values, duration,
+                                                ds["lyapunov_err"].values,
+                                                averaging_time(asked, P[:, model.omega_index]),
                                                 last.commensurate))
     return ds
 

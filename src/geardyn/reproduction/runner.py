@@ -19,7 +19,7 @@ import xarray as xr
 from geardyn.analysis.bifurcation import ContinuedSweep, continued_sweeps
 from geardyn.analysis.lyapunov import lyapunov_err_attrs, lyapunov_lanes
 from geardyn.analysis.motion import LYAPUNOV_FLOOR, LYAPUNOV_Z, exponent_sign, rule_text
-from geardyn.analysis.periodicity import common_section
+from geardyn.core.plan import lane_section
 from geardyn.core.settings import RunSettings
 from geardyn.models.base import Model
 from geardyn.reproduction.cases import Case
@@ -229,8 +229,8 @@ def _classify(ds: xr.Dataset, sweep: ContinuedSweep, r: dict) -> xr.Dataset:
     ds["lyapunov_err"] = ("Omega", err, lyapunov_err_attrs("tau"))
     ds["lyapunov_duration"] = ("Omega", np.where(need, duration, np.nan), {
         "long_name": "time the Lyapunov exponent was averaged over", "units": "tau"})
-    section = common_section(values, model.other_frequencies(model.lane_params("Omega", values)),
-                             max_periods=r["max_section_periods"])[1]
+    section = lane_section(model, model.lane_params("Omega", values), values,
+                           r["max_section_periods"])[1]
     ds["motion"] = ("Omega", motion_labels(period, lam, lyapunov_err=err, duration=duration,
                                            section=section, **rule), {
         "long_name": "motion class", "meaning": "period-k, chaotic, quasi-periodic, "
