@@ -18,6 +18,7 @@ from geardyn.cli import bifurcation as cli_bifurcation
 from geardyn.cli.main import app, main
 from geardyn.io.netcdf import load_dataset, save_dataset
 from geardyn.io.toml import builtin_study, load_study, paper_study, study_to_toml
+from geardyn.study import build_model
 from geardyn.testing import assert_result
 
 
@@ -185,7 +186,7 @@ def test_bifurcation_writes_what_the_api_computes(tmp_path):
     assert png.read_bytes()[:8] == PNG
     saved = load_dataset(nc)
     study = builtin_study("paper_fig3")
-    direct = bifurcation(study.build_model(), param="Omega",
+    direct = bifurcation(build_model(study), param="Omega",
                                  values=np.linspace(0.6, 2.6, 5), transient=60.0, samples=6,
                                  steps_per_period=64)
     np.testing.assert_array_equal(saved["period"].values, direct["period"].values)
@@ -365,7 +366,7 @@ def test_plot_redraws_saved_results(tmp_path):
 
 def test_plot_redraws_maps_and_reproduction_cases(tmp_path):
     from geardyn import map2d
-    from geardyn.io.zarr_store import save_zarr_dataset
+    from geardyn.execution.zarr_store import save_zarr_dataset
 
     g = GearPair(zeta=0.05, kappa=0.2, Fa=0.2)
     m = map2d(g, x=("Omega", [0.8, 1.2]), y=("zeta", [0.05, 0.1]), transient=50.0, samples=4)

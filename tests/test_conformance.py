@@ -14,7 +14,7 @@ import pytest
 
 import geardyn
 from conformance_cases import IDS, cases, dead_zone_events, dead_zone_rhs, user_model
-from geardyn.solvers.kernels import KernelSource
+from geardyn.core.kernel_source import KernelSource
 from geardyn.testing import RULES, ModelContractError, check_model
 
 # ---------------------------------------------------------------------------------------------

@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 import geardyn
+from geardyn.execution.executor import inputs_digest, lane_results, run_chunks, run_lanes_task
 from geardyn.solvers.ensemble import LaneResults, run_lanes
-from geardyn.solvers.executor import inputs_digest, lane_results, run_chunks, run_lanes_task
 
 GEAR = geardyn.GearPair(zeta=0.05, kappa=0.2, Fm=0.1, Fa=0.2)
 OMEGAS = np.linspace(0.4, 3.0, 13)

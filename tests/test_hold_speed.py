@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 import geardyn
+from geardyn.study import build_model
 
 KM_SQ = np.array([0.5e9, 0.825e9, 1.6e9])
 
@@ -81,7 +82,7 @@ def test_cli_hold_speed_writes_what_the_api_computes(tmp_path):
     r = CliRunner().invoke(app, args)
     assert r.exit_code == 0, r.output
     saved = load_dataset(nc)
-    model = builtin_study("paper_fig3").build_model(omega=1.1)
+    model = build_model(builtin_study("paper_fig3"), omega=1.1)
     direct = geardyn.bifurcation(model, "Km_sq", np.linspace(0.5e9, 1.6e9, 3), transient=20.0,
                                  samples=3, hold="speed")
     assert saved.attrs["hold"] == "speed"

@@ -29,6 +29,7 @@ from geardyn.io.toml import (
     save_params,
     save_study,
 )
+from geardyn.study import build_model
 
 # --------------------------------------------------------------------------- parameters
 
@@ -124,20 +125,20 @@ def test_study_base_and_changes():
     s = load_study(STUDY_TEXT)
     assert isinstance(s.params, PaperBase)
     assert s.planetary_params == PlanetaryParams.paper(xi1=0.1, backlash=3e-5, B1=100.0)
-    m = s.build_model()
+    m = build_model(s)
     assert isinstance(m, CATTDevice)
     assert m.interpretation == "carrier-only" and m.omega == 1.5
-    assert s.build_model(interpretation="as-printed", omega=2.0).interpretation == "as-printed"
+    assert build_model(s, interpretation="as-printed", omega=2.0).interpretation == "as-printed"
     assert s.run.periods == 8 and s.run.transient == 4000.0
     assert s.plot_state == "X_sq"
 
 
 def test_study_full_params_and_gear_pair():
     full = Study(study=StudyInfo(name="f"), params=PlanetaryParams.paper(N=3))
-    assert full.build_model().params_in.n_planets == 3
+    assert build_model(full).params_in.n_planets == 3
     gp = load_study('[study]\nmodel = "gear_pair"\n[params]\nzeta = 0.1\nFa = 0.2\n')
     assert isinstance(gp.params, GearPairParams)
-    model = gp.build_model(omega=1.3)
+    model = build_model(gp, omega=1.3)
     assert isinstance(model, GearPair) and model.omega == 1.3
     assert gp.plot_state == "x"
     with pytest.raises(StudyError):

@@ -12,6 +12,7 @@ import geardyn
 from geardyn.analysis.lyapunov import lyapunov, lyapunov_lanes
 from geardyn.io.toml import builtin_study
 from geardyn.models import catt_kernels
+from geardyn.study import build_model
 from test_verification_catt import theta_from_mesh
 
 
@@ -449,7 +450,7 @@ def test_sweep_exponent_continues_its_lane_in_both_forcing_phases():
     same time, equal within the errors to an independent run of that system from the model's
     initial state (long transient), and clearly unlike the restart at time 0 (load phase 0),
     which the sweep's exponent used to be."""
-    model = builtin_study("paper_fig14").build_model()
+    model = build_model(builtin_study("paper_fig14"))
     lam_load = model.params[catt_kernels.LAMBDA]
     assert lam_load == 2.0
     samples = 512

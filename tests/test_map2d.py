@@ -199,7 +199,7 @@ def test_cli_map_zarr_output_opens_with_plain_xarray_and_redraws(tmp_path, capsy
     import xarray as xr
 
     from geardyn.cli.main import main
-    from geardyn.io.zarr_store import LaneStore
+    from geardyn.execution.zarr_store import LaneStore
 
     study = tmp_path / "gp.toml"
     study.write_text(GEAR_STUDY)

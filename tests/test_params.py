@@ -11,7 +11,7 @@ import pytest
 from pydantic import ValidationError
 
 from geardyn import CATTDevice, Mesh, PlanetaryParams, PlanetOverride
-from geardyn.io.toml import format_error
+from geardyn.cli.errors import format_error
 
 MESH = dict(
     mean_stiffness=0.825e9, stiffness_amplitude=0.2e9, backlash=5e-5, error=1e-5,

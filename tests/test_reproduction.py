@@ -38,6 +38,7 @@ from geardyn.reproduction.motion import motion_labels
 from geardyn.reproduction.tables import BEGIN, END, generated_section
 from geardyn.reproduction.verdicts import MARKER, read_verdicts, verdict_document
 from geardyn.solvers.reference import reference_solution
+from geardyn.study import build_model
 from geardyn.testing import assert_result
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -319,7 +320,7 @@ TINY = ("--resolution", 3, "--transient", 300, "--samples", 8, "--jobs", 1)
 def _reference_periods(case_name: str, omegas, transient: float, samples: int) -> list[int]:
     """Up-sweep continuation replayed with DOP853 (rtol 1e-12); each point classified by
     counting distinct stroboscopic states (relative tolerance 1e-6) and checking they cycle."""
-    model = get_case(case_name).study.build_model("consistent")
+    model = build_model(get_case(case_name).study, "consistent")
     y, t = model.initial_state(), 0.0
     out = []
     for om in sorted(omegas):

@@ -17,14 +17,15 @@ import pytest
 import xarray as xr
 
 import geardyn
-from geardyn.io.toml import load_study
-from geardyn.io.zarr_store import (
+from geardyn.execution.executor import lane_results, run_chunks, run_lanes_task
+from geardyn.execution.zarr_store import (
     LaneStore,
     StoreMismatchError,
     load_zarr_dataset,
     save_zarr_dataset,
 )
-from geardyn.solvers.executor import lane_results, run_chunks, run_lanes_task
+from geardyn.io.toml import load_study
+from geardyn.study import build_model
 
 GEAR = geardyn.GearPair(zeta=0.05, kappa=0.2, Fm=0.1, Fa=0.2)
 OMEGAS = np.linspace(0.4, 3.0, 10)
@@ -278,7 +279,7 @@ def test_killed_cli_run_resumes_to_the_uninterrupted_result(tmp_path):
     np.testing.assert_array_equal(runs[killed > 0], 1)
     np.testing.assert_array_equal(runs[killed == 0], 2)
 
-    model = load_study(study).build_model()
+    model = build_model(load_study(study))
     whole = geardyn.map2d(model, x=_axis(X), y=_axis(Y), transient=300.0, samples=16,
                           chunk=CHUNK)
     with warnings.catch_warnings():

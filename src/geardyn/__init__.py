@@ -9,16 +9,17 @@ The public API::
 """
 
 from geardyn import testing
+from geardyn._version import __version__ as __version__
 from geardyn.analysis.bifurcation import ContinuedSweep, bifurcation, continued_sweeps
 from geardyn.analysis.lyapunov import LyapunovEstimate, lyapunov, lyapunov_lanes
 from geardyn.analysis.map2d import map2d
 from geardyn.analysis.motion import motion_classes
 from geardyn.analysis.periodicity import classify_period, common_section
 from geardyn.analysis.spectrum import amplitude_spectrum, label_peaks
+from geardyn.core.model import Model
 from geardyn.core.settings import RunSettings
 from geardyn.core.status import Status
 from geardyn.errors import GeardynError, ParameterError, StudyError
-from geardyn.models.base import Model
 from geardyn.models.catt import CATTDevice, DimensionalCATT
 from geardyn.models.derived import INTERPRETATIONS
 from geardyn.models.gear_pair import GearPair
@@ -26,8 +27,7 @@ from geardyn.models.params import Carrier, Gear, Loads, Mesh, PlanetaryParams, P
 from geardyn.models.user import UserModel
 from geardyn.solvers.reference import reference_solution
 from geardyn.solvers.simulate import default_steps_per_period, simulate
-
-__version__ = "0.1.0"
+from geardyn.study import build_model
 
 __all__ = [
     "INTERPRETATIONS",
@@ -51,6 +51,7 @@ __all__ = [
     "UserModel",
     "amplitude_spectrum",
     "bifurcation",
+    "build_model",
     "classify_period",
     "common_section",
     "continued_sweeps",

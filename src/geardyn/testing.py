@@ -32,7 +32,7 @@ from typing import Any
 
 import numpy as np
 
-from geardyn.models.base import Model
+from geardyn.core.model import Model
 from geardyn.solvers.kernels import TEMPLATES, KernelSource, kernels_for
 
 __all__ = [

@@ -18,12 +18,12 @@ from geardyn.analysis.lanes import (
 )
 from geardyn.analysis.lyapunov import lyapunov_err_attrs
 from geardyn.analysis.motion import averaging_time, motion_variable
+from geardyn.core.model import Model
 from geardyn.core.plan import forcing_period
 from geardyn.core.settings import RunSettings, resolve_run
 from geardyn.core.status import Status
-from geardyn.models.base import Model
+from geardyn.execution.executor import lane_results, run_chunks, run_lanes_task
 from geardyn.solvers.ensemble import LaneResults
-from geardyn.solvers.executor import lane_results, run_chunks, run_lanes_task
 from geardyn.solvers.kernels import kernels_for
 
 #: Old keyword names of run settings and the RunSettings field each maps onto.
@@ -110,7 +110,7 @@ def bifurcation(
     client, store
         Independent starts only: a ``dask.distributed.Client`` runs the chunks on its cluster,
         and a Zarr ``store`` path keeps finished chunks so that a rerun resumes (see
-        :func:`geardyn.solvers.executor.run_chunks` and ``docs/scaling.md``). Either way the
+        :func:`geardyn.execution.executor.run_chunks` and ``docs/scaling.md``). Either way the
         result is bitwise that of a local run.
     hold
         What stays fixed along a sweep of another parameter: ``"Omega"`` (default) the

@@ -25,10 +25,10 @@ from typing import Any
 
 import numpy as np
 
+from geardyn.core.model import Model
 from geardyn.core.plan import lane_omega, lane_section, lane_steps
 from geardyn.core.settings import RunSettings, resolve_run
 from geardyn.core.status import Status
-from geardyn.models.base import Model
 from geardyn.solvers.ensemble import LaneResults, run_lanes
 from geardyn.solvers.kernels import kernels_for
 

@@ -22,8 +22,8 @@ from geardyn.analysis.lanes import (
     variable_dims,
 )
 from geardyn.analysis.lyapunov import lyapunov_err_attrs
+from geardyn.core.model import Model
 from geardyn.core.status import status_attrs
-from geardyn.models.base import Model
 from geardyn.solvers.ensemble import LaneResults
 
 

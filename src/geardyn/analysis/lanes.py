@@ -11,7 +11,7 @@ import numpy as np
 
 from geardyn.analysis.contact import REGIMES, UNBOUNDED_LABEL, contact_regime
 from geardyn.analysis.periodicity import DEFAULT_MAX_PERIOD, DEFAULT_TOL, classify_period
-from geardyn.models.base import Model
+from geardyn.core.model import Model
 from geardyn.solvers.ensemble import LaneResults
 
 __all__ = ["CONTACT_LABELS", "has_mesh_forces", "lane_periods", "lane_variables", "variable_attrs",

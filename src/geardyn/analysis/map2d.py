@@ -4,7 +4,7 @@ Every grid point is one lane (its own coefficient vector, from
 :meth:`~geardyn.Model.lane_params_grid`) integrated from the model's initial state, as in a
 bifurcation sweep with independent starts; the per-lane analysis is the same
 (:func:`geardyn.analysis.lanes.lane_variables`). Chunks of lanes run through
-:func:`geardyn.solvers.executor.run_chunks`: locally, on a Dask cluster, and resumable with a Zarr
+:func:`geardyn.execution.executor.run_chunks`: locally, on a Dask cluster, and resumable with a Zarr
 store. :func:`estimate_map` tells the cost of a grid before it is built.
 """
 
@@ -28,6 +28,7 @@ from geardyn.analysis.lanes import (
     lane_variables,
 )
 from geardyn.analysis.motion import averaging_time, motion_variable
+from geardyn.core.model import Model
 from geardyn.core.plan import (
     default_steps_per_period,
     forcing_period,
@@ -37,9 +38,8 @@ from geardyn.core.plan import (
 )
 from geardyn.core.settings import RunSettings, resolve_run
 from geardyn.core.status import Status
-from geardyn.models.base import Model
+from geardyn.execution.executor import default_chunk, run_chunks
 from geardyn.solvers.ensemble import run_lanes
-from geardyn.solvers.executor import default_chunk, run_chunks
 
 __all__ = ["MapEstimate", "check_steps", "estimate_map", "map2d", "measure_ns_per_lane_step"]
 
@@ -213,7 +213,7 @@ def map2d(
 
 def _save_store(ds: xr.Dataset, store: Any) -> None:
     """Write the finished map at the root of its Zarr store (beside the lane store)."""
-    from geardyn.io.zarr_store import LaneStore, save_zarr_dataset
+    from geardyn.execution.zarr_store import LaneStore, save_zarr_dataset
 
     save_zarr_dataset(ds, store.path if isinstance(store, LaneStore) else store)
 

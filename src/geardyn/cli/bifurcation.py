@@ -46,6 +46,7 @@ from geardyn.cli.common import (
     usable_omega,
 )
 from geardyn.errors import ParameterError, StudyError
+from geardyn.study import build_model
 
 __all__ = ["bifurcation_command", "parse_range", "plot_command", "register"]
 
@@ -110,7 +111,7 @@ def _check_param_values(model, param: str, ends: tuple[float, float], range_text
     they give finite coefficients (and a positive Omega)."""
     import numpy as np
 
-    from geardyn.io.toml import format_error
+    from geardyn.cli.errors import format_error
 
     for value in ends:
         try:
@@ -256,7 +257,7 @@ def bifurcation_command(
         raise ParameterError("--omega", om, "must be a positive finite number (with a finite "
                              "period)")
     interp = interpretation.value if interpretation is not None else None
-    model = s.build_model(interpretation=interp, omega=om)
+    model = build_model(s, interpretation=interp, omega=om)
     _check_param_name(model, name)
     if range_ is not None:
         start, stop, num = parse_range(range_)
@@ -391,7 +392,7 @@ def _load_result(result: Path):
     from geardyn.io.netcdf import load_dataset
 
     if result.suffix.lower() == ".zarr" and result.is_dir():
-        from geardyn.io.zarr_store import load_zarr_dataset
+        from geardyn.execution.zarr_store import load_zarr_dataset
 
         reader, what = load_zarr_dataset, "a finished map's Zarr store"
     else:

@@ -198,7 +198,7 @@ def make_parents(*paths: Path | None) -> None:
 def run_reporting_errors(call: Callable[[], Any]) -> int:
     """Run ``call`` (a click main in non-standalone mode) and return the exit status; expected
     errors print one line ``error: ...`` on stderr and give status 2."""
-    from geardyn.io.toml import format_error
+    from geardyn.cli.errors import format_error
 
     with warnings.catch_warnings(record=True) as caught:
         try:

@@ -51,6 +51,7 @@ from geardyn.cli.common import (
 )
 from geardyn.core.status import Status
 from geardyn.errors import ParameterError, StudyError
+from geardyn.study import build_model
 
 __all__ = ["EXIT_ERROR", "EXPECTED_ERRORS", "app", "main"]
 
@@ -80,7 +81,7 @@ _stderr = stderr_console
 
 def _version(value: bool) -> None:
     if value:
-        from geardyn import __version__
+        from geardyn._version import __version__
 
         typer.echo(f"geardyn {__version__}")
         raise typer.Exit()
@@ -131,7 +132,7 @@ def params_show(
 
     s = load_study_source(study)
     interp = interpretation.value if interpretation is not None else None
-    model = s.build_model(interpretation=interp)
+    model = build_model(s, interpretation=interp)
     out = _stdout()
     out.print(f"[bold]study[/bold] {escape(s.study.name)}: "
               f"{escape(s.study.description or s.study.model)}")
@@ -248,7 +249,7 @@ def simulate(
         check_count("--steps-per-period", spp)
     plot_state = state or s.plot_state
     interp = interpretation.value if interpretation is not None else None
-    model = s.build_model(interpretation=interp, omega=om)
+    model = build_model(s, interpretation=interp, omega=om)
     known = (*model.state_names, *model.observable_names)
     if plot is not None and plot_state not in known and f"{plot_state}1" not in known:
         raise ParameterError("--state" if state else "study.plot_state", plot_state,

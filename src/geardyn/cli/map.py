@@ -37,6 +37,7 @@ from geardyn.cli.common import (
     usable_omega,
 )
 from geardyn.errors import ParameterError, StudyError
+from geardyn.study import build_model
 
 __all__ = ["map_command", "parse_axis", "register"]
 
@@ -109,7 +110,7 @@ def map_command(
     from rich.console import Console
 
     from geardyn.analysis.map2d import check_steps, estimate_map, map2d, measure_ns_per_lane_step
-    from geardyn.io.toml import format_error
+    from geardyn.cli.errors import format_error
 
     x_axis, y_axis = parse_axis(x, "--x"), parse_axis(y, "--y")
     if x_axis[0] == y_axis[0]:
@@ -129,7 +130,7 @@ def map_command(
     run_settings({"transient": ("--transient", transient),
                   "steps_per_period": ("--steps-per-period", steps_per_period)})
     s = load_study_source(study)
-    model = s.build_model(interpretation=interpretation)
+    model = build_model(s, interpretation=interpretation)
     tr = s.run.transient if transient is None else transient
     n_samples = s.run.periods if samples is None else samples
     spp = s.run.steps_per_period if steps_per_period is None else steps_per_period
@@ -213,8 +214,8 @@ def _run(map2d, model, x_axis, y_axis, run, lyapunov, client, out, chunk, err):
 
 def _save(ds, out: Path, plot: Path | None, err) -> None:
     from geardyn.analysis.periodicity import APERIODIC, UNBOUNDED
+    from geardyn.execution.zarr_store import save_zarr_dataset
     from geardyn.io.netcdf import save_dataset
-    from geardyn.io.zarr_store import save_zarr_dataset
 
     for path in (out, plot):
         if path is not None:

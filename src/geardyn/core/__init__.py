@@ -1,11 +1,15 @@
-"""The core of geardyn: run settings, the lane plan, the section, numerical outcomes.
+"""The core of geardyn: the model interface, the kernel source, run settings, the lane plan, the
+section, numerical outcomes.
 
-Nothing here imports anything of geardyn outside ``geardyn.core`` (a test checks it): the
-modules above (models, solvers, analysis, io, cli) build on these, never the other way round.
+Nothing here imports anything of geardyn outside ``geardyn.core`` except the base modules
+:mod:`geardyn.errors` and :mod:`geardyn.units` (``tests/test_layers.py`` checks it): the layers
+above (models, io, solvers, execution, analysis, ...) build on these, never the other way round.
 """
 
+from geardyn.core.kernel_source import KernelSource
+from geardyn.core.model import Model
 from geardyn.core.plan import LanePlan
 from geardyn.core.settings import RunSettings, SettingsError
 from geardyn.core.status import Status
 
-__all__ = ["LanePlan", "RunSettings", "SettingsError", "Status"]
+__all__ = ["KernelSource", "LanePlan", "Model", "RunSettings", "SettingsError", "Status"]

@@ -12,6 +12,8 @@ A model has a state vector (``state_names``), a coefficient vector (``params``, 
 Built-in models (:class:`~geardyn.CATTDevice`, :class:`~geardyn.GearPair`) and a user's own
 (:class:`~geardyn.UserModel`) all subclass :class:`Model`. The rules a model keeps are numbered in
 :class:`Model`'s docstring (the model contract); :func:`geardyn.testing.check_model` checks them.
+This module belongs to the core: it imports nothing of geardyn outside :mod:`geardyn.core`
+(``geardyn.models.base`` re-exports it under its earlier name).
 """
 
 from __future__ import annotations
@@ -21,8 +23,8 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from geardyn.core.kernel_source import KernelSource
 from geardyn.core.plan import forcing_period
-from geardyn.solvers.kernels import KernelSource
 
 
 def unique_rows(A: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -47,7 +49,7 @@ class Model:
     Every solver, sweep and analysis relies on these rules, and
     :func:`geardyn.testing.check_model` checks each (one check per number; a broken rule is
     reported by its number and name). ``n_states = len(state_names)``; the compiled functions
-    are those of :attr:`kernel` (:class:`~geardyn.solvers.kernels.KernelSource`).
+    are those of :attr:`kernel` (:class:`~geardyn.core.kernel_source.KernelSource`).
 
     1. **names** -- ``state_names`` is a non-empty tuple of distinct strings, one per state;
        ``event_names``, ``observable_names`` and ``param_names`` are tuples of distinct strings;

@@ -11,9 +11,9 @@ run them anywhere and in any order, and the assembled result is bitwise the same
 * ``client=dask.distributed.Client(...)``: every chunk is one Dask task carrying the packed
   model and its lanes' inputs. Workers import the model's compiled functions by name and build
   (or load from ``$GEARDYN_CACHE_DIR``) their own kernels, see :func:`portable`.
-* ``store``: a :class:`~geardyn.io.zarr_store.LaneStore` (or a path to one): every finished chunk
-  is written there as it completes, then marked done; a rerun with the same inputs computes only
-  the chunks not marked done. See ``docs/scaling.md``.
+* ``store``: a :class:`~geardyn.execution.zarr_store.LaneStore` (or a path to one): every
+  finished chunk is written there as it completes, then marked done; a rerun with the same
+  inputs computes only the chunks not marked done. See ``docs/scaling.md``.
 """
 
 from __future__ import annotations
@@ -27,16 +27,15 @@ import os
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
-from geardyn.models.base import Model
+from geardyn._version import __version__
+from geardyn.core.kernel_source import KernelSource
+from geardyn.core.model import Model
+from geardyn.execution.zarr_store import LaneStore
 from geardyn.solvers.ensemble import LaneResults, run_lanes
-from geardyn.solvers.kernels import KernelSource
-
-if TYPE_CHECKING:
-    from geardyn.io.zarr_store import LaneStore
 
 __all__ = ["PortableModel", "chunk_bounds", "default_chunk", "inputs_digest", "lane_results",
            "portable", "run_chunks", "run_lanes_task"]
@@ -46,6 +45,9 @@ __all__ = ["PortableModel", "chunk_bounds", "default_chunk", "inputs_digest", "l
 MIN_CHUNK = 64
 #: Default number of chunks a sweep is cut into (for progress reports and resumability).
 DEFAULT_CHUNKS = 20
+
+#: Packages whose source (with the model's modules) determines what a store keeps.
+_COMPUTING_PACKAGES = ("core", "solvers", "analysis")
 
 LaneTask = Callable[..., dict[str, np.ndarray]]
 Progress = Callable[[int, int], None]
@@ -155,13 +157,10 @@ def _task_text(task: LaneTask) -> str:
 def _code_digest(modules: tuple[str, ...]) -> str:
     """SHA-256 of the source of geardyn's core, solvers and analyses and of ``modules`` (the
     model's): the code that computes what a store keeps."""
-    import geardyn.analysis
-    import geardyn.core
-    import geardyn.solvers
-
+    root = Path(__file__).resolve().parent.parent  # the geardyn package, read, not imported
     files: list[Path] = []
-    for pkg in (geardyn.core, geardyn.solvers, geardyn.analysis):
-        files += sorted(Path(next(iter(pkg.__path__))).glob("*.py"))
+    for pkg in _COMPUTING_PACKAGES:
+        files += sorted((root / pkg).glob("*.py"))
     for name in modules:
         origin = getattr(importlib.import_module(name), "__file__", None)
         if origin:
@@ -179,8 +178,6 @@ def inputs_digest(task: LaneTask, model: Model, inputs: Mapping[str, np.ndarray]
     settings, the model's kind and compiled functions, every input array (bytes, shape, dtype),
     the chunk size and ``meta`` (JSON-able study details), the geardyn version and the source of
     the code that computes the results (solvers, analyses, the model's modules)."""
-    from geardyn import __version__
-
     h = hashlib.sha256()
     k = model.kernel
     refs = [_function_ref(f) for f in (k.rhs, k.events, k.observe)]
@@ -231,7 +228,7 @@ def run_chunks(
     client
         ``None`` (run here) or a ``dask.distributed.Client`` (one task per chunk).
     store
-        A :class:`~geardyn.io.zarr_store.LaneStore`, or the path of a Zarr store to create or
+        A :class:`~geardyn.execution.zarr_store.LaneStore`, or the path of a Zarr store to create or
         resume: finished chunks are read from it instead of being run, new ones written to it as
         they complete. A store holding a run with other inputs (:func:`inputs_digest`) is refused.
     progress
@@ -297,6 +294,4 @@ def run_chunks(
 def _open_store(store: Any) -> LaneStore | None:
     if store is None:
         return None
-    from geardyn.io.zarr_store import LaneStore
-
     return store if isinstance(store, LaneStore) else LaneStore(store)

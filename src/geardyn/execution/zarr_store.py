@@ -10,7 +10,7 @@ A map's store (``geardyn.map2d(..., store="map.zarr")``, ``geardyn map --out map
     map.zarr/lanes/outputs/<name>   one array per output, lane-first, chunked like the run
 
 A :class:`LaneStore` keeps the per-lane outputs of a chunked run
-(:func:`geardyn.solvers.executor.run_chunks`) in the ``lanes`` group as they complete. A chunk's
+(:func:`geardyn.execution.executor.run_chunks`) in the ``lanes`` group as they complete. A chunk's
 data are written before its ``done`` entry, and every file of the store is written atomically
 (zarr's local store writes a temporary file, then renames it), so a run killed at any moment
 leaves no half-written chunk counted as done: the next run with the same inputs recomputes
@@ -41,6 +41,7 @@ import xarray as xr
 
 from geardyn.errors import GeardynError
 from geardyn.io.atomic import atomic_replace
+from geardyn.io.netcdf import netcdf_attrs
 
 __all__ = ["LANES_GROUP", "LaneStore", "StoreMismatchError", "load_zarr_dataset",
            "save_zarr_dataset"]
@@ -298,8 +299,6 @@ def save_zarr_dataset(ds: xr.Dataset, path: str | os.PathLike[str], group: str |
     ``group``), so that ``xarray.open_zarr(path)`` opens it, quietly (consolidated metadata).
     The store's other groups (the lane store) stay; its earlier dataset is replaced. Attributes
     are converted as for NetCDF. Returns the path."""
-    from geardyn.io.netcdf import netcdf_attrs
-
     path = Path(path)
     _prepare_root(path)
     out = _map_variables(ds, _strings_as_objects)

@@ -24,8 +24,10 @@ A *study file* holds the device parameters plus run settings::
 For ``model = "gear_pair"`` the ``[params]`` table holds :class:`~geardyn.GearPair` arguments
 (``zeta``, ``kappa``, ``Fm``, ``Fa``, ``Omega``, ``kappa_phase``, ``error_phase``, ``backlash``).
 
-Every error names the field path and the value; :func:`format_error` renders any expected error
-as one line.
+This module only reads and validates: a study file becomes a :class:`Study` (plain, validated
+data; its device parameters a :class:`~geardyn.PlanetaryParams`). Turning a study into a model is
+:func:`geardyn.study.build_model`'s job, one layer up; every error names the field path and the
+value, and :func:`geardyn.cli.errors.format_error` renders it as one line.
 """
 
 from __future__ import annotations
@@ -51,7 +53,6 @@ from pydantic_core import InitErrorDetails, PydanticCustomError
 
 from geardyn.errors import ParameterError, StudyError
 from geardyn.io.atomic import atomic_replace
-from geardyn.models.derived import INTERPRETATIONS
 from geardyn.models.params import PAPER_NAMES, Angle, PlanetaryParams, Real, Whole
 
 __all__ = [
@@ -64,7 +65,6 @@ __all__ = [
     "SweepSettings",
     "builtin_study",
     "builtin_study_names",
-    "format_error",
     "load_params",
     "load_study",
     "paper_study",
@@ -322,67 +322,9 @@ class Study(BaseModel):
     def plot_state(self) -> str:
         return self.study.plot_state or DEFAULT_PLOT_STATE[self.study.model]
 
-    def build_model(self, interpretation: str | None = None, omega: float | None = None):
-        """The study's model: a :class:`~geardyn.CATTDevice` or a :class:`~geardyn.GearPair`.
-
-        ``interpretation`` and ``omega`` override the study's (``omega`` defaults to
-        ``run.omega``, else 1).
-        """
-        from geardyn.models.catt import CATTDevice
-        from geardyn.models.gear_pair import GearPair
-
-        if interpretation is not None and interpretation not in INTERPRETATIONS:
-            raise ParameterError(
-                "interpretation", interpretation, f"must be one of {', '.join(INTERPRETATIONS)}"
-            )
-        om = omega if omega is not None else self.run.omega
-        if isinstance(self.params, GearPairParams):
-            kwargs = self.params.model_dump()
-            if om is not None:
-                kwargs["Omega"] = float(om)
-            return check_usable(lambda: GearPair(**kwargs))
-        return check_usable(lambda: CATTDevice(
-            self.planetary_params,
-            interpretation or self.study.interpretation,  # type: ignore[arg-type]
-            omega=1.0 if om is None else float(om),
-        ))
-
     def to_toml_dict(self) -> dict[str, Any]:
         """The study as TOML-ready tables (``None`` values left out)."""
         return self.model_dump(exclude_none=True)
-
-
-def check_usable(build):
-    """The model ``build()`` returns, if its coefficients, natural frequencies and initial state
-    are finite; else a :class:`ParameterError` naming the first quantity that is not.
-
-    Values that each pass validation can still overflow together (a module of 1e200 m, an inertia
-    of 1e-308 kg m^2): the model would then integrate NaNs. Floating-point warnings raised while
-    building are silenced, as the error replaces them.
-    """
-    import numpy as np
-
-    with np.errstate(all="ignore"):
-        try:
-            model = build()
-            checks = [(f"coefficient {n}", v) for n, v in zip(model.param_names, model.params,
-                                                                strict=True)]
-            if hasattr(model, "natural_frequencies"):
-                checks += [("natural frequency", w) for w in model.natural_frequencies()]
-            checks += [(f"initial state {n}", v)
-                       for n, v in zip(model.state_names, model.initial_state(), strict=True)]
-        except (ArithmeticError, ValueError) as exc:  # overflow, singular matrix, ...
-            if isinstance(exc, ParameterError | ValidationError):
-                raise
-            reason = exc.args[-1] if isinstance(exc, OverflowError) and exc.args else str(exc)
-            reason = " ".join(str(reason).split()) or type(exc).__name__
-            raise ParameterError("params", reason, "the parameters give no usable model (a value"
-                                 " is too extreme)") from None
-    for what, value in checks:
-        if not math.isfinite(float(value)):
-            raise ParameterError("params", float(value), f"the model's {what} is not finite (a"
-                                 " parameter value is too extreme)")
-    return model
 
 
 # --------------------------------------------------------------------------- reading
@@ -542,59 +484,3 @@ def builtin_study_text(name: str) -> str:
 def builtin_study(name: str) -> Study:
     """A study shipped with geardyn, by name (``"paper_fig3"``)."""
     return load_study(builtin_study_text(name))
-
-
-# --------------------------------------------------------------------------- errors
-def _loc_text(loc: tuple) -> str:
-    out = ""
-    for part in loc:
-        if isinstance(part, int):
-            out += f"[{part}]"
-        else:
-            out += ("." if out else "") + str(part)
-    return out
-
-
-def _one_validation_error(err: dict[str, Any]) -> str:
-    msg = str(err.get("msg", "invalid value"))
-    for prefix in ("Value error, ", "Assertion failed, "):
-        if msg.startswith(prefix):
-            msg = msg[len(prefix):]
-    if err.get("type") == "extra_forbidden":
-        msg = "unknown key (not a field of this table)"
-    where = _loc_text(tuple(err.get("loc", ())))
-    text = f"{where}: {msg}" if where else msg
-    value = err.get("input")
-    if err.get("type") != "missing" and not isinstance(value, dict | list | BaseModel) and (
-        "(got " not in msg
-    ):
-        text += f" (got {value!r})"
-    return text
-
-
-def format_error(exc: BaseException) -> str:
-    """One line describing an expected error: the field path and the value where known.
-
-    >>> format_error(ParameterError("sun_mesh.mean_stiffness", -1.0, "must be > 0"))
-    'sun_mesh.mean_stiffness: must be > 0 (got -1.0)'
-    """
-    if isinstance(exc, ValidationError):
-        # an unknown key is usually the cause of the "Field required" errors beside it
-        errors = sorted(exc.errors(include_url=False),
-                        key=lambda e: e.get("type") != "extra_forbidden")
-        text = _one_validation_error(errors[0]) if errors else str(exc)
-        if len(errors) > 1:
-            text += f" (and {len(errors) - 1} more error{'s' if len(errors) > 2 else ''})"
-    elif isinstance(exc, tomllib.TOMLDecodeError):
-        text = f"invalid TOML: {exc}"
-    elif isinstance(exc, KeyError):
-        text = str(exc.args[0]) if exc.args else "unknown key"
-    elif isinstance(exc, FileNotFoundError):
-        text = f"file not found: {exc.filename}" if exc.filename else str(exc)
-    elif isinstance(exc, IsADirectoryError | PermissionError | NotADirectoryError):
-        text = f"{exc.strerror}: {exc.filename}" if exc.filename else str(exc)
-    elif isinstance(exc, OSError):
-        text = f"{exc.strerror or exc}: {exc.filename}" if exc.filename else str(exc)
-    else:
-        text = str(exc) or type(exc).__name__
-    return " ".join(text.split())

@@ -31,9 +31,10 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from geardyn.core.kernel_source import KernelSource
+from geardyn.core.model import Model, unique_rows
 from geardyn.errors import ParameterError
 from geardyn.models import catt_kernels as ck
-from geardyn.models.base import Model, unique_rows
 from geardyn.models.derived import (
     INTERPRETATIONS,
     Derived,
@@ -43,7 +44,6 @@ from geardyn.models.derived import (
 )
 from geardyn.models.params import PAPER_NAMES, PlanetaryParams
 from geardyn.models.stiffness import fourier_coefficients, harmonics_needed
-from geardyn.solvers.kernels import KernelSource
 
 _KERNEL = KernelSource(ck.catt_rhs, ck.catt_events, ck.catt_observe)
 #: The reduced model's kernel: the same functions compiled for one planet set.
@@ -429,9 +429,7 @@ class CATTDevice(Model):
             y[2 + 4 * i] = -x[4 * i] / d.r_bq[i]
             y[4 + 4 * i] = (y[2 + 4 * i] * d.r_bq[i] - x[4 * i + 2]) / d.r_bp[i]
         dy = np.empty(theta.n_states)
-        from geardyn.solvers.kernels import kernels_for
-
-        kernels_for(theta.kernel).rhs(0.0, y, dy, np.ascontiguousarray(theta.params), 0.0, 1.0)
+        theta.kernel.rhs(0.0, y, dy, np.ascontiguousarray(theta.params), 0.0, 1.0)
         return float(dy[1])
 
     def general(self) -> CATTDevice:

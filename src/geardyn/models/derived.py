@@ -25,45 +25,12 @@ from typing import Literal
 
 import numpy as np
 
+# DERIVED_FORMULAS is defined with the parameters (which check overrides by name), shown here
+from geardyn.models.params import DERIVED_FORMULAS as DERIVED_FORMULAS
 from geardyn.models.params import PlanetaryParams
 
 Interpretation = Literal["consistent", "carrier-only", "as-printed"]
 INTERPRETATIONS: tuple[str, ...] = ("consistent", "carrier-only", "as-printed")
-
-#: Every derived quantity: (unit, formula). Per-planet ones are arrays of length N.
-DERIVED_FORMULAS: dict[str, tuple[str, str]] = {
-    "r_bs": ("m", "sun base radius: given, else m z cos(alpha) / 2"),
-    "r_bq": ("m", "inside planet base radius: given, else m z cos(alpha) / 2"),
-    "r_bp": ("m", "outside planet base radius: given, else m z cos(alpha) / 2"),
-    "m_s": ("kg", "sun mass: given, else density pi (m z/2)^2 face_width (solid disc)"),
-    "m_q": ("kg", "inside planet mass: given, else solid disc at the pitch radius"),
-    "m_p": ("kg", "outside planet mass: given, else solid disc at the pitch radius"),
-    "J_s": ("kg m^2", "sun inertia: given, else J_p (same 40-tooth blank as the outside planet)"),
-    "J_q": ("kg m^2", "inside planet inertia (Table 1)"),
-    "J_p": ("kg m^2", "outside planet inertia (Table 1)"),
-    "M_s": ("kg", "M_s = J_s / r_bs^2 (Eq. 11)"),
-    "M_q": ("kg", "M_q = J_q / r_bq^2 (Eq. 11)"),
-    "M_p": ("kg", "M_p = J_p / r_bp^2 (Eq. 11)"),
-    "r_bc": ("m", "carrier reference radius: given, else r_c1"),
-    "J_c_eff": (
-        "kg m^2",
-        "consistent: J_c + sum(m_p r_c2^2 + m_q r_c1^2); carrier-only: J_c;"
-        " as-printed: J_c + sum(m_p r_c2 + m_q r_c1) (Eq. 1)",
-    ),
-    "M_c": ("kg", "M_c = J_c_eff / r_bc^2 (Eq. 11)"),
-    "arm": ("m", "moment arm of each sun-planet mesh force on the carrier: r_bs cos(alpha)"),
-    "omega_n": (
-        "rad/s",
-        "consistent, carrier-only: sqrt(Km_sq (1/M_s + 1/M_c));"
-        " as-printed: sqrt(Km_sq / (1/M_s + 1/M_c)) (Eq. 9); Km_sq of planet set 1",
-    ),
-    "C_sq": ("N s/m", "C_sq = 2 xi1 sqrt(Km_sq / (1/M_s + 1/M_q)) (Eq. 6)"),
-    "C_pq": ("N s/m", "C_pq = 2 xi2 sqrt(Km_pq / (1/M_p + 1/M_q)) (Eq. 6)"),
-    "gamma": (
-        "1",
-        "factor on the carrier damping term of Eq. (10): 1; as-printed 1/omega_n (the typo)",
-    ),
-}
 
 #: The dimensionless coefficients of Eq. (10), per planet set i, with their formulas.
 COEFFICIENT_FORMULAS: dict[str, str] = {

@@ -7,8 +7,8 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
-from geardyn.models.base import Model, unique_rows
-from geardyn.solvers.kernels import KernelSource
+from geardyn.core.kernel_source import KernelSource
+from geardyn.core.model import Model, unique_rows
 
 
 class UserModel(Model):

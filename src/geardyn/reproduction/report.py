@@ -92,7 +92,7 @@ def _by_interpretation(results: Results) -> dict[str, dict[str, xr.Dataset]]:
 def build_report(results: Results, figures: Mapping[tuple[str, str], dict[str, Path]],
                  root: Path, command: str = "geardyn reproduce") -> Document:
     """The report's content from the case results and the written figures."""
-    from geardyn import __version__
+    from geardyn._version import __version__
 
     per_interp = _by_interpretation(results)
     interps = list(per_interp)

@@ -19,12 +19,13 @@ import xarray as xr
 from geardyn.analysis.bifurcation import ContinuedSweep, continued_sweeps
 from geardyn.analysis.lyapunov import lyapunov_err_attrs, lyapunov_lanes
 from geardyn.analysis.motion import LYAPUNOV_FLOOR, LYAPUNOV_Z, exponent_sign, rule_text
+from geardyn.core.model import Model
 from geardyn.core.plan import lane_section
 from geardyn.core.settings import RunSettings
-from geardyn.models.base import Model
 from geardyn.reproduction.cases import Case
 from geardyn.reproduction.motion import motion_labels
 from geardyn.solvers.simulate import default_steps_per_period
+from geardyn.study import build_model
 
 __all__ = ["DIRECTIONS", "ReproductionSettings", "branch_lyapunov", "run_case", "run_cases",
            "sweep_values"]
@@ -169,7 +170,7 @@ def _sweeps(tasks: list[tuple[Case, str, str]], settings: ReproductionSettings,
     for case, interp, direction in tasks:
         r = settings.resolve(case)
         run = settings.run_settings(case)
-        model = case.study.build_model(interpretation=interp)
+        model = build_model(case.study, interpretation=interp)
         sweep = ContinuedSweep(
             model, "Omega", sweep_values(case, settings), direction, transient=run.transient,
             continued_transient=run.continued_transient, transient_max=run.transient_max,
@@ -257,7 +258,7 @@ def _assemble(case: Case, interpretation: str, settings: ReproductionSettings,
         ordered.append(ds)
     out = xr.concat(ordered, dim="sweep", combine_attrs="drop_conflicts")
     out = out.assign_coords(sweep=("sweep", list(DIRECTIONS)))
-    model = case.study.build_model(interpretation=interpretation)
+    model = build_model(case.study, interpretation=interpretation)
     loads = case.params.loads
     up, down = per_direction["up"], per_direction["down"]
     out.attrs.update(

@@ -19,13 +19,12 @@ import os
 import sys
 import tempfile
 import types
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numba
 
-from geardyn.solvers import _noop
+from geardyn.core.kernel_source import KernelSource
 
 _IMPORT_MARK = "# MODEL-IMPORT"
 _CORE_MARK = "# CORE-IMPORT"
@@ -42,49 +41,6 @@ def observe(t, y, out, p, s, c):
 """
 
 _LOADED: dict[tuple, types.ModuleType] = {}
-
-
-@dataclass(frozen=True)
-class KernelSource:
-    """A model's compiled functions (numba dispatchers) in the kernel interface."""
-
-    rhs: Any
-    events: Any = None
-    observe: Any = None
-    #: True for a user's ``rhs(t, y, dy, p)`` / ``observe(t, y, out, p)`` without the forcing
-    #: phase arguments; the generated kernel adapts them.
-    plain: bool = False
-
-    def functions(self) -> dict[str, Any]:
-        prefix = "user_" if self.plain else ""
-        funcs = {
-            f"{prefix}rhs": self.rhs,
-            "events": self.events if self.events is not None else _noop.no_events,
-            f"{prefix}observe": (
-                self.observe if self.observe is not None
-                else (_noop.no_observables_plain if self.plain else _noop.no_observables)
-            ),
-        }
-        if not self.plain:
-            funcs.update(_lane_functions(funcs))
-        return funcs
-
-
-def _lane_functions(funcs: dict[str, Any]) -> dict[str, Any]:
-    """The lane-block forms of a model's functions, where its module defines them: for ``rhs``
-    named ``f``, a compiled ``f_lanes`` beside it becomes ``rhs_lanes`` (and so for ``events``
-    and ``observe``). The sweep kernel runs them on a block of lanes in structure-of-arrays
-    layout (see :mod:`._kernel_template`); without them it calls the per-lane functions."""
-    out = {}
-    for alias in ("rhs", "events", "observe"):
-        py = getattr(funcs[alias], "py_func", None)
-        mod = sys.modules.get(getattr(py, "__module__", ""), None)
-        fn = getattr(mod, f"{py.__name__}_lanes", None) if py is not None else None
-        if fn is not None and hasattr(fn, "py_func"):
-            out[f"{alias}_lanes"] = fn
-    if out and len(out) < 3:
-        return {}  # all three or none: the kernel mixes no layouts
-    return out
 
 
 def cache_dir() -> Path:

@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from geardyn.models.base import Model
+from geardyn.core.model import Model
 from geardyn.solvers.kernels import kernels_for
 
 

@@ -8,6 +8,7 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
+from geardyn.core.model import Model
 from geardyn.core.plan import (  # noqa: F401  (the step rule's old home)
     MIN_STEPS_PER_PERIOD,
     STEPS_PER_FASTEST_MODE,
@@ -24,7 +25,6 @@ from geardyn.core.settings import (  # noqa: F401  (DEFAULT_BOUND: its old home)
     resolve_run,
 )
 from geardyn.core.status import Status, status_meaning
-from geardyn.models.base import Model
 from geardyn.solvers.kernels import kernels_for
 
 #: simulate's own defaults of the run settings (a time history from the start, 64 periods).

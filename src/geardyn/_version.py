@@ -1,0 +1,3 @@
+"""geardyn's version (a base module: it imports nothing)."""
+
+__version__ = "0.1.0"

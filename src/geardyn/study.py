@@ -1,0 +1,81 @@
+"""Studies turned into models: the one place that knows which model a study file names.
+
+:mod:`geardyn.io.toml` reads and validates a study file (or a packaged one,
+``geardyn/studies/*.toml``) into a :class:`~geardyn.io.toml.Study`, plain validated data;
+:func:`build_model` makes the :class:`~geardyn.CATTDevice` or :class:`~geardyn.GearPair` it
+describes. This module sits above both ``models`` and ``io`` (``tests/test_layers.py``), so that
+reading a study never imports a model's kernels, and the packaged study files stay data.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+
+import numpy as np
+from pydantic import ValidationError
+
+from geardyn.core.model import Model
+from geardyn.errors import ParameterError
+from geardyn.io.toml import GearPairParams, Study
+from geardyn.models.catt import CATTDevice
+from geardyn.models.derived import INTERPRETATIONS
+from geardyn.models.gear_pair import GearPair
+
+__all__ = ["build_model", "check_usable"]
+
+
+def build_model(study: Study, interpretation: str | None = None, omega: float | None = None
+                ) -> Model:
+    """The study's model: a :class:`~geardyn.CATTDevice` or a :class:`~geardyn.GearPair`.
+
+    ``interpretation`` and ``omega`` override the study's (``omega`` defaults to
+    ``[run].omega``, else 1). Raises :class:`~geardyn.ParameterError` for an unknown
+    interpretation or parameters that give no usable model (:func:`check_usable`).
+    """
+    if interpretation is not None and interpretation not in INTERPRETATIONS:
+        raise ParameterError(
+            "interpretation", interpretation, f"must be one of {', '.join(INTERPRETATIONS)}"
+        )
+    om = omega if omega is not None else study.run.omega
+    if isinstance(study.params, GearPairParams):
+        kwargs = study.params.model_dump()
+        if om is not None:
+            kwargs["Omega"] = float(om)
+        return check_usable(lambda: GearPair(**kwargs))
+    return check_usable(lambda: CATTDevice(
+        study.planetary_params,
+        interpretation or study.study.interpretation,  # type: ignore[arg-type]
+        omega=1.0 if om is None else float(om),
+    ))
+
+
+def check_usable(build: Callable[[], Model]) -> Model:
+    """The model ``build()`` returns, if its coefficients, natural frequencies and initial state
+    are finite; else a :class:`ParameterError` naming the first quantity that is not.
+
+    Values that each pass validation can still overflow together (a module of 1e200 m, an inertia
+    of 1e-308 kg m^2): the model would then integrate NaNs. Floating-point warnings raised while
+    building are silenced, as the error replaces them.
+    """
+    with np.errstate(all="ignore"):
+        try:
+            model = build()
+            checks = [(f"coefficient {n}", v) for n, v in zip(model.param_names, model.params,
+                                                                strict=True)]
+            if hasattr(model, "natural_frequencies"):
+                checks += [("natural frequency", w) for w in model.natural_frequencies()]
+            checks += [(f"initial state {n}", v)
+                       for n, v in zip(model.state_names, model.initial_state(), strict=True)]
+        except (ArithmeticError, ValueError) as exc:  # overflow, singular matrix, ...
+            if isinstance(exc, ParameterError | ValidationError):
+                raise
+            reason = exc.args[-1] if isinstance(exc, OverflowError) and exc.args else str(exc)
+            reason = " ".join(str(reason).split()) or type(exc).__name__
+            raise ParameterError("params", reason, "the parameters give no usable model (a value"
+                                 " is too extreme)") from None
+    for what, value in checks:
+        if not math.isfinite(float(value)):
+            raise ParameterError("params", float(value), f"the model's {what} is not finite (a"
+                                 " parameter value is too extreme)")
+    return model
