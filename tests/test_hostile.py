@@ -31,11 +31,11 @@ from hypothesis import strategies as st
 from pydantic import ValidationError
 from typer.testing import CliRunner
 
+from geardyn.cli.errors import format_error
 from geardyn.cli.main import app
 from geardyn.errors import GeardynError
 from geardyn.io.toml import (
     builtin_study_text,
-    format_error,
     load_params,
     load_study,
     paper_study,

@@ -13,6 +13,7 @@ import xarray as xr
 from pydantic import ValidationError
 
 from geardyn import CATTDevice, GearPair, PlanetaryParams, PlanetOverride, StudyError
+from geardyn.cli.errors import format_error
 from geardyn.io.netcdf import load_dataset, netcdf_attrs, save_dataset
 from geardyn.io.toml import (
     GearPairParams,
@@ -23,7 +24,6 @@ from geardyn.io.toml import (
     SweepSettings,
     builtin_study,
     builtin_study_names,
-    format_error,
     load_params,
     load_study,
     save_params,

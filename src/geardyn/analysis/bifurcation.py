@@ -143,10 +143,8 @@ def bifurcation(
     P = lane_params_held(model, param, values, hold)
     base_y0 = _initial_states(model, param, values, y0)
     if continuation:
-        sweep = ContinuedSweep(model, param, values, continuation, transient=run.transient,
-                               continued_transient=run.continued_transient,
-                               transient_max=run.transient_max,
-                               steps_per_period=run.steps_per_period, y0=base_y0, hold=hold)
+        sweep = ContinuedSweep(model, param, values, continuation, y0=base_y0, hold=hold,
+                               run=run)
         ((ds, last),) = _continued([sweep], run, progress)
     else:
         L, ns = values.size, model.n_states
@@ -189,20 +187,36 @@ def bifurcation(
 @dataclass(frozen=True)
 class ContinuedSweep:
     """One sweep by continuation for :func:`continued_sweeps`: ``model`` swept in ``param``
-    over ``values`` in the ``direction`` "up" (ascending) or "down", with the transients and
-    step of :func:`bifurcation` (``y0``: the cold start's state, default the model's
-    initial state)."""
+    over ``values`` in the ``direction`` "up" (ascending) or "down" (``y0``: the cold start's
+    state, default the model's initial state).
+
+    ``run``: the sweep's own :class:`~geardyn.RunSettings`, whose transients (``transient``,
+    ``continued_transient``, ``transient_max``) and ``steps_per_period`` the sweep uses, as
+    :func:`bifurcation` does; or, for compatibility, those four as keyword arguments (not both).
+    After construction ``run`` holds the validated settings and the four fields their values."""
 
     model: Model
     param: str
     values: np.ndarray
     direction: str = "up"
-    transient: float = 4000.0
+    transient: float | None = None
     continued_transient: float | None = None
     transient_max: float | None = None
     steps_per_period: int | None = None
     y0: np.ndarray | None = None
     hold: str = "Omega"
+    run: RunSettings | None = None
+
+    def __post_init__(self) -> None:
+        legacy = {k: getattr(self, k) for k in _SWEEP_FIELDS if getattr(self, k) is not None}
+        run = resolve_run(self.run, legacy)
+        object.__setattr__(self, "run", run)
+        for k in _SWEEP_FIELDS:
+            object.__setattr__(self, k, getattr(run, k))
+
+
+#: The settings each continued sweep has of its own (the others are shared by the sweeps).
+_SWEEP_FIELDS = ("transient", "continued_transient", "transient_max", "steps_per_period")
 
 
 def continued_sweeps(
@@ -225,9 +239,9 @@ def continued_sweeps(
 
 
 def _sweep_run(sw: ContinuedSweep, run: RunSettings) -> RunSettings:
-    """``run`` with the transients and step of the sweep ``sw`` (validated there)."""
-    return run.replace(transient=sw.transient, continued_transient=sw.continued_transient,
-                       transient_max=sw.transient_max, steps_per_period=sw.steps_per_period)
+    """The shared ``run`` with the transients and step of the sweep ``sw``."""
+    assert sw.run is not None  # set by ContinuedSweep
+    return run.replace(**{k: getattr(sw.run, k) for k in _SWEEP_FIELDS})
 
 
 def _continued(sweeps: Sequence[ContinuedSweep], run: RunSettings,

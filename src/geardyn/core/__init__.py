@@ -1,9 +1,10 @@
 """The core of geardyn: the model interface, the kernel source, run settings, the lane plan, the
 section, numerical outcomes.
 
-Nothing here imports anything of geardyn outside ``geardyn.core`` except the base modules
-:mod:`geardyn.errors` and :mod:`geardyn.units` (``tests/test_layers.py`` checks it): the layers
-above (models, io, solvers, execution, analysis, ...) build on these, never the other way round.
+Nothing here imports anything of geardyn outside ``geardyn.core``; only the base modules
+(:mod:`geardyn.errors`, :mod:`geardyn.units`, which import nothing of geardyn) sit below it
+(``tests/test_core.py`` and ``tests/test_layers.py`` check it). The layers above (models, io,
+solvers, execution, analysis, ...) build on these, never the other way round.
 """
 
 from geardyn.core.kernel_source import KernelSource

@@ -171,10 +171,7 @@ def _sweeps(tasks: list[tuple[Case, str, str]], settings: ReproductionSettings,
         r = settings.resolve(case)
         run = settings.run_settings(case)
         model = build_model(case.study, interpretation=interp)
-        sweep = ContinuedSweep(
-            model, "Omega", sweep_values(case, settings), direction, transient=run.transient,
-            continued_transient=run.continued_transient, transient_max=run.transient_max,
-            steps_per_period=run.steps_per_period)
+        sweep = ContinuedSweep(model, "Omega", sweep_values(case, settings), direction, run=run)
         plans.append((sweep, r, run))
     case0, interp0, _ = tasks[0]
     label = (f"{case0.name} {interp0} up and down" if len(tasks) == 2
