@@ -1,6 +1,6 @@
 """Compiled right-hand sides of the CATT device (numba).
 
-Kernel interface shared by every geardyn model (see :mod:`geardyn.core.model`):
+Kernel interface shared by every geardyn model (see :mod:`geardyn.models.base`):
 
 ``rhs(t, y, dy, p, s, c)``
     writes dy/dt; ``s, c = sin(Omega t), cos(Omega t)`` are supplied by the solver (from a table on
