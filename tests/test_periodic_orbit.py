@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import math
 
+import numba as nb
 import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
@@ -206,3 +207,69 @@ def test_period_two_orbit_after_the_doubling():
     d = min(np.max(np.abs(ref[0] - orb.x)), np.max(np.abs(ref[0] - x1)))
     assert d < 1e-6
     assert np.max(np.abs(ref[1] - ref[0])) > 1e-3
+
+
+@nb.njit(cache=True)
+def _duffing(t, y, dy, p):
+    """x'' + delta x' + x + beta x^3 = gamma cos(Omega t); p = (Omega, delta, beta, gamma)."""
+    dy[0] = y[1]
+    dy[1] = -p[1] * y[1] - y[0] - p[2] * y[0] ** 3 + p[3] * math.cos(p[0] * t)
+
+
+def test_smooth_nonlinear_multipliers_match_the_variational_equations():
+    """A user's Duffing oscillator: the monodromy against DOP853 (rtol 1e-12) of the orbit and
+    its variational equation, the Jacobian written out here, to 1e-8."""
+    om, delta, beta, gamma = 1.2, 0.1, 0.5, 0.3
+    m = geardyn.UserModel(_duffing, n_states=2, params=[om, delta, beta, gamma],
+                          param_names=["Omega", "delta", "beta", "gamma"], natural_frequency=1.6)
+    orb = geardyn.periodic_orbit(m)
+    assert orb.converged, orb.message
+    T = 2 * math.pi / om
+
+    def augmented(t, z):
+        x, v = z[0], z[1]
+        J = np.array([[0.0, 1.0], [-1.0 - 3 * beta * x * x, -delta]])
+        f = [v, -delta * v - x - beta * x**3 + gamma * math.cos(om * t)]
+        return np.concatenate([f, (J @ z[2:].reshape(2, 2)).ravel()])
+
+    sol = solve_ivp(augmented, (0.0, T), np.concatenate([orb.x, np.eye(2).ravel()]),
+                    method="DOP853", rtol=1e-12, atol=1e-14)
+    assert np.max(np.abs(sol.y[:2, -1] - orb.x)) < 1e-8  # an orbit of the exact flow
+    M = sol.y[2:, -1].reshape(2, 2)
+    assert np.max(np.abs(orb.monodromy - M)) < 1e-8
+    assert np.max(np.abs(_sorted(orb.multipliers) - _sorted(np.linalg.eigvals(M)))) < 1e-8
+    assert abs(np.real(np.prod(orb.multipliers)) / math.exp(-delta * T) - 1) < 1e-8
+
+
+def test_paper_device_period_doubled_orbit_with_contact_loss():
+    """Fig. 3's device at Omega = 1.2, where the sweep shows period 2: the period-1 orbit
+    exists, loses contact, and is unstable through a multiplier below -1; its multipliers agree
+    with differences of the reference integrator's period map, and Liouville holds."""
+    base = geardyn.CATTDevice(geardyn.PlanetaryParams.paper(xi1=0.05, xi2=0.05),
+                              interpretation="consistent")
+    om = 1.2
+    m = base.with_omega(om)
+    guess = geardyn.periodic_orbit(base, omega=1.0).x  # the stable orbit nearby
+    orb = geardyn.periodic_orbit(m, guess=guess)
+    assert orb.converged, orb.message
+    assert orb.crossings.sum() > 0
+    assert orb.stability == "unstable" and np.min(orb.multipliers.real) < -1.1
+    c = dict(zip(m.param_names, m.params, strict=True))
+    trace = -(c["c_sq_q"] + c["c_sq_c"] + c["c_pq_q"] + c["c_pq_p"])
+    T = 2 * math.pi / om
+    assert abs(np.real(np.prod(orb.multipliers)) / math.exp(trace * T) - 1) < 1e-8
+    assert np.max(np.abs(_reference_period_map(m, orb.x, T) - orb.x)) < 1e-6
+    Mref = _reference_monodromy(m, orb.x, T)
+    assert np.max(np.abs(_sorted(orb.multipliers) - _sorted(np.linalg.eigvals(Mref)))) < 1e-4
+    two = geardyn.periodic_orbit(m, period=2)  # what the sweep shows
+    assert two.converged and two.least_period == 2 and two.stability == "stable"
+    assert orb.least_period == 1
+
+
+def test_body_angle_model_has_no_periodic_orbit_and_says_so():
+    """The SI body-angle form turns as a whole (its angles grow): no periodic orbit of its
+    states exists; the result is a failure with a message, not an orbit."""
+    m = geardyn.CATTDevice(geardyn.PlanetaryParams.paper(xi1=0.05, xi2=0.05)).dimensional()
+    orb = geardyn.periodic_orbit(m, omega=0.5 * m.device.omega_n, max_iter=5)  # in rad/s
+    assert not orb.converged and orb.message
+    assert orb.stability == "unknown"

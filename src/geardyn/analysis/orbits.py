@@ -70,6 +70,11 @@ NEWTON_MAX_ITER = 40
 MIN_DAMPING = 2.0**-10
 #: A multiplier within this of the unit circle makes the verdict "marginal".
 MARGINAL = 1e-6
+#: Most grid points recorded along an orbit (every grid point up to this many; else every
+#: n-th, n the least that keeps the count below it).
+MAX_ORBIT_POINTS = 200_000
+#: Most points of the orbit at which the trace of the Jacobian is evaluated (Liouville).
+TRACE_POINTS = 2048
 
 
 class OrbitStatus(IntEnum):
@@ -229,6 +234,12 @@ class NewtonResult:
     message: str
 
 
+def _fmt(x: np.ndarray) -> str:
+    """A state for a message (6 significant digits, at most 8 entries shown)."""
+    return np.array2string(np.asarray(x), precision=6, threshold=8, edgeitems=4,
+                           max_line_width=10_000)
+
+
 def _norm(v: np.ndarray, scale: np.ndarray) -> float:
     return float(np.max(np.abs(v / scale))) if v.size else 0.0
 
@@ -243,8 +254,15 @@ def newton_shooting(problem: ShootingProblem, x0: np.ndarray, tol: float = NEWTO
     what happened (:class:`OrbitStatus`) and the message where."""
     s = problem.scale
     x = np.asarray(x0, dtype=float).copy()
-    ev = problem.evaluate(x)
+    nan = np.full((x.size, x.size), np.nan)
+    ev = ShootingEval(x, np.full(x.size, np.nan), nan, np.full((1, x.size), np.nan),
+                      np.zeros(problem.model.n_events, np.int64), Status.DIVERGED, 0)
     history: list[float] = []
+    if not np.all(np.isfinite(x)):
+        return NewtonResult(x, ev, 0, (), OrbitStatus.DIVERGED,
+                            f"the starting state is not finite ({_fmt(x)}): the guess's "
+                            f"transient run diverged?")
+    ev = problem.evaluate(x)
 
     def done(status: OrbitStatus, msg: str) -> NewtonResult:
         return NewtonResult(x, ev, len(history) - 1 if history else 0, tuple(history), status,
@@ -252,7 +270,7 @@ def newton_shooting(problem: ShootingProblem, x0: np.ndarray, tol: float = NEWTO
 
     for it in range(max_iter + 1):
         if ev.status != Status.OK:
-            return done(OrbitStatus.DIVERGED, f"the period map diverged from x={x.tolist()} "
+            return done(OrbitStatus.DIVERGED, f"the period map diverged from x={_fmt(x)} "
                                               f"(iteration {it})")
         r = _norm(ev.residual, s)
         history.append(r)
@@ -265,11 +283,11 @@ def newton_shooting(problem: ShootingProblem, x0: np.ndarray, tol: float = NEWTO
         try:
             dx = np.linalg.solve(J, -ev.residual)
         except np.linalg.LinAlgError:
-            return done(OrbitStatus.SINGULAR, f"M - I is singular at x={x.tolist()} "
+            return done(OrbitStatus.SINGULAR, f"M - I is singular at x={_fmt(x)} "
                                               f"(iteration {it})")
         if not np.all(np.isfinite(dx)) or np.linalg.cond(J) > 1e14:
             return done(OrbitStatus.SINGULAR, f"M - I is numerically singular at "
-                                              f"x={x.tolist()} (iteration {it})")
+                                              f"x={_fmt(x)} (iteration {it})")
         lam = 1.0
         while True:
             trial = problem.evaluate(x + lam * dx)
@@ -281,7 +299,7 @@ def newton_shooting(problem: ShootingProblem, x0: np.ndarray, tol: float = NEWTO
                 return done(OrbitStatus.NOT_CONVERGED,
                             f"Newton stalled at iteration {it}: no step down to "
                             f"{MIN_DAMPING:g} of the Newton step lowers the residual "
-                            f"{r:.3g} (x={x.tolist()})")
+                            f"{r:.3g} (x={_fmt(x)})")
     return done(OrbitStatus.NOT_CONVERGED, f"Newton did not converge in {max_iter} iterations: "
                                            f"residual {history[-1]:.3g} (tolerance {tol:g})")
 
@@ -318,7 +336,8 @@ class PeriodicOrbit:
 
     ``x``: the section point (state at time ``t0``, forcing phase zero); ``times`` and
     ``states``: the orbit at every grid point of one orbit period (k q forcing periods, both
-    ends included); ``observables``: the model's outputs (mesh forces) there; ``multipliers``
+    ends included; every n-th where there would be more than :data:`MAX_ORBIT_POINTS`);
+    ``observables``: the model's outputs (mesh forces) there; ``multipliers``
     (sorted by decreasing modulus) and ``eigenvectors`` (columns) of ``monodromy``;
     ``crossings``: edge crossings of the orbit per event over one orbit period;
     ``trace_integral``: the integral of the Jacobian's trace over the period (Liouville:
@@ -375,6 +394,28 @@ class PeriodicOrbit:
         return self.stability == "stable"
 
     @property
+    def section_points(self) -> np.ndarray:
+        """The orbit's k section points (states at the starts of its sections), (k, n)."""
+        n = self.states.shape[0] - 1  # recorded intervals over the orbit
+        every = n // self.period
+        return self.states[: self.period * every : every]
+
+    @property
+    def least_period(self) -> int:
+        """The least period in sections: the smallest divisor d of k with the section point
+        back (to 1e-6 of 1 + |x|, scaled) after d sections (a period-k search can find an orbit
+        of a divisor of k); 0 when not converged."""
+        if not self.converged:
+            return 0
+        pts = self.section_points / self.problem.scale
+        x = pts[0]
+        for d in range(1, self.period):
+            if self.period % d == 0 and np.max(np.abs(pts[d] - x)) <= 1e-6 * (
+                    1.0 + np.max(np.abs(x))):
+                return d
+        return self.period
+
+    @property
     def liouville_error(self) -> float:
         """|prod(multipliers) / exp(trace_integral) - 1|: how well the monodromy keeps
         Liouville's formula (the integrator's error in the phase-space volume)."""
@@ -428,6 +469,7 @@ def orbit_dataset(orb: PeriodicOrbit) -> xr.Dataset:
         model=m.name,
         Omega=pr.omega,
         period=pr.period,
+        least_period=orb.least_period,
         section_periods=pr.sections,
         forcing_periods=pr.forcing_periods,
         duration=pr.duration,
@@ -516,7 +558,13 @@ def build_orbit(problem: ShootingProblem, res: NewtonResult) -> PeriodicOrbit:
     """The :class:`PeriodicOrbit` of a Newton result (the orbit integrated once more from its
     last iterate, every grid point recorded)."""
     m = problem.model
-    ev = problem.evaluate(res.x, jacobian=True, stride=1)
+    stride = max(1, math.ceil(problem.n_steps / MAX_ORBIT_POINTS))
+    while problem.n_steps % stride:
+        stride += 1
+    if np.all(np.isfinite(res.x)):
+        ev = problem.evaluate(res.x, jacobian=True, stride=stride)
+    else:
+        ev = res.evaluation
     n = m.n_states
     if ev.status == Status.OK:
         mu, V = np.linalg.eig(ev.monodromy)
@@ -524,7 +572,7 @@ def build_orbit(problem: ShootingProblem, res: NewtonResult) -> PeriodicOrbit:
         mu, V = mu[order], V[:, order]
     else:
         mu, V = np.full(n, np.nan + 0j), np.full((n, n), np.nan + 0j)
-    times = problem.t0 + np.arange(ev.states.shape[0]) * problem.step
+    times = problem.t0 + np.arange(ev.states.shape[0]) * (stride * problem.step)
     obs = _observables(m, problem, times, ev.states)
     trace = _trace_integral(m, problem, times, ev.states)
     return PeriodicOrbit(
@@ -553,10 +601,12 @@ def _observables(m: Model, problem: ShootingProblem, times: np.ndarray, Y: np.nd
 
 def _trace_integral(m: Model, problem: ShootingProblem, times: np.ndarray, Y: np.ndarray
                     ) -> float:
-    """Integral of the Jacobian's trace along the orbit (trapezoid on the grid; exact for a
-    constant trace, as in the built-in models)."""
+    """Integral of the Jacobian's trace along the orbit (trapezoid on at most
+    :data:`TRACE_POINTS` of the recorded points; exact for a constant trace, as in the built-in
+    models)."""
     if not np.all(np.isfinite(Y)):
         return float("nan")
-    tr = np.array([jacobian_trace(m, t, y, problem.params) for t, y in zip(times, Y,
-                                                                            strict=True)])
-    return float(np.sum(0.5 * (tr[1:] + tr[:-1]) * np.diff(times)))
+    idx = np.unique(np.linspace(0, times.size - 1, min(times.size, TRACE_POINTS)).astype(int))
+    tr = np.array([jacobian_trace(m, times[i], Y[i], problem.params) for i in idx])
+    t = times[idx]
+    return float(np.sum(0.5 * (tr[1:] + tr[:-1]) * np.diff(t)))

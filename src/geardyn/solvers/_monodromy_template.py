@@ -104,8 +104,8 @@ def _rows_step(i, t0, Y, p, h, omega, n_per, s_tab, c_tab, n_ev, K, TMP, Y1, SID
 
 
 @nb.njit(**_JIT)
-def _tangent_step(i, t0, Z, S, IS, p, h, omega, n_per, s_tab, c_tab, n_ev, YP, K, TMP, Y1, SIDE,
-                  G0, G1, W, gbuf, NCR, UNRES):
+def _tangent_step(i, t0, Z, S, IS, p, h, omega, n_per, s_tab, c_tab, n_ev, YP, E, K, TMP, Y1,
+                  SIDE, G0, G1, W, gbuf, NCR, UNRES):
     """Advance the state y (row 0 of Z) by grid step i and each tangent vector (rows 1..n, in
     z = y / S; IS = 1 / S) by the central difference of that step's map. The state is row 0
     of YP, tangent j's perturbed states rows 2 j - 1 and 2 j."""
@@ -115,7 +115,6 @@ def _tangent_step(i, t0, Z, S, IS, p, h, omega, n_per, s_tab, c_tab, n_ev, YP, K
         zq = Z[0, q] * IS[q]
         ny += zq * zq
     scale = FD_DELTA * (1.0 + min(math.sqrt(ny), FD_NORM_CAP))
-    E = np.empty(m)
     for q in range(ns):
         YP[0, q] = Z[0, q]
     for j in range(1, m):
@@ -168,6 +167,7 @@ def period_map(p, y0, scale, t0, h, omega, n_per, n_steps, n_ev, bound, stride, 
     for j in range(1, m):
         Z[j, j - 1] = 1.0
     YP = np.zeros((nr, ns))
+    E = np.zeros(m)  # the perturbation size of each tangent vector in this step
     K = np.zeros((4, nr, ns))
     TMP = np.zeros((nr, ns))
     Y1 = np.zeros((nr, ns))
@@ -187,8 +187,8 @@ def period_map(p, y0, scale, t0, h, omega, n_per, n_steps, n_ev, bound, stride, 
         Y[0, q] = y0[q]
     for i in range(n_steps):
         if jacobian:
-            ok = _tangent_step(i, t0, Z, S, IS, p, h, omega, n_per, s_tab, c_tab, n_ev, YP, K,
-                               TMP, Y1, SIDE, G0, G1, W, gbuf, NCR, UNRES)
+            ok = _tangent_step(i, t0, Z, S, IS, p, h, omega, n_per, s_tab, c_tab, n_ev, YP, E,
+                               K, TMP, Y1, SIDE, G0, G1, W, gbuf, NCR, UNRES)
         else:
             _rows_step(i, t0, Z, p, h, omega, n_per, s_tab, c_tab, n_ev, K, TMP, Y1, SIDE, G0,
                        G1, W, gbuf, NCR, UNRES)
