@@ -14,6 +14,7 @@ from scipy.integrate import solve_ivp
 from scipy.linalg import expm
 
 import geardyn
+import geardyn.io
 from geardyn.analysis.orbits import OrbitStatus, jacobian_trace, shooting_problem
 from geardyn.testing import assert_result
 
@@ -89,7 +90,7 @@ def test_time_varying_stiffness_multipliers_match_the_variational_equations():
     assert np.max(np.abs(_reference_period_map(m, orb.x, T) - orb.x)) < 1e-8
 
 
-def test_orbit_with_contact_loss_against_the_reference_integrator():
+def test_orbit_with_contact_loss_against_the_reference_integrator(tmp_path):
     om, zeta = 0.9, 0.05
     m = geardyn.GearPair(zeta=zeta, Fm=0.1, Fa=0.05).with_omega(om)
     orb = geardyn.periodic_orbit(m)
@@ -114,6 +115,8 @@ def test_orbit_with_contact_loss_against_the_reference_integrator():
     assert ds.attrs["converged"] == 1 and ds.attrs["stability"] == "stable"
     assert int(ds["edge_crossings"].sum()) == int(orb.crossings.sum())
     assert orb.mesh_crossings() == {"mesh": int(orb.crossings.sum())}
+    geardyn.io.save_dataset(ds, tmp_path / "orbit.nc")
+    assert geardyn.io.load_dataset(tmp_path / "orbit.nc").identical(ds)
 
 
 def test_unstable_period_one_orbit_past_a_period_doubling():
