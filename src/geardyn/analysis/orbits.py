@@ -74,7 +74,7 @@ MARGINAL = 1e-6
 #: n-th, n the least that keeps the count below it).
 MAX_ORBIT_POINTS = 200_000
 #: Most points of the orbit at which the trace of the Jacobian is evaluated (Liouville).
-TRACE_POINTS = 2048
+TRACE_POINTS = 256
 
 
 class OrbitStatus(IntEnum):
@@ -171,11 +171,17 @@ class ShootingProblem:
         return self.forcing_periods * forcing_period(self.omega)
 
     def with_params(self, params: np.ndarray) -> ShootingProblem:
-        """The same problem at another coefficient vector (Omega read from it; same steps per
-        period and section), e.g. for a continuation step."""
+        """The same problem at another coefficient vector (Omega read from it, the section
+        re-derived; the same steps per forcing period), e.g. for a continuation step. Raises
+        ValueError where the forcings have no common period."""
         p = np.ascontiguousarray(params, dtype=float).copy()
         om = float(p[self.model.omega_index])
-        return replace(self, params=p, omega=om)
+        if not (math.isfinite(om) and om > 0):
+            raise ValueError(f"Omega must be > 0 (got {om!r})")
+        every, ok = lane_section(self.model, p[None, :], np.array([om]))
+        if not ok[0]:
+            raise ValueError(f"at Omega={om:g} the forcings have no common period")
+        return replace(self, params=p, omega=om, sections=int(every[0]))
 
     def evaluate(self, x: np.ndarray, jacobian: bool = True, stride: int | None = None
                  ) -> ShootingEval:
