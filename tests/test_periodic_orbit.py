@@ -7,7 +7,6 @@ from __future__ import annotations
 
 import math
 
-import numba as nb
 import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
@@ -17,6 +16,7 @@ import geardyn
 import geardyn.io
 from geardyn.analysis.orbits import OrbitStatus, jacobian_trace, shooting_problem
 from geardyn.testing import assert_result
+from orbit_cases import duffing
 
 
 def _sorted(mu: np.ndarray) -> np.ndarray:
@@ -212,18 +212,11 @@ def test_period_two_orbit_after_the_doubling():
     assert np.max(np.abs(ref[1] - ref[0])) > 1e-3
 
 
-@nb.njit(cache=True)
-def _duffing(t, y, dy, p):
-    """x'' + delta x' + x + beta x^3 = gamma cos(Omega t); p = (Omega, delta, beta, gamma)."""
-    dy[0] = y[1]
-    dy[1] = -p[1] * y[1] - y[0] - p[2] * y[0] ** 3 + p[3] * math.cos(p[0] * t)
-
-
 def test_smooth_nonlinear_multipliers_match_the_variational_equations():
     """A user's Duffing oscillator: the monodromy against DOP853 (rtol 1e-12) of the orbit and
     its variational equation, the Jacobian written out here, to 1e-8."""
     om, delta, beta, gamma = 1.2, 0.1, 0.5, 0.3
-    m = geardyn.UserModel(_duffing, n_states=2, params=[om, delta, beta, gamma],
+    m = geardyn.UserModel(duffing, n_states=2, params=[om, delta, beta, gamma],
                           param_names=["Omega", "delta", "beta", "gamma"], natural_frequency=1.6)
     orb = geardyn.periodic_orbit(m)
     assert orb.converged, orb.message
