@@ -240,6 +240,20 @@ class NewtonResult:
     message: str
 
 
+def _fold_hint(M: np.ndarray) -> str:
+    """A note for a failed Newton whose last monodromy has a real multiplier near +1 (within
+    0.05): past a fold the orbit may not exist at this parameter."""
+    if not np.all(np.isfinite(M)):
+        return ""
+    mu = np.linalg.eigvals(M)
+    d = np.abs(mu - 1.0)
+    k = int(np.argmin(d))
+    if d[k] < 0.05:
+        return (f"; a multiplier near +1 ({mu[k].real:.4g}): near a fold (turning point) the "
+                f"orbit may not exist here (continue in arclength)")
+    return ""
+
+
 def _fmt(x: np.ndarray) -> str:
     """A state for a message (6 significant digits, at most 8 entries shown)."""
     return np.array2string(np.asarray(x), precision=6, threshold=8, edgeitems=4,
@@ -271,6 +285,8 @@ def newton_shooting(problem: ShootingProblem, x0: np.ndarray, tol: float = NEWTO
     ev = problem.evaluate(x)
 
     def done(status: OrbitStatus, msg: str) -> NewtonResult:
+        if status == OrbitStatus.NOT_CONVERGED:
+            msg += _fold_hint(ev.monodromy)
         return NewtonResult(x, ev, len(history) - 1 if history else 0, tuple(history), status,
                             msg)
 
