@@ -115,6 +115,16 @@ def test_orbit_with_contact_loss_against_the_reference_integrator(tmp_path):
     assert ds.attrs["converged"] == 1 and ds.attrs["stability"] == "stable"
     assert int(ds["edge_crossings"].sum()) == int(orb.crossings.sum())
     assert orb.mesh_crossings() == {"mesh": int(orb.crossings.sum())}
+    # the orbit over the period, its mesh force and contact regime, against the reference
+    Y = geardyn.reference_solution(m, orb.x, orb.times)
+    assert np.max(np.abs(Y - orb.states)) < 1e-7
+    x, v = Y[:, 0], Y[:, 1]
+    F = np.where(x > 1, x - 1, np.where(x < -1, x + 1, 0.0)) + 2 * zeta * v
+    assert abs(orb.mesh_forces()["force_peak"][0] - np.max(np.abs(F))) < 1e-7
+    assert abs(orb.mesh_forces()["dynamic_factor"][0] - np.max(np.abs(F)) / 0.1) < 1e-6
+    assert x.min() < 1 and x.min() > -1  # separates, never touches the back flank
+    assert orb.contact() == {"mesh": "single"}
+    assert list(ds["contact"].values) == ["single"]
     geardyn.io.save_dataset(ds, tmp_path / "orbit.nc")
     assert geardyn.io.load_dataset(tmp_path / "orbit.nc").identical(ds)
 

@@ -49,6 +49,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import xarray as xr
 
+from geardyn.analysis.contact import contact_regime
+from geardyn.analysis.lanes import has_mesh_forces, variable_attrs
 from geardyn.core.plan import default_steps_per_period, forcing_period, lane_section
 from geardyn.core.settings import DEFAULT_BOUND, INTEGRATOR, RunSettings
 from geardyn.core.status import Status, status_meaning
@@ -383,6 +385,9 @@ class PeriodicOrbit:
     integration_status: Status
     unresolved: int
     trace_integral: float
+    #: Least and greatest value of each switching function at the orbit's grid points.
+    event_min: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    event_max: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
     @property
     def converged(self) -> bool:
@@ -444,6 +449,31 @@ class PeriodicOrbit:
         det = float(np.real(np.prod(self.multipliers)))
         return abs(det / math.exp(self.trace_integral) - 1.0)
 
+    def contact(self) -> dict[str, str]:
+        """The contact regime of each mesh over the orbit (``none``, ``single``, ``double``,
+        ``unbounded``), as the sweeps classify it (:func:`geardyn.analysis.contact
+        .contact_regime`, from the events' extremes and the located crossings)."""
+        st = np.array([int(self.integration_status)])
+        return {name: str(contact_regime(self.event_min[None, :], self.event_max[None, :],
+                                         self.crossings[None, :], i, j, st)[0])
+                for name, i, j in self.model.meshes}
+
+    def mesh_forces(self) -> dict[str, np.ndarray] | None:
+        """Per mesh over the orbit: ``force_peak`` (max |F|), ``force_rms`` and
+        ``dynamic_factor`` (peak / static mesh force, where the model gives it), or None when
+        the model does not observe one force per mesh."""
+        m = self.model
+        if not has_mesh_forces(m):
+            return None
+        F = self.observables[:-1]  # one period: the last point repeats the first
+        out = {"force_peak": np.max(np.abs(F), axis=0),
+               "force_rms": np.sqrt(np.mean(F * F, axis=0))}
+        static = m.static_mesh_forces()
+        if static is not None:
+            with np.errstate(divide="ignore", invalid="ignore"):
+                out["dynamic_factor"] = out["force_peak"] / np.abs(np.asarray(static))
+        return out
+
     def mesh_crossings(self) -> dict[str, int]:
         """Edge crossings per orbit period of each mesh (both edges of its dead zone)."""
         return {name: int(self.crossings[i] + self.crossings[j])
@@ -485,6 +515,12 @@ def orbit_dataset(orb: PeriodicOrbit) -> xr.Dataset:
         ds = ds.assign_coords(event=("event", list(m.event_names)))
         ds["edge_crossings"] = ("event", orb.crossings, {
             "long_name": "dead-zone edge crossings per orbit period", "units": "1"})
+    if m.meshes:
+        ds = ds.assign_coords(mesh=("mesh", [name for name, _, _ in m.meshes]))
+        attrs = variable_attrs(m)
+        ds["contact"] = ("mesh", list(orb.contact().values()), attrs["contact"])
+        for name, values in (orb.mesh_forces() or {}).items():
+            ds[name] = ("mesh", values, attrs[name])
     pr = orb.problem
     ds.attrs.update(
         geardyn_kind="periodic-orbit",
@@ -597,13 +633,14 @@ def build_orbit(problem: ShootingProblem, res: NewtonResult) -> PeriodicOrbit:
     times = problem.t0 + np.arange(ev.states.shape[0]) * (stride * problem.step)
     obs = _observables(m, problem, times, ev.states)
     trace = _trace_integral(m, problem, times, ev.states)
+    G = _events_along(m, problem, times, ev.states)
     return PeriodicOrbit(
         model=m, problem=problem, x=res.x.copy(), times=times, states=ev.states,
         observables=obs, monodromy=ev.monodromy, multipliers=mu, eigenvectors=V,
         crossings=ev.crossings, residual=float(res.residuals[-1]) if res.residuals else np.nan,
         iterations=res.iterations, residuals=res.residuals, status=res.status,
         message=res.message, integration_status=ev.status, unresolved=ev.unresolved,
-        trace_integral=trace)
+        trace_integral=trace, event_min=np.min(G, axis=0), event_max=np.max(G, axis=0))
 
 
 def _observables(m: Model, problem: ShootingProblem, times: np.ndarray, Y: np.ndarray
@@ -618,6 +655,22 @@ def _observables(m: Model, problem: ShootingProblem, times: np.ndarray, Y: np.nd
             ph = problem.omega * (t - problem.t0)
             k.observe(t, Y[i], o, problem.params, math.sin(ph), math.cos(ph))
             out[i] = o
+    return out
+
+
+def _events_along(m: Model, problem: ShootingProblem, times: np.ndarray, Y: np.ndarray
+                  ) -> np.ndarray:
+    """The switching functions at the recorded points, (points, n_events) (NaN rows where the
+    state is not finite; one NaN row when there are no points)."""
+    out = np.full((max(times.size, 1), m.n_events), np.nan)
+    if not m.n_events:
+        return out
+    k = kernels_for(m.kernel)
+    g = np.empty(m.n_events)
+    for i, t in enumerate(times):
+        if np.all(np.isfinite(Y[i])):
+            k.events(t, Y[i], g, problem.params)
+            out[i] = g
     return out
 
 
