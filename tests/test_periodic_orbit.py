@@ -14,7 +14,13 @@ from scipy.linalg import expm
 
 import geardyn
 import geardyn.io
-from geardyn.analysis.orbits import OrbitStatus, jacobian_trace, shooting_problem
+from geardyn.analysis.orbits import (
+    OrbitStatus,
+    build_orbit,
+    jacobian_trace,
+    newton_shooting,
+    shooting_problem,
+)
 from geardyn.testing import assert_result
 from orbit_cases import duffing
 
@@ -176,7 +182,11 @@ def test_shooting_problem_gives_residual_and_jacobian_for_continuation():
                - prob.evaluate(x - e, jacobian=False).residual) / (2 * d)
         assert np.allclose(ev.jacobian[:, j], col, atol=1e-7)
     p2 = m.lane_params("Omega", [0.95])[0]
-    assert prob.with_params(p2).omega == 0.95
+    moved = prob.with_params(p2)
+    assert moved.omega == 0.95 and moved.model.omega == 0.95 and prob.model.omega == 0.9
+    assert moved.duration == pytest.approx(2 * math.pi / 0.95)
+    orb = build_orbit(moved, newton_shooting(moved, geardyn.periodic_orbit(m).x))
+    assert orb.converged and orb.omega == 0.95
     with pytest.raises(ValueError, match="period"):
         shooting_problem(m, period=0)
 

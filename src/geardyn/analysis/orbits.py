@@ -41,6 +41,7 @@ the Jacobian for a state at a coefficient vector; ``with_params(p)`` moves the p
 
 from __future__ import annotations
 
+import copy
 import math
 from dataclasses import dataclass, field, replace
 from enum import IntEnum
@@ -137,7 +138,9 @@ class ShootingProblem:
 
     ``params``: the coefficient vector; ``omega``: the forcing frequency (from ``params``);
     ``sections``: forcing periods per section (q); ``period``: sections per orbit (k);
-    ``steps_per_period``: RK4 steps per forcing period; ``t0``: start time (forcing phase zero).
+    ``steps_per_period``: RK4 steps per forcing period; ``t0``: start time (forcing phase zero);
+    ``section_limit``: the longest common period taken as a section (None: the default).
+    ``model`` holds ``params`` (a copy of the model's, set by :meth:`with_params`).
     """
 
     model: Any
@@ -149,6 +152,7 @@ class ShootingProblem:
     bound: float = DEFAULT_BOUND
     t0: float = 0.0
     scale: np.ndarray = field(default=None)  # type: ignore[assignment]
+    section_limit: int | None = None
 
     def __post_init__(self) -> None:
         if self.scale is None:
@@ -180,10 +184,12 @@ class ShootingProblem:
         om = float(p[self.model.omega_index])
         if not (math.isfinite(om) and om > 0):
             raise ValueError(f"Omega must be > 0 (got {om!r})")
-        every, ok = lane_section(self.model, p[None, :], np.array([om]))
+        every, ok = lane_section(self.model, p[None, :], np.array([om]), self.section_limit)
         if not ok[0]:
             raise ValueError(f"at Omega={om:g} the forcings have no common period")
-        return replace(self, params=p, omega=om, sections=int(every[0]))
+        model = copy.copy(self.model)  # derived quantities (static forces) follow params
+        model.params = p
+        return replace(self, model=model, params=p, omega=om, sections=int(every[0]))
 
     def evaluate(self, x: np.ndarray, jacobian: bool = True, stride: int | None = None
                  ) -> ShootingEval:
@@ -224,7 +230,7 @@ def shooting_problem(model: Model, omega: float | None = None, period: int = 1,
         n = ORBIT_STEP_FACTOR * default_steps_per_period(model, om)
     bound = DEFAULT_BOUND if run is None else run.bound
     return ShootingProblem(model, np.ascontiguousarray(model.params, dtype=float).copy(), om,
-                           int(period), int(every[0]), int(n), bound)
+                           int(period), int(every[0]), int(n), bound, section_limit=limit)
 
 
 # ----------------------------------------------------------------------------- Newton
