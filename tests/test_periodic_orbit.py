@@ -289,3 +289,21 @@ def test_body_angle_model_has_no_periodic_orbit_and_says_so():
     orb = geardyn.periodic_orbit(m, omega=0.5 * m.device.omega_n, max_iter=5)  # in rad/s
     assert not orb.converged and orb.message
     assert orb.stability == "unknown"
+
+
+def test_load_fluctuation_orbit_on_the_common_section():
+    """Fig. 14's device (load fluctuation at Lambda = 2): at Omega = 3 the forcings share the
+    period 3 T (Lambda / Omega = 2 / 3), the section the sweeps use; the orbit closes there in
+    the reference integrator and keeps Liouville."""
+    from geardyn.io import builtin_study
+
+    m = builtin_study("paper_fig14").build_model().with_omega(3.0)
+    orb = geardyn.periodic_orbit(m)
+    assert orb.converged, orb.message
+    assert orb.problem.sections == 3 and orb.duration == pytest.approx(3 * 2 * math.pi / 3.0)
+    assert orb.crossings.sum() > 0
+    assert np.max(np.abs(_reference_period_map(m, orb.x, orb.duration) - orb.x)) < 1e-8
+    c = dict(zip(m.param_names, m.params, strict=True))
+    trace = -(c["c_sq_q"] + c["c_sq_c"] + c["c_pq_q"] + c["c_pq_p"])
+    det = np.real(np.prod(orb.multipliers))
+    assert abs(det / math.exp(trace * orb.duration) - 1) < 2e-8  # RK4's error in the volume
