@@ -55,8 +55,25 @@ def _case() -> xr.Dataset:
     return ds
 
 
+def _orbit() -> xr.Dataset:
+    t = np.arange(5.0)
+    ds = xr.Dataset(coords={"time": ("time", t, {"units": "tau"}), "state": ("state", ["x", "v"]),
+                            "state_in": ("state_in", ["x", "v"]),
+                            "multiplier": ("multiplier", [0, 1])})
+    ds["x"] = ("time", np.sin(t), {"units": "1"})
+    ds["v"] = ("time", np.cos(t), {"units": "1"})
+    ds["section_point"] = ("state", [0.0, 1.0])
+    ds["monodromy"] = (("state", "state_in"), np.eye(2) * 0.5)
+    ds["multiplier_real"] = ("multiplier", [0.5, 0.5])
+    ds["multiplier_imag"] = ("multiplier", [0.0, 0.0])
+    ds.attrs.update(geardyn_kind="periodic-orbit", status=0, status_meaning="0 ok",
+                    steps_per_period=4, time_unit="tau", Omega=1.0, period=1, converged=1,
+                    orbit_status=0, message="converged", residual=0.0, stability="stable")
+    return ds
+
+
 BUILD = {"simulation": _simulation, "bifurcation": _sweep, "map2d": _map,
-         "reproduction-case": _case}
+         "reproduction-case": _case, "periodic-orbit": _orbit}
 
 
 @pytest.mark.parametrize("kind", KINDS)
@@ -66,7 +83,8 @@ def test_well_formed_results_pass(kind):
 
 @pytest.mark.parametrize("kind,name", [("simulation", "poincare"), ("simulation", "v"),
                                        ("bifurcation", "period"), ("bifurcation", "status"),
-                                       ("map2d", "status"), ("reproduction-case", "poincare")])
+                                       ("map2d", "status"), ("reproduction-case", "poincare"),
+                                       ("periodic-orbit", "monodromy")])
 def test_a_removed_variable_is_named(kind, name):
     ds = BUILD[kind]().drop_vars(name)
     with pytest.raises(AssertionError, match=f"'{name}' missing"):

@@ -14,6 +14,7 @@ from geardyn.analysis.bifurcation import ContinuedSweep, bifurcation, continued_
 from geardyn.analysis.lyapunov import LyapunovEstimate, lyapunov, lyapunov_lanes
 from geardyn.analysis.map2d import map2d
 from geardyn.analysis.motion import motion_classes
+from geardyn.analysis.orbits import PeriodicOrbit, periodic_orbit
 from geardyn.analysis.periodicity import classify_period, common_section
 from geardyn.analysis.spectrum import amplitude_spectrum, label_peaks
 from geardyn.core.model import Model
@@ -43,6 +44,7 @@ __all__ = [
     "Mesh",
     "Model",
     "ParameterError",
+    "PeriodicOrbit",
     "PlanetOverride",
     "PlanetaryParams",
     "RunSettings",
@@ -60,6 +62,7 @@ __all__ = [
     "lyapunov_lanes",
     "map2d",
     "motion_classes",
+    "periodic_orbit",
     "default_steps_per_period",
     "reference_solution",
     "simulate",

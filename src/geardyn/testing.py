@@ -610,8 +610,9 @@ def check_model(
 # ------------------------------------------------------------------------------ result datasets
 #: The kinds of result dataset, as recorded in ``attrs["geardyn_kind"]``: what
 #: :func:`geardyn.simulate`, :func:`geardyn.bifurcation`, :func:`geardyn.map2d` and the
-#: reproduction (``geardyn reproduce``, one case under one interpretation) return.
-KINDS = ("simulation", "bifurcation", "map2d", "reproduction-case")
+#: reproduction (``geardyn reproduce``, one case under one interpretation) and
+#: :func:`geardyn.periodic_orbit` (``PeriodicOrbit.to_dataset()``) return.
+KINDS = ("simulation", "bifurcation", "map2d", "reproduction-case", "periodic-orbit")
 
 
 def _result_spec(ds: Any, kind: str) -> tuple[list[str], dict[str, tuple[str, ...]],
@@ -639,6 +640,15 @@ def _result_spec(ds: Any, kind: str) -> tuple[list[str], dict[str, tuple[str, ..
         x, y = str(a.get("x", "x")), str(a.get("y", "y"))
         return (["x", "y", "time_unit"], {y: (y,), x: (x,)},
                 {"period": (y, x), "status": (y, x)}, ["status"])
+    if kind == "periodic-orbit":
+        states = [str(s) for s in ds["state"].values] if "state" in ds.coords else []
+        variables = {"section_point": ("state",), "monodromy": ("state", "state_in"),
+                     "multiplier_real": ("multiplier",), "multiplier_imag": ("multiplier",)}
+        variables.update({s: ("time",) for s in states})
+        return (["status", "status_meaning", "steps_per_period", "time_unit", "Omega", "period",
+                 "converged", "orbit_status", "message", "residual", "stability"],
+                {"time": ("time",), "state": ("state",), "multiplier": ("multiplier",)},
+                variables, [])
     raise AssertionError(f"unknown result kind {kind!r}: one of {', '.join(KINDS)}")
 
 
@@ -692,7 +702,7 @@ def assert_result(ds: Any, kind: str) -> None:
     for name in statuses:
         if name in ds.variables:
             problems += _status_problems(name, ds[name].values)
-    if kind == "simulation" and "status" in ds.attrs:
+    if kind in ("simulation", "periodic-orbit") and "status" in ds.attrs:
         problems += _status_problems("attrs['status']", ds.attrs["status"])
     if problems:
         raise AssertionError(f"not a geardyn {kind} result: " + "; ".join(problems))

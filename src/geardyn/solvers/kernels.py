@@ -67,6 +67,7 @@ def _importable(fn: Any) -> bool:
 TEMPLATES: dict[str, str] = {
     "rk4": "geardyn.solvers._kernel_template",
     "lyapunov": "geardyn.solvers._lyapunov_template",
+    "monodromy": "geardyn.solvers._monodromy_template",
 }
 
 

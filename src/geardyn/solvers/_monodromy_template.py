@@ -1,0 +1,213 @@
+"""The period map and its Jacobian (the monodromy matrix), specialised per model.
+
+This file is a template, like :mod:`geardyn.solvers._kernel_template`:
+:func:`geardyn.solvers.kernels.kernels_for` (template ``"monodromy"``) copies it with the import
+line marked ``MODEL-IMPORT`` replaced by the model's compiled functions. As it stands it is a valid
+module bound to the small test oscillator of :mod:`geardyn.solvers._template_model`.
+
+Numerics (the approach of :mod:`geardyn.solvers._lyapunov_template`, without renormalisation)
+------------------------------------------------------------------------------------------------
+* The state y is advanced on the main solver's grid (RK4 steps of ``h``, ``n_per`` per forcing
+  period, forcing phase from the half-step table), every step split at the located crossings of
+  the switching functions (:mod:`._step_core`).
+* The Jacobian of the map over ``n_steps`` grid steps, M = D Phi_n ... D Phi_1, is built one
+  grid step at a time: its columns (in the scaled coordinates z = y / s, s the model's
+  ``state_scale``) are tangent vectors, each advanced by the central difference of that grid
+  step's map, ``(Phi(y + e s v) - Phi(y - e s v)) / (2 e s)`` with ``e |v| = FD_DELTA (1 +
+  min(|y / s|, FD_NORM_CAP))``. The perturbed states locate their own edge crossings, so a step
+  in which one of them crosses is differentiated correctly: the Jacobian switches exactly at the
+  edge. The vector field is continuous across the edges (the dead-zone force is), so the flow is
+  C^1 there and no saltation matrix is needed. For a step map affine in y (a linear model, also
+  with time-varying stiffness) the difference is exact up to rounding, ~eps / FD_DELTA ~ 1e-10
+  relative per step; otherwise its error is O(e^2) per step.
+* Cost: (2 n + 1) RK4 steps per grid step for n states, run as the rows of one lockstep block.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba as nb
+import numpy as np
+
+from geardyn.solvers._step_core import (  # CORE-IMPORT
+    _JIT,
+    GBUF_ROWS,
+    STATUS_DIVERGED,
+    STATUS_OK,
+    _events_i,
+    _healthy,
+    _leaves_side_step,
+    _rhs_i,
+    _side,
+    _split_step,
+    phase_table,
+)
+from geardyn.solvers._template_model import events, observe, rhs  # MODEL-IMPORT
+
+#: Relative size of the finite-difference perturbation (as in the Lyapunov kernel).
+FD_DELTA = 2.0**-20
+
+#: Cap on |y / s| in the perturbation size (as in the Lyapunov kernel).
+FD_NORM_CAP = 2.0**10
+
+__all__ = ["events", "observe", "period_map", "phase_table", "rhs"]
+
+
+@nb.njit(**_JIT)
+def _rows_step(i, t0, Y, p, h, omega, n_per, s_tab, c_tab, n_ev, K, TMP, Y1, SIDE, G0, G1, W,
+               gbuf, NCR, UNRES):
+    """Advance every row of Y (independent states of one lane) by grid step i (time t0 + i h to
+    t0 + (i + 1) h, forcing phase from the table at i mod n_per), each row with its crossings
+    located; row r's crossings are counted in NCR[r], its split-limit hits in UNRES[r]."""
+    nr, ns = Y.shape
+    t = t0 + i * h
+    hh = 0.5 * h
+    j0 = 2 * (i % n_per)
+    if n_ev > 0:
+        for r in range(nr):
+            _events_i(t, Y[r], G0[r], p)
+            for j in range(n_ev):
+                SIDE[r, j] = _side(G0[r, j])
+    for st in range(4):
+        if st == 0:
+            ts = t
+            jj = j0
+        elif st < 3:
+            ts = t + hh
+            jj = j0 + 1
+        else:
+            ts = t + h
+            jj = j0 + 2
+        a = h if st == 3 else hh
+        for r in range(nr):
+            if st > 0:
+                for q in range(ns):
+                    TMP[r, q] = Y[r, q] + a * K[st - 1, r, q]
+            _rhs_i(ts, Y[r] if st == 0 else TMP[r], K[st, r], p, s_tab[jj], c_tab[jj])
+    h6 = h / 6.0
+    for r in range(nr):
+        for q in range(ns):
+            Y1[r, q] = Y[r, q] + h6 * (K[0, r, q] + 2.0 * K[1, r, q] + 2.0 * K[2, r, q]
+                                       + K[3, r, q])
+    for r in range(nr):
+        crossed = 0
+        if n_ev > 0:
+            _events_i(t + h, Y1[r], G1[r], p)
+            crossed = _leaves_side_step(r, t, t + h, Y, K[0], G0, G1, SIDE, p, W[8], gbuf)
+        if crossed:
+            UNRES[r] += _split_step(i, t0, Y[r], Y1[r], p, h, omega, n_per, SIDE[r], G1[r],
+                                    NCR[r], W, W[8], gbuf)
+        else:
+            for q in range(ns):
+                Y[r, q] = Y1[r, q]
+
+
+@nb.njit(**_JIT)
+def _tangent_step(i, t0, Z, S, IS, p, h, omega, n_per, s_tab, c_tab, n_ev, YP, E, K, TMP, Y1,
+                  SIDE, G0, G1, W, gbuf, NCR, UNRES):
+    """Advance the state y (row 0 of Z) by grid step i and each tangent vector (rows 1..n, in
+    z = y / S; IS = 1 / S) by the central difference of that step's map. The state is row 0
+    of YP, tangent j's perturbed states rows 2 j - 1 and 2 j."""
+    m, ns = Z.shape
+    ny = 0.0
+    for q in range(ns):
+        zq = Z[0, q] * IS[q]
+        ny += zq * zq
+    scale = FD_DELTA * (1.0 + min(math.sqrt(ny), FD_NORM_CAP))
+    for q in range(ns):
+        YP[0, q] = Z[0, q]
+    for j in range(1, m):
+        nv = 0.0
+        for q in range(ns):
+            nv += Z[j, q] * Z[j, q]
+        nv = math.sqrt(nv)
+        if not (nv > 0.0 and math.isfinite(nv)):
+            return False
+        e = scale / nv
+        E[j] = e
+        for q in range(ns):
+            d = e * (S[q] * Z[j, q])
+            YP[2 * j - 1, q] = Z[0, q] + d
+            YP[2 * j, q] = Z[0, q] - d
+    _rows_step(i, t0, YP, p, h, omega, n_per, s_tab, c_tab, n_ev, K, TMP, Y1, SIDE, G0, G1, W,
+               gbuf, NCR, UNRES)
+    for j in range(1, m):
+        inv = 0.5 / E[j]
+        for q in range(ns):
+            Z[j, q] = ((YP[2 * j - 1, q] - YP[2 * j, q]) * inv) * IS[q]
+    for q in range(ns):
+        Z[0, q] = YP[0, q]
+    return True
+
+
+@nb.njit(**_JIT)
+def period_map(p, y0, scale, t0, h, omega, n_per, n_steps, n_ev, bound, stride, jacobian):
+    """The map y0 -> y(t0 + n_steps h) of one lane and, with ``jacobian``, its Jacobian.
+
+    Grid: step h (= 2 pi / (omega n_per)); y0 is given at time t0, where the forcing phase is
+    zero; ``n_ev`` switching functions are located inside steps. ``scale``: the model's state
+    scale (the finite differences are sized in y / scale). Returns (y_end[ns], M[ns, ns] (the
+    Jacobian dy_end / dy0; NaN without ``jacobian``), Y[n_rec, ns] (the state at every stride-th
+    grid point, n_rec = n_steps // stride + 1), ncross[n_ev] (the state's edge crossings),
+    status, unresolved (steps of any row that reached the split limit)).
+    """
+    ns = y0.size
+    s_tab, c_tab = phase_table(n_per, omega != 0.0)
+    S = np.empty(ns)
+    IS = np.empty(ns)
+    for q in range(ns):
+        S[q] = scale[q]
+        IS[q] = 1.0 / scale[q]
+    m = ns + 1 if jacobian else 1
+    nr = 2 * m - 1
+    Z = np.zeros((m, ns))
+    for q in range(ns):
+        Z[0, q] = y0[q]
+    for j in range(1, m):
+        Z[j, j - 1] = 1.0
+    YP = np.zeros((nr, ns))
+    E = np.zeros(m)  # the perturbation size of each tangent vector in this step
+    K = np.zeros((4, nr, ns))
+    TMP = np.zeros((nr, ns))
+    Y1 = np.zeros((nr, ns))
+    ne = max(n_ev, 1)
+    SIDE = np.ones((nr, ne), np.int64)
+    G0 = np.zeros((nr, ne))
+    G1 = np.zeros((nr, ne))
+    W = np.zeros((9, ns))
+    gbuf = np.zeros((GBUF_ROWS, ne))
+    NCR = np.zeros((nr, ne), np.int64)
+    UNRES = np.zeros(nr, np.int64)
+    n_rec = n_steps // stride + 1
+    Y = np.full((n_rec, ns), np.nan)
+    M = np.full((ns, ns), np.nan)
+    status = STATUS_OK
+    for q in range(ns):
+        Y[0, q] = y0[q]
+    for i in range(n_steps):
+        if jacobian:
+            ok = _tangent_step(i, t0, Z, S, IS, p, h, omega, n_per, s_tab, c_tab, n_ev, YP, E,
+                               K, TMP, Y1, SIDE, G0, G1, W, gbuf, NCR, UNRES)
+        else:
+            _rows_step(i, t0, Z, p, h, omega, n_per, s_tab, c_tab, n_ev, K, TMP, Y1, SIDE, G0,
+                       G1, W, gbuf, NCR, UNRES)
+            ok = True
+        if not ok or not _healthy(Z[0], bound):
+            status = STATUS_DIVERGED
+            break
+        if (i + 1) % stride == 0:
+            for q in range(ns):
+                Y[(i + 1) // stride, q] = Z[0, q]
+    unres = 0
+    for r in range(nr):
+        unres += UNRES[r]
+    if status == STATUS_OK and jacobian:
+        for j in range(ns):  # column j of M in y: S (Z[j + 1] in z) / S[j]
+            for q in range(ns):
+                M[q, j] = S[q] * Z[j + 1, q] * IS[j]
+        for j in range(ns):
+            for q in range(ns):
+                if not math.isfinite(M[q, j]):
+                    status = STATUS_DIVERGED
+    return Z[0].copy(), M, Y, NCR[0, :n_ev].copy(), status, unres
