@@ -21,15 +21,14 @@ ROOT = Path(geardyn.__file__).resolve().parent
 #: The layers, lowest first: a module may import its own layer and those before it, never one
 #: after it. Each entry names the modules (or packages, with everything in them) of the layer.
 LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
-    # modules with no geardyn imports: exceptions, unit parsing, the version, the packaged
-    # study files (data only; io reads them as files)
-    ("base", ("geardyn._version", "geardyn.errors", "geardyn.units", "geardyn.studies")),
+    # modules with no geardyn imports: exceptions, unit parsing, the version, file primitives
+    # (atomic writes, attribute encoding), the packaged study files (data only)
+    ("base", ("geardyn._version", "geardyn.errors", "geardyn.files", "geardyn.units",
+              "geardyn.studies")),
     # the model interface, the kernel source, run settings, the lane plan, the section, status
     ("core", ("geardyn.core",)),
     # the models: CATT device, gear pair, user models, parameter records
     ("models", ("geardyn.models",)),
-    # files <-> plain data: TOML study/parameter files, NetCDF, atomic writes
-    ("io", ("geardyn.io",)),
     # numerics: the kernel generator and templates, lane ensembles, simulate, the reference
     ("solvers", ("geardyn.solvers",)),
     # chunking, Dask, the resumable Zarr store
@@ -38,6 +37,8 @@ LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
     ("analysis", ("geardyn.analysis",)),
     # the model contract's checks and assert_result
     ("testing", ("geardyn.testing",)),
+    # files <-> plain data: TOML study/parameter files, NetCDF results
+    ("io", ("geardyn.io",)),
     ("plotting", ("geardyn.plotting",)),
     # study files turned into models
     ("study", ("geardyn.study",)),

@@ -40,8 +40,7 @@ import numpy as np
 import xarray as xr
 
 from geardyn.errors import GeardynError
-from geardyn.io.atomic import atomic_replace
-from geardyn.io.netcdf import netcdf_attrs
+from geardyn.files import atomic_replace, netcdf_attrs
 
 __all__ = ["LANES_GROUP", "LaneStore", "StoreMismatchError", "load_zarr_dataset",
            "save_zarr_dataset"]

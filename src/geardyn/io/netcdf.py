@@ -9,57 +9,16 @@ the converted attributes come back identical.
 
 from __future__ import annotations
 
-import json
 import os
 from pathlib import Path
-from typing import Any
 
-import numpy as np
 import xarray as xr
 
-from geardyn.io.atomic import atomic_replace
+from geardyn.files import atomic_replace, netcdf_attrs
 
 __all__ = ["load_dataset", "netcdf_attrs", "save_dataset"]
 
 ENGINE = "h5netcdf"
-
-
-def _attr_value(value: Any) -> Any:
-    """A netCDF-safe attribute value, or ``None`` to drop it."""
-    if value is None:
-        return None
-    if isinstance(value, bool | np.bool_):
-        return int(value)
-    if isinstance(value, dict):
-        return json.dumps(value, default=_json_default, sort_keys=True)
-    if isinstance(value, list | tuple):
-        items = list(value)
-        if any(isinstance(v, dict | list | tuple) or v is None for v in items):
-            return json.dumps(items, default=_json_default)
-        if any(isinstance(v, bool | np.bool_) for v in items):
-            return [int(v) if isinstance(v, bool | np.bool_) else v for v in items]
-        return items
-    if isinstance(value, np.ndarray) and value.dtype == bool:
-        return value.astype(np.int8)
-    return value
-
-
-def _json_default(obj: Any) -> Any:
-    if isinstance(obj, np.generic):
-        return obj.item()
-    if isinstance(obj, np.ndarray):
-        return obj.tolist()
-    raise TypeError(f"attribute value of type {type(obj).__name__} cannot be stored")
-
-
-def netcdf_attrs(attrs: dict[str, Any]) -> dict[str, Any]:
-    """``attrs`` with the conversions :func:`save_dataset` applies."""
-    out = {}
-    for key, value in attrs.items():
-        v = _attr_value(value)
-        if v is not None:
-            out[str(key)] = v
-    return out
 
 
 def _converted(ds: xr.Dataset) -> xr.Dataset:

@@ -52,7 +52,7 @@ from pydantic import (
 from pydantic_core import InitErrorDetails, PydanticCustomError
 
 from geardyn.errors import ParameterError, StudyError
-from geardyn.io.atomic import atomic_replace
+from geardyn.files import atomic_replace
 from geardyn.models.params import PAPER_NAMES, Angle, PlanetaryParams, Real, Whole
 
 __all__ = [
