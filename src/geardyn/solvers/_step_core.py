@@ -54,9 +54,11 @@ GRAZE_BOUND_STEP = 0.6
 #: An interior extremum of an edge function counts as a crossing only beyond the edge by more than
 #: this fraction of the function's size over the step (shallower dips are touching, not crossing).
 GRAZE_TOL = 1e-9
-#: Newton's method on an event's cubic along the step stops at a step (in the fraction of the
-#: step) or bracket below this.
-ROOT_TOL = 1e-14
+#: Newton's method on an event's cubic along the step stops after a step (in the fraction of
+#: the step) below this: the error left is about |P''/2P'| ROOT_TOL^2 (quadratic convergence).
+ROOT_TOL = 1e-8
+#: ... or, where it bisects, when the bracket is below this.
+BRACKET_TOL = 1e-13
 #: The root of the cubic is taken when the model's event there is within this fraction of the
 #: step (in time) from its zero, by the cubic's slope; else the model's events refine it.
 CONFIRM_TOL = 1e-9
@@ -209,11 +211,12 @@ def _cubic_locate(j, side_j, c0, c1, c2, c3, b, fb, y0, f0, y1, f1, dt, t, p, yb
             b = x
         dp = (3.0 * c3 * x + 2.0 * c2) * x + c1
         xn = x - px / dp if dp != 0.0 else 0.5 * (a + b)
-        if not (a < xn < b):
+        newton = a < xn < b
+        if not newton:
             xn = 0.5 * (a + b)
         step = abs(xn - x)
         x = xn
-        if step <= ROOT_TOL or b - a <= ROOT_TOL:
+        if (newton and step <= ROOT_TOL) or b - a <= BRACKET_TOL:
             break
     _hermite(y0, f0, y1, f1, dt, x, ybuf)
     _events_i(t + x * dt, ybuf, g, p)
@@ -281,22 +284,24 @@ def _beyond(th, e, j, side_j, tol, y0, f0, y1, f1, dt, t, p, ybuf, g):
 
 
 @nb.njit(inline="always", **_JIT)
-def _interpolant_events(y0, f0, y1, f1, dt, t, p, ybuf, gbuf):
-    _events_i(t, y0, gbuf[0], p)
-    for m in range(1, 3):
-        _hermite(y0, f0, y1, f1, dt, m / 3.0, ybuf)
-        _events_i(t + m / 3.0 * dt, ybuf, gbuf[2 + m], p)
+def _interpolant_events(y0, f0, y1, f1, dt, t, p, ybuf, g0, g13, g23):
+    """:func:`interpolant_events` into the rows g0, g13, g23 (theta = 0, 1/3, 2/3)."""
+    _events_i(t, y0, g0, p)
+    _hermite(y0, f0, y1, f1, dt, 1.0 / 3.0, ybuf)
+    _events_i(t + 1.0 / 3.0 * dt, ybuf, g13, p)
+    _hermite(y0, f0, y1, f1, dt, 2.0 / 3.0, ybuf)
+    _events_i(t + 2.0 / 3.0 * dt, ybuf, g23, p)
 
 
 @nb.njit(**_JIT)
 def interpolant_events(y0, f0, y1, f1, dt, t, p, ybuf, gbuf):
     """The events along a step's cubic Hermite interpolant (start y0, end y1, derivatives f0, f1,
     length dt, from time t) at theta = 0, 1/3, 2/3 into rows 0, 3, 4 of gbuf (GBUF_ROWS rows)."""
-    _interpolant_events(y0, f0, y1, f1, dt, t, p, ybuf, gbuf)
+    _interpolant_events(y0, f0, y1, f1, dt, t, p, ybuf, gbuf[0], gbuf[3], gbuf[4])
 
 
 @nb.njit(inline="always", **_JIT)
-def _first_crossing(j, side_j, graze, g1j, y0, f0, y1, f1, dt, t, p, ybuf, gbuf):
+def _first_crossing(j, side_j, graze, g1j, y0, f0, y1, f1, dt, t, p, ybuf, gbuf, gsc):
     """:func:`first_crossing`; without ``graze`` the end's side alone decides (one crossing at
     most: the caller's prefilter ruled a graze out)."""
     v0 = gbuf[0, j]
@@ -308,18 +313,17 @@ def _first_crossing(j, side_j, graze, g1j, y0, f0, y1, f1, dt, t, p, ybuf, gbuf)
         tol = GRAZE_TOL * max(max(abs(v0), abs(v1)), max(abs(v2), abs(g1j)))
         th1, e1, th2, e2 = cubic_extrema(v0, v1, v2, g1j)
         b = th1
-        gb = _beyond(th1, e1, j, side_j, tol, y0, f0, y1, f1, dt, t, p, ybuf, gbuf[1])
+        gb = _beyond(th1, e1, j, side_j, tol, y0, f0, y1, f1, dt, t, p, ybuf, gsc)
         if gb != gb:
             b = th2
-            gb = _beyond(th2, e2, j, side_j, tol, y0, f0, y1, f1, dt, t, p, ybuf, gbuf[1])
+            gb = _beyond(th2, e2, j, side_j, tol, y0, f0, y1, f1, dt, t, p, ybuf, gsc)
         if gb != gb:
             b = 1.0
             gb = g1j
     if b == 1.0 and _side(g1j) == side_j:
         return 2.0
     c0, c1, c2, c3 = _cubic_coeffs(v0, v1, v2, g1j)
-    return _cubic_locate(j, side_j, c0, c1, c2, c3, b, gb, y0, f0, y1, f1, dt, t, p, ybuf,
-                         gbuf[1])
+    return _cubic_locate(j, side_j, c0, c1, c2, c3, b, gb, y0, f0, y1, f1, dt, t, p, ybuf, gsc)
 
 
 @nb.njit(**_JIT)
@@ -337,7 +341,7 @@ def first_crossing(j, side_j, g1j, y0, f0, y1, f1, dt, t, p, ybuf, gbuf):
     the end's side decides. The bracket [0, b] handed to the root finder ends at the first such
     extremum (or the end), so it holds exactly one crossing, the first; the root is found on
     the cubic (:func:`_cubic_locate`)."""
-    return _first_crossing(j, side_j, True, g1j, y0, f0, y1, f1, dt, t, p, ybuf, gbuf)
+    return _first_crossing(j, side_j, True, g1j, y0, f0, y1, f1, dt, t, p, ybuf, gbuf, gbuf[1])
 
 
 @nb.njit(**_JIT)
@@ -418,9 +422,16 @@ def _leaves_side_step(r, t0, t1, Y, K1, G0, G1, SIDE, p, ybuf, gbuf):
 
 @nb.njit(inline="always", **_JIT)
 def _sincos_small(d):
-    """sin d, cos d for |d| <= SMALL_ANGLE (Taylor polynomials to d^17 and d^18: truncation
-    below 1e-18; no libm call)."""
+    """sin d, cos d for |d| <= SMALL_ANGLE, no libm call: Taylor polynomials to d^9 and d^10
+    for |d| <= 0.1, else to d^17 and d^18 (truncation below 1e-18 either way)."""
     d2 = d * d
+    if abs(d) <= 0.1:
+        sn = d * (1.0 + d2 * (-1.0 / 6.0 + d2 * (1.0 / 120.0 + d2 * (-1.0 / 5040.0 + d2 * (
+            1.0 / 362880.0)))))
+        cs = 1.0 + d2 * (-0.5 + d2 * (1.0 / 24.0 + d2 * (-1.0 / 720.0 + d2 * (1.0 / 40320.0
+                                                                           + d2 * (
+            -1.0 / 3628800.0)))))
+        return sn, cs
     sn = d * (1.0 + d2 * (-1.0 / 6.0 + d2 * (1.0 / 120.0 + d2 * (-1.0 / 5040.0 + d2 * (
         1.0 / 362880.0 + d2 * (-1.0 / 39916800.0 + d2 * (1.0 / 6227020800.0 + d2 * (
             -1.0 / 1307674368000.0 + d2 * (1.0 / 355687428096000.0)))))))))
@@ -443,15 +454,19 @@ def _phase_at(sa, ca, wh, i_mod, x):
 
 
 @nb.njit(inline="always", **_JIT)
-def _rk4_stages(t, y, h, p, s1, c1, s2, c2, work, out):
-    """:func:`_rk4` with k1 given (row 0 of work; rows 1-3: k2-k4, row 4: scratch), the model's
-    rhs inlined once (one call site for the three stages), the same arithmetic."""
+def _rk4_stages(t, y, h, p, s1, c1, s2, c2, k1, kst, acc, tmp, out):
+    """:func:`_rk4` with k1 given, the model's rhs inlined once (one call site for the three
+    stages: each stage's k in kst, their weighted sum in acc), the same arithmetic."""
     ns = y.size
     hh = 0.5 * h
+    for q in range(ns):
+        acc[q] = k1[q]
+        tmp[q] = y[q] + hh * k1[q]
     for st in range(1, 4):
-        a = h if st == 3 else hh
-        for q in range(ns):
-            work[4, q] = y[q] + a * work[st - 1, q]
+        if st > 1:
+            a = h if st == 3 else hh
+            for q in range(ns):
+                tmp[q] = y[q] + a * kst[q]
         ts = t + hh
         ss = s1
         cc = c1
@@ -459,10 +474,16 @@ def _rk4_stages(t, y, h, p, s1, c1, s2, c2, work, out):
             ts = t + h
             ss = s2
             cc = c2
-        _rhs_i(ts, work[4], work[st], p, ss, cc)
+        _rhs_i(ts, tmp, kst, p, ss, cc)
+        if st == 3:
+            for q in range(ns):
+                acc[q] = acc[q] + kst[q]
+        else:
+            for q in range(ns):
+                acc[q] = acc[q] + 2.0 * kst[q]
     h6 = h / 6.0
     for q in range(ns):
-        out[q] = y[q] + h6 * (work[0, q] + 2.0 * work[1, q] + 2.0 * work[2, q] + work[3, q])
+        out[q] = y[q] + h6 * acc[q]
 
 
 @nb.njit(**_JIT)
@@ -481,8 +502,16 @@ def _split_step(i, t0, y, y_trial, p, h, omega, n_per, side, g1, ncross, work, y
     comes from that at the grid point by angle addition. work: 7 rows of the state's size."""
     n_ev = g1.size
     ns = y.size
+    k1 = work[0]
+    kst = work[1]
+    acc = work[2]
+    tmp = work[4]
     f1 = work[5]
     ystart = work[6]
+    g0 = gbuf[0]
+    gsc = gbuf[1]
+    g13 = gbuf[3]
+    g23 = gbuf[4]
     u = 0.0  # fraction of the grid step done
     i_mod = i % n_per
     wh = omega * h
@@ -495,7 +524,7 @@ def _split_step(i, t0, y, y_trial, p, h, omega, n_per, side, g1, ncross, work, y
     for _ in range(MAX_SPLITS):
         t = t0 + (i + u) * h
         dt = (1.0 - u) * h
-        _rhs_i(t, y, work[0], p, s0, c0)
+        _rhs_i(t, y, k1, p, s0, c0)
         graze = False
         need = False
         for j in range(n_ev):
@@ -504,7 +533,7 @@ def _split_step(i, t0, y, y_trial, p, h, omega, n_per, side, g1, ncross, work, y
             need = need or flag or _side(g1[j]) != side[j]
         if u > 0.0:
             sm, cm = _phase_at(sa, ca, wh, i_mod, 0.5 * (1.0 + u))
-            _rk4_stages(t, y, dt, p, sm, cm, s_end, c_end, work, y_trial)
+            _rk4_stages(t, y, dt, p, sm, cm, s_end, c_end, k1, kst, acc, tmp, y_trial)
             _events_i(t_end, y_trial, g1, p)
             need = graze
             for j in range(n_ev):
@@ -516,14 +545,14 @@ def _split_step(i, t0, y, y_trial, p, h, omega, n_per, side, g1, ncross, work, y
         _rhs_i(t_end, y_trial, f1, p, s_end, c_end)
         for q in range(ns):
             ystart[q] = y[q]
-        _interpolant_events(ystart, work[0], y_trial, f1, dt, t, p, ybuf, gbuf)
+        _interpolant_events(ystart, k1, y_trial, f1, dt, t, p, ybuf, g0, g13, g23)
         first = -1
         theta = 2.0
         for j in range(n_ev):
             flag = gbuf[GRAZE_ROW, j] != 0.0
             if flag or _side(g1[j]) != side[j]:
-                th = _first_crossing(j, side[j], flag, g1[j], ystart, work[0], y_trial, f1, dt,
-                                     t, p, ybuf, gbuf)
+                th = _first_crossing(j, side[j], flag, g1[j], ystart, k1, y_trial, f1, dt, t,
+                                     p, ybuf, gbuf, gsc)
             else:
                 th = 2.0
             gbuf[2, j] = th
@@ -538,7 +567,7 @@ def _split_step(i, t0, y, y_trial, p, h, omega, n_per, side, g1, ncross, work, y
         tu = u + theta * (1.0 - u)
         sm, cm = _phase_at(sa, ca, wh, i_mod, tm)
         s0, c0 = _phase_at(sa, ca, wh, i_mod, tu)
-        _rk4_stages(t, ystart, theta * dt, p, sm, cm, s0, c0, work, y)
+        _rk4_stages(t, ystart, theta * dt, p, sm, cm, s0, c0, k1, kst, acc, tmp, y)
         for j in range(n_ev):
             if gbuf[2, j] <= theta + SIMULTANEOUS:
                 side[j] = -side[j]
