@@ -8,8 +8,9 @@ model's ``rhs`` and ``events``. As it stands it is a valid module bound to the t
 :mod:`geardyn.solvers._template_model`.
 
 Edge location: a step that leaves a side of an edge (a zero of ``events``) is split at the
-crossing, located by root-finding (Illinois) on the cubic Hermite interpolant of the step (error
-O(h^4) in the crossing time), and integrated in sub-steps, so every RK4 stage sees a smooth
+crossing, located on the cubic Hermite interpolant of the step (error O(h^4) in the crossing
+time: Newton's method on the event's cubic along it, :func:`_cubic_locate`, checked on the model's
+event once), and integrated in sub-steps, so every RK4 stage sees a smooth
 right-hand side and the method keeps 4th order. A step leaves a side when its end lies on the
 other side, or when it grazes the edge: crosses it twice (or any even number of times) inside the
 step. A graze is found from the interior extrema of the edge function along the interpolant
@@ -21,7 +22,8 @@ instant).
 
 Cost: the check of an ordinary step (:func:`_leaves_side`) is the sign test at the step's end
 and a bound on the dip of each edge function from its last three grid values (no evaluation of
-the model); only steps that can graze by that bound are redone (:func:`_split_step`).
+the model); only steps that can graze by that bound are redone (:func:`_split_step`). A split
+costs about 9 evaluations of the model's rhs and 8 of its events (``bench/crossing.py``).
 """
 
 from __future__ import annotations
