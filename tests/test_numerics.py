@@ -92,7 +92,9 @@ def test_default_steps_reach_1e6_on_periodic_attractors(omega, loss):
     assert (int(fine["edge_crossings"].sum()) > 0) == loss
     # the reference's own attractor: run it on from the fine RK4 point, keep the last points
     ref = geardyn.reference_solution(m, y_fine, np.arange(25) * T, rtol=1e-12, atol=1e-13)[-4:]
-    assert np.max(np.abs(ref[2:] - ref[:2])) < 1e-9  # period 1 or 2, converged
+    # period 1 or 2, converged: to 1e-8, the reference's own reproducibility here (at
+    # Omega = 0.6 a start moved by 1e-14 changed this difference from 2e-10 to 9e-9)
+    assert np.max(np.abs(ref[2:] - ref[:2])) < 1e-8
     ds = geardyn.simulate(m, transient=4000.0, periods=4)
     assert ds.attrs["steps_per_period"] == geardyn.default_steps_per_period(m)
     assert _poincare_distance(ref, ds["poincare"].values) < 1e-6

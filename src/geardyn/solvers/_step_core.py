@@ -8,8 +8,9 @@ model's ``rhs`` and ``events``. As it stands it is a valid module bound to the t
 :mod:`geardyn.solvers._template_model`.
 
 Edge location: a step that leaves a side of an edge (a zero of ``events``) is split at the
-crossing, located by root-finding (Illinois) on the cubic Hermite interpolant of the step (error
-O(h^4) in the crossing time), and integrated in sub-steps, so every RK4 stage sees a smooth
+crossing, located on the cubic Hermite interpolant of the step (error O(h^4) in the crossing
+time: Newton's method on the event's cubic along it, :func:`_cubic_locate`, checked on the model's
+event once), and integrated in sub-steps, so every RK4 stage sees a smooth
 right-hand side and the method keeps 4th order. A step leaves a side when its end lies on the
 other side, or when it grazes the edge: crosses it twice (or any even number of times) inside the
 step. A graze is found from the interior extrema of the edge function along the interpolant
@@ -21,7 +22,8 @@ instant).
 
 Cost: the check of an ordinary step (:func:`_leaves_side`) is the sign test at the step's end
 and a bound on the dip of each edge function from its last three grid values (no evaluation of
-the model); only steps that can graze by that bound are redone (:func:`_split_step`).
+the model); only steps that can graze by that bound are redone (:func:`_split_step`). A split
+costs about 9 evaluations of the model's rhs and 8 of its events (``bench/crossing.py``).
 """
 
 from __future__ import annotations
@@ -54,6 +56,16 @@ GRAZE_BOUND_STEP = 0.6
 #: An interior extremum of an edge function counts as a crossing only beyond the edge by more than
 #: this fraction of the function's size over the step (shallower dips are touching, not crossing).
 GRAZE_TOL = 1e-9
+#: Newton's method on an event's cubic along the step stops after a step (in the fraction of
+#: the step) below this: the error left is about |P''/2P'| ROOT_TOL^2 (quadratic convergence).
+ROOT_TOL = 1e-8
+#: ... or, where it bisects, when the bracket is below this.
+BRACKET_TOL = 1e-13
+#: The root of the cubic is taken when the model's event there is within this fraction of the
+#: step (in time) from its zero, by the cubic's slope; else the model's events refine it.
+CONFIRM_TOL = 1e-9
+#: Largest phase increment (radians) that :func:`_phase_at` takes from its polynomials.
+SMALL_ANGLE = 0.8
 STATUS_OK = 0
 STATUS_DIVERGED = 1
 # MODEL-ADAPTERS (a user's plain functions are adapted to the kernel interface here)
@@ -116,13 +128,10 @@ def _hermite(y0, f0, y1, f1, dt, theta, out):
         out[q] = h00 * y0[q] + h10 * f0[q] + h01 * y1[q] + h11 * f1[q]
 
 
-@nb.njit(**_JIT)
-def _locate(j, side_j, g0j, b, fb, y0, f0, y1, f1, dt, t, p, ybuf, gbuf):
-    """Fraction in (0, b] of the step where event j leaves side side_j (Illinois method on the
-    step's interpolant), given a bracket [0, b] that holds exactly one crossing: g0j the event at
-    the start (taken as on side side_j), fb its value at b (on the other side)."""
-    a = 0.0
-    fa = g0j if _side(g0j) == side_j else (1e-300 if side_j > 0 else 0.0)
+@nb.njit(inline="always", **_JIT)
+def _illinois(j, side_j, a, fa, b, fb, y0, f0, y1, f1, dt, t, p, ybuf, g):
+    """Illinois root finding of event j (the model's, on the step's interpolant) in the
+    bracket [a, b]: fa on side side_j, fb off it. Returns the bracket's end off the side."""
     last = 0
     for _ in range(60):
         denom = fb - fa
@@ -130,8 +139,8 @@ def _locate(j, side_j, g0j, b, fb, y0, f0, y1, f1, dt, t, p, ybuf, gbuf):
         if not (a < x < b):
             x = 0.5 * (a + b)
         _hermite(y0, f0, y1, f1, dt, x, ybuf)
-        events(t + x * dt, ybuf, gbuf, p)
-        fx = gbuf[j]
+        _events_i(t + x * dt, ybuf, g, p)
+        fx = g[j]
         if _side(fx) == side_j:
             a = x
             fa = fx
@@ -147,6 +156,79 @@ def _locate(j, side_j, g0j, b, fb, y0, f0, y1, f1, dt, t, p, ybuf, gbuf):
         if b - a < 1e-13:
             break
     return b
+
+
+@nb.njit(inline="always", **_JIT)
+def _forced(g0j, side_j):
+    """The event at the start of a (sub-)step taken as on side side_j (a start a hair beyond
+    the edge, just after a located crossing, counts as on it)."""
+    return g0j if _side(g0j) == side_j else (1e-300 if side_j > 0 else 0.0)
+
+
+@nb.njit(**_JIT)
+def _locate(j, side_j, g0j, b, fb, y0, f0, y1, f1, dt, t, p, ybuf, gbuf):
+    """Fraction in (0, b] of the step where event j leaves side side_j (Illinois method on the
+    step's interpolant, the model's event evaluated at every iterate), given a bracket [0, b]
+    that holds exactly one crossing: g0j the event at the start (taken as on side side_j), fb
+    its value at b (on the other side). The split path uses :func:`_cubic_locate`; this is its
+    fallback for events that are not affine in the state."""
+    return _illinois(j, side_j, 0.0, _forced(g0j, side_j), b, fb, y0, f0, y1, f1, dt, t, p,
+                     ybuf, gbuf)
+
+
+@nb.njit(inline="always", **_JIT)
+def _cubic_coeffs(v0, v1, v2, v3):
+    """Power-basis coefficients (c0, c1, c2, c3) in theta of the cubic through (0, v0),
+    (1/3, v1), (2/3, v2), (1, v3)."""
+    d1 = v1 - v0
+    d2 = v2 - 2.0 * v1 + v0
+    d3 = v3 - 3.0 * v2 + 3.0 * v1 - v0
+    return v0, 3.0 * d1 - 1.5 * d2 + d3, 4.5 * (d2 - d3), 4.5 * d3
+
+
+@nb.njit(inline="always", **_JIT)
+def _cubic_locate(j, side_j, c0, c1, c2, c3, b, fb, y0, f0, y1, f1, dt, t, p, ybuf, g):
+    """Fraction in (0, b] of the step where event j leaves side side_j, given the cubic
+    c0 + c1 x + c2 x^2 + c3 x^3 of the event along the step's interpolant (exact for an event
+    affine in time and state) and a bracket [0, b] that holds exactly one crossing (the start
+    taken as on side side_j; fb: the model's event at b, off the side).
+
+    Newton's method on the cubic, safeguarded by the bracket (no model evaluations), then one
+    evaluation of the model's event at the root: it is taken when the event there is within
+    CONFIRM_TOL of the step from its crossing (always, up to round-off, for affine events);
+    otherwise the model's events take over (:func:`_illinois`, bracket narrowed)."""
+    a = 0.0
+    hi = b
+    fa = _forced(c0, side_j)
+    x = (a * fb - b * fa) / (fb - fa) if fb != fa else 0.5 * b
+    if not (a < x < b):
+        x = 0.5 * (a + b)
+    for _ in range(60):
+        px = ((c3 * x + c2) * x + c1) * x + c0
+        if px == 0.0:
+            break
+        if _side(px) == side_j:
+            a = x
+        else:
+            b = x
+        dp = (3.0 * c3 * x + 2.0 * c2) * x + c1
+        xn = x - px / dp if dp != 0.0 else 0.5 * (a + b)
+        newton = a < xn < b
+        if not newton:
+            xn = 0.5 * (a + b)
+        step = abs(xn - x)
+        x = xn
+        if (newton and step <= ROOT_TOL) or b - a <= BRACKET_TOL:
+            break
+    _hermite(y0, f0, y1, f1, dt, x, ybuf)
+    _events_i(t + x * dt, ybuf, g, p)
+    gx = g[j]
+    if abs(gx) <= CONFIRM_TOL * abs((3.0 * c3 * x + 2.0 * c2) * x + c1):
+        return x
+    if _side(gx) == side_j:
+        return _illinois(j, side_j, x, gx, hi, fb, y0, f0, y1, f1, dt, t, p, ybuf, g)
+    return _illinois(j, side_j, 0.0, _forced(c0, side_j), x, gx, y0, f0, y1, f1, dt, t, p, ybuf,
+                     g)
 
 
 @nb.njit(inline="always", **_JIT)
@@ -192,25 +274,58 @@ def cubic_extrema(v0, v1, v2, v3):
 
 
 @nb.njit(inline="always", **_JIT)
-def _beyond(th, e, j, side_j, tol, y0, f0, y1, f1, dt, t, p, ybuf, gbuf):
+def _beyond(th, e, j, side_j, tol, y0, f0, y1, f1, dt, t, p, ybuf, g):
     """The event j on the interpolant at th if the cubic's value e there and it both lie beyond
-    the edge (off side side_j, by more than tol); else NaN."""
+    the edge (off side side_j, by more than tol); else NaN. g: scratch row."""
     if not (th > 0.0 and side_j * e < 0.0 and abs(e) > tol):
         return np.nan
     _hermite(y0, f0, y1, f1, dt, th, ybuf)
-    events(t + th * dt, ybuf, gbuf[1], p)
-    ge = gbuf[1, j]
+    _events_i(t + th * dt, ybuf, g, p)
+    ge = g[j]
     return ge if _side(ge) != side_j and abs(ge) > tol else np.nan
+
+
+@nb.njit(inline="always", **_JIT)
+def _interpolant_events(y0, f0, y1, f1, dt, t, p, ybuf, g0, g13, g23):
+    """:func:`interpolant_events` into the rows g0, g13, g23 (theta = 0, 1/3, 2/3)."""
+    _events_i(t, y0, g0, p)
+    _hermite(y0, f0, y1, f1, dt, 1.0 / 3.0, ybuf)
+    _events_i(t + 1.0 / 3.0 * dt, ybuf, g13, p)
+    _hermite(y0, f0, y1, f1, dt, 2.0 / 3.0, ybuf)
+    _events_i(t + 2.0 / 3.0 * dt, ybuf, g23, p)
 
 
 @nb.njit(**_JIT)
 def interpolant_events(y0, f0, y1, f1, dt, t, p, ybuf, gbuf):
     """The events along a step's cubic Hermite interpolant (start y0, end y1, derivatives f0, f1,
     length dt, from time t) at theta = 0, 1/3, 2/3 into rows 0, 3, 4 of gbuf (GBUF_ROWS rows)."""
-    events(t, y0, gbuf[0], p)
-    for m in range(1, 3):
-        _hermite(y0, f0, y1, f1, dt, m / 3.0, ybuf)
-        events(t + m / 3.0 * dt, ybuf, gbuf[2 + m], p)
+    _interpolant_events(y0, f0, y1, f1, dt, t, p, ybuf, gbuf[0], gbuf[3], gbuf[4])
+
+
+@nb.njit(inline="always", **_JIT)
+def _first_crossing(j, side_j, graze, g1j, y0, f0, y1, f1, dt, t, p, ybuf, gbuf, gsc):
+    """:func:`first_crossing`; without ``graze`` the end's side alone decides (one crossing at
+    most: the caller's prefilter ruled a graze out)."""
+    v0 = gbuf[0, j]
+    v1 = gbuf[3, j]
+    v2 = gbuf[4, j]
+    b = 1.0
+    gb = g1j
+    if graze:
+        tol = GRAZE_TOL * max(max(abs(v0), abs(v1)), max(abs(v2), abs(g1j)))
+        th1, e1, th2, e2 = cubic_extrema(v0, v1, v2, g1j)
+        b = th1
+        gb = _beyond(th1, e1, j, side_j, tol, y0, f0, y1, f1, dt, t, p, ybuf, gsc)
+        if gb != gb:
+            b = th2
+            gb = _beyond(th2, e2, j, side_j, tol, y0, f0, y1, f1, dt, t, p, ybuf, gsc)
+        if gb != gb:
+            b = 1.0
+            gb = g1j
+    if b == 1.0 and _side(g1j) == side_j:
+        return 2.0
+    c0, c1, c2, c3 = _cubic_coeffs(v0, v1, v2, g1j)
+    return _cubic_locate(j, side_j, c0, c1, c2, c3, b, gb, y0, f0, y1, f1, dt, t, p, ybuf, gsc)
 
 
 @nb.njit(**_JIT)
@@ -220,29 +335,15 @@ def first_crossing(j, side_j, g1j, y0, f0, y1, f1, dt, t, p, ybuf, gbuf):
     rows 0, 3, 4: the events at theta = 0, 1/3, 2/3 (:func:`interpolant_events`); row 1 is
     scratch.
 
-    Along the interpolant an event that is linear in the state is exactly the cubic through
-    those four values (in general: to the interpolant's O(h^4)). An interior extremum of that
-    cubic beyond the edge (by more than GRAZE_TOL of the event's size over the step), confirmed
-    by the event on the interpolant there, has a crossing before it: the orbit grazes the edge
-    (an even number of crossings in the step) or crosses it several times. Otherwise the end's
-    side decides. The bracket [0, b] handed to the root finder ends at the first such extremum
-    (or the end), so it holds exactly one crossing, the first."""
-    v0 = gbuf[0, j]
-    v1 = gbuf[3, j]
-    v2 = gbuf[4, j]
-    tol = GRAZE_TOL * max(max(abs(v0), abs(v1)), max(abs(v2), abs(g1j)))
-    th1, e1, th2, e2 = cubic_extrema(v0, v1, v2, g1j)
-    b = th1
-    gb = _beyond(th1, e1, j, side_j, tol, y0, f0, y1, f1, dt, t, p, ybuf, gbuf)
-    if gb != gb:
-        b = th2
-        gb = _beyond(th2, e2, j, side_j, tol, y0, f0, y1, f1, dt, t, p, ybuf, gbuf)
-    if gb != gb:
-        if _side(g1j) == side_j:
-            return 2.0
-        b = 1.0
-        gb = g1j
-    return _locate(j, side_j, v0, b, gb, y0, f0, y1, f1, dt, t, p, ybuf, gbuf[1])
+    Along the interpolant an event that is affine in time and state is exactly the cubic
+    through those four values (in general: to the interpolant's O(h^4)). An interior extremum
+    of that cubic beyond the edge (by more than GRAZE_TOL of the event's size over the step),
+    confirmed by the event on the interpolant there, has a crossing before it: the orbit grazes
+    the edge (an even number of crossings in the step) or crosses it several times. Otherwise
+    the end's side decides. The bracket [0, b] handed to the root finder ends at the first such
+    extremum (or the end), so it holds exactly one crossing, the first; the root is found on
+    the cubic (:func:`_cubic_locate`)."""
+    return _first_crossing(j, side_j, True, g1j, y0, f0, y1, f1, dt, t, p, ybuf, gbuf, gbuf[1])
 
 
 @nb.njit(**_JIT)
@@ -321,58 +422,138 @@ def _leaves_side_step(r, t0, t1, Y, K1, G0, G1, SIDE, p, ybuf, gbuf):
     return out
 
 
+@nb.njit(inline="always", **_JIT)
+def _sincos_small(d):
+    """sin d, cos d for |d| <= SMALL_ANGLE, no libm call: Taylor polynomials to d^9 and d^10
+    for |d| <= 0.1, else to d^17 and d^18 (truncation below 1e-18 either way)."""
+    d2 = d * d
+    if abs(d) <= 0.1:
+        sn = d * (1.0 + d2 * (-1.0 / 6.0 + d2 * (1.0 / 120.0 + d2 * (-1.0 / 5040.0 + d2 * (
+            1.0 / 362880.0)))))
+        cs = 1.0 + d2 * (-0.5 + d2 * (1.0 / 24.0 + d2 * (-1.0 / 720.0 + d2 * (
+            1.0 / 40320.0 + d2 * (-1.0 / 3628800.0)))))
+        return sn, cs
+    sn = d * (1.0 + d2 * (-1.0 / 6.0 + d2 * (1.0 / 120.0 + d2 * (-1.0 / 5040.0 + d2 * (
+        1.0 / 362880.0 + d2 * (-1.0 / 39916800.0 + d2 * (1.0 / 6227020800.0 + d2 * (
+            -1.0 / 1307674368000.0 + d2 * (1.0 / 355687428096000.0)))))))))
+    cs = 1.0 + d2 * (-0.5 + d2 * (1.0 / 24.0 + d2 * (-1.0 / 720.0 + d2 * (1.0 / 40320.0 + d2 * (
+        -1.0 / 3628800.0 + d2 * (1.0 / 479001600.0 + d2 * (-1.0 / 87178291200.0 + d2 * (
+            1.0 / 20922789888000.0 + d2 * (-1.0 / 6402373705728000.0)))))))))
+    return sn, cs
+
+
+@nb.njit(inline="always", **_JIT)
+def _phase_at(sa, ca, wh, i_mod, x):
+    """sin and cos of the forcing phase wh (i_mod + x) at the fraction x in [0, 1] of grid step
+    i_mod, from those at its start (sa, ca) by angle addition (libm only for long steps)."""
+    d = wh * x
+    if abs(d) <= SMALL_ANGLE:
+        sd, cd = _sincos_small(d)
+        return sa * cd + ca * sd, ca * cd - sa * sd
+    a = wh * (i_mod + x)
+    return math.sin(a), math.cos(a)
+
+
+@nb.njit(inline="always", **_JIT)
+def _rk4_stages(t, y, h, p, s1, c1, s2, c2, k1, kst, acc, tmp, out):
+    """:func:`_rk4` with k1 given, the model's rhs inlined once (one call site for the three
+    stages: each stage's k in kst, their weighted sum in acc), the same arithmetic."""
+    ns = y.size
+    hh = 0.5 * h
+    for q in range(ns):
+        acc[q] = k1[q]
+        tmp[q] = y[q] + hh * k1[q]
+    for st in range(1, 4):
+        if st > 1:
+            a = h if st == 3 else hh
+            for q in range(ns):
+                tmp[q] = y[q] + a * kst[q]
+        ts = t + hh
+        ss = s1
+        cc = c1
+        if st == 3:
+            ts = t + h
+            ss = s2
+            cc = c2
+        _rhs_i(ts, tmp, kst, p, ss, cc)
+        if st == 3:
+            for q in range(ns):
+                acc[q] = acc[q] + kst[q]
+        else:
+            for q in range(ns):
+                acc[q] = acc[q] + 2.0 * kst[q]
+    h6 = h / 6.0
+    for q in range(ns):
+        out[q] = y[q] + h6 * acc[q]
+
+
 @nb.njit(**_JIT)
 def _split_step(i, t0, y, y_trial, p, h, omega, n_per, side, g1, ncross, work, ybuf, gbuf):
     """Finish grid step i of one lane with edge crossings located; y holds the start, and
     y_trial/g1 the unsplit trial step; gbuf has GBUF_ROWS rows, row GRAZE_ROW flagging the
     events that may graze (set by the caller's prefilter: those get :func:`first_crossing`,
     the others a crossing only where the end's side differs). Returns 1 if the split limit was
-    reached, else 0."""
+    reached, else 0.
+
+    Per (sub-)step to check: f at its start (the RK4's k1) and end, the events at 0, 1/3, 2/3
+    of the step's interpolant, the first crossing on the cubic of each event
+    (:func:`_cubic_locate`: no model evaluations but one per located event), then RK4 to the
+    crossing (k1 reused) and from there to the grid point; after that last sub-step only the
+    end's side is tested unless an event may graze. The forcing phase at the fractional points
+    comes from that at the grid point by angle addition. work: 7 rows of the state's size."""
+    n_ev = g1.size
+    ns = y.size
     k1 = work[0]
-    k2 = work[1]
-    k3 = work[2]
-    k4 = work[3]
+    kst = work[1]
+    acc = work[2]
     tmp = work[4]
     f1 = work[5]
     ystart = work[6]
-    n_ev = g1.size
+    g0 = gbuf[0]
+    gsc = gbuf[1]
+    g13 = gbuf[3]
+    g23 = gbuf[4]
     u = 0.0  # fraction of the grid step done
     i_mod = i % n_per
     wh = omega * h
     t_end = t0 + (i + 1) * h
-    s_end = math.sin(wh * (i_mod + 1))
-    c_end = math.cos(wh * (i_mod + 1))
+    sa = math.sin(wh * i_mod)
+    ca = math.cos(wh * i_mod)
+    s_end, c_end = _phase_at(sa, ca, wh, i_mod, 1.0)
+    s0 = sa
+    c0 = ca
     for _ in range(MAX_SPLITS):
         t = t0 + (i + u) * h
         dt = (1.0 - u) * h
-        s0 = math.sin(wh * (i_mod + u))
-        c0 = math.cos(wh * (i_mod + u))
+        _rhs_i(t, y, k1, p, s0, c0)
+        graze = False
+        need = False
+        for j in range(n_ev):
+            flag = gbuf[GRAZE_ROW, j] != 0.0
+            graze = graze or flag
+            need = need or flag or _side(g1[j]) != side[j]
         if u > 0.0:
-            sm = math.sin(wh * (i_mod + 0.5 * (1.0 + u)))
-            cm = math.cos(wh * (i_mod + 0.5 * (1.0 + u)))
-            _rk4(t, y, dt, p, s0, c0, sm, cm, s_end, c_end, k1, k2, k3, k4, tmp, y_trial, False)
-            events(t_end, y_trial, g1, p)
-        else:
-            rhs(t, y, k1, p, s0, c0)
+            sm, cm = _phase_at(sa, ca, wh, i_mod, 0.5 * (1.0 + u))
+            _rk4_stages(t, y, dt, p, sm, cm, s_end, c_end, k1, kst, acc, tmp, y_trial)
+            _events_i(t_end, y_trial, g1, p)
+            need = graze
+            for j in range(n_ev):
+                need = need or _side(g1[j]) != side[j]
+        if not need:
+            for q in range(ns):
+                y[q] = y_trial[q]
+            return 0
+        _rhs_i(t_end, y_trial, f1, p, s_end, c_end)
+        for q in range(ns):
+            ystart[q] = y[q]
+        _interpolant_events(ystart, k1, y_trial, f1, dt, t, p, ybuf, g0, g13, g23)
         first = -1
         theta = 2.0
-        rhs(t_end, y_trial, f1, p, s_end, c_end)
-        for q in range(y.size):
-            ystart[q] = y[q]
-        graze = False
         for j in range(n_ev):
-            graze = graze or gbuf[GRAZE_ROW, j] != 0.0
-        if graze:
-            interpolant_events(ystart, k1, y_trial, f1, dt, t, p, ybuf, gbuf)
-        else:
-            events(t, y, gbuf[0], p)
-        for j in range(n_ev):
-            if gbuf[GRAZE_ROW, j] != 0.0:  # may graze, or cross more than once
-                th = first_crossing(j, side[j], g1[j], ystart, k1, y_trial, f1, dt, t, p, ybuf,
-                                    gbuf)
-            elif _side(g1[j]) != side[j]:  # one crossing
-                th = _locate(j, side[j], gbuf[0, j], 1.0, g1[j], ystart, k1, y_trial, f1, dt, t,
-                             p, ybuf, gbuf[1])
+            flag = gbuf[GRAZE_ROW, j] != 0.0
+            if flag or _side(g1[j]) != side[j]:
+                th = _first_crossing(j, side[j], flag, g1[j], ystart, k1, y_trial, f1, dt, t,
+                                     p, ybuf, gbuf, gsc)
             else:
                 th = 2.0
             gbuf[2, j] = th
@@ -380,24 +561,23 @@ def _split_step(i, t0, y, y_trial, p, h, omega, n_per, side, g1, ncross, work, y
                 theta = th
                 first = j
         if first < 0:
-            for q in range(y.size):
+            for q in range(ns):
                 y[q] = y_trial[q]
             return 0
-        dts = theta * dt
         tm = u + 0.5 * theta * (1.0 - u)
         tu = u + theta * (1.0 - u)
-        _rk4(t, ystart, dts, p, s0, c0, math.sin(wh * (i_mod + tm)), math.cos(wh * (i_mod + tm)),
-             math.sin(wh * (i_mod + tu)), math.cos(wh * (i_mod + tu)), k1, k2, k3, k4, tmp, y,
-             True)
+        sm, cm = _phase_at(sa, ca, wh, i_mod, tm)
+        s0, c0 = _phase_at(sa, ca, wh, i_mod, tu)
+        _rk4_stages(t, ystart, theta * dt, p, sm, cm, s0, c0, k1, kst, acc, tmp, y)
         for j in range(n_ev):
             if gbuf[2, j] <= theta + SIMULTANEOUS:
                 side[j] = -side[j]
                 ncross[j] += 1
         u = tu
         if u >= 1.0:
-            events(t_end, y, g1, p)
+            _events_i(t_end, y, g1, p)
             return 0
-    for q in range(y.size):
+    for q in range(ns):
         y[q] = y_trial[q]
     for j in range(n_ev):
         side[j] = _side(g1[j])
