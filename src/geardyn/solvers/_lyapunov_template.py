@@ -756,7 +756,8 @@ def _lane_books(step, first, nl, k, renorm, bound, ZT, Zl, Cl, logs, IST, ENDS, 
                 ACTR, H, out, err, used, status):
     """The bookkeeping of the block's lanes due at this step, as in :func:`_run`:
     renormalisation (health, modified Gram-Schmidt on a gathered copy), block statistics, the
-    result at a lane's last step. Returns the next step at which a lane is due."""
+    result at a lane's last step. Returns the next step at which a lane is due. (One loop, no
+    inlined helpers with array arguments: each would cost reference counting per lane.)"""
     m, ns = Zl.shape
     nxt = np.iinfo(np.int64).max
     changed = False
@@ -764,60 +765,57 @@ def _lane_books(step, first, nl, k, renorm, bound, ZT, Zl, Cl, logs, IST, ENDS, 
         if not ACT[l]:
             continue
         if IST[l, _DUE] == step:
-            _one_lane_books(l, first + l, step, k, m, ns, renorm, bound, ZT, Zl, Cl, logs, IST,
-                            ENDS, BLK, ACC, ACT, H, out, err, used, status)
-            if ACT[l]:
-                IST[l, _DUE] = _lane_due(IST, l, renorm, ENDS)
-            else:
+            lane = first + l
+            n_tr = IST[l, _NTR]
+            measure = step > n_tr
+            c = IST[l, _CUR]
+            renormalise = (step - IST[l, _LAST] == renorm or step == n_tr
+                           or step == IST[l, _TOTAL])
+            block_end = measure and step - n_tr == ENDS[l, c]
+            if renormalise or block_end:
+                for j in range(m):
+                    for q in range(ns):
+                        Zl[j, q] = ZT[j, q, l]
+            if renormalise:
+                IST[l, _LAST] = step
+                healthy = True
+                for q in range(ns):
+                    healthy = healthy and abs(Zl[0, q]) <= bound  # False for NaN too
+                if not healthy or not _orthonormalise(Zl, logs, measure):
+                    ACT[l] = False
+                    status[lane] = STATUS_DIVERGED
+                    changed = True
+                    continue
+                for j in range(m):
+                    for q in range(ns):
+                        ZT[j, q, l] = Zl[j, q]
+                if measure:
+                    for j in range(k):
+                        ACC[l, j] += logs[j]
+                        BLK[l, c, j] += logs[j]
+                if block_end:
+                    IST[l, _CUR] = c + 1
+            elif block_end:
+                # a block ends between renormalisations: its share of the running stretch, on
+                # a copy
+                _stretch_logs(Zl, Cl, logs)
+                for j in range(k):
+                    BLK[l, c, j] += logs[j]
+                    BLK[l, c + 1, j] -= logs[j]
+                IST[l, _CUR] = c + 1
+            if step == IST[l, _TOTAL]:
+                ACT[l] = False
                 changed = True
-        if ACT[l]:
-            nxt = min(nxt, IST[l, _DUE])
+                _lane_result(l, lane, k, IST[l, _NST], H[lane], ENDS, IST[l, _NBK], BLK, ACC,
+                             out, err, used)
+                continue
+            IST[l, _DUE] = _lane_due(IST, l, renorm, ENDS)
+        nxt = min(nxt, IST[l, _DUE])
     if changed:
         for s in range(2 * k + 1):
             for l in range(nl):
                 ACTR[s * nl + l] = ACT[l]
     return nxt
-
-
-@nb.njit(inline="always", **_JIT)
-def _one_lane_books(l, lane, step, k, m, ns, renorm, bound, ZT, Zl, Cl, logs, IST, ENDS, BLK, ACC,
-                    ACT, H, out, err, used, status):
-    """Lane l's bookkeeping at a due step (see :func:`_lane_books`)."""
-    n_tr = IST[l, _NTR]
-    measure = step > n_tr
-    c = IST[l, _CUR]
-    if step - IST[l, _LAST] == renorm or step == n_tr or step == IST[l, _TOTAL]:
-        IST[l, _LAST] = step
-        for j in range(m):
-            for q in range(ns):
-                Zl[j, q] = ZT[j, q, l]
-        if not _healthy(Zl[0], bound) or not _orthonormalise(Zl, logs, measure):
-            ACT[l] = False
-            status[lane] = STATUS_DIVERGED
-            return
-        for j in range(m):
-            for q in range(ns):
-                ZT[j, q, l] = Zl[j, q]
-        if measure:
-            for j in range(k):
-                ACC[l, j] += logs[j]
-                BLK[l, c, j] += logs[j]
-        if measure and step - n_tr == ENDS[l, c]:
-            IST[l, _CUR] = c + 1
-    elif measure and step - n_tr == ENDS[l, c]:
-        # a block ends between renormalisations: its share of the running stretch, on a copy
-        for j in range(m):
-            for q in range(ns):
-                Zl[j, q] = ZT[j, q, l]
-        _stretch_logs(Zl, Cl, logs)
-        for j in range(k):
-            BLK[l, c, j] += logs[j]
-            BLK[l, c + 1, j] -= logs[j]
-        IST[l, _CUR] = c + 1
-    if step == IST[l, _TOTAL]:
-        ACT[l] = False
-        _lane_result(l, lane, k, IST[l, _NST], H[lane], ENDS, IST[l, _NBK], BLK, ACC, out, err,
-                     used)
 
 
 @nb.njit(**_JIT)
