@@ -23,28 +23,30 @@ def paper_device(**kw) -> geardyn.CATTDevice:
 
 
 def _lanes(model, omegas, n_per, periods_tr, periods_st, y0, t0):
-    """Kernel arguments for lanes of one grid (n_per steps per period), step counts per lane."""
+    """Kernel arguments for lanes with n_per steps per period (one for all or one per lane) and
+    their own step counts; the last entry: n_per per lane."""
+    n_per = np.broadcast_to(np.asarray(n_per, np.int64), omegas.shape).copy()
     P = np.ascontiguousarray(model.lane_params("Omega", omegas))
     H = 2.0 * np.pi / omegas / n_per
     n_tr = np.asarray(periods_tr, np.int64) * n_per
     n_st = np.asarray(periods_st, np.int64) * n_per
     Y0 = np.ascontiguousarray(np.broadcast_to(y0, (omegas.size, model.n_states)), dtype=float)
     T0 = np.ascontiguousarray(t0, dtype=float)
-    return P, Y0, T0, H, np.ascontiguousarray(omegas, dtype=float), n_tr, n_st
+    return P, Y0, T0, H, np.ascontiguousarray(omegas, dtype=float), n_tr, n_st, n_per
 
 
-def _reference(kern, model, args, n_per, renorm, k, bound=1e6):
+def _reference(kern, model, args, renorm, k, bound=1e6):
     """Each lane through the one-lane kernel (lyapunov_single), as lyapunov() runs it."""
-    P, Y0, T0, H, OM, n_tr, n_st = args
+    P, Y0, T0, H, OM, n_tr, n_st, n_per = args
     scale = np.ones(model.n_states)
-    res = [kern.lyapunov_single(P[i], Y0[i], scale, T0[i], H[i], OM[i], n_per, n_tr[i], n_st[i],
+    res = [kern.lyapunov_single(P[i], Y0[i], scale, T0[i], H[i], OM[i], n_per[i], n_tr[i], n_st[i],
                                 renorm, k, bound, model.n_events, 16) for i in range(len(P))]
     return (np.array([r[0] for r in res]), np.array([r[1] for r in res]),
             np.array([r[2] for r in res]), np.array([r[3] for r in res]))
 
 
-def _blocks(kern, model, args, n_per, renorm, k, block_rows, n_ev=None, bound=1e6):
-    P, Y0, T0, H, OM, n_tr, n_st = args
+def _blocks(kern, model, args, renorm, k, block_rows, n_ev=None, bound=1e6):
+    P, Y0, T0, H, OM, n_tr, n_st, n_per = args
     L = len(P)
     out, err = np.full((L, k), -1.0), np.full((L, k), -1.0)
     used, status = np.full(L, -1, np.int64), np.full(L, -1, np.int64)
@@ -62,7 +64,7 @@ def _assert_bitwise(got, ref):
 @pytest.mark.parametrize("k", [1, 4])
 def test_catt_blocks_bitwise_equal_to_one_lane_kernel(k):
     # the reduced paper device at Omegas with and without contact loss, lanes with their own
-    # transient, measuring window, start time and state; renorm 7 so that blocks of the
+    # grid, transient, measuring window, start time and state; renorm 7 so that blocks of the
     # measuring window end between renormalisations
     model = paper_device()
     assert model.n_events == 4
@@ -71,14 +73,16 @@ def test_catt_blocks_bitwise_equal_to_one_lane_kernel(k):
     om = np.array([0.7, 1.05, 1.4, 1.8, 2.3, 2.9, 3.6])
     rng = np.random.default_rng(3)
     y0 = model.initial_state() + rng.uniform(-0.5, 0.5, (om.size, 4))
-    args = _lanes(model, om, 48, [3, 0, 5, 2, 4, 1, 6], [12, 9, 7, 16, 5, 11, 3], y0,
+    # lanes of different grids share blocks (the kernel's per-row phase tables)
+    args = _lanes(model, om, [48, 64, 48, 40, 64, 48, 56], [3, 0, 5, 2, 4, 1, 6],
+                  [12, 9, 7, 16, 5, 11, 3], y0,
                   rng.uniform(0.0, 50.0, om.size))
-    ref = _reference(kern, model, args, 48, 7, k)
+    ref = _reference(kern, model, args, 7, k)
     assert np.all(ref[3] == 0) and np.all(np.isfinite(ref[0]))
     for rows in (64, 2 * k + 1, 1000):  # several lanes per block, one, all
-        _assert_bitwise(_blocks(kern, model, args, 48, 7, k, rows), ref)
+        _assert_bitwise(_blocks(kern, model, args, 7, k, rows), ref)
     # edges matter in these lanes (contact is lost): without locating them the exponents differ
-    plain = _blocks(kern, model, args, 48, 7, k, 64, n_ev=0)
+    plain = _blocks(kern, model, args, 7, k, 64, n_ev=0)
     assert not np.array_equal(plain[0], ref[0])
 
 
@@ -91,10 +95,10 @@ def test_gear_pair_blocks_bitwise_equal_with_a_diverged_lane():
         args = _lanes(model, om, 32, [10, 20, 5, 0, 15], [40, 25, 30, 50, 20], y0,
                       [0.0, 3.0, 0.0, 7.5, 1.0])
         for k in (1, 2):
-            ref = _reference(kern, model, args, 32, 10, k)
+            ref = _reference(kern, model, args, 10, k)
             assert ref[3][2] == 1 and np.all(np.isnan(ref[0][2]))  # diverged
             for rows in (64, 5):
-                _assert_bitwise(_blocks(kern, model, args, 32, 10, k, rows), ref)
+                _assert_bitwise(_blocks(kern, model, args, 10, k, rows), ref)
 
 
 def test_generic_lane_path_general_catt_model():
@@ -104,8 +108,8 @@ def test_generic_lane_path_general_catt_model():
     assert not hasattr(kern, "rhs_lanes")
     om = np.array([1.1, 1.6, 2.4])
     args = _lanes(model, om, 40, [2, 0, 3], [6, 8, 5], model.initial_state(), [0.0, 0.0, 2.0])
-    ref = _reference(kern, model, args, 40, 10, 1)
-    _assert_bitwise(_blocks(kern, model, args, 40, 10, 1, 64), ref)
+    ref = _reference(kern, model, args, 10, 1)
+    _assert_bitwise(_blocks(kern, model, args, 10, 1, 64), ref)
 
 
 @nb.njit(cache=True)

@@ -370,11 +370,28 @@ def lyapunov_single(p, y0, scale, t0, h, omega, n_per, n_transient, n_steps, ren
                 renorm_every, k, bound, n_ev, n_blocks)
 
 
-@nb.njit(parallel=True, **_JIT)
 def lyapunov_lanes_rows(P, Y0, scale, T0, H, OMEGA, n_per, n_transient, n_steps, renorm_every,
                         bound, out, err, n_ev=0, n_blocks=16):
-    """Largest exponent of every lane (row of P, Y0), in parallel over lanes, one lane at a
-    time (the rows of :func:`lyapunov_single`): the reference of :func:`lyapunov_lanes`.
+    """:func:`lyapunov_lanes` one lane at a time (the rows of :func:`lyapunov_single`), the
+    lanes of each grid (n_per: one for all lanes or one per lane) in parallel: the kernel before
+    the lane blocks, kept as their reference."""
+    L = Y0.shape[0]
+    nper = np.broadcast_to(np.asarray(n_per, np.int64), (L,))
+    for n in np.unique(nper):
+        idx = np.nonzero(nper == n)[0]
+        part, part_err = np.full(idx.size, np.nan), np.full(idx.size, np.nan)
+        sel = [np.ascontiguousarray(np.asarray(a)[idx])
+               for a in (P, Y0, T0, H, OMEGA, n_transient, n_steps)]
+        _lanes_rows(sel[0], sel[1], scale, sel[2], sel[3], sel[4], int(n), sel[5], sel[6],
+                    renorm_every, bound, part, part_err, n_ev, n_blocks)
+        out[idx], err[idx] = part, part_err
+
+
+@nb.njit(parallel=True, **_JIT)
+def _lanes_rows(P, Y0, scale, T0, H, OMEGA, n_per, n_transient, n_steps, renorm_every, bound, out,
+                err, n_ev=0, n_blocks=16):
+    """Largest exponent of every lane (row of P, Y0; n_per steps per period), in parallel over
+    lanes, one lane at a time (the rows of :func:`lyapunov_single`).
 
     scale: the state scale (one vector for all lanes, as in :func:`lyapunov_single`); T0: start
     time (forcing phase zero there, as in :func:`lyapunov_single`) per lane; H, OMEGA:
@@ -456,11 +473,14 @@ else:
 
 
 @nb.njit(inline="always", **_JIT)
-def _fill_phase(nr, s, c, SP, CP):
-    """The block's forcing phase (one grid, one step) as per-row arrays."""
-    for r in range(nr):
-        SP[r] = s
-        CP[r] = c
+def _fill_phase(nr, IDX, S_TAB, C_TAB, PH):
+    """The rows' forcing phases of a grid step from their tables: sin and cos at the step's
+    start, middle and end (IDX[r]: the start's index in S_TAB, C_TAB) into rows 0-5 of PH."""
+    for d in range(3):
+        for r in range(nr):
+            j = IDX[r] + d
+            PH[2 * d, r] = S_TAB[j]
+            PH[2 * d + 1, r] = C_TAB[j]
 
 
 @nb.njit(inline="always", **_JIT)
@@ -522,26 +542,24 @@ def _fd_combine(nl, m, ZT, IS, Y, E, ACT):
 
 
 @nb.njit(inline="always", **_JIT)
-def _rows_rk4(nr, Y, Y1, K1, K2, K3, K4, TMP, TS, TM, TE, HR, HH, H6, PT, P, LANE, SP, CP, SC,
-              s_tab, c_tab, j0, ybuf, dbuf):
-    """One RK4 trial step of every row into Y1 (the arithmetic of :func:`_grid_step_rows`)."""
+def _rows_rk4(nr, Y, Y1, K1, K2, K3, K4, TMP, TS, TM, TE, HR, HH, H6, PT, P, LANE, PH, SC, ybuf,
+              dbuf):
+    """One RK4 trial step of every row into Y1 (the arithmetic of :func:`_grid_step_rows`); PH:
+    the rows' forcing phases (sin, cos) at the step's start, middle and end (rows 0-5)."""
     ns = Y.shape[0]
-    _fill_phase(nr, s_tab[j0], c_tab[j0], SP, CP)
-    _rows_rhs(TS, Y, K1, PT, P, LANE, nr, SP, CP, SC, ybuf, dbuf)
-    _fill_phase(nr, s_tab[j0 + 1], c_tab[j0 + 1], SP, CP)
+    _rows_rhs(TS, Y, K1, PT, P, LANE, nr, PH[0], PH[1], SC, ybuf, dbuf)
     for q in range(ns):
         for r in range(nr):
             TMP[q, r] = Y[q, r] + HH[r] * K1[q, r]
-    _rows_rhs(TM, TMP, K2, PT, P, LANE, nr, SP, CP, SC, ybuf, dbuf)
+    _rows_rhs(TM, TMP, K2, PT, P, LANE, nr, PH[2], PH[3], SC, ybuf, dbuf)
     for q in range(ns):
         for r in range(nr):
             TMP[q, r] = Y[q, r] + HH[r] * K2[q, r]
-    _rows_rhs(TM, TMP, K3, PT, P, LANE, nr, SP, CP, SC, ybuf, dbuf)
-    _fill_phase(nr, s_tab[j0 + 2], c_tab[j0 + 2], SP, CP)
+    _rows_rhs(TM, TMP, K3, PT, P, LANE, nr, PH[2], PH[3], SC, ybuf, dbuf)
     for q in range(ns):
         for r in range(nr):
             TMP[q, r] = Y[q, r] + HR[r] * K3[q, r]
-    _rows_rhs(TE, TMP, K4, PT, P, LANE, nr, SP, CP, SC, ybuf, dbuf)
+    _rows_rhs(TE, TMP, K4, PT, P, LANE, nr, PH[4], PH[5], SC, ybuf, dbuf)
     for q in range(ns):
         for r in range(nr):
             Y1[q, r] = Y[q, r] + H6[r] * (K1[q, r] + 2.0 * K2[q, r] + 2.0 * K3[q, r] + K4[q, r])
@@ -565,7 +583,7 @@ def _rows_screen(nr, G0, G1, GE, GR, FLAG):
 
 
 @nb.njit(inline="always", **_JIT)
-def _rows_commit(i, nr, n_per, Y, Y1, G0, G1, GR, FLAG, ACTR, P, LANE, T0R, HR, OMEGA, ys,
+def _rows_commit(i, nr, NPR, Y, Y1, G0, G1, GR, FLAG, ACTR, P, LANE, T0R, HR, OMEGA, ys,
                  y1s, sides, g1s, ncross, W, gbuf):
     """Take the trial step of the active lanes' rows: the unflagged ones vectorised, the flagged
     ones one by one with the crossings located (:func:`_split_step`)."""
@@ -585,18 +603,19 @@ def _rows_commit(i, nr, n_per, Y, Y1, G0, G1, GR, FLAG, ACTR, P, LANE, T0R, HR, 
             sides[j] = _side(G0[j, r])
             g1s[j] = G1[j, r]
             gbuf[GRAZE_ROW, j] = GR[j, r]
-        _split_step(i, T0R[r], ys, y1s, P[lane], HR[r], OMEGA[lane], n_per, sides, g1s, ncross,
+        _split_step(i, T0R[r], ys, y1s, P[lane], HR[r], OMEGA[lane], NPR[r], sides, g1s, ncross,
                     W, W[8], gbuf)
         for q in range(ns):
             Y[q, r] = ys[q]
 
 
 @nb.njit(**_JIT)
-def _lyap_block(first, nl, k, P, Y0, S, T0, H, OMEGA, n_per, s_tab, c_tab, n_transient, n_steps,
-                renorm_every, bound, n_ev, n_blocks, out, err, used, status):
-    """The k leading exponents of lanes first..first+nl-1 (all with n_per steps per period,
-    phase table s_tab, c_tab), their rows in one block (see above); per lane what
-    :func:`_run` computes for it, into out[lane], err[lane], used[lane], status[lane]."""
+def _lyap_block(first, nl, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF, n_transient,
+                n_steps, renorm_every, bound, n_ev, n_blocks, out, err, used, status):
+    """The k leading exponents of lanes first..first+nl-1 (lane with NPER[lane] steps per
+    period, its phase table at S_TAB, C_TAB[OFF[lane]:]), their rows in one block (see above);
+    per lane what :func:`_run` computes for it, into out[lane], err[lane], used[lane],
+    status[lane]."""
     ns = Y0.shape[1]
     m = k + 1
     nr = (2 * k + 1) * nl
@@ -621,8 +640,10 @@ def _lyap_block(first, nl, k, P, Y0, S, T0, H, OMEGA, n_per, s_tab, c_tab, n_tra
     TM = np.empty(nr)
     TE = np.empty(nr)
     HD = np.empty(nr)
-    SP = np.empty(nr)
-    CP = np.empty(nr)
+    PH = np.empty((6, nr))  # the rows' forcing phases in a step (see _fill_phase)
+    IDX = np.empty(nr, np.int64)  # the index of a row's phase at the step's start in S_TAB
+    NPR = np.empty(nr, np.int64)  # a row's steps per period
+    END = np.empty(nr, np.int64)  # the index of a row's phase table's last period start + 2
     SC = np.zeros((8, nr))
     ne = max(n_ev, 1)
     G0 = np.zeros((ne, nr))
@@ -669,7 +690,7 @@ def _lyap_block(first, nl, k, P, Y0, S, T0, H, OMEGA, n_per, s_tab, c_tab, n_tra
         IST[l, _TOTAL] = n_transient[lane] + n_steps[lane]
         ACT[l] = IST[l, _TOTAL] > 0
         max_total = max(max_total, IST[l, _TOTAL])
-        ends = _block_bounds(max(n_steps[lane], 1), n_per, n_blocks)
+        ends = _block_bounds(max(n_steps[lane], 1), NPER[lane], n_blocks)
         IST[l, _NBK] = ends.size
         for b in range(ends.size):
             ENDS[l, b] = ends[b]
@@ -694,6 +715,9 @@ def _lyap_block(first, nl, k, P, Y0, S, T0, H, OMEGA, n_per, s_tab, c_tab, n_tra
         HR[r] = H[lane]
         HH[r] = 0.5 * H[lane]
         H6[r] = H[lane] / 6.0
+        NPR[r] = NPER[lane]
+        IDX[r] = OFF[lane]
+        END[r] = OFF[lane] + 2 * NPER[lane]
         ACTR[r] = ACT[l]
     due = max_total
     for l in range(nl):
@@ -714,8 +738,9 @@ def _lyap_block(first, nl, k, P, Y0, S, T0, H, OMEGA, n_per, s_tab, c_tab, n_tra
             HD[r] = TE[r] - t
         if n_ev > 0:
             _rows_events(TS, Y, G0, PT, P, LANE, nr, ybuf, gb)
-        _rows_rk4(nr, Y, Y1, K1, K2, K3, K4, TMP, TS, TM, TE, HR, HH, H6, PT, P, LANE, SP, CP,
-                  SC, s_tab, c_tab, 2 * (i % n_per), ybuf, dbuf)
+        _fill_phase(nr, IDX, S_TAB, C_TAB, PH)
+        _rows_rk4(nr, Y, Y1, K1, K2, K3, K4, TMP, TS, TM, TE, HR, HH, H6, PT, P, LANE, PH, SC, ybuf,
+                  dbuf)
         if n_ev > 0:
             _rows_events(TE, Y1, G1, PT, P, LANE, nr, ybuf, gb)
             for q in range(ns):
@@ -723,9 +748,11 @@ def _lyap_block(first, nl, k, P, Y0, S, T0, H, OMEGA, n_per, s_tab, c_tab, n_tra
                     TMP[q, r] = Y[q, r] + HD[r] * K1[q, r]
             _rows_events(TE, TMP, GE, PT, P, LANE, nr, ybuf, gb)
             _rows_screen(nr, G0, G1, GE, GR, FLAG)
-        _rows_commit(i, nr, n_per, Y, Y1, G0, G1, GR, FLAG, ACTR, P, LANE, T0R, HR, OMEGA, ys,
+        _rows_commit(i, nr, NPR, Y, Y1, G0, G1, GR, FLAG, ACTR, P, LANE, T0R, HR, OMEGA, ys,
                      y1s, sides, g1s, ncross, W, gbuf)
         _fd_combine(nl, m, ZT, IS, Y, E, ACT)
+        for r in range(nr):  # the next step's phase index: 2 (i + 1 mod n_per) from the start
+            IDX[r] = IDX[r] + 2 if IDX[r] + 2 < END[r] else IDX[r] + 2 - 2 * NPR[r]
         step = i + 1
         if step >= due:
             due = _lane_books(step, first, nl, k, renorm, bound, ZT, Zl, Cl, logs, IST, ENDS, BLK,
@@ -845,27 +872,41 @@ def _block_count(L, k, block_rows, min_blocks):
 
 
 @nb.njit(parallel=True, **_JIT)
-def lyapunov_block_lanes(P, Y0, scale, T0, H, OMEGA, n_per, n_transient, n_steps, renorm_every, k,
+def lyapunov_block_lanes(P, Y0, scale, T0, H, OMEGA, NPER, n_transient, n_steps, renorm_every, k,
                          bound, out, err, used, status, n_ev=0, n_blocks=16,
                          block_rows=BLOCK_ROWS, min_blocks=1):
-    """The k leading exponents of every lane (row of P, Y0; all with n_per steps per period),
-    the lanes' rows in blocks of at most ``block_rows`` rows (2 k + 1 per lane, at least one
-    lane), blocks in parallel. Arguments as in :func:`lyapunov_lanes`; fills out[L, k],
-    err[L, k] (NaN where diverged), used[L] (blocks of the standard error) and status[L]. Each
-    lane's result is bitwise that of :func:`lyapunov_single` with the same arguments, whatever
-    ``block_rows`` and ``min_blocks`` (see :func:`_block_count`)."""
+    """The k leading exponents of every lane (row of P, Y0; NPER[lane] steps per period: lanes
+    of different grids may share a block), the lanes' rows in blocks of at most ``block_rows``
+    rows (2 k + 1 per lane, at least one lane), consecutive lanes in a block, blocks in
+    parallel. Other arguments as in :func:`lyapunov_lanes`; fills out[L, k], err[L, k] (NaN
+    where diverged), used[L] (blocks of the standard error) and status[L]. Each lane's result
+    is bitwise that of :func:`lyapunov_single` with the same arguments, whatever the lanes
+    beside it, ``block_rows`` and ``min_blocks`` (see :func:`_block_count`)."""
     L = Y0.shape[0]
     forced = False
     for lane in range(L):
         if OMEGA[lane] != 0.0:
             forced = True
-    s_tab, c_tab = phase_table(n_per, forced)
+    # one phase table per grid, concatenated; OFF[lane]: the start of the lane's
+    grids = np.unique(NPER)
+    starts = np.zeros(grids.size + 1, np.int64)
+    for g in range(grids.size):
+        starts[g + 1] = starts[g] + 2 * grids[g] + 1
+    S_TAB = np.zeros(starts[-1])
+    C_TAB = np.ones(starts[-1])
+    for g in range(grids.size):
+        s_tab, c_tab = phase_table(grids[g], forced)
+        S_TAB[starts[g]:starts[g + 1]] = s_tab
+        C_TAB[starts[g]:starts[g + 1]] = c_tab
+    OFF = np.zeros(L, np.int64)
+    for lane in range(L):
+        OFF[lane] = starts[np.searchsorted(grids, NPER[lane])]
     n_blk = _block_count(L, k, block_rows, min_blocks)
     for b in nb.prange(n_blk):
         lo = b * L // n_blk
         hi = (b + 1) * L // n_blk
         if hi > lo:
-            _lyap_block(lo, hi - lo, k, P, Y0, scale, T0, H, OMEGA, n_per, s_tab, c_tab,
+            _lyap_block(lo, hi - lo, k, P, Y0, scale, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
                         n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err, used,
                         status)
 
@@ -873,22 +914,29 @@ def lyapunov_block_lanes(P, Y0, scale, T0, H, OMEGA, n_per, n_transient, n_steps
 def lyapunov_lanes(P, Y0, scale, T0, H, OMEGA, n_per, n_transient, n_steps, renorm_every, bound,
                    out, err, n_ev=0, n_blocks=16):
     """Largest exponent of every lane (row of P, Y0), the lanes in blocks in parallel
-    (:func:`lyapunov_block_lanes` with k = 1; bitwise :func:`lyapunov_lanes_rows`).
+    (:func:`lyapunov_block_lanes` with k = 1, lanes ordered by their step count so that a
+    block's lanes end together; bitwise :func:`lyapunov_lanes_rows`).
 
     scale: the state scale (one vector for all lanes, as in :func:`lyapunov_single`); T0: start
     time (forcing phase zero there, as in :func:`lyapunov_single`) per lane; H, OMEGA:
-    step and forcing frequency per lane; n_transient, n_steps: per-lane step counts (int
-    arrays); n_ev and n_blocks as in :func:`lyapunov_single`. Fills out[L] and err[L] (the
-    standard error; NaN for diverged lanes).
+    step and forcing frequency per lane; n_per: steps per period, one for all lanes or one per
+    lane; n_transient, n_steps: per-lane step counts (int arrays); n_ev and n_blocks as in
+    :func:`lyapunov_single`. Fills out[L] and err[L] (the standard error; NaN for diverged
+    lanes).
     """
     L = Y0.shape[0]
+    nper = np.ascontiguousarray(np.broadcast_to(np.asarray(n_per, np.int64), (L,)))
+    order = np.argsort(np.asarray(n_transient) + np.asarray(n_steps), kind="stable")
     o2 = np.full((L, 1), np.nan)
     e2 = np.full((L, 1), np.nan)
     used = np.zeros(L, np.int64)
     status = np.zeros(L, np.int64)
-    lyapunov_block_lanes(P, Y0, scale, T0, H, OMEGA, n_per, n_transient, n_steps, renorm_every,
-                         1, bound, o2, e2, used, status, n_ev, n_blocks, BLOCK_ROWS,
-                         nb.get_num_threads())
+    if L > 0:
+        p_, y_, t_, h_, w_, n_, tr_, st_ = (
+            np.ascontiguousarray(np.asarray(a)[order])
+            for a in (P, Y0, T0, H, OMEGA, nper, n_transient, n_steps))
+        lyapunov_block_lanes(p_, y_, scale, t_, h_, w_, n_, tr_, st_, renorm_every, 1, bound, o2,
+                             e2, used, status, n_ev, n_blocks, BLOCK_ROWS, nb.get_num_threads())
     ok = status == STATUS_OK
-    out[:] = np.where(ok, o2[:, 0], np.nan)
-    err[:] = np.where(ok, e2[:, 0], np.nan)
+    out[order] = np.where(ok, o2[:, 0], np.nan)
+    err[order] = np.where(ok, e2[:, 0], np.nan)
