@@ -41,6 +41,26 @@ def count_lane_steps(model, P, transient: float, duration: float) -> int:
                    for T, k in zip(periods, n, strict=True)))
 
 
+def kernel_args(model, P, transient: float, duration: float):
+    """The kernel's lane arrays, as ``lyapunov_lanes`` builds them."""
+    n = lane_steps(model, P, None).astype(np.int64)
+    om = np.ascontiguousarray(P[:, model.omega_index])
+    periods = forcing_period(om)
+    n_tr = np.array([periods_covering(transient, T) * k for T, k in zip(periods, n, strict=True)],
+                    dtype=np.int64)
+    n_st = np.array([max(1, periods_covering(duration, T)) * k
+                     for T, k in zip(periods, n, strict=True)], dtype=np.int64)
+    Y0 = np.ascontiguousarray(np.tile(model.initial_state(), (P.shape[0], 1)))
+    return P, Y0, np.ones(model.n_states), np.zeros(P.shape[0]), periods / n, om, n, n_tr, n_st
+
+
+def run_kernel(fn, args, n_ev):
+    out, err = np.full(args[0].shape[0], np.nan), np.full(args[0].shape[0], np.nan)
+    t_wall, t_cpu = time.perf_counter(), time.process_time()
+    fn(*args, 10, 1e6, out, err, n_ev, 16)
+    return time.perf_counter() - t_wall, time.process_time() - t_cpu
+
+
 def run(model, P, transient, duration):
     t_wall, t_cpu = time.perf_counter(), time.process_time()
     lam, err = lyapunov_lanes(model, P, transient=transient, duration=duration, with_error=True)
@@ -82,6 +102,20 @@ def main() -> None:
         wall = statistics.median(t[0] for t in tt)
         cpu = statistics.median(t[1] for t in tt)
         print(f"  {name:12s} wall {wall:8.4f} s  cpu {cpu:8.4f} s  "
+              f"{wall * a.threads / steps * 1e9:7.1f} ns/lane-step/thread (wall)  "
+              f"{cpu / steps * 1e9:7.1f} ns/lane-step (cpu)")
+    # the same lanes without edge location (n_ev = 0): the cost of stepping alone
+    args = kernel_args(model, P, a.transient, a.duration)
+    plain = {name: [] for name in kernels}
+    for rep in range(a.repeat + 1):
+        for name, fn in kernels.items():
+            wall, cpu = run_kernel(fn, args, 0)
+            if rep:
+                plain[name].append((wall, cpu))
+    for name, tt in plain.items():
+        wall = statistics.median(t[0] for t in tt)
+        cpu = statistics.median(t[1] for t in tt)
+        print(f"  {name:12s} no edge location: wall {wall:8.4f} s  "
               f"{wall * a.threads / steps * 1e9:7.1f} ns/lane-step/thread (wall)  "
               f"{cpu / steps * 1e9:7.1f} ns/lane-step (cpu)")
     (la, ea), (lb, eb) = results["blocks"], results["rows (main)"]

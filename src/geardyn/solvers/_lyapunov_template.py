@@ -871,6 +871,29 @@ def _block_count(L, k, block_rows, min_blocks):
     return max((L + per - 1) // per, min(L, min_blocks))
 
 
+@nb.njit(**_JIT)
+def _lyap_block_local(lo, hi, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF, n_transient,
+                      n_steps, renorm_every, bound, n_ev, n_blocks, out, err, used, status):
+    """:func:`_lyap_block` for lanes lo..hi-1 on copies of their inputs and outputs, so that
+    the block's thread touches no shared array while it steps (the reference counts of arrays
+    shared by threads would bounce between the cores' caches)."""
+    n = hi - lo
+    o = np.full((n, k), np.nan)
+    e = np.full((n, k), np.nan)
+    u = np.zeros(n, np.int64)
+    st = np.zeros(n, np.int64)
+    _lyap_block(0, n, k, P[lo:hi].copy(), Y0[lo:hi].copy(), S.copy(), T0[lo:hi].copy(),
+                H[lo:hi].copy(), OMEGA[lo:hi].copy(), NPER[lo:hi].copy(), S_TAB.copy(),
+                C_TAB.copy(), OFF[lo:hi].copy(), n_transient[lo:hi].copy(),
+                n_steps[lo:hi].copy(), renorm_every, bound, n_ev, n_blocks, o, e, u, st)
+    for i in range(n):
+        for j in range(k):
+            out[lo + i, j] = o[i, j]
+            err[lo + i, j] = e[i, j]
+        used[lo + i] = u[i]
+        status[lo + i] = st[i]
+
+
 @nb.njit(parallel=True, **_JIT)
 def lyapunov_block_lanes(P, Y0, scale, T0, H, OMEGA, NPER, n_transient, n_steps, renorm_every, k,
                          bound, out, err, used, status, n_ev=0, n_blocks=16,
@@ -906,9 +929,9 @@ def lyapunov_block_lanes(P, Y0, scale, T0, H, OMEGA, NPER, n_transient, n_steps,
         lo = b * L // n_blk
         hi = (b + 1) * L // n_blk
         if hi > lo:
-            _lyap_block(lo, hi - lo, k, P, Y0, scale, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
-                        n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err, used,
-                        status)
+            _lyap_block_local(lo, hi, k, P, Y0, scale, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
+                              n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err,
+                              used, status)
 
 
 def lyapunov_lanes(P, Y0, scale, T0, H, OMEGA, n_per, n_transient, n_steps, renorm_every, bound,
