@@ -278,12 +278,8 @@ def lyapunov_lanes(
     if L > 0:
         scale = _state_scale(model)
         kern = kernels_for(model.kernel, "lyapunov")
-        groups = ([(1, np.arange(L))] if model.omega_index is None  # one phase table each
-                  else [(int(n), np.nonzero(n_lane == n)[0]) for n in np.unique(n_lane)])
-        for n, idx in groups:
-            part, part_err = np.full(idx.size, np.nan), np.full(idx.size, np.nan)
-            kern.lyapunov_lanes(P[idx], Y0[idx], scale, T0[idx], H[idx], OMEGA[idx], n,
-                                n_tr[idx], n_st[idx], renorm, float(bound), part, part_err,
-                                model.n_events, n_blk)
-            out[idx], err[idx] = part, part_err
+        # lanes of every grid together (the kernel blocks them, whatever their steps)
+        n_per = np.ones(L, np.int64) if model.omega_index is None else n_lane.astype(np.int64)
+        kern.lyapunov_lanes(P, Y0, scale, T0, H, OMEGA, n_per, n_tr, n_st, renorm, float(bound),
+                            out, err, model.n_events, n_blk)
     return (out, err) if with_error else out

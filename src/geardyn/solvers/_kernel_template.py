@@ -313,8 +313,17 @@ if "rhs_lanes" in globals():  # the model's lane-block functions (see .kernels),
     _observe_lm = nb.njit(**_INLINE)(observe_lanes.py_func)  # noqa: F821
 
     @nb.njit(inline="always", **_JIT)
+    def _phase_rows(nl, s, c, SC):
+        """The block's forcing phase as per-lane arrays (SC rows 6, 7) for the model."""
+        for k in range(nl):
+            SC[6, k] = s
+            SC[7, k] = c
+        return SC[6], SC[7]
+
+    @nb.njit(inline="always", **_JIT)
     def _rhs_lanes(T, Y, DY, PT, P, first, nl, s, c, SC, ybuf, dbuf):
-        _rhs_lm(T, Y, DY, PT, nl, s, c, SC)
+        S, C = _phase_rows(nl, s, c, SC)
+        _rhs_lm(T, Y, DY, PT, nl, S, C, SC)
 
     @nb.njit(inline="always", **_JIT)
     def _events_lanes(T, Y, G, PT, P, first, nl, ybuf, gb):
@@ -322,7 +331,8 @@ if "rhs_lanes" in globals():  # the model's lane-block functions (see .kernels),
 
     @nb.njit(inline="always", **_JIT)
     def _observe_lanes(T, Y, O, PT, P, first, nl, s, c, SC, ybuf, ob):
-        _observe_lm(T, Y, O, PT, nl, s, c, SC)
+        S, C = _phase_rows(nl, s, c, SC)
+        _observe_lm(T, Y, O, PT, nl, S, C, SC)
 
 else:
     _rhs_lanes = _rhs_lanes_generic

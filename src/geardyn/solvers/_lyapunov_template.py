@@ -63,8 +63,11 @@ import numba as nb
 import numpy as np
 
 from geardyn.solvers._step_core import (  # CORE-IMPORT
+    _INLINE,
     _JIT,
     GBUF_ROWS,
+    GRAZE_BOUND_STEP,
+    GRAZE_ROW,
     STATUS_DIVERGED,
     STATUS_OK,
     _events_i,
@@ -87,7 +90,8 @@ FD_NORM_CAP = 2.0**10
 
 # the model interface names are part of the template's namespace (the generated copy re-binds
 # them); only rhs and events are used here
-__all__ = ["events", "lyapunov_lanes", "lyapunov_single", "observe", "phase_table", "rhs"]
+__all__ = ["BLOCK_ROWS", "events", "lyapunov_block_lanes", "lyapunov_lanes", "lyapunov_lanes_rows",
+           "lyapunov_single", "observe", "phase_table", "rhs"]
 
 
 @nb.njit(**_JIT)
@@ -366,10 +370,28 @@ def lyapunov_single(p, y0, scale, t0, h, omega, n_per, n_transient, n_steps, ren
                 renorm_every, k, bound, n_ev, n_blocks)
 
 
+def lyapunov_lanes_rows(P, Y0, scale, T0, H, OMEGA, n_per, n_transient, n_steps, renorm_every,
+                        bound, out, err, n_ev=0, n_blocks=16):
+    """:func:`lyapunov_lanes` one lane at a time (the rows of :func:`lyapunov_single`), the
+    lanes of each grid (n_per: one for all lanes or one per lane) in parallel: the kernel before
+    the lane blocks, kept as their reference."""
+    L = Y0.shape[0]
+    nper = np.broadcast_to(np.asarray(n_per, np.int64), (L,))
+    for n in np.unique(nper):
+        idx = np.nonzero(nper == n)[0]
+        part, part_err = np.full(idx.size, np.nan), np.full(idx.size, np.nan)
+        sel = [np.ascontiguousarray(np.asarray(a)[idx])
+               for a in (P, Y0, T0, H, OMEGA, n_transient, n_steps)]
+        _lanes_rows(sel[0], sel[1], scale, sel[2], sel[3], sel[4], int(n), sel[5], sel[6],
+                    renorm_every, bound, part, part_err, n_ev, n_blocks)
+        out[idx], err[idx] = part, part_err
+
+
 @nb.njit(parallel=True, **_JIT)
-def lyapunov_lanes(P, Y0, scale, T0, H, OMEGA, n_per, n_transient, n_steps, renorm_every, bound,
-                   out, err, n_ev=0, n_blocks=16):
-    """Largest exponent of every lane (row of P, Y0), in parallel over lanes.
+def _lanes_rows(P, Y0, scale, T0, H, OMEGA, n_per, n_transient, n_steps, renorm_every, bound, out,
+                err, n_ev=0, n_blocks=16):
+    """Largest exponent of every lane (row of P, Y0; n_per steps per period), in parallel over
+    lanes, one lane at a time (the rows of :func:`lyapunov_single`).
 
     scale: the state scale (one vector for all lanes, as in :func:`lyapunov_single`); T0: start
     time (forcing phase zero there, as in :func:`lyapunov_single`) per lane; H, OMEGA:
@@ -389,3 +411,555 @@ def lyapunov_lanes(P, Y0, scale, T0, H, OMEGA, n_per, n_transient, n_steps, reno
                                bound, n_ev, n_blocks)
         out[lane] = ex[0] if st == STATUS_OK else np.nan
         err[lane] = er[0] if st == STATUS_OK else np.nan
+
+
+# ---------------------------------------------------------------------------------------------
+# Lane blocks, structure of arrays: the integrations of several lanes (each lane's state row and
+# its 2 k perturbed rows) advance as the rows of one block, state Y[q, r] with the row index r
+# innermost and contiguous, the block's width a runtime value, so that the RK4 stages, the
+# model's lane-block functions (``rhs_lanes``, ``events_lanes``; see :mod:`.kernels`), the side
+# test, the finite-difference set-up and its combination are loops over rows without calls,
+# which LLVM vectorises. Row r = slot nl + l holds slot ``slot`` of lane l of the block (slots
+# 2 j - 2, 2 j - 1: tangent j's y + e s v and y - e s v; slot 2 k: the state), so that a lane's
+# rows lie nl apart. Each row gets its own coefficients (PT[:, r]), times and forcing phase
+# (SP[r], CP[r]). A row whose trial step leaves a side of an edge (or may graze one) is finished
+# on the scalar path (:func:`_split_step`). Gram-Schmidt, the block statistics and the health
+# check run per lane, at its renormalisations, on a gathered copy with the functions of the
+# one-lane kernel. Every row's arithmetic is that of :func:`_grid_step_rows`, operation for
+# operation (no fastmath), so results are bitwise those of :func:`lyapunov_single`, whatever the
+# blocking, position or thread.
+
+#: Most rows of a lane block (lanes of 2 k + 1 rows each; at least one lane).
+BLOCK_ROWS = 64
+
+
+@nb.njit(inline="always", **_JIT)
+def _rows_rhs_generic(T, Y, DY, PT, P, LANE, nr, SP, CP, SC, ybuf, dbuf):
+    ns = Y.shape[0]
+    for r in range(nr):
+        for q in range(ns):
+            ybuf[q] = Y[q, r]
+        _rhs_i(T[r], ybuf, dbuf, P[LANE[r]], SP[r], CP[r])
+        for q in range(ns):
+            DY[q, r] = dbuf[q]
+
+
+@nb.njit(inline="always", **_JIT)
+def _rows_events_generic(T, Y, G, PT, P, LANE, nr, ybuf, gb):
+    ns = Y.shape[0]
+    for r in range(nr):
+        for q in range(ns):
+            ybuf[q] = Y[q, r]
+        _events_i(T[r], ybuf, gb, P[LANE[r]])
+        for j in range(G.shape[0]):
+            G[j, r] = gb[j]
+
+
+if "rhs_lanes" in globals():  # the model's lane-block functions (see .kernels), inlined
+    _rhs_lm = nb.njit(**_INLINE)(rhs_lanes.py_func)  # noqa: F821
+    _events_lm = nb.njit(**_INLINE)(events_lanes.py_func)  # noqa: F821
+
+    @nb.njit(inline="always", **_JIT)
+    def _rows_rhs(T, Y, DY, PT, P, LANE, nr, SP, CP, SC, ybuf, dbuf):
+        _rhs_lm(T, Y, DY, PT, nr, SP, CP, SC)
+
+    @nb.njit(inline="always", **_JIT)
+    def _rows_events(T, Y, G, PT, P, LANE, nr, ybuf, gb):
+        _events_lm(T, Y, G, PT, nr)
+
+else:
+    _rows_rhs = _rows_rhs_generic
+    _rows_events = _rows_events_generic
+
+
+@nb.njit(inline="always", **_JIT)
+def _fill_phase(nr, IDX, S_TAB, C_TAB, PH):
+    """The rows' forcing phases of a grid step from their tables: sin and cos at the step's
+    start, middle and end (IDX[r]: the start's index in S_TAB, C_TAB) into rows 0-5 of PH."""
+    for d in range(3):
+        for r in range(nr):
+            j = IDX[r] + d
+            PH[2 * d, r] = S_TAB[j]
+            PH[2 * d + 1, r] = C_TAB[j]
+
+
+@nb.njit(inline="always", **_JIT)
+def _fd_setup(nl, m, ZT, S, IS, Y, E, OK, NY):
+    """The rows of a grid step from the lanes' states and tangent vectors (ZT[j, q, l]), as in
+    :func:`_tangent_step`: slot 2 k the state, slots 2 j - 2 and 2 j - 1 y +- e S v_j with
+    e |v_j| = FD_DELTA (1 + min(|y / S|, FD_NORM_CAP)); E[j, l] = e (NaN for a lost vector,
+    whose rows follow the state; OK[j, l] False)."""
+    ns = ZT.shape[1]
+    last = 2 * (m - 1)
+    for l in range(nl):
+        NY[l] = 0.0
+    for q in range(ns):
+        for l in range(nl):
+            zq = ZT[0, q, l] * IS[q]
+            NY[l] += zq * zq
+    for l in range(nl):
+        NY[l] = FD_DELTA * (1.0 + min(math.sqrt(NY[l]), FD_NORM_CAP))  # the scale
+    for q in range(ns):
+        for l in range(nl):
+            Y[q, last * nl + l] = ZT[0, q, l]
+    for j in range(1, m):
+        for l in range(nl):
+            E[j, l] = 0.0
+        for q in range(ns):
+            for l in range(nl):
+                E[j, l] += ZT[j, q, l] * ZT[j, q, l]
+        for l in range(nl):
+            nv = math.sqrt(E[j, l])
+            ok = nv > 0.0 and math.isfinite(nv)
+            OK[j, l] = ok
+            E[j, l] = NY[l] / nv if ok else np.nan
+        for q in range(ns):
+            sq = S[q]
+            for l in range(nl):
+                z0 = ZT[0, q, l]
+                d = E[j, l] * (sq * ZT[j, q, l])
+                Y[q, (2 * j - 2) * nl + l] = z0 + d if OK[j, l] else z0
+                Y[q, (2 * j - 1) * nl + l] = z0 - d if OK[j, l] else z0
+
+
+@nb.njit(inline="always", **_JIT)
+def _fd_combine(nl, m, ZT, IS, Y, E, ACT):
+    """The active lanes' new tangent vectors (Phi(y + e S v) - Phi(y - e S v)) / (2 e S) and
+    states from the stepped rows, as in :func:`_tangent_step` (NaN for a lost vector)."""
+    ns = ZT.shape[1]
+    last = 2 * (m - 1)
+    for j in range(1, m):
+        for q in range(ns):
+            iq = IS[q]
+            for l in range(nl):
+                e = E[j, l]
+                v = ((Y[q, (2 * j - 2) * nl + l] - Y[q, (2 * j - 1) * nl + l]) * (0.5 / e)) * iq
+                v = v if math.isfinite(e) else np.nan
+                ZT[j, q, l] = v if ACT[l] else ZT[j, q, l]
+    for q in range(ns):
+        for l in range(nl):
+            ZT[0, q, l] = Y[q, last * nl + l] if ACT[l] else ZT[0, q, l]
+
+
+@nb.njit(inline="always", **_JIT)
+def _rows_rk4(nr, Y, Y1, K1, K2, K3, K4, TMP, TS, TM, TE, HR, HH, H6, PT, P, LANE, PH, SC, ybuf,
+              dbuf):
+    """One RK4 trial step of every row into Y1 (the arithmetic of :func:`_grid_step_rows`); PH:
+    the rows' forcing phases (sin, cos) at the step's start, middle and end (rows 0-5)."""
+    ns = Y.shape[0]
+    _rows_rhs(TS, Y, K1, PT, P, LANE, nr, PH[0], PH[1], SC, ybuf, dbuf)
+    for q in range(ns):
+        for r in range(nr):
+            TMP[q, r] = Y[q, r] + HH[r] * K1[q, r]
+    _rows_rhs(TM, TMP, K2, PT, P, LANE, nr, PH[2], PH[3], SC, ybuf, dbuf)
+    for q in range(ns):
+        for r in range(nr):
+            TMP[q, r] = Y[q, r] + HH[r] * K2[q, r]
+    _rows_rhs(TM, TMP, K3, PT, P, LANE, nr, PH[2], PH[3], SC, ybuf, dbuf)
+    for q in range(ns):
+        for r in range(nr):
+            TMP[q, r] = Y[q, r] + HR[r] * K3[q, r]
+    _rows_rhs(TE, TMP, K4, PT, P, LANE, nr, PH[4], PH[5], SC, ybuf, dbuf)
+    for q in range(ns):
+        for r in range(nr):
+            Y1[q, r] = Y[q, r] + H6[r] * (K1[q, r] + 2.0 * K2[q, r] + 2.0 * K3[q, r] + K4[q, r])
+
+
+@nb.njit(inline="always", **_JIT)
+def _rows_screen(nr, G0, G1, GE, GR, FLAG):
+    """:func:`_leaves_side_step` for every row, vectorised: FLAG[r] != 0 where row r's trial
+    step ends on another side of an edge than it started (G0, G1: events at the ends) or may
+    graze one (GR[j, r] = 1; GE: events at y + h f(t, y))."""
+    for r in range(nr):
+        FLAG[r] = 0.0
+    for j in range(G1.shape[0]):
+        for r in range(nr):
+            g0 = G0[j, r]
+            g1 = G1[j, r]
+            crossed = (1.0 if g1 > 0.0 else -1.0) != (1.0 if g0 > 0.0 else -1.0)
+            graze = not min(abs(g0), abs(g1)) > GRAZE_BOUND_STEP * abs(GE[j, r] - g1)
+            GR[j, r] = 1.0 if graze else 0.0
+            FLAG[r] += 1.0 if (crossed | graze) else 0.0
+
+
+@nb.njit(inline="always", **_JIT)
+def _rows_commit(i, nr, NPR, Y, Y1, G0, G1, GR, FLAG, ACTR, P, LANE, T0R, HR, OMEGA, ys,
+                 y1s, sides, g1s, ncross, W, gbuf):
+    """Take the trial step of the active lanes' rows: the unflagged ones vectorised, the flagged
+    ones one by one with the crossings located (:func:`_split_step`)."""
+    ns = Y.shape[0]
+    n_ev = G1.shape[0]
+    for q in range(ns):
+        for r in range(nr):
+            Y[q, r] = Y1[q, r] if ACTR[r] and FLAG[r] == 0.0 else Y[q, r]
+    for r in range(nr):
+        if FLAG[r] == 0.0 or not ACTR[r]:
+            continue
+        lane = LANE[r]
+        for q in range(ns):
+            ys[q] = Y[q, r]
+            y1s[q] = Y1[q, r]
+        for j in range(n_ev):
+            sides[j] = _side(G0[j, r])
+            g1s[j] = G1[j, r]
+            gbuf[GRAZE_ROW, j] = GR[j, r]
+        _split_step(i, T0R[r], ys, y1s, P[lane], HR[r], OMEGA[lane], NPR[r], sides, g1s, ncross,
+                    W, W[8], gbuf)
+        for q in range(ns):
+            Y[q, r] = ys[q]
+
+
+@nb.njit(**_JIT)
+def _lyap_block(first, nl, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF, n_transient,
+                n_steps, renorm_every, bound, n_ev, n_blocks, out, err, used, status):
+    """The k leading exponents of lanes first..first+nl-1 (lane with NPER[lane] steps per
+    period, its phase table at S_TAB, C_TAB[OFF[lane]:]), their rows in one block (see above);
+    per lane what :func:`_run` computes for it, into out[lane], err[lane], used[lane],
+    status[lane]."""
+    ns = Y0.shape[1]
+    m = k + 1
+    nr = (2 * k + 1) * nl
+    IS = np.empty(ns)
+    for q in range(ns):
+        IS[q] = 1.0 / S[q]
+    ZT = np.zeros((m, ns, nl))
+    Y = np.empty((ns, nr))
+    Y1 = np.empty((ns, nr))
+    K1 = np.empty((ns, nr))
+    K2 = np.empty((ns, nr))
+    K3 = np.empty((ns, nr))
+    K4 = np.empty((ns, nr))
+    TMP = np.empty((ns, nr))
+    PT = np.empty((P.shape[1], nr))
+    LANE = np.empty(nr, np.int64)
+    T0R = np.empty(nr)
+    HR = np.empty(nr)
+    HH = np.empty(nr)
+    H6 = np.empty(nr)
+    TS = np.empty(nr)
+    TM = np.empty(nr)
+    TE = np.empty(nr)
+    HD = np.empty(nr)
+    PH = np.empty((6, nr))  # the rows' forcing phases in a step (see _fill_phase)
+    IDX = np.empty(nr, np.int64)  # the index of a row's phase at the step's start in S_TAB
+    NPR = np.empty(nr, np.int64)  # a row's steps per period
+    END = np.empty(nr, np.int64)  # the index of a row's phase table's last period start + 2
+    SC = np.zeros((8, nr))
+    ne = max(n_ev, 1)
+    G0 = np.zeros((ne, nr))
+    G1 = np.zeros((ne, nr))
+    GE = np.zeros((ne, nr))
+    GR = np.zeros((ne, nr))
+    FLAG = np.zeros(nr)
+    E = np.zeros((m, nl))
+    OK = np.zeros((m, nl), np.bool_)
+    NY = np.zeros(nl)
+    # per lane
+    ACT = np.zeros(nl, np.bool_)
+    ACTR = np.zeros(nr, np.bool_)  # ACT of each row's lane
+    IST = np.zeros((nl, 7), np.int64)  # see _LAST, ...
+    nbmax = max(n_blocks, 1)
+    ENDS = np.zeros((nl, nbmax), np.int64)
+    BLK = np.zeros((nl, nbmax, k))
+    ACC = np.zeros((nl, k))
+    # the one-lane machinery's scratch
+    Zl = np.zeros((m, ns))
+    Cl = np.zeros((m, ns))
+    logs = np.zeros(k)
+    ys = np.zeros(ns)
+    y1s = np.zeros(ns)
+    ybuf = np.zeros(ns)
+    dbuf = np.zeros(ns)
+    gb = np.zeros(ne)
+    sides = np.ones(ne, np.int64)
+    g1s = np.zeros(ne)
+    ncross = np.zeros(ne, np.int64)
+    W = np.zeros((9, ns))
+    gbuf = np.zeros((GBUF_ROWS, ne))
+    renorm = max(renorm_every, 1)
+    max_total = 0
+    for l in range(nl):
+        lane = first + l
+        for j in range(k):
+            out[lane, j] = np.nan
+            err[lane, j] = np.nan
+        used[lane] = 0
+        status[lane] = STATUS_OK
+        IST[l, _NTR] = n_transient[lane]
+        IST[l, _NST] = n_steps[lane]
+        IST[l, _TOTAL] = n_transient[lane] + n_steps[lane]
+        ACT[l] = IST[l, _TOTAL] > 0
+        max_total = max(max_total, IST[l, _TOTAL])
+        ends = _block_bounds(max(n_steps[lane], 1), NPER[lane], n_blocks)
+        IST[l, _NBK] = ends.size
+        for b in range(ends.size):
+            ENDS[l, b] = ends[b]
+        IST[l, _DUE] = _lane_due(IST, l, renorm, ENDS)
+        for q in range(ns):
+            Zl[0, q] = Y0[lane, q]
+        # generic, orthonormalised start vectors: e_j + 0.1 (1, ..., 1)
+        for j in range(1, m):
+            for q in range(ns):
+                Zl[j, q] = 0.1 + (1.0 if q == j - 1 else 0.0)
+        _orthonormalise(Zl, logs, False)
+        for j in range(m):
+            for q in range(ns):
+                ZT[j, q, l] = Zl[j, q]
+    for r in range(nr):
+        l = r % nl
+        lane = first + l
+        LANE[r] = lane
+        for j in range(P.shape[1]):
+            PT[j, r] = P[lane, j]
+        T0R[r] = T0[lane]
+        HR[r] = H[lane]
+        HH[r] = 0.5 * H[lane]
+        H6[r] = H[lane] / 6.0
+        NPR[r] = NPER[lane]
+        IDX[r] = OFF[lane]
+        END[r] = OFF[lane] + 2 * NPER[lane]
+        ACTR[r] = ACT[l]
+    due = max_total
+    for l in range(nl):
+        if ACT[l]:
+            due = min(due, IST[l, _DUE])
+    for i in range(max_total):
+        live = False
+        for l in range(nl):
+            live = live or ACT[l]
+        if not live:
+            break
+        _fd_setup(nl, m, ZT, S, IS, Y, E, OK, NY)
+        for r in range(nr):
+            t = T0R[r] + i * HR[r]
+            TS[r] = t
+            TM[r] = t + HH[r]
+            TE[r] = t + HR[r]
+            HD[r] = TE[r] - t
+        if n_ev > 0:
+            _rows_events(TS, Y, G0, PT, P, LANE, nr, ybuf, gb)
+        _fill_phase(nr, IDX, S_TAB, C_TAB, PH)
+        _rows_rk4(nr, Y, Y1, K1, K2, K3, K4, TMP, TS, TM, TE, HR, HH, H6, PT, P, LANE, PH, SC, ybuf,
+                  dbuf)
+        if n_ev > 0:
+            _rows_events(TE, Y1, G1, PT, P, LANE, nr, ybuf, gb)
+            for q in range(ns):
+                for r in range(nr):
+                    TMP[q, r] = Y[q, r] + HD[r] * K1[q, r]
+            _rows_events(TE, TMP, GE, PT, P, LANE, nr, ybuf, gb)
+            _rows_screen(nr, G0, G1, GE, GR, FLAG)
+        _rows_commit(i, nr, NPR, Y, Y1, G0, G1, GR, FLAG, ACTR, P, LANE, T0R, HR, OMEGA, ys,
+                     y1s, sides, g1s, ncross, W, gbuf)
+        _fd_combine(nl, m, ZT, IS, Y, E, ACT)
+        for r in range(nr):  # the next step's phase index: 2 (i + 1 mod n_per) from the start
+            IDX[r] = IDX[r] + 2 if IDX[r] + 2 < END[r] else IDX[r] + 2 - 2 * NPR[r]
+        step = i + 1
+        if step >= due:
+            due = _lane_books(step, first, nl, k, renorm, bound, ZT, Zl, Cl, logs, IST, ENDS, BLK,
+                              ACC, ACT, ACTR, H, out, err, used, status)
+
+
+#: Columns of the per-lane integer state of a block (IST): the step of the last
+#: renormalisation, the block being measured, transient and measured steps, their total, the
+#: number of blocks, the lane's next due step.
+_LAST, _CUR, _NTR, _NST, _TOTAL, _NBK, _DUE = range(7)
+
+
+@nb.njit(**_JIT)
+def _lane_due(IST, l, renorm, ENDS):
+    """The next step at which lane l needs its bookkeeping: a renormalisation (every
+    ``renorm`` steps, at the end of the transient, at the end) or the end of a block of the
+    measuring window."""
+    due = min(IST[l, _LAST] + renorm, IST[l, _TOTAL])
+    if IST[l, _NTR] > IST[l, _LAST]:
+        due = min(due, IST[l, _NTR])
+    if IST[l, _CUR] < IST[l, _NBK]:
+        due = min(due, IST[l, _NTR] + ENDS[l, IST[l, _CUR]])
+    return due
+
+
+@nb.njit(**_JIT)
+def _lane_books(step, first, nl, k, renorm, bound, ZT, Zl, Cl, logs, IST, ENDS, BLK, ACC, ACT,
+                ACTR, H, out, err, used, status):
+    """The bookkeeping of the block's lanes due at this step, as in :func:`_run`:
+    renormalisation (health, modified Gram-Schmidt on a gathered copy), block statistics, the
+    result at a lane's last step. Returns the next step at which a lane is due. (One loop, no
+    inlined helpers with array arguments: each would cost reference counting per lane.)"""
+    m, ns = Zl.shape
+    nxt = np.iinfo(np.int64).max
+    changed = False
+    for l in range(nl):
+        if not ACT[l]:
+            continue
+        if IST[l, _DUE] == step:
+            lane = first + l
+            n_tr = IST[l, _NTR]
+            measure = step > n_tr
+            c = IST[l, _CUR]
+            renormalise = (step - IST[l, _LAST] == renorm or step == n_tr
+                           or step == IST[l, _TOTAL])
+            block_end = measure and step - n_tr == ENDS[l, c]
+            if renormalise or block_end:
+                for j in range(m):
+                    for q in range(ns):
+                        Zl[j, q] = ZT[j, q, l]
+            if renormalise:
+                IST[l, _LAST] = step
+                healthy = True
+                for q in range(ns):
+                    healthy = healthy and abs(Zl[0, q]) <= bound  # False for NaN too
+                if not healthy or not _orthonormalise(Zl, logs, measure):
+                    ACT[l] = False
+                    status[lane] = STATUS_DIVERGED
+                    changed = True
+                    continue
+                for j in range(m):
+                    for q in range(ns):
+                        ZT[j, q, l] = Zl[j, q]
+                if measure:
+                    for j in range(k):
+                        ACC[l, j] += logs[j]
+                        BLK[l, c, j] += logs[j]
+                if block_end:
+                    IST[l, _CUR] = c + 1
+            elif block_end:
+                # a block ends between renormalisations: its share of the running stretch, on
+                # a copy
+                _stretch_logs(Zl, Cl, logs)
+                for j in range(k):
+                    BLK[l, c, j] += logs[j]
+                    BLK[l, c + 1, j] -= logs[j]
+                IST[l, _CUR] = c + 1
+            if step == IST[l, _TOTAL]:
+                ACT[l] = False
+                changed = True
+                _lane_result(l, lane, k, IST[l, _NST], H[lane], ENDS, IST[l, _NBK], BLK, ACC,
+                             out, err, used)
+                continue
+            IST[l, _DUE] = _lane_due(IST, l, renorm, ENDS)
+        nxt = min(nxt, IST[l, _DUE])
+    if changed:
+        for s in range(2 * k + 1):
+            for l in range(nl):
+                ACTR[s * nl + l] = ACT[l]
+    return nxt
+
+
+@nb.njit(**_JIT)
+def _lane_result(l, lane, k, n_steps, h, ENDS, nbk, BLK, ACC, out, err, used):
+    """The exponents and standard errors of lane l at its end (as :func:`_run` returns them)."""
+    if n_steps <= 0:
+        return
+    tm = n_steps * h
+    for j in range(k):
+        out[lane, j] = ACC[l, j] / tm
+    blk = BLK[l, :nbk].copy()
+    ends = ENDS[l, :nbk].copy()
+    er = np.full(k, np.nan)
+    _block_stderr(blk, ends, h, er)
+    for j in range(k):
+        err[lane, j] = er[j]
+    used[lane] = nbk
+
+
+@nb.njit(**_JIT)
+def _block_count(L, k, block_rows, min_blocks):
+    """Blocks for L lanes of 2 k + 1 rows: at most ``block_rows`` rows each (at least one
+    lane), at least ``min_blocks`` (e.g. one per thread) while there are lanes; lanes are dealt
+    out evenly (block b: lanes b L // n to (b + 1) L // n)."""
+    per = max(block_rows // (2 * k + 1), 1)
+    return max((L + per - 1) // per, min(L, min_blocks))
+
+
+@nb.njit(**_JIT)
+def _lyap_block_local(lo, hi, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF, n_transient,
+                      n_steps, renorm_every, bound, n_ev, n_blocks, out, err, used, status):
+    """:func:`_lyap_block` for lanes lo..hi-1 on copies of their inputs and outputs, so that
+    the block's thread touches no shared array while it steps (the reference counts of arrays
+    shared by threads would bounce between the cores' caches)."""
+    n = hi - lo
+    o = np.full((n, k), np.nan)
+    e = np.full((n, k), np.nan)
+    u = np.zeros(n, np.int64)
+    st = np.zeros(n, np.int64)
+    _lyap_block(0, n, k, P[lo:hi].copy(), Y0[lo:hi].copy(), S.copy(), T0[lo:hi].copy(),
+                H[lo:hi].copy(), OMEGA[lo:hi].copy(), NPER[lo:hi].copy(), S_TAB.copy(),
+                C_TAB.copy(), OFF[lo:hi].copy(), n_transient[lo:hi].copy(),
+                n_steps[lo:hi].copy(), renorm_every, bound, n_ev, n_blocks, o, e, u, st)
+    for i in range(n):
+        for j in range(k):
+            out[lo + i, j] = o[i, j]
+            err[lo + i, j] = e[i, j]
+        used[lo + i] = u[i]
+        status[lo + i] = st[i]
+
+
+@nb.njit(parallel=True, **_JIT)
+def lyapunov_block_lanes(P, Y0, scale, T0, H, OMEGA, NPER, n_transient, n_steps, renorm_every, k,
+                         bound, out, err, used, status, n_ev=0, n_blocks=16,
+                         block_rows=BLOCK_ROWS, min_blocks=1):
+    """The k leading exponents of every lane (row of P, Y0; NPER[lane] steps per period: lanes
+    of different grids may share a block), the lanes' rows in blocks of at most ``block_rows``
+    rows (2 k + 1 per lane, at least one lane), consecutive lanes in a block, blocks in
+    parallel. Other arguments as in :func:`lyapunov_lanes`; fills out[L, k], err[L, k] (NaN
+    where diverged), used[L] (blocks of the standard error) and status[L]. Each lane's result
+    is bitwise that of :func:`lyapunov_single` with the same arguments, whatever the lanes
+    beside it, ``block_rows`` and ``min_blocks`` (see :func:`_block_count`)."""
+    L = Y0.shape[0]
+    forced = False
+    for lane in range(L):
+        if OMEGA[lane] != 0.0:
+            forced = True
+    # one phase table per grid, concatenated; OFF[lane]: the start of the lane's
+    grids = np.unique(NPER)
+    starts = np.zeros(grids.size + 1, np.int64)
+    for g in range(grids.size):
+        starts[g + 1] = starts[g] + 2 * grids[g] + 1
+    S_TAB = np.zeros(starts[-1])
+    C_TAB = np.ones(starts[-1])
+    for g in range(grids.size):
+        s_tab, c_tab = phase_table(grids[g], forced)
+        S_TAB[starts[g]:starts[g + 1]] = s_tab
+        C_TAB[starts[g]:starts[g + 1]] = c_tab
+    OFF = np.zeros(L, np.int64)
+    for lane in range(L):
+        OFF[lane] = starts[np.searchsorted(grids, NPER[lane])]
+    n_blk = _block_count(L, k, block_rows, min_blocks)
+    for b in nb.prange(n_blk):
+        lo = b * L // n_blk
+        hi = (b + 1) * L // n_blk
+        if hi > lo:
+            _lyap_block_local(lo, hi, k, P, Y0, scale, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
+                              n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err,
+                              used, status)
+
+
+def lyapunov_lanes(P, Y0, scale, T0, H, OMEGA, n_per, n_transient, n_steps, renorm_every, bound,
+                   out, err, n_ev=0, n_blocks=16):
+    """Largest exponent of every lane (row of P, Y0), the lanes in blocks in parallel
+    (:func:`lyapunov_block_lanes` with k = 1, lanes ordered by their step count so that a
+    block's lanes end together; bitwise :func:`lyapunov_lanes_rows`).
+
+    scale: the state scale (one vector for all lanes, as in :func:`lyapunov_single`); T0: start
+    time (forcing phase zero there, as in :func:`lyapunov_single`) per lane; H, OMEGA:
+    step and forcing frequency per lane; n_per: steps per period, one for all lanes or one per
+    lane; n_transient, n_steps: per-lane step counts (int arrays); n_ev and n_blocks as in
+    :func:`lyapunov_single`. Fills out[L] and err[L] (the standard error; NaN for diverged
+    lanes).
+    """
+    L = Y0.shape[0]
+    nper = np.ascontiguousarray(np.broadcast_to(np.asarray(n_per, np.int64), (L,)))
+    order = np.argsort(np.asarray(n_transient) + np.asarray(n_steps), kind="stable")
+    o2 = np.full((L, 1), np.nan)
+    e2 = np.full((L, 1), np.nan)
+    used = np.zeros(L, np.int64)
+    status = np.zeros(L, np.int64)
+    if L > 0:
+        p_, y_, t_, h_, w_, n_, tr_, st_ = (
+            np.ascontiguousarray(np.asarray(a)[order])
+            for a in (P, Y0, T0, H, OMEGA, nper, n_transient, n_steps))
+        lyapunov_block_lanes(p_, y_, scale, t_, h_, w_, n_, tr_, st_, renorm_every, 1, bound, o2,
+                             e2, used, status, n_ev, n_blocks, BLOCK_ROWS, nb.get_num_threads())
+    ok = status == STATUS_OK
+    out[order] = np.where(ok, o2[:, 0], np.nan)
+    err[order] = np.where(ok, e2[:, 0], np.nan)

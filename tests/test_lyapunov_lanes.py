@@ -1,0 +1,161 @@
+"""The Lyapunov kernel on lane blocks (rows of many lanes in one structure-of-arrays block)
+against the one-lane kernel it replaces: exponents, errors, blocks and status bitwise equal."""
+
+from __future__ import annotations
+
+import math
+
+import numba as nb
+import numpy as np
+import pytest
+
+import geardyn
+from geardyn.analysis import lyapunov as lyap_mod
+from geardyn.solvers.kernels import kernels_for
+
+#: Gear pair lanes: chaotic, period-1 with contact loss (two edge crossings per period).
+CHAOTIC = dict(zeta=0.02, kappa=0.2, Fm=0.1, Fa=0.3)
+IMPACTING = dict(zeta=0.1, kappa=0.2, Fm=0.1, Fa=0.15)
+
+
+def paper_device(**kw) -> geardyn.CATTDevice:
+    return geardyn.CATTDevice(geardyn.PlanetaryParams.paper(xi1=0.05, xi2=0.05), **kw)
+
+
+def _lanes(model, omegas, n_per, periods_tr, periods_st, y0, t0):
+    """Kernel arguments for lanes with n_per steps per period (one for all or one per lane) and
+    their own step counts; the last entry: n_per per lane."""
+    n_per = np.broadcast_to(np.asarray(n_per, np.int64), omegas.shape).copy()
+    P = np.ascontiguousarray(model.lane_params("Omega", omegas))
+    H = 2.0 * np.pi / omegas / n_per
+    n_tr = np.asarray(periods_tr, np.int64) * n_per
+    n_st = np.asarray(periods_st, np.int64) * n_per
+    Y0 = np.ascontiguousarray(np.broadcast_to(y0, (omegas.size, model.n_states)), dtype=float)
+    T0 = np.ascontiguousarray(t0, dtype=float)
+    return P, Y0, T0, H, np.ascontiguousarray(omegas, dtype=float), n_tr, n_st, n_per
+
+
+def _reference(kern, model, args, renorm, k, bound=1e6):
+    """Each lane through the one-lane kernel (lyapunov_single), as lyapunov() runs it."""
+    P, Y0, T0, H, OM, n_tr, n_st, n_per = args
+    scale = np.ones(model.n_states)
+    res = [kern.lyapunov_single(P[i], Y0[i], scale, T0[i], H[i], OM[i], n_per[i], n_tr[i], n_st[i],
+                                renorm, k, bound, model.n_events, 16) for i in range(len(P))]
+    return (np.array([r[0] for r in res]), np.array([r[1] for r in res]),
+            np.array([r[2] for r in res]), np.array([r[3] for r in res]))
+
+
+def _blocks(kern, model, args, renorm, k, block_rows, n_ev=None, bound=1e6):
+    P, Y0, T0, H, OM, n_tr, n_st, n_per = args
+    L = len(P)
+    out, err = np.full((L, k), -1.0), np.full((L, k), -1.0)
+    used, status = np.full(L, -1, np.int64), np.full(L, -1, np.int64)
+    kern.lyapunov_block_lanes(P, Y0, np.ones(model.n_states), T0, H, OM, n_per, n_tr, n_st,
+                              renorm, k, bound, out, err, used, status,
+                              model.n_events if n_ev is None else n_ev, 16, block_rows, 2)
+    return out, err, used, status
+
+
+def _assert_bitwise(got, ref):
+    for g, r in zip(got, ref, strict=True):
+        assert np.array_equal(g, r, equal_nan=True), (g, r)
+
+
+@pytest.mark.parametrize("k", [1, 4])
+def test_catt_blocks_bitwise_equal_to_one_lane_kernel(k):
+    # the reduced paper device at Omegas with and without contact loss, lanes with their own
+    # grid, transient, measuring window, start time and state; renorm 7 so that blocks of the
+    # measuring window end between renormalisations
+    model = paper_device()
+    assert model.n_events == 4
+    kern = kernels_for(model.kernel, "lyapunov")
+    assert hasattr(kern, "rhs_lanes")  # the model's lane-block functions are used
+    om = np.array([0.7, 1.05, 1.4, 1.8, 2.3, 2.9, 3.6])
+    rng = np.random.default_rng(3)
+    y0 = model.initial_state() + rng.uniform(-0.5, 0.5, (om.size, 4))
+    # lanes of different grids share blocks (the kernel's per-row phase tables)
+    args = _lanes(model, om, [48, 64, 48, 40, 64, 48, 56], [3, 0, 5, 2, 4, 1, 6],
+                  [12, 9, 7, 16, 5, 11, 3], y0,
+                  rng.uniform(0.0, 50.0, om.size))
+    ref = _reference(kern, model, args, 7, k)
+    assert np.all(ref[3] == 0) and np.all(np.isfinite(ref[0]))
+    for rows in (64, 2 * k + 1, 1000):  # several lanes per block, one, all
+        _assert_bitwise(_blocks(kern, model, args, 7, k, rows), ref)
+    # edges matter in these lanes (contact is lost): without locating them the exponents differ
+    plain = _blocks(kern, model, args, 7, k, 64, n_ev=0)
+    assert not np.array_equal(plain[0], ref[0])
+
+
+def test_gear_pair_blocks_bitwise_equal_with_a_diverged_lane():
+    for kw in (CHAOTIC, IMPACTING):
+        model = geardyn.GearPair(**kw)
+        kern = kernels_for(model.kernel, "lyapunov")
+        om = np.array([0.6, 0.92, 1.15, 1.3, 0.8])
+        y0 = np.array([[0.5, 0.0], [1.2, 0.1], [1e9, 0.0], [0.9, -0.2], [1.5, 0.0]])
+        args = _lanes(model, om, 32, [10, 20, 5, 0, 15], [40, 25, 30, 50, 20], y0,
+                      [0.0, 3.0, 0.0, 7.5, 1.0])
+        for k in (1, 2):
+            ref = _reference(kern, model, args, 10, k)
+            assert ref[3][2] == 1 and np.all(np.isnan(ref[0][2]))  # diverged
+            for rows in (64, 5):
+                _assert_bitwise(_blocks(kern, model, args, 10, k, rows), ref)
+
+
+def test_generic_lane_path_general_catt_model():
+    # the general CATT model has no lane-block functions: the rows are evaluated one by one
+    model = paper_device(reduced=False)
+    kern = kernels_for(model.kernel, "lyapunov")
+    assert not hasattr(kern, "rhs_lanes")
+    om = np.array([1.1, 1.6, 2.4])
+    args = _lanes(model, om, 40, [2, 0, 3], [6, 8, 5], model.initial_state(), [0.0, 0.0, 2.0])
+    ref = _reference(kern, model, args, 10, 1)
+    _assert_bitwise(_blocks(kern, model, args, 10, 1, 64), ref)
+
+
+@nb.njit(cache=True)
+def _lorenz(t, y, dy, p):
+    dy[0] = p[0] * (y[1] - y[0])
+    dy[1] = y[0] * (p[1] - y[2]) - y[1]
+    dy[2] = y[0] * y[1] - p[2] * y[2]
+
+
+def test_public_lanes_equal_one_lane_kernel(monkeypatch):
+    # geardyn.lyapunov_lanes (lanes of several step ladders, an autonomous user model) against
+    # the same call through the one-lane-at-a-time kernel
+    cases = [(paper_device(), paper_device().lane_params("Omega", np.linspace(0.6, 3.0, 9)),
+              dict(transient=10.0, duration=40.0)),
+             (geardyn.UserModel(_lorenz, n_states=3, params=np.array([10.0, 28.0, 8.0 / 3.0]),
+                                period=None, state_names=["x", "y", "z"]),
+              np.array([[10.0, 28.0, 8.0 / 3.0], [10.0, 0.5, 8.0 / 3.0]]),
+              dict(y0=[1.0, 1.0, 1.0], transient=2.0, duration=10.0))]
+    for model, P, run in cases:
+        new = lyap_mod.lyapunov_lanes(model, P, with_error=True, **run)
+        kern = kernels_for(model.kernel, "lyapunov")
+        with monkeypatch.context() as mp:
+            mp.setattr(kern, "lyapunov_lanes", kern.lyapunov_lanes_rows)
+            old = lyap_mod.lyapunov_lanes(model, P, with_error=True, **run)
+        _assert_bitwise(new, old)
+        assert np.all(np.isfinite(new[0]))
+    assert math.isfinite(new[0][0])
+
+
+@pytest.mark.parametrize("waveform", ["sine", "rectangular"])
+def test_lane_block_functions_take_a_phase_per_lane(waveform):
+    # rhs_lanes / observe_lanes with S[k], C[k] per lane (25 stiffness harmonics for the
+    # rectangular waveform: the harmonic recurrence per lane) against the per-lane functions
+    from geardyn.models import catt_kernels as ck
+
+    m = geardyn.CATTDevice(geardyn.PlanetaryParams.paper(waveform=waveform)).with_omega(0.9)
+    nl, rng = 11, np.random.default_rng(0)
+    PT = np.ascontiguousarray(np.tile(m.params[:, None], (1, nl)))
+    Y, DY, O, SC = rng.uniform(-2, 2, (4, nl)), np.zeros((4, nl)), np.zeros((2, nl)), np.zeros(
+        (8, nl))
+    ph, T = rng.uniform(0, 2 * np.pi, nl), rng.uniform(0, 10, nl)
+    S, C = np.sin(ph), np.cos(ph)
+    ck.catt_rhs_one_lanes(T, Y, DY, PT, nl, S, C, SC)
+    ck.catt_observe_one_lanes(T, Y, O, PT, nl, S, C, SC)
+    for k in range(nl):
+        dy, o = np.zeros(4), np.zeros(2)
+        ck.catt_rhs_one(T[k], Y[:, k].copy(), dy, m.params, S[k], C[k])
+        ck.catt_observe_one(T[k], Y[:, k].copy(), o, m.params, S[k], C[k])
+        assert np.array_equal(dy, DY[:, k]) and np.array_equal(o, O[:, k])
