@@ -233,13 +233,14 @@ def theta_events(t, y, g, p):
 # Lane-block forms of the reduced model (one planet set) for the sweep kernel: the same
 # arithmetic as catt_rhs_one / catt_events_one / catt_observe_one, operation for operation (so
 # results are bitwise equal), on a block of lanes in structure-of-arrays layout: state Y[q, k],
-# coefficients PT[j, k] (lane k of the block innermost), nl lanes, one forcing phase (s, c)
-# for the block. The lane loops have no calls and vectorise. SC: scratch rows (>= 4, width of
-# the block). The kernel generator picks them up by name (``<function>_lanes``).
+# coefficients PT[j, k] (lane k of the block innermost), nl lanes, the forcing phase per lane
+# (S[k], C[k]: sin and cos of Omega t). The lane loops have no calls and vectorise. SC: scratch
+# rows (>= 4, width of the block). The kernel generator picks them up by name
+# (``<function>_lanes``).
 
 
 @nb.njit(inline="always", **_JIT)
-def _lane_forcing(T, PT, nl, s, c, SC):
+def _lane_forcing(T, PT, nl, S, C, SC):
     """Per-lane stiffness factors (rows 0, 1: sun-inside, inside-outside) and the load terms
     (rows 2, 3: load_c, sin_l1) of :func:`_rhs` for one planet set, into SC."""
     nh = int(PT[N_HARM, 0])  # the same in every lane: it fixes the vector's layout
@@ -248,8 +249,8 @@ def _lane_forcing(T, PT, nl, s, c, SC):
     fluctuates = False
     if nh == 1:  # one loop (the same arithmetic as below)
         for k in range(nl):
-            SC[0, k] = 1.0 + (PT[fs, k] * c + PT[fs + 1, k] * s)
-            SC[1, k] = 1.0 + (PT[fp, k] * c + PT[fp + 1, k] * s)
+            SC[0, k] = 1.0 + (PT[fs, k] * C[k] + PT[fs + 1, k] * S[k])
+            SC[1, k] = 1.0 + (PT[fp, k] * C[k] + PT[fp + 1, k] * S[k])
             SC[2, k] = PT[F_C0, k]
             SC[3, k] = 0.0
             fluctuates |= (PT[F_C1, k] != 0.0) | (PT[HEADER + F_P1, k] != 0.0)
@@ -257,13 +258,12 @@ def _lane_forcing(T, PT, nl, s, c, SC):
             _load_terms(T, PT, nl, SC)
         return
     for k in range(nl):
-        SC[0, k] = PT[fs, k] * c + PT[fs + 1, k] * s
-        SC[1, k] = PT[fp, k] * c + PT[fp + 1, k] * s
-    ch = c
-    sh = s
-    for h in range(1, nh):
-        ch, sh = ch * c - sh * s, sh * c + ch * s
-        for k in range(nl):
+        SC[0, k] = PT[fs, k] * C[k] + PT[fs + 1, k] * S[k]
+        SC[1, k] = PT[fp, k] * C[k] + PT[fp + 1, k] * S[k]
+        ch = C[k]
+        sh = S[k]
+        for h in range(1, nh):  # the harmonics by the recurrence of _stiffness, per lane
+            ch, sh = ch * C[k] - sh * S[k], sh * C[k] + ch * S[k]
             SC[0, k] += PT[fs + 2 * h, k] * ch + PT[fs + 2 * h + 1, k] * sh
             SC[1, k] += PT[fp + 2 * h, k] * ch + PT[fp + 2 * h + 1, k] * sh
     for k in range(nl):
@@ -286,9 +286,9 @@ def _load_terms(T, PT, nl, SC):
 
 
 @nb.njit(**_JIT)
-def catt_rhs_one_lanes(T, Y, DY, PT, nl, s, c, SC):
+def catt_rhs_one_lanes(T, Y, DY, PT, nl, S, C, SC):
     """:func:`catt_rhs_one` for lanes 0..nl-1 of a block (see above)."""
-    _lane_forcing(T, PT, nl, s, c, SC)
+    _lane_forcing(T, PT, nl, S, C, SC)
     o = HEADER
     for k in range(nl):
         om2 = PT[OMEGA, k] * PT[OMEGA, k]
@@ -304,12 +304,12 @@ def catt_rhs_one_lanes(T, Y, DY, PT, nl, s, c, SC):
         f_pq = PT[o + K_PQ_Q, k] * gp + PT[o + C_PQ_Q, k] * vp
         f_pp = PT[o + K_PQ_P, k] * gp + PT[o + C_PQ_P, k] * vp
         load_p = PT[o + F_P0, k] + PT[o + F_P1, k] * SC[3, k]
-        d1 = -f_sq + f_pq + om2 * (PT[o + E_SQ_S, k] * s + PT[o + E_SQ_C, k] * c)
+        d1 = -f_sq + f_pq + om2 * (PT[o + E_SQ_S, k] * S[k] + PT[o + E_SQ_C, k] * C[k])
         DY[0, k] = vs
         DY[1, k] = d1 + (SC[2, k] - carrier)
         DY[2, k] = vp
         DY[3, k] = (f_sq - f_pq - f_pp + load_p
-                    + om2 * (PT[o + E_PQ_S, k] * s + PT[o + E_PQ_C, k] * c))
+                    + om2 * (PT[o + E_PQ_S, k] * S[k] + PT[o + E_PQ_C, k] * C[k]))
 
 
 @nb.njit(**_JIT)
@@ -324,9 +324,9 @@ def catt_events_one_lanes(T, Y, G, PT, nl):
 
 
 @nb.njit(**_JIT)
-def catt_observe_one_lanes(T, Y, O, PT, nl, s, c, SC):
+def catt_observe_one_lanes(T, Y, O, PT, nl, S, C, SC):
     """:func:`catt_observe_one` for lanes 0..nl-1 of a block."""
-    _lane_forcing(T, PT, nl, s, c, SC)
+    _lane_forcing(T, PT, nl, S, C, SC)
     o = HEADER
     for k in range(nl):
         gs = SC[0, k] * dead_zone(Y[0, k], PT[o + B_SQ, k])

@@ -51,8 +51,8 @@ def gear_pair_observe(t, y, out, p, s, c):
 
 # Lane-block forms for the sweep kernel (picked up by name, ``<function>_lanes``): the same
 # arithmetic as the functions above, operation for operation, on lanes 0..nl-1 of a block in
-# structure-of-arrays layout (state Y[q, k], coefficients PT[j, k], one forcing phase s, c);
-# the lane loops vectorise. SC: scratch rows (>= 4) of the block's width.
+# structure-of-arrays layout (state Y[q, k], coefficients PT[j, k], forcing phase S[k], C[k]
+# per lane); the lane loops vectorise. SC: scratch rows (>= 4) of the block's width.
 
 
 @nb.njit(inline="always", **_JIT)
@@ -78,15 +78,15 @@ def _phase_factors(PT, nl, SC):
 
 
 @nb.njit(**_JIT)
-def gear_pair_rhs_lanes(T, Y, DY, PT, nl, s, c, SC):
+def gear_pair_rhs_lanes(T, Y, DY, PT, nl, S, C, SC):
     """:func:`gear_pair_rhs` for lanes 0..nl-1 of a block."""
     _phase_factors(PT, nl, SC)
     for k in range(nl):
         x = Y[0, k]
         b = PT[BACKLASH, k]
         g = x - b if x > b else (x + b if x < -b else 0.0)
-        ck = c * SC[0, k] - s * SC[1, k]
-        ce = c * SC[2, k] - s * SC[3, k]
+        ck = C[k] * SC[0, k] - S[k] * SC[1, k]
+        ce = C[k] * SC[2, k] - S[k] * SC[3, k]
         om = PT[OMEGA, k]
         DY[0, k] = Y[1, k]
         DY[1, k] = (PT[FM, k] + PT[FA, k] * om * om * ce - 2.0 * PT[ZETA, k] * Y[1, k]
@@ -102,14 +102,14 @@ def gear_pair_events_lanes(T, Y, G, PT, nl):
 
 
 @nb.njit(**_JIT)
-def gear_pair_observe_lanes(T, Y, O, PT, nl, s, c, SC):
+def gear_pair_observe_lanes(T, Y, O, PT, nl, S, C, SC):
     """:func:`gear_pair_observe` for lanes 0..nl-1 of a block."""
     _phase_factors(PT, nl, SC)
     for k in range(nl):
         x = Y[0, k]
         b = PT[BACKLASH, k]
         g = x - b if x > b else (x + b if x < -b else 0.0)
-        ck = c * SC[0, k] - s * SC[1, k]
+        ck = C[k] * SC[0, k] - S[k] * SC[1, k]
         O[0, k] = (1.0 + PT[KAPPA, k] * ck) * g + 2.0 * PT[ZETA, k] * Y[1, k]
 
 
