@@ -17,12 +17,13 @@ Numerics
   time), and integrated in sub-steps. Every RK4 stage then sees a smooth right-hand side and the
   method keeps 4th order. A step is split at most ``MAX_SPLITS`` times (chattering); the count of
   steps that hit the limit is returned (see :mod:`._step_core`).
-* The sweep advances lanes (parameter sets) in lockstep blocks of up to ``BLOCK`` lanes with one
-  step count, in structure-of-arrays layout (lane index innermost, block width a runtime value),
-  so that the RK4 stages, the model's lane-block functions where it has them, the side test and
-  the statistics vectorise over lanes; lanes that leave a side of an edge finish on the scalar
-  path. Blocks run in parallel (``prange``). A lane's arithmetic does not depend on its
-  neighbours (no fastmath), so results are bitwise independent of blocking and threads.
+* The sweep advances lanes (parameter sets) through blocks of up to ``BLOCK`` refilling slots,
+  one block per worker, each slot with its own lane, grid step, phase and steps per period, in
+  structure-of-arrays layout (slot index innermost, block width a runtime value), so that the
+  RK4 stages, the model's lane-block functions where it has them, the side test and the
+  statistics vectorise over slots; lanes that leave a side of an edge finish on the scalar
+  path. Workers run in parallel (``prange``). A lane's arithmetic does not depend on its
+  neighbours (no fastmath), so results are bitwise independent of slots, schedule and threads.
   ``trajectory`` (one lane) keeps the row layout of ``_block_step``.
 * A lane whose state leaves ``|y| <= bound`` or stops being finite is marked diverged (status 1)
   and frozen; the others go on.
