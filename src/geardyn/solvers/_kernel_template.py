@@ -338,13 +338,16 @@ else:
 
 @nb.njit(inline="always", **_JIT)
 def _lanes_phase(nl, OFF, PHASE, S_TAB, C_TAB, PH):
-    """Gather every slot's forcing phase for its next grid step from the concatenated tables:
-    sin/cos at the step's start, middle and end into the rows of PH (SA, CA, SB, CB, SE, CE)."""
+    """Every slot's forcing phase for its next grid step, into the rows of PH (SA, CA, SB, CB,
+    SE, CE: sin/cos at the step's start, middle and end): the start is the last step's end
+    (SE, CE; set to the table's first point when a lane is loaded; the table's last point,
+    2 n_per, equals its first bit for bit), the middle and end are gathered from the
+    concatenated tables."""
     SA, CA, SB, CB, SE, CE = PH
     for k in range(nl):
         j = OFF[k] + 2 * PHASE[k]
-        SA[k] = S_TAB[j]
-        CA[k] = C_TAB[j]
+        SA[k] = SE[k]
+        CA[k] = CE[k]
         SB[k] = S_TAB[j + 1]
         CB[k] = C_TAB[j + 1]
         SE[k] = S_TAB[j + 2]
@@ -558,7 +561,8 @@ def _sweep_worker(w, lanes, cfg, sched, out):
           K3.reshape(ns * nl), K4.reshape(ns * nl), TMP.reshape(ns * nl))
     HW = (HW3[0].reshape(ns * nl), HW3[1].reshape(ns * nl), HW3[2].reshape(ns * nl))
     nxt = q0  # the next lane of the queue
-    n_act = 0
+    n_act = 0  # slots holding a running lane
+    n_samp = 0  # of those, past their transient (or at its end): the statistics run
     ended = True
     while True:
         if ended:  # (re)fill the ended slots from the queue: a lane starts at its grid step 0
@@ -584,6 +588,8 @@ def _sweep_worker(w, lanes, cfg, sched, out):
                 HB[k] = h
                 T0B[k] = T0[lane]
                 TT[k] = T0[lane]
+                PH6[4, k] = S_TAB[OFF[k]]  # the phase at the start (see _lanes_phase)
+                PH6[5, k] = C_TAB[OFF[k]]
                 for q in range(ns):
                     HW3[0, q, k] = 0.5 * h
                     HW3[1, q, k] = h
@@ -647,6 +653,7 @@ def _sweep_worker(w, lanes, cfg, sched, out):
                     END[k] = True
                     ended = True
                     n_act -= 1
+                    n_samp -= 1 if step > n_tr[k] else 0
                     for r in range(n_samples):
                         for q in range(ns):
                             samples[lane, r, q] = np.nan
@@ -659,11 +666,14 @@ def _sweep_worker(w, lanes, cfg, sched, out):
                     _transient_end(k, lane, Y, ys, R, D, n_ring, n_tr, n_end, next_sample,
                                    conv_tol, converged, sample_every, n_transient_max, ncross,
                                    n_ev)
+                    n_samp += 1 if step == n_tr[k] else 0  # not extended: sampling starts
                 DUE[k] = n_tr[k] if n_tr[k] > step else next_sample[k]
         # statistics over the sampled stretch, vectorised over the slots
+        if n_samp == 0:
+            continue
         sampling = False
         for k in range(nl):
-            STAT[k] = ACT[k] and STEP[k] > n_tr[k]
+            STAT[k] = ACT[k] & (STEP[k] > n_tr[k])
             n_stat[k] += 1 if STAT[k] else 0
             sampling |= STAT[k]
         if not sampling:
@@ -707,6 +717,7 @@ def _sweep_worker(w, lanes, cfg, sched, out):
                 END[k] = True
                 ended = True
                 n_act -= 1
+                n_samp -= 1
                 for q in range(ns):
                     final[lane, q] = Y[q, k]
                 _write_out(k, lane, n_ev, n_obs, n_tr, GMIN, GMAX, OMAX, OMIN, OSQ, n_stat,
