@@ -355,37 +355,34 @@ def _lanes_phase(nl, OFF, PHASE, S_TAB, C_TAB, PH):
 
 
 @nb.njit(inline="always", **_JIT)
-def _lanes_rk4(STEP, nl, Y, Y1, K1, K2, K3, K4, TMP, HW, TT, HB, T0B, PT, P, LANE, PH, SC,
+def _lanes_rk4(STEP, nl, Y, Y1, K1, K2, K3, K4, TMP, FL, HW, TT, HB, T0B, PT, P, LANE, PH, SC,
                ybuf, dbuf):
-    """The RK4 trial of the grid step STEP[k] of slots 0..nl-1 into Y1; TT holds the steps' end
-    times afterwards. HW: h/2, h and h/6 per (state, slot), so the stage updates are plain
-    loops; PH: the slots' forcing phases (:func:`_lanes_phase`)."""
-    HH, HF, H6 = HW
+    """The RK4 trial of every slot's grid step STEP[k] into Y1; TT holds the step's end times
+    afterwards. FL: flat views (state and slot in one index) of Y, Y1, K1..K4, TMP; HW: flat
+    rows of h/2, h and h/6 per (state, slot), so the stage updates are one loop each; PH: the
+    slots' forcing phases (:func:`_lanes_phase`)."""
+    Yf, Y1f, K1f, K2f, K3f, K4f, TMPf = FL
+    HHf, HFf, H6f = HW
     SA, CA, SB, CB, SE, CE = PH
-    ns = Y.shape[0]
+    m_all = Yf.size
     for k in range(nl):
         TT[k] = T0B[k] + STEP[k] * HB[k]
     _rhs_lanes(TT, Y, K1, PT, P, LANE, nl, SA, CA, SC, ybuf, dbuf)
-    for q in range(ns):
-        for k in range(nl):
-            TMP[q, k] = Y[q, k] + HH[q, k] * K1[q, k]
+    for m in range(m_all):
+        TMPf[m] = Yf[m] + HHf[m] * K1f[m]
     for k in range(nl):
         TT[k] = T0B[k] + STEP[k] * HB[k] + 0.5 * HB[k]
     _rhs_lanes(TT, TMP, K2, PT, P, LANE, nl, SB, CB, SC, ybuf, dbuf)
-    for q in range(ns):
-        for k in range(nl):
-            TMP[q, k] = Y[q, k] + HH[q, k] * K2[q, k]
+    for m in range(m_all):
+        TMPf[m] = Yf[m] + HHf[m] * K2f[m]
     _rhs_lanes(TT, TMP, K3, PT, P, LANE, nl, SB, CB, SC, ybuf, dbuf)
-    for q in range(ns):
-        for k in range(nl):
-            TMP[q, k] = Y[q, k] + HF[q, k] * K3[q, k]
+    for m in range(m_all):
+        TMPf[m] = Yf[m] + HFf[m] * K3f[m]
     for k in range(nl):
         TT[k] = T0B[k] + (STEP[k] + 1) * HB[k]
     _rhs_lanes(TT, TMP, K4, PT, P, LANE, nl, SE, CE, SC, ybuf, dbuf)
-    for q in range(ns):
-        for k in range(nl):
-            Y1[q, k] = Y[q, k] + H6[q, k] * (K1[q, k] + 2.0 * K2[q, k] + 2.0 * K3[q, k]
-                                             + K4[q, k])
+    for m in range(m_all):
+        Y1f[m] = Yf[m] + H6f[m] * (K1f[m] + 2.0 * K2f[m] + 2.0 * K3f[m] + K4f[m])
 
 
 @nb.njit(inline="always", **_JIT)
@@ -489,9 +486,7 @@ def _sweep_worker(w, lanes, cfg, sched, out):
     Slot arrays: LANE (the lane held), ACT (holds a running lane), END (to be refilled), STEP
     (the lane's grid steps done), PHASE (its grid point in the period), NPER, OFF (its phase
     table's offset), HB, T0B (step, start time), n_tr, n_end, next_sample, DUE (the next step
-    with bookkeeping: end of the transient or a sample), n_stat, n_ring (section points kept).
-    Once the queue is done, the per-step loops end at the last running slot (the live width
-    nw): the longest lanes, loaded first, sit in the first slots and run on alone."""
+    with bookkeeping: end of the transient or a sample), n_stat, n_ring (section points kept)."""
     P, Y0, H, OMEGA, T0, n_transient, n_transient_max, sample_every = lanes
     conv_tol, conv_depth, n_samples, locate, bound, n_ev, n_obs, width = cfg
     start, queue, lane_nper, lane_tab, S_TAB, C_TAB = sched
@@ -562,9 +557,10 @@ def _sweep_worker(w, lanes, cfg, sched, out):
     ybuf = np.zeros(ns)
     gbuf = event_buffer(0, n_ev)
     HW3 = np.zeros((3, ns, nl))  # h/2, h, h/6 per (state, slot)
-    HW = (HW3[0], HW3[1], HW3[2])
+    FL = (Y.reshape(ns * nl), Y1.reshape(ns * nl), K1.reshape(ns * nl), K2.reshape(ns * nl),
+          K3.reshape(ns * nl), K4.reshape(ns * nl), TMP.reshape(ns * nl))
+    HW = (HW3[0].reshape(ns * nl), HW3[1].reshape(ns * nl), HW3[2].reshape(ns * nl))
     nxt = q0  # the next lane of the queue
-    nw = nl  # the live width: slots nw.. hold no running lane (and get none)
     n_act = 0  # slots holding a running lane
     n_samp = 0  # of those, past their transient (or at its end): the statistics run
     ended = True
@@ -631,25 +627,22 @@ def _sweep_worker(w, lanes, cfg, sched, out):
                             SIDE[j, k] = 1.0 if G1[j, k] > 0.0 else -1.0
         if n_act == 0:
             break
-        if nxt >= q1:  # the queue is done: the loops end at the last running slot
-            while not ACT[nw - 1]:
-                nw -= 1
         # one grid step of every slot
-        _lanes_phase(nw, OFF, PHASE, S_TAB, C_TAB, PH)
-        _lanes_rk4(STEP, nw, Y, Y1, K1, K2, K3, K4, TMP, HW, TT, HB, T0B, PT, P, LANE, PH, SC,
-                   ybuf, dbuf)
+        _lanes_phase(nl, OFF, PHASE, S_TAB, C_TAB, PH)
+        _lanes_rk4(STEP, nl, Y, Y1, K1, K2, K3, K4, TMP, FL, HW, TT, HB, T0B, PT, P, LANE, PH,
+                   SC, ybuf, dbuf)
         if n_ev > 0:
-            _events_lanes(TT, Y1, G1, PT, P, LANE, nw, ybuf, gb)
-            _lanes_screen(nw, G1, GS, GP, SIDE, GR, FLAG, locate)
-        _lanes_finish(STEP, nw, NPER, Y, Y1, G1, GR, SIDE, FLAG, ACT, P, LANE, HB, T0B, OMEGA,
+            _events_lanes(TT, Y1, G1, PT, P, LANE, nl, ybuf, gb)
+            _lanes_screen(nl, G1, GS, GP, SIDE, GR, FLAG, locate)
+        _lanes_finish(STEP, nl, NPER, Y, Y1, G1, GR, SIDE, FLAG, ACT, P, LANE, HB, T0B, OMEGA,
                       locate, ncross, unresolved, ys, y1s, sides, g1s, work, ybuf, gbuf)
         GP, GS, G1 = GS, G1, GP  # history of the grid values: g_{i}, g_{i+1}
-        _advance(nw, STEP, PHASE, NPER)
+        _advance(nl, STEP, PHASE, NPER)
         due = False
-        for k in range(nw):
+        for k in range(nl):
             due |= ACT[k] & ((PHASE[k] == 0) | (STEP[k] >= DUE[k]))
         if due:
-            for k in range(nw):  # health, end of the transient
+            for k in range(nl):  # health, end of the transient
                 if not ACT[k] or not (PHASE[k] == 0 or STEP[k] >= DUE[k]):
                     continue
                 lane = LANE[k]
@@ -679,36 +672,36 @@ def _sweep_worker(w, lanes, cfg, sched, out):
         if n_samp == 0:
             continue
         sampling = False
-        for k in range(nw):
+        for k in range(nl):
             STAT[k] = ACT[k] & (STEP[k] > n_tr[k])
             n_stat[k] += 1 if STAT[k] else 0
             sampling |= STAT[k]
         if not sampling:
             continue
         for j in range(n_ev):
-            for k in range(nw):
+            for k in range(nl):
                 g = GS[j, k]
                 GMIN[j, k] = min(GMIN[j, k], g) if STAT[k] else GMIN[j, k]
                 GMAX[j, k] = max(GMAX[j, k], g) if STAT[k] else GMAX[j, k]
         if n_obs > 0:
-            for k in range(nw):
+            for k in range(nl):
                 TT[k] = T0B[k] + STEP[k] * HB[k]
                 j = OFF[k] + 2 * PHASE[k]
                 SO[k] = S_TAB[j]
                 CO[k] = C_TAB[j]
-            _observe_lanes(TT, Y, O, PT, P, LANE, nw, SO, CO, SC, ybuf, ob)
+            _observe_lanes(TT, Y, O, PT, P, LANE, nl, SO, CO, SC, ybuf, ob)
             for j in range(n_obs):
-                for k in range(nw):
+                for k in range(nl):
                     v = O[j, k]
                     OMAX[j, k] = max(OMAX[j, k], v) if STAT[k] else OMAX[j, k]
                     OMIN[j, k] = min(OMIN[j, k], v) if STAT[k] else OMIN[j, k]
                     OSQ[j, k] = OSQ[j, k] + v * v if STAT[k] else OSQ[j, k]
         due = False
-        for k in range(nw):
+        for k in range(nl):
             due |= STAT[k] & (STEP[k] >= DUE[k])
         if not due:
             continue
-        for k in range(nw):  # samples, end
+        for k in range(nl):  # samples, end
             if not STAT[k] or STEP[k] < DUE[k]:
                 continue
             lane = LANE[k]
