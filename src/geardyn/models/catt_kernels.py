@@ -233,16 +233,16 @@ def theta_events(t, y, g, p):
 # Lane-block forms of the reduced model (one planet set) for the sweep kernel: the same
 # arithmetic as catt_rhs_one / catt_events_one / catt_observe_one, operation for operation (so
 # results are bitwise equal), on a block of lanes in structure-of-arrays layout: state Y[q, k],
-# coefficients PT[j, k] (lane k of the block innermost), nl lanes, forcing phase per lane
-# (S[k], C[k]: its sin and cos). The lane loops have no calls and vectorise. SC: scratch rows
-# (>= 6, width of the block). The kernel generator picks them up by name (``<function>_lanes``).
+# coefficients PT[j, k] (lane k of the block innermost), nl lanes, the forcing phase per lane
+# (S[k], C[k]: sin and cos of Omega t). The lane loops have no calls and vectorise. SC: scratch
+# rows (>= 4, width of the block). The kernel generator picks them up by name
+# (``<function>_lanes``).
 
 
 @nb.njit(inline="always", **_JIT)
 def _lane_forcing(T, PT, nl, S, C, SC):
     """Per-lane stiffness factors (rows 0, 1: sun-inside, inside-outside) and the load terms
-    (rows 2, 3: load_c, sin_l1) of :func:`_rhs` for one planet set, into SC (rows 4, 5: the
-    harmonics' cos and sin, scratch). S[k], C[k]: sin and cos of lane k's forcing phase."""
+    (rows 2, 3: load_c, sin_l1) of :func:`_rhs` for one planet set, into SC."""
     nh = int(PT[N_HARM, 0])  # the same in every lane: it fixes the vector's layout
     fs = HEADER + BLOCK_FIXED
     fp = fs + 2 * nh
@@ -260,15 +260,10 @@ def _lane_forcing(T, PT, nl, S, C, SC):
     for k in range(nl):
         SC[0, k] = PT[fs, k] * C[k] + PT[fs + 1, k] * S[k]
         SC[1, k] = PT[fp, k] * C[k] + PT[fp + 1, k] * S[k]
-        SC[4, k] = C[k]
-        SC[5, k] = S[k]
-    for h in range(1, nh):
-        for k in range(nl):
-            ch = SC[4, k]
-            sh = SC[5, k]
+        ch = C[k]
+        sh = S[k]
+        for h in range(1, nh):  # the harmonics by the recurrence of _stiffness, per lane
             ch, sh = ch * C[k] - sh * S[k], sh * C[k] + ch * S[k]
-            SC[4, k] = ch
-            SC[5, k] = sh
             SC[0, k] += PT[fs + 2 * h, k] * ch + PT[fs + 2 * h + 1, k] * sh
             SC[1, k] += PT[fp + 2 * h, k] * ch + PT[fp + 2 * h + 1, k] * sh
     for k in range(nl):

@@ -15,8 +15,8 @@ import math
 import numba as nb
 import numpy as np
 
-from geardyn.core.kernel_source import KernelSource
 from geardyn.models.base import Model
+from geardyn.solvers.kernels import KernelSource
 
 _JIT = {"cache": True, "error_model": "numpy", "boundscheck": False}
 OMEGA, ZETA, KAPPA, FM, FA, PHI_K, PHI_E, BACKLASH = range(8)
@@ -51,8 +51,8 @@ def gear_pair_observe(t, y, out, p, s, c):
 
 # Lane-block forms for the sweep kernel (picked up by name, ``<function>_lanes``): the same
 # arithmetic as the functions above, operation for operation, on lanes 0..nl-1 of a block in
-# structure-of-arrays layout (state Y[q, k], coefficients PT[j, k], forcing phase S[k], C[k]);
-# the lane loops vectorise. SC: scratch rows (>= 4) of the block's width.
+# structure-of-arrays layout (state Y[q, k], coefficients PT[j, k], forcing phase S[k], C[k]
+# per lane); the lane loops vectorise. SC: scratch rows (>= 4) of the block's width.
 
 
 @nb.njit(inline="always", **_JIT)

@@ -17,12 +17,13 @@ Numerics
   time), and integrated in sub-steps. Every RK4 stage then sees a smooth right-hand side and the
   method keeps 4th order. A step is split at most ``MAX_SPLITS`` times (chattering); the count of
   steps that hit the limit is returned (see :mod:`._step_core`).
-* The sweep advances lanes (parameter sets) in lockstep blocks of up to ``BLOCK`` lanes with one
-  step count, in structure-of-arrays layout (lane index innermost, block width a runtime value),
-  so that the RK4 stages, the model's lane-block functions where it has them, the side test and
-  the statistics vectorise over lanes; lanes that leave a side of an edge finish on the scalar
-  path. Blocks run in parallel (``prange``). A lane's arithmetic does not depend on its
-  neighbours (no fastmath), so results are bitwise independent of blocking and threads.
+* The sweep advances lanes (parameter sets) through blocks of up to ``BLOCK`` refilling slots,
+  one block per worker, each slot with its own lane, grid step, phase and steps per period, in
+  structure-of-arrays layout (slot index innermost, block width a runtime value), so that the
+  RK4 stages, the model's lane-block functions where it has them, the side test and the
+  statistics vectorise over slots; lanes that leave a side of an edge finish on the scalar
+  path. Workers run in parallel (``prange``). A lane's arithmetic does not depend on its
+  neighbours (no fastmath), so results are bitwise independent of slots, schedule and threads.
   ``trajectory`` (one lane) keeps the row layout of ``_block_step``.
 * A lane whose state leaves ``|y| <= bound`` or stops being finite is marked diverged (status 1)
   and frozen; the others go on.
@@ -262,47 +263,52 @@ def _settled(y, D, n, tol):
 
 
 # ---------------------------------------------------------------------------------------------
-# The sweep's lane blocks, structure of arrays: a block of nl lanes (all with the same steps per
-# period, so one forcing phase for the block) holds its state as Y[q, k], its events as G[j, k],
-# its coefficients transposed as PT[j, k]: the lane index is innermost and contiguous, and the
-# block width nl is a runtime value. The RK4 stages, the side test and the statistics are loops
-# over lanes without calls, which LLVM vectorises; a built-in model's ``*_lanes`` functions
+# The sweep's lane blocks, structure of arrays. Each worker owns a block of ``width`` slots; a
+# slot holds one lane at a time, with its own grid step, phase (grid point within the period),
+# steps per period and forcing-phase table, so lanes of every step count share a block. The
+# block holds its state as Y[q, k], its events as G[j, k], its coefficients transposed as
+# PT[j, k] (slot k innermost and contiguous; the width is a runtime value). All slots advance
+# one grid step per iteration; when a lane ends (or diverges) its results are written out and
+# the slot takes the next lane of the worker's queue, so blocks stay full until the queue's
+# tail. The RK4 stages, the phase gathers, the side test and the statistics are loops over
+# slots without calls, which LLVM vectorises; a built-in model's ``*_lanes`` functions
 # (generated module: ``rhs_lanes``, ``events_lanes``, ``observe_lanes``) evaluate the model the
-# same way. A model without them is evaluated lane by lane (the per-lane functions, gathered).
-# Lanes that leave a side of an edge are finished one by one on the scalar path
-# (:func:`_split_step`). No fastmath: each lane's arithmetic is the scalar kernel's, so a lane's
-# result does not depend on its block, its position or the thread.
+# same way, with the forcing phase per slot (S[k], C[k]). A model without them is evaluated lane
+# by lane (the per-lane functions, gathered). Lanes that leave a side of an edge are finished
+# one by one on the scalar path (:func:`_split_step`). No fastmath: each lane's arithmetic is
+# the scalar kernel's, so a lane's result does not depend on its slot, its neighbours, its
+# worker or the thread count.
 
 
 @nb.njit(inline="always", **_JIT)
-def _rhs_lanes_generic(T, Y, DY, PT, P, first, nl, s, c, SC, ybuf, dbuf):
+def _rhs_lanes_generic(T, Y, DY, PT, P, LANE, nl, S, C, SC, ybuf, dbuf):
     ns = Y.shape[0]
     for k in range(nl):
         for q in range(ns):
             ybuf[q] = Y[q, k]
-        _rhs_i(T[k], ybuf, dbuf, P[first + k], s, c)
+        _rhs_i(T[k], ybuf, dbuf, P[LANE[k]], S[k], C[k])
         for q in range(ns):
             DY[q, k] = dbuf[q]
 
 
 @nb.njit(inline="always", **_JIT)
-def _events_lanes_generic(T, Y, G, PT, P, first, nl, ybuf, gb):
+def _events_lanes_generic(T, Y, G, PT, P, LANE, nl, ybuf, gb):
     ns = Y.shape[0]
     for k in range(nl):
         for q in range(ns):
             ybuf[q] = Y[q, k]
-        _events_i(T[k], ybuf, gb, P[first + k])
+        _events_i(T[k], ybuf, gb, P[LANE[k]])
         for j in range(G.shape[0]):
             G[j, k] = gb[j]
 
 
 @nb.njit(inline="always", **_JIT)
-def _observe_lanes_generic(T, Y, O, PT, P, first, nl, s, c, SC, ybuf, ob):
+def _observe_lanes_generic(T, Y, O, PT, P, LANE, nl, S, C, SC, ybuf, ob):
     ns = Y.shape[0]
     for k in range(nl):
         for q in range(ns):
             ybuf[q] = Y[q, k]
-        _observe_i(T[k], ybuf, ob, P[first + k], s, c)
+        _observe_i(T[k], ybuf, ob, P[LANE[k]], S[k], C[k])
         for j in range(O.shape[0]):
             O[j, k] = ob[j]
 
@@ -313,25 +319,15 @@ if "rhs_lanes" in globals():  # the model's lane-block functions (see .kernels),
     _observe_lm = nb.njit(**_INLINE)(observe_lanes.py_func)  # noqa: F821
 
     @nb.njit(inline="always", **_JIT)
-    def _phase_rows(nl, s, c, SC):
-        """The block's forcing phase as per-lane arrays (SC rows 6, 7) for the model."""
-        for k in range(nl):
-            SC[6, k] = s
-            SC[7, k] = c
-        return SC[6], SC[7]
-
-    @nb.njit(inline="always", **_JIT)
-    def _rhs_lanes(T, Y, DY, PT, P, first, nl, s, c, SC, ybuf, dbuf):
-        S, C = _phase_rows(nl, s, c, SC)
+    def _rhs_lanes(T, Y, DY, PT, P, LANE, nl, S, C, SC, ybuf, dbuf):
         _rhs_lm(T, Y, DY, PT, nl, S, C, SC)
 
     @nb.njit(inline="always", **_JIT)
-    def _events_lanes(T, Y, G, PT, P, first, nl, ybuf, gb):
+    def _events_lanes(T, Y, G, PT, P, LANE, nl, ybuf, gb):
         _events_lm(T, Y, G, PT, nl)
 
     @nb.njit(inline="always", **_JIT)
-    def _observe_lanes(T, Y, O, PT, P, first, nl, s, c, SC, ybuf, ob):
-        S, C = _phase_rows(nl, s, c, SC)
+    def _observe_lanes(T, Y, O, PT, P, LANE, nl, S, C, SC, ybuf, ob):
         _observe_lm(T, Y, O, PT, nl, S, C, SC)
 
 else:
@@ -341,38 +337,58 @@ else:
 
 
 @nb.njit(inline="always", **_JIT)
-def _lanes_rk4(i, first, nl, Y, Y1, K1, K2, K3, K4, TMP, FL, HW, TT, HB, T0B, PT, P, sa, ca, sb,
-               cb, se, ce, SC, ybuf, dbuf):
-    """The RK4 trial of grid step i for lanes 0..nl-1 of a block into Y1; TT holds the step's
-    end times afterwards. FL: flat views (state and lane in one index) of Y, Y1, K1..K4, TMP;
-    HW: flat rows of h/2, h and h/6 per (state, lane), so the stage updates are one loop each."""
+def _lanes_phase(nl, OFF, PHASE, S_TAB, C_TAB, PH):
+    """Every slot's forcing phase for its next grid step, into the rows of PH (SA, CA, SB, CB,
+    SE, CE: sin/cos at the step's start, middle and end): the start is the last step's end
+    (SE, CE; set to the table's first point when a lane is loaded; the table's last point,
+    2 n_per, equals its first bit for bit), the middle and end are gathered from the
+    concatenated tables."""
+    SA, CA, SB, CB, SE, CE = PH
+    for k in range(nl):
+        j = OFF[k] + 2 * PHASE[k]
+        SA[k] = SE[k]
+        CA[k] = CE[k]
+        SB[k] = S_TAB[j + 1]
+        CB[k] = C_TAB[j + 1]
+        SE[k] = S_TAB[j + 2]
+        CE[k] = C_TAB[j + 2]
+
+
+@nb.njit(inline="always", **_JIT)
+def _lanes_rk4(STEP, nl, Y, Y1, K1, K2, K3, K4, TMP, FL, HW, TT, HB, T0B, PT, P, LANE, PH, SC,
+               ybuf, dbuf):
+    """The RK4 trial of every slot's grid step STEP[k] into Y1; TT holds the step's end times
+    afterwards. FL: flat views (state and slot in one index) of Y, Y1, K1..K4, TMP; HW: flat
+    rows of h/2, h and h/6 per (state, slot), so the stage updates are one loop each; PH: the
+    slots' forcing phases (:func:`_lanes_phase`)."""
     Yf, Y1f, K1f, K2f, K3f, K4f, TMPf = FL
     HHf, HFf, H6f = HW
+    SA, CA, SB, CB, SE, CE = PH
     m_all = Yf.size
     for k in range(nl):
-        TT[k] = T0B[k] + i * HB[k]
-    _rhs_lanes(TT, Y, K1, PT, P, first, nl, sa, ca, SC, ybuf, dbuf)
+        TT[k] = T0B[k] + STEP[k] * HB[k]
+    _rhs_lanes(TT, Y, K1, PT, P, LANE, nl, SA, CA, SC, ybuf, dbuf)
     for m in range(m_all):
         TMPf[m] = Yf[m] + HHf[m] * K1f[m]
     for k in range(nl):
-        TT[k] = T0B[k] + i * HB[k] + 0.5 * HB[k]
-    _rhs_lanes(TT, TMP, K2, PT, P, first, nl, sb, cb, SC, ybuf, dbuf)
+        TT[k] = T0B[k] + STEP[k] * HB[k] + 0.5 * HB[k]
+    _rhs_lanes(TT, TMP, K2, PT, P, LANE, nl, SB, CB, SC, ybuf, dbuf)
     for m in range(m_all):
         TMPf[m] = Yf[m] + HHf[m] * K2f[m]
-    _rhs_lanes(TT, TMP, K3, PT, P, first, nl, sb, cb, SC, ybuf, dbuf)
+    _rhs_lanes(TT, TMP, K3, PT, P, LANE, nl, SB, CB, SC, ybuf, dbuf)
     for m in range(m_all):
         TMPf[m] = Yf[m] + HFf[m] * K3f[m]
     for k in range(nl):
-        TT[k] = T0B[k] + (i + 1) * HB[k]
-    _rhs_lanes(TT, TMP, K4, PT, P, first, nl, se, ce, SC, ybuf, dbuf)
+        TT[k] = T0B[k] + (STEP[k] + 1) * HB[k]
+    _rhs_lanes(TT, TMP, K4, PT, P, LANE, nl, SE, CE, SC, ybuf, dbuf)
     for m in range(m_all):
         Y1f[m] = Yf[m] + H6f[m] * (K1f[m] + 2.0 * K2f[m] + 2.0 * K3f[m] + K4f[m])
 
 
 @nb.njit(inline="always", **_JIT)
 def _lanes_screen(nl, G1, GS, GP, SIDE, GR, FLAG, locate):
-    """The side test of a block's trial step, vectorised over lanes (:func:`_leaves_side` for
-    every lane): FLAG[k] != 0 where lane k's step ends on another side of an edge or, with
+    """The side test of a block's trial step, vectorised over slots (:func:`_leaves_side` for
+    every lane): FLAG[k] != 0 where slot k's step ends on another side of an edge or, with
     ``locate``, may graze one (GR[j, k] = 1: edge j may; from the grid values g_{i-1} = GP,
     g_i = GS, g_{i+1} = G1)."""
     for k in range(nl):
@@ -391,9 +407,9 @@ def _lanes_screen(nl, G1, GS, GP, SIDE, GR, FLAG, locate):
 
 
 @nb.njit(inline="always", **_JIT)
-def _lanes_finish(i, first, nl, n_per, Y, Y1, G1, GR, SIDE, FLAG, ACT, P, HB, T0B, OMEGA,
+def _lanes_finish(STEP, nl, NPER, Y, Y1, G1, GR, SIDE, FLAG, ACT, P, LANE, HB, T0B, OMEGA,
                   locate, NCROSS, UNRES, ys, y1s, sides, g1s, work, ybuf, gbuf):
-    """Commit the trial step of the active lanes: the unflagged ones vectorised, the flagged
+    """Commit the trial step of the active slots: the unflagged ones vectorised, the flagged
     ones (a side left or a possible graze) one by one, with the crossings located
     (:func:`_split_step`) or, without ``locate``, counted at the step's end."""
     ns = Y.shape[0]
@@ -404,7 +420,7 @@ def _lanes_finish(i, first, nl, n_per, Y, Y1, G1, GR, SIDE, FLAG, ACT, P, HB, T0
     for k in range(nl):
         if FLAG[k] == 0.0 or not ACT[k]:
             continue
-        lane = first + k
+        lane = LANE[k]
         if not locate:
             for j in range(n_ev):
                 s_new = 1.0 if G1[j, k] > 0.0 else -1.0
@@ -421,8 +437,8 @@ def _lanes_finish(i, first, nl, n_per, Y, Y1, G1, GR, SIDE, FLAG, ACT, P, HB, T0
             sides[j] = 1 if SIDE[j, k] > 0.0 else -1
             g1s[j] = G1[j, k]
             gbuf[GRAZE_ROW, j] = GR[j, k]
-        UNRES[lane] += _split_step(i, T0B[k], ys, y1s, P[lane], HB[k], OMEGA[lane], n_per,
-                                   sides, g1s, NCROSS[lane], work, ybuf, gbuf)
+        UNRES[lane] += _split_step(STEP[k], T0B[k], ys, y1s, P[lane], HB[k], OMEGA[lane],
+                                   NPER[k], sides, g1s, NCROSS[lane], work, ybuf, gbuf)
         for q in range(ns):
             Y[q, k] = ys[q]
         for j in range(n_ev):
@@ -439,41 +455,68 @@ def _healthy_lane(Y, k, bound):
 
 
 @nb.njit(inline="always", **_JIT)
-def _next_due(step, nl, ACT, n_tr, next_sample):
-    """The next step at which some active lane of the block ends its transient, takes a
-    sample or ends (the per-lane bookkeeping runs only then and once a period)."""
-    due = np.iinfo(np.int64).max
+def _advance(nl, STEP, PHASE, NPER):
+    """One grid step on every slot's clock: its step count and its grid point in the period."""
     for k in range(nl):
-        if ACT[k]:
-            due = min(due, n_tr[k] if n_tr[k] > step else next_sample[k])
-    return due
+        STEP[k] += 1
+        ph = PHASE[k] + 1
+        PHASE[k] = 0 if ph == NPER[k] else ph
+
+
+@nb.njit(inline="always", **_JIT)
+def _write_out(k, lane, n_ev, n_obs, n_tr, GMIN, GMAX, OMAX, OMIN, OSQ, n_stat, status,
+               transient_steps, gmin, gmax, omax, omin, orms):
+    """The statistics of the lane that has ended in slot k, to its outputs."""
+    transient_steps[lane] = n_tr[k]
+    for j in range(n_ev):
+        gmin[lane, j] = GMIN[j, k]
+        gmax[lane, j] = GMAX[j, k]
+    for j in range(n_obs):
+        omax[lane, j] = OMAX[j, k]
+        omin[lane, j] = OMIN[j, k]
+        if n_stat[k] > 0 and status[lane] == STATUS_OK:
+            orms[lane, j] = np.sqrt(OSQ[j, k] / n_stat[k])
+        else:
+            orms[lane, j] = np.nan
 
 
 @nb.njit(**_JIT)
-def _sweep_block(first, nl, n_per, s_tab, c_tab, P, Y0, H, OMEGA, T0, n_transient,
-                 n_transient_max, conv_tol, conv_depth, n_samples, sample_every, locate, bound,
-                 n_ev, n_obs, samples, final, status, gmin, gmax, ncross, omax, omin, orms,
-                 unresolved, transient_steps, converged):
-    """One lockstep block of :func:`sweep`: lanes first..first+nl-1, all with n_per steps per
-    period (phase table s_tab, c_tab), in structure-of-arrays layout (see above)."""
+def _sweep_worker(w, lanes, cfg, sched, out):
+    """Worker w of :func:`sweep`: its queue of lanes through one block of refilling slots.
+    Slot arrays: LANE (the lane held), ACT (holds a running lane), END (to be refilled), STEP
+    (the lane's grid steps done), PHASE (its grid point in the period), NPER, OFF (its phase
+    table's offset), HB, T0B (step, start time), n_tr, n_end, next_sample, DUE (the next step
+    with bookkeeping: end of the transient or a sample), n_stat, n_ring (section points kept)."""
+    P, Y0, H, OMEGA, T0, n_transient, n_transient_max, sample_every = lanes
+    conv_tol, conv_depth, n_samples, locate, bound, n_ev, n_obs, width = cfg
+    start, queue, lane_nper, lane_tab, S_TAB, C_TAB = sched
+    (samples, final, status, gmin, gmax, ncross, omax, omin, orms, unresolved, transient_steps,
+     converged) = out
+    q0 = start[w]
+    q1 = start[w + 1]
+    nl = min(width, q1 - q0)
+    if nl <= 0:
+        return
     ns = Y0.shape[1]
     n_g = max(n_ev, 1)
+    n_o = max(n_obs, 1)
     depth = max(conv_depth, 1)
     R = np.zeros((nl, depth, ns))  # the last section points of the transient
     D = np.zeros((nl, 3 * depth, depth))  # their differences, per candidate period
-    n_ring = np.zeros(nl, np.int64)
-    Y = np.empty((ns, nl))
-    Y1 = np.empty((ns, nl))
-    K1 = np.empty((ns, nl))
-    K2 = np.empty((ns, nl))
-    K3 = np.empty((ns, nl))
-    K4 = np.empty((ns, nl))
-    TMP = np.empty((ns, nl))
-    PT = np.empty((P.shape[1], nl))
+    Y = np.zeros((ns, nl))
+    Y1 = np.zeros((ns, nl))
+    K1 = np.zeros((ns, nl))
+    K2 = np.zeros((ns, nl))
+    K3 = np.zeros((ns, nl))
+    K4 = np.zeros((ns, nl))
+    TMP = np.zeros((ns, nl))
+    PT = np.zeros((P.shape[1], nl))
     SC = np.zeros((8, nl))
-    TT = np.empty(nl)
-    HB = np.empty(nl)
-    T0B = np.empty(nl)
+    PH6 = np.zeros((6, nl))
+    PH = (PH6[0], PH6[1], PH6[2], PH6[3], PH6[4], PH6[5])
+    SO = np.zeros(nl)
+    CO = np.zeros(nl)
+    TT = np.zeros(nl)
     GP = np.full((n_g, nl), np.nan)  # events at the grid points i - 1, i, i + 1
     GS = np.zeros((n_g, nl))
     G1 = np.zeros((n_g, nl))
@@ -482,16 +525,26 @@ def _sweep_block(first, nl, n_per, s_tab, c_tab, P, Y0, H, OMEGA, T0, n_transien
     FLAG = np.zeros(nl)
     GMIN = np.full((n_g, nl), np.inf)
     GMAX = np.full((n_g, nl), -np.inf)
-    O = np.zeros((max(n_obs, 1), nl))
-    OMAX = np.full((max(n_obs, 1), nl), -np.inf)
-    OMIN = np.full((max(n_obs, 1), nl), np.inf)
-    OSQ = np.zeros((max(n_obs, 1), nl))
+    O = np.zeros((n_o, nl))
+    OMAX = np.full((n_o, nl), -np.inf)
+    OMIN = np.full((n_o, nl), np.inf)
+    OSQ = np.zeros((n_o, nl))
     STAT = np.zeros(nl, np.bool_)
-    ACT = np.ones(nl, np.bool_)
+    ACT = np.zeros(nl, np.bool_)
+    END = np.ones(nl, np.bool_)  # slots to (re)fill
+    LANE = np.zeros(nl, np.int64)
+    STEP = np.zeros(nl, np.int64)
+    PHASE = np.zeros(nl, np.int64)
+    NPER = np.ones(nl, np.int64)
+    OFF = np.zeros(nl, np.int64)
+    HB = np.zeros(nl)
+    T0B = np.zeros(nl)
     n_end = np.zeros(nl, np.int64)
     n_tr = np.zeros(nl, np.int64)
     next_sample = np.zeros(nl, np.int64)
+    DUE = np.zeros(nl, np.int64)
     n_stat = np.zeros(nl, np.int64)
+    n_ring = np.zeros(nl, np.int64)
     # the scalar path's scratch
     ys = np.zeros(ns)
     y1s = np.zeros(ns)
@@ -499,107 +552,132 @@ def _sweep_block(first, nl, n_per, s_tab, c_tab, P, Y0, H, OMEGA, T0, n_transien
     sides = np.ones(n_g, np.int64)
     g1s = np.zeros(n_g)
     gb = np.zeros(n_g)
-    ob = np.zeros(max(n_obs, 1))
+    ob = np.zeros(n_o)
     work = np.zeros((7, ns))
     ybuf = np.zeros(ns)
     gbuf = event_buffer(0, n_ev)
-    HW3 = np.empty((3, ns, nl))  # h/2, h, h/6 per (state, lane)
-    max_end = 0
-    for k in range(nl):
-        lane = first + k
-        for q in range(ns):
-            HW3[0, q, k] = 0.5 * H[lane]
-            HW3[1, q, k] = H[lane]
-            HW3[2, q, k] = H[lane] / 6.0
-        for j in range(P.shape[1]):
-            PT[j, k] = P[lane, j]
-        for q in range(ns):
-            Y[q, k] = Y0[lane, q]
-        HB[k] = H[lane]
-        T0B[k] = T0[lane]
-        TT[k] = T0[lane]
-        status[lane] = STATUS_OK
-        unresolved[lane] = 0
-        converged[lane] = 0 if conv_tol > 0.0 else -1
-        for j in range(n_ev):
-            ncross[lane, j] = 0
-        n_tr[k] = n_transient[lane]
-        n_end[k] = n_transient[lane] + n_samples * sample_every[lane]
-        next_sample[k] = n_transient[lane] + sample_every[lane]
-        max_end = max(max_end, n_end[k])
+    HW3 = np.zeros((3, ns, nl))  # h/2, h, h/6 per (state, slot)
     FL = (Y.reshape(ns * nl), Y1.reshape(ns * nl), K1.reshape(ns * nl), K2.reshape(ns * nl),
           K3.reshape(ns * nl), K4.reshape(ns * nl), TMP.reshape(ns * nl))
     HW = (HW3[0].reshape(ns * nl), HW3[1].reshape(ns * nl), HW3[2].reshape(ns * nl))
-    if n_ev > 0:
-        _events_lanes(TT, Y, GS, PT, P, first, nl, ybuf, gb)
-        for j in range(n_ev):
+    nxt = q0  # the next lane of the queue
+    n_act = 0  # slots holding a running lane
+    n_samp = 0  # of those, past their transient (or at its end): the statistics run
+    ended = True
+    while True:
+        if ended:  # (re)fill the ended slots from the queue: a lane starts at its grid step 0
+            ended = False
+            loaded = False
             for k in range(nl):
-                SIDE[j, k] = 1.0 if GS[j, k] > 0.0 else -1.0
-    min_tr = n_tr[0]
-    for k in range(nl):
-        min_tr = min(min_tr, n_tr[k])
-    due = _next_due(0, nl, ACT, n_tr, next_sample)
-    phase = 0  # grid point index within the period
-    i = -1
-    while i + 1 < max_end:
-        i += 1
-        j0 = 2 * phase
-        _lanes_rk4(i, first, nl, Y, Y1, K1, K2, K3, K4, TMP, FL, HW, TT, HB, T0B, PT, P, s_tab[j0],
-                   c_tab[j0], s_tab[j0 + 1], c_tab[j0 + 1], s_tab[j0 + 2], c_tab[j0 + 2], SC,
-                   ybuf, dbuf)
+                if not END[k]:
+                    continue
+                END[k] = False
+                if nxt >= q1:
+                    continue
+                lane = queue[nxt]
+                nxt += 1
+                loaded = True
+                n_act += 1
+                ACT[k] = True
+                LANE[k] = lane
+                STEP[k] = 0
+                PHASE[k] = 0
+                NPER[k] = lane_nper[lane]
+                OFF[k] = lane_tab[lane]
+                h = H[lane]
+                HB[k] = h
+                T0B[k] = T0[lane]
+                TT[k] = T0[lane]
+                PH6[4, k] = S_TAB[OFF[k]]  # the phase at the start (see _lanes_phase)
+                PH6[5, k] = C_TAB[OFF[k]]
+                for q in range(ns):
+                    HW3[0, q, k] = 0.5 * h
+                    HW3[1, q, k] = h
+                    HW3[2, q, k] = h / 6.0
+                    Y[q, k] = Y0[lane, q]
+                for j in range(P.shape[1]):
+                    PT[j, k] = P[lane, j]
+                status[lane] = STATUS_OK
+                unresolved[lane] = 0
+                converged[lane] = 0 if conv_tol > 0.0 else -1
+                for j in range(n_ev):
+                    ncross[lane, j] = 0
+                n_tr[k] = n_transient[lane]
+                n_end[k] = n_transient[lane] + n_samples * sample_every[lane]
+                next_sample[k] = n_transient[lane] + sample_every[lane]
+                DUE[k] = n_tr[k] if n_tr[k] > 0 else next_sample[k]
+                n_stat[k] = 0
+                n_ring[k] = 0
+                for j in range(n_g):
+                    GP[j, k] = np.nan
+                    GMIN[j, k] = np.inf
+                    GMAX[j, k] = -np.inf
+                for j in range(n_o):
+                    OMAX[j, k] = -np.inf
+                    OMIN[j, k] = np.inf
+                    OSQ[j, k] = 0.0
+                R[k] = 0.0
+                D[k] = 0.0
+            if loaded and n_ev > 0:  # the events at the new lanes' start (G1: scratch here)
+                _events_lanes(TT, Y, G1, PT, P, LANE, nl, ybuf, gb)
+                for k in range(nl):
+                    if ACT[k] and STEP[k] == 0:
+                        for j in range(n_ev):
+                            GS[j, k] = G1[j, k]
+                            SIDE[j, k] = 1.0 if G1[j, k] > 0.0 else -1.0
+        if n_act == 0:
+            break
+        # one grid step of every slot
+        _lanes_phase(nl, OFF, PHASE, S_TAB, C_TAB, PH)
+        _lanes_rk4(STEP, nl, Y, Y1, K1, K2, K3, K4, TMP, FL, HW, TT, HB, T0B, PT, P, LANE, PH,
+                   SC, ybuf, dbuf)
         if n_ev > 0:
-            _events_lanes(TT, Y1, G1, PT, P, first, nl, ybuf, gb)
+            _events_lanes(TT, Y1, G1, PT, P, LANE, nl, ybuf, gb)
             _lanes_screen(nl, G1, GS, GP, SIDE, GR, FLAG, locate)
-        _lanes_finish(i, first, nl, n_per, Y, Y1, G1, GR, SIDE, FLAG, ACT, P, HB, T0B, OMEGA,
+        _lanes_finish(STEP, nl, NPER, Y, Y1, G1, GR, SIDE, FLAG, ACT, P, LANE, HB, T0B, OMEGA,
                       locate, ncross, unresolved, ys, y1s, sides, g1s, work, ybuf, gbuf)
         GP, GS, G1 = GS, G1, GP  # history of the grid values: g_{i}, g_{i+1}
-        step = i + 1
-        phase += 1
-        if phase == n_per:
-            phase = 0
-        if phase == 0 or step >= due:
+        _advance(nl, STEP, PHASE, NPER)
+        due = False
+        for k in range(nl):
+            due |= ACT[k] & ((PHASE[k] == 0) | (STEP[k] >= DUE[k]))
+        if due:
             for k in range(nl):  # health, end of the transient
-                if not ACT[k]:
+                if not ACT[k] or not (PHASE[k] == 0 or STEP[k] >= DUE[k]):
                     continue
-                lane = first + k
-                if (phase == 0 or step == n_end[k]) and not _healthy_lane(Y, k, bound):
+                lane = LANE[k]
+                step = STEP[k]
+                if (PHASE[k] == 0 or step == n_end[k]) and not _healthy_lane(Y, k, bound):
                     status[lane] = STATUS_DIVERGED
                     ACT[k] = False
+                    END[k] = True
+                    ended = True
+                    n_act -= 1
+                    n_samp -= 1 if step > n_tr[k] else 0
                     for r in range(n_samples):
                         for q in range(ns):
                             samples[lane, r, q] = np.nan
                     for q in range(ns):
                         final[lane, q] = np.nan
+                    _write_out(k, lane, n_ev, n_obs, n_tr, GMIN, GMAX, OMAX, OMIN, OSQ, n_stat,
+                               status, transient_steps, gmin, gmax, omax, omin, orms)
                     continue
-                if step != n_tr[k]:
-                    continue
-                if conv_tol > 0.0 and converged[lane] == 0:
-                    every = sample_every[lane]
-                    for q in range(ns):
-                        ys[q] = Y[q, k]
-                    _section_diffs(ys, R[k], n_ring[k], D[k])
-                    if _settled(ys, D[k], n_ring[k], conv_tol):
-                        converged[lane] = 1
-                    elif n_tr[k] + every <= n_transient_max[lane]:
-                        # not settled yet: one more section period of transient
-                        slot = n_ring[k] % R.shape[1]
-                        for q in range(ns):
-                            R[k, slot, q] = ys[q]
-                        n_ring[k] += 1
-                        n_tr[k] += every
-                        n_end[k] += every
-                        next_sample[k] += every
-                        max_end = max(max_end, n_end[k])
-                        continue
-                for j in range(n_ev):
-                    ncross[lane, j] = 0
-            due = _next_due(step, nl, ACT, n_tr, next_sample)
-        if step <= min_tr:
+                if step == n_tr[k]:
+                    _transient_end(k, lane, Y, ys, R, D, n_ring, n_tr, n_end, next_sample,
+                                   conv_tol, converged, sample_every, n_transient_max, ncross,
+                                   n_ev)
+                    n_samp += 1 if step == n_tr[k] else 0  # not extended: sampling starts
+                DUE[k] = n_tr[k] if n_tr[k] > step else next_sample[k]
+        # statistics over the sampled stretch, vectorised over the slots
+        if n_samp == 0:
             continue
-        # statistics over the sampled stretch, vectorised over the block's lanes
+        sampling = False
         for k in range(nl):
-            STAT[k] = ACT[k] and step > n_tr[k]
+            STAT[k] = ACT[k] & (STEP[k] > n_tr[k])
             n_stat[k] += 1 if STAT[k] else 0
+            sampling |= STAT[k]
+        if not sampling:
+            continue
         for j in range(n_ev):
             for k in range(nl):
                 g = GS[j, k]
@@ -607,83 +685,98 @@ def _sweep_block(first, nl, n_per, s_tab, c_tab, P, Y0, H, OMEGA, T0, n_transien
                 GMAX[j, k] = max(GMAX[j, k], g) if STAT[k] else GMAX[j, k]
         if n_obs > 0:
             for k in range(nl):
-                TT[k] = T0B[k] + step * HB[k]
-            _observe_lanes(TT, Y, O, PT, P, first, nl, s_tab[2 * phase], c_tab[2 * phase], SC,
-                           ybuf, ob)
+                TT[k] = T0B[k] + STEP[k] * HB[k]
+                j = OFF[k] + 2 * PHASE[k]
+                SO[k] = S_TAB[j]
+                CO[k] = C_TAB[j]
+            _observe_lanes(TT, Y, O, PT, P, LANE, nl, SO, CO, SC, ybuf, ob)
             for j in range(n_obs):
                 for k in range(nl):
                     v = O[j, k]
                     OMAX[j, k] = max(OMAX[j, k], v) if STAT[k] else OMAX[j, k]
                     OMIN[j, k] = min(OMIN[j, k], v) if STAT[k] else OMIN[j, k]
                     OSQ[j, k] = OSQ[j, k] + v * v if STAT[k] else OSQ[j, k]
-        if step >= due:
-            for k in range(nl):  # samples, end
-                if not STAT[k]:
-                    continue
-                lane = first + k
-                if step == next_sample[k]:
-                    r = (step - n_tr[k]) // sample_every[lane] - 1
-                    for q in range(ns):
-                        samples[lane, r, q] = Y[q, k]
-                    next_sample[k] += sample_every[lane]
-                if step == n_end[k]:
-                    ACT[k] = False
-                    for q in range(ns):
-                        final[lane, q] = Y[q, k]
-            due = _next_due(step, nl, ACT, n_tr, next_sample)
-    for k in range(nl):
-        lane = first + k
-        transient_steps[lane] = n_tr[k]
-        for j in range(n_ev):
-            gmin[lane, j] = GMIN[j, k]
-            gmax[lane, j] = GMAX[j, k]
-        for j in range(n_obs):
-            omax[lane, j] = OMAX[j, k]
-            omin[lane, j] = OMIN[j, k]
-            if n_stat[k] > 0 and status[lane] == STATUS_OK:
-                orms[lane, j] = np.sqrt(OSQ[j, k] / n_stat[k])
-            else:
-                orms[lane, j] = np.nan
+        due = False
+        for k in range(nl):
+            due |= STAT[k] & (STEP[k] >= DUE[k])
+        if not due:
+            continue
+        for k in range(nl):  # samples, end
+            if not STAT[k] or STEP[k] < DUE[k]:
+                continue
+            lane = LANE[k]
+            step = STEP[k]
+            if step == next_sample[k]:
+                r = (step - n_tr[k]) // sample_every[lane] - 1
+                for q in range(ns):
+                    samples[lane, r, q] = Y[q, k]
+                next_sample[k] += sample_every[lane]
+            DUE[k] = next_sample[k]
+            if step == n_end[k]:
+                ACT[k] = False
+                END[k] = True
+                ended = True
+                n_act -= 1
+                n_samp -= 1
+                for q in range(ns):
+                    final[lane, q] = Y[q, k]
+                _write_out(k, lane, n_ev, n_obs, n_tr, GMIN, GMAX, OMAX, OMIN, OSQ, n_stat,
+                           status, transient_steps, gmin, gmax, omax, omin, orms)
+
+
+@nb.njit(inline="always", **_JIT)
+def _transient_end(k, lane, Y, ys, R, D, n_ring, n_tr, n_end, next_sample, conv_tol, converged,
+                   sample_every, n_transient_max, ncross, n_ev):
+    """Slot k's lane has reached the end of its transient: with the convergence test on and the
+    lane not settled yet (:func:`_settled`), one more section period of transient (up to the
+    limit); else the sampled stretch starts (its crossing counts from 0)."""
+    if conv_tol > 0.0 and converged[lane] == 0:
+        every = sample_every[lane]
+        for q in range(ys.size):
+            ys[q] = Y[q, k]
+        _section_diffs(ys, R[k], n_ring[k], D[k])
+        if _settled(ys, D[k], n_ring[k], conv_tol):
+            converged[lane] = 1
+        elif n_tr[k] + every <= n_transient_max[lane]:
+            slot = n_ring[k] % R.shape[1]
+            for q in range(ys.size):
+                R[k, slot, q] = ys[q]
+            n_ring[k] += 1
+            n_tr[k] += every
+            n_end[k] += every
+            next_sample[k] += every
+            return
+    for j in range(n_ev):
+        ncross[lane, j] = 0
 
 
 @nb.njit(parallel=True, **_JIT)
-def sweep(P, Y0, H, OMEGA, T0, n_transient, n_transient_max, conv_tol, conv_depth, n_samples,
-          sample_every, locate, bound, n_ev, n_obs, block_first, block_nl, block_nper,
-          block_tab, S_TAB, C_TAB, worker_start, worker_blocks, samples, final, status, gmin,
-          gmax, ncross, omax, omin, orms, unresolved, transient_steps, converged):
-    """Integrate every lane from time T0[lane] (a whole number of forcing periods):
-    ``n_transient[lane]`` grid steps, then ``n_samples`` section samples, one every
-    ``sample_every[lane]`` grid steps, with statistics over the sampled stretch.
+def sweep(lanes, cfg, work_queues, out):
+    """Integrate every lane l from time T0[l] (a whole number of forcing periods):
+    ``n_transient[l]`` grid steps, then ``n_samples`` section samples, one every
+    ``sample_every[l]`` grid steps, with statistics over the sampled stretch. Arguments:
+    :class:`~geardyn.core.kernel_args.LaneInputs`, ``SweepConfig``, ``Schedule`` and
+    ``LaneOutputs`` (preallocated, filled here).
 
     With ``conv_tol > 0`` the transient goes on, one section period at a time up to
-    ``n_transient_max[lane]`` steps, until the section point is estimated within
+    ``n_transient_max[l]`` steps, until the section point is estimated within
     conv_tol (1 + |point|) of a periodic orbit of period k <= ``conv_depth`` sections: from the
     contraction of the differences |x_n - x_{n-k}| over successive k sections (see
     :func:`_settled`; a slowly attracting orbit, Floquet multiplier near +-1, needs the longer
-    transient it takes); converged[lane] is 1 then, 0 if the limit came first, -1 without the
-    test; transient_steps[lane] is the transient used.
+    transient it takes); converged[l] is 1 then, 0 if the limit came first, -1 without the
+    test; transient_steps[l] is the transient used.
 
-    Lanes are grouped in lockstep blocks (block b: lanes block_first[b] ... + block_nl[b], all
-    with block_nper[b] steps per period and the phase table S_TAB/C_TAB[block_tab[b]:]); worker
-    w runs blocks worker_blocks[worker_start[w]:worker_start[w + 1]] (a static, cost-balanced
-    schedule made by the caller). Lanes are independent, so results do not depend on blocking,
-    order or threads.
+    Worker w (in parallel, ``prange``) runs the lanes queue[start[w]:start[w + 1]] (a static,
+    cost-balanced schedule made by the caller) through one block of ``width`` slots that are
+    refilled from the queue as lanes end (see above). Lanes are independent, so results do not
+    depend on the schedule, the width or the threads.
 
-    Outputs (preallocated, filled here): samples[L, n_samples, ns] (NaN where diverged),
-    final[L, ns], status[L], gmin/gmax[L, n_ev] (extremes of the events at grid points),
-    ncross[L, n_ev] (edge crossings while sampling), omax/omin/orms[L, n_obs] (extremes and RMS
-    of the observables at grid points), unresolved[L] (steps that reached the split limit).
-    A block runs in lockstep to its longest lane; a lane that has ended or diverged is frozen
-    (no further steps, crossings or statistics).
+    Outputs: samples[L, n_samples, ns] (NaN where diverged), final[L, ns], status[L],
+    gmin/gmax[L, n_ev] (extremes of the events at grid points), ncross[L, n_ev] (edge crossings
+    while sampling), omax/omin/orms[L, n_obs] (extremes and RMS of the observables at grid
+    points), unresolved[L] (steps that reached the split limit). A lane that diverges stops
+    there (no further steps, crossings or statistics).
     """
-    n_workers = worker_start.size - 1
+    n_workers = work_queues.start.size - 1  # (not named ``sched``: numba's parfor uses it)
     for w in nb.prange(n_workers):
-        for b in range(worker_start[w], worker_start[w + 1]):
-            blk = worker_blocks[b]
-            n_per = block_nper[blk]
-            o = block_tab[blk]
-            _sweep_block(block_first[blk], block_nl[blk], n_per, S_TAB[o : o + 2 * n_per + 1],
-                         C_TAB[o : o + 2 * n_per + 1], P, Y0, H, OMEGA, T0, n_transient,
-                         n_transient_max, conv_tol, conv_depth, n_samples, sample_every, locate,
-                         bound, n_ev, n_obs, samples, final, status, gmin, gmax, ncross, omax,
-                         omin, orms, unresolved, transient_steps, converged)
+        _sweep_worker(w, lanes, cfg, work_queues, out)

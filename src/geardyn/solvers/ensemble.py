@@ -2,9 +2,10 @@
 
 :func:`run_lanes` is the engine under every sweep. Each lane integrates the model with its own
 coefficient vector for a transient (a time, rounded up to whole forcing periods of that lane),
-then records stroboscopic samples and statistics. Lanes sharing a number of steps per period run
-in one parallel kernel call; within it, lanes are advanced in lockstep blocks (see
-``_kernel_template``). Results do not depend on how lanes are grouped or on the thread count.
+then records stroboscopic samples and statistics. All lanes run in one parallel kernel call: each
+worker advances its queue of lanes (whatever their steps per period) through a block of
+refilling slots (see ``_kernel_template``). Results do not depend on the schedule, the block
+width or the thread count.
 The settings come as one :class:`~geardyn.core.settings.RunSettings`; every step count is
 derived once by :class:`~geardyn.core.plan.LanePlan` (:func:`run_plan` runs a given plan).
 """
@@ -15,6 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from geardyn.core.kernel_args import LaneInputs, LaneOutputs, Schedule, SweepConfig
 from geardyn.core.plan import (  # noqa: F401  (the step rule's old home)
     _LADDER,
     LanePlan,
@@ -117,8 +119,11 @@ def run_lanes(
 
 
 def run_plan(model: Model, P: np.ndarray, y0: np.ndarray, plan: LanePlan,
-             converge_depth: int = 16) -> LaneResults:
-    """Run the lanes ``P`` from ``y0`` as ``plan`` says (see :func:`run_lanes`)."""
+             converge_depth: int = 16, *, width: int | None = None,
+             workers: int | None = None) -> LaneResults:
+    """Run the lanes ``P`` from ``y0`` as ``plan`` says (see :func:`run_lanes`). ``width``:
+    slots per worker's block (default the kernel's ``BLOCK``), ``workers``: parallel workers
+    (default numba's thread count); neither changes a lane's result, bit for bit."""
     if converge_depth < 1:
         raise ValueError(f"converge_depth must be >= 1 (got {converge_depth!r})")
     P = np.ascontiguousarray(np.atleast_2d(P), dtype=float)
@@ -127,7 +132,7 @@ def run_plan(model: Model, P: np.ndarray, y0: np.ndarray, plan: LanePlan,
     Y0 = np.ascontiguousarray(np.broadcast_to(np.asarray(y0, dtype=float), (L, ns)))
     run = plan.settings
     samples = run.samples
-    n_lane, period, every = plan.steps_per_period, plan.period, plan.sample_every
+    n_lane = np.ascontiguousarray(plan.steps_per_period, dtype=np.int64)
     n_ev, n_obs = model.n_events, model.n_observables
     k = kernels_for(model.kernel)
     out = LaneResults(
@@ -142,55 +147,41 @@ def run_plan(model: Model, P: np.ndarray, y0: np.ndarray, plan: LanePlan,
         obs_min=np.zeros((L, n_obs)),
         obs_rms=np.zeros((L, n_obs)),
         unresolved=np.zeros(L, np.int64),
-        steps_per_period=n_lane,
+        steps_per_period=plan.steps_per_period,
         transient_periods=plan.transient_periods.copy(),
         converged=np.full(L, -1, np.int64),
-        sample_every=every.copy(),
+        sample_every=plan.sample_every.copy(),
         commensurate=plan.commensurate.copy(),
     )
-    # lanes sorted by steps per period, then period: a lockstep block holds lanes of one step
-    # count and similar length
-    order = np.lexsort((period, n_lane))
-    sched = _schedule(n_lane[order], plan.total_periods[order], k.BLOCK)
-    tr_steps = np.empty(L, np.int64)
-    conv = np.empty(L, np.int64)
-    s_tab, c_tab, tab_of = _phase_tables(k, n_lane)
-    smp = np.empty((L, samples, ns))
-    fin = np.empty((L, ns))
-    st = np.empty(L, np.int64)
-    gmin = np.empty((L, n_ev))
-    gmax = np.empty((L, n_ev))
-    nc = np.empty((L, n_ev), np.int64)
-    omax = np.empty((L, n_obs))
-    omin = np.empty((L, n_obs))
-    orms = np.empty((L, n_obs))
-    unres = np.empty(L, np.int64)
-    first, nl, nper, w_start, w_blocks = sched
-    k.sweep(P[order], Y0[order], plan.step[order], plan.omega[order], plan.t0[order],
-            plan.transient_steps[order], plan.transient_max_steps[order],
-            float(run.converge_tol), int(converge_depth), int(samples),
-            plan.sample_steps[order], bool(run.locate_edges), float(run.bound), n_ev,
-            n_obs, first, nl, nper, np.array([tab_of[int(n)] for n in nper], np.int64),
-            s_tab, c_tab, w_start, w_blocks, smp, fin, st, gmin, gmax, nc, omax, omin, orms,
-            unres, tr_steps, conv)
-    out.samples[order] = smp
-    out.final[order] = fin
-    out.status[order] = st
-    out.event_min[order] = gmin
-    out.event_max[order] = gmax
-    out.crossings[order] = nc
-    out.obs_max[order] = omax
-    out.obs_min[order] = omin
-    out.obs_rms[order] = orms
-    out.unresolved[order] = unres
-    out.converged[order] = conv
-    out.transient_periods[order] = tr_steps // n_lane[order]
+    tr_steps = np.zeros(L, np.int64)
+    s_tab, c_tab, lane_tab = _phase_tables(k, n_lane)
+    start, queue = _schedule(plan.total_periods * n_lane, workers)
+
+    def lane_array(x, dtype):
+        return np.ascontiguousarray(x, dtype=dtype)
+
+    lanes = LaneInputs(P, Y0, lane_array(plan.step, float), lane_array(plan.omega, float),
+                       lane_array(plan.t0, float), lane_array(plan.transient_steps, np.int64),
+                       lane_array(plan.transient_max_steps, np.int64),
+                       lane_array(plan.sample_steps, np.int64))
+    cfg = SweepConfig(float(run.converge_tol), int(converge_depth), int(samples),
+                      bool(run.locate_edges), float(run.bound), int(n_ev), int(n_obs),
+                      int(width or k.BLOCK))
+    if cfg.width < 1:
+        raise ValueError(f"width must be >= 1 (got {width!r})")
+    sched = Schedule(start, queue, n_lane, lane_tab, s_tab, c_tab)
+    res = LaneOutputs(out.samples, out.final, out.status, out.event_min, out.event_max,
+                      out.crossings, out.obs_max, out.obs_min, out.obs_rms, out.unresolved,
+                      tr_steps, out.converged)
+    k.sweep(lanes, cfg, sched, res)
+    out.transient_periods = tr_steps // n_lane
     out.final_time = plan.final_time(out.transient_periods)
     return out
 
 
 def _phase_tables(k, n_lane: np.ndarray):
-    """Concatenated forcing-phase tables of every distinct step count, and their offsets."""
+    """Concatenated forcing-phase tables of every distinct step count, and each lane's offset
+    into them."""
     s_parts, c_parts, offset, pos = [], [], {}, 0
     for n in np.unique(n_lane):
         s, c = k.phase_table(int(n), True)
@@ -198,36 +189,26 @@ def _phase_tables(k, n_lane: np.ndarray):
         s_parts.append(s)
         c_parts.append(c)
         pos += s.size
-    return np.concatenate(s_parts), np.concatenate(c_parts), offset
+    lane_tab = np.array([offset[int(n)] for n in n_lane], np.int64)
+    return np.concatenate(s_parts), np.concatenate(c_parts), lane_tab
 
 
-def _schedule(n_per: np.ndarray, periods: np.ndarray, block: int, workers: int | None = None):
-    """Lockstep blocks over lanes (already sorted by step count) and a cost-balanced static
-    assignment of blocks to workers (longest block first to the least loaded worker).
-
-    Returns (block_first, block_nl, block_nper, worker_start, worker_blocks)."""
+def _schedule(cost: np.ndarray, workers: int | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """A cost-balanced static schedule of lanes (``cost``: lane-steps of each) over workers:
+    lanes longest first, dealt to the workers back and forth (1, 2, .., w, w, .., 1, 1, ..), so
+    that each worker's total is about the same and its queue runs longest first (the block's
+    tail is short lanes). Returns (start, queue): worker w takes the lanes
+    queue[start[w]:start[w + 1]] in that order."""
     import numba
 
-    workers = workers or numba.get_num_threads()
-    first, nl, nper, cost = [], [], [], []
-    L = n_per.size
-    a = 0
-    while a < L:
-        b = a + 1
-        while b < L and b - a < block and n_per[b] == n_per[a]:
-            b += 1
-        first.append(a)
-        nl.append(b - a)
-        nper.append(int(n_per[a]))
-        cost.append(float(np.max(periods[a:b])) * int(n_per[a]) * (b - a + block) / 2)
-        a = b
-    load = np.zeros(workers)
-    assigned: list[list[int]] = [[] for _ in range(workers)]
-    for blk in np.argsort(cost, kind="stable")[::-1]:
-        w = int(np.argmin(load))
-        assigned[w].append(int(blk))
-        load[w] += cost[blk]
-    start = np.cumsum([0] + [len(x) for x in assigned]).astype(np.int64)
-    blocks = np.array([b for x in assigned for b in x], dtype=np.int64)
-    return (np.array(first, np.int64), np.array(nl, np.int64), np.array(nper, np.int64), start,
-            blocks)
+    L = cost.size
+    workers = max(1, min(int(workers or numba.get_num_threads()), L))
+    order = np.argsort(-np.asarray(cost, dtype=float), kind="stable")
+    pos = np.arange(L)
+    rnd, col = np.divmod(pos, workers)
+    worker = np.where(rnd % 2 == 0, col, workers - 1 - col)
+    by_worker = np.argsort(worker, kind="stable")  # keeps the longest-first order per worker
+    queue = order[by_worker].astype(np.int64)
+    start = np.zeros(workers + 1, np.int64)
+    start[1:] = np.cumsum(np.bincount(worker, minlength=workers))
+    return start, queue

@@ -1,0 +1,84 @@
+"""The sweep kernel's refilling slots: a worker's block holds lanes of every step count at once,
+each slot with its own step, phase and phase table, and takes the next lane of its queue when
+one ends. A lane's arithmetic is the scalar kernel's whatever its slot, neighbours, worker, the
+block width or the queue's order, so every result is bitwise the same, and equal to the
+one-lane path (``trajectory``, under :func:`geardyn.simulate`)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import geardyn
+from geardyn.core.plan import LanePlan
+from geardyn.core.settings import RunSettings
+from geardyn.solvers.ensemble import LaneResults, _schedule, run_plan
+
+_FIELDS = [f for f in LaneResults.__dataclass_fields__ if f != "final_time"]
+
+
+def _lanes(n_lanes: int = 23):
+    """Gear-pair lanes with five step counts, different transients (so lanes end, and slots
+    refill, at different steps) and a bound that some lanes near resonance exceed."""
+    model = geardyn.GearPair(zeta=0.05, kappa=0.2, Fm=0.1, Fa=0.2)
+    omega = np.linspace(0.3, 3.0, n_lanes)
+    P = model.lane_params("Omega", omega)
+    n_per = np.array([64, 128, 96, 256, 80])[np.arange(n_lanes) % 5]
+    transient = (5 + np.arange(n_lanes) * 7 % 31) * 2 * math.pi / omega
+    return model, P, n_per, transient
+
+
+def _run(model, P, n_per, transient, run, **kw) -> LaneResults:
+    plan = LanePlan.build(model, P, run, transient=transient, steps_per_period=n_per,
+                          sample_every=1)
+    return run_plan(model, P, model.initial_state(), plan, **kw)
+
+
+def _assert_same(a: LaneResults, b: LaneResults, index=slice(None)) -> None:
+    for f in _FIELDS:
+        np.testing.assert_array_equal(getattr(a, f)[index], getattr(b, f), err_msg=f)
+
+
+@pytest.mark.parametrize("converge", [None, 1e-6])
+def test_results_do_not_depend_on_width_workers_or_queue_order(converge):
+    model, P, n_per, transient = _lanes()
+    run = RunSettings(samples=6, bound=1.1, converge=converge,
+                      transient_max=None if converge is None else 200.0)
+    ref = _run(model, P, n_per, transient, run)
+    assert len(set(n_per)) == 5
+    assert np.any(ref.status == 1) and np.any(ref.status == 0)  # some lanes diverge
+    assert np.all(ref.crossings.sum(axis=1) >= 0) and ref.crossings.sum() > 0
+    if converge is not None:
+        assert np.any(ref.converged == 1)
+    for width, workers in ((5, 3), (1, 1), (64, 1), (3, 7)):
+        _assert_same(ref, _run(model, P, n_per, transient, run, width=width, workers=workers))
+    perm = np.random.default_rng(3).permutation(P.shape[0])
+    got = _run(model, P[perm], n_per[perm], transient[perm], run, width=4, workers=2)
+    _assert_same(ref, got, perm)
+
+
+def test_lanes_equal_the_one_lane_path_bitwise():
+    model, P, n_per, transient = _lanes(11)
+    run = RunSettings(samples=6)
+    r = _run(model, P, n_per, transient, run, width=4, workers=2)
+    assert np.all(r.status == 0)
+    omega = P[:, 0]
+    for j in (0, 3, 7, 10):
+        ds = geardyn.simulate(model, omega=float(omega[j]), transient=float(transient[j]),
+                              periods=6, steps_per_period=int(n_per[j]))
+        np.testing.assert_array_equal(r.samples[j], ds["poincare"].values[1:])
+
+
+def test_schedule_balances_lane_steps_and_runs_longest_first():
+    cost = np.random.default_rng(0).integers(1, 1000, 301).astype(float)
+    start, queue = _schedule(cost, workers=4)
+    assert np.array_equal(np.sort(queue), np.arange(cost.size))
+    loads = [cost[queue[start[w]:start[w + 1]]].sum() for w in range(4)]
+    assert max(loads) - min(loads) <= cost.max()
+    for w in range(4):
+        q = cost[queue[start[w]:start[w + 1]]]
+        assert np.all(np.diff(q) <= 0)
+    start, queue = _schedule(cost[:2], workers=8)  # no more workers than lanes
+    assert start.size == 3 and sorted(queue) == [0, 1]
