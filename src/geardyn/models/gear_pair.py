@@ -16,7 +16,7 @@ import numba as nb
 import numpy as np
 
 from geardyn.models.base import Model
-from geardyn.solvers.kernels import KernelSource
+from geardyn.core.kernel_source import KernelSource
 
 _JIT = {"cache": True, "error_model": "numpy", "boundscheck": False}
 OMEGA, ZETA, KAPPA, FM, FA, PHI_K, PHI_E, BACKLASH = range(8)
