@@ -15,8 +15,8 @@ import math
 import numba as nb
 import numpy as np
 
-from geardyn.models.base import Model
 from geardyn.core.kernel_source import KernelSource
+from geardyn.models.base import Model
 
 _JIT = {"cache": True, "error_model": "numpy", "boundscheck": False}
 OMEGA, ZETA, KAPPA, FM, FA, PHI_K, PHI_E, BACKLASH = range(8)
