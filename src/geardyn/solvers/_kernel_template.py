@@ -606,6 +606,7 @@ def _sweep_worker(w, lanes, cfg, sched, out):
                 n_end[k] = n_transient[lane] + n_samples * sample_every[lane]
                 next_sample[k] = n_transient[lane] + sample_every[lane]
                 DUE[k] = n_tr[k] if n_tr[k] > 0 else next_sample[k]
+                n_samp += 1 if n_tr[k] == 0 else 0  # no transient: it samples from step 0
                 n_stat[k] = 0
                 n_ring[k] = 0
                 for j in range(n_g):
