@@ -560,6 +560,32 @@ def _sweep_worker(w, lanes, cfg, sched, out):
     FL = (Y.reshape(ns * nl), Y1.reshape(ns * nl), K1.reshape(ns * nl), K2.reshape(ns * nl),
           K3.reshape(ns * nl), K4.reshape(ns * nl), TMP.reshape(ns * nl))
     HW = (HW3[0].reshape(ns * nl), HW3[1].reshape(ns * nl), HW3[2].reshape(ns * nl))
+    blk = (R, D, Y, Y1, K1, K2, K3, K4, TMP, PT, SC, PH6, PH, SO, CO, TT, GP, GS, G1, GR, SIDE,
+           FLAG, GMIN, GMAX, O, OMAX, OMIN, OSQ, HW3, FL, HW)
+    slots = (STAT, ACT, END, LANE, STEP, PHASE, NPER, OFF, HB, T0B, n_end, n_tr, next_sample,
+             DUE, n_stat, n_ring)
+    scratch = (ys, y1s, dbuf, sides, g1s, gb, ob, work, ybuf, gbuf)
+    _block_run(q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch)
+
+
+@nb.njit(_nrt=False, **_JIT)
+def _block_run(q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch):
+    """The block loop of :func:`_sweep_worker` (its arrays allocated there). Compiled without
+    reference counting (``_nrt=False``: it allocates nothing), so that passing the block's
+    arrays to the inlined helpers and rotating the event history cost no atomic increments."""
+    P, Y0, H, OMEGA, T0, n_transient, n_transient_max, sample_every = lanes
+    conv_tol, conv_depth, n_samples, locate, bound, n_ev, n_obs, width = cfg
+    start, queue, lane_nper, lane_tab, S_TAB, C_TAB = sched
+    (samples, final, status, gmin, gmax, ncross, omax, omin, orms, unresolved, transient_steps,
+     converged) = out
+    (R, D, Y, Y1, K1, K2, K3, K4, TMP, PT, SC, PH6, PH, SO, CO, TT, GP, GS, G1, GR, SIDE, FLAG,
+     GMIN, GMAX, O, OMAX, OMIN, OSQ, HW3, FL, HW) = blk
+    (STAT, ACT, END, LANE, STEP, PHASE, NPER, OFF, HB, T0B, n_end, n_tr, next_sample, DUE,
+     n_stat, n_ring) = slots
+    ys, y1s, dbuf, sides, g1s, gb, ob, work, ybuf, gbuf = scratch
+    ns = Y0.shape[1]
+    n_g = GP.shape[0]
+    n_o = O.shape[0]
     nxt = q0  # the next lane of the queue
     n_act = 0  # slots holding a running lane
     n_samp = 0  # of those, past their transient (or at its end): the statistics run
