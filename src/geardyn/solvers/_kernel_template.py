@@ -345,13 +345,14 @@ def _lanes_phase(nl, OFF, PHASE, S_TAB, C_TAB, PH):
     concatenated tables."""
     SA, CA, SB, CB, SE, CE = PH
     for k in range(nl):
-        j = OFF[k] + 2 * PHASE[k]
+        j1 = np.uint64(OFF[k] + 2 * PHASE[k] + 1)  # unsigned: no wraparound test, a gather
+        j2 = np.uint64(OFF[k] + 2 * PHASE[k] + 2)
         SA[k] = SE[k]
         CA[k] = CE[k]
-        SB[k] = S_TAB[j + 1]
-        CB[k] = C_TAB[j + 1]
-        SE[k] = S_TAB[j + 2]
-        CE[k] = C_TAB[j + 2]
+        SB[k] = S_TAB[j1]
+        CB[k] = C_TAB[j1]
+        SE[k] = S_TAB[j2]
+        CE[k] = C_TAB[j2]
 
 
 @nb.njit(inline="always", **_JIT)
@@ -409,41 +410,61 @@ def _lanes_screen(nl, G1, GS, GP, SIDE, GR, FLAG, locate):
 @nb.njit(inline="always", **_JIT)
 def _lanes_finish(STEP, nl, NPER, Y, Y1, G1, GR, SIDE, FLAG, ACT, P, LANE, HB, T0B, OMEGA,
                   locate, NCROSS, UNRES, ys, y1s, sides, g1s, work, ybuf, gbuf):
-    """Commit the trial step of the active slots: the unflagged ones vectorised, the flagged
-    ones (a side left or a possible graze) one by one, with the crossings located
-    (:func:`_split_step`) or, without ``locate``, counted at the step's end."""
+    """Commit the trial step of the active slots: the unflagged ones vectorised (a select of
+    values loaded unconditionally, so that no branch stops the vectoriser), the flagged ones (a
+    side left or a possible graze) one by one (:func:`_finish_flagged`). FLAG[k] is 1 on
+    return where slot k was flagged and active, else 0."""
     ns = Y.shape[0]
-    n_ev = G1.shape[0]
+    n_flag = 0
+    for k in range(nl):
+        flagged = ACT[k] & (FLAG[k] != 0.0)
+        FLAG[k] = 1.0 if flagged else 0.0
+        n_flag += 1 if flagged else 0
     for q in range(ns):
         for k in range(nl):
-            Y[q, k] = Y1[q, k] if ACT[k] and FLAG[k] == 0.0 else Y[q, k]
+            a = Y1[q, k]
+            b = Y[q, k]
+            Y[q, k] = a if (ACT[k] & (FLAG[k] == 0.0)) else b
+    if n_flag == 0:
+        return
     for k in range(nl):
-        if FLAG[k] == 0.0 or not ACT[k]:
-            continue
-        lane = LANE[k]
-        if not locate:
-            for j in range(n_ev):
-                s_new = 1.0 if G1[j, k] > 0.0 else -1.0
-                if s_new != SIDE[j, k]:
-                    SIDE[j, k] = s_new
-                    NCROSS[lane, j] += 1
-            for q in range(ns):
-                Y[q, k] = Y1[q, k]
-            continue
-        for q in range(ns):
-            ys[q] = Y[q, k]
-            y1s[q] = Y1[q, k]
+        if FLAG[k] != 0.0:
+            _finish_flagged(k, STEP, NPER, Y, Y1, G1, GR, SIDE, P, LANE, HB, T0B, OMEGA, locate,
+                            NCROSS, UNRES, ys, y1s, sides, g1s, work, ybuf, gbuf)
+
+
+@nb.njit(_nrt=False, **_JIT)
+def _finish_flagged(k, STEP, NPER, Y, Y1, G1, GR, SIDE, P, LANE, HB, T0B, OMEGA, locate, NCROSS,
+                    UNRES, ys, y1s, sides, g1s, work, ybuf, gbuf):
+    """Finish slot k's flagged trial step on the scalar path: the crossings located
+    (:func:`_split_step`) or, without ``locate``, counted at the step's end. Out of line, so
+    that the slot loop that calls it stays small."""
+    ns = Y.shape[0]
+    n_ev = G1.shape[0]
+    lane = LANE[k]
+    if not locate:
         for j in range(n_ev):
-            sides[j] = 1 if SIDE[j, k] > 0.0 else -1
-            g1s[j] = G1[j, k]
-            gbuf[GRAZE_ROW, j] = GR[j, k]
-        UNRES[lane] += _split_step(STEP[k], T0B[k], ys, y1s, P[lane], HB[k], OMEGA[lane],
-                                   NPER[k], sides, g1s, NCROSS[lane], work, ybuf, gbuf)
+            s_new = 1.0 if G1[j, k] > 0.0 else -1.0
+            if s_new != SIDE[j, k]:
+                SIDE[j, k] = s_new
+                NCROSS[lane, j] += 1
         for q in range(ns):
-            Y[q, k] = ys[q]
-        for j in range(n_ev):
-            SIDE[j, k] = float(sides[j])
-            G1[j, k] = g1s[j]
+            Y[q, k] = Y1[q, k]
+        return
+    for q in range(ns):
+        ys[q] = Y[q, k]
+        y1s[q] = Y1[q, k]
+    for j in range(n_ev):
+        sides[j] = 1 if SIDE[j, k] > 0.0 else -1
+        g1s[j] = G1[j, k]
+        gbuf[GRAZE_ROW, j] = GR[j, k]
+    UNRES[lane] += _split_step(STEP[k], T0B[k], ys, y1s, P[lane], HB[k], OMEGA[lane],
+                               NPER[k], sides, g1s, NCROSS[lane], work, ybuf, gbuf)
+    for q in range(ns):
+        Y[q, k] = ys[q]
+    for j in range(n_ev):
+        SIDE[j, k] = float(sides[j])
+        G1[j, k] = g1s[j]
 
 
 @nb.njit(inline="always", **_JIT)
@@ -514,8 +535,6 @@ def _sweep_worker(w, lanes, cfg, sched, out):
     SC = np.zeros((8, nl))
     PH6 = np.zeros((6, nl))
     PH = (PH6[0], PH6[1], PH6[2], PH6[3], PH6[4], PH6[5])
-    SO = np.zeros(nl)
-    CO = np.zeros(nl)
     TT = np.zeros(nl)
     GP = np.full((n_g, nl), np.nan)  # events at the grid points i - 1, i, i + 1
     GS = np.zeros((n_g, nl))
@@ -560,7 +579,7 @@ def _sweep_worker(w, lanes, cfg, sched, out):
     FL = (Y.reshape(ns * nl), Y1.reshape(ns * nl), K1.reshape(ns * nl), K2.reshape(ns * nl),
           K3.reshape(ns * nl), K4.reshape(ns * nl), TMP.reshape(ns * nl))
     HW = (HW3[0].reshape(ns * nl), HW3[1].reshape(ns * nl), HW3[2].reshape(ns * nl))
-    blk = (R, D, Y, Y1, K1, K2, K3, K4, TMP, PT, SC, PH6, PH, SO, CO, TT, GP, GS, G1, GR, SIDE,
+    blk = (R, D, Y, Y1, K1, K2, K3, K4, TMP, PT, SC, PH6, PH, TT, GP, GS, G1, GR, SIDE,
            FLAG, GMIN, GMAX, O, OMAX, OMIN, OSQ, HW3, FL, HW)
     slots = (STAT, ACT, END, LANE, STEP, PHASE, NPER, OFF, HB, T0B, n_end, n_tr, next_sample,
              DUE, n_stat, n_ring)
@@ -578,11 +597,13 @@ def _block_run(q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch):
     start, queue, lane_nper, lane_tab, S_TAB, C_TAB = sched
     (samples, final, status, gmin, gmax, ncross, omax, omin, orms, unresolved, transient_steps,
      converged) = out
-    (R, D, Y, Y1, K1, K2, K3, K4, TMP, PT, SC, PH6, PH, SO, CO, TT, GP, GS, G1, GR, SIDE, FLAG,
+    (R, D, Y, Y1, K1, K2, K3, K4, TMP, PT, SC, PH6, PH, TT, GP, GS, G1, GR, SIDE, FLAG,
      GMIN, GMAX, O, OMAX, OMIN, OSQ, HW3, FL, HW) = blk
     (STAT, ACT, END, LANE, STEP, PHASE, NPER, OFF, HB, T0B, n_end, n_tr, next_sample, DUE,
      n_stat, n_ring) = slots
     ys, y1s, dbuf, sides, g1s, gb, ob, work, ybuf, gbuf = scratch
+    SE = PH[4]  # the phase at the grid point reached (see _lanes_phase)
+    CE = PH[5]
     ns = Y0.shape[1]
     n_g = GP.shape[0]
     n_o = O.shape[0]
@@ -710,13 +731,8 @@ def _block_run(q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch):
                 g = GS[j, k]
                 GMIN[j, k] = min(GMIN[j, k], g) if STAT[k] else GMIN[j, k]
                 GMAX[j, k] = max(GMAX[j, k], g) if STAT[k] else GMAX[j, k]
-        if n_obs > 0:
-            for k in range(nl):
-                TT[k] = T0B[k] + STEP[k] * HB[k]
-                j = OFF[k] + 2 * PHASE[k]
-                SO[k] = S_TAB[j]
-                CO[k] = C_TAB[j]
-            _observe_lanes(TT, Y, O, PT, P, LANE, nl, SO, CO, SC, ybuf, ob)
+        if n_obs > 0:  # at the grid point just reached: TT and the step's end phase (SE, CE)
+            _observe_lanes(TT, Y, O, PT, P, LANE, nl, SE, CE, SC, ybuf, ob)
             for j in range(n_obs):
                 for k in range(nl):
                     v = O[j, k]
