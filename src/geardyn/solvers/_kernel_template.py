@@ -337,18 +337,14 @@ else:
 
 
 @nb.njit(inline="always", **_JIT)
-def _lanes_phase(nl, OFF, PHASE, S_TAB, C_TAB, PH):
-    """Every slot's forcing phase for its next grid step, into the rows of PH (SA, CA, SB, CB,
-    SE, CE: sin/cos at the step's start, middle and end): the start is the last step's end
-    (SE, CE; set to the table's first point when a lane is loaded; the table's last point,
-    2 n_per, equals its first bit for bit), the middle and end are gathered from the
-    concatenated tables."""
-    SA, CA, SB, CB, SE, CE = PH
+def _lanes_phase(nl, OFF, PHASE, S_TAB, C_TAB, SB, CB, SE, CE):
+    """Every slot's forcing phase at the middle and the end of its next grid step (sin, cos)
+    into SB, CB, SE, CE, gathered from the concatenated tables (the phase at the step's start
+    is the last step's end, SE and CE before the call: set to the table's first point when a
+    lane is loaded; the table's last point, 2 n_per, equals its first bit for bit)."""
     for k in range(nl):
-        j1 = np.uint64(OFF[k] + 2 * PHASE[k] + 1)  # unsigned: no wraparound test, a gather
+        j1 = np.uint64(OFF[k] + 2 * PHASE[k] + 1)  # unsigned: no wraparound test
         j2 = np.uint64(OFF[k] + 2 * PHASE[k] + 2)
-        SA[k] = SE[k]
-        CA[k] = CE[k]
         SB[k] = S_TAB[j1]
         CB[k] = C_TAB[j1]
         SE[k] = S_TAB[j2]
@@ -357,18 +353,20 @@ def _lanes_phase(nl, OFF, PHASE, S_TAB, C_TAB, PH):
 
 @nb.njit(inline="always", **_JIT)
 def _lanes_rk4(STEP, nl, Y, Y1, K1, K2, K3, K4, TMP, FL, HW, TT, HB, T0B, PT, P, LANE, PH, SC,
-               ybuf, dbuf):
+               ybuf, dbuf, OFF, PHASE, S_TAB, C_TAB):
     """The RK4 trial of every slot's grid step STEP[k] into Y1; TT holds the step's end times
     afterwards. FL: flat views (state and slot in one index) of Y, Y1, K1..K4, TMP; HW: flat
     rows of h/2, h and h/6 per (state, slot), so the stage updates are one loop each; PH: the
-    slots' forcing phases (:func:`_lanes_phase`)."""
+    slots' forcing phases (SB, CB, SE, CE: sin/cos at the step's middle and end; SE, CE hold
+    the start's on entry, see :func:`_lanes_phase`)."""
     Yf, Y1f, K1f, K2f, K3f, K4f, TMPf = FL
     HHf, HFf, H6f = HW
-    SA, CA, SB, CB, SE, CE = PH
+    SB, CB, SE, CE = PH
     m_all = Yf.size
     for k in range(nl):
         TT[k] = T0B[k] + STEP[k] * HB[k]
-    _rhs_lanes(TT, Y, K1, PT, P, LANE, nl, SA, CA, SC, ybuf, dbuf)
+    _rhs_lanes(TT, Y, K1, PT, P, LANE, nl, SE, CE, SC, ybuf, dbuf)
+    _lanes_phase(nl, OFF, PHASE, S_TAB, C_TAB, SB, CB, SE, CE)
     for m in range(m_all):
         TMPf[m] = Yf[m] + HHf[m] * K1f[m]
     for k in range(nl):
@@ -533,8 +531,8 @@ def _sweep_worker(w, lanes, cfg, sched, out):
     TMP = np.zeros((ns, nl))
     PT = np.zeros((P.shape[1], nl))
     SC = np.zeros((8, nl))
-    PH6 = np.zeros((6, nl))
-    PH = (PH6[0], PH6[1], PH6[2], PH6[3], PH6[4], PH6[5])
+    PH6 = np.zeros((4, nl))  # sin, cos of the forcing phase at a step's middle and end
+    PH = (PH6[0], PH6[1], PH6[2], PH6[3])
     TT = np.zeros(nl)
     GP = np.full((n_g, nl), np.nan)  # events at the grid points i - 1, i, i + 1
     GS = np.zeros((n_g, nl))
@@ -549,6 +547,7 @@ def _sweep_worker(w, lanes, cfg, sched, out):
     OMIN = np.full((n_o, nl), np.inf)
     OSQ = np.zeros((n_o, nl))
     STAT = np.zeros(nl, np.bool_)
+    MSK = np.zeros(nl, np.bool_)  # slots with bookkeeping due
     ACT = np.zeros(nl, np.bool_)
     END = np.ones(nl, np.bool_)  # slots to (re)fill
     LANE = np.zeros(nl, np.int64)
@@ -581,7 +580,7 @@ def _sweep_worker(w, lanes, cfg, sched, out):
     HW = (HW3[0].reshape(ns * nl), HW3[1].reshape(ns * nl), HW3[2].reshape(ns * nl))
     blk = (R, D, Y, Y1, K1, K2, K3, K4, TMP, PT, SC, PH6, PH, TT, GP, GS, G1, GR, SIDE,
            FLAG, GMIN, GMAX, O, OMAX, OMIN, OSQ, HW3, FL, HW)
-    slots = (STAT, ACT, END, LANE, STEP, PHASE, NPER, OFF, HB, T0B, n_end, n_tr, next_sample,
+    slots = (STAT, MSK, ACT, END, LANE, STEP, PHASE, NPER, OFF, HB, T0B, n_end, n_tr, next_sample,
              DUE, n_stat, n_ring)
     scratch = (ys, y1s, dbuf, sides, g1s, gb, ob, work, ybuf, gbuf)
     _block_run(q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch)
@@ -599,11 +598,11 @@ def _block_run(q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch):
      converged) = out
     (R, D, Y, Y1, K1, K2, K3, K4, TMP, PT, SC, PH6, PH, TT, GP, GS, G1, GR, SIDE, FLAG,
      GMIN, GMAX, O, OMAX, OMIN, OSQ, HW3, FL, HW) = blk
-    (STAT, ACT, END, LANE, STEP, PHASE, NPER, OFF, HB, T0B, n_end, n_tr, next_sample, DUE,
+    (STAT, MSK, ACT, END, LANE, STEP, PHASE, NPER, OFF, HB, T0B, n_end, n_tr, next_sample, DUE,
      n_stat, n_ring) = slots
     ys, y1s, dbuf, sides, g1s, gb, ob, work, ybuf, gbuf = scratch
-    SE = PH[4]  # the phase at the grid point reached (see _lanes_phase)
-    CE = PH[5]
+    SE = PH[2]  # the phase at the grid point reached (see _lanes_phase)
+    CE = PH[3]
     ns = Y0.shape[1]
     n_g = GP.shape[0]
     n_o = O.shape[0]
@@ -635,8 +634,8 @@ def _block_run(q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch):
                 HB[k] = h
                 T0B[k] = T0[lane]
                 TT[k] = T0[lane]
-                PH6[4, k] = S_TAB[OFF[k]]  # the phase at the start (see _lanes_phase)
-                PH6[5, k] = C_TAB[OFF[k]]
+                PH6[2, k] = S_TAB[OFF[k]]  # the phase at the start (see _lanes_phase)
+                PH6[3, k] = C_TAB[OFF[k]]
                 for q in range(ns):
                     HW3[0, q, k] = 0.5 * h
                     HW3[1, q, k] = h
@@ -676,9 +675,8 @@ def _block_run(q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch):
         if n_act == 0:
             break
         # one grid step of every slot
-        _lanes_phase(nl, OFF, PHASE, S_TAB, C_TAB, PH)
         _lanes_rk4(STEP, nl, Y, Y1, K1, K2, K3, K4, TMP, FL, HW, TT, HB, T0B, PT, P, LANE, PH,
-                   SC, ybuf, dbuf)
+                   SC, ybuf, dbuf, OFF, PHASE, S_TAB, C_TAB)
         if n_ev > 0:
             _events_lanes(TT, Y1, G1, PT, P, LANE, nl, ybuf, gb)
             _lanes_screen(nl, G1, GS, GP, SIDE, GR, FLAG, locate)
@@ -688,34 +686,18 @@ def _block_run(q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch):
         _advance(nl, STEP, PHASE, NPER)
         due = False
         for k in range(nl):
-            due |= ACT[k] & ((PHASE[k] == 0) | (STEP[k] >= DUE[k]))
+            MSK[k] = ACT[k] & ((PHASE[k] == 0) | (STEP[k] >= DUE[k]))
+            due |= MSK[k]
         if due:
-            for k in range(nl):  # health, end of the transient
-                if not ACT[k] or not (PHASE[k] == 0 or STEP[k] >= DUE[k]):
-                    continue
-                lane = LANE[k]
-                step = STEP[k]
-                if (PHASE[k] == 0 or step == n_end[k]) and not _healthy_lane(Y, k, bound):
-                    status[lane] = STATUS_DIVERGED
-                    ACT[k] = False
-                    END[k] = True
-                    ended = True
-                    n_act -= 1
-                    n_samp -= 1 if step > n_tr[k] else 0
-                    for r in range(n_samples):
-                        for q in range(ns):
-                            samples[lane, r, q] = np.nan
-                    for q in range(ns):
-                        final[lane, q] = np.nan
-                    _write_out(k, lane, n_ev, n_obs, n_tr, GMIN, GMAX, OMAX, OMIN, OSQ, n_stat,
-                               status, transient_steps, gmin, gmax, omax, omin, orms)
-                    continue
-                if step == n_tr[k]:
-                    _transient_end(k, lane, Y, ys, R, D, n_ring, n_tr, n_end, next_sample,
-                                   conv_tol, converged, sample_every, n_transient_max, ncross,
-                                   n_ev)
-                    n_samp += 1 if step == n_tr[k] else 0  # not extended: sampling starts
-                DUE[k] = n_tr[k] if n_tr[k] > step else next_sample[k]
+            for k in range(nl):  # health, end of the transient (out of line: a short scan)
+                if MSK[k]:
+                    gone, d_samp = _slot_check(k, Y, R, D, ys, LANE, STEP, PHASE, n_end, n_tr,
+                                               next_sample, DUE, n_ring, ACT, END, GMIN, GMAX,
+                                               OMAX, OMIN, OSQ, n_stat, lanes, cfg, out)
+                    n_samp += d_samp
+                    if gone:
+                        ended = True
+                        n_act -= 1
         # statistics over the sampled stretch, vectorised over the slots
         if n_samp == 0:
             continue
@@ -741,30 +723,79 @@ def _block_run(q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch):
                     OSQ[j, k] = OSQ[j, k] + v * v if STAT[k] else OSQ[j, k]
         due = False
         for k in range(nl):
-            due |= STAT[k] & (STEP[k] >= DUE[k])
+            MSK[k] = STAT[k] & (STEP[k] >= DUE[k])
+            due |= MSK[k]
         if not due:
             continue
-        for k in range(nl):  # samples, end
-            if not STAT[k] or STEP[k] < DUE[k]:
-                continue
-            lane = LANE[k]
-            step = STEP[k]
-            if step == next_sample[k]:
-                r = (step - n_tr[k]) // sample_every[lane] - 1
-                for q in range(ns):
-                    samples[lane, r, q] = Y[q, k]
-                next_sample[k] += sample_every[lane]
-            DUE[k] = next_sample[k]
-            if step == n_end[k]:
-                ACT[k] = False
-                END[k] = True
+        for k in range(nl):  # samples, end (out of line: a short scan)
+            if MSK[k] and _slot_sample(k, Y, LANE, STEP, n_end, n_tr, next_sample, DUE, ACT, END,
+                                       GMIN, GMAX, OMAX, OMIN, OSQ, n_stat, lanes, cfg, out):
                 ended = True
                 n_act -= 1
                 n_samp -= 1
-                for q in range(ns):
-                    final[lane, q] = Y[q, k]
-                _write_out(k, lane, n_ev, n_obs, n_tr, GMIN, GMAX, OMAX, OMIN, OSQ, n_stat,
-                           status, transient_steps, gmin, gmax, omax, omin, orms)
+
+
+@nb.njit(_nrt=False, **_JIT)
+def _slot_check(k, Y, R, D, ys, LANE, STEP, PHASE, n_end, n_tr, next_sample, DUE, n_ring, ACT,
+                END, GMIN, GMAX, OMAX, OMIN, OSQ, n_stat, lanes, cfg, out):
+    """Slot k at the start of a period or at its due step (see :func:`_sweep_worker`): its
+    health (at a period's start or the lane's end; a diverged lane ends here) and the end of its
+    transient. Returns (ended, change of the count of sampling slots)."""
+    n_transient_max, sample_every = lanes[6], lanes[7]
+    conv_tol, n_samples, bound, n_ev, n_obs = cfg[0], cfg[2], cfg[4], cfg[5], cfg[6]
+    (samples, final, status, gmin, gmax, ncross, omax, omin, orms, unresolved, transient_steps,
+     converged) = out
+    ns = Y.shape[0]
+    lane = LANE[k]
+    step = STEP[k]
+    if (PHASE[k] == 0 or step == n_end[k]) and not _healthy_lane(Y, k, bound):
+        status[lane] = STATUS_DIVERGED
+        ACT[k] = False
+        END[k] = True
+        for r in range(n_samples):
+            for q in range(ns):
+                samples[lane, r, q] = np.nan
+        for q in range(ns):
+            final[lane, q] = np.nan
+        _write_out(k, lane, n_ev, n_obs, n_tr, GMIN, GMAX, OMAX, OMIN, OSQ, n_stat, status,
+                   transient_steps, gmin, gmax, omax, omin, orms)
+        return True, -1 if step > n_tr[k] else 0
+    d_samp = 0
+    if step == n_tr[k]:
+        _transient_end(k, lane, Y, ys, R, D, n_ring, n_tr, n_end, next_sample, conv_tol,
+                       converged, sample_every, n_transient_max, ncross, n_ev)
+        d_samp = 1 if step == n_tr[k] else 0  # not extended: sampling starts
+    DUE[k] = n_tr[k] if n_tr[k] > step else next_sample[k]
+    return False, d_samp
+
+
+@nb.njit(_nrt=False, **_JIT)
+def _slot_sample(k, Y, LANE, STEP, n_end, n_tr, next_sample, DUE, ACT, END, GMIN, GMAX, OMAX,
+                 OMIN, OSQ, n_stat, lanes, cfg, out):
+    """Slot k (sampling) at its due step: the section sample, the lane's end. Returns True
+    when the lane has ended."""
+    sample_every = lanes[7]
+    n_ev, n_obs = cfg[5], cfg[6]
+    (samples, final, status, gmin, gmax, ncross, omax, omin, orms, unresolved, transient_steps,
+     converged) = out
+    ns = Y.shape[0]
+    lane = LANE[k]
+    step = STEP[k]
+    if step == next_sample[k]:
+        r = (step - n_tr[k]) // sample_every[lane] - 1
+        for q in range(ns):
+            samples[lane, r, q] = Y[q, k]
+        next_sample[k] += sample_every[lane]
+    DUE[k] = next_sample[k]
+    if step != n_end[k]:
+        return False
+    ACT[k] = False
+    END[k] = True
+    for q in range(ns):
+        final[lane, q] = Y[q, k]
+    _write_out(k, lane, n_ev, n_obs, n_tr, GMIN, GMAX, OMAX, OMIN, OSQ, n_stat, status,
+               transient_steps, gmin, gmax, omax, omin, orms)
+    return True
 
 
 @nb.njit(inline="always", **_JIT)
