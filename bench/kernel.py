@@ -287,7 +287,7 @@ def vector_report(w: Workload) -> str:
     mod = fresh_kernels(w.model.kernel)
     with _Use(mod, False):
         ens.run_lanes(w.model, w.P[:8], w.model.initial_state(), 1.0, 1, steps_per_period=64)
-    fn = getattr(mod, "_sweep_worker", mod.sweep)  # the block loop (prange calls it)
+    fn = getattr(mod, "_block_run", getattr(mod, "_sweep_worker", mod.sweep))  # the block loop
     asm = fn.inspect_asm(fn.signatures[0])
     z, y, sd = (len(re.findall(r"\n\s+v\w+" + r, asm))
                 for r in (r"pd\s+[^\n]*%zmm", r"pd\s+[^\n]*%ymm", r"sd\s"))
