@@ -38,7 +38,6 @@ import xarray as xr
 
 from geardyn.analysis.branch_data import BranchPoint, branch_dataset, orbit_summary
 from geardyn.analysis.orbits import (
-    ORBIT_STEP_FACTOR,
     OrbitStatus,
     ShootingEval,
     ShootingProblem,
@@ -54,7 +53,11 @@ from geardyn.core.status import Status
 #: Corrector tolerance: max |G / state_scale| <= tol (1 + max |x / state_scale|).
 CORRECTOR_TOL = 1e-10
 #: Most corrector iterations per step.
-CORRECTOR_MAX_ITER = 8
+CORRECTOR_MAX_ITER = 12
+#: The step grows after a corrector of at most this many iterations, shrinks after one of at
+#: least SHRINK_ITER (chord iterations: each costs one period map).
+GROW_ITER = 4
+SHRINK_ITER = 8
 #: Relative step of the central difference dG/dp.
 DP_REL = 1e-6
 #: Least cosine between successive tangents for a step to be accepted.
@@ -63,6 +66,9 @@ MIN_COS = 0.9
 LOCATE_TOL = 1e-7
 #: Most trials of a location.
 LOCATE_MAX_ITER = 60
+#: The default step of a branch: this many times the sweeps' step rule (multipliers to ~1e-8;
+#: :data:`~geardyn.analysis.orbits.ORBIT_STEP_FACTOR` for a lone orbit).
+BRANCH_STEP_FACTOR = 2
 #: The steps per forcing period are re-derived at an accepted point where the step rule's
 #: count leaves this ratio of the current one.
 STEP_RATIO = 1.25
@@ -121,11 +127,14 @@ class _Point:
     jac: np.ndarray
     tangent: np.ndarray = field(default_factory=lambda: np.zeros(0))
     iterations: int = 0
+    _mu: np.ndarray | None = None
 
     @property
     def mu(self) -> np.ndarray:
-        mu = np.linalg.eigvals(self.ev.monodromy)
-        return mu[np.argsort(-np.abs(mu), kind="stable")]
+        if self._mu is None:
+            mu = np.linalg.eigvals(self.ev.monodromy)
+            self._mu = mu[np.argsort(-np.abs(mu), kind="stable")]
+        return self._mu
 
 
 @dataclass
@@ -212,12 +221,12 @@ class _Tracer:
         return replace(pr, steps_per_period=int(n or self.n))
 
     def steps_for(self, p: float) -> int:
-        """The default steps per forcing period at p (:data:`ORBIT_STEP_FACTOR` times the step
+        """The default steps per forcing period at p (:data:`BRANCH_STEP_FACTOR` times the step
         rule), or the fixed count asked for."""
         if self.fixed_steps:
             return int(self.fixed_steps)
         P = self.params_at(p)
-        return ORBIT_STEP_FACTOR * default_steps_per_period(self.model, params=P)
+        return BRANCH_STEP_FACTOR * default_steps_per_period(self.model, params=P)
 
     def renew_steps(self, p: float) -> None:
         """Re-derive the steps per period at p where the rule's count left the ratio
@@ -261,29 +270,44 @@ class _Tracer:
     def converged(self, r: np.ndarray, z: np.ndarray) -> bool:
         return float(np.max(np.abs(r))) <= self.tol * (1.0 + float(np.max(np.abs(z[:-1]))))
 
-    def correct(self, z_pred: np.ndarray, t: np.ndarray) -> _Point | _Failure:
-        """Newton on G(z) = 0, t . (z - z_pred) = 0 from z_pred."""
-        z = z_pred.copy()
-        for it in range(self.max_iter + 1):
+    def correct(self, z_pred: np.ndarray, t: np.ndarray, J0: np.ndarray | None = None,
+                max_iter: int | None = None) -> _Point | _Failure:
+        """Newton on G(z) = 0, t . (z - z_pred) = 0 from z_pred: a chord method on the
+        Jacobian ``J0`` (e.g. the last point's) while the residual falls by half per iteration,
+        else with the Jacobian at the iterate; the point's own Jacobian at the end."""
+        z, J = z_pred.copy(), J0
+        last = math.inf
+        max_iter = self.max_iter if max_iter is None else max_iter
+        for it in range(max_iter + 1):
+            fresh = J is None
             try:
-                r, ev, pr = self.evaluate(z)
-            except _Invalid as err:
-                return _Failure(BranchStatus.INVALID, f"at {self.param}={self.p_of(z):.8g}: "
-                                                      f"{err}")
-            if ev.status != Status.OK or not np.all(np.isfinite(ev.monodromy)):
-                return _Failure(BranchStatus.DIVERGED, f"the period map diverged at "
-                                                       f"{self.param}={self.p_of(z):.8g}")
-            try:
-                J = self.jacobian(z, ev)
+                r, ev, pr = self.evaluate(z, jacobian=fresh)
+                if ev.status != Status.OK:
+                    return _Failure(BranchStatus.DIVERGED, f"the period map diverged at "
+                                                           f"{self.param}={self.p_of(z):.8g}")
+                done = self.converged(r, z)
+                if done and not fresh:
+                    r, ev, pr = self.evaluate(z, jacobian=True)
+                    fresh = True
+                if fresh:
+                    if not np.all(np.isfinite(ev.monodromy)):
+                        return _Failure(BranchStatus.DIVERGED, f"the monodromy is not finite at "
+                                        f"{self.param}={self.p_of(z):.8g}")
+                    J = self.jacobian(z, ev)
             except _Invalid as err:
                 return _Failure(BranchStatus.INVALID, f"at {self.param}={self.p_of(z):.8g}: "
                                                       f"{err}")
             except FloatingPointError as err:
                 return _Failure(BranchStatus.DIVERGED, f"at {self.param}={self.p_of(z):.8g}: "
                                                        f"{err}")
-            if self.converged(r, z):
+            if done:
                 return _Point(z, ev, pr, J, iterations=it)
-            if it == self.max_iter:
+            norm = float(np.max(np.abs(r)))
+            if not fresh and norm > 0.5 * last:  # the chord stalls: a fresh Jacobian next
+                J, last = None, math.inf
+                continue
+            last = norm
+            if it == max_iter:
                 break
             A = np.vstack([J, t])
             rhs = -np.concatenate([r, [t @ (z - z_pred)]])
@@ -294,7 +318,7 @@ class _Tracer:
                                                             f"{self.param}={self.p_of(z):.8g}")
             z = z + dz
         return _Failure(BranchStatus.NOT_CONVERGED,
-                        f"the corrector did not converge in {self.max_iter} iterations near "
+                        f"the corrector did not converge in {max_iter} iterations near "
                         f"{self.param}={self.p_of(z):.8g}")
 
     def tangent(self, J: np.ndarray, ref: np.ndarray) -> np.ndarray:
@@ -386,7 +410,7 @@ class _BranchRunner:
             nxt, fail = None, None
             while nxt is None:
                 z_pred = cur.z + ds * cur.tangent
-                got = tr.correct(z_pred, cur.tangent)
+                got = tr.correct(z_pred, cur.tangent, cur.jac)
                 if isinstance(got, _Point):
                     got.tangent = tr.tangent(got.jac, cur.tangent)
                     if got.tangent @ cur.tangent >= MIN_COS or ds <= st.ds_min:
@@ -416,9 +440,9 @@ class _BranchRunner:
             self.record(nxt, s)
             if end is not None:
                 return BranchStatus.COMPLETED, f"reached {tr.param}={end:.8g}"
-            if nxt.iterations <= 2:
+            if nxt.iterations <= GROW_ITER:
                 ds = min(st.ds_max, ds * 1.6)
-            elif nxt.iterations >= 5:
+            elif nxt.iterations >= SHRINK_ITER:
                 ds = max(st.ds_min, ds * 0.6)
             tr.renew_steps(p_new)
             cur, tests = nxt, new_tests
@@ -433,7 +457,7 @@ class _BranchRunner:
         z[-1] = bound / tr.pscale
         e = np.zeros(z.size)
         e[-1] = 1.0
-        got = tr.correct(z, e)
+        got = tr.correct(z, e, nxt.jac)
         if not isinstance(got, _Point):
             return None
         got.tangent = tr.tangent(got.jac, nxt.tangent)
@@ -462,7 +486,9 @@ class _BranchRunner:
         z_pred = a.z + sigma * (b.z - a.z)
         t = b.z - a.z
         t = t / np.linalg.norm(t)
-        got = tr.correct(z_pred, t)
+        got = tr.correct(z_pred, t, a.jac)
+        if not isinstance(got, _Point):  # e.g. at a graze: Newton with fresh Jacobians
+            got = tr.correct(z_pred, t, None, 3 * tr.max_iter)
         if not isinstance(got, _Point):
             return None
         got.tangent = tr.tangent(got.jac, a.tangent)
@@ -539,7 +565,7 @@ class _BranchRunner:
 def continuation(model: Model, param: str = "Omega", start: float | None = None,
                  stop: float | None = None, period: int = 1, guess: np.ndarray | None = None,
                  run: RunSettings | None = None, *, ds: float = 0.01, ds_min: float = 1e-7,
-                 ds_max: float = 0.05, max_points: int = 2000,
+                 ds_max: float = 0.2, max_points: int = 2000,
                  tol: float = CORRECTOR_TOL, locate_tol: float = LOCATE_TOL,
                  switch: bool | Callable[[Bifurcation], bool] = False, max_period: int = 16,
                  steps_per_period: int | None = None, p_scale: float | None = None,
@@ -571,7 +597,7 @@ def continuation(model: Model, param: str = "Omega", start: float | None = None,
         function of the :class:`Bifurcation` saying whether to; recursively (a cascade) while
         2k <= ``max_period``.
     steps_per_period
-        RK4 steps per forcing period, fixed (default: :data:`ORBIT_STEP_FACTOR` times the step
+        RK4 steps per forcing period, fixed (default: :data:`BRANCH_STEP_FACTOR` times the step
         rule, re-derived along the branch).
     progress
         Called as ``progress(points, value)`` after each accepted point.

@@ -74,23 +74,13 @@ def orbit_summary(problem: ShootingProblem, x: np.ndarray, value: float, arcleng
     """The :class:`BranchPoint` of the orbit through ``x`` (integrated once more, recording at
     most :data:`SUMMARY_POINTS` grid points)."""
     m = problem.model
-    ev = problem.evaluate(x, jacobian=False, stride=_stride(problem.n_steps))
-    Y = ev.states[:-1]  # one period: the last point repeats the first
     k = kernels_for(m.kernel)
-    n_pts = Y.shape[0]
-    dt = problem.step * (problem.n_steps // max(n_pts, 1))
-    G = np.zeros((n_pts, m.n_events))
-    O = np.zeros((n_pts, m.n_observables))
-    g, o = np.empty(m.n_events), np.empty(m.n_observables)
-    for i in range(n_pts):
-        t = problem.t0 + i * dt
-        if m.n_events:
-            k.events(t, Y[i], g, problem.params)
-            G[i] = g
-        if m.n_observables:
-            ph = problem.omega * (t - problem.t0)
-            k.observe(t, Y[i], o, problem.params, math.sin(ph), math.cos(ph))
-            O[i] = o
+    n = problem.n_steps
+    Y, O, G, _nc, status, _unres, _done = k.trajectory(
+        problem.params, np.ascontiguousarray(x, dtype=float), problem.step, problem.omega,
+        problem.steps_per_period, 0, n, _stride(n), True, problem.bound, m.n_events,
+        m.n_observables)
+    Y, O, G = Y[:-1], O[:-1, : m.n_observables], G[:-1, : m.n_events]  # one period
     Ys = Y / problem.scale
     norm = float(np.sqrt(np.mean(np.sum(Ys * Ys, axis=1))))
     meshes = m.meshes
@@ -98,7 +88,7 @@ def orbit_summary(problem: ShootingProblem, x: np.ndarray, value: float, arcleng
     dmax, drms, damp = np.zeros(nm), np.zeros(nm), np.zeros(nm)
     per_mesh = np.zeros(nm, np.int64)
     contact = []
-    st = np.array([int(ev.status)])
+    st = np.array([int(status)])
     gmin, gmax = G.min(axis=0)[None, :], G.max(axis=0)[None, :]
     for q, (_name, i, j) in enumerate(meshes):
         X = 0.5 * (G[:, i] + G[:, j])
