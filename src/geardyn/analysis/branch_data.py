@@ -135,7 +135,8 @@ def _point_variables(model: Model, pts: list[BranchPoint], n: int) -> dict[str, 
         "branch": ("point", stack(lambda p: p.branch, (), np.int64), {
             "long_name": "branch number (see the branch dimension)"}),
         "period": ("point", stack(lambda p: p.period, (), np.int64), {
-            "long_name": "period of the orbit in section periods (k)"}),
+            "long_name": "period of the orbit in section periods (k)",
+            "meaning": "k: the orbit closes after k section periods (the branch's k)"}),
         "section_point": (("point", "state"), stack(lambda p: p.x, (n,)), {
             "units": model.state_units, "long_name": "state at the section (forcing phase 0)"}),
         "orbit_norm": ("point", stack(lambda p: p.norm, ()), {

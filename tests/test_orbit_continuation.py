@@ -1,0 +1,204 @@
+"""Pseudo-arclength continuation of periodic orbits (geardyn.continuation) against independent
+results: the analytic frequency response of the linear oscillator, the principal instability
+zone of the damped Mathieu equation (its monodromy by DOP853 here, boundaries by brentq), the
+closed-form onset of tooth separation, the hysteresis band of up/down brute-force sweeps, the
+reference integrator's period map, and the paper device's brute-force diagram."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+from scipy.optimize import brentq
+
+import geardyn
+from geardyn import BranchStatus, ContinuedSweep, continued_sweeps
+
+
+def _table(ds, kind: str) -> np.ndarray:
+    return np.sort(ds["bifurcation_value"].values[ds["bifurcation_kind"].values == kind])
+
+
+def _linear_amplitude(om, zeta: float, fa: float) -> np.ndarray:
+    """|A| of x = b + Fm + Re(A e^{i Omega t}) for x'' + 2 zeta x' + x - b = Fm + Fa Omega^2
+    cos(Omega t) (teeth in contact, constant stiffness)."""
+    om = np.asarray(om)
+    return fa * om**2 / np.abs(1.0 - om**2 + 2j * zeta * om)
+
+
+def test_linear_branch_is_the_analytic_frequency_response():
+    zeta, fa = 0.05, 0.02
+    m = geardyn.GearPair(zeta=zeta, kappa=0.0, Fm=2.0, Fa=fa)
+    ds = geardyn.continuation(m, "Omega", 0.5, 1.5)
+    geardyn.testing.assert_result(ds, "continuation")
+    assert ds.attrs["status"] == BranchStatus.COMPLETED, ds.attrs["message"]
+    om = ds["Omega"].values
+    assert om[0] == 0.5 and om[-1] == 1.5 and ds.sizes["point"] > 10
+    A = _linear_amplitude(om, zeta, fa)
+    # RMS of a sinusoid sampled evenly over its period is exact: |A| / sqrt 2 (the error left
+    # is RK4's at the branch's step)
+    assert np.max(np.abs(ds["deflection_rms"].values[:, 0] * math.sqrt(2) - A)) < 1e-6 * A.max()
+    assert np.max(np.abs(ds["deflection_amplitude"].values[:, 0] - A)) < 1e-4 * A.max()
+    # the multipliers: exp((-zeta +- i sqrt(1 - zeta^2)) T), |mu| = exp(-zeta T)
+    T = 2 * math.pi / om
+    assert np.allclose(ds["multiplier_abs"].values, np.exp(-zeta * T)[:, None], rtol=1e-7)
+    assert ds.sizes["bifurcation"] == 0
+    assert set(ds["stability"].values) == {"stable"}
+    assert set(ds["contact"].values.ravel()) == {"none"}
+
+
+def _mathieu_pd_test(om: float, zeta: float, kappa: float) -> float:
+    """det(M + I) of x'' + 2 zeta x' + (1 + kappa cos(Omega t)) x = 0 over one period (DOP853):
+    zero where a multiplier is -1 (a boundary of the principal instability zone)."""
+    def f(t, z):
+        J = np.array([[0.0, 1.0], [-(1.0 + kappa * math.cos(om * t)), -2.0 * zeta]])
+        return (J @ z.reshape(2, 2)).ravel()
+
+    M = solve_ivp(f, (0.0, 2 * math.pi / om), np.eye(2).ravel(), method="DOP853", rtol=1e-12,
+                  atol=1e-14).y[:, -1].reshape(2, 2)
+    return float(np.linalg.det(M + np.eye(2)))
+
+
+def test_mathieu_hill_period_doublings_are_the_instability_zone_boundaries():
+    """Teeth always in contact (large mean load, no transmission error): the variational
+    equation is the damped Mathieu equation, whose principal zone (Omega near 2) is bounded by
+    multipliers -1; the period-1 branch's period doublings lie on its boundaries."""
+    zeta, kappa = 0.05, 0.4
+    m = geardyn.GearPair(zeta=zeta, kappa=kappa, Fm=1.0, Fa=0.0)
+    ds = geardyn.continuation(m, "Omega", 1.5, 2.6)
+    assert ds.attrs["status"] == BranchStatus.COMPLETED, ds.attrs["message"]
+    assert np.all(ds["mesh_crossings"].values == 0)
+    grid = np.linspace(1.5, 2.6, 12)
+    f = [_mathieu_pd_test(o, zeta, kappa) for o in grid]
+    zone = [brentq(_mathieu_pd_test, grid[i], grid[i + 1], args=(zeta, kappa), xtol=1e-12)
+            for i in range(grid.size - 1) if np.sign(f[i]) != np.sign(f[i + 1])]
+    assert len(zone) == 2
+    pd = _table(ds, "period-doubling")
+    assert pd.size == 2
+    assert np.max(np.abs(pd - zone)) < 1e-4
+    assert np.max(ds["bifurcation_error"].values) < 1e-6
+    # unstable inside the zone, stable outside
+    om = ds["Omega"].values
+    inside = (om > zone[0] + 1e-3) & (om < zone[1] - 1e-3)
+    outside = (om < zone[0] - 1e-3) | (om > zone[1] + 1e-3)
+    assert set(ds["stability"].values[inside]) == {"unstable"}
+    assert set(ds["stability"].values[outside]) == {"stable"}
+
+
+def test_softening_folds_bracket_the_sweeps_hysteresis_and_contact_onset():
+    """Contact loss at Fa = 0.05, zeta = 0.05: the resonance bends to lower frequencies; the
+    branch's folds bound the band where up and down sweeps disagree (within the sweep's step),
+    and its contact changes are the closed-form onsets of separation, where the linear
+    response's amplitude equals the mean load."""
+    zeta, fa, fm = 0.05, 0.05, 0.1
+    m = geardyn.GearPair(zeta=zeta, Fm=fm, Fa=fa)
+    ds = geardyn.continuation(m, "Omega", 0.5, 1.6)
+    assert ds.attrs["status"] == BranchStatus.COMPLETED, ds.attrs["message"]
+    folds = _table(ds, "fold")
+    assert folds.size == 2
+    onset = _table(ds, "contact")
+
+    def g(om):
+        return _linear_amplitude(om, zeta, fa) - fm
+
+    exact = [brentq(g, 0.5, 1.0, xtol=1e-14), brentq(g, 1.1, 2.0, xtol=1e-14)]
+    assert onset.size == 2
+    assert np.max(np.abs(onset - exact)) < 1e-6
+    # the unstable middle branch lies between the folds
+    st = ds["stability"].values
+    om = ds["Omega"].values
+    bad = om[st == "unstable"]
+    assert bad.size and bad.min() >= folds[0] - 1e-9 and bad.max() <= folds[1] + 1e-9
+    # brute force: up and down sweeps by continuation
+    h = 0.01
+    vals = np.round(np.arange(0.6, 0.9 + h / 2, h), 6)
+    up, down = continued_sweeps(
+        [ContinuedSweep(m, "Omega", vals, d, transient=300.0, continued_transient=50.0,
+                        transient_max=3000.0) for d in ("up", "down")],
+        samples=4, converge=1e-8)
+    a, b = up["force_peak"].values[:, 0], down["force_peak"].values[:, 0]
+    differ = vals[np.abs(a - b) > 1e-3 * np.abs(a).max()]
+    assert differ.size > 3
+    assert differ.min() - h <= folds[0] <= differ.min()
+    assert differ.max() <= folds[1] <= differ.max() + h
+
+
+def test_branch_switching_follows_the_period_two_orbit():
+    """At the period doubling of the gear pair with stiffness variation, the period-2 branch:
+    its points are fixed points of the reference integrator's twice-iterated map, not of the
+    once-iterated one, and it starts at the located doubling."""
+    m = geardyn.GearPair(zeta=0.02, Fm=0.1, Fa=0.1, kappa=0.2)
+    ds = geardyn.continuation(m, "Omega", 1.9, 1.5, switch=True, max_period=2)
+    pd = np.flatnonzero(ds["bifurcation_kind"].values == "period-doubling")
+    assert pd.size >= 1
+    assert ds.sizes["branch_id"] == 1 + pd.size
+    two = ds.where(ds["branch"] == 1, drop=True)
+    assert np.all(two["period"].values == 2) and two.sizes["point"] > 3
+    assert ds["branch_parent"].values[1] == pd[0]
+    first = float(two["Omega"].values[0])
+    assert abs(first - ds["bifurcation_value"].values[pd[0]]) < 0.02
+    k = two.sizes["point"] // 2
+    om = float(two["Omega"].values[k])
+    x = two["section_point"].values[k]
+    T = 2 * math.pi / om
+    mm = m.with_omega(om)
+    ref = geardyn.reference_solution(mm, x, np.array([T, 2 * T]))
+    assert np.max(np.abs(ref[1] - x)) < 1e-7
+    assert np.max(np.abs(ref[0] - x)) > 1e-3
+
+
+def test_failures_end_the_branch_with_a_message_keeping_the_points():
+    m = geardyn.GearPair(zeta=0.05, kappa=0.5, Fm=1.0, Fa=0.0, Omega=1.2)
+    ds = geardyn.continuation(m, "kappa", 0.5, 1.5)  # |kappa| < 1 is the valid region
+    assert ds.attrs["status"] == BranchStatus.INVALID
+    assert "kappa=" in ds.attrs["message"] and ds.sizes["point"] > 2
+    assert ds["kappa"].values.max() < 1.0
+    with pytest.raises(ValueError, match="valid region"):
+        geardyn.continuation(m, "kappa", 1.2, 1.5)
+    # a bound that the resonant orbit exceeds: the integration diverges
+    lin = geardyn.GearPair(zeta=0.05, Fm=2.0, Fa=0.02)
+    ds = geardyn.continuation(lin, "Omega", 0.5, 1.5, run=geardyn.RunSettings(bound=3.1))
+    assert ds.attrs["status"] in (BranchStatus.DIVERGED, BranchStatus.NOT_CONVERGED)
+    assert "Omega=" in ds.attrs["message"] and ds.sizes["point"] > 2
+    assert ds["Omega"].values.max() < 1.0
+    # no orbit at the start: a Newton that cannot converge (one iteration)
+    bad = geardyn.continuation(geardyn.GearPair(zeta=0.05, Fm=0.1, Fa=0.05), "Omega", 0.9,
+                               1.0, guess=np.array([3.0, 2.0]), tol=1e-300)
+    assert bad.attrs["status"] == BranchStatus.START_FAILED and bad.sizes["point"] == 0
+    assert "Omega=0.9" in bad.attrs["message"]
+
+
+@pytest.mark.slow
+def test_paper_device_period_doubling_agrees_with_the_brute_force_diagram():
+    """Fig. 3's device: the period-1 branch turns period 2 at a located period doubling that
+    lies in the step of the brute-force diagram where its period goes from 1 to 2; the branch's
+    multipliers there agree with differences of the reference integrator's period map."""
+    base = geardyn.CATTDevice(geardyn.PlanetaryParams.paper(xi1=0.05, xi2=0.05),
+                              interpretation="consistent")
+    ds = geardyn.continuation(base, "Omega", 0.9, 1.4)
+    pd = _table(ds, "period-doubling")
+    assert pd.size >= 1
+    h = 0.01
+    vals = np.round(np.arange(0.95, 1.3 + h / 2, h), 6)
+    bf = geardyn.bifurcation(base, "Omega", vals, continuation="up", transient=1500.0,
+                             continued_transient=200.0, transient_max=6000.0, converge=1e-8,
+                             samples=8)
+    per = bf["period"].values
+    first2 = vals[np.argmax(per == 2)]
+    assert per[0] == 1 and np.any(per == 2)
+    assert first2 - h - 1e-9 <= pd[0] <= first2 + 1e-9
+    # multipliers at the branch point nearest Omega = 1.2 vs the reference integrator
+    k = int(np.argmin(np.abs(ds["Omega"].values - 1.2)))
+    om, x = float(ds["Omega"].values[k]), ds["section_point"].values[k]
+    m, T, d = base.with_omega(om), 2 * math.pi / om, 1e-5
+    M = np.empty((x.size, x.size))
+    for j in range(x.size):
+        e = np.zeros(x.size)
+        e[j] = d
+        M[:, j] = (geardyn.reference_solution(m, x + e, np.array([T]))[0]
+                   - geardyn.reference_solution(m, x - e, np.array([T]))[0]) / (2 * d)
+    mu = ds["multiplier_real"].values[k] + 1j * ds["multiplier_imag"].values[k]
+    ref = np.linalg.eigvals(M)
+    assert np.max(np.abs(np.sort_complex(mu) - np.sort_complex(ref))) < 1e-4
