@@ -56,8 +56,8 @@ CORRECTOR_TOL = 1e-10
 CORRECTOR_MAX_ITER = 12
 #: The step grows after a corrector of at most this many iterations, shrinks after one of at
 #: least SHRINK_ITER (chord iterations: each costs one period map).
-GROW_ITER = 4
-SHRINK_ITER = 8
+GROW_ITER = 5
+SHRINK_ITER = 9
 #: Relative step of the central difference dG/dp.
 DP_REL = 1e-6
 #: Least cosine between successive tangents for a step to be accepted.
@@ -271,10 +271,11 @@ class _Tracer:
         return float(np.max(np.abs(r))) <= self.tol * (1.0 + float(np.max(np.abs(z[:-1]))))
 
     def correct(self, z_pred: np.ndarray, t: np.ndarray, J0: np.ndarray | None = None,
-                max_iter: int | None = None) -> _Point | _Failure:
+                max_iter: int | None = None, final: bool = True) -> _Point | _Failure:
         """Newton on G(z) = 0, t . (z - z_pred) = 0 from z_pred: a chord method on the
         Jacobian ``J0`` (e.g. the last point's) while the residual falls by half per iteration,
-        else with the Jacobian at the iterate; the point's own Jacobian at the end."""
+        else with the Jacobian at the iterate; the point's own Jacobian and monodromy at the end
+        (``final``; else the point keeps the last Jacobian used and no monodromy)."""
         z, J = z_pred.copy(), J0
         last = math.inf
         max_iter = self.max_iter if max_iter is None else max_iter
@@ -286,7 +287,7 @@ class _Tracer:
                     return _Failure(BranchStatus.DIVERGED, f"the period map diverged at "
                                                            f"{self.param}={self.p_of(z):.8g}")
                 done = self.converged(r, z)
-                if done and not fresh:
+                if done and not fresh and final:
                     r, ev, pr = self.evaluate(z, jacobian=True)
                     fresh = True
                 if fresh:
@@ -481,22 +482,27 @@ class _BranchRunner:
         found.sort(key=lambda f: abs(f.value - self.tr.p_of(a.z)))
         self.bifs += found
 
-    def _trial(self, a: _Point, b: _Point, sigma: float) -> _Point | None:
+    def _trial(self, a: _Point, b: _Point, sigma: float, final: bool = True) -> _Point | None:
+        """The branch point at the arclength fraction ``sigma`` from a to b (with its
+        monodromy and tangent when ``final``)."""
         tr = self.tr
         z_pred = a.z + sigma * (b.z - a.z)
         t = b.z - a.z
         t = t / np.linalg.norm(t)
-        got = tr.correct(z_pred, t, a.jac)
+        got = tr.correct(z_pred, t, a.jac, final=final)
         if not isinstance(got, _Point):  # e.g. at a graze: Newton with fresh Jacobians
-            got = tr.correct(z_pred, t, None, 3 * tr.max_iter)
+            got = tr.correct(z_pred, t, None, 3 * tr.max_iter, final=final)
         if not isinstance(got, _Point):
             return None
-        got.tangent = tr.tangent(got.jac, a.tangent)
+        if final:
+            got.tangent = tr.tangent(got.jac, a.tangent)
         return got
 
     def _value(self, pt: _Point, key: str, mesh: int | None) -> float:
-        t = _tests(pt)
-        return float(t[key][mesh]) if key == "contact" else float(t[key])
+        if key == "contact":
+            _name, i, j = pt.problem.model.meshes[mesh]
+            return float(pt.ev.crossings[i] + pt.ev.crossings[j])
+        return float(_tests(pt)[key])
 
     def _locate(self, a: _Point, b: _Point, kind: str, key: str, mesh: int | None
                 ) -> Bifurcation | None:
@@ -517,7 +523,7 @@ class _BranchRunner:
                 sig = (sa * fb - sb * fa) / (fb - fa)
                 lo_, hi_ = sa + 0.02 * (sb - sa), sb - 0.02 * (sb - sa)
                 sig = min(max(sig, lo_), hi_)
-            pt = self._trial(a, b, sig)
+            pt = self._trial(a, b, sig, final=key != "contact")
             if pt is None:
                 break
             f = self._value(pt, key, mesh)
@@ -547,8 +553,7 @@ class _BranchRunner:
             return None
         p = tr.p_of(best.z)
         err = max(abs(pa - p), abs(pb - p))
-        mu = best.mu
-        crit = _critical(kind, mu)
+        crit = _critical(kind, best.mu) if key != "contact" else complex(np.nan)
         if kind == "neimark-sacker" and not np.isfinite(crit.real):
             return None  # a neutral saddle (a real pair mu, 1/mu), not a bifurcation
         if kind == "contact":
@@ -557,8 +562,9 @@ class _BranchRunner:
             detail = f"complex pair |mu| = 1, angle {math.degrees(abs(np.angle(crit))):.4g} deg"
         else:
             detail = f"multiplier {crit.real:.6g}"
+        M = best.ev.monodromy if key != "contact" else np.full_like(a.ev.monodromy, np.nan)
         return Bifurcation(kind, p, err, len(self.points) - 1, self.number, tr.x_of(best.z),
-                           crit, detail, best.ev.monodromy.copy(), tr.period)
+                           crit, detail, M.copy(), tr.period)
 
 
 # ----------------------------------------------------------------------------- the API
