@@ -279,10 +279,12 @@ class _Tracer:
         z, J = z_pred.copy(), J0
         last = math.inf
         max_iter = self.max_iter if max_iter is None else max_iter
+        self.iterates: list[tuple[np.ndarray, np.ndarray]] = []
         for it in range(max_iter + 1):
             fresh = J is None
             try:
                 r, ev, pr = self.evaluate(z, jacobian=fresh)
+                self.iterates.append((z, ev.crossings))
                 if ev.status != Status.OK:
                     return _Failure(BranchStatus.DIVERGED, f"the period map diverged at "
                                                            f"{self.param}={self.p_of(z):.8g}")
@@ -504,6 +506,22 @@ class _BranchRunner:
             return float(pt.ev.crossings[i] + pt.ev.crossings[j])
         return float(_tests(pt)[key])
 
+    def _straddle(self, a: _Point, mesh: int, ca: float
+                  ) -> tuple[_Point, float, float] | None:
+        """Where a contact trial's corrector cannot converge because the period map jumps
+        (by the integrator's error) where the crossing count changes, its iterates alternate
+        between the two counts on the same arclength hyperplane: the change lies between them.
+        Returns (a point there, the bracket's ends) or None."""
+        _name, i, j = a.problem.model.meshes[mesh]
+        its = self.tr.iterates[-6:]
+        on = [self.tr.p_of(z) for z, c in its if c[i] + c[j] == ca]
+        off = [self.tr.p_of(z) for z, c in its if c[i] + c[j] != ca]
+        if not on or not off:
+            return None
+        z = its[-1][0]
+        every = on + off
+        return _Point(z, a.ev, a.problem, a.jac), min(every), max(every)
+
     def _locate(self, a: _Point, b: _Point, kind: str, key: str, mesh: int | None
                 ) -> Bifurcation | None:
         """Regula falsi (Illinois) on the arclength fraction between a and b for the zero of
@@ -524,6 +542,10 @@ class _BranchRunner:
                 lo_, hi_ = sa + 0.02 * (sb - sa), sb - 0.02 * (sb - sa)
                 sig = min(max(sig, lo_), hi_)
             pt = self._trial(a, b, sig, final=key != "contact")
+            if pt is None and key == "contact":
+                got = self._straddle(a, mesh, ca)
+                if got is not None:
+                    best, pa, pb = got
             if pt is None:
                 break
             f = self._value(pt, key, mesh)
