@@ -14,6 +14,7 @@ from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
 import geardyn
+from continuation_cases import van_der_pol
 from geardyn import BranchStatus, ContinuedSweep, continued_sweeps
 
 
@@ -202,3 +203,36 @@ def test_paper_device_period_doubling_agrees_with_the_brute_force_diagram():
     mu = ds["multiplier_real"].values[k] + 1j * ds["multiplier_imag"].values[k]
     ref = np.linalg.eigvals(M)
     assert np.max(np.abs(np.sort_complex(mu) - np.sort_complex(ref))) < 1e-4
+
+
+def test_neimark_sacker_of_the_forced_van_der_pol_oscillator_keeps_liouville():
+    """x'' - eps (1 - x^2) x' + x = gamma cos(Omega t), far from 1:1 resonance: as the forcing
+    weakens the entrained orbit loses stability through a complex pair. Liouville gives
+    |mu|^2 = det M = exp(eps * integral of (1 - x^2)) for a complex pair, so at the
+    Neimark-Sacker point the orbit's mean of x^2 is 1: checked on the reference integrator's
+    orbit from the located section point."""
+    om, eps = 1.2, 0.1
+    m = geardyn.UserModel(van_der_pol, n_states=2, params=[om, eps, 1.5],
+                          param_names=["Omega", "eps", "gamma"], natural_frequency=1.0)
+    ds = geardyn.continuation(m, "gamma", 1.5, 0.2)
+    ns = np.flatnonzero(ds["bifurcation_kind"].values == "neimark-sacker")
+    assert ns.size == 1, ds["bifurcation_kind"].values
+    k = int(ns[0])
+    gamma = float(ds["bifurcation_value"].values[k])
+    assert ds["bifurcation_error"].values[k] < 1e-6
+    assert abs(ds["bifurcation_multiplier_imag"].values[k]) > 0.1
+    x0 = ds["bifurcation_section_point"].values[k]
+    T = 2 * math.pi / om
+
+    def f(t, z):
+        x, v = z[0], z[1]
+        return [v, eps * (1 - x * x) * v - x + gamma * math.cos(om * t), x * x]
+
+    sol = solve_ivp(f, (0.0, T), [x0[0], x0[1], 0.0], method="DOP853", rtol=1e-12,
+                    atol=1e-14)
+    assert np.max(np.abs(sol.y[:2, -1] - x0)) < 1e-7  # a periodic orbit of the exact flow
+    assert abs(sol.y[2, -1] / T - 1.0) < 1e-6
+    # stable before (strong forcing), unstable after
+    g = ds["gamma"].values
+    assert set(ds["stability"].values[g > gamma + 1e-3]) == {"stable"}
+    assert set(ds["stability"].values[g < gamma - 1e-3]) == {"unstable"}
