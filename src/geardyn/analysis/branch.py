@@ -30,13 +30,20 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
-from enum import IntEnum
 from typing import Any
 
 import numpy as np
 import xarray as xr
 
-from geardyn.analysis.branch_data import BranchPoint, branch_dataset, orbit_summary
+from geardyn.analysis.branch_data import (
+    BranchPoint,
+    BranchStatus,
+    branch_dataset,
+    orbit_summary,
+)
+from geardyn.analysis.branch_data import (
+    branch_status_meaning as branch_status_meaning,
+)
 from geardyn.analysis.orbits import (
     OrbitStatus,
     ShootingEval,
@@ -72,36 +79,6 @@ BRANCH_STEP_FACTOR = 2
 #: The steps per forcing period are re-derived at an accepted point where the step rule's
 #: count leaves this ratio of the current one.
 STEP_RATIO = 1.25
-
-
-class BranchStatus(IntEnum):
-    """How a branch ended."""
-
-    COMPLETED = 0
-    MAX_POINTS = 1
-    NOT_CONVERGED = 2
-    INVALID = 3
-    DIVERGED = 4
-    START_FAILED = 5
-
-    @property
-    def message(self) -> str:
-        return _BRANCH_MESSAGES[self]
-
-
-_BRANCH_MESSAGES = {
-    BranchStatus.COMPLETED: "reached an end of the parameter range",
-    BranchStatus.MAX_POINTS: "reached the most points",
-    BranchStatus.NOT_CONVERGED: "the corrector did not converge at the least step",
-    BranchStatus.INVALID: "the parameter left the model's valid region",
-    BranchStatus.DIVERGED: "the integration diverged",
-    BranchStatus.START_FAILED: "no periodic orbit found at the start",
-}
-
-
-def branch_status_meaning() -> str:
-    """The branch status codes as one attribute string."""
-    return ", ".join(f"{int(s)} {s.message}" for s in BranchStatus)
 
 
 class _Invalid(ValueError):

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from enum import IntEnum
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -22,8 +23,37 @@ from geardyn.core.settings import INTEGRATOR
 from geardyn.solvers.kernels import kernels_for
 
 if TYPE_CHECKING:
-    from geardyn.analysis.branch import BranchRun
     from geardyn.core.model import Model
+
+class BranchStatus(IntEnum):
+    """How a branch ended."""
+
+    COMPLETED = 0
+    MAX_POINTS = 1
+    NOT_CONVERGED = 2
+    INVALID = 3
+    DIVERGED = 4
+    START_FAILED = 5
+
+    @property
+    def message(self) -> str:
+        return _BRANCH_MESSAGES[self]
+
+
+_BRANCH_MESSAGES = {
+    BranchStatus.COMPLETED: "reached an end of the parameter range",
+    BranchStatus.MAX_POINTS: "reached the most points",
+    BranchStatus.NOT_CONVERGED: "the corrector did not converge at the least step",
+    BranchStatus.INVALID: "the parameter left the model's valid region",
+    BranchStatus.DIVERGED: "the integration diverged",
+    BranchStatus.START_FAILED: "no periodic orbit found at the start",
+}
+
+
+def branch_status_meaning() -> str:
+    """The branch status codes as one attribute string."""
+    return ", ".join(f"{int(s)} {s.message}" for s in BranchStatus)
+
 
 #: Most recorded points per orbit for the summaries (every grid point up to this many).
 SUMMARY_POINTS = 4096
@@ -173,7 +203,7 @@ def _point_variables(model: Model, pts: list[BranchPoint], n: int) -> dict[str, 
     return v
 
 
-def _bifurcation_variables(runs: list[BranchRun], n: int, offsets: list[int]
+def _bifurcation_variables(runs: list[Any], n: int, offsets: list[int]
                            ) -> dict[str, Any]:
     bifs = [(r, b) for r in runs for b in r.bifurcations]
     B = len(bifs)
@@ -206,10 +236,8 @@ def _bifurcation_variables(runs: list[BranchRun], n: int, offsets: list[int]
 
 
 def branch_dataset(model: Model, param: str, start: float, stop: float,
-                   runs: list[BranchRun], tracer: Any) -> xr.Dataset:
+                   runs: list[Any], tracer: Any) -> xr.Dataset:
     """The continuation dataset (``geardyn_kind = "continuation"``) of the branches ``runs``."""
-    from geardyn.analysis.branch import branch_status_meaning
-
     n = model.n_states
     pts = [p for r in runs for p in r.points]
     offsets, k = [], 0
