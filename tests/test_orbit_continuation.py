@@ -148,6 +148,12 @@ def test_branch_switching_follows_the_period_two_orbit():
     ref = geardyn.reference_solution(mm, x, np.array([T, 2 * T]))
     assert np.max(np.abs(ref[1] - x)) < 1e-7
     assert np.max(np.abs(ref[0] - x)) > 1e-3
+    # a function decides which doublings to switch at
+    asked = []
+    none = geardyn.continuation(m, "Omega", 1.9, 1.5, switch=lambda b: asked.append(b) or False)
+    assert none.sizes["branch_id"] == 1 and len(asked) == pd.size
+    assert asked[0].kind == "period-doubling" and asked[0].value == pytest.approx(
+        ds["bifurcation_value"].values[pd[0]], abs=1e-6)
 
 
 def test_failures_end_the_branch_with_a_message_keeping_the_points():
@@ -171,36 +177,47 @@ def test_failures_end_the_branch_with_a_message_keeping_the_points():
     assert "Omega=0.9" in bad.attrs["message"]
 
 
-@pytest.mark.slow
 def test_paper_device_period_doubling_agrees_with_the_brute_force_diagram():
     """Fig. 3's device: the period-1 branch turns period 2 at a located period doubling that
-    lies in the step of the brute-force diagram where its period goes from 1 to 2; the branch's
-    multipliers there agree with differences of the reference integrator's period map."""
+    lies in the step of the brute-force diagram where its period goes from 1 to 2; the switched
+    period-2 branch ends at Omega = 1.05 on the attractor the sweep shows there; the branch's
+    multipliers agree with differences of the reference integrator's period map."""
     base = geardyn.CATTDevice(geardyn.PlanetaryParams.paper(xi1=0.05, xi2=0.05),
                               interpretation="consistent")
-    ds = geardyn.continuation(base, "Omega", 0.9, 1.4)
-    pd = _table(ds, "period-doubling")
-    assert pd.size >= 1
+    end = 1.05
+    ds = geardyn.continuation(base, "Omega", 0.9, end, switch=True, max_period=2)
+    pd = _table(ds.where(ds["bifurcation_branch"] == 0, drop=True), "period-doubling")
+    assert pd.size == 1
     h = 0.01
-    vals = np.round(np.arange(0.95, 1.3 + h / 2, h), 6)
+    vals = np.round(np.arange(0.95, 1.1 + h / 2, h), 6)
     bf = geardyn.bifurcation(base, "Omega", vals, continuation="up", transient=1500.0,
-                             continued_transient=200.0, transient_max=6000.0, converge=1e-8,
+                             continued_transient=200.0, transient_max=6000.0, converge=1e-9,
                              samples=8)
     per = bf["period"].values
     first2 = vals[np.argmax(per == 2)]
     assert per[0] == 1 and np.any(per == 2)
     assert first2 - h - 1e-9 <= pd[0] <= first2 + 1e-9
-    # multipliers at the branch point nearest Omega = 1.2 vs the reference integrator
-    k = int(np.argmin(np.abs(ds["Omega"].values - 1.2)))
-    om, x = float(ds["Omega"].values[k]), ds["section_point"].values[k]
+    # the period-2 branch's last point, at Omega = end, is on the sweep's period-2 attractor
+    two = ds.where(ds["branch"] == 1, drop=True)
+    assert np.all(two["period"].values == 2)
+    assert two["Omega"].values[-1] == end and two["stability"].values[-1] == "stable"
+    k = int(np.argmin(np.abs(vals - end)))
+    assert per[k] == 2
+    seen = bf["poincare"].values[k]  # (sample, state)
+    x = two["section_point"].values[-1]
+    assert np.min(np.max(np.abs(seen - x), axis=1)) < 1e-5
+    # multipliers at the branch point nearest Omega = 1 vs the reference integrator
+    one = ds.where(ds["branch"] == 0, drop=True)
+    j = int(np.argmin(np.abs(one["Omega"].values - 1.0)))
+    om, x = float(one["Omega"].values[j]), one["section_point"].values[j]
     m, T, d = base.with_omega(om), 2 * math.pi / om, 1e-5
     M = np.empty((x.size, x.size))
-    for j in range(x.size):
+    for q in range(x.size):
         e = np.zeros(x.size)
-        e[j] = d
-        M[:, j] = (geardyn.reference_solution(m, x + e, np.array([T]))[0]
+        e[q] = d
+        M[:, q] = (geardyn.reference_solution(m, x + e, np.array([T]))[0]
                    - geardyn.reference_solution(m, x - e, np.array([T]))[0]) / (2 * d)
-    mu = ds["multiplier_real"].values[k] + 1j * ds["multiplier_imag"].values[k]
+    mu = one["multiplier_real"].values[j] + 1j * one["multiplier_imag"].values[j]
     ref = np.linalg.eigvals(M)
     assert np.max(np.abs(np.sort_complex(mu) - np.sort_complex(ref))) < 1e-4
 
