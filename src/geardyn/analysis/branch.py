@@ -27,6 +27,7 @@ parameter is known to ``locate_tol``.
 
 from __future__ import annotations
 
+import copy
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
@@ -45,6 +46,7 @@ from geardyn.analysis.branch_data import (
     branch_status_meaning as branch_status_meaning,
 )
 from geardyn.analysis.orbits import (
+    GUESS_PERIODS,
     OrbitStatus,
     ShootingEval,
     ShootingProblem,
@@ -69,6 +71,9 @@ SHRINK_ITER = 9
 DP_REL = 1e-6
 #: Least cosine between successive tangents for a step to be accepted.
 MIN_COS = 0.9
+#: The default guess at the start: a transient of GUESS_PERIODS section periods, at most
+#: GUESS_TIME time units.
+GUESS_TIME = 2000.0
 #: Default location tolerance in the parameter.
 LOCATE_TOL = 1e-7
 #: Most trials of a location.
@@ -162,6 +167,10 @@ class _Tracer:
         self.scale = self.base.scale
         self.n = self.base.steps_per_period
         self._cache: dict[float, np.ndarray] = {}
+        self._renewed_at = math.nan
+        # Omega alone moves and no other forcing acts: the section stays one forcing period
+        others = model.other_frequencies(np.atleast_2d(model.params))
+        self._one_section = param == "Omega" and bool(np.all(np.isnan(others)))
 
     # -- parameters
     def params_at(self, p: float) -> np.ndarray:
@@ -189,6 +198,13 @@ class _Tracer:
         return P
 
     def problem_at(self, p: float, n: int | None = None) -> ShootingProblem:
+        """The shooting problem at p with ``n`` (default the current) steps per period."""
+        if self._one_section:  # as ShootingProblem.with_params, without re-deriving the section
+            P = self.params_at(p)
+            model = copy.copy(self.base.model)
+            model.params = P
+            return replace(self.base, model=model, params=P, omega=p, sections=1,
+                           steps_per_period=int(n or self.n))
         try:
             pr = self.base.with_params(self.params_at(p))
         except _Invalid:
@@ -207,7 +223,10 @@ class _Tracer:
 
     def renew_steps(self, p: float) -> None:
         """Re-derive the steps per period at p where the rule's count left the ratio
-        :data:`STEP_RATIO` of the current one."""
+        :data:`STEP_RATIO` of the current one (asked only after p moved by 2 %)."""
+        if abs(p - self._renewed_at) <= 0.02 * abs(p):
+            return
+        self._renewed_at = p
         want = self.steps_for(p)
         if not (self.n / STEP_RATIO <= want <= self.n * STEP_RATIO):
             self.n = want
@@ -588,7 +607,8 @@ def continuation(model: Model, param: str = "Omega", start: float | None = None,
     period
         k: orbits of the k-th iterate of the section map.
     guess
-        A state near the orbit at ``start`` (default: the end of a transient run there).
+        A state near the orbit at ``start`` (default: the end of a transient run there, 200
+        section periods but at most :data:`GUESS_TIME` time units; ``run.transient`` if given).
     run
         :class:`~geardyn.RunSettings` (``steps_per_period``, ``bound``, ``transient`` of the
         default guess).
@@ -645,7 +665,9 @@ def _first_branch(tracer: _Tracer, st: _Settings, start: float, stop: float,
     """Converge the orbit at ``start`` and continue it towards ``stop``."""
     pr = tracer.problem_at(start)
     if guess is None:
-        guess = default_guess(pr, transient=None if run is None else run.transient)
+        T_s = pr.sections * 2 * math.pi / pr.omega
+        transient = min(GUESS_PERIODS * T_s, GUESS_TIME) if run is None else run.transient
+        guess = default_guess(pr, transient=transient)
     guess = np.asarray(guess, dtype=float)
     if guess.shape != (pr.model.n_states,):
         raise ValueError(f"guess must have {pr.model.n_states} entries")
