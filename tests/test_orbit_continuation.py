@@ -14,6 +14,7 @@ from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
 import geardyn
+import geardyn.io
 from continuation_cases import van_der_pol
 from geardyn import BranchStatus, ContinuedSweep, continued_sweeps
 
@@ -29,11 +30,15 @@ def _linear_amplitude(om, zeta: float, fa: float) -> np.ndarray:
     return fa * om**2 / np.abs(1.0 - om**2 + 2j * zeta * om)
 
 
-def test_linear_branch_is_the_analytic_frequency_response():
+def test_linear_branch_is_the_analytic_frequency_response(tmp_path):
     zeta, fa = 0.05, 0.02
     m = geardyn.GearPair(zeta=zeta, kappa=0.0, Fm=2.0, Fa=fa)
-    ds = geardyn.continuation(m, "Omega", 0.5, 1.5)
+    seen = []
+    ds = geardyn.continuation(m, "Omega", 0.5, 1.5, progress=lambda k, v: seen.append((k, v)))
     geardyn.testing.assert_result(ds, "continuation")
+    assert seen[-1] == (ds.sizes["point"], 1.5)
+    geardyn.io.save_dataset(ds, tmp_path / "branch.nc")
+    assert geardyn.io.load_dataset(tmp_path / "branch.nc").identical(ds)
     assert ds.attrs["status"] == BranchStatus.COMPLETED, ds.attrs["message"]
     om = ds["Omega"].values
     assert om[0] == 0.5 and om[-1] == 1.5 and ds.sizes["point"] > 10

@@ -396,8 +396,9 @@ class _BranchRunner:
         if self.st.progress is not None:
             self.st.progress(len(self.points), tr.p_of(pt.z))
 
-    def run(self, first: _Point, ds: float, skip_first_tests: bool = False
-            ) -> tuple[BranchStatus, str]:
+    def run(self, first: _Point, ds: float) -> tuple[BranchStatus, str]:
+        """Continue from ``first`` (converged, with its tangent) with first step ``ds`` until
+        the branch ends; returns how it ended."""
         tr, st = self.tr, self.st
         cur, s = first, 0.0
         self.record(cur, s)
@@ -433,8 +434,7 @@ class _BranchRunner:
                                                     f"{end:.8g} (last point not corrected "
                                                     f"onto the bound)")
             new_tests = _tests(nxt)
-            if not (skip_first_tests and len(self.points) == 1):
-                self._detect(cur, nxt, tests, new_tests)
+            self._detect(cur, nxt, tests, new_tests)
             s += float(np.linalg.norm(nxt.z - cur.z))
             self.record(nxt, s)
             if end is not None:
