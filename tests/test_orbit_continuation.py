@@ -137,9 +137,10 @@ def test_branch_switching_follows_the_period_two_orbit():
     once-iterated one, and it starts at the located doubling."""
     m = geardyn.GearPair(zeta=0.02, Fm=0.1, Fa=0.1, kappa=0.2)
     ds = geardyn.continuation(m, "Omega", 1.9, 1.5, switch=True, max_period=2)
-    pd = np.flatnonzero(ds["bifurcation_kind"].values == "period-doubling")
+    pd = np.flatnonzero((ds["bifurcation_kind"].values == "period-doubling")
+                        & (ds["bifurcation_branch"].values == 0))
     assert pd.size >= 1
-    assert ds.sizes["branch_id"] == 1 + pd.size
+    assert ds.sizes["branch_id"] == 1 + pd.size  # period-2 branches not switched again
     two = ds.where(ds["branch"] == 1, drop=True)
     assert np.all(two["period"].values == 2) and two.sizes["point"] > 3
     assert ds["branch_parent"].values[1] == pd[0]
@@ -157,6 +158,7 @@ def test_branch_switching_follows_the_period_two_orbit():
     asked = []
     none = geardyn.continuation(m, "Omega", 1.9, 1.5, switch=lambda b: asked.append(b) or False)
     assert none.sizes["branch_id"] == 1 and len(asked) == pd.size
+    assert np.all(ds["branch_period"].values[1:] == 2)
     assert asked[0].kind == "period-doubling" and asked[0].value == pytest.approx(
         ds["bifurcation_value"].values[pd[0]], abs=1e-6)
 
