@@ -174,7 +174,7 @@ def test_failures_end_the_branch_with_a_message_keeping_the_points():
     # a bound that the resonant orbit exceeds: the integration diverges
     lin = geardyn.GearPair(zeta=0.05, Fm=2.0, Fa=0.02)
     ds = geardyn.continuation(lin, "Omega", 0.5, 1.5, run=geardyn.RunSettings(bound=3.1))
-    assert ds.attrs["status"] in (BranchStatus.DIVERGED, BranchStatus.NOT_CONVERGED)
+    assert ds.attrs["status"] == BranchStatus.DIVERGED
     assert "Omega=" in ds.attrs["message"] and ds.sizes["point"] > 2
     assert ds["Omega"].values.max() < 1.0
     # no orbit at the start: a Newton that cannot converge (one iteration)
