@@ -182,6 +182,14 @@ def test_failures_end_the_branch_with_a_message_keeping_the_points():
                                1.0, guess=np.array([3.0, 2.0]), tol=1e-300)
     assert bad.attrs["status"] == BranchStatus.START_FAILED and bad.sizes["point"] == 0
     assert "Omega=0.9" in bad.attrs["message"]
+    # a second excitation at a fixed Lambda: next to Omega = 3 the forcings have no common
+    # period, so no branch of periodic orbits leaves it
+    from geardyn.io import builtin_study
+
+    fig14 = geardyn.build_model(builtin_study("paper_fig14")).with_omega(3.0)
+    qp = geardyn.continuation(fig14, "Omega", 3.0, 3.5)
+    assert qp.attrs["status"] == BranchStatus.START_FAILED
+    assert "no common period" in qp.attrs["message"]
 
 
 def test_paper_device_period_doubling_agrees_with_the_brute_force_diagram():

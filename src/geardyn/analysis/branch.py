@@ -211,6 +211,9 @@ class _Tracer:
             raise
         except ValueError as err:
             raise _Invalid(str(err)) from err
+        if pr.sections != self.base.sections:
+            raise _Invalid(f"the common period of the forcings changes from {self.base.sections}"
+                           f" to {pr.sections} forcing periods (another section map)")
         return replace(pr, steps_per_period=int(n or self.n))
 
     def steps_for(self, p: float) -> int:
@@ -677,7 +680,11 @@ def _first_branch(tracer: _Tracer, st: _Settings, start: float, stop: float,
                          f"no orbit at {tracer.param}={start:.8g}: {res.message}")
     z = tracer.z_of(res.x, start)
     ev = res.evaluation
-    J = tracer.jacobian(z, ev)
+    try:
+        J = tracer.jacobian(z, ev)
+    except (_Invalid, FloatingPointError) as err:
+        return BranchRun(tracer.period, [], [], BranchStatus.START_FAILED,
+                         f"no branch from {tracer.param}={start:.8g}: next to it {err}")
     pt = _Point(z, ev, pr, J, iterations=res.iterations)
     pt.tangent = _null_tangent(J, stop - start)
     runner = _BranchRunner(tracer, st, 0)
