@@ -120,7 +120,7 @@ class _Point:
 
 
 @dataclass
-class Bifurcation:
+class BifurcationPoint:
     """A located bifurcation: ``kind`` (fold, period-doubling, neimark-sacker, contact),
     parameter value ``value`` with ``error`` (a bound on the distance to the true switch point
     of the test function), ``index`` (the branch point before it), ``branch`` (the branch's
@@ -146,7 +146,7 @@ class BranchRun:
 
     period: int
     points: list[BranchPoint]
-    bifurcations: list[Bifurcation]
+    bifurcations: list[BifurcationPoint]
     status: BranchStatus
     message: str
     parent: int = -1
@@ -390,7 +390,7 @@ class _BranchRunner:
     def __init__(self, tracer: _Tracer, st: _Settings, number: int):
         self.tr, self.st, self.number = tracer, st, number
         self.points: list[BranchPoint] = []
-        self.bifs: list[Bifurcation] = []
+        self.bifs: list[BifurcationPoint] = []
 
     def record(self, pt: _Point, s: float) -> None:
         tr = self.tr
@@ -467,7 +467,7 @@ class _BranchRunner:
 
     # -- detection and location
     def _detect(self, a: _Point, b: _Point, ta: dict, tb: dict) -> None:
-        found: list[Bifurcation] = []
+        found: list[BifurcationPoint] = []
         for kind, key in (("fold", "fold"), ("period-doubling", "pd"),
                           ("neimark-sacker", "ns")):
             if np.sign(ta[key]) != np.sign(tb[key]) and ta[key] != 0 and tb[key] != 0:
@@ -522,7 +522,7 @@ class _BranchRunner:
         return _Point(z, a.ev, a.problem, a.jac), min(every), max(every)
 
     def _locate(self, a: _Point, b: _Point, kind: str, key: str, mesh: int | None
-                ) -> Bifurcation | None:
+                ) -> BifurcationPoint | None:
         """Regula falsi (Illinois) on the arclength fraction between a and b for the zero of
         the test function (bisection for the contact count), each trial corrected."""
         tr = self.tr
@@ -584,7 +584,7 @@ class _BranchRunner:
         else:
             detail = f"multiplier {crit.real:.6g}"
         M = best.ev.monodromy if key != "contact" else np.full_like(a.ev.monodromy, np.nan)
-        return Bifurcation(kind, p, err, len(self.points) - 1, self.number, tr.x_of(best.z),
+        return BifurcationPoint(kind, p, err, len(self.points) - 1, self.number, tr.x_of(best.z),
                            crit, detail, M.copy(), tr.period)
 
 
@@ -594,7 +594,7 @@ def continuation(model: Model, param: str = "Omega", start: float | None = None,
                  run: RunSettings | None = None, *, ds: float = 0.01, ds_min: float = 1e-7,
                  ds_max: float = 0.2, max_points: int = 2000,
                  tol: float = CORRECTOR_TOL, locate_tol: float = LOCATE_TOL,
-                 switch: bool | Callable[[Bifurcation], bool] = False, max_period: int = 16,
+                 switch: bool | Callable[[BifurcationPoint], bool] = False, max_period: int = 16,
                  steps_per_period: int | None = None, p_scale: float | None = None,
                  progress: Callable[[int, float], None] | None = None) -> xr.Dataset:
     """Follow the period-``period`` orbit of ``model`` in ``param`` from ``start`` to ``stop``.
@@ -622,7 +622,7 @@ def continuation(model: Model, param: str = "Omega", start: float | None = None,
         Corrector tolerance (scaled residual) and the location tolerance in the parameter.
     switch
         At each located period doubling start the period-2k branch: True for every one, or a
-        function of the :class:`Bifurcation` saying whether to; recursively (a cascade) while
+        function of the :class:`BifurcationPoint` saying whether to; recursively (a cascade) while
         2k <= ``max_period``.
     steps_per_period
         RK4 steps per forcing period, fixed (default: :data:`BRANCH_STEP_FACTOR` times the step
@@ -694,7 +694,7 @@ def _first_branch(tracer: _Tracer, st: _Settings, start: float, stop: float,
 
 def _switch_all(model: Model, param: str, runs: list[BranchRun], st: _Settings,
                 run: RunSettings | None, steps_per_period: int | None, tol: float,
-                switch: bool | Callable[[Bifurcation], bool], max_period: int,
+                switch: bool | Callable[[BifurcationPoint], bool], max_period: int,
                 pscale: float) -> None:
     """Branch switching at the period doublings of ``runs`` (growing the list: a cascade)."""
     if switch is False:
@@ -712,7 +712,7 @@ def _switch_all(model: Model, param: str, runs: list[BranchRun], st: _Settings,
         i += 1
 
 
-def _bif_number(runs: list[BranchRun], b: Bifurcation) -> int:
+def _bif_number(runs: list[BranchRun], b: BifurcationPoint) -> int:
     """The index of ``b`` in the concatenated bifurcation table of ``runs``."""
     k = 0
     for r in runs:
@@ -723,7 +723,7 @@ def _bif_number(runs: list[BranchRun], b: Bifurcation) -> int:
     return -1
 
 
-def _switched(model: Model, param: str, b: Bifurcation, number: int, st: _Settings,
+def _switched(model: Model, param: str, b: BifurcationPoint, number: int, st: _Settings,
               run: RunSettings | None, steps_per_period: int | None, tol: float,
               pscale: float) -> BranchRun:
     """The period-2k branch from the period doubling ``b``: predictor along the eigenvector of
