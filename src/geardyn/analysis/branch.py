@@ -71,6 +71,11 @@ SHRINK_ITER = 9
 DP_REL = 1e-6
 #: Least cosine between successive tangents for a step to be accepted.
 MIN_COS = 0.9
+#: Most movement of any Floquet multiplier (to the nearest of the last point's) in a step:
+#: beyond it the step is halved (down to MU_MOVE_DS), so that a multiplier does not cross the
+#: unit circle twice unseen within a step.
+MAX_MU_MOVE = 0.3
+MU_MOVE_DS = 1e-3
 #: The default guess at the start: a transient of GUESS_PERIODS section periods, at most
 #: GUESS_TIME time units.
 GUESS_TIME = 2000.0
@@ -357,6 +362,11 @@ def _tests(pt: _Point) -> dict[str, Any]:
             "ns": ns, "contact": tuple(int(c[i] + c[j]) for _, i, j in meshes)}
 
 
+def _spectrum_moved(a: np.ndarray, b: np.ndarray) -> float:
+    """The largest distance from a multiplier of ``b`` to the nearest of ``a``."""
+    return float(np.max(np.min(np.abs(b[:, None] - a[None, :]), axis=1)))
+
+
 def _critical(kind: str, mu: np.ndarray) -> complex:
     """The multiplier that a bifurcation of ``kind`` is about."""
     if kind == "fold":
@@ -416,7 +426,9 @@ class _BranchRunner:
                 got = tr.correct(z_pred, cur.tangent, cur.jac)
                 if isinstance(got, _Point):
                     got.tangent = tr.tangent(got.jac, cur.tangent)
-                    if got.tangent @ cur.tangent >= MIN_COS or ds <= st.ds_min:
+                    turn = got.tangent @ cur.tangent < MIN_COS
+                    moved = _spectrum_moved(cur.mu, got.mu) > MAX_MU_MOVE and ds > MU_MOVE_DS
+                    if not (turn or moved) or ds <= st.ds_min:
                         nxt = got
                         break
                     got = _Failure(BranchStatus.NOT_CONVERGED, f"the tangent turned sharply "
