@@ -268,3 +268,30 @@ def test_neimark_sacker_of_the_forced_van_der_pol_oscillator_keeps_liouville():
     g = ds["gamma"].values
     assert set(ds["stability"].values[g > gamma + 1e-3]) == {"stable"}
     assert set(ds["stability"].values[g < gamma - 1e-3]) == {"unstable"}
+
+
+def test_physical_parameter_of_the_device_period_doubling_on_the_reference_map():
+    """Continued in the device's damping ratio xi (a physical parameter: every coefficient is
+    re-derived) at Omega = 1.2, the period-1 orbit regains stability through -1; at the located
+    xi the reference integrator's period map (DOP853, central differences) has a multiplier -1."""
+    base = geardyn.CATTDevice(geardyn.PlanetaryParams.paper(xi1=0.05, xi2=0.05),
+                              interpretation="consistent")
+    guess = geardyn.periodic_orbit(base, omega=1.0).x
+    m = base.with_omega(1.2)
+    ds = geardyn.continuation(m, "xi", 0.05, 0.3, guess=guess)
+    assert ds.attrs["status"] == BranchStatus.COMPLETED, ds.attrs["message"]
+    pd = np.flatnonzero(ds["bifurcation_kind"].values == "period-doubling")
+    assert pd.size == 1
+    xi = float(ds["bifurcation_value"].values[pd[0]])
+    x = ds["bifurcation_section_point"].values[pd[0]]
+    at = m.with_params(xi=xi)
+    T, d = 2 * math.pi / 1.2, 1e-5
+    assert np.max(np.abs(geardyn.reference_solution(at, x, np.array([T]))[0] - x)) < 1e-6
+    M = np.empty((x.size, x.size))
+    for q in range(x.size):
+        e = np.zeros(x.size)
+        e[q] = d
+        M[:, q] = (geardyn.reference_solution(at, x + e, np.array([T]))[0]
+                   - geardyn.reference_solution(at, x - e, np.array([T]))[0]) / (2 * d)
+    assert np.min(np.abs(np.linalg.eigvals(M) + 1.0)) < 1e-4
+    assert ds["stability"].values[0] == "unstable" and ds["stability"].values[-1] == "stable"
