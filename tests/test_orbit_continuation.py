@@ -171,6 +171,8 @@ def test_failures_end_the_branch_with_a_message_keeping_the_points():
     assert ds["kappa"].values.max() < 1.0
     with pytest.raises(ValueError, match="valid region"):
         geardyn.continuation(m, "kappa", 1.2, 1.5)
+    with pytest.raises(KeyError, match="known"):
+        geardyn.continuation(m, "kapa", 0.2, 0.5)
     # a bound that the resonant orbit exceeds: the integration diverges
     lin = geardyn.GearPair(zeta=0.05, Fm=2.0, Fa=0.02)
     ds = geardyn.continuation(lin, "Omega", 0.5, 1.5, run=geardyn.RunSettings(bound=3.1))

@@ -644,10 +644,10 @@ def continuation(model: Model, param: str = "Omega", start: float | None = None,
 
     Returns a Dataset (``geardyn_kind = "continuation"``; see ``docs/continuation.md``): the
     points of every branch along ``point``, the bifurcations along ``bifurcation``, one entry
-    per branch along ``branch``. A failure is not an exception: it ends its branch with
+    per branch along ``branch_id``. A failure is not an exception: it ends its branch with
     ``branch_status`` and ``branch_message`` naming the parameter value, keeping its points.
     """
-    if start is None:
+    if start is None:  # a coefficient's current value (a KeyError naming the known ones)
         start = float(model.params[model._param_index(param)])
     if stop is None:
         raise ValueError("stop: give the other end of the parameter range")
@@ -659,9 +659,9 @@ def continuation(model: Model, param: str = "Omega", start: float | None = None,
     pscale = float(p_scale) if p_scale else abs(stop - start)
     st = _Settings(min(start, stop), max(start, stop), ds, ds_min, ds_max, int(max_points),
                    float(locate_tol), progress)
-    try:
+    try:  # an unknown name: the model's KeyError naming the known ones
         at_start = model.with_params(**{param: start})
-    except (ValueError, KeyError) as err:
+    except ValueError as err:
         raise ValueError(f"{param}={start:g} is outside the model's valid region: {err}"
                          ) from err
     tracer = _Tracer(at_start, param, period, pscale, run, steps_per_period, tol,
