@@ -662,6 +662,8 @@ def continuation(model: Model, param: str = "Omega", start: float | None = None,
     try:  # an unknown name: the model's KeyError naming the known ones
         at_start = model.with_params(**{param: start})
     except ValueError as err:
+        if isinstance(err, KeyError):  # UnknownParameterError is both
+            raise
         raise ValueError(f"{param}={start:g} is outside the model's valid region: {err}"
                          ) from err
     tracer = _Tracer(at_start, param, period, pscale, run, steps_per_period, tol,
