@@ -41,6 +41,7 @@ test-slow: $(STAMP)
 bench: $(STAMP)
 	$(BIN)/python bench/bifurcation.py
 	$(BIN)/python bench/map.py --write
+	$(BIN)/python bench/continuation.py
 
 # geardyn against plain numba RK4, SciPy LSODA, diffrax and numbalsoda on the gear-pair workload,
 # all in one run (about 1-2 min on 2 cores); replaces the "## Peers" section of bench/RESULTS.md.

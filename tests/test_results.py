@@ -72,8 +72,29 @@ def _orbit() -> xr.Dataset:
     return ds
 
 
+def _branch() -> xr.Dataset:
+    n = 3
+    ds = xr.Dataset(coords={"point": ("point", np.arange(n)),
+                            "Omega": ("point", [0.5, 0.6, 0.7]), "state": ("state", ["x", "v"]),
+                            "multiplier": ("multiplier", [0, 1]), "branch_id": ("branch_id", [0])})
+    ds["section_point"] = (("point", "state"), np.zeros((n, 2)))
+    ds["multiplier_real"] = (("point", "multiplier"), np.full((n, 2), 0.5))
+    ds["multiplier_imag"] = (("point", "multiplier"), np.zeros((n, 2)))
+    ds["stability"] = ("point", ["stable"] * n)
+    ds["branch"] = ("point", np.zeros(n, dtype=int))
+    ds["period"] = ("point", np.ones(n, dtype=int), PERIOD)
+    ds["bifurcation_kind"] = ("bifurcation", ["fold"])
+    ds["bifurcation_value"] = ("bifurcation", [0.55])
+    ds["branch_status"] = ("branch_id", [0])
+    ds["branch_message"] = ("branch_id", ["reached Omega=0.7"])
+    ds.attrs.update(geardyn_kind="continuation", param="Omega", start=0.5, stop=0.7, period=1,
+                    status=0, message="reached Omega=0.7", status_meaning="0 completed",
+                    time_unit="tau")
+    return ds
+
+
 BUILD = {"simulation": _simulation, "bifurcation": _sweep, "map2d": _map,
-         "reproduction-case": _case, "periodic-orbit": _orbit}
+         "reproduction-case": _case, "periodic-orbit": _orbit, "continuation": _branch}
 
 
 @pytest.mark.parametrize("kind", KINDS)
@@ -84,7 +105,8 @@ def test_well_formed_results_pass(kind):
 @pytest.mark.parametrize("kind,name", [("simulation", "poincare"), ("simulation", "v"),
                                        ("bifurcation", "period"), ("bifurcation", "status"),
                                        ("map2d", "status"), ("reproduction-case", "poincare"),
-                                       ("periodic-orbit", "monodromy")])
+                                       ("periodic-orbit", "monodromy"),
+                                       ("continuation", "bifurcation_value")])
 def test_a_removed_variable_is_named(kind, name):
     ds = BUILD[kind]().drop_vars(name)
     with pytest.raises(AssertionError, match=f"'{name}' missing"):

@@ -11,6 +11,7 @@ The public API::
 from geardyn import testing
 from geardyn._version import __version__ as __version__
 from geardyn.analysis.bifurcation import ContinuedSweep, bifurcation, continued_sweeps
+from geardyn.analysis.branch import BifurcationPoint, BranchStatus, continuation
 from geardyn.analysis.lyapunov import LyapunovEstimate, lyapunov, lyapunov_lanes
 from geardyn.analysis.map2d import map2d
 from geardyn.analysis.motion import motion_classes
@@ -32,6 +33,8 @@ from geardyn.study import build_model
 
 __all__ = [
     "INTERPRETATIONS",
+    "BifurcationPoint",
+    "BranchStatus",
     "CATTDevice",
     "Carrier",
     "ContinuedSweep",
@@ -56,6 +59,7 @@ __all__ = [
     "build_model",
     "classify_period",
     "common_section",
+    "continuation",
     "continued_sweeps",
     "label_peaks",
     "lyapunov",

@@ -611,8 +611,10 @@ def check_model(
 #: The kinds of result dataset, as recorded in ``attrs["geardyn_kind"]``: what
 #: :func:`geardyn.simulate`, :func:`geardyn.bifurcation`, :func:`geardyn.map2d` and the
 #: reproduction (``geardyn reproduce``, one case under one interpretation) and
-#: :func:`geardyn.periodic_orbit` (``PeriodicOrbit.to_dataset()``) return.
-KINDS = ("simulation", "bifurcation", "map2d", "reproduction-case", "periodic-orbit")
+#: :func:`geardyn.periodic_orbit` (``PeriodicOrbit.to_dataset()``) and
+#: :func:`geardyn.continuation` return.
+KINDS = ("simulation", "bifurcation", "map2d", "reproduction-case", "periodic-orbit",
+         "continuation")
 
 
 def _result_spec(ds: Any, kind: str) -> tuple[list[str], dict[str, tuple[str, ...]],
@@ -649,6 +651,17 @@ def _result_spec(ds: Any, kind: str) -> tuple[list[str], dict[str, tuple[str, ..
                  "converged", "orbit_status", "message", "residual", "stability"],
                 {"time": ("time",), "state": ("state",), "multiplier": ("multiplier",)},
                 variables, [])
+    if kind == "continuation":
+        p = str(a.get("param", "Omega"))
+        return (["param", "start", "stop", "period", "status", "message", "status_meaning",
+                 "time_unit"],
+                {"point": ("point",), p: ("point",), "state": ("state",),
+                 "multiplier": ("multiplier",), "branch_id": ("branch_id",)},
+                {"section_point": ("point", "state"), "multiplier_real": ("point", "multiplier"),
+                 "multiplier_imag": ("point", "multiplier"), "stability": ("point",),
+                 "branch": ("point",), "bifurcation_kind": ("bifurcation",),
+                 "bifurcation_value": ("bifurcation",), "branch_status": ("branch_id",),
+                 "branch_message": ("branch_id",)}, [])
     raise AssertionError(f"unknown result kind {kind!r}: one of {', '.join(KINDS)}")
 
 
