@@ -10,6 +10,7 @@ The public API::
 
 from geardyn import testing
 from geardyn._version import __version__ as __version__
+from geardyn.analysis.basins import basins
 from geardyn.analysis.bifurcation import ContinuedSweep, bifurcation, continued_sweeps
 from geardyn.analysis.lyapunov import LyapunovEstimate, lyapunov, lyapunov_lanes
 from geardyn.analysis.map2d import map2d
@@ -52,6 +53,7 @@ __all__ = [
     "StudyError",
     "UserModel",
     "amplitude_spectrum",
+    "basins",
     "bifurcation",
     "build_model",
     "classify_period",
