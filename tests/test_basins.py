@@ -183,3 +183,14 @@ def test_figure_marks_every_attractor_and_the_diverged_cells(tmp_path, bistable)
     ds["attractor_id"][0, 0] = -1
     fig = plot_basins(ds)
     assert any("diverged" in t.get_text() for t in fig.axes[0].get_legend().get_texts())
+
+
+def test_plot_command_redraws_a_saved_basins_result(tmp_path, bistable):
+    from geardyn.io.netcdf import save_dataset
+
+    _, ds = bistable
+    nc = tmp_path / "b.nc"
+    save_dataset(ds, nc)
+    r = _invoke("plot", nc, "--out", tmp_path / "again.png")
+    assert r.exit_code == 0, r.output
+    assert "basins dataset" in r.stdout and (tmp_path / "again.png").exists()

@@ -88,8 +88,24 @@ def _basins() -> xr.Dataset:
     return ds
 
 
+def _frc() -> xr.Dataset:
+    ds = xr.Dataset(coords={"sweep": ("sweep", ["up", "down"]), "Omega": ("Omega", [0.5, 1.0]),
+                            "mesh": ("mesh", ["mesh"]), "jump": ("jump", [0])})
+    for name in ("dte_rms", "dte_peak", "dte_mean"):
+        ds[name] = (("sweep", "Omega", "mesh"), np.ones((2, 2, 1)), {"units": "1"})
+    ds["period"] = (("sweep", "Omega"), np.ones((2, 2), dtype=int), PERIOD)
+    ds["status"] = (("sweep", "Omega"), np.zeros((2, 2), dtype=int), status_attrs())
+    ds["hysteresis"] = ("Omega", [False, True])
+    ds["jump_omega"] = ("jump", [0.75], {"meaning": "midpoint"})
+    ds["jump_sweep"] = ("jump", ["up"])
+    ds.attrs.update(geardyn_kind="frequency-response", param="Omega", time_unit="tau",
+                    resolution=0.5)
+    return ds
+
+
 BUILD = {"simulation": _simulation, "bifurcation": _sweep, "map2d": _map,
-         "reproduction-case": _case, "periodic-orbit": _orbit, "basins": _basins}
+         "reproduction-case": _case, "periodic-orbit": _orbit, "basins": _basins,
+         "frequency-response": _frc}
 
 
 @pytest.mark.parametrize("kind", KINDS)
@@ -101,7 +117,8 @@ def test_well_formed_results_pass(kind):
                                        ("bifurcation", "period"), ("bifurcation", "status"),
                                        ("map2d", "status"), ("reproduction-case", "poincare"),
                                        ("periodic-orbit", "monodromy"),
-                                       ("basins", "attractor_id")])
+                                       ("basins", "attractor_id"),
+                                       ("frequency-response", "dte_rms")])
 def test_a_removed_variable_is_named(kind, name):
     ds = BUILD[kind]().drop_vars(name)
     with pytest.raises(AssertionError, match=f"'{name}' missing"):

@@ -12,6 +12,7 @@ from geardyn import testing
 from geardyn._version import __version__ as __version__
 from geardyn.analysis.basins import basins
 from geardyn.analysis.bifurcation import ContinuedSweep, bifurcation, continued_sweeps
+from geardyn.analysis.frc import frequency_response
 from geardyn.analysis.lyapunov import LyapunovEstimate, lyapunov, lyapunov_lanes
 from geardyn.analysis.map2d import map2d
 from geardyn.analysis.motion import motion_classes
@@ -59,6 +60,7 @@ __all__ = [
     "classify_period",
     "common_section",
     "continued_sweeps",
+    "frequency_response",
     "label_peaks",
     "lyapunov",
     "lyapunov_lanes",

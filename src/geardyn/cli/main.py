@@ -11,6 +11,7 @@
     geardyn plot RESULT.nc [--out fig.png|fig.pdf] [--state X_sq]
     geardyn basins STUDY.toml --omega W --x X_sq:LO:HI:N --y V_sq:LO:HI:N [--out b.nc]
                    [--plot b.png]
+    geardyn frc STUDY.toml [--range 0.5:1.5:201] [--out frc.nc] [--plot frc.png]
 
 A STUDY argument is a TOML file or the name of a built-in study (``paper_fig3``). Every expected
 error (bad parameters, missing files, invalid TOML, bad values) and every usage error ends the
@@ -307,6 +308,7 @@ def main(argv: list[str] | None = None) -> int:
 __import__("geardyn.cli.map", fromlist=["register"]).register(app)  # geardyn map (cli/map.py)
 __import__("geardyn.cli.reproduce", fromlist=["register"]).register(app)  # cli/reproduce.py
 __import__("geardyn.cli.basins", fromlist=["register"]).register(app)  # cli/basins.py
+__import__("geardyn.cli.frc", fromlist=["register"]).register(app)  # cli/frc.py
 
 if __name__ == "__main__":
     main()
