@@ -312,6 +312,7 @@ def match_orbits(ds: xr.Dataset, orbits: Sequence[Any]) -> xr.Dataset:
     ds = ds.copy()
     ds["attractor_orbit"] = ("attractor", found, ds["attractor_orbit"].attrs)
     ds.attrs["n_orbits"] = len(orbits)
+    ds.attrs.setdefault("orbit_names", ", ".join(f"orbit {j}" for j in range(len(orbits))))
     return ds
 
 

@@ -28,8 +28,9 @@ def _label(ds: xr.Dataset, a: int) -> str:
     if "attractor_contact" in ds:
         text += f", contact {', '.join(str(c) for c in ds['attractor_contact'].values[a])}"
     orbit = int(ds["attractor_orbit"].values[a])
+    names = str(ds.attrs.get("orbit_names", "")).split(", ")
     if orbit >= 0:
-        text += f", orbit {orbit}"
+        text += f", {names[orbit]}" if orbit < len(names) and names[orbit] else f", orbit {orbit}"
     return text
 
 
