@@ -133,3 +133,14 @@ def test_cli_writes_what_the_api_computes_and_draws_it(tmp_path):
     assert {"sweep up", "sweep down", "branch, stable", "branch, unstable"} <= labels
     r = CliRunner().invoke(app, ["frc", str(study), "--mesh", "nope", "--quiet"])
     assert r.exit_code == 2 and "--mesh" in r.stderr
+    # the branch from a file, over the figure; and geardyn plot redraws the saved curves
+    from geardyn.io.netcdf import save_dataset
+
+    save_dataset(branch, tmp_path / "branch.nc")
+    r = CliRunner().invoke(app, ["frc", str(study), "--quiet", "--branch",
+                                 str(tmp_path / "branch.nc"), "--plot", str(png)])
+    assert r.exit_code == 0, r.output
+    r = CliRunner().invoke(app, ["frc", str(study), "--quiet", "--branch", str(nc)])
+    assert r.exit_code == 2 and "no dimension 'point'" in r.stderr
+    r = CliRunner().invoke(app, ["plot", str(nc), "--out", str(tmp_path / "again.pdf")])
+    assert r.exit_code == 0 and "frequency response dataset" in r.stdout

@@ -4,7 +4,8 @@
 
     geardyn frc STUDY.toml [--range 0.5:1.5:201] [--transient T] [--continued-transient T]
                 [--converge TOL] [--samples N] [--steps-per-period N] [--mesh NAME]
-                [--interpretation ...] [--quiet] [--yes] [--out frc.nc] [--plot frc.png]
+                [--branch branch.nc ...] [--interpretation ...] [--quiet] [--yes]
+                [--out frc.nc] [--plot frc.png]
 
 Unset options come from the study's ``[sweep]`` (start, stop, num, samples; the sweep must be
 of Omega) and ``[run]`` tables. A progress bar is drawn when stderr is a terminal.
@@ -13,6 +14,7 @@ of Omega) and ``[run]`` tables. A progress bar is drawn when stderr is a termina
 from __future__ import annotations
 
 import time
+from pathlib import Path
 from typing import Annotated
 
 import typer
@@ -61,6 +63,11 @@ def frc_command(
     ] = None,
     steps_per_period: StepsOption = None,
     mesh: Annotated[str | None, typer.Option(help="Mesh drawn (default: the first).")] = None,
+    branch: Annotated[
+        list[Path] | None, typer.Option(help="A continuation branch (NetCDF: dim 'point', "
+                                             "Omega, dte_rms, ..., stable) drawn over the "
+                                             "curves; repeatable.")
+    ] = None,
     interpretation: InterpretationOption = None,
     quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No progress bar.")] = False,
     yes: YesOption = False,
@@ -111,6 +118,7 @@ def frc_command(
                    False, yes=yes, option="--range/--samples/--transient",
                    value=f"{start:g}:{stop:g}:{num}, {n_samples} samples, transient {tr:g}",
                    what="frequency response")
+    branches = [_load_branch(p) for p in branch or []]
     make_parents(out, plot)
     show_bar = not quiet and _stderr_is_terminal()
     t0 = time.perf_counter()
@@ -128,11 +136,27 @@ def frc_command(
     if plot is not None:
         from geardyn.plotting.frc import plot_frc
 
-        plot_frc(ds, path=plot, mesh=mesh)
+        plot_frc(ds, path=plot, mesh=mesh, branches=branches)
         written.append(str(plot))
     typer.echo(f"{s.study.name}: {num} values of Omega in [{start:g}, {stop:g}] up and down, "
                f"{elapsed:.1f} s: {_summary(ds)}"
                + (f"; wrote {', '.join(written)}" if written else "; nothing written"))
+
+
+def _load_branch(path: Path):
+    """A continuation branch to draw: a NetCDF dataset with the dimension ``point``."""
+    from geardyn.io.netcdf import load_dataset
+
+    if not path.exists():
+        raise FileNotFoundError(2, "No such file", str(path))
+    try:
+        b = load_dataset(path)
+    except (OSError, ValueError, KeyError) as exc:
+        raise ParameterError("--branch", str(path), f"cannot read it as NetCDF ({exc})") \
+            from None
+    if "point" not in b.dims:
+        raise ParameterError("--branch", str(path), "not a branch (no dimension 'point')")
+    return b
 
 
 def _summary(ds) -> str:

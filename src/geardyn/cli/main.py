@@ -11,7 +11,7 @@
     geardyn plot RESULT.nc [--out fig.png|fig.pdf] [--state X_sq]
     geardyn basins STUDY.toml --omega W --x X_sq:LO:HI:N --y V_sq:LO:HI:N [--out b.nc]
                    [--plot b.png]
-    geardyn frc STUDY.toml [--range 0.5:1.5:201] [--out frc.nc] [--plot frc.png]
+    geardyn frc STUDY.toml [--range 0.5:1.5:201] [--branch b.nc] [--out frc.nc] [--plot frc.png]
 
 A STUDY argument is a TOML file or the name of a built-in study (``paper_fig3``). Every expected
 error (bad parameters, missing files, invalid TOML, bad values) and every usage error ends the
