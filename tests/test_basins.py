@@ -113,6 +113,26 @@ def test_linear_case_has_one_attractor_the_analytic_steady_state():
                         1.0, rel_tol=1e-12)
 
 
+def test_a_chaotic_attractor_is_one_attractor_without_period():
+    """The gear pair that tests/test_lyapunov.py shows chaotic (nearby trajectories separate):
+    every cell reaches it; non-periodic lanes are grouped by their section points' extent."""
+    g = geardyn.GearPair(zeta=0.02, kappa=0.2, Fm=0.1, Fa=0.3, Omega=0.92)
+    ds = geardyn.basins(g, None, ("x", 0.0, 2.0, 5), ("v", -1.0, 1.0, 4), transient=500.0,
+                        samples=64, converge=None)
+    assert np.all(ds["period"].values == 0)
+    np.testing.assert_array_equal(ds["attractor_period"].values, [0])
+    np.testing.assert_array_equal(ds["attractor_fraction"].values, [1.0])
+    assert np.all(np.isfinite(ds["attractor_point"].values[0, 0]))
+
+
+def test_orbits_at_another_frequency_are_refused(bistable):
+    from geardyn.analysis.basins import match_orbits
+
+    g, ds = bistable
+    with pytest.raises(ValueError, match="Omega"):
+        match_orbits(ds, [geardyn.periodic_orbit(g, omega=0.9)])
+
+
 def test_bad_input_is_named():
     g = geardyn.GearPair(**PAIR)
     with pytest.raises(ValueError, match="X_sq"):

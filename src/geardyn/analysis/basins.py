@@ -196,9 +196,9 @@ def _orbit_matches(orbits: Sequence[Any], period: np.ndarray, points: list[np.nd
 # ---------------------------------------------------------------------------- the analysis
 def basins(
     model: Model,
-    omega: float | None = None,
-    x: Axis = ("x", -1.0, 1.0, 11),
-    y: Axis = ("v", -1.0, 1.0, 11),
+    omega: float | None,
+    x: Axis,
+    y: Axis,
     run: RunSettings | None = None,
     *,
     base: np.ndarray | Sequence[float] | None = None,
@@ -214,7 +214,7 @@ def basins(
     Parameters
     ----------
     omega
-        Forcing frequency (default the model's).
+        Forcing frequency (None: the model's).
     x, y
         The grid's axes: ``(state, lo, hi, n)`` (n evenly spaced values) or ``(state, values)``,
         a state name of the model (``model.state_names``, e.g. ``"X_sq"``, ``"V_sq"`` for the
