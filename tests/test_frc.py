@@ -30,6 +30,8 @@ def test_linear_regime_equals_the_analytic_frequency_response():
         one = ds.sel(sweep=s, mesh="mesh")
         np.testing.assert_allclose(one["dte_rms"].values, A / math.sqrt(2), rtol=2e-6)
         np.testing.assert_allclose(one["dte_peak"].values, A, rtol=5e-6)
+        np.testing.assert_allclose(one["dte_amplitude"].values, A, rtol=5e-6)
+        np.testing.assert_allclose(one["dte_max"].values, fm + 1.0 + A, rtol=5e-6)
         np.testing.assert_allclose(one["dte_mean"].values, fm + 1.0, rtol=1e-9)
         force = A * np.abs(1 + 2j * zeta * om)
         np.testing.assert_allclose(one["dynamic_factor"].values, 1 + force / fm, rtol=1e-3)
@@ -131,6 +133,15 @@ def test_cli_writes_what_the_api_computes_and_draws_it(tmp_path):
     fig = plot_frc(direct, branches=[branch])
     labels = {t.get_text() for t in fig.axes[0].get_legend().get_texts()}
     assert {"sweep up", "sweep down", "branch, stable", "branch, unstable"} <= labels
+    # ... and one named as geardyn.continuation names its variables, two branch numbers
+    cont = branch.drop_vars("stable").rename(dte_rms="deflection_rms",
+                                             dte_amplitude="deflection_amplitude")
+    cont["stability"] = ("point", np.where(branch["stable"].values, "stable", "unstable"))
+    cont["branch"] = ("point", (np.arange(cont.sizes["point"]) >= 10).astype(int))
+    fig = plot_frc(direct, branches=[cont])
+    for ax in fig.axes[:3]:
+        drawn = [ln for ln in ax.get_lines() if ln.get_color() == "black"]
+        assert len(drawn) == 4  # two branches, stable and unstable each
     r = CliRunner().invoke(app, ["frc", str(study), "--mesh", "nope", "--quiet"])
     assert r.exit_code == 2 and "--mesh" in r.stderr
     # the branch from a file, over the figure; and geardyn plot redraws the saved curves

@@ -7,8 +7,10 @@ mesh the classic gear-dynamics quantities:
 
 * the dynamic transmission error (DTE), i.e. the mesh deflection delta (the midpoint of the
   mesh's dead-zone switching functions, (delta - b + delta + b) / 2): its mean ``dte_mean``,
-  the RMS of its alternating part ``dte_rms`` (about the mean) and its peak alternating value
-  ``dte_peak`` = max |delta - mean|. They are measured over one period of the attractor (k
+  the RMS of its alternating part ``dte_rms`` (about the mean), its peak alternating value
+  ``dte_peak`` = max |delta - mean|, its amplitude ``dte_amplitude`` = (max - min) / 2 and
+  its largest magnitude ``dte_max`` = max |delta| (extremes refined by a parabola through the
+  largest sample and its neighbours). They are measured over one period of the attractor (k
   forcing periods for a period-k motion, ``samples`` forcing periods when it has no period),
   integrated once more from the sweep's final state at its final time on the sweep's own grid
   (fixed-step RK4, the edges located), every grid point counted (the rectangle rule, spectrally
@@ -33,10 +35,13 @@ unit is 1/omega_n, or a :class:`~geardyn.DimensionalCATT`, in seconds) the datas
 frequency in Hz and the input (carrier) speed in rpm as coordinates along ``Omega``: with the
 sun held fixed the sun mesh's frequency is z_sun times the carrier speed.
 
-Overlaying a continuation branch: the variables are named so that a branch dataset (dim
-``point`` along the branch, the parameter ``Omega`` a variable, the same names ``dte_rms``,
-``dte_peak``, ``dynamic_factor`` (point, mesh) and a boolean ``stable`` (point)) can be drawn
-over the curves (:func:`geardyn.plotting.frc.plot_frc`'s ``branches``).
+Overlaying a continuation branch: a branch dataset (dim ``point`` along the branch, the
+parameter ``Omega`` a variable) is drawn over the curves by
+:func:`geardyn.plotting.frc.plot_frc` (``branches``), its variables read under these names or
+those of :func:`geardyn.continuation`'s branches (``deflection_rms`` for ``dte_rms``,
+``deflection_amplitude`` for ``dte_amplitude``, ``deflection_max`` for ``dte_max``;
+``dynamic_factor`` alike), stability from ``stable`` (bool) or ``stability`` ("stable", ...),
+one line per ``branch`` number.
 """
 
 from __future__ import annotations
@@ -93,13 +98,18 @@ def mesh_deflections(model: Model, G: np.ndarray) -> np.ndarray:
     return np.stack([(G[..., d] + G[..., b]) / 2.0 for _, d, b in model.meshes], axis=-1)
 
 
+#: The DTE statistics, in the order :func:`_dte_stats` returns them.
+DTE_STATS = ("dte_mean", "dte_rms", "dte_peak", "dte_amplitude", "dte_max")
+
+
 def _dte_stats(model: Model, p: np.ndarray, y: np.ndarray, t0: float, n: int, periods: int,
-               bound: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(mean, RMS about the mean, peak |delta - mean|) of each mesh deflection over
-    ``periods`` forcing periods from state ``y`` at time ``t0`` and forcing phase 0 (the
-    sweep's final state), ``n`` steps a period; NaN when the run diverges. The run starts at
-    the whole forcing period nearest ``t0`` (the forcing phase is exact; a second excitation's
-    phase is that of this time, see the ``dte_window`` attribute)."""
+               bound: float) -> tuple[np.ndarray, ...]:
+    """:data:`DTE_STATS` of each mesh deflection (mean, RMS about the mean, max |delta -
+    mean|, (max - min) / 2, max |delta|) over ``periods`` forcing periods from state ``y`` at
+    time ``t0`` and forcing phase 0 (the sweep's final state), ``n`` steps a period; NaN when
+    the run diverges. The run starts at the whole forcing period nearest ``t0`` (the forcing
+    phase is exact; a second excitation's phase is that of this time, see the ``dte_window``
+    attribute)."""
     k = kernels_for(model.kernel)
     omega = float(p[model.omega_index])
     h = 2.0 * math.pi / omega / n
@@ -107,26 +117,25 @@ def _dte_stats(model: Model, p: np.ndarray, y: np.ndarray, t0: float, n: int, pe
     steps = periods * n
     _, _, G, _, status, _, _ = k.trajectory(p, y, h, omega, n, i0, steps, 1, True, bound,
                                             model.n_events, model.n_observables)
-    nan = np.full(len(model.meshes), np.nan)
     if status != Status.OK:
-        return nan, nan, nan
+        return tuple(np.full(len(model.meshes), np.nan) for _ in DTE_STATS)
     d = mesh_deflections(model, G[:-1])  # one whole number of periods: the last repeats
     mean = np.mean(d, axis=0)
     alt = d - mean
-    return mean, np.sqrt(np.mean(alt * alt, axis=0)), _peaks(alt)
+    top, bottom = _refined_max(d), -_refined_max(-d)
+    return (mean, np.sqrt(np.mean(alt * alt, axis=0)), np.maximum(top - mean, mean - bottom),
+            0.5 * (top - bottom), np.maximum(np.abs(top), np.abs(bottom)))
 
 
-def _peaks(alt: np.ndarray) -> np.ndarray:
-    """max |alt| of each column (samples over whole periods, so periodic), refined by the
-    parabola through the largest sample and its two neighbours (the extremum of a smooth
-    signal: error O(h^3) instead of the samples' O(h^2))."""
-    out = np.empty(alt.shape[1])
-    n = alt.shape[0]
-    for m in range(alt.shape[1]):
-        a = alt[:, m]
-        i = int(np.argmax(np.abs(a)))
-        sign = 1.0 if a[i] >= 0 else -1.0
-        y0, y1, y2 = sign * a[(i - 1) % n], sign * a[i], sign * a[(i + 1) % n]
+def _refined_max(a: np.ndarray) -> np.ndarray:
+    """The largest value of each column of ``a`` (samples over whole periods, so periodic),
+    refined by the parabola through the largest sample and its two neighbours (the extremum of
+    a smooth signal: error O(h^3) instead of the samples' O(h^2))."""
+    out = np.empty(a.shape[1])
+    n = a.shape[0]
+    for m in range(a.shape[1]):
+        i = int(np.argmax(a[:, m]))
+        y0, y1, y2 = a[(i - 1) % n, m], a[i, m], a[(i + 1) % n, m]
         curv = y0 - 2.0 * y1 + y2
         out[m] = y1 - (y0 - y2) ** 2 / (8.0 * curv) if curv < 0 else y1
     return out
@@ -183,6 +192,7 @@ def frequency_response(
     -------
     xarray.Dataset (``geardyn_kind = "frequency-response"``) with dims ``sweep`` ("up",
     "down"), ``Omega``, ``mesh`` and ``jump``: ``dte_mean``, ``dte_rms``, ``dte_peak``,
+    ``dte_amplitude``, ``dte_max``,
     ``force_rms``, ``force_peak``, ``dynamic_factor`` (sweep, Omega, mesh), ``period``,
     ``status`` (sweep, Omega), ``contact`` (sweep, Omega, mesh), ``hysteresis`` (Omega), the
     jump table ``jump_sweep``, ``jump_mesh``, ``jump_omega``, ``jump_lo``, ``jump_hi``,
@@ -217,7 +227,7 @@ def _dataset(model: Model, om: np.ndarray, runs: tuple[xr.Dataset, xr.Dataset],
              run: RunSettings) -> xr.Dataset:
     n_mesh = len(model.meshes)
     shape = (len(SWEEPS), om.size, n_mesh)
-    stats = {k: np.full(shape, np.nan) for k in ("dte_mean", "dte_rms", "dte_peak")}
+    stats = {k: np.full(shape, np.nan) for k in DTE_STATS}
     P = model.lane_params("Omega", om)
     for s, sw in enumerate(runs):
         final = _final_states(sw)
@@ -229,7 +239,7 @@ def _dataset(model: Model, om: np.ndarray, runs: tuple[xr.Dataset, xr.Dataset],
             periods = k * every if k > 0 else run.samples
             out = _dte_stats(model, P[j], final[j], float(sw["final_time"].values[j]),
                              int(sw["steps_per_period"].values[j]), periods, run.bound)
-            for name, v in zip(("dte_mean", "dte_rms", "dte_peak"), out, strict=True):
+            for name, v in zip(DTE_STATS, out, strict=True):
                 stats[name][s, j] = v
     ds = xr.Dataset(coords={"sweep": ("sweep", list(SWEEPS)),
                             "Omega": ("Omega", om, {"long_name": "forcing (mesh) frequency",
@@ -247,6 +257,10 @@ def _dataset(model: Model, om: np.ndarray, runs: tuple[xr.Dataset, xr.Dataset],
         "units": units})
     ds["dte_peak"] = (dims, stats["dte_peak"], {
         "long_name": "peak dynamic transmission error, max |deflection - mean|", "units": units})
+    ds["dte_amplitude"] = (dims, stats["dte_amplitude"], {
+        "long_name": "DTE amplitude, (max - min) / 2 of the mesh deflection", "units": units})
+    ds["dte_max"] = (dims, stats["dte_max"], {
+        "long_name": "largest |mesh deflection|", "units": units})
     for name in ("force_rms", "force_peak", "dynamic_factor", "contact"):
         if name in runs[0]:
             ds[name] = (dims, np.stack([r[name].values for r in runs]), runs[0][name].attrs)

@@ -18,7 +18,14 @@ from geardyn.plotting.style import RC
 __all__ = ["PANELS", "plot_frc"]
 
 #: (variable, axis label) of each panel, top to bottom.
-PANELS = (("dte_rms", "RMS DTE"), ("dte_peak", "peak DTE"), ("dynamic_factor", "dynamic factor"))
+PANELS = (("dte_rms", "RMS DTE"), ("dte_amplitude", "DTE amplitude\n(max - min) / 2"),
+          ("dynamic_factor", "dynamic factor"))
+#: Names a continuation branch may give each variable (geardyn.continuation's first).
+BRANCH_NAMES = {"dte_rms": ("dte_rms", "deflection_rms"),
+                "dte_amplitude": ("dte_amplitude", "deflection_amplitude"),
+                "dte_max": ("dte_max", "deflection_max"),
+                "dte_peak": ("dte_peak",),
+                "dynamic_factor": ("dynamic_factor",)}
 SWEEP_STYLE = {"up": {"color": "#1f77b4", "marker": ">", "label": "sweep up"},
                "down": {"color": "#d62728", "marker": "<", "label": "sweep down"}}
 
@@ -38,20 +45,36 @@ def _bands(omega: np.ndarray, band: np.ndarray) -> list[tuple[float, float]]:
     return out
 
 
-def _branch(ax, branch: xr.Dataset, name: str, mesh: str | None) -> None:
-    """One continuation branch (dim ``point``) of ``name``: stable solid, unstable dashed."""
+def _stable(branch: xr.Dataset) -> np.ndarray:
+    """Per point: stable (``stable`` bool, or ``stability == "stable"``; all when neither)."""
+    if "stable" in branch:
+        return branch["stable"].values.astype(bool)
+    if "stability" in branch:
+        return branch["stability"].values.astype(str) == "stable"
+    return np.ones(branch.sizes["point"], dtype=bool)
+
+
+def _branch(ax, branch: xr.Dataset, name: str, mesh: str | None, labelled: set[str]) -> None:
+    """A continuation branch dataset (dim ``point``) of ``name`` (or an alias,
+    :data:`BRANCH_NAMES`): stable solid, unstable dashed, one line per ``branch`` number."""
     param = str(branch.attrs.get("param", "Omega"))
-    if name not in branch or param not in branch:
+    found = next((n for n in BRANCH_NAMES.get(name, (name,)) if n in branch), None)
+    if found is None or param not in branch:
         return
-    y = branch[name]
+    y = branch[found]
     if "mesh" in y.dims:
-        y = y.sel(mesh=mesh) if mesh is not None else y.isel(mesh=0)
+        y = y.sel(mesh=mesh) if mesh is not None and mesh in y["mesh"] else y.isel(mesh=0)
     x, y = branch[param].values, y.values
-    stable = branch["stable"].values.astype(bool) if "stable" in branch else np.ones(x.size, bool)
-    for flag, ls in ((True, "-"), (False, "--")):
-        yy = np.where(stable == flag, y, np.nan)
-        ax.plot(x, yy, color="black", ls=ls, lw=1.0,
-                label="branch, " + ("stable" if flag else "unstable"))
+    stable = _stable(branch)
+    ids = branch["branch"].values if "branch" in branch else np.zeros(x.size, int)
+    for b in np.unique(ids):
+        on = ids == b
+        for flag, ls in ((True, "-"), (False, "--")):
+            label = "branch, " + ("stable" if flag else "unstable")
+            yy = np.where(on & (stable == flag), y, np.nan)
+            ax.plot(x[on], yy[on], color="black", ls=ls, lw=1.0,
+                    label=None if label in labelled else label)
+            labelled.add(label)
 
 
 def plot_frc(ds: xr.Dataset, path: str | os.PathLike | None = None, *, mesh: str | None = None,
@@ -81,8 +104,9 @@ def plot_frc(ds: xr.Dataset, path: str | os.PathLike | None = None, *, mesh: str
                 style = SWEEP_STYLE.get(str(s), {"label": str(s)})
                 ax.plot(om, ds[name].sel(sweep=s, mesh=mesh).values, ms=3, lw=0.8,
                         markevery=max(1, om.size // 60), **style)
+            labelled: set[str] = set()
             for b in branches:
-                _branch(ax, b, name, mesh)
+                _branch(ax, b, name, mesh, labelled)
             for j in range(ds.sizes.get("jump", 0)):
                 if str(ds["jump_mesh"].values[j]) != mesh:
                     continue
