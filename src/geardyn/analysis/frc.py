@@ -22,13 +22,14 @@ Jumps: ``hysteresis`` marks the points where the up and down sweeps disagree (``
 some mesh differing by more than ``band_tol`` relative where at least one sweep is periodic,
 or the contact regime differing, or the period where both sweeps found one): there two
 attractors coexist. (Where neither sweep found a period, their RMS values are two finite
-samplings of non-periodic motion and differ anyway: no evidence of coexistence.) A sweep
-jumps where it leaves such a band in its direction (the up sweep at the band's top, the down
-sweep at its bottom), its ``dte_rms`` changing there by more than ``jump_tol`` relative to the
-larger value. The jump lies between the two grid points (``jump_lo``, ``jump_hi``): it is
-located to one grid step (``resolution``), reported at the midpoint (``jump_omega``). A band
-that reaches an end of the grid has its jump outside it (``band_at_grid_end`` = 1); a steep
-but single-valued change (a resonance on a coarse grid) is no jump.
+samplings of non-periodic motion and differ anyway: no evidence of coexistence.) Each sweep
+leaves a band of coexistence by a jump: per band, sweep and mesh, the grid step touching the
+band (from the point before it to the point after it) where ``dte_rms`` changes most, if by
+more than ``jump_tol`` relative to the larger value. The jump lies between the step's two grid
+points (``jump_lo``, ``jump_hi``): it is located to one grid step (``resolution``), reported
+at the midpoint (``jump_omega``). A band that reaches an end of the grid may have its jump
+outside it (``band_at_grid_end`` = 1); a steep but single-valued change (a resonance on a
+coarse grid) is no jump.
 
 Physical axes: where the model has physical units (a :class:`~geardyn.CATTDevice`, whose time
 unit is 1/omega_n, or a :class:`~geardyn.DimensionalCATT`, in seconds) the dataset has the mesh
@@ -147,19 +148,35 @@ def _relative(a: np.ndarray, b: np.ndarray) -> np.ndarray:
         return np.abs(a - b) / np.maximum(np.maximum(np.abs(a), np.abs(b)), 1e-300)
 
 
-def _jumps(name: str, rms: np.ndarray, band: np.ndarray, tol: float
-           ) -> list[tuple[int, int, int]]:
-    """(lower index, upper index, mesh) of each jump of the sweep ``name`` (values ascending):
-    a step out of the hysteresis ``band`` in the sweep's direction (the up sweep leaves a band
-    at its top, the down sweep at its bottom) where ``rms`` (Omega, mesh) changes by more than
-    ``tol`` relative."""
-    rel = _relative(rms[1:], rms[:-1])
-    if name == "up":
-        edge = band[:-1] & ~band[1:]
-    else:
-        edge = ~band[:-1] & band[1:]
-    return [(int(j), int(j) + 1, int(m)) for j, m in zip(*np.nonzero(edge[:, None] & (rel > tol)),
-                                                        strict=True)]
+def _band_runs(band: np.ndarray) -> list[tuple[int, int]]:
+    """(first, last) index of each run of True in ``band``."""
+    runs, start = [], None
+    for j, b in enumerate(band):
+        if b and start is None:
+            start = j
+        if start is not None and (not b or j == band.size - 1):
+            runs.append((start, j if b else j - 1))
+            start = None
+    return runs
+
+
+def _jumps(rms: np.ndarray, band: np.ndarray, tol: float) -> list[tuple[int, int, int]]:
+    """(lower index, upper index, mesh) of the jumps of one sweep (values ascending): per band
+    of coexistence and mesh, the step touching the band (from its last point before to its
+    first point after) where ``rms`` (Omega, mesh) changes most, if by more than ``tol``
+    relative."""
+    rel = _relative(rms[1:], rms[:-1])  # step j: from point j to j + 1
+    out = []
+    for first, last in _band_runs(band):
+        steps = np.arange(max(first - 1, 0), min(last + 1, rel.shape[0]))
+        if steps.size == 0:
+            continue
+        for m in range(rms.shape[1]):
+            r = np.where(np.isfinite(rel[steps, m]), rel[steps, m], -np.inf)
+            j = int(steps[int(np.argmax(r))])
+            if rel[j, m] > tol:
+                out.append((j, j + 1, m))
+    return out
 
 
 # ---------------------------------------------------------------------------- the analysis
@@ -310,7 +327,7 @@ def _mark_band_and_jumps(ds: xr.Dataset, jump_tol: float, band_tol: float) -> No
     band = differ & ok
     rows = []
     for s, name in enumerate(SWEEPS):
-        for lo, hi, m in _jumps(name, rms[s], band, jump_tol):
+        for lo, hi, m in _jumps(rms[s], band, jump_tol):
             before, after = (lo, hi) if name == "up" else (hi, lo)
             rows.append((name, ds["mesh"].values[m], 0.5 * (om[lo] + om[hi]), om[lo], om[hi],
                          rms[s, before, m], rms[s, after, m]))

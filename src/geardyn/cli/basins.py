@@ -149,7 +149,7 @@ def _with_orbits(model, om, ds, k_max: int):
 
     orbits = []
     for a in range(ds.sizes["attractor"]):
-        k = int(ds["attractor_period"].values[a])
+        k = int(ds["section_period"].values[a])  # sections, as periodic_orbit counts
         if 1 <= k <= k_max:
             orbits.append(periodic_orbit(model, om, period=k,
                                          guess=ds["attractor_point"].values[a, 0]))
