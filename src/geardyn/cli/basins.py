@@ -160,8 +160,10 @@ def _summary(ds) -> str:
     parts = []
     for a in range(ds.sizes["attractor"]):
         k = int(ds["attractor_period"].values[a])
+        orbit = int(ds["attractor_orbit"].values[a])
         parts.append(f"#{a} {'period-' + str(k) if k > 0 else 'no period'} "
-                     f"{100 * float(ds['attractor_fraction'].values[a]):.1f}%")
+                     f"{100 * float(ds['attractor_fraction'].values[a]):.1f}%"
+                     + (f" (Newton orbit {orbit})" if orbit >= 0 else ""))
     parts.append(f"diverged {100 * float(ds.attrs['diverged_fraction']):.1f}%")
     return ", ".join(parts)
 
