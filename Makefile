@@ -24,8 +24,12 @@ demo: $(STAMP)
 	$(BIN)/geardyn bifurcation paper_fig3 --interpretation consistent --out out/fig3.nc --plot out/fig3.png
 	$(BIN)/geardyn simulate paper_fig3 --interpretation consistent --omega 1.1 --out out/fig3_omega1.1.nc --plot out/fig3_omega1.1.png
 
+# warm_kernels compiles the built-in models' kernels once, two models at a time, before the two
+# test workers start (else both compile the same kernels side by side); with a warm cache it
+# only loads them.
 test: $(STAMP)
 	$(BIN)/ruff check src tests
+	$(BIN)/python tests/warm_kernels.py --jobs 2
 	$(BIN)/python -m pytest -n 2 -q
 
 # The long studies only (marked @pytest.mark.slow; pyproject's addopts keep them out of
@@ -37,6 +41,7 @@ test-slow: $(STAMP)
 bench: $(STAMP)
 	$(BIN)/python bench/bifurcation.py
 	$(BIN)/python bench/map.py --write
+	$(BIN)/python bench/continuation.py
 
 # geardyn against plain numba RK4, SciPy LSODA, diffrax and numbalsoda on the gear-pair workload,
 # all in one run (about 1-2 min on 2 cores); replaces the "## Peers" section of bench/RESULTS.md.

@@ -5,13 +5,13 @@ from __future__ import annotations
 
 import math
 
-import numba as nb
 import numpy as np
 import pytest
 
 import geardyn
 from geardyn.analysis import lyapunov as lyap_mod
 from geardyn.solvers.kernels import kernels_for
+from test_lyapunov import lorenz_rhs as _lorenz  # one Lorenz kernel for both files
 
 #: Gear pair lanes: chaotic, period-1 with contact loss (two edge crossings per period).
 CHAOTIC = dict(zeta=0.02, kappa=0.2, Fm=0.1, Fa=0.3)
@@ -110,13 +110,6 @@ def test_generic_lane_path_general_catt_model():
     args = _lanes(model, om, 40, [2, 0, 3], [6, 8, 5], model.initial_state(), [0.0, 0.0, 2.0])
     ref = _reference(kern, model, args, 10, 1)
     _assert_bitwise(_blocks(kern, model, args, 10, 1, 64), ref)
-
-
-@nb.njit(cache=True)
-def _lorenz(t, y, dy, p):
-    dy[0] = p[0] * (y[1] - y[0])
-    dy[1] = y[0] * (p[1] - y[2]) - y[1]
-    dy[2] = y[0] * y[1] - p[2] * y[2]
 
 
 def test_public_lanes_equal_one_lane_kernel(monkeypatch):

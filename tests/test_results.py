@@ -72,8 +72,61 @@ def _orbit() -> xr.Dataset:
     return ds
 
 
+def _branch() -> xr.Dataset:
+    n = 3
+    ds = xr.Dataset(coords={"point": ("point", np.arange(n)),
+                            "Omega": ("point", [0.5, 0.6, 0.7]), "state": ("state", ["x", "v"]),
+                            "multiplier": ("multiplier", [0, 1]), "branch_id": ("branch_id", [0])})
+    ds["section_point"] = (("point", "state"), np.zeros((n, 2)))
+    ds["multiplier_real"] = (("point", "multiplier"), np.full((n, 2), 0.5))
+    ds["multiplier_imag"] = (("point", "multiplier"), np.zeros((n, 2)))
+    ds["stability"] = ("point", ["stable"] * n)
+    ds["branch"] = ("point", np.zeros(n, dtype=int))
+    ds["period"] = ("point", np.ones(n, dtype=int), PERIOD)
+    ds["bifurcation_kind"] = ("bifurcation", ["fold"])
+    ds["bifurcation_value"] = ("bifurcation", [0.55])
+    ds["branch_status"] = ("branch_id", [0])
+    ds["branch_message"] = ("branch_id", ["reached Omega=0.7"])
+    ds.attrs.update(geardyn_kind="continuation", param="Omega", start=0.5, stop=0.7, period=1,
+                    status=0, message="reached Omega=0.7", status_meaning="0 completed",
+                    time_unit="tau")
+    return ds
+
+
+def _basins() -> xr.Dataset:
+    ds = xr.Dataset(coords={"v": ("v", [0.0, 1.0]), "x": ("x", [1.0, 2.0, 3.0]),
+                            "attractor": ("attractor", [0, 1]), "point": ("point", [0]),
+                            "state": ("state", ["x", "v"])})
+    ds["attractor_id"] = (("v", "x"), np.array([[0, 0, 1], [1, -1, 0]]), {"meaning": "id"})
+    ds["period"] = (("v", "x"), np.ones((2, 3), dtype=int), PERIOD)
+    ds["status"] = (("v", "x"), np.zeros((2, 3), dtype=int), status_attrs())
+    ds["attractor_period"] = ("attractor", [1, 1])
+    ds["attractor_fraction"] = ("attractor", [0.5, 1 / 3], {"meaning": "share"})
+    ds["attractor_point"] = (("attractor", "point", "state"), np.zeros((2, 1, 2)))
+    ds["attractor_orbit"] = ("attractor", [-1, -1])
+    ds.attrs.update(geardyn_kind="basins", x="x", y="v", Omega=1.0, time_unit="tau",
+                    diverged_fraction=1 / 6, n_attractors=2)
+    return ds
+
+
+def _frc() -> xr.Dataset:
+    ds = xr.Dataset(coords={"sweep": ("sweep", ["up", "down"]), "Omega": ("Omega", [0.5, 1.0]),
+                            "mesh": ("mesh", ["mesh"]), "jump": ("jump", [0])})
+    for name in ("dte_rms", "dte_peak", "dte_mean"):
+        ds[name] = (("sweep", "Omega", "mesh"), np.ones((2, 2, 1)), {"units": "1"})
+    ds["period"] = (("sweep", "Omega"), np.ones((2, 2), dtype=int), PERIOD)
+    ds["status"] = (("sweep", "Omega"), np.zeros((2, 2), dtype=int), status_attrs())
+    ds["hysteresis"] = ("Omega", [False, True])
+    ds["jump_omega"] = ("jump", [0.75], {"meaning": "midpoint"})
+    ds["jump_sweep"] = ("jump", ["up"])
+    ds.attrs.update(geardyn_kind="frequency-response", param="Omega", time_unit="tau",
+                    resolution=0.5)
+    return ds
+
+
 BUILD = {"simulation": _simulation, "bifurcation": _sweep, "map2d": _map,
-         "reproduction-case": _case, "periodic-orbit": _orbit}
+         "reproduction-case": _case, "periodic-orbit": _orbit, "continuation": _branch,
+         "basins": _basins, "frequency-response": _frc}
 
 
 @pytest.mark.parametrize("kind", KINDS)
@@ -84,7 +137,10 @@ def test_well_formed_results_pass(kind):
 @pytest.mark.parametrize("kind,name", [("simulation", "poincare"), ("simulation", "v"),
                                        ("bifurcation", "period"), ("bifurcation", "status"),
                                        ("map2d", "status"), ("reproduction-case", "poincare"),
-                                       ("periodic-orbit", "monodromy")])
+                                       ("periodic-orbit", "monodromy"),
+                                       ("continuation", "bifurcation_value"),
+                                       ("basins", "attractor_id"),
+                                       ("frequency-response", "dte_rms")])
 def test_a_removed_variable_is_named(kind, name):
     ds = BUILD[kind]().drop_vars(name)
     with pytest.raises(AssertionError, match=f"'{name}' missing"):

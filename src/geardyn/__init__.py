@@ -10,7 +10,10 @@ The public API::
 
 from geardyn import testing
 from geardyn._version import __version__ as __version__
+from geardyn.analysis.basins import basins
 from geardyn.analysis.bifurcation import ContinuedSweep, bifurcation, continued_sweeps
+from geardyn.analysis.branch import BifurcationPoint, BranchStatus, continuation
+from geardyn.analysis.frc import frequency_response
 from geardyn.analysis.lyapunov import LyapunovEstimate, lyapunov, lyapunov_lanes
 from geardyn.analysis.map2d import map2d
 from geardyn.analysis.motion import motion_classes
@@ -32,6 +35,8 @@ from geardyn.study import build_model
 
 __all__ = [
     "INTERPRETATIONS",
+    "BifurcationPoint",
+    "BranchStatus",
     "CATTDevice",
     "Carrier",
     "ContinuedSweep",
@@ -52,11 +57,14 @@ __all__ = [
     "StudyError",
     "UserModel",
     "amplitude_spectrum",
+    "basins",
     "bifurcation",
     "build_model",
     "classify_period",
     "common_section",
+    "continuation",
     "continued_sweeps",
+    "frequency_response",
     "label_peaks",
     "lyapunov",
     "lyapunov_lanes",

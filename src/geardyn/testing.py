@@ -611,8 +611,10 @@ def check_model(
 #: The kinds of result dataset, as recorded in ``attrs["geardyn_kind"]``: what
 #: :func:`geardyn.simulate`, :func:`geardyn.bifurcation`, :func:`geardyn.map2d` and the
 #: reproduction (``geardyn reproduce``, one case under one interpretation) and
-#: :func:`geardyn.periodic_orbit` (``PeriodicOrbit.to_dataset()``) return.
-KINDS = ("simulation", "bifurcation", "map2d", "reproduction-case", "periodic-orbit")
+#: :func:`geardyn.periodic_orbit` (``PeriodicOrbit.to_dataset()``), :func:`geardyn.continuation`,
+#: :func:`geardyn.basins` and :func:`geardyn.frequency_response` return.
+KINDS = ("simulation", "bifurcation", "map2d", "reproduction-case", "periodic-orbit",
+         "continuation", "basins", "frequency-response")
 
 
 def _result_spec(ds: Any, kind: str) -> tuple[list[str], dict[str, tuple[str, ...]],
@@ -649,12 +651,42 @@ def _result_spec(ds: Any, kind: str) -> tuple[list[str], dict[str, tuple[str, ..
                  "converged", "orbit_status", "message", "residual", "stability"],
                 {"time": ("time",), "state": ("state",), "multiplier": ("multiplier",)},
                 variables, [])
+    if kind == "continuation":
+        p = str(a.get("param", "Omega"))
+        return (["param", "start", "stop", "period", "status", "message", "status_meaning",
+                 "time_unit"],
+                {"point": ("point",), p: ("point",), "state": ("state",),
+                 "multiplier": ("multiplier",), "branch_id": ("branch_id",)},
+                {"section_point": ("point", "state"), "multiplier_real": ("point", "multiplier"),
+                 "multiplier_imag": ("point", "multiplier"), "stability": ("point",),
+                 "branch": ("point",), "bifurcation_kind": ("bifurcation",),
+                 "bifurcation_value": ("bifurcation",), "branch_status": ("branch_id",),
+                 "branch_message": ("branch_id",)}, [])
+    if kind == "basins":
+        x, y = str(a.get("x", "x")), str(a.get("y", "y"))
+        return (["x", "y", "Omega", "time_unit", "diverged_fraction", "n_attractors"],
+                {y: (y,), x: (x,), "attractor": ("attractor",), "state": ("state",)},
+                {"attractor_id": (y, x), "period": (y, x), "status": (y, x),
+                 "attractor_period": ("attractor",), "attractor_fraction": ("attractor",),
+                 "attractor_point": ("attractor", "point", "state"),
+                 "attractor_orbit": ("attractor",)}, ["status"])
+    if kind == "frequency-response":
+        lead = ("sweep", "Omega")
+        return (["param", "time_unit", "resolution"],
+                {"sweep": ("sweep",), "Omega": ("Omega",), "mesh": ("mesh",),
+                 "jump": ("jump",)},
+                {"dte_rms": (*lead, "mesh"), "dte_peak": (*lead, "mesh"),
+                 "dte_mean": (*lead, "mesh"), "period": lead, "status": lead,
+                 "hysteresis": ("Omega",), "jump_omega": ("jump",), "jump_sweep": ("jump",)},
+                ["status"])
     raise AssertionError(f"unknown result kind {kind!r}: one of {', '.join(KINDS)}")
 
 
 #: Attributes a variable of each name must carry (its units or the meaning of its codes).
-_VARIABLE_ATTRS = {"period": ("meaning",), "status": ("meaning",), "final_time": ("units",),
-                   "poincare_time": ("units",), "time": ("units",)}
+_VARIABLE_ATTRS = {"period": ("meaning",), "status": ("meaning",),
+                   "final_time": ("units",), "poincare_time": ("units",), "time": ("units",),
+                   "attractor_id": ("meaning",), "attractor_fraction": ("meaning",),
+                   "dte_rms": ("units",), "dte_peak": ("units",), "jump_omega": ("meaning",)}
 
 
 def _status_problems(name: str, values: np.ndarray) -> list[str]:

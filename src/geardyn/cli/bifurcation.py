@@ -349,7 +349,8 @@ def bifurcation_command(
 
 #: What ``geardyn plot`` calls each result kind (``attrs["geardyn_kind"]``).
 _PLOT_KIND = {"simulation": "simulation", "bifurcation": "bifurcation", "map2d": "map",
-              "reproduction-case": "reproduction"}
+              "reproduction-case": "reproduction", "basins": "basins",
+              "frequency-response": "frequency response"}
 
 
 def _dataset_kind(ds) -> str:
@@ -435,6 +436,20 @@ def plot_command(
         make_parents(target)
         plot_map(ds, path=target)
         typer.echo(f"{result}: map dataset; wrote {target}")
+        return
+    if kind in ("basins", "frequency response"):
+        if state is not None:
+            raise ParameterError("--state", state, f"a {kind} figure shows no state; leave it out")
+        make_parents(target)
+        if kind == "basins":
+            from geardyn.plotting.basins import plot_basins
+
+            plot_basins(ds, path=target)
+        else:
+            from geardyn.plotting.frc import plot_frc
+
+            plot_frc(ds, path=target)
+        typer.echo(f"{result}: {kind} dataset; wrote {target}")
         return
     if kind == "reproduction":
         attrs = dict(ds.attrs, continuation=sweep.value)

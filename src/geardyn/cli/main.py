@@ -9,6 +9,9 @@
     geardyn bifurcation STUDY.toml [--param Omega] [--range 0.1:4:1000]
                      [--continuation none|up|down] [--lyapunov] [--out out.nc] [--plot out.png]
     geardyn plot RESULT.nc [--out fig.png|fig.pdf] [--state X_sq]
+    geardyn basins STUDY.toml --omega W --x X_sq:LO:HI:N --y V_sq:LO:HI:N [--out b.nc]
+                   [--plot b.png]
+    geardyn frc STUDY.toml [--range 0.5:1.5:201] [--branch b.nc] [--out frc.nc] [--plot frc.png]
 
 A STUDY argument is a TOML file or the name of a built-in study (``paper_fig3``). Every expected
 error (bad parameters, missing files, invalid TOML, bad values) and every usage error ends the
@@ -304,6 +307,8 @@ def main(argv: list[str] | None = None) -> int:
 
 __import__("geardyn.cli.map", fromlist=["register"]).register(app)  # geardyn map (cli/map.py)
 __import__("geardyn.cli.reproduce", fromlist=["register"]).register(app)  # cli/reproduce.py
+__import__("geardyn.cli.basins", fromlist=["register"]).register(app)  # cli/basins.py
+__import__("geardyn.cli.frc", fromlist=["register"]).register(app)  # cli/frc.py
 
 if __name__ == "__main__":
     main()

@@ -6,12 +6,14 @@
     geardyn reproduce --all [--interpretation consistent|carrier-only|as-printed|all]
                       [--resolution N] [--transient T] [--samples S] [--jobs N]
                       [--out out/reproduce] [--verdicts docs/reproduction-verdicts.md]
-                      [--no-figures]
+                      [--no-figures] [--basins N]
 
 Writes, under ``--out``, ``CASE-INTERPRETATION.nc`` (data), ``CASE-INTERPRETATION.png`` and
 ``...-down.png`` (the diagrams swept up and down), ``report.md``, a self-contained
 ``report.html`` and ``verdicts.md`` (every claim's verdict per interpretation; ``--verdicts``
-writes it to another path too). See ``docs/reproduction.md``.
+writes it to another path too); with ``--basins N`` also ``basins-CASE-INTERPRETATION.nc|png``
+(the basins of attraction where a case's sweeps disagree while periodic, see
+:mod:`geardyn.reproduction.basins`). See ``docs/reproduction.md``.
 """
 
 from __future__ import annotations
@@ -81,6 +83,9 @@ def reproduce_command(
     figures: Annotated[bool, typer.Option(
         "--figures/--no-figures", help="Draw the diagrams (PNG, embedded in report.html); "
         "without them only the data, the report and the verdict table are written.")] = True,
+    basins: Annotated[int, typer.Option(
+        help="Also the basins of attraction (N x N initial conditions) where a case's up and "
+             "down sweeps disagree while periodic (0: none).")] = 0,
     quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No progress bar.")] = False,
 ) -> None:
     """Recompute the paper's bifurcation diagrams (swept up and down) and write a report that
@@ -109,6 +114,8 @@ def reproduce_command(
         raise ParameterError("--samples", samples, "must be >= 2")
     if transient is not None and not transient >= 0:
         raise ParameterError("--transient", transient, "must be >= 0")
+    if not 0 <= basins <= 1000:
+        raise ParameterError("--basins", basins, "must be a grid size in 0..1000")
     if jobs is not None and jobs < 1:
         raise ParameterError("--jobs", jobs, "must be >= 1")
     workers = jobs or os.cpu_count() or 1
@@ -124,9 +131,11 @@ def reproduce_command(
         + (f" --resolution {resolution}" if resolution else "")
         + (f" --transient {transient:g}" if transient is not None else "")
         + (f" --samples {samples}" if samples else "")
+        + (f" --basins {basins}" if basins else "")
         + (f" --verdicts {verdicts}" if verdicts is not None else ""))
-    with stderr_console().status("writing figures, data and the report"):
-        paths = write_report(results, out, command=command, figures=figures)
+    with stderr_console().status("writing figures, data and the report"
+                                 + (" (and the basins of attraction)" if basins else "")):
+        paths = write_report(results, out, command=command, figures=figures, basins=basins)
     for interp in interps:
         found = evaluate({c: ds for (c, i), ds in results.items() if i == interp})
         counts: dict[str, int] = {}

@@ -90,8 +90,12 @@ def _by_interpretation(results: Results) -> dict[str, dict[str, xr.Dataset]]:
 
 
 def build_report(results: Results, figures: Mapping[tuple[str, str], dict[str, Path]],
-                 root: Path, command: str = "geardyn reproduce") -> Document:
-    """The report's content from the case results and the written figures."""
+                 root: Path, command: str = "geardyn reproduce",
+                 basins: Mapping[tuple[str, str], tuple[xr.Dataset, Path]] | None = None
+                 ) -> Document:
+    """The report's content from the case results and the written figures; ``basins``: per
+    (case, interpretation) the basins of attraction where its sweeps disagree and their figure
+    (:mod:`geardyn.reproduction.basins`)."""
     from geardyn._version import __version__
 
     per_interp = _by_interpretation(results)
@@ -236,6 +240,12 @@ def build_report(results: Results, figures: Mapping[tuple[str, str], dict[str, P
             for direction in DIRECTIONS:
                 if direction in paths:
                     doc.image(paths[direction], f"{case.figure}, {i}, swept {direction}")
+            if basins is not None and (case_name, i) in basins:
+                from geardyn.reproduction.basins import summary
+
+                b, path = basins[(case_name, i)]
+                doc.para(summary(b))
+                doc.image(path, f"{case.figure}, {i}, basins of attraction")
 
     doc.heading("Run time")
     rows = []
@@ -286,10 +296,12 @@ def _unresolved_warning(doc: Document, results: Results) -> None:
 
 
 def write_report(results: Results, out: Path, command: str = "geardyn reproduce",
-                 figures: bool = True) -> dict[str, Path]:
+                 figures: bool = True, basins: int = 0) -> dict[str, Path]:
     """Write every case's files, the report and the verdict table (``verdicts.md``, see
     :mod:`geardyn.reproduction.verdicts`) under ``out``; returns the paths of the report
-    (``"markdown"``, ``"html"``) and of the table (``"verdicts"``)."""
+    (``"markdown"``, ``"html"``) and of the table (``"verdicts"``). ``basins`` > 0: also the
+    basins of attraction (``basins`` x ``basins`` initial conditions) of every case whose up
+    and down sweeps disagree while periodic (``basins-<case>-<interpretation>.nc|png``)."""
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     written: dict[tuple[str, str], dict[str, Path]] = {}
@@ -297,7 +309,8 @@ def write_report(results: Results, out: Path, command: str = "geardyn reproduce"
         paths = write_case_files(ds, out) if figures else {
             "data": save_dataset(ds, out / f"{_file_stem(*key)}.nc")}
         written[key] = paths
-    doc = build_report(results, written, out, command)
+    found = _case_basins(results, out, basins) if basins > 0 else None
+    doc = build_report(results, written, out, command, basins=found)
     md = out / "report.md"
     md.write_text(doc.markdown(out), encoding="utf-8")
     page = out / "report.html"
@@ -306,3 +319,19 @@ def write_report(results: Results, out: Path, command: str = "geardyn reproduce"
     table = write_verdicts(evaluate_all(results), out / "verdicts.md", command, settings,
                            provisional)
     return {"markdown": md, "html": page, "verdicts": table}
+
+
+def _case_basins(results: Results, out: Path, n: int
+                 ) -> dict[tuple[str, str], tuple[xr.Dataset, Path]]:
+    """The basins of every case result (not shared with another) whose sweeps disagree while
+    periodic, written under ``out``."""
+    from geardyn.reproduction.basins import case_basins, write_basins
+
+    found = {}
+    for (case_name, i), ds in results.items():
+        if ds.attrs.get("shared_with"):
+            continue
+        b = case_basins(Case(case_name), i, ds, n)
+        if b is not None:
+            found[(case_name, i)] = (b, write_basins(b, out, _file_stem(case_name, i))["figure"])
+    return found

@@ -853,4 +853,4 @@ def sweep(lanes, cfg, work_queues, out):
     """
     n_workers = work_queues.start.size - 1  # (not named ``sched``: numba's parfor uses it)
     for w in nb.prange(n_workers):
-        _sweep_worker(w, lanes, cfg, work_queues, out)
+        _sweep_worker(np.int64(w), lanes, cfg, work_queues, out)

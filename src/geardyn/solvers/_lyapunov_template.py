@@ -366,8 +366,11 @@ def lyapunov_single(p, y0, scale, t0, h, omega, n_per, n_transient, n_steps, ren
     ``blocks`` of them used); exponents are NaN if diverged.
     """
     s_tab, c_tab = phase_table(n_per, omega != 0.0)
-    return _run(p, y0, scale, t0, h, omega, n_per, s_tab, c_tab, n_transient, n_steps,
-                renorm_every, k, bound, n_ev, n_blocks)
+    # copies and int64 casts: a read-only array, a literal or an omitted argument would compile
+    # _run once more for each such caller
+    return _run(p.copy(), y0.copy(), scale.copy(), t0, h, omega, n_per, s_tab, c_tab,
+                n_transient, n_steps, renorm_every, np.int64(k), bound, np.int64(n_ev),
+                np.int64(n_blocks))
 
 
 def lyapunov_lanes_rows(P, Y0, scale, T0, H, OMEGA, n_per, n_transient, n_steps, renorm_every,
@@ -407,8 +410,8 @@ def _lanes_rows(P, Y0, scale, T0, H, OMEGA, n_per, n_transient, n_steps, renorm_
     s_tab, c_tab = phase_table(n_per, forced)
     for lane in nb.prange(L):
         ex, er, _nb, st = _run(P[lane], Y0[lane], scale, T0[lane], H[lane], OMEGA[lane], n_per,
-                               s_tab, c_tab, n_transient[lane], n_steps[lane], renorm_every, 1,
-                               bound, n_ev, n_blocks)
+                               s_tab, c_tab, n_transient[lane], n_steps[lane], renorm_every,
+                               np.int64(1), bound, np.int64(n_ev), np.int64(n_blocks))
         out[lane] = ex[0] if st == STATUS_OK else np.nan
         err[lane] = er[0] if st == STATUS_OK else np.nan
 
@@ -905,6 +908,9 @@ def lyapunov_block_lanes(P, Y0, scale, T0, H, OMEGA, NPER, n_transient, n_steps,
     where diverged), used[L] (blocks of the standard error) and status[L]. Each lane's result
     is bitwise that of :func:`lyapunov_single` with the same arguments, whatever the lanes
     beside it, ``block_rows`` and ``min_blocks`` (see :func:`_block_count`)."""
+    # writable copies and int64 casts below: a read-only array, a literal or an omitted argument
+    # would compile the block kernel once more for each such caller
+    P_w, Y0_w, scale_w = P.copy(), Y0.copy(), scale.copy()
     L = Y0.shape[0]
     forced = False
     for lane in range(L):
@@ -929,8 +935,9 @@ def lyapunov_block_lanes(P, Y0, scale, T0, H, OMEGA, NPER, n_transient, n_steps,
         lo = b * L // n_blk
         hi = (b + 1) * L // n_blk
         if hi > lo:
-            _lyap_block_local(lo, hi, k, P, Y0, scale, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
-                              n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err,
+            _lyap_block_local(np.int64(lo), np.int64(hi), np.int64(k), P_w, Y0_w, scale_w, T0,
+                              H, OMEGA, NPER, S_TAB, C_TAB, OFF, n_transient, n_steps,
+                              renorm_every, bound, np.int64(n_ev), np.int64(n_blocks), out, err,
                               used, status)
 
 

@@ -129,7 +129,9 @@ def run_plan(model: Model, P: np.ndarray, y0: np.ndarray, plan: LanePlan,
     P = np.ascontiguousarray(np.atleast_2d(P), dtype=float)
     L = P.shape[0]
     ns = model.n_states
-    Y0 = np.ascontiguousarray(np.broadcast_to(np.asarray(y0, dtype=float), (L, ns)))
+    # always a fresh writable array: a read-only view (one lane broadcast) would compile the
+    # sweep kernel a second time, for the read-only type
+    Y0 = np.array(np.broadcast_to(np.asarray(y0, dtype=float), (L, ns)), order="C")
     run = plan.settings
     samples = run.samples
     n_lane = np.ascontiguousarray(plan.steps_per_period, dtype=np.int64)

@@ -1,0 +1,174 @@
+"""``geardyn frc``: frequency-response curves of a study by up and down sweeps.
+
+::
+
+    geardyn frc STUDY.toml [--range 0.5:1.5:201] [--transient T] [--continued-transient T]
+                [--converge TOL] [--samples N] [--steps-per-period N] [--mesh NAME]
+                [--branch branch.nc ...] [--interpretation ...] [--quiet] [--yes]
+                [--out frc.nc] [--plot frc.png]
+
+Unset options come from the study's ``[sweep]`` (start, stop, num, samples; the sweep must be
+of Omega) and ``[run]`` tables. A progress bar is drawn when stderr is a terminal.
+"""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+from typing import Annotated
+
+import typer
+from rich.markup import escape
+
+from geardyn.cli.common import (
+    ESTIMATE_POINTS,
+    InterpretationOption,
+    NetCDFOutOption,
+    PlotOption,
+    StepsOption,
+    YesOption,
+    check_count,
+    check_plot_path,
+    check_run_cost,
+    load_study_source,
+    make_parents,
+    run_settings,
+    usable_omega,
+)
+from geardyn.errors import ParameterError, StudyError
+from geardyn.study import build_model
+
+__all__ = ["frc_command", "register"]
+
+
+def frc_command(
+    study: Annotated[str, typer.Argument(help="Study TOML file or built-in study name.")],
+    range_: Annotated[
+        str | None, typer.Option("--range", help="Omega START:STOP:NUM (default: the study's "
+                                                 "[sweep]).")
+    ] = None,
+    transient: Annotated[
+        float | None, typer.Option(help="Transient of the first point (default: run.transient).")
+    ] = None,
+    continued_transient: Annotated[
+        float | None, typer.Option(help="Least transient of a continued point (default: "
+                                        "--transient).")
+    ] = None,
+    converge: Annotated[
+        float | None, typer.Option(help="Transient until the section point settles to this "
+                                        "tolerance.")
+    ] = None,
+    samples: Annotated[
+        int | None, typer.Option(help="Section points per point (default: the study's).")
+    ] = None,
+    steps_per_period: StepsOption = None,
+    mesh: Annotated[str | None, typer.Option(help="Mesh drawn (default: the first).")] = None,
+    branch: Annotated[
+        list[Path] | None, typer.Option(help="A continuation branch (NetCDF: dim 'point', "
+                                             "Omega, dte_rms, ..., stable) drawn over the "
+                                             "curves; repeatable.")
+    ] = None,
+    interpretation: InterpretationOption = None,
+    quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No progress bar.")] = False,
+    yes: YesOption = False,
+    out: NetCDFOutOption = None,
+    plot: PlotOption = None,
+) -> None:
+    """Frequency-response curves: RMS and peak dynamic transmission error and dynamic factor
+    against Omega (and mesh frequency, input speed), sweeping up and down; the jumps located."""
+    import numpy as np
+
+    from geardyn.analysis.frc import frequency_response
+    from geardyn.cli.bifurcation import _progress_bar, _stderr_is_terminal, parse_range
+
+    s = load_study_source(study)
+    sweep = s.sweep
+    if range_ is not None:
+        start, stop, num = parse_range(range_)
+    elif sweep is not None and sweep.param == "Omega":
+        start, stop, num = sweep.start, sweep.stop, sweep.num
+    else:
+        raise StudyError("--range: not given, and the study has no [sweep] of Omega")
+    if not (usable_omega(start) and usable_omega(stop)):
+        raise ParameterError("--range", f"{start:g}:{stop:g}", "Omega must be > 0 and finite")
+    if out is not None and out.suffix.lower() != ".nc":
+        raise ParameterError("--out", str(out), "suffix must be .nc (NetCDF)")
+    check_plot_path("--plot", plot)
+    interp = interpretation.value if interpretation is not None else None
+    model = build_model(s, interpretation=interp)
+    if not model.meshes:
+        raise ParameterError("STUDY", study, f"{model.name} has no backlash mesh")
+    names = [m[0] for m in model.meshes]
+    if mesh is not None and mesh not in names:
+        raise ParameterError("--mesh", mesh, f"not a mesh of the model; meshes: "
+                             f"{', '.join(names)}")
+    tr = s.run.transient if transient is None else transient
+    n_samples = samples if samples is not None else (
+        sweep.samples if sweep is not None and sweep.samples is not None else s.run.periods)
+    spp = s.run.steps_per_period if steps_per_period is None else steps_per_period
+    check_count("--samples", n_samples)
+    if n_samples < 2:
+        raise ParameterError("--samples", n_samples, "must be >= 2 (the period needs two)")
+    run = run_settings({"transient": ("--transient", tr), "samples": ("--samples", n_samples),
+                        "steps_per_period": ("--steps-per-period", spp),
+                        "converge": ("--converge", converge),
+                        "continued_transient": ("--continued-transient", continued_transient)})
+    omegas = np.linspace(start, stop, min(num, ESTIMATE_POINTS))
+    check_run_cost(model, 2 * num, omegas, tr if converge is None else 10 * tr, n_samples, spp,
+                   False, yes=yes, option="--range/--samples/--transient",
+                   value=f"{start:g}:{stop:g}:{num}, {n_samples} samples, transient {tr:g}",
+                   what="frequency response")
+    branches = [_load_branch(p) for p in branch or []]
+    make_parents(out, plot)
+    show_bar = not quiet and _stderr_is_terminal()
+    t0 = time.perf_counter()
+    with _progress_bar(show_bar, escape(f"{s.study.name}: up and down")) as callback:
+        ds = frequency_response(model, np.linspace(start, stop, num), run, progress=callback)
+    elapsed = time.perf_counter() - t0
+    ds.attrs["study"] = s.study.name
+    ds.attrs["wall_time_s"] = round(elapsed, 3)
+    written = []
+    if out is not None:
+        from geardyn.io.netcdf import save_dataset
+
+        save_dataset(ds, out)
+        written.append(str(out))
+    if plot is not None:
+        from geardyn.plotting.frc import plot_frc
+
+        plot_frc(ds, path=plot, mesh=mesh, branches=branches)
+        written.append(str(plot))
+    typer.echo(f"{s.study.name}: {num} values of Omega in [{start:g}, {stop:g}] up and down, "
+               f"{elapsed:.1f} s: {_summary(ds)}"
+               + (f"; wrote {', '.join(written)}" if written else "; nothing written"))
+
+
+def _load_branch(path: Path):
+    """A continuation branch to draw: a NetCDF dataset with the dimension ``point``."""
+    from geardyn.io.netcdf import load_dataset
+
+    if not path.exists():
+        raise FileNotFoundError(2, "No such file", str(path))
+    try:
+        b = load_dataset(path)
+    except (OSError, ValueError, KeyError) as exc:
+        raise ParameterError("--branch", str(path), f"cannot read it as NetCDF ({exc})") \
+            from None
+    if "point" not in b.dims:
+        raise ParameterError("--branch", str(path), "not a branch (no dimension 'point')")
+    return b
+
+
+def _summary(ds) -> str:
+    n = ds.sizes["jump"]
+    if not n:
+        return "no jumps"
+    parts = [f"{ds['jump_sweep'].values[j]} jump ({ds['jump_mesh'].values[j]}) at Omega "
+             f"{float(ds['jump_lo'].values[j]):.6g}..{float(ds['jump_hi'].values[j]):.6g}"
+             for j in range(n)]
+    return f"{n} jump{'s' if n > 1 else ''}: " + ", ".join(parts)
+
+
+def register(app: typer.Typer) -> None:
+    """Add ``geardyn frc`` to the command line ``app``."""
+    app.command("frc")(frc_command)

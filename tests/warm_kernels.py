@@ -1,0 +1,60 @@
+"""Compile the built-in models' kernels once, before the test workers start (``make test``).
+
+Every test worker (pytest-xdist) is a separate process, and numba compiles a kernel in the first
+process that needs it and finds no cached copy; two workers that start on the same model compile
+its kernels twice, side by side, one core each. This script compiles each built-in model's
+kernels (sweep, trajectory, Lyapunov lanes and single lane, monodromy) in its own process, the
+models spread over ``--jobs`` processes, through the public API with the argument types the
+tests use, so that the workers load them from the on-disk cache instead. With a warm cache it
+only loads them (a few seconds). Running it is an optimisation: the tests do not depend on it.
+
+    python tests/warm_kernels.py --jobs 2
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from concurrent.futures import ProcessPoolExecutor
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+
+def _warm(case: str) -> tuple[str, float]:
+    """Run each analysis once on a tiny workload of the conformance case ``case``."""
+    import numpy as np
+
+    import geardyn
+    from conformance_cases import cases
+
+    t0 = time.perf_counter()
+    model, y0 = cases()[case]
+    omega = float(model.params[model.omega_index])
+    values = np.array([omega, 1.05 * omega])
+    geardyn.simulate(model, omega=omega, periods=2, y0=y0)
+    geardyn.bifurcation(model, "Omega", values, transient=0.0, samples=2)
+    geardyn.lyapunov(model, y0=y0, transient=0.0, duration=1.0)
+    geardyn.lyapunov_lanes(model, model.lane_params("Omega", values), transient=0.0,
+                           duration=1.0)
+    geardyn.periodic_orbit(model, omega=omega, guess=y0, max_iter=1)
+    return case, time.perf_counter() - t0
+
+
+def main(argv: list[str] | None = None) -> int:
+    from conformance_cases import IDS
+
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--jobs", type=int, default=2, help="processes (default 2)")
+    args = ap.parse_args(argv)
+    t0 = time.perf_counter()
+    with ProcessPoolExecutor(max_workers=max(1, args.jobs)) as pool:
+        for case, seconds in pool.map(_warm, IDS):
+            print(f"warm_kernels: {case} {seconds:.1f} s", flush=True)
+    print(f"warm_kernels: {time.perf_counter() - t0:.1f} s in all", flush=True)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
