@@ -29,6 +29,9 @@ QUANTITIES = ("section", "deflection_max", "deflection_rms", "deflection_amplitu
               "dynamic_factor", "force_peak", "force_rms", "orbit_norm")
 #: Colours of the branches by their period k (1, 2, 4, 8, ...; others cycle).
 BRANCH_COLORS = ("black", "#1f77b4", "#17becf", "#8c564b", "#e377c2")
+#: Offsets (points) of a bifurcation's label from its marker: the first, then where labels of
+#: nearby bifurcations already sit.
+LABEL_OFFSETS = ((3, 4), (3, -11), (-15, 4), (-15, -11), (3, 14), (-15, 14))
 #: Multipliers beyond this modulus are outside the unit-circle panel (counted in its title).
 MU_VIEW = 2.5
 
@@ -166,14 +169,24 @@ def _draw_bifurcations(ax, ds: xr.Dataset, y: np.ndarray, quantity: str, state: 
 
     kinds = ds["bifurcation_kind"].values.astype(str)
     seen: dict[str, Line2D] = {}
+    placed: list[tuple[float, float]] = []
+    finite = y[np.isfinite(y)]
+    x_span = abs(float(ds.attrs["stop"]) - float(ds.attrs["start"])) or 1.0
+    y_span = float(np.ptp(finite)) if finite.size else 1.0
     for j, kind in enumerate(kinds):
         short, long, marker, color = BIFURCATION_LABELS.get(kind, (kind, kind, "*", "k"))
         v = float(ds["bifurcation_value"].values[j])
         yj = _bifurcation_y(ds, y, j, quantity, state)
         ax.plot([v], [yj], ls="", marker=marker, ms=6, mfc=color, mec="k", mew=0.5,
                 gid="bifurcation", zorder=5)
-        ax.annotate(short, (v, yj), xytext=(3, 4), textcoords="offset points", fontsize=7,
-                    color=color, fontweight="bold", gid="bifurcation-label", zorder=6)
+        # labels of neighbouring points go round their markers, not on top of each other
+        near = sum(abs(v - a) < 0.03 * x_span and abs(yj - b) < 0.06 * (y_span or 1.0)
+                   for a, b in placed)
+        placed.append((v, yj))
+        first = 1 if kind == "contact" else 0  # contact labels below, the others above
+        ax.annotate(short, (v, yj), xytext=LABEL_OFFSETS[(first + near) % len(LABEL_OFFSETS)],
+                    textcoords="offset points", fontsize=7, color=color, fontweight="bold",
+                    gid="bifurcation-label", zorder=6)
         if kind not in seen:
             seen[kind] = Line2D([], [], ls="", marker=marker, ms=6, mfc=color, mec="k", mew=0.5,
                                 label=f"{short}: {long}")
