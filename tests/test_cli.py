@@ -545,3 +545,20 @@ def test_continue_writes_a_branch_that_ends_early(tmp_path):
     saved = load_dataset(nc)
     assert saved.attrs["status"] == BranchStatus.INVALID and saved.sizes["point"] > 2
     assert saved["kappa"].values.max() < 1.0 and "kappa=" in r.stderr
+
+
+def test_continue_switches_at_period_doublings(tmp_path):
+    study = tmp_path / "pd.toml"
+    study.write_text(SOFT_STUDY.replace("kappa = 0.0", "kappa = 0.2")
+                     .replace("zeta = 0.05", "zeta = 0.02").replace("Fa = 0.05", "Fa = 0.1"))
+    nc, png = tmp_path / "pd.nc", tmp_path / "pd.png"
+    r = invoke("continue", study, "--range", "1.9:1.5", "--switch", "--max-period", "2",
+               "--quiet", "--out", nc, "--plot", png)
+    assert r.returncode == 0, r.stderr
+    saved = load_dataset(nc)
+    assert_result(saved, "continuation")
+    doublings = int(np.sum(saved["bifurcation_kind"].values[saved["bifurcation_branch"].values
+                                                            == 0] == "period-doubling"))
+    assert doublings >= 1 and saved.sizes["branch_id"] == 1 + doublings
+    assert list(saved["branch_period"].values) == [1] + [2] * doublings
+    assert "period-2" in r.stdout and png.read_bytes()[:8] == PNG

@@ -134,7 +134,7 @@ def continue_command(
     range_: Annotated[
         str | None, typer.Option("--range", help="START:STOP: the branch starts at START and "
                                                  "heads for STOP (default: the study's "
-                                                 "[sweep]).")
+                                                 "sweep table).")
     ] = None,
     period: Annotated[int, typer.Option(help="k: the period-k orbit (in forcing periods).")] = 1,
     switch: Annotated[
