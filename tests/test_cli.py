@@ -502,6 +502,8 @@ def test_continue_over_a_brute_force_diagram_with_progress(tmp_path, monkeypatch
                           "--over", "sweeps Fa")
     assert_one_line_error(invoke("continue", study, "--range", "0.6:1.0", "--over",
                                  tmp_path / "none.nc"), "none.nc")
+    assert_one_line_error(invoke("continue", study, "--range", "0.6:1.0", "--over", bif,
+                                 "--quantity", "deflection_rms"), "--quantity", "--over")
 
 
 @pytest.mark.parametrize(("args", "fragments"), [

@@ -230,6 +230,10 @@ def continue_command(
     run = run_settings({"transient": ("--transient", transient),
                         "steps_per_period": ("--steps-per-period", spp)})
     over_ds = _load_over(over, name) if over is not None else None
+    if over_ds is not None and quantity != "section" and not (
+            quantity in over_ds and set(over_ds[quantity].dims) <= {name, "mesh"}):
+        raise ParameterError("--quantity", quantity, "the --over diagram has no such variable "
+                             "(its Poincaré points go with --quantity section)")
     make_parents(out, plot)
 
     show_bar = not quiet and _stderr_is_terminal()
