@@ -417,3 +417,150 @@ def test_bifurcation_transient_by_convergence(tmp_path):
     assert np.all(used >= 300.0) and np.all(used < 3000.0)
     assert_one_line_error(invoke("bifurcation", "paper_fig3", "--converge", "-1", "--quiet"),
                           "--converge")
+
+
+# --------------------------------------------------------------------------- continue
+SOFT_STUDY = """
+[study]
+name = "soft"
+model = "gear_pair"
+[params]
+zeta = 0.05
+kappa = 0.0
+Fm = 0.1
+Fa = 0.05
+[run]
+omega = 1.2
+"""
+
+
+def _soft_study(tmp_path) -> Path:
+    study = tmp_path / "soft.toml"
+    study.write_text(SOFT_STUDY)
+    return study
+
+
+def test_continue_writes_the_branch_and_its_figure(tmp_path):
+    from geardyn import continuation
+
+    study = _soft_study(tmp_path)
+    nc, png = tmp_path / "out" / "branch.nc", tmp_path / "out" / "branch.png"
+    r = invoke("continue", study, "--param", "Omega", "--range", "0.6:1.0", "--quiet",
+               "--out", nc, "--plot", png)
+    assert r.returncode == 0, r.stderr
+    saved = load_dataset(nc)
+    assert_result(saved, "continuation")
+    assert png.read_bytes()[:8] == PNG
+    assert saved.attrs["study"] == "soft" and saved.attrs["status"] == 0
+    direct = continuation(GearPair(zeta=0.05, kappa=0.0, Fm=0.1, Fa=0.05), "Omega", 0.6, 1.0)
+    np.testing.assert_array_equal(saved["Omega"].values, direct["Omega"].values)
+    assert list(saved["bifurcation_kind"].values) == list(direct["bifurcation_kind"].values)
+    assert "2 fold" in r.stdout and str(nc) in r.stdout and "ended early" not in r.stderr
+    # geardyn plot recognises the kind and redraws it
+    r = invoke("plot", nc, "--out", tmp_path / "again.pdf")
+    assert r.returncode == 0, r.stderr
+    assert "continuation dataset" in r.stdout
+    assert (tmp_path / "again.pdf").read_bytes()[:5] == PDF
+    assert_one_line_error(invoke("plot", nc, "--state", "Q"), "--state", "'Q'")
+
+
+def test_continue_over_a_brute_force_diagram_with_progress(tmp_path, monkeypatch):
+    from geardyn.cli import continuation as cli_continuation
+
+    study = _soft_study(tmp_path)
+    bif = tmp_path / "bif.nc"
+    r = invoke("bifurcation", study, "--range", "0.6:1.0:5", "--transient", "100", "--samples",
+               "4", "--steps-per-period", "64", "--quiet", "--out", bif)
+    assert r.returncode == 0, r.stderr
+    calls: list[tuple[int, float]] = []
+    real_bar = cli_continuation._continue_bar
+
+    @contextlib.contextmanager
+    def recording_bar(show, label, param, start, stop):
+        with real_bar(show, label, param, start, stop) as callback:
+            def record(points, value):
+                calls.append((points, value))
+                callback(points, value)
+
+            yield None if callback is None else record
+
+    monkeypatch.setattr(cli_bifurcation, "_stderr_is_terminal", lambda: True)
+    monkeypatch.setattr(cli_continuation, "_continue_bar", recording_bar)
+    png = tmp_path / "over.png"
+    r = invoke("continue", study, "--range", "0.6:1.0", "--over", bif, "--quantity",
+               "dynamic_factor", "--plot", png)
+    assert r.returncode == 0, r.stderr
+    assert png.read_bytes()[:8] == PNG and "nothing written" not in r.stdout
+    assert calls and calls[-1][1] == 1.0
+    assert [p for p, _ in calls] == list(range(1, len(calls) + 1))
+    # a diagram of another parameter, or not a diagram at all
+    other = tmp_path / "fa.nc"
+    r = invoke("bifurcation", study, "--param", "Fa", "--range", "0.04:0.05:2", "--omega", "0.9",
+               "--transient", "50", "--samples", "2", "--quiet", "--out", other)
+    assert r.returncode == 0, r.stderr
+    assert_one_line_error(invoke("continue", study, "--range", "0.6:1.0", "--over", other),
+                          "--over", "sweeps Fa")
+    assert_one_line_error(invoke("continue", study, "--range", "0.6:1.0", "--over",
+                                 tmp_path / "none.nc"), "none.nc")
+    assert_one_line_error(invoke("continue", study, "--range", "0.6:1.0", "--over", bif,
+                                 "--quantity", "deflection_rms"), "--quantity", "--over")
+
+
+@pytest.mark.parametrize(("args", "fragments"), [
+    (("--range", "0.6"), ("--range", "START:STOP", "'0.6'")),
+    (("--range", "a:1"), ("--range", "numbers", "'a:1'")),
+    (("--range", "1:1"), ("--range", "differ")),
+    (("--range", "0.6:nan"), ("--range", "finite")),
+    (("--range", "-1:1"), ("--range", "Omega = -1")),
+    (("--range", "0.6:1", "--period", "0"), ("--period",)),
+    (("--range", "0.6:1", "--param", "kapa"), ("--param", "'kapa'", "known")),
+    (("--range", "0.6:1", "--quantity", "nothing"), ("--quantity", "'nothing'")),
+    (("--range", "0.6:1", "--state", "Q"), ("--state", "'Q'")),
+    (("--range", "0.6:1", "--out", "b.zarr"), ("--out", ".nc")),
+    (("--range", "0.6:1", "--plot", "b.gif"), ("--plot", "b.gif")),
+    ((), ("--range", "no [sweep]")),
+])
+def test_continue_bad_input_is_one_line_error(tmp_path, args, fragments):
+    study = _soft_study(tmp_path)
+    r = invoke("continue", study, "--quiet", *args)
+    assert_one_line_error(r, *fragments)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["soft.toml"]  # nothing written
+
+
+def test_continue_writes_a_branch_that_ends_early(tmp_path):
+    from geardyn.analysis.branch_data import BranchStatus
+
+    study = _soft_study(tmp_path)
+    nc, png = tmp_path / "short.nc", tmp_path / "short.png"
+    r = invoke("continue", study, "--range", "0.6:1.0", "--max-points", "5", "--quiet",
+               "--out", nc, "--plot", png)
+    assert r.returncode == 0, r.stderr
+    saved = load_dataset(nc)
+    assert_result(saved, "continuation")
+    assert saved.sizes["point"] == 5 and saved.attrs["status"] == BranchStatus.MAX_POINTS
+    assert "ended early" in r.stderr and saved.attrs["message"] in " ".join(r.stderr.split())
+    assert png.read_bytes()[:8] == PNG
+    # the parameter leaves the valid region (|kappa| < 1): the points up to there are kept
+    r = invoke("continue", study, "--param", "kappa", "--range", "0.5:1.5", "--omega", "1.2",
+               "--quiet", "--out", nc)
+    assert r.returncode == 0, r.stderr
+    saved = load_dataset(nc)
+    assert saved.attrs["status"] == BranchStatus.INVALID and saved.sizes["point"] > 2
+    assert saved["kappa"].values.max() < 1.0 and "kappa=" in r.stderr
+
+
+def test_continue_switches_at_period_doublings(tmp_path):
+    study = tmp_path / "pd.toml"
+    study.write_text(SOFT_STUDY.replace("kappa = 0.0", "kappa = 0.2")
+                     .replace("zeta = 0.05", "zeta = 0.02").replace("Fa = 0.05", "Fa = 0.1"))
+    nc, png = tmp_path / "pd.nc", tmp_path / "pd.png"
+    r = invoke("continue", study, "--range", "1.9:1.5", "--switch", "--max-period", "2",
+               "--quiet", "--out", nc, "--plot", png)
+    assert r.returncode == 0, r.stderr
+    saved = load_dataset(nc)
+    assert_result(saved, "continuation")
+    doublings = int(np.sum(saved["bifurcation_kind"].values[saved["bifurcation_branch"].values
+                                                            == 0] == "period-doubling"))
+    assert doublings >= 1 and saved.sizes["branch_id"] == 1 + doublings
+    assert list(saved["branch_period"].values) == [1] + [2] * doublings
+    assert "period-2" in r.stdout and png.read_bytes()[:8] == PNG

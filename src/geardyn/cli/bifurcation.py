@@ -350,7 +350,7 @@ def bifurcation_command(
 #: What ``geardyn plot`` calls each result kind (``attrs["geardyn_kind"]``).
 _PLOT_KIND = {"simulation": "simulation", "bifurcation": "bifurcation", "map2d": "map",
               "reproduction-case": "reproduction", "basins": "basins",
-              "frequency-response": "frequency response"}
+              "frequency-response": "frequency response", "continuation": "continuation"}
 
 
 def _dataset_kind(ds) -> str:
@@ -410,8 +410,8 @@ def _load_result(result: Path):
 
 def plot_command(
     result: Annotated[Path, typer.Argument(help="A NetCDF file written by geardyn simulate, "
-                                                "bifurcation, map or reproduce, or a map's "
-                                                ".zarr store.")],
+                                                "bifurcation, map, reproduce, basins, frc or "
+                                                "continue, or a map's .zarr store.")],
     out: Annotated[
         Path | None, typer.Option(help="Figure to write, .png, .pdf or .svg (default: RESULT "
                                        "with .png).")
@@ -423,7 +423,8 @@ def plot_command(
         SweepDirection, typer.Option(help="A reproduction case file: the sweep drawn.")
     ] = SweepDirection.up,
 ) -> None:
-    """Redraw the figure of a saved simulation, bifurcation, map or reproduction case."""
+    """Redraw the figure of a saved simulation, bifurcation, map, reproduction case, basins,
+    frequency response or continued branch."""
     target = out if out is not None else result.with_suffix(".png")
     check_plot_path("--out", target)
     ds = _load_result(result)
@@ -450,6 +451,15 @@ def plot_command(
 
             plot_frc(ds, path=target)
         typer.echo(f"{result}: {kind} dataset; wrote {target}")
+        return
+    if kind == "continuation":
+        from geardyn.plotting.branch import plot_branch
+
+        names = [str(v) for v in ds["state"].values]
+        shown = _check_state(names, state, "--state") if state is not None else None
+        make_parents(target)
+        plot_branch(ds, path=target, state=shown)
+        typer.echo(f"{result}: continuation dataset; wrote {target}")
         return
     if kind == "reproduction":
         attrs = dict(ds.attrs, continuation=sweep.value)

@@ -12,6 +12,8 @@
     geardyn basins STUDY.toml --omega W --x X_sq:LO:HI:N --y V_sq:LO:HI:N [--out b.nc]
                    [--plot b.png]
     geardyn frc STUDY.toml [--range 0.5:1.5:201] [--branch b.nc] [--out frc.nc] [--plot frc.png]
+    geardyn continue STUDY.toml --param Omega --range 0.5:4 [--period K] [--switch]
+                     [--over bifurcation.nc] [--out branch.nc] [--plot branch.png]
 
 A STUDY argument is a TOML file or the name of a built-in study (``paper_fig3``). Every expected
 error (bad parameters, missing files, invalid TOML, bad values) and every usage error ends the
@@ -309,6 +311,7 @@ __import__("geardyn.cli.map", fromlist=["register"]).register(app)  # geardyn ma
 __import__("geardyn.cli.reproduce", fromlist=["register"]).register(app)  # cli/reproduce.py
 __import__("geardyn.cli.basins", fromlist=["register"]).register(app)  # cli/basins.py
 __import__("geardyn.cli.frc", fromlist=["register"]).register(app)  # cli/frc.py
+__import__("geardyn.cli.continuation", fromlist=["register"]).register(app)  # cli/continuation.py
 
 if __name__ == "__main__":
     main()
