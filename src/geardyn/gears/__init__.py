@@ -4,7 +4,7 @@ Pure numpy: everything here produces plain numbers, arrays and callables that a 
 takes (mean stiffness, Fourier coefficients, phases). See docs/gears.md.
 """
 
-from geardyn.gears.geometry import GearMesh, SpurGear, involute, inverse_involute
+from geardyn.gears.geometry import GearMesh, SpurGear, inverse_involute, involute
 from geardyn.gears.iso6336 import ISOStiffness, iso6336_stiffness
 from geardyn.gears.phasing import (
     MeshPhases,
