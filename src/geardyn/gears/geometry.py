@@ -11,6 +11,7 @@ on the reference circle is m (pi/2 + 2 x tan(alpha)). No tip shortening is appli
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import dataclass, field
 
 from geardyn.errors import ParameterError
@@ -79,8 +80,9 @@ class SpurGear:
 
     def _validate(self) -> None:
         n = self.name
-        if isinstance(self.teeth, bool) or not isinstance(self.teeth, int):
+        if isinstance(self.teeth, bool) or not isinstance(self.teeth, numbers.Integral):
             raise ParameterError(f"{n}.teeth", self.teeth, "must be a whole number")
+        object.__setattr__(self, "teeth", int(self.teeth))
         if self.teeth < MIN_TEETH:
             raise ParameterError(f"{n}.teeth", self.teeth, f"must be >= {MIN_TEETH}")
         for attr in ("module", "face_width"):

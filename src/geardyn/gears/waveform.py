@@ -107,7 +107,7 @@ class StiffnessWaveform:
         return {"mean_stiffness": self.mean, "stiffness_amplitude": self.amplitude,
                 "waveform": "rectangular", "contact_ratio": self.contact_ratio,
                 "harmonics": harmonics,
-                "stiffness_phase": -2.0 * math.pi * ((self.centre + phase) % 1.0)}
+                "stiffness_phase": float(-2.0 * math.pi * ((self.centre + phase) % 1.0))}
 
 
 def double_contact_centre(mesh: GearMesh) -> float:
