@@ -308,3 +308,48 @@ def test_planetary_geometry_ties_the_meshes_together():
     assert k_ring.c_prime > k_sun.c_prime  # an internal mesh is stiffer
     w_sun, w_ring = pg.waveforms()
     assert w_sun.mean == pytest.approx(k_sun.mesh_stiffness)
+
+
+@pytest.mark.parametrize("z_s, z_r, angles_deg", [(25, 71, [0, 90, 180, 270]),
+                                                  (25, 71, [0, 90, 187.5, 277.5]),
+                                                  (21, 69, [0, 120, 240])])
+def test_phases_by_following_the_teeth(z_s, z_r, angles_deg):
+    """Carrier frame: the sun's teeth turn forwards, the ring's backwards; a mesh event is a
+    tooth passing the planet's direction psi_n. The first event after t = 0 at each planet,
+    relative to planet 1's, in mesh cycles."""
+    psi = np.radians(angles_deg)
+    ph = mesh_phases(z_s, z_r, psi)
+
+    def first_event(teeth, direction, offset):
+        # tooth j at angle offset + direction * t + 2 pi j / teeth (t in mesh cycles: one
+        # cycle turns the gear by one pitch); the first t >= 0 at which one sits at psi_n
+        pitch = 2 * np.pi / teeth
+        return np.array([((p - offset) * direction / pitch) % 1.0 for p in psi])
+
+    sun = first_event(z_s, +1, 0.123)
+    ring = first_event(z_r, -1, 0.456)
+    gap_s = np.abs((sun - sun[0]) % 1.0 - ph.sun)
+    assert np.all(np.minimum(gap_s, 1 - gap_s) < 1e-9)
+    ring_rel = (ring - ring[0]) % 1.0
+    expected = (ph.ring - ph.ring[0]) % 1.0
+    gap = np.abs(ring_rel - expected)
+    assert np.all(np.minimum(gap, 1 - gap) < 1e-9)
+
+
+def test_angular_thickness_against_a_parametric_involute():
+    """Build the tooth's flank point by point (the involute unwound from the base circle,
+    turned so that its width on the reference circle is m (pi/2 + 2 x tan alpha)) and measure
+    its angular width at other radii."""
+    g = gear(23, 0.3, m=2e-3)
+    rb = g.base_radius
+
+    def flank_angle(r):  # polar angle of the standard involute at radius r (numerically)
+        u = brentq(lambda u: rb * math.hypot(1.0, u) - r, 0.0, 10.0)
+        x, y = rb * (math.cos(u) + u * math.sin(u)), rb * (math.sin(u) - u * math.cos(u))
+        return math.atan2(y, x)
+
+    s_ref = g.module * (math.pi / 2 + 2 * 0.3 * math.tan(g.pressure_angle))
+    beta0 = s_ref / (2 * g.reference_radius) + flank_angle(g.reference_radius)
+    for r in (rb * 1.001, g.reference_radius, 0.5 * (g.reference_radius + g.tip_radius),
+              g.tip_radius):
+        assert g.angular_thickness(r) == pytest.approx(2 * (beta0 - flank_angle(r)), abs=1e-12)
