@@ -10,6 +10,7 @@ import pytest
 from scipy.optimize import brentq
 
 import geardyn
+from geardyn.cli.errors import format_error
 from geardyn.errors import ParameterError
 from geardyn.gears import (
     GearMesh,
@@ -145,6 +146,7 @@ def test_bad_geometry_names_the_field(build, field, reason):
     with pytest.raises(ParameterError, match=reason) as info:
         build()
     assert info.value.field == field
+    assert format_error(info.value).startswith(f"{field}: ")  # the CLI's line (exit 2)
 
 
 def test_unit_strings():
@@ -276,7 +278,7 @@ def test_net_sun_force_shows_the_harmonics_the_rules_predict(z_s, z_r, n_planets
 
 
 def test_in_phase_and_sequential_phasing():
-    in_phase = mesh_phases(24, 72, 4)
+    in_phase = mesh_phases(24, 72, np.int64(4))
     assert np.allclose(in_phase.sun, 0) and np.allclose(in_phase.ring, 0)
     seq = mesh_phases(25, 71, 4)
     assert np.allclose(seq.sun, [0, 0.25, 0.5, 0.75])

@@ -26,6 +26,7 @@ the ring).
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import dataclass
 from functools import cached_property
 
@@ -42,7 +43,8 @@ ASSEMBLY_TOL = 1e-6
 
 def equally_spaced(n_planets: int) -> np.ndarray:
     """psi_n = 2 pi (n - 1) / N [rad]."""
-    if isinstance(n_planets, bool) or not isinstance(n_planets, int) or n_planets < 1:
+    if isinstance(n_planets, bool) or not isinstance(n_planets, numbers.Integral) \
+            or n_planets < 1:
         raise ParameterError("n_planets", n_planets, "must be a whole number >= 1")
     return 2.0 * np.pi * np.arange(n_planets) / n_planets
 
@@ -75,10 +77,10 @@ def mesh_phases(sun_teeth: int, ring_teeth: int, planet_angles: np.ndarray | int
     ``planet_angles`` [rad] or a planet count (equally spaced). ``sun_ring_phase`` is gamma_rs
     (see :func:`sun_ring_phase`; :class:`PlanetaryGeometry` computes it from the teeth).
     """
-    angles = (equally_spaced(planet_angles) if isinstance(planet_angles, int)
+    angles = (equally_spaced(planet_angles) if isinstance(planet_angles, numbers.Integral)
               else np.asarray(planet_angles, dtype=float).ravel())
     for name, z in (("sun_teeth", sun_teeth), ("ring_teeth", ring_teeth)):
-        if isinstance(z, bool) or not isinstance(z, int) or z < 5:
+        if isinstance(z, bool) or not isinstance(z, numbers.Integral) or z < 5:
             raise ParameterError(name, z, "must be a whole number >= 5")
     if angles.size < 1:
         raise ParameterError("planet_angles", planet_angles, "need at least one planet")
@@ -106,6 +108,7 @@ def surviving_harmonics(teeth: int, n_planets: int, harmonics: int) -> dict[int,
     """For equally spaced planets, which harmonics l = 1..``harmonics`` of the mesh frequency
     survive in the net torque and in the net translational force on the sun (``teeth`` = Z_s)
     or ring (Z_r)."""
+    equally_spaced(n_planets)  # validates the count
     out = {}
     for ell in range(1, harmonics + 1):
         r = (ell * teeth) % n_planets
