@@ -149,6 +149,12 @@ def test_bad_geometry_names_the_field(build, field, reason):
     assert format_error(info.value).startswith(f"{field}: ")  # the CLI's line (exit 2)
 
 
+def test_inverse_involute_round_trip():
+    alpha = np.linspace(0.01, 1.45, 50)
+    back = [geardyn.gears.inverse_involute(geardyn.gears.involute(a)) for a in alpha]
+    assert np.allclose(back, alpha, rtol=0, atol=1e-13)
+
+
 def test_unit_strings():
     g = SpurGear(20, "3 mm", "20 deg", "25 mm", 0.1)
     assert g.module == pytest.approx(3e-3) and g.pressure_angle == pytest.approx(20 * DEG)

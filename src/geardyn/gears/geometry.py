@@ -187,9 +187,11 @@ class GearMesh:
 
     def __post_init__(self) -> None:
         p, w = self.pinion, self.wheel
-        if w.internal != self.internal or p.internal:
+        if p.internal:
+            raise ParameterError("pinion.internal", True, "the pinion must be an external gear")
+        if w.internal != self.internal:
             raise ParameterError("wheel.internal", w.internal,
-                                 "the wheel of an internal mesh (and only it) must be internal")
+                                 f"must match the mesh's internal={self.internal}")
         if abs(p.module - w.module) > 1e-12 * p.module:
             raise ParameterError("wheel.module", w.module, f"differs from the pinion's {p.module}")
         if abs(p.pressure_angle - w.pressure_angle) > 1e-12:
