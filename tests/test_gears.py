@@ -41,12 +41,22 @@ def test_public_module():
 
 
 def test_khk_profile_shifted_external_pair():
-    """KHK Gear Technical Reference, 'Calculation of profile shifted spur gears' (z1 = 12,
-    z2 = 24, m = 3, alpha = 20 deg, x1 = 0.6, x2 = 0.36): alpha_w = 26.0886 deg,
-    a = 56.4999 mm."""
+    """The profile-shifted spur pair of the KHK Gear Technical Reference (z1 = 12, z2 = 24,
+    m = 3, alpha = 20 deg, x1 = 0.6, x2 = 0.36), as tabulated in "Profile Shifted External Spur
+    Gears", bolsover.com/utilitiesforalibre/profile-shifted-external-spur-gears.html: working
+    centre distance 56.500 mm, working pressure angle 26.0888 deg (from a = 56.500; a computed
+    from the shifts is 56.4999 mm), outside diameters 44.840 and 79.400 mm, contact ratio
+    1.202."""
     mesh = GearMesh(gear(12, 0.6, m=3e-3), gear(24, 0.36, m=3e-3))
-    assert math.degrees(mesh.operating_pressure_angle) == pytest.approx(26.0886, abs=1e-4)
-    assert mesh.centre_distance * 1e3 == pytest.approx(56.4999, abs=1e-4)
+    assert math.degrees(mesh.operating_pressure_angle) == pytest.approx(26.0888, abs=3e-4)
+    assert mesh.centre_distance * 1e3 == pytest.approx(56.500, abs=5e-4)
+    # KHK shortens both tips to keep the standard clearance at the widened centre distance
+    # (addendum (1 + y - x_other) m, y = 0.8333): an addendum factor of 1 - (x1 + x2 - y)
+    ha = 1.0 - (0.6 + 0.36 - (56.5 - 54.0) / 3.0)
+    short = GearMesh(gear(12, 0.6, m=3e-3, addendum=ha), gear(24, 0.36, m=3e-3, addendum=ha))
+    assert 2e3 * short.pinion.tip_radius == pytest.approx(44.840, abs=1e-3)
+    assert 2e3 * short.wheel.tip_radius == pytest.approx(79.400, abs=1e-3)
+    assert short.contact_ratio == pytest.approx(1.202, abs=5e-4)
 
 
 def test_khk_profile_shifted_internal_pair():
