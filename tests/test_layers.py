@@ -27,6 +27,8 @@ LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
               "geardyn.studies")),
     # the model interface, the kernel source, run settings, the lane plan, the section, status
     ("core", ("geardyn.core",)),
+    # gear geometry, ISO 6336 stiffness, stiffness waves, planetary mesh phasing (pure numpy)
+    ("gears", ("geardyn.gears",)),
     # the models: CATT device, gear pair, user models, parameter records
     ("models", ("geardyn.models",)),
     # numerics: the kernel generator and templates, lane ensembles, simulate, the reference

@@ -8,7 +8,7 @@ The public API::
     ds = geardyn.simulate(m, omega=1.1, transient=4000.0, periods=64)
 """
 
-from geardyn import testing
+from geardyn import gears, testing
 from geardyn._version import __version__ as __version__
 from geardyn.analysis.basins import basins
 from geardyn.analysis.bifurcation import ContinuedSweep, bifurcation, continued_sweeps
@@ -65,6 +65,7 @@ __all__ = [
     "continuation",
     "continued_sweeps",
     "frequency_response",
+    "gears",
     "label_peaks",
     "lyapunov",
     "lyapunov_lanes",

@@ -1,0 +1,35 @@
+"""Gear geometry, ISO 6336-1 mesh stiffness, stiffness waveforms and planetary mesh phasing.
+
+Pure numpy: everything here produces plain numbers, arrays and callables that a model's mesh
+takes (mean stiffness, Fourier coefficients, phases). See docs/gears.md.
+"""
+
+from geardyn.gears.geometry import GearMesh, SpurGear, inverse_involute, involute
+from geardyn.gears.iso6336 import ISOStiffness, iso6336_stiffness
+from geardyn.gears.phasing import (
+    MeshPhases,
+    PlanetaryGeometry,
+    equally_spaced,
+    mesh_phases,
+    sun_ring_phase,
+    surviving_harmonics,
+)
+from geardyn.gears.waveform import StiffnessWaveform, double_contact_centre, mesh_stiffness_waveform
+
+__all__ = [
+    "GearMesh",
+    "ISOStiffness",
+    "MeshPhases",
+    "PlanetaryGeometry",
+    "SpurGear",
+    "StiffnessWaveform",
+    "double_contact_centre",
+    "equally_spaced",
+    "involute",
+    "inverse_involute",
+    "iso6336_stiffness",
+    "mesh_phases",
+    "mesh_stiffness_waveform",
+    "sun_ring_phase",
+    "surviving_harmonics",
+]
