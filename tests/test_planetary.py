@@ -310,3 +310,72 @@ def test_bad_input_names_the_field(kw, field):
     with pytest.raises(ParameterError) as err:
         geardyn.PlanetaryGearSet(**{**LP, "n_planets": 3, **kw})
     assert err.value.field == field
+
+
+# ---------------------------------------------------------------------------------------------
+# study files
+
+STUDY = """
+[study]
+name = "lp4"
+model = "planetary"
+[params]
+n_planets = 4
+sun_pressure_angle = "24.6 deg"
+ring_pressure_angle = "24.6 deg"
+sun_mesh_stiffness = "5e8 N/m"
+ring_mesh_stiffness = 5e8
+sun_backlash = "10 um"
+[params.sun]
+mass = 0.4
+inertia_over_r2 = 0.39
+bearing_stiffness = 1e8
+[params.ring]
+mass = 2.35
+inertia_over_r2 = 3.0
+bearing_stiffness = 1e8
+torsional_stiffness = 1e9
+[params.carrier]
+mass = 5.43
+inertia_over_r2 = 6.29
+bearing_stiffness = 1e8
+[params.planet]
+mass = "660 g"
+inertia_over_r2 = 0.61
+bearing_stiffness = 1e8
+[run]
+omega = 0.7
+"""
+
+
+def test_study_file_builds_the_gear_set():
+    from geardyn.io.toml import load_study
+
+    model = geardyn.build_model(load_study(STUDY))
+    assert isinstance(model, geardyn.PlanetaryGearSet)
+    assert model.omega == 0.7
+    np.testing.assert_allclose(model.natural_frequencies(), gear_set(4).natural_frequencies(),
+                               rtol=1e-12)
+    assert model.backlash[0] == pytest.approx(10e-6)
+
+
+@pytest.mark.parametrize(("old", "new", "field"), [
+    ("mass = 0.4", "mass = -0.4", "params.sun.mass"),
+    ('sun_mesh_stiffness = "5e8 N/m"', 'sun_mesh_stiffness = "5e8 kg"',
+     "params.sun_mesh_stiffness"),
+])
+def test_study_file_bad_value_names_the_field(old, new, field):
+    from geardyn.io.toml import load_study
+
+    with pytest.raises(ParameterError) as err:
+        geardyn.build_model(load_study(STUDY.replace(old, new, 1)))
+    assert err.value.field == field
+
+
+def test_study_file_unknown_key_is_refused():
+    from pydantic import ValidationError
+
+    from geardyn.io.toml import load_study
+
+    with pytest.raises((ValidationError, geardyn.StudyError), match="params.sun.spin"):
+        load_study(STUDY.replace("[params.sun]\n", "[params.sun]\nspin = 1\n"))

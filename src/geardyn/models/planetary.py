@@ -416,7 +416,8 @@ class PlanetaryGearSet(Model):
         from scipy.linalg import eigh
 
         lam, phi = eigh(self.stiffness_matrix(), self.mass_matrix())
-        return np.clip(lam, 0.0, None), phi
+        big = float(np.max(np.abs(lam))) if lam.size else 0.0
+        return np.where(lam > 1e-12 * big, lam, 0.0), phi  # a rigid-body mode: exactly 0
 
     def _damping_matrix(self) -> np.ndarray:
         """Viscous damping [N s/m]: modal (M Phi diag(2 zeta w) Phi^T M) plus nothing per mesh
