@@ -379,3 +379,16 @@ def test_study_file_unknown_key_is_refused():
 
     with pytest.raises((ValidationError, geardyn.StudyError), match="params.sun.spin"):
         load_study(STUDY.replace("[params.sun]\n", "[params.sun]\nspin = 1\n"))
+
+
+def test_sweep_in_a_physical_parameter_sees_contact_loss():
+    """A bifurcation sweep of the gear set in a constructor input (lanes rebuilt by
+    lane_params) ends ok in every lane, and its ring meshes lose contact."""
+    gs = _contact_loss_set()
+    ds = geardyn.bifurcation(gs, "ring_mesh_error", [4e-6, 5e-6, 6e-6], transient=50.0,
+                             samples=4)
+    assert np.all(ds["status"].values == 0)
+    assert list(ds["mesh"].values) == list(gs.mesh_names)
+    contact = ds["contact"].sel(mesh=["r1", "r2", "r3"]).values
+    assert np.all(contact != "none")
+    assert np.all(np.isfinite(ds["dynamic_factor"].values))

@@ -468,10 +468,11 @@ class PlanetaryGearSet(Model):
         p[lay["F1"]:lay["F1"] + n] = Minv @ F[1] / (L * w0 * w0)
         p[lay["Kt"]:lay["Kt"] + n * n] = (Minv @ self.stiffness_matrix(False)).ravel() / w0**2
         p[lay["Ct"]:lay["Ct"] + n * n] = (Minv @ self._damping_matrix()).ravel() / w0
+        p[pk.DAMPED] = float(np.any(p[lay["Ct"]:lay["Ct"] + n * n] != 0.0))
         W = self.mesh_rows()
         k, c = self.mesh_stiffnesses(), self._mesh_damping()
         names_p = ["Omega", "n_dof", "n_meshes", "n_harmonics", "torque_on", "torque_order",
-                   "torque_phase", "spare"]
+                   "torque_phase", "damped"]
         names_p += [f"F0_{d}" for d in names] + [f"F1_{d}" for d in names]
         names_p += [f"Kt_{a}_{b}" for a in names for b in names]
         names_p += [f"Ct_{a}_{b}" for a in names for b in names]
@@ -528,6 +529,10 @@ class PlanetaryGearSet(Model):
         if rest:
             base = copy.copy(out)
             out = Model.with_params(base, **rest)
+            if "damped" not in rest:  # a raw Ct entry switches the modal damping product on
+                lay, n = out._layout, int(out.params[pk.N_DOF])
+                ct = out.params[lay["Ct"]:lay["Ct"] + n * n]
+                out.params[pk.DAMPED] = float(np.any(ct != 0.0))
             out.raw_overrides = {**raw, **{k: v for k, v in rest.items() if k != "Omega"}}
         return out
 

@@ -12,8 +12,9 @@ CF_m [N] the force per unit deflection and deflection rate, k_m the relative sti
 series in the mesh phase), e_m = ES_m sin(Omega tau) + EC_m cos(Omega tau) the transmission error.
 f_m is the dynamic mesh force [N], the observable.
 
-Coefficient vector: a header, the dof vectors F0, F1, the matrices Kt, Ct (row-major), then one
-block per mesh (fixed entries, 2 nh Fourier coefficients, W, G).
+Coefficient vector: a header (``DAMPED`` is 1 where Ct is not zero), the dof vectors F0, F1,
+the matrices Kt, Ct (row-major), then one block per mesh (fixed entries, 2 nh Fourier
+coefficients, W, G).
 """
 
 from __future__ import annotations
@@ -23,7 +24,7 @@ import math
 import numba as nb
 
 # header
-OMEGA, N_DOF, N_MESH, N_HARM, TORQUE_ON, TORQUE_ORDER, TORQUE_PHASE, SPARE = range(8)
+OMEGA, N_DOF, N_MESH, N_HARM, TORQUE_ON, TORQUE_ORDER, TORQUE_PHASE, DAMPED = range(8)
 HEADER = 8
 # mesh block fixed entries
 M_B, M_ES, M_EC, M_KF, M_CF = range(5)
@@ -100,12 +101,16 @@ def planetary_rhs(t, y, dy, p, s, c):
     fl = 0.0
     if p[TORQUE_ON] != 0.0:
         fl = math.sin(p[TORQUE_ORDER] * p[OMEGA] * t + p[TORQUE_PHASE])
+    damped = p[DAMPED] != 0.0  # modal damping: the Ct product (skipped when Ct = 0)
     for i in range(n):
         acc = p[f0 + i] + p[f1 + i] * fl
         r = kt + i * n
-        q = ct + i * n
         for j in range(n):
-            acc -= p[r + j] * y[j] + p[q + j] * y[n + j]
+            acc -= p[r + j] * y[j]
+        if damped:
+            q = ct + i * n
+            for j in range(n):
+                acc -= p[q + j] * y[n + j]
         dy[i] = y[n + i]
         dy[n + i] = acc
     for m in range(nm):
