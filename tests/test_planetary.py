@@ -392,3 +392,55 @@ def test_sweep_in_a_physical_parameter_sees_contact_loss():
     contact = ds["contact"].sel(mesh=["r1", "r2", "r3"]).values
     assert np.all(contact != "none")
     assert np.all(np.isfinite(ds["dynamic_factor"].values))
+
+
+def test_mesh_forces_follow_the_formula():
+    """observe at a random state and time equals k_m [1 + A sin(w t + phi_m)] g(delta_m - e_m,
+    b_m) + c_m (delta_m' - e_m') evaluated here in SI from the published-block rows."""
+    n, a = 3, 24.6 * DEG
+    psi = np.array([0.0, 110.0, 235.0]) * DEG
+    gs = gear_set(n, planet_angles=["0 deg", "110 deg", "235 deg"],
+                  sun_stiffness_fluctuation=0.2, ring_stiffness_fluctuation=[0.1, 0.15, 0.05],
+                  sun_mesh_phase=[0.0, 1.0, 2.0], ring_mesh_phase=0.5,
+                  sun_backlash="3 um", ring_backlash=[1e-6, 2e-6, 4e-6],
+                  sun_mesh_error="2 um", ring_mesh_error="1 um", ring_error_phase=0.3,
+                  mesh_damping=[0.03, 0.05, 0.07], mesh_frequency=2 * math.pi * 900)
+    rng = np.random.default_rng(3)
+    X, V, tau = rng.normal(0, 5, 18), rng.normal(0, 3, 18), 7.3
+    L, w0, w = gs.length_scale, gs.time_scale, 2 * math.pi * 900
+    t, q, qd = tau / w0, L * X, L * w0 * V
+    out = np.empty(2 * n)
+    gs.kernel.observe(tau, np.r_[X, V], out, gs.params, math.sin(gs.omega * tau),
+                      math.cos(gs.omega * tau))
+    for m in range(2 * n):
+        i, sun = m % n, m < n
+        row = np.zeros(18)
+        if sun:
+            row[6:9] = [-math.sin(psi[i] - a), math.cos(psi[i] - a), 1.0]
+            row[9 + 3 * i:12 + 3 * i] = [-math.sin(a), -math.cos(a), 1.0]
+        else:
+            row[3:6] = [-math.sin(psi[i] + a), math.cos(psi[i] + a), 1.0]
+            row[9 + 3 * i:12 + 3 * i] = [math.sin(a), -math.cos(a), -1.0]
+        k, amp = 5e8, (0.2 if sun else [0.1, 0.15, 0.05][i])
+        phi = [0.0, 1.0, 2.0][i] if sun else 0.5
+        b = 3e-6 if sun else [1e-6, 2e-6, 4e-6][i]
+        E, phe = (2e-6, 0.0) if sun else (1e-6, 0.3)
+        e = E * math.sin(w * t + phi + phe)
+        ed = E * w * math.cos(w * t + phi + phe)
+        x = row @ q - e
+        g = x - b if x > b else (x + b if x < -b else 0.0)
+        jg = 0.39 if sun else 3.0
+        c = 2 * [0.03, 0.05, 0.07][i] * math.sqrt(k * jg * 0.61 / (jg + 0.61))
+        F = k * (1 + amp * math.sin(w * t + phi)) * g + c * (row @ qd - ed)
+        assert out[m] == pytest.approx(F, rel=1e-9), gs.mesh_names[m]
+
+
+def test_fourier_waveform_input_matches_the_sine():
+    """A waveform given as Fourier coefficients (the plug-in for geometry) with mesh phases
+    gives the coefficients of the built-in sine with the same phases."""
+    kw = dict(sun_stiffness_fluctuation=0.2, ring_stiffness_fluctuation=0.2,
+              sun_mesh_phase=[0.0, 0.7, 1.9], ring_mesh_phase=[0.4, 0.1, 2.2])
+    sine = gear_set(3, **kw)
+    given = gear_set(3, waveform=([0.0], [0.2]), **kw)
+    np.testing.assert_allclose(given.fourier, sine.fourier, atol=1e-15)
+    assert np.any(sine.fourier != 0.0)
