@@ -444,3 +444,22 @@ def test_fourier_waveform_input_matches_the_sine():
     given = gear_set(3, waveform=([0.0], [0.2]), **kw)
     np.testing.assert_allclose(given.fourier, sine.fourier, atol=1e-15)
     assert np.any(sine.fourier != 0.0)
+
+
+def test_cli_sweeps_a_planetary_study(tmp_path, capsys):
+    from geardyn.cli.main import main
+
+    path = tmp_path / "lp4.toml"
+    path.write_text(STUDY)
+    nc = tmp_path / "sweep.nc"
+    with pytest.raises(SystemExit) as info:
+        main(["bifurcation", str(path), "--param", "ring_mesh_error", "--range", "1e-6:3e-6:3",
+              "--transient", "20", "--samples", "4", "--out", str(nc)])
+    out = capsys.readouterr()
+    assert info.value.code == 0, out.err
+    assert nc.exists()
+    with pytest.raises(SystemExit) as info:
+        main(["bifurcation", str(path), "--param", "spin", "--range", "1:2:3", "--out",
+              str(nc)])
+    err = capsys.readouterr().err
+    assert info.value.code == 2 and "sun_backlash" in err and "Kt_" not in err

@@ -38,6 +38,9 @@ from geardyn.units import to_si
 _KERNEL = KernelSource(pk.planetary_rhs, pk.planetary_events, pk.planetary_observe)
 CENTRAL = ("carrier", "ring", "sun")
 _SHORT = {"carrier": "c", "ring": "r", "sun": "s"}
+#: Constructor inputs that fix the model's layout or are not numbers: not swept by name.
+_NOT_SWEPT = {"n_planets", "waveform", "harmonics", "rotational_only", "fixed", "carrier_speed",
+              "planet_angles", "sun", "ring", "carrier", "planet", "time_scale", "length_scale"}
 #: Relative tolerance within which two natural frequencies count as one repeated frequency.
 MULTIPLICITY_RTOL = 1e-6
 
@@ -501,6 +504,14 @@ class PlanetaryGearSet(Model):
         self.event_names = tuple(f"x_{m}{s}b_{m}" for m in self.mesh_names for s in "-+")
         self.meshes = tuple((m, 2 * i, 2 * i + 1) for i, m in enumerate(self.mesh_names))
         self._layout = lay
+
+    @property
+    def physical_names(self) -> tuple[str, ...]:
+        """The numeric constructor inputs a sweep accepts by name (SI), e.g. ``sun_backlash``,
+        ``mesh_frequency``, ``sun_torque`` (raw coefficients are in ``param_names``)."""
+        return tuple(k for k, v in self.inputs.items() if k not in _NOT_SWEPT
+                     and (v is None or isinstance(v, int | float | str))
+                     and not isinstance(v, bool))
 
     @property
     def mesh_names(self) -> tuple[str, ...]:
