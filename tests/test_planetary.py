@@ -463,3 +463,19 @@ def test_cli_sweeps_a_planetary_study(tmp_path, capsys):
               str(nc)])
     err = capsys.readouterr().err
     assert info.value.code == 2 and "sun_backlash" in err and "Kt_" not in err
+
+
+def test_bearing_forces_balance_the_mesh_forces_on_a_planet():
+    """Static equilibrium of planet n along eta_n: its bearing's tangential force equals
+    -(F_sn cos a_s + F_rn cos a_r); along zeta_n the radial force equals
+    -F_sn sin a_s + F_rn sin a_r."""
+    gs = _contact_loss_set()
+    y = gs.initial_state()
+    fb = gs.bearing_forces(y)
+    F = gs.static_mesh_forces()
+    ca, sa = math.cos(24.6 * DEG), math.sin(24.6 * DEG)
+    for i in range(3):
+        fs, fr = F[i], F[3 + i]
+        assert fb[f"F_p{i + 1}_tangential"] == pytest.approx(-(fs + fr) * ca, rel=1e-8)
+        assert fb[f"F_p{i + 1}_radial"] == pytest.approx((fr - fs) * sa, rel=1e-6, abs=1e-6)
+    assert set(fb) >= {"F_c_x", "F_c_y", "F_s_x", "F_s_y", "F_r_x", "F_r_y"}

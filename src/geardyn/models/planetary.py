@@ -673,6 +673,34 @@ class PlanetaryGearSet(Model):
             sign = new
         return X
 
+    def bearing_forces(self, y: np.ndarray) -> dict[str, np.ndarray]:
+        """Bearing forces [N] at states ``y`` (..., n_states; e.g. stacked from a
+        :func:`~geardyn.simulate` result): ``F_<c|r|s>_x``, ``F_<c|r|s>_y`` (the bearing spring
+        forces k_b x, k_b y of carrier, ring and sun, where they have coordinates) and per planet
+        ``F_p<n>_radial``, ``F_p<n>_tangential`` (k_p times the planet bearing's radial and
+        tangential deflections, see ``docs/planetary.md``). Not observables of the kernel, so
+        that sweeps keep one observable per mesh (and the dynamic factors)."""
+        y = np.asarray(y, dtype=float)
+        n = len(self.dof_names())
+        q = self.length_scale * (y[..., :n] @ self.constraint().T)  # full coordinates [m]
+        out: dict[str, np.ndarray] = {}
+        for j, k in enumerate(CENTRAL):
+            if k in self.fixed or self.rotational_only:
+                continue
+            kb = self.members[k].bearing_stiffness
+            out[f"F_{_SHORT[k]}_x"] = kb * q[..., 3 * j]
+            out[f"F_{_SHORT[k]}_y"] = kb * q[..., 3 * j + 1]
+        kp = self.members["planet"].bearing_stiffness
+        for i, psi in enumerate(self.psi):
+            o = 9 + 3 * i
+            c, s = math.cos(psi), math.sin(psi)
+            radial = c * q[..., 0] + s * q[..., 1] - q[..., o]
+            tangential = -s * q[..., 0] + c * q[..., 1] - q[..., o + 1] + q[..., 2]
+            if not self.rotational_only:
+                out[f"F_p{i + 1}_radial"] = kp * radial
+                out[f"F_p{i + 1}_tangential"] = kp * tangential
+        return out
+
     def initial_state(self) -> np.ndarray:
         """The quasi-static state (:meth:`static_state`), at rest."""
         return np.concatenate([self.static_state(), np.zeros(len(self.state_names) // 2)])
