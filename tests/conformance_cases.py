@@ -59,6 +59,23 @@ def _kicked(m: geardyn.Model, kick: list[float]) -> np.ndarray:
     return m.initial_state() + np.resize(np.asarray(kick), m.n_states)
 
 
+def planetary() -> geardyn.PlanetaryGearSet:
+    """A small planetary gear set (N = 3, unequally spaced planets, so that no coupling
+    cancels to rounding residue) with backlash, stiffness fluctuation and transmission error,
+    balanced torques."""
+    M = geardyn.Member
+    a = 24.6 * math.pi / 180
+    return geardyn.PlanetaryGearSet(
+        n_planets=3, sun_pressure_angle=a, ring_pressure_angle=a,
+        sun=M(0.4, 0.39, 1e8, 0.0, radius=0.03), ring=M(2.35, 3.0, 1e8, 1e9),
+        carrier=M(5.43, 6.29, 1e8, 0.0, radius=0.08), planet=M(0.66, 0.61, 1e8),
+        sun_mesh_stiffness=5e8, ring_mesh_stiffness=5e8,
+        planet_angles=["0 deg", "110 deg", "235 deg"], sun_torque=100.0,
+        carrier_torque=-2 * math.cos(a) * 100 / 0.03 * 0.08, sun_backlash=10e-6,
+        ring_backlash=10e-6, sun_stiffness_fluctuation=0.2, ring_stiffness_fluctuation=0.2,
+        sun_mesh_error=5e-6, ring_mesh_error=5e-6, mesh_frequency=2 * math.pi * 1500)
+
+
 def cases() -> dict[str, tuple[geardyn.Model, np.ndarray]]:
     """Case id -> (model, start state)."""
     reduced = _catt()
@@ -66,13 +83,17 @@ def cases() -> dict[str, tuple[geardyn.Model, np.ndarray]]:
     dim = reduced.dimensional()
     pair = geardyn.GearPair(Omega=1.3, kappa=0.2, Fa=0.2)
     user = user_model()
+    gs = planetary()
+    kick = np.random.default_rng(1).normal(0.0, 1.0, gs.n_states) * np.r_[[3.0] * 18, [1.0] * 18]
     return {
         "CATTDevice-reduced": (reduced, _kicked(reduced, [0.3, 0.1, -0.2, 0.05])),
         "CATTDevice-general": (general, _kicked(general, [0.3, 0.1, -0.2, 0.05])),
         "DimensionalCATT": (dim, dim.initial_state()),
         "GearPair": (pair, np.zeros(2)),
         "UserModel": (user, np.array([1.0, 0.0])),
+        "PlanetaryGearSet": (gs, gs.initial_state() + kick),
     }
 
 
-IDS = ("CATTDevice-reduced", "CATTDevice-general", "DimensionalCATT", "GearPair", "UserModel")
+IDS = ("CATTDevice-reduced", "CATTDevice-general", "DimensionalCATT", "GearPair", "UserModel",
+       "PlanetaryGearSet")

@@ -28,6 +28,7 @@ from geardyn.models.catt import CATTDevice, DimensionalCATT
 from geardyn.models.derived import INTERPRETATIONS
 from geardyn.models.gear_pair import GearPair
 from geardyn.models.params import Carrier, Gear, Loads, Mesh, PlanetaryParams, PlanetOverride
+from geardyn.models.planetary import Member, PlanetaryGearSet
 from geardyn.models.user import UserModel
 from geardyn.solvers.reference import reference_solution
 from geardyn.solvers.simulate import default_steps_per_period, simulate
@@ -46,11 +47,13 @@ __all__ = [
     "Gear",
     "Loads",
     "LyapunovEstimate",
+    "Member",
     "Mesh",
     "Model",
     "ParameterError",
     "PeriodicOrbit",
     "PlanetOverride",
+    "PlanetaryGearSet",
     "PlanetaryParams",
     "RunSettings",
     "Status",

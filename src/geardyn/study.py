@@ -17,17 +17,19 @@ from pydantic import ValidationError
 
 from geardyn.core.model import Model
 from geardyn.errors import ParameterError
-from geardyn.io.toml import GearPairParams, Study
+from geardyn.io.toml import GearPairParams, PlanetaryGearSetParams, Study
 from geardyn.models.catt import CATTDevice
 from geardyn.models.derived import INTERPRETATIONS
 from geardyn.models.gear_pair import GearPair
+from geardyn.models.planetary import Member, PlanetaryGearSet
 
-__all__ = ["build_model", "check_usable"]
+__all__ = ["build_model", "check_usable", "planetary_model"]
 
 
 def build_model(study: Study, interpretation: str | None = None, omega: float | None = None
                 ) -> Model:
-    """The study's model: a :class:`~geardyn.CATTDevice` or a :class:`~geardyn.GearPair`.
+    """The study's model: a :class:`~geardyn.CATTDevice`, a :class:`~geardyn.GearPair` or a
+    :class:`~geardyn.PlanetaryGearSet`.
 
     ``interpretation`` and ``omega`` override the study's (``omega`` defaults to
     ``[run].omega``, else 1). Raises :class:`~geardyn.ParameterError` for an unknown
@@ -43,11 +45,29 @@ def build_model(study: Study, interpretation: str | None = None, omega: float | 
         if om is not None:
             kwargs["Omega"] = float(om)
         return check_usable(lambda: GearPair(**kwargs))
+    if isinstance(study.params, PlanetaryGearSetParams):
+        return check_usable(lambda: planetary_model(study.params, om))
     return check_usable(lambda: CATTDevice(
         study.planetary_params,
         interpretation or study.study.interpretation,  # type: ignore[arg-type]
         omega=1.0 if om is None else float(om),
     ))
+
+
+def planetary_model(params: PlanetaryGearSetParams, omega: float | None = None
+                    ) -> PlanetaryGearSet:
+    """The :class:`~geardyn.PlanetaryGearSet` of a planetary study's ``[params]`` (with the
+    dimensionless mesh frequency ``omega`` where given). A bad value raises
+    :class:`ParameterError` naming ``params.<field>``."""
+    kw = params.model_dump()
+    for name in ("sun", "ring", "carrier", "planet"):
+        kw[name] = Member(**kw[name])
+    kw["fixed"] = tuple(kw["fixed"])
+    try:
+        model = PlanetaryGearSet(**kw)
+    except ParameterError as exc:
+        raise ParameterError(f"params.{exc.field}", exc.value, exc.reason) from None
+    return model if omega is None else model.with_omega(float(omega))
 
 
 def check_usable(build: Callable[[], Model]) -> Model:

@@ -91,6 +91,9 @@ def _sweepable(model) -> list[str]:
 
     if isinstance(model, CATTDevice):
         return ["Omega", *(n for n in PAPER_NAMES if n != "waveform")]
+    physical = getattr(model, "physical_names", None)  # models with named physical inputs
+    if physical is not None:
+        return ["Omega", *physical]
     return ["Omega", *(n for n in model.param_names if n != "Omega")]
 
 

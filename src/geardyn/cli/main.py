@@ -150,6 +150,18 @@ def params_show(
         out.print(table)
         out.print("natural frequency (in contact): 1 (unit of dimensionless time)")
         return
+    if s.study.model == "planetary":
+        out.print(f"{escape(repr(model))}: time scale omega_0 = {_fmt(model.time_scale)} rad/s, "
+                  f"length scale L = {_fmt(model.length_scale)} m")
+        modes = model.modes()
+        table = Table(title="Natural frequencies (linear model, mean stiffness)")
+        for col in ("f [Hz]", "multiplicity", "type"):
+            table.add_column(col, justify="right")
+        for k in range(modes.sizes["mode"]):
+            table.add_row(_fmt(float(modes["frequency"][k])), str(int(modes["multiplicity"][k])),
+                          str(modes["type"].values[k]))
+        out.print(table)
+        return
 
     out.print(f"[bold]interpretation[/bold] {model.interpretation}")
     table = Table(title="Derived quantities (SI)")

@@ -9,7 +9,7 @@ A *study file* holds the device parameters plus run settings::
     [study]
     name = "fig3"
     description = "Paper Fig. 3"
-    model = "catt"                  # or "gear_pair"
+    model = "catt"                  # or "gear_pair", "planetary"
     interpretation = "consistent"   # consistent | carrier-only | as-printed
     plot_state = "X_sq"             # the coordinate figures show
     [params]                        # PlanetaryParams fields (nested tables), or:
@@ -23,6 +23,10 @@ A *study file* holds the device parameters plus run settings::
 
 For ``model = "gear_pair"`` the ``[params]`` table holds :class:`~geardyn.GearPair` arguments
 (``zeta``, ``kappa``, ``Fm``, ``Fa``, ``Omega``, ``kappa_phase``, ``error_phase``, ``backlash``).
+For ``model = "planetary"`` it holds :class:`~geardyn.PlanetaryGearSet` arguments
+(:class:`PlanetaryGearSetParams`: SI numbers or unit strings; ``[params.sun]``, ``[params.ring]``,
+``[params.carrier]``, ``[params.planet]`` are :class:`~geardyn.Member` tables); their values are
+checked when the model is built (errors name ``params.<field>``).
 
 This module only reads and validates: a study file becomes a :class:`Study` (plain, validated
 data; its device parameters a :class:`~geardyn.PlanetaryParams`). Turning a study into a model is
@@ -57,7 +61,9 @@ from geardyn.models.params import PAPER_NAMES, Angle, PlanetaryParams, Real, Who
 
 __all__ = [
     "GearPairParams",
+    "MemberTable",
     "PaperBase",
+    "PlanetaryGearSetParams",
     "RunSettings",
     "RunTable",
     "Study",
@@ -79,8 +85,8 @@ _HEADER = (
     "# Unit strings such as \"50 um\" or \"20 deg\" are accepted on input.\n\n"
 )
 
-Model = Literal["catt", "gear_pair"]
-DEFAULT_PLOT_STATE: dict[str, str] = {"catt": "X_sq", "gear_pair": "x"}
+Model = Literal["catt", "gear_pair", "planetary"]
+DEFAULT_PLOT_STATE: dict[str, str] = {"catt": "X_sq", "gear_pair": "x", "planetary": "u_s"}
 
 
 # --------------------------------------------------------------------------- study schema
@@ -91,7 +97,8 @@ class StudyInfo(BaseModel):
 
     name: str = Field("unnamed", min_length=1, description="short name")
     description: str = Field("", description="one-line description")
-    model: Model = Field("catt", description="catt (the paper's device) or gear_pair")
+    model: Model = Field("catt", description="catt (the paper's device), gear_pair or "
+                         "planetary (Lin & Parker gear set)")
     interpretation: Literal["consistent", "carrier-only", "as-printed"] = Field(
         "consistent", description="how to read the paper's ambiguous formulas (catt only)"
     )
@@ -180,6 +187,68 @@ class GearPairParams(BaseModel):
     backlash: Real = Field(1.0, ge=0, description="backlash half-width")
 
 
+#: A quantity: an SI number or a unit string ("24.6 deg", "5e8 N/m").
+Quantity = float | str
+#: A quantity, or one per planet.
+PerPlanet = float | str | list[float | str]
+
+
+class MemberTable(BaseModel):
+    """A ``[params.<member>]`` table of a planetary study: :class:`~geardyn.Member` fields."""
+
+    model_config = _CONFIG
+
+    mass: Quantity
+    inertia_over_r2: Quantity
+    bearing_stiffness: Quantity
+    torsional_stiffness: Quantity = 0.0
+    radius: Quantity | None = None
+
+
+class PlanetaryGearSetParams(BaseModel):
+    """``[params]`` of a ``planetary`` study: the arguments of :class:`~geardyn.PlanetaryGearSet`
+    (types checked here; values when the model is built)."""
+
+    model_config = _CONFIG
+
+    n_planets: int = 3
+    sun_pressure_angle: Quantity = "24.6 deg"
+    ring_pressure_angle: Quantity = "24.6 deg"
+    sun: MemberTable
+    ring: MemberTable
+    carrier: MemberTable
+    planet: MemberTable
+    sun_mesh_stiffness: Quantity
+    ring_mesh_stiffness: Quantity
+    planet_angles: list[Quantity] | None = None
+    sun_stiffness_fluctuation: PerPlanet = 0.0
+    ring_stiffness_fluctuation: PerPlanet = 0.0
+    waveform: Literal["sine", "rectangular"] = "sine"
+    contact_ratio: float = 1.6
+    harmonics: int = 9
+    sun_mesh_phase: PerPlanet = 0.0
+    ring_mesh_phase: PerPlanet = 0.0
+    sun_backlash: PerPlanet = 0.0
+    ring_backlash: PerPlanet = 0.0
+    sun_mesh_error: PerPlanet = 0.0
+    ring_mesh_error: PerPlanet = 0.0
+    sun_error_phase: PerPlanet = 0.0
+    ring_error_phase: PerPlanet = 0.0
+    mesh_damping: PerPlanet = 0.05
+    modal_damping: float = 0.0
+    sun_torque: Quantity = 0.0
+    ring_torque: Quantity = 0.0
+    carrier_torque: Quantity = 0.0
+    torque_fluctuation: float = 0.0
+    torque_order: float = 1.0
+    torque_phase: Quantity = 0.0
+    mesh_frequency: Quantity | None = None
+    rotational_only: bool = False
+    fixed: list[Literal["carrier", "ring", "sun"]] = Field(default_factory=list)
+    time_scale: Quantity | None = None
+    length_scale: Quantity = 1e-6
+
+
 def _relocated(exc: ValidationError, loc_of) -> ValidationError:
     """``exc`` with every error's location mapped by ``loc_of(loc) -> loc``."""
     details: list[InitErrorDetails] = []
@@ -239,13 +308,14 @@ class Study(BaseModel):
     """A study: device parameters plus run and sweep settings (one TOML file).
 
     ``params`` is a :class:`PlanetaryParams` (full form), a :class:`PaperBase` (paper values plus
-    changes) or, for ``model = "gear_pair"``, a :class:`GearPairParams`.
+    changes) or, for ``model = "gear_pair"``, a :class:`GearPairParams`, for
+    ``model = "planetary"`` a :class:`PlanetaryGearSetParams`.
     """
 
     model_config = _CONFIG
 
     study: StudyInfo = Field(default_factory=StudyInfo)
-    params: PlanetaryParams | PaperBase | GearPairParams
+    params: PlanetaryParams | PaperBase | GearPairParams | PlanetaryGearSetParams
     run: RunTable = Field(default_factory=RunTable)
     sweep: SweepSettings | None = None
 
@@ -285,6 +355,8 @@ class Study(BaseModel):
         out = dict(data)
         if kind == "gear_pair":
             target: type[BaseModel] = GearPairParams
+        elif kind == "planetary":
+            target = PlanetaryGearSetParams
         elif "base" in raw:
             out["params"] = _resolve_paper(raw)[0]
             return out
@@ -298,11 +370,13 @@ class Study(BaseModel):
 
     @model_validator(mode="after")
     def _check_consistency(self) -> Study:
-        gear_pair = isinstance(self.params, GearPairParams)
-        if gear_pair != (self.study.model == "gear_pair"):
+        holds = ("gear_pair" if isinstance(self.params, GearPairParams) else "planetary"
+                 if isinstance(self.params, PlanetaryGearSetParams) else "catt")
+        if holds != self.study.model:
+            kind = {"gear_pair": "GearPair", "planetary": "PlanetaryGearSet",
+                    "catt": "PlanetaryParams"}[holds]
             raise ValueError(
-                f"study.model is {self.study.model!r} but [params] holds "
-                f"{'GearPair' if gear_pair else 'PlanetaryParams'} parameters"
+                f"study.model is {self.study.model!r} but [params] holds {kind} parameters"
             )
         if isinstance(self.params, PaperBase):
             self._planetary = _resolve_paper(self.params.model_dump())[1]
@@ -315,7 +389,8 @@ class Study(BaseModel):
     def planetary_params(self) -> PlanetaryParams:
         """The resolved device parameters (catt studies)."""
         if self._planetary is None:
-            raise StudyError(f"study {self.study.name!r} is a gear_pair study: no device params")
+            raise StudyError(f"study {self.study.name!r} is a {self.study.model} study: no CATT "
+                             "device params")
         return self._planetary
 
     @property

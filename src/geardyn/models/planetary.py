@@ -1,0 +1,736 @@
+"""The lumped-parameter planetary gear set of Lin & Parker (J. Vib. Acoust. 121, 1999, 316-321).
+
+Carrier c, ring r, sun s and N planets, each with three degrees of freedom in the carrier frame
+(a frame that turns with the carrier's mean speed): the carrier, ring and sun translations x, y
+and rotations u = r theta (r: the base radius of the sun and ring, the radius of the planet
+centres for the carrier), and per planet n its radial and tangential translations zeta_n, eta_n
+and rotation u_n = r_p theta_n. Planet n sits at the angle psi_n. Mesh deflections along the lines
+of action (``docs/planetary.md``)::
+
+    delta_sn = -x_s sin psi_sn + y_s cos psi_sn - zeta_n sin a_s - eta_n cos a_s + u_s + u_n
+    delta_rn = -x_r sin psi_rn + y_r cos psi_rn + zeta_n sin a_r - eta_n cos a_r + u_r - u_n
+
+with psi_sn = psi_n - a_s, psi_rn = psi_n + a_r. Planet bearings deflect by
+x_c cos psi_n + y_c sin psi_n - zeta_n (radial) and -x_c sin psi_n + y_c cos psi_n - eta_n + u_c
+(tangential). Each mesh spring acts through a dead zone (backlash) with a time-varying stiffness
+and a transmission error. Gyroscopic and centripetal terms of the rotating carrier are omitted
+(the carrier-frame model at low carrier speed, as in Lin & Parker's modal analysis).
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from types import SimpleNamespace
+from typing import Any
+
+import numpy as np
+
+from geardyn.core.kernel_source import KernelSource
+from geardyn.core.model import Model, unique_rows
+from geardyn.errors import ParameterError
+from geardyn.models import planetary_kernels as pk
+from geardyn.models.stiffness import fourier_coefficients
+from geardyn.units import to_si
+
+_KERNEL = KernelSource(pk.planetary_rhs, pk.planetary_events, pk.planetary_observe)
+CENTRAL = ("carrier", "ring", "sun")
+_SHORT = {"carrier": "c", "ring": "r", "sun": "s"}
+#: Constructor inputs that fix the model's layout or are not numbers: not swept by name.
+_NOT_SWEPT = {"n_planets", "waveform", "harmonics", "rotational_only", "fixed", "carrier_speed",
+              "planet_angles", "sun", "ring", "carrier", "planet", "time_scale", "length_scale"}
+#: Relative tolerance within which two natural frequencies count as one repeated frequency.
+MULTIPLICITY_RTOL = 1e-6
+
+
+def _si(field: str, value: object, kind: str, minimum: float | None = 0.0,
+        strict: bool = False) -> float:
+    """``value`` in SI (a number or a unit string), finite and >= (or >) ``minimum``."""
+    try:
+        v = to_si(value, kind)
+    except ValueError as exc:
+        raise ParameterError(field, value, str(exc)) from None
+    if not math.isfinite(v):
+        raise ParameterError(field, value, "must be finite")
+    if minimum is not None and (v <= minimum if strict else v < minimum):
+        raise ParameterError(field, value, f"must be {'>' if strict else '>='} {minimum:g}")
+    return v
+
+
+@dataclass(frozen=True)
+class Member:
+    """One member of a planetary gear set (SI inputs; numbers or unit strings).
+
+    mass [kg]; inertia_over_r2 [kg] the rotational inertia over the squared radius r of its
+    rotation coordinate u = r theta (base radius of sun and ring, planet-centre radius for the
+    carrier, base radius of a planet); bearing_stiffness [N/m] of its translational bearing (a
+    planet's: its bearing on the carrier); torsional_stiffness [N/m] of its torsional support,
+    acting on u (0: free; a planet has none); radius [m] of u, needed only to turn a torque on
+    the member into a force on u.
+    """
+
+    mass: float
+    inertia_over_r2: float
+    bearing_stiffness: float
+    torsional_stiffness: float = 0.0
+    radius: float | None = None
+
+    def checked(self, name: str) -> Member:
+        """A copy with SI floats, validated; errors name ``<name>.<field>``."""
+        radius = None if self.radius is None else _si(f"{name}.radius", self.radius, "length",
+                                                      strict=True)
+        return Member(
+            mass=_si(f"{name}.mass", self.mass, "mass", strict=True),
+            inertia_over_r2=_si(f"{name}.inertia_over_r2", self.inertia_over_r2, "mass",
+                                strict=True),
+            bearing_stiffness=_si(f"{name}.bearing_stiffness", self.bearing_stiffness,
+                                  "stiffness"),
+            torsional_stiffness=_si(f"{name}.torsional_stiffness", self.torsional_stiffness,
+                                    "stiffness"),
+            radius=radius)
+
+
+def _per_planet(field: str, value: Any, n: int, kind: str, minimum: float | None = 0.0
+                ) -> np.ndarray:
+    """A scalar or a sequence of n values, in SI."""
+    if isinstance(value, str | int | float) and not isinstance(value, bool):
+        return np.full(n, _si(field, value, kind, minimum))
+    vals = list(value)
+    if len(vals) != n:
+        raise ParameterError(field, value, f"needs one value per planet ({n}) or a scalar")
+    return np.array([_si(f"{field}[{i}]", v, kind, minimum) for i, v in enumerate(vals)])
+
+
+def _waveform(field: str, waveform: Any, rel: np.ndarray, phase: np.ndarray, contact_ratio: float,
+              harmonics: int) -> np.ndarray:
+    """Relative Fourier coefficients (meshes, 2 nh) [a_1, b_1, a_2, ...] of k(theta) - 1 per
+    mesh, for the mesh phase theta + phase_m."""
+    if isinstance(waveform, str):
+        if waveform not in ("sine", "rectangular"):
+            raise ParameterError(field, waveform, "must be 'sine', 'rectangular' or a pair "
+                                 "(a, b) of relative Fourier coefficients")
+        nh = 1 if waveform == "sine" else harmonics
+        out = np.zeros((rel.size, 2 * nh))
+        for m in range(rel.size):
+            mesh = SimpleNamespace(waveform=waveform, stiffness_amplitude=rel[m],
+                                   mean_stiffness=1.0, stiffness_phase=phase[m],
+                                   contact_ratio=contact_ratio, harmonics=harmonics)
+            a, b = fourier_coefficients(mesh, nh)  # type: ignore[arg-type]
+            out[m, 0::2], out[m, 1::2] = a, b
+        return out
+    try:
+        a0, b0 = (np.asarray(v, dtype=float).ravel() for v in waveform)
+    except (TypeError, ValueError):
+        raise ParameterError(field, waveform, "must be 'sine', 'rectangular' or a pair (a, b) "
+                             "of relative Fourier coefficients") from None
+    if a0.size != b0.size or a0.size == 0 or not np.all(np.isfinite(a0) & np.isfinite(b0)):
+        raise ParameterError(field, waveform, "a and b must be finite, of equal length >= 1")
+    h = np.arange(1, a0.size + 1)
+    out = np.zeros((rel.size, 2 * a0.size))
+    for m in range(rel.size):  # the waveform shifted by phase_m: harmonic h turns by h phase_m
+        cs, sn = np.cos(h * phase[m]), np.sin(h * phase[m])
+        out[m, 0::2] = a0 * cs + b0 * sn
+        out[m, 1::2] = b0 * cs - a0 * sn
+    return out
+
+
+def _clean(A: np.ndarray, rel: float = 1e-12) -> np.ndarray:
+    """``A`` with entries below ``rel`` times its largest magnitude set to 0: the rounding
+    residue of trigonometric sums (cos(pi/2) = 6e-17), which would couple coordinates that
+    the model leaves uncoupled."""
+    A = np.array(A, dtype=float)
+    big = float(np.max(np.abs(A))) if A.size else 0.0
+    A[np.abs(A) < rel * big] = 0.0
+    return A
+
+
+def _minimum_relative_stiffness(coef: np.ndarray) -> float:
+    theta = np.linspace(0.0, 2.0 * math.pi, 2048, endpoint=False)
+    h = np.arange(1, coef.shape[1] // 2 + 1)[:, None]
+    C, S = np.cos(h * theta), np.sin(h * theta)
+    k = 1.0 + coef[:, 0::2] @ C + coef[:, 1::2] @ S
+    return float(k.min()) if k.size else 1.0
+
+
+class PlanetaryGearSet(Model):
+    """The Lin & Parker (1999) rotational-translational planetary gear model, nonlinear.
+
+    Inputs are SI (numbers or unit strings, e.g. ``"24.6 deg"``, ``"5e8 N/m"``). The model
+    integrates a dimensionless form: displacements over ``length_scale`` L (default 1 um) and
+    time tau = omega_0 t with ``time_scale`` omega_0 [rad/s] (default
+    sqrt(sun_mesh_stiffness / planet.inertia_over_r2)); ``Omega`` = mesh_frequency / omega_0 is
+    the dimensionless mesh frequency. Both scales stay fixed under :meth:`with_params`, so a
+    sweep in any parameter keeps the meaning of Omega and of the states.
+
+    Parameters
+    ----------
+    n_planets, planet_angles
+        N and the planet angles psi_n [rad] (default equally spaced, psi_n = 2 pi (n - 1) / N).
+    sun_pressure_angle, ring_pressure_angle
+        Pressure angles a_s, a_r of the sun-planet and ring-planet meshes.
+    sun, ring, carrier, planet
+        :class:`Member` data (the planet's ``bearing_stiffness`` is its bearing on the carrier).
+    sun_mesh_stiffness, ring_mesh_stiffness
+        Mean mesh stiffnesses [N/m].
+    sun_stiffness_fluctuation, ring_stiffness_fluctuation
+        Relative amplitude of the stiffness fluctuation (half peak-to-peak over the mean, as in
+        :class:`~geardyn.Mesh`); ``waveform`` ``"sine"``, ``"rectangular"`` (``contact_ratio``,
+        ``harmonics``) or a pair (a, b) of relative Fourier coefficients of k/k_mean - 1 (then
+        the fluctuations are ignored). Mesh m's stiffness is k_m (1 + w(Omega tau + phase_m)).
+    sun_mesh_phase, ring_mesh_phase
+        Mesh phases [rad of the mesh cycle], scalar or one per planet (e.g. Parker & Lin 2004).
+    sun_backlash, ring_backlash
+        Backlash half-width b of each mesh [m] (dead zone), scalar or per planet.
+    sun_mesh_error, ring_mesh_error, sun_error_phase, ring_error_phase
+        Transmission error e_m = E sin(Omega tau + phase_m + error_phase) [m] of each mesh.
+    mesh_damping, modal_damping
+        Viscous damping: per mesh ratio zeta_m (c_m = 2 zeta_m sqrt(k_m m_e), m_e the equivalent
+        rotational mass of the mesh's two gears; acting on the deflection rate, also in the
+        backlash) and/or a modal damping ratio of every mode of the linear model at mean
+        stiffness.
+    sun_torque, ring_torque, carrier_torque
+        Mean external torques [N m] on the members (need the member's ``radius``).
+    torque_fluctuation, torque_order, torque_phase
+        The sun (input) torque fluctuates as T_s (1 + A sin(order Omega tau + phase)).
+    mesh_frequency
+        Mesh frequency [rad/s] (the forcing); default omega_0 (Omega = 1).
+    rotational_only
+        The purely torsional model: member centres fixed, planets carried rigidly by the
+        carrier (eta_n = u_c, zeta_n = 0).
+    fixed
+        Members held fixed (all their coordinates removed), e.g. ``("ring",)``.
+    carrier_speed
+        Must be None: gyroscopic and centripetal terms are not modelled (omitted).
+    """
+
+    name = "PlanetaryGearSet"
+    time_unit = "1"
+    state_units = "1"
+    observable_units = "N"
+
+    def __init__(self, n_planets: int = 3, sun_pressure_angle: Any = "24.6 deg",
+                 ring_pressure_angle: Any = "24.6 deg", *, sun: Member, ring: Member,
+                 carrier: Member, planet: Member, sun_mesh_stiffness: Any,
+                 ring_mesh_stiffness: Any, planet_angles: Sequence[Any] | None = None,
+                 sun_stiffness_fluctuation: Any = 0.0, ring_stiffness_fluctuation: Any = 0.0,
+                 waveform: Any = "sine", contact_ratio: float = 1.6, harmonics: int = 9,
+                 sun_mesh_phase: Any = 0.0, ring_mesh_phase: Any = 0.0,
+                 sun_backlash: Any = 0.0, ring_backlash: Any = 0.0,
+                 sun_mesh_error: Any = 0.0, ring_mesh_error: Any = 0.0,
+                 sun_error_phase: Any = 0.0, ring_error_phase: Any = 0.0,
+                 mesh_damping: Any = 0.05, modal_damping: float = 0.0,
+                 sun_torque: Any = 0.0, ring_torque: Any = 0.0, carrier_torque: Any = 0.0,
+                 torque_fluctuation: float = 0.0, torque_order: float = 1.0,
+                 torque_phase: float = 0.0, mesh_frequency: Any = None,
+                 rotational_only: bool = False, fixed: Sequence[str] = (),
+                 carrier_speed: Any = None, time_scale: Any = None,
+                 length_scale: Any = 1e-6):
+        self.inputs: dict[str, Any] = {k: v for k, v in locals().items()
+                                       if k not in ("self", "__class__")}
+        if isinstance(n_planets, bool) or not isinstance(n_planets, int | np.integer) \
+                or not 1 <= n_planets <= 32:
+            raise ParameterError("n_planets", n_planets, "must be an integer from 1 to 32")
+        n = int(n_planets)
+        if carrier_speed is not None:
+            raise ParameterError("carrier_speed", carrier_speed, "gyroscopic and centripetal "
+                                 "terms of a rotating carrier are not modelled; leave it None")
+        fixed = tuple(fixed)
+        for f in fixed:
+            if f not in CENTRAL:
+                raise ParameterError("fixed", fixed, f"{f!r} is not one of {', '.join(CENTRAL)}")
+        self.n_planets = n
+        self.rotational_only = bool(rotational_only)
+        self.fixed = fixed
+        self.members = {k: m.checked(k) if isinstance(m, Member) else None
+                        for k, m in (("sun", sun), ("ring", ring), ("carrier", carrier),
+                                     ("planet", planet))}
+        for k, m in self.members.items():
+            if m is None:
+                raise ParameterError(k, self.inputs[k], "must be a geardyn.Member")
+        if self.members["planet"].torsional_stiffness != 0.0:
+            raise ParameterError("planet.torsional_stiffness", planet.torsional_stiffness,
+                                 "a planet has no torsional support; must be 0")
+        self.alpha_s = _si("sun_pressure_angle", sun_pressure_angle, "angle")
+        self.alpha_r = _si("ring_pressure_angle", ring_pressure_angle, "angle")
+        for f, a in (("sun_pressure_angle", self.alpha_s), ("ring_pressure_angle", self.alpha_r)):
+            if not a < math.pi / 2:
+                raise ParameterError(f, a, "must be below 90 deg")
+        if planet_angles is None:
+            self.psi = 2.0 * math.pi * np.arange(n) / n
+        else:
+            self.psi = _per_planet("planet_angles", planet_angles, n, "angle", None)
+        self.k_s = _si("sun_mesh_stiffness", sun_mesh_stiffness, "stiffness", strict=True)
+        self.k_r = _si("ring_mesh_stiffness", ring_mesh_stiffness, "stiffness", strict=True)
+        per = {}
+        for f, kind in (("sun_stiffness_fluctuation", "dimensionless"),
+                        ("ring_stiffness_fluctuation", "dimensionless"),
+                        ("sun_mesh_phase", "angle"), ("ring_mesh_phase", "angle"),
+                        ("sun_backlash", "length"), ("ring_backlash", "length"),
+                        ("sun_mesh_error", "length"), ("ring_mesh_error", "length"),
+                        ("sun_error_phase", "angle"), ("ring_error_phase", "angle"),
+                        ("mesh_damping", "dimensionless")):
+            minimum = 0.0 if kind in ("length", "dimensionless") else None
+            per[f] = _per_planet(f, self.inputs[f], n, kind, minimum)
+        both = lambda f: np.concatenate([per[f"sun_{f}"], per[f"ring_{f}"]])  # noqa: E731
+        if not isinstance(contact_ratio, int | float) or not 1.0 < contact_ratio < 2.0:
+            raise ParameterError("contact_ratio", contact_ratio, "must be between 1 and 2")
+        if isinstance(harmonics, bool) or not isinstance(harmonics, int) \
+                or not 1 <= harmonics <= 200:
+            raise ParameterError("harmonics", harmonics, "must be an integer from 1 to 200")
+        self.mesh_phase = both("mesh_phase")
+        self.fourier = _waveform("waveform", waveform, both("stiffness_fluctuation"),
+                                 self.mesh_phase, float(contact_ratio), harmonics)
+        if _minimum_relative_stiffness(self.fourier) <= 0.0:
+            raise ParameterError("sun_stiffness_fluctuation", sun_stiffness_fluctuation,
+                                 "the stiffness fluctuation makes a mesh stiffness negative; "
+                                 "it must stay > 0")
+        self.backlash = both("backlash")
+        self.error = both("mesh_error")
+        self.error_phase = both("error_phase") + self.mesh_phase
+        self.mesh_damping = per["mesh_damping"]
+        self.modal_damping = _si("modal_damping", modal_damping, "dimensionless")
+        self.torques = {k: _si(f"{k}_torque", self.inputs[f"{k}_torque"], "torque", None)
+                        for k in ("sun", "ring", "carrier")}
+        for k, t in self.torques.items():
+            if t != 0.0 and self.members[k].radius is None:
+                raise ParameterError(f"{k}.radius", None, f"needed to apply {k}_torque")
+        self.torque_fluctuation = _si("torque_fluctuation", torque_fluctuation, "dimensionless")
+        self.torque_order = _si("torque_order", torque_order, "dimensionless", strict=True)
+        self.torque_phase = _si("torque_phase", torque_phase, "angle", None)
+        self.length_scale = _si("length_scale", length_scale, "length", strict=True)
+        default_w0 = math.sqrt(self.k_s / self.members["planet"].inertia_over_r2)
+        self.time_scale = (default_w0 if time_scale is None
+                           else _si("time_scale", time_scale, "frequency", strict=True))
+        mf = self.time_scale if mesh_frequency is None else _si("mesh_frequency",
+                                                                mesh_frequency, "frequency")
+        self._build(mf / self.time_scale)
+
+    # ------------------------------------------------------------------ assembly (SI)
+    def full_dof_names(self) -> tuple[str, ...]:
+        """Coordinates of the full model: x, y, u of carrier, ring, sun; zeta, eta, u per
+        planet."""
+        names = [f"{v}_{_SHORT[m]}" for m in CENTRAL for v in ("x", "y", "u")]
+        for i in range(self.n_planets):
+            names += [f"zeta_{i + 1}", f"eta_{i + 1}", f"u_{i + 1}"]
+        return tuple(names)
+
+    def _full_mass(self) -> np.ndarray:
+        d = []
+        for k in (*CENTRAL,) + ("planet",) * self.n_planets:
+            m = self.members[k]
+            d += [m.mass, m.mass, m.inertia_over_r2]
+        return np.diag(d)
+
+    def _full_support_stiffness(self) -> np.ndarray:
+        """Bearings, torsional supports and planet bearings [N/m] (full coordinates)."""
+        nf = 9 + 3 * self.n_planets
+        K = np.zeros((nf, nf))
+        for j, k in enumerate(CENTRAL):
+            m = self.members[k]
+            K[3 * j, 3 * j] += m.bearing_stiffness
+            K[3 * j + 1, 3 * j + 1] += m.bearing_stiffness
+            K[3 * j + 2, 3 * j + 2] += m.torsional_stiffness
+        kp = self.members["planet"].bearing_stiffness
+        for i, psi in enumerate(self.psi):
+            o = 9 + 3 * i
+            for row in (self._row({0: math.cos(psi), 1: math.sin(psi), o: -1.0}),
+                        self._row({0: -math.sin(psi), 1: math.cos(psi), 2: 1.0, o + 1: -1.0})):
+                K += kp * np.outer(row, row)
+        return _clean(K)
+
+    def _row(self, entries: dict[int, float]) -> np.ndarray:
+        r = np.zeros(9 + 3 * self.n_planets)
+        for j, v in entries.items():
+            r[j] += v
+        return r
+
+    def full_mesh_rows(self) -> np.ndarray:
+        """Mesh deflection rows (2N, full coordinates): sun-planet meshes, then ring-planet."""
+        a_s, a_r = self.alpha_s, self.alpha_r
+        rows = []
+        for i, psi in enumerate(self.psi):
+            o = 9 + 3 * i
+            ps = psi - a_s
+            rows.append(self._row({6: -math.sin(ps), 7: math.cos(ps), 8: 1.0,
+                                   o: -math.sin(a_s), o + 1: -math.cos(a_s), o + 2: 1.0}))
+        for i, psi in enumerate(self.psi):
+            o = 9 + 3 * i
+            pr = psi + a_r
+            rows.append(self._row({3: -math.sin(pr), 4: math.cos(pr), 5: 1.0,
+                                   o: math.sin(a_r), o + 1: -math.cos(a_r), o + 2: -1.0}))
+        return _clean(np.array(rows))
+
+    def constraint(self) -> np.ndarray:
+        """T (full dofs x model dofs): full coordinates = T @ model coordinates."""
+        names = self.full_dof_names()
+        nf = len(names)
+        keep: list[int] = []
+        for j, k in enumerate(CENTRAL):
+            if k in self.fixed:
+                continue
+            keep += [3 * j + 2] if self.rotational_only else [3 * j, 3 * j + 1, 3 * j + 2]
+        for i in range(self.n_planets):
+            o = 9 + 3 * i
+            keep += [o + 2] if self.rotational_only else [o, o + 1, o + 2]
+        T = np.zeros((nf, len(keep)))
+        for col, j in enumerate(keep):
+            T[j, col] = 1.0
+        if self.rotational_only and "carrier" not in self.fixed:
+            uc = keep.index(2)
+            for i in range(self.n_planets):
+                T[9 + 3 * i + 1, uc] = 1.0  # eta_n = u_c: planets carried by the carrier
+        self._kept = keep
+        return T
+
+    def dof_names(self) -> tuple[str, ...]:
+        """The model's coordinates (the full ones kept by :meth:`constraint`)."""
+        self.constraint()
+        full = self.full_dof_names()
+        return tuple(full[j] for j in self._kept)
+
+    def mass_matrix(self) -> np.ndarray:
+        """M [kg] in the model's coordinates."""
+        T = self.constraint()
+        return T.T @ self._full_mass() @ T
+
+    def mesh_rows(self) -> np.ndarray:
+        """Mesh deflection rows (2N, model coordinates)."""
+        return self.full_mesh_rows() @ self.constraint()
+
+    def mesh_stiffnesses(self) -> np.ndarray:
+        """Mean stiffness [N/m] of every mesh (sun-planet meshes, then ring-planet)."""
+        n = self.n_planets
+        return np.concatenate([np.full(n, self.k_s), np.full(n, self.k_r)])
+
+    def stiffness_matrix(self, meshes: bool = True) -> np.ndarray:
+        """K [N/m] in the model's coordinates at mean mesh stiffness (no backlash); without the
+        mesh springs when ``meshes`` is False."""
+        T = self.constraint()
+        K = T.T @ self._full_support_stiffness() @ T
+        if meshes:
+            W = self.mesh_rows()
+            K = K + W.T @ (self.mesh_stiffnesses()[:, None] * W)
+        return K
+
+    def _eig(self) -> tuple[np.ndarray, np.ndarray]:
+        """Eigenvalues (rad/s)^2 ascending and mass-normalised shapes of K phi = lam M phi."""
+        from scipy.linalg import eigh
+
+        lam, phi = eigh(self.stiffness_matrix(), self.mass_matrix())
+        big = float(np.max(np.abs(lam))) if lam.size else 0.0
+        return np.where(lam > 1e-12 * big, lam, 0.0), phi  # a rigid-body mode: exactly 0
+
+    def _damping_matrix(self) -> np.ndarray:
+        """Viscous damping [N s/m]: modal (M Phi diag(2 zeta w) Phi^T M) plus nothing per mesh
+        (mesh damping acts in the mesh force)."""
+        M = self.mass_matrix()
+        if self.modal_damping == 0.0:
+            return np.zeros_like(M)
+        lam, phi = self._eig()
+        return _clean(M @ phi @ np.diag(2.0 * self.modal_damping * np.sqrt(lam)) @ phi.T @ M)
+
+    def _mesh_damping(self) -> np.ndarray:
+        """c_m = 2 zeta_m sqrt(k_m m_e) [N s/m] of every mesh."""
+        jp = self.members["planet"].inertia_over_r2
+        out = []
+        for k, gear in ((self.k_s, "sun"), (self.k_r, "ring")):
+            jg = self.members[gear].inertia_over_r2
+            out.append(np.full(self.n_planets, 2.0 * math.sqrt(k * jg * jp / (jg + jp))))
+        return np.concatenate(out) * np.tile(self.mesh_damping, 2)
+
+    def _forces(self) -> np.ndarray:
+        """Mean generalised forces [N] on the model's coordinates, and the fluctuating part."""
+        F = np.zeros(9 + 3 * self.n_planets)
+        Fl = np.zeros_like(F)
+        for j, k in enumerate(CENTRAL):
+            if self.torques[k] != 0.0:
+                F[3 * j + 2] = self.torques[k] / self.members[k].radius
+        Fl[8] = F[8] * self.torque_fluctuation
+        T = self.constraint()
+        return np.stack([T.T @ F, T.T @ Fl])
+
+    # ------------------------------------------------------------------ coefficient vector
+    def _build(self, omega: float) -> None:
+        names = self.dof_names()
+        n = len(names)
+        nm = 2 * self.n_planets
+        nh = self.fourier.shape[1] // 2
+        lay = pk.layout(n, nm, nh)
+        L, w0 = self.length_scale, self.time_scale
+        M = self.mass_matrix()
+        Minv = np.diag(1.0 / np.diag(M))
+        p = np.zeros(lay["size"])
+        p[pk.OMEGA] = omega
+        p[pk.N_DOF], p[pk.N_MESH], p[pk.N_HARM] = n, nm, nh
+        F = self._forces()
+        p[pk.TORQUE_ON] = float(np.any(F[1] != 0.0))
+        p[pk.TORQUE_ORDER], p[pk.TORQUE_PHASE] = self.torque_order, self.torque_phase
+        p[lay["F0"]:lay["F0"] + n] = Minv @ F[0] / (L * w0 * w0)
+        p[lay["F1"]:lay["F1"] + n] = Minv @ F[1] / (L * w0 * w0)
+        p[lay["Kt"]:lay["Kt"] + n * n] = (Minv @ self.stiffness_matrix(False)).ravel() / w0**2
+        p[lay["Ct"]:lay["Ct"] + n * n] = (Minv @ self._damping_matrix()).ravel() / w0
+        p[pk.DAMPED] = float(np.any(p[lay["Ct"]:lay["Ct"] + n * n] != 0.0))
+        W = self.mesh_rows()
+        k, c = self.mesh_stiffnesses(), self._mesh_damping()
+        names_p = ["Omega", "n_dof", "n_meshes", "n_harmonics", "torque_on", "torque_order",
+                   "torque_phase", "damped"]
+        names_p += [f"F0_{d}" for d in names] + [f"F1_{d}" for d in names]
+        names_p += [f"Kt_{a}_{b}" for a in names for b in names]
+        names_p += [f"Ct_{a}_{b}" for a in names for b in names]
+        for m in range(nm):
+            o = lay["mesh"] + m * lay["block"]
+            blk = p[o:o + lay["block"]]
+            blk[pk.M_B] = self.backlash[m] / L
+            blk[pk.M_ES] = self.error[m] * math.cos(self.error_phase[m]) / L
+            blk[pk.M_EC] = self.error[m] * math.sin(self.error_phase[m]) / L
+            blk[pk.M_KF] = k[m] * L
+            blk[pk.M_CF] = c[m] * L * w0
+            f = pk.MESH_FIXED
+            blk[f:f + 2 * nh] = self.fourier[m]
+            blk[f + 2 * nh:f + 2 * nh + n] = W[m]
+            blk[f + 2 * nh + n:] = Minv @ W[m] / (L * w0 * w0)
+            mn = self.mesh_names[m]
+            names_p += [f"{mn}_{v}" for v in ("b", "E_s", "E_c", "KF", "CF")]
+            names_p += [f"{mn}_{ab}{h}" for h in range(1, nh + 1) for ab in "ab"]
+            names_p += [f"{mn}_W_{d}" for d in names] + [f"{mn}_G_{d}" for d in names]
+        self.params = p
+        self.param_names = tuple(names_p)
+        self.omega_index = pk.OMEGA
+        self.kernel = _KERNEL
+        self.state_names = names + tuple(f"d{d}" for d in names)
+        self.observable_names = tuple(f"F_{m}" for m in self.mesh_names)
+        self.event_names = tuple(f"x_{m}{s}b_{m}" for m in self.mesh_names for s in "-+")
+        self.meshes = tuple((m, 2 * i, 2 * i + 1) for i, m in enumerate(self.mesh_names))
+        self._layout = lay
+
+    @property
+    def physical_names(self) -> tuple[str, ...]:
+        """The numeric constructor inputs a sweep accepts by name (SI), e.g. ``sun_backlash``,
+        ``mesh_frequency``, ``sun_torque`` (raw coefficients are in ``param_names``)."""
+        return tuple(k for k, v in self.inputs.items() if k not in _NOT_SWEPT
+                     and (v is None or isinstance(v, int | float | str))
+                     and not isinstance(v, bool))
+
+    @property
+    def mesh_names(self) -> tuple[str, ...]:
+        """``s1..sN`` (sun-planet meshes), then ``r1..rN`` (ring-planet meshes)."""
+        n = self.n_planets
+        return tuple(f"s{i + 1}" for i in range(n)) + tuple(f"r{i + 1}" for i in range(n))
+
+    # ------------------------------------------------------------------ parameters by name
+    def with_params(self, **values: float) -> PlanetaryGearSet:
+        """A copy with parameters changed by name: constructor inputs (``sun_mesh_stiffness``,
+        ``sun_backlash``, ``mesh_frequency``, ``sun_torque``, ...) rebuild the model with the
+        same length and time scales; ``Omega`` (dimensionless mesh frequency) and raw
+        coefficients (``param_names``) set that entry of the vector."""
+        physical = {k: v for k, v in values.items() if k in self.inputs}
+        rest = {k: float(v) for k, v in values.items() if k not in physical}
+        raw = getattr(self, "raw_overrides", {})
+        if physical:
+            kw = {**self.inputs, "time_scale": self.time_scale,
+                  "length_scale": self.length_scale, **physical}
+            if "mesh_frequency" not in physical:
+                kw["mesh_frequency"] = self.omega * self.time_scale
+            out = type(self)(**kw)
+            rest = {**raw, **rest}
+        else:
+            out = copy.copy(self)
+        if rest:
+            base = copy.copy(out)
+            out = Model.with_params(base, **rest)
+            if "damped" not in rest:  # a raw Ct entry switches the modal damping product on
+                lay, n = out._layout, int(out.params[pk.N_DOF])
+                ct = out.params[lay["Ct"]:lay["Ct"] + n * n]
+                out.params[pk.DAMPED] = float(np.any(ct != 0.0))
+            out.raw_overrides = {**raw, **{k: v for k, v in rest.items() if k != "Omega"}}
+        return out
+
+    def lane_params(self, name: str, values: Sequence[float] | np.ndarray) -> np.ndarray:
+        """Coefficient vectors (lanes x n_params) with ``name`` set to ``values`` (a physical
+        input re-derives every coefficient, as :meth:`with_params`)."""
+        if name in self.inputs:
+            vals = np.asarray(values, dtype=float).ravel()
+            rows = [self.with_params(**{name: float(v)}).params for v in vals]
+            if len({r.size for r in rows}) != 1:
+                raise ValueError(f"sweeping {name!r} changes the model's size")
+            return np.array(rows)
+        return Model.lane_params(self, name, values)
+
+    # ------------------------------------------------------------------ linear analysis
+    def _lane_matrix(self, P: np.ndarray) -> np.ndarray:
+        """Dimensionless mean-stiffness matrices A (lanes, n, n) of X'' = -A X from ``P``."""
+        lay = self._layout
+        n, nm, nh = int(P[0, pk.N_DOF]), int(P[0, pk.N_MESH]), int(P[0, pk.N_HARM])
+        A = P[:, lay["Kt"]:lay["Kt"] + n * n].reshape(-1, n, n).copy()
+        f = pk.MESH_FIXED + 2 * nh
+        for m in range(nm):
+            o = lay["mesh"] + m * lay["block"]
+            W = P[:, o + f:o + f + n]
+            G = P[:, o + f + n:o + f + 2 * n]
+            A += P[:, o + pk.M_KF, None, None] * G[:, :, None] * W[:, None, :]
+        return A
+
+    def fastest_natural_frequency(self, P: np.ndarray | None = None) -> np.ndarray:
+        """Fastest natural frequency [omega_0] of the linear model at mean stiffness in every
+        lane of ``P`` (from the lane's coefficients; one eigenproblem per distinct row)."""
+        P = np.atleast_2d(self.params if P is None else np.asarray(P, dtype=float))
+        rows, inverse = unique_rows(P)
+        lam = np.linalg.eigvals(self._lane_matrix(rows))
+        return np.sqrt(np.max(np.abs(lam), axis=1))[inverse]
+
+    def other_frequencies(self, P: np.ndarray) -> np.ndarray:
+        """The torque fluctuation's frequency order * Omega where it acts and differs from the
+        mesh frequency, else NaN (one column)."""
+        P = np.atleast_2d(P)
+        on = (P[:, pk.TORQUE_ON] != 0.0) & (P[:, pk.TORQUE_ORDER] != 1.0)
+        return np.where(on, P[:, pk.TORQUE_ORDER] * P[:, pk.OMEGA], np.nan)[:, None]
+
+    def natural_frequencies(self) -> np.ndarray:
+        """Natural frequencies [Hz] of the linear model at mean stiffness, ascending, each
+        repeated by its multiplicity (a rigid-body mode gives 0)."""
+        lam, _ = self._eig()
+        return np.sqrt(lam) / (2.0 * math.pi)
+
+    def modes(self):
+        """Natural frequencies and mode shapes, classified (xarray Dataset over ``mode``).
+
+        Variables: ``frequency`` [Hz], ``multiplicity`` (of the frequency, within
+        :data:`MULTIPLICITY_RTOL`), ``type`` (``"rotational"``: no member centre moves;
+        ``"translational"``: the carrier, ring and sun do not rotate; ``"planet"``: only the
+        planets move; ``"mixed"`` otherwise, e.g. unequal spacing), ``shape`` (mode, dof):
+        mass-normalised shapes [kg^-1/2] in the model's coordinates. A repeated frequency's
+        shapes span its eigenspace and are classified together.
+        """
+        import xarray as xr
+
+        lam, phi = self._eig()
+        f = np.sqrt(lam) / (2.0 * math.pi)
+        groups = _groups(f)
+        names = self.dof_names()
+        mult = np.zeros(f.size, int)
+        kind = np.empty(f.size, object)
+        for g in groups:
+            mult[g] = len(g)
+            kind[g] = self._classify(phi[:, g], names)
+        return xr.Dataset(
+            {"frequency": ("mode", f, {"units": "Hz"}),
+             "multiplicity": ("mode", mult),
+             "type": ("mode", kind.astype(str)),
+             "shape": (("mode", "dof"), phi.T, {"units": "kg^-1/2"})},
+            coords={"mode": np.arange(f.size), "dof": list(names)},
+            attrs={"model": self.name, "n_planets": self.n_planets,
+                   "rotational_only": int(self.rotational_only)})
+
+    def _classify(self, shapes: np.ndarray, names: tuple[str, ...], tol: float = 1e-6) -> str:
+        """Kind of the eigenspace spanned by ``shapes`` (dofs x k), from the energy of its parts
+        (basis-independent: sums over the space)."""
+        M = np.diag(self.mass_matrix())
+        e = np.sum(M[:, None] * shapes**2, axis=1)  # kinetic-energy share per dof
+        total = e.sum()
+        central = np.array([d.endswith(("_c", "_r", "_s")) for d in names])
+        trans = central & np.array([d[0] in "xy" for d in names])
+        rot = central & np.array([d[0] == "u" for d in names])
+        if e[central].sum() <= tol * total:
+            return "planet"
+        if e[trans].sum() <= tol * total and self._planets_alike(shapes, names, tol):
+            return "rotational"
+        if e[rot].sum() <= tol * total:
+            return "translational"
+        return "mixed"
+
+    def _planets_alike(self, shapes: np.ndarray, names: tuple[str, ...], tol: float) -> bool:
+        """Every planet moves alike (in its own frame) in every shape."""
+        n = self.n_planets
+        per = [[j for j, d in enumerate(names) if d.endswith(f"_{i + 1}")] for i in range(n)]
+        first = shapes[per[0]]
+        scale = max(float(np.max(np.abs(shapes))), 1e-300)
+        return all(np.max(np.abs(shapes[p] - first)) <= math.sqrt(tol) * scale for p in per[1:])
+
+    # ------------------------------------------------------------------ static state
+    def static_state(self) -> np.ndarray:
+        """Dimensionless coordinates X of the quasi-static state under the mean torques (mean
+        stiffness, no error), each loaded mesh on its loaded flank: A X = F0 + sum kf b s G,
+        the flank signs s iterated; least squares where a rigid-body mode leaves A singular."""
+        lay = self._layout
+        n, nm, nh = int(self.params[pk.N_DOF]), int(self.params[pk.N_MESH]), \
+            int(self.params[pk.N_HARM])
+        A = self._lane_matrix(self.params[None, :])[0]
+        F0 = self.params[lay["F0"]:lay["F0"] + n]
+        f = pk.MESH_FIXED + 2 * nh
+        blocks = [self.params[lay["mesh"] + m * lay["block"]:][:lay["block"]] for m in range(nm)]
+        sign = np.zeros(nm)
+        X = np.zeros(n)
+        for _ in range(4):
+            rhs = F0 + sum(b[pk.M_KF] * b[pk.M_B] * sign[m] * b[f + n:f + 2 * n]
+                           for m, b in enumerate(blocks))
+            X = _clean(np.linalg.lstsq(A, rhs, rcond=None)[0])
+            d = np.array([b[f:f + n] @ X for b in blocks])
+            new = np.sign(d)
+            if np.array_equal(new, sign):
+                break
+            sign = new
+        return X
+
+    def bearing_forces(self, y: np.ndarray) -> dict[str, np.ndarray]:
+        """Bearing forces [N] at states ``y`` (..., n_states; e.g. stacked from a
+        :func:`~geardyn.simulate` result): ``F_<c|r|s>_x``, ``F_<c|r|s>_y`` (the bearing spring
+        forces k_b x, k_b y of carrier, ring and sun, where they have coordinates) and per planet
+        ``F_p<n>_radial``, ``F_p<n>_tangential`` (k_p times the planet bearing's radial and
+        tangential deflections, see ``docs/planetary.md``). Not observables of the kernel, so
+        that sweeps keep one observable per mesh (and the dynamic factors)."""
+        y = np.asarray(y, dtype=float)
+        n = len(self.dof_names())
+        q = self.length_scale * (y[..., :n] @ self.constraint().T)  # full coordinates [m]
+        out: dict[str, np.ndarray] = {}
+        for j, k in enumerate(CENTRAL):
+            if k in self.fixed or self.rotational_only:
+                continue
+            kb = self.members[k].bearing_stiffness
+            out[f"F_{_SHORT[k]}_x"] = kb * q[..., 3 * j]
+            out[f"F_{_SHORT[k]}_y"] = kb * q[..., 3 * j + 1]
+        kp = self.members["planet"].bearing_stiffness
+        for i, psi in enumerate(self.psi):
+            o = 9 + 3 * i
+            c, s = math.cos(psi), math.sin(psi)
+            radial = c * q[..., 0] + s * q[..., 1] - q[..., o]
+            tangential = -s * q[..., 0] + c * q[..., 1] - q[..., o + 1] + q[..., 2]
+            if not self.rotational_only:
+                out[f"F_p{i + 1}_radial"] = kp * radial
+                out[f"F_p{i + 1}_tangential"] = kp * tangential
+        return out
+
+    def initial_state(self) -> np.ndarray:
+        """The quasi-static state (:meth:`static_state`), at rest."""
+        return np.concatenate([self.static_state(), np.zeros(len(self.state_names) // 2)])
+
+    def static_mesh_forces(self) -> np.ndarray:
+        """Static mesh forces [N] of the quasi-static state, in the order of the meshes."""
+        lay = self._layout
+        n, nm, nh = (int(self.params[i]) for i in (pk.N_DOF, pk.N_MESH, pk.N_HARM))
+        X = self.static_state()
+        f = pk.MESH_FIXED + 2 * nh
+        out = np.empty(nm)
+        for m in range(nm):
+            b = self.params[lay["mesh"] + m * lay["block"]:][:lay["block"]]
+            d = b[f:f + n] @ X
+            out[m] = b[pk.M_KF] * (d - min(max(d, -b[pk.M_B]), b[pk.M_B]))
+        return out
+
+    def __repr__(self) -> str:
+        form = "rotational-only" if self.rotational_only else "rotational-translational"
+        return (f"PlanetaryGearSet(N={self.n_planets}, {form}, dofs={len(self.dof_names())}, "
+                f"Omega={self.omega:g})")
+
+
+def _groups(f: np.ndarray) -> list[list[int]]:
+    """Indices of ascending frequencies grouped into repeated values (relative tolerance)."""
+    scale = max(float(np.max(f)), 1e-300) if f.size else 1.0
+    groups: list[list[int]] = []
+    for i, v in enumerate(f):
+        if groups and abs(v - f[groups[-1][0]]) <= MULTIPLICITY_RTOL * max(v, 1e-3 * scale):
+            groups[-1].append(i)
+        else:
+            groups.append([i])
+    return groups
