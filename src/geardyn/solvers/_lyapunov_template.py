@@ -565,7 +565,12 @@ def _rows_commit(i, nr, NPR, Y, Y1, G0, G1, GR, FLAG, ACTR, P, LANE, T0R, HR, OM
     n_ev = G1.shape[0]
     for q in range(ns):
         for r in range(nr):
-            Y[q, r] = Y1[q, r] if ACTR[r] and FLAG[r] == 0.0 else Y[q, r]
+            Y[q, r] = Y1[q, r] if ACTR[r] & (FLAG[r] == 0.0) else Y[q, r]
+    n_split = 0  # (no short-circuit operators: the row loops stay branch-free and vectorise)
+    for r in range(nr):
+        n_split += 1 if ACTR[r] & (FLAG[r] != 0.0) else 0
+    if n_split == 0:
+        return
     for r in range(nr):
         if FLAG[r] == 0.0 or not ACTR[r]:
             continue
