@@ -123,7 +123,7 @@ def test_generated_lyapunov_exponents_sum_to_the_divergence(all_cases, case):
     n, h, steps = _grid(model, periods=1)
     p = np.ascontiguousarray(model.params)
     scale = np.ascontiguousarray(model.state_scale, dtype=float)
-    exps, _, _, status = k.lyapunov_single(p, y0, scale, 0.0, h, model.omega, n, 0, steps, 8,
+    exps, _, _, status, _ = k.lyapunov_single(p, y0, scale, 0.0, h, model.omega, n, 0, steps, 8,
                                            model.n_states, DEFAULT_BOUND, model.n_events)
     assert status == 0
     tr = _trace(model, y0)

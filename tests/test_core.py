@@ -152,6 +152,7 @@ def test_status_codes_equal_the_kernel_constants():
 
     assert Status.OK == _step_core.STATUS_OK == 0
     assert Status.DIVERGED == _step_core.STATUS_DIVERGED == 1
+    assert Status.SPLIT_LIMIT == _step_core.STATUS_SPLIT_LIMIT == 2
     assert status_meaning().startswith("0 ok, 1 diverged")
     assert Status.DIVERGED.message.startswith("diverged")
 

@@ -30,6 +30,19 @@ def forced_oscillator_rhs(t, y, dy, p):
     dy[1] = -2.0 * p[0] * y[1] - y[0] + p[1] * math.cos(p[2] * t)
 
 
+@nb.njit(cache=True)
+def drift_decay_rhs(t, y, dy, p):
+    # x' = 1 (exponent 0), y' = -y (exponent -1); the events are levels of x
+    dy[0] = 1.0
+    dy[1] = -y[1]
+
+
+@nb.njit(cache=True)
+def levels_events(t, y, g, p):
+    for j in range(g.size):
+        g[j] = y[0] - p[j]
+
+
 LORENZ = np.array([10.0, 28.0, 8.0 / 3.0])
 #: Largest Lorenz exponent at sigma=10, rho=28, beta=8/3 (Viswanath 1998: 0.9056).
 LORENZ_LAMBDA1 = 0.9056
@@ -475,3 +488,66 @@ def test_sweep_exponent_continues_its_lane_in_both_forcing_phases():
     assert abs(fresh.value - same.value) < 3.0 * (fresh.stderr + same.stderr)
     zero = geardyn.lyapunov(m, y0=ds["poincare"].values[1, -1], t0=0.0, **kw)
     assert abs(zero.value - same.value) > 3.0 * (zero.stderr + same.stderr)
+
+
+# ----------------------------------------------------------------------------- split limit
+N_LEVELS = 20
+
+
+def levels_model(n_cross: int) -> geardyn.UserModel:
+    """x' = 1, y' = -y with N_LEVELS switching functions x - c_j (smooth field: only the edge
+    location sees them), n_cross of the levels inside (0, 1) (crossed in the first step of
+    dt = 1), the rest at -10 (never crossed)."""
+    levels = np.full(N_LEVELS, -10.0)
+    levels[:n_cross] = 0.05 + 0.9 * np.arange(n_cross) / N_LEVELS
+    return geardyn.UserModel(drift_decay_rhs, 2, params=levels, events=levels_events,
+                             n_events=N_LEVELS)
+
+
+def test_split_limit_is_reported():
+    """A grid step that crosses more distinct edges than the split limit (MAX_SPLITS = 16 located
+    crossings per step) falls back unsplit: counted per row (the state and its 2 k
+    finite-difference neighbours each cross all the levels in the first step) and the lane's
+    status is SPLIT_LIMIT, in the one-lane and in the lane-block kernel; 10 levels are located
+    cleanly. The field is smooth, so the exponents stay those of x' = 1, y' = -y."""
+    from geardyn.solvers._step_core import MAX_SPLITS
+
+    assert 10 < MAX_SPLITS < N_LEVELS
+    run = dict(y0=[0.0, 1.0], transient=0.0, duration=5.0, dt=1.0)
+    clean = lyapunov(levels_model(10), with_error=True, **run)
+    assert clean.status == geardyn.Status.OK and clean.unresolved == 0 and clean.ok
+    model = levels_model(N_LEVELS)
+    est = lyapunov(model, with_error=True, **run)
+    assert est.status == geardyn.Status.SPLIT_LIMIT and not est.ok
+    assert est.unresolved == 3  # k = 1: three rows, one step each
+    assert abs(est.value) < 2e-3  # x' = 1: exponent 0 (finite-time: log(cond) / T)
+    spec = lyapunov(model, spectrum=True, with_error=True, **run)
+    assert spec.unresolved == 5 and spec.status == geardyn.Status.SPLIT_LIMIT
+    assert abs(spec.value[1] + 1.0) < 0.03
+    with pytest.warns(RuntimeWarning, match="split limit"):
+        assert lyapunov(model, **run) == est.value
+    # the lane blocks: every lane reports it, the exponent kept (not NaN)
+    P = np.tile(model.params, (3, 1))
+    exps, errs, unres, status = lyapunov_lanes(model, P, with_status=True, **run)
+    assert np.array_equal(unres, [3, 3, 3])
+    assert np.all(status == geardyn.Status.SPLIT_LIMIT)
+    assert np.array_equal(exps, np.full(3, est.value))
+    assert np.array_equal(errs, np.full(3, est.stderr))
+
+
+def test_run_settings():
+    """lyapunov(run=RunSettings(...)) is lyapunov with the same keywords; not both."""
+    g = geardyn.GearPair(**IMPACTING)
+    kw = dict(transient=60.0, steps_per_period=64, bound=1e5)
+    a = lyapunov(g, duration=100.0, with_error=True, **kw)
+    b = lyapunov(g, run=geardyn.RunSettings(**kw), duration=100.0, with_error=True)
+    assert a == b
+    # locate_edges=False: the edges are integrated across (a different exponent at this step)
+    c = lyapunov(g, run=geardyn.RunSettings(locate_edges=False, **kw), duration=100.0)
+    assert c != a.value and abs(c - a.value) < 0.05
+    with pytest.raises(TypeError, match="not both"):
+        lyapunov(g, run=geardyn.RunSettings(), transient=10.0)
+    with pytest.raises(TypeError, match="samples"):
+        lyapunov(g, samples=10)
+    with pytest.raises(ValueError, match="steps_per_period"):
+        lyapunov(g, steps_per_period=2)

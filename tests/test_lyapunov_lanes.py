@@ -42,7 +42,8 @@ def _reference(kern, model, args, renorm, k, bound=1e6):
     res = [kern.lyapunov_single(P[i], Y0[i], scale, T0[i], H[i], OM[i], n_per[i], n_tr[i], n_st[i],
                                 renorm, k, bound, model.n_events, 16) for i in range(len(P))]
     return (np.array([r[0] for r in res]), np.array([r[1] for r in res]),
-            np.array([r[2] for r in res]), np.array([r[3] for r in res]))
+            np.array([r[2] for r in res]), np.array([r[3] for r in res]),
+            np.array([r[4] for r in res]))
 
 
 def _blocks(kern, model, args, renorm, k, block_rows, n_ev=None, bound=1e6):
@@ -50,10 +51,11 @@ def _blocks(kern, model, args, renorm, k, block_rows, n_ev=None, bound=1e6):
     L = len(P)
     out, err = np.full((L, k), -1.0), np.full((L, k), -1.0)
     used, status = np.full(L, -1, np.int64), np.full(L, -1, np.int64)
+    unres = np.full(L, -1, np.int64)
     kern.lyapunov_block_lanes(P, Y0, np.ones(model.n_states), T0, H, OM, n_per, n_tr, n_st,
-                              renorm, k, bound, out, err, used, status,
+                              renorm, k, bound, out, err, used, status, unres,
                               model.n_events if n_ev is None else n_ev, 16, block_rows, 2)
-    return out, err, used, status
+    return out, err, used, status, unres
 
 
 def _assert_bitwise(got, ref):

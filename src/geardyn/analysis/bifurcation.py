@@ -16,7 +16,7 @@ from geardyn.analysis.dataset import sweep_dataset
 from geardyn.analysis.lanes import (
     has_mesh_forces,
 )
-from geardyn.analysis.lyapunov import lyapunov_err_attrs
+from geardyn.analysis.lyapunov import lyapunov_err_attrs, lyapunov_unresolved_attrs
 from geardyn.analysis.motion import averaging_time, motion_variable
 from geardyn.core.model import Model
 from geardyn.core.plan import forcing_period
@@ -127,7 +127,8 @@ def bifurcation(
     max_period found, -1 unbounded), ``contact`` (param, mesh: none/single/double/unbounded),
     ``force_peak``, ``force_rms``, ``dynamic_factor`` (param, mesh), ``status``,
     ``final_time`` (param: the model time of the final state, the last Poincare point), and
-    ``lyapunov`` with its standard error ``lyapunov_err`` (param) when asked: started from each
+    ``lyapunov`` with its standard error ``lyapunov_err`` and ``lyapunov_unresolved`` (param:
+    its steps at the edge-split limit) when asked: started from each
     point's final state at its final time, so both forcing phases continue (see
     ``docs/lyapunov.md``), and then ``motion`` (param: the motion class of
     :func:`geardyn.analysis.motion.motion_classes`).
@@ -167,8 +168,9 @@ def bifurcation(
         final = last.final
         start = np.where(np.isfinite(final), final, np.broadcast_to(base_y0, final.shape))
         asked = run.samples * _mean_period(model, P)  # averaging time asked for
-        exps, errs = lyapunov_lanes(model, P, start, min(run.transient, LYAPUNOV_ALIGN), asked,
-                                    run.steps_per_period, t0=last.final_time, with_error=True)
+        exps, errs, unres, _ = lyapunov_lanes(model, P, start, min(run.transient, LYAPUNOV_ALIGN),
+                                              asked, run.steps_per_period, t0=last.final_time,
+                                              with_status=True)
         ok = ds["status"].values == Status.OK
         method = ("tangent-map QR (Benettin), from the point's final state at its final time, "
                   f"{LYAPUNOV_ALIGN:g} time units to align, then as long as the sampling")
@@ -177,6 +179,7 @@ def bifurcation(
             "method": method})
         ds["lyapunov_err"] = (param, np.where(ok & np.isfinite(exps), errs, np.nan),
                               lyapunov_err_attrs(model.time_unit))
+        ds["lyapunov_unresolved"] = (param, unres, lyapunov_unresolved_attrs())
         ds["motion"] = (param, *motion_variable(ds["period"].values, ds["lyapunov"].values,
                                                 ds["lyapunov_err"].values,
                                                 averaging_time(asked, P[:, model.omega_index]),

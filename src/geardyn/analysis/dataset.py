@@ -21,7 +21,7 @@ from geardyn.analysis.lanes import (
     variable_attrs,
     variable_dims,
 )
-from geardyn.analysis.lyapunov import lyapunov_err_attrs
+from geardyn.analysis.lyapunov import lyapunov_err_attrs, lyapunov_unresolved_attrs
 from geardyn.core.model import Model
 from geardyn.core.status import status_attrs
 from geardyn.solvers.ensemble import LaneResults
@@ -86,19 +86,21 @@ def map_dataset(model: Model, y: tuple[str, np.ndarray], x: tuple[str, np.ndarra
                 out: dict[str, np.ndarray], max_period: int, tol: float) -> xr.Dataset:
     """The map dataset over the grid ``y`` x ``x`` (name, values) of the per-point results
     ``out`` (flat, y-major): the per-lane variables, ``status`` and, where computed,
-    ``lyapunov`` and ``lyapunov_err``; ``contact`` codes become their labels. Without the
-    run settings and the motion classes."""
+    ``lyapunov``, ``lyapunov_err`` and ``lyapunov_unresolved``; ``contact`` codes become their
+    labels. Without the run settings and the motion classes."""
     (yn, yv), (xn, xv) = y, x
     ny, nx = yv.size, xv.size
     ds = _with_mesh(xr.Dataset(coords={yn: (yn, yv), xn: (xn, xv)}), model)
     dims, attrs = variable_dims(model), variable_attrs(model, max_period, tol)
-    dims.update(status=(), lyapunov=(), lyapunov_err=())
+    dims.update(status=(), lyapunov=(), lyapunov_err=(), lyapunov_unresolved=())
     attrs.update(status=status_attrs(),
                  lyapunov={"long_name": "largest Lyapunov exponent",
                            "units": f"1/{model.time_unit}",
                            "start": "each point's final state at its final time"},
-                 lyapunov_err=lyapunov_err_attrs(model.time_unit))
-    for name in (*variable_dims(model), "status", "lyapunov", "lyapunov_err"):
+                 lyapunov_err=lyapunov_err_attrs(model.time_unit),
+                 lyapunov_unresolved=lyapunov_unresolved_attrs())
+    for name in (*variable_dims(model), "status", "lyapunov", "lyapunov_err",
+                 "lyapunov_unresolved"):
         if name not in out:
             continue
         data = out[name].reshape(ny, nx, *out[name].shape[1:])

@@ -11,7 +11,9 @@ the spread of its block averages over the run. See ``docs/lyapunov.md`` and the 
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -21,7 +23,8 @@ from geardyn.core.plan import (
     lane_steps,
     periods_covering,
 )
-from geardyn.core.settings import DEFAULT_BOUND, MIN_STEPS
+from geardyn.core.settings import DEFAULT_BOUND, MIN_STEPS, RunSettings, resolve_run
+from geardyn.core.status import Status
 from geardyn.models.base import Model
 from geardyn.solvers.kernels import kernels_for
 
@@ -32,8 +35,14 @@ DEFAULT_RENORM_EVERY = 10
 #: Default number of blocks the measuring window is cut into for the standard error.
 DEFAULT_BLOCKS = 16
 
-__all__ = ["DEFAULT_BLOCKS", "DEFAULT_DT", "DEFAULT_RENORM_EVERY", "LyapunovEstimate",
-           "lyapunov", "lyapunov_err_attrs", "lyapunov_lanes"]
+#: Defaults of :func:`lyapunov` where they differ from :class:`~geardyn.RunSettings`'.
+LYAPUNOV_DEFAULTS = {"transient": 100.0}
+#: The :class:`~geardyn.RunSettings` fields that :func:`lyapunov` uses (also as keywords).
+LYAPUNOV_FIELDS = ("transient", "steps_per_period", "locate_edges", "bound")
+
+__all__ = ["DEFAULT_BLOCKS", "DEFAULT_DT", "DEFAULT_RENORM_EVERY", "LYAPUNOV_DEFAULTS",
+           "LyapunovEstimate", "lyapunov", "lyapunov_err_attrs", "lyapunov_lanes",
+           "lyapunov_unresolved_attrs"]
 
 
 @dataclass(frozen=True)
@@ -44,11 +53,23 @@ class LyapunovEstimate:
     ``stderr``: its 1-sigma standard error, std(block rates) / sqrt(n_blocks) over blocks of
     whole forcing periods of the measuring window (same shape; NaN with fewer than 2 blocks or
     when diverged);
-    ``n_blocks``: the number of blocks used."""
+    ``n_blocks``: the number of blocks used;
+    ``unresolved``: grid steps (of the state or of a finite-difference neighbour) that reached
+    the edge-location split limit and were integrated unsplit across an edge;
+    ``status``: :attr:`~geardyn.Status.OK`, :attr:`~geardyn.Status.DIVERGED` (value NaN) or
+    :attr:`~geardyn.Status.SPLIT_LIMIT` (``unresolved`` > 0: the value is kept, but it rests
+    on steps that are not 4th order across an edge)."""
 
     value: float | np.ndarray
     stderr: float | np.ndarray
     n_blocks: int
+    unresolved: int = 0
+    status: Status = Status.OK
+
+    @property
+    def ok(self) -> bool:
+        """Whether the run ended cleanly (:attr:`~geardyn.Status.OK`)."""
+        return self.status == Status.OK
 
 
 def lyapunov_err_attrs(time_unit: str) -> dict[str, str]:
@@ -61,6 +82,16 @@ def lyapunov_err_attrs(time_unit: str) -> dict[str, str]:
         "method": f"batch means: the measuring window cut into n = {DEFAULT_BLOCKS} blocks of "
                   "whole forcing periods (fewer if shorter), std(block rates, ddof=1) / "
                   "sqrt(n); see docs/lyapunov.md, Uncertainty"}
+
+
+def lyapunov_unresolved_attrs() -> dict[str, str]:
+    """Attributes of a dataset's ``lyapunov_unresolved`` variable."""
+    return {
+        "long_name": "grid steps of the Lyapunov run that reached the edge-split limit",
+        "units": "1",
+        "meaning": "steps of the state or of a finite-difference neighbour integrated unsplit "
+                   "across an edge (chattering); > 0: the exponent is kept but less accurate "
+                   "(geardyn.Status.SPLIT_LIMIT)"}
 
 
 def _check_blocks(n_blocks: int) -> int:
@@ -97,24 +128,40 @@ def _state_scale(model: Model) -> np.ndarray:
     return s
 
 
+def _lyapunov_run(run: RunSettings | None, settings: dict[str, Any]) -> RunSettings:
+    """The run settings of :func:`lyapunov`: ``run``, or the old keywords (``transient``,
+    ``steps_per_period``, ``locate_edges``, ``bound``) on its defaults."""
+    extra = sorted(set(settings) - set(LYAPUNOV_FIELDS))
+    if extra:
+        raise TypeError(f"lyapunov() got an unexpected keyword argument {extra[0]!r} (run "
+                        f"settings it uses: {', '.join(LYAPUNOV_FIELDS)})")
+    return resolve_run(run, settings, LYAPUNOV_DEFAULTS)
+
+
 def lyapunov(
     model: Model,
     y0=None,
-    transient: float = 100.0,
+    run: RunSettings | None = None,
+    *,
     duration: float = 2000.0,
     spectrum: bool = False,
     dt: float | None = None,
-    steps_per_period: int | None = None,
     renorm_every: int | None = None,
-    bound: float = DEFAULT_BOUND,
     t0: float = 0.0,
     with_error: bool = False,
     n_blocks: int = DEFAULT_BLOCKS,
+    **settings: Any,
 ) -> float | np.ndarray | LyapunovEstimate:
     """Largest Lyapunov exponent of ``model`` (or the whole spectrum), per unit model time.
 
     Parameters
     ----------
+    run
+        The run settings, :class:`~geardyn.RunSettings`; of its fields ``transient``,
+        ``steps_per_period``, ``locate_edges`` and ``bound`` are used (the measuring window is
+        ``duration``, not ``samples``). For compatibility those four may be given as keyword
+        arguments instead (not together with ``run``); without either, ``transient`` is 100
+        time units (not RunSettings' 4000) and the rest RunSettings' defaults.
     y0
         Initial state (default: ``model.initial_state()``), at time ``t0``.
     t0
@@ -126,28 +173,33 @@ def lyapunov(
         attractor. A state at another forcing phase cannot be started (the phase is tabulated
         on the period-aligned grid from zero).
     transient, duration
-        Time discarded first and time averaged over, in the model's time unit. For a forced model
-        both are rounded up to whole forcing periods.
+        Time discarded first (``run.transient``) and time averaged over, in the model's time
+        unit. For a forced model both are rounded up to whole forcing periods.
     spectrum
         False: the largest exponent (one tangent vector), a float. True: all ``n_states``
         exponents, in descending order, as an array.
     dt
         Step of an autonomous model (``model.omega == 0``; default 0.01). Not used for a forced
-        model, whose grid has ``steps_per_period`` steps per forcing period (default
+        model, whose grid has ``run.steps_per_period`` steps per forcing period (default
         :func:`~geardyn.solvers.simulate.default_steps_per_period`), as in ``simulate``.
+    locate_edges
+        ``run.locate_edges``: locate the model's edge crossings inside steps (default True;
+        False integrates across them, as ``simulate`` does then).
     renorm_every
         RK4 steps between re-orthonormalisations (default 10).
     bound
-        A state beyond this magnitude counts as diverged; the result is then NaN.
+        ``run.bound``: a state beyond this magnitude counts as diverged; the result is then NaN.
     with_error, n_blocks
-        True: return a :class:`LyapunovEstimate` (value, stderr, n_blocks) instead, the standard
-        error from the spread of the rates over ``n_blocks`` blocks of the measuring window (see
-        ``docs/lyapunov.md``, "Uncertainty").
+        True: return a :class:`LyapunovEstimate` (value, stderr, n_blocks, unresolved, status)
+        instead, the standard error from the spread of the rates over ``n_blocks`` blocks of
+        the measuring window (see ``docs/lyapunov.md``, "Uncertainty"). Without it, a run with
+        steps at the edge-split limit (status SPLIT_LIMIT) warns (RuntimeWarning).
 
     For a forced model the exponent of the flow's zero direction (along the forcing phase) is not
     included: the phase is not a state, so a forced model with n states has n exponents.
     """
-    transient = _check_time("transient", transient, False)
+    run = _lyapunov_run(run, settings)
+    transient, steps_per_period, bound = run.transient, run.steps_per_period, run.bound
     duration = _check_time("duration", duration, True)
     y = _initial(model, y0)
     t0 = float(t0)
@@ -182,9 +234,11 @@ def lyapunov(
     k = model.n_states if spectrum else 1
     kern = kernels_for(model.kernel, "lyapunov")
     p = np.ascontiguousarray(model.params, dtype=float)
-    ex, er, used, _status = kern.lyapunov_single(p, y, _state_scale(model), t0, h, om, n_per,
-                                                 n_tr, n_st, renorm, k, float(bound),
-                                                 model.n_events, n_blk)
+    n_ev = model.n_events if run.locate_edges else 0
+    ex, er, used, code, unres = kern.lyapunov_single(p, y, _state_scale(model), t0, h, om, n_per,
+                                                     n_tr, n_st, renorm, k, float(bound), n_ev,
+                                                     n_blk)
+    status = Status(int(code))
     ex = np.asarray(ex, dtype=float)
     er = np.asarray(er, dtype=float)
     if spectrum:
@@ -193,7 +247,11 @@ def lyapunov(
     else:
         value, err = float(ex[0]), float(er[0])
     if with_error:
-        return LyapunovEstimate(value, err, int(used))
+        return LyapunovEstimate(value, err, int(used), int(unres), status)
+    if status == Status.SPLIT_LIMIT:
+        warnings.warn(f"lyapunov: {int(unres)} grid steps reached the edge-split limit and were "
+                      "integrated unsplit across an edge (status SPLIT_LIMIT); the exponent is "
+                      "less accurate (with_error=True reports it)", RuntimeWarning, stacklevel=2)
     return value
 
 
@@ -210,7 +268,8 @@ def lyapunov_lanes(
     t0: float | np.ndarray = 0.0,
     with_error: bool = False,
     n_blocks: int = DEFAULT_BLOCKS,
-) -> np.ndarray | tuple[np.ndarray, np.ndarray]:
+    with_status: bool = False,
+) -> np.ndarray | tuple[np.ndarray, ...]:
     """Largest Lyapunov exponent for each row of the coefficient matrix ``P`` (lanes x n_params,
     e.g. from ``model.lane_params``), computed in parallel; NaN for diverged lanes.
 
@@ -226,6 +285,10 @@ def lyapunov_lanes(
     phase zero there, as in :func:`lyapunov`): a sweep's ``LaneResults.final_time`` continues
     each lane in both forcing phases. ``with_error``: return ``(exponents, stderr)``, the standard
     errors from ``n_blocks`` blocks as in :func:`lyapunov` (NaN where the exponent is NaN).
+    ``with_status``: return ``(exponents, stderr, unresolved, status)`` (whatever
+    ``with_error``): per lane the steps at the edge-split limit and the
+    :class:`~geardyn.Status` code (as in :class:`LyapunovEstimate`; exponents kept where
+    SPLIT_LIMIT, NaN where DIVERGED).
     """
     P = np.ascontiguousarray(np.atleast_2d(np.asarray(P, dtype=float)))
     L = P.shape[0]
@@ -275,11 +338,15 @@ def lyapunov_lanes(
         raise ValueError(f"renorm_every must be >= 1 (got {renorm_every!r})")
     out = np.full(L, np.nan)
     err = np.full(L, np.nan)
+    unres = np.zeros(L, np.int64)
+    status = np.zeros(L, np.int64)
     if L > 0:
         scale = _state_scale(model)
         kern = kernels_for(model.kernel, "lyapunov")
         # lanes of every grid together (the kernel blocks them, whatever their steps)
         n_per = np.ones(L, np.int64) if model.omega_index is None else n_lane.astype(np.int64)
         kern.lyapunov_lanes(P, Y0, scale, T0, H, OMEGA, n_per, n_tr, n_st, renorm, float(bound),
-                            out, err, model.n_events, n_blk)
+                            out, err, model.n_events, n_blk, unres, status)
+    if with_status:
+        return out, err, unres, status
     return (out, err) if with_error else out

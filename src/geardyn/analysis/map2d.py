@@ -68,10 +68,11 @@ def _map_task(model: Model, P: np.ndarray, y0: np.ndarray, static: np.ndarray | 
         # attractor its period and contact describe
         start = np.where(np.isfinite(r.final), r.final,
                          np.broadcast_to(np.asarray(y0, dtype=float), r.final.shape))
-        exps, errs = lyapunov_lanes(model, P, start, t0=r.final_time, with_error=True,
-                                    **lyapunov)
+        exps, errs, unres, _ = lyapunov_lanes(model, P, start, t0=r.final_time,
+                                              with_status=True, **lyapunov)
         out["lyapunov"] = np.where(r.status == Status.OK, exps, np.nan)
         out["lyapunov_err"] = np.where(np.isfinite(out["lyapunov"]), errs, np.nan)
+        out["lyapunov_unresolved"] = unres
     return out
 
 

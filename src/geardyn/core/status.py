@@ -1,9 +1,11 @@
 """Numerical outcomes of an integration, as one enumeration shared by the kernels and Python.
 
-The compiled kernels write these codes (their constants ``STATUS_OK`` and ``STATUS_DIVERGED``
-in ``solvers/_step_core.py`` equal the values here; a test checks it). Steps that reached the
-edge-location split limit are not a lane status but a count (``unresolved``), since a lane
-with a few of them is still a valid result.
+The compiled kernels write these codes (their constants ``STATUS_OK``, ``STATUS_DIVERGED`` and
+``STATUS_SPLIT_LIMIT`` in ``solvers/_step_core.py`` equal the values here; a test checks it).
+Steps that reached the edge-location split limit are always counted (``unresolved``); the
+Lyapunov kernels also mark such a lane :attr:`Status.SPLIT_LIMIT` (its exponent is kept but
+rests on steps integrated unsplit across an edge), while a sweep lane keeps its status and
+reports the count in ``unresolved_steps``.
 """
 
 from __future__ import annotations
@@ -18,6 +20,7 @@ class Status(IntEnum):
 
     OK = 0
     DIVERGED = 1
+    SPLIT_LIMIT = 2
 
     @property
     def message(self) -> str:
@@ -28,6 +31,7 @@ class Status(IntEnum):
 _MESSAGES = {
     Status.OK: "ok",
     Status.DIVERGED: "diverged (|state| > bound or not finite)",
+    Status.SPLIT_LIMIT: "split limit reached (steps integrated unsplit across an edge)",
 }
 
 

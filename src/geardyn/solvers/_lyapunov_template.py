@@ -70,10 +70,11 @@ from geardyn.solvers._step_core import (  # CORE-IMPORT
     GRAZE_ROW,
     STATUS_DIVERGED,
     STATUS_OK,
+    STATUS_SPLIT_LIMIT,
     _events_i,
     _healthy,
-    _leaves_side_step,
     _rhs_i,
+    _rows_step,
     _side,
     _split_step,
     phase_table,
@@ -95,62 +96,13 @@ __all__ = ["BLOCK_ROWS", "events", "lyapunov_block_lanes", "lyapunov_lanes", "ly
 
 
 @nb.njit(**_JIT)
-def _grid_step_rows(i, t0, Y, p, h, omega, n_per, s_tab, c_tab, n_ev, K, TMP, Y1, SIDE, G0, G1, W,
-                    gbuf, ncross):
-    """Advance every row of Y (independent states of one lane) by grid step i (time t0 + i h to
-    t0 + (i + 1) h, forcing phase from the table at i mod n_per): one RK4 step per row, the
-    rows' stages interleaved; a row whose trial step changes the side of a switching function is
-    redone with the crossings located (:func:`_split_step`), as the main solver does."""
-    nr, ns = Y.shape
-    t = t0 + i * h
-    hh = 0.5 * h
-    j0 = 2 * (i % n_per)
-    if n_ev > 0:
-        for r in range(nr):
-            _events_i(t, Y[r], G0[r], p)
-            for j in range(n_ev):
-                SIDE[r, j] = _side(G0[r, j])
-    for st in range(4):
-        if st == 0:
-            ts = t
-            jj = j0
-        elif st < 3:
-            ts = t + hh
-            jj = j0 + 1
-        else:
-            ts = t + h
-            jj = j0 + 2
-        a = h if st == 3 else hh
-        for r in range(nr):
-            if st > 0:
-                for q in range(ns):
-                    TMP[r, q] = Y[r, q] + a * K[st - 1, r, q]
-            _rhs_i(ts, Y[r] if st == 0 else TMP[r], K[st, r], p, s_tab[jj], c_tab[jj])
-    h6 = h / 6.0
-    for r in range(nr):
-        for q in range(ns):
-            Y1[r, q] = Y[r, q] + h6 * (K[0, r, q] + 2.0 * K[1, r, q] + 2.0 * K[2, r, q]
-                                       + K[3, r, q])
-    for r in range(nr):
-        crossed = 0
-        if n_ev > 0:
-            _events_i(t + h, Y1[r], G1[r], p)
-            crossed = _leaves_side_step(r, t, t + h, Y, K[0], G0, G1, SIDE, p, W[8], gbuf)
-        if crossed:
-            _split_step(i, t0, Y[r], Y1[r], p, h, omega, n_per, SIDE[r], G1[r], ncross, W,
-                        W[8], gbuf)
-        else:
-            for q in range(ns):
-                Y[r, q] = Y1[r, q]
-
-
-@nb.njit(**_JIT)
 def _tangent_step(i, t0, Z, S, IS, p, h, omega, n_per, s_tab, c_tab, n_ev, YP, E, K, TMP, Y1,
-                  SIDE, G0, G1, W, gbuf, ncross):
+                  SIDE, G0, G1, W, gbuf, NCR, UNRES):
     """Advance the state y (row 0 of Z) by one grid step and each tangent vector v (rows 1..,
     in the scaled coordinates z = y / S; IS = 1 / S) by the derivative of that step map:
     (Phi(y + e S v) - Phi(y - e S v)) / (2 e S). The 2 k + 1 states are the rows of YP
-    (tangent j: rows 2 j - 2 and 2 j - 1; the state: the last row)."""
+    (tangent j: rows 2 j - 2 and 2 j - 1; the state: the last row), stepped by
+    :func:`_rows_step` (row r's crossings counted in NCR[r], its split-limit steps in UNRES[r])."""
     m, ns = Z.shape
     ny = 0.0
     for q in range(ns):
@@ -177,8 +129,8 @@ def _tangent_step(i, t0, Z, S, IS, p, h, omega, n_per, s_tab, c_tab, n_ev, YP, E
             d = e * (S[q] * Z[j, q])
             YP[2 * j - 2, q] = Z[0, q] + d
             YP[2 * j - 1, q] = Z[0, q] - d
-    _grid_step_rows(i, t0, YP, p, h, omega, n_per, s_tab, c_tab, n_ev, K, TMP, Y1, SIDE, G0, G1, W,
-                    gbuf, ncross)
+    _rows_step(i, t0, YP, p, h, omega, n_per, s_tab, c_tab, n_ev, K, TMP, Y1, SIDE, G0, G1, W,
+               gbuf, NCR, UNRES)
     for j in range(1, m):
         if not math.isfinite(E[j]):
             for q in range(ns):
@@ -275,8 +227,10 @@ def _block_stderr(blk, ends, h, err):
 def _run(p, y0, S, t0, h, omega, n_per, s_tab, c_tab, n_transient, n_steps, renorm_every, k,
          bound, n_ev, n_blocks):
     """Exponents (sum of logs / measured time), their standard errors (from up to ``n_blocks``
-    blocks of whole forcing periods of the measuring window), the number of blocks and the
-    status of one lane, started at time t0 (forcing phase zero there); tangent vectors in the
+    blocks of whole forcing periods of the measuring window), the number of blocks, the
+    status (STATUS_SPLIT_LIMIT where a step of any row reached the split limit, the exponents
+    kept; STATUS_DIVERGED, exponents NaN) and the number of such steps (all rows) of one
+    lane, started at time t0 (forcing phase zero there); tangent vectors in the
     coordinates y / S (S: the state scale)."""
     ns = y0.size
     IS = np.empty(ns)
@@ -296,7 +250,8 @@ def _run(p, y0, S, t0, h, omega, n_per, s_tab, c_tab, n_transient, n_steps, reno
     G0 = np.zeros((nr, ne))
     G1 = np.zeros((nr, ne))
     gbuf = np.zeros((GBUF_ROWS, ne))
-    ncross = np.zeros(ne, np.int64)
+    NCR = np.zeros((nr, ne), np.int64)
+    UNRES = np.zeros(nr, np.int64)
     acc = np.zeros(k)
     logs = np.zeros(k)
     ends = _block_bounds(max(n_steps, 1), n_per, n_blocks)
@@ -318,16 +273,16 @@ def _run(p, y0, S, t0, h, omega, n_per, s_tab, c_tab, n_transient, n_steps, reno
     cur = 0  # the block being measured
     for i in range(total):
         _tangent_step(i, t0, Z, S, IS, p, h, omega, n_per, s_tab, c_tab, n_ev, YP, E, K, TMP, Y1,
-                      SIDE, G0, G1, W, gbuf, ncross)
+                      SIDE, G0, G1, W, gbuf, NCR, UNRES)
         since += 1
         step = i + 1
         measure = step > n_transient
         if since == renorm or step == n_transient or step == total:
             since = 0
             if not _healthy(Z[0], bound):
-                return out, err, 0, STATUS_DIVERGED
+                return out, err, 0, STATUS_DIVERGED, UNRES.sum()
             if not _orthonormalise(Z, logs, measure):
-                return out, err, 0, STATUS_DIVERGED
+                return out, err, 0, STATUS_DIVERGED, UNRES.sum()
             if measure:
                 for j in range(k):
                     acc[j] += logs[j]
@@ -342,13 +297,15 @@ def _run(p, y0, S, t0, h, omega, n_per, s_tab, c_tab, n_transient, n_steps, reno
                 blk[cur, j] += logs[j]
                 blk[cur + 1, j] -= logs[j]
             cur += 1
+    unres = UNRES.sum()
+    status = STATUS_SPLIT_LIMIT if unres > 0 else STATUS_OK
     if n_steps <= 0:
-        return out, err, 0, STATUS_OK
+        return out, err, 0, status, unres
     tm = n_steps * h
     for j in range(k):
         out[j] = acc[j] / tm
     _block_stderr(blk, ends, h, err)
-    return out, err, nbk, STATUS_OK
+    return out, err, nbk, status, unres
 
 
 @nb.njit(**_JIT)
@@ -361,9 +318,12 @@ def lyapunov_single(p, y0, scale, t0, h, omega, n_per, n_transient, n_steps, ren
     (omega n_per) for a forced model); the state y0 is given at time t0,
     where the forcing phase is zero; ``n_transient`` steps are discarded and ``n_steps``
     measured. ``n_ev``: the model's number of switching functions, whose crossings are located
-    inside a step (0: none located). Returns (exponents[k], stderr[k], blocks, status): the
-    standard errors from ``n_blocks`` blocks of the measuring window (:func:`_block_stderr`;
-    ``blocks`` of them used); exponents are NaN if diverged.
+    inside a step (0: none located). Returns (exponents[k], stderr[k], blocks, status,
+    unresolved): the standard errors from ``n_blocks`` blocks of the measuring window
+    (:func:`_block_stderr`; ``blocks`` of them used); exponents are NaN if diverged (status
+    STATUS_DIVERGED); ``unresolved``: grid steps of the state or a perturbed row that reached
+    the split limit (MAX_SPLITS) and fell back unsplit, the status then STATUS_SPLIT_LIMIT
+    (exponents kept) unless diverged.
     """
     s_tab, c_tab = phase_table(n_per, omega != 0.0)
     # copies and int64 casts: a read-only array, a literal or an omitted argument would compile
@@ -374,7 +334,7 @@ def lyapunov_single(p, y0, scale, t0, h, omega, n_per, n_transient, n_steps, ren
 
 
 def lyapunov_lanes_rows(P, Y0, scale, T0, H, OMEGA, n_per, n_transient, n_steps, renorm_every,
-                        bound, out, err, n_ev=0, n_blocks=16):
+                        bound, out, err, n_ev=0, n_blocks=16, unresolved=None, status=None):
     """:func:`lyapunov_lanes` one lane at a time (the rows of :func:`lyapunov_single`), the
     lanes of each grid (n_per: one for all lanes or one per lane) in parallel: the kernel before
     the lane blocks, kept as their reference."""
@@ -383,16 +343,21 @@ def lyapunov_lanes_rows(P, Y0, scale, T0, H, OMEGA, n_per, n_transient, n_steps,
     for n in np.unique(nper):
         idx = np.nonzero(nper == n)[0]
         part, part_err = np.full(idx.size, np.nan), np.full(idx.size, np.nan)
+        part_u, part_s = np.zeros(idx.size, np.int64), np.zeros(idx.size, np.int64)
         sel = [np.ascontiguousarray(np.asarray(a)[idx])
                for a in (P, Y0, T0, H, OMEGA, n_transient, n_steps)]
         _lanes_rows(sel[0], sel[1], scale, sel[2], sel[3], sel[4], int(n), sel[5], sel[6],
-                    renorm_every, bound, part, part_err, n_ev, n_blocks)
+                    renorm_every, bound, part, part_err, part_u, part_s, n_ev, n_blocks)
         out[idx], err[idx] = part, part_err
+        if unresolved is not None:
+            unresolved[idx] = part_u
+        if status is not None:
+            status[idx] = part_s
 
 
 @nb.njit(parallel=True, **_JIT)
 def _lanes_rows(P, Y0, scale, T0, H, OMEGA, n_per, n_transient, n_steps, renorm_every, bound, out,
-                err, n_ev=0, n_blocks=16):
+                err, unres, status, n_ev=0, n_blocks=16):
     """Largest exponent of every lane (row of P, Y0; n_per steps per period), in parallel over
     lanes, one lane at a time (the rows of :func:`lyapunov_single`).
 
@@ -400,7 +365,7 @@ def _lanes_rows(P, Y0, scale, T0, H, OMEGA, n_per, n_transient, n_steps, renorm_
     time (forcing phase zero there, as in :func:`lyapunov_single`) per lane; H, OMEGA:
     step and forcing frequency per lane; n_transient, n_steps: per-lane step counts (int
     arrays); n_ev and n_blocks as in :func:`lyapunov_single`. Fills out[L] and err[L] (the
-    standard error; NaN for diverged lanes).
+    standard error; NaN for diverged lanes), unres[L] and status[L] (see :func:`_run`).
     """
     L, ns = Y0.shape
     forced = False
@@ -409,11 +374,14 @@ def _lanes_rows(P, Y0, scale, T0, H, OMEGA, n_per, n_transient, n_steps, renorm_
             forced = True
     s_tab, c_tab = phase_table(n_per, forced)
     for lane in nb.prange(L):
-        ex, er, _nb, st = _run(P[lane], Y0[lane], scale, T0[lane], H[lane], OMEGA[lane], n_per,
-                               s_tab, c_tab, n_transient[lane], n_steps[lane], renorm_every,
-                               np.int64(1), bound, np.int64(n_ev), np.int64(n_blocks))
-        out[lane] = ex[0] if st == STATUS_OK else np.nan
-        err[lane] = er[0] if st == STATUS_OK else np.nan
+        ex, er, _nb, st, un = _run(P[lane], Y0[lane], scale, T0[lane], H[lane], OMEGA[lane],
+                                   n_per, s_tab, c_tab, n_transient[lane], n_steps[lane],
+                                   renorm_every, np.int64(1), bound, np.int64(n_ev),
+                                   np.int64(n_blocks))
+        out[lane] = ex[0] if st != STATUS_DIVERGED else np.nan
+        err[lane] = er[0] if st != STATUS_DIVERGED else np.nan
+        unres[lane] = un
+        status[lane] = st
 
 
 # ---------------------------------------------------------------------------------------------
@@ -428,12 +396,17 @@ def _lanes_rows(P, Y0, scale, T0, H, OMEGA, n_per, n_transient, n_steps, renorm_
 # (SP[r], CP[r]). A row whose trial step leaves a side of an edge (or may graze one) is finished
 # on the scalar path (:func:`_split_step`). Gram-Schmidt, the block statistics and the health
 # check run per lane, at its renormalisations, on a gathered copy with the functions of the
-# one-lane kernel. Every row's arithmetic is that of :func:`_grid_step_rows`, operation for
+# one-lane kernel. Every row's arithmetic is that of :func:`_rows_step`, operation for
 # operation (no fastmath), so results are bitwise those of :func:`lyapunov_single`, whatever the
 # blocking, position or thread.
 
 #: Most rows of a lane block (lanes of 2 k + 1 rows each; at least one lane).
 BLOCK_ROWS = 64
+#: The rows of a block are padded to a multiple of this (see :func:`_lyap_block`): LLVM
+#: vectorises the row loops 8 wide, interleaved 4 times, and runs a remainder of up to 31 rows
+#: scalar (at 63 rows a third of the time; the model's lane functions cost ~3 ns per row
+#: vectorised, ~9 ns scalar). Only where the model has lane-block functions (else 1).
+ROW_PAD = 1
 
 
 @nb.njit(inline="always", **_JIT)
@@ -461,6 +434,7 @@ def _rows_events_generic(T, Y, G, PT, P, LANE, nr, ybuf, gb):
 if "rhs_lanes" in globals():  # the model's lane-block functions (see .kernels), inlined
     _rhs_lm = nb.njit(**_INLINE)(rhs_lanes.py_func)  # noqa: F821
     _events_lm = nb.njit(**_INLINE)(events_lanes.py_func)  # noqa: F821
+    ROW_PAD = 32
 
     @nb.njit(inline="always", **_JIT)
     def _rows_rhs(T, Y, DY, PT, P, LANE, nr, SP, CP, SC, ybuf, dbuf):
@@ -547,7 +521,7 @@ def _fd_combine(nl, m, ZT, IS, Y, E, ACT):
 @nb.njit(inline="always", **_JIT)
 def _rows_rk4(nr, Y, Y1, K1, K2, K3, K4, TMP, TS, TM, TE, HR, HH, H6, PT, P, LANE, PH, SC, ybuf,
               dbuf):
-    """One RK4 trial step of every row into Y1 (the arithmetic of :func:`_grid_step_rows`); PH:
+    """One RK4 trial step of every row into Y1 (the arithmetic of :func:`_rows_step`); PH:
     the rows' forcing phases (sin, cos) at the step's start, middle and end (rows 0-5)."""
     ns = Y.shape[0]
     _rows_rhs(TS, Y, K1, PT, P, LANE, nr, PH[0], PH[1], SC, ybuf, dbuf)
@@ -587,14 +561,20 @@ def _rows_screen(nr, G0, G1, GE, GR, FLAG):
 
 @nb.njit(inline="always", **_JIT)
 def _rows_commit(i, nr, NPR, Y, Y1, G0, G1, GR, FLAG, ACTR, P, LANE, T0R, HR, OMEGA, ys,
-                 y1s, sides, g1s, ncross, W, gbuf):
+                 y1s, sides, g1s, ncross, W, gbuf, UNRR):
     """Take the trial step of the active lanes' rows: the unflagged ones vectorised, the flagged
-    ones one by one with the crossings located (:func:`_split_step`)."""
+    ones one by one with the crossings located (:func:`_split_step`; a step of row r that
+    reaches the split limit is counted in UNRR[r])."""
     ns = Y.shape[0]
     n_ev = G1.shape[0]
     for q in range(ns):
         for r in range(nr):
-            Y[q, r] = Y1[q, r] if ACTR[r] and FLAG[r] == 0.0 else Y[q, r]
+            Y[q, r] = Y1[q, r] if ACTR[r] & (FLAG[r] == 0.0) else Y[q, r]
+    n_split = 0  # (no short-circuit operators: the row loops stay branch-free and vectorise)
+    for r in range(nr):
+        n_split += 1 if ACTR[r] & (FLAG[r] != 0.0) else 0
+    if n_split == 0:
+        return
     for r in range(nr):
         if FLAG[r] == 0.0 or not ACTR[r]:
             continue
@@ -606,60 +586,64 @@ def _rows_commit(i, nr, NPR, Y, Y1, G0, G1, GR, FLAG, ACTR, P, LANE, T0R, HR, OM
             sides[j] = _side(G0[j, r])
             g1s[j] = G1[j, r]
             gbuf[GRAZE_ROW, j] = GR[j, r]
-        _split_step(i, T0R[r], ys, y1s, P[lane], HR[r], OMEGA[lane], NPR[r], sides, g1s, ncross,
-                    W, W[8], gbuf)
+        UNRR[r] += _split_step(i, T0R[r], ys, y1s, P[lane], HR[r], OMEGA[lane], NPR[r], sides,
+                               g1s, ncross, W, W[8], gbuf)
         for q in range(ns):
             Y[q, r] = ys[q]
 
 
 @nb.njit(**_JIT)
 def _lyap_block(first, nl, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF, n_transient,
-                n_steps, renorm_every, bound, n_ev, n_blocks, out, err, used, status):
+                n_steps, renorm_every, bound, n_ev, n_blocks, out, err, used, status, unres):
     """The k leading exponents of lanes first..first+nl-1 (lane with NPER[lane] steps per
     period, its phase table at S_TAB, C_TAB[OFF[lane]:]), their rows in one block (see above);
     per lane what :func:`_run` computes for it, into out[lane], err[lane], used[lane],
-    status[lane]."""
+    status[lane], unres[lane]."""
     ns = Y0.shape[1]
     m = k + 1
     nr = (2 * k + 1) * nl
+    # the rows' arrays padded to a multiple of ROW_PAD (rows nr.. copy lane 0's coefficients
+    # and never commit a step), so that the row loops have no scalar remainder
+    nrp = (nr + ROW_PAD - 1) // ROW_PAD * ROW_PAD
     IS = np.empty(ns)
     for q in range(ns):
         IS[q] = 1.0 / S[q]
     ZT = np.zeros((m, ns, nl))
-    Y = np.empty((ns, nr))
-    Y1 = np.empty((ns, nr))
-    K1 = np.empty((ns, nr))
-    K2 = np.empty((ns, nr))
-    K3 = np.empty((ns, nr))
-    K4 = np.empty((ns, nr))
-    TMP = np.empty((ns, nr))
-    PT = np.empty((P.shape[1], nr))
-    LANE = np.empty(nr, np.int64)
-    T0R = np.empty(nr)
-    HR = np.empty(nr)
-    HH = np.empty(nr)
-    H6 = np.empty(nr)
-    TS = np.empty(nr)
-    TM = np.empty(nr)
-    TE = np.empty(nr)
-    HD = np.empty(nr)
-    PH = np.empty((6, nr))  # the rows' forcing phases in a step (see _fill_phase)
-    IDX = np.empty(nr, np.int64)  # the index of a row's phase at the step's start in S_TAB
-    NPR = np.empty(nr, np.int64)  # a row's steps per period
-    END = np.empty(nr, np.int64)  # the index of a row's phase table's last period start + 2
-    SC = np.zeros((8, nr))
+    Y = np.zeros((ns, nrp))  # padded rows: a state at zero
+    Y1 = np.empty((ns, nrp))
+    K1 = np.empty((ns, nrp))
+    K2 = np.empty((ns, nrp))
+    K3 = np.empty((ns, nrp))
+    K4 = np.empty((ns, nrp))
+    TMP = np.empty((ns, nrp))
+    PT = np.empty((P.shape[1], nrp))
+    LANE = np.empty(nrp, np.int64)
+    T0R = np.empty(nrp)
+    HR = np.empty(nrp)
+    HH = np.empty(nrp)
+    H6 = np.empty(nrp)
+    TS = np.empty(nrp)
+    TM = np.empty(nrp)
+    TE = np.empty(nrp)
+    HD = np.empty(nrp)
+    PH = np.empty((6, nrp))  # the rows' forcing phases in a step (see _fill_phase)
+    IDX = np.empty(nrp, np.int64)  # the index of a row's phase at the step's start in S_TAB
+    NPR = np.empty(nrp, np.int64)  # a row's steps per period
+    END = np.empty(nrp, np.int64)  # the index of a row's phase table's last period start + 2
+    SC = np.zeros((8, nrp))
     ne = max(n_ev, 1)
-    G0 = np.zeros((ne, nr))
-    G1 = np.zeros((ne, nr))
-    GE = np.zeros((ne, nr))
-    GR = np.zeros((ne, nr))
-    FLAG = np.zeros(nr)
+    G0 = np.zeros((ne, nrp))
+    G1 = np.zeros((ne, nrp))
+    GE = np.zeros((ne, nrp))
+    GR = np.zeros((ne, nrp))
+    FLAG = np.zeros(nrp)
+    UNRR = np.zeros(nrp, np.int64)  # each row's steps that reached the split limit
     E = np.zeros((m, nl))
     OK = np.zeros((m, nl), np.bool_)
     NY = np.zeros(nl)
     # per lane
     ACT = np.zeros(nl, np.bool_)
-    ACTR = np.zeros(nr, np.bool_)  # ACT of each row's lane
+    ACTR = np.zeros(nrp, np.bool_)  # ACT of each row's lane
     IST = np.zeros((nl, 7), np.int64)  # see _LAST, ...
     nbmax = max(n_blocks, 1)
     ENDS = np.zeros((nl, nbmax), np.int64)
@@ -708,8 +692,8 @@ def _lyap_block(first, nl, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF, n
         for j in range(m):
             for q in range(ns):
                 ZT[j, q, l] = Zl[j, q]
-    for r in range(nr):
-        l = r % nl
+    for r in range(nrp):
+        l = r % nl if r < nr else 0
         lane = first + l
         LANE[r] = lane
         for j in range(P.shape[1]):
@@ -721,7 +705,7 @@ def _lyap_block(first, nl, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF, n
         NPR[r] = NPER[lane]
         IDX[r] = OFF[lane]
         END[r] = OFF[lane] + 2 * NPER[lane]
-        ACTR[r] = ACT[l]
+        ACTR[r] = ACT[l] and r < nr
     due = max_total
     for l in range(nl):
         if ACT[l]:
@@ -733,33 +717,41 @@ def _lyap_block(first, nl, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF, n
         if not live:
             break
         _fd_setup(nl, m, ZT, S, IS, Y, E, OK, NY)
-        for r in range(nr):
+        for r in range(nrp):
             t = T0R[r] + i * HR[r]
             TS[r] = t
             TM[r] = t + HH[r]
             TE[r] = t + HR[r]
             HD[r] = TE[r] - t
         if n_ev > 0:
-            _rows_events(TS, Y, G0, PT, P, LANE, nr, ybuf, gb)
-        _fill_phase(nr, IDX, S_TAB, C_TAB, PH)
-        _rows_rk4(nr, Y, Y1, K1, K2, K3, K4, TMP, TS, TM, TE, HR, HH, H6, PT, P, LANE, PH, SC, ybuf,
-                  dbuf)
+            _rows_events(TS, Y, G0, PT, P, LANE, nrp, ybuf, gb)
+        _fill_phase(nrp, IDX, S_TAB, C_TAB, PH)
+        _rows_rk4(nrp, Y, Y1, K1, K2, K3, K4, TMP, TS, TM, TE, HR, HH, H6, PT, P, LANE, PH, SC,
+                  ybuf, dbuf)
         if n_ev > 0:
-            _rows_events(TE, Y1, G1, PT, P, LANE, nr, ybuf, gb)
+            _rows_events(TE, Y1, G1, PT, P, LANE, nrp, ybuf, gb)
             for q in range(ns):
-                for r in range(nr):
+                for r in range(nrp):
                     TMP[q, r] = Y[q, r] + HD[r] * K1[q, r]
-            _rows_events(TE, TMP, GE, PT, P, LANE, nr, ybuf, gb)
-            _rows_screen(nr, G0, G1, GE, GR, FLAG)
-        _rows_commit(i, nr, NPR, Y, Y1, G0, G1, GR, FLAG, ACTR, P, LANE, T0R, HR, OMEGA, ys,
-                     y1s, sides, g1s, ncross, W, gbuf)
+            _rows_events(TE, TMP, GE, PT, P, LANE, nrp, ybuf, gb)
+            _rows_screen(nrp, G0, G1, GE, GR, FLAG)
+        _rows_commit(i, nrp, NPR, Y, Y1, G0, G1, GR, FLAG, ACTR, P, LANE, T0R, HR, OMEGA, ys,
+                     y1s, sides, g1s, ncross, W, gbuf, UNRR)
         _fd_combine(nl, m, ZT, IS, Y, E, ACT)
-        for r in range(nr):  # the next step's phase index: 2 (i + 1 mod n_per) from the start
+        for r in range(nrp):  # the next step's phase index: 2 (i + 1 mod n_per) from the start
             IDX[r] = IDX[r] + 2 if IDX[r] + 2 < END[r] else IDX[r] + 2 - 2 * NPR[r]
         step = i + 1
         if step >= due:
             due = _lane_books(step, first, nl, k, renorm, bound, ZT, Zl, Cl, logs, IST, ENDS, BLK,
                               ACC, ACT, ACTR, H, out, err, used, status)
+    for l in range(nl):  # the split-limit steps of each lane's rows (slots nl apart)
+        lane = first + l
+        u = 0
+        for slot in range(2 * k + 1):
+            u += UNRR[slot * nl + l]
+        unres[lane] = u
+        if u > 0 and status[lane] == STATUS_OK:
+            status[lane] = STATUS_SPLIT_LIMIT
 
 
 #: Columns of the per-lane integer state of a block (IST): the step of the last
@@ -876,7 +868,7 @@ def _block_count(L, k, block_rows, min_blocks):
 
 @nb.njit(**_JIT)
 def _lyap_block_local(lo, hi, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF, n_transient,
-                      n_steps, renorm_every, bound, n_ev, n_blocks, out, err, used, status):
+                      n_steps, renorm_every, bound, n_ev, n_blocks, out, err, used, status, unres):
     """:func:`_lyap_block` for lanes lo..hi-1 on copies of their inputs and outputs, so that
     the block's thread touches no shared array while it steps (the reference counts of arrays
     shared by threads would bounce between the cores' caches)."""
@@ -885,27 +877,30 @@ def _lyap_block_local(lo, hi, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF
     e = np.full((n, k), np.nan)
     u = np.zeros(n, np.int64)
     st = np.zeros(n, np.int64)
+    un = np.zeros(n, np.int64)
     _lyap_block(0, n, k, P[lo:hi].copy(), Y0[lo:hi].copy(), S.copy(), T0[lo:hi].copy(),
                 H[lo:hi].copy(), OMEGA[lo:hi].copy(), NPER[lo:hi].copy(), S_TAB.copy(),
                 C_TAB.copy(), OFF[lo:hi].copy(), n_transient[lo:hi].copy(),
-                n_steps[lo:hi].copy(), renorm_every, bound, n_ev, n_blocks, o, e, u, st)
+                n_steps[lo:hi].copy(), renorm_every, bound, n_ev, n_blocks, o, e, u, st, un)
     for i in range(n):
         for j in range(k):
             out[lo + i, j] = o[i, j]
             err[lo + i, j] = e[i, j]
         used[lo + i] = u[i]
         status[lo + i] = st[i]
+        unres[lo + i] = un[i]
 
 
 @nb.njit(parallel=True, **_JIT)
 def lyapunov_block_lanes(P, Y0, scale, T0, H, OMEGA, NPER, n_transient, n_steps, renorm_every, k,
-                         bound, out, err, used, status, n_ev=0, n_blocks=16,
+                         bound, out, err, used, status, unres, n_ev=0, n_blocks=16,
                          block_rows=BLOCK_ROWS, min_blocks=1):
     """The k leading exponents of every lane (row of P, Y0; NPER[lane] steps per period: lanes
     of different grids may share a block), the lanes' rows in blocks of at most ``block_rows``
     rows (2 k + 1 per lane, at least one lane), consecutive lanes in a block, blocks in
     parallel. Other arguments as in :func:`lyapunov_lanes`; fills out[L, k], err[L, k] (NaN
-    where diverged), used[L] (blocks of the standard error) and status[L]. Each lane's result
+    where diverged), used[L] (blocks of the standard error), status[L] and unres[L] (steps at
+    the split limit; see :func:`_run`). Each lane's result
     is bitwise that of :func:`lyapunov_single` with the same arguments, whatever the lanes
     beside it, ``block_rows`` and ``min_blocks`` (see :func:`_block_count`)."""
     # writable copies and int64 casts below: a read-only array, a literal or an omitted argument
@@ -938,11 +933,11 @@ def lyapunov_block_lanes(P, Y0, scale, T0, H, OMEGA, NPER, n_transient, n_steps,
             _lyap_block_local(np.int64(lo), np.int64(hi), np.int64(k), P_w, Y0_w, scale_w, T0,
                               H, OMEGA, NPER, S_TAB, C_TAB, OFF, n_transient, n_steps,
                               renorm_every, bound, np.int64(n_ev), np.int64(n_blocks), out, err,
-                              used, status)
+                              used, status, unres)
 
 
 def lyapunov_lanes(P, Y0, scale, T0, H, OMEGA, n_per, n_transient, n_steps, renorm_every, bound,
-                   out, err, n_ev=0, n_blocks=16):
+                   out, err, n_ev=0, n_blocks=16, unresolved=None, status=None):
     """Largest exponent of every lane (row of P, Y0), the lanes in blocks in parallel
     (:func:`lyapunov_block_lanes` with k = 1, lanes ordered by their step count so that a
     block's lanes end together; bitwise :func:`lyapunov_lanes_rows`).
@@ -952,7 +947,8 @@ def lyapunov_lanes(P, Y0, scale, T0, H, OMEGA, n_per, n_transient, n_steps, reno
     step and forcing frequency per lane; n_per: steps per period, one for all lanes or one per
     lane; n_transient, n_steps: per-lane step counts (int arrays); n_ev and n_blocks as in
     :func:`lyapunov_single`. Fills out[L] and err[L] (the standard error; NaN for diverged
-    lanes).
+    lanes) and, where given, unresolved[L] (steps at the split limit) and status[L] (see
+    :func:`_run`).
     """
     L = Y0.shape[0]
     nper = np.ascontiguousarray(np.broadcast_to(np.asarray(n_per, np.int64), (L,)))
@@ -960,13 +956,18 @@ def lyapunov_lanes(P, Y0, scale, T0, H, OMEGA, n_per, n_transient, n_steps, reno
     o2 = np.full((L, 1), np.nan)
     e2 = np.full((L, 1), np.nan)
     used = np.zeros(L, np.int64)
-    status = np.zeros(L, np.int64)
+    st2 = np.zeros(L, np.int64)
+    un2 = np.zeros(L, np.int64)
     if L > 0:
         p_, y_, t_, h_, w_, n_, tr_, st_ = (
             np.ascontiguousarray(np.asarray(a)[order])
             for a in (P, Y0, T0, H, OMEGA, nper, n_transient, n_steps))
         lyapunov_block_lanes(p_, y_, scale, t_, h_, w_, n_, tr_, st_, renorm_every, 1, bound, o2,
-                             e2, used, status, n_ev, n_blocks, BLOCK_ROWS, nb.get_num_threads())
-    ok = status == STATUS_OK
+                             e2, used, st2, un2, n_ev, n_blocks, BLOCK_ROWS, nb.get_num_threads())
+    ok = st2 != STATUS_DIVERGED
     out[order] = np.where(ok, o2[:, 0], np.nan)
     err[order] = np.where(ok, e2[:, 0], np.nan)
+    if unresolved is not None:
+        unresolved[order] = un2
+    if status is not None:
+        status[order] = st2

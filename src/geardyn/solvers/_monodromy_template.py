@@ -35,12 +35,8 @@ from geardyn.solvers._step_core import (  # CORE-IMPORT
     GBUF_ROWS,
     STATUS_DIVERGED,
     STATUS_OK,
-    _events_i,
     _healthy,
-    _leaves_side_step,
-    _rhs_i,
-    _side,
-    _split_step,
+    _rows_step,
     phase_table,
 )
 from geardyn.solvers._template_model import events, observe, rhs  # MODEL-IMPORT
@@ -52,55 +48,6 @@ FD_DELTA = 2.0**-20
 FD_NORM_CAP = 2.0**10
 
 __all__ = ["events", "observe", "period_map", "phase_table", "rhs"]
-
-
-@nb.njit(**_JIT)
-def _rows_step(i, t0, Y, p, h, omega, n_per, s_tab, c_tab, n_ev, K, TMP, Y1, SIDE, G0, G1, W,
-               gbuf, NCR, UNRES):
-    """Advance every row of Y (independent states of one lane) by grid step i (time t0 + i h to
-    t0 + (i + 1) h, forcing phase from the table at i mod n_per), each row with its crossings
-    located; row r's crossings are counted in NCR[r], its split-limit hits in UNRES[r]."""
-    nr, ns = Y.shape
-    t = t0 + i * h
-    hh = 0.5 * h
-    j0 = 2 * (i % n_per)
-    if n_ev > 0:
-        for r in range(nr):
-            _events_i(t, Y[r], G0[r], p)
-            for j in range(n_ev):
-                SIDE[r, j] = _side(G0[r, j])
-    for st in range(4):
-        if st == 0:
-            ts = t
-            jj = j0
-        elif st < 3:
-            ts = t + hh
-            jj = j0 + 1
-        else:
-            ts = t + h
-            jj = j0 + 2
-        a = h if st == 3 else hh
-        for r in range(nr):
-            if st > 0:
-                for q in range(ns):
-                    TMP[r, q] = Y[r, q] + a * K[st - 1, r, q]
-            _rhs_i(ts, Y[r] if st == 0 else TMP[r], K[st, r], p, s_tab[jj], c_tab[jj])
-    h6 = h / 6.0
-    for r in range(nr):
-        for q in range(ns):
-            Y1[r, q] = Y[r, q] + h6 * (K[0, r, q] + 2.0 * K[1, r, q] + 2.0 * K[2, r, q]
-                                       + K[3, r, q])
-    for r in range(nr):
-        crossed = 0
-        if n_ev > 0:
-            _events_i(t + h, Y1[r], G1[r], p)
-            crossed = _leaves_side_step(r, t, t + h, Y, K[0], G0, G1, SIDE, p, W[8], gbuf)
-        if crossed:
-            UNRES[r] += _split_step(i, t0, Y[r], Y1[r], p, h, omega, n_per, SIDE[r], G1[r],
-                                    NCR[r], W, W[8], gbuf)
-        else:
-            for q in range(ns):
-                Y[r, q] = Y1[r, q]
 
 
 @nb.njit(**_JIT)

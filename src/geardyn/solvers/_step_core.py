@@ -68,6 +68,9 @@ CONFIRM_TOL = 1e-9
 SMALL_ANGLE = 0.8
 STATUS_OK = 0
 STATUS_DIVERGED = 1
+#: Some grid steps reached the split limit (MAX_SPLITS) and fell back unsplit (the Lyapunov
+#: kernels' lane status; the sweep counts them in ``unresolved_steps`` instead).
+STATUS_SPLIT_LIMIT = 2
 # MODEL-ADAPTERS (a user's plain functions are adapted to the kernel interface here)
 # The model's functions inlined (numba IR inlining) where they are called in a loop: a call with
 # array arguments would otherwise cost reference counting on every stage of every step.
@@ -591,3 +594,56 @@ def _healthy(y, bound):
         if not (abs(v) <= bound):  # False for NaN too
             return False
     return True
+
+
+@nb.njit(**_JIT)
+def _rows_step(i, t0, Y, p, h, omega, n_per, s_tab, c_tab, n_ev, K, TMP, Y1, SIDE, G0, G1, W,
+               gbuf, NCR, UNRES):
+    """Advance every row of Y (independent states of one lane, e.g. a state and its
+    finite-difference neighbours) by grid step i (time t0 + i h to t0 + (i + 1) h, forcing
+    phase from the table s_tab, c_tab at i mod n_per): one RK4 step per row, the rows' stages
+    interleaved; a row whose trial step may leave a side of an edge (:func:`_leaves_side_step`)
+    is redone with the crossings located (:func:`_split_step`). Row r's crossings are counted
+    in NCR[r], its steps that reached the split limit in UNRES[r]. Scratch: K[4, nr, ns], TMP,
+    Y1 like Y, SIDE, G0, G1 [nr, max(n_ev, 1)], W[9, ns], gbuf[GBUF_ROWS, max(n_ev, 1)]."""
+    nr, ns = Y.shape
+    t = t0 + i * h
+    hh = 0.5 * h
+    j0 = 2 * (i % n_per)
+    if n_ev > 0:
+        for r in range(nr):
+            _events_i(t, Y[r], G0[r], p)
+            for j in range(n_ev):
+                SIDE[r, j] = _side(G0[r, j])
+    for st in range(4):
+        if st == 0:
+            ts = t
+            jj = j0
+        elif st < 3:
+            ts = t + hh
+            jj = j0 + 1
+        else:
+            ts = t + h
+            jj = j0 + 2
+        a = h if st == 3 else hh
+        for r in range(nr):
+            if st > 0:
+                for q in range(ns):
+                    TMP[r, q] = Y[r, q] + a * K[st - 1, r, q]
+            _rhs_i(ts, Y[r] if st == 0 else TMP[r], K[st, r], p, s_tab[jj], c_tab[jj])
+    h6 = h / 6.0
+    for r in range(nr):
+        for q in range(ns):
+            Y1[r, q] = Y[r, q] + h6 * (K[0, r, q] + 2.0 * K[1, r, q] + 2.0 * K[2, r, q]
+                                       + K[3, r, q])
+    for r in range(nr):
+        crossed = 0
+        if n_ev > 0:
+            _events_i(t + h, Y1[r], G1[r], p)
+            crossed = _leaves_side_step(r, t, t + h, Y, K[0], G0, G1, SIDE, p, W[8], gbuf)
+        if crossed:
+            UNRES[r] += _split_step(i, t0, Y[r], Y1[r], p, h, omega, n_per, SIDE[r], G1[r],
+                                    NCR[r], W, W[8], gbuf)
+        else:
+            for q in range(ns):
+                Y[r, q] = Y1[r, q]
