@@ -21,8 +21,8 @@ from __future__ import annotations
 
 import copy
 import math
-from collections.abc import Sequence
-from dataclasses import dataclass
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, replace
 from types import SimpleNamespace
 from typing import Any
 
@@ -92,6 +92,24 @@ class Member:
             radius=radius)
 
 
+#: PlanetaryGearSet inputs that :meth:`PlanetaryGearSet.from_geometry` takes from the geometry.
+_FROM_GEOMETRY = ("n_planets", "planet_angles", "sun_pressure_angle", "ring_pressure_angle",
+                  "sun_mesh_stiffness", "ring_mesh_stiffness", "waveform", "contact_ratio",
+                  "sun_stiffness_fluctuation", "ring_stiffness_fluctuation", "sun_mesh_phase",
+                  "ring_mesh_phase")
+
+
+def _with_radius(name: str, member: Member, radius: float) -> Member:
+    """``member`` with ``radius`` set from the geometry; a given radius must agree with it."""
+    if member.radius is None:
+        return replace(member, radius=radius)
+    given = _si(f"{name}.radius", member.radius, "length", strict=True)
+    if abs(given - radius) > 1e-9 * radius:
+        raise ParameterError(f"{name}.radius", member.radius,
+                             f"differs from the geometry's {radius:.6g} m (leave it None)")
+    return member
+
+
 def _per_planet(field: str, value: Any, n: int, kind: str, minimum: float | None = 0.0
                 ) -> np.ndarray:
     """A scalar or a sequence of n values, in SI."""
@@ -136,6 +154,22 @@ def _waveform(field: str, waveform: Any, rel: np.ndarray, phase: np.ndarray, con
     return out
 
 
+def _waveforms(field: str, waveform: Any, rel: np.ndarray, phase: np.ndarray,
+               contact_ratio: float, harmonics: int) -> np.ndarray:
+    """:func:`_waveform`, or for a mapping ``{"sun": (a, b), "ring": (a, b)}`` one pair of
+    relative Fourier coefficients per mesh group (the shorter padded with zeros)."""
+    if not isinstance(waveform, Mapping):
+        return _waveform(field, waveform, rel, phase, contact_ratio, harmonics)
+    if set(waveform) != {"sun", "ring"}:
+        raise ParameterError(field, dict(waveform), "a mapping needs exactly the keys 'sun' "
+                             "and 'ring', each a pair (a, b) of relative Fourier coefficients")
+    n = rel.size // 2
+    parts = [_waveform(f"{field}.{g}", waveform[g], rel[sl], phase[sl], contact_ratio,
+                       harmonics) for g, sl in (("sun", slice(0, n)), ("ring", slice(n, None)))]
+    width = max(p.shape[1] for p in parts)
+    return np.vstack([np.pad(p, ((0, 0), (0, width - p.shape[1]))) for p in parts])
+
+
 def _clean(A: np.ndarray, rel: float = 1e-12) -> np.ndarray:
     """``A`` with entries below ``rel`` times its largest magnitude set to 0: the rounding
     residue of trigonometric sums (cos(pi/2) = 6e-17), which would couple coordinates that
@@ -178,7 +212,9 @@ class PlanetaryGearSet(Model):
         Relative amplitude of the stiffness fluctuation (half peak-to-peak over the mean, as in
         :class:`~geardyn.Mesh`); ``waveform`` ``"sine"``, ``"rectangular"`` (``contact_ratio``,
         ``harmonics``) or a pair (a, b) of relative Fourier coefficients of k/k_mean - 1 (then
-        the fluctuations are ignored). Mesh m's stiffness is k_m (1 + w(Omega tau + phase_m)).
+        the fluctuations are ignored), or a mapping {"sun": (a, b), "ring": (a, b)} of one
+        pair per mesh group (:meth:`from_geometry`). Mesh m's stiffness is
+        k_m (1 + w(Omega tau + phase_m)).
     sun_mesh_phase, ring_mesh_phase
         Mesh phases [rad of the mesh cycle], scalar or one per planet (e.g. Parker & Lin 2004).
     sun_backlash, ring_backlash
@@ -280,7 +316,7 @@ class PlanetaryGearSet(Model):
                 or not 1 <= harmonics <= 200:
             raise ParameterError("harmonics", harmonics, "must be an integer from 1 to 200")
         self.mesh_phase = both("mesh_phase")
-        self.fourier = _waveform("waveform", waveform, both("stiffness_fluctuation"),
+        self.fourier = _waveforms("waveform", waveform, both("stiffness_fluctuation"),
                                  self.mesh_phase, float(contact_ratio), harmonics)
         if _minimum_relative_stiffness(self.fourier) <= 0.0:
             raise ParameterError("sun_stiffness_fluctuation", sun_stiffness_fluctuation,
@@ -306,6 +342,66 @@ class PlanetaryGearSet(Model):
         mf = self.time_scale if mesh_frequency is None else _si("mesh_frequency",
                                                                 mesh_frequency, "frequency")
         self._build(mf / self.time_scale)
+
+    @classmethod
+    def from_geometry(cls, geometry: Any, *, sun: Member, ring: Member, carrier: Member,
+                      planet: Member, harmonics: int = 15,
+                      waveform_options: Mapping[str, Any] | None = None,
+                      **kw: Any) -> PlanetaryGearSet:
+        """The gear set of a :class:`geardyn.gears.PlanetaryGeometry` (see ``docs/planetary.md``,
+        "From gear geometry").
+
+        From the geometry: ``n_planets`` and ``planet_angles``; the operating pressure angles
+        of the sun-planet and ring-planet meshes; the mean mesh stiffnesses (the means of the
+        ISO 6336-1 single/double contact waves, ``geometry.waveforms(**waveform_options)``);
+        their relative Fourier coefficients (``harmonics`` terms, exact: no smoothing beyond
+        the waves' ``transition`` ramps) as ``waveform={"sun": ..., "ring": ...}``; the Parker &
+        Lin phases gamma as ``sun_mesh_phase``/``ring_mesh_phase`` = -2 pi gamma (mesh n's
+        stiffness is k(theta - 2 pi gamma_n)); the members' ``radius`` where None (base radius
+        of sun, ring and planet, the carrier's: the centre distance); ``sun_backlash`` and
+        ``ring_backlash`` where not given: half the geometry's normal backlash
+        j cos(alpha_w) / 2 of each mesh [m] (0 at the default, tight centre distance).
+        ``kw`` are the other :class:`PlanetaryGearSet` inputs (damping, torques, errors, ...).
+        """
+        from geardyn.gears import PlanetaryGeometry
+
+        if not isinstance(geometry, PlanetaryGeometry):
+            raise ParameterError("geometry", type(geometry).__name__,
+                                 "must be a geardyn.gears.PlanetaryGeometry")
+        for f in _FROM_GEOMETRY:
+            if f in kw:
+                raise ParameterError(f, kw[f], "comes from the geometry; change the gears "
+                                     "(or build PlanetaryGearSet directly)")
+        w_sun, w_ring = geometry.waveforms(**dict(waveform_options or {}))
+        phases = geometry.phases
+        meshes = {"sun": geometry.sun_mesh, "ring": geometry.ring_mesh}
+        radii = {"sun": geometry.sun.base_radius, "ring": geometry.ring.base_radius,
+                 "carrier": geometry.sun_mesh.centre_distance,
+                 "planet": geometry.planet.base_radius}
+        members = {}
+        for name, m in (("sun", sun), ("ring", ring), ("carrier", carrier), ("planet", planet)):
+            if not isinstance(m, Member):
+                raise ParameterError(name, m, "must be a geardyn.Member")
+            members[name] = _with_radius(name, m, radii[name])
+        for g, mesh in meshes.items():
+            kw.setdefault(f"{g}_backlash",
+                          0.5 * max(mesh.backlash, 0.0) * math.cos(mesh.operating_pressure_angle))
+        if isinstance(harmonics, bool) or not isinstance(harmonics, int) \
+                or not 1 <= harmonics <= 200:
+            raise ParameterError("harmonics", harmonics, "must be an integer from 1 to 200")
+        model = cls(
+            n_planets=geometry.n_planets, planet_angles=list(geometry.planet_angles),
+            sun_pressure_angle=meshes["sun"].operating_pressure_angle,
+            ring_pressure_angle=meshes["ring"].operating_pressure_angle,
+            sun_mesh_stiffness=w_sun.mean, ring_mesh_stiffness=w_ring.mean,
+            waveform={"sun": w_sun.fourier(harmonics), "ring": w_ring.fourier(harmonics)},
+            harmonics=harmonics,
+            sun_mesh_phase=[-2.0 * math.pi * float(g) for g in phases.sun],
+            ring_mesh_phase=[-2.0 * math.pi * float(g) for g in phases.ring],
+            **members, **kw)
+        model.geometry = geometry
+        model.stiffness_waveforms = (w_sun, w_ring)
+        return model
 
     # ------------------------------------------------------------------ assembly (SI)
     def full_dof_names(self) -> tuple[str, ...]:
