@@ -1,0 +1,156 @@
+"""PlanetaryGearSet.from_geometry: the gear set built from a geardyn.gears.PlanetaryGeometry.
+
+The mesh stiffness the compiled kernel sees is compared with the geometry's stiffness wave
+evaluated at the mesh's delay (end-to-end sign convention), the mesh phases with Parker & Lin's
+rules written out here, the static sun mesh forces with the sun's torque balance over its base
+radius (m z cos(alpha) / 2 computed here), and bad geometries with the field they name.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import geardyn
+import geardyn.gears as g
+from geardyn.errors import ParameterError
+
+M = geardyn.Member
+MEMBERS = dict(
+    sun=M(mass=0.4, inertia_over_r2=0.39, bearing_stiffness=1e8),
+    ring=M(mass=2.35, inertia_over_r2=3.0, bearing_stiffness=1e8, torsional_stiffness=1e9),
+    carrier=M(mass=5.43, inertia_over_r2=6.29, bearing_stiffness=1e8, torsional_stiffness=1e9),
+    planet=M(mass=0.66, inertia_over_r2=0.61, bearing_stiffness=1e8))
+MODULE = 2e-3
+
+
+def stage(zs: int, zp: int, zr: int, n: int = 4, **gear) -> g.PlanetaryGeometry:
+    def gear_(z: int, name: str, internal: bool = False) -> g.SpurGear:
+        return g.SpurGear(z, MODULE, "20 deg", "20 mm", internal=internal, name=name, **gear)
+    return g.PlanetaryGeometry(gear_(zs, "sun"), gear_(zp, "planet"),
+                               gear_(zr, "ring", internal=True), n_planets=n)
+
+
+def built(geometry: g.PlanetaryGeometry, **kw) -> geardyn.PlanetaryGearSet:
+    return geardyn.PlanetaryGearSet.from_geometry(geometry, **{**MEMBERS, **kw})
+
+
+def kernel_stiffness(gs: geardyn.PlanetaryGearSet, theta: float) -> np.ndarray:
+    """k_m [N/m] of every mesh at mesh phase theta, from the compiled observable: at a state
+    with unit (dimensionless) deflection in every mesh, at rest, no backlash or error, the mesh
+    force is k_m(theta) L."""
+    W = gs.mesh_rows()
+    X = np.linalg.lstsq(W, np.ones(W.shape[0]), rcond=None)[0]
+    assert np.allclose(W @ X, 1.0)
+    out = np.empty(W.shape[0])
+    tau = theta / gs.omega
+    gs.kernel.observe(tau, np.r_[X, np.zeros_like(X)], out, gs.params, math.sin(theta),
+                      math.cos(theta))
+    return out / gs.length_scale
+
+
+def test_kernel_stiffness_is_the_geometry_wave_delayed_by_the_phase():
+    """Every mesh's stiffness at mesh phase theta is the geometry's wave at theta - 2 pi gamma_n:
+    exactly its Fourier series, and pointwise the (ramped) wave itself."""
+    geo = stage(25, 23, 71)
+    gs = built(geo, harmonics=200, waveform_options={"transition": 0.05})
+    w_sun, w_ring = geo.waveforms(transition=0.05)
+    gam = np.concatenate([geo.phases.sun, geo.phases.ring])
+    waves = [w_sun] * 4 + [w_ring] * 4
+    assert len(set(np.round(gam[:4], 9))) == 4  # the phases differ: the check has teeth
+    h = np.arange(1, 201)
+    worst = 0.0
+    for theta in np.linspace(0.0, 2 * math.pi, 37):
+        k = kernel_stiffness(gs, theta)
+        for m, (w, gm) in enumerate(zip(waves, gam, strict=True)):
+            a, b = w.fourier(200, phase=gm)
+            series = w.mean * (1.0 + a @ np.cos(h * theta) + b @ np.sin(h * theta))
+            assert k[m] == pytest.approx(series, rel=1e-9)
+            worst = max(worst, abs(k[m] - float(w(theta, gm))) / w.mean)
+    assert worst < 0.02
+    # the opposite sign convention would be far off
+    k = kernel_stiffness(gs, 0.3)
+    wrong = [float(w(0.3, -gm)) for w, gm in zip(waves, gam, strict=True)]
+    assert np.max(np.abs(k - wrong)) / w_sun.mean > 0.2
+
+
+def test_in_phase_set_has_equal_sun_mesh_phases():
+    """Z_s = 24, Z_r = 72, N = 4: Z_s psi_n / 2 pi = 6 n is whole, every sun mesh in phase
+    (and every ring mesh: 18 n), so all sun meshes get the same stiffness coefficients."""
+    gs = built(stage(24, 24, 72))
+    n = 4
+    ph = np.mod(gs.mesh_phase, 2 * math.pi)
+    ph[np.isclose(ph, 2 * math.pi)] = 0.0
+    assert np.allclose(ph[:n], ph[0]) and np.allclose(ph[n:], ph[n])
+    assert np.allclose(gs.fourier[:n], gs.fourier[0], atol=1e-12)
+    assert np.allclose(gs.fourier[n:], gs.fourier[n], atol=1e-12)
+
+
+def test_sequentially_phased_set_has_parker_lin_phases():
+    """Z_s = 25, Z_r = 71, N = 4: gamma_sn = 25 (n - 1) / 4, gamma_rn = gamma_rs - 71 (n - 1) / 4
+    (mod 1), gamma_rs = 0 for an odd, unshifted planet (Z_p = 23); the model's phases are
+    -2 pi gamma."""
+    gs = built(stage(25, 23, 71))
+    n = np.arange(4)
+    want = np.concatenate([(25 * n / 4) % 1.0, (-71 * n / 4) % 1.0])
+    got = (-gs.mesh_phase / (2 * math.pi)) % 1.0
+    got[np.isclose(got, 1.0)] = 0.0
+    assert np.allclose(got, want, atol=1e-12)
+    assert np.allclose(want[:4], [0.0, 0.25, 0.5, 0.75])
+
+
+def test_angles_stiffness_radii_and_static_forces_from_the_geometry():
+    """Operating pressure angles, mean stiffnesses (ISO c_gamma_alpha b), radii; the static
+    sun mesh forces balance the sun torque over the base radius m z cos(20 deg) / 2."""
+    geo = stage(25, 23, 71)
+    gs = built(geo, sun_torque=50.0)
+    iso_s, iso_r = geo.stiffness()
+    assert gs.k_s == pytest.approx(iso_s.mesh_stiffness, rel=1e-12)
+    assert gs.k_r == pytest.approx(iso_r.mesh_stiffness, rel=1e-12)
+    assert gs.alpha_s == pytest.approx(math.radians(20.0), rel=1e-9)  # tight, unshifted
+    assert gs.alpha_r == pytest.approx(math.radians(20.0), rel=1e-9)
+    r_bs = MODULE * 25 * math.cos(math.radians(20.0)) / 2
+    assert gs.members["sun"].radius == pytest.approx(r_bs, rel=1e-12)
+    assert gs.members["carrier"].radius == pytest.approx(MODULE * (25 + 23) / 2, rel=1e-12)
+    assert gs.members["ring"].radius == pytest.approx(r_bs * 71 / 25, rel=1e-12)
+    F = gs.static_mesh_forces()
+    assert F[:4].sum() == pytest.approx(50.0 / r_bs, rel=1e-6)
+    assert np.allclose(F[:4], F[0], rtol=1e-6)  # equally spaced: equal load sharing
+
+
+def test_backlash_from_a_wider_centre_distance():
+    """A stage built at a wider centre distance (the ring shifted out so that its mesh opens
+    too): half the normal backlash of each mesh, j cos(alpha_w) / 2, unless given."""
+    sun = g.SpurGear(25, MODULE, "20 deg", "20 mm", name="sun")
+    planet = g.SpurGear(23, MODULE, "20 deg", "20 mm", name="planet")
+    ring = g.SpurGear(71, MODULE, "20 deg", "20 mm", internal=True, name="ring",
+                      profile_shift=0.05)
+    geo = g.PlanetaryGeometry(sun, planet, ring, n_planets=4, centre_distance=0.04802)
+    gs = built(geo)
+    for m, mesh in ((0, geo.sun_mesh), (4, geo.ring_mesh)):
+        assert mesh.backlash > 0
+        want = 0.5 * mesh.backlash * math.cos(mesh.operating_pressure_angle)
+        assert gs.backlash[m] == pytest.approx(want, rel=1e-12)
+    assert gs.alpha_s > math.radians(20.0)
+    assert np.all(built(geo, sun_backlash=1e-6).backlash[:4] == 1e-6)
+
+
+def test_bad_geometry_and_inputs_name_the_field():
+    with pytest.raises(ParameterError) as e:  # 6 planets: tip circles overlap
+        stage(25, 23, 71, n=6)
+    assert e.value.field == "planet_angles" and "collide" in str(e.value)
+    with pytest.raises(ParameterError) as e:  # stub teeth: too short a path of contact
+        stage(25, 23, 71, addendum=0.5)
+    assert e.value.field == "contact_ratio"
+    geo = stage(25, 23, 71)
+    with pytest.raises(ParameterError) as e:
+        built(geo, sun_mesh_stiffness=1e8)
+    assert e.value.field == "sun_mesh_stiffness"
+    with pytest.raises(ParameterError) as e:
+        built(geo, sun=M(mass=0.4, inertia_over_r2=0.39, bearing_stiffness=1e8, radius=0.05))
+    assert e.value.field == "sun.radius"
+    with pytest.raises(ParameterError) as e:
+        geardyn.PlanetaryGearSet.from_geometry("not a geometry", **MEMBERS)
+    assert e.value.field == "geometry"
