@@ -22,6 +22,7 @@ from geardyn.models.catt import CATTDevice
 from geardyn.models.derived import INTERPRETATIONS
 from geardyn.models.gear_pair import GearPair
 from geardyn.models.planetary import Member, PlanetaryGearSet
+from geardyn.units import to_si
 
 __all__ = ["build_model", "check_usable", "planetary_model"]
 
@@ -63,11 +64,48 @@ def planetary_model(params: PlanetaryGearSetParams, omega: float | None = None
     for name in ("sun", "ring", "carrier", "planet"):
         kw[name] = Member(**kw[name])
     kw["fixed"] = tuple(kw["fixed"])
+    geometry = kw.pop("geometry")
     try:
-        model = PlanetaryGearSet(**kw)
+        if geometry is None:
+            for name in ("sun_mesh_stiffness", "ring_mesh_stiffness"):
+                if kw[name] is None:
+                    raise ParameterError(name, None, "required (or give [params.geometry])")
+            model = PlanetaryGearSet(**kw)
+        else:
+            model = _from_geometry(geometry, kw, params.model_fields_set)
     except ParameterError as exc:
         raise ParameterError(f"params.{exc.field}", exc.value, exc.reason) from None
     return model if omega is None else model.with_omega(float(omega))
+
+
+def _from_geometry(table: dict, kw: dict, given: set[str]) -> PlanetaryGearSet:
+    """:meth:`PlanetaryGearSet.from_geometry` of a ``[params.geometry]`` table; ``kw`` the
+    other ``[params]`` (``given``: the fields the file sets)."""
+    from geardyn.gears import PlanetaryGeometry, SpurGear
+    from geardyn.models.planetary import _FROM_GEOMETRY
+
+    for name in _FROM_GEOMETRY:
+        if name in given and name not in ("n_planets", "planet_angles"):
+            raise ParameterError(name, kw[name], "comes from [params.geometry]; remove it")
+    gears = {}
+    for name in ("sun", "planet", "ring"):
+        g = table[name]
+        gears[name] = SpurGear(
+            g["teeth"], table["module"], table["pressure_angle"],
+            g["face_width"] if g["face_width"] is not None else table["face_width"],
+            profile_shift=g["profile_shift"], addendum=table["addendum"],
+            dedendum=table["dedendum"], internal=name == "ring", name=f"geometry.{name}")
+    angles = kw.pop("planet_angles")
+    stage = PlanetaryGeometry(
+        gears["sun"], gears["planet"], gears["ring"], n_planets=kw["n_planets"],
+        planet_angles=None if angles is None else tuple(to_si(a, "angle") for a in angles),
+        centre_distance=None if table["centre_distance"] is None
+        else to_si(table["centre_distance"], "length"))
+    extra = {k: v for k, v in kw.items() if k not in _FROM_GEOMETRY}
+    if "harmonics" not in given:
+        extra.pop("harmonics")
+    return PlanetaryGearSet.from_geometry(
+        stage, waveform_options={"transition": table["transition"]}, **extra)
 
 
 def check_usable(build: Callable[[], Model]) -> Model:

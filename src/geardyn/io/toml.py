@@ -25,8 +25,10 @@ For ``model = "gear_pair"`` the ``[params]`` table holds :class:`~geardyn.GearPa
 (``zeta``, ``kappa``, ``Fm``, ``Fa``, ``Omega``, ``kappa_phase``, ``error_phase``, ``backlash``).
 For ``model = "planetary"`` it holds :class:`~geardyn.PlanetaryGearSet` arguments
 (:class:`PlanetaryGearSetParams`: SI numbers or unit strings; ``[params.sun]``, ``[params.ring]``,
-``[params.carrier]``, ``[params.planet]`` are :class:`~geardyn.Member` tables); their values are
-checked when the model is built (errors name ``params.<field>``).
+``[params.carrier]``, ``[params.planet]`` are :class:`~geardyn.Member` tables; a
+``[params.geometry]`` table (:class:`GeometryTable`) builds it from gear geometry instead of
+mesh stiffnesses); their values are checked when the model is built (errors name
+``params.<field>``).
 
 This module only reads and validates: a study file becomes a :class:`Study` (plain, validated
 data; its device parameters a :class:`~geardyn.PlanetaryParams`). Turning a study into a model is
@@ -61,6 +63,8 @@ from geardyn.models.params import PAPER_NAMES, Angle, PlanetaryParams, Real, Who
 
 __all__ = [
     "GearPairParams",
+    "GearTable",
+    "GeometryTable",
     "MemberTable",
     "PaperBase",
     "PlanetaryGearSetParams",
@@ -205,6 +209,36 @@ class MemberTable(BaseModel):
     radius: Quantity | None = None
 
 
+class GearTable(BaseModel):
+    """A ``[params.geometry.<sun|planet|ring>]`` table: one gear's teeth and profile shift
+    (module, pressure angle, face width and tooth proportions default to the stage's)."""
+
+    model_config = _CONFIG
+
+    teeth: int
+    profile_shift: float = 0.0
+    face_width: Quantity | None = None
+
+
+class GeometryTable(BaseModel):
+    """``[params.geometry]`` of a planetary study: the stage the gear set is built from
+    (:meth:`~geardyn.PlanetaryGearSet.from_geometry`); ``n_planets`` and ``planet_angles`` of
+    ``[params]`` place the planets."""
+
+    model_config = _CONFIG
+
+    module: Quantity
+    pressure_angle: Quantity = "20 deg"
+    face_width: Quantity
+    addendum: float = 1.0
+    dedendum: float = 1.25
+    centre_distance: Quantity | None = None
+    transition: float = 0.0
+    sun: GearTable
+    planet: GearTable
+    ring: GearTable
+
+
 class PlanetaryGearSetParams(BaseModel):
     """``[params]`` of a ``planetary`` study: the arguments of :class:`~geardyn.PlanetaryGearSet`
     (types checked here; values when the model is built)."""
@@ -218,8 +252,9 @@ class PlanetaryGearSetParams(BaseModel):
     ring: MemberTable
     carrier: MemberTable
     planet: MemberTable
-    sun_mesh_stiffness: Quantity
-    ring_mesh_stiffness: Quantity
+    sun_mesh_stiffness: Quantity | None = None  # required unless [params.geometry]
+    ring_mesh_stiffness: Quantity | None = None
+    geometry: GeometryTable | None = None
     planet_angles: list[Quantity] | None = None
     sun_stiffness_fluctuation: PerPlanet = 0.0
     ring_stiffness_fluctuation: PerPlanet = 0.0
