@@ -9,6 +9,7 @@ radius (m z cos(alpha) / 2 computed here), and bad geometries with the field the
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -154,3 +155,29 @@ def test_bad_geometry_and_inputs_name_the_field():
     with pytest.raises(ParameterError) as e:
         geardyn.PlanetaryGearSet.from_geometry("not a geometry", **MEMBERS)
     assert e.value.field == "geometry"
+
+
+def test_builtin_study_builds_from_its_geometry():
+    """planetary_example: [params.geometry] gives the same set as from_geometry here; a
+    mesh stiffness next to the geometry, or none without it, names params.<field>."""
+    from geardyn.io import load_study
+    from geardyn.study import build_model
+
+    path = Path(geardyn.__file__).parent / "studies" / "planetary_example.toml"
+    text = path.read_text()
+    gs = build_model(load_study(path))
+    geo = stage(25, 23, 71)
+    w_sun, w_ring = geo.waveforms(transition=0.05)
+    assert gs.k_s == pytest.approx(w_sun.mean, rel=1e-12)
+    assert gs.k_r == pytest.approx(w_ring.mean, rel=1e-12)
+    assert np.allclose(gs.mesh_phase[:4], -2 * math.pi * geo.phases.sun)
+    assert np.all(gs.backlash == 1e-5) and gs.fourier.shape == (8, 30)
+    bad = text.replace("[params]\n", "[params]\nsun_mesh_stiffness = 1e8\n", 1)
+    with pytest.raises(ParameterError) as e:
+        build_model(load_study(bad))
+    assert e.value.field == "params.sun_mesh_stiffness"
+    start = text.index("[params.geometry]")
+    without = text[:start] + text[text.index("[params.sun]"):]
+    with pytest.raises(ParameterError) as e:
+        build_model(load_study(without))
+    assert e.value.field == "params.sun_mesh_stiffness"
