@@ -181,3 +181,14 @@ def test_builtin_study_builds_from_its_geometry():
     with pytest.raises(ParameterError) as e:
         build_model(load_study(without))
     assert e.value.field == "params.sun_mesh_stiffness"
+
+
+def test_saved_study_round_trips():
+    """A study written back (every field, defaults included) builds the same set."""
+    from geardyn.io import load_study
+    from geardyn.io.toml import study_to_toml
+    from geardyn.study import build_model
+
+    study = load_study(Path(geardyn.__file__).parent / "studies" / "planetary_example.toml")
+    again = build_model(load_study(study_to_toml(study)))
+    assert np.array_equal(again.params, build_model(study).params)

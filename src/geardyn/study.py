@@ -72,20 +72,21 @@ def planetary_model(params: PlanetaryGearSetParams, omega: float | None = None
                     raise ParameterError(name, None, "required (or give [params.geometry])")
             model = PlanetaryGearSet(**kw)
         else:
-            model = _from_geometry(geometry, kw, params.model_fields_set)
+            model = _from_geometry(geometry, kw)
     except ParameterError as exc:
         raise ParameterError(f"params.{exc.field}", exc.value, exc.reason) from None
     return model if omega is None else model.with_omega(float(omega))
 
 
-def _from_geometry(table: dict, kw: dict, given: set[str]) -> PlanetaryGearSet:
+def _from_geometry(table: dict, kw: dict) -> PlanetaryGearSet:
     """:meth:`PlanetaryGearSet.from_geometry` of a ``[params.geometry]`` table; ``kw`` the
-    other ``[params]`` (``given``: the fields the file sets)."""
+    other ``[params]``: those the geometry gives must keep their defaults."""
     from geardyn.gears import PlanetaryGeometry, SpurGear
     from geardyn.models.planetary import _FROM_GEOMETRY
 
+    fields = PlanetaryGearSetParams.model_fields
     for name in _FROM_GEOMETRY:
-        if name in given and name not in ("n_planets", "planet_angles"):
+        if name not in ("n_planets", "planet_angles") and kw[name] != fields[name].default:
             raise ParameterError(name, kw[name], "comes from [params.geometry]; remove it")
     gears = {}
     for name in ("sun", "planet", "ring"):
@@ -102,8 +103,6 @@ def _from_geometry(table: dict, kw: dict, given: set[str]) -> PlanetaryGearSet:
         centre_distance=None if table["centre_distance"] is None
         else to_si(table["centre_distance"], "length"))
     extra = {k: v for k, v in kw.items() if k not in _FROM_GEOMETRY}
-    if "harmonics" not in given:
-        extra.pop("harmonics")
     return PlanetaryGearSet.from_geometry(
         stage, waveform_options={"transition": table["transition"]}, **extra)
 

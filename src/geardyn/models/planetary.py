@@ -345,7 +345,7 @@ class PlanetaryGearSet(Model):
 
     @classmethod
     def from_geometry(cls, geometry: Any, *, sun: Member, ring: Member, carrier: Member,
-                      planet: Member, harmonics: int = 15,
+                      planet: Member, harmonics: int = 9,
                       waveform_options: Mapping[str, Any] | None = None,
                       **kw: Any) -> PlanetaryGearSet:
         """The gear set of a :class:`geardyn.gears.PlanetaryGeometry` (see ``docs/planetary.md``,
