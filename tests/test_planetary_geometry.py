@@ -192,3 +192,25 @@ def test_saved_study_round_trips():
     study = load_study(Path(geardyn.__file__).parent / "studies" / "planetary_example.toml")
     again = build_model(load_study(study_to_toml(study)))
     assert np.array_equal(again.params, build_model(study).params)
+
+
+@pytest.mark.parametrize(("teeth", "torque", "force"), [
+    ((25, 23, 71), {4, 8}, {1, 3, 5, 7}),   # sequentially phased: Z_s = 25, N = 4
+    ((24, 24, 72), set(range(1, 9)), set()),  # in phase: every harmonic is rotational
+])
+def test_net_sun_excitation_keeps_the_harmonics_the_phasing_rules_allow(teeth, torque, force):
+    """Equal deflection in every mesh: the net torque and force on the sun from the kernel's
+    mesh forces over one mesh cycle hold harmonic l of the mesh frequency only where the rules
+    say (Parker 2000): torque where l Z_s / N is whole, force where l Z_s = +-1 (mod N)."""
+    gs = built(stage(*teeth), harmonics=12, waveform_options={"transition": 0.05})
+    names = gs.dof_names()
+    sun = [names.index(d) for d in ("x_s", "y_s", "u_s")]
+    W = gs.mesh_rows()[:4, sun]  # the sun meshes' rows on the sun's coordinates
+    theta = np.linspace(0.0, 2 * math.pi, 64, endpoint=False)
+    net = np.array([W.T @ kernel_stiffness(gs, th)[:4] for th in theta])  # (64, 3)
+    spec = np.abs(np.fft.rfft(net, axis=0)) / len(theta)
+    scale = spec[1:9].max()
+    for ell in range(1, 9):
+        f_amp = math.hypot(spec[ell, 0], spec[ell, 1])
+        assert (spec[ell, 2] > 1e-6 * scale) == (ell in torque), ell
+        assert (f_amp > 1e-6 * scale) == (ell in force), ell
