@@ -16,6 +16,7 @@ period-1..K orbits by Newton shooting from each attractor's section point and ma
 from __future__ import annotations
 
 import time
+from pathlib import Path
 from typing import Annotated
 
 import typer
@@ -34,6 +35,7 @@ from geardyn.cli.common import (
     make_parents,
     run_settings,
     usable_omega,
+    write_outputs,
 )
 from geardyn.errors import ParameterError, StudyError
 from geardyn.study import build_model
@@ -123,22 +125,16 @@ def basins_command(
     if orbit_period:
         ds = _with_orbits(model, om, ds, orbit_period)
     elapsed = time.perf_counter() - t0
-    ds.attrs["study"] = s.study.name
-    ds.attrs["wall_time_s"] = round(elapsed, 3)
-    written = []
-    if out is not None:
-        from geardyn.io.netcdf import save_dataset
 
-        save_dataset(ds, out)
-        written.append(str(out))
-    if plot is not None:
+    def draw(path: Path) -> None:
         from geardyn.plotting.basins import plot_basins
 
-        plot_basins(ds, path=plot)
-        written.append(str(plot))
+        plot_basins(ds, path=path)
+
+    wrote = write_outputs(ds, out, plot, draw, study=s.study.name,
+                          wall_time_s=round(elapsed, 3))
     typer.echo(f"{s.study.name}: basins at Omega = {om:g}, {lanes} cells, {elapsed:.1f} s: "
-               f"{_summary(ds)}" + (f"; wrote {', '.join(written)}" if written else
-                                    "; nothing written"))
+               f"{_summary(ds)}{wrote}")
 
 
 def _with_orbits(model, om, ds, k_max: int):

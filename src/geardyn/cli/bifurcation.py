@@ -44,6 +44,7 @@ from geardyn.cli.common import (
     run_settings,
     stderr_console,
     usable_omega,
+    write_outputs,
 )
 from geardyn.errors import ParameterError, StudyError
 from geardyn.study import build_model
@@ -328,25 +329,17 @@ def bifurcation_command(
                          continuation=None if cont == "none" else cont,
                          lyapunov=lyap, progress=callback, hold=hold)
     elapsed = time.perf_counter() - t0
-    ds.attrs["study"] = s.study.name
-    ds.attrs["plot_state"] = plot_state
-    ds.attrs["wall_time_s"] = round(elapsed, 3)
 
-    written = []
-    if out is not None:
-        from geardyn.io.netcdf import save_dataset
-
-        save_dataset(ds, out)
-        written.append(str(out))
-    if plot is not None:
+    def draw(path: Path) -> None:
         from geardyn.plotting.bifurcation import plot_bifurcation
 
-        plot_bifurcation(ds, state=plot_state, path=plot)
-        written.append(str(plot))
+        plot_bifurcation(ds, state=plot_state, path=path)
+
+    wrote = write_outputs(ds, out, plot, draw, study=s.study.name, plot_state=plot_state,
+                          wall_time_s=round(elapsed, 3))
     typer.echo(
         f"{s.study.name}: {num} values of {name} in [{start:g}, {stop:g}], continuation {cont}, "
-        f"{elapsed:.1f} s: {_summary(ds)}"
-        + (f"; wrote {', '.join(written)}" if written else "; nothing written")
+        f"{elapsed:.1f} s: {_summary(ds)}{wrote}"
     )
 
 

@@ -195,6 +195,24 @@ def make_parents(*paths: Path | None) -> None:
             path.parent.mkdir(parents=True, exist_ok=True)
 
 
+def write_outputs(ds: Any, out: Path | None, plot: Path | None,
+                  draw: Callable[[Path], None], **attrs: Any) -> str:
+    """Record ``attrs`` (study name, wall time, ...) on the result ``ds``, save it to ``out``
+    (NetCDF) and ``draw(plot)`` where given; returns the tail of the command's summary line
+    ("; wrote A, B" or "; nothing written")."""
+    ds.attrs.update(attrs)
+    written = []
+    if out is not None:
+        from geardyn.io.netcdf import save_dataset
+
+        save_dataset(ds, out)
+        written.append(str(out))
+    if plot is not None:
+        draw(plot)
+        written.append(str(plot))
+    return f"; wrote {', '.join(written)}" if written else "; nothing written"
+
+
 def run_reporting_errors(call: Callable[[], Any]) -> int:
     """Run ``call`` (a click main in non-standalone mode) and return the exit status; expected
     errors print one line ``error: ...`` on stderr and give status 2."""

@@ -40,6 +40,7 @@ from geardyn.cli.common import (
     run_settings,
     stderr_console,
     usable_omega,
+    write_outputs,
 )
 from geardyn.errors import ParameterError, StudyError
 from geardyn.study import build_model
@@ -245,21 +246,15 @@ def continue_command(
                           max_period=max_period, steps_per_period=spp,
                           max_points=max_points, progress=callback)
     elapsed = time.perf_counter() - t0
-    ds.attrs["study"] = s.study.name
-    ds.attrs["plot_state"] = plot_state
-    ds.attrs["wall_time_s"] = round(elapsed, 3)
-    written = []
-    if out is not None:
-        from geardyn.io.netcdf import save_dataset
 
-        save_dataset(ds, out)
-        written.append(str(out))
-    if plot is not None:
+    def draw(path: Path) -> None:
         from geardyn.plotting.branch import plot_branch
 
-        plot_branch(ds, path=plot, over=over_ds, quantity=quantity, state=plot_state,
+        plot_branch(ds, path=path, over=over_ds, quantity=quantity, state=plot_state,
                     mesh=mesh)
-        written.append(str(plot))
+
+    wrote = write_outputs(ds, out, plot, draw, study=s.study.name, plot_state=plot_state,
+                          wall_time_s=round(elapsed, 3))
     err = stderr_console()
     for b in range(ds.sizes["branch_id"]):
         if int(ds["branch_status"].values[b]):
@@ -267,8 +262,7 @@ def continue_command(
                       f"{escape(str(ds['branch_message'].values[b]))}", highlight=False,
                       soft_wrap=True)
     typer.echo(f"{s.study.name}: {name} from {start:g} to {stop:g}, {elapsed:.1f} s: "
-               f"{_summary(ds)}"
-               + (f"; wrote {', '.join(written)}" if written else "; nothing written"))
+               f"{_summary(ds)}{wrote}")
 
 
 def register(app: typer.Typer) -> None:

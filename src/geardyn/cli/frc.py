@@ -34,6 +34,7 @@ from geardyn.cli.common import (
     make_parents,
     run_settings,
     usable_omega,
+    write_outputs,
 )
 from geardyn.errors import ParameterError, StudyError
 from geardyn.study import build_model
@@ -125,22 +126,16 @@ def frc_command(
     with _progress_bar(show_bar, escape(f"{s.study.name}: up and down")) as callback:
         ds = frequency_response(model, np.linspace(start, stop, num), run, progress=callback)
     elapsed = time.perf_counter() - t0
-    ds.attrs["study"] = s.study.name
-    ds.attrs["wall_time_s"] = round(elapsed, 3)
-    written = []
-    if out is not None:
-        from geardyn.io.netcdf import save_dataset
 
-        save_dataset(ds, out)
-        written.append(str(out))
-    if plot is not None:
+    def draw(path: Path) -> None:
         from geardyn.plotting.frc import plot_frc
 
-        plot_frc(ds, path=plot, mesh=mesh, branches=branches)
-        written.append(str(plot))
+        plot_frc(ds, path=path, mesh=mesh, branches=branches)
+
+    wrote = write_outputs(ds, out, plot, draw, study=s.study.name,
+                          wall_time_s=round(elapsed, 3))
     typer.echo(f"{s.study.name}: {num} values of Omega in [{start:g}, {stop:g}] up and down, "
-               f"{elapsed:.1f} s: {_summary(ds)}"
-               + (f"; wrote {', '.join(written)}" if written else "; nothing written"))
+               f"{elapsed:.1f} s: {_summary(ds)}{wrote}")
 
 
 def _load_branch(path: Path):
