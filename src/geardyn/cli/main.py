@@ -324,6 +324,7 @@ __import__("geardyn.cli.reproduce", fromlist=["register"]).register(app)  # cli/
 __import__("geardyn.cli.basins", fromlist=["register"]).register(app)  # cli/basins.py
 __import__("geardyn.cli.frc", fromlist=["register"]).register(app)  # cli/frc.py
 __import__("geardyn.cli.continuation", fromlist=["register"]).register(app)  # cli/continuation.py
+__import__("geardyn.cli.explore", fromlist=["register"]).register(app)  # cli/explore.py
 
 if __name__ == "__main__":
     main()
