@@ -34,6 +34,9 @@ from geardyn.plotting.bifurcation import PERIOD_CLASSES, REGIME_COLORS
 __all__ = ["ExplorerSession", "make_application"]
 
 _ERROR_STYLE = "color:#b00020"
+#: Plot area width and left border (px), the same for the diagram and its contact bands so that
+#: their parameter axes line up.
+FRAME_WIDTH, BORDER_LEFT = 760, 60
 
 
 def _class_data(view: DiagramView | None, cls: int) -> dict[str, Any]:
@@ -87,7 +90,8 @@ class ExplorerSession:
         w = st.window
         self.x_range = Range1d(w.start, w.stop, name="x_range")
         tools = [BoxZoomTool(dimensions="width"), TapTool(), PanTool(dimensions="width")]
-        fig = figure(height=430, width=900, x_range=self.x_range, y_range=DataRange1d(),
+        fig = figure(frame_height=360, frame_width=FRAME_WIDTH, min_border_left=BORDER_LEFT,
+                     x_range=self.x_range, y_range=DataRange1d(),
                      tools=tools, active_drag=tools[0], name="diagram",
                      x_axis_label=st.param, y_axis_label=st.effective_study.plot_state,
                      title="bifurcation diagram: box-zoom to recompute a window, click a point")
@@ -96,8 +100,10 @@ class ExplorerSession:
             src = ColumnDataSource({"x": [], "y": []}, name=f"points_{cls}")
             self.point_sources[cls] = src
             fig.scatter("x", "y", source=src, size=2.5, color=color, legend_label=label)
-        fig.legend.location = "top_right"
-        fig.legend.label_text_font_size = "8pt"
+        legend = fig.legend[0]
+        legend.label_text_font_size = "8pt"
+        legend.title = "period"
+        fig.add_layout(legend, "right")
         self.marker = ColumnDataSource({"x": []}, name="marker")
         fig.ray("x", 0, source=self.marker, length=0, angle=np.pi / 2, color="black",
                 line_dash="dashed")
@@ -110,7 +116,8 @@ class ExplorerSession:
         self.bands, self.band_sources = [], {}
         for mesh in (str(m) for m in self.ds["mesh"].values):
             src = ColumnDataSource({"x": [], "color": [], "regime": []}, name=f"band_{mesh}")
-            band = figure(height=45, width=900, x_range=self.x_range, tools="",
+            band = figure(frame_height=14, frame_width=FRAME_WIDTH, min_border_left=BORDER_LEFT,
+                          x_range=self.x_range, tools="",
                           toolbar_location=None, y_range=(0, 1), name=f"band_fig_{mesh}")
             band.rect("x", 0.5, width=1.0, height=1.0, color="color", source=src,
                       name=f"band_rect_{mesh}")
@@ -191,7 +198,8 @@ class ExplorerSession:
                        **kw)
         phase.line("x", "v", source=s["phase"], alpha=0.6)
         phase.scatter("x", "v", source=s["section"], color="red", size=5)
-        section = figure(title="Poincaré section", name="orbit_section_fig", **kw)
+        section = figure(title="Poincaré section (one point per forcing period)",
+                         name="orbit_section_fig", **kw)
         section.scatter("x", "v", source=s["section"], color="red", size=4)
         spectrum = figure(title="amplitude spectrum (frequency / Ω)", y_axis_type="log",
                           name="orbit_spectrum_fig", **kw)
@@ -233,8 +241,9 @@ class ExplorerSession:
         s["peaks"].data = {"f": [p[0] for p in orbit.peaks], "a": [p[1] for p in orbit.peaks],
                            "label": [p[2] for p in orbit.peaks]}
         self.orbit_figs[0].yaxis.axis_label = orbit.state
-        self.orbit_figs[1].xaxis.axis_label = orbit.state
-        self.orbit_figs[1].yaxis.axis_label = orbit.velocity or "d/dt"
+        for fig in self.orbit_figs[1:3]:
+            fig.xaxis.axis_label = orbit.state
+            fig.yaxis.axis_label = orbit.velocity or f"d{orbit.state}/dt"
         notes = "".join(f"<br>{html.escape(n)}" for n in orbit.notes)
         self.orbit_text.text = html.escape(orbit.summary()) + notes
 

@@ -57,6 +57,14 @@ def _num(x: float) -> str:
     return repr(float(x)) if float(x) != int(x) else str(int(x))
 
 
+def _rounded(lo: float, hi: float, digits: int = 4) -> tuple[float, float]:
+    """The ends of a zoomed window rounded to ``digits`` significant digits of its width (a
+    box zoom gives ends like 0.8992665036674817; the command line reads better with 0.8993)."""
+    decimals = max(0, digits - 1 - math.floor(math.log10(hi - lo)))
+    a, b = round(lo, decimals), round(hi, decimals)
+    return (a, b) if a < b else (lo, hi)
+
+
 def parse_value(text: str) -> float | str:
     """A control's text: a number where it reads as one, else the text (a unit string such as
     ``"30 um"``, which the parameter validation converts or refuses)."""
@@ -226,6 +234,7 @@ class ExplorerState:
         lo, hi = sorted((float(start), float(stop)))
         if not (math.isfinite(lo) and math.isfinite(hi)) or lo == hi:
             return f"window: needs two different finite ends (got {start!r}, {stop!r})"
+        lo, hi = _rounded(lo, hi)
         if self.param == "Omega" and lo <= 0:
             return f"window: Omega must stay positive (got {lo:g})"
         new = Window(lo, hi, self.window.num)
