@@ -63,6 +63,8 @@ class ExplorerSession:
         # and settings; the request holds this session's model, which later changes replace)
         self.ds, self.request = ds, state.diagram_request()
         self.runner = Runner(describe_error)
+        self._pending: DiagramRequest | None = None
+        self._pending_orbit = None
         self.describe_error = describe_error
         self._build()
         self._show_diagram(ds, self.request)
@@ -267,25 +269,28 @@ class ExplorerSession:
         def job(progress):
             return compute_diagram(request, progress)
 
-        gen = self.runner.submit(
-            job, on_done=lambda ds: self._later(self._diagram_done, gen, ds, request),
-            on_error=lambda msg: self._later(self._diagram_failed, gen, msg),
-            on_progress=lambda d, t: self._later(self._diagram_progress, gen, d, t),
+        # results reach the page on its own thread, and only for the newest request (a
+        # superseded one that finished meanwhile is dropped there)
+        self._pending = request
+        self.runner.submit(
+            job, on_done=lambda ds: self._later(self._diagram_done, request, ds),
+            on_error=lambda msg: self._later(self._diagram_failed, request, msg),
+            on_progress=lambda d, t: self._later(self._diagram_progress, request, d, t),
             key="diagram")
 
-    def _diagram_progress(self, gen: int, done: int, total: int) -> None:
-        if self.runner.current(gen, "diagram"):
+    def _diagram_progress(self, request: DiagramRequest, done: int, total: int) -> None:
+        if request is self._pending:
             pct = 100.0 * done / max(total, 1)
             self.progress.text = (f"computing … <progress value='{done}' max='{total}'>"
                                   f"</progress> {done}/{total} ({pct:.0f}%)")
 
-    def _diagram_done(self, gen: int, ds, request: DiagramRequest) -> None:
-        if self.runner.current(gen, "diagram"):
+    def _diagram_done(self, request: DiagramRequest, ds) -> None:
+        if request is self._pending:
             self._set_message("")
             self._show_diagram(ds, request)
 
-    def _diagram_failed(self, gen: int, message: str) -> None:
-        if self.runner.current(gen, "diagram"):
+    def _diagram_failed(self, request: DiagramRequest, message: str) -> None:
+        if request is self._pending:
             self._set_message(f"computation failed: {message}; the last good view is kept")
             self._show_diagram(self.ds, self.request)
 
@@ -339,20 +344,17 @@ class ExplorerSession:
         self.marker.data = {"x": [req.value]}
         self.orbit_text.text = f"computing the orbit at {req.param} = {req.value:.6g} …"
 
-        def done(orbit):
-            self._later(self._orbit_done, gen, orbit)
+        self._pending_orbit = req
+        self.runner.submit(lambda _progress: compute_orbit(req),
+                           lambda orbit: self._later(self._orbit_done, req, orbit),
+                           lambda msg: self._later(self._orbit_failed, req, msg), key="orbit")
 
-        def failed(msg):
-            self._later(self._orbit_failed, gen, msg)
-
-        gen = self.runner.submit(lambda _progress: compute_orbit(req), done, failed, key="orbit")
-
-    def _orbit_done(self, gen: int, orbit: OrbitView) -> None:
-        if self.runner.current(gen, "orbit"):
+    def _orbit_done(self, req, orbit: OrbitView) -> None:
+        if req is self._pending_orbit:
             self._show_orbit(orbit)
 
-    def _orbit_failed(self, gen: int, message: str) -> None:
-        if self.runner.current(gen, "orbit"):
+    def _orbit_failed(self, req, message: str) -> None:
+        if req is self._pending_orbit:
             self.orbit_text.text = (f'<span style="{_ERROR_STYLE}">orbit failed: '
                                     f'{html.escape(message)}</span>')
 
