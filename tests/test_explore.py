@@ -198,3 +198,97 @@ def test_a_failure_is_reported_and_nothing_else():
     gen = runner.submit(fails, done.append, errors.append)
     runner.wait(10)
     assert done == [] and errors == ["failed: no good"] and runner.current(gen)
+
+
+def test_only_a_non_local_address_is_warned_about(tmp_path):
+    from geardyn.explore.server import host_warning
+
+    assert host_warning("127.0.0.1", tmp_path) is None
+    assert host_warning("localhost", tmp_path) is None
+    warning = host_warning("0.0.0.0", tmp_path)
+    assert warning.startswith("warning: serving on 0.0.0.0") and str(tmp_path) in warning
+
+
+def test_explore_refuses_a_bad_range_in_one_line(capsys):
+    from geardyn.cli.main import main
+
+    with pytest.raises(SystemExit) as stop:
+        main(["explore", "paper_fig3", "--range", "1:1:10"])
+    assert stop.value.code == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == ["error: --range: START and STOP must differ (got '1:1:10')"]
+
+
+# ---------------------------------------------------------------------- the page, without browser
+@pytest.fixture()
+def session(state, monkeypatch):
+    """The page's session on a plain Bokeh document; results are applied at once (no server
+    loop), from the worker thread."""
+    from bokeh.document import Document
+
+    from geardyn.explore import app
+
+    ds = compute_diagram(state.diagram_request())
+    page = app.ExplorerSession(Document(), state, ds, format_error)
+    monkeypatch.setattr(page, "_later", lambda fn, *args: fn(*args))
+    yield page
+    page.runner.shutdown()
+
+
+def _points(page) -> list:
+    return sorted((float(x), float(y)) for src in page.point_sources.values()
+                  for x, y in zip(src.data["x"], src.data["y"], strict=True))
+
+
+def test_the_page_shows_the_diagram_and_refuses_an_invalid_value(session):
+    before = _points(session)
+    assert len(before) == 6 * 8
+    assert session.band_sources["mesh"].data["color"]  # the contact bands
+    assert "--range 1.6:2.4:6" in session.command.text
+    session._on_param("zeta", "value", "0.1", "-1")
+    assert "params.zeta: Input should be greater than or equal to 0" in \
+        session.input_messages["zeta"].text
+    assert session.state.overrides == {} and session._pending is None  # nothing recomputed
+    assert _points(session) == before
+
+
+def test_a_failed_computation_keeps_the_last_good_view(session, monkeypatch):
+    from geardyn.explore import app
+
+    before = _points(session)
+
+    def fails(request, progress=None):
+        raise ValueError("the kernel refused")
+
+    monkeypatch.setattr(app, "compute_diagram", fails)
+    session._on_param("zeta", "value", "0.1", "0.2")
+    session.runner.wait(30)
+    assert "computation failed: the kernel refused; the last good view is kept" in \
+        session.message.text
+    assert _points(session) == before and session.progress.text.startswith("ready")
+
+
+def test_a_new_window_supersedes_the_running_computation(session, monkeypatch):
+    from geardyn.explore import app
+
+    started, release, calls = threading.Event(), threading.Event(), []
+    real = app.compute_diagram
+
+    def slow_first(request, progress=None):
+        calls.append(request.window)
+        if len(calls) == 1:
+            started.set()
+            release.wait(30)
+        return real(request, progress)
+
+    monkeypatch.setattr(app, "compute_diagram", slow_first)
+    session._zoom(1.7, 2.3, session.window_message)
+    assert started.wait(30)
+    session._zoom(1.8, 2.0, session.window_message)  # while the first runs
+    release.set()
+    session.runner.wait(60)
+    assert calls[0] == Window(1.7, 2.3, 6)  # started, stopped at its first progress report
+    assert session.request.window == Window(1.8, 2.0, 6)
+    xs = sorted({x for x, _ in _points(session)})
+    np.testing.assert_allclose(xs, np.linspace(1.8, 2.0, 6))
+    assert "--range 1.8:2:6" in session.command.text

@@ -5,14 +5,24 @@ from __future__ import annotations
 
 import sys
 from collections.abc import Callable
+from pathlib import Path
 
 from geardyn.explore.compute import compute_diagram
 from geardyn.explore.state import ExplorerState
 
-__all__ = ["LOCAL_HOSTS", "serve"]
+__all__ = ["LOCAL_HOSTS", "host_warning", "serve"]
 
 #: Addresses that reach only this machine.
 LOCAL_HOSTS = ("127.0.0.1", "localhost", "::1")
+
+
+def host_warning(host: str, save_dir: Path) -> str | None:
+    """The warning printed when the explorer is bound to an address other machines reach."""
+    if host in LOCAL_HOSTS:
+        return None
+    return (f"warning: serving on {host}: the explorer is reachable from other machines and "
+            "has no authentication; anyone who reaches it can run computations and write "
+            f"files under {save_dir}")
 
 
 def serve(make_state: Callable[[], ExplorerState], *, port: int = 5006,
@@ -26,10 +36,9 @@ def serve(make_state: Callable[[], ExplorerState], *, port: int = 5006,
     from geardyn.explore.app import make_application
 
     state = make_state()
-    if host not in LOCAL_HOSTS:
-        print(f"warning: serving on {host}: the explorer is reachable from other machines and "
-              "has no authentication; anyone who reaches it can run computations and write "
-              f"files under {state.save_dir}", file=sys.stderr)
+    warning = host_warning(host, state.save_dir)
+    if warning is not None:
+        print(warning, file=sys.stderr)
     request = state.diagram_request()
     w = request.window
     echo(f"computing the first diagram: {w.num} values of {request.param} in "
