@@ -183,7 +183,7 @@ class ExplorerSession:
         self.doc.title = f"geardyn explore: {st.study.study.name}"
 
     def _orbit_figures(self, figure, ColumnDataSource) -> list:  # noqa: N803
-        from bokeh.models import LabelSet
+        from bokeh.models import LabelSet, Range1d
 
         self.orbit_sources = {
             "time": ColumnDataSource({"t": [], "x": []}, name="orbit_time"),
@@ -204,7 +204,7 @@ class ExplorerSession:
                          name="orbit_section_fig", **kw)
         section.scatter("x", "v", source=s["section"], color="red", size=4)
         spectrum = figure(title="amplitude spectrum (frequency / Ω)", y_axis_type="log",
-                          name="orbit_spectrum_fig", **kw)
+                          y_range=Range1d(1e-10, 1.0), name="orbit_spectrum_fig", **kw)
         spectrum.line("f", "a", source=s["spectrum"])
         spectrum.add_layout(LabelSet(x="f", y="a", text="label", source=s["peaks"],
                                      text_font_size="8pt", y_offset=3, text_align="center"))
@@ -240,6 +240,15 @@ class ExplorerSession:
         amp = orbit.amplitude
         floor = float(np.max(amp)) * 1e-10 if amp.size and np.max(amp) > 0 else 1e-300
         s["spectrum"].data = {"f": orbit.frequency, "a": np.maximum(amp, floor)}
+        if amp.size and np.max(amp) > 0:  # room above the highest peak for its label
+            self.orbit_figs[3].y_range.update(start=float(np.max(amp)) * 1e-9,
+                                              end=float(np.max(amp)) * 30.0)
+        # a period-1 section is one point: show it at the scale of the orbit, not of round-off
+        for rng, values in ((self.orbit_figs[2].x_range, orbit.x),
+                            (self.orbit_figs[2].y_range, orbit.v)):
+            finite = values[np.isfinite(values)]
+            spread = float(np.ptp(finite)) if finite.size else 0.0
+            rng.min_interval = 0.05 * spread if spread > 0 else None
         s["peaks"].data = {"f": [p[0] for p in orbit.peaks], "a": [p[1] for p in orbit.peaks],
                            "label": [p[2] for p in orbit.peaks]}
         self.orbit_figs[0].yaxis.axis_label = orbit.state
