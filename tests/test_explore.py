@@ -292,3 +292,15 @@ def test_a_new_window_supersedes_the_running_computation(session, monkeypatch):
     xs = sorted({x for x, _ in _points(session)})
     np.testing.assert_allclose(xs, np.linspace(1.8, 2.0, 6))
     assert "--range 1.8:2:6" in session.command.text
+
+
+def test_a_click_fills_the_orbit_panels(session):
+    from types import SimpleNamespace
+
+    session._on_tap(SimpleNamespace(x=2.05))
+    session.runner.wait(60)
+    assert session.marker.data["x"] == [pytest.approx(2.08)]  # nearest of 1.6, 1.76, ..., 2.4
+    assert session.orbit_text.text.startswith("Omega = 2.08: ")
+    for name in ("time", "phase", "section", "spectrum", "peaks"):
+        assert len(next(iter(session.orbit_sources[name].data.values()))) > 0, name
+    assert "Ω" in session.orbit_sources["peaks"].data["label"]

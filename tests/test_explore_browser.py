@@ -235,7 +235,7 @@ def test_zoom_click_change_a_parameter_and_save(server, browser):
     for source, column in (("orbit_time", "t"), ("orbit_phase", "x"), ("orbit_section", "x"),
                            ("orbit_spectrum", "f")):
         assert len(page.column(source, column)) > 8, source
-    assert page.column("orbit_peaks", "label")
+    assert page.column("orbit_peaks", "label"), summary
 
     # an invalid parameter: the message next to the control, the diagram unchanged
     page.type_into("param_zeta", "-1")

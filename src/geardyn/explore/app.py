@@ -52,6 +52,19 @@ def _band_data(view: DiagramView, mesh: str) -> dict[str, Any]:
     return {"x": view.values[: len(regimes)], "color": colors, "regime": list(regimes)}
 
 
+def _padded(points: np.ndarray, orbit: np.ndarray) -> dict[str, float]:
+    """Range of the section ``points``, padded by 5 % of the whole ``orbit``'s extent (so a
+    period-1 point sits in a window of the orbit's scale, not of round-off)."""
+    pts = points[np.isfinite(points)]
+    whole = orbit[np.isfinite(orbit)]
+    if not pts.size:
+        return {"start": 0.0, "end": 1.0}
+    lo, hi = float(np.min(pts)), float(np.max(pts))
+    pad = max(0.05 * (float(np.ptp(whole)) if whole.size else 0.0), 0.05 * (hi - lo),
+              1e-9 * max(1.0, abs(lo)))
+    return {"start": lo - pad, "end": hi + pad}
+
+
 class ExplorerSession:
     """The widgets, figures and callbacks of one browser session."""
 
@@ -201,6 +214,7 @@ class ExplorerSession:
         phase.line("x", "v", source=s["phase"], alpha=0.6)
         phase.scatter("x", "v", source=s["section"], color="red", size=5)
         section = figure(title="Poincaré section (one point per forcing period)",
+                         x_range=Range1d(0, 1), y_range=Range1d(0, 1),
                          name="orbit_section_fig", **kw)
         section.scatter("x", "v", source=s["section"], color="red", size=4)
         spectrum = figure(title="amplitude spectrum (frequency / Ω)", y_axis_type="log",
@@ -244,11 +258,10 @@ class ExplorerSession:
             self.orbit_figs[3].y_range.update(start=float(np.max(amp)) * 1e-9,
                                               end=float(np.max(amp)) * 30.0)
         # a period-1 section is one point: show it at the scale of the orbit, not of round-off
-        for rng, values in ((self.orbit_figs[2].x_range, orbit.x),
-                            (self.orbit_figs[2].y_range, orbit.v)):
-            finite = values[np.isfinite(values)]
-            spread = float(np.ptp(finite)) if finite.size else 0.0
-            rng.min_interval = 0.05 * spread if spread > 0 else None
+        section = self.orbit_figs[2]
+        for rng, points, orbit_values in ((section.x_range, orbit.section_x, orbit.x),
+                                          (section.y_range, orbit.section_v, orbit.v)):
+            rng.update(**_padded(points, orbit_values))
         s["peaks"].data = {"f": [p[0] for p in orbit.peaks], "a": [p[1] for p in orbit.peaks],
                            "label": [p[2] for p in orbit.peaks]}
         self.orbit_figs[0].yaxis.axis_label = orbit.state
