@@ -304,3 +304,20 @@ def test_a_click_fills_the_orbit_panels(session):
     for name in ("time", "phase", "section", "spectrum", "peaks"):
         assert len(next(iter(session.orbit_sources[name].data.values()))) > 0, name
     assert "Ω" in session.orbit_sources["peaks"].data["label"]
+
+
+def test_another_parameter_is_swept_at_the_studys_omega():
+    study = load_study(STUDY.replace("[run]", "[run]\nomega = 2.0"))
+    state = ExplorerState(study, "gp.toml", "zeta", Window(0.05, 0.15, 3),
+                          describe_error=format_error)
+    assert state.main_params() == ("backlash", "Fa", "kappa")  # the swept one left out
+    req = state.diagram_request()
+    ds = compute_diagram(req)
+    np.testing.assert_allclose(ds["zeta"].values, [0.05, 0.1, 0.15])
+    orbit = compute_orbit(orbit_request(req, ds, 0.11))
+    assert orbit.param == "zeta" and orbit.value == pytest.approx(0.1) and orbit.omega == 2.0
+    # the orbit's model is the study's with zeta = 0.1: the diagram's point at 0.1
+    np.testing.assert_allclose(orbit.section_x[-8:], ds["poincare"].sel(state="x").values[1],
+                               rtol=1e-9, atol=1e-12)
+    with pytest.raises(Exception, match="--param"):
+        ExplorerState(load_study(STUDY), "gp.toml", "zeta", Window(0.05, 0.15, 3))
