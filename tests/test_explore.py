@@ -321,3 +321,19 @@ def test_another_parameter_is_swept_at_the_studys_omega():
                                rtol=1e-9, atol=1e-12)
     with pytest.raises(Exception, match="--param"):
         ExplorerState(load_study(STUDY), "gp.toml", "zeta", Window(0.05, 0.15, 3))
+
+
+def test_unbounded_values_are_marked_on_top_of_the_diagram():
+    import xarray as xr
+
+    values = np.array([1.0, 2.0, 3.0])
+    poincare = np.array([[[0.1], [0.2]], [[np.nan], [np.nan]], [[0.5], [0.3]]])
+    ds = xr.Dataset(
+        {"poincare": (("Omega", "sample", "state"), poincare),
+         "period": ("Omega", [1, -1, 0]),
+         "contact": (("Omega", "mesh"), [["none"], ["unbounded"], ["single"]])},
+        coords={"Omega": values, "state": ["x"], "mesh": ["mesh"]}, attrs={"param": "Omega"})
+    view = diagram_view(ds)
+    assert sorted(zip(view.x, view.y, view.period_class, strict=True)) == [
+        (1.0, 0.1, 1), (1.0, 0.2, 1), (2.0, 0.5, -1), (3.0, 0.3, 0), (3.0, 0.5, 0)]
+    assert list(view.contact["mesh"]) == ["none", "unbounded", "single"]

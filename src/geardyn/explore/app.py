@@ -93,6 +93,7 @@ class ExplorerSession:
             ColumnDataSource,
             DataRange1d,
             Div,
+            HoverTool,
             PanTool,
             Range1d,
             Select,
@@ -114,7 +115,9 @@ class ExplorerSession:
         for cls, label, color in PERIOD_CLASSES:
             src = ColumnDataSource({"x": [], "y": []}, name=f"points_{cls}")
             self.point_sources[cls] = src
-            fig.scatter("x", "y", source=src, size=2.5, color=color, legend_label=label)
+            fig.scatter("x", "y", source=src, size=7 if cls == -1 else 2.5, color=color,
+                        marker="inverted_triangle" if cls == -1 else "circle",
+                        legend_label=label)
         legend = fig.legend[0]
         legend.label_text_font_size = "8pt"
         legend.title = "period"
@@ -124,6 +127,8 @@ class ExplorerSession:
                 line_dash="dashed")
         fig.ray("x", 0, source=self.marker, length=0, angle=-np.pi / 2, color="black",
                 line_dash="dashed")
+        fig.add_tools(HoverTool(tooltips=[(st.param, "@x{0.0000}"), ("point", "@y{0.0000}")],
+                                renderers=fig.renderers[:len(PERIOD_CLASSES)]))
         fig.on_event(RangesUpdate, self._on_ranges)
         fig.on_event(Tap, self._on_tap)
         self.diagram = fig

@@ -42,7 +42,7 @@ class DiagramView:
     param: str
     state: str
     x: np.ndarray  # parameter value of every point
-    y: np.ndarray  # the Poincare point's state
+    y: np.ndarray  # the Poincare point's state (unbounded values: at the top, class -1)
     period_class: np.ndarray  # legend class (see geardyn.plotting.bifurcation.PERIOD_CLASSES)
     values: np.ndarray  # the window's values
     width: float  # spacing of the values (band cell width)
@@ -62,10 +62,16 @@ def diagram_view(ds: xr.Dataset, state: str | None = None) -> DiagramView:
     classes = np.broadcast_to(period_class(period)[:, None], pts.shape)
     xx = np.broadcast_to(values[:, None], pts.shape)
     keep = np.isfinite(pts)
+    x, y, cls = xx[keep], pts[keep], classes[keep]
+    lost = ~keep.any(axis=1) & (period == -1)  # unbounded, no finite point: marked on top
+    if np.any(lost):
+        top = float(np.max(y)) if y.size else 1.0
+        x = np.concatenate([x, values[lost]])
+        y = np.concatenate([y, np.full(int(lost.sum()), top)])
+        cls = np.concatenate([cls, np.full(int(lost.sum()), -1)])
     contact = {str(m): ds["contact"].sel(mesh=m).values.astype(str) for m in ds["mesh"].values}
     width = float(abs(values[1] - values[0])) if values.size > 1 else 1.0
-    return DiagramView(param, name, xx[keep], pts[keep], classes[keep], values, width, contact,
-                       period)
+    return DiagramView(param, name, x, y, cls, values, width, contact, period)
 
 
 @dataclass
