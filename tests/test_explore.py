@@ -266,6 +266,12 @@ def test_a_failed_computation_keeps_the_last_good_view(session, monkeypatch):
     assert "computation failed: the kernel refused; the last good view is kept" in \
         session.message.text
     assert _points(session) == before and session.progress.text.startswith("ready")
+    # the state and the controls are back at the view shown
+    assert session.state.overrides == {} and session.inputs["zeta"].value == "0.1"
+    session._zoom(1.7, 1.9, session.window_message)
+    session.runner.wait(30)
+    assert session.state.window == Window(1.6, 2.4, 6) and session.state.history == []
+    assert "--range 1.6:2.4:6" in session.command.text
 
 
 def test_a_new_window_supersedes_the_running_computation(session, monkeypatch):

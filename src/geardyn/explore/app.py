@@ -77,6 +77,7 @@ class ExplorerSession:
         self.ds, self.request = ds, state.diagram_request()
         self.runner = Runner(describe_error)
         self._pending: DiagramRequest | None = None
+        self._syncing = False
         self._pending_orbit = None
         self.describe_error = describe_error
         self._build()
@@ -319,7 +320,22 @@ class ExplorerSession:
     def _diagram_failed(self, request: DiagramRequest, message: str) -> None:
         if request is self._pending:
             self._set_message(f"computation failed: {message}; the last good view is kept")
+            self.state.restore(self.request)
+            self._sync_controls()
             self._show_diagram(self.ds, self.request)
+
+    def _sync_controls(self) -> None:
+        """The controls show the state's values (without triggering their callbacks)."""
+        self._syncing = True
+        try:
+            for name, box in self.inputs.items():
+                box.value = str(self.state.current_value(name))
+            self.continuation.value = self.state.continuation
+            if self.state.kind == "catt":
+                self.interpretation.value = (self.state.interpretation
+                                             or self.state.study.study.interpretation)
+        finally:
+            self._syncing = False
 
     def _set_message(self, text: str) -> None:
         self.message.text = f'<span style="{_ERROR_STYLE}">{html.escape(text)}</span>' \
@@ -345,6 +361,8 @@ class ExplorerSession:
         self.recompute()
 
     def _on_window_text(self, _attr, _old, new: str) -> None:
+        if self._syncing:
+            return
         parts = new.replace(",", ":").split(":")
         try:
             x0, x1 = (float(p) for p in parts[:2])
@@ -386,6 +404,8 @@ class ExplorerSession:
                                     f'{html.escape(message)}</span>')
 
     def _on_param(self, name: str, _attr, _old, new: str) -> None:
+        if self._syncing:
+            return
         msg = self.state.set_override(name, new)
         box = self.input_messages[name]
         if msg is not None:
@@ -395,10 +415,14 @@ class ExplorerSession:
         self.recompute()
 
     def _on_continuation(self, _attr, _old, new: str) -> None:
+        if self._syncing:
+            return
         if self.state.set_continuation(new) is None:
             self.recompute()
 
     def _on_interpretation(self, _attr, _old, new: str) -> None:
+        if self._syncing:
+            return
         msg = self.state.set_interpretation(new)
         self.interpretation_message.text = (
             f'<span style="{_ERROR_STYLE}">{html.escape(msg)}</span>' if msg else "")

@@ -87,6 +87,8 @@ class DiagramRequest:
     continuation: str
     plot_state: str
     attrs: dict[str, Any] = field(default_factory=dict)
+    #: The state's view when the request was made (:meth:`ExplorerState.restore` returns to it).
+    view: dict[str, Any] = field(default_factory=dict, repr=False)
 
 
 def _error_text(exc: BaseException) -> str:
@@ -265,7 +267,23 @@ class ExplorerState:
             model=self._model, param=self.param, window=self.window, run=self.run_settings(),
             continuation=self.continuation, plot_state=self._effective.plot_state,
             attrs={"study": self.study.study.name, "plot_state": self._effective.plot_state,
-                   "command": self.command()})
+                   "command": self.command()},
+            view={"window": self.window, "overrides": dict(self.overrides),
+                  "interpretation": self.interpretation, "continuation": self.continuation,
+                  "effective": self._effective, "model": self._model})
+
+    def restore(self, request: DiagramRequest) -> None:
+        """Return to the view of ``request`` (the last good one, after a computation failed):
+        its window (dropping a history entry that repeats it), parameters and settings."""
+        v = request.view
+        if not v:
+            return
+        if self.window != v["window"] and self.history and self.history[-1] == v["window"]:
+            self.history.pop()
+        self.window = v["window"]
+        self.overrides, self.interpretation = dict(v["overrides"]), v["interpretation"]
+        self.continuation = v["continuation"]
+        self._effective, self._model = v["effective"], v["model"]
 
     def nearest_value(self, x: float) -> float:
         """The window's parameter value nearest to ``x``."""
