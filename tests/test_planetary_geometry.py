@@ -121,6 +121,19 @@ def test_angles_stiffness_radii_and_static_forces_from_the_geometry():
     assert np.allclose(F[:4], F[0], rtol=1e-6)  # equally spaced: equal load sharing
 
 
+def test_with_params_keeps_the_geometry():
+    """A set built from geometry keeps its geometry and stiffness waves through with_params
+    (a rebuild from its inputs) and lane_params, and the rebuilt set is what from_geometry
+    builds with the changed input."""
+    geo = stage(25, 23, 71)
+    gs = built(geo, sun_torque=50.0)
+    changed = gs.with_params(sun_backlash=2e-5)
+    assert changed.geometry is geo and changed.stiffness_waveforms == gs.stiffness_waveforms
+    assert np.array_equal(changed.params, built(geo, sun_torque=50.0, sun_backlash=2e-5).params)
+    assert changed.with_params(sun_torque=10.0).geometry is geo
+    assert gs.with_params(Omega=0.3).geometry is geo
+
+
 def test_backlash_from_a_wider_centre_distance():
     """A stage built at a wider centre distance (the ring shifted out so that its mesh opens
     too): half the normal backlash of each mesh, j cos(alpha_w) / 2, unless given."""

@@ -99,6 +99,10 @@ _FROM_GEOMETRY = ("n_planets", "planet_angles", "sun_pressure_angle", "ring_pres
                   "ring_mesh_phase")
 
 
+#: Attributes :meth:`PlanetaryGearSet.from_geometry` attaches, kept by ``with_params``.
+_FROM_BUILD = ("geometry", "stiffness_waveforms")
+
+
 def _with_radius(name: str, member: Member, radius: float) -> Member:
     """``member`` with ``radius`` set from the geometry; a given radius must agree with it."""
     if member.radius is None:
@@ -630,6 +634,9 @@ class PlanetaryGearSet(Model):
             if "mesh_frequency" not in physical:
                 kw["mesh_frequency"] = self.omega * self.time_scale
             out = type(self)(**kw)
+            for name in _FROM_BUILD:  # what from_geometry attached (the inputs came from it)
+                if hasattr(self, name):
+                    setattr(out, name, getattr(self, name))
             rest = {**raw, **rest}
         else:
             out = copy.copy(self)
