@@ -248,3 +248,77 @@ def test_builtin_study_sweep_finds_periods_and_contact_loss(tmp_path):
     assert ds.attrs["converge"] == 1e-6
     assert ds.attrs["transient"] >= 20 * 2 * math.pi / 0.3
     assert np.any(ds["contact"].sel(Omega=0.8).values != "none")
+
+
+def _willis_mesh_frequency(zs: int, zr: int, held: str, input_rpm: float) -> float:
+    """Mesh frequency [rad/s] by the Willis equation z_s w_s + z_r w_r = (z_s + z_r) w_c with
+    the held member still and the input (the sun; the carrier when the sun is held) at
+    ``input_rpm``: z_s times the sun's speed relative to the carrier."""
+    w_in = input_rpm * 2 * math.pi / 60
+    if held == "ring":
+        w_s, w_c = w_in, zs * w_in / (zs + zr)
+    elif held == "carrier":
+        w_s, w_c = w_in, 0.0
+    else:  # sun held, carrier input
+        w_s, w_c = 0.0, w_in
+    return zs * abs(w_s - w_c)
+
+
+@pytest.mark.parametrize("held", ["ring", "carrier", "sun"])
+def test_input_speed_sets_the_mesh_frequency_by_the_kinematics(held):
+    """input_speed [rpm] (a number or a unit string) sets the mesh frequency of the Willis
+    equation for the held member; lane_params sweeps it; a set without geometry refuses it."""
+    gs = built(stage(25, 23, 71), held=held)
+    want = _willis_mesh_frequency(25, 71, held, 3000.0)
+    for value in (3000.0, "3000 rpm", f"{3000 * 2 * math.pi / 60!r} rad/s"):
+        lane = gs.with_params(input_speed=value)
+        assert lane.omega * lane.time_scale == pytest.approx(want, rel=1e-12)
+        assert lane.input_speed == pytest.approx(3000.0, rel=1e-12)
+    P = gs.lane_params("input_speed", [1000.0, 3000.0])
+    assert P[:, gs.omega_index] * gs.time_scale == pytest.approx(
+        [_willis_mesh_frequency(25, 71, held, 1000.0), want], rel=1e-12)
+    assert gs.input_member == ("carrier" if held == "sun" else "sun")
+    assert "input_speed" in gs.physical_names
+    plain = geardyn.PlanetaryGearSet(**MEMBERS, n_planets=4, sun_mesh_stiffness=3e8,
+                                     ring_mesh_stiffness=4e8)
+    assert "input_speed" not in plain.physical_names
+    with pytest.raises(ParameterError) as e:
+        plain.with_params(input_speed=3000.0)
+    assert e.value.field == "input_speed"
+    with pytest.raises(ParameterError) as e:
+        gs.with_params(input_speed=-1.0)
+    assert e.value.field == "input_speed"
+
+
+def test_study_held_and_input_speed_sweep_axis_units(tmp_path):
+    """[params].held sets the kinematics (only with [params.geometry]); the CLI sweeps
+    input_speed [rpm] and the dataset's axis carries its unit, as a mesh_frequency axis its."""
+    from typer.testing import CliRunner
+
+    from geardyn.cli.main import app
+    from geardyn.io import load_study
+    from geardyn.io.netcdf import load_dataset
+    from geardyn.study import build_model
+
+    path = Path(geardyn.__file__).parent / "studies" / "planetary_example.toml"
+    text = path.read_text()
+    assert build_model(load_study(path)).held == "ring"
+    carrier = text.replace("[params]\n", '[params]\nheld = "carrier"\n', 1)
+    assert build_model(load_study(carrier)).mesh_frequency_per_input_speed() == 25.0
+    start = text.index("[params.geometry]")
+    without = text[:start] + text[text.index("[params.sun]"):]
+    without = without.replace("[params]\n", '[params]\nheld = "ring"\nsun_mesh_stiffness = 3e8\n'
+                              "ring_mesh_stiffness = 4e8\n", 1)
+    with pytest.raises(ParameterError) as e:
+        build_model(load_study(without))
+    assert e.value.field == "params.held"
+    for param, rng, unit in (("input_speed", "3000:6000:2", "rpm"),
+                             ("mesh_frequency", "5000:9000:2", "rad/s")):
+        out = tmp_path / f"{param}.nc"
+        r = CliRunner().invoke(app, ["bifurcation", "planetary_example", "--param", param,
+                                     "--range", rng, "--transient", "20", "--samples", "2",
+                                     "--quiet", "--out", str(out)])
+        assert r.exit_code == 0, r.output
+        ds = load_dataset(out)
+        assert ds[param].attrs["units"] == unit
+        assert list(ds[param].values) == [float(v) for v in rng.split(":")[:2]]

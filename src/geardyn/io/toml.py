@@ -349,6 +349,9 @@ class PlanetaryGearSetParams(BaseModel):
     mesh_frequency: Quantity | None = None
     rotational_only: bool = False
     fixed: list[Literal["carrier", "ring", "sun"]] = Field(default_factory=list)
+    held: Literal["carrier", "ring", "sun"] | None = Field(
+        None, description="member held in the input_speed kinematics (with [params.geometry]; "
+        "default: the one fixed member, else the ring)")
     time_scale: Quantity | None = None
     length_scale: Quantity = 1e-6
 
