@@ -240,8 +240,8 @@ def test_builtin_study_sweep_finds_periods_and_contact_loss(tmp_path):
     from geardyn.io.netcdf import load_dataset
 
     out = tmp_path / "b.nc"
-    r = CliRunner().invoke(app, ["bifurcation", "planetary_example", "--range", "0.3:0.8:3",
-                                 "--quiet", "--out", str(out)])
+    r = CliRunner().invoke(app, ["bifurcation", "planetary_example", "--param", "Omega",
+                                 "--range", "0.3:0.8:3", "--quiet", "--out", str(out)])
     assert r.exit_code == 0, r.output
     ds = load_dataset(out)
     assert np.all(ds["period"].values >= 1), ds["period"].values
