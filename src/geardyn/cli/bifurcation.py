@@ -143,6 +143,8 @@ def _lowest_omega(model, param: str, ends: tuple[float, float], hold: str) -> fl
         return min(ends)
     from geardyn.analysis.bifurcation import lane_params_held
 
+    if hold != "speed" or not hasattr(model, "omega_n"):
+        hold = "Omega"  # a bad --hold is refused with its own message below
     return float(min(lane_params_held(model, param, list(ends), hold)[:, model.omega_index]))
 
 
@@ -293,8 +295,9 @@ def bifurcation_command(
     cont = (continuation.value if continuation is not None
             else sweep.continuation if sweep is not None else "none")
     lyap = lyapunov if lyapunov is not None else bool(sweep is not None and sweep.lyapunov)
-    tr = (s.run.transient_time(_lowest_omega(model, name, (start, stop), hold))
-          if transient is None else transient)
+    tr = transient if transient is not None else s.run.transient if (
+        s.run.transient_periods is None) else s.run.transient_time(
+        _lowest_omega(model, name, (start, stop), hold))
     n_samples = samples if samples is not None else (
         sweep.samples if sweep is not None and sweep.samples is not None else s.run.periods)
     spp = s.run.steps_per_period if steps_per_period is None else steps_per_period
