@@ -322,3 +322,22 @@ def test_study_held_and_input_speed_sweep_axis_units(tmp_path):
         ds = load_dataset(out)
         assert ds[param].attrs["units"] == unit
         assert list(ds[param].values) == [float(v) for v in rng.split(":")[:2]]
+
+
+def test_frequency_response_axes_of_a_set_from_geometry():
+    """The frc dataset's physical axes of a set from geometry: mesh frequency [Hz] and input
+    (sun) speed [rpm] by the Willis kinematics (ring held); without geometry only the first."""
+    from geardyn.analysis.frc import physical_axes
+
+    gs = built(stage(25, 23, 71))
+    om = np.array([0.2, 0.5])
+    axes = physical_axes(gs, om)
+    w = om * gs.time_scale
+    assert axes["mesh_frequency"][0] == pytest.approx(w / (2 * math.pi), rel=1e-12)
+    assert axes["mesh_frequency"][1]["units"] == "Hz"
+    rpm = [3000.0 * w_m / _willis_mesh_frequency(25, 71, "ring", 3000.0) for w_m in w]
+    assert axes["input_speed"][0] == pytest.approx(rpm, rel=1e-12)
+    assert axes["input_speed"][1]["units"] == "rpm"
+    plain = geardyn.PlanetaryGearSet(**MEMBERS, n_planets=4, sun_mesh_stiffness=3e8,
+                                     ring_mesh_stiffness=4e8)
+    assert set(physical_axes(plain, om)) == {"mesh_frequency"}
