@@ -255,7 +255,7 @@ def simulate(
         raise ParameterError("--omega", om, "must be a positive finite number (with a finite "
                              "period)")
     check_plot_path("--plot", plot)
-    tr = s.run.transient if transient is None else transient
+    tr = s.run.transient_time(om) if transient is None else transient
     n_periods = s.run.periods if periods is None else periods
     spp = s.run.steps_per_period if steps_per_period is None else steps_per_period
     run = run_settings({"transient": ("--transient", tr), "samples": ("--periods", n_periods),
