@@ -1075,7 +1075,24 @@ def _fused_steps(fast, nl, locate, Y, Y1, PT, SE, CE, H6, FLAG, G, ST, slots, S_
     return n_flag, n_out
 
 
+_slot_check_i = nb.njit(inline="always", **_JIT)(_slot_check.py_func)
+_slot_sample_i = nb.njit(inline="always", **_JIT)(_slot_sample.py_func)
+
+
 @nb.njit(_nrt=False, **_JIT)
+def _slots_out(nl, G1, SE, CE, lanes, cfg, out, blk, slots, scratch):
+    """:func:`_slot_out` for every marked slot (MSK), in one call per block step (a call
+    passes every block array by value: one per slot cost a fifth of the run). Returns the
+    number of lanes that ended."""
+    MSK = slots[1]
+    gone = 0
+    for k in range(nl):
+        if MSK[k] and _slot_out(k, G1, SE, CE, lanes, cfg, out, blk, slots, scratch):
+            gone += 1
+    return gone
+
+
+@nb.njit(inline="always", **_JIT)
 def _slot_out(k, G1, SE, CE, lanes, cfg, out, blk, slots, scratch):
     """Slot k's step out of line (marked by :func:`_fused_steps`): a flagged step finished on
     the scalar path (:func:`_finish_flagged`), the bookkeeping of a period's start
@@ -1096,7 +1113,7 @@ def _slot_out(k, G1, SE, CE, lanes, cfg, out, blk, slots, scratch):
                         locate, ncross, unresolved, ys, y1s, sides, g1s, work, ybuf, gbuf)
     step = STEP[k]
     if PHASE[k] == 0 or step >= DUE[k]:
-        gone, _ = _slot_check(k, Y, R, D, ys, LANE, STEP, PHASE, n_end, n_tr, next_sample, DUE,
+        gone, _ = _slot_check_i(k, Y, R, D, ys, LANE, STEP, PHASE, n_end, n_tr, next_sample, DUE,
                               n_ring, ACT, END, GMIN, GMAX, OMAX, OMIN, OSQ, n_stat, lanes, cfg,
                               out)
         if gone:
@@ -1112,7 +1129,7 @@ def _slot_out(k, G1, SE, CE, lanes, cfg, out, blk, slots, scratch):
     _t_stats(GMIN, GMAX, OMAX, OMIN, OSQ, k, (), o, True)
     if step < DUE[k]:
         return False
-    return _slot_sample(k, Y, LANE, STEP, n_end, n_tr, next_sample, DUE, ACT, END, GMIN, GMAX,
+    return _slot_sample_i(k, Y, LANE, STEP, n_end, n_tr, next_sample, DUE, ACT, END, GMIN, GMAX,
                         OMAX, OMIN, OSQ, n_stat, lanes, cfg, out)
 
 
@@ -1159,10 +1176,10 @@ def _fused_run(fast, q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch):
         n_flag, n_out = _fused_steps(fast, nl, locate, Yf, Y1f, PT, SE, CE, H6, FLAG,
                                      (GSf, GPf, GRf, SIDEf), stats, slots, S_TAB, C_TAB, phx)
         if n_out > 0:
-            for k in range(nl):
-                if MSK[k] and _slot_out(k, GS, SE, CE, lanes, cfg, out, blk, slots, scratch):
-                    ended = True
-                    n_act -= 1
+            gone = _slots_out(nl, GS, SE, CE, lanes, cfg, out, blk, slots, scratch)
+            if gone > 0:
+                ended = True
+                n_act -= gone
 
 
 class _NoAliasCompiler(nb.core.compiler.Compiler):
