@@ -40,6 +40,7 @@ class KernelSource:
         }
         if not self.plain:
             funcs.update(_lane_functions(funcs))
+            funcs.update(_lane_scalar_functions(funcs))
         return funcs
 
 
@@ -58,3 +59,20 @@ def _lane_functions(funcs: dict[str, Any]) -> dict[str, Any]:
     if out and len(out) < 3:
         return {}  # all three or none: the kernel mixes no layouts
     return out
+
+
+def _lane_scalar_functions(funcs: dict[str, Any]) -> dict[str, Any]:
+    """The lane-scalar forms of a model's functions, where its module defines them: for ``rhs``
+    named ``f``, ``f_lane`` (with ``f_lane_fast`` and the state size ``f_lane_states``) becomes
+    ``rhs_lane`` (``rhs_lane_fast``), and so ``events_lane``, ``observe_lane``: lane k of a
+    block, state and results as tuples, so that the sweep kernel fuses a grid step of every
+    slot into one loop (see :mod:`._kernel_template`). All or none."""
+    out = {}
+    for alias, suffix in (("rhs", "_lane"), ("events", "_lane"), ("observe", "_lane"),
+                          ("rhs", "_lane_fast")):
+        py = getattr(funcs[alias], "py_func", None)
+        mod = sys.modules.get(getattr(py, "__module__", ""), None)
+        fn = getattr(mod, f"{py.__name__}{suffix}", None) if py is not None else None
+        if fn is not None and hasattr(fn, "py_func"):
+            out[f"{alias}{suffix}"] = fn
+    return out if len(out) == 4 else {}

@@ -334,3 +334,91 @@ def catt_observe_one_lanes(T, Y, O, PT, nl, S, C, SC):
         scale = PT[o + FORCE_SCALE, k]
         O[0, k] = scale * (PT[o + K_SQ_Q, k] * gs + PT[o + C_SQ_Q, k] * Y[1, k])
         O[1, k] = scale * (PT[o + K_PQ_Q, k] * gp + PT[o + C_PQ_Q, k] * Y[3, k])
+
+
+# ---------------------------------------------------------------------------------------------
+# Lane-scalar forms of the reduced model for the sweep kernel's fused step loop: lane k of a
+# block (coefficients PT[j, k]), the state and the result as tuples (local scalars, registers),
+# the same arithmetic as catt_rhs_one / catt_events_one / catt_observe_one operation for
+# operation (bitwise equal). ``fast``: the lane has one stiffness harmonic and no load
+# fluctuation (``catt_rhs_one_lane_fast``), so no inner loop and no libm call stop the
+# vectoriser; the kernel passes it as a constant. Picked up by name (``<function>_lane``).
+
+#: State size of the lane-scalar forms (the tuples' length).
+catt_rhs_one_lane_states = 4
+
+
+@nb.njit(inline="always", **_JIT)
+def _stiffness_lane(PT, k, f, nh, s, c):
+    """:func:`_stiffness` of lane k (coefficient rows f.. of PT)."""
+    acc = PT[f, k] * c + PT[f + 1, k] * s
+    ch = c
+    sh = s
+    for h in range(1, nh):
+        ch, sh = ch * c - sh * s, sh * c + ch * s
+        acc += PT[f + 2 * h, k] * ch + PT[f + 2 * h + 1, k] * sh
+    return 1.0 + acc
+
+
+@nb.njit(inline="always", **_JIT)
+def _mesh_factors_lane(t, PT, k, s, c, fast):
+    """Stiffness factors (sun-inside, inside-outside) and load terms (load_c, sin_l1) of lane
+    k, as :func:`_rhs` computes them for one planet set."""
+    fs = HEADER + BLOCK_FIXED
+    if fast:
+        return (1.0 + (PT[fs, k] * c + PT[fs + 1, k] * s),
+                1.0 + (PT[fs + 2, k] * c + PT[fs + 3, k] * s), PT[F_C0, k], 0.0)
+    nh = int(PT[N_HARM, k])
+    load_c = PT[F_C0, k]
+    sin_l1 = 0.0
+    if PT[F_C1, k] != 0.0 or PT[HEADER + F_P1, k] != 0.0:
+        load_c += PT[F_C1, k] * math.sin(PT[LAMBDA, k] * t + PT[PSI2, k])
+        sin_l1 = math.sin(PT[LAMBDA, k] * t + PT[PSI1, k])
+    return (_stiffness_lane(PT, k, fs, nh, s, c), _stiffness_lane(PT, k, fs + 2 * nh, nh, s, c),
+            load_c, sin_l1)
+
+
+@nb.njit(**_JIT)
+def catt_rhs_one_lane_fast(PT, k):
+    """Whether lane k may take the fast form (one harmonic, no load fluctuation)."""
+    return (PT[N_HARM, k] == 1.0) & (PT[F_C1, k] == 0.0) & (PT[HEADER + F_P1, k] == 0.0)
+
+
+@nb.njit(inline="always", **_JIT)
+def catt_rhs_one_lane(t, y, PT, k, s, c, fast):
+    """:func:`catt_rhs_one` of lane k: dy/dt as a tuple."""
+    o = HEADER
+    ks, kp, load_c, sin_l1 = _mesh_factors_lane(t, PT, k, s, c, fast)
+    om2 = PT[OMEGA, k] * PT[OMEGA, k]
+    xs, vs, xp, vp = y
+    gs = ks * dead_zone(xs, PT[o + B_SQ, k])
+    gp = kp * dead_zone(xp, PT[o + B_PQ, k])
+    carrier = 0.0
+    carrier += PT[o + K_SQ_C, k] * gs + PT[o + C_SQ_C, k] * vs
+    f_sq = PT[o + K_SQ_Q, k] * gs + PT[o + C_SQ_Q, k] * vs
+    f_pq = PT[o + K_PQ_Q, k] * gp + PT[o + C_PQ_Q, k] * vp
+    f_pp = PT[o + K_PQ_P, k] * gp + PT[o + C_PQ_P, k] * vp
+    load_p = PT[o + F_P0, k] + PT[o + F_P1, k] * sin_l1
+    d1 = -f_sq + f_pq + om2 * (PT[o + E_SQ_S, k] * s + PT[o + E_SQ_C, k] * c)
+    d3 = (f_sq - f_pq - f_pp + load_p + om2 * (PT[o + E_PQ_S, k] * s + PT[o + E_PQ_C, k] * c))
+    return (vs, d1 + (load_c - carrier), vp, d3)
+
+
+@nb.njit(inline="always", **_JIT)
+def catt_events_one_lane(t, y, PT, k):
+    """:func:`catt_events_one` of lane k, as a tuple."""
+    o = HEADER
+    return (y[0] - PT[o + B_SQ, k], y[0] + PT[o + B_SQ, k], y[2] - PT[o + B_PQ, k],
+            y[2] + PT[o + B_PQ, k])
+
+
+@nb.njit(inline="always", **_JIT)
+def catt_observe_one_lane(t, y, PT, k, s, c, fast):
+    """:func:`catt_observe_one` of lane k, as a tuple."""
+    o = HEADER
+    ks, kp, _, _ = _mesh_factors_lane(t, PT, k, s, c, fast)
+    gs = ks * dead_zone(y[0], PT[o + B_SQ, k])
+    gp = kp * dead_zone(y[2], PT[o + B_PQ, k])
+    scale = PT[o + FORCE_SCALE, k]
+    return (scale * (PT[o + K_SQ_Q, k] * gs + PT[o + C_SQ_Q, k] * y[1]),
+            scale * (PT[o + K_PQ_Q, k] * gp + PT[o + C_PQ_Q, k] * y[3]))

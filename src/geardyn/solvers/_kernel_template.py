@@ -427,14 +427,14 @@ def _lanes_finish(STEP, nl, NPER, Y, Y1, G1, GR, SIDE, FLAG, ACT, P, LANE, HB, T
         return
     for k in range(nl):
         if FLAG[k] != 0.0:
-            _finish_flagged(k, STEP, NPER, Y, Y1, G1, GR, SIDE, P, LANE, HB, T0B, OMEGA, locate,
+            _finish_flagged(k, STEP[k], NPER, Y, Y1, G1, GR, SIDE, P, LANE, HB, T0B, OMEGA, locate,
                             NCROSS, UNRES, ys, y1s, sides, g1s, work, ybuf, gbuf)
 
 
 @nb.njit(_nrt=False, **_JIT)
-def _finish_flagged(k, STEP, NPER, Y, Y1, G1, GR, SIDE, P, LANE, HB, T0B, OMEGA, locate, NCROSS,
+def _finish_flagged(k, i, NPER, Y, Y1, G1, GR, SIDE, P, LANE, HB, T0B, OMEGA, locate, NCROSS,
                     UNRES, ys, y1s, sides, g1s, work, ybuf, gbuf):
-    """Finish slot k's flagged trial step on the scalar path: the crossings located
+    """Finish slot k's flagged trial step (grid step i) on the scalar path: the crossings located
     (:func:`_split_step`) or, without ``locate``, counted at the step's end. Out of line, so
     that the slot loop that calls it stays small."""
     ns = Y.shape[0]
@@ -456,7 +456,7 @@ def _finish_flagged(k, STEP, NPER, Y, Y1, G1, GR, SIDE, P, LANE, HB, T0B, OMEGA,
         sides[j] = 1 if SIDE[j, k] > 0.0 else -1
         g1s[j] = G1[j, k]
         gbuf[GRAZE_ROW, j] = GR[j, k]
-    UNRES[lane] += _split_step(STEP[k], T0B[k], ys, y1s, P[lane], HB[k], OMEGA[lane],
+    UNRES[lane] += _split_step(i, T0B[k], ys, y1s, P[lane], HB[k], OMEGA[lane],
                                NPER[k], sides, g1s, NCROSS[lane], work, ybuf, gbuf)
     for q in range(ns):
         Y[q, k] = ys[q]
@@ -516,53 +516,57 @@ def _sweep_worker(w, lanes, cfg, sched, out):
     nl = min(width, q1 - q0)
     if nl <= 0:
         return
+    nw = nl  # the block arrays' width; the fused loop's rows are BLOCK slots apart
+    if FUSED:
+        nl = min(nl, BLOCK)
+        nw = BLOCK
     ns = Y0.shape[1]
     n_g = max(n_ev, 1)
     n_o = max(n_obs, 1)
     depth = max(conv_depth, 1)
-    R = np.zeros((nl, depth, ns))  # the last section points of the transient
-    D = np.zeros((nl, 3 * depth, depth))  # their differences, per candidate period
-    Y = np.zeros((ns, nl))
-    Y1 = np.zeros((ns, nl))
-    K1 = np.zeros((ns, nl))
-    K2 = np.zeros((ns, nl))
-    K3 = np.zeros((ns, nl))
-    K4 = np.zeros((ns, nl))
-    TMP = np.zeros((ns, nl))
-    PT = np.zeros((P.shape[1], nl))
-    SC = np.zeros((8, nl))
-    PH6 = np.zeros((4, nl))  # sin, cos of the forcing phase at a step's middle and end
+    R = np.zeros((nw, depth, ns))  # the last section points of the transient
+    D = np.zeros((nw, 3 * depth, depth))  # their differences, per candidate period
+    Y = np.zeros((ns, nw))
+    Y1 = np.zeros((ns, nw))
+    K1 = np.zeros((ns, nw))
+    K2 = np.zeros((ns, nw))
+    K3 = np.zeros((ns, nw))
+    K4 = np.zeros((ns, nw))
+    TMP = np.zeros((ns, nw))
+    PT = np.zeros((P.shape[1], nw))
+    SC = np.zeros((8, nw))
+    PH6 = np.zeros((4, nw))  # sin, cos of the forcing phase at a step's middle and end
     PH = (PH6[0], PH6[1], PH6[2], PH6[3])
-    TT = np.zeros(nl)
-    GP = np.full((n_g, nl), np.nan)  # events at the grid points i - 1, i, i + 1
-    GS = np.zeros((n_g, nl))
-    G1 = np.zeros((n_g, nl))
-    GR = np.zeros((n_g, nl))
-    SIDE = np.ones((n_g, nl))
-    FLAG = np.zeros(nl)
-    GMIN = np.full((n_g, nl), np.inf)
-    GMAX = np.full((n_g, nl), -np.inf)
-    O = np.zeros((n_o, nl))
-    OMAX = np.full((n_o, nl), -np.inf)
-    OMIN = np.full((n_o, nl), np.inf)
-    OSQ = np.zeros((n_o, nl))
-    STAT = np.zeros(nl, np.bool_)
-    MSK = np.zeros(nl, np.bool_)  # slots with bookkeeping due
-    ACT = np.zeros(nl, np.bool_)
-    END = np.ones(nl, np.bool_)  # slots to (re)fill
-    LANE = np.zeros(nl, np.int64)
-    STEP = np.zeros(nl, np.int64)
-    PHASE = np.zeros(nl, np.int64)
-    NPER = np.ones(nl, np.int64)
-    OFF = np.zeros(nl, np.int64)
-    HB = np.zeros(nl)
-    T0B = np.zeros(nl)
-    n_end = np.zeros(nl, np.int64)
-    n_tr = np.zeros(nl, np.int64)
-    next_sample = np.zeros(nl, np.int64)
-    DUE = np.zeros(nl, np.int64)
-    n_stat = np.zeros(nl, np.int64)
-    n_ring = np.zeros(nl, np.int64)
+    TT = np.zeros(nw)
+    GP = np.full((n_g, nw), np.nan)  # events at the grid points i - 1, i, i + 1
+    GS = np.zeros((n_g, nw))
+    G1 = np.zeros((n_g, nw))
+    GR = np.zeros((n_g, nw))
+    SIDE = np.ones((n_g, nw))
+    FLAG = np.zeros(nw)
+    GMIN = np.full((n_g, nw), np.inf)
+    GMAX = np.full((n_g, nw), -np.inf)
+    O = np.zeros((n_o, nw))
+    OMAX = np.full((n_o, nw), -np.inf)
+    OMIN = np.full((n_o, nw), np.inf)
+    OSQ = np.zeros((n_o, nw))
+    STAT = np.zeros(nw, np.bool_)
+    MSK = np.zeros(nw, np.bool_)  # slots with bookkeeping due
+    ACT = np.zeros(nw, np.bool_)
+    END = np.ones(nw, np.bool_)  # slots to (re)fill
+    LANE = np.zeros(nw, np.int64)
+    STEP = np.zeros(nw, np.int64)
+    PHASE = np.zeros(nw, np.int64)
+    NPER = np.ones(nw, np.int64)
+    OFF = np.zeros(nw, np.int64)
+    HB = np.zeros(nw)
+    T0B = np.zeros(nw)
+    n_end = np.zeros(nw, np.int64)
+    n_tr = np.zeros(nw, np.int64)
+    next_sample = np.zeros(nw, np.int64)
+    DUE = np.zeros(nw, np.int64)
+    n_stat = np.zeros(nw, np.int64)
+    n_ring = np.zeros(nw, np.int64)
     # the scalar path's scratch
     ys = np.zeros(ns)
     y1s = np.zeros(ns)
@@ -574,10 +578,10 @@ def _sweep_worker(w, lanes, cfg, sched, out):
     work = np.zeros((7, ns))
     ybuf = np.zeros(ns)
     gbuf = event_buffer(0, n_ev)
-    HW3 = np.zeros((3, ns, nl))  # h/2, h, h/6 per (state, slot)
-    FL = (Y.reshape(ns * nl), Y1.reshape(ns * nl), K1.reshape(ns * nl), K2.reshape(ns * nl),
-          K3.reshape(ns * nl), K4.reshape(ns * nl), TMP.reshape(ns * nl))
-    HW = (HW3[0].reshape(ns * nl), HW3[1].reshape(ns * nl), HW3[2].reshape(ns * nl))
+    HW3 = np.zeros((3, ns, nw))  # h/2, h, h/6 per (state, slot)
+    FL = (Y.reshape(ns * nw), Y1.reshape(ns * nw), K1.reshape(ns * nw), K2.reshape(ns * nw),
+          K3.reshape(ns * nw), K4.reshape(ns * nw), TMP.reshape(ns * nw))
+    HW = (HW3[0].reshape(ns * nw), HW3[1].reshape(ns * nw), HW3[2].reshape(ns * nw))
     blk = (R, D, Y, Y1, K1, K2, K3, K4, TMP, PT, SC, PH6, PH, TT, GP, GS, G1, GR, SIDE,
            FLAG, GMIN, GMAX, O, OMAX, OMIN, OSQ, HW3, FL, HW)
     slots = (STAT, MSK, ACT, END, LANE, STEP, PHASE, NPER, OFF, HB, T0B, n_end, n_tr, next_sample,
@@ -586,8 +590,63 @@ def _sweep_worker(w, lanes, cfg, sched, out):
     _block_run(q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch)
 
 
+@nb.njit(inline="always", **_JIT)
+def _load_slot(k, lane, lanes, cfg, sched, out, blk, slots, GP):
+    """Slot k takes lane ``lane`` at its grid step 0 (GP: the block's events at the grid point
+    before, rotated by the block loop). Returns 1 if the lane samples from step 0 (no
+    transient), else 0."""
+    P, Y0, H, OMEGA, T0, n_transient, n_transient_max, sample_every = lanes
+    conv_tol, conv_depth, n_samples, locate, bound, n_ev, n_obs, width = cfg
+    start, queue, lane_nper, lane_tab, S_TAB, C_TAB = sched
+    (samples, final, status, gmin, gmax, ncross, omax, omin, orms, unresolved, transient_steps,
+     converged) = out
+    (R, D, Y, Y1, K1, K2, K3, K4, TMP, PT, SC, PH6, PH, TT, _, GS, G1, GR, SIDE, FLAG,
+     GMIN, GMAX, O, OMAX, OMIN, OSQ, HW3, FL, HW) = blk
+    (STAT, MSK, ACT, END, LANE, STEP, PHASE, NPER, OFF, HB, T0B, n_end, n_tr, next_sample, DUE,
+     n_stat, n_ring) = slots
+    ns = Y0.shape[1]
+    n_g = GP.shape[0]
+    n_o = O.shape[0]
+    ACT[k] = True
+    LANE[k] = lane
+    STEP[k] = 0
+    PHASE[k] = 0
+    NPER[k] = lane_nper[lane]
+    OFF[k] = lane_tab[lane]
+    h = H[lane]
+    HB[k] = h
+    T0B[k] = T0[lane]
+    TT[k] = T0[lane]
+    for q in range(ns):
+        Y[q, k] = Y0[lane, q]
+    for j in range(P.shape[1]):
+        PT[j, k] = P[lane, j]
+    status[lane] = STATUS_OK
+    unresolved[lane] = 0
+    converged[lane] = 0 if conv_tol > 0.0 else -1
+    for j in range(n_ev):
+        ncross[lane, j] = 0
+    n_tr[k] = n_transient[lane]
+    n_end[k] = n_transient[lane] + n_samples * sample_every[lane]
+    next_sample[k] = n_transient[lane] + sample_every[lane]
+    DUE[k] = n_tr[k] if n_tr[k] > 0 else next_sample[k]
+    n_stat[k] = 0
+    n_ring[k] = 0
+    for j in range(n_g):
+        GP[j, k] = np.nan
+        GMIN[j, k] = np.inf
+        GMAX[j, k] = -np.inf
+    for j in range(n_o):
+        OMAX[j, k] = -np.inf
+        OMIN[j, k] = np.inf
+        OSQ[j, k] = 0.0
+    R[k] = 0.0
+    D[k] = 0.0
+    return 1 if n_tr[k] == 0 else 0  # no transient: it samples from step 0
+
+
 @nb.njit(_nrt=False, **_JIT)
-def _block_run(q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch):
+def _block_run_soa(q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch):
     """The block loop of :func:`_sweep_worker` (its arrays allocated there). Compiled without
     reference counting (``_nrt=False``: it allocates nothing), so that passing the block's
     arrays to the inlined helpers and rotating the event history cost no atomic increments."""
@@ -604,8 +663,6 @@ def _block_run(q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch):
     SE = PH[2]  # the phase at the grid point reached (see _lanes_phase)
     CE = PH[3]
     ns = Y0.shape[1]
-    n_g = GP.shape[0]
-    n_o = O.shape[0]
     nxt = q0  # the next lane of the queue
     n_act = 0  # slots holding a running lane
     n_samp = 0  # of those, past their transient (or at its end): the statistics run
@@ -624,47 +681,13 @@ def _block_run(q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch):
                 nxt += 1
                 loaded = True
                 n_act += 1
-                ACT[k] = True
-                LANE[k] = lane
-                STEP[k] = 0
-                PHASE[k] = 0
-                NPER[k] = lane_nper[lane]
-                OFF[k] = lane_tab[lane]
-                h = H[lane]
-                HB[k] = h
-                T0B[k] = T0[lane]
-                TT[k] = T0[lane]
+                n_samp += _load_slot(k, lane, lanes, cfg, sched, out, blk, slots, GP)
                 PH6[2, k] = S_TAB[OFF[k]]  # the phase at the start (see _lanes_phase)
                 PH6[3, k] = C_TAB[OFF[k]]
                 for q in range(ns):
-                    HW3[0, q, k] = 0.5 * h
-                    HW3[1, q, k] = h
-                    HW3[2, q, k] = h / 6.0
-                    Y[q, k] = Y0[lane, q]
-                for j in range(P.shape[1]):
-                    PT[j, k] = P[lane, j]
-                status[lane] = STATUS_OK
-                unresolved[lane] = 0
-                converged[lane] = 0 if conv_tol > 0.0 else -1
-                for j in range(n_ev):
-                    ncross[lane, j] = 0
-                n_tr[k] = n_transient[lane]
-                n_end[k] = n_transient[lane] + n_samples * sample_every[lane]
-                next_sample[k] = n_transient[lane] + sample_every[lane]
-                DUE[k] = n_tr[k] if n_tr[k] > 0 else next_sample[k]
-                n_samp += 1 if n_tr[k] == 0 else 0  # no transient: it samples from step 0
-                n_stat[k] = 0
-                n_ring[k] = 0
-                for j in range(n_g):
-                    GP[j, k] = np.nan
-                    GMIN[j, k] = np.inf
-                    GMAX[j, k] = -np.inf
-                for j in range(n_o):
-                    OMAX[j, k] = -np.inf
-                    OMIN[j, k] = np.inf
-                    OSQ[j, k] = 0.0
-                R[k] = 0.0
-                D[k] = 0.0
+                    HW3[0, q, k] = 0.5 * H[lane]
+                    HW3[1, q, k] = H[lane]
+                    HW3[2, q, k] = H[lane] / 6.0
             if loaded and n_ev > 0:  # the events at the new lanes' start (G1: scratch here)
                 _events_lanes(TT, Y, G1, PT, P, LANE, nl, ybuf, gb)
                 for k in range(nl):
@@ -822,6 +845,385 @@ def _transient_end(k, lane, Y, ys, R, D, n_ring, n_tr, n_end, next_sample, conv_
             return
     for j in range(n_ev):
         ncross[lane, j] = 0
+
+
+# ---------------------------------------------------------------------------------------------
+# The fused step loop, for a model with lane-scalar functions (``rhs_lane``, ``events_lane``,
+# ``observe_lane``, ``rhs_lane_fast``; see :mod:`geardyn.core.kernel_source`): one loop over the
+# slots does a slot's whole grid step, the four RK4 stages with the model's rhs inlined and the
+# state, stages and coefficients in local variables (registers), the events, the side test, the
+# commit, the clocks and the statistics; nothing but the block's state goes through memory, and
+# LLVM vectorises the loop over slots. Slots whose step was flagged (a side left or a possible
+# graze) or that have bookkeeping due (a period's start, a sample, the end) are finished out of
+# line (:func:`_slot_out`), their statistics there too. The arithmetic of every lane is that of
+# the scalar kernel, operation for operation (no fastmath), so results are bitwise those of the
+# other paths. The tuple helpers below are written out per tuple length when numba types them.
+
+
+def _tuple_source(args, lines, scope=None):
+    """A Python function ``f(args)`` with the body ``lines`` (for the overloads below)."""
+    text = f"def _f({args}):\n" + "".join(f"    {line}\n" for line in lines)
+    env = dict(scope or {})
+    exec(compile(text, "<geardyn-lane-tuples>", "exec"), env)
+    return env["_f"]
+
+
+def _t_load(Y, k):
+    """(Y[0, k], .., Y[LANE_NS - 1, k])."""
+
+
+def _t_store(Y, k, y, keep, cond):
+    """Y[q, k] = y[q] if cond else keep[q]."""
+
+
+def _t_axpy(y, a, x):
+    """y + a x, elementwise."""
+
+
+def _t_comb(y, h6, k1, k2, k3, k4):
+    """The RK4 combination y + h6 (k1 + 2 k2 + 2 k3 + k4), elementwise."""
+
+
+def _t_screen(g1, GS, GP, SIDE, GR, k, locate):
+    """:func:`_lanes_screen` of slot k for the events g1 at the trial step's end; the history
+    shifted in place (GP[:, k] = GS[:, k], GS[:, k] = g1). True when the step is flagged."""
+
+
+def _t_stats(GMIN, GMAX, OMAX, OMIN, OSQ, k, g, o, stat):
+    """The statistics of slot k at a grid point (events g, observables o), where ``stat``."""
+
+
+def _t_side(GS, SIDE, k, g):
+    """A lane's start: the events g into GS[:, k], their sides into SIDE[:, k]."""
+
+
+@nb.njit(**_JIT)
+def _pick(cond, a, b):
+    """a if cond else b, a select (a call, inlined by LLVM: numba's inliner would leave the
+    generated tuple helpers with phi variables it then warns about)."""
+    return a if cond else b
+
+
+@nb.njit(inline="always", **_JIT)
+def _screen_one(g1, s, g0, gp, locate):
+    """One event of :func:`_lanes_screen`: (graze, flagged)."""
+    d2 = g1 - 2.0 * g0 + gp
+    crossed = (1.0 if g1 > 0.0 else -1.0) != s
+    near = not min(abs(g0), abs(g1)) > GRAZE_BOUND * abs(d2)
+    graze = locate & (crossed | (not s * d2 < 0.0)) & near
+    return graze, crossed | graze
+
+
+def _ix(arr, name, row):
+    """Source text of element (row, k) of a block array: ``name[row, k]``, or of its flat view
+    (rows of BLOCK slots: constant offsets, so that LLVM sees rows that cannot overlap)."""
+    return f"{name}[{row}, k]" if arr.ndim == 2 else f"{name}[{row * BLOCK} + k]"
+
+
+def _ov_t_load(Y, k):
+    n = globals()["LANE_NS"]
+    return _tuple_source("Y, k", ["return (" + "".join(f"{_ix(Y, 'Y', q)}, " for q in range(n))
+                                  + ")"])
+
+
+def _ov_t_store(Y, k, y, keep, cond):
+    return _tuple_source("Y, k, y, keep, cond",
+                         [f"{_ix(Y, 'Y', q)} = _pick(cond, y[{q}], keep[{q}])"
+                          for q in range(len(y))] or ["pass"], {"_pick": _pick})
+
+
+def _ov_t_axpy(y, a, x):
+    return _tuple_source("y, a, x",
+                         ["return (" + "".join(f"y[{q}] + a * x[{q}], " for q in range(len(y)))
+                          + ")"])
+
+
+def _ov_t_comb(y, h6, k1, k2, k3, k4):
+    terms = "".join(f"y[{q}] + h6 * (k1[{q}] + 2.0 * k2[{q}] + 2.0 * k3[{q}] + k4[{q}]), "
+                    for q in range(len(y)))
+    return _tuple_source("y, h6, k1, k2, k3, k4", [f"return ({terms})"])
+
+
+def _ov_t_screen(g1, GS, GP, SIDE, GR, k, locate):
+    lines = ["hit = False"]
+    for j in range(len(g1)):
+        gs, gp = _ix(GS, "GS", j), _ix(GP, "GP", j)
+        lines += [f"g0 = {gs}",
+                  f"gr, fl = _screen_one(g1[{j}], {_ix(SIDE, 'SIDE', j)}, g0, {gp}, locate)",
+                  f"{_ix(GR, 'GR', j)} = _pick(gr, 1.0, 0.0)", f"{gp} = g0", f"{gs} = g1[{j}]",
+                  "hit = hit | fl"]
+    return _tuple_source("g1, GS, GP, SIDE, GR, k, locate", [*lines, "return hit"],
+                         {"_screen_one": _screen_one, "_pick": _pick})
+
+
+def _ov_t_stats(GMIN, GMAX, OMAX, OMIN, OSQ, k, g, o, stat):
+    lines = ["pass"]
+    for j in range(len(g)):
+        for name, op in (("GMIN", "min"), ("GMAX", "max")):
+            e = _ix(GMIN, name, j)
+            lines.append(f"{e} = _pick(stat, {op}({e}, g[{j}]), {e})")
+    for j in range(len(o)):
+        lines.append(f"v = o[{j}]")
+        for name, op in (("OMAX", "max"), ("OMIN", "min")):
+            e = _ix(OMAX, name, j)
+            lines.append(f"{e} = _pick(stat, {op}({e}, v), {e})")
+        e = _ix(OSQ, "OSQ", j)
+        lines.append(f"{e} = _pick(stat, {e} + v * v, {e})")
+    return _tuple_source("GMIN, GMAX, OMAX, OMIN, OSQ, k, g, o, stat", lines, {"_pick": _pick})
+
+
+def _ov_t_side(GS, SIDE, k, g):
+    lines = ["pass"]
+    for j in range(len(g)):
+        lines += [f"{_ix(GS, 'GS', j)} = g[{j}]",
+                  f"{_ix(SIDE, 'SIDE', j)} = _pick(g[{j}] > 0.0, 1.0, -1.0)"]
+    return _tuple_source("GS, SIDE, k, g", lines, {"_pick": _pick})
+
+
+if "rhs_lane" in globals():  # the model's lane-scalar functions (see .kernels)
+    FUSED = True
+    _rhs_l = rhs_lane  # noqa: F821
+    _events_l = events_lane  # noqa: F821
+    _observe_l = observe_lane  # noqa: F821
+    _lane_fast = rhs_lane_fast  # noqa: F821
+    #: The state size of the model's lane-scalar functions (``<rhs>_lane_states``).
+    LANE_NS = int(_rhs_l.py_func.__globals__[_rhs_l.py_func.__name__ + "_states"])
+    for _stub, _impl in ((_t_load, _ov_t_load), (_t_store, _ov_t_store), (_t_axpy, _ov_t_axpy),
+                         (_t_comb, _ov_t_comb), (_t_screen, _ov_t_screen),
+                         (_t_stats, _ov_t_stats), (_t_side, _ov_t_side)):
+        nb.extending.overload(_stub, inline="always")(_impl)
+else:
+    FUSED = False
+
+
+@nb.njit(inline="always", **_JIT)
+def _flat(arrays):
+    """Flat views of a tuple of five block arrays (rows of BLOCK slots)."""
+    a, b, c, d, e = arrays
+    return (a.reshape(a.size), b.reshape(b.size), c.reshape(c.size), d.reshape(d.size),
+            e.reshape(e.size))
+
+
+@nb.njit(inline="always", **_JIT)
+def _fused_steps(fast, nl, locate, Y, Y1, PT, SE, CE, H6, FLAG, G, ST, slots, S_TAB, C_TAB,
+                 PH):
+    """One grid step of every slot, fused (see above), on flat views of the block arrays (rows
+    of BLOCK slots, see :func:`_flat`): the trial into Y1, committed into Y
+    where the slot is active and unflagged; the events' history shifted (GP = g_i, GS =
+    g_{i+1}), graze flags into GR; the slots'
+    clocks advanced, SE, CE the phase at the grid point reached; the statistics of the slots
+    that sample and need nothing out of line. FLAG[k] = 1 where slot k's step is flagged,
+    MSK[k] where it is flagged or has bookkeeping due (see :func:`_slot_out`). ``fast``: a
+    constant, the model's fast form (every active lane qualifies). G: the events (GS, GP, GR,
+    SIDE), ST: the statistics (GMIN, GMAX, OMAX, OMIN, OSQ), PH: scratch rows for the
+    phases at the step's middle and end. Returns (flagged, marked)."""
+    GS, GP, GR, SIDE = G
+    GMIN, GMAX, OMAX, OMIN, OSQ = ST
+    (STAT, MSK, ACT, END, LANE, STEP, PHASE, NPER, OFF, HB, T0B, n_end, n_tr, next_sample, DUE,
+     n_stat, n_ring) = slots
+    SB, CB, SN, CN = PH
+    for k in range(nl):  # the phase gathers (scalar), apart: the fused loop reads rows
+        j1 = np.uint64(OFF[k] + 2 * PHASE[k] + 1)  # unsigned: no wraparound test
+        j2 = np.uint64(OFF[k] + 2 * PHASE[k] + 2)
+        SB[k] = S_TAB[j1]
+        CB[k] = C_TAB[j1]
+        SN[k] = S_TAB[j2]
+        CN[k] = C_TAB[j2]
+    n_flag = 0
+    n_out = 0
+    for k in range(nl):
+        h = HB[k]
+        st = STEP[k]
+        ph = PHASE[k]
+        t0b = T0B[k]
+        sb = SB[k]
+        cb = CB[k]
+        se = SN[k]
+        ce = CN[k]
+        y = _t_load(Y, k)
+        hh = 0.5 * h
+        k1 = _rhs_l(t0b + st * h, y, PT, k, SE[k], CE[k], fast)
+        tb = t0b + st * h + 0.5 * h
+        k2 = _rhs_l(tb, _t_axpy(y, hh, k1), PT, k, sb, cb, fast)
+        k3 = _rhs_l(tb, _t_axpy(y, hh, k2), PT, k, sb, cb, fast)
+        te = t0b + (st + 1) * h
+        k4 = _rhs_l(te, _t_axpy(y, h, k3), PT, k, se, ce, fast)
+        y1 = _t_comb(y, H6[k], k1, k2, k3, k4)
+        g1 = _events_l(te, y1, PT, k)
+        hit = _t_screen(g1, GS, GP, SIDE, GR, k, locate)
+        act = ACT[k]
+        flagged = act & hit
+        _t_store(Y1, k, y1, y1, True)
+        _t_store(Y, k, y1, y, act & (not hit))
+        SE[k] = se
+        CE[k] = ce
+        st1 = st + 1
+        ph1 = ph + 1
+        ph1 = 0 if ph1 == NPER[k] else ph1
+        STEP[k] = st1
+        PHASE[k] = ph1
+        due = act & ((ph1 == 0) | (st1 >= DUE[k]))
+        stat = act & (st1 > n_tr[k]) & (not hit) & (not due)
+        o = _observe_l(te, y1, PT, k, se, ce, fast)
+        _t_stats(GMIN, GMAX, OMAX, OMIN, OSQ, k, g1, o, stat)
+        n_stat[k] += 1 if stat else 0
+        FLAG[k] = 1.0 if flagged else 0.0
+        mark = flagged | due
+        MSK[k] = mark
+        n_flag += 1 if flagged else 0
+        n_out += 1 if mark else 0
+    return n_flag, n_out
+
+
+_slot_check_i = nb.njit(inline="always", **_JIT)(_slot_check.py_func)
+_slot_sample_i = nb.njit(inline="always", **_JIT)(_slot_sample.py_func)
+
+
+@nb.njit(_nrt=False, **_JIT)
+def _slots_out(nl, G1, SE, CE, lanes, cfg, out, blk, slots, scratch):
+    """:func:`_slot_out` for every marked slot (MSK), in one call per block step (a call
+    passes every block array by value: one per slot cost a fifth of the run). Returns the
+    number of lanes that ended."""
+    MSK = slots[1]
+    gone = 0
+    for k in range(nl):
+        if MSK[k] and _slot_out(k, G1, SE, CE, lanes, cfg, out, blk, slots, scratch):
+            gone += 1
+    return gone
+
+
+@nb.njit(inline="always", **_JIT)
+def _slot_out(k, G1, SE, CE, lanes, cfg, out, blk, slots, scratch):
+    """Slot k's step out of line (marked by :func:`_fused_steps`): a flagged step finished on
+    the scalar path (:func:`_finish_flagged`), the bookkeeping of a period's start
+    (:func:`_slot_check`), the statistics at the grid point reached, the sample and the end
+    (:func:`_slot_sample`), in the order of the other paths. G1: the events at the grid point
+    reached (the block's GS, see :func:`_fused_steps`). Returns True when the lane has ended."""
+    P, Y0, H, OMEGA, T0, n_transient, n_transient_max, sample_every = lanes
+    locate = cfg[3]
+    (samples, final, status, gmin, gmax, ncross, omax, omin, orms, unresolved, transient_steps,
+     converged) = out
+    (R, D, Y, Y1, K1, K2, K3, K4, TMP, PT, SC, PH6, PH, TT, GP, GS, _, GR, SIDE, FLAG,
+     GMIN, GMAX, O, OMAX, OMIN, OSQ, HW3, FL, HW) = blk
+    (STAT, MSK, ACT, END, LANE, STEP, PHASE, NPER, OFF, HB, T0B, n_end, n_tr, next_sample, DUE,
+     n_stat, n_ring) = slots
+    ys, y1s, dbuf, sides, g1s, gb, ob, work, ybuf, gbuf = scratch
+    if FLAG[k] != 0.0:
+        _finish_flagged(k, STEP[k] - 1, NPER, Y, Y1, G1, GR, SIDE, P, LANE, HB, T0B, OMEGA,
+                        locate, ncross, unresolved, ys, y1s, sides, g1s, work, ybuf, gbuf)
+    step = STEP[k]
+    if PHASE[k] == 0 or step >= DUE[k]:
+        gone, _ = _slot_check_i(k, Y, R, D, ys, LANE, STEP, PHASE, n_end, n_tr, next_sample, DUE,
+                              n_ring, ACT, END, GMIN, GMAX, OMAX, OMIN, OSQ, n_stat, lanes, cfg,
+                              out)
+        if gone:
+            return True
+    if step <= n_tr[k]:
+        return False
+    n_stat[k] += 1
+    for j in range(G1.shape[0]):
+        g = G1[j, k]
+        GMIN[j, k] = min(GMIN[j, k], g)
+        GMAX[j, k] = max(GMAX[j, k], g)
+    o = _observe_l(T0B[k] + step * HB[k], _t_load(Y, k), PT, k, SE[k], CE[k], False)
+    _t_stats(GMIN, GMAX, OMAX, OMIN, OSQ, k, (), o, True)
+    if step < DUE[k]:
+        return False
+    return _slot_sample_i(k, Y, LANE, STEP, n_end, n_tr, next_sample, DUE, ACT, END, GMIN, GMAX,
+                        OMAX, OMIN, OSQ, n_stat, lanes, cfg, out)
+
+
+@nb.njit(inline="always", **_JIT)
+def _fused_run(fast, q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch):
+    """:func:`_block_run_soa` with the fused step loop (a model with lane-scalar functions),
+    every lane of the worker's queue taking the model's fast form or none (``fast``, a
+    constant: one copy of the loop per compiled function, see :func:`_block_run_fused`)."""
+    locate = cfg[3]
+    start, queue, lane_nper, lane_tab, S_TAB, C_TAB = sched
+    (R, D, Y, Y1, K1, K2, K3, K4, TMP, PT, SC, PH6, PH, TT, GP, GS, G1, GR, SIDE, FLAG,
+     GMIN, GMAX, O, OMAX, OMIN, OSQ, HW3, FL, HW) = blk
+    (STAT, MSK, ACT, END, LANE, STEP, PHASE, NPER, OFF, HB, T0B, n_end, n_tr, next_sample, DUE,
+     n_stat, n_ring) = slots
+    SE = PH[2]  # the phase at the grid point reached
+    CE = PH[3]
+    H6 = HW[2]  # h / 6 of slot k at [k] (row q = 0 of HW3[2])
+    phx = (PH[0], PH[1], SC[0], SC[1])  # sin, cos at the step's middle; at its end (scratch)
+    stats = _flat((GMIN, GMAX, OMAX, OMIN, OSQ))
+    Yf, Y1f = _flat((Y, Y1, Y, Y, Y))[:2]
+    GSf, GPf, GRf, SIDEf, _ = _flat((GS, GP, GR, SIDE, GR))
+    nxt = q0  # the next lane of the queue
+    n_act = 0  # slots holding a running lane
+    ended = True
+    while True:
+        if ended:  # (re)fill the ended slots from the queue: a lane starts at its grid step 0
+            ended = False
+            for k in range(nl):
+                if not END[k]:
+                    continue
+                END[k] = False
+                if nxt >= q1:
+                    continue
+                lane = queue[nxt]
+                nxt += 1
+                n_act += 1
+                _load_slot(k, lane, lanes, cfg, sched, out, blk, slots, GP)
+                SE[k] = S_TAB[OFF[k]]  # the phase at the start
+                CE[k] = C_TAB[OFF[k]]
+                H6[k] = HB[k] / 6.0
+                _t_side(GS, SIDE, k, _events_l(TT[k], _t_load(Y, k), PT, k))
+        if n_act == 0:
+            break
+        n_flag, n_out = _fused_steps(fast, nl, locate, Yf, Y1f, PT, SE, CE, H6, FLAG,
+                                     (GSf, GPf, GRf, SIDEf), stats, slots, S_TAB, C_TAB, phx)
+        if n_out > 0:
+            gone = _slots_out(nl, GS, SE, CE, lanes, cfg, out, blk, slots, scratch)
+            if gone > 0:
+                ended = True
+                n_act -= gone
+
+
+class _NoAliasCompiler(nb.core.compiler.Compiler):
+    """numba's pipeline with the function's array arguments declared ``noalias`` (LLVM), so
+    that the fused loop needs no runtime overlap checks of its ~30 block arrays (there are too
+    many: LLVM would not vectorise it). The caller guarantees it: no two array arguments of
+    :func:`_block_run_fast` (or ``_general``) that it touches share memory (``blk``'s views ``PH``,
+    ``HW`` and ``FL`` of ``PH6``, ``HW3`` and the state arrays are used there, not those)."""
+
+    def define_pipelines(self):
+        self.state.flags.noalias = True
+        return super().define_pipelines()
+
+
+@nb.njit(_nrt=False, pipeline_class=_NoAliasCompiler, **_JIT)
+def _block_run_fast(q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch):
+    """:func:`_fused_run` with the model's fast form (compiled on its own: a second copy of the
+    loop in the same function, or a branch around it, stops LLVM's alias analysis)."""
+    _fused_run(True, q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch)
+
+
+@nb.njit(_nrt=False, pipeline_class=_NoAliasCompiler, **_JIT)
+def _block_run_general(q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch):
+    """:func:`_fused_run` with the model's general form (scalar)."""
+    _fused_run(False, q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch)
+
+
+@nb.njit(_nrt=False, **_JIT)
+def _block_run_fused(q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch):
+    """The fused block loop of the worker's queue (see :func:`_fused_run`): the fast form when
+    every lane of the queue takes it (``rhs_lane_fast``), else the general one."""
+    P = lanes[0]
+    queue = sched[1]
+    PTq = P.T  # coefficient rows, lane innermost (as rhs_lane_fast reads them)
+    fast = True
+    for i in range(q0, q1):
+        fast = fast & _lane_fast(PTq, queue[i])
+    if fast:
+        _block_run_fast(q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch)
+    else:
+        _block_run_general(q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch)
+
+
+_block_run = _block_run_fused if FUSED else _block_run_soa
 
 
 @nb.njit(parallel=True, **_JIT)
