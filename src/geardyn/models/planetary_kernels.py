@@ -7,14 +7,25 @@ generalised coordinates over the length scale L and ' = d/dtau, tau = omega_0 t:
     f_m = KF_m k_m(Omega tau) g(W_m . X - e_m, b_m) + CF_m (W_m . X' - e_m')
 
 Kt, Ct: the linear (bearing, support) stiffness and the modal damping matrices premultiplied by
-M^-1 (dense); per mesh m: W_m the deflection row, G_m = M^-1 W_m / (L omega_0^2) [1/N], KF_m and
-CF_m [N] the force per unit deflection and deflection rate, k_m the relative stiffness (Fourier
-series in the mesh phase), e_m = ES_m sin(Omega tau) + EC_m cos(Omega tau) the transmission error.
-f_m is the dynamic mesh force [N], the observable.
+M^-1; per mesh m: W_m the deflection row, G_m = M^-1 W_m / (L omega_0^2) [1/N], KF_m and CF_m [N]
+the force per unit deflection and deflection rate, k_m the relative stiffness (Fourier series in
+the mesh phase), e_m = ES_m sin(Omega tau) + EC_m cos(Omega tau) the transmission error. f_m is
+the dynamic mesh force [N], the observable.
 
 Coefficient vector: a header (``DAMPED`` is 1 where Ct is not zero), the dof vectors F0, F1,
-the matrices Kt, Ct (row-major), then one block per mesh (fixed entries, 2 nh Fourier
-coefficients, W, G).
+the matrices Kt, Ct (row-major), one block per mesh (fixed entries, 2 nh Fourier coefficients,
+W, G), then the *structure* the kernels read (:func:`fill_structure`, derived from the dense
+parts): the count nk of the structural entries of Kt, their rows, columns and values, and per
+mesh ``MESH_NZ`` dof indices with the W and G values there (a mesh row touches at most six
+coordinates: the sun or ring and the planet, three each). So a right-hand side costs
+O(nk + n_mesh (MESH_NZ + n_harm)) instead of O(n^2 + n_mesh n): the dense Kt product and the
+dense mesh rows are the same sums without their structural zeros, term for term in the same order
+(results equal the dense evaluation's). Ct (modal damping) stays dense.
+
+The ``*_lanes`` forms evaluate the same arithmetic, operation for operation, on a block of lanes
+in structure-of-arrays layout (state Y[q, k], coefficients PT[j, k], the forcing phase S[k],
+C[k]; SC: >= 8 scratch rows) for the sweep kernel; the structure (indices) is the same in every
+lane of a sweep (it depends only on inputs that are not swept).
 """
 
 from __future__ import annotations
@@ -22,6 +33,7 @@ from __future__ import annotations
 import math
 
 import numba as nb
+import numpy as np
 
 # header
 OMEGA, N_DOF, N_MESH, N_HARM, TORQUE_ON, TORQUE_ORDER, TORQUE_PHASE, DAMPED = range(8)
@@ -29,20 +41,83 @@ HEADER = 8
 # mesh block fixed entries
 M_B, M_ES, M_EC, M_KF, M_CF = range(5)
 MESH_FIXED = 5
+#: Structural entries per mesh row in the structure section (padded with zero weights).
+MESH_NZ = 6
+#: Meshes whose relative stiffness the lane-block rhs holds at once (scratch rows 0..5; rows 6,
+#: 7 carry the harmonic recurrence).
+_CHUNK = 6
 
 _JIT = {"cache": True, "error_model": "numpy", "boundscheck": False}
 
 
-def layout(n: int, n_mesh: int, nh: int) -> dict[str, int]:
-    """Offsets of the parts of the coefficient vector for n dofs, n_mesh meshes, nh harmonics."""
+def layout(n: int, n_mesh: int, nh: int, nk: int = 0) -> dict[str, int]:
+    """Offsets of the parts of the coefficient vector for n dofs, n_mesh meshes, nh harmonics
+    and nk structural entries of Kt."""
     f0 = HEADER
     f1 = f0 + n
     kt = f1 + n
     ct = kt + n * n
     mesh = ct + n * n
     bs = MESH_FIXED + 2 * nh + 2 * n
+    st = mesh + n_mesh * bs
+    mz = st + 1 + 3 * nk
     return {"F0": f0, "F1": f1, "Kt": kt, "Ct": ct, "mesh": mesh, "block": bs,
-            "size": mesh + n_mesh * bs}
+            "structure": st, "mesh_nz": mz, "size": mz + n_mesh * 3 * MESH_NZ}
+
+
+def structure_names(dofs: tuple[str, ...], mesh_names: tuple[str, ...],
+                    kt_entries: list[tuple[int, int]]) -> list[str]:
+    """Names of the structure section's entries (derived coefficients, see the module doc)."""
+    nk = len(kt_entries)
+    out = ["nk"] + [f"Kt_row{e}" for e in range(nk)] + [f"Kt_col{e}" for e in range(nk)]
+    out += [f"Kt_nz_{dofs[i]}_{dofs[j]}" for i, j in kt_entries]
+    for m in mesh_names:
+        out += [f"{m}_nz_index{j}" for j in range(MESH_NZ)]
+        out += [f"{m}_nz_W{j}" for j in range(MESH_NZ)] + [f"{m}_nz_G{j}" for j in range(MESH_NZ)]
+    return out
+
+
+def fill_structure(P: np.ndarray, kt_entries: list[tuple[int, int]],
+                   mesh_dofs: list[list[int]]) -> None:
+    """Write the structure section of every row of ``P`` (lanes x size, in place) from its dense
+    parts: the Kt entries ``kt_entries`` (row-major order) and per mesh the dofs ``mesh_dofs[m]``
+    (ascending, at most ``MESH_NZ``). A dense Kt, W or G entry outside the structure that is not
+    zero (e.g. a raw coefficient override) is a ``ValueError``."""
+    P = np.atleast_2d(P)
+    n, nm, nh = int(P[0, N_DOF]), int(P[0, N_MESH]), int(P[0, N_HARM])
+    nk = len(kt_entries)
+    lay = layout(n, nm, nh, nk)
+    st = lay["structure"]
+    K = P[:, lay["Kt"]:lay["Kt"] + n * n].reshape(-1, n, n)
+    inside = np.zeros((n, n), bool)
+    for i, j in kt_entries:
+        inside[i, j] = True
+    if np.any(K[:, ~inside] != 0.0):
+        raise ValueError("a Kt entry outside the gear set's structure is not zero; the kernel "
+                         "reads only the structural entries")
+    P[:, st] = nk
+    P[:, st + 1:st + 1 + nk] = [i for i, _ in kt_entries]
+    P[:, st + 1 + nk:st + 1 + 2 * nk] = [j for _, j in kt_entries]
+    P[:, st + 1 + 2 * nk:st + 1 + 3 * nk] = K[:, [i for i, _ in kt_entries],
+                                              [j for _, j in kt_entries]]
+    f = MESH_FIXED + 2 * nh
+    for m, dofs in enumerate(mesh_dofs):
+        if len(dofs) > MESH_NZ or list(dofs) != sorted(set(dofs)):
+            raise ValueError(f"mesh {m}: at most {MESH_NZ} ascending dofs (got {dofs})")
+        o = lay["mesh"] + m * lay["block"]
+        W = P[:, o + f:o + f + n]
+        G = P[:, o + f + n:o + f + 2 * n]
+        out = np.ones(n, bool)
+        out[list(dofs)] = False
+        if np.any(W[:, out] != 0.0) or np.any(G[:, out] != 0.0):
+            raise ValueError(f"mesh {m}: a W or G entry outside the gear set's structure is "
+                             "not zero; the kernel reads only the structural entries")
+        q = lay["mesh_nz"] + m * 3 * MESH_NZ
+        k = len(dofs)
+        P[:, q:q + 3 * MESH_NZ] = 0.0  # padding: index 0, zero weights
+        P[:, q:q + k] = dofs
+        P[:, q + MESH_NZ:q + MESH_NZ + k] = W[:, list(dofs)]
+        P[:, q + 2 * MESH_NZ:q + 2 * MESH_NZ + k] = G[:, list(dofs)]
 
 
 @nb.njit(inline="always", **_JIT)
@@ -65,14 +140,29 @@ def _relative_stiffness(p, f, nh, s, c):
 
 
 @nb.njit(inline="always", **_JIT)
-def _mesh_state(y, p, o, n, nh, s, c):
-    """Deflection minus error and its rate (W . X - e, W . X' - e') of the mesh block at o."""
-    w = o + MESH_FIXED + 2 * nh
+def _offsets(p):
+    """n, n_mesh, nh, the mesh blocks' offset and size, the structure's and its mesh part's."""
+    n = int(p[N_DOF])
+    nm = int(p[N_MESH])
+    nh = int(p[N_HARM])
+    mesh = HEADER + 2 * n + 2 * n * n
+    bs = MESH_FIXED + 2 * nh + 2 * n
+    st = mesh + nm * bs
+    mz = st + 1 + 3 * int(p[st])
+    return n, nm, nh, mesh, bs, st, mz
+
+
+@nb.njit(inline="always", **_JIT)
+def _mesh_state(y, p, o, q, n, s, c):
+    """Deflection minus error and its rate (W . X - e, W . X' - e') of the mesh block at o, its
+    structure at q."""
     d = 0.0
     v = 0.0
-    for j in range(n):
-        d += p[w + j] * y[j]
-        v += p[w + j] * y[n + j]
+    for j in range(MESH_NZ):
+        i = int(p[q + j])
+        w = p[q + MESH_NZ + j]
+        d += w * y[i]
+        v += w * y[n + i]
     om = p[OMEGA]
     d -= p[o + M_ES] * s + p[o + M_EC] * c
     v -= om * (p[o + M_ES] * c - p[o + M_EC] * s)
@@ -80,8 +170,8 @@ def _mesh_state(y, p, o, n, nh, s, c):
 
 
 @nb.njit(inline="always", **_JIT)
-def _mesh_force(y, p, o, n, nh, s, c):
-    d, v = _mesh_state(y, p, o, n, nh, s, c)
+def _mesh_force(y, p, o, q, n, nh, s, c):
+    d, v = _mesh_state(y, p, o, q, n, s, c)
     k = _relative_stiffness(p, o + MESH_FIXED, nh, s, c)
     return p[o + M_KF] * k * _dead_zone(d, p[o + M_B]) + p[o + M_CF] * v
 
@@ -89,46 +179,37 @@ def _mesh_force(y, p, o, n, nh, s, c):
 @nb.njit(**_JIT)
 def planetary_rhs(t, y, dy, p, s, c):
     """dy/dt of the planetary gear set (dimensionless)."""
-    n = int(p[N_DOF])
-    nm = int(p[N_MESH])
-    nh = int(p[N_HARM])
-    f0 = HEADER
-    f1 = f0 + n
-    kt = f1 + n
-    ct = kt + n * n
-    mesh = ct + n * n
-    bs = MESH_FIXED + 2 * nh + 2 * n
+    n, nm, nh, mesh, bs, st, mz = _offsets(p)
     fl = 0.0
     if p[TORQUE_ON] != 0.0:
         fl = math.sin(p[TORQUE_ORDER] * p[OMEGA] * t + p[TORQUE_PHASE])
-    damped = p[DAMPED] != 0.0  # modal damping: the Ct product (skipped when Ct = 0)
+    f1 = HEADER + n
     for i in range(n):
-        acc = p[f0 + i] + p[f1 + i] * fl
-        r = kt + i * n
-        for j in range(n):
-            acc -= p[r + j] * y[j]
-        if damped:
-            q = ct + i * n
-            for j in range(n):
-                acc -= p[q + j] * y[n + j]
         dy[i] = y[n + i]
-        dy[n + i] = acc
+        dy[n + i] = p[HEADER + i] + p[f1 + i] * fl
+    nk = int(p[st])
+    for e in range(nk):
+        dy[n + int(p[st + 1 + e])] -= p[st + 1 + 2 * nk + e] * y[int(p[st + 1 + nk + e])]
+    if p[DAMPED] != 0.0:  # modal damping: the dense Ct product (skipped when Ct = 0)
+        ct = HEADER + 2 * n + n * n
+        for i in range(n):
+            acc = dy[n + i]
+            r = ct + i * n
+            for j in range(n):
+                acc -= p[r + j] * y[n + j]
+            dy[n + i] = acc
     for m in range(nm):
         o = mesh + m * bs
-        f = _mesh_force(y, p, o, n, nh, s, c)
-        g = o + MESH_FIXED + 2 * nh + n
-        for j in range(n):
-            dy[n + j] -= f * p[g + j]
+        q = mz + m * 3 * MESH_NZ
+        f = _mesh_force(y, p, o, q, n, nh, s, c)
+        for j in range(MESH_NZ):
+            dy[n + int(p[q + j])] -= f * p[q + 2 * MESH_NZ + j]
 
 
 @nb.njit(**_JIT)
 def planetary_events(t, y, g, p):
     """Dead-zone edges: x_m - b_m and x_m + b_m of every mesh (x_m = W_m . X - e_m)."""
-    n = int(p[N_DOF])
-    nm = int(p[N_MESH])
-    nh = int(p[N_HARM])
-    mesh = HEADER + 2 * n + 2 * n * n
-    bs = MESH_FIXED + 2 * nh + 2 * n
+    n, nm, nh, mesh, bs, st, mz = _offsets(p)
     s = 0.0
     c = 1.0
     errors = False
@@ -140,7 +221,7 @@ def planetary_events(t, y, g, p):
         c = math.cos(p[OMEGA] * t)
     for m in range(nm):
         o = mesh + m * bs
-        d, _ = _mesh_state(y, p, o, n, nh, s, c)
+        d, _ = _mesh_state(y, p, o, mz + m * 3 * MESH_NZ, n, s, c)
         g[2 * m] = d - p[o + M_B]
         g[2 * m + 1] = d + p[o + M_B]
 
@@ -148,10 +229,203 @@ def planetary_events(t, y, g, p):
 @nb.njit(**_JIT)
 def planetary_observe(t, y, out, p, s, c):
     """Dynamic mesh forces [N], one per mesh (sun-planet meshes, then ring-planet meshes)."""
-    n = int(p[N_DOF])
-    nm = int(p[N_MESH])
-    nh = int(p[N_HARM])
+    n, nm, nh, mesh, bs, st, mz = _offsets(p)
+    for m in range(nm):
+        out[m] = _mesh_force(y, p, mesh + m * bs, mz + m * 3 * MESH_NZ, n, nh, s, c)
+
+
+# ---------------------------------------------------------------------------------------------
+# Lane-block forms (structure of arrays, lane k innermost): the arithmetic of the functions
+# above, operation for operation, so a lane's result is bitwise the per-lane one's.
+
+
+@nb.njit(inline="always", **_JIT)
+def _lanes_offsets(PT):
+    n = int(PT[N_DOF, 0])
+    nm = int(PT[N_MESH, 0])
+    nh = int(PT[N_HARM, 0])
     mesh = HEADER + 2 * n + 2 * n * n
     bs = MESH_FIXED + 2 * nh + 2 * n
+    st = mesh + nm * bs
+    mz = st + 1 + 3 * int(PT[st, 0])
+    return n, nm, nh, mesh, bs, st, mz
+
+
+@nb.njit(inline="always", **_JIT)
+def _lanes_stiffness(PT, nl, S, C, SC, mesh, bs, nh, m0, m1):
+    """:func:`_relative_stiffness` of meshes m0..m1-1 (at most ``_CHUNK``) into SC rows 0.., the
+    harmonic recurrence in rows 6, 7."""
+    if nh == 0:
+        for m in range(m0, m1):
+            for k in range(nl):
+                SC[m - m0, k] = 1.0
+        return
+    for m in range(m0, m1):
+        f = mesh + m * bs + MESH_FIXED
+        for k in range(nl):
+            SC[m - m0, k] = PT[f, k] * C[k] + PT[f + 1, k] * S[k]
+    for k in range(nl):
+        SC[6, k] = C[k]
+        SC[7, k] = S[k]
+    for h in range(1, nh):
+        for k in range(nl):
+            ch = SC[6, k]
+            sh = SC[7, k]
+            SC[6, k] = ch * C[k] - sh * S[k]
+            SC[7, k] = sh * C[k] + ch * S[k]
+        for m in range(m0, m1):
+            f = mesh + m * bs + MESH_FIXED + 2 * h
+            for k in range(nl):
+                SC[m - m0, k] += PT[f, k] * SC[6, k] + PT[f + 1, k] * SC[7, k]
+    for m in range(m0, m1):
+        for k in range(nl):
+            SC[m - m0, k] = 1.0 + SC[m - m0, k]
+
+
+@nb.njit(**_JIT)
+def planetary_rhs_lanes(T, Y, DY, PT, nl, S, C, SC):
+    """:func:`planetary_rhs` for lanes 0..nl-1 of a block."""
+    n, nm, nh, mesh, bs, st, mz = _lanes_offsets(PT)
+    torque = False
+    damped = False
+    for k in range(nl):
+        torque |= PT[TORQUE_ON, k] != 0.0
+        damped |= PT[DAMPED, k] != 0.0
+    for k in range(nl):
+        SC[0, k] = 0.0
+    if torque:
+        for k in range(nl):
+            if PT[TORQUE_ON, k] != 0.0:
+                SC[0, k] = math.sin(PT[TORQUE_ORDER, k] * PT[OMEGA, k] * T[k]
+                                    + PT[TORQUE_PHASE, k])
+    f1 = HEADER + n
+    for i in range(n):
+        for k in range(nl):
+            DY[i, k] = Y[n + i, k]
+            DY[n + i, k] = PT[HEADER + i, k] + PT[f1 + i, k] * SC[0, k]
+    nk = int(PT[st, 0])
+    for e in range(nk):
+        i = n + int(PT[st + 1 + e, 0])
+        j = int(PT[st + 1 + nk + e, 0])
+        r = st + 1 + 2 * nk + e
+        for k in range(nl):
+            DY[i, k] -= PT[r, k] * Y[j, k]
+    if damped:  # Ct = 0 in an undamped lane: its terms subtract zeros
+        ct = HEADER + 2 * n + n * n
+        for i in range(n):
+            for j in range(n):
+                r = ct + i * n + j
+                for k in range(nl):
+                    DY[n + i, k] -= PT[r, k] * Y[n + j, k]
+    for m0 in range(0, nm, _CHUNK):
+        m1 = min(m0 + _CHUNK, nm)
+        _lanes_stiffness(PT, nl, S, C, SC, mesh, bs, nh, m0, m1)
+        for m in range(m0, m1):
+            _lanes_mesh(Y, DY, PT, nl, S, C, SC, n, mesh + m * bs, mz + m * 3 * MESH_NZ, m - m0,
+                        True)
+
+
+@nb.njit(inline="always", **_JIT)
+def _lanes_mesh(Y, DY, PT, nl, S, C, SC, n, o, q, row, apply):
+    """Mesh force of the block at o (structure at q, relative stiffness in SC[row]) for every
+    lane: subtracted from the accelerations DY (``apply``) or written to DY[0] (observables)."""
+    i0 = int(PT[q, 0])
+    i1 = int(PT[q + 1, 0])
+    i2 = int(PT[q + 2, 0])
+    i3 = int(PT[q + 3, 0])
+    i4 = int(PT[q + 4, 0])
+    i5 = int(PT[q + 5, 0])
+    w = q + MESH_NZ
+    g = q + 2 * MESH_NZ
+    for k in range(nl):
+        d = 0.0
+        v = 0.0
+        d += PT[w, k] * Y[i0, k]
+        v += PT[w, k] * Y[n + i0, k]
+        d += PT[w + 1, k] * Y[i1, k]
+        v += PT[w + 1, k] * Y[n + i1, k]
+        d += PT[w + 2, k] * Y[i2, k]
+        v += PT[w + 2, k] * Y[n + i2, k]
+        d += PT[w + 3, k] * Y[i3, k]
+        v += PT[w + 3, k] * Y[n + i3, k]
+        d += PT[w + 4, k] * Y[i4, k]
+        v += PT[w + 4, k] * Y[n + i4, k]
+        d += PT[w + 5, k] * Y[i5, k]
+        v += PT[w + 5, k] * Y[n + i5, k]
+        d -= PT[o + M_ES, k] * S[k] + PT[o + M_EC, k] * C[k]
+        v -= PT[OMEGA, k] * (PT[o + M_ES, k] * C[k] - PT[o + M_EC, k] * S[k])
+        f = PT[o + M_KF, k] * SC[row, k] * _dead_zone(d, PT[o + M_B, k]) + PT[o + M_CF, k] * v
+        if apply:
+            DY[n + i0, k] -= f * PT[g, k]
+            DY[n + i1, k] -= f * PT[g + 1, k]
+            DY[n + i2, k] -= f * PT[g + 2, k]
+            DY[n + i3, k] -= f * PT[g + 3, k]
+            DY[n + i4, k] -= f * PT[g + 4, k]
+            DY[n + i5, k] -= f * PT[g + 5, k]
+        else:
+            DY[0, k] = f
+
+
+@nb.njit(**_JIT)
+def planetary_events_lanes(T, Y, G, PT, nl):
+    """:func:`planetary_events` for lanes 0..nl-1 of a block."""
+    n, nm, nh, mesh, bs, st, mz = _lanes_offsets(PT)
+    errors = False
+    for k in range(nl):
+        for m in range(nm):
+            o = mesh + m * bs
+            errors |= (PT[o + M_ES, k] != 0.0) | (PT[o + M_EC, k] != 0.0)
+    if errors:  # the forcing phase per lane, as the per-lane function (one lane at a time)
+        for k in range(nl):
+            lane_err = False
+            for m in range(nm):
+                o = mesh + m * bs
+                lane_err |= (PT[o + M_ES, k] != 0.0) | (PT[o + M_EC, k] != 0.0)
+            s = 0.0
+            c = 1.0
+            if lane_err:
+                s = math.sin(PT[OMEGA, k] * T[k])
+                c = math.cos(PT[OMEGA, k] * T[k])
+            for m in range(nm):
+                o = mesh + m * bs
+                q = mz + m * 3 * MESH_NZ
+                d = 0.0
+                for j in range(MESH_NZ):
+                    d += PT[q + MESH_NZ + j, k] * Y[int(PT[q + j, 0]), k]
+                d -= PT[o + M_ES, k] * s + PT[o + M_EC, k] * c
+                G[2 * m, k] = d - PT[o + M_B, k]
+                G[2 * m + 1, k] = d + PT[o + M_B, k]
+        return
     for m in range(nm):
-        out[m] = _mesh_force(y, p, mesh + m * bs, n, nh, s, c)
+        o = mesh + m * bs
+        q = mz + m * 3 * MESH_NZ
+        w = q + MESH_NZ
+        i0 = int(PT[q, 0])
+        i1 = int(PT[q + 1, 0])
+        i2 = int(PT[q + 2, 0])
+        i3 = int(PT[q + 3, 0])
+        i4 = int(PT[q + 4, 0])
+        i5 = int(PT[q + 5, 0])
+        for k in range(nl):
+            d = 0.0
+            d += PT[w, k] * Y[i0, k]
+            d += PT[w + 1, k] * Y[i1, k]
+            d += PT[w + 2, k] * Y[i2, k]
+            d += PT[w + 3, k] * Y[i3, k]
+            d += PT[w + 4, k] * Y[i4, k]
+            d += PT[w + 5, k] * Y[i5, k]
+            d -= PT[o + M_ES, k] * 0.0 + PT[o + M_EC, k] * 1.0
+            G[2 * m, k] = d - PT[o + M_B, k]
+            G[2 * m + 1, k] = d + PT[o + M_B, k]
+
+
+@nb.njit(**_JIT)
+def planetary_observe_lanes(T, Y, O, PT, nl, S, C, SC):
+    """:func:`planetary_observe` for lanes 0..nl-1 of a block (O: one row per mesh)."""
+    n, nm, nh, mesh, bs, st, mz = _lanes_offsets(PT)
+    for m0 in range(0, nm, _CHUNK):
+        m1 = min(m0 + _CHUNK, nm)
+        _lanes_stiffness(PT, nl, S, C, SC, mesh, bs, nh, m0, m1)
+        for m in range(m0, m1):
+            _lanes_mesh(Y, O[m:m + 1], PT, nl, S, C, SC, n, mesh + m * bs,
+                        mz + m * 3 * MESH_NZ, m - m0, False)
