@@ -595,6 +595,8 @@ class PlanetaryGearSet(Model):
         self._structure = (kt_entries, mesh_dofs)
         pk.fill_structure(p, kt_entries, mesh_dofs)
         names_p += pk.structure_names(names, self.mesh_names, kt_entries)
+        cache_names, p[lay["cache"]:] = pk.cache_entries(nm)
+        names_p += cache_names
         self.params = p
         self.param_names = tuple(names_p)
         self.omega_index = pk.OMEGA
@@ -610,16 +612,18 @@ class PlanetaryGearSet(Model):
         each mesh row touches (ascending), from the structure alone (not the values), so the
         same for every lane of a sweep; see :func:`planetary_kernels.fill_structure`."""
         nf = 9 + 3 * self.n_planets
-        S = np.eye(nf, dtype=int)
+        Tf = self.constraint()
+        Sm = np.eye(Tf.shape[1], dtype=bool)  # bearings and supports of the members
         rows_s, rows_r = [], []
-        for i in range(self.n_planets):
+        for i, psi in enumerate(self.psi):  # a planet bearing: one stiffness, two directions
             o = 9 + 3 * i
-            for keys in ([0, 1, o], [0, 1, 2, o + 1]):  # planet bearing: radial, tangential
-                S[np.ix_(keys, keys)] = 1
+            c, s = math.cos(psi), math.sin(psi)
+            Kn = sum(np.outer(r, r) for r in (self._row({0: c, 1: s, o: -1.0}),
+                                              self._row({0: -s, 1: c, 2: 1.0, o + 1: -1.0})))
+            Sm |= _clean(Tf.T @ Kn @ Tf) != 0.0
             rows_s.append([6, 7, 8, o, o + 1, o + 2])
             rows_r.append([3, 4, 5, o, o + 1, o + 2])
-        T = (self.constraint() != 0.0).astype(int)
-        Sm = T.T @ S @ T
+        T = (Tf != 0.0).astype(int)
         kt = [(int(i), int(j)) for i, j in zip(*np.nonzero(Sm), strict=True)]
         dofs = []
         for keys in rows_s + rows_r:

@@ -24,8 +24,10 @@ dense mesh rows are the same sums without their structural zeros, term for term 
 
 The ``*_lanes`` forms evaluate the same arithmetic, operation for operation, on a block of lanes
 in structure-of-arrays layout (state Y[q, k], coefficients PT[j, k], the forcing phase S[k],
-C[k]; SC: >= 8 scratch rows) for the sweep kernel; the structure (indices) is the same in every
-lane of a sweep (it depends only on inputs that are not swept).
+C[k]; SC: >= 2 scratch rows) for the sweep kernel; the structure (indices) is the same in every
+lane of a sweep (it depends only on inputs that are not swept). The vector ends with the rows
+of a relative-stiffness cache (:func:`cache_entries`), workspace of the lane-block functions in
+the block's own copy PT (:func:`_lanes_cached_stiffness`).
 """
 
 from __future__ import annotations
@@ -43,9 +45,10 @@ M_B, M_ES, M_EC, M_KF, M_CF = range(5)
 MESH_FIXED = 5
 #: Structural entries per mesh row in the structure section (padded with zero weights).
 MESH_NZ = 6
-#: Meshes whose relative stiffness the lane-block rhs holds at once (scratch rows 0..5; rows 6,
-#: 7 carry the harmonic recurrence).
-_CHUNK = 6
+#: Entries of the lane-block functions' relative-stiffness cache, and the key of an empty one (no
+#: sine or cosine equals it).
+CACHE_ENTRIES = 2
+EMPTY = 2.0
 
 _JIT = {"cache": True, "error_model": "numpy", "boundscheck": False}
 
@@ -61,8 +64,22 @@ def layout(n: int, n_mesh: int, nh: int, nk: int = 0) -> dict[str, int]:
     bs = MESH_FIXED + 2 * nh + 2 * n
     st = mesh + n_mesh * bs
     mz = st + 1 + 3 * nk
+    cache = mz + n_mesh * 3 * MESH_NZ
     return {"F0": f0, "F1": f1, "Kt": kt, "Ct": ct, "mesh": mesh, "block": bs,
-            "structure": st, "mesh_nz": mz, "size": mz + n_mesh * 3 * MESH_NZ}
+            "structure": st, "mesh_nz": mz, "cache": cache,
+            "size": cache + 1 + CACHE_ENTRIES * (2 + n_mesh)}
+
+
+def cache_entries(n_mesh: int) -> tuple[list[str], list[float]]:
+    """Names and initial values of the stiffness cache rows (see :func:`_lanes_cached_stiffness`):
+    the entry used last, then per entry the forcing phase (sin, cos; 2.0: empty) and the
+    relative stiffness of every mesh there. Workspace of the lane-block functions, not inputs."""
+    names = ["cache_last"]
+    values = [0.0]
+    for e in range(CACHE_ENTRIES):
+        names += [f"cache{e}_sin", f"cache{e}_cos"] + [f"cache{e}_k{m}" for m in range(n_mesh)]
+        values += [EMPTY, EMPTY] + [0.0] * n_mesh
+    return names, values
 
 
 def structure_names(dofs: tuple[str, ...], mesh_names: tuple[str, ...],
@@ -176,6 +193,31 @@ def _mesh_force(y, p, o, q, n, nh, s, c):
     return p[o + M_KF] * k * _dead_zone(d, p[o + M_B]) + p[o + M_CF] * v
 
 
+@nb.njit(inline="always", **_JIT)
+def _mesh_forces_shared(y, out, p, n, nm, nh, mesh, bs, mz, s, c):
+    """The mesh forces into out[:nm]: :func:`_mesh_force` of every mesh with one harmonic
+    recurrence for all (the same operations per mesh; the relative stiffnesses first, in out)."""
+    for m in range(nm):
+        out[m] = 1.0
+    if nh > 0:
+        for m in range(nm):
+            f = mesh + m * bs + MESH_FIXED
+            out[m] = p[f] * c + p[f + 1] * s
+        ch = c
+        sh = s
+        for h in range(1, nh):
+            ch, sh = ch * c - sh * s, sh * c + ch * s
+            for m in range(nm):
+                f = mesh + m * bs + MESH_FIXED + 2 * h
+                out[m] += p[f] * ch + p[f + 1] * sh
+        for m in range(nm):
+            out[m] = 1.0 + out[m]
+    for m in range(nm):
+        o = mesh + m * bs
+        d, v = _mesh_state(y, p, o, mz + m * 3 * MESH_NZ, n, s, c)
+        out[m] = p[o + M_KF] * out[m] * _dead_zone(d, p[o + M_B]) + p[o + M_CF] * v
+
+
 @nb.njit(**_JIT)
 def planetary_rhs(t, y, dy, p, s, c):
     """dy/dt of the planetary gear set (dimensionless)."""
@@ -183,9 +225,11 @@ def planetary_rhs(t, y, dy, p, s, c):
     fl = 0.0
     if p[TORQUE_ON] != 0.0:
         fl = math.sin(p[TORQUE_ORDER] * p[OMEGA] * t + p[TORQUE_PHASE])
+    shared = nm <= n  # the mesh forces first, into dy[:nm] (scratch until the end)
+    if shared:
+        _mesh_forces_shared(y, dy, p, n, nm, nh, mesh, bs, mz, s, c)
     f1 = HEADER + n
     for i in range(n):
-        dy[i] = y[n + i]
         dy[n + i] = p[HEADER + i] + p[f1 + i] * fl
     nk = int(p[st])
     for e in range(nk):
@@ -199,11 +243,12 @@ def planetary_rhs(t, y, dy, p, s, c):
                 acc -= p[r + j] * y[n + j]
             dy[n + i] = acc
     for m in range(nm):
-        o = mesh + m * bs
         q = mz + m * 3 * MESH_NZ
-        f = _mesh_force(y, p, o, q, n, nh, s, c)
+        f = dy[m] if shared else _mesh_force(y, p, mesh + m * bs, q, n, nh, s, c)
         for j in range(MESH_NZ):
             dy[n + int(p[q + j])] -= f * p[q + 2 * MESH_NZ + j]
+    for i in range(n):
+        dy[i] = y[n + i]
 
 
 @nb.njit(**_JIT)
@@ -230,8 +275,7 @@ def planetary_events(t, y, g, p):
 def planetary_observe(t, y, out, p, s, c):
     """Dynamic mesh forces [N], one per mesh (sun-planet meshes, then ring-planet meshes)."""
     n, nm, nh, mesh, bs, st, mz = _offsets(p)
-    for m in range(nm):
-        out[m] = _mesh_force(y, p, mesh + m * bs, mz + m * 3 * MESH_NZ, n, nh, s, c)
+    _mesh_forces_shared(y, out, p, n, nm, nh, mesh, bs, mz, s, c)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -252,34 +296,61 @@ def _lanes_offsets(PT):
 
 
 @nb.njit(inline="always", **_JIT)
-def _lanes_stiffness(PT, nl, S, C, SC, mesh, bs, nh, m0, m1):
-    """:func:`_relative_stiffness` of meshes m0..m1-1 (at most ``_CHUNK``) into SC rows 0.., the
-    harmonic recurrence in rows 6, 7."""
+def _lanes_stiffness(PT, nl, S, C, SC, rb, mesh, bs, nh, nm):
+    """:func:`_relative_stiffness` of every mesh m into PT[rb + m] (the harmonic recurrence in
+    SC rows 0, 1), the same operations in the same order."""
     if nh == 0:
-        for m in range(m0, m1):
+        for m in range(nm):
             for k in range(nl):
-                SC[m - m0, k] = 1.0
+                PT[rb + m, k] = 1.0
         return
-    for m in range(m0, m1):
+    for m in range(nm):
         f = mesh + m * bs + MESH_FIXED
         for k in range(nl):
-            SC[m - m0, k] = PT[f, k] * C[k] + PT[f + 1, k] * S[k]
+            PT[rb + m, k] = PT[f, k] * C[k] + PT[f + 1, k] * S[k]
     for k in range(nl):
-        SC[6, k] = C[k]
-        SC[7, k] = S[k]
+        SC[0, k] = C[k]
+        SC[1, k] = S[k]
     for h in range(1, nh):
         for k in range(nl):
-            ch = SC[6, k]
-            sh = SC[7, k]
-            SC[6, k] = ch * C[k] - sh * S[k]
-            SC[7, k] = sh * C[k] + ch * S[k]
-        for m in range(m0, m1):
+            ch = SC[0, k]
+            sh = SC[1, k]
+            SC[0, k] = ch * C[k] - sh * S[k]
+            SC[1, k] = sh * C[k] + ch * S[k]
+        for m in range(nm):
             f = mesh + m * bs + MESH_FIXED + 2 * h
             for k in range(nl):
-                SC[m - m0, k] += PT[f, k] * SC[6, k] + PT[f + 1, k] * SC[7, k]
-    for m in range(m0, m1):
+                PT[rb + m, k] += PT[f, k] * SC[0, k] + PT[f + 1, k] * SC[1, k]
+    for m in range(nm):
         for k in range(nl):
-            SC[m - m0, k] = 1.0 + SC[m - m0, k]
+            PT[rb + m, k] = 1.0 + PT[rb + m, k]
+
+
+@nb.njit(inline="always", **_JIT)
+def _lanes_cached_stiffness(PT, nl, S, C, SC, cache, mesh, bs, nh, nm):
+    """Row of PT from which the relative stiffness of mesh m is row + m, at the forcing phase
+    (S, C) of every lane. The block's PT carries a small cache (rows from ``cache``; reset to
+    empty whenever a slot is loaded with a lane's coefficients): the four RK4 stages of a step
+    see two new phases (the mid-step one twice, the end one again as the next step's start and
+    for the observables), so half the evaluations are found there. An entry is used only where
+    every lane's phase equals its key exactly, so the values are those computed anew."""
+    width = 2 + nm
+    for e in range(CACHE_ENTRIES):
+        b = cache + 1 + e * width
+        hit = True
+        for k in range(nl):
+            hit &= (PT[b, k] == S[k]) & (PT[b + 1, k] == C[k])
+        if hit:
+            PT[cache, 0] = e
+            return b + 2
+    e = (int(PT[cache, 0]) + 1) % CACHE_ENTRIES  # not the entry used last
+    b = cache + 1 + e * width
+    _lanes_stiffness(PT, nl, S, C, SC, b + 2, mesh, bs, nh, nm)
+    for k in range(nl):
+        PT[b, k] = S[k]
+        PT[b + 1, k] = C[k]
+    PT[cache, 0] = e
+    return b + 2
 
 
 @nb.njit(**_JIT)
@@ -317,18 +388,17 @@ def planetary_rhs_lanes(T, Y, DY, PT, nl, S, C, SC):
                 r = ct + i * n + j
                 for k in range(nl):
                     DY[n + i, k] -= PT[r, k] * Y[n + j, k]
-    for m0 in range(0, nm, _CHUNK):
-        m1 = min(m0 + _CHUNK, nm)
-        _lanes_stiffness(PT, nl, S, C, SC, mesh, bs, nh, m0, m1)
-        for m in range(m0, m1):
-            _lanes_mesh(Y, DY, PT, nl, S, C, SC, n, mesh + m * bs, mz + m * 3 * MESH_NZ, m - m0,
-                        True)
+    kr = _lanes_cached_stiffness(PT, nl, S, C, SC, mz + nm * 3 * MESH_NZ, mesh, bs, nh, nm)
+    for m in range(nm):
+        _lanes_mesh(Y, DY, PT, nl, S, C, SC, n, mesh + m * bs, mz + m * 3 * MESH_NZ, kr + m,
+                    True)
 
 
 @nb.njit(inline="always", **_JIT)
 def _lanes_mesh(Y, DY, PT, nl, S, C, SC, n, o, q, row, apply):
-    """Mesh force of the block at o (structure at q, relative stiffness in SC[row]) for every
-    lane: subtracted from the accelerations DY (``apply``) or written to DY[0] (observables)."""
+    """Mesh force of the block at o (structure at q, relative stiffness in PT[row]) for every
+    lane, into SC[0], then subtracted from the accelerations DY (``apply``) or copied to DY[0]
+    (observables). One store stream per lane loop, so that the loops vectorise."""
     i0 = int(PT[q, 0])
     i1 = int(PT[q + 1, 0])
     i2 = int(PT[q + 2, 0])
@@ -336,7 +406,6 @@ def _lanes_mesh(Y, DY, PT, nl, S, C, SC, n, o, q, row, apply):
     i4 = int(PT[q + 4, 0])
     i5 = int(PT[q + 5, 0])
     w = q + MESH_NZ
-    g = q + 2 * MESH_NZ
     for k in range(nl):
         d = 0.0
         v = 0.0
@@ -354,16 +423,17 @@ def _lanes_mesh(Y, DY, PT, nl, S, C, SC, n, o, q, row, apply):
         v += PT[w + 5, k] * Y[n + i5, k]
         d -= PT[o + M_ES, k] * S[k] + PT[o + M_EC, k] * C[k]
         v -= PT[OMEGA, k] * (PT[o + M_ES, k] * C[k] - PT[o + M_EC, k] * S[k])
-        f = PT[o + M_KF, k] * SC[row, k] * _dead_zone(d, PT[o + M_B, k]) + PT[o + M_CF, k] * v
-        if apply:
-            DY[n + i0, k] -= f * PT[g, k]
-            DY[n + i1, k] -= f * PT[g + 1, k]
-            DY[n + i2, k] -= f * PT[g + 2, k]
-            DY[n + i3, k] -= f * PT[g + 3, k]
-            DY[n + i4, k] -= f * PT[g + 4, k]
-            DY[n + i5, k] -= f * PT[g + 5, k]
-        else:
-            DY[0, k] = f
+        SC[0, k] = (PT[o + M_KF, k] * PT[row, k] * _dead_zone(d, PT[o + M_B, k])
+                    + PT[o + M_CF, k] * v)
+    if not apply:
+        for k in range(nl):
+            DY[0, k] = SC[0, k]
+        return
+    g = q + 2 * MESH_NZ
+    for j in range(MESH_NZ):
+        r = n + int(PT[q + j, 0])
+        for k in range(nl):
+            DY[r, k] -= SC[0, k] * PT[g + j, k]
 
 
 @nb.njit(**_JIT)
@@ -406,7 +476,7 @@ def planetary_events_lanes(T, Y, G, PT, nl):
         i3 = int(PT[q + 3, 0])
         i4 = int(PT[q + 4, 0])
         i5 = int(PT[q + 5, 0])
-        for k in range(nl):
+        for k in range(nl):  # the deflection into row 2m + 1 first: one store per loop
             d = 0.0
             d += PT[w, k] * Y[i0, k]
             d += PT[w + 1, k] * Y[i1, k]
@@ -414,7 +484,9 @@ def planetary_events_lanes(T, Y, G, PT, nl):
             d += PT[w + 3, k] * Y[i3, k]
             d += PT[w + 4, k] * Y[i4, k]
             d += PT[w + 5, k] * Y[i5, k]
-            d -= PT[o + M_ES, k] * 0.0 + PT[o + M_EC, k] * 1.0
+            G[2 * m + 1, k] = d - (PT[o + M_ES, k] * 0.0 + PT[o + M_EC, k] * 1.0)
+        for k in range(nl):
+            d = G[2 * m + 1, k]
             G[2 * m, k] = d - PT[o + M_B, k]
             G[2 * m + 1, k] = d + PT[o + M_B, k]
 
@@ -423,9 +495,7 @@ def planetary_events_lanes(T, Y, G, PT, nl):
 def planetary_observe_lanes(T, Y, O, PT, nl, S, C, SC):
     """:func:`planetary_observe` for lanes 0..nl-1 of a block (O: one row per mesh)."""
     n, nm, nh, mesh, bs, st, mz = _lanes_offsets(PT)
-    for m0 in range(0, nm, _CHUNK):
-        m1 = min(m0 + _CHUNK, nm)
-        _lanes_stiffness(PT, nl, S, C, SC, mesh, bs, nh, m0, m1)
-        for m in range(m0, m1):
-            _lanes_mesh(Y, O[m:m + 1], PT, nl, S, C, SC, n, mesh + m * bs,
-                        mz + m * 3 * MESH_NZ, m - m0, False)
+    kr = _lanes_cached_stiffness(PT, nl, S, C, SC, mz + nm * 3 * MESH_NZ, mesh, bs, nh, nm)
+    for m in range(nm):
+        _lanes_mesh(Y, O[m:m + 1], PT, nl, S, C, SC, n, mesh + m * bs, mz + m * 3 * MESH_NZ,
+                    kr + m, False)
