@@ -28,6 +28,7 @@ from geardyn.io.toml import (
     load_study,
     save_params,
     save_study,
+    study_to_toml,
 )
 from geardyn.study import build_model
 
@@ -195,6 +196,20 @@ def test_study_round_trip_is_lossless(tmp_path, study):
          "sweep.samples: Input should be greater than or equal to 2 (got 1)"),
         ('[params]\nbase = "paper"\n[sweep]\nstart = 1\nstop = 1\nnum = 3\n',
          "sweep: start and stop must differ (got 1.0 twice)"),
+        ('[params]\nbase = "paper"\n[run]\ntransient = 10\ntransient_periods = 20\n',
+         "run: give the transient either as transient (time) or as transient_periods"),
+        ('[params]\nbase = "paper"\n[run]\ntransient_periods = 0\n',
+         "run.transient_periods: Input should be greater than 0 (got 0)"),
+        ('[params]\nbase = "paper"\n[run]\nconverge = 1.5\n',
+         "run.converge: Input should be less than 1 (got 1.5)"),
+        ('[params]\nbase = "paper"\n[run]\ntransient_max = 9000\n',
+         "run: transient_max is the limit of a transient by convergence: set converge"),
+        ('[params]\nbase = "paper"\n[run]\nconverge = 1e-6\ntransient_max = 9\n',
+         "run: transient_max (9) must be >= transient (4000)"),
+        ('[params]\nbase = "paper"\n[run]\nmax_period = 0\n',
+         "run.max_period: Input should be greater than or equal to 1 (got 0)"),
+        ('[params]\nbase = "paper"\n[run]\nperiod_tol = "tight"\n',
+         "run.period_tol: Input should be a valid number"),
     ],
 )
 def test_bad_study_errors_name_field(text, start):
@@ -203,6 +218,26 @@ def test_bad_study_errors_name_field(text, start):
     line = format_error(info.value)
     assert line.startswith(start), line
     assert "\n" not in line
+
+
+def test_run_table_settings_and_transient_in_periods():
+    """[run] sets every RunSettings field it names; transient_periods is that many periods of
+    the lowest forcing frequency given, and is written back without a transient."""
+    text = ('[params]\nbase = "paper"\n[run]\ntransient_periods = 20\nconverge = 1e-7\n'
+            "transient_max = 50000\ncontinued_transient = 100\nmax_period = 8\n"
+            "period_tol = 1e-4\nperiods = 16\nsteps_per_period = 64\n")
+    study = load_study(text)
+    run = study.run_settings(omega=0.5)
+    assert run.transient == pytest.approx(20 * 2 * math.pi / 0.5)
+    assert (run.converge, run.transient_max, run.continued_transient) == (1e-7, 50000, 100)
+    assert (run.max_period, run.period_tol, run.samples, run.steps_per_period) == (
+        8, 1e-4, 16, 64)
+    assert study.run_settings(omega=0.5, transient=7.0, max_period=3).transient == 7.0
+    with pytest.raises(StudyError, match="run.transient_periods"):
+        study.run_settings()
+    again = load_study(study_to_toml(study))
+    assert again.run == study.run and "\ntransient =" not in study_to_toml(study)
+    assert load_study('[params]\nbase = "paper"\n').run_settings().transient == 4000.0
 
 
 @pytest.mark.parametrize(("value", "expected"), [

@@ -45,6 +45,8 @@ LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
     # study files turned into models
     ("study", ("geardyn.study",)),
     ("reproduction", ("geardyn.reproduction",)),
+    # the browser explorer: its state, computations (public API calls) and Bokeh page
+    ("explore", ("geardyn.explore",)),
     ("cli", ("geardyn.cli",)),
     # the package itself: the public names (geardyn.simulate, ...)
     ("api", ("geardyn",)),

@@ -121,6 +121,19 @@ def test_angles_stiffness_radii_and_static_forces_from_the_geometry():
     assert np.allclose(F[:4], F[0], rtol=1e-6)  # equally spaced: equal load sharing
 
 
+def test_with_params_keeps_the_geometry():
+    """A set built from geometry keeps its geometry and stiffness waves through with_params
+    (a rebuild from its inputs) and lane_params, and the rebuilt set is what from_geometry
+    builds with the changed input."""
+    geo = stage(25, 23, 71)
+    gs = built(geo, sun_torque=50.0)
+    changed = gs.with_params(sun_backlash=2e-5)
+    assert changed.geometry is geo and changed.stiffness_waveforms == gs.stiffness_waveforms
+    assert np.array_equal(changed.params, built(geo, sun_torque=50.0, sun_backlash=2e-5).params)
+    assert changed.with_params(sun_torque=10.0).geometry is geo
+    assert gs.with_params(Omega=0.3).geometry is geo
+
+
 def test_backlash_from_a_wider_centre_distance():
     """A stage built at a wider centre distance (the ring shifted out so that its mesh opens
     too): half the normal backlash of each mesh, j cos(alpha_w) / 2, unless given."""
@@ -214,3 +227,117 @@ def test_net_sun_excitation_keeps_the_harmonics_the_phasing_rules_allow(teeth, t
         f_amp = math.hypot(spec[ell, 0], spec[ell, 1])
         assert (spec[ell, 2] > 1e-6 * scale) == (ell in torque), ell
         assert (f_amp > 1e-6 * scale) == (ell in force), ell
+
+
+def test_builtin_study_sweep_finds_periods_and_contact_loss(tmp_path):
+    """Regression: ``geardyn bifurcation planetary_example`` with the study's [run] settings
+    found no period at any point (a 300 tau transient against bearing modes damped ~1e-4).
+    With the study's settings (transient in forcing periods, by convergence; modal damping)
+    every point of a few Omega values gets a period, and the meshes lose contact near 0.8."""
+    from typer.testing import CliRunner
+
+    from geardyn.cli.main import app
+    from geardyn.io.netcdf import load_dataset
+
+    out = tmp_path / "b.nc"
+    r = CliRunner().invoke(app, ["bifurcation", "planetary_example", "--param", "Omega",
+                                 "--range", "0.3:0.8:3", "--quiet", "--out", str(out)])
+    assert r.exit_code == 0, r.output
+    ds = load_dataset(out)
+    assert np.all(ds["period"].values >= 1), ds["period"].values
+    assert ds.attrs["converge"] == 1e-6
+    assert ds.attrs["transient"] >= 20 * 2 * math.pi / 0.3
+    assert np.any(ds["contact"].sel(Omega=0.8).values != "none")
+
+
+def _willis_mesh_frequency(zs: int, zr: int, held: str, input_rpm: float) -> float:
+    """Mesh frequency [rad/s] by the Willis equation z_s w_s + z_r w_r = (z_s + z_r) w_c with
+    the held member still and the input (the sun; the carrier when the sun is held) at
+    ``input_rpm``: z_s times the sun's speed relative to the carrier."""
+    w_in = input_rpm * 2 * math.pi / 60
+    if held == "ring":
+        w_s, w_c = w_in, zs * w_in / (zs + zr)
+    elif held == "carrier":
+        w_s, w_c = w_in, 0.0
+    else:  # sun held, carrier input
+        w_s, w_c = 0.0, w_in
+    return zs * abs(w_s - w_c)
+
+
+@pytest.mark.parametrize("held", ["ring", "carrier", "sun"])
+def test_input_speed_sets_the_mesh_frequency_by_the_kinematics(held):
+    """input_speed [rpm] (a number or a unit string) sets the mesh frequency of the Willis
+    equation for the held member; lane_params sweeps it; a set without geometry refuses it."""
+    gs = built(stage(25, 23, 71), held=held)
+    want = _willis_mesh_frequency(25, 71, held, 3000.0)
+    for value in (3000.0, "3000 rpm", f"{3000 * 2 * math.pi / 60!r} rad/s"):
+        lane = gs.with_params(input_speed=value)
+        assert lane.omega * lane.time_scale == pytest.approx(want, rel=1e-12)
+        assert lane.input_speed == pytest.approx(3000.0, rel=1e-12)
+    P = gs.lane_params("input_speed", [1000.0, 3000.0])
+    assert P[:, gs.omega_index] * gs.time_scale == pytest.approx(
+        [_willis_mesh_frequency(25, 71, held, 1000.0), want], rel=1e-12)
+    assert gs.input_member == ("carrier" if held == "sun" else "sun")
+    assert "input_speed" in gs.physical_names
+    plain = geardyn.PlanetaryGearSet(**MEMBERS, n_planets=4, sun_mesh_stiffness=3e8,
+                                     ring_mesh_stiffness=4e8)
+    assert "input_speed" not in plain.physical_names
+    with pytest.raises(ParameterError) as e:
+        plain.with_params(input_speed=3000.0)
+    assert e.value.field == "input_speed"
+    with pytest.raises(ParameterError) as e:
+        gs.with_params(input_speed=-1.0)
+    assert e.value.field == "input_speed"
+
+
+def test_study_held_and_input_speed_sweep_axis_units(tmp_path):
+    """[params].held sets the kinematics (only with [params.geometry]); the CLI sweeps
+    input_speed [rpm] and the dataset's axis carries its unit, as a mesh_frequency axis its."""
+    from typer.testing import CliRunner
+
+    from geardyn.cli.main import app
+    from geardyn.io import load_study
+    from geardyn.io.netcdf import load_dataset
+    from geardyn.study import build_model
+
+    path = Path(geardyn.__file__).parent / "studies" / "planetary_example.toml"
+    text = path.read_text()
+    assert build_model(load_study(path)).held == "ring"
+    carrier = text.replace("[params]\n", '[params]\nheld = "carrier"\n', 1)
+    assert build_model(load_study(carrier)).mesh_frequency_per_input_speed() == 25.0
+    start = text.index("[params.geometry]")
+    without = text[:start] + text[text.index("[params.sun]"):]
+    without = without.replace("[params]\n", '[params]\nheld = "ring"\nsun_mesh_stiffness = 3e8\n'
+                              "ring_mesh_stiffness = 4e8\n", 1)
+    with pytest.raises(ParameterError) as e:
+        build_model(load_study(without))
+    assert e.value.field == "params.held"
+    for param, rng, unit in (("input_speed", "3000:6000:2", "rpm"),
+                             ("mesh_frequency", "5000:9000:2", "rad/s")):
+        out = tmp_path / f"{param}.nc"
+        r = CliRunner().invoke(app, ["bifurcation", "planetary_example", "--param", param,
+                                     "--range", rng, "--transient", "20", "--samples", "2",
+                                     "--quiet", "--out", str(out)])
+        assert r.exit_code == 0, r.output
+        ds = load_dataset(out)
+        assert ds[param].attrs["units"] == unit
+        assert list(ds[param].values) == [float(v) for v in rng.split(":")[:2]]
+
+
+def test_frequency_response_axes_of_a_set_from_geometry():
+    """The frc dataset's physical axes of a set from geometry: mesh frequency [Hz] and input
+    (sun) speed [rpm] by the Willis kinematics (ring held); without geometry only the first."""
+    from geardyn.analysis.frc import physical_axes
+
+    gs = built(stage(25, 23, 71))
+    om = np.array([0.2, 0.5])
+    axes = physical_axes(gs, om)
+    w = om * gs.time_scale
+    assert axes["mesh_frequency"][0] == pytest.approx(w / (2 * math.pi), rel=1e-12)
+    assert axes["mesh_frequency"][1]["units"] == "Hz"
+    rpm = [3000.0 * w_m / _willis_mesh_frequency(25, 71, "ring", 3000.0) for w_m in w]
+    assert axes["input_speed"][0] == pytest.approx(rpm, rel=1e-12)
+    assert axes["input_speed"][1]["units"] == "rpm"
+    plain = geardyn.PlanetaryGearSet(**MEMBERS, n_planets=4, sun_mesh_stiffness=3e8,
+                                     ring_mesh_stiffness=4e8)
+    assert set(physical_axes(plain, om)) == {"mesh_frequency"}

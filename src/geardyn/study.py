@@ -65,20 +65,24 @@ def planetary_model(params: PlanetaryGearSetParams, omega: float | None = None
         kw[name] = Member(**kw[name])
     kw["fixed"] = tuple(kw["fixed"])
     geometry = kw.pop("geometry")
+    held = kw.pop("held")
     try:
         if geometry is None:
+            if held is not None:
+                raise ParameterError("held", held, "sets the input-speed kinematics of a set "
+                                     "built from [params.geometry]; give that table")
             for name in ("sun_mesh_stiffness", "ring_mesh_stiffness"):
                 if kw[name] is None:
                     raise ParameterError(name, None, "required (or give [params.geometry])")
             model = PlanetaryGearSet(**kw)
         else:
-            model = _from_geometry(geometry, kw)
+            model = _from_geometry(geometry, kw, held)
     except ParameterError as exc:
         raise ParameterError(f"params.{exc.field}", exc.value, exc.reason) from None
     return model if omega is None else model.with_omega(float(omega))
 
 
-def _from_geometry(table: dict, kw: dict) -> PlanetaryGearSet:
+def _from_geometry(table: dict, kw: dict, held: str | None = None) -> PlanetaryGearSet:
     """:meth:`PlanetaryGearSet.from_geometry` of a ``[params.geometry]`` table; ``kw`` the
     other ``[params]``: those the geometry gives must keep their defaults."""
     from geardyn.gears import PlanetaryGeometry, SpurGear
@@ -104,7 +108,7 @@ def _from_geometry(table: dict, kw: dict) -> PlanetaryGearSet:
         else to_si(table["centre_distance"], "length"))
     extra = {k: v for k, v in kw.items() if k not in _FROM_GEOMETRY}
     return PlanetaryGearSet.from_geometry(
-        stage, waveform_options={"transition": table["transition"]}, **extra)
+        stage, waveform_options={"transition": table["transition"]}, held=held, **extra)
 
 
 def check_usable(build: Callable[[], Model]) -> Model:

@@ -38,6 +38,14 @@ def model_attrs(model: Model) -> dict[str, object]:
     return attrs
 
 
+def param_attrs(model: Model, name: str) -> dict[str, str]:
+    """Attributes of the axis of swept parameter ``name`` (``units``, ...), where the model
+    names them (``model.param_attrs``, e.g. the planetary set's ``mesh_frequency`` [rad/s] and
+    ``input_speed`` [rpm]); else none."""
+    attrs = getattr(model, "param_attrs", None)
+    return dict(attrs(name)) if attrs is not None else {}
+
+
 def _with_mesh(ds: xr.Dataset, model: Model) -> xr.Dataset:
     """``ds`` with the ``mesh`` coordinate (the meshes' names), where the model has meshes."""
     if model.meshes:
@@ -56,7 +64,7 @@ def sweep_dataset(model: Model, param: str, values: np.ndarray, runs: Sequence[L
     per_lane["unresolved_steps"] = np.sum([r.unresolved for r in runs], axis=0)  # every start
     status = np.max(np.stack([r.status for r in runs], axis=1), axis=1)
     ds = xr.Dataset(coords={
-        param: (param, values),
+        param: (param, values, param_attrs(model, param)),
         "sample": ("sample", np.arange(poincare.shape[1])),
         "state": ("state", list(model.state_names)),
     })
@@ -90,7 +98,8 @@ def map_dataset(model: Model, y: tuple[str, np.ndarray], x: tuple[str, np.ndarra
     labels. Without the run settings and the motion classes."""
     (yn, yv), (xn, xv) = y, x
     ny, nx = yv.size, xv.size
-    ds = _with_mesh(xr.Dataset(coords={yn: (yn, yv), xn: (xn, xv)}), model)
+    ds = _with_mesh(xr.Dataset(coords={yn: (yn, yv, param_attrs(model, yn)),
+                                       xn: (xn, xv, param_attrs(model, xn))}), model)
     dims, attrs = variable_dims(model), variable_attrs(model, max_period, tol)
     dims.update(status=(), lyapunov=(), lyapunov_err=(), lyapunov_unresolved=())
     attrs.update(status=status_attrs(),

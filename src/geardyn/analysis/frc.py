@@ -75,7 +75,12 @@ BAND_TOL = 0.01
 # ---------------------------------------------------------------------------- axes, deflections
 def physical_axes(model: Model, omega: np.ndarray) -> dict[str, tuple[np.ndarray, dict]] | None:
     """Mesh frequency [Hz] and input (carrier) speed [rpm] at the forcing frequencies
-    ``omega`` (the model's own units), or None when the model has no physical time unit."""
+    ``omega`` (the model's own units), or None when the model has no physical time unit; a
+    model with ``speed_axes(omega)`` (the planetary gear set: input speed of the sun, from its
+    geometry) gives its own."""
+    axes = getattr(model, "speed_axes", None)  # the model names its own (PlanetaryGearSet)
+    if axes is not None:
+        return axes(omega)
     device = getattr(model, "device", None)  # DimensionalCATT: time in seconds
     if model.time_unit == "s" and device is not None:
         w = np.asarray(omega, dtype=float)

@@ -102,7 +102,7 @@ def basins_command(
     y_axis = _state_axis(y, "--y", model.state_names)
     if x_axis[0] == y_axis[0]:
         raise ParameterError("--y", y, "must name another state than --x")
-    tr = s.run.transient if transient is None else transient
+    tr = s.run.transient_time(om) if transient is None else transient
     spp = s.run.steps_per_period if steps_per_period is None else steps_per_period
     run0 = run_settings({"transient": ("--transient", tr),
                          "steps_per_period": ("--steps-per-period", spp),

@@ -11,8 +11,9 @@ saved result).
     geardyn plot RESULT.nc|map.zarr [--out fig.png|fig.pdf] [--state X_sq] [--sweep up|down]
 
 Unset options come from the study's ``[sweep]`` table (param, range, continuation, samples,
-lyapunov) and ``[run]`` table (transient, steps_per_period, omega, and periods as the default
-number of samples). A progress bar is drawn when stderr is a terminal (``--quiet``: never).
+lyapunov) and ``[run]`` table (transient or transient_periods, steps_per_period, omega, converge,
+transient_max, continued_transient, max_period, period_tol, and periods as the default number of
+samples). A progress bar is drawn when stderr is a terminal (``--quiet``: never).
 """
 
 from __future__ import annotations
@@ -43,6 +44,7 @@ from geardyn.cli.common import (
     make_parents,
     run_settings,
     stderr_console,
+    study_run_options,
     usable_omega,
     write_outputs,
 )
@@ -132,6 +134,20 @@ def _check_param_values(model, param: str, ends: tuple[float, float], range_text
                              "a finite period)")
 
 
+def _lowest_omega(model, param: str, ends: tuple[float, float], hold: str) -> float | None:
+    """The lowest forcing frequency Omega at the ends of a sweep of ``param`` (what
+    ``[run].transient_periods`` counts periods of); None for a model without one."""
+    if model.omega_index is None:
+        return None
+    if param == "Omega":
+        return min(ends)
+    from geardyn.analysis.bifurcation import lane_params_held
+
+    if hold != "speed" or not hasattr(model, "omega_n"):
+        hold = "Omega"  # a bad --hold is refused with its own message below
+    return float(min(lane_params_held(model, param, list(ends), hold)[:, model.omega_index]))
+
+
 def _check_state(names, state: str, option: str) -> str:
     for candidate in (state, f"{state}1"):
         if candidate in names:
@@ -206,13 +222,13 @@ def bifurcation_command(
     ] = None,
     transient: Annotated[
         float | None, typer.Option(help="Discarded time per point, dimensionless tau "
-                                        "(default: run.transient).")
+                                        "(default: run.transient or run.transient_periods).")
     ] = None,
     converge: Annotated[
         float | None, typer.Option(help="Transient by convergence: run on past --transient "
                                         "(a minimum), up to 10x it, until the Poincare point "
                                         "is estimated within this relative tolerance of its "
-                                        "orbit (e.g. 1e-8).")
+                                        "orbit (e.g. 1e-8; default: run.converge).")
     ] = None,
     continued_transient: Annotated[
         float | None, typer.Option(help="With --continuation: the discarded time of a continued "
@@ -279,19 +295,21 @@ def bifurcation_command(
     cont = (continuation.value if continuation is not None
             else sweep.continuation if sweep is not None else "none")
     lyap = lyapunov if lyapunov is not None else bool(sweep is not None and sweep.lyapunov)
-    tr = s.run.transient if transient is None else transient
+    tr = transient if transient is not None else s.run.transient if (
+        s.run.transient_periods is None) else s.run.transient_time(
+        _lowest_omega(model, name, (start, stop), hold))
     n_samples = samples if samples is not None else (
         sweep.samples if sweep is not None and sweep.samples is not None else s.run.periods)
     spp = s.run.steps_per_period if steps_per_period is None else steps_per_period
     run = run_settings({"transient": ("--transient", tr), "samples": ("--samples", n_samples),
                         "steps_per_period": ("--steps-per-period", spp),
-                        "converge": ("--converge", converge),
-                        "continued_transient": ("--continued-transient", continued_transient)})
+                        **study_run_options(s, converge=converge,
+                                            continued_transient=continued_transient)})
     if n_samples < 2:
         raise ParameterError("--samples", n_samples, "must be >= 2 (the period needs two)")
     if converge is not None and not converge < 1:
         raise ParameterError("--converge", converge, "must be a tolerance in (0, 1)")
-    if continued_transient is not None and cont == "none":
+    if continued_transient is not None and cont == "none":  # [run]'s: for continued sweeps
         raise ParameterError("--continued-transient", continued_transient,
                              "applies to --continuation up or down")
     if hold not in ("Omega", "speed"):
@@ -313,7 +331,8 @@ def bifurcation_command(
     # transient may run to 10x --transient
     omegas = (np.linspace(start, stop, min(num, ESTIMATE_POINTS)) if name == "Omega"
               else [model.omega])
-    check_run_cost(model, num, omegas, tr if converge is None else 10 * tr, n_samples, spp, lyap,
+    check_run_cost(model, num, omegas, tr if run.converge is None else run.transient_limit,
+                   n_samples, spp, lyap,
                    chunk=num, yes=yes, option="--range/--samples/--transient/--steps-per-period",
                    value=f"{range_text}, {n_samples} samples, transient {tr:g}, "
                          f"{spp or 'automatic'} steps/period", what="sweep")

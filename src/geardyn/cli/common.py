@@ -117,6 +117,22 @@ def run_settings(options: dict[str, tuple[str, Any]]):
         raise ParameterError(option, value, reason.rsplit(" (got ", 1)[0]) from None
 
 
+def study_run_options(study, **given: Any) -> dict[str, tuple[str, Any]]:
+    """The :func:`run_settings` options a command takes from the study's ``[run]`` table
+    (``converge``, ``transient_max``, ``continued_transient``, ``max_period``, ``period_tol``),
+    each named ``run.<field>`` unless its command-line option ``given`` (field -> value or None)
+    sets it, then named ``--<field>``."""
+    out: dict[str, tuple[str, Any]] = {}
+    for field in ("converge", "transient_max", "continued_transient", "max_period",
+                  "period_tol"):
+        value = given.get(field)
+        if value is not None:
+            out[field] = (f"--{field.replace('_', '-')}", value)
+        else:
+            out[field] = (f"run.{field}", getattr(study.run, field))
+    return out
+
+
 def check_count(option: str, value: int) -> None:
     """A one-line error naming ``option`` when ``value`` exceeds :data:`MAX_COUNT`."""
     if value > MAX_COUNT:

@@ -8,7 +8,9 @@
                 [--out frc.nc] [--plot frc.png]
 
 Unset options come from the study's ``[sweep]`` (start, stop, num, samples; the sweep must be
-of Omega) and ``[run]`` tables. A progress bar is drawn when stderr is a terminal.
+of Omega) and ``[run]`` tables (transient or transient_periods, converge, transient_max,
+continued_transient, max_period, period_tol, steps_per_period). A progress bar is drawn when
+stderr is a terminal.
 """
 
 from __future__ import annotations
@@ -33,6 +35,7 @@ from geardyn.cli.common import (
     load_study_source,
     make_parents,
     run_settings,
+    study_run_options,
     usable_omega,
     write_outputs,
 )
@@ -103,7 +106,7 @@ def frc_command(
     if mesh is not None and mesh not in names:
         raise ParameterError("--mesh", mesh, f"not a mesh of the model; meshes: "
                              f"{', '.join(names)}")
-    tr = s.run.transient if transient is None else transient
+    tr = s.run.transient_time(min(start, stop)) if transient is None else transient
     n_samples = samples if samples is not None else (
         sweep.samples if sweep is not None and sweep.samples is not None else s.run.periods)
     spp = s.run.steps_per_period if steps_per_period is None else steps_per_period
@@ -112,10 +115,11 @@ def frc_command(
         raise ParameterError("--samples", n_samples, "must be >= 2 (the period needs two)")
     run = run_settings({"transient": ("--transient", tr), "samples": ("--samples", n_samples),
                         "steps_per_period": ("--steps-per-period", spp),
-                        "converge": ("--converge", converge),
-                        "continued_transient": ("--continued-transient", continued_transient)})
+                        **study_run_options(s, converge=converge,
+                                            continued_transient=continued_transient)})
     omegas = np.linspace(start, stop, min(num, ESTIMATE_POINTS))
-    check_run_cost(model, 2 * num, omegas, tr if converge is None else 10 * tr, n_samples, spp,
+    check_run_cost(model, 2 * num, omegas,
+                   tr if run.converge is None else run.transient_limit, n_samples, spp,
                    False, yes=yes, option="--range/--samples/--transient",
                    value=f"{start:g}:{stop:g}:{num}, {n_samples} samples, transient {tr:g}",
                    what="frequency response")

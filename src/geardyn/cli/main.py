@@ -255,7 +255,7 @@ def simulate(
         raise ParameterError("--omega", om, "must be a positive finite number (with a finite "
                              "period)")
     check_plot_path("--plot", plot)
-    tr = s.run.transient if transient is None else transient
+    tr = s.run.transient_time(om) if transient is None else transient
     n_periods = s.run.periods if periods is None else periods
     spp = s.run.steps_per_period if steps_per_period is None else steps_per_period
     run = run_settings({"transient": ("--transient", tr), "samples": ("--periods", n_periods),
@@ -324,6 +324,7 @@ __import__("geardyn.cli.reproduce", fromlist=["register"]).register(app)  # cli/
 __import__("geardyn.cli.basins", fromlist=["register"]).register(app)  # cli/basins.py
 __import__("geardyn.cli.frc", fromlist=["register"]).register(app)  # cli/frc.py
 __import__("geardyn.cli.continuation", fromlist=["register"]).register(app)  # cli/continuation.py
+__import__("geardyn.cli.explore", fromlist=["register"]).register(app)  # cli/explore.py
 
 if __name__ == "__main__":
     main()

@@ -34,6 +34,7 @@ from geardyn.cli.common import (
     load_study_source,
     refuse_if_costly,
     run_settings,
+    study_run_options,
     usable_omega,
 )
 from geardyn.errors import ParameterError, StudyError
@@ -131,7 +132,6 @@ def map_command(
                   "steps_per_period": ("--steps-per-period", steps_per_period)})
     s = load_study_source(study)
     model = build_model(s, interpretation=interpretation)
-    tr = s.run.transient if transient is None else transient
     n_samples = s.run.periods if samples is None else samples
     spp = s.run.steps_per_period if steps_per_period is None else steps_per_period
     if n_samples < 2:
@@ -155,6 +155,10 @@ def map_command(
             raise ParameterError(option, f"{name}:{start}:{stop}", "an end of the axis makes the"
                                  " model's coefficients infinite (a value is too extreme)")
 
+    tr = transient
+    if tr is None:  # [run].transient, or transient_periods of the lowest Omega of the map
+        low = [min(a[1], a[2]) for a in (x_axis, y_axis) if a[0] == "Omega"]
+        tr = s.run.transient_time(low[0] if low else model.omega)
     lanes = x_axis[3] * y_axis[3]
     omega_axis = next((a for a in (x_axis, y_axis) if a[0] == "Omega"), None)
     omegas = (np.linspace(omega_axis[1], omega_axis[2], min(omega_axis[3], ESTIMATE_POINTS))
@@ -182,7 +186,8 @@ def map_command(
         err.print(f"map: {estimate.describe()}")
         run = run_settings({"transient": ("--transient", tr),
                             "samples": ("--samples", n_samples),
-                            "steps_per_period": ("--steps-per-period", spp)})
+                            "steps_per_period": ("--steps-per-period", spp),
+                            **study_run_options(s)})
         ds = _run(map2d, model, x_axis, y_axis, run, lyapunov, client, out,
                   chunk, err)
     finally:

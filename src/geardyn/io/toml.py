@@ -16,8 +16,12 @@ A *study file* holds the device parameters plus run settings::
     base = "paper"                  # PlanetaryParams.paper() ...
     [params.changes]                # ... with changes by the paper's names (xi1, backlash, B1, ...)
     xi1 = 0.05
-    [run]                           # optional: omega, transient, periods, steps_per_period
-    transient = 4000.0
+    [run]                           # optional: omega, periods, steps_per_period and
+    transient = 4000.0              # the transient: a time (tau) ...
+    # transient_periods = 20        # ... or forcing periods of the run's lowest Omega
+    converge = 1e-6                 # optional: transient by convergence (then a minimum),
+    transient_max = 40000.0         #   up to this (default 10 x transient)
+    # continued_transient, max_period, period_tol: as geardyn.RunSettings
     [sweep]                         # optional: param, start, stop, num, continuation,
                                     # samples, lyapunov (see SweepSettings)
 
@@ -29,6 +33,14 @@ For ``model = "planetary"`` it holds :class:`~geardyn.PlanetaryGearSet` argument
 ``[params.geometry]`` table (:class:`GeometryTable`) builds it from gear geometry instead of
 mesh stiffnesses); their values are checked when the model is built (errors name
 ``params.<field>``).
+
+The ``[run]`` table (:class:`RunTable`) sets the :class:`geardyn.RunSettings` of the study's
+runs (command-line options win): ``transient`` (tau) or ``transient_periods`` (not both: the
+transient is then that many forcing periods at the lowest Omega of the run, e.g. of a sweep's
+range, so every point gets at least that many), ``periods`` (samples), ``steps_per_period``,
+``converge`` (a relative tolerance in (0, 1): the transient runs on until the Poincare point has
+settled, up to ``transient_max``, which needs ``converge``), ``continued_transient``,
+``max_period`` and ``period_tol`` (the period classifier). Errors name ``run.<field>``.
 
 This module only reads and validates: a study file becomes a :class:`Study` (plain, validated
 data; its device parameters a :class:`~geardyn.PlanetaryParams`). Turning a study into a model is
@@ -57,6 +69,7 @@ from pydantic import (
 )
 from pydantic_core import InitErrorDetails, PydanticCustomError
 
+from geardyn.core.settings import DEFAULT_MAX_PERIOD, DEFAULT_TOL
 from geardyn.errors import ParameterError, StudyError
 from geardyn.files import atomic_replace
 from geardyn.models.params import PAPER_NAMES, Angle, PlanetaryParams, Real, Whole
@@ -112,17 +125,73 @@ class StudyInfo(BaseModel):
 
 
 class RunTable(BaseModel):
-    """The ``[run]`` table: defaults of ``geardyn simulate`` and ``geardyn bifurcation``
-    (command-line options win). ``omega`` is also the fixed Omega of a sweep of another
-    parameter; ``transient`` and ``steps_per_period`` apply to sweeps too.
-    :meth:`Study.run_settings` turns it into the :class:`geardyn.RunSettings` of a run."""
+    """The ``[run]`` table: defaults of ``geardyn simulate``, ``bifurcation``, ``frc``, ``map``
+    and ``basins`` (command-line options win). ``omega`` is also the fixed Omega of a sweep of
+    another parameter; the transient, convergence and classifier settings apply to sweeps too.
+    :meth:`Study.run_settings` turns it into the :class:`geardyn.RunSettings` of a run.
+
+    The transient is given either as a time (``transient``, dimensionless tau) or in forcing
+    periods (``transient_periods``: at least that many periods at every point of the run, i.e.
+    ``transient_periods`` x 2 pi / the lowest Omega of the run), not both. ``converge`` turns the
+    transient into a minimum: the run goes on, up to ``transient_max``, until the Poincare point
+    has settled to that relative tolerance."""
 
     model_config = _CONFIG
 
     omega: Real | None = Field(None, gt=0, description="mesh frequency Omega = omega/omega_n")
     transient: Real = Field(4000.0, ge=0, description="discarded time, dimensionless tau")
+    transient_periods: Real | None = Field(
+        None, gt=0, description="discarded time in forcing periods of the lowest Omega of the "
+        "run (instead of transient)")
     periods: Whole = Field(64, ge=1, description="forcing periods recorded")
     steps_per_period: Whole | None = Field(None, ge=4, description="RK4 steps per period")
+    converge: Real | None = Field(
+        None, gt=0, lt=1, description="transient by convergence: relative tolerance to which "
+        "the Poincare point must settle (the transient is then a minimum)")
+    transient_max: Real | None = Field(
+        None, gt=0, description="longest transient by convergence, tau (default 10 x transient)")
+    continued_transient: Real | None = Field(
+        None, ge=0, description="transient of a continued sweep point, tau (default transient)")
+    max_period: Whole | None = Field(
+        None, ge=1, le=256, description="longest period (in forcing periods) classified "
+        f"(default {DEFAULT_MAX_PERIOD})")
+    period_tol: Real | None = Field(
+        None, gt=0, lt=1, description=f"relative tolerance of the period classifier (default "
+        f"{DEFAULT_TOL:g})")
+
+    @model_validator(mode="after")
+    def _consistent(self) -> RunTable:
+        if self.transient_periods is not None and "transient" in self.model_fields_set:
+            raise ValueError("give the transient either as transient (time) or as "
+                             "transient_periods (forcing periods), not both")
+        if self.transient_max is not None:
+            if self.converge is None:
+                raise ValueError("transient_max is the limit of a transient by convergence: "
+                                 "set converge too")
+            if self.transient_periods is None and self.transient_max < self.transient:
+                raise ValueError(f"transient_max ({self.transient_max:g}) must be >= "
+                                 f"transient ({self.transient:g})")
+        return self
+
+    def transient_time(self, omega: float | None = None) -> float:
+        """The discarded time [tau]: ``transient``, or ``transient_periods`` x 2 pi / ``omega``,
+        ``omega`` the lowest forcing frequency Omega of the run (a StudyError without it)."""
+        if self.transient_periods is None:
+            return self.transient
+        if omega is None or not (math.isfinite(omega) and omega > 0):
+            raise StudyError(f"run.transient_periods: needs the run's forcing frequency Omega "
+                             f"(got {omega!r})")
+        return self.transient_periods * 2.0 * math.pi / omega
+
+    def settings_fields(self, omega: float | None = None) -> dict[str, Any]:
+        """The :class:`geardyn.RunSettings` fields this table sets (``transient`` at the lowest
+        forcing frequency ``omega``, see :meth:`transient_time`; ``samples`` excluded)."""
+        out: dict[str, Any] = {"transient": self.transient_time(omega),
+                               "steps_per_period": self.steps_per_period}
+        for name in ("converge", "transient_max", "continued_transient", "max_period",
+                     "period_tol"):
+            out[name] = getattr(self, name)
+        return {k: v for k, v in out.items() if v is not None}
 
 
 #: The old name of :class:`RunTable` (not :class:`geardyn.RunSettings`, which it builds).
@@ -280,6 +349,9 @@ class PlanetaryGearSetParams(BaseModel):
     mesh_frequency: Quantity | None = None
     rotational_only: bool = False
     fixed: list[Literal["carrier", "ring", "sun"]] = Field(default_factory=list)
+    held: Literal["carrier", "ring", "sun"] | None = Field(
+        None, description="member held in the input_speed kinematics (with [params.geometry]; "
+        "default: the one fixed member, else the ring)")
     time_scale: Quantity | None = None
     length_scale: Quantity = 1e-6
 
@@ -356,9 +428,10 @@ class Study(BaseModel):
 
     _planetary: PlanetaryParams | None = PrivateAttr(None)
 
-    def run_settings(self, sweep: bool = False, **options: Any):
-        """The :class:`geardyn.RunSettings` of this study: ``transient`` and
-        ``steps_per_period`` of ``[run]``, the samples ``[run].periods`` (with ``sweep``:
+    def run_settings(self, sweep: bool = False, omega: float | None = None, **options: Any):
+        """The :class:`geardyn.RunSettings` of this study: the ``[run]`` table's settings
+        (:meth:`RunTable.settings_fields`; ``omega`` the lowest forcing frequency of the run,
+        needed by ``transient_periods``), the samples ``[run].periods`` (with ``sweep``:
         ``[sweep].samples`` where given), and ``options`` (RunSettings fields; ``None`` keeps
         the study's value) over them."""
         from geardyn.core.settings import RunSettings as Settings
@@ -366,9 +439,12 @@ class Study(BaseModel):
         samples = self.run.periods
         if sweep and self.sweep is not None and self.sweep.samples is not None:
             samples = self.sweep.samples
-        base = {"transient": self.run.transient, "samples": samples,
-                "steps_per_period": self.run.steps_per_period}
-        base.update({k: v for k, v in options.items() if v is not None})
+        given = {k: v for k, v in options.items() if v is not None}
+        base = self.run.settings_fields(omega) if "transient" not in given else {
+            **self.run.model_copy(update={"transient_periods": None}).settings_fields(),
+            "transient": given["transient"]}
+        base["samples"] = samples
+        base.update(given)
         return Settings(**base)
 
     @model_validator(mode="before")
@@ -433,8 +509,12 @@ class Study(BaseModel):
         return self.study.plot_state or DEFAULT_PLOT_STATE[self.study.model]
 
     def to_toml_dict(self) -> dict[str, Any]:
-        """The study as TOML-ready tables (``None`` values left out)."""
-        return self.model_dump(exclude_none=True)
+        """The study as TOML-ready tables (``None`` values left out; ``[run].transient`` too
+        where ``transient_periods`` stands for it)."""
+        data = self.model_dump(exclude_none=True)
+        if self.run.transient_periods is not None:
+            data["run"].pop("transient", None)
+        return data
 
 
 # --------------------------------------------------------------------------- reading

@@ -99,6 +99,25 @@ _FROM_GEOMETRY = ("n_planets", "planet_angles", "sun_pressure_angle", "ring_pres
                   "ring_mesh_phase")
 
 
+#: Attributes :meth:`PlanetaryGearSet.from_geometry` attaches, kept by ``with_params``.
+_FROM_BUILD = ("geometry", "stiffness_waveforms", "held")
+#: The sweep parameter of a set built from geometry: the input member's speed [rpm].
+INPUT_SPEED = "input_speed"
+#: Units of the swept inputs, by kind (dataset axis attributes; see ``param_attrs``).
+_UNITS = {"mesh_frequency": "rad/s", INPUT_SPEED: "rpm", "torque_phase": "rad",
+          "sun_pressure_angle": "rad", "ring_pressure_angle": "rad"}
+_UNIT_SUFFIXES = (("_torque", "N m"), ("_mesh_stiffness", "N/m"), ("_backlash", "m"),
+                  ("_mesh_error", "m"), ("_phase", "rad"))
+
+
+def _rpm(field: str, value: object) -> float:
+    """A speed in rpm: a plain number is rpm, a unit string (``"3000 rpm"``, ``"300 rad/s"``)
+    is converted; finite and >= 0."""
+    if isinstance(value, str):
+        return _si(field, value, "frequency") * 60.0 / (2.0 * math.pi)
+    return _si(field, value, "dimensionless")
+
+
 def _with_radius(name: str, member: Member, radius: float) -> Member:
     """``member`` with ``radius`` set from the geometry; a given radius must agree with it."""
     if member.radius is None:
@@ -347,7 +366,7 @@ class PlanetaryGearSet(Model):
     def from_geometry(cls, geometry: Any, *, sun: Member, ring: Member, carrier: Member,
                       planet: Member, harmonics: int = 9,
                       waveform_options: Mapping[str, Any] | None = None,
-                      **kw: Any) -> PlanetaryGearSet:
+                      held: str | None = None, **kw: Any) -> PlanetaryGearSet:
         """The gear set of a :class:`geardyn.gears.PlanetaryGeometry` (see ``docs/planetary.md``,
         "From gear geometry").
 
@@ -362,6 +381,8 @@ class PlanetaryGearSet(Model):
         ``ring_backlash`` where not given: half the geometry's normal backlash
         j cos(alpha_w) / 2 of each mesh [m] (0 at the default, tight centre distance).
         ``kw`` are the other :class:`PlanetaryGearSet` inputs (damping, torques, errors, ...).
+        ``held``: the member held still in the kinematics of :attr:`input_speed` (``"ring"``,
+        ``"carrier"`` or ``"sun"``; default the one member in ``fixed``, else the ring).
         """
         from geardyn.gears import PlanetaryGeometry
 
@@ -401,7 +422,64 @@ class PlanetaryGearSet(Model):
             **members, **kw)
         model.geometry = geometry
         model.stiffness_waveforms = (w_sun, w_ring)
+        model.held = _held(held, model.fixed)
         return model
+
+    # ------------------------------------------------------------------ input speed
+    @property
+    def input_member(self) -> str:
+        """The member whose speed :attr:`input_speed` is: the sun, or the carrier when the
+        sun is held."""
+        return "carrier" if getattr(self, "held", None) == "sun" else "sun"
+
+    def mesh_frequency_per_input_speed(self) -> float:
+        """Mesh frequency over input speed (both rad/s) of a set built from geometry. The mesh
+        frequency is Z_s times the sun's speed relative to the carrier: Z_s Z_r / (Z_s + Z_r)
+        with the ring held (sun input), Z_s with the carrier held (sun input) or with the sun
+        held (carrier input). A set without geometry raises :class:`ParameterError`."""
+        geo = getattr(self, "geometry", None)
+        if geo is None:
+            raise ParameterError(INPUT_SPEED, None, "needs a gear set built from geometry "
+                                 "(from_geometry or [params.geometry]: the tooth counts); sweep "
+                                 "mesh_frequency [rad/s] instead")
+        zs, zr = geo.sun.teeth, geo.ring.teeth
+        return zs * zr / (zs + zr) if self.held == "ring" else float(zs)
+
+    @property
+    def input_speed(self) -> float:
+        """The input member's speed [rpm] at the model's mesh frequency (set from geometry)."""
+        w = self.omega * self.time_scale / self.mesh_frequency_per_input_speed()
+        return w * 60.0 / (2.0 * math.pi)
+
+    def param_attrs(self, name: str) -> dict[str, str]:
+        """Attributes of a swept parameter's axis: ``units`` (SI, rpm for ``input_speed``)
+        and, for the speeds, ``long_name``; empty for a name without a known unit."""
+        if name == INPUT_SPEED:
+            held = getattr(self, "held", None)
+            return {"units": "rpm", "long_name": f"input ({self.input_member}) speed",
+                    "meaning": f"mesh frequency / {self.mesh_frequency_per_input_speed():.6g} "
+                               f"({held} held), in rpm"}
+        if name == "mesh_frequency":
+            return {"units": "rad/s", "long_name": "mesh frequency"}
+        if name == "Omega":
+            return {}
+        unit = _UNITS.get(name) or next((u for suffix, u in _UNIT_SUFFIXES
+                                         if name.endswith(suffix)), None)
+        if unit is None and name in self.inputs and name not in _NOT_SWEPT:
+            unit = "1"
+        return {} if unit is None else {"units": unit}
+
+    def speed_axes(self, omega: np.ndarray) -> dict[str, tuple[np.ndarray, dict]]:
+        """Mesh frequency [Hz] and, for a set built from geometry, input speed [rpm] at the
+        dimensionless mesh frequencies ``omega`` (coordinates along Omega)."""
+        w = np.asarray(omega, dtype=float) * self.time_scale
+        out = {"mesh_frequency": (w / (2.0 * math.pi),
+                                  {"units": "Hz", "long_name": "mesh frequency"})}
+        if getattr(self, "geometry", None) is not None:
+            attrs = self.param_attrs(INPUT_SPEED)
+            out[INPUT_SPEED] = (w / self.mesh_frequency_per_input_speed() * 60.0
+                                / (2.0 * math.pi), attrs)
+        return out
 
     # ------------------------------------------------------------------ assembly (SI)
     def full_dof_names(self) -> tuple[str, ...]:
@@ -636,9 +714,10 @@ class PlanetaryGearSet(Model):
     def physical_names(self) -> tuple[str, ...]:
         """The numeric constructor inputs a sweep accepts by name (SI), e.g. ``sun_backlash``,
         ``mesh_frequency``, ``sun_torque`` (raw coefficients are in ``param_names``)."""
-        return tuple(k for k, v in self.inputs.items() if k not in _NOT_SWEPT
-                     and (v is None or isinstance(v, int | float | str))
-                     and not isinstance(v, bool))
+        names = tuple(k for k, v in self.inputs.items() if k not in _NOT_SWEPT
+                      and (v is None or isinstance(v, int | float | str))
+                      and not isinstance(v, bool))
+        return names + ((INPUT_SPEED,) if getattr(self, "geometry", None) is not None else ())
 
     @property
     def mesh_names(self) -> tuple[str, ...]:
@@ -651,7 +730,17 @@ class PlanetaryGearSet(Model):
         """A copy with parameters changed by name: constructor inputs (``sun_mesh_stiffness``,
         ``sun_backlash``, ``mesh_frequency``, ``sun_torque``, ...) rebuild the model with the
         same length and time scales; ``Omega`` (dimensionless mesh frequency) and raw
-        coefficients (``param_names``) set that entry of the vector."""
+        coefficients (``param_names``) set that entry of the vector. ``input_speed`` (a set
+        built from geometry; rpm, or a unit string such as ``"3000 rpm"``) sets the mesh
+        frequency (:meth:`mesh_frequency_per_input_speed`)."""
+        if INPUT_SPEED in values:
+            values = dict(values)
+            rpm = _rpm(INPUT_SPEED, values.pop(INPUT_SPEED))
+            if "mesh_frequency" in values or "Omega" in values:
+                raise ParameterError(INPUT_SPEED, rpm, "sets the mesh frequency: give it, "
+                                     "mesh_frequency or Omega, one of them")
+            values["mesh_frequency"] = (rpm * 2.0 * math.pi / 60.0
+                                        * self.mesh_frequency_per_input_speed())
         physical = {k: v for k, v in values.items() if k in self.inputs}
         rest = {k: float(v) for k, v in values.items() if k not in physical}
         raw = getattr(self, "raw_overrides", {})
@@ -661,6 +750,9 @@ class PlanetaryGearSet(Model):
             if "mesh_frequency" not in physical:
                 kw["mesh_frequency"] = self.omega * self.time_scale
             out = type(self)(**kw)
+            for name in _FROM_BUILD:  # what from_geometry attached (the inputs came from it)
+                if hasattr(self, name):
+                    setattr(out, name, getattr(self, name))
             rest = {**raw, **rest}
         else:
             out = copy.copy(self)
@@ -678,7 +770,7 @@ class PlanetaryGearSet(Model):
     def lane_params(self, name: str, values: Sequence[float] | np.ndarray) -> np.ndarray:
         """Coefficient vectors (lanes x n_params) with ``name`` set to ``values`` (a physical
         input re-derives every coefficient, as :meth:`with_params`)."""
-        if name in self.inputs:
+        if name in self.inputs or name == INPUT_SPEED:
             vals = np.asarray(values, dtype=float).ravel()
             rows = [self.with_params(**{name: float(v)}).params for v in vals]
             if len({r.size for r in rows}) != 1:
@@ -852,6 +944,16 @@ class PlanetaryGearSet(Model):
         form = "rotational-only" if self.rotational_only else "rotational-translational"
         return (f"PlanetaryGearSet(N={self.n_planets}, {form}, dofs={len(self.dof_names())}, "
                 f"Omega={self.omega:g})")
+
+
+def _held(held: str | None, fixed: tuple[str, ...]) -> str:
+    """The member held in the input-speed kinematics: ``held``, else the one member in
+    ``fixed``, else the ring."""
+    if held is None:
+        return fixed[0] if len(fixed) == 1 else "ring"
+    if held not in CENTRAL:
+        raise ParameterError("held", held, f"must be one of {', '.join(CENTRAL)}")
+    return held
 
 
 def _groups(f: np.ndarray) -> list[list[int]]:

@@ -1,0 +1,352 @@
+"""What the explorer shows and how it changes, as plain Python (no web framework): the study,
+the parameter window and its history, the parameter overrides, the command line that reproduces
+the view, and the saving of the view.
+
+Every change goes through :class:`ExplorerState`; a change that is not valid returns the message
+to show and leaves the state as it was. The computations live in :mod:`geardyn.explore.compute`.
+"""
+
+from __future__ import annotations
+
+import math
+import shlex
+from collections.abc import Callable
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from geardyn.core.model import Model
+from geardyn.errors import ParameterError
+from geardyn.io.toml import GearPairParams, PaperBase, PlanetaryGearSetParams, Study
+
+__all__ = ["CONTINUATIONS", "INTERPRETATIONS", "MAIN_PARAMS", "DiagramRequest", "ExplorerState",
+           "Window", "parse_value"]
+
+#: The main parameters offered as controls, per model kind (``[study].model``): damping ratios,
+#: backlash, meshing error, load (or torque) fluctuation.
+MAIN_PARAMS: dict[str, tuple[str, ...]] = {
+    "catt": ("xi1", "xi2", "backlash", "error", "B1", "Lambda"),
+    "gear_pair": ("zeta", "backlash", "Fa", "kappa"),
+    "planetary": ("mesh_damping", "sun_backlash", "ring_backlash", "sun_mesh_error",
+                  "torque_fluctuation"),
+}
+INTERPRETATIONS = ("consistent", "carrier-only", "as-printed")
+CONTINUATIONS = ("none", "up", "down")
+
+
+@dataclass(frozen=True)
+class Window:
+    """A parameter window: ``num`` evenly spaced values from ``start`` to ``stop``."""
+
+    start: float
+    stop: float
+    num: int
+
+    def values(self) -> np.ndarray:
+        return np.linspace(self.start, self.stop, self.num)
+
+    @property
+    def text(self) -> str:
+        """``START:STOP:NUM`` as ``--range`` takes it (shortest repr: reproduces exactly)."""
+        return f"{_num(self.start)}:{_num(self.stop)}:{self.num}"
+
+
+def _num(x: float) -> str:
+    return repr(float(x)) if float(x) != int(x) else str(int(x))
+
+
+def _rounded(lo: float, hi: float, digits: int = 4) -> tuple[float, float]:
+    """The ends of a zoomed window rounded to ``digits`` significant digits of its width (a
+    box zoom gives ends like 0.8992665036674817; the command line reads better with 0.8993)."""
+    decimals = max(0, digits - 1 - math.floor(math.log10(hi - lo)))
+    a, b = round(lo, decimals), round(hi, decimals)
+    return (a, b) if a < b else (lo, hi)
+
+
+def parse_value(text: str) -> float | str:
+    """A control's text: a number where it reads as one, else the text (a unit string such as
+    ``"30 um"``, which the parameter validation converts or refuses)."""
+    text = text.strip()
+    try:
+        return float(text)
+    except ValueError:
+        return text
+
+
+@dataclass(frozen=True)
+class DiagramRequest:
+    """Everything one diagram computation needs, captured when it is asked for (a later change of
+    the state does not alter a running computation)."""
+
+    model: Model
+    param: str
+    window: Window
+    run: Any  # RunSettings
+    continuation: str
+    plot_state: str
+    attrs: dict[str, Any] = field(default_factory=dict)
+    #: The state's view when the request was made (:meth:`ExplorerState.restore` returns to it).
+    view: dict[str, Any] = field(default_factory=dict, repr=False)
+
+
+def _error_text(exc: BaseException) -> str:
+    return str(exc)
+
+
+class ExplorerState:
+    """The explorer's view of one study.
+
+    Parameters
+    ----------
+    study
+        The study (:func:`geardyn.io.load_study`).
+    source
+        How the study was named on the command line (file or built-in name), for the reproducing
+        command.
+    param, window
+        The swept parameter and the first window (default: the study's ``[sweep]``).
+    save_dir
+        Where :meth:`save` writes the view (and the study with the overrides).
+    describe_error
+        Turns an exception into the one-line message shown (the CLI passes its formatter).
+    """
+
+    def __init__(self, study: Study, source: str, param: str | None = None,
+                 window: Window | None = None, *, interpretation: str | None = None,
+                 continuation: str | None = None, save_dir: Path | str = Path("out/explore"),
+                 describe_error: Callable[[BaseException], str] = _error_text):
+        sweep = study.sweep
+        self.study = study
+        self.source = source
+        self.param = param or (sweep.param if sweep is not None else "Omega")
+        if window is None:
+            if sweep is None or sweep.param != self.param:
+                raise ParameterError("--range", None, "not given, and the study's [sweep] does "
+                                     f"not sweep {self.param}")
+            window = Window(float(sweep.start), float(sweep.stop), int(sweep.num))
+        if window.start == window.stop or window.num < 2:
+            raise ParameterError("--range", window.text, "needs START != STOP and NUM >= 2")
+        self.window = window
+        self.history: list[Window] = []
+        self.overrides: dict[str, float | str] = {}
+        self.interpretation = interpretation
+        self.continuation = continuation or (sweep.continuation if sweep is not None else "none")
+        self.describe_error = describe_error
+        self.save_dir = Path(save_dir)
+        if self.param != "Omega" and study.run.omega is None:
+            raise ParameterError("--param", self.param, "a sweep of another parameter than "
+                                 "Omega needs [run].omega in the study")
+        self._effective = study
+        self._model = self._build(study, interpretation)
+
+    # ------------------------------------------------------------------ model
+    @property
+    def kind(self) -> str:
+        return self.study.study.model
+
+    def main_params(self) -> tuple[str, ...]:
+        """The parameters offered as controls (the swept one left out)."""
+        return tuple(p for p in MAIN_PARAMS.get(self.kind, ()) if p != self.param)
+
+    def _build(self, study: Study, interpretation: str | None) -> Model:
+        from geardyn.study import build_model
+
+        model = build_model(study, interpretation=interpretation, omega=study.run.omega)
+        if self.param != "Omega":
+            model.lane_params(self.param, [self.window.start, self.window.stop])
+        return model
+
+    @property
+    def model(self) -> Model:
+        """The model of the current view (study plus overrides and interpretation)."""
+        return self._model
+
+    @property
+    def effective_study(self) -> Study:
+        """The study with the overrides applied (what the reproducing command runs)."""
+        return self._effective
+
+    def current_value(self, name: str) -> Any:
+        """The value of a main parameter in the current view (override text, else the study's
+        value in SI units)."""
+        if name in self.overrides:
+            return self.overrides[name]
+        params = self._effective.params
+        if self.kind == "catt":
+            from geardyn.models.params import PAPER_NAMES
+
+            target: Any = self._effective.planetary_params
+            for part in PAPER_NAMES[name][0]:
+                target = getattr(target, part)
+            return target
+        value = getattr(params, name)
+        return value[0] if isinstance(value, list | tuple) else value
+
+    def _with_overrides(self, overrides: dict[str, float | str]) -> Study:
+        """The study with ``overrides`` applied, validated as a study file is."""
+        doc = self.study.model_dump(exclude_none=True)
+        params = self.study.params
+        if isinstance(params, PaperBase):
+            doc["params"]["changes"] = {**doc["params"].get("changes", {}), **overrides}
+        elif isinstance(params, GearPairParams | PlanetaryGearSetParams):
+            doc["params"].update(overrides)
+        else:  # full PlanetaryParams
+            doc["params"] = params.replace(**overrides).model_dump(exclude_none=True)
+        return Study.model_validate(doc)
+
+    def set_override(self, name: str, text: str) -> str | None:
+        """Set a main parameter from a control's text. Returns None, or the validation message
+        (the state is then unchanged)."""
+        if name not in MAIN_PARAMS.get(self.kind, ()):
+            return f"{name}: not a parameter of this explorer"
+        overrides = {**self.overrides, name: parse_value(text)}
+        return self._apply(overrides, self.interpretation)
+
+    def set_interpretation(self, value: str) -> str | None:
+        """Change the interpretation (CATT device studies only); None or the message."""
+        if self.kind != "catt":
+            return f"interpretation: a {self.kind} study has none"
+        if value not in INTERPRETATIONS:
+            return f"interpretation: must be one of {', '.join(INTERPRETATIONS)} (got {value!r})"
+        return self._apply(self.overrides, value)
+
+    def set_continuation(self, value: str) -> str | None:
+        if value not in CONTINUATIONS:
+            return f"continuation: must be one of {', '.join(CONTINUATIONS)} (got {value!r})"
+        self.continuation = value
+        return None
+
+    def _apply(self, overrides: dict[str, float | str], interpretation: str | None
+               ) -> str | None:
+        try:
+            study = self._with_overrides(overrides)
+            model = self._build(study, interpretation)
+        except Exception as exc:  # every refusal is shown, the state kept
+            return self.describe_error(exc)
+        self.overrides, self.interpretation = overrides, interpretation
+        self._effective, self._model = study, model
+        return None
+
+    # ------------------------------------------------------------------ window
+    def zoom(self, start: float, stop: float) -> str | None:
+        """Move to the window [start, stop] (same number of points); the current one goes on the
+        history. None, or why not (the state is then unchanged)."""
+        lo, hi = sorted((float(start), float(stop)))
+        if not (math.isfinite(lo) and math.isfinite(hi)) or lo == hi:
+            return f"window: needs two different finite ends (got {start!r}, {stop!r})"
+        lo, hi = _rounded(lo, hi)
+        if self.param == "Omega" and lo <= 0:
+            return f"window: Omega must stay positive (got {lo:g})"
+        new = Window(lo, hi, self.window.num)
+        if self.param != "Omega":
+            try:
+                self._model.lane_params(self.param, [lo, hi])
+            except Exception as exc:
+                return self.describe_error(exc)
+        if new != self.window:
+            self.history.append(self.window)
+            self.window = new
+        return None
+
+    def back(self) -> bool:
+        """Return to the previous window; False when there is none."""
+        if not self.history:
+            return False
+        self.window = self.history.pop()
+        return True
+
+    # ------------------------------------------------------------------ requests
+    def run_settings(self):
+        return self._effective.run_settings(sweep=True)
+
+    def diagram_request(self) -> DiagramRequest:
+        """The computation of the current view's diagram."""
+        return DiagramRequest(
+            model=self._model, param=self.param, window=self.window, run=self.run_settings(),
+            continuation=self.continuation, plot_state=self._effective.plot_state,
+            attrs={"study": self.study.study.name, "plot_state": self._effective.plot_state,
+                   "command": self.command()},
+            view={"window": self.window, "overrides": dict(self.overrides),
+                  "interpretation": self.interpretation, "continuation": self.continuation,
+                  "effective": self._effective, "model": self._model})
+
+    def restore(self, request: DiagramRequest) -> None:
+        """Return to the view of ``request`` (the last good one, after a computation failed):
+        its window (dropping a history entry that repeats it), parameters and settings."""
+        v = request.view
+        if not v:
+            return
+        if self.window != v["window"] and self.history and self.history[-1] == v["window"]:
+            self.history.pop()
+        self.window = v["window"]
+        self.overrides, self.interpretation = dict(v["overrides"]), v["interpretation"]
+        self.continuation = v["continuation"]
+        self._effective, self._model = v["effective"], v["model"]
+
+    def nearest_value(self, x: float) -> float:
+        """The window's parameter value nearest to ``x``."""
+        values = self.window.values()
+        return float(values[int(np.argmin(np.abs(values - x)))])
+
+    # ------------------------------------------------------------------ reproduce, save
+    def command(self, out: Path | str | None = None, plot: Path | str | None = None,
+                study_file: Path | str | None = None) -> str:
+        """The ``geardyn bifurcation`` command line that computes the current view. With
+        overrides it names ``study_file`` (the study with them, which :meth:`save` writes)."""
+        source = str(study_file) if study_file is not None else self.source
+        if self.overrides and study_file is None:
+            source = str(self.study_file())
+        args = ["geardyn", "bifurcation", source, "--param", self.param,
+                "--range", self.window.text, "--continuation", self.continuation]
+        if self.interpretation is not None:
+            args += ["--interpretation", self.interpretation]
+        if out is not None:
+            args += ["--out", str(out)]
+        if plot is not None:
+            args += ["--plot", str(plot)]
+        return shlex.join(args)
+
+    def study_file(self) -> Path:
+        """Where :meth:`save` writes the study with the overrides."""
+        return self.save_dir / f"{self.study.study.name}-explore.toml"
+
+    def file_stem(self) -> str:
+        w = self.window
+        return f"{self.study.study.name}_{self.param}_{w.start:.6g}-{w.stop:.6g}_{w.num}"
+
+    def save(self, ds: Any, directory: Path | str | None = None) -> list[Path]:
+        """Write the view ``ds`` (the current diagram) to ``directory`` (default
+        :attr:`save_dir`) as NetCDF and PNG, the files ``geardyn bifurcation --out --plot``
+        writes, plus the study with the overrides (when there are any) and the command line;
+        returns the paths written."""
+        from geardyn.io.netcdf import save_dataset
+        from geardyn.io.toml import save_study
+        from geardyn.plotting.bifurcation import plot_bifurcation
+
+        directory = self.save_dir if directory is None else Path(directory)
+        directory.mkdir(parents=True, exist_ok=True)
+        stem = self.file_stem()
+        nc, png = directory / f"{stem}.nc", directory / f"{stem}.png"
+        written = []
+        study_file = None
+        if self.overrides:
+            study_file = directory / self.study_file().name
+            save_study(self._effective, study_file)
+            written.append(study_file)
+        command = self.command(out=nc, plot=png, study_file=study_file)
+        ds = ds.copy()
+        ds.attrs.update(study=self.study.study.name, plot_state=self._effective.plot_state,
+                        command=command)
+        save_dataset(ds, nc)
+        plot_bifurcation(ds, state=self._effective.plot_state, path=png)
+        cmd = directory / f"{stem}.command.txt"
+        cmd.write_text(command + "\n", encoding="utf-8")
+        return [*written, nc, png, cmd]
+
+    def snapshot(self) -> dict[str, Any]:
+        """The view as plain data (for display and tests)."""
+        return {"param": self.param, "window": replace(self.window),
+                "history": list(self.history), "overrides": dict(self.overrides),
+                "interpretation": self.interpretation, "continuation": self.continuation}
