@@ -49,6 +49,9 @@ MESH_NZ = 6
 #: sine or cosine equals it).
 CACHE_ENTRIES = 2
 EMPTY = 2.0
+#: The last row of the vector: 0 in a freshly loaded slot; the lane-block rhs then checks
+#: whether the block's lanes share one Ct (:func:`_lanes_ct_uniform`).
+CT_ROWS = 1
 
 _JIT = {"cache": True, "error_model": "numpy", "boundscheck": False}
 
@@ -67,7 +70,7 @@ def layout(n: int, n_mesh: int, nh: int, nk: int = 0) -> dict[str, int]:
     cache = mz + n_mesh * 3 * MESH_NZ
     return {"F0": f0, "F1": f1, "Kt": kt, "Ct": ct, "mesh": mesh, "block": bs,
             "structure": st, "mesh_nz": mz, "cache": cache,
-            "size": cache + 1 + CACHE_ENTRIES * (2 + n_mesh)}
+            "size": cache + 1 + CACHE_ENTRIES * (2 + n_mesh) + CT_ROWS}
 
 
 def cache_entries(n_mesh: int) -> tuple[list[str], list[float]]:
@@ -79,7 +82,7 @@ def cache_entries(n_mesh: int) -> tuple[list[str], list[float]]:
     for e in range(CACHE_ENTRIES):
         names += [f"cache{e}_sin", f"cache{e}_cos"] + [f"cache{e}_k{m}" for m in range(n_mesh)]
         values += [EMPTY, EMPTY] + [0.0] * n_mesh
-    return names, values
+    return names + ["cache_ct_checked"], values + [0.0]
 
 
 def structure_names(dofs: tuple[str, ...], mesh_names: tuple[str, ...],
@@ -353,6 +356,50 @@ def _lanes_cached_stiffness(PT, nl, S, C, SC, cache, mesh, bs, nh, nm):
     return b + 2
 
 
+@nb.njit(inline="always", **_JIT)
+def _lanes_ct_uniform(PT, nl, cache, n):
+    """Whether every lane of the block has the same Ct (e.g. a sweep in Omega), so that one
+    copy serves all. Checked again only after a slot was loaded (its row ``CT_CHECKED`` of the
+    cache section is then 0); the answer is kept in that row of slot 0."""
+    chk = cache + 1 + CACHE_ENTRIES * (2 + int(PT[N_MESH, 0]))
+    fresh = False
+    for k in range(nl):
+        fresh |= PT[chk, k] == 0.0
+    if fresh:
+        ct = HEADER + 2 * n + n * n
+        same = True
+        for r in range(ct, ct + n * n):
+            v = PT[r, 0]
+            for k in range(nl):
+                same &= PT[r, k] == v
+        for k in range(nl):
+            PT[chk, k] = 1.0
+        PT[chk, 0] = 2.0 if same else 1.0
+    return PT[chk, 0] == 2.0
+
+
+@nb.njit(inline="always", **_JIT)
+def _lanes_ct_broadcast(Y, DY, PT, nl, n):
+    """DY[n + i] -= sum_j Ct[i, j] Y[n + j] with slot 0's Ct for every lane (all equal), in the
+    per-lane order."""
+    ct = HEADER + 2 * n + n * n
+    n4 = n - n % 4
+    for i in range(n):
+        r = ct + i * n
+        for j in range(0, n4, 4):
+            c0 = PT[r + j, 0]
+            c1 = PT[r + j + 1, 0]
+            c2 = PT[r + j + 2, 0]
+            c3 = PT[r + j + 3, 0]
+            for k in range(nl):
+                DY[n + i, k] = (DY[n + i, k] - c0 * Y[n + j, k] - c1 * Y[n + j + 1, k]
+                                - c2 * Y[n + j + 2, k] - c3 * Y[n + j + 3, k])
+        for j in range(n4, n):
+            c0 = PT[r + j, 0]
+            for k in range(nl):
+                DY[n + i, k] -= c0 * Y[n + j, k]
+
+
 @nb.njit(**_JIT)
 def planetary_rhs_lanes(T, Y, DY, PT, nl, S, C, SC):
     """:func:`planetary_rhs` for lanes 0..nl-1 of a block."""
@@ -381,7 +428,9 @@ def planetary_rhs_lanes(T, Y, DY, PT, nl, S, C, SC):
         r = st + 1 + 2 * nk + e
         for k in range(nl):
             DY[i, k] -= PT[r, k] * Y[j, k]
-    if damped:  # Ct = 0 in an undamped lane: its terms subtract zeros
+    if damped and _lanes_ct_uniform(PT, nl, mz + nm * 3 * MESH_NZ, n):
+        _lanes_ct_broadcast(Y, DY, PT, nl, n)
+    elif damped:  # Ct = 0 in an undamped lane: its terms subtract zeros
         ct = HEADER + 2 * n + n * n
         n4 = n - n % 4
         for i in range(n):
