@@ -2,16 +2,17 @@
 gear set (42 states) of the built-in study ``planetary_example``.
 
 Workload: the study's model, 400 Omega in [0.05, 1.2] (mesh frequency over the time scale;
-about 1000-25000 rpm input speed), no continuation, through ``geardyn.bifurcation``, with
+about 1250-30000 rpm input speed), no continuation, through ``geardyn.bifurcation``, with
 explicit settings instead of the study's [run]: ``--samples`` (32) Poincare points after a
 transient of ``--transient-periods`` (200) mesh periods at the lowest Omega, i.e. a transient of
 200 * 2 pi / 0.05 = 25133 time units in every lane (more periods at higher Omega), default steps
-per period. ``--stride k`` runs every k-th point only (a quick, proportional subset). Prints
+per period (``--study-run``: the study's own [run] instead, i.e. transient_periods and
+converge, with ``--samples``). ``--stride k`` runs every k-th point only (a quick subset). Prints
 the workload (lane-steps, steps per period used), the median of ``--repeat`` warm runs (wall
 and process CPU time) and ns per lane-step, and a checksum of the Poincare points.
 
     .venv/bin/python bench/planetary.py [--threads 2] [--repeat 3] [--stride 1]
-        [--transient-periods 200] [--samples 32]
+        [--transient-periods 200] [--samples 32] [--study-run]
 """
 
 from __future__ import annotations
@@ -35,6 +36,9 @@ def workload(args: argparse.Namespace):
     study = builtin_study("planetary_example")
     model = geardyn.build_model(study)
     omegas = np.linspace(0.05, 1.2, 400)[::args.stride]
+    if args.study_run:  # the study's [run] (transient in periods of the lowest Omega, converge)
+        return model, omegas, study.run_settings(sweep=True, omega=float(np.min(omegas)),
+                                                 samples=args.samples)
     transient = args.transient_periods * 2.0 * math.pi / float(np.min(omegas))
     run = geardyn.RunSettings(transient=transient, samples=args.samples)
     return model, omegas, run
@@ -47,6 +51,8 @@ def main() -> None:
     ap.add_argument("--stride", type=int, default=1)
     ap.add_argument("--transient-periods", type=float, default=200.0)
     ap.add_argument("--samples", type=int, default=32)
+    ap.add_argument("--study-run", action="store_true",
+                    help="the study's own [run] settings (with --samples) instead")
     args = ap.parse_args()
     numba.set_num_threads(args.threads)
     model, omegas, run = workload(args)
@@ -57,7 +63,8 @@ def main() -> None:
           f"{platform.machine()}, {os.cpu_count()} cpus, load {os.getloadavg()[0]:.1f}")
     print(f"workload: planetary_example ({model!r}), {omegas.size} Omega in "
           f"[{omegas.min():g}, {omegas.max():g}], transient {run.transient:.1f} "
-          f"({args.transient_periods:g} periods at Omega {omegas.min():g}), {run.samples} "
+          f"({run.transient * omegas.min() / (2 * math.pi):g} periods at Omega "
+          f"{omegas.min():g}; converge {run.converge}), {run.samples} "
           f"samples, default steps per period: {n.max()} at Omega {omegas.min():g} .. "
           f"{n.min()} at Omega {omegas.max():g} (fastest natural frequency "
           f"{float(model.fastest_natural_frequency()[0]):.4f})")
