@@ -77,6 +77,10 @@ def main() -> None:
         walls.append(time.perf_counter() - t0)
         cpus.append(time.process_time() - c0)
     wall, cpu = statistics.median(walls), statistics.median(cpus)
+    if "transient_periods" in ds and "steps_per_period" in ds:  # as run (converge: longer)
+        steps = int(np.sum((ds["transient_periods"].values + run.samples * plan.sample_every)
+                           * ds["steps_per_period"].values.astype(np.int64)))
+        print(f"lane-steps as run: {steps:.4e}")
     print(f"warm wall time: median {wall:.2f} s of {[round(w, 2) for w in walls]}; "
           f"CPU {cpu:.2f} s of {[round(c, 2) for c in cpus]}")
     print(f"{wall * 1e9 / steps:.0f} ns wall per lane-step, {cpu * 1e9 / steps:.0f} ns CPU "
