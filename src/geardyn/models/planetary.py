@@ -631,7 +631,8 @@ class PlanetaryGearSet(Model):
         n = len(names)
         nm = 2 * self.n_planets
         nh = self.fourier.shape[1] // 2
-        lay = pk.layout(n, nm, nh)
+        kt_entries, mesh_dofs = self._kernel_structure()
+        lay = pk.layout(n, nm, nh, len(kt_entries))
         L, w0 = self.length_scale, self.time_scale
         M = self.mass_matrix()
         Minv = np.diag(1.0 / np.diag(M))
@@ -669,6 +670,11 @@ class PlanetaryGearSet(Model):
             names_p += [f"{mn}_{v}" for v in ("b", "E_s", "E_c", "KF", "CF")]
             names_p += [f"{mn}_{ab}{h}" for h in range(1, nh + 1) for ab in "ab"]
             names_p += [f"{mn}_W_{d}" for d in names] + [f"{mn}_G_{d}" for d in names]
+        self._structure = (kt_entries, mesh_dofs)
+        pk.fill_structure(p, kt_entries, mesh_dofs)
+        names_p += pk.structure_names(names, self.mesh_names, kt_entries)
+        cache_names, p[lay["cache"]:] = pk.cache_entries(nm)
+        names_p += cache_names
         self.params = p
         self.param_names = tuple(names_p)
         self.omega_index = pk.OMEGA
@@ -678,6 +684,31 @@ class PlanetaryGearSet(Model):
         self.event_names = tuple(f"x_{m}{s}b_{m}" for m in self.mesh_names for s in "-+")
         self.meshes = tuple((m, 2 * i, 2 * i + 1) for i, m in enumerate(self.mesh_names))
         self._layout = lay
+
+    def _kernel_structure(self) -> tuple[list[tuple[int, int]], list[list[int]]]:
+        """The entries of Kt that the supports can make non-zero (row-major) and the model dofs
+        each mesh row touches (ascending), from the structure alone (not the values), so the
+        same for every lane of a sweep; see :func:`planetary_kernels.fill_structure`."""
+        nf = 9 + 3 * self.n_planets
+        Tf = self.constraint()
+        Sm = np.eye(Tf.shape[1], dtype=bool)  # bearings and supports of the members
+        rows_s, rows_r = [], []
+        for i, psi in enumerate(self.psi):  # a planet bearing: one stiffness, two directions
+            o = 9 + 3 * i
+            c, s = math.cos(psi), math.sin(psi)
+            Kn = sum(np.outer(r, r) for r in (self._row({0: c, 1: s, o: -1.0}),
+                                              self._row({0: -s, 1: c, 2: 1.0, o + 1: -1.0})))
+            Sm |= _clean(Tf.T @ Kn @ Tf) != 0.0
+            rows_s.append([6, 7, 8, o, o + 1, o + 2])
+            rows_r.append([3, 4, 5, o, o + 1, o + 2])
+        T = (Tf != 0.0).astype(int)
+        kt = [(int(i), int(j)) for i, j in zip(*np.nonzero(Sm), strict=True)]
+        dofs = []
+        for keys in rows_s + rows_r:
+            r = np.zeros(nf, dtype=int)
+            r[keys] = 1
+            dofs.append([int(j) for j in np.nonzero(r @ T)[0]])
+        return kt, dofs
 
     @property
     def physical_names(self) -> tuple[str, ...]:
@@ -732,6 +763,7 @@ class PlanetaryGearSet(Model):
                 lay, n = out._layout, int(out.params[pk.N_DOF])
                 ct = out.params[lay["Ct"]:lay["Ct"] + n * n]
                 out.params[pk.DAMPED] = float(np.any(ct != 0.0))
+            pk.fill_structure(out.params, *out._structure)  # the kernel's copy of Kt, W, G
             out.raw_overrides = {**raw, **{k: v for k, v in rest.items() if k != "Omega"}}
         return out
 
@@ -744,7 +776,9 @@ class PlanetaryGearSet(Model):
             if len({r.size for r in rows}) != 1:
                 raise ValueError(f"sweeping {name!r} changes the model's size")
             return np.array(rows)
-        return Model.lane_params(self, name, values)
+        P = Model.lane_params(self, name, values)
+        pk.fill_structure(P, *self._structure)  # the kernel's copy of Kt, W, G
+        return P
 
     # ------------------------------------------------------------------ linear analysis
     def _lane_matrix(self, P: np.ndarray) -> np.ndarray:

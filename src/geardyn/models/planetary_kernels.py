@@ -7,14 +7,27 @@ generalised coordinates over the length scale L and ' = d/dtau, tau = omega_0 t:
     f_m = KF_m k_m(Omega tau) g(W_m . X - e_m, b_m) + CF_m (W_m . X' - e_m')
 
 Kt, Ct: the linear (bearing, support) stiffness and the modal damping matrices premultiplied by
-M^-1 (dense); per mesh m: W_m the deflection row, G_m = M^-1 W_m / (L omega_0^2) [1/N], KF_m and
-CF_m [N] the force per unit deflection and deflection rate, k_m the relative stiffness (Fourier
-series in the mesh phase), e_m = ES_m sin(Omega tau) + EC_m cos(Omega tau) the transmission error.
-f_m is the dynamic mesh force [N], the observable.
+M^-1; per mesh m: W_m the deflection row, G_m = M^-1 W_m / (L omega_0^2) [1/N], KF_m and CF_m [N]
+the force per unit deflection and deflection rate, k_m the relative stiffness (Fourier series in
+the mesh phase), e_m = ES_m sin(Omega tau) + EC_m cos(Omega tau) the transmission error. f_m is
+the dynamic mesh force [N], the observable.
 
 Coefficient vector: a header (``DAMPED`` is 1 where Ct is not zero), the dof vectors F0, F1,
-the matrices Kt, Ct (row-major), then one block per mesh (fixed entries, 2 nh Fourier
-coefficients, W, G).
+the matrices Kt, Ct (row-major), one block per mesh (fixed entries, 2 nh Fourier coefficients,
+W, G), then the *structure* the kernels read (:func:`fill_structure`, derived from the dense
+parts): the count nk of the structural entries of Kt, their rows, columns and values, and per
+mesh ``MESH_NZ`` dof indices with the W and G values there (a mesh row touches at most six
+coordinates: the sun or ring and the planet, three each). So a right-hand side costs
+O(nk + n_mesh (MESH_NZ + n_harm)) instead of O(n^2 + n_mesh n): the dense Kt product and the
+dense mesh rows are the same sums without their structural zeros, term for term in the same order
+(results equal the dense evaluation's). Ct (modal damping) stays dense.
+
+The ``*_lanes`` forms evaluate the same arithmetic, operation for operation, on a block of lanes
+in structure-of-arrays layout (state Y[q, k], coefficients PT[j, k], the forcing phase S[k],
+C[k]; SC: >= 2 scratch rows) for the sweep kernel; the structure (indices) is the same in every
+lane of a sweep (it depends only on inputs that are not swept). The vector ends with the rows
+of a relative-stiffness cache (:func:`cache_entries`), workspace of the lane-block functions in
+the block's own copy PT (:func:`_lanes_cached_stiffness`).
 """
 
 from __future__ import annotations
@@ -22,6 +35,7 @@ from __future__ import annotations
 import math
 
 import numba as nb
+import numpy as np
 
 # header
 OMEGA, N_DOF, N_MESH, N_HARM, TORQUE_ON, TORQUE_ORDER, TORQUE_PHASE, DAMPED = range(8)
@@ -29,20 +43,101 @@ HEADER = 8
 # mesh block fixed entries
 M_B, M_ES, M_EC, M_KF, M_CF = range(5)
 MESH_FIXED = 5
+#: Structural entries per mesh row in the structure section (padded with zero weights).
+MESH_NZ = 6
+#: Entries of the lane-block functions' relative-stiffness cache, and the key of an empty one (no
+#: sine or cosine equals it).
+CACHE_ENTRIES = 2
+EMPTY = 2.0
+#: The last row of the vector: 0 in a freshly loaded slot; the lane-block rhs then checks
+#: whether the block's lanes share one Ct (:func:`_lanes_ct_uniform`).
+CT_ROWS = 1
 
 _JIT = {"cache": True, "error_model": "numpy", "boundscheck": False}
 
 
-def layout(n: int, n_mesh: int, nh: int) -> dict[str, int]:
-    """Offsets of the parts of the coefficient vector for n dofs, n_mesh meshes, nh harmonics."""
+def layout(n: int, n_mesh: int, nh: int, nk: int = 0) -> dict[str, int]:
+    """Offsets of the parts of the coefficient vector for n dofs, n_mesh meshes, nh harmonics
+    and nk structural entries of Kt."""
     f0 = HEADER
     f1 = f0 + n
     kt = f1 + n
     ct = kt + n * n
     mesh = ct + n * n
     bs = MESH_FIXED + 2 * nh + 2 * n
+    st = mesh + n_mesh * bs
+    mz = st + 1 + 3 * nk
+    cache = mz + n_mesh * 3 * MESH_NZ
     return {"F0": f0, "F1": f1, "Kt": kt, "Ct": ct, "mesh": mesh, "block": bs,
-            "size": mesh + n_mesh * bs}
+            "structure": st, "mesh_nz": mz, "cache": cache,
+            "size": cache + 1 + CACHE_ENTRIES * (2 + n_mesh) + CT_ROWS}
+
+
+def cache_entries(n_mesh: int) -> tuple[list[str], list[float]]:
+    """Names and initial values of the stiffness cache rows (see :func:`_lanes_cached_stiffness`):
+    the entry used last, then per entry the forcing phase (sin, cos; 2.0: empty) and the
+    relative stiffness of every mesh there. Workspace of the lane-block functions, not inputs."""
+    names = ["cache_last"]
+    values = [0.0]
+    for e in range(CACHE_ENTRIES):
+        names += [f"cache{e}_sin", f"cache{e}_cos"] + [f"cache{e}_k{m}" for m in range(n_mesh)]
+        values += [EMPTY, EMPTY] + [0.0] * n_mesh
+    return names + ["cache_ct_checked"], values + [0.0]
+
+
+def structure_names(dofs: tuple[str, ...], mesh_names: tuple[str, ...],
+                    kt_entries: list[tuple[int, int]]) -> list[str]:
+    """Names of the structure section's entries (derived coefficients, see the module doc)."""
+    nk = len(kt_entries)
+    out = ["nk"] + [f"Kt_row{e}" for e in range(nk)] + [f"Kt_col{e}" for e in range(nk)]
+    out += [f"Kt_nz_{dofs[i]}_{dofs[j]}" for i, j in kt_entries]
+    for m in mesh_names:
+        out += [f"{m}_nz_index{j}" for j in range(MESH_NZ)]
+        out += [f"{m}_nz_W{j}" for j in range(MESH_NZ)] + [f"{m}_nz_G{j}" for j in range(MESH_NZ)]
+    return out
+
+
+def fill_structure(P: np.ndarray, kt_entries: list[tuple[int, int]],
+                   mesh_dofs: list[list[int]]) -> None:
+    """Write the structure section of every row of ``P`` (lanes x size, in place) from its dense
+    parts: the Kt entries ``kt_entries`` (row-major order) and per mesh the dofs ``mesh_dofs[m]``
+    (ascending, at most ``MESH_NZ``). A dense Kt, W or G entry outside the structure that is not
+    zero (e.g. a raw coefficient override) is a ``ValueError``."""
+    P = np.atleast_2d(P)
+    n, nm, nh = int(P[0, N_DOF]), int(P[0, N_MESH]), int(P[0, N_HARM])
+    nk = len(kt_entries)
+    lay = layout(n, nm, nh, nk)
+    st = lay["structure"]
+    K = P[:, lay["Kt"]:lay["Kt"] + n * n].reshape(-1, n, n)
+    inside = np.zeros((n, n), bool)
+    for i, j in kt_entries:
+        inside[i, j] = True
+    if np.any(K[:, ~inside] != 0.0):
+        raise ValueError("a Kt entry outside the gear set's structure is not zero; the kernel "
+                         "reads only the structural entries")
+    P[:, st] = nk
+    P[:, st + 1:st + 1 + nk] = [i for i, _ in kt_entries]
+    P[:, st + 1 + nk:st + 1 + 2 * nk] = [j for _, j in kt_entries]
+    P[:, st + 1 + 2 * nk:st + 1 + 3 * nk] = K[:, [i for i, _ in kt_entries],
+                                              [j for _, j in kt_entries]]
+    f = MESH_FIXED + 2 * nh
+    for m, dofs in enumerate(mesh_dofs):
+        if len(dofs) > MESH_NZ or list(dofs) != sorted(set(dofs)):
+            raise ValueError(f"mesh {m}: at most {MESH_NZ} ascending dofs (got {dofs})")
+        o = lay["mesh"] + m * lay["block"]
+        W = P[:, o + f:o + f + n]
+        G = P[:, o + f + n:o + f + 2 * n]
+        out = np.ones(n, bool)
+        out[list(dofs)] = False
+        if np.any(W[:, out] != 0.0) or np.any(G[:, out] != 0.0):
+            raise ValueError(f"mesh {m}: a W or G entry outside the gear set's structure is "
+                             "not zero; the kernel reads only the structural entries")
+        q = lay["mesh_nz"] + m * 3 * MESH_NZ
+        k = len(dofs)
+        P[:, q:q + 3 * MESH_NZ] = 0.0  # padding: index 0, zero weights
+        P[:, q:q + k] = dofs
+        P[:, q + MESH_NZ:q + MESH_NZ + k] = W[:, list(dofs)]
+        P[:, q + 2 * MESH_NZ:q + 2 * MESH_NZ + k] = G[:, list(dofs)]
 
 
 @nb.njit(inline="always", **_JIT)
@@ -65,14 +160,29 @@ def _relative_stiffness(p, f, nh, s, c):
 
 
 @nb.njit(inline="always", **_JIT)
-def _mesh_state(y, p, o, n, nh, s, c):
-    """Deflection minus error and its rate (W . X - e, W . X' - e') of the mesh block at o."""
-    w = o + MESH_FIXED + 2 * nh
+def _offsets(p):
+    """n, n_mesh, nh, the mesh blocks' offset and size, the structure's and its mesh part's."""
+    n = int(p[N_DOF])
+    nm = int(p[N_MESH])
+    nh = int(p[N_HARM])
+    mesh = HEADER + 2 * n + 2 * n * n
+    bs = MESH_FIXED + 2 * nh + 2 * n
+    st = mesh + nm * bs
+    mz = st + 1 + 3 * int(p[st])
+    return n, nm, nh, mesh, bs, st, mz
+
+
+@nb.njit(inline="always", **_JIT)
+def _mesh_state(y, p, o, q, n, s, c):
+    """Deflection minus error and its rate (W . X - e, W . X' - e') of the mesh block at o, its
+    structure at q."""
     d = 0.0
     v = 0.0
-    for j in range(n):
-        d += p[w + j] * y[j]
-        v += p[w + j] * y[n + j]
+    for j in range(MESH_NZ):
+        i = int(p[q + j])
+        w = p[q + MESH_NZ + j]
+        d += w * y[i]
+        v += w * y[n + i]
     om = p[OMEGA]
     d -= p[o + M_ES] * s + p[o + M_EC] * c
     v -= om * (p[o + M_ES] * c - p[o + M_EC] * s)
@@ -80,55 +190,74 @@ def _mesh_state(y, p, o, n, nh, s, c):
 
 
 @nb.njit(inline="always", **_JIT)
-def _mesh_force(y, p, o, n, nh, s, c):
-    d, v = _mesh_state(y, p, o, n, nh, s, c)
+def _mesh_force(y, p, o, q, n, nh, s, c):
+    d, v = _mesh_state(y, p, o, q, n, s, c)
     k = _relative_stiffness(p, o + MESH_FIXED, nh, s, c)
     return p[o + M_KF] * k * _dead_zone(d, p[o + M_B]) + p[o + M_CF] * v
+
+
+@nb.njit(inline="always", **_JIT)
+def _mesh_forces_shared(y, out, p, n, nm, nh, mesh, bs, mz, s, c):
+    """The mesh forces into out[:nm]: :func:`_mesh_force` of every mesh with one harmonic
+    recurrence for all (the same operations per mesh; the relative stiffnesses first, in out)."""
+    for m in range(nm):
+        out[m] = 1.0
+    if nh > 0:
+        for m in range(nm):
+            f = mesh + m * bs + MESH_FIXED
+            out[m] = p[f] * c + p[f + 1] * s
+        ch = c
+        sh = s
+        for h in range(1, nh):
+            ch, sh = ch * c - sh * s, sh * c + ch * s
+            for m in range(nm):
+                f = mesh + m * bs + MESH_FIXED + 2 * h
+                out[m] += p[f] * ch + p[f + 1] * sh
+        for m in range(nm):
+            out[m] = 1.0 + out[m]
+    for m in range(nm):
+        o = mesh + m * bs
+        d, v = _mesh_state(y, p, o, mz + m * 3 * MESH_NZ, n, s, c)
+        out[m] = p[o + M_KF] * out[m] * _dead_zone(d, p[o + M_B]) + p[o + M_CF] * v
 
 
 @nb.njit(**_JIT)
 def planetary_rhs(t, y, dy, p, s, c):
     """dy/dt of the planetary gear set (dimensionless)."""
-    n = int(p[N_DOF])
-    nm = int(p[N_MESH])
-    nh = int(p[N_HARM])
-    f0 = HEADER
-    f1 = f0 + n
-    kt = f1 + n
-    ct = kt + n * n
-    mesh = ct + n * n
-    bs = MESH_FIXED + 2 * nh + 2 * n
+    n, nm, nh, mesh, bs, st, mz = _offsets(p)
     fl = 0.0
     if p[TORQUE_ON] != 0.0:
         fl = math.sin(p[TORQUE_ORDER] * p[OMEGA] * t + p[TORQUE_PHASE])
-    damped = p[DAMPED] != 0.0  # modal damping: the Ct product (skipped when Ct = 0)
+    shared = nm <= n  # the mesh forces first, into dy[:nm] (scratch until the end)
+    if shared:
+        _mesh_forces_shared(y, dy, p, n, nm, nh, mesh, bs, mz, s, c)
+    f1 = HEADER + n
     for i in range(n):
-        acc = p[f0 + i] + p[f1 + i] * fl
-        r = kt + i * n
-        for j in range(n):
-            acc -= p[r + j] * y[j]
-        if damped:
-            q = ct + i * n
+        dy[n + i] = p[HEADER + i] + p[f1 + i] * fl
+    nk = int(p[st])
+    for e in range(nk):
+        dy[n + int(p[st + 1 + e])] -= p[st + 1 + 2 * nk + e] * y[int(p[st + 1 + nk + e])]
+    if p[DAMPED] != 0.0:  # modal damping: the dense Ct product (skipped when Ct = 0)
+        ct = HEADER + 2 * n + n * n
+        for i in range(n):
+            acc = dy[n + i]
+            r = ct + i * n
             for j in range(n):
-                acc -= p[q + j] * y[n + j]
-        dy[i] = y[n + i]
-        dy[n + i] = acc
+                acc -= p[r + j] * y[n + j]
+            dy[n + i] = acc
     for m in range(nm):
-        o = mesh + m * bs
-        f = _mesh_force(y, p, o, n, nh, s, c)
-        g = o + MESH_FIXED + 2 * nh + n
-        for j in range(n):
-            dy[n + j] -= f * p[g + j]
+        q = mz + m * 3 * MESH_NZ
+        f = dy[m] if shared else _mesh_force(y, p, mesh + m * bs, q, n, nh, s, c)
+        for j in range(MESH_NZ):
+            dy[n + int(p[q + j])] -= f * p[q + 2 * MESH_NZ + j]
+    for i in range(n):
+        dy[i] = y[n + i]
 
 
 @nb.njit(**_JIT)
 def planetary_events(t, y, g, p):
     """Dead-zone edges: x_m - b_m and x_m + b_m of every mesh (x_m = W_m . X - e_m)."""
-    n = int(p[N_DOF])
-    nm = int(p[N_MESH])
-    nh = int(p[N_HARM])
-    mesh = HEADER + 2 * n + 2 * n * n
-    bs = MESH_FIXED + 2 * nh + 2 * n
+    n, nm, nh, mesh, bs, st, mz = _offsets(p)
     s = 0.0
     c = 1.0
     errors = False
@@ -140,7 +269,7 @@ def planetary_events(t, y, g, p):
         c = math.cos(p[OMEGA] * t)
     for m in range(nm):
         o = mesh + m * bs
-        d, _ = _mesh_state(y, p, o, n, nh, s, c)
+        d, _ = _mesh_state(y, p, o, mz + m * 3 * MESH_NZ, n, s, c)
         g[2 * m] = d - p[o + M_B]
         g[2 * m + 1] = d + p[o + M_B]
 
@@ -148,10 +277,281 @@ def planetary_events(t, y, g, p):
 @nb.njit(**_JIT)
 def planetary_observe(t, y, out, p, s, c):
     """Dynamic mesh forces [N], one per mesh (sun-planet meshes, then ring-planet meshes)."""
-    n = int(p[N_DOF])
-    nm = int(p[N_MESH])
-    nh = int(p[N_HARM])
+    n, nm, nh, mesh, bs, st, mz = _offsets(p)
+    _mesh_forces_shared(y, out, p, n, nm, nh, mesh, bs, mz, s, c)
+
+
+# ---------------------------------------------------------------------------------------------
+# Lane-block forms (structure of arrays, lane k innermost): the arithmetic of the functions
+# above, operation for operation, so a lane's result is bitwise the per-lane one's.
+
+
+@nb.njit(inline="always", **_JIT)
+def _lanes_offsets(PT):
+    n = int(PT[N_DOF, 0])
+    nm = int(PT[N_MESH, 0])
+    nh = int(PT[N_HARM, 0])
     mesh = HEADER + 2 * n + 2 * n * n
     bs = MESH_FIXED + 2 * nh + 2 * n
+    st = mesh + nm * bs
+    mz = st + 1 + 3 * int(PT[st, 0])
+    return n, nm, nh, mesh, bs, st, mz
+
+
+@nb.njit(inline="always", **_JIT)
+def _lanes_stiffness(PT, nl, S, C, SC, rb, mesh, bs, nh, nm):
+    """:func:`_relative_stiffness` of every mesh m into PT[rb + m] (the harmonic recurrence in
+    SC rows 0, 1), the same operations in the same order."""
+    if nh == 0:
+        for m in range(nm):
+            for k in range(nl):
+                PT[rb + m, k] = 1.0
+        return
     for m in range(nm):
-        out[m] = _mesh_force(y, p, mesh + m * bs, n, nh, s, c)
+        f = mesh + m * bs + MESH_FIXED
+        for k in range(nl):
+            PT[rb + m, k] = PT[f, k] * C[k] + PT[f + 1, k] * S[k]
+    for k in range(nl):
+        SC[0, k] = C[k]
+        SC[1, k] = S[k]
+    for h in range(1, nh):
+        for k in range(nl):
+            ch = SC[0, k]
+            sh = SC[1, k]
+            SC[0, k] = ch * C[k] - sh * S[k]
+            SC[1, k] = sh * C[k] + ch * S[k]
+        for m in range(nm):
+            f = mesh + m * bs + MESH_FIXED + 2 * h
+            for k in range(nl):
+                PT[rb + m, k] += PT[f, k] * SC[0, k] + PT[f + 1, k] * SC[1, k]
+    for m in range(nm):
+        for k in range(nl):
+            PT[rb + m, k] = 1.0 + PT[rb + m, k]
+
+
+@nb.njit(inline="always", **_JIT)
+def _lanes_cached_stiffness(PT, nl, S, C, SC, cache, mesh, bs, nh, nm):
+    """Row of PT from which the relative stiffness of mesh m is row + m, at the forcing phase
+    (S, C) of every lane. The block's PT carries a small cache (rows from ``cache``; reset to
+    empty whenever a slot is loaded with a lane's coefficients): the four RK4 stages of a step
+    see two new phases (the mid-step one twice, the end one again as the next step's start and
+    for the observables), so half the evaluations are found there. An entry is used only where
+    every lane's phase equals its key exactly, so the values are those computed anew."""
+    width = 2 + nm
+    for e in range(CACHE_ENTRIES):
+        b = cache + 1 + e * width
+        hit = True
+        for k in range(nl):
+            hit &= (PT[b, k] == S[k]) & (PT[b + 1, k] == C[k])
+        if hit:
+            PT[cache, 0] = e
+            return b + 2
+    e = (int(PT[cache, 0]) + 1) % CACHE_ENTRIES  # not the entry used last
+    b = cache + 1 + e * width
+    _lanes_stiffness(PT, nl, S, C, SC, b + 2, mesh, bs, nh, nm)
+    for k in range(nl):
+        PT[b, k] = S[k]
+        PT[b + 1, k] = C[k]
+    PT[cache, 0] = e
+    return b + 2
+
+
+@nb.njit(inline="always", **_JIT)
+def _lanes_ct_uniform(PT, nl, cache, n):
+    """Whether every lane of the block has the same Ct (e.g. a sweep in Omega), so that one
+    copy serves all. Checked again only after a slot was loaded (its row ``CT_CHECKED`` of the
+    cache section is then 0); the answer is kept in that row of slot 0."""
+    chk = cache + 1 + CACHE_ENTRIES * (2 + int(PT[N_MESH, 0]))
+    fresh = False
+    for k in range(nl):
+        fresh |= PT[chk, k] == 0.0
+    if fresh:
+        ct = HEADER + 2 * n + n * n
+        same = True
+        for r in range(ct, ct + n * n):
+            v = PT[r, 0]
+            for k in range(nl):
+                same &= PT[r, k] == v
+        for k in range(nl):
+            PT[chk, k] = 1.0
+        PT[chk, 0] = 2.0 if same else 1.0
+    return PT[chk, 0] == 2.0
+
+
+@nb.njit(inline="always", **_JIT)
+def _lanes_ct_broadcast(Y, DY, PT, nl, n):
+    """DY[n + i] -= sum_j Ct[i, j] Y[n + j] with slot 0's Ct for every lane (all equal), in the
+    per-lane order."""
+    ct = HEADER + 2 * n + n * n
+    n4 = n - n % 4
+    for i in range(n):
+        r = ct + i * n
+        for j in range(0, n4, 4):
+            c0 = PT[r + j, 0]
+            c1 = PT[r + j + 1, 0]
+            c2 = PT[r + j + 2, 0]
+            c3 = PT[r + j + 3, 0]
+            for k in range(nl):
+                DY[n + i, k] = (DY[n + i, k] - c0 * Y[n + j, k] - c1 * Y[n + j + 1, k]
+                                - c2 * Y[n + j + 2, k] - c3 * Y[n + j + 3, k])
+        for j in range(n4, n):
+            c0 = PT[r + j, 0]
+            for k in range(nl):
+                DY[n + i, k] -= c0 * Y[n + j, k]
+
+
+@nb.njit(**_JIT)
+def planetary_rhs_lanes(T, Y, DY, PT, nl, S, C, SC):
+    """:func:`planetary_rhs` for lanes 0..nl-1 of a block."""
+    n, nm, nh, mesh, bs, st, mz = _lanes_offsets(PT)
+    torque = False
+    damped = False
+    for k in range(nl):
+        torque |= PT[TORQUE_ON, k] != 0.0
+        damped |= PT[DAMPED, k] != 0.0
+    for k in range(nl):
+        SC[0, k] = 0.0
+    if torque:
+        for k in range(nl):
+            if PT[TORQUE_ON, k] != 0.0:
+                SC[0, k] = math.sin(PT[TORQUE_ORDER, k] * PT[OMEGA, k] * T[k]
+                                    + PT[TORQUE_PHASE, k])
+    f1 = HEADER + n
+    for i in range(n):
+        for k in range(nl):
+            DY[i, k] = Y[n + i, k]
+            DY[n + i, k] = PT[HEADER + i, k] + PT[f1 + i, k] * SC[0, k]
+    nk = int(PT[st, 0])
+    for e in range(nk):
+        i = n + int(PT[st + 1 + e, 0])
+        j = int(PT[st + 1 + nk + e, 0])
+        r = st + 1 + 2 * nk + e
+        for k in range(nl):
+            DY[i, k] -= PT[r, k] * Y[j, k]
+    if damped and _lanes_ct_uniform(PT, nl, mz + nm * 3 * MESH_NZ, n):
+        _lanes_ct_broadcast(Y, DY, PT, nl, n)
+    elif damped:  # Ct = 0 in an undamped lane: its terms subtract zeros
+        ct = HEADER + 2 * n + n * n
+        n4 = n - n % 4
+        for i in range(n):
+            r = ct + i * n
+            for j in range(0, n4, 4):  # four terms per pass over the lanes, in order
+                for k in range(nl):
+                    DY[n + i, k] = (DY[n + i, k] - PT[r + j, k] * Y[n + j, k]
+                                    - PT[r + j + 1, k] * Y[n + j + 1, k]
+                                    - PT[r + j + 2, k] * Y[n + j + 2, k]
+                                    - PT[r + j + 3, k] * Y[n + j + 3, k])
+            for j in range(n4, n):
+                for k in range(nl):
+                    DY[n + i, k] -= PT[r + j, k] * Y[n + j, k]
+    kr = _lanes_cached_stiffness(PT, nl, S, C, SC, mz + nm * 3 * MESH_NZ, mesh, bs, nh, nm)
+    for m in range(nm):
+        _lanes_mesh(Y, DY, PT, nl, S, C, SC, n, mesh + m * bs, mz + m * 3 * MESH_NZ, kr + m,
+                    True)
+
+
+@nb.njit(inline="always", **_JIT)
+def _lanes_mesh(Y, DY, PT, nl, S, C, SC, n, o, q, row, apply):
+    """Mesh force of the block at o (structure at q, relative stiffness in PT[row]) for every
+    lane, into SC[0], then subtracted from the accelerations DY (``apply``) or copied to DY[0]
+    (observables). One store stream per lane loop, so that the loops vectorise."""
+    i0 = int(PT[q, 0])
+    i1 = int(PT[q + 1, 0])
+    i2 = int(PT[q + 2, 0])
+    i3 = int(PT[q + 3, 0])
+    i4 = int(PT[q + 4, 0])
+    i5 = int(PT[q + 5, 0])
+    w = q + MESH_NZ
+    for k in range(nl):
+        d = 0.0
+        v = 0.0
+        d += PT[w, k] * Y[i0, k]
+        v += PT[w, k] * Y[n + i0, k]
+        d += PT[w + 1, k] * Y[i1, k]
+        v += PT[w + 1, k] * Y[n + i1, k]
+        d += PT[w + 2, k] * Y[i2, k]
+        v += PT[w + 2, k] * Y[n + i2, k]
+        d += PT[w + 3, k] * Y[i3, k]
+        v += PT[w + 3, k] * Y[n + i3, k]
+        d += PT[w + 4, k] * Y[i4, k]
+        v += PT[w + 4, k] * Y[n + i4, k]
+        d += PT[w + 5, k] * Y[i5, k]
+        v += PT[w + 5, k] * Y[n + i5, k]
+        d -= PT[o + M_ES, k] * S[k] + PT[o + M_EC, k] * C[k]
+        v -= PT[OMEGA, k] * (PT[o + M_ES, k] * C[k] - PT[o + M_EC, k] * S[k])
+        SC[0, k] = (PT[o + M_KF, k] * PT[row, k] * _dead_zone(d, PT[o + M_B, k])
+                    + PT[o + M_CF, k] * v)
+    if not apply:
+        for k in range(nl):
+            DY[0, k] = SC[0, k]
+        return
+    g = q + 2 * MESH_NZ
+    for j in range(MESH_NZ):
+        r = n + int(PT[q + j, 0])
+        for k in range(nl):
+            DY[r, k] -= SC[0, k] * PT[g + j, k]
+
+
+@nb.njit(**_JIT)
+def planetary_events_lanes(T, Y, G, PT, nl):
+    """:func:`planetary_events` for lanes 0..nl-1 of a block."""
+    n, nm, nh, mesh, bs, st, mz = _lanes_offsets(PT)
+    errors = False
+    for k in range(nl):
+        for m in range(nm):
+            o = mesh + m * bs
+            errors |= (PT[o + M_ES, k] != 0.0) | (PT[o + M_EC, k] != 0.0)
+    if errors:  # the forcing phase per lane, as the per-lane function (one lane at a time)
+        for k in range(nl):
+            lane_err = False
+            for m in range(nm):
+                o = mesh + m * bs
+                lane_err |= (PT[o + M_ES, k] != 0.0) | (PT[o + M_EC, k] != 0.0)
+            s = 0.0
+            c = 1.0
+            if lane_err:
+                s = math.sin(PT[OMEGA, k] * T[k])
+                c = math.cos(PT[OMEGA, k] * T[k])
+            for m in range(nm):
+                o = mesh + m * bs
+                q = mz + m * 3 * MESH_NZ
+                d = 0.0
+                for j in range(MESH_NZ):
+                    d += PT[q + MESH_NZ + j, k] * Y[int(PT[q + j, 0]), k]
+                d -= PT[o + M_ES, k] * s + PT[o + M_EC, k] * c
+                G[2 * m, k] = d - PT[o + M_B, k]
+                G[2 * m + 1, k] = d + PT[o + M_B, k]
+        return
+    for m in range(nm):
+        o = mesh + m * bs
+        q = mz + m * 3 * MESH_NZ
+        w = q + MESH_NZ
+        i0 = int(PT[q, 0])
+        i1 = int(PT[q + 1, 0])
+        i2 = int(PT[q + 2, 0])
+        i3 = int(PT[q + 3, 0])
+        i4 = int(PT[q + 4, 0])
+        i5 = int(PT[q + 5, 0])
+        for k in range(nl):  # the deflection into row 2m + 1 first: one store per loop
+            d = 0.0
+            d += PT[w, k] * Y[i0, k]
+            d += PT[w + 1, k] * Y[i1, k]
+            d += PT[w + 2, k] * Y[i2, k]
+            d += PT[w + 3, k] * Y[i3, k]
+            d += PT[w + 4, k] * Y[i4, k]
+            d += PT[w + 5, k] * Y[i5, k]
+            G[2 * m + 1, k] = d - (PT[o + M_ES, k] * 0.0 + PT[o + M_EC, k] * 1.0)
+        for k in range(nl):
+            d = G[2 * m + 1, k]
+            G[2 * m, k] = d - PT[o + M_B, k]
+            G[2 * m + 1, k] = d + PT[o + M_B, k]
+
+
+@nb.njit(**_JIT)
+def planetary_observe_lanes(T, Y, O, PT, nl, S, C, SC):
+    """:func:`planetary_observe` for lanes 0..nl-1 of a block (O: one row per mesh)."""
+    n, nm, nh, mesh, bs, st, mz = _lanes_offsets(PT)
+    kr = _lanes_cached_stiffness(PT, nl, S, C, SC, mz + nm * 3 * MESH_NZ, mesh, bs, nh, nm)
+    for m in range(nm):
+        _lanes_mesh(Y, O[m:m + 1], PT, nl, S, C, SC, n, mesh + m * bs, mz + m * 3 * MESH_NZ,
+                    kr + m, False)
