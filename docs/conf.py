@@ -22,6 +22,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "src"))
+sys.path.insert(0, str(ROOT / "docs" / "_ext"))
 os.environ.setdefault("MPLBACKEND", "Agg")
 os.environ.setdefault("NUMBA_CACHE_DIR", str(ROOT / ".geardyn-cache" / "numba"))
 os.environ.setdefault("GEARDYN_CACHE_DIR", str(ROOT / ".geardyn-cache"))
@@ -134,7 +135,8 @@ sphinx_gallery_conf = {
     "abort_on_example_error": False,
     "only_warn_on_example_error": False,
     "matplotlib_animations": False,
-    "image_scrapers": ("matplotlib",),
+    "image_scrapers": ("matplotlib", "figure_scraper.scrape"),
+    "capture_repr": (),
     "reset_modules": ("matplotlib",),
     "show_memory": False,
     "plot_gallery": "True",

@@ -109,10 +109,12 @@ class ModelReport:
 
     @property
     def failed(self) -> tuple[RuleResult, ...]:
+        """The rules that failed."""
         return tuple(r for r in self.results if r.status == "failed")
 
     @property
     def ok(self) -> bool:
+        """Whether no rule failed (skipped rules do not count)."""
         return not self.failed
 
     def __str__(self) -> str:

@@ -397,18 +397,22 @@ class PeriodicOrbit:
 
     @property
     def converged(self) -> bool:
+        """Whether Newton's iteration converged (``status`` is ``CONVERGED``)."""
         return self.status == OrbitStatus.CONVERGED
 
     @property
     def omega(self) -> float:
+        """The forcing frequency Omega of the orbit."""
         return self.problem.omega
 
     @property
     def period(self) -> int:
+        """k: the orbit is a fixed point of the k-th iterate of the section map."""
         return self.problem.period
 
     @property
     def duration(self) -> float:
+        """The orbit's period in model time."""
         return self.problem.duration
 
     @property
@@ -424,6 +428,7 @@ class PeriodicOrbit:
 
     @property
     def stable(self) -> bool:
+        """Whether ``stability`` is ``'stable'``."""
         return self.stability == "stable"
 
     @property

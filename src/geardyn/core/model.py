@@ -114,14 +114,17 @@ class Model:
     # ------------------------------------------------------------------ sizes
     @property
     def n_states(self) -> int:
+        """Length of the state vector."""
         return len(self.state_names)
 
     @property
     def n_events(self) -> int:
+        """Number of switching functions (events)."""
         return len(self.event_names)
 
     @property
     def n_observables(self) -> int:
+        """Number of observables (outputs such as mesh forces)."""
         return len(self.observable_names)
 
     @property
