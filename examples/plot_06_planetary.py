@@ -41,7 +41,12 @@ ax.legend()
 
 # %%
 # A sweep of Omega (the mesh frequency over the model's time scale) through the lowest
-# resonances: 70 points and a short transient (the study's ``[sweep]`` has 400).
+# resonances: 70 points and a short transient (the study's ``[sweep]`` has 400). The stage is
+# lightly damped (mesh damping only), and within this page's short transient its Poincaré points
+# have not settled (the classifier finds no period: grey); the bands below show where each
+# sun-planet (s) and ring-planet (r) mesh loses contact near the resonances. For settled motion
+# add ``modal_damping`` to the study's ``[params]`` and a transient by convergence
+# (``RunSettings(converge=1e-8)``).
 run = geardyn.RunSettings(transient=200.0, samples=16)
 bif = geardyn.bifurcation(gs, "Omega", np.linspace(0.05, 1.2, 70), run)
 fig = plot_bifurcation(bif, state=study.plot_state)
