@@ -104,14 +104,36 @@ def _imports(dotted: str) -> bool:
     return False
 
 
+def _pydantic_signature(app, what, name, obj, options, signature, return_annotation):
+    """A parameter class (pydantic model) shows its fields and defaults, not the validators
+    wrapped into their annotations."""
+    import inspect
+
+    from pydantic import BaseModel
+
+    if what != "class" or not (inspect.isclass(obj) and issubclass(obj, BaseModel)):
+        return None
+    parts = []
+    for field, info in obj.model_fields.items():
+        if info.is_required():
+            parts.append(field)
+        elif info.default_factory is not None:
+            parts.append(f"{field}=...")
+        else:
+            parts.append(f"{field}={info.default!r}")
+    return "(*, " + ", ".join(parts) + ")", None
+
+
 def setup(app):
     app.connect("missing-reference", _internal_reference, priority=900)
+    app.connect("autodoc-process-signature", _pydantic_signature)
 
 
 # --- autodoc / numpydoc ------------------------------------------------------------------------
 autosummary_generate = True
 autosummary_imported_members = True
-autodoc_default_options = {"members": True, "member-order": "bysource", "inherited-members": False}
+autodoc_default_options = {"members": True, "member-order": "bysource", "inherited-members": False,
+                           "exclude-members": "model_config, model_fields, model_computed_fields"}
 autodoc_typehints = "signature"
 autodoc_class_signature = "mixed"
 autodoc_preserve_defaults = True
