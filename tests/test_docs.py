@@ -94,3 +94,17 @@ def test_gallery_examples_have_a_title_and_a_figure():
         doc = ast.get_docstring(ast.parse(path.read_text(encoding="utf-8")))
         assert doc and re.search(r"^=+$", doc, re.M), f"{path.name}: no title in its docstring"
         assert "fig" in path.read_text(encoding="utf-8"), f"{path.name} draws no figure"
+
+
+def test_user_guide_study_file_is_valid():
+    """The TOML study shown in the user guide reads, validates and builds its model."""
+    from geardyn.io import load_study
+
+    text = (ROOT / "docs" / "guide" / "studies.md").read_text(encoding="utf-8")
+    toml = re.search(r"```toml\n(.*?)```", text, re.S)
+    assert toml, "no TOML study in docs/guide/studies.md"
+    model = geardyn.build_model(load_study(toml.group(1)))
+    assert isinstance(model, geardyn.CATTDevice)
+    by_api = geardyn.CATTDevice(geardyn.PlanetaryParams.paper(xi1=0.02, xi2=0.02,
+                                                              backlash="50 um"))
+    assert list(model.params) == pytest.approx(list(by_api.params), rel=1e-12)
