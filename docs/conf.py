@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import os
 import sys
+import warnings
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -80,10 +81,26 @@ def _internal_reference(app, env, node, contnode):
     target = node["reftarget"].lstrip("~.")
     if target.startswith("geardyn."):
         found = _imports(target)
-    else:  # a short name (a module constant): defined in one of geardyn's modules
-        found = any(name.startswith("geardyn") and hasattr(mod, target)
-                    for name, mod in list(sys.modules.items()))
+    else:  # a short name: a member of the class being documented, or a module constant
+        found = _class_member(node, target) or any(
+            name.startswith("geardyn") and hasattr(mod, target)
+            for name, mod in list(sys.modules.items()))
     return nodes.literal(target, node.astext() or target) if found else None
+
+
+def _class_member(node, target: str) -> bool:
+    """Whether ``target`` is an attribute or an annotated field of the class in whose
+    docstring the reference stands."""
+    import importlib
+
+    module, klass = node.get("py:module"), node.get("py:class")
+    if not (module and klass):
+        return False
+    obj = importlib.import_module(module)
+    for part in klass.split("."):
+        obj = getattr(obj, part, None)
+    return obj is not None and (hasattr(obj, target) or any(
+        target in vars(c).get("__annotations__", {}) for c in getattr(obj, "__mro__", ())))
 
 
 def _imports(dotted: str) -> bool:
@@ -141,6 +158,8 @@ numpydoc_show_class_members = False
 numpydoc_class_members_toctree = False
 numpydoc_xref_param_type = False
 numpydoc_validation_checks: set[str] = set()
+# numpydoc drops a section it does not know (with only a UserWarning): make that fail the build.
+warnings.filterwarnings("error", message="Unknown section", category=UserWarning)
 
 # --- MyST (the notes in docs/*.md) -------------------------------------------------------------
 myst_enable_extensions = ["dollarmath", "colon_fence", "deflist"]
