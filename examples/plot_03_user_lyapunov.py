@@ -15,24 +15,23 @@ forcing period is 2 pi / Omega.
 A sweep with ``lyapunov=True`` gives every point its largest Lyapunov exponent (per unit
 time), its standard error and a motion class; :func:`geardyn.lyapunov` gives the exponent (or
 the whole spectrum) at one point.
+
+The right-hand side is a ``numba.njit`` function in a small module beside this script,
+``examples/duffing_model.py`` (in a module that can be imported, its kernels are cached on disk;
+defined in the script itself it would work the same, compiled anew in every process):
+
+.. literalinclude:: ../../examples/duffing_model.py
+   :pyobject: duffing
 """
 
 # %%
 import math
 
-import numba
 import numpy as np
+from duffing_model import duffing
 
 import geardyn
 from geardyn.plotting import plot_bifurcation
-
-
-@numba.njit
-def duffing(t, y, dydt, p):
-    delta, gamma, omega = p[0], p[1], p[2]
-    dydt[0] = y[1]
-    dydt[1] = -delta * y[1] + y[0] - y[0] ** 3 + gamma * math.cos(omega * t)
-
 
 model = geardyn.UserModel(duffing, n_states=2, params=[0.3, 0.5, 1.2],
                           param_names=["delta", "gamma", "Omega"], state_names=["x", "v"],
