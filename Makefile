@@ -63,7 +63,7 @@ reproduce-verdicts: $(STAMP)
 
 # The documentation site (Sphinx, docs/conf.py) into docs/_build/html (open index.html), offline;
 # warnings are errors (broken cross-references, docstrings that do not parse, a gallery example
-# in examples/ that fails). The examples run at every build: measured 6.4 min CPU with a cold
+# in examples/ that fails). The examples run at every build: measured 5.8 min CPU with a cold
 # numba cache (kernel compiles; after `make test` most kernels are warm), 41 s CPU warm.
 DOCS_STAMP := $(VENV)/.docs-installed
 $(DOCS_STAMP): $(STAMP) pyproject.toml
