@@ -109,10 +109,12 @@ class ModelReport:
 
     @property
     def failed(self) -> tuple[RuleResult, ...]:
+        """The rules that failed."""
         return tuple(r for r in self.results if r.status == "failed")
 
     @property
     def ok(self) -> bool:
+        """Whether no rule failed (skipped rules do not count)."""
         return not self.failed
 
     def __str__(self) -> str:
@@ -563,7 +565,7 @@ def check_model(
     probes
         Further states: the kink scan (rule 8) also runs along the straight line from y0 to
         each; give states on the far side of every kink of a model whose kinks the default
-        paths (y0 to -y0, each coordinate over y0 +- 2 |y0|) do not reach.
+        paths (y0 to -y0, each coordinate over ``y0 +- 2 abs(y0)``) do not reach.
     periods, steps_per_period, rtol
         Rule 10: forcing periods run (time units for an autonomous model), steps per period
         (default: the model's default step) and the largest difference allowed from the

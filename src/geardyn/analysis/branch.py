@@ -629,7 +629,7 @@ def continuation(model: Model, param: str = "Omega", start: float | None = None,
         default guess).
     ds, ds_min, ds_max
         First, least and greatest arclength step in the scaled unknowns (x / state_scale,
-        p / p_scale; ``p_scale`` default |stop - start|).
+        p / p_scale; ``p_scale`` default ``abs(stop - start)``).
     tol, locate_tol
         Corrector tolerance (scaled residual) and the location tolerance in the parameter.
     switch

@@ -37,6 +37,7 @@ class BranchStatus(IntEnum):
 
     @property
     def message(self) -> str:
+        """What the status means, in words."""
         return _BRANCH_MESSAGES[self]
 
 

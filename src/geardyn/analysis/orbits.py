@@ -397,23 +397,27 @@ class PeriodicOrbit:
 
     @property
     def converged(self) -> bool:
+        """Whether Newton's iteration converged (``status`` is ``CONVERGED``)."""
         return self.status == OrbitStatus.CONVERGED
 
     @property
     def omega(self) -> float:
+        """The forcing frequency Omega of the orbit."""
         return self.problem.omega
 
     @property
     def period(self) -> int:
+        """k: the orbit is a fixed point of the k-th iterate of the section map."""
         return self.problem.period
 
     @property
     def duration(self) -> float:
+        """The orbit's period in model time."""
         return self.problem.duration
 
     @property
     def stability(self) -> str:
-        """'stable' (every |multiplier| < 1), 'unstable' (one > 1), 'marginal' (the largest
+        """'stable' (every ``abs(multiplier) < 1``), 'unstable' (one > 1), 'marginal' (the largest
         within :data:`MARGINAL` of 1) or 'unknown' (not converged or not finite)."""
         if not self.converged or not np.all(np.isfinite(self.multipliers)):
             return "unknown"
@@ -424,6 +428,7 @@ class PeriodicOrbit:
 
     @property
     def stable(self) -> bool:
+        """Whether ``stability`` is ``'stable'``."""
         return self.stability == "stable"
 
     @property
@@ -436,8 +441,8 @@ class PeriodicOrbit:
     @property
     def least_period(self) -> int:
         """The least period in sections: the smallest divisor d of k with the section point
-        back (to 1e-6 of 1 + |x|, scaled) after d sections (a period-k search can find an orbit
-        of a divisor of k); 0 when not converged."""
+        back (to ``1e-6 (1 + abs(x))``, scaled) after d sections (a period-k search can find an
+        orbit of a divisor of k); 0 when not converged."""
         if not self.converged:
             return 0
         pts = self.section_points / self.problem.scale
@@ -450,22 +455,22 @@ class PeriodicOrbit:
 
     @property
     def liouville_error(self) -> float:
-        """|prod(multipliers) / exp(trace_integral) - 1|: how well the monodromy keeps
+        """``abs(prod(multipliers) / exp(trace_integral) - 1)``: how well the monodromy keeps
         Liouville's formula (the integrator's error in the phase-space volume)."""
         det = float(np.real(np.prod(self.multipliers)))
         return abs(det / math.exp(self.trace_integral) - 1.0)
 
     def contact(self) -> dict[str, str]:
         """The contact regime of each mesh over the orbit (``none``, ``single``, ``double``,
-        ``unbounded``), as the sweeps classify it (:func:`geardyn.analysis.contact
-        .contact_regime`, from the events' extremes and the located crossings)."""
+        ``unbounded``), as the sweeps classify it (``geardyn.analysis.contact
+        .contact_regime``, from the events' extremes and the located crossings)."""
         st = np.array([int(self.integration_status)])
         return {name: str(contact_regime(self.event_min[None, :], self.event_max[None, :],
                                          self.crossings[None, :], i, j, st)[0])
                 for name, i, j in self.model.meshes}
 
     def mesh_forces(self) -> dict[str, np.ndarray] | None:
-        """Per mesh over the orbit: ``force_peak`` (max |F|), ``force_rms`` and
+        """Per mesh over the orbit: ``force_peak`` (``max abs(F)``), ``force_rms`` and
         ``dynamic_factor`` (peak / static mesh force, where the model gives it), or None when
         the model does not observe one force per mesh."""
         m = self.model
@@ -599,7 +604,7 @@ def periodic_orbit(model: Model, omega: float | None = None, period: int = 1,
         :class:`~geardyn.RunSettings`: ``steps_per_period``, ``bound``, ``transient`` (of the
         default guess), ``max_section_periods``.
     tol, max_iter
-        Newton tolerance (scaled max norm, relative to 1 + |x|) and most iterations.
+        Newton tolerance (scaled max norm, relative to ``1 + abs(x)``) and most iterations.
     steps_per_period
         RK4 steps per forcing period (default ``run``'s, else :data:`ORBIT_STEP_FACTOR` times
         the step rule).

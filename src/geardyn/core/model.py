@@ -44,9 +44,9 @@ def unique_rows(A: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 class Model:
     """Base class of geardyn models. Subclasses set the attributes in ``__init__``.
 
-    The model contract
-    ------------------
-    Every solver, sweep and analysis relies on these rules, and
+    Notes
+    -----
+    **The model contract.** Every solver, sweep and analysis relies on these rules, and
     :func:`geardyn.testing.check_model` checks each (one check per number; a broken rule is
     reported by its number and name). ``n_states = len(state_names)``; the compiled functions
     are those of :attr:`kernel` (:class:`~geardyn.core.kernel_source.KernelSource`).
@@ -114,14 +114,17 @@ class Model:
     # ------------------------------------------------------------------ sizes
     @property
     def n_states(self) -> int:
+        """Length of the state vector."""
         return len(self.state_names)
 
     @property
     def n_events(self) -> int:
+        """Number of switching functions (events)."""
         return len(self.event_names)
 
     @property
     def n_observables(self) -> int:
+        """Number of observables (outputs such as mesh forces)."""
         return len(self.observable_names)
 
     @property

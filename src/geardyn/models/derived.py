@@ -30,6 +30,8 @@ from geardyn.models.params import DERIVED_FORMULAS as DERIVED_FORMULAS
 from geardyn.models.params import PlanetaryParams
 
 Interpretation = Literal["consistent", "carrier-only", "as-printed"]
+#: The names of the three interpretations of the paper's formulas (docs/model.md), the default
+#: first.
 INTERPRETATIONS: tuple[str, ...] = ("consistent", "carrier-only", "as-printed")
 
 #: The dimensionless coefficients of Eq. (10), per planet set i, with their formulas.

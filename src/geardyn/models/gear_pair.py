@@ -117,7 +117,7 @@ class GearPair(Model):
     """Single spur gear pair with backlash, time-varying stiffness and transmission error.
 
     Parameters (all dimensionless): ``zeta`` damping ratio, ``kappa`` relative stiffness
-    variation (|kappa| < 1), ``Fm`` mean load, ``Fa`` transmission-error amplitude, ``Omega``
+    variation (``abs(kappa) < 1``), ``Fm`` mean load, ``Fa`` transmission-error amplitude, ``Omega``
     mesh frequency, ``kappa_phase`` and ``error_phase`` [rad], ``backlash`` half-width (1 when x
     is scaled by it).
     """
@@ -177,7 +177,8 @@ class GearPair(Model):
 
     def separation_onset(self, omegas: np.ndarray) -> np.ndarray:
         """Linear prediction (kappa = 0): the teeth separate where
-        Fa Omega^2 / |1 - Omega^2 + 2 i zeta Omega| > Fm. Returns that amplitude ratio minus 1."""
+        ``Fa Omega^2 / abs(1 - Omega^2 + 2 i zeta Omega) > Fm``. Returns that amplitude ratio
+        minus 1."""
         om = np.asarray(omegas, dtype=float)
         zeta, fm, fa = self.params[ZETA], self.params[FM], self.params[FA]
         amp = fa * om**2 / np.abs(1.0 - om**2 + 2j * zeta * om)
