@@ -28,7 +28,7 @@ demo: $(STAMP)
 # test workers start (else both compile the same kernels side by side); with a warm cache it
 # only loads them.
 test: $(STAMP)
-	$(BIN)/ruff check src tests
+	$(BIN)/ruff check src tests examples bench
 	$(BIN)/python tests/warm_kernels.py --jobs 2
 	$(BIN)/python -m pytest -n 2 -q
 
@@ -74,7 +74,7 @@ docs: $(DOCS_STAMP)
 	MPLBACKEND=Agg $(BIN)/sphinx-build -W --keep-going -q -b html docs docs/_build/html
 
 lint: $(STAMP)
-	$(BIN)/ruff check src tests
+	$(BIN)/ruff check src tests examples bench
 
 clean:
 	rm -rf $(VENV) out .geardyn-cache docs/_build docs/api/generated docs/auto_examples

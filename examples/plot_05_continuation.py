@@ -20,7 +20,9 @@ from geardyn.plotting.branch import plot_branch
 pair = geardyn.GearPair(zeta=0.05, Fm=0.1, Fa=0.05)
 branch = geardyn.continuation(pair, "Omega", 0.5, 1.6)
 print("branch:", branch.attrs.get("message", ""))
-for kind, value in zip(branch["bifurcation_kind"].values, branch["bifurcation_value"].values):
+for kind, value in zip(
+    branch["bifurcation_kind"].values, branch["bifurcation_value"].values, strict=True
+):
     print(f"{kind:>8} at Omega = {value:.6f}")
 
 sweep = geardyn.bifurcation(pair, "Omega", np.linspace(0.5, 1.6, 56), transient=300.0,
