@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import contextlib
+import math
 import subprocess
 import sys
 import tomllib
@@ -462,6 +463,42 @@ def test_continue_writes_the_branch_and_its_figure(tmp_path):
     assert "continuation dataset" in r.stdout
     assert (tmp_path / "again.pdf").read_bytes()[:5] == PDF
     assert_one_line_error(invoke("plot", nc, "--state", "Q"), "--state", "'Q'")
+
+
+def test_continue_takes_the_first_orbits_transient_from_the_study(tmp_path, monkeypatch):
+    """[run] transient_periods (at the start's Omega), converge and transient_max reach the
+    continuation's first orbit (--transient replaces the study's transient only)."""
+    import geardyn.analysis.branch as branch_module
+    from geardyn import RunSettings, continuation
+
+    study = tmp_path / "settled.toml"
+    study.write_text(SOFT_STUDY.replace("omega = 1.2", "omega = 1.2\ntransient_periods = 30\n"
+                                        "converge = 1e-9\ntransient_max = 900.0"))
+    seen: list = []
+    real = branch_module.continuation
+
+    def recording(*args, **kwargs):
+        seen.append(kwargs["run"])
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(branch_module, "continuation", recording)
+    nc = tmp_path / "b.nc"
+    r = invoke("continue", study, "--range", "0.6:1.0", "--quiet", "--out", nc)
+    assert r.returncode == 0, r.stderr
+    run = seen[-1]
+    assert run.transient == pytest.approx(30 * 2 * math.pi / 0.6)
+    assert run.converge == 1e-9 and run.transient_max == 900.0
+    direct = continuation(GearPair(zeta=0.05, kappa=0.0, Fm=0.1, Fa=0.05), "Omega", 0.6, 1.0,
+                          run=RunSettings(transient=30 * 2 * math.pi / 0.6, converge=1e-9,
+                                          transient_max=900.0))
+    np.testing.assert_array_equal(load_dataset(nc)["Omega"].values, direct["Omega"].values)
+    r = invoke("continue", study, "--range", "0.6:1.0", "--transient", "50", "--quiet")
+    assert r.returncode == 0, r.stderr
+    assert seen[-1].transient == 50.0 and seen[-1].converge == 1e-9
+    # a study without any transient keeps the continuation's own default guess
+    r = invoke("continue", _soft_study(tmp_path), "--range", "0.6:1.0", "--quiet")
+    assert r.returncode == 0, r.stderr
+    assert seen[-1] is None
 
 
 def test_continue_over_a_brute_force_diagram_with_progress(tmp_path, monkeypatch):

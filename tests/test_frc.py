@@ -175,3 +175,32 @@ def test_cli_writes_what_the_api_computes_and_draws_it(tmp_path):
     assert r.exit_code == 2 and "no dimension 'point'" in r.stderr
     r = CliRunner().invoke(app, ["plot", str(nc), "--out", str(tmp_path / "again.pdf")])
     assert r.exit_code == 0 and "frequency response dataset" in r.stdout
+
+
+def test_cli_sweeps_the_studys_input_speed(tmp_path):
+    """``geardyn frc planetary_example`` sweeps the study's own [sweep] parameter, the input
+    speed in rpm: each speed becomes Omega through the model's kinematics (with_params), and
+    the dataset's input_speed axis, computed back from Omega by speed_axes, gives the speeds
+    asked. A model without that parameter, or a parameter that is not a frequency, is a
+    one-line error naming --param."""
+    from typer.testing import CliRunner
+
+    from geardyn.cli.main import app
+    from geardyn.io.netcdf import load_dataset
+
+    nc = tmp_path / "p.nc"
+    r = CliRunner().invoke(app, ["frc", "planetary_example", "--range", "4000:6000:2",
+                                 "--transient", "30", "--samples", "2", "--quiet", "--yes",
+                                 "--out", str(nc)])
+    assert r.exit_code == 0, r.output
+    assert "input_speed [4000, 6000]" in r.stdout
+    saved = load_dataset(nc)
+    assert_result(saved, "frequency-response")
+    np.testing.assert_allclose(saved["input_speed"].values, [4000.0, 6000.0], rtol=1e-12)
+    study = tmp_path / "soft.toml"
+    study.write_text(STUDY)
+    r = CliRunner().invoke(app, ["frc", str(study), "--param", "input_speed", "--range",
+                                 "1:2:2", "--quiet"])
+    assert r.exit_code == 2 and "--param" in r.stderr
+    r = CliRunner().invoke(app, ["frc", str(study), "--param", "zeta", "--quiet"])
+    assert r.exit_code == 2 and "--param" in r.stderr and "frequency" in r.stderr

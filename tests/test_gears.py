@@ -172,9 +172,52 @@ def test_unit_strings():
 
 # -- ISO 6336-1 method B ------------------------------------------------------------------------
 
+#: The two spur planetary stages of the NREL 5 MW reference gearbox: gear data from Nejad,
+#: Guo, Gao & Moan, "Development of a 5 MW reference gearbox for offshore wind turbines", Wind
+#: Energy 19 (2016) 1089-1106, doi:10.1002/we.1884; the stiffnesses as KISSsoft 03/2017
+#: (ISO 6336:2006 method B) reports them for those stages, computed by G. F. S. Rebouças (NTNU)
+#: and published in github.com/gfsReboucas/Drivetrain, @NREL_5MW/stage_01.rtf and stage_02.rtf
+#: ("Singular tooth stiffness c'", "Meshing stiffness cgalf", "Transverse contact ratio").
+#: Every gear: alpha_n = 20 deg, basic rack h_aP* 1.0, h_fP* 1.25 (so C_B = 0.975), C_M 0.8,
+#: webbed blanks b_s/b = 0.25 with C_R printed as 0.862 (s_R/m_n = 3.5 gives 0.86232), line
+#: load above 100 N/mm (519.8 and 1587.5 N/mm). Profile shifts in ISO 21771's sign (an
+#: internal gear's x is -x of geardyn's convention); tip alteration k m_n of the external gears
+#: (-1.750 mm and -10.861 mm) as the addendum factor 1 + k.
+#: (stage, mesh): (module, (z1, x1, k1), (z2, x2_iso, k2), internal, c', c_gamma_alpha, eps_a)
+NREL_5MW = {
+    ("stage 2", "sun-planet"): (21e-3, (18, 0.3890, -1.75 / 21), (36, 0.5039, -1.75 / 21),
+                                False, 12.240, 15.640, 1.370),
+    ("stage 2", "planet-ring"): (21e-3, (36, 0.5039, -1.75 / 21), (93, 0.1171, 0.0),
+                                 True, 14.053, 20.563, 1.618),
+    ("stage 1", "sun-planet"): (45e-3, (19, 0.6170, -10.861 / 45), (17, 0.8021, -10.861 / 45),
+                                False, 12.362, 13.426, 1.115),
+    ("stage 1", "planet-ring"): (45e-3, (17, 0.8021, -10.861 / 45), (56, -0.5013, 0.0),
+                                 True, 13.289, 16.063, 1.278),
+}
+
+
+@pytest.mark.parametrize("case", list(NREL_5MW), ids=" ".join)
+def test_iso_stiffness_against_kisssoft_for_the_nrel_5mw_gearbox(case):
+    """c', c_gamma_alpha and eps_alpha against the independent KISSsoft figures (printed to 3
+    decimals: 6e-4 covers their rounding). Stage 1's sun (19 teeth) is larger than its planets
+    (17): ISO's gear 1 is then the planet, and taking the sun as gear 1 gives c' = 12.665,
+    2.4 % off; the ring's profile shift enters with ISO's sign (the other sign gives 13.81
+    instead of 13.289)."""
+    m, (z1, x1, k1), (z2, x2, k2), internal, c_ref, c_ga_ref, eps_ref = NREL_5MW[case]
+    first = SpurGear(z1, m, 20 * DEG, 0.5, x1, addendum=1 + k1)
+    second = SpurGear(z2, m, 20 * DEG, 0.5, -x2 if internal else x2, addendum=1 + k2,
+                      internal=internal)
+    iso = iso6336_stiffness(GearMesh(first, second, internal=internal), web_ratio=0.25,
+                            rim_ratio=3.5)
+    assert iso.C_B == pytest.approx(0.975) and iso.C_R == pytest.approx(0.862, abs=5e-4)
+    assert iso.contact_ratio == pytest.approx(eps_ref, abs=6e-4)
+    assert iso.c_prime == pytest.approx(c_ref, abs=6e-4)
+    assert iso.c_gamma_alpha == pytest.approx(c_ga_ref, abs=6e-4)
+    assert iso.z_n1 == (z1 if internal else min(z1, z2))
+
+
 def test_iso_single_and_mesh_stiffness_by_hand():
-    """No published worked example of c' and c_gamma_alpha could be found; this evaluates
-    ISO 6336-1:2006 clause 9, method B, by hand with the standard's numbers written out, for
+    """ISO 6336-1:2006 clause 9, method B, by hand with the standard's numbers written out, for
     the DIN 3990 example pair z = (19, 104), x = (0.5, 0.15), basic rack h_fP = 1.25 m,
     alpha_Pn = 20 deg, solid blanks, F_t K_A / b >= 100 N/mm, b = 48.64 mm."""
     mesh = GearMesh(gear(19, 0.5, b=48.64e-3), gear(104, 0.15, b=48.64e-3))

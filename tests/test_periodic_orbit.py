@@ -78,6 +78,35 @@ def test_linear_orbit_matches_the_analytic_steady_state_and_expm():
         assert np.allclose(M @ vk, orb.multipliers[k] * vk, atol=1e-8)
 
 
+def test_default_guess_with_converge_runs_on_until_the_section_point_settles():
+    """The guess's transient by convergence (``run.converge``, as ``geardyn continue`` takes
+    it from a study's [run]): the linear pair's free motion decays by exp(-zeta T) ~ 0.68 a
+    period, so after 5 periods the section point is ~5e-3 from the analytic steady state; with
+    converge = 1e-9 the run goes on until consecutive points agree to 1e-9 (1 + |y|) ~ 4e-9,
+    which leaves at most 4e-9 x 0.68 / (1 - 0.68) ~ 9e-9; a limit (transient_max) stops it
+    earlier."""
+    from geardyn.analysis.orbits import default_guess
+
+    om, zeta = 0.8, 0.05
+    m = geardyn.GearPair(zeta=zeta, kappa=0.0, Fm=2.0, Fa=0.02).with_omega(om)
+    pr = shooting_problem(m)
+    A = _linear_response(m, om)
+    exact = np.array([1.0 + 2.0 + A.real, -om * A.imag])
+    T = 2 * math.pi / om
+
+    def error(y):
+        return np.max(np.abs(y - exact))
+
+    short = default_guess(pr, transient=5 * T)
+    settled = default_guess(pr, transient=5 * T, converge=1e-9)
+    capped = default_guess(pr, transient=5 * T, converge=1e-9, transient_max=20 * T)
+    assert error(short) > 1e-3
+    assert error(settled) < 2e-8
+    assert error(short) > error(capped) > error(settled)
+    assert error(capped) == pytest.approx(
+        error(default_guess(pr, transient=20 * T)), rel=1e-6)
+
+
 def test_time_varying_stiffness_multipliers_match_the_variational_equations():
     om, zeta, kappa = 1.3, 0.05, 0.3
     m = geardyn.GearPair(zeta=zeta, kappa=kappa, Fm=2.0, Fa=0.02).with_omega(om)

@@ -271,6 +271,38 @@ def test_contact_loss_matches_reference_integrator():
     assert np.max(np.abs(Y - ref) / np.where(scale > 0, scale, 1.0)) < 1e-4
 
 
+def test_rk4_keeps_fourth_order_through_contact_loss_and_the_step_rule_is_converged():
+    """Step-size convergence of the 21-state set with backlash, fluctuating stiffness and
+    contact loss: the largest section-point error (relative to each state's range) over 4
+    periods against DOP853 (rtol 1e-12, restarted at every located edge) falls at fourth
+    order as the steps per period double (edges located), the step rule's default lies on
+    the converged side (within 1e-5 of the reference; measured 6.7e-7 at 787 steps per
+    period), and stepping over the edges unlocated is >10x worse there."""
+    gs = _contact_loss_set()
+    y0 = gs.initial_state()
+    T = 2 * math.pi / gs.omega
+    periods = 4
+    ref = geardyn.reference_solution(gs, y0, np.arange(periods + 1) * T)
+    scale = np.max(np.abs(ref), axis=0)
+    scale = np.where(scale > 0, scale, 1.0)
+
+    def error(n: int | None, locate: bool = True) -> tuple[float, int]:
+        ds = geardyn.simulate(gs, periods=periods, y0=y0, steps_per_period=n,
+                              locate_edges=locate)
+        assert ds.attrs["status"] == geardyn.Status.OK
+        return (float(np.max(np.abs(ds["poincare"].values - ref) / scale)),
+                int(ds.attrs["steps_per_period"]))
+
+    default, n_default = error(None)
+    ns = [n_default // 4, n_default // 2, n_default]
+    errs = [error(n)[0] for n in ns[:2]] + [default]
+    p = -np.polyfit(np.log(ns), np.log(errs), 1)[0]
+    assert p > 3.5, (ns, errs)
+    assert default < 1e-5
+    # without the located edges the kinks cost the order: ~100x the error at the same step
+    assert error(n_default, locate=False)[0] > 10 * default
+
+
 def test_static_forces_balance_the_torque():
     gs = _contact_loss_set()
     F = gs.static_mesh_forces()

@@ -625,8 +625,9 @@ def continuation(model: Model, param: str = "Omega", start: float | None = None,
         A state near the orbit at ``start`` (default: the end of a transient run there, 200
         section periods but at most :data:`GUESS_TIME` time units; ``run.transient`` if given).
     run
-        :class:`~geardyn.RunSettings` (``steps_per_period``, ``bound``, ``transient`` of the
-        default guess).
+        :class:`~geardyn.RunSettings` (``steps_per_period``, ``bound``; ``transient``,
+        ``converge`` and ``transient_max`` of the default guess, see
+        :func:`~geardyn.analysis.orbits.default_guess`).
     ds, ds_min, ds_max
         First, least and greatest arclength step in the scaled unknowns (x / state_scale,
         p / p_scale; ``p_scale`` default ``abs(stop - start)``).
@@ -684,7 +685,9 @@ def _first_branch(tracer: _Tracer, st: _Settings, start: float, stop: float,
     if guess is None:
         T_s = pr.sections * 2 * math.pi / pr.omega
         transient = min(GUESS_PERIODS * T_s, GUESS_TIME) if run is None else run.transient
-        guess = default_guess(pr, transient=transient)
+        guess = default_guess(pr, transient=transient,
+                              converge=None if run is None else run.converge,
+                              transient_max=None if run is None else run.transient_max)
     guess = np.asarray(guess, dtype=float)
     if guess.shape != (pr.model.n_states,):
         raise ValueError(f"guess must have {pr.model.n_states} entries")

@@ -568,19 +568,42 @@ def orbit_dataset(orb: PeriodicOrbit) -> xr.Dataset:
 
 # ----------------------------------------------------------------------------- the API
 def default_guess(problem: ShootingProblem, y0: np.ndarray | None = None,
-                  transient: float | None = None) -> np.ndarray:
+                  transient: float | None = None, converge: float | None = None,
+                  transient_max: float | None = None) -> np.ndarray:
     """The section point after a transient run at the problem's coefficients (default
-    :data:`GUESS_PERIODS` section periods from ``model.initial_state()``)."""
+    :data:`GUESS_PERIODS` section periods from ``model.initial_state()``).
+
+    With ``converge`` the transient is a minimum: the run goes on, one orbit period
+    (``problem.sections`` forcing periods) at a time, until two consecutive section points
+    differ by at most ``converge (1 + max |y|)`` or the time reaches ``transient_max``
+    (default 10 x the transient); Newton shooting then corrects what is left either way."""
     m = problem.model
     k = kernels_for(m.kernel)
     T_s = problem.sections * forcing_period(problem.omega)
     n_sec = GUESS_PERIODS if transient is None else max(1, math.ceil(transient / T_s - 1e-9))
     n = problem.steps_per_period
     y = np.asarray(m.initial_state() if y0 is None else y0, dtype=float)
-    steps = n_sec * problem.sections * n
-    Y = k.trajectory(problem.params, y, problem.step, problem.omega, n, 0, steps, steps, True,
-                     problem.bound, m.n_events, m.n_observables)[0]
-    return Y[-1].copy()
+
+    def run_sections(y: np.ndarray, count: int) -> np.ndarray:
+        steps = count * problem.sections * n
+        Y = k.trajectory(problem.params, y, problem.step, problem.omega, n, 0, steps, steps,
+                         True, problem.bound, m.n_events, m.n_observables)[0]
+        return Y[-1].copy()
+
+    y = run_sections(y, n_sec)
+    if converge is None:
+        return y
+    limit = 10.0 * n_sec * T_s if transient_max is None else float(transient_max)
+    extra = max(0, math.floor(limit / T_s + 1e-9) - n_sec)
+    for _ in range(extra):
+        if not np.all(np.isfinite(y)):
+            break
+        y_next = run_sections(y, 1)
+        settled = np.max(np.abs(y_next - y)) <= converge * (1.0 + np.max(np.abs(y_next)))
+        y = y_next
+        if settled:
+            break
+    return y
 
 
 def periodic_orbit(model: Model, omega: float | None = None, period: int = 1,
@@ -601,8 +624,9 @@ def periodic_orbit(model: Model, omega: float | None = None, period: int = 1,
         after a transient run from ``model.initial_state()`` (``run.transient`` when ``run``
         is given, else :data:`GUESS_PERIODS` sections).
     run
-        :class:`~geardyn.RunSettings`: ``steps_per_period``, ``bound``, ``transient`` (of the
-        default guess), ``max_section_periods``.
+        :class:`~geardyn.RunSettings`: ``steps_per_period``, ``bound``, ``transient``,
+        ``converge`` and ``transient_max`` (of the default guess, see :func:`default_guess`),
+        ``max_section_periods``.
     tol, max_iter
         Newton tolerance (scaled max norm, relative to ``1 + abs(x)``) and most iterations.
     steps_per_period
@@ -614,7 +638,9 @@ def periodic_orbit(model: Model, omega: float | None = None, period: int = 1,
     """
     problem = shooting_problem(model, omega, period, run, steps_per_period)
     if guess is None:
-        guess = default_guess(problem, transient=None if run is None else run.transient)
+        guess = default_guess(problem, transient=None if run is None else run.transient,
+                              converge=None if run is None else run.converge,
+                              transient_max=None if run is None else run.transient_max)
     guess = np.asarray(guess, dtype=float)
     if guess.shape != (problem.model.n_states,):
         raise ValueError(f"guess must have {problem.model.n_states} entries "

@@ -9,8 +9,9 @@
                      [--quiet] [--out branch.nc] [--plot branch.png]
 
 Unset options come from the study: ``--param`` and ``--range`` from its ``[sweep]`` (start, stop),
-``--omega`` (the fixed Omega of a branch in another parameter) and ``--steps-per-period`` from
-``[run]``. A branch that ends early (most points, corrector failure, the parameter leaving the
+``--omega`` (the fixed Omega of a branch in another parameter), ``--steps-per-period`` and the
+first orbit's transient (``transient`` or ``transient_periods``, ``converge``, ``transient_max``)
+from ``[run]``. A branch that ends early (most points, corrector failure, the parameter leaving the
 model's valid region, divergence, no orbit at the start) is still written, its status and
 message in the file (``branch_status``, ``branch_message``) and printed on stderr; the exit
 status is 0. A progress bar (the parameter's way through the range) is drawn when stderr is a
@@ -106,6 +107,26 @@ def _load_over(path: Path, param: str):
         raise ParameterError("--over", str(path), f"the diagram sweeps {swept}, the branch "
                              f"follows {param}")
     return ds
+
+
+def _guess_run(s, model, name: str, start: float,
+               transient: float | None, spp: int | None):
+    """The :class:`~geardyn.RunSettings` of the branch's first orbit: ``--transient``, else the
+    study's ``[run]`` transient (``transient`` or ``transient_periods`` at the start's Omega)
+    with its ``converge`` and ``transient_max``; None (the continuation's own default guess:
+    200 periods, at most 2000 time units) when neither the option nor the study sets one."""
+    table = s.run
+    fields: dict = {"steps_per_period": ("--steps-per-period", spp)}
+    if transient is not None:
+        fields["transient"] = ("--transient", transient)
+    elif table.transient_periods is not None or "transient" in table.model_fields_set:
+        om = start if name == "Omega" else model.with_params(**{name: start}).omega
+        fields["transient"] = ("run.transient", table.transient_time(om))
+    elif table.converge is None:
+        return None
+    for field in ("converge", "transient_max"):
+        fields[field] = (f"run.{field}", getattr(table, field))
+    return run_settings(fields)
 
 
 def _summary(ds) -> str:
@@ -228,8 +249,7 @@ def continue_command(
     if quantity != "section" and not names:
         raise ParameterError("--quantity", quantity, f"{model.name} has no backlash mesh")
     spp = s.run.steps_per_period if steps_per_period is None else steps_per_period
-    run = run_settings({"transient": ("--transient", transient),
-                        "steps_per_period": ("--steps-per-period", spp)})
+    run = _guess_run(s, model, name, start, transient, spp)
     over_ds = _load_over(over, name) if over is not None else None
     if over_ds is not None and quantity != "section" and not (
             quantity in over_ds and set(over_ds[quantity].dims) <= {name, "mesh"}):
@@ -242,7 +262,7 @@ def continue_command(
     with _continue_bar(show_bar, escape(f"{s.study.name}: period-{period} branch"), name,
                        start, stop) as callback:
         ds = continuation(model, name, start, stop, period=period,
-                          run=run if transient is not None else None, switch=switch,
+                          run=run, switch=switch,
                           max_period=max_period, steps_per_period=spp,
                           max_points=max_points, progress=callback)
     elapsed = time.perf_counter() - t0

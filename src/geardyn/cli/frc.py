@@ -2,15 +2,16 @@
 
 ::
 
-    geardyn frc STUDY.toml [--range 0.5:1.5:201] [--transient T] [--continued-transient T]
+    geardyn frc STUDY.toml [--range 0.5:1.5:201] [--param Omega|mesh_frequency|input_speed]
+                [--transient T] [--continued-transient T]
                 [--converge TOL] [--samples N] [--steps-per-period N] [--mesh NAME]
                 [--branch branch.nc ...] [--interpretation ...] [--quiet] [--yes]
                 [--out frc.nc] [--plot frc.png]
 
-Unset options come from the study's ``[sweep]`` (start, stop, num, samples; the sweep must be
-of Omega) and ``[run]`` tables (transient or transient_periods, converge, transient_max,
-continued_transient, max_period, period_tol, steps_per_period). A progress bar is drawn when
-stderr is a terminal.
+Unset options come from the study's ``[sweep]`` (param, start, stop, num, samples; the sweep must
+be of Omega, mesh_frequency or input_speed, which are turned into Omega point by point) and
+``[run]`` tables (transient or transient_periods, converge, transient_max, continued_transient,
+max_period, period_tol, steps_per_period). A progress bar is drawn when stderr is a terminal.
 """
 
 from __future__ import annotations
@@ -48,8 +49,14 @@ __all__ = ["frc_command", "register"]
 def frc_command(
     study: Annotated[str, typer.Argument(help="Study TOML file or built-in study name.")],
     range_: Annotated[
-        str | None, typer.Option("--range", help="Omega START:STOP:NUM (default: the study's "
-                                                 "[sweep]).")
+        str | None, typer.Option("--range", help="START:STOP:NUM of --param (default: the "
+                                                 "study's [sweep]).")
+    ] = None,
+    param: Annotated[
+        str | None, typer.Option(help="The swept frequency: Omega, or mesh_frequency [rad/s] "
+                                      "or input_speed [rpm] of a model that has them (default: "
+                                      "the study's sweep.param when it is one of these, else "
+                                      "Omega).")
     ] = None,
     transient: Annotated[
         float | None, typer.Option(help="Transient of the first point (default: run.transient).")
@@ -87,19 +94,28 @@ def frc_command(
 
     s = load_study_source(study)
     sweep = s.sweep
+    swept = sweep.param if sweep is not None and sweep.param in FREQUENCY_PARAMS else None
+    name = param or swept or "Omega"
+    if name not in FREQUENCY_PARAMS:
+        raise ParameterError("--param", name, "must be a frequency: "
+                             + ", ".join(FREQUENCY_PARAMS))
     if range_ is not None:
         start, stop, num = parse_range(range_)
-    elif sweep is not None and sweep.param == "Omega":
+    elif sweep is not None and sweep.param == name:
         start, stop, num = sweep.start, sweep.stop, sweep.num
     else:
-        raise StudyError("--range: not given, and the study has no [sweep] of Omega")
+        why = "the study has no [sweep]" if sweep is None else f"the study sweeps {sweep.param}"
+        raise StudyError(f"--range: not given, and {why}, not {name}")
     if not (usable_omega(start) and usable_omega(stop)):
-        raise ParameterError("--range", f"{start:g}:{stop:g}", "Omega must be > 0 and finite")
+        raise ParameterError("--range", f"{start:g}:{stop:g}", f"{name} must be > 0 and finite")
     if out is not None and out.suffix.lower() != ".nc":
         raise ParameterError("--out", str(out), "suffix must be .nc (NetCDF)")
     check_plot_path("--plot", plot)
     interp = interpretation.value if interpretation is not None else None
     model = build_model(s, interpretation=interp)
+    values = np.linspace(start, stop, num)
+    omegas_all = values if name == "Omega" else _omegas(model, name, values)
+    start, stop = float(omegas_all[0]), float(omegas_all[-1])
     if not model.meshes:
         raise ParameterError("STUDY", study, f"{model.name} has no backlash mesh")
     names = [m[0] for m in model.meshes]
@@ -117,7 +133,7 @@ def frc_command(
                         "steps_per_period": ("--steps-per-period", spp),
                         **study_run_options(s, converge=converge,
                                             continued_transient=continued_transient)})
-    omegas = np.linspace(start, stop, min(num, ESTIMATE_POINTS))
+    omegas = np.linspace(start, stop, min(num, ESTIMATE_POINTS))  # Omega, evenly spaced
     check_run_cost(model, 2 * num, omegas,
                    tr if run.converge is None else run.transient_limit, n_samples, spp,
                    False, yes=yes, option="--range/--samples/--transient",
@@ -128,7 +144,7 @@ def frc_command(
     show_bar = not quiet and _stderr_is_terminal()
     t0 = time.perf_counter()
     with _progress_bar(show_bar, escape(f"{s.study.name}: up and down")) as callback:
-        ds = frequency_response(model, np.linspace(start, stop, num), run, progress=callback)
+        ds = frequency_response(model, omegas_all, run, progress=callback)
     elapsed = time.perf_counter() - t0
 
     def draw(path: Path) -> None:
@@ -138,8 +154,27 @@ def frc_command(
 
     wrote = write_outputs(ds, out, plot, draw, study=s.study.name,
                           wall_time_s=round(elapsed, 3))
-    typer.echo(f"{s.study.name}: {num} values of Omega in [{start:g}, {stop:g}] up and down, "
+    span = f"[{start:g}, {stop:g}]" if name == "Omega" else (
+        f"{name} [{values[0]:g}, {values[-1]:g}] (Omega [{start:g}, {stop:g}])")
+    typer.echo(f"{s.study.name}: {num} values of Omega in {span} up and down, "
                f"{elapsed:.1f} s: {_summary(ds)}{wrote}")
+
+
+#: The parameters ``geardyn frc`` sweeps: the forcing frequency and its physical forms.
+FREQUENCY_PARAMS = ("Omega", "mesh_frequency", "input_speed")
+
+
+def _omegas(model, name: str, values):
+    """The dimensionless forcing frequencies Omega of ``values`` of ``name`` (mesh_frequency
+    [rad/s] or input_speed [rpm]), each through ``model.with_params`` as a sweep sets them; a
+    model without that parameter is a one-line error naming --param."""
+    import numpy as np
+
+    try:
+        return np.array([model.with_params(**{name: float(v)}).omega for v in values])
+    except KeyError as err:
+        raise ParameterError("--param", name, f"{model.name} has no such parameter ({err})") \
+            from None
 
 
 def _load_branch(path: Path):

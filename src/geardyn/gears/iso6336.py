@@ -4,7 +4,8 @@ ISO 6336-1:2006, clause 9 (tooth stiffness parameters c' and c_gamma), method B:
 
 * q' = C1 + C2/z_n1 + C3/z_n2 + C4 x1 + C5 x1/z_n1 + C6 x2 + C7 x2/z_n2 + C8 x1^2 + C9 x2^2,
   the minimum flexibility of a tooth pair [mm um/N], with z_n = z / (cos^2 beta_b cos beta)
-  (z_n = z for spur gears) and, for an internal pair, z_n2 = infinity;
+  (z_n = z for spur gears), gear 1 the pinion (the gear with fewer teeth) and, for an internal
+  pair, z_n2 = infinity;
 * c'_th = 1 / q' (theoretical single stiffness) [N/(mm um)];
 * c' = c'_th C_M C_R C_B cos(beta) (single stiffness), C_M = 0.8, C_R = 1 for solid blanks
   (1 + ln(b_s/b) / (5 exp(s_R / (5 m_n))) for a web of width b_s and a rim of thickness s_R),
@@ -92,9 +93,13 @@ def iso6336_stiffness(mesh: GearMesh, *, line_load: float | None = None,
 
     ``line_load`` is F_t K_A / b [N/m] (None: >= 100 N/mm, no load correction); ``web_ratio``
     b_s/b and ``rim_ratio`` s_R/m_n describe a webbed blank (None: solid). The face width is the
-    smaller of the two gears'.
+    smaller of the two gears'. Gear 1 of the q' formula (z_n1, x1) is ISO's pinion, the gear
+    with fewer teeth, whichever of ``mesh.pinion`` and ``mesh.wheel`` that is (a planetary set's
+    sun may have more teeth than its planets); of an internal pair, the external gear.
     """
     p, w = mesh.pinion, mesh.wheel
+    if not mesh.internal and w.teeth < p.teeth:
+        p, w = w, p  # ISO's gear 1 is the pinion: the gear with fewer teeth, driving or not
     z1 = float(p.teeth)
     z2 = math.inf if mesh.internal else float(w.teeth)
     x1 = p.profile_shift
