@@ -16,6 +16,9 @@ Reports lane-steps per second, the scaling efficiency of 2 workers against 1
 map. ``--write`` puts the table under the "map" heading of bench/RESULTS.md.
 
     .venv/bin/python bench/map.py [--nx 32] [--ny 8] [--chunk 32] [--repeat 3] [--write]
+    .venv/bin/python bench/map.py --nx 500 --ny 500 --chunk 0 --repeat 1 --local-only
+
+(``--chunk 0``: map2d's default chunk.)
 """
 
 from __future__ import annotations
@@ -97,6 +100,8 @@ def main() -> None:
     ap.add_argument("--chunk", type=int, default=32)
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--write", action="store_true", help="update bench/RESULTS.md")
+    ap.add_argument("--local-only", action="store_true",
+                    help="only the local map (issue 11's 500 x 500 target), printed")
     args = ap.parse_args()
     import numba
 
@@ -104,6 +109,15 @@ def main() -> None:
 
     cores = os.cpu_count() or 1
     model = geardyn.CATTDevice(geardyn.PlanetaryParams.paper(xi1=0.05, xi2=0.05))
+    if args.local_only:
+        t, ds = timed(model, args)
+        steps = lane_steps(ds)
+        bad = int(np.sum(ds["status"].values != 0))
+        print(f"local map {args.nx} x {args.ny}: median {t:.1f} s of {args.repeat}, "
+              f"{steps:.3e} lane-steps, {t / steps * 1e9:.1f} ns wall per lane-step, "
+              f"{t * cores / steps * 1e9:.1f} ns per lane-step per thread ({cores} threads), "
+              f"points not ok: {bad}; load average {os.getloadavg()[0]:.2f}")
+        return
     configs = [("local", None, None), ("dask 1w x 1t", 1, 1), ("dask 2w x 1t", 2, 1),
                (f"dask 1w x {cores}t", 1, cores)]
     rows, ref, steps = [], None, 0

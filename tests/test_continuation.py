@@ -116,3 +116,51 @@ def test_continued_sweeps_bad_input_names_the_field(device, sweep, message):
     with pytest.raises(ValueError, match="converge must be a positive tolerance"):
         continued_sweeps([ContinuedSweep(device, "Omega", [0.5], transient=10.0)], samples=2,
                          converge=-1.0)
+
+
+def _point_by_point(branch: Branch, run: geardyn.RunSettings) -> list:
+    """A branch continued the plain way, one run_lanes call per point from the final state
+    and time of the point before (cold again after a point that did not end well): the
+    reference the chained lanes of continue_branches must reproduce bit for bit."""
+    y, t0, cold, out = branch.y0, 0.0, True, []
+    for j in range(branch.P.shape[0]):
+        lo, hi = branch.transients(j, cold, run.converge is not None)
+        r = run_lanes(branch.model, branch.P[j:j + 1], y, transient=np.array([lo]),
+                      steps_per_period=np.array([branch.steps[j]]), t0=np.array([t0]),
+                      transient_max=np.array([hi]), run=run)
+        out.append(r)
+        if r.status[0] == geardyn.Status.OK:
+            y, t0, cold = r.final[0], float(r.final_time[0]), False
+        else:
+            y, t0, cold = branch.y0, 0.0, True
+    return out
+
+
+@pytest.mark.parametrize("segment", [3, 64])
+def test_chained_points_equal_the_point_by_point_continuation(segment):
+    """continue_branches runs a branch's points as a chain of lanes (each starts in the slot
+    where the one before ended): every field of every point is bitwise the plain
+    point-by-point continuation's, for branches of different lengths and step counts, with
+    convergence on, whatever the segment length; and where the amplitude passes the bound
+    at Omega = 0.5 (status diverged) the branch restarts cold, as it does point by point."""
+    from geardyn.analysis.continuation import continue_branches
+
+    pair = geardyn.GearPair(zeta=0.05, kappa=0.2, Fm=0.1, Fa=0.2)
+    up = np.linspace(0.5, 1.5, 9)
+    branches = [Branch(pair, pair.lane_params("Omega", up), pair.initial_state(),
+                       transient=200.0, continued_transient=30.0, transient_max=600.0),
+                Branch(pair, pair.lane_params("Omega", up[::-1][:6]), pair.initial_state(),
+                       transient=150.0, continued_transient=20.0, transient_max=500.0)]
+    run = geardyn.RunSettings(transient=0.0, samples=4, converge=1e-8, bound=1.05)
+    chained = continue_branches(branches, run, segment=segment)
+    restarts = 0
+    for b, got in zip(branches, chained, strict=True):
+        ref = _point_by_point(b, run)
+        assert got.status.size == len(ref)
+        for j, r in enumerate(ref):
+            for name in got.__dataclass_fields__:
+                a, e = getattr(got, name)[j:j + 1], getattr(r, name)
+                assert np.array_equal(a, e, equal_nan=a.dtype.kind == "f"), (name, j)
+        s = got.status
+        restarts += int(np.sum((s[:-1] == geardyn.Status.DIVERGED) & (s[1:] == geardyn.Status.OK)))
+    assert restarts >= 1  # a diverged point, then a cold restart that ended well

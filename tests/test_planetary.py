@@ -13,6 +13,7 @@ from scipy.linalg import eigh, solve
 
 import geardyn
 from geardyn.errors import ParameterError
+from geardyn.testing import assert_result
 
 M = geardyn.Member
 DEG = math.pi / 180.0
@@ -236,6 +237,70 @@ def test_linear_forced_response():
     X = np.stack([ds[nm].values for nm in gs.state_names[:21]], axis=1)
     q = (Q[None, :] * np.exp(1j * w * tau[:, None] / w0)).imag / L
     assert np.max(np.abs(X - q)) < 1e-6 * np.max(np.abs(q))
+
+
+def test_orbit_continuation_and_lyapunov_of_the_linear_set_match_its_eigenvalues():
+    """The 42-state set through the orbit analyses: without backlash or stiffness fluctuation
+    it is linear and time-invariant, x' = A x + f(t), with A assembled here from Lin &
+    Parker's blocks and the modal damping. Its Floquet multipliers are exp(lambda T) for the
+    eigenvalues lambda of A (periodic_orbit, and every point of a continuation in Omega, all
+    stable, no bifurcation), and its largest Lyapunov exponent is max Re lambda."""
+    from scipy.linalg import eigvals
+
+    gs = _linear_set(mesh_frequency=2 * math.pi * 1300)
+    Mm, K = lp_matrices(4)
+    K[8, 8] += 2e7
+    K[2, 2] += 3e8
+    lam, phi = eigh(K, Mm)
+    C = Mm @ phi @ np.diag(2 * 0.05 * np.sqrt(lam)) @ phi.T @ Mm
+    n = 21
+    A = np.block([[np.zeros((n, n)), np.eye(n)],
+                  [-solve(Mm, K), -solve(Mm, C)]]) / gs.time_scale  # d/dtau
+    ev = eigvals(A)
+
+    def expected(omega: float) -> np.ndarray:
+        return np.sort(np.abs(np.exp(ev * 2 * math.pi / omega)))
+
+    spp = 256  # a third of the step rule's: RK4's exp(lambda h) of the fastest modes is then
+    # ~5e-6 off, that of the slow modes (the largest multipliers) ~1e-10
+    orb = geardyn.periodic_orbit(gs, steps_per_period=spp)
+    assert orb.converged, orb.message
+    assert np.max(np.abs(np.sort(np.abs(orb.multipliers)) - expected(gs.omega))) < 2e-5
+    assert np.max(np.abs(orb.multipliers)) == pytest.approx(expected(gs.omega)[-1], abs=1e-9)
+    assert orb.stability == "stable"
+    br = geardyn.continuation(gs, "Omega", gs.omega, 1.05 * gs.omega, max_points=40,
+                              steps_per_period=spp)
+    assert int(br.attrs["status"]) == 0 and br["Omega"].values[-1] == pytest.approx(
+        1.05 * gs.omega)
+    assert br.sizes["bifurcation"] == 0 and set(br["stability"].values) == {"stable"}
+    last = np.sort(br["multiplier_abs"].values[-1])
+    assert np.max(np.abs(last - expected(float(br["Omega"].values[-1])))) < 2e-5
+    largest = geardyn.lyapunov(gs, transient=50.0, duration=2000.0)
+    assert largest == pytest.approx(ev.real.max(), rel=0.03)
+
+
+def test_basins_and_map2d_of_the_linear_set():
+    """The sweep-engine analyses on the 42-state set, linear: from every cell of a basins grid
+    the run ends on the one attractor, the Newton orbit; and a map2d over (Omega, sun torque)
+    obeys superposition: the peak mesh forces at two torques differ by the difference of the
+    static mesh forces, whatever the forcing frequency."""
+    gs = _linear_set(mesh_frequency=2 * math.pi * 1300)
+    orb = geardyn.periodic_orbit(gs, steps_per_period=256)
+    u, x = orb.x[gs.state_names.index("u_s")], orb.x[gs.state_names.index("x_s")]
+    b = geardyn.basins(gs, None, ("u_s", u - 2, u + 2, 2), ("x_s", x - 2, x + 2, 2),
+                       transient=1500.0, orbits=[orb], base=orb.x)
+    assert_result(b, "basins")
+    assert b.attrs["n_attractors"] == 1 and list(b["attractor_orbit"].values) == [0]
+    om = [gs.omega, 1.05 * gs.omega]
+    mp = geardyn.map2d(gs, ("Omega", om), ("sun_torque", [50.0, 100.0]), transient=1500.0,
+                       samples=4)
+    assert_result(mp, "map2d")
+    assert np.all(mp["period"].values == 1)
+    d = mp["force_peak"].sel(sun_torque=100.0).values - mp["force_peak"].sel(
+        sun_torque=50.0).values
+    static = (gs.with_params(sun_torque=100.0).static_mesh_forces()
+              - gs.with_params(sun_torque=50.0).static_mesh_forces())
+    assert np.max(np.abs(d - static[None, :])) < 1e-9 * np.max(np.abs(static))
 
 
 #: The carrier torque [N m] that balances 100 N m on the sun (base radius 0.03 m, carrier radius

@@ -341,3 +341,29 @@ def test_frequency_response_axes_of_a_set_from_geometry():
     plain = geardyn.PlanetaryGearSet(**MEMBERS, n_planets=4, sun_mesh_stiffness=3e8,
                                      ring_mesh_stiffness=4e8)
     assert set(physical_axes(plain, om)) == {"mesh_frequency"}
+
+
+@pytest.mark.parametrize(("old", "new", "fragments"), [
+    ("teeth = 23", "teeth = 3", ("params.geometry.planet.teeth", ">= 5", "3")),
+    ("n_planets = 4", "n_planets = 7", ("params.planet_angles", "collide")),
+    ("teeth = 71", "teeth = 70", ("params.centre_distance", "zero-backlash")),
+    ('module = "2 mm"', 'module = "-2 mm"', ("params.geometry.sun.module", "> 0")),
+])
+def test_bad_geometry_in_a_study_is_a_one_line_cli_error(tmp_path, old, new, fragments):
+    """A study file with impossible gear geometry (too few teeth, colliding planets, a ring
+    that does not fit the sun and planets, a negative module): exit status 2 and one line
+    naming the field, before anything runs."""
+    from typer.testing import CliRunner
+
+    from geardyn.cli.main import app
+
+    text = (Path(geardyn.__file__).parent / "studies" / "planetary_example.toml").read_text()
+    assert old in text
+    study = tmp_path / "bad.toml"
+    study.write_text(text.replace(old, new, 1))
+    r = CliRunner().invoke(app, ["bifurcation", str(study), "--range", "1000:2000:2",
+                                 "--quiet"])
+    assert r.exit_code == 2
+    lines = r.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error: "), r.stderr
+    assert all(f in lines[0] for f in fragments), lines[0]

@@ -31,7 +31,7 @@ WARM = {
     "DimensionalCATT": ("trajectory", "lyapunov", "orbit"),
     "GearPair": ("trajectory", "sweep", "lyapunov", "lanes", "orbit"),
     "UserModel": ("trajectory", "lyapunov"),
-    "PlanetaryGearSet": ("trajectory", "sweep", "lyapunov"),
+    "PlanetaryGearSet": ("trajectory", "sweep", "lyapunov", "orbit"),
 }
 
 

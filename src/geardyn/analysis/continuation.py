@@ -3,10 +3,13 @@ the previous one, so a sweep follows one attractor and shows hysteresis.
 
 A branch is inherently sequential, but several branches (a sweep up and one down, or the
 sweeps of several studies) are independent of each other: :func:`continue_branches` advances
-all of them together, point ``j`` of every branch as one lane of one
-:func:`~geardyn.solvers.ensemble.run_lanes` call. The lanes then share lockstep blocks and
-threads instead of running one after another; each branch's result is bitwise the one it gets
-alone (lanes do not interact).
+all of them together in one :func:`~geardyn.solvers.ensemble.run_lanes` call per
+:data:`SEGMENT` points, each branch's points a *chain* of lanes: a point starts in the slot
+where the point before it ended, from its final state at its end time. The branches then share
+the vector blocks and threads instead of running one after another, and a slot whose point
+settles early goes on with the branch's next point instead of idling until the slowest point
+of the call has ended. Each branch's result is bitwise the one it gets alone, point by point
+(lanes do not interact).
 
 A continued point starts next to its attractor, so it needs a far shorter transient than a cold
 start: ``continued_transient`` is its minimum, and the transient goes on until the Poincare
@@ -75,10 +78,17 @@ class Branch:
         return short, max(short, longest)
 
 
+#: Points of each branch per kernel call (a segment of its chain): the calls report progress,
+#: and a branch's last lane of a segment waits for the slowest one only there.
+SEGMENT = 64
+
+
 def continue_branches(
     branches: Sequence[Branch],
     run: RunSettings | int | None = None,
     progress: Callable[[int, int], None] | None = None,
+    *,
+    segment: int = SEGMENT,
     **settings: Any,
 ) -> list[LaneResults]:
     """Run every branch by continuation, all branches together (see the module docs), with the
@@ -86,7 +96,13 @@ def continue_branches(
     transients and steps apply; an int: the samples), or of the keyword arguments of those
     names; the branches must share the model's compiled kernel. Returns one
     :class:`~geardyn.solvers.ensemble.LaneResults` per branch, its lanes in the branch's
-    order. ``progress(done, total)`` counts points of all branches."""
+    order. ``progress(done, total)`` counts points of all branches.
+
+    Each kernel call runs the next ``segment`` points of every branch as a chain of lanes
+    (``run_lanes(chain=...)``): a branch's point starts in the slot where the point before it
+    ended, from its final state and time, so the slots stay busy however the points'
+    transients differ. After a point that did not end well the branch restarts cold in the
+    next call (its initial state, time 0, the cold transient), as a lone point would."""
     if not branches:
         return []
     kernel = kernels_for(branches[0].model.kernel)
@@ -98,6 +114,8 @@ def continue_branches(
     if isinstance(run, (int, np.integer)):
         settings["samples"] = run
         run = None
+    if int(segment) < 1:
+        raise ValueError(f"segment must be >= 1 (got {segment!r})")
     run = resolve_run(run, settings)
     # the branches' transients, steps and section are per lane (below)
     run = run.replace(max_section_periods=branches[0].max_section_periods)
@@ -108,27 +126,46 @@ def continue_branches(
     y = [b.y0 for b in branches]
     t0 = [0.0 for _ in branches]
     cold = [True for _ in branches]
+    nxt = [0 for _ in branches]  # each branch's next point
     done = 0
-    for j in range(max(n)):
+    while True:
+        live = [i for i in range(len(branches)) if nxt[i] < n[i]]
+        if not live:
+            break
         if progress is not None:
             progress(done, total)
-        live = [i for i, b in enumerate(branches) if j < n[i]]
-        lims = [branches[i].transients(j, cold[i], converge > 0) for i in live]
-        r = run_lanes(branches[live[0]].model, np.stack([branches[i].P[j] for i in live]),
-                      np.stack([np.broadcast_to(y[i], branches[i].y0.shape[-1:]) for i in live]),
-                      transient=np.array([a for a, _ in lims]),
-                      steps_per_period=np.array([branches[i].steps[j] for i in live]),
-                      t0=np.array([t0[i] for i in live]),
-                      transient_max=np.array([b for _, b in lims]), run=run)
-        for k, i in enumerate(live):
-            parts[i].append(r.take(slice(k, k + 1)))
-            if converge > 0 and not branches[i].commensurate[j]:
-                parts[i][-1].converged[:] = -1  # no section to test: a fixed transient
-            if r.status[k] == Status.OK:
-                y[i], t0[i], cold[i] = r.final[k], float(r.final_time[k]), False
-            else:  # lost the branch: restart from the initial state
-                y[i], t0[i], cold[i] = branches[i].y0, 0.0, True
-        done += len(live)
+        points = {i: range(nxt[i], min(n[i], nxt[i] + int(segment))) for i in live}
+        P, Y0, T0, tr, tmax, steps, chain, first = [], [], [], [], [], [], [], {}
+        for i in live:
+            b = branches[i]
+            first[i] = len(P)
+            for q, j in enumerate(points[i]):
+                lo, hi = b.transients(j, cold[i] and q == 0, converge > 0)
+                P.append(b.P[j])
+                Y0.append(np.broadcast_to(y[i] if q == 0 else b.y0, b.y0.shape[-1:]))
+                T0.append(t0[i] if q == 0 else 0.0)
+                tr.append(lo)
+                tmax.append(hi)
+                steps.append(b.steps[j])
+                chain.append(len(P) if q + 1 < len(points[i]) else -1)
+        r = run_lanes(branches[live[0]].model, np.stack(P), np.stack(Y0),
+                      transient=np.array(tr), steps_per_period=np.array(steps),
+                      t0=np.array(T0), transient_max=np.array(tmax), run=run,
+                      chain=np.array(chain, np.int64))
+        for i in live:
+            b = branches[i]
+            for q, j in enumerate(points[i]):
+                lane = first[i] + q
+                parts[i].append(r.take(slice(lane, lane + 1)))
+                if converge > 0 and not b.commensurate[j]:
+                    parts[i][-1].converged[:] = -1  # no section to test: a fixed transient
+                done += 1
+                nxt[i] = j + 1
+                if r.status[lane] == Status.OK:
+                    y[i], t0[i], cold[i] = r.final[lane], float(r.final_time[lane]), False
+                else:  # lost the branch: restart from the initial state (the chain stopped)
+                    y[i], t0[i], cold[i] = b.y0, 0.0, True
+                    break
     if progress is not None:
         progress(total, total)
     return [LaneResults.concat(p) for p in parts]

@@ -45,7 +45,10 @@ class SweepConfig(NamedTuple):
 class Schedule(NamedTuple):
     """Which worker runs which lanes: worker w takes the lanes queue[start[w]:start[w + 1]] in
     that order; lane l has n_per[l] steps per period and its phase table at S_TAB/C_TAB[tab[l]:]
-    (2 n_per + 1 half-step points of sin and cos of the forcing phase)."""
+    (2 n_per + 1 half-step points of sin and cos of the forcing phase). ``chain`` (empty: none)
+    chains lanes, a sweep by continuation: chain[l] is the lane that starts, in the slot where
+    lane l ended and only if it ended well, from l's final state at l's end time (-1: none);
+    the queue then holds the chains' first lanes only."""
 
     start: np.ndarray
     queue: np.ndarray
@@ -53,6 +56,7 @@ class Schedule(NamedTuple):
     tab: np.ndarray
     S_TAB: np.ndarray
     C_TAB: np.ndarray
+    chain: np.ndarray
 
 
 class LaneOutputs(NamedTuple):

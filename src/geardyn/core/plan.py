@@ -252,6 +252,10 @@ class LanePlan:
         """Forcing periods of the (minimum) transient plus the sampled stretch."""
         return self.transient_periods + self.samples * self.sample_every
 
-    def final_time(self, transient_periods: np.ndarray) -> np.ndarray:
-        """Model time at the last sample, given the transient each lane used (in periods)."""
-        return self.t0 + (transient_periods + self.samples * self.sample_every) * self.period
+    def final_time(self, transient_periods: np.ndarray, t0: np.ndarray | None = None
+                   ) -> np.ndarray:
+        """Model time at the last sample, given the transient each lane used (in periods) and
+        its start time (default the plan's ``t0``; chained lanes start when the one before
+        them ended)."""
+        start = self.t0 if t0 is None else t0
+        return start + (transient_periods + self.samples * self.sample_every) * self.period

@@ -508,7 +508,7 @@ def _sweep_worker(w, lanes, cfg, sched, out):
     with bookkeeping: end of the transient or a sample), n_stat, n_ring (section points kept)."""
     P, Y0, H, OMEGA, T0, n_transient, n_transient_max, sample_every = lanes
     conv_tol, conv_depth, n_samples, locate, bound, n_ev, n_obs, width = cfg
-    start, queue, lane_nper, lane_tab, S_TAB, C_TAB = sched
+    start, queue, lane_nper, lane_tab, S_TAB, C_TAB, chain = sched
     (samples, final, status, gmin, gmax, ncross, omax, omin, orms, unresolved, transient_steps,
      converged) = out
     q0 = start[w]
@@ -591,13 +591,47 @@ def _sweep_worker(w, lanes, cfg, sched, out):
 
 
 @nb.njit(inline="always", **_JIT)
+def _chained(k, lanes, cfg, sched, out, slots):
+    """The lane that follows the one that has just ended in slot k on its chain
+    (``sched.chain``: a sweep by continuation, each point starting where the one before
+    ended), its start state and time set to that lane's final state and end time (the time
+    as :meth:`~geardyn.core.plan.LanePlan.final_time` computes it); -1 when there is no
+    chain, the slot held no lane yet, the chain ends there, or that lane did not end well (the
+    caller restarts the rest of the chain)."""
+    chain = sched[6]
+    if chain.size == 0:
+        return -1
+    LANE = slots[4]
+    STEP = slots[5]
+    if STEP[k] == 0:  # never held a lane (a lane always takes at least one step)
+        return -1
+    prev = LANE[k]
+    succ = chain[prev]
+    status = out[2]
+    if succ < 0 or status[prev] != STATUS_OK:
+        return -1
+    Y0 = lanes[1]
+    OMEGA = lanes[3]
+    T0 = lanes[4]
+    sample_every = lanes[7]
+    final = out[1]
+    transient_steps = out[10]
+    nper = sched[2][prev]
+    for q in range(Y0.shape[1]):
+        Y0[succ, q] = final[prev, q]
+    periods = transient_steps[prev] // nper + cfg[2] * (sample_every[prev] // nper)
+    T0[succ] = T0[prev] + periods * (2.0 * np.pi / OMEGA[prev])
+    return succ
+
+
+@nb.njit(inline="always", **_JIT)
 def _load_slot(k, lane, lanes, cfg, sched, out, blk, slots, GP):
     """Slot k takes lane ``lane`` at its grid step 0 (GP: the block's events at the grid point
     before, rotated by the block loop). Returns 1 if the lane samples from step 0 (no
     transient), else 0."""
     P, Y0, H, OMEGA, T0, n_transient, n_transient_max, sample_every = lanes
     conv_tol, conv_depth, n_samples, locate, bound, n_ev, n_obs, width = cfg
-    start, queue, lane_nper, lane_tab, S_TAB, C_TAB = sched
+    start, queue, lane_nper, lane_tab, S_TAB, C_TAB, chain = sched
     (samples, final, status, gmin, gmax, ncross, omax, omin, orms, unresolved, transient_steps,
      converged) = out
     (R, D, Y, Y1, K1, K2, K3, K4, TMP, PT, SC, PH6, PH, TT, _, GS, G1, GR, SIDE, FLAG,
@@ -652,7 +686,7 @@ def _block_run_soa(q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch):
     arrays to the inlined helpers and rotating the event history cost no atomic increments."""
     P, Y0, H, OMEGA, T0, n_transient, n_transient_max, sample_every = lanes
     conv_tol, conv_depth, n_samples, locate, bound, n_ev, n_obs, width = cfg
-    start, queue, lane_nper, lane_tab, S_TAB, C_TAB = sched
+    start, queue, lane_nper, lane_tab, S_TAB, C_TAB, chain = sched
     (samples, final, status, gmin, gmax, ncross, omax, omin, orms, unresolved, transient_steps,
      converged) = out
     (R, D, Y, Y1, K1, K2, K3, K4, TMP, PT, SC, PH6, PH, TT, GP, GS, G1, GR, SIDE, FLAG,
@@ -675,10 +709,12 @@ def _block_run_soa(q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch):
                 if not END[k]:
                     continue
                 END[k] = False
-                if nxt >= q1:
-                    continue
-                lane = queue[nxt]
-                nxt += 1
+                lane = _chained(k, lanes, cfg, sched, out, slots)
+                if lane < 0:
+                    if nxt >= q1:
+                        continue
+                    lane = queue[nxt]
+                    nxt += 1
                 loaded = True
                 n_act += 1
                 n_samp += _load_slot(k, lane, lanes, cfg, sched, out, blk, slots, GP)
@@ -1139,7 +1175,7 @@ def _fused_run(fast, q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch):
     every lane of the worker's queue taking the model's fast form or none (``fast``, a
     constant: one copy of the loop per compiled function, see :func:`_block_run_fused`)."""
     locate = cfg[3]
-    start, queue, lane_nper, lane_tab, S_TAB, C_TAB = sched
+    start, queue, lane_nper, lane_tab, S_TAB, C_TAB, chain = sched
     (R, D, Y, Y1, K1, K2, K3, K4, TMP, PT, SC, PH6, PH, TT, GP, GS, G1, GR, SIDE, FLAG,
      GMIN, GMAX, O, OMAX, OMIN, OSQ, HW3, FL, HW) = blk
     (STAT, MSK, ACT, END, LANE, STEP, PHASE, NPER, OFF, HB, T0B, n_end, n_tr, next_sample, DUE,
@@ -1161,10 +1197,12 @@ def _fused_run(fast, q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch):
                 if not END[k]:
                     continue
                 END[k] = False
-                if nxt >= q1:
-                    continue
-                lane = queue[nxt]
-                nxt += 1
+                lane = _chained(k, lanes, cfg, sched, out, slots)
+                if lane < 0:
+                    if nxt >= q1:
+                        continue
+                    lane = queue[nxt]
+                    nxt += 1
                 n_act += 1
                 _load_slot(k, lane, lanes, cfg, sched, out, blk, slots, GP)
                 SE[k] = S_TAB[OFF[k]]  # the phase at the start
@@ -1213,10 +1251,14 @@ def _block_run_fused(q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch):
     every lane of the queue takes it (``rhs_lane_fast``), else the general one."""
     P = lanes[0]
     queue = sched[1]
+    chain = sched[6]
     PTq = P.T  # coefficient rows, lane innermost (as rhs_lane_fast reads them)
     fast = True
     for i in range(q0, q1):
-        fast = fast & _lane_fast(PTq, queue[i])
+        lane = queue[i]
+        while lane >= 0:  # the lane and those chained after it
+            fast = fast & _lane_fast(PTq, lane)
+            lane = chain[lane] if chain.size > 0 else -1
     if fast:
         _block_run_fast(q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch)
     else:

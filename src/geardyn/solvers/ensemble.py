@@ -77,6 +77,7 @@ def run_lanes(
     max_section_periods: int | None = None,
     *,
     run: RunSettings | None = None,
+    chain: np.ndarray | None = None,
 ) -> LaneResults:
     """Integrate one lane per row of ``P`` (coefficient vectors) from ``y0`` (one state, or one
     per lane) and return stroboscopic samples (one every ``sample_every`` forcing periods) and
@@ -94,7 +95,13 @@ def run_lanes(
     on, one sampling interval at a time up to ``transient_max`` (default 10 x transient), until
     the section point is estimated within ``converge (1 + |point|)`` of a periodic orbit of
     period <= ``converge_depth`` sections (from the contraction of successive differences,
-    docs/numerics.md); ``converged`` tells per lane whether it was."""
+    docs/numerics.md); ``converged`` tells per lane whether it was.
+
+    ``chain`` (one int per lane, -1: none) makes sweeps by continuation: lane ``chain[l]``
+    starts where lane l ended (its final state, at its end time; its own ``y0`` row and
+    ``t0`` are ignored), in the same slot, if lane l ended well (status ok); after a lane that
+    did not, the rest of its chain is not run (their results are left as allocated; the
+    caller restarts them)."""
     per_lane = {"transient": transient, "transient_max": transient_max,
                 "steps_per_period": steps_per_period}
     scalars = {k: v for k, v in per_lane.items() if v is not None and np.ndim(v) == 0}
@@ -115,12 +122,12 @@ def run_lanes(
                         f"(got run= and {next(iter(legacy))}=)")
     plan = LanePlan.build(model, np.ascontiguousarray(np.atleast_2d(P), dtype=float), run,
                           sample_every=sample_every, t0=t0, **overrides)
-    return run_plan(model, P, y0, plan, converge_depth)
+    return run_plan(model, P, y0, plan, converge_depth, chain=chain)
 
 
 def run_plan(model: Model, P: np.ndarray, y0: np.ndarray, plan: LanePlan,
              converge_depth: int = 16, *, width: int | None = None,
-             workers: int | None = None) -> LaneResults:
+             workers: int | None = None, chain: np.ndarray | None = None) -> LaneResults:
     """Run the lanes ``P`` from ``y0`` as ``plan`` says (see :func:`run_lanes`). ``width``:
     slots per worker's block (default the kernel's ``BLOCK``), ``workers``: parallel workers
     (default numba's thread count); neither changes a lane's result, bit for bit."""
@@ -157,13 +164,22 @@ def run_plan(model: Model, P: np.ndarray, y0: np.ndarray, plan: LanePlan,
     )
     tr_steps = np.zeros(L, np.int64)
     s_tab, c_tab, lane_tab = _phase_tables(k, n_lane)
-    start, queue = _schedule(plan.total_periods * n_lane, workers)
+    cost = plan.total_periods * n_lane
+    if chain is None:
+        chain = np.empty(0, np.int64)
+        start, queue = _schedule(cost, workers)
+    else:
+        chain = _check_chain(chain, L)
+        heads, chain_cost = _chain_heads(chain, cost)
+        start, queue = _schedule(chain_cost, workers)
+        queue = heads[queue]
 
     def lane_array(x, dtype):
         return np.ascontiguousarray(x, dtype=dtype)
 
+    T0 = np.array(plan.t0, dtype=float)  # a copy: chained lanes' start times are set in it
     lanes = LaneInputs(P, Y0, lane_array(plan.step, float), lane_array(plan.omega, float),
-                       lane_array(plan.t0, float), lane_array(plan.transient_steps, np.int64),
+                       T0, lane_array(plan.transient_steps, np.int64),
                        lane_array(plan.transient_max_steps, np.int64),
                        lane_array(plan.sample_steps, np.int64))
     cfg = SweepConfig(float(run.converge_tol), int(converge_depth), int(samples),
@@ -171,14 +187,49 @@ def run_plan(model: Model, P: np.ndarray, y0: np.ndarray, plan: LanePlan,
                       int(width or k.BLOCK))
     if cfg.width < 1:
         raise ValueError(f"width must be >= 1 (got {width!r})")
-    sched = Schedule(start, queue, n_lane, lane_tab, s_tab, c_tab)
+    sched = Schedule(start, queue, n_lane, lane_tab, s_tab, c_tab, chain)
     res = LaneOutputs(out.samples, out.final, out.status, out.event_min, out.event_max,
                       out.crossings, out.obs_max, out.obs_min, out.obs_rms, out.unresolved,
                       tr_steps, out.converged)
     k.sweep(lanes, cfg, sched, res)
     out.transient_periods = tr_steps // n_lane
-    out.final_time = plan.final_time(out.transient_periods)
+    out.final_time = plan.final_time(out.transient_periods, T0)
     return out
+
+
+def _check_chain(chain: np.ndarray, lanes: int) -> np.ndarray:
+    """``chain`` as the kernel takes it (int64, one entry per lane), checked: each entry -1 or
+    another lane, no lane the successor of two, no cycle."""
+    c = np.ascontiguousarray(chain, dtype=np.int64)
+    if c.shape != (lanes,):
+        raise ValueError(f"chain must have one entry per lane ({lanes}), got shape {c.shape}")
+    linked = c[c >= 0]
+    if np.any(c < -1) or np.any(linked >= lanes) or np.any(linked == np.flatnonzero(c >= 0)):
+        raise ValueError("chain entries must be -1 or the index of another lane")
+    if np.unique(linked).size != linked.size:
+        raise ValueError("chain: a lane follows two lanes")
+    heads = np.setdiff1d(np.arange(lanes), linked)
+    seen = 0
+    for h in heads:
+        lane = h
+        while lane >= 0:
+            seen += 1
+            lane = c[lane]
+    if seen != lanes:
+        raise ValueError("chain: a cycle (some lanes follow no first lane)")
+    return c
+
+
+def _chain_heads(chain: np.ndarray, cost: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The first lane of every chain and the chain's total cost (lane-steps)."""
+    heads = np.setdiff1d(np.arange(chain.size), chain[chain >= 0]).astype(np.int64)
+    total = np.zeros(heads.size)
+    for i, h in enumerate(heads):
+        lane = h
+        while lane >= 0:
+            total[i] += cost[lane]
+            lane = chain[lane]
+    return heads, total
 
 
 def _phase_tables(k, n_lane: np.ndarray):
