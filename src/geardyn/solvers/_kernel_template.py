@@ -590,14 +590,15 @@ def _sweep_worker(w, lanes, cfg, sched, out):
     _block_run(q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch)
 
 
-@nb.njit(inline="always", **_JIT)
+@nb.njit(_nrt=False, **_JIT)
 def _chained(k, lanes, cfg, sched, out, slots):
     """The lane that follows the one that has just ended in slot k on its chain
     (``sched.chain``: a sweep by continuation, each point starting where the one before
     ended), its start state and time set to that lane's final state and end time (the time
     as :meth:`~geardyn.core.plan.LanePlan.final_time` computes it); -1 when there is no
     chain, the slot held no lane yet, the chain ends there, or that lane did not end well (the
-    caller restarts the rest of the chain)."""
+    caller restarts the rest of the chain). Out of line: called once per lane, and kept out of
+    the block loop's function, whose size decides whether LLVM vectorises its step loop."""
     chain = sched[6]
     if chain.size == 0:
         return -1
