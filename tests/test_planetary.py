@@ -200,15 +200,21 @@ def _linear_set(**kw) -> geardyn.PlanetaryGearSet:
                     sun_error_phase=0.4, **kw)
 
 
-def test_linear_forced_response():
-    """Zero backlash and constant stiffness: the kernel run started on the harmonic solution of
-    M q'' + C q' + K q = sum_m w_m k_m e_m(t) stays on it."""
-    gs = _linear_set(mesh_frequency=2 * math.pi * 1300)
+def _linear_set_matrices() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """M, K and C of :func:`_linear_set` from Lin & Parker's blocks: the sun's and carrier's
+    torsional supports added, modal damping 0.05 on every mode."""
     Mm, K = lp_matrices(4)
     K[8, 8] += 2e7
     K[2, 2] += 3e8
     lam, phi = eigh(K, Mm)
-    C = Mm @ phi @ np.diag(2 * 0.05 * np.sqrt(lam)) @ phi.T @ Mm
+    return Mm, K, Mm @ phi @ np.diag(2 * 0.05 * np.sqrt(lam)) @ phi.T @ Mm
+
+
+def test_linear_forced_response():
+    """Zero backlash and constant stiffness: the kernel run started on the harmonic solution of
+    M q'' + C q' + K q = sum_m w_m k_m e_m(t) stays on it."""
+    gs = _linear_set(mesh_frequency=2 * math.pi * 1300)
+    Mm, K, C = _linear_set_matrices()
     # mesh deflection rows from the blocks' structure (sun mesh n, then ring mesh n)
     psi = 2 * np.pi * np.arange(4) / 4
     a = 24.6 * DEG
@@ -248,11 +254,7 @@ def test_orbit_continuation_and_lyapunov_of_the_linear_set_match_its_eigenvalues
     from scipy.linalg import eigvals
 
     gs = _linear_set(mesh_frequency=2 * math.pi * 1300)
-    Mm, K = lp_matrices(4)
-    K[8, 8] += 2e7
-    K[2, 2] += 3e8
-    lam, phi = eigh(K, Mm)
-    C = Mm @ phi @ np.diag(2 * 0.05 * np.sqrt(lam)) @ phi.T @ Mm
+    Mm, K, C = _linear_set_matrices()
     n = 21
     A = np.block([[np.zeros((n, n)), np.eye(n)],
                   [-solve(Mm, K), -solve(Mm, C)]]) / gs.time_scale  # d/dtau

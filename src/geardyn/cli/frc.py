@@ -45,6 +45,9 @@ from geardyn.study import build_model
 
 __all__ = ["frc_command", "register"]
 
+#: The parameters ``geardyn frc`` sweeps: the forcing frequency and its physical forms.
+FREQUENCY_PARAMS = ("Omega", "mesh_frequency", "input_speed")
+
 
 def frc_command(
     study: Annotated[str, typer.Argument(help="Study TOML file or built-in study name.")],
@@ -158,10 +161,6 @@ def frc_command(
         f"{name} [{values[0]:g}, {values[-1]:g}] (Omega [{start:g}, {stop:g}])")
     typer.echo(f"{s.study.name}: {num} values of Omega in {span} up and down, "
                f"{elapsed:.1f} s: {_summary(ds)}{wrote}")
-
-
-#: The parameters ``geardyn frc`` sweeps: the forcing frequency and its physical forms.
-FREQUENCY_PARAMS = ("Omega", "mesh_frequency", "input_speed")
 
 
 def _omegas(model, name: str, values):

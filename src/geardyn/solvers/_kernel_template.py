@@ -590,6 +590,19 @@ def _sweep_worker(w, lanes, cfg, sched, out):
     _block_run(q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch)
 
 
+@nb.njit(inline="always", **_JIT)
+def _next_lane(k, nxt, q1, lanes, cfg, sched, out, slots):
+    """The lane slot k takes next, and the queue position after it: the successor on the
+    chain of the lane that ended there (:func:`_chained`), else the queue's next lane; -1 when
+    there is neither."""
+    lane = _chained(k, lanes, cfg, sched, out, slots)
+    if lane >= 0:
+        return lane, nxt
+    if nxt >= q1:
+        return -1, nxt
+    return sched[1][nxt], nxt + 1
+
+
 @nb.njit(_nrt=False, **_JIT)
 def _chained(k, lanes, cfg, sched, out, slots):
     """The lane that follows the one that has just ended in slot k on its chain
@@ -710,12 +723,9 @@ def _block_run_soa(q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch):
                 if not END[k]:
                     continue
                 END[k] = False
-                lane = _chained(k, lanes, cfg, sched, out, slots)
+                lane, nxt = _next_lane(k, nxt, q1, lanes, cfg, sched, out, slots)
                 if lane < 0:
-                    if nxt >= q1:
-                        continue
-                    lane = queue[nxt]
-                    nxt += 1
+                    continue
                 loaded = True
                 n_act += 1
                 n_samp += _load_slot(k, lane, lanes, cfg, sched, out, blk, slots, GP)
@@ -1198,12 +1208,9 @@ def _fused_run(fast, q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch):
                 if not END[k]:
                     continue
                 END[k] = False
-                lane = _chained(k, lanes, cfg, sched, out, slots)
+                lane, nxt = _next_lane(k, nxt, q1, lanes, cfg, sched, out, slots)
                 if lane < 0:
-                    if nxt >= q1:
-                        continue
-                    lane = queue[nxt]
-                    nxt += 1
+                    continue
                 n_act += 1
                 _load_slot(k, lane, lanes, cfg, sched, out, blk, slots, GP)
                 SE[k] = S_TAB[OFF[k]]  # the phase at the start
