@@ -397,7 +397,6 @@ def test_with_params_keeps_scales_and_rebuilds():
     (dict(sun=M(-1.0, 0.39, 1e8)), "sun.mass"),
     (dict(sun_mesh_stiffness="5e8 N"), "sun_mesh_stiffness"),
     (dict(planet=M(0.66, 0.61, 1e8, 1e6)), "planet.torsional_stiffness"),
-    (dict(carrier_speed=100.0), "carrier_speed"),
     (dict(sun_torque=10.0), "sun.radius"),
     (dict(sun_stiffness_fluctuation=1.5), "sun_stiffness_fluctuation"),
     (dict(sun_backlash=[1e-6, 2e-6]), "sun_backlash"),

@@ -346,7 +346,9 @@ def test_frequency_response_axes_of_a_set_from_geometry():
 @pytest.mark.parametrize(("old", "new", "fragments"), [
     ("teeth = 23", "teeth = 3", ("params.geometry.planet.teeth", ">= 5", "3")),
     ("n_planets = 4", "n_planets = 7", ("params.planet_angles", "collide")),
-    ("teeth = 71", "teeth = 70", ("params.centre_distance", "zero-backlash")),
+    ("teeth = 71", "teeth = 70", ("params.geometry.ring.teeth", "Z_s + 2 Z_p = 71", "70")),
+    ("teeth = 71", "teeth = 71\nprofile_shift = 0.5",
+     ("params.geometry.ring.profile_shift", "does not mesh")),
     ('module = "2 mm"', 'module = "-2 mm"', ("params.geometry.sun.module", "> 0")),
 ])
 def test_bad_geometry_in_a_study_is_a_one_line_cli_error(tmp_path, old, new, fragments):
@@ -367,3 +369,71 @@ def test_bad_geometry_in_a_study_is_a_one_line_cli_error(tmp_path, old, new, fra
     lines = r.stderr.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("error: "), r.stderr
     assert all(f in lines[0] for f in fragments), lines[0]
+
+
+def _flank_at(gear: g.SpurGear, radius: float) -> tuple[float, np.ndarray]:
+    """The upper (counter-clockwise) flank of a tooth centred at angle 0, drawn here as an
+    involute unwound from the base circle: its polar angle at ``radius`` and its outward unit
+    normal there (by finite differences, pointing away from the tooth)."""
+    from scipy.optimize import brentq
+
+    rb, r0 = gear.base_radius, gear.module * gear.teeth / 2
+    s0 = gear.module * (math.pi / 2 + 2 * gear.profile_shift * math.tan(gear.pressure_angle))
+    t0 = math.sqrt(r0**2 - rb**2) / rb
+    b = s0 / (2 * r0) + t0 - math.atan(t0)  # half the tooth's angle at the base circle
+
+    def q(t: float) -> np.ndarray:  # unwound clockwise from the base circle at angle b
+        return rb * _rotated(np.array([math.cos(t) + t * math.sin(t),
+                                       t * math.cos(t) - math.sin(t)]), b)
+
+    t = brentq(lambda t: np.linalg.norm(q(t)) - radius, 0.0, 5.0)
+    p, d = q(t), (q(t + 1e-7) - q(t - 1e-7)) / 2e-7
+    n = np.array([d[1], -d[0]]) / np.linalg.norm(d)
+    if np.dot(n, np.array([-p[1], p[0]])) < 0:  # away from the tooth: towards larger angles
+        n = -n
+    return math.atan2(p[1], p[0]), n
+
+
+def _rotated(v: np.ndarray, angle: float) -> np.ndarray:
+    c, s = math.cos(angle), math.sin(angle)
+    return np.array([c * v[0] - s * v[1], s * v[0] + c * v[1]])
+
+
+@pytest.mark.parametrize(("teeth", "shifts"), [
+    ((25, 23, 71), (-0.2, 0.2, 0.2)),   # shifted teeth, both pitch radii equal
+    ((25, 23, 72), (-0.4, 0.4, 0.0)),   # unequal operating pitch radii of the planet
+    ((25, 23, 71), (0.0, 0.0, 0.0)),
+])
+def test_sun_ring_phase_by_tooth_construction(teeth, shifts):
+    """gamma_rs from the planet's teeth drawn here: the planet (centre (a, 0), sun at the origin)
+    turns clockwise as the sun drives counter-clockwise; at the sun-side pitch point (angle pi,
+    operating pitch radius) the sun pushes the planet tooth's flank whose outward normal points
+    to -y, and at the ring-side one (angle 0) the planet pushes the ring with its flank whose
+    normal points to -y (its direction of motion). The delay from the one flank's passage to the
+    other's, in planet tooth pitches, is gamma_rs."""
+    zs, zp, zr = teeth
+    gears = [g.SpurGear(z, MODULE, "20 deg", "20 mm", profile_shift=x, internal=i, name=nm)
+             for z, x, i, nm in zip(teeth, shifts, (False, False, True), ("sun", "planet", "ring"),
+                                    strict=True)]
+    geo = g.PlanetaryGeometry(*gears, n_planets=1)
+    planet = gears[1]
+    r_sun_side = geo.sun_mesh.operating_pitch_radii[1]
+    r_ring_side = geo.ring_mesh.operating_pitch_radii[0]
+
+    def loaded_centre(radius: float, at: float) -> float:
+        """The centre angle of the tooth whose loaded (-y facing) flank is at angle ``at``."""
+        h, n = _flank_at(planet, radius)
+        for side in (1, -1):  # upper flank at `at` (centre at - h), or the mirrored lower one
+            centre = at - side * h
+            normal = _rotated(np.array([n[0], side * n[1]]), centre)
+            if normal[1] < 0:
+                return centre
+        raise AssertionError("no flank faces -y")
+
+    c_sun = loaded_centre(r_sun_side, math.pi)
+    c_ring = loaded_centre(r_ring_side, 0.0)
+    # tooth centres c0 + 2 pi k / Z_p - beta: the ring-side passage comes (c_sun - c_ring) later
+    gamma = ((c_sun - c_ring) * zp / (2 * math.pi)) % 1.0
+    assert min(abs(gamma - geo.phases.sun_ring), 1 - abs(gamma - geo.phases.sun_ring)) < 1e-9
+    if shifts != (0.0, 0.0, 0.0):
+        assert 1e-3 < geo.phases.sun_ring < 1 - 1e-3 and abs(geo.phases.sun_ring - 0.5) > 1e-3

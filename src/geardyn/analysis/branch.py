@@ -189,6 +189,7 @@ class _Tracer:
         if self.param == "Omega":
             if not p > 0:
                 raise _Invalid(f"Omega must be > 0 (got {p:.8g})")
+        if self.param == "Omega" and self.model.omega_is_entry:
             P = self.model.params.astype(float).copy()
             P[self.model.omega_index] = p
         else:

@@ -110,6 +110,10 @@ class Model:
     kernel: KernelSource
     #: Meshes with a backlash dead zone: (name, index of event X - b, index of event X + b).
     meshes: tuple[tuple[str, int, int], ...] = ()
+    #: Omega is one entry of ``params`` and no other coefficient depends on it, so a lane's
+    #: Omega may be set by writing that entry; False where Omega moves other coefficients (set
+    #: it through ``lane_params``/``with_params``).
+    omega_is_entry: bool = True
 
     # ------------------------------------------------------------------ sizes
     @property
@@ -184,7 +188,7 @@ class Model:
             raise ValueError(f"x and y must be different parameters (both {x!r})")
         xv = np.asarray(x_values, dtype=float).ravel()
         yv = np.asarray(y_values, dtype=float).ravel()
-        if y == "Omega":  # the frequency is one entry of every vector: set it on the x rows
+        if y == "Omega" and self.omega_is_entry:  # one entry of every vector: set it on x rows
             row = self.lane_params(x, xv)
             P = np.tile(row, (yv.size, 1))
             P[:, self._param_index("Omega")] = np.repeat(yv, xv.size)

@@ -272,7 +272,8 @@ class GearMesh:
         a0 = self.zero_backlash_centre_distance
         if j < -1e-9 * self.pinion.module:
             raise ParameterError("centre_distance", a,
-                                 f"teeth overlap: it is below the zero-backlash distance"
+                                 f"teeth overlap: it is {'above' if self.internal else 'below'}"
+                                 f" the zero-backlash distance"
                                  f" {a0:.6g} m of these tooth counts and profile shifts")
         if j > j_max:
             raise ParameterError("centre_distance", a,

@@ -151,9 +151,22 @@ class PlanetaryGeometry:
 
     @cached_property
     def ring_mesh(self) -> GearMesh:
-        """The planet (pinion) - ring (internal wheel) mesh at the same centre distance."""
-        return GearMesh(self.planet, self.ring, centre_distance=self.sun_mesh.centre_distance,
-                        internal=True)
+        """The planet (pinion) - ring (internal wheel) mesh at the same centre distance. A ring
+        that does not fit it is an error naming the ring's ``teeth`` (Z_r != Z_s + 2 Z_p) or
+        its ``profile_shift``."""
+        a = self.sun_mesh.centre_distance
+        try:
+            return GearMesh(self.planet, self.ring, centre_distance=a, internal=True)
+        except ParameterError as exc:
+            if exc.field != "centre_distance":
+                raise
+            zs, zp, zr = self.sun.teeth, self.planet.teeth, self.ring.teeth
+            name = self.ring.name
+            field, value = ((f"{name}.teeth", zr) if zr != zs + 2 * zp
+                            else (f"{name}.profile_shift", self.ring.profile_shift))
+            raise ParameterError(field, value, f"the ring does not mesh with the planets at the "
+                                 f"sun mesh's centre distance {a:.6g} m ({exc.reason}); without "
+                                 f"profile shifts Z_r = Z_s + 2 Z_p = {zs + 2 * zp}") from None
 
     @cached_property
     def phases(self) -> MeshPhases:

@@ -349,6 +349,12 @@ class PlanetaryGearSetParams(BaseModel):
     mesh_frequency: Quantity | None = None
     rotational_only: bool = False
     fixed: list[Literal["carrier", "ring", "sun"]] = Field(default_factory=list)
+    carrier_speed: Quantity | None = Field(
+        None, description="carrier speed (rad/s or e.g. \"300 rpm\"; \"kinematic\": from the "
+        "tooth counts of [params.geometry], following the input speed): gyroscopic and "
+        "centripetal terms")
+    carrier_speed_ratio: float | None = None
+    centrifugal_preload: bool = True
     held: Literal["carrier", "ring", "sun"] | None = Field(
         None, description="member held in the input_speed kinematics (with [params.geometry]; "
         "default: the one fixed member, else the ring)")

@@ -13,8 +13,9 @@ of action (``docs/planetary.md``)::
 with psi_sn = psi_n - a_s, psi_rn = psi_n + a_r. Planet bearings deflect by
 x_c cos psi_n + y_c sin psi_n - zeta_n (radial) and -x_c sin psi_n + y_c cos psi_n - eta_n + u_c
 (tangential). Each mesh spring acts through a dead zone (backlash) with a time-varying stiffness
-and a transmission error. Gyroscopic and centripetal terms of the rotating carrier are omitted
-(the carrier-frame model at low carrier speed, as in Lin & Parker's modal analysis).
+and a transmission error. With a carrier speed the rotating frame's gyroscopic and centripetal
+terms act on the translations (``carrier_speed``; ``docs/planetary.md``, "Rotating carrier");
+without one they are omitted (the carrier-frame model at low carrier speed).
 """
 
 from __future__ import annotations
@@ -39,8 +40,9 @@ _KERNEL = KernelSource(pk.planetary_rhs, pk.planetary_events, pk.planetary_obser
 CENTRAL = ("carrier", "ring", "sun")
 _SHORT = {"carrier": "c", "ring": "r", "sun": "s"}
 #: Constructor inputs that fix the model's layout or are not numbers: not swept by name.
-_NOT_SWEPT = {"n_planets", "waveform", "harmonics", "rotational_only", "fixed", "carrier_speed",
-              "planet_angles", "sun", "ring", "carrier", "planet", "time_scale", "length_scale"}
+_NOT_SWEPT = {"n_planets", "waveform", "harmonics", "rotational_only", "fixed",
+              "centrifugal_preload", "planet_angles", "sun", "ring", "carrier", "planet",
+              "time_scale", "length_scale"}
 #: Relative tolerance within which two natural frequencies count as one repeated frequency.
 MULTIPLICITY_RTOL = 1e-6
 
@@ -104,7 +106,8 @@ _FROM_BUILD = ("geometry", "stiffness_waveforms", "held")
 #: The sweep parameter of a set built from geometry: the input member's speed [rpm].
 INPUT_SPEED = "input_speed"
 #: Units of the swept inputs, by kind (dataset axis attributes; see ``param_attrs``).
-_UNITS = {"mesh_frequency": "rad/s", INPUT_SPEED: "rpm", "torque_phase": "rad",
+_UNITS = {"mesh_frequency": "rad/s", INPUT_SPEED: "rpm", "carrier_speed": "rad/s",
+          "carrier_speed_ratio": "1", "torque_phase": "rad",
           "sun_pressure_angle": "rad", "ring_pressure_angle": "rad"}
 _UNIT_SUFFIXES = (("_torque", "N m"), ("_mesh_stiffness", "N/m"), ("_backlash", "m"),
                   ("_mesh_error", "m"), ("_phase", "rad"))
@@ -256,8 +259,23 @@ class PlanetaryGearSet(Model):
         carrier (eta_n = u_c, zeta_n = 0).
     fixed
         Members held fixed (all their coordinates removed), e.g. ``("ring",)``.
-    carrier_speed
-        Must be None: gyroscopic and centripetal terms are not modelled (omitted).
+    carrier_speed, carrier_speed_ratio
+        The carrier's speed Omega_c [rad/s, or a unit string such as ``"300 rpm"``], positive in
+        the sense of psi and u: the model then carries the rotating frame's gyroscopic (Coriolis)
+        and centripetal terms, M q'' + Omega_c G q' + (K - Omega_c^2 K_Omega) q = T (Lin &
+        Parker 1999; ``docs/planetary.md``, "Rotating carrier"). Or ``carrier_speed_ratio``:
+        Omega_c / mesh_frequency, so that the carrier speed follows the mesh frequency in a
+        sweep; :meth:`from_geometry` sets it from the tooth counts with
+        ``carrier_speed="kinematic"``. Both None (default): the terms are omitted (the
+        carrier-frame model at low carrier speed). Not with ``rotational_only`` (no
+        translations to act on).
+    centrifugal_preload
+        With a carrier speed: True (default) adds the planets' centrifugal load
+        m_p Omega_c^2 r_c on their bearings (needs ``carrier.radius`` r_c) and lets it turn
+        with the carrier: a planet's tangential centripetal term acts on its bearing's
+        tangential deflection eta_n - u_c (the expansion about the preloaded state), so a rigid
+        rotation of the gear train stays a zero-frequency mode; False: Lin & Parker's published
+        terms (on eta_n; a free rotation then diverges at any carrier speed).
     """
 
     name = "PlanetaryGearSet"
@@ -280,7 +298,8 @@ class PlanetaryGearSet(Model):
                  torque_fluctuation: float = 0.0, torque_order: float = 1.0,
                  torque_phase: float = 0.0, mesh_frequency: Any = None,
                  rotational_only: bool = False, fixed: Sequence[str] = (),
-                 carrier_speed: Any = None, time_scale: Any = None,
+                 carrier_speed: Any = None, carrier_speed_ratio: Any = None,
+                 centrifugal_preload: bool = True, time_scale: Any = None,
                  length_scale: Any = 1e-6):
         self.inputs: dict[str, Any] = {k: v for k, v in locals().items()
                                        if k not in ("self", "__class__")}
@@ -288,9 +307,6 @@ class PlanetaryGearSet(Model):
                 or not 1 <= n_planets <= 32:
             raise ParameterError("n_planets", n_planets, "must be an integer from 1 to 32")
         n = int(n_planets)
-        if carrier_speed is not None:
-            raise ParameterError("carrier_speed", carrier_speed, "gyroscopic and centripetal "
-                                 "terms of a rotating carrier are not modelled; leave it None")
         fixed = tuple(fixed)
         for f in fixed:
             if f not in CENTRAL:
@@ -307,6 +323,7 @@ class PlanetaryGearSet(Model):
         if self.members["planet"].torsional_stiffness != 0.0:
             raise ParameterError("planet.torsional_stiffness", planet.torsional_stiffness,
                                  "a planet has no torsional support; must be 0")
+        self._carrier_inputs(carrier_speed, carrier_speed_ratio, centrifugal_preload)
         self.alpha_s = _si("sun_pressure_angle", sun_pressure_angle, "angle")
         self.alpha_r = _si("ring_pressure_angle", ring_pressure_angle, "angle")
         for f, a in (("sun_pressure_angle", self.alpha_s), ("ring_pressure_angle", self.alpha_r)):
@@ -362,6 +379,81 @@ class PlanetaryGearSet(Model):
                                                                 mesh_frequency, "frequency")
         self._build(mf / self.time_scale)
 
+    def _carrier_inputs(self, speed: Any, ratio: Any, preload: Any) -> None:
+        """Validate the rotating carrier's inputs (see the class doc)."""
+        if isinstance(speed, str) and speed.strip().lower() == "kinematic":
+            raise ParameterError("carrier_speed", speed, "'kinematic' needs the tooth counts: "
+                                 "build the set with PlanetaryGearSet.from_geometry (or "
+                                 "[params.geometry] in a study), or give the speed")
+        if speed is not None and ratio is not None:
+            raise ParameterError("carrier_speed_ratio", ratio, "give carrier_speed or "
+                                 "carrier_speed_ratio, not both")
+        if not isinstance(preload, bool | np.bool_):
+            raise ParameterError("centrifugal_preload", preload, "must be true or false")
+        self.carrier_speed = None if speed is None else _si("carrier_speed", speed,
+                                                            "frequency", None)
+        self.carrier_speed_ratio = None if ratio is None else _si(
+            "carrier_speed_ratio", ratio, "dimensionless", None)
+        self.centrifugal_preload = bool(preload)
+        spinning = (self.carrier_speed or 0.0) != 0.0 or (self.carrier_speed_ratio or 0.0) != 0.0
+        field = "carrier_speed" if speed is not None else "carrier_speed_ratio"
+        if spinning and self.rotational_only:
+            raise ParameterError(field, speed if speed is not None else ratio,
+                                 "the rotational-only model has no translations for the "
+                                 "gyroscopic and centripetal terms to act on; leave it None")
+        if spinning and self.centrifugal_preload and self.members["carrier"].radius is None:
+            raise ParameterError("carrier.radius", None, "needed for the planets' centrifugal "
+                                 "load at a carrier speed (or centrifugal_preload=false)")
+
+    def carrier_omega(self, mesh_frequency: float | None = None) -> float:
+        """The carrier speed Omega_c [rad/s] at ``mesh_frequency`` [rad/s] (default the model's):
+        ``carrier_speed``, or ``carrier_speed_ratio`` times the mesh frequency; 0 when omitted."""
+        if self.carrier_speed is not None:
+            return self.carrier_speed
+        if self.carrier_speed_ratio is None:
+            return 0.0
+        mf = self.omega * self.time_scale if mesh_frequency is None else mesh_frequency
+        return self.carrier_speed_ratio * mf
+
+    @property
+    def _omega_sets_carrier(self) -> bool:
+        return bool(self.carrier_speed_ratio)
+
+    @property
+    def omega_is_entry(self) -> bool:
+        """False when the carrier speed follows the mesh frequency (``carrier_speed_ratio``):
+        then Omega moves Kt and Ct too, and a lane's Omega is set through :meth:`lane_params`."""
+        return not self._omega_sets_carrier
+
+    def rotating_frame_matrices(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """G [kg], K_Omega [kg] and the centrifugal force per Omega_c^2 f [kg m] in the model's
+        coordinates: the gyroscopic term is Omega_c G q', the centripetal one -Omega_c^2
+        K_Omega q, the load Omega_c^2 f (Lin & Parker 1999: G = [[0, -2m], [2m, 0]] and
+        diag(m, m) on every member's two carrier-frame translations; with
+        ``centrifugal_preload`` a planet's tangential entry acts on its bearing's tangential
+        deflection eta_n - u_c, and f is the planets' radial load m_p r_c; see
+        ``docs/planetary.md``, "Rotating carrier")."""
+        nf = 9 + 3 * self.n_planets
+        G = np.zeros((nf, nf))
+        K = np.zeros((nf, nf))
+        f = np.zeros(nf)
+        for j, k in enumerate((*CENTRAL,) + ("planet",) * self.n_planets):
+            m = self.members[k].mass
+            G[3 * j, 3 * j + 1], G[3 * j + 1, 3 * j] = -2.0 * m, 2.0 * m
+            K[3 * j, 3 * j] = K[3 * j + 1, 3 * j + 1] = m
+        if self.centrifugal_preload:  # on the bearing's tangential deflection eta_n - u_c
+            mp = self.members["planet"].mass
+            rc = self.members["carrier"].radius
+            for i in range(self.n_planets):
+                e = 9 + 3 * i + 1
+                K[e, 2] -= mp
+                K[2, e] -= mp
+                K[2, 2] += mp
+                if rc is not None:
+                    f[e - 1] = mp * rc
+        T = self.constraint()
+        return T.T @ G @ T, T.T @ K @ T, T.T @ f
+
     @classmethod
     def from_geometry(cls, geometry: Any, *, sun: Member, ring: Member, carrier: Member,
                       planet: Member, harmonics: int = 9,
@@ -380,7 +472,9 @@ class PlanetaryGearSet(Model):
         of sun, ring and planet, the carrier's: the centre distance); ``sun_backlash`` and
         ``ring_backlash`` where not given: half the geometry's normal backlash
         j cos(alpha_w) / 2 of each mesh [m] (0 at the default, tight centre distance).
-        ``kw`` are the other :class:`PlanetaryGearSet` inputs (damping, torques, errors, ...).
+        ``kw`` are the other :class:`PlanetaryGearSet` inputs (damping, torques, errors, ...);
+        ``carrier_speed="kinematic"`` sets ``carrier_speed_ratio`` from the tooth counts and
+        ``held`` (:func:`_kinematic_ratio`), so the carrier speed follows the input speed.
         ``held``: the member held still in the kinematics of :attr:`input_speed` (``"ring"``,
         ``"carrier"`` or ``"sun"``; default the one member in ``fixed``, else the ring).
         """
@@ -404,6 +498,14 @@ class PlanetaryGearSet(Model):
             if not isinstance(m, Member):
                 raise ParameterError(name, m, "must be a geardyn.Member")
             members[name] = _with_radius(name, m, radii[name])
+        if isinstance(kw.get("carrier_speed"), str) \
+                and kw["carrier_speed"].strip().lower() == "kinematic":
+            kw.pop("carrier_speed")
+            if kw.get("carrier_speed_ratio") is not None:
+                raise ParameterError("carrier_speed_ratio", kw["carrier_speed_ratio"],
+                                     "carrier_speed = 'kinematic' sets it; give one of them")
+            kw["carrier_speed_ratio"] = _kinematic_ratio(
+                _held(held, tuple(kw.get("fixed", ()))), geometry)
         for g, mesh in meshes.items():
             kw.setdefault(f"{g}_backlash",
                           0.5 * max(mesh.backlash, 0.0) * math.cos(mesh.operating_pressure_angle))
@@ -640,12 +742,19 @@ class PlanetaryGearSet(Model):
         p[pk.OMEGA] = omega
         p[pk.N_DOF], p[pk.N_MESH], p[pk.N_HARM] = n, nm, nh
         F = self._forces()
+        K, C = self.stiffness_matrix(False), self._damping_matrix()
+        wc = self.carrier_omega(omega * w0)
+        if wc != 0.0:  # the rotating carrier (see rotating_frame_matrices)
+            G, K_omega, f = self.rotating_frame_matrices()
+            K, C = _clean(K - wc * wc * K_omega), C + wc * G
+            F = F.copy()
+            F[0] = F[0] + wc * wc * f
         p[pk.TORQUE_ON] = float(np.any(F[1] != 0.0))
         p[pk.TORQUE_ORDER], p[pk.TORQUE_PHASE] = self.torque_order, self.torque_phase
         p[lay["F0"]:lay["F0"] + n] = Minv @ F[0] / (L * w0 * w0)
         p[lay["F1"]:lay["F1"] + n] = Minv @ F[1] / (L * w0 * w0)
-        p[lay["Kt"]:lay["Kt"] + n * n] = (Minv @ self.stiffness_matrix(False)).ravel() / w0**2
-        p[lay["Ct"]:lay["Ct"] + n * n] = (Minv @ self._damping_matrix()).ravel() / w0
+        p[lay["Kt"]:lay["Kt"] + n * n] = (Minv @ K).ravel() / w0**2
+        p[lay["Ct"]:lay["Ct"] + n * n] = (Minv @ C).ravel() / w0
         p[pk.DAMPED] = float(np.any(p[lay["Ct"]:lay["Ct"] + n * n] != 0.0))
         W = self.mesh_rows()
         k, c = self.mesh_stiffnesses(), self._mesh_damping()
@@ -733,6 +842,15 @@ class PlanetaryGearSet(Model):
         coefficients (``param_names``) set that entry of the vector. ``input_speed`` (a set
         built from geometry; rpm, or a unit string such as ``"3000 rpm"``) sets the mesh
         frequency (:meth:`mesh_frequency_per_input_speed`)."""
+        if "Omega" in values and self._omega_sets_carrier:  # Omega moves the carrier speed
+            values = dict(values)
+            om = float(values.pop("Omega"))
+            if "mesh_frequency" in values or INPUT_SPEED in values:
+                raise ParameterError("Omega", om, "sets the mesh frequency: give it, "
+                                     "mesh_frequency or input_speed, one of them")
+            out = self.with_params(mesh_frequency=om * self.time_scale, **values)
+            out.params[pk.OMEGA] = om
+            return out
         if INPUT_SPEED in values:
             values = dict(values)
             rpm = _rpm(INPUT_SPEED, values.pop(INPUT_SPEED))
@@ -770,7 +888,8 @@ class PlanetaryGearSet(Model):
     def lane_params(self, name: str, values: Sequence[float] | np.ndarray) -> np.ndarray:
         """Coefficient vectors (lanes x n_params) with ``name`` set to ``values`` (a physical
         input re-derives every coefficient, as :meth:`with_params`)."""
-        if name in self.inputs or name == INPUT_SPEED:
+        if name in self.inputs or name == INPUT_SPEED or (name == "Omega"
+                                                           and self._omega_sets_carrier):
             vals = np.asarray(values, dtype=float).ravel()
             rows = [self.with_params(**{name: float(v)}).params for v in vals]
             if len({r.size for r in rows}) != 1:
@@ -799,8 +918,15 @@ class PlanetaryGearSet(Model):
         lane of ``P`` (from the lane's coefficients; one eigenproblem per distinct row)."""
         P = np.atleast_2d(self.params if P is None else np.asarray(P, dtype=float))
         rows, inverse = unique_rows(P)
-        lam = np.linalg.eigvals(self._lane_matrix(rows))
-        return np.sqrt(np.max(np.abs(lam), axis=1))[inverse]
+        A = self._lane_matrix(rows)
+        if self.carrier_speed is None and self.carrier_speed_ratio is None:
+            return np.sqrt(np.max(np.abs(np.linalg.eigvals(A)), axis=1))[inverse]
+        # a rotating carrier: |lambda| of the first-order matrix with Ct (gyroscopic, damping)
+        n, lay = A.shape[1], self._layout
+        Ct = rows[:, lay["Ct"]:lay["Ct"] + n * n].reshape(-1, n, n)
+        Z, eye = np.zeros_like(A), np.broadcast_to(np.eye(n), A.shape)
+        first = np.concatenate([np.concatenate([Z, eye], 2), np.concatenate([-A, -Ct], 2)], 1)
+        return np.max(np.abs(np.linalg.eigvals(first)), axis=1)[inverse]
 
     def other_frequencies(self, P: np.ndarray) -> np.ndarray:
         """The torque fluctuation's frequency order * Omega where it acts and differs from the
@@ -809,9 +935,46 @@ class PlanetaryGearSet(Model):
         on = (P[:, pk.TORQUE_ON] != 0.0) & (P[:, pk.TORQUE_ORDER] != 1.0)
         return np.where(on, P[:, pk.TORQUE_ORDER] * P[:, pk.OMEGA], np.nan)[:, None]
 
+    def _rotating_eig(self) -> tuple[np.ndarray, np.ndarray]:
+        """One eigenvalue lambda [rad/s] per mode (Im >= 0, ascending abs(Im)) and complex shapes
+        (phi^H M phi = 1, largest entry real; abs(lambda) below 1e-6 of the largest: 0, a
+        rigid-body mode; abs(Re lambda) below 1e-9 of it: 0, rounding) of the undamped
+        rotating-carrier problem (lambda^2 M + lambda Omega_c G + K - Omega_c^2 K_Omega) phi = 0,
+        from its first-order form. Its spectrum is symmetric about both axes: each mode is a
+        pair lambda, conj or -lambda, of which the one with the larger imaginary part (and then
+        real part) is kept."""
+        from scipy.linalg import eig
+
+        wc = self.carrier_omega()
+        G, K_omega, _ = self.rotating_frame_matrices()
+        M = self.mass_matrix()
+        K = self.stiffness_matrix() - wc * wc * K_omega
+        n = M.shape[0]
+        Minv = np.diag(1.0 / np.diag(M))
+        A = np.block([[np.zeros((n, n)), np.eye(n)], [-Minv @ K, -wc * (Minv @ G)]])
+        lam, V = eig(A)
+        scale = max(float(np.max(np.abs(lam))), 1e-300)
+        im = np.where(np.abs(lam.imag) <= 1e-9 * scale, 0.0, lam.imag)
+        order = np.lexsort((-lam.real, -im, np.abs(im)))
+        keep = order[0::2]  # the first of each pair: the larger Im, then the larger Re
+        keep = keep[np.argsort(np.abs(im[keep]), kind="stable")]
+        phi = V[:n, keep]
+        norm = np.sqrt(np.real(np.einsum("ik,i,ik->k", phi.conj(), np.diag(M), phi)))
+        phi = phi / norm
+        big = phi[np.argmax(np.abs(phi), axis=0), np.arange(phi.shape[1])]
+        phi = phi * (np.abs(big) / big)
+        re = np.where(np.abs(lam.real) <= 1e-9 * scale, 0.0, lam.real)  # rounding: stable
+        out = re[keep] + 1j * np.abs(im[keep])
+        # a rigid-body mode is a double zero, split by rounding to ~sqrt(eps): exactly 0
+        return np.where(np.abs(out) <= 1e-6 * scale, 0.0, out), phi
+
     def natural_frequencies(self) -> np.ndarray:
         """Natural frequencies [Hz] of the linear model at mean stiffness, ascending, each
-        repeated by its multiplicity (a rigid-body mode gives 0)."""
+        repeated by its multiplicity (a rigid-body mode gives 0). With a carrier speed: the
+        frequencies abs(Im lambda) / 2 pi of the rotating-carrier problem in the carrier frame
+        (:meth:`modes` has its growth rates)."""
+        if self.carrier_omega() != 0.0:
+            return np.abs(self._rotating_eig()[0].imag) / (2.0 * math.pi)
         lam, _ = self._eig()
         return np.sqrt(lam) / (2.0 * math.pi)
 
@@ -823,12 +986,21 @@ class PlanetaryGearSet(Model):
         ``"translational"``: the carrier, ring and sun do not rotate; ``"planet"``: only the
         planets move; ``"mixed"`` otherwise, e.g. unequal spacing), ``shape`` (mode, dof):
         mass-normalised shapes [kg^-1/2] in the model's coordinates. A repeated frequency's
-        shapes span its eigenspace and are classified together.
+        shapes span its eigenspace and are classified together. With a carrier speed: the
+        modes of the gyroscopic problem (:meth:`natural_frequencies`), complex shapes
+        (phi^H M phi = 1) classified by their energy shares, and ``growth_rate`` [1/s], Re
+        lambda (> 0: the linear model is unstable at that speed, divergence or flutter).
         """
         import xarray as xr
 
-        lam, phi = self._eig()
-        f = np.sqrt(lam) / (2.0 * math.pi)
+        extra = {}
+        if self.carrier_omega() != 0.0:
+            lam, phi = self._rotating_eig()
+            f = np.abs(lam.imag) / (2.0 * math.pi)
+            extra["growth_rate"] = ("mode", lam.real, {"units": "1/s"})
+        else:
+            lam, phi = self._eig()
+            f = np.sqrt(lam) / (2.0 * math.pi)
         groups = _groups(f)
         names = self.dof_names()
         mult = np.zeros(f.size, int)
@@ -840,16 +1012,19 @@ class PlanetaryGearSet(Model):
             {"frequency": ("mode", f, {"units": "Hz"}),
              "multiplicity": ("mode", mult),
              "type": ("mode", kind.astype(str)),
-             "shape": (("mode", "dof"), phi.T, {"units": "kg^-1/2"})},
+             "shape": (("mode", "dof"), phi.T, {"units": "kg^-1/2"}), **extra},
             coords={"mode": np.arange(f.size), "dof": list(names)},
             attrs={"model": self.name, "n_planets": self.n_planets,
-                   "rotational_only": int(self.rotational_only)})
+                   "rotational_only": int(self.rotational_only),
+                   "carrier_speed": self.carrier_omega(),
+                   "carrier_speed_units": "rad/s",
+                   "centrifugal_preload": int(self.centrifugal_preload)})
 
     def _classify(self, shapes: np.ndarray, names: tuple[str, ...], tol: float = 1e-6) -> str:
         """Kind of the eigenspace spanned by ``shapes`` (dofs x k), from the energy of its parts
         (basis-independent: sums over the space)."""
         M = np.diag(self.mass_matrix())
-        e = np.sum(M[:, None] * shapes**2, axis=1)  # kinetic-energy share per dof
+        e = np.sum(M[:, None] * np.abs(shapes)**2, axis=1)  # kinetic-energy share per dof
         total = e.sum()
         central = np.array([d.endswith(("_c", "_r", "_s")) for d in names])
         trans = central & np.array([d[0] in "xy" for d in names])
@@ -954,6 +1129,14 @@ def _held(held: str | None, fixed: tuple[str, ...]) -> str:
     if held not in CENTRAL:
         raise ParameterError("held", held, f"must be one of {', '.join(CENTRAL)}")
     return held
+
+
+def _kinematic_ratio(held: str, geometry: Any) -> float:
+    """Carrier speed over mesh frequency from the tooth counts: 1/Z_r with the ring held,
+    1/Z_s with the sun held, 0 with the carrier held (the mesh frequency is Z_r abs(w_r - w_c) =
+    Z_s abs(w_s - w_c))."""
+    return {"ring": 1.0 / geometry.ring.teeth, "sun": 1.0 / geometry.sun.teeth,
+            "carrier": 0.0}[held]
 
 
 def _groups(f: np.ndarray) -> list[list[int]]:
