@@ -11,8 +11,11 @@ converge, with ``--samples``). ``--stride k`` runs every k-th point only (a quic
 the workload (lane-steps, steps per period used), the median of ``--repeat`` warm runs (wall
 and process CPU time) and ns per lane-step, and a checksum of the Poincare points.
 
+``--carrier-speed kinematic`` (or a speed such as ``"3000 rpm"``) runs the set with its
+carrier's gyroscopic and centripetal terms (``docs/planetary.md``, "Rotating carrier").
+
     .venv/bin/python bench/planetary.py [--threads 2] [--repeat 3] [--stride 1]
-        [--transient-periods 200] [--samples 32] [--study-run]
+        [--transient-periods 200] [--samples 32] [--study-run] [--carrier-speed kinematic]
 """
 
 from __future__ import annotations
@@ -34,6 +37,9 @@ from geardyn.io.toml import builtin_study
 
 def workload(args: argparse.Namespace):
     study = builtin_study("planetary_example")
+    if args.carrier_speed is not None:
+        study = study.model_copy(update={"params": study.params.model_copy(
+            update={"carrier_speed": args.carrier_speed})})
     model = geardyn.build_model(study)
     omegas = np.linspace(0.05, 1.2, 400)[::args.stride]
     if args.study_run:  # the study's [run] (transient in periods of the lowest Omega, converge)
@@ -53,6 +59,8 @@ def main() -> None:
     ap.add_argument("--samples", type=int, default=32)
     ap.add_argument("--study-run", action="store_true",
                     help="the study's own [run] settings (with --samples) instead")
+    ap.add_argument("--carrier-speed", default=None,
+                    help="the set's carrier_speed: 'kinematic' or a speed ('3000 rpm')")
     args = ap.parse_args()
     numba.set_num_threads(args.threads)
     model, omegas, run = workload(args)

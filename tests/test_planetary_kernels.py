@@ -40,6 +40,8 @@ def dense_rhs(gs: geardyn.PlanetaryGearSet, t: float, y: np.ndarray) -> np.ndarr
     Ct = p[lay["Ct"]:lay["Ct"] + n * n].reshape(n, n)
     fl = np.sin(p[pk.TORQUE_ORDER] * om * t + p[pk.TORQUE_PHASE])
     acc = p[lay["F0"]:lay["F0"] + n] + p[lay["F1"]:lay["F1"] + n] * fl - Kt @ X - Ct @ V
+    G = gs.rotating_frame_matrices()[0]  # the Coriolis term, from the model's G
+    acc -= gs.carrier_omega() / gs.time_scale * (G / np.diag(gs.mass_matrix())[:, None]) @ V
     h = np.arange(1, nh + 1)
     for m in range(nm):
         b = p[lay["mesh"] + m * lay["block"]:][:lay["block"]]
@@ -55,7 +57,11 @@ def dense_rhs(gs: geardyn.PlanetaryGearSet, t: float, y: np.ndarray) -> np.ndarr
     return np.concatenate([V, acc])
 
 
-@pytest.mark.parametrize("kw", [{}, {"rotational_only": True}, {"fixed": ("ring",)}])
+SPINNING = {"carrier": M(5.43, 6.29, 1e8, 0.0, radius=0.08), "carrier_speed": 900.0}
+
+
+@pytest.mark.parametrize("kw", [{}, {"rotational_only": True}, {"fixed": ("ring",)}, SPINNING,
+                                {**SPINNING, "fixed": ("carrier",)}])
 def test_rhs_matches_the_dense_formula(kw):
     gs = busy_set(**kw)
     rng = np.random.default_rng(3)
@@ -92,6 +98,24 @@ def test_lanes_with_different_damping_reproduce_single_simulations_bitwise():
     for j in (0, 1):
         ds = geardyn.simulate(gs.with_params(modal_damping=zetas[j]), transient=30.0,
                               periods=3, steps_per_period=64)
+        np.testing.assert_array_equal(r.samples[j], ds["poincare"].values[1:])
+
+
+@pytest.mark.parametrize(("name", "values"), [
+    ("Omega", [0.4, 0.9, 0.55]),                   # carrier speed following Omega: w_c per lane
+    ("carrier_speed", [0.0, 700.0, 1500.0]),       # one lane standing still in a spinning block
+])
+def test_rotating_lanes_reproduce_single_simulations_bitwise(name, values):
+    gs = busy_set(carrier=M(5.43, 6.29, 1e8, 0.0, radius=0.08), carrier_speed_ratio=1 / 71)
+    if name == "carrier_speed":
+        gs = busy_set(carrier=M(5.43, 6.29, 1e8, 0.0, radius=0.08), carrier_speed=1.0)
+    P = gs.lane_params(name, values)
+    r = run_lanes(gs, P, gs.initial_state(), 30.0, 3, steps_per_period=64)
+    assert np.all(r.status == 0)
+    assert len({row[gs._layout["gyro"]] for row in P}) == 3  # the lanes' speeds differ
+    for j in range(3):
+        ds = geardyn.simulate(gs.with_params(**{name: values[j]}), transient=30.0, periods=3,
+                              steps_per_period=64, y0=gs.initial_state())
         np.testing.assert_array_equal(r.samples[j], ds["poincare"].values[1:])
 
 

@@ -734,19 +734,21 @@ class PlanetaryGearSet(Model):
         nm = 2 * self.n_planets
         nh = self.fourier.shape[1] // 2
         kt_entries, mesh_dofs = self._kernel_structure()
-        lay = pk.layout(n, nm, nh, len(kt_entries))
-        L, w0 = self.length_scale, self.time_scale
         M = self.mass_matrix()
         Minv = np.diag(1.0 / np.diag(M))
+        G_unit = _clean(Minv @ self.rotating_frame_matrices()[0])  # M^-1 G (structural)
+        gyro = [(int(i), int(j)) for i, j in zip(*np.nonzero(G_unit), strict=True)]
+        lay = pk.layout(n, nm, nh, len(kt_entries), len(gyro))
+        L, w0 = self.length_scale, self.time_scale
         p = np.zeros(lay["size"])
         p[pk.OMEGA] = omega
         p[pk.N_DOF], p[pk.N_MESH], p[pk.N_HARM] = n, nm, nh
         F = self._forces()
         K, C = self.stiffness_matrix(False), self._damping_matrix()
         wc = self.carrier_omega(omega * w0)
-        if wc != 0.0:  # the rotating carrier (see rotating_frame_matrices)
-            G, K_omega, f = self.rotating_frame_matrices()
-            K, C = _clean(K - wc * wc * K_omega), C + wc * G
+        if wc != 0.0:  # the rotating carrier (see rotating_frame_matrices); G: the gyro section
+            _, K_omega, f = self.rotating_frame_matrices()
+            K = _clean(K - wc * wc * K_omega)
             F = F.copy()
             F[0] = F[0] + wc * wc * f
         p[pk.TORQUE_ON] = float(np.any(F[1] != 0.0))
@@ -782,8 +784,14 @@ class PlanetaryGearSet(Model):
         self._structure = (kt_entries, mesh_dofs)
         pk.fill_structure(p, kt_entries, mesh_dofs)
         names_p += pk.structure_names(names, self.mesh_names, kt_entries)
-        cache_names, p[lay["cache"]:] = pk.cache_entries(nm)
+        cache_names, p[lay["cache"]:lay["gyro"]] = pk.cache_entries(nm)
         names_p += cache_names
+        g, ng = lay["gyro"], len(gyro)
+        p[g], p[g + 1] = wc / w0, ng
+        p[g + 2:g + 2 + ng] = [i for i, _ in gyro]
+        p[g + 2 + ng:g + 2 + 2 * ng] = [j for _, j in gyro]
+        p[g + 2 + 2 * ng:g + 2 + 3 * ng] = [G_unit[i, j] for i, j in gyro]
+        names_p += pk.gyro_names(names, gyro)
         self.params = p
         self.param_names = tuple(names_p)
         self.omega_index = pk.OMEGA
@@ -913,6 +921,17 @@ class PlanetaryGearSet(Model):
             A += P[:, o + pk.M_KF, None, None] * G[:, :, None] * W[:, None, :]
         return A
 
+    def _gyro_ct(self, P: np.ndarray) -> np.ndarray:
+        """The Coriolis part w_c M^-1 G of X'' (lanes, n, n) of every row of ``P`` (the gyro
+        section: see :func:`planetary_kernels._gyro_offset`)."""
+        n, g = len(self.dof_names()), self._layout["gyro"]
+        ng = int(P[0, g + 1])
+        out = np.zeros((P.shape[0], n, n))
+        rows = P[0, g + 2:g + 2 + ng].astype(int)
+        cols = P[0, g + 2 + ng:g + 2 + 2 * ng].astype(int)
+        out[:, rows, cols] = P[:, g, None] * P[:, g + 2 + 2 * ng:g + 2 + 3 * ng]
+        return out
+
     def fastest_natural_frequency(self, P: np.ndarray | None = None) -> np.ndarray:
         """Fastest natural frequency [omega_0] of the linear model at mean stiffness in every
         lane of ``P`` (from the lane's coefficients; one eigenproblem per distinct row)."""
@@ -923,7 +942,7 @@ class PlanetaryGearSet(Model):
             return np.sqrt(np.max(np.abs(np.linalg.eigvals(A)), axis=1))[inverse]
         # a rotating carrier: |lambda| of the first-order matrix with Ct (gyroscopic, damping)
         n, lay = A.shape[1], self._layout
-        Ct = rows[:, lay["Ct"]:lay["Ct"] + n * n].reshape(-1, n, n)
+        Ct = rows[:, lay["Ct"]:lay["Ct"] + n * n].reshape(-1, n, n) + self._gyro_ct(rows)
         Z, eye = np.zeros_like(A), np.broadcast_to(np.eye(n), A.shape)
         first = np.concatenate([np.concatenate([Z, eye], 2), np.concatenate([-A, -Ct], 2)], 1)
         return np.max(np.abs(np.linalg.eigvals(first)), axis=1)[inverse]

@@ -20,7 +20,10 @@ mesh ``MESH_NZ`` dof indices with the W and G values there (a mesh row touches a
 coordinates: the sun or ring and the planet, three each). So a right-hand side costs
 O(nk + n_mesh (MESH_NZ + n_harm)) instead of O(n^2 + n_mesh n): the dense Kt product and the
 dense mesh rows are the same sums without their structural zeros, term for term in the same order
-(results equal the dense evaluation's). Ct (modal damping) stays dense.
+(results equal the dense evaluation's). Ct (modal damping) stays dense. A rotating carrier's
+Coriolis term -w_c (M^-1 G) X' (``docs/planetary.md``, "Rotating carrier") has its own
+structural section at the very end (:func:`_gyro_offset`), so that Ct stays the same in every lane
+of a sweep in which the carrier speed w_c follows the mesh frequency.
 
 The ``*_lanes`` forms evaluate the same arithmetic, operation for operation, on a block of lanes
 in structure-of-arrays layout (state Y[q, k], coefficients PT[j, k], the forcing phase S[k],
@@ -56,9 +59,9 @@ CT_ROWS = 1
 _JIT = {"cache": True, "error_model": "numpy", "boundscheck": False}
 
 
-def layout(n: int, n_mesh: int, nh: int, nk: int = 0) -> dict[str, int]:
-    """Offsets of the parts of the coefficient vector for n dofs, n_mesh meshes, nh harmonics
-    and nk structural entries of Kt."""
+def layout(n: int, n_mesh: int, nh: int, nk: int = 0, ng: int = 0) -> dict[str, int]:
+    """Offsets of the parts of the coefficient vector for n dofs, n_mesh meshes, nh harmonics,
+    nk structural entries of Kt and ng of the gyroscopic matrix (:func:`_gyro_offset`)."""
     f0 = HEADER
     f1 = f0 + n
     kt = f1 + n
@@ -68,9 +71,19 @@ def layout(n: int, n_mesh: int, nh: int, nk: int = 0) -> dict[str, int]:
     st = mesh + n_mesh * bs
     mz = st + 1 + 3 * nk
     cache = mz + n_mesh * 3 * MESH_NZ
+    gyro = cache + 1 + CACHE_ENTRIES * (2 + n_mesh) + CT_ROWS
     return {"F0": f0, "F1": f1, "Kt": kt, "Ct": ct, "mesh": mesh, "block": bs,
-            "structure": st, "mesh_nz": mz, "cache": cache,
-            "size": cache + 1 + CACHE_ENTRIES * (2 + n_mesh) + CT_ROWS}
+            "structure": st, "mesh_nz": mz, "cache": cache, "gyro": gyro,
+            "size": gyro + 2 + 3 * ng}
+
+
+def gyro_names(dofs: tuple[str, ...], entries: list[tuple[int, int]]) -> list[str]:
+    """Names of the gyroscopic section: the carrier speed Omega_c / omega_0, the count, then
+    the rows, columns and values of M^-1 G (see :func:`_gyro_offset`)."""
+    ng = len(entries)
+    return (["carrier_speed_tau", "n_gyro"] + [f"gyro_row{e}" for e in range(ng)]
+            + [f"gyro_col{e}" for e in range(ng)]
+            + [f"gyro_{dofs[i]}_{dofs[j]}" for i, j in entries])
 
 
 def cache_entries(n_mesh: int) -> tuple[list[str], list[float]]:
@@ -173,6 +186,15 @@ def _offsets(p):
 
 
 @nb.njit(inline="always", **_JIT)
+def _gyro_offset(nm, mz):
+    """Offset of the gyroscopic section, after the cache: the carrier speed w_c = Omega_c /
+    omega_0, the count ng, then ng rows, columns and values of M^-1 G (the Coriolis term is
+    -w_c (M^-1 G) X' in X''); structural, so the same in every lane of a sweep, while w_c may
+    differ per lane (a carrier speed that follows the mesh frequency)."""
+    return mz + nm * 3 * MESH_NZ + 1 + CACHE_ENTRIES * (2 + nm) + CT_ROWS
+
+
+@nb.njit(inline="always", **_JIT)
 def _mesh_state(y, p, o, q, n, s, c):
     """Deflection minus error and its rate (W . X - e, W . X' - e') of the mesh block at o, its
     structure at q."""
@@ -245,6 +267,13 @@ def planetary_rhs(t, y, dy, p, s, c):
             for j in range(n):
                 acc -= p[r + j] * y[n + j]
             dy[n + i] = acc
+    g = _gyro_offset(nm, mz)
+    wc = p[g]
+    if wc != 0.0:  # the rotating carrier's Coriolis term (structural entries)
+        ng = int(p[g + 1])
+        for e in range(ng):
+            j = n + int(p[g + 2 + ng + e])
+            dy[n + int(p[g + 2 + e])] -= (wc * p[g + 2 + 2 * ng + e]) * y[j]
     for m in range(nm):
         q = mz + m * 3 * MESH_NZ
         f = dy[m] if shared else _mesh_force(y, p, mesh + m * bs, q, n, nh, s, c)
@@ -444,6 +473,18 @@ def planetary_rhs_lanes(T, Y, DY, PT, nl, S, C, SC):
             for j in range(n4, n):
                 for k in range(nl):
                     DY[n + i, k] -= PT[r + j, k] * Y[n + j, k]
+    g = _gyro_offset(nm, mz)
+    spinning = False
+    for k in range(nl):
+        spinning |= PT[g, k] != 0.0
+    if spinning:  # w_c = 0 in a lane: its terms subtract zeros (as the scalar form skips them)
+        ng = int(PT[g + 1, 0])
+        for e in range(ng):
+            i = n + int(PT[g + 2 + e, 0])
+            j = n + int(PT[g + 2 + ng + e, 0])
+            r = g + 2 + 2 * ng + e
+            for k in range(nl):
+                DY[i, k] -= (PT[g, k] * PT[r, k]) * Y[j, k]
     kr = _lanes_cached_stiffness(PT, nl, S, C, SC, mz + nm * 3 * MESH_NZ, mesh, bs, nh, nm)
     for m in range(nm):
         _lanes_mesh(Y, DY, PT, nl, S, C, SC, n, mesh + m * bs, mz + m * 3 * MESH_NZ, kr + m,
