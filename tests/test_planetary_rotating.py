@@ -238,3 +238,22 @@ def test_study_file_sets_the_kinematic_carrier_speed():
     with pytest.raises(ParameterError) as e:
         build_model(load_study(without))
     assert e.value.field == "params.carrier_speed"
+
+
+def test_a_grid_over_omega_keeps_the_kinematic_carrier_speed():
+    """map2d's grid with Omega on y and a physical input on x (planetary_example, kinematic
+    carrier speed): every row keeps its Omega exactly (a rebuild does not round it: 9 of these
+    57 values came back rounded before) and the carrier speed that goes with it."""
+    from geardyn.io.toml import builtin_study
+    from geardyn.study import build_model
+
+    study = builtin_study("planetary_example")
+    gs = build_model(study.model_copy(update={"params": study.params.model_copy(
+        update={"carrier_speed": "kinematic"})}))
+    om = np.linspace(0.05, 1.2, 57)
+    P = gs.lane_params_grid("sun_torque", [10.0, 20.0], "Omega", om)
+    assert np.array_equal(P[:, gs.omega_index], np.repeat(om, 2))
+    for row, v in zip(P[::2], om, strict=True):
+        ref = gs.with_params(Omega=float(v), sun_torque=10.0)
+        assert ref.omega == v
+        np.testing.assert_array_equal(row, ref.params)

@@ -876,6 +876,8 @@ class PlanetaryGearSet(Model):
             if "mesh_frequency" not in physical:
                 kw["mesh_frequency"] = self.omega * self.time_scale
             out = type(self)(**kw)
+            if "mesh_frequency" not in physical:  # Omega as it was, not (Omega w0) / w0
+                out.params[pk.OMEGA] = self.omega
             for name in _FROM_BUILD:  # what from_geometry attached (the inputs came from it)
                 if hasattr(self, name):
                     setattr(out, name, getattr(self, name))
