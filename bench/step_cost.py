@@ -1,8 +1,10 @@
 """Per-lane-step cost of the sweep kernel on one thread (issue 11, "fast"): the paper's reference
 workload (every ``--stride``-th of its 1000 Omega, transient 2000, 200 samples, default steps),
 through ``run_lanes``, with and without edge location; median of ``--repeat`` warm runs.
+``--study NAME`` takes that built-in study's model instead (e.g. ``paper_fig13``: the load
+fluctuation, which the fused loop runs in its general form).
 
-    .venv/bin/python bench/step_cost.py [--stride 4] [--repeat 3] [--threads 1]
+    .venv/bin/python bench/step_cost.py [--stride 4] [--repeat 3] [--threads 1] [--study NAME]
 """
 
 from __future__ import annotations
@@ -23,9 +25,16 @@ def main() -> None:
     ap.add_argument("--stride", type=int, default=4)
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--threads", type=int, default=1)
+    ap.add_argument("--study", default=None, help="a built-in study's model (default: the "
+                    "paper's device, xi1 = xi2 = 0.05)")
     args = ap.parse_args()
     numba.set_num_threads(args.threads)
-    model = geardyn.CATTDevice(geardyn.PlanetaryParams.paper(xi1=0.05, xi2=0.05))
+    if args.study:
+        from geardyn.io.toml import builtin_study
+
+        model = geardyn.build_model(builtin_study(args.study))
+    else:
+        model = geardyn.CATTDevice(geardyn.PlanetaryParams.paper(xi1=0.05, xi2=0.05))
     omegas = np.linspace(0.1, 4.0, 1000)[::args.stride]
     P = model.lane_params("Omega", omegas)
     y0 = model.initial_state()
