@@ -416,14 +416,10 @@ class PlanetaryGearSet(Model):
         return self.carrier_speed_ratio * mf
 
     @property
-    def _omega_sets_carrier(self) -> bool:
-        return bool(self.carrier_speed_ratio)
-
-    @property
     def omega_is_entry(self) -> bool:
         """False when the carrier speed follows the mesh frequency (``carrier_speed_ratio``):
         then Omega moves Kt and Ct too, and a lane's Omega is set through :meth:`lane_params`."""
-        return not self._omega_sets_carrier
+        return not self.carrier_speed_ratio
 
     def rotating_frame_matrices(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """G [kg], K_Omega [kg] and the centrifugal force per Omega_c^2 f [kg m] in the model's
@@ -736,7 +732,8 @@ class PlanetaryGearSet(Model):
         kt_entries, mesh_dofs = self._kernel_structure()
         M = self.mass_matrix()
         Minv = np.diag(1.0 / np.diag(M))
-        G_unit = _clean(Minv @ self.rotating_frame_matrices()[0])  # M^-1 G (structural)
+        G, K_omega, f = self.rotating_frame_matrices()
+        G_unit = _clean(Minv @ G)  # M^-1 G (structural: the gyro section)
         gyro = [(int(i), int(j)) for i, j in zip(*np.nonzero(G_unit), strict=True)]
         lay = pk.layout(n, nm, nh, len(kt_entries), len(gyro))
         L, w0 = self.length_scale, self.time_scale
@@ -747,7 +744,6 @@ class PlanetaryGearSet(Model):
         K, C = self.stiffness_matrix(False), self._damping_matrix()
         wc = self.carrier_omega(omega * w0)
         if wc != 0.0:  # the rotating carrier (see rotating_frame_matrices); G: the gyro section
-            _, K_omega, f = self.rotating_frame_matrices()
             K = _clean(K - wc * wc * K_omega)
             F = F.copy()
             F[0] = F[0] + wc * wc * f
@@ -850,7 +846,7 @@ class PlanetaryGearSet(Model):
         coefficients (``param_names``) set that entry of the vector. ``input_speed`` (a set
         built from geometry; rpm, or a unit string such as ``"3000 rpm"``) sets the mesh
         frequency (:meth:`mesh_frequency_per_input_speed`)."""
-        if "Omega" in values and self._omega_sets_carrier:  # Omega moves the carrier speed
+        if "Omega" in values and not self.omega_is_entry:  # Omega moves the carrier speed
             values = dict(values)
             om = float(values.pop("Omega"))
             if "mesh_frequency" in values or INPUT_SPEED in values:
@@ -899,7 +895,7 @@ class PlanetaryGearSet(Model):
         """Coefficient vectors (lanes x n_params) with ``name`` set to ``values`` (a physical
         input re-derives every coefficient, as :meth:`with_params`)."""
         if name in self.inputs or name == INPUT_SPEED or (name == "Omega"
-                                                           and self._omega_sets_carrier):
+                                                           and not self.omega_is_entry):
             vals = np.asarray(values, dtype=float).ravel()
             rows = [self.with_params(**{name: float(v)}).params for v in vals]
             if len({r.size for r in rows}) != 1:
