@@ -18,7 +18,8 @@ from geardyn.solvers.reference import reference_solution
 from geardyn.solvers.simulate import DEFAULT_BOUND, default_steps_per_period
 
 #: Modules a generated kernel may import besides the model's own.
-_ALLOWED = {"__future__", "math", "numba", "numpy", "geardyn.core._noop"}
+_ALLOWED = {"__future__", "math", "numba", "numpy", "geardyn.core._noop",
+            "geardyn.core.kernel_source"}
 _TEMPLATE_MODULES = {"geardyn.solvers._template_model", "geardyn.solvers._step_core",
                      *TEMPLATES.values()}
 

@@ -63,15 +63,19 @@ def _assert_bitwise(got, ref):
         assert np.array_equal(g, r, equal_nan=True), (g, r)
 
 
-@pytest.mark.parametrize("k", [1, 4])
-def test_catt_blocks_bitwise_equal_to_one_lane_kernel(k):
+@pytest.mark.parametrize(("k", "load"), [(1, False), (4, False), (1, True)])
+def test_catt_blocks_bitwise_equal_to_one_lane_kernel(k, load):
     # the reduced paper device at Omegas with and without contact loss, lanes with their own
     # grid, transient, measuring window, start time and state; renorm 7 so that blocks of the
-    # measuring window end between renormalisations
-    model = paper_device()
+    # measuring window end between renormalisations. k = 1 runs the fused block (the model's
+    # lane-scalar form: quiet, or with the load fluctuating), k = 4 the row blocks.
+    model = (geardyn.CATTDevice(geardyn.PlanetaryParams.paper(
+        xi1=0.05, xi2=0.05, B1="100 N m", B2="100 N m", Lambda=0.1)) if load
+        else paper_device())
     assert model.n_events == 4
     kern = kernels_for(model.kernel, "lyapunov")
     assert hasattr(kern, "rhs_lanes")  # the model's lane-block functions are used
+    assert kern.FUSED  # and its lane-scalar ones
     om = np.array([0.7, 1.05, 1.4, 1.8, 2.3, 2.9, 3.6])
     rng = np.random.default_rng(3)
     y0 = model.initial_state() + rng.uniform(-0.5, 0.5, (om.size, 4))
@@ -86,6 +90,13 @@ def test_catt_blocks_bitwise_equal_to_one_lane_kernel(k):
     # edges matter in these lanes (contact is lost): without locating them the exponents differ
     plain = _blocks(kern, model, args, 7, k, 64, n_ev=0)
     assert not np.array_equal(plain[0], ref[0])
+    # a lane that leaves the bound is marked diverged, the others untouched: lane 2 starts
+    # far out (its first health check fails), the others stay within 50
+    far = (args[0], args[1].copy(), *args[2:])
+    far[1][2] *= 100.0
+    ref = _reference(kern, model, far, 7, k, bound=50.0)
+    assert ref[3][2] == 1 and np.all(np.delete(ref[3], 2) == 0), ref[3]
+    _assert_bitwise(_blocks(kern, model, far, 7, k, 64, bound=50.0), ref)
 
 
 def test_gear_pair_blocks_bitwise_equal_with_a_diverged_lane():

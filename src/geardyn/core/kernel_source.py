@@ -14,7 +14,16 @@ from typing import Any
 
 from geardyn.core import _noop
 
-__all__ = ["KernelSource"]
+__all__ = ["FORM_GENERAL", "FORM_LOAD", "FORM_QUIET", "LANE_FORMS", "KernelSource"]
+
+#: The lane forms of a model's lane-scalar functions (``rhs_lane(..., form)``): the sweep kernel
+#: compiles its fused step loop once per form, with ``form`` a constant there, and runs a queue
+#: of lanes in the form ``rhs_lane_form`` gives all of them (else FORM_GENERAL). FORM_GENERAL
+#: must serve every lane; the others are a model's specialisations without inner loops or libm
+#: calls, which the vectoriser needs (for the CATT model: one stiffness harmonic, the load
+#: quiet or fluctuating). A model may leave any but FORM_GENERAL unused.
+FORM_GENERAL, FORM_QUIET, FORM_LOAD = 0, 1, 2
+LANE_FORMS = 3
 
 
 @dataclass(frozen=True)
@@ -63,13 +72,13 @@ def _lane_functions(funcs: dict[str, Any]) -> dict[str, Any]:
 
 def _lane_scalar_functions(funcs: dict[str, Any]) -> dict[str, Any]:
     """The lane-scalar forms of a model's functions, where its module defines them: for ``rhs``
-    named ``f``, ``f_lane`` (with ``f_lane_fast`` and the state size ``f_lane_states``) becomes
-    ``rhs_lane`` (``rhs_lane_fast``), and so ``events_lane``, ``observe_lane``: lane k of a
+    named ``f``, ``f_lane`` (with ``f_lane_form`` and the state size ``f_lane_states``) becomes
+    ``rhs_lane`` (``rhs_lane_form``), and so ``events_lane``, ``observe_lane``: lane k of a
     block, state and results as tuples, so that the sweep kernel fuses a grid step of every
     slot into one loop (see :mod:`._kernel_template`). All or none."""
     out = {}
     for alias, suffix in (("rhs", "_lane"), ("events", "_lane"), ("observe", "_lane"),
-                          ("rhs", "_lane_fast")):
+                          ("rhs", "_lane_form")):
         py = getattr(funcs[alias], "py_func", None)
         mod = sys.modules.get(getattr(py, "__module__", ""), None)
         fn = getattr(mod, f"{py.__name__}{suffix}", None) if py is not None else None

@@ -22,6 +22,8 @@ import math
 
 import numba as nb
 
+from geardyn.core.kernel_source import FORM_GENERAL, FORM_LOAD, FORM_QUIET
+
 # header
 OMEGA, LAMBDA, N_BLOCKS, N_HARM, F_C0, F_C1, PSI1, PSI2 = range(8)
 HEADER = 8
@@ -43,6 +45,42 @@ _JIT = {"cache": True, "error_model": "numpy", "boundscheck": False}
 def dead_zone(x, b):
     """g(x, b) of Eq. (3): x - b above b, x + b below -b, 0 between (branch-free, exact)."""
     return x - min(max(x, -b), b)
+
+
+# The load fluctuation's sine, as arithmetic (no libm call), so that the sweep kernel's fused
+# lane loop vectorises with the load on: Cody-Waite reduction by pi/2 in three parts (exact for
+# |x| < 2^20 pi / 2 ~ 1.6e6), then the minimax polynomials of fdlibm's __kernel_sin and
+# __kernel_cos (coefficients from Sun's fdlibm, k_sin.c / k_cos.c) and a branch-free quadrant
+# select. Within 2 ulp of sin(x) there; beyond, the reduction rounds by about ulp(x), the
+# rounding of the argument Lambda t + psi itself (tests/test_catt_lane_forms.py). Every form of
+# the load term (scalar, lanes, lane-scalar) calls it, so they stay bitwise equal.
+_S1, _S2, _S3 = -1.66666666666666324348e-01, 8.33333333332248946124e-03, -1.98412698298579493134e-04
+_S4, _S5, _S6 = 2.75573137070700676789e-06, -2.50507602534068634195e-08, 1.58969099521155010221e-10
+_C1, _C2, _C3 = 4.16666666666666019037e-02, -1.38888888888741095749e-03, 2.48015872894767294178e-05
+_C4, _C5, _C6 = -2.75573143513906633035e-07, 2.08757232129817482790e-09, -1.13596475577881948265e-11
+_INV_PIO2 = 6.36619772367581382433e-01
+_PIO2_1 = 1.57079632673412561417e00  # pi/2 in three parts: 33 + 33 + 53 bits
+_PIO2_2 = 6.07710050630396597660e-11
+_PIO2_3 = 2.02226624871116645580e-21
+#: |x| below which :func:`load_sin` is within 2 ulp of sin(x) (the reduction is exact).
+LOAD_SIN_EXACT_BELOW = 1.6e6
+
+
+@nb.njit(inline="always", **_JIT)
+def load_sin(x):
+    """sin(x) without a libm call (see above): within 2 ulp for |x| < LOAD_SIN_EXACT_BELOW."""
+    n = math.floor(x * _INV_PIO2 + 0.5)
+    r = ((x - n * _PIO2_1) - n * _PIO2_2) - n * _PIO2_3
+    z = r * r
+    s = r + r * z * (_S1 + z * (_S2 + z * (_S3 + z * (_S4 + z * (_S5 + z * _S6)))))
+    hz = 0.5 * z
+    w = 1.0 - hz
+    c = w + (((1.0 - w) - hz) + z * z * (_C1 + z * (_C2 + z * (_C3 + z * (_C4 + z * (
+        _C5 + z * _C6))))))
+    q = n - 4.0 * math.floor(n * 0.25)  # the quadrant, 0..3
+    v = s if q == 0.0 else c
+    v = -s if q == 2.0 else v
+    return -c if q == 3.0 else v
 
 
 @nb.njit(inline="always", **_JIT)
@@ -71,8 +109,8 @@ def _rhs(t, y, dy, p, s, c, n_sets):
     load_c = p[F_C0]
     sin_l1 = 0.0
     if p[F_C1] != 0.0 or p[HEADER + F_P1] != 0.0:
-        load_c += p[F_C1] * math.sin(p[LAMBDA] * t + p[PSI2])
-        sin_l1 = math.sin(p[LAMBDA] * t + p[PSI1])
+        load_c += p[F_C1] * load_sin(p[LAMBDA] * t + p[PSI2])
+        sin_l1 = load_sin(p[LAMBDA] * t + p[PSI1])
     carrier = 0.0
     for i in range(n_sets):
         o = HEADER + i * bs
@@ -281,8 +319,8 @@ def _load_terms(T, PT, nl, SC):
     """The load fluctuation of :func:`_rhs` (rows 2, 3 of SC: load_c, sin_l1) where it is on."""
     for k in range(nl):
         if PT[F_C1, k] != 0.0 or PT[HEADER + F_P1, k] != 0.0:
-            SC[2, k] += PT[F_C1, k] * math.sin(PT[LAMBDA, k] * T[k] + PT[PSI2, k])
-            SC[3, k] = math.sin(PT[LAMBDA, k] * T[k] + PT[PSI1, k])
+            SC[2, k] += PT[F_C1, k] * load_sin(PT[LAMBDA, k] * T[k] + PT[PSI2, k])
+            SC[3, k] = load_sin(PT[LAMBDA, k] * T[k] + PT[PSI1, k])
 
 
 @nb.njit(**_JIT)
@@ -340,9 +378,12 @@ def catt_observe_one_lanes(T, Y, O, PT, nl, S, C, SC):
 # Lane-scalar forms of the reduced model for the sweep kernel's fused step loop: lane k of a
 # block (coefficients PT[j, k]), the state and the result as tuples (local scalars, registers),
 # the same arithmetic as catt_rhs_one / catt_events_one / catt_observe_one operation for
-# operation (bitwise equal). ``fast``: the lane has one stiffness harmonic and no load
-# fluctuation (``catt_rhs_one_lane_fast``), so no inner loop and no libm call stop the
-# vectoriser; the kernel passes it as a constant. Picked up by name (``<function>_lane``).
+# operation (bitwise equal). ``form`` (a constant in each compiled copy of the kernel's loop,
+# see :data:`geardyn.core.kernel_source.LANE_FORMS`): FORM_QUIET, one stiffness harmonic and no
+# load fluctuation; FORM_LOAD, one harmonic with the load fluctuating (its sine by
+# :func:`load_sin`, branch-free); in both no inner loop and no libm call stop the vectoriser.
+# FORM_GENERAL: any lane (a harmonics loop; scalar). ``catt_rhs_one_lane_form`` says which a
+# lane may take. Picked up by name (``<function>_lane``).
 
 #: State size of the lane-scalar forms (the tuples' length).
 catt_rhs_one_lane_states = 4
@@ -361,34 +402,45 @@ def _stiffness_lane(PT, k, f, nh, s, c):
 
 
 @nb.njit(inline="always", **_JIT)
-def _mesh_factors_lane(t, PT, k, s, c, fast):
+def _mesh_factors_lane(t, PT, k, s, c, form):
     """Stiffness factors (sun-inside, inside-outside) and load terms (load_c, sin_l1) of lane
-    k, as :func:`_rhs` computes them for one planet set."""
+    k, as :func:`_rhs` computes them for one planet set, in the lane form ``form`` (see
+    :func:`catt_rhs_one_lane_form`)."""
     fs = HEADER + BLOCK_FIXED
-    if fast:
+    if form == FORM_QUIET:
         return (1.0 + (PT[fs, k] * c + PT[fs + 1, k] * s),
                 1.0 + (PT[fs + 2, k] * c + PT[fs + 3, k] * s), PT[F_C0, k], 0.0)
+    if form == FORM_LOAD:  # the load on (no branch: the scalar path takes it too)
+        return (1.0 + (PT[fs, k] * c + PT[fs + 1, k] * s),
+                1.0 + (PT[fs + 2, k] * c + PT[fs + 3, k] * s),
+                PT[F_C0, k] + PT[F_C1, k] * load_sin(PT[LAMBDA, k] * t + PT[PSI2, k]),
+                load_sin(PT[LAMBDA, k] * t + PT[PSI1, k]))
     nh = int(PT[N_HARM, k])
     load_c = PT[F_C0, k]
     sin_l1 = 0.0
     if PT[F_C1, k] != 0.0 or PT[HEADER + F_P1, k] != 0.0:
-        load_c += PT[F_C1, k] * math.sin(PT[LAMBDA, k] * t + PT[PSI2, k])
-        sin_l1 = math.sin(PT[LAMBDA, k] * t + PT[PSI1, k])
+        load_c += PT[F_C1, k] * load_sin(PT[LAMBDA, k] * t + PT[PSI2, k])
+        sin_l1 = load_sin(PT[LAMBDA, k] * t + PT[PSI1, k])
     return (_stiffness_lane(PT, k, fs, nh, s, c), _stiffness_lane(PT, k, fs + 2 * nh, nh, s, c),
             load_c, sin_l1)
 
 
 @nb.njit(**_JIT)
-def catt_rhs_one_lane_fast(PT, k):
-    """Whether lane k may take the fast form (one harmonic, no load fluctuation)."""
-    return (PT[N_HARM, k] == 1.0) & (PT[F_C1, k] == 0.0) & (PT[HEADER + F_P1, k] == 0.0)
+def catt_rhs_one_lane_form(PT, k):
+    """The lane form lane k may take: FORM_QUIET (one stiffness harmonic, no load fluctuation),
+    FORM_LOAD (one harmonic, the load fluctuating), else FORM_GENERAL (a harmonics loop)."""
+    if PT[N_HARM, k] != 1.0:
+        return FORM_GENERAL
+    if (PT[F_C1, k] == 0.0) & (PT[HEADER + F_P1, k] == 0.0):
+        return FORM_QUIET
+    return FORM_LOAD
 
 
 @nb.njit(inline="always", **_JIT)
-def catt_rhs_one_lane(t, y, PT, k, s, c, fast):
+def catt_rhs_one_lane(t, y, PT, k, s, c, form):
     """:func:`catt_rhs_one` of lane k: dy/dt as a tuple."""
     o = HEADER
-    ks, kp, load_c, sin_l1 = _mesh_factors_lane(t, PT, k, s, c, fast)
+    ks, kp, load_c, sin_l1 = _mesh_factors_lane(t, PT, k, s, c, form)
     om2 = PT[OMEGA, k] * PT[OMEGA, k]
     xs, vs, xp, vp = y
     gs = ks * dead_zone(xs, PT[o + B_SQ, k])
@@ -413,10 +465,10 @@ def catt_events_one_lane(t, y, PT, k):
 
 
 @nb.njit(inline="always", **_JIT)
-def catt_observe_one_lane(t, y, PT, k, s, c, fast):
+def catt_observe_one_lane(t, y, PT, k, s, c, form):
     """:func:`catt_observe_one` of lane k, as a tuple."""
     o = HEADER
-    ks, kp, _, _ = _mesh_factors_lane(t, PT, k, s, c, fast)
+    ks, kp, _, _ = _mesh_factors_lane(t, PT, k, s, c, min(form, FORM_QUIET))
     gs = ks * dead_zone(y[0], PT[o + B_SQ, k])
     gp = kp * dead_zone(y[2], PT[o + B_PQ, k])
     scale = PT[o + FORCE_SCALE, k]

@@ -34,9 +34,12 @@ from __future__ import annotations
 import numba as nb
 import numpy as np
 
+from geardyn.core.kernel_source import FORM_GENERAL, FORM_LOAD, FORM_QUIET
 from geardyn.solvers._step_core import (  # CORE-IMPORT
     _INLINE,
     _JIT,
+    BLOCK,
+    FUSED,
     GRAZE_BOUND,
     GRAZE_ROW,
     MAX_SPLITS,
@@ -44,12 +47,26 @@ from geardyn.solvers._step_core import (  # CORE-IMPORT
     STATUS_DIVERGED,
     STATUS_OK,
     _events_i,
+    _events_l,
+    _flat,
     _healthy,
     _keep_start,
+    _lane_form,
     _leaves_side,
+    _NoAliasCompiler,
+    _observe_l,
     _rhs_i,
+    _rhs_l,
     _side,
     _split_step,
+    _t_axpy,
+    _t_comb,
+    _t_healthy,
+    _t_load,
+    _t_screen,
+    _t_side,
+    _t_stats,
+    _t_store,
     event_buffer,
     phase_table,
 )
@@ -60,7 +77,6 @@ _observe_i = nb.njit(**_INLINE)(observe.py_func)
 __all__ = ["BLOCK", "MAX_SPLITS", "SIMULTANEOUS", "events", "observe", "phase_table", "rhs",
            "sweep", "trajectory"]
 
-BLOCK = 64
 
 
 @nb.njit(**_JIT)
@@ -591,16 +607,35 @@ def _sweep_worker(w, lanes, cfg, sched, out):
 
 
 @nb.njit(inline="always", **_JIT)
-def _next_lane(k, nxt, q1, lanes, cfg, sched, out, slots):
+def _next_lane(k, nxt, q1, lanes, cfg, sched, out, slots, form):
     """The lane slot k takes next, and the queue position after it: the successor on the
-    chain of the lane that ended there (:func:`_chained`), else the queue's next lane; -1 when
-    there is neither."""
+    chain of the lane that ended there (:func:`_chained`), else the queue's next lane of lane
+    form ``form`` (:func:`_entry_form`; any lane where ``form`` < 0); -1 when there is
+    neither."""
     lane = _chained(k, lanes, cfg, sched, out, slots)
     if lane >= 0:
         return lane, nxt
-    if nxt >= q1:
-        return -1, nxt
-    return sched[1][nxt], nxt + 1
+    queue = sched[1]
+    while nxt < q1:
+        lane = queue[nxt]
+        nxt += 1
+        if form < 0 or _entry_form(lanes[0], sched[6], lane) == form:
+            return lane, nxt
+    return -1, nxt
+
+
+@nb.njit(_nrt=False, **_JIT)
+def _entry_form(P, chain, lane):
+    """The lane form of a queue entry: that of the lane and of every lane chained after it if
+    they agree, else FORM_GENERAL (``rhs_lane_form``; FORM_GENERAL without lane forms)."""
+    PTq = P.T  # coefficient rows, lane innermost (as rhs_lane_form reads them)
+    form = _lane_form(PTq, lane)
+    nxt = chain[lane] if chain.size > 0 else -1
+    while nxt >= 0 and form != FORM_GENERAL:
+        if _lane_form(PTq, nxt) != form:
+            return FORM_GENERAL
+        nxt = chain[nxt]
+    return form
 
 
 @nb.njit(_nrt=False, **_JIT)
@@ -723,7 +758,7 @@ def _block_run_soa(q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch):
                 if not END[k]:
                     continue
                 END[k] = False
-                lane, nxt = _next_lane(k, nxt, q1, lanes, cfg, sched, out, slots)
+                lane, nxt = _next_lane(k, nxt, q1, lanes, cfg, sched, out, slots, -1)
                 if lane < 0:
                     continue
                 loaded = True
@@ -894,165 +929,8 @@ def _transient_end(k, lane, Y, ys, R, D, n_ring, n_tr, n_end, next_sample, conv_
         ncross[lane, j] = 0
 
 
-# ---------------------------------------------------------------------------------------------
-# The fused step loop, for a model with lane-scalar functions (``rhs_lane``, ``events_lane``,
-# ``observe_lane``, ``rhs_lane_fast``; see :mod:`geardyn.core.kernel_source`): one loop over the
-# slots does a slot's whole grid step, the four RK4 stages with the model's rhs inlined and the
-# state, stages and coefficients in local variables (registers), the events, the side test, the
-# commit, the clocks and the statistics; nothing but the block's state goes through memory, and
-# LLVM vectorises the loop over slots. Slots whose step was flagged (a side left or a possible
-# graze) or that have bookkeeping due (a period's start, a sample, the end) are finished out of
-# line (:func:`_slot_out`), their statistics there too. The arithmetic of every lane is that of
-# the scalar kernel, operation for operation (no fastmath), so results are bitwise those of the
-# other paths. The tuple helpers below are written out per tuple length when numba types them.
-
-
-def _tuple_source(args, lines, scope=None):
-    """A Python function ``f(args)`` with the body ``lines`` (for the overloads below)."""
-    text = f"def _f({args}):\n" + "".join(f"    {line}\n" for line in lines)
-    env = dict(scope or {})
-    exec(compile(text, "<geardyn-lane-tuples>", "exec"), env)
-    return env["_f"]
-
-
-def _t_load(Y, k):
-    """(Y[0, k], .., Y[LANE_NS - 1, k])."""
-
-
-def _t_store(Y, k, y, keep, cond):
-    """Y[q, k] = y[q] if cond else keep[q]."""
-
-
-def _t_axpy(y, a, x):
-    """y + a x, elementwise."""
-
-
-def _t_comb(y, h6, k1, k2, k3, k4):
-    """The RK4 combination y + h6 (k1 + 2 k2 + 2 k3 + k4), elementwise."""
-
-
-def _t_screen(g1, GS, GP, SIDE, GR, k, locate):
-    """:func:`_lanes_screen` of slot k for the events g1 at the trial step's end; the history
-    shifted in place (GP[:, k] = GS[:, k], GS[:, k] = g1). True when the step is flagged."""
-
-
-def _t_stats(GMIN, GMAX, OMAX, OMIN, OSQ, k, g, o, stat):
-    """The statistics of slot k at a grid point (events g, observables o), where ``stat``."""
-
-
-def _t_side(GS, SIDE, k, g):
-    """A lane's start: the events g into GS[:, k], their sides into SIDE[:, k]."""
-
-
-@nb.njit(**_JIT)
-def _pick(cond, a, b):
-    """a if cond else b, a select (a call, inlined by LLVM: numba's inliner would leave the
-    generated tuple helpers with phi variables it then warns about)."""
-    return a if cond else b
-
-
 @nb.njit(inline="always", **_JIT)
-def _screen_one(g1, s, g0, gp, locate):
-    """One event of :func:`_lanes_screen`: (graze, flagged)."""
-    d2 = g1 - 2.0 * g0 + gp
-    crossed = (1.0 if g1 > 0.0 else -1.0) != s
-    near = not min(abs(g0), abs(g1)) > GRAZE_BOUND * abs(d2)
-    graze = locate & (crossed | (not s * d2 < 0.0)) & near
-    return graze, crossed | graze
-
-
-def _ix(arr, name, row):
-    """Source text of element (row, k) of a block array: ``name[row, k]``, or of its flat view
-    (rows of BLOCK slots: constant offsets, so that LLVM sees rows that cannot overlap)."""
-    return f"{name}[{row}, k]" if arr.ndim == 2 else f"{name}[{row * BLOCK} + k]"
-
-
-def _ov_t_load(Y, k):
-    n = globals()["LANE_NS"]
-    return _tuple_source("Y, k", ["return (" + "".join(f"{_ix(Y, 'Y', q)}, " for q in range(n))
-                                  + ")"])
-
-
-def _ov_t_store(Y, k, y, keep, cond):
-    return _tuple_source("Y, k, y, keep, cond",
-                         [f"{_ix(Y, 'Y', q)} = _pick(cond, y[{q}], keep[{q}])"
-                          for q in range(len(y))] or ["pass"], {"_pick": _pick})
-
-
-def _ov_t_axpy(y, a, x):
-    return _tuple_source("y, a, x",
-                         ["return (" + "".join(f"y[{q}] + a * x[{q}], " for q in range(len(y)))
-                          + ")"])
-
-
-def _ov_t_comb(y, h6, k1, k2, k3, k4):
-    terms = "".join(f"y[{q}] + h6 * (k1[{q}] + 2.0 * k2[{q}] + 2.0 * k3[{q}] + k4[{q}]), "
-                    for q in range(len(y)))
-    return _tuple_source("y, h6, k1, k2, k3, k4", [f"return ({terms})"])
-
-
-def _ov_t_screen(g1, GS, GP, SIDE, GR, k, locate):
-    lines = ["hit = False"]
-    for j in range(len(g1)):
-        gs, gp = _ix(GS, "GS", j), _ix(GP, "GP", j)
-        lines += [f"g0 = {gs}",
-                  f"gr, fl = _screen_one(g1[{j}], {_ix(SIDE, 'SIDE', j)}, g0, {gp}, locate)",
-                  f"{_ix(GR, 'GR', j)} = _pick(gr, 1.0, 0.0)", f"{gp} = g0", f"{gs} = g1[{j}]",
-                  "hit = hit | fl"]
-    return _tuple_source("g1, GS, GP, SIDE, GR, k, locate", [*lines, "return hit"],
-                         {"_screen_one": _screen_one, "_pick": _pick})
-
-
-def _ov_t_stats(GMIN, GMAX, OMAX, OMIN, OSQ, k, g, o, stat):
-    lines = ["pass"]
-    for j in range(len(g)):
-        for name, op in (("GMIN", "min"), ("GMAX", "max")):
-            e = _ix(GMIN, name, j)
-            lines.append(f"{e} = _pick(stat, {op}({e}, g[{j}]), {e})")
-    for j in range(len(o)):
-        lines.append(f"v = o[{j}]")
-        for name, op in (("OMAX", "max"), ("OMIN", "min")):
-            e = _ix(OMAX, name, j)
-            lines.append(f"{e} = _pick(stat, {op}({e}, v), {e})")
-        e = _ix(OSQ, "OSQ", j)
-        lines.append(f"{e} = _pick(stat, {e} + v * v, {e})")
-    return _tuple_source("GMIN, GMAX, OMAX, OMIN, OSQ, k, g, o, stat", lines, {"_pick": _pick})
-
-
-def _ov_t_side(GS, SIDE, k, g):
-    lines = ["pass"]
-    for j in range(len(g)):
-        lines += [f"{_ix(GS, 'GS', j)} = g[{j}]",
-                  f"{_ix(SIDE, 'SIDE', j)} = _pick(g[{j}] > 0.0, 1.0, -1.0)"]
-    return _tuple_source("GS, SIDE, k, g", lines, {"_pick": _pick})
-
-
-if "rhs_lane" in globals():  # the model's lane-scalar functions (see .kernels)
-    FUSED = True
-    _rhs_l = rhs_lane  # noqa: F821
-    _events_l = events_lane  # noqa: F821
-    _observe_l = observe_lane  # noqa: F821
-    _lane_fast = rhs_lane_fast  # noqa: F821
-    #: The state size of the model's lane-scalar functions (``<rhs>_lane_states``).
-    LANE_NS = int(_rhs_l.py_func.__globals__[_rhs_l.py_func.__name__ + "_states"])
-    for _stub, _impl in ((_t_load, _ov_t_load), (_t_store, _ov_t_store), (_t_axpy, _ov_t_axpy),
-                         (_t_comb, _ov_t_comb), (_t_screen, _ov_t_screen),
-                         (_t_stats, _ov_t_stats), (_t_side, _ov_t_side)):
-        nb.extending.overload(_stub, inline="always")(_impl)
-else:
-    FUSED = False
-
-
-@nb.njit(inline="always", **_JIT)
-def _flat(arrays):
-    """Flat views of a tuple of five block arrays (rows of BLOCK slots)."""
-    a, b, c, d, e = arrays
-    return (a.reshape(a.size), b.reshape(b.size), c.reshape(c.size), d.reshape(d.size),
-            e.reshape(e.size))
-
-
-@nb.njit(inline="always", **_JIT)
-def _fused_steps(fast, nl, locate, Y, Y1, PT, SE, CE, H6, FLAG, G, ST, slots, S_TAB, C_TAB,
+def _fused_steps(form, nl, locate, bound, Y, Y1, PT, SE, CE, H6, FLAG, G, ST, slots, S_TAB, C_TAB,
                  PH):
     """One grid step of every slot, fused (see above), on flat views of the block arrays (rows
     of BLOCK slots, see :func:`_flat`): the trial into Y1, committed into Y
@@ -1060,8 +938,10 @@ def _fused_steps(fast, nl, locate, Y, Y1, PT, SE, CE, H6, FLAG, G, ST, slots, S_
     g_{i+1}), graze flags into GR; the slots'
     clocks advanced, SE, CE the phase at the grid point reached; the statistics of the slots
     that sample and need nothing out of line. FLAG[k] = 1 where slot k's step is flagged,
-    MSK[k] where it is flagged or has bookkeeping due (see :func:`_slot_out`). ``fast``: a
-    constant, the model's fast form (every active lane qualifies). G: the events (GS, GP, GR,
+    MSK[k] where it is flagged or has bookkeeping due (see :func:`_slot_out`: a sample, the
+    transient's end or the lane's, or a period's start where the state is out of ``bound`` or
+    not finite; a healthy period's start is done here). ``form``: a
+    constant, the model's lane form (every active lane takes it). G: the events (GS, GP, GR,
     SIDE), ST: the statistics (GMIN, GMAX, OMAX, OMIN, OSQ), PH: scratch rows for the
     phases at the step's middle and end. Returns (flagged, marked)."""
     GS, GP, GR, SIDE = G
@@ -1089,12 +969,12 @@ def _fused_steps(fast, nl, locate, Y, Y1, PT, SE, CE, H6, FLAG, G, ST, slots, S_
         ce = CN[k]
         y = _t_load(Y, k)
         hh = 0.5 * h
-        k1 = _rhs_l(t0b + st * h, y, PT, k, SE[k], CE[k], fast)
+        k1 = _rhs_l(t0b + st * h, y, PT, k, SE[k], CE[k], form)
         tb = t0b + st * h + 0.5 * h
-        k2 = _rhs_l(tb, _t_axpy(y, hh, k1), PT, k, sb, cb, fast)
-        k3 = _rhs_l(tb, _t_axpy(y, hh, k2), PT, k, sb, cb, fast)
+        k2 = _rhs_l(tb, _t_axpy(y, hh, k1), PT, k, sb, cb, form)
+        k3 = _rhs_l(tb, _t_axpy(y, hh, k2), PT, k, sb, cb, form)
         te = t0b + (st + 1) * h
-        k4 = _rhs_l(te, _t_axpy(y, h, k3), PT, k, se, ce, fast)
+        k4 = _rhs_l(te, _t_axpy(y, h, k3), PT, k, se, ce, form)
         y1 = _t_comb(y, H6[k], k1, k2, k3, k4)
         g1 = _events_l(te, y1, PT, k)
         hit = _t_screen(g1, GS, GP, SIDE, GR, k, locate)
@@ -1109,9 +989,10 @@ def _fused_steps(fast, nl, locate, Y, Y1, PT, SE, CE, H6, FLAG, G, ST, slots, S_
         ph1 = 0 if ph1 == NPER[k] else ph1
         STEP[k] = st1
         PHASE[k] = ph1
-        due = act & ((ph1 == 0) | (st1 >= DUE[k]))
+        # a period's start needs the health check out of line only where it fails (NaN too)
+        due = act & (((ph1 == 0) & (not _t_healthy(y1, bound))) | (st1 >= DUE[k]))
         stat = act & (st1 > n_tr[k]) & (not hit) & (not due)
-        o = _observe_l(te, y1, PT, k, se, ce, fast)
+        o = _observe_l(te, y1, PT, k, se, ce, form)
         _t_stats(GMIN, GMAX, OMAX, OMIN, OSQ, k, g1, o, stat)
         n_stat[k] += 1 if stat else 0
         FLAG[k] = 1.0 if flagged else 0.0
@@ -1172,7 +1053,7 @@ def _slot_out(k, G1, SE, CE, lanes, cfg, out, blk, slots, scratch):
         g = G1[j, k]
         GMIN[j, k] = min(GMIN[j, k], g)
         GMAX[j, k] = max(GMAX[j, k], g)
-    o = _observe_l(T0B[k] + step * HB[k], _t_load(Y, k), PT, k, SE[k], CE[k], False)
+    o = _observe_l(T0B[k] + step * HB[k], _t_load(Y, k), PT, k, SE[k], CE[k], FORM_GENERAL)
     _t_stats(GMIN, GMAX, OMAX, OMIN, OSQ, k, (), o, True)
     if step < DUE[k]:
         return False
@@ -1181,10 +1062,10 @@ def _slot_out(k, G1, SE, CE, lanes, cfg, out, blk, slots, scratch):
 
 
 @nb.njit(inline="always", **_JIT)
-def _fused_run(fast, q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch):
+def _fused_run(form, q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch):
     """:func:`_block_run_soa` with the fused step loop (a model with lane-scalar functions),
-    every lane of the worker's queue taking the model's fast form or none (``fast``, a
-    constant: one copy of the loop per compiled function, see :func:`_block_run_fused`)."""
+    every lane of the worker's queue taking the model's lane form ``form`` (a constant: one
+    copy of the loop per compiled function, see :func:`_block_run_fused`)."""
     locate = cfg[3]
     start, queue, lane_nper, lane_tab, S_TAB, C_TAB, chain = sched
     (R, D, Y, Y1, K1, K2, K3, K4, TMP, PT, SC, PH6, PH, TT, GP, GS, G1, GR, SIDE, FLAG,
@@ -1200,6 +1081,8 @@ def _fused_run(fast, q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch):
     GSf, GPf, GRf, SIDEf, _ = _flat((GS, GP, GR, SIDE, GR))
     nxt = q0  # the next lane of the queue
     n_act = 0  # slots holding a running lane
+    for k in range(nl):  # every slot is free (an earlier pass, of another form, has ended)
+        END[k] = True
     ended = True
     while True:
         if ended:  # (re)fill the ended slots from the queue: a lane starts at its grid step 0
@@ -1208,7 +1091,7 @@ def _fused_run(fast, q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch):
                 if not END[k]:
                     continue
                 END[k] = False
-                lane, nxt = _next_lane(k, nxt, q1, lanes, cfg, sched, out, slots)
+                lane, nxt = _next_lane(k, nxt, q1, lanes, cfg, sched, out, slots, form)
                 if lane < 0:
                     continue
                 n_act += 1
@@ -1219,7 +1102,7 @@ def _fused_run(fast, q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch):
                 _t_side(GS, SIDE, k, _events_l(TT[k], _t_load(Y, k), PT, k))
         if n_act == 0:
             break
-        n_flag, n_out = _fused_steps(fast, nl, locate, Yf, Y1f, PT, SE, CE, H6, FLAG,
+        n_flag, n_out = _fused_steps(form, nl, locate, cfg[4], Yf, Y1f, PT, SE, CE, H6, FLAG,
                                      (GSf, GPf, GRf, SIDEf), stats, slots, S_TAB, C_TAB, phx)
         if n_out > 0:
             gone = _slots_out(nl, GS, SE, CE, lanes, cfg, out, blk, slots, scratch)
@@ -1228,49 +1111,47 @@ def _fused_run(fast, q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch):
                 n_act -= gone
 
 
-class _NoAliasCompiler(nb.core.compiler.Compiler):
-    """numba's pipeline with the function's array arguments declared ``noalias`` (LLVM), so
-    that the fused loop needs no runtime overlap checks of its ~30 block arrays (there are too
-    many: LLVM would not vectorise it). The caller guarantees it: no two array arguments of
-    :func:`_block_run_fast` (or ``_general``) that it touches share memory (``blk``'s views ``PH``,
-    ``HW`` and ``FL`` of ``PH6``, ``HW3`` and the state arrays are used there, not those)."""
-
-    def define_pipelines(self):
-        self.state.flags.noalias = True
-        return super().define_pipelines()
+# One compiled copy of the loop per lane form (a second copy in the same function, or a branch
+# around it, stops LLVM's alias analysis).
+@nb.njit(_nrt=False, pipeline_class=_NoAliasCompiler, **_JIT)
+def _block_run_form0(q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch):
+    """:func:`_fused_run` in the model's general lane form (FORM_GENERAL)."""
+    _fused_run(FORM_GENERAL, q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch)
 
 
 @nb.njit(_nrt=False, pipeline_class=_NoAliasCompiler, **_JIT)
-def _block_run_fast(q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch):
-    """:func:`_fused_run` with the model's fast form (compiled on its own: a second copy of the
-    loop in the same function, or a branch around it, stops LLVM's alias analysis)."""
-    _fused_run(True, q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch)
+def _block_run_form1(q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch):
+    """:func:`_fused_run` in the lane form FORM_QUIET."""
+    _fused_run(FORM_QUIET, q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch)
 
 
 @nb.njit(_nrt=False, pipeline_class=_NoAliasCompiler, **_JIT)
-def _block_run_general(q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch):
-    """:func:`_fused_run` with the model's general form (scalar)."""
-    _fused_run(False, q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch)
+def _block_run_form2(q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch):
+    """:func:`_fused_run` in the lane form FORM_LOAD."""
+    _fused_run(FORM_LOAD, q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch)
 
 
 @nb.njit(_nrt=False, **_JIT)
 def _block_run_fused(q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch):
-    """The fused block loop of the worker's queue (see :func:`_fused_run`): the fast form when
-    every lane of the queue takes it (``rhs_lane_fast``), else the general one."""
+    """The fused block loop of the worker's queue (see :func:`_fused_run`): one pass per lane
+    form present in it (:func:`_entry_form`), each taking the queue's entries of its form in
+    the queue's order, in the copy of the loop compiled for that form. (Lanes are
+    independent: the results do not depend on the order.)"""
     P = lanes[0]
-    queue = sched[1]
     chain = sched[6]
-    PTq = P.T  # coefficient rows, lane innermost (as rhs_lane_fast reads them)
-    fast = True
+    queue = sched[1]
+    quiet = load = general = False
     for i in range(q0, q1):
-        lane = queue[i]
-        while lane >= 0:  # the lane and those chained after it
-            fast = fast & _lane_fast(PTq, lane)
-            lane = chain[lane] if chain.size > 0 else -1
-    if fast:
-        _block_run_fast(q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch)
-    else:
-        _block_run_general(q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch)
+        f = _entry_form(P, chain, queue[i])
+        quiet |= f == FORM_QUIET
+        load |= f == FORM_LOAD
+        general |= f == FORM_GENERAL
+    if quiet:
+        _block_run_form1(q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch)
+    if load:
+        _block_run_form2(q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch)
+    if general:
+        _block_run_form0(q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch)
 
 
 _block_run = _block_run_fused if FUSED else _block_run_soa

@@ -62,9 +62,12 @@ import math
 import numba as nb
 import numpy as np
 
+from geardyn.core.kernel_source import FORM_GENERAL, FORM_LOAD, FORM_QUIET
 from geardyn.solvers._step_core import (  # CORE-IMPORT
     _INLINE,
     _JIT,
+    BLOCK,
+    FUSED,
     GBUF_ROWS,
     GRAZE_BOUND_STEP,
     GRAZE_ROW,
@@ -72,11 +75,21 @@ from geardyn.solvers._step_core import (  # CORE-IMPORT
     STATUS_OK,
     STATUS_SPLIT_LIMIT,
     _events_i,
+    _events_l,
     _healthy,
+    _lane_form,
+    _NoAliasCompiler,
+    _pick,
     _rhs_i,
+    _rhs_l,
     _rows_step,
     _side,
     _split_step,
+    _t_axpy,
+    _t_comb,
+    _t_load,
+    _t_store,
+    _tuple_source,
     phase_table,
 )
 from geardyn.solvers._template_model import events, observe, rhs  # MODEL-IMPORT
@@ -593,12 +606,67 @@ def _rows_commit(i, nr, NPR, Y, Y1, G0, G1, GR, FLAG, ACTR, P, LANE, T0R, HR, OM
 
 
 @nb.njit(**_JIT)
+def _lanes_init(first, nl, k, Y0, NPER, n_transient, n_steps, renorm_every, n_blocks, out, err,
+                used, status, ZT, ACT):
+    """A Lyapunov block's per-lane start (both block kernels): outputs cleared, step counts,
+    blocks of the measuring window and first due step (IST, ENDS), the orthonormalised start
+    vectors into ZT[:, :, l], ACT. Returns (IST, ENDS, BLK, ACC, Zl, Cl, logs, max_total)."""
+    m, ns = k + 1, Y0.shape[1]
+    IST = np.zeros((nl, 7), np.int64)  # see _LAST, ...
+    nbmax = max(n_blocks, 1)
+    ENDS = np.zeros((nl, nbmax), np.int64)
+    BLK = np.zeros((nl, nbmax, k))
+    ACC = np.zeros((nl, k))
+    # the one-lane machinery's scratch
+    Zl = np.zeros((m, ns))
+    Cl = np.zeros((m, ns))
+    logs = np.zeros(k)
+    renorm = max(renorm_every, 1)
+    max_total = 0
+    for l in range(nl):
+        lane = first + l
+        for j in range(k):
+            out[lane, j] = np.nan
+            err[lane, j] = np.nan
+        used[lane] = 0
+        status[lane] = STATUS_OK
+        IST[l, _NTR] = n_transient[lane]
+        IST[l, _NST] = n_steps[lane]
+        IST[l, _TOTAL] = n_transient[lane] + n_steps[lane]
+        ACT[l] = IST[l, _TOTAL] > 0
+        max_total = max(max_total, IST[l, _TOTAL])
+        ends = _block_bounds(max(n_steps[lane], 1), NPER[lane], n_blocks)
+        IST[l, _NBK] = ends.size
+        for b in range(ends.size):
+            ENDS[l, b] = ends[b]
+        IST[l, _DUE] = _lane_due(IST, l, renorm, ENDS)
+        for q in range(ns):
+            Zl[0, q] = Y0[lane, q]
+        # generic, orthonormalised start vectors: e_j + 0.1 (1, ..., 1)
+        for j in range(1, m):
+            for q in range(ns):
+                Zl[j, q] = 0.1 + (1.0 if q == j - 1 else 0.0)
+        _orthonormalise(Zl, logs, False)
+        for j in range(m):
+            for q in range(ns):
+                ZT[j, q, l] = Zl[j, q]
+    return IST, ENDS, BLK, ACC, Zl, Cl, logs, max_total
+
+
+@nb.njit(**_JIT)
 def _lyap_block(first, nl, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF, n_transient,
                 n_steps, renorm_every, bound, n_ev, n_blocks, out, err, used, status, unres):
     """The k leading exponents of lanes first..first+nl-1 (lane with NPER[lane] steps per
     period, its phase table at S_TAB, C_TAB[OFF[lane]:]), their rows in one block (see above);
     per lane what :func:`_run` computes for it, into out[lane], err[lane], used[lane],
     status[lane], unres[lane]."""
+    if FUSED and k == 1 and n_ev > 0 and nl <= BLOCK:
+        form = _block_form(P, first, nl)
+        if form == FORM_QUIET or form == FORM_LOAD:
+            _lyap_block_fused(form, first, nl, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
+                              n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out,
+                              err, used, status, unres)
+            return
     ns = Y0.shape[1]
     m = k + 1
     nr = (2 * k + 1) * nl
@@ -644,15 +712,6 @@ def _lyap_block(first, nl, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF, n
     # per lane
     ACT = np.zeros(nl, np.bool_)
     ACTR = np.zeros(nrp, np.bool_)  # ACT of each row's lane
-    IST = np.zeros((nl, 7), np.int64)  # see _LAST, ...
-    nbmax = max(n_blocks, 1)
-    ENDS = np.zeros((nl, nbmax), np.int64)
-    BLK = np.zeros((nl, nbmax, k))
-    ACC = np.zeros((nl, k))
-    # the one-lane machinery's scratch
-    Zl = np.zeros((m, ns))
-    Cl = np.zeros((m, ns))
-    logs = np.zeros(k)
     ys = np.zeros(ns)
     y1s = np.zeros(ns)
     ybuf = np.zeros(ns)
@@ -664,34 +723,10 @@ def _lyap_block(first, nl, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF, n
     W = np.zeros((9, ns))
     gbuf = np.zeros((GBUF_ROWS, ne))
     renorm = max(renorm_every, 1)
-    max_total = 0
-    for l in range(nl):
-        lane = first + l
-        for j in range(k):
-            out[lane, j] = np.nan
-            err[lane, j] = np.nan
-        used[lane] = 0
-        status[lane] = STATUS_OK
-        IST[l, _NTR] = n_transient[lane]
-        IST[l, _NST] = n_steps[lane]
-        IST[l, _TOTAL] = n_transient[lane] + n_steps[lane]
-        ACT[l] = IST[l, _TOTAL] > 0
-        max_total = max(max_total, IST[l, _TOTAL])
-        ends = _block_bounds(max(n_steps[lane], 1), NPER[lane], n_blocks)
-        IST[l, _NBK] = ends.size
-        for b in range(ends.size):
-            ENDS[l, b] = ends[b]
-        IST[l, _DUE] = _lane_due(IST, l, renorm, ENDS)
-        for q in range(ns):
-            Zl[0, q] = Y0[lane, q]
-        # generic, orthonormalised start vectors: e_j + 0.1 (1, ..., 1)
-        for j in range(1, m):
-            for q in range(ns):
-                Zl[j, q] = 0.1 + (1.0 if q == j - 1 else 0.0)
-        _orthonormalise(Zl, logs, False)
-        for j in range(m):
-            for q in range(ns):
-                ZT[j, q, l] = Zl[j, q]
+    IST, ENDS, BLK, ACC, Zl, Cl, logs, max_total = _lanes_init(first, nl, k, Y0, NPER,
+                                                                n_transient, n_steps,
+                                                                renorm_every, n_blocks, out,
+                                                                err, used, status, ZT, ACT)
     for r in range(nrp):
         l = r % nl if r < nr else 0
         lane = first + l
@@ -754,6 +789,340 @@ def _lyap_block(first, nl, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF, n
             status[lane] = STATUS_SPLIT_LIMIT
 
 
+# ---------------------------------------------------------------------------------------------
+# The fused Lyapunov block (k = 1, a model with lane-scalar functions in a vectorising form,
+# see :data:`geardyn.core.kernel_source.LANE_FORMS`): one loop over the block's lanes per grid
+# step does what the row loops above do for each lane's three rows (the state, y + e S v and
+# y - e S v): the finite-difference set-up, the RK4 trials with the model's rhs inlined and
+# the states in registers, the events and the side test, and, where no row of the lane is
+# flagged, the commit and the new tangent vector. A lane with a flagged row is finished out of
+# line (:func:`_lyap_flagged`: the flagged rows' split steps, then its combination). The
+# arithmetic of each row is that of :func:`_rows_rk4` and of the one-lane kernel, operation for
+# operation, so the exponents are bitwise the same (tests/test_lyapunov_lanes.py). The block's
+# arrays are BLOCK lanes wide (rows at constant offsets) and the loop's function is compiled
+# with its arrays ``noalias``, as the sweep's fused loop (see its template).
+
+
+def _t_dot_scaled(y, IS):
+    """sum_q (y_q IS[q])^2, summed from 0.0 in the order of q (as :func:`_fd_setup`)."""
+
+
+def _t_dot(y):
+    """sum_q y_q^2, summed from 0.0 in the order of q."""
+
+
+def _t_fd_rows(z0, v, S, e, ok):
+    """The two perturbed rows z0 + e (S v) and z0 - e (S v) (z0 where not ok), as tuples."""
+
+
+def _t_fd_tangent(ya, yb, e, IS):
+    """((ya - yb) (0.5 / e)) IS, elementwise: the new tangent vector (NaN where e is not
+    finite)."""
+
+
+def _ov_t_dot_scaled(y, IS):
+    body = ["acc = 0.0"] + [f"z = y[{q}] * IS[{q}]\n    acc += z * z" for q in range(len(y))]
+    return _tuple_source("y, IS", [*body, "return acc"])
+
+
+def _ov_t_dot(y):
+    body = ["acc = 0.0"] + [f"acc += y[{q}] * y[{q}]" for q in range(len(y))]
+    return _tuple_source("y", [*body, "return acc"])
+
+
+def _ov_t_fd_rows(z0, v, S, e, ok):
+    n = len(z0)
+    lines = [f"d{q} = e * (S[{q}] * v[{q}])" for q in range(n)]
+    plus = "".join(f"_pick(ok, z0[{q}] + d{q}, z0[{q}]), " for q in range(n))
+    minus = "".join(f"_pick(ok, z0[{q}] - d{q}, z0[{q}]), " for q in range(n))
+    return _tuple_source("z0, v, S, e, ok", [*lines, f"return ({plus}), ({minus})"],
+                         {"_pick": _pick})
+
+
+def _ov_t_fd_tangent(ya, yb, e, IS):
+    terms = "".join(f"_pick(fin, ((ya[{q}] - yb[{q}]) * (0.5 / e)) * IS[{q}], np.nan), "
+                    for q in range(len(ya)))
+    return _tuple_source("ya, yb, e, IS", ["fin = math.isfinite(e)", f"return ({terms})"],
+                         {"_pick": _pick, "math": math, "np": np})
+
+
+if FUSED:
+    for _stub, _impl in ((_t_dot_scaled, _ov_t_dot_scaled), (_t_dot, _ov_t_dot),
+                         (_t_fd_rows, _ov_t_fd_rows), (_t_fd_tangent, _ov_t_fd_tangent)):
+        nb.extending.overload(_stub, inline="always")(_impl)
+
+
+@nb.njit(inline="always", **_JIT)
+def _row_trial(form, y, PT, l, ts, tm, te, hh, h, h6, hd, ph):
+    """One row's RK4 trial (as :func:`_rows_rk4`) and its events at the start, the end and
+    y + hd f (the graze predictor): (y1, g0, g1, ge)."""
+    s0, c0, s1, c1, s2, c2 = ph
+    k1 = _rhs_l(ts, y, PT, l, s0, c0, form)
+    k2 = _rhs_l(tm, _t_axpy(y, hh, k1), PT, l, s1, c1, form)
+    k3 = _rhs_l(tm, _t_axpy(y, hh, k2), PT, l, s1, c1, form)
+    k4 = _rhs_l(te, _t_axpy(y, h, k3), PT, l, s2, c2, form)
+    y1 = _t_comb(y, h6, k1, k2, k3, k4)
+    return (y1, _events_l(ts, y, PT, l), _events_l(te, y1, PT, l),
+            _events_l(te, _t_axpy(y, hd, k1), PT, l))
+
+
+@nb.njit(inline="always", **_JIT)
+def _lyap_fused_steps(form, i, nl, Z0, Z1, S, IS, PT, T0L, HL, HHL, H6L, PH, ACT, ROWS, EV,
+                      FLAG, EL):
+    """Grid step i of every lane of the block (see above). Z0, Z1: the state and the tangent
+    vector (flat rows of BLOCK lanes, committed where the lane is active and unflagged); PH:
+    the sin, cos at the step's start, middle and end (six rows); ROWS: each row's start and
+    trial (six arrays: start +, -, state; trial +, -, state); EV: each row's events at the
+    start, at the end and its graze flags (nine arrays); FLAG[l] = 1 where a row of lane l is
+    flagged (an active lane), EL[l] its e. Returns the number of flagged lanes."""
+    YA, YB, YC, Y1A, Y1B, Y1C = ROWS
+    G0A, G0B, G0C, G1A, G1B, G1C, GRA, GRB, GRC = EV
+    P0, P1, P2, P3, P4, P5 = PH
+    n_flag = 0
+    for l in range(nl):
+        z0 = _t_load(Z0, l)
+        v = _t_load(Z1, l)
+        ny = FD_DELTA * (1.0 + min(math.sqrt(_t_dot_scaled(z0, IS)), FD_NORM_CAP))
+        nv = math.sqrt(_t_dot(v))
+        ok = (nv > 0.0) & math.isfinite(nv)
+        e = _pick(ok, ny / nv, np.nan)
+        ya, yb = _t_fd_rows(z0, v, S, e, ok)
+        h = HL[l]
+        ts = T0L[l] + i * h
+        hh = HHL[l]
+        tm = ts + hh
+        te = ts + h
+        hd = te - ts
+        h6 = H6L[l]
+        ph = (P0[l], P1[l], P2[l], P3[l], P4[l], P5[l])
+        y1a, g0a, g1a, gea = _row_trial(form, ya, PT, l, ts, tm, te, hh, h, h6, hd, ph)
+        y1b, g0b, g1b, geb = _row_trial(form, yb, PT, l, ts, tm, te, hh, h, h6, hd, ph)
+        y1c, g0c, g1c, gec = _row_trial(form, z0, PT, l, ts, tm, te, hh, h, h6, hd, ph)
+        fa = _t_screen_rows(g0a, g1a, gea, GRA, l)
+        fb = _t_screen_rows(g0b, g1b, geb, GRB, l)
+        fc = _t_screen_rows(g0c, g1c, gec, GRC, l)
+        act = ACT[l]
+        flagged = act & (fa | fb | fc)
+        keep = act & (not flagged)
+        _t_store(YA, l, ya, ya, True)
+        _t_store(YB, l, yb, yb, True)
+        _t_store(YC, l, z0, z0, True)
+        _t_store(Y1A, l, y1a, y1a, True)
+        _t_store(Y1B, l, y1b, y1b, True)
+        _t_store(Y1C, l, y1c, y1c, True)
+        _t_store(G0A, l, g0a, g0a, True)
+        _t_store(G0B, l, g0b, g0b, True)
+        _t_store(G0C, l, g0c, g0c, True)
+        _t_store(G1A, l, g1a, g1a, True)
+        _t_store(G1B, l, g1b, g1b, True)
+        _t_store(G1C, l, g1c, g1c, True)
+        _t_store(Z1, l, _t_fd_tangent(y1a, y1b, e, IS), v, keep)
+        _t_store(Z0, l, y1c, z0, keep)
+        FLAG[l] = 1.0 if flagged else 0.0
+        EL[l] = e
+        n_flag += 1 if flagged else 0
+    return n_flag
+
+
+def _t_screen_rows(g0, g1, ge, GR, l):
+    """:func:`_rows_screen` of one row: its graze flags into GR[:, l]; True when flagged."""
+
+
+def _ov_t_screen_rows(g0, g1, ge, GR, l):
+    lines = ["hit = False"]
+    for j in range(len(g0)):
+        lines += [f"a = g0[{j}]", f"b = g1[{j}]",
+                  "crossed = (1.0 if b > 0.0 else -1.0) != (1.0 if a > 0.0 else -1.0)",
+                  f"graze = not min(abs(a), abs(b)) > GRAZE_BOUND_STEP * abs(ge[{j}] - b)",
+                  f"GR[{j * BLOCK} + l] = _pick(graze, 1.0, 0.0)", "hit = hit | crossed | graze"]
+    return _tuple_source("g0, g1, ge, GR, l", [*lines, "return hit"],
+                         {"_pick": _pick, "GRAZE_BOUND_STEP": GRAZE_BOUND_STEP, "BLOCK": BLOCK})
+
+
+if FUSED:
+    nb.extending.overload(_t_screen_rows, inline="always")(_ov_t_screen_rows)
+
+
+@nb.njit(_nrt=False, **_JIT)
+def _lyap_flagged(i, nl, first, P, Z0, Z1, IS, T0L, HL, OMEGA, NPL, ACT, ROWS, EV, FLAG, EL,
+                  UNRR, scratch):
+    """The flagged lanes of step i out of line: each row whose trial is flagged finished on the
+    scalar path (:func:`_split_step`), then the lane's commit and tangent vector from its rows
+    (as :func:`_rows_commit` and :func:`_fd_combine`)."""
+    ys, y1s, sides, g1s, ncross, W, gbuf = scratch
+    ns = ys.size
+    n_ev = g1s.size
+    for l in range(nl):
+        if FLAG[l] == 0.0:
+            continue
+        lane = first + l
+        for r in range(3):
+            Y, Y1 = ROWS[r], ROWS[3 + r]
+            G0, G1, GR = EV[r], EV[3 + r], EV[6 + r]
+            hit = False
+            for j in range(n_ev):
+                a = G0[j * BLOCK + l]
+                hit = hit or _side(G1[j * BLOCK + l]) != _side(a) or GR[j * BLOCK + l] != 0.0
+            if not hit:
+                for q in range(ns):
+                    Y[q * BLOCK + l] = Y1[q * BLOCK + l]
+                continue
+            for q in range(ns):
+                ys[q] = Y[q * BLOCK + l]
+                y1s[q] = Y1[q * BLOCK + l]
+            for j in range(n_ev):
+                sides[j] = _side(G0[j * BLOCK + l])
+                g1s[j] = G1[j * BLOCK + l]
+                gbuf[GRAZE_ROW, j] = GR[j * BLOCK + l]
+            UNRR[r * BLOCK + l] += _split_step(i, T0L[l], ys, y1s, P[lane], HL[l], OMEGA[lane],
+                                               NPL[l], sides, g1s, ncross, W, W[8], gbuf)
+            for q in range(ns):
+                Y[q * BLOCK + l] = ys[q]
+        e = EL[l]
+        fin = math.isfinite(e)
+        for q in range(ns):
+            v = ((ROWS[0][q * BLOCK + l] - ROWS[1][q * BLOCK + l]) * (0.5 / e)) * IS[q]
+            Z1[q * BLOCK + l] = v if fin else np.nan
+        for q in range(ns):
+            Z0[q * BLOCK + l] = ROWS[2][q * BLOCK + l]
+
+
+@nb.njit(inline="always", **_JIT)
+def _lyap_fused_run(form, first, nl, max_total, due, renorm, bound, P, OMEGA, H, S, IS, PT,
+                    lanes, rows, books, out, err, used, status, scratch):
+    """The time loop of a fused Lyapunov block (see above): every grid step of the block's
+    lanes, their flagged lanes out of line, their bookkeeping where due (:func:`_lane_books`)."""
+    (Z0, Z1, ZT, T0L, HL, HHL, H6L, IDX, NPL, ENDL, PH, ACT, ACTR, FLAG, EL, UNRR) = lanes
+    ROWS, EV = rows
+    IST, ENDS, BLK, ACC, Zl, Cl, logs = books
+    S_TAB, C_TAB = scratch[0], scratch[1]
+    for i in range(max_total):
+        live = False
+        for l in range(nl):
+            live = live | ACT[l]
+        if not live:
+            break
+        for l in range(nl):  # the phase gathers (scalar), apart: the fused loop reads rows
+            j = IDX[l]
+            for d in range(3):
+                PH[2 * d][l] = S_TAB[j + d]
+                PH[2 * d + 1][l] = C_TAB[j + d]
+        n_flag = _lyap_fused_steps(form, i, nl, Z0, Z1, S, IS, PT, T0L, HL, HHL, H6L, PH, ACT,
+                                   ROWS, EV, FLAG, EL)
+        if n_flag > 0:
+            _lyap_flagged(i, nl, first, P, Z0, Z1, IS, T0L, HL, OMEGA, NPL, ACT, ROWS, EV, FLAG,
+                          EL, UNRR, scratch[2:])
+        for l in range(nl):  # the next step's phase index: 2 (i + 1 mod n_per) from the start
+            IDX[l] = IDX[l] + 2 if IDX[l] + 2 < ENDL[l] else IDX[l] + 2 - 2 * NPL[l]
+        step = i + 1
+        if step >= due:
+            due = _lane_books_core(step, first, nl, 1, renorm, bound, ZT, Zl, Cl, logs, IST,
+                                   ENDS, BLK, ACC, ACT, ACTR, status)
+
+
+@nb.njit(_nrt=False, pipeline_class=_NoAliasCompiler, **_JIT)
+def _lyap_run_form1(first, nl, max_total, due, renorm, bound, P, OMEGA, H, S, IS, PT, lanes,
+                    rows, books, out, err, used, status, scratch):
+    """:func:`_lyap_fused_run` in the lane form FORM_QUIET (compiled on its own, noalias)."""
+    _lyap_fused_run(FORM_QUIET, first, nl, max_total, due, renorm, bound, P, OMEGA, H, S, IS,
+                    PT, lanes, rows, books, out, err, used, status, scratch)
+
+
+@nb.njit(_nrt=False, pipeline_class=_NoAliasCompiler, **_JIT)
+def _lyap_run_form2(first, nl, max_total, due, renorm, bound, P, OMEGA, H, S, IS, PT, lanes,
+                    rows, books, out, err, used, status, scratch):
+    """:func:`_lyap_fused_run` in the lane form FORM_LOAD."""
+    _lyap_fused_run(FORM_LOAD, first, nl, max_total, due, renorm, bound, P, OMEGA, H, S, IS,
+                    PT, lanes, rows, books, out, err, used, status, scratch)
+
+
+@nb.njit(**_JIT)
+def _block_form(P, first, nl):
+    """The lane form every lane of the block takes (``rhs_lane_form``), else FORM_GENERAL."""
+    PTq = P.T
+    form = _lane_form(PTq, first)
+    for l in range(1, nl):
+        if _lane_form(PTq, first + l) != form:
+            return FORM_GENERAL
+    return form
+
+
+@nb.njit(**_JIT)
+def _lyap_block_fused(form, first, nl, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
+                      n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err, used,
+                      status, unres):
+    """:func:`_lyap_block` with k = 1 in the fused loop of lane form ``form`` (FORM_QUIET or
+    FORM_LOAD; nl <= BLOCK lanes): the same results, bitwise."""
+    ns = Y0.shape[1]
+    IS = np.empty(ns)
+    for q in range(ns):
+        IS[q] = 1.0 / S[q]
+    ZT = np.zeros((2, ns, BLOCK))
+    Z0 = ZT[0].reshape(ns * BLOCK)
+    Z1 = ZT[1].reshape(ns * BLOCK)
+    PT = np.zeros((P.shape[1], BLOCK))
+    T0L = np.zeros(BLOCK)
+    HL = np.zeros(BLOCK)
+    HHL = np.zeros(BLOCK)
+    H6L = np.zeros(BLOCK)
+    IDX = np.zeros(BLOCK, np.int64)
+    NPL = np.ones(BLOCK, np.int64)
+    ENDL = np.zeros(BLOCK, np.int64)
+    PH6 = np.zeros((6, BLOCK))
+    PH = (PH6[0], PH6[1], PH6[2], PH6[3], PH6[4], PH6[5])
+    ACT = np.zeros(BLOCK, np.bool_)
+    ACTR = np.zeros(3 * nl, np.bool_)  # (written by _lane_books; unused here)
+    FLAG = np.zeros(BLOCK)
+    EL = np.zeros(BLOCK)
+    UNRR = np.zeros(3 * BLOCK, np.int64)
+    R6 = np.zeros((6, ns * BLOCK))
+    ROWS = (R6[0], R6[1], R6[2], R6[3], R6[4], R6[5])
+    E9 = np.zeros((9, max(n_ev, 1) * BLOCK))
+    EV = (E9[0], E9[1], E9[2], E9[3], E9[4], E9[5], E9[6], E9[7], E9[8])
+    IST, ENDS, BLK, ACC, Zl, Cl, logs, max_total = _lanes_init(first, nl, 1, Y0, NPER,
+                                                                n_transient, n_steps,
+                                                                renorm_every, n_blocks, out,
+                                                                err, used, status, ZT, ACT)
+    for l in range(nl):
+        lane = first + l
+        for j in range(P.shape[1]):
+            PT[j, l] = P[lane, j]
+        T0L[l] = T0[lane]
+        HL[l] = H[lane]
+        HHL[l] = 0.5 * H[lane]
+        H6L[l] = H[lane] / 6.0
+        NPL[l] = NPER[lane]
+        IDX[l] = OFF[lane]
+        ENDL[l] = OFF[lane] + 2 * NPER[lane]
+    renorm = max(renorm_every, 1)
+    due = max_total
+    for l in range(nl):
+        if ACT[l]:
+            due = min(due, IST[l, _DUE])
+    ne = max(n_ev, 1)
+    scratch = (S_TAB, C_TAB, np.zeros(ns), np.zeros(ns), np.ones(ne, np.int64), np.zeros(ne),
+               np.zeros(ne, np.int64), np.zeros((9, ns)), np.zeros((GBUF_ROWS, ne)))
+    lanes = (Z0, Z1, ZT, T0L, HL, HHL, H6L, IDX, NPL, ENDL, PH, ACT, ACTR, FLAG, EL, UNRR)
+    books = (IST, ENDS, BLK, ACC, Zl, Cl, logs)
+    if form == FORM_LOAD:
+        _lyap_run_form2(first, nl, max_total, due, renorm, bound, P, OMEGA, H, S, IS, PT,
+                        lanes, (ROWS, EV), books, out, err, used, status, scratch)
+    else:
+        _lyap_run_form1(first, nl, max_total, due, renorm, bound, P, OMEGA, H, S, IS, PT,
+                        lanes, (ROWS, EV), books, out, err, used, status, scratch)
+    for l in range(nl):  # the results of the lanes that ended well (deferred, see above)
+        lane = first + l
+        if status[lane] != STATUS_DIVERGED:
+            _lane_result(l, lane, 1, IST[l, _NST], H[lane], ENDS, IST[l, _NBK], BLK, ACC, out,
+                         err, used)
+    for l in range(nl):
+        lane = first + l
+        u = UNRR[l] + UNRR[BLOCK + l] + UNRR[2 * BLOCK + l]
+        unres[lane] = u
+        if u > 0 and status[lane] == STATUS_OK:
+            status[lane] = STATUS_SPLIT_LIMIT
+
+
 #: Columns of the per-lane integer state of a block (IST): the step of the last
 #: renormalisation, the block being measured, transient and measured steps, their total, the
 #: number of blocks, the lane's next due step.
@@ -776,9 +1145,25 @@ def _lane_due(IST, l, renorm, ENDS):
 @nb.njit(**_JIT)
 def _lane_books(step, first, nl, k, renorm, bound, ZT, Zl, Cl, logs, IST, ENDS, BLK, ACC, ACT,
                 ACTR, H, out, err, used, status):
+    """:func:`_lane_books_core`, then the result of every lane that ended well at this step
+    (:func:`_lane_result`). Returns the next step at which a lane is due."""
+    nxt = _lane_books_core(step, first, nl, k, renorm, bound, ZT, Zl, Cl, logs, IST, ENDS, BLK,
+                           ACC, ACT, ACTR, status)
+    for l in range(nl):
+        if IST[l, _TOTAL] == step and status[first + l] != STATUS_DIVERGED:
+            _lane_result(l, first + l, k, IST[l, _NST], H[first + l], ENDS, IST[l, _NBK], BLK,
+                         ACC, out, err, used)
+    return nxt
+
+
+@nb.njit(**_JIT)
+def _lane_books_core(step, first, nl, k, renorm, bound, ZT, Zl, Cl, logs, IST, ENDS, BLK, ACC,
+                     ACT, ACTR, status):
     """The bookkeeping of the block's lanes due at this step, as in :func:`_run`:
     renormalisation (health, modified Gram-Schmidt on a gathered copy), block statistics, the
-    result at a lane's last step. Returns the next step at which a lane is due. (One loop, no
+    end of a lane at its last step (its result is the caller's: :func:`_lane_result`
+    allocates, and the fused block's loop allocates nothing). Returns the next step at which a
+    lane is due. (One loop, no
     inlined helpers with array arguments: each would cost reference counting per lane.)"""
     m, ns = Zl.shape
     nxt = np.iinfo(np.int64).max
@@ -828,8 +1213,6 @@ def _lane_books(step, first, nl, k, renorm, bound, ZT, Zl, Cl, logs, IST, ENDS, 
             if step == IST[l, _TOTAL]:
                 ACT[l] = False
                 changed = True
-                _lane_result(l, lane, k, IST[l, _NST], H[lane], ENDS, IST[l, _NBK], BLK, ACC,
-                             out, err, used)
                 continue
             IST[l, _DUE] = _lane_due(IST, l, renorm, ENDS)
         nxt = min(nxt, IST[l, _DUE])

@@ -1,0 +1,117 @@
+"""The CATT model's lane forms (see :data:`geardyn.core.kernel_source.LANE_FORMS`): the sweep
+kernel runs a queue of quiet lanes, of lanes with the load fluctuating, of several stiffness
+harmonics or a mixture, each in its own compiled copy of the fused loop, and every lane's
+result is bitwise that of the one-lane path (``simulate``). The load's sine
+(:func:`~geardyn.models.catt_kernels.load_sin`) is checked against libm's."""
+
+from __future__ import annotations
+
+import math
+
+import numba as nb
+import numpy as np
+import pytest
+
+import geardyn
+from geardyn.core.kernel_source import FORM_GENERAL, FORM_LOAD, FORM_QUIET
+from geardyn.models import catt_kernels as ck
+from geardyn.solvers.ensemble import run_lanes
+
+_OMEGAS = np.array([0.7, 1.3, 2.2, 3.1, 0.45])
+
+
+@nb.njit(cache=True)
+def _load_sin_array(x, out):
+    for i in range(x.size):
+        out[i] = ck.load_sin(x[i])
+
+
+@pytest.mark.parametrize("limit", [4.0, 1e3, 1e6])
+def test_load_sin_is_within_two_ulp_of_libm(limit):
+    rng = np.random.default_rng(1)
+    x = np.concatenate([rng.uniform(-limit, limit, 200_000),
+                        np.arange(-40, 41) * math.pi / 4])  # the quadrant boundaries
+    got = np.empty_like(x)
+    _load_sin_array(x, got)
+    ref = np.array([math.sin(v) for v in x])
+    assert np.max(np.abs(got - ref)) <= 2 * np.spacing(1.0) / 2  # |sin| <= 1: 2 ulp of 1 / 2
+    big = np.abs(ref) > 1e-3
+    ulp = np.abs(got - ref)[big] / np.spacing(np.abs(ref[big]))
+    assert np.max(ulp) <= 2.0
+    assert ck.LOAD_SIN_EXACT_BELOW >= limit
+
+
+def test_load_sin_beyond_the_exact_range_errs_by_the_arguments_own_rounding():
+    """A long continuation's time grows with its chain (Lambda t ~ 1e8): there the reduction
+    rounds, by about ulp(x), which is the rounding of the argument Lambda t + psi itself."""
+    x = np.random.default_rng(2).uniform(1e6, 1e8, 100_000)
+    got = np.empty_like(x)
+    _load_sin_array(x, got)
+    ref = np.array([math.sin(v) for v in x])
+    assert np.all(np.abs(got - ref) <= 2 * np.spacing(x) + 4 * np.spacing(1.0))
+
+
+def _device(**changes):
+    return geardyn.CATTDevice(geardyn.PlanetaryParams.paper(xi1=0.1, xi2=0.1, **changes))
+
+
+_LOAD = {"B1": "100 N m", "B2": "100 N m", "Lambda": 0.1}
+
+
+def _assert_lanes_equal_simulate(models, omegas, steps=48):
+    """run_lanes of the stacked lanes of ``models`` (one model's layout) against simulate."""
+    P = np.vstack([m.lane_params("Omega", omegas) for m in models])
+    first = models[0]
+    r = run_lanes(first, P, first.initial_state(), 200.0, 3, steps_per_period=steps,
+                  sample_every=1)
+    assert np.all(r.status == 0)
+    for j in range(P.shape[0]):
+        m = models[j // omegas.size]
+        ds = geardyn.simulate(m, omega=float(omegas[j % omegas.size]), transient=200.0,
+                              periods=3, steps_per_period=steps)
+        np.testing.assert_array_equal(r.samples[j], ds["poincare"].values[1:], err_msg=str(j))
+
+
+def _form(model):
+    P = np.ascontiguousarray(model.lane_params("Omega", _OMEGAS[:1]).T)
+    return ck.catt_rhs_one_lane_form(P, 0)
+
+
+def test_each_lane_form_equals_the_one_lane_path_bitwise():
+    quiet, load = _device(), _device(**_LOAD)
+    rect = _device(waveform="rectangular")
+    assert (_form(quiet), _form(load), _form(rect)) == (FORM_QUIET, FORM_LOAD, FORM_GENERAL)
+    _assert_lanes_equal_simulate([load], _OMEGAS)
+    _assert_lanes_equal_simulate([rect], _OMEGAS[:3])
+    # quiet and fluctuating lanes in one queue run in the general form: still the same results
+    _assert_lanes_equal_simulate([quiet, load], _OMEGAS[:3])
+
+
+def test_the_load_changes_the_motion():
+    """(So that the test above compares lanes that take the load's branch-free form.)"""
+    quiet, load = _device(), _device(**_LOAD)
+    P = np.vstack([quiet.lane_params("Omega", _OMEGAS[:2]), load.lane_params("Omega", _OMEGAS[:2])])
+    r = run_lanes(quiet, P, quiet.initial_state(), 200.0, 3, steps_per_period=48)
+    assert np.max(np.abs(r.samples[:2] - r.samples[2:])) > 1e-3
+
+
+def test_chains_mixing_forms_run_in_the_general_form_and_equal_lane_by_lane_runs():
+    """A chain (a sweep by continuation) whose lanes take different forms runs in the general
+    form, the uniform chains and lone lanes in theirs, one pass per form in the same block; each
+    chained lane equals the lane run alone from its predecessor's final state and time."""
+    quiet, load = _device(), _device(**_LOAD)
+    omega = np.array([1.3])
+    rows = [quiet, load, quiet, load, load, quiet, load]  # chains 0 -> 1 -> 2 and 3 -> 4
+    P = np.vstack([m.lane_params("Omega", omega) for m in rows])
+    chain = np.array([1, 2, -1, 4, -1, -1, -1])
+    y0 = quiet.initial_state()
+    kw = dict(steps_per_period=48, sample_every=1)
+    r = run_lanes(quiet, P, y0, 100.0, 3, chain=chain, **kw)
+    assert np.all(r.status == 0)
+    for head in (0, 3, 5, 6):
+        lane, start, t0 = head, y0, np.zeros(1)
+        while lane >= 0:
+            alone = run_lanes(quiet, P[[lane]], start, 100.0, 3, t0=t0, **kw)
+            np.testing.assert_array_equal(r.samples[lane], alone.samples[0], err_msg=str(lane))
+            np.testing.assert_array_equal(r.final[lane], alone.final[0])
+            start, t0, lane = alone.final[0], alone.final_time[:1], chain[lane]
