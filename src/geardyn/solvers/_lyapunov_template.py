@@ -605,6 +605,21 @@ def _rows_commit(i, nr, NPR, Y, Y1, G0, G1, GR, FLAG, ACTR, P, LANE, T0R, HR, OM
             Y[q, r] = ys[q]
 
 
+@nb.njit(inline="always", **_JIT)
+def _set_column(r, lane, P, T0, H, NPER, OFF, PT, T0R, HR, HH, H6, NPR, IDX, END):
+    """Column r of a block's per-row (or per-lane) arrays from lane ``lane``: coefficients,
+    start time, step, half and sixth step, steps per period, phase-table index and end."""
+    for j in range(P.shape[1]):
+        PT[j, r] = P[lane, j]
+    T0R[r] = T0[lane]
+    HR[r] = H[lane]
+    HH[r] = 0.5 * H[lane]
+    H6[r] = H[lane] / 6.0
+    NPR[r] = NPER[lane]
+    IDX[r] = OFF[lane]
+    END[r] = OFF[lane] + 2 * NPER[lane]
+
+
 @nb.njit(**_JIT)
 def _lanes_init(first, nl, k, Y0, NPER, n_transient, n_steps, renorm_every, n_blocks, out, err,
                 used, status, ZT, ACT):
@@ -731,15 +746,7 @@ def _lyap_block(first, nl, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF, n
         l = r % nl if r < nr else 0
         lane = first + l
         LANE[r] = lane
-        for j in range(P.shape[1]):
-            PT[j, r] = P[lane, j]
-        T0R[r] = T0[lane]
-        HR[r] = H[lane]
-        HH[r] = 0.5 * H[lane]
-        H6[r] = H[lane] / 6.0
-        NPR[r] = NPER[lane]
-        IDX[r] = OFF[lane]
-        END[r] = OFF[lane] + 2 * NPER[lane]
+        _set_column(r, lane, P, T0, H, NPER, OFF, PT, T0R, HR, HH, H6, NPR, IDX, END)
         ACTR[r] = ACT[l] and r < nr
     due = max_total
     for l in range(nl):
@@ -1084,16 +1091,7 @@ def _lyap_block_fused(form, first, nl, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TA
                                                                 renorm_every, n_blocks, out,
                                                                 err, used, status, ZT, ACT)
     for l in range(nl):
-        lane = first + l
-        for j in range(P.shape[1]):
-            PT[j, l] = P[lane, j]
-        T0L[l] = T0[lane]
-        HL[l] = H[lane]
-        HHL[l] = 0.5 * H[lane]
-        H6L[l] = H[lane] / 6.0
-        NPL[l] = NPER[lane]
-        IDX[l] = OFF[lane]
-        ENDL[l] = OFF[lane] + 2 * NPER[lane]
+        _set_column(l, first + l, P, T0, H, NPER, OFF, PT, T0L, HL, HHL, H6L, NPL, IDX, ENDL)
     renorm = max(renorm_every, 1)
     due = max_total
     for l in range(nl):
