@@ -55,6 +55,7 @@ from geardyn.solvers._step_core import (  # CORE-IMPORT
     _leaves_side,
     _NoAliasCompiler,
     _observe_l,
+    _padded,
     _rhs_i,
     _rhs_l,
     _side,
@@ -451,8 +452,9 @@ def _lanes_finish(STEP, nl, NPER, Y, Y1, G1, GR, SIDE, FLAG, ACT, P, LANE, HB, T
 def _finish_flagged(k, i, NPER, Y, Y1, G1, GR, SIDE, P, LANE, HB, T0B, OMEGA, locate, NCROSS,
                     UNRES, ys, y1s, sides, g1s, work, ybuf, gbuf):
     """Finish slot k's flagged trial step (grid step i) on the scalar path: the crossings located
-    (:func:`_split_step`) or, without ``locate``, counted at the step's end. Out of line, so
-    that the slot loop that calls it stays small."""
+    (:func:`_split_step`) or, without ``locate``, counted at the step's end. Out of the slot
+    loops, so that they stay small: a call from the SoA loop, inlined into :func:`_slot_out`
+    (itself out of the fused loop; a call there passed its ~20 arrays by value)."""
     ns = Y.shape[0]
     n_ev = G1.shape[0]
     lane = LANE[k]
@@ -594,6 +596,7 @@ def _sweep_worker(w, lanes, cfg, sched, out):
     work = np.zeros((7, ns))
     ybuf = np.zeros(ns)
     gbuf = event_buffer(0, n_ev)
+    marked = np.zeros(nw, np.int64)  # the marked slots of a block step (_slots_out)
     HW3 = np.zeros((3, ns, nw))  # h/2, h, h/6 per (state, slot)
     FL = (Y.reshape(ns * nw), Y1.reshape(ns * nw), K1.reshape(ns * nw), K2.reshape(ns * nw),
           K3.reshape(ns * nw), K4.reshape(ns * nw), TMP.reshape(ns * nw))
@@ -602,7 +605,7 @@ def _sweep_worker(w, lanes, cfg, sched, out):
            FLAG, GMIN, GMAX, O, OMAX, OMIN, OSQ, HW3, FL, HW)
     slots = (STAT, MSK, ACT, END, LANE, STEP, PHASE, NPER, OFF, HB, T0B, n_end, n_tr, next_sample,
              DUE, n_stat, n_ring)
-    scratch = (ys, y1s, dbuf, sides, g1s, gb, ob, work, ybuf, gbuf)
+    scratch = (ys, y1s, dbuf, sides, g1s, gb, ob, work, ybuf, gbuf, marked)
     _block_run(q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch)
 
 
@@ -742,7 +745,7 @@ def _block_run_soa(q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch):
      GMIN, GMAX, O, OMAX, OMIN, OSQ, HW3, FL, HW) = blk
     (STAT, MSK, ACT, END, LANE, STEP, PHASE, NPER, OFF, HB, T0B, n_end, n_tr, next_sample, DUE,
      n_stat, n_ring) = slots
-    ys, y1s, dbuf, sides, g1s, gb, ob, work, ybuf, gbuf = scratch
+    ys, y1s, dbuf, sides, g1s, gb, ob, work, ybuf, gbuf, _ = scratch
     SE = PH[2]  # the phase at the grid point reached (see _lanes_phase)
     CE = PH[3]
     ns = Y0.shape[1]
@@ -1004,18 +1007,28 @@ def _fused_steps(form, nl, locate, bound, Y, Y1, PT, SE, CE, H6, FLAG, G, ST, sl
 
 
 _slot_check_i = nb.njit(inline="always", **_JIT)(_slot_check.py_func)
+_finish_flagged_i = nb.njit(inline="always", **_JIT)(_finish_flagged.py_func)
 _slot_sample_i = nb.njit(inline="always", **_JIT)(_slot_sample.py_func)
 
 
 @nb.njit(_nrt=False, **_JIT)
 def _slots_out(nl, G1, SE, CE, lanes, cfg, out, blk, slots, scratch):
     """:func:`_slot_out` for every marked slot (MSK), in one call per block step (a call
-    passes every block array by value: one per slot cost a fifth of the run). Returns the
-    number of lanes that ended."""
+    passes every block array by value: one per slot cost a fifth of the run). The marked slots
+    are gathered first, in a loop of their own: the loop over the block's slots with the
+    bookkeeping inlined in it kept a dozen pointers stepping on the stack, half of this
+    function's time on the paper's lanes, where ~1 slot in 60 is marked. Returns the number
+    of lanes that ended."""
     MSK = slots[1]
-    gone = 0
+    marked = scratch[10]
+    n = 0
     for k in range(nl):
-        if MSK[k] and _slot_out(k, G1, SE, CE, lanes, cfg, out, blk, slots, scratch):
+        if MSK[k]:
+            marked[n] = k
+            n += 1
+    gone = 0
+    for m in range(n):
+        if _slot_out(marked[m], G1, SE, CE, lanes, cfg, out, blk, slots, scratch):
             gone += 1
     return gone
 
@@ -1035,10 +1048,10 @@ def _slot_out(k, G1, SE, CE, lanes, cfg, out, blk, slots, scratch):
      GMIN, GMAX, O, OMAX, OMIN, OSQ, HW3, FL, HW) = blk
     (STAT, MSK, ACT, END, LANE, STEP, PHASE, NPER, OFF, HB, T0B, n_end, n_tr, next_sample, DUE,
      n_stat, n_ring) = slots
-    ys, y1s, dbuf, sides, g1s, gb, ob, work, ybuf, gbuf = scratch
+    ys, y1s, dbuf, sides, g1s, gb, ob, work, ybuf, gbuf, _ = scratch
     if FLAG[k] != 0.0:
-        _finish_flagged(k, STEP[k] - 1, NPER, Y, Y1, G1, GR, SIDE, P, LANE, HB, T0B, OMEGA,
-                        locate, ncross, unresolved, ys, y1s, sides, g1s, work, ybuf, gbuf)
+        _finish_flagged_i(k, STEP[k] - 1, NPER, Y, Y1, G1, GR, SIDE, P, LANE, HB, T0B, OMEGA,
+                          locate, ncross, unresolved, ys, y1s, sides, g1s, work, ybuf, gbuf)
     step = STEP[k]
     if PHASE[k] == 0 or step >= DUE[k]:
         gone, _ = _slot_check_i(k, Y, R, D, ys, LANE, STEP, PHASE, n_end, n_tr, next_sample, DUE,
@@ -1081,6 +1094,7 @@ def _fused_run(form, q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch):
     GSf, GPf, GRf, SIDEf, _ = _flat((GS, GP, GR, SIDE, GR))
     nxt = q0  # the next lane of the queue
     n_act = 0  # slots holding a running lane
+    nv = _padded(nl)  # the fused loop's slots: nl and idle ones (never filled, never active)
     for k in range(nl):  # every slot is free (an earlier pass, of another form, has ended)
         END[k] = True
     ended = True
@@ -1102,7 +1116,7 @@ def _fused_run(form, q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch):
                 _t_side(GS, SIDE, k, _events_l(TT[k], _t_load(Y, k), PT, k))
         if n_act == 0:
             break
-        n_flag, n_out = _fused_steps(form, nl, locate, cfg[4], Yf, Y1f, PT, SE, CE, H6, FLAG,
+        n_flag, n_out = _fused_steps(form, nv, locate, cfg[4], Yf, Y1f, PT, SE, CE, H6, FLAG,
                                      (GSf, GPf, GRf, SIDEf), stats, slots, S_TAB, C_TAB, phx)
         if n_out > 0:
             gone = _slots_out(nl, GS, SE, CE, lanes, cfg, out, blk, slots, scratch)

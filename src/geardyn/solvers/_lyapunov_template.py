@@ -79,6 +79,7 @@ from geardyn.solvers._step_core import (  # CORE-IMPORT
     _healthy,
     _lane_form,
     _NoAliasCompiler,
+    _padded,
     _pick,
     _rhs_i,
     _rhs_l,
@@ -1003,6 +1004,7 @@ def _lyap_fused_run(form, first, nl, max_total, due, renorm, bound, P, OMEGA, H,
     ROWS, EV = rows
     IST, ENDS, BLK, ACC, Zl, Cl, logs = books
     S_TAB, C_TAB = scratch[0], scratch[1]
+    nv = _padded(nl)  # the fused loop's lanes: nl and idle ones (never active)
     for i in range(max_total):
         live = False
         for l in range(nl):
@@ -1014,7 +1016,7 @@ def _lyap_fused_run(form, first, nl, max_total, due, renorm, bound, P, OMEGA, H,
             for d in range(3):
                 PH[2 * d][l] = S_TAB[j + d]
                 PH[2 * d + 1][l] = C_TAB[j + d]
-        n_flag = _lyap_fused_steps(form, i, nl, Z0, Z1, S, IS, PT, T0L, HL, HHL, H6L, PH, ACT,
+        n_flag = _lyap_fused_steps(form, i, nv, Z0, Z1, S, IS, PT, T0L, HL, HHL, H6L, PH, ACT,
                                    ROWS, EV, FLAG, EL)
         if n_flag > 0:
             _lyap_flagged(i, nl, first, P, Z0, Z1, IS, T0L, HL, OMEGA, NPL, ACT, ROWS, EV, FLAG,

@@ -19,6 +19,7 @@ import os
 import sys
 import tempfile
 import types
+import warnings
 from pathlib import Path
 from typing import Any
 
@@ -41,6 +42,13 @@ def observe(t, y, out, p, s, c):
 """
 
 _LOADED: dict[tuple, types.ModuleType] = {}
+
+# While the generated kernels compile, numba's internal pedantic check (NumbaIRAssumptionWarning,
+# "please report") and its debug-line notes (NumbaDebugInfoWarning) fire hundreds of times on
+# the inlined tuple helpers; they say nothing about a model or a result, and a first run of
+# ``geardyn reproduce`` printed pages of them. Only these two numba categories are silenced.
+warnings.filterwarnings("ignore", category=numba.core.errors.NumbaIRAssumptionWarning)
+warnings.filterwarnings("ignore", category=numba.core.errors.NumbaDebugInfoWarning)
 
 
 def cache_dir() -> Path:
