@@ -33,6 +33,9 @@ from __future__ import annotations
 
 import numba as nb
 import numpy as np
+from llvmlite import ir as llvm_ir
+from numba.core import cgutils
+from numba.extending import intrinsic
 
 from geardyn.core.kernel_source import FORM_GENERAL, FORM_LOAD, FORM_QUIET
 from geardyn.solvers._step_core import (  # CORE-IMPORT
@@ -932,6 +935,30 @@ def _transient_end(k, lane, Y, ys, R, D, n_ring, n_tr, n_end, next_sample, conv_
         ncross[lane, j] = 0
 
 
+#: How far ahead (in table entries) the fused loop asks for a slot's forcing-phase tables
+#: (:func:`prefetch`): a slot reads two entries of each per grid step, so 16 is eight steps.
+PREFETCH_AHEAD = 16
+
+
+@intrinsic
+def prefetch(typingctx, arr, idx):
+    """A hint to fetch ``arr[idx]`` into the cache (``llvm.prefetch``: x86 ``prefetcht0``).
+    It never faults and does not change a result, so ``idx`` may lie past the array's end.
+    The fused loop's slots walk their own phase tables: with a lane's table per step count
+    (~500 on the paper's Omega grid, ~3.5 MB), one stream per table and slot, more streams
+    than the hardware prefetchers follow (see :func:`_fused_steps`)."""
+    def codegen(context, builder, signature, args):
+        ary = context.make_array(signature.args[0])(context, builder, args[0])
+        i8p = llvm_ir.IntType(8).as_pointer()
+        i32 = llvm_ir.IntType(32)
+        fnty = llvm_ir.FunctionType(llvm_ir.VoidType(), [i8p, i32, i32, i32])
+        fn = cgutils.get_or_insert_function(builder.module, fnty, "llvm.prefetch.p0")
+        ptr = builder.bitcast(builder.gep(ary.data, [args[1]]), i8p)  # not inbounds: no UB
+        builder.call(fn, [ptr, i32(0), i32(3), i32(1)])  # a read, kept in every level, data
+        return context.get_dummy_value()
+    return nb.types.void(arr, idx), codegen
+
+
 @nb.njit(inline="always", **_JIT)
 def _fused_steps(form, nl, locate, bound, Y, Y1, PT, SE, CE, H6, FLAG, G, ST, slots, S_TAB, C_TAB,
                  PH):
@@ -959,6 +986,8 @@ def _fused_steps(form, nl, locate, bound, Y, Y1, PT, SE, CE, H6, FLAG, G, ST, sl
         CB[k] = C_TAB[j1]
         SN[k] = S_TAB[j2]
         CN[k] = C_TAB[j2]
+        prefetch(S_TAB, j2 + np.uint64(PREFETCH_AHEAD))  # every slot walks its own tables
+        prefetch(C_TAB, j2 + np.uint64(PREFETCH_AHEAD))
     n_flag = 0
     n_out = 0
     for k in range(nl):
@@ -1116,6 +1145,9 @@ def _fused_run(form, q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch):
                 _t_side(GS, SIDE, k, _events_l(TT[k], _t_load(Y, k), PT, k))
         if n_act == 0:
             break
+        if nxt >= q1 and _padded(n_act) < nv:  # the queue is out: no slot empties for a lane
+            _compact(nv, blk, slots)  # of it, so the block's running lanes move down
+            nv = _padded(n_act)
         n_flag, n_out = _fused_steps(form, nv, locate, cfg[4], Yf, Y1f, PT, SE, CE, H6, FLAG,
                                      (GSf, GPf, GRf, SIDEf), stats, slots, S_TAB, C_TAB, phx)
         if n_out > 0:
@@ -1123,6 +1155,65 @@ def _fused_run(form, q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch):
             if gone > 0:
                 ended = True
                 n_act -= gone
+
+
+@nb.njit(_nrt=False, **_JIT)
+def _compact(nv, blk, slots):
+    """Move the running lanes of slots n_act.. (n_act: the number of running lanes) of the
+    fused loop's nv slots into the free slots below n_act, so that the loop can run over
+    _padded(n_act) slots: once a worker's queue is out, its block's last lanes (the longest, or
+    a branch's chain of continued points) would otherwise drag every vector of the block along
+    to the end. A lane's arithmetic does not depend on its slot: its results stay bitwise the
+    same. Out of line: called at most once per vector of slots freed."""
+    ACT = slots[2]
+    n_act = 0
+    for k in range(nv):
+        n_act += 1 if ACT[k] else 0
+    dst = 0
+    for src in range(n_act, nv):
+        if not ACT[src]:
+            continue
+        while ACT[dst]:
+            dst += 1
+        _move_slot(src, dst, blk, slots)
+
+
+@nb.njit(inline="always", **_JIT)
+def _move_slot(src, dst, blk, slots):
+    """Slot src's lane into the free slot dst: every column that lives from one step to the next
+    (state, coefficients, phase, events and their history, statistics, convergence ring,
+    clocks); src is left free (not running, not to be refilled, nothing marked, no lane
+    held)."""
+    (R, D, Y, Y1, K1, K2, K3, K4, TMP, PT, SC, PH6, PH, TT, GP, GS, G1, GR, SIDE, FLAG,
+     GMIN, GMAX, O, OMAX, OMIN, OSQ, HW3, FL, HW) = blk
+    (STAT, MSK, ACT, END, LANE, STEP, PHASE, NPER, OFF, HB, T0B, n_end, n_tr, next_sample, DUE,
+     n_stat, n_ring) = slots
+    for A in (Y, PT, PH6, GP, GS, G1, GR, SIDE, GMIN, GMAX, OMAX, OMIN, OSQ):
+        for j in range(A.shape[0]):
+            A[j, dst] = A[j, src]
+    for j in range(HW3.shape[0]):
+        for q in range(HW3.shape[1]):
+            HW3[j, q, dst] = HW3[j, q, src]
+    for j in range(R.shape[1]):
+        for q in range(R.shape[2]):
+            R[dst, j, q] = R[src, j, q]
+    for j in range(D.shape[1]):
+        for q in range(D.shape[2]):
+            D[dst, j, q] = D[src, j, q]
+    TT[dst] = TT[src]
+    FLAG[dst] = FLAG[src]
+    for B in (STAT, MSK, ACT, END):
+        B[dst] = B[src]
+    for I in (LANE, STEP, PHASE, NPER, OFF, n_end, n_tr, next_sample, DUE, n_stat, n_ring):
+        I[dst] = I[src]
+    HB[dst] = HB[src]
+    T0B[dst] = T0B[src]
+    ACT[src] = False
+    END[src] = False
+    STEP[src] = 0  # holds no lane: the next pass does not continue its chain (_chained)
+    MSK[src] = False
+    STAT[src] = False
+    FLAG[src] = 0.0
 
 
 # One compiled copy of the loop per lane form (a second copy in the same function, or a branch
