@@ -1,69 +1,71 @@
-"""Continuation benchmark (issue 12): the period-1 branch of the paper's Fig. 3 case.
+"""Benchmark of the reproduction's continued sweeps: every kernel call of
+:func:`geardyn.analysis.continuation.continue_branches` timed, with its chains' lengths.
 
-Workload: the paper's device (Tables 1-2, consistent interpretation, reduced model, xi1 = xi2 =
-0.05), ``geardyn.continuation(device, "Omega", 0.1, 4.0)`` at its defaults: pseudo-arclength
-continuation of the period-1 orbit with every fold, period doubling, Neimark-Sacker point and
-contact change located (to 1e-7 in Omega). One cold call compiles (or loads) the kernels; the
-warm wall time is the median of ``--repeat`` calls. Reports the points, the corrector's period
-maps, the bifurcations found, and the target (<= 10 s warm).
+Runs :func:`geardyn.reproduction.runner.run_cases` for the paper's figure cases under the
+given interpretations, with ``continuation.run_lanes`` wrapped to record, per call, the lanes,
+the chains, the lane-steps done, the longest chain and the mean one (lane-steps) and the wall
+time; and the Lyapunov calls' total wall time. A call waits for its longest chain, so
+mean / max says how much of it a block's tail can waste.
 
-    .venv/bin/python bench/continuation.py [--repeat 3] [--lo 0.1] [--hi 4.0]
+    .venv/bin/python bench/continuation.py [consistent[,carrier-only,...]]
 """
 
 from __future__ import annotations
 
-import argparse
-import platform
-import statistics
+import sys
 import time
-from collections import Counter
 
-import numba
+import numpy as np
 
-import geardyn
-
-TARGET_S = 10.0
-
-
-def device() -> geardyn.CATTDevice:
-    return geardyn.CATTDevice(geardyn.PlanetaryParams.paper(xi1=0.05, xi2=0.05),
-                              interpretation="consistent")
+import geardyn.analysis.continuation as continuation
+import geardyn.reproduction.runner as runner
+from geardyn.reproduction.cases import paper_cases
 
 
 def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--repeat", type=int, default=3)
-    ap.add_argument("--lo", type=float, default=0.1)
-    ap.add_argument("--hi", type=float, default=4.0)
-    a = ap.parse_args()
-    m = device()
-    print(f"# geardyn {geardyn.__version__}, numba {numba.__version__}, "
-          f"{numba.get_num_threads()} threads, {platform.machine()}")
-    t = time.perf_counter()
-    geardyn.continuation(m, "Omega", 1.0, 1.1)
-    print(f"cold call (compile or load kernels): {time.perf_counter() - t:.2f} s")
-    times, cpu, ds = [], [], None
-    for _ in range(a.repeat):
-        t, c = time.perf_counter(), time.process_time()
-        ds = geardyn.continuation(m, "Omega", a.lo, a.hi)
-        times.append(time.perf_counter() - t)
-        cpu.append(time.process_time() - c)
-    assert ds is not None
-    med = statistics.median(times)
-    print(f"period-1 branch, Omega in [{a.lo:g}, {a.hi:g}]: warm wall time median {med:.2f} s "
-          f"of [{', '.join(f'{x:.2f}' for x in times)}]; CPU time median "
-          f"{statistics.median(cpu):.2f} s (one thread: the continuation is serial)")
-    print(f"points: {ds.sizes['point']}, arclength {float(ds['arclength'][-1]):.1f}, "
-          f"status: {ds.attrs['message']}")
-    kinds = Counter(str(k) for k in ds["bifurcation_kind"].values)
-    print("bifurcations: " + ", ".join(f"{k} {n}" for k, n in sorted(kinds.items())))
-    for k, v, e in zip(ds["bifurcation_kind"].values, ds["bifurcation_value"].values,
-                       ds["bifurcation_error"].values, strict=True):
-        if k != "contact":
-            print(f"  {k:16s} Omega = {v:.7f} (+- {e:.1e})")
-    print(f"max location error: {float(ds['bifurcation_error'].max()):.1e}")
-    print(f"target <= {TARGET_S:g} s warm: {'met' if med <= TARGET_S else 'NOT met'} "
-          f"(wall time; on a loaded machine compare the CPU time)")
+    calls: list[dict] = []
+    lyapunov: list[float] = []
+    run_lanes = continuation.run_lanes
+    lyapunov_lanes = runner.lyapunov_lanes
+
+    def timed_run_lanes(model, P, Y0, *, chain, **kw):
+        t = time.perf_counter()
+        r = run_lanes(model, P, Y0, chain=chain, **kw)
+        wall = time.perf_counter() - t
+        every = r.sample_every // r.steps_per_period
+        steps = (r.transient_periods + kw["run"].samples * every) * r.steps_per_period
+        heads = np.setdiff1d(np.arange(chain.size), chain[chain >= 0])
+        lengths = []
+        for lane in heads:
+            total = 0
+            while lane >= 0:
+                total += int(steps[lane])
+                lane = chain[lane]
+            lengths.append(total)
+        calls.append(dict(lanes=int(chain.size), chains=len(lengths), steps=int(steps.sum()),
+                          longest=max(lengths), mean=float(np.mean(lengths)), wall=wall))
+        return r
+
+    def timed_lyapunov(*args, **kw):
+        t = time.perf_counter()
+        out = lyapunov_lanes(*args, **kw)
+        lyapunov.append(time.perf_counter() - t)
+        return out
+
+    continuation.run_lanes = timed_run_lanes
+    runner.lyapunov_lanes = timed_lyapunov
+    interpretations = sys.argv[1].split(",") if len(sys.argv) > 1 else ["consistent"]
+    start = time.perf_counter()
+    runner.run_cases(paper_cases(), interpretations)
+    total = time.perf_counter() - start
+    print(f"total wall {total:.1f} s")
+    print(f"continuation: {len(calls)} calls, {sum(c['wall'] for c in calls):.1f} s, "
+          f"{sum(c['steps'] for c in calls):.3e} lane-steps")
+    print("lanes chains lane-steps longest mean/longest wall_s")
+    for c in calls:
+        print(f"{c['lanes']} {c['chains']} {c['steps']} {c['longest']} "
+              f"{c['mean'] / c['longest']:.2f} {c['wall']:.2f}")
+    print(f"lyapunov: {len(lyapunov)} calls, {sum(lyapunov):.1f} s")
 
 
 if __name__ == "__main__":
