@@ -7,7 +7,11 @@ and compares every variable bit for bit against the first run, and against a run
 thread. On 2026-12-02 (session 10) this found Fig. 3's upward sweep differing between runs on
 2 threads (from its 41st point: other transients, Poincare points, periods), with the kernels
 of both ``ed920c2`` and its successor; one thread gave the same result twice, and so did one
-of three 2-thread runs.
+of three 2-thread runs. The cause (session 11): a worker's second lane-form pass continued
+lane 0's chain (Fig. 3 up, points 1-63) a second time from slots that had held no lane, in the
+other worker too, and the two runs raced on the points' outputs (one run's ``converged`` flag
+cut the other's transient short). Fixed in the sweep template (``_fused_run``); since then
+every run here is bitwise equal to the first and to the 1-thread run.
 
     .venv/bin/python bench/determinism.py [--num 150] [--runs 3]
 """

@@ -122,7 +122,7 @@ def old_run_plan(k):
             unresolved=np.zeros(L, np.int64), steps_per_period=n_lane,
             transient_periods=plan.transient_periods.copy(),
             converged=np.full(L, -1, np.int64), sample_every=every.copy(),
-            commensurate=plan.commensurate.copy())
+            commensurate=plan.commensurate.copy(), steps=np.zeros(L, np.int64))
         order = np.lexsort((period, n_lane))
         first, nl, nper, w_start, w_blocks = _old_schedule(n_lane[order],
                                                            plan.total_periods[order], k.BLOCK)

@@ -115,3 +115,52 @@ def test_chains_mixing_forms_run_in_the_general_form_and_equal_lane_by_lane_runs
             np.testing.assert_array_equal(r.samples[lane], alone.samples[0], err_msg=str(lane))
             np.testing.assert_array_equal(r.final[lane], alone.final[0])
             start, t0, lane = alone.final[0], alone.final_time[:1], chain[lane]
+    # each lane ran once: its grid steps are its transient and its samples, no more
+    np.testing.assert_array_equal(
+        r.steps, r.steps_per_period * (r.transient_periods + 3 * r.sample_every))
+
+
+def _planned_steps(r, samples):
+    return r.steps_per_period * (r.transient_periods + samples * r.sample_every)
+
+
+@pytest.mark.parametrize("workers", [1, 2])
+def test_a_later_form_pass_runs_no_chain_again(workers):
+    """A worker's queue with a quiet chain and load lanes runs two passes of the fused loop
+    (quiet, then load). A slot that held no lane in the first pass, or held a chain that has
+    run, must not read as holding one in the second: until 2026-12-02 the loop advanced free
+    slots' clocks, so the second pass continued lane 0's chain (LANE 0) a second time, in
+    another worker too, racing with the first run on its outputs (bench/determinism.py found
+    the reproduction's Fig. 3 sweep differing between runs). Each lane is run exactly once."""
+    from geardyn.core.plan import LanePlan
+    from geardyn.core.settings import RunSettings
+    from geardyn.solvers.ensemble import run_plan
+
+    quiet, load = _device(), _device(**_LOAD)
+    omega = np.linspace(1.1, 1.4, 4)
+    P = np.vstack([quiet.lane_params("Omega", omega), load.lane_params("Omega", omega[:3])])
+    chain = np.array([1, 2, 3, -1, -1, -1, -1])  # a quiet chain 0 -> 3, three lone load lanes
+    run = RunSettings(samples=3, transient=60.0, steps_per_period=48)
+    plan = LanePlan.build(quiet, P, run, sample_every=1)
+    r = run_plan(quiet, P, quiet.initial_state(), plan, chain=chain, workers=workers)
+    assert np.all(r.status == 0)
+    np.testing.assert_array_equal(r.steps, _planned_steps(r, 3))
+    lone = run_plan(quiet, P[4:], quiet.initial_state(), LanePlan.build(quiet, P[4:], run,
+                                                                         sample_every=1))
+    np.testing.assert_array_equal(r.samples[4:], lone.samples)
+
+
+def test_a_chain_stops_at_a_lane_that_did_not_end_well_and_says_so():
+    """After a lane that diverges the rest of its chain is not run: those lanes report
+    Status.NOT_RUN and no steps (not the 'ok' of an array as allocated); the diverged lane
+    reports the steps it took."""
+    from geardyn.core.status import Status
+
+    quiet = _device()
+    P = quiet.lane_params("Omega", np.array([1.2, 1.25, 1.3]))
+    r = run_lanes(quiet, P, quiet.initial_state(), 50.0, 3, steps_per_period=48,
+                  sample_every=1, bound=1e-3, chain=np.array([1, 2, -1]))
+    assert r.status[0] == Status.DIVERGED
+    assert 0 < r.steps[0] < _planned_steps(r, 3)[0]
+    assert list(r.status[1:]) == [Status.NOT_RUN, Status.NOT_RUN]
+    assert list(r.steps[1:]) == [0, 0]

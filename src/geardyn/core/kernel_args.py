@@ -64,7 +64,8 @@ class LaneOutputs(NamedTuple):
     [L, n_samples, ns] (NaN where diverged), final state [L, ns], status [L], extremes of the
     events [L, n_ev], located crossings while sampling [L, n_ev], extremes and RMS of the
     observables [L, n_obs], steps that reached the split limit [L], transient used in grid
-    steps [L], convergence flag [L] (1 settled, 0 limit reached, -1 test off)."""
+    steps [L], convergence flag [L] (1 settled, 0 limit reached, -1 test off), grid steps
+    integrated [L] (zeros in, added to by the kernel)."""
 
     samples: np.ndarray
     final: np.ndarray
@@ -78,3 +79,4 @@ class LaneOutputs(NamedTuple):
     unresolved: np.ndarray
     transient_steps: np.ndarray
     converged: np.ndarray
+    steps: np.ndarray

@@ -21,6 +21,7 @@ class Status(IntEnum):
     OK = 0
     DIVERGED = 1
     SPLIT_LIMIT = 2
+    NOT_RUN = 3
 
     @property
     def message(self) -> str:
@@ -32,6 +33,7 @@ _MESSAGES = {
     Status.OK: "ok",
     Status.DIVERGED: "diverged (|state| > bound or not finite)",
     Status.SPLIT_LIMIT: "split limit reached (steps integrated unsplit across an edge)",
+    Status.NOT_RUN: "not run (a continuation chain's lane after one that did not end well)",
 }
 
 

@@ -505,9 +505,11 @@ def _advance(nl, STEP, PHASE, NPER):
 
 @nb.njit(inline="always", **_JIT)
 def _write_out(k, lane, n_ev, n_obs, n_tr, GMIN, GMAX, OMAX, OMIN, OSQ, n_stat, status,
-               transient_steps, gmin, gmax, omax, omin, orms):
-    """The statistics of the lane that has ended in slot k, to its outputs."""
+               transient_steps, gmin, gmax, omax, omin, orms, STEP, steps):
+    """The statistics of the lane that has ended in slot k, to its outputs; its grid steps
+    added to ``steps[lane]`` (a count of the work done: a lane run twice would show)."""
     transient_steps[lane] = n_tr[k]
+    steps[lane] += STEP[k]
     for j in range(n_ev):
         gmin[lane, j] = GMIN[j, k]
         gmax[lane, j] = GMAX[j, k]
@@ -531,7 +533,7 @@ def _sweep_worker(w, lanes, cfg, sched, out):
     conv_tol, conv_depth, n_samples, locate, bound, n_ev, n_obs, width = cfg
     start, queue, lane_nper, lane_tab, S_TAB, C_TAB, chain = sched
     (samples, final, status, gmin, gmax, ncross, omax, omin, orms, unresolved, transient_steps,
-     converged) = out
+     converged, steps) = out
     q0 = start[w]
     q1 = start[w + 1]
     nl = min(width, q1 - q0)
@@ -650,15 +652,20 @@ def _chained(k, lanes, cfg, sched, out, slots):
     (``sched.chain``: a sweep by continuation, each point starting where the one before
     ended), its start state and time set to that lane's final state and end time (the time
     as :meth:`~geardyn.core.plan.LanePlan.final_time` computes it); -1 when there is no
-    chain, the slot held no lane yet, the chain ends there, or that lane did not end well (the
-    caller restarts the rest of the chain). Out of line: called once per lane, and kept out of
-    the block loop's function, whose size decides whether LLVM vectorises its step loop."""
+    chain, the slot has held no lane in this pass (STEP[k] == 0: a lane takes at least one
+    step; the fused loop's passes reset it), the chain ends there, or that lane did not end
+    well (the caller restarts the rest of the chain). A slot without a lane must never read as
+    one: LANE[k] is then stale (0, or a lane whose chain has run), and continuing from it
+    would run a chain's tail a second time, in another worker too (a race on its outputs:
+    until 2026-12-02 the fused loop's passes did that, see bench/determinism.py). Out of line:
+    called once per lane, and kept out of the block loop's function, whose size decides
+    whether LLVM vectorises its step loop."""
     chain = sched[6]
     if chain.size == 0:
         return -1
     LANE = slots[4]
     STEP = slots[5]
-    if STEP[k] == 0:  # never held a lane (a lane always takes at least one step)
+    if STEP[k] == 0:  # holds no lane (see above)
         return -1
     prev = LANE[k]
     succ = chain[prev]
@@ -688,7 +695,7 @@ def _load_slot(k, lane, lanes, cfg, sched, out, blk, slots, GP):
     conv_tol, conv_depth, n_samples, locate, bound, n_ev, n_obs, width = cfg
     start, queue, lane_nper, lane_tab, S_TAB, C_TAB, chain = sched
     (samples, final, status, gmin, gmax, ncross, omax, omin, orms, unresolved, transient_steps,
-     converged) = out
+     converged, steps) = out
     (R, D, Y, Y1, K1, K2, K3, K4, TMP, PT, SC, PH6, PH, TT, _, GS, G1, GR, SIDE, FLAG,
      GMIN, GMAX, O, OMAX, OMIN, OSQ, HW3, FL, HW) = blk
     (STAT, MSK, ACT, END, LANE, STEP, PHASE, NPER, OFF, HB, T0B, n_end, n_tr, next_sample, DUE,
@@ -743,7 +750,7 @@ def _block_run_soa(q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch):
     conv_tol, conv_depth, n_samples, locate, bound, n_ev, n_obs, width = cfg
     start, queue, lane_nper, lane_tab, S_TAB, C_TAB, chain = sched
     (samples, final, status, gmin, gmax, ncross, omax, omin, orms, unresolved, transient_steps,
-     converged) = out
+     converged, steps) = out
     (R, D, Y, Y1, K1, K2, K3, K4, TMP, PT, SC, PH6, PH, TT, GP, GS, G1, GR, SIDE, FLAG,
      GMIN, GMAX, O, OMAX, OMIN, OSQ, HW3, FL, HW) = blk
     (STAT, MSK, ACT, END, LANE, STEP, PHASE, NPER, OFF, HB, T0B, n_end, n_tr, next_sample, DUE,
@@ -855,7 +862,7 @@ def _slot_check(k, Y, R, D, ys, LANE, STEP, PHASE, n_end, n_tr, next_sample, DUE
     n_transient_max, sample_every = lanes[6], lanes[7]
     conv_tol, n_samples, bound, n_ev, n_obs = cfg[0], cfg[2], cfg[4], cfg[5], cfg[6]
     (samples, final, status, gmin, gmax, ncross, omax, omin, orms, unresolved, transient_steps,
-     converged) = out
+     converged, steps) = out
     ns = Y.shape[0]
     lane = LANE[k]
     step = STEP[k]
@@ -869,7 +876,7 @@ def _slot_check(k, Y, R, D, ys, LANE, STEP, PHASE, n_end, n_tr, next_sample, DUE
         for q in range(ns):
             final[lane, q] = np.nan
         _write_out(k, lane, n_ev, n_obs, n_tr, GMIN, GMAX, OMAX, OMIN, OSQ, n_stat, status,
-                   transient_steps, gmin, gmax, omax, omin, orms)
+                   transient_steps, gmin, gmax, omax, omin, orms, STEP, steps)
         return True, -1 if step > n_tr[k] else 0
     d_samp = 0
     if step == n_tr[k]:
@@ -888,7 +895,7 @@ def _slot_sample(k, Y, LANE, STEP, n_end, n_tr, next_sample, DUE, ACT, END, GMIN
     sample_every = lanes[7]
     n_ev, n_obs = cfg[5], cfg[6]
     (samples, final, status, gmin, gmax, ncross, omax, omin, orms, unresolved, transient_steps,
-     converged) = out
+     converged, steps) = out
     ns = Y.shape[0]
     lane = LANE[k]
     step = STEP[k]
@@ -905,7 +912,7 @@ def _slot_sample(k, Y, LANE, STEP, n_end, n_tr, next_sample, DUE, ACT, END, GMIN
     for q in range(ns):
         final[lane, q] = Y[q, k]
     _write_out(k, lane, n_ev, n_obs, n_tr, GMIN, GMAX, OMAX, OMIN, OSQ, n_stat, status,
-               transient_steps, gmin, gmax, omax, omin, orms)
+               transient_steps, gmin, gmax, omax, omin, orms, STEP, steps)
     return True
 
 
@@ -1072,7 +1079,7 @@ def _slot_out(k, G1, SE, CE, lanes, cfg, out, blk, slots, scratch):
     P, Y0, H, OMEGA, T0, n_transient, n_transient_max, sample_every = lanes
     locate = cfg[3]
     (samples, final, status, gmin, gmax, ncross, omax, omin, orms, unresolved, transient_steps,
-     converged) = out
+     converged, steps) = out
     (R, D, Y, Y1, K1, K2, K3, K4, TMP, PT, SC, PH6, PH, TT, GP, GS, _, GR, SIDE, FLAG,
      GMIN, GMAX, O, OMAX, OMIN, OSQ, HW3, FL, HW) = blk
     (STAT, MSK, ACT, END, LANE, STEP, PHASE, NPER, OFF, HB, T0B, n_end, n_tr, next_sample, DUE,
@@ -1126,6 +1133,9 @@ def _fused_run(form, q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch):
     nv = _padded(nl)  # the fused loop's slots: nl and idle ones (never filled, never active)
     for k in range(nl):  # every slot is free (an earlier pass, of another form, has ended)
         END[k] = True
+        # and continues no chain (_chained): an earlier pass ran its chains to their ends, and
+        # the fused loop advances a free slot's clock too (STEP > 0 would read as a lane held)
+        STEP[k] = 0
     ended = True
     while True:
         if ended:  # (re)fill the ended slots from the queue: a lane starts at its grid step 0
@@ -1146,19 +1156,19 @@ def _fused_run(form, q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch):
         if n_act == 0:
             break
         if nxt >= q1 and _padded(n_act) < nv:  # the queue is out: no slot empties for a lane
-            _compact(nv, blk, slots)  # of it, so the block's running lanes move down
+            _compact(nv, n_act, blk, slots)  # of it, so the block's running lanes move down
             nv = _padded(n_act)
         n_flag, n_out = _fused_steps(form, nv, locate, cfg[4], Yf, Y1f, PT, SE, CE, H6, FLAG,
                                      (GSf, GPf, GRf, SIDEf), stats, slots, S_TAB, C_TAB, phx)
         if n_out > 0:
-            gone = _slots_out(nl, GS, SE, CE, lanes, cfg, out, blk, slots, scratch)
+            gone = _slots_out(min(nl, nv), GS, SE, CE, lanes, cfg, out, blk, slots, scratch)
             if gone > 0:
                 ended = True
                 n_act -= gone
 
 
 @nb.njit(_nrt=False, **_JIT)
-def _compact(nv, blk, slots):
+def _compact(nv, n_act, blk, slots):
     """Move the running lanes of slots n_act.. (n_act: the number of running lanes) of the
     fused loop's nv slots into the free slots below n_act, so that the loop can run over
     _padded(n_act) slots: once a worker's queue is out, its block's last lanes (the longest, or
@@ -1166,9 +1176,6 @@ def _compact(nv, blk, slots):
     to the end. A lane's arithmetic does not depend on its slot: its results stay bitwise the
     same. Out of line: called at most once per vector of slots freed."""
     ACT = slots[2]
-    n_act = 0
-    for k in range(nv):
-        n_act += 1 if ACT[k] else 0
     dst = 0
     for src in range(n_act, nv):
         if not ACT[src]:
@@ -1209,8 +1216,7 @@ def _move_slot(src, dst, blk, slots):
     HB[dst] = HB[src]
     T0B[dst] = T0B[src]
     ACT[src] = False
-    END[src] = False
-    STEP[src] = 0  # holds no lane: the next pass does not continue its chain (_chained)
+    END[src] = False  # not refilled in this pass (a next pass starts every slot afresh)
     MSK[src] = False
     STAT[src] = False
     FLAG[src] = 0.0
@@ -1286,8 +1292,11 @@ def sweep(lanes, cfg, work_queues, out):
     Outputs: samples[L, n_samples, ns] (NaN where diverged), final[L, ns], status[L],
     gmin/gmax[L, n_ev] (extremes of the events at grid points), ncross[L, n_ev] (edge crossings
     while sampling), omax/omin/orms[L, n_obs] (extremes and RMS of the observables at grid
-    points), unresolved[L] (steps that reached the split limit). A lane that diverges stops
-    there (no further steps, crossings or statistics).
+    points), unresolved[L] (steps that reached the split limit), transient_steps[L],
+    converged[L] (above), steps[L] (grid steps integrated, added to: each lane is run once, so
+    it equals the lane's transient plus sampled steps, or where it diverged; 0 for a chain's
+    lanes not run). A lane that diverges stops there (no further steps, crossings or
+    statistics).
     """
     n_workers = work_queues.start.size - 1  # (not named ``sched``: numba's parfor uses it)
     for w in nb.prange(n_workers):

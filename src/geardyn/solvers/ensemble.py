@@ -24,6 +24,7 @@ from geardyn.core.plan import (  # noqa: F401  (the step rule's old home)
     lane_steps_per_period,
 )
 from geardyn.core.settings import RunSettings
+from geardyn.core.status import Status
 from geardyn.models.base import Model
 from geardyn.solvers.kernels import kernels_for
 
@@ -48,6 +49,7 @@ class LaneResults:
     converged: np.ndarray  # (L,) transient by convergence: 1 settled, 0 hit the limit, -1 off
     sample_every: np.ndarray  # (L,) forcing periods between samples (the section's period)
     commensurate: np.ndarray  # (L,) False: a second excitation at an irrational frequency ratio
+    steps: np.ndarray  # (L,) grid steps integrated (transient + sampled; fewer where diverged)
 
     def take(self, index: slice | np.ndarray) -> LaneResults:
         """The lanes ``index`` (a slice or an index array) of every field."""
@@ -100,8 +102,9 @@ def run_lanes(
     ``chain`` (one int per lane, -1: none) makes sweeps by continuation: lane ``chain[l]``
     starts where lane l ended (its final state, at its end time; its own ``y0`` row and
     ``t0`` are ignored), in the same slot, if lane l ended well (status ok); after a lane that
-    did not, the rest of its chain is not run (their results are left as allocated; the
-    caller restarts them)."""
+    did not, the rest of its chain is not run (status ``Status.NOT_RUN``, ``steps`` 0, the
+    other results as allocated; the caller restarts them). ``steps`` counts the grid steps
+    each lane was integrated: its transient plus its sampled stretch (fewer if it diverged)."""
     per_lane = {"transient": transient, "transient_max": transient_max,
                 "steps_per_period": steps_per_period}
     scalars = {k: v for k, v in per_lane.items() if v is not None and np.ndim(v) == 0}
@@ -148,7 +151,7 @@ def run_plan(model: Model, P: np.ndarray, y0: np.ndarray, plan: LanePlan,
         samples=np.full((L, samples, ns), np.nan),
         final=np.full((L, ns), np.nan),
         final_time=np.zeros(L),
-        status=np.zeros(L, np.int64),
+        status=np.full(L, int(Status.NOT_RUN), np.int64),  # each lane sets its own when it runs
         event_min=np.zeros((L, n_ev)),
         event_max=np.zeros((L, n_ev)),
         crossings=np.zeros((L, n_ev), np.int64),
@@ -161,6 +164,7 @@ def run_plan(model: Model, P: np.ndarray, y0: np.ndarray, plan: LanePlan,
         converged=np.full(L, -1, np.int64),
         sample_every=plan.sample_every.copy(),
         commensurate=plan.commensurate.copy(),
+        steps=np.zeros(L, np.int64),
     )
     tr_steps = np.zeros(L, np.int64)
     s_tab, c_tab, lane_tab = _phase_tables(k, n_lane)
@@ -190,7 +194,7 @@ def run_plan(model: Model, P: np.ndarray, y0: np.ndarray, plan: LanePlan,
     sched = Schedule(start, queue, n_lane, lane_tab, s_tab, c_tab, chain)
     res = LaneOutputs(out.samples, out.final, out.status, out.event_min, out.event_max,
                       out.crossings, out.obs_max, out.obs_min, out.obs_rms, out.unresolved,
-                      tr_steps, out.converged)
+                      tr_steps, out.converged, out.steps)
     k.sweep(lanes, cfg, sched, res)
     out.transient_periods = tr_steps // n_lane
     out.final_time = plan.final_time(out.transient_periods, T0)
