@@ -116,11 +116,11 @@ def test_chains_mixing_forms_run_in_the_general_form_and_equal_lane_by_lane_runs
             np.testing.assert_array_equal(r.final[lane], alone.final[0])
             start, t0, lane = alone.final[0], alone.final_time[:1], chain[lane]
     # each lane ran once: its grid steps are its transient and its samples, no more
-    np.testing.assert_array_equal(
-        r.steps, r.steps_per_period * (r.transient_periods + 3 * r.sample_every))
+    np.testing.assert_array_equal(r.steps, _planned_steps(r, 3))
 
 
 def _planned_steps(r, samples):
+    """A lane's transient plus ``samples`` sections, in grid steps."""
     return r.steps_per_period * (r.transient_periods + samples * r.sample_every)
 
 
@@ -144,7 +144,7 @@ def test_a_later_form_pass_runs_no_chain_again(workers):
     plan = LanePlan.build(quiet, P, run, sample_every=1)
     r = run_plan(quiet, P, quiet.initial_state(), plan, chain=chain, workers=workers)
     assert np.all(r.status == 0)
-    np.testing.assert_array_equal(r.steps, _planned_steps(r, 3))
+    np.testing.assert_array_equal(r.steps, plan.steps_per_period * plan.total_periods)
     lone = run_plan(quiet, P[4:], quiet.initial_state(), LanePlan.build(quiet, P[4:], run,
                                                                          sample_every=1))
     np.testing.assert_array_equal(r.samples[4:], lone.samples)
