@@ -138,7 +138,7 @@ def main() -> None:
 
     print(f"# geardyn {geardyn.__version__}, numba {numba.__version__}, "
           f"{numba.config.NUMBA_NUM_THREADS} threads, {platform.processor() or platform.machine()}"
-          f", {os.cpu_count()} cpus")
+          f", {os.cpu_count()} cpus; SIMD {geardyn._jit_target.APPLIED.split(':')[0]}")
     wall, times, ds = time_geardyn(model, values, args.repeat)
     steps = lane_steps(ds)
     threads = numba.config.NUMBA_NUM_THREADS

@@ -316,7 +316,8 @@ def main() -> None:
                  np.linspace(0.2, 3.0, args.lanes), 400, 100, 128),
     ]
     print(f"# geardyn {geardyn.__version__}, numba {numba.__version__}, "
-          f"{numba.get_num_threads()} threads; old kernel: {args.old}; median of {args.repeat}")
+          f"{numba.get_num_threads()} threads; old kernel: {args.old}; median of {args.repeat}; "
+          f"SIMD {geardyn._jit_target.APPLIED.split(':')[0]}")
     print("| workload | kernel | wall [s] | ns/lane-step/thread | same, no edge location "
           "| crossings/lane-step | ns/located crossing |")
     print("|---|---|---|---|---|---|---|")

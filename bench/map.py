@@ -132,12 +132,16 @@ def main() -> None:
     thr = {name: r for name, _, r, _ in rows}
     efficiency = thr["dask 2w x 1t"] / (2 * thr["dask 1w x 1t"])
     load = os.getloadavg()
+    import geardyn
+
+    simd = geardyn._jit_target.APPLIED.split(":")[0]
     lines = [
         f"Workload: paper device, Omega [0.5, 3.5] x xi [0.02, 0.2], {args.nx} x {args.ny} = "
         f"{args.nx * args.ny} points, transient tau = {TRANSIENT:g}, {SAMPLES} samples, default "
         f"steps per period, {args.chunk} points per task; {steps:.3e} lane-steps per map.",
         f"Machine: {platform.machine()}, {cores} cores, numba {numba.__version__}, Python "
-        f"{sys.version.split()[0]}; 1-min load average at the end {load[0]:.2f} (shared).",
+        f"{sys.version.split()[0]}, SIMD {simd}; 1-min load average at the end {load[0]:.2f} "
+        "(shared).",
         f"Command: `.venv/bin/python bench/map.py --nx {args.nx} --ny {args.ny} --chunk "
         f"{args.chunk} --repeat {args.repeat} --write` (median of {args.repeat} warm runs).",
         "",

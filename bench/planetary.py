@@ -68,7 +68,8 @@ def main() -> None:
     n = plan.steps_per_period.astype(np.int64)
     steps = int(np.sum(plan.transient_steps + run.samples * plan.sample_steps))
     print(f"# geardyn {geardyn.__version__}, numba {numba.__version__}, {args.threads} threads, "
-          f"{platform.machine()}, {os.cpu_count()} cpus, load {os.getloadavg()[0]:.1f}")
+          f"{platform.machine()}, {os.cpu_count()} cpus, load {os.getloadavg()[0]:.1f}, "
+          f"SIMD {geardyn._jit_target.APPLIED.split(':')[0]}")
     print(f"workload: planetary_example ({model!r}), {omegas.size} Omega in "
           f"[{omegas.min():g}, {omegas.max():g}], transient {run.transient:.1f} "
           f"({run.transient * omegas.min() / (2 * math.pi):g} periods at Omega "

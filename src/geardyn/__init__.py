@@ -8,7 +8,7 @@ The public API::
     ds = geardyn.simulate(m, omega=1.1, transient=4000.0, periods=64)
 """
 
-from geardyn import gears, testing
+from geardyn import _jit_target, gears, testing  # noqa: F401  (_jit_target first: its docstring)
 from geardyn._version import __version__ as __version__
 from geardyn.analysis.basins import basins
 from geardyn.analysis.bifurcation import ContinuedSweep, bifurcation, continued_sweeps

@@ -1,0 +1,169 @@
+"""The sweep kernel's fused step loop alone (``_fused_steps``), in ns per slot-step, with parts
+of it taken out: what each part costs, and what is vectorised.
+
+One block of 64 slots of the paper's device (xi = 0.05; 64 Omega of [0.1, 4], 19 step counts,
+each slot its own phase table), every slot active and sampling, the loop called ``--steps``
+times by a driver compiled like the kernel's (``noalias`` arrays, no reference counting), one
+thread; the variants' calls alternate, median of ``--repeat``. Nothing out of line runs: a
+flagged slot keeps its state (the loop's cost does not depend on the values), so the numbers
+are a floor for the loop, not a model of a sweep. A variant is the generated kernel's source
+with lines replaced (checked, so a template change that moves them fails loudly):
+
+``base``: the loop as it is; ``nostats``: without the observables and statistics;
+``noscreen``: without the side test and graze screen (nothing flagged); ``nobook``: without the
+health check and due test; ``shared``: every slot reads the first phase table (one stream);
+``noprefetch``: without the prefetches; ``+``-joined names combine them.
+
+    .venv/bin/python bench/fused_loop.py [--variants base,nostats,noscreen] [--steps 20000]
+                                         [--repeat 9] [--asm]
+
+The vector width is numba's CPU target (``GEARDYN_SIMD_WIDTH``, see ``geardyn._jit_target``).
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib.util
+import re
+import statistics
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numba as nb
+import numpy as np
+
+import geardyn
+from geardyn.core.plan import lane_steps_per_period
+from geardyn.solvers.kernels import kernels_for
+
+#: variant part -> (line of the generated kernel, its replacement)
+EDITS = {
+    "nostats": [("        o = _observe_l(te, y1, PT, k, se, ce, form)\n", ""),
+                ("        _t_stats(GMIN, GMAX, OMAX, OMIN, OSQ, k, g1, o, stat)\n", "")],
+    "noscreen": [("        hit = _t_screen(g1, GS, GP, SIDE, GR, k, locate)\n",
+                  "        hit = False\n")],
+    "nobook": [("        due = act & (((ph1 == 0) & (not _t_healthy(y1, bound))) | "
+                "(st1 >= DUE[k]))\n", "        due = False\n")],
+    "shared": [("j1 = np.uint64(OFF[k] + 2 * PHASE[k] + 1)", "j1 = np.uint64(2 * PHASE[k] + 1)"),
+               ("j2 = np.uint64(OFF[k] + 2 * PHASE[k] + 2)", "j2 = np.uint64(2 * PHASE[k] + 2)")],
+    "noprefetch": [("        prefetch(S_TAB, j2 + np.uint64(PREFETCH_AHEAD))  # every slot walks "
+                    "its own tables\n        prefetch(C_TAB, j2 + np.uint64(PREFETCH_AHEAD))\n",
+                    "")],
+}
+BLOCK = 64
+
+
+def variant_module(source: str, name: str, folder: Path):
+    """The kernel module with the edits of variant ``name``, imported from ``folder``."""
+    text = source.replace("_CACHE = True", "_CACHE = False")  # nothing cached from a temp dir
+    for part in name.split("+"):
+        if part == "base":
+            continue
+        for old, new in EDITS[part]:
+            if old not in text:
+                raise SystemExit(f"variant {part}: the line {old.strip()!r} is not in the kernel")
+            text = text.replace(old, new)
+    mod_name = "fused_" + re.sub(r"\W", "_", name)
+    path = folder / f"{mod_name}.py"
+    path.write_text(text)
+    spec = importlib.util.spec_from_file_location(mod_name, path)
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[mod_name] = module
+    spec.loader.exec_module(module)
+    return module
+
+
+def block_arrays(m, model, omegas):
+    """The arguments of ``_fused_steps`` for one block of len(omegas) active slots."""
+    P = np.ascontiguousarray(model.lane_params("Omega", omegas))
+    nper = lane_steps_per_period(model, P)
+    nw, ns, n_g, n_o = BLOCK, len(model.state_names), len(model.event_names), \
+        len(model.observable_names)
+    offsets, s_parts, c_parts, pos = {}, [], [], 0
+    for n in np.unique(nper):
+        s, c = m.phase_table(int(n), True)
+        offsets[int(n)] = pos
+        s_parts.append(s)
+        c_parts.append(c)
+        pos += s.size
+    Y = np.repeat(np.asarray(model.initial_state(), float)[:, None], nw, axis=1)
+    HB = 2 * np.pi / omegas / nper
+    i64 = np.int64
+    far = 1 << 60
+    slots = (np.zeros(nw, np.bool_), np.zeros(nw, np.bool_), np.ones(nw, np.bool_),
+             np.zeros(nw, np.bool_), np.arange(nw, dtype=i64), np.zeros(nw, i64),
+             np.zeros(nw, i64), nper.astype(i64), np.array([offsets[int(n)] for n in nper], i64),
+             HB, np.zeros(nw), np.full(nw, far, i64), np.zeros(nw, i64), np.full(nw, far, i64),
+             np.full(nw, far, i64), np.zeros(nw, i64), np.zeros(nw, i64))
+    G = (np.zeros(n_g * nw), np.full(n_g * nw, np.nan), np.zeros(n_g * nw), np.ones(n_g * nw))
+    ST = (np.full(n_g * nw, np.inf), np.full(n_g * nw, -np.inf), np.full(n_o * nw, -np.inf),
+          np.full(n_o * nw, np.inf), np.zeros(n_o * nw))
+    PH = tuple(np.zeros(nw) for _ in range(4))
+    return (Y.reshape(-1), np.zeros(ns * nw), np.ascontiguousarray(P.T), np.zeros(nw),
+            np.ones(nw), HB / 6.0, np.zeros(nw), G, ST, slots, np.concatenate(s_parts),
+            np.concatenate(c_parts), PH)
+
+
+def driver(m):
+    """A compiled caller of module m's fused loop in its quiet lane form."""
+    form = m.FORM_QUIET
+    steps = m._fused_steps
+
+    def drive(n, nv, locate, bound, Yf, Y1f, PT, SE, CE, H6, FLAG, G, ST, slots, S_TAB, C_TAB,
+              PH):
+        flagged = 0
+        for _ in range(n):
+            nf, _no = steps(form, nv, locate, bound, Yf, Y1f, PT, SE, CE, H6, FLAG, G, ST,
+                            slots, S_TAB, C_TAB, PH)
+            flagged += nf
+        return flagged
+
+    return nb.njit(_nrt=False, pipeline_class=m._NoAliasCompiler, boundscheck=False,
+                   error_model="numpy")(drive)
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--variants", default="base,nostats,noscreen,nobook,shared")
+    ap.add_argument("--steps", type=int, default=20000)
+    ap.add_argument("--repeat", type=int, default=9)
+    ap.add_argument("--asm", action="store_true", help="count zmm / ymm instructions")
+    args = ap.parse_args()
+    model = geardyn.CATTDevice(geardyn.PlanetaryParams.paper(xi1=0.05, xi2=0.05))
+    source = Path(kernels_for(model.kernel).__file__).read_text()
+    omegas = np.linspace(0.1, 4.0, 1000)[::15][:BLOCK]
+    names = args.variants.split(",")
+    print(f"# geardyn {geardyn.__version__}, numba {nb.__version__}, SIMD "
+          f"{geardyn._jit_target.APPLIED.split(':')[0]}; one block of {BLOCK} slots, "
+          f"{args.steps} loop calls, median of {args.repeat}")
+    runs = {}
+    with tempfile.TemporaryDirectory() as tmp:
+        for name in names:
+            m = variant_module(source, name, Path(tmp))
+            d = driver(m)
+            d(2, BLOCK, True, 1e6, *block_arrays(m, model, omegas))
+            runs[name] = (d, m)
+        times = {n: [] for n in names}
+        for _ in range(args.repeat):
+            for name in names:
+                d, m = runs[name]
+                a = block_arrays(m, model, omegas)
+                t0 = time.perf_counter()
+                d(args.steps, BLOCK, True, 1e6, *a)
+                times[name].append((time.perf_counter() - t0) * 1e9 / (args.steps * BLOCK))
+    base = statistics.median(times[names[0]])
+    for name in names:
+        med = statistics.median(times[name])
+        line = f"{name:32s} {med:7.2f} ns/slot-step ({med / base:.2f}x {names[0]})"
+        if args.asm:
+            d, _ = runs[name]
+            asm = d.inspect_asm(d.signatures[0]).splitlines()
+            line += (f"; zmm {sum('zmm' in s for s in asm)}, ymm {sum('ymm' in s for s in asm)}"
+                     " instructions")
+        print(line)
+
+
+if __name__ == "__main__":
+    main()
