@@ -36,6 +36,7 @@ import numpy as np
 
 import geardyn
 from geardyn.core.plan import lane_steps_per_period
+from geardyn.solvers.ensemble import _phase_tables
 from geardyn.solvers.kernels import kernels_for
 
 #: variant part -> (line of the generated kernel, its replacement)
@@ -81,20 +82,14 @@ def block_arrays(m, model, omegas):
     nper = lane_steps_per_period(model, P)
     nw, ns, n_g, n_o = BLOCK, len(model.state_names), len(model.event_names), \
         len(model.observable_names)
-    offsets, s_parts, c_parts, pos = {}, [], [], 0
-    for n in np.unique(nper):
-        s, c = m.phase_table(int(n), True)
-        offsets[int(n)] = pos
-        s_parts.append(s)
-        c_parts.append(c)
-        pos += s.size
+    s_tab, c_tab, lane_tab = _phase_tables(m, nper)
     Y = np.repeat(np.asarray(model.initial_state(), float)[:, None], nw, axis=1)
     HB = 2 * np.pi / omegas / nper
     i64 = np.int64
     far = 1 << 60
     slots = (np.zeros(nw, np.bool_), np.zeros(nw, np.bool_), np.ones(nw, np.bool_),
              np.zeros(nw, np.bool_), np.arange(nw, dtype=i64), np.zeros(nw, i64),
-             np.zeros(nw, i64), nper.astype(i64), np.array([offsets[int(n)] for n in nper], i64),
+             np.zeros(nw, i64), nper.astype(i64), lane_tab,
              HB, np.zeros(nw), np.full(nw, far, i64), np.zeros(nw, i64), np.full(nw, far, i64),
              np.full(nw, far, i64), np.zeros(nw, i64), np.zeros(nw, i64))
     G = (np.zeros(n_g * nw), np.full(n_g * nw, np.nan), np.zeros(n_g * nw), np.ones(n_g * nw))
@@ -102,8 +97,7 @@ def block_arrays(m, model, omegas):
           np.full(n_o * nw, np.inf), np.zeros(n_o * nw))
     PH = tuple(np.zeros(nw) for _ in range(4))
     return (Y.reshape(-1), np.zeros(ns * nw), np.ascontiguousarray(P.T), np.zeros(nw),
-            np.ones(nw), HB / 6.0, np.zeros(nw), G, ST, slots, np.concatenate(s_parts),
-            np.concatenate(c_parts), PH)
+            np.ones(nw), HB / 6.0, np.zeros(nw), G, ST, slots, s_tab, c_tab, PH)
 
 
 def driver(m):

@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import os
 import warnings
+from collections.abc import Mapping
 
 #: The environment variable that chooses the vector width.
 ENV = "GEARDYN_SIMD_WIDTH"
@@ -39,7 +40,7 @@ MODES: dict[str, str | None] = {"512": "-prefer-256-bit", "256": "+prefer-256-bi
 DEFAULT = "512"
 
 
-def mode_from_env(environ: dict[str, str] | os._Environ) -> str:
+def mode_from_env(environ: Mapping[str, str]) -> str:
     """The vector-width mode ``environ`` asks for (``ENV``, default ``DEFAULT``); a clear
     error naming the variable for any other value."""
     value = environ.get(ENV, DEFAULT).strip().lower() or DEFAULT
