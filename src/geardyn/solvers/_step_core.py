@@ -79,9 +79,8 @@ _INLINE = {"inline": "always", "error_model": "numpy", "boundscheck": False}
 _rhs_i = nb.njit(**_INLINE)(rhs.py_func)
 _events_i = nb.njit(**_INLINE)(events.py_func)
 # The split path (a step with a located crossing: :func:`_split_step`, :func:`_rk4_stages` and
-# the root finders) calls the model's own functions instead: inlined, they were copied into it
-# four and more times each, which cost a third of a kernel's compile time for ~1 % of its
-# steps (a call costs a few ns against ~400 ns for a located crossing).
+# the root finders) inlines them too; a model with lane-scalar functions takes those there
+# instead, the state in registers (see :func:`_split_rhs` and the FUSED block below).
 
 
 @nb.njit(**_JIT)
@@ -124,14 +123,19 @@ def _rk4(t, y, h, p, s0, c0, s1, c1, s2, c2, k1, k2, k3, k4, tmp, out, have_k1):
 
 
 @nb.njit(inline="always", **_JIT)
-def _hermite(y0, f0, y1, f1, dt, theta, out):
-    """Cubic Hermite interpolant of a step of length dt at fraction theta."""
+def _hermite_weights(dt, theta):
+    """The cubic Hermite basis of a step of length dt at fraction theta: the weights of y0, f0,
+    y1, f1."""
     t2 = theta * theta
     t3 = t2 * theta
-    h00 = 2.0 * t3 - 3.0 * t2 + 1.0
-    h10 = (t3 - 2.0 * t2 + theta) * dt
-    h01 = -2.0 * t3 + 3.0 * t2
-    h11 = (t3 - t2) * dt
+    return (2.0 * t3 - 3.0 * t2 + 1.0, (t3 - 2.0 * t2 + theta) * dt, -2.0 * t3 + 3.0 * t2,
+            (t3 - t2) * dt)
+
+
+@nb.njit(inline="always", **_JIT)
+def _hermite(y0, f0, y1, f1, dt, theta, out):
+    """Cubic Hermite interpolant of a step of length dt at fraction theta."""
+    h00, h10, h01, h11 = _hermite_weights(dt, theta)
     for q in range(y0.size):
         out[q] = h00 * y0[q] + h10 * f0[q] + h01 * y1[q] + h11 * f1[q]
 
@@ -495,6 +499,20 @@ def _rk4_stages(t, y, h, p, s1, c1, s2, c2, k1, kst, acc, tmp, out):
         out[q] = y[q] + h6 * acc[q]
 
 
+@nb.njit(inline="always", **_JIT)
+def _split_rhs(t, y, out, p, s, c):
+    """The model's rhs f(t, y) into out, on the split path (for a model with lane-scalar
+    functions: the lane form, see below)."""
+    _rhs_i(t, y, out, p, s, c)
+
+
+@nb.njit(inline="always", **_JIT)
+def _split_copy(dst, src):
+    """dst[:] = src, on the split path (see :func:`_split_rhs`)."""
+    for q in range(src.size):
+        dst[q] = src[q]
+
+
 @nb.njit(_nrt=False, **_JIT)  # it allocates nothing: no reference counting of its views
 def _split_step(i, t0, y, y_trial, p, h, omega, n_per, side, g1, ncross, work, ybuf, gbuf):
     """Finish grid step i of one lane with edge crossings located; y holds the start, and
@@ -535,7 +553,7 @@ def _split_step(i, t0, y, y_trial, p, h, omega, n_per, side, g1, ncross, work, y
     for _ in range(MAX_SPLITS):
         t = t0 + (i + u) * h
         dt = (1.0 - u) * h
-        _rhs_i(t, y, k1, p, s0, c0)
+        _split_rhs(t, y, k1, p, s0, c0)
         graze = False
         need = False
         for j in range(n_ev):
@@ -550,12 +568,10 @@ def _split_step(i, t0, y, y_trial, p, h, omega, n_per, side, g1, ncross, work, y
             for j in range(n_ev):
                 need = need or _side(g1[j]) != side[j]
         if not need:
-            for q in range(ns):
-                y[q] = y_trial[q]
+            _split_copy(y, y_trial)
             return 0
-        _rhs_i(t_end, y_trial, f1, p, s_end, c_end)
-        for q in range(ns):
-            ystart[q] = y[q]
+        _split_rhs(t_end, y_trial, f1, p, s_end, c_end)
+        _split_copy(ystart, y)
         _interpolant_events(ystart, k1, y_trial, f1, dt, t, p, ybuf, g0, g13, g23)
         first = -1
         theta = 2.0
@@ -571,8 +587,7 @@ def _split_step(i, t0, y, y_trial, p, h, omega, n_per, side, g1, ncross, work, y
                 theta = th
                 first = j
         if first < 0:
-            for q in range(ns):
-                y[q] = y_trial[q]
+            _split_copy(y, y_trial)
             return 0
         tm = u + 0.5 * theta * (1.0 - u)
         tu = u + theta * (1.0 - u)
@@ -725,6 +740,18 @@ def _t_healthy(y, bound):
     """:func:`_healthy_lane` of the state tuple y, branch-free."""
 
 
+def _t_get(y):
+    """(y[0], .., y[LANE_NS - 1]) of a state vector."""
+
+
+def _t_put(y, v):
+    """y[q] = v[q] for the state vector y."""
+
+
+def _t_hermite(y0, f0, y1, f1, h00, h10, h01, h11):
+    """The cubic Hermite combination h00 y0 + h10 f0 + h01 y1 + h11 f1, elementwise."""
+
+
 @nb.njit(**_JIT)
 def _pick(cond, a, b):
     """a if cond else b, a select (a call, inlined by LLVM: numba's inliner would leave the
@@ -805,6 +832,21 @@ def _ov_t_healthy(y, bound):
     return _tuple_source("y, bound", [f"return {terms}"])
 
 
+def _ov_t_get(y):
+    n = globals()["LANE_NS"]
+    return _tuple_source("y", ["return (" + "".join(f"y[{q}], " for q in range(n)) + ")"])
+
+
+def _ov_t_put(y, v):
+    return _tuple_source("y, v", [f"y[{q}] = v[{q}]" for q in range(len(v))] or ["pass"])
+
+
+def _ov_t_hermite(y0, f0, y1, f1, h00, h10, h01, h11):
+    terms = "".join(f"h00 * y0[{q}] + h10 * f0[{q}] + h01 * y1[{q}] + h11 * f1[{q}], "
+                    for q in range(len(y0)))
+    return _tuple_source("y0, f0, y1, f1, h00, h10, h01, h11", [f"return ({terms})"])
+
+
 def _ov_t_side(GS, SIDE, k, g):
     lines = ["pass"]
     for j in range(len(g)):
@@ -824,8 +866,39 @@ if "rhs_lane" in globals():  # the model's lane-scalar functions (see .kernels)
     for _stub, _impl in ((_t_load, _ov_t_load), (_t_store, _ov_t_store), (_t_axpy, _ov_t_axpy),
                          (_t_comb, _ov_t_comb), (_t_screen, _ov_t_screen),
                          (_t_stats, _ov_t_stats), (_t_side, _ov_t_side),
-                         (_t_healthy, _ov_t_healthy)):
+                         (_t_healthy, _ov_t_healthy), (_t_get, _ov_t_get), (_t_put, _ov_t_put),
+                         (_t_hermite, _ov_t_hermite)):
         nb.extending.overload(_stub, inline="always")(_impl)
+
+    # The split path in the lane form: the state and the stages in registers, read and written
+    # element by element. With the array loops LLVM loaded a freshly stored state or stage as
+    # one vector, which no store can forward to (a stall of ~15 cycles each, ~1/5 of a split,
+    # see bench/perf_map.py); the same arithmetic (bitwise equal).
+    @nb.njit(inline="always", **_JIT)
+    def _split_rhs(t, y, out, p, s, c):  # noqa: F811 - the lane form of the generic one
+        v = _rhs_l(t, _t_get(y), p[None, :].T, 0, s, c, FORM_GENERAL)
+        _t_put(out, v)
+
+    @nb.njit(inline="always", **_JIT)
+    def _split_copy(dst, src):  # noqa: F811
+        _t_put(dst, _t_get(src))
+
+    @nb.njit(inline="always", **_JIT)
+    def _rk4_stages(t, y, h, p, s1, c1, s2, c2, k1, kst, acc, tmp, out):  # noqa: F811
+        pt = p[None, :].T  # PT[j, 0] = p[j]: the lane functions' coefficient layout, a view
+        yt = _t_get(y)
+        k1t = _t_get(k1)
+        hh = 0.5 * h
+        k2 = _rhs_l(t + hh, _t_axpy(yt, hh, k1t), pt, 0, s1, c1, FORM_GENERAL)
+        k3 = _rhs_l(t + hh, _t_axpy(yt, hh, k2), pt, 0, s1, c1, FORM_GENERAL)
+        k4 = _rhs_l(t + h, _t_axpy(yt, h, k3), pt, 0, s2, c2, FORM_GENERAL)
+        _t_put(out, _t_comb(yt, h / 6.0, k1t, k2, k3, k4))
+
+    @nb.njit(inline="always", **_JIT)
+    def _hermite(y0, f0, y1, f1, dt, theta, out):  # noqa: F811
+        h00, h10, h01, h11 = _hermite_weights(dt, theta)
+        _t_put(out, _t_hermite(_t_get(y0), _t_get(f0), _t_get(y1), _t_get(f1), h00, h10, h01,
+                               h11))
 else:
     FUSED = False
     LANE_NS = 0
