@@ -12,7 +12,12 @@ with lines replaced (checked, so a template change that moves them fails loudly)
 ``base``: the loop as it is; ``nostats``: without the observables and statistics;
 ``noscreen``: without the side test and graze screen (nothing flagged); ``nobook``: without the
 health check and due test; ``shared``: every slot reads the first phase table (one stream);
-``noprefetch``: without the prefetches; ``+``-joined names combine them.
+``noprefetch``: without the prefetches; ``contract``: compiled with ``fastmath={"contract"}``
+(fused multiply-adds where LLVM sees them; results change at the rounding level, and across
+code paths differently, so not geardyn's setting); ``nochain``: the RK4 stages made
+independent of each other (wrong results, the same operations: is the loop latency-bound?);
+``+``-joined names combine them. ``--gear-pair``: bench/peers.py's gear pair instead of the
+paper's device.
 
     .venv/bin/python bench/fused_loop.py [--variants base,nostats,noscreen] [--steps 20000]
                                          [--repeat 9] [--asm]
@@ -49,6 +54,12 @@ EDITS = {
                 "(st1 >= DUE[k]))\n", "        due = False\n")],
     "shared": [("j1 = np.uint64(OFF[k] + 2 * PHASE[k] + 1)", "j1 = np.uint64(2 * PHASE[k] + 1)"),
                ("j2 = np.uint64(OFF[k] + 2 * PHASE[k] + 2)", "j2 = np.uint64(2 * PHASE[k] + 2)")],
+    "contract": [('_JIT = {"cache": _CACHE, "error_model": "numpy", "boundscheck": False}',
+                  '_JIT = {"cache": _CACHE, "error_model": "numpy", "boundscheck": False, '
+                  '"fastmath": {"contract"}}')],
+    "nochain": [("_t_axpy(y, hh, k1)", "_t_axpy(y, hh, y)"),
+                ("_t_axpy(y, hh, k2)", "_t_axpy(y, hh, y)"),
+                ("_t_axpy(y, h, k3)", "_t_axpy(y, h, y)")],
     "noprefetch": [("        prefetch(S_TAB, j2 + np.uint64(PREFETCH_AHEAD))  # every slot walks "
                     "its own tables\n        prefetch(C_TAB, j2 + np.uint64(PREFETCH_AHEAD))\n",
                     "")],
@@ -115,7 +126,7 @@ def driver(m):
         return flagged
 
     return nb.njit(_nrt=False, pipeline_class=m._NoAliasCompiler, boundscheck=False,
-                   error_model="numpy")(drive)
+                   error_model="numpy", fastmath=m._JIT.get("fastmath", False))(drive)
 
 
 def main() -> None:
@@ -124,10 +135,16 @@ def main() -> None:
     ap.add_argument("--steps", type=int, default=20000)
     ap.add_argument("--repeat", type=int, default=9)
     ap.add_argument("--asm", action="store_true", help="count zmm / ymm instructions")
+    ap.add_argument("--gear-pair", action="store_true", help="bench/peers.py's gear pair "
+                    "(Omega in [0.2, 3]) instead of the paper's device")
     args = ap.parse_args()
-    model = geardyn.CATTDevice(geardyn.PlanetaryParams.paper(xi1=0.05, xi2=0.05))
+    if args.gear_pair:
+        model = geardyn.GearPair(zeta=0.05, kappa=0.2, Fm=0.1, Fa=0.2)
+    else:
+        model = geardyn.CATTDevice(geardyn.PlanetaryParams.paper(xi1=0.05, xi2=0.05))
     source = Path(kernels_for(model.kernel).__file__).read_text()
-    omegas = np.linspace(0.1, 4.0, 1000)[::15][:BLOCK]
+    omegas = (np.linspace(0.2, 3.0, 400)[::6] if args.gear_pair
+              else np.linspace(0.1, 4.0, 1000)[::15])[:BLOCK]
     names = args.variants.split(",")
     print(f"# geardyn {geardyn.__version__}, numba {nb.__version__}, SIMD "
           f"{geardyn._jit_target.APPLIED.split(':')[0]}; one block of {BLOCK} slots, "

@@ -50,6 +50,11 @@ from pathlib import Path
 import numba as nb
 import numpy as np
 
+# first, before this module defines a numba function: geardyn sets numba's CPU target at its
+# import (geardyn._jit_target: 512-bit vectors by default), and a target set up before that is
+# kept, so geardyn's kernels (and the plain ones here) would be built at another width
+import geardyn  # noqa: E402, I001
+
 OMEGA_RANGE = (0.2, 3.0)
 POINTS = 400
 TRANSIENT = 500.0 * math.pi  # time units; 400 forcing periods at Omega = 1.6
@@ -99,8 +104,6 @@ def workload(points: int = POINTS, transient: float = TRANSIENT,
 
 
 def model():
-    import geardyn
-
     return geardyn.GearPair(**COEFFS)
 
 
@@ -307,8 +310,6 @@ def measure(sweeps: list[Sweep], repeat: int) -> list[Row]:
 
 def geardyn_sweeps(wl: Workload, ref: np.ndarray) -> list[Sweep]:
     """geardyn.bifurcation at 128 steps per period and at its default step (warmed)."""
-    import geardyn
-
     m = model()
     out = []
     for n, label in ((STEPS, f"{STEPS} steps/period"), (None, "default step")):
@@ -586,7 +587,8 @@ def machine() -> str:
     load = os.getloadavg()
     return (f"{os.cpu_count()} cores, {cpu}, {platform.machine()}, Python "
             f"{platform.python_version()}, numpy {np.__version__}, numba {nb.__version__} with "
-            f"{nb.config.NUMBA_NUM_THREADS} threads; 1/5/15-min load average at the end "
+            f"{nb.config.NUMBA_NUM_THREADS} threads, SIMD "
+            f"{geardyn._jit_target.APPLIED.split(':')[0]}; 1/5/15-min load average at the end "
             f"{load[0]:.2f}/{load[1]:.2f}/{load[2]:.2f}")
 
 

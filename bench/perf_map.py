@@ -10,7 +10,8 @@ prints ``perf report``'s top symbols.
     .venv/bin/python bench/perf_map.py [--points 1000] [--threads 1] [--top 25]
                                        [--annotate _split_step]
 
-Workload: bench/bifurcation.py's paper reference workload (``--points`` values of Omega).
+Workload: bench/bifurcation.py's paper reference workload (``--points`` values of Omega), or
+with ``--gear-pair`` bench/peers.py's (the gear pair at 128 steps per period, 400 Omega).
 """
 
 from __future__ import annotations
@@ -161,16 +162,24 @@ def main() -> None:
     ap.add_argument("--threads", type=int, default=1)
     ap.add_argument("--top", type=int, default=25)
     ap.add_argument("--no-edges", action="store_true")
+    ap.add_argument("--gear-pair", action="store_true", help="bench/peers.py's workload")
     ap.add_argument("--annotate", action="append", default=[],
                     help="the hottest instructions of the function whose name contains this")
     args = ap.parse_args()
     _record_cache_loads()
     numba.set_num_threads(args.threads)
-    model = device()
-    values = np.linspace(0.1, 4.0, args.points)
     kw = {"locate_edges": False} if args.no_edges else {}
+    if args.gear_pair:
+        import peers
+
+        model, values = peers.model(), peers.workload().omega
+        kw.update(transient=peers.TRANSIENT, samples=peers.SAMPLES,
+                  steps_per_period=peers.STEPS)
+    else:
+        model, values = device(), np.linspace(0.1, 4.0, args.points)
+        kw.update(transient=TRANSIENT, samples=SAMPLES)
     # a first run loads every kernel the workload uses (the map is written after it)
-    geardyn.bifurcation(model, "Omega", values, transient=TRANSIENT, samples=SAMPLES, **kw)
+    geardyn.bifurcation(model, "Omega", values, **kw)
     rows = write_map(Path(f"/tmp/perf-{os.getpid()}.map"))
     print(f"{len(rows)} functions in /tmp/perf-{os.getpid()}.map")
     data = Path(f"/tmp/perf-{os.getpid()}.data")
@@ -178,7 +187,7 @@ def main() -> None:
                             "-p", str(os.getpid())], stderr=subprocess.DEVNULL)
     time.sleep(0.5)
     t0 = time.perf_counter()
-    geardyn.bifurcation(model, "Omega", values, transient=TRANSIENT, samples=SAMPLES, **kw)
+    geardyn.bifurcation(model, "Omega", values, **kw)
     wall = time.perf_counter() - t0
     rec.send_signal(2)
     rec.wait()

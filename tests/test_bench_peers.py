@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import importlib.util
 import math
+import os
+import subprocess
 import sys
 from pathlib import Path
 
@@ -61,3 +63,15 @@ def test_write_section_replaces_only_peers(peers, tmp_path):
     assert "keep 2" in text
     peers.write_section("## Peers\n\nnewer\n", path)  # replaces again, appends nothing
     assert path.read_text().count("## Peers") == 1 and "newer" in path.read_text()
+
+
+@pytest.mark.parametrize("script", ["peers", "crossing", "fused_loop"])
+def test_bench_scripts_leave_geardyn_its_vector_width(script):
+    # the bench scripts that define numba functions must import geardyn first: numba's CPU
+    # target is set up by the first numba function defined, and geardyn sets it at import
+    # (geardyn._jit_target); imported too late, its kernels run at another vector width
+    code = (f"import sys; sys.path.insert(0, {str(PEERS.parent)!r}); import {script}; "
+            "import geardyn; print(geardyn._jit_target.APPLIED)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=True, env={**os.environ, "GEARDYN_SIMD_WIDTH": "256"})
+    assert out.stdout.strip().startswith("256:"), out.stdout + out.stderr

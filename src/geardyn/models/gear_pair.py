@@ -15,7 +15,7 @@ import math
 import numba as nb
 import numpy as np
 
-from geardyn.core.kernel_source import KernelSource
+from geardyn.core.kernel_source import FORM_GENERAL, FORM_QUIET, KernelSource
 from geardyn.models.base import Model
 
 _JIT = {"cache": True, "error_model": "numpy", "boundscheck": False}
@@ -111,6 +111,68 @@ def gear_pair_observe_lanes(T, Y, O, PT, nl, S, C, SC):
         g = x - b if x > b else (x + b if x < -b else 0.0)
         ck = C[k] * SC[0, k] - S[k] * SC[1, k]
         O[0, k] = (1.0 + PT[KAPPA, k] * ck) * g + 2.0 * PT[ZETA, k] * Y[1, k]
+
+
+# Lane-scalar forms for the sweep kernel's fused step loop (picked up by name, ``<function>_lane``):
+# lane k of a block (coefficients PT[j, k]), the state and the results as tuples, the same
+# arithmetic as the functions above operation for operation (bitwise equal). FORM_QUIET: both
+# phases 0, where cos 0 = 1 and sin 0 = 0 exactly (no libm call: the loop vectorises);
+# FORM_GENERAL: any lane (libm for the phases; scalar). The model has no FORM_LOAD.
+
+#: State size of the lane-scalar forms (the tuples' length).
+gear_pair_rhs_lane_states = 2
+
+
+@nb.njit(**_JIT)
+def gear_pair_rhs_lane_form(PT, k):
+    """The lane form lane k may take: FORM_QUIET where both phases are 0, else FORM_GENERAL."""
+    if (PT[PHI_K, k] == 0.0) & (PT[PHI_E, k] == 0.0):
+        return FORM_QUIET
+    return FORM_GENERAL
+
+
+@nb.njit(inline="always", **_JIT)
+def _gap_lane(x, b):
+    """g(x, b) as the other forms compute it (x - b above b, x + b below -b, 0 between),
+    branch-free: the subtraction of the clamped x is exact, so the values are the same."""
+    return x - min(max(x, -b), b)
+
+
+@nb.njit(inline="always", **_JIT)
+def _phase_lane(PT, k, s, c, form):
+    """(ck, ce) of lane k: the stiffness and error phases' cosines as the other forms compute
+    them (``c cos(phi) - s sin(phi)``; cos 0 = 1 and sin 0 = 0 exactly, in libm too). The
+    general form (the split path's, for every lane) calls libm only where a phase is not 0."""
+    if form == FORM_QUIET or ((PT[PHI_K, k] == 0.0) & (PT[PHI_E, k] == 0.0)):
+        return c * 1.0 - s * 0.0, c * 1.0 - s * 0.0
+    pk = PT[PHI_K, k]
+    pe = PT[PHI_E, k]
+    return c * math.cos(pk) - s * math.sin(pk), c * math.cos(pe) - s * math.sin(pe)
+
+
+@nb.njit(inline="always", **_JIT)
+def gear_pair_rhs_lane(t, y, PT, k, s, c, form):
+    """:func:`gear_pair_rhs` of lane k: dy/dt as a tuple."""
+    x, v = y
+    g = _gap_lane(x, PT[BACKLASH, k])
+    ck, ce = _phase_lane(PT, k, s, c, form)
+    om = PT[OMEGA, k]
+    return (v, PT[FM, k] + PT[FA, k] * om * om * ce - 2.0 * PT[ZETA, k] * v
+            - (1.0 + PT[KAPPA, k] * ck) * g)
+
+
+@nb.njit(inline="always", **_JIT)
+def gear_pair_events_lane(t, y, PT, k):
+    """:func:`gear_pair_events` of lane k, as a tuple."""
+    return (y[0] - PT[BACKLASH, k], y[0] + PT[BACKLASH, k])
+
+
+@nb.njit(inline="always", **_JIT)
+def gear_pair_observe_lane(t, y, PT, k, s, c, form):
+    """:func:`gear_pair_observe` of lane k, as a tuple."""
+    g = _gap_lane(y[0], PT[BACKLASH, k])
+    ck, _ = _phase_lane(PT, k, s, c, form)
+    return ((1.0 + PT[KAPPA, k] * ck) * g + 2.0 * PT[ZETA, k] * y[1],)
 
 
 class GearPair(Model):
