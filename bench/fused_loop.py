@@ -139,12 +139,14 @@ def main() -> None:
                     "(Omega in [0.2, 3]) instead of the paper's device")
     args = ap.parse_args()
     if args.gear_pair:
-        model = geardyn.GearPair(zeta=0.05, kappa=0.2, Fm=0.1, Fa=0.2)
+        import peers
+
+        model, omegas = peers.model(), peers.workload().omega[::6]
     else:
         model = geardyn.CATTDevice(geardyn.PlanetaryParams.paper(xi1=0.05, xi2=0.05))
+        omegas = np.linspace(0.1, 4.0, 1000)[::15]
+    omegas = omegas[:BLOCK]
     source = Path(kernels_for(model.kernel).__file__).read_text()
-    omegas = (np.linspace(0.2, 3.0, 400)[::6] if args.gear_pair
-              else np.linspace(0.1, 4.0, 1000)[::15])[:BLOCK]
     names = args.variants.split(",")
     print(f"# geardyn {geardyn.__version__}, numba {nb.__version__}, SIMD "
           f"{geardyn._jit_target.APPLIED.split(':')[0]}; one block of {BLOCK} slots, "

@@ -17,6 +17,7 @@ import numpy as np
 
 from geardyn.core.kernel_source import FORM_GENERAL, FORM_QUIET, KernelSource
 from geardyn.models.base import Model
+from geardyn.models.catt_kernels import dead_zone
 
 _JIT = {"cache": True, "error_model": "numpy", "boundscheck": False}
 OMEGA, ZETA, KAPPA, FM, FA, PHI_K, PHI_E, BACKLASH = range(8)
@@ -123,19 +124,16 @@ def gear_pair_observe_lanes(T, Y, O, PT, nl, S, C, SC):
 gear_pair_rhs_lane_states = 2
 
 
+@nb.njit(inline="always", **_JIT)
+def _unphased(PT, k):
+    """True where lane k's stiffness and error phases are both 0."""
+    return (PT[PHI_K, k] == 0.0) & (PT[PHI_E, k] == 0.0)
+
+
 @nb.njit(**_JIT)
 def gear_pair_rhs_lane_form(PT, k):
     """The lane form lane k may take: FORM_QUIET where both phases are 0, else FORM_GENERAL."""
-    if (PT[PHI_K, k] == 0.0) & (PT[PHI_E, k] == 0.0):
-        return FORM_QUIET
-    return FORM_GENERAL
-
-
-@nb.njit(inline="always", **_JIT)
-def _gap_lane(x, b):
-    """g(x, b) as the other forms compute it (x - b above b, x + b below -b, 0 between),
-    branch-free: the subtraction of the clamped x is exact, so the values are the same."""
-    return x - min(max(x, -b), b)
+    return FORM_QUIET if _unphased(PT, k) else FORM_GENERAL
 
 
 @nb.njit(inline="always", **_JIT)
@@ -143,7 +141,7 @@ def _phase_lane(PT, k, s, c, form):
     """(ck, ce) of lane k: the stiffness and error phases' cosines as the other forms compute
     them (``c cos(phi) - s sin(phi)``; cos 0 = 1 and sin 0 = 0 exactly, in libm too). The
     general form (the split path's, for every lane) calls libm only where a phase is not 0."""
-    if form == FORM_QUIET or ((PT[PHI_K, k] == 0.0) & (PT[PHI_E, k] == 0.0)):
+    if form == FORM_QUIET or _unphased(PT, k):
         return c * 1.0 - s * 0.0, c * 1.0 - s * 0.0
     pk = PT[PHI_K, k]
     pe = PT[PHI_E, k]
@@ -154,7 +152,7 @@ def _phase_lane(PT, k, s, c, form):
 def gear_pair_rhs_lane(t, y, PT, k, s, c, form):
     """:func:`gear_pair_rhs` of lane k: dy/dt as a tuple."""
     x, v = y
-    g = _gap_lane(x, PT[BACKLASH, k])
+    g = dead_zone(x, PT[BACKLASH, k])  # the other forms' g, branch-free: the same values
     ck, ce = _phase_lane(PT, k, s, c, form)
     om = PT[OMEGA, k]
     return (v, PT[FM, k] + PT[FA, k] * om * om * ce - 2.0 * PT[ZETA, k] * v
@@ -170,7 +168,7 @@ def gear_pair_events_lane(t, y, PT, k):
 @nb.njit(inline="always", **_JIT)
 def gear_pair_observe_lane(t, y, PT, k, s, c, form):
     """:func:`gear_pair_observe` of lane k, as a tuple."""
-    g = _gap_lane(y[0], PT[BACKLASH, k])
+    g = dead_zone(y[0], PT[BACKLASH, k])
     ck, _ = _phase_lane(PT, k, s, c, form)
     return ((1.0 + PT[KAPPA, k] * ck) * g + 2.0 * PT[ZETA, k] * y[1],)
 
