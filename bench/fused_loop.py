@@ -2,7 +2,7 @@
 of it taken out: what each part costs, and what is vectorised.
 
 One block of 64 slots of the paper's device (xi = 0.05; 64 Omega of [0.1, 4], 19 step counts,
-each slot its own phase table), every slot active and sampling, the loop called ``--steps``
+each slot its own phase increments), every slot active and sampling, the loop called ``--steps``
 times by a driver compiled like the kernel's (``noalias`` arrays, no reference counting), one
 thread; the variants' calls alternate, median of ``--repeat``. Nothing out of line runs: a
 flagged slot keeps its state (the loop's cost does not depend on the values), so the numbers
@@ -11,13 +11,11 @@ with lines replaced (checked, so a template change that moves them fails loudly)
 
 ``base``: the loop as it is; ``nostats``: without the observables and statistics;
 ``noscreen``: without the side test and graze screen (nothing flagged); ``nobook``: without the
-health check and due test; ``shared``: every slot reads the first phase table (one stream);
-``noprefetch``: without the prefetches; ``contract``: compiled with ``fastmath={"contract"}``
-(fused multiply-adds where LLVM sees them; results change at the rounding level, and across
-code paths differently, so not geardyn's setting); ``nochain``: the RK4 stages made
-independent of each other (wrong results, the same operations: is the loop latency-bound?);
-``+``-joined names combine them. ``--gear-pair``: bench/peers.py's gear pair instead of the
-paper's device.
+health check and due test; ``contract``: compiled with ``fastmath={"contract"}`` (fused
+multiply-adds where LLVM sees them; results change at the rounding level, and across code
+paths differently, so not geardyn's setting); ``nochain``: the RK4 stages made independent of
+each other (wrong results, the same operations: is the loop latency-bound?); ``+``-joined
+names combine them. ``--gear-pair``: bench/peers.py's gear pair instead of the paper's device.
 
     .venv/bin/python bench/fused_loop.py [--variants base,nostats,noscreen] [--steps 20000]
                                          [--repeat 9] [--asm]
@@ -52,17 +50,12 @@ EDITS = {
                   "        hit = False\n")],
     "nobook": [("        due = act & (((ph1 == 0) & (not _t_healthy(y1, bound))) | "
                 "(st1 >= DUE[k]))\n", "        due = False\n")],
-    "shared": [("j1 = np.uint64(OFF[k] + 2 * PHASE[k] + 1)", "j1 = np.uint64(2 * PHASE[k] + 1)"),
-               ("j2 = np.uint64(OFF[k] + 2 * PHASE[k] + 2)", "j2 = np.uint64(2 * PHASE[k] + 2)")],
     "contract": [('_JIT = {"cache": _CACHE, "error_model": "numpy", "boundscheck": False}',
                   '_JIT = {"cache": _CACHE, "error_model": "numpy", "boundscheck": False, '
                   '"fastmath": {"contract"}}')],
     "nochain": [("_t_axpy(y, hh, k1)", "_t_axpy(y, hh, y)"),
                 ("_t_axpy(y, hh, k2)", "_t_axpy(y, hh, y)"),
                 ("_t_axpy(y, h, k3)", "_t_axpy(y, h, y)")],
-    "noprefetch": [("        prefetch(S_TAB, j2 + np.uint64(PREFETCH_AHEAD))  # every slot walks "
-                    "its own tables\n        prefetch(C_TAB, j2 + np.uint64(PREFETCH_AHEAD))\n",
-                    "")],
 }
 BLOCK = 64
 
@@ -93,7 +86,8 @@ def block_arrays(m, model, omegas):
     nper = lane_steps_per_period(model, P)
     nw, ns, n_g, n_o = BLOCK, len(model.state_names), len(model.event_names), \
         len(model.observable_names)
-    s_tab, c_tab, lane_tab = _phase_tables(m, nper)
+    _, _, lane_tab = _phase_tables(m, nper)
+    rot = np.array([m.phase_increments(int(n)) for n in nper]).T
     Y = np.repeat(np.asarray(model.initial_state(), float)[:, None], nw, axis=1)
     HB = 2 * np.pi / omegas / nper
     i64 = np.int64
@@ -106,9 +100,10 @@ def block_arrays(m, model, omegas):
     G = (np.zeros(n_g * nw), np.full(n_g * nw, np.nan), np.zeros(n_g * nw), np.ones(n_g * nw))
     ST = (np.full(n_g * nw, np.inf), np.full(n_g * nw, -np.inf), np.full(n_o * nw, -np.inf),
           np.full(n_o * nw, np.inf), np.zeros(n_o * nw))
+    ROT = tuple(np.ascontiguousarray(r) for r in rot)
     PH = tuple(np.zeros(nw) for _ in range(4))
     return (Y.reshape(-1), np.zeros(ns * nw), np.ascontiguousarray(P.T), np.zeros(nw),
-            np.ones(nw), HB / 6.0, np.zeros(nw), G, ST, slots, s_tab, c_tab, PH)
+            np.ones(nw), HB / 6.0, np.zeros(nw), G, ST, slots, ROT, PH)
 
 
 def driver(m):
@@ -116,12 +111,11 @@ def driver(m):
     form = m.FORM_QUIET
     steps = m._fused_steps
 
-    def drive(n, nv, locate, bound, Yf, Y1f, PT, SE, CE, H6, FLAG, G, ST, slots, S_TAB, C_TAB,
-              PH):
+    def drive(n, nv, locate, bound, Yf, Y1f, PT, SE, CE, H6, FLAG, G, ST, slots, ROT, PH):
         flagged = 0
         for _ in range(n):
             nf, _no = steps(form, nv, locate, bound, Yf, Y1f, PT, SE, CE, H6, FLAG, G, ST,
-                            slots, S_TAB, C_TAB, PH)
+                            slots, ROT, PH)
             flagged += nf
         return flagged
 
@@ -131,7 +125,7 @@ def driver(m):
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--variants", default="base,nostats,noscreen,nobook,shared")
+    ap.add_argument("--variants", default="base,nostats,noscreen,nobook")
     ap.add_argument("--steps", type=int, default=20000)
     ap.add_argument("--repeat", type=int, default=9)
     ap.add_argument("--asm", action="store_true", help="count zmm / ymm instructions")

@@ -33,9 +33,6 @@ from __future__ import annotations
 
 import numba as nb
 import numpy as np
-from llvmlite import ir as llvm_ir
-from numba.core import cgutils
-from numba.extending import intrinsic
 
 from geardyn.core.kernel_source import FORM_GENERAL, FORM_LOAD, FORM_QUIET
 from geardyn.solvers._step_core import (  # CORE-IMPORT
@@ -72,6 +69,8 @@ from geardyn.solvers._step_core import (  # CORE-IMPORT
     _t_stats,
     _t_store,
     event_buffer,
+    phase_increments,
+    phase_rotate,
     phase_table,
 )
 from geardyn.solvers._template_model import events, observe, rhs  # MODEL-IMPORT
@@ -557,8 +556,9 @@ def _sweep_worker(w, lanes, cfg, sched, out):
     K4 = np.zeros((ns, nw))
     TMP = np.zeros((ns, nw))
     PT = np.zeros((P.shape[1], nw))
-    SC = np.zeros((8, nw))
-    PH6 = np.zeros((4, nw))  # sin, cos of the forcing phase at a step's middle and end
+    SC = np.zeros((8, nw))  # scratch; in the fused loop rows 4-7: the slot's phase increments
+    # sin, cos of the forcing phase at a step's middle and end
+    PH6 = np.zeros((4, nw))
     PH = (PH6[0], PH6[1], PH6[2], PH6[3])
     TT = np.zeros(nw)
     GP = np.full((n_g, nw), np.nan)  # events at the grid points i - 1, i, i + 1
@@ -942,33 +942,8 @@ def _transient_end(k, lane, Y, ys, R, D, n_ring, n_tr, n_end, next_sample, conv_
         ncross[lane, j] = 0
 
 
-#: How far ahead (in table entries) the fused loop asks for a slot's forcing-phase tables
-#: (:func:`prefetch`): a slot reads two entries of each per grid step, so 16 is eight steps.
-PREFETCH_AHEAD = 16
-
-
-@intrinsic
-def prefetch(typingctx, arr, idx):
-    """A hint to fetch ``arr[idx]`` into the cache (``llvm.prefetch``: x86 ``prefetcht0``).
-    It never faults and does not change a result, so ``idx`` may lie past the array's end.
-    The fused loop's slots walk their own phase tables: with a lane's table per step count
-    (~500 on the paper's Omega grid, ~3.5 MB), one stream per table and slot, more streams
-    than the hardware prefetchers follow (see :func:`_fused_steps`)."""
-    def codegen(context, builder, signature, args):
-        ary = context.make_array(signature.args[0])(context, builder, args[0])
-        i8p = llvm_ir.IntType(8).as_pointer()
-        i32 = llvm_ir.IntType(32)
-        fnty = llvm_ir.FunctionType(llvm_ir.VoidType(), [i8p, i32, i32, i32])
-        fn = cgutils.get_or_insert_function(builder.module, fnty, "llvm.prefetch.p0")
-        ptr = builder.bitcast(builder.gep(ary.data, [args[1]]), i8p)  # not inbounds: no UB
-        builder.call(fn, [ptr, i32(0), i32(3), i32(1)])  # a read, kept in every level, data
-        return context.get_dummy_value()
-    return nb.types.void(arr, idx), codegen
-
-
 @nb.njit(inline="always", **_JIT)
-def _fused_steps(form, nl, locate, bound, Y, Y1, PT, SE, CE, H6, FLAG, G, ST, slots, S_TAB, C_TAB,
-                 PH):
+def _fused_steps(form, nl, locate, bound, Y, Y1, PT, SE, CE, H6, FLAG, G, ST, slots, ROT, PH):
     """One grid step of every slot, fused (see above), on flat views of the block arrays (rows
     of BLOCK slots, see :func:`_flat`): the trial into Y1, committed into Y
     where the slot is active and unflagged; the events' history shifted (GP = g_i, GS =
@@ -979,22 +954,30 @@ def _fused_steps(form, nl, locate, bound, Y, Y1, PT, SE, CE, H6, FLAG, G, ST, sl
     transient's end or the lane's, or a period's start where the state is out of ``bound`` or
     not finite; a healthy period's start is done here). ``form``: a
     constant, the model's lane form (every active lane takes it). G: the events (GS, GP, GR,
-    SIDE), ST: the statistics (GMIN, GMAX, OMAX, OMIN, OSQ), PH: scratch rows for the
-    phases at the step's middle and end. Returns (flagged, marked)."""
+    SIDE), ST: the statistics (GMIN, GMAX, OMAX, OMIN, OSQ). The phases at the step's middle
+    and end (into the scratch rows PH) are SE, CE rotated (:func:`phase_rotate`) by the slot's
+    increments ROT (rows: alpha, beta of half a step, of a whole one:
+    :func:`phase_increments`), the period's end exactly (0, 1): the values of the slot's phase
+    table (:func:`phase_table`), bitwise, in a vector loop of their own (gathered from the
+    tables, scalar loads, they were a quarter of the gear pair's loop). ROT are rows of the
+    block's scratch SC: the same rows as a new member of ``blk`` left the fused loop scalar
+    (3.3x the time; the cause was not found). Returns (flagged, marked)."""
     GS, GP, GR, SIDE = G
     GMIN, GMAX, OMAX, OMIN, OSQ = ST
     (STAT, MSK, ACT, END, LANE, STEP, PHASE, NPER, OFF, HB, T0B, n_end, n_tr, next_sample, DUE,
      n_stat, n_ring) = slots
+    AH, BH, AD, BD = ROT
     SB, CB, SN, CN = PH
-    for k in range(nl):  # the phase gathers (scalar), apart: the fused loop reads rows
-        j1 = np.uint64(OFF[k] + 2 * PHASE[k] + 1)  # unsigned: no wraparound test
-        j2 = np.uint64(OFF[k] + 2 * PHASE[k] + 2)
-        SB[k] = S_TAB[j1]
-        CB[k] = C_TAB[j1]
-        SN[k] = S_TAB[j2]
-        CN[k] = C_TAB[j2]
-        prefetch(S_TAB, j2 + np.uint64(PREFETCH_AHEAD))  # every slot walks its own tables
-        prefetch(C_TAB, j2 + np.uint64(PREFETCH_AHEAD))
+    for k in range(nl):
+        s0 = SE[k]
+        c0 = CE[k]
+        sb, cb = phase_rotate(s0, c0, AH[k], BH[k])
+        se, ce = phase_rotate(s0, c0, AD[k], BD[k])
+        end = PHASE[k] + 1 == NPER[k]  # the period's end, as in the table
+        SB[k] = sb
+        CB[k] = cb
+        SN[k] = 0.0 if end else se
+        CN[k] = 1.0 if end else ce
     n_flag = 0
     n_out = 0
     for k in range(nl):
@@ -1125,6 +1108,7 @@ def _fused_run(form, q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch):
     CE = PH[3]
     H6 = HW[2]  # h / 6 of slot k at [k] (row q = 0 of HW3[2])
     phx = (PH[0], PH[1], SC[0], SC[1])  # sin, cos at the step's middle; at its end (scratch)
+    ROT = (SC[4], SC[5], SC[6], SC[7])  # the slot's phase increments (phase_increments)
     stats = _flat((GMIN, GMAX, OMAX, OMIN, OSQ))
     Yf, Y1f = _flat((Y, Y1, Y, Y, Y))[:2]
     GSf, GPf, GRf, SIDEf, _ = _flat((GS, GP, GR, SIDE, GR))
@@ -1151,6 +1135,7 @@ def _fused_run(form, q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch):
                 _load_slot(k, lane, lanes, cfg, sched, out, blk, slots, GP)
                 SE[k] = S_TAB[OFF[k]]  # the phase at the start
                 CE[k] = C_TAB[OFF[k]]
+                ROT[0][k], ROT[1][k], ROT[2][k], ROT[3][k] = phase_increments(NPER[k])
                 H6[k] = HB[k] / 6.0
                 _t_side(GS, SIDE, k, _events_l(TT[k], _t_load(Y, k), PT, k))
         if n_act == 0:
@@ -1159,7 +1144,7 @@ def _fused_run(form, q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch):
             _compact(nv, n_act, blk, slots)  # of it, so the block's running lanes move down
             nv = _padded(n_act)
         n_flag, n_out = _fused_steps(form, nv, locate, cfg[4], Yf, Y1f, PT, SE, CE, H6, FLAG,
-                                     (GSf, GPf, GRf, SIDEf), stats, slots, S_TAB, C_TAB, phx)
+                                     (GSf, GPf, GRf, SIDEf), stats, slots, ROT, phx)
         if n_out > 0:
             gone = _slots_out(min(nl, nv), GS, SE, CE, lanes, cfg, out, blk, slots, scratch)
             if gone > 0:
@@ -1195,7 +1180,7 @@ def _move_slot(src, dst, blk, slots):
      GMIN, GMAX, O, OMAX, OMIN, OSQ, HW3, FL, HW) = blk
     (STAT, MSK, ACT, END, LANE, STEP, PHASE, NPER, OFF, HB, T0B, n_end, n_tr, next_sample, DUE,
      n_stat, n_ring) = slots
-    for A in (Y, PT, PH6, GP, GS, G1, GR, SIDE, GMIN, GMAX, OMAX, OMIN, OSQ):
+    for A in (Y, PT, PH6, SC, GP, GS, G1, GR, SIDE, GMIN, GMAX, OMAX, OMIN, OSQ):
         for j in range(A.shape[0]):
             A[j, dst] = A[j, src]
     for j in range(HW3.shape[0]):
