@@ -3,10 +3,11 @@
 Workload: the paper's device (Tables 1-2, consistent interpretation), xi1 = xi2 = 0.05,
 1000 values of Omega in [0.1, 4], transient tau >= 2000, 200 sampled periods, default steps per
 period. Reports, in one run: warm wall time of ``geardyn.bifurcation`` (median of ``--repeat``),
-lane-steps and ns per RK4 step per lane, the same work with ``scipy.integrate.solve_ivp`` (RK45,
-rtol 1e-6) measured on a few points and extrapolated by simulated time, the ratio, and the
-agreement of the Poincare points with the reference integrator (DOP853, rtol 1e-12, restarted at
-every edge crossing).
+lane-steps and ns per RK4 step per lane, the same without edge location, the located crossings
+per lane-step (counted while sampling) and the time edge location adds per crossing, the same
+work with ``scipy.integrate.solve_ivp`` (RK45, rtol 1e-6) measured on a few points and
+extrapolated by simulated time, the ratio, and the agreement of the Poincare points with the
+reference integrator (DOP853, rtol 1e-12, restarted at every edge crossing).
 
     .venv/bin/python bench/bifurcation.py [--repeat 3] [--points 1000] [--no-precision]
 """
@@ -24,6 +25,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 import geardyn
+from geardyn.solvers.ensemble import run_lanes
 from geardyn.solvers.kernels import kernels_for
 from geardyn.solvers.reference import reference_solution
 
@@ -148,6 +150,24 @@ def main() -> None:
     print(f"lane-steps: {steps:.3e}; {wall / steps * 1e9:.1f} ns wall per lane-step, "
           f"{wall * threads / steps * 1e9:.1f} ns per lane-step per thread")
     print(f"periods classified: {np.bincount(np.clip(ds['period'].values + 1, 0, 18))}")
+    t_off = []
+    for _ in range(args.repeat):
+        t = time.perf_counter()
+        geardyn.bifurcation(model, "Omega", values, transient=TRANSIENT, samples=SAMPLES,
+                            locate_edges=False)
+        t_off.append(time.perf_counter() - t)
+    wall_off = statistics.median(t_off)
+    # the located crossings are counted while sampling only: their rate over the sampled
+    # lane-steps, and the time edge location adds per crossing at that rate over every lane-step
+    r = run_lanes(model, model.lane_params("Omega", values), model.initial_state(),
+                  transient=TRANSIENT, samples=SAMPLES)
+    sampled = int(np.sum(r.steps_per_period.astype(np.int64) * r.sample_every * SAMPLES))
+    rate = float(r.crossings.sum()) / sampled
+    extra = (wall - wall_off) * threads / (rate * steps) * 1e9
+    print(f"edge location off: median {wall_off:.2f} s ({wall_off * threads / steps * 1e9:.1f} "
+          f"ns per lane-step per thread); located crossings while sampling: {rate:.4f} per "
+          f"lane-step, so ~{rate * steps:.2e} in the run, {extra:.0f} ns of thread time each "
+          f"(the time edge location adds / those crossings)")
     sim_time = simulated_time(ds)
     per_time = scipy_cost_per_time(model, [0.3, 1.1, 2.5])
     scipy_total = per_time * sim_time

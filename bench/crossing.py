@@ -16,6 +16,7 @@ located crossing moves by round-off, not more).
 from __future__ import annotations
 
 import argparse
+import inspect
 import math
 import statistics
 import sys
@@ -38,9 +39,22 @@ def drivers(mod):
     rhs, events = mod.rhs, mod.events
     rk4, split, keep, leaves = mod._rk4, mod._split_step, mod._keep_start, mod._leaves_side
     phase_table, event_buffer, graze_row = mod.phase_table, mod.event_buffer, mod.GRAZE_ROW
+    # the split takes the step's start and end phase (sin, cos) from the caller since the
+    # session-15 step core; before, it computed them (libm)
+    takes_phase = "sa" in inspect.signature(split.py_func).parameters
+    if takes_phase:
+        @nb.njit(inline="always")
+        def split_call(i, y, y1, p, h, omega, n_per, ph, side, g1, ncross, work, ybuf, gbuf):
+            return split(i, 0.0, y, y1, p, h, omega, n_per, ph[0], ph[1], ph[2], ph[3], side,
+                         g1, ncross, work, ybuf, gbuf)
+    else:
+        @nb.njit(inline="always")
+        def split_call(i, y, y1, p, h, omega, n_per, ph, side, g1, ncross, work, ybuf, gbuf):
+            return split(i, 0.0, y, y1, p, h, omega, n_per, side, g1, ncross, work, ybuf, gbuf)
 
     @nb.njit
-    def record(p, y0, h, omega, n_per, n_skip, n_steps, n_ev, recs_y, recs_g, recs_i):
+    def record(p, y0, h, omega, n_per, n_skip, n_steps, n_ev, recs_y, recs_g, recs_i,
+               recs_ph):
         """Integrate one lane; record the inputs of every split call after n_skip steps."""
         ns = y0.size
         s_tab, c_tab = phase_table(n_per, True)
@@ -57,8 +71,10 @@ def drivers(mod):
         for j in range(n_ev):
             SIDE[0, j] = 1 if G[0, j] > 0.0 else -1
         n = 0
+        ph = np.zeros(4)
         for i in range(n_steps):
             j0 = 2 * (i % n_per)
+            ph[0], ph[1], ph[2], ph[3] = s_tab[j0], c_tab[j0], s_tab[j0 + 2], c_tab[j0 + 2]
             rk4(i * h, y, h, p, s_tab[j0], c_tab[j0], s_tab[j0 + 1], c_tab[j0 + 1],
                 s_tab[j0 + 2], c_tab[j0 + 2], work[0], work[1], work[2], work[3], work[4], y1,
                 False)
@@ -73,15 +89,16 @@ def drivers(mod):
                         recs_g[n, 0, j] = SIDE[0, j]
                         recs_g[n, 1, j] = G[0, j]
                         recs_g[n, 2, j] = gbuf[graze_row, j]
+                    recs_ph[n] = ph
                     n += 1
-                split(i, 0.0, y, y1, p, h, omega, n_per, SIDE[0], G[0], ncross, work, ybuf,
-                      gbuf)
+                split_call(i, y, y1, p, h, omega, n_per, ph, SIDE[0], G[0], ncross, work, ybuf,
+                           gbuf)
             else:
                 y[:] = y1
         return n
 
     @nb.njit
-    def replay(P, H, OM, NPER, lane, recs_i, recs_y, recs_g, n_rep, out):
+    def replay(P, H, OM, NPER, lane, recs_i, recs_y, recs_g, recs_ph, n_rep, out):
         """Call the split on every record n_rep times; returns (crossings, unresolved)."""
         ns = recs_y.shape[2]
         n_ev = recs_g.shape[2]
@@ -104,8 +121,8 @@ def drivers(mod):
                     side[j] = int(recs_g[r, 0, j])
                     g1[j] = recs_g[r, 1, j]
                     gbuf[graze_row, j] = recs_g[r, 2, j]
-                unres += split(recs_i[r], 0.0, y, y1, P[k], H[k], OM[k], NPER[k], side, g1,
-                               ncross, work, ybuf, gbuf)
+                unres += split_call(recs_i[r], y, y1, P[k], H[k], OM[k], NPER[k], recs_ph[r],
+                                    side, g1, ncross, work, ybuf, gbuf)
                 for q in range(ns):
                     out[r, q] = y[q]
         return ncross.sum(), unres
@@ -138,20 +155,22 @@ def collect(model, omegas, periods_skip, periods, n_ev, per_lane, record):
     nper = lane_steps_per_period(model, P)
     H = 2 * np.pi / omegas / nper
     ns = model.initial_state().size
-    ri, ry, rg, lane = [], [], [], []
+    ri, ry, rg, rph, lane = [], [], [], [], []
     for k in range(len(omegas)):
         recs_y = np.zeros((per_lane, 2, ns))
         recs_g = np.zeros((per_lane, 3, n_ev))
         recs_i = np.zeros(per_lane, np.int64)
+        recs_ph = np.zeros((per_lane, 4))
         n = record(P[k], model.initial_state(), H[k], omegas[k], int(nper[k]),
                    periods_skip * int(nper[k]), (periods_skip + periods) * int(nper[k]), n_ev,
-                   recs_y, recs_g, recs_i)
+                   recs_y, recs_g, recs_i, recs_ph)
         ri.append(recs_i[:n])
         ry.append(recs_y[:n])
         rg.append(recs_g[:n])
+        rph.append(recs_ph[:n])
         lane.append(np.full(n, k))
     return (P, H, omegas, nper.astype(np.int64), np.concatenate(lane), np.concatenate(ri),
-            np.concatenate(ry), np.concatenate(rg))
+            np.concatenate(ry), np.concatenate(rg), np.concatenate(rph))
 
 
 def main() -> None:
@@ -186,13 +205,13 @@ def main() -> None:
         res = {}
         y = model.initial_state().astype(float)
         for k in mods:  # compile
-            drv[k][1](*data[:8], 1, outs[k])
+            drv[k][1](*data[:9], 1, outs[k])
             drv[k][2](data[0][0], y.copy(), 10, False)
             drv[k][2](data[0][0], y.copy(), 10, True)
         for _ in range(args.rounds):
             for k in mods:
                 t = time.process_time()
-                res[k] = drv[k][1](*data[:8], n_rep, outs[k])
+                res[k] = drv[k][1](*data[:9], n_rep, outs[k])
                 times[k].append(time.process_time() - t)
             for ev, key in ((False, "rhs"), (True, "events")):
                 t = time.process_time()

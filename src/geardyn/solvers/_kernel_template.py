@@ -150,7 +150,8 @@ def _block_step(i, first, nl, active, Y, Y1, K1, K2, K3, K4, TMP, TT, G, SIDE, P
         crossed = _leaves_side(i, k, G, SIDE, locate, gbuf)
         if crossed and locate:
             UNRES[lane] += _split_step(i, T0[lane], Y[k], Y1[k], P[lane], H[lane], OMEGA[lane],
-                                       n_per, SIDE[k], G[k], NCROSS[lane], work, ybuf, gbuf)
+                                       n_per, sa, ca, se, ce, SIDE[k], G[k], NCROSS[lane], work,
+                                       ybuf, gbuf)
             continue
         if crossed:
             for j in range(n_ev):
@@ -426,7 +427,7 @@ def _lanes_screen(nl, G1, GS, GP, SIDE, GR, FLAG, locate):
 
 @nb.njit(inline="always", **_JIT)
 def _lanes_finish(STEP, nl, NPER, Y, Y1, G1, GR, SIDE, FLAG, ACT, P, LANE, HB, T0B, OMEGA,
-                  locate, NCROSS, UNRES, ys, y1s, sides, g1s, work, ybuf, gbuf):
+                  locate, NCROSS, UNRES, ys, y1s, sides, g1s, work, ybuf, gbuf, TABS, OFF):
     """Commit the trial step of the active slots: the unflagged ones vectorised (a select of
     values loaded unconditionally, so that no branch stops the vectoriser), the flagged ones (a
     side left or a possible graze) one by one (:func:`_finish_flagged`). FLAG[k] is 1 on
@@ -447,16 +448,18 @@ def _lanes_finish(STEP, nl, NPER, Y, Y1, G1, GR, SIDE, FLAG, ACT, P, LANE, HB, T
     for k in range(nl):
         if FLAG[k] != 0.0:
             _finish_flagged(k, STEP[k], NPER, Y, Y1, G1, GR, SIDE, P, LANE, HB, T0B, OMEGA, locate,
-                            NCROSS, UNRES, ys, y1s, sides, g1s, work, ybuf, gbuf)
+                            NCROSS, UNRES, ys, y1s, sides, g1s, work, ybuf, gbuf, TABS, OFF)
 
 
 @nb.njit(_nrt=False, **_JIT)
 def _finish_flagged(k, i, NPER, Y, Y1, G1, GR, SIDE, P, LANE, HB, T0B, OMEGA, locate, NCROSS,
-                    UNRES, ys, y1s, sides, g1s, work, ybuf, gbuf):
+                    UNRES, ys, y1s, sides, g1s, work, ybuf, gbuf, TABS, OFF):
     """Finish slot k's flagged trial step (grid step i) on the scalar path: the crossings located
     (:func:`_split_step`) or, without ``locate``, counted at the step's end. Out of the slot
     loops, so that they stay small: a call from the SoA loop, inlined into :func:`_slot_out`
-    (itself out of the fused loop; a call there passed its ~20 arrays by value)."""
+    (itself out of the fused loop; a call there passed its ~20 arrays by value). TABS: the
+    concatenated phase tables (S_TAB, C_TAB), slot k's at OFF[k]: the step's start and end
+    phase for the split."""
     ns = Y.shape[0]
     n_ev = G1.shape[0]
     lane = LANE[k]
@@ -476,8 +479,11 @@ def _finish_flagged(k, i, NPER, Y, Y1, G1, GR, SIDE, P, LANE, HB, T0B, OMEGA, lo
         sides[j] = 1 if SIDE[j, k] > 0.0 else -1
         g1s[j] = G1[j, k]
         gbuf[GRAZE_ROW, j] = GR[j, k]
-    UNRES[lane] += _split_step(i, T0B[k], ys, y1s, P[lane], HB[k], OMEGA[lane],
-                               NPER[k], sides, g1s, NCROSS[lane], work, ybuf, gbuf)
+    S_TAB, C_TAB = TABS
+    j0 = OFF[k] + 2 * (i % NPER[k])
+    UNRES[lane] += _split_step(i, T0B[k], ys, y1s, P[lane], HB[k], OMEGA[lane], NPER[k],
+                               S_TAB[j0], C_TAB[j0], S_TAB[j0 + 2], C_TAB[j0 + 2], sides, g1s,
+                               NCROSS[lane], work, ybuf, gbuf)
     for q in range(ns):
         Y[q, k] = ys[q]
     for j in range(n_ev):
@@ -799,7 +805,8 @@ def _block_run_soa(q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch):
             _events_lanes(TT, Y1, G1, PT, P, LANE, nl, ybuf, gb)
             _lanes_screen(nl, G1, GS, GP, SIDE, GR, FLAG, locate)
         _lanes_finish(STEP, nl, NPER, Y, Y1, G1, GR, SIDE, FLAG, ACT, P, LANE, HB, T0B, OMEGA,
-                      locate, ncross, unresolved, ys, y1s, sides, g1s, work, ybuf, gbuf)
+                      locate, ncross, unresolved, ys, y1s, sides, g1s, work, ybuf, gbuf,
+                      (S_TAB, C_TAB), OFF)
         GP, GS, G1 = GS, G1, GP  # history of the grid values: g_{i}, g_{i+1}
         _advance(nl, STEP, PHASE, NPER)
         due = False
@@ -1031,7 +1038,7 @@ _slot_sample_i = nb.njit(inline="always", **_JIT)(_slot_sample.py_func)
 
 
 @nb.njit(_nrt=False, **_JIT)
-def _slots_out(nl, G1, SE, CE, lanes, cfg, out, blk, slots, scratch):
+def _slots_out(nl, G1, SE, CE, TABS, lanes, cfg, out, blk, slots, scratch):
     """:func:`_slot_out` for every marked slot (MSK), in one call per block step (a call
     passes every block array by value: one per slot cost a fifth of the run). The marked slots
     are gathered first, in a loop of their own: the loop over the block's slots with the
@@ -1047,13 +1054,13 @@ def _slots_out(nl, G1, SE, CE, lanes, cfg, out, blk, slots, scratch):
             n += 1
     gone = 0
     for m in range(n):
-        if _slot_out(marked[m], G1, SE, CE, lanes, cfg, out, blk, slots, scratch):
+        if _slot_out(marked[m], G1, SE, CE, TABS, lanes, cfg, out, blk, slots, scratch):
             gone += 1
     return gone
 
 
 @nb.njit(inline="always", **_JIT)
-def _slot_out(k, G1, SE, CE, lanes, cfg, out, blk, slots, scratch):
+def _slot_out(k, G1, SE, CE, TABS, lanes, cfg, out, blk, slots, scratch):
     """Slot k's step out of line (marked by :func:`_fused_steps`): a flagged step finished on
     the scalar path (:func:`_finish_flagged`), the bookkeeping of a period's start
     (:func:`_slot_check`), the statistics at the grid point reached, the sample and the end
@@ -1070,7 +1077,8 @@ def _slot_out(k, G1, SE, CE, lanes, cfg, out, blk, slots, scratch):
     ys, y1s, dbuf, sides, g1s, gb, ob, work, ybuf, gbuf, _ = scratch
     if FLAG[k] != 0.0:
         _finish_flagged_i(k, STEP[k] - 1, NPER, Y, Y1, G1, GR, SIDE, P, LANE, HB, T0B, OMEGA,
-                          locate, ncross, unresolved, ys, y1s, sides, g1s, work, ybuf, gbuf)
+                          locate, ncross, unresolved, ys, y1s, sides, g1s, work, ybuf, gbuf,
+                          TABS, OFF)
     step = STEP[k]
     if PHASE[k] == 0 or step >= DUE[k]:
         gone, _ = _slot_check_i(k, Y, R, D, ys, LANE, STEP, PHASE, n_end, n_tr, next_sample, DUE,
@@ -1146,7 +1154,8 @@ def _fused_run(form, q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch):
         n_flag, n_out = _fused_steps(form, nv, locate, cfg[4], Yf, Y1f, PT, SE, CE, H6, FLAG,
                                      (GSf, GPf, GRf, SIDEf), stats, slots, ROT, phx)
         if n_out > 0:
-            gone = _slots_out(min(nl, nv), GS, SE, CE, lanes, cfg, out, blk, slots, scratch)
+            gone = _slots_out(min(nl, nv), GS, SE, CE, (S_TAB, C_TAB), lanes, cfg, out, blk,
+                              slots, scratch)
             if gone > 0:
                 ended = True
                 n_act -= gone

@@ -575,10 +575,11 @@ def _rows_screen(nr, G0, G1, GE, GR, FLAG):
 
 @nb.njit(inline="always", **_JIT)
 def _rows_commit(i, nr, NPR, Y, Y1, G0, G1, GR, FLAG, ACTR, P, LANE, T0R, HR, OMEGA, ys,
-                 y1s, sides, g1s, ncross, W, gbuf, UNRR):
+                 y1s, sides, g1s, ncross, W, gbuf, UNRR, PH):
     """Take the trial step of the active lanes' rows: the unflagged ones vectorised, the flagged
     ones one by one with the crossings located (:func:`_split_step`; a step of row r that
-    reaches the split limit is counted in UNRR[r])."""
+    reaches the split limit is counted in UNRR[r]). PH: the rows' phases of the step
+    (:func:`_fill_phase`), the start's and end's passed to the split."""
     ns = Y.shape[0]
     n_ev = G1.shape[0]
     for q in range(ns):
@@ -600,8 +601,9 @@ def _rows_commit(i, nr, NPR, Y, Y1, G0, G1, GR, FLAG, ACTR, P, LANE, T0R, HR, OM
             sides[j] = _side(G0[j, r])
             g1s[j] = G1[j, r]
             gbuf[GRAZE_ROW, j] = GR[j, r]
-        UNRR[r] += _split_step(i, T0R[r], ys, y1s, P[lane], HR[r], OMEGA[lane], NPR[r], sides,
-                               g1s, ncross, W, W[8], gbuf)
+        UNRR[r] += _split_step(i, T0R[r], ys, y1s, P[lane], HR[r], OMEGA[lane], NPR[r],
+                               PH[0, r], PH[1, r], PH[4, r], PH[5, r], sides, g1s, ncross, W,
+                               W[8], gbuf)
         for q in range(ns):
             Y[q, r] = ys[q]
 
@@ -779,7 +781,7 @@ def _lyap_block(first, nl, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF, n
             _rows_events(TE, TMP, GE, PT, P, LANE, nrp, ybuf, gb)
             _rows_screen(nrp, G0, G1, GE, GR, FLAG)
         _rows_commit(i, nrp, NPR, Y, Y1, G0, G1, GR, FLAG, ACTR, P, LANE, T0R, HR, OMEGA, ys,
-                     y1s, sides, g1s, ncross, W, gbuf, UNRR)
+                     y1s, sides, g1s, ncross, W, gbuf, UNRR, PH)
         _fd_combine(nl, m, ZT, IS, Y, E, ACT)
         for r in range(nrp):  # the next step's phase index: 2 (i + 1 mod n_per) from the start
             IDX[r] = IDX[r] + 2 if IDX[r] + 2 < END[r] else IDX[r] + 2 - 2 * NPR[r]
@@ -953,10 +955,11 @@ if FUSED:
 
 @nb.njit(_nrt=False, **_JIT)
 def _lyap_flagged(i, nl, first, P, Z0, Z1, IS, T0L, HL, OMEGA, NPL, ACT, ROWS, EV, FLAG, EL,
-                  UNRR, scratch):
+                  UNRR, PH, scratch):
     """The flagged lanes of step i out of line: each row whose trial is flagged finished on the
     scalar path (:func:`_split_step`), then the lane's commit and tangent vector from its rows
-    (as :func:`_rows_commit` and :func:`_fd_combine`)."""
+    (as :func:`_rows_commit` and :func:`_fd_combine`). PH: the lanes' phases of the step
+    (start, middle, end), the start's and end's passed to the split."""
     ys, y1s, sides, g1s, ncross, W, gbuf = scratch
     ns = ys.size
     n_ev = g1s.size
@@ -983,7 +986,8 @@ def _lyap_flagged(i, nl, first, P, Z0, Z1, IS, T0L, HL, OMEGA, NPL, ACT, ROWS, E
                 g1s[j] = G1[j * BLOCK + l]
                 gbuf[GRAZE_ROW, j] = GR[j * BLOCK + l]
             UNRR[r * BLOCK + l] += _split_step(i, T0L[l], ys, y1s, P[lane], HL[l], OMEGA[lane],
-                                               NPL[l], sides, g1s, ncross, W, W[8], gbuf)
+                                               NPL[l], PH[0][l], PH[1][l], PH[4][l], PH[5][l],
+                                               sides, g1s, ncross, W, W[8], gbuf)
             for q in range(ns):
                 Y[q * BLOCK + l] = ys[q]
         e = EL[l]
@@ -1020,7 +1024,7 @@ def _lyap_fused_run(form, first, nl, max_total, due, renorm, bound, P, OMEGA, H,
                                    ROWS, EV, FLAG, EL)
         if n_flag > 0:
             _lyap_flagged(i, nl, first, P, Z0, Z1, IS, T0L, HL, OMEGA, NPL, ACT, ROWS, EV, FLAG,
-                          EL, UNRR, scratch[2:])
+                          EL, UNRR, PH, scratch[2:])
         for l in range(nl):  # the next step's phase index: 2 (i + 1 mod n_per) from the start
             IDX[l] = IDX[l] + 2 if IDX[l] + 2 < ENDL[l] else IDX[l] + 2 - 2 * NPL[l]
         step = i + 1

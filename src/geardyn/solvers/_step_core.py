@@ -541,7 +541,8 @@ def _split_copy(dst, src):
 
 
 @nb.njit(_nrt=False, **_JIT)  # it allocates nothing: no reference counting of its views
-def _split_step(i, t0, y, y_trial, p, h, omega, n_per, side, g1, ncross, work, ybuf, gbuf):
+def _split_step(i, t0, y, y_trial, p, h, omega, n_per, sa, ca, s_end, c_end, side, g1, ncross,
+                work, ybuf, gbuf):
     """Finish grid step i of one lane with edge crossings located; y holds the start, and
     y_trial/g1 the unsplit trial step; gbuf has GBUF_ROWS rows, row GRAZE_ROW flagging the
     events that may graze (set by the caller's prefilter: those get :func:`first_crossing`,
@@ -555,7 +556,10 @@ def _split_step(i, t0, y, y_trial, p, h, omega, n_per, side, g1, ncross, work, y
     end's side is tested unless an event may graze. The forcing phase at the fractional points
     comes from that at the grid point by angle addition. The model's rhs and events are inlined
     here and in the helpers (``_rhs_i``, ``_events_i``: no calls, no reference counting; the
-    same arithmetic). work: 7 rows of the state's size."""
+    same arithmetic). sa, ca and s_end, c_end: sin and cos of the forcing phase at the step's
+    start and end, the caller's phase-table values (:func:`phase_table`), so a split sees the
+    phases of the unsplit step, bitwise, and calls no libm for them. work: 7 rows of the
+    state's size."""
     n_ev = g1.size
     ns = y.size
     k1 = work[0]
@@ -572,9 +576,6 @@ def _split_step(i, t0, y, y_trial, p, h, omega, n_per, side, g1, ncross, work, y
     i_mod = i % n_per
     wh = omega * h
     t_end = t0 + (i + 1) * h
-    sa = math.sin(wh * i_mod)
-    ca = math.cos(wh * i_mod)
-    s_end, c_end = _phase_at(sa, ca, wh, i_mod, 1.0)
     s0 = sa
     c0 = ca
     for _ in range(MAX_SPLITS):
@@ -691,7 +692,8 @@ def _rows_step(i, t0, Y, p, h, omega, n_per, s_tab, c_tab, n_ev, K, TMP, Y1, SID
             _events_i(t + h, Y1[r], G1[r], p)
             crossed = _leaves_side_step(r, t, t + h, Y, K[0], G0, G1, SIDE, p, W[8], gbuf)
         if crossed:
-            UNRES[r] += _split_step(i, t0, Y[r], Y1[r], p, h, omega, n_per, SIDE[r], G1[r],
+            UNRES[r] += _split_step(i, t0, Y[r], Y1[r], p, h, omega, n_per, s_tab[j0],
+                                    c_tab[j0], s_tab[j0 + 2], c_tab[j0 + 2], SIDE[r], G1[r],
                                     NCR[r], W, W[8], gbuf)
         else:
             for q in range(ns):
