@@ -131,3 +131,41 @@ def test_bifurcation_lyapunov_separates_periodic_from_chaotic():
     # the motion class decides against each exponent's uncertainty (analysis.motion)
     assert list(ds["motion"].values) == ["period-1", "chaotic"]
     assert np.all(ds["lyapunov_err"].values > 0) and lam[1] > 3 * ds["lyapunov_err"].values[1]
+
+
+def test_classify_period_of_many_lanes_equals_the_rule_lane_by_lane():
+    """classify_period works on batches of lanes at once; against the module's rule written out
+    for one lane at a time (smallest k with max |x[i + k] - x[i]| <= tol max(1, max |x|)), on
+    lanes of periods 1-6, aperiodic, diverged and near-tolerance ones, across batch edges."""
+    from geardyn.analysis import periodicity
+
+    rng = np.random.default_rng(7)
+    n_lanes, n, ns, tol = 300, 24, 3, 1e-5
+    x = np.empty((n_lanes, n, ns))
+    for lane in range(n_lanes):
+        k = int(rng.integers(1, 8))  # 7: no period <= 6 in 24 samples
+        base = rng.normal(size=(k, ns)) * 10.0 ** rng.integers(-2, 3)
+        x[lane] = np.tile(base, (n // k + 1, 1))[:n]
+        x[lane] += rng.normal(size=(n, ns)) * tol * 10.0 ** rng.uniform(-1.5, 0.5)
+    x[5, 3, 1] = np.nan
+    x[17, -1, 0] = np.inf
+
+    def one(xl):
+        if not np.all(np.isfinite(xl)):
+            return -1
+        scale = tol * max(1.0, float(np.max(np.abs(xl))))
+        for k in range(1, 7):
+            if np.max(np.abs(xl[k:] - xl[:-k])) <= scale:
+                return k
+        return 0
+
+    expect = np.array([one(xl) for xl in x])
+    assert {-1, 0, 1, 2, 3, 6} <= set(expect.tolist())
+    old = periodicity._BATCH
+    try:
+        for batch in (7, 4096):
+            periodicity._BATCH = batch
+            np.testing.assert_array_equal(classify_period(x, max_period=6, tol=tol), expect)
+    finally:
+        periodicity._BATCH = old
+

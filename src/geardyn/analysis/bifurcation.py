@@ -105,8 +105,11 @@ def bifurcation(
     progress
         Called as ``progress(done, total)`` (integrations finished, of all) after each chunk.
     chunk
-        Lanes per kernel call (default: about a twentieth of the sweep, at least 64). Lanes are
-        independent, so the result does not depend on it.
+        Lanes per kernel call. Default: the whole sweep in one call where there is no
+        ``progress``, ``client`` or ``store`` (chunks serve those; without them each chunk's
+        tail, where one core waits for the other's last lanes, is only lost time), else about a
+        twentieth of the sweep, at least 64. Lanes are independent, so the result does not
+        depend on it.
     client, store
         Independent starts only: a ``dask.distributed.Client`` runs the chunks on its cluster,
         and a Zarr ``store`` path keeps finished chunks so that a rerun resumes (see

@@ -34,6 +34,9 @@ __all__ = ["APERIODIC", "DEFAULT_MAX_PERIOD", "DEFAULT_TOL", "MAX_COMMON_PERIODS
 
 UNBOUNDED = -1
 APERIODIC = 0
+#: Lanes classified together (bounds the temporaries of a large map: a batch of 64 samples of
+#: 4 states is 8 MB).
+_BATCH = 4096
 
 
 def classify_period(samples: np.ndarray, max_period: int = DEFAULT_MAX_PERIOD,
@@ -47,16 +50,20 @@ def classify_period(samples: np.ndarray, max_period: int = DEFAULT_MAX_PERIOD,
         raise ValueError("period classification needs at least 2 samples per lane")
     k_max = min(max_period, n - 1)
     out = np.full(lanes, APERIODIC, dtype=np.int64)
-    for lane in range(lanes):
-        xl = x[lane]
-        if not np.all(np.isfinite(xl)):
-            out[lane] = UNBOUNDED
-            continue
-        scale = tol * max(1.0, float(np.max(np.abs(xl))))
+    finite = np.all(np.isfinite(x), axis=(1, 2))
+    out[~finite] = UNBOUNDED
+    if not finite.any():
+        return out
+    idx = np.flatnonzero(finite)
+    for a in range(0, idx.size, _BATCH):  # the comparisons of one lane, for a batch of lanes
+        rows = idx[a:a + _BATCH]
+        xb = x[rows]
+        scale = tol * np.maximum(1.0, np.max(np.abs(xb), axis=(1, 2)))
+        period = np.full(rows.size, APERIODIC, dtype=np.int64)
         for k in range(1, k_max + 1):
-            if np.max(np.abs(xl[k:] - xl[:-k])) <= scale:
-                out[lane] = k
-                break
+            repeats = np.max(np.abs(xb[:, k:] - xb[:, :-k]), axis=(1, 2)) <= scale
+            period[(period == APERIODIC) & repeats] = k  # the smallest k that repeats
+        out[rows] = period
     return out
 
 

@@ -43,7 +43,8 @@ __all__ = ["PortableModel", "chunk_bounds", "default_chunk", "inputs_digest", "l
 #: Smallest default chunk (lanes per task): a kernel call runs lanes in lockstep blocks of 8 on
 #: every core, so fewer lanes leave cores idle.
 MIN_CHUNK = 64
-#: Default number of chunks a sweep is cut into (for progress reports and resumability).
+#: Default number of chunks a sweep is cut into where it reports progress, runs on Dask or keeps
+#: a store (:func:`run_chunks`; else it runs in one call).
 DEFAULT_CHUNKS = 20
 
 #: Packages whose source (with the model's modules) determines what a store keeps.
@@ -224,7 +225,10 @@ def run_chunks(
     inputs
         Lane-first arrays, all with the same number of lanes.
     chunk
-        Lanes per task (default :func:`default_chunk`).
+        Lanes per task. Default: every lane in one task where there is no ``client``,
+        ``store`` or ``progress`` (chunks serve those; without them a chunk's tail, where a
+        core waits for another's last lanes, is lost time: the gear pair's 400-lane sweep of
+        bench/peers.py in 7 chunks took 1.13x one call), else :func:`default_chunk`.
     client
         ``None`` (run here) or a ``dask.distributed.Client`` (one task per chunk).
     store
@@ -243,9 +247,14 @@ def run_chunks(
     n_lanes = sizes.pop()
     if n_lanes == 0:
         raise ValueError("no lanes to run")
-    size = int(chunk) if chunk else default_chunk(n_lanes)
-    bounds = chunk_bounds(n_lanes, size)
     lane_store = _open_store(store)
+    if chunk:
+        size = int(chunk)
+    elif client is None and lane_store is None and progress is None:
+        size = n_lanes  # nothing to report, keep or ship between chunks: one call
+    else:
+        size = default_chunk(n_lanes)
+    bounds = chunk_bounds(n_lanes, size)
     results: list[dict[str, np.ndarray] | None] = [None] * len(bounds)
     todo = list(range(len(bounds)))
     if lane_store is not None:
