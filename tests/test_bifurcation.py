@@ -168,4 +168,3 @@ def test_classify_period_of_many_lanes_equals_the_rule_lane_by_lane():
             np.testing.assert_array_equal(classify_period(x, max_period=6, tol=tol), expect)
     finally:
         periodicity._BATCH = old
-

@@ -52,8 +52,6 @@ def classify_period(samples: np.ndarray, max_period: int = DEFAULT_MAX_PERIOD,
     out = np.full(lanes, APERIODIC, dtype=np.int64)
     finite = np.all(np.isfinite(x), axis=(1, 2))
     out[~finite] = UNBOUNDED
-    if not finite.any():
-        return out
     idx = np.flatnonzero(finite)
     for a in range(0, idx.size, _BATCH):  # the comparisons of one lane, for a batch of lanes
         rows = idx[a:a + _BATCH]

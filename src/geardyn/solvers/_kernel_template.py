@@ -966,7 +966,7 @@ def _fused_steps(form, nl, locate, bound, Y, Y1, PT, SE, CE, H6, FLAG, G, ST, sl
     increments ROT (rows: alpha, beta of half a step, of a whole one:
     :func:`phase_increments`), the period's end exactly (0, 1): the values of the slot's phase
     table (:func:`phase_table`), bitwise, in a vector loop of their own (gathered from the
-    tables, scalar loads, they were a quarter of the gear pair's loop). ROT are rows of the
+    tables, scalar loads, they were ~12 % of the gear pair's loop). ROT are rows of the
     block's scratch SC: the same rows as a new member of ``blk`` left the fused loop scalar
     (3.3x the time; the cause was not found). Returns (flagged, marked)."""
     GS, GP, GR, SIDE = G

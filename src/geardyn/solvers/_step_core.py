@@ -91,7 +91,7 @@ def phase_increments(n_per):
     a = math.pi / n_per
     sh = math.sin(0.5 * a)
     sd = math.sin(a)
-    return 2.0 * sh * sh, math.sin(a), 2.0 * sd * sd, math.sin(2.0 * a)
+    return 2.0 * sh * sh, sd, 2.0 * sd * sd, math.sin(2.0 * a)
 
 
 @nb.njit(inline="always", **_JIT)
