@@ -30,13 +30,13 @@ demo: $(STAMP)
 test: $(STAMP)
 	$(BIN)/ruff check src tests examples bench
 	$(BIN)/python tests/warm_kernels.py --jobs 2
-	$(BIN)/python -m pytest -n 2 -q
+	$(BIN)/python -m pytest -n 2 -q --durations=15
 
 # The long studies only (marked @pytest.mark.slow; pyproject's addopts keep them out of
 # `make test`, and this -m replaces that selection): a whole Fig. 3 diagram at the default
 # step against DOP853 orbits, a real `geardyn map` killed with SIGKILL and resumed.
 test-slow: $(STAMP)
-	$(BIN)/python -m pytest -n 2 -q -m slow
+	$(BIN)/python -m pytest -n 2 -q -m slow --timeout=3600
 
 bench: $(STAMP)
 	$(BIN)/python bench/bifurcation.py
