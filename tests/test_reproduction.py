@@ -387,8 +387,8 @@ def test_pipeline_at_tiny_resolution(tmp_path, capsys):
     assert evaluate({"fig5": ds})["C10"].status == expected
 
 
-def test_worker_processes_give_the_serial_result():
-    from geardyn.reproduction import ReproductionSettings, run_cases
+def test_worker_processes_give_the_serial_result(tmp_path):
+    from geardyn.reproduction import ReproductionSettings, run_cases, write_report
 
     settings = ReproductionSettings(num=3, transient=200.0, samples=6)
     cases = [get_case("fig5"), get_case("fig8")]
@@ -401,6 +401,19 @@ def test_worker_processes_give_the_serial_result():
         np.testing.assert_array_equal(ds["motion"].values, other["motion"].values)
         assert ds.attrs["plot_state"] == other.attrs["plot_state"] == get_case(key[0]).plot_state
     assert parallel[("fig8", "consistent")].attrs["shared_with"] == "fig5"
+
+    # the case files written by two worker processes are those written here, byte for byte
+    write_report(serial, tmp_path / "one", jobs=1)
+    write_report(serial, tmp_path / "two", jobs=2)
+    names = sorted(p.name for p in (tmp_path / "one").iterdir())
+    assert names == sorted(p.name for p in (tmp_path / "two").iterdir())
+    pngs = [n for n in names if n.endswith(".png")]
+    assert len(pngs) == 4  # two cases, up and down
+    for name in pngs:
+        assert (tmp_path / "one" / name).read_bytes() == (tmp_path / "two" / name).read_bytes()
+    for name in (n for n in names if n.endswith(".nc")):
+        one, two = (load_dataset(tmp_path / d / name) for d in ("one", "two"))
+        assert one.identical(two)
 
 
 def test_reproduce_refuses_bad_input(capsys):

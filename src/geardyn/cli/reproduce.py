@@ -74,7 +74,8 @@ def reproduce_command(
     samples: Annotated[int | None, typer.Option(
         help="Mesh periods sampled per point (default: the study's).")] = None,
     jobs: Annotated[int | None, typer.Option(
-        help="Worker processes, each continuing its share of the sweeps with one thread "
+        help="Worker processes, each continuing its share of the sweeps with one thread, then "
+        "drawing its share of the figures "
         "(default: one per core; 1: all sweeps together in this process, on every core).")] = None,
     out: Annotated[Path, typer.Option(help="Output folder.")] = Path("out/reproduce"),
     verdicts: Annotated[Path | None, typer.Option(
@@ -135,7 +136,8 @@ def reproduce_command(
         + (f" --verdicts {verdicts}" if verdicts is not None else ""))
     with stderr_console().status("writing figures, data and the report"
                                  + (" (and the basins of attraction)" if basins else "")):
-        paths = write_report(results, out, command=command, figures=figures, basins=basins)
+        paths = write_report(results, out, command=command, figures=figures, basins=basins,
+                             jobs=workers)
     for interp in interps:
         found = evaluate({c: ds for (c, i), ds in results.items() if i == interp})
         counts: dict[str, int] = {}
