@@ -435,3 +435,16 @@ def test_interpretation_table_in_docs_is_generated():
     start, end = text.index(BEGIN), text.index(END) + len(END)
     assert text[start:end] == generated_section(), (
         "docs/model.md is out of date: run python -m geardyn.reproduction.tables")
+
+
+def test_default_steps_at_every_omega_is_the_one_run_rule():
+    from geardyn.reproduction.runner import default_steps_at
+    from geardyn.solvers.simulate import default_steps_per_period
+
+    omegas = np.linspace(0.1, 4.0, 40)
+    for name in ("fig3", "fig13"):  # without and with the load's fluctuation
+        case = get_case(name)
+        assert case.load_noise == (name != "fig3")
+        model = build_model(case.study, interpretation="as-printed")
+        expected = [default_steps_per_period(model, float(w)) for w in omegas]
+        assert list(default_steps_at(model, omegas)) == expected

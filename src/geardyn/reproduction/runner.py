@@ -20,11 +20,10 @@ from geardyn.analysis.bifurcation import ContinuedSweep, continued_sweeps
 from geardyn.analysis.lyapunov import lyapunov_err_attrs, lyapunov_lanes
 from geardyn.analysis.motion import LYAPUNOV_FLOOR, LYAPUNOV_Z, exponent_sign, rule_text
 from geardyn.core.model import Model
-from geardyn.core.plan import lane_section
+from geardyn.core.plan import lane_section, steps_per_period_rule
 from geardyn.core.settings import RunSettings
 from geardyn.reproduction.cases import Case
 from geardyn.reproduction.motion import motion_labels
-from geardyn.solvers.simulate import default_steps_per_period
 from geardyn.study import build_model
 
 __all__ = ["DIRECTIONS", "ReproductionSettings", "branch_lyapunov", "run_case", "run_cases",
@@ -124,6 +123,16 @@ def sweep_values(case: Case, settings: ReproductionSettings) -> np.ndarray:
     return np.linspace(r["start"], r["stop"], int(r["num"]))
 
 
+def default_steps_at(model: Model, omegas: np.ndarray) -> np.ndarray:
+    """Default steps per period (:func:`geardyn.core.plan.default_steps_per_period`) of the
+    model at each of the frequencies ``omegas``, all at once."""
+    omegas = np.asarray(omegas, dtype=float)
+    rule = steps_per_period_rule(model, model.lane_params("Omega", omegas), omegas)
+    if not np.all(np.isfinite(rule)):
+        raise OverflowError("steps per period do not fit an integer; check Omega")
+    return np.ceil(rule).astype(np.int64)
+
+
 def branch_lyapunov(model: Model, values: np.ndarray, y0: np.ndarray, need: np.ndarray,
                     transient: float, duration: float,
                     steps_per_period: int | None = None,
@@ -143,8 +152,8 @@ def branch_lyapunov(model: Model, values: np.ndarray, y0: np.ndarray, need: np.n
     if idx.size == 0:
         return out, err
     idx = idx[np.argsort(values[idx], kind="stable")]
-    steps = np.array([steps_per_period or default_steps_per_period(model, float(values[i]))
-                      for i in idx])
+    steps = (np.full(idx.size, int(steps_per_period)) if steps_per_period
+             else default_steps_at(model, values[idx]))
     groups: list[list[int]] = []
     for j in range(idx.size):
         if not groups or steps[groups[-1][0]] > 1.25 * steps[j] or len(groups[-1]) >= 64:
