@@ -52,11 +52,11 @@ bench-peers: $(STAMP)
 	$(BIN)/python -m pip install --quiet numbalsoda || echo "numbalsoda did not install: its row is skipped"
 	$(BIN)/python bench/peers.py --write
 
-# The paper's whole study at its resolution (about 4 min on 2 cores): out/reproduce/report.html
+# The paper's whole study at its resolution (about 1 min on 2 cores): out/reproduce/report.html
 reproduce: $(STAMP)
 	$(BIN)/geardyn reproduce --all --out out/reproduce
 
-# Every claim under all three interpretations (about 11 min on 2 cores): the report in
+# Every claim under all three interpretations (about 2 min on 2 cores): the report in
 # out/reproduce-all and the verdict table committed as docs/reproduction-verdicts.md
 reproduce-verdicts: $(STAMP)
 	$(BIN)/geardyn reproduce --all --interpretation all --out out/reproduce-all --verdicts docs/reproduction-verdicts.md
