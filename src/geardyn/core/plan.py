@@ -109,6 +109,16 @@ def default_steps_per_period(model: Any, omega: float | None = None,
     return math.ceil(n)  # an OverflowError when it is not finite
 
 
+def default_steps_at(model: Any, omegas: np.ndarray) -> np.ndarray:
+    """:func:`default_steps_per_period` of the model's own coefficients at each of the
+    frequencies ``omegas`` (int64), all at once."""
+    omegas = np.asarray(omegas, dtype=float).ravel()
+    rule = steps_per_period_rule(model, model.lane_params("Omega", omegas), omegas)
+    if not np.all(np.isfinite(rule)):
+        raise OverflowError("steps per period do not fit an integer; check Omega")
+    return np.ceil(rule).astype(np.int64)
+
+
 def lane_steps_per_period(model: Any, P: np.ndarray) -> np.ndarray:
     """Default steps per forcing period of each lane (row of ``P``), rounded up to the ladder:
     the step rule with the lane's own Omega, other forcings and fastest natural frequency (from

@@ -298,7 +298,7 @@ def _unresolved_warning(doc: Document, results: Results) -> None:
 def _write_all_case_files(results: Results, out: Path, jobs: int
                           ) -> dict[tuple[str, str], dict[str, Path]]:
     """:func:`write_case_files` for every result, in ``jobs`` worker processes when > 1 (the
-    figures are most of a report's time: ~0.4 s each, two per case). The files do not depend
+    figures are most of a report's time: ~0.3 s each, two per case). The files do not depend
     on the process that writes them."""
     if jobs <= 1 or len(results) < 2:
         return {key: write_case_files(ds, out) for key, ds in results.items()}

@@ -20,7 +20,7 @@ from geardyn.analysis.bifurcation import ContinuedSweep, continued_sweeps
 from geardyn.analysis.lyapunov import lyapunov_err_attrs, lyapunov_lanes
 from geardyn.analysis.motion import LYAPUNOV_FLOOR, LYAPUNOV_Z, exponent_sign, rule_text
 from geardyn.core.model import Model
-from geardyn.core.plan import lane_section, steps_per_period_rule
+from geardyn.core.plan import default_steps_at, lane_section
 from geardyn.core.settings import RunSettings
 from geardyn.reproduction.cases import Case
 from geardyn.reproduction.motion import motion_labels
@@ -121,16 +121,6 @@ class ReproductionSettings:
 def sweep_values(case: Case, settings: ReproductionSettings) -> np.ndarray:
     r = settings.resolve(case)
     return np.linspace(r["start"], r["stop"], int(r["num"]))
-
-
-def default_steps_at(model: Model, omegas: np.ndarray) -> np.ndarray:
-    """Default steps per period (:func:`geardyn.core.plan.default_steps_per_period`) of the
-    model at each of the frequencies ``omegas``, all at once."""
-    omegas = np.asarray(omegas, dtype=float)
-    rule = steps_per_period_rule(model, model.lane_params("Omega", omegas), omegas)
-    if not np.all(np.isfinite(rule)):
-        raise OverflowError("steps per period do not fit an integer; check Omega")
-    return np.ceil(rule).astype(np.int64)
 
 
 def branch_lyapunov(model: Model, values: np.ndarray, y0: np.ndarray, need: np.ndarray,
