@@ -11,6 +11,7 @@ import geardyn
 from geardyn.analysis.map2d import estimate_map
 from geardyn.analysis.periodicity import classify_period
 from geardyn.plotting.map2d import plot_map
+from geardyn.solvers.ensemble import busy_lanes
 from geardyn.testing import assert_result
 
 
@@ -143,9 +144,31 @@ def test_estimate_counts_the_lane_steps_the_map_takes():
     est = estimate_map(g, lanes=6, omegas=om, transient=100.0, samples=8,
                        ns_per_lane_step=100.0)
     assert est.lane_steps == pytest.approx(taken, rel=1e-12)
-    assert est.seconds == pytest.approx(taken * 100e-9)
+    # 6 lanes leave vector slots idle: they take as long as busy_lanes(6) lanes
+    assert est.busy_share == busy_lanes(6) / 6 > 1.0
+    assert est.seconds == pytest.approx(taken * 100e-9 * est.busy_share)
+    alone = estimate_map(g, lanes=6, omegas=om, transient=100.0, samples=8,
+                         ns_per_lane_step=100.0, blocks=False)
+    assert alone.busy_share == 1.0 and alone.seconds == pytest.approx(taken * 100e-9)
     big = estimate_map(g, lanes=10**9, omegas=om, transient=100.0, samples=8)
     assert big.memory_bytes > 10**9 * 8 * g.params.size
+    assert big.busy_share == pytest.approx(1.0, rel=1e-6)
+
+
+@pytest.mark.parametrize("threads", [1, 2, 3, 64])
+def test_busy_lanes_are_the_slots_the_schedule_fills(threads):
+    """The lanes' worth of time of a run: every thread's share (as the kernels' schedule deals
+    the lanes) in whole vectors of SIMD_SLOTS, times the threads (the speed is measured with
+    SIMD_SLOTS lanes per thread)."""
+    from geardyn.solvers._step_core import SIMD_SLOTS
+    from geardyn.solvers.ensemble import _schedule
+
+    for lanes in (1, 2, 7, 8, 9, 16, 17, 100, 1000):
+        start, _ = _schedule(np.ones(lanes), threads)
+        widest = int(np.max(np.diff(start)))
+        vectors = -(-widest // SIMD_SLOTS)
+        assert busy_lanes(lanes, threads) == threads * vectors * SIMD_SLOTS, lanes
+        assert busy_lanes(lanes, threads) >= lanes
 
 
 # ------------------------------------------------------------------ command line

@@ -39,7 +39,7 @@ from geardyn.core.plan import (
 from geardyn.core.settings import RunSettings, resolve_run
 from geardyn.core.status import Status
 from geardyn.execution.executor import default_chunk, run_chunks
-from geardyn.solvers.ensemble import run_lanes
+from geardyn.solvers.ensemble import busy_lanes, run_lanes
 
 __all__ = ["MapEstimate", "check_steps", "estimate_map", "map2d", "measure_ns_per_lane_step"]
 
@@ -227,13 +227,16 @@ class MapEstimate:
     lanes: int
     lane_steps: float  # RK4 steps over all lanes (Lyapunov steps weighted by LYAPUNOV_COST)
     memory_bytes: float  # peak memory of this process
-    seconds: float  # wall time at ``ns_per_lane_step``
+    seconds: float  # wall time at ``ns_per_lane_step``, times ``busy_share``
     ns_per_lane_step: float
+    busy_share: float = 1.0  # > 1: too few lanes to fill every thread's vectors (busy_lanes)
 
     def describe(self) -> str:
+        idle = (f", x{self.busy_share:.3g} for vector slots left idle"
+                if self.busy_share > 1.0 else "")
         return (f"{self.lanes} points, {self.lane_steps:.3g} lane-steps, about "
                 f"{_bytes_text(self.memory_bytes)} of memory and {_time_text(self.seconds)} "
-                f"(at {self.ns_per_lane_step:.3g} ns per lane-step)")
+                f"(at {self.ns_per_lane_step:.3g} ns per lane-step{idle})")
 
 
 def _bytes_text(n: float) -> str:
@@ -285,7 +288,8 @@ def check_steps(model: Model, omegas: np.ndarray, transient: float, samples: int
 def estimate_map(model: Model, lanes: int, omegas: Sequence[float] | np.ndarray,
                  transient: float, samples: int, steps_per_period: int | None = None,
                  lyapunov: bool = False, chunk: int | None = None,
-                 ns_per_lane_step: float = 300.0, parallel: float = 1.0) -> MapEstimate:
+                 ns_per_lane_step: float = 300.0, parallel: float = 1.0,
+                 blocks: bool = True) -> MapEstimate:
     """Cost of a map of ``lanes`` points, from a few representative forcing frequencies
     ``omegas`` (the Omega axis subsampled, or the model's one Omega) — nothing of the size of the
     grid is allocated.
@@ -294,13 +298,17 @@ def estimate_map(model: Model, lanes: int, omegas: Sequence[float] | np.ndarray,
     for assembly), plus one chunk's Poincare samples (``chunk x samples x states x 8`` bytes,
     twice). Time: lane-steps x ``ns_per_lane_step`` (wall time per lane-step of this machine with
     every core busy, e.g. :func:`measure_ns_per_lane_step`) / ``parallel`` (how many such
-    machines a cluster is worth).
+    machines a cluster is worth). ``blocks``: the lanes run in the sweep kernels' blocks, where
+    fewer lanes than fill every thread's vectors take as long as that many
+    (:func:`~geardyn.solvers.ensemble.busy_lanes`: one lane on 2 threads costs 16 lanes' time);
+    False: one lane on its own (a simulation).
     """
     om = np.asarray(omegas, dtype=float).ravel()
     if om.size == 0 or not np.all(np.isfinite(om) & (om > 0)):
         raise ValueError("Omega must be positive and finite")
     per_lane = float(np.mean(_steps_per_lane(model, om, transient, samples, steps_per_period)))
     steps = lanes * per_lane
+    share = busy_lanes(lanes) / lanes if blocks and lanes > 0 else 1.0  # vectors left idle
     if lyapunov:
         n = int(steps_per_period or default_steps_per_period(model, float(om.min())))
         duration = samples * float(np.mean(forcing_period(om)))
@@ -314,8 +322,9 @@ def estimate_map(model: Model, lanes: int, omegas: Sequence[float] | np.ndarray,
     size = chunk or default_chunk(lanes)
     memory = lanes * per_point + 2 * 8.0 * min(size, lanes) * samples * ns
     return MapEstimate(lanes=int(lanes), lane_steps=float(steps), memory_bytes=float(memory),
-                       seconds=float(steps * ns_per_lane_step * 1e-9 / max(parallel, 1e-9)),
-                       ns_per_lane_step=float(ns_per_lane_step))
+                       seconds=float(steps * share * ns_per_lane_step * 1e-9
+                                     / max(parallel, 1e-9)),
+                       ns_per_lane_step=float(ns_per_lane_step), busy_share=float(share))
 
 
 def measure_ns_per_lane_step(model: Model, omega: float, steps_per_period: int | None = None,

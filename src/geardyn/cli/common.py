@@ -166,13 +166,16 @@ def refuse_if_costly(estimate, option: str, value: object, yes: bool, what: str,
 
 def check_run_cost(model, lanes: int, omegas, transient: float, samples: int,
                    steps_per_period: int | None, lyapunov: bool, *, option: str, value: object,
-                   yes: bool, what: str, chunk: int | None = None, record_columns: int = 0):
+                   yes: bool, what: str, chunk: int | None = None, record_columns: int = 0,
+                   blocks: bool = True):
     """Estimate a run of ``lanes`` integrations with :func:`~geardyn.analysis.map2d.estimate_map`
     before anything of its size is built, and refuse it (:func:`refuse_if_costly`) when it is
     too large or too long. The time is first estimated at a default speed and, only when that
     exceeds the limit, at this machine's measured speed. ``record_columns``: values kept per
     step over the ``samples`` periods (a time history at ``omegas[0]``), which the estimate adds
-    to its memory. Returns the estimate."""
+    to its memory. ``blocks``: the lanes run in the sweep kernels' blocks (False: one lane on
+    its own, a simulation; see :func:`~geardyn.analysis.map2d.estimate_map`). Returns the
+    estimate."""
     import dataclasses
 
     import numpy as np
@@ -193,7 +196,7 @@ def check_run_cost(model, lanes: int, omegas, transient: float, samples: int,
 
     def estimate(**speed):
         est = estimate_map(model, lanes, omegas, transient, samples, steps_per_period, lyapunov,
-                           chunk, **speed)
+                           chunk, blocks=blocks, **speed)
         return dataclasses.replace(est, memory_bytes=est.memory_bytes + history)
 
     est = estimate()

@@ -275,7 +275,7 @@ def simulate(
                    option="--omega/--periods/--transient/--steps-per-period",
                    value=f"Omega {om:g}, {n_periods} periods, transient {tr:g}, "
                          f"{spp or 'automatic'} steps/period",
-                   what="simulation", record_columns=1 + len(known))
+                   what="simulation", record_columns=1 + len(known), blocks=False)
     make_parents(out, plot)
 
     err = _stderr()

@@ -250,6 +250,22 @@ def _phase_tables(k, n_lane: np.ndarray):
     return np.concatenate(s_parts), np.concatenate(c_parts), lane_tab
 
 
+def busy_lanes(lanes: int, threads: int | None = None) -> int:
+    """The lanes' worth of work a run of ``lanes`` lanes costs on ``threads`` threads (default
+    numba's): the schedule (:func:`_schedule`) gives each of up to ``threads`` workers its share,
+    and a worker steps its block's slots in whole vectors of ``SIMD_SLOTS``, so that fewer than
+    ``SIMD_SLOTS`` lanes per thread take as long as ``SIMD_SLOTS`` per thread (e.g. 1 lane on 2
+    threads: 16). Equal to ``lanes`` when they fill the vectors of every thread."""
+    import numba
+
+    from geardyn.solvers._step_core import SIMD_SLOTS
+
+    threads = max(1, int(threads or numba.get_num_threads()))
+    lanes = max(1, int(lanes))
+    per_worker = -(-lanes // min(threads, lanes))
+    return threads * (-(-per_worker // SIMD_SLOTS) * SIMD_SLOTS)
+
+
 def _schedule(cost: np.ndarray, workers: int | None = None) -> tuple[np.ndarray, np.ndarray]:
     """A cost-balanced static schedule of lanes (``cost``: lane-steps of each) over workers:
     lanes longest first, dealt to the workers back and forth (1, 2, .., w, w, .., 1, 1, ..), so
