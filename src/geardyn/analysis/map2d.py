@@ -330,11 +330,9 @@ def estimate_map(model: Model, lanes: int, omegas: Sequence[float] | np.ndarray,
 def measure_ns_per_lane_step(model: Model, omega: float, steps_per_period: int | None = None,
                              steps: int = 20000) -> float:
     """Wall time per lane-step (ns) of :func:`run_lanes` on this machine with every core busy:
-    a short run of 8 lanes per thread, timed after a first call that compiles or loads the
-    kernel."""
-    import numba
-
-    lanes = 8 * numba.get_num_threads()
+    a short run of the lanes that just fill every thread's vectors (:func:`busy_lanes` of one
+    lane: 8 per thread), timed after a first call that compiles or loads the kernel."""
+    lanes = busy_lanes(1)
     n = int(steps_per_period) if steps_per_period else ladder_steps(
         default_steps_per_period(model, omega))
     n = min(n, steps // 2)  # the cost of a step hardly depends on the steps per period
