@@ -38,8 +38,12 @@ test: $(STAMP)
 test-slow: $(STAMP)
 	$(BIN)/python -m pytest -n 2 -q -m slow --timeout=3600
 
+# Each script's --write replaces its rows of the "Current figures" table at the top of
+# bench/RESULTS.md (date and commit stamped); the reproduction's timing is bench/reproduce.py.
 bench: $(STAMP)
-	$(BIN)/python bench/bifurcation.py
+	$(BIN)/python bench/bifurcation.py --write
+	$(BIN)/python bench/lyapunov.py --write
+	$(BIN)/python bench/crossing.py --write
 	$(BIN)/python bench/map.py --write
 	$(BIN)/python bench/continuation.py
 

@@ -24,6 +24,7 @@ import time
 import numpy as np
 from scipy.integrate import solve_ivp
 
+import _results as results
 import geardyn
 from geardyn.solvers.ensemble import run_lanes
 from geardyn.solvers.kernels import kernels_for
@@ -133,6 +134,8 @@ def main() -> None:
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--points", type=int, default=1000)
     ap.add_argument("--no-precision", action="store_true")
+    ap.add_argument("--write", action="store_true",
+                    help="record the figure in bench/RESULTS.md's current-figures table")
     args = ap.parse_args()
     model = device()
     values = np.linspace(0.1, 4.0, args.points)
@@ -175,6 +178,15 @@ def main() -> None:
           f"{sim_time:.3e} time units: {scipy_total:.0f} s; ratio {scipy_total / wall:.0f}x")
     err = agreement(model, ds, [0.35, 1.1, 3.5])
     print(f"Poincare points vs DOP853 rtol 1e-12 (3 points, 20 periods): max rel. error {err:.2e}")
+    if args.write:
+        results.record(
+            "paper-workload", "paper reference workload (1000 Omega, transient 2000, 200 "
+            "periods) <= 0.3 s",
+            f"{wall:.2f} s wall, median of {args.repeat} ({wall * threads / steps * 1e9:.1f} ns "
+            f"per lane-step per thread; {wall_off:.2f} s without edge location; Poincare points "
+            f"{err:.1e} from DOP853; SciPy RK45 {scipy_total / wall:.0f}x slower)",
+            results.against(wall, 0.3),
+            f".venv/bin/python bench/bifurcation.py --repeat {args.repeat} --no-precision --write")
     if not args.no_precision:
         print("\n| Omega | method | setting | max rel. error | cost [ms per unit time] |")
         print("|---|---|---|---|---|")

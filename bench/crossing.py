@@ -31,6 +31,7 @@ from geardyn.core.plan import lane_steps_per_period
 from geardyn.solvers import kernels as kmod
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
+import _results as results  # noqa: E402
 from kernel import old_kernels  # noqa: E402
 
 
@@ -178,7 +179,10 @@ def main() -> None:
     ap.add_argument("--rounds", type=int, default=7)
     ap.add_argument("--old", default="e8ac560")
     ap.add_argument("--lanes", type=int, default=16)
+    ap.add_argument("--write", action="store_true",
+                    help="record the figure in bench/RESULTS.md's current-figures table")
     args = ap.parse_args()
+    located = {}
     cases = [
         ("reduced CATT, paper (xi 0.05), default steps",
          geardyn.CATTDevice(geardyn.PlanetaryParams.paper(xi1=0.05, xi2=0.05)),
@@ -223,6 +227,8 @@ def main() -> None:
             print(f"| {name} | {k} | {n_rec} | {n_cross // n_rep} | "
                   f"{t / (n_rec * n_rep) * 1e9:.0f} | {t / max(n_cross, 1) * 1e9:.0f} | "
                   f"{int(res[k][1]) // n_rep} |")
+        located[name.split(",")[0].split(" (")[0]] = (
+            statistics.median(times["new"]) / max(int(res["new"][0]), 1) * 1e9)
         ratio = statistics.median(times["new"]) / statistics.median(times["old"])
         diff = np.max(np.abs(outs["new"] - outs["old"])) / np.max(np.abs(outs["old"]))
         t_rhs, t_ev = (statistics.median(trhs[key]) / 100_000 * 1e9 for key in trhs)
@@ -230,6 +236,13 @@ def main() -> None:
         print(f"|  {grazing} of the {n_rec} calls have an edge flagged as a possible graze |")
         print(f"|  scale: one scalar rhs {t_rhs:.1f} ns, one events {t_ev:.1f} ns; max rel. "
               f"state difference after the split, new - old: {diff:.1e} |")
+    if args.write:
+        results.record(
+            "crossing", "located crossing <= 100 ns",
+            "; ".join(f"{v:.0f} ns {k}" for k, v in located.items())
+            + f" (replayed split calls, CPU, median of {args.rounds} rounds)",
+            results.against(max(located.values()), 100.0),
+            f".venv/bin/python bench/crossing.py --old {args.old} --rounds {args.rounds} --write")
 
 
 if __name__ == "__main__":

@@ -76,6 +76,8 @@ def main() -> None:
     ap.add_argument("--transient", type=float, default=20.0)
     ap.add_argument("--duration", type=float, default=200.0)
     ap.add_argument("--threads", type=int, default=numba.config.NUMBA_NUM_THREADS)
+    ap.add_argument("--write", action="store_true",
+                    help="record the figure in bench/RESULTS.md's current-figures table")
     a = ap.parse_args()
     numba.set_num_threads(a.threads)
     model = device()
@@ -121,6 +123,17 @@ def main() -> None:
     (la, ea), (lb, eb) = results["blocks"], results["rows (main)"]
     same = np.array_equal(la, lb, equal_nan=True) and np.array_equal(ea, eb, equal_nan=True)
     print(f"  exponents and errors bitwise equal: {same}; finite {np.isfinite(la).sum()}/{la.size}")
+    if a.write:
+        tt = times["blocks"]
+        wall = statistics.median(t[0] for t in tt)
+        cpu = statistics.median(t[1] for t in tt)
+        per = wall * a.threads / steps * 1e9
+        results.record(
+            "lyapunov", "Lyapunov kernel <= 30 ns per lane-step",
+            f"{per:.1f} ns wall per lane-step per thread, {cpu / steps * 1e9:.1f} ns CPU "
+            f"(median of {a.repeat}, {a.threads} threads); block and row kernels bitwise equal: "
+            f"{same}", results.against(per, 30.0),
+            f".venv/bin/python bench/lyapunov.py --repeat {a.repeat} --write")
 
 
 if __name__ == "__main__":

@@ -117,6 +117,18 @@ def main() -> None:
               f"{steps:.3e} lane-steps, {t / steps * 1e9:.1f} ns wall per lane-step, "
               f"{t * cores / steps * 1e9:.1f} ns per lane-step per thread ({cores} threads), "
               f"points not ok: {bad}; load average {os.getloadavg()[0]:.2f}")
+        if args.write:
+            import _results as results
+
+            results.record(
+                f"map-{args.nx}" if args.nx == args.ny else f"map-{args.nx}x{args.ny}",
+                f"{args.nx} x {args.ny} map" + (" <= 120 s" if args.nx == args.ny == 500
+                                                 else ""),
+                f"{t:.1f} s (median of {args.repeat}; {steps:.3e} lane-steps, "
+                f"{t * cores / steps * 1e9:.1f} ns per lane-step per thread; points not ok: "
+                f"{bad})", results.against(t, 120.0) if args.nx == args.ny == 500 else "-",
+                f".venv/bin/python bench/map.py --nx {args.nx} --ny {args.ny} --chunk "
+                f"{args.chunk} --repeat {args.repeat} --local-only --write")
         return
     configs = [("local", None, None), ("dask 1w x 1t", 1, 1), ("dask 2w x 1t", 2, 1),
                (f"dask 1w x {cores}t", 1, cores)]

@@ -575,6 +575,25 @@ def targets(rows: list[Row]) -> list[str]:
     return out
 
 
+def record_targets(rows: list[Row], command: str) -> None:
+    """The two gear-pair targets in RESULTS.md's current-figures table."""
+    import _results as results
+
+    by = {r.key: r for r in rows}
+    ratio = by["g128"].wall / by["rk4"].wall
+    results.record("gear-pair-vs-rk4", f"gear pair at {STEPS} steps/period <= 1/3 of plain "
+                   "numba RK4", f"{ratio:.2f}x ({by['g128'].wall:.3f} s against "
+                   f"{by['rk4'].wall:.3f} s)", results.against(ratio, 1 / 3), command)
+    lines = targets(rows)[2:]
+    ratios = [float(m.group(1)) for m in (re.search(r"takes ([0-9.]+)x", s) for s in lines)
+              if m]
+    results.record("equal-accuracy", f"gear pair at equal accuracy ({TARGET:g}) >= 5x every "
+                   "peer", "; ".join(lines),
+                   results.against(min(ratios), 5.0, lower_is_better=False) if ratios
+                   else "no peer measured",
+                   command)
+
+
 def machine() -> str:
     """Cores, CPU model, numba threads, versions, load average."""
     cpu = platform.processor() or platform.machine()
@@ -696,7 +715,8 @@ def main() -> None:
         cmd = "make bench-peers" if os.environ.get("MAKELEVEL") else \
             "python bench/peers.py " + " ".join(sys.argv[1:])
         write_section(section(rows, base, wl, cmd))
-        print(f"wrote the Peers section of {RESULTS}")
+        record_targets(rows, cmd)
+        print(f"wrote the Peers section and the current figures of {RESULTS}")
 
 
 def _as_module() -> object:

@@ -6,6 +6,7 @@ from __future__ import annotations
 import importlib.util
 import math
 import os
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -63,6 +64,28 @@ def test_write_section_replaces_only_peers(peers, tmp_path):
     assert "keep 2" in text
     peers.write_section("## Peers\n\nnewer\n", path)  # replaces again, appends nothing
     assert path.read_text().count("## Peers") == 1 and "newer" in path.read_text()
+
+
+def test_current_figures_row_is_replaced_alone_with_date_and_commit(tmp_path):
+    spec = importlib.util.spec_from_file_location("bench_results", PEERS.with_name("_results.py"))
+    results = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(results)
+    path = tmp_path / "RESULTS.md"
+    path.write_text("# Benchmark results\n\nintro\n\n## Peers\n\nkeep\n")
+    results.record("lyapunov", "<= 30 ns", "68.8 ns", "2.29x over", "bench/lyapunov.py", path)
+    results.record("paper-workload", "<= 0.3 s", "1.18 s", "3.93x over", "bench/bif.py", path)
+    results.record("lyapunov", "<= 30 ns", "25.0 | ns", "met", "bench/lyapunov.py", path)
+    text = path.read_text()
+    rows = [line for line in text.splitlines() if line.startswith("| ")][1:]
+    assert [r.split("|")[1].strip() for r in rows] == ["paper-workload", "lyapunov"]
+    cells = [c.strip() for c in rows[1].strip("|").split("|")]
+    assert cells[2:4] == ["25.0 / ns", "met"]  # a pipe in a figure cannot break the table
+    assert re.fullmatch(r"\d{4}-\d{2}-\d{2}", cells[4]) and cells[5]
+    assert "68.8" not in text and text.count(results.BEGIN) == 1
+    assert text.index(results.BEGIN) < text.index("intro") < text.index("## Peers")  # on top
+    assert "keep" in text
+    assert results.against(1.18, 0.3) == "3.93x over" and results.against(0.2, 0.3) == "met"
+    assert results.against(4.0, 5.0, lower_is_better=False) == "1.25x under"
 
 
 @pytest.mark.parametrize("script", ["peers", "crossing", "fused_loop"])
