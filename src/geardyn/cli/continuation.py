@@ -14,8 +14,9 @@ first orbit's transient (``transient`` or ``transient_periods``, ``converge``, `
 from ``[run]``. A branch that ends early (most points, corrector failure, the parameter leaving the
 model's valid region, divergence, no orbit at the start) is still written, its status and
 message in the file (``branch_status``, ``branch_message``) and printed on stderr; the exit
-status is 0. A progress bar (the parameter's way through the range) is drawn when stderr is a
-terminal.
+status is 0. A branch that reached the range's end or returned onto its own points (it retraces
+itself) is complete. A progress bar (the parameter's way through the range) is drawn when stderr
+is a terminal.
 """
 
 from __future__ import annotations
@@ -48,6 +49,9 @@ from geardyn.study import build_model
 
 __all__ = ["continue_command", "parse_span", "register"]
 
+
+#: Branch statuses of a complete branch (not reported as ending early).
+FULL_BRANCH = (0, 6)  # BranchStatus.COMPLETED, BranchStatus.RETRACED
 
 def parse_span(text: str, option: str = "--range") -> tuple[float, float]:
     """``START:STOP`` -> (start, stop), finite and different (a third field, a sweep's NUM, is
@@ -195,8 +199,8 @@ def continue_command(
     plot: PlotOption = None,
 ) -> None:
     """Follow a periodic orbit in a parameter (pseudo-arclength continuation), stable or not;
-    locate its folds, period doublings, Neimark-Sacker points and contact changes; save the
-    branch (NetCDF) and draw it."""
+    locate its folds, branch points, period doublings, Neimark-Sacker points and contact
+    changes; save the branch (NetCDF) and draw it."""
     from geardyn.analysis.branch import continuation
     from geardyn.cli.bifurcation import (
         _check_param_name,
@@ -277,7 +281,7 @@ def continue_command(
                           wall_time_s=round(elapsed, 3))
     err = stderr_console()
     for b in range(ds.sizes["branch_id"]):
-        if int(ds["branch_status"].values[b]):
+        if int(ds["branch_status"].values[b]) not in FULL_BRANCH:
             err.print(f"branch {b} (period {int(ds['branch_period'].values[b])}) ended early: "
                       f"{escape(str(ds['branch_message'].values[b]))}", highlight=False,
                       soft_wrap=True)
