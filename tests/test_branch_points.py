@@ -16,8 +16,10 @@ from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
 import geardyn
+import geardyn.testing
 from branch_cases import duffing_with_spectators, parametric_rayleigh
 from geardyn import BranchStatus
+from geardyn.plotting.branch import plot_branch
 
 
 def _monodromy(f, n: int, T: float, x0: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -209,14 +211,14 @@ def test_period_two_bubble_rejoins_at_the_second_doubling_and_ends_there(zone):
     assert np.max(np.abs(value[on == 0] - zone)) < 1e-6
     assert ds.sizes["branch_id"] == 3
     for b, other in ((1, zone[1]), (2, zone[0])):
-        assert ds["branch_status"].values[b] == BranchStatus.RETRACED
+        pts = ds["branch"].values == b
+        assert np.all(ds["period"].values[pts] == 2) and pts.sum() < 100
         assert "retraces itself" in str(ds["branch_message"].values[b])
+        assert ds["branch_status"].values[b] == 6  # BranchStatus.RETRACED
         assert list(kind[on == b]) == ["branch point"]
         assert abs(value[on == b][0] - other) < 1e-5
-        pts = ds["branch"].values == b
         om = ds["Omega"].values[pts]
         assert om.min() > zone[0] - 1e-5 and om.max() < zone[1] + 1e-5
-        assert np.all(ds["period"].values[pts] == 2) and pts.sum() < 100
         x = ds["section_point"].values[pts]
         k = int(np.argmax(np.abs(x[:, 0])))
         w = float(om[k])
@@ -229,6 +231,11 @@ def test_period_two_bubble_rejoins_at_the_second_doubling_and_ends_there(zone):
         ends = solve_ivp(f, (0.0, 2 * T), x[k], method="DOP853", rtol=1e-12, atol=1e-13,
                          t_eval=[T, 2 * T]).y.T
         assert np.max(np.abs(ends[1] - x[k])) < 1e-6 < 1e-2 < np.max(np.abs(ends[0] - x[k]))
+    geardyn.testing.assert_result(ds, "continuation")
+    fig = plot_branch(ds)
+    labels = sorted(t.get_text() for t in fig.axes[0].texts if t.get_gid() == "bifurcation-label")
+    assert labels == ["BP", "BP", "PD", "PD"]
+    assert "ended early" not in fig.get_suptitle()  # retracing completes a branch
 
 
 # ----------------------------------------------------------------------------- location
@@ -262,6 +269,9 @@ def test_failed_location_keeps_the_bifurcation_with_its_bracket(monkeypatch, zon
         k = int(ds["bifurcation_point"].values[j])
         ends = np.sort(ds["Omega"].values[k:k + 2])
         assert np.allclose([v[j] - e[j], v[j] + e[j]], ends, atol=1e-12)
+    labels = [t.get_text() for t in plot_branch(ds).axes[0].texts
+              if t.get_gid() == "bifurcation-label"]
+    assert labels.count("PD?") >= 2 and "PD" not in labels
     assert ds.sizes["branch_id"] == 3
     for b in (1, 2):
         assert ds["branch_parent"].values[b] in np.flatnonzero(on)
@@ -287,15 +297,19 @@ def test_location_outside_its_step_is_not_kept_as_located(monkeypatch, zone):
     kinds = ds["bifurcation_kind"].values
     assert list(kinds) == ["period-doubling"] * 2
     v, e = ds["bifurcation_value"].values, ds["bifurcation_error"].values
-    assert np.all((v - e <= zone) & (zone <= v + e))
+    assert np.all((v - e <= zone) & (zone <= v + e)), (v, e, zone)
+    for j, k in enumerate(ds["bifurcation_point"].values):  # in the step it was seen in
+        lo, hi = np.sort(ds["Omega"].values[k:k + 2])
+        assert lo <= v[j] <= hi
     assert np.all(ds["bifurcation_located"].values == 0)
     assert all("outside the step" in str(d) for d in ds["bifurcation_detail"].values)
 
 
 def test_corrector_far_from_its_predictor_is_rejected(monkeypatch):
     """A corrector that lands far along the branch (here: forced once to start 0.3 on) is
-    rejected and the step halved: the linear gear pair's branch keeps its points close (the
-    response still the analytic one)."""
+    rejected and the step halved. The gear pair in contact continued in Fa: a straight branch
+    (the response is linear in Fa, the multipliers do not move), so no other guard sees the
+    jump; the points keep the analytic response."""
     from geardyn.analysis import branch
 
     correct = branch._Tracer.correct
@@ -308,11 +322,12 @@ def test_corrector_far_from_its_predictor_is_rejected(monkeypatch):
         return correct(self, z_pred, t, J0, max_iter, final)
 
     monkeypatch.setattr(branch._Tracer, "correct", jumpy)
-    zeta, fa = 0.05, 0.02
-    ds = geardyn.continuation(geardyn.GearPair(zeta=zeta, kappa=0.0, Fm=2.0, Fa=fa), "Omega",
-                              0.5, 1.5)
+    zeta, om = 0.05, 0.8
+    m = geardyn.GearPair(zeta=zeta, kappa=0.0, Fm=2.0, Fa=0.01, Omega=om)
+    ds = geardyn.continuation(m, "Fa", 0.01, 0.05)
     assert ds.attrs["status"] == BranchStatus.COMPLETED, ds.attrs["message"]
-    om = ds["Omega"].values
-    assert np.max(np.diff(om)) < 0.25
-    A = fa * om**2 / np.abs(1.0 - om**2 + 2j * zeta * om)
+    assert len(calls) > 4
+    # a step's chord is about its length ds <= ds_max = 0.2; the jump would add 0.3
+    assert np.max(np.diff(ds["arclength"].values)) < 0.21
+    A = ds["Fa"].values * om**2 / abs(1.0 - om**2 + 2j * zeta * om)
     assert np.max(np.abs(ds["deflection_amplitude"].values[:, 0] - A)) < 1e-4 * A.max()

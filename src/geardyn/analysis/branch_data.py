@@ -65,6 +65,11 @@ BIFURCATION_KINDS = {
 }
 
 
+#: The statuses of a complete branch: it reached an end of the range, or returned onto its own
+#: points (any other status: it ended early).
+COMPLETE = (BranchStatus.COMPLETED, BranchStatus.RETRACED)
+
+
 def branch_status_meaning() -> str:
     """The branch status codes as one attribute string."""
     return ", ".join(f"{int(s)} {s.message}" for s in BranchStatus)

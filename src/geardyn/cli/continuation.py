@@ -50,9 +50,6 @@ from geardyn.study import build_model
 __all__ = ["continue_command", "parse_span", "register"]
 
 
-#: Branch statuses of a complete branch (not reported as ending early).
-FULL_BRANCH = (0, 6)  # BranchStatus.COMPLETED, BranchStatus.RETRACED
-
 def parse_span(text: str, option: str = "--range") -> tuple[float, float]:
     """``START:STOP`` -> (start, stop), finite and different (a third field, a sweep's NUM, is
     accepted and ignored: the continuation picks its own steps)."""
@@ -148,6 +145,9 @@ def _summary(ds) -> str:
                      f"{param} {span}")
     kinds = [str(k) for k in ds["bifurcation_kind"].values]
     found = ", ".join(f"{kinds.count(k)} {k}" for k in dict.fromkeys(kinds)) or "none"
+    if "bifurcation_located" in ds:
+        lost = int(np.sum(ds["bifurcation_located"].values == 0))
+        found += f" ({lost} not located)" if lost else ""
     return "; ".join(parts) + f"; bifurcations: {found}"
 
 
@@ -279,9 +279,11 @@ def continue_command(
 
     wrote = write_outputs(ds, out, plot, draw, study=s.study.name, plot_state=plot_state,
                           wall_time_s=round(elapsed, 3))
+    from geardyn.analysis.branch_data import COMPLETE
+
     err = stderr_console()
     for b in range(ds.sizes["branch_id"]):
-        if int(ds["branch_status"].values[b]) not in FULL_BRANCH:
+        if int(ds["branch_status"].values[b]) not in COMPLETE:
             err.print(f"branch {b} (period {int(ds['branch_period'].values[b])}) ended early: "
                       f"{escape(str(ds['branch_message'].values[b]))}", highlight=False,
                       soft_wrap=True)

@@ -239,8 +239,11 @@ def _title(ds: xr.Dataset, param: str) -> str:
         else [int(ds.attrs.get("period", 1))]
     text = (f"{who}: period-{'/'.join(str(k) for k in periods)} branch"
             f"{'es' if ds.sizes.get('branch_id', 1) > 1 else ''} continued in {param}")
+    from geardyn.analysis.branch_data import COMPLETE
+
     ended = [f"branch {b}: {ds['branch_message'].values[b]}"
-             for b in range(ds.sizes.get("branch_id", 0)) if int(ds["branch_status"].values[b])]
+             for b in range(ds.sizes.get("branch_id", 0))
+             if int(ds["branch_status"].values[b]) not in COMPLETE]
     return text + ("\nended early: " + "; ".join(ended) if ended else "")
 
 
