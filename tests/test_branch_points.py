@@ -82,6 +82,10 @@ def test_constructed_multipliers_real_pair_product_through_one_is_not_neimark_sa
     assert detected(_monitors(one_a, 1.0), _monitors(one_b, 1.0)) == [("branch point", "bp")]
     assert detected(_monitors(one_a, 1.0), _monitors(one_a, -1.0)) == [
         ("branch point", "fold")]
+    # a neutral multiplier (exactly +1 at both points): det(M - I) is round-off, a turn a fold
+    neutral_a, neutral_b = _block([1.0 - 1e-12, 0.5], []), _block([1.0 + 1e-12, 0.6], [])
+    assert detected(_monitors(neutral_a, 1.0), _monitors(neutral_b, -1.0)) == [("fold", "fold")]
+    assert detected(_monitors(neutral_a, 1.0), _monitors(neutral_b, 1.0)) == []
     # -1: a period doubling
     assert detected(_monitors(_block([-0.9, 0.5], [])), _monitors(_block([-1.1, 0.5], []))
                     ) == [("period-doubling", "pd")]

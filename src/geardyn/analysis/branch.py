@@ -101,6 +101,9 @@ MAX_CORRECTION = 3.0
 #: A Neimark-Sacker point needs a complex-conjugate pair with ||mu| - 1| at most this at the
 #: located point.
 NS_MODULUS_TOL = 1e-4
+#: A multiplier within this of +1 at both ends of a step is a neutral direction of the model:
+#: det(M - I) is round-off there and no branch point is sought.
+NEUTRAL_TOL = 1e-9
 #: A multiplier is complex where |Im mu| > COMPLEX_TOL (1 + |mu|).
 COMPLEX_TOL = 1e-8
 #: A new point within RETRACE_TOL segment lengths of a segment between two earlier points of
@@ -388,12 +391,13 @@ def _null_tangent(J: np.ndarray, direction: float) -> np.ndarray:
 def monitor_functions(M: np.ndarray, mu: np.ndarray, tangent_p: float) -> dict[str, float]:
     """The test functions of a point with monodromy ``M``, multipliers ``mu`` and tangent
     p component ``tangent_p``: fold (tangent_p), bp (det(M - I)), pd (det(M + I)), ns (prod over
-    pairs of mu_i mu_j - 1)."""
+    pairs of mu_i mu_j - 1), one (the distance of the nearest multiplier to +1)."""
     prod = np.prod([mu[i] * mu[j] - 1.0 for i in range(mu.size) for j in range(i + 1, mu.size)])
     ns = float(np.real(prod)) if mu.size > 1 else 1.0
     eye = np.eye(M.shape[0])
     return {"fold": float(tangent_p), "bp": float(np.linalg.det(M - eye)),
-            "pd": float(np.linalg.det(M + eye)), "ns": ns}
+            "pd": float(np.linalg.det(M + eye)), "ns": ns,
+            "one": float(np.min(np.abs(mu - 1.0))) if mu.size else math.inf}
 
 
 def _tests(pt: _Point) -> dict[str, Any]:
@@ -413,9 +417,13 @@ def detected(ta: dict, tb: dict) -> list[tuple[str, str]]:
     """(kind, test function to locate) of each bifurcation that the test functions ``ta`` and
     ``tb`` of two points show between them (not contact). A turn (fold test) with det(M - I)
     is a fold; either alone is a branch point; a Neimark-Sacker candidate still needs its
-    complex pair on the unit circle (:func:`neimark_sacker_pair`)."""
+    complex pair on the unit circle (:func:`neimark_sacker_pair`). Where a multiplier stays
+    within :data:`NEUTRAL_TOL` of +1 at both points (a neutral direction of the model, det(M - I)
+    at round-off) det(M - I) is not used: a turn is a fold."""
     out = []
     turn, through_one = _changed(ta, tb, "fold"), _changed(ta, tb, "bp")
+    if max(ta["one"], tb["one"]) < NEUTRAL_TOL:
+        through_one = turn
     if turn and through_one:
         out.append(("fold", "fold"))
     elif through_one:
