@@ -242,6 +242,31 @@ def test_period_two_bubble_rejoins_at_the_second_doubling_and_ends_there(zone):
     assert "ended early" not in fig.get_suptitle()  # retracing completes a branch
 
 
+def test_retrace_check_ends_a_closed_curve_after_one_round_not_at_its_turns():
+    """The retrace check on points of a circle in (x, p) (two turns of the parameter) with
+    steps of 0.2 rad: silent over the first round, folds included, and it fires once the points
+    come round onto the first ones."""
+    from types import SimpleNamespace
+
+    from geardyn.analysis import branch
+
+    tracer = SimpleNamespace(param="p", p_of=lambda z: float(z[-1]))
+    runner = branch._BranchRunner(tracer, None, 0)
+    h = 0.2
+    fired = []
+    for i, a in enumerate(np.arange(0.0, 2.5 * math.pi, h)):
+        z = np.array([math.cos(a), math.sin(a)])  # (x, p)
+        pt = SimpleNamespace(z=z, tangent=np.array([-math.sin(a), math.cos(a)]))
+        s = i * h
+        why = runner._retraced(pt, s)
+        if why:
+            fired.append(a)
+        runner._copies.append(z[None, :])
+        runner._arc.append(s)
+    assert fired and 2 * math.pi < fired[0] < 2 * math.pi + 2 * h
+    assert "retraces itself" in runner._retraced(pt, s + h)
+
+
 # ----------------------------------------------------------------------------- location
 def _hill() -> geardyn.GearPair:
     return geardyn.GearPair(zeta=ZETA, kappa=KAPPA, Fm=1.0, Fa=0.0)
