@@ -83,8 +83,10 @@ def _branch() -> xr.Dataset:
     ds["stability"] = ("point", ["stable"] * n)
     ds["branch"] = ("point", np.zeros(n, dtype=int))
     ds["period"] = ("point", np.ones(n, dtype=int), PERIOD)
-    ds["bifurcation_kind"] = ("bifurcation", ["fold"])
-    ds["bifurcation_value"] = ("bifurcation", [0.55])
+    ds["bifurcation_kind"] = ("bifurcation", ["fold", "branch point"], {"meaning": "kinds"})
+    ds["bifurcation_value"] = ("bifurcation", [0.55, 0.65])
+    ds["bifurcation_error"] = ("bifurcation", [1e-8, 0.05])
+    ds["bifurcation_located"] = ("bifurcation", [1, 0], {"meaning": "1 located"})
     ds["branch_status"] = ("branch_id", [0])
     ds["branch_message"] = ("branch_id", ["reached Omega=0.7"])
     ds.attrs.update(geardyn_kind="continuation", param="Omega", start=0.5, stop=0.7, period=1,
@@ -152,6 +154,14 @@ def test_the_wrong_kind_fails(kind):
     other = next(k for k in KINDS if k != kind)
     with pytest.raises(AssertionError, match="geardyn_kind"):
         assert_result(BUILD[kind](), other)
+
+
+def test_an_unknown_bifurcation_kind_or_branch_status_fails():
+    ds = _branch()
+    ds["bifurcation_kind"].values[1] = "pitchfork"
+    ds["branch_status"].values[0] = 9
+    with pytest.raises(AssertionError, match="'pitchfork'.*branch_status: codes \\[9\\]"):
+        assert_result(ds, "continuation")
 
 
 def test_a_missing_kind_attribute_fails():

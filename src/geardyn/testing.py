@@ -662,7 +662,8 @@ def _result_spec(ds: Any, kind: str) -> tuple[list[str], dict[str, tuple[str, ..
                 {"section_point": ("point", "state"), "multiplier_real": ("point", "multiplier"),
                  "multiplier_imag": ("point", "multiplier"), "stability": ("point",),
                  "branch": ("point",), "bifurcation_kind": ("bifurcation",),
-                 "bifurcation_value": ("bifurcation",), "branch_status": ("branch_id",),
+                 "bifurcation_value": ("bifurcation",), "bifurcation_error": ("bifurcation",),
+                 "bifurcation_located": ("bifurcation",), "branch_status": ("branch_id",),
                  "branch_message": ("branch_id",)}, [])
     if kind == "basins":
         x, y = str(a.get("x", "x")), str(a.get("y", "y"))
@@ -688,7 +689,8 @@ def _result_spec(ds: Any, kind: str) -> tuple[list[str], dict[str, tuple[str, ..
 _VARIABLE_ATTRS = {"period": ("meaning",), "status": ("meaning",),
                    "final_time": ("units",), "poincare_time": ("units",), "time": ("units",),
                    "attractor_id": ("meaning",), "attractor_fraction": ("meaning",),
-                   "dte_rms": ("units",), "dte_peak": ("units",), "jump_omega": ("meaning",)}
+                   "dte_rms": ("units",), "dte_peak": ("units",), "jump_omega": ("meaning",),
+                   "bifurcation_kind": ("meaning",), "bifurcation_located": ("meaning",)}
 
 
 def _status_problems(name: str, values: np.ndarray) -> list[str]:
@@ -705,14 +707,33 @@ def _status_problems(name: str, values: np.ndarray) -> list[str]:
     return []
 
 
+def _continuation_problems(ds: Any) -> list[str]:
+    """Unknown bifurcation kinds and branch status codes of a continuation result."""
+    from geardyn.analysis.branch_data import BIFURCATION_KINDS, BranchStatus
+
+    problems = []
+    if "bifurcation_kind" in ds.variables:
+        bad = sorted(set(map(str, ds["bifurcation_kind"].values)) - set(BIFURCATION_KINDS))
+        if bad:
+            problems.append(f"bifurcation_kind: {bad} are not of {list(BIFURCATION_KINDS)}")
+    if "branch_status" in ds.variables:
+        codes = np.asarray(ds["branch_status"].values).astype(np.int64)
+        bad = np.setdiff1d(codes, [int(s) for s in BranchStatus])
+        if bad.size:
+            problems.append(f"branch_status: codes {bad.tolist()} are not BranchStatus codes")
+    return problems
+
+
 def assert_result(ds: Any, kind: str) -> None:
     """Assert that ``ds`` is a well-formed geardyn result of ``kind`` (one of :data:`KINDS`).
 
     Checks ``attrs["geardyn_kind"] == kind``; the kind's required attributes, coordinates and
     variables, each with its dimensions; the units or meaning attributes the kind promises
-    (``status`` and ``period`` a ``meaning``, times their ``units``); and that every status
-    code is a :class:`geardyn.Status` code. Raises :class:`AssertionError` naming every
-    problem found."""
+    (``status`` and ``period`` a ``meaning``, times their ``units``); that every status
+    code is a :class:`geardyn.Status` code; for a continuation, that every bifurcation kind is
+    one of :data:`geardyn.analysis.branch_data.BIFURCATION_KINDS` and every branch status a
+    :class:`~geardyn.analysis.branch_data.BranchStatus` code. Raises :class:`AssertionError`
+    naming every problem found."""
     if kind not in KINDS:
         raise AssertionError(f"unknown result kind {kind!r}: one of {', '.join(KINDS)}")
     problems: list[str] = []
@@ -736,6 +757,8 @@ def assert_result(ds: Any, kind: str) -> None:
     for name in statuses:
         if name in ds.variables:
             problems += _status_problems(name, ds[name].values)
+    if kind == "continuation":
+        problems += _continuation_problems(ds)
     if kind in ("simulation", "periodic-orbit") and "status" in ds.attrs:
         problems += _status_problems("attrs['status']", ds.attrs["status"])
     if problems:

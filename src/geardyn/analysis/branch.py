@@ -15,14 +15,22 @@ p), followed in the arclength of the scaled unknowns z = (x / state_scale, p / p
 
 Test functions on each step between two accepted points (see ``docs/continuation.md``):
 
-* fold: the p component of the tangent changes sign (a real multiplier through +1);
+* fold: the p component of the tangent and det(M - I) both change sign (a real multiplier
+  through +1 where the parameter turns);
+* branch point: exactly one of the two changes sign: det(M - I) without a turn (a real
+  multiplier through +1, another branch crosses), or a turn without det(M - I) (the branch
+  meets another and turns back onto itself, e.g. a period-2k branch its period-k orbit);
 * period doubling: det(M + I) changes sign (a real multiplier through -1);
-* Neimark-Sacker: prod_{i<j} (mu_i mu_j - 1) changes sign with the critical pair complex;
+* Neimark-Sacker: prod_{i<j} (mu_i mu_j - 1) changes sign and a complex-conjugate pair has
+  ||mu| - 1| <= :data:`NS_MODULUS_TOL` at the located point (a real pair's product through 1
+  is not one);
 * contact change: the edge crossings per orbit period of a mesh change.
 
 Each is located on the step by regula falsi (Illinois; bisection for the integer contact test)
 on the arclength between the two points, each trial corrected onto the branch, until the
-parameter is known to ``locate_tol``.
+parameter is known to ``locate_tol``. A location that fails keeps the bifurcation, not located,
+with the bracket it changed sign in. A branch that returns onto its own points ends
+(:attr:`BranchStatus.RETRACED`).
 """
 
 from __future__ import annotations
@@ -36,6 +44,9 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
+from geardyn.analysis.branch_data import (
+    BIFURCATION_KINDS as BIFURCATION_KINDS,
+)
 from geardyn.analysis.branch_data import (
     BranchPoint,
     BranchStatus,
@@ -83,6 +94,24 @@ GUESS_TIME = 2000.0
 LOCATE_TOL = 1e-7
 #: Most trials of a location.
 LOCATE_MAX_ITER = 60
+#: A corrected point farther than this many step lengths from its predictor (the step ds of a
+#: continuation step, the chord of the step for a location trial) is rejected: the corrector
+#: jumped (e.g. onto another branch); the step is halved / the trial fails.
+MAX_CORRECTION = 3.0
+#: A Neimark-Sacker point needs a complex-conjugate pair with ||mu| - 1| at most this at the
+#: located point.
+NS_MODULUS_TOL = 1e-4
+#: A multiplier within this of +1 at both ends of a step is a neutral direction of the model:
+#: det(M - I) is round-off there and no branch point is sought.
+NEUTRAL_TOL = 1e-9
+#: A multiplier is complex where |Im mu| > COMPLEX_TOL (1 + |mu|).
+COMPLEX_TOL = 1e-8
+#: A new point within RETRACE_TOL segment lengths of a segment between two earlier points of
+#: its branch (of their section points shifted by 0..k-1 section periods), its tangent along
+#: the segment (cosine >= MIN_COS either way), and for the unshifted points at least
+#: RETRACE_GAP segment lengths of arclength behind it, ends the branch: it retraces itself.
+RETRACE_TOL = 0.15
+RETRACE_GAP = 3.0
 #: The default step of a branch: this many times the sweeps' step rule (multipliers to ~1e-8;
 #: :data:`~geardyn.analysis.orbits.ORBIT_STEP_FACTOR` for a lone orbit).
 BRANCH_STEP_FACTOR = 2
@@ -126,11 +155,13 @@ class _Point:
 
 @dataclass
 class BifurcationPoint:
-    """A located bifurcation: ``kind`` (fold, period-doubling, neimark-sacker, contact),
-    parameter value ``value`` with ``error`` (a bound on the distance to the true switch point
-    of the test function), ``index`` (the branch point before it), ``branch`` (the branch's
-    number), ``x`` (the section point there), ``multiplier`` (the critical multiplier; NaN for
-    contact), ``detail`` (words), ``monodromy`` and ``period`` (k of the branch)."""
+    """A detected bifurcation: ``kind`` (one of :data:`BIFURCATION_KINDS`), parameter value
+    ``value`` with ``error`` (a bound on the distance to the true switch point of the test
+    function), ``index`` (the branch point before it), ``branch`` (the branch's number), ``x``
+    (the section point there), ``multiplier`` (the critical multiplier; NaN for contact),
+    ``detail`` (words), ``monodromy`` and ``period`` (k of the branch). ``located`` False: the
+    location failed; ``value`` +- ``error`` is the bracket the test function changed sign in,
+    ``x`` and ``monodromy`` are those of the bracket's end at parameter ``section_value``."""
 
     kind: str
     value: float
@@ -142,6 +173,13 @@ class BifurcationPoint:
     detail: str
     monodromy: np.ndarray
     period: int
+    located: bool = True
+    section_value: float = math.nan
+
+    @property
+    def at(self) -> float:
+        """The parameter value of ``x`` and ``monodromy``."""
+        return self.value if self.located else self.section_value
 
 
 @dataclass
@@ -350,17 +388,74 @@ def _null_tangent(J: np.ndarray, direction: float) -> np.ndarray:
 
 
 # ----------------------------------------------------------------------------- test functions
-def _tests(pt: _Point) -> dict[str, Any]:
-    """The test functions at a point: fold (p component of the tangent), pd (det(M + I)),
-    ns (prod over pairs of mu_i mu_j - 1), contact (crossings per orbit period per mesh)."""
-    M = pt.ev.monodromy
-    mu = pt.mu
+def monitor_functions(M: np.ndarray, mu: np.ndarray, tangent_p: float) -> dict[str, float]:
+    """The test functions of a point with monodromy ``M``, multipliers ``mu`` and tangent
+    p component ``tangent_p``: fold (tangent_p), bp (det(M - I)), pd (det(M + I)), ns (prod over
+    pairs of mu_i mu_j - 1), one (the distance of the nearest multiplier to +1)."""
     prod = np.prod([mu[i] * mu[j] - 1.0 for i in range(mu.size) for j in range(i + 1, mu.size)])
     ns = float(np.real(prod)) if mu.size > 1 else 1.0
+    eye = np.eye(M.shape[0])
+    return {"fold": float(tangent_p), "bp": float(np.linalg.det(M - eye)),
+            "pd": float(np.linalg.det(M + eye)), "ns": ns,
+            "one": float(np.min(np.abs(mu - 1.0))) if mu.size else math.inf}
+
+
+def _tests(pt: _Point) -> dict[str, Any]:
+    """:func:`monitor_functions` at a point, with contact (crossings per orbit period per mesh)."""
     c = pt.ev.crossings
     meshes = pt.problem.model.meshes
-    return {"fold": float(pt.tangent[-1]), "pd": float(np.linalg.det(M + np.eye(M.shape[0]))),
-            "ns": ns, "contact": tuple(int(c[i] + c[j]) for _, i, j in meshes)}
+    out: dict[str, Any] = monitor_functions(pt.ev.monodromy, pt.mu, pt.tangent[-1])
+    out["contact"] = tuple(int(c[i] + c[j]) for _, i, j in meshes)
+    return out
+
+
+def _changed(ta: dict, tb: dict, key: str) -> bool:
+    return bool(ta[key] != 0 and tb[key] != 0 and np.sign(ta[key]) != np.sign(tb[key]))
+
+
+def detected(ta: dict, tb: dict) -> list[tuple[str, str]]:
+    """(kind, test function to locate) of each bifurcation that the test functions ``ta`` and
+    ``tb`` of two points show between them (not contact). A turn (fold test) with det(M - I)
+    is a fold; either alone is a branch point; a Neimark-Sacker candidate still needs its
+    complex pair on the unit circle (:func:`neimark_sacker_pair`). Where a multiplier stays
+    within :data:`NEUTRAL_TOL` of +1 at both points (a neutral direction of the model, det(M - I)
+    at round-off) det(M - I) is not used: a turn is a fold."""
+    out = []
+    turn, through_one = _changed(ta, tb, "fold"), _changed(ta, tb, "bp")
+    if max(ta["one"], tb["one"]) < NEUTRAL_TOL:
+        through_one = turn
+    if turn and through_one:
+        out.append(("fold", "fold"))
+    elif through_one:
+        out.append(("branch point", "bp"))
+    elif turn:
+        out.append(("branch point", "fold"))
+    if _changed(ta, tb, "pd"):
+        out.append(("period-doubling", "pd"))
+    if _changed(ta, tb, "ns"):
+        out.append(("neimark-sacker", "ns"))
+    return out
+
+
+def _complex(mu: np.ndarray) -> np.ndarray:
+    return np.abs(mu.imag) > COMPLEX_TOL * (1.0 + np.abs(mu))
+
+
+def neimark_sacker_pair(mu: np.ndarray, tol: float = NS_MODULUS_TOL) -> complex | None:
+    """The multiplier (Im > 0) of the complex-conjugate pair of ``mu`` nearest the unit circle
+    where it is within ``tol`` of it, else None."""
+    cand = mu[_complex(mu) & (mu.imag > 0)]
+    if cand.size == 0:
+        return None
+    c = complex(cand[np.argmin(np.abs(np.abs(cand) - 1.0))])
+    if abs(abs(c) - 1.0) > tol or np.min(np.abs(mu - c.conjugate())) > 1e-6 * (1 + abs(c)):
+        return None
+    return c
+
+
+def _complex_outside(mu: np.ndarray) -> int:
+    """How many complex multipliers lie outside the unit circle."""
+    return int(np.count_nonzero(_complex(mu) & (np.abs(mu) > 1.0)))
 
 
 def _spectrum_moved(a: np.ndarray, b: np.ndarray) -> float:
@@ -370,7 +465,7 @@ def _spectrum_moved(a: np.ndarray, b: np.ndarray) -> float:
 
 def _critical(kind: str, mu: np.ndarray) -> complex:
     """The multiplier that a bifurcation of ``kind`` is about."""
-    if kind == "fold":
+    if kind in ("fold", "branch point"):
         return complex(mu[np.argmin(np.abs(mu - 1.0))])
     if kind == "period-doubling":
         return complex(mu[np.argmin(np.abs(mu + 1.0))])
@@ -402,6 +497,9 @@ class _BranchRunner:
         self.tr, self.st, self.number = tracer, st, number
         self.points: list[BranchPoint] = []
         self.bifs: list[BifurcationPoint] = []
+        self._copies: list[np.ndarray] = []  # per point: (k, n + 1) shifted section points
+        self._arc: list[float] = []
+        self._trial_failure = ""
 
     def record(self, pt: _Point, s: float) -> None:
         tr = self.tr
@@ -416,30 +514,16 @@ class _BranchRunner:
         tr, st = self.tr, self.st
         cur, s = first, 0.0
         self.record(cur, s)
+        self._remember(cur, s)
         tests = _tests(cur)
         while True:
             if len(self.points) >= st.max_points:
                 return BranchStatus.MAX_POINTS, (f"stopped after {st.max_points} points at "
                                                  f"{tr.param}={tr.p_of(cur.z):.8g}")
-            nxt, fail = None, None
-            while nxt is None:
-                z_pred = cur.z + ds * cur.tangent
-                got = tr.correct(z_pred, cur.tangent, cur.jac)
-                if isinstance(got, _Point):
-                    got.tangent = tr.tangent(got.jac, cur.tangent)
-                    turn = got.tangent @ cur.tangent < MIN_COS
-                    moved = _spectrum_moved(cur.mu, got.mu) > MAX_MU_MOVE and ds > MU_MOVE_DS
-                    if not (turn or moved) or ds <= st.ds_min:
-                        nxt = got
-                        break
-                    got = _Failure(BranchStatus.NOT_CONVERGED, f"the tangent turned sharply "
-                                   f"at {tr.param}={tr.p_of(got.z):.8g}")
-                fail = got
-                if ds <= st.ds_min:
-                    return fail.status, (f"{fail.status.message}: {fail.message} (step "
-                                         f"{ds:.3g}); the branch ends at "
-                                         f"{tr.param}={tr.p_of(cur.z):.8g}")
-                ds = max(st.ds_min, ds / 2)
+            got_step = self._step(cur, ds)
+            if isinstance(got_step, tuple) and isinstance(got_step[0], BranchStatus):
+                return got_step
+            nxt, ds = got_step
             p_new = tr.p_of(nxt.z)
             end = None
             if p_new > st.hi or p_new < st.lo:
@@ -455,12 +539,44 @@ class _BranchRunner:
             self.record(nxt, s)
             if end is not None:
                 return BranchStatus.COMPLETED, f"reached {tr.param}={end:.8g}"
+            back = self._retraced(nxt, s)
+            if back:
+                return BranchStatus.RETRACED, back
+            self._remember(nxt, s)
             if nxt.iterations <= GROW_ITER:
                 ds = min(st.ds_max, ds * 1.6)
             elif nxt.iterations >= SHRINK_ITER:
                 ds = max(st.ds_min, ds * 0.6)
             tr.renew_steps(p_new)
             cur, tests = nxt, new_tests
+
+    def _step(self, cur: _Point, ds: float
+              ) -> tuple[_Point, float] | tuple[BranchStatus, str]:
+        """The next point from ``cur`` (predictor, corrector, step control) and the step it
+        took; (status, message) where the branch ends."""
+        tr, st = self.tr, self.st
+        while True:
+            z_pred = cur.z + ds * cur.tangent
+            got = tr.correct(z_pred, cur.tangent, cur.jac)
+            if isinstance(got, _Point):
+                far = float(np.linalg.norm(got.z - z_pred))
+                if far > MAX_CORRECTION * ds:
+                    got = _Failure(BranchStatus.NOT_CONVERGED, (
+                        f"the corrector moved {far / ds:.3g} step lengths from the predictor "
+                        f"(most {MAX_CORRECTION:g}) to {tr.param}={tr.p_of(got.z):.8g}"))
+            if isinstance(got, _Point):
+                got.tangent = tr.tangent(got.jac, cur.tangent)
+                turn = got.tangent @ cur.tangent < MIN_COS
+                moved = _spectrum_moved(cur.mu, got.mu) > MAX_MU_MOVE and ds > MU_MOVE_DS
+                if not (turn or moved) or ds <= st.ds_min:
+                    return got, ds
+                got = _Failure(BranchStatus.NOT_CONVERGED, f"the tangent turned sharply "
+                               f"at {tr.param}={tr.p_of(got.z):.8g}")
+            if ds <= st.ds_min:
+                return got.status, (f"{got.status.message}: {got.message} (step "
+                                    f"{ds:.3g}); the branch ends at "
+                                    f"{tr.param}={tr.p_of(cur.z):.8g}")
+            ds = max(st.ds_min, ds / 2)
 
     def _at_bound(self, cur: _Point, nxt: _Point, bound: float) -> _Point | None:
         """The branch's point at the parameter value ``bound`` between ``cur`` and ``nxt`` (the
@@ -478,15 +594,60 @@ class _BranchRunner:
         got.tangent = tr.tangent(got.jac, nxt.tangent)
         return got
 
+    # -- retracing
+    def _remember(self, pt: _Point, s: float) -> None:
+        """Keep the point's section points (scaled, with p), all k of them, for
+        :meth:`_retraced`."""
+        self._copies.append(self._shifted(pt))
+        self._arc.append(s)
+
+    def _shifted(self, pt: _Point) -> np.ndarray:
+        """(k, n + 1): the point's z with its section point moved on by 0..k-1 sections."""
+        k = pt.problem.period
+        if k == 1:
+            return pt.z[None, :].copy()
+        pr = pt.problem
+        x = self.tr.x_of(pt.z)
+        ev = pr.evaluate(x, jacobian=False, stride=pr.sections * pr.steps_per_period)
+        Y = np.asarray(ev.states)[:k] / self.tr.scale
+        return np.column_stack([Y, np.full(k, pt.z[-1])])
+
+    def _retraced(self, pt: _Point, s: float) -> str:
+        """Why ``pt`` (at arclength ``s``) lies on the branch already computed ('' if not):
+        within :data:`RETRACE_TOL` segment lengths of a segment between two earlier points (or
+        of their section points shifted by r sections), along it (tangent cosine >= MIN_COS
+        either way) and, unshifted, at least :data:`RETRACE_GAP` segment lengths behind."""
+        if len(self._copies) < 3:
+            return ""
+        Z = np.stack(self._copies)  # (m, k, n + 1)
+        arc = np.asarray(self._arc)
+        z, t = pt.z, pt.tangent
+        for r in range(Z.shape[1]):
+            A, B = Z[:-1, r], Z[1:, r]
+            D = B - A
+            L = np.linalg.norm(D, axis=1)
+            with np.errstate(invalid="ignore", divide="ignore"):
+                w = np.clip(np.einsum("ij,ij->i", z - A, D) / L**2, 0.0, 1.0)
+                dist = np.linalg.norm(A + w[:, None] * D - z, axis=1)
+                along = np.abs(D @ t) / L
+            hit = (L > 0) & (dist <= RETRACE_TOL * L) & (along >= MIN_COS)
+            if r == 0:
+                hit &= s - arc[1:] >= RETRACE_GAP * L
+            if np.any(hit):
+                j = int(np.flatnonzero(hit)[0])
+                shift = f", section points shifted by {r} of {Z.shape[1]}" if r else ""
+                return (f"the branch returned onto its own points at {self.tr.param}="
+                        f"{self.tr.p_of(z):.8g} (between its points {j} and {j + 1}{shift}): it "
+                        f"retraces itself")
+        return ""
+
     # -- detection and location
     def _detect(self, a: _Point, b: _Point, ta: dict, tb: dict) -> None:
         found: list[BifurcationPoint] = []
-        for kind, key in (("fold", "fold"), ("period-doubling", "pd"),
-                          ("neimark-sacker", "ns")):
-            if np.sign(ta[key]) != np.sign(tb[key]) and ta[key] != 0 and tb[key] != 0:
-                bif = self._locate(a, b, kind, key, None)
-                if bif is not None:
-                    found.append(bif)
+        for kind, key in detected(ta, tb):
+            bif = self._locate(a, b, kind, key, None)
+            if bif is not None:
+                found.append(bif)
         for m, (name, _i, _j) in enumerate(a.problem.model.meshes):
             if ta["contact"][m] != tb["contact"][m]:
                 bif = self._locate(a, b, "contact", "contact", m)
@@ -498,15 +659,23 @@ class _BranchRunner:
 
     def _trial(self, a: _Point, b: _Point, sigma: float, final: bool = True) -> _Point | None:
         """The branch point at the arclength fraction ``sigma`` from a to b (with its
-        monodromy and tangent when ``final``)."""
+        monodromy and tangent when ``final``); None (why in ``_trial_failure``) where the
+        corrector fails or lands more than :data:`MAX_CORRECTION` chords from the chord."""
         tr = self.tr
         z_pred = a.z + sigma * (b.z - a.z)
         t = b.z - a.z
-        t = t / np.linalg.norm(t)
+        chord = float(np.linalg.norm(t))
+        t = t / chord
         got = tr.correct(z_pred, t, a.jac, final=final)
         if not isinstance(got, _Point):  # e.g. at a graze: Newton with fresh Jacobians
             got = tr.correct(z_pred, t, None, 3 * tr.max_iter, final=final)
         if not isinstance(got, _Point):
+            self._trial_failure = got.message
+            return None
+        far = float(np.linalg.norm(got.z - z_pred))
+        if far > MAX_CORRECTION * chord:
+            self._trial_failure = (f"the corrector moved {far / chord:.3g} chords from the "
+                                   f"trial's predictor to {tr.param}={tr.p_of(got.z):.8g}")
             return None
         if final:
             got.tangent = tr.tangent(got.jac, a.tangent)
@@ -534,18 +703,21 @@ class _BranchRunner:
         every = on + off
         return _Point(z, a.ev, a.problem, a.jac), min(every), max(every)
 
-    def _locate(self, a: _Point, b: _Point, kind: str, key: str, mesh: int | None
-                ) -> BifurcationPoint | None:
+    def _search(self, a: _Point, b: _Point, key: str, mesh: int | None
+                ) -> tuple[_Point | None, float, float, _Point, _Point]:
         """Regula falsi (Illinois) on the arclength fraction between a and b for the zero of
-        the test function (bisection for the contact count), each trial corrected."""
+        the test function (bisection for the contact count), each trial corrected: (the trial
+        nearest the zero or None, the final bracket in p, the points at its ends)."""
         tr = self.tr
         fa, fb = self._value(a, key, mesh), self._value(b, key, mesh)
-        ca, cb = fa, fb
+        ca = fa
         if key == "contact":  # an integer: bisect on the side it is on
             fa, fb = -1.0, 1.0
         sa, sb = 0.0, 1.0
         pa, pb = tr.p_of(a.z), tr.p_of(b.z)
+        end_a, end_b = a, b
         best, best_f, side = None, math.inf, 0
+        self._trial_failure = ""
         for _ in range(LOCATE_MAX_ITER):
             if key == "contact":
                 sig = 0.5 * (sa + sb)
@@ -567,12 +739,12 @@ class _BranchRunner:
             if abs(f) < best_f or key == "contact":
                 best, best_f = pt, abs(f)
             if np.sign(f) == np.sign(fa):
-                sa, fa, pa = sig, f, p
+                sa, fa, pa, end_a = sig, f, p, pt
                 if side == -1 and key != "contact":
                     fb *= 0.5
                 side = -1
             else:
-                sb, fb, pb = sig, f, p
+                sb, fb, pb, end_b = sig, f, p, pt
                 if side == 1 and key != "contact":
                     fa *= 0.5
                 side = 1
@@ -583,22 +755,92 @@ class _BranchRunner:
             if f == 0.0:
                 pa = pb = pf
                 break
+        return best, pa, pb, end_a, end_b
+
+    def _step_range(self, a: _Point, b: _Point) -> tuple[float, float]:
+        """The parameter range the branch can cover between a and b: their values, widened by
+        the chord (in the parameter) where the parameter turns in the step."""
+        tr = self.tr
+        lo, hi = sorted((tr.p_of(a.z), tr.p_of(b.z)))
+        if np.sign(a.tangent[-1]) != np.sign(b.tangent[-1]):
+            w = float(np.linalg.norm(b.z - a.z)) * tr.pscale
+            lo, hi = lo - w, hi + w
+        return lo, hi
+
+    def _locate(self, a: _Point, b: _Point, kind: str, key: str, mesh: int | None
+                ) -> BifurcationPoint | None:
+        """The bifurcation ``kind`` whose test function ``key`` changes sign between a and b,
+        located (:meth:`_search`), or kept as not located with its bracket; None for a
+        Neimark-Sacker candidate without a complex pair through the unit circle."""
+        tr = self.tr
+        best, pa, pb, end_a, end_b = self._search(a, b, key, mesh)
+        lo, hi = self._step_range(a, b)
+        slack = self.st.locate_tol
+        why = ""
         if best is None:
-            return None
+            why = f"the first trial failed: {self._trial_failure or 'no corrector'}"
+        elif not lo - slack <= tr.p_of(best.z) <= hi + slack:
+            why = (f"the located value {tr.p_of(best.z):.8g} lies outside the step "
+                   f"[{lo:.8g}, {hi:.8g}]")
+            pa, pb, end_a, end_b = tr.p_of(a.z), tr.p_of(b.z), a, b
+        if kind == "neimark-sacker":
+            if _complex_outside(a.mu) == _complex_outside(b.mu) and (
+                    why or neimark_sacker_pair(best.mu) is None):
+                return None  # a real pair's product through 1 (e.g. a neutral saddle)
+            if not why and neimark_sacker_pair(best.mu) is None:
+                why = (f"no complex pair within {NS_MODULUS_TOL:g} of the unit circle at "
+                       f"{tr.p_of(best.z):.8g}")
+        if why:
+            return self._not_located(a, b, kind, key, mesh, (pa, pb), (end_a, end_b), why)
         p = tr.p_of(best.z)
         err = max(abs(pa - p), abs(pb - p))
         crit = _critical(kind, best.mu) if key != "contact" else complex(np.nan)
-        if kind == "neimark-sacker" and not np.isfinite(crit.real):
-            return None  # a neutral saddle (a real pair mu, 1/mu), not a bifurcation
-        if kind == "contact":
-            detail = f"{int(ca)} -> {int(cb)} edge crossings per orbit period"
-        elif kind == "neimark-sacker":
-            detail = f"complex pair |mu| = 1, angle {math.degrees(abs(np.angle(crit))):.4g} deg"
-        else:
-            detail = f"multiplier {crit.real:.6g}"
+        detail = self._detail(kind, key, mesh, a, b, crit)
         M = best.ev.monodromy if key != "contact" else np.full_like(a.ev.monodromy, np.nan)
         return BifurcationPoint(kind, p, err, len(self.points) - 1, self.number, tr.x_of(best.z),
-                           crit, detail, M.copy(), tr.period)
+                                crit, detail, M.copy(), tr.period)
+
+    def _detail(self, kind: str, key: str, mesh: int | None, a: _Point, b: _Point,
+                crit: complex) -> str:
+        if kind == "contact":
+            ca, cb = self._value(a, key, mesh), self._value(b, key, mesh)
+            return f"{int(ca)} -> {int(cb)} edge crossings per orbit period"
+        if kind == "neimark-sacker":
+            return f"complex pair |mu| = 1, angle {math.degrees(abs(np.angle(crit))):.4g} deg"
+        if kind == "branch point" and key == "fold":
+            return (f"the parameter turns with no multiplier through +1 (multiplier "
+                    f"{crit.real:.6g}): another branch meets this one (e.g. a period-2k branch "
+                    f"its period-k orbit at a period doubling)")
+        if kind == "branch point":
+            return f"multiplier {crit.real:.6g} through +1 without a turn: another branch crosses"
+        return f"multiplier {crit.real:.6g}"
+
+    def _not_located(self, a: _Point, b: _Point, kind: str, key: str, mesh: int | None,
+                     bracket: tuple[float, float], ends: tuple[_Point, _Point], why: str
+                     ) -> BifurcationPoint:
+        """The bifurcation kept though not located: value the bracket's midpoint, error its
+        half-width (widened by the step's chord where the parameter turns), x and monodromy of
+        the bracket's end where the test function is smaller."""
+        tr = self.tr
+        lo, hi = sorted(bracket)
+        if key == "fold":  # the turning value lies beyond both ends, within the chord
+            w = float(np.linalg.norm(b.z - a.z)) * tr.pscale
+            lo, hi = lo - w, hi + w
+        if key == "contact":
+            end = ends[0]
+            crit = complex(np.nan)
+        else:
+            fa, fb = (abs(self._value(e, key, mesh)) for e in ends)
+            end = ends[0] if fa <= fb else ends[1]
+            crit = _critical(kind, end.mu)
+        detail = self._detail(kind, key, mesh, a, b, crit) if key == "contact" else (
+            f"multiplier {crit:.6g} at {tr.p_of(end.z):.8g}")
+        detail = (f"not located ({why}): the test function changed sign in "
+                  f"[{lo:.8g}, {hi:.8g}]; {detail}")
+        M = end.ev.monodromy if key != "contact" else np.full_like(a.ev.monodromy, np.nan)
+        return BifurcationPoint(kind, 0.5 * (lo + hi), 0.5 * (hi - lo), len(self.points) - 1,
+                                self.number, tr.x_of(end.z), crit, detail, M.copy(), tr.period,
+                                located=False, section_value=tr.p_of(end.z))
 
 
 # ----------------------------------------------------------------------------- the API
@@ -747,15 +989,17 @@ def _switched(model: Model, param: str, b: BifurcationPoint, number: int, st: _S
     """The period-2k branch from the period doubling ``b``: predictor along the eigenvector of
     the multiplier -1 at fixed parameter, the corrector on the doubled map."""
     k2 = 2 * b.period
-    at = model.with_params(**{param: b.value})
+    at = model.with_params(**{param: b.at})
     tracer = _Tracer(at, param, k2, pscale, run, steps_per_period, tol, CORRECTOR_MAX_ITER)
-    tracer.n = tracer.steps_for(b.value)
+    tracer.n = tracer.steps_for(b.at)
     mu, V = np.linalg.eig(b.monodromy)
     v = np.real(V[:, int(np.argmin(np.abs(mu + 1.0)))]) / tracer.scale
     v /= np.linalg.norm(v)
     t0 = np.concatenate([v, [0.0]])
-    z0 = tracer.z_of(b.x, b.value)
+    z0 = tracer.z_of(b.x, b.at)
     msg = ""
+    where = "" if b.located else (f" (not located: started from the bracket's end at "
+                                  f"{param}={b.at:.8g})")
     for h in (0.02, 0.05, 0.01, 0.1, 0.005):
         got = tracer.correct(z0 + h * t0, t0)
         if not isinstance(got, _Point):
@@ -769,8 +1013,8 @@ def _switched(model: Model, param: str, b: BifurcationPoint, number: int, st: _S
         got.tangent = tracer.tangent(got.jac, t0)
         runner = _BranchRunner(tracer, st, number)
         status, message = runner.run(got, min(st.ds, h))
-        return BranchRun(k2, runner.points, runner.bifs, status, message)
+        return BranchRun(k2, runner.points, runner.bifs, status, message + where)
     return BranchRun(k2, [], [], BranchStatus.START_FAILED,
                      f"no period-{k2} orbit found next to the period doubling at "
-                     f"{param}={b.value:.8g}: {msg}")
+                     f"{param}={b.value:.8g}{where}: {msg}")
 

@@ -34,6 +34,7 @@ class BranchStatus(IntEnum):
     INVALID = 3
     DIVERGED = 4
     START_FAILED = 5
+    RETRACED = 6
 
     @property
     def message(self) -> str:
@@ -48,7 +49,25 @@ _BRANCH_MESSAGES = {
     BranchStatus.INVALID: "the parameter left the model's valid region",
     BranchStatus.DIVERGED: "the integration diverged",
     BranchStatus.START_FAILED: "no periodic orbit found at the start",
+    BranchStatus.RETRACED: "the branch returned onto its own points (it retraces itself, "
+                           "e.g. a period-2k branch that rejoins its period-k orbit)",
 }
+
+
+#: The bifurcation kinds (``bifurcation_kind``), in words.
+BIFURCATION_KINDS = {
+    "fold": "real multiplier through +1 where the parameter turns (limit point)",
+    "branch point": "real multiplier through +1 without a turn, or a turn without a "
+                    "multiplier through +1 (another branch meets this one)",
+    "period-doubling": "real multiplier through -1",
+    "neimark-sacker": "complex pair through the unit circle",
+    "contact": "edge crossings per orbit period change",
+}
+
+
+#: The statuses of a complete branch: it reached an end of the range, or returned onto its own
+#: points (any other status: it ended early).
+COMPLETE = (BranchStatus.COMPLETED, BranchStatus.RETRACED)
 
 
 def branch_status_meaning() -> str:
@@ -213,9 +232,11 @@ def _bifurcation_variables(runs: list[Any], n: int, offsets: list[int]
     mu = np.array([b.multiplier for _, b in bifs], dtype=complex)
     return {
         "bifurcation_kind": ("bifurcation", kind, {
-            "meaning": "fold (real multiplier through +1, turning point), period-doubling "
-                       "(real multiplier through -1), neimark-sacker (complex pair through "
-                       "the unit circle), contact (edge crossings per orbit period change)"}),
+            "meaning": "; ".join(f"{k}: {v}" for k, v in BIFURCATION_KINDS.items())}),
+        "bifurcation_located": ("bifurcation", np.array([int(b.located) for _, b in bifs],
+                                                        np.int64), {
+            "meaning": "1 located (value +- error); 0 not located: the test function changed "
+                       "sign in [value - error, value + error], bifurcation_detail says why"}),
         "bifurcation_value": ("bifurcation", np.array([b.value for _, b in bifs], float), {
             "long_name": "located parameter value"}),
         "bifurcation_error": ("bifurcation", np.array([b.error for _, b in bifs], float), {

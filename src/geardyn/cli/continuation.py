@@ -14,8 +14,9 @@ first orbit's transient (``transient`` or ``transient_periods``, ``converge``, `
 from ``[run]``. A branch that ends early (most points, corrector failure, the parameter leaving the
 model's valid region, divergence, no orbit at the start) is still written, its status and
 message in the file (``branch_status``, ``branch_message``) and printed on stderr; the exit
-status is 0. A progress bar (the parameter's way through the range) is drawn when stderr is a
-terminal.
+status is 0. A branch that reached the range's end or returned onto its own points (it retraces
+itself) is complete. A progress bar (the parameter's way through the range) is drawn when stderr
+is a terminal.
 """
 
 from __future__ import annotations
@@ -144,6 +145,9 @@ def _summary(ds) -> str:
                      f"{param} {span}")
     kinds = [str(k) for k in ds["bifurcation_kind"].values]
     found = ", ".join(f"{kinds.count(k)} {k}" for k in dict.fromkeys(kinds)) or "none"
+    if "bifurcation_located" in ds:
+        lost = int(np.sum(ds["bifurcation_located"].values == 0))
+        found += f" ({lost} not located)" if lost else ""
     return "; ".join(parts) + f"; bifurcations: {found}"
 
 
@@ -195,8 +199,8 @@ def continue_command(
     plot: PlotOption = None,
 ) -> None:
     """Follow a periodic orbit in a parameter (pseudo-arclength continuation), stable or not;
-    locate its folds, period doublings, Neimark-Sacker points and contact changes; save the
-    branch (NetCDF) and draw it."""
+    locate its folds, branch points, period doublings, Neimark-Sacker points and contact
+    changes; save the branch (NetCDF) and draw it."""
     from geardyn.analysis.branch import continuation
     from geardyn.cli.bifurcation import (
         _check_param_name,
@@ -275,9 +279,11 @@ def continue_command(
 
     wrote = write_outputs(ds, out, plot, draw, study=s.study.name, plot_state=plot_state,
                           wall_time_s=round(elapsed, 3))
+    from geardyn.analysis.branch_data import COMPLETE
+
     err = stderr_console()
     for b in range(ds.sizes["branch_id"]):
-        if int(ds["branch_status"].values[b]):
+        if int(ds["branch_status"].values[b]) not in COMPLETE:
             err.print(f"branch {b} (period {int(ds['branch_period'].values[b])}) ended early: "
                       f"{escape(str(ds['branch_message'].values[b]))}", highlight=False,
                       soft_wrap=True)

@@ -1,7 +1,8 @@
 """Continued branches of periodic orbits (:func:`geardyn.continuation`): the branch against its
 parameter, alone or over a brute-force bifurcation diagram (:func:`geardyn.bifurcation`), stable
-parts solid and unstable ones dashed, the located bifurcations marked and labelled (LP fold, PD
-period doubling, NS Neimark-Sacker, CC contact change); beside it the Floquet multipliers on the
+parts solid and unstable ones dashed, the located bifurcations marked and labelled (LP fold, BP
+branch point, PD period doubling, NS Neimark-Sacker, CC contact change; a '?' after the label:
+not located, marked at the middle of its bracket); beside it the Floquet multipliers on the
 unit circle, coloured by the parameter."""
 
 from __future__ import annotations
@@ -19,6 +20,7 @@ __all__ = ["BIFURCATION_LABELS", "QUANTITIES", "plot_branch", "stability_segment
 #: Label, marker and colour of each bifurcation kind (``bifurcation_kind``).
 BIFURCATION_LABELS: dict[str, tuple[str, str, str, str]] = {
     "fold": ("LP", "fold (limit point)", "o", "#d62728"),
+    "branch point": ("BP", "branch point", "v", "#8c564b"),
     "period-doubling": ("PD", "period doubling", "s", "#2ca02c"),
     "neimark-sacker": ("NS", "Neimark–Sacker", "D", "#9467bd"),
     "contact": ("CC", "contact change", "^", "#ff7f0e"),
@@ -164,7 +166,8 @@ def _draw_branch(ax, ds: xr.Dataset, x: np.ndarray, y: np.ndarray) -> list:
 
 
 def _draw_bifurcations(ax, ds: xr.Dataset, y: np.ndarray, quantity: str, state: str) -> list:
-    """A marker and a label (LP, PD, NS, CC) per located bifurcation; legend handles."""
+    """A marker and a label (LP, BP, PD, NS, CC; '?' appended where not located) per
+    bifurcation; legend handles."""
     from matplotlib.lines import Line2D
 
     kinds = ds["bifurcation_kind"].values.astype(str)
@@ -184,7 +187,10 @@ def _draw_bifurcations(ax, ds: xr.Dataset, y: np.ndarray, quantity: str, state: 
                    for a, b in placed)
         placed.append((v, yj))
         first = 1 if kind == "contact" else 0  # contact labels below, the others above
-        ax.annotate(short, (v, yj), xytext=LABEL_OFFSETS[(first + near) % len(LABEL_OFFSETS)],
+        located = ("bifurcation_located" not in ds
+                   or bool(ds["bifurcation_located"].values[j]))
+        ax.annotate(short if located else f"{short}?", (v, yj),
+                    xytext=LABEL_OFFSETS[(first + near) % len(LABEL_OFFSETS)],
                     textcoords="offset points", fontsize=7, color=color, fontweight="bold",
                     gid="bifurcation-label", zorder=6)
         if kind not in seen:
@@ -233,8 +239,11 @@ def _title(ds: xr.Dataset, param: str) -> str:
         else [int(ds.attrs.get("period", 1))]
     text = (f"{who}: period-{'/'.join(str(k) for k in periods)} branch"
             f"{'es' if ds.sizes.get('branch_id', 1) > 1 else ''} continued in {param}")
+    from geardyn.analysis.branch_data import COMPLETE
+
     ended = [f"branch {b}: {ds['branch_message'].values[b]}"
-             for b in range(ds.sizes.get("branch_id", 0)) if int(ds["branch_status"].values[b])]
+             for b in range(ds.sizes.get("branch_id", 0))
+             if int(ds["branch_status"].values[b]) not in COMPLETE]
     return text + ("\nended early: " + "; ".join(ended) if ended else "")
 
 
@@ -261,7 +270,7 @@ def plot_branch(ds: xr.Dataset, path: str | os.PathLike | None = None, *,
 
     Returns a matplotlib Figure (no pyplot): the first axes hold the branch, one line per
     stability segment (stable solid, unstable and marginal dashed; gid ``branch-stable`` /
-    ``branch-unstable``) and one marker (gid ``bifurcation``) with its label (LP, PD, NS, CC)
+    ``branch-unstable``) and one marker (gid ``bifurcation``) with its label (LP, BP, PD, NS, CC)
     per located bifurcation.
     """
     import matplotlib
