@@ -217,3 +217,89 @@ def test_plot_command_redraws_a_saved_basins_result(tmp_path, bistable):
     r = _invoke("plot", nc, "--out", tmp_path / "again.png")
     assert r.exit_code == 0, r.output
     assert "basins dataset" in r.stdout and (tmp_path / "again.png").exists()
+
+
+# -- unresolved cells ----------------------------------------------------------------------------
+
+#: Always in contact (the linear case above): one attractor, the analytic steady state.
+LINEAR = dict(zeta=0.05, kappa=0.0, Fm=2.0, Fa=0.02)
+LINEAR_OMEGA = 1.3
+
+
+def _linear_steady_state() -> np.ndarray:
+    zeta, fm, fa, om = LINEAR["zeta"], LINEAR["Fm"], LINEAR["Fa"], LINEAR_OMEGA
+    amp = fa * om**2 / (1 - om**2 + 2j * zeta * om)
+    return np.array([fm + 1.0 + amp.real, -om * amp.imag])
+
+
+def test_cells_whose_transient_did_not_settle_are_unresolved_not_an_attractor():
+    """A transient budget too short for the far cells (converge 1e-3, transient_max 120): the
+    cells that settled form the one attractor, the analytic steady state; every cell that hit
+    transient_max unsettled gets id -2, is flagged in ``unresolved`` and counted apart, and no
+    attractor is made of them (drifting by ~1e-3 a period, they would otherwise be grouped as a
+    'no period' attractor)."""
+    g = geardyn.GearPair(**LINEAR)
+    ds = geardyn.basins(g, omega=LINEAR_OMEGA, x=("x", 2.0, 4.0, 6), y=("v", -0.5, 0.5, 5),
+                        transient=20.0, transient_max=120.0, converge=1e-3, samples=4,
+                        max_period=2)
+    assert_result(ds, "basins")
+    settled = ds["converged"].values == 1
+    assert settled.any() and (~settled).any()  # both kinds present: the check has teeth
+    ids = ds["attractor_id"].values
+    np.testing.assert_array_equal(ids == -2, ~settled)
+    np.testing.assert_array_equal(ds["unresolved"].values, (~settled).astype(np.int8))
+    assert ds.attrs["n_attractors"] == 1 and np.all(ids[settled] == 0)
+    np.testing.assert_allclose(ds["attractor_point"].values[0, 0], _linear_steady_state(),
+                               atol=2e-2)
+    assert ds.attrs["unresolved_cells"] == int(np.sum(~settled))
+    assert ds.attrs["diverged_cells"] == 0
+    assert math.isclose(ds["attractor_fraction"].values.sum() + ds.attrs["unresolved_fraction"],
+                        1.0, rel_tol=1e-12)
+
+
+def test_cells_at_the_split_limit_are_unresolved_not_diverged(monkeypatch):
+    """Lanes whose steps reached the edge-split limit (the kernel's count ``unresolved`` > 0,
+    or status SPLIT_LIMIT) are set here on a fixed-transient run of the linear case: they get
+    id -2 (not an attractor, not diverged), the others the one attractor."""
+    import geardyn.analysis.basins as basins_module
+    from geardyn.core.status import Status
+
+    real = basins_module.run_lanes
+    marked = {3: ("steps", 5), 7: ("status", Status.SPLIT_LIMIT), 12: ("steps", 1)}
+
+    def run_lanes(model, P, y0, run):
+        r = real(model, P, y0, run=run)
+        for lane, (what, value) in marked.items():
+            if what == "steps":
+                r.unresolved[lane] = value
+            else:
+                r.status[lane] = value
+        return r
+
+    monkeypatch.setattr(basins_module, "run_lanes", run_lanes)
+    g = geardyn.GearPair(**LINEAR)
+    ds = geardyn.basins(g, omega=LINEAR_OMEGA, x=("x", 2.0, 4.0, 6), y=("v", -0.5, 0.5, 5),
+                        transient=400.0, samples=4, max_period=2, converge=None)
+    assert_result(ds, "basins")
+    ids = ds["attractor_id"].values.ravel()
+    want = np.zeros(ids.size, np.int64)
+    want[list(marked)] = -2
+    np.testing.assert_array_equal(ids, want)
+    assert ds.attrs["n_attractors"] == 1 and ds.attrs["diverged_cells"] == 0
+    assert ds.attrs["unresolved_cells"] == len(marked)
+    assert ds["unresolved_steps"].values.ravel()[3] == 5
+    np.testing.assert_allclose(ds["attractor_point"].values[0, 0], _linear_steady_state(),
+                               atol=1e-7)
+
+
+def test_figure_and_summary_show_the_unresolved_cells(bistable):
+    from geardyn.cli.basins import _summary
+    from geardyn.plotting.basins import plot_basins
+
+    _, ds = bistable
+    ds = ds.copy(deep=True)
+    ds["attractor_id"][0, 0] = -2
+    ds.attrs["unresolved_fraction"] = 1 / ds["attractor_id"].size
+    labels = [t.get_text() for t in plot_basins(ds).axes[0].get_legend().get_texts()]
+    assert any(t.startswith("unresolved") for t in labels)
+    assert "unresolved 0.3%" in _summary(ds)

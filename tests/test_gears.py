@@ -3,7 +3,13 @@ each checked against an independent computation or a published value."""
 
 from __future__ import annotations
 
+import ast
+import io
 import math
+import re
+import tokenize
+from decimal import Decimal
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -151,6 +157,7 @@ def test_contact_ratio_by_construction(pinion, wheel, internal, a):
     (lambda: PlanetaryGeometry(gear(24, m=2e-3), gear(24, m=2e-3), gear(72, m=2e-3, internal=True),
                                n_planets=6), "planet_angles", "collide"),
     (lambda: mesh_phases(24, 72, 5), "planet_angles[1]", "assembled"),
+    (lambda: mesh_phases(25, 71, 4, sun_turns=0), "sun_turns", "sense"),
 ])
 def test_bad_geometry_names_the_field(build, field, reason):
     with pytest.raises(ParameterError, match=reason) as info:
@@ -374,12 +381,13 @@ def test_planetary_geometry_ties_the_meshes_together():
 @pytest.mark.parametrize("z_s, z_r, angles_deg", [(25, 71, [0, 90, 180, 270]),
                                                   (25, 71, [0, 90, 187.5, 277.5]),
                                                   (21, 69, [0, 120, 240])])
-def test_phases_by_following_the_teeth(z_s, z_r, angles_deg):
-    """Carrier frame: the sun's teeth turn forwards, the ring's backwards; a mesh event is a
-    tooth passing the planet's direction psi_n. The first event after t = 0 at each planet,
-    relative to planet 1's, in mesh cycles."""
+@pytest.mark.parametrize("sun_turns", [1, -1])
+def test_phases_by_following_the_teeth(z_s, z_r, angles_deg, sun_turns):
+    """Carrier frame: the sun's teeth turn in the sense ``sun_turns`` of psi, the ring's the
+    other way; a mesh event is a tooth passing the planet's direction psi_n. The first event
+    after t = 0 at each planet, relative to planet 1's, in mesh cycles."""
     psi = np.radians(angles_deg)
-    ph = mesh_phases(z_s, z_r, psi)
+    ph = mesh_phases(z_s, z_r, psi, sun_turns=sun_turns)
 
     def first_event(teeth, direction, offset):
         # tooth j at angle offset + direction * t + 2 pi j / teeth (t in mesh cycles: one
@@ -387,8 +395,8 @@ def test_phases_by_following_the_teeth(z_s, z_r, angles_deg):
         pitch = 2 * np.pi / teeth
         return np.array([((p - offset) * direction / pitch) % 1.0 for p in psi])
 
-    sun = first_event(z_s, +1, 0.123)
-    ring = first_event(z_r, -1, 0.456)
+    sun = first_event(z_s, sun_turns, 0.123)
+    ring = first_event(z_r, -sun_turns, 0.456)
     gap_s = np.abs((sun - sun[0]) % 1.0 - ph.sun)
     assert np.all(np.minimum(gap_s, 1 - gap_s) < 1e-9)
     ring_rel = (ring - ring[0]) % 1.0
@@ -414,3 +422,68 @@ def test_angular_thickness_against_a_parametric_involute():
     for r in (rb * 1.001, g.reference_radius, 0.5 * (g.reference_radius + g.tip_radius),
               g.tip_radius):
         assert g.angular_thickness(r) == pytest.approx(2 * (beta0 - flank_angle(r)), abs=1e-12)
+
+
+# -- the documented example ----------------------------------------------------------------------
+
+DOCS = Path(__file__).resolve().parents[1] / "docs"
+_NUMBER = re.compile(r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?")
+_HARMONIC = re.compile(r"(\d+): (force|torque|none)")
+
+
+def _documented(comment: str) -> tuple[object, float] | None:
+    """The value a ``# ...`` comment documents, and half a unit of its last digit shown: the
+    longest prefix of whitespace-separated words that is a Python literal; None if none is."""
+    words = comment.split()
+    for n in range(len(words), 0, -1):
+        text = " ".join(words[:n])
+        try:
+            value = ast.literal_eval(text)
+        except (ValueError, SyntaxError):
+            continue
+        digits = [Decimal(t).as_tuple().exponent for t in _NUMBER.findall(text)]
+        return value, 0.5 * 10.0 ** min(digits) if digits else 0.0
+    return None
+
+
+def _run_documented_block(path: Path) -> list[tuple[str, object, object, float]]:
+    """Run the first python block of ``path`` statement by statement; for every expression
+    whose comment documents a value: (source, value returned, value documented, tolerance)."""
+    text = path.read_text()
+    code = text.split("```python\n", 1)[1].split("```", 1)[0]
+    comments = {tok.start[0]: tok.string[1:].strip()
+                for tok in tokenize.generate_tokens(io.StringIO(code).readline)
+                if tok.type == tokenize.COMMENT}
+    ns: dict = {}
+    checks = []
+    for node in ast.parse(code).body:
+        comment = comments.get(node.end_lineno, "")
+        if not isinstance(node, ast.Expr):
+            exec(compile(ast.Module([node], []), str(path), "exec"), ns)
+            continue
+        value = eval(compile(ast.Expression(node.value), str(path), "eval"), ns)
+        harmonics = _HARMONIC.findall(comment)
+        if harmonics:  # {1: force, 2: none, ...}: the harmonics that survive
+            want = {int(h): {"torque": k == "torque", "force": k == "force"}
+                    for h, k in harmonics}
+            checks.append((ast.get_source_segment(code, node), value, want, 0.0))
+            continue
+        doc = _documented(comment)
+        if doc is not None:
+            checks.append((ast.get_source_segment(code, node), value, *doc))
+    return checks
+
+
+def test_gears_doc_example_numbers_are_what_the_code_returns():
+    """docs/gears.md's example: every number in a comment equals the code's value to the
+    digits shown (contact ratios, ISO c' and c_gamma_alpha, mesh stiffness, phases, harmonics)."""
+    checks = _run_documented_block(DOCS / "gears.md")
+    assert len(checks) >= 9  # the block's documented values are all found
+    for source, value, want, tol in checks:
+        if isinstance(want, dict):
+            assert value == want, source
+            continue
+        got = np.atleast_1d(np.asarray(value, dtype=float))
+        assert got.shape == np.atleast_1d(np.asarray(want, dtype=float)).shape, source
+        assert np.all(np.abs(got - np.asarray(want, dtype=float)) <= tol * (1 + 1e-9)), \
+            f"{source}: the code gives {value}, docs/gears.md says {want}"

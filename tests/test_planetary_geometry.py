@@ -437,3 +437,50 @@ def test_sun_ring_phase_by_tooth_construction(teeth, shifts):
     assert min(abs(gamma - geo.phases.sun_ring), 1 - abs(gamma - geo.phases.sun_ring)) < 1e-9
     if shifts != (0.0, 0.0, 0.0):
         assert 1e-3 < geo.phases.sun_ring < 1 - 1e-3 and abs(geo.phases.sun_ring - 0.5) > 1e-3
+
+
+def _willis_speeds(zs: int, zr: int, held: str) -> dict[str, float]:
+    """Speeds [rad/s] of sun, ring and carrier with ``held`` still and the input (the sun; the
+    carrier when the sun is held) at +1 in the sense of psi: Z_s w_s + Z_r w_r = (Z_s + Z_r) w_c."""
+    if held == "ring":
+        return {"sun": 1.0, "ring": 0.0, "carrier": zs / (zs + zr)}
+    if held == "carrier":
+        return {"sun": 1.0, "ring": -zs / zr, "carrier": 0.0}
+    return {"sun": 0.0, "ring": (zs + zr) / zr, "carrier": 1.0}
+
+
+@pytest.mark.parametrize("held", ["ring", "carrier", "sun"])
+def test_mesh_phases_follow_the_teeth_for_every_held_member(held):
+    """Unequally spaced planets (25/23/71, psi = 0, 90, 187.5, 277.5 deg): in the carrier frame
+    the sun's teeth turn at w_s - w_c and the ring's at w_r - w_c (Willis, the input turning in
+    the sense of psi, as the model's kinematic carrier speed does); a mesh event is a tooth
+    passing the planet's direction psi_n, and mesh n's phase is the delay of its first event
+    after planet 1's, in mesh cycles. With the sun held the sun turns backwards relative to the
+    carrier, so its phases are -Z_s psi_n / 2 pi, not Z_s psi_n / 2 pi."""
+    zs, zr = 25, 71
+    psi = np.radians([0.0, 90.0, 187.5, 277.5])
+    even = stage(zs, 23, zr)
+    geo = g.PlanetaryGeometry(even.sun, even.planet, even.ring, planet_angles=tuple(psi))
+    gs = built(geo, held=held, carrier_speed="kinematic")
+    w = _willis_speeds(zs, zr, held)
+    w_mesh = zs * abs(w["sun"] - w["carrier"])
+    assert zr * abs(w["ring"] - w["carrier"]) == pytest.approx(w_mesh)
+    # the model's carrier turns as assumed here: carrier speed / mesh frequency
+    assert gs.carrier_speed_ratio == pytest.approx(w["carrier"] / w_mesh, abs=1e-15)
+
+    def first_event(teeth: int, rate: float, offset: float) -> np.ndarray:
+        # tooth j at offset + rate t + 2 pi j / teeth; t in mesh cycles (one pitch per cycle)
+        return ((psi - offset) * np.sign(rate) / (2 * np.pi / teeth)) % 1.0
+
+    sun = first_event(zs, w["sun"] - w["carrier"], 0.123)
+    ring = first_event(zr, w["ring"] - w["carrier"], 0.456)
+    model = (-gs.mesh_phase / (2 * math.pi)) % 1.0
+    n = len(psi)
+
+    def close(a: np.ndarray, b: np.ndarray) -> bool:
+        d = np.abs((a - b) % 1.0)
+        return bool(np.all(np.minimum(d, 1.0 - d) < 1e-9))
+
+    assert close(model[:n], (sun - sun[0]) % 1.0)
+    assert close(model[n:] - model[n], (ring - ring[0]) % 1.0)
+    assert not close(model[:n], (-(sun - sun[0])) % 1.0)  # the other sense differs here

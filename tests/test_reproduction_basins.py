@@ -66,6 +66,8 @@ def test_velocity_pairs_and_the_report_line():
     assert "Omega = 0.4865" in line and "3 x 2 initial X_sq, V_sq" in line
     assert "#0 period-1 75.0% (the down sweep's orbit)" in line
     assert "#1 period-1 25.0%;" in line and "diverged 0.0%" in line
+    b.attrs.update(unresolved_fraction=1 / 6)
+    assert "unresolved 16.7%" in summary(b)
 
 
 def test_reproduce_with_basins_writes_them_into_the_report(tmp_path, capsys, monkeypatch):

@@ -667,9 +667,11 @@ def _result_spec(ds: Any, kind: str) -> tuple[list[str], dict[str, tuple[str, ..
                  "branch_message": ("branch_id",)}, [])
     if kind == "basins":
         x, y = str(a.get("x", "x")), str(a.get("y", "y"))
-        return (["x", "y", "Omega", "time_unit", "diverged_fraction", "n_attractors"],
+        return (["x", "y", "Omega", "time_unit", "diverged_fraction", "unresolved_fraction",
+                 "n_attractors"],
                 {y: (y,), x: (x,), "attractor": ("attractor",), "state": ("state",)},
                 {"attractor_id": (y, x), "period": (y, x), "status": (y, x),
+                 "unresolved": (y, x),
                  "attractor_period": ("attractor",), "attractor_fraction": ("attractor",),
                  "attractor_point": ("attractor", "point", "state"),
                  "attractor_orbit": ("attractor",)}, ["status"])
@@ -689,6 +691,7 @@ def _result_spec(ds: Any, kind: str) -> tuple[list[str], dict[str, tuple[str, ..
 _VARIABLE_ATTRS = {"period": ("meaning",), "status": ("meaning",),
                    "final_time": ("units",), "poincare_time": ("units",), "time": ("units",),
                    "attractor_id": ("meaning",), "attractor_fraction": ("meaning",),
+                   "unresolved": ("meaning",),
                    "dte_rms": ("units",), "dte_peak": ("units",), "jump_omega": ("meaning",),
                    "bifurcation_kind": ("meaning",), "bifurcation_located": ("meaning",)}
 

@@ -3,10 +3,18 @@
 Every parameter is stored as a float in SI units. A plain number is taken to be SI already; a
 string is parsed with pint and converted to the field's SI unit, so ``"1500 N m"``, ``"1.5 kN*m"``
 and ``1500`` are the same input torque.
+
+Frequencies and speeds (kind ``"frequency"``, SI unit rad/s) are angular: a plain number is
+rad/s, and a unit string must say whether it counts radians or cycles. ``"10 rad/s"``,
+``"5 deg/s"`` and ``"3000 rpm"`` (= 3000 * 2 pi / 60 rad/s) carry an angle; ``"50 Hz"`` and
+``"2 kHz"`` count cycles, 1 Hz = 2 pi rad/s. A bare inverse time (``"1/s"``, ``"s^-1"``,
+``"1/min"``) says neither and is refused as ambiguous (pint itself takes the radian as
+dimensionless and would read 1 Hz as 1 rad/s).
 """
 
 from __future__ import annotations
 
+import math
 import re
 from functools import lru_cache
 
@@ -84,6 +92,14 @@ def to_si(value: object, kind: str) -> float:
         raise ValueError(f"cannot read {text!r} as a quantity ({type(exc).__name__})") from None
     if not isinstance(q, pint.Quantity):  # a bare number parsed from a string: as it is
         return _real(q, text, unit)
+    magnitude = _magnitude(q, text, unit)
+    if kind == "frequency":
+        return _angular(q, text, magnitude)
+    return magnitude
+
+
+def _magnitude(q: pint.Quantity, text: str, unit: str) -> float:
+    """``q`` in ``unit`` (pint's conversion), rounded to 15 significant digits."""
     try:
         magnitude = _real(q.to(unit or "dimensionless").magnitude, text, unit)
     except pint.DimensionalityError:
@@ -98,6 +114,32 @@ def to_si(value: object, kind: str) -> float:
     # Unit conversion multiplies by powers of ten; rounding to 15 significant digits removes the
     # last-bit noise ("50 um" -> 5e-05, not 4.9999999999999996e-05).
     return float(f"{magnitude:.15g}")
+
+
+#: Units that count cycles per unit time (1 Hz = 2 pi rad/s), by pint's base name.
+_CYCLE_UNITS = ("hertz",)
+
+
+def _angular(q: pint.Quantity, text: str, magnitude: float) -> float:
+    """An angular frequency [rad/s] from a quantity of dimension 1/time whose conversion to rad/s
+    gave ``magnitude``: as it is when the units carry an angle (rad/s, deg/s, rpm), 2 pi times
+    it when they count cycles (Hz); a bare inverse time (1/s) or a mix is refused."""
+    ureg = registry()
+    cycles = 0.0
+    for name, exponent in q.unit_items():
+        if any(base in _CYCLE_UNITS for _, base, _ in ureg.parse_unit_name(name)):
+            cycles += exponent
+    base = dict(q.to_base_units().unit_items())
+    angle = base.pop("radian", 0)
+    base.pop("second", None)
+    if base or (cycles, angle) not in ((0, 1), (1, 0)):
+        why = ("a bare inverse time: write rad/s for an angular frequency, or Hz or rpm for"
+               " cycles" if (cycles, angle) == (0, 0) and not base
+               else "its units mix cycles, angles or counts")
+        raise ValueError(f"{text!r} is ambiguous as an angular frequency in rad/s ({why})")
+    if cycles:
+        return 2.0 * math.pi * magnitude
+    return magnitude
 
 
 def _real(value: object, text: str, unit: str) -> float:

@@ -14,7 +14,12 @@ identified from them:
   grouped by the bounding box of their section points, boxes within ``chaos_tol`` (relative to
   the box's size and ``max(1, |x|)``) being the same attractor. This is a heuristic (two
   chaotic attractors with overlapping boxes are one), stated in the result's attributes;
-* diverged lanes (|state| > bound): attractor id -1, never dropped, counted separately.
+* diverged lanes (|state| > bound): attractor id -1, never dropped, counted separately;
+* unresolved lanes: attractor id -2, never part of an attractor, counted separately: the
+  transient by convergence reached ``transient_max`` without the section point settling
+  (``converged`` 0), or grid steps reached the edge-split limit and were integrated unsplit
+  across an edge (``unresolved_steps`` > 0; status SPLIT_LIMIT), so the section points the lane
+  recorded are not trusted to identify its attractor.
 
 The attractors get ids 0, 1, ... in decreasing order of the share of the grid they attract.
 Where :class:`~geardyn.PeriodicOrbit` objects are given (from :func:`geardyn.periodic_orbit` at
@@ -40,11 +45,13 @@ from geardyn.core.status import Status, status_attrs
 from geardyn.execution.executor import default_chunk, run_chunks
 from geardyn.solvers.ensemble import run_lanes
 
-__all__ = ["CHAOS_TOL", "CONVERGE", "DIVERGED", "MATCH_TOL", "basins", "grid_axis", "match_cycles",
-           "match_orbits"]
+__all__ = ["CHAOS_TOL", "CONVERGE", "DIVERGED", "MATCH_TOL", "UNRESOLVED", "basins", "grid_axis",
+           "match_cycles", "match_orbits"]
 
 #: Attractor id of a diverged cell.
 DIVERGED = -1
+#: Attractor id of an unresolved cell (transient not settled, or steps at the split limit).
+UNRESOLVED = -2
 #: Default tolerance of matching periodic attractors (relative, scaled states).
 MATCH_TOL = 1e-3
 #: Default tolerance of grouping non-periodic lanes by their section points' bounding boxes.
@@ -100,6 +107,7 @@ def _basin_task(model: Model, P: np.ndarray, y0: np.ndarray, *, run: RunSettings
     var = lane_variables(model, r, None, run.max_period, run.period_tol)
     out = {"section_period": classify_period(r.samples, run.max_period, run.period_tol),
            "period": var["period"], "status": r.status, "converged": r.converged,
+           "unresolved_steps": r.unresolved,
            "last": r.samples[:, -keep:], "box_min": np.min(r.samples, axis=1),
            "box_max": np.max(r.samples, axis=1), "final_time": r.final_time}
     if "contact" in var:
@@ -238,13 +246,16 @@ def basins(
     Returns
     -------
     xarray.Dataset (``geardyn_kind = "basins"``) with dims (y, x) of the grid and
-    ``attractor`` (the table's rows): ``attractor`` id per cell (-1 diverged), ``period`` (in
-    forcing periods, as the sweeps), ``status``, ``converged``, ``contact`` per mesh; the table
+    ``attractor`` (the table's rows): ``attractor_id`` per cell (-1 diverged, -2 unresolved),
+    ``unresolved`` (1 where the cell's transient did not settle or steps reached the
+    edge-split limit), ``unresolved_steps``, ``period`` (in forcing periods, as the sweeps),
+    ``status``, ``converged``, ``contact`` per mesh; the table
     ``attractor_period``, ``attractor_point`` (attractor, point, state: its section points,
     NaN-padded; for a non-periodic attractor its last section point), ``attractor_fraction``,
     ``attractor_cells``, ``attractor_orbit`` (-1 none), ``attractor_start`` (the first grid
-    cell that reaches it), ``attractor_contact``, ``attractor_force_rms``; settings and
-    ``diverged_fraction`` in ``attrs``.
+    cell that reaches it), ``attractor_contact``, ``attractor_force_rms``; settings,
+    ``diverged_fraction``, ``diverged_cells``, ``unresolved_fraction`` and ``unresolved_cells``
+    in ``attrs``.
     """
     if run is None:
         mp = int(settings.get("max_period", RunSettings().max_period))
@@ -277,9 +288,11 @@ def basins(
     out = run_chunks(functools.partial(_basin_task, run=run, keep=keep), m, {"P": P, "y0": Y0},
                      chunk=size, progress=progress, meta={"analysis": "basins"})
     scale = np.asarray(m.state_scale, dtype=float)
-    sec = np.where(out["status"] == Status.OK, out["section_period"], UNBOUNDED)
+    diverged, unresolved = _outcomes(out)
+    sec = np.where(diverged | unresolved, UNBOUNDED, out["section_period"])
     raw = _identify(sec, out["last"] / scale, np.stack([out["box_min"], out["box_max"]], 1)
                     / scale, match_tol, chaos_tol)
+    raw[unresolved] = UNRESOLVED
     labels, table = _table(raw, sec, out, Y0, scale)
     ds = _dataset(m, (yn, yv), (xn, xv), labels, out, table, keep)
     ds.attrs.update(run.attrs())
@@ -289,6 +302,8 @@ def basins(
         base_state=b, state_scale=scale, n_attractors=int(table["period"].size),
         diverged_fraction=float(np.mean(labels == DIVERGED)),
         diverged_cells=int(np.sum(labels == DIVERGED)),
+        unresolved_fraction=float(np.mean(labels == UNRESOLVED)),
+        unresolved_cells=int(np.sum(labels == UNRESOLVED)),
         start="each cell from the base state with its two grid states, at time 0 (phase 0)",
         aperiodic_matching="non-periodic lanes grouped by the bounding boxes of their section "
                            "points (chaos_tol): a heuristic",
@@ -316,13 +331,25 @@ def match_orbits(ds: xr.Dataset, orbits: Sequence[Any]) -> xr.Dataset:
     return ds
 
 
+def _outcomes(out: dict[str, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+    """(diverged, unresolved) per lane: diverged where the status is neither OK nor
+    SPLIT_LIMIT; unresolved where not diverged and the transient did not settle (``converged``
+    0) or steps reached the edge-split limit (``unresolved_steps`` > 0 or status SPLIT_LIMIT)."""
+    status = np.asarray(out["status"])
+    diverged = (status != Status.OK) & (status != Status.SPLIT_LIMIT)
+    unresolved = ~diverged & ((np.asarray(out["converged"]) == 0)
+                              | (np.asarray(out["unresolved_steps"]) > 0)
+                              | (status == Status.SPLIT_LIMIT))
+    return diverged, unresolved
+
+
 def _table(raw: np.ndarray, sec: np.ndarray, out: dict[str, np.ndarray], Y0: np.ndarray,
            scale: np.ndarray) -> tuple[np.ndarray, dict[str, Any]]:
     """Relabel attractors by decreasing share of the grid; their table (one entry each)."""
-    ids = [a for a in np.unique(raw) if a != DIVERGED]
+    ids = [a for a in np.unique(raw) if a >= 0]
     counts = np.array([np.sum(raw == a) for a in ids], np.int64)
     order = [ids[i] for i in np.argsort(-counts, kind="stable")]
-    labels = np.full(raw.size, DIVERGED, np.int64)
+    labels = np.where(raw < 0, raw, DIVERGED).astype(np.int64)
     first = []
     for new, a in enumerate(order):
         where = raw == a
@@ -354,7 +381,15 @@ def _dataset(m: Model, y: tuple[str, np.ndarray], x: tuple[str, np.ndarray], lab
     grid = (yn, xn)
     ds["attractor_id"] = (grid, labels.reshape(shape), {
         "long_name": "attractor reached from the cell's initial state",
-        "meaning": "index into the attractor table (dim 'attractor'); -1 diverged"})
+        "meaning": "index into the attractor table (dim 'attractor'); -1 diverged, "
+                   "-2 unresolved (see 'unresolved')"})
+    ds["unresolved"] = (grid, (labels == UNRESOLVED).reshape(shape).astype(np.int8), {
+        "long_name": "cell without a trusted attractor (attractor_id -2)",
+        "meaning": "1: the transient by convergence reached transient_max unsettled (converged "
+                   "0) or grid steps reached the edge-split limit (unresolved_steps > 0); "
+                   "0 otherwise"})
+    ds["unresolved_steps"] = (grid, out["unresolved_steps"].reshape(shape), {
+        "long_name": "grid steps that reached the edge-split limit"})
     ds["period"] = (grid, out["period"].reshape(shape), {
         "long_name": "period in forcing periods",
         "meaning": "k>=1 period-k, 0 no period <= max_period found, -1 unbounded"})
@@ -381,18 +416,19 @@ def _dataset(m: Model, y: tuple[str, np.ndarray], x: tuple[str, np.ndarray], lab
                      "sweeps' section_periods)"})
     ds["attractor_fraction"] = ("attractor", table["cells"] / n, {
         "long_name": "share of the grid's cells attracted",
-        "meaning": "sum over attractors + diverged_fraction = 1"})
+        "meaning": "sum over attractors + diverged_fraction + unresolved_fraction = 1"})
     ds["attractor_orbit"] = ("attractor", np.full(A, -1, np.int64), {
         "meaning": "index of the given PeriodicOrbit the attractor reproduces; -1 none"})
     ds["attractor_start"] = (("attractor", "state"), table["start"].reshape(A, m.n_states), {
         "long_name": "initial state of the first cell reaching the attractor"})
     first = table["first"]
+    n_mesh = len(m.meshes)
     if "contact" in out:
         ds["attractor_contact"] = (("attractor", "mesh"), np.array(CONTACT_LABELS)[
-            out["contact"][first]].reshape(A, -1))
+            out["contact"][first]].reshape(A, n_mesh))
     if "force_rms" in out:
         ds["attractor_force_rms"] = (("attractor", "mesh"), out["force_rms"][first].reshape(
-            A, -1), {"units": m.observable_units})
+            A, n_mesh), {"units": m.observable_units})
         ds["attractor_force_peak"] = (("attractor", "mesh"), out["force_peak"][first].reshape(
-            A, -1), {"units": m.observable_units})
+            A, n_mesh), {"units": m.observable_units})
     return ds

@@ -161,6 +161,8 @@ def _summary(ds) -> str:
                      f"{100 * float(ds['attractor_fraction'].values[a]):.1f}%"
                      + (f" (Newton orbit {orbit})" if orbit >= 0 else ""))
     parts.append(f"diverged {100 * float(ds.attrs['diverged_fraction']):.1f}%")
+    parts.append(f"unresolved {100 * float(ds.attrs.get('unresolved_fraction', 0.0)):.1f}% "
+                 "(transient unsettled or steps at the split limit)")
     return ", ".join(parts)
 
 

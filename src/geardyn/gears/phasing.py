@@ -9,7 +9,11 @@ stiffness is k(t - gamma T_m). Then
 * gamma_sn = Z_s psi_n / (2 pi)  (mod 1),
 * gamma_rn = gamma_rs - Z_r psi_n / (2 pi)  (mod 1),
 
-where gamma_rs is the ring-planet phase relative to the sun-planet phase of the same planet. A
+where gamma_rs is the ring-planet phase relative to the sun-planet phase of the same planet.
+When the sun turns against psi relative to the carrier (the sun held and the carrier driven in
+the sense of psi: the sun, loaded backwards too, still drives the planets in the carrier frame)
+the set is the mirror image of one with the planets at -psi_n: gamma_sn = -Z_s psi_n / (2 pi),
+gamma_rn = gamma_rs + Z_r psi_n / (2 pi) (mod 1), gamma_rs unchanged (symmetric teeth). A
 planet can be assembled only where (Z_s + Z_r) psi_n / (2 pi) is a whole number, which makes
 the two expressions agree for every planet. gamma_rs follows from the planet's tooth thickness:
 the sun loads one flank of a planet tooth at the sun-side pitch point, the ring the opposite
@@ -71,12 +75,17 @@ def _check_assembly(sun_teeth: int, ring_teeth: int, angles: np.ndarray) -> None
 
 
 def mesh_phases(sun_teeth: int, ring_teeth: int, planet_angles: np.ndarray | int,
-                sun_ring_phase: float = 0.0) -> MeshPhases:
+                sun_ring_phase: float = 0.0, sun_turns: int = 1) -> MeshPhases:
     """Phases of every sun-planet and ring-planet mesh (Parker & Lin 2004).
 
     ``planet_angles`` [rad] or a planet count (equally spaced). ``sun_ring_phase`` is gamma_rs
     (see :func:`sun_ring_phase`; :class:`PlanetaryGeometry` computes it from the teeth).
+    ``sun_turns``: +1 when the sun turns in the sense of psi relative to the carrier, -1 when
+    against it (the mirrored set, see the module doc).
     """
+    if sun_turns not in (1, -1) or isinstance(sun_turns, bool):
+        raise ParameterError("sun_turns", sun_turns, "must be +1 or -1 (the sense in which "
+                             "the sun turns relative to the carrier)")
     angles = (equally_spaced(planet_angles) if isinstance(planet_angles, numbers.Integral)
               else np.asarray(planet_angles, dtype=float).ravel())
     for name, z in (("sun_teeth", sun_teeth), ("ring_teeth", ring_teeth)):
@@ -85,7 +94,7 @@ def mesh_phases(sun_teeth: int, ring_teeth: int, planet_angles: np.ndarray | int
     if angles.size < 1:
         raise ParameterError("planet_angles", planet_angles, "need at least one planet")
     _check_assembly(sun_teeth, ring_teeth, angles)
-    rel = angles - angles[0]
+    rel = sun_turns * (angles - angles[0])
     gamma_s = (sun_teeth * rel / (2.0 * np.pi)) % 1.0
     gamma_r = (sun_ring_phase - ring_teeth * rel / (2.0 * np.pi)) % 1.0
     # whole cycles come out as 1 - 1e-16: fold them to 0
@@ -170,9 +179,15 @@ class PlanetaryGeometry:
 
     @cached_property
     def phases(self) -> MeshPhases:
-        """Parker & Lin mesh phases, gamma_rs from the planet's teeth."""
+        """Parker & Lin mesh phases, gamma_rs from the planet's teeth, the sun turning in the
+        sense of psi relative to the carrier (ring or carrier held, sun input)."""
+        return self.phases_turning(1)
+
+    def phases_turning(self, sun_turns: int) -> MeshPhases:
+        """The mesh phases with the sun turning in the sense of psi relative to the carrier
+        (``sun_turns`` = +1) or against it (-1: the sun held, the carrier driven)."""
         return mesh_phases(self.sun.teeth, self.ring.teeth, np.asarray(self.planet_angles),
-                           sun_ring_phase(self.sun_mesh, self.ring_mesh))
+                           sun_ring_phase(self.sun_mesh, self.ring_mesh), sun_turns)
 
     def _check_spacing(self) -> None:
         a = self.sun_mesh.centre_distance

@@ -464,10 +464,12 @@ class PlanetaryGearSet(Model):
         their relative Fourier coefficients (``harmonics`` terms, exact: no smoothing beyond
         the waves' ``transition`` ramps) as ``waveform={"sun": ..., "ring": ...}``; the Parker &
         Lin phases gamma as ``sun_mesh_phase``/``ring_mesh_phase`` = -2 pi gamma (mesh n's
-        stiffness is k(theta - 2 pi gamma_n)); the members' ``radius`` where None (base radius
-        of sun, ring and planet, the carrier's: the centre distance); ``sun_backlash`` and
-        ``ring_backlash`` where not given: half the geometry's normal backlash
-        j cos(alpha_w) / 2 of each mesh [m] (0 at the default, tight centre distance).
+        stiffness is k(theta - 2 pi gamma_n); the input turning in the sense of psi, so with
+        the sun held the sun turns against psi relative to the carrier and the phases are
+        ``geometry.phases_turning(-1)``, else ``geometry.phases``); the members' ``radius``
+        where None (base radius of sun, ring and planet, the carrier's: the centre distance);
+        ``sun_backlash`` and ``ring_backlash`` where not given: half the geometry's normal
+        backlash j cos(alpha_w) / 2 of each mesh [m] (0 at the default, tight centre distance).
         ``kw`` are the other :class:`PlanetaryGearSet` inputs (damping, torques, errors, ...);
         ``carrier_speed="kinematic"`` sets ``carrier_speed_ratio`` from the tooth counts and
         ``held`` (:func:`_kinematic_ratio`), so the carrier speed follows the input speed.
@@ -484,7 +486,8 @@ class PlanetaryGearSet(Model):
                 raise ParameterError(f, kw[f], "comes from the geometry; change the gears "
                                      "(or build PlanetaryGearSet directly)")
         w_sun, w_ring = geometry.waveforms(**dict(waveform_options or {}))
-        phases = geometry.phases
+        held_member = _held(held, tuple(kw.get("fixed", ())))
+        phases = geometry.phases_turning(_sun_turns(held_member))
         meshes = {"sun": geometry.sun_mesh, "ring": geometry.ring_mesh}
         radii = {"sun": geometry.sun.base_radius, "ring": geometry.ring.base_radius,
                  "carrier": geometry.sun_mesh.centre_distance,
@@ -500,8 +503,7 @@ class PlanetaryGearSet(Model):
             if kw.get("carrier_speed_ratio") is not None:
                 raise ParameterError("carrier_speed_ratio", kw["carrier_speed_ratio"],
                                      "carrier_speed = 'kinematic' sets it; give one of them")
-            kw["carrier_speed_ratio"] = _kinematic_ratio(
-                _held(held, tuple(kw.get("fixed", ()))), geometry)
+            kw["carrier_speed_ratio"] = _kinematic_ratio(held_member, geometry)
         for g, mesh in meshes.items():
             kw.setdefault(f"{g}_backlash",
                           0.5 * max(mesh.backlash, 0.0) * math.cos(mesh.operating_pressure_angle))
@@ -1146,6 +1148,13 @@ def _held(held: str | None, fixed: tuple[str, ...]) -> str:
     if held not in CENTRAL:
         raise ParameterError("held", held, f"must be one of {', '.join(CENTRAL)}")
     return held
+
+
+def _sun_turns(held: str) -> int:
+    """The sense of the sun's rotation relative to the carrier, the input member turning in the
+    sense of psi and u: +1 with the ring or carrier held (sun input), -1 with the sun held
+    (carrier input; the sun then turns backwards relative to the carrier)."""
+    return -1 if held == "sun" else 1
 
 
 def _kinematic_ratio(held: str, geometry: Any) -> float:

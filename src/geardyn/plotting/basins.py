@@ -1,7 +1,8 @@
 """Basins of attraction: the attractor reached from each initial condition as a colour map, one
-colour per attractor (diverged cells black), the attractors' section points marked on the same
-axes (the grid's axes are states), and a legend with each attractor's period, share of the grid,
-contact regime and matched orbit."""
+colour per attractor (diverged cells black, unresolved cells light grey), the attractors' section
+points marked on the same axes (the grid's axes are states), and a legend with each attractor's
+period, share of the grid, contact regime and matched orbit, and the diverged and unresolved
+shares."""
 
 from __future__ import annotations
 
@@ -15,10 +16,11 @@ from geardyn.plotting.style import RC, state_label
 
 __all__ = ["plot_basins"]
 
-#: Attractor colours (cycled); diverged cells are black.
+#: Attractor colours (cycled); diverged cells are black, unresolved ones light grey.
 COLORS = ("#4C72B0", "#DD8452", "#55A868", "#C44E52", "#8172B3", "#937860", "#DA8BC3",
           "#8C8C8C", "#CCB974", "#64B5CD")
 DIVERGED_COLOR = "#000000"
+UNRESOLVED_COLOR = "#D9D9D9"
 
 
 def _label(ds: xr.Dataset, a: int) -> str:
@@ -47,25 +49,28 @@ def plot_basins(ds: xr.Dataset, path: str | os.PathLike | None = None):
     xn, yn = ds.attrs["x"], ds.attrs["y"]
     ids = ds["attractor_id"].values
     n = ds.sizes["attractor"]
-    colors = [DIVERGED_COLOR] + [COLORS[a % len(COLORS)] for a in range(n)]
+    colors = [UNRESOLVED_COLOR, DIVERGED_COLOR] + [COLORS[a % len(COLORS)] for a in range(n)]
     cmap = ListedColormap(colors)
-    norm = BoundaryNorm(np.arange(-1, n + 1) - 0.5, cmap.N)
+    norm = BoundaryNorm(np.arange(-2, n + 1) - 0.5, cmap.N)
     with matplotlib.rc_context(RC):
         fig = Figure(figsize=(7.6, 4.8), layout="constrained")
         ax = fig.subplots()
         ax.pcolormesh(ds[xn].values, ds[yn].values, ids, cmap=cmap, norm=norm,
                       shading="nearest")
-        handles = [Patch(facecolor=colors[a + 1], label=_label(ds, a)) for a in range(n)]
-        diverged = float(ds.attrs.get("diverged_fraction", np.mean(ids < 0)))
-        if np.any(ids < 0):
+        handles = [Patch(facecolor=colors[a + 2], label=_label(ds, a)) for a in range(n)]
+        if np.any(ids == -1):
             handles.append(Patch(facecolor=DIVERGED_COLOR,
-                                 label=f"diverged, {100 * diverged:.1f}%"))
+                                 label=f"diverged, {100 * np.mean(ids == -1):.1f}%"))
+        if np.any(ids == -2):
+            handles.append(Patch(facecolor=UNRESOLVED_COLOR, edgecolor="0.5",
+                                 label=f"unresolved (unsettled or split limit), "
+                                       f"{100 * np.mean(ids == -2):.1f}%"))
         states = [str(s) for s in ds["state"].values]
         pts = ds["attractor_point"].values
         for a in range(n):
             p = pts[a][np.all(np.isfinite(pts[a]), axis=1)]
             ax.plot(p[:, states.index(xn)], p[:, states.index(yn)], ls="none", marker="*",
-                    ms=13, mfc=colors[a + 1], mec="black", mew=1.0)
+                    ms=13, mfc=colors[a + 2], mec="black", mew=1.0)
         ax.set_xlim(ds[xn].values.min(), ds[xn].values.max())
         ax.set_ylim(ds[yn].values.min(), ds[yn].values.max())
         ax.set_xlabel(f"initial {state_label(xn)}")

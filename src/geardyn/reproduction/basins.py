@@ -98,7 +98,8 @@ def case_basins(case: Case, interpretation: str, ds: xr.Dataset, n: int,
 
 
 def summary(b: xr.Dataset) -> str:
-    """One line: the frequency, each attractor's period, share and the sweeps it carries."""
+    """One line: the frequency, each attractor's period, share and the sweeps it carries, and
+    the shares of diverged and unresolved cells."""
     sweeps = str(b.attrs.get("sweeps", "up, down")).split(", ")
     parts = []
     for a in range(b.sizes["attractor"]):
@@ -108,6 +109,7 @@ def summary(b: xr.Dataset) -> str:
         parts.append(f"#{a} {'period-' + str(k) if k > 0 else 'no period'} "
                      f"{100 * float(b['attractor_fraction'].values[a]):.1f}%{follow}")
     parts.append(f"diverged {100 * float(b.attrs['diverged_fraction']):.1f}%")
+    parts.append(f"unresolved {100 * float(b.attrs.get('unresolved_fraction', 0.0)):.1f}%")
     return (f"basins of attraction at Omega = {float(b.attrs['Omega']):.4g} "
             f"({b.sizes[b.attrs['x']]} x {b.sizes[b.attrs['y']]} initial "
             f"{b.attrs['x']}, {b.attrs['y']}): " + "; ".join(parts))
