@@ -3,9 +3,8 @@
 LLVM tunes code for most Intel server CPUs with AVX-512 (Skylake-SP to Emerald Rapids) to
 prefer 256-bit vectors (``prefer-256-bit``, against the clock drop of 512-bit code on the
 first of them), while for AMD Zen 4 it prefers 512 bits. geardyn's fused step loops are
-vector code over lanes and gain from the wider registers: on an Emerald Rapids the paper's
-reference workload takes 0.89x the time with 512-bit vectors, its fused step loop 0.70x
-(``bench/RESULTS.md``, session 12). The kernels are compiled without fastmath, every lane's
+vector code over lanes and gain from the wider registers (the figures are in
+``bench/RESULTS.md``). The kernels are compiled without fastmath, every lane's
 arithmetic is elementwise, so results are bitwise the same at any width
 (``tests/test_jit_target.py``).
 
