@@ -3,10 +3,11 @@ PYTHON ?= python3
 VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
-export NUMBA_CACHE_DIR ?= $(CURDIR)/.geardyn-cache/numba
-export GEARDYN_CACHE_DIR ?= $(CURDIR)/.geardyn-cache
+# Compiled kernels go to geardyn's one cache, the same for `make`, `geardyn` and the Python API:
+# $GEARDYN_CACHE_DIR (default ~/.cache/geardyn; numba's code in its numba/ unless NUMBA_CACHE_DIR
+# is set), see src/geardyn/_cache.py.
 
-.PHONY: venv demo test test-slow bench bench-peers reproduce reproduce-verdicts lint clean docs
+.PHONY: venv demo test test-slow bench bench-peers reproduce reproduce-verdicts lint clean clean-cache docs
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -77,4 +78,8 @@ lint: $(STAMP)
 	$(BIN)/ruff check src tests examples bench
 
 clean:
-	rm -rf $(VENV) out .geardyn-cache docs/_build docs/api/generated docs/auto_examples
+	rm -rf $(VENV) out docs/_build docs/api/generated docs/auto_examples
+
+# geardyn's kernel cache (every model's kernels compile again on their next use)
+clean-cache:
+	rm -rf "$${GEARDYN_CACHE_DIR:-$${XDG_CACHE_HOME:-$$HOME/.cache}/geardyn}"
