@@ -14,12 +14,14 @@ import pytest
 
 import geardyn
 
-#: docs/numerics.md: the default step keeps the Poincare points of periodic attractors with
-#: contact loss within 1e-6 (dimensionless, max norm) of the exact orbit at nine points in ten,
-#: and within 2.5e-6 at every point (the worst next to a change of contact regime).
+#: docs/numerics.md states what this asserts: the default step keeps the Poincare points of the
+#: periodic attractors of the Fig. 3 diagram within 1e-6 (dimensionless, max norm) of the exact
+#: orbit at >= 80 % of the points, and within 5e-6 at every point (measured: 56 of 62, 90 %,
+#: and at most 2.2e-6; the bounds leave room for a kernel change that moves an error by a few
+#: tenths, while the old default of 48 steps per fastest mode, errors 7e-6 to 1.2e-5, fails).
 POINT_TOL = 1e-6
-POINT_TOL_MAX = 2.5e-6
-SHARE_WITHIN_TOL = 0.9
+POINT_TOL_MAX = 5e-6
+SHARE_WITHIN_TOL = 0.8
 
 
 def _flow(model: geardyn.Model, y: np.ndarray, periods: int) -> np.ndarray:
@@ -50,8 +52,8 @@ def _shoot(model: geardyn.Model, y: np.ndarray, periods: int, iterations: int = 
 @pytest.mark.slow
 def test_fig3_diagram_at_the_default_step_is_within_1e6_of_the_dop853_orbits():
     """Every periodic point (period <= 4) of the Fig. 3 diagram, 0.5 <= Omega <= 4 every 0.05,
-    at the default step: its Poincare point is within 2.5e-6 of the DOP853 periodic orbit, and
-    within 1e-6 at nine points in ten (measured: 56 of 62; 1.2e-6 to 2.2e-6 at Omega = 0.95,
+    at the default step: its Poincare point is within 5e-6 of the DOP853 periodic orbit, and
+    within 1e-6 at >= 80 % of the points (measured: 56 of 62; 1.2e-6 to 2.2e-6 at Omega = 0.95,
     1.75, 1.9, 1.95, 2.0, 2.65, each next to a change of contact regime)."""
     model = geardyn.CATTDevice(geardyn.PlanetaryParams.paper())  # consistent, xi = 0.05
     omegas = np.round(np.arange(0.5, 4.0001, 0.05), 10)
