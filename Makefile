@@ -34,10 +34,9 @@ test: $(STAMP)
 	$(BIN)/python -m pytest -n 2 -q --durations=15
 
 # The long studies only (marked @pytest.mark.slow; pyproject's addopts keep them out of
-# `make test`, and this -m replaces that selection): a whole Fig. 3 diagram at the default
-# step against DOP853 orbits (docs/numerics.md's accuracy figures), results bitwise the same at
-# 512- and 256-bit vectors (compiles the kernels at 256 bits), a real `geardyn map` killed with
-# SIGKILL and resumed. CI (.ci/run) runs them after `make test`.
+# `make test`, and this -m replaces that selection): results bitwise the same at 512- and
+# 256-bit vectors (compiles the kernels at 256 bits), a real `geardyn map` killed with SIGKILL
+# and resumed. CI (.ci/run) runs them after `make test` and `make docs`.
 test-slow: $(STAMP)
 	$(BIN)/python -m pytest -n 2 -q -m slow --timeout=1800 --durations=5
 

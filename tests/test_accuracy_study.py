@@ -1,8 +1,10 @@
-"""Long studies (``make test-slow``): whole diagrams at the default step against DOP853.
+"""The default step's accuracy over a whole Fig. 3 diagram against DOP853 (``make test``).
 
-The fast suite checks the default step at a few points (``tests/test_numerics.py``); here every
-periodic point of a whole Fig. 3 diagram is compared with the periodic orbit that the adaptive
-reference (DOP853, rtol 1e-12, edges located) finds by shooting from it.
+``tests/test_numerics.py`` checks the default step at a few points; here every periodic point
+of a whole Fig. 3 diagram is compared with the periodic orbit that the adaptive reference
+(DOP853, rtol 1e-12, edges located) finds by shooting from it. docs/numerics.md quotes what
+this asserts. (About 15 s of CPU with warm kernels: the diagram is 71 lanes, the shooting
+~60 short DOP853 solves per point.)
 """
 
 from __future__ import annotations
@@ -10,7 +12,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-import pytest
 
 import geardyn
 
@@ -30,10 +31,12 @@ def _flow(model: geardyn.Model, y: np.ndarray, periods: int) -> np.ndarray:
     return geardyn.reference_solution(model, y, [periods * T], rtol=1e-12, atol=1e-12)[-1]
 
 
-def _shoot(model: geardyn.Model, y: np.ndarray, periods: int, iterations: int = 4
+def _shoot(model: geardyn.Model, y: np.ndarray, periods: int, iterations: int = 10
            ) -> tuple[np.ndarray, float]:
     """Newton on Phi(y) - y = 0 (Phi: the reference flow over ``periods`` periods, Jacobian by
-    forward differences): the exact periodic point nearest ``y``, and its closure |Phi(y*) - y*|."""
+    forward differences, so convergence can be slow: up to ``iterations`` steps, stopping when
+    a step is below 1e-11): the exact periodic point nearest ``y``, and its closure
+    |Phi(y*) - y*|."""
     y = np.asarray(y, dtype=float).copy()
     eye = np.eye(y.size)
     for _ in range(iterations):
@@ -49,7 +52,6 @@ def _shoot(model: geardyn.Model, y: np.ndarray, periods: int, iterations: int = 
     return y, float(np.max(np.abs(_flow(model, y, periods) - y)))
 
 
-@pytest.mark.slow
 def test_fig3_diagram_at_the_default_step_is_within_1e6_of_the_dop853_orbits():
     """Every periodic point (period <= 4) of the Fig. 3 diagram, 0.5 <= Omega <= 4 every 0.05,
     at the default step: its Poincare point is within 5e-6 of the DOP853 periodic orbit, and
@@ -66,7 +68,10 @@ def test_fig3_diagram_at_the_default_step_is_within_1e6_of_the_dop853_orbits():
             continue
         y = ds["poincare"].values[i, -1]
         exact, closure = _shoot(model.with_omega(float(om)), y, k)
-        assert closure < 1e-9, (om, closure)  # shooting converged onto a periodic orbit
+        # shooting converged onto a periodic orbit: closure 100x below the tolerance checked
+        # (measured <= 1e-11 at most points; 1e-9 where an orbit nearly grazes an edge, the
+        # reference's own reproducibility there: Omega = 2.65, 3.45)
+        assert closure < 1e-8, (om, closure)
         errors[float(om)] = float(np.max(np.abs(y - exact)))
     assert len(errors) >= 50, period  # most of the diagram is periodic: all of it checked
     over = {om: f"{e:.2e} ({ds['contact'].values[list(omegas).index(om)].tolist()})"
