@@ -189,7 +189,7 @@ def test_readme_names_the_cache_every_entry_point_uses(monkeypatch):
 
     for var in ("GEARDYN_CACHE_DIR", "XDG_CACHE_HOME"):
         monkeypatch.delenv(var, raising=False)
-    default = re.search(r"`\$GEARDYN_CACHE_DIR` \(default `([^`]+)`\)", README)
+    default = re.search(r"`\$GEARDYN_CACHE_DIR` \(default `([^`]+)`[;)]", README)
     assert default, "the README does not name the kernel cache and its default"
     assert Path(default.group(1)).expanduser() == cache_root()
 
