@@ -239,7 +239,9 @@ def reference(wl: Workload, cache: Path | None = None) -> np.ndarray:
 
 
 def _cache_dir() -> Path:
-    return Path(os.environ.get("GEARDYN_CACHE_DIR", Path.home() / ".cache" / "geardyn"))
+    from geardyn._cache import cache_root
+
+    return cache_root()
 
 
 def max_error(points: np.ndarray, ref: np.ndarray) -> float:

@@ -25,8 +25,6 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "src"))
 sys.path.insert(0, str(ROOT / "docs" / "_ext"))
 os.environ.setdefault("MPLBACKEND", "Agg")
-os.environ.setdefault("NUMBA_CACHE_DIR", str(ROOT / ".geardyn-cache" / "numba"))
-os.environ.setdefault("GEARDYN_CACHE_DIR", str(ROOT / ".geardyn-cache"))
 
 import geardyn  # noqa: E402
 

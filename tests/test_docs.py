@@ -108,3 +108,107 @@ def test_user_guide_study_file_is_valid():
     by_api = geardyn.CATTDevice(geardyn.PlanetaryParams.paper(xi1=0.02, xi2=0.02,
                                                               backlash="50 um"))
     assert list(model.params) == pytest.approx(list(by_api.params), rel=1e-12)
+
+
+# ----------------------------------------------------------------------------------- README
+README = (ROOT / "README.md").read_text(encoding="utf-8")
+
+
+def _readme_blocks(lang: str) -> list[str]:
+    """The README's fenced code blocks of language ``lang`` ("" for unlabelled ones)."""
+    return [m.group(2) for m in re.finditer(r"^```(\w*)\n(.*?)^```", README, re.S | re.M)
+            if m.group(1) == lang]
+
+
+def _readme_command_lines(program: str) -> list[str]:
+    """Every ``program ...`` command of the README: lines of its shell and plain code blocks
+    (backslash continuations joined, ``#`` comments dropped) and inline code spans."""
+    lines = []
+    for block in _readme_blocks("sh") + _readme_blocks(""):
+        for line in block.replace("\\\n", " ").splitlines():
+            line = line.split(" #")[0].strip()
+            if line.startswith(program + " "):
+                lines.append(line)
+    prose = re.sub(r"^```.*?^```", "", README, flags=re.S | re.M)
+    lines += [s for s in re.findall(r"`([^`\n]+)`", prose) if s.startswith(program + " ")]
+    return lines
+
+
+def _cli_options() -> dict[str, set[str]]:
+    """The options each ``geardyn`` (sub)command's --help lists, by command path ("" for the
+    program itself, "params show" for a subcommand of a group)."""
+    import click
+    import typer
+
+    from geardyn.cli.main import app
+
+    found: dict[str, set[str]] = {}
+
+    def walk(cmd: click.Command, path: str) -> None:
+        found[path] = {opt for p in cmd.params if not getattr(p, "hidden", False)
+                       for opt in (*p.opts, *p.secondary_opts) if opt.startswith("--")}
+        found[path].add("--help")
+        for name, sub in getattr(cmd, "commands", {}).items():
+            walk(sub, f"{path} {name}".strip())
+
+    walk(typer.main.get_command(app), "")
+    return found
+
+
+def test_readme_command_lines_use_options_that_exist():
+    """Every ``geardyn SUBCOMMAND ... --option`` of the README names a subcommand and options
+    that its --help lists (the README's command summary, its examples and its prose)."""
+    commands = _cli_options()
+    lines = _readme_command_lines("geardyn")
+    assert len(lines) >= 20, lines  # the command summary and the examples were all found
+    wrong = []
+    for line in lines:
+        words = line.split()[1:]
+        path = ""
+        while words and f"{path} {words[0]}".strip() in commands:
+            path = f"{path} {words.pop(0)}".strip()
+        if path == "" and words and not words[0].startswith("-"):
+            wrong.append(f"{line}: no subcommand {words[0]!r}")
+            continue
+        wrong += [f"{line}: {path or 'geardyn'} has no {opt}"
+                  for opt in re.findall(r"(?<![\w-])--[a-z][a-z0-9-]*", line)
+                  if opt not in commands[path]]
+    assert not wrong, "\n".join(wrong)
+
+
+def test_readme_make_targets_exist():
+    targets = set(re.findall(r"^([a-z][\w-]*):", (ROOT / "Makefile").read_text(), re.M))
+    named = set(re.findall(r"make ([a-z][\w-]*)", README))
+    assert named and named <= targets, named - targets
+
+
+def test_readme_names_the_cache_every_entry_point_uses(monkeypatch):
+    """The README names $GEARDYN_CACHE_DIR and its default, which is where geardyn puts the
+    kernels when nothing is set."""
+    from geardyn._cache import cache_root
+
+    for var in ("GEARDYN_CACHE_DIR", "XDG_CACHE_HOME"):
+        monkeypatch.delenv(var, raising=False)
+    default = re.search(r"`\$GEARDYN_CACHE_DIR` \(default `([^`]+)`[;)]", README)
+    assert default, "the README does not name the kernel cache and its default"
+    assert Path(default.group(1)).expanduser() == cache_root()
+
+
+def test_readme_python_snippet_runs(tmp_path, monkeypatch):
+    """The README's Python blocks run as printed (in a scratch folder: they write files)."""
+    blocks = _readme_blocks("python")
+    assert blocks, "no ```python block in README.md"
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setenv("MPLBACKEND", "Agg")
+    for k, block in enumerate(blocks):
+        exec(compile(block, f"README.md:python-block-{k}", "exec"), {"__name__": "__readme__"})
+    assert (tmp_path / "run.nc").exists() and (tmp_path / "bif.pdf").exists()
+
+
+def test_license_file_matches_pyproject():
+    import tomllib
+
+    license_ = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]["license"]
+    text = (ROOT / "LICENSE").read_text(encoding="utf-8")
+    assert license_ == {"text": "MIT"} and text.startswith("MIT License")
+    assert "Permission is hereby granted, free of charge" in text

@@ -49,8 +49,10 @@ stop = 2.4
 num = 40
 samples = 16
 """
-CHROME_FLAGS = ("--headless", "--no-sandbox", "--disable-gpu", "--disable-quic",
-                "--no-first-run", "--disable-background-networking",
+#: --disable-dev-shm-usage: containers give /dev/shm 64 MB, too small for Chromium's renderer
+#: (it crashes or hangs); its shared memory goes to /tmp instead.
+CHROME_FLAGS = ("--headless", "--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage",
+                "--disable-quic", "--no-first-run", "--disable-background-networking",
                 "--disable-component-update", "--disable-sync", "--window-size=1250,1750")
 #: Seconds the server may take to compute its first diagram (kernels warm: a few seconds).
 START_TIMEOUT = 240.0

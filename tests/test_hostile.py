@@ -496,9 +496,11 @@ def test_cli_study_argument(data, raw, workdir):
                                   if command[0] != "params" else [*command, study], names)
 
 
-def test_excessive_grids_are_refused_with_an_estimate(workdir):
+def test_excessive_grids_are_refused_with_an_estimate(workdir, monkeypatch):
     """Huge sweeps and maps are refused before anything of their size is allocated, quoting the
-    estimated memory or time; ``--yes`` is what overrides it."""
+    estimated memory or time; ``--yes`` is what overrides it. The time is estimated at a fixed
+    speed (``GEARDYN_NS_PER_LANE_STEP``), not at this machine's measured one."""
+    monkeypatch.setenv("GEARDYN_NS_PER_LANE_STEP", "300")
     cases = [
         (["bifurcation", "paper_fig3", "--range", "0.1:4:1000000000", "-q"], "sweep too large"),
         (["bifurcation", "paper_fig3", "--range", "0.1:4:1000", "--samples", str(10**9), "-q"],

@@ -20,13 +20,14 @@ def _has_avx512() -> bool:
     return "+avx512f" in ll.get_host_cpu_features().flatten().split(",")
 
 
-def _fresh(code: str, **env: str) -> dict:
-    """Run ``code`` (which prints one JSON line last) in a fresh interpreter with ``env``."""
+def _fresh(code: str, timeout: float = 600.0, **env: str) -> dict:
+    """Run ``code`` (which prints one JSON line last) in a fresh interpreter with ``env``,
+    within ``timeout`` seconds."""
     full = {k: v for k, v in os.environ.items()
             if k not in (jt.ENV, "NUMBA_CPU_NAME", "NUMBA_CPU_FEATURES")}
     full.update(env)
     out = subprocess.run([sys.executable, "-c", code], env=full, capture_output=True,
-                         text=True, timeout=600)
+                         text=True, timeout=timeout)
     assert out.returncode == 0, out.stderr
     return json.loads(out.stdout.strip().splitlines()[-1])
 
@@ -103,7 +104,8 @@ def test_results_are_bitwise_the_same_at_every_vector_width():
     """The reduced CATT device's lanes (edges located, 40 lanes of 12 step counts: full and
     partial vectors) at 512 and 256 bits: each compiles its own kernels (numba's cache is keyed
     by the CPU features)."""
-    wide = _fresh(_SWEEP, **{jt.ENV: "512"})
-    narrow = _fresh(_SWEEP, **{jt.ENV: "256"})
+    # a cold compile of the sweep kernels takes minutes (over 600 s on a loaded 2-core machine)
+    wide = _fresh(_SWEEP, timeout=1500.0, **{jt.ENV: "512"})
+    narrow = _fresh(_SWEEP, timeout=1500.0, **{jt.ENV: "256"})
     assert np.sum(wide["crossings"]) > 0
     assert wide == narrow

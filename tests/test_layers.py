@@ -23,9 +23,9 @@ ROOT = Path(geardyn.__file__).resolve().parent
 LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
     # modules with no geardyn imports: exceptions, unit parsing, the version, file primitives
     # (atomic writes, attribute encoding), the packaged study files (data only), numba's CPU
-    # target (the kernels' vector width, set up before any kernel is defined)
+    # target (the kernels' vector width, set up before any kernel is defined), the cache folder
     ("base", ("geardyn._version", "geardyn.errors", "geardyn.files", "geardyn.units",
-              "geardyn.studies", "geardyn._jit_target")),
+              "geardyn.studies", "geardyn._jit_target", "geardyn._cache")),
     # the model interface, the kernel source, run settings, the lane plan, the section, status
     ("core", ("geardyn.core",)),
     # gear geometry, ISO 6336 stiffness, stiffness waves, planetary mesh phasing (pure numpy)

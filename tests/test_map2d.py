@@ -259,11 +259,17 @@ def test_cli_map_zarr_output_opens_with_plain_xarray_and_redraws(tmp_path, capsy
     (["--x", "Omega:1e-300:1e-300:2", "--y", "zeta:0.1:0.2:2"], "Omega/transient"),
     (["--x", "Omega:0.5:3:100000", "--y", "zeta:0.1:0.2:100000"], "--x/--y: map too large"),
     # 1.7e13 lane-steps: more than the 1 h limit at any speed above 0.21 ns per lane-step (at
-    # 1e9, 1.7e11 lane-steps, a measured speed under 21 ns passed the check and ran for hours)
+    # 1e9, 1.7e11 lane-steps, a measured speed under 21 ns passed the check and ran for hours);
+    # the speed is fixed below, so the refusal does not rest on this machine's load
     (["--x", "Omega:0.5:3:4", "--y", "zeta:0.1:0.2:2", "--transient", "1e11"],
      "--x/--y: map too long"),
 ])
-def test_cli_map_bad_input_is_one_line_naming_the_field(tmp_path, capsys, axes, field):
+def test_cli_map_bad_input_is_one_line_naming_the_field(tmp_path, capsys, monkeypatch, axes,
+                                                        field):
+    import geardyn.analysis.map2d as map2d_module
+
+    monkeypatch.setenv(map2d_module.SPEED_ENV, "300")
+    monkeypatch.setattr(map2d_module, "run_lanes", _no_kernel_runs)
     study = tmp_path / "gp.toml"
     study.write_text(GEAR_STUDY)
     code, _, err = _cli([str(study), *axes, "--out", str(tmp_path / "m.nc")], capsys)
@@ -271,3 +277,22 @@ def test_cli_map_bad_input_is_one_line_naming_the_field(tmp_path, capsys, axes, 
     lines = err.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith(f"error: {field}"), err
     assert not (tmp_path / "m.nc").exists()
+
+
+def _no_kernel_runs(*args, **kwargs):
+    raise AssertionError("a kernel ran: the speed was measured, not taken from the environment")
+
+
+def test_fixed_speed_replaces_the_measurement(monkeypatch):
+    """$GEARDYN_NS_PER_LANE_STEP is the speed the estimates use, and no kernel runs for it; a
+    value that is not a positive number is an error naming the variable."""
+    import geardyn.analysis.map2d as map2d_module
+
+    g = geardyn.GearPair(zeta=0.05, Fm=0.1, Fa=0.2)
+    monkeypatch.setattr(map2d_module, "run_lanes", _no_kernel_runs)
+    monkeypatch.setenv(map2d_module.SPEED_ENV, "123.5")
+    assert map2d_module.measure_ns_per_lane_step(g, 1.0) == 123.5
+    for bad in ("0", "-3", "nan", "inf", "fast"):
+        monkeypatch.setenv(map2d_module.SPEED_ENV, bad)
+        with pytest.raises(ValueError, match=map2d_module.SPEED_ENV):
+            map2d_module.measure_ns_per_lane_step(g, 1.0)

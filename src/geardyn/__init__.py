@@ -8,7 +8,9 @@ The public API::
     ds = geardyn.simulate(m, omega=1.1, transient=4000.0, periods=64)
 """
 
-from geardyn import _jit_target, gears, testing  # noqa: F401  (_jit_target first: its docstring)
+# _cache, then _jit_target, before anything else: numba's cache folder and CPU target (their
+# docstrings say why)
+from geardyn import _cache, _jit_target, gears, testing  # noqa: F401
 from geardyn._version import __version__ as __version__
 from geardyn.analysis.basins import basins
 from geardyn.analysis.bifurcation import ContinuedSweep, bifurcation, continued_sweeps

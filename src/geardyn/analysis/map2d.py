@@ -327,11 +327,36 @@ def estimate_map(model: Model, lanes: int, omegas: Sequence[float] | np.ndarray,
                        ns_per_lane_step=float(ns_per_lane_step), busy_share=float(share))
 
 
+#: The environment variable that fixes the speed :func:`measure_ns_per_lane_step` returns (ns per
+#: lane-step, > 0) instead of measuring it: run-time estimates and the refusals that rest on
+#: them then do not depend on this machine's load (the tests set it).
+SPEED_ENV = "GEARDYN_NS_PER_LANE_STEP"
+
+
+def fixed_ns_per_lane_step() -> float | None:
+    """The speed ``$GEARDYN_NS_PER_LANE_STEP`` fixes (ns per lane-step), or None where unset;
+    ValueError naming the variable for a value that is not a positive finite number."""
+    text = os.environ.get(SPEED_ENV, "").strip()
+    if not text:
+        return None
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not (math.isfinite(value) and value > 0):
+        raise ValueError(f"{SPEED_ENV}={text!r}: must be a positive number of ns per lane-step")
+    return value
+
+
 def measure_ns_per_lane_step(model: Model, omega: float, steps_per_period: int | None = None,
                              steps: int = 20000) -> float:
     """Wall time per lane-step (ns) of :func:`run_lanes` on this machine with every core busy:
     a short run of the lanes that just fill every thread's vectors (:func:`busy_lanes` of one
-    lane: 8 per thread), timed after a first call that compiles or loads the kernel."""
+    lane: 8 per thread), timed after a first call that compiles or loads the kernel. Where
+    ``$GEARDYN_NS_PER_LANE_STEP`` is set (:data:`SPEED_ENV`), its value, and nothing runs."""
+    fixed = fixed_ns_per_lane_step()
+    if fixed is not None:
+        return fixed
     lanes = busy_lanes(1)
     n = int(steps_per_period) if steps_per_period else ladder_steps(
         default_steps_per_period(model, omega))

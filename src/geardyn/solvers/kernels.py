@@ -5,7 +5,8 @@ is tied to the process), so geardyn writes, once per model, a copy of
 :mod:`geardyn.solvers._kernel_template` whose import line names the model's functions, into
 ``$GEARDYN_CACHE_DIR/kernels`` (default ``~/.cache/geardyn/kernels``), and imports it. The file name
 is a hash of the template and of the model's source, so an edited model gets a new kernel; numba
-caches the compiled code beside it, and a second run does not recompile. Functions that cannot be
+caches the compiled code in ``$NUMBA_CACHE_DIR`` (default ``$GEARDYN_CACHE_DIR/numba``, see
+:mod:`geardyn._cache`), and a second run does not recompile. Functions that cannot be
 imported by name (defined in ``__main__`` or a notebook) get an in-memory kernel, compiled once per
 process.
 """
@@ -25,6 +26,7 @@ from typing import Any
 
 import numba
 
+from geardyn._cache import cache_root
 from geardyn.core.kernel_source import KernelSource
 
 _IMPORT_MARK = "# MODEL-IMPORT"
@@ -52,12 +54,9 @@ warnings.filterwarnings("ignore", category=numba.core.errors.NumbaDebugInfoWarni
 
 
 def cache_dir() -> Path:
-    """Where generated kernels live: $GEARDYN_CACHE_DIR, else $XDG_CACHE_HOME/geardyn."""
-    root = os.environ.get("GEARDYN_CACHE_DIR")
-    if not root:
-        root = os.path.join(os.environ.get("XDG_CACHE_HOME", os.path.expanduser("~/.cache")),
-                            "geardyn")
-    return Path(root) / "kernels"
+    """Where generated kernels live: ``kernels/`` in geardyn's cache folder
+    (:func:`geardyn._cache.cache_root`: $GEARDYN_CACHE_DIR, default ~/.cache/geardyn)."""
+    return cache_root() / "kernels"
 
 
 def _importable(fn: Any) -> bool:

@@ -1,0 +1,76 @@
+"""One kernel cache for every entry point: ``import geardyn`` (the API, the ``geardyn`` command,
+the tests) puts generated kernels and numba's compiled code in ``$GEARDYN_CACHE_DIR`` (default
+``~/.cache/geardyn``), explicitly set variables win, and ``make`` does not move it."""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+_CACHE_VARS = ("GEARDYN_CACHE_DIR", "NUMBA_CACHE_DIR", "XDG_CACHE_HOME")
+
+#: Run in a fresh interpreter: where geardyn's kernels and numba's cache go, and whether the
+#: vector-width setting survived a compile (numba reloads its configuration when it compiles).
+_PROBE = """
+import json, sys
+if sys.argv[1] == "numba-first":
+    import numba  # noqa: F401
+import geardyn, numba
+from numba.core import config
+from geardyn.solvers.kernels import cache_dir
+features = config.CPU_FEATURES
+numba.njit(lambda x: x + 1)(1)  # a compile: numba reloads its configuration here
+print(json.dumps({"kernels": str(cache_dir()), "numba": config.CACHE_DIR,
+                  "features_kept": config.CPU_FEATURES == features}))
+"""
+
+
+def _probe(env: dict[str, str], order: str = "geardyn-first") -> dict:
+    base = {k: v for k, v in os.environ.items() if k not in _CACHE_VARS}
+    base["PYTHONPATH"] = os.pathsep.join([str(ROOT / "src"), base.get("PYTHONPATH", "")])
+    out = subprocess.run([sys.executable, "-c", _PROBE, order], env={**base, **env},
+                         capture_output=True, text=True, timeout=300, check=True)
+    return json.loads(out.stdout.strip().splitlines()[-1])
+
+
+@pytest.mark.parametrize("order", ["geardyn-first", "numba-first"])
+def test_default_cache_holds_kernels_and_numba_code(tmp_path, order):
+    """Nothing set: both under $XDG_CACHE_HOME/geardyn (~/.cache/geardyn), also where numba was
+    imported before geardyn, and the vector-width setting is not lost on the reload."""
+    got = _probe({"XDG_CACHE_HOME": str(tmp_path)}, order)
+    assert Path(got["kernels"]) == tmp_path / "geardyn" / "kernels"
+    assert Path(got["numba"]) == tmp_path / "geardyn" / "numba"
+    assert got["features_kept"]
+
+
+def test_home_cache_is_the_default(tmp_path):
+    got = _probe({"HOME": str(tmp_path)})
+    assert Path(got["numba"]) == tmp_path / ".cache" / "geardyn" / "numba"
+
+
+def test_set_variables_win(tmp_path):
+    got = _probe({"GEARDYN_CACHE_DIR": str(tmp_path / "g")})
+    assert Path(got["kernels"]) == tmp_path / "g" / "kernels"
+    assert Path(got["numba"]) == tmp_path / "g" / "numba"
+    got = _probe({"GEARDYN_CACHE_DIR": str(tmp_path / "g"), "NUMBA_CACHE_DIR": str(tmp_path / "n")})
+    assert Path(got["kernels"]) == tmp_path / "g" / "kernels"
+    assert Path(got["numba"]) == tmp_path / "n"
+
+
+@pytest.mark.skipif(shutil.which("make") is None, reason="make is not installed")
+def test_make_does_not_move_the_cache():
+    """``make demo`` / ``make test`` use the cache the plain ``geardyn`` command uses: the
+    Makefile exports no cache folder of its own."""
+    env = {k: v for k, v in os.environ.items() if k not in _CACHE_VARS}
+    out = subprocess.run(
+        ["make", "-s", "--no-print-directory", "-f", str(ROOT / "Makefile"), "--eval",
+         'show-cache-env: ; @echo "[$$GEARDYN_CACHE_DIR][$$NUMBA_CACHE_DIR]"', "show-cache-env"],
+        cwd=ROOT, env=env, capture_output=True, text=True, timeout=60, check=True)
+    assert out.stdout.strip() == "[][]"
