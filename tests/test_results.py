@@ -106,8 +106,9 @@ def _basins() -> xr.Dataset:
     ds["attractor_fraction"] = ("attractor", [0.5, 1 / 3], {"meaning": "share"})
     ds["attractor_point"] = (("attractor", "point", "state"), np.zeros((2, 1, 2)))
     ds["attractor_orbit"] = ("attractor", [-1, -1])
+    ds["unresolved"] = (("v", "x"), np.zeros((2, 3), dtype=np.int8), {"meaning": "1: unresolved"})
     ds.attrs.update(geardyn_kind="basins", x="x", y="v", Omega=1.0, time_unit="tau",
-                    diverged_fraction=1 / 6, n_attractors=2)
+                    diverged_fraction=1 / 6, unresolved_fraction=0.0, n_attractors=2)
     return ds
 
 
