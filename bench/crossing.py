@@ -68,7 +68,7 @@ def drivers(mod):
         SIDE = np.ones((1, n_ev), np.int64)
         ncross = np.zeros(n_ev, np.int64)
         active = np.ones(1, np.bool_)
-        events(0.0, y, G[0], p)
+        events(0.0, y, G[0], p, s_tab[0], c_tab[0])
         for j in range(n_ev):
             SIDE[0, j] = 1 if G[0, j] > 0.0 else -1
         n = 0
@@ -80,7 +80,7 @@ def drivers(mod):
                 s_tab[j0 + 2], c_tab[j0 + 2], work[0], work[1], work[2], work[3], work[4], y1,
                 False)
             keep(i, 1, active, G, gbuf)
-            events((i + 1) * h, y1, G[0], p)
+            events((i + 1) * h, y1, G[0], p, s_tab[j0 + 2], c_tab[j0 + 2])
             if leaves(i, 0, G, SIDE, True, gbuf):
                 if i >= n_skip and n < recs_i.shape[0]:
                     recs_i[n] = i
@@ -141,7 +141,7 @@ def drivers(mod):
         for m in range(n):
             y[0] += 1e-12
             if ev:
-                events(0.1 * m, y, g, p)
+                events(0.1 * m, y, g, p, sc[0, m % 64], sc[1, m % 64])
                 acc += g[0]
             else:
                 rhs(0.1 * m, y, dy, p, sc[0, m % 64], sc[1, m % 64])

@@ -44,15 +44,16 @@ def located(k, p, om, y0, h, j=0):
     f0, f1 = f(0.0, y0), f(h, y1)
     n_ev = 2
     g1 = np.zeros(n_ev)
-    k.events(h, y1, g1, p)
+    k.events(h, y1, g1, p, *sc[2])
+    pc = (*sc[0], om * h, 0, 0.0, 1.0)  # the step's forcing phase (_step_core._phase_in)
     ybuf, gbuf = np.zeros(y0.size), np.zeros((k.GBUF_ROWS, n_ev))
-    k.interpolant_events(y0, f0, y1, f1, h, 0.0, p, ybuf, gbuf)
+    k.interpolant_events(y0, f0, y1, f1, h, 0.0, p, ybuf, gbuf, pc)
     side = 1 if gbuf[0, j] > 0 else -1
-    theta = k.first_crossing(j, side, g1[j], y0, f0, y1, f1, h, 0.0, p, ybuf, gbuf)
+    theta = k.first_crossing(j, side, g1[j], y0, f0, y1, f1, h, 0.0, p, ybuf, gbuf, pc)
     ill = np.nan
     if (g1[j] > 0) != (side > 0):
         ill = k._locate(j, side, gbuf[0, j], 1.0, g1[j], y0, f0, y1, f1, h, 0.0, p, ybuf,
-                        gbuf[1]) * h
+                        gbuf[1], pc) * h
     return theta * h, ill
 
 

@@ -34,12 +34,13 @@ def _core_step(roots_of_x_minus_b, scale=1.0):
     y0, y1 = np.array([b + val[0], 0.0]), np.array([b + val[1], 0.0])
     f0, f1 = np.array([der[0], 0.0]), np.array([der[1], 0.0])
     ybuf, gbuf, g1 = np.zeros(2), np.zeros((core.GBUF_ROWS, 2)), np.zeros(2)
-    core.events(1.0, y1, g1, p)
-    core.interpolant_events(y0, f0, y1, f1, 1.0, 0.0, p, ybuf, gbuf)
+    core.events(1.0, y1, g1, p, 0.0, 1.0)
+    pc = core.NO_PHASE
+    core.interpolant_events(y0, f0, y1, f1, 1.0, 0.0, p, ybuf, gbuf, pc)
     side = 1 if gbuf[0, 0] > 0 else -1
-    new = core.first_crossing(0, side, g1[0], y0, f0, y1, f1, 1.0, 0.0, p, ybuf, gbuf)
+    new = core.first_crossing(0, side, g1[0], y0, f0, y1, f1, 1.0, 0.0, p, ybuf, gbuf, pc)
     old = (core._locate(0, side, gbuf[0, 0], 1.0, g1[0], y0, f0, y1, f1, 1.0, 0.0, p, ybuf,
-                        gbuf[1]) if (g1[0] > 0) != (side > 0) else 2.0)
+                        gbuf[1], pc) if (g1[0] > 0) != (side > 0) else 2.0)
     return new, old
 
 

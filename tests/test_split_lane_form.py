@@ -25,8 +25,8 @@ def _rhs(t, y, dy, p, s, c):
 
 
 @nb.njit(cache=True)
-def _events(t, y, g, p):
-    ck.catt_events_one(t, y, g, p)
+def _events(t, y, g, p, s, c):
+    ck.catt_events_one(t, y, g, p, s, c)
 
 
 @nb.njit(cache=True)

@@ -32,6 +32,7 @@ from typing import Any
 
 import numpy as np
 
+from geardyn.core.kernel_source import events_take_phase
 from geardyn.core.model import Model
 from geardyn.solvers.kernels import TEMPLATES, KernelSource, kernels_for
 
@@ -166,10 +167,17 @@ def _functions(model: Model) -> list[_Fn]:
 
     out = [_Fn("rhs", model.n_states, with_phase(ks.rhs))]
     if ks.events is not None:
-        out.append(_Fn("events", model.n_events, lambda t, y, g, p: ks.events(t, y, g, p)))
+        out.append(_Fn("events", model.n_events, _events_call(ks.events, om)))
     if ks.observe is not None:
         out.append(_Fn("observe", model.n_observables, with_phase(ks.observe)))
     return out
+
+
+def _events_call(events: Any, om: float) -> Callable:
+    """``events`` as a call ``f(t, y, g, p)`` (the forcing phase from t where it takes it)."""
+    if not events_take_phase(events):
+        return lambda t, y, g, p: events(t, y, g, p)
+    return lambda t, y, g, p: events(t, y, g, p, math.sin(om * t), math.cos(om * t))
 
 
 def _guarded(values: np.ndarray, guard: float) -> tuple[np.ndarray, np.ndarray]:
@@ -269,14 +277,15 @@ def _check_kernel(model: Model) -> None:
     if not isinstance(ks, KernelSource):
         raise _Broken(f"kernel must be a KernelSource (got {type(ks).__name__})")
     phase = 4 if ks.plain else 6
-    for label, fn, n in (("rhs", ks.rhs, phase), ("events", ks.events, 4),
-                         ("observe", ks.observe, phase)):
+    for label, fn, n in (("rhs", ks.rhs, (phase,)), ("events", ks.events, (6, 4)),
+                         ("observe", ks.observe, (phase,))):
         if fn is None:
             continue
         if not hasattr(fn, "py_func"):
             raise _Broken(f"{label} is not numba-compiled (decorate it with numba.njit)")
-        if _arity(fn) != n:
-            raise _Broken(f"{label} takes {_arity(fn)} arguments; the interface has {n}")
+        if _arity(fn) not in n:
+            raise _Broken(f"{label} takes {_arity(fn)} arguments; the interface has "
+                          f"{' or '.join(map(str, n))}")
     if ks.rhs is None:
         raise _Broken("kernel has no rhs")
     if (ks.events is not None) != (model.n_events > 0):

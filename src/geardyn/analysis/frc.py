@@ -270,19 +270,19 @@ def _dataset(model: Model, om: np.ndarray, runs: tuple[xr.Dataset, xr.Dataset],
     axes = physical_axes(model, om)
     if axes is not None:
         ds = ds.assign_coords({k: ("Omega", v, a) for k, (v, a) in axes.items()})
-    units = "m" if model.time_unit == "s" else "1"
+    units = deflection_units(model)
     dims = ("sweep", "Omega", "mesh")
     ds["dte_mean"] = (dims, stats["dte_mean"], {
-        "long_name": "mean mesh deflection (transmission error)", "units": units})
+        "long_name": "mean mesh deflection (transmission error)", **units})
     ds["dte_rms"] = (dims, stats["dte_rms"], {
         "long_name": "RMS dynamic transmission error (mesh deflection about its mean)",
-        "units": units})
+        **units})
     ds["dte_peak"] = (dims, stats["dte_peak"], {
-        "long_name": "peak dynamic transmission error, max |deflection - mean|", "units": units})
+        "long_name": "peak dynamic transmission error, max |deflection - mean|", **units})
     ds["dte_amplitude"] = (dims, stats["dte_amplitude"], {
-        "long_name": "DTE amplitude, (max - min) / 2 of the mesh deflection", "units": units})
+        "long_name": "DTE amplitude, (max - min) / 2 of the mesh deflection", **units})
     ds["dte_max"] = (dims, stats["dte_max"], {
-        "long_name": "largest |mesh deflection|", "units": units})
+        "long_name": "largest |mesh deflection|", **units})
     for name in ("force_rms", "force_peak", "dynamic_factor", "contact"):
         if name in runs[0]:
             ds[name] = (dims, np.stack([r[name].values for r in runs]), runs[0][name].attrs)
@@ -291,6 +291,27 @@ def _dataset(model: Model, om: np.ndarray, runs: tuple[xr.Dataset, xr.Dataset],
     ds["status"] = (("sweep", "Omega"), np.stack([r["status"].values for r in runs]),
                     status_attrs())
     return ds
+
+
+#: Unit names of the length scales that have one.
+_LENGTH_UNITS = {1.0: "m", 1e-3: "mm", 1e-6: "um", 1e-9: "nm"}
+
+
+def deflection_units(model: Model) -> dict[str, object]:
+    """The attributes of a mesh deflection in the model's state units: ``units``, and where the
+    model integrates lengths over a scale L (``length_scale`` [m] of the planetary gear set;
+    b_c of the CATT device, X = x / b_c) ``length_scale`` and ``length_scale_units`` ("m"): a
+    value times ``length_scale`` is metres, and ``units`` names that unit (``"um"`` for 1 um,
+    else ``"<L> m"``). Metres for a model in SI units (time in seconds), else dimensionless
+    ("1")."""
+    scale = getattr(model, "length_scale", None)
+    if scale is None and model.time_unit != "s" and hasattr(model, "params_in"):
+        scale = getattr(model.params_in, "b_c", None)
+    if scale is not None:
+        L = float(scale)
+        return {"units": _LENGTH_UNITS.get(L, f"{L:g} m"), "length_scale": L,
+                "length_scale_units": "m"}
+    return {"units": "m" if model.time_unit == "s" else "1"}
 
 
 def _window_text(model: Model, om: np.ndarray) -> str:

@@ -706,7 +706,8 @@ def _events_along(m: Model, problem: ShootingProblem, times: np.ndarray, Y: np.n
     g = np.empty(m.n_events)
     for i, t in enumerate(times):
         if np.all(np.isfinite(Y[i])):
-            k.events(t, Y[i], g, problem.params)
+            ph = problem.omega * (t - problem.t0)
+            k.events(t, Y[i], g, problem.params, math.sin(ph), math.cos(ph))
             out[i] = g
     return out
 

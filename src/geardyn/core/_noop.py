@@ -6,7 +6,7 @@ import numba as nb
 
 
 @nb.njit(cache=True)
-def no_events(t, y, g, p):
+def no_events(t, y, g, p, s, c):
     pass
 
 

@@ -8,13 +8,15 @@ outside :mod:`geardyn.core`.
 
 from __future__ import annotations
 
+import inspect
 import sys
 from dataclasses import dataclass
 from typing import Any
 
 from geardyn.core import _noop
 
-__all__ = ["FORM_GENERAL", "FORM_LOAD", "FORM_QUIET", "LANE_FORMS", "KernelSource"]
+__all__ = ["FORM_GENERAL", "FORM_LOAD", "FORM_QUIET", "LANE_FORMS", "KernelSource",
+           "events_take_phase"]
 
 #: The lane forms of a model's lane-scalar functions (``rhs_lane(..., form)``): the sweep kernel
 #: compiles its fused step loop once per form, with ``form`` a constant there, and runs a queue
@@ -34,23 +36,33 @@ class KernelSource:
     events: Any = None
     observe: Any = None
     #: True for a user's ``rhs(t, y, dy, p)`` / ``observe(t, y, out, p)`` without the forcing
-    #: phase arguments; the generated kernel adapts them.
+    #: phase arguments; the generated kernel adapts them. ``events`` is adapted wherever it
+    #: takes ``(t, y, g, p)`` (:func:`events_take_phase`), plain or not.
     plain: bool = False
 
     def functions(self) -> dict[str, Any]:
         prefix = "user_" if self.plain else ""
+        events = self.events if self.events is not None else _noop.no_events
         funcs = {
             f"{prefix}rhs": self.rhs,
-            "events": self.events if self.events is not None else _noop.no_events,
+            ("events" if events_take_phase(events) else "user_events"): events,
             f"{prefix}observe": (
                 self.observe if self.observe is not None
                 else (_noop.no_observables_plain if self.plain else _noop.no_observables)
             ),
         }
-        if not self.plain:
+        if not self.plain and "events" in funcs:
             funcs.update(_lane_functions(funcs))
             funcs.update(_lane_scalar_functions(funcs))
         return funcs
+
+
+def events_take_phase(events: Any) -> bool:
+    """Whether a compiled ``events`` takes the forcing phase, ``events(t, y, g, p, s, c)`` (the
+    interface); ``events(t, y, g, p)`` (a model whose switching functions do not depend on the
+    forcing) is adapted by the generated kernel."""
+    py = getattr(events, "py_func", events)
+    return len(inspect.signature(py).parameters) != 4
 
 
 def _lane_functions(funcs: dict[str, Any]) -> dict[str, Any]:

@@ -4,10 +4,21 @@ A model has a state vector (``state_names``), a coefficient vector (``params``, 
 ``param_names``) and compiled functions in the kernel interface (:class:`KernelSource`):
 
 * ``rhs(t, y, dy, p, s, c)`` writes dy/dt at time t; ``s, c`` are sin and cos of the forcing
-  phase Omega t, supplied by the solver (``Omega = p[omega_index]``; 0 for autonomous models).
-* ``events(t, y, g, p)`` (optional) writes switching functions whose zero crossings are kinks of
-  the right-hand side; the solver locates them inside a step.
+  phase, supplied by the solver (``Omega = p[omega_index]``; 0 for autonomous models).
+* ``events(t, y, g, p, s, c)`` (optional) writes switching functions whose zero crossings are
+  kinks of the right-hand side, at the same forcing phase; the solver locates them inside a
+  step. An ``events(t, y, g, p)`` whose switching functions do not depend on the forcing is
+  accepted too (the kernel adapts it).
 * ``observe(t, y, o, p, s, c)`` (optional) writes derived outputs, e.g. mesh forces.
+
+**One forcing phase.** The phase theta with sin/cos ``s, c`` is Omega times the time since the
+start of the run, or of the lane: a point of a sweep by continuation starts at the previous
+point's end time t0 at phase 0 (its Omega is not the previous point's), so theta = Omega (t -
+t0), not Omega t. Every term whose frequency is an integer multiple of Omega (stiffness,
+transmission error in the right-hand side and in the switching functions, observables, a
+torque fluctuation of integer order) takes its phase from ``s, c``; only a second,
+incommensurate excitation (the CATT load fluctuation Lambda, a planetary torque fluctuation
+of non-integer order) reads ``t``, which runs on through a chain of continued points.
 
 Built-in models (:class:`~geardyn.CATTDevice`, :class:`~geardyn.GearPair`) and a user's own
 (:class:`~geardyn.UserModel`) all subclass :class:`Model`. The rules a model keeps are numbered in
@@ -60,9 +71,10 @@ class Model:
     3. **initial state** -- ``initial_state()`` is a finite float vector of ``n_states`` entries.
     4. **kernel functions** -- ``kernel.rhs``, ``kernel.events`` and ``kernel.observe`` are
        ``numba.njit`` functions with the interface's arguments: ``rhs(t, y, dy, p, s, c)``,
-       ``events(t, y, g, p)``, ``observe(t, y, o, p, s, c)`` (``rhs(t, y, dy, p)`` and
-       ``observe(t, y, o, p)`` when ``kernel.plain``); ``s, c`` are sin and cos of the forcing
-       phase Omega t, supplied by the solver (0 and 1 for an autonomous model). ``events`` is
+       ``events(t, y, g, p, s, c)`` (or ``events(t, y, g, p)``), ``observe(t, y, o, p, s, c)``
+       (``rhs(t, y, dy, p)`` and ``observe(t, y, o, p)`` when ``kernel.plain``); ``s, c`` are
+       sin and cos of the forcing phase (above), supplied by the solver (0 and 1 for an
+       autonomous model). ``events`` is
        given exactly when ``event_names`` is non-empty, ``observe`` exactly when
        ``observable_names`` is, and every kernel template
        (:data:`~geardyn.solvers.kernels.TEMPLATES`) builds for them.

@@ -587,7 +587,8 @@ class DimensionalCATT(Model):
 
     def mesh_coordinates(self, t: np.ndarray, y: np.ndarray) -> np.ndarray:
         """Dimensionless mesh coordinates and their tau-derivatives (Eq. 8, 9) of body-angle states
-        y[..., state] at times t [s], in the general CATTDevice state order."""
+        y[..., state] at times t [s] from forcing phase 0 (the mesh phase is omega t), in the
+        general CATTDevice state order."""
         prm = self.device.params_in
         d = self.device.derived
         w = self.omega

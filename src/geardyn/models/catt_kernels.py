@@ -3,10 +3,13 @@
 Kernel interface shared by every geardyn model (see :mod:`geardyn.models.base`):
 
 ``rhs(t, y, dy, p, s, c)``
-    writes dy/dt; ``s, c = sin(Omega t), cos(Omega t)`` are supplied by the solver (from a table on
-    the period-aligned grid), ``p`` is the coefficient vector.
-``events(t, y, g, p)``
-    switching functions whose zero crossings are the kinks of the right-hand side.
+    writes dy/dt; ``s, c`` are sin and cos of the forcing (mesh) phase, supplied by the solver
+    (from a table on the period-aligned grid, 0 at the start of a run or lane), ``p`` is the
+    coefficient vector. Every term at the mesh frequency takes its phase from (s, c); the load
+    fluctuation at Lambda (a second excitation, in general incommensurate) from the time t.
+``events(t, y, g, p, s, c)``
+    switching functions whose zero crossings are the kinks of the right-hand side, at the same
+    forcing phase (s, c) as the right-hand side.
 ``observe(t, y, o, p, s, c)``
     derived outputs (here: the dynamic mesh forces in newtons).
 
@@ -167,7 +170,7 @@ def catt_rhs(t, y, dy, p, s, c):
 
 
 @nb.njit(**_JIT)
-def catt_events(t, y, g, p):
+def catt_events(t, y, g, p, s, c):
     """Dead-zone edges: X - b and X + b of every mesh."""
     _events(y, g, p, int(p[N_BLOCKS]))
 
@@ -185,7 +188,7 @@ def catt_rhs_one(t, y, dy, p, s, c):
 
 
 @nb.njit(**_JIT)
-def catt_events_one(t, y, g, p):
+def catt_events_one(t, y, g, p, s, c):
     _events(y, g, p, 1)
 
 
@@ -247,13 +250,12 @@ def theta_rhs(t, y, dy, p, s, c):
 
 
 @nb.njit(**_JIT)
-def theta_events(t, y, g, p):
+def theta_events(t, y, g, p, s, c):
     """Dead-zone edges of Eq. (1): x - b and x + b of every mesh deflection [m] (sun-inside,
-    inside-outside per planet set), the deflections written as in :func:`theta_rhs`."""
+    inside-outside per planet set), the deflections written as in :func:`theta_rhs` (the
+    meshing errors at the forcing phase s, c)."""
     n = int(p[T_N])
     bs = T_BLOCK_FIXED + 4 * int(p[T_NH])
-    s = math.sin(p[T_OMEGA] * t)
-    c = math.cos(p[T_OMEGA] * t)
     for i in range(n):
         o = T_HEADER + i * bs
         j = 2 + 4 * i
@@ -351,7 +353,7 @@ def catt_rhs_one_lanes(T, Y, DY, PT, nl, S, C, SC):
 
 
 @nb.njit(**_JIT)
-def catt_events_one_lanes(T, Y, G, PT, nl):
+def catt_events_one_lanes(T, Y, G, PT, nl, S, C):
     """:func:`catt_events_one` for lanes 0..nl-1 of a block."""
     o = HEADER
     for k in range(nl):
@@ -457,7 +459,7 @@ def catt_rhs_one_lane(t, y, PT, k, s, c, form):
 
 
 @nb.njit(inline="always", **_JIT)
-def catt_events_one_lane(t, y, PT, k):
+def catt_events_one_lane(t, y, PT, k, s, c):
     """:func:`catt_events_one` of lane k, as a tuple."""
     o = HEADER
     return (y[0] - PT[o + B_SQ, k], y[0] + PT[o + B_SQ, k], y[2] - PT[o + B_PQ, k],

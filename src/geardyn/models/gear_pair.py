@@ -36,7 +36,7 @@ def gear_pair_rhs(t, y, dy, p, s, c):
 
 
 @nb.njit(**_JIT)
-def gear_pair_events(t, y, g, p):
+def gear_pair_events(t, y, g, p, s, c):
     g[0] = y[0] - p[BACKLASH]
     g[1] = y[0] + p[BACKLASH]
 
@@ -95,7 +95,7 @@ def gear_pair_rhs_lanes(T, Y, DY, PT, nl, S, C, SC):
 
 
 @nb.njit(**_JIT)
-def gear_pair_events_lanes(T, Y, G, PT, nl):
+def gear_pair_events_lanes(T, Y, G, PT, nl, S, C):
     """:func:`gear_pair_events` for lanes 0..nl-1 of a block."""
     for k in range(nl):
         G[0, k] = Y[0, k] - PT[BACKLASH, k]
@@ -160,7 +160,7 @@ def gear_pair_rhs_lane(t, y, PT, k, s, c, form):
 
 
 @nb.njit(inline="always", **_JIT)
-def gear_pair_events_lane(t, y, PT, k):
+def gear_pair_events_lane(t, y, PT, k, s, c):
     """:func:`gear_pair_events` of lane k, as a tuple."""
     return (y[0] - PT[BACKLASH, k], y[0] + PT[BACKLASH, k])
 

@@ -251,7 +251,10 @@ class PlanetaryGearSet(Model):
     sun_torque, ring_torque, carrier_torque
         Mean external torques [N m] on the members (need the member's ``radius``).
     torque_fluctuation, torque_order, torque_phase
-        The sun (input) torque fluctuates as T_s (1 + A sin(order Omega tau + phase)).
+        The sun (input) torque fluctuates as T_s (1 + A sin(order Omega tau + phase)). An
+        integer order is locked to the mesh phase (the phase the mesh stiffness and error take,
+        0 at the start of a run or of a continued sweep's point); a non-integer order is a
+        second excitation whose phase runs with the time of the run (or of the sweep's chain).
     mesh_frequency
         Mesh frequency [rad/s] (the forcing); default omega_0 (Omega = 1).
     rotational_only

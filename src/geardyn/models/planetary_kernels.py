@@ -3,14 +3,21 @@
 Dimensionless form (see :mod:`geardyn.models.planetary`): state ``(X, X')`` with X = q / L the
 generalised coordinates over the length scale L and ' = d/dtau, tau = omega_0 t::
 
-    X'' = F0 + F1 sin(r Omega tau + psi) - Kt X - Ct X' - sum_m f_m G_m
+    X'' = F0 + F1 sin(r theta + psi) - Kt X - Ct X' - sum_m f_m G_m
     f_m = KF_m k_m(Omega tau) g(W_m . X - e_m, b_m) + CF_m (W_m . X' - e_m')
 
 Kt, Ct: the linear (bearing, support) stiffness and the modal damping matrices premultiplied by
 M^-1; per mesh m: W_m the deflection row, G_m = M^-1 W_m / (L omega_0^2) [1/N], KF_m and CF_m [N]
 the force per unit deflection and deflection rate, k_m the relative stiffness (Fourier series in
-the mesh phase), e_m = ES_m sin(Omega tau) + EC_m cos(Omega tau) the transmission error. f_m is
+the mesh phase), e_m = ES_m sin(theta) + EC_m cos(theta) the transmission error. f_m is
 the dynamic mesh force [N], the observable.
+
+theta is the mesh (forcing) phase the solver supplies as ``s, c`` = sin, cos theta (Omega tau
+from the start of a run or of a continued lane): the stiffness, the transmission error in the
+right-hand side and in the switching functions, and a torque fluctuation of integer order r
+(locked to the mesh) all take it (:func:`_torque_wave`). A torque fluctuation of non-integer
+order r is a second, incommensurate excitation: its phase is r Omega tau + psi from the time tau
+the solver passes (the time since the start of the sweep's chain or of the run).
 
 Coefficient vector: a header (``DAMPED`` is 1 where Ct is not zero), the dof vectors F0, F1,
 the matrices Kt, Ct (row-major), one block per mesh (fixed entries, 2 nh Fourier coefficients,
@@ -243,13 +250,23 @@ def _mesh_forces_shared(y, out, p, n, nm, nh, mesh, bs, mz, s, c):
         out[m] = p[o + M_KF] * out[m] * _dead_zone(d, p[o + M_B]) + p[o + M_CF] * v
 
 
+@nb.njit(inline="always", **_JIT)
+def _torque_wave(t, order, omega, phase, s, c):
+    """sin of the torque fluctuation's phase: order theta + phase for an integer order, theta
+    the mesh phase with sine s and cosine c (locked to the mesh); order omega t + phase
+    otherwise (from the time t)."""
+    if order == math.floor(order):
+        return math.sin(order * math.atan2(s, c) + phase)
+    return math.sin(order * omega * t + phase)
+
+
 @nb.njit(**_JIT)
 def planetary_rhs(t, y, dy, p, s, c):
     """dy/dt of the planetary gear set (dimensionless)."""
     n, nm, nh, mesh, bs, st, mz = _offsets(p)
     fl = 0.0
     if p[TORQUE_ON] != 0.0:
-        fl = math.sin(p[TORQUE_ORDER] * p[OMEGA] * t + p[TORQUE_PHASE])
+        fl = _torque_wave(t, p[TORQUE_ORDER], p[OMEGA], p[TORQUE_PHASE], s, c)
     shared = nm <= n  # the mesh forces first, into dy[:nm] (scratch until the end)
     if shared:
         _mesh_forces_shared(y, dy, p, n, nm, nh, mesh, bs, mz, s, c)
@@ -284,18 +301,10 @@ def planetary_rhs(t, y, dy, p, s, c):
 
 
 @nb.njit(**_JIT)
-def planetary_events(t, y, g, p):
-    """Dead-zone edges: x_m - b_m and x_m + b_m of every mesh (x_m = W_m . X - e_m)."""
+def planetary_events(t, y, g, p, s, c):
+    """Dead-zone edges: x_m - b_m and x_m + b_m of every mesh (x_m = W_m . X - e_m, the error
+    at the mesh phase s, c)."""
     n, nm, nh, mesh, bs, st, mz = _offsets(p)
-    s = 0.0
-    c = 1.0
-    errors = False
-    for m in range(nm):
-        o = mesh + m * bs
-        errors |= (p[o + M_ES] != 0.0) | (p[o + M_EC] != 0.0)
-    if errors:
-        s = math.sin(p[OMEGA] * t)
-        c = math.cos(p[OMEGA] * t)
     for m in range(nm):
         o = mesh + m * bs
         d, _ = _mesh_state(y, p, o, mz + m * 3 * MESH_NZ, n, s, c)
@@ -443,8 +452,8 @@ def planetary_rhs_lanes(T, Y, DY, PT, nl, S, C, SC):
     if torque:
         for k in range(nl):
             if PT[TORQUE_ON, k] != 0.0:
-                SC[0, k] = math.sin(PT[TORQUE_ORDER, k] * PT[OMEGA, k] * T[k]
-                                    + PT[TORQUE_PHASE, k])
+                SC[0, k] = _torque_wave(T[k], PT[TORQUE_ORDER, k], PT[OMEGA, k],
+                                        PT[TORQUE_PHASE, k], S[k], C[k])
     f1 = HEADER + n
     for i in range(n):
         for k in range(nl):
@@ -534,35 +543,9 @@ def _lanes_mesh(Y, DY, PT, nl, S, C, SC, n, o, q, row, apply):
 
 
 @nb.njit(**_JIT)
-def planetary_events_lanes(T, Y, G, PT, nl):
-    """:func:`planetary_events` for lanes 0..nl-1 of a block."""
+def planetary_events_lanes(T, Y, G, PT, nl, S, C):
+    """:func:`planetary_events` for lanes 0..nl-1 of a block (the mesh phase S[k], C[k])."""
     n, nm, nh, mesh, bs, st, mz = _lanes_offsets(PT)
-    errors = False
-    for k in range(nl):
-        for m in range(nm):
-            o = mesh + m * bs
-            errors |= (PT[o + M_ES, k] != 0.0) | (PT[o + M_EC, k] != 0.0)
-    if errors:  # the forcing phase per lane, as the per-lane function (one lane at a time)
-        for k in range(nl):
-            lane_err = False
-            for m in range(nm):
-                o = mesh + m * bs
-                lane_err |= (PT[o + M_ES, k] != 0.0) | (PT[o + M_EC, k] != 0.0)
-            s = 0.0
-            c = 1.0
-            if lane_err:
-                s = math.sin(PT[OMEGA, k] * T[k])
-                c = math.cos(PT[OMEGA, k] * T[k])
-            for m in range(nm):
-                o = mesh + m * bs
-                q = mz + m * 3 * MESH_NZ
-                d = 0.0
-                for j in range(MESH_NZ):
-                    d += PT[q + MESH_NZ + j, k] * Y[int(PT[q + j, 0]), k]
-                d -= PT[o + M_ES, k] * s + PT[o + M_EC, k] * c
-                G[2 * m, k] = d - PT[o + M_B, k]
-                G[2 * m + 1, k] = d + PT[o + M_B, k]
-        return
     for m in range(nm):
         o = mesh + m * bs
         q = mz + m * 3 * MESH_NZ
@@ -581,7 +564,7 @@ def planetary_events_lanes(T, Y, G, PT, nl):
             d += PT[w + 3, k] * Y[i3, k]
             d += PT[w + 4, k] * Y[i4, k]
             d += PT[w + 5, k] * Y[i5, k]
-            G[2 * m + 1, k] = d - (PT[o + M_ES, k] * 0.0 + PT[o + M_EC, k] * 1.0)
+            G[2 * m + 1, k] = d - (PT[o + M_ES, k] * S[k] + PT[o + M_EC, k] * C[k])
         for k in range(nl):
             d = G[2 * m + 1, k]
             G[2 * m, k] = d - PT[o + M_B, k]

@@ -29,6 +29,8 @@ class UserModel(Model):
     events
         Optional compiled ``events(t, y, g, p)``: switching functions whose zero crossings are
         kinks of ``rhs`` (e.g. ``x - b`` and ``x + b`` for a dead zone); the solvers locate them.
+        ``events(t, y, g, p, s, c)`` takes the forcing phase too (sin and cos, as the solver
+        gives it to the built-in models; see :mod:`geardyn.core.model`).
     n_events, observe, observable_names
         Number of switching functions; optional compiled ``observe(t, y, out, p)``.
     natural_frequency

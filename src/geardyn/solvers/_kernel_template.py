@@ -92,10 +92,10 @@ def _rhs_block(T, Y, DY, P, first, nl, active, s, c):
 
 
 @nb.njit(**_JIT)
-def _events_block(T, Y, G, P, first, nl, active):
+def _events_block(T, Y, G, P, first, nl, active, s, c):
     for k in range(nl):
         if active[k]:
-            _events_i(T[k], Y[k], G[k], P[first + k])
+            _events_i(T[k], Y[k], G[k], P[first + k], s, c)
 
 
 @nb.njit(**_JIT)
@@ -142,7 +142,7 @@ def _block_step(i, first, nl, active, Y, Y1, K1, K2, K3, K4, TMP, TT, G, SIDE, P
         for q in range(ns):
             Y1[k, q] = Y[k, q] + h6 * (K1[k, q] + 2.0 * K2[k, q] + 2.0 * K3[k, q] + K4[k, q])
     _keep_start(i, nl, active, G, gbuf)
-    _events_block(TT, Y1, G, P, first, nl, active)
+    _events_block(TT, Y1, G, P, first, nl, active, se, ce)
     for k in range(nl):
         if not active[k]:
             continue
@@ -196,7 +196,8 @@ def trajectory(p, y0, h, omega, n_per, i0, n_steps, stride, locate, bound, n_ev,
     out_g = np.full((n_rec, max(n_ev, 1)), np.nan)
     for q in range(ns):
         Y[0, q] = y0[q]
-    events(i0 * h, Y[0], G[0], p)
+    j0 = 2 * (i0 % n_per)
+    events(i0 * h, Y[0], G[0], p, s_tab[j0], c_tab[j0])
     for j in range(n_ev):
         SIDE[0, j] = _side(G[0, j])
     status = STATUS_OK
@@ -214,7 +215,7 @@ def trajectory(p, y0, h, omega, n_per, i0, n_steps, stride, locate, bound, n_ev,
                 for q in range(n_obs):
                     out_o[r, q] = obuf[q]
             if n_ev > 0:
-                events(t, Y[0], gbuf[0], p)
+                events(t, Y[0], gbuf[0], p, s_tab[j0], c_tab[j0])
                 for q in range(n_ev):
                     out_g[r, q] = gbuf[0, q]
         if i == i0 + n_steps:
@@ -312,12 +313,12 @@ def _rhs_lanes_generic(T, Y, DY, PT, P, LANE, nl, S, C, SC, ybuf, dbuf):
 
 
 @nb.njit(inline="always", **_JIT)
-def _events_lanes_generic(T, Y, G, PT, P, LANE, nl, ybuf, gb):
+def _events_lanes_generic(T, Y, G, PT, P, LANE, nl, S, C, ybuf, gb):
     ns = Y.shape[0]
     for k in range(nl):
         for q in range(ns):
             ybuf[q] = Y[q, k]
-        _events_i(T[k], ybuf, gb, P[LANE[k]])
+        _events_i(T[k], ybuf, gb, P[LANE[k]], S[k], C[k])
         for j in range(G.shape[0]):
             G[j, k] = gb[j]
 
@@ -343,8 +344,8 @@ if "rhs_lanes" in globals():  # the model's lane-block functions (see .kernels),
         _rhs_lm(T, Y, DY, PT, nl, S, C, SC)
 
     @nb.njit(inline="always", **_JIT)
-    def _events_lanes(T, Y, G, PT, P, LANE, nl, ybuf, gb):
-        _events_lm(T, Y, G, PT, nl)
+    def _events_lanes(T, Y, G, PT, P, LANE, nl, S, C, ybuf, gb):
+        _events_lm(T, Y, G, PT, nl, S, C)
 
     @nb.njit(inline="always", **_JIT)
     def _observe_lanes(T, Y, O, PT, P, LANE, nl, S, C, SC, ybuf, ob):
@@ -790,7 +791,7 @@ def _block_run_soa(q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch):
                     HW3[1, q, k] = H[lane]
                     HW3[2, q, k] = H[lane] / 6.0
             if loaded and n_ev > 0:  # the events at the new lanes' start (G1: scratch here)
-                _events_lanes(TT, Y, G1, PT, P, LANE, nl, ybuf, gb)
+                _events_lanes(TT, Y, G1, PT, P, LANE, nl, SE, CE, ybuf, gb)
                 for k in range(nl):
                     if ACT[k] and STEP[k] == 0:
                         for j in range(n_ev):
@@ -802,7 +803,7 @@ def _block_run_soa(q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch):
         _lanes_rk4(STEP, nl, Y, Y1, K1, K2, K3, K4, TMP, FL, HW, TT, HB, T0B, PT, P, LANE, PH,
                    SC, ybuf, dbuf, OFF, PHASE, S_TAB, C_TAB)
         if n_ev > 0:
-            _events_lanes(TT, Y1, G1, PT, P, LANE, nl, ybuf, gb)
+            _events_lanes(TT, Y1, G1, PT, P, LANE, nl, SE, CE, ybuf, gb)
             _lanes_screen(nl, G1, GS, GP, SIDE, GR, FLAG, locate)
         _lanes_finish(STEP, nl, NPER, Y, Y1, G1, GR, SIDE, FLAG, ACT, P, LANE, HB, T0B, OMEGA,
                       locate, ncross, unresolved, ys, y1s, sides, g1s, work, ybuf, gbuf,
@@ -1005,7 +1006,7 @@ def _fused_steps(form, nl, locate, bound, Y, Y1, PT, SE, CE, H6, FLAG, G, ST, sl
         te = t0b + (st + 1) * h
         k4 = _rhs_l(te, _t_axpy(y, h, k3), PT, k, se, ce, form)
         y1 = _t_comb(y, H6[k], k1, k2, k3, k4)
-        g1 = _events_l(te, y1, PT, k)
+        g1 = _events_l(te, y1, PT, k, se, ce)
         hit = _t_screen(g1, GS, GP, SIDE, GR, k, locate)
         act = ACT[k]
         flagged = act & hit
@@ -1145,7 +1146,7 @@ def _fused_run(form, q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch):
                 CE[k] = C_TAB[OFF[k]]
                 ROT[0][k], ROT[1][k], ROT[2][k], ROT[3][k] = phase_increments(NPER[k])
                 H6[k] = HB[k] / 6.0
-                _t_side(GS, SIDE, k, _events_l(TT[k], _t_load(Y, k), PT, k))
+                _t_side(GS, SIDE, k, _events_l(TT[k], _t_load(Y, k), PT, k, SE[k], CE[k]))
         if n_act == 0:
             break
         if nxt >= q1 and _padded(n_act) < nv:  # the queue is out: no slot empties for a lane

@@ -435,12 +435,12 @@ def _rows_rhs_generic(T, Y, DY, PT, P, LANE, nr, SP, CP, SC, ybuf, dbuf):
 
 
 @nb.njit(inline="always", **_JIT)
-def _rows_events_generic(T, Y, G, PT, P, LANE, nr, ybuf, gb):
+def _rows_events_generic(T, Y, G, PT, P, LANE, nr, SP, CP, ybuf, gb):
     ns = Y.shape[0]
     for r in range(nr):
         for q in range(ns):
             ybuf[q] = Y[q, r]
-        _events_i(T[r], ybuf, gb, P[LANE[r]])
+        _events_i(T[r], ybuf, gb, P[LANE[r]], SP[r], CP[r])
         for j in range(G.shape[0]):
             G[j, r] = gb[j]
 
@@ -455,8 +455,8 @@ if "rhs_lanes" in globals():  # the model's lane-block functions (see .kernels),
         _rhs_lm(T, Y, DY, PT, nr, SP, CP, SC)
 
     @nb.njit(inline="always", **_JIT)
-    def _rows_events(T, Y, G, PT, P, LANE, nr, ybuf, gb):
-        _events_lm(T, Y, G, PT, nr)
+    def _rows_events(T, Y, G, PT, P, LANE, nr, SP, CP, ybuf, gb):
+        _events_lm(T, Y, G, PT, nr, SP, CP)
 
 else:
     _rows_rhs = _rows_rhs_generic
@@ -768,17 +768,17 @@ def _lyap_block(first, nl, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF, n
             TM[r] = t + HH[r]
             TE[r] = t + HR[r]
             HD[r] = TE[r] - t
-        if n_ev > 0:
-            _rows_events(TS, Y, G0, PT, P, LANE, nrp, ybuf, gb)
         _fill_phase(nrp, IDX, S_TAB, C_TAB, PH)
+        if n_ev > 0:
+            _rows_events(TS, Y, G0, PT, P, LANE, nrp, PH[0], PH[1], ybuf, gb)
         _rows_rk4(nrp, Y, Y1, K1, K2, K3, K4, TMP, TS, TM, TE, HR, HH, H6, PT, P, LANE, PH, SC,
                   ybuf, dbuf)
         if n_ev > 0:
-            _rows_events(TE, Y1, G1, PT, P, LANE, nrp, ybuf, gb)
+            _rows_events(TE, Y1, G1, PT, P, LANE, nrp, PH[4], PH[5], ybuf, gb)
             for q in range(ns):
                 for r in range(nrp):
                     TMP[q, r] = Y[q, r] + HD[r] * K1[q, r]
-            _rows_events(TE, TMP, GE, PT, P, LANE, nrp, ybuf, gb)
+            _rows_events(TE, TMP, GE, PT, P, LANE, nrp, PH[4], PH[5], ybuf, gb)
             _rows_screen(nrp, G0, G1, GE, GR, FLAG)
         _rows_commit(i, nrp, NPR, Y, Y1, G0, G1, GR, FLAG, ACTR, P, LANE, T0R, HR, OMEGA, ys,
                      y1s, sides, g1s, ncross, W, gbuf, UNRR, PH)
@@ -872,8 +872,8 @@ def _row_trial(form, y, PT, l, ts, tm, te, hh, h, h6, hd, ph):
     k3 = _rhs_l(tm, _t_axpy(y, hh, k2), PT, l, s1, c1, form)
     k4 = _rhs_l(te, _t_axpy(y, h, k3), PT, l, s2, c2, form)
     y1 = _t_comb(y, h6, k1, k2, k3, k4)
-    return (y1, _events_l(ts, y, PT, l), _events_l(te, y1, PT, l),
-            _events_l(te, _t_axpy(y, hd, k1), PT, l))
+    return (y1, _events_l(ts, y, PT, l, s0, c0), _events_l(te, y1, PT, l, s2, c2),
+            _events_l(te, _t_axpy(y, hd, k1), PT, l, s2, c2))
 
 
 @nb.njit(inline="always", **_JIT)

@@ -168,9 +168,10 @@ def _hermite(y0, f0, y1, f1, dt, theta, out):
 
 
 @nb.njit(inline="always", **_JIT)
-def _illinois(j, side_j, a, fa, b, fb, y0, f0, y1, f1, dt, t, p, ybuf, g):
+def _illinois(j, side_j, a, fa, b, fb, y0, f0, y1, f1, dt, t, p, ybuf, g, pc):
     """Illinois root finding of event j (the model's, on the step's interpolant) in the
-    bracket [a, b]: fa on side side_j, fb off it. Returns the bracket's end off the side."""
+    bracket [a, b]: fa on side side_j, fb off it. Returns the bracket's end off the side.
+    pc: the step's forcing phase (:func:`_phase_in`)."""
     last = 0
     for _ in range(60):
         denom = fb - fa
@@ -178,7 +179,8 @@ def _illinois(j, side_j, a, fa, b, fb, y0, f0, y1, f1, dt, t, p, ybuf, g):
         if not (a < x < b):
             x = 0.5 * (a + b)
         _hermite(y0, f0, y1, f1, dt, x, ybuf)
-        _events_i(t + x * dt, ybuf, g, p)
+        sx, cx = _phase_in(pc, x)
+        _events_i(t + x * dt, ybuf, g, p, sx, cx)
         fx = g[j]
         if _side(fx) == side_j:
             a = x
@@ -205,14 +207,15 @@ def _forced(g0j, side_j):
 
 
 @nb.njit(**_JIT)
-def _locate(j, side_j, g0j, b, fb, y0, f0, y1, f1, dt, t, p, ybuf, gbuf):
+def _locate(j, side_j, g0j, b, fb, y0, f0, y1, f1, dt, t, p, ybuf, gbuf, pc):
     """Fraction in (0, b] of the step where event j leaves side side_j (Illinois method on the
     step's interpolant, the model's event evaluated at every iterate), given a bracket [0, b]
     that holds exactly one crossing: g0j the event at the start (taken as on side side_j), fb
     its value at b (on the other side). The split path uses :func:`_cubic_locate`; this is its
-    fallback for events that are not affine in the state."""
+    fallback for events that are not affine in the state. pc: the step's forcing phase
+    (:func:`_phase_in`)."""
     return _illinois(j, side_j, 0.0, _forced(g0j, side_j), b, fb, y0, f0, y1, f1, dt, t, p,
-                     ybuf, gbuf)
+                     ybuf, gbuf, pc)
 
 
 @nb.njit(inline="always", **_JIT)
@@ -226,7 +229,7 @@ def _cubic_coeffs(v0, v1, v2, v3):
 
 
 @nb.njit(inline="always", **_JIT)
-def _cubic_locate(j, side_j, c0, c1, c2, c3, b, fb, y0, f0, y1, f1, dt, t, p, ybuf, g):
+def _cubic_locate(j, side_j, c0, c1, c2, c3, b, fb, y0, f0, y1, f1, dt, t, p, ybuf, g, pc):
     """Fraction in (0, b] of the step where event j leaves side side_j, given the cubic
     c0 + c1 x + c2 x^2 + c3 x^3 of the event along the step's interpolant (exact for an event
     affine in time and state) and a bracket [0, b] that holds exactly one crossing (the start
@@ -260,14 +263,15 @@ def _cubic_locate(j, side_j, c0, c1, c2, c3, b, fb, y0, f0, y1, f1, dt, t, p, yb
         if (newton and step <= ROOT_TOL) or b - a <= BRACKET_TOL:
             break
     _hermite(y0, f0, y1, f1, dt, x, ybuf)
-    _events_i(t + x * dt, ybuf, g, p)
+    sx, cx = _phase_in(pc, x)
+    _events_i(t + x * dt, ybuf, g, p, sx, cx)
     gx = g[j]
     if abs(gx) <= CONFIRM_TOL * abs((3.0 * c3 * x + 2.0 * c2) * x + c1):
         return x
     if _side(gx) == side_j:
-        return _illinois(j, side_j, x, gx, hi, fb, y0, f0, y1, f1, dt, t, p, ybuf, g)
+        return _illinois(j, side_j, x, gx, hi, fb, y0, f0, y1, f1, dt, t, p, ybuf, g, pc)
     return _illinois(j, side_j, 0.0, _forced(c0, side_j), x, gx, y0, f0, y1, f1, dt, t, p, ybuf,
-                     g)
+                     g, pc)
 
 
 @nb.njit(inline="always", **_JIT)
@@ -313,36 +317,41 @@ def cubic_extrema(v0, v1, v2, v3):
 
 
 @nb.njit(inline="always", **_JIT)
-def _beyond(th, e, j, side_j, tol, y0, f0, y1, f1, dt, t, p, ybuf, g):
+def _beyond(th, e, j, side_j, tol, y0, f0, y1, f1, dt, t, p, ybuf, g, pc):
     """The event j on the interpolant at th if the cubic's value e there and it both lie beyond
     the edge (off side side_j, by more than tol); else NaN. g: scratch row."""
     if not (th > 0.0 and side_j * e < 0.0 and abs(e) > tol):
         return np.nan
     _hermite(y0, f0, y1, f1, dt, th, ybuf)
-    _events_i(t + th * dt, ybuf, g, p)
+    sx, cx = _phase_in(pc, th)
+    _events_i(t + th * dt, ybuf, g, p, sx, cx)
     ge = g[j]
     return ge if _side(ge) != side_j and abs(ge) > tol else np.nan
 
 
 @nb.njit(inline="always", **_JIT)
-def _interpolant_events(y0, f0, y1, f1, dt, t, p, ybuf, g0, g13, g23):
+def _interpolant_events(y0, f0, y1, f1, dt, t, p, ybuf, g0, g13, g23, pc):
     """:func:`interpolant_events` into the rows g0, g13, g23 (theta = 0, 1/3, 2/3)."""
-    _events_i(t, y0, g0, p)
+    sx, cx = _phase_in(pc, 0.0)
+    _events_i(t, y0, g0, p, sx, cx)
     _hermite(y0, f0, y1, f1, dt, 1.0 / 3.0, ybuf)
-    _events_i(t + 1.0 / 3.0 * dt, ybuf, g13, p)
+    sx, cx = _phase_in(pc, 1.0 / 3.0)
+    _events_i(t + 1.0 / 3.0 * dt, ybuf, g13, p, sx, cx)
     _hermite(y0, f0, y1, f1, dt, 2.0 / 3.0, ybuf)
-    _events_i(t + 2.0 / 3.0 * dt, ybuf, g23, p)
+    sx, cx = _phase_in(pc, 2.0 / 3.0)
+    _events_i(t + 2.0 / 3.0 * dt, ybuf, g23, p, sx, cx)
 
 
 @nb.njit(**_JIT)
-def interpolant_events(y0, f0, y1, f1, dt, t, p, ybuf, gbuf):
+def interpolant_events(y0, f0, y1, f1, dt, t, p, ybuf, gbuf, pc):
     """The events along a step's cubic Hermite interpolant (start y0, end y1, derivatives f0, f1,
-    length dt, from time t) at theta = 0, 1/3, 2/3 into rows 0, 3, 4 of gbuf (GBUF_ROWS rows)."""
-    _interpolant_events(y0, f0, y1, f1, dt, t, p, ybuf, gbuf[0], gbuf[3], gbuf[4])
+    length dt, from time t; forcing phase pc, see :func:`_phase_in`) at theta = 0, 1/3, 2/3
+    into rows 0, 3, 4 of gbuf (GBUF_ROWS rows)."""
+    _interpolant_events(y0, f0, y1, f1, dt, t, p, ybuf, gbuf[0], gbuf[3], gbuf[4], pc)
 
 
 @nb.njit(inline="always", **_JIT)
-def _first_crossing(j, side_j, graze, g1j, y0, f0, y1, f1, dt, t, p, ybuf, gbuf, gsc):
+def _first_crossing(j, side_j, graze, g1j, y0, f0, y1, f1, dt, t, p, ybuf, gbuf, gsc, pc):
     """:func:`first_crossing`; without ``graze`` the end's side alone decides (one crossing at
     most: the caller's prefilter ruled a graze out)."""
     v0 = gbuf[0, j]
@@ -354,21 +363,22 @@ def _first_crossing(j, side_j, graze, g1j, y0, f0, y1, f1, dt, t, p, ybuf, gbuf,
         tol = GRAZE_TOL * max(max(abs(v0), abs(v1)), max(abs(v2), abs(g1j)))
         th1, e1, th2, e2 = cubic_extrema(v0, v1, v2, g1j)
         b = th1
-        gb = _beyond(th1, e1, j, side_j, tol, y0, f0, y1, f1, dt, t, p, ybuf, gsc)
+        gb = _beyond(th1, e1, j, side_j, tol, y0, f0, y1, f1, dt, t, p, ybuf, gsc, pc)
         if gb != gb:
             b = th2
-            gb = _beyond(th2, e2, j, side_j, tol, y0, f0, y1, f1, dt, t, p, ybuf, gsc)
+            gb = _beyond(th2, e2, j, side_j, tol, y0, f0, y1, f1, dt, t, p, ybuf, gsc, pc)
         if gb != gb:
             b = 1.0
             gb = g1j
     if b == 1.0 and _side(g1j) == side_j:
         return 2.0
     c0, c1, c2, c3 = _cubic_coeffs(v0, v1, v2, g1j)
-    return _cubic_locate(j, side_j, c0, c1, c2, c3, b, gb, y0, f0, y1, f1, dt, t, p, ybuf, gsc)
+    return _cubic_locate(j, side_j, c0, c1, c2, c3, b, gb, y0, f0, y1, f1, dt, t, p, ybuf, gsc,
+                         pc)
 
 
 @nb.njit(**_JIT)
-def first_crossing(j, side_j, g1j, y0, f0, y1, f1, dt, t, p, ybuf, gbuf):
+def first_crossing(j, side_j, g1j, y0, f0, y1, f1, dt, t, p, ybuf, gbuf, pc):
     """Fraction in (0, 1] of the step where event j first leaves side side_j along the step's
     cubic Hermite interpolant, or 2.0 if it stays on its side. g1j: the event at the end; gbuf
     rows 0, 3, 4: the events at theta = 0, 1/3, 2/3 (:func:`interpolant_events`); row 1 is
@@ -381,8 +391,9 @@ def first_crossing(j, side_j, g1j, y0, f0, y1, f1, dt, t, p, ybuf, gbuf):
     the edge (an even number of crossings in the step) or crosses it several times. Otherwise
     the end's side decides. The bracket [0, b] handed to the root finder ends at the first such
     extremum (or the end), so it holds exactly one crossing, the first; the root is found on
-    the cubic (:func:`_cubic_locate`)."""
-    return _first_crossing(j, side_j, True, g1j, y0, f0, y1, f1, dt, t, p, ybuf, gbuf, gbuf[1])
+    the cubic (:func:`_cubic_locate`). pc: the step's forcing phase (:func:`_phase_in`)."""
+    return _first_crossing(j, side_j, True, g1j, y0, f0, y1, f1, dt, t, p, ybuf, gbuf, gbuf[1],
+                           pc)
 
 
 @nb.njit(**_JIT)
@@ -438,16 +449,16 @@ def _leaves_side(i, k, G, SIDE, locate, gbuf):
 
 
 @nb.njit(inline="always", **_JIT)
-def _leaves_side_step(r, t0, t1, Y, K1, G0, G1, SIDE, p, ybuf, gbuf):
+def _leaves_side_step(r, t0, t1, Y, K1, G0, G1, SIDE, p, ybuf, gbuf, s1, c1):
     """:func:`_leaves_side` for a lone step without history (row r: Y[r] at time t0 to the trial
     end at t1, K1[r] = f(t0, Y[r]), events G0[r], G1[r] at the ends, sides SIDE[r]): an event may
     graze when min(|g(t0)|, |g(t1)|) <= GRAZE_BOUND_STEP |a|, a = events(y + h f) - events(y1)
     = h g'(t0) - (g(t1) - g(t0)) (exact for events linear in the state); one evaluation of
-    ``events``. ybuf, gbuf row 1: scratch."""
+    ``events`` (at the end's forcing phase s1, c1). ybuf, gbuf row 1: scratch."""
     h = t1 - t0
     for q in range(Y.shape[1]):
         ybuf[q] = Y[r, q] + h * K1[r, q]
-    _events_i(t1, ybuf, gbuf[1], p)
+    _events_i(t1, ybuf, gbuf[1], p, s1, c1)
     out = 0
     for j in range(G1.shape[1]):
         g1 = G1[r, j]
@@ -491,6 +502,20 @@ def _phase_at(sa, ca, wh, i_mod, x):
         return sa * cd + ca * sd, ca * cd - sa * sd
     a = wh * (i_mod + x)
     return math.sin(a), math.cos(a)
+
+
+@nb.njit(inline="always", **_JIT)
+def _phase_in(pc, x):
+    """sin and cos of the forcing phase at the fraction x of a (sub-)step of the split path:
+    pc = (sa, ca, wh, i_mod, u, span), the sub-step from the fraction u of grid step i_mod
+    (phase sa, ca at its start, wh = Omega h) over the fraction span of it (:func:`_phase_at`
+    at u + x span: at x = 0, bitwise the phase the sub-step's rhs takes)."""
+    sa, ca, wh, i_mod, u, span = pc
+    return _phase_at(sa, ca, wh, i_mod, u + x * span)
+
+
+#: The phase context (:func:`_phase_in`) of an unforced step: phase 0 throughout.
+NO_PHASE = (0.0, 1.0, 0.0, 0, 0.0, 1.0)
 
 
 @nb.njit(inline="always", **_JIT)
@@ -591,7 +616,7 @@ def _split_step(i, t0, y, y_trial, p, h, omega, n_per, sa, ca, s_end, c_end, sid
         if u > 0.0:
             sm, cm = _phase_at(sa, ca, wh, i_mod, 0.5 * (1.0 + u))
             _rk4_stages(t, y, dt, p, sm, cm, s_end, c_end, k1, kst, acc, tmp, y_trial)
-            _events_i(t_end, y_trial, g1, p)
+            _events_i(t_end, y_trial, g1, p, s_end, c_end)
             need = graze
             for j in range(n_ev):
                 need = need or _side(g1[j]) != side[j]
@@ -600,14 +625,15 @@ def _split_step(i, t0, y, y_trial, p, h, omega, n_per, sa, ca, s_end, c_end, sid
             return 0
         _split_rhs(t_end, y_trial, f1, p, s_end, c_end)
         _split_copy(ystart, y)
-        _interpolant_events(ystart, k1, y_trial, f1, dt, t, p, ybuf, g0, g13, g23)
+        pc = (sa, ca, wh, i_mod, u, 1.0 - u)
+        _interpolant_events(ystart, k1, y_trial, f1, dt, t, p, ybuf, g0, g13, g23, pc)
         first = -1
         theta = 2.0
         for j in range(n_ev):
             flag = gbuf[GRAZE_ROW, j] != 0.0
             if flag or _side(g1[j]) != side[j]:
                 th = _first_crossing(j, side[j], flag, g1[j], ystart, k1, y_trial, f1, dt, t,
-                                     p, ybuf, gbuf, gsc)
+                                     p, ybuf, gbuf, gsc, pc)
             else:
                 th = 2.0
             gbuf[2, j] = th
@@ -628,7 +654,7 @@ def _split_step(i, t0, y, y_trial, p, h, omega, n_per, sa, ca, s_end, c_end, sid
                 ncross[j] += 1
         u = tu
         if u >= 1.0:
-            _events_i(t_end, y, g1, p)
+            _events_i(t_end, y, g1, p, s_end, c_end)
             return 0
     for q in range(ns):
         y[q] = y_trial[q]
@@ -662,7 +688,7 @@ def _rows_step(i, t0, Y, p, h, omega, n_per, s_tab, c_tab, n_ev, K, TMP, Y1, SID
     j0 = 2 * (i % n_per)
     if n_ev > 0:
         for r in range(nr):
-            _events_i(t, Y[r], G0[r], p)
+            _events_i(t, Y[r], G0[r], p, s_tab[j0], c_tab[j0])
             for j in range(n_ev):
                 SIDE[r, j] = _side(G0[r, j])
     for st in range(4):
@@ -689,8 +715,9 @@ def _rows_step(i, t0, Y, p, h, omega, n_per, s_tab, c_tab, n_ev, K, TMP, Y1, SID
     for r in range(nr):
         crossed = 0
         if n_ev > 0:
-            _events_i(t + h, Y1[r], G1[r], p)
-            crossed = _leaves_side_step(r, t, t + h, Y, K[0], G0, G1, SIDE, p, W[8], gbuf)
+            _events_i(t + h, Y1[r], G1[r], p, s_tab[j0 + 2], c_tab[j0 + 2])
+            crossed = _leaves_side_step(r, t, t + h, Y, K[0], G0, G1, SIDE, p, W[8], gbuf,
+                                        s_tab[j0 + 2], c_tab[j0 + 2])
         if crossed:
             UNRES[r] += _split_step(i, t0, Y[r], Y1[r], p, h, omega, n_per, s_tab[j0],
                                     c_tab[j0], s_tab[j0 + 2], c_tab[j0 + 2], SIDE[r], G1[r],

@@ -21,7 +21,7 @@ def rhs(t, y, dy, p, s, c):
 
 
 @nb.njit(**_JIT)
-def events(t, y, g, p):
+def events(t, y, g, p, s, c):
     g[0] = y[0] - p[1]
     g[1] = y[0] + p[1]
 

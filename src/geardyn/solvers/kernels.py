@@ -43,6 +43,13 @@ def observe(t, y, out, p, s, c):
     user_observe(t, y, out, p)
 """
 
+_EVENTS_ADAPTER = """
+
+@nb.njit(**_JIT)
+def events(t, y, g, p, s, c):
+    user_events(t, y, g, p)
+"""
+
 _LOADED: dict[tuple, types.ModuleType] = {}
 
 # While the generated kernels compile, numba's internal pedantic check (NumbaIRAssumptionWarning,
@@ -106,11 +113,12 @@ def _splice_core(text: str, adapters: str = "") -> str:
     raise RuntimeError("kernel template has lost its CORE-IMPORT line")
 
 
-def _template_text(template: str, plain: bool = False) -> str:
+def _template_text(template: str, plain: bool = False, user_events: bool = False) -> str:
     if template not in TEMPLATES:
         raise KeyError(f"unknown kernel template {template!r}; known: {', '.join(TEMPLATES)}")
     text = inspect.getsource(importlib.import_module(TEMPLATES[template]))
-    return _splice_core(text, _PLAIN_ADAPTERS if plain else "")
+    adapters = (_PLAIN_ADAPTERS if plain else "") + (_EVENTS_ADAPTER if user_events else "")
+    return _splice_core(text, adapters)
 
 
 def _import_line(funcs: dict[str, Any]) -> str:
@@ -145,10 +153,10 @@ def kernels_for(source: KernelSource, template: str = "rk4") -> types.ModuleType
     """The kernel module of ``template`` for a model's functions (built, written and imported on
     first use, then kept for the process)."""
     funcs = source.functions()
-    key = (template, source.plain, *(id(f) for f in funcs.values()))
+    key = (template, source.plain, *funcs, *(id(f) for f in funcs.values()))
     if key in _LOADED:
         return _LOADED[key]
-    text = _template_text(template, source.plain)
+    text = _template_text(template, source.plain, "user_events" in funcs)
     if all(_importable(f) for f in funcs.values()):
         code = _replace_import(text, _import_line(funcs))
         digest = _source_digest(code, funcs)

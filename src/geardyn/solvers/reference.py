@@ -27,7 +27,7 @@ def _functions(model: Model):
         return dy.copy()
 
     def ev(t, y):
-        k.events(t, y, g, p)
+        k.events(t, y, g, p, np.sin(om * t), np.cos(om * t))
         return g[: model.n_events].copy()
 
     return f, ev
