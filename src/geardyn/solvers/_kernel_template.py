@@ -663,8 +663,8 @@ def _chained(k, lanes, cfg, sched, out, slots):
     step; the fused loop's passes reset it), the chain ends there, or that lane did not end
     well (the caller restarts the rest of the chain). A slot without a lane must never read as
     one: LANE[k] is then stale (0, or a lane whose chain has run), and continuing from it
-    would run a chain's tail a second time, in another worker too (a race on its outputs:
-    until 2026-12-02 the fused loop's passes did that, see bench/determinism.py). Out of line:
+    would run a chain's tail a second time, in another worker too (a race on its outputs;
+    bench/determinism.py checks for it). Out of line:
     called once per lane, and kept out of the block loop's function, whose size decides
     whether LLVM vectorises its step loop."""
     chain = sched[6]
@@ -966,8 +966,8 @@ def _fused_steps(form, nl, locate, bound, Y, Y1, PT, SE, CE, H6, FLAG, G, ST, sl
     and end (into the scratch rows PH) are SE, CE rotated (:func:`phase_rotate`) by the slot's
     increments ROT (rows: alpha, beta of half a step, of a whole one:
     :func:`phase_increments`), the period's end exactly (0, 1): the values of the slot's phase
-    table (:func:`phase_table`), bitwise, in a vector loop of their own (gathered from the
-    tables, scalar loads, they were ~12 % of the gear pair's loop). ROT are rows of the
+    table (:func:`phase_table`), bitwise, in a vector loop of their own (no scalar gathers
+    from the tables). ROT are rows of the
     block's scratch SC: the same rows as a new member of ``blk`` left the fused loop scalar
     (3.3x the time; the cause was not found). Returns (flagged, marked)."""
     GS, GP, GR, SIDE = G

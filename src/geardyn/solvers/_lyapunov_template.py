@@ -418,8 +418,8 @@ def _lanes_rows(P, Y0, scale, T0, H, OMEGA, n_per, n_transient, n_steps, renorm_
 BLOCK_ROWS = 64
 #: The rows of a block are padded to a multiple of this (see :func:`_lyap_block`): LLVM
 #: vectorises the row loops 8 wide, interleaved 4 times, and runs a remainder of up to 31 rows
-#: scalar (at 63 rows a third of the time; the model's lane functions cost ~3 ns per row
-#: vectorised, ~9 ns scalar). Only where the model has lane-block functions (else 1).
+#: scalar (the model's lane functions cost about three times as much per row scalar as
+#: vectorised). Only where the model has lane-block functions (else 1).
 ROW_PAD = 1
 
 
