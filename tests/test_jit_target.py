@@ -32,12 +32,8 @@ def _fresh(code: str, timeout: float = 600.0, **env: str) -> dict:
     return json.loads(out.stdout.strip().splitlines()[-1])
 
 
-_STATE = """
-import json, warnings
-warnings.simplefilter("error", RuntimeWarning)
-{pre}
-import geardyn
-from numba.core import config
+#: A vectorisable loop compiled by numba; ``asm`` its assembly.
+_AXPY = """
 import numba, numpy as np
 @numba.njit
 def axpy(a, b):
@@ -46,23 +42,22 @@ def axpy(a, b):
 a = np.ones(64)
 axpy(a, a)
 asm = axpy.inspect_asm(axpy.signatures[0])
+"""
+
+_STATE = """
+import json, warnings
+warnings.simplefilter("error", RuntimeWarning)
+{pre}
+import geardyn
+from numba.core import config
+""" + _AXPY.replace("{", "{{").replace("}", "}}") + """
 print(json.dumps({{"applied": geardyn._jit_target.APPLIED, "features": config.CPU_FEATURES,
                   "zmm": "zmm" in asm}}))
 """
 
 
-#: The same function compiled by numba without geardyn (numba's own CPU target).
-_NUMBA_ALONE = """
-import json
-import numba, numpy as np
-@numba.njit
-def axpy(a, b):
-    for i in range(a.size):
-        a[i] = 1.5 * a[i] + b[i]
-a = np.ones(64)
-axpy(a, a)
-print(json.dumps({"zmm": "zmm" in axpy.inspect_asm(axpy.signatures[0])}))
-"""
+#: The same loop compiled by numba without geardyn (numba's own CPU target).
+_NUMBA_ALONE = "import json" + _AXPY + 'print(json.dumps({"zmm": "zmm" in asm}))'
 
 
 def test_the_mode_is_read_from_the_environment_and_checked():
