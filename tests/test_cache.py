@@ -20,14 +20,17 @@ _CACHE_VARS = ("GEARDYN_CACHE_DIR", "NUMBA_CACHE_DIR", "XDG_CACHE_HOME")
 #: vector-width setting survived a compile (numba reloads its configuration when it compiles).
 _PROBE = """
 import json, sys
+from pathlib import Path
 if sys.argv[1] == "numba-first":
     import numba  # noqa: F401
 import geardyn, numba
 from numba.core import config
 from geardyn.solvers.kernels import cache_dir
+from geardyn.core._noop import no_events
 features = config.CPU_FEATURES
 numba.njit(lambda x: x + 1)(1)  # a compile: numba reloads its configuration here
-print(json.dumps({"kernels": str(cache_dir()), "numba": config.CACHE_DIR,
+numba_dir = Path(no_events._cache._cache_path).parent  # where numba keeps geardyn's code
+print(json.dumps({"kernels": str(cache_dir()), "numba": str(numba_dir),
                   "features_kept": config.CPU_FEATURES == features}))
 """
 

@@ -2,27 +2,34 @@
 API, the tests), set up at import.
 
 ``$GEARDYN_CACHE_DIR`` (default ``$XDG_CACHE_HOME/geardyn``, i.e. ``~/.cache/geardyn``) holds
-the generated kernel modules (``kernels/``) and numba's compiled code (``numba/``: numba's
-``NUMBA_CACHE_DIR``, which geardyn sets to this folder when the user has not set it). Explicitly
-set variables win: ``NUMBA_CACHE_DIR`` keeps numba's code wherever it names.
+the generated kernel modules (``kernels/``) and numba's compiled code of geardyn's functions
+(``numba/``). Explicitly set variables win: ``NUMBA_CACHE_DIR`` keeps numba's code wherever it
+names.
 
-This module runs before any numba function of geardyn is defined: numba picks the cache folder
-of a function when it is decorated, so ``NUMBA_CACHE_DIR`` is set (and numba's configuration
-reloaded, where numba was imported already) before that. It is set in ``os.environ``, so
-subprocesses (test workers, Dask workers started from here) use the same folder.
+geardyn changes no numba setting and no environment variable for this: it registers a cache
+locator (:class:`GeardynCacheLocator`, first in numba's list of locators) that answers only for
+geardyn's own functions (files in the geardyn package and the generated kernels) and only while
+``NUMBA_CACHE_DIR`` is unset; every other function keeps numba's own locators. numba picks the
+locator of a function when it is decorated, so this module runs before geardyn defines any numba
+function. Subprocesses that import geardyn (test workers, Dask workers) register it too. Where
+``NUMBA_CACHE_LOCATOR_CLASSES`` is set, numba uses only the classes it names (numba's setting
+wins).
 """
 
 from __future__ import annotations
 
 import os
-import sys
 from collections.abc import Mapping
 from pathlib import Path
+
+from numba.core import caching, config
 
 #: The environment variable that names geardyn's cache folder.
 ENV = "GEARDYN_CACHE_DIR"
 #: numba's own variable for its cache folder (numba reads it).
 NUMBA_ENV = "NUMBA_CACHE_DIR"
+#: The geardyn package's folder: numba functions defined in files below it are geardyn's.
+PACKAGE_DIR = Path(__file__).resolve().parent
 
 
 def cache_root(environ: Mapping[str, str] | None = None) -> Path:
@@ -37,22 +44,48 @@ def cache_root(environ: Mapping[str, str] | None = None) -> Path:
 
 
 def numba_cache_dir(environ: Mapping[str, str] | None = None) -> Path:
-    """Where numba keeps compiled code: ``$NUMBA_CACHE_DIR`` where set, else
+    """Where numba keeps geardyn's compiled code: ``$NUMBA_CACHE_DIR`` where set, else
     ``cache_root()/numba``."""
     env = os.environ if environ is None else environ
     return Path(env.get(NUMBA_ENV) or cache_root(env) / "numba")
 
 
-def _configure() -> str:
-    """Point numba's cache at :func:`numba_cache_dir` unless the user set ``NUMBA_CACHE_DIR``;
-    returns what was done (see :data:`APPLIED`)."""
-    if os.environ.get(NUMBA_ENV):
-        return f"{NUMBA_ENV} is set: numba's cache stays at {os.environ[NUMBA_ENV]}"
-    os.environ[NUMBA_ENV] = str(numba_cache_dir())
-    if "numba.core.config" in sys.modules:  # numba read its environment already: again
-        sys.modules["numba.core.config"].reload_config()
-    return f"{NUMBA_ENV} set to {os.environ[NUMBA_ENV]}"
+def is_geardyn_file(py_file: str | os.PathLike[str]) -> bool:
+    """Whether ``py_file`` is geardyn's: in the geardyn package or a generated kernel module
+    (``cache_root()/kernels``)."""
+    path = Path(os.path.abspath(py_file))
+    return any(path.is_relative_to(folder)
+               for folder in (PACKAGE_DIR, Path(os.path.abspath(cache_root() / "kernels"))))
 
 
-#: What :func:`_configure` did at import.
-APPLIED: str = _configure()
+class GeardynCacheLocator(caching.UserProvidedCacheLocator):
+    """numba's cache locator for geardyn's functions: the layout of numba's own
+    ``NUMBA_CACHE_DIR`` locator, rooted at :func:`numba_cache_dir`. It declines (numba's other
+    locators decide) for any other file, and where ``NUMBA_CACHE_DIR`` is set."""
+
+    def __init__(self, py_func, py_file):  # noqa: ANN001 (numba's signature)
+        self._py_file = py_file
+        self._lineno = py_func.__code__.co_firstlineno
+        self._cache_path = os.path.join(str(numba_cache_dir()),
+                                        self.get_suitable_cache_subpath(py_file))
+
+    @classmethod
+    def from_function(cls, py_func, py_file):  # noqa: ANN001, ANN206 (numba's signature)
+        if config.CACHE_DIR or not is_geardyn_file(py_file):
+            return None
+        return super(caching.UserProvidedCacheLocator, cls).from_function(py_func, py_file)
+
+
+def _register() -> str:
+    """Put :class:`GeardynCacheLocator` first in numba's locators (once); returns what was
+    done (see :data:`APPLIED`)."""
+    locators = caching.CacheImpl._locator_classes
+    if GeardynCacheLocator not in locators:
+        locators.insert(0, GeardynCacheLocator)
+    if config.CACHE_DIR:
+        return f"{NUMBA_ENV} is set: numba's cache stays at {config.CACHE_DIR}"
+    return f"geardyn's functions cached in {numba_cache_dir()}"
+
+
+#: What :func:`_register` did at import.
+APPLIED: str = _register()

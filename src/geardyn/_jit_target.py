@@ -23,6 +23,13 @@ nothing where that has happened already (numba was used before geardyn was impor
 the user set ``NUMBA_CPU_NAME`` or ``NUMBA_CPU_FEATURES`` (numba's own settings win).
 :data:`APPLIED` says what was done. numba's kernel cache is keyed by the features, so kernels
 compiled at one width are never loaded at another.
+
+This is the one process-wide setting ``import geardyn`` makes (``numba.config.CPU_FEATURES``,
+except with ``native``): numba has one CPU target per process, whose LLVM target machine is
+created once, with these features, when the first function is compiled; a width for geardyn's
+kernels alone would need a numba target of geardyn's own, for every kernel and model function.
+numba functions of other code compiled in the same process get the same tuning (their results
+are bitwise the same at any width, as above, unless compiled with fastmath).
 """
 
 from __future__ import annotations

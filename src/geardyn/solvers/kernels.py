@@ -52,12 +52,34 @@ def events(t, y, g, p, s, c):
 
 _LOADED: dict[tuple, types.ModuleType] = {}
 
-# While the generated kernels compile, numba's internal pedantic check (NumbaIRAssumptionWarning,
-# "please report") and its debug-line notes (NumbaDebugInfoWarning) fire hundreds of times on
-# the inlined tuple helpers; they say nothing about a model or a result, and a first run of
-# ``geardyn reproduce`` printed pages of them. Only these two numba categories are silenced.
-warnings.filterwarnings("ignore", category=numba.core.errors.NumbaIRAssumptionWarning)
-warnings.filterwarnings("ignore", category=numba.core.errors.NumbaDebugInfoWarning)
+#: numba's warnings silenced while geardyn's generated kernels compile: its internal pedantic check
+#: (NumbaIRAssumptionWarning, "please report") and its debug-line notes (NumbaDebugInfoWarning)
+#: fire hundreds of times on the inlined tuple helpers and say nothing about a model or a result.
+QUIET_WARNINGS = (numba.core.errors.NumbaIRAssumptionWarning,
+                  numba.core.errors.NumbaDebugInfoWarning)
+
+
+def _quiet_compile(dispatcher: Any) -> None:
+    """Make ``dispatcher`` compile with :data:`QUIET_WARNINGS` ignored; the warning filters are
+    restored when its compile returns (nothing is filtered outside geardyn's compiles)."""
+    compile_ = dispatcher.compile
+
+    def compile(sig: Any) -> Any:
+        with warnings.catch_warnings():
+            for category in QUIET_WARNINGS:
+                warnings.filterwarnings("ignore", category=category)
+            return compile_(sig)
+
+    dispatcher.compile = compile
+
+
+def _quiet_module(module: types.ModuleType) -> None:
+    """:func:`_quiet_compile` for every numba function ``module`` defines (the entry points; the
+    functions they call compile inside their compile)."""
+    for value in list(vars(module).values()):
+        if (isinstance(value, numba.core.registry.CPUDispatcher)
+                and value.py_func.__module__ == module.__name__):
+            _quiet_compile(value)
 
 
 def cache_dir() -> Path:
@@ -180,5 +202,6 @@ def kernels_for(source: KernelSource, template: str = "rk4") -> types.ModuleType
         module = types.ModuleType(f"geardyn_{template}_inmemory_{len(_LOADED)}")
         module.__dict__.update(funcs)
         exec(compile(code, module.__name__, "exec"), module.__dict__)
+    _quiet_module(module)
     _LOADED[key] = module
     return module

@@ -1,0 +1,134 @@
+"""``import geardyn`` changes no process-wide setting: no warning filter, no environment
+variable, no numba configuration value (numba's CPU features aside, see :mod:`geardyn._jit_target`
+for why), neither at import nor after a first run (geardyn's compile-time warning filters are
+scoped to its own compiles)."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+
+#: A fresh interpreter: the process-wide state before ``import geardyn`` (its dependencies, named
+#: in argv[2], imported already: what they do at import is theirs), after it, and after a first
+#: small run (a gear-pair trajectory, kernels from the cache).
+_PROBE = """
+import importlib, json, os, sys, warnings
+import numba
+from numba.core import config
+
+for name in json.loads(sys.argv[2]):
+    try:
+        importlib.import_module(name)
+    except Exception:
+        pass
+
+
+def state():
+    cfg = {k: repr(getattr(config, k)) for k in dir(config) if k.isupper()}
+    return {"filters": [repr(f) for f in warnings.filters], "environ": dict(os.environ),
+            "config": cfg}
+
+
+out = {"before": state()}
+import geardyn
+out["imported"] = state()
+if sys.argv[1] == "run":
+    g = geardyn.GearPair(zeta=0.05, kappa=0.0, Fm=0.1, Fa=0.0)
+    geardyn.simulate(g, omega=1.2, transient=10.0, periods=4)
+    out["ran"] = state()
+print(json.dumps(out))
+"""
+
+
+#: The modules other than geardyn's that ``import geardyn`` imports.
+_DEPENDENCIES = """
+import json, sys
+before = set(sys.modules)
+import geardyn
+print(json.dumps(sorted(m for m in set(sys.modules) - before
+                        if m.split(".")[0] not in ("geardyn", "__main__"))))
+"""
+
+
+def _run(code: str, env: dict[str, str], *args: str) -> object:
+    base = {k: v for k, v in os.environ.items() if k != "NUMBA_CACHE_DIR"}
+    base["PYTHONPATH"] = os.pathsep.join([str(ROOT / "src"), base.get("PYTHONPATH", "")])
+    out = subprocess.run([sys.executable, "-c", code, *args], env={**base, **env},
+                         capture_output=True, text=True, timeout=600, check=True)
+    return json.loads(out.stdout.strip().splitlines()[-1])
+
+
+def _states(env: dict[str, str], mode: str) -> dict:
+    dependencies = _run(_DEPENDENCIES, env)
+    return _run(_PROBE, env, mode, json.dumps(dependencies))
+
+
+def _changes(a: dict, b: dict) -> dict:
+    """What differs between two states: per part, the keys (or filters) added, removed or
+    changed."""
+    diff = {"filters": sorted(set(b["filters"]) ^ set(a["filters"]))
+            if a["filters"] != b["filters"] else []}
+    for part in ("environ", "config"):
+        keys = set(a[part]) | set(b[part])
+        diff[part] = sorted(k for k in keys if a[part].get(k) != b[part].get(k))
+    return diff
+
+
+_NONE = {"filters": [], "environ": [], "config": []}
+
+
+def test_import_and_first_run_change_no_global_state():
+    """Default vector width: only numba's CPU features change (the one process-wide numba
+    setting, documented in :mod:`geardyn._jit_target`); warning filters, the environment and
+    every other numba configuration value are as before the import and after a first run."""
+    got = _states({}, "run")
+    expected = {**_NONE, "config": ["CPU_FEATURES"]}
+    assert _changes(got["before"], got["imported"]) == expected
+    assert _changes(got["before"], got["ran"]) == expected
+
+
+@pytest.mark.parametrize("cache_var", ["unset", "set"])
+def test_native_width_import_changes_nothing(tmp_path, cache_var):
+    """With ``GEARDYN_SIMD_WIDTH=native`` (numba's own CPU target) ``import geardyn`` changes no
+    warning filter, environment variable or numba configuration value at all, whether or not
+    ``NUMBA_CACHE_DIR`` is set."""
+    env = {"GEARDYN_SIMD_WIDTH": "native"}
+    if cache_var == "set":
+        env["NUMBA_CACHE_DIR"] = str(tmp_path)
+    got = _states(env, "import")
+    assert _changes(got["before"], got["imported"]) == _NONE
+
+
+def test_quiet_compile_scopes_its_filter():
+    """A kernel's compile runs with numba's two noisy categories ignored; other warnings pass,
+    and the warning filters are as before once it returns."""
+    import warnings
+
+    import numba
+
+    from geardyn.solvers.kernels import _quiet_compile
+
+    class Dispatcher:
+        def compile(self, sig):
+            warnings.warn("pedantic", numba.core.errors.NumbaIRAssumptionWarning,
+                          stacklevel=1)
+            warnings.warn("debug lines", numba.core.errors.NumbaDebugInfoWarning,
+                          stacklevel=1)
+            warnings.warn("a real one", UserWarning, stacklevel=1)
+            return sig
+
+    d = Dispatcher()
+    _quiet_compile(d)
+    filters = list(warnings.filters)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        assert d.compile("sig") == "sig"
+    assert [str(w.message) for w in caught] == ["a real one"]
+    assert warnings.filters == filters
