@@ -13,9 +13,10 @@ import numpy as np
 import pytest
 
 from conformance_cases import IDS, cases
+from geardyn.core.plan import default_steps_per_period
+from geardyn.core.settings import DEFAULT_BOUND
 from geardyn.solvers.kernels import TEMPLATES, cache_dir, kernels_for
 from geardyn.solvers.reference import reference_solution
-from geardyn.solvers.simulate import DEFAULT_BOUND, default_steps_per_period
 
 #: Modules a generated kernel may import besides the model's own.
 _ALLOWED = {"__future__", "math", "numba", "numpy", "llvmlite", "geardyn.core._noop",

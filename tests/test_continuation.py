@@ -11,8 +11,8 @@ import pytest
 import geardyn
 from geardyn import ContinuedSweep, continued_sweeps
 from geardyn.analysis.continuation import Branch
+from geardyn.core.plan import STEPS_PER_OTHER_FORCING, default_steps_per_period
 from geardyn.solvers.ensemble import run_lanes
-from geardyn.solvers.simulate import STEPS_PER_OTHER_FORCING, default_steps_per_period
 
 VARIABLES = ("poincare", "period", "converged", "transient_periods", "contact", "force_peak",
              "status")

@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 
 import geardyn
+from geardyn.core.plan import lane_steps_per_period
 from geardyn.errors import ParameterError
-from geardyn.solvers.ensemble import lane_steps_per_period
 from geardyn.solvers.kernels import kernels_for
 from geardyn.solvers.simulate import default_steps_per_period
 

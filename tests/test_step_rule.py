@@ -11,12 +11,13 @@ import pytest
 import scipy.linalg
 
 import geardyn
-from geardyn.solvers.ensemble import lane_steps_per_period, run_lanes
-from geardyn.solvers.simulate import (
+from geardyn.core.plan import (
     MIN_STEPS_PER_PERIOD,
     STEPS_PER_FASTEST_MODE,
     default_steps_per_period,
+    lane_steps_per_period,
 )
+from geardyn.solvers.ensemble import run_lanes
 
 KM_PQ = np.array([1.0e9, 4.0e9, 16.0e9])
 

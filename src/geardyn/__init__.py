@@ -23,7 +23,12 @@ from geardyn.analysis.orbits import PeriodicOrbit, periodic_orbit
 from geardyn.analysis.periodicity import classify_period, common_section
 from geardyn.analysis.spectrum import amplitude_spectrum, label_peaks
 from geardyn.core.model import Model
-from geardyn.core.settings import RunSettings
+from geardyn.core.settings import (
+    ContinuationSettings,
+    LyapunovSettings,
+    NewtonSettings,
+    RunSettings,
+)
 from geardyn.core.status import Status
 from geardyn.errors import GeardynError, ParameterError, StudyError
 from geardyn.models.catt import CATTDevice, DimensionalCATT
@@ -42,6 +47,7 @@ __all__ = [
     "BranchStatus",
     "CATTDevice",
     "Carrier",
+    "ContinuationSettings",
     "ContinuedSweep",
     "DimensionalCATT",
     "GearPair",
@@ -49,9 +55,11 @@ __all__ = [
     "Gear",
     "Loads",
     "LyapunovEstimate",
+    "LyapunovSettings",
     "Member",
     "Mesh",
     "Model",
+    "NewtonSettings",
     "ParameterError",
     "PeriodicOrbit",
     "PlanetOverride",

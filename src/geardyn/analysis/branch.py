@@ -67,11 +67,13 @@ from geardyn.analysis.orbits import (
 )
 from geardyn.core.model import Model
 from geardyn.core.plan import default_steps_per_period
-from geardyn.core.settings import RunSettings
+from geardyn.core.settings import CORRECTOR_TOL as CORRECTOR_TOL
+from geardyn.core.settings import LOCATE_TOL as LOCATE_TOL
+from geardyn.core.settings import ContinuationSettings, RunSettings, resolve_settings
 from geardyn.core.status import Status
 
-#: Corrector tolerance: max |G / state_scale| <= tol (1 + max |x / state_scale|).
-CORRECTOR_TOL = 1e-10
+#: CORRECTOR_TOL (from core.settings, ContinuationSettings' default): the corrector converged
+#: where max |G / state_scale| <= tol (1 + max |x / state_scale|).
 #: Most corrector iterations per step.
 CORRECTOR_MAX_ITER = 12
 #: The step grows after a corrector of at most this many iterations, shrinks after one of at
@@ -90,8 +92,6 @@ MU_MOVE_DS = 1e-3
 #: The default guess at the start: a transient of GUESS_PERIODS section periods, at most
 #: GUESS_TIME time units.
 GUESS_TIME = 2000.0
-#: Default location tolerance in the parameter.
-LOCATE_TOL = 1e-7
 #: Most trials of a location.
 LOCATE_MAX_ITER = 60
 #: A corrected point farther than this many step lengths from its predictor (the step ds of a
@@ -846,12 +846,11 @@ class _BranchRunner:
 # ----------------------------------------------------------------------------- the API
 def continuation(model: Model, param: str = "Omega", start: float | None = None,
                  stop: float | None = None, period: int = 1, guess: np.ndarray | None = None,
-                 run: RunSettings | None = None, *, ds: float = 0.01, ds_min: float = 1e-7,
-                 ds_max: float = 0.2, max_points: int = 2000,
-                 tol: float = CORRECTOR_TOL, locate_tol: float = LOCATE_TOL,
-                 switch: bool | Callable[[BifurcationPoint], bool] = False, max_period: int = 16,
-                 steps_per_period: int | None = None, p_scale: float | None = None,
-                 progress: Callable[[int, float], None] | None = None) -> xr.Dataset:
+                 run: RunSettings | None = None, *, settings: ContinuationSettings | None = None,
+                 switch: bool | Callable[[BifurcationPoint], bool] = False,
+                 steps_per_period: int | None = None,
+                 progress: Callable[[int, float], None] | None = None,
+                 **legacy: Any) -> xr.Dataset:
     """Follow the period-``period`` orbit of ``model`` in ``param`` from ``start`` to ``stop``.
 
     Parameters
@@ -871,15 +870,16 @@ def continuation(model: Model, param: str = "Omega", start: float | None = None,
         :class:`~geardyn.RunSettings` (``steps_per_period``, ``bound``; ``transient``,
         ``converge`` and ``transient_max`` of the default guess, see
         :func:`~geardyn.analysis.orbits.default_guess`).
-    ds, ds_min, ds_max
-        First, least and greatest arclength step in the scaled unknowns (x / state_scale,
-        p / p_scale; ``p_scale`` default ``abs(stop - start)``).
-    tol, locate_tol
-        Corrector tolerance (scaled residual) and the location tolerance in the parameter.
+    settings
+        :class:`~geardyn.ContinuationSettings`: the arclength steps ``ds``, ``ds_min``,
+        ``ds_max`` (in the scaled unknowns x / state_scale, p / p_scale; ``p_scale`` default
+        ``abs(stop - start)``), ``max_points``, the corrector tolerance ``tol``, the location
+        tolerance ``locate_tol`` and the switching limit ``max_period``. Its fields given as
+        keyword arguments are deprecated (a DeprecationWarning).
     switch
         At each located period doubling start the period-2k branch: True for every one, or a
         function of the :class:`BifurcationPoint` saying whether to; recursively (a cascade) while
-        2k <= ``max_period``.
+        2k <= ``settings.max_period``.
     steps_per_period
         RK4 steps per forcing period, fixed (default: :data:`BRANCH_STEP_FACTOR` times the step
         rule, re-derived along the branch).
@@ -891,6 +891,7 @@ def continuation(model: Model, param: str = "Omega", start: float | None = None,
     per branch along ``branch_id``. A failure is not an exception: it ends its branch with
     ``branch_status`` and ``branch_message`` naming the parameter value, keeping its points.
     """
+    cs = resolve_settings(ContinuationSettings, settings, legacy, "continuation")
     if start is None:  # a coefficient's current value (a KeyError naming the known ones)
         start = float(model.params[model._param_index(param)])
     if stop is None:
@@ -898,11 +899,9 @@ def continuation(model: Model, param: str = "Omega", start: float | None = None,
     start, stop = float(start), float(stop)
     if not (math.isfinite(start) and math.isfinite(stop)) or start == stop:
         raise ValueError(f"start and stop must be finite and different (got {start}, {stop})")
-    if not 0 < ds_min <= ds <= ds_max:
-        raise ValueError("need 0 < ds_min <= ds <= ds_max")
-    pscale = float(p_scale) if p_scale else abs(stop - start)
-    st = _Settings(min(start, stop), max(start, stop), ds, ds_min, ds_max, int(max_points),
-                   float(locate_tol), progress)
+    pscale = cs.p_scale if cs.p_scale is not None else abs(stop - start)
+    st = _Settings(min(start, stop), max(start, stop), cs.ds, cs.ds_min, cs.ds_max,
+                   cs.max_points, cs.locate_tol, progress)
     try:  # an unknown name: the model's KeyError naming the known ones
         at_start = model.with_params(**{param: start})
     except ValueError as err:
@@ -910,14 +909,14 @@ def continuation(model: Model, param: str = "Omega", start: float | None = None,
             raise
         raise ValueError(f"{param}={start:g} is outside the model's valid region: {err}"
                          ) from err
-    tracer = _Tracer(at_start, param, period, pscale, run, steps_per_period, tol,
+    tracer = _Tracer(at_start, param, period, pscale, run, steps_per_period, cs.tol,
                      CORRECTOR_MAX_ITER)
     tracer.n = tracer.steps_for(start)
     runs: list[BranchRun] = []
     first_run = _first_branch(tracer, st, start, stop, guess, run)
     runs.append(first_run)
     _switch_all(model if param == "Omega" else at_start, param, runs, st, run,
-                steps_per_period, tol, switch, max_period, pscale)
+                steps_per_period, cs.tol, switch, cs.max_period, pscale)
     return branch_dataset(model, param, start, stop, runs, tracer)
 
 

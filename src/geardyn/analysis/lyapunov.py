@@ -10,6 +10,7 @@ the spread of its block averages over the run. See ``docs/lyapunov.md`` and the 
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import warnings
 from dataclasses import dataclass
@@ -17,23 +18,32 @@ from typing import Any
 
 import numpy as np
 
+from geardyn.core.model import Model
 from geardyn.core.plan import (
     default_steps_per_period,
     forcing_period,
     lane_steps,
     periods_covering,
 )
-from geardyn.core.settings import DEFAULT_BOUND, MIN_STEPS, RunSettings, resolve_run
+from geardyn.core.settings import (
+    DEFAULT_BOUND,
+    LYAPUNOV_BLOCKS,
+    LYAPUNOV_DT,
+    LYAPUNOV_RENORM_EVERY,
+    MIN_STEPS,
+    LyapunovSettings,
+    RunSettings,
+    resolve_run,
+    resolve_settings,
+)
 from geardyn.core.status import Status
-from geardyn.models.base import Model
 from geardyn.solvers.kernels import kernels_for
 
-#: Default step of an autonomous model.
-DEFAULT_DT = 0.01
-#: Default number of RK4 steps between re-orthonormalisations.
-DEFAULT_RENORM_EVERY = 10
-#: Default number of blocks the measuring window is cut into for the standard error.
-DEFAULT_BLOCKS = 16
+#: Defaults (LyapunovSettings'): the step of an autonomous model, RK4 steps between
+#: re-orthonormalisations, blocks of the measuring window for the standard error.
+DEFAULT_DT = LYAPUNOV_DT
+DEFAULT_RENORM_EVERY = LYAPUNOV_RENORM_EVERY
+DEFAULT_BLOCKS = LYAPUNOV_BLOCKS
 
 #: Defaults of :func:`lyapunov` where they differ from :class:`~geardyn.RunSettings`'.
 LYAPUNOV_DEFAULTS = {"transient": 100.0}
@@ -128,14 +138,23 @@ def _state_scale(model: Model) -> np.ndarray:
     return s
 
 
-def _lyapunov_run(run: RunSettings | None, settings: dict[str, Any]) -> RunSettings:
-    """The run settings of :func:`lyapunov`: ``run``, or the old keywords (``transient``,
-    ``steps_per_period``, ``locate_edges``, ``bound``) on its defaults."""
-    extra = sorted(set(settings) - set(LYAPUNOV_FIELDS))
+#: The :class:`~geardyn.LyapunovSettings` fields (deprecated as keywords of :func:`lyapunov`).
+SETTINGS_FIELDS = tuple(f.name for f in dataclasses.fields(LyapunovSettings))
+
+
+def _lyapunov_run(run: RunSettings | None, settings: LyapunovSettings | None,
+                  keywords: dict[str, Any]) -> tuple[RunSettings, LyapunovSettings]:
+    """The run and Lyapunov settings of :func:`lyapunov`: ``run``, or the run keywords
+    (``transient``, ``steps_per_period``, ``locate_edges``, ``bound``) on its defaults, and
+    ``settings`` (its fields as keywords: deprecated)."""
+    extra = sorted(set(keywords) - set(LYAPUNOV_FIELDS) - set(SETTINGS_FIELDS))
     if extra:
         raise TypeError(f"lyapunov() got an unexpected keyword argument {extra[0]!r} (run "
                         f"settings it uses: {', '.join(LYAPUNOV_FIELDS)})")
-    return resolve_run(run, settings, LYAPUNOV_DEFAULTS)
+    legacy = {k: v for k, v in keywords.items() if k in SETTINGS_FIELDS}
+    given = {k: v for k, v in keywords.items() if k in LYAPUNOV_FIELDS}
+    return (resolve_run(run, given, LYAPUNOV_DEFAULTS),
+            resolve_settings(LyapunovSettings, settings, legacy, "lyapunov", stacklevel=4))
 
 
 def lyapunov(
@@ -143,14 +162,11 @@ def lyapunov(
     y0=None,
     run: RunSettings | None = None,
     *,
-    duration: float = 2000.0,
+    settings: LyapunovSettings | None = None,
     spectrum: bool = False,
-    dt: float | None = None,
-    renorm_every: int | None = None,
     t0: float = 0.0,
     with_error: bool = False,
-    n_blocks: int = DEFAULT_BLOCKS,
-    **settings: Any,
+    **keywords: Any,
 ) -> float | np.ndarray | LyapunovEstimate:
     """Largest Lyapunov exponent of ``model`` (or the whole spectrum), per unit model time.
 
@@ -172,35 +188,42 @@ def lyapunov(
         its time (a sweep's ``final_time``) continue that run in both forcing phases, on its own
         attractor. A state at another forcing phase cannot be started (the phase is tabulated
         on the period-aligned grid from zero).
+    settings
+        :class:`~geardyn.LyapunovSettings`: ``duration`` (time averaged over), ``dt`` (step of
+        an autonomous model), ``renorm_every``, ``n_blocks``. Its fields given as keyword
+        arguments are deprecated (a DeprecationWarning).
     transient, duration
-        Time discarded first (``run.transient``) and time averaged over, in the model's time
-        unit. For a forced model both are rounded up to whole forcing periods.
+        Time discarded first (``run.transient``) and time averaged over (``settings.duration``),
+        in the model's time unit. For a forced model both are rounded up to whole forcing
+        periods.
     spectrum
         False: the largest exponent (one tangent vector), a float. True: all ``n_states``
         exponents, in descending order, as an array.
     dt
-        Step of an autonomous model (``model.omega == 0``; default 0.01). Not used for a forced
+        ``settings.dt``: step of an autonomous model (``model.omega == 0``; default 0.01).
+        Not used for a forced
         model, whose grid has ``run.steps_per_period`` steps per forcing period (default
         :func:`~geardyn.solvers.simulate.default_steps_per_period`), as in ``simulate``.
     locate_edges
         ``run.locate_edges``: locate the model's edge crossings inside steps (default True;
         False integrates across them, as ``simulate`` does then).
     renorm_every
-        RK4 steps between re-orthonormalisations (default 10).
+        ``settings.renorm_every``: RK4 steps between re-orthonormalisations (default 10).
     bound
         ``run.bound``: a state beyond this magnitude counts as diverged; the result is then NaN.
-    with_error, n_blocks
+    with_error
         True: return a :class:`LyapunovEstimate` (value, stderr, n_blocks, unresolved, status)
-        instead, the standard error from the spread of the rates over ``n_blocks`` blocks of
+        instead, the standard error from the spread of the rates over ``settings.n_blocks``
+        blocks of
         the measuring window (see ``docs/lyapunov.md``, "Uncertainty"). Without it, a run with
         steps at the edge-split limit (status SPLIT_LIMIT) warns (RuntimeWarning).
 
     For a forced model the exponent of the flow's zero direction (along the forcing phase) is not
     included: the phase is not a state, so a forced model with n states has n exponents.
     """
-    run = _lyapunov_run(run, settings)
+    run, ls = _lyapunov_run(run, settings, keywords)
     transient, steps_per_period, bound = run.transient, run.steps_per_period, run.bound
-    duration = _check_time("duration", duration, True)
+    duration, dt, renorm_every, n_blocks = ls.duration, ls.dt, ls.renorm_every, ls.n_blocks
     y = _initial(model, y0)
     t0 = float(t0)
     if not math.isfinite(t0):

@@ -53,7 +53,15 @@ import xarray as xr
 from geardyn.analysis.contact import contact_regime
 from geardyn.analysis.lanes import has_mesh_forces, variable_attrs
 from geardyn.core.plan import default_steps_per_period, forcing_period, lane_section
-from geardyn.core.settings import DEFAULT_BOUND, INTEGRATOR, RunSettings
+from geardyn.core.settings import (
+    DEFAULT_BOUND,
+    INTEGRATOR,
+    NEWTON_MAX_ITER,
+    NEWTON_TOL,
+    NewtonSettings,
+    RunSettings,
+    resolve_settings,
+)
 from geardyn.core.status import Status, status_meaning
 from geardyn.solvers.kernels import kernels_for
 
@@ -65,10 +73,8 @@ if TYPE_CHECKING:
 ORBIT_STEP_FACTOR = 4
 #: Default transient of the default guess, in section periods.
 GUESS_PERIODS = 200
-#: Default Newton tolerance: max |F(x) / state_scale| <= tol (1 + max |x / state_scale|).
-NEWTON_TOL = 1e-10
-#: Default most Newton iterations.
-NEWTON_MAX_ITER = 40
+#: NEWTON_TOL, NEWTON_MAX_ITER (from core.settings, NewtonSettings' defaults): converged where
+#: max |F(x) / state_scale| <= tol (1 + max |x / state_scale|), in at most max_iter iterations.
 #: Smallest damping factor of a Newton step before it counts as failed.
 MIN_DAMPING = 2.0**-10
 #: A multiplier within this of the unit circle makes the verdict "marginal".
@@ -608,8 +614,8 @@ def default_guess(problem: ShootingProblem, y0: np.ndarray | None = None,
 
 def periodic_orbit(model: Model, omega: float | None = None, period: int = 1,
                    guess: np.ndarray | None = None, run: RunSettings | None = None, *,
-                   tol: float = NEWTON_TOL, max_iter: int = NEWTON_MAX_ITER,
-                   steps_per_period: int | None = None) -> PeriodicOrbit:
+                   settings: NewtonSettings | None = None,
+                   steps_per_period: int | None = None, **legacy: Any) -> PeriodicOrbit:
     """A period-``period`` orbit of ``model``'s stroboscopic map at ``omega`` by Newton shooting.
 
     Parameters
@@ -627,8 +633,10 @@ def periodic_orbit(model: Model, omega: float | None = None, period: int = 1,
         :class:`~geardyn.RunSettings`: ``steps_per_period``, ``bound``, ``transient``,
         ``converge`` and ``transient_max`` (of the default guess, see :func:`default_guess`),
         ``max_section_periods``.
-    tol, max_iter
-        Newton tolerance (scaled max norm, relative to ``1 + abs(x)``) and most iterations.
+    settings
+        :class:`~geardyn.NewtonSettings`: the Newton tolerance ``tol`` (scaled max norm,
+        relative to ``1 + abs(x)``) and most iterations ``max_iter``. Its fields given as
+        keyword arguments are deprecated (a DeprecationWarning).
     steps_per_period
         RK4 steps per forcing period (default ``run``'s, else :data:`ORBIT_STEP_FACTOR` times
         the step rule).
@@ -636,6 +644,7 @@ def periodic_orbit(model: Model, omega: float | None = None, period: int = 1,
     Returns a :class:`PeriodicOrbit`. A Newton that does not converge is not an exception:
     ``status``/``message`` say what happened and the last iterate is kept.
     """
+    newton = resolve_settings(NewtonSettings, settings, legacy, "periodic_orbit")
     problem = shooting_problem(model, omega, period, run, steps_per_period)
     if guess is None:
         guess = default_guess(problem, transient=None if run is None else run.transient,
@@ -645,7 +654,7 @@ def periodic_orbit(model: Model, omega: float | None = None, period: int = 1,
     if guess.shape != (problem.model.n_states,):
         raise ValueError(f"guess must have {problem.model.n_states} entries "
                          f"({', '.join(problem.model.state_names)})")
-    res = newton_shooting(problem, guess, tol, max_iter)
+    res = newton_shooting(problem, guess, newton.tol, newton.max_iter)
     return build_orbit(problem, res)
 
 

@@ -208,6 +208,7 @@ def continue_command(
         _check_state,
         _stderr_is_terminal,
     )
+    from geardyn.core.settings import ContinuationSettings
     from geardyn.plotting.branch import QUANTITIES
 
     s = load_study_source(study)
@@ -265,10 +266,10 @@ def continue_command(
     t0 = time.perf_counter()
     with _continue_bar(show_bar, escape(f"{s.study.name}: period-{period} branch"), name,
                        start, stop) as callback:
-        ds = continuation(model, name, start, stop, period=period,
-                          run=run, switch=switch,
-                          max_period=max_period, steps_per_period=spp,
-                          max_points=max_points, progress=callback)
+        ds = continuation(model, name, start, stop, period=period, run=run, switch=switch,
+                          settings=ContinuationSettings(max_period=max_period,
+                                                        max_points=max_points),
+                          steps_per_period=spp, progress=callback)
     elapsed = time.perf_counter() - t0
 
     def draw(path: Path) -> None:

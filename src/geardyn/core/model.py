@@ -24,7 +24,7 @@ Built-in models (:class:`~geardyn.CATTDevice`, :class:`~geardyn.GearPair`) and a
 (:class:`~geardyn.UserModel`) all subclass :class:`Model`. The rules a model keeps are numbered in
 :class:`Model`'s docstring (the model contract); :func:`geardyn.testing.check_model` checks them.
 This module belongs to the core: it imports nothing of geardyn outside :mod:`geardyn.core`
-(``geardyn.models.base`` re-exports it under its earlier name).
+(its earlier home ``geardyn.models.base`` answers with a DeprecationWarning).
 """
 
 from __future__ import annotations

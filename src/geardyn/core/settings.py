@@ -101,14 +101,21 @@ class RunSettings:
         (>= 1; None: :data:`geardyn.core.section.MAX_COMMON_PERIODS`).
     """
 
-    transient: float = 4000.0
-    samples: int = 200
-    steps_per_period: int | None = None
+    transient: float = dataclasses.field(default=4000.0, metadata={
+        "help": "Discarded time before sampling (model time units, tau when dimensionless)"})
+    samples: int = dataclasses.field(default=200, metadata={
+        "help": "Poincare points (sections) sampled per point"})
+    steps_per_period: int | None = dataclasses.field(default=None, metadata={
+        "help": "RK4 steps per forcing period"})
     locate_edges: bool = True
     bound: float = DEFAULT_BOUND
-    converge: float | None = None
+    converge: float | None = dataclasses.field(default=None, metadata={
+        "help": "Transient by convergence: run on past --transient (a minimum) until the "
+                "section point settles to this relative tolerance"})
     transient_max: float | None = None
-    continued_transient: float | None = None
+    continued_transient: float | None = dataclasses.field(default=None, metadata={
+        "help": "Least discarded time of a continued point, which starts next to its "
+                "attractor (a minimum with --converge)"})
     max_period: int = DEFAULT_MAX_PERIOD
     period_tol: float = DEFAULT_TOL
     max_section_periods: int | None = None
@@ -202,3 +209,165 @@ def resolve_run(run: RunSettings | None, legacy: Mapping[str, Any],
                             f"arguments, not both (got run= and {name}=)")
         return run
     return RunSettings(**{**dict(defaults or {}), **given})
+
+
+# ----------------------------------------------------------------------------- analyses
+def _positive(name: str, value: Any) -> float:
+    value = _real(name, value)
+    if not (math.isfinite(value) and value > 0):
+        raise SettingsError(f"{name} must be a finite number > 0 (got {value!r})")
+    return value
+
+
+def _validate(obj: Any) -> None:
+    """Check and normalise every field of a settings dataclass by its metadata ``kind``
+    (``positive``, ``whole`` with ``least``, ``optional-positive``, ``optional-whole``)."""
+    for f in dataclasses.fields(obj):
+        value, kind = getattr(obj, f.name), f.metadata.get("kind")
+        if value is None and kind is not None and kind.startswith("optional-"):
+            continue
+        if kind in ("positive", "optional-positive"):
+            value = _positive(f.name, value)
+        elif kind in ("whole", "optional-whole"):
+            value = _whole(f.name, value, f.metadata.get("least", 1))
+        object.__setattr__(obj, f.name, value)
+
+
+def _field(default: Any, kind: str, help: str, least: int = 1) -> Any:
+    """A settings field: its default, its check (see :func:`_validate`) and its help text (the
+    CLI's, where it has an option)."""
+    return dataclasses.field(default=default,
+                             metadata={"kind": kind, "least": least, "help": help})
+
+
+class _AnalysisSettings:
+    """What the analysis settings share: validation at construction and ``replace``."""
+
+    def __post_init__(self) -> None:
+        _validate(self)
+        self._check()
+
+    def _check(self) -> None:
+        """Checks across fields (none by default)."""
+
+    def replace(self, **changes: Any) -> Any:
+        """A copy with ``changes`` (field names), validated anew."""
+        names = [f.name for f in dataclasses.fields(self)]
+        unknown = sorted(set(changes) - set(names))
+        if unknown:
+            raise TypeError(f"{type(self).__name__} has no field {unknown[0]!r} "
+                            f"(fields: {', '.join(names)})")
+        return dataclasses.replace(self, **changes)
+
+
+#: Defaults of Newton shooting: tolerance (scaled residual) and most iterations.
+NEWTON_TOL = 1e-10
+NEWTON_MAX_ITER = 40
+
+
+@dataclass(frozen=True)
+class NewtonSettings(_AnalysisSettings):
+    """Newton shooting of a periodic orbit (:func:`geardyn.periodic_orbit`).
+
+    tol
+        Converged when max |F / state_scale| <= tol (1 + max |x / state_scale|) (> 0).
+    max_iter
+        Most Newton iterations (>= 1).
+    """
+
+    tol: float = _field(NEWTON_TOL, "positive", "Newton tolerance (scaled residual)")
+    max_iter: int = _field(NEWTON_MAX_ITER, "whole", "most Newton iterations")
+
+
+#: Defaults of the continuation corrector and of bifurcation location.
+CORRECTOR_TOL = 1e-10
+LOCATE_TOL = 1e-7
+
+
+@dataclass(frozen=True)
+class ContinuationSettings(_AnalysisSettings):
+    """Pseudo-arclength continuation of periodic orbits (:func:`geardyn.continuation`).
+
+    ds, ds_min, ds_max
+        First, least and greatest arclength step in the scaled unknowns (x / state_scale,
+        p / p_scale); 0 < ds_min <= ds <= ds_max.
+    max_points
+        Most points of a branch (>= 1).
+    tol
+        Corrector tolerance (scaled residual, > 0).
+    locate_tol
+        Location tolerance of a bifurcation in the parameter (> 0).
+    max_period
+        Branch switching at period doublings goes on (a cascade) while 2k <= max_period.
+    p_scale
+        The parameter's scale in the arclength (> 0; None: ``abs(stop - start)``).
+    """
+
+    ds: float = _field(0.01, "positive", "first arclength step")
+    ds_min: float = _field(1e-7, "positive", "least arclength step")
+    ds_max: float = _field(0.2, "positive", "greatest arclength step")
+    max_points: int = _field(2000, "whole", "most points per branch")
+    tol: float = _field(CORRECTOR_TOL, "positive", "corrector tolerance (scaled residual)")
+    locate_tol: float = _field(LOCATE_TOL, "positive",
+                               "location tolerance of a bifurcation in the parameter")
+    max_period: int = _field(16, "whole", "longest period of a switched branch (2k <= N)")
+    p_scale: float | None = _field(None, "optional-positive",
+                                   "the parameter's scale in the arclength")
+
+    def _check(self) -> None:
+        if not self.ds_min <= self.ds <= self.ds_max:
+            raise SettingsError(f"ds must lie in [ds_min, ds_max] (got ds_min={self.ds_min!r}, "
+                                f"ds={self.ds!r}, ds_max={self.ds_max!r})")
+
+
+#: Defaults of the Lyapunov estimate.
+LYAPUNOV_DURATION = 2000.0
+LYAPUNOV_DT = 0.01
+LYAPUNOV_RENORM_EVERY = 10
+LYAPUNOV_BLOCKS = 16
+
+
+@dataclass(frozen=True)
+class LyapunovSettings(_AnalysisSettings):
+    """How Lyapunov exponents are measured (:func:`geardyn.lyapunov`,
+    :func:`geardyn.lyapunov_lanes`); the transient, steps and bound are the run's.
+
+    duration
+        Time averaged over, in the model's time unit, rounded up to whole forcing periods (> 0).
+    dt
+        Step of an autonomous model (> 0; None: :data:`LYAPUNOV_DT`); not for a forced model,
+        whose grid has the run's steps per period.
+    renorm_every
+        RK4 steps between re-orthonormalisations (>= 1).
+    n_blocks
+        Blocks of the measuring window for the standard error (>= 2).
+    """
+
+    duration: float = _field(LYAPUNOV_DURATION, "positive", "time averaged over")
+    dt: float | None = _field(None, "optional-positive",
+                              f"step of an autonomous model (default {LYAPUNOV_DT})")
+    renorm_every: int = _field(LYAPUNOV_RENORM_EVERY, "whole",
+                               "RK4 steps between re-orthonormalisations")
+    n_blocks: int = _field(LYAPUNOV_BLOCKS, "whole", "blocks for the standard error", least=2)
+
+
+def resolve_settings(kind: type, settings: Any, legacy: Mapping[str, Any], where: str,
+                     stacklevel: int = 3) -> Any:
+    """The ``kind`` settings of a public function that takes ``settings=`` and, for one
+    deprecation cycle, their fields as keyword arguments (``legacy``: those given): one
+    DeprecationWarning naming the replacement (``stacklevel``: the public function's caller,
+    seen from here); giving both is a TypeError."""
+    if settings is not None and not isinstance(settings, kind):
+        raise TypeError(f"settings must be a {kind.__name__} (got {type(settings).__name__})")
+    if not legacy:
+        return kind() if settings is None else settings
+    if settings is not None:
+        raise TypeError(f"{where}: give settings={kind.__name__}(...) or keyword arguments, "
+                        f"not both (got settings= and {next(iter(legacy))}=)")
+    import warnings
+
+    args = ", ".join(f"{k}={v!r}" for k, v in legacy.items())
+    warnings.warn(f"{where}({', '.join(f'{k}=' for k in legacy)}) is deprecated: pass "
+                  f"settings=geardyn.{kind.__name__}({args})", DeprecationWarning,
+                  stacklevel=stacklevel)
+    return kind(**legacy)

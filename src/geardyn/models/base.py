@@ -1,6 +1,7 @@
-"""The model interface, kept under its earlier name: :class:`Model` lives in
-:mod:`geardyn.core.model` (the core layer), and is re-exported here."""
+"""The model interface's earlier home: :class:`Model` and ``unique_rows`` live in
+:mod:`geardyn.core.model`; importing them from here is deprecated (a DeprecationWarning)."""
 
-from geardyn.core.model import Model, unique_rows
+from geardyn.core.moved import moved
 
-__all__ = ["Model", "unique_rows"]
+__getattr__ = moved(__name__, {"Model": "geardyn.core.model",
+                               "unique_rows": "geardyn.core.model"})

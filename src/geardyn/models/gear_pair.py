@@ -16,7 +16,7 @@ import numba as nb
 import numpy as np
 
 from geardyn.core.kernel_source import FORM_GENERAL, FORM_QUIET, KernelSource
-from geardyn.models.base import Model
+from geardyn.core.model import Model
 from geardyn.models.catt_kernels import dead_zone
 
 _JIT = {"cache": True, "error_model": "numpy", "boundscheck": False}

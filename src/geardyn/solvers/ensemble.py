@@ -17,16 +17,16 @@ from dataclasses import dataclass
 import numpy as np
 
 from geardyn.core.kernel_args import LaneInputs, LaneOutputs, Schedule, SweepConfig
-from geardyn.core.plan import (  # noqa: F401  (the step rule's old home)
-    _LADDER,
-    LanePlan,
-    ladder_steps,
-    lane_steps_per_period,
-)
+from geardyn.core.model import Model
+from geardyn.core.moved import moved
+from geardyn.core.plan import LanePlan
 from geardyn.core.settings import RunSettings
 from geardyn.core.status import Status
-from geardyn.models.base import Model
 from geardyn.solvers.kernels import kernels_for
+
+#: Names whose home is now the core layer (deprecated here).
+__getattr__ = moved(__name__, dict.fromkeys(("_LADDER", "ladder_steps", "lane_steps_per_period"),
+                                            "geardyn.core.plan"))
 
 
 @dataclass

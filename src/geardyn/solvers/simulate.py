@@ -9,23 +9,17 @@ import numpy as np
 import xarray as xr
 
 from geardyn.core.model import Model
-from geardyn.core.plan import (  # noqa: F401  (the step rule's old home)
-    MIN_STEPS_PER_PERIOD,
-    STEPS_PER_FASTEST_MODE,
-    STEPS_PER_OTHER_FORCING,
-    default_steps_per_period,
-    forcing_period,
-    periods_covering,
-    steps_per_period_rule,
-)
-from geardyn.core.settings import (  # noqa: F401  (DEFAULT_BOUND: its old home)
-    DEFAULT_BOUND,
-    INTEGRATOR,
-    RunSettings,
-    resolve_run,
-)
+from geardyn.core.moved import moved
+from geardyn.core.plan import default_steps_per_period, forcing_period, periods_covering
+from geardyn.core.settings import INTEGRATOR, RunSettings, resolve_run
 from geardyn.core.status import Status, status_meaning
 from geardyn.solvers.kernels import kernels_for
+
+#: Names whose home is now the core layer (deprecated here).
+__getattr__ = moved(__name__, {
+    **dict.fromkeys(("MIN_STEPS_PER_PERIOD", "STEPS_PER_FASTEST_MODE",
+                     "STEPS_PER_OTHER_FORCING", "steps_per_period_rule"), "geardyn.core.plan"),
+    "DEFAULT_BOUND": "geardyn.core.settings"})
 
 #: simulate's own defaults of the run settings (a time history from the start, 64 periods).
 SIMULATE_DEFAULTS = {"transient": 0.0, "samples": 64}

@@ -1,0 +1,150 @@
+"""Settings objects for continuation, Newton shooting and Lyapunov exponents beside RunSettings:
+validated at construction (the message names the field), passed whole as ``settings=``; their
+fields as keyword arguments still work for one deprecation cycle, with one DeprecationWarning
+naming the replacement and the same result; old homes of moved names warn once."""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+import pytest
+import xarray as xr
+
+import geardyn
+from geardyn import ContinuationSettings, LyapunovSettings, NewtonSettings
+from geardyn.core.settings import SettingsError, SettingsTypeError
+
+PAIR = dict(zeta=0.05, kappa=0.0, Fm=0.1, Fa=0.0)
+
+
+@pytest.mark.parametrize(("kind", "field", "value", "error"), [
+    (ContinuationSettings, "ds", -0.01, SettingsError),
+    (ContinuationSettings, "ds_max", float("nan"), SettingsError),
+    (ContinuationSettings, "max_points", 0, SettingsError),
+    (ContinuationSettings, "max_points", 2.5, SettingsTypeError),
+    (ContinuationSettings, "tol", "1e-8", SettingsTypeError),
+    (ContinuationSettings, "p_scale", 0.0, SettingsError),
+    (NewtonSettings, "tol", 0.0, SettingsError),
+    (NewtonSettings, "max_iter", 0, SettingsError),
+    (LyapunovSettings, "duration", float("inf"), SettingsError),
+    (LyapunovSettings, "n_blocks", 1, SettingsError),
+    (LyapunovSettings, "renorm_every", True, SettingsTypeError),
+    (LyapunovSettings, "dt", -1.0, SettingsError),
+])
+def test_bad_field_is_named_at_construction(kind, field, value, error):
+    with pytest.raises(error, match=rf"^{field} must"):
+        kind(**{field: value})
+
+
+def test_settings_are_frozen_and_normalised():
+    s = ContinuationSettings(ds_max=1, max_points=10.0)
+    assert (type(s.ds_max), type(s.max_points)) == (float, int)
+    with pytest.raises(AttributeError):
+        s.ds = 0.1
+    assert s.replace(ds=0.05).ds == 0.05
+    with pytest.raises(TypeError, match="no field 'step'"):
+        s.replace(step=1.0)
+
+
+def test_step_order_is_checked_across_fields():
+    with pytest.raises(SettingsError, match="ds must lie in"):
+        ContinuationSettings(ds=0.5, ds_max=0.2)
+
+
+def _one_deprecation(record, replacement: str) -> None:
+    deprecations = [w for w in record if issubclass(w.category, DeprecationWarning)]
+    assert len(deprecations) == 1, [str(w.message) for w in deprecations]
+    assert replacement in str(deprecations[0].message)
+    assert deprecations[0].filename == __file__  # points at the caller
+
+
+def test_continuation_keywords_warn_once_and_agree():
+    g = geardyn.GearPair(zeta=0.05, Fm=0.1, Fa=0.05)
+    new = geardyn.continuation(g, "Omega", 0.5, 0.6,
+                               settings=ContinuationSettings(max_points=4, ds=0.02))
+    with warnings.catch_warnings(record=True) as record:
+        warnings.simplefilter("always")
+        old = geardyn.continuation(g, "Omega", 0.5, 0.6, max_points=4, ds=0.02)
+    _one_deprecation(record, "settings=geardyn.ContinuationSettings(max_points=4, ds=0.02)")
+    xr.testing.assert_identical(old, new)
+    with pytest.raises(TypeError, match="not both"):
+        geardyn.continuation(g, "Omega", 0.5, 0.6, settings=ContinuationSettings(), ds=0.02)
+
+
+def test_periodic_orbit_keywords_warn_once_and_agree():
+    g = geardyn.GearPair(**PAIR)
+    new = geardyn.periodic_orbit(g, omega=1.2, settings=NewtonSettings(tol=1e-9, max_iter=30))
+    with warnings.catch_warnings(record=True) as record:
+        warnings.simplefilter("always")
+        old = geardyn.periodic_orbit(g, omega=1.2, tol=1e-9, max_iter=30)
+    _one_deprecation(record, "settings=geardyn.NewtonSettings(tol=1e-09, max_iter=30)")
+    np.testing.assert_array_equal(old.x, new.x)
+    assert old.iterations == new.iterations
+
+
+def test_lyapunov_keywords_warn_once_and_agree():
+    g = geardyn.GearPair(**PAIR).with_omega(1.2)
+    run = geardyn.RunSettings(transient=50.0)
+    new = geardyn.lyapunov(g, run=run, settings=LyapunovSettings(duration=200.0, n_blocks=4))
+    with warnings.catch_warnings(record=True) as record:
+        warnings.simplefilter("always")
+        old = geardyn.lyapunov(g, run=run, duration=200.0, n_blocks=4)
+    _one_deprecation(record, "settings=geardyn.LyapunovSettings(duration=200.0, n_blocks=4)")
+    assert old == new
+    with pytest.raises(TypeError, match="unexpected keyword argument 'durations'"):
+        geardyn.lyapunov(g, run=run, durations=200.0)
+
+
+#: Names that moved: (old home, name, new home).
+MOVED = [
+    ("geardyn.models.base", "Model", "geardyn.core.model"),
+    ("geardyn.solvers.simulate", "STEPS_PER_OTHER_FORCING", "geardyn.core.plan"),
+    ("geardyn.solvers.simulate", "DEFAULT_BOUND", "geardyn.core.settings"),
+    ("geardyn.solvers.ensemble", "lane_steps_per_period", "geardyn.core.plan"),
+]
+
+_OLD_HOMES = """
+import importlib, json, sys, warnings
+warnings.simplefilter("always")
+import geardyn
+out = []
+for old, name, new in json.loads(sys.argv[1]):
+    with warnings.catch_warnings(record=True) as record:
+        warnings.simplefilter("always")
+        same = getattr(importlib.import_module(old), name) is getattr(
+            importlib.import_module(new), name)
+        getattr(importlib.import_module(old), name)
+    out.append([same, [(w.category.__name__, str(w.message)) for w in record]])
+print(json.dumps(out))
+"""
+
+
+def test_old_homes_warn_once_and_nothing_uses_them():
+    """In a fresh interpreter (``import geardyn`` itself warns nothing), each old home gives the
+    moved object with one DeprecationWarning naming the new home, however often it is asked;
+    src/, docs/ and examples/ import nothing from an old home."""
+    import json
+    import os
+    import re
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[1]
+    env = {**os.environ, "PYTHONPATH": str(root / "src")}
+    out = subprocess.run([sys.executable, "-c", _OLD_HOMES, json.dumps(MOVED)], env=env,
+                         capture_output=True, text=True, timeout=300, check=True)
+    got = json.loads(out.stdout.strip().splitlines()[-1])
+    assert "DeprecationWarning" not in out.stderr  # import geardyn: nothing deprecated used
+    for (old, name, new), (same, record) in zip(MOVED, got, strict=True):
+        assert same
+        assert record == [["DeprecationWarning", f"{old}.{name} is deprecated: import it "
+                                                 f"from {new}"]]
+    files = [p for d in ("src", "docs", "examples") for p in (root / d).rglob("*")
+             if p.suffix in (".py", ".md", ".rst")]
+    for old, name, _ in MOVED:
+        pattern = re.compile(rf"from {re.escape(old)} import[^\n]*\b{name}\b|"
+                             rf"{re.escape(old)}\.{name}\b")
+        users = [str(p.relative_to(root)) for p in files if pattern.search(p.read_text())]
+        assert users == [], f"{old}.{name} used in {users}"
