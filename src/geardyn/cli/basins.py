@@ -33,6 +33,7 @@ from geardyn.cli.common import (
     check_run_cost,
     load_study_source,
     make_parents,
+    run_option,
     run_settings,
     usable_omega,
     write_outputs,
@@ -59,16 +60,9 @@ def basins_command(
     omega: Annotated[
         float | None, typer.Option(help="Mesh frequency Omega (default: the study's run.omega).")
     ] = None,
-    transient: Annotated[
-        float | None, typer.Option(help="Least discarded time per cell (default: run.transient).")
-    ] = None,
-    samples: Annotated[
-        int | None, typer.Option(help="Section points per cell (default: 2 max_period + 2).")
-    ] = None,
-    converge: Annotated[
-        float | None, typer.Option(help="Transient until the section point settles to this "
-                                        "tolerance (default 1e-8).")
-    ] = None,
+    transient: run_option("transient", "the least per cell; default: run.transient") = None,
+    samples: run_option("samples", "per cell; default: 2 max_period + 2") = None,
+    converge: run_option("converge", "default 1e-8") = None,
     steps_per_period: StepsOption = None,
     orbit_period: Annotated[
         int, typer.Option(help="Match the attractors to Newton-shooting orbits of period <= K "

@@ -35,13 +35,16 @@ from geardyn.cli.common import (
     InterpretationOption,
     NetCDFOutOption,
     PlotOption,
+    SamplesOption,
     StepsOption,
+    TransientOption,
     YesOption,
     check_count,
     check_plot_path,
     check_run_cost,
     load_study_source,
     make_parents,
+    run_option,
     run_settings,
     stderr_console,
     study_run_options,
@@ -220,26 +223,12 @@ def bifurcation_command(
         typer.Option("--lyapunov/--no-lyapunov", help="Largest Lyapunov exponent per point "
                                                       "(default: sweep.lyapunov)."),
     ] = None,
-    transient: Annotated[
-        float | None, typer.Option(help="Discarded time per point, dimensionless tau "
-                                        "(default: run.transient or run.transient_periods).")
-    ] = None,
-    converge: Annotated[
-        float | None, typer.Option(help="Transient by convergence: run on past --transient "
-                                        "(a minimum), up to 10x it, until the Poincare point "
-                                        "is estimated within this relative tolerance of its "
-                                        "orbit (e.g. 1e-8; default: run.converge).")
-    ] = None,
-    continued_transient: Annotated[
-        float | None, typer.Option(help="With --continuation: the discarded time of a continued "
-                                        "point, which starts next to its attractor (a minimum "
-                                        "with --converge; default: --transient). The first "
-                                        "point gets --transient.")
-    ] = None,
-    samples: Annotated[
-        int | None, typer.Option(help="Forcing periods sampled per point (default: "
-                                      "sweep.samples, else run.periods).")
-    ] = None,
+    transient: TransientOption = None,
+    converge: run_option("converge", "up to 10x --transient, e.g. 1e-8; "
+                          "default: run.converge") = None,
+    continued_transient: run_option("continued_transient", "with --continuation; the first "
+                                     "point gets --transient; default: --transient") = None,
+    samples: SamplesOption = None,
     steps_per_period: StepsOption = None,
     omega: Annotated[
         float | None, typer.Option(help="The fixed Omega when sweeping another parameter "

@@ -52,13 +52,52 @@ class Interpretation(StrEnum):
     as_printed = "as-printed"
 
 
-# Options that several commands share, declared once.
+def option_name(field: str) -> str:
+    """The command-line option of a settings field: ``--`` and its name with dashes."""
+    return "--" + field.replace("_", "-")
+
+
+def settings_option(kind: type, field: str, default: str, option: str | None = None) -> Any:
+    """The typer option of the settings dataclass ``kind``'s ``field``, generated from it: named
+    :func:`option_name` (or ``option``), its type the field's (None: unset, the study's or the
+    settings' default applies), its help the field's ``help`` metadata and ``default`` (what
+    applies when the option is not given, which the command decides)."""
+    import dataclasses
+    import typing
+
+    f = next((f for f in dataclasses.fields(kind) if f.name == field), None)
+    if f is None or "help" not in f.metadata:
+        raise KeyError(f"{kind.__name__}.{field} has no command-line help")
+    hint = typing.get_type_hints(kind)[field]
+    base = next(t for t in (typing.get_args(hint) or (hint,)) if t is not type(None))
+    return Annotated[base | None, typer.Option(option or option_name(field),
+                                               help=f"{f.metadata['help']} ({default}).")]
+
+
+def run_option(field: str, default: str, option: str | None = None) -> Any:
+    from geardyn.core.settings import RunSettings
+
+    return settings_option(RunSettings, field, default, option)
+
+
+def continuation_option(field: str, default: str) -> Any:
+    from geardyn.core.settings import ContinuationSettings
+
+    return settings_option(ContinuationSettings, field, default)
+
+
+# Options that several commands share, declared once; the settings options are generated from
+# the settings' fields (see settings_option).
 InterpretationOption = Annotated[
     Interpretation | None, typer.Option(help="Interpretation (default: the study's).")
 ]
-StepsOption = Annotated[
-    int | None, typer.Option(help="RK4 steps per forcing period (default: automatic).")
-]
+StepsOption = run_option("steps_per_period", "default: automatic")
+TransientOption = run_option("transient", "default: run.transient or run.transient_periods")
+SamplesOption = run_option("samples", "default: sweep.samples, else run.periods")
+ConvergeOption = run_option("converge", "default: run.converge")
+ContinuedTransientOption = run_option("continued_transient", "default: --transient")
+MaxPointsOption = continuation_option("max_points", "default 2000")
+MaxPeriodOption = continuation_option("max_period", "default 16")
 YesOption = Annotated[
     bool, typer.Option("--yes", help="Run even when the estimated memory or time exceeds the "
                                       "limits.")
@@ -100,14 +139,19 @@ def usable_omega(value: float) -> bool:
 
 
 def run_settings(options: dict[str, tuple[str, Any]]):
-    """The :class:`~geardyn.RunSettings` of a command, built once from ``options`` (field ->
-    (option name, value); ``None`` values take the default); an invalid value is a one-line
-    :class:`ParameterError` naming the option."""
+    """The :class:`~geardyn.RunSettings` of a command (see :func:`settings_from_options`)."""
     from geardyn.core.settings import RunSettings
 
+    return settings_from_options(RunSettings, options)
+
+
+def settings_from_options(kind: type, options: dict[str, tuple[str, Any]]):
+    """The ``kind`` settings of a command, built once from ``options`` (field -> (option name,
+    value); ``None`` values take the default); an invalid value is a one-line
+    :class:`ParameterError` naming the option."""
     given = {field: value for field, (_, value) in options.items() if value is not None}
     try:
-        return RunSettings(**given)
+        return kind(**given)
     except (TypeError, ValueError) as exc:
         text = str(exc)
         field, _, reason = text.partition(" ")

@@ -32,6 +32,8 @@ from rich.markup import escape
 
 from geardyn.cli.common import (
     InterpretationOption,
+    MaxPeriodOption,
+    MaxPointsOption,
     NetCDFOutOption,
     PlotOption,
     StepsOption,
@@ -39,7 +41,10 @@ from geardyn.cli.common import (
     check_plot_path,
     load_study_source,
     make_parents,
+    option_name,
+    run_option,
     run_settings,
+    settings_from_options,
     stderr_console,
     usable_omega,
     write_outputs,
@@ -167,17 +172,15 @@ def continue_command(
         bool, typer.Option("--switch", help="At each period doubling follow the period-2k "
                                             "branch too (a cascade, up to --max-period).")
     ] = False,
-    max_period: Annotated[int, typer.Option(help="Longest period switched to.")] = 16,
+    max_period: MaxPeriodOption = None,
     omega: Annotated[
         float | None, typer.Option(help="The fixed Omega of a branch in another parameter "
                                         "(default: run.omega).")
     ] = None,
-    transient: Annotated[
-        float | None, typer.Option(help="Transient of the starting guess (default: 200 "
-                                        "periods, at most 2000 time units).")
-    ] = None,
+    transient: run_option("transient", "of the starting guess; default: 200 periods, at "
+                           "most 2000 time units") = None,
     steps_per_period: StepsOption = None,
-    max_points: Annotated[int, typer.Option(help="Most points per branch.")] = 2000,
+    max_points: MaxPointsOption = None,
     over: Annotated[
         Path | None, typer.Option(help="A brute-force bifurcation diagram (NetCDF from "
                                        "geardyn bifurcation, same parameter) drawn under the "
@@ -228,11 +231,13 @@ def continue_command(
         raise StudyError(f"--range: not given, and {why}")
     if period < 1:
         raise ParameterError("--period", period, "must be >= 1")
-    if max_period < period:
-        raise ParameterError("--max-period", max_period, f"must be >= --period ({period})")
-    if max_points < 1:
-        raise ParameterError("--max-points", max_points, "must be >= 1")
-    check_count("--max-points", max_points)
+    cset = settings_from_options(ContinuationSettings,
+                                 {"max_period": (option_name("max_period"), max_period),
+                                  "max_points": (option_name("max_points"), max_points)})
+    if cset.max_period < period:
+        raise ParameterError("--max-period", cset.max_period,
+                             f"must be >= --period ({period})")
+    check_count("--max-points", cset.max_points)
     if quantity not in QUANTITIES:
         raise ParameterError("--quantity", quantity, f"must be one of {', '.join(QUANTITIES)}")
     if out is not None and out.suffix.lower() != ".nc":
@@ -267,8 +272,7 @@ def continue_command(
     with _continue_bar(show_bar, escape(f"{s.study.name}: period-{period} branch"), name,
                        start, stop) as callback:
         ds = continuation(model, name, start, stop, period=period, run=run, switch=switch,
-                          settings=ContinuationSettings(max_period=max_period,
-                                                        max_points=max_points),
+                          settings=cset,
                           steps_per_period=spp, progress=callback)
     elapsed = time.perf_counter() - t0
 

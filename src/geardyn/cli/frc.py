@@ -25,6 +25,8 @@ from rich.markup import escape
 
 from geardyn.cli.common import (
     ESTIMATE_POINTS,
+    ContinuedTransientOption,
+    ConvergeOption,
     InterpretationOption,
     NetCDFOutOption,
     PlotOption,
@@ -35,6 +37,7 @@ from geardyn.cli.common import (
     check_run_cost,
     load_study_source,
     make_parents,
+    run_option,
     run_settings,
     study_run_options,
     usable_omega,
@@ -61,20 +64,10 @@ def frc_command(
                                       "the study's sweep.param when it is one of these, else "
                                       "Omega).")
     ] = None,
-    transient: Annotated[
-        float | None, typer.Option(help="Transient of the first point (default: run.transient).")
-    ] = None,
-    continued_transient: Annotated[
-        float | None, typer.Option(help="Least transient of a continued point (default: "
-                                        "--transient).")
-    ] = None,
-    converge: Annotated[
-        float | None, typer.Option(help="Transient until the section point settles to this "
-                                        "tolerance.")
-    ] = None,
-    samples: Annotated[
-        int | None, typer.Option(help="Section points per point (default: the study's).")
-    ] = None,
+    transient: run_option("transient", "of the first point; default: run.transient") = None,
+    continued_transient: ContinuedTransientOption = None,
+    converge: ConvergeOption = None,
+    samples: run_option("samples", "default: the study's") = None,
     steps_per_period: StepsOption = None,
     mesh: Annotated[str | None, typer.Option(help="Mesh drawn (default: the first).")] = None,
     branch: Annotated[

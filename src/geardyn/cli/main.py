@@ -50,6 +50,7 @@ from geardyn.cli.common import (
     check_run_cost,
     load_study_source,
     make_parents,
+    run_option,
     run_settings,
     stderr_console,
     usable_omega,
@@ -227,12 +228,9 @@ def simulate(
         float | None,
         typer.Option(help="Mesh frequency Omega = omega/omega_n (default: the study's run.omega)."),
     ] = None,
-    transient: Annotated[
-        float | None, typer.Option(help="Discarded time, dimensionless (default: run.transient).")
-    ] = None,
-    periods: Annotated[
-        int | None, typer.Option(help="Forcing periods recorded (default: run.periods).")
-    ] = None,
+    transient: run_option("transient", "default: run.transient") = None,
+    periods: run_option("samples", "forcing periods recorded; default: run.periods",
+                         option="--periods") = None,
     steps_per_period: StepsOption = None,
     interpretation: InterpretationOption = None,
     state: Annotated[

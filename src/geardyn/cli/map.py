@@ -33,6 +33,7 @@ from geardyn.cli.common import (
     check_count,
     load_study_source,
     refuse_if_costly,
+    run_option,
     run_settings,
     study_run_options,
     usable_omega,
@@ -85,12 +86,8 @@ def map_command(
     y: Annotated[str, typer.Option("--y", help="y axis NAME:START:STOP:NUM, e.g. xi:0.01:0.3:200")],
     out: Annotated[Path, typer.Option(help="Result: map.nc (NetCDF) or map.zarr (resumable).")],
     plot: Annotated[Path | None, typer.Option(help="Figure (.png, .pdf or .svg).")] = None,
-    transient: Annotated[
-        float | None, typer.Option(help="Discarded time per point (default: run.transient).")
-    ] = None,
-    samples: Annotated[
-        int | None, typer.Option(help="Forcing periods sampled per point (default: run.periods).")
-    ] = None,
+    transient: run_option("transient", "default: run.transient") = None,
+    samples: run_option("samples", "default: run.periods") = None,
     steps_per_period: StepsOption = None,
     lyapunov: Annotated[
         bool, typer.Option("--lyapunov", help="Also the largest Lyapunov exponent per point.")

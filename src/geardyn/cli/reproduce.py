@@ -27,7 +27,7 @@ from typing import Annotated
 
 import typer
 
-from geardyn.cli.common import stderr_console
+from geardyn.cli.common import run_option, stderr_console
 from geardyn.errors import ParameterError
 
 __all__ = ["register", "reproduce_command"]
@@ -68,11 +68,9 @@ def reproduce_command(
         InterpretationChoice.consistent),
     resolution: Annotated[int | None, typer.Option(
         help="Omega points per sweep (default: the study's, the paper's resolution).")] = None,
-    transient: Annotated[float | None, typer.Option(
-        help="Longest transient per point, dimensionless time; each point stops earlier once "
-        "its Poincare point settles (default: the study's).")] = None,
-    samples: Annotated[int | None, typer.Option(
-        help="Mesh periods sampled per point (default: the study's).")] = None,
+    transient: run_option("transient", "the longest per point: each point stops earlier once "
+                           "its Poincare point settles; default: the study's") = None,
+    samples: run_option("samples", "mesh periods; default: the study's") = None,
     jobs: Annotated[int | None, typer.Option(
         help="Worker processes, each continuing its share of the sweeps with one thread, then "
         "drawing its share of the figures "
