@@ -32,6 +32,7 @@ from typing import Any
 
 import numpy as np
 
+from geardyn.core import results
 from geardyn.core.kernel_source import events_take_phase
 from geardyn.core.model import Model
 from geardyn.solvers.kernels import TEMPLATES, KernelSource, kernels_for
@@ -619,104 +620,13 @@ def check_model(
 
 
 # ------------------------------------------------------------------------------ result datasets
-#: The kinds of result dataset, as recorded in ``attrs["geardyn_kind"]``: what
-#: :func:`geardyn.simulate`, :func:`geardyn.bifurcation`, :func:`geardyn.map2d` and the
-#: reproduction (``geardyn reproduce``, one case under one interpretation) and
-#: :func:`geardyn.periodic_orbit` (``PeriodicOrbit.to_dataset()``), :func:`geardyn.continuation`,
-#: :func:`geardyn.basins` and :func:`geardyn.frequency_response` return.
-KINDS = ("simulation", "bifurcation", "map2d", "reproduction-case", "periodic-orbit",
-         "continuation", "basins", "frequency-response")
-
-
-def _result_spec(ds: Any, kind: str) -> tuple[list[str], dict[str, tuple[str, ...]],
-                                              dict[str, tuple[str, ...]], list[str]]:
-    """(required attributes, coordinates with their dims, variables with their dims (any
-    order), the status variables) of a dataset of ``kind``; the dims name the attributes'
-    values where they depend on them (``param``, ``x``, ``y``)."""
-    a = ds.attrs
-    if kind == "simulation":
-        states = [str(s) for s in ds["state"].values] if "state" in ds.coords else []
-        variables = {"poincare": ("sample", "state"), "poincare_time": ("sample",)}
-        variables.update({s: ("time",) for s in states})
-        return (["status", "status_meaning", "steps_per_period", "time_unit"],
-                {"time": ("time",), "sample": ("sample",), "state": ("state",)}, variables, [])
-    if kind in ("bifurcation", "reproduction-case"):
-        p = str(a.get("param", "Omega"))
-        lead = (p,) if kind == "bifurcation" else ("sweep", p)
-        coords = {p: (p,), "sample": ("sample",), "state": ("state",)}
-        if kind == "reproduction-case":
-            coords["sweep"] = ("sweep",)
-        variables = {"poincare": (*lead, "sample", "state"), "period": lead, "status": lead,
-                     "final_time": lead}
-        return ["param", "time_unit"], coords, variables, ["status"]
-    if kind == "map2d":
-        x, y = str(a.get("x", "x")), str(a.get("y", "y"))
-        return (["x", "y", "time_unit"], {y: (y,), x: (x,)},
-                {"period": (y, x), "status": (y, x)}, ["status"])
-    if kind == "periodic-orbit":
-        states = [str(s) for s in ds["state"].values] if "state" in ds.coords else []
-        variables = {"section_point": ("state",), "monodromy": ("state", "state_in"),
-                     "multiplier_real": ("multiplier",), "multiplier_imag": ("multiplier",)}
-        variables.update({s: ("time",) for s in states})
-        return (["status", "status_meaning", "steps_per_period", "time_unit", "Omega", "period",
-                 "converged", "orbit_status", "message", "residual", "stability"],
-                {"time": ("time",), "state": ("state",), "multiplier": ("multiplier",)},
-                variables, [])
-    if kind == "continuation":
-        p = str(a.get("param", "Omega"))
-        return (["param", "start", "stop", "period", "status", "message", "status_meaning",
-                 "time_unit"],
-                {"point": ("point",), p: ("point",), "state": ("state",),
-                 "multiplier": ("multiplier",), "branch_id": ("branch_id",)},
-                {"section_point": ("point", "state"), "multiplier_real": ("point", "multiplier"),
-                 "multiplier_imag": ("point", "multiplier"), "stability": ("point",),
-                 "branch": ("point",), "bifurcation_kind": ("bifurcation",),
-                 "bifurcation_value": ("bifurcation",), "bifurcation_error": ("bifurcation",),
-                 "bifurcation_located": ("bifurcation",), "branch_status": ("branch_id",),
-                 "branch_message": ("branch_id",)}, [])
-    if kind == "basins":
-        x, y = str(a.get("x", "x")), str(a.get("y", "y"))
-        return (["x", "y", "Omega", "time_unit", "diverged_fraction", "unresolved_fraction",
-                 "n_attractors"],
-                {y: (y,), x: (x,), "attractor": ("attractor",), "state": ("state",)},
-                {"attractor_id": (y, x), "period": (y, x), "status": (y, x),
-                 "unresolved": (y, x),
-                 "attractor_period": ("attractor",), "attractor_fraction": ("attractor",),
-                 "attractor_point": ("attractor", "point", "state"),
-                 "attractor_orbit": ("attractor",)}, ["status"])
-    if kind == "frequency-response":
-        lead = ("sweep", "Omega")
-        return (["param", "time_unit", "resolution"],
-                {"sweep": ("sweep",), "Omega": ("Omega",), "mesh": ("mesh",),
-                 "jump": ("jump",)},
-                {"dte_rms": (*lead, "mesh"), "dte_peak": (*lead, "mesh"),
-                 "dte_mean": (*lead, "mesh"), "period": lead, "status": lead,
-                 "hysteresis": ("Omega",), "jump_omega": ("jump",), "jump_sweep": ("jump",)},
-                ["status"])
-    raise AssertionError(f"unknown result kind {kind!r}: one of {', '.join(KINDS)}")
-
-
-#: Attributes a variable of each name must carry (its units or the meaning of its codes).
-_VARIABLE_ATTRS = {"period": ("meaning",), "status": ("meaning",),
-                   "final_time": ("units",), "poincare_time": ("units",), "time": ("units",),
-                   "attractor_id": ("meaning",), "attractor_fraction": ("meaning",),
-                   "unresolved": ("meaning",),
-                   "dte_rms": ("units",), "dte_peak": ("units",), "jump_omega": ("meaning",),
-                   "bifurcation_kind": ("meaning",), "bifurcation_located": ("meaning",)}
-
-
-def _status_problems(name: str, values: np.ndarray) -> list[str]:
-    """What is wrong with the status codes ``values`` of ``name`` (empty when all are known)."""
-    from geardyn.core.status import Status
-
-    codes = np.asarray(values)
-    if codes.dtype.kind not in "iuf" or np.any(~np.isfinite(codes.astype(float))):
-        return [f"{name}: not integer status codes (dtype {codes.dtype})"]
-    bad = np.setdiff1d(codes.astype(np.int64), [int(s) for s in Status])
-    if bad.size:
-        return [f"{name}: codes {bad.tolist()} are not geardyn.Status codes "
-                f"{[int(s) for s in Status]}"]
-    return []
+#: The kinds of result dataset, as recorded in ``attrs["geardyn_kind"]`` (the registry
+#: :data:`geardyn.core.results.SCHEMAS`): what :func:`geardyn.simulate`,
+#: :func:`geardyn.bifurcation`, :func:`geardyn.map2d`, the reproduction (``geardyn reproduce``,
+#: one case under one interpretation), :func:`geardyn.periodic_orbit`
+#: (``PeriodicOrbit.to_dataset()``), :func:`geardyn.continuation`, :func:`geardyn.basins` and
+#: :func:`geardyn.frequency_response` return.
+KINDS = results.KINDS
 
 
 def _continuation_problems(ds: Any) -> list[str]:
@@ -739,39 +649,17 @@ def _continuation_problems(ds: Any) -> list[str]:
 def assert_result(ds: Any, kind: str) -> None:
     """Assert that ``ds`` is a well-formed geardyn result of ``kind`` (one of :data:`KINDS`).
 
-    Checks ``attrs["geardyn_kind"] == kind``; the kind's required attributes, coordinates and
-    variables, each with its dimensions; the units or meaning attributes the kind promises
-    (``status`` and ``period`` a ``meaning``, times their ``units``); that every status
-    code is a :class:`geardyn.Status` code; for a continuation, that every bifurcation kind is
-    one of :data:`geardyn.analysis.branch_data.BIFURCATION_KINDS` and every branch status a
+    Checks, against the kind's schema in :data:`geardyn.core.results.SCHEMAS` (the one the
+    builders fill), ``attrs["geardyn_kind"] == kind``; the kind's required attributes,
+    coordinates and variables, each with its dimensions; the units or meaning attributes the
+    kind promises (``status`` and ``period`` a ``meaning``, times their ``units``); that every
+    status code is a :class:`geardyn.Status` code; for a continuation, that every bifurcation
+    kind is one of :data:`geardyn.analysis.branch_data.BIFURCATION_KINDS` and every branch
+    status a
     :class:`~geardyn.analysis.branch_data.BranchStatus` code. Raises :class:`AssertionError`
     naming every problem found."""
-    if kind not in KINDS:
-        raise AssertionError(f"unknown result kind {kind!r}: one of {', '.join(KINDS)}")
-    problems: list[str] = []
-    recorded = ds.attrs.get("geardyn_kind")
-    if recorded != kind:
-        problems.append(f"attrs['geardyn_kind'] is {recorded!r}, expected {kind!r}")
-    attrs, coords, variables, statuses = _result_spec(ds, kind)
-    problems += [f"attribute {a!r} missing" for a in attrs if a not in ds.attrs]
-    for group, wanted, ordered in (("coordinate", coords, True), ("variable", variables, False)):
-        for name, dims in wanted.items():
-            if name not in (ds.coords if group == "coordinate" else ds.variables):
-                problems.append(f"{group} {name!r} missing")
-                continue
-            have = tuple(ds[name].dims)
-            if (have != dims) if ordered else (sorted(have) != sorted(dims)):
-                problems.append(f"{group} {name!r} has dims {have}, expected {dims}")
-    for name, keys in _VARIABLE_ATTRS.items():
-        if name in ds.variables:
-            problems += [f"{name!r} has no {k!r} attribute" for k in keys
-                         if k not in ds[name].attrs]
-    for name in statuses:
-        if name in ds.variables:
-            problems += _status_problems(name, ds[name].values)
+    problems = results.problems(ds, kind)  # the schema of the kind (an unknown kind: named)
     if kind == "continuation":
         problems += _continuation_problems(ds)
-    if kind in ("simulation", "periodic-orbit") and "status" in ds.attrs:
-        problems += _status_problems("attrs['status']", ds.attrs["status"])
     if problems:
         raise AssertionError(f"not a geardyn {kind} result: " + "; ".join(problems))

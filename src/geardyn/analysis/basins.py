@@ -40,6 +40,7 @@ from geardyn.analysis.dataset import model_attrs
 from geardyn.analysis.lanes import CONTACT_LABELS, has_mesh_forces, lane_variables
 from geardyn.analysis.periodicity import APERIODIC, UNBOUNDED, classify_period
 from geardyn.core.model import Model
+from geardyn.core.results import finish
 from geardyn.core.settings import RunSettings, resolve_run
 from geardyn.core.status import Status, status_attrs
 from geardyn.execution.executor import default_chunk, run_chunks
@@ -297,7 +298,7 @@ def basins(
     ds = _dataset(m, (yn, yv), (xn, xv), labels, out, table, keep)
     ds.attrs.update(run.attrs())
     ds.attrs.update(
-        geardyn_kind="basins", model=m.name, x=xn, y=yn, Omega=om, time_unit=m.time_unit,
+        model=m.name, x=xn, y=yn, Omega=om, time_unit=m.time_unit,
         match_tol=match_tol, chaos_tol=chaos_tol, chunk=size, n_orbits=0,
         base_state=b, state_scale=scale, n_attractors=int(table["period"].size),
         diverged_fraction=float(np.mean(labels == DIVERGED)),
@@ -309,7 +310,7 @@ def basins(
                            "points (chaos_tol): a heuristic",
     )
     ds.attrs.update(model_attrs(m))
-    return match_orbits(ds, orbits) if len(orbits) else ds
+    return finish(match_orbits(ds, orbits) if len(orbits) else ds, "basins")
 
 
 def match_orbits(ds: xr.Dataset, orbits: Sequence[Any]) -> xr.Dataset:

@@ -19,6 +19,7 @@ import xarray as xr
 from geardyn.analysis.contact import contact_regime
 from geardyn.analysis.lanes import has_mesh_forces, variable_attrs
 from geardyn.analysis.orbits import MARGINAL, ShootingProblem
+from geardyn.core.results import finish
 from geardyn.core.settings import INTEGRATOR
 from geardyn.solvers.kernels import kernels_for
 
@@ -291,11 +292,11 @@ def branch_dataset(model: Model, param: str, start: float, stop: float,
         "long_name": "index of the branch's first point"})
     first = runs[0]
     ds.attrs.update(
-        geardyn_kind="continuation", model=model.name, param=param, start=start, stop=stop,
+        model=model.name, param=param, start=start, stop=stop,
         period=int(first.period), status=int(first.status), message=first.message,
         status_meaning=branch_status_meaning(), integrator=INTEGRATOR,
         method="pseudo-arclength continuation of Newton shooting on the located RK4 period "
                "map; dG/dp by central differences",
         p_scale=float(tracer.pscale), time_unit=model.time_unit,
         corrector_tol=float(tracer.tol))
-    return ds
+    return finish(ds, "continuation")

@@ -2,8 +2,9 @@
 (:func:`geardyn.map2d`) share their coordinates, per-lane variables (dims, units and meanings
 from :mod:`geardyn.analysis.lanes`), status meanings and model attributes here.
 
-Every result records its kind in ``attrs["geardyn_kind"]``; :func:`geardyn.testing.assert_result`
-checks a dataset against what its kind promises. (The simulation's dataset is built in
+Every builder ends with :func:`geardyn.core.results.finish`: the kind recorded in
+``attrs["geardyn_kind"]`` and the dataset checked against the kind's schema, the registry
+:func:`geardyn.testing.assert_result` reads too. (The simulation's dataset is built in
 :mod:`geardyn.solvers.simulate`, a layer below analysis.)
 """
 
@@ -23,6 +24,7 @@ from geardyn.analysis.lanes import (
 )
 from geardyn.analysis.lyapunov import lyapunov_err_attrs, lyapunov_unresolved_attrs
 from geardyn.core.model import Model
+from geardyn.core.results import finish
 from geardyn.core.status import status_attrs
 from geardyn.solvers.ensemble import LaneResults
 
@@ -84,10 +86,9 @@ def sweep_dataset(model: Model, param: str, values: np.ndarray, runs: Sequence[L
     ds["final_time"] = (param, first.final_time, {
         "long_name": "model time at the last Poincare sample (the final state)",
         "units": model.time_unit})
-    ds.attrs.update(geardyn_kind="bifurcation", model=model.name, param=param,
-                    time_unit=model.time_unit)
+    ds.attrs.update(model=model.name, param=param, time_unit=model.time_unit)
     ds.attrs.update(model_attrs(model))
-    return ds
+    return finish(ds, "bifurcation")
 
 
 def map_dataset(model: Model, y: tuple[str, np.ndarray], x: tuple[str, np.ndarray],

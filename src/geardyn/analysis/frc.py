@@ -57,6 +57,7 @@ import xarray as xr
 from geardyn.analysis.bifurcation import ContinuedSweep, continued_sweeps
 from geardyn.analysis.dataset import model_attrs
 from geardyn.core.model import Model
+from geardyn.core.results import finish
 from geardyn.core.settings import RunSettings, resolve_run
 from geardyn.core.status import Status, status_attrs
 from geardyn.solvers.kernels import kernels_for
@@ -237,12 +238,12 @@ def frequency_response(
     ds = _dataset(model, om, (up, down), run)
     _mark_band_and_jumps(ds, jump_tol, band_tol)
     ds.attrs.update(run.attrs())
-    ds.attrs.update(geardyn_kind="frequency-response", model=model.name, param="Omega",
+    ds.attrs.update(model=model.name, param="Omega",
                     time_unit=model.time_unit, jump_tol=jump_tol, band_tol=band_tol,
                     resolution=float(np.max(np.diff(om))),
                     dte_window=_window_text(model, om))
     ds.attrs.update(model_attrs(model))
-    return ds
+    return finish(ds, "frequency-response")
 
 
 def _dataset(model: Model, om: np.ndarray, runs: tuple[xr.Dataset, xr.Dataset],

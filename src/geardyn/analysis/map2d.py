@@ -36,6 +36,7 @@ from geardyn.core.plan import (
     lane_section,
     periods_covering,
 )
+from geardyn.core.results import finish
 from geardyn.core.settings import RunSettings, resolve_run
 from geardyn.core.status import Status
 from geardyn.execution.executor import default_chunk, run_chunks
@@ -199,7 +200,7 @@ def map2d(
         ds["motion"] = ((yn, xn), labels.reshape(ny, nx), motion_attrs)
     ds.attrs.update(run.attrs())
     ds.attrs.update(
-        geardyn_kind="map2d", model=model.name, x=xn, y=yn, lyapunov=int(bool(lyapunov)),
+        model=model.name, x=xn, y=yn, lyapunov=int(bool(lyapunov)),
         time_unit=model.time_unit,
         chunk=size, start="each point from its own model's initial state",
     )
@@ -207,6 +208,7 @@ def map2d(
         ds.attrs.update(lyapunov_duration=lyap["duration"],
                         lyapunov_steps_per_period=int(steps_per_period or 0))
     ds.attrs.update(model_attrs(model))
+    finish(ds, "map2d")
     if store is not None:
         _save_store(ds, store)
     return ds

@@ -53,6 +53,7 @@ import xarray as xr
 from geardyn.analysis.contact import contact_regime
 from geardyn.analysis.lanes import has_mesh_forces, variable_attrs
 from geardyn.core.plan import default_steps_per_period, forcing_period, lane_section
+from geardyn.core.results import finish
 from geardyn.core.settings import (
     DEFAULT_BOUND,
     INTEGRATOR,
@@ -540,7 +541,6 @@ def orbit_dataset(orb: PeriodicOrbit) -> xr.Dataset:
             ds[name] = ("mesh", values, attrs[name])
     pr = orb.problem
     ds.attrs.update(
-        geardyn_kind="periodic-orbit",
         model=m.name,
         Omega=pr.omega,
         period=pr.period,
@@ -569,7 +569,7 @@ def orbit_dataset(orb: PeriodicOrbit) -> xr.Dataset:
     )
     if hasattr(m, "interpretation"):
         ds.attrs["interpretation"] = m.interpretation
-    return ds
+    return finish(ds, "periodic-orbit")
 
 
 # ----------------------------------------------------------------------------- the API

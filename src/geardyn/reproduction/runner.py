@@ -21,6 +21,7 @@ from geardyn.analysis.lyapunov import lyapunov_err_attrs, lyapunov_lanes
 from geardyn.analysis.motion import LYAPUNOV_FLOOR, LYAPUNOV_Z, exponent_sign, rule_text
 from geardyn.core.model import Model
 from geardyn.core.plan import default_steps_at, lane_section
+from geardyn.core.results import finish
 from geardyn.core.settings import RunSettings
 from geardyn.reproduction.cases import Case
 from geardyn.reproduction.motion import motion_labels
@@ -259,7 +260,6 @@ def _assemble(case: Case, interpretation: str, settings: ReproductionSettings,
     up, down = per_direction["up"], per_direction["down"]
     out.attrs.update(
         {f"setting_{k}": v for k, v in settings.resolve(case).items()},
-        geardyn_kind="reproduction-case",
         interpretation=interpretation,
         lane_steps_up=up["lane_steps"], lane_steps_down=down["lane_steps"],
         lyapunov_time_up_s=float(up["lyapunov_wall_time_s"]),
@@ -277,7 +277,7 @@ def _assemble(case: Case, interpretation: str, settings: ReproductionSettings,
         static_deflection=[float(g) for g in model.static_forces()[:2]],
         unresolved_steps=int(out["unresolved_steps"].sum()),
     )
-    return label_case(out, case)
+    return finish(label_case(out, case), "reproduction-case")
 
 
 def run_case(case: Case, interpretation: str = "consistent",

@@ -11,6 +11,7 @@ import xarray as xr
 from geardyn.core.model import Model
 from geardyn.core.moved import moved
 from geardyn.core.plan import default_steps_per_period, forcing_period, periods_covering
+from geardyn.core.results import finish
 from geardyn.core.settings import INTEGRATOR, RunSettings, resolve_run
 from geardyn.core.status import Status, status_meaning
 from geardyn.solvers.kernels import kernels_for
@@ -124,7 +125,6 @@ def simulate(
             "long_name": "dead-zone edge crossings while recording"})
         ds = ds.assign_coords(event=("event", list(model.event_names)))
     ds.attrs.update(
-        geardyn_kind="simulation",
         model=model.name,
         Omega=om,
         period=period,
@@ -151,4 +151,4 @@ def simulate(
     other = model.other_frequencies(np.atleast_2d(model.params))[0]
     if other.size and np.isfinite(other[0]):  # a second excitation (the load fluctuation)
         ds.attrs["Lambda"] = float(other[0])
-    return ds
+    return finish(ds, "simulation")
