@@ -27,7 +27,8 @@ def soft() -> xr.Dataset:
 def doubled() -> xr.Dataset:
     """A period-1 branch with two period doublings and the period-2 branches switched to."""
     m = geardyn.GearPair(zeta=0.02, Fm=0.1, Fa=0.1, kappa=0.2)
-    return geardyn.continuation(m, "Omega", 1.9, 1.5, switch=True, max_period=2)
+    return geardyn.continuation(m, "Omega", 1.9, 1.5, switch=True,
+                                settings=geardyn.ContinuationSettings(max_period=2))
 
 
 def _runs(ds: xr.Dataset) -> list[tuple[int, bool]]:
@@ -154,13 +155,14 @@ def test_over_the_brute_force_diagram_and_files(soft, tmp_path):
 
 def test_a_branch_that_ended_early_says_so(soft):
     short = geardyn.continuation(geardyn.GearPair(zeta=0.05, Fm=0.1, Fa=0.05), "Omega", 0.6,
-                                 1.0, max_points=4)
+                                 1.0, settings=geardyn.ContinuationSettings(max_points=4))
     fig = plot_branch(short)
     assert "ended early" in fig.get_suptitle() and "4 points" in fig.get_suptitle()
     assert "ended early" not in plot_branch(soft).get_suptitle()
     # nothing continued at all: an empty figure with the reason
     none = geardyn.continuation(geardyn.GearPair(zeta=0.05, Fm=0.1, Fa=0.05), "Omega", 0.9,
-                                1.0, guess=np.array([3.0, 2.0]), tol=1e-300)
+                                1.0, guess=np.array([3.0, 2.0]),
+                                settings=geardyn.ContinuationSettings(tol=1e-300))
     assert none.sizes["point"] == 0
     fig = plot_branch(none)
     assert not _lines(fig.axes[0], "branch-stable") and "Omega=0.9" in fig.get_suptitle()

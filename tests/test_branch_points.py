@@ -208,7 +208,8 @@ def test_period_two_bubble_rejoins_at_the_second_doubling_and_ends_there(zone):
     meets x = 0 and turns back onto its own orbits, and ends there as retracing; its points
     are fixed points of the DOP853 twice-iterated map."""
     ds = geardyn.continuation(_parametric(ZETA, KAPPA), "Omega", 1.6, 2.4, guess=np.zeros(2),
-                              switch=True, max_period=2, max_points=200)
+                              switch=True,
+                              settings=geardyn.ContinuationSettings(max_period=2, max_points=200))
     kind, value = ds["bifurcation_kind"].values, ds["bifurcation_value"].values
     on = ds["bifurcation_branch"].values
     assert list(kind[on == 0]) == ["period-doubling"] * 2
@@ -284,8 +285,8 @@ def test_failed_location_keeps_the_bifurcation_with_its_bracket(monkeypatch, zon
         return None
 
     monkeypatch.setattr(branch._BranchRunner, "_trial", fail)
-    ds = geardyn.continuation(_hill(), "Omega", 1.5, 2.6, switch=True, max_period=2,
-                              max_points=30)
+    ds = geardyn.continuation(_hill(), "Omega", 1.5, 2.6, switch=True,
+                              settings=geardyn.ContinuationSettings(max_period=2, max_points=30))
     on = ds["bifurcation_branch"].values == 0
     assert list(ds["bifurcation_kind"].values[on]) == ["period-doubling"] * 2
     assert np.all(ds["bifurcation_located"].values[on] == 0)

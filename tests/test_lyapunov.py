@@ -72,14 +72,15 @@ def rk4_polynomial(Z):
 
 # ----------------------------------------------------------------------------- Lorenz
 def test_lorenz_largest_exponent():
-    lam = lyapunov(lorenz_model(), y0=[1.0, 1.0, 1.0], transient=100.0, duration=2000.0)
+    lam = lyapunov(lorenz_model(), y0=[1.0, 1.0, 1.0], transient=100.0,
+                   settings=geardyn.LyapunovSettings(duration=2000.0))
     assert abs(lam - LORENZ_LAMBDA1) < 0.01 * LORENZ_LAMBDA1
 
 
 def test_lorenz_spectrum():
     sigma, _rho, beta = LORENZ
-    lam = lyapunov(lorenz_model(), y0=[1.0, 1.0, 1.0], transient=100.0, duration=2000.0,
-                   spectrum=True)
+    lam = lyapunov(lorenz_model(), y0=[1.0, 1.0, 1.0], transient=100.0,
+                   spectrum=True, settings=geardyn.LyapunovSettings(duration=2000.0))
     assert lam.shape == (3,)
     assert np.all(np.diff(lam) < 0)
     assert abs(lam[0] - LORENZ_LAMBDA1) < 0.01 * LORENZ_LAMBDA1
@@ -123,9 +124,10 @@ def test_gear_pair_periodic_negative():
 
 def test_gear_pair_chaotic_positive():
     model = geardyn.GearPair(**CHAOTIC)
-    lam = lyapunov(model, transient=500.0, duration=5000.0)
+    lam = lyapunov(model, transient=500.0, settings=geardyn.LyapunovSettings(duration=5000.0))
     assert 0.04 < lam < 0.12
-    spec = lyapunov(model, transient=500.0, duration=5000.0, spectrum=True)
+    spec = lyapunov(model, transient=500.0, spectrum=True,
+                    settings=geardyn.LyapunovSettings(duration=5000.0))
     assert abs(spec.sum() + 2 * CHAOTIC["zeta"]) < 1e-5  # trace of J, with impacts
     # independent signal: two trajectories started 1e-9 apart on the attractor separate to O(1)
     y_att = geardyn.simulate(model, transient=500.0, periods=1)["poincare"].values[-1]
@@ -171,7 +173,7 @@ def test_state_scale_default_and_checked():
     for bad in ([1.0], [1.0, 0.0], [1.0, -2.0], [1.0, np.inf], [1.0, np.nan]):
         m = _Scaled(bad, **IMPACTING)
         with pytest.raises(ValueError, match="state_scale"):
-            lyapunov(m, transient=1.0, duration=10.0)
+            lyapunov(m, transient=1.0, settings=geardyn.LyapunovSettings(duration=10.0))
         with pytest.raises(ValueError, match="state_scale"):
             lyapunov_lanes(m, m.lane_params("Omega", [1.0]), transient=1.0, duration=10.0)
 
@@ -181,8 +183,10 @@ def test_exponent_does_not_depend_on_the_state_scale():
     # kappa = max(s) / min(s), so the finite-time exponent by at most 2 log(kappa) / duration
     # (both measured from aligned vectors), and the limit not at all
     scale, run = np.array([3.0, 0.25]), dict(transient=200.0, duration=500.0, steps_per_period=64)
-    a = lyapunov(geardyn.GearPair(**IMPACTING), **run)
-    b = lyapunov(_Scaled(scale, **IMPACTING), **run)
+    one = dict(transient=200.0, steps_per_period=64,
+               settings=geardyn.LyapunovSettings(duration=run["duration"]))
+    a = lyapunov(geardyn.GearPair(**IMPACTING), **one)
+    b = lyapunov(_Scaled(scale, **IMPACTING), **one)
     assert a != b  # the scale reaches the kernel
     assert abs(a - b) < 2.0 * math.log(scale.max() / scale.min()) / run["duration"]
     P = geardyn.GearPair(**IMPACTING).params
@@ -221,10 +225,12 @@ def test_dimensional_catt_exponents_match_the_mesh_form():
     dm = c.dimensional()
     y0 = theta_from_mesh(c, x0)
     np.testing.assert_allclose(dm.mesh_coordinates(0.0, y0), x0, atol=1e-11)
-    run = dict(transient=1000.0, duration=1000.0, with_error=True)
+    run = dict(transient=1000.0, settings=geardyn.LyapunovSettings(duration=1000.0),
+               with_error=True)
     red = lyapunov(c, **run)
     gen = lyapunov(c.general(), y0=x0, spectrum=True, **run)
-    run = dict(transient=1000.0 / wn, duration=1000.0 / wn, with_error=True)  # seconds
+    run = dict(transient=1000.0 / wn, settings=geardyn.LyapunovSettings(duration=1000.0 / wn),
+               with_error=True)  # seconds
     dim1 = lyapunov(dm, y0=y0, **run)
     dim = lyapunov(dm, y0=y0, spectrum=True, **run)
     # the largest exponent: chaotic, and the same per unit tau within the stated errors
@@ -269,7 +275,8 @@ def test_dimensional_catt_spectrum_sums_to_the_divergence_after_the_carrier_drif
     wn = c.omega_n
     assert abs(c.carrier_acceleration()) > 1e3
     y0 = theta_from_mesh(c, c.expand_state(c.initial_state()))
-    lam = lyapunov(dm, y0=y0, transient=4000.0 / wn, duration=200.0 / wn, spectrum=True)
+    lam = lyapunov(dm, y0=y0, transient=4000.0 / wn, spectrum=True,
+                   settings=geardyn.LyapunovSettings(duration=200.0 / wn))
     tr = _divergence(dm, y0)
     assert abs(lam.sum() - tr) < 1e-5 * abs(tr), (lam.sum(), tr)  # measured 2.3e-7
 
@@ -326,10 +333,10 @@ def test_impacting_orbit_matches_floquet_reference(impacting_floquet):
     # its statistical error plus its discretisation error (estimated by step doubling) plus
     # the reference's own finite-difference error.
     model, y, ref, ref_err = impacting_floquet
-    l1 = lyapunov(model, y0=y, transient=50.0, duration=500.0, steps_per_period=96,
-                  with_error=True)
-    l2 = lyapunov(model, y0=y, transient=50.0, duration=500.0, steps_per_period=192,
-                  with_error=True)
+    l1 = lyapunov(model, y0=y, transient=50.0, steps_per_period=96,
+                  with_error=True, settings=geardyn.LyapunovSettings(duration=500.0))
+    l2 = lyapunov(model, y0=y, transient=50.0, steps_per_period=192,
+                  with_error=True, settings=geardyn.LyapunovSettings(duration=500.0))
     disc = abs(l1.value - l2.value)
     # with the edge crossings located inside a step the exponent converges fast: 96 and 192
     # steps agree to 1e-4 relative (measured 2e-6 relative; without location the error is
@@ -346,7 +353,7 @@ def test_impacting_orbit_exponent_at_every_step_count(impacting_floquet):
     across the edges (locate_edges=False) the error at 96 steps exceeds 10 % (measured 22 %):
     the bound above tells the two apart."""
     model, y, ref, ref_err = impacting_floquet
-    run = dict(y0=y, transient=50.0, duration=500.0)
+    run = dict(y0=y, transient=50.0, settings=geardyn.LyapunovSettings(duration=500.0))
     for n in (64, 256, 1024, 4096):
         lam = lyapunov(model, steps_per_period=n, **run)
         assert abs(lam - ref) < 1e-6 + 2.0 * ref_err, (n, lam, ref)
@@ -372,7 +379,8 @@ def test_contact_orbit_within_error_and_rotation_bias_of_floquet_reference():
                          for d in 1e-4 * np.eye(2)])
     kappa = np.linalg.cond(np.linalg.eig(M)[1])
     for duration in (100.0, 300.0, 1000.0):
-        est = lyapunov(model, y0=y, transient=100.0, duration=duration, with_error=True)
+        est = lyapunov(model, y0=y, transient=100.0, with_error=True,
+                       settings=geardyn.LyapunovSettings(duration=duration))
         bias = math.log(kappa) / (math.ceil(duration / T - 1e-9) * T)
         assert abs(est.value - ref) < 3.0 * est.stderr + bias
 
@@ -387,7 +395,8 @@ def test_stderr_of_chaotic_exponent_matches_spread_of_repeats():
     gap = math.ceil(duration / model.period) + 10  # periods between the starts
     points = geardyn.simulate(model, transient=500.0, periods=n_rep * gap)["poincare"].values
     runs = [lyapunov(model, y0=points[j * gap], t0=j * gap * model.period, transient=50.0,
-                     duration=duration, with_error=True) for j in range(n_rep)]
+                     with_error=True, settings=geardyn.LyapunovSettings(duration=duration))
+            for j in range(n_rep)]
     values = np.array([r.value for r in runs])
     errors = np.array([r.stderr for r in runs])
     assert np.all(values > 0) and all(r.n_blocks == 16 for r in runs)
@@ -396,25 +405,29 @@ def test_stderr_of_chaotic_exponent_matches_spread_of_repeats():
     # so its error is orders of magnitude smaller
     periodic = geardyn.GearPair(**IMPACTING)
     y = geardyn.simulate(periodic, transient=1000.0, periods=1)["poincare"].values[-1]
-    reg = lyapunov(periodic, y0=y, transient=50.0, duration=duration, with_error=True)
+    reg = lyapunov(periodic, y0=y, transient=50.0, with_error=True,
+                   settings=geardyn.LyapunovSettings(duration=duration))
     assert reg.stderr < 1e-3 * errors.min()
 
 
 def test_with_error_shapes_and_nan():
     g = geardyn.GearPair(**IMPACTING)
-    spec = lyapunov(g, transient=50.0, duration=100.0, spectrum=True, with_error=True)
+    spec = lyapunov(g, transient=50.0, spectrum=True, with_error=True,
+                    settings=geardyn.LyapunovSettings(duration=100.0))
     assert spec.value.shape == spec.stderr.shape == (2,) and spec.value[0] > spec.value[1]
     assert np.all(spec.stderr > 0)
-    short = lyapunov(g, transient=0.0, duration=g.period, with_error=True)
+    short = lyapunov(g, transient=0.0, with_error=True,
+                     settings=geardyn.LyapunovSettings(duration=g.period))
     assert short.n_blocks == 1 and math.isnan(short.stderr) and math.isfinite(short.value)
-    few = lyapunov(g, transient=0.0, duration=3 * g.period, with_error=True)
+    few = lyapunov(g, transient=0.0, with_error=True,
+                   settings=geardyn.LyapunovSettings(duration=3 * g.period))
     assert few.n_blocks == 3 and math.isfinite(few.stderr)  # at most one block per period
     P = g.lane_params("Omega", [1.15, 0.6])
     lam, err = lyapunov_lanes(g, P, y0=np.array([[0.5, 0.0], [1e9, 0.0]]), transient=10.0,
                               duration=50.0, with_error=True)
     assert np.isfinite(lam[0]) and np.isfinite(err[0]) and np.isnan(lam[1]) and np.isnan(err[1])
     with pytest.raises(ValueError):
-        lyapunov(g, n_blocks=1)
+        lyapunov(g, settings=geardyn.LyapunovSettings(n_blocks=1))
     with pytest.raises(ValueError):
         lyapunov(g, t0=math.nan)
 
@@ -423,7 +436,7 @@ def test_step_convergence_chaotic():
     # a chaotic exponent is a long-time average: at n and 2n the trajectories differ, so the
     # estimates agree only to their statistical error (~2% at duration 20000, measured)
     model = geardyn.GearPair(**CHAOTIC)
-    run = dict(transient=500.0, duration=20000.0)
+    run = dict(transient=500.0, settings=geardyn.LyapunovSettings(duration=20000.0))
     l1, l2, l4 = (lyapunov(model, steps_per_period=n, **run) for n in (64, 128, 256))
     assert abs(l1 - l2) < 0.06 * abs(l2)
     assert abs(l4 - l2) < 0.06 * abs(l2)
@@ -437,8 +450,8 @@ def test_lanes_match_single():
     out = lyapunov_lanes(model, P, transient=300.0, duration=600.0, steps_per_period=64)
     assert out.shape == (3,)
     for om, lam in zip(omegas, out, strict=True):
-        single = lyapunov(model.with_omega(om), transient=300.0, duration=600.0,
-                          steps_per_period=64)
+        single = lyapunov(model.with_omega(om), transient=300.0,
+                          steps_per_period=64, settings=geardyn.LyapunovSettings(duration=600.0))
         assert lam == pytest.approx(single, rel=1e-12, abs=1e-14)
     assert out[0] < 0 < out[1]
 
@@ -467,15 +480,15 @@ def test_lanes_autonomous():
 def test_bad_arguments():
     g = geardyn.GearPair()
     with pytest.raises(ValueError):
-        lyapunov(g, duration=0.0)
+        lyapunov(g, settings=geardyn.LyapunovSettings(duration=0.0))
     with pytest.raises(ValueError):
-        lyapunov(g, dt=0.01)
+        lyapunov(g, settings=geardyn.LyapunovSettings(dt=0.01))
     with pytest.raises(ValueError):
         lyapunov(lorenz_model(), steps_per_period=64)
     with pytest.raises(ValueError):
         lyapunov(g, y0=[1.0, 2.0, 3.0])
     with pytest.raises(ValueError):
-        lyapunov(g, renorm_every=0)
+        lyapunov(g, settings=geardyn.LyapunovSettings(renorm_every=0))
 
 
 # ----------------------------------------------------------------------------- start time
@@ -503,13 +516,14 @@ def test_sweep_exponent_continues_its_lane_in_both_forcing_phases():
         pytest.fail("no continued sweep reached Omega = 2 at a load phase in (2.6, 5.8)")
     m = model.with_omega(2.0)
     # as bifurcation does: 200 time units to align, then as long as the sampling (mean period)
-    kw = dict(transient=200.0, duration=samples * float(np.mean(2.0 * math.pi / values)),
+    duration = samples * float(np.mean(2.0 * math.pi / values))
+    kw = dict(transient=200.0, settings=geardyn.LyapunovSettings(duration=duration),
               steps_per_period=int(ds["steps_per_period"].values[1]), with_error=True)
     same = geardyn.lyapunov(m, y0=ds["poincare"].values[1, -1], t0=t_final, **kw)
     assert ds["lyapunov"].values[1] == same.value
     assert ds["lyapunov_err"].values[1] == same.stderr
-    fresh = geardyn.lyapunov(m, t0=t_final, transient=1000.0, duration=kw["duration"],
-                             with_error=True)
+    fresh = geardyn.lyapunov(m, t0=t_final, transient=1000.0, with_error=True,
+                             settings=geardyn.LyapunovSettings(duration=duration))
     assert abs(fresh.value - same.value) < 3.0 * (fresh.stderr + same.stderr)
     zero = geardyn.lyapunov(m, y0=ds["poincare"].values[1, -1], t0=0.0, **kw)
     assert abs(zero.value - same.value) > 3.0 * (zero.stderr + same.stderr)
@@ -538,7 +552,8 @@ def test_split_limit_is_reported():
     from geardyn.solvers._step_core import MAX_SPLITS
 
     assert 10 < MAX_SPLITS < N_LEVELS
-    run = dict(y0=[0.0, 1.0], transient=0.0, duration=5.0, dt=1.0)
+    run = dict(y0=[0.0, 1.0], transient=0.0,
+               settings=geardyn.LyapunovSettings(duration=5.0, dt=1.0))
     clean = lyapunov(levels_model(10), with_error=True, **run)
     assert clean.status == geardyn.Status.OK and clean.unresolved == 0 and clean.ok
     model = levels_model(N_LEVELS)
@@ -553,7 +568,8 @@ def test_split_limit_is_reported():
         assert lyapunov(model, **run) == est.value
     # the lane blocks: every lane reports it, the exponent kept (not NaN)
     P = np.tile(model.params, (3, 1))
-    exps, errs, unres, status = lyapunov_lanes(model, P, with_status=True, **run)
+    exps, errs, unres, status = lyapunov_lanes(model, P, y0=[0.0, 1.0], transient=0.0,
+                                               duration=5.0, dt=1.0, with_status=True)
     assert np.array_equal(unres, [3, 3, 3])
     assert np.all(status == geardyn.Status.SPLIT_LIMIT)
     assert np.array_equal(exps, np.full(3, est.value))
@@ -564,11 +580,13 @@ def test_run_settings():
     """lyapunov(run=RunSettings(...)) is lyapunov with the same keywords; not both."""
     g = geardyn.GearPair(**IMPACTING)
     kw = dict(transient=60.0, steps_per_period=64, bound=1e5)
-    a = lyapunov(g, duration=100.0, with_error=True, **kw)
-    b = lyapunov(g, run=geardyn.RunSettings(**kw), duration=100.0, with_error=True)
+    a = lyapunov(g, with_error=True, **kw, settings=geardyn.LyapunovSettings(duration=100.0))
+    b = lyapunov(g, run=geardyn.RunSettings(**kw), with_error=True,
+                 settings=geardyn.LyapunovSettings(duration=100.0))
     assert a == b
     # locate_edges=False: the edges are integrated across (a different exponent at this step)
-    c = lyapunov(g, run=geardyn.RunSettings(locate_edges=False, **kw), duration=100.0)
+    c = lyapunov(g, run=geardyn.RunSettings(locate_edges=False, **kw),
+                 settings=geardyn.LyapunovSettings(duration=100.0))
     assert c != a.value and abs(c - a.value) < 0.05
     with pytest.raises(TypeError, match="not both"):
         lyapunov(g, run=geardyn.RunSettings(), transient=10.0)

@@ -41,7 +41,8 @@ def block_exponent(model, y0, block: float, n: int) -> tuple[float, float, float
 
     The block means come from one trajectory: the kernel is deterministic, so the exponent over
     j blocks times j * block is the log stretch up to the end of block j."""
-    logs = [0.0] + [lyapunov(model, y0=y0, transient=100.0, duration=j * block) * j * block
+    logs = [0.0] + [lyapunov(model, y0=y0, transient=100.0,
+                             settings=geardyn.LyapunovSettings(duration=j * block)) * j * block
                     for j in range(1, n + 1)]
     means = np.diff(logs) / block
     return logs[-1] / (n * block), float(means.std(ddof=1) / math.sqrt(n)), n * block

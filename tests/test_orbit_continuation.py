@@ -136,7 +136,8 @@ def test_branch_switching_follows_the_period_two_orbit():
     its points are fixed points of the reference integrator's twice-iterated map, not of the
     once-iterated one, and it starts at the located doubling."""
     m = geardyn.GearPair(zeta=0.02, Fm=0.1, Fa=0.1, kappa=0.2)
-    ds = geardyn.continuation(m, "Omega", 1.9, 1.5, switch=True, max_period=2)
+    ds = geardyn.continuation(m, "Omega", 1.9, 1.5, switch=True,
+                              settings=geardyn.ContinuationSettings(max_period=2))
     pd = np.flatnonzero((ds["bifurcation_kind"].values == "period-doubling")
                         & (ds["bifurcation_branch"].values == 0))
     assert pd.size >= 1
@@ -181,7 +182,8 @@ def test_failures_end_the_branch_with_a_message_keeping_the_points():
     assert ds["Omega"].values.max() < 1.0
     # no orbit at the start: a Newton that cannot converge (one iteration)
     bad = geardyn.continuation(geardyn.GearPair(zeta=0.05, Fm=0.1, Fa=0.05), "Omega", 0.9,
-                               1.0, guess=np.array([3.0, 2.0]), tol=1e-300)
+                               1.0, guess=np.array([3.0, 2.0]),
+                               settings=geardyn.ContinuationSettings(tol=1e-300))
     assert bad.attrs["status"] == BranchStatus.START_FAILED and bad.sizes["point"] == 0
     assert "Omega=0.9" in bad.attrs["message"]
     # a second excitation at a fixed Lambda: next to Omega = 3 the forcings have no common
@@ -202,7 +204,8 @@ def test_paper_device_period_doubling_agrees_with_the_brute_force_diagram():
     base = geardyn.CATTDevice(geardyn.PlanetaryParams.paper(xi1=0.05, xi2=0.05),
                               interpretation="consistent")
     end = 1.05
-    ds = geardyn.continuation(base, "Omega", 0.9, end, switch=True, max_period=2)
+    ds = geardyn.continuation(base, "Omega", 0.9, end, switch=True,
+                              settings=geardyn.ContinuationSettings(max_period=2))
     pd = _table(ds.where(ds["bifurcation_branch"] == 0, drop=True), "period-doubling")
     assert pd.size == 1
     h = 0.01

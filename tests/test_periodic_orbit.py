@@ -189,7 +189,8 @@ def test_unstable_period_one_orbit_past_a_period_doubling():
 
 def test_newton_failures_are_reported_not_raised():
     m = geardyn.GearPair(zeta=0.05, Fm=0.1, Fa=0.05).with_omega(0.9)
-    orb = geardyn.periodic_orbit(m, guess=np.array([3.0, 2.0]), max_iter=1)
+    orb = geardyn.periodic_orbit(m, guess=np.array([3.0, 2.0]),
+                                 settings=geardyn.NewtonSettings(max_iter=1))
     assert orb.status == OrbitStatus.NOT_CONVERGED and not orb.converged
     assert "did not converge" in orb.message or "stalled" in orb.message
     assert orb.stability == "unknown"
@@ -322,7 +323,8 @@ def test_body_angle_model_has_no_periodic_orbit_and_says_so():
     """The SI body-angle form turns as a whole (its angles grow): no periodic orbit of its
     states exists; the result is a failure with a message, not an orbit."""
     m = geardyn.CATTDevice(geardyn.PlanetaryParams.paper(xi1=0.05, xi2=0.05)).dimensional()
-    orb = geardyn.periodic_orbit(m, omega=0.5 * m.device.omega_n, max_iter=5)  # in rad/s
+    orb = geardyn.periodic_orbit(m, omega=0.5 * m.device.omega_n,
+                                 settings=geardyn.NewtonSettings(max_iter=5))  # in rad/s
     assert not orb.converged and orb.message
     assert orb.stability == "unknown"
 

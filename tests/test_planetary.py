@@ -270,14 +270,16 @@ def test_orbit_continuation_and_lyapunov_of_the_linear_set_match_its_eigenvalues
     assert np.max(np.abs(np.sort(np.abs(orb.multipliers)) - expected(gs.omega))) < 2e-5
     assert np.max(np.abs(orb.multipliers)) == pytest.approx(expected(gs.omega)[-1], abs=1e-9)
     assert orb.stability == "stable"
-    br = geardyn.continuation(gs, "Omega", gs.omega, 1.05 * gs.omega, max_points=40,
-                              steps_per_period=spp)
+    br = geardyn.continuation(gs, "Omega", gs.omega, 1.05 * gs.omega,
+                              steps_per_period=spp,
+                              settings=geardyn.ContinuationSettings(max_points=40))
     assert int(br.attrs["status"]) == 0 and br["Omega"].values[-1] == pytest.approx(
         1.05 * gs.omega)
     assert br.sizes["bifurcation"] == 0 and set(br["stability"].values) == {"stable"}
     last = np.sort(br["multiplier_abs"].values[-1])
     assert np.max(np.abs(last - expected(float(br["Omega"].values[-1])))) < 2e-5
-    largest = geardyn.lyapunov(gs, transient=50.0, duration=2000.0)
+    largest = geardyn.lyapunov(gs, transient=50.0,
+                               settings=geardyn.LyapunovSettings(duration=2000.0))
     assert largest == pytest.approx(ev.real.max(), rel=0.03)
 
 

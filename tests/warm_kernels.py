@@ -49,10 +49,12 @@ def _warm(case: str) -> tuple[str, float]:
     runs = {
         "trajectory": lambda: geardyn.simulate(model, omega=omega, periods=2, y0=y0),
         "sweep": lambda: geardyn.bifurcation(model, "Omega", values, transient=0.0, samples=2),
-        "lyapunov": lambda: geardyn.lyapunov(model, y0=y0, transient=0.0, duration=1.0),
+        "lyapunov": lambda: geardyn.lyapunov(model, y0=y0, transient=0.0,
+                                             settings=geardyn.LyapunovSettings(duration=1.0)),
         "lanes": lambda: geardyn.lyapunov_lanes(model, model.lane_params("Omega", values),
                                                 transient=0.0, duration=1.0),
-        "orbit": lambda: geardyn.periodic_orbit(model, omega=omega, guess=y0, max_iter=1),
+        "orbit": lambda: geardyn.periodic_orbit(model, omega=omega, guess=y0,
+                                                settings=geardyn.NewtonSettings(max_iter=1)),
     }
     failed = []
     for name in WARM.get(case, tuple(runs)):

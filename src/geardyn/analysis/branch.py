@@ -67,13 +67,9 @@ from geardyn.analysis.orbits import (
 )
 from geardyn.core.model import Model
 from geardyn.core.plan import default_steps_per_period
-from geardyn.core.settings import CORRECTOR_TOL as CORRECTOR_TOL
-from geardyn.core.settings import LOCATE_TOL as LOCATE_TOL
 from geardyn.core.settings import ContinuationSettings, RunSettings, resolve_settings
 from geardyn.core.status import Status
 
-#: CORRECTOR_TOL (from core.settings, ContinuationSettings' default): the corrector converged
-#: where max |G / state_scale| <= tol (1 + max |x / state_scale|).
 #: Most corrector iterations per step.
 CORRECTOR_MAX_ITER = 12
 #: The step grows after a corrector of at most this many iterations, shrinks after one of at

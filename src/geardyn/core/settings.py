@@ -294,7 +294,8 @@ class ContinuationSettings(_AnalysisSettings):
     max_points
         Most points of a branch (>= 1).
     tol
-        Corrector tolerance (scaled residual, > 0).
+        Corrector tolerance (> 0): converged where max |G / state_scale| <= tol (1 + max
+        |x / state_scale|).
     locate_tol
         Location tolerance of a bifurcation in the parameter (> 0).
     max_period
