@@ -145,7 +145,7 @@ def params_show(
         table = Table(title="GearPair parameters (dimensionless)")
         table.add_column("name")
         table.add_column("value", justify="right")
-        for name, value in zip(model.param_names, model.params, strict=True):
+        for name, value in model.coefficient_values().items():
             table.add_row(name, _fmt(float(value)))
         out.print(table)
         out.print("natural frequency (in contact): 1 (unit of dimensionless time)")

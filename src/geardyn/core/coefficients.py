@@ -71,7 +71,7 @@ class Coefficient:
     """One declared entry of a coefficient vector.
 
     ``unit`` is the unit of the value in the vector ("1" dimensionless); ``per_lane`` whether
-    lanes of one sweep may hold different values (structure and workspace never do);
+    lanes of one sweep may hold different values (parameters by default; structure never);
     ``derived_from`` the physical inputs a derived coefficient is computed from; ``constant``
     the kernel's index constant (default the upper-cased name); ``default`` the value
     :meth:`CoefficientLayout.build` writes when none is given (workspace: its initial value);
@@ -98,8 +98,8 @@ class Coefficient:
             raise ValueError(f"{self.name}: a derived coefficient names what it derives from")
         if self.per_lane is None:
             object.__setattr__(self, "per_lane", self.kind in PARAMETER_KINDS)
-        if self.per_lane and self.kind not in PARAMETER_KINDS:
-            raise ValueError(f"{self.name}: {self.kind} entries are never per lane")
+        if self.per_lane and self.kind == "structure":
+            raise ValueError(f"{self.name}: structure is the same in every lane")
 
     @property
     def is_parameter(self) -> bool:
@@ -217,14 +217,24 @@ class CoefficientLayout:
         """Every entry an input coefficient named ``names`` (a model that declares nothing)."""
         return cls.of(CoefficientBlock(tuple(Coefficient(n) for n in names)), model=model)
 
-    def extend(self, entries: Iterable[Coefficient], suffix: str = "") -> int:
-        """Append ``entries`` (names with ``suffix``); returns the index of the first. A name
-        placed twice (a suffix that makes two names equal) is found at its first place."""
+    def extend(self, entries: Iterable[Coefficient], suffix: str = "", prefix: str = "") -> int:
+        """Append ``entries`` (names as ``prefix + name + suffix``); returns the index of the
+        first. A name placed twice (a suffix that makes two names equal) is found at its first
+        place."""
         start = len(self._slots)
         for c in entries:
-            name = c.name + suffix
+            name = prefix + c.name + suffix
             self._index.setdefault(name, len(self._slots))
             self._slots.append(Slot(name, c))
+        return start
+
+    def place(self, names: Iterable[str], coefficient: Coefficient) -> int:
+        """Append one entry per name in ``names``, each declared by ``coefficient`` (a series
+        of like entries: indices, cache rows); returns the index of the first."""
+        start = len(self._slots)
+        for name in names:
+            self._index.setdefault(name, len(self._slots))
+            self._slots.append(Slot(name, coefficient))
         return start
 
     # ------------------------------------------------------------------ lookups
