@@ -64,8 +64,8 @@ RULES: tuple[Rule, ...] = (
          "observable_names and param_names are tuples of distinct strings; every mesh names "
          "two events that exist"),
     Rule(2, "coefficients", "params is a 1-D float array of finite numbers laid out as "
-         "coefficient_layout declares (param_names: its parameters); omega_index is None (autonomous) or the index of a finite "
-         "Omega >= 0"),
+         "coefficient_layout declares (param_names: its parameters); omega_index is None "
+         "(autonomous) or the index of a finite Omega >= 0"),
     Rule(3, "initial state", "initial_state() is a finite float vector of n_states entries"),
     Rule(4, "kernel functions", "kernel is a KernelSource of numba-compiled functions with the "
          "interface's arguments; events is given exactly when event_names is non-empty, "
