@@ -321,7 +321,7 @@ def lane_params_held(model: Model, param: str, values: np.ndarray | Sequence[flo
     if param in ("Omega", "Lambda"):
         raise ValueError(f"hold='speed' sweeps another parameter at a fixed physical speed; "
                          f"param {param!r} is a speed itself")
-    if not hasattr(model, "omega_n"):
+    if not model.capabilities.frequency_scale:
         raise ValueError(f"hold='speed' needs a model whose time unit is a physical frequency "
                          f"omega_n; {model.name} has none")
     base = float(model.omega_n)

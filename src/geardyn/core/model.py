@@ -139,6 +139,9 @@ class Model:
     raw_overrides_allowed: bool = False
     #: Names that ``with_params`` takes as physical inputs (they re-derive the coefficients).
     physical_names: tuple[str, ...] = ()
+    #: Length [m] of one unit of the model's displacement states, where it integrates lengths
+    #: over a scale (None: none declared).
+    length_scale: float | None = None
 
     # ------------------------------------------------------------------ sizes
     @property
@@ -347,6 +350,15 @@ class Model:
     def with_omega(self, omega: float) -> Model:
         """A copy with the forcing frequency set to ``omega``."""
         return self.with_params(Omega=omega)
+
+    def dataset_attrs(self) -> dict[str, object]:
+        """Attributes every dataset of this model records (none here; e.g. the CATT device's
+        ``interpretation`` and ``omega_n``)."""
+        return {}
+
+    def param_attrs(self, name: str) -> dict[str, str]:
+        """Attributes of the axis of a sweep in ``name`` (``units``, ...); none here."""
+        return {}
 
     def static_mesh_forces(self) -> np.ndarray | None:
         """Static mesh forces (one per mesh, observable units) for the dynamic factor, or None."""

@@ -266,6 +266,10 @@ class CATTDevice(Model):
         """omega_n [rad/s]: the unit of dimensionless time (interpretation-dependent)."""
         return float(self.derived.omega_n)
 
+    def dataset_attrs(self) -> dict[str, object]:
+        """``interpretation`` and ``omega_n`` [rad/s], recorded in every dataset."""
+        return {"interpretation": self.interpretation, "omega_n": self.omega_n}
+
     def replace(self, **changes) -> CATTDevice:
         """A new device with physical parameters changed by the paper's names (``xi1``,
         ``backlash``, ``B1``, ...) and/or ``Omega``. Raw coefficients set before
@@ -591,6 +595,11 @@ class DimensionalCATT(Model):
             (f"{m}{i + 1}", 4 * i + 2 * k, 4 * i + 2 * k + 1)
             for i in range(n) for k, m in enumerate(("sq", "pq"))
         )
+
+    @property
+    def params_in(self) -> PlanetaryParams:
+        """The device's parameters (the body-angle model is built from them)."""
+        return self.device.params_in
 
     def fastest_natural_frequency(self, P: np.ndarray | None = None) -> np.ndarray:
         """Fastest natural frequency [rad/s] of Eq. (1) linearised (mean stiffness, no backlash)
