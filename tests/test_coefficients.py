@@ -238,3 +238,24 @@ def test_capabilities_are_declared_not_probed():
     axes = physical_axes(MODELS["dimensional"], np.array([2 * math.pi * 26.0]))
     assert axes is not None and axes["mesh_frequency"][0][0] == pytest.approx(26.0)
     assert deflection_units(device)["length_scale"] == device.params_in.b_c
+
+
+# ------------------------------------------------------------------------------ vocabularies
+def test_explorer_and_cli_read_the_declared_vocabulary(tmp_path):
+    from typer.testing import CliRunner
+
+    from geardyn.cli.main import app
+    from geardyn.explore.state import MAIN_PARAMS, ExplorerState
+
+    study = load_study('[study]\nmodel = "gear_pair"\n[params]\nzeta = 0.1\n[sweep]\n'
+                       'param = "Omega"\nstart = 1.6\nstop = 2.4\nnum = 6\nsamples = 8\n')
+    state = ExplorerState(study, "gp.toml", save_dir=tmp_path)
+    for name in MAIN_PARAMS["gear_pair"]:
+        assert name in GEAR_PAIR.vocabulary()
+        assert state.param_help(name) == GEAR_PAIR[name].describe()
+    assert state.param_help("zeta") == "damping ratio"
+    path = tmp_path / "gp.toml"
+    path.write_text('[study]\nmodel = "gear_pair"\n[params]\nzeta = 0.1\n')
+    result = CliRunner().invoke(app, ["params", "show", str(path)])
+    assert result.exit_code == 0, result.output
+    assert "transmission-error amplitude" in result.output
