@@ -259,3 +259,15 @@ def test_explorer_and_cli_read_the_declared_vocabulary(tmp_path):
     result = CliRunner().invoke(app, ["params", "show", str(path)])
     assert result.exit_code == 0, result.output
     assert "transmission-error amplitude" in result.output
+
+
+def test_a_coefficient_declared_alike_in_every_lane_is_not_swept():
+    fixed = CoefficientBlock((Coefficient("Omega"), Coefficient("mu", per_lane=False)))
+    m = user_model()
+    toy = geardyn.UserModel(m.kernel.rhs, n_states=2, params=[1.0, 0.5], name="toy")
+    toy.coefficient_layout = CoefficientLayout.of(fixed, model="toy")
+    assert toy.param_names == ("Omega", "mu")
+    np.testing.assert_array_equal(toy.lane_params("Omega", [1.0, 2.0])[:, 0], [1.0, 2.0])
+    with pytest.raises(ParameterError, match="^mu: the same in every lane of toy"):
+        toy.lane_params("mu", [0.5, 0.6])
+    assert toy.with_params(mu=0.7).params[1] == 0.7

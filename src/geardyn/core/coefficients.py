@@ -44,10 +44,12 @@ Declaring a model (e.g. a gear pair with eight per-lane coefficients)::
     ))
     OMEGA, ZETA = GEAR_PAIR.offset("Omega"), GEAR_PAIR.offset("zeta")   # kernel constants
 
-and in the model's ``__init__``: ``self.coefficient_layout = CoefficientLayout.of(GEAR_PAIR)``,
-``self.params = self.coefficient_layout.build(values)``; ``param_names`` then follows the
-layout. A cos/sin pair derived from a phase is declared ``kind="derived"`` with
-``derived_from=("kappa_phase",)``.
+and in the model's ``__init__``: ``self.coefficient_layout = CoefficientLayout.of(GEAR_PAIR,
+model="GearPair")``, ``self.params = self.coefficient_layout.build(values, validate=True)``;
+``param_names`` then follows the layout, and ``Model.with_params`` validates by the declaration.
+A cos/sin pair derived from a phase is declared ``kind="derived"`` with
+``derived_from=("kappa_phase",)``. (The gear pair's actual declaration is
+:data:`geardyn.models.gear_pair_coefficients.GEAR_PAIR`.)
 """
 
 from __future__ import annotations

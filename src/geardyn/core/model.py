@@ -30,6 +30,7 @@ This module belongs to the core: it imports nothing of geardyn outside :mod:`gea
 from __future__ import annotations
 
 import copy
+import functools
 from collections.abc import Sequence
 
 import numpy as np
@@ -53,6 +54,12 @@ def unique_rows(A: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     inverse = np.empty(A.shape[0], np.int64)
     inverse[order] = np.cumsum(new) - 1
     return S[new], inverse
+
+
+@functools.lru_cache(maxsize=256)
+def _plain_layout(names: tuple[str, ...], model: str) -> CoefficientLayout:
+    """The layout of a model that declares none: every entry an input named by ``names``."""
+    return CoefficientLayout.plain(names, model)
 
 
 class Model:
@@ -188,7 +195,7 @@ class Model:
         declares none has every entry an input coefficient named by ``param_names``."""
         layout = self.__dict__.get("_coefficient_layout")
         if layout is None:
-            return CoefficientLayout.plain(self.param_names, self.name)
+            return _plain_layout(tuple(self.param_names), self.name)
         return layout
 
     @coefficient_layout.setter
@@ -260,8 +267,12 @@ class Model:
         frequency); physical models override it to re-derive every coefficient.
         """
         values = np.asarray(values, dtype=float).ravel()
+        idx = self._raw_target(name)
+        if not self.coefficient_layout.slots[idx].coefficient.per_lane and values.size > 1:
+            raise ParameterError(name, values[0], f"the same in every lane of {self.name}; "
+                                 "it cannot be swept")
         P = np.tile(self.params, (values.size, 1))
-        P[:, self._raw_target(name)] = values
+        P[:, idx] = values
         return P
 
     def lane_params_grid(self, x: str, x_values: Sequence[float] | np.ndarray, y: str,
