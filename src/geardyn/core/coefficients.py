@@ -66,6 +66,8 @@ from geardyn.errors import ParameterError, UnknownParameterError
 KINDS: tuple[str, ...] = ("input", "derived", "structure", "workspace")
 #: The kinds that are parameters (``param_names``, ``with_params``, ``lane_params``).
 PARAMETER_KINDS: frozenset[str] = frozenset({"input", "derived"})
+#: How many parameter names an error message lists.
+_LISTED = 40
 
 
 @dataclass(frozen=True)
@@ -268,19 +270,19 @@ class CoefficientLayout:
     def __contains__(self, name: object) -> bool:
         return name in self._index
 
-    def slot(self, name: str) -> Slot:
+    def slot(self, name: str, value: object = None) -> Slot:
         """The entry ``name`` (any kind); :class:`~geardyn.errors.UnknownParameterError`
-        listing the parameters when there is none."""
+        listing the parameters when there is none (``value``: the value given with it)."""
         if name not in self._index:
-            raise UnknownParameterError(name, None, self._unknown())
+            raise UnknownParameterError(name, value, self._unknown())
         return self._slots[self._index[name]]
 
-    def index(self, name: str) -> int:
+    def index(self, name: str, value: object = None) -> int:
         """The vector index of the parameter ``name``. A structure or workspace entry, or an
         unknown name, is an :class:`~geardyn.errors.UnknownParameterError` (a ``KeyError``)."""
-        s = self.slot(name)
+        s = self.slot(name, value)
         if not s.coefficient.is_parameter:
-            raise UnknownParameterError(name, None, self._not_parameter(s))
+            raise UnknownParameterError(name, value, self._not_parameter(s))
         return self._index[name]
 
     def raw_index(self, name: str) -> int:
@@ -288,14 +290,19 @@ class CoefficientLayout:
         self.slot(name)
         return self._index[name]
 
+    def _known(self) -> str:
+        names = self.names
+        if len(names) <= _LISTED:
+            return ", ".join(names)
+        return f"{', '.join(names[:_LISTED])}, ... ({len(names)} in all: param_names)"
+
     def _unknown(self) -> str:
-        return f"{self.model} has no parameter of this name; known: {', '.join(self.names)}"
+        return f"{self.model} has no parameter of this name; known: {self._known()}"
 
     def _not_parameter(self, s: Slot) -> str:
         what = {"structure": "structure", "workspace": "kernel workspace"}[s.coefficient.kind]
         meaning = f"{s.coefficient.meaning}: " if s.coefficient.meaning else ""
-        return (f"{meaning}{what} of {self.model}, never a parameter; parameters: "
-                f"{', '.join(self.names)}")
+        return f"{meaning}{what} of {self.model}, never a parameter; parameters: {self._known()}"
 
     # ------------------------------------------------------------------ vectors
     def build(self, values: Mapping[str, float], validate: bool = False) -> np.ndarray:
@@ -332,6 +339,6 @@ class CoefficientLayout:
         (else a :class:`~geardyn.errors.ParameterError` naming it). Returns them as floats."""
         out = {}
         for name, value in values.items():
+            self.index(name, value)
             out[name] = self.slot(name).coefficient.check(name, value)
-            self.index(name)
         return out

@@ -228,9 +228,9 @@ class Model:
         :class:`~geardyn.errors.UnknownParameterError`; a derived coefficient a
         :class:`~geardyn.errors.ParameterError` naming what it derives from, unless the model
         takes raw overrides (:attr:`raw_overrides_allowed`)."""
-        idx = self.param_index(name)
         if name == "Omega" and self.omega_index is not None:
-            return idx
+            return self.omega_index
+        idx = self.coefficient_layout.index(name, value)
         decl = self.coefficient_layout.slot(name).coefficient
         if decl.kind == "derived" and not self.raw_overrides_allowed:
             raise ParameterError(name, value, f"derived from {', '.join(decl.derived_from)}; "

@@ -33,7 +33,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from geardyn.core.capabilities import Capabilities
-from geardyn.core.coefficients import Coefficient, CoefficientBlock, CoefficientLayout
+from geardyn.core.coefficients import CoefficientLayout
 from geardyn.core.kernel_source import KernelSource
 from geardyn.core.model import Model, unique_rows
 from geardyn.errors import ParameterError
@@ -42,6 +42,8 @@ from geardyn.models.derived import (
     CATT_BLOCK,
     CATT_HEADER,
     INTERPRETATIONS,
+    THETA_BLOCK,
+    THETA_HEADER,
     Derived,
     Interpretation,
     catt_harmonics,
@@ -72,51 +74,6 @@ def catt_layout(n_sets: int, reduced: bool, n_harmonics: int) -> CoefficientLayo
         out.extend(CATT_BLOCK.entries, suffix)
         out.extend(harmonics.entries, suffix)
     return out
-
-
-def _t(name: str, unit: str, meaning: str, constant: str, *inputs: str) -> Coefficient:
-    kind = "derived" if inputs else "input"
-    return Coefficient(name, unit, meaning, kind, inputs, constant=f"T_{constant}")
-
-
-#: The header of the body-angle model's coefficient vector (SI).
-THETA_HEADER = CoefficientBlock((
-    _t("omega", "rad/s", "mesh frequency", "OMEGA"),
-    _t("omega_L", "rad/s", "load-fluctuation frequency", "OMEGA_L"),
-    Coefficient("n_sets", "1", "number of planet sets", "structure", constant="T_N"),
-    Coefficient("n_harmonics", "1", "number of stiffness harmonics", "structure",
-                constant="T_NH"),
-    _t("T_D", "N m", "driving torque on the carrier", "TD"),
-    _t("A1", "N m", "mean load torque on the outside planets", "A1"),
-    _t("B1", "N m", "fluctuation of the outside planets' load torque", "B1"),
-    _t("psi1", "rad", "phase of the outside-planet load fluctuation", "PSI1"),
-    _t("A2", "N m", "mean load torque on the carrier", "A2"),
-    _t("B2", "N m", "fluctuation of the carrier's load torque", "B2"),
-    _t("psi2", "rad", "phase of the carrier load fluctuation", "PSI2"),
-    _t("J_c", "kg m^2", "effective carrier inertia", "JC", "J_c", "m_q", "m_p", "r_c1", "r_c2"),
-    _t("r_c1", "m", "carrier radius of the inside planets", "RC1"),
-    _t("arm", "m", "lever arm of the sun mesh force on the carrier", "ARM", "r_bs",
-       "pressure_angle"),
-))
-#: One planet set's block of the body-angle model (then its stiffness harmonics).
-THETA_BLOCK = CoefficientBlock((
-    _t("J_q", "kg m^2", "inside planet inertia", "JQ"),
-    _t("J_p", "kg m^2", "outside planet inertia", "JP"),
-    _t("r_bq", "m", "inside planet base radius", "RBQ", "pitch_radius", "pressure_angle"),
-    _t("r_bp", "m", "outside planet base radius", "RBP", "pitch_radius", "pressure_angle"),
-    _t("Km_sq", "N/m", "sun-inside mean mesh stiffness", "KM_SQ"),
-    _t("Km_pq", "N/m", "inside-outside mean mesh stiffness", "KM_PQ"),
-    _t("C_sq", "N s/m", "sun-inside mesh damping", "C_SQ", "xi1", "Km_sq", "M_s", "M_q"),
-    _t("C_pq", "N s/m", "inside-outside mesh damping", "C_PQ", "xi2", "Km_pq", "M_p", "M_q"),
-    _t("b_sq", "m", "sun-inside backlash half-width", "B_SQ"),
-    _t("b_pq", "m", "inside-outside backlash half-width", "B_PQ"),
-    _t("E_sq_s", "m", "sun-inside meshing error, sine part", "E_SQ_S", "E_sq", "error_phase"),
-    _t("E_sq_c", "m", "sun-inside meshing error, cosine part", "E_SQ_C", "E_sq", "error_phase"),
-    _t("E_pq_s", "m", "inside-outside meshing error, sine part", "E_PQ_S", "E_pq",
-       "error_phase"),
-    _t("E_pq_c", "m", "inside-outside meshing error, cosine part", "E_PQ_C", "E_pq",
-       "error_phase"),
-))
 
 
 @functools.lru_cache(maxsize=64)

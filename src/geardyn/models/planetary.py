@@ -31,84 +31,26 @@ from typing import Any
 import numpy as np
 
 from geardyn.core.capabilities import Capabilities
-from geardyn.core.coefficients import Coefficient, CoefficientBlock, CoefficientLayout
+from geardyn.core.coefficients import CoefficientLayout
 from geardyn.core.kernel_source import KernelSource
 from geardyn.core.model import Model, unique_rows
 from geardyn.errors import ParameterError
 from geardyn.models import planetary_kernels as pk
+from geardyn.models.planetary_coefficients import (
+    CARRIER_SPEED,
+    FORCES,
+    HEADER,
+    MATRICES,
+    MESH,
+    MESH_ROW,
+    harmonics_block,
+    structure_entry,
+    workspace_entry,
+)
 from geardyn.models.stiffness import fourier_coefficients
 from geardyn.units import to_si
 
 _KERNEL = KernelSource(pk.planetary_rhs, pk.planetary_events, pk.planetary_observe)
-
-
-def _d(name: str, unit: str, meaning: str, *inputs: str, constant: str | None = None
-       ) -> Coefficient:
-    return Coefficient(name, unit, meaning, "derived", inputs, constant=constant)
-
-
-def _s(name: str, meaning: str, constant: str | None = None) -> Coefficient:
-    return Coefficient(name, "1", meaning, "structure", constant=constant)
-
-
-def _w(name: str, meaning: str, constant: str | None = None) -> Coefficient:
-    return Coefficient(name, "1", meaning, "workspace", constant=constant)
-
-
-_MASSES = ("mass", "inertia_over_r2")
-#: The header of the coefficient vector (offsets: :mod:`planetary_kernels`' constants).
-HEADER = CoefficientBlock((
-    Coefficient("Omega", "1", "mesh frequency / omega_0"),
-    _s("n_dof", "number of coordinates"),
-    _s("n_meshes", "number of meshes", constant="N_MESH"),
-    _s("n_harmonics", "number of stiffness harmonics", constant="N_HARM"),
-    _w("torque_on", "1 where the torque fluctuation F1 is not zero (kernel flag)"),
-    Coefficient("torque_order", "1", "order of the input torque fluctuation"),
-    Coefficient("torque_phase", "rad", "phase of the input torque fluctuation"),
-    _w("damped", "1 where Ct is not zero (kernel flag)"),
-))
-#: Per coordinate d: F0_d, F1_d (names suffixed _d); per pair (a, b): Kt_a_b, Ct_a_b.
-FORCES = CoefficientBlock((
-    _d("F0", "1", "mean generalised force, M^-1 F / (L omega_0^2)", "sun_torque",
-       "ring_torque", "carrier_torque", *_MASSES, "length_scale", "time_scale"),
-    _d("F1", "1", "fluctuating generalised force, M^-1 F1 / (L omega_0^2)",
-       "torque_fluctuation", "sun_torque", *_MASSES, "length_scale", "time_scale"),
-))
-MATRICES = CoefficientBlock((
-    _d("Kt", "1", "bearing and support stiffness, M^-1 K / omega_0^2", "bearing_stiffness",
-       "torsional_stiffness", *_MASSES, "carrier_speed", "time_scale"),
-    _d("Ct", "1", "modal damping, M^-1 C / omega_0", "modal_damping", *_MASSES, "time_scale"),
-))
-#: One mesh block's fixed entries (names prefixed with the mesh's name, s1 .. rN).
-MESH = CoefficientBlock((
-    _d("b", "1", "backlash half-width / L", "sun_backlash", "ring_backlash", "length_scale",
-       constant="M_B"),
-    _d("E_s", "1", "transmission error / L, sine part", "sun_mesh_error", "ring_mesh_error",
-       "sun_error_phase", "ring_error_phase", "length_scale", constant="M_ES"),
-    _d("E_c", "1", "transmission error / L, cosine part", "sun_mesh_error", "ring_mesh_error",
-       "sun_error_phase", "ring_error_phase", "length_scale", constant="M_EC"),
-    _d("KF", "N", "mesh force per unit deflection X (k_m L)", "sun_mesh_stiffness",
-       "ring_mesh_stiffness", "length_scale", constant="M_KF"),
-    _d("CF", "N", "mesh force per unit deflection rate X' (c_m L omega_0)", "mesh_damping",
-       "sun_mesh_stiffness", "ring_mesh_stiffness", "length_scale", constant="M_CF"),
-))
-#: Per coordinate d of a mesh: its deflection row W_d and M^-1 W / (L omega_0^2), G_d.
-MESH_ROW = CoefficientBlock((
-    _d("W", "1", "mesh deflection row", "sun_pressure_angle", "ring_pressure_angle",
-       "planet_angles"),
-    _d("G", "1/N", "M^-1 W / (L omega_0^2)", "sun_pressure_angle", "ring_pressure_angle",
-       "planet_angles", *_MASSES, "length_scale", "time_scale"),
-))
-_CARRIER_SPEED = _d("carrier_speed_tau", "1", "carrier speed Omega_c / omega_0",
-                    "carrier_speed", "carrier_speed_ratio", "time_scale")
-
-
-def _harmonics(nh: int) -> CoefficientBlock:
-    return CoefficientBlock(tuple(
-        _d(f"{ab}{h}", "1", f"{'cosine' if ab == 'a' else 'sine'} part of harmonic {h} of the "
-           "relative mesh stiffness", "waveform", "sun_stiffness_fluctuation",
-           "ring_stiffness_fluctuation", "sun_mesh_phase", "ring_mesh_phase")
-        for h in range(1, nh + 1) for ab in "ab"))
 
 
 @functools.lru_cache(maxsize=32)
@@ -127,23 +69,24 @@ def planetary_layout(dofs: tuple[str, ...], mesh_names: tuple[str, ...], nh: int
         for a in dofs:
             for b in dofs:
                 out.extend((c,), f"_{a}_{b}")
-    harmonics = _harmonics(nh)
+    harmonics = harmonics_block(nh)
     for m in mesh_names:
         out.extend(MESH.entries + harmonics.entries, prefix=f"{m}_")
         for c in MESH_ROW.entries:
             for d in dofs:
                 out.extend((c,), f"_{d}", prefix=f"{m}_")
-    index = _s("structure", "sparse index or count of the kernel's structure section")
-    copy_ = _w("structure copy", "the kernel's copy of a structural value (written from the "
-               "dense entries)")
+    index = structure_entry("structure", "sparse index or count of the kernel's structure")
+    copy_ = workspace_entry("structure copy", "the kernel's copy of a structural value "
+                            "(written from the dense entries)")
     for name in pk.structure_names(dofs, mesh_names, list(kt_entries)):
         copy = "_nz_W" in name or "_nz_G" in name or name.startswith("Kt_nz_")
         out.place((name,), copy_ if copy else index)
-    cache = _w("cache", "relative-stiffness cache of the lane-block functions")
+    cache = workspace_entry("cache", "relative-stiffness cache of the lane-block functions")
     out.place(pk.cache_entries(len(mesh_names))[0], cache)
     gyro_names = pk.gyro_names(dofs, list(gyro))
-    out.place(gyro_names[:1], _CARRIER_SPEED)
-    pattern = _s("gyro", "the Coriolis pattern M^-1 G (rows, columns, values; every lane alike)")
+    out.place(gyro_names[:1], CARRIER_SPEED)
+    pattern = structure_entry("gyro", "the Coriolis pattern M^-1 G (rows, columns, values; "
+                              "every lane alike)")
     out.place(gyro_names[1:], pattern)
     return out
 CENTRAL = ("carrier", "ring", "sun")
