@@ -252,6 +252,10 @@ class CoefficientLayout:
         """Every placed entry, in vector order."""
         return tuple(self._slots)
 
+    def at(self, index: int) -> Slot:
+        """The entry at vector index ``index``."""
+        return self._slots[index]
+
     @property
     def names(self) -> tuple[str, ...]:
         """The parameters' names, in vector order (``Model.param_names``)."""

@@ -240,11 +240,11 @@ class Model:
     def _checked_raw(self, values: dict[str, float]) -> dict[int, float]:
         """``values`` (coefficients by name) as index -> value, each name checked by
         :meth:`_raw_target` and each value against its declaration (finite, in range)."""
-        slots = self.coefficient_layout.slots
+        layout = self.coefficient_layout
         out = {}
         for name, value in values.items():
             idx = self._raw_target(name, value)
-            out[idx] = slots[idx].coefficient.check(name, value)
+            out[idx] = layout.at(idx).coefficient.check(name, value)
         return out
 
     def _with_physical(self, values: dict[str, float]) -> Model:
@@ -264,11 +264,13 @@ class Model:
         """Coefficient vectors (lanes x n_params) with the parameter ``name`` set to ``values``.
 
         The base implementation sets one entry of ``params`` by name (``"Omega"`` is the forcing
-        frequency); physical models override it to re-derive every coefficient.
+        frequency), by the rules of :meth:`with_params` (a coefficient declared the same in
+        every lane cannot be swept); physical models override it to re-derive every
+        coefficient.
         """
         values = np.asarray(values, dtype=float).ravel()
         idx = self._raw_target(name)
-        if not self.coefficient_layout.slots[idx].coefficient.per_lane and values.size > 1:
+        if not self.coefficient_layout.at(idx).coefficient.per_lane and values.size > 1:
             raise ParameterError(name, values[0], f"the same in every lane of {self.name}; "
                                  "it cannot be swept")
         P = np.tile(self.params, (values.size, 1))
