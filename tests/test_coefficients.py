@@ -271,3 +271,16 @@ def test_a_coefficient_declared_alike_in_every_lane_is_not_swept():
     with pytest.raises(ParameterError, match="^mu: the same in every lane of toy"):
         toy.lane_params("mu", [0.5, 0.6])
     assert toy.with_params(mu=0.7).params[1] == 0.7
+
+
+def test_a_raw_sweep_sets_the_kernel_flags_per_lane():
+    """Sweeping a raw modal-damping entry from an undamped set switches the kernel's ``damped``
+    flag on in the damped lanes (it stayed 0 in every lane: the damping was silently dropped)."""
+    gs = busy_set(modal_damping=0.0)
+    name = next(n for n in gs.param_names if n.startswith("Ct_"))
+    assert gs.params[pk.DAMPED] == 0.0
+    P = gs.lane_params(name, [0.0, 0.1])
+    np.testing.assert_array_equal(P[:, pk.DAMPED], [0.0, 1.0])
+    F1 = next(n for n in gs.param_names if n.startswith("F1_"))
+    P = busy_set(torque_fluctuation=0.0).lane_params(F1, [0.0, 0.2])
+    np.testing.assert_array_equal(P[:, pk.TORQUE_ON], [0.0, 1.0])

@@ -941,12 +941,7 @@ class PlanetaryGearSet(Model):
             out = copy.copy(self)
         if rest:
             out = Model._with_raw(out, rest)
-            # the kernel's flags and its copy of Kt, W, G follow the raw entries
-            lay, n = out._layout, int(out.params[pk.N_DOF])
-            ct = out.params[lay["Ct"]:lay["Ct"] + n * n]
-            out.params[pk.DAMPED] = float(np.any(ct != 0.0))
-            out.params[pk.TORQUE_ON] = float(np.any(out.params[lay["F1"]:lay["F1"] + n] != 0.0))
-            pk.fill_structure(out.params, *out._structure)
+            out._refresh_workspace(out.params)  # the flags and copies follow the raw entries
             out.raw_overrides = {**raw, **{k: v for k, v in rest.items() if k != "Omega"}}
         return out
 
@@ -961,8 +956,17 @@ class PlanetaryGearSet(Model):
                 raise ValueError(f"sweeping {name!r} changes the model's size")
             return np.array(rows)
         P = Model.lane_params(self, name, values)
-        pk.fill_structure(P, *self._structure)  # the kernel's copy of Kt, W, G
+        self._refresh_workspace(P)
         return P
+
+    def _refresh_workspace(self, P: np.ndarray) -> None:
+        """Write the kernel's flags (``damped``, ``torque_on``) and its copy of Kt, W, G in
+        every row of ``P`` (in place) from the row's own coefficients."""
+        P = np.atleast_2d(P)
+        lay, n = self._layout, int(P[0, pk.N_DOF])
+        P[:, pk.DAMPED] = np.any(P[:, lay["Ct"]:lay["Ct"] + n * n] != 0.0, axis=1)
+        P[:, pk.TORQUE_ON] = np.any(P[:, lay["F1"]:lay["F1"] + n] != 0.0, axis=1)
+        pk.fill_structure(P, *self._structure)
 
     # ------------------------------------------------------------------ linear analysis
     def _lane_matrix(self, P: np.ndarray) -> np.ndarray:
