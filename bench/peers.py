@@ -196,7 +196,7 @@ def rk4_lanes_table(omega, n_tr, samples, n_steps, coef, y0, out):
 def coefficients() -> np.ndarray:
     """(zeta, kappa, Fm, Fa, backlash) of the benchmark model (phases are zero)."""
     m = model()
-    named = dict(zip(m.param_names, m.params, strict=True))
+    named = m.coefficient_values()
     if named["kappa_phase"] or named["error_phase"]:
         raise ValueError("the plain kernel assumes zero forcing phases")
     return np.array([named[k] for k in ("zeta", "kappa", "Fm", "Fa", "backlash")])

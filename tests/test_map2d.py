@@ -53,7 +53,7 @@ def test_lane_params_grid_refuses_an_order_that_loses_a_setting(device):
     Q = device.lane_params_grid("k_sq_q", [0.1, 0.2], "xi", [0.02, 0.1])
     np.testing.assert_array_equal(P.reshape(2, 2, -1), Q.reshape(2, 2, -1).transpose(1, 0, 2))
     P = device.lane_params_grid("c_sq_q", [0.1, 0.2], "xi", [0.02, 0.1])  # the working order
-    np.testing.assert_array_equal(P[:, device.param_names.index("c_sq_q")], [0.1, 0.2] * 2)
+    np.testing.assert_array_equal(P[:, device.param_index("c_sq_q")], [0.1, 0.2] * 2)
     with pytest.raises(ValueError, match="different parameters"):
         device.lane_params_grid("xi", [0.02], "xi", [0.1])
 

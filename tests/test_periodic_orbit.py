@@ -230,7 +230,7 @@ def test_catt_device_orbit_keeps_liouville():
     base = geardyn.CATTDevice(geardyn.PlanetaryParams.paper(xi1=0.05, xi2=0.05))
     om = 0.5
     m = base.with_omega(om)
-    c = dict(zip(m.param_names, m.params, strict=True))
+    c = m.coefficient_values()
     trace = -(c["c_sq_q"] + c["c_sq_c"] + c["c_pq_q"] + c["c_pq_p"])
     assert abs(jacobian_trace(m, 0.3, m.initial_state()) - trace) < 1e-8 * abs(trace)
     orb = geardyn.periodic_orbit(m)
@@ -307,7 +307,7 @@ def test_paper_device_period_doubled_orbit_with_contact_loss():
     assert orb.converged, orb.message
     assert orb.crossings.sum() > 0
     assert orb.stability == "unstable" and np.min(orb.multipliers.real) < -1.1
-    c = dict(zip(m.param_names, m.params, strict=True))
+    c = m.coefficient_values()
     trace = -(c["c_sq_q"] + c["c_sq_c"] + c["c_pq_q"] + c["c_pq_p"])
     T = 2 * math.pi / om
     assert abs(np.real(np.prod(orb.multipliers)) / math.exp(trace * T) - 1) < 1e-8
@@ -341,7 +341,7 @@ def test_load_fluctuation_orbit_on_the_common_section():
     assert orb.problem.sections == 3 and orb.duration == pytest.approx(3 * 2 * math.pi / 3.0)
     assert orb.crossings.sum() > 0
     assert np.max(np.abs(_reference_period_map(m, orb.x, orb.duration) - orb.x)) < 1e-8
-    c = dict(zip(m.param_names, m.params, strict=True))
+    c = m.coefficient_values()
     trace = -(c["c_sq_q"] + c["c_sq_c"] + c["c_pq_q"] + c["c_pq_p"])
     det = np.real(np.prod(orb.multipliers))
     assert abs(det / math.exp(trace * orb.duration) - 1) < 2e-8  # RK4's error in the volume

@@ -123,11 +123,11 @@ def test_raw_override_outside_the_structure_is_refused():
     gs = busy_set()
     names = gs.dof_names()
     inside = f"Kt_{names[0]}_{names[0]}"
-    out = gs.with_params(**{inside: 2.0 * gs.params[gs.param_names.index(inside)]})
+    out = gs.with_params(**{inside: 2.0 * gs.params[gs.param_index(inside)]})
     lay = out._layout
     st = lay["structure"]
     nk = int(out.params[st])
-    assert 2.0 * gs.params[gs.param_names.index(inside)] in out.params[st + 1 + 2 * nk:][:nk]
+    assert 2.0 * gs.params[gs.param_index(inside)] in out.params[st + 1 + 2 * nk:][:nk]
     with pytest.raises(ValueError, match="outside the gear set's structure"):
         gs.with_params(**{f"Kt_{names[0]}_u_s": 1.0})
     with pytest.raises(ValueError, match="outside the gear set's structure"):

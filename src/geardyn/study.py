@@ -122,8 +122,7 @@ def check_usable(build: Callable[[], Model]) -> Model:
     with np.errstate(all="ignore"):
         try:
             model = build()
-            checks = [(f"coefficient {n}", v) for n, v in zip(model.param_names, model.params,
-                                                                strict=True)]
+            checks = [(f"coefficient {n}", v) for n, v in model.coefficient_values().items()]
             if hasattr(model, "natural_frequencies"):
                 checks += [("natural frequency", w) for w in model.natural_frequencies()]
             checks += [(f"initial state {n}", v)

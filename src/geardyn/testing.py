@@ -64,9 +64,9 @@ RULES: tuple[Rule, ...] = (
     Rule(1, "names", "state_names is a non-empty tuple of distinct strings; event_names, "
          "observable_names and param_names are tuples of distinct strings; every mesh names "
          "two events that exist"),
-    Rule(2, "coefficients", "params is a 1-D float array of finite numbers, one per "
-         "param_names entry; omega_index is None (autonomous) or the index of a finite "
-         "Omega >= 0"),
+    Rule(2, "coefficients", "params is a 1-D float array of finite numbers laid out as "
+         "coefficient_layout declares (param_names: its parameters); omega_index is None "
+         "(autonomous) or the index of a finite Omega >= 0"),
     Rule(3, "initial state", "initial_state() is a finite float vector of n_states entries"),
     Rule(4, "kernel functions", "kernel is a KernelSource of numba-compiled functions with the "
          "interface's arguments; events is given exactly when event_names is non-empty, "
@@ -249,8 +249,12 @@ def _check_coefficients(model: Model) -> None:
                       f"{getattr(p, 'dtype', '')} {getattr(p, 'shape', '')})")
     if not np.all(np.isfinite(p)):
         raise _Broken(f"params has non-finite entries at {np.flatnonzero(~np.isfinite(p))}")
-    if len(model.param_names) != p.size:
-        raise _Broken(f"{len(model.param_names)} param_names for {p.size} params")
+    layout = model.coefficient_layout  # declared, or one input per param_names entry
+    if layout.size != p.size:
+        raise _Broken(f"{len(model.param_names)} param_names (a layout of {layout.size} "
+                      f"entries) for {p.size} params")
+    if tuple(model.param_names) != layout.names:
+        raise _Broken("param_names are not the parameters of the coefficient layout")
     k = model.omega_index
     if k is not None:
         if not isinstance(k, int | np.integer) or not 0 <= k < p.size:

@@ -321,7 +321,7 @@ def lane_params_held(model: Model, param: str, values: np.ndarray | Sequence[flo
     if param in ("Omega", "Lambda"):
         raise ValueError(f"hold='speed' sweeps another parameter at a fixed physical speed; "
                          f"param {param!r} is a speed itself")
-    if not hasattr(model, "omega_n"):
+    if not model.capabilities.frequency_scale:
         raise ValueError(f"hold='speed' needs a model whose time unit is a physical frequency "
                          f"omega_n; {model.name} has none")
     base = float(model.omega_n)
@@ -341,7 +341,7 @@ def _lambda(model: Model) -> float:
     """The model's Lambda parameter (0 when it has none)."""
     if "Lambda" not in model.param_names:
         return 0.0
-    return float(model.params[model.param_names.index("Lambda")])
+    return float(model.params[model.param_index("Lambda")])
 
 
 def _record_hold(ds: xr.Dataset, model: Model, param: str, P: np.ndarray,
@@ -356,7 +356,7 @@ def _record_hold(ds: xr.Dataset, model: Model, param: str, P: np.ndarray,
     coords = {"Omega": (param, P[:, model.omega_index], {
         "long_name": "dimensionless mesh frequency of each point (fixed physical speed)"})}
     if _lambda(model):
-        k = model.param_names.index("Lambda")
+        k = model.param_index("Lambda")
         coords["Lambda"] = (param, P[:, k], {
             "long_name": "dimensionless load frequency of each point (fixed physical speed)"})
     return ds.assign_coords(coords)

@@ -32,20 +32,14 @@ from geardyn.solvers.ensemble import LaneResults
 def model_attrs(model: Model) -> dict[str, object]:
     """The attributes every sweep and map records about its model: ``interpretation`` and the
     natural frequency ``omega_n`` (rad/s), where the model has them."""
-    attrs: dict[str, object] = {}
-    if hasattr(model, "interpretation"):
-        attrs["interpretation"] = model.interpretation
-    if hasattr(model, "omega_n"):
-        attrs["omega_n"] = float(model.omega_n)
-    return attrs
+    return dict(model.dataset_attrs())
 
 
 def param_attrs(model: Model, name: str) -> dict[str, str]:
     """Attributes of the axis of swept parameter ``name`` (``units``, ...), where the model
     names them (``model.param_attrs``, e.g. the planetary set's ``mesh_frequency`` [rad/s] and
     ``input_speed`` [rpm]); else none."""
-    attrs = getattr(model, "param_attrs", None)
-    return dict(attrs(name)) if attrs is not None else {}
+    return dict(model.param_attrs(name))
 
 
 def _with_mesh(ds: xr.Dataset, model: Model) -> xr.Dataset:

@@ -79,18 +79,15 @@ def physical_axes(model: Model, omega: np.ndarray) -> dict[str, tuple[np.ndarray
     ``omega`` (the model's own units), or None when the model has no physical time unit; a
     model with ``speed_axes(omega)`` (the planetary gear set: input speed of the sun, from its
     geometry) gives its own."""
-    axes = getattr(model, "speed_axes", None)  # the model names its own (PlanetaryGearSet)
-    if axes is not None:
-        return axes(omega)
-    device = getattr(model, "device", None)  # DimensionalCATT: time in seconds
-    if model.time_unit == "s" and device is not None:
-        w = np.asarray(omega, dtype=float)
-        params = device.params_in
-    elif hasattr(model, "omega_n") and hasattr(model, "params_in"):
-        w = np.asarray(omega, dtype=float) * float(model.omega_n)
-        params = model.params_in
-    else:
+    caps = model.capabilities
+    if caps.physical_axes:  # the model names its own (PlanetaryGearSet)
+        return model.speed_axes(omega)  # type: ignore[attr-defined]
+    if not caps.paper_device:
         return None
+    params = model.params_in  # type: ignore[attr-defined]
+    w = np.asarray(omega, dtype=float)
+    if model.time_unit != "s":  # the mesh-coordinate form: time in 1 / omega_n
+        w = w * float(model.omega_n)  # type: ignore[attr-defined]
     f = w / (2.0 * math.pi)
     z = int(params.sun.teeth)
     return {"mesh_frequency": (f, {"units": "Hz", "long_name": "mesh frequency"}),
@@ -305,9 +302,9 @@ def deflection_units(model: Model) -> dict[str, object]:
     value times ``length_scale`` is metres, and ``units`` names that unit (``"um"`` for 1 um,
     else ``"<L> m"``). Metres for a model in SI units (time in seconds), else dimensionless
     ("1")."""
-    scale = getattr(model, "length_scale", None)
-    if scale is None and model.time_unit != "s" and hasattr(model, "params_in"):
-        scale = getattr(model.params_in, "b_c", None)
+    scale = model.length_scale
+    if scale is None and model.time_unit != "s" and model.capabilities.paper_device:
+        scale = model.params_in.b_c  # type: ignore[attr-defined]
     if scale is not None:
         L = float(scale)
         return {"units": _LENGTH_UNITS.get(L, f"{L:g} m"), "length_scale": L,

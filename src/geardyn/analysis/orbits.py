@@ -567,8 +567,8 @@ def orbit_dataset(orb: PeriodicOrbit) -> xr.Dataset:
         unresolved_steps=orb.unresolved,
         time_unit=m.time_unit,
     )
-    if hasattr(m, "interpretation"):
-        ds.attrs["interpretation"] = m.interpretation
+    if m.capabilities.interpretation:
+        ds.attrs["interpretation"] = m.dataset_attrs()["interpretation"]
     return finish(ds, "periodic-orbit")
 
 

@@ -92,14 +92,8 @@ def parse_range(text: str, option: str = "--range") -> tuple[float, float, int]:
 
 def _sweepable(model) -> list[str]:
     """Names a sweep of ``model`` accepts, for error messages."""
-    from geardyn.models.catt import CATTDevice
-    from geardyn.models.params import PAPER_NAMES
-
-    if isinstance(model, CATTDevice):
-        return ["Omega", *(n for n in PAPER_NAMES if n != "waveform")]
-    physical = getattr(model, "physical_names", None)  # models with named physical inputs
-    if physical is not None:
-        return ["Omega", *physical]
+    if model.capabilities.physical_inputs:  # models with named physical inputs
+        return ["Omega", *model.physical_names]
     return ["Omega", *(n for n in model.param_names if n != "Omega")]
 
 
@@ -146,7 +140,7 @@ def _lowest_omega(model, param: str, ends: tuple[float, float], hold: str) -> fl
         return min(ends)
     from geardyn.analysis.bifurcation import lane_params_held
 
-    if hold != "speed" or not hasattr(model, "omega_n"):
+    if hold != "speed" or not model.capabilities.frequency_scale:
         hold = "Omega"  # a bad --hold is refused with its own message below
     return float(min(lane_params_held(model, param, list(ends), hold)[:, model.omega_index]))
 
@@ -306,7 +300,7 @@ def bifurcation_command(
     if hold == "speed" and name in ("Omega", "Lambda"):
         raise ParameterError("--hold", hold, f"speed holds the physical speed while another "
                              f"parameter is swept; {name} is a speed itself")
-    if hold == "speed" and not hasattr(model, "omega_n"):
+    if hold == "speed" and not model.capabilities.frequency_scale:
         raise ParameterError("--hold", hold, f"{model.name} has no physical frequency omega_n")
     check_count("--samples", n_samples)
     if spp is not None:

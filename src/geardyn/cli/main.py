@@ -143,11 +143,18 @@ def params_show(
     out.print(f"[bold]study[/bold] {escape(s.study.name)}: "
               f"{escape(s.study.description or s.study.model)}")
     if s.study.model == "gear_pair":
+        from geardyn.models.gear_pair_coefficients import GEAR_PAIR
+
         table = Table(title="GearPair parameters (dimensionless)")
         table.add_column("name")
         table.add_column("value", justify="right")
-        for name, value in zip(model.param_names, model.params, strict=True):
-            table.add_row(name, _fmt(float(value)))
+        table.add_column("unit")
+        table.add_column("meaning")
+        vocabulary = GEAR_PAIR.vocabulary()
+        for name, value in model.coefficient_values().items():
+            c = vocabulary.get(name)
+            table.add_row(name, _fmt(float(value)), escape(c.unit if c else ""),
+                          escape(c.meaning if c else ""))
         out.print(table)
         out.print("natural frequency (in contact): 1 (unit of dimensionless time)")
         return

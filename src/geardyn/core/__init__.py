@@ -7,10 +7,13 @@ Nothing here imports anything of geardyn outside ``geardyn.core``; only the base
 solvers, execution, analysis, ...) build on these, never the other way round.
 """
 
+from geardyn.core.capabilities import Capabilities
+from geardyn.core.coefficients import Coefficient, CoefficientBlock, CoefficientLayout
 from geardyn.core.kernel_source import KernelSource
 from geardyn.core.model import Model
 from geardyn.core.plan import LanePlan
 from geardyn.core.settings import RunSettings, SettingsError
 from geardyn.core.status import Status
 
-__all__ = ["KernelSource", "LanePlan", "Model", "RunSettings", "SettingsError", "Status"]
+__all__ = ["Capabilities", "Coefficient", "CoefficientBlock", "CoefficientLayout", "KernelSource",
+           "LanePlan", "Model", "RunSettings", "SettingsError", "Status"]

@@ -30,12 +30,16 @@ This module belongs to the core: it imports nothing of geardyn outside :mod:`gea
 from __future__ import annotations
 
 import copy
+import functools
 from collections.abc import Sequence
 
 import numpy as np
 
+from geardyn.core.capabilities import Capabilities
+from geardyn.core.coefficients import CoefficientLayout
 from geardyn.core.kernel_source import KernelSource
 from geardyn.core.plan import forcing_period
+from geardyn.errors import ParameterError
 
 
 def unique_rows(A: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -52,6 +56,12 @@ def unique_rows(A: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return S[new], inverse
 
 
+@functools.lru_cache(maxsize=256)
+def _plain_layout(names: tuple[str, ...], model: str) -> CoefficientLayout:
+    """The layout of a model that declares none: every entry an input named by ``names``."""
+    return CoefficientLayout.plain(names, model)
+
+
 class Model:
     """Base class of geardyn models. Subclasses set the attributes in ``__init__``.
 
@@ -65,9 +75,11 @@ class Model:
     1. **names** -- ``state_names`` is a non-empty tuple of distinct strings, one per state;
        ``event_names``, ``observable_names`` and ``param_names`` are tuples of distinct strings;
        every entry ``(name, i, j)`` of ``meshes`` names two events that exist.
-    2. **coefficients** -- ``params`` is a 1-D float64 array of finite numbers, one per entry of
-       ``param_names``; ``omega_index`` is None (an autonomous model) or the index of the forcing
-       frequency Omega >= 0 in ``params``.
+    2. **coefficients** -- ``params`` is a 1-D float64 array of finite numbers laid out as
+       :attr:`coefficient_layout` declares (:mod:`geardyn.core.coefficients`); ``param_names``
+       are the layout's parameters (structure and workspace entries are not parameters: index
+       ``params`` by :meth:`param_index`, not by ``param_names.index``); ``omega_index`` is None
+       (an autonomous model) or the index of the forcing frequency Omega >= 0 in ``params``.
     3. **initial state** -- ``initial_state()`` is a finite float vector of ``n_states`` entries.
     4. **kernel functions** -- ``kernel.rhs``, ``kernel.events`` and ``kernel.observe`` are
        ``numba.njit`` functions with the interface's arguments: ``rhs(t, y, dy, p, s, c)``,
@@ -126,6 +138,17 @@ class Model:
     #: Omega may be set by writing that entry; False where Omega moves other coefficients (set
     #: it through ``lane_params``/``with_params``).
     omega_is_entry: bool = True
+    #: What the model offers beyond the interface (frequency scale, dataset attributes, ...):
+    #: analyses read this declaration, never probe attributes.
+    capabilities: Capabilities = Capabilities()
+    #: ``with_params`` may set a derived coefficient directly (a raw override) instead of
+    #: refusing it; such a model records them in ``raw_overrides``.
+    raw_overrides_allowed: bool = False
+    #: Names that ``with_params`` takes as physical inputs (they re-derive the coefficients).
+    physical_names: tuple[str, ...] = ()
+    #: Length [m] of one unit of the model's displacement states, where it integrates lengths
+    #: over a scale (None: none declared).
+    length_scale: float | None = None
 
     # ------------------------------------------------------------------ sizes
     @property
@@ -166,23 +189,92 @@ class Model:
         """Default initial state (zeros; models override with something physical)."""
         return np.zeros(self.n_states)
 
-    def _param_index(self, name: str) -> int:
+    @property
+    def coefficient_layout(self) -> CoefficientLayout:
+        """The declared layout of ``params`` (:mod:`geardyn.core.coefficients`); a model that
+        declares none has every entry an input coefficient named by ``param_names``."""
+        layout = self.__dict__.get("_coefficient_layout")
+        if layout is None:
+            return _plain_layout(tuple(self.param_names), self.name)
+        return layout
+
+    @coefficient_layout.setter
+    def coefficient_layout(self, layout: CoefficientLayout) -> None:
+        self._coefficient_layout = layout
+        self.param_names = layout.names
+
+    def param_index(self, name: str) -> int:
+        """The index in ``params`` of the parameter ``name`` (``"Omega"``: the forcing
+        frequency). An unknown name, or a structure or workspace entry, is an
+        :class:`~geardyn.errors.UnknownParameterError` (a ``KeyError``) listing the parameters."""
         if name == "Omega" and self.omega_index is not None:
             return self.omega_index
-        if name in self.param_names:
-            return self.param_names.index(name)
-        known = ", ".join(self.param_names) or "none"
-        raise KeyError(f"{self.name} has no parameter {name!r}; known: {known}")
+        return self.coefficient_layout.index(name)
+
+    _param_index = param_index
+
+    def coefficient_values(self, p: np.ndarray | None = None) -> dict[str, float]:
+        """The parameters of ``p`` (default ``params``) by name (structure and workspace left
+        out)."""
+        return self.coefficient_layout.read(self.params if p is None else p)
+
+    def _is_physical(self, name: str) -> bool:
+        """Whether ``with_params`` takes ``name`` as a physical input (re-derives)."""
+        return name in self.physical_names
+
+    def _raw_target(self, name: str, value: object = None) -> int:
+        """The index ``with_params``/``lane_params`` set for the coefficient ``name``: an
+        unknown name or a structure or workspace entry is an
+        :class:`~geardyn.errors.UnknownParameterError`; a derived coefficient a
+        :class:`~geardyn.errors.ParameterError` naming what it derives from, unless the model
+        takes raw overrides (:attr:`raw_overrides_allowed`)."""
+        if name == "Omega" and self.omega_index is not None:
+            return self.omega_index
+        idx = self.coefficient_layout.index(name, value)
+        decl = self.coefficient_layout.slot(name).coefficient
+        if decl.kind == "derived" and not self.raw_overrides_allowed:
+            raise ParameterError(name, value, f"derived from {', '.join(decl.derived_from)}; "
+                                 f"{self.name} sets it from those, change them instead")
+        return idx
+
+    def _checked_raw(self, values: dict[str, float]) -> dict[int, float]:
+        """``values`` (coefficients by name) as index -> value, each name checked by
+        :meth:`_raw_target` and each value against its declaration (finite, in range)."""
+        layout = self.coefficient_layout
+        out = {}
+        for name, value in values.items():
+            idx = self._raw_target(name, value)
+            out[idx] = layout.at(idx).coefficient.check(name, value)
+        return out
+
+    def _with_physical(self, values: dict[str, float]) -> Model:
+        """A copy with physical inputs changed (models with :attr:`physical_names`)."""
+        raise NotImplementedError(f"{self.name} has no physical inputs")
+
+    def _with_raw(self, values: dict[str, float]) -> Model:
+        """A copy with coefficients set by name (checked by :meth:`_checked_raw`)."""
+        out = copy.copy(self)
+        p = self.params.copy()
+        for idx, value in self._checked_raw(values).items():
+            p[idx] = value
+        out.params = p
+        return out
 
     def lane_params(self, name: str, values: Sequence[float] | np.ndarray) -> np.ndarray:
         """Coefficient vectors (lanes x n_params) with the parameter ``name`` set to ``values``.
 
         The base implementation sets one entry of ``params`` by name (``"Omega"`` is the forcing
-        frequency); physical models override it to re-derive every coefficient.
+        frequency), by the rules of :meth:`with_params` (a coefficient declared the same in
+        every lane cannot be swept); physical models override it to re-derive every
+        coefficient.
         """
         values = np.asarray(values, dtype=float).ravel()
+        idx = self._raw_target(name)
+        if not self.coefficient_layout.at(idx).coefficient.per_lane and values.size > 1:
+            raise ParameterError(name, values[0], f"the same in every lane of {self.name}; "
+                                 "it cannot be swept")
         P = np.tile(self.params, (values.size, 1))
-        P[:, self._param_index(name)] = values
+        P[:, idx] = values
         return P
 
     def lane_params_grid(self, x: str, x_values: Sequence[float] | np.ndarray, y: str,
@@ -217,13 +309,22 @@ class Model:
         return P
 
     def with_params(self, **values: float) -> Model:
-        """A copy of the model with parameters changed by name."""
-        out = copy.copy(self)
-        p = self.params.copy()
-        for name, value in values.items():
-            p[self._param_index(name)] = float(value)
-        out.params = p
-        return out
+        """A copy of the model with parameters changed by name, the same rules for every model:
+
+        * a physical input (:attr:`physical_names`) re-derives the coefficients;
+        * an input coefficient (or ``"Omega"``) sets its entry, checked against its declaration
+          (finite, in range: else a :class:`~geardyn.errors.ParameterError` naming it);
+        * a derived coefficient is refused naming what it derives from, unless the model takes
+          raw overrides (:attr:`raw_overrides_allowed`);
+        * a structure or workspace entry, or an unknown name, is an
+          :class:`~geardyn.errors.UnknownParameterError` (a ``KeyError``) listing the parameters.
+        """
+        physical = {k: v for k, v in values.items() if self._is_physical(k)}
+        raw = {k: v for k, v in values.items() if k not in physical}
+        for name, value in raw.items():  # refuse before any rebuild
+            self._raw_target(name, value)
+        out = self._with_physical(physical) if physical else copy.copy(self)
+        return out._with_raw(raw) if raw else out
 
     def other_frequencies(self, P: np.ndarray) -> np.ndarray:
         """Frequencies (rad per model time unit) of forcings other than Omega that act in each
@@ -262,6 +363,15 @@ class Model:
     def with_omega(self, omega: float) -> Model:
         """A copy with the forcing frequency set to ``omega``."""
         return self.with_params(Omega=omega)
+
+    def dataset_attrs(self) -> dict[str, object]:
+        """Attributes every dataset of this model records (none here; e.g. the CATT device's
+        ``interpretation`` and ``omega_n``)."""
+        return {}
+
+    def param_attrs(self, name: str) -> dict[str, str]:
+        """Attributes of the axis of a sweep in ``name`` (``units``, ...); none here."""
+        return {}
 
     def static_mesh_forces(self) -> np.ndarray | None:
         """Static mesh forces (one per mesh, observable units) for the dynamic factor, or None."""

@@ -169,7 +169,7 @@ class ExplorerSession:
         controls = []
         for name in st.main_params():
             box = TextInput(title=name, value=str(st.current_value(name)), name=f"param_{name}",
-                            width=150)
+                            width=150, description=st.param_help(name) or None)
             box.on_change("value", partial(self._on_param, name))
             msg = Div(text="", name=f"param_{name}_message", width=150)
             self.inputs[name], self.input_messages[name] = box, msg

@@ -150,6 +150,21 @@ class ExplorerState:
         """The parameters offered as controls (the swept one left out)."""
         return tuple(p for p in MAIN_PARAMS.get(self.kind, ()) if p != self.param)
 
+    def param_help(self, name: str) -> str:
+        """What a control's parameter is (meaning and unit), from the model's declared
+        coefficients (:mod:`geardyn.core.coefficients`; the gear pair's
+        :data:`~geardyn.models.gear_pair_coefficients.GEAR_PAIR`) or the units of its sweep
+        axis; empty where nothing is declared."""
+        from geardyn.models.gear_pair_coefficients import GEAR_PAIR
+
+        layout = self.model.coefficient_layout
+        if name in layout.names and layout.slot(name).coefficient.meaning:
+            return layout.slot(name).coefficient.describe()
+        if self.kind == "gear_pair" and name in GEAR_PAIR.vocabulary():
+            return GEAR_PAIR[name].describe()
+        units = self.model.param_attrs(name).get("units")
+        return f"[{units}]" if units else ""
+
     def _build(self, study: Study, interpretation: str | None) -> Model:
         from geardyn.study import build_model
 

@@ -64,14 +64,17 @@ from pydantic import (
     Field,
     PrivateAttr,
     ValidationError,
+    create_model,
     field_validator,
     model_validator,
 )
 from pydantic_core import InitErrorDetails, PydanticCustomError
 
+from geardyn.core.coefficients import CoefficientBlock
 from geardyn.core.settings import DEFAULT_MAX_PERIOD, DEFAULT_TOL
 from geardyn.errors import ParameterError, StudyError
 from geardyn.files import atomic_replace
+from geardyn.models.gear_pair_coefficients import GEAR_PAIR
 from geardyn.models.params import PAPER_NAMES, Angle, PlanetaryParams, Real, Whole
 
 __all__ = [
@@ -245,19 +248,28 @@ class PaperBase(BaseModel):
         return PlanetaryParams.paper(**self.changes)
 
 
-class GearPairParams(BaseModel):
-    """``[params]`` of a ``gear_pair`` study: the arguments of :class:`~geardyn.GearPair`."""
+def study_table(name: str, block: CoefficientBlock, doc: str) -> type[BaseModel]:
+    """A ``[params]`` table generated from a model's declared coefficients: one field per
+    parameter of ``block`` (its default, range and meaning; an angle for a unit of rad, else a
+    number), unknown keys refused naming the field."""
+    fields: dict[str, Any] = {}
+    for c in block.entries:
+        if not c.is_parameter:
+            continue
+        kind: Any = Angle if c.unit == "rad" else Real
+        limits = {k: v for k, v in (("ge", c.minimum), ("le", c.maximum),
+                                    ("gt", c.exclusive_minimum), ("lt", c.exclusive_maximum))
+                  if v is not None}
+        default = ... if c.default is None else c.default
+        fields[c.name] = (kind, Field(default, description=c.meaning, **limits))
+    return create_model(name, __config__=_CONFIG, __doc__=doc, __module__=__name__, **fields)
 
-    model_config = _CONFIG
 
-    zeta: Real = Field(0.05, ge=0, description="damping ratio")
-    kappa: Real = Field(0.0, gt=-1, lt=1, description="relative stiffness variation")
-    Fm: Real = Field(0.1, description="mean load")
-    Fa: Real = Field(0.05, description="transmission-error amplitude")
-    Omega: Real = Field(1.0, ge=0, description="mesh frequency")
-    kappa_phase: Angle = 0.0
-    error_phase: Angle = 0.0
-    backlash: Real = Field(1.0, ge=0, description="backlash half-width")
+#: ``[params]`` of a ``gear_pair`` study: the arguments of :class:`~geardyn.GearPair`, from its
+#: declared coefficients (:data:`~geardyn.models.gear_pair_coefficients.GEAR_PAIR`).
+GearPairParams = study_table(
+    "GearPairParams", GEAR_PAIR,
+    "``[params]`` of a ``gear_pair`` study: the arguments of :class:`~geardyn.GearPair`.")
 
 
 #: A quantity: an SI number or a unit string ("24.6 deg", "5e8 N/m").

@@ -26,19 +26,27 @@ states; :class:`CATTDevice` picks that form automatically.
 from __future__ import annotations
 
 import copy
+import functools
 import math
 from collections.abc import Sequence
 
 import numpy as np
 
+from geardyn.core.capabilities import Capabilities
+from geardyn.core.coefficients import CoefficientLayout
 from geardyn.core.kernel_source import KernelSource
 from geardyn.core.model import Model, unique_rows
 from geardyn.errors import ParameterError
 from geardyn.models import catt_kernels as ck
 from geardyn.models.derived import (
+    CATT_BLOCK,
+    CATT_HEADER,
     INTERPRETATIONS,
+    THETA_BLOCK,
+    THETA_HEADER,
     Derived,
     Interpretation,
+    catt_harmonics,
     coefficients,
     derive,
 )
@@ -49,13 +57,35 @@ _KERNEL = KernelSource(ck.catt_rhs, ck.catt_events, ck.catt_observe)
 #: The reduced model's kernel: the same functions compiled for one planet set.
 _KERNEL_ONE = KernelSource(ck.catt_rhs_one, ck.catt_events_one, ck.catt_observe_one)
 _THETA_KERNEL = KernelSource(ck.theta_rhs, ck.theta_events)
-#: Coefficients that fix the layout of the vector: a raw override of them is refused.
-_STRUCTURAL = {
-    "n_blocks": "the number of planet-set blocks fixes the vector's layout; change N instead",
-    "n_harmonics": "the number of stiffness harmonics fixes the vector's layout; change the "
-                   "waveform or harmonics of the meshes instead",
-    "spare": "an unused slot of the coefficient vector",
-}
+#: The block coefficients :meth:`CATTDevice._coefficients_of` reads back per planet set.
+_READ_BACK = ("k_sq_c", "c_sq_c", "k_sq_q", "c_sq_q", "k_pq_q", "c_pq_q", "k_pq_p", "c_pq_p",
+              "b_sq", "b_pq", "f_p0", "f_p1")
+
+
+@functools.lru_cache(maxsize=64)
+def catt_layout(n_sets: int, reduced: bool, n_harmonics: int) -> CoefficientLayout:
+    """The mesh-coordinate model's coefficient vector: :data:`~geardyn.models.derived.CATT_HEADER`,
+    then per planet set :data:`~geardyn.models.derived.CATT_BLOCK` and its stiffness harmonics
+    (names suffixed with the set's number in the general form)."""
+    harmonics = catt_harmonics(n_harmonics)
+    out = CoefficientLayout.of(CATT_HEADER, model="CATTDevice")
+    for i in range(n_sets):
+        suffix = "" if reduced else str(i + 1)
+        out.extend(CATT_BLOCK.entries, suffix)
+        out.extend(harmonics.entries, suffix)
+    return out
+
+
+@functools.lru_cache(maxsize=64)
+def theta_layout(n_sets: int, n_harmonics: int) -> CoefficientLayout:
+    """The body-angle model's coefficient vector: :data:`THETA_HEADER`, then per planet set
+    :data:`THETA_BLOCK` and its stiffness harmonics (names suffixed with the set's number)."""
+    harmonics = catt_harmonics(n_harmonics)
+    out = CoefficientLayout.of(THETA_HEADER, model="DimensionalCATT")
+    for i in range(n_sets):
+        out.extend(THETA_BLOCK.entries, str(i + 1))
+        out.extend(harmonics.entries, str(i + 1))
+    return out
 
 
 class CATTDevice(Model):
@@ -79,6 +109,12 @@ class CATTDevice(Model):
     time_unit = "1"
     state_units = "1"
     observable_units = "N"
+    capabilities = Capabilities(frequency_scale=True, interpretation=True,
+                                physical_inputs=True, paper_device=True)
+    raw_overrides_allowed = True
+    #: The paper's names of the physical parameters (``with_params`` re-derives from them;
+    #: ``waveform`` is not a number, so not swept).
+    physical_names = tuple(n for n in PAPER_NAMES if n != "waveform")
 
     def __init__(
         self,
@@ -127,14 +163,15 @@ class CATTDevice(Model):
             )
         self.name = "CATTDevice"
         self.kernel = _KERNEL_ONE if n_sets == 1 else _KERNEL
-        self.omega_index = ck.OMEGA
+        self.omega_index = CATT_HEADER.offset("Omega")
+        self.coefficient_layout = catt_layout(n_sets, self.reduced, self._n_harmonics())
         self.params = self._coefficient_vector(omega)
-        self.param_names = self._names()
         #: Raw coefficients set by name through ``with_params`` (name -> value), applied on top
         #: of the coefficients derived from ``params_in``.
         self.raw_overrides: dict[str, float] = {}
         if not np.all(np.isfinite(self.params)):
-            bad = self.param_names[int(np.argmax(~np.isfinite(self.params)))]
+            names = self.coefficient_layout.all_names
+            bad = names[int(np.argmax(~np.isfinite(self.params)))]
             raise ParameterError("params", bad, "the parameters give a dimensionless "
                                  "coefficient that is not finite (extreme magnitudes)")
 
@@ -144,64 +181,51 @@ class CATTDevice(Model):
         return max(max(harmonics_needed(s[0]), harmonics_needed(s[1])) for s in sets)
 
     def _coefficient_vector(self, omega: float) -> np.ndarray:
+        """The vector of :func:`catt_layout`, from the derived coefficients."""
         prm = self.params_in
         co = self.coefficients
         d = self.derived
         nh = self._n_harmonics()
-        bs = ck.block_size(nh)
-        p = np.zeros(ck.HEADER + self.n_sets * bs)
-        p[ck.OMEGA] = omega
-        p[ck.LAMBDA] = prm.loads.Lambda
-        p[ck.N_BLOCKS] = self.n_sets
-        p[ck.N_HARM] = nh
-        p[ck.F_C0] = co["f_c0"]
-        p[ck.F_C1] = co["f_c1"]
-        p[ck.PSI1] = prm.loads.psi1
-        p[ck.PSI2] = prm.loads.psi2
+        values: dict[str, float] = {
+            "Omega": omega, "Lambda": prm.loads.Lambda, "n_blocks": self.n_sets,
+            "n_harmonics": nh, "f_c0": co["f_c0"], "f_c1": co["f_c1"],
+            "psi1": prm.loads.psi1, "psi2": prm.loads.psi2,
+        }
         mult = prm.n_planets if self.reduced else 1
         for i in range(self.n_sets):
-            o = ck.HEADER + i * bs
+            sfx = "" if self.reduced else str(i + 1)
             sq, pq, _, _ = prm.planet_set(i)
-            blk = p[o : o + bs]
-            blk[ck.K_SQ_C] = mult * co["k_sq_c"][i]
-            blk[ck.C_SQ_C] = mult * co["c_sq_c"][i]
-            for name, idx in (
-                ("k_sq_q", ck.K_SQ_Q), ("c_sq_q", ck.C_SQ_Q), ("k_pq_q", ck.K_PQ_Q),
-                ("c_pq_q", ck.C_PQ_Q), ("k_pq_p", ck.K_PQ_P), ("c_pq_p", ck.C_PQ_P),
-                ("b_sq", ck.B_SQ), ("b_pq", ck.B_PQ),
-            ):
-                blk[idx] = co[name][i]
-            blk[ck.E_SQ_S] = co["E_sq"][i] * math.cos(sq.error_phase)
-            blk[ck.E_SQ_C] = co["E_sq"][i] * math.sin(sq.error_phase)
-            blk[ck.E_PQ_S] = co["E_pq"][i] * math.cos(pq.error_phase)
-            blk[ck.E_PQ_C] = co["E_pq"][i] * math.sin(pq.error_phase)
-            blk[ck.F_P0] = co["f_p0"][i]
-            blk[ck.F_P1] = co["f_p1"][i]
-            blk[ck.FORCE_SCALE] = prm.b_c * d.omega_n**2 * d.M_q[i]
-            for mesh, off in ((sq, 0), (pq, 2 * nh)):
+            values[f"k_sq_c{sfx}"] = mult * co["k_sq_c"][i]
+            values[f"c_sq_c{sfx}"] = mult * co["c_sq_c"][i]
+            for name in ("k_sq_q", "c_sq_q", "k_pq_q", "c_pq_q", "k_pq_p", "c_pq_p", "b_sq",
+                         "b_pq", "f_p0", "f_p1"):
+                values[f"{name}{sfx}"] = co[name][i]
+            values[f"E_sq_s{sfx}"] = co["E_sq"][i] * math.cos(sq.error_phase)
+            values[f"E_sq_c{sfx}"] = co["E_sq"][i] * math.sin(sq.error_phase)
+            values[f"E_pq_s{sfx}"] = co["E_pq"][i] * math.cos(pq.error_phase)
+            values[f"E_pq_c{sfx}"] = co["E_pq"][i] * math.sin(pq.error_phase)
+            values[f"force_scale{sfx}"] = prm.b_c * d.omega_n**2 * d.M_q[i]
+            values[f"spare{sfx}"] = 0.0
+            for mesh, m in ((sq, "ksq"), (pq, "kpq")):
                 a, b = fourier_coefficients(mesh, nh)
-                blk[ck.BLOCK_FIXED + off : ck.BLOCK_FIXED + off + 2 * nh : 2] = a
-                blk[ck.BLOCK_FIXED + off + 1 : ck.BLOCK_FIXED + off + 2 * nh : 2] = b
-        return p
+                for h in range(nh):
+                    values[f"{m}_a{h + 1}{sfx}"] = a[h]
+                    values[f"{m}_b{h + 1}{sfx}"] = b[h]
+        return self.coefficient_layout.build(values)
 
     def _names(self) -> tuple[str, ...]:
-        head = ["Omega", "Lambda", "n_blocks", "n_harmonics", "f_c0", "f_c1", "psi1", "psi2"]
-        fixed = ["k_sq_c", "c_sq_c", "k_sq_q", "c_sq_q", "k_pq_q", "c_pq_q", "k_pq_p", "c_pq_p",
-                 "b_sq", "b_pq", "E_sq_s", "E_sq_c", "E_pq_s", "E_pq_c", "f_p0", "f_p1",
-                 "force_scale", "spare"]
-        nh = int(self.params[ck.N_HARM])
-        four = [f"{m}_{ab}{h}" for m in ("ksq", "kpq") for h in range(1, nh + 1) for ab in "ab"]
-        names = list(head)
-        for i in range(self.n_sets):
-            suffix = "" if self.reduced else str(i + 1)
-            names += [f"{n}{suffix}" for n in fixed + four]
-        return tuple(names)
+        """The parameters' names (:func:`catt_layout`; structural entries left out)."""
+        return self.coefficient_layout.names
 
     # ------------------------------------------------------------------ parameters by name
     @property
     def omega_n(self) -> float:
         """omega_n [rad/s]: the unit of dimensionless time (interpretation-dependent)."""
         return float(self.derived.omega_n)
+
+    def dataset_attrs(self) -> dict[str, object]:
+        """``interpretation`` and ``omega_n`` [rad/s], recorded in every dataset."""
+        return {"interpretation": self.interpretation, "omega_n": self.omega_n}
 
     def replace(self, **changes) -> CATTDevice:
         """A new device with physical parameters changed by the paper's names (``xi1``,
@@ -231,43 +255,38 @@ class CATTDevice(Model):
         return out
 
     def with_params(self, **values: float) -> CATTDevice:
-        """A copy with parameters changed by name: physical ones (the paper's names, see
-        :data:`~geardyn.models.params.PAPER_NAMES`, and ``Omega``) re-derive every coefficient;
-        any other name sets that raw coefficient of the vector (e.g. ``k_pq_q``, ``f_c0``;
-        dimensionless, in units of this device's omega_n, which stays; the reduced form's
-        ``k_sq_c`` and ``c_sq_c`` are the N planet sets' together). Everything derived
-        (natural frequencies, static forces, initial state, default step) then follows the
-        coefficients. Raises :class:`~geardyn.errors.ParameterError` for a coefficient that
-        fixes the vector's layout (``n_blocks``, ``n_harmonics``, ``spare``) and for a physical
-        change that would undo an earlier raw one."""
-        physical = {k: v for k, v in values.items() if k in PAPER_NAMES or k == "Omega"}
-        rest = {k: float(v) for k, v in values.items() if k not in physical}
-        out = self.replace(**physical) if physical else self
-        return out._override(rest) if rest else (out if physical else copy.copy(self))
+        """A copy with parameters changed by name (:meth:`Model.with_params`): physical ones
+        (the paper's names, see :data:`~geardyn.models.params.PAPER_NAMES`, and ``Omega``)
+        re-derive every coefficient; any other name sets that raw coefficient of the vector
+        (e.g. ``k_pq_q``, ``f_c0``; dimensionless, in units of this device's omega_n, which
+        stays; the reduced form's ``k_sq_c`` and ``c_sq_c`` are the N planet sets' together).
+        Everything derived (natural frequencies, static forces, initial state, default step)
+        then follows the coefficients. Raises :class:`~geardyn.errors.ParameterError` for an
+        entry that fixes the vector's layout (``n_blocks``, ``n_harmonics``, ``spare``: not
+        parameters) and for a physical change that would undo an earlier raw one."""
+        return Model.with_params(self, **values)  # type: ignore[return-value]
+
+    def _is_physical(self, name: str) -> bool:
+        return name in PAPER_NAMES or name == "Omega"
+
+    def _with_physical(self, values: dict[str, float]) -> CATTDevice:
+        return self.replace(**values)
+
+    def _with_raw(self, values: dict[str, float]) -> CATTDevice:
+        return self._override(values)
 
     def _kind(self, name: str) -> str:
         """The coefficient ``name`` without its planet-set suffix (the reduced form's name)."""
-        idx = self._param_index(name)
-        if idx < ck.HEADER:
-            return self.param_names[idx]
-        bs = ck.block_size(int(self.params[ck.N_HARM]))
-        suffix = "" if self.reduced else str((idx - ck.HEADER) // bs + 1)
-        return self.param_names[idx].removesuffix(suffix)
+        return self.coefficient_layout.slot(name).coefficient.name
 
     def _override(self, raw: dict[str, float]) -> CATTDevice:
-        """A copy with raw coefficients set (checked: known, not structural, finite)."""
+        """A copy with raw coefficients set (checked: known parameters, finite)."""
         out = copy.copy(self)
         p = self.params.copy()
-        for name, value in raw.items():
-            idx = self._param_index(name)
-            base = self._kind(name)
-            if base in _STRUCTURAL:
-                raise ParameterError(name, value, _STRUCTURAL[base])
-            if not math.isfinite(value):
-                raise ParameterError(name, value, "a raw coefficient must be finite")
+        for idx, value in self._checked_raw(raw).items():
             p[idx] = value
         out.params = p
-        out.raw_overrides = {**self.raw_overrides, **raw}
+        out.raw_overrides = {**self.raw_overrides, **{k: float(v) for k, v in raw.items()}}
         out.coefficients = out._coefficients_of(p)
         return out
 
@@ -276,24 +295,25 @@ class CATTDevice(Model):
         (the reduced form's carrier coupling is N sets' together: divided by N)."""
         co = dict(self.coefficients)
         touched = {self._kind(k) for k in self.raw_overrides}
-        blk = self._blocks(p[None, :])[0]
+        values = self.coefficient_layout.read(p)
         n = self.params_in.n_planets
+        sfx = [""] if self.reduced else [str(i + 1) for i in range(self.n_sets)]
+
+        def per_set(name: str) -> np.ndarray:
+            return np.array([values[name + s] for s in sfx])
 
         def put(name: str, v: np.ndarray) -> None:
             co[name] = np.broadcast_to(v, (n,)).copy() if v.size == 1 else v.copy()
 
-        for name, idx in (("k_sq_c", ck.K_SQ_C), ("c_sq_c", ck.C_SQ_C), ("k_sq_q", ck.K_SQ_Q),
-                          ("c_sq_q", ck.C_SQ_Q), ("k_pq_q", ck.K_PQ_Q), ("c_pq_q", ck.C_PQ_Q),
-                          ("k_pq_p", ck.K_PQ_P), ("c_pq_p", ck.C_PQ_P), ("b_sq", ck.B_SQ),
-                          ("b_pq", ck.B_PQ), ("f_p0", ck.F_P0), ("f_p1", ck.F_P1)):
+        for name in _READ_BACK:
             if name in touched:
-                put(name, blk[:, idx] / (n if self.reduced and name[2:] == "_sq_c" else 1))
-        for name, s_idx, c_idx in (("E_sq", ck.E_SQ_S, ck.E_SQ_C), ("E_pq", ck.E_PQ_S, ck.E_PQ_C)):
+                put(name, per_set(name) / (n if self.reduced and name[2:] == "_sq_c" else 1))
+        for name in ("E_sq", "E_pq"):
             if touched & {f"{name}_s", f"{name}_c"}:
-                put(name, np.hypot(blk[:, s_idx], blk[:, c_idx]))
-        for name, idx in (("f_c0", ck.F_C0), ("f_c1", ck.F_C1)):
+                put(name, np.hypot(per_set(f"{name}_s"), per_set(f"{name}_c")))
+        for name in ("f_c0", "f_c1"):
             if name in touched:
-                co[name] = float(p[idx])
+                co[name] = values[name]
         return co
 
     def lane_params(self, name: str, values: Sequence[float] | np.ndarray) -> np.ndarray:
@@ -303,8 +323,6 @@ class CATTDevice(Model):
             if len({r.size for r in rows}) != 1:
                 raise ValueError(f"sweeping {name!r} changes the model's size; sweep N separately")
             return np.array(rows)
-        if name != "Omega" and values.size:
-            self._override({name: float(values[0])})  # refuses a structural coefficient
         return Model.lane_params(self, name, values)
 
     # ------------------------------------------------------------------ linear analysis
@@ -440,7 +458,7 @@ class CATTDevice(Model):
         n = self.params_in.n_planets
         raw: dict[str, float] = {}
         for name, value in self.raw_overrides.items():
-            if name in out.param_names[: ck.HEADER] or not self.reduced:
+            if name in CATT_HEADER.names or not self.reduced:
                 raw[name] = value
             else:  # a reduced block coefficient: the same in every set (carrier coupling / N)
                 per = value / n if name in ("k_sq_c", "c_sq_c") else value
@@ -482,56 +500,44 @@ class DimensionalCATT(Model):
 
     time_unit = "s"
     state_units = "rad, rad/s"
+    capabilities = Capabilities(paper_device=True)
 
     def __init__(self, device: CATTDevice):
         prm = device.params_in
         d = device.derived
         n = prm.n_planets
         nh = int(device.params[ck.N_HARM])
-        bs = ck.T_BLOCK_FIXED + 4 * nh
-        p = np.zeros(ck.T_HEADER + n * bs)
         loads = prm.loads
-        p[ck.T_OMEGA] = device.omega * d.omega_n
-        p[ck.T_OMEGA_L] = loads.Lambda * d.omega_n
-        p[ck.T_N] = n
-        p[ck.T_NH] = nh
-        p[ck.T_TD] = loads.T_D
-        p[ck.T_A1] = loads.A1
-        p[ck.T_B1] = loads.B1
-        p[ck.T_PSI1] = loads.psi1
-        p[ck.T_A2] = loads.A2
-        p[ck.T_B2] = loads.B2
-        p[ck.T_PSI2] = loads.psi2
-        p[ck.T_JC] = d.J_c_eff
-        p[ck.T_RC1] = prm.carrier.r_c1
-        p[ck.T_ARM] = d.arm
+        values: dict[str, float] = {
+            "omega": device.omega * d.omega_n, "omega_L": loads.Lambda * d.omega_n,
+            "n_sets": n, "n_harmonics": nh, "T_D": loads.T_D, "A1": loads.A1, "B1": loads.B1,
+            "psi1": loads.psi1, "A2": loads.A2, "B2": loads.B2, "psi2": loads.psi2,
+            "J_c": d.J_c_eff, "r_c1": prm.carrier.r_c1, "arm": d.arm,
+        }
         for i in range(n):
-            o = ck.T_HEADER + i * bs
+            k = str(i + 1)
             sq, pq, _, _ = prm.planet_set(i)
-            p[o + ck.T_JQ] = d.J_q[i]
-            p[o + ck.T_JP] = d.J_p[i]
-            p[o + ck.T_RBQ] = d.r_bq[i]
-            p[o + ck.T_RBP] = d.r_bp[i]
-            p[o + ck.T_KM_SQ] = sq.mean_stiffness
-            p[o + ck.T_KM_PQ] = pq.mean_stiffness
-            p[o + ck.T_C_SQ] = d.C_sq[i]
-            p[o + ck.T_C_PQ] = d.C_pq[i]
-            p[o + ck.T_B_SQ] = sq.backlash
-            p[o + ck.T_B_PQ] = pq.backlash
-            p[o + ck.T_E_SQ_S] = sq.error * math.cos(sq.error_phase)
-            p[o + ck.T_E_SQ_C] = sq.error * math.sin(sq.error_phase)
-            p[o + ck.T_E_PQ_S] = pq.error * math.cos(pq.error_phase)
-            p[o + ck.T_E_PQ_C] = pq.error * math.sin(pq.error_phase)
-            for mesh, off in ((sq, 0), (pq, 2 * nh)):
+            values.update({
+                f"J_q{k}": d.J_q[i], f"J_p{k}": d.J_p[i], f"r_bq{k}": d.r_bq[i],
+                f"r_bp{k}": d.r_bp[i], f"Km_sq{k}": sq.mean_stiffness,
+                f"Km_pq{k}": pq.mean_stiffness, f"C_sq{k}": d.C_sq[i], f"C_pq{k}": d.C_pq[i],
+                f"b_sq{k}": sq.backlash, f"b_pq{k}": pq.backlash,
+                f"E_sq_s{k}": sq.error * math.cos(sq.error_phase),
+                f"E_sq_c{k}": sq.error * math.sin(sq.error_phase),
+                f"E_pq_s{k}": pq.error * math.cos(pq.error_phase),
+                f"E_pq_c{k}": pq.error * math.sin(pq.error_phase),
+            })
+            for mesh, m in ((sq, "ksq"), (pq, "kpq")):
                 a, b = fourier_coefficients(mesh, nh)
-                p[o + ck.T_BLOCK_FIXED + off : o + ck.T_BLOCK_FIXED + off + 2 * nh : 2] = a
-                p[o + ck.T_BLOCK_FIXED + off + 1 : o + ck.T_BLOCK_FIXED + off + 2 * nh : 2] = b
+                for h in range(nh):
+                    values[f"{m}_a{h + 1}{k}"] = a[h]
+                    values[f"{m}_b{h + 1}{k}"] = b[h]
         self.device = device
-        self.params = p
         self.name = "DimensionalCATT"
+        self.coefficient_layout = theta_layout(n, nh)
+        self.params = self.coefficient_layout.build(values)
         self.kernel = _THETA_KERNEL
-        self.omega_index = ck.T_OMEGA
-        self.param_names = ("omega",) + tuple(f"p{k}" for k in range(1, p.size))
+        self.omega_index = THETA_HEADER.offset("omega")
         self.state_names = ("theta_c", "dtheta_c") + tuple(
             f"{v}{i + 1}" for i in range(n)
             for v in ("theta_q", "dtheta_q", "theta_p", "dtheta_p")
@@ -546,6 +552,11 @@ class DimensionalCATT(Model):
             (f"{m}{i + 1}", 4 * i + 2 * k, 4 * i + 2 * k + 1)
             for i in range(n) for k, m in enumerate(("sq", "pq"))
         )
+
+    @property
+    def params_in(self) -> PlanetaryParams:
+        """The device's parameters (the body-angle model is built from them)."""
+        return self.device.params_in
 
     def fastest_natural_frequency(self, P: np.ndarray | None = None) -> np.ndarray:
         """Fastest natural frequency [rad/s] of Eq. (1) linearised (mean stiffness, no backlash)

@@ -26,14 +26,22 @@ import math
 import numba as nb
 
 from geardyn.core.kernel_source import FORM_GENERAL, FORM_LOAD, FORM_QUIET
+from geardyn.models.derived import CATT_BLOCK, CATT_HEADER, THETA_BLOCK, THETA_HEADER
 
+# Index constants: the offsets of the declared coefficients (geardyn.models.derived).
 # header
-OMEGA, LAMBDA, N_BLOCKS, N_HARM, F_C0, F_C1, PSI1, PSI2 = range(8)
-HEADER = 8
+_H = CATT_HEADER.offset
+OMEGA, LAMBDA, N_BLOCKS, N_HARM = _H("Omega"), _H("Lambda"), _H("n_blocks"), _H("n_harmonics")
+F_C0, F_C1, PSI1, PSI2 = _H("f_c0"), _H("f_c1"), _H("psi1"), _H("psi2")
+HEADER = CATT_HEADER.size
 # block
-(K_SQ_C, C_SQ_C, K_SQ_Q, C_SQ_Q, K_PQ_Q, C_PQ_Q, K_PQ_P, C_PQ_P, B_SQ, B_PQ,
- E_SQ_S, E_SQ_C, E_PQ_S, E_PQ_C, F_P0, F_P1, FORCE_SCALE, SPARE) = range(18)
-BLOCK_FIXED = 18
+_B = CATT_BLOCK.offset
+K_SQ_C, C_SQ_C, K_SQ_Q, C_SQ_Q = _B("k_sq_c"), _B("c_sq_c"), _B("k_sq_q"), _B("c_sq_q")
+K_PQ_Q, C_PQ_Q, K_PQ_P, C_PQ_P = _B("k_pq_q"), _B("c_pq_q"), _B("k_pq_p"), _B("c_pq_p")
+B_SQ, B_PQ, F_P0, F_P1 = _B("b_sq"), _B("b_pq"), _B("f_p0"), _B("f_p1")
+E_SQ_S, E_SQ_C, E_PQ_S, E_PQ_C = _B("E_sq_s"), _B("E_sq_c"), _B("E_pq_s"), _B("E_pq_c")
+FORCE_SCALE, SPARE = _B("force_scale"), _B("spare")
+BLOCK_FIXED = CATT_BLOCK.size
 
 
 def block_size(n_harmonics: int) -> int:
@@ -200,13 +208,19 @@ def catt_observe_one(t, y, out, p, s, c):
 # ---------------------------------------------------------------------------------------------
 # Dimensional form, Eq. (1), in the body angles (SI units, time in seconds).
 # State: theta_c, theta_c', then per planet set theta_q, theta_q', theta_p, theta_p'.
-T_OMEGA, T_OMEGA_L, T_N, T_NH, T_TD, T_A1, T_B1, T_PSI1, T_A2, T_B2, T_PSI2, T_JC, T_RC1, T_ARM = (
-    range(14)
-)
-T_HEADER = 14
-(T_JQ, T_JP, T_RBQ, T_RBP, T_KM_SQ, T_KM_PQ, T_C_SQ, T_C_PQ, T_B_SQ, T_B_PQ,
- T_E_SQ_S, T_E_SQ_C, T_E_PQ_S, T_E_PQ_C) = range(14)
-T_BLOCK_FIXED = 14
+# Index constants: the offsets of the declared coefficients (geardyn.models.derived).
+_TH, _TB = THETA_HEADER.offset, THETA_BLOCK.offset
+T_OMEGA, T_OMEGA_L, T_N, T_NH = _TH("omega"), _TH("omega_L"), _TH("n_sets"), _TH("n_harmonics")
+T_TD, T_A1, T_B1, T_PSI1 = _TH("T_D"), _TH("A1"), _TH("B1"), _TH("psi1")
+T_A2, T_B2, T_PSI2 = _TH("A2"), _TH("B2"), _TH("psi2")
+T_JC, T_RC1, T_ARM = _TH("J_c"), _TH("r_c1"), _TH("arm")
+T_HEADER = THETA_HEADER.size
+T_JQ, T_JP, T_RBQ, T_RBP = _TB("J_q"), _TB("J_p"), _TB("r_bq"), _TB("r_bp")
+T_KM_SQ, T_KM_PQ, T_C_SQ, T_C_PQ = _TB("Km_sq"), _TB("Km_pq"), _TB("C_sq"), _TB("C_pq")
+T_B_SQ, T_B_PQ = _TB("b_sq"), _TB("b_pq")
+T_E_SQ_S, T_E_SQ_C = _TB("E_sq_s"), _TB("E_sq_c")
+T_E_PQ_S, T_E_PQ_C = _TB("E_pq_s"), _TB("E_pq_c")
+T_BLOCK_FIXED = THETA_BLOCK.size
 
 
 @nb.njit(**_JIT)

@@ -25,6 +25,8 @@ from typing import Literal
 
 import numpy as np
 
+from geardyn.core.coefficients import Coefficient, CoefficientBlock
+
 # DERIVED_FORMULAS is defined with the parameters (which check overrides by name), shown here
 from geardyn.models.params import DERIVED_FORMULAS as DERIVED_FORMULAS
 from geardyn.models.params import PlanetaryParams
@@ -34,24 +36,121 @@ Interpretation = Literal["consistent", "carrier-only", "as-printed"]
 #: first.
 INTERPRETATIONS: tuple[str, ...] = ("consistent", "carrier-only", "as-printed")
 
-#: The dimensionless coefficients of Eq. (10), per planet set i, with their formulas.
+
+def _d(name: str, meaning: str, *inputs: str, unit: str = "1",
+       constant: str | None = None) -> Coefficient:
+    return Coefficient(name, unit, meaning, "derived", inputs, constant=constant)
+
+
+def _structure(name: str, meaning: str, constant: str | None = None) -> Coefficient:
+    return Coefficient(name, "1", meaning, "structure", constant=constant)
+
+
+#: The header of the mesh-coordinate model's coefficient vector (offsets: the kernel constants
+#: of :mod:`geardyn.models.catt_kernels`).
+CATT_HEADER = CoefficientBlock((
+    Coefficient("Omega", "1", "mesh frequency omega / omega_n"),
+    Coefficient("Lambda", "1", "load-fluctuation frequency / omega_n"),
+    _structure("n_blocks", "number of planet-set blocks (the vector's layout)"),
+    _structure("n_harmonics", "number of stiffness harmonics (the vector's layout)",
+               constant="N_HARM"),
+    _d("f_c0", "r_c1 (T_D - A2) / (M_c r_bc^2 omega_n^2 b_c)  (net mean torque on the carrier)",
+       "T_D", "A2", "r_c1", "M_c", "r_bc", "omega_n", "b_c"),
+    _d("f_c1", "-r_c1 B2 / (M_c r_bc^2 omega_n^2 b_c)",
+       "B2", "r_c1", "M_c", "r_bc", "omega_n", "b_c"),
+    Coefficient("psi1", "rad", "phase of the outside-planet load fluctuation"),
+    Coefficient("psi2", "rad", "phase of the carrier load fluctuation"),
+))
+
+#: One planet set's block (then its 4 nh stiffness harmonics, :func:`catt_harmonics`).
+CATT_BLOCK = CoefficientBlock((
+    _d("k_sq_c", "r_c1 arm Km_sq / (M_c r_bc^2 omega_n^2)  (sun mesh stiffness on the carrier)",
+       "Km_sq", "r_c1", "arm", "M_c", "r_bc", "omega_n"),
+    _d("c_sq_c", "gamma r_c1 arm C_sq / (M_c r_bc^2 omega_n)  (sun mesh damping on the carrier)",
+       "xi1", "Km_sq", "r_c1", "arm", "M_c", "r_bc", "omega_n"),
+    _d("k_sq_q", "Km_sq / (M_q omega_n^2)", "Km_sq", "M_q", "omega_n"),
+    _d("c_sq_q", "C_sq / (M_q omega_n)", "xi1", "Km_sq", "M_q", "omega_n"),
+    _d("k_pq_q", "Km_pq / (M_q omega_n^2)", "Km_pq", "M_q", "omega_n"),
+    _d("c_pq_q", "C_pq / (M_q omega_n)", "xi2", "Km_pq", "M_q", "omega_n"),
+    _d("k_pq_p", "Km_pq / (M_p omega_n^2)", "Km_pq", "M_p", "omega_n"),
+    _d("c_pq_p", "C_pq / (M_p omega_n)", "xi2", "Km_pq", "M_p", "omega_n"),
+    _d("b_sq", "b_sq / b_c  (dimensionless backlash)", "b_sq", "b_c"),
+    _d("b_pq", "b_pq / b_c", "b_pq", "b_c"),
+    _d("E_sq_s", "E_sq cos(phase) / b_c  (meshing error, sine part)", "E_sq", "b_c"),
+    _d("E_sq_c", "E_sq sin(phase) / b_c  (meshing error, cosine part)", "E_sq", "b_c"),
+    _d("E_pq_s", "E_pq cos(phase) / b_c", "E_pq", "b_c"),
+    _d("E_pq_c", "E_pq sin(phase) / b_c", "E_pq", "b_c"),
+    _d("f_p0", "A1 / (M_p r_bp omega_n^2 b_c)  (mean load on the outside planet)",
+       "A1", "M_p", "r_bp", "omega_n", "b_c"),
+    _d("f_p1", "B1 / (M_p r_bp omega_n^2 b_c)", "B1", "M_p", "r_bp", "omega_n", "b_c"),
+    _d("force_scale", "b_c omega_n^2 M_q  (mesh force per unit dimensionless deflection)",
+       "b_c", "omega_n", "M_q", unit="N"),
+    _structure("spare", "an unused slot of the coefficient vector"),
+))
+
+
+def catt_harmonics(n_harmonics: int) -> CoefficientBlock:
+    """The relative-stiffness Fourier coefficients of one planet set's two meshes: ksq_a1,
+    ksq_b1, ..., then kpq_a1, ... (cosine and sine parts of k(theta) / Km - 1)."""
+    return CoefficientBlock(tuple(
+        _d(f"{m}_{ab}{h}", f"{'cosine' if ab == 'a' else 'sine'} part of harmonic {h} of the "
+           f"relative {m[1:]} mesh stiffness", "waveform", f"Ka_{m[1:]}", f"Km_{m[1:]}")
+        for m in ("ksq", "kpq") for h in range(1, n_harmonics + 1) for ab in "ab"))
+
+
+def _t(name: str, unit: str, meaning: str, constant: str, *inputs: str) -> Coefficient:
+    kind = "derived" if inputs else "input"
+    return Coefficient(name, unit, meaning, kind, inputs, constant=f"T_{constant}")
+
+
+#: The header of the body-angle model's coefficient vector (SI).
+THETA_HEADER = CoefficientBlock((
+    _t("omega", "rad/s", "mesh frequency", "OMEGA"),
+    _t("omega_L", "rad/s", "load-fluctuation frequency", "OMEGA_L"),
+    Coefficient("n_sets", "1", "number of planet sets", "structure", constant="T_N"),
+    Coefficient("n_harmonics", "1", "number of stiffness harmonics", "structure",
+                constant="T_NH"),
+    _t("T_D", "N m", "driving torque on the carrier", "TD"),
+    _t("A1", "N m", "mean load torque on the outside planets", "A1"),
+    _t("B1", "N m", "fluctuation of the outside planets' load torque", "B1"),
+    _t("psi1", "rad", "phase of the outside-planet load fluctuation", "PSI1"),
+    _t("A2", "N m", "mean load torque on the carrier", "A2"),
+    _t("B2", "N m", "fluctuation of the carrier's load torque", "B2"),
+    _t("psi2", "rad", "phase of the carrier load fluctuation", "PSI2"),
+    _t("J_c", "kg m^2", "effective carrier inertia", "JC", "J_c", "m_q", "m_p", "r_c1", "r_c2"),
+    _t("r_c1", "m", "carrier radius of the inside planets", "RC1"),
+    _t("arm", "m", "lever arm of the sun mesh force on the carrier", "ARM", "r_bs",
+       "pressure_angle"),
+))
+#: One planet set's block of the body-angle model (then its stiffness harmonics).
+THETA_BLOCK = CoefficientBlock((
+    _t("J_q", "kg m^2", "inside planet inertia", "JQ"),
+    _t("J_p", "kg m^2", "outside planet inertia", "JP"),
+    _t("r_bq", "m", "inside planet base radius", "RBQ", "pitch_radius", "pressure_angle"),
+    _t("r_bp", "m", "outside planet base radius", "RBP", "pitch_radius", "pressure_angle"),
+    _t("Km_sq", "N/m", "sun-inside mean mesh stiffness", "KM_SQ"),
+    _t("Km_pq", "N/m", "inside-outside mean mesh stiffness", "KM_PQ"),
+    _t("C_sq", "N s/m", "sun-inside mesh damping", "C_SQ", "xi1", "Km_sq", "M_s", "M_q"),
+    _t("C_pq", "N s/m", "inside-outside mesh damping", "C_PQ", "xi2", "Km_pq", "M_p", "M_q"),
+    _t("b_sq", "m", "sun-inside backlash half-width", "B_SQ"),
+    _t("b_pq", "m", "inside-outside backlash half-width", "B_PQ"),
+    _t("E_sq_s", "m", "sun-inside meshing error, sine part", "E_SQ_S", "E_sq", "error_phase"),
+    _t("E_sq_c", "m", "sun-inside meshing error, cosine part", "E_SQ_C", "E_sq", "error_phase"),
+    _t("E_pq_s", "m", "inside-outside meshing error, sine part", "E_PQ_S", "E_pq",
+       "error_phase"),
+    _t("E_pq_c", "m", "inside-outside meshing error, cosine part", "E_PQ_C", "E_pq",
+       "error_phase"),
+))
+
+
+#: The dimensionless coefficients of Eq. (10), per planet set i, with their formulas (the
+#: error amplitudes E_sq, E_pq enter the vector as sine and cosine parts).
 COEFFICIENT_FORMULAS: dict[str, str] = {
-    "k_sq_c": "r_c1 arm Km_sq / (M_c r_bc^2 omega_n^2)  (sun mesh stiffness on the carrier)",
-    "c_sq_c": "gamma r_c1 arm C_sq / (M_c r_bc^2 omega_n)  (sun mesh damping on the carrier)",
-    "k_sq_q": "Km_sq / (M_q omega_n^2)",
-    "c_sq_q": "C_sq / (M_q omega_n)",
-    "k_pq_q": "Km_pq / (M_q omega_n^2)",
-    "c_pq_q": "C_pq / (M_q omega_n)",
-    "k_pq_p": "Km_pq / (M_p omega_n^2)",
-    "c_pq_p": "C_pq / (M_p omega_n)",
-    "b_sq": "b_sq / b_c  (dimensionless backlash)",
-    "b_pq": "b_pq / b_c",
+    **{c.name: c.meaning for c in CATT_BLOCK.entries[:10]},
     "E_sq": "E_sq / b_c  (dimensionless meshing error)",
     "E_pq": "E_pq / b_c",
-    "f_p0": "A1 / (M_p r_bp omega_n^2 b_c)  (mean load on the outside planet)",
-    "f_p1": "B1 / (M_p r_bp omega_n^2 b_c)",
-    "f_c0": "r_c1 (T_D - A2) / (M_c r_bc^2 omega_n^2 b_c)  (net mean torque on the carrier)",
-    "f_c1": "-r_c1 B2 / (M_c r_bc^2 omega_n^2 b_c)",
+    **{c.name: c.meaning for c in CATT_BLOCK.entries[14:16]},
+    **{c.name: c.meaning for c in CATT_HEADER.entries[4:6]},
 }
 
 _PER_PLANET = {"r_bq", "r_bp", "m_q", "m_p", "J_q", "J_p", "M_q", "M_p", "C_sq", "C_pq"}

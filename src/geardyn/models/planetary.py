@@ -21,6 +21,7 @@ without one they are omitted (the carrier-frame model at low carrier speed).
 from __future__ import annotations
 
 import copy
+import functools
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
@@ -29,14 +30,65 @@ from typing import Any
 
 import numpy as np
 
+from geardyn.core.capabilities import Capabilities
+from geardyn.core.coefficients import CoefficientLayout
 from geardyn.core.kernel_source import KernelSource
 from geardyn.core.model import Model, unique_rows
 from geardyn.errors import ParameterError
 from geardyn.models import planetary_kernels as pk
+from geardyn.models.planetary_coefficients import (
+    CARRIER_SPEED,
+    FORCES,
+    HEADER,
+    MATRICES,
+    MESH,
+    MESH_ROW,
+    harmonics_block,
+    structure_entry,
+    workspace_entry,
+)
 from geardyn.models.stiffness import fourier_coefficients
 from geardyn.units import to_si
 
 _KERNEL = KernelSource(pk.planetary_rhs, pk.planetary_events, pk.planetary_observe)
+
+
+@functools.lru_cache(maxsize=32)
+def planetary_layout(dofs: tuple[str, ...], mesh_names: tuple[str, ...], nh: int,
+                     kt_entries: tuple[tuple[int, int], ...], gyro: tuple[tuple[int, int], ...]
+                     ) -> CoefficientLayout:
+    """The coefficient vector of a gear set (:func:`planetary_kernels.layout`): parameters,
+    then the structure the kernels read (sparse indices and counts: structure; their copies of
+    the Kt, W and G values: workspace), the stiffness cache (workspace), the gyroscopic section
+    (the carrier speed a parameter, the M^-1 G pattern structure)."""
+    out = CoefficientLayout.of(HEADER, model="PlanetaryGearSet")
+    for c in FORCES.entries:
+        for d in dofs:
+            out.extend((c,), f"_{d}")
+    for c in MATRICES.entries:
+        for a in dofs:
+            for b in dofs:
+                out.extend((c,), f"_{a}_{b}")
+    harmonics = harmonics_block(nh)
+    for m in mesh_names:
+        out.extend(MESH.entries + harmonics.entries, prefix=f"{m}_")
+        for c in MESH_ROW.entries:
+            for d in dofs:
+                out.extend((c,), f"_{d}", prefix=f"{m}_")
+    index = structure_entry("structure", "sparse index or count of the kernel's structure")
+    copy_ = workspace_entry("structure copy", "the kernel's copy of a structural value "
+                            "(written from the dense entries)")
+    for name in pk.structure_names(dofs, mesh_names, list(kt_entries)):
+        copy = "_nz_W" in name or "_nz_G" in name or name.startswith("Kt_nz_")
+        out.place((name,), copy_ if copy else index)
+    cache = workspace_entry("cache", "relative-stiffness cache of the lane-block functions")
+    out.place(pk.cache_entries(len(mesh_names))[0], cache)
+    gyro_names = pk.gyro_names(dofs, list(gyro))
+    out.place(gyro_names[:1], CARRIER_SPEED)
+    pattern = structure_entry("gyro", "the Coriolis pattern M^-1 G (rows, columns, values; "
+                              "every lane alike)")
+    out.place(gyro_names[1:], pattern)
+    return out
 CENTRAL = ("carrier", "ring", "sun")
 _SHORT = {"carrier": "c", "ring": "r", "sun": "s"}
 #: Constructor inputs that fix the model's layout or are not numbers: not swept by name.
@@ -285,6 +337,15 @@ class PlanetaryGearSet(Model):
     time_unit = "1"
     state_units = "1"
     observable_units = "N"
+    capabilities = Capabilities(physical_inputs=True, physical_axes=True)
+    raw_overrides_allowed = True
+    #: Raw coefficients set by name through ``with_params`` (name -> value), applied again on
+    #: top of a rebuild from changed inputs.
+    raw_overrides: dict[str, float] = {}
+    #: The stage a set built by :meth:`from_geometry` came from (None otherwise).
+    geometry: Any = None
+    #: The member a set built by :meth:`from_geometry` holds fixed (None otherwise).
+    held: str | None = None
 
     def __init__(self, n_planets: int = 3, sun_pressure_angle: Any = "24.6 deg",
                  ring_pressure_angle: Any = "24.6 deg", *, sun: Member, ring: Member,
@@ -533,14 +594,14 @@ class PlanetaryGearSet(Model):
     def input_member(self) -> str:
         """The member whose speed :attr:`input_speed` is: the sun, or the carrier when the
         sun is held."""
-        return "carrier" if getattr(self, "held", None) == "sun" else "sun"
+        return "carrier" if self.held == "sun" else "sun"
 
     def mesh_frequency_per_input_speed(self) -> float:
         """Mesh frequency over input speed (both rad/s) of a set built from geometry. The mesh
         frequency is Z_s times the sun's speed relative to the carrier: Z_s Z_r / (Z_s + Z_r)
         with the ring held (sun input), Z_s with the carrier held (sun input) or with the sun
         held (carrier input). A set without geometry raises :class:`ParameterError`."""
-        geo = getattr(self, "geometry", None)
+        geo = self.geometry
         if geo is None:
             raise ParameterError(INPUT_SPEED, None, "needs a gear set built from geometry "
                                  "(from_geometry or [params.geometry]: the tooth counts); sweep "
@@ -558,7 +619,7 @@ class PlanetaryGearSet(Model):
         """Attributes of a swept parameter's axis: ``units`` (SI, rpm for ``input_speed``)
         and, for the speeds, ``long_name``; empty for a name without a known unit."""
         if name == INPUT_SPEED:
-            held = getattr(self, "held", None)
+            held = self.held
             return {"units": "rpm", "long_name": f"input ({self.input_member}) speed",
                     "meaning": f"mesh frequency / {self.mesh_frequency_per_input_speed():.6g} "
                                f"({held} held), in rpm"}
@@ -578,7 +639,7 @@ class PlanetaryGearSet(Model):
         w = np.asarray(omega, dtype=float) * self.time_scale
         out = {"mesh_frequency": (w / (2.0 * math.pi),
                                   {"units": "Hz", "long_name": "mesh frequency"})}
-        if getattr(self, "geometry", None) is not None:
+        if self.geometry is not None:
             attrs = self.param_attrs(INPUT_SPEED)
             out[INPUT_SPEED] = (w / self.mesh_frequency_per_input_speed() * 60.0
                                 / (2.0 * math.pi), attrs)
@@ -761,11 +822,6 @@ class PlanetaryGearSet(Model):
         p[pk.DAMPED] = float(np.any(p[lay["Ct"]:lay["Ct"] + n * n] != 0.0))
         W = self.mesh_rows()
         k, c = self.mesh_stiffnesses(), self._mesh_damping()
-        names_p = ["Omega", "n_dof", "n_meshes", "n_harmonics", "torque_on", "torque_order",
-                   "torque_phase", "damped"]
-        names_p += [f"F0_{d}" for d in names] + [f"F1_{d}" for d in names]
-        names_p += [f"Kt_{a}_{b}" for a in names for b in names]
-        names_p += [f"Ct_{a}_{b}" for a in names for b in names]
         for m in range(nm):
             o = lay["mesh"] + m * lay["block"]
             blk = p[o:o + lay["block"]]
@@ -778,23 +834,19 @@ class PlanetaryGearSet(Model):
             blk[f:f + 2 * nh] = self.fourier[m]
             blk[f + 2 * nh:f + 2 * nh + n] = W[m]
             blk[f + 2 * nh + n:] = Minv @ W[m] / (L * w0 * w0)
-            mn = self.mesh_names[m]
-            names_p += [f"{mn}_{v}" for v in ("b", "E_s", "E_c", "KF", "CF")]
-            names_p += [f"{mn}_{ab}{h}" for h in range(1, nh + 1) for ab in "ab"]
-            names_p += [f"{mn}_W_{d}" for d in names] + [f"{mn}_G_{d}" for d in names]
         self._structure = (kt_entries, mesh_dofs)
         pk.fill_structure(p, kt_entries, mesh_dofs)
-        names_p += pk.structure_names(names, self.mesh_names, kt_entries)
-        cache_names, p[lay["cache"]:lay["gyro"]] = pk.cache_entries(nm)
-        names_p += cache_names
+        p[lay["cache"]:lay["gyro"]] = pk.cache_entries(nm)[1]
         g, ng = lay["gyro"], len(gyro)
         p[g], p[g + 1] = wc / w0, ng
         p[g + 2:g + 2 + ng] = [i for i, _ in gyro]
         p[g + 2 + ng:g + 2 + 2 * ng] = [j for _, j in gyro]
         p[g + 2 + 2 * ng:g + 2 + 3 * ng] = [G_unit[i, j] for i, j in gyro]
-        names_p += pk.gyro_names(names, gyro)
+        self.coefficient_layout = planetary_layout(names, self.mesh_names, nh, tuple(kt_entries),
+                                                   tuple(gyro))
+        if self.coefficient_layout.size != p.size:
+            raise RuntimeError("the declared coefficient layout does not match the kernel's")
         self.params = p
-        self.param_names = tuple(names_p)
         self.omega_index = pk.OMEGA
         self.kernel = _KERNEL
         self.state_names = names + tuple(f"d{d}" for d in names)
@@ -835,7 +887,7 @@ class PlanetaryGearSet(Model):
         names = tuple(k for k, v in self.inputs.items() if k not in _NOT_SWEPT
                       and (v is None or isinstance(v, int | float | str))
                       and not isinstance(v, bool))
-        return names + ((INPUT_SPEED,) if getattr(self, "geometry", None) is not None else ())
+        return names + ((INPUT_SPEED,) if self.geometry is not None else ())
 
     @property
     def mesh_names(self) -> tuple[str, ...]:
@@ -870,7 +922,9 @@ class PlanetaryGearSet(Model):
                                         * self.mesh_frequency_per_input_speed())
         physical = {k: v for k, v in values.items() if k in self.inputs}
         rest = {k: float(v) for k, v in values.items() if k not in physical}
-        raw = getattr(self, "raw_overrides", {})
+        for name, value in rest.items():  # unknown, structure, workspace: refused first
+            self._raw_target(name, value)
+        raw = self.raw_overrides
         if physical:
             kw = {**self.inputs, "time_scale": self.time_scale,
                   "length_scale": self.length_scale, **physical}
@@ -880,19 +934,14 @@ class PlanetaryGearSet(Model):
             if "mesh_frequency" not in physical:  # Omega as it was, not (Omega w0) / w0
                 out.params[pk.OMEGA] = self.omega
             for name in _FROM_BUILD:  # what from_geometry attached (the inputs came from it)
-                if hasattr(self, name):
-                    setattr(out, name, getattr(self, name))
+                if name in self.__dict__:
+                    setattr(out, name, self.__dict__[name])
             rest = {**raw, **rest}
         else:
             out = copy.copy(self)
         if rest:
-            base = copy.copy(out)
-            out = Model.with_params(base, **rest)
-            if "damped" not in rest:  # a raw Ct entry switches the modal damping product on
-                lay, n = out._layout, int(out.params[pk.N_DOF])
-                ct = out.params[lay["Ct"]:lay["Ct"] + n * n]
-                out.params[pk.DAMPED] = float(np.any(ct != 0.0))
-            pk.fill_structure(out.params, *out._structure)  # the kernel's copy of Kt, W, G
+            out = Model._with_raw(out, rest)
+            out._refresh_workspace(out.params)  # the flags and copies follow the raw entries
             out.raw_overrides = {**raw, **{k: v for k, v in rest.items() if k != "Omega"}}
         return out
 
@@ -907,8 +956,17 @@ class PlanetaryGearSet(Model):
                 raise ValueError(f"sweeping {name!r} changes the model's size")
             return np.array(rows)
         P = Model.lane_params(self, name, values)
-        pk.fill_structure(P, *self._structure)  # the kernel's copy of Kt, W, G
+        self._refresh_workspace(P)
         return P
+
+    def _refresh_workspace(self, P: np.ndarray) -> None:
+        """Write the kernel's flags (``damped``, ``torque_on``) and its copy of Kt, W, G in
+        every row of ``P`` (in place) from the row's own coefficients."""
+        P = np.atleast_2d(P)
+        lay, n = self._layout, int(P[0, pk.N_DOF])
+        P[:, pk.DAMPED] = np.any(P[:, lay["Ct"]:lay["Ct"] + n * n] != 0.0, axis=1)
+        P[:, pk.TORQUE_ON] = np.any(P[:, lay["F1"]:lay["F1"] + n] != 0.0, axis=1)
+        pk.fill_structure(P, *self._structure)
 
     # ------------------------------------------------------------------ linear analysis
     def _lane_matrix(self, P: np.ndarray) -> np.ndarray:

@@ -47,12 +47,20 @@ import math
 import numba as nb
 import numpy as np
 
+from geardyn.models.planetary_coefficients import HEADER as HEADER_BLOCK
+from geardyn.models.planetary_coefficients import MESH
+
+# Index constants: the offsets of the declared coefficients (geardyn.models.planetary_coefficients)
 # header
-OMEGA, N_DOF, N_MESH, N_HARM, TORQUE_ON, TORQUE_ORDER, TORQUE_PHASE, DAMPED = range(8)
-HEADER = 8
+_H = HEADER_BLOCK.offset
+OMEGA, N_DOF, N_MESH, N_HARM = _H("Omega"), _H("n_dof"), _H("n_meshes"), _H("n_harmonics")
+TORQUE_ON, TORQUE_ORDER = _H("torque_on"), _H("torque_order")
+TORQUE_PHASE, DAMPED = _H("torque_phase"), _H("damped")
+HEADER = HEADER_BLOCK.size
 # mesh block fixed entries
-M_B, M_ES, M_EC, M_KF, M_CF = range(5)
-MESH_FIXED = 5
+_M = MESH.offset
+M_B, M_ES, M_EC, M_KF, M_CF = _M("b"), _M("E_s"), _M("E_c"), _M("KF"), _M("CF")
+MESH_FIXED = MESH.size
 #: Structural entries per mesh row in the structure section (padded with zero weights).
 MESH_NZ = 6
 #: Entries of the lane-block functions' relative-stiffness cache, and the key of an empty one (no

@@ -142,11 +142,8 @@ def simulate(
         unresolved_steps=int(unresolved),
         time_unit=model.time_unit,
     )
-    for key in ("interpretation",):
-        if hasattr(model, key):
-            ds.attrs[key] = getattr(model, key)
-    if hasattr(model, "omega_n"):
-        ds.attrs["omega_n"] = float(model.omega_n)
+    ds.attrs.update(model.dataset_attrs())
+    if "omega_n" in ds.attrs:
         ds.attrs["omega_n_units"] = "rad/s"
     other = model.other_frequencies(np.atleast_2d(model.params))[0]
     if other.size and np.isfinite(other[0]):  # a second excitation (the load fluctuation)

@@ -1,0 +1,39 @@
+"""What a model offers beyond the model interface, declared by the model's class.
+
+Analyses, io and the CLI read :attr:`geardyn.core.model.Model.capabilities` instead of probing
+attributes (``hasattr(model, "omega_n")``) or classes (``isinstance(model, CATTDevice)``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+
+@dataclass(frozen=True)
+class Capabilities:
+    """Optional capabilities of a model class.
+
+    ``frequency_scale``
+        The model's time unit is 1 / omega_n for a physical frequency ``model.omega_n``
+        [rad/s] (a dimensionless model): sweeps may hold the physical speed
+        (``hold="speed"``), and datasets record ``omega_n``.
+    ``interpretation``
+        The model reads a paper's formulas in one of several ways, ``model.interpretation``
+        (recorded in every dataset).
+    ``physical_inputs``
+        Sweeps and ``with_params`` take the model's physical inputs by name
+        (``model.physical_names``) rather than its raw coefficients.
+    ``physical_axes``
+        The model gives the physical axes of its forcing frequency itself
+        (``model.speed_axes(omega)``: mesh frequency, input speed).
+    ``paper_device``
+        A model of the CATT paper's device (``model.params_in``: its
+        :class:`~geardyn.models.params.PlanetaryParams`, read for the mesh frequency of the sun
+        gear's teeth and the length scale b_c).
+    """
+
+    frequency_scale: bool = False
+    interpretation: bool = False
+    physical_inputs: bool = False
+    physical_axes: bool = False
+    paper_device: bool = False

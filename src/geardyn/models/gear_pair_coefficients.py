@@ -1,0 +1,24 @@
+"""The gear pair's coefficients, declared once (:mod:`geardyn.core.coefficients`): the vector
+layout of :class:`~geardyn.GearPair` (in ``param_names`` order), with units, meanings, defaults
+and admissible ranges; the ``gear_pair`` study table (:class:`geardyn.io.toml.GearPairParams`)
+is generated from it."""
+
+from __future__ import annotations
+
+from geardyn.core.coefficients import Coefficient, CoefficientBlock
+
+#: The gear pair's coefficient vector: every entry an input, dimensionless (time in units of
+#: 1 / the natural frequency in contact, x in units of the backlash scale).
+GEAR_PAIR = CoefficientBlock((
+    Coefficient("Omega", "1", "mesh frequency", default=1.0, minimum=0.0),
+    Coefficient("zeta", "1", "damping ratio", default=0.05, minimum=0.0),
+    Coefficient("kappa", "1", "relative stiffness variation", default=0.0,
+                exclusive_minimum=-1.0, exclusive_maximum=1.0),
+    Coefficient("Fm", "1", "mean load", default=0.1, constant="FM"),
+    Coefficient("Fa", "1", "transmission-error amplitude", default=0.05, constant="FA"),
+    Coefficient("kappa_phase", "rad", "phase of the stiffness variation", default=0.0,
+                constant="PHI_K"),
+    Coefficient("error_phase", "rad", "phase of the transmission error", default=0.0,
+                constant="PHI_E"),
+    Coefficient("backlash", "1", "backlash half-width", default=1.0, minimum=0.0),
+))

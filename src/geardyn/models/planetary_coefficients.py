@@ -1,0 +1,80 @@
+"""The planetary gear set's coefficients, declared once (:mod:`geardyn.core.coefficients`): the
+header and mesh-block offsets are :mod:`geardyn.models.planetary_kernels`' index constants; the
+whole vector (:func:`geardyn.models.planetary.planetary_layout`) places these with the structure
+and workspace the kernel reads."""
+
+from __future__ import annotations
+
+from geardyn.core.coefficients import Coefficient, CoefficientBlock
+
+
+def _d(name: str, unit: str, meaning: str, *inputs: str, constant: str | None = None
+       ) -> Coefficient:
+    return Coefficient(name, unit, meaning, "derived", inputs, constant=constant)
+
+
+def structure_entry(name: str, meaning: str, constant: str | None = None) -> Coefficient:
+    """A structure entry (constant for the model, never a parameter)."""
+    return Coefficient(name, "1", meaning, "structure", constant=constant)
+
+
+def workspace_entry(name: str, meaning: str, constant: str | None = None) -> Coefficient:
+    """A workspace entry (written by the kernel or from other entries, never a parameter)."""
+    return Coefficient(name, "1", meaning, "workspace", constant=constant)
+
+
+_MASSES = ("mass", "inertia_over_r2")
+#: The header of the coefficient vector (offsets: :mod:`planetary_kernels`' constants).
+HEADER = CoefficientBlock((
+    Coefficient("Omega", "1", "mesh frequency / omega_0"),
+    structure_entry("n_dof", "number of coordinates"),
+    structure_entry("n_meshes", "number of meshes", constant="N_MESH"),
+    structure_entry("n_harmonics", "number of stiffness harmonics", constant="N_HARM"),
+    workspace_entry("torque_on", "1 where the torque fluctuation F1 is not zero (kernel flag)"),
+    Coefficient("torque_order", "1", "order of the input torque fluctuation"),
+    Coefficient("torque_phase", "rad", "phase of the input torque fluctuation"),
+    workspace_entry("damped", "1 where Ct is not zero (kernel flag)"),
+))
+#: Per coordinate d: F0_d, F1_d (names suffixed _d); per pair (a, b): Kt_a_b, Ct_a_b.
+FORCES = CoefficientBlock((
+    _d("F0", "1", "mean generalised force, M^-1 F / (L omega_0^2)", "sun_torque",
+       "ring_torque", "carrier_torque", *_MASSES, "length_scale", "time_scale"),
+    _d("F1", "1", "fluctuating generalised force, M^-1 F1 / (L omega_0^2)",
+       "torque_fluctuation", "sun_torque", *_MASSES, "length_scale", "time_scale"),
+))
+MATRICES = CoefficientBlock((
+    _d("Kt", "1", "bearing and support stiffness, M^-1 K / omega_0^2", "bearing_stiffness",
+       "torsional_stiffness", *_MASSES, "carrier_speed", "time_scale"),
+    _d("Ct", "1", "modal damping, M^-1 C / omega_0", "modal_damping", *_MASSES, "time_scale"),
+))
+#: One mesh block's fixed entries (names prefixed with the mesh's name, s1 .. rN).
+MESH = CoefficientBlock((
+    _d("b", "1", "backlash half-width / L", "sun_backlash", "ring_backlash", "length_scale",
+       constant="M_B"),
+    _d("E_s", "1", "transmission error / L, sine part", "sun_mesh_error", "ring_mesh_error",
+       "sun_error_phase", "ring_error_phase", "length_scale", constant="M_ES"),
+    _d("E_c", "1", "transmission error / L, cosine part", "sun_mesh_error", "ring_mesh_error",
+       "sun_error_phase", "ring_error_phase", "length_scale", constant="M_EC"),
+    _d("KF", "N", "mesh force per unit deflection X (k_m L)", "sun_mesh_stiffness",
+       "ring_mesh_stiffness", "length_scale", constant="M_KF"),
+    _d("CF", "N", "mesh force per unit deflection rate X' (c_m L omega_0)", "mesh_damping",
+       "sun_mesh_stiffness", "ring_mesh_stiffness", "length_scale", constant="M_CF"),
+))
+#: Per coordinate d of a mesh: its deflection row W_d and M^-1 W / (L omega_0^2), G_d.
+MESH_ROW = CoefficientBlock((
+    _d("W", "1", "mesh deflection row", "sun_pressure_angle", "ring_pressure_angle",
+       "planet_angles"),
+    _d("G", "1/N", "M^-1 W / (L omega_0^2)", "sun_pressure_angle", "ring_pressure_angle",
+       "planet_angles", *_MASSES, "length_scale", "time_scale"),
+))
+CARRIER_SPEED = _d("carrier_speed_tau", "1", "carrier speed Omega_c / omega_0",
+                    "carrier_speed", "carrier_speed_ratio", "time_scale")
+
+
+def harmonics_block(nh: int) -> CoefficientBlock:
+    """A mesh's relative-stiffness Fourier coefficients a1, b1, ..., a_nh, b_nh."""
+    return CoefficientBlock(tuple(
+        _d(f"{ab}{h}", "1", f"{'cosine' if ab == 'a' else 'sine'} part of harmonic {h} of the "
+           "relative mesh stiffness", "waveform", "sun_stiffness_fluctuation",
+           "ring_stiffness_fluctuation", "sun_mesh_phase", "ring_mesh_phase")
+        for h in range(1, nh + 1) for ab in "ab"))
