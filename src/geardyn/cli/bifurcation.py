@@ -97,7 +97,7 @@ def _sweepable(model) -> list[str]:
     physical = getattr(model, "physical_names", None)  # models with named physical inputs
     if physical is not None:
         return ["Omega", *physical]
-    return ["Omega", *(n for n in model.param_names if n != "Omega")]
+    return ["Omega", *(n for n in model.param_names if n != "Omega" and n not in model.derived)]
 
 
 def _check_param_name(model, param: str) -> None:

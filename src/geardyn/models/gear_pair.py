@@ -79,6 +79,7 @@ class GearPair(Model):
     event_names = ("x-b", "x+b")
     observable_names = ("F",)
     meshes = (("mesh", 0, 1),)
+    derived = DERIVED
     #: The parameters, then the derived coefficients (:data:`DERIVED`), in the kernel's order.
     param_names = ("Omega", "zeta", "kappa", "Fm", "Fa", "kappa_phase", "error_phase",
                    "backlash", *DERIVED)
