@@ -14,3 +14,11 @@ def duffing(t, y, dydt, p):
     delta, gamma, omega = p[0], p[1], p[2]
     dydt[0] = y[1]
     dydt[1] = -delta * y[1] + y[0] - y[0] ** 3 + gamma * math.cos(omega * t)
+
+
+@numba.njit(cache=True)
+def duffing_one(t, y, p, s, c):
+    """The same oscillator in the one form (the way to write a model, see
+    geardyn.UserModel.from_one_form): y = (x, v), the coefficients by name, c = cos(Omega t)."""
+    x, v = y
+    return (v, -p.delta * v + x - x * x * x + p.gamma * c)

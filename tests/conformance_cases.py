@@ -5,11 +5,16 @@ model has them."""
 from __future__ import annotations
 
 import math
+import sys
+from pathlib import Path
 
 import numba
 import numpy as np
 
 import geardyn
+
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "examples"))
+from gear_pair_model import gear_pair  # noqa: E402 - the gear pair as a one-form user model
 
 _JIT = {"cache": True, "error_model": "numpy", "boundscheck": False}
 #: The user model's coefficients: backlash half-width, damping ratio, force amplitude,
@@ -91,9 +96,10 @@ def cases() -> dict[str, tuple[geardyn.Model, np.ndarray]]:
         "DimensionalCATT": (dim, dim.initial_state()),
         "GearPair": (pair, np.zeros(2)),
         "UserModel": (user, np.array([1.0, 0.0])),
+        "UserModel-one-form": (gear_pair(Omega=1.3, kappa=0.2, Fa=0.2), np.zeros(2)),
         "PlanetaryGearSet": (gs, gs.initial_state() + kick),
     }
 
 
 IDS = ("CATTDevice-reduced", "CATTDevice-general", "DimensionalCATT", "GearPair", "UserModel",
-       "PlanetaryGearSet")
+       "UserModel-one-form", "PlanetaryGearSet")

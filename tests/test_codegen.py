@@ -20,7 +20,7 @@ from geardyn.solvers.reference import reference_solution
 
 #: Modules a generated kernel may import besides the model's own.
 _ALLOWED = {"__future__", "math", "numba", "numpy", "llvmlite", "geardyn.core._noop",
-            "geardyn.core.kernel_source"}
+            "geardyn.core.kernel_source", "geardyn.core.one_form"}
 #: Packages whose submodules a generated kernel may import too (numba.extending, numba.core:
 #: the sweep template's prefetch intrinsic).
 _ALLOWED_PACKAGES = {"numba", "llvmlite"}

@@ -139,29 +139,26 @@ def test_gear_pair_rk4_matches_reference(kappa, omega):
     assert p > 3.7
 
 
-def test_lanes_in_both_lane_forms_equal_single_simulations_bitwise():
-    # the sweep kernel runs the gear pair in its fused step loop (lane-scalar functions): lanes
-    # with both phases 0 in the quiet form (vectorised), the others in the general form, in
-    # one queue; each lane must equal simulate (the one-lane path, the array functions)
-    from geardyn.core.kernel_source import FORM_QUIET
-    from geardyn.models.gear_pair import gear_pair_rhs_lane_form
+def test_phased_and_unphased_lanes_equal_single_simulations_bitwise():
+    # the sweep kernel runs the gear pair in its fused step loop (lane-scalar layout generated
+    # from the one form), phased and unphased lanes in one queue (the phases' cos and sin are
+    # derived coefficients); each lane must equal simulate (the one-lane path, array layout)
     from geardyn.solvers.ensemble import run_lanes
     from geardyn.solvers.kernels import kernels_for
 
     m = geardyn.GearPair(zeta=0.05, kappa=0.2, Fm=0.1, Fa=0.2)
     assert kernels_for(m.kernel).FUSED
     omegas = np.array([0.5, 0.8, 1.1, 1.6, 2.1, 2.7, 0.9, 1.3])
-    P = m.lane_params("Omega", omegas)
-    ik, ie = m.param_names.index("kappa_phase"), m.param_names.index("error_phase")
-    P[1::3, ik] = 0.3
-    P[2::3, ie] = -0.7
-    forms = [gear_pair_rhs_lane_form(np.ascontiguousarray(P.T), j) for j in range(P.shape[0])]
-    assert forms.count(FORM_QUIET) == 3  # lanes 0, 3, 6
+    phases = [(0.0, 0.0), (0.3, 0.0), (0.0, -0.7)]
+    P = np.array([m.with_params(Omega=float(om), kappa_phase=phases[j % 3][0],
+                                error_phase=phases[j % 3][1]).params
+                  for j, om in enumerate(omegas)])
     r = run_lanes(m, P, m.initial_state(), 300.0, 6, steps_per_period=64)
     assert np.all(r.status == 0)
     assert np.sum(r.crossings) > 40  # contact lost and regained: the split ran
     for j in range(omegas.size):
-        mj = m.with_params(kappa_phase=float(P[j, ik]), error_phase=float(P[j, ie]))
+        kp, ep = phases[j % 3]
+        mj = m.with_params(kappa_phase=kp, error_phase=ep)
         ds = geardyn.simulate(mj, omega=omegas[j], transient=300.0, periods=6,
                               steps_per_period=64)
         np.testing.assert_array_equal(r.samples[j], ds["poincare"].values[1:])

@@ -160,6 +160,10 @@ def _functions(model: Model) -> list[_Fn]:
     sin/cos(Omega t) filled in from t)."""
     ks: KernelSource = model.kernel
     om = model.omega
+    if ks.one_form is not None:  # the generated array form of the one form (see core.one_form)
+        gen = kernels_for(ks)
+        ks = KernelSource(gen.rhs, gen.events if ks.events is not None else None,
+                          gen.observe if ks.observe is not None else None)
 
     def with_phase(fn: Any) -> Callable:
         if ks.plain:
@@ -281,8 +285,9 @@ def _check_kernel(model: Model) -> None:
     ks = model.kernel
     if not isinstance(ks, KernelSource):
         raise _Broken(f"kernel must be a KernelSource (got {type(ks).__name__})")
-    phase = 4 if ks.plain else 6
-    for label, fn, n in (("rhs", ks.rhs, (phase,)), ("events", ks.events, (6, 4)),
+    phase = 4 if ks.plain else (5 if ks.one_form is not None else 6)
+    for label, fn, n in (("rhs", ks.rhs, (phase,)),
+                         ("events", ks.events, (5,) if ks.one_form is not None else (6, 4)),
                          ("observe", ks.observe, (phase,))):
         if fn is None:
             continue

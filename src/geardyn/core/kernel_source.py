@@ -14,6 +14,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from geardyn.core import _noop
+from geardyn.core.one_form import OneForm
 
 __all__ = ["FORM_GENERAL", "FORM_LOAD", "FORM_QUIET", "LANE_FORMS", "KernelSource",
            "events_take_phase"]
@@ -39,8 +40,15 @@ class KernelSource:
     #: phase arguments; the generated kernel adapts them. ``events`` is adapted wherever it
     #: takes ``(t, y, g, p)`` (:func:`events_take_phase`), plain or not.
     plain: bool = False
+    #: Set where the functions are in the one form (:mod:`geardyn.core.one_form`):
+    #: ``rhs(t, y, p, s, c) -> tuple`` etc.; the generated kernel writes every layout from them.
+    one_form: OneForm | None = None
 
     def functions(self) -> dict[str, Any]:
+        if self.one_form is not None:
+            return {f"one_{name}": fn for name, fn in
+                    (("rhs", self.rhs), ("events", self.events), ("observe", self.observe))
+                    if fn is not None}
         prefix = "user_" if self.plain else ""
         events = self.events if self.events is not None else _noop.no_events
         funcs = {

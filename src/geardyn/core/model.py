@@ -30,8 +30,10 @@ This module belongs to the core: it imports nothing of geardyn outside :mod:`gea
 from __future__ import annotations
 
 import copy
+import copy
 import functools
-from collections.abc import Sequence
+from collections.abc import Callable, Mapping, Sequence
+from types import MappingProxyType
 
 import numpy as np
 
@@ -84,7 +86,10 @@ class Model:
     4. **kernel functions** -- ``kernel.rhs``, ``kernel.events`` and ``kernel.observe`` are
        ``numba.njit`` functions with the interface's arguments: ``rhs(t, y, dy, p, s, c)``,
        ``events(t, y, g, p, s, c)`` (or ``events(t, y, g, p)``), ``observe(t, y, o, p, s, c)``
-       (``rhs(t, y, dy, p)`` and ``observe(t, y, o, p)`` when ``kernel.plain``); ``s, c`` are
+       (``rhs(t, y, dy, p)`` and ``observe(t, y, o, p)`` when ``kernel.plain``; in the one
+       form, ``kernel.one_form`` set, tuple-valued ``rhs(t, y, p, s, c)``, ``events`` and
+       ``observe`` alike, from which the engine generates this interface, see
+       :mod:`geardyn.core.one_form`); ``s, c`` are
        sin and cos of the forcing phase (above), supplied by the solver (0 and 1 for an
        autonomous model). ``events`` is
        given exactly when ``event_names`` is non-empty, ``observe`` exactly when
@@ -134,6 +139,10 @@ class Model:
     kernel: KernelSource
     #: Meshes with a backlash dead zone: (name, index of event X - b, index of event X + b).
     meshes: tuple[tuple[str, int, int], ...] = ()
+    #: Derived coefficients (entries of ``params`` after the parameters): name -> (the parameter
+    #: it follows, the function of its value); they follow it and are not set on their own
+    #: (see :func:`geardyn.core.one_form.fill_derived`).
+    derived: Mapping[str, tuple[str, Callable[[float], float]]] = MappingProxyType({})
     #: Omega is one entry of ``params`` and no other coefficient depends on it, so a lane's
     #: Omega may be set by writing that entry; False where Omega moves other coefficients (set
     #: it through ``lane_params``/``with_params``).

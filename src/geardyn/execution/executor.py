@@ -34,6 +34,7 @@ import numpy as np
 from geardyn._version import __version__
 from geardyn.core.kernel_source import KernelSource
 from geardyn.core.model import Model
+from geardyn.core.one_form import OneForm
 from geardyn.execution.zarr_store import LaneStore
 from geardyn.solvers.ensemble import LaneResults, run_lanes
 
@@ -98,6 +99,7 @@ class PortableModel:
     refs: dict[str, tuple[str, str] | None]
     by_value: dict[str, Any]
     plain: bool
+    one_form: OneForm | None = None
     _unpacked: Model | None = field(default=None, repr=False, compare=False)
 
     def unpack(self) -> Model:
@@ -107,7 +109,7 @@ class PortableModel:
                      for name, ref in self.refs.items()}
             model = copy.copy(self.model)
             model.kernel = KernelSource(funcs["rhs"], funcs["events"], funcs["observe"],
-                                        plain=self.plain)
+                                        plain=self.plain, one_form=self.one_form)
             self._unpacked = model
         return self._unpacked
 
@@ -125,7 +127,7 @@ def portable(model: Model) -> PortableModel:
     by_value = {name: fn for name, fn in funcs.items() if fn is not None and refs[name] is None}
     bare = copy.copy(model)
     bare.kernel = None  # type: ignore[assignment]
-    return PortableModel(bare, refs, by_value, bool(k.plain))
+    return PortableModel(bare, refs, by_value, bool(k.plain), k.one_form)
 
 
 def _run_portable(task: LaneTask, packed: PortableModel, inputs: dict[str, np.ndarray]
@@ -189,7 +191,8 @@ def inputs_digest(task: LaneTask, model: Model, inputs: Mapping[str, np.ndarray]
         "model": [type(model).__module__, type(model).__qualname__, model.name,
                   list(model.state_names)],
         "kernel": [r or repr(f) for r, f in zip(refs, (k.rhs, k.events, k.observe),
-                                                strict=True)],
+                                                strict=True)]
+        + ([repr(k.one_form)] if k.one_form is not None else []),
         "meta": meta or {},
     }
     h.update(json.dumps(head, sort_keys=True, default=repr).encode())

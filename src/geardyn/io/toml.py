@@ -250,11 +250,11 @@ class PaperBase(BaseModel):
 
 def study_table(name: str, block: CoefficientBlock, doc: str) -> type[BaseModel]:
     """A ``[params]`` table generated from a model's declared coefficients: one field per
-    parameter of ``block`` (its default, range and meaning; an angle for a unit of rad, else a
+    input of ``block`` (derived entries follow their inputs; its default, range and meaning; an angle for a unit of rad, else a
     number), unknown keys refused naming the field."""
     fields: dict[str, Any] = {}
     for c in block.entries:
-        if not c.is_parameter:
+        if c.kind != "input":
             continue
         kind: Any = Angle if c.unit == "rad" else Real
         limits = {k: v for k, v in (("ge", c.minimum), ("le", c.maximum),

@@ -11,166 +11,60 @@ static transmission error of amplitude Fa, kappa the relative stiffness variatio
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 
 import numba as nb
 import numpy as np
 
-from geardyn.core.kernel_source import FORM_GENERAL, FORM_QUIET, KernelSource
+from geardyn.core.coefficients import CoefficientLayout
+from geardyn.core.kernel_source import KernelSource
 from geardyn.core.model import Model
-from geardyn.models.catt_kernels import dead_zone
+from geardyn.core.one_form import OneForm, fill_derived, refuse_derived
+from geardyn.models.elements import dead_zone
+from geardyn.models.gear_pair_coefficients import GEAR_PAIR
 
 _JIT = {"cache": True, "error_model": "numpy", "boundscheck": False}
-OMEGA, ZETA, KAPPA, FM, FA, PHI_K, PHI_E, BACKLASH = range(8)
+#: Index constants of the declared coefficients (models/gear_pair_coefficients.py).
+OMEGA, ZETA, KAPPA, FM, FA, PHI_K, PHI_E, BACKLASH, COS_K, SIN_K, COS_E, SIN_E = (
+    GEAR_PAIR.offset(n) for n in GEAR_PAIR.names)
+_LAYOUT = CoefficientLayout.of(GEAR_PAIR, model="GearPair")
+
+# The model in the one form (geardyn.core.one_form): y = (x, v), p the lane's coefficients by
+# name, s and c sin and cos of the forcing phase; the phases enter through their cos and sin,
+# derived coefficients (no libm call per step: the sweep's lane loop vectorises).
 
 
 @nb.njit(**_JIT)
-def gear_pair_rhs(t, y, dy, p, s, c):
-    x = y[0]
-    b = p[BACKLASH]
-    g = x - b if x > b else (x + b if x < -b else 0.0)
-    ck = c * math.cos(p[PHI_K]) - s * math.sin(p[PHI_K])
-    ce = c * math.cos(p[PHI_E]) - s * math.sin(p[PHI_E])
-    dy[0] = y[1]
-    dy[1] = (p[FM] + p[FA] * p[OMEGA] * p[OMEGA] * ce - 2.0 * p[ZETA] * y[1]
-             - (1.0 + p[KAPPA] * ck) * g)
-
-
-@nb.njit(**_JIT)
-def gear_pair_events(t, y, g, p, s, c):
-    g[0] = y[0] - p[BACKLASH]
-    g[1] = y[0] + p[BACKLASH]
-
-
-@nb.njit(**_JIT)
-def gear_pair_observe(t, y, out, p, s, c):
-    x = y[0]
-    b = p[BACKLASH]
-    g = x - b if x > b else (x + b if x < -b else 0.0)
-    ck = c * math.cos(p[PHI_K]) - s * math.sin(p[PHI_K])
-    out[0] = (1.0 + p[KAPPA] * ck) * g + 2.0 * p[ZETA] * y[1]
-
-
-# Lane-block forms for the sweep kernel (picked up by name, ``<function>_lanes``): the same
-# arithmetic as the functions above, operation for operation, on lanes 0..nl-1 of a block in
-# structure-of-arrays layout (state Y[q, k], coefficients PT[j, k], forcing phase S[k], C[k]
-# per lane); the lane loops vectorise. SC: scratch rows (>= 4) of the block's width.
-
-
-@nb.njit(inline="always", **_JIT)
-def _phase_factors(PT, nl, SC):
-    """cos and sin of the stiffness and error phases of every lane into SC rows 0-3 (no libm
-    call when a phase is 0: cos 0 = 1 and sin 0 = 0 exactly)."""
-    phased = False
-    for k in range(nl):
-        SC[0, k] = 1.0
-        SC[1, k] = 0.0
-        SC[2, k] = 1.0
-        SC[3, k] = 0.0
-        phased |= (PT[PHI_K, k] != 0.0) | (PT[PHI_E, k] != 0.0)
-    if not phased:  # no libm call in the common case (a guarded call may be speculated)
-        return
-    for k in range(nl):
-        if PT[PHI_K, k] != 0.0:
-            SC[0, k] = math.cos(PT[PHI_K, k])
-            SC[1, k] = math.sin(PT[PHI_K, k])
-        if PT[PHI_E, k] != 0.0:
-            SC[2, k] = math.cos(PT[PHI_E, k])
-            SC[3, k] = math.sin(PT[PHI_E, k])
-
-
-@nb.njit(**_JIT)
-def gear_pair_rhs_lanes(T, Y, DY, PT, nl, S, C, SC):
-    """:func:`gear_pair_rhs` for lanes 0..nl-1 of a block."""
-    _phase_factors(PT, nl, SC)
-    for k in range(nl):
-        x = Y[0, k]
-        b = PT[BACKLASH, k]
-        g = x - b if x > b else (x + b if x < -b else 0.0)
-        ck = C[k] * SC[0, k] - S[k] * SC[1, k]
-        ce = C[k] * SC[2, k] - S[k] * SC[3, k]
-        om = PT[OMEGA, k]
-        DY[0, k] = Y[1, k]
-        DY[1, k] = (PT[FM, k] + PT[FA, k] * om * om * ce - 2.0 * PT[ZETA, k] * Y[1, k]
-                    - (1.0 + PT[KAPPA, k] * ck) * g)
-
-
-@nb.njit(**_JIT)
-def gear_pair_events_lanes(T, Y, G, PT, nl, S, C):
-    """:func:`gear_pair_events` for lanes 0..nl-1 of a block."""
-    for k in range(nl):
-        G[0, k] = Y[0, k] - PT[BACKLASH, k]
-        G[1, k] = Y[0, k] + PT[BACKLASH, k]
-
-
-@nb.njit(**_JIT)
-def gear_pair_observe_lanes(T, Y, O, PT, nl, S, C, SC):
-    """:func:`gear_pair_observe` for lanes 0..nl-1 of a block."""
-    _phase_factors(PT, nl, SC)
-    for k in range(nl):
-        x = Y[0, k]
-        b = PT[BACKLASH, k]
-        g = x - b if x > b else (x + b if x < -b else 0.0)
-        ck = C[k] * SC[0, k] - S[k] * SC[1, k]
-        O[0, k] = (1.0 + PT[KAPPA, k] * ck) * g + 2.0 * PT[ZETA, k] * Y[1, k]
-
-
-# Lane-scalar forms for the sweep kernel's fused step loop (picked up by name, ``<function>_lane``):
-# lane k of a block (coefficients PT[j, k]), the state and the results as tuples, the same
-# arithmetic as the functions above operation for operation (bitwise equal). FORM_QUIET: both
-# phases 0, where cos 0 = 1 and sin 0 = 0 exactly (no libm call: the loop vectorises);
-# FORM_GENERAL: any lane (libm for the phases; scalar). The model has no FORM_LOAD.
-
-#: State size of the lane-scalar forms (the tuples' length).
-gear_pair_rhs_lane_states = 2
-
-
-@nb.njit(inline="always", **_JIT)
-def _unphased(PT, k):
-    """True where lane k's stiffness and error phases are both 0."""
-    return (PT[PHI_K, k] == 0.0) & (PT[PHI_E, k] == 0.0)
-
-
-@nb.njit(**_JIT)
-def gear_pair_rhs_lane_form(PT, k):
-    """The lane form lane k may take: FORM_QUIET where both phases are 0, else FORM_GENERAL."""
-    return FORM_QUIET if _unphased(PT, k) else FORM_GENERAL
-
-
-@nb.njit(inline="always", **_JIT)
-def _phase_lane(PT, k, s, c, form):
-    """(ck, ce) of lane k: the stiffness and error phases' cosines as the other forms compute
-    them (``c cos(phi) - s sin(phi)``; cos 0 = 1 and sin 0 = 0 exactly, in libm too). The
-    general form (the split path's, for every lane) calls libm only where a phase is not 0."""
-    if form == FORM_QUIET or _unphased(PT, k):
-        return c * 1.0 - s * 0.0, c * 1.0 - s * 0.0
-    pk = PT[PHI_K, k]
-    pe = PT[PHI_E, k]
-    return c * math.cos(pk) - s * math.sin(pk), c * math.cos(pe) - s * math.sin(pe)
-
-
-@nb.njit(inline="always", **_JIT)
-def gear_pair_rhs_lane(t, y, PT, k, s, c, form):
-    """:func:`gear_pair_rhs` of lane k: dy/dt as a tuple."""
+def gear_pair_rhs(t, y, p, s, c):
     x, v = y
-    g = dead_zone(x, PT[BACKLASH, k])  # the other forms' g, branch-free: the same values
-    ck, ce = _phase_lane(PT, k, s, c, form)
-    om = PT[OMEGA, k]
-    return (v, PT[FM, k] + PT[FA, k] * om * om * ce - 2.0 * PT[ZETA, k] * v
-            - (1.0 + PT[KAPPA, k] * ck) * g)
+    g = dead_zone(x, p.backlash)
+    ck = c * p.cos_kappa_phase - s * p.sin_kappa_phase
+    ce = c * p.cos_error_phase - s * p.sin_error_phase
+    return (v, p.Fm + p.Fa * p.Omega * p.Omega * ce - 2.0 * p.zeta * v
+            - (1.0 + p.kappa * ck) * g)
 
 
-@nb.njit(inline="always", **_JIT)
-def gear_pair_events_lane(t, y, PT, k, s, c):
-    """:func:`gear_pair_events` of lane k, as a tuple."""
-    return (y[0] - PT[BACKLASH, k], y[0] + PT[BACKLASH, k])
+@nb.njit(**_JIT)
+def gear_pair_events(t, y, p, s, c):
+    return (y[0] - p.backlash, y[0] + p.backlash)
 
 
-@nb.njit(inline="always", **_JIT)
-def gear_pair_observe_lane(t, y, PT, k, s, c, form):
-    """:func:`gear_pair_observe` of lane k, as a tuple."""
-    g = dead_zone(y[0], PT[BACKLASH, k])
-    ck, _ = _phase_lane(PT, k, s, c, form)
-    return ((1.0 + PT[KAPPA, k] * ck) * g + 2.0 * PT[ZETA, k] * y[1],)
+@nb.njit(**_JIT)
+def gear_pair_observe(t, y, p, s, c):
+    g = dead_zone(y[0], p.backlash)
+    ck = c * p.cos_kappa_phase - s * p.sin_kappa_phase
+    return ((1.0 + p.kappa * ck) * g + 2.0 * p.zeta * y[1],)
+
+
+#: Derived coefficients: name -> (the parameter it follows, the function of it), computed with
+#: Python's ``math`` (the libm of the compiled code: cos 0 = 1 and sin 0 = 0 exactly).
+DERIVED = {"cos_kappa_phase": ("kappa_phase", math.cos),
+           "sin_kappa_phase": ("kappa_phase", math.sin),
+           "cos_error_phase": ("error_phase", math.cos),
+           "sin_error_phase": ("error_phase", math.sin)}
+
+_KERNEL = KernelSource(gear_pair_rhs, gear_pair_events, gear_pair_observe,
+                       one_form=OneForm(GEAR_PAIR.names, 2, 2, 1))
 
 
 class GearPair(Model):
@@ -187,7 +81,10 @@ class GearPair(Model):
     event_names = ("x-b", "x+b")
     observable_names = ("F",)
     meshes = (("mesh", 0, 1),)
-    param_names = ("Omega", "zeta", "kappa", "Fm", "Fa", "kappa_phase", "error_phase", "backlash")
+    derived = DERIVED
+    #: The declared coefficients (:data:`~geardyn.models.gear_pair_coefficients.GEAR_PAIR`):
+    #: the parameters, then the derived coefficients (:data:`DERIVED`), in the kernel's order.
+    param_names = GEAR_PAIR.names
 
     def __init__(self, zeta: float = 0.05, kappa: float = 0.0, Fm: float = 0.1, Fa: float = 0.05,
                  Omega: float = 1.0, kappa_phase: float = 0.0, error_phase: float = 0.0,
@@ -206,17 +103,31 @@ class GearPair(Model):
             raise ValueError(f"backlash: must be >= 0 (got {backlash!r})")
         if Omega < 0:
             raise ValueError(f"Omega: must be >= 0 (got {Omega!r})")
-        self.params = np.array([float(values[k]) for k in self.param_names])
+        self.params = np.array([float(values[k]) for k in self.param_names[:COS_K]]
+                               + [0.0] * len(DERIVED))
+        fill_derived(self.params, self.param_names, DERIVED)
+        self.coefficient_layout = _LAYOUT
         self.omega_index = OMEGA
-        self.kernel = KernelSource(gear_pair_rhs, gear_pair_events, gear_pair_observe)
+        self.kernel = _KERNEL
 
     def with_params(self, **values: float) -> GearPair:
         """A copy with parameters changed by name, validated as in the constructor (every
-        derived quantity reads the coefficient vector, so it follows)."""
-        current = dict(zip(self.param_names, (float(v) for v in self.params), strict=True))
+        derived quantity reads the coefficient vector, so it follows). The derived coefficients
+        (:data:`DERIVED`) follow their parameter and cannot be set."""
+        refuse_derived(values, DERIVED)
+        current = dict(zip(self.param_names[:COS_K], (float(v) for v in self.params),
+                           strict=False))
         for name in values:
             self._param_index(name)  # unknown names: KeyError naming the known ones
         return type(self)(**{**current, **{k: float(v) for k, v in values.items()}})
+
+    def lane_params(self, name: str, values: Sequence[float] | np.ndarray) -> np.ndarray:
+        """Coefficient vectors with ``name`` set to ``values``, the derived coefficients
+        following it."""
+        refuse_derived((name,), DERIVED)
+        P = Model.lane_params(self, name, values)
+        fill_derived(P, self.param_names, DERIVED)
+        return P
 
     def fastest_natural_frequency(self, P: np.ndarray | None = None) -> np.ndarray:
         """The linear natural frequency in contact, 1 in every lane (time is scaled by it)."""

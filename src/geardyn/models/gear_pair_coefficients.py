@@ -1,13 +1,15 @@
 """The gear pair's coefficients, declared once (:mod:`geardyn.core.coefficients`): the vector
 layout of :class:`~geardyn.GearPair` (in ``param_names`` order), with units, meanings, defaults
 and admissible ranges; the ``gear_pair`` study table (:class:`geardyn.io.toml.GearPairParams`)
-is generated from it."""
+is generated from its inputs."""
 
 from __future__ import annotations
 
 from geardyn.core.coefficients import Coefficient, CoefficientBlock
 
-#: The gear pair's coefficient vector: every entry an input, dimensionless (time in units of
+#: The gear pair's coefficient vector: eight inputs, then the cos and sin of the two phases
+#: (derived: computed by :class:`~geardyn.GearPair` from the phases, so that no lane calls libm
+#: per step); dimensionless (time in units of
 #: 1 / the natural frequency in contact, x in units of the backlash scale).
 GEAR_PAIR = CoefficientBlock((
     Coefficient("Omega", "1", "mesh frequency", default=1.0, minimum=0.0),
@@ -21,4 +23,14 @@ GEAR_PAIR = CoefficientBlock((
     Coefficient("error_phase", "rad", "phase of the transmission error", default=0.0,
                 constant="PHI_E"),
     Coefficient("backlash", "1", "backlash half-width", default=1.0, minimum=0.0),
+    Coefficient("cos_kappa_phase", "1", "cos of the stiffness phase", kind="derived",
+                derived_from=("kappa_phase",), constant="COS_K"),
+    Coefficient("sin_kappa_phase", "1", "sin of the stiffness phase", kind="derived",
+                derived_from=("kappa_phase",), constant="SIN_K"),
+    Coefficient("cos_error_phase", "1", "cos of the error phase", kind="derived",
+                derived_from=("error_phase",), constant="COS_E"),
+    Coefficient("sin_error_phase", "1", "sin of the error phase", kind="derived",
+                derived_from=("error_phase",), constant="SIN_E"),
 ))
+#: The study file's fields: the inputs.
+INPUTS = tuple(c.name for c in GEAR_PAIR.entries if c.kind == "input")

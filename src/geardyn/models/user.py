@@ -1,18 +1,40 @@
-"""A user's own model: any numba-compiled right-hand side, through the same solvers and analyses."""
+"""A user's own model: any numba-compiled right-hand side, through the same solvers and analyses.
+
+The way to write one is the one form (:meth:`UserModel.from_one_form`, see
+:mod:`geardyn.core.one_form`): the physics once, per lane, as tuple-valued functions that read
+the coefficients by name; it runs on the same vectorised path as the built-in models and may
+declare its meshes. The constructor's plain ``rhs(t, y, dydt, p)`` (writing dydt in place) is
+the legacy form: it runs on the generic per-lane path, several times slower on a sweep.
+"""
 
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
+from typing import Any
 
 import numpy as np
 
 from geardyn.core.kernel_source import KernelSource
 from geardyn.core.model import Model, unique_rows
+from geardyn.core.one_form import (
+    Derivations,
+    OneForm,
+    check_names,
+    coefficient_type,
+    fill_derived,
+    refuse_derived,
+)
+
+#: A mesh of :meth:`UserModel.from_one_form`: (name, drive event, back event) or (name, drive
+#: event, back event, force observable), events and observables by name or index.
+MeshSpec = tuple[str, str | int, str | int] | tuple[str, str | int, str | int, str | int]
 
 
 class UserModel(Model):
-    """Wrap a compiled ``rhs(t, y, dydt, p)`` (writing dydt in place) as a geardyn model.
+    """A user's model. Write it in the one form with :meth:`from_one_form` (the fast path);
+    the constructor wraps a compiled ``rhs(t, y, dydt, p)`` (writing dydt in place: the legacy
+    form, on the generic, slower sweep path).
 
     Parameters
     ----------
@@ -58,9 +80,19 @@ class UserModel(Model):
         name: str = "UserModel",
         natural_frequency: float | Callable[[np.ndarray], float] | None = None,
     ):
-        for fn, label in ((rhs, "rhs"), (events, "events"), (observe, "observe")):
-            if fn is not None and not hasattr(fn, "py_func"):
-                raise TypeError(f"{label} must be a numba.njit-compiled function")
+        _check_compiled(rhs, events, observe)
+        self._setup(n_states, params, period, state_names, param_names, name, natural_frequency)
+        if events is not None and n_events < 1:
+            raise ValueError("events given: set n_events to the number of switching functions")
+        self.event_names = tuple(f"event{j}" for j in range(n_events if events else 0))
+        self.observable_names = tuple(observable_names) if observe is not None else ()
+        self.kernel = KernelSource(rhs, events, observe, plain=True)
+
+    def _setup(self, n_states: int, params: Sequence[float] | np.ndarray, period: float | None,
+               state_names: Sequence[str] | None, param_names: Sequence[str] | None,
+               name: str, natural_frequency: float | Callable[[np.ndarray], float] | None
+               ) -> None:
+        """Sizes, names, coefficients and forcing, as the constructor documents them."""
         if n_states < 1:
             raise ValueError(f"n_states must be >= 1 (got {n_states})")
         p = np.asarray(params, dtype=float).ravel()
@@ -73,10 +105,6 @@ class UserModel(Model):
         names = list(param_names or (f"p{i}" for i in range(p.size)))
         if len(names) != p.size:
             raise ValueError(f"param_names has {len(names)} names for {p.size} parameters")
-        if events is not None and n_events < 1:
-            raise ValueError("events given: set n_events to the number of switching functions")
-        self.event_names = tuple(f"event{j}" for j in range(n_events if events else 0))
-        self.observable_names = tuple(observable_names) if observe is not None else ()
         if "Omega" in names:
             self.omega_index = names.index("Omega")
         elif period is not None:
@@ -94,7 +122,137 @@ class UserModel(Model):
             raise ValueError(f"natural_frequency must be > 0 or a function of p "
                              f"(got {natural_frequency!r})")
         self.natural_frequency = natural_frequency
-        self.kernel = KernelSource(rhs, events, observe, plain=True)
+        self.derived: Derivations = {}
+        self._static_forces: Callable[[Any], Sequence[float]] | None = None
+        self._initial: Sequence[float] | Callable[[Any], Sequence[float]] | None = None
+
+    @classmethod
+    def from_one_form(
+        cls,
+        rhs: Callable,
+        params: Mapping[str, float],
+        states: Sequence[str],
+        *,
+        events: Callable | None = None,
+        event_names: Sequence[str] = (),
+        observe: Callable | None = None,
+        observable_names: Sequence[str] = (),
+        meshes: Sequence[MeshSpec] = (),
+        static_forces: Callable[[Any], Sequence[float]] | None = None,
+        derived: Derivations | None = None,
+        initial_state: Sequence[float] | Callable[[Any], Sequence[float]] | None = None,
+        period: float | None = None,
+        name: str = "UserModel",
+        natural_frequency: float | Callable[[np.ndarray], float] | None = None,
+    ) -> UserModel:
+        """A model written in the one form (:mod:`geardyn.core.one_form`).
+
+        Parameters
+        ----------
+        rhs
+            ``numba.njit`` function ``rhs(t, y, p, s, c)`` returning dy/dt as a tuple: ``y``
+            the state (a tuple), ``p`` the coefficients by name (``p.zeta``), ``s, c`` sin and
+            cos of the forcing phase Omega (t - t0) (0 and 1 for an autonomous model). Define
+            it in an importable module (not ``__main__``) and its kernels are cached on disk.
+        params
+            The coefficients by name, in order: ``{"Omega": 1.2, "zeta": 0.05, ...}``. With
+            ``"Omega"`` among them the model is forced at that frequency (sweeps over
+            ``"Omega"`` work); else ``period`` forces it (a hidden ``Omega`` is appended), or
+            it is autonomous. Names are Python identifiers.
+        states
+            The state names (their number is the state size).
+        events, event_names
+            Optional ``events(t, y, p, s, c)`` returning the switching functions (zeros at the
+            kinks of ``rhs``, e.g. ``x - b`` and ``x + b`` of a dead zone) and their names.
+        observe, observable_names
+            Optional ``observe(t, y, p, s, c)`` returning the observables, and their names.
+        meshes
+            Backlash meshes ``(name, drive event, back event)`` (``x - b`` and ``x + b``), by
+            event name or index: contact regimes are reported for them. A fourth entry names
+            the mesh's force observable; then every mesh names one, the observables are these
+            forces in mesh order, and peak/RMS forces are reported (and the dynamic factor
+            where ``static_forces`` is given).
+        static_forces
+            ``static_forces(p)``: the static force of each mesh from the coefficients (named
+            tuple), for the dynamic factor.
+        derived
+            Derived coefficients: ``{"cos_phi": ("phi", math.cos)}``; each is a coefficient
+            (after ``params``) that follows its parameter (computed once per value with the
+            Python function) and cannot be set itself. Use it for a cos/sin of a coefficient,
+            so that ``rhs`` calls no libm routine per step and the sweep vectorises.
+        initial_state
+            The default start state: a sequence, or a function of the coefficients (default
+            zeros).
+        period, name, natural_frequency
+            As in the constructor.
+        """
+        _check_compiled(rhs, events, observe)
+        derived = dict(derived or {})
+        names = [*params, *derived]
+        values = [float(v) for v in params.values()] + [0.0] * len(derived)
+        for key, (src, fn) in derived.items():
+            if src not in params or not callable(fn):
+                raise ValueError(f"derived {key!r}: needs (parameter, function), the parameter "
+                                 f"one of params (got {(src, fn)!r})")
+        check_names(tuple(names))
+        event_names = tuple(event_names) if events is not None else ()
+        if events is not None and not event_names:
+            raise ValueError("events given: name the switching functions (event_names)")
+        if observe is not None and not observable_names:
+            raise ValueError("observe given: name the observables (observable_names)")
+        model = cls.__new__(cls)
+        model._setup(len(states), values, period, states, names, name, natural_frequency)
+        fill_derived(model.params, model.param_names, derived)
+        model.event_names = event_names
+        model.observable_names = tuple(observable_names) if observe is not None else ()
+        model.meshes = _meshes(meshes, model.event_names, model.observable_names)
+        model.derived = derived
+        model._static_forces = static_forces
+        model._initial = initial_state
+        model.kernel = KernelSource(rhs, events, observe, one_form=OneForm(
+            model.param_names, model.n_states, model.n_events, model.n_observables))
+        return model
+
+    def coefficients(self, p: np.ndarray | None = None) -> Any:
+        """The coefficients ``p`` (default the model's) as the one form's named tuple."""
+        row = self.params if p is None else np.asarray(p, dtype=float)
+        return coefficient_type(self.param_names)(*(float(v) for v in row))
+
+    def with_params(self, **values: float) -> UserModel:
+        """A copy with parameters changed by name (derived coefficients follow them)."""
+        refuse_derived(values, self.derived)
+        out = Model.with_params(self, **values)
+        fill_derived(out.params, self.param_names, self.derived)
+        return out
+
+    def lane_params(self, name: str, values: Sequence[float] | np.ndarray) -> np.ndarray:
+        """Coefficient vectors with ``name`` set to ``values`` (derived coefficients follow)."""
+        refuse_derived((name,), self.derived)
+        P = Model.lane_params(self, name, values)
+        fill_derived(P, self.param_names, self.derived)
+        return P
+
+    def initial_state(self) -> np.ndarray:
+        """The declared start state (``initial_state`` of :meth:`from_one_form`), else zeros."""
+        init = self._initial
+        if init is None:
+            return np.zeros(self.n_states)
+        y = np.asarray(init(self.coefficients()) if callable(init) else init, dtype=float)
+        if y.shape != (self.n_states,):
+            raise ValueError(f"initial_state has shape {y.shape}; the model has "
+                             f"{self.n_states} states")
+        return y
+
+    def static_mesh_forces(self) -> np.ndarray | None:
+        """The declared static mesh forces (``static_forces`` of :meth:`from_one_form`), or
+        None."""
+        if self._static_forces is None:
+            return None
+        f = np.asarray(self._static_forces(self.coefficients()), dtype=float).ravel()
+        if f.size != len(self.meshes):
+            raise ValueError(f"static_forces gives {f.size} values for {len(self.meshes)} "
+                             f"meshes")
+        return f
 
     def fastest_natural_frequency(self, P: np.ndarray | None = None) -> np.ndarray:
         """``natural_frequency`` in every lane of ``P`` (NaN when it was not given; see the
@@ -107,3 +265,41 @@ class UserModel(Model):
             return np.full(P.shape[0], float(w))
         rows, inverse = unique_rows(P)
         return np.array([float(w(r)) for r in rows])[inverse]
+
+
+def _check_compiled(rhs: Callable, events: Callable | None, observe: Callable | None) -> None:
+    for fn, label in ((rhs, "rhs"), (events, "events"), (observe, "observe")):
+        if (fn is not None or label == "rhs") and not hasattr(fn, "py_func"):
+            raise TypeError(f"{label} must be a numba.njit-compiled function")
+
+
+def _index(kind: str, ref: str | int, names: tuple[str, ...]) -> int:
+    if isinstance(ref, str):
+        if ref not in names:
+            raise ValueError(f"mesh: {ref!r} is not one of the {kind} ({', '.join(names)})")
+        return names.index(ref)
+    if not 0 <= int(ref) < len(names):
+        raise ValueError(f"mesh: {kind} index {ref!r} out of range ({len(names)} {kind})")
+    return int(ref)
+
+
+def _meshes(specs: Sequence[MeshSpec], events: tuple[str, ...], observables: tuple[str, ...]
+            ) -> tuple[tuple[str, int, int], ...]:
+    """The meshes as (name, drive event index, back event index); where they name force
+    observables, these must be the observables in mesh order (the forces the analyses read)."""
+    out, forces = [], []
+    for spec in specs:
+        if len(spec) not in (3, 4):
+            raise ValueError(f"mesh {spec!r}: (name, drive event, back event[, force])")
+        out.append((str(spec[0]), _index("events", spec[1], events),
+                    _index("events", spec[2], events)))
+        if len(spec) == 4:
+            forces.append(_index("observables", spec[3], observables))
+    if forces and forces != list(range(len(out))) or (forces and len(observables) != len(out)):
+        raise ValueError("meshes: where meshes name force observables, every mesh names one "
+                         "and the observables are exactly these forces, in mesh order (got "
+                         f"observables {observables!r})")
+    names = [m[0] for m in out]
+    if len(set(names)) != len(names):
+        raise ValueError(f"meshes: names repeat ({', '.join(names)})")
+    return tuple(out)

@@ -28,6 +28,7 @@ import numba
 
 from geardyn._cache import cache_root
 from geardyn.core.kernel_source import KernelSource
+from geardyn.core.one_form import adapters as one_form_adapters
 
 _IMPORT_MARK = "# MODEL-IMPORT"
 _CORE_MARK = "# CORE-IMPORT"
@@ -135,11 +136,17 @@ def _splice_core(text: str, adapters: str = "") -> str:
     raise RuntimeError("kernel template has lost its CORE-IMPORT line")
 
 
-def _template_text(template: str, plain: bool = False, user_events: bool = False) -> str:
+def _template_text(template: str, source: KernelSource | None = None,
+                   user_events: bool = False) -> str:
     if template not in TEMPLATES:
         raise KeyError(f"unknown kernel template {template!r}; known: {', '.join(TEMPLATES)}")
     text = inspect.getsource(importlib.import_module(TEMPLATES[template]))
-    adapters = (_PLAIN_ADAPTERS if plain else "") + (_EVENTS_ADAPTER if user_events else "")
+    if source is not None and source.one_form is not None:
+        adapters = one_form_adapters(source.one_form)
+    else:
+        plain = source is not None and source.plain
+        adapters = ((_PLAIN_ADAPTERS if plain else "")
+                    + (_EVENTS_ADAPTER if user_events else ""))
     return _splice_core(text, adapters)
 
 
@@ -175,10 +182,10 @@ def kernels_for(source: KernelSource, template: str = "rk4") -> types.ModuleType
     """The kernel module of ``template`` for a model's functions (built, written and imported on
     first use, then kept for the process)."""
     funcs = source.functions()
-    key = (template, source.plain, *funcs, *(id(f) for f in funcs.values()))
+    key = (template, source.plain, source.one_form, *funcs, *(id(f) for f in funcs.values()))
     if key in _LOADED:
         return _LOADED[key]
-    text = _template_text(template, source.plain, "user_events" in funcs)
+    text = _template_text(template, source, "user_events" in funcs)
     if all(_importable(f) for f in funcs.values()):
         code = _replace_import(text, _import_line(funcs))
         digest = _source_digest(code, funcs)

@@ -1,0 +1,221 @@
+"""The one model form (geardyn.core.one_form): a model's physics written once as per-lane
+tuple-valued functions, every kernel layout generated from it. GearPair is written so; a user's
+model written so (examples/gear_pair_model.py, examples/duffing_model.py) runs the same code path
+and gets contact regimes, forces and frequency-response curves like a built-in."""
+
+from __future__ import annotations
+
+import math
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import geardyn
+from geardyn.core.one_form import call_tuple, coefficient_type
+from geardyn.solvers.ensemble import LaneResults, run_lanes
+from geardyn.solvers.kernels import kernels_for
+from geardyn.testing import check_model
+
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "examples"))
+from duffing_model import duffing, duffing_one  # noqa: E402
+from gear_pair_model import gear_pair  # noqa: E402
+
+COEFFS = dict(zeta=0.05, kappa=0.2, Fm=0.1, Fa=0.2)
+PHASES = ((0.0, 0.0), (0.3, 0.0), (0.0, -0.7), (0.3, -0.7))
+#: Points (t, x, v, forcing phase) where the generated functions are evaluated: in the dead
+#: zone, on both sides of it, on an edge.
+POINTS = ((0.1, 1.7, 0.3, 0.4), (2.0, -1.3, -0.2, 2.5), (0.7, 0.2, 0.9, -1.1), (0.0, 1.0, 0.0, 0.0))
+
+
+def _hand(x: float, v: float, s: float, c: float, zeta: float, kappa: float, Fm: float,
+          Fa: float, Omega: float, phi_k: float, phi_e: float, b: float
+          ) -> tuple[tuple[float, float], tuple[float, float], float]:
+    """dy/dt, events and mesh force of the gear pair, written out here in Python floats (the
+    operations in the model's order, so the values are those bit for bit)."""
+    g = x - b if x > b else (x + b if x < -b else 0.0)
+    ck = c * math.cos(phi_k) - s * math.sin(phi_k)
+    ce = c * math.cos(phi_e) - s * math.sin(phi_e)
+    acc = Fm + Fa * Omega * Omega * ce - 2.0 * zeta * v - (1.0 + kappa * ck) * g
+    return (v, acc), (x - b, x + b), (1.0 + kappa * ck) * g + 2.0 * zeta * v
+
+
+@pytest.mark.parametrize("phases", PHASES)
+def test_generated_layouts_equal_the_hand_evaluated_physics(phases):
+    kp, ep = phases
+    m = geardyn.GearPair(**COEFFS, Omega=1.3, kappa_phase=kp, error_phase=ep)
+    gen = kernels_for(m.kernel)
+    p = m.params
+    PT = np.ascontiguousarray(np.stack([p, p]).T)  # two lanes, coefficients PT[j, k]
+    for t, x, v, ph in POINTS:
+        s, c = math.sin(ph), math.cos(ph)
+        dy_h, g_h, f_h = _hand(x, v, s, c, 0.05, 0.2, 0.1, 0.2, 1.3, kp, ep, 1.0)
+        y = np.array([x, v])
+        dy, g, o = np.zeros(2), np.zeros(2), np.zeros(1)
+        gen.rhs(t, y, dy, p, s, c)
+        gen.events(t, y, g, p, s, c)
+        gen.observe(t, y, o, p, s, c)
+        assert tuple(dy) == dy_h and tuple(g) == g_h and o[0] == f_h
+        assert call_tuple(m.kernel.rhs, m.param_names, t, y, p, s, c) == dy_h
+        assert gen.rhs_lane(t, (x, v), PT, 1, s, c, 0) == dy_h
+        assert gen.events_lane(t, (x, v), PT, 1, s, c) == g_h
+        assert gen.observe_lane(t, (x, v), PT, 1, s, c, 0) == (f_h,)
+        Y, DY, G, O = np.array([[x, 0.0], [v, 0.0]]), np.zeros((2, 2)), np.zeros((2, 2)), \
+            np.zeros((1, 2))
+        T, S, C, SC = np.full(2, t), np.array([s, 0.0]), np.array([c, 1.0]), np.zeros((4, 2))
+        gen.rhs_lanes(T, Y, DY, PT, 1, S, C, SC)
+        gen.events_lanes(T, Y, G, PT, 1, S, C)
+        gen.observe_lanes(T, Y, O, PT, 1, S, C, SC)
+        assert tuple(DY[:, 0]) == dy_h and tuple(G[:, 0]) == g_h and O[0, 0] == f_h
+
+
+def test_derived_coefficients_follow_their_parameter_and_cannot_be_set():
+    m = geardyn.GearPair(**COEFFS)
+    names = m.param_names
+    assert m.params[names.index("cos_kappa_phase")] == 1.0
+    assert m.params[names.index("sin_error_phase")] == 0.0
+    with pytest.raises(ValueError, match="derived from 'kappa_phase'"):
+        m.with_params(cos_kappa_phase=0.5)
+    with pytest.raises(ValueError, match="derived from 'error_phase'"):
+        m.lane_params("sin_error_phase", [0.1])
+    P = m.lane_params("kappa_phase", [0.0, 0.3, -1.2])
+    assert list(P[:, names.index("cos_kappa_phase")]) == [1.0, math.cos(0.3), math.cos(-1.2)]
+    assert list(P[:, names.index("sin_kappa_phase")]) == [0.0, math.sin(0.3), math.sin(-1.2)]
+    q = m.with_params(error_phase=0.4).params
+    assert q[names.index("cos_error_phase")] == math.cos(0.4)
+    u = gear_pair(**COEFFS)
+    with pytest.raises(ValueError, match="derived from 'phi_k'"):
+        u.with_params(sin_phi_k=0.0)
+    assert u.with_params(phi_k=0.3).coefficients().cos_phi_k == math.cos(0.3)
+
+
+def test_coefficient_type_pickles_by_name():
+    import pickle
+
+    cls = coefficient_type(("Omega", "zeta"))
+    assert pickle.loads(pickle.dumps(cls)) is cls
+    assert cls(1.0, 2.0).zeta == 2.0
+
+
+def _lanes(m: geardyn.Model) -> np.ndarray:
+    omegas = np.array([0.5, 0.8, 1.1, 1.6, 2.1, 2.7, 0.9, 1.3])
+    names = dict(zip(("kappa_phase", "error_phase"), ("phi_k", "phi_e"), strict=True))
+    rows = []
+    for j, om in enumerate(omegas):
+        kp, ep = PHASES[j % 4]
+        if isinstance(m, geardyn.GearPair):
+            rows.append(m.with_params(Omega=om, kappa_phase=kp, error_phase=ep).params)
+        else:
+            rows.append(m.with_params(Omega=om, **{names["kappa_phase"]: kp,
+                                                   names["error_phase"]: ep}).params)
+    return np.array(rows)
+
+
+def test_phased_gear_pair_matches_the_reference_integrator():
+    m = geardyn.GearPair(zeta=0.05, kappa=0.2, Fm=0.1, Fa=0.1, Omega=0.8, kappa_phase=0.9,
+                         error_phase=-0.4)
+    T = 2.0 * math.pi / 0.8
+    ds = geardyn.simulate(m, transient=0.0, periods=4, steps_per_period=512)
+    ref = geardyn.reference_solution(m, m.initial_state(), T * np.arange(1, 5))
+    np.testing.assert_allclose(ds["poincare"].values[1:], ref, atol=2e-8)
+
+
+def test_user_gear_pair_equals_gear_pair_bitwise():
+    pair, user = geardyn.GearPair(**COEFFS), gear_pair(**COEFFS)
+    assert kernels_for(user.kernel).FUSED
+    r_pair = run_lanes(pair, _lanes(pair), pair.initial_state(), 300.0, 6,
+                       steps_per_period=64)
+    r_user = run_lanes(user, _lanes(user), user.initial_state(), 300.0, 6,
+                       steps_per_period=64)
+    for name in LaneResults.__dataclass_fields__:
+        np.testing.assert_array_equal(getattr(r_user, name), getattr(r_pair, name),
+                                      err_msg=name)
+    om = np.linspace(0.5, 2.5, 9)
+    a = geardyn.bifurcation(pair, "Omega", om, transient=200.0, samples=10)
+    b = geardyn.bifurcation(user, "Omega", om, transient=200.0, samples=10)
+    for name in ("poincare", "contact", "force_peak", "force_rms", "dynamic_factor"):
+        np.testing.assert_array_equal(b[name].values, a[name].values, err_msg=name)
+    assert set(a["contact"].values.ravel()) >= {"none", "single"}
+    orb_p = geardyn.periodic_orbit(pair.with_omega(0.9))
+    orb_u = geardyn.periodic_orbit(user.with_omega(0.9))
+    np.testing.assert_array_equal(orb_u.monodromy, orb_p.monodromy)
+    lp = geardyn.lyapunov(pair.with_omega(1.4), duration=300.0, spectrum=True)
+    lu = geardyn.lyapunov(user.with_omega(1.4), duration=300.0, spectrum=True)
+    np.testing.assert_array_equal(lu, lp)
+
+
+def test_user_mesh_gets_a_frequency_response_matching_linear_theory():
+    # teeth always in contact (Fm >> the response): u = x - b obeys the linear oscillator
+    # u'' + 2 zeta u' + u = Fm + Fa Omega^2 cos(Omega t), amplitude |H| = Fa Omega^2 / |1 -
+    # Omega^2 + 2 i zeta Omega|; the mesh force u + 2 zeta u' peaks at Fm + |H| |1 + 2 i zeta
+    # Omega|, the dynamic factor that over the static force Fm
+    zeta, Fm, Fa = 0.1, 2.0, 0.02
+    user = gear_pair(zeta=zeta, kappa=0.0, Fm=Fm, Fa=Fa)
+    om = np.array([0.5, 0.8, 1.2, 1.6])
+    ds = geardyn.frequency_response(user, om, transient=300.0, samples=20,
+                                    steps_per_period=256)
+    H = np.abs(Fa * om**2 / (1.0 - om**2 + 2j * zeta * om))
+    for sweep in range(2):
+        assert list(ds["contact"].values[sweep, :, 0]) == ["none"] * om.size
+        np.testing.assert_allclose(ds["dte_amplitude"].values[sweep, :, 0], H, rtol=1e-5)
+        peak = Fm + H * np.abs(1.0 + 2j * zeta * om)
+        np.testing.assert_allclose(ds["dynamic_factor"].values[sweep, :, 0], peak / Fm,
+                                   rtol=1e-4)
+
+
+def _duffing_models(delta: float = 0.3, gamma: float = 0.1, omega: float = 1.2):
+    one = geardyn.UserModel.from_one_form(
+        duffing_one, params={"delta": delta, "gamma": gamma, "Omega": omega},
+        states=("x", "v"), initial_state=(1.0, 0.0), natural_frequency=math.sqrt(2.0),
+        name="Duffing")
+    legacy = geardyn.UserModel(duffing, 2, [delta, gamma, omega],
+                               param_names=("delta", "gamma", "Omega"),
+                               natural_frequency=math.sqrt(2.0))
+    return one, legacy
+
+
+def test_duffing_one_form_through_simulate_sweep_lyapunov_and_orbits():
+    delta = 0.3
+    one, legacy = _duffing_models(delta)
+    assert kernels_for(one.kernel).FUSED
+    y0 = one.initial_state()
+    T = 2.0 * math.pi / 1.2
+    ds = geardyn.simulate(one, transient=0.0, periods=5, steps_per_period=256)
+    ref = geardyn.reference_solution(one, y0, T * np.arange(1, 6))
+    np.testing.assert_allclose(ds["poincare"].values[1:], ref, atol=1e-8)
+    # the sweep's lanes equal single simulations bit for bit
+    om = np.array([0.9, 1.2, 1.5])
+    r = run_lanes(one, one.lane_params("Omega", om), y0, 60.0, 4, steps_per_period=64)
+    for j, w in enumerate(om):
+        d = geardyn.simulate(one, omega=float(w), transient=60.0, periods=4,
+                             steps_per_period=64)
+        np.testing.assert_array_equal(r.samples[j], d["poincare"].values[1:])
+    # Liouville: the exponents sum to the trace of the Jacobian, -delta, and the monodromy's
+    # determinant is exp(-delta T); the exponents are those of the orbit's multipliers (a
+    # complex pair here: both -delta / 2, which a finite run approaches slowly)
+    spec = geardyn.lyapunov(one, duration=400.0, spectrum=True)
+    assert float(np.sum(spec)) == pytest.approx(-delta, abs=1e-6)
+    orb = geardyn.periodic_orbit(one)
+    assert orb.status == 0
+    assert float(np.linalg.det(orb.monodromy)) == pytest.approx(math.exp(-delta * T),
+                                                               rel=1e-7)
+    np.testing.assert_allclose(np.sort(spec), np.sort(np.log(np.abs(orb.multipliers)) / T),
+                               atol=2e-3)
+    np.testing.assert_allclose(orb.x, geardyn.periodic_orbit(legacy).x, atol=1e-9)
+
+
+@pytest.mark.parametrize("which", ["gear pair", "duffing"])
+def test_one_form_models_keep_the_model_contract(which):
+    model = gear_pair(**COEFFS, Omega=1.3) if which == "gear pair" else _duffing_models()[0]
+    report = check_model(model)
+    assert report.ok, str(report)
+
+
+def test_mesh_declarations_are_checked():
+    with pytest.raises(ValueError, match="not one of the events"):
+        geardyn.UserModel.from_one_form(duffing_one, {"delta": 0.3, "gamma": 0.1,
+                                                      "Omega": 1.0},
+                                        ("x", "v"), meshes=[("m", "x-b", "x+b")])
+    with pytest.raises(ValueError, match="Python identifiers"):
+        geardyn.UserModel.from_one_form(duffing_one, {"de lta": 0.3}, ("x", "v"))
