@@ -30,7 +30,6 @@ This module belongs to the core: it imports nothing of geardyn outside :mod:`gea
 from __future__ import annotations
 
 import copy
-import copy
 import functools
 from collections.abc import Callable, Mapping, Sequence
 from types import MappingProxyType

@@ -250,8 +250,8 @@ class PaperBase(BaseModel):
 
 def study_table(name: str, block: CoefficientBlock, doc: str) -> type[BaseModel]:
     """A ``[params]`` table generated from a model's declared coefficients: one field per
-    input of ``block`` (derived entries follow their inputs; its default, range and meaning; an angle for a unit of rad, else a
-    number), unknown keys refused naming the field."""
+    input of ``block`` (its default, range and meaning; an angle for a unit of rad, else a
+    number; derived entries follow their inputs), unknown keys refused naming the field."""
     fields: dict[str, Any] = {}
     for c in block.entries:
         if c.kind != "input":
