@@ -12,9 +12,10 @@ compiled). An analysis's figure is what it compiles beyond those before it (shar
 compile once). numba's compile events give the functions that dominate: the exclusive time of
 each compiled function (its own compile, those it compiles in turn subtracted), summed by name.
 
-    .venv/bin/python bench/compile.py [--models GearPair UserModel] [--top 8] [--write]
+    .venv/bin/python bench/compile.py [--models GearPair UserModel] [--top 8] [--json F] [--write]
 
-``--write`` replaces the ``compile-*`` rows of bench/RESULTS.md's current-figures table. Cold
+``--write`` replaces the ``compile-*`` rows of bench/RESULTS.md's current-figures table
+(``--from-json F``: those of an earlier run's ``--json F``, without measuring again). Cold
 compiles on a shared machine are noisy: CPU seconds are the steadier figure.
 """
 
@@ -157,6 +158,22 @@ def report(case: str, cold: dict, warm: dict, top: int) -> str:
     return "\n".join(lines)
 
 
+def record(case: str, cold: dict, warm: dict) -> None:
+    """Replace the row ``compile-<case>`` of bench/RESULTS.md's current-figures table."""
+    import _results as results
+
+    cpu = sum(v[0] for v in cold.values())
+    wall = sum(v[1] for v in cold.values())
+    cached = sum(v[0] for v in warm.values())
+    target = TARGET_USER if case == "UserModel" else TARGET_BUILTIN
+    per = ", ".join(f"{k} {v[0]:.0f}" for k, v in cold.items() if k != "import")
+    results.record(
+        f"compile-{case}", f"first use of every analysis, empty cache: <= {target:.0f} s CPU",
+        f"{cpu:.0f} s CPU ({wall:.0f} s wall; {per}); cached {cached:.1f} s CPU",
+        results.against(cpu, target),
+        f".venv/bin/python bench/compile.py --models {case} --write")
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--models", nargs="*", default=None, help="case ids (default: all)")
@@ -164,6 +181,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--json", type=Path, default=None, help="also write the raw rows here")
     ap.add_argument("--write", action="store_true",
                     help="replace the compile-* rows of bench/RESULTS.md's table")
+    ap.add_argument("--from-json", type=Path, default=None,
+                    help="report (and --write) the rows of an earlier run's --json instead")
     ap.add_argument("--child", default=None, help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
     if args.child:
@@ -171,27 +190,20 @@ def main(argv: list[str] | None = None) -> int:
         return 0
     from conformance_cases import IDS
 
-    raw = {}
-    for case in args.models or IDS:
-        cold, warm = measure(case)
-        raw[case] = {"cold": cold, "warm": warm}
+    if args.from_json:
+        raw = json.loads(args.from_json.read_text())
+    else:
+        raw = {}
+    for case in ([c for c in IDS if c in raw] if args.from_json else args.models or IDS):
+        if not args.from_json:
+            cold, warm = measure(case)
+            raw[case] = {"cold": cold, "warm": warm}
+        cold, warm = raw[case]["cold"], raw[case]["warm"]
         print(report(case, cold, warm, args.top), flush=True)
         if args.json:
             args.json.write_text(json.dumps(raw, indent=1))
         if args.write:
-            import _results as results
-
-            cpu = sum(v[0] for v in cold.values())
-            wall = sum(v[1] for v in cold.values())
-            cached = sum(v[0] for v in warm.values())
-            target = TARGET_USER if case == "UserModel" else TARGET_BUILTIN
-            per = ", ".join(f"{k} {v[0]:.0f}" for k, v in cold.items() if k != "import")
-            results.record(
-                f"compile-{case}",
-                f"first use of every analysis, empty cache: <= {target:.0f} s",
-                f"{cpu:.0f} s CPU ({wall:.0f} s wall; {per}); cached {cached:.1f} s CPU",
-                results.against(cpu, target),
-                f".venv/bin/python bench/compile.py --models {case} --write")
+            record(case, cold, warm)
     return 0
 
 
