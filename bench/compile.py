@@ -194,7 +194,7 @@ def main(argv: list[str] | None = None) -> int:
         raw = json.loads(args.from_json.read_text())
     else:
         raw = {}
-    for case in ([c for c in IDS if c in raw] if args.from_json else args.models or IDS):
+    for case in args.models or ([c for c in IDS if c in raw] if args.from_json else IDS):
         if not args.from_json:
             cold, warm = measure(case)
             raw[case] = {"cold": cold, "warm": warm}
