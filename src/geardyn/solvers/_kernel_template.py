@@ -22,7 +22,7 @@ Numerics
   structure-of-arrays layout (slot index innermost, block width a runtime value), so that the
   RK4 stages, the model's lane-block functions where it has them, the side test and the
   statistics vectorise over slots; lanes that leave a side of an edge finish on the scalar
-  path. Workers run in parallel (``prange``). A lane's arithmetic does not depend on its
+  path. Workers run in parallel (threads). A lane's arithmetic does not depend on its
   neighbours (no fastmath), so results are bitwise independent of slots, schedule and threads.
   ``trajectory`` (one lane) keeps the row layout of ``_block_step``.
 * A lane whose state leaves ``|y| <= bound`` or stops being finite is marked diverged (status 1)
@@ -34,7 +34,8 @@ from __future__ import annotations
 import numba as nb
 import numpy as np
 
-from geardyn.core.kernel_source import FORM_GENERAL, FORM_LOAD, FORM_QUIET
+from geardyn.core.kernel_source import FORM_GENERAL, FORM_LOAD, FORM_QUIET, LANE_FORMS
+from geardyn.solvers._parallel import run_workers
 from geardyn.solvers._step_core import (  # CORE-IMPORT
     _INLINE,
     _JIT,
@@ -528,27 +529,82 @@ def _write_out(k, lane, n_ev, n_obs, n_tr, GMIN, GMAX, OMAX, OMIN, OSQ, n_stat, 
             orms[lane, j] = np.nan
 
 
-@nb.njit(**_JIT)
+@nb.njit(nogil=True, **_JIT)
 def _sweep_worker(w, lanes, cfg, sched, out):
-    """Worker w of :func:`sweep`: its queue of lanes through one block of refilling slots.
-    Slot arrays: LANE (the lane held), ACT (holds a running lane), END (to be refilled), STEP
-    (the lane's grid steps done), PHASE (its grid point in the period), NPER, OFF (its phase
-    table's offset), HB, T0B (step, start time), n_tr, n_end, next_sample, DUE (the next step
-    with bookkeeping: end of the transient or a sample), n_stat, n_ring (section points kept)."""
-    P, Y0, H, OMEGA, T0, n_transient, n_transient_max, sample_every = lanes
-    conv_tol, conv_depth, n_samples, locate, bound, n_ev, n_obs, width = cfg
-    start, queue, lane_nper, lane_tab, S_TAB, C_TAB, chain = sched
-    (samples, final, status, gmin, gmax, ncross, omax, omin, orms, unresolved, transient_steps,
-     converged, steps) = out
+    """Worker w of :func:`sweep`: its queue of lanes through one block of refilling slots
+    (:func:`_block_run_soa`; a model without lane-scalar functions)."""
+    q0, q1, nl, nw = _worker_span(w, cfg, sched)
+    if nl > 0:
+        blk, slots, scratch = _block_arrays(nw, lanes, cfg)
+        _block_run_soa(q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch)
+
+
+# One worker per lane form (a model with lane-scalar functions), each compiled on its first call:
+# a sweep compiles the fused loop of the forms its lanes take only (see :func:`sweep`).
+@nb.njit(nogil=True, **_JIT)
+def _sweep_worker_form0(w, lanes, cfg, sched, out):
+    """Worker w of :func:`sweep`: the entries of its queue in lane form FORM_GENERAL through
+    one block of refilling slots (:func:`_block_run_form0`)."""
+    q0, q1, nl, nw = _worker_span(w, cfg, sched)
+    if nl > 0:
+        blk, slots, scratch = _block_arrays(nw, lanes, cfg)
+        _block_run_form0(q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch)
+
+
+@nb.njit(nogil=True, **_JIT)
+def _sweep_worker_form1(w, lanes, cfg, sched, out):
+    """:func:`_sweep_worker_form0` in the lane form FORM_QUIET."""
+    q0, q1, nl, nw = _worker_span(w, cfg, sched)
+    if nl > 0:
+        blk, slots, scratch = _block_arrays(nw, lanes, cfg)
+        _block_run_form1(q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch)
+
+
+@nb.njit(nogil=True, **_JIT)
+def _sweep_worker_form2(w, lanes, cfg, sched, out):
+    """:func:`_sweep_worker_form0` in the lane form FORM_LOAD."""
+    q0, q1, nl, nw = _worker_span(w, cfg, sched)
+    if nl > 0:
+        blk, slots, scratch = _block_arrays(nw, lanes, cfg)
+        _block_run_form2(q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch)
+
+
+@nb.njit(**_JIT)
+def _forms_present(P, sched):
+    """present[w, f]: whether worker w's queue holds an entry of lane form f
+    (:func:`_entry_form`)."""
+    start, queue, chain = sched[0], sched[1], sched[6]
+    present = np.zeros((start.size - 1, LANE_FORMS), np.bool_)
+    for w in range(start.size - 1):
+        for i in range(start[w], start[w + 1]):
+            present[w, _entry_form(P, chain, queue[i])] = True
+    return present
+
+
+@nb.njit(inline="always", **_JIT)
+def _worker_span(w, cfg, sched):
+    """Worker w's queue positions q0..q1, the slots it runs (nl, 0 for none) and the width of
+    its block's arrays (nw; the fused loop's rows are BLOCK slots apart)."""
+    start = sched[0]
     q0 = start[w]
     q1 = start[w + 1]
-    nl = min(width, q1 - q0)
-    if nl <= 0:
-        return
-    nw = nl  # the block arrays' width; the fused loop's rows are BLOCK slots apart
+    nl = max(min(cfg[7], q1 - q0), 0)
+    nw = nl
     if FUSED:
         nl = min(nl, BLOCK)
         nw = BLOCK
+    return q0, q1, nl, nw
+
+
+@nb.njit(inline="always", **_JIT)
+def _block_arrays(nw, lanes, cfg):
+    """The arrays of a worker's block of nw slots (blk, slots, scratch). Slot arrays: LANE (the
+    lane held), ACT (holds a running lane), END (to be refilled), STEP (the lane's grid steps
+    done), PHASE (its grid point in the period), NPER, OFF (its phase table's offset), HB, T0B
+    (step, start time), n_tr, n_end, next_sample, DUE (the next step with bookkeeping: end of
+    the transient or a sample), n_stat, n_ring (section points kept)."""
+    P, Y0 = lanes[0], lanes[1]
+    conv_depth, n_ev, n_obs = cfg[1], cfg[5], cfg[6]
     ns = Y0.shape[1]
     n_g = max(n_ev, 1)
     n_o = max(n_obs, 1)
@@ -618,7 +674,7 @@ def _sweep_worker(w, lanes, cfg, sched, out):
     slots = (STAT, MSK, ACT, END, LANE, STEP, PHASE, NPER, OFF, HB, T0B, n_end, n_tr, next_sample,
              DUE, n_stat, n_ring)
     scratch = (ys, y1s, dbuf, sides, g1s, gb, ob, work, ybuf, gbuf, marked)
-    _block_run(q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch)
+    return blk, slots, scratch
 
 
 @nb.njit(inline="always", **_JIT)
@@ -1106,7 +1162,7 @@ def _slot_out(k, G1, SE, CE, TABS, lanes, cfg, out, blk, slots, scratch):
 def _fused_run(form, q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch):
     """:func:`_block_run_soa` with the fused step loop (a model with lane-scalar functions),
     every lane of the worker's queue taking the model's lane form ``form`` (a constant: one
-    copy of the loop per compiled function, see :func:`_block_run_fused`)."""
+    copy of the loop per compiled function, see :func:`sweep`)."""
     locate = cfg[3]
     start, queue, lane_nper, lane_tab, S_TAB, C_TAB, chain = sched
     (R, D, Y, Y1, K1, K2, K3, K4, TMP, PT, SC, PH6, PH, TT, GP, GS, G1, GR, SIDE, FLAG,
@@ -1237,33 +1293,6 @@ def _block_run_form2(q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch):
     _fused_run(FORM_LOAD, q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch)
 
 
-@nb.njit(_nrt=False, **_JIT)
-def _block_run_fused(q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch):
-    """The fused block loop of the worker's queue (see :func:`_fused_run`): one pass per lane
-    form present in it (:func:`_entry_form`), each taking the queue's entries of its form in
-    the queue's order, in the copy of the loop compiled for that form. (Lanes are
-    independent: the results do not depend on the order.)"""
-    P = lanes[0]
-    chain = sched[6]
-    queue = sched[1]
-    quiet = load = general = False
-    for i in range(q0, q1):
-        f = _entry_form(P, chain, queue[i])
-        quiet |= f == FORM_QUIET
-        load |= f == FORM_LOAD
-        general |= f == FORM_GENERAL
-    if quiet:
-        _block_run_form1(q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch)
-    if load:
-        _block_run_form2(q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch)
-    if general:
-        _block_run_form0(q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch)
-
-
-_block_run = _block_run_fused if FUSED else _block_run_soa
-
-
-@nb.njit(parallel=True, **_JIT)
 def sweep(lanes, cfg, work_queues, out):
     """Integrate every lane l from time T0[l] (a whole number of forcing periods):
     ``n_transient[l]`` grid steps, then ``n_samples`` section samples, one every
@@ -1279,7 +1308,8 @@ def sweep(lanes, cfg, work_queues, out):
     transient it takes); converged[l] is 1 then, 0 if the limit came first, -1 without the
     test; transient_steps[l] is the transient used.
 
-    Worker w (in parallel, ``prange``) runs the lanes queue[start[w]:start[w + 1]] (a static,
+    Worker w (in parallel, on threads: :func:`geardyn.solvers._parallel.run_workers`) runs the
+    lanes queue[start[w]:start[w + 1]] (a static,
     cost-balanced schedule made by the caller) through one block of ``width`` slots that are
     refilled from the queue as lanes end (see above). Lanes are independent, so results do not
     depend on the schedule, the width or the threads.
@@ -1293,6 +1323,24 @@ def sweep(lanes, cfg, work_queues, out):
     lanes not run). A lane that diverges stops there (no further steps, crossings or
     statistics).
     """
-    n_workers = work_queues.start.size - 1  # (not named ``sched``: numba's parfor uses it)
-    for w in nb.prange(n_workers):
-        _sweep_worker(np.int64(w), lanes, cfg, work_queues, out)
+    args = (lanes, cfg, work_queues, out)
+    n_workers = work_queues.start.size - 1
+    if not FUSED:
+        run_workers(_sweep_worker, n_workers, args)
+        return
+    present = _forms_present(lanes.P, work_queues)
+    used = [f for f in _FORM_ORDER if present[:, f].any()]
+    workers = {f: _FORM_WORKERS[f] for f in used}  # (compiled on their first call)
+
+    def passes(w, *args):  # one pass of worker w's queue per lane form present in it
+        for f in used:
+            if present[w, f]:
+                workers[f](w, *args)
+
+    run_workers(passes, n_workers, args)
+
+
+#: The sweep's workers by lane form, and the order of a worker's passes (one per form).
+_FORM_WORKERS = {FORM_GENERAL: _sweep_worker_form0, FORM_QUIET: _sweep_worker_form1,
+                 FORM_LOAD: _sweep_worker_form2}
+_FORM_ORDER = (FORM_QUIET, FORM_LOAD, FORM_GENERAL)

@@ -63,6 +63,7 @@ import numba as nb
 import numpy as np
 
 from geardyn.core.kernel_source import FORM_GENERAL, FORM_LOAD, FORM_QUIET
+from geardyn.solvers._parallel import run_workers
 from geardyn.solvers._step_core import (  # CORE-IMPORT
     _INLINE,
     _JIT,
@@ -677,14 +678,8 @@ def _lyap_block(first, nl, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF, n
     """The k leading exponents of lanes first..first+nl-1 (lane with NPER[lane] steps per
     period, its phase table at S_TAB, C_TAB[OFF[lane]:]), their rows in one block (see above);
     per lane what :func:`_run` computes for it, into out[lane], err[lane], used[lane],
-    status[lane], unres[lane]."""
-    if FUSED and k == 1 and n_ev > 0 and nl <= BLOCK:
-        form = _block_form(P, first, nl)
-        if form == FORM_QUIET or form == FORM_LOAD:
-            _lyap_block_fused(form, first, nl, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
-                              n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out,
-                              err, used, status, unres)
-            return
+    status[lane], unres[lane]. (A block of a model's lane form takes the fused loop instead:
+    :func:`_block_path`.)"""
     ns = Y0.shape[1]
     m = k + 1
     nr = (2 * k + 1) * nl
@@ -1060,12 +1055,13 @@ def _block_form(P, first, nl):
     return form
 
 
-@nb.njit(**_JIT)
+@nb.njit(inline="always", **_JIT)
 def _lyap_block_fused(form, first, nl, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
                       n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err, used,
                       status, unres):
     """:func:`_lyap_block` with k = 1 in the fused loop of lane form ``form`` (FORM_QUIET or
-    FORM_LOAD; nl <= BLOCK lanes): the same results, bitwise."""
+    FORM_LOAD, a constant: one form compiled per caller; nl <= BLOCK lanes): the same
+    results, bitwise."""
     ns = Y0.shape[1]
     IS = np.empty(ns)
     for q in range(ns):
@@ -1131,6 +1127,24 @@ def _lyap_block_fused(form, first, nl, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TA
 #: renormalisation, the block being measured, transient and measured steps, their total, the
 #: number of blocks, the lane's next due step.
 _LAST, _CUR, _NTR, _NST, _TOTAL, _NBK, _DUE = range(7)
+
+
+@nb.njit(**_JIT)
+def _lyap_block_form1(first, nl, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF, n_transient,
+                      n_steps, renorm_every, bound, n_ev, n_blocks, out, err, used, status, unres):
+    """:func:`_lyap_block_fused` in the lane form FORM_QUIET (k = 1)."""
+    _lyap_block_fused(FORM_QUIET, first, nl, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
+                      n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err, used,
+                      status, unres)
+
+
+@nb.njit(**_JIT)
+def _lyap_block_form2(first, nl, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF, n_transient,
+                      n_steps, renorm_every, bound, n_ev, n_blocks, out, err, used, status, unres):
+    """:func:`_lyap_block_fused` in the lane form FORM_LOAD (k = 1)."""
+    _lyap_block_fused(FORM_LOAD, first, nl, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
+                      n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err, used,
+                      status, unres)
 
 
 @nb.njit(**_JIT)
@@ -1253,10 +1267,12 @@ def _block_count(L, k, block_rows, min_blocks):
     return max((L + per - 1) // per, min(L, min_blocks))
 
 
-@nb.njit(**_JIT)
-def _lyap_block_local(lo, hi, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF, n_transient,
-                      n_steps, renorm_every, bound, n_ev, n_blocks, out, err, used, status, unres):
-    """:func:`_lyap_block` for lanes lo..hi-1 on copies of their inputs and outputs, so that
+@nb.njit(inline="always", **_JIT)
+def _lyap_block_local(form, lo, hi, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
+                      n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err, used,
+                      status, unres):
+    """:func:`_lyap_block` (``form`` FORM_GENERAL), or the fused loop of lane form ``form``
+    (a constant), for lanes lo..hi-1 on copies of their inputs and outputs, so that
     the block's thread touches no shared array while it steps (the reference counts of arrays
     shared by threads would bounce between the cores' caches)."""
     n = hi - lo
@@ -1265,10 +1281,19 @@ def _lyap_block_local(lo, hi, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF
     u = np.zeros(n, np.int64)
     st = np.zeros(n, np.int64)
     un = np.zeros(n, np.int64)
-    _lyap_block(0, n, k, P[lo:hi].copy(), Y0[lo:hi].copy(), S.copy(), T0[lo:hi].copy(),
-                H[lo:hi].copy(), OMEGA[lo:hi].copy(), NPER[lo:hi].copy(), S_TAB.copy(),
-                C_TAB.copy(), OFF[lo:hi].copy(), n_transient[lo:hi].copy(),
-                n_steps[lo:hi].copy(), renorm_every, bound, n_ev, n_blocks, o, e, u, st, un)
+    Pb, Y0b, Sb, T0b = P[lo:hi].copy(), Y0[lo:hi].copy(), S.copy(), T0[lo:hi].copy()
+    Hb, OMb, NPb, OFb = H[lo:hi].copy(), OMEGA[lo:hi].copy(), NPER[lo:hi].copy(), OFF[lo:hi].copy()
+    STb, CTb = S_TAB.copy(), C_TAB.copy()
+    NTb, NSb = n_transient[lo:hi].copy(), n_steps[lo:hi].copy()
+    if form == FORM_QUIET:
+        _lyap_block_form1(0, n, k, Pb, Y0b, Sb, T0b, Hb, OMb, NPb, STb, CTb, OFb, NTb, NSb,
+                          renorm_every, bound, n_ev, n_blocks, o, e, u, st, un)
+    elif form == FORM_LOAD:
+        _lyap_block_form2(0, n, k, Pb, Y0b, Sb, T0b, Hb, OMb, NPb, STb, CTb, OFb, NTb, NSb,
+                          renorm_every, bound, n_ev, n_blocks, o, e, u, st, un)
+    else:
+        _lyap_block(0, n, k, Pb, Y0b, Sb, T0b, Hb, OMb, NPb, STb, CTb, OFb, NTb, NSb,
+                    renorm_every, bound, n_ev, n_blocks, o, e, u, st, un)
     for i in range(n):
         for j in range(k):
             out[lo + i, j] = o[i, j]
@@ -1278,27 +1303,46 @@ def _lyap_block_local(lo, hi, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF
         unres[lo + i] = un[i]
 
 
-@nb.njit(parallel=True, **_JIT)
 def lyapunov_block_lanes(P, Y0, scale, T0, H, OMEGA, NPER, n_transient, n_steps, renorm_every, k,
                          bound, out, err, used, status, unres, n_ev=0, n_blocks=16,
                          block_rows=BLOCK_ROWS, min_blocks=1):
     """The k leading exponents of every lane (row of P, Y0; NPER[lane] steps per period: lanes
     of different grids may share a block), the lanes' rows in blocks of at most ``block_rows``
     rows (2 k + 1 per lane, at least one lane), consecutive lanes in a block, blocks in
-    parallel. Other arguments as in :func:`lyapunov_lanes`; fills out[L, k], err[L, k] (NaN
-    where diverged), used[L] (blocks of the standard error), status[L] and unres[L] (steps at
-    the split limit; see :func:`_run`). Each lane's result
-    is bitwise that of :func:`lyapunov_single` with the same arguments, whatever the lanes
-    beside it, ``block_rows`` and ``min_blocks`` (see :func:`_block_count`)."""
-    # writable copies and int64 casts below: a read-only array, a literal or an omitted argument
+    parallel (threads, :func:`geardyn.solvers._parallel.run_workers`). Other arguments as in
+    :func:`lyapunov_lanes`; fills out[L, k], err[L, k] (NaN where diverged), used[L] (blocks
+    of the standard error), status[L] and unres[L] (steps at the split limit; see
+    :func:`_run`). Each lane's result is bitwise that of :func:`lyapunov_single` with the same
+    arguments, whatever the lanes beside it, ``block_rows`` and ``min_blocks`` (see
+    :func:`_block_count`)."""
+    # writable contiguous copies and int64 casts: a read-only array or another integer type
     # would compile the block kernel once more for each such caller
-    P_w, Y0_w, scale_w = P.copy(), Y0.copy(), scale.copy()
-    L = Y0.shape[0]
+    i64 = np.int64
+    P_w, Y0_w = np.array(P, float, order="C"), np.array(Y0, float, order="C")
+    scale_w = np.array(scale, float, order="C")
+    S_TAB, C_TAB, OFF, n_blk = _block_tables(OMEGA, NPER, i64(k), i64(block_rows),
+                                             i64(min_blocks))
+    args = (i64(n_blk), i64(k), P_w, Y0_w, scale_w, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
+            n_transient, n_steps, renorm_every, bound, i64(n_ev), i64(n_blocks), out, err, used,
+            status, unres)
+    paths = _block_paths(P_w, n_blk, i64(k), i64(n_ev))
+
+    def block(b, *args):
+        _BLOCK_WORKERS[int(paths[b])](b, *args)
+
+    run_workers(block, int(n_blk), args)
+
+
+@nb.njit(**_JIT)
+def _block_tables(OMEGA, NPER, k, block_rows, min_blocks):
+    """The lanes' phase tables (one per grid, concatenated: S_TAB, C_TAB; OFF[lane]: the start
+    of the lane's) and the number of blocks (:func:`_block_count`) of
+    :func:`lyapunov_block_lanes`."""
+    L = OMEGA.shape[0]
     forced = False
     for lane in range(L):
         if OMEGA[lane] != 0.0:
             forced = True
-    # one phase table per grid, concatenated; OFF[lane]: the start of the lane's
     grids = np.unique(NPER)
     starts = np.zeros(grids.size + 1, np.int64)
     for g in range(grids.size):
@@ -1312,15 +1356,71 @@ def lyapunov_block_lanes(P, Y0, scale, T0, H, OMEGA, NPER, n_transient, n_steps,
     OFF = np.zeros(L, np.int64)
     for lane in range(L):
         OFF[lane] = starts[np.searchsorted(grids, NPER[lane])]
-    n_blk = _block_count(L, k, block_rows, min_blocks)
-    for b in nb.prange(n_blk):
-        lo = b * L // n_blk
-        hi = (b + 1) * L // n_blk
-        if hi > lo:
-            _lyap_block_local(np.int64(lo), np.int64(hi), np.int64(k), P_w, Y0_w, scale_w, T0,
-                              H, OMEGA, NPER, S_TAB, C_TAB, OFF, n_transient, n_steps,
-                              renorm_every, bound, np.int64(n_ev), np.int64(n_blocks), out, err,
-                              used, status, unres)
+    return S_TAB, C_TAB, OFF, _block_count(L, k, block_rows, min_blocks)
+
+
+@nb.njit(inline="always", **_JIT)
+def _block_lanes(b, n_blk, L):
+    """Lanes lo..hi-1 of block b of n_blk (b L // n_blk to (b + 1) L // n_blk)."""
+    return np.int64(b * L // n_blk), np.int64((b + 1) * L // n_blk)
+
+
+@nb.njit(**_JIT)
+def _block_paths(P, n_blk, k, n_ev):
+    """The path of each block of :func:`lyapunov_block_lanes`: the fused loop of the lane form
+    its lanes all take (FORM_QUIET, FORM_LOAD: a model with lane-scalar functions, k = 1,
+    switching functions, at most BLOCK lanes), else FORM_GENERAL (the row block,
+    :func:`_lyap_block`)."""
+    paths = np.full(n_blk, FORM_GENERAL, np.int64)
+    if not FUSED:
+        return paths
+    for b in range(n_blk):
+        lo, hi = _block_lanes(b, n_blk, P.shape[0])
+        if k == 1 and n_ev > 0 and 0 < hi - lo <= BLOCK:
+            form = _block_form(P, lo, hi - lo)
+            if form == FORM_QUIET or form == FORM_LOAD:
+                paths[b] = form
+    return paths
+
+
+@nb.njit(nogil=True, **_JIT)
+def _lyap_block_worker(b, n_blk, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF, n_transient,
+                       n_steps, renorm_every, bound, n_ev, n_blocks, out, err, used, status,
+                       unres):
+    """Block b of n_blk of :func:`lyapunov_block_lanes` (:func:`_block_lanes`) through the row
+    block (:func:`_lyap_block_local`)."""
+    lo, hi = _block_lanes(b, n_blk, Y0.shape[0])
+    if hi > lo:
+        _lyap_block_local(FORM_GENERAL, lo, hi, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB,
+                          OFF, n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out,
+                          err, used, status, unres)
+
+
+@nb.njit(nogil=True, **_JIT)
+def _lyap_block_worker_form1(b, n_blk, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
+                             n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err,
+                             used, status, unres):
+    """:func:`_lyap_block_worker` through the fused loop in the lane form FORM_QUIET."""
+    lo, hi = _block_lanes(b, n_blk, Y0.shape[0])
+    _lyap_block_local(FORM_QUIET, lo, hi, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
+                      n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err, used,
+                      status, unres)
+
+
+@nb.njit(nogil=True, **_JIT)
+def _lyap_block_worker_form2(b, n_blk, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
+                             n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err,
+                             used, status, unres):
+    """:func:`_lyap_block_worker` through the fused loop in the lane form FORM_LOAD."""
+    lo, hi = _block_lanes(b, n_blk, Y0.shape[0])
+    _lyap_block_local(FORM_LOAD, lo, hi, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
+                      n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err, used,
+                      status, unres)
+
+
+#: The Lyapunov block workers by path (:func:`_block_paths`), each compiled on its first call.
+_BLOCK_WORKERS = {FORM_GENERAL: _lyap_block_worker, FORM_QUIET: _lyap_block_worker_form1,
+                  FORM_LOAD: _lyap_block_worker_form2}
 
 
 def lyapunov_lanes(P, Y0, scale, T0, H, OMEGA, n_per, n_transient, n_steps, renorm_every, bound,

@@ -4,7 +4,9 @@ numba cannot cache a kernel that receives the right-hand side as an argument (th
 is tied to the process), so geardyn writes, once per model, a copy of
 :mod:`geardyn.solvers._kernel_template` whose import line names the model's functions, into
 ``$GEARDYN_CACHE_DIR/kernels`` (default ``~/.cache/geardyn/kernels``), and imports it. The file name
-is a hash of the template and of the model's source, so an edited model gets a new kernel; numba
+is a hash of the template and of the model's source, so an edited model gets a new kernel (the
+shared step machinery of :mod:`._step_core` is one such module per model, ``core``, which the
+model's other kernel modules import: compiled once per model, not once per template); numba
 caches the compiled code in ``$NUMBA_CACHE_DIR`` (default ``$GEARDYN_CACHE_DIR/numba``, see
 :mod:`geardyn._cache`), and a second run does not recompile. Functions that cannot be
 imported by name (defined in ``__main__`` or a notebook) get an in-memory kernel, compiled once per
@@ -125,6 +127,53 @@ def _core_text(adapters: str) -> str:
 def _splice_core(text: str, adapters: str = "") -> str:
     """Replace the template's ``CORE-IMPORT`` statement (one line, or a parenthesised import
     starting on the marked line) by the shared core's text (see :func:`_core_text`)."""
+    return _splice(text, _core_text(adapters))
+
+
+def _adapters(source: KernelSource | None, user_events: bool) -> str:
+    """Definitions of the kernel interface's names for a model's functions: every layout of a
+    one-form model (:func:`geardyn.core.one_form.adapters`), or a plain model's adapters."""
+    if source is not None and source.one_form is not None:
+        return one_form_adapters(source.one_form)
+    plain = source is not None and source.plain
+    return (_PLAIN_ADAPTERS if plain else "") + (_EVENTS_ADAPTER if user_events else "")
+
+
+def _template_text(template: str, source: KernelSource | None = None,
+                   user_events: bool = False, core: str | None = None) -> str:
+    """A template's text with the shared core: imported from the model's generated core module
+    ``core`` (see :func:`_core_import`), or without one spliced in as text, with the model's
+    adapters (:func:`_adapters`)."""
+    if template not in TEMPLATES:
+        raise KeyError(f"unknown kernel template {template!r}; known: {', '.join(TEMPLATES)}")
+    adapters = _adapters(source, user_events)
+    if template == CORE:
+        return _core_text(adapters) + "\n"
+    text = inspect.getsource(importlib.import_module(TEMPLATES[template]))
+    if core is not None:
+        return _splice(text, _core_import(core))
+    return _splice_core(text, adapters)
+
+
+# The model's step machinery (:mod:`._step_core` with the model's functions: the split step,
+# the tangent rows, the phase table, ...) is one generated module per model, ``core``, which
+# the model's other kernel modules import, so that each of its functions is compiled (and
+# cached) once per model, not once per template.
+CORE = "core"
+TEMPLATES[CORE] = "geardyn.solvers._step_core"
+
+
+def _core_import(core: str) -> str:
+    """The statement that gives a template module every name of the model's core module (as
+    splicing the core's text in would)."""
+    return (f"import {core} as _core_module  # noqa: E402\n"
+            "globals().update({k: v for k, v in vars(_core_module).items()"
+            " if not k.startswith('__')})")
+
+
+def _splice(text: str, statement: str) -> str:
+    """Replace the template's ``CORE-IMPORT`` statement (one line, or a parenthesised import
+    starting on the marked line) by ``statement``."""
     lines = text.splitlines()
     for k, line in enumerate(lines):
         if line.rstrip().endswith(_CORE_MARK):
@@ -132,22 +181,8 @@ def _splice_core(text: str, adapters: str = "") -> str:
             if "(" in line and ")" not in line:
                 while ")" not in lines[end]:
                     end += 1
-            return "\n".join([*lines[:k], _core_text(adapters), *lines[end + 1 :]]) + "\n"
+            return "\n".join([*lines[:k], statement, *lines[end + 1 :]]) + "\n"
     raise RuntimeError("kernel template has lost its CORE-IMPORT line")
-
-
-def _template_text(template: str, source: KernelSource | None = None,
-                   user_events: bool = False) -> str:
-    if template not in TEMPLATES:
-        raise KeyError(f"unknown kernel template {template!r}; known: {', '.join(TEMPLATES)}")
-    text = inspect.getsource(importlib.import_module(TEMPLATES[template]))
-    if source is not None and source.one_form is not None:
-        adapters = one_form_adapters(source.one_form)
-    else:
-        plain = source is not None and source.plain
-        adapters = ((_PLAIN_ADAPTERS if plain else "")
-                    + (_EVENTS_ADAPTER if user_events else ""))
-    return _splice_core(text, adapters)
 
 
 def _import_line(funcs: dict[str, Any]) -> str:
@@ -185,7 +220,8 @@ def kernels_for(source: KernelSource, template: str = "rk4") -> types.ModuleType
     key = (template, source.plain, source.one_form, *funcs, *(id(f) for f in funcs.values()))
     if key in _LOADED:
         return _LOADED[key]
-    text = _template_text(template, source, "user_events" in funcs)
+    core = kernels_for(source, CORE).__name__ if template != CORE else None
+    text = _template_text(template, source, "user_events" in funcs, core)
     if all(_importable(f) for f in funcs.values()):
         code = _replace_import(text, _import_line(funcs))
         digest = _source_digest(code, funcs)
@@ -207,6 +243,7 @@ def kernels_for(source: KernelSource, template: str = "rk4") -> types.ModuleType
             "_CACHE = True", "_CACHE = False"
         )
         module = types.ModuleType(f"geardyn_{template}_inmemory_{len(_LOADED)}")
+        sys.modules[module.__name__] = module  # (the model's other kernel modules import its core)
         module.__dict__.update(funcs)
         exec(compile(code, module.__name__, "exec"), module.__dict__)
     _quiet_module(module)
