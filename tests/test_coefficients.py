@@ -98,7 +98,7 @@ def test_declared_offsets_are_the_kernels_index_constants(block, module, prefix)
         assert getattr(module, prefix + name) == offset, name
     sizes = {derived.CATT_HEADER: ck.HEADER, derived.CATT_BLOCK: ck.BLOCK_FIXED,
              catt.THETA_HEADER: ck.T_HEADER, catt.THETA_BLOCK: ck.T_BLOCK_FIXED,
-             planetary.HEADER: pk.HEADER, planetary.MESH: pk.MESH_FIXED, GEAR_PAIR: 8}
+             planetary.HEADER: pk.HEADER, planetary.MESH: pk.MESH_FIXED, GEAR_PAIR: 12}
     assert block.size == sizes[block]
 
 
