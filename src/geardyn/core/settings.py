@@ -270,7 +270,7 @@ class NewtonSettings(_AnalysisSettings):
     """Newton shooting of a periodic orbit (:func:`geardyn.periodic_orbit`).
 
     tol
-        Converged when max |F / state_scale| <= tol (1 + max |x / state_scale|) (> 0).
+        Converged when ``max |F / state_scale| <= tol (1 + max |x / state_scale|)`` (> 0).
     max_iter
         Most Newton iterations (>= 1).
     """
@@ -294,8 +294,8 @@ class ContinuationSettings(_AnalysisSettings):
     max_points
         Most points of a branch (>= 1).
     tol
-        Corrector tolerance (> 0): converged where max |G / state_scale| <= tol (1 + max
-        |x / state_scale|).
+        Corrector tolerance (> 0): converged where
+        ``max |G / state_scale| <= tol (1 + max |x / state_scale|)``.
     locate_tol
         Location tolerance of a bifurcation in the parameter (> 0).
     max_period
