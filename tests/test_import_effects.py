@@ -132,3 +132,30 @@ def test_quiet_compile_scopes_its_filter():
         assert d.compile("sig") == "sig"
     assert [str(w.message) for w in caught] == ["a real one"]
     assert warnings.filters == filters
+
+
+def test_quiet_compiles_on_threads_leave_the_filters_as_they_were():
+    """Threads that compile at once (the sweep's workers start on threads) restore the warning
+    filters in pairs: none of the scoped filters is left installed afterwards."""
+    import threading
+    import time
+    import warnings
+
+    from geardyn.solvers.kernels import _quiet_compile
+
+    class Dispatcher:
+        def compile(self, sig):
+            time.sleep(0.02 * sig)  # overlapping compiles: the first to start ends first
+            return sig
+
+    filters = list(warnings.filters)
+    dispatchers = [Dispatcher() for _ in range(8)]
+    for d in dispatchers:
+        _quiet_compile(d)
+    threads = [threading.Thread(target=d.compile, args=(k + 1,))
+               for k, d in enumerate(dispatchers)]
+    for th in threads:
+        th.start()
+    for th in threads:
+        th.join()
+    assert warnings.filters == filters

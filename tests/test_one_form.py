@@ -22,6 +22,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "examples"))
 from duffing_model import duffing, duffing_one  # noqa: E402
 from gear_pair_model import gear_pair  # noqa: E402
 
+LY300 = geardyn.LyapunovSettings(duration=300.0)
+
 COEFFS = dict(zeta=0.05, kappa=0.2, Fm=0.1, Fa=0.2)
 PHASES = ((0.0, 0.0), (0.3, 0.0), (0.0, -0.7), (0.3, -0.7))
 #: Points (t, x, v, forcing phase) where the generated functions are evaluated: in the dead
@@ -140,8 +142,8 @@ def test_user_gear_pair_equals_gear_pair_bitwise():
     orb_p = geardyn.periodic_orbit(pair.with_omega(0.9))
     orb_u = geardyn.periodic_orbit(user.with_omega(0.9))
     np.testing.assert_array_equal(orb_u.monodromy, orb_p.monodromy)
-    lp = geardyn.lyapunov(pair.with_omega(1.4), duration=300.0, spectrum=True)
-    lu = geardyn.lyapunov(user.with_omega(1.4), duration=300.0, spectrum=True)
+    lp = geardyn.lyapunov(pair.with_omega(1.4), spectrum=True, settings=LY300)
+    lu = geardyn.lyapunov(user.with_omega(1.4), spectrum=True, settings=LY300)
     np.testing.assert_array_equal(lu, lp)
 
 
@@ -194,7 +196,7 @@ def test_duffing_one_form_through_simulate_sweep_lyapunov_and_orbits():
     # Liouville: the exponents sum to the trace of the Jacobian, -delta, and the monodromy's
     # determinant is exp(-delta T); the exponents are those of the orbit's multipliers (a
     # complex pair here: both -delta / 2, which a finite run approaches slowly)
-    spec = geardyn.lyapunov(one, duration=400.0, spectrum=True)
+    spec = geardyn.lyapunov(one, spectrum=True, settings=geardyn.LyapunovSettings(duration=400.0))
     assert float(np.sum(spec)) == pytest.approx(-delta, abs=1e-6)
     orb = geardyn.periodic_orbit(one)
     assert orb.status == 0

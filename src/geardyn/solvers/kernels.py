@@ -27,6 +27,7 @@ from pathlib import Path
 from typing import Any
 
 import numba
+from numba.core.compiler_lock import global_compiler_lock
 
 from geardyn._cache import cache_root
 from geardyn.core.kernel_source import KernelSource
@@ -62,13 +63,21 @@ QUIET_WARNINGS = (numba.core.errors.NumbaIRAssumptionWarning,
                   numba.core.errors.NumbaDebugInfoWarning)
 
 
+#: Serialises the scoped filters of :func:`_quiet_compile`: ``warnings.catch_warnings`` saves
+#: and restores the process's filter list, so two threads compiling at once (the sweep's workers
+#: start on threads) would interleave and could leave a filter installed. It is numba's own
+#: re-entrant compiler lock (numba compiles under it anyway, so this costs no parallelism, and
+#: one lock cannot be taken in two orders by a compile that calls another).
+_COMPILE_LOCK = global_compiler_lock
+
+
 def _quiet_compile(dispatcher: Any) -> None:
     """Make ``dispatcher`` compile with :data:`QUIET_WARNINGS` ignored; the warning filters are
     restored when its compile returns (nothing is filtered outside geardyn's compiles)."""
     compile_ = dispatcher.compile
 
     def compile(sig: Any) -> Any:
-        with warnings.catch_warnings():
+        with _COMPILE_LOCK, warnings.catch_warnings():
             for category in QUIET_WARNINGS:
                 warnings.filterwarnings("ignore", category=category)
             return compile_(sig)
