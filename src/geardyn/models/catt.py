@@ -25,7 +25,6 @@ states; :class:`CATTDevice` picks that form automatically.
 
 from __future__ import annotations
 
-import copy
 import functools
 import math
 from collections.abc import Sequence
@@ -281,13 +280,9 @@ class CATTDevice(Model):
 
     def _override(self, raw: dict[str, float]) -> CATTDevice:
         """A copy with raw coefficients set (checked: known parameters, finite)."""
-        out = copy.copy(self)
-        p = self.params.copy()
-        for idx, value in self._checked_raw(raw).items():
-            p[idx] = value
-        out.params = p
+        out = Model._with_raw(self, raw)
         out.raw_overrides = {**self.raw_overrides, **{k: float(v) for k, v in raw.items()}}
-        out.coefficients = out._coefficients_of(p)
+        out.coefficients = out._coefficients_of(out.params)
         return out
 
     def _coefficients_of(self, p: np.ndarray) -> dict[str, np.ndarray | float]:
