@@ -167,7 +167,7 @@ def _hermite(y0, f0, y1, f1, dt, theta, out):
         out[q] = h00 * y0[q] + h10 * f0[q] + h01 * y1[q] + h11 * f1[q]
 
 
-@nb.njit(inline="always", **_JIT)
+@nb.njit(**_JIT)
 def _illinois(j, side_j, a, fa, b, fb, y0, f0, y1, f1, dt, t, p, ybuf, g, pc):
     """Illinois root finding of event j (the model's, on the step's interpolant) in the
     bracket [a, b]: fa on side side_j, fb off it. Returns the bracket's end off the side.
@@ -316,7 +316,7 @@ def cubic_extrema(v0, v1, v2, v3):
     return (r1 / 3.0, _cubic_at(r1, v0, d1, d2, d3), r2 / 3.0, _cubic_at(r2, v0, d1, d2, d3))
 
 
-@nb.njit(inline="always", **_JIT)
+@nb.njit(**_JIT)
 def _beyond(th, e, j, side_j, tol, y0, f0, y1, f1, dt, t, p, ybuf, g, pc):
     """The event j on the interpolant at th if the cubic's value e there and it both lie beyond
     the edge (off side side_j, by more than tol); else NaN. g: scratch row."""
