@@ -879,12 +879,15 @@ def _lyap_fused_steps(form, i, nl, Z0, Z1, S, IS, PT, T0L, HL, HHL, H6L, PH, ACT
     the sin, cos at the step's start, middle and end (six rows); ROWS: each row's start and
     trial (six arrays: start +, -, state; trial +, -, state); EV: each row's events at the
     start, at the end and its graze flags (nine arrays); FLAG[l] = 1 where a row of lane l is
-    flagged (an active lane), EL[l] its e. Returns the number of flagged lanes."""
+    flagged (an active lane), EL[l] its e. Returns the number of flagged lanes.
+
+    Three passes over the lanes: the rows' starts; each row's trial (one lane loop per row,
+    the model's functions inlined once, not once per row: a third of the compile); the
+    commit. Each row's arithmetic is that of a lone step."""
     YA, YB, YC, Y1A, Y1B, Y1C = ROWS
     G0A, G0B, G0C, G1A, G1B, G1C, GRA, GRB, GRC = EV
     P0, P1, P2, P3, P4, P5 = PH
-    n_flag = 0
-    for l in range(nl):
+    for l in range(nl):  # the rows' starts: the state and its neighbours z0 +- e S v
         z0 = _t_load(Z0, l)
         v = _t_load(Z1, l)
         ny = FD_DELTA * (1.0 + min(math.sqrt(_t_dot_scaled(z0, IS)), FD_NORM_CAP))
@@ -892,39 +895,41 @@ def _lyap_fused_steps(form, i, nl, Z0, Z1, S, IS, PT, T0L, HL, HHL, H6L, PH, ACT
         ok = (nv > 0.0) & math.isfinite(nv)
         e = _pick(ok, ny / nv, np.nan)
         ya, yb = _t_fd_rows(z0, v, S, e, ok)
-        h = HL[l]
-        ts = T0L[l] + i * h
-        hh = HHL[l]
-        tm = ts + hh
-        te = ts + h
-        hd = te - ts
-        h6 = H6L[l]
-        ph = (P0[l], P1[l], P2[l], P3[l], P4[l], P5[l])
-        y1a, g0a, g1a, gea = _row_trial(form, ya, PT, l, ts, tm, te, hh, h, h6, hd, ph)
-        y1b, g0b, g1b, geb = _row_trial(form, yb, PT, l, ts, tm, te, hh, h, h6, hd, ph)
-        y1c, g0c, g1c, gec = _row_trial(form, z0, PT, l, ts, tm, te, hh, h, h6, hd, ph)
-        fa = _t_screen_rows(g0a, g1a, gea, GRA, l)
-        fb = _t_screen_rows(g0b, g1b, geb, GRB, l)
-        fc = _t_screen_rows(g0c, g1c, gec, GRC, l)
-        act = ACT[l]
-        flagged = act & (fa | fb | fc)
-        keep = act & (not flagged)
         _t_store(YA, l, ya, ya, True)
         _t_store(YB, l, yb, yb, True)
         _t_store(YC, l, z0, z0, True)
-        _t_store(Y1A, l, y1a, y1a, True)
-        _t_store(Y1B, l, y1b, y1b, True)
-        _t_store(Y1C, l, y1c, y1c, True)
-        _t_store(G0A, l, g0a, g0a, True)
-        _t_store(G0B, l, g0b, g0b, True)
-        _t_store(G0C, l, g0c, g0c, True)
-        _t_store(G1A, l, g1a, g1a, True)
-        _t_store(G1B, l, g1b, g1b, True)
-        _t_store(G1C, l, g1c, g1c, True)
-        _t_store(Z1, l, _t_fd_tangent(y1a, y1b, e, IS), v, keep)
-        _t_store(Z0, l, y1c, z0, keep)
-        FLAG[l] = 1.0 if flagged else 0.0
         EL[l] = e
+        FLAG[l] = 0.0
+    for r in range(3):  # each row's trial and screen
+        Y = YA if r == 0 else (YB if r == 1 else YC)
+        Y1 = Y1A if r == 0 else (Y1B if r == 1 else Y1C)
+        G0 = G0A if r == 0 else (G0B if r == 1 else G0C)
+        G1 = G1A if r == 0 else (G1B if r == 1 else G1C)
+        GR = GRA if r == 0 else (GRB if r == 1 else GRC)
+        for l in range(nl):
+            y = _t_load(Y, l)
+            h = HL[l]
+            ts = T0L[l] + i * h
+            hh = HHL[l]
+            tm = ts + hh
+            te = ts + h
+            hd = te - ts
+            ph = (P0[l], P1[l], P2[l], P3[l], P4[l], P5[l])
+            y1, g0, g1, ge = _row_trial(form, y, PT, l, ts, tm, te, hh, h, H6L[l], hd, ph)
+            hit = _t_screen_rows(g0, g1, ge, GR, l)
+            _t_store(Y1, l, y1, y1, True)
+            _t_store(G0, l, g0, g0, True)
+            _t_store(G1, l, g1, g1, True)
+            FLAG[l] = _pick(hit, 1.0, FLAG[l])
+    n_flag = 0
+    for l in range(nl):  # the commit of the active, unflagged lanes
+        act = ACT[l]
+        flagged = act & (FLAG[l] != 0.0)
+        keep = act & (not flagged)
+        v = _t_load(Z1, l)
+        _t_store(Z1, l, _t_fd_tangent(_t_load(Y1A, l), _t_load(Y1B, l), EL[l], IS), v, keep)
+        _t_store(Z0, l, _t_load(Y1C, l), _t_load(YC, l), keep)
+        FLAG[l] = 1.0 if flagged else 0.0
         n_flag += 1 if flagged else 0
     return n_flag
 
