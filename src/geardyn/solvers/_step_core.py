@@ -582,9 +582,10 @@ def _split_step(i, t0, y, y_trial, p, h, omega, n_per, sa, ca, s_end, c_end, sid
     comes from that at the grid point by angle addition. The model's rhs and events are inlined
     here and in the helpers (``_rhs_i``, ``_events_i``: no calls, no reference counting; the
     same arithmetic), except in the rare fallbacks :func:`_illinois` and :func:`_beyond`,
-    compiled once and called (each inlined copy costs compile time, see docs/engine.md). sa, ca and s_end, c_end: sin and cos of the forcing phase at the step's
-    start and end, the caller's phase-table values (:func:`phase_table`), so a split sees the
-    phases of the unsplit step, bitwise, and calls no libm for them. work: 7 rows of the
+    compiled once and called (each inlined copy costs compile time, see docs/engine.md).
+    sa, ca and s_end, c_end: sin and cos of the forcing phase at the step's start and end,
+    the caller's phase-table values (:func:`phase_table`), so a split sees the phases of the
+    unsplit step, bitwise, and calls no libm for them. work: 7 rows of the
     state's size."""
     n_ev = g1.size
     ns = y.size
