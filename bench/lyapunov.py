@@ -23,6 +23,7 @@ import time
 import numba
 import numpy as np
 
+import _results as results
 import geardyn
 from geardyn.analysis.lyapunov import lyapunov_lanes
 from geardyn.core.plan import forcing_period, lane_steps, periods_covering
@@ -86,7 +87,7 @@ def main() -> None:
     kern = kernels_for(model.kernel, "lyapunov")
     kernels = {"blocks": kern.lyapunov_lanes, "rows (main)": kern.lyapunov_lanes_rows}
     times = {name: [] for name in kernels}
-    results = {}
+    exponents = {}
     for rep in range(a.repeat + 1):  # the first round compiles / warms up
         for name, fn in kernels.items():
             kern.lyapunov_lanes = fn
@@ -94,7 +95,7 @@ def main() -> None:
                 wall, cpu, lam, err = run(model, P, a.transient, a.duration)
             finally:
                 kern.lyapunov_lanes = kernels["blocks"]
-            results[name] = (lam, err)
+            exponents[name] = (lam, err)
             if rep:
                 times[name].append((wall, cpu))
     print(f"paper device, reduced, {a.lanes} lanes Omega in [{a.lo}, {a.hi}], transient "
@@ -120,7 +121,7 @@ def main() -> None:
         print(f"  {name:12s} no edge location: wall {wall:8.4f} s  "
               f"{wall * a.threads / steps * 1e9:7.1f} ns/lane-step/thread (wall)  "
               f"{cpu / steps * 1e9:7.1f} ns/lane-step (cpu)")
-    (la, ea), (lb, eb) = results["blocks"], results["rows (main)"]
+    (la, ea), (lb, eb) = exponents["blocks"], exponents["rows (main)"]
     same = np.array_equal(la, lb, equal_nan=True) and np.array_equal(ea, eb, equal_nan=True)
     print(f"  exponents and errors bitwise equal: {same}; finite {np.isfinite(la).sum()}/{la.size}")
     if a.write:
