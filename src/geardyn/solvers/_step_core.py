@@ -947,20 +947,10 @@ if "rhs_lane" in globals():  # the model's lane-scalar functions (see .kernels)
         yt = _t_get(y)
         k1t = _t_get(k1)
         hh = 0.5 * h
-        # the three stages in a loop: the model's rhs inlined once, not three times (the
-        # split path is scalar code; the arithmetic is that of the stages written out)
-        k2 = k1t
-        k3 = k1t
-        kp = k1t
-        for st in range(3):
-            last = st == 2
-            kp = _rhs_l(t + h if last else t + hh, _t_axpy(yt, h if last else hh, kp), pt, 0,
-                        s2 if last else s1, c2 if last else c1, FORM_GENERAL)
-            if st == 0:
-                k2 = kp
-            elif st == 1:
-                k3 = kp
-        _t_put(out, _t_comb(yt, h / 6.0, k1t, k2, k3, kp))
+        k2 = _rhs_l(t + hh, _t_axpy(yt, hh, k1t), pt, 0, s1, c1, FORM_GENERAL)
+        k3 = _rhs_l(t + hh, _t_axpy(yt, hh, k2), pt, 0, s1, c1, FORM_GENERAL)
+        k4 = _rhs_l(t + h, _t_axpy(yt, h, k3), pt, 0, s2, c2, FORM_GENERAL)
+        _t_put(out, _t_comb(yt, h / 6.0, k1t, k2, k3, k4))
 
     @nb.njit(inline="always", **_JIT)
     def _hermite(y0, f0, y1, f1, dt, theta, out):  # noqa: F811
