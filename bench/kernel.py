@@ -55,6 +55,12 @@ def old_kernels(source: kmod.KernelSource, rev: str):
     end = k
     while ")" not in lines[end]:
         end += 1
+    if source.one_form is not None:  # the model's layouts, generated from its one form
+        marks = [i for i, ln in enumerate(core) if ln.startswith("# MODEL-ADAPTERS")]
+        if not marks:
+            raise ValueError(f"revision {rev} predates the one model form: a one-form model "
+                             "cannot run on its kernels")
+        core = [*core[:marks[0]], kmod._adapters(source, False), *core[marks[0]:]]
     text = "\n".join([*lines[:k], *core, *lines[end + 1:]]) + "\n"
     funcs = source.functions()
     funcs.update(_old_lane_functions(funcs, rev))
