@@ -882,8 +882,8 @@ def _lyap_fused_steps(form, i, nl, Z0, Z1, S, IS, PT, T0L, HL, HHL, H6L, PH, ACT
     flagged (an active lane), EL[l] its e. Returns the number of flagged lanes.
 
     Three passes over the lanes: the rows' starts; each row's trial (one lane loop per row,
-    the model's functions inlined once, not once per row: a third of the compile); the
-    commit. Each row's arithmetic is that of a lone step."""
+    so the model's functions are inlined once, not once per row); the commit. Each row's
+    arithmetic is that of a lone step."""
     YA, YB, YC, Y1A, Y1B, Y1C = ROWS
     G0A, G0B, G0C, G1A, G1B, G1C, GRA, GRB, GRC = EV
     P0, P1, P2, P3, P4, P5 = PH
