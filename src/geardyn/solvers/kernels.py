@@ -32,6 +32,7 @@ from numba.core.compiler_lock import global_compiler_lock
 from geardyn._cache import cache_root
 from geardyn.core.kernel_source import KernelSource
 from geardyn.core.one_form import adapters as one_form_adapters
+from geardyn.solvers import compile_share
 
 _IMPORT_MARK = "# MODEL-IMPORT"
 _CORE_MARK = "# CORE-IMPORT"
@@ -71,10 +72,13 @@ QUIET_WARNINGS = (numba.core.errors.NumbaIRAssumptionWarning,
 _COMPILE_LOCK = global_compiler_lock
 
 
-def _quiet_compile(dispatcher: Any) -> None:
+def _quiet_compile(dispatcher: Any, cached: bool = False) -> None:
     """Make ``dispatcher`` compile with :data:`QUIET_WARNINGS` ignored; the warning filters are
-    restored when its compile returns (nothing is filtered outside geardyn's compiles)."""
-    compile_ = dispatcher.compile
+    restored when its compile returns (nothing is filtered outside geardyn's compiles). A
+    ``cached`` module's functions compile under their lock (:mod:`.compile_share`): one process
+    compiles a function, the others load it from the cache."""
+    compile_ = compile_share.shared(dispatcher, dispatcher.compile) if cached else (
+        dispatcher.compile)
 
     def compile(sig: Any) -> Any:
         with _COMPILE_LOCK, warnings.catch_warnings():
@@ -88,10 +92,11 @@ def _quiet_compile(dispatcher: Any) -> None:
 def _quiet_module(module: types.ModuleType) -> None:
     """:func:`_quiet_compile` for every numba function ``module`` defines (the entry points; the
     functions they call compile inside their compile)."""
+    cached = getattr(module, "__file__", None) is not None
     for value in list(vars(module).values()):
         if (isinstance(value, numba.core.registry.CPUDispatcher)
                 and value.py_func.__module__ == module.__name__):
-            _quiet_compile(value)
+            _quiet_compile(value, cached)
 
 
 def cache_dir() -> Path:
@@ -257,4 +262,16 @@ def kernels_for(source: KernelSource, template: str = "rk4") -> types.ModuleType
         exec(compile(code, module.__name__, "exec"), module.__dict__)
     _quiet_module(module)
     _LOADED[key] = module
+    if template != CORE:
+        # the split step (every template's scalar path) compiles in a helper process meanwhile
+        compile_share.compile_ahead(sys.modules[core], AHEAD)
     return module
+
+
+#: The core functions :func:`kernels_for` has compiled ahead (:func:`.compile_share.compile_ahead`)
+#: when it first loads one of a model's templates: name -> the signature every template calls
+#: it with (``tests/test_compile_share.py`` checks that the templates compile no other).
+AHEAD = {"_split_step": "(int64, float64, float64[::1], float64[::1], float64[::1], float64, "
+                        "float64, int64, float64, float64, float64, float64, int64[::1], "
+                        "float64[::1], int64[::1], float64[:, ::1], float64[::1], "
+                        "float64[:, ::1])"}
