@@ -385,23 +385,28 @@ def _lanes_rk4(STEP, nl, Y, Y1, K1, K2, K3, K4, TMP, FL, HW, TT, HB, T0B, PT, P,
     HHf, HFf, H6f = HW
     SB, CB, SE, CE = PH
     m_all = Yf.size
+    KS = (K1, K2, K3, K4)
+    KSf = (K1f, K2f, K3f, K4f)
     for k in range(nl):
         TT[k] = T0B[k] + STEP[k] * HB[k]
-    _rhs_lanes(TT, Y, K1, PT, P, LANE, nl, SE, CE, SC, ybuf, dbuf)
-    _lanes_phase(nl, OFF, PHASE, S_TAB, C_TAB, SB, CB, SE, CE)
-    for m in range(m_all):
-        TMPf[m] = Yf[m] + HHf[m] * K1f[m]
-    for k in range(nl):
-        TT[k] = T0B[k] + STEP[k] * HB[k] + 0.5 * HB[k]
-    _rhs_lanes(TT, TMP, K2, PT, P, LANE, nl, SB, CB, SC, ybuf, dbuf)
-    for m in range(m_all):
-        TMPf[m] = Yf[m] + HHf[m] * K2f[m]
-    _rhs_lanes(TT, TMP, K3, PT, P, LANE, nl, SB, CB, SC, ybuf, dbuf)
-    for m in range(m_all):
-        TMPf[m] = Yf[m] + HFf[m] * K3f[m]
-    for k in range(nl):
-        TT[k] = T0B[k] + (STEP[k] + 1) * HB[k]
-    _rhs_lanes(TT, TMP, K4, PT, P, LANE, nl, SE, CE, SC, ybuf, dbuf)
+    for stage in range(4):  # one call site of the model (one inlined copy: compile time)
+        mid = stage == 1 or stage == 2
+        _rhs_lanes(TT, Y if stage == 0 else TMP, KS[stage], PT, P, LANE, nl, SB if mid else SE,
+                   CB if mid else CE, SC, ybuf, dbuf)
+        if stage == 0:
+            _lanes_phase(nl, OFF, PHASE, S_TAB, C_TAB, SB, CB, SE, CE)
+        if stage == 3:
+            break
+        Kf = KSf[stage]
+        Hf = HFf if stage == 2 else HHf
+        for m in range(m_all):
+            TMPf[m] = Yf[m] + Hf[m] * Kf[m]
+        if stage == 0:
+            for k in range(nl):
+                TT[k] = T0B[k] + STEP[k] * HB[k] + 0.5 * HB[k]
+        elif stage == 2:
+            for k in range(nl):
+                TT[k] = T0B[k] + (STEP[k] + 1) * HB[k]
     for m in range(m_all):
         Y1f[m] = Yf[m] + H6f[m] * (K1f[m] + 2.0 * K2f[m] + 2.0 * K3f[m] + K4f[m])
 
