@@ -164,3 +164,63 @@ def test_a_chain_stops_at_a_lane_that_did_not_end_well_and_says_so():
     assert 0 < r.steps[0] < _planned_steps(r, 3)[0]
     assert list(r.status[1:]) == [Status.NOT_RUN, Status.NOT_RUN]
     assert list(r.steps[1:]) == [0, 0]
+
+
+@nb.njit
+def _lane_calls_quiet(y, PT, s, c):
+    """Four rhs calls and an observation at a constant lane form, as a kernel's fused loop."""
+    a = ck.catt_rhs_one_lane(0.1, y, PT, 0, s, c, FORM_QUIET)
+    b = ck.catt_rhs_one_lane(0.2, a, PT, 0, s, c, FORM_QUIET)
+    return b, ck.catt_observe_one_lane(0.2, b, PT, 0, s, c, FORM_QUIET)
+
+
+@nb.njit
+def _lane_calls_load(y, PT, s, c):
+    a = ck.catt_rhs_one_lane(0.1, y, PT, 0, s, c, FORM_LOAD)
+    return a, ck.catt_observe_one_lane(0.1, a, PT, 0, s, c, FORM_LOAD)
+
+
+@nb.njit
+def _lane_calls_general(y, PT, s, c):
+    a = ck.catt_rhs_one_lane(0.1, y, PT, 0, s, c, FORM_GENERAL)
+    return a, ck.catt_observe_one_lane(0.1, a, PT, 0, s, c, FORM_GENERAL)
+
+
+def _model_functions_typed(fn, *args):
+    """The names of the model module's compiled functions that numba typed in compiling ``fn``
+    (those inlined into it and those it calls)."""
+    fn(*args)
+    (ov,) = fn.overloads.values()
+    return {t.dispatcher.py_func.__name__ for t in ov.type_annotation.typemap.values()
+            if isinstance(t, nb.core.types.Dispatcher)
+            and t.dispatcher.py_func.__module__ == ck.__name__}
+
+
+@pytest.mark.parametrize(("fn", "own"), [(_lane_calls_quiet, {"_rhs_quiet", "_observe_quiet"}),
+                                         (_lane_calls_load, {"_rhs_load", "_observe_quiet"}),
+                                         (_lane_calls_general,
+                                          {"_rhs_general", "_observe_general"})])
+def test_a_constant_lane_form_compiles_that_forms_code_only(fn, own):
+    """A kernel's compile time goes with the code numba inlines and types: a call site of a
+    constant form holds that form's functions only (no other form's, no load sine where the
+    load is quiet, no harmonics loop outside the general form)."""
+    P = np.ascontiguousarray(_device().lane_params("Omega", _OMEGAS[:1]).T)
+    typed = _model_functions_typed(fn, (0.01, 0.0, -0.02, 0.0), P, 0.3, math.sqrt(0.91))
+    assert typed == {"catt_rhs_one_lane", "catt_observe_one_lane"} | own
+
+
+@nb.njit
+def _rhs_at_form(y, PT, s, c, form):
+    return ck.catt_rhs_one_lane(0.7, y, PT, 0, s, c, form)
+
+
+def test_every_form_of_a_quiet_lane_equals_the_array_form_with_form_a_variable():
+    """``form`` need not be a constant: each form of a lane that all may take (one harmonic, the
+    load quiet) gives the bits of the array form :func:`catt_rhs_one`."""
+    p = _device().lane_params("Omega", _OMEGAS[1:2])[0]
+    PT = np.ascontiguousarray(p[:, None])
+    y, s, c = np.array([2e-3, -0.1, -1e-3, 0.05]), 0.6, 0.8
+    ref = np.empty(4)
+    ck.catt_rhs_one(0.7, y, ref, p, s, c)
+    for form in (FORM_QUIET, FORM_LOAD, FORM_GENERAL):
+        np.testing.assert_array_equal(np.array(_rhs_at_form(tuple(y), PT, s, c, form)), ref)

@@ -418,19 +418,29 @@ def _stiffness_lane(PT, k, f, nh, s, c):
 
 
 @nb.njit(inline="always", **_JIT)
-def _mesh_factors_lane(t, PT, k, s, c, form):
-    """Stiffness factors (sun-inside, inside-outside) and load terms (load_c, sin_l1) of lane
-    k, as :func:`_rhs` computes them for one planet set, in the lane form ``form`` (see
-    :func:`catt_rhs_one_lane_form`)."""
+def _factors_quiet(t, PT, k, s, c):
+    """Stiffness factors (sun-inside, inside-outside) and load terms (load_c, sin_l1) of lane k,
+    as :func:`_rhs` computes them for one planet set, in the lane form FORM_QUIET."""
     fs = HEADER + BLOCK_FIXED
-    if form == FORM_QUIET:
-        return (1.0 + (PT[fs, k] * c + PT[fs + 1, k] * s),
-                1.0 + (PT[fs + 2, k] * c + PT[fs + 3, k] * s), PT[F_C0, k], 0.0)
-    if form == FORM_LOAD:  # the load on (no branch: the scalar path takes it too)
-        return (1.0 + (PT[fs, k] * c + PT[fs + 1, k] * s),
-                1.0 + (PT[fs + 2, k] * c + PT[fs + 3, k] * s),
-                PT[F_C0, k] + PT[F_C1, k] * load_sin(PT[LAMBDA, k] * t + PT[PSI2, k]),
-                load_sin(PT[LAMBDA, k] * t + PT[PSI1, k]))
+    return (1.0 + (PT[fs, k] * c + PT[fs + 1, k] * s),
+            1.0 + (PT[fs + 2, k] * c + PT[fs + 3, k] * s), PT[F_C0, k], 0.0)
+
+
+@nb.njit(inline="always", **_JIT)
+def _factors_load(t, PT, k, s, c):
+    """:func:`_factors_quiet` in the lane form FORM_LOAD: the load on (no branch: the scalar
+    path takes it too)."""
+    fs = HEADER + BLOCK_FIXED
+    return (1.0 + (PT[fs, k] * c + PT[fs + 1, k] * s),
+            1.0 + (PT[fs + 2, k] * c + PT[fs + 3, k] * s),
+            PT[F_C0, k] + PT[F_C1, k] * load_sin(PT[LAMBDA, k] * t + PT[PSI2, k]),
+            load_sin(PT[LAMBDA, k] * t + PT[PSI1, k]))
+
+
+@nb.njit(inline="always", **_JIT)
+def _factors_general(t, PT, k, s, c):
+    """:func:`_factors_quiet` in the lane form FORM_GENERAL (any lane)."""
+    fs = HEADER + BLOCK_FIXED
     nh = int(PT[N_HARM, k])
     load_c = PT[F_C0, k]
     sin_l1 = 0.0
@@ -441,22 +451,11 @@ def _mesh_factors_lane(t, PT, k, s, c, form):
             load_c, sin_l1)
 
 
-@nb.njit(**_JIT)
-def catt_rhs_one_lane_form(PT, k):
-    """The lane form lane k may take: FORM_QUIET (one stiffness harmonic, no load fluctuation),
-    FORM_LOAD (one harmonic, the load fluctuating), else FORM_GENERAL (a harmonics loop)."""
-    if PT[N_HARM, k] != 1.0:
-        return FORM_GENERAL
-    if (PT[F_C1, k] == 0.0) & (PT[HEADER + F_P1, k] == 0.0):
-        return FORM_QUIET
-    return FORM_LOAD
-
-
 @nb.njit(inline="always", **_JIT)
-def catt_rhs_one_lane(t, y, PT, k, s, c, form):
-    """:func:`catt_rhs_one` of lane k: dy/dt as a tuple."""
+def _rhs_lane(t, y, PT, k, s, c, factors):
+    """:func:`catt_rhs_one` of lane k with the mesh factors ``factors`` (of a lane form)."""
     o = HEADER
-    ks, kp, load_c, sin_l1 = _mesh_factors_lane(t, PT, k, s, c, form)
+    ks, kp, load_c, sin_l1 = factors
     om2 = PT[OMEGA, k] * PT[OMEGA, k]
     xs, vs, xp, vp = y
     gs = ks * dead_zone(xs, PT[o + B_SQ, k])
@@ -473,6 +472,70 @@ def catt_rhs_one_lane(t, y, PT, k, s, c, form):
 
 
 @nb.njit(inline="always", **_JIT)
+def _observe_lane(t, y, PT, k, s, c, factors):
+    """:func:`catt_observe_one` of lane k with the mesh factors ``factors``."""
+    o = HEADER
+    ks, kp, _, _ = factors
+    gs = ks * dead_zone(y[0], PT[o + B_SQ, k])
+    gp = kp * dead_zone(y[2], PT[o + B_PQ, k])
+    scale = PT[o + FORCE_SCALE, k]
+    return (scale * (PT[o + K_SQ_Q, k] * gs + PT[o + C_SQ_Q, k] * y[1]),
+            scale * (PT[o + K_PQ_Q, k] * gp + PT[o + C_PQ_Q, k] * y[3]))
+
+
+# The lane-scalar functions of each lane form, compiled on their own (once per argument types,
+# and cached) and inlined by LLVM where they are called (``forceinline``: the fused loops
+# vectorise as with numba's inlining). ``catt_rhs_one_lane`` and ``catt_observe_one_lane``,
+# which numba inlines, call the one of ``form``: where ``form`` is a constant (each compiled copy
+# of a kernel's fused loop, the split path), numba's branch pruning leaves that call only, so
+# that a kernel's compile types one call per site and its code holds its own form's arithmetic.
+@nb.njit(forceinline=True, **_JIT)
+def _rhs_quiet(t, y, PT, k, s, c):
+    return _rhs_lane(t, y, PT, k, s, c, _factors_quiet(t, PT, k, s, c))
+
+
+@nb.njit(forceinline=True, **_JIT)
+def _rhs_load(t, y, PT, k, s, c):
+    return _rhs_lane(t, y, PT, k, s, c, _factors_load(t, PT, k, s, c))
+
+
+@nb.njit(forceinline=True, **_JIT)
+def _rhs_general(t, y, PT, k, s, c):
+    return _rhs_lane(t, y, PT, k, s, c, _factors_general(t, PT, k, s, c))
+
+
+@nb.njit(forceinline=True, **_JIT)
+def _observe_quiet(t, y, PT, k, s, c):
+    return _observe_lane(t, y, PT, k, s, c, _factors_quiet(t, PT, k, s, c))
+
+
+@nb.njit(forceinline=True, **_JIT)
+def _observe_general(t, y, PT, k, s, c):
+    return _observe_lane(t, y, PT, k, s, c, _factors_general(t, PT, k, s, c))
+
+
+@nb.njit(**_JIT)
+def catt_rhs_one_lane_form(PT, k):
+    """The lane form lane k may take: FORM_QUIET (one stiffness harmonic, no load fluctuation),
+    FORM_LOAD (one harmonic, the load fluctuating), else FORM_GENERAL (a harmonics loop)."""
+    if PT[N_HARM, k] != 1.0:
+        return FORM_GENERAL
+    if (PT[F_C1, k] == 0.0) & (PT[HEADER + F_P1, k] == 0.0):
+        return FORM_QUIET
+    return FORM_LOAD
+
+
+@nb.njit(inline="always", **_JIT)
+def catt_rhs_one_lane(t, y, PT, k, s, c, form):
+    """:func:`catt_rhs_one` of lane k in the lane form ``form``: dy/dt as a tuple."""
+    if form == FORM_QUIET:
+        return _rhs_quiet(t, y, PT, k, s, c)
+    if form == FORM_LOAD:
+        return _rhs_load(t, y, PT, k, s, c)
+    return _rhs_general(t, y, PT, k, s, c)
+
+
+@nb.njit(inline="always", **_JIT)
 def catt_events_one_lane(t, y, PT, k, s, c):
     """:func:`catt_events_one` of lane k, as a tuple."""
     o = HEADER
@@ -482,11 +545,8 @@ def catt_events_one_lane(t, y, PT, k, s, c):
 
 @nb.njit(inline="always", **_JIT)
 def catt_observe_one_lane(t, y, PT, k, s, c, form):
-    """:func:`catt_observe_one` of lane k, as a tuple."""
-    o = HEADER
-    ks, kp, _, _ = _mesh_factors_lane(t, PT, k, s, c, min(form, FORM_QUIET))
-    gs = ks * dead_zone(y[0], PT[o + B_SQ, k])
-    gp = kp * dead_zone(y[2], PT[o + B_PQ, k])
-    scale = PT[o + FORCE_SCALE, k]
-    return (scale * (PT[o + K_SQ_Q, k] * gs + PT[o + C_SQ_Q, k] * y[1]),
-            scale * (PT[o + K_PQ_Q, k] * gp + PT[o + C_PQ_Q, k] * y[3]))
+    """:func:`catt_observe_one` of lane k, as a tuple (the load terms unused: FORM_LOAD lanes
+    take the quiet form's factors)."""
+    if form == FORM_GENERAL:
+        return _observe_general(t, y, PT, k, s, c)
+    return _observe_quiet(t, y, PT, k, s, c)
