@@ -11,6 +11,8 @@ seconds. A second process on the same, now filled, cache runs them again (loaded
 compiled). An analysis's figure is what it compiles beyond those before it (shared functions
 compile once). numba's compile events give the functions that dominate: the exclusive time of
 each compiled function (its own compile, those it compiles in turn subtracted), summed by name.
+The split step is not compiled ahead in a helper process here (``GEARDYN_COMPILE_AHEAD=0``), so
+that the process's CPU seconds are the whole compile.
 
     .venv/bin/python bench/compile.py [--models GearPair UserModel] [--top 8] [--json F] [--write]
 
@@ -122,7 +124,7 @@ def child(case: str) -> dict:
 
 
 def run_child(case: str, cache: str) -> dict:
-    env = dict(os.environ, GEARDYN_CACHE_DIR=cache)
+    env = dict(os.environ, GEARDYN_CACHE_DIR=cache, GEARDYN_COMPILE_AHEAD="0")
     env.pop("NUMBA_CACHE_DIR", None)
     out = subprocess.run([sys.executable, __file__, "--child", case], env=env, check=True,
                          capture_output=True, text=True)
