@@ -8,6 +8,7 @@ import json
 import os
 import subprocess
 import sys
+import threading
 import time
 import types
 from pathlib import Path
@@ -121,3 +122,24 @@ def test_compile_ahead_switched_off(monkeypatch):
     monkeypatch.setenv(compile_share.ENV, "0")
     assert compile_share.compile_ahead(module, {"_split_step": "(int64,)"}) is None
     assert not compile_share._STARTED
+
+
+def test_a_compile_inside_a_compile_of_the_same_function_does_not_wait_on_itself(
+        tmp_path, monkeypatch):
+    """numba may compile another signature of a function inside its compile (a literal
+    argument): the lock is re-entrant within the process (an flock per open file is not)."""
+    monkeypatch.setenv("GEARDYN_CACHE_DIR", str(tmp_path))
+    d = _fake_dispatcher("geardyn_core_x", "rhs_lane_form")
+    calls = []
+
+    def compile_(sig):
+        calls.append(sig)
+        if sig == ("int64",):
+            inner(("Literal[int](1)",))
+
+    inner = compile_share.shared(d, compile_)
+    done = []
+    th = threading.Thread(target=lambda: (inner(("int64",)), done.append(True)), daemon=True)
+    th.start()
+    th.join(10.0)
+    assert done and calls == [("int64",), ("Literal[int](1)",)]

@@ -49,19 +49,34 @@ def lock_path(module: str, name: str) -> Path:
     return cache_root() / "locks" / f"{module}.{name}.lock"
 
 
+#: Lock files this process holds, with the depth of their holds: a compile may compile another
+#: signature of the same function inside it (an flock is per open file, so a second open of
+#: the same file would wait on this process's own lock for ever).
+_HELD: dict[Path, int] = {}
+
+
 @contextmanager
 def compile_lock(module: str, name: str) -> Iterator[None]:
-    """Hold the lock of ``module.name``'s compile (blocking while another process holds it)."""
-    if fcntl is None:
-        yield
-        return
+    """Hold the lock of ``module.name``'s compile (blocking while another process holds it;
+    re-entrant within this process, where numba's compiler lock serialises compiles)."""
     path = lock_path(module, name)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    with open(path, "a") as fh:
-        fcntl.flock(fh, fcntl.LOCK_EX)
+    if fcntl is None or path in _HELD:
+        if path in _HELD:
+            _HELD[path] += 1
         try:
             yield
         finally:
+            if path in _HELD:
+                _HELD[path] -= 1
+        return
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with open(path, "a") as fh:
+        fcntl.flock(fh, fcntl.LOCK_EX)
+        _HELD[path] = 1
+        try:
+            yield
+        finally:
+            del _HELD[path]
             fcntl.flock(fh, fcntl.LOCK_UN)
 
 
