@@ -22,7 +22,7 @@ import os
 import subprocess
 import sys
 import types
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
@@ -129,7 +129,7 @@ def compile_ahead(module: types.ModuleType, signatures: dict[str, str]) -> subpr
     if not names or key in _STARTED:
         return None
     env = dict(os.environ, PYTHONPATH=os.pathsep.join(p for p in sys.path if p))
-    cmd = [sys.executable, "-m", "geardyn.solvers.compile_share", module.__name__, path,
+    cmd = [sys.executable, "-m", "geardyn.solvers.compile_helper", module.__name__, path,
            *(f"{n}={signatures[n]}" for n in names)]
     try:
         proc = subprocess.Popen(cmd, env=env, stdin=subprocess.DEVNULL,
@@ -138,24 +138,3 @@ def compile_ahead(module: types.ModuleType, signatures: dict[str, str]) -> subpr
         return None
     _STARTED[key] = proc
     return proc
-
-
-def _compile_in_helper(module_name: str, path: str, specs: Sequence[str]) -> None:
-    """The helper process of :func:`compile_ahead`: import the generated module from ``path``
-    and compile each ``name=signature`` of ``specs`` under its lock."""
-    import importlib.util
-
-    from geardyn.solvers.kernels import _quiet_module
-
-    spec = importlib.util.spec_from_file_location(module_name, path)
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[module_name] = module
-    spec.loader.exec_module(module)
-    _quiet_module(module)
-    for item in specs:
-        name, _, text = item.partition("=")
-        getattr(module, name).compile(signature_types(text))
-
-
-if __name__ == "__main__":
-    _compile_in_helper(sys.argv[1], sys.argv[2], sys.argv[3:])
