@@ -18,10 +18,12 @@ function itself when it needs it, with the same result.
 
 from __future__ import annotations
 
+import atexit
 import os
 import subprocess
 import sys
 import types
+import warnings
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
@@ -136,5 +138,16 @@ def compile_ahead(module: types.ModuleType, signatures: dict[str, str]) -> subpr
                                 stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     except OSError:
         return None
+    if not _STARTED:
+        atexit.register(_leave_helpers_running)
     _STARTED[key] = proc
     return proc
+
+
+def _leave_helpers_running() -> None:
+    """At exit, a helper still compiling goes on and fills the disk cache for the next process;
+    its ``Popen`` object is then deleted unwaited, which is meant: no ResourceWarning for it."""
+    for proc in _STARTED.values():
+        if proc.poll() is None:
+            warnings.filterwarnings("ignore", message=f"subprocess {proc.pid} is still running",
+                                    category=ResourceWarning)
