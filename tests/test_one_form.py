@@ -221,3 +221,34 @@ def test_mesh_declarations_are_checked():
                                         ("x", "v"), meshes=[("m", "x-b", "x+b")])
     with pytest.raises(ValueError, match="Python identifiers"):
         geardyn.UserModel.from_one_form(duffing_one, {"de lta": 0.3}, ("x", "v"))
+
+
+def test_mesh_forces_are_what_the_meshes_declare_not_a_count_of_observables():
+    """One mesh and one observable: the observable is read as the mesh force only where the
+    mesh names it (a fourth entry); a mesh without it reports contact, no forces."""
+    import gear_pair_model as gp
+
+    def pair(meshes):
+        return geardyn.UserModel.from_one_form(
+            gp.pair_rhs, params=dict(Omega=1.0, zeta=0.05, kappa=0.0, Fm=0.1, Fa=0.05,
+                                     phi_k=0.0, phi_e=0.0, b=1.0),
+            derived={"cos_phi_k": ("phi_k", math.cos), "sin_phi_k": ("phi_k", math.sin),
+                     "cos_phi_e": ("phi_e", math.cos), "sin_phi_e": ("phi_e", math.sin)},
+            states=("x", "v"), events=gp.pair_events, event_names=("x-b", "x+b"),
+            observe=gp.pair_force, observable_names=("energy",), meshes=meshes,
+            natural_frequency=1.0)
+
+    om = np.linspace(0.8, 1.2, 3)
+    plain = geardyn.bifurcation(pair([("mesh", "x-b", "x+b")]), "Omega", om, transient=50.0,
+                                samples=4)
+    assert "contact" in plain and "force_peak" not in plain and "dynamic_factor" not in plain
+    forced = geardyn.bifurcation(pair([("mesh", "x-b", "x+b", "energy")]), "Omega", om,
+                                 transient=50.0, samples=4)
+    assert "force_peak" in forced and "force_rms" in forced
+
+
+def test_the_contract_refuses_mesh_forces_without_one_force_per_mesh():
+    model = geardyn.GearPair()
+    model.observable_names = ("F", "G")
+    report = check_model(model, raise_on_failure=False)
+    assert not report.ok and "mesh_forces" in str(report)

@@ -244,6 +244,10 @@ def _check_names(model: Model) -> None:
     for mesh in model.meshes:
         if len(mesh) != 3 or not all(0 <= j < model.n_events for j in mesh[1:]):
             raise _Broken(f"mesh {mesh!r} does not name two of the {model.n_events} events")
+    if model.capabilities.mesh_forces and not (
+            model.meshes and model.n_observables == len(model.meshes)):
+        raise _Broken(f"capabilities.mesh_forces: the observables must be the forces of the "
+                      f"{len(model.meshes)} meshes (got {model.n_observables} observables)")
 
 
 def _check_coefficients(model: Model) -> None:

@@ -22,9 +22,10 @@ CONTACT_LABELS: tuple[str, ...] = (*REGIMES, UNBOUNDED_LABEL)
 
 
 def has_mesh_forces(model: Model) -> bool:
-    """True when the model observes one force per backlash mesh (so peak/RMS forces and the
-    dynamic factor are reported; the latter needs the static mesh forces)."""
-    return bool(model.meshes) and model.n_observables == len(model.meshes)
+    """True when the model declares its observables to be its meshes' forces
+    (:attr:`~geardyn.core.capabilities.Capabilities.mesh_forces`): peak/RMS forces and the
+    dynamic factor are reported (the latter needs the static mesh forces)."""
+    return model.capabilities.mesh_forces
 
 
 def variable_dims(model: Model) -> dict[str, tuple[str, ...]]:

@@ -30,6 +30,10 @@ class Capabilities:
         A model of the CATT paper's device (``model.params_in``: its
         :class:`~geardyn.models.params.PlanetaryParams`, read for the mesh frequency of the sun
         gear's teeth and the length scale b_c).
+    ``mesh_forces``
+        The observables are the meshes' forces: one per entry of ``model.meshes``, in mesh
+        order (sweeps report peak and RMS mesh forces, and the dynamic factor where the model
+        gives its static mesh forces).
     """
 
     frequency_scale: bool = False
@@ -37,3 +41,4 @@ class Capabilities:
     physical_inputs: bool = False
     physical_axes: bool = False
     paper_device: bool = False
+    mesh_forces: bool = False

@@ -75,7 +75,8 @@ class Model:
 
     1. **names** -- ``state_names`` is a non-empty tuple of distinct strings, one per state;
        ``event_names``, ``observable_names`` and ``param_names`` are tuples of distinct strings;
-       every entry ``(name, i, j)`` of ``meshes`` names two events that exist.
+       every entry ``(name, i, j)`` of ``meshes`` names two events that exist; a model whose
+       ``capabilities.mesh_forces`` is set has one observable per mesh (its force).
     2. **coefficients** -- ``params`` is a 1-D float64 array of finite numbers laid out as
        :attr:`coefficient_layout` declares (:mod:`geardyn.core.coefficients`); ``param_names``
        are the layout's parameters (structure and workspace entries are not parameters: index

@@ -109,7 +109,7 @@ class CATTDevice(Model):
     state_units = "1"
     observable_units = "N"
     capabilities = Capabilities(frequency_scale=True, interpretation=True,
-                                physical_inputs=True, paper_device=True)
+                                physical_inputs=True, paper_device=True, mesh_forces=True)
     raw_overrides_allowed = True
     #: The paper's names of the physical parameters (``with_params`` re-derives from them;
     #: ``waveform`` is not a number, so not swept).

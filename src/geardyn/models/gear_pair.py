@@ -16,6 +16,7 @@ from collections.abc import Sequence
 import numba as nb
 import numpy as np
 
+from geardyn.core.capabilities import Capabilities
 from geardyn.core.coefficients import CoefficientLayout
 from geardyn.core.kernel_source import KernelSource
 from geardyn.core.model import Model
@@ -81,6 +82,7 @@ class GearPair(Model):
     event_names = ("x-b", "x+b")
     observable_names = ("F",)
     meshes = (("mesh", 0, 1),)
+    capabilities = Capabilities(mesh_forces=True)
     derived = DERIVED
     #: The declared coefficients (:data:`~geardyn.models.gear_pair_coefficients.GEAR_PAIR`):
     #: the parameters, then the derived coefficients (:data:`DERIVED`), in the kernel's order.

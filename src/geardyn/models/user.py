@@ -15,6 +15,7 @@ from typing import Any
 
 import numpy as np
 
+from geardyn.core.capabilities import Capabilities
 from geardyn.core.kernel_source import KernelSource
 from geardyn.core.model import Model, unique_rows
 from geardyn.core.one_form import (
@@ -205,7 +206,8 @@ class UserModel(Model):
         fill_derived(model.params, model.param_names, derived)
         model.event_names = event_names
         model.observable_names = tuple(observable_names) if observe is not None else ()
-        model.meshes = _meshes(meshes, model.event_names, model.observable_names)
+        model.meshes, forces = _meshes(meshes, model.event_names, model.observable_names)
+        model.capabilities = Capabilities(mesh_forces=forces)
         model.derived = derived
         model._static_forces = static_forces
         model._initial = initial_state
@@ -284,9 +286,10 @@ def _index(kind: str, ref: str | int, names: tuple[str, ...]) -> int:
 
 
 def _meshes(specs: Sequence[MeshSpec], events: tuple[str, ...], observables: tuple[str, ...]
-            ) -> tuple[tuple[str, int, int], ...]:
-    """The meshes as (name, drive event index, back event index); where they name force
-    observables, these must be the observables in mesh order (the forces the analyses read)."""
+            ) -> tuple[tuple[tuple[str, int, int], ...], bool]:
+    """The meshes as (name, drive event index, back event index), and whether they name force
+    observables (these must then be the observables in mesh order: the forces the analyses
+    read)."""
     out, forces = [], []
     for spec in specs:
         if len(spec) not in (3, 4):
@@ -302,4 +305,4 @@ def _meshes(specs: Sequence[MeshSpec], events: tuple[str, ...], observables: tup
     names = [m[0] for m in out]
     if len(set(names)) != len(names):
         raise ValueError(f"meshes: names repeat ({', '.join(names)})")
-    return tuple(out)
+    return tuple(out), bool(forces)
