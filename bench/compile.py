@@ -56,12 +56,16 @@ def _runs(model, y0):
     return {
         "simulate": lambda: geardyn.simulate(model, omega=omega, periods=2, y0=y0),
         "sweep": lambda: geardyn.bifurcation(model, "Omega", values, transient=0.0, samples=2),
-        "lyapunov": lambda: geardyn.lyapunov(model, y0=y0, transient=0.0, duration=1.0),
+        "lyapunov": lambda: geardyn.lyapunov(model, y0=y0, transient=0.0,
+                                             settings=geardyn.LyapunovSettings(duration=1.0)),
         "lanes": lambda: geardyn.lyapunov_lanes(model, model.lane_params("Omega", values),
-                                                transient=0.0, duration=1.0),
-        "orbit": lambda: geardyn.periodic_orbit(model, omega=omega, guess=y0, max_iter=1),
-        "continuation": lambda: geardyn.continuation(model, "Omega", omega, 1.02 * omega,
-                                                     guess=y0, max_points=3),
+                                                run=geardyn.RunSettings(transient=0.0),
+                                                settings=geardyn.LyapunovSettings(duration=1.0)),
+        "orbit": lambda: geardyn.periodic_orbit(model, omega=omega, guess=y0,
+                                                settings=geardyn.NewtonSettings(max_iter=1)),
+        "continuation": lambda: geardyn.continuation(
+            model, "Omega", omega, 1.02 * omega, guess=y0,
+            settings=geardyn.ContinuationSettings(max_points=3)),
     }
 
 

@@ -64,7 +64,9 @@ def run_kernel(fn, args, n_ev):
 
 def run(model, P, transient, duration):
     t_wall, t_cpu = time.perf_counter(), time.process_time()
-    lam, err = lyapunov_lanes(model, P, transient=transient, duration=duration, with_error=True)
+    lam, err = lyapunov_lanes(model, P, run=geardyn.RunSettings(transient=transient),
+                              settings=geardyn.LyapunovSettings(duration=duration),
+                              with_error=True)
     return time.perf_counter() - t_wall, time.process_time() - t_cpu, lam, err
 
 

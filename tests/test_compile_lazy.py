@@ -71,7 +71,8 @@ out["simulate"] = census(pair, "rk4", sweep)
 geardyn.bifurcation(dev, "Omega", np.linspace(0.8, 1.6, 6), transient=10.0, samples=2)
 out["sweep"] = census(dev, "rk4", sweep)
 lam = geardyn.lyapunov_lanes(dev, dev.lane_params("Omega", np.linspace(0.8, 1.6, 4)),
-                             transient=5.0, duration=10.0)
+                             run=geardyn.RunSettings(transient=5.0),
+                             settings=geardyn.LyapunovSettings(duration=10.0))
 out["lanes"] = census(dev, "lyapunov", lyap)
 out["lanes_finite"] = bool(np.all(np.isfinite(lam)))
 print(json.dumps(out))

@@ -164,3 +164,34 @@ def test_chained_points_equal_the_point_by_point_continuation(segment):
         s = got.status
         restarts += int(np.sum((s[:-1] == geardyn.Status.DIVERGED) & (s[1:] == geardyn.Status.OK)))
     assert restarts >= 1  # a diverged point, then a cold restart that ended well
+
+
+def test_continue_branches_keywords_warn_once_and_agree():
+    """continue_branches' settings as keyword arguments (or an int run: the samples) still work,
+    bitwise as run=RunSettings(...), with one DeprecationWarning naming that replacement and
+    pointing at the caller; run= and a keyword together is a TypeError."""
+    import warnings
+
+    from geardyn.analysis.continuation import continue_branches
+
+    pair = geardyn.GearPair(zeta=0.05, kappa=0.2, Fm=0.1, Fa=0.2)
+    branches = [Branch(pair, pair.lane_params("Omega", np.linspace(0.8, 1.2, 4)),
+                       pair.initial_state(), transient=100.0, continued_transient=20.0)]
+    new = continue_branches(branches, geardyn.RunSettings(samples=4, converge=1e-8))
+    four = continue_branches(branches, geardyn.RunSettings(samples=4))
+    for call, replacement, ref in [
+            (dict(samples=4, converge=1e-8), "samples=4, converge=1e-08", new),
+            (dict(run=4), "samples=4", four)]:
+        with warnings.catch_warnings(record=True) as record:
+            warnings.simplefilter("always")
+            old = continue_branches(branches, **call)
+        deprecations = [w for w in record if issubclass(w.category, DeprecationWarning)]
+        assert [str(w.message) for w in deprecations] == [
+            f"continue_branches({', '.join(k + '=' for k in call if k != 'run') or 'samples='})"
+            f" is deprecated: pass run=geardyn.RunSettings({replacement})"]
+        assert deprecations[0].filename == __file__
+        for name in type(old[0]).__dataclass_fields__:
+            a, b = getattr(old[0], name), getattr(ref[0], name)
+            assert a.dtype == b.dtype and a.tobytes() == b.tobytes(), name
+    with pytest.raises(TypeError, match="not both"):
+        continue_branches(branches, geardyn.RunSettings(samples=4), samples=4)

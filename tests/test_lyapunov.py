@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 import geardyn
+from geardyn import LyapunovSettings, RunSettings
 from geardyn.analysis.lyapunov import lyapunov, lyapunov_lanes
 from geardyn.io.toml import builtin_study
 from geardyn.models import catt_kernels
@@ -175,7 +176,8 @@ def test_state_scale_default_and_checked():
         with pytest.raises(ValueError, match="state_scale"):
             lyapunov(m, transient=1.0, settings=geardyn.LyapunovSettings(duration=10.0))
         with pytest.raises(ValueError, match="state_scale"):
-            lyapunov_lanes(m, m.lane_params("Omega", [1.0]), transient=1.0, duration=10.0)
+            lyapunov_lanes(m, m.lane_params("Omega", [1.0]), run=RunSettings(transient=1.0),
+                           settings=LyapunovSettings(duration=10.0))
 
 
 def test_exponent_does_not_depend_on_the_state_scale():
@@ -190,8 +192,10 @@ def test_exponent_does_not_depend_on_the_state_scale():
     assert a != b  # the scale reaches the kernel
     assert abs(a - b) < 2.0 * math.log(scale.max() / scale.min()) / run["duration"]
     P = geardyn.GearPair(**IMPACTING).params
-    la = lyapunov_lanes(geardyn.GearPair(**IMPACTING), P, **run)
-    lb = lyapunov_lanes(_Scaled(scale, **IMPACTING), P, **run)
+    lanes = dict(run=RunSettings(transient=200.0, steps_per_period=64),
+                 settings=LyapunovSettings(duration=run["duration"]))
+    la = lyapunov_lanes(geardyn.GearPair(**IMPACTING), P, **lanes)
+    lb = lyapunov_lanes(_Scaled(scale, **IMPACTING), P, **lanes)
     assert la[0] == pytest.approx(a, rel=1e-12) and lb[0] == pytest.approx(b, rel=1e-12)
 
 
@@ -423,8 +427,9 @@ def test_with_error_shapes_and_nan():
                    settings=geardyn.LyapunovSettings(duration=3 * g.period))
     assert few.n_blocks == 3 and math.isfinite(few.stderr)  # at most one block per period
     P = g.lane_params("Omega", [1.15, 0.6])
-    lam, err = lyapunov_lanes(g, P, y0=np.array([[0.5, 0.0], [1e9, 0.0]]), transient=10.0,
-                              duration=50.0, with_error=True)
+    lam, err = lyapunov_lanes(g, P, y0=np.array([[0.5, 0.0], [1e9, 0.0]]),
+                              run=RunSettings(transient=10.0),
+                              settings=LyapunovSettings(duration=50.0), with_error=True)
     assert np.isfinite(lam[0]) and np.isfinite(err[0]) and np.isnan(lam[1]) and np.isnan(err[1])
     with pytest.raises(ValueError):
         lyapunov(g, settings=geardyn.LyapunovSettings(n_blocks=1))
@@ -447,7 +452,8 @@ def test_lanes_match_single():
     model = geardyn.GearPair(zeta=0.02, kappa=0.2, Fm=0.1, Fa=0.3)
     omegas = np.array([0.5, 0.92, 1.15])
     P = model.lane_params("Omega", omegas)
-    out = lyapunov_lanes(model, P, transient=300.0, duration=600.0, steps_per_period=64)
+    out = lyapunov_lanes(model, P, run=RunSettings(transient=300.0, steps_per_period=64),
+                         settings=LyapunovSettings(duration=600.0))
     assert out.shape == (3,)
     for om, lam in zip(omegas, out, strict=True):
         single = lyapunov(model.with_omega(om), transient=300.0,
@@ -459,8 +465,8 @@ def test_lanes_match_single():
 def test_lanes_diverged_is_nan():
     model = geardyn.GearPair(zeta=0.05, Fm=0.1, Fa=0.05)
     P = model.lane_params("Omega", [0.5, 0.6])
-    out = lyapunov_lanes(model, P, y0=np.array([[1.1, 0.0], [1e9, 0.0]]), transient=10.0,
-                         duration=20.0)
+    out = lyapunov_lanes(model, P, y0=np.array([[1.1, 0.0], [1e9, 0.0]]),
+                         run=RunSettings(transient=10.0), settings=LyapunovSettings(duration=20.0))
     assert np.isfinite(out[0]) and np.isnan(out[1])
 
 
@@ -468,7 +474,8 @@ def test_lanes_autonomous():
     u = lorenz_model()
     P = np.tile(LORENZ, (2, 1))
     P[1, 1] = 0.5  # rho < 1: the origin is a stable node
-    out = lyapunov_lanes(u, P, y0=[1.0, 1.0, 1.0], transient=50.0, duration=500.0)
+    out = lyapunov_lanes(u, P, y0=[1.0, 1.0, 1.0], run=RunSettings(transient=50.0),
+                         settings=LyapunovSettings(duration=500.0))
     assert abs(out[0] - LORENZ_LAMBDA1) < 0.05
     # largest eigenvalue of the Jacobian at the origin: the slowest decay
     sigma, rho = LORENZ[0], 0.5
@@ -568,8 +575,10 @@ def test_split_limit_is_reported():
         assert lyapunov(model, **run) == est.value
     # the lane blocks: every lane reports it, the exponent kept (not NaN)
     P = np.tile(model.params, (3, 1))
-    exps, errs, unres, status = lyapunov_lanes(model, P, y0=[0.0, 1.0], transient=0.0,
-                                               duration=5.0, dt=1.0, with_status=True)
+    exps, errs, unres, status = lyapunov_lanes(model, P, y0=[0.0, 1.0],
+                                               run=RunSettings(transient=0.0),
+                                               settings=LyapunovSettings(duration=5.0, dt=1.0),
+                                               with_status=True)
     assert np.array_equal(unres, [3, 3, 3])
     assert np.all(status == geardyn.Status.SPLIT_LIMIT)
     assert np.array_equal(exps, np.full(3, est.value))

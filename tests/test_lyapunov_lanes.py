@@ -129,11 +129,13 @@ def test_public_lanes_equal_one_lane_kernel(monkeypatch):
     # geardyn.lyapunov_lanes (lanes of several step ladders, an autonomous user model) against
     # the same call through the one-lane-at-a-time kernel
     cases = [(paper_device(), paper_device().lane_params("Omega", np.linspace(0.6, 3.0, 9)),
-              dict(transient=10.0, duration=40.0)),
+              dict(run=geardyn.RunSettings(transient=10.0),
+                   settings=geardyn.LyapunovSettings(duration=40.0))),
              (geardyn.UserModel(_lorenz, n_states=3, params=np.array([10.0, 28.0, 8.0 / 3.0]),
                                 period=None, state_names=["x", "y", "z"]),
               np.array([[10.0, 28.0, 8.0 / 3.0], [10.0, 0.5, 8.0 / 3.0]]),
-              dict(y0=[1.0, 1.0, 1.0], transient=2.0, duration=10.0))]
+              dict(y0=[1.0, 1.0, 1.0], run=geardyn.RunSettings(transient=2.0),
+                   settings=geardyn.LyapunovSettings(duration=10.0)))]
     for model, P, run in cases:
         new = lyap_mod.lyapunov_lanes(model, P, with_error=True, **run)
         kern = kernels_for(model.kernel, "lyapunov")

@@ -96,6 +96,62 @@ def test_lyapunov_keywords_warn_once_and_agree():
         geardyn.lyapunov(g, run=run, durations=200.0)
 
 
+def _bitwise(a: tuple[np.ndarray, ...], b: tuple[np.ndarray, ...]) -> None:
+    assert len(a) == len(b)
+    for x, y in zip(a, b, strict=True):
+        assert x.dtype == y.dtype and x.shape == y.shape and x.tobytes() == y.tobytes()
+
+
+def test_lyapunov_lanes_keywords_warn_once_and_agree():
+    """lyapunov_lanes takes run= and settings= as lyapunov does: the old keywords give bitwise
+    the same lanes, the LyapunovSettings fields with one DeprecationWarning; both is a
+    TypeError; without run, transient is 100 time units (LYAPUNOV_DEFAULTS)."""
+    g = geardyn.GearPair(**PAIR)
+    P = g.lane_params("Omega", [0.6, 1.2, 1.5])
+    y0 = np.array([[0.5, 0.0], [0.5, 0.0], [1e9, 0.0]])  # the last lane diverges
+    run = geardyn.RunSettings(transient=50.0, steps_per_period=32)
+    ls = LyapunovSettings(duration=200.0, n_blocks=4)
+    new = geardyn.lyapunov_lanes(g, P, y0, run, settings=ls, with_status=True)
+    with warnings.catch_warnings(record=True) as record:
+        warnings.simplefilter("always")
+        old = geardyn.lyapunov_lanes(g, P, y0, transient=50.0, steps_per_period=32,
+                                     duration=200.0, n_blocks=4, with_status=True)
+    _one_deprecation(record, "settings=geardyn.LyapunovSettings(duration=200.0, n_blocks=4)")
+    _bitwise(old, new)
+    assert np.all(np.isfinite(new[0][:2])) and np.isnan(new[0][2])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # the run keywords alone: the compatibility path
+        same = geardyn.lyapunov_lanes(g, P, y0, transient=50.0, steps_per_period=32,
+                                      settings=ls, with_status=True)
+        default = geardyn.lyapunov_lanes(g, P[:2], settings=ls, with_error=True)
+        hundred = geardyn.lyapunov_lanes(g, P[:2], run=geardyn.RunSettings(transient=100.0),
+                                         settings=ls, with_error=True)
+    _bitwise(same, new)
+    _bitwise(default, hundred)
+    with pytest.raises(TypeError, match="not both"):
+        geardyn.lyapunov_lanes(g, P, settings=ls, duration=200.0)
+    with pytest.raises(TypeError, match="not both"):
+        geardyn.lyapunov_lanes(g, P, run=run, transient=50.0)
+    with pytest.raises(TypeError, match="lyapunov_lanes.*unexpected keyword argument 'samples'"):
+        geardyn.lyapunov_lanes(g, P, samples=10)
+
+
+def test_lyapunov_lanes_use_the_run_as_lyapunov_does():
+    """Each lane of lyapunov_lanes is lyapunov's one-lane kernel on the same run, also with
+    locate_edges=False (the edges integrated across), which changes an impacting exponent."""
+    g = geardyn.GearPair(zeta=0.02, kappa=0.2, Fm=0.1, Fa=0.3)
+    omegas = [0.92, 1.15]
+    ls = LyapunovSettings(duration=300.0)
+    lanes = {}
+    for locate in (True, False):
+        run = geardyn.RunSettings(transient=100.0, steps_per_period=64, locate_edges=locate)
+        lanes[locate] = geardyn.lyapunov_lanes(g, g.lane_params("Omega", omegas), run=run,
+                                               settings=ls)
+        one = [geardyn.lyapunov(g.with_omega(om), run=run, settings=ls) for om in omegas]
+        np.testing.assert_allclose(lanes[locate], one, rtol=1e-12, atol=1e-14)
+    assert np.all(np.abs(lanes[True] - lanes[False]) > 1e-6)
+
+
 #: Names that moved: (old home, name, new home).
 MOVED = [
     ("geardyn.models.base", "Model", "geardyn.core.model"),

@@ -52,7 +52,8 @@ def _warm(case: str) -> tuple[str, float]:
         "lyapunov": lambda: geardyn.lyapunov(model, y0=y0, transient=0.0,
                                              settings=geardyn.LyapunovSettings(duration=1.0)),
         "lanes": lambda: geardyn.lyapunov_lanes(model, model.lane_params("Omega", values),
-                                                transient=0.0, duration=1.0),
+                                                run=geardyn.RunSettings(transient=0.0),
+                                                settings=geardyn.LyapunovSettings(duration=1.0)),
         "orbit": lambda: geardyn.periodic_orbit(model, omega=omega, guess=y0,
                                                 settings=geardyn.NewtonSettings(max_iter=1)),
     }

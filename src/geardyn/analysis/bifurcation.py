@@ -20,7 +20,7 @@ from geardyn.analysis.lyapunov import lyapunov_err_attrs, lyapunov_unresolved_at
 from geardyn.analysis.motion import averaging_time, motion_variable
 from geardyn.core.model import Model
 from geardyn.core.plan import forcing_period
-from geardyn.core.settings import RunSettings, resolve_run
+from geardyn.core.settings import LyapunovSettings, RunSettings, resolve_run
 from geardyn.core.status import Status
 from geardyn.execution.executor import lane_results, run_chunks, run_lanes_task
 from geardyn.solvers.ensemble import LaneResults
@@ -171,9 +171,11 @@ def bifurcation(
         final = last.final
         start = np.where(np.isfinite(final), final, np.broadcast_to(base_y0, final.shape))
         asked = run.samples * _mean_period(model, P)  # averaging time asked for
-        exps, errs, unres, _ = lyapunov_lanes(model, P, start, min(run.transient, LYAPUNOV_ALIGN),
-                                              asked, run.steps_per_period, t0=last.final_time,
-                                              with_status=True)
+        align = RunSettings(transient=min(run.transient, LYAPUNOV_ALIGN),
+                            steps_per_period=run.steps_per_period)
+        exps, errs, unres, _ = lyapunov_lanes(model, P, start, align,
+                                              settings=LyapunovSettings(duration=asked),
+                                              t0=last.final_time, with_status=True)
         ok = ds["status"].values == Status.OK
         method = ("tangent-map QR (Benettin), from the point's final state at its final time, "
                   f"{LYAPUNOV_ALIGN:g} time units to align, then as long as the sampling")

@@ -93,8 +93,9 @@ def continue_branches(
 ) -> list[LaneResults]:
     """Run every branch by continuation, all branches together (see the module docs), with the
     ``samples``, ``converge``, ``locate_edges`` and ``bound`` of ``run`` (the branches' own
-    transients and steps apply; an int: the samples), or of the keyword arguments of those
-    names; the branches must share the model's compiled kernel. Returns one
+    transients and steps apply); those as keyword arguments, or an int as ``run`` (the
+    samples), are deprecated (one DeprecationWarning naming ``run=geardyn.RunSettings(...)``).
+    The branches must share the model's compiled kernel. Returns one
     :class:`~geardyn.solvers.ensemble.LaneResults` per branch, its lanes in the branch's
     order. ``progress(done, total)`` counts points of all branches.
 
@@ -116,7 +117,7 @@ def continue_branches(
         run = None
     if int(segment) < 1:
         raise ValueError(f"segment must be >= 1 (got {segment!r})")
-    run = resolve_run(run, settings)
+    run = resolve_run(run, settings, where="continue_branches")
     # the branches' transients, steps and section are per lane (below)
     run = run.replace(max_section_periods=branches[0].max_section_periods)
     converge = run.converge_tol

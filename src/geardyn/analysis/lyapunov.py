@@ -26,7 +26,6 @@ from geardyn.core.plan import (
     periods_covering,
 )
 from geardyn.core.settings import (
-    DEFAULT_BOUND,
     LYAPUNOV_BLOCKS,
     LYAPUNOV_DT,
     LYAPUNOV_RENORM_EVERY,
@@ -111,14 +110,6 @@ def _check_blocks(n_blocks: int) -> int:
     return n
 
 
-def _check_time(name: str, value: float, positive: bool) -> float:
-    value = float(value)
-    if not math.isfinite(value) or value < 0 or (positive and value == 0):
-        need = "> 0" if positive else ">= 0"
-        raise ValueError(f"{name} must be a finite time {need} (got {value!r})")
-    return value
-
-
 def _initial(model: Model, y0) -> np.ndarray:
     y = np.asarray(model.initial_state() if y0 is None else y0, dtype=float).ravel().copy()
     if y.shape != (model.n_states,):
@@ -143,18 +134,19 @@ SETTINGS_FIELDS = tuple(f.name for f in dataclasses.fields(LyapunovSettings))
 
 
 def _lyapunov_run(run: RunSettings | None, settings: LyapunovSettings | None,
-                  keywords: dict[str, Any]) -> tuple[RunSettings, LyapunovSettings]:
-    """The run and Lyapunov settings of :func:`lyapunov`: ``run``, or the run keywords
-    (``transient``, ``steps_per_period``, ``locate_edges``, ``bound``) on its defaults, and
-    ``settings`` (its fields as keywords: deprecated)."""
+                  keywords: dict[str, Any], where: str) -> tuple[RunSettings, LyapunovSettings]:
+    """The run and Lyapunov settings of :func:`lyapunov` and :func:`lyapunov_lanes` (``where``:
+    the function's name): ``run``, or the run keywords (``transient``, ``steps_per_period``,
+    ``locate_edges``, ``bound``) on :data:`LYAPUNOV_DEFAULTS`, and ``settings`` (its fields as
+    keywords: deprecated, one DeprecationWarning pointing at the public function's caller)."""
     extra = sorted(set(keywords) - set(LYAPUNOV_FIELDS) - set(SETTINGS_FIELDS))
     if extra:
-        raise TypeError(f"lyapunov() got an unexpected keyword argument {extra[0]!r} (run "
+        raise TypeError(f"{where}() got an unexpected keyword argument {extra[0]!r} (run "
                         f"settings it uses: {', '.join(LYAPUNOV_FIELDS)})")
     legacy = {k: v for k, v in keywords.items() if k in SETTINGS_FIELDS}
     given = {k: v for k, v in keywords.items() if k in LYAPUNOV_FIELDS}
     return (resolve_run(run, given, LYAPUNOV_DEFAULTS),
-            resolve_settings(LyapunovSettings, settings, legacy, "lyapunov", stacklevel=4))
+            resolve_settings(LyapunovSettings, settings, legacy, where, stacklevel=4))
 
 
 def lyapunov(
@@ -221,7 +213,7 @@ def lyapunov(
     For a forced model the exponent of the flow's zero direction (along the forcing phase) is not
     included: the phase is not a state, so a forced model with n states has n exponents.
     """
-    run, ls = _lyapunov_run(run, settings, keywords)
+    run, ls = _lyapunov_run(run, settings, keywords, "lyapunov")
     transient, steps_per_period, bound = run.transient, run.steps_per_period, run.bound
     duration, dt, renorm_every, n_blocks = ls.duration, ls.dt, ls.renorm_every, ls.n_blocks
     y = _initial(model, y0)
@@ -282,23 +274,25 @@ def lyapunov_lanes(
     model: Model,
     P: np.ndarray,
     y0=None,
-    transient: float = 100.0,
-    duration: float = 2000.0,
-    steps_per_period: int | None = None,
-    dt: float | None = None,
-    renorm_every: int | None = None,
-    bound: float = DEFAULT_BOUND,
+    run: RunSettings | None = None,
+    *,
+    settings: LyapunovSettings | None = None,
     t0: float | np.ndarray = 0.0,
     with_error: bool = False,
-    n_blocks: int = DEFAULT_BLOCKS,
     with_status: bool = False,
+    **keywords: Any,
 ) -> np.ndarray | tuple[np.ndarray, ...]:
     """Largest Lyapunov exponent for each row of the coefficient matrix ``P`` (lanes x n_params,
     e.g. from ``model.lane_params``), computed in parallel; NaN for diverged lanes.
 
     ``y0``: one initial state for all lanes, or one per lane (lanes x n_states); default
-    ``model.initial_state()``. ``transient`` and ``duration`` are times, rounded up to whole
-    forcing periods of each lane (lanes differ in Omega, so their step counts differ). The grid has
+    ``model.initial_state()``. ``run`` and ``settings`` as in :func:`lyapunov`: of the
+    :class:`~geardyn.RunSettings` ``transient``, ``steps_per_period``, ``locate_edges`` and
+    ``bound`` are used (also as keyword arguments, not together with ``run``; without either,
+    ``transient`` is 100 time units), of the :class:`~geardyn.LyapunovSettings` ``duration``,
+    ``dt``, ``renorm_every`` and ``n_blocks`` (its fields as keyword arguments: deprecated, a
+    DeprecationWarning). ``transient`` and ``duration`` are times, rounded up to whole forcing
+    periods of each lane (lanes differ in Omega, so their step counts differ). The grid has
     ``steps_per_period`` steps per period (default: each lane's own
     :func:`default_steps_per_period`, rounded up to the sweep's step ladder, as in
     :func:`~geardyn.solvers.ensemble.run_lanes`); an autonomous model uses the step ``dt``
@@ -313,14 +307,15 @@ def lyapunov_lanes(
     :class:`~geardyn.Status` code (as in :class:`LyapunovEstimate`; exponents kept where
     SPLIT_LIMIT, NaN where DIVERGED).
     """
+    run, ls = _lyapunov_run(run, settings, keywords, "lyapunov_lanes")
+    transient, steps_per_period, bound = run.transient, run.steps_per_period, run.bound
+    duration, dt, renorm_every, n_blocks = ls.duration, ls.dt, ls.renorm_every, ls.n_blocks
     P = np.ascontiguousarray(np.atleast_2d(np.asarray(P, dtype=float)))
     L = P.shape[0]
     if P.shape[1] != model.params.size:
         raise ValueError(f"P must have {model.params.size} columns (got {P.shape[1]})")
     if not np.all(np.isfinite(P)):
         raise ValueError("P must be finite")
-    transient = _check_time("transient", transient, False)
-    duration = _check_time("duration", duration, True)
     if y0 is None:
         Y0 = np.tile(model.initial_state(), (L, 1))
     else:
@@ -368,8 +363,9 @@ def lyapunov_lanes(
         kern = kernels_for(model.kernel, "lyapunov")
         # lanes of every grid together (the kernel blocks them, whatever their steps)
         n_per = np.ones(L, np.int64) if model.omega_index is None else n_lane.astype(np.int64)
+        n_ev = model.n_events if run.locate_edges else 0
         kern.lyapunov_lanes(P, Y0, scale, T0, H, OMEGA, n_per, n_tr, n_st, renorm, float(bound),
-                            out, err, model.n_events, n_blk, unres, status)
+                            out, err, n_ev, n_blk, unres, status)
     if with_status:
         return out, err, unres, status
     return (out, err) if with_error else out

@@ -37,7 +37,7 @@ from geardyn.core.plan import (
     periods_covering,
 )
 from geardyn.core.results import finish
-from geardyn.core.settings import RunSettings, resolve_run
+from geardyn.core.settings import LyapunovSettings, RunSettings, resolve_run
 from geardyn.core.status import Status
 from geardyn.execution.executor import default_chunk, run_chunks
 from geardyn.solvers.ensemble import busy_lanes, run_lanes
@@ -181,8 +181,9 @@ def map2d(
         omega = P[:, model.omega_index]
         duration = float(samples * np.mean(forcing_period(omega)))
         # each lane's own step (lyapunov_lanes: the step rule on the lane's coefficients)
-        lyap = dict(transient=transient, duration=duration,
-                    steps_per_period=steps_per_period, bound=run.bound)
+        lyap = dict(run=RunSettings(transient=transient, steps_per_period=steps_per_period,
+                                    bound=run.bound),
+                    settings=LyapunovSettings(duration=duration))
     task = functools.partial(_map_task, run=run, lyapunov=lyap)
     size = int(chunk) if chunk else default_chunk(P.shape[0])
     meta = {"analysis": "map2d", "model": model.name, "x": xn, "y": yn}
@@ -196,7 +197,7 @@ def map2d(
         section = lane_section(model, P, P[:, model.omega_index], run.max_section_periods)[1]
         labels, motion_attrs = motion_variable(
             period, ds["lyapunov"].values.ravel(), ds["lyapunov_err"].values.ravel(),
-            averaging_time(lyap["duration"], P[:, model.omega_index]), section)
+            averaging_time(lyap["settings"].duration, P[:, model.omega_index]), section)
         ds["motion"] = ((yn, xn), labels.reshape(ny, nx), motion_attrs)
     ds.attrs.update(run.attrs())
     ds.attrs.update(
@@ -205,7 +206,7 @@ def map2d(
         chunk=size, start="each point from its own model's initial state",
     )
     if lyap is not None:
-        ds.attrs.update(lyapunov_duration=lyap["duration"],
+        ds.attrs.update(lyapunov_duration=lyap["settings"].duration,
                         lyapunov_steps_per_period=int(steps_per_period or 0))
     ds.attrs.update(model_attrs(model))
     finish(ds, "map2d")

@@ -188,13 +188,16 @@ FIELDS = tuple(f.name for f in dataclasses.fields(RunSettings))
 
 def resolve_run(run: RunSettings | None, legacy: Mapping[str, Any],
                 defaults: Mapping[str, Any] | None = None,
-                aliases: Mapping[str, str] | None = None) -> RunSettings:
+                aliases: Mapping[str, str] | None = None, where: str | None = None,
+                stacklevel: int = 3) -> RunSettings:
     """The settings of a public function that takes ``run=`` and, for compatibility, the old
     keyword arguments: ``legacy`` holds those the caller gave (name -> value), ``aliases`` maps
     an old name onto a field (``tol`` -> ``period_tol``), ``defaults`` the function's own
     defaults where they differ from RunSettings' (``simulate``'s transient 0). Giving ``run``
     and an old keyword together raises a TypeError naming the keyword; an unknown keyword
-    raises a TypeError too."""
+    raises a TypeError too. ``where`` (the function's name): the old keywords are deprecated,
+    one DeprecationWarning naming the equivalent ``run=geardyn.RunSettings(...)``
+    (``stacklevel``: the public function's caller, seen from here)."""
     aliases = dict(aliases or {})
     given = {aliases.get(k, k): v for k, v in legacy.items()}
     unknown = sorted(set(given) - set(FIELDS))
@@ -208,7 +211,16 @@ def resolve_run(run: RunSettings | None, legacy: Mapping[str, Any],
             raise TypeError(f"give the run settings either as run=RunSettings(...) or as keyword "
                             f"arguments, not both (got run= and {name}=)")
         return run
-    return RunSettings(**{**dict(defaults or {}), **given})
+    fields = {**dict(defaults or {}), **given}
+    out = RunSettings(**fields)
+    if where is not None and given:
+        import warnings
+
+        args = ", ".join(f"{k}={v!r}" for k, v in fields.items())
+        warnings.warn(f"{where}({', '.join(f'{k}=' for k in legacy)}) is deprecated: pass "
+                      f"run=geardyn.RunSettings({args})", DeprecationWarning,
+                      stacklevel=stacklevel)
+    return out
 
 
 # ----------------------------------------------------------------------------- analyses

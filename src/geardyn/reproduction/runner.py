@@ -22,7 +22,7 @@ from geardyn.analysis.motion import LYAPUNOV_FLOOR, LYAPUNOV_Z, exponent_sign, r
 from geardyn.core.model import Model
 from geardyn.core.plan import default_steps_at, lane_section
 from geardyn.core.results import finish
-from geardyn.core.settings import RunSettings
+from geardyn.core.settings import LyapunovSettings, RunSettings
 from geardyn.reproduction.cases import Case
 from geardyn.reproduction.motion import motion_labels
 from geardyn.study import build_model
@@ -154,8 +154,8 @@ def branch_lyapunov(model: Model, values: np.ndarray, y0: np.ndarray, need: np.n
         lanes = idx[g]
         out[lanes], err[lanes] = lyapunov_lanes(
             model, model.lane_params("Omega", values[lanes]), np.asarray(y0)[lanes],
-            transient=transient, duration=duration, steps_per_period=int(max(steps[g])),
-            t0=t0[lanes], with_error=True)
+            RunSettings(transient=transient, steps_per_period=int(max(steps[g]))),
+            settings=LyapunovSettings(duration=duration), t0=t0[lanes], with_error=True)
     return out, np.where(np.isfinite(out), err, np.nan)
 
 
