@@ -77,6 +77,74 @@ def test_layout_errors_name_the_field():
         lay.validate({"n": 3.0})
 
 
+# ------------------------------------------------------------------------------ derivations
+def phase_block() -> CoefficientBlock:
+    """A phase and its cos and sin, derived with their functions."""
+    return CoefficientBlock((
+        Coefficient("phi", "rad", "phase"),
+        Coefficient("cos_phi", "1", "cos of the phase", "derived", ("phi",), derive=math.cos),
+        Coefficient("sin_phi", "1", "sin of the phase", "derived", ("phi",), derive=math.sin),
+    ))
+
+
+def test_a_derived_coefficient_carries_its_function_and_the_layout_fills_it():
+    phase = phase_block()
+    lay = CoefficientLayout.of(phase, (phase, "2"), model="toy")
+    assert lay.derivations() == {"cos_phi": ("phi", math.cos), "sin_phi": ("phi", math.sin),
+                                 "cos_phi2": ("phi2", math.cos), "sin_phi2": ("phi2", math.sin)}
+    P = np.zeros((3, 6))
+    P[:, 0], P[:, 3] = [0.0, 0.5, 0.5], [1.0, -2.0, 3.0]
+    assert lay.fill_derived(P) is P
+    for row, (a, b) in zip(P, [(0.0, 1.0), (0.5, -2.0), (0.5, 3.0)], strict=True):
+        assert list(row) == [a, math.cos(a), math.sin(a), b, math.cos(b), math.sin(b)]
+    assert lay.vocabulary()["phi2"].unit == "rad" and set(lay.vocabulary()) == set(lay.names)
+    for bad in (dict(kind="input", derive=math.cos),
+                dict(kind="derived", derived_from=("a", "b"), derive=math.cos),
+                dict(kind="derived", derived_from=("a",), derive=1.0)):
+        with pytest.raises(ValueError, match="^x: derive is the function of one input"):
+            Coefficient("x", **bad)
+    with pytest.raises(ValueError, match="^x: unit must be a string"):
+        Coefficient("x", 1.0)
+    with pytest.raises(ValueError, match="^cos_phi: a derived coefficient with its function"):
+        CoefficientLayout().place(["c1", "c2"], phase["cos_phi"])
+
+
+def test_with_params_and_lane_params_refill_the_declared_derivations():
+    """Model's own with_params and lane_params (no model override) refill a derived
+    coefficient from its declaration, and refuse it naming its input."""
+    block = CoefficientBlock((Coefficient("Omega"), *phase_block().entries))
+    toy = geardyn.UserModel(user_model().kernel.rhs, n_states=2, params=[1.0, 0.0, 1.0, 0.0],
+                            name="toy")
+    toy.coefficient_layout = CoefficientLayout.of(block, model="toy")
+    out = toy.with_params(phi=0.4)
+    assert list(out.params) == [1.0, 0.4, math.cos(0.4), math.sin(0.4)]
+    P = toy.lane_params("phi", [0.1, -0.2])
+    np.testing.assert_array_equal(P[:, 2:], [[math.cos(0.1), math.sin(0.1)],
+                                             [math.cos(-0.2), math.sin(-0.2)]])
+    with pytest.raises(ParameterError, match="^cos_phi: derived from phi"):
+        toy.with_params(cos_phi=0.5)
+    with pytest.raises(ParameterError, match="^phi: must be a number"):
+        toy.with_params(phi=True)
+
+
+def test_the_gear_pair_declares_each_derived_coefficient_once():
+    """GearPair.derived is read from the functions in GEAR_PAIR; its with_params and lane_params
+    are Model's, and fill the cos/sin of the phases as the compiled code's libm does."""
+    declared = {c.name: (c.derived_from[0], c.derive) for c in GEAR_PAIR.entries
+                if c.kind == "derived"}
+    assert dict(geardyn.GearPair.derived) == declared == {
+        "cos_kappa_phase": ("kappa_phase", math.cos), "sin_kappa_phase": ("kappa_phase", math.sin),
+        "cos_error_phase": ("error_phase", math.cos), "sin_error_phase": ("error_phase", math.sin)}
+    assert "with_params" not in vars(geardyn.GearPair)
+    assert "lane_params" not in vars(geardyn.GearPair)
+    m = geardyn.GearPair().with_params(kappa_phase=0.3, error_phase=-1.1)
+    got = m.coefficient_values()
+    assert (got["cos_kappa_phase"], got["sin_kappa_phase"]) == (math.cos(0.3), math.sin(0.3))
+    assert (got["cos_error_phase"], got["sin_error_phase"]) == (math.cos(-1.1), math.sin(-1.1))
+    with pytest.raises(ParameterError, match="^backlash: must be >= 0"):
+        m.with_params(backlash=-0.5)
+
+
 def test_declarations_are_checked():
     with pytest.raises(ValueError, match="names what it derives from"):
         Coefficient("k", kind="derived")
@@ -138,7 +206,7 @@ TABLE = {
     "catt-general": ("k_pq_q2", True, "spare3", None, "f_c0"),
     "dimensional": ("C_sq1", False, "n_sets", None, "T_D"),
     "planetary": ("s1_KF", True, "n_dof", "cache0_sin", "torque_phase"),
-    "gear-pair": (None, False, None, None, "zeta"),
+    "gear-pair": ("cos_kappa_phase", False, None, None, "zeta"),
     "user": (None, False, None, None, "zeta"),
 }
 

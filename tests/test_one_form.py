@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 
 import geardyn
+from geardyn.core.coefficients import Coefficient
 from geardyn.core.one_form import call_tuple, coefficient_type
 from geardyn.solvers.ensemble import LaneResults, run_lanes
 from geardyn.solvers.kernels import kernels_for
@@ -77,9 +78,9 @@ def test_derived_coefficients_follow_their_parameter_and_cannot_be_set():
     names = m.param_names
     assert m.params[names.index("cos_kappa_phase")] == 1.0
     assert m.params[names.index("sin_error_phase")] == 0.0
-    with pytest.raises(ValueError, match="derived from 'kappa_phase'"):
+    with pytest.raises(ValueError, match="derived from kappa_phase"):
         m.with_params(cos_kappa_phase=0.5)
-    with pytest.raises(ValueError, match="derived from 'error_phase'"):
+    with pytest.raises(ValueError, match="derived from error_phase"):
         m.lane_params("sin_error_phase", [0.1])
     P = m.lane_params("kappa_phase", [0.0, 0.3, -1.2])
     assert list(P[:, names.index("cos_kappa_phase")]) == [1.0, math.cos(0.3), math.cos(-1.2)]
@@ -87,7 +88,7 @@ def test_derived_coefficients_follow_their_parameter_and_cannot_be_set():
     q = m.with_params(error_phase=0.4).params
     assert q[names.index("cos_error_phase")] == math.cos(0.4)
     u = gear_pair(**COEFFS)
-    with pytest.raises(ValueError, match="derived from 'phi_k'"):
+    with pytest.raises(ValueError, match="derived from phi_k"):
         u.with_params(sin_phi_k=0.0)
     assert u.with_params(phi_k=0.3).coefficients().cos_phi_k == math.cos(0.3)
 
@@ -252,3 +253,104 @@ def test_the_contract_refuses_mesh_forces_without_one_force_per_mesh():
     model.observable_names = ("F", "G")
     report = check_model(model, raise_on_failure=False)
     assert not report.ok and "mesh_forces" in str(report)
+
+
+# ------------------------------------------------------------------------------ declarations
+def declared() -> tuple[Coefficient, ...]:
+    """Units, meanings and ranges of some of the user gear pair's coefficients; cos/sin of the
+    error phase declared here with their function, those of the stiffness phase through
+    ``derived``."""
+    return (
+        Coefficient("Omega", "1", "mesh frequency / natural frequency", minimum=0.0),
+        Coefficient("zeta", "1", "damping ratio", minimum=0.0),
+        Coefficient("kappa", "1", "relative stiffness variation", exclusive_minimum=-1.0,
+                    exclusive_maximum=1.0),
+        Coefficient("phi_k", "rad", "phase of the stiffness variation"),
+        Coefficient("cos_phi_e", "1", "cos of the error phase", "derived", ("phi_e",),
+                    derive=math.cos),
+        Coefficient("sin_phi_e", "1", "sin of the error phase", "derived", ("phi_e",),
+                    derive=math.sin),
+    )
+
+
+def declared_pair(coefficients=None, derived=None, **params):
+    """The user gear pair of ``examples/gear_pair_model.py`` with declared coefficients."""
+    import gear_pair_model as gp
+
+    values = dict(Omega=1.0, zeta=0.05, kappa=0.2, Fm=0.1, Fa=0.2, phi_k=0.0, phi_e=0.0, b=1.0)
+    return geardyn.UserModel.from_one_form(
+        gp.pair_rhs, params={**values, **params},
+        derived={"cos_phi_k": ("phi_k", math.cos), "sin_phi_k": ("phi_k", math.sin)}
+        if derived is None else derived,
+        coefficients=declared() if coefficients is None else coefficients, states=("x", "v"),
+        events=gp.pair_events, event_names=("x-b", "x+b"), observe=gp.pair_force,
+        observable_names=("F",),
+        meshes=[("mesh", "x-b", "x+b", "F")], static_forces=lambda p: (p.Fm,),
+        natural_frequency=1.0, name="declared pair")
+
+
+def test_a_user_model_declares_units_meanings_and_ranges():
+    m = declared_pair(phi_k=0.3, phi_e=-0.7)
+    plain = gear_pair(**COEFFS, phi_k=0.3, phi_e=-0.7)
+    assert m.param_names == plain.param_names  # the same vector, so the same kernels
+    np.testing.assert_array_equal(m.params, plain.params)
+    lay = m.coefficient_layout
+    assert lay.slot("phi_k").coefficient.unit == "rad"
+    assert lay.vocabulary()["zeta"].describe() == "damping ratio"
+    assert lay.slot("Fm").coefficient == Coefficient("Fm")  # undeclared: an input of unit 1
+    assert lay.slot("cos_phi_e").coefficient.kind == "derived"
+    assert lay.slot("cos_phi_k").coefficient.derived_from == ("phi_k",)
+    assert m.derived == {"cos_phi_k": ("phi_k", math.cos), "sin_phi_k": ("phi_k", math.sin),
+                         "cos_phi_e": ("phi_e", math.cos), "sin_phi_e": ("phi_e", math.sin)}
+    assert m.param_attrs("phi_k") == {"units": "rad",
+                                      "long_name": "phase of the stiffness variation"}
+    assert m.param_attrs("Fm") == {}
+    assert m.with_params(phi_e=0.25).coefficients().sin_phi_e == math.sin(0.25)
+    with pytest.raises(geardyn.ParameterError, match="^zeta: must be >= 0"):
+        m.with_params(zeta=-0.01)
+    with pytest.raises(geardyn.ParameterError, match="^kappa: must be < 1"):
+        m.with_params(kappa=1.0)
+    with pytest.raises(geardyn.ParameterError, match="^Omega: must be >= 0"):
+        m.with_omega(-1.0)
+    with pytest.raises(geardyn.ParameterError, match="^cos_phi_e: derived from phi_e"):
+        m.with_params(cos_phi_e=1.0)
+    with pytest.raises(geardyn.ParameterError, match="^zeta: must be >= 0"):
+        declared_pair(zeta=-0.5)
+
+
+def test_a_user_models_declarations_are_checked_naming_the_field():
+    cases = [
+        ([Coefficient("zeta2", "1", "typo")], "coefficients: 'zeta2' is not among params"),
+        ([("zeta", "1")], r"coefficients\[0\]: a geardyn.core.coefficients.Coefficient"),
+        ([Coefficient("zeta"), Coefficient("zeta")], "'zeta' is declared twice"),
+        ([Coefficient("zeta", kind="derived", derived_from=("kappa",), derive=abs)],
+         "'zeta' has a value in params, so it is an input"),
+        ([Coefficient("c", kind="derived", derived_from=("kappa",))], "'c' is derived; give"),
+        ([Coefficient("c", kind="derived", derived_from=("nope",), derive=abs)],
+         "derived 'c': derived from 'nope', which is not among params"),
+        ([Coefficient("cos_phi_k", kind="derived", derived_from=("phi_k",), derive=abs)],
+         "'cos_phi_k' is declared in derived too"),
+    ]
+    for coefficients, message in cases:
+        with pytest.raises(ValueError, match=message):
+            declared_pair(coefficients)
+    with pytest.raises(ValueError, match="^zeta: unit must be a string"):
+        declared_pair([Coefficient("zeta", 1)])
+    with pytest.raises(ValueError, match="derived 'c': needs"):
+        declared_pair((), derived={"c": "phi_k"})
+
+
+def test_a_user_models_sweep_axis_carries_its_declared_unit():
+    """A sweep in a declared phase: the axis has its unit and meaning, and each lane is the model
+    with that phase (derived cos/sin follow it per lane)."""
+    m = declared_pair()
+    phases = np.array([0.0, 1.3])
+    ds = geardyn.bifurcation(m, "phi_k", phases, transient=40.0, samples=4)
+    assert ds["phi_k"].attrs == {"units": "rad", "long_name": "phase of the stiffness variation"}
+    for k, phase in enumerate(phases):
+        one = geardyn.bifurcation(m.with_params(phi_k=float(phase)), "Omega", [1.0],
+                                  transient=40.0, samples=4)
+        np.testing.assert_allclose(ds["poincare"].values[k], one["poincare"].values[0],
+                                   rtol=1e-12, atol=1e-12)
+    om = geardyn.bifurcation(m, "Omega", [0.9, 1.1], transient=40.0, samples=4)
+    assert om["Omega"].attrs["long_name"] == "mesh frequency / natural frequency"

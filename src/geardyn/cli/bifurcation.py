@@ -94,7 +94,9 @@ def _sweepable(model) -> list[str]:
     """Names a sweep of ``model`` accepts, for error messages."""
     if model.capabilities.physical_inputs:  # models with named physical inputs
         return ["Omega", *model.physical_names]
-    return ["Omega", *(n for n in model.param_names if n != "Omega" and n not in model.derived)]
+    layout = model.coefficient_layout
+    return ["Omega", *(n for n in model.param_names
+                       if n != "Omega" and layout.slot(n).coefficient.kind == "input")]
 
 
 def _check_param_name(model, param: str) -> None:

@@ -12,7 +12,7 @@ From the declarations come:
   (:meth:`CoefficientLayout.build`), read back into a dict (:meth:`CoefficientLayout.read`),
   validation naming the field (:meth:`CoefficientLayout.validate`);
 * the vocabulary (names, units, meanings) of study files, CLI help and the explorer
-  (:meth:`CoefficientBlock.vocabulary`).
+  (:meth:`CoefficientBlock.vocabulary`, :meth:`CoefficientLayout.vocabulary`).
 
 Four kinds of entry (:data:`KINDS`), and only the first two are parameters:
 
@@ -21,7 +21,11 @@ Four kinds of entry (:data:`KINDS`), and only the first two are parameters:
 ``derived``
     computed from physical inputs (``derived_from`` names them); ``Model.with_params`` refuses
     it, naming those inputs, unless the model accepts raw overrides
-    (``Model.raw_overrides_allowed``, the CATT device);
+    (``Model.raw_overrides_allowed``, the CATT device). One that is a function of one input's
+    value carries that function (``derive=math.cos``): the layout then fills it
+    (:meth:`CoefficientLayout.fill_derived`) wherever that input is set (``with_params``,
+    ``lane_params``), so no model writes the derivation a second time; others are computed by
+    the model's own code from its physical inputs;
 ``structure``
     constant for the model and the same in every lane (counts, sparse indices): it fixes the
     vector's layout or the kernel's loops; never a parameter;
@@ -47,15 +51,20 @@ Declaring a model (e.g. a gear pair with eight per-lane coefficients)::
 and in the model's ``__init__``: ``self.coefficient_layout = CoefficientLayout.of(GEAR_PAIR,
 model="GearPair")``, ``self.params = self.coefficient_layout.build(values, validate=True)``;
 ``param_names`` then follows the layout, and ``Model.with_params`` validates by the declaration.
-A cos/sin pair derived from a phase is declared ``kind="derived"`` with
-``derived_from=("kappa_phase",)``. (The gear pair's actual declaration is
+A cos/sin pair derived from a phase is declared with its function::
+
+    Coefficient("cos_kappa_phase", "1", "cos of the stiffness phase", kind="derived",
+                derived_from=("kappa_phase",), derive=math.cos)
+
+and ``layout.fill_derived(p)`` computes it from ``kappa_phase`` (``Model.with_params`` and
+``Model.lane_params`` call it). (The gear pair's actual declaration is
 :data:`geardyn.models.gear_pair_coefficients.GEAR_PAIR`.)
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -79,7 +88,10 @@ class Coefficient:
     ``derived_from`` the physical inputs a derived coefficient is computed from; ``constant``
     the kernel's index constant (default the upper-cased name); ``default`` the value
     :meth:`CoefficientLayout.build` writes when none is given (workspace: its initial value);
-    ``minimum``/``maximum`` (inclusive) and ``exclusive_*`` the admissible range."""
+    ``minimum``/``maximum`` (inclusive) and ``exclusive_*`` the admissible range; ``derive``,
+    for a derived coefficient of one input, the function of that input's value that gives it
+    (computed once per distinct value, in Python: ``math.cos`` is the libm the compiled code
+    calls, so the same bits)."""
 
     name: str
     unit: str = "1"
@@ -93,13 +105,26 @@ class Coefficient:
     maximum: float | None = None
     exclusive_minimum: float | None = None
     exclusive_maximum: float | None = None
+    derive: Callable[[float], float] | None = None
 
     def __post_init__(self) -> None:
+        for label in ("name", "unit", "meaning"):
+            if not isinstance(getattr(self, label), str):
+                raise ValueError(f"{self.name}: {label} must be a string "
+                                 f"(got {getattr(self, label)!r})")
         if self.kind not in KINDS:
             raise ValueError(f"{self.name}: kind must be one of {', '.join(KINDS)}; "
                              f"got {self.kind!r}")
+        if isinstance(self.derived_from, str):
+            raise ValueError(f"{self.name}: derived_from is a tuple of names "
+                             f"(got {self.derived_from!r})")
         if self.kind == "derived" and not self.derived_from:
             raise ValueError(f"{self.name}: a derived coefficient names what it derives from")
+        if self.derive is not None and not (self.kind == "derived" and callable(self.derive)
+                                            and len(self.derived_from) == 1):
+            raise ValueError(f"{self.name}: derive is the function of one input's value that "
+                             "gives a derived coefficient (kind 'derived', derived_from one "
+                             f"name, derive callable; got {self.derive!r})")
         if self.per_lane is None:
             object.__setattr__(self, "per_lane", self.kind in PARAMETER_KINDS)
         if self.per_lane and self.kind == "structure":
@@ -117,8 +142,13 @@ class Coefficient:
 
     def check(self, field_name: str, value: float) -> float:
         """``value`` as a float, or a :class:`~geardyn.errors.ParameterError` naming
-        ``field_name`` when it is not finite or outside the declared range."""
-        v = float(value)
+        ``field_name`` when it is not a finite number or outside the declared range."""
+        try:
+            v = float(value)
+        except (TypeError, ValueError):
+            v = None
+        if v is None or isinstance(value, bool):
+            raise ParameterError(field_name, value, "must be a number")
         if not math.isfinite(v):
             raise ParameterError(field_name, value, "must be finite")
         for bound, bad, word in ((self.minimum, v < (self.minimum or 0.0), ">="),
@@ -185,6 +215,11 @@ class CoefficientBlock:
         return {c.name: c for c in self.entries if c.is_parameter}
 
 
+#: Derived coefficients that carry their function: name -> (the entry it follows, the function
+#: of that entry's value), as :meth:`CoefficientLayout.derivations` gives them.
+Derivations = Mapping[str, tuple[str, Callable[[float], float]]]
+
+
 @dataclass(frozen=True)
 class Slot:
     """One placed entry of a layout: its name in the vector and its declaration."""
@@ -203,6 +238,7 @@ class CoefficientLayout:
         self.model = model
         self._slots: list[Slot] = []
         self._index: dict[str, int] = {}
+        self._derivations: dict[str, tuple[str, Callable[[float], float]]] = {}
 
     # ------------------------------------------------------------------ building the layout
     @classmethod
@@ -230,11 +266,19 @@ class CoefficientLayout:
             name = prefix + c.name + suffix
             self._index.setdefault(name, len(self._slots))
             self._slots.append(Slot(name, c))
+            if c.derive is not None:
+                self._derivations.setdefault(name, (prefix + c.derived_from[0] + suffix,
+                                                    c.derive))
         return start
 
     def place(self, names: Iterable[str], coefficient: Coefficient) -> int:
         """Append one entry per name in ``names``, each declared by ``coefficient`` (a series
-        of like entries: indices, cache rows); returns the index of the first."""
+        of like entries: indices, cache rows); returns the index of the first. A coefficient
+        that carries a ``derive`` function is placed by :meth:`extend` instead."""
+        if coefficient.derive is not None:
+            raise ValueError(f"{coefficient.name}: a derived coefficient with its function is "
+                             "placed by extend (its input's name is its own, with the same "
+                             "prefix and suffix)")
         start = len(self._slots)
         for name in names:
             self._index.setdefault(name, len(self._slots))
@@ -273,6 +317,16 @@ class CoefficientLayout:
 
     def __contains__(self, name: object) -> bool:
         return name in self._index
+
+    def vocabulary(self) -> dict[str, Coefficient]:
+        """The parameters by their names in the vector (names, units, meanings: the
+        vocabulary of study files, CLI help, the explorer and dataset axes)."""
+        return {s.name: s.coefficient for s in self._slots if s.coefficient.is_parameter}
+
+    def derivations(self) -> dict[str, tuple[str, Callable[[float], float]]]:
+        """The derived coefficients that carry their function (``derive``): name -> (the
+        entry it follows, the function of its value), in vector order (``Model.derived``)."""
+        return dict(self._derivations)
 
     def slot(self, name: str, value: object = None) -> Slot:
         """The entry ``name`` (any kind); :class:`~geardyn.errors.UnknownParameterError`
@@ -326,6 +380,21 @@ class CoefficientLayout:
                 raise ParameterError(s.name, None, f"{self.model}: no value given")
             p[k] = v
         return p
+
+    def fill_derived(self, P: np.ndarray) -> np.ndarray:
+        """Set, in place, every derived coefficient that carries its function (``derive``) in
+        the vector or rows ``P`` from the entry it follows: each function is called once per
+        distinct value, in Python (``math.cos``: the libm the compiled code calls, so the same
+        bits). Returns ``P``. An input the layout does not hold is a ValueError naming both."""
+        for name, (source, fn) in self._derivations.items():
+            if source not in self._index:
+                raise ValueError(f"{name}: derived from {source}, which {self.model} does not "
+                                 "declare")
+            col = P[..., self._index[source]]
+            values, inverse = np.unique(col, return_inverse=True)
+            P[..., self._index[name]] = np.array([fn(float(v)) for v in values])[
+                inverse].reshape(col.shape)
+        return P
 
     def read(self, p: np.ndarray, parameters_only: bool = True) -> dict[str, float]:
         """The vector ``p`` read back by name (parameters only, unless ``parameters_only`` is

@@ -139,9 +139,11 @@ class Model:
     kernel: KernelSource
     #: Meshes with a backlash dead zone: (name, index of event X - b, index of event X + b).
     meshes: tuple[tuple[str, int, int], ...] = ()
-    #: Derived coefficients (entries of ``params`` after the parameters): name -> (the parameter
-    #: it follows, the function of its value); they follow it and are not set on their own
-    #: (see :func:`geardyn.core.one_form.fill_derived`).
+    #: Derived coefficients that carry their function in the declaration (``Coefficient(...,
+    #: derive=math.cos)``): name -> (the parameter it follows, the function of its value), as
+    #: ``coefficient_layout.derivations()`` gives them; :meth:`with_params` and
+    #: :meth:`lane_params` refill them from the layout (:meth:`CoefficientLayout.fill_derived
+    #: <geardyn.core.coefficients.CoefficientLayout.fill_derived>`).
     derived: Mapping[str, tuple[str, Callable[[float], float]]] = MappingProxyType({})
     #: Omega is one entry of ``params`` and no other coefficient depends on it, so a lane's
     #: Omega may be set by writing that entry; False where Omega moves other coefficients (set
@@ -261,12 +263,13 @@ class Model:
         raise NotImplementedError(f"{self.name} has no physical inputs")
 
     def _with_raw(self, values: dict[str, float]) -> Model:
-        """A copy with coefficients set by name (checked by :meth:`_checked_raw`)."""
+        """A copy with coefficients set by name (checked by :meth:`_checked_raw`), the derived
+        coefficients declared with their function following them."""
         out = copy.copy(self)
         p = self.params.copy()
         for idx, value in self._checked_raw(values).items():
             p[idx] = value
-        out.params = p
+        out.params = self.coefficient_layout.fill_derived(p)
         return out
 
     def lane_params(self, name: str, values: Sequence[float] | np.ndarray) -> np.ndarray:
@@ -274,8 +277,8 @@ class Model:
 
         The base implementation sets one entry of ``params`` by name (``"Omega"`` is the forcing
         frequency), by the rules of :meth:`with_params` (a coefficient declared the same in
-        every lane cannot be swept); physical models override it to re-derive every
-        coefficient.
+        every lane cannot be swept), the derived coefficients declared with their function
+        following it; physical models override it to re-derive every coefficient.
         """
         values = np.asarray(values, dtype=float).ravel()
         idx = self._raw_target(name)
@@ -284,7 +287,7 @@ class Model:
                                  "it cannot be swept")
         P = np.tile(self.params, (values.size, 1))
         P[:, idx] = values
-        return P
+        return self.coefficient_layout.fill_derived(P)
 
     def lane_params_grid(self, x: str, x_values: Sequence[float] | np.ndarray, y: str,
                          y_values: Sequence[float] | np.ndarray) -> np.ndarray:
@@ -322,7 +325,8 @@ class Model:
 
         * a physical input (:attr:`physical_names`) re-derives the coefficients;
         * an input coefficient (or ``"Omega"``) sets its entry, checked against its declaration
-          (finite, in range: else a :class:`~geardyn.errors.ParameterError` naming it);
+          (finite, in range: else a :class:`~geardyn.errors.ParameterError` naming it); the
+          derived coefficients declared with their function (``derive``) follow it;
         * a derived coefficient is refused naming what it derives from, unless the model takes
           raw overrides (:attr:`raw_overrides_allowed`);
         * a structure or workspace entry, or an unknown name, is an

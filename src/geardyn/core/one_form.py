@@ -19,7 +19,8 @@ unused fields never loaded.
 
 Every lane takes the one form FORM_QUIET: the fused loop vectorises wherever the functions call
 no libm routine per lane (a model precomputes cos/sin of a coefficient as coefficients of its
-own, see :class:`geardyn.models.gear_pair.GearPair`).
+own: derived coefficients declared with their function, filled by the coefficient layout; see
+:mod:`geardyn.core.coefficients` and :class:`geardyn.models.gear_pair.GearPair`).
 
 This module belongs to the core: it imports nothing of geardyn outside :mod:`geardyn.core`.
 """
@@ -28,14 +29,12 @@ from __future__ import annotations
 
 import collections
 import keyword
-from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
-import numpy as np
+from geardyn.core.coefficients import Derivations
 
-__all__ = ["Derivations", "OneForm", "adapters", "call_tuple", "coefficient_type", "fill_derived",
-           "refuse_derived"]
+__all__ = ["Derivations", "OneForm", "adapters", "call_tuple", "coefficient_type"]
 
 _TYPE_PREFIX = "Coefficients_"
 
@@ -98,31 +97,6 @@ def __getattr__(attr: str) -> type:
             raise AttributeError(attr) from None
         return coefficient_type(tuple(names.split(",")) if names else ())
     raise AttributeError(f"module {__name__!r} has no attribute {attr!r}")
-
-
-#: Derived coefficients of a model: name -> (the parameter it follows, a function of its value).
-Derivations = Mapping[str, tuple[str, Callable[[float], float]]]
-
-
-def fill_derived(P: np.ndarray, names: Sequence[str], derived: Derivations) -> None:
-    """Set the derived coefficients of every coefficient vector in ``P`` (one vector or rows)
-    from the parameters they follow, in place; each value is computed once by the Python
-    function (e.g. ``math.cos``: the libm the compiled code calls, so the same bits)."""
-    names = list(names)
-    for name, (src, fn) in derived.items():
-        col = P[..., names.index(src)]
-        values, inverse = np.unique(col, return_inverse=True)
-        P[..., names.index(name)] = np.array([fn(float(v)) for v in values])[inverse].reshape(
-            col.shape)
-
-
-def refuse_derived(names: Iterable[str], derived: Derivations) -> None:
-    """ValueError naming the parameter a derived coefficient follows, for any of ``names``
-    that is derived (a derived coefficient is not set on its own)."""
-    for name in names:
-        if name in derived:
-            raise ValueError(f"{name} is derived from {derived[name][0]!r} and follows it; "
-                             f"set {derived[name][0]!r} instead")
 
 
 def call_tuple(fn: Any, names: tuple[str, ...], t: float, y: Any, p: Any, s: float,

@@ -11,7 +11,7 @@ static transmission error of amplitude Fa, kappa the relative stiffness variatio
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from types import MappingProxyType
 
 import numba as nb
 import numpy as np
@@ -20,7 +20,7 @@ from geardyn.core.capabilities import Capabilities
 from geardyn.core.coefficients import CoefficientLayout
 from geardyn.core.kernel_source import KernelSource
 from geardyn.core.model import Model
-from geardyn.core.one_form import OneForm, fill_derived, refuse_derived
+from geardyn.core.one_form import OneForm
 from geardyn.models.elements import dead_zone
 from geardyn.models.gear_pair_coefficients import GEAR_PAIR
 
@@ -57,12 +57,10 @@ def gear_pair_observe(t, y, p, s, c):
     return ((1.0 + p.kappa * ck) * g + 2.0 * p.zeta * y[1],)
 
 
-#: Derived coefficients: name -> (the parameter it follows, the function of it), computed with
-#: Python's ``math`` (the libm of the compiled code: cos 0 = 1 and sin 0 = 0 exactly).
-DERIVED = {"cos_kappa_phase": ("kappa_phase", math.cos),
-           "sin_kappa_phase": ("kappa_phase", math.sin),
-           "cos_error_phase": ("error_phase", math.cos),
-           "sin_error_phase": ("error_phase", math.sin)}
+#: Derived coefficients: name -> (the parameter it follows, the function of it), read from their
+#: declarations in :data:`~geardyn.models.gear_pair_coefficients.GEAR_PAIR` (computed with
+#: Python's ``math``, the libm of the compiled code: cos 0 = 1 and sin 0 = 0 exactly).
+DERIVED = MappingProxyType(_LAYOUT.derivations())
 
 _KERNEL = KernelSource(gear_pair_rhs, gear_pair_events, gear_pair_observe,
                        one_form=OneForm(GEAR_PAIR.names, 2, 2, 1))
@@ -86,6 +84,8 @@ class GearPair(Model):
     derived = DERIVED
     #: The declared coefficients (:data:`~geardyn.models.gear_pair_coefficients.GEAR_PAIR`):
     #: the parameters, then the derived coefficients (:data:`DERIVED`), in the kernel's order.
+    #: ``with_params`` and ``lane_params`` are :class:`~geardyn.Model`'s: they validate by the
+    #: declarations and refill the derived coefficients from them.
     param_names = GEAR_PAIR.names
 
     def __init__(self, zeta: float = 0.05, kappa: float = 0.0, Fm: float = 0.1, Fa: float = 0.05,
@@ -105,31 +105,11 @@ class GearPair(Model):
             raise ValueError(f"backlash: must be >= 0 (got {backlash!r})")
         if Omega < 0:
             raise ValueError(f"Omega: must be >= 0 (got {Omega!r})")
-        self.params = np.array([float(values[k]) for k in self.param_names[:COS_K]]
-                               + [0.0] * len(DERIVED))
-        fill_derived(self.params, self.param_names, DERIVED)
+        self.params = _LAYOUT.fill_derived(np.array(
+            [float(values[k]) for k in self.param_names[:COS_K]] + [0.0] * len(DERIVED)))
         self.coefficient_layout = _LAYOUT
         self.omega_index = OMEGA
         self.kernel = _KERNEL
-
-    def with_params(self, **values: float) -> GearPair:
-        """A copy with parameters changed by name, validated as in the constructor (every
-        derived quantity reads the coefficient vector, so it follows). The derived coefficients
-        (:data:`DERIVED`) follow their parameter and cannot be set."""
-        refuse_derived(values, DERIVED)
-        current = dict(zip(self.param_names[:COS_K], (float(v) for v in self.params),
-                           strict=False))
-        for name in values:
-            self._param_index(name)  # unknown names: KeyError naming the known ones
-        return type(self)(**{**current, **{k: float(v) for k, v in values.items()}})
-
-    def lane_params(self, name: str, values: Sequence[float] | np.ndarray) -> np.ndarray:
-        """Coefficient vectors with ``name`` set to ``values``, the derived coefficients
-        following it."""
-        refuse_derived((name,), DERIVED)
-        P = Model.lane_params(self, name, values)
-        fill_derived(P, self.param_names, DERIVED)
-        return P
 
     def fastest_natural_frequency(self, P: np.ndarray | None = None) -> np.ndarray:
         """The linear natural frequency in contact, 1 in every lane (time is scaled by it)."""

@@ -5,11 +5,13 @@ is generated from its inputs."""
 
 from __future__ import annotations
 
+import math
+
 from geardyn.core.coefficients import Coefficient, CoefficientBlock
 
 #: The gear pair's coefficient vector: eight inputs, then the cos and sin of the two phases
-#: (derived: computed by :class:`~geardyn.GearPair` from the phases, so that no lane calls libm
-#: per step); dimensionless (time in units of
+#: (derived, each with its function: the layout fills them from the phases wherever a phase is
+#: set, so that no lane calls libm per step); dimensionless (time in units of
 #: 1 / the natural frequency in contact, x in units of the backlash scale).
 GEAR_PAIR = CoefficientBlock((
     Coefficient("Omega", "1", "mesh frequency", default=1.0, minimum=0.0),
@@ -24,13 +26,13 @@ GEAR_PAIR = CoefficientBlock((
                 constant="PHI_E"),
     Coefficient("backlash", "1", "backlash half-width", default=1.0, minimum=0.0),
     Coefficient("cos_kappa_phase", "1", "cos of the stiffness phase", kind="derived",
-                derived_from=("kappa_phase",), constant="COS_K"),
+                derived_from=("kappa_phase",), derive=math.cos, constant="COS_K"),
     Coefficient("sin_kappa_phase", "1", "sin of the stiffness phase", kind="derived",
-                derived_from=("kappa_phase",), constant="SIN_K"),
+                derived_from=("kappa_phase",), derive=math.sin, constant="SIN_K"),
     Coefficient("cos_error_phase", "1", "cos of the error phase", kind="derived",
-                derived_from=("error_phase",), constant="COS_E"),
+                derived_from=("error_phase",), derive=math.cos, constant="COS_E"),
     Coefficient("sin_error_phase", "1", "sin of the error phase", kind="derived",
-                derived_from=("error_phase",), constant="SIN_E"),
+                derived_from=("error_phase",), derive=math.sin, constant="SIN_E"),
 ))
 #: The study file's fields: the inputs.
 INPUTS = tuple(c.name for c in GEAR_PAIR.entries if c.kind == "input")

@@ -5,6 +5,11 @@ The way to write one is the one form (:meth:`UserModel.from_one_form`, see
 the coefficients by name; it runs on the same vectorised path as the built-in models and may
 declare its meshes. The constructor's plain ``rhs(t, y, dydt, p)`` (writing dydt in place) is
 the legacy form: it runs on the generic per-lane path, several times slower on a sweep.
+
+A one-form model declares its coefficients as a built-in does (``coefficients=``: a
+:class:`~geardyn.core.coefficients.Coefficient` per parameter, with unit, meaning and range):
+``model.coefficient_layout``, ``with_params`` (range checks naming the field), the explorer's
+help and a sweep's axis attributes (``units``, ``long_name``) read them.
 """
 
 from __future__ import annotations
@@ -16,16 +21,10 @@ from typing import Any
 import numpy as np
 
 from geardyn.core.capabilities import Capabilities
+from geardyn.core.coefficients import Coefficient, CoefficientBlock, CoefficientLayout
 from geardyn.core.kernel_source import KernelSource
 from geardyn.core.model import Model, unique_rows
-from geardyn.core.one_form import (
-    Derivations,
-    OneForm,
-    check_names,
-    coefficient_type,
-    fill_derived,
-    refuse_derived,
-)
+from geardyn.core.one_form import Derivations, OneForm, check_names, coefficient_type
 
 #: A mesh of :meth:`UserModel.from_one_form`: (name, drive event, back event) or (name, drive
 #: event, back event, force observable), events and observables by name or index.
@@ -124,6 +123,7 @@ class UserModel(Model):
                              f"(got {natural_frequency!r})")
         self.natural_frequency = natural_frequency
         self.derived: Derivations = {}
+        self._declared: frozenset[str] = frozenset()
         self._static_forces: Callable[[Any], Sequence[float]] | None = None
         self._initial: Sequence[float] | Callable[[Any], Sequence[float]] | None = None
 
@@ -141,6 +141,7 @@ class UserModel(Model):
         meshes: Sequence[MeshSpec] = (),
         static_forces: Callable[[Any], Sequence[float]] | None = None,
         derived: Derivations | None = None,
+        coefficients: Sequence[Coefficient] = (),
         initial_state: Sequence[float] | Callable[[Any], Sequence[float]] | None = None,
         period: float | None = None,
         name: str = "UserModel",
@@ -180,7 +181,19 @@ class UserModel(Model):
             Derived coefficients: ``{"cos_phi": ("phi", math.cos)}``; each is a coefficient
             (after ``params``) that follows its parameter (computed once per value with the
             Python function) and cannot be set itself. Use it for a cos/sin of a coefficient,
-            so that ``rhs`` calls no libm routine per step and the sweep vectorises.
+            so that ``rhs`` calls no libm routine per step and the sweep vectorises. (Short for
+            ``Coefficient("cos_phi", kind="derived", derived_from=("phi",),
+            derive=math.cos)`` in ``coefficients``.)
+        coefficients
+            Declarations (:class:`~geardyn.core.coefficients.Coefficient`) of some or all of
+            the parameters, by name: unit, meaning and admissible range
+            (``Coefficient("k", "N/m", "mesh stiffness", exclusive_minimum=0.0)``), as the
+            built-in models declare theirs. ``params`` and ``with_params`` are checked against
+            them (a ParameterError naming the field), and ``model.coefficient_layout``, a
+            sweep's axis (``units``, ``long_name``) and the explorer read them. A derived
+            coefficient with its function (``kind="derived"``, ``derived_from=(name,)``,
+            ``derive=fn``) is placed after ``params``. An undeclared parameter is an input of
+            unit "1".
         initial_state
             The default start state: a sequence, or a function of the coefficients (default
             zeros).
@@ -188,13 +201,9 @@ class UserModel(Model):
             As in the constructor.
         """
         _check_compiled(rhs, events, observe)
-        derived = dict(derived or {})
-        names = [*params, *derived]
-        values = [float(v) for v in params.values()] + [0.0] * len(derived)
-        for key, (src, fn) in derived.items():
-            if src not in params or not callable(fn):
-                raise ValueError(f"derived {key!r}: needs (parameter, function), the parameter "
-                                 f"one of params (got {(src, fn)!r})")
+        entries = _declarations(params, derived or {}, coefficients)
+        names = [c.name for c in entries]
+        values = [float(v) for v in params.values()] + [0.0] * (len(entries) - len(params))
         check_names(tuple(names))
         event_names = tuple(event_names) if events is not None else ()
         if events is not None and not event_names:
@@ -203,12 +212,19 @@ class UserModel(Model):
             raise ValueError("observe given: name the observables (observable_names)")
         model = cls.__new__(cls)
         model._setup(len(states), values, period, states, names, name, natural_frequency)
-        fill_derived(model.params, model.param_names, derived)
+        if len(model.param_names) > len(entries):  # the hidden forcing frequency of ``period``
+            entries.append(Coefficient("Omega", meaning="forcing frequency (2 pi / period)"))
+        model.coefficient_layout = CoefficientLayout.of(CoefficientBlock(tuple(entries)),
+                                                        model=name)
+        model.coefficient_layout.validate({k: float(v) for k, v in params.items()})
+        model.coefficient_layout.fill_derived(model.params)
+        model.derived = model.coefficient_layout.derivations()
+        model.omega_is_entry = all(src != "Omega" for src, _ in model.derived.values())
+        model._declared = frozenset(c.name for c in coefficients)
         model.event_names = event_names
         model.observable_names = tuple(observable_names) if observe is not None else ()
         model.meshes, forces = _meshes(meshes, model.event_names, model.observable_names)
         model.capabilities = Capabilities(mesh_forces=forces)
-        model.derived = derived
         model._static_forces = static_forces
         model._initial = initial_state
         model.kernel = KernelSource(rhs, events, observe, one_form=OneForm(
@@ -220,19 +236,14 @@ class UserModel(Model):
         row = self.params if p is None else np.asarray(p, dtype=float)
         return coefficient_type(self.param_names)(*(float(v) for v in row))
 
-    def with_params(self, **values: float) -> UserModel:
-        """A copy with parameters changed by name (derived coefficients follow them)."""
-        refuse_derived(values, self.derived)
-        out = Model.with_params(self, **values)
-        fill_derived(out.params, self.param_names, self.derived)
-        return out
-
-    def lane_params(self, name: str, values: Sequence[float] | np.ndarray) -> np.ndarray:
-        """Coefficient vectors with ``name`` set to ``values`` (derived coefficients follow)."""
-        refuse_derived((name,), self.derived)
-        P = Model.lane_params(self, name, values)
-        fill_derived(P, self.param_names, self.derived)
-        return P
+    def param_attrs(self, name: str) -> dict[str, str]:
+        """Attributes of a swept parameter's axis from its declaration (``coefficients`` of
+        :meth:`from_one_form`): ``units`` and ``long_name`` (its meaning); empty for a
+        parameter declared nowhere."""
+        if name not in self._declared:
+            return {}
+        c = self.coefficient_layout.slot(name).coefficient
+        return {"units": c.unit, **({"long_name": c.meaning} if c.meaning else {})}
 
     def initial_state(self) -> np.ndarray:
         """The declared start state (``initial_state`` of :meth:`from_one_form`), else zeros."""
@@ -267,6 +278,58 @@ class UserModel(Model):
             return np.full(P.shape[0], float(w))
         rows, inverse = unique_rows(P)
         return np.array([float(w(r)) for r in rows])[inverse]
+
+
+def _declarations(params: Mapping[str, float], derived: Derivations,
+                  coefficients: Sequence[Coefficient]) -> list[Coefficient]:
+    """The declared coefficients in vector order: one per parameter of ``params`` (its entry of
+    ``coefficients``, else an input of unit "1"), then the derived ones (``derived``, then those
+    of ``coefficients``). ValueError naming the field for anything else."""
+    declared: dict[str, Coefficient] = {}
+    for k, c in enumerate(coefficients):
+        if not isinstance(c, Coefficient):
+            raise ValueError(f"coefficients[{k}]: a geardyn.core.coefficients.Coefficient "
+                             f"(got {c!r})")
+        if c.name in declared:
+            raise ValueError(f"coefficients: {c.name!r} is declared twice")
+        declared[c.name] = c
+    shorthand: dict[str, Coefficient] = {}
+    for key, spec in derived.items():
+        if not (isinstance(spec, tuple) and len(spec) == 2 and callable(spec[1])):
+            raise ValueError(f"derived {key!r}: needs (parameter, function) (got {spec!r})")
+        if key in declared:
+            raise ValueError(f"coefficients: {key!r} is declared in derived too")
+        shorthand[key] = Coefficient(key, kind="derived", derived_from=(spec[0],),
+                                     derive=spec[1])
+    inputs = [_input(name, declared.pop(name, None)) for name in params]
+    followers = [*shorthand.values(), *declared.values()]
+    for c in followers:
+        _check_derived(c, params)
+    return [*inputs, *followers]
+
+
+def _input(name: str, c: Coefficient | None) -> Coefficient:
+    """The declaration of the parameter ``name`` (an input of unit "1" where none is given)."""
+    if c is None:
+        return Coefficient(name)
+    if c.kind != "input":
+        raise ValueError(f"coefficients: {name!r} has a value in params, so it is an input "
+                         f"(declared kind {c.kind!r})")
+    return c
+
+
+def _check_derived(c: Coefficient, params: Mapping[str, float]) -> None:
+    """ValueError naming ``c`` unless it is a derived coefficient with its function, of a
+    parameter in ``params``."""
+    if c.kind != "derived":
+        raise ValueError(f"coefficients: {c.name!r} is not among params "
+                         f"({', '.join(params)}) nor a derived coefficient")
+    if c.derive is None:
+        raise ValueError(f"coefficients: {c.name!r} is derived; give derive= (the function of "
+                         f"its input's value that gives it)")
+    if c.derived_from[0] not in params:
+        raise ValueError(f"derived {c.name!r}: derived from {c.derived_from[0]!r}, which is not "
+                         f"among params ({', '.join(params)})")
 
 
 def _check_compiled(rhs: Callable, events: Callable | None, observe: Callable | None) -> None:
