@@ -116,6 +116,7 @@ def test_with_params_and_lane_params_refill_the_declared_derivations():
     toy = geardyn.UserModel(user_model().kernel.rhs, n_states=2, params=[1.0, 0.0, 1.0, 0.0],
                             name="toy")
     toy.coefficient_layout = CoefficientLayout.of(block, model="toy")
+    assert toy.derived == {"cos_phi": ("phi", math.cos), "sin_phi": ("phi", math.sin)}
     out = toy.with_params(phi=0.4)
     assert list(out.params) == [1.0, 0.4, math.cos(0.4), math.sin(0.4)]
     P = toy.lane_params("phi", [0.1, -0.2])

@@ -316,6 +316,13 @@ def test_a_user_model_declares_units_meanings_and_ranges():
         m.with_params(cos_phi_e=1.0)
     with pytest.raises(geardyn.ParameterError, match="^zeta: must be >= 0"):
         declared_pair(zeta=-0.5)
+    squared = declared_pair(derived={"cos_phi_k": ("phi_k", math.cos),
+                                     "sin_phi_k": ("phi_k", math.sin),
+                                     "Omega2": ("Omega", lambda w: w * w)})
+    assert m.omega_is_entry and not squared.omega_is_entry  # Omega moves Omega2
+    assert squared.with_omega(3.0).coefficients().Omega2 == 9.0
+    P = squared.lane_params("Omega", [2.0, 0.5])
+    assert list(P[:, squared.param_index("Omega2")]) == [4.0, 0.25]
 
 
 def test_a_user_models_declarations_are_checked_naming_the_field():
@@ -338,6 +345,8 @@ def test_a_user_models_declarations_are_checked_naming_the_field():
         declared_pair([Coefficient("zeta", 1)])
     with pytest.raises(ValueError, match="derived 'c': needs"):
         declared_pair((), derived={"c": "phi_k"})
+    with pytest.raises(ValueError, match="coefficients: a sequence of"):
+        declared_pair(Coefficient("zeta"))
 
 
 def test_a_user_models_sweep_axis_carries_its_declared_unit():

@@ -122,7 +122,6 @@ class UserModel(Model):
             raise ValueError(f"natural_frequency must be > 0 or a function of p "
                              f"(got {natural_frequency!r})")
         self.natural_frequency = natural_frequency
-        self.derived: Derivations = {}
         self._declared: frozenset[str] = frozenset()
         self._static_forces: Callable[[Any], Sequence[float]] | None = None
         self._initial: Sequence[float] | Callable[[Any], Sequence[float]] | None = None
@@ -218,7 +217,6 @@ class UserModel(Model):
                                                         model=name)
         model.coefficient_layout.validate({k: float(v) for k, v in params.items()})
         model.coefficient_layout.fill_derived(model.params)
-        model.derived = model.coefficient_layout.derivations()
         model.omega_is_entry = all(src != "Omega" for src, _ in model.derived.values())
         model._declared = frozenset(c.name for c in coefficients)
         model.event_names = event_names
@@ -235,6 +233,12 @@ class UserModel(Model):
         """The coefficients ``p`` (default the model's) as the one form's named tuple."""
         row = self.params if p is None else np.asarray(p, dtype=float)
         return coefficient_type(self.param_names)(*(float(v) for v in row))
+
+    @property
+    def derived(self) -> Derivations:
+        """The derived coefficients declared with their function: name -> (the parameter it
+        follows, the function), read from :attr:`coefficient_layout`."""
+        return self.coefficient_layout.derivations()
 
     def param_attrs(self, name: str) -> dict[str, str]:
         """Attributes of a swept parameter's axis from its declaration (``coefficients`` of
@@ -285,6 +289,9 @@ def _declarations(params: Mapping[str, float], derived: Derivations,
     """The declared coefficients in vector order: one per parameter of ``params`` (its entry of
     ``coefficients``, else an input of unit "1"), then the derived ones (``derived``, then those
     of ``coefficients``). ValueError naming the field for anything else."""
+    if isinstance(coefficients, Coefficient | str | Mapping):
+        raise ValueError(f"coefficients: a sequence of geardyn.core.coefficients.Coefficient "
+                         f"(got {coefficients!r})")
     declared: dict[str, Coefficient] = {}
     for k, c in enumerate(coefficients):
         if not isinstance(c, Coefficient):
