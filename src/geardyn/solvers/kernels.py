@@ -5,8 +5,10 @@ is tied to the process), so geardyn writes, once per model, a copy of
 :mod:`geardyn.solvers._kernel_template` whose import line names the model's functions, into
 ``$GEARDYN_CACHE_DIR/kernels`` (default ``~/.cache/geardyn/kernels``), and imports it. The file name
 is a hash of the template and of the model's source, so an edited model gets a new kernel (the
-shared step machinery of :mod:`._step_core` is one such module per model, ``core``, which the
-model's other kernel modules import: compiled once per model, not once per template); numba
+model's part of the step machinery, :mod:`._step_core`, is one such module per model, ``core``,
+which the model's other kernel modules import: compiled once per model, not once per template;
+the step machinery that does not depend on the model, :mod:`._split_core`, is an ordinary
+module, compiled once for every model, that calls the model through function pointers); numba
 caches the compiled code in ``$NUMBA_CACHE_DIR`` (default ``$GEARDYN_CACHE_DIR/numba``, see
 :mod:`geardyn._cache`), and a second run does not recompile. Functions that cannot be
 imported by name (defined in ``__main__`` or a notebook) get an in-memory kernel, compiled once per
@@ -263,15 +265,30 @@ def kernels_for(source: KernelSource, template: str = "rk4") -> types.ModuleType
     _quiet_module(module)
     _LOADED[key] = module
     if template != CORE:
-        # the split step (every template's scalar path) compiles in a helper process meanwhile
-        compile_share.compile_ahead(sys.modules[core], AHEAD)
+        # the shared split step (every template's scalar path) compiles in a helper process
+        # meanwhile, where no model has compiled it before
+        compile_share.compile_ahead(_shared_module(), AHEAD)
     return module
 
 
-#: The core functions :func:`kernels_for` has compiled ahead (:func:`.compile_share.compile_ahead`)
+#: The shared step machinery (:mod:`._split_core`): compiled and cached once for every model.
+SHARED = "geardyn.solvers._split_core"
+#: Its functions that :func:`kernels_for` compiles ahead (:func:`.compile_share.compile_ahead`)
 #: when it first loads one of a model's templates: name -> the signature every template calls
 #: it with (``tests/test_compile_share.py`` checks that the templates compile no other).
-AHEAD = {"_split_step": "(int64, float64, float64[::1], float64[::1], float64[::1], float64, "
-                        "float64, int64, float64, float64, float64, float64, int64[::1], "
-                        "float64[::1], int64[::1], float64[:, ::1], float64[::1], "
-                        "float64[:, ::1])"}
+AHEAD = {"_split_step": "(UniTuple(int64, 2), int64, float64, float64[::1], float64[::1], "
+                        "float64[::1], float64, float64, int64, float64, float64, float64, "
+                        "float64, int64[::1], float64[::1], int64[::1], float64[:, ::1], "
+                        "float64[::1], float64[:, ::1])"}
+
+
+def _shared_module() -> types.ModuleType:
+    """:mod:`._split_core`, its compiles quiet and shared between processes (first call)."""
+    module = importlib.import_module(SHARED)
+    if SHARED not in _QUIETED:
+        _quiet_module(module)
+        _QUIETED.add(SHARED)
+    return module
+
+
+_QUIETED: set[str] = set()
