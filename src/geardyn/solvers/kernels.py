@@ -282,13 +282,18 @@ AHEAD = {"_split_step": "(UniTuple(int64, 2), int64, float64, float64[::1], floa
                         "float64[::1], float64[:, ::1])"}
 
 
+#: Every module of kernel functions that do not depend on the model (compiled once for all).
+SHARED_MODULES = (SHARED, "geardyn.solvers._sweep_books", "geardyn.solvers._lyapunov_books")
+
+
 def _shared_module() -> types.ModuleType:
-    """:mod:`._split_core`, its compiles quiet and shared between processes (first call)."""
-    module = importlib.import_module(SHARED)
-    if SHARED not in _QUIETED:
-        _quiet_module(module)
-        _QUIETED.add(SHARED)
-    return module
+    """:mod:`._split_core`; on the first call, the functions of every module of
+    :data:`SHARED_MODULES` compile quietly and under their locks (:func:`_quiet_module`)."""
+    if not _QUIETED:
+        for name in SHARED_MODULES:
+            _quiet_module(importlib.import_module(name))
+        _QUIETED.append(True)
+    return importlib.import_module(SHARED)
 
 
-_QUIETED: set[str] = set()
+_QUIETED: list[bool] = []
