@@ -14,7 +14,11 @@ each compiled function (its own compile, those it compiles in turn subtracted), 
 The split step is not compiled ahead in a helper process here (``GEARDYN_COMPILE_AHEAD=0``), so
 that the process's CPU seconds are the whole compile.
 
-    .venv/bin/python bench/compile.py [--models GearPair UserModel] [--top 8] [--json F] [--write]
+    .venv/bin/python bench/compile.py [--models GearPair UserModel] [--primer UserModel] [--top 8]
+                                      [--json F] [--write]
+
+``--primer CASE`` runs that case first on each empty cache, so that a model's figure is its own
+compile with the shared step core (compiled once for every model) already cached.
 
 ``--write`` replaces the ``compile-*`` rows of bench/RESULTS.md's current-figures table
 (``--from-json F``: those of an earlier run's ``--json F``, without measuring again). Cold
@@ -135,9 +139,13 @@ def run_child(case: str, cache: str) -> dict:
     return json.loads(out.stdout.strip().splitlines()[-1])
 
 
-def measure(case: str) -> tuple[dict, dict]:
-    """(cold, warm) rows of ``case``: a process on an empty cache, then one on the filled one."""
+def measure(case: str, primer: str | None = None) -> tuple[dict, dict]:
+    """(cold, warm) rows of ``case``: a process on an empty cache, then one on the filled one.
+    With ``primer`` (another case), a process running that case first fills the cache with what
+    every model shares (the shared step core), so that ``cold`` is the model's own compile."""
     with tempfile.TemporaryDirectory(prefix="geardyn-compile-") as cache:
+        if primer is not None:
+            run_child(primer, cache)
         cold = run_child(case, cache)
         warm = run_child(case, cache)
     return cold, warm
@@ -164,8 +172,9 @@ def report(case: str, cold: dict, warm: dict, top: int) -> str:
     return "\n".join(lines)
 
 
-def record(case: str, cold: dict, warm: dict) -> None:
-    """Replace the row ``compile-<case>`` of bench/RESULTS.md's current-figures table."""
+def record(case: str, cold: dict, warm: dict, primer: str | None = None) -> None:
+    """Replace the row ``compile-<case>`` (``compile-<case>-own`` with a primer) of
+    bench/RESULTS.md's current-figures table."""
     import _results as results
 
     cpu = sum(v[0] for v in cold.values())
@@ -173,11 +182,16 @@ def record(case: str, cold: dict, warm: dict) -> None:
     cached = sum(v[0] for v in warm.values())
     target = TARGET_USER if case.startswith("UserModel") else TARGET_BUILTIN
     per = ", ".join(f"{k} {v[0]:.0f}" for k, v in cold.items() if k != "import")
+    if primer is None:
+        key, what, flag = f"compile-{case}", "empty cache", ""
+    else:
+        key, what, flag = (f"compile-{case}-own", f"shared core cached (by {primer})",
+                           f" --primer {primer}")
     results.record(
-        f"compile-{case}", f"first use of every analysis, empty cache: <= {target:.0f} s CPU",
+        key, f"first use of every analysis, {what}: <= {target:.0f} s CPU",
         f"{cpu:.0f} s CPU ({wall:.0f} s wall; {per}); cached {cached:.1f} s CPU",
         results.against(cpu, target),
-        f".venv/bin/python bench/compile.py --models {case} --write")
+        f".venv/bin/python bench/compile.py --models {case}{flag} --write")
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -189,6 +203,9 @@ def main(argv: list[str] | None = None) -> int:
                     help="replace the compile-* rows of bench/RESULTS.md's table")
     ap.add_argument("--from-json", type=Path, default=None,
                     help="report (and --write) the rows of an earlier run's --json instead")
+    ap.add_argument("--primer", default=None,
+                    help="a case run first on the empty cache (its figures discarded), so that "
+                         "each model's figure is its own compile with the shared core cached")
     ap.add_argument("--child", default=None, help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
     if args.child:
@@ -202,14 +219,14 @@ def main(argv: list[str] | None = None) -> int:
         raw = {}
     for case in args.models or ([c for c in IDS if c in raw] if args.from_json else IDS):
         if not args.from_json:
-            cold, warm = measure(case)
+            cold, warm = measure(case, args.primer)
             raw[case] = {"cold": cold, "warm": warm}
         cold, warm = raw[case]["cold"], raw[case]["warm"]
         print(report(case, cold, warm, args.top), flush=True)
         if args.json:
             args.json.write_text(json.dumps(raw, indent=1))
         if args.write:
-            record(case, cold, warm)
+            record(case, cold, warm, args.primer)
     return 0
 
 

@@ -72,8 +72,8 @@ def test_another_function_has_its_own_lock(tmp_path, monkeypatch):
             != compile_share.lock_path("geardyn_core_b", "_split_step"))
 
 
-# In a fresh process with an empty cache: the helper started by kernels_for compiles the shared
-# split step; the trajectory kernel, compiled after the helper has ended, loads it from the cache
+# In a fresh process with an empty cache: the helper started by kernels_for compiles the split
+# step; the trajectory kernel, compiled after the helper has ended, loads it from the cache
 # (numba counts a cache hit for the signature, no miss): the signature declared in AHEAD is the
 # one the template calls it with.
 _SCRIPT = """
@@ -88,7 +88,8 @@ helpers = list(compile_share._STARTED.values())
 for proc in helpers:
     proc.wait()
 geardyn.simulate(model, omega=1.2, periods=3, y0=[1.0, 0.0])
-stats = kernels._shared_module()._split_step.stats
+core = kernels.kernels_for(model.kernel, "core")
+stats = core._split_step.stats
 print(json.dumps({"helpers": len(helpers), "codes": [p.returncode for p in helpers],
                   "hits": [str(s) for s in stats.cache_hits],
                   "misses": [str(s) for s in stats.cache_misses],

@@ -162,3 +162,15 @@ def test_phased_and_unphased_lanes_equal_single_simulations_bitwise():
         ds = geardyn.simulate(mj, omega=omegas[j], transient=300.0, periods=6,
                               steps_per_period=64)
         np.testing.assert_array_equal(r.samples[j], ds["poincare"].values[1:])
+
+
+def test_a_sweep_axis_carries_the_declared_unit_and_meaning():
+    """The swept coefficient's axis is labelled from its declaration: a phase in radians, the
+    dimensionless mesh frequency in 1 (the base model read nothing and left both unlabelled)."""
+    pair = geardyn.GearPair(Fa=0.2)
+    ds = geardyn.bifurcation(pair, "kappa_phase", np.array([0.0, 0.5]),
+                             run=geardyn.RunSettings(transient=2, samples=2))
+    assert ds["kappa_phase"].attrs["units"] == "rad"
+    assert "phase" in ds["kappa_phase"].attrs["long_name"]
+    assert pair.param_attrs("Omega")["units"] == "1"
+    assert pair.param_attrs("no_such_name") == {}

@@ -1,8 +1,9 @@
-"""A model with lane-scalar functions (the sweep's fused loop) gives results bitwise those of
-the same model without them (the structure-of-arrays blocks); both split flagged steps in the
-shared step core (:mod:`geardyn.solvers._split_core`), through the model's array functions.
-The reference here is the same reduced CATT model through wrappers that hide its lane
-functions, so its kernel takes the generic path."""
+"""The split step (a grid step with located edge crossings) of a model with lane-scalar
+functions evaluates them, with the state and the stages in registers (``_split_rhs``,
+``_rk4_stages``, ``_hermite`` in :mod:`geardyn.solvers._step_core`); its results are bitwise
+those of the split on the model's array functions. The reference here is the same reduced CATT
+model through wrappers that hide its lane functions, so its kernel takes the generic path
+(structure-of-arrays blocks, the array forms of the split's helpers)."""
 
 from __future__ import annotations
 

@@ -383,8 +383,14 @@ class Model:
         return {}
 
     def param_attrs(self, name: str) -> dict[str, str]:
-        """Attributes of the axis of a sweep in ``name`` (``units``, ...); none here."""
-        return {}
+        """Attributes of the axis of a sweep in ``name``: ``units`` and ``long_name`` (its
+        meaning) from the coefficient's declaration, where the model declares its layout;
+        none for a name it does not declare."""
+        layout = self.__dict__.get("_coefficient_layout")
+        if layout is None or name not in layout.names:
+            return {}
+        c = layout.slot(name).coefficient
+        return {"units": c.unit, **({"long_name": c.meaning} if c.meaning else {})}
 
     def static_mesh_forces(self) -> np.ndarray | None:
         """Static mesh forces (one per mesh, observable units) for the dynamic factor, or None."""

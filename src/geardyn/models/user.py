@@ -244,10 +244,7 @@ class UserModel(Model):
         """Attributes of a swept parameter's axis from its declaration (``coefficients`` of
         :meth:`from_one_form`): ``units`` and ``long_name`` (its meaning); empty for a
         parameter declared nowhere."""
-        if name not in self._declared:
-            return {}
-        c = self.coefficient_layout.slot(name).coefficient
-        return {"units": c.unit, **({"long_name": c.meaning} if c.meaning else {})}
+        return super().param_attrs(name) if name in self._declared else {}
 
     def initial_state(self) -> np.ndarray:
         """The declared start state (``initial_state`` of :meth:`from_one_form`), else zeros."""

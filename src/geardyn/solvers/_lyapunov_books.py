@@ -13,7 +13,7 @@ import math
 import numba as nb
 import numpy as np
 
-from geardyn.solvers._split_core import _JIT, STATUS_DIVERGED, STATUS_OK, phase_table
+from geardyn.solvers._step_shared import _JIT, STATUS_DIVERGED, STATUS_OK, phase_table
 
 #: Columns of the per-lane integer state of a block (IST): the step of the last
 #: renormalisation, the block being measured, transient and measured steps, their total, the

@@ -1,28 +1,40 @@
-"""A model's step machinery: the shared machinery of :mod:`._split_core` bound to the model's
-functions, and the lane-tuple helpers of the fused loops, sized to the model.
+"""The scalar step machinery shared by the kernel templates: the forcing-phase table, one RK4
+step, the cubic Hermite interpolant of a step, crossing location, and a grid step split at the
+located edge crossings.
 
-This is template text: :func:`geardyn.solvers.kernels.kernels_for` writes it, with the model's
-functions at its ``MODEL-IMPORT`` line and their adapters at ``MODEL-ADAPTERS``, as the model's
-generated core module, which the model's other kernel modules import (see the templates'
-``CORE-IMPORT`` line). As it stands it is a valid module bound to the test oscillator of
-:mod:`geardyn.solvers._template_model`.
+Like the templates, this is template text: :func:`geardyn.solvers.kernels.kernels_for` splices it
+into a generated kernel module in place of the template's ``CORE-IMPORT`` line, bound there to the
+model's ``rhs`` and ``events``. As it stands it is a valid module bound to the test oscillator of
+:mod:`geardyn.solvers._template_model`. What does not evaluate the model (constants, the
+phase table, the cubic of an edge function, the block screen) is in :mod:`._step_shared`,
+compiled once for every model, and imported here.
 
-The model's array-form ``rhs`` and ``events`` are compiled here as C callbacks; the split step,
-the root finders and the rows of a lane (:mod:`._split_core`, compiled once for every model) call
-them through their addresses (:mod:`.model_calls`). The wrappers below give those functions their
-model-bound signatures. What else a model compiles (its sweep, Lyapunov and monodromy kernels,
-with its functions inlined) is in the templates.
+Edge location: a step that leaves a side of an edge (a zero of ``events``) is split at the
+crossing, located on the cubic Hermite interpolant of the step (error O(h^4) in the crossing
+time: Newton's method on the event's cubic along it, :func:`_cubic_locate`, checked on the model's
+event once), and integrated in sub-steps, so every RK4 stage sees a smooth
+right-hand side and the method keeps 4th order. A step leaves a side when its end lies on the
+other side, or when it grazes the edge: crosses it twice (or any even number of times) inside the
+step. A graze is found from the interior extrema of the edge function along the interpolant
+(:func:`first_crossing`); the first crossing of a step is always the one located. A step is split
+at most ``MAX_SPLITS`` times (chattering); a step that reaches the limit falls back unsplit and is
+counted (``unresolved_steps`` in every result). Crossings located within ``SIMULTANEOUS`` of a
+step of the earliest are taken together (identical planet sets cross their edges at the same
+instant).
+
+Cost: the check of an ordinary step (:func:`_leaves_side`) is the sign test at the step's end
+and a bound on the dip of each edge function from its last three grid values (no evaluation of
+the model); only steps that can graze by that bound are redone (:func:`_split_step`). A split
+costs about 9 evaluations of the model's rhs and 8 of its events (``bench/crossing.py``).
 """
 
 from __future__ import annotations
 
 import numba as nb
-from numba import carray
+import numpy as np
 
 from geardyn.core.kernel_source import FORM_GENERAL
-from geardyn.solvers import _split_core as _shared
-from geardyn.solvers._split_core import (  # noqa: F401 - the templates import them from here
-    _INLINE,
+from geardyn.solvers._step_shared import (  # noqa: F401 - the templates import them from here
     BLOCK,
     BRACKET_TOL,
     CONFIRM_TOL,
@@ -40,12 +52,19 @@ from geardyn.solvers._split_core import (  # noqa: F401 - the templates import t
     STATUS_DIVERGED,
     STATUS_OK,
     STATUS_SPLIT_LIMIT,
+    _cubic_at,
+    _cubic_coeffs,
+    _forced,
     _healthy,
+    _hermite_weights,
     _keep_start,
     _leaves_side,
     _padded,
     _phase_at,
+    _phase_in,
+    _quadratic_roots,
     _side,
+    _sincos_small,
     cubic_extrema,
     event_buffer,
     phase_increments,
@@ -53,74 +72,443 @@ from geardyn.solvers._split_core import (  # noqa: F401 - the templates import t
     phase_table,
 )
 from geardyn.solvers._template_model import events, rhs  # MODEL-IMPORT
-from geardyn.solvers.model_calls import FORM_SIG, addresses
 
 _CACHE = True
 _JIT = {"cache": _CACHE, "error_model": "numpy", "boundscheck": False}
 # MODEL-ADAPTERS (a user's plain functions are adapted to the kernel interface here)
-# The model's functions inlined (numba IR inlining) where the templates call them in a loop: a
-# call with array arguments would otherwise cost reference counting on every stage of every step.
+# The model's functions inlined (numba IR inlining) where they are called in a loop: a call with
+# array arguments would otherwise cost reference counting on every stage of every step.
+_INLINE = {"inline": "always", "error_model": "numpy", "boundscheck": False}
 _rhs_i = nb.njit(**_INLINE)(rhs.py_func)
 _events_i = nb.njit(**_INLINE)(events.py_func)
-_CFUNC = {"cache": _CACHE, "error_model": "numpy", "boundscheck": False}
-
-
-@nb.cfunc(FORM_SIG, **_CFUNC)
-def _rhs_c(t, y, ny, out, nout, p, n_p, s, c):
-    """The model's rhs as a C callback (:data:`.model_calls.FORM_SIG`)."""
-    _rhs_i(t, carray(y, ny), carray(out, nout), carray(p, n_p), s, c)
-
-
-@nb.cfunc(FORM_SIG, **_CFUNC)
-def _events_c(t, y, ny, out, nout, p, n_p, s, c):
-    """The model's events as a C callback (:data:`.model_calls.FORM_SIG`)."""
-    _events_i(t, carray(y, ny), carray(out, nout), carray(p, n_p), s, c)
-
-
-#: () -> (address of rhs, address of events): the ``fn`` of :mod:`._split_core`.
-_fn = addresses(_rhs_c, _events_c)
-
-
-@nb.njit(inline="always", **_JIT)
-def _split_step(i, t0, y, y_trial, p, h, omega, n_per, sa, ca, s_end, c_end, side, g1, ncross,
-                work, ybuf, gbuf):
-    """:func:`._split_core._split_step` of this model."""
-    return _shared._split_step(_fn(), i, t0, y, y_trial, p, h, omega, n_per, sa, ca, s_end,
-                               c_end, side, g1, ncross, work, ybuf, gbuf)
-
-
-@nb.njit(inline="always", **_JIT)
-def _rows_step(i, t0, Y, p, h, omega, n_per, s_tab, c_tab, n_ev, K, TMP, Y1, SIDE, G0, G1, W,
-               gbuf, NCR, UNRES):
-    """:func:`._split_core._rows_step` of this model."""
-    _shared._rows_step(_fn(), i, t0, Y, p, h, omega, n_per, s_tab, c_tab, n_ev, K, TMP, Y1,
-                       SIDE, G0, G1, W, gbuf, NCR, UNRES)
+# The split path (a step with a located crossing: :func:`_split_step`, :func:`_rk4_stages` and
+# the root finders) inlines them too; a model with lane-scalar functions takes those there
+# instead, the state in registers (see :func:`_split_rhs` and the FUSED block below).
 
 
 @nb.njit(**_JIT)
 def _rk4(t, y, h, p, s0, c0, s1, c1, s2, c2, k1, k2, k3, k4, tmp, out, have_k1):
-    """:func:`._split_core._rk4` of this model."""
-    _shared._rk4(_fn(), t, y, h, p, s0, c0, s1, c1, s2, c2, k1, k2, k3, k4, tmp, out, have_k1)
+    """One RK4 step of size h from (t, y) into out; k1 holds f(t, y) if have_k1."""
+    ns = y.size
+    if not have_k1:
+        rhs(t, y, k1, p, s0, c0)
+    hh = 0.5 * h
+    for q in range(ns):
+        tmp[q] = y[q] + hh * k1[q]
+    rhs(t + hh, tmp, k2, p, s1, c1)
+    for q in range(ns):
+        tmp[q] = y[q] + hh * k2[q]
+    rhs(t + hh, tmp, k3, p, s1, c1)
+    for q in range(ns):
+        tmp[q] = y[q] + h * k3[q]
+    rhs(t + h, tmp, k4, p, s2, c2)
+    h6 = h / 6.0
+    for q in range(ns):
+        out[q] = y[q] + h6 * (k1[q] + 2.0 * k2[q] + 2.0 * k3[q] + k4[q])
+
+
+@nb.njit(inline="always", **_JIT)
+def _hermite(y0, f0, y1, f1, dt, theta, out):
+    """Cubic Hermite interpolant of a step of length dt at fraction theta."""
+    h00, h10, h01, h11 = _hermite_weights(dt, theta)
+    for q in range(y0.size):
+        out[q] = h00 * y0[q] + h10 * f0[q] + h01 * y1[q] + h11 * f1[q]
 
 
 @nb.njit(**_JIT)
-def interpolant_events(y0, f0, y1, f1, dt, t, p, ybuf, gbuf, pc):
-    """:func:`._split_core.interpolant_events` of this model."""
-    _shared.interpolant_events(_fn(), y0, f0, y1, f1, dt, t, p, ybuf, gbuf, pc)
+def _illinois(j, side_j, a, fa, b, fb, y0, f0, y1, f1, dt, t, p, ybuf, g, pc):
+    """Illinois root finding of event j (the model's, on the step's interpolant) in the
+    bracket [a, b]: fa on side side_j, fb off it. Returns the bracket's end off the side.
+    pc: the step's forcing phase (:func:`_phase_in`)."""
+    last = 0
+    for _ in range(60):
+        denom = fb - fa
+        x = (a * fb - b * fa) / denom if denom != 0.0 else 0.5 * (a + b)
+        if not (a < x < b):
+            x = 0.5 * (a + b)
+        _hermite(y0, f0, y1, f1, dt, x, ybuf)
+        sx, cx = _phase_in(pc, x)
+        _events_i(t + x * dt, ybuf, g, p, sx, cx)
+        fx = g[j]
+        if _side(fx) == side_j:
+            a = x
+            fa = fx
+            if last == -1:
+                fb *= 0.5
+            last = -1
+        else:
+            b = x
+            fb = fx
+            if last == 1:
+                fa *= 0.5
+            last = 1
+        if b - a < 1e-13:
+            break
+    return b
 
 
 @nb.njit(**_JIT)
 def _locate(j, side_j, g0j, b, fb, y0, f0, y1, f1, dt, t, p, ybuf, gbuf, pc):
-    """:func:`._split_core._locate` of this model."""
-    return _shared._locate(_fn(), j, side_j, g0j, b, fb, y0, f0, y1, f1, dt, t, p, ybuf, gbuf,
-                           pc)
+    """Fraction in (0, b] of the step where event j leaves side side_j (Illinois method on the
+    step's interpolant, the model's event evaluated at every iterate), given a bracket [0, b]
+    that holds exactly one crossing: g0j the event at the start (taken as on side side_j), fb
+    its value at b (on the other side). The split path uses :func:`_cubic_locate`; this is its
+    fallback for events that are not affine in the state. pc: the step's forcing phase
+    (:func:`_phase_in`)."""
+    return _illinois(j, side_j, 0.0, _forced(g0j, side_j), b, fb, y0, f0, y1, f1, dt, t, p,
+                     ybuf, gbuf, pc)
+
+
+@nb.njit(inline="always", **_JIT)
+def _cubic_locate(j, side_j, c0, c1, c2, c3, b, fb, y0, f0, y1, f1, dt, t, p, ybuf, g, pc):
+    """Fraction in (0, b] of the step where event j leaves side side_j, given the cubic
+    c0 + c1 x + c2 x^2 + c3 x^3 of the event along the step's interpolant (exact for an event
+    affine in time and state) and a bracket [0, b] that holds exactly one crossing (the start
+    taken as on side side_j; fb: the model's event at b, off the side).
+
+    Newton's method on the cubic, safeguarded by the bracket (no model evaluations), then one
+    evaluation of the model's event at the root: it is taken when the event there is within
+    CONFIRM_TOL of the step from its crossing (always, up to round-off, for affine events);
+    otherwise the model's events take over (:func:`_illinois`, bracket narrowed)."""
+    a = 0.0
+    hi = b
+    fa = _forced(c0, side_j)
+    x = (a * fb - b * fa) / (fb - fa) if fb != fa else 0.5 * b
+    if not (a < x < b):
+        x = 0.5 * (a + b)
+    for _ in range(60):
+        px = ((c3 * x + c2) * x + c1) * x + c0
+        if px == 0.0:
+            break
+        if _side(px) == side_j:
+            a = x
+        else:
+            b = x
+        dp = (3.0 * c3 * x + 2.0 * c2) * x + c1
+        xn = x - px / dp if dp != 0.0 else 0.5 * (a + b)
+        newton = a < xn < b
+        if not newton:
+            xn = 0.5 * (a + b)
+        step = abs(xn - x)
+        x = xn
+        if (newton and step <= ROOT_TOL) or b - a <= BRACKET_TOL:
+            break
+    _hermite(y0, f0, y1, f1, dt, x, ybuf)
+    sx, cx = _phase_in(pc, x)
+    _events_i(t + x * dt, ybuf, g, p, sx, cx)
+    gx = g[j]
+    if abs(gx) <= CONFIRM_TOL * abs((3.0 * c3 * x + 2.0 * c2) * x + c1):
+        return x
+    if _side(gx) == side_j:
+        return _illinois(j, side_j, x, gx, hi, fb, y0, f0, y1, f1, dt, t, p, ybuf, g, pc)
+    return _illinois(j, side_j, 0.0, _forced(c0, side_j), x, gx, y0, f0, y1, f1, dt, t, p, ybuf,
+                     g, pc)
+
+
+@nb.njit(**_JIT)
+def _beyond(th, e, j, side_j, tol, y0, f0, y1, f1, dt, t, p, ybuf, g, pc):
+    """The event j on the interpolant at th if the cubic's value e there and it both lie beyond
+    the edge (off side side_j, by more than tol); else NaN. g: scratch row."""
+    if not (th > 0.0 and side_j * e < 0.0 and abs(e) > tol):
+        return np.nan
+    _hermite(y0, f0, y1, f1, dt, th, ybuf)
+    sx, cx = _phase_in(pc, th)
+    _events_i(t + th * dt, ybuf, g, p, sx, cx)
+    ge = g[j]
+    return ge if _side(ge) != side_j and abs(ge) > tol else np.nan
+
+
+@nb.njit(inline="always", **_JIT)
+def _interpolant_events(y0, f0, y1, f1, dt, t, p, ybuf, g0, g13, g23, pc):
+    """:func:`interpolant_events` into the rows g0, g13, g23 (theta = 0, 1/3, 2/3)."""
+    sx, cx = _phase_in(pc, 0.0)
+    _events_i(t, y0, g0, p, sx, cx)
+    _hermite(y0, f0, y1, f1, dt, 1.0 / 3.0, ybuf)
+    sx, cx = _phase_in(pc, 1.0 / 3.0)
+    _events_i(t + 1.0 / 3.0 * dt, ybuf, g13, p, sx, cx)
+    _hermite(y0, f0, y1, f1, dt, 2.0 / 3.0, ybuf)
+    sx, cx = _phase_in(pc, 2.0 / 3.0)
+    _events_i(t + 2.0 / 3.0 * dt, ybuf, g23, p, sx, cx)
+
+
+@nb.njit(**_JIT)
+def interpolant_events(y0, f0, y1, f1, dt, t, p, ybuf, gbuf, pc):
+    """The events along a step's cubic Hermite interpolant (start y0, end y1, derivatives f0, f1,
+    length dt, from time t; forcing phase pc, see :func:`_phase_in`) at theta = 0, 1/3, 2/3
+    into rows 0, 3, 4 of gbuf (GBUF_ROWS rows)."""
+    _interpolant_events(y0, f0, y1, f1, dt, t, p, ybuf, gbuf[0], gbuf[3], gbuf[4], pc)
+
+
+@nb.njit(inline="always", **_JIT)
+def _first_crossing(j, side_j, graze, g1j, y0, f0, y1, f1, dt, t, p, ybuf, gbuf, gsc, pc):
+    """:func:`first_crossing`; without ``graze`` the end's side alone decides (one crossing at
+    most: the caller's prefilter ruled a graze out)."""
+    v0 = gbuf[0, j]
+    v1 = gbuf[3, j]
+    v2 = gbuf[4, j]
+    b = 1.0
+    gb = g1j
+    if graze:
+        tol = GRAZE_TOL * max(max(abs(v0), abs(v1)), max(abs(v2), abs(g1j)))
+        th1, e1, th2, e2 = cubic_extrema(v0, v1, v2, g1j)
+        b = th1
+        gb = _beyond(th1, e1, j, side_j, tol, y0, f0, y1, f1, dt, t, p, ybuf, gsc, pc)
+        if gb != gb:
+            b = th2
+            gb = _beyond(th2, e2, j, side_j, tol, y0, f0, y1, f1, dt, t, p, ybuf, gsc, pc)
+        if gb != gb:
+            b = 1.0
+            gb = g1j
+    if b == 1.0 and _side(g1j) == side_j:
+        return 2.0
+    c0, c1, c2, c3 = _cubic_coeffs(v0, v1, v2, g1j)
+    return _cubic_locate(j, side_j, c0, c1, c2, c3, b, gb, y0, f0, y1, f1, dt, t, p, ybuf, gsc,
+                         pc)
 
 
 @nb.njit(**_JIT)
 def first_crossing(j, side_j, g1j, y0, f0, y1, f1, dt, t, p, ybuf, gbuf, pc):
-    """:func:`._split_core.first_crossing` of this model."""
-    return _shared.first_crossing(_fn(), j, side_j, g1j, y0, f0, y1, f1, dt, t, p, ybuf, gbuf,
-                                  pc)
+    """Fraction in (0, 1] of the step where event j first leaves side side_j along the step's
+    cubic Hermite interpolant, or 2.0 if it stays on its side. g1j: the event at the end; gbuf
+    rows 0, 3, 4: the events at theta = 0, 1/3, 2/3 (:func:`interpolant_events`); row 1 is
+    scratch.
+
+    Along the interpolant an event that is affine in time and state is exactly the cubic
+    through those four values (in general: to the interpolant's O(h^4)). An interior extremum
+    of that cubic beyond the edge (by more than GRAZE_TOL of the event's size over the step),
+    confirmed by the event on the interpolant there, has a crossing before it: the orbit grazes
+    the edge (an even number of crossings in the step) or crosses it several times. Otherwise
+    the end's side decides. The bracket [0, b] handed to the root finder ends at the first such
+    extremum (or the end), so it holds exactly one crossing, the first; the root is found on
+    the cubic (:func:`_cubic_locate`). pc: the step's forcing phase (:func:`_phase_in`)."""
+    return _first_crossing(j, side_j, True, g1j, y0, f0, y1, f1, dt, t, p, ybuf, gbuf, gbuf[1],
+                           pc)
+
+
+@nb.njit(inline="always", **_JIT)
+def _leaves_side_step(r, t0, t1, Y, K1, G0, G1, SIDE, p, ybuf, gbuf, s1, c1):
+    """:func:`_leaves_side` for a lone step without history (row r: Y[r] at time t0 to the trial
+    end at t1, K1[r] = f(t0, Y[r]), events G0[r], G1[r] at the ends, sides SIDE[r]): an event may
+    graze when min(|g(t0)|, |g(t1)|) <= GRAZE_BOUND_STEP |a|, a = events(y + h f) - events(y1)
+    = h g'(t0) - (g(t1) - g(t0)) (exact for events linear in the state); one evaluation of
+    ``events`` (at the end's forcing phase s1, c1). ybuf, gbuf row 1: scratch."""
+    h = t1 - t0
+    for q in range(Y.shape[1]):
+        ybuf[q] = Y[r, q] + h * K1[r, q]
+    _events_i(t1, ybuf, gbuf[1], p, s1, c1)
+    out = 0
+    for j in range(G1.shape[1]):
+        g1 = G1[r, j]
+        if _side(g1) != SIDE[r, j]:
+            out = 1
+        graze = 0.0
+        if not min(abs(G0[r, j]), abs(g1)) > GRAZE_BOUND_STEP * abs(gbuf[1, j] - g1):
+            graze = 1.0
+            out = max(out, 2)
+        gbuf[GRAZE_ROW, j] = graze
+    return out
+
+
+@nb.njit(inline="always", **_JIT)
+def _rk4_stages(t, y, h, p, s1, c1, s2, c2, k1, kst, acc, tmp, out):
+    """:func:`_rk4` with k1 given, the model's rhs inlined once (one call site for the three
+    stages: each stage's k in kst, their weighted sum in acc), the same arithmetic."""
+    ns = y.size
+    hh = 0.5 * h
+    for q in range(ns):
+        acc[q] = k1[q]
+        tmp[q] = y[q] + hh * k1[q]
+    for st in range(1, 4):
+        if st > 1:
+            a = h if st == 3 else hh
+            for q in range(ns):
+                tmp[q] = y[q] + a * kst[q]
+        ts = t + hh
+        ss = s1
+        cc = c1
+        if st == 3:
+            ts = t + h
+            ss = s2
+            cc = c2
+        _rhs_i(ts, tmp, kst, p, ss, cc)
+        if st == 3:
+            for q in range(ns):
+                acc[q] = acc[q] + kst[q]
+        else:
+            for q in range(ns):
+                acc[q] = acc[q] + 2.0 * kst[q]
+    h6 = h / 6.0
+    for q in range(ns):
+        out[q] = y[q] + h6 * acc[q]
+
+
+@nb.njit(inline="always", **_JIT)
+def _split_rhs(t, y, out, p, s, c):
+    """The model's rhs f(t, y) into out, on the split path (for a model with lane-scalar
+    functions: the lane form, see below)."""
+    _rhs_i(t, y, out, p, s, c)
+
+
+@nb.njit(inline="always", **_JIT)
+def _split_copy(dst, src):
+    """dst[:] = src, on the split path (see :func:`_split_rhs`)."""
+    for q in range(src.size):
+        dst[q] = src[q]
+
+
+@nb.njit(_nrt=False, **_JIT)  # it allocates nothing: no reference counting of its views
+def _split_step(i, t0, y, y_trial, p, h, omega, n_per, sa, ca, s_end, c_end, side, g1, ncross,
+                work, ybuf, gbuf):
+    """Finish grid step i of one lane with edge crossings located; y holds the start, and
+    y_trial/g1 the unsplit trial step; gbuf has GBUF_ROWS rows, row GRAZE_ROW flagging the
+    events that may graze (set by the caller's prefilter: those get :func:`first_crossing`,
+    the others a crossing only where the end's side differs). Returns 1 if the split limit was
+    reached, else 0.
+
+    Per (sub-)step to check: f at its start (the RK4's k1) and end, the events at 0, 1/3, 2/3
+    of the step's interpolant, the first crossing on the cubic of each event
+    (:func:`_cubic_locate`: no model evaluations but one per located event), then RK4 to the
+    crossing (k1 reused) and from there to the grid point; after that last sub-step only the
+    end's side is tested unless an event may graze. The forcing phase at the fractional points
+    comes from that at the grid point by angle addition. The model's rhs and events are inlined
+    here and in the helpers (``_rhs_i``, ``_events_i``: no calls, no reference counting; the
+    same arithmetic), except in the rare fallbacks :func:`_illinois` and :func:`_beyond`,
+    compiled once and called (each inlined copy costs compile time, see docs/engine.md).
+    sa, ca and s_end, c_end: sin and cos of the forcing phase at the step's start and end,
+    the caller's phase-table values (:func:`phase_table`), so a split sees the phases of the
+    unsplit step, bitwise, and calls no libm for them. work: 7 rows of the
+    state's size."""
+    n_ev = g1.size
+    ns = y.size
+    k1 = work[0]
+    kst = work[1]
+    acc = work[2]
+    tmp = work[4]
+    f1 = work[5]
+    ystart = work[6]
+    g0 = gbuf[0]
+    gsc = gbuf[1]
+    g13 = gbuf[3]
+    g23 = gbuf[4]
+    u = 0.0  # fraction of the grid step done
+    i_mod = i % n_per
+    wh = omega * h
+    t_end = t0 + (i + 1) * h
+    s0 = sa
+    c0 = ca
+    for _ in range(MAX_SPLITS):
+        t = t0 + (i + u) * h
+        dt = (1.0 - u) * h
+        _split_rhs(t, y, k1, p, s0, c0)
+        graze = False
+        need = False
+        for j in range(n_ev):
+            flag = gbuf[GRAZE_ROW, j] != 0.0
+            graze = graze or flag
+            need = need or flag or _side(g1[j]) != side[j]
+        if u > 0.0:
+            sm, cm = _phase_at(sa, ca, wh, i_mod, 0.5 * (1.0 + u))
+            _rk4_stages(t, y, dt, p, sm, cm, s_end, c_end, k1, kst, acc, tmp, y_trial)
+            _events_i(t_end, y_trial, g1, p, s_end, c_end)
+            need = graze
+            for j in range(n_ev):
+                need = need or _side(g1[j]) != side[j]
+        if not need:
+            _split_copy(y, y_trial)
+            return 0
+        _split_rhs(t_end, y_trial, f1, p, s_end, c_end)
+        _split_copy(ystart, y)
+        pc = (sa, ca, wh, i_mod, u, 1.0 - u)
+        _interpolant_events(ystart, k1, y_trial, f1, dt, t, p, ybuf, g0, g13, g23, pc)
+        first = -1
+        theta = 2.0
+        for j in range(n_ev):
+            flag = gbuf[GRAZE_ROW, j] != 0.0
+            if flag or _side(g1[j]) != side[j]:
+                th = _first_crossing(j, side[j], flag, g1[j], ystart, k1, y_trial, f1, dt, t,
+                                     p, ybuf, gbuf, gsc, pc)
+            else:
+                th = 2.0
+            gbuf[2, j] = th
+            if th < theta:
+                theta = th
+                first = j
+        if first < 0:
+            _split_copy(y, y_trial)
+            return 0
+        tm = u + 0.5 * theta * (1.0 - u)
+        tu = u + theta * (1.0 - u)
+        sm, cm = _phase_at(sa, ca, wh, i_mod, tm)
+        s0, c0 = _phase_at(sa, ca, wh, i_mod, tu)
+        _rk4_stages(t, ystart, theta * dt, p, sm, cm, s0, c0, k1, kst, acc, tmp, y)
+        for j in range(n_ev):
+            if gbuf[2, j] <= theta + SIMULTANEOUS:
+                side[j] = -side[j]
+                ncross[j] += 1
+        u = tu
+        if u >= 1.0:
+            _events_i(t_end, y, g1, p, s_end, c_end)
+            return 0
+    for q in range(ns):
+        y[q] = y_trial[q]
+    for j in range(n_ev):
+        side[j] = _side(g1[j])
+    return 1
+
+
+@nb.njit(**_JIT)
+def _rows_step(i, t0, Y, p, h, omega, n_per, s_tab, c_tab, n_ev, K, TMP, Y1, SIDE, G0, G1, W,
+               gbuf, NCR, UNRES):
+    """Advance every row of Y (independent states of one lane, e.g. a state and its
+    finite-difference neighbours) by grid step i (time t0 + i h to t0 + (i + 1) h, forcing
+    phase from the table s_tab, c_tab at i mod n_per): one RK4 step per row, the rows' stages
+    interleaved; a row whose trial step may leave a side of an edge (:func:`_leaves_side_step`)
+    is redone with the crossings located (:func:`_split_step`). Row r's crossings are counted
+    in NCR[r], its steps that reached the split limit in UNRES[r]. Scratch: K[4, nr, ns], TMP,
+    Y1 like Y, SIDE, G0, G1 [nr, max(n_ev, 1)], W[9, ns], gbuf[GBUF_ROWS, max(n_ev, 1)]."""
+    nr, ns = Y.shape
+    t = t0 + i * h
+    hh = 0.5 * h
+    j0 = 2 * (i % n_per)
+    if n_ev > 0:
+        for r in range(nr):
+            _events_i(t, Y[r], G0[r], p, s_tab[j0], c_tab[j0])
+            for j in range(n_ev):
+                SIDE[r, j] = _side(G0[r, j])
+    for st in range(4):
+        if st == 0:
+            ts = t
+            jj = j0
+        elif st < 3:
+            ts = t + hh
+            jj = j0 + 1
+        else:
+            ts = t + h
+            jj = j0 + 2
+        a = h if st == 3 else hh
+        for r in range(nr):
+            if st > 0:
+                for q in range(ns):
+                    TMP[r, q] = Y[r, q] + a * K[st - 1, r, q]
+            _rhs_i(ts, Y[r] if st == 0 else TMP[r], K[st, r], p, s_tab[jj], c_tab[jj])
+    h6 = h / 6.0
+    for r in range(nr):
+        for q in range(ns):
+            Y1[r, q] = Y[r, q] + h6 * (K[0, r, q] + 2.0 * K[1, r, q] + 2.0 * K[2, r, q]
+                                       + K[3, r, q])
+    for r in range(nr):
+        crossed = 0
+        if n_ev > 0:
+            _events_i(t + h, Y1[r], G1[r], p, s_tab[j0 + 2], c_tab[j0 + 2])
+            crossed = _leaves_side_step(r, t, t + h, Y, K[0], G0, G1, SIDE, p, W[8], gbuf,
+                                        s_tab[j0 + 2], c_tab[j0 + 2])
+        if crossed:
+            UNRES[r] += _split_step(i, t0, Y[r], Y1[r], p, h, omega, n_per, s_tab[j0],
+                                    c_tab[j0], s_tab[j0 + 2], c_tab[j0 + 2], SIDE[r], G1[r],
+                                    NCR[r], W, W[8], gbuf)
+        else:
+            for q in range(ns):
+                Y[r, q] = Y1[r, q]
 
 
 # ---------------------------------------------------------------------------------------------
@@ -175,6 +563,18 @@ def _t_side(GS, SIDE, k, g):
 
 def _t_healthy(y, bound):
     """:func:`_healthy_lane` of the state tuple y, branch-free."""
+
+
+def _t_get(y):
+    """(y[0], .., y[LANE_NS - 1]) of a state vector."""
+
+
+def _t_put(y, v):
+    """y[q] = v[q] for the state vector y."""
+
+
+def _t_hermite(y0, f0, y1, f1, h00, h10, h01, h11):
+    """The cubic Hermite combination h00 y0 + h10 f0 + h01 y1 + h11 f1, elementwise."""
 
 
 @nb.njit(**_JIT)
@@ -257,6 +657,21 @@ def _ov_t_healthy(y, bound):
     return _tuple_source("y, bound", [f"return {terms}"])
 
 
+def _ov_t_get(y):
+    n = globals()["LANE_NS"]
+    return _tuple_source("y", ["return (" + "".join(f"y[{q}], " for q in range(n)) + ")"])
+
+
+def _ov_t_put(y, v):
+    return _tuple_source("y, v", [f"y[{q}] = v[{q}]" for q in range(len(v))] or ["pass"])
+
+
+def _ov_t_hermite(y0, f0, y1, f1, h00, h10, h01, h11):
+    terms = "".join(f"h00 * y0[{q}] + h10 * f0[{q}] + h01 * y1[{q}] + h11 * f1[{q}], "
+                    for q in range(len(y0)))
+    return _tuple_source("y0, f0, y1, f1, h00, h10, h01, h11", [f"return ({terms})"])
+
+
 def _ov_t_side(GS, SIDE, k, g):
     lines = ["pass"]
     for j in range(len(g)):
@@ -276,8 +691,39 @@ if "rhs_lane" in globals():  # the model's lane-scalar functions (see .kernels)
     for _stub, _impl in ((_t_load, _ov_t_load), (_t_store, _ov_t_store), (_t_axpy, _ov_t_axpy),
                          (_t_comb, _ov_t_comb), (_t_screen, _ov_t_screen),
                          (_t_stats, _ov_t_stats), (_t_side, _ov_t_side),
-                         (_t_healthy, _ov_t_healthy)):
+                         (_t_healthy, _ov_t_healthy), (_t_get, _ov_t_get), (_t_put, _ov_t_put),
+                         (_t_hermite, _ov_t_hermite)):
         nb.extending.overload(_stub, inline="always")(_impl)
+
+    # The split path in the lane form: the state and the stages in registers, read and written
+    # element by element. With the array loops LLVM loaded a freshly stored state or stage as
+    # one vector, which no store can forward to (a stall of ~15 cycles each, ~1/5 of a split,
+    # see bench/perf_map.py); the same arithmetic (bitwise equal).
+    @nb.njit(inline="always", **_JIT)
+    def _split_rhs(t, y, out, p, s, c):  # noqa: F811 - the lane form of the generic one
+        v = _rhs_l(t, _t_get(y), p[None, :].T, 0, s, c, FORM_GENERAL)
+        _t_put(out, v)
+
+    @nb.njit(inline="always", **_JIT)
+    def _split_copy(dst, src):  # noqa: F811
+        _t_put(dst, _t_get(src))
+
+    @nb.njit(inline="always", **_JIT)
+    def _rk4_stages(t, y, h, p, s1, c1, s2, c2, k1, kst, acc, tmp, out):  # noqa: F811
+        pt = p[None, :].T  # PT[j, 0] = p[j]: the lane functions' coefficient layout, a view
+        yt = _t_get(y)
+        k1t = _t_get(k1)
+        hh = 0.5 * h
+        k2 = _rhs_l(t + hh, _t_axpy(yt, hh, k1t), pt, 0, s1, c1, FORM_GENERAL)
+        k3 = _rhs_l(t + hh, _t_axpy(yt, hh, k2), pt, 0, s1, c1, FORM_GENERAL)
+        k4 = _rhs_l(t + h, _t_axpy(yt, h, k3), pt, 0, s2, c2, FORM_GENERAL)
+        _t_put(out, _t_comb(yt, h / 6.0, k1t, k2, k3, k4))
+
+    @nb.njit(inline="always", **_JIT)
+    def _hermite(y0, f0, y1, f1, dt, theta, out):  # noqa: F811
+        h00, h10, h01, h11 = _hermite_weights(dt, theta)
+        _t_put(out, _t_hermite(_t_get(y0), _t_get(f0), _t_get(y1), _t_get(f1), h00, h10, h01,
+                               h11))
 else:
     FUSED = False
     LANE_NS = 0

@@ -13,7 +13,7 @@ from __future__ import annotations
 import numba as nb
 import numpy as np
 
-from geardyn.solvers._split_core import _JIT, STATUS_DIVERGED, STATUS_OK, event_buffer
+from geardyn.solvers._step_shared import _JIT, STATUS_DIVERGED, STATUS_OK, event_buffer
 
 #: A difference of section points below this fraction of the tolerance counts as settled
 #: whatever its contraction rate (the rate of differences at round-off level is noise).

@@ -5,10 +5,10 @@ is tied to the process), so geardyn writes, once per model, a copy of
 :mod:`geardyn.solvers._kernel_template` whose import line names the model's functions, into
 ``$GEARDYN_CACHE_DIR/kernels`` (default ``~/.cache/geardyn/kernels``), and imports it. The file name
 is a hash of the template and of the model's source, so an edited model gets a new kernel (the
-model's part of the step machinery, :mod:`._step_core`, is one such module per model, ``core``,
-which the model's other kernel modules import: compiled once per model, not once per template;
-the step machinery that does not depend on the model, :mod:`._split_core`, is an ordinary
-module, compiled once for every model, that calls the model through function pointers); numba
+model's step machinery, :mod:`._step_core`, is one such module per model, ``core``, which the
+model's other kernel modules import: compiled once per model, not once per template; what does
+not depend on the model, :data:`SHARED_MODULES`, is ordinary modules, compiled once for every
+model); numba
 caches the compiled code in ``$NUMBA_CACHE_DIR`` (default ``$GEARDYN_CACHE_DIR/numba``, see
 :mod:`geardyn._cache`), and a second run does not recompile. Functions that cannot be
 imported by name (defined in ``__main__`` or a notebook) get an in-memory kernel, compiled once per
@@ -264,36 +264,31 @@ def kernels_for(source: KernelSource, template: str = "rk4") -> types.ModuleType
         exec(compile(code, module.__name__, "exec"), module.__dict__)
     _quiet_module(module)
     _LOADED[key] = module
+    _quiet_shared()
     if template != CORE:
-        # the shared split step (every template's scalar path) compiles in a helper process
-        # meanwhile, where no model has compiled it before
-        compile_share.compile_ahead(_shared_module(), AHEAD)
+        # the split step (every template's scalar path) compiles in a helper process meanwhile
+        compile_share.compile_ahead(sys.modules[core], AHEAD)
     return module
 
 
-#: The shared step machinery (:mod:`._split_core`): compiled and cached once for every model.
-SHARED = "geardyn.solvers._split_core"
-#: Its functions that :func:`kernels_for` compiles ahead (:func:`.compile_share.compile_ahead`)
+#: The core functions :func:`kernels_for` has compiled ahead (:func:`.compile_share.compile_ahead`)
 #: when it first loads one of a model's templates: name -> the signature every template calls
 #: it with (``tests/test_compile_share.py`` checks that the templates compile no other).
-AHEAD = {"_split_step": "(UniTuple(int64, 2), int64, float64, float64[::1], float64[::1], "
-                        "float64[::1], float64, float64, int64, float64, float64, float64, "
-                        "float64, int64[::1], float64[::1], int64[::1], float64[:, ::1], "
-                        "float64[::1], float64[:, ::1])"}
+AHEAD = {"_split_step": "(int64, float64, float64[::1], float64[::1], float64[::1], float64, "
+                        "float64, int64, float64, float64, float64, float64, int64[::1], "
+                        "float64[::1], int64[::1], float64[:, ::1], float64[::1], "
+                        "float64[:, ::1])"}
+#: The modules of kernel functions that do not depend on the model: ordinary modules, compiled
+#: and cached once for every model.
+SHARED_MODULES = ("geardyn.solvers._step_shared", "geardyn.solvers._sweep_books",
+                  "geardyn.solvers._lyapunov_books")
+_QUIETED: list[bool] = []
 
 
-#: Every module of kernel functions that do not depend on the model (compiled once for all).
-SHARED_MODULES = (SHARED, "geardyn.solvers._sweep_books", "geardyn.solvers._lyapunov_books")
-
-
-def _shared_module() -> types.ModuleType:
-    """:mod:`._split_core`; on the first call, the functions of every module of
-    :data:`SHARED_MODULES` compile quietly and under their locks (:func:`_quiet_module`)."""
+def _quiet_shared() -> None:
+    """On the first call, the functions of every module of :data:`SHARED_MODULES` compile
+    quietly and under their locks, like a generated module's (:func:`_quiet_module`)."""
     if not _QUIETED:
         for name in SHARED_MODULES:
             _quiet_module(importlib.import_module(name))
         _QUIETED.append(True)
-    return importlib.import_module(SHARED)
-
-
-_QUIETED: list[bool] = []
