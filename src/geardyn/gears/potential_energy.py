@@ -1,0 +1,397 @@
+"""Mesh stiffness of an external spur pair by the potential-energy method.
+
+Each tooth is a cantilever of variable section on its involute flank (Yang & Lin 1987; Tian
+2004; Wu, Zuo & Parey 2008; Chaari, Fakhfakh & Haddar 2009), of face width b and Young's
+modulus E (shear modulus G = E / (2 (1 + nu))). In the tooth's own frame (x along the centre
+line from the gear centre, y across it) the involute point whose tangent touches the base circle
+(radius r_b) at angle alpha from the centre line is
+
+    x(alpha) = r_b [cos alpha - (alpha_2 - alpha) sin alpha]
+    h(alpha) = r_b [sin alpha + (alpha_2 - alpha) cos alpha]     (half thickness)
+    dx = r_b (alpha_2 - alpha) cos alpha dalpha
+
+with alpha_2 the half angular thickness of the tooth on the base circle. A contact whose roll
+angle is tan(alpha_c) = s / r_b (s: distance from the gear's tangent point on the line of action)
+lies at alpha = -alpha_1, alpha_1 = s / r_b - alpha_2: alpha_1 is the angle between the contact
+force F and the normal to the centre line, so F splits into F cos alpha_1 (bending, shear) and
+F sin alpha_1 (axial compression). With x_c, h_c the contact point's coordinates, the energies
+F^2 / (2 k) give the compliances
+
+    1/k_b = int [cos a1 (x_c - x) - sin a1 h_c]^2 / (E I) dx,   I = (2/3) h^3 b
+    1/k_s = int 1.2 cos^2 a1 / (G A) dx,                       A = 2 h b
+    1/k_a = int sin^2 a1 / (E A) dx
+
+integrated from the root section to the contact point (alpha from -alpha_1 to the root) by a
+fixed Gauss-Legendre rule, vectorised over contact positions. The root section:
+
+* root circle below the base circle (r_f < r_b, fewer than about 42 teeth at 20 deg): the
+  flank between the root and base circles is the straight radial line of half thickness
+  h_b = r_b sin alpha_2 (Chen & Shao 2011; Ma et al. 2014; Liang, Zuo & Pandey 2014), a
+  section of constant h from x = r_f cos alpha_3 (sin alpha_3 = h_b / r_f) to x = r_b cos
+  alpha_2, whose integrals are closed forms. ``root_segment=False`` leaves it out: the
+  cantilever then starts at the base circle (Tian 2004; Wu, Zuo & Parey 2008);
+* root circle above the base circle: the cantilever starts at the root circle, alpha_3 =
+  alpha_2 - sqrt(r_f^2 / r_b^2 - 1) (the involute below r_f is not material).
+
+The fillet (trochoid) is not modelled in the cantilever; the gear body's deflection below the
+root circle is the fillet-foundation term of Sainsot, Velex & Duverger (2004):
+
+    1/k_f = cos^2 a1 / (E b) [L* (u_f/S_f)^2 + M* (u_f/S_f) + P* (1 + Q* tan^2 a1)]
+
+with u_f the distance along the centre line from the root circle to where the line of the force
+crosses it (x_c - h_c tan a1 - r_f), S_f = 2 r_f theta_f the chord of the tooth at the root circle
+(theta_f: its half angle there), and X* = A/theta_f^2 + B h_fi^2 + C h_fi/theta_f + D/theta_f +
+E h_fi + F, h_fi = r_f / r_int (r_int: the bore radius), the published polynomial fits (their
+range of validity is not checked here). The Hertz term of a line contact of two equal
+materials is load-independent, k_h = pi E b / (4 (1 - nu^2)) (Yang & Lin 1987). One pair:
+
+    1/k = 1/k_h + sum over both gears (1/k_b + 1/k_s + 1/k_a + 1/k_f)
+
+and the mesh stiffness is the sum over the pairs in contact (pairs act in parallel, load
+sharing by equal deflection). External pairs only; b is the smaller face width.
+"""
+
+from __future__ import annotations
+
+import math
+import numbers
+from collections.abc import Sequence
+from dataclasses import dataclass
+from functools import lru_cache
+
+import numpy as np
+import xarray as xr
+
+from geardyn.errors import ParameterError
+from geardyn.gears.geometry import GearMesh, SpurGear
+from geardyn.units import to_si
+
+#: Young's modulus [Pa] and Poisson ratio of the steel of the 19/48 literature pair.
+STEEL_YOUNG = 2.068e11
+STEEL_POISSON = 0.3
+#: Gauss-Legendre nodes of the tooth integrals (relative error below 1e-10 for spur teeth).
+DEFAULT_NODES = 32
+
+#: Sainsot, Velex & Duverger (2004): coefficients (A, B, C, D, E, F) of
+#: X* = A/theta_f^2 + B h_fi^2 + C h_fi/theta_f + D/theta_f + E h_fi + F.
+SAINSOT_COEFFS: dict[str, tuple[float, ...]] = {
+    "L": (-5.574e-5, -1.9986e-3, -2.3015e-4, 4.7702e-3, 0.0271, 6.8045),
+    "M": (60.111e-5, 28.100e-3, -83.431e-4, -9.9256e-3, 0.1624, 0.9086),
+    "P": (-50.952e-5, 185.50e-3, 0.0538e-4, 53.300e-3, 0.2895, 0.9236),
+    "Q": (-6.2042e-5, 9.0889e-3, -4.0964e-4, 7.8297e-3, -0.1472, 0.6904),
+}
+
+#: The energy terms of one tooth, in the order of the compliance sum.
+TOOTH_TERMS = ("bending", "shear", "axial", "fillet")
+
+
+def sainsot_coefficient(name: str, h_fi: float, theta_f: float) -> float:
+    """Sainsot's fitted coefficient ``name`` (L, M, P or Q) at h_fi = r_f / r_int and the
+    half angle theta_f [rad] of the tooth at the root circle."""
+    a, b, c, d, e, f = SAINSOT_COEFFS[name]
+    return (a / theta_f ** 2 + b * h_fi ** 2 + c * h_fi / theta_f + d / theta_f + e * h_fi + f)
+
+
+@dataclass(frozen=True)
+class ToothModel:
+    """One gear's tooth as the potential-energy method sees it (SI units, radians).
+
+    ``top`` is the upper limit of the involute parameter alpha (the root end of the involute
+    cantilever); ``segment`` is (x_root, x_base, h_b) of the straight part between the root and
+    base circles, or None; ``fillet`` holds Sainsot's (L*, M*, P*, Q*)."""
+
+    name: str
+    base_radius: float
+    root_radius: float
+    half_base_angle: float
+    top: float
+    segment: tuple[float, float, float] | None
+    theta_f: float
+    bore_radius: float
+    fillet: tuple[float, float, float, float]
+
+    @property
+    def h_fi(self) -> float:
+        """r_f / r_int."""
+        return self.root_radius / self.bore_radius
+
+
+def tooth_model(gear: SpurGear, bore_radius: float, *, root_segment: bool = True,
+                role: str | None = None) -> ToothModel:
+    """The cantilever and fillet-foundation description of ``gear``'s tooth (external gear)
+    on a bore of radius ``bore_radius`` [m]; ``role`` names the gear in errors."""
+    role = role or gear.name
+    if gear.internal:
+        raise ParameterError(f"{role}.internal", True,
+                             "the potential-energy stiffness covers external gears only")
+    if gear.profile_shift < gear.min_profile_shift - 1e-12:
+        raise ParameterError(f"{role}.profile_shift", gear.profile_shift,
+                             "undercut teeth: the tooth model needs the whole involute flank"
+                             f" (profile shift >= {gear.min_profile_shift:.4f})")
+    r_b, r_f = gear.base_radius, gear.root_radius
+    if not 0.0 < bore_radius < r_f:
+        raise ParameterError(f"{role}.bore_radius", bore_radius,
+                             f"must lie between 0 and the root radius {r_f:.6g} m")
+    a2 = 0.5 * gear.angular_thickness(r_b)
+    segment = None
+    if r_f <= r_b:
+        h_b = r_b * math.sin(a2)
+        a3 = math.asin(h_b / r_f)
+        top, theta_f = a2, a3
+        if root_segment and r_f < r_b:
+            segment = (r_f * math.cos(a3), r_b * math.cos(a2), h_b)
+    else:
+        top = a2 - math.sqrt((r_f / r_b) ** 2 - 1.0)
+        phi = a2 - top
+        theta_f = math.atan2(math.sin(top) + phi * math.cos(top),
+                             math.cos(top) - phi * math.sin(top))
+    h_fi = r_f / bore_radius
+    fillet = tuple(sainsot_coefficient(n, h_fi, theta_f) for n in "LMPQ")
+    return ToothModel(name=role, base_radius=r_b, root_radius=r_f, half_base_angle=a2,
+                      top=top, segment=segment, theta_f=theta_f, bore_radius=bore_radius,
+                      fillet=fillet)  # type: ignore[arg-type]
+
+
+@lru_cache(maxsize=8)
+def _gauss(nodes: int) -> tuple[np.ndarray, np.ndarray]:
+    x, w = np.polynomial.legendre.leggauss(nodes)
+    return x, w
+
+
+def contact_point(tooth: ToothModel, alpha1: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(x_c, h_c) [m] of the contact at load angle ``alpha1`` [rad] in the tooth's frame."""
+    r_b, a2 = tooth.base_radius, tooth.half_base_angle
+    roll = alpha1 + a2
+    return (r_b * (np.cos(alpha1) + roll * np.sin(alpha1)),
+            r_b * (roll * np.cos(alpha1) - np.sin(alpha1)))
+
+
+def tooth_compliances(tooth: ToothModel, alpha1: np.ndarray, *, young: float, poisson: float,
+                      face_width: float, nodes: int = DEFAULT_NODES) -> dict[str, np.ndarray]:
+    """Compliances 1/k_b, 1/k_s, 1/k_a, 1/k_f [m/N] of ``tooth`` loaded at the load angles
+    ``alpha1`` [rad] (any shape), by name (:data:`TOOTH_TERMS`)."""
+    a1 = np.asarray(alpha1, dtype=float)
+    lower = -a1
+    if np.any(lower >= tooth.top):
+        raise ParameterError(f"{tooth.name}.dedendum", None,
+                             "a contact lies at or below the root section of the tooth")
+    r_b, a2, b, e = tooth.base_radius, tooth.half_base_angle, face_width, young
+    g = young / (2.0 * (1.0 + poisson))
+    xg, wg = _gauss(nodes)
+    half = 0.5 * (tooth.top - lower)[..., None]
+    al = 0.5 * (tooth.top + lower)[..., None] + half * xg
+    phi = a2 - al
+    cos_al, sin_al = np.cos(al), np.sin(al)
+    h = r_b * (sin_al + phi * cos_al)
+    x = r_b * (cos_al - phi * sin_al)
+    dx = r_b * phi * cos_al * half * wg
+    x_c, h_c = contact_point(tooth, a1)
+    cos1, sin1 = np.cos(a1), np.sin(a1)
+    arm = cos1[..., None] * (x_c[..., None] - x) - (sin1 * h_c)[..., None]
+    bending = np.sum(arm ** 2 / (e * (2.0 / 3.0) * h ** 3 * b) * dx, axis=-1)
+    inv_area = np.sum(dx / (2.0 * h * b), axis=-1)  # int dx / A
+    shear = 1.2 * cos1 ** 2 / g * inv_area
+    axial = sin1 ** 2 / e * inv_area
+    if tooth.segment is not None:
+        x_r, x_b, h_b = tooth.segment
+        inertia, area, length = (2.0 / 3.0) * h_b ** 3 * b, 2.0 * h_b * b, x_b - x_r
+        u_r = cos1 * (x_c - x_r) - sin1 * h_c
+        u_b = cos1 * (x_c - x_b) - sin1 * h_c
+        bending = bending + (u_r ** 3 - u_b ** 3) / (3.0 * cos1 * e * inertia)
+        shear = shear + 1.2 * cos1 ** 2 * length / (g * area)
+        axial = axial + sin1 ** 2 * length / (e * area)
+    return {"bending": bending, "shear": shear, "axial": axial,
+            "fillet": fillet_compliance(tooth, a1, young=young, face_width=face_width)}
+
+
+def fillet_compliance(tooth: ToothModel, alpha1: np.ndarray, *, young: float,
+                      face_width: float) -> np.ndarray:
+    """Sainsot's fillet-foundation compliance 1/k_f [m/N] at the load angles ``alpha1``."""
+    a1 = np.asarray(alpha1, dtype=float)
+    x_c, h_c = contact_point(tooth, a1)
+    u_f = x_c - h_c * np.tan(a1) - tooth.root_radius
+    s_f = 2.0 * tooth.root_radius * tooth.theta_f
+    ratio = u_f / s_f
+    lf, mf, pf, qf = tooth.fillet
+    return (np.cos(a1) ** 2 / (young * face_width)
+            * (lf * ratio ** 2 + mf * ratio + pf * (1.0 + qf * np.tan(a1) ** 2)))
+
+
+def hertz_stiffness(young: float, poisson: float, face_width: float) -> float:
+    """k_h = pi E b / (4 (1 - nu^2)) [N/m] (Yang & Lin 1987, equal materials)."""
+    return math.pi * young * face_width / (4.0 * (1.0 - poisson ** 2))
+
+
+@dataclass(frozen=True)
+class PotentialEnergyPair:
+    """A spur mesh prepared for the potential-energy method: both teeth, material, width."""
+
+    mesh: GearMesh
+    pinion: ToothModel
+    wheel: ToothModel
+    young: float
+    poisson: float
+    face_width: float
+    nodes: int
+
+    @property
+    def hertz(self) -> float:
+        """k_h [N/m]."""
+        return hertz_stiffness(self.young, self.poisson, self.face_width)
+
+    def load_angles(self, position: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """alpha_1 [rad] of pinion and wheel tooth for contacts at ``position`` [m] along the
+        line of action from the pitch point (positive towards the pinion's tip)."""
+        mesh = self.mesh
+        s1 = self.pinion.base_radius * math.tan(mesh.operating_pressure_angle) + position
+        s2 = mesh.line_of_action_length - s1
+        return (s1 / self.pinion.base_radius - self.pinion.half_base_angle,
+                s2 / self.wheel.base_radius - self.wheel.half_base_angle)
+
+    def terms(self, position: np.ndarray) -> dict[str, np.ndarray]:
+        """Stiffness [N/m] of each energy term (``hertz``, ``bending_pinion``, ...,
+        ``fillet_wheel``) and of the pair (``pair``) for contacts at ``position`` [m]."""
+        pos = np.asarray(position, dtype=float)
+        a_p, a_w = self.load_angles(pos)
+        kw = dict(young=self.young, poisson=self.poisson, face_width=self.face_width,
+                  nodes=self.nodes)
+        out = {"hertz": np.full(pos.shape, self.hertz)}
+        compliance = np.full(pos.shape, 1.0 / self.hertz)
+        for role, tooth, a1 in (("pinion", self.pinion, a_p), ("wheel", self.wheel, a_w)):
+            for term, c in tooth_compliances(tooth, a1, **kw).items():
+                out[f"{term}_{role}"] = 1.0 / c
+                compliance = compliance + c
+        out["pair"] = 1.0 / compliance
+        return out
+
+
+def _positive(value: object, kind: str, name: str) -> float:
+    try:
+        v = to_si(value, kind)
+    except ValueError as exc:
+        raise ParameterError(name, value, str(exc)) from None
+    if not (math.isfinite(v) and v > 0.0):
+        raise ParameterError(name, value, "must be a finite number > 0")
+    return v
+
+
+def _bores(bore_radius: object) -> tuple[object, object]:
+    if isinstance(bore_radius, str) or not isinstance(bore_radius, Sequence):
+        return bore_radius, bore_radius
+    if len(bore_radius) != 2:
+        raise ParameterError("bore_radius", bore_radius,
+                             "give one radius or two (pinion, wheel)")
+    return bore_radius[0], bore_radius[1]
+
+
+def prepare_pair(mesh: GearMesh, *, bore_radius: object, young: object = STEEL_YOUNG,
+                 poisson: object = STEEL_POISSON, root_segment: bool = True,
+                 nodes: int = DEFAULT_NODES) -> PotentialEnergyPair:
+    """Validate the inputs of :func:`potential_energy_stiffness` and build both teeth."""
+    if mesh.internal:
+        raise ParameterError("mesh.internal", True,
+                             "the potential-energy stiffness covers external pairs only")
+    e = _positive(young, "pressure", "young")
+    try:
+        nu = to_si(poisson, "dimensionless")
+    except ValueError as exc:
+        raise ParameterError("poisson", poisson, str(exc)) from None
+    if not 0.0 <= nu < 0.5:
+        raise ParameterError("poisson", poisson, "must lie in [0, 0.5)")
+    if isinstance(nodes, bool) or not isinstance(nodes, numbers.Integral) or not nodes >= 4:
+        raise ParameterError("nodes", nodes, "must be a whole number >= 4")
+    bp, bw = _bores(bore_radius)
+    teeth = []
+    for role, gear, bore in (("pinion", mesh.pinion, bp), ("wheel", mesh.wheel, bw)):
+        r = _positive(bore, "length", f"{role}.bore_radius")
+        teeth.append(tooth_model(gear, r, root_segment=root_segment, role=role))
+    width = min(mesh.pinion.face_width, mesh.wheel.face_width)
+    return PotentialEnergyPair(mesh=mesh, pinion=teeth[0], wheel=teeth[1], young=e,
+                               poisson=nu, face_width=width, nodes=int(nodes))
+
+
+def _angle_grid(mesh: GearMesh, angles: object) -> np.ndarray:
+    """Pinion angles [deg]: ``angles`` points over one mesh cycle, or the given angles."""
+    cycle = 360.0 / mesh.pinion.teeth
+    if isinstance(angles, numbers.Integral) and not isinstance(angles, bool):
+        if angles < 1:
+            raise ParameterError("angles", angles, "must be >= 1 points per mesh cycle")
+        return cycle * np.arange(int(angles)) / int(angles)
+    try:
+        grid = np.asarray(angles, dtype=float).reshape(-1)
+    except (TypeError, ValueError):
+        raise ParameterError("angles", angles, "give a number of points or angles in deg")\
+            from None
+    if grid.size == 0 or not np.all(np.isfinite(grid)):
+        raise ParameterError("angles", angles, "must be finite pinion angles in deg")
+    return grid
+
+
+def _units(name: str) -> str:
+    return "" if name in ("pairs_in_contact", "in_contact") else "N/m"
+
+
+def potential_energy_stiffness(mesh: GearMesh, *, bore_radius: object, angles: object = 360,
+                               young: object = STEEL_YOUNG, poisson: object = STEEL_POISSON,
+                               root_segment: bool = True,
+                               nodes: int = DEFAULT_NODES) -> xr.Dataset:
+    """Mesh stiffness of the external spur ``mesh`` over pinion angles by the potential-energy
+    method (module docstring): a Dataset over ``angle`` (pinion rotation [deg]; an int
+    ``angles`` is that many points over one mesh cycle, 360/z1 deg, from the passage of a pair
+    through the pitch point; or give the angles) with coordinates ``cycle`` (mesh cycles) and
+    ``pair`` (pair k passes the pitch point k mesh cycles before the cycle's start: its contact
+    lies (cycle mod 1 + k) p_b beyond the pitch point).
+
+    Variables: ``mesh_stiffness`` [N/m], ``pairs_in_contact``; per pair ``in_contact``,
+    ``position`` (along the line of action from the pitch point [m]), ``pair_stiffness`` [N/m]
+    (0 out of contact) and each energy term's stiffness ``k_hertz``, ``k_bending_pinion``, ...
+    ``k_fillet_wheel`` [N/m] (NaN out of contact). A pair is in contact from the start of the
+    path of contact (included) to its end (excluded). ``bore_radius`` [m]: one radius or
+    (pinion, wheel); ``young`` [Pa], ``poisson``; ``nodes``: Gauss-Legendre nodes.
+    """
+    pair = prepare_pair(mesh, bore_radius=bore_radius, young=young, poisson=poisson,
+                        root_segment=root_segment, nodes=nodes)
+    deg = _angle_grid(mesh, angles)
+    cycles = deg * mesh.pinion.teeth / 360.0
+    frac = cycles - np.floor(cycles)
+    p_b = mesh.base_pitch
+    start, end = -mesh.approach_length / p_b, mesh.recess_length / p_b
+    ks = np.arange(math.floor(start), math.floor(end) + 1)
+    u = frac[:, None] + ks[None, :]  # contact position in base pitches
+    inside = (u >= start) & (u < end)
+    position = u * p_b
+    terms = pair.terms(np.where(inside, position, 0.0))
+    k_pair = np.where(inside, terms.pop("pair"), 0.0)
+    data = {"mesh_stiffness": (("angle",), k_pair.sum(axis=1)),
+            "pairs_in_contact": (("angle",), inside.sum(axis=1)),
+            "in_contact": (("angle", "pair"), inside),
+            "position": (("angle", "pair"), position),
+            "pair_stiffness": (("angle", "pair"), k_pair)}
+    for name, k in terms.items():
+        data[f"k_{name}"] = (("angle", "pair"), np.where(inside, k, np.nan))
+    ds = xr.Dataset(data, coords={"angle": deg, "cycle": ("angle", cycles), "pair": ks})
+    for name in ds.data_vars:
+        ds[name].attrs["units"] = "m" if name == "position" else _units(name)
+    ds["angle"].attrs.update(units="deg", long_name="pinion rotation")
+    ds["cycle"].attrs.update(units="", long_name="mesh cycles")
+    ds.attrs.update(_attrs(pair, root_segment))
+    return ds
+
+
+def _attrs(pair: PotentialEnergyPair, root_segment: bool) -> dict[str, object]:
+    mesh = pair.mesh
+    out: dict[str, object] = {
+        "method": "potential energy (Yang & Lin 1987; Tian 2004; Chaari et al. 2009) with the"
+                  " fillet foundation of Sainsot, Velex & Duverger 2004",
+        "root": ("straight flank from the root to the base circle" if root_segment
+                 else "cantilever from the base circle (or the root circle above it)"),
+        "young_Pa": pair.young, "poisson": pair.poisson, "face_width_m": pair.face_width,
+        "hertz_stiffness_N_per_m": pair.hertz, "contact_ratio": mesh.contact_ratio,
+        "base_pitch_m": mesh.base_pitch, "quadrature_nodes": pair.nodes,
+    }
+    for role, tooth in (("pinion", pair.pinion), ("wheel", pair.wheel)):
+        out[f"{role}_bore_radius_m"] = tooth.bore_radius
+        out[f"{role}_h_fi"] = tooth.h_fi
+        out[f"{role}_theta_f_rad"] = tooth.theta_f
+        out[f"{role}_root_below_base"] = int(tooth.root_radius < tooth.base_radius)
+    return out
