@@ -1,4 +1,5 @@
-"""Gear geometry, ISO 6336-1 mesh stiffness, stiffness waveforms and planetary mesh phasing.
+"""Gear geometry, ISO 6336-1 and potential-energy mesh stiffness, stiffness waveforms and
+planetary mesh phasing.
 
 Pure numpy: everything here produces plain numbers, arrays and callables that a model's mesh
 takes (mean stiffness, Fourier coefficients, phases). See docs/gears.md.
@@ -14,6 +15,15 @@ from geardyn.gears.phasing import (
     sun_ring_phase,
     surviving_harmonics,
 )
+from geardyn.gears.potential_energy import (
+    PotentialEnergyPair,
+    ToothModel,
+    hertz_stiffness,
+    potential_energy_stiffness,
+    prepare_pair,
+    tooth_compliances,
+    tooth_model,
+)
 from geardyn.gears.waveform import StiffnessWaveform, double_contact_centre, mesh_stiffness_waveform
 
 __all__ = [
@@ -21,15 +31,22 @@ __all__ = [
     "ISOStiffness",
     "MeshPhases",
     "PlanetaryGeometry",
+    "PotentialEnergyPair",
     "SpurGear",
     "StiffnessWaveform",
+    "ToothModel",
     "double_contact_centre",
     "equally_spaced",
+    "hertz_stiffness",
     "involute",
     "inverse_involute",
     "iso6336_stiffness",
     "mesh_phases",
     "mesh_stiffness_waveform",
+    "potential_energy_stiffness",
+    "prepare_pair",
     "sun_ring_phase",
     "surviving_harmonics",
+    "tooth_compliances",
+    "tooth_model",
 ]
