@@ -8,13 +8,15 @@ quad, the geometry from the textbook relations for unshifted gears), never from 
 from __future__ import annotations
 
 import math
+import re
+from pathlib import Path
 
 import numpy as np
 import pytest
 from scipy.integrate import quad
 
 from geardyn.errors import ParameterError
-from geardyn.gears import GearMesh, SpurGear
+from geardyn.gears import GearMesh, SpurGear, iso6336_stiffness
 from geardyn.gears.potential_energy import (
     potential_energy_stiffness,
     prepare_pair,
@@ -266,3 +268,33 @@ def test_undercut_and_internal_are_refused() -> None:
     with pytest.raises(ParameterError) as info:
         SpurGear(Z1, M, ALPHA, -B, name="pinion")
     assert info.value.field == "pinion.face_width"
+
+
+# -- docs/gears.md's comparison with ISO 6336-1 ----------------------------------------------
+
+_ROW = re.compile(r"^\| (\d+)/(\d+), m ([\d.]+) mm, b (\d+) mm \|(.*)\|$", re.M)
+
+
+def test_docs_iso_comparison_table_is_computed() -> None:
+    """Every number of docs/gears.md's potential-energy vs ISO table, recomputed."""
+    text = (Path(__file__).resolve().parent.parent / "docs" / "gears.md").read_text()
+    table = text.split("<!-- pe-iso-table:begin")[1].split("<!-- pe-iso-table:end")[0]
+    rows = _ROW.findall(table)
+    assert len(rows) >= 3
+    for z1, z2, m, b, cells in rows:
+        doc = [float(c) for c in cells.split("|")]
+        mesh = GearMesh(SpurGear(int(z1), f"{m} mm", "20 deg", f"{b} mm", name="pinion"),
+                        SpurGear(int(z2), f"{m} mm", "20 deg", f"{b} mm", name="wheel"))
+        iso = iso6336_stiffness(mesh)
+        per_width = mesh.pinion.face_width * 1e9  # N/m -> N/(mm um)
+        means = {}
+        for h_fi in (1.5, 2.0, 3.0):
+            bores = (mesh.pinion.root_radius / h_fi, mesh.wheel.root_radius / h_fi)
+            ds = potential_energy_stiffness(mesh, bore_radius=bores, angles=720)
+            means[h_fi] = float(ds.mesh_stiffness.mean()) / per_width
+        bores = (mesh.pinion.root_radius / 2.0, mesh.wheel.root_radius / 2.0)
+        single = prepare_pair(mesh, bore_radius=bores).terms(np.array([0.0]))["pair"][0]
+        got = [mesh.contact_ratio, iso.c_prime, iso.c_gamma_alpha, single / per_width,
+               means[1.5], means[2.0], means[3.0], means[2.0] / iso.c_gamma_alpha]
+        digits = [4, 2, 2, 2, 2, 2, 2, 2]
+        assert [round(g, d) for g, d in zip(got, digits, strict=True)] == doc, (z1, z2)
