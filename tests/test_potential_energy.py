@@ -159,6 +159,29 @@ def test_root_circle_sides(mesh: GearMesh) -> None:
     assert pair.pinion.segment is not None and pair.wheel.segment is None
 
 
+def test_mesh_stiffness_over_the_cycle_matches_an_independent_computation(
+        mesh: GearMesh) -> None:
+    """Pairs placed on the line of action here, each tooth's terms by quad (above)."""
+    n = 12
+    ds = potential_energy_stiffness(mesh, bore_radius=BORES, angles=n)
+    p, w = _geometry(Z1), _geometry(Z2)
+    pb = math.pi * M * math.cos(ALPHA)
+    g_f = math.sqrt(w["ra"] ** 2 - w["rb"] ** 2) - w["rb"] * math.tan(ALPHA)
+    g_a = math.sqrt(p["ra"] ** 2 - p["rb"] ** 2) - p["rb"] * math.tan(ALPHA)
+    k_h = math.pi * E * B / (4.0 * (1.0 - NU ** 2))
+    for i in range(n):
+        total = 0.0
+        for u in (i / n, i / n - 1.0):  # the pair at or past the pitch point, the next one
+            if not -g_f <= u * pb < g_a:
+                continue
+            c = 1.0 / k_h
+            for z, roll in ((Z1, math.tan(ALPHA) + u * pb / p["rb"]),
+                            (Z2, math.tan(ALPHA) - u * pb / w["rb"])):
+                c += sum(_reference(z, _alpha1(z, roll)).values())
+            total += 1.0 / c
+        assert ds.mesh_stiffness.values[i] == pytest.approx(total, rel=1e-10), i
+
+
 def test_pair_stiffness_is_the_series_sum(mesh: GearMesh) -> None:
     ds = potential_energy_stiffness(mesh, bore_radius=BORES, angles=24)
     names = [f"k_{t}_{g}" for g in ("pinion", "wheel")
