@@ -17,6 +17,7 @@ from geardyn.gears.phasing import (
 )
 from geardyn.gears.potential_energy import (
     PotentialEnergyPair,
+    RootCrack,
     ToothModel,
     hertz_stiffness,
     potential_energy_stiffness,
@@ -32,6 +33,7 @@ __all__ = [
     "MeshPhases",
     "PlanetaryGeometry",
     "PotentialEnergyPair",
+    "RootCrack",
     "SpurGear",
     "StiffnessWaveform",
     "ToothModel",

@@ -97,14 +97,16 @@ class ToothModel:
     """One gear's tooth as the potential-energy method sees it (SI units, radians).
 
     ``top`` is the upper limit of the involute parameter alpha (the root end of the involute
-    cantilever); ``segment`` is (x_root, x_base, h_b) of the straight part between the root and
-    base circles, or None; ``fillet`` holds Sainsot's (L*, M*, P*, Q*)."""
+    cantilever), ``tip`` its value at the tip circle; ``segment`` is (x_root, x_base, h_b) of
+    the straight part between the root and base circles, or None; ``fillet`` holds Sainsot's
+    (L*, M*, P*, Q*)."""
 
     name: str
     base_radius: float
     root_radius: float
     half_base_angle: float
     top: float
+    tip: float
     segment: tuple[float, float, float] | None
     theta_f: float
     bore_radius: float
@@ -147,8 +149,9 @@ def tooth_model(gear: SpurGear, bore_radius: float, *, root_segment: bool = True
                              math.cos(top) - phi * math.sin(top))
     h_fi = r_f / bore_radius
     fillet = tuple(sainsot_coefficient(n, h_fi, theta_f) for n in "LMPQ")
+    tip = a2 - math.sqrt((gear.tip_radius / r_b) ** 2 - 1.0)
     return ToothModel(name=role, base_radius=r_b, root_radius=r_f, half_base_angle=a2,
-                      top=top, segment=segment, theta_f=theta_f, bore_radius=bore_radius,
+                      top=top, tip=tip, segment=segment, theta_f=theta_f, bore_radius=bore_radius,
                       fillet=fillet)  # type: ignore[arg-type]
 
 
@@ -166,20 +169,80 @@ def contact_point(tooth: ToothModel, alpha1: np.ndarray) -> tuple[np.ndarray, np
             r_b * (roll * np.cos(alpha1) - np.sin(alpha1)))
 
 
-def tooth_compliances(tooth: ToothModel, alpha1: np.ndarray, *, young: float, poisson: float,
-                      face_width: float, nodes: int = DEFAULT_NODES) -> dict[str, np.ndarray]:
-    """Compliances 1/k_b, 1/k_s, 1/k_a, 1/k_f [m/N] of ``tooth`` loaded at the load angles
-    ``alpha1`` [rad] (any shape), by name (:data:`TOOTH_TERMS`)."""
-    a1 = np.asarray(alpha1, dtype=float)
-    lower = -a1
-    if np.any(lower >= tooth.top):
-        raise ParameterError(f"{tooth.name}.dedendum", None,
-                             "a contact lies at or below the root section of the tooth")
+@dataclass(frozen=True)
+class RootCrack:
+    """A straight crack at the root of one tooth's loaded flank (Tian 2004; Wu, Zuo & Parey
+    2008; Chen & Shao 2011): ``depth`` q [m] along the crack, ``angle`` v [rad] between the crack
+    and the tooth's centre line (q sin v is its reach across the tooth), on tooth ``tooth`` of
+    ``gear`` ("pinion" or "wheel"; tooth 0 passes the pitch point at pinion angle 0, tooth j
+    j mesh cycles later). Quantities may be unit strings."""
+
+    depth: float
+    angle: float = math.radians(45.0)
+    gear: str = "pinion"
+    tooth: int = 0
+
+    def __post_init__(self) -> None:
+        set_ = object.__setattr__
+        try:
+            set_(self, "depth", to_si(self.depth, "length"))
+            set_(self, "angle", to_si(self.angle, "angle"))
+        except ValueError as exc:
+            raise ParameterError("crack", self, str(exc)) from None
+        if not (math.isfinite(self.depth) and self.depth >= 0.0):
+            raise ParameterError("crack.depth", self.depth, "must be a finite length >= 0")
+        if not 0.0 < self.angle <= 0.5 * math.pi:
+            raise ParameterError("crack.angle", self.angle, "must lie in (0, 90 deg]")
+        if self.gear not in ("pinion", "wheel"):
+            raise ParameterError("crack.gear", self.gear, "must be 'pinion' or 'wheel'")
+        if isinstance(self.tooth, bool) or not isinstance(self.tooth, numbers.Integral):
+            raise ParameterError("crack.tooth", self.tooth, "must be a whole number")
+
+    @property
+    def reach(self) -> float:
+        """q sin v [m]: how far the crack tip lies inside the flank, across the tooth."""
+        return self.depth * math.sin(self.angle)
+
+
+def root_half_thickness(tooth: ToothModel) -> float:
+    """Half thickness h_r [m] of the cantilever's root section (where a root crack starts)."""
+    phi = tooth.half_base_angle - tooth.top
+    return tooth.base_radius * (math.sin(tooth.top) + phi * math.cos(tooth.top))
+
+
+def crack_limit(tooth: ToothModel, h_q: float) -> float:
+    """alpha_c: the involute parameter above which (towards the root) the flank's half thickness
+    exceeds h_q, the crack tip's distance from the centre line (Tian's crack limit line runs
+    from the tip parallel to the centre line until it meets the flank); the tooth tip's alpha if
+    the line reaches the tip. h(alpha) rises with alpha for alpha < 0."""
+    r_b, a2 = tooth.base_radius, tooth.half_base_angle
+
+    def h(a: float) -> float:
+        return r_b * (math.sin(a) + (a2 - a) * math.cos(a))
+
+    if h(tooth.tip) >= h_q:
+        return tooth.tip
+    lo, hi = tooth.tip, 0.0
+    for _ in range(200):
+        mid = 0.5 * (lo + hi)
+        if h(mid) < h_q:
+            lo = mid
+        else:
+            hi = mid
+        if hi - lo <= 1e-15:
+            break
+    return hi
+
+
+def _involute_piece(tooth: ToothModel, a1: np.ndarray, lower: np.ndarray, upper: np.ndarray,
+                    h_q: float | None, young: float, face_width: float,
+                    nodes: int) -> tuple[np.ndarray, np.ndarray]:
+    """(int M^2/(E I) dx / F^2, int dx / A) over alpha in [lower, upper] of the involute
+    cantilever; the section is 2h wide, or h + h_q on a cracked tooth."""
     r_b, a2, b, e = tooth.base_radius, tooth.half_base_angle, face_width, young
-    g = young / (2.0 * (1.0 + poisson))
     xg, wg = _gauss(nodes)
-    half = 0.5 * (tooth.top - lower)[..., None]
-    al = 0.5 * (tooth.top + lower)[..., None] + half * xg
+    half = 0.5 * (upper - lower)[..., None]
+    al = 0.5 * (upper + lower)[..., None] + half * xg
     phi = a2 - al
     cos_al, sin_al = np.cos(al), np.sin(al)
     h = r_b * (sin_al + phi * cos_al)
@@ -188,13 +251,57 @@ def tooth_compliances(tooth: ToothModel, alpha1: np.ndarray, *, young: float, po
     x_c, h_c = contact_point(tooth, a1)
     cos1, sin1 = np.cos(a1), np.sin(a1)
     arm = cos1[..., None] * (x_c[..., None] - x) - (sin1 * h_c)[..., None]
-    bending = np.sum(arm ** 2 / (e * (2.0 / 3.0) * h ** 3 * b) * dx, axis=-1)
-    inv_area = np.sum(dx / (2.0 * h * b), axis=-1)  # int dx / A
+    if h_q is None:
+        inertia, area = (2.0 / 3.0) * h ** 3 * b, 2.0 * h * b
+    else:
+        inertia, area = (h + h_q) ** 3 * b / 12.0, (h + h_q) * b
+    return (np.sum(arm ** 2 / (e * inertia) * dx, axis=-1), np.sum(dx / area, axis=-1))
+
+
+def tooth_compliances(tooth: ToothModel, alpha1: np.ndarray, *, young: float, poisson: float,
+                      face_width: float, nodes: int = DEFAULT_NODES,
+                      crack: RootCrack | None = None) -> dict[str, np.ndarray]:
+    """Compliances 1/k_b, 1/k_s, 1/k_a, 1/k_f [m/N] of ``tooth`` loaded at the load angles
+    ``alpha1`` [rad] (any shape), by name (:data:`TOOTH_TERMS`).
+
+    A ``crack`` of nonzero depth (its gear and tooth index are not looked at here) narrows every
+    section below Tian's crack limit line to h + h_q, h_q = h_r - q sin v (h_r: the root
+    section's half thickness), bending arm unchanged; the fillet term stays healthy (Chen & Shao
+    2011). Cracks reaching past the centre line (q sin v >= h_r) are refused. A zero-depth crack
+    is the healthy tooth."""
+    a1 = np.asarray(alpha1, dtype=float)
+    lower = -a1
+    if np.any(lower >= tooth.top):
+        raise ParameterError(f"{tooth.name}.dedendum", None,
+                             "a contact lies at or below the root section of the tooth")
+    b, e = face_width, young
+    g = young / (2.0 * (1.0 + poisson))
+    top = np.full(a1.shape, tooth.top)
+    h_q: float | None = None
+    if crack is None or crack.depth == 0.0:
+        bending, inv_area = _involute_piece(tooth, a1, lower, top, None, e, b, nodes)
+    else:
+        h_r = root_half_thickness(tooth)
+        if not crack.reach < h_r:
+            raise ParameterError("crack.depth", crack.depth,
+                                 f"the crack reaches {crack.reach:.4g} m across the tooth, past"
+                                 f" its centre line (root half thickness {h_r:.4g} m)")
+        h_q = h_r - crack.reach
+        split = np.maximum(lower, crack_limit(tooth, h_q))
+        bend_h, area_h = _involute_piece(tooth, a1, lower, split, None, e, b, nodes)
+        bend_c, area_c = _involute_piece(tooth, a1, split, top, h_q, e, b, nodes)
+        bending, inv_area = bend_h + bend_c, area_h + area_c
+    cos1, sin1 = np.cos(a1), np.sin(a1)
     shear = 1.2 * cos1 ** 2 / g * inv_area
     axial = sin1 ** 2 / e * inv_area
     if tooth.segment is not None:
         x_r, x_b, h_b = tooth.segment
-        inertia, area, length = (2.0 / 3.0) * h_b ** 3 * b, 2.0 * h_b * b, x_b - x_r
+        x_c, h_c = contact_point(tooth, a1)
+        if h_q is None:
+            inertia, area = (2.0 / 3.0) * h_b ** 3 * b, 2.0 * h_b * b
+        else:
+            inertia, area = (h_b + h_q) ** 3 * b / 12.0, (h_b + h_q) * b
+        length = x_b - x_r
         u_r = cos1 * (x_c - x_r) - sin1 * h_c
         u_b = cos1 * (x_c - x_b) - sin1 * h_c
         bending = bending + (u_r ** 3 - u_b ** 3) / (3.0 * cos1 * e * inertia)
@@ -233,6 +340,7 @@ class PotentialEnergyPair:
     poisson: float
     face_width: float
     nodes: int
+    crack: RootCrack | None = None
 
     @property
     def hertz(self) -> float:
@@ -248,9 +356,12 @@ class PotentialEnergyPair:
         return (s1 / self.pinion.base_radius - self.pinion.half_base_angle,
                 s2 / self.wheel.base_radius - self.wheel.half_base_angle)
 
-    def terms(self, position: np.ndarray) -> dict[str, np.ndarray]:
+    def terms(self, position: np.ndarray,
+              faulty: np.ndarray | None = None) -> dict[str, np.ndarray]:
         """Stiffness [N/m] of each energy term (``hertz``, ``bending_pinion``, ...,
-        ``fillet_wheel``) and of the pair (``pair``) for contacts at ``position`` [m]."""
+        ``fillet_wheel``) and of the pair (``pair``) for contacts at ``position`` [m]. With a
+        ``crack``, the cracked gear's tooth is the cracked one where ``faulty`` (a boolean
+        array like ``position``; None: everywhere)."""
         pos = np.asarray(position, dtype=float)
         a_p, a_w = self.load_angles(pos)
         kw = dict(young=self.young, poisson=self.poisson, face_width=self.face_width,
@@ -258,7 +369,15 @@ class PotentialEnergyPair:
         out = {"hertz": np.full(pos.shape, self.hertz)}
         compliance = np.full(pos.shape, 1.0 / self.hertz)
         for role, tooth, a1 in (("pinion", self.pinion, a_p), ("wheel", self.wheel, a_w)):
-            for term, c in tooth_compliances(tooth, a1, **kw).items():
+            comp = tooth_compliances(tooth, a1, **kw)
+            if self.crack is not None and self.crack.gear == role:
+                mask = np.ones(pos.shape, bool) if faulty is None else np.asarray(faulty, bool)
+                if mask.any():
+                    cracked = tooth_compliances(tooth, a1[mask], crack=self.crack, **kw)
+                    for t in comp:
+                        comp[t] = comp[t].copy()
+                        comp[t][mask] = cracked[t]
+            for term, c in comp.items():
                 out[f"{term}_{role}"] = 1.0 / c
                 compliance = compliance + c
         out["pair"] = 1.0 / compliance
@@ -286,7 +405,8 @@ def _bores(bore_radius: object) -> tuple[object, object]:
 
 def prepare_pair(mesh: GearMesh, *, bore_radius: object, young: object = STEEL_YOUNG,
                  poisson: object = STEEL_POISSON, root_segment: bool = True,
-                 nodes: int = DEFAULT_NODES) -> PotentialEnergyPair:
+                 nodes: int = DEFAULT_NODES,
+                 crack: RootCrack | None = None) -> PotentialEnergyPair:
     """Validate the inputs of :func:`potential_energy_stiffness` and build both teeth."""
     if mesh.internal:
         raise ParameterError("mesh.internal", True,
@@ -306,17 +426,38 @@ def prepare_pair(mesh: GearMesh, *, bore_radius: object, young: object = STEEL_Y
         r = _positive(bore, "length", f"{role}.bore_radius")
         teeth.append(tooth_model(gear, r, root_segment=root_segment, role=role))
     width = min(mesh.pinion.face_width, mesh.wheel.face_width)
+    if crack is not None:
+        _check_crack(crack, mesh, teeth[0] if crack.gear == "pinion" else teeth[1])
     return PotentialEnergyPair(mesh=mesh, pinion=teeth[0], wheel=teeth[1], young=e,
-                               poisson=nu, face_width=width, nodes=int(nodes))
+                               poisson=nu, face_width=width, nodes=int(nodes), crack=crack)
 
 
-def _angle_grid(mesh: GearMesh, angles: object) -> np.ndarray:
-    """Pinion angles [deg]: ``angles`` points over one mesh cycle, or the given angles."""
-    cycle = 360.0 / mesh.pinion.teeth
+def _check_crack(crack: object, mesh: GearMesh, tooth: ToothModel) -> None:
+    if not isinstance(crack, RootCrack):
+        raise ParameterError("crack", crack, "must be a RootCrack or None")
+    z = (mesh.pinion if crack.gear == "pinion" else mesh.wheel).teeth
+    if not 0 <= crack.tooth < z:
+        raise ParameterError("crack.tooth", crack.tooth, f"must lie in [0, {z - 1}]")
+    h_r = root_half_thickness(tooth)
+    if not crack.reach < h_r:
+        raise ParameterError("crack.depth", crack.depth,
+                             f"the crack reaches {crack.reach:.4g} m across the tooth, past its"
+                             f" centre line (root half thickness {h_r:.4g} m)")
+
+
+def _cycle_grid(mesh: GearMesh, angles: object,
+                cycles: object) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(mesh cycles, whole cycles n, fraction of the cycle) of the pinion angles: ``angles``
+    points per mesh cycle over ``cycles`` mesh cycles (the fractions of every cycle the same
+    floats), or the given angles [deg]."""
+    if isinstance(cycles, bool) or not isinstance(cycles, numbers.Integral) or cycles < 1:
+        raise ParameterError("cycles", cycles, "must be a whole number >= 1")
     if isinstance(angles, numbers.Integral) and not isinstance(angles, bool):
         if angles < 1:
             raise ParameterError("angles", angles, "must be >= 1 points per mesh cycle")
-        return cycle * np.arange(int(angles)) / int(angles)
+        i = np.arange(int(angles) * int(cycles))
+        whole, frac = (i // int(angles)).astype(float), (i % int(angles)) / int(angles)
+        return whole + frac, whole, frac
     try:
         grid = np.asarray(angles, dtype=float).reshape(-1)
     except (TypeError, ValueError):
@@ -324,58 +465,88 @@ def _angle_grid(mesh: GearMesh, angles: object) -> np.ndarray:
             from None
     if grid.size == 0 or not np.all(np.isfinite(grid)):
         raise ParameterError("angles", angles, "must be finite pinion angles in deg")
-    return grid
+    cyc = grid * mesh.pinion.teeth / 360.0
+    whole = np.floor(cyc)
+    return cyc, whole, cyc - whole
 
 
 def _units(name: str) -> str:
-    return "" if name in ("pairs_in_contact", "in_contact") else "N/m"
+    unitless = ("pairs_in_contact", "in_contact", "tooth_pinion", "tooth_wheel")
+    return "" if name in unitless else "N/m"
 
 
 def potential_energy_stiffness(mesh: GearMesh, *, bore_radius: object, angles: object = 360,
                                young: object = STEEL_YOUNG, poisson: object = STEEL_POISSON,
-                               root_segment: bool = True,
-                               nodes: int = DEFAULT_NODES) -> xr.Dataset:
+                               root_segment: bool = True, nodes: int = DEFAULT_NODES,
+                               crack: RootCrack | None = None, cycles: int = 1) -> xr.Dataset:
     """Mesh stiffness of the external spur ``mesh`` over pinion angles by the potential-energy
     method (module docstring): a Dataset over ``angle`` (pinion rotation [deg]; an int
-    ``angles`` is that many points over one mesh cycle, 360/z1 deg, from the passage of a pair
-    through the pitch point; or give the angles) with coordinates ``cycle`` (mesh cycles) and
-    ``pair`` (pair k passes the pitch point k mesh cycles before the cycle's start: its contact
-    lies (cycle mod 1 + k) p_b beyond the pitch point).
+    ``angles`` is that many points per mesh cycle, 360/z1 deg, over ``cycles`` mesh cycles from
+    the passage of pinion tooth 0 and wheel tooth 0 through the pitch point; or give the angles)
+    with coordinates ``cycle`` (mesh cycles) and ``pair`` (pair k passes the pitch point k mesh
+    cycles before the start of the current cycle n = floor(cycle): its contact lies
+    (cycle - n + k) p_b beyond the pitch point, between pinion tooth (n - k) mod z1 and wheel
+    tooth (n - k) mod z2: variables ``tooth_pinion``, ``tooth_wheel``).
 
     Variables: ``mesh_stiffness`` [N/m], ``pairs_in_contact``; per pair ``in_contact``,
     ``position`` (along the line of action from the pitch point [m]), ``pair_stiffness`` [N/m]
     (0 out of contact) and each energy term's stiffness ``k_hertz``, ``k_bending_pinion``, ...
     ``k_fillet_wheel`` [N/m] (NaN out of contact). A pair is in contact from the start of the
     path of contact (included) to its end (excluded). ``bore_radius`` [m]: one radius or
-    (pinion, wheel); ``young`` [Pa], ``poisson``; ``nodes``: Gauss-Legendre nodes.
+    (pinion, wheel); ``young`` [Pa], ``poisson``; ``nodes``: Gauss-Legendre nodes. ``crack``:
+    a :class:`RootCrack` on one tooth (see :func:`tooth_compliances`); a pinion tooth returns
+    every z1 mesh cycles, a wheel tooth every z2 (the hunting period: lcm(z1, z2) cycles).
     """
     pair = prepare_pair(mesh, bore_radius=bore_radius, young=young, poisson=poisson,
-                        root_segment=root_segment, nodes=nodes)
-    deg = _angle_grid(mesh, angles)
-    cycles = deg * mesh.pinion.teeth / 360.0
-    frac = cycles - np.floor(cycles)
+                        root_segment=root_segment, nodes=nodes, crack=crack)
+    cyc, n, frac = _cycle_grid(mesh, angles, cycles)
+    deg = cyc * (360.0 / mesh.pinion.teeth)
     p_b = mesh.base_pitch
     start, end = -mesh.approach_length / p_b, mesh.recess_length / p_b
     ks = np.arange(math.floor(start), math.floor(end) + 1)
     u = frac[:, None] + ks[None, :]  # contact position in base pitches
     inside = (u >= start) & (u < end)
     position = u * p_b
-    terms = pair.terms(np.where(inside, position, 0.0))
+    passage = n.astype(np.int64)[:, None] - ks[None, :]  # the pair's pitch-point cycle
+    tooth_p, tooth_w = passage % mesh.pinion.teeth, passage % mesh.wheel.teeth
+    faulty = None
+    if crack is not None:
+        faulty = inside & ((tooth_p if crack.gear == "pinion" else tooth_w) == crack.tooth)
+    terms = _terms_on_grid(pair, position, inside, faulty)
     k_pair = np.where(inside, terms.pop("pair"), 0.0)
     data = {"mesh_stiffness": (("angle",), k_pair.sum(axis=1)),
             "pairs_in_contact": (("angle",), inside.sum(axis=1)),
             "in_contact": (("angle", "pair"), inside),
             "position": (("angle", "pair"), position),
+            "tooth_pinion": (("angle", "pair"), tooth_p),
+            "tooth_wheel": (("angle", "pair"), tooth_w),
             "pair_stiffness": (("angle", "pair"), k_pair)}
     for name, k in terms.items():
         data[f"k_{name}"] = (("angle", "pair"), np.where(inside, k, np.nan))
-    ds = xr.Dataset(data, coords={"angle": deg, "cycle": ("angle", cycles), "pair": ks})
+    ds = xr.Dataset(data, coords={"angle": deg, "cycle": ("angle", cyc), "pair": ks})
     for name in ds.data_vars:
         ds[name].attrs["units"] = "m" if name == "position" else _units(name)
     ds["angle"].attrs.update(units="deg", long_name="pinion rotation")
     ds["cycle"].attrs.update(units="", long_name="mesh cycles")
     ds.attrs.update(_attrs(pair, root_segment))
     return ds
+
+
+def _terms_on_grid(pair: PotentialEnergyPair, position: np.ndarray, inside: np.ndarray,
+                   faulty: np.ndarray | None) -> dict[str, np.ndarray]:
+    """Every term at the contacts ``inside`` (0 elsewhere), each distinct position evaluated
+    once (a grid over many mesh cycles repeats the positions of one cycle exactly)."""
+    where, inverse = np.unique(position[inside], return_inverse=True)
+    healthy = pair.terms(where, np.zeros(where.shape, bool))
+    out = {}
+    for name, values in healthy.items():
+        out[name] = np.zeros(position.shape)
+        out[name][inside] = values[inverse]
+    if faulty is not None and faulty.any():
+        where, inverse = np.unique(position[faulty], return_inverse=True)
+        for name, values in pair.terms(where).items():
+            out[name][faulty] = values[inverse]
+    return out
 
 
 def _attrs(pair: PotentialEnergyPair, root_segment: bool) -> dict[str, object]:
@@ -388,6 +559,10 @@ def _attrs(pair: PotentialEnergyPair, root_segment: bool) -> dict[str, object]:
         "young_Pa": pair.young, "poisson": pair.poisson, "face_width_m": pair.face_width,
         "hertz_stiffness_N_per_m": pair.hertz, "contact_ratio": mesh.contact_ratio,
         "base_pitch_m": mesh.base_pitch, "quadrature_nodes": pair.nodes,
+        "crack": "none" if pair.crack is None else (
+            f"root crack on {pair.crack.gear} tooth {pair.crack.tooth}: depth"
+            f" {pair.crack.depth:.6g} m, angle {math.degrees(pair.crack.angle):.6g} deg"
+            " (Tian's crack limit line; fillet foundation healthy)"),
     }
     for role, tooth in (("pinion", pair.pinion), ("wheel", pair.wheel)):
         out[f"{role}_bore_radius_m"] = tooth.bore_radius
