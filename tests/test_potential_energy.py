@@ -18,6 +18,7 @@ from scipy.integrate import quad
 from geardyn.errors import ParameterError
 from geardyn.gears import GearMesh, SpurGear, iso6336_stiffness
 from geardyn.gears.potential_energy import (
+    RootCrack,
     potential_energy_stiffness,
     prepare_pair,
     tooth_compliances,
@@ -321,3 +322,108 @@ def test_docs_iso_comparison_table_is_computed() -> None:
                means[1.5], means[2.0], means[3.0], means[2.0] / iso.c_gamma_alpha]
         digits = [4, 2, 2, 2, 2, 2, 2, 2]
         assert [round(g, d) for g, d in zip(got, digits, strict=True)] == doc, (z1, z2)
+
+
+# -- root crack on one tooth -----------------------------------------------------------------
+
+
+def _cracked_reference(z: int, a1: float, reach: float) -> dict[str, float]:
+    """Tian's cracked tooth by quad: every section is h + min(h, h_q) thick (the crack limit
+    line at h_q = h_r - q sin v from the centre line cuts the sections wider than h_q), the
+    straight root flank h_b + h_q; pinion (r_f < r_b) only."""
+    g = _geometry(z)
+    rb, rf, a2 = g["rb"], g["rf"], g["a2"]
+    hb = rb * math.sin(a2)
+    hq = hb - reach
+    c, s = math.cos(a1), math.sin(a1)
+    xc = rb * (math.cos(a1) + (a1 + a2) * math.sin(a1))
+    hc = rb * ((a1 + a2) * math.cos(a1) - math.sin(a1))
+    g_mod = E / (2.0 * (1.0 + NU))
+
+    def geom(a: float) -> tuple[float, float, float]:
+        h = rb * (math.sin(a) + (a2 - a) * math.cos(a))
+        x = rb * (math.cos(a) - (a2 - a) * math.sin(a))
+        return h + min(h, hq), x, rb * (a2 - a) * math.cos(a)
+
+    def bend(a: float) -> float:
+        t, x, dx = geom(a)
+        return (c * (xc - x) - s * hc) ** 2 / (E * t ** 3 * B / 12.0) * dx
+
+    def inv_area(a: float) -> float:
+        t, _, dx = geom(a)
+        return dx / (t * B)
+
+    tight = dict(epsabs=0.0, epsrel=1e-12, limit=400)
+    x0, x1 = math.sqrt(rf ** 2 - hb ** 2), rb * math.cos(a2)
+    t_b = hb + hq
+    bending = (quad(bend, -a1, a2, **tight)[0]
+               + quad(lambda x: (c * (xc - x) - s * hc) ** 2 / (E * t_b ** 3 * B / 12.0),
+                      x0, x1, **tight)[0])
+    area = quad(inv_area, -a1, a2, **tight)[0] + (x1 - x0) / (t_b * B)
+    return {"bending": bending, "shear": 1.2 * c ** 2 / g_mod * area,
+            "axial": s ** 2 / E * area}
+
+
+@pytest.mark.parametrize("depth", [0.4e-3, 1.5e-3, 3.5e-3])
+def test_cracked_tooth_matches_quad(mesh: GearMesh, depth: float) -> None:
+    crack = RootCrack(depth, "45 deg")
+    pair = prepare_pair(mesh, bore_radius=BORES, crack=crack)
+    a1 = np.array([_alpha1(Z1, roll) for roll in _rolls(Z1, Z2)])
+    got = tooth_compliances(pair.pinion, a1, young=E, poisson=NU, face_width=B, crack=crack)
+    healthy = tooth_compliances(pair.pinion, a1, young=E, poisson=NU, face_width=B)
+    for i, alpha1 in enumerate(a1):
+        ref = _cracked_reference(Z1, float(alpha1), depth * math.sin(math.radians(45.0)))
+        for name, value in ref.items():
+            assert got[name][i] == pytest.approx(value, rel=1e-8), (name, i)
+            assert got[name][i] > healthy[name][i]
+        assert got["fillet"][i] == healthy["fillet"][i]
+
+
+def test_zero_crack_is_healthy_bitwise(mesh: GearMesh) -> None:
+    healthy = potential_energy_stiffness(mesh, bore_radius=BORES, angles=60, cycles=Z1)
+    zero = potential_energy_stiffness(mesh, bore_radius=BORES, angles=60, cycles=Z1,
+                                      crack=RootCrack(0.0, tooth=3))
+    for name in healthy.data_vars:
+        np.testing.assert_array_equal(zero[name].values, healthy[name].values)
+
+
+def test_stiffness_falls_monotonically_with_crack_depth(mesh: GearMesh) -> None:
+    depths = [0.0, 1e-5, 0.5e-3, 1e-3, 1.5e-3, 2e-3, 2.5e-3, 3e-3, 3.5e-3]
+    runs = [potential_energy_stiffness(mesh, bore_radius=BORES, angles=40, cycles=2 * Z1,
+                                       crack=RootCrack(q, tooth=5)).mesh_stiffness.values
+            for q in depths]
+    ds = potential_energy_stiffness(mesh, bore_radius=BORES, angles=40, cycles=2 * Z1)
+    touched = ((ds.tooth_pinion == 5) & ds.in_contact).any("pair").values
+    assert touched.any() and not touched.all()
+    for shallower, deeper in zip(runs, runs[1:], strict=False):
+        assert np.all(deeper[touched] < shallower[touched])
+        np.testing.assert_array_equal(deeper[~touched], shallower[~touched])
+    # once per pinion revolution: the pattern repeats every z1 mesh cycles
+    n = 40 * Z1
+    np.testing.assert_array_equal(runs[-1][:n], runs[-1][n:])
+
+
+def test_tooth_indices_follow_the_pitch_point_passages(mesh: GearMesh) -> None:
+    ds = potential_energy_stiffness(mesh, bore_radius=BORES, angles=10, cycles=3 * Z2)
+    n = np.floor(ds.cycle.values).astype(int)
+    for j, k in enumerate(ds.pair.values):
+        np.testing.assert_array_equal(ds.tooth_pinion.values[:, j], (n - k) % Z1)
+        np.testing.assert_array_equal(ds.tooth_wheel.values[:, j], (n - k) % Z2)
+    cracked = potential_energy_stiffness(mesh, bore_radius=BORES, angles=10, cycles=3 * Z2,
+                                         crack=RootCrack("1 mm", gear="wheel", tooth=7))
+    changed = cracked.mesh_stiffness.values != ds.mesh_stiffness.values
+    assert np.array_equal(changed, ((ds.tooth_wheel == 7) & ds.in_contact).any("pair").values)
+
+
+@pytest.mark.parametrize("crack, field", [
+    (lambda: RootCrack(4.0e-3, "90 deg"), "crack.depth"),  # past the centre line
+    (lambda: RootCrack(1e-3, tooth=19), "crack.tooth"),
+    (lambda: RootCrack(-1e-3), "crack.depth"),
+    (lambda: RootCrack(float("nan")), "crack.depth"),
+    (lambda: RootCrack(1e-3, angle=0.0), "crack.angle"),
+    (lambda: RootCrack(1e-3, gear="ring"), "crack.gear"),
+])
+def test_bad_cracks_name_the_field(mesh: GearMesh, crack, field: str) -> None:
+    with pytest.raises(ParameterError) as info:
+        potential_energy_stiffness(mesh, bore_radius=BORES, crack=crack())
+    assert info.value.field == field

@@ -191,7 +191,7 @@ class RootCrack:
             raise ParameterError("crack", self, str(exc)) from None
         if not (math.isfinite(self.depth) and self.depth >= 0.0):
             raise ParameterError("crack.depth", self.depth, "must be a finite length >= 0")
-        if not 0.0 < self.angle <= 0.5 * math.pi:
+        if not 0.0 < self.angle <= 0.5 * math.pi * (1.0 + 1e-12):  # "90 deg" in float
             raise ParameterError("crack.angle", self.angle, "must lie in (0, 90 deg]")
         if self.gear not in ("pinion", "wheel"):
             raise ParameterError("crack.gear", self.gear, "must be 'pinion' or 'wheel'")
