@@ -49,6 +49,9 @@ materials is load-independent, k_h = pi E b / (4 (1 - nu^2)) (Yang & Lin 1987). 
 
 and the mesh stiffness is the sum over the pairs in contact (pairs act in parallel, load
 sharing by equal deflection). External pairs only; b is the smaller face width.
+
+A :class:`RootCrack` on one tooth narrows the sections below Tian's crack limit line (see
+:func:`tooth_compliances`); the tooth indices of each pair follow the pitch-point passages.
 """
 
 from __future__ import annotations
