@@ -270,6 +270,9 @@ def test_bore_enters_the_fillet_term_only(mesh: GearMesh) -> None:
     (dict(angles=0), "angles"),
     (dict(angles=[0.0, float("nan")]), "angles"),
     (dict(nodes=2), "nodes"),
+    (dict(cycles=0), "cycles"),
+    (dict(cycles=1.5), "cycles"),
+    (dict(crack="1 mm"), "crack"),
 ])
 def test_bad_inputs_name_the_field(mesh: GearMesh, kwargs: dict, field: str) -> None:
     args = dict(bore_radius=BORES) | kwargs

@@ -430,14 +430,15 @@ def prepare_pair(mesh: GearMesh, *, bore_radius: object, young: object = STEEL_Y
         teeth.append(tooth_model(gear, r, root_segment=root_segment, role=role))
     width = min(mesh.pinion.face_width, mesh.wheel.face_width)
     if crack is not None:
-        _check_crack(crack, mesh, teeth[0] if crack.gear == "pinion" else teeth[1])
+        _check_crack(crack, mesh, teeth)
     return PotentialEnergyPair(mesh=mesh, pinion=teeth[0], wheel=teeth[1], young=e,
                                poisson=nu, face_width=width, nodes=int(nodes), crack=crack)
 
 
-def _check_crack(crack: object, mesh: GearMesh, tooth: ToothModel) -> None:
+def _check_crack(crack: object, mesh: GearMesh, teeth: list[ToothModel]) -> None:
     if not isinstance(crack, RootCrack):
         raise ParameterError("crack", crack, "must be a RootCrack or None")
+    tooth = teeth[0] if crack.gear == "pinion" else teeth[1]
     z = (mesh.pinion if crack.gear == "pinion" else mesh.wheel).teeth
     if not 0 <= crack.tooth < z:
         raise ParameterError("crack.tooth", crack.tooth, f"must lie in [0, {z - 1}]")
