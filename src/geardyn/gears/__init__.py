@@ -2,7 +2,8 @@
 planetary mesh phasing.
 
 Pure numpy: everything here produces plain numbers, arrays and callables that a model's mesh
-takes (mean stiffness, Fourier coefficients, phases). See docs/gears.md.
+takes (mean stiffness, Fourier coefficients, phases); the potential-energy stiffness comes as a
+labelled xarray Dataset. See docs/gears.md.
 """
 
 from geardyn.gears.geometry import GearMesh, SpurGear, inverse_involute, involute
