@@ -1,7 +1,9 @@
-"""Gear geometry, ISO 6336-1 mesh stiffness, stiffness waveforms and planetary mesh phasing.
+"""Gear geometry, ISO 6336-1 and potential-energy mesh stiffness, stiffness waveforms and
+planetary mesh phasing.
 
 Pure numpy: everything here produces plain numbers, arrays and callables that a model's mesh
-takes (mean stiffness, Fourier coefficients, phases). See docs/gears.md.
+takes (mean stiffness, Fourier coefficients, phases); the potential-energy stiffness comes as a
+labelled xarray Dataset. See docs/gears.md.
 """
 
 from geardyn.gears.geometry import GearMesh, SpurGear, inverse_involute, involute
@@ -14,6 +16,16 @@ from geardyn.gears.phasing import (
     sun_ring_phase,
     surviving_harmonics,
 )
+from geardyn.gears.potential_energy import (
+    PotentialEnergyPair,
+    RootCrack,
+    ToothModel,
+    hertz_stiffness,
+    potential_energy_stiffness,
+    prepare_pair,
+    tooth_compliances,
+    tooth_model,
+)
 from geardyn.gears.waveform import StiffnessWaveform, double_contact_centre, mesh_stiffness_waveform
 
 __all__ = [
@@ -21,15 +33,23 @@ __all__ = [
     "ISOStiffness",
     "MeshPhases",
     "PlanetaryGeometry",
+    "PotentialEnergyPair",
+    "RootCrack",
     "SpurGear",
     "StiffnessWaveform",
+    "ToothModel",
     "double_contact_centre",
     "equally_spaced",
+    "hertz_stiffness",
     "involute",
     "inverse_involute",
     "iso6336_stiffness",
     "mesh_phases",
     "mesh_stiffness_waveform",
+    "potential_energy_stiffness",
+    "prepare_pair",
     "sun_ring_phase",
     "surviving_harmonics",
+    "tooth_compliances",
+    "tooth_model",
 ]

@@ -1,0 +1,76 @@
+"""Potential-energy mesh stiffness of the 19/48 spur pair (m 3.2 mm, 20 deg, b 16 mm, bores
+12/35 mm), the xarray Dataset included: one mesh cycle at 360 pinion angles (target <= 50 ms),
+and the hunting period (lcm(19, 48) = 912 mesh cycles, 360 angles each) with a 2 mm root crack
+on one pinion tooth (target <= 1 s).
+
+Wall time: the median of ``--repeat`` calls of
+:func:`geardyn.gears.potential_energy_stiffness` after one warm-up call.
+
+    .venv/bin/python bench/stiffness.py [--repeat 21] [--angles 360] [--write]
+"""
+
+from __future__ import annotations
+
+import argparse
+import statistics
+import sys
+import time
+from pathlib import Path
+
+from geardyn.gears import GearMesh, RootCrack, SpurGear, potential_energy_stiffness
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+import _results as results  # noqa: E402
+
+TARGET_S = 0.050
+HUNTING_TARGET_S = 1.0
+HUNTING = 19 * 48  # lcm(19, 48) mesh cycles
+
+
+def _mesh() -> GearMesh:
+    return GearMesh(SpurGear(19, "3.2 mm", "20 deg", "16 mm", name="pinion"),
+                    SpurGear(48, "3.2 mm", "20 deg", "16 mm", name="wheel"))
+
+
+def measure(repeat: int, angles: int, **options: object) -> tuple[float, float]:
+    """(median wall seconds of one call, mean mesh stiffness [N/m])."""
+    mesh = _mesh()
+    ds = potential_energy_stiffness(mesh, bore_radius=(0.012, 0.035), angles=angles, **options)
+    times = []
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        potential_energy_stiffness(mesh, bore_radius=(0.012, 0.035), angles=angles, **options)
+        times.append(time.perf_counter() - t0)
+    return statistics.median(times), float(ds.mesh_stiffness.mean())
+
+
+def main(argv: list[str] | None = None) -> None:
+    """Run the benchmark; ``--write`` records the figure in bench/RESULTS.md."""
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--repeat", type=int, default=21)
+    ap.add_argument("--angles", type=int, default=360)
+    ap.add_argument("--write", action="store_true")
+    args = ap.parse_args(argv)
+    wall, mean = measure(args.repeat, args.angles)
+    measured = (f"{wall * 1e3:.2f} ms wall, median of {args.repeat} ({args.angles} angles,"
+                f" 19/48 pair; mean stiffness {mean:.4e} N/m)")
+    print(measured)
+    hunt_repeat = max(1, args.repeat // 4)
+    hunt, hunt_mean = measure(hunt_repeat, args.angles, cycles=HUNTING,
+                              crack=RootCrack("2 mm", "45 deg", tooth=0))
+    hunted = (f"{hunt:.3f} s wall, median of {hunt_repeat} ({HUNTING} mesh cycles x"
+              f" {args.angles} angles, 2 mm crack on pinion tooth 0; mean {hunt_mean:.4e} N/m)")
+    print(hunted)
+    if args.write:
+        command = f".venv/bin/python bench/stiffness.py --repeat {args.repeat} --write"
+        results.record("pe-stiffness",
+                       "potential-energy mesh stiffness, one mesh cycle at 360 angles <= 50 ms",
+                       measured, results.against(wall, TARGET_S), command)
+        results.record("pe-stiffness-hunting",
+                       "potential-energy stiffness, 19/48 hunting period, one cracked tooth"
+                       " <= 1 s", hunted, results.against(hunt, HUNTING_TARGET_S), command)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,576 @@
+"""Mesh stiffness of an external spur pair by the potential-energy method.
+
+Each tooth is a cantilever of variable section on its involute flank (Yang & Lin 1987; Tian
+2004; Wu, Zuo & Parey 2008; Chaari, Fakhfakh & Haddar 2009), of face width b and Young's
+modulus E (shear modulus G = E / (2 (1 + nu))). In the tooth's own frame (x along the centre
+line from the gear centre, y across it) the involute point whose tangent touches the base circle
+(radius r_b) at angle alpha from the centre line is
+
+    x(alpha) = r_b [cos alpha - (alpha_2 - alpha) sin alpha]
+    h(alpha) = r_b [sin alpha + (alpha_2 - alpha) cos alpha]     (half thickness)
+    dx = r_b (alpha_2 - alpha) cos alpha dalpha
+
+with alpha_2 the half angular thickness of the tooth on the base circle. A contact whose roll
+angle is tan(alpha_c) = s / r_b (s: distance from the gear's tangent point on the line of action)
+lies at alpha = -alpha_1, alpha_1 = s / r_b - alpha_2: alpha_1 is the angle between the contact
+force F and the normal to the centre line, so F splits into F cos alpha_1 (bending, shear) and
+F sin alpha_1 (axial compression). With x_c, h_c the contact point's coordinates, the energies
+F^2 / (2 k) give the compliances
+
+    1/k_b = int [cos a1 (x_c - x) - sin a1 h_c]^2 / (E I) dx,   I = (2/3) h^3 b
+    1/k_s = int 1.2 cos^2 a1 / (G A) dx,                       A = 2 h b
+    1/k_a = int sin^2 a1 / (E A) dx
+
+integrated from the root section to the contact point (alpha from -alpha_1 to the root) by a
+fixed Gauss-Legendre rule, vectorised over contact positions. The root section:
+
+* root circle below the base circle (r_f < r_b, fewer than about 42 teeth at 20 deg): the
+  flank between the root and base circles is the straight radial line of half thickness
+  h_b = r_b sin alpha_2 (Chen & Shao 2011; Ma et al. 2014; Liang, Zuo & Pandey 2014), a
+  section of constant h from x = r_f cos alpha_3 (sin alpha_3 = h_b / r_f) to x = r_b cos
+  alpha_2, whose integrals are closed forms. ``root_segment=False`` leaves it out: the
+  cantilever then starts at the base circle (Tian 2004; Wu, Zuo & Parey 2008);
+* root circle above the base circle: the cantilever starts at the root circle, alpha_3 =
+  alpha_2 - sqrt(r_f^2 / r_b^2 - 1) (the involute below r_f is not material).
+
+The fillet (trochoid) is not modelled in the cantilever; the gear body's deflection below the
+root circle is the fillet-foundation term of Sainsot, Velex & Duverger (2004):
+
+    1/k_f = cos^2 a1 / (E b) [L* (u_f/S_f)^2 + M* (u_f/S_f) + P* (1 + Q* tan^2 a1)]
+
+with u_f the distance along the centre line from the root circle to where the line of the force
+crosses it (x_c - h_c tan a1 - r_f), S_f = 2 r_f theta_f the chord of the tooth at the root circle
+(theta_f: its half angle there), and X* = A/theta_f^2 + B h_fi^2 + C h_fi/theta_f + D/theta_f +
+E h_fi + F, h_fi = r_f / r_int (r_int: the bore radius), the published polynomial fits (their
+range of validity is not checked here). The Hertz term of a line contact of two equal
+materials is load-independent, k_h = pi E b / (4 (1 - nu^2)) (Yang & Lin 1987). One pair:
+
+    1/k = 1/k_h + sum over both gears (1/k_b + 1/k_s + 1/k_a + 1/k_f)
+
+and the mesh stiffness is the sum over the pairs in contact (pairs act in parallel, load
+sharing by equal deflection). External pairs only; b is the smaller face width.
+
+A :class:`RootCrack` on one tooth narrows the sections below Tian's crack limit line (see
+:func:`tooth_compliances`); the tooth indices of each pair follow the pitch-point passages.
+"""
+
+from __future__ import annotations
+
+import math
+import numbers
+from collections.abc import Sequence
+from dataclasses import dataclass
+from functools import lru_cache
+
+import numpy as np
+import xarray as xr
+
+from geardyn.errors import ParameterError
+from geardyn.gears.geometry import GearMesh, SpurGear
+from geardyn.units import to_si
+
+#: Young's modulus [Pa] and Poisson ratio of the steel of the 19/48 literature pair.
+STEEL_YOUNG = 2.068e11
+STEEL_POISSON = 0.3
+#: Gauss-Legendre nodes of the tooth integrals (relative error below 1e-10 for spur teeth).
+DEFAULT_NODES = 32
+
+#: Sainsot, Velex & Duverger (2004): coefficients (A, B, C, D, E, F) of
+#: X* = A/theta_f^2 + B h_fi^2 + C h_fi/theta_f + D/theta_f + E h_fi + F.
+SAINSOT_COEFFS: dict[str, tuple[float, ...]] = {
+    "L": (-5.574e-5, -1.9986e-3, -2.3015e-4, 4.7702e-3, 0.0271, 6.8045),
+    "M": (60.111e-5, 28.100e-3, -83.431e-4, -9.9256e-3, 0.1624, 0.9086),
+    "P": (-50.952e-5, 185.50e-3, 0.0538e-4, 53.300e-3, 0.2895, 0.9236),
+    "Q": (-6.2042e-5, 9.0889e-3, -4.0964e-4, 7.8297e-3, -0.1472, 0.6904),
+}
+
+#: The energy terms of one tooth, in the order of the compliance sum.
+TOOTH_TERMS = ("bending", "shear", "axial", "fillet")
+
+
+def sainsot_coefficient(name: str, h_fi: float, theta_f: float) -> float:
+    """Sainsot's fitted coefficient ``name`` (L, M, P or Q) at h_fi = r_f / r_int and the
+    half angle theta_f [rad] of the tooth at the root circle."""
+    a, b, c, d, e, f = SAINSOT_COEFFS[name]
+    return (a / theta_f ** 2 + b * h_fi ** 2 + c * h_fi / theta_f + d / theta_f + e * h_fi + f)
+
+
+@dataclass(frozen=True)
+class ToothModel:
+    """One gear's tooth as the potential-energy method sees it (SI units, radians).
+
+    ``top`` is the upper limit of the involute parameter alpha (the root end of the involute
+    cantilever), ``tip`` its value at the tip circle; ``segment`` is (x_root, x_base, h_b) of
+    the straight part between the root and base circles, or None; ``fillet`` holds Sainsot's
+    (L*, M*, P*, Q*)."""
+
+    name: str
+    base_radius: float
+    root_radius: float
+    half_base_angle: float
+    top: float
+    tip: float
+    segment: tuple[float, float, float] | None
+    theta_f: float
+    bore_radius: float
+    fillet: tuple[float, float, float, float]
+
+    @property
+    def h_fi(self) -> float:
+        """r_f / r_int."""
+        return self.root_radius / self.bore_radius
+
+
+def tooth_model(gear: SpurGear, bore_radius: float, *, root_segment: bool = True,
+                role: str | None = None) -> ToothModel:
+    """The cantilever and fillet-foundation description of ``gear``'s tooth (external gear)
+    on a bore of radius ``bore_radius`` [m]; ``role`` names the gear in errors."""
+    role = role or gear.name
+    if gear.internal:
+        raise ParameterError(f"{role}.internal", True,
+                             "the potential-energy stiffness covers external gears only")
+    if gear.profile_shift < gear.min_profile_shift - 1e-12:
+        raise ParameterError(f"{role}.profile_shift", gear.profile_shift,
+                             "undercut teeth: the tooth model needs the whole involute flank"
+                             f" (profile shift >= {gear.min_profile_shift:.4f})")
+    r_b, r_f = gear.base_radius, gear.root_radius
+    if not 0.0 < bore_radius < r_f:
+        raise ParameterError(f"{role}.bore_radius", bore_radius,
+                             f"must lie between 0 and the root radius {r_f:.6g} m")
+    a2 = 0.5 * gear.angular_thickness(r_b)
+    segment = None
+    if r_f <= r_b:
+        h_b = r_b * math.sin(a2)
+        a3 = math.asin(h_b / r_f)
+        top, theta_f = a2, a3
+        if root_segment and r_f < r_b:
+            segment = (r_f * math.cos(a3), r_b * math.cos(a2), h_b)
+    else:
+        top = a2 - math.sqrt((r_f / r_b) ** 2 - 1.0)
+        phi = a2 - top
+        theta_f = math.atan2(math.sin(top) + phi * math.cos(top),
+                             math.cos(top) - phi * math.sin(top))
+    h_fi = r_f / bore_radius
+    fillet = tuple(sainsot_coefficient(n, h_fi, theta_f) for n in "LMPQ")
+    tip = a2 - math.sqrt((gear.tip_radius / r_b) ** 2 - 1.0)
+    return ToothModel(name=role, base_radius=r_b, root_radius=r_f, half_base_angle=a2,
+                      top=top, tip=tip, segment=segment, theta_f=theta_f, bore_radius=bore_radius,
+                      fillet=fillet)  # type: ignore[arg-type]
+
+
+@lru_cache(maxsize=8)
+def _gauss(nodes: int) -> tuple[np.ndarray, np.ndarray]:
+    x, w = np.polynomial.legendre.leggauss(nodes)
+    return x, w
+
+
+def contact_point(tooth: ToothModel, alpha1: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(x_c, h_c) [m] of the contact at load angle ``alpha1`` [rad] in the tooth's frame."""
+    r_b, a2 = tooth.base_radius, tooth.half_base_angle
+    roll = alpha1 + a2
+    return (r_b * (np.cos(alpha1) + roll * np.sin(alpha1)),
+            r_b * (roll * np.cos(alpha1) - np.sin(alpha1)))
+
+
+@dataclass(frozen=True)
+class RootCrack:
+    """A straight crack at the root of one tooth's loaded flank (Tian 2004; Wu, Zuo & Parey
+    2008; Chen & Shao 2011): ``depth`` q [m] along the crack, ``angle`` v [rad] between the crack
+    and the tooth's centre line (q sin v is its reach across the tooth), on tooth ``tooth`` of
+    ``gear`` ("pinion" or "wheel"; tooth 0 passes the pitch point at pinion angle 0, tooth j
+    j mesh cycles later). Quantities may be unit strings."""
+
+    depth: float
+    angle: float = math.radians(45.0)
+    gear: str = "pinion"
+    tooth: int = 0
+
+    def __post_init__(self) -> None:
+        set_ = object.__setattr__
+        try:
+            set_(self, "depth", to_si(self.depth, "length"))
+            set_(self, "angle", to_si(self.angle, "angle"))
+        except ValueError as exc:
+            raise ParameterError("crack", self, str(exc)) from None
+        if not (math.isfinite(self.depth) and self.depth >= 0.0):
+            raise ParameterError("crack.depth", self.depth, "must be a finite length >= 0")
+        if not 0.0 < self.angle <= 0.5 * math.pi * (1.0 + 1e-12):  # "90 deg" in float
+            raise ParameterError("crack.angle", self.angle, "must lie in (0, 90 deg]")
+        if self.gear not in ("pinion", "wheel"):
+            raise ParameterError("crack.gear", self.gear, "must be 'pinion' or 'wheel'")
+        if isinstance(self.tooth, bool) or not isinstance(self.tooth, numbers.Integral):
+            raise ParameterError("crack.tooth", self.tooth, "must be a whole number")
+
+    @property
+    def reach(self) -> float:
+        """q sin v [m]: how far the crack tip lies inside the flank, across the tooth."""
+        return self.depth * math.sin(self.angle)
+
+
+def root_half_thickness(tooth: ToothModel) -> float:
+    """Half thickness h_r [m] of the cantilever's root section (where a root crack starts)."""
+    phi = tooth.half_base_angle - tooth.top
+    return tooth.base_radius * (math.sin(tooth.top) + phi * math.cos(tooth.top))
+
+
+def crack_limit(tooth: ToothModel, h_q: float) -> float:
+    """alpha_c: the involute parameter above which (towards the root) the flank's half thickness
+    exceeds h_q, the crack tip's distance from the centre line (Tian's crack limit line runs
+    from the tip parallel to the centre line until it meets the flank); the tooth tip's alpha if
+    the line reaches the tip. h(alpha) rises with alpha for alpha < 0."""
+    r_b, a2 = tooth.base_radius, tooth.half_base_angle
+
+    def h(a: float) -> float:
+        return r_b * (math.sin(a) + (a2 - a) * math.cos(a))
+
+    if h(tooth.tip) >= h_q:
+        return tooth.tip
+    lo, hi = tooth.tip, 0.0
+    for _ in range(200):
+        mid = 0.5 * (lo + hi)
+        if h(mid) < h_q:
+            lo = mid
+        else:
+            hi = mid
+        if hi - lo <= 1e-15:
+            break
+    return hi
+
+
+def _involute_piece(tooth: ToothModel, a1: np.ndarray, lower: np.ndarray, upper: np.ndarray,
+                    h_q: float | None, young: float, face_width: float,
+                    nodes: int) -> tuple[np.ndarray, np.ndarray]:
+    """(int M^2/(E I) dx / F^2, int dx / A) over alpha in [lower, upper] of the involute
+    cantilever; the section is 2h wide, or h + h_q on a cracked tooth."""
+    r_b, a2, b, e = tooth.base_radius, tooth.half_base_angle, face_width, young
+    xg, wg = _gauss(nodes)
+    half = 0.5 * (upper - lower)[..., None]
+    al = 0.5 * (upper + lower)[..., None] + half * xg
+    phi = a2 - al
+    cos_al, sin_al = np.cos(al), np.sin(al)
+    h = r_b * (sin_al + phi * cos_al)
+    x = r_b * (cos_al - phi * sin_al)
+    dx = r_b * phi * cos_al * half * wg
+    x_c, h_c = contact_point(tooth, a1)
+    cos1, sin1 = np.cos(a1), np.sin(a1)
+    arm = cos1[..., None] * (x_c[..., None] - x) - (sin1 * h_c)[..., None]
+    if h_q is None:
+        inertia, area = (2.0 / 3.0) * h ** 3 * b, 2.0 * h * b
+    else:
+        inertia, area = (h + h_q) ** 3 * b / 12.0, (h + h_q) * b
+    return (np.sum(arm ** 2 / (e * inertia) * dx, axis=-1), np.sum(dx / area, axis=-1))
+
+
+def tooth_compliances(tooth: ToothModel, alpha1: np.ndarray, *, young: float, poisson: float,
+                      face_width: float, nodes: int = DEFAULT_NODES,
+                      crack: RootCrack | None = None) -> dict[str, np.ndarray]:
+    """Compliances 1/k_b, 1/k_s, 1/k_a, 1/k_f [m/N] of ``tooth`` loaded at the load angles
+    ``alpha1`` [rad] (any shape), by name (:data:`TOOTH_TERMS`).
+
+    A ``crack`` of nonzero depth (its gear and tooth index are not looked at here) narrows every
+    section below Tian's crack limit line to h + h_q, h_q = h_r - q sin v (h_r: the root
+    section's half thickness), bending arm unchanged; the fillet term stays healthy (Chen & Shao
+    2011). Cracks reaching past the centre line (q sin v >= h_r) are refused. A zero-depth crack
+    is the healthy tooth."""
+    a1 = np.asarray(alpha1, dtype=float)
+    lower = -a1
+    if np.any(lower >= tooth.top):
+        raise ParameterError(f"{tooth.name}.dedendum", None,
+                             "a contact lies at or below the root section of the tooth")
+    b, e = face_width, young
+    g = young / (2.0 * (1.0 + poisson))
+    top = np.full(a1.shape, tooth.top)
+    h_q: float | None = None
+    if crack is None or crack.depth == 0.0:
+        bending, inv_area = _involute_piece(tooth, a1, lower, top, None, e, b, nodes)
+    else:
+        h_r = root_half_thickness(tooth)
+        if not crack.reach < h_r:
+            raise ParameterError("crack.depth", crack.depth,
+                                 f"the crack reaches {crack.reach:.4g} m across the tooth, past"
+                                 f" its centre line (root half thickness {h_r:.4g} m)")
+        h_q = h_r - crack.reach
+        split = np.maximum(lower, crack_limit(tooth, h_q))
+        bend_h, area_h = _involute_piece(tooth, a1, lower, split, None, e, b, nodes)
+        bend_c, area_c = _involute_piece(tooth, a1, split, top, h_q, e, b, nodes)
+        bending, inv_area = bend_h + bend_c, area_h + area_c
+    cos1, sin1 = np.cos(a1), np.sin(a1)
+    shear = 1.2 * cos1 ** 2 / g * inv_area
+    axial = sin1 ** 2 / e * inv_area
+    if tooth.segment is not None:
+        x_r, x_b, h_b = tooth.segment
+        x_c, h_c = contact_point(tooth, a1)
+        if h_q is None:
+            inertia, area = (2.0 / 3.0) * h_b ** 3 * b, 2.0 * h_b * b
+        else:
+            inertia, area = (h_b + h_q) ** 3 * b / 12.0, (h_b + h_q) * b
+        length = x_b - x_r
+        u_r = cos1 * (x_c - x_r) - sin1 * h_c
+        u_b = cos1 * (x_c - x_b) - sin1 * h_c
+        bending = bending + (u_r ** 3 - u_b ** 3) / (3.0 * cos1 * e * inertia)
+        shear = shear + 1.2 * cos1 ** 2 * length / (g * area)
+        axial = axial + sin1 ** 2 * length / (e * area)
+    return {"bending": bending, "shear": shear, "axial": axial,
+            "fillet": fillet_compliance(tooth, a1, young=young, face_width=face_width)}
+
+
+def fillet_compliance(tooth: ToothModel, alpha1: np.ndarray, *, young: float,
+                      face_width: float) -> np.ndarray:
+    """Sainsot's fillet-foundation compliance 1/k_f [m/N] at the load angles ``alpha1``."""
+    a1 = np.asarray(alpha1, dtype=float)
+    x_c, h_c = contact_point(tooth, a1)
+    u_f = x_c - h_c * np.tan(a1) - tooth.root_radius
+    s_f = 2.0 * tooth.root_radius * tooth.theta_f
+    ratio = u_f / s_f
+    lf, mf, pf, qf = tooth.fillet
+    return (np.cos(a1) ** 2 / (young * face_width)
+            * (lf * ratio ** 2 + mf * ratio + pf * (1.0 + qf * np.tan(a1) ** 2)))
+
+
+def hertz_stiffness(young: float, poisson: float, face_width: float) -> float:
+    """k_h = pi E b / (4 (1 - nu^2)) [N/m] (Yang & Lin 1987, equal materials)."""
+    return math.pi * young * face_width / (4.0 * (1.0 - poisson ** 2))
+
+
+@dataclass(frozen=True)
+class PotentialEnergyPair:
+    """A spur mesh prepared for the potential-energy method: both teeth, material, width."""
+
+    mesh: GearMesh
+    pinion: ToothModel
+    wheel: ToothModel
+    young: float
+    poisson: float
+    face_width: float
+    nodes: int
+    crack: RootCrack | None = None
+
+    @property
+    def hertz(self) -> float:
+        """k_h [N/m]."""
+        return hertz_stiffness(self.young, self.poisson, self.face_width)
+
+    def load_angles(self, position: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """alpha_1 [rad] of pinion and wheel tooth for contacts at ``position`` [m] along the
+        line of action from the pitch point (positive towards the pinion's tip)."""
+        mesh = self.mesh
+        s1 = self.pinion.base_radius * math.tan(mesh.operating_pressure_angle) + position
+        s2 = mesh.line_of_action_length - s1
+        return (s1 / self.pinion.base_radius - self.pinion.half_base_angle,
+                s2 / self.wheel.base_radius - self.wheel.half_base_angle)
+
+    def terms(self, position: np.ndarray,
+              faulty: np.ndarray | None = None) -> dict[str, np.ndarray]:
+        """Stiffness [N/m] of each energy term (``hertz``, ``bending_pinion``, ...,
+        ``fillet_wheel``) and of the pair (``pair``) for contacts at ``position`` [m]. With a
+        ``crack``, the cracked gear's tooth is the cracked one where ``faulty`` (a boolean
+        array like ``position``; None: everywhere)."""
+        pos = np.asarray(position, dtype=float)
+        a_p, a_w = self.load_angles(pos)
+        kw = dict(young=self.young, poisson=self.poisson, face_width=self.face_width,
+                  nodes=self.nodes)
+        out = {"hertz": np.full(pos.shape, self.hertz)}
+        compliance = np.full(pos.shape, 1.0 / self.hertz)
+        for role, tooth, a1 in (("pinion", self.pinion, a_p), ("wheel", self.wheel, a_w)):
+            comp = tooth_compliances(tooth, a1, **kw)
+            if self.crack is not None and self.crack.gear == role:
+                mask = np.ones(pos.shape, bool) if faulty is None else np.asarray(faulty, bool)
+                if mask.any():
+                    cracked = tooth_compliances(tooth, a1[mask], crack=self.crack, **kw)
+                    for t in comp:
+                        comp[t] = comp[t].copy()
+                        comp[t][mask] = cracked[t]
+            for term, c in comp.items():
+                out[f"{term}_{role}"] = 1.0 / c
+                compliance = compliance + c
+        out["pair"] = 1.0 / compliance
+        return out
+
+
+def _positive(value: object, kind: str, name: str) -> float:
+    try:
+        v = to_si(value, kind)
+    except ValueError as exc:
+        raise ParameterError(name, value, str(exc)) from None
+    if not (math.isfinite(v) and v > 0.0):
+        raise ParameterError(name, value, "must be a finite number > 0")
+    return v
+
+
+def _bores(bore_radius: object) -> tuple[object, object]:
+    if isinstance(bore_radius, str) or not isinstance(bore_radius, Sequence):
+        return bore_radius, bore_radius
+    if len(bore_radius) != 2:
+        raise ParameterError("bore_radius", bore_radius,
+                             "give one radius or two (pinion, wheel)")
+    return bore_radius[0], bore_radius[1]
+
+
+def prepare_pair(mesh: GearMesh, *, bore_radius: object, young: object = STEEL_YOUNG,
+                 poisson: object = STEEL_POISSON, root_segment: bool = True,
+                 nodes: int = DEFAULT_NODES,
+                 crack: RootCrack | None = None) -> PotentialEnergyPair:
+    """Validate the inputs of :func:`potential_energy_stiffness` and build both teeth."""
+    if mesh.internal:
+        raise ParameterError("mesh.internal", True,
+                             "the potential-energy stiffness covers external pairs only")
+    e = _positive(young, "pressure", "young")
+    try:
+        nu = to_si(poisson, "dimensionless")
+    except ValueError as exc:
+        raise ParameterError("poisson", poisson, str(exc)) from None
+    if not 0.0 <= nu < 0.5:
+        raise ParameterError("poisson", poisson, "must lie in [0, 0.5)")
+    if isinstance(nodes, bool) or not isinstance(nodes, numbers.Integral) or not nodes >= 4:
+        raise ParameterError("nodes", nodes, "must be a whole number >= 4")
+    bp, bw = _bores(bore_radius)
+    teeth = []
+    for role, gear, bore in (("pinion", mesh.pinion, bp), ("wheel", mesh.wheel, bw)):
+        r = _positive(bore, "length", f"{role}.bore_radius")
+        teeth.append(tooth_model(gear, r, root_segment=root_segment, role=role))
+    width = min(mesh.pinion.face_width, mesh.wheel.face_width)
+    if crack is not None:
+        _check_crack(crack, mesh, teeth)
+    return PotentialEnergyPair(mesh=mesh, pinion=teeth[0], wheel=teeth[1], young=e,
+                               poisson=nu, face_width=width, nodes=int(nodes), crack=crack)
+
+
+def _check_crack(crack: object, mesh: GearMesh, teeth: list[ToothModel]) -> None:
+    if not isinstance(crack, RootCrack):
+        raise ParameterError("crack", crack, "must be a RootCrack or None")
+    tooth = teeth[0] if crack.gear == "pinion" else teeth[1]
+    z = (mesh.pinion if crack.gear == "pinion" else mesh.wheel).teeth
+    if not 0 <= crack.tooth < z:
+        raise ParameterError("crack.tooth", crack.tooth, f"must lie in [0, {z - 1}]")
+    h_r = root_half_thickness(tooth)
+    if not crack.reach < h_r:
+        raise ParameterError("crack.depth", crack.depth,
+                             f"the crack reaches {crack.reach:.4g} m across the tooth, past its"
+                             f" centre line (root half thickness {h_r:.4g} m)")
+
+
+def _cycle_grid(mesh: GearMesh, angles: object,
+                cycles: object) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(mesh cycles, whole cycles n, fraction of the cycle) of the pinion angles: ``angles``
+    points per mesh cycle over ``cycles`` mesh cycles (the fractions of every cycle the same
+    floats), or the given angles [deg]."""
+    if isinstance(cycles, bool) or not isinstance(cycles, numbers.Integral) or cycles < 1:
+        raise ParameterError("cycles", cycles, "must be a whole number >= 1")
+    if isinstance(angles, numbers.Integral) and not isinstance(angles, bool):
+        if angles < 1:
+            raise ParameterError("angles", angles, "must be >= 1 points per mesh cycle")
+        i = np.arange(int(angles) * int(cycles))
+        whole, frac = (i // int(angles)).astype(float), (i % int(angles)) / int(angles)
+        return whole + frac, whole, frac
+    try:
+        grid = np.asarray(angles, dtype=float).reshape(-1)
+    except (TypeError, ValueError):
+        raise ParameterError("angles", angles, "give a number of points or angles in deg")\
+            from None
+    if grid.size == 0 or not np.all(np.isfinite(grid)):
+        raise ParameterError("angles", angles, "must be finite pinion angles in deg")
+    cyc = grid * mesh.pinion.teeth / 360.0
+    whole = np.floor(cyc)
+    return cyc, whole, cyc - whole
+
+
+def _units(name: str) -> str:
+    unitless = ("pairs_in_contact", "in_contact", "tooth_pinion", "tooth_wheel")
+    return "" if name in unitless else "N/m"
+
+
+def potential_energy_stiffness(mesh: GearMesh, *, bore_radius: object, angles: object = 360,
+                               young: object = STEEL_YOUNG, poisson: object = STEEL_POISSON,
+                               root_segment: bool = True, nodes: int = DEFAULT_NODES,
+                               crack: RootCrack | None = None, cycles: int = 1) -> xr.Dataset:
+    """Mesh stiffness of the external spur ``mesh`` over pinion angles by the potential-energy
+    method (module docstring): a Dataset over ``angle`` (pinion rotation [deg]; an int
+    ``angles`` is that many points per mesh cycle, 360/z1 deg, over ``cycles`` mesh cycles from
+    the passage of pinion tooth 0 and wheel tooth 0 through the pitch point; or give the angles)
+    with coordinates ``cycle`` (mesh cycles) and ``pair`` (pair k passes the pitch point k mesh
+    cycles before the start of the current cycle n = floor(cycle): its contact lies
+    (cycle - n + k) p_b beyond the pitch point, between pinion tooth (n - k) mod z1 and wheel
+    tooth (n - k) mod z2: variables ``tooth_pinion``, ``tooth_wheel``).
+
+    Variables: ``mesh_stiffness`` [N/m], ``pairs_in_contact``; per pair ``in_contact``,
+    ``position`` (along the line of action from the pitch point [m]), ``pair_stiffness`` [N/m]
+    (0 out of contact) and each energy term's stiffness ``k_hertz``, ``k_bending_pinion``, ...
+    ``k_fillet_wheel`` [N/m] (NaN out of contact). A pair is in contact from the start of the
+    path of contact (included) to its end (excluded). ``bore_radius`` [m]: one radius or
+    (pinion, wheel); ``young`` [Pa], ``poisson``; ``nodes``: Gauss-Legendre nodes. ``crack``:
+    a :class:`RootCrack` on one tooth (see :func:`tooth_compliances`); a pinion tooth returns
+    every z1 mesh cycles, a wheel tooth every z2 (the hunting period: lcm(z1, z2) cycles).
+    """
+    pair = prepare_pair(mesh, bore_radius=bore_radius, young=young, poisson=poisson,
+                        root_segment=root_segment, nodes=nodes, crack=crack)
+    cyc, n, frac = _cycle_grid(mesh, angles, cycles)
+    deg = cyc * (360.0 / mesh.pinion.teeth)
+    p_b = mesh.base_pitch
+    start, end = -mesh.approach_length / p_b, mesh.recess_length / p_b
+    ks = np.arange(math.floor(start), math.floor(end) + 1)
+    u = frac[:, None] + ks[None, :]  # contact position in base pitches
+    inside = (u >= start) & (u < end)
+    position = u * p_b
+    passage = n.astype(np.int64)[:, None] - ks[None, :]  # the pair's pitch-point cycle
+    tooth_p, tooth_w = passage % mesh.pinion.teeth, passage % mesh.wheel.teeth
+    faulty = None
+    if crack is not None:
+        faulty = inside & ((tooth_p if crack.gear == "pinion" else tooth_w) == crack.tooth)
+    terms = _terms_on_grid(pair, position, inside, faulty)
+    k_pair = np.where(inside, terms.pop("pair"), 0.0)
+    data = {"mesh_stiffness": (("angle",), k_pair.sum(axis=1)),
+            "pairs_in_contact": (("angle",), inside.sum(axis=1)),
+            "in_contact": (("angle", "pair"), inside),
+            "position": (("angle", "pair"), position),
+            "tooth_pinion": (("angle", "pair"), tooth_p),
+            "tooth_wheel": (("angle", "pair"), tooth_w),
+            "pair_stiffness": (("angle", "pair"), k_pair)}
+    for name, k in terms.items():
+        data[f"k_{name}"] = (("angle", "pair"), np.where(inside, k, np.nan))
+    ds = xr.Dataset(data, coords={"angle": deg, "cycle": ("angle", cyc), "pair": ks})
+    for name in ds.data_vars:
+        ds[name].attrs["units"] = "m" if name == "position" else _units(name)
+    ds["angle"].attrs.update(units="deg", long_name="pinion rotation")
+    ds["cycle"].attrs.update(units="", long_name="mesh cycles")
+    ds.attrs.update(_attrs(pair, root_segment))
+    return ds
+
+
+def _terms_on_grid(pair: PotentialEnergyPair, position: np.ndarray, inside: np.ndarray,
+                   faulty: np.ndarray | None) -> dict[str, np.ndarray]:
+    """Every term at the contacts ``inside`` (0 elsewhere), each distinct position evaluated
+    once (a grid over many mesh cycles repeats the positions of one cycle exactly)."""
+    where, inverse = np.unique(position[inside], return_inverse=True)
+    healthy = pair.terms(where, np.zeros(where.shape, bool))
+    out = {}
+    for name, values in healthy.items():
+        out[name] = np.zeros(position.shape)
+        out[name][inside] = values[inverse]
+    if faulty is not None and faulty.any():
+        where, inverse = np.unique(position[faulty], return_inverse=True)
+        for name, values in pair.terms(where).items():
+            out[name][faulty] = values[inverse]
+    return out
+
+
+def _attrs(pair: PotentialEnergyPair, root_segment: bool) -> dict[str, object]:
+    mesh = pair.mesh
+    out: dict[str, object] = {
+        "method": "potential energy (Yang & Lin 1987; Tian 2004; Chaari et al. 2009) with the"
+                  " fillet foundation of Sainsot, Velex & Duverger 2004",
+        "root": ("straight flank from the root to the base circle" if root_segment
+                 else "cantilever from the base circle (or the root circle above it)"),
+        "young_Pa": pair.young, "poisson": pair.poisson, "face_width_m": pair.face_width,
+        "hertz_stiffness_N_per_m": pair.hertz, "contact_ratio": mesh.contact_ratio,
+        "base_pitch_m": mesh.base_pitch, "quadrature_nodes": pair.nodes,
+        "crack": "none" if pair.crack is None else (
+            f"root crack on {pair.crack.gear} tooth {pair.crack.tooth}: depth"
+            f" {pair.crack.depth:.6g} m, angle {math.degrees(pair.crack.angle):.6g} deg"
+            " (Tian's crack limit line; fillet foundation healthy)"),
+    }
+    for role, tooth in (("pinion", pair.pinion), ("wheel", pair.wheel)):
+        out[f"{role}_bore_radius_m"] = tooth.bore_radius
+        out[f"{role}_h_fi"] = tooth.h_fi
+        out[f"{role}_theta_f_rad"] = tooth.theta_f
+        out[f"{role}_root_below_base"] = int(tooth.root_radius < tooth.base_radius)
+    return out
