@@ -131,8 +131,10 @@ def bifurcation(
     ``force_peak``, ``force_rms``, ``dynamic_factor`` (param, mesh), ``status``,
     ``final_time`` (param: the model time of the final state, the last Poincare point), and
     ``lyapunov`` with its standard error ``lyapunov_err`` and ``lyapunov_unresolved`` (param:
-    its steps at the edge-split limit) when asked: started from each
-    point's final state at its final time, so both forcing phases continue (see
+    its steps at the edge-split limit) when asked: with the run's step, ``locate_edges`` and
+    ``bound``, started from each point's final state at its final time (after at most
+    :data:`LYAPUNOV_ALIGN` time units aligning the tangent vector), so both forcing phases
+    continue (see
     ``docs/lyapunov.md``), and then ``motion`` (param: the motion class of
     :func:`geardyn.analysis.motion.motion_classes`).
     """
@@ -171,8 +173,8 @@ def bifurcation(
         final = last.final
         start = np.where(np.isfinite(final), final, np.broadcast_to(base_y0, final.shape))
         asked = run.samples * _mean_period(model, P)  # averaging time asked for
-        align = RunSettings(transient=min(run.transient, LYAPUNOV_ALIGN),
-                            steps_per_period=run.steps_per_period)
+        # the sweep's own run (step, locate_edges, bound), with the short aligning transient
+        align = run.replace(transient=min(run.transient, LYAPUNOV_ALIGN))
         exps, errs, unres, _ = lyapunov_lanes(model, P, start, align,
                                               settings=LyapunovSettings(duration=asked),
                                               t0=last.final_time, with_status=True)
