@@ -106,3 +106,62 @@ def test_map2d_lyapunov_uses_the_runs_locate_edges():
 
 def _identical(a: xr.Dataset, b: xr.Dataset) -> None:
     xr.testing.assert_identical(a, b)
+
+
+# ------------------------------------------------------------------ 2. the step: run or keyword
+@pytest.mark.parametrize("call", ["periodic_orbit", "continuation", "shooting_problem"])
+def test_steps_per_period_beside_run_is_an_error_naming_both(call):
+    """A steps_per_period keyword beside run= no longer overrides the run's step silently: a
+    TypeError naming both values (also when the run leaves the step to the default)."""
+    from geardyn.analysis.orbits import shooting_problem
+
+    g = geardyn.GearPair(Omega=0.5, zeta=0.05, kappa=0.2, Fa=0.2)
+    for run_steps in (96, None):
+        run = RunSettings(transient=20.0, steps_per_period=run_steps)
+        with pytest.raises(TypeError, match=rf"not both.*steps_per_period={run_steps!r} and "
+                                            r"steps_per_period=200"):
+            if call == "periodic_orbit":
+                geardyn.periodic_orbit(g, run=run, steps_per_period=200)
+            elif call == "continuation":
+                geardyn.continuation(g, "Omega", 0.5, 0.52, run=run, steps_per_period=200)
+            else:
+                shooting_problem(g, None, 1, run, 200)
+
+
+def test_orbit_step_from_the_run_or_the_keyword():
+    """The run's step and the keyword of a run-less call each reach the shooting problem."""
+    from geardyn.analysis.orbits import shooting_problem
+
+    g = geardyn.GearPair(Omega=0.5, zeta=0.05, kappa=0.2, Fa=0.2)
+    assert shooting_problem(g, run=RunSettings(steps_per_period=96)).steps_per_period == 96
+    assert shooting_problem(g, steps_per_period=200).steps_per_period == 200
+    default = shooting_problem(g).steps_per_period
+    assert shooting_problem(g, run=RunSettings()).steps_per_period == default
+
+
+def test_cli_continue_gives_the_step_once(tmp_path, monkeypatch):
+    """``geardyn continue --transient ... --steps-per-period ...`` puts the step in the run it
+    builds and passes no keyword beside it; without a transient the keyword carries it."""
+    from typer.testing import CliRunner
+
+    import geardyn.analysis.branch as branch_module
+    from geardyn.cli.main import app
+
+    study = tmp_path / "soft.toml"
+    study.write_text('[study]\nname = "soft"\nmodel = "gear_pair"\n[params]\nzeta = 0.05\n'
+                     'kappa = 0.0\nFm = 0.1\nFa = 0.05\n[run]\nomega = 1.2\n')
+    seen: list = []
+
+    def recording(*args, **kwargs):
+        seen.append((kwargs["run"], kwargs["steps_per_period"]))
+        return real(*args, **kwargs)
+
+    real = branch_module.continuation
+    monkeypatch.setattr(branch_module, "continuation", recording)
+    base = ["continue", str(study), "--range", "0.6:0.62", "--quiet", "--steps-per-period", "96"]
+    for extra in (["--transient", "50"], []):
+        r = CliRunner().invoke(app, base + extra)
+        assert r.exit_code == 0, (r.exception, r.stdout)
+    (with_run, keyword), (no_run, alone) = seen
+    assert with_run.steps_per_period == 96 and keyword is None
+    assert no_run is None and alone == 96
