@@ -22,7 +22,8 @@ import geardyn
 from geardyn.plotting.frc import plot_frc
 
 pair = geardyn.GearPair(zeta=0.05, kappa=0.0, Fm=0.1, Fa=0.05)
-frc = geardyn.frequency_response(pair, np.linspace(0.4, 1.6, 121), transient=300.0, samples=8)
+frc = geardyn.frequency_response(pair, np.linspace(0.4, 1.6, 121),
+                                 geardyn.RunSettings(transient=300.0, samples=8))
 print(frc[["jump_sweep", "jump_lo", "jump_hi"]].to_dataframe().to_string())
 
 fig = plot_frc(frc)

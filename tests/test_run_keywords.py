@@ -9,6 +9,9 @@
 
 from __future__ import annotations
 
+import contextlib
+import warnings
+
 import numpy as np
 import pytest
 import xarray as xr
@@ -104,10 +107,6 @@ def test_map2d_lyapunov_uses_the_runs_locate_edges():
     assert not np.array_equal(direct, located)
 
 
-def _identical(a: xr.Dataset, b: xr.Dataset) -> None:
-    xr.testing.assert_identical(a, b)
-
-
 # ------------------------------------------------------------------ 2. the step: run or keyword
 @pytest.mark.parametrize("call", ["periodic_orbit", "continuation", "shooting_problem"])
 def test_steps_per_period_beside_run_is_an_error_naming_both(call):
@@ -165,3 +164,139 @@ def test_cli_continue_gives_the_step_once(tmp_path, monkeypatch):
     (with_run, keyword), (no_run, alone) = seen
     assert with_run.steps_per_period == 96 and keyword is None
     assert no_run is None and alone == 96
+
+
+# ------------------------------------------------------------------ 3. bare run keywords warn
+def _soft() -> geardyn.GearPair:
+    return geardyn.GearPair(zeta=0.05, kappa=0.0, Fm=0.1, Fa=0.05)
+
+
+def _one_warning(record, where: str, keywords: str) -> str:
+    """The one DeprecationWarning of a call: names the call's keywords and run=, and points at
+    this file (the caller of the public function)."""
+    deprecations = [w for w in record if issubclass(w.category, DeprecationWarning)]
+    assert len(deprecations) == 1, [str(w.message) for w in deprecations]
+    (w,) = deprecations
+    text = str(w.message)
+    assert text.startswith(f"{where}({keywords}) is deprecated: pass run=geardyn.RunSettings(")
+    assert w.filename == __file__, w.filename
+    return text
+
+
+OMEGAS = np.array([0.6, 0.8, 1.0])
+SHORT = RunSettings(transient=40.0, samples=4, steps_per_period=64)
+
+
+def _kw_and_run(where: str):
+    """(call with keywords, call with run=, keywords in the message) of each function."""
+    g = _soft()
+    P = g.lane_params("Omega", OMEGAS)
+    ls = LyapunovSettings(duration=30.0)
+    grid = (("x", -0.5, 0.5, 2), ("v", -0.5, 0.5, 2))
+
+    def basins_run(**fields):
+        from geardyn.analysis.basins import basins_run
+
+        return basins_run(**fields)
+
+    return {
+        "simulate": (lambda: geardyn.simulate(g, 0.8, periods=4, steps_per_period=64),
+                     lambda: geardyn.simulate(g, 0.8, RunSettings(transient=0.0, samples=4,
+                                                                   steps_per_period=64)),
+                     "periods=, steps_per_period="),
+        "bifurcation": (lambda: geardyn.bifurcation(g, "Omega", OMEGAS, transient=40.0,
+                                                    samples=4, steps_per_period=64, tol=1e-6),
+                        lambda: geardyn.bifurcation(g, "Omega", OMEGAS,
+                                                    SHORT.replace(period_tol=1e-6)),
+                        "transient=, samples=, steps_per_period=, tol="),
+        "map2d": (lambda: geardyn.map2d(g, ("Omega", OMEGAS), ("zeta", [0.05]), transient=40.0,
+                                        samples=4, steps_per_period=64),
+                  lambda: geardyn.map2d(g, ("Omega", OMEGAS), ("zeta", [0.05]), SHORT),
+                  "transient=, samples=, steps_per_period="),
+        "basins": (lambda: geardyn.basins(g, 0.8, *grid, transient=40.0, steps_per_period=64),
+                   lambda: geardyn.basins(g, 0.8, *grid,
+                                          run=basins_run(transient=40.0, steps_per_period=64)),
+                   "transient=, steps_per_period="),
+        "frequency_response": (
+            lambda: geardyn.frequency_response(g, OMEGAS, transient=40.0, samples=4,
+                                               steps_per_period=64),
+            lambda: geardyn.frequency_response(g, OMEGAS, SHORT),
+            "transient=, samples=, steps_per_period="),
+        "continued_sweeps": (
+            lambda: geardyn.continued_sweeps([geardyn.ContinuedSweep(g, "Omega", OMEGAS,
+                                                                     run=SHORT)], samples=4),
+            lambda: geardyn.continued_sweeps([geardyn.ContinuedSweep(g, "Omega", OMEGAS,
+                                                                     run=SHORT)],
+                                             RunSettings(samples=4)),
+            "samples="),
+        "ContinuedSweep": (
+            lambda: geardyn.continued_sweeps([geardyn.ContinuedSweep(
+                g, "Omega", OMEGAS, transient=40.0, steps_per_period=64)], RunSettings(samples=4)),
+            lambda: geardyn.continued_sweeps([geardyn.ContinuedSweep(
+                g, "Omega", OMEGAS, run=RunSettings(transient=40.0, steps_per_period=64))],
+                RunSettings(samples=4)),
+            "transient=, steps_per_period="),
+        "lyapunov": (lambda: geardyn.lyapunov(g.with_omega(0.8), transient=20.0,
+                                              steps_per_period=64, settings=ls),
+                     lambda: geardyn.lyapunov(g.with_omega(0.8),
+                                              run=RunSettings(transient=20.0,
+                                                              steps_per_period=64),
+                                              settings=ls),
+                     "transient=, steps_per_period="),
+        "lyapunov_lanes": (lambda: geardyn.lyapunov_lanes(g, P, locate_edges=False, settings=ls),
+                           lambda: geardyn.lyapunov_lanes(g, P, run=RunSettings(
+                               transient=100.0, locate_edges=False), settings=ls),
+                           "locate_edges="),
+    }[where]
+
+
+WHERE = ("simulate", "bifurcation", "map2d", "basins", "frequency_response", "continued_sweeps",
+         "ContinuedSweep", "lyapunov", "lyapunov_lanes")
+
+
+@pytest.mark.parametrize("where", WHERE)
+def test_run_keywords_warn_once_and_give_the_run_result(where):
+    """The keyword form warns once, naming the keywords and the equivalent run (the function's
+    own defaults included), pointing at the caller; the run= form does not warn; both give
+    bitwise the same result."""
+    with_keywords, with_run, keywords = _kw_and_run(where)
+    with pytest.warns(DeprecationWarning) as record:
+        old = with_keywords()
+    text = _one_warning(record, where, keywords)
+    with warnings_as_errors():
+        new = with_run()
+    if where == "simulate":
+        assert "transient=0.0, samples=4, steps_per_period=64" in text
+    if where == "lyapunov_lanes":
+        assert "transient=100.0, locate_edges=False" in text
+    if where == "basins":
+        assert "samples=34, converge=1e-08, transient=40.0" in text
+    if isinstance(old, list):
+        for a, b in zip(old, new, strict=True):
+            xr.testing.assert_identical(a, b)
+    elif isinstance(old, xr.Dataset):
+        xr.testing.assert_identical(old, new)
+    else:
+        np.testing.assert_array_equal(old, new)
+
+
+@contextlib.contextmanager
+def warnings_as_errors():
+    """A context in which any DeprecationWarning is an error."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", DeprecationWarning)
+        yield
+
+
+def test_no_internal_path_warns():
+    """The analyses that call others (bifurcation with continuation and Lyapunov,
+    frequency_response, the reproduction's basins) give them run=, never keywords."""
+    g = _soft()
+    with warnings_as_errors():
+        geardyn.bifurcation(g, "Omega", OMEGAS, SHORT, continuation="down", lyapunov=True)
+        geardyn.bifurcation(g, "Omega", OMEGAS, SHORT, lyapunov=True)
+        geardyn.map2d(g, ("Omega", OMEGAS), ("zeta", [0.05]), SHORT, lyapunov=True)
+        geardyn.frequency_response(g, OMEGAS, SHORT)
+        geardyn.simulate(g)
+        geardyn.lyapunov(g, settings=LyapunovSettings(duration=20.0))
+

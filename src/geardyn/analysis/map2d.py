@@ -135,7 +135,8 @@ def map2d(
         :class:`~geardyn.RunSettings`, as for :func:`~geardyn.bifurcation` (independent
         starts from each point's own initial state; ``samples`` >= 2), or its fields as the
         old keyword arguments (``transient``, ``samples``, ``steps_per_period``,
-        ``max_period``, ``tol``, ``locate_edges``, ``bound``, ...).
+        ``max_period``, ``tol``, ``locate_edges``, ``bound``, ...; deprecated, one
+        DeprecationWarning naming the equivalent ``run=``).
     lyapunov
         Also compute the largest Lyapunov exponent per point (over ``samples`` mean forcing
         periods, with the run's ``transient``, ``locate_edges``, ``bound`` and grid of
@@ -163,7 +164,7 @@ def map2d(
     counts, and ``lyapunov`` and ``lyapunov_err`` when asked; the settings in ``attrs``
     (``x``, ``y``, ...).
     """
-    run = resolve_run(run, settings, aliases={"tol": "period_tol"})
+    run = resolve_run(run, settings, aliases={"tol": "period_tol"}, where="map2d")
     transient, samples, steps_per_period = run.transient, run.samples, run.steps_per_period
     xn, xv = _axis(x, "x")
     yn, yv = _axis(y, "y")
