@@ -44,12 +44,14 @@ def lane_steps(ds) -> int:
 
 
 def time_geardyn(model, values, repeat: int):
-    geardyn.bifurcation(model, "Omega", values[:4], transient=20.0, samples=2)  # compile/load
+    geardyn.bifurcation(model, "Omega", values[:4],
+                        run=geardyn.RunSettings(transient=20.0, samples=2))  # compile/load
     times = []
     ds = None
     for _ in range(repeat):
         t = time.perf_counter()
-        ds = geardyn.bifurcation(model, "Omega", values, transient=TRANSIENT, samples=SAMPLES)
+        ds = geardyn.bifurcation(model, "Omega", values,
+                                 run=geardyn.RunSettings(transient=TRANSIENT, samples=SAMPLES))
         times.append(time.perf_counter() - t)
     return statistics.median(times), times, ds
 
@@ -111,10 +113,11 @@ def work_precision(model, omegas=(0.6, 1.1, 3.5), periods: int = 10, transient: 
         n0 = geardyn.default_steps_per_period(m)
         for factor in (0.5, 1.0, 2.0, 4.0):
             n = max(8, int(round(n0 * factor)))
-            geardyn.simulate(m, transient=T, periods=1, steps_per_period=n)  # warm
+            geardyn.simulate(m, run=geardyn.RunSettings(transient=T, samples=1,
+                                                        steps_per_period=n))  # warm
+            run = geardyn.RunSettings(transient=n_tr * T, samples=periods, steps_per_period=n)
             t = time.perf_counter()
-            ds = geardyn.simulate(m, transient=n_tr * T, periods=periods, steps_per_period=n,
-                                  y0=y0, record_every=n)
+            ds = geardyn.simulate(m, run=run, y0=y0, record_every=n)
             cost = (time.perf_counter() - t) / t_eval[-1]
             pts = np.stack([ds[s].values for s in m.state_names], axis=1)[1:]
             err = float(np.max(np.abs(pts - truth)) / scale)
@@ -156,8 +159,8 @@ def main() -> None:
     t_off = []
     for _ in range(args.repeat):
         t = time.perf_counter()
-        geardyn.bifurcation(model, "Omega", values, transient=TRANSIENT, samples=SAMPLES,
-                            locate_edges=False)
+        geardyn.bifurcation(model, "Omega", values, run=geardyn.RunSettings(
+            transient=TRANSIENT, samples=SAMPLES, locate_edges=False))
         t_off.append(time.perf_counter() - t)
     wall_off = statistics.median(t_off)
     # the located crossings are counted while sampling only: their rate over the sampled

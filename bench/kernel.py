@@ -270,9 +270,10 @@ def paper_workload(mod, repeat: int, old: bool):
     model = geardyn.CATTDevice(geardyn.PlanetaryParams.paper(xi1=0.05, xi2=0.05))
     values = np.linspace(0.1, 4.0, 1000)
     with _Use(mod, old):
-        geardyn.bifurcation(model, "Omega", values[:4], transient=20.0, samples=2)
-        t, ds = timed(lambda: geardyn.bifurcation(model, "Omega", values, transient=2000.0,
-                                                  samples=200), repeat)
+        geardyn.bifurcation(model, "Omega", values[:4],
+                            run=geardyn.RunSettings(transient=20.0, samples=2))
+        run = geardyn.RunSettings(transient=2000.0, samples=200)
+        t, ds = timed(lambda: geardyn.bifurcation(model, "Omega", values, run), repeat)
     return t, ds
 
 

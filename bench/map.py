@@ -52,10 +52,12 @@ def run_map(model, args, client=None, warm=False):
 
     if warm:  # 8 one-point tasks: every worker compiles or loads its kernel
         return geardyn.map2d(model, x=("Omega", [0.5, 1.0, 2.0, 3.0]), y=("xi", [0.02, 0.2]),
-                             transient=20.0, samples=2, chunk=1, client=client)
+                             run=geardyn.RunSettings(transient=20.0, samples=2), chunk=1,
+                             client=client)
     return geardyn.map2d(model, x=("Omega", np.linspace(0.5, 3.5, args.nx)),
-                         y=("xi", np.linspace(0.02, 0.2, args.ny)), transient=TRANSIENT,
-                         samples=SAMPLES, chunk=args.chunk, client=client)
+                         y=("xi", np.linspace(0.02, 0.2, args.ny)),
+                         run=geardyn.RunSettings(transient=TRANSIENT, samples=SAMPLES),
+                         chunk=args.chunk, client=client)
 
 
 def timed(model, args, client=None):

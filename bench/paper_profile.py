@@ -24,7 +24,8 @@ def _median_time(model, values, **kw) -> float:
     times = []
     for _ in range(2):
         t0 = time.perf_counter()
-        geardyn.bifurcation(model, "Omega", values, transient=TRANSIENT, samples=SAMPLES, **kw)
+        geardyn.bifurcation(model, "Omega", values,
+                            run=geardyn.RunSettings(transient=TRANSIENT, samples=SAMPLES, **kw))
         times.append(time.perf_counter() - t0)
     return statistics.median(times)
 
@@ -32,7 +33,8 @@ def _median_time(model, values, **kw) -> float:
 def main() -> None:
     model = device()
     values = np.linspace(0.1, 4.0, 1000)
-    geardyn.bifurcation(model, "Omega", values[:4], transient=20.0, samples=2)  # compile/load
+    geardyn.bifurcation(model, "Omega", values[:4],
+                        run=geardyn.RunSettings(transient=20.0, samples=2))  # compile/load
     for threads in [int(a) for a in sys.argv[1:]] or [numba.config.NUMBA_NUM_THREADS]:
         numba.set_num_threads(threads)
         with_edges = _median_time(model, values)

@@ -316,8 +316,8 @@ def geardyn_sweeps(wl: Workload, ref: np.ndarray) -> list[Sweep]:
     out = []
     for n, label in ((STEPS, f"{STEPS} steps/period"), (None, "default step")):
         def run(n=n):
-            return geardyn.bifurcation(m, "Omega", wl.omega, transient=TRANSIENT,
-                                       samples=wl.samples, steps_per_period=n)
+            return geardyn.bifurcation(m, "Omega", wl.omega, run=geardyn.RunSettings(
+                transient=TRANSIENT, samples=wl.samples, steps_per_period=n))
 
         def finish(row: Row, ds, n=n) -> None:
             if not np.array_equal(ds["transient_periods"].values, wl.n_tr):
@@ -331,8 +331,8 @@ def geardyn_sweeps(wl: Workload, ref: np.ndarray) -> list[Sweep]:
             if bad:
                 row.note += f"; {bad} lanes not ok"
 
-        geardyn.bifurcation(m, "Omega", wl.omega[:4], transient=10.0, samples=2,
-                            steps_per_period=n)  # compile or load the kernel
+        geardyn.bifurcation(m, "Omega", wl.omega[:4], run=geardyn.RunSettings(
+            transient=10.0, samples=2, steps_per_period=n))  # compile or load the kernel
         out.append(Sweep(Row("geardyn.bifurcation", label, note="edges located",
                              key="g128" if n else "gdef"), run, finish))
     return out

@@ -179,7 +179,7 @@ def main() -> None:
         model, values = device(), np.linspace(0.1, 4.0, args.points)
         kw.update(transient=TRANSIENT, samples=SAMPLES)
     # a first run loads every kernel the workload uses (the map is written after it)
-    geardyn.bifurcation(model, "Omega", values, **kw)
+    geardyn.bifurcation(model, "Omega", values, run=geardyn.RunSettings(**kw))
     rows = write_map(Path(f"/tmp/perf-{os.getpid()}.map"))
     print(f"{len(rows)} functions in /tmp/perf-{os.getpid()}.map")
     data = Path(f"/tmp/perf-{os.getpid()}.data")
@@ -187,7 +187,7 @@ def main() -> None:
                             "-p", str(os.getpid())], stderr=subprocess.DEVNULL)
     time.sleep(0.5)
     t0 = time.perf_counter()
-    geardyn.bifurcation(model, "Omega", values, **kw)
+    geardyn.bifurcation(model, "Omega", values, run=geardyn.RunSettings(**kw))
     wall = time.perf_counter() - t0
     rec.send_signal(2)
     rec.wait()

@@ -48,5 +48,5 @@ fig = plot_bifurcation(bif, state="X_sq")
 # :func:`geardyn.simulate`.
 from geardyn.plotting import plot_simulation  # noqa: E402
 
-ds = geardyn.simulate(model, omega=1.1, transient=1000.0, periods=32)
+ds = geardyn.simulate(model, omega=1.1, run=run)  # 1000 time units, then 32 periods
 fig_point = plot_simulation(ds, state="X_sq")

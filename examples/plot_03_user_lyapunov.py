@@ -55,6 +55,7 @@ fig = plot_bifurcation(bif, state="x")
 # %%
 # The spectrum at Omega = 1.2: the exponents sum to -delta (the divergence of the flow),
 # a check that needs no reference.
-lam = geardyn.lyapunov(model.with_omega(1.2), y0=[1.0, 0.0], transient=300.0,
+lam = geardyn.lyapunov(model.with_omega(1.2), y0=[1.0, 0.0],
+                       run=geardyn.RunSettings(transient=300.0),
                        settings=geardyn.LyapunovSettings(duration=3000.0), spectrum=True)
 print("spectrum:", lam, " sum:", lam.sum(), " (expected -0.3)")

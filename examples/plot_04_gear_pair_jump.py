@@ -22,7 +22,8 @@ import geardyn
 from geardyn.plotting.frc import plot_frc
 
 pair = geardyn.GearPair(zeta=0.05, kappa=0.0, Fm=0.1, Fa=0.05)
-frc = geardyn.frequency_response(pair, np.linspace(0.4, 1.6, 121), transient=300.0, samples=8)
+frc = geardyn.frequency_response(pair, np.linspace(0.4, 1.6, 121),
+                                 geardyn.RunSettings(transient=300.0, samples=8))
 print(frc[["jump_sweep", "jump_lo", "jump_hi"]].to_dataframe().to_string())
 
 fig = plot_frc(frc)
@@ -35,9 +36,8 @@ from geardyn import ContinuedSweep  # noqa: E402
 
 omegas = np.linspace(0.6, 1.2, 61)
 run = geardyn.RunSettings(transient=300.0, samples=8)
-up, down = geardyn.continued_sweeps(
-    [ContinuedSweep(pair, "Omega", omegas, "up"), ContinuedSweep(pair, "Omega", omegas, "down")],
-    run)
+up, down = geardyn.continued_sweeps(  # each sweep's transients come from its own run
+    [ContinuedSweep(pair, "Omega", omegas, d, run=run) for d in ("up", "down")], run)
 for name, ds in (("up", up), ("down", down)):
     x = ds["poincare"].sel(state="x").isel(sample=-1).values
     print(f"{name:>4}: section x at Omega = 0.8: {x[np.argmin(abs(omegas - 0.8))]:.3f}")

@@ -25,8 +25,8 @@ for kind, value in zip(
 ):
     print(f"{kind:>8} at Omega = {value:.6f}")
 
-sweep = geardyn.bifurcation(pair, "Omega", np.linspace(0.5, 1.6, 56), transient=300.0,
-                            samples=16)
+sweep = geardyn.bifurcation(pair, "Omega", np.linspace(0.5, 1.6, 56),
+                            run=geardyn.RunSettings(transient=300.0, samples=16))
 fig = plot_branch(branch, over=sweep)
 
 # %%

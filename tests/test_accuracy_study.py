@@ -59,7 +59,8 @@ def test_fig3_diagram_at_the_default_step_is_within_1e6_of_the_dop853_orbits():
     1.75, 1.9, 1.95, 2.0, 2.65, each next to a change of contact regime)."""
     model = geardyn.CATTDevice(geardyn.PlanetaryParams.paper())  # consistent, xi = 0.05
     omegas = np.round(np.arange(0.5, 4.0001, 0.05), 10)
-    ds = geardyn.bifurcation(model, values=omegas, transient=4000.0, samples=16)
+    ds = geardyn.bifurcation(model, values=omegas,
+                             run=geardyn.RunSettings(transient=4000.0, samples=16))
     period = ds["period"].values
     errors = {}
     for i, om in enumerate(omegas):

@@ -29,7 +29,8 @@ def _pair(b2: float) -> tuple[CATTDevice, CATTDevice, np.ndarray]:
 
 
 def _history(m: CATTDevice, omega: float, y0: np.ndarray, periods: int) -> np.ndarray:
-    ds = geardyn.simulate(m, omega=omega, transient=0.0, periods=periods, y0=y0)
+    ds = geardyn.simulate(m, omega=omega,
+                          run=geardyn.RunSettings(transient=0.0, samples=periods), y0=y0)
     assert ds.attrs["status"] == 0
     return np.stack([ds[s].values for s in m.state_names], axis=1)
 
@@ -65,8 +66,10 @@ def test_sweep_data_show_where_the_shift_holds():
     m1, m2, shift = _pair(20e-6)
     values = np.array([1.6, 2.0])
     # no transient: the sampled stretch holds the first back-flank contact at Omega = 2
-    ds1 = geardyn.bifurcation(m1, "Omega", values, transient=0.0, samples=16)
-    ds2 = geardyn.bifurcation(m2, "Omega", values, transient=0.0, samples=16,
+    ds1 = geardyn.bifurcation(m1, "Omega", values,
+                              run=geardyn.RunSettings(transient=0.0, samples=16))
+    ds2 = geardyn.bifurcation(m2, "Omega", values,
+                              run=geardyn.RunSettings(transient=0.0, samples=16),
                               y0=m1.initial_state() - shift)
     assert list(back_flank_contact(ds1)) == [False, False]
     assert list(back_flank_contact(ds2)) == [False, True]

@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 import geardyn
+from geardyn.analysis.basins import basins_run
 from geardyn.testing import assert_result
 
 #: The softening gear pair (contact loss) of the hysteresis band: up and down continued sweeps
@@ -24,7 +25,7 @@ TRANSIENT = 300.0  # decay exp(-zeta T) = 3e-7 of the transient
 def bistable():
     g = geardyn.GearPair(**PAIR)
     ds = geardyn.basins(g, omega=OMEGA, x=("x", -1.0, 3.0, 20), y=("v", -1.5, 1.5, 16),
-                        transient=TRANSIENT)
+                        run=basins_run(transient=TRANSIENT))
     return g, ds
 
 
@@ -72,7 +73,7 @@ def test_two_attractors_in_the_hysteresis_band_match_shooting_and_reference(bist
         orbits.append(orb)
     # passed in (in reverse order), the orbits are matched to their attractors
     again = geardyn.basins(g, omega=OMEGA, x=("x", -1.0, 3.0, 20), y=("v", -1.5, 1.5, 16),
-                           transient=TRANSIENT, orbits=orbits[::-1])
+                           run=basins_run(transient=TRANSIENT), orbits=orbits[::-1])
     np.testing.assert_array_equal(again["attractor_orbit"].values, [1, 0])
     np.testing.assert_array_equal(again["attractor_id"].values, ids)
 
@@ -93,7 +94,7 @@ def test_linear_case_has_one_attractor_the_analytic_steady_state():
     zeta, fm, fa, om = 0.05, 2.0, 0.02, 1.3
     g = geardyn.GearPair(zeta=zeta, kappa=0.0, Fm=fm, Fa=fa)
     ds = geardyn.basins(g, omega=om, x=("x", 2.0, 4.0, 6), y=("v", -0.5, 0.5, 5),
-                        transient=400.0, samples=4, max_period=2)
+                        run=basins_run(transient=400.0, samples=4, max_period=2))
     assert_result(ds, "basins")
     assert ds.attrs["n_attractors"] == 1
     np.testing.assert_array_equal(ds["attractor_fraction"].values, [1.0])
@@ -104,7 +105,7 @@ def test_linear_case_has_one_attractor_the_analytic_steady_state():
     # a bound that the first forcing period of the far cells leaves (amplitude ~37 e^{-zeta T}
     # ~ 29 about x = 3; |state| is checked once a period): they diverge, never dropped
     out = geardyn.basins(g, omega=om, x=("x", 2.0, 40.0, 6), y=("v", -0.5, 0.5, 5),
-                         transient=400.0, samples=4, max_period=2, bound=10.0)
+                         run=basins_run(transient=400.0, samples=4, max_period=2, bound=10.0))
     ids = out["attractor_id"].values
     assert np.all(ids[:, -1] == -1) and np.all(ids[:, 0] == 0)
     np.testing.assert_array_equal(out["status"].values == 1, ids == -1)
@@ -120,8 +121,8 @@ def test_a_chaotic_attractor_is_one_attractor_without_period():
     the forcing phase's rounding (1e-16) split one cell of 20 off at 64 samples; at 128 and 256
     every cell groups as one."""
     g = geardyn.GearPair(zeta=0.02, kappa=0.2, Fm=0.1, Fa=0.3, Omega=0.92)
-    ds = geardyn.basins(g, None, ("x", 0.0, 2.0, 5), ("v", -1.0, 1.0, 4), transient=500.0,
-                        samples=256, converge=None)
+    ds = geardyn.basins(g, None, ("x", 0.0, 2.0, 5), ("v", -1.0, 1.0, 4),
+                        run=basins_run(transient=500.0, samples=256, converge=None))
     assert np.all(ds["period"].values == 0)
     np.testing.assert_array_equal(ds["attractor_period"].values, [0])
     np.testing.assert_array_equal(ds["attractor_fraction"].values, [1.0])
@@ -240,8 +241,8 @@ def test_cells_whose_transient_did_not_settle_are_unresolved_not_an_attractor():
     'no period' attractor)."""
     g = geardyn.GearPair(**LINEAR)
     ds = geardyn.basins(g, omega=LINEAR_OMEGA, x=("x", 2.0, 4.0, 6), y=("v", -0.5, 0.5, 5),
-                        transient=20.0, transient_max=120.0, converge=1e-3, samples=4,
-                        max_period=2)
+                        run=basins_run(transient=20.0, transient_max=120.0, converge=1e-3,
+                                       samples=4, max_period=2))
     assert_result(ds, "basins")
     settled = ds["converged"].values == 1
     assert settled.any() and (~settled).any()  # both kinds present: the check has teeth
@@ -279,7 +280,7 @@ def test_cells_at_the_split_limit_are_unresolved_not_diverged(monkeypatch):
     monkeypatch.setattr(basins_module, "run_lanes", run_lanes)
     g = geardyn.GearPair(**LINEAR)
     ds = geardyn.basins(g, omega=LINEAR_OMEGA, x=("x", 2.0, 4.0, 6), y=("v", -0.5, 0.5, 5),
-                        transient=400.0, samples=4, max_period=2, converge=None)
+                        run=basins_run(transient=400.0, samples=4, max_period=2, converge=None))
     assert_result(ds, "basins")
     ids = ds["attractor_id"].values.ravel()
     want = np.zeros(ids.size, np.int64)

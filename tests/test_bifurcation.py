@@ -50,8 +50,9 @@ def test_lanes_reproduce_single_simulations_bitwise():
     r = run_lanes(m, m.lane_params("Omega", omegas), m.initial_state(), 300.0, 4,
                   steps_per_period=64)
     for j in (0, 1, 8, 10):
-        ds = geardyn.simulate(m, omega=omegas[j], transient=300.0, periods=4,
-                              steps_per_period=64)
+        ds = geardyn.simulate(m, omega=omegas[j],
+                              run=geardyn.RunSettings(transient=300.0, samples=4,
+                                                      steps_per_period=64))
         np.testing.assert_array_equal(r.samples[j], ds["poincare"].values[1:])
     # and it does not depend on the order of the lanes
     perm = np.random.default_rng(0).permutation(omegas.size)
@@ -63,8 +64,9 @@ def test_lanes_reproduce_single_simulations_bitwise():
 def test_diverging_lane_is_marked_and_sweep_goes_on():
     u = geardyn.UserModel(forced_oscillator, n_states=2, params=[0.05, 1.3],
                           param_names=["c", "Omega"])
-    ds = bifurcation(u, param="c", values=[-0.2, 0.05, 0.1], transient=500.0, samples=8,
-                     bound=1e3, steps_per_period=256)
+    ds = bifurcation(u, param="c", values=[-0.2, 0.05, 0.1],
+                     run=geardyn.RunSettings(transient=500.0, samples=8, steps_per_period=256,
+                                             bound=1e3))
     assert_result(ds, "bifurcation")
     np.testing.assert_array_equal(ds["status"].values, [1, 0, 0])
     np.testing.assert_array_equal(ds["period"].values, [-1, 1, 1])
@@ -79,7 +81,7 @@ def test_gear_pair_contact_regime_matches_reference_trajectory():
     """The regime from the sweep statistics agrees with the extremes of an accurate trajectory."""
     g = geardyn.GearPair(zeta=0.05, kappa=0.0, Fm=0.1, Fa=0.05)
     omegas = np.array([0.5, 1.2, 3.0])
-    ds = bifurcation(g, values=omegas, transient=600.0, samples=10)
+    ds = bifurcation(g, values=omegas, run=geardyn.RunSettings(transient=600.0, samples=10))
     for j, om in enumerate(omegas):
         gw = g.with_omega(om)
         y_start = ds["poincare"].values[j, 0]
@@ -99,8 +101,10 @@ def test_continuation_shows_coexisting_solutions_of_the_softening_oscillator():
     sweeping up and down must each follow one branch somewhere in the hysteresis band."""
     g = geardyn.GearPair(zeta=0.02, kappa=0.0, Fm=0.2, Fa=0.06)
     om = np.linspace(0.6, 1.2, 25)
-    up = bifurcation(g, values=om, transient=400.0, samples=8, continuation="up")
-    down = bifurcation(g, values=om, transient=400.0, samples=8, continuation="down")
+    up = bifurcation(g, values=om,
+                     run=geardyn.RunSettings(transient=400.0, samples=8), continuation="up")
+    down = bifurcation(g, values=om,
+                       run=geardyn.RunSettings(transient=400.0, samples=8), continuation="down")
     amp_up = np.ptp(up["poincare"].values[..., 0], axis=1) + np.abs(up["poincare"].values[:, 0, 0])
     amp_dn = np.ptp(down["poincare"].values[..., 0], axis=1) + np.abs(
         down["poincare"].values[:, 0, 0])
@@ -112,11 +116,12 @@ def test_continuation_shows_coexisting_solutions_of_the_softening_oscillator():
 def test_physical_parameter_sweeps(param, values):
     m = geardyn.CATTDevice(geardyn.PlanetaryParams.paper(), omega=1.1)
     vals = [geardyn.units.to_si(v, "length") if isinstance(v, str) else v for v in values]
-    ds = bifurcation(m, param=param, values=vals, transient=300.0, samples=4,
-                     steps_per_period=64)
+    ds = bifurcation(m, param=param, values=vals,
+                     run=geardyn.RunSettings(transient=300.0, samples=4, steps_per_period=64))
     for j, v in enumerate(vals):
-        one = geardyn.simulate(m.with_params(**{param: v}), transient=300.0, periods=4,
-                               steps_per_period=64)
+        one = geardyn.simulate(m.with_params(**{param: v}),
+                               run=geardyn.RunSettings(transient=300.0, samples=4,
+                                                       steps_per_period=64))
         np.testing.assert_array_equal(ds["poincare"].values[j], one["poincare"].values[1:])
 
 
@@ -124,7 +129,8 @@ def test_bifurcation_lyapunov_separates_periodic_from_chaotic():
     """Omega = 0.92 is chaotic for this gear pair (tests/test_lyapunov.py shows nearby
     trajectories separating); Omega = 0.5 is period-1."""
     g = geardyn.GearPair(zeta=0.02, kappa=0.2, Fm=0.1, Fa=0.3)
-    ds = bifurcation(g, values=[0.5, 0.92], transient=500.0, samples=50, lyapunov=True)
+    ds = bifurcation(g, values=[0.5, 0.92],
+                     run=geardyn.RunSettings(transient=500.0, samples=50), lyapunov=True)
     np.testing.assert_array_equal(ds["period"].values, [1, 0])
     lam = ds["lyapunov"].values
     assert lam[0] < -0.005 and lam[1] > 0.02

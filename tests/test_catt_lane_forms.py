@@ -67,8 +67,9 @@ def _assert_lanes_equal_simulate(models, omegas, steps=48):
     assert np.all(r.status == 0)
     for j in range(P.shape[0]):
         m = models[j // omegas.size]
-        ds = geardyn.simulate(m, omega=float(omegas[j % omegas.size]), transient=200.0,
-                              periods=3, steps_per_period=steps)
+        ds = geardyn.simulate(m, omega=float(omegas[j % omegas.size]),
+                              run=geardyn.RunSettings(transient=200.0, samples=3,
+                                                      steps_per_period=steps))
         np.testing.assert_array_equal(r.samples[j], ds["poincare"].values[1:], err_msg=str(j))
 
 

@@ -14,7 +14,7 @@ import pytest
 import xarray as xr
 from typer.testing import CliRunner
 
-from geardyn import GearPair, PlanetaryParams, bifurcation, simulate
+from geardyn import GearPair, PlanetaryParams, RunSettings, bifurcation, simulate
 from geardyn.cli import bifurcation as cli_bifurcation
 from geardyn.cli.main import app, main
 from geardyn.io.netcdf import load_dataset, save_dataset
@@ -187,9 +187,8 @@ def test_bifurcation_writes_what_the_api_computes(tmp_path):
     assert png.read_bytes()[:8] == PNG
     saved = load_dataset(nc)
     study = builtin_study("paper_fig3")
-    direct = bifurcation(build_model(study), param="Omega",
-                                 values=np.linspace(0.6, 2.6, 5), transient=60.0, samples=6,
-                                 steps_per_period=64)
+    direct = bifurcation(build_model(study), param="Omega", values=np.linspace(0.6, 2.6, 5),
+                         run=RunSettings(transient=60.0, samples=6, steps_per_period=64))
     np.testing.assert_array_equal(saved["period"].values, direct["period"].values)
     np.testing.assert_array_equal(saved["poincare"].values, direct["poincare"].values)
     np.testing.assert_array_equal(saved["contact"].values, direct["contact"].values)
@@ -231,7 +230,8 @@ def test_bifurcation_defaults_come_from_the_study(tmp_path):
     assert pdf.read_bytes()[:5] == PDF
     saved = load_dataset(nc)
     g = GearPair(zeta=0.05, kappa=0.2, Fa=0.2)
-    direct = bifurcation(g, values=np.linspace(0.6, 1.4, 5), transient=150.0, samples=8,
+    direct = bifurcation(g, values=np.linspace(0.6, 1.4, 5),
+                         run=RunSettings(transient=150.0, samples=8),
                                  continuation="down", lyapunov=True)
     np.testing.assert_array_equal(saved["period"].values, direct["period"].values)
     np.testing.assert_array_equal(saved["lyapunov"].values, direct["lyapunov"].values)
@@ -243,7 +243,7 @@ def test_bifurcation_defaults_come_from_the_study(tmp_path):
     assert r.returncode == 0, r.stderr
     saved = load_dataset(nc)
     direct = bifurcation(g.with_omega(0.9), param="Fa", values=[0.1, 0.2, 0.3],
-                                 transient=150.0, samples=4)
+                                 run=RunSettings(transient=150.0, samples=4))
     np.testing.assert_array_equal(saved["poincare"].values, direct["poincare"].values)
     assert "lyapunov" not in saved and list(saved["Fa"].values) == [0.1, 0.2, 0.3]
 
@@ -321,8 +321,10 @@ def test_bifurcation_continued_transient(tmp_path):
     assert r.returncode == 0, r.stderr
     saved = load_dataset(nc)
     g = GearPair(zeta=0.05, kappa=0.2, Fa=0.2)
-    direct = bifurcation(g, values=np.linspace(0.6, 1.4, 5), transient=150.0, samples=8,
-                         continuation="down", converge=1e-8, continued_transient=20.0)
+    direct = bifurcation(g, values=np.linspace(0.6, 1.4, 5),
+                         run=RunSettings(transient=150.0, samples=8, converge=1e-8,
+                                         continued_transient=20.0),
+                         continuation="down")
     np.testing.assert_array_equal(saved["poincare"].values, direct["poincare"].values)
     assert saved.attrs["continued_transient"] == 20.0
     np.testing.assert_array_equal(saved["transient_periods"].values,
@@ -336,9 +338,10 @@ def test_bifurcation_continued_transient(tmp_path):
 
 def test_plot_redraws_saved_results(tmp_path):
     g = GearPair(zeta=0.05, kappa=0.2, Fa=0.2)
-    bif = save_dataset(bifurcation(g, values=[0.8, 0.95, 1.2], transient=100.0,
-                                           samples=8), tmp_path / "bif.nc")
-    sim = save_dataset(simulate(g, omega=0.95, transient=100.0, periods=8),
+    bif = save_dataset(bifurcation(g, values=[0.8, 0.95, 1.2],
+                                   run=RunSettings(transient=100.0, samples=8)),
+                       tmp_path / "bif.nc")
+    sim = save_dataset(simulate(g, omega=0.95, run=RunSettings(transient=100.0, samples=8)),
                        tmp_path / "sim.nc")
     assert_result(load_dataset(sim), "simulation")
     assert_result(load_dataset(bif), "bifurcation")
@@ -370,7 +373,8 @@ def test_plot_redraws_maps_and_reproduction_cases(tmp_path):
     from geardyn.execution.zarr_store import save_zarr_dataset
 
     g = GearPair(zeta=0.05, kappa=0.2, Fa=0.2)
-    m = map2d(g, x=("Omega", [0.8, 1.2]), y=("zeta", [0.05, 0.1]), transient=50.0, samples=4)
+    m = map2d(g, x=("Omega", [0.8, 1.2]), y=("zeta", [0.05, 0.1]),
+              run=RunSettings(transient=50.0, samples=4))
     nc = save_dataset(m, tmp_path / "map.nc")
     save_zarr_dataset(m, tmp_path / "map.zarr")
     for path in (nc, tmp_path / "map.zarr"):
@@ -380,7 +384,7 @@ def test_plot_redraws_maps_and_reproduction_cases(tmp_path):
         assert (tmp_path / f"{path.suffix[1:]}.png").read_bytes()[:8] == PNG
     assert_one_line_error(invoke("plot", nc, "--state", "x"), "--state", "map")
     # a reproduction case file: the sweeps up and down along "sweep"
-    parts = [bifurcation(g, values=[0.8, 0.95, 1.2], transient=50.0, samples=4,
+    parts = [bifurcation(g, values=[0.8, 0.95, 1.2], run=RunSettings(transient=50.0, samples=4),
                          continuation=d) for d in ("up", "down")]
     case = xr.concat(parts, dim="sweep", combine_attrs="drop_conflicts")
     case = case.assign_coords(sweep=("sweep", ["up", "down"]))

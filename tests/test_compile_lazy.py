@@ -66,9 +66,10 @@ sweep = ["trajectory", "_sweep_worker", "_sweep_worker_form0", "_sweep_worker_fo
 lyap = ["lyapunov_single", "_lyap_block_worker", "_lyap_block_worker_form1",
         "_lyap_block_worker_form2"]
 out = {}
-geardyn.simulate(pair, omega=1.3, periods=2)
+geardyn.simulate(pair, omega=1.3, run=geardyn.RunSettings(transient=0.0, samples=2))
 out["simulate"] = census(pair, "rk4", sweep)
-geardyn.bifurcation(dev, "Omega", np.linspace(0.8, 1.6, 6), transient=10.0, samples=2)
+geardyn.bifurcation(dev, "Omega", np.linspace(0.8, 1.6, 6),
+                    run=geardyn.RunSettings(transient=10.0, samples=2))
 out["sweep"] = census(dev, "rk4", sweep)
 lam = geardyn.lyapunov_lanes(dev, dev.lane_params("Omega", np.linspace(0.8, 1.6, 4)),
                              run=geardyn.RunSettings(transient=5.0),

@@ -32,7 +32,7 @@ def test_builtin_model_keeps_the_contract(all_cases, case):
     report = check_model(model, y0=y0)
     assert [r.status for r in report.results] == ["ok"] * len(RULES), str(report)
     if model.n_events:  # the run really crossed edges, so rule 10 tested their location
-        ds = geardyn.simulate(model, periods=2, y0=y0)
+        ds = geardyn.simulate(model, run=geardyn.RunSettings(transient=0.0, samples=2), y0=y0)
         assert int(ds["edge_crossings"].sum()) > 0
 
 

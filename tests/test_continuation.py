@@ -27,18 +27,22 @@ def test_branches_continued_together_equal_each_alone(device):
     om = np.linspace(0.6, 1.6, 7)
     stiffer = geardyn.CATTDevice(geardyn.PlanetaryParams.paper(xi1=0.2, xi2=0.2))
     pair = geardyn.GearPair(zeta=0.05)  # another kernel: its own group
-    sweeps = [ContinuedSweep(device, "Omega", om, "up", transient=300.0,
-                             continued_transient=30.0, transient_max=300.0),
-              ContinuedSweep(device, "Omega", om, "down", transient=300.0,
-                             continued_transient=30.0, transient_max=300.0),
-              ContinuedSweep(stiffer, "Omega", om[:4], "down", transient=200.0),
-              ContinuedSweep(pair, "Omega", om, "up", transient=100.0)]
-    together = continued_sweeps(sweeps, samples=6, converge=1e-8)
+    sweeps = [ContinuedSweep(device, "Omega", om, "up",
+                             run=geardyn.RunSettings(transient=300.0, transient_max=300.0,
+                                                     continued_transient=30.0)),
+              ContinuedSweep(device, "Omega", om, "down",
+                             run=geardyn.RunSettings(transient=300.0, transient_max=300.0,
+                                                     continued_transient=30.0)),
+              ContinuedSweep(stiffer, "Omega", om[:4], "down",
+                             run=geardyn.RunSettings(transient=200.0)),
+              ContinuedSweep(pair, "Omega", om, "up", run=geardyn.RunSettings(transient=100.0))]
+    together = continued_sweeps(sweeps, run=geardyn.RunSettings(samples=6, converge=1e-8))
     for sw, ds in zip(sweeps, together, strict=True):
-        alone = geardyn.bifurcation(sw.model, "Omega", sw.values, transient=sw.transient,
-                                    samples=6, continuation=sw.direction, converge=1e-8,
-                                    transient_max=sw.transient_max,
-                                    continued_transient=sw.continued_transient)
+        run = geardyn.RunSettings(transient=sw.transient, samples=6, converge=1e-8,
+                                  transient_max=sw.transient_max,
+                                  continued_transient=sw.continued_transient)
+        alone = geardyn.bifurcation(sw.model, "Omega", sw.values, run=run,
+                                    continuation=sw.direction)
         assert ds.attrs["continuation"] == sw.direction
         for name in VARIABLES:
             if name in alone:
@@ -52,10 +56,13 @@ def test_continued_points_with_short_transients_match_cold_starts(device):
     # period-1 region with one attractor: every continued point, after a short transient
     # ended by convergence, sits where a cold start ends after a long fixed transient
     om = np.linspace(0.3, 0.6, 6)
-    cont = geardyn.bifurcation(device, "Omega", om, transient=1500.0, samples=4,
-                               continuation="up", converge=1e-9, transient_max=1500.0,
-                               continued_transient=20.0)
-    cold = geardyn.bifurcation(device, "Omega", om, transient=1500.0, samples=4)
+    cont = geardyn.bifurcation(device, "Omega", om,
+                               run=geardyn.RunSettings(transient=1500.0, samples=4, converge=1e-9,
+                                                       transient_max=1500.0,
+                                                       continued_transient=20.0),
+                               continuation="up")
+    cold = geardyn.bifurcation(device, "Omega", om,
+                               run=geardyn.RunSettings(transient=1500.0, samples=4))
     assert cont["converged"].values[1:].tolist() == [1] * 5  # the cold start: no room left
     periods = 2 * math.pi / om
     used = cont["transient_periods"].values * periods
@@ -78,8 +85,10 @@ def test_incommensurate_continued_points_run_the_short_transient():
     assert b.transients(1, cold=True, converge=True) == (800.0, 800.0)  # untestable, cold
     assert b.transients(1, cold=False, converge=True) == (50.0, 50.0)
     assert b.transients(2, cold=False, converge=True) == (50.0, 800.0)
-    ds = geardyn.bifurcation(m, "Omega", om, transient=400.0, samples=4, continuation="up",
-                             converge=1e-8, transient_max=800.0, continued_transient=50.0)
+    ds = geardyn.bifurcation(m, "Omega", om,
+                             run=geardyn.RunSettings(transient=400.0, samples=4, converge=1e-8,
+                                                     transient_max=800.0, continued_transient=50.0),
+                             continuation="up")
     conv = ds["converged"].values
     assert conv[1] == -1  # no section to test
     used = ds["transient_periods"].values[1] * 2 * math.pi / om[1]
@@ -109,13 +118,15 @@ def test_fast_load_fluctuation_sets_the_step():
     (dict(values=[0.5, float("nan")]), "values: must be finite"),
 ])
 def test_continued_sweeps_bad_input_names_the_field(device, sweep, message):
-    spec = dict(model=device, param="Omega", values=[0.5, 0.6], direction="up", transient=10.0)
+    spec = dict(model=device, param="Omega", values=[0.5, 0.6], direction="up",
+                run=geardyn.RunSettings(transient=10.0))
     spec.update(sweep)
     with pytest.raises(ValueError, match=message):
-        continued_sweeps([ContinuedSweep(**spec)], samples=2)
+        continued_sweeps([ContinuedSweep(**spec)], run=geardyn.RunSettings(samples=2))
     with pytest.raises(ValueError, match="converge must be a positive tolerance"):
-        continued_sweeps([ContinuedSweep(device, "Omega", [0.5], transient=10.0)], samples=2,
-                         converge=-1.0)
+        continued_sweeps([ContinuedSweep(device, "Omega", [0.5],
+                                         run=geardyn.RunSettings(transient=10.0))],
+                         run=geardyn.RunSettings(samples=2, converge=-1.0))
 
 
 def _point_by_point(branch: Branch, run: geardyn.RunSettings) -> list:

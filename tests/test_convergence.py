@@ -47,9 +47,11 @@ def runs(omega: float):
     """The sweep's samples at omega: transient by convergence (tolerance TOL) and a long fixed
     transient (40000 tau, over 5700 periods) as the reference."""
     model = geardyn.GearPair(**PAIR, Omega=omega)
-    conv = geardyn.bifurcation(model, "Omega", [omega], transient=200.0, samples=8,
-                               converge=TOL, transient_max=40000.0)
-    fixed = geardyn.bifurcation(model, "Omega", [omega], transient=40000.0, samples=8)
+    conv = geardyn.bifurcation(model, "Omega", [omega],
+                               run=geardyn.RunSettings(transient=200.0, samples=8, converge=TOL,
+                                                       transient_max=40000.0))
+    fixed = geardyn.bifurcation(model, "Omega", [omega],
+                                run=geardyn.RunSettings(transient=40000.0, samples=8))
     return model, conv, fixed
 
 
@@ -98,8 +100,9 @@ def test_period_two_past_the_flip_is_resolved():
     split = {}
     for omega in (0.903, 0.906):
         m = model.with_omega(omega)
-        conv = geardyn.bifurcation(m, "Omega", [omega], transient=200.0, samples=8,
-                                   converge=TOL, transient_max=40000.0)
+        conv = geardyn.bifurcation(m, "Omega", [omega],
+                                   run=geardyn.RunSettings(transient=200.0, samples=8, converge=TOL,
+                                                           transient_max=40000.0))
         x = conv["poincare"].values[0]
         y2, _ = reference_orbit(m, x[-1], 2)
         s = float(np.max(np.abs(period_map(m, y2, 1) - y2)))

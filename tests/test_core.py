@@ -165,14 +165,16 @@ def device():
 
 def test_old_keywords_equal_run_settings_bitwise(device):
     om = np.array([0.7, 1.1, 1.9])
-    old = geardyn.bifurcation(device, "Omega", om, transient=60.0, samples=4, tol=1e-4,
-                              converge=1e-8, transient_max=120.0)
+    with pytest.warns(DeprecationWarning, match=r"bifurcation\(transient=, samples="):
+        old = geardyn.bifurcation(device, "Omega", om, transient=60.0, samples=4, tol=1e-4,
+                                  converge=1e-8, transient_max=120.0)
     run = RunSettings(transient=60.0, samples=4, period_tol=1e-4, converge=1e-8,
                       transient_max=120.0)
     new = geardyn.bifurcation(device, "Omega", om, run)
     xr.testing.assert_identical(old, new)
     assert new.attrs["period_tol"] == 1e-4 and new["status"].attrs["meaning"].startswith("0 ok")
-    sim_old = geardyn.simulate(device, omega=1.1, transient=20.0, periods=2)
+    with pytest.warns(DeprecationWarning, match=r"simulate\(transient=, periods=\)"):
+        sim_old = geardyn.simulate(device, omega=1.1, transient=20.0, periods=2)
     sim_new = geardyn.simulate(device, 1.1, RunSettings(transient=20.0, samples=2))
     xr.testing.assert_identical(sim_old, sim_new)
     P = device.lane_params("Omega", om)
@@ -219,9 +221,11 @@ def test_core_imports_nothing_above_it():
 
 
 def test_continued_sweeps_run_equals_keywords(device):
-    sweep = geardyn.ContinuedSweep(device, "Omega", [0.8, 1.0, 1.2], "down", transient=80.0,
-                                   continued_transient=20.0)
-    (old,) = geardyn.continued_sweeps([sweep], samples=3, converge=1e-8, tol=1e-4)
+    with pytest.warns(DeprecationWarning, match=r"ContinuedSweep\(transient="):
+        sweep = geardyn.ContinuedSweep(device, "Omega", [0.8, 1.0, 1.2], "down",
+                                       transient=80.0, continued_transient=20.0)
+    with pytest.warns(DeprecationWarning, match=r"continued_sweeps\(samples="):
+        (old,) = geardyn.continued_sweeps([sweep], samples=3, converge=1e-8, tol=1e-4)
     (new,) = geardyn.continued_sweeps([sweep], RunSettings(samples=3, converge=1e-8,
                                                            period_tol=1e-4))
     xr.testing.assert_identical(old, new)
@@ -231,8 +235,9 @@ def test_continued_sweeps_run_equals_keywords(device):
 def test_continued_sweep_takes_run_settings(device):
     """A sweep's transients and step come from its RunSettings or, equally, the old keywords,
     validated once when the sweep is made."""
-    old = geardyn.ContinuedSweep(device, "Omega", [0.8, 1.0], "down", transient=80.0,
-                                 continued_transient=20.0, steps_per_period=64)
+    with pytest.warns(DeprecationWarning, match=r"ContinuedSweep\(transient="):
+        old = geardyn.ContinuedSweep(device, "Omega", [0.8, 1.0], "down", transient=80.0,
+                                     continued_transient=20.0, steps_per_period=64)
     run = RunSettings(transient=80.0, continued_transient=20.0, steps_per_period=64)
     new = geardyn.ContinuedSweep(device, "Omega", [0.8, 1.0], "down", run=run)
     assert new.run == old.run == run

@@ -15,7 +15,7 @@ GEAR = geardyn.GearPair(zeta=0.05, kappa=0.2, Fm=0.1, Fa=0.2)
 OMEGAS = np.linspace(0.4, 3.0, 13)
 SETTINGS = dict(transient=150.0, samples=8, steps_per_period=128)
 MAP = dict(x=("Omega", np.linspace(0.5, 3.0, 7)), y=("zeta", [0.02, 0.05, 0.1]),
-           transient=200.0, samples=16, lyapunov=True, chunk=4)
+           run=geardyn.RunSettings(transient=200.0, samples=16), lyapunov=True, chunk=4)
 
 
 def _assert_same(a: LaneResults, b: LaneResults, skip: tuple[str, ...] = ()) -> None:
@@ -97,7 +97,8 @@ def test_map_on_two_dask_workers_is_bitwise_the_local_map(dask_client):
 
 
 def test_sweep_on_dask_is_bitwise_the_local_sweep(dask_client):
-    kw = dict(values=OMEGAS, transient=150.0, samples=8, starts=2, chunk=5)
+    kw = dict(values=OMEGAS, run=geardyn.RunSettings(transient=150.0, samples=8), starts=2,
+              chunk=5)
     local = geardyn.bifurcation(GEAR, **kw)
     remote = geardyn.bifurcation(GEAR, client=dask_client, **kw)
     assert np.array_equal(local["poincare"].values, remote["poincare"].values, equal_nan=True)

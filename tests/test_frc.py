@@ -23,7 +23,7 @@ def test_linear_regime_equals_the_analytic_frequency_response():
     zeta, fm, fa = 0.05, 2.0, 0.02
     g = geardyn.GearPair(zeta=zeta, kappa=0.0, Fm=fm, Fa=fa)
     om = np.linspace(0.5, 2.0, 7)
-    ds = geardyn.frequency_response(g, om, transient=400.0, samples=4)
+    ds = geardyn.frequency_response(g, om, run=geardyn.RunSettings(transient=400.0, samples=4))
     assert_result(ds, "frequency-response")
     A = np.abs(fa * om**2 / (1 - om**2 + 2j * zeta * om))
     for s in ("up", "down"):
@@ -45,7 +45,8 @@ def test_dte_of_an_impacting_orbit_equals_the_reference_integration():
     DOP853 (rtol 1e-12, restarted at every edge) over one period from the orbit's section
     point (Newton shooting), sampled at 4000 points."""
     g = geardyn.GearPair(**SOFT)
-    ds = geardyn.frequency_response(g, np.array([0.88, 0.9, 0.92]), transient=300.0, samples=8)
+    ds = geardyn.frequency_response(g, np.array([0.88, 0.9, 0.92]),
+                                    run=geardyn.RunSettings(transient=300.0, samples=8))
     orb = geardyn.periodic_orbit(g, omega=0.9)
     assert orb.converged and orb.contact() == {"mesh": "single"}
     t = np.linspace(0.0, 2 * math.pi / 0.9, 4001)
@@ -68,12 +69,16 @@ def _band(up, down) -> np.ndarray:
 
 def test_jumps_of_the_softening_pair_lie_in_the_hysteresis_band_of_the_sweeps():
     g = geardyn.GearPair(**SOFT)
-    ds = geardyn.frequency_response(g, np.linspace(0.6, 1.0, 21), transient=300.0, samples=8)
+    ds = geardyn.frequency_response(g, np.linspace(0.6, 1.0, 21),
+                                    run=geardyn.RunSettings(transient=300.0, samples=8))
     assert_result(ds, "frequency-response")
     res = ds.attrs["resolution"]
     fine = np.linspace(0.66, 0.88, 45)  # step 0.005
-    up = geardyn.bifurcation(g, values=fine, transient=300.0, samples=8, continuation="up")
-    down = geardyn.bifurcation(g, values=fine, transient=300.0, samples=8, continuation="down")
+    up = geardyn.bifurcation(g, values=fine,
+                             run=geardyn.RunSettings(transient=300.0, samples=8), continuation="up")
+    down = geardyn.bifurcation(g, values=fine,
+                               run=geardyn.RunSettings(transient=300.0, samples=8),
+                               continuation="down")
     band = fine[_band(up, down)]
     assert band.size >= 5, "expected a hysteresis band"
     lo, hi = band.min(), band.max()
@@ -143,7 +148,7 @@ def test_cli_writes_what_the_api_computes_and_draws_it(tmp_path):
     saved = load_dataset(nc)
     assert_result(saved, "frequency-response")
     direct = geardyn.frequency_response(geardyn.GearPair(**SOFT), np.linspace(0.6, 1.0, 21),
-                                        transient=300.0, samples=8)
+                                        run=geardyn.RunSettings(transient=300.0, samples=8))
     np.testing.assert_array_equal(saved["dte_rms"].values, direct["dte_rms"].values)
     np.testing.assert_array_equal(saved["jump_omega"].values, direct["jump_omega"].values)
     assert png.read_bytes()[:4] == b"\x89PNG"

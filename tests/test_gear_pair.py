@@ -47,7 +47,9 @@ def _loses_contact(omega: float, steps_per_period: int | None) -> tuple[bool, in
     g = geardyn.GearPair(zeta=ZETA, kappa=0.0, Fm=FM, Fa=FA, backlash=B, Omega=omega)
     H = linear_response(omega)
     y0 = np.array([B + FM + H.real, -omega * H.imag])
-    ds = geardyn.simulate(g, periods=4, steps_per_period=steps_per_period, y0=y0)
+    ds = geardyn.simulate(g,
+                          run=geardyn.RunSettings(transient=0.0, samples=4,
+                                                  steps_per_period=steps_per_period), y0=y0)
     lost = int(ds["edge_crossings"].sel(event="x-b")) > 0 or float(ds["x"].min()) < B
     return lost, int(ds.attrs["steps_per_period"])
 
@@ -59,8 +61,12 @@ def _dip_error(omega: float, n: int) -> float:
     g = geardyn.GearPair(zeta=ZETA, kappa=0.0, Fm=FM, Fa=FA, backlash=B, Omega=omega)
     H = linear_response(omega)
     y0 = np.array([B + FM + H.real, -omega * H.imag])
-    coarse = geardyn.simulate(g, periods=4, steps_per_period=n, y0=y0)
-    fine = geardyn.simulate(g, periods=4, steps_per_period=32 * n, y0=y0)
+    coarse = geardyn.simulate(g,
+                              run=geardyn.RunSettings(transient=0.0, samples=4, steps_per_period=n),
+                              y0=y0)
+    fine = geardyn.simulate(g,
+                            run=geardyn.RunSettings(transient=0.0, samples=4,
+                                                    steps_per_period=32 * n), y0=y0)
     fine = fine.sel(time=coarse["time"].values, method="nearest")
     np.testing.assert_allclose(fine["time"].values, coarse["time"].values, rtol=0, atol=1e-9)
     return max(float(np.max(np.abs(coarse[s].values - fine[s].values))) for s in ("x", "v"))
@@ -106,7 +112,7 @@ def test_separation_onset_matches_linear_theory(side):
     # start on the linear steady state (phase 0 at tau = 0), so that below the onset the
     # transient cannot knock the pair onto a coexisting impacting branch
     y0 = np.array([B + FM + H.real, -om * H.imag])
-    ds = geardyn.simulate(g, transient=600.0, periods=8, y0=y0)
+    ds = geardyn.simulate(g, run=geardyn.RunSettings(transient=600.0, samples=8), y0=y0)
     x = ds["x"].values
     gap = x.min() - B
     crossed = int(ds["edge_crossings"].sel(event="x-b"))
@@ -123,7 +129,9 @@ def test_separation_onset_matches_linear_theory(side):
 @pytest.mark.parametrize(("kappa", "omega"), [(0.0, 1.0), (0.2, 0.9), (0.2, 2.0)])
 def test_gear_pair_rk4_matches_reference(kappa, omega):
     g = geardyn.GearPair(zeta=ZETA, kappa=kappa, Fm=FM, Fa=FA, Omega=omega)
-    y0 = geardyn.simulate(g, transient=1000.0, periods=1, steps_per_period=1024)[
+    y0 = geardyn.simulate(g,
+                          run=geardyn.RunSettings(transient=1000.0, samples=1,
+                                                  steps_per_period=1024))[
         "poincare"].values[-1]
     T = 2 * math.pi / omega
     ref = [y0]
@@ -131,9 +139,11 @@ def test_gear_pair_rk4_matches_reference(kappa, omega):
         ref.append(geardyn.reference_solution(g, ref[-1], [(k + 1) * T], t0=k * T, rtol=1e-13,
                                               atol=1e-14)[0])
     ref = np.array(ref)
-    ds = geardyn.simulate(g, periods=10, y0=y0)
+    ds = geardyn.simulate(g, run=geardyn.RunSettings(transient=0.0, samples=10), y0=y0)
     assert np.max(np.abs(ds["poincare"].values - ref)) < 1e-6
-    errs = [np.max(np.abs(geardyn.simulate(g, periods=10, y0=y0, steps_per_period=n)[
+    errs = [np.max(np.abs(geardyn.simulate(g,
+                                           run=geardyn.RunSettings(transient=0.0, samples=10,
+                                                                   steps_per_period=n), y0=y0)[
         "poincare"].values - ref)) for n in (32, 64, 128, 256)]
     p = -np.polyfit(np.log([32, 64, 128, 256]), np.log(errs), 1)[0]
     assert p > 3.7
@@ -159,8 +169,9 @@ def test_phased_and_unphased_lanes_equal_single_simulations_bitwise():
     for j in range(omegas.size):
         kp, ep = phases[j % 3]
         mj = m.with_params(kappa_phase=kp, error_phase=ep)
-        ds = geardyn.simulate(mj, omega=omegas[j], transient=300.0, periods=6,
-                              steps_per_period=64)
+        ds = geardyn.simulate(mj, omega=omegas[j],
+                              run=geardyn.RunSettings(transient=300.0, samples=6,
+                                                      steps_per_period=64))
         np.testing.assert_array_equal(r.samples[j], ds["poincare"].values[1:])
 
 

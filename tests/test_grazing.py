@@ -178,7 +178,8 @@ def test_grazing_crossings_and_contact_agree_with_dop853(grazing_sweep):
     regime = np.where(expected[:, 0] > 0, "single", "none")
     Y0 = np.array([_steady(float(fa)) for fa in fas])
     # the trajectory kernel (simulate)
-    got = np.array([geardyn.simulate(model.with_params(Fa=float(fa)), periods=PERIODS, y0=y0)
+    got = np.array([geardyn.simulate(model.with_params(Fa=float(fa)),
+                                     run=geardyn.RunSettings(transient=0.0, samples=PERIODS), y0=y0)
                     ["edge_crossings"].values for fa, y0 in zip(fas, Y0, strict=True)])
     np.testing.assert_array_equal(got, expected)
     # the sweep kernel: crossing counts of the lanes, and the contact regime of the sweep
@@ -186,7 +187,8 @@ def test_grazing_crossings_and_contact_agree_with_dop853(grazing_sweep):
                   steps_per_period=n)
     np.testing.assert_array_equal(r.crossings, expected)
     assert np.all(r.unresolved == 0)
-    ds = geardyn.bifurcation(model, "Fa", fas, transient=0.0, samples=PERIODS, y0=Y0)
+    ds = geardyn.bifurcation(model, "Fa", fas,
+                             run=geardyn.RunSettings(transient=0.0, samples=PERIODS), y0=Y0)
     np.testing.assert_array_equal(ds["contact"].values[:, 0], regime)
     assert np.all(ds["unresolved_steps"].values == 0)
 
@@ -214,16 +216,18 @@ def test_unresolved_steps_reach_every_result():
     model = geardyn.UserModel(_ramp_rhs, 1, [2 * math.pi, 0.5 * h / N_EDGES],
                               param_names=["Omega", "c"], events=_ramp_events,
                               n_events=N_EDGES)
-    ds = geardyn.simulate(model, periods=1, steps_per_period=64)
+    ds = geardyn.simulate(model,
+                          run=geardyn.RunSettings(transient=0.0, samples=1, steps_per_period=64))
     assert ds.attrs["unresolved_steps"] == 1
-    sw = geardyn.bifurcation(model, "c", [0.5 * h / N_EDGES, 2 * h], transient=0.0, samples=2,
-                             steps_per_period=64)
+    sw = geardyn.bifurcation(model, "c", [0.5 * h / N_EDGES, 2 * h],
+                             run=geardyn.RunSettings(transient=0.0, samples=2, steps_per_period=64))
     np.testing.assert_array_equal(sw["unresolved_steps"].values, [1, 0])
-    two = geardyn.bifurcation(model, "c", [0.5 * h / N_EDGES], transient=0.0, samples=2,
-                              steps_per_period=64, starts=2, spread=0.0)
+    two = geardyn.bifurcation(model, "c", [0.5 * h / N_EDGES],
+                              run=geardyn.RunSettings(transient=0.0, samples=2,
+                                                      steps_per_period=64), starts=2, spread=0.0)
     assert int(two["unresolved_steps"].values[0]) == 2  # both starts
     mp = geardyn.map2d(model, ("c", [0.5 * h / N_EDGES, 2 * h]), ("Omega", [2 * math.pi]),
-                       transient=0.0, samples=2, steps_per_period=64)
+                       run=geardyn.RunSettings(transient=0.0, samples=2, steps_per_period=64))
     np.testing.assert_array_equal(mp["unresolved_steps"].values, [[1, 0]])
 
 

@@ -31,7 +31,7 @@ def omega_n_by_hand(m: geardyn.CATTDevice, km_sq: float) -> float:
 
 
 def test_sweep_at_fixed_speed_equals_each_point_built_by_hand(device):
-    kw = dict(transient=40.0, samples=4)
+    kw = dict(run=geardyn.RunSettings(transient=40.0, samples=4))
     ds = geardyn.bifurcation(device, "Km_sq", KM_SQ, hold="speed", **kw)
     assert ds.attrs["hold"] == "speed"
     wn = np.array([omega_n_by_hand(device, v) for v in KM_SQ])
@@ -52,7 +52,8 @@ def test_sweep_at_fixed_speed_equals_each_point_built_by_hand(device):
 
 
 def test_continued_sweep_at_fixed_speed_records_the_lane_omegas(device):
-    ds = geardyn.bifurcation(device, "Km_sq", KM_SQ, hold="speed", transient=20.0, samples=2,
+    ds = geardyn.bifurcation(device, "Km_sq", KM_SQ, hold="speed",
+                             run=geardyn.RunSettings(transient=20.0, samples=2),
                              continuation="down")
     wn = np.array([omega_n_by_hand(device, v) for v in KM_SQ])
     np.testing.assert_allclose(ds["Omega"].values * wn, 1.1 * omega_n_by_hand(device, 0.825e9),
@@ -83,8 +84,8 @@ def test_cli_hold_speed_writes_what_the_api_computes(tmp_path):
     assert r.exit_code == 0, r.output
     saved = load_dataset(nc)
     model = build_model(builtin_study("paper_fig3"), omega=1.1)
-    direct = geardyn.bifurcation(model, "Km_sq", np.linspace(0.5e9, 1.6e9, 3), transient=20.0,
-                                 samples=3, hold="speed")
+    direct = geardyn.bifurcation(model, "Km_sq", np.linspace(0.5e9, 1.6e9, 3),
+                                 run=geardyn.RunSettings(transient=20.0, samples=3), hold="speed")
     assert saved.attrs["hold"] == "speed"
     np.testing.assert_array_equal(saved["Omega"].values, direct["Omega"].values)
     np.testing.assert_array_equal(saved["poincare"].values, direct["poincare"].values)

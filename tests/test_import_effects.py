@@ -41,7 +41,7 @@ import geardyn
 out["imported"] = state()
 if sys.argv[1] == "run":
     g = geardyn.GearPair(zeta=0.05, kappa=0.0, Fm=0.1, Fa=0.0)
-    geardyn.simulate(g, omega=1.2, transient=10.0, periods=4)
+    geardyn.simulate(g, omega=1.2, run=geardyn.RunSettings(transient=10.0, samples=4))
     out["ran"] = state()
 print(json.dumps(out))
 """

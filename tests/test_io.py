@@ -324,7 +324,8 @@ def test_netcdf_round_trip_identical(tmp_path):
 def test_netcdf_simulation_round_trip(tmp_path):
     import geardyn
 
-    ds = geardyn.simulate(GearPair(Fa=0.2), omega=1.2, transient=20.0, periods=4)
+    ds = geardyn.simulate(GearPair(Fa=0.2), omega=1.2,
+                          run=geardyn.RunSettings(transient=20.0, samples=4))
     back = load_dataset(save_dataset(ds, tmp_path / "gp.nc"))
     xr.testing.assert_identical(back, ds)
 
@@ -352,11 +353,13 @@ def test_netcdf_bifurcation_round_trip_identical(tmp_path, kind):
 
     if kind == "catt":
         m = CATTDevice(PlanetaryParams.paper(xi1=0.05, xi2=0.05))
-        ds = geardyn.bifurcation(m, values=[0.6, 1.1, 2.5], transient=50.0, samples=4,
-                                 steps_per_period=64)
+        ds = geardyn.bifurcation(m, values=[0.6, 1.1, 2.5],
+                                 run=geardyn.RunSettings(transient=50.0, samples=4,
+                                                         steps_per_period=64))
     else:
         g = GearPair(zeta=0.05, kappa=0.2, Fa=0.2)
-        ds = geardyn.bifurcation(g, values=[0.5, 0.95, 1.3], transient=50.0, samples=4,
+        ds = geardyn.bifurcation(g, values=[0.5, 0.95, 1.3],
+                                 run=geardyn.RunSettings(transient=50.0, samples=4),
                                  starts=2, lyapunov=True)
     ds.attrs.update(study="fig3", plot_state=str(ds["state"].values[0]), wall_time_s=1.25)
     back = load_dataset(save_dataset(ds, tmp_path / "bif.nc"))

@@ -73,14 +73,14 @@ def rk4_polynomial(Z):
 
 # ----------------------------------------------------------------------------- Lorenz
 def test_lorenz_largest_exponent():
-    lam = lyapunov(lorenz_model(), y0=[1.0, 1.0, 1.0], transient=100.0,
+    lam = lyapunov(lorenz_model(), y0=[1.0, 1.0, 1.0], run=geardyn.RunSettings(transient=100.0),
                    settings=geardyn.LyapunovSettings(duration=2000.0))
     assert abs(lam - LORENZ_LAMBDA1) < 0.01 * LORENZ_LAMBDA1
 
 
 def test_lorenz_spectrum():
     sigma, _rho, beta = LORENZ
-    lam = lyapunov(lorenz_model(), y0=[1.0, 1.0, 1.0], transient=100.0,
+    lam = lyapunov(lorenz_model(), y0=[1.0, 1.0, 1.0], run=geardyn.RunSettings(transient=100.0),
                    spectrum=True, settings=geardyn.LyapunovSettings(duration=2000.0))
     assert lam.shape == (3,)
     assert np.all(np.diff(lam) < 0)
@@ -100,7 +100,8 @@ def test_linear_oscillator_spectrum(which):
     else:
         model = geardyn.UserModel(forced_oscillator_rhs, 2, params=[zeta, 0.3, omega],
                                   period=2.0 * math.pi / omega)
-    lam = lyapunov(model, y0=[0.3, 0.0], spectrum=True, steps_per_period=n)
+    lam = lyapunov(model, y0=[0.3, 0.0], spectrum=True,
+                   run=geardyn.RunSettings(transient=100.0, steps_per_period=n))
     # the sum is log|det| of the step map per unit time: exactly that of the RK4 polynomial of
     # h A, and -2 zeta (the trace) up to the O(h^4) error of RK4
     A = np.array([[0.0, 1.0], [-1.0, -2.0 * zeta]])
@@ -125,15 +126,20 @@ def test_gear_pair_periodic_negative():
 
 def test_gear_pair_chaotic_positive():
     model = geardyn.GearPair(**CHAOTIC)
-    lam = lyapunov(model, transient=500.0, settings=geardyn.LyapunovSettings(duration=5000.0))
+    lam = lyapunov(model,
+                   run=geardyn.RunSettings(transient=500.0),
+                   settings=geardyn.LyapunovSettings(duration=5000.0))
     assert 0.04 < lam < 0.12
-    spec = lyapunov(model, transient=500.0, spectrum=True,
+    spec = lyapunov(model, run=geardyn.RunSettings(transient=500.0), spectrum=True,
                     settings=geardyn.LyapunovSettings(duration=5000.0))
     assert abs(spec.sum() + 2 * CHAOTIC["zeta"]) < 1e-5  # trace of J, with impacts
     # independent signal: two trajectories started 1e-9 apart on the attractor separate to O(1)
-    y_att = geardyn.simulate(model, transient=500.0, periods=1)["poincare"].values[-1]
-    a = geardyn.simulate(model, y0=y_att, periods=200)
-    b = geardyn.simulate(model, y0=y_att + np.array([1e-9, 0.0]), periods=200)
+    y_att = geardyn.simulate(model,
+                             run=geardyn.RunSettings(transient=500.0,
+                                                     samples=1))["poincare"].values[-1]
+    a = geardyn.simulate(model, y0=y_att, run=geardyn.RunSettings(transient=0.0, samples=200))
+    b = geardyn.simulate(model, y0=y_att + np.array([1e-9, 0.0]),
+                         run=geardyn.RunSettings(transient=0.0, samples=200))
     sep = np.abs(a["poincare"].values[:, 0] - b["poincare"].values[:, 0])
     assert sep[:5].max() < 1e-6
     assert sep.max() > 0.1
@@ -142,7 +148,9 @@ def test_gear_pair_chaotic_positive():
 def test_gear_pair_periodic_reference_not_diverging():
     # the opposite signal for the periodic case: nearby trajectories approach each other
     model = geardyn.GearPair(zeta=0.05, Fm=0.1, Fa=0.05, Omega=0.5)
-    y_att = geardyn.simulate(model, transient=500.0, periods=1)["poincare"].values[-1]
+    y_att = geardyn.simulate(model,
+                             run=geardyn.RunSettings(transient=500.0,
+                                                     samples=1))["poincare"].values[-1]
     t = model.period * np.arange(40)
     a = geardyn.reference_solution(model, y_att, t)
     b = geardyn.reference_solution(model, y_att + np.array([1e-6, 0.0]), t)
@@ -174,7 +182,9 @@ def test_state_scale_default_and_checked():
     for bad in ([1.0], [1.0, 0.0], [1.0, -2.0], [1.0, np.inf], [1.0, np.nan]):
         m = _Scaled(bad, **IMPACTING)
         with pytest.raises(ValueError, match="state_scale"):
-            lyapunov(m, transient=1.0, settings=geardyn.LyapunovSettings(duration=10.0))
+            lyapunov(m,
+                     run=geardyn.RunSettings(transient=1.0),
+                     settings=geardyn.LyapunovSettings(duration=10.0))
         with pytest.raises(ValueError, match="state_scale"):
             lyapunov_lanes(m, m.lane_params("Omega", [1.0]), run=RunSettings(transient=1.0),
                            settings=LyapunovSettings(duration=10.0))
@@ -185,7 +195,7 @@ def test_exponent_does_not_depend_on_the_state_scale():
     # kappa = max(s) / min(s), so the finite-time exponent by at most 2 log(kappa) / duration
     # (both measured from aligned vectors), and the limit not at all
     scale, run = np.array([3.0, 0.25]), dict(transient=200.0, duration=500.0, steps_per_period=64)
-    one = dict(transient=200.0, steps_per_period=64,
+    one = dict(run=RunSettings(transient=200.0, steps_per_period=64),
                settings=geardyn.LyapunovSettings(duration=run["duration"]))
     a = lyapunov(geardyn.GearPair(**IMPACTING), **one)
     b = lyapunov(_Scaled(scale, **IMPACTING), **one)
@@ -229,12 +239,12 @@ def test_dimensional_catt_exponents_match_the_mesh_form():
     dm = c.dimensional()
     y0 = theta_from_mesh(c, x0)
     np.testing.assert_allclose(dm.mesh_coordinates(0.0, y0), x0, atol=1e-11)
-    run = dict(transient=1000.0, settings=geardyn.LyapunovSettings(duration=1000.0),
-               with_error=True)
+    run = dict(run=RunSettings(transient=1000.0),
+               settings=geardyn.LyapunovSettings(duration=1000.0), with_error=True)
     red = lyapunov(c, **run)
     gen = lyapunov(c.general(), y0=x0, spectrum=True, **run)
-    run = dict(transient=1000.0 / wn, settings=geardyn.LyapunovSettings(duration=1000.0 / wn),
-               with_error=True)  # seconds
+    run = dict(run=RunSettings(transient=1000.0 / wn),
+               settings=geardyn.LyapunovSettings(duration=1000.0 / wn), with_error=True)  # s
     dim1 = lyapunov(dm, y0=y0, **run)
     dim = lyapunov(dm, y0=y0, spectrum=True, **run)
     # the largest exponent: chaotic, and the same per unit tau within the stated errors
@@ -279,7 +289,7 @@ def test_dimensional_catt_spectrum_sums_to_the_divergence_after_the_carrier_drif
     wn = c.omega_n
     assert abs(c.carrier_acceleration()) > 1e3
     y0 = theta_from_mesh(c, c.expand_state(c.initial_state()))
-    lam = lyapunov(dm, y0=y0, transient=4000.0 / wn, spectrum=True,
+    lam = lyapunov(dm, y0=y0, run=geardyn.RunSettings(transient=4000.0 / wn), spectrum=True,
                    settings=geardyn.LyapunovSettings(duration=200.0 / wn))
     tr = _divergence(dm, y0)
     assert abs(lam.sum() - tr) < 1e-5 * abs(tr), (lam.sum(), tr)  # measured 2.3e-7
@@ -320,7 +330,9 @@ def impacting_floquet():
     finite-difference error (steps 1e-4 and 1e-5 compared)."""
     model = geardyn.GearPair(**IMPACTING)
     T = model.period
-    guess = geardyn.simulate(model, transient=400.0, periods=1)["poincare"].values[-1]
+    guess = geardyn.simulate(model,
+                             run=geardyn.RunSettings(transient=400.0,
+                                                     samples=1))["poincare"].values[-1]
     y, mu = reference_floquet(model, guess)
     assert np.all(np.abs(mu.imag) == 0) and np.all(np.abs(mu) < 1)  # stable, real
     ref = math.log(np.abs(mu).max()) / T
@@ -337,9 +349,9 @@ def test_impacting_orbit_matches_floquet_reference(impacting_floquet):
     # its statistical error plus its discretisation error (estimated by step doubling) plus
     # the reference's own finite-difference error.
     model, y, ref, ref_err = impacting_floquet
-    l1 = lyapunov(model, y0=y, transient=50.0, steps_per_period=96,
+    l1 = lyapunov(model, y0=y, run=geardyn.RunSettings(transient=50.0, steps_per_period=96),
                   with_error=True, settings=geardyn.LyapunovSettings(duration=500.0))
-    l2 = lyapunov(model, y0=y, transient=50.0, steps_per_period=192,
+    l2 = lyapunov(model, y0=y, run=geardyn.RunSettings(transient=50.0, steps_per_period=192),
                   with_error=True, settings=geardyn.LyapunovSettings(duration=500.0))
     disc = abs(l1.value - l2.value)
     # with the edge crossings located inside a step the exponent converges fast: 96 and 192
@@ -357,11 +369,12 @@ def test_impacting_orbit_exponent_at_every_step_count(impacting_floquet):
     across the edges (locate_edges=False) the error at 96 steps exceeds 10 % (measured 22 %):
     the bound above tells the two apart."""
     model, y, ref, ref_err = impacting_floquet
-    run = dict(y0=y, transient=50.0, settings=geardyn.LyapunovSettings(duration=500.0))
+    run = dict(y0=y, settings=geardyn.LyapunovSettings(duration=500.0))
+    base = RunSettings(transient=50.0)
     for n in (64, 256, 1024, 4096):
-        lam = lyapunov(model, steps_per_period=n, **run)
+        lam = lyapunov(model, run=base.replace(steps_per_period=n), **run)
         assert abs(lam - ref) < 1e-6 + 2.0 * ref_err, (n, lam, ref)
-    across = lyapunov(model, steps_per_period=96, locate_edges=False, **run)
+    across = lyapunov(model, run=base.replace(steps_per_period=96, locate_edges=False), **run)
     assert abs(across - ref) > 0.1 * abs(ref), (across, ref)
 
 
@@ -373,7 +386,9 @@ def test_contact_orbit_within_error_and_rotation_bias_of_floquet_reference():
     # by the bias log(kappa) / D on top of its statistical error (docs/lyapunov.md, Uncertainty).
     model = geardyn.GearPair(zeta=0.05, Fm=0.1, Fa=0.05, Omega=0.5)
     T = model.period
-    guess = geardyn.simulate(model, transient=400.0, periods=1)["poincare"].values[-1]
+    guess = geardyn.simulate(model,
+                             run=geardyn.RunSettings(transient=400.0,
+                                                     samples=1))["poincare"].values[-1]
     y, mu = reference_floquet(model, guess)
     assert np.all(mu.imag != 0)
     ref = math.log(np.abs(mu).max()) / T
@@ -383,7 +398,7 @@ def test_contact_orbit_within_error_and_rotation_bias_of_floquet_reference():
                          for d in 1e-4 * np.eye(2)])
     kappa = np.linalg.cond(np.linalg.eig(M)[1])
     for duration in (100.0, 300.0, 1000.0):
-        est = lyapunov(model, y0=y, transient=100.0, with_error=True,
+        est = lyapunov(model, y0=y, run=geardyn.RunSettings(transient=100.0), with_error=True,
                        settings=geardyn.LyapunovSettings(duration=duration))
         bias = math.log(kappa) / (math.ceil(duration / T - 1e-9) * T)
         assert abs(est.value - ref) < 3.0 * est.stderr + bias
@@ -397,8 +412,11 @@ def test_stderr_of_chaotic_exponent_matches_spread_of_repeats():
     model = geardyn.GearPair(**CHAOTIC)
     n_rep, duration = 8, 1000.0
     gap = math.ceil(duration / model.period) + 10  # periods between the starts
-    points = geardyn.simulate(model, transient=500.0, periods=n_rep * gap)["poincare"].values
-    runs = [lyapunov(model, y0=points[j * gap], t0=j * gap * model.period, transient=50.0,
+    points = geardyn.simulate(model,
+                              run=geardyn.RunSettings(transient=500.0,
+                                                      samples=n_rep * gap))["poincare"].values
+    runs = [lyapunov(model, y0=points[j * gap], t0=j * gap * model.period,
+                     run=geardyn.RunSettings(transient=50.0),
                      with_error=True, settings=geardyn.LyapunovSettings(duration=duration))
             for j in range(n_rep)]
     values = np.array([r.value for r in runs])
@@ -408,22 +426,24 @@ def test_stderr_of_chaotic_exponent_matches_spread_of_repeats():
     # a settled periodic orbit of the same length: its blocks (whole forcing periods) repeat,
     # so its error is orders of magnitude smaller
     periodic = geardyn.GearPair(**IMPACTING)
-    y = geardyn.simulate(periodic, transient=1000.0, periods=1)["poincare"].values[-1]
-    reg = lyapunov(periodic, y0=y, transient=50.0, with_error=True,
+    y = geardyn.simulate(periodic,
+                         run=geardyn.RunSettings(transient=1000.0,
+                                                 samples=1))["poincare"].values[-1]
+    reg = lyapunov(periodic, y0=y, run=geardyn.RunSettings(transient=50.0), with_error=True,
                    settings=geardyn.LyapunovSettings(duration=duration))
     assert reg.stderr < 1e-3 * errors.min()
 
 
 def test_with_error_shapes_and_nan():
     g = geardyn.GearPair(**IMPACTING)
-    spec = lyapunov(g, transient=50.0, spectrum=True, with_error=True,
+    spec = lyapunov(g, run=geardyn.RunSettings(transient=50.0), spectrum=True, with_error=True,
                     settings=geardyn.LyapunovSettings(duration=100.0))
     assert spec.value.shape == spec.stderr.shape == (2,) and spec.value[0] > spec.value[1]
     assert np.all(spec.stderr > 0)
-    short = lyapunov(g, transient=0.0, with_error=True,
+    short = lyapunov(g, run=geardyn.RunSettings(transient=0.0), with_error=True,
                      settings=geardyn.LyapunovSettings(duration=g.period))
     assert short.n_blocks == 1 and math.isnan(short.stderr) and math.isfinite(short.value)
-    few = lyapunov(g, transient=0.0, with_error=True,
+    few = lyapunov(g, run=geardyn.RunSettings(transient=0.0), with_error=True,
                    settings=geardyn.LyapunovSettings(duration=3 * g.period))
     assert few.n_blocks == 3 and math.isfinite(few.stderr)  # at most one block per period
     P = g.lane_params("Omega", [1.15, 0.6])
@@ -441,8 +461,9 @@ def test_step_convergence_chaotic():
     # a chaotic exponent is a long-time average: at n and 2n the trajectories differ, so the
     # estimates agree only to their statistical error (~2% at duration 20000, measured)
     model = geardyn.GearPair(**CHAOTIC)
-    run = dict(transient=500.0, settings=geardyn.LyapunovSettings(duration=20000.0))
-    l1, l2, l4 = (lyapunov(model, steps_per_period=n, **run) for n in (64, 128, 256))
+    settings = geardyn.LyapunovSettings(duration=20000.0)
+    l1, l2, l4 = (lyapunov(model, run=RunSettings(transient=500.0, steps_per_period=n),
+                           settings=settings) for n in (64, 128, 256))
     assert abs(l1 - l2) < 0.06 * abs(l2)
     assert abs(l4 - l2) < 0.06 * abs(l2)
 
@@ -456,8 +477,9 @@ def test_lanes_match_single():
                          settings=LyapunovSettings(duration=600.0))
     assert out.shape == (3,)
     for om, lam in zip(omegas, out, strict=True):
-        single = lyapunov(model.with_omega(om), transient=300.0,
-                          steps_per_period=64, settings=geardyn.LyapunovSettings(duration=600.0))
+        single = lyapunov(model.with_omega(om),
+                          run=geardyn.RunSettings(transient=300.0, steps_per_period=64),
+                          settings=geardyn.LyapunovSettings(duration=600.0))
         assert lam == pytest.approx(single, rel=1e-12, abs=1e-14)
     assert out[0] < 0 < out[1]
 
@@ -491,7 +513,7 @@ def test_bad_arguments():
     with pytest.raises(ValueError):
         lyapunov(g, settings=geardyn.LyapunovSettings(dt=0.01))
     with pytest.raises(ValueError):
-        lyapunov(lorenz_model(), steps_per_period=64)
+        lyapunov(lorenz_model(), run=geardyn.RunSettings(transient=100.0, steps_per_period=64))
     with pytest.raises(ValueError):
         lyapunov(g, y0=[1.0, 2.0, 3.0])
     with pytest.raises(ValueError):
@@ -514,7 +536,8 @@ def test_sweep_exponent_continues_its_lane_in_both_forcing_phases():
     samples = 512
     for first in 2.0 + 0.002 * np.arange(1, 12):  # find a start whose load phase is far from 0
         values = np.array([first, 2.0])
-        ds = geardyn.bifurcation(model, "Omega", values, transient=600.0, samples=samples,
+        ds = geardyn.bifurcation(model, "Omega", values,
+                                 run=geardyn.RunSettings(transient=600.0, samples=samples),
                                  continuation="down", lyapunov=True)
         t_final = float(ds["final_time"].values[1])
         if 2.6 < (lam_load * t_final) % (2.0 * math.pi) < 5.8:
@@ -524,12 +547,14 @@ def test_sweep_exponent_continues_its_lane_in_both_forcing_phases():
     m = model.with_omega(2.0)
     # as bifurcation does: 200 time units to align, then as long as the sampling (mean period)
     duration = samples * float(np.mean(2.0 * math.pi / values))
-    kw = dict(transient=200.0, settings=geardyn.LyapunovSettings(duration=duration),
-              steps_per_period=int(ds["steps_per_period"].values[1]), with_error=True)
+    kw = dict(run=RunSettings(transient=200.0,
+                              steps_per_period=int(ds["steps_per_period"].values[1])),
+              settings=geardyn.LyapunovSettings(duration=duration), with_error=True)
     same = geardyn.lyapunov(m, y0=ds["poincare"].values[1, -1], t0=t_final, **kw)
     assert ds["lyapunov"].values[1] == same.value
     assert ds["lyapunov_err"].values[1] == same.stderr
-    fresh = geardyn.lyapunov(m, t0=t_final, transient=1000.0, with_error=True,
+    fresh = geardyn.lyapunov(m, t0=t_final,
+                             run=geardyn.RunSettings(transient=1000.0), with_error=True,
                              settings=geardyn.LyapunovSettings(duration=duration))
     assert abs(fresh.value - same.value) < 3.0 * (fresh.stderr + same.stderr)
     zero = geardyn.lyapunov(m, y0=ds["poincare"].values[1, -1], t0=0.0, **kw)
@@ -559,7 +584,7 @@ def test_split_limit_is_reported():
     from geardyn.solvers._step_core import MAX_SPLITS
 
     assert 10 < MAX_SPLITS < N_LEVELS
-    run = dict(y0=[0.0, 1.0], transient=0.0,
+    run = dict(y0=[0.0, 1.0], run=RunSettings(transient=0.0),
                settings=geardyn.LyapunovSettings(duration=5.0, dt=1.0))
     clean = lyapunov(levels_model(10), with_error=True, **run)
     assert clean.status == geardyn.Status.OK and clean.unresolved == 0 and clean.ok
@@ -586,10 +611,13 @@ def test_split_limit_is_reported():
 
 
 def test_run_settings():
-    """lyapunov(run=RunSettings(...)) is lyapunov with the same keywords; not both."""
+    """lyapunov(run=RunSettings(...)) is lyapunov with the same (deprecated) keywords; not
+    both."""
     g = geardyn.GearPair(**IMPACTING)
     kw = dict(transient=60.0, steps_per_period=64, bound=1e5)
-    a = lyapunov(g, with_error=True, **kw, settings=geardyn.LyapunovSettings(duration=100.0))
+    with pytest.warns(DeprecationWarning, match=r"lyapunov\(transient=, steps_per_period=, "
+                                                r"bound=\) is deprecated"):
+        a = lyapunov(g, with_error=True, **kw, settings=geardyn.LyapunovSettings(duration=100.0))
     b = lyapunov(g, run=geardyn.RunSettings(**kw), with_error=True,
                  settings=geardyn.LyapunovSettings(duration=100.0))
     assert a == b
@@ -602,4 +630,4 @@ def test_run_settings():
     with pytest.raises(TypeError, match="samples"):
         lyapunov(g, samples=10)
     with pytest.raises(ValueError, match="steps_per_period"):
-        lyapunov(g, steps_per_period=2)
+        lyapunov(g, run=geardyn.RunSettings(transient=100.0, steps_per_period=2))

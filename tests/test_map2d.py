@@ -66,7 +66,8 @@ def test_contact_map_matches_the_linear_separation_boundary():
     g = geardyn.GearPair(zeta=0.05, kappa=0.0, Fm=0.1, Fa=0.05)
     om = np.linspace(0.4, 2.5, 8)
     fa = np.array([0.02, 0.05, 0.12])
-    ds = geardyn.map2d(g, x=("Omega", om), y=("Fa", fa), transient=600.0, samples=10)
+    ds = geardyn.map2d(g, x=("Omega", om), y=("Fa", fa),
+                       run=geardyn.RunSettings(transient=600.0, samples=10))
     assert ds["contact"].dims == ("Fa", "Omega", "mesh")
     onset = np.array([g.with_params(Fa=a).separation_onset(om) for a in fa])
     clear = np.abs(onset) > 0.05
@@ -81,15 +82,15 @@ def test_map_points_equal_single_simulations(device):
     Omega: its period class and its Poincare points' class agree, and the map equals a
     bifurcation sweep along Omega at each xi."""
     om, xi = np.array([0.6, 1.1, 2.2]), np.array([0.03, 0.12])
-    kw = dict(transient=300.0, samples=6, steps_per_period=64)
+    kw = dict(run=geardyn.RunSettings(transient=300.0, samples=6, steps_per_period=64))
     ds = geardyn.map2d(device, x=("Omega", om), y=("xi", xi), **kw)
     assert_result(ds, "map2d")
     for j, v in enumerate(xi):
         row = geardyn.bifurcation(device.with_params(xi=v), values=om, **kw)
         for name in ("period", "contact", "force_peak", "force_rms", "dynamic_factor"):
             np.testing.assert_array_equal(ds[name].values[j], row[name].values, err_msg=name)
-    one = geardyn.simulate(device.with_params(xi=xi[1]), omega=om[2], transient=300.0,
-                           periods=6, steps_per_period=64)
+    one = geardyn.simulate(device.with_params(xi=xi[1]), omega=om[2],
+                           run=geardyn.RunSettings(transient=300.0, samples=6, steps_per_period=64))
     assert_result(one, "simulation")
     assert ds["period"].values[1, 2] == classify_period(one["poincare"].values[1:])
 
@@ -98,8 +99,8 @@ def test_map_lyapunov_separates_chaos_from_periodic_motion():
     """Omega = 0.92 is chaotic for this gear pair and Omega = 0.5 period-1 (see
     tests/test_lyapunov.py); a map over (Omega, zeta) shows both."""
     g = geardyn.GearPair(zeta=0.02, kappa=0.2, Fm=0.1, Fa=0.3)
-    ds = geardyn.map2d(g, x=("Omega", [0.5, 0.92]), y=("zeta", [0.02]), transient=500.0,
-                       samples=50, lyapunov=True)
+    ds = geardyn.map2d(g, x=("Omega", [0.5, 0.92]), y=("zeta", [0.02]),
+                       run=geardyn.RunSettings(transient=500.0, samples=50), lyapunov=True)
     np.testing.assert_array_equal(ds["period"].values, [[1, 0]])
     lam = ds["lyapunov"].values[0]
     assert lam[0] < -0.005 and lam[1] > 0.02
@@ -116,14 +117,14 @@ def test_map_lyapunov_separates_chaos_from_periodic_motion():
 def test_bad_axes_give_an_error_naming_them(kwargs, match):
     g = geardyn.GearPair()
     with pytest.raises((ValueError, KeyError), match=match):
-        geardyn.map2d(g, transient=10.0, samples=4, **kwargs)
+        geardyn.map2d(g, run=geardyn.RunSettings(transient=10.0, samples=4), **kwargs)
 
 
 # ------------------------------------------------------------------ plot and estimate
 def test_plot_map_legend_lists_the_classes_present(tmp_path):
     g = geardyn.GearPair(zeta=0.05, kappa=0.2, Fm=0.1, Fa=0.2)
     ds = geardyn.map2d(g, x=("Omega", np.linspace(0.5, 3.0, 6)), y=("zeta", [0.03, 0.1]),
-                       transient=200.0, samples=16)
+                       run=geardyn.RunSettings(transient=200.0, samples=16))
     path = tmp_path / "map.png"
     fig = plot_map(ds, path=path)
     assert path.stat().st_size > 5000
@@ -139,7 +140,8 @@ def test_plot_map_legend_lists_the_classes_present(tmp_path):
 def test_estimate_counts_the_lane_steps_the_map_takes():
     g = geardyn.GearPair(zeta=0.05, Fm=0.1, Fa=0.2)
     om = np.array([0.5, 1.3, 2.9])
-    ds = geardyn.map2d(g, x=("Omega", om), y=("zeta", [0.05, 0.1]), transient=100.0, samples=8)
+    ds = geardyn.map2d(g, x=("Omega", om), y=("zeta", [0.05, 0.1]),
+                       run=geardyn.RunSettings(transient=100.0, samples=8))
     taken = np.sum(ds["steps_per_period"].values * (ds["transient_periods"].values + 8))
     est = estimate_map(g, lanes=6, omegas=om, transient=100.0, samples=8,
                        ns_per_lane_step=100.0)
@@ -209,7 +211,8 @@ def test_cli_map_writes_the_map_and_its_figure(tmp_path, capsys):
     got = load_dataset(tmp_path / "m.nc")
     model = geardyn.GearPair(zeta=0.05, kappa=0.2, Fm=0.1, Fa=0.2)
     want = geardyn.map2d(model, x=("Omega", np.linspace(0.5, 3, 6)),
-                         y=("zeta", np.linspace(0.02, 0.1, 3)), transient=100.0, samples=8)
+                         y=("zeta", np.linspace(0.02, 0.1, 3)),
+                         run=geardyn.RunSettings(transient=100.0, samples=8))
     np.testing.assert_array_equal(got["period"].values, want["period"].values)
     np.testing.assert_array_equal(got["contact"].values, want["contact"].values)
 
@@ -240,7 +243,8 @@ def test_cli_map_zarr_output_opens_with_plain_xarray_and_redraws(tmp_path, capsy
             opened = opened.load()
     model = geardyn.GearPair(zeta=0.05, kappa=0.2, Fm=0.1, Fa=0.2)
     want = geardyn.map2d(model, x=("Omega", np.linspace(0.5, 3, 4)),
-                         y=("zeta", np.linspace(0.02, 0.1, 2)), transient=100.0, samples=8,
+                         y=("zeta", np.linspace(0.02, 0.1, 2)),
+                         run=geardyn.RunSettings(transient=100.0, samples=8),
                          chunk=3)
     xr.testing.assert_identical(opened, want.assign_attrs(study="gp"))
     with pytest.raises(SystemExit) as exc:

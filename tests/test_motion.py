@@ -41,7 +41,7 @@ def block_exponent(model, y0, block: float, n: int) -> tuple[float, float, float
 
     The block means come from one trajectory: the kernel is deterministic, so the exponent over
     j blocks times j * block is the log stretch up to the end of block j."""
-    logs = [0.0] + [lyapunov(model, y0=y0, transient=100.0,
+    logs = [0.0] + [lyapunov(model, y0=y0, run=geardyn.RunSettings(transient=100.0),
                              settings=geardyn.LyapunovSettings(duration=j * block)) * j * block
                     for j in range(1, n + 1)]
     means = np.diff(logs) / block
@@ -49,8 +49,9 @@ def block_exponent(model, y0, block: float, n: int) -> tuple[float, float, float
 
 
 def settled(model, omega: float, max_period: int = 16, transient: float = 600.0):
-    ds = geardyn.bifurcation(model, "Omega", [omega], transient=transient, samples=64,
-                             max_period=max_period)
+    ds = geardyn.bifurcation(model, "Omega", [omega],
+                             run=geardyn.RunSettings(transient=transient, samples=64,
+                                                     max_period=max_period))
     return int(ds["period"].values[0]), ds["poincare"].values[0, -1]
 
 

@@ -35,21 +35,24 @@ def trajectory_errors(model, y0, ns, locate):
     ref = geardyn.reference_solution(model, y0, times, rtol=1e-13, atol=1e-14)
     errs = []
     for n in ns:
-        ds = geardyn.simulate(model, periods=K_PERIODS, steps_per_period=int(n), y0=y0,
-                              locate_edges=locate)
+        ds = geardyn.simulate(model,
+                              run=geardyn.RunSettings(transient=0.0, samples=K_PERIODS,
+                                                      steps_per_period=int(n), locate_edges=locate),
+                              y0=y0)
         errs.append(np.max(np.abs(ds["poincare"].values - ref)))
     return np.array(errs)
 
 
 def on_attractor(model, n=1024):
-    ds = geardyn.simulate(model, transient=3000.0, periods=1, steps_per_period=n)
+    ds = geardyn.simulate(model,
+                          run=geardyn.RunSettings(transient=3000.0, samples=1, steps_per_period=n))
     return ds["poincare"].values[-1], ds
 
 
 def test_rk4_is_fourth_order_while_teeth_stay_in_contact():
     m = geardyn.CATTDevice(geardyn.PlanetaryParams.paper(error="0.1 um")).with_omega(1.1)
     y0, _ = on_attractor(m, 512)
-    ds = geardyn.simulate(m, periods=K_PERIODS, y0=y0)
+    ds = geardyn.simulate(m, run=geardyn.RunSettings(transient=0.0, samples=K_PERIODS), y0=y0)
     assert int(ds["edge_crossings"].sum()) == 0
     ns = np.array([32, 64, 128, 256])
     for locate in (True, False):
@@ -62,7 +65,7 @@ def test_rk4_is_fourth_order_while_teeth_stay_in_contact():
 def test_edge_location_keeps_fourth_order_with_contact_loss(omega):
     m = geardyn.CATTDevice(geardyn.PlanetaryParams.paper()).with_omega(omega)
     y0, _ = on_attractor(m)
-    ds = geardyn.simulate(m, periods=K_PERIODS, y0=y0)
+    ds = geardyn.simulate(m, run=geardyn.RunSettings(transient=0.0, samples=K_PERIODS), y0=y0)
     assert int(ds["edge_crossings"].sum()) >= K_PERIODS  # the teeth separate every period
     ns_loc = dense(32, 256)
     p_loc = order(ns_loc, trajectory_errors(m, y0, ns_loc, True))
@@ -95,7 +98,7 @@ def test_default_steps_reach_1e6_on_periodic_attractors(omega, loss):
     # period 1 or 2, converged: to 1e-8, the reference's own reproducibility here (at
     # Omega = 0.6 a start moved by 1e-14 changed this difference from 2e-10 to 9e-9)
     assert np.max(np.abs(ref[2:] - ref[:2])) < 1e-8
-    ds = geardyn.simulate(m, transient=4000.0, periods=4)
+    ds = geardyn.simulate(m, run=geardyn.RunSettings(transient=4000.0, samples=4))
     assert ds.attrs["steps_per_period"] == geardyn.default_steps_per_period(m)
     assert _poincare_distance(ref, ds["poincare"].values) < 1e-6
     assert _poincare_distance(ds["poincare"].values, ref) < 1e-6

@@ -119,7 +119,8 @@ def test_phased_gear_pair_matches_the_reference_integrator():
     m = geardyn.GearPair(zeta=0.05, kappa=0.2, Fm=0.1, Fa=0.1, Omega=0.8, kappa_phase=0.9,
                          error_phase=-0.4)
     T = 2.0 * math.pi / 0.8
-    ds = geardyn.simulate(m, transient=0.0, periods=4, steps_per_period=512)
+    ds = geardyn.simulate(m,
+                          run=geardyn.RunSettings(transient=0.0, samples=4, steps_per_period=512))
     ref = geardyn.reference_solution(m, m.initial_state(), T * np.arange(1, 5))
     np.testing.assert_allclose(ds["poincare"].values[1:], ref, atol=2e-8)
 
@@ -135,8 +136,8 @@ def test_user_gear_pair_equals_gear_pair_bitwise():
         np.testing.assert_array_equal(getattr(r_user, name), getattr(r_pair, name),
                                       err_msg=name)
     om = np.linspace(0.5, 2.5, 9)
-    a = geardyn.bifurcation(pair, "Omega", om, transient=200.0, samples=10)
-    b = geardyn.bifurcation(user, "Omega", om, transient=200.0, samples=10)
+    a = geardyn.bifurcation(pair, "Omega", om, run=geardyn.RunSettings(transient=200.0, samples=10))
+    b = geardyn.bifurcation(user, "Omega", om, run=geardyn.RunSettings(transient=200.0, samples=10))
     for name in ("poincare", "contact", "force_peak", "force_rms", "dynamic_factor"):
         np.testing.assert_array_equal(b[name].values, a[name].values, err_msg=name)
     assert set(a["contact"].values.ravel()) >= {"none", "single"}
@@ -156,8 +157,9 @@ def test_user_mesh_gets_a_frequency_response_matching_linear_theory():
     zeta, Fm, Fa = 0.1, 2.0, 0.02
     user = gear_pair(zeta=zeta, kappa=0.0, Fm=Fm, Fa=Fa)
     om = np.array([0.5, 0.8, 1.2, 1.6])
-    ds = geardyn.frequency_response(user, om, transient=300.0, samples=20,
-                                    steps_per_period=256)
+    ds = geardyn.frequency_response(user, om,
+                                    run=geardyn.RunSettings(transient=300.0, samples=20,
+                                                            steps_per_period=256))
     H = np.abs(Fa * om**2 / (1.0 - om**2 + 2j * zeta * om))
     for sweep in range(2):
         assert list(ds["contact"].values[sweep, :, 0]) == ["none"] * om.size
@@ -184,15 +186,17 @@ def test_duffing_one_form_through_simulate_sweep_lyapunov_and_orbits():
     assert kernels_for(one.kernel).FUSED
     y0 = one.initial_state()
     T = 2.0 * math.pi / 1.2
-    ds = geardyn.simulate(one, transient=0.0, periods=5, steps_per_period=256)
+    ds = geardyn.simulate(one,
+                          run=geardyn.RunSettings(transient=0.0, samples=5, steps_per_period=256))
     ref = geardyn.reference_solution(one, y0, T * np.arange(1, 6))
     np.testing.assert_allclose(ds["poincare"].values[1:], ref, atol=1e-8)
     # the sweep's lanes equal single simulations bit for bit
     om = np.array([0.9, 1.2, 1.5])
     r = run_lanes(one, one.lane_params("Omega", om), y0, 60.0, 4, steps_per_period=64)
     for j, w in enumerate(om):
-        d = geardyn.simulate(one, omega=float(w), transient=60.0, periods=4,
-                             steps_per_period=64)
+        d = geardyn.simulate(one, omega=float(w),
+                             run=geardyn.RunSettings(transient=60.0, samples=4,
+                                                     steps_per_period=64))
         np.testing.assert_array_equal(r.samples[j], d["poincare"].values[1:])
     # Liouville: the exponents sum to the trace of the Jacobian, -delta, and the monodromy's
     # determinant is exp(-delta T); the exponents are those of the orbit's multipliers (a
@@ -240,11 +244,11 @@ def test_mesh_forces_are_what_the_meshes_declare_not_a_count_of_observables():
             natural_frequency=1.0)
 
     om = np.linspace(0.8, 1.2, 3)
-    plain = geardyn.bifurcation(pair([("mesh", "x-b", "x+b")]), "Omega", om, transient=50.0,
-                                samples=4)
+    plain = geardyn.bifurcation(pair([("mesh", "x-b", "x+b")]), "Omega", om,
+                                run=geardyn.RunSettings(transient=50.0, samples=4))
     assert "contact" in plain and "force_peak" not in plain and "dynamic_factor" not in plain
     forced = geardyn.bifurcation(pair([("mesh", "x-b", "x+b", "energy")]), "Omega", om,
-                                 transient=50.0, samples=4)
+                                 run=geardyn.RunSettings(transient=50.0, samples=4))
     assert "force_peak" in forced and "force_rms" in forced
 
 
@@ -354,12 +358,13 @@ def test_a_user_models_sweep_axis_carries_its_declared_unit():
     with that phase (derived cos/sin follow it per lane)."""
     m = declared_pair()
     phases = np.array([0.0, 1.3])
-    ds = geardyn.bifurcation(m, "phi_k", phases, transient=40.0, samples=4)
+    ds = geardyn.bifurcation(m, "phi_k", phases, run=geardyn.RunSettings(transient=40.0, samples=4))
     assert ds["phi_k"].attrs == {"units": "rad", "long_name": "phase of the stiffness variation"}
     for k, phase in enumerate(phases):
         one = geardyn.bifurcation(m.with_params(phi_k=float(phase)), "Omega", [1.0],
-                                  transient=40.0, samples=4)
+                                  run=geardyn.RunSettings(transient=40.0, samples=4))
         np.testing.assert_allclose(ds["poincare"].values[k], one["poincare"].values[0],
                                    rtol=1e-12, atol=1e-12)
-    om = geardyn.bifurcation(m, "Omega", [0.9, 1.1], transient=40.0, samples=4)
+    om = geardyn.bifurcation(m, "Omega", [0.9, 1.1],
+                             run=geardyn.RunSettings(transient=40.0, samples=4))
     assert om["Omega"].attrs["long_name"] == "mesh frequency / natural frequency"

@@ -121,9 +121,10 @@ def test_softening_folds_bracket_the_sweeps_hysteresis_and_contact_onset():
     h = 0.01
     vals = np.round(np.arange(0.6, 0.9 + h / 2, h), 6)
     up, down = continued_sweeps(
-        [ContinuedSweep(m, "Omega", vals, d, transient=300.0, continued_transient=50.0,
-                        transient_max=3000.0) for d in ("up", "down")],
-        samples=4, converge=1e-8)
+        [ContinuedSweep(m, "Omega", vals, d,
+                        run=geardyn.RunSettings(transient=300.0, transient_max=3000.0,
+                                                continued_transient=50.0)) for d in ("up", "down")],
+        run=geardyn.RunSettings(samples=4, converge=1e-8))
     a, b = up["force_peak"].values[:, 0], down["force_peak"].values[:, 0]
     differ = vals[np.abs(a - b) > 1e-3 * np.abs(a).max()]
     assert differ.size > 3
@@ -210,9 +211,10 @@ def test_paper_device_period_doubling_agrees_with_the_brute_force_diagram():
     assert pd.size == 1
     h = 0.01
     vals = np.round(np.arange(0.95, 1.1 + h / 2, h), 6)
-    bf = geardyn.bifurcation(base, "Omega", vals, continuation="up", transient=1500.0,
-                             continued_transient=200.0, transient_max=6000.0, converge=1e-9,
-                             samples=8)
+    bf = geardyn.bifurcation(base, "Omega", vals, continuation="up",
+                             run=geardyn.RunSettings(transient=1500.0, samples=8, converge=1e-9,
+                                                     transient_max=6000.0,
+                                                     continued_transient=200.0))
     per = bf["period"].values
     first2 = vals[np.argmax(per == 2)]
     assert per[0] == 1 and np.any(per == 2)

@@ -115,8 +115,8 @@ def test_planetary_dte_carries_its_unit_and_scale(scale):
     mesh deflects by b + F / k (F the static mesh force). The DTE's unit and length scale
     convert the reported mean to metres; the RMS about it is zero."""
     gs = _planetary(length_scale=scale)
-    ds = geardyn.frequency_response(gs, gs.omega * np.array([0.9, 1.1]), transient=200.0,
-                                    samples=2)
+    ds = geardyn.frequency_response(gs, gs.omega * np.array([0.9, 1.1]),
+                                    run=geardyn.RunSettings(transient=200.0, samples=2))
     expected = BACKLASH + np.abs(gs.static_mesh_forces()) / SUN_K  # m
     units = {1e-6: "um", 1e-5: "1e-05 m"}[scale]
     for name in ("dte_mean", "dte_rms", "dte_peak", "dte_amplitude", "dte_max"):

@@ -12,6 +12,7 @@ import pytest
 from scipy.linalg import eigh, solve
 
 import geardyn
+from geardyn.analysis.basins import basins_run
 from geardyn.errors import ParameterError
 from geardyn.testing import assert_result
 
@@ -238,7 +239,7 @@ def test_linear_forced_response():
     Q = solve(K - w * w * Mm + 1j * w * C, rhs)
     L, w0 = gs.length_scale, gs.time_scale
     y0 = np.r_[Q.imag, (1j * w * Q).imag / w0] / L  # q = Im(Q e^{iwt}) at t = 0
-    ds = geardyn.simulate(gs, periods=3, y0=y0)
+    ds = geardyn.simulate(gs, run=geardyn.RunSettings(transient=0.0, samples=3), y0=y0)
     tau = ds["time"].values
     X = np.stack([ds[nm].values for nm in gs.state_names[:21]], axis=1)
     q = (Q[None, :] * np.exp(1j * w * tau[:, None] / w0)).imag / L
@@ -278,7 +279,7 @@ def test_orbit_continuation_and_lyapunov_of_the_linear_set_match_its_eigenvalues
     assert br.sizes["bifurcation"] == 0 and set(br["stability"].values) == {"stable"}
     last = np.sort(br["multiplier_abs"].values[-1])
     assert np.max(np.abs(last - expected(float(br["Omega"].values[-1])))) < 2e-5
-    largest = geardyn.lyapunov(gs, transient=50.0,
+    largest = geardyn.lyapunov(gs, run=geardyn.RunSettings(transient=50.0),
                                settings=geardyn.LyapunovSettings(duration=2000.0))
     assert largest == pytest.approx(ev.real.max(), rel=0.03)
 
@@ -292,12 +293,12 @@ def test_basins_and_map2d_of_the_linear_set():
     orb = geardyn.periodic_orbit(gs, steps_per_period=256)
     u, x = orb.x[gs.state_names.index("u_s")], orb.x[gs.state_names.index("x_s")]
     b = geardyn.basins(gs, None, ("u_s", u - 2, u + 2, 2), ("x_s", x - 2, x + 2, 2),
-                       transient=1500.0, orbits=[orb], base=orb.x)
+                       run=basins_run(transient=1500.0), orbits=[orb], base=orb.x)
     assert_result(b, "basins")
     assert b.attrs["n_attractors"] == 1 and list(b["attractor_orbit"].values) == [0]
     om = [gs.omega, 1.05 * gs.omega]
-    mp = geardyn.map2d(gs, ("Omega", om), ("sun_torque", [50.0, 100.0]), transient=1500.0,
-                       samples=4)
+    mp = geardyn.map2d(gs, ("Omega", om), ("sun_torque", [50.0, 100.0]),
+                       run=geardyn.RunSettings(transient=1500.0, samples=4))
     assert_result(mp, "map2d")
     assert np.all(mp["period"].values == 1)
     d = mp["force_peak"].sel(sun_torque=100.0).values - mp["force_peak"].sel(
@@ -326,7 +327,7 @@ def _contact_loss_set() -> geardyn.PlanetaryGearSet:
 def test_contact_loss_matches_reference_integrator():
     gs = _contact_loss_set()
     y0 = gs.initial_state()
-    ds = geardyn.simulate(gs, periods=4, y0=y0)
+    ds = geardyn.simulate(gs, run=geardyn.RunSettings(transient=0.0, samples=4), y0=y0)
     assert ds.attrs["status"] == geardyn.Status.OK
     assert int(ds["edge_crossings"].sum()) > 0
     # contact loss: some mesh deflection inside its backlash
@@ -356,8 +357,9 @@ def test_rk4_keeps_fourth_order_through_contact_loss_and_the_step_rule_is_conver
     scale = np.where(scale > 0, scale, 1.0)
 
     def error(n: int | None, locate: bool = True) -> tuple[float, int]:
-        ds = geardyn.simulate(gs, periods=periods, y0=y0, steps_per_period=n,
-                              locate_edges=locate)
+        run = geardyn.RunSettings(transient=0.0, samples=periods, steps_per_period=n,
+                                  locate_edges=locate)
+        ds = geardyn.simulate(gs, run=run, y0=y0)
         assert ds.attrs["status"] == geardyn.Status.OK
         return (float(np.max(np.abs(ds["poincare"].values - ref) / scale)),
                 int(ds.attrs["steps_per_period"]))
@@ -485,8 +487,8 @@ def test_sweep_in_a_physical_parameter_sees_contact_loss():
     """A bifurcation sweep of the gear set in a constructor input (lanes rebuilt by
     lane_params) ends ok in every lane, and its ring meshes lose contact."""
     gs = _contact_loss_set()
-    ds = geardyn.bifurcation(gs, "ring_mesh_error", [4e-6, 5e-6, 6e-6], transient=50.0,
-                             samples=4)
+    ds = geardyn.bifurcation(gs, "ring_mesh_error", [4e-6, 5e-6, 6e-6],
+                             run=geardyn.RunSettings(transient=50.0, samples=4))
     assert np.all(ds["status"].values == 0)
     assert list(ds["mesh"].values) == list(gs.mesh_names)
     contact = ds["contact"].sel(mesh=["r1", "r2", "r3"]).values

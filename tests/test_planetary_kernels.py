@@ -84,8 +84,9 @@ def test_lanes_reproduce_single_simulations_bitwise():
                   steps_per_period=64)
     assert np.all(r.status == 0)
     for j in (0, 3):
-        ds = geardyn.simulate(gs, omega=omegas[j], transient=30.0, periods=3,
-                              steps_per_period=64)
+        ds = geardyn.simulate(gs, omega=omegas[j],
+                              run=geardyn.RunSettings(transient=30.0, samples=3,
+                                                      steps_per_period=64))
         np.testing.assert_array_equal(r.samples[j], ds["poincare"].values[1:])
 
 
@@ -96,8 +97,9 @@ def test_lanes_with_different_damping_reproduce_single_simulations_bitwise():
     r = run_lanes(gs, gs.lane_params("modal_damping", zetas), gs.initial_state(), 30.0, 3,
                   steps_per_period=64)
     for j in (0, 1):
-        ds = geardyn.simulate(gs.with_params(modal_damping=zetas[j]), transient=30.0,
-                              periods=3, steps_per_period=64)
+        ds = geardyn.simulate(gs.with_params(modal_damping=zetas[j]),
+                              run=geardyn.RunSettings(transient=30.0, samples=3,
+                                                      steps_per_period=64))
         np.testing.assert_array_equal(r.samples[j], ds["poincare"].values[1:])
 
 
@@ -114,8 +116,9 @@ def test_rotating_lanes_reproduce_single_simulations_bitwise(name, values):
     assert np.all(r.status == 0)
     assert len({row[gs._layout["gyro"]] for row in P}) == 3  # the lanes' speeds differ
     for j in range(3):
-        ds = geardyn.simulate(gs.with_params(**{name: values[j]}), transient=30.0, periods=3,
-                              steps_per_period=64, y0=gs.initial_state())
+        ds = geardyn.simulate(gs.with_params(**{name: values[j]}),
+                              run=geardyn.RunSettings(transient=30.0, samples=3,
+                                                      steps_per_period=64), y0=gs.initial_state())
         np.testing.assert_array_equal(r.samples[j], ds["poincare"].values[1:])
 
 

@@ -112,7 +112,7 @@ def test_a_sun_on_its_bearing_seen_from_the_rotating_carrier():
     y0 = np.zeros(2 * n)
     y0[names.index("x_s")] = A / L
     y0[n + names.index("y_s")] = -wc * A / (L * w0)  # at rest in the ground frame
-    ds = geardyn.simulate(gs, periods=3, y0=y0)
+    ds = geardyn.simulate(gs, run=geardyn.RunSettings(transient=0.0, samples=3), y0=y0)
     t = ds["time"].values / w0
     z = (ds["x_s"].values + 1j * ds["y_s"].values) * L
     np.testing.assert_allclose(z, A * np.cos(wn * t) * np.exp(-1j * wc * t), rtol=0, atol=1e-5 * A)
@@ -137,7 +137,7 @@ def test_linear_forced_response_with_a_rotating_carrier():
     qs = solve(Ke, wc * wc * f)
     L, w0 = gs.length_scale, gs.time_scale
     y0 = np.r_[qs + Q.imag, (1j * w * Q).imag / w0] / L
-    ds = geardyn.simulate(gs, periods=3, y0=y0)
+    ds = geardyn.simulate(gs, run=geardyn.RunSettings(transient=0.0, samples=3), y0=y0)
     tau = ds["time"].values
     X = np.stack([ds[nm].values for nm in gs.state_names[:21]], axis=1)
     q = (qs[None, :] + (Q[None, :] * np.exp(1j * w * tau[:, None] / w0)).imag) / L
@@ -209,7 +209,9 @@ def test_a_rotating_set_with_contact_loss_keeps_the_model_contract():
     kick = np.random.default_rng(1).normal(0.0, 1.0, gs.n_states) * np.r_[[3.0] * 18, [1.0] * 18]
     report = check_model(gs, y0=gs.initial_state() + kick)
     assert [r.status for r in report.results] == ["ok"] * len(RULES), str(report)
-    ds = geardyn.simulate(gs, periods=2, y0=gs.initial_state() + kick)
+    ds = geardyn.simulate(gs,
+                          run=geardyn.RunSettings(transient=0.0, samples=2),
+                          y0=gs.initial_state() + kick)
     assert int(ds["edge_crossings"].sum()) > 0
 
 

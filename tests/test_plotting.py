@@ -125,7 +125,8 @@ def test_bifurcation_state_choice_and_errors():
 
 def test_real_sweep_figure_files_and_round_trip(tmp_path):
     g = geardyn.GearPair(zeta=0.05, kappa=0.2, Fa=0.2)
-    ds = geardyn.bifurcation(g, values=np.linspace(0.6, 1.4, 9), transient=200.0, samples=8,
+    ds = geardyn.bifurcation(g, values=np.linspace(0.6, 1.4, 9),
+                             run=geardyn.RunSettings(transient=200.0, samples=8),
                              starts=2, lyapunov=True)
     for name, magic in (("bif.png", PNG), ("bif.pdf", PDF)):
         plot_bifurcation(ds, path=tmp_path / name)
@@ -184,9 +185,10 @@ def test_simulation_spectrum_shows_the_subharmonic_of_a_period_two_motion(omega,
     """The gear pair's period from its Poincaré points (bifurcation) and from its spectrum
     (an Ω/2 line) agree."""
     g = geardyn.GearPair(zeta=0.05, kappa=0.2, Fa=0.2)
-    sweep = geardyn.bifurcation(g, values=[omega], transient=500.0, samples=32)
+    sweep = geardyn.bifurcation(g, values=[omega],
+                                run=geardyn.RunSettings(transient=500.0, samples=32))
     assert int(sweep["period"][0]) == period
-    ds = geardyn.simulate(g, omega=omega, transient=500.0, periods=32)
+    ds = geardyn.simulate(g, omega=omega, run=geardyn.RunSettings(transient=500.0, samples=32))
     labels = _spectrum_labels(plot_simulation(ds, "x"))
     assert "Ω" in labels
     assert ("Ω/2" in labels) == (period == 2)

@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 import xarray as xr
 
+from geardyn.analysis.basins import basins_run
 from geardyn.reproduction.basins import _velocity, basin_omega, summary
 
 
@@ -82,7 +83,8 @@ def test_reproduce_with_basins_writes_them_into_the_report(tmp_path, capsys, mon
     def fake(case, interpretation, ds, n, transient=None):
         asked.append((case.name, interpretation, n))
         b = geardyn.basins(geardyn.GearPair(Fm=2.0, Fa=0.02), omega=1.3, x=("x", 2.0, 4.0, n),
-                           y=("v", -0.5, 0.5, n), transient=100.0, samples=4, max_period=2)
+                           y=("v", -0.5, 0.5, n),
+                           run=basins_run(transient=100.0, samples=4, max_period=2))
         b.attrs.update(sweeps="up, down", study=f"{case.figure} ({interpretation})")
         return b
 

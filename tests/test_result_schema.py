@@ -14,7 +14,7 @@ from geardyn.testing import KINDS, assert_result
 
 def _simulation():
     g = geardyn.GearPair(zeta=0.05, kappa=0.0, Fm=0.1, Fa=0.0)
-    return geardyn.simulate(g, omega=1.2, transient=10.0, periods=4)
+    return geardyn.simulate(g, omega=1.2, run=geardyn.RunSettings(transient=10.0, samples=4))
 
 
 def _require(monkeypatch, kind: str, name: str, dims: tuple[str, ...]) -> None:

@@ -98,12 +98,12 @@ def test_store_refuses_other_inputs(tmp_path):
     with pytest.raises(StoreMismatchError, match="other inputs"):
         _run(path, chunk=4)
     with pytest.raises(StoreMismatchError, match="other inputs"):
-        geardyn.map2d(GEAR, x=("Omega", [1.0, 2.0]), y=("zeta", [0.1]), transient=10.0,
-                      samples=4, store=path)
+        geardyn.map2d(GEAR, x=("Omega", [1.0, 2.0]), y=("zeta", [0.1]),
+                      run=geardyn.RunSettings(transient=10.0, samples=4), store=path)
 
 
 def test_resumable_sweep_equals_the_plain_sweep(tmp_path):
-    kw = dict(values=OMEGAS, transient=100.0, samples=8, chunk=4)
+    kw = dict(values=OMEGAS, run=geardyn.RunSettings(transient=100.0, samples=8), chunk=4)
     plain = geardyn.bifurcation(GEAR, **kw)
     stored = geardyn.bifurcation(GEAR, store=tmp_path / "sweep.zarr", **kw)
     again = geardyn.bifurcation(GEAR, store=tmp_path / "sweep.zarr", **kw)
@@ -112,8 +112,8 @@ def test_resumable_sweep_equals_the_plain_sweep(tmp_path):
 
 
 # ------------------------------------------------------------------ the dataset at the root
-MAP = dict(x=("Omega", np.linspace(0.5, 3.0, 5)), y=("zeta", [0.03, 0.08]), transient=50.0,
-           samples=8, chunk=3)
+MAP = dict(x=("Omega", np.linspace(0.5, 3.0, 5)), y=("zeta", [0.03, 0.08]),
+           run=geardyn.RunSettings(transient=50.0, samples=8), chunk=3)
 
 
 def _open_quietly(path) -> xr.Dataset:
@@ -280,7 +280,8 @@ def test_killed_cli_run_resumes_to_the_uninterrupted_result(tmp_path):
     np.testing.assert_array_equal(runs[killed == 0], 2)
 
     model = build_model(load_study(study))
-    whole = geardyn.map2d(model, x=_axis(X), y=_axis(Y), transient=300.0, samples=16,
+    whole = geardyn.map2d(model, x=_axis(X), y=_axis(Y),
+                          run=geardyn.RunSettings(transient=300.0, samples=16),
                           chunk=CHUNK)
     with warnings.catch_warnings():
         warnings.simplefilter("error")

@@ -80,15 +80,17 @@ def test_transient_by_convergence_gives_up_on_chaos():
 
 
 def test_simulation_records_the_second_excitation(noisy_device):
-    ds = geardyn.simulate(noisy_device, transient=0.0, periods=1, steps_per_period=64)
+    ds = geardyn.simulate(noisy_device,
+                          run=geardyn.RunSettings(transient=0.0, samples=1, steps_per_period=64))
     assert ds.attrs["Lambda"] == 0.3
 
 
 def test_bifurcation_reports_sections_and_convergence(noisy_device):
     # Lambda = 0.3: Omega = 0.6 is commensurate (2 periods), 0.3 * sqrt(5) is not
     values = [0.6, 0.3 * math.sqrt(5)]
-    ds = geardyn.bifurcation(noisy_device, "Omega", values, transient=300.0, samples=8,
-                             converge=1e-8, transient_max=3000.0)
+    ds = geardyn.bifurcation(noisy_device, "Omega", values,
+                             run=geardyn.RunSettings(transient=300.0, samples=8, converge=1e-8,
+                                                     transient_max=3000.0))
     assert ds["section_periods"].values.tolist() == [2, 1]
     # heavily damped: the common-period orbit is period-1 in the section, 2 forcing periods;
     # the quasi-periodically forced point has no period

@@ -104,8 +104,9 @@ def _bitwise(a: tuple[np.ndarray, ...], b: tuple[np.ndarray, ...]) -> None:
 
 def test_lyapunov_lanes_keywords_warn_once_and_agree():
     """lyapunov_lanes takes run= and settings= as lyapunov does: the old keywords give bitwise
-    the same lanes, the LyapunovSettings fields with one DeprecationWarning; both is a
-    TypeError; without run, transient is 100 time units (LYAPUNOV_DEFAULTS)."""
+    the same lanes, the LyapunovSettings fields and the run fields each with one
+    DeprecationWarning; both is a TypeError; without run, transient is 100 time units
+    (LYAPUNOV_DEFAULTS)."""
     g = geardyn.GearPair(**PAIR)
     P = g.lane_params("Omega", [0.6, 1.2, 1.5])
     y0 = np.array([[0.5, 0.0], [0.5, 0.0], [1e9, 0.0]])  # the last lane diverges
@@ -116,13 +117,23 @@ def test_lyapunov_lanes_keywords_warn_once_and_agree():
         warnings.simplefilter("always")
         old = geardyn.lyapunov_lanes(g, P, y0, transient=50.0, steps_per_period=32,
                                      duration=200.0, n_blocks=4, with_status=True)
-    _one_deprecation(record, "settings=geardyn.LyapunovSettings(duration=200.0, n_blocks=4)")
+    deprecations = sorted(str(w.message) for w in record
+                          if issubclass(w.category, DeprecationWarning))
+    assert deprecations == [
+        "lyapunov_lanes(duration=, n_blocks=) is deprecated: pass "
+        "settings=geardyn.LyapunovSettings(duration=200.0, n_blocks=4)",
+        "lyapunov_lanes(transient=, steps_per_period=) is deprecated: pass "
+        "run=geardyn.RunSettings(transient=50.0, steps_per_period=32)"]
+    assert {w.filename for w in record} == {__file__}
     _bitwise(old, new)
     assert np.all(np.isfinite(new[0][:2])) and np.isnan(new[0][2])
-    with warnings.catch_warnings():
-        warnings.simplefilter("error")  # the run keywords alone: the compatibility path
+    with warnings.catch_warnings(record=True) as record:
+        warnings.simplefilter("always")  # the run keywords alone: deprecated too
         same = geardyn.lyapunov_lanes(g, P, y0, transient=50.0, steps_per_period=32,
                                       settings=ls, with_status=True)
+    _one_deprecation(record, "run=geardyn.RunSettings(transient=50.0, steps_per_period=32)")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # neither keywords nor run: no warning
         default = geardyn.lyapunov_lanes(g, P[:2], settings=ls, with_error=True)
         hundred = geardyn.lyapunov_lanes(g, P[:2], run=geardyn.RunSettings(transient=100.0),
                                          settings=ls, with_error=True)

@@ -154,7 +154,9 @@ def test_simulated_linear_oscillator_spectrum_matches_its_frequency_response():
     lam = om * 8 / periods  # sidebands on frequency bins
     u = geardyn.UserModel(modulated_oscillator, n_states=2, params=[c, m, lam, om],
                           param_names=["c", "m", "Lambda", "Omega"], state_names=["x", "v"])
-    ds = geardyn.simulate(u, transient=400.0, periods=periods, steps_per_period=256)
+    ds = geardyn.simulate(u,
+                          run=geardyn.RunSettings(transient=400.0, samples=periods,
+                                                  steps_per_period=256))
     spec = amplitude_spectrum(ds, "x", Lambda=lam)
     peaks = label_peaks(spec)
     amps = dict(zip(peaks["label"].values.tolist(), peaks["amplitude"].values, strict=True))

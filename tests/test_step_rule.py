@@ -86,7 +86,7 @@ def test_km_pq_sweep_at_the_default_step_agrees_with_dop853():
     the base model's step (what every lane got before) misses 1e-6 there."""
     omega = 2.0
     m = geardyn.CATTDevice(geardyn.PlanetaryParams.paper(), omega=omega)
-    ds = geardyn.bifurcation(m, "Km_pq", KM_PQ, transient=60.0, samples=3)
+    ds = geardyn.bifurcation(m, "Km_pq", KM_PQ, run=geardyn.RunSettings(transient=60.0, samples=3))
     stiff = m.with_params(Km_pq=KM_PQ[-1])
     n = ds["steps_per_period"].values
     assert n[-1] > n[0] and n[-1] == lane_steps_per_period(stiff, stiff.params[None])[0]

@@ -66,8 +66,9 @@ def test_lanes_equal_the_one_lane_path_bitwise():
     assert np.all(r.status == 0)
     omega = P[:, 0]
     for j in (0, 3, 7, 10):
-        ds = geardyn.simulate(model, omega=float(omega[j]), transient=float(transient[j]),
-                              periods=6, steps_per_period=int(n_per[j]))
+        ds = geardyn.simulate(model, omega=float(omega[j]),
+                              run=geardyn.RunSettings(transient=float(transient[j]), samples=6,
+                                                      steps_per_period=int(n_per[j])))
         np.testing.assert_array_equal(r.samples[j], ds["poincare"].values[1:])
 
 

@@ -57,7 +57,7 @@ def rel_diff(a, b):
 
 
 def crossings(m, x0, periods):
-    ds = geardyn.simulate(m, periods=periods, y0=x0)
+    ds = geardyn.simulate(m, run=geardyn.RunSettings(transient=0.0, samples=periods), y0=x0)
     return int(ds["edge_crossings"].sum())
 
 
@@ -133,8 +133,10 @@ def test_general_model_equals_reduced(error, omega, locate):
     m = geardyn.CATTDevice(geardyn.PlanetaryParams.paper(error=error))
     g = m.general()
     assert m.reduced and not g.reduced and g.n_states == 4 * m.n_states
-    a = geardyn.simulate(m, omega=omega, periods=100, locate_edges=locate)
-    b = geardyn.simulate(g, omega=omega, periods=100, locate_edges=locate,
+    a = geardyn.simulate(m, omega=omega,
+                         run=geardyn.RunSettings(transient=0.0, samples=100, locate_edges=locate))
+    b = geardyn.simulate(g, omega=omega,
+                         run=geardyn.RunSettings(transient=0.0, samples=100, locate_edges=locate),
                          y0=m.expand_state(m.initial_state()))
     assert a.attrs["steps_per_period"] == b.attrs["steps_per_period"]
     A = a["poincare"].values
@@ -151,8 +153,10 @@ def test_general_model_equals_reduced_with_edge_location(omega):
     does and the two agree to rounding, with no step left unresolved."""
     m = geardyn.CATTDevice(geardyn.PlanetaryParams.paper())
     g = m.general()
-    a = geardyn.simulate(m, omega=omega, periods=100)
-    b = geardyn.simulate(g, omega=omega, periods=100, y0=m.expand_state(m.initial_state()))
+    a = geardyn.simulate(m, omega=omega, run=geardyn.RunSettings(transient=0.0, samples=100))
+    b = geardyn.simulate(g, omega=omega,
+                         run=geardyn.RunSettings(transient=0.0, samples=100),
+                         y0=m.expand_state(m.initial_state()))
     A = a["poincare"].values
     B = b["poincare"].values.reshape(A.shape[0], 4, 4)
     assert np.max(np.abs(B - B[:, :1, :])) == 0.0  # the sets stay identical
@@ -240,7 +244,8 @@ def test_damped_simulation_settles_on_the_static_state(planets):
     km = np.array([p.planet_set(i)[0].mean_stiffness for i in range(p.n_planets)])
     start = m.initial_state() + 0.5
     start[1::2] = 0.0
-    ds = geardyn.simulate(m, omega=1.0, transient=3000.0, periods=1, y0=start)
+    ds = geardyn.simulate(m, omega=1.0,
+                          run=geardyn.RunSettings(transient=3000.0, samples=1), y0=start)
     mean_x_sq = ds["poincare"].values[-1, 0::4]  # no forcing: the state is constant
     expected = (F[: m.n_sets, 0] / km[: m.n_sets] + 5.0e-5) / p.b_c
     np.testing.assert_allclose(mean_x_sq, expected, rtol=1e-9)
@@ -351,8 +356,10 @@ def test_parametric_resonance_floquet_and_simulation():
     assert abs(np.prod(mu_in) - 1.0) < 1e-8  # Liouville: no damping, det = 1
 
     y0 = np.array([1e-3, 0.0, 1e-3, 0.0])
-    grow = geardyn.simulate(m, omega=inside, periods=80, y0=y0)
-    stay = geardyn.simulate(m, omega=outside, periods=80, y0=y0)
+    grow = geardyn.simulate(m, omega=inside,
+                            run=geardyn.RunSettings(transient=0.0, samples=80), y0=y0)
+    stay = geardyn.simulate(m, omega=outside,
+                            run=geardyn.RunSettings(transient=0.0, samples=80), y0=y0)
     amp_in = np.max(np.abs(grow["poincare"].values[:, [0, 2]]), axis=1)
     amp_out = np.max(np.abs(stay["poincare"].values[:, [0, 2]]), axis=1)
     assert grow.attrs["status"] == 0 and stay.attrs["status"] == 0

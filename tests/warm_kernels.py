@@ -47,9 +47,12 @@ def _warm(case: str) -> tuple[str, float]:
     omega = float(model.params[model.omega_index])
     values = np.array([omega, 1.05 * omega])
     runs = {
-        "trajectory": lambda: geardyn.simulate(model, omega=omega, periods=2, y0=y0),
-        "sweep": lambda: geardyn.bifurcation(model, "Omega", values, transient=0.0, samples=2),
-        "lyapunov": lambda: geardyn.lyapunov(model, y0=y0, transient=0.0,
+        "trajectory": lambda: geardyn.simulate(model, omega=omega,
+                                               run=geardyn.RunSettings(transient=0.0, samples=2),
+                                               y0=y0),
+        "sweep": lambda: geardyn.bifurcation(model, "Omega", values,
+                                             run=geardyn.RunSettings(transient=0.0, samples=2)),
+        "lyapunov": lambda: geardyn.lyapunov(model, y0=y0, run=geardyn.RunSettings(transient=0.0),
                                              settings=geardyn.LyapunovSettings(duration=1.0)),
         "lanes": lambda: geardyn.lyapunov_lanes(model, model.lane_params("Omega", values),
                                                 run=geardyn.RunSettings(transient=0.0),

@@ -5,7 +5,7 @@ The public API::
     import geardyn
     p = geardyn.PlanetaryParams.paper(xi1=0.05, xi2=0.05)
     m = geardyn.CATTDevice(p, interpretation="consistent")
-    ds = geardyn.simulate(m, omega=1.1, transient=4000.0, periods=64)
+    ds = geardyn.simulate(m, omega=1.1, run=geardyn.RunSettings(transient=4000.0, samples=64))
 """
 
 # _cache, then _jit_target, before anything else: the cache locator of geardyn's numba functions

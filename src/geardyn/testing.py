@@ -486,12 +486,14 @@ FAST_PERIODS_PER_RTOL = 4.0
 
 def _check_run(model: Model, y0: np.ndarray, periods: int, steps_per_period: int | None,
                rtol: float) -> str:
+    from geardyn.core.settings import RunSettings
     from geardyn.core.status import Status
     from geardyn.solvers.reference import reference_solution
     from geardyn.solvers.simulate import simulate
 
     kw = {} if model.omega_index is not None and model.omega > 0 else {"sample_interval": 1.0}
-    ds = simulate(model, periods=periods, y0=y0, steps_per_period=steps_per_period, **kw)
+    run = RunSettings(transient=0.0, samples=periods, steps_per_period=steps_per_period)
+    ds = simulate(model, run=run, y0=y0, **kw)
     if ds.attrs["status"] != Status.OK:
         raise _Broken(f"the kernel run did not end ok (status {ds.attrs['status']}: "
                       f"{ds.attrs.get('status_meaning', '')}) in {periods} periods at "

@@ -46,8 +46,8 @@ from geardyn.core.status import Status, status_attrs
 from geardyn.execution.executor import default_chunk, run_chunks
 from geardyn.solvers.ensemble import run_lanes
 
-__all__ = ["CHAOS_TOL", "CONVERGE", "DIVERGED", "MATCH_TOL", "UNRESOLVED", "basins", "grid_axis",
-           "match_cycles", "match_orbits"]
+__all__ = ["CHAOS_TOL", "CONVERGE", "DIVERGED", "MATCH_TOL", "UNRESOLVED", "basins",
+           "basins_run", "grid_axis", "match_cycles", "match_orbits"]
 
 #: Attractor id of a diverged cell.
 DIVERGED = -1
@@ -64,6 +64,18 @@ CONVERGE = 1e-8
 SAMPLES_PER_PERIOD = 2
 
 Axis = tuple[str, float, float, int] | tuple[str, Sequence[float] | np.ndarray]
+
+
+def _default_fields(max_period: Any) -> dict[str, Any]:
+    """basins' own defaults where no ``run`` is given: samples 2 max_period + 2, converge."""
+    return {"samples": SAMPLES_PER_PERIOD * int(max_period) + 2, "converge": CONVERGE}
+
+
+def basins_run(**fields: Any) -> RunSettings:
+    """The :class:`~geardyn.RunSettings` :func:`basins` uses without ``run``: ``samples``
+    2 ``max_period`` + 2 and ``converge`` :data:`CONVERGE`, then ``fields``."""
+    mp = fields.get("max_period", RunSettings().max_period)
+    return RunSettings(**{**_default_fields(mp), **fields})
 
 
 # ---------------------------------------------------------------------------- the grid
@@ -229,11 +241,13 @@ def basins(
         a state name of the model (``model.state_names``, e.g. ``"X_sq"``, ``"V_sq"`` for the
         CATT device, ``"x"``, ``"v"`` for the gear pair), in the model's state units.
     run
-        :class:`~geardyn.RunSettings` (or its fields as keywords): ``transient`` (time before the
+        :class:`~geardyn.RunSettings` (its fields as keywords: deprecated, one
+        DeprecationWarning naming the equivalent ``run=``): ``transient`` (time before the
         attractor is read), ``samples`` (default 2 ``max_period`` + 2 when not given),
         ``max_period``, ``period_tol``, ``converge`` (default :data:`CONVERGE` when ``run`` is
         not given: each lane runs on, up to ``transient_max``, until its section point
-        settles), ``steps_per_period``, ``bound``.
+        settles), ``steps_per_period``, ``bound``; :func:`basins_run` builds a run with these
+        defaults.
     base
         The other states of every initial condition (default ``model.initial_state()``).
     orbits
@@ -258,11 +272,10 @@ def basins(
     ``diverged_fraction``, ``diverged_cells``, ``unresolved_fraction`` and ``unresolved_cells``
     in ``attrs``.
     """
-    if run is None:
-        mp = int(settings.get("max_period", RunSettings().max_period))
-        settings.setdefault("samples", SAMPLES_PER_PERIOD * mp + 2)
-        settings.setdefault("converge", CONVERGE)
-    run = resolve_run(run, settings, aliases={"tol": "period_tol"})
+    defaults: dict[str, Any] = {}
+    if run is None:  # basins' own defaults of samples and converge (basins_run)
+        defaults = _default_fields(settings.get("max_period", RunSettings().max_period))
+    run = resolve_run(run, settings, defaults, aliases={"tol": "period_tol"}, where="basins")
     if model.omega_index is None:
         raise ValueError(f"{model.name} is not periodically forced: basins need a section")
     if run.samples < 2:

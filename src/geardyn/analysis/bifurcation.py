@@ -74,8 +74,9 @@ def bifurcation(
         The run settings, :class:`~geardyn.RunSettings` (default ``RunSettings()``). The old
         keyword arguments ``transient``, ``samples``, ``steps_per_period``, ``converge``,
         ``transient_max``, ``continued_transient``, ``max_period``, ``tol`` (the field
-        ``period_tol``), ``locate_edges``, ``bound`` and ``max_section_periods`` still work and
-        build it (not together with ``run``). The settings:
+        ``period_tol``), ``locate_edges``, ``bound`` and ``max_section_periods`` still build it
+        (not together with ``run``) but are deprecated: one DeprecationWarning naming the
+        equivalent ``run=geardyn.RunSettings(...)``. The settings:
     transient
         Time discarded at every point, in model time units (tau), rounded up to whole periods
         (whole common periods when a second excitation is commensurate with Omega).
@@ -131,12 +132,14 @@ def bifurcation(
     ``force_peak``, ``force_rms``, ``dynamic_factor`` (param, mesh), ``status``,
     ``final_time`` (param: the model time of the final state, the last Poincare point), and
     ``lyapunov`` with its standard error ``lyapunov_err`` and ``lyapunov_unresolved`` (param:
-    its steps at the edge-split limit) when asked: started from each
-    point's final state at its final time, so both forcing phases continue (see
+    its steps at the edge-split limit) when asked: with the run's step, ``locate_edges`` and
+    ``bound``, started from each point's final state at its final time (after at most
+    :data:`LYAPUNOV_ALIGN` time units aligning the tangent vector), so both forcing phases
+    continue (see
     ``docs/lyapunov.md``), and then ``motion`` (param: the motion class of
     :func:`geardyn.analysis.motion.motion_classes`).
     """
-    run = resolve_run(run, settings, aliases=ALIASES)
+    run = resolve_run(run, settings, aliases=ALIASES, where="bifurcation")
     values = _check_values(values)
     if continuation not in (None, "up", "down"):
         raise ValueError(f"continuation must be None, 'up' or 'down' (got {continuation!r})")
@@ -171,8 +174,8 @@ def bifurcation(
         final = last.final
         start = np.where(np.isfinite(final), final, np.broadcast_to(base_y0, final.shape))
         asked = run.samples * _mean_period(model, P)  # averaging time asked for
-        align = RunSettings(transient=min(run.transient, LYAPUNOV_ALIGN),
-                            steps_per_period=run.steps_per_period)
+        # the sweep's own run (step, locate_edges, bound), with the short aligning transient
+        align = run.replace(transient=min(run.transient, LYAPUNOV_ALIGN))
         exps, errs, unres, _ = lyapunov_lanes(model, P, start, align,
                                               settings=LyapunovSettings(duration=asked),
                                               t0=last.final_time, with_status=True)
@@ -200,7 +203,8 @@ class ContinuedSweep:
 
     ``run``: the sweep's own :class:`~geardyn.RunSettings`, whose transients (``transient``,
     ``continued_transient``, ``transient_max``) and ``steps_per_period`` the sweep uses, as
-    :func:`bifurcation` does; or, for compatibility, those four as keyword arguments (not both).
+    :func:`bifurcation` does; or those four as keyword arguments (not both; deprecated, one
+    DeprecationWarning naming the equivalent ``run=``).
     After construction ``run`` holds the validated settings and the four fields their values."""
 
     model: Model
@@ -217,7 +221,8 @@ class ContinuedSweep:
 
     def __post_init__(self) -> None:
         legacy = {k: getattr(self, k) for k in _SWEEP_FIELDS if getattr(self, k) is not None}
-        run = resolve_run(self.run, legacy)
+        # stacklevel: the caller of the dataclass's __init__
+        run = resolve_run(self.run, legacy, where="ContinuedSweep", stacklevel=4)
         object.__setattr__(self, "run", run)
         for k in _SWEEP_FIELDS:
             object.__setattr__(self, k, getattr(run, k))
@@ -241,8 +246,9 @@ def continued_sweeps(
     run one group after another. ``run``: the :class:`~geardyn.RunSettings` shared by the
     sweeps (samples, converge, max_period, period_tol, locate_edges, bound,
     max_section_periods; each sweep's transients and step come from the sweep), or the old
-    keyword arguments of those (``tol`` for period_tol)."""
-    run = resolve_run(run, settings, aliases=ALIASES)
+    keyword arguments of those (``tol`` for period_tol; deprecated, one DeprecationWarning
+    naming the equivalent ``run=``)."""
+    run = resolve_run(run, settings, aliases=ALIASES, where="continued_sweeps")
     return [ds for ds, _ in _continued(sweeps, run, progress)]
 
 

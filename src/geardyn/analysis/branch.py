@@ -63,7 +63,8 @@ from geardyn.analysis.orbits import (
     ShootingProblem,
     default_guess,
     newton_shooting,
-    shooting_problem,
+    orbit_steps,
+    problem_with_steps,
 )
 from geardyn.core.model import Model
 from geardyn.core.plan import default_steps_per_period
@@ -200,9 +201,9 @@ class _Tracer:
                  max_iter: int):
         self.model, self.param, self.period = model, param, int(period)
         self.pscale = pscale
-        self.fixed_steps = steps_per_period or (run.steps_per_period if run else None)
+        self.fixed_steps = steps_per_period  # resolved with the run (orbit_steps)
         self.tol, self.max_iter = tol, max_iter
-        self.base = shooting_problem(model, None, period, run, self.fixed_steps or None)
+        self.base = problem_with_steps(model, None, period, run, self.fixed_steps)
         self.scale = self.base.scale
         self.n = self.base.steps_per_period
         self._cache: dict[float, np.ndarray] = {}
@@ -877,8 +878,9 @@ def continuation(model: Model, param: str = "Omega", start: float | None = None,
         function of the :class:`BifurcationPoint` saying whether to; recursively (a cascade) while
         2k <= ``settings.max_period``.
     steps_per_period
-        RK4 steps per forcing period, fixed (default: :data:`BRANCH_STEP_FACTOR` times the step
-        rule, re-derived along the branch).
+        RK4 steps per forcing period, fixed, of a call without ``run`` (with ``run``, give
+        ``run.steps_per_period``: both together are a TypeError naming both values); default
+        :data:`BRANCH_STEP_FACTOR` times the step rule, re-derived along the branch.
     progress
         Called as ``progress(points, value)`` after each accepted point.
 
@@ -888,6 +890,7 @@ def continuation(model: Model, param: str = "Omega", start: float | None = None,
     ``branch_status`` and ``branch_message`` naming the parameter value, keeping its points.
     """
     cs = resolve_settings(ContinuationSettings, settings, legacy, "continuation")
+    steps_per_period = orbit_steps(run, steps_per_period, "continuation")
     if start is None:  # a coefficient's current value (a KeyError naming the known ones)
         start = float(model.params[model._param_index(param)])
     if stop is None:

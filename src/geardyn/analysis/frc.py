@@ -202,7 +202,7 @@ def frequency_response(
     run
         :class:`~geardyn.RunSettings` of the sweeps (``transient`` of the first point,
         ``continued_transient``, ``converge``, ``samples``, ``steps_per_period``, ...), or its
-        fields as keywords.
+        fields as keywords (deprecated, one DeprecationWarning naming the equivalent ``run=``).
     jump_tol, band_tol
         Relative thresholds of a jump and of the hysteresis band (see the module docs).
     progress
@@ -220,7 +220,8 @@ def frequency_response(
     ``input_speed`` [rpm] along ``Omega`` where the model has physical units; ``resolution``
     (the largest grid step) and the settings in ``attrs``.
     """
-    run = resolve_run(run, settings, aliases={"tol": "period_tol"})
+    run = resolve_run(run, settings, aliases={"tol": "period_tol"},
+                      where="frequency_response")
     om = np.sort(np.asarray(omega, dtype=float).ravel())
     if om.size < 2 or not np.all(np.isfinite(om) & (om > 0)):
         raise ValueError("omega: give at least 2 positive finite forcing frequencies")

@@ -46,7 +46,7 @@ DEFAULT_BLOCKS = LYAPUNOV_BLOCKS
 
 #: Defaults of :func:`lyapunov` where they differ from :class:`~geardyn.RunSettings`'.
 LYAPUNOV_DEFAULTS = {"transient": 100.0}
-#: The :class:`~geardyn.RunSettings` fields that :func:`lyapunov` uses (also as keywords).
+#: The :class:`~geardyn.RunSettings` fields that :func:`lyapunov` uses (as keywords: deprecated).
 LYAPUNOV_FIELDS = ("transient", "steps_per_period", "locate_edges", "bound")
 
 __all__ = ["DEFAULT_BLOCKS", "DEFAULT_DT", "DEFAULT_RENORM_EVERY", "LYAPUNOV_DEFAULTS",
@@ -145,7 +145,7 @@ def _lyapunov_run(run: RunSettings | None, settings: LyapunovSettings | None,
                         f"settings it uses: {', '.join(LYAPUNOV_FIELDS)})")
     legacy = {k: v for k, v in keywords.items() if k in SETTINGS_FIELDS}
     given = {k: v for k, v in keywords.items() if k in LYAPUNOV_FIELDS}
-    return (resolve_run(run, given, LYAPUNOV_DEFAULTS),
+    return (resolve_run(run, given, LYAPUNOV_DEFAULTS, where=where, stacklevel=4),
             resolve_settings(LyapunovSettings, settings, legacy, where, stacklevel=4))
 
 
@@ -167,9 +167,10 @@ def lyapunov(
     run
         The run settings, :class:`~geardyn.RunSettings`; of its fields ``transient``,
         ``steps_per_period``, ``locate_edges`` and ``bound`` are used (the measuring window is
-        ``duration``, not ``samples``). For compatibility those four may be given as keyword
-        arguments instead (not together with ``run``); without either, ``transient`` is 100
-        time units (not RunSettings' 4000) and the rest RunSettings' defaults.
+        ``duration``, not ``samples``). Those four as keyword arguments instead (not together
+        with ``run``) are deprecated: one DeprecationWarning naming the equivalent
+        ``run=geardyn.RunSettings(...)``. Without either, ``transient`` is 100 time units (not
+        RunSettings' 4000) and the rest RunSettings' defaults.
     y0
         Initial state (default: ``model.initial_state()``), at time ``t0``.
     t0
@@ -288,7 +289,7 @@ def lyapunov_lanes(
     ``y0``: one initial state for all lanes, or one per lane (lanes x n_states); default
     ``model.initial_state()``. ``run`` and ``settings`` as in :func:`lyapunov`: of the
     :class:`~geardyn.RunSettings` ``transient``, ``steps_per_period``, ``locate_edges`` and
-    ``bound`` are used (also as keyword arguments, not together with ``run``; without either,
+    ``bound`` are used (as keyword arguments, not together with ``run``: deprecated; without either,
     ``transient`` is 100 time units), of the :class:`~geardyn.LyapunovSettings` ``duration``,
     ``dt``, ``renorm_every`` and ``n_blocks`` (its fields as keyword arguments: deprecated, a
     DeprecationWarning). ``transient`` and ``duration`` are times, rounded up to whole forcing

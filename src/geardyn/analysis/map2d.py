@@ -135,11 +135,13 @@ def map2d(
         :class:`~geardyn.RunSettings`, as for :func:`~geardyn.bifurcation` (independent
         starts from each point's own initial state; ``samples`` >= 2), or its fields as the
         old keyword arguments (``transient``, ``samples``, ``steps_per_period``,
-        ``max_period``, ``tol``, ``locate_edges``, ``bound``, ...).
+        ``max_period``, ``tol``, ``locate_edges``, ``bound``, ...; deprecated, one
+        DeprecationWarning naming the equivalent ``run=``).
     lyapunov
         Also compute the largest Lyapunov exponent per point (over ``samples`` mean forcing
-        periods, on a grid of ``steps_per_period`` steps, default each point's own step rule),
-        from the point's final state at its final time, with its standard error
+        periods, with the run's ``transient``, ``locate_edges``, ``bound`` and grid of
+        ``steps_per_period`` steps, default each point's own step rule), from the point's
+        final state at its final time, with its standard error
         (``lyapunov_err``) and the motion class (``motion``, see :mod:`geardyn.analysis.motion`).
     client
         A ``dask.distributed.Client``: chunks run as tasks on its cluster. The result is bitwise
@@ -162,7 +164,7 @@ def map2d(
     counts, and ``lyapunov`` and ``lyapunov_err`` when asked; the settings in ``attrs``
     (``x``, ``y``, ...).
     """
-    run = resolve_run(run, settings, aliases={"tol": "period_tol"})
+    run = resolve_run(run, settings, aliases={"tol": "period_tol"}, where="map2d")
     transient, samples, steps_per_period = run.transient, run.samples, run.steps_per_period
     xn, xv = _axis(x, "x")
     yn, yv = _axis(y, "y")
@@ -180,10 +182,9 @@ def map2d(
     if lyapunov:
         omega = P[:, model.omega_index]
         duration = float(samples * np.mean(forcing_period(omega)))
-        # each lane's own step (lyapunov_lanes: the step rule on the lane's coefficients)
-        lyap = dict(run=RunSettings(transient=transient, steps_per_period=steps_per_period,
-                                    bound=run.bound),
-                    settings=LyapunovSettings(duration=duration))
+        # the map's own run (transient, step, locate_edges, bound); without a step, each
+        # lane's own (lyapunov_lanes: the step rule on the lane's coefficients)
+        lyap = dict(run=run, settings=LyapunovSettings(duration=duration))
     task = functools.partial(_map_task, run=run, lyapunov=lyap)
     size = int(chunk) if chunk else default_chunk(P.shape[0])
     meta = {"analysis": "map2d", "model": model.name, "x": xn, "y": yn}

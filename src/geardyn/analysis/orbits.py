@@ -212,13 +212,38 @@ class ShootingProblem:
         return ShootingEval(x.copy(), end, M, Y, np.asarray(nc), Status(int(st)), int(unres))
 
 
+def orbit_steps(run: RunSettings | None, steps_per_period: int | None, where: str
+                ) -> int | None:
+    """The fixed step of an orbit analysis (None: its default): ``run.steps_per_period``, or
+    the keyword ``steps_per_period`` of a call without ``run`` (the run-less defaults of the
+    guess have no RunSettings equivalent, so the keyword stays for that call). Both together
+    raise a TypeError naming both values, as
+    :func:`~geardyn.core.settings.resolve_run` refuses ``run=`` beside a run keyword."""
+    if not steps_per_period:
+        return None if run is None else run.steps_per_period
+    if run is not None:
+        raise TypeError(f"{where}: give the step either as run=RunSettings(steps_per_period="
+                        f"...) or as steps_per_period=, not both (got run.steps_per_period="
+                        f"{run.steps_per_period!r} and steps_per_period={steps_per_period!r})")
+    return steps_per_period
+
+
 def shooting_problem(model: Model, omega: float | None = None, period: int = 1,
                      run: RunSettings | None = None, steps_per_period: int | None = None
                      ) -> ShootingProblem:
     """The :class:`ShootingProblem` of ``model`` at ``omega`` (default the model's): period-k
     orbits of the section map (the common period of the forcings where there are two,
-    :func:`geardyn.core.plan.lane_section`), ``steps_per_period`` (default ``run``'s, else
+    :func:`geardyn.core.plan.lane_section`), with ``run.steps_per_period`` or, without
+    ``run``, ``steps_per_period`` (not both, see :func:`orbit_steps`; default
     :data:`ORBIT_STEP_FACTOR` times the step rule)."""
+    steps = orbit_steps(run, steps_per_period, "shooting_problem")
+    return problem_with_steps(model, omega, period, run, steps)
+
+
+def problem_with_steps(model: Model, omega: float | None, period: int,
+                       run: RunSettings | None, steps: int | None) -> ShootingProblem:
+    """:func:`shooting_problem` with the step already resolved (``steps``; None: the
+    default), the rest (bound, section limit) from ``run``."""
     if omega is not None:
         model = model.with_omega(float(omega))
     om = model.omega
@@ -232,7 +257,7 @@ def shooting_problem(model: Model, omega: float | None = None, period: int = 1,
     if not commensurate[0]:
         raise ValueError(f"{model.name} at Omega={om:g}: the forcings have no common period "
                          f"(quasi-periodic forcing), so there is no periodic orbit to find")
-    n = steps_per_period or (run.steps_per_period if run is not None else None)
+    n = steps
     if n is None:
         n = ORBIT_STEP_FACTOR * default_steps_per_period(model, om)
     bound = DEFAULT_BOUND if run is None else run.bound
@@ -638,14 +663,16 @@ def periodic_orbit(model: Model, omega: float | None = None, period: int = 1,
         relative to ``1 + abs(x)``) and most iterations ``max_iter``. Its fields given as
         keyword arguments are deprecated (a DeprecationWarning).
     steps_per_period
-        RK4 steps per forcing period (default ``run``'s, else :data:`ORBIT_STEP_FACTOR` times
-        the step rule).
+        RK4 steps per forcing period of a call without ``run`` (with ``run``, give
+        ``run.steps_per_period``: both together are a TypeError naming both values); default
+        :data:`ORBIT_STEP_FACTOR` times the step rule.
 
     Returns a :class:`PeriodicOrbit`. A Newton that does not converge is not an exception:
     ``status``/``message`` say what happened and the last iterate is kept.
     """
     newton = resolve_settings(NewtonSettings, settings, legacy, "periodic_orbit")
-    problem = shooting_problem(model, omega, period, run, steps_per_period)
+    steps = orbit_steps(run, steps_per_period, "periodic_orbit")
+    problem = problem_with_steps(model, omega, period, run, steps)
     if guess is None:
         guess = default_guess(problem, transient=None if run is None else run.transient,
                               converge=None if run is None else run.converge,

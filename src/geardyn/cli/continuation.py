@@ -271,9 +271,10 @@ def continue_command(
     t0 = time.perf_counter()
     with _continue_bar(show_bar, escape(f"{s.study.name}: period-{period} branch"), name,
                        start, stop) as callback:
+        # the step: in the run where there is one (it holds spp), else the keyword
         ds = continuation(model, name, start, stop, period=period, run=run, switch=switch,
-                          settings=cset,
-                          steps_per_period=spp, progress=callback)
+                          settings=cset, steps_per_period=spp if run is None else None,
+                          progress=callback)
     elapsed = time.perf_counter() - t0
 
     def draw(path: Path) -> None:

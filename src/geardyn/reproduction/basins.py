@@ -68,7 +68,7 @@ def case_basins(case: Case, interpretation: str, ds: xr.Dataset, n: int,
     ``ds`` on an ``n`` x ``n`` grid (None where the sweeps never disagree while periodic);
     ``transient``: the least transient (default the case's), each cell running on until its
     section point settles (to 1e-8) or ten times that."""
-    from geardyn.analysis.basins import basins
+    from geardyn.analysis.basins import basins, basins_run
     from geardyn.analysis.orbits import periodic_orbit
     from geardyn.study import build_model
 
@@ -87,7 +87,7 @@ def case_basins(case: Case, interpretation: str, ds: xr.Dataset, n: int,
                              guess=at["poincare"].values[s, -1])
               for s in range(ds.sizes["sweep"])]
     out = basins(model, om, (state, *_axis(pts[:, 0], n)), (vel, *_axis(pts[:, 1], n)),
-                 transient=tr, transient_max=10 * tr, orbits=orbits)
+                 run=basins_run(transient=tr, transient_max=10 * tr), orbits=orbits)
     out.attrs.update(case=str(ds.attrs.get("case", case.name)), interpretation=interpretation,
                      study=f"{ds.attrs.get('figure', case.figure)} ({interpretation})",
                      sweeps=", ".join(str(s) for s in ds["sweep"].values),

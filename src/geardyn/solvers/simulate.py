@@ -46,8 +46,10 @@ def simulate(
         :class:`~geardyn.RunSettings`: ``transient`` (time discarded first, in the model's time
         unit, rounded up to whole forcing periods), ``samples`` (forcing periods recorded),
         ``steps_per_period`` (default :func:`default_steps_per_period`), ``locate_edges``,
-        ``bound``. Or, as before, the keywords ``transient`` (default 0), ``periods`` (the
-        samples, default 64), ``steps_per_period``, ``locate_edges`` and ``bound``.
+        ``bound``. Without ``run``: transient 0 and 64 periods. The keywords ``transient``,
+        ``periods`` (the samples), ``steps_per_period``, ``locate_edges`` and ``bound`` still
+        build it but are deprecated (one DeprecationWarning naming the equivalent
+        ``run=geardyn.RunSettings(...)``, these defaults included).
     record_every
         Record every n-th grid point (must divide ``steps_per_period``).
     sample_interval
@@ -59,7 +61,8 @@ def simulate(
     observable (mesh forces) over ``time``; ``poincare`` (sample, state), the states once per
     forcing period; ``status`` (:class:`~geardyn.Status`). Attributes record the settings.
     """
-    run = resolve_run(run, settings, SIMULATE_DEFAULTS, aliases={"periods": "samples"})
+    run = resolve_run(run, settings, SIMULATE_DEFAULTS, aliases={"periods": "samples"},
+                      where="simulate")
     transient, periods, bound = run.transient, run.samples, run.bound
     locate_edges = run.locate_edges
     if omega is not None:
