@@ -87,7 +87,7 @@ kernels.kernels_for(model.kernel)
 helpers = list(compile_share._STARTED.values())
 for proc in helpers:
     proc.wait()
-geardyn.simulate(model, omega=1.2, periods=3, y0=[1.0, 0.0])
+geardyn.simulate(model, omega=1.2, run=geardyn.RunSettings(samples=3), y0=[1.0, 0.0])
 core = kernels.kernels_for(model.kernel, "core")
 stats = core._split_step.stats
 print(json.dumps({"helpers": len(helpers), "codes": [p.returncode for p in helpers],
