@@ -1,7 +1,8 @@
 """The generated kernel source of every built-in model, for every kernel template: it parses,
-keeps no template marker or template binding, imports the model's own functions (and nothing
-else from geardyn), and its kernel runs: the RK4 kernel's ``trajectory`` matches the reference
-integrator, and the Lyapunov kernel's exponents sum to the divergence of the vector field."""
+keeps no template marker or template binding, imports the model's own functions (and from
+geardyn nothing else but the modules every model shares), and its kernel runs: the RK4
+kernel's ``trajectory`` matches the reference integrator, and the Lyapunov kernel's exponents
+sum to the divergence of the vector field."""
 
 from __future__ import annotations
 
@@ -15,12 +16,14 @@ import pytest
 from conformance_cases import IDS, cases
 from geardyn.core.plan import default_steps_per_period
 from geardyn.core.settings import DEFAULT_BOUND
-from geardyn.solvers.kernels import TEMPLATES, cache_dir, kernels_for
+from geardyn.solvers.kernels import SHARED_MODULES, TEMPLATES, cache_dir, kernels_for
 from geardyn.solvers.reference import reference_solution
 
-#: Modules a generated kernel may import besides the model's own.
+#: Modules a generated kernel may import besides the model's own (the shared modules: kernel
+#: code that does not evaluate the model, compiled once for every model).
 _ALLOWED = {"__future__", "math", "numba", "numpy", "llvmlite", "geardyn.core._noop",
-            "geardyn.core.kernel_source", "geardyn.core.one_form", "geardyn.solvers._parallel"}
+            "geardyn.core.kernel_source", "geardyn.core.one_form", "geardyn.solvers._parallel",
+            *SHARED_MODULES}
 #: Packages whose submodules a generated kernel may import too (numba.extending, numba.core:
 #: the sweep template's prefetch intrinsic).
 _ALLOWED_PACKAGES = {"numba", "llvmlite"}
