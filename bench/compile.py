@@ -18,7 +18,7 @@ that the process's CPU seconds are the whole compile.
                                       [--json F] [--write]
 
 ``--primer CASE`` runs that case first on each empty cache, so that a model's figure is its own
-compile with the shared step core (compiled once for every model) already cached.
+compile with the shared modules (compiled once for every model) already cached.
 
 ``--write`` replaces the ``compile-*`` rows of bench/RESULTS.md's current-figures table
 (``--from-json F``: those of an earlier run's ``--json F``, without measuring again). Cold
@@ -144,7 +144,7 @@ def run_child(case: str, cache: str) -> dict:
 def measure(case: str, primer: str | None = None) -> tuple[dict, dict]:
     """(cold, warm) rows of ``case``: a process on an empty cache, then one on the filled one.
     With ``primer`` (another case), a process running that case first fills the cache with what
-    every model shares (the shared step core), so that ``cold`` is the model's own compile."""
+    every model shares (the shared modules), so that ``cold`` is the model's own compile."""
     with tempfile.TemporaryDirectory(prefix="geardyn-compile-") as cache:
         if primer is not None:
             run_child(primer, cache)
@@ -187,7 +187,7 @@ def record(case: str, cold: dict, warm: dict, primer: str | None = None) -> None
     if primer is None:
         key, what, flag = f"compile-{case}", "empty cache", ""
     else:
-        key, what, flag = (f"compile-{case}-own", f"shared core cached (by {primer})",
+        key, what, flag = (f"compile-{case}-own", f"shared modules cached (by {primer})",
                            f" --primer {primer}")
     results.record(
         key, f"first use of every analysis, {what}: <= {target:.0f} s CPU",
@@ -207,7 +207,7 @@ def main(argv: list[str] | None = None) -> int:
                     help="report (and --write) the rows of an earlier run's --json instead")
     ap.add_argument("--primer", default=None,
                     help="a case run first on the empty cache (its figures discarded), so that "
-                         "each model's figure is its own compile with the shared core cached")
+                         "each model's figure is its own compile with the shared modules cached")
     ap.add_argument("--child", default=None, help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
     if args.child:

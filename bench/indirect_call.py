@@ -1,19 +1,22 @@
 """Design measurement: a model-independent step core that calls the model through a pointer.
 
-Today every model compiles its own copy of the step machinery (the split step, the sweep's
-block loop, the Lyapunov and monodromy kernels) with the model's functions inlined: ~35 s of
-numba per model on a 2-core machine, most of it the same machinery again. The alternative
-measured here: the machinery compiled once (cached, for every model) and the model's part
-compiled alone as ``numba.cfunc`` functions called through their address, which travels as an
-integer argument (so the cached core holds no process-specific address).
+Every model compiles its own copy of the step machinery that evaluates it (the split step, the
+sweep's block loop, the Lyapunov and monodromy kernels) with the model's functions inlined
+(``bench/compile.py``: most of a model's compile). The alternative measured here: the machinery
+compiled once (cached, for every model) and the model's part compiled alone as ``numba.cfunc``
+functions called through their address, which travels as an integer argument (so the cached core
+holds no process-specific address).
 
-Three measurements, each on the gear pair's equations (2 states, dead zone, forced stiffness),
+Two measurements, each on the gear pair's equations (2 states, dead zone, forced stiffness),
 the model inlined into the loop against the model called through its pointer:
 
 * ``fused``: the sweep's fused trial step over a block of slots (state in registers, slots
   innermost), one call per grid step for the whole block;
-* ``stages``: the structure-of-arrays RK4, one call per stage for the block;
-* ``scalar``: one lane's RK4 with one call per stage (the split path's granularity).
+* ``stages``: the structure-of-arrays RK4, one call per stage for the block.
+
+At the granularity of one lane (the split step's calls of the model) the pointer costs much
+more: the split step compiled once with the model called so (commit 12f11bb) made a located
+crossing 1.47x (gear pair) to 1.67x (reduced CATT) dearer, ``bench/crossing.py --old``.
 
 Both sides compute the same arithmetic; the results must be bitwise equal (printed). The last
 lines time the cold compile of the model's part alone and check that the core, compiled in this
@@ -42,8 +45,6 @@ import _results as results  # noqa: E402
 F8P = types.CPointer(types.float64)
 #: The model's block function: (Y, Y1 or DY, P, leading dimension, slots, S, C, h) -> None.
 BLOCK_SIG = types.void(F8P, F8P, F8P, types.intp, types.intp, F8P, F8P, types.float64)
-#: The model's scalar function: (t, y, dy, p, s, c) -> None.
-SCALAR_SIG = types.void(types.float64, F8P, F8P, F8P, types.float64, types.float64)
 
 
 def _data(context, builder, ty, value):
@@ -66,25 +67,6 @@ def call_block(typingctx, addr, Y, OUT, P, nl, S, C, h):
                      [_data(context, builder, ty[1], y), _data(context, builder, ty[2], out),
                       _data(context, builder, ty[3], p), ld, n,
                       _data(context, builder, ty[5], s), _data(context, builder, ty[6], c), hh])
-        return context.get_dummy_value()
-
-    return sig, codegen
-
-
-@intrinsic
-def call_scalar(typingctx, addr, t, y, dy, p, s, c):
-    """Call the scalar function at address ``addr`` (int64)."""
-    sig = types.void(addr, t, y, dy, p, s, c)
-
-    def codegen(context, builder, signature, args):
-        a, tt, y, dy, p, s, c = args
-        ty = signature.args
-        d = ir.DoubleType()
-        fnty = ir.FunctionType(ir.VoidType(), [d, d.as_pointer(), d.as_pointer(),
-                                               d.as_pointer(), d, d])
-        builder.call(builder.inttoptr(a, fnty.as_pointer()),
-                     [tt, _data(context, builder, ty[2], y), _data(context, builder, ty[3], dy),
-                      _data(context, builder, ty[4], p), s, c])
         return context.get_dummy_value()
 
     return sig, codegen
@@ -121,11 +103,6 @@ def _stage(Y, DY, P, nl, S, C):
                                   S[k], C[k])
 
 
-@nb.njit(inline="always")
-def _scalar(t, y, dy, p, s, c):
-    dy[0], dy[1] = _rhs(y[0], y[1], p[0], p[1], p[2], p[3], s, c)
-
-
 def _model_part():
     """The model's compiled part (cfuncs), and the seconds its cold compile took."""
     t0 = time.process_time()
@@ -140,11 +117,8 @@ def _model_part():
         _stage(carray(y, (2, ld)), carray(dy, (2, ld)), carray(p, (4, ld)), nl, carray(s, ld),
                carray(c, ld))
 
-    @nb.cfunc(SCALAR_SIG, boundscheck=False, error_model="numpy")
-    def scalar(t, y, dy, p, s, c):
-        _scalar(t, carray(y, 2), carray(dy, 2), carray(p, 4), s, c)
 
-    return (trial, stage, scalar), time.process_time() - t0
+    return (trial, stage), time.process_time() - t0
 
 
 # ----------------------------------------------------------------------------- the loops
@@ -196,36 +170,6 @@ def _stage_loop(stage):
     return run
 
 
-def _scalar_loop(rhs):
-    @nb.njit(boundscheck=False)
-    def run(Y, P, h, n, addr):
-        ns, nl = Y.shape
-        y = np.empty(ns)
-        tmp = np.empty(ns)
-        p = np.empty(P.shape[0])
-        K = np.empty((4, ns))
-        for k in range(nl):
-            for q in range(ns):
-                y[q] = Y[q, k]
-            for j in range(P.shape[0]):
-                p[j] = P[j, k]
-            for i in range(n):
-                s = ST[(i + k) & 1023]
-                c = CT[(i + k) & 1023]
-                for st in range(4):
-                    rhs(addr, 0.0, y if st == 0 else tmp, K[st], p, s, c)
-                    if st == 3:
-                        break
-                    w = h if st == 2 else 0.5 * h
-                    for q in range(ns):
-                        tmp[q] = y[q] + w * K[st, q]
-                for q in range(ns):
-                    y[q] += h / 6 * (K[0, q] + 2 * K[1, q] + 2 * K[2, q] + K[3, q])
-            for q in range(ns):
-                Y[q, k] = y[q]
-    return run
-
-
 @nb.njit(inline="always")
 def _fused_inline(addr, Y, Y1, P, nl, S, C, h):
     _trial(Y, Y1, P, nl, S, C, h)
@@ -236,15 +180,9 @@ def _stage_inline(addr, Y, DY, P, nl, S, C, h):
     _stage(Y, DY, P, nl, S, C)
 
 
-@nb.njit(inline="always")
-def _scalar_inline(addr, t, y, dy, p, s, c):
-    _scalar(t, y, dy, p, s, c)
-
-
 LOOPS = {
     "fused": (_fused_loop(_fused_inline), _fused_loop(call_block), 0),
     "stages": (_stage_loop(_stage_inline), _stage_loop(call_block), 1),
-    "scalar": (_scalar_loop(_scalar_inline), _scalar_loop(call_scalar), 2),
 }
 
 
@@ -280,18 +218,18 @@ def main(argv: list[str] | None = None) -> int:
         ratios[name] = ns_ind / ns_in
         print(f"{name:7s} inlined {ns_in:6.2f} ns/lane-step   through the pointer {ns_ind:6.2f}"
               f"   ratio {ns_ind / ns_in:5.3f}   bitwise equal: {np.array_equal(y_in, y_ind)}")
-    (trial2, _, _), _ = _model_part()  # a second model's part: new addresses
+    (trial2, _), _ = _model_part()  # a second model's part: new addresses
     before = len(LOOPS["fused"][1].signatures)
     _time(LOOPS["fused"][1], Y0, P, 2, trial2.address, 1)
     reused = len(LOOPS["fused"][1].signatures) == before
-    print(f"model part (3 cfuncs) cold compile: {model_compile:.2f} s CPU; "
+    print(f"model part (2 cfuncs) cold compile: {model_compile:.2f} s CPU; "
           f"core reused for a second model without a compile: {reused}")
     if args.write:
         results.record(
             "indirect-call",
             "design: model called through a pointer from a shared core, fused block <= 1.05x",
-            f"fused block {ratios['fused']:.3f}x, SoA stages {ratios['stages']:.3f}x, one lane "
-            f"(split-path granularity) {ratios['scalar']:.3f}x of the inlined loop "
+            f"fused block {ratios['fused']:.3f}x, SoA stages {ratios['stages']:.3f}x of the "
+            f"inlined loop "
             f"({nl} slots, median of {args.repeat}); model part compiles in "
             f"{model_compile:.1f} s CPU; core reused: {reused}",
             "met" if ratios["fused"] <= 1.05 else "over",
