@@ -31,8 +31,7 @@ from __future__ import annotations
 
 import copy
 import functools
-from collections.abc import Callable, Mapping, Sequence
-from types import MappingProxyType
+from collections.abc import Sequence
 
 import numpy as np
 
@@ -139,12 +138,6 @@ class Model:
     kernel: KernelSource
     #: Meshes with a backlash dead zone: (name, index of event X - b, index of event X + b).
     meshes: tuple[tuple[str, int, int], ...] = ()
-    #: Derived coefficients that carry their function in the declaration (``Coefficient(...,
-    #: derive=math.cos)``): name -> (the parameter it follows, the function of its value), as
-    #: ``coefficient_layout.derivations()`` gives them; :meth:`with_params` and
-    #: :meth:`lane_params` refill them from the layout (:meth:`CoefficientLayout.fill_derived
-    #: <geardyn.core.coefficients.CoefficientLayout.fill_derived>`).
-    derived: Mapping[str, tuple[str, Callable[[float], float]]] = MappingProxyType({})
     #: Omega is one entry of ``params`` and no other coefficient depends on it, so a lane's
     #: Omega may be set by writing that entry; False where Omega moves other coefficients (set
     #: it through ``lane_params``/``with_params``).
