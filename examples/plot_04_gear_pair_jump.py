@@ -36,8 +36,8 @@ from geardyn import ContinuedSweep  # noqa: E402
 
 omegas = np.linspace(0.6, 1.2, 61)
 run = geardyn.RunSettings(transient=300.0, samples=8)
-up, down = geardyn.continued_sweeps(  # each sweep's transients come from its own run
-    [ContinuedSweep(pair, "Omega", omegas, d, run=run) for d in ("up", "down")], run)
+up, down = geardyn.continued_sweeps(  # sweeps without a run of their own take this one
+    [ContinuedSweep(pair, "Omega", omegas, d) for d in ("up", "down")], run)
 for name, ds in (("up", up), ("down", down)):
     x = ds["poincare"].sel(state="x").isel(sample=-1).values
     print(f"{name:>4}: section x at Omega = 0.8: {x[np.argmin(abs(omegas - 0.8))]:.3f}")

@@ -248,6 +248,21 @@ def test_continued_sweep_takes_run_settings(device):
         geardyn.ContinuedSweep(device, "Omega", [0.8], transient=-1.0)
 
 
+def test_continued_sweeps_shared_run_reaches_sweeps_without_their_own(device):
+    """A sweep made without a run takes its transients and step from continued_sweeps' run
+    (bitwise bifurcation's continuation with that run), and a sweep's own run differing in a
+    shared field is a TypeError naming both values."""
+    run = RunSettings(transient=60.0, continued_transient=20.0, samples=3,
+                      steps_per_period=48)
+    (ds,) = geardyn.continued_sweeps([geardyn.ContinuedSweep(device, "Omega", [0.8, 1.0])], run)
+    alone = geardyn.bifurcation(device, "Omega", [0.8, 1.0], run, continuation="up")
+    xr.testing.assert_identical(ds, alone)
+    assert (ds.attrs["transient"], ds.attrs["continued_transient"]) == (60.0, 20.0)
+    own = geardyn.ContinuedSweep(device, "Omega", [0.8], run=run.replace(samples=4))
+    with pytest.raises(TypeError, match=r"samples=4 \(the sweep's run\) and samples=3"):
+        geardyn.continued_sweeps([own], run)
+
+
 def test_study_run_table_builds_run_settings():
     from geardyn.io import builtin_study
 

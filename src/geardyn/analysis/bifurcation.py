@@ -5,7 +5,7 @@ from __future__ import annotations
 import functools
 import os
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 from typing import Any
 
 import numpy as np
@@ -204,8 +204,13 @@ class ContinuedSweep:
     ``run``: the sweep's own :class:`~geardyn.RunSettings`, whose transients (``transient``,
     ``continued_transient``, ``transient_max``) and ``steps_per_period`` the sweep uses, as
     :func:`bifurcation` does; or those four as keyword arguments (not both; deprecated, one
-    DeprecationWarning naming the equivalent ``run=``).
-    After construction ``run`` holds the validated settings and the four fields their values."""
+    DeprecationWarning naming the equivalent ``run=``). The other fields of a ``run`` are
+    those of the run given to :func:`continued_sweeps`: one left at its default takes that
+    run's value, one set otherwise must equal it (else TypeError naming both). None (and no
+    keywords): the sweep takes its transients and step from the run given to
+    :func:`continued_sweeps`.
+    After construction ``run`` holds the validated settings and the four fields their values,
+    or all five are None (the shared run applies)."""
 
     model: Model
     param: str
@@ -221,6 +226,8 @@ class ContinuedSweep:
 
     def __post_init__(self) -> None:
         legacy = {k: getattr(self, k) for k in _SWEEP_FIELDS if getattr(self, k) is not None}
+        if self.run is None and not legacy:
+            return  # the run given to continued_sweeps applies
         # stacklevel: the caller of the dataclass's __init__
         run = resolve_run(self.run, legacy, where="ContinuedSweep", stacklevel=4)
         object.__setattr__(self, "run", run)
@@ -245,16 +252,39 @@ def continued_sweeps(
     :mod:`geardyn.analysis.continuation`). Sweeps whose models compile to different kernels
     run one group after another. ``run``: the :class:`~geardyn.RunSettings` shared by the
     sweeps (samples, converge, max_period, period_tol, locate_edges, bound,
-    max_section_periods; each sweep's transients and step come from the sweep), or the old
-    keyword arguments of those (``tol`` for period_tol; deprecated, one DeprecationWarning
-    naming the equivalent ``run=``)."""
+    max_section_periods, and the transients and step of every sweep made without a run of
+    its own), or the old keyword arguments of those (``tol`` for period_tol; deprecated, one
+    DeprecationWarning naming the equivalent ``run=``). A sweep made with its own run takes
+    its transients (``transient``, ``continued_transient``, ``transient_max``) and
+    ``steps_per_period`` from it; any other field of it set to other than its default and
+    ``run``'s value is a TypeError naming both values. Each dataset records the settings it
+    ran with in its attributes."""
     run = resolve_run(run, settings, aliases=ALIASES, where="continued_sweeps")
     return [ds for ds, _ in _continued(sweeps, run, progress)]
 
 
+def shared_settings(run: RunSettings) -> tuple[tuple[str, Any], ...]:
+    """The fields of ``run`` that the sweeps of one :func:`continued_sweeps` call share (all
+    but each sweep's transients and step), as (name, value) pairs."""
+    return tuple((f.name, getattr(run, f.name)) for f in fields(RunSettings)
+                 if f.name not in _SWEEP_FIELDS)
+
+
 def _sweep_run(sw: ContinuedSweep, run: RunSettings) -> RunSettings:
-    """The shared ``run`` with the transients and step of the sweep ``sw``."""
-    assert sw.run is not None  # set by ContinuedSweep
+    """The shared ``run`` with the transients and step of the sweep ``sw`` where it has a run
+    of its own. Raises TypeError naming both values where the sweep's run sets a shared field
+    (one the sweep cannot set) to other than its default and ``run``'s value."""
+    if sw.run is None:
+        return run
+    default = dict(shared_settings(RunSettings()))
+    clash = [f"{name}={own!r} (the sweep's run) and {name}={shared!r} (continued_sweeps' run)"
+             for (name, own), (_, shared) in zip(shared_settings(sw.run), shared_settings(run),
+                                                 strict=True)
+             if own != default[name] and own != shared]
+    if clash:
+        raise TypeError("a ContinuedSweep's run sets its transients and step; its other "
+                        "settings are continued_sweeps' run's, so not both: got "
+                        + "; ".join(clash))
     return run.replace(**{k: getattr(sw.run, k) for k in _SWEEP_FIELDS})
 
 

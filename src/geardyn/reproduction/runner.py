@@ -16,7 +16,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 import xarray as xr
 
-from geardyn.analysis.bifurcation import ContinuedSweep, continued_sweeps
+from geardyn.analysis.bifurcation import ContinuedSweep, continued_sweeps, shared_settings
 from geardyn.analysis.lyapunov import lyapunov_err_attrs, lyapunov_lanes
 from geardyn.analysis.motion import LYAPUNOV_FLOOR, LYAPUNOV_Z, exponent_sign, rule_text
 from geardyn.core.model import Model
@@ -182,9 +182,10 @@ def _sweeps(tasks: list[tuple[Case, str, str]], settings: ReproductionSettings,
             progress(label, done, total)
 
     swept: list[xr.Dataset] = [xr.Dataset()] * len(tasks)
-    groups: dict[int, list[int]] = {}  # one continuation per number of samples
+    # one continuation per set of shared settings (all but each sweep's transients and step)
+    groups: dict[tuple, list[int]] = {}
     for i, (_, _r, run) in enumerate(plans):
-        groups.setdefault(run.samples, []).append(i)
+        groups.setdefault(shared_settings(run), []).append(i)
     for members in groups.values():
         done = continued_sweeps([plans[i][0] for i in members], plans[members[0]][2],
                                 progress=tick)
