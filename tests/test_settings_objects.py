@@ -92,6 +92,13 @@ def test_lyapunov_keywords_warn_once_and_agree():
         old = geardyn.lyapunov(g, run=run, duration=200.0, n_blocks=4)
     _one_deprecation(record, "settings=geardyn.LyapunovSettings(duration=200.0, n_blocks=4)")
     assert old == new
+    with warnings.catch_warnings(record=True) as record:
+        warnings.simplefilter("always")  # run and Lyapunov keywords: one warning naming both
+        both = geardyn.lyapunov(g, transient=50.0, duration=200.0, n_blocks=4)
+    _one_deprecation(record, "lyapunov(transient=, duration=, n_blocks=) is deprecated: pass "
+                     "run=geardyn.RunSettings(transient=50.0), "
+                     "settings=geardyn.LyapunovSettings(duration=200.0, n_blocks=4)")
+    assert both == new
     with pytest.raises(TypeError, match="unexpected keyword argument 'durations'"):
         geardyn.lyapunov(g, run=run, durations=200.0)
 
@@ -119,11 +126,10 @@ def test_lyapunov_lanes_keywords_warn_once_and_agree():
                                      duration=200.0, n_blocks=4, with_status=True)
     deprecations = sorted(str(w.message) for w in record
                           if issubclass(w.category, DeprecationWarning))
-    assert deprecations == [
-        "lyapunov_lanes(duration=, n_blocks=) is deprecated: pass "
-        "settings=geardyn.LyapunovSettings(duration=200.0, n_blocks=4)",
-        "lyapunov_lanes(transient=, steps_per_period=) is deprecated: pass "
-        "run=geardyn.RunSettings(transient=50.0, steps_per_period=32)"]
+    assert deprecations == [  # one warning naming both replacements
+        "lyapunov_lanes(transient=, steps_per_period=, duration=, n_blocks=) is deprecated: "
+        "pass run=geardyn.RunSettings(transient=50.0, steps_per_period=32), "
+        "settings=geardyn.LyapunovSettings(duration=200.0, n_blocks=4)"]
     assert {w.filename for w in record} == {__file__}
     _bitwise(old, new)
     assert np.all(np.isfinite(new[0][:2])) and np.isnan(new[0][2])

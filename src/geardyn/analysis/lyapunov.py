@@ -32,8 +32,10 @@ from geardyn.core.settings import (
     MIN_STEPS,
     LyapunovSettings,
     RunSettings,
+    replacement,
     resolve_run,
     resolve_settings,
+    warn_deprecated,
 )
 from geardyn.core.status import Status
 from geardyn.solvers.kernels import kernels_for
@@ -138,15 +140,23 @@ def _lyapunov_run(run: RunSettings | None, settings: LyapunovSettings | None,
     """The run and Lyapunov settings of :func:`lyapunov` and :func:`lyapunov_lanes` (``where``:
     the function's name): ``run``, or the run keywords (``transient``, ``steps_per_period``,
     ``locate_edges``, ``bound``) on :data:`LYAPUNOV_DEFAULTS`, and ``settings`` (its fields as
-    keywords: deprecated, one DeprecationWarning pointing at the public function's caller)."""
+    keywords: deprecated, one DeprecationWarning pointing at the public function's caller,
+    naming both replacements where both kinds of keywords are given)."""
     extra = sorted(set(keywords) - set(LYAPUNOV_FIELDS) - set(SETTINGS_FIELDS))
     if extra:
         raise TypeError(f"{where}() got an unexpected keyword argument {extra[0]!r} (run "
                         f"settings it uses: {', '.join(LYAPUNOV_FIELDS)})")
     legacy = {k: v for k, v in keywords.items() if k in SETTINGS_FIELDS}
     given = {k: v for k, v in keywords.items() if k in LYAPUNOV_FIELDS}
-    return (resolve_run(run, given, LYAPUNOV_DEFAULTS, where=where, stacklevel=4),
-            resolve_settings(LyapunovSettings, settings, legacy, where, stacklevel=4))
+    if not (legacy and given):
+        return (resolve_run(run, given, LYAPUNOV_DEFAULTS, where=where, stacklevel=4),
+                resolve_settings(LyapunovSettings, settings, legacy, where, stacklevel=4))
+    out = (resolve_run(run, given, LYAPUNOV_DEFAULTS),  # where=None: no warning of its own
+           resolve_settings(LyapunovSettings, settings, legacy, where, warn=False))
+    warn_deprecated(where, [*given, *legacy],
+                    [replacement("run", RunSettings, {**LYAPUNOV_DEFAULTS, **given}),
+                     replacement("settings", LyapunovSettings, legacy)], stacklevel=3)
+    return out
 
 
 def lyapunov(

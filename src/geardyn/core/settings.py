@@ -10,7 +10,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import numbers
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -214,13 +214,25 @@ def resolve_run(run: RunSettings | None, legacy: Mapping[str, Any],
     fields = {**dict(defaults or {}), **given}
     out = RunSettings(**fields)
     if where is not None and given:
-        import warnings
-
-        args = ", ".join(f"{k}={v!r}" for k, v in fields.items())
-        warnings.warn(f"{where}({', '.join(f'{k}=' for k in legacy)}) is deprecated: pass "
-                      f"run=geardyn.RunSettings({args})", DeprecationWarning,
-                      stacklevel=stacklevel)
+        warn_deprecated(where, legacy, [replacement("run", RunSettings, fields)], stacklevel)
     return out
+
+
+def replacement(param: str, kind: type, fields: Mapping[str, Any]) -> str:
+    """The text ``param=geardyn.Kind(a=1, ...)`` naming the settings that replace keywords."""
+    args = ", ".join(f"{k}={v!r}" for k, v in fields.items())
+    return f"{param}=geardyn.{kind.__name__}({args})"
+
+
+def warn_deprecated(where: str, keywords: Iterable[str], replacements: Sequence[str],
+                    stacklevel: int) -> None:
+    """One DeprecationWarning: ``where``'s ``keywords`` are deprecated, pass the
+    ``replacements`` (``stacklevel``: the public function's caller, seen from the caller of
+    this function)."""
+    import warnings
+
+    warnings.warn(f"{where}({', '.join(f'{k}=' for k in keywords)}) is deprecated: pass "
+                  f"{', '.join(replacements)}", DeprecationWarning, stacklevel=stacklevel + 1)
 
 
 # ----------------------------------------------------------------------------- analyses
@@ -365,11 +377,11 @@ class LyapunovSettings(_AnalysisSettings):
 
 
 def resolve_settings(kind: type, settings: Any, legacy: Mapping[str, Any], where: str,
-                     stacklevel: int = 3) -> Any:
+                     stacklevel: int = 3, warn: bool = True) -> Any:
     """The ``kind`` settings of a public function that takes ``settings=`` and, for one
     deprecation cycle, their fields as keyword arguments (``legacy``: those given): one
     DeprecationWarning naming the replacement (``stacklevel``: the public function's caller,
-    seen from here); giving both is a TypeError."""
+    seen from here; ``warn`` False: the caller warns); giving both is a TypeError."""
     if settings is not None and not isinstance(settings, kind):
         raise TypeError(f"settings must be a {kind.__name__} (got {type(settings).__name__})")
     if not legacy:
@@ -377,10 +389,7 @@ def resolve_settings(kind: type, settings: Any, legacy: Mapping[str, Any], where
     if settings is not None:
         raise TypeError(f"{where}: give settings={kind.__name__}(...) or keyword arguments, "
                         f"not both (got settings= and {next(iter(legacy))}=)")
-    import warnings
-
-    args = ", ".join(f"{k}={v!r}" for k, v in legacy.items())
-    warnings.warn(f"{where}({', '.join(f'{k}=' for k in legacy)}) is deprecated: pass "
-                  f"settings=geardyn.{kind.__name__}({args})", DeprecationWarning,
-                  stacklevel=stacklevel)
-    return kind(**legacy)
+    out = kind(**legacy)
+    if warn:
+        warn_deprecated(where, legacy, [replacement("settings", kind, legacy)], stacklevel)
+    return out
