@@ -448,3 +448,44 @@ def test_default_steps_at_every_omega_is_the_one_run_rule():
         model = build_model(case.study, interpretation="as-printed")
         expected = [default_steps_per_period(model, float(w)) for w in omegas]
         assert list(default_steps_at(model, omegas)) == expected
+
+
+def test_branch_lyapunov_takes_the_sweeps_run(monkeypatch):
+    """The reproduction's Lyapunov exponents run with the sweep's locate_edges and bound
+    (bitwise lyapunov_lanes with that run), and _classify hands the sweep's run on."""
+    import geardyn
+    from geardyn.core.settings import LyapunovSettings, RunSettings
+    from geardyn.reproduction import runner
+
+    g = geardyn.GearPair(zeta=0.05, Fm=0.1, Fa=0.05)
+    values = np.array([0.9, 1.1])
+    y0 = np.array([[0.5, 0.0], [0.5, 0.0]])
+    run = RunSettings(locate_edges=False, bound=50.0)
+    lam, _ = runner.branch_lyapunov(g, values, y0, np.ones(2, bool), 20.0, 100.0, 32, 0.0,
+                                    run=run)
+    want = geardyn.lyapunov_lanes(g, g.lane_params("Omega", values), y0,
+                                  run.replace(transient=20.0, steps_per_period=32),
+                                  settings=LyapunovSettings(duration=100.0), t0=np.zeros(2),
+                                  with_error=True)[0]
+    assert lam.tobytes() == want.tobytes()
+    located = runner.branch_lyapunov(g, values, y0, np.ones(2, bool), 20.0, 100.0, 32, 0.0)[0]
+    assert located.tobytes() != lam.tobytes()  # locate_edges matters here
+
+    class Stop(Exception):
+        pass
+
+    seen: dict = {}
+
+    def capture(*args, **kwargs):
+        seen.update(kwargs)
+        raise Stop
+
+    ds = xr.Dataset({"period": ("Omega", [0]), "poincare": (("Omega", "sample", "state"),
+                                                            np.zeros((1, 1, 2))),
+                     "final_time": ("Omega", [0.0])})
+    sweep = geardyn.ContinuedSweep(g, "Omega", [1.0], run=run)
+    r = {"lyapunov_screen": 10.0, "lyapunov_duration": 10.0, "lyapunov_transient": 5.0}
+    monkeypatch.setattr(runner, "branch_lyapunov", capture)
+    with pytest.raises(Stop):
+        runner._classify(ds, sweep, r)
+    assert seen["run"] is sweep.run

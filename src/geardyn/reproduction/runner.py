@@ -127,11 +127,13 @@ def sweep_values(case: Case, settings: ReproductionSettings) -> np.ndarray:
 def branch_lyapunov(model: Model, values: np.ndarray, y0: np.ndarray, need: np.ndarray,
                     transient: float, duration: float,
                     steps_per_period: int | None = None,
-                    t0: np.ndarray | float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+                    t0: np.ndarray | float = 0.0,
+                    run: RunSettings | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Largest Lyapunov exponent [1/tau] and its standard error at the Omega ``values`` where
     ``need`` is true, each started from its own state ``y0[i]`` at its own time ``t0[i]`` (the
     sweep's final time, so both forcing phases continue); NaN elsewhere, and where the
-    integration diverged.
+    integration diverged. ``run``: the sweep's settings, whose ``locate_edges`` and ``bound``
+    apply (None: RunSettings' defaults); ``transient`` and the step are the arguments'.
 
     Lanes are grouped by their default step count (within a factor 1.25) so that a low Omega
     does not impose its fine step on the whole sweep; each group runs in parallel."""
@@ -150,11 +152,12 @@ def branch_lyapunov(model: Model, values: np.ndarray, y0: np.ndarray, need: np.n
         if not groups or steps[groups[-1][0]] > 1.25 * steps[j] or len(groups[-1]) >= 64:
             groups.append([])
         groups[-1].append(j)
+    base = RunSettings() if run is None else run
     for g in groups:
         lanes = idx[g]
         out[lanes], err[lanes] = lyapunov_lanes(
             model, model.lane_params("Omega", values[lanes]), np.asarray(y0)[lanes],
-            RunSettings(transient=transient, steps_per_period=int(max(steps[g]))),
+            base.replace(transient=transient, steps_per_period=int(max(steps[g]))),
             settings=LyapunovSettings(duration=duration), t0=t0[lanes], with_error=True)
     return out, np.where(np.isfinite(out), err, np.nan)
 
@@ -210,13 +213,14 @@ def _classify(ds: xr.Dataset, sweep: ContinuedSweep, r: dict) -> xr.Dataset:
     need = period == 0
     screen = min(r["lyapunov_screen"], r["lyapunov_duration"])
     lam, err = branch_lyapunov(model, values, final, need, r["lyapunov_transient"], screen,
-                               sweep.steps_per_period, t_final)
+                               sweep.steps_per_period, t_final, run=sweep.run)
     duration = np.full(lam.shape, screen)
     rule = {"z": r["lyapunov_z"], "floor": r["lyapunov_floor"]}
     again = need & ~(exponent_sign(lam, err, duration, **rule) < 0)
     if r["lyapunov_screen"] < r["lyapunov_duration"] and again.any():
         lam2, err2 = branch_lyapunov(model, values, final, again, r["lyapunov_transient"],
-                                     r["lyapunov_duration"], sweep.steps_per_period, t_final)
+                                     r["lyapunov_duration"], sweep.steps_per_period, t_final,
+                                     run=sweep.run)
         lam[again], err[again] = lam2[again], err2[again]
         duration[again] = r["lyapunov_duration"]
     ds["lyapunov"] = ("Omega", lam, {
