@@ -27,6 +27,7 @@ from geardyn.gears.potential_energy import (
     tooth_compliances,
     tooth_model,
 )
+from geardyn.gears.tip_relief import TipRelief, loaded_contact, relief_gap
 from geardyn.gears.waveform import StiffnessWaveform, double_contact_centre, mesh_stiffness_waveform
 
 __all__ = [
@@ -38,6 +39,7 @@ __all__ = [
     "RootCrack",
     "SpurGear",
     "StiffnessWaveform",
+    "TipRelief",
     "ToothModel",
     "coast_phase",
     "double_contact_centre",
@@ -46,10 +48,12 @@ __all__ = [
     "involute",
     "inverse_involute",
     "iso6336_stiffness",
+    "loaded_contact",
     "mesh_phases",
     "mesh_stiffness_waveform",
     "potential_energy_stiffness",
     "prepare_pair",
+    "relief_gap",
     "sun_ring_phase",
     "surviving_harmonics",
     "tooth_compliances",
