@@ -430,3 +430,89 @@ def test_bad_cracks_name_the_field(mesh: GearMesh, crack, field: str) -> None:
     with pytest.raises(ParameterError) as info:
         potential_energy_stiffness(mesh, bore_radius=BORES, crack=crack())
     assert info.value.field == field
+
+
+# -- the coast (back) flank --------------------------------------------------------------------
+
+
+def _inv(a: float) -> float:
+    return math.tan(a) - a
+
+
+def _pitch_thickness_fraction(z1: int, z2: int, x1: float, x2: float,
+                              a: float) -> tuple[float, float]:
+    """(s_w1 / p_w1, j / p_w1) at centre distance ``a`` from the textbook thickness formula
+    s_w = d_w (s / d + inv alpha - inv alpha_w), s = m (pi/2 + 2 x tan alpha)."""
+    r1, r2 = M * z1 / 2.0, M * z2 / 2.0
+    a_w = math.acos((r1 + r2) * math.cos(ALPHA) / a)
+    rw1, rw2 = r1 * math.cos(ALPHA) / math.cos(a_w), r2 * math.cos(ALPHA) / math.cos(a_w)
+
+    def s_w(r: float, rw: float, x: float) -> float:
+        s = M * (math.pi / 2.0 + 2.0 * x * math.tan(ALPHA))
+        return 2.0 * rw * (s / (2.0 * r) + _inv(ALPHA) - _inv(a_w))
+
+    p_w1 = 2.0 * math.pi * rw1 / z1
+    t1, t2 = s_w(r1, rw1, x1), s_w(r2, rw2, x2)  # arcs of the rolling circles
+    return t1 / p_w1, (p_w1 - t1 - t2) / p_w1
+
+
+@pytest.mark.parametrize("shift, extra", [((0.0, 0.0), 0.0), ((0.3, -0.1), 0.0),
+                                          ((0.2, 0.1), 2e-4)])
+def test_coast_stiffness_is_the_drive_stiffness_mirrored(shift: tuple[float, float],
+                                                         extra: float) -> None:
+    """K_coast(c) = K_drive(phi - c), phi = s_w1 / p_w1 from the thickness formula here
+    (1/2 for unshifted teeth without backlash), for zero and nonzero backlash."""
+    p = SpurGear(Z1, M, ALPHA, B, profile_shift=shift[0], name="pinion")
+    w = SpurGear(Z2, M, ALPHA, B, profile_shift=shift[1], name="wheel")
+    a0 = GearMesh(p, w).centre_distance
+    mesh = GearMesh(p, w, centre_distance=a0 + extra)
+    phi, j = _pitch_thickness_fraction(Z1, Z2, *shift, a0 + extra)
+    if shift == (0.0, 0.0):
+        assert phi == pytest.approx(0.5, abs=1e-12)
+    c = (np.arange(97) + 0.3183) / 97.0 * 3.0  # off the contact boundaries
+    deg = 360.0 / Z1
+    coast = potential_energy_stiffness(mesh, bore_radius=BORES, angles=c * deg)
+    drive = potential_energy_stiffness(mesh, bore_radius=BORES, angles=(phi - c) * deg)
+    assert coast.attrs["coast_phase_cycles"] == pytest.approx(phi, abs=1e-12)
+    assert coast.attrs["backlash_cycles"] == pytest.approx(j, abs=1e-12)
+    assert (extra == 0.0) == (abs(j) < 1e-12)
+    np.testing.assert_allclose(coast.mesh_stiffness_coast.values,
+                               drive.mesh_stiffness.values, rtol=1e-12)
+    np.testing.assert_array_equal(coast.pairs_in_contact_coast.values,
+                                  drive.pairs_in_contact.values)
+    assert coast.mesh_stiffness_coast.attrs["units"] == "N/m"
+    # not the drive side itself: the phase matters
+    assert not np.allclose(coast.mesh_stiffness_coast.values, coast.mesh_stiffness.values)
+
+
+def test_coast_teeth_and_contact_follow_the_flanks(mesh: GearMesh) -> None:
+    """Pinion tooth j's coast flank passes the pitch point phi + j cycles after angle 0 (its
+    contact there at position 0). Wheel tooth i's drive flank passes it at cycle i, its coast
+    flank s_w2 / p_w cycles earlier: the wheel tooth there is i = phi + j + s_w2 / p_w. A coast
+    contact moves towards the pinion root as the pinion turns."""
+    ds = potential_energy_stiffness(mesh, bore_radius=BORES, angles=40, cycles=Z1 + 2)
+    phi, j_b = _pitch_thickness_fraction(Z1, Z2, 0.0, 0.0, mesh.centre_distance)
+    for j in (0, 3, Z1 - 1):
+        c = phi + j
+        wheel_tooth = round(c + (1.0 - phi - j_b)) % Z2
+        i = int(np.argmin(np.abs(ds.cycle.values - c)))
+        sel = ds.isel(angle=i)
+        at = np.flatnonzero(np.abs(sel.position_coast.values) < 1e-12)
+        assert at.size == 1
+        assert int(sel.tooth_pinion_coast.values[at[0]]) == j
+        assert int(sel.tooth_wheel_coast.values[at[0]]) == wheel_tooth
+        assert bool(sel.in_contact_coast.values[at[0]])
+    d = ds.isel(angle=slice(0, 2))
+    moved = d.position_coast.values[1] - d.position_coast.values[0]
+    np.testing.assert_allclose(moved, -mesh.base_pitch / 40.0, rtol=1e-9)
+
+
+def test_coast_crack_is_felt_by_the_cracked_tooth_only(mesh: GearMesh) -> None:
+    crack = RootCrack(depth=2e-3, gear="pinion", tooth=2)
+    ds = potential_energy_stiffness(mesh, bore_radius=BORES, angles=24, cycles=Z1, crack=crack)
+    healthy = potential_energy_stiffness(mesh, bore_radius=BORES, angles=24, cycles=Z1)
+    hit = (ds.in_contact_coast & (ds.tooth_pinion_coast == 2)).any("pair_coast").values
+    k, k0 = ds.mesh_stiffness_coast.values, healthy.mesh_stiffness_coast.values
+    assert hit.any()
+    assert np.all(k[hit] < k0[hit])
+    np.testing.assert_array_equal(k[~hit], k0[~hit])

@@ -20,12 +20,14 @@ from geardyn.gears.potential_energy import (
     PotentialEnergyPair,
     RootCrack,
     ToothModel,
+    coast_phase,
     hertz_stiffness,
     potential_energy_stiffness,
     prepare_pair,
     tooth_compliances,
     tooth_model,
 )
+from geardyn.gears.tip_relief import TipRelief, loaded_contact, relief_gap
 from geardyn.gears.waveform import StiffnessWaveform, double_contact_centre, mesh_stiffness_waveform
 
 __all__ = [
@@ -37,17 +39,21 @@ __all__ = [
     "RootCrack",
     "SpurGear",
     "StiffnessWaveform",
+    "TipRelief",
     "ToothModel",
+    "coast_phase",
     "double_contact_centre",
     "equally_spaced",
     "hertz_stiffness",
     "involute",
     "inverse_involute",
     "iso6336_stiffness",
+    "loaded_contact",
     "mesh_phases",
     "mesh_stiffness_waveform",
     "potential_energy_stiffness",
     "prepare_pair",
+    "relief_gap",
     "sun_ring_phase",
     "surviving_harmonics",
     "tooth_compliances",

@@ -50,6 +50,14 @@ materials is load-independent, k_h = pi E b / (4 (1 - nu^2)) (Yang & Lin 1987). 
 and the mesh stiffness is the sum over the pairs in contact (pairs act in parallel, load
 sharing by equal deflection). External pairs only; b is the smaller face width.
 
+The coast (back) flanks of symmetric teeth mesh on the mirror image of the line of action
+(Guo & Parker 2014, back-side contact): a coast contact at the same distance from the pitch point
+loads both teeth at the same load angles, so the coast pair stiffness is the drive one at that
+position; the coast contacts travel the path of contact backwards, and a pinion tooth's coast
+flank passes the pitch point phi = s_w1 / p_w1 mesh cycles after its drive flank (see
+:func:`coast_phase`), so K_coast(c) = K_drive(phi - c) in mesh cycles c of the pinion, each
+flank taken in its own contact (the relative rotation between the two is the backlash).
+
 A :class:`RootCrack` on one tooth narrows the sections below Tian's crack limit line (see
 :func:`tooth_compliances`); the tooth indices of each pair follow the pitch-point passages.
 """
@@ -476,7 +484,46 @@ def _cycle_grid(mesh: GearMesh, angles: object,
 
 def _units(name: str) -> str:
     unitless = ("pairs_in_contact", "in_contact", "tooth_pinion", "tooth_wheel")
-    return "" if name in unitless else "N/m"
+    return "" if name.removesuffix("_coast") in unitless else "N/m"
+
+
+def coast_phase(mesh: GearMesh) -> float:
+    """phi [mesh cycles]: the pinion rotation, in mesh cycles, from the passage of a pinion
+    tooth's drive flank through the pitch point to that of its coast flank, s_w1 / p_w1 (the
+    tooth thickness over the pitch on the operating pitch circle; 1/2 for unshifted teeth at
+    the zero-backlash centre distance)."""
+    r_w1 = mesh.operating_pitch_radii[0]
+    return mesh.pinion.angular_thickness(r_w1) * mesh.pinion.teeth / (2.0 * math.pi)
+
+
+def _coast(pair: PotentialEnergyPair, n: np.ndarray, frac: np.ndarray,
+           crack: RootCrack | None) -> tuple[dict[str, tuple], np.ndarray]:
+    """The coast-flank variables (``*_coast``) over the grid, and the coast pair indices.
+
+    Coast pair k' holds the pinion tooth whose coast flank passed the pitch point k' mesh cycles
+    before the start of cycle n, (n - k') mod z1, against wheel tooth (n - k' + 1) mod z2 (the
+    wheel tooth behind it); its contact lies (phi - frac - k') p_b from the pitch point towards
+    the pinion tip on the coast line of action and moves towards the pinion root. A pair is in
+    contact from the end of the path (included) to its start (excluded)."""
+    mesh = pair.mesh
+    p_b, phi = mesh.base_pitch, coast_phase(mesh)
+    start, end = -mesh.approach_length / p_b, mesh.recess_length / p_b
+    ks = np.arange(math.floor(phi - end), math.ceil(phi - start) + 1)
+    u = phi - frac[:, None] - ks[None, :]
+    inside = (u > start) & (u <= end)
+    position = u * p_b
+    passage = n.astype(np.int64)[:, None] - ks[None, :]
+    tooth_p, tooth_w = passage % mesh.pinion.teeth, (passage + 1) % mesh.wheel.teeth
+    faulty = None
+    if crack is not None:
+        faulty = inside & ((tooth_p if crack.gear == "pinion" else tooth_w) == crack.tooth)
+    k_pair = np.where(inside, _terms_on_grid(pair, position, inside, faulty)["pair"], 0.0)
+    dims = ("angle", "pair_coast")
+    return {"mesh_stiffness_coast": (("angle",), k_pair.sum(axis=1)),
+            "pairs_in_contact_coast": (("angle",), inside.sum(axis=1)),
+            "in_contact_coast": (dims, inside), "position_coast": (dims, position),
+            "tooth_pinion_coast": (dims, tooth_p), "tooth_wheel_coast": (dims, tooth_w),
+            "pair_stiffness_coast": (dims, k_pair)}, ks
 
 
 def potential_energy_stiffness(mesh: GearMesh, *, bore_radius: object, angles: object = 360,
@@ -500,6 +547,15 @@ def potential_energy_stiffness(mesh: GearMesh, *, bore_radius: object, angles: o
     (pinion, wheel); ``young`` [Pa], ``poisson``; ``nodes``: Gauss-Legendre nodes. ``crack``:
     a :class:`RootCrack` on one tooth (see :func:`tooth_compliances`); a pinion tooth returns
     every z1 mesh cycles, a wheel tooth every z2 (the hunting period: lcm(z1, z2) cycles).
+
+    The coast flank: ``mesh_stiffness_coast`` [N/m], ``pairs_in_contact_coast`` and per coast
+    pair (dimension ``pair_coast``) ``in_contact_coast``, ``position_coast`` [m] (on the coast
+    line of action from the pitch point, positive towards the pinion tip),
+    ``tooth_pinion_coast``, ``tooth_wheel_coast``, ``pair_stiffness_coast`` [N/m], at the same
+    pinion angles with the pinion turned onto its coast flanks (see ``_coast``); attrs
+    ``coast_phase_cycles`` (phi), ``backlash_m`` and ``backlash_cycles`` (j / p_w1, the dead
+    zone between the flanks). A crack narrows the cracked tooth's sections under either flank's
+    load (its faces taken open).
     """
     pair = prepare_pair(mesh, bore_radius=bore_radius, young=young, poisson=poisson,
                         root_segment=root_segment, nodes=nodes, crack=crack)
@@ -518,6 +574,7 @@ def potential_energy_stiffness(mesh: GearMesh, *, bore_radius: object, angles: o
         faulty = inside & ((tooth_p if crack.gear == "pinion" else tooth_w) == crack.tooth)
     terms = _terms_on_grid(pair, position, inside, faulty)
     k_pair = np.where(inside, terms.pop("pair"), 0.0)
+    coast, ks_c = _coast(pair, n, frac, crack)
     data = {"mesh_stiffness": (("angle",), k_pair.sum(axis=1)),
             "pairs_in_contact": (("angle",), inside.sum(axis=1)),
             "in_contact": (("angle", "pair"), inside),
@@ -527,9 +584,11 @@ def potential_energy_stiffness(mesh: GearMesh, *, bore_radius: object, angles: o
             "pair_stiffness": (("angle", "pair"), k_pair)}
     for name, k in terms.items():
         data[f"k_{name}"] = (("angle", "pair"), np.where(inside, k, np.nan))
-    ds = xr.Dataset(data, coords={"angle": deg, "cycle": ("angle", cyc), "pair": ks})
+    data.update(coast)
+    ds = xr.Dataset(data, coords={"angle": deg, "cycle": ("angle", cyc), "pair": ks,
+                                  "pair_coast": ks_c})
     for name in ds.data_vars:
-        ds[name].attrs["units"] = "m" if name == "position" else _units(name)
+        ds[name].attrs["units"] = "m" if name.startswith("position") else _units(name)
     ds["angle"].attrs.update(units="deg", long_name="pinion rotation")
     ds["cycle"].attrs.update(units="", long_name="mesh cycles")
     ds.attrs.update(_attrs(pair, root_segment))
@@ -563,6 +622,9 @@ def _attrs(pair: PotentialEnergyPair, root_segment: bool) -> dict[str, object]:
         "young_Pa": pair.young, "poisson": pair.poisson, "face_width_m": pair.face_width,
         "hertz_stiffness_N_per_m": pair.hertz, "contact_ratio": mesh.contact_ratio,
         "base_pitch_m": mesh.base_pitch, "quadrature_nodes": pair.nodes,
+        "coast_phase_cycles": coast_phase(mesh), "backlash_m": mesh.backlash,
+        "backlash_cycles": mesh.backlash / (2.0 * math.pi * mesh.operating_pitch_radii[0]
+                                            / mesh.pinion.teeth),
         "crack": "none" if pair.crack is None else (
             f"root crack on {pair.crack.gear} tooth {pair.crack.tooth}: depth"
             f" {pair.crack.depth:.6g} m, angle {math.degrees(pair.crack.angle):.6g} deg"
