@@ -77,3 +77,20 @@ def test_make_does_not_move_the_cache():
          'show-cache-env: ; @echo "[$$GEARDYN_CACHE_DIR][$$NUMBA_CACHE_DIR]"', "show-cache-env"],
         cwd=ROOT, env=env, capture_output=True, text=True, timeout=60, check=True)
     assert out.stdout.strip() == "[][]"
+
+
+def test_a_shared_modules_edit_renames_every_generated_kernel(tmp_path, monkeypatch):
+    """numba's cache of a generated module holds the compiled code of the shared modules it
+    imports and checks only the generated file: an edit of a shared module must give every
+    generated module a new name (a new file, compiled anew), not load the old code."""
+    from geardyn.solvers import kernels
+
+    shared = tmp_path / "geardyn_fake_shared.py"
+    shared.write_text("X = 1\n")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    monkeypatch.setattr(kernels, "SHARED_MODULES", (*kernels.SHARED_MODULES,
+                                                    "geardyn_fake_shared"))
+    before = kernels._source_digest("text", {})
+    assert kernels._source_digest("text", {}) == before
+    shared.write_text("X = 2\n")
+    assert kernels._source_digest("text", {}) != before

@@ -8,10 +8,12 @@ from __future__ import annotations
 
 import math
 
+import numba as nb
 import numpy as np
 import pytest
 
 import geardyn
+from geardyn.solvers._step_shared import phase_table, phase_table_values
 
 K_PERIODS = 10
 
@@ -109,14 +111,28 @@ def test_phase_table_by_rotation_stays_within_a_few_ulp_of_the_exact_phase(n_per
     """The forcing-phase table is built by the rotations the fused step loop applies on the fly
     (phase_rotate); against sin and cos in extended precision, its drift over a period stays
     below 1e-14 (libm's own table: ~7e-16), and the period's end is exactly (0, 1)."""
-    from geardyn.solvers.kernels import kernels_for
-
-    k = kernels_for(geardyn.CATTDevice(geardyn.PlanetaryParams.paper()).kernel)
-    s, c = k.phase_table(n_per, True)
+    s, c = phase_table_values(n_per, True)
     pi = np.longdouble("3.14159265358979323846264338327950288")
     a = pi * np.arange(2 * n_per + 1, dtype=np.longdouble) / n_per
     err = max(np.max(np.abs(s - np.sin(a))), np.max(np.abs(c - np.cos(a))))
     assert err < 1e-14
     assert (s[0], c[0], s[-1], c[-1]) == (0.0, 1.0, 0.0, 1.0)
-    s0, c0 = k.phase_table(n_per, False)
+    s0, c0 = phase_table_values(n_per, False)
     assert np.all(s0 == 0.0) and np.all(c0 == 1.0)
+
+
+@nb.njit
+def _compiled_phase_table(n_per, forced):
+    return phase_table(n_per, forced)
+
+
+@pytest.mark.parametrize("n_per", [1, 4, 7, 1000, 4096])
+def test_the_interpreters_phase_table_is_the_compiled_one_bitwise(n_per):
+    """The orchestrating code takes the forcing-phase table from the interpreter
+    (phase_table_values); the kernels compute it compiled (phase_table): the same bits."""
+    for forced in (True, False):
+        want = _compiled_phase_table(n_per, forced)
+        got = phase_table_values(n_per, forced)
+        for g, w in zip(got, want, strict=True):
+            assert g.dtype == w.dtype and np.array_equal(g.view(np.int64), w.view(np.int64))
+    assert not phase_table_values(n_per, True)[0].flags.writeable

@@ -11,6 +11,7 @@ compiles with the model's functions inlined; the sweep's and the Lyapunov kernel
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numba as nb
@@ -91,6 +92,28 @@ def phase_table(n_per, forced):
             s[2 * p + 1], c[2 * p + 1] = phase_rotate(s[2 * p], c[2 * p], ah, bh)
             if p < n_per - 1:
                 s[2 * p + 2], c[2 * p + 2] = phase_rotate(s[2 * p], c[2 * p], ad, bd)
+    return s, c
+
+
+@functools.lru_cache(maxsize=64)
+def phase_table_values(n_per: int, forced: bool) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`phase_table` computed by the interpreter (read-only arrays, kept per ``n_per``),
+    for the orchestrating code: the same rotations in the same order of IEEE operations, so
+    bitwise the compiled table. Python code does not call this module's compiled functions
+    itself: their code is linked into every model's cached kernels, and their own entry from
+    Python has read a wrong environment when cached copies compiled by other processes were
+    loaded beside it (numba's "'descr' is NULL" SystemError)."""
+    s = np.zeros(2 * n_per + 1)
+    c = np.ones(2 * n_per + 1)
+    if forced:
+        ah, bh, ad, bd = phase_increments.py_func(n_per)
+        rotate = phase_rotate.py_func
+        for p in range(n_per):
+            s[2 * p + 1], c[2 * p + 1] = rotate(s[2 * p], c[2 * p], ah, bh)
+            if p < n_per - 1:
+                s[2 * p + 2], c[2 * p + 2] = rotate(s[2 * p], c[2 * p], ad, bd)
+    s.setflags(write=False)
+    c.setflags(write=False)
     return s, c
 
 

@@ -22,6 +22,7 @@ from geardyn.core.moved import moved
 from geardyn.core.plan import LanePlan
 from geardyn.core.settings import RunSettings
 from geardyn.core.status import Status
+from geardyn.solvers._step_shared import phase_table_values
 from geardyn.solvers.kernels import kernels_for
 
 #: Names whose home is now the core layer (deprecated here).
@@ -167,7 +168,7 @@ def run_plan(model: Model, P: np.ndarray, y0: np.ndarray, plan: LanePlan,
         steps=np.zeros(L, np.int64),
     )
     tr_steps = np.zeros(L, np.int64)
-    s_tab, c_tab, lane_tab = _phase_tables(k, n_lane)
+    s_tab, c_tab, lane_tab = _phase_tables(n_lane)
     cost = plan.total_periods * n_lane
     if chain is None:
         chain = np.empty(0, np.int64)
@@ -236,12 +237,12 @@ def _chain_heads(chain: np.ndarray, cost: np.ndarray) -> tuple[np.ndarray, np.nd
     return heads, total
 
 
-def _phase_tables(k, n_lane: np.ndarray):
+def _phase_tables(n_lane: np.ndarray):
     """Concatenated forcing-phase tables of every distinct step count, and each lane's offset
     into them."""
     s_parts, c_parts, offset, pos = [], [], {}, 0
     for n in np.unique(n_lane):
-        s, c = k.phase_table(int(n), True)
+        s, c = phase_table_values(int(n), True)
         offset[int(n)] = pos
         s_parts.append(s)
         c_parts.append(c)

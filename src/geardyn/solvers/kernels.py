@@ -210,10 +210,14 @@ def _import_line(funcs: dict[str, Any]) -> str:
 
 
 def _source_digest(text: str, funcs: dict[str, Any]) -> str:
+    """The hash that names a generated module: its text, numba's version, the sources of the
+    model's modules and of :data:`SHARED_MODULES` (numba's cache of the generated module holds
+    their compiled code too, and checks only the generated file)."""
     h = hashlib.sha256(text.encode())
     h.update(numba.__version__.encode())
-    for fn in funcs.values():
-        path = sys.modules[fn.py_func.__module__].__file__
+    paths = [sys.modules[fn.py_func.__module__].__file__ for fn in funcs.values()]
+    paths += [importlib.import_module(name).__file__ for name in SHARED_MODULES]
+    for path in paths:
         h.update(Path(path).read_bytes())
     return h.hexdigest()[:20]
 
