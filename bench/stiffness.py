@@ -58,7 +58,7 @@ def main(argv: list[str] | None = None) -> None:
     print(measured)
     hunt_repeat = max(1, args.repeat // 4)
     hunt, hunt_mean = measure(hunt_repeat, args.angles, cycles=HUNTING,
-                              crack=RootCrack("2 mm", "45 deg", tooth=0))
+                              faults=RootCrack("2 mm", "45 deg", tooth=0))
     hunted = (f"{hunt:.3f} s wall, median of {hunt_repeat} ({HUNTING} mesh cycles x"
               f" {args.angles} angles, 2 mm crack on pinion tooth 0; mean {hunt_mean:.4e} N/m)")
     print(hunted)
