@@ -402,3 +402,11 @@ def test_crack_keyword_is_deprecated(mesh: GearMesh) -> None:
     with pytest.raises(TypeError):
         potential_energy_stiffness(mesh, bore_radius=BORES, angles=4, crack=crack,
                                    faults=Wear(1e-5))
+
+
+def test_missing_tooth_takes_one_z_th_of_the_mean(mesh: GearMesh) -> None:
+    """Every pinion tooth runs through the same contacts once a revolution, so a missing one
+    takes exactly 1/z1 of the mean stiffness over a revolution."""
+    k0 = _run(mesh, (), angles=36).mesh_stiffness.values
+    k = _run(mesh, BrokenTooth(tooth=4), angles=36).mesh_stiffness.values
+    assert k.mean() == pytest.approx(k0.mean() * (1.0 - 1.0 / Z1), rel=1e-13, abs=0.0)

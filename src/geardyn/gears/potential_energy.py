@@ -330,7 +330,8 @@ def tooth_compliances(tooth: ToothModel, alpha1: np.ndarray, *, young: float, po
       (q sin v >= h_r) are refused.
     * :class:`Spall`: the sections whose flank point lies on the spall lose a depth x width
       rectangle at the loaded flank: A = 2hb - w d, I about the reduced section's centroid
-      (Saxena, Parey & Chouksey 2016; Ma et al. 2015); bending arm and fillet unchanged. The
+      (after Saxena, Parey & Chouksey 2016; Liang, Zhang, Liu & Zuo 2016); bending arm and
+      fillet unchanged. The
       contact width (Hertz) is the pair's: see :class:`PotentialEnergyPair`.
     * :class:`Wear`: the sections of the active profile (from ``tooth.start_roll`` to the tip)
       thin to 2h - h_w (Chen, Lei, Fu & Hou 2021, uniform depth); fillet unchanged.
@@ -455,8 +456,9 @@ class PotentialEnergyPair:
         ``fillet_wheel``) and of the pair (``pair``) for contacts at ``position`` [m] between a
         pinion tooth with the fault ``pinion`` and a wheel tooth with ``wheel`` (None:
         healthy). A spall on the loaded flank narrows the Hertz contact to b - w where the
-        contact lies on it (the wider spall where both teeth have one there); ``coast``: the
-        contacts are on the coast flanks, which a spall does not touch."""
+        contact lies on it (Chaari, Baccar, Abbes & Haddar 2008; the wider spall where both
+        teeth have one there); ``coast``: the contacts are on the coast flanks, which a spall
+        does not touch."""
         pos = np.asarray(position, dtype=float)
         a_p, a_w = self.load_angles(pos)
         kw = dict(young=self.young, poisson=self.poisson, face_width=self.face_width,
