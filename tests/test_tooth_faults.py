@@ -72,9 +72,10 @@ def _roll_at(along: float) -> float:
     return math.sqrt(2.0 * (g["rb"] * math.tan(ALPHA) ** 2 / 2.0 + along) / g["rb"])
 
 
-def _reference(a1: float, section) -> dict[str, float]:
+def _reference(a1: float, section, points: tuple[float, ...] = ()) -> dict[str, float]:
     """Bending, shear, axial compliance of the pinion tooth by quad in alpha, the section at
-    alpha (I, A) from ``section(alpha, h)``; straight root flank healthy."""
+    alpha (I, A) from ``section(alpha, h)`` (discontinuous at most at ``points``); straight
+    root flank healthy."""
     g = _pinion()
     rb, rf, a2 = g["rb"], g["rf"], g["a2"]
     c, s = math.cos(a1), math.sin(a1)
@@ -96,12 +97,14 @@ def _reference(a1: float, section) -> dict[str, float]:
         _, area, _, dx = geom(a)
         return dx / area
 
-    tight = dict(epsabs=0.0, epsrel=1e-12, limit=400)
+    inner = [p for p in points if -a1 < p < a2]
+    tight = dict(epsabs=0.0, epsrel=1e-12, limit=400, points=inner or None)
     hb = rb * math.sin(a2)
     x0, x1 = math.sqrt(rf ** 2 - hb ** 2), rb * math.cos(a2)
     i_b, a_b = 2.0 * hb ** 3 * B / 3.0, 2.0 * hb * B
     bending = (quad(bend, -a1, a2, **tight)[0]
-               + quad(lambda x: (c * (xc - x) - s * hc) ** 2 / (E * i_b), x0, x1, **tight)[0])
+               + quad(lambda x: (c * (xc - x) - s * hc) ** 2 / (E * i_b), x0, x1,
+                      epsabs=0.0, epsrel=1e-12)[0])
     area = quad(inv_area, -a1, a2, **tight)[0] + (x1 - x0) / a_b
     return {"bending": bending, "shear": 1.2 * c ** 2 / g_mod * area, "axial": s ** 2 / E * area}
 
@@ -139,9 +142,9 @@ def test_spalled_tooth_matches_quad(mesh: GearMesh) -> None:
     got = tooth_compliances(pair.pinion, a1, young=E, poisson=NU, face_width=B, fault=spall)
     healthy = tooth_compliances(pair.pinion, a1, young=E, poisson=NU, face_width=B)
     for i, alpha1 in enumerate(a1):
-        ref = _reference(float(alpha1), section)
+        ref = _reference(float(alpha1), section, (g["a2"] - t_hi, g["a2"] - t_lo))
         for name, value in ref.items():
-            assert got[name][i] == pytest.approx(value, rel=1e-9, abs=0.0), (name, i)
+            assert got[name][i] == pytest.approx(value, rel=1e-10, abs=0.0), (name, i)
         assert got["fillet"][i] == healthy["fillet"][i]
     assert got["bending"][0] == healthy["bending"][0]  # the spall lies above that contact
     assert np.all(got["bending"][1:] > healthy["bending"][1:])
@@ -197,8 +200,8 @@ def test_worn_tooth_matches_quad(mesh: GearMesh) -> None:
     a1 = np.array([g["t_low"] + 0.02, math.tan(ALPHA), g["t_tip"]]) - g["a2"]
     got = tooth_compliances(pair.pinion, a1, young=E, poisson=NU, face_width=B, fault=wear)
     for i, alpha1 in enumerate(a1):
-        for name, value in _reference(float(alpha1), section).items():
-            assert got[name][i] == pytest.approx(value, rel=1e-9, abs=0.0), (name, i)
+        for name, value in _reference(float(alpha1), section, (g["a2"] - g["t_low"],)).items():
+            assert got[name][i] == pytest.approx(value, rel=1e-10, abs=0.0), (name, i)
 
 
 def test_zero_wear_is_healthy_bitwise(mesh: GearMesh, healthy) -> None:
@@ -410,3 +413,85 @@ def test_missing_tooth_takes_one_z_th_of_the_mean(mesh: GearMesh) -> None:
     k0 = _run(mesh, (), angles=36).mesh_stiffness.values
     k = _run(mesh, BrokenTooth(tooth=4), angles=36).mesh_stiffness.values
     assert k.mean() == pytest.approx(k0.mean() * (1.0 - 1.0 / Z1), rel=1e-13, abs=0.0)
+
+
+# -- Archard's wear profile ------------------------------------------------------------------
+
+
+def _slip(gear: str, s: np.ndarray) -> np.ndarray:
+    """|v1 - v2| / v of the flank point of ``gear`` in contact at line-of-action position s:
+    v_i = omega_i rho_i, rho the distance from the gear's tangent point, omega_2/omega_1 =
+    z1/z2 (textbook geometry of the unshifted pair)."""
+    rb1, rb2 = M * Z1 / 2.0 * math.cos(ALPHA), M * Z2 / 2.0 * math.cos(ALPHA)
+    rho1 = rb1 * math.tan(ALPHA) + s
+    rho2 = (rb1 + rb2) * math.tan(ALPHA) - rho1
+    v1, v2 = rho1, Z1 / Z2 * rho2
+    return np.abs(v1 - v2) / (v1 if gear == "pinion" else v2)
+
+
+@pytest.mark.parametrize("gear", ["pinion", "wheel"])
+def test_archard_gap_follows_load_share_times_slip(mesh: GearMesh, gear: str) -> None:
+    """The gap of an Archard-worn tooth is proportional to k_i / sum k (from the healthy
+    Dataset's pair columns) times the slip written out here, zero at the pitch point, at most
+    the given depth and reaching it near the path's ends."""
+    depth, tooth = 30e-6, 3
+    cycles = Z1 if gear == "pinion" else Z2
+    ds0 = _run(mesh, (), angles=48, cycles=cycles)
+    ds = _run(mesh, Wear(depth, gear=gear, tooth=tooth, profile="archard"), angles=48,
+              cycles=cycles)
+    idx = (ds0.tooth_pinion if gear == "pinion" else ds0.tooth_wheel).values
+    worn = ds0.in_contact.values & (idx == tooth)
+    share = ds0.pair_stiffness.values / ds0.mesh_stiffness.values[:, None]
+    rate = (share * _slip(gear, ds0.position.values))[worn]
+    gap = ds.fault_gap.values[worn]
+    pitch = np.abs(ds0.position.values[worn]) < 1e-15
+    assert pitch.any()
+    np.testing.assert_allclose(gap[pitch], 0.0, atol=1e-18)
+    ratio = gap[~pitch] / rate[~pitch]
+    np.testing.assert_allclose(ratio, ratio[0], rtol=1e-9)
+    assert gap.max() <= depth and gap.max() > 0.8 * depth
+    np.testing.assert_array_equal(ds.fault_gap.values[~worn], 0.0)
+
+
+def test_archard_worn_tooth_matches_quad(mesh: GearMesh) -> None:
+    """The sections thinned by the profile's depth at their flank point, by quad with the
+    stretches' ends as break points."""
+    wear = Wear(40e-6, profile="archard")
+    pair = prepare_pair(mesh, bore_radius=BORES, faults=wear)
+    profile = pair.profile_of(wear)
+    g = _pinion()
+
+    def section(a: float, h: float) -> tuple[float, float]:
+        if a <= g["a2"] - g["t_low"]:
+            t = 2.0 * h - float(profile.depth_at(np.array([g["a2"] - a]))[0])
+            return t ** 3 * B / 12.0, t * B
+        return 2.0 * h ** 3 * B / 3.0, 2.0 * h * B
+
+    a1 = np.array([g["t_low"] + 0.02, math.tan(ALPHA) + 0.05, g["t_tip"]]) - g["a2"]
+    got = tooth_compliances(pair.pinion, a1, young=E, poisson=NU, face_width=B, fault=wear,
+                            wear_profile=profile)
+    healthy = tooth_compliances(pair.pinion, a1, young=E, poisson=NU, face_width=B)
+    for i, alpha1 in enumerate(a1):
+        breaks = tuple(g["a2"] - t for t in profile.rolls)
+        for name, value in _reference(float(alpha1), section, breaks).items():
+            assert got[name][i] == pytest.approx(value, rel=1e-9, abs=0.0), (name, i)
+            assert got[name][i] > healthy[name][i]
+    with pytest.raises(ParameterError) as info:
+        tooth_compliances(pair.pinion, a1, young=E, poisson=NU, face_width=B, fault=wear)
+    assert info.value.field == "wear.profile"
+
+
+def test_archard_wear_zero_and_monotone(mesh: GearMesh, healthy) -> None:
+    zero = _run(mesh, Wear(0.0, tooth=6, profile="archard"))
+    for name in healthy.data_vars:
+        np.testing.assert_array_equal(zero[name].values, healthy[name].values)
+    touched = ((healthy.tooth_pinion == 6) & healthy.in_contact).any("pair").values
+    runs = [_run(mesh, Wear(d, tooth=6, profile="archard")).mesh_stiffness.values
+            for d in (0.0, 5e-6, 50e-6, 200e-6)]
+    for thin, thick in zip(runs, runs[1:], strict=False):
+        assert np.all(thick[touched] <= thin[touched])
+        assert np.count_nonzero(thick[touched] < thin[touched]) >= touched.sum() // 2
+        np.testing.assert_array_equal(thick[~touched], thin[~touched])
+    with pytest.raises(ParameterError) as info:
+        Wear(1e-5, profile="linear")
+    assert info.value.field == "wear.profile"

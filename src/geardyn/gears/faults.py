@@ -136,22 +136,32 @@ class Spall:
                 f" {self.position:.6g} m from the reference circle")
 
 
+#: The wear profiles along the flank (see :class:`Wear`).
+WEAR_PROFILES = ("uniform", "archard")
+
+
 @dataclass(frozen=True)
 class Wear:
-    """Uniform wear of ``depth`` [m] over the active profile of one tooth's loaded flank, on
-    tooth ``tooth`` of ``gear``: the flank's sections thin by ``depth`` and its contacts open a
-    gap of ``depth`` (the unloaded transmission error, see
+    """Wear of the active profile of one tooth's loaded flank, on tooth ``tooth`` of ``gear``:
+    ``profile`` "uniform" removes ``depth`` [m] everywhere on it, "archard" follows Archard's
+    law along the flank (the sliding distance times the load, zero at the pitch point) with
+    ``depth`` [m] its largest value. The flank's sections thin by the local depth and its
+    contacts open a gap of it (the unloaded transmission error, see
     :func:`geardyn.gears.loaded_contact`). Zero depth is the healthy tooth."""
 
     depth: float
     gear: str = "pinion"
     tooth: int = 0
+    profile: str = "uniform"
 
     kind = "wear"
 
     def __post_init__(self) -> None:
         _length(self, "wear", "depth")
         _place(self, "wear")
+        if self.profile not in WEAR_PROFILES:
+            raise ParameterError("wear.profile", self.profile,
+                                 f"must be one of {', '.join(WEAR_PROFILES)}")
 
     @property
     def is_null(self) -> bool:
@@ -160,8 +170,9 @@ class Wear:
 
     def describe(self) -> str:
         """One line for the Dataset's attrs."""
-        return (f"uniform wear on {self.gear} tooth {self.tooth}: {self.depth:.6g} m over the"
-                " active profile")
+        size = "" if self.profile == "uniform" else " at most"
+        return (f"{self.profile} wear on {self.gear} tooth {self.tooth}:{size} {self.depth:.6g} m"
+                " over the active profile")
 
 
 @dataclass(frozen=True)

@@ -224,12 +224,13 @@ def crack_limit(tooth: ToothModel, h_q: float) -> float:
     return hi
 
 
-Section = Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]
+#: (I, A) of a faulty section from its healthy half thickness h and involute parameter alpha.
+Section = Callable[[np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray]]
 
 
 def _crack_section(h_q: float, b: float) -> Section:
     """(I, A) of sections cut by a crack limit line h_q from the centre line: h + h_q thick."""
-    return lambda h: ((h + h_q) ** 3 * b / 12.0, (h + h_q) * b)
+    return lambda h, al: ((h + h_q) ** 3 * b / 12.0, (h + h_q) * b)
 
 
 def _spall_section(width: float, depth: float, b: float) -> Section:
@@ -237,7 +238,7 @@ def _spall_section(width: float, depth: float, b: float) -> Section:
     I about the reduced section's own centroid (shifted by y_c towards the other flank)."""
     cut = width * depth
 
-    def section(h: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def section(h: np.ndarray, al: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         area = 2.0 * h * b - cut
         y_c = -cut * (h - 0.5 * depth) / area
         inertia = ((2.0 / 3.0) * h ** 3 * b + 2.0 * h * b * y_c ** 2
@@ -249,14 +250,25 @@ def _spall_section(width: float, depth: float, b: float) -> Section:
 
 def _wear_section(depth: float, b: float) -> Section:
     """(I, A) of sections thinned by ``depth`` at the loaded flank: 2h - depth thick."""
-    return lambda h: ((2.0 * h - depth) ** 3 * b / 12.0, (2.0 * h - depth) * b)
+    return lambda h, al: ((2.0 * h - depth) ** 3 * b / 12.0, (2.0 * h - depth) * b)
+
+
+def _profile_section(profile: WearProfile, a2: float, b: float) -> Section:
+    """(I, A) of sections thinned by the wear depth ``profile`` at their flank point."""
+
+    def section(h: np.ndarray, al: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        t = 2.0 * h - profile.depth_at(a2 - al)
+        return t ** 3 * b / 12.0, t * b
+
+    return section
 
 
 def _involute_piece(tooth: ToothModel, a1: np.ndarray, lower: np.ndarray, upper: np.ndarray,
                     section: Section | None, young: float, face_width: float,
                     nodes: int) -> tuple[np.ndarray, np.ndarray]:
     """(int M^2/(E I) dx / F^2, int dx / A) over alpha in [lower, upper] of the involute
-    cantilever; the section is 2h wide, or ``section(h)`` gives (I, A) of a faulty one."""
+    cantilever; the section is 2h wide, or ``section(h, alpha)`` gives (I, A) of a faulty
+    one."""
     r_b, a2, b, e = tooth.base_radius, tooth.half_base_angle, face_width, young
     xg, wg = _gauss(nodes)
     half = 0.5 * (upper - lower)[..., None]
@@ -272,7 +284,7 @@ def _involute_piece(tooth: ToothModel, a1: np.ndarray, lower: np.ndarray, upper:
     if section is None:
         inertia, area = (2.0 / 3.0) * h ** 3 * b, 2.0 * h * b
     else:
-        inertia, area = section(h)
+        inertia, area = section(h, al)
     return (np.sum(arm ** 2 / (e * inertia) * dx, axis=-1), np.sum(dx / area, axis=-1))
 
 
@@ -295,15 +307,31 @@ def half_thickness(tooth: ToothModel, alpha: float) -> float:
     return tooth.base_radius * (math.sin(alpha) + (a2 - alpha) * math.cos(alpha))
 
 
-def _section_loss(tooth: ToothModel, fault: Spall | Wear,
-                  face_width: float) -> tuple[float, float, Section]:
-    """(alpha_lo, alpha_hi, section): the involute parameters between which ``fault`` thins
-    the sections, and their (I, A)."""
+@dataclass(frozen=True)
+class WearProfile:
+    """The wear depth along the loaded flank of a worn tooth: ``depth_at(t)`` [m] at the flank's
+    roll angles t [rad] on its active profile, smooth between the roll angles ``rolls``
+    (ascending, from the start of the active profile to the tip)."""
+
+    rolls: tuple[float, ...]
+    depth_at: Callable[[np.ndarray], np.ndarray]
+
+
+def _section_loss(tooth: ToothModel, fault: Spall | Wear, face_width: float,
+                  profile: WearProfile | None) -> tuple[list[float], Section]:
+    """(breaks, section): the involute parameters (ascending) from where ``fault`` thins the
+    sections to where it stops, the section smooth between them, and its (I, A)."""
     a2 = tooth.half_base_angle
     if isinstance(fault, Spall):
         t_lo, t_hi = spall_rolls(tooth, fault)
-        return a2 - t_hi, a2 - t_lo, _spall_section(fault.width, fault.depth, face_width)
-    return tooth.tip, a2 - tooth.start_roll, _wear_section(fault.depth, face_width)
+        return [a2 - t_hi, a2 - t_lo], _spall_section(fault.width, fault.depth, face_width)
+    if fault.profile == "uniform":
+        return [tooth.tip, a2 - tooth.start_roll], _wear_section(fault.depth, face_width)
+    if profile is None:
+        raise ParameterError("wear.profile", fault.profile,
+                             "Archard's profile needs the mesh: pass wear_profile="
+                             "PotentialEnergyPair.wear_profile(wear)")
+    return sorted(a2 - t for t in profile.rolls), _profile_section(profile, a2, face_width)
 
 
 def _one_fault(fault: object, crack: object, where: str) -> object:
@@ -318,7 +346,7 @@ def _one_fault(fault: object, crack: object, where: str) -> object:
 
 def tooth_compliances(tooth: ToothModel, alpha1: np.ndarray, *, young: float, poisson: float,
                       face_width: float, nodes: int = DEFAULT_NODES,
-                      fault: Fault | None = None,
+                      fault: Fault | None = None, wear_profile: WearProfile | None = None,
                       crack: RootCrack | None = None) -> dict[str, np.ndarray]:
     """Compliances 1/k_b, 1/k_s, 1/k_a, 1/k_f [m/N] of ``tooth`` loaded at the load angles
     ``alpha1`` [rad] (any shape), by name (:data:`TOOTH_TERMS`), with ``fault`` (its gear and
@@ -334,7 +362,9 @@ def tooth_compliances(tooth: ToothModel, alpha1: np.ndarray, *, young: float, po
       fillet unchanged. The
       contact width (Hertz) is the pair's: see :class:`PotentialEnergyPair`.
     * :class:`Wear`: the sections of the active profile (from ``tooth.start_roll`` to the tip)
-      thin to 2h - h_w (Chen, Lei, Fu & Hou 2021, uniform depth); fillet unchanged.
+      thin to 2h - h_w (Chen, Lei, Fu & Hou 2021), h_w the uniform depth or, for Archard's
+      profile, ``wear_profile``'s depth at the section's flank point
+      (:meth:`PotentialEnergyPair.wear_profile`); fillet unchanged.
 
     ``crack=`` is the deprecated spelling of ``fault=`` for a root crack. A
     :class:`BrokenTooth` has no compliance (refused)."""
@@ -365,12 +395,12 @@ def tooth_compliances(tooth: ToothModel, alpha1: np.ndarray, *, young: float, po
                                          nodes)
         bending, inv_area = bend_h + bend_c, area_h + area_c
     elif isinstance(fault, (Spall, Wear)):
-        lo, hi, section = _section_loss(tooth, fault, b)
-        p1 = np.minimum(np.maximum(lower, lo), top)
-        p2 = np.minimum(np.maximum(lower, hi), top)
-        bending, inv_area = _involute_piece(tooth, a1, lower, p1, None, e, b, nodes)
-        for piece in (_involute_piece(tooth, a1, p1, p2, section, e, b, nodes),
-                      _involute_piece(tooth, a1, p2, top, None, e, b, nodes)):
+        breaks, section = _section_loss(tooth, fault, b, wear_profile)
+        cuts = [np.minimum(np.maximum(lower, x), top) for x in breaks]
+        bending, inv_area = _involute_piece(tooth, a1, lower, cuts[0], None, e, b, nodes)
+        pieces = [(lo, hi, section) for lo, hi in zip(cuts, cuts[1:], strict=False)]
+        for lo, hi, sec in [*pieces, (cuts[-1], top, None)]:
+            piece = _involute_piece(tooth, a1, lo, hi, sec, e, b, nodes)
             bending, inv_area = bending + piece[0], inv_area + piece[1]
     else:
         raise ParameterError("fault", fault, "must be a RootCrack, Spall, Wear or None")
@@ -425,6 +455,7 @@ class PotentialEnergyPair:
     face_width: float
     nodes: int
     faults: tuple[Fault, ...] = ()
+    wear_profiles: tuple[tuple[Wear, WearProfile], ...] = ()
 
     @property
     def hertz(self) -> float:
@@ -439,6 +470,70 @@ class PotentialEnergyPair:
         s2 = mesh.line_of_action_length - s1
         return (s1 / self.pinion.base_radius - self.pinion.half_base_angle,
                 s2 / self.wheel.base_radius - self.wheel.half_base_angle)
+
+    def _flank(self, gear: str) -> tuple[Callable, Callable]:
+        """(position of roll, roll of position): the line-of-action position s [m] of the contact
+        at roll angle t of ``gear``'s drive flank, and back."""
+        mesh = self.mesh
+        s_p = mesh.pinion.base_radius * math.tan(mesh.operating_pressure_angle)
+        if gear == "pinion":
+            r_b = mesh.pinion.base_radius
+            return (lambda t: r_b * t - s_p), (lambda s: (s + s_p) / r_b)
+        r_b, length = mesh.wheel.base_radius, mesh.line_of_action_length
+        return (lambda t: length - s_p - r_b * t), (lambda s: (length - s_p - s) / r_b)
+
+    def archard_rate(self, gear: str, position: np.ndarray) -> np.ndarray:
+        """Archard's wear per mesh passage of ``gear``'s flank point in contact at ``position``
+        [m], up to the wear coefficient over the face width: the load share q = k / sum k of the
+        healthy pairs in contact (equal approach) times the slip |v_1 - v_2| / v of the point
+        (v = omega rho, rho the radius of curvature, the distance from the gear's tangent point
+        on the line of action)."""
+        mesh = self.mesh
+        s = np.asarray(position, dtype=float)
+        p_b, g_f, g_a = mesh.base_pitch, mesh.approach_length, mesh.recess_length
+        k = self.terms(s)["pair"]
+        total = k.copy()
+        for m in (-2, -1, 1, 2):
+            other = s + m * p_b
+            inside = (other >= -g_f) & (other < g_a)
+            if inside.any():
+                total[inside] += self.terms(other[inside])["pair"]
+        rho1 = mesh.pinion.base_radius * math.tan(mesh.operating_pressure_angle) + s
+        rho2 = mesh.line_of_action_length - rho1
+        ratio = mesh.pinion.teeth / mesh.wheel.teeth  # omega_2 / omega_1
+        slip = (np.abs(1.0 - ratio * rho2 / rho1) if gear == "pinion"
+                else np.abs(1.0 - rho1 / (ratio * rho2)))
+        return k / total * slip
+
+    def wear_profile(self, wear: Wear) -> WearProfile:
+        """The depth of ``wear`` along its flank (module docstring of
+        :mod:`geardyn.gears.faults`): uniform, or Archard's h(t) = depth r(s(t)) / max r,
+        r = :meth:`archard_rate` (one wear step on the healthy mesh), its maximum taken over 129
+        points of each smooth stretch of the path of contact (ends included)."""
+        tooth = self.pinion if wear.gear == "pinion" else self.wheel
+        t_start, t_tip = tooth.start_roll, tooth.half_base_angle - tooth.tip
+        depth = wear.depth
+        if wear.profile == "uniform":
+            return WearProfile((t_start, t_tip), lambda t: np.full(np.shape(t), depth))
+        mesh = self.mesh
+        p_b, g_f, g_a = mesh.base_pitch, mesh.approach_length, mesh.recess_length
+        at, roll = self._flank(wear.gear)
+        ends = sorted({-g_f, g_a - p_b, 0.0, p_b - g_f, g_a})
+        ends = [x for x in ends if -g_f <= x <= g_a]
+        nudge = 1e-9 * p_b  # the one-sided limits at the ends of each stretch
+        grid = np.concatenate([np.linspace(lo + nudge, hi - nudge, 129)
+                               for lo, hi in zip(ends, ends[1:], strict=False)])
+        scale = depth / float(np.max(self.archard_rate(wear.gear, grid)))
+        rolls = tuple(sorted(float(roll(x)) for x in ends))
+        gear = wear.gear
+        return WearProfile(rolls, lambda t: scale * self.archard_rate(gear, at(np.asarray(t))))
+
+    def profile_of(self, fault: Fault | None) -> WearProfile | None:
+        """The :class:`WearProfile` of a :class:`Wear` of this pair's ``faults``, else None."""
+        for wear, profile in self.wear_profiles:
+            if wear is fault:
+                return profile
+        return None
 
     def _lost_width(self, tooth: ToothModel, fault: Fault | None,
                     a1: np.ndarray) -> np.ndarray | None:
@@ -475,7 +570,8 @@ class PotentialEnergyPair:
         compliance = 1.0 / out["hertz"]
         for role, tooth, a1, fault in (("pinion", self.pinion, a_p, pinion),
                                        ("wheel", self.wheel, a_w, wheel)):
-            comp = tooth_compliances(tooth, a1, fault=fault, **kw)
+            comp = tooth_compliances(tooth, a1, fault=fault, wear_profile=self.profile_of(fault),
+                                     **kw)
             for term, c in comp.items():
                 out[f"{term}_{role}"] = 1.0 / c
                 compliance = compliance + c
@@ -553,9 +649,13 @@ def prepare_pair(mesh: GearMesh, *, bore_radius: object, young: object = STEEL_Y
                                                                          strict=True)]
     width = min(mesh.pinion.face_width, mesh.wheel.face_width)
     _check_faults(fault_list, mesh, teeth, width)
-    return PotentialEnergyPair(mesh=mesh, pinion=teeth[0], wheel=teeth[1], young=e,
+    pair = PotentialEnergyPair(mesh=mesh, pinion=teeth[0], wheel=teeth[1], young=e,
                                poisson=nu, face_width=width, nodes=int(nodes),
                                faults=fault_list)  # type: ignore[arg-type]
+    wears = [f for f in fault_list if isinstance(f, Wear)]
+    if not wears:
+        return pair
+    return replace(pair, wear_profiles=tuple((w, pair.wear_profile(w)) for w in wears))
 
 
 def _check_faults(faults: tuple[object, ...], mesh: GearMesh, teeth: list[ToothModel],
@@ -666,13 +766,11 @@ def coast_phase(mesh: GearMesh) -> float:
 
 
 def _fault_codes(pair: PotentialEnergyPair, tooth_p: np.ndarray,
-                 tooth_w: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+                 tooth_w: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Per pair slot: the index into ``pair.faults`` of the pinion and the wheel tooth's fault
-    (-1: none, or one of zero size), whether either tooth is missing, and the gap [m] of the
-    teeth's wear."""
+    (-1: none, or one of zero size), and whether either tooth is missing."""
     mesh = pair.mesh
     luts = {"pinion": np.full(mesh.pinion.teeth, -1), "wheel": np.full(mesh.wheel.teeth, -1)}
-    wear = {"pinion": np.zeros(mesh.pinion.teeth), "wheel": np.zeros(mesh.wheel.teeth)}
     gone = {"pinion": np.zeros(mesh.pinion.teeth, bool),
             "wheel": np.zeros(mesh.wheel.teeth, bool)}
     for i, fault in enumerate(pair.faults):
@@ -680,11 +778,23 @@ def _fault_codes(pair: PotentialEnergyPair, tooth_p: np.ndarray,
             gone[fault.gear][fault.tooth] = True
         elif not fault.is_null:
             luts[fault.gear][fault.tooth] = i
-            if isinstance(fault, Wear):
-                wear[fault.gear][fault.tooth] = fault.depth
     return (luts["pinion"][tooth_p], luts["wheel"][tooth_w],
-            gone["pinion"][tooth_p] | gone["wheel"][tooth_w],
-            wear["pinion"][tooth_p] + wear["wheel"][tooth_w])
+            gone["pinion"][tooth_p] | gone["wheel"][tooth_w])
+
+
+def _wear_gap(pair: PotentialEnergyPair, position: np.ndarray, inside: np.ndarray,
+              tooth_p: np.ndarray, tooth_w: np.ndarray) -> np.ndarray:
+    """The gap [m] the worn teeth open at the drive contacts ``inside`` (0 elsewhere): the
+    wear depth at each contact's point of the worn flank, both teeth's added."""
+    gap = np.zeros(position.shape)
+    for wear, profile in pair.wear_profiles:
+        if wear.is_null:
+            continue
+        mask = inside & ((tooth_p if wear.gear == "pinion" else tooth_w) == wear.tooth)
+        if mask.any():
+            where, inverse = np.unique(position[mask], return_inverse=True)
+            gap[mask] += profile.depth_at(pair._flank(wear.gear)[1](where))[inverse]
+    return gap
 
 
 def _coast(pair: PotentialEnergyPair, n: np.ndarray,
@@ -706,7 +816,7 @@ def _coast(pair: PotentialEnergyPair, n: np.ndarray,
     position = u * p_b
     passage = n.astype(np.int64)[:, None] - ks[None, :]
     tooth_p, tooth_w = passage % mesh.pinion.teeth, (passage + 1) % mesh.wheel.teeth
-    fp, fw, gone, _ = _fault_codes(pair, tooth_p, tooth_w)
+    fp, fw, gone = _fault_codes(pair, tooth_p, tooth_w)
     inside &= ~gone
     k_pair = np.where(inside, _terms_on_grid(pair, position, inside, fp, fw, coast=True)["pair"],
                       0.0)
@@ -768,8 +878,9 @@ def potential_energy_stiffness(mesh: GearMesh, *, bore_radius: object, angles: o
     position = u * p_b
     passage = n.astype(np.int64)[:, None] - ks[None, :]  # the pair's pitch-point cycle
     tooth_p, tooth_w = passage % mesh.pinion.teeth, passage % mesh.wheel.teeth
-    fp, fw, gone, gap = _fault_codes(pair, tooth_p, tooth_w)
+    fp, fw, gone = _fault_codes(pair, tooth_p, tooth_w)
     inside &= ~gone
+    gap = _wear_gap(pair, position, inside, tooth_p, tooth_w)
     terms = _terms_on_grid(pair, position, inside, fp, fw)
     k_pair = np.where(inside, terms.pop("pair"), 0.0)
     coast, ks_c = _coast(pair, n, frac)
@@ -780,7 +891,7 @@ def potential_energy_stiffness(mesh: GearMesh, *, bore_radius: object, angles: o
             "tooth_pinion": (("angle", "pair"), tooth_p),
             "tooth_wheel": (("angle", "pair"), tooth_w),
             "pair_stiffness": (("angle", "pair"), k_pair),
-            "fault_gap": (("angle", "pair"), np.where(inside, gap, 0.0))}
+            "fault_gap": (("angle", "pair"), gap)}
     for name, k in terms.items():
         data[f"k_{name}"] = (("angle", "pair"), np.where(inside, k, np.nan))
     data.update(coast)
