@@ -10,7 +10,8 @@ active flank, a tooth index beyond the tooth count) are made when the pair is pr
 * :class:`RootCrack` (``depth``, ``angle``): a straight crack at the root of the loaded flank.
 * :class:`Spall` (``length``, ``width``, ``depth``, ``position``): a rectangular spall or pit on
   the loaded flank.
-* :class:`Wear` (``depth``): uniform wear of the loaded flank's active profile.
+* :class:`Wear` (``depth``, ``profile``): uniform or Archard wear of the loaded flank's active
+  profile.
 * :class:`BrokenTooth`: the tooth is missing.
 
 Errors name the field as ``<kind>.<field>`` (``spall.position``), with the kind of

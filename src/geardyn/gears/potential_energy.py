@@ -487,7 +487,8 @@ class PotentialEnergyPair:
         [m], up to the wear coefficient over the face width: the load share q = k / sum k of the
         healthy pairs in contact (equal approach) times the slip |v_1 - v_2| / v of the point
         (v = omega rho, rho the radius of curvature, the distance from the gear's tangent point
-        on the line of action)."""
+        on the line of action). Archard (1953): wear depth = k_w x pressure x sliding distance;
+        Flodin & Andersson (1997) integrate it along spur flanks in the same way."""
         mesh = self.mesh
         s = np.asarray(position, dtype=float)
         p_b, g_f, g_a = mesh.base_pitch, mesh.approach_length, mesh.recess_length
