@@ -99,6 +99,10 @@ SAINSOT_COEFFS: dict[str, tuple[float, ...]] = {
     "Q": (-6.2042e-5, 9.0889e-3, -4.0964e-4, 7.8297e-3, -0.1472, 0.6904),
 }
 
+#: Degree of the Chebyshev interpolant of Archard's wear rate on each smooth stretch of the
+#: flank (the interpolation error is below 1e-10 of the largest depth for spur teeth).
+ARCHARD_DEGREE = 40
+
 #: The energy terms of one tooth, in the order of the compliance sum.
 TOOTH_TERMS = ("bending", "shear", "axial", "fillet")
 
@@ -510,7 +514,10 @@ class PotentialEnergyPair:
         """The depth of ``wear`` along its flank (module docstring of
         :mod:`geardyn.gears.faults`): uniform, or Archard's h(t) = depth r(s(t)) / max r,
         r = :meth:`archard_rate` (one wear step on the healthy mesh), its maximum taken over 129
-        points of each smooth stretch of the path of contact (ends included)."""
+        points of each smooth stretch of the path of contact (ends included). Within each
+        stretch (between the path's ends, the single-contact ends and the pitch point) r is
+        smooth and is evaluated by its Chebyshev interpolant of degree
+        :data:`ARCHARD_DEGREE` in the roll angle."""
         tooth = self.pinion if wear.gear == "pinion" else self.wheel
         t_start, t_tip = tooth.start_roll, tooth.half_base_angle - tooth.tip
         depth = wear.depth
@@ -527,7 +534,28 @@ class PotentialEnergyPair:
         scale = depth / float(np.max(self.archard_rate(wear.gear, grid)))
         rolls = tuple(sorted(float(roll(x)) for x in ends))
         gear = wear.gear
-        return WearProfile(rolls, lambda t: scale * self.archard_rate(gear, at(np.asarray(t))))
+        pieces = []
+        for lo, hi in zip(rolls, rolls[1:], strict=False):
+            mid, half = 0.5 * (hi + lo), 0.5 * (hi - lo)
+
+            def rate(x: np.ndarray, mid: float = mid, half: float = half) -> np.ndarray:
+                return scale * self.archard_rate(gear, at(mid + half * x))
+
+            pieces.append((mid, half, np.polynomial.chebyshev.chebinterpolate(
+                rate, ARCHARD_DEGREE)))
+        inner = np.array(rolls[1:-1])
+
+        def depth_at(t: np.ndarray) -> np.ndarray:
+            t = np.asarray(t, dtype=float)
+            which = np.searchsorted(inner, t, side="right")
+            out = np.zeros(t.shape)
+            for i, (mid, half, coef) in enumerate(pieces):
+                mask = which == i
+                if mask.any():
+                    out[mask] = np.polynomial.chebyshev.chebval((t[mask] - mid) / half, coef)
+            return out
+
+        return WearProfile(rolls, depth_at)
 
     def profile_of(self, fault: Fault | None) -> WearProfile | None:
         """The :class:`WearProfile` of a :class:`Wear` of this pair's ``faults``, else None."""
