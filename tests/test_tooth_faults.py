@@ -405,6 +405,16 @@ def test_crack_keyword_is_deprecated(mesh: GearMesh) -> None:
     with pytest.raises(TypeError):
         potential_energy_stiffness(mesh, bore_radius=BORES, angles=4, crack=crack,
                                    faults=Wear(1e-5))
+    pair = prepare_pair(mesh, bore_radius=BORES, faults=crack)
+    a1 = np.array([0.2, 0.4])
+    kw = dict(young=E, poisson=NU, face_width=B)
+    with pytest.warns(DeprecationWarning, match="prepare_pair"):
+        assert prepare_pair(mesh, bore_radius=BORES, crack=crack).faults == (crack,)
+    with pytest.warns(DeprecationWarning, match="tooth_compliances"):
+        old_c = tooth_compliances(pair.pinion, a1, crack=crack, **kw)
+    new_c = tooth_compliances(pair.pinion, a1, fault=crack, **kw)
+    for name in new_c:
+        np.testing.assert_array_equal(old_c[name], new_c[name])
 
 
 def test_missing_tooth_takes_one_z_th_of_the_mean(mesh: GearMesh) -> None:
