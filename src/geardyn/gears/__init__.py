@@ -6,6 +6,7 @@ takes (mean stiffness, Fourier coefficients, phases); the potential-energy stiff
 labelled xarray Dataset. See docs/gears.md.
 """
 
+from geardyn.gears.faults import FAULT_KINDS, BrokenTooth, Spall, Wear
 from geardyn.gears.geometry import GearMesh, SpurGear, inverse_involute, involute
 from geardyn.gears.iso6336 import ISOStiffness, iso6336_stiffness
 from geardyn.gears.phasing import (
@@ -31,16 +32,20 @@ from geardyn.gears.tip_relief import TipRelief, loaded_contact, relief_gap
 from geardyn.gears.waveform import StiffnessWaveform, double_contact_centre, mesh_stiffness_waveform
 
 __all__ = [
+    "FAULT_KINDS",
+    "BrokenTooth",
     "GearMesh",
     "ISOStiffness",
     "MeshPhases",
     "PlanetaryGeometry",
     "PotentialEnergyPair",
     "RootCrack",
+    "Spall",
     "SpurGear",
     "StiffnessWaveform",
     "TipRelief",
     "ToothModel",
+    "Wear",
     "coast_phase",
     "double_contact_centre",
     "equally_spaced",

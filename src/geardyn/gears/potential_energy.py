@@ -58,22 +58,29 @@ flank passes the pitch point phi = s_w1 / p_w1 mesh cycles after its drive flank
 :func:`coast_phase`), so K_coast(c) = K_drive(phi - c) in mesh cycles c of the pinion, each
 flank taken in its own contact (the relative rotation between the two is the backlash).
 
-A :class:`RootCrack` on one tooth narrows the sections below Tian's crack limit line (see
-:func:`tooth_compliances`); the tooth indices of each pair follow the pitch-point passages.
+Faults (:mod:`geardyn.gears.faults`), each on its own tooth: a :class:`RootCrack` narrows the
+sections below Tian's crack limit line, a :class:`Spall` the sections under it and the Hertz
+contact on it, :class:`Wear` the sections of the active profile (and opens a gap, the
+``fault_gap`` that :func:`~geardyn.gears.loaded_contact` adds to the tip relief's), and a
+:class:`BrokenTooth` takes its pairs out of contact (see :func:`tooth_compliances` and
+:meth:`PotentialEnergyPair.terms`); the tooth indices of each pair follow the pitch-point
+passages.
 """
 
 from __future__ import annotations
 
 import math
 import numbers
-from collections.abc import Sequence
-from dataclasses import dataclass
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, replace
 from functools import lru_cache
 
 import numpy as np
 import xarray as xr
 
+from geardyn.core.settings import warn_deprecated
 from geardyn.errors import ParameterError
+from geardyn.gears.faults import BrokenTooth, Fault, RootCrack, Spall, Wear
 from geardyn.gears.geometry import GearMesh, SpurGear
 from geardyn.units import to_si
 
@@ -91,6 +98,10 @@ SAINSOT_COEFFS: dict[str, tuple[float, ...]] = {
     "P": (-50.952e-5, 185.50e-3, 0.0538e-4, 53.300e-3, 0.2895, 0.9236),
     "Q": (-6.2042e-5, 9.0889e-3, -4.0964e-4, 7.8297e-3, -0.1472, 0.6904),
 }
+
+#: Degree of the Chebyshev interpolant of Archard's wear rate on each smooth stretch of the
+#: flank (the interpolation error is below 1e-10 of the largest depth for spur teeth).
+ARCHARD_DEGREE = 40
 
 #: The energy terms of one tooth, in the order of the compliance sum.
 TOOTH_TERMS = ("bending", "shear", "axial", "fillet")
@@ -110,7 +121,11 @@ class ToothModel:
     ``top`` is the upper limit of the involute parameter alpha (the root end of the involute
     cantilever), ``tip`` its value at the tip circle; ``segment`` is (x_root, x_base, h_b) of
     the straight part between the root and base circles, or None; ``fillet`` holds Sainsot's
-    (L*, M*, P*, Q*)."""
+    (L*, M*, P*, Q*). ``pitch_roll`` is the roll angle tan(alpha) of the reference circle and
+    ``start_roll`` that of the lowest contact of the flank in its mesh (the start of the active
+    profile; 0, the base circle, until the mesh is known: :func:`prepare_pair` sets it). A flank
+    point at roll angle t lies at alpha = half_base_angle - t, r_b t^2 / 2 along the involute
+    from the base circle."""
 
     name: str
     base_radius: float
@@ -122,6 +137,8 @@ class ToothModel:
     theta_f: float
     bore_radius: float
     fillet: tuple[float, float, float, float]
+    pitch_roll: float = math.nan
+    start_roll: float = 0.0
 
     @property
     def h_fi(self) -> float:
@@ -163,7 +180,8 @@ def tooth_model(gear: SpurGear, bore_radius: float, *, root_segment: bool = True
     tip = a2 - math.sqrt((gear.tip_radius / r_b) ** 2 - 1.0)
     return ToothModel(name=role, base_radius=r_b, root_radius=r_f, half_base_angle=a2,
                       top=top, tip=tip, segment=segment, theta_f=theta_f, bore_radius=bore_radius,
-                      fillet=fillet)  # type: ignore[arg-type]
+                      fillet=fillet,  # type: ignore[arg-type]
+                      pitch_roll=math.tan(gear.pressure_angle))
 
 
 @lru_cache(maxsize=8)
@@ -178,41 +196,6 @@ def contact_point(tooth: ToothModel, alpha1: np.ndarray) -> tuple[np.ndarray, np
     roll = alpha1 + a2
     return (r_b * (np.cos(alpha1) + roll * np.sin(alpha1)),
             r_b * (roll * np.cos(alpha1) - np.sin(alpha1)))
-
-
-@dataclass(frozen=True)
-class RootCrack:
-    """A straight crack at the root of one tooth's loaded flank (Tian 2004; Wu, Zuo & Parey
-    2008; Chen & Shao 2011): ``depth`` q [m] along the crack, ``angle`` v [rad] between the crack
-    and the tooth's centre line (q sin v is its reach across the tooth), on tooth ``tooth`` of
-    ``gear`` ("pinion" or "wheel"; tooth 0 passes the pitch point at pinion angle 0, tooth j
-    j mesh cycles later). Quantities may be unit strings."""
-
-    depth: float
-    angle: float = math.radians(45.0)
-    gear: str = "pinion"
-    tooth: int = 0
-
-    def __post_init__(self) -> None:
-        set_ = object.__setattr__
-        try:
-            set_(self, "depth", to_si(self.depth, "length"))
-            set_(self, "angle", to_si(self.angle, "angle"))
-        except ValueError as exc:
-            raise ParameterError("crack", self, str(exc)) from None
-        if not (math.isfinite(self.depth) and self.depth >= 0.0):
-            raise ParameterError("crack.depth", self.depth, "must be a finite length >= 0")
-        if not 0.0 < self.angle <= 0.5 * math.pi * (1.0 + 1e-12):  # "90 deg" in float
-            raise ParameterError("crack.angle", self.angle, "must lie in (0, 90 deg]")
-        if self.gear not in ("pinion", "wheel"):
-            raise ParameterError("crack.gear", self.gear, "must be 'pinion' or 'wheel'")
-        if isinstance(self.tooth, bool) or not isinstance(self.tooth, numbers.Integral):
-            raise ParameterError("crack.tooth", self.tooth, "must be a whole number")
-
-    @property
-    def reach(self) -> float:
-        """q sin v [m]: how far the crack tip lies inside the flank, across the tooth."""
-        return self.depth * math.sin(self.angle)
 
 
 def root_half_thickness(tooth: ToothModel) -> float:
@@ -245,11 +228,51 @@ def crack_limit(tooth: ToothModel, h_q: float) -> float:
     return hi
 
 
+#: (I, A) of a faulty section from its healthy half thickness h and involute parameter alpha.
+Section = Callable[[np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray]]
+
+
+def _crack_section(h_q: float, b: float) -> Section:
+    """(I, A) of sections cut by a crack limit line h_q from the centre line: h + h_q thick."""
+    return lambda h, al: ((h + h_q) ** 3 * b / 12.0, (h + h_q) * b)
+
+
+def _spall_section(width: float, depth: float, b: float) -> Section:
+    """(I, A) of the 2h x b section less a ``depth`` x ``width`` rectangle at the loaded flank,
+    I about the reduced section's own centroid (shifted by y_c towards the other flank)."""
+    cut = width * depth
+
+    def section(h: np.ndarray, al: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        area = 2.0 * h * b - cut
+        y_c = -cut * (h - 0.5 * depth) / area
+        inertia = ((2.0 / 3.0) * h ** 3 * b + 2.0 * h * b * y_c ** 2
+                   - width * depth ** 3 / 12.0 - cut * (h - 0.5 * depth - y_c) ** 2)
+        return inertia, area
+
+    return section
+
+
+def _wear_section(depth: float, b: float) -> Section:
+    """(I, A) of sections thinned by ``depth`` at the loaded flank: 2h - depth thick."""
+    return lambda h, al: ((2.0 * h - depth) ** 3 * b / 12.0, (2.0 * h - depth) * b)
+
+
+def _profile_section(profile: WearProfile, a2: float, b: float) -> Section:
+    """(I, A) of sections thinned by the wear depth ``profile`` at their flank point."""
+
+    def section(h: np.ndarray, al: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        t = 2.0 * h - profile.depth_at(a2 - al)
+        return t ** 3 * b / 12.0, t * b
+
+    return section
+
+
 def _involute_piece(tooth: ToothModel, a1: np.ndarray, lower: np.ndarray, upper: np.ndarray,
-                    h_q: float | None, young: float, face_width: float,
+                    section: Section | None, young: float, face_width: float,
                     nodes: int) -> tuple[np.ndarray, np.ndarray]:
     """(int M^2/(E I) dx / F^2, int dx / A) over alpha in [lower, upper] of the involute
-    cantilever; the section is 2h wide, or h + h_q on a cracked tooth."""
+    cantilever; the section is 2h wide, or ``section(h, alpha)`` gives (I, A) of a faulty
+    one."""
     r_b, a2, b, e = tooth.base_radius, tooth.half_base_angle, face_width, young
     xg, wg = _gauss(nodes)
     half = 0.5 * (upper - lower)[..., None]
@@ -262,24 +285,94 @@ def _involute_piece(tooth: ToothModel, a1: np.ndarray, lower: np.ndarray, upper:
     x_c, h_c = contact_point(tooth, a1)
     cos1, sin1 = np.cos(a1), np.sin(a1)
     arm = cos1[..., None] * (x_c[..., None] - x) - (sin1 * h_c)[..., None]
-    if h_q is None:
+    if section is None:
         inertia, area = (2.0 / 3.0) * h ** 3 * b, 2.0 * h * b
     else:
-        inertia, area = (h + h_q) ** 3 * b / 12.0, (h + h_q) * b
+        inertia, area = section(h, al)
     return (np.sum(arm ** 2 / (e * inertia) * dx, axis=-1), np.sum(dx / area, axis=-1))
+
+
+def profile_roll(tooth: ToothModel, position: float) -> float:
+    """The roll angle of the flank point ``position`` [m] along the involute from the reference
+    circle (positive towards the tip); NaN below the base circle."""
+    s = 0.5 * tooth.base_radius * tooth.pitch_roll ** 2 + position
+    return math.sqrt(2.0 * s / tooth.base_radius) if s >= 0.0 else math.nan
+
+
+def spall_rolls(tooth: ToothModel, spall: Spall) -> tuple[float, float]:
+    """(t_lo, t_hi): the roll angles of the root- and tip-side edges of ``spall``."""
+    return (profile_roll(tooth, spall.position - 0.5 * spall.length),
+            profile_roll(tooth, spall.position + 0.5 * spall.length))
+
+
+def half_thickness(tooth: ToothModel, alpha: float) -> float:
+    """h(alpha) [m] of the involute flank."""
+    a2 = tooth.half_base_angle
+    return tooth.base_radius * (math.sin(alpha) + (a2 - alpha) * math.cos(alpha))
+
+
+@dataclass(frozen=True)
+class WearProfile:
+    """The wear depth along the loaded flank of a worn tooth: ``depth_at(t)`` [m] at the flank's
+    roll angles t [rad] on its active profile, smooth between the roll angles ``rolls``
+    (ascending, from the start of the active profile to the tip)."""
+
+    rolls: tuple[float, ...]
+    depth_at: Callable[[np.ndarray], np.ndarray]
+
+
+def _section_loss(tooth: ToothModel, fault: Spall | Wear, face_width: float,
+                  profile: WearProfile | None) -> tuple[list[float], Section]:
+    """(breaks, section): the involute parameters (ascending) from where ``fault`` thins the
+    sections to where it stops, the section smooth between them, and its (I, A)."""
+    a2 = tooth.half_base_angle
+    if isinstance(fault, Spall):
+        t_lo, t_hi = spall_rolls(tooth, fault)
+        return [a2 - t_hi, a2 - t_lo], _spall_section(fault.width, fault.depth, face_width)
+    if fault.profile == "uniform":
+        return [tooth.tip, a2 - tooth.start_roll], _wear_section(fault.depth, face_width)
+    if profile is None:
+        raise ParameterError("wear.profile", fault.profile,
+                             "Archard's profile needs the mesh: pass wear_profile="
+                             "PotentialEnergyPair.wear_profile(wear)")
+    return sorted(a2 - t for t in profile.rolls), _profile_section(profile, a2, face_width)
+
+
+def _one_fault(fault: object, crack: object, where: str) -> object:
+    """``fault``, or the deprecated ``crack`` keyword's value (one DeprecationWarning)."""
+    if crack is None:
+        return fault
+    if fault is not None:
+        raise TypeError(f"{where}: give fault= only (crack= is its deprecated spelling)")
+    warn_deprecated(where, ["crack"], ["fault=geardyn.gears.RootCrack(...)"], stacklevel=3)
+    return crack
 
 
 def tooth_compliances(tooth: ToothModel, alpha1: np.ndarray, *, young: float, poisson: float,
                       face_width: float, nodes: int = DEFAULT_NODES,
+                      fault: Fault | None = None, wear_profile: WearProfile | None = None,
                       crack: RootCrack | None = None) -> dict[str, np.ndarray]:
     """Compliances 1/k_b, 1/k_s, 1/k_a, 1/k_f [m/N] of ``tooth`` loaded at the load angles
-    ``alpha1`` [rad] (any shape), by name (:data:`TOOTH_TERMS`).
+    ``alpha1`` [rad] (any shape), by name (:data:`TOOTH_TERMS`), with ``fault`` (its gear and
+    tooth index are not looked at here; a fault of zero size is the healthy tooth):
 
-    A ``crack`` of nonzero depth (its gear and tooth index are not looked at here) narrows every
-    section below Tian's crack limit line to h + h_q, h_q = h_r - q sin v (h_r: the root
-    section's half thickness), bending arm unchanged; the fillet term stays healthy (Chen & Shao
-    2011). Cracks reaching past the centre line (q sin v >= h_r) are refused. A zero-depth crack
-    is the healthy tooth."""
+    * :class:`RootCrack`: every section below Tian's crack limit line narrows to h + h_q,
+      h_q = h_r - q sin v (h_r: the root section's half thickness), bending arm unchanged; the
+      fillet term stays healthy (Chen & Shao 2011). Cracks reaching past the centre line
+      (q sin v >= h_r) are refused.
+    * :class:`Spall`: the sections whose flank point lies on the spall lose a depth x width
+      rectangle at the loaded flank: A = 2hb - w d, I about the reduced section's centroid
+      (after Saxena, Parey & Chouksey 2016; Liang, Zhang, Liu & Zuo 2016); bending arm and
+      fillet unchanged. The
+      contact width (Hertz) is the pair's: see :class:`PotentialEnergyPair`.
+    * :class:`Wear`: the sections of the active profile (from ``tooth.start_roll`` to the tip)
+      thin to 2h - h_w (Chen, Lei, Fu & Hou 2021), h_w the uniform depth or, for Archard's
+      profile, ``wear_profile``'s depth at the section's flank point
+      (:meth:`PotentialEnergyPair.wear_profile`); fillet unchanged.
+
+    ``crack=`` is the deprecated spelling of ``fault=`` for a root crack. A
+    :class:`BrokenTooth` has no compliance (refused)."""
+    fault = _one_fault(fault, crack, "tooth_compliances")
     a1 = np.asarray(alpha1, dtype=float)
     lower = -a1
     if np.any(lower >= tooth.top):
@@ -289,19 +382,32 @@ def tooth_compliances(tooth: ToothModel, alpha1: np.ndarray, *, young: float, po
     g = young / (2.0 * (1.0 + poisson))
     top = np.full(a1.shape, tooth.top)
     h_q: float | None = None
-    if crack is None or crack.depth == 0.0:
+    if isinstance(fault, BrokenTooth):
+        raise ParameterError("fault", fault, "a missing tooth has no compliance")
+    if fault is None or fault.is_null:
         bending, inv_area = _involute_piece(tooth, a1, lower, top, None, e, b, nodes)
-    else:
+    elif isinstance(fault, RootCrack):
         h_r = root_half_thickness(tooth)
-        if not crack.reach < h_r:
-            raise ParameterError("crack.depth", crack.depth,
-                                 f"the crack reaches {crack.reach:.4g} m across the tooth, past"
+        if not fault.reach < h_r:
+            raise ParameterError("crack.depth", fault.depth,
+                                 f"the crack reaches {fault.reach:.4g} m across the tooth, past"
                                  f" its centre line (root half thickness {h_r:.4g} m)")
-        h_q = h_r - crack.reach
+        h_q = h_r - fault.reach
         split = np.maximum(lower, crack_limit(tooth, h_q))
         bend_h, area_h = _involute_piece(tooth, a1, lower, split, None, e, b, nodes)
-        bend_c, area_c = _involute_piece(tooth, a1, split, top, h_q, e, b, nodes)
+        bend_c, area_c = _involute_piece(tooth, a1, split, top, _crack_section(h_q, b), e, b,
+                                         nodes)
         bending, inv_area = bend_h + bend_c, area_h + area_c
+    elif isinstance(fault, (Spall, Wear)):
+        breaks, section = _section_loss(tooth, fault, b, wear_profile)
+        cuts = [np.minimum(np.maximum(lower, x), top) for x in breaks]
+        bending, inv_area = _involute_piece(tooth, a1, lower, cuts[0], None, e, b, nodes)
+        pieces = [(lo, hi, section) for lo, hi in zip(cuts, cuts[1:], strict=False)]
+        for lo, hi, sec in [*pieces, (cuts[-1], top, None)]:
+            piece = _involute_piece(tooth, a1, lo, hi, sec, e, b, nodes)
+            bending, inv_area = bending + piece[0], inv_area + piece[1]
+    else:
+        raise ParameterError("fault", fault, "must be a RootCrack, Spall, Wear or None")
     cos1, sin1 = np.cos(a1), np.sin(a1)
     shear = 1.2 * cos1 ** 2 / g * inv_area
     axial = sin1 ** 2 / e * inv_area
@@ -342,7 +448,8 @@ def hertz_stiffness(young: float, poisson: float, face_width: float) -> float:
 
 @dataclass(frozen=True)
 class PotentialEnergyPair:
-    """A spur mesh prepared for the potential-energy method: both teeth, material, width."""
+    """A spur mesh prepared for the potential-energy method: both teeth, material, width and
+    the ``faults`` (each on its own tooth; zero-size ones included)."""
 
     mesh: GearMesh
     pinion: ToothModel
@@ -351,7 +458,8 @@ class PotentialEnergyPair:
     poisson: float
     face_width: float
     nodes: int
-    crack: RootCrack | None = None
+    faults: tuple[Fault, ...] = ()
+    wear_profiles: tuple[tuple[Wear, WearProfile], ...] = ()
 
     @property
     def hertz(self) -> float:
@@ -367,27 +475,132 @@ class PotentialEnergyPair:
         return (s1 / self.pinion.base_radius - self.pinion.half_base_angle,
                 s2 / self.wheel.base_radius - self.wheel.half_base_angle)
 
-    def terms(self, position: np.ndarray,
-              faulty: np.ndarray | None = None) -> dict[str, np.ndarray]:
+    def _flank(self, gear: str) -> tuple[Callable, Callable]:
+        """(position of roll, roll of position): the line-of-action position s [m] of the contact
+        at roll angle t of ``gear``'s drive flank, and back."""
+        mesh = self.mesh
+        s_p = mesh.pinion.base_radius * math.tan(mesh.operating_pressure_angle)
+        if gear == "pinion":
+            r_b = mesh.pinion.base_radius
+            return (lambda t: r_b * t - s_p), (lambda s: (s + s_p) / r_b)
+        r_b, length = mesh.wheel.base_radius, mesh.line_of_action_length
+        return (lambda t: length - s_p - r_b * t), (lambda s: (length - s_p - s) / r_b)
+
+    def archard_rate(self, gear: str, position: np.ndarray) -> np.ndarray:
+        """Archard's wear per mesh passage of ``gear``'s flank point in contact at ``position``
+        [m], up to the wear coefficient over the face width: the load share q = k / sum k of the
+        healthy pairs in contact (equal approach) times the slip |v_1 - v_2| / v of the point
+        (v = omega rho, rho the radius of curvature, the distance from the gear's tangent point
+        on the line of action). Archard (1953): wear depth = k_w x pressure x sliding distance;
+        Flodin & Andersson (1997) integrate it along spur flanks in the same way."""
+        mesh = self.mesh
+        s = np.asarray(position, dtype=float)
+        p_b, g_f, g_a = mesh.base_pitch, mesh.approach_length, mesh.recess_length
+        k = self.terms(s)["pair"]
+        total = k.copy()
+        for m in (-2, -1, 1, 2):
+            other = s + m * p_b
+            inside = (other >= -g_f) & (other < g_a)
+            if inside.any():
+                total[inside] += self.terms(other[inside])["pair"]
+        rho1 = mesh.pinion.base_radius * math.tan(mesh.operating_pressure_angle) + s
+        rho2 = mesh.line_of_action_length - rho1
+        ratio = mesh.pinion.teeth / mesh.wheel.teeth  # omega_2 / omega_1
+        slip = (np.abs(1.0 - ratio * rho2 / rho1) if gear == "pinion"
+                else np.abs(1.0 - rho1 / (ratio * rho2)))
+        return k / total * slip
+
+    def wear_profile(self, wear: Wear) -> WearProfile:
+        """The depth of ``wear`` along its flank (module docstring of
+        :mod:`geardyn.gears.faults`): uniform, or Archard's h(t) = depth r(s(t)) / max r,
+        r = :meth:`archard_rate` (one wear step on the healthy mesh), its maximum taken over 129
+        points of each smooth stretch of the path of contact (ends included). Within each
+        stretch (between the path's ends, the single-contact ends and the pitch point) r is
+        smooth and is evaluated by its Chebyshev interpolant of degree
+        :data:`ARCHARD_DEGREE` in the roll angle."""
+        tooth = self.pinion if wear.gear == "pinion" else self.wheel
+        t_start, t_tip = tooth.start_roll, tooth.half_base_angle - tooth.tip
+        depth = wear.depth
+        if wear.profile == "uniform":
+            return WearProfile((t_start, t_tip), lambda t: np.full(np.shape(t), depth))
+        mesh = self.mesh
+        p_b, g_f, g_a = mesh.base_pitch, mesh.approach_length, mesh.recess_length
+        at, roll = self._flank(wear.gear)
+        ends = sorted({-g_f, g_a - p_b, 0.0, p_b - g_f, g_a})
+        ends = [x for x in ends if -g_f <= x <= g_a]
+        nudge = 1e-9 * p_b  # the one-sided limits at the ends of each stretch
+        grid = np.concatenate([np.linspace(lo + nudge, hi - nudge, 129)
+                               for lo, hi in zip(ends, ends[1:], strict=False)])
+        scale = depth / float(np.max(self.archard_rate(wear.gear, grid)))
+        rolls = tuple(sorted(float(roll(x)) for x in ends))
+        gear = wear.gear
+        pieces = []
+        for lo, hi in zip(rolls, rolls[1:], strict=False):
+            mid, half = 0.5 * (hi + lo), 0.5 * (hi - lo)
+
+            def rate(x: np.ndarray, mid: float = mid, half: float = half) -> np.ndarray:
+                return scale * self.archard_rate(gear, at(mid + half * x))
+
+            pieces.append((mid, half, np.polynomial.chebyshev.chebinterpolate(
+                rate, ARCHARD_DEGREE)))
+        inner = np.array(rolls[1:-1])
+
+        def depth_at(t: np.ndarray) -> np.ndarray:
+            t = np.asarray(t, dtype=float)
+            which = np.searchsorted(inner, t, side="right")
+            out = np.zeros(t.shape)
+            for i, (mid, half, coef) in enumerate(pieces):
+                mask = which == i
+                if mask.any():
+                    out[mask] = np.polynomial.chebyshev.chebval((t[mask] - mid) / half, coef)
+            return out
+
+        return WearProfile(rolls, depth_at)
+
+    def profile_of(self, fault: Fault | None) -> WearProfile | None:
+        """The :class:`WearProfile` of a :class:`Wear` of this pair's ``faults``, else None."""
+        for wear, profile in self.wear_profiles:
+            if wear is fault:
+                return profile
+        return None
+
+    def _lost_width(self, tooth: ToothModel, fault: Fault | None,
+                    a1: np.ndarray) -> np.ndarray | None:
+        """The face width [m] a spall takes from contacts at load angles ``a1`` on its flank
+        (0 off the spall), or None without a spall."""
+        if not isinstance(fault, Spall) or fault.is_null:
+            return None
+        t_lo, t_hi = spall_rolls(tooth, fault)
+        roll = a1 + tooth.half_base_angle
+        return np.where((roll >= t_lo) & (roll <= t_hi), fault.width, 0.0)
+
+    def terms(self, position: np.ndarray, pinion: Fault | None = None,
+              wheel: Fault | None = None, *, coast: bool = False) -> dict[str, np.ndarray]:
         """Stiffness [N/m] of each energy term (``hertz``, ``bending_pinion``, ...,
-        ``fillet_wheel``) and of the pair (``pair``) for contacts at ``position`` [m]. With a
-        ``crack``, the cracked gear's tooth is the cracked one where ``faulty`` (a boolean
-        array like ``position``; None: everywhere)."""
+        ``fillet_wheel``) and of the pair (``pair``) for contacts at ``position`` [m] between a
+        pinion tooth with the fault ``pinion`` and a wheel tooth with ``wheel`` (None:
+        healthy). A spall on the loaded flank narrows the Hertz contact to b - w where the
+        contact lies on it (Chaari, Baccar, Abbes & Haddar 2008; the wider spall where both
+        teeth have one there); ``coast``: the contacts are on the coast flanks, which a spall
+        does not touch."""
         pos = np.asarray(position, dtype=float)
         a_p, a_w = self.load_angles(pos)
         kw = dict(young=self.young, poisson=self.poisson, face_width=self.face_width,
                   nodes=self.nodes)
         out = {"hertz": np.full(pos.shape, self.hertz)}
-        compliance = np.full(pos.shape, 1.0 / self.hertz)
-        for role, tooth, a1 in (("pinion", self.pinion, a_p), ("wheel", self.wheel, a_w)):
-            comp = tooth_compliances(tooth, a1, **kw)
-            if self.crack is not None and self.crack.gear == role:
-                mask = np.ones(pos.shape, bool) if faulty is None else np.asarray(faulty, bool)
-                if mask.any():
-                    cracked = tooth_compliances(tooth, a1[mask], crack=self.crack, **kw)
-                    for t in comp:
-                        comp[t] = comp[t].copy()
-                        comp[t][mask] = cracked[t]
+        if not coast:
+            lost = [w for w in (self._lost_width(self.pinion, pinion, a_p),
+                                self._lost_width(self.wheel, wheel, a_w)) if w is not None]
+            if lost:
+                width = self.face_width - np.maximum.reduce(lost)
+                out["hertz"] = np.where(width < self.face_width,
+                                        hertz_stiffness(self.young, self.poisson, width),
+                                        self.hertz)
+        compliance = 1.0 / out["hertz"]
+        for role, tooth, a1, fault in (("pinion", self.pinion, a_p, pinion),
+                                       ("wheel", self.wheel, a_w, wheel)):
+            comp = tooth_compliances(tooth, a1, fault=fault, wear_profile=self.profile_of(fault),
+                                     **kw)
             for term, c in comp.items():
                 out[f"{term}_{role}"] = 1.0 / c
                 compliance = compliance + c
@@ -414,11 +627,32 @@ def _bores(bore_radius: object) -> tuple[object, object]:
     return bore_radius[0], bore_radius[1]
 
 
+def _fault_tuple(faults: object, crack: object, where: str) -> tuple[object, ...]:
+    """``faults`` (one fault or a sequence) as a tuple, with the deprecated ``crack`` keyword's
+    value (one DeprecationWarning pointing at the public function's caller)."""
+    if faults is None:
+        out: tuple[object, ...] = ()
+    elif isinstance(faults, Sequence) and not isinstance(faults, str):
+        out = tuple(faults)
+    else:
+        out = (faults,)
+    if crack is None:
+        return out
+    if out:
+        raise TypeError(f"{where}: give the faults as faults=(...) only (crack= is the"
+                        " deprecated spelling of one root crack)")
+    warn_deprecated(where, ["crack"], ["faults=(geardyn.gears.RootCrack(...),)"], stacklevel=3)
+    return (crack,)
+
+
 def prepare_pair(mesh: GearMesh, *, bore_radius: object, young: object = STEEL_YOUNG,
                  poisson: object = STEEL_POISSON, root_segment: bool = True,
-                 nodes: int = DEFAULT_NODES,
+                 nodes: int = DEFAULT_NODES, faults: object = (),
                  crack: RootCrack | None = None) -> PotentialEnergyPair:
-    """Validate the inputs of :func:`potential_energy_stiffness` and build both teeth."""
+    """Validate the inputs of :func:`potential_energy_stiffness` and build both teeth (their
+    ``start_roll`` at the mesh's lowest contacts). ``crack=`` is the deprecated spelling of
+    ``faults=(crack,)``."""
+    fault_list = _fault_tuple(faults, crack, "prepare_pair")
     if mesh.internal:
         raise ParameterError("mesh.internal", True,
                              "the potential-energy stiffness covers external pairs only")
@@ -436,25 +670,89 @@ def prepare_pair(mesh: GearMesh, *, bore_radius: object, young: object = STEEL_Y
     for role, gear, bore in (("pinion", mesh.pinion, bp), ("wheel", mesh.wheel, bw)):
         r = _positive(bore, "length", f"{role}.bore_radius")
         teeth.append(tooth_model(gear, r, root_segment=root_segment, role=role))
+    # the lowest contacts: the pinion's at the start of the path, the wheel's at its end
+    s1 = mesh.pinion.base_radius * math.tan(mesh.operating_pressure_angle)
+    starts = ((s1 - mesh.approach_length) / mesh.pinion.base_radius,
+              (mesh.line_of_action_length - s1 - mesh.recess_length) / mesh.wheel.base_radius)
+    teeth = [replace(t, start_roll=max(start, 0.0)) for t, start in zip(teeth, starts,
+                                                                         strict=True)]
     width = min(mesh.pinion.face_width, mesh.wheel.face_width)
-    if crack is not None:
-        _check_crack(crack, mesh, teeth)
-    return PotentialEnergyPair(mesh=mesh, pinion=teeth[0], wheel=teeth[1], young=e,
-                               poisson=nu, face_width=width, nodes=int(nodes), crack=crack)
+    _check_faults(fault_list, mesh, teeth, width)
+    pair = PotentialEnergyPair(mesh=mesh, pinion=teeth[0], wheel=teeth[1], young=e,
+                               poisson=nu, face_width=width, nodes=int(nodes),
+                               faults=fault_list)  # type: ignore[arg-type]
+    wears = [f for f in fault_list if isinstance(f, Wear)]
+    if not wears:
+        return pair
+    return replace(pair, wear_profiles=tuple((w, pair.wear_profile(w)) for w in wears))
 
 
-def _check_crack(crack: object, mesh: GearMesh, teeth: list[ToothModel]) -> None:
-    if not isinstance(crack, RootCrack):
-        raise ParameterError("crack", crack, "must be a RootCrack or None")
-    tooth = teeth[0] if crack.gear == "pinion" else teeth[1]
-    z = (mesh.pinion if crack.gear == "pinion" else mesh.wheel).teeth
-    if not 0 <= crack.tooth < z:
-        raise ParameterError("crack.tooth", crack.tooth, f"must lie in [0, {z - 1}]")
+def _check_faults(faults: tuple[object, ...], mesh: GearMesh, teeth: list[ToothModel],
+                  width: float) -> None:
+    """Each fault a fault object, on a tooth that exists, one fault a tooth, and fitting its
+    tooth (errors name the fault's field)."""
+    seen: dict[tuple[str, int], object] = {}
+    for fault in faults:
+        if not isinstance(fault, (RootCrack, Spall, Wear, BrokenTooth)):
+            raise ParameterError("faults", fault,
+                                 "must be RootCrack, Spall, Wear or BrokenTooth objects")
+        kind = fault.kind
+        z = (mesh.pinion if fault.gear == "pinion" else mesh.wheel).teeth
+        if not 0 <= fault.tooth < z:
+            raise ParameterError(f"{kind}.tooth", fault.tooth, f"must lie in [0, {z - 1}]")
+        key = (fault.gear, fault.tooth)
+        if key in seen:
+            raise ParameterError("faults", fault, f"{fault.gear} tooth {fault.tooth} already"
+                                 f" has a fault ({seen[key]!r}): one fault a tooth")
+        seen[key] = fault
+        tooth = teeth[0] if fault.gear == "pinion" else teeth[1]
+        if isinstance(fault, RootCrack):
+            _check_crack(fault, tooth)
+        elif isinstance(fault, Spall):
+            _check_spall(fault, tooth, width)
+        elif isinstance(fault, Wear):
+            h_tip = half_thickness(tooth, tooth.tip)
+            if not fault.depth < h_tip:
+                raise ParameterError("wear.depth", fault.depth,
+                                     f"must be less than the half thickness at the tip,"
+                                     f" {h_tip:.4g} m")
+
+
+def _check_crack(crack: RootCrack, tooth: ToothModel) -> None:
     h_r = root_half_thickness(tooth)
     if not crack.reach < h_r:
         raise ParameterError("crack.depth", crack.depth,
                              f"the crack reaches {crack.reach:.4g} m across the tooth, past its"
                              f" centre line (root half thickness {h_r:.4g} m)")
+
+
+def _check_spall(spall: Spall, tooth: ToothModel, width: float) -> None:
+    """The spall narrower than the face and on the active profile, its depth short of the
+    centre line."""
+    if not spall.width < width:
+        raise ParameterError("spall.width", spall.width,
+                             f"must be less than the face width {width:.6g} m")
+    r_b, a2 = tooth.base_radius, tooth.half_base_angle
+    t_start, t_tip = tooth.start_roll, a2 - tooth.tip
+
+    def along(t: float) -> float:  # from the reference circle along the involute [m]
+        return 0.5 * r_b * (t * t - tooth.pitch_roll ** 2)
+
+    active = f"[{along(t_start):.6g}, {along(t_tip):.6g}] m from the reference circle"
+    if not along(t_start) <= spall.position <= along(t_tip):
+        raise ParameterError("spall.position", spall.position,
+                             f"off the active flank of {tooth.name}: the active profile lies"
+                             f" {active}")
+    t_lo, t_hi = spall_rolls(tooth, spall)
+    if not (t_lo >= t_start * (1.0 - 1e-12) and t_hi <= t_tip * (1.0 + 1e-12)):
+        raise ParameterError("spall.length", spall.length,
+                             f"the spall reaches off the active flank of {tooth.name}: the"
+                             f" active profile lies {active}")
+    h_min = half_thickness(tooth, a2 - t_hi)
+    if not spall.depth < h_min:
+        raise ParameterError("spall.depth", spall.depth,
+                             f"must be less than the half thickness {h_min:.4g} m at the"
+                             " spall's tip-side edge")
 
 
 def _cycle_grid(mesh: GearMesh, angles: object,
@@ -496,15 +794,48 @@ def coast_phase(mesh: GearMesh) -> float:
     return mesh.pinion.angular_thickness(r_w1) * mesh.pinion.teeth / (2.0 * math.pi)
 
 
-def _coast(pair: PotentialEnergyPair, n: np.ndarray, frac: np.ndarray,
-           crack: RootCrack | None) -> tuple[dict[str, tuple], np.ndarray]:
+def _fault_codes(pair: PotentialEnergyPair, tooth_p: np.ndarray,
+                 tooth_w: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Per pair slot: the index into ``pair.faults`` of the pinion and the wheel tooth's fault
+    (-1: none, or one of zero size), and whether either tooth is missing."""
+    mesh = pair.mesh
+    luts = {"pinion": np.full(mesh.pinion.teeth, -1), "wheel": np.full(mesh.wheel.teeth, -1)}
+    gone = {"pinion": np.zeros(mesh.pinion.teeth, bool),
+            "wheel": np.zeros(mesh.wheel.teeth, bool)}
+    for i, fault in enumerate(pair.faults):
+        if isinstance(fault, BrokenTooth):
+            gone[fault.gear][fault.tooth] = True
+        elif not fault.is_null:
+            luts[fault.gear][fault.tooth] = i
+    return (luts["pinion"][tooth_p], luts["wheel"][tooth_w],
+            gone["pinion"][tooth_p] | gone["wheel"][tooth_w])
+
+
+def _wear_gap(pair: PotentialEnergyPair, position: np.ndarray, inside: np.ndarray,
+              tooth_p: np.ndarray, tooth_w: np.ndarray) -> np.ndarray:
+    """The gap [m] the worn teeth open at the drive contacts ``inside`` (0 elsewhere): the
+    wear depth at each contact's point of the worn flank, both teeth's added."""
+    gap = np.zeros(position.shape)
+    for wear, profile in pair.wear_profiles:
+        if wear.is_null:
+            continue
+        mask = inside & ((tooth_p if wear.gear == "pinion" else tooth_w) == wear.tooth)
+        if mask.any():
+            where, inverse = np.unique(position[mask], return_inverse=True)
+            gap[mask] += profile.depth_at(pair._flank(wear.gear)[1](where))[inverse]
+    return gap
+
+
+def _coast(pair: PotentialEnergyPair, n: np.ndarray,
+           frac: np.ndarray) -> tuple[dict[str, tuple], np.ndarray]:
     """The coast-flank variables (``*_coast``) over the grid, and the coast pair indices.
 
     Coast pair k' holds the pinion tooth whose coast flank passed the pitch point k' mesh cycles
     before the start of cycle n, (n - k') mod z1, against wheel tooth (n - k' + 1) mod z2 (the
     wheel tooth behind it); its contact lies (phi - frac - k') p_b from the pitch point towards
     the pinion tip on the coast line of action and moves towards the pinion root. A pair is in
-    contact from the end of the path (included) to its start (excluded)."""
+    contact from the end of the path (included) to its start (excluded), unless one of its
+    teeth is missing."""
     mesh = pair.mesh
     p_b, phi = mesh.base_pitch, coast_phase(mesh)
     start, end = -mesh.approach_length / p_b, mesh.recess_length / p_b
@@ -514,10 +845,10 @@ def _coast(pair: PotentialEnergyPair, n: np.ndarray, frac: np.ndarray,
     position = u * p_b
     passage = n.astype(np.int64)[:, None] - ks[None, :]
     tooth_p, tooth_w = passage % mesh.pinion.teeth, (passage + 1) % mesh.wheel.teeth
-    faulty = None
-    if crack is not None:
-        faulty = inside & ((tooth_p if crack.gear == "pinion" else tooth_w) == crack.tooth)
-    k_pair = np.where(inside, _terms_on_grid(pair, position, inside, faulty)["pair"], 0.0)
+    fp, fw, gone = _fault_codes(pair, tooth_p, tooth_w)
+    inside &= ~gone
+    k_pair = np.where(inside, _terms_on_grid(pair, position, inside, fp, fw, coast=True)["pair"],
+                      0.0)
     dims = ("angle", "pair_coast")
     return {"mesh_stiffness_coast": (("angle",), k_pair.sum(axis=1)),
             "pairs_in_contact_coast": (("angle",), inside.sum(axis=1)),
@@ -529,7 +860,8 @@ def _coast(pair: PotentialEnergyPair, n: np.ndarray, frac: np.ndarray,
 def potential_energy_stiffness(mesh: GearMesh, *, bore_radius: object, angles: object = 360,
                                young: object = STEEL_YOUNG, poisson: object = STEEL_POISSON,
                                root_segment: bool = True, nodes: int = DEFAULT_NODES,
-                               crack: RootCrack | None = None, cycles: int = 1) -> xr.Dataset:
+                               faults: object = (), cycles: int = 1,
+                               crack: RootCrack | None = None) -> xr.Dataset:
     """Mesh stiffness of the external spur ``mesh`` over pinion angles by the potential-energy
     method (module docstring): a Dataset over ``angle`` (pinion rotation [deg]; an int
     ``angles`` is that many points per mesh cycle, 360/z1 deg, over ``cycles`` mesh cycles from
@@ -541,12 +873,16 @@ def potential_energy_stiffness(mesh: GearMesh, *, bore_radius: object, angles: o
 
     Variables: ``mesh_stiffness`` [N/m], ``pairs_in_contact``; per pair ``in_contact``,
     ``position`` (along the line of action from the pitch point [m]), ``pair_stiffness`` [N/m]
-    (0 out of contact) and each energy term's stiffness ``k_hertz``, ``k_bending_pinion``, ...
-    ``k_fillet_wheel`` [N/m] (NaN out of contact). A pair is in contact from the start of the
-    path of contact (included) to its end (excluded). ``bore_radius`` [m]: one radius or
-    (pinion, wheel); ``young`` [Pa], ``poisson``; ``nodes``: Gauss-Legendre nodes. ``crack``:
-    a :class:`RootCrack` on one tooth (see :func:`tooth_compliances`); a pinion tooth returns
-    every z1 mesh cycles, a wheel tooth every z2 (the hunting period: lcm(z1, z2) cycles).
+    (0 out of contact), ``fault_gap`` [m] (the gap the teeth's wear opens, 0 without) and each
+    energy term's stiffness ``k_hertz``, ``k_bending_pinion``, ... ``k_fillet_wheel`` [N/m]
+    (NaN out of contact). A pair is in contact from the start of the path of contact (included)
+    to its end (excluded), unless one of its teeth is missing. ``bore_radius`` [m]: one radius
+    or (pinion, wheel); ``young`` [Pa], ``poisson``; ``nodes``: Gauss-Legendre nodes.
+    ``faults``: one fault or a sequence (:class:`RootCrack`, :class:`Spall`, :class:`Wear`,
+    :class:`BrokenTooth`), each on its own tooth (see :func:`tooth_compliances` and
+    :class:`PotentialEnergyPair`); a pinion tooth returns every z1 mesh cycles, a wheel tooth
+    every z2 (the hunting period: lcm(z1, z2) cycles). ``crack=`` is the deprecated spelling of
+    ``faults=(crack,)``.
 
     The coast flank: ``mesh_stiffness_coast`` [N/m], ``pairs_in_contact_coast`` and per coast
     pair (dimension ``pair_coast``) ``in_contact_coast``, ``position_coast`` [m] (on the coast
@@ -554,11 +890,13 @@ def potential_energy_stiffness(mesh: GearMesh, *, bore_radius: object, angles: o
     ``tooth_pinion_coast``, ``tooth_wheel_coast``, ``pair_stiffness_coast`` [N/m], at the same
     pinion angles with the pinion turned onto its coast flanks (see ``_coast``); attrs
     ``coast_phase_cycles`` (phi), ``backlash_m`` and ``backlash_cycles`` (j / p_w1, the dead
-    zone between the flanks). A crack narrows the cracked tooth's sections under either flank's
-    load (its faces taken open).
+    zone between the flanks). Faults sit on the drive flank: a crack, a spall or wear thins the
+    tooth's sections under either flank's load (crack faces taken open); a spall's contact
+    width and wear's gap act on the drive flank only; a missing tooth carries on neither.
     """
+    fault_list = _fault_tuple(faults, crack, "potential_energy_stiffness")
     pair = prepare_pair(mesh, bore_radius=bore_radius, young=young, poisson=poisson,
-                        root_segment=root_segment, nodes=nodes, crack=crack)
+                        root_segment=root_segment, nodes=nodes, faults=fault_list)
     cyc, n, frac = _cycle_grid(mesh, angles, cycles)
     deg = cyc * (360.0 / mesh.pinion.teeth)
     p_b = mesh.base_pitch
@@ -569,26 +907,28 @@ def potential_energy_stiffness(mesh: GearMesh, *, bore_radius: object, angles: o
     position = u * p_b
     passage = n.astype(np.int64)[:, None] - ks[None, :]  # the pair's pitch-point cycle
     tooth_p, tooth_w = passage % mesh.pinion.teeth, passage % mesh.wheel.teeth
-    faulty = None
-    if crack is not None:
-        faulty = inside & ((tooth_p if crack.gear == "pinion" else tooth_w) == crack.tooth)
-    terms = _terms_on_grid(pair, position, inside, faulty)
+    fp, fw, gone = _fault_codes(pair, tooth_p, tooth_w)
+    inside &= ~gone
+    gap = _wear_gap(pair, position, inside, tooth_p, tooth_w)
+    terms = _terms_on_grid(pair, position, inside, fp, fw)
     k_pair = np.where(inside, terms.pop("pair"), 0.0)
-    coast, ks_c = _coast(pair, n, frac, crack)
+    coast, ks_c = _coast(pair, n, frac)
     data = {"mesh_stiffness": (("angle",), k_pair.sum(axis=1)),
             "pairs_in_contact": (("angle",), inside.sum(axis=1)),
             "in_contact": (("angle", "pair"), inside),
             "position": (("angle", "pair"), position),
             "tooth_pinion": (("angle", "pair"), tooth_p),
             "tooth_wheel": (("angle", "pair"), tooth_w),
-            "pair_stiffness": (("angle", "pair"), k_pair)}
+            "pair_stiffness": (("angle", "pair"), k_pair),
+            "fault_gap": (("angle", "pair"), gap)}
     for name, k in terms.items():
         data[f"k_{name}"] = (("angle", "pair"), np.where(inside, k, np.nan))
     data.update(coast)
     ds = xr.Dataset(data, coords={"angle": deg, "cycle": ("angle", cyc), "pair": ks,
                                   "pair_coast": ks_c})
     for name in ds.data_vars:
-        ds[name].attrs["units"] = "m" if name.startswith("position") else _units(name)
+        ds[name].attrs["units"] = ("m" if name.startswith("position") or name == "fault_gap"
+                                   else _units(name))
     ds["angle"].attrs.update(units="deg", long_name="pinion rotation")
     ds["cycle"].attrs.update(units="", long_name="mesh cycles")
     ds.attrs.update(_attrs(pair, root_segment))
@@ -596,19 +936,25 @@ def potential_energy_stiffness(mesh: GearMesh, *, bore_radius: object, angles: o
 
 
 def _terms_on_grid(pair: PotentialEnergyPair, position: np.ndarray, inside: np.ndarray,
-                   faulty: np.ndarray | None) -> dict[str, np.ndarray]:
+                   fp: np.ndarray, fw: np.ndarray, *, coast: bool = False) -> dict[str, np.ndarray]:
     """Every term at the contacts ``inside`` (0 elsewhere), each distinct position evaluated
-    once (a grid over many mesh cycles repeats the positions of one cycle exactly)."""
+    once (a grid over many mesh cycles repeats the positions of one cycle exactly), then again
+    for each combination (``fp``, ``fw``) of faults on the teeth in contact that occurs."""
     where, inverse = np.unique(position[inside], return_inverse=True)
-    healthy = pair.terms(where, np.zeros(where.shape, bool))
+    healthy = pair.terms(where, coast=coast)
     out = {}
     for name, values in healthy.items():
         out[name] = np.zeros(position.shape)
         out[name][inside] = values[inverse]
-    if faulty is not None and faulty.any():
-        where, inverse = np.unique(position[faulty], return_inverse=True)
-        for name, values in pair.terms(where).items():
-            out[name][faulty] = values[inverse]
+    faulty = inside & ((fp >= 0) | (fw >= 0))
+    if faulty.any():
+        for ip, iw in np.unique(np.stack([fp[faulty], fw[faulty]], axis=1), axis=0):
+            mask = faulty & (fp == ip) & (fw == iw)
+            where, inverse = np.unique(position[mask], return_inverse=True)
+            values = pair.terms(where, pair.faults[ip] if ip >= 0 else None,
+                                pair.faults[iw] if iw >= 0 else None, coast=coast)
+            for name, v in values.items():
+                out[name][mask] = v[inverse]
     return out
 
 
@@ -625,10 +971,7 @@ def _attrs(pair: PotentialEnergyPair, root_segment: bool) -> dict[str, object]:
         "coast_phase_cycles": coast_phase(mesh), "backlash_m": mesh.backlash,
         "backlash_cycles": mesh.backlash / (2.0 * math.pi * mesh.operating_pitch_radii[0]
                                             / mesh.pinion.teeth),
-        "crack": "none" if pair.crack is None else (
-            f"root crack on {pair.crack.gear} tooth {pair.crack.tooth}: depth"
-            f" {pair.crack.depth:.6g} m, angle {math.degrees(pair.crack.angle):.6g} deg"
-            " (Tian's crack limit line; fillet foundation healthy)"),
+        "faults": "; ".join(f.describe() for f in pair.faults) or "none",
     }
     for role, tooth in (("pinion", pair.pinion), ("wheel", pair.wheel)):
         out[f"{role}_bore_radius_m"] = tooth.bore_radius

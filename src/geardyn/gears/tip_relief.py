@@ -8,8 +8,9 @@ A tip relief removes material near a gear's tip: ``amount`` C [m] at the tip, ov
     e(s) = C ((s - (g_a - L)) / L)^p      for s > g_a - L   (pinion relief)
     e(s) = C ((-g_f + L - s) / L)^p       for s < -g_f + L  (wheel relief)
 
-and e = 0 elsewhere; reliefs on both gears add. A relief shorter than the path of contact
-is required (L in (0, g_a + g_f]).
+and e = 0 elsewhere; reliefs on both gears add, and so does the wear depth of a worn tooth
+(:class:`~geardyn.gears.Wear`, the stiffness Dataset's ``fault_gap``) on its pairs. A relief
+shorter than the path of contact is required (L in (0, g_a + g_f]).
 
 The loaded contact (the "unloaded transmission error and load-dependent contact" of the
 potential-energy literature, e.g. Ma, Song, Pang, Chen and co-workers on tip relief with the
@@ -116,7 +117,8 @@ def loaded_contact(mesh: GearMesh, stiffness: xr.Dataset, force: float,
                    relief: tuple[TipRelief, ...] = ()) -> xr.Dataset:
     """The loaded static transmission error and mesh stiffness of ``stiffness`` (a Dataset of
     :func:`~geardyn.gears.potential_energy_stiffness` for ``mesh``) under the normal force
-    ``force`` [N] along the line of action with the tip ``relief`` (module docstring).
+    ``force`` [N] along the line of action with the tip ``relief`` (module docstring); the gaps
+    of worn teeth (its ``fault_gap``) add to the relief's.
 
     Variables over ``angle``: ``unloaded_transmission_error`` [m], ``transmission_error`` [m]
     (delta), ``tangent_stiffness`` and ``secant_stiffness`` [N/m], ``pairs_loaded``; over
@@ -132,8 +134,11 @@ def loaded_contact(mesh: GearMesh, stiffness: xr.Dataset, force: float,
     k = stiffness["pair_stiffness"].values
     inside = stiffness["in_contact"].values
     if not inside.any(axis=1).all():
-        raise ParameterError("stiffness", None, "an angle has no pair in contact")
+        raise ParameterError("stiffness", None, "an angle has no pair in contact (a missing"
+                             " tooth in single contact leaves the gears free there)")
     e = relief_gap(mesh, stiffness["position"].values, relief)
+    if "fault_gap" in stiffness:
+        e = e + stiffness["fault_gap"].values
     delta, loaded = _solve(k, e, f)
     pair_force = np.where(loaded, k * (delta[:, None] - e), 0.0)
     e_min = np.min(np.where(inside, e, np.inf), axis=1)

@@ -1,0 +1,206 @@
+"""Tooth faults of a spur pair for the potential-energy mesh stiffness.
+
+Each fault sits on tooth ``tooth`` of ``gear`` ("pinion" or "wheel"; tooth 0 passes the pitch
+point at pinion angle 0, tooth j j mesh cycles later) and is built from keyword arguments whose
+names are its fields; lengths and angles may be unit strings (:func:`geardyn.units.to_si`).
+What a fault does to the stiffness is in :mod:`geardyn.gears.potential_energy` and
+docs/gears.md; the checks that need the mesh (a crack past the centre line, a spall off the
+active flank, a tooth index beyond the tooth count) are made when the pair is prepared.
+
+* :class:`RootCrack` (``depth``, ``angle``): a straight crack at the root of the loaded flank.
+* :class:`Spall` (``length``, ``width``, ``depth``, ``position``): a rectangular spall or pit on
+  the loaded flank.
+* :class:`Wear` (``depth``, ``profile``): uniform or Archard wear of the loaded flank's active
+  profile.
+* :class:`BrokenTooth`: the tooth is missing.
+
+Errors name the field as ``<kind>.<field>`` (``spall.position``), with the kind of
+:data:`FAULT_KINDS` (``crack`` for a root crack).
+"""
+
+from __future__ import annotations
+
+import math
+import numbers
+from dataclasses import dataclass
+
+from geardyn.errors import ParameterError
+from geardyn.units import to_si
+
+GEARS = ("pinion", "wheel")
+
+
+def _place(fault: object, kind: str) -> None:
+    """Check the ``gear`` and ``tooth`` fields of ``fault`` (errors ``<kind>.gear`` ...)."""
+    gear, tooth = fault.gear, fault.tooth  # type: ignore[attr-defined]
+    if gear not in GEARS:
+        raise ParameterError(f"{kind}.gear", gear, "must be 'pinion' or 'wheel'")
+    if isinstance(tooth, bool) or not isinstance(tooth, numbers.Integral) or tooth < 0:
+        raise ParameterError(f"{kind}.tooth", tooth, "must be a whole number >= 0")
+    object.__setattr__(fault, "tooth", int(tooth))
+
+
+def _length(fault: object, kind: str, name: str, *, signed: bool = False) -> None:
+    """Convert field ``name`` of ``fault`` to metres: finite, and >= 0 unless ``signed``."""
+    value = getattr(fault, name)
+    try:
+        v = to_si(value, "length")
+    except ValueError as exc:
+        raise ParameterError(f"{kind}.{name}", value, str(exc)) from None
+    if not math.isfinite(v) or (not signed and v < 0.0):
+        raise ParameterError(f"{kind}.{name}", value,
+                             "must be a finite length" + ("" if signed else " >= 0"))
+    object.__setattr__(fault, name, v)
+
+
+@dataclass(frozen=True)
+class RootCrack:
+    """A straight crack at the root of one tooth's loaded flank (Tian 2004; Wu, Zuo & Parey
+    2008; Chen & Shao 2011): ``depth`` q [m] along the crack, ``angle`` v [rad] between the crack
+    and the tooth's centre line (q sin v is its reach across the tooth), on tooth ``tooth`` of
+    ``gear`` ("pinion" or "wheel"; tooth 0 passes the pitch point at pinion angle 0, tooth j
+    j mesh cycles later). Quantities may be unit strings."""
+
+    depth: float
+    angle: float = math.radians(45.0)
+    gear: str = "pinion"
+    tooth: int = 0
+
+    kind = "crack"
+
+    def __post_init__(self) -> None:
+        set_ = object.__setattr__
+        try:
+            set_(self, "depth", to_si(self.depth, "length"))
+            set_(self, "angle", to_si(self.angle, "angle"))
+        except ValueError as exc:
+            raise ParameterError("crack", self, str(exc)) from None
+        if not (math.isfinite(self.depth) and self.depth >= 0.0):
+            raise ParameterError("crack.depth", self.depth, "must be a finite length >= 0")
+        if not 0.0 < self.angle <= 0.5 * math.pi * (1.0 + 1e-12):  # "90 deg" in float
+            raise ParameterError("crack.angle", self.angle, "must lie in (0, 90 deg]")
+        if self.gear not in GEARS:
+            raise ParameterError("crack.gear", self.gear, "must be 'pinion' or 'wheel'")
+        if isinstance(self.tooth, bool) or not isinstance(self.tooth, numbers.Integral):
+            raise ParameterError("crack.tooth", self.tooth, "must be a whole number")
+
+    @property
+    def reach(self) -> float:
+        """q sin v [m]: how far the crack tip lies inside the flank, across the tooth."""
+        return self.depth * math.sin(self.angle)
+
+    @property
+    def is_null(self) -> bool:
+        """True for a zero-depth crack (the healthy tooth)."""
+        return self.depth == 0.0
+
+    def describe(self) -> str:
+        """One line for the Dataset's attrs."""
+        return (f"root crack on {self.gear} tooth {self.tooth}: depth {self.depth:.6g} m, angle"
+                f" {math.degrees(self.angle):.6g} deg (Tian's crack limit line; fillet"
+                " foundation healthy)")
+
+
+@dataclass(frozen=True)
+class Spall:
+    """A rectangular spall (or pit) on the loaded flank of one tooth: ``length`` [m] along the
+    involute profile, ``width`` [m] across the face (less than the face width), ``depth`` [m]
+    into the tooth across its section, centred ``position`` [m] along the profile from the
+    reference (standard pitch) circle, positive towards the tip; on tooth ``tooth`` of
+    ``gear``. The spall must lie on the flank's active profile (checked with the mesh). A spall
+    of zero length, width or depth is the healthy tooth."""
+
+    length: float
+    width: float
+    depth: float
+    position: float = 0.0
+    gear: str = "pinion"
+    tooth: int = 0
+
+    kind = "spall"
+
+    def __post_init__(self) -> None:
+        for name in ("length", "width", "depth"):
+            _length(self, "spall", name)
+        _length(self, "spall", "position", signed=True)
+        _place(self, "spall")
+
+    @property
+    def is_null(self) -> bool:
+        """True when the spall removes no material."""
+        return self.length == 0.0 or self.width == 0.0 or self.depth == 0.0
+
+    def describe(self) -> str:
+        """One line for the Dataset's attrs."""
+        return (f"spall on {self.gear} tooth {self.tooth}: {self.length:.6g} m along the profile"
+                f" x {self.width:.6g} m across the face x {self.depth:.6g} m deep, centred"
+                f" {self.position:.6g} m from the reference circle")
+
+
+#: The wear profiles along the flank (see :class:`Wear`).
+WEAR_PROFILES = ("uniform", "archard")
+
+
+@dataclass(frozen=True)
+class Wear:
+    """Wear of the active profile of one tooth's loaded flank, on tooth ``tooth`` of ``gear``:
+    ``profile`` "uniform" removes ``depth`` [m] everywhere on it, "archard" follows Archard's
+    law along the flank (the sliding distance times the load, zero at the pitch point) with
+    ``depth`` [m] its largest value. The flank's sections thin by the local depth and its
+    contacts open a gap of it (the unloaded transmission error, see
+    :func:`geardyn.gears.loaded_contact`). Zero depth is the healthy tooth."""
+
+    depth: float
+    gear: str = "pinion"
+    tooth: int = 0
+    profile: str = "uniform"
+
+    kind = "wear"
+
+    def __post_init__(self) -> None:
+        _length(self, "wear", "depth")
+        _place(self, "wear")
+        if self.profile not in WEAR_PROFILES:
+            raise ParameterError("wear.profile", self.profile,
+                                 f"must be one of {', '.join(WEAR_PROFILES)}")
+
+    @property
+    def is_null(self) -> bool:
+        """True for zero wear."""
+        return self.depth == 0.0
+
+    def describe(self) -> str:
+        """One line for the Dataset's attrs."""
+        size = "" if self.profile == "uniform" else " at most"
+        return (f"{self.profile} wear on {self.gear} tooth {self.tooth}:{size} {self.depth:.6g} m"
+                " over the active profile")
+
+
+@dataclass(frozen=True)
+class BrokenTooth:
+    """Tooth ``tooth`` of ``gear`` is missing (broken off at the root): a pair holding it
+    carries nothing while it would be in contact."""
+
+    gear: str = "pinion"
+    tooth: int = 0
+
+    kind = "broken_tooth"
+
+    def __post_init__(self) -> None:
+        _place(self, "broken_tooth")
+
+    @property
+    def is_null(self) -> bool:
+        """A missing tooth is never the healthy tooth."""
+        return False
+
+    def describe(self) -> str:
+        """One line for the Dataset's attrs."""
+        return f"{self.gear} tooth {self.tooth} missing"
+
+
+Fault = RootCrack | Spall | Wear | BrokenTooth
+
+#: The fault classes by kind (the ``kind`` of a study file's fault table).
+FAULT_KINDS: dict[str, type] = {"crack": RootCrack, "spall": Spall, "wear": Wear,
+                                "broken_tooth": BrokenTooth}
