@@ -94,3 +94,42 @@ def test_a_shared_modules_edit_renames_every_generated_kernel(tmp_path, monkeypa
     assert kernels._source_digest("text", {}) == before
     shared.write_text("X = 2\n")
     assert kernels._source_digest("text", {}) != before
+
+
+_UID_SCRIPT = """
+import json, numba
+from geardyn.solvers import kernels
+def f(x):
+    return x + 1
+d = numba.njit(f)
+kernels._quiet_compile(d)
+d(1)
+print(json.dumps([o.fndesc.uid for o in d.overloads.values()]))
+"""
+
+
+def test_code_compiled_in_two_processes_shares_no_name(tmp_path):
+    """The same function compiled first thing in two processes gets different names (numba
+    numbers compiled functions from 1 in every process; geardyn's compiles from a random base),
+    so cached kernels compiled by several processes define no symbol twice when one process
+    loads them."""
+    env = {**os.environ, "GEARDYN_CACHE_DIR": str(tmp_path), "PYTHONPATH": str(ROOT / "src")}
+    env.pop("NUMBA_CACHE_DIR", None)
+    uids = [json.loads(subprocess.run([sys.executable, "-c", _UID_SCRIPT], env=env,
+                                      capture_output=True, text=True, check=True).stdout)[0]
+            for _ in range(2)]
+    assert uids[0] != uids[1] and min(uids) >= 1 << 16
+
+
+def test_numbas_own_numbering_is_restored_after_a_geardyn_compile():
+    import numba
+    from numba.core.bytecode import FunctionIdentity
+
+    from geardyn.solvers import kernels
+
+    before = FunctionIdentity._unique_ids
+    d = numba.njit(lambda x: x * 2)
+    kernels._quiet_compile(d)
+    assert d(2) == 4
+    assert FunctionIdentity._unique_ids is before
+    assert next(iter(d.overloads.values())).fndesc.uid >= 1 << 16

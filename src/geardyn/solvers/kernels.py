@@ -20,15 +20,20 @@ from __future__ import annotations
 import hashlib
 import importlib.util
 import inspect
+import itertools
 import os
+import secrets
 import sys
 import tempfile
 import types
 import warnings
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
 import numba
+import numba.core.bytecode
 from numba.core.compiler_lock import global_compiler_lock
 
 from geardyn._cache import cache_root
@@ -74,6 +79,40 @@ QUIET_WARNINGS = (numba.core.errors.NumbaIRAssumptionWarning,
 _COMPILE_LOCK = global_compiler_lock
 
 
+#: geardyn's own numbering of the functions it compiles: (pid, counter from a random base).
+_UIDS: list = [None, None]
+_UID_DEPTH = [0]
+
+
+def _uid_counter() -> itertools.count:
+    """This process's counter (a new random base after a fork)."""
+    if _UIDS[0] != os.getpid():
+        _UIDS[:] = [os.getpid(), itertools.count(secrets.randbits(47) << 16)]
+    return _UIDS[1]
+
+
+@contextmanager
+def unique_names() -> Iterator[None]:
+    """Number the functions compiled inside (numba's ``FunctionIdentity`` ids, part of every
+    compiled symbol's and environment's name) from a random base of this process, and restore
+    numba's own numbering afterwards; to be entered under numba's compiler lock. numba counts
+    from 1 in every process, so the same function compiled early in two processes gets the
+    same names; cached kernels from several processes, loaded into one, would define the same
+    symbols, and the entry of a shared function called from Python can read another copy's
+    environment (numba's "'descr' is NULL"). From a random base per process, code compiled in
+    different processes shares no name."""
+    ident = numba.core.bytecode.FunctionIdentity
+    if _UID_DEPTH[0] == 0:
+        saved, ident._unique_ids = ident._unique_ids, _uid_counter()
+    _UID_DEPTH[0] += 1
+    try:
+        yield
+    finally:
+        _UID_DEPTH[0] -= 1
+        if _UID_DEPTH[0] == 0:
+            ident._unique_ids = saved
+
+
 def _quiet_compile(dispatcher: Any, cached: bool = False) -> None:
     """Make ``dispatcher`` compile with :data:`QUIET_WARNINGS` ignored; the warning filters are
     restored when its compile returns (nothing is filtered outside geardyn's compiles). A
@@ -83,7 +122,7 @@ def _quiet_compile(dispatcher: Any, cached: bool = False) -> None:
         dispatcher.compile)
 
     def compile(sig: Any) -> Any:
-        with _COMPILE_LOCK, warnings.catch_warnings():
+        with _COMPILE_LOCK, unique_names(), warnings.catch_warnings():
             for category in QUIET_WARNINGS:
                 warnings.filterwarnings("ignore", category=category)
             return compile_(sig)
