@@ -1,0 +1,85 @@
+"""``geardyn stiffness``: the potential-energy mesh stiffness of a study's ``[gears]``.
+
+::
+
+    geardyn stiffness STUDY.toml [-o stiffness.nc] [--plot] [--figure stiffness.png]
+
+The pair comes from the study's ``[gears]``, the faults on its teeth from ``[[faults]]`` and
+the angles, cycles and quadrature from ``[stiffness]`` (:class:`~geardyn.io.toml.GearsTable`,
+:class:`~geardyn.io.toml.FaultTable`, :class:`~geardyn.io.toml.StiffnessTable`); the result
+is :func:`geardyn.gears.potential_energy_stiffness`'s Dataset, written as NetCDF (default
+``<study name>_stiffness.nc``). ``--plot`` draws it (``--figure``, default OUT with .png): drive
+and coast flank, pairs in contact, and with a fault the healthy pair's drive stiffness.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from geardyn.cli.common import check_plot_path, load_study_source, make_parents
+from geardyn.errors import ParameterError
+
+__all__ = ["register", "stiffness_command"]
+
+
+def stiffness_command(
+    study: Annotated[str, typer.Argument(help="Study TOML file with a [gears] table, or a "
+                                              "built-in study name.")],
+    out: Annotated[
+        Path | None, typer.Option("--out", "-o", help="NetCDF file to write (.nc; default: "
+                                                      "<study name>_stiffness.nc).")
+    ] = None,
+    plot: Annotated[bool, typer.Option("--plot", help="Also draw the mesh stiffness.")] = False,
+    figure: Annotated[
+        Path | None, typer.Option(help="Figure to write with --plot (.png, .pdf or .svg; "
+                                       "default: OUT with .png).")
+    ] = None,
+) -> None:
+    """Mesh stiffness of a spur pair by the potential-energy method: drive and coast flank over
+    the pinion angle, every energy term, the faults of [[faults]]; NetCDF and a figure."""
+    from geardyn.study import mesh_stiffness
+
+    s = load_study_source(study)
+    if s.gears is None:
+        raise ParameterError("STUDY", study, "has no [gears] table (the pair whose mesh "
+                             "stiffness to compute)")
+    target = out if out is not None else Path(f"{s.study.name}_stiffness.nc")
+    if target.suffix.lower() != ".nc":
+        raise ParameterError("--out", str(target), "suffix must be .nc (NetCDF)")
+    if figure is not None and not plot:
+        raise ParameterError("--figure", str(figure), "draws nothing without --plot")
+    drawn = (figure if figure is not None else target.with_suffix(".png")) if plot else None
+    check_plot_path("--figure", drawn)
+    make_parents(target, drawn)
+    ds = mesh_stiffness(s)
+    from geardyn.io.netcdf import save_dataset
+
+    save_dataset(ds, target)
+    written = [str(target)]
+    if drawn is not None:
+        from geardyn.plotting.stiffness import plot_mesh_stiffness
+
+        healthy = mesh_stiffness(s, faults=False) if s.faults else None
+        plot_mesh_stiffness(ds, path=drawn, healthy=healthy)
+        written.append(str(drawn))
+    typer.echo(f"{_summary(s.study.name, ds)}; wrote {', '.join(written)}")
+
+
+def _summary(name: str, ds) -> str:
+    """One line: the pair, the grid and the drive and coast mesh stiffness."""
+    k, kc = ds["mesh_stiffness"].values, ds["mesh_stiffness_coast"].values
+    c = ds["cycle"].values
+    cycles = float(c[-1] - c[0] + (c[1] - c[0] if c.size > 1 else 0.0))
+    fault = ds.attrs.get("crack", "none")
+    return (f"{name}: contact ratio {ds.attrs['contact_ratio']:.5f}, {k.size} pinion angles"
+            f" over {cycles:.4g} mesh cycles; mesh stiffness drive {k.mean():.4g} N/m"
+            f" ({k.min():.4g}..{k.max():.4g}), coast {kc.mean():.4g} N/m"
+            f" ({kc.min():.4g}..{kc.max():.4g}); fault: {fault.split(' (')[0]}")
+
+
+def register(app: typer.Typer) -> None:
+    """Add ``geardyn stiffness`` to the command line ``app``."""
+    app.command("stiffness")(stiffness_command)
