@@ -588,6 +588,18 @@ class StiffnessTable(BaseModel):
         return int(self.cycles)
 
 
+def _check_fault(mesh: GearMesh, kw: dict[str, Any], fault: object, where: tuple) -> None:
+    """:func:`~geardyn.gears.prepare_pair` of the pair with ``fault`` (None: the faults ``kw``
+    holds); a refusal is an error at ``where`` and the fault's field it names."""
+    try:
+        prepare_pair(mesh, **kw, **({} if fault is None else _fault_keywords([fault])))
+    except ParameterError as exc:
+        name = exc.field.rpartition(".")[2]
+        fields = () if fault is None else inspect.signature(type(fault)).parameters
+        raise _study_error(where + ((name,) if name in fields else ()), exc.value,
+                           exc.reason) from None
+
+
 def _fault_keywords(faults: list) -> dict[str, Any]:
     """The keywords of :func:`~geardyn.gears.potential_energy_stiffness` that put ``faults``
     (built :data:`FAULT_KINDS` objects) on the pair: at most one, a root crack."""
@@ -775,7 +787,8 @@ class Study(BaseModel):
         :func:`~geardyn.gears.potential_energy_stiffness` for it: bore radii, material,
         ``[stiffness]`` settings and (unless ``faults`` is false: the healthy pair) the
         ``[[faults]]``, built and checked against the teeth; a ValidationError naming the
-        field where they are refused."""
+        field where they are refused (each fault is checked on its own first, so that an error
+        names its table)."""
         if self.gears is None:
             raise StudyError(f"study {self.study.name!r} has no [gears] table")
         tables = (self.faults or []) if faults else []
@@ -786,21 +799,22 @@ class Study(BaseModel):
             kw: dict[str, Any] = {
                 "bore_radius": self.gears.bores(), "young": self.gears.young,
                 "poisson": self.gears.poisson, "root_segment": settings.root_segment,
-                "nodes": settings.nodes, **_fault_keywords(built)}
+                "nodes": settings.nodes}
             prepare_pair(mesh, **kw)
         except ParameterError as exc:
             missing = exc.value is None and exc.reason.startswith("required")
-            raise _study_error(self._location(exc.field, built), exc.value, exc.reason,
+            raise _study_error(self._location(exc.field), exc.value, exc.reason,
                                "missing" if missing else "value_error") from None
+        for i, fault in enumerate(built):
+            _check_fault(mesh, kw, fault, ("faults", i))
+        if built:
+            kw.update(_fault_keywords(built))
+            _check_fault(mesh, kw, None, ("faults",))
         kw.update(angles=settings.angles, cycles=settings.mesh_cycles(mesh))
         return mesh, kw
 
-    def _location(self, field: str, faults: list) -> tuple:
+    def _location(self, field: str) -> tuple:
         """Where in the study a :class:`ParameterError` of the gears' ``field`` lies."""
-        head, _, name = field.partition(".")
-        if head == "crack":
-            index = next(i for i, f in enumerate(faults) if isinstance(f, RootCrack))
-            return ("faults", index, name) if name else ("faults", index)
         if field in StiffnessTable.model_fields:
             return ("stiffness", field)
         return self.gears.location(field)  # type: ignore[union-attr]
