@@ -116,6 +116,8 @@ def test_cli_writes_what_the_api_computes(tmp_path, capsys, source, by_api):
     assert_bitwise_equal(written, computed)
     assert written.attrs["study"] == source
     assert f"contact ratio {computed.attrs['contact_ratio']:.5f}" in r.stdout
+    tooth = "wheel tooth 2" if source == "shifted" else "pinion tooth 9"
+    assert f"faults: root crack on {tooth}: depth" in r.stdout
     if source == "stiffness_19_48":  # the pair the issue names
         assert round(written.attrs["contact_ratio"], 5) == 1.64563
 
@@ -148,8 +150,8 @@ BAD = [
     ('depth = "1.5 mm"\n', "", ("faults[0].depth", "required")),
     ("tooth = 2", "tooth = 48", ("faults[0].tooth", "[0, 47]")),
     ('gear = "wheel"', 'gear = "ring"', ("faults[0].gear", "pinion")),
-    ('kind = "root_crack"', 'kind = "spall"', ("faults[0].kind", "unknown fault kind",
-                                               "root_crack")),
+    ('kind = "root_crack"', 'kind = "pitting"', ("faults[0].kind", "unknown fault kind",
+                                                 "root_crack")),
     ("teeth = 19", "teeth = 9", ("gears.pinion.profile_shift", "undercut", "9 teeth")),
     ('bore_radius = "36 mm"', 'bore_radius = "80 mm"', ("gears.wheel.bore_radius",
                                                          "root radius")),
@@ -161,8 +163,8 @@ BAD = [
      ("gears.centre_distance", "overlap")),
     ("cycles = 5", "cycles = 0", ("stiffness.cycles", "hunting")),
     ("nodes = 24", "nodes = 2", ("stiffness.nodes",)),
-    ("[stiffness]", '[[faults]]\nkind = "root_crack"\ndepth = "1 mm"\n\n[stiffness]',
-     ("faults:", "one fault")),
+    ("[stiffness]", '[[faults]]\nkind = "root_crack"\ngear = "wheel"\ntooth = 2\n'
+     'depth = "1 mm"\n\n[stiffness]', ("faults:",)),  # a second fault on the same tooth
 ]
 
 

@@ -73,11 +73,12 @@ def _summary(name: str, ds) -> str:
     k, kc = ds["mesh_stiffness"].values, ds["mesh_stiffness_coast"].values
     c = ds["cycle"].values
     cycles = float(c[-1] - c[0] + (c[1] - c[0] if c.size > 1 else 0.0))
-    fault = ds.attrs.get("crack", "none")
+    from geardyn.plotting.stiffness import fault_text
+
     return (f"{name}: contact ratio {ds.attrs['contact_ratio']:.5f}, {k.size} pinion angles"
             f" over {cycles:.4g} mesh cycles; mesh stiffness drive {k.mean():.4g} N/m"
             f" ({k.min():.4g}..{k.max():.4g}), coast {kc.mean():.4g} N/m"
-            f" ({kc.min():.4g}..{kc.max():.4g}); fault: {fault.split(' (')[0]}")
+            f" ({kc.min():.4g}..{kc.max():.4g}); faults: {fault_text(ds)}")
 
 
 def register(app: typer.Typer) -> None:

@@ -5,6 +5,7 @@ stiffness under a faulty one, and the pairs in contact on each flank; mesh cycle
 from __future__ import annotations
 
 import os
+import re
 from pathlib import Path
 
 import numpy as np
@@ -12,10 +13,17 @@ import xarray as xr
 
 from geardyn.plotting.style import RC
 
-__all__ = ["plot_mesh_stiffness"]
+__all__ = ["fault_text", "plot_mesh_stiffness"]
 
 #: (variable, label, colour) of each flank.
 FLANKS = (("", "drive flank", "#1f77b4"), ("_coast", "coast flank", "#d62728"))
+
+
+def fault_text(ds: xr.Dataset) -> str:
+    """The dataset's faults in short (``attrs["faults"]``, or ``attrs["crack"]`` of a root
+    crack alone), without their parenthesised model notes; "none" without."""
+    text = str(ds.attrs.get("faults", ds.attrs.get("crack", "none")))
+    return re.sub(r" \([^()]*\)", "", text)
 
 
 def _is_stiffness(ds: xr.Dataset) -> bool:
@@ -72,10 +80,10 @@ def plot_mesh_stiffness(ds: xr.Dataset, path: str | os.PathLike | None = None, *
                                                          lambda c: c / per_degree))
             sec.set_xlabel("mesh cycles")
         name = ds.attrs.get("study", "")
-        crack = ds.attrs.get("crack", "none")
+        faults = fault_text(ds)
         fig.suptitle(f"{name + ': ' if name else ''}potential-energy mesh stiffness, contact"
                      f" ratio {float(ds.attrs.get('contact_ratio', np.nan)):.4f}"
-                     + ("" if crack == "none" else f"\n{crack.split(' (')[0]}"))
+                     + ("" if faults == "none" else f"\n{faults}"))
         if path is not None:
             fig.savefig(Path(path))
     return fig
