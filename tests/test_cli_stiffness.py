@@ -163,6 +163,8 @@ BAD = [
      ("gears.centre_distance", "overlap")),
     ("cycles = 5", "cycles = 0", ("stiffness.cycles", "hunting")),
     ("nodes = 24", "nodes = 2", ("stiffness.nodes",)),
+    ("angles = 90", "angles = 10000000000", ("stiffness.angles", "GiB", "--yes")),
+    ('angle = "40 deg"', 'angle = "1 kg"', ("faults[0]:", "rad")),
     ("[stiffness]", '[[faults]]\nkind = "root_crack"\ngear = "wheel"\ntooth = 2\n'
      'depth = "1 mm"\n\n[stiffness]', ("faults:",)),  # a second fault on the same tooth
 ]

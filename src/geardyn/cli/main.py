@@ -14,7 +14,7 @@
     geardyn frc STUDY.toml [--range 0.5:1.5:201] [--branch b.nc] [--out frc.nc] [--plot frc.png]
     geardyn continue STUDY.toml --param Omega --range 0.5:4 [--period K] [--switch]
                      [--over bifurcation.nc] [--out branch.nc] [--plot branch.png]
-    geardyn stiffness STUDY.toml [-o stiffness.nc] [--plot] [--figure stiffness.png]
+    geardyn stiffness STUDY.toml [-o stiffness.nc] [--plot] [--figure stiffness.png] [--yes]
 
 A STUDY argument is a TOML file or the name of a built-in study (``paper_fig3``). Every expected
 error (bad parameters, missing files, invalid TOML, bad values) and every usage error ends the

@@ -2,27 +2,39 @@
 
 ::
 
-    geardyn stiffness STUDY.toml [-o stiffness.nc] [--plot] [--figure stiffness.png]
+    geardyn stiffness STUDY.toml [-o stiffness.nc] [--plot] [--figure stiffness.png] [--yes]
 
 The pair comes from the study's ``[gears]``, the faults on its teeth from ``[[faults]]`` and
 the angles, cycles and quadrature from ``[stiffness]`` (:class:`~geardyn.io.toml.GearsTable`,
 :class:`~geardyn.io.toml.FaultTable`, :class:`~geardyn.io.toml.StiffnessTable`); the result
 is :func:`geardyn.gears.potential_energy_stiffness`'s Dataset, written as NetCDF (default
 ``<study name>_stiffness.nc``). ``--plot`` draws it (``--figure``, default OUT with .png): drive
-and coast flank, pairs in contact, and with a fault the healthy pair's drive stiffness.
+and coast flank, pairs in contact, and with a fault the healthy pair's drive stiffness. A grid
+whose result would not fit in half the machine's memory is refused unless ``--yes``.
 """
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 from typing import Annotated
 
 import typer
 
-from geardyn.cli.common import check_plot_path, load_study_source, make_parents
+from geardyn.cli.common import (
+    YesOption,
+    check_plot_path,
+    load_study_source,
+    make_parents,
+    memory_limit,
+)
 from geardyn.errors import ParameterError
 
 __all__ = ["register", "stiffness_command"]
+
+#: Bytes per pinion angle and variable row, peak while computing: an upper bound (the 19/48
+#: pair, 10 rows, peaks at about 1.2 kB per angle against the 2 kB this gives).
+BYTES_PER_VALUE = 200.0
 
 
 def stiffness_command(
@@ -37,6 +49,7 @@ def stiffness_command(
         Path | None, typer.Option(help="Figure to write with --plot (.png, .pdf or .svg; "
                                        "default: OUT with .png).")
     ] = None,
+    yes: YesOption = False,
 ) -> None:
     """Mesh stiffness of a spur pair by the potential-energy method: drive and coast flank over
     the pinion angle, every energy term, the faults of [[faults]]; NetCDF and a figure."""
@@ -53,6 +66,7 @@ def stiffness_command(
         raise ParameterError("--figure", str(figure), "draws nothing without --plot")
     drawn = (figure if figure is not None else target.with_suffix(".png")) if plot else None
     check_plot_path("--figure", drawn)
+    _check_memory(s, yes)
     make_parents(target, drawn)
     ds = mesh_stiffness(s)
     from geardyn.io.netcdf import save_dataset
@@ -66,6 +80,21 @@ def stiffness_command(
         plot_mesh_stiffness(ds, path=drawn, healthy=healthy)
         written.append(str(drawn))
     typer.echo(f"{_summary(s.study.name, ds)}; wrote {', '.join(written)}")
+
+
+def _check_memory(study, yes: bool) -> None:
+    """Refuse (unless ``yes``) a grid whose result would take more than
+    :func:`~geardyn.cli.common.memory_limit`: about :data:`BYTES_PER_VALUE` per pinion angle
+    and per variable row (the pairs of both flanks and the per-angle variables)."""
+    mesh, kw = study.stiffness_inputs()
+    angles = kw["angles"] * kw["cycles"]
+    rows = 2 * (math.ceil(mesh.contact_ratio) + 2) + 2
+    need = float(angles) * rows * BYTES_PER_VALUE
+    if need > memory_limit() and not yes:
+        raise ParameterError("stiffness.angles", kw["angles"],
+                             f"{angles} pinion angles ({kw['cycles']} mesh cycles) need about"
+                             f" {need / 2**30:.3g} GiB, above the limit of"
+                             f" {memory_limit() / 2**30:.3g} GiB (pass --yes to run anyway)")
 
 
 def _summary(name: str, ds) -> str:

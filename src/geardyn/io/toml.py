@@ -550,10 +550,11 @@ class FaultTable(BaseModel):
                                    kind="missing")
         try:
             return cls(**given)
-        except ParameterError as exc:
+        except ParameterError as exc:  # a field the class names, else the whole table
             name = exc.field.rpartition(".")[2]
-            raise _study_error(where + ((name,) if name in params else ()), exc.value,
-                               exc.reason) from None
+            if name in params:
+                raise _study_error(where + (name,), exc.value, exc.reason) from None
+            raise _study_error(where, given, exc.reason) from None
 
 
 class StiffnessTable(BaseModel):
