@@ -224,6 +224,15 @@ def test_plot_writes_a_figure_with_the_healthy_pair(tmp_path, capsys, suffix):
     assert f"wrote {out}, {fig}" in r.stdout
 
 
+def test_geardyn_plot_redraws_a_saved_stiffness(tmp_path, capsys):
+    out = tmp_path / "k.nc"
+    assert run(capsys, "stiffness", "stiffness_19_48", "-o", out).returncode == 0
+    r = run(capsys, "plot", out, "--out", tmp_path / "again.pdf")
+    assert r.returncode == 0, r.stderr
+    assert "mesh stiffness dataset" in r.stdout
+    assert (tmp_path / "again.pdf").read_bytes().startswith(b"%PDF")
+
+
 def test_plot_default_figure_and_bad_figure_paths(tmp_path, capsys):
     out = tmp_path / "k.nc"
     r = run(capsys, "stiffness", "stiffness_19_48", "-o", out, "--plot")
