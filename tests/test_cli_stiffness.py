@@ -224,6 +224,15 @@ def test_plot_writes_a_figure_with_the_healthy_pair(tmp_path, capsys, suffix):
     assert f"wrote {out}, {fig}" in r.stdout
 
 
+def test_help_shows_the_command(capsys):
+    r = run(capsys, "stiffness", "--help")
+    assert r.returncode == 0
+    text = " ".join(r.stdout.split())
+    assert "gears table" in text and "faults on its teeth" in text and "--figure" in text
+    r = run(capsys, "--help")
+    assert "stiffness" in r.stdout
+
+
 def test_geardyn_plot_redraws_a_saved_stiffness(tmp_path, capsys):
     out = tmp_path / "k.nc"
     assert run(capsys, "stiffness", "stiffness_19_48", "-o", out).returncode == 0

@@ -38,7 +38,7 @@ BYTES_PER_VALUE = 200.0
 
 
 def stiffness_command(
-    study: Annotated[str, typer.Argument(help="Study TOML file with a [gears] table, or a "
+    study: Annotated[str, typer.Argument(help="Study TOML file with a gears table, or a "
                                               "built-in study name.")],
     out: Annotated[
         Path | None, typer.Option("--out", "-o", help="NetCDF file to write (.nc; default: "
@@ -51,8 +51,9 @@ def stiffness_command(
     ] = None,
     yes: YesOption = False,
 ) -> None:
-    """Mesh stiffness of a spur pair by the potential-energy method: drive and coast flank over
-    the pinion angle, every energy term, the faults of [[faults]]; NetCDF and a figure."""
+    """Mesh stiffness of a study's spur pair by the potential-energy method: drive and coast
+    flank over the pinion angle, every energy term, the faults on its teeth; NetCDF and a
+    figure."""
     from geardyn.study import mesh_stiffness
 
     s = load_study_source(study)
