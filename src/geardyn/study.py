@@ -3,8 +3,9 @@
 :mod:`geardyn.io.toml` reads and validates a study file (or a packaged one,
 ``geardyn/studies/*.toml``) into a :class:`~geardyn.io.toml.Study`, plain validated data;
 :func:`build_model` makes the :class:`~geardyn.CATTDevice` or :class:`~geardyn.GearPair` it
-describes. This module sits above both ``models`` and ``io`` (``tests/test_layers.py``), so that
-reading a study never imports a model's kernels, and the packaged study files stay data.
+describes, :func:`mesh_stiffness` the potential-energy mesh stiffness of its ``[gears]``. This
+module sits above both ``models`` and ``io`` (``tests/test_layers.py``), so that reading a
+study never imports a model's kernels, and the packaged study files stay data.
 """
 
 from __future__ import annotations
@@ -13,10 +14,11 @@ import math
 from collections.abc import Callable
 
 import numpy as np
+import xarray as xr
 from pydantic import ValidationError
 
 from geardyn.core.model import Model
-from geardyn.errors import ParameterError
+from geardyn.errors import ParameterError, StudyError
 from geardyn.io.toml import GearPairParams, PlanetaryGearSetParams, Study
 from geardyn.models.catt import CATTDevice
 from geardyn.models.derived import INTERPRETATIONS
@@ -24,7 +26,7 @@ from geardyn.models.gear_pair import GearPair
 from geardyn.models.planetary import Member, PlanetaryGearSet
 from geardyn.units import to_si
 
-__all__ = ["build_model", "check_usable", "planetary_model"]
+__all__ = ["build_model", "check_usable", "mesh_stiffness", "planetary_model"]
 
 
 def build_model(study: Study, interpretation: str | None = None, omega: float | None = None
@@ -40,6 +42,9 @@ def build_model(study: Study, interpretation: str | None = None, omega: float | 
         raise ParameterError(
             "interpretation", interpretation, f"must be one of {', '.join(INTERPRETATIONS)}"
         )
+    if study.params is None:
+        raise StudyError(f"study {study.study.name!r} has no [params]: it describes gears"
+                         " ([gears]) for geardyn stiffness, not a model")
     om = omega if omega is not None else study.run.omega
     if isinstance(study.params, GearPairParams):
         kwargs = study.params.model_dump()
@@ -53,6 +58,18 @@ def build_model(study: Study, interpretation: str | None = None, omega: float | 
         interpretation or study.study.interpretation,  # type: ignore[arg-type]
         omega=1.0 if om is None else float(om),
     ))
+
+
+def mesh_stiffness(study: Study, faults: bool = True) -> xr.Dataset:
+    """The potential-energy mesh stiffness of the study's ``[gears]`` pair
+    (:func:`~geardyn.gears.potential_energy_stiffness` with the ``[stiffness]`` settings and the
+    ``[[faults]]``; ``faults=False``: the healthy pair), the study's name in its attrs."""
+    from geardyn.gears import potential_energy_stiffness
+
+    mesh, kw = study.stiffness_inputs(faults=faults)
+    ds = potential_energy_stiffness(mesh, **kw)
+    ds.attrs["study"] = study.study.name
+    return ds
 
 
 def planetary_model(params: PlanetaryGearSetParams, omega: float | None = None

@@ -383,9 +383,11 @@ def _guess_kind(ds, source: str) -> str:
         return "reproduction" if "sweep" in ds.dims else "bifurcation"
     if "period" in ds and "x" in ds.attrs and "y" in ds.attrs:
         return "map"
-    raise ParameterError("RESULT", source, "not a geardyn simulation, bifurcation, map or "
-                         "reproduction dataset (no attrs['geardyn_kind'], and its variables "
-                         "match none)")
+    if "mesh_stiffness" in ds and "mesh_stiffness_coast" in ds and "angle" in ds.dims:
+        return "mesh stiffness"  # geardyn stiffness, geardyn.gears.potential_energy_stiffness
+    raise ParameterError("RESULT", source, "not a geardyn simulation, bifurcation, map, "
+                         "reproduction or mesh stiffness dataset (no attrs['geardyn_kind'], and "
+                         "its variables match none)")
 
 
 def _load_result(result: Path):
@@ -410,8 +412,9 @@ def _load_result(result: Path):
 
 def plot_command(
     result: Annotated[Path, typer.Argument(help="A NetCDF file written by geardyn simulate, "
-                                                "bifurcation, map, reproduce, basins, frc or "
-                                                "continue, or a map's .zarr store.")],
+                                                "bifurcation, map, reproduce, basins, frc, "
+                                                "continue or stiffness, or a map's .zarr "
+                                                "store.")],
     out: Annotated[
         Path | None, typer.Option(help="Figure to write, .png, .pdf or .svg (default: RESULT "
                                        "with .png).")
@@ -424,7 +427,7 @@ def plot_command(
     ] = SweepDirection.up,
 ) -> None:
     """Redraw the figure of a saved simulation, bifurcation, map, reproduction case, basins,
-    frequency response or continued branch."""
+    frequency response, continued branch or mesh stiffness."""
     target = out if out is not None else result.with_suffix(".png")
     check_plot_path("--out", target)
     ds = _load_result(result)
@@ -438,7 +441,7 @@ def plot_command(
         plot_map(ds, path=target)
         typer.echo(f"{result}: map dataset; wrote {target}")
         return
-    if kind in ("basins", "frequency response"):
+    if kind in ("basins", "frequency response", "mesh stiffness"):
         if state is not None:
             raise ParameterError("--state", state, f"a {kind} figure shows no state; leave it out")
         make_parents(target)
@@ -446,6 +449,10 @@ def plot_command(
             from geardyn.plotting.basins import plot_basins
 
             plot_basins(ds, path=target)
+        elif kind == "mesh stiffness":
+            from geardyn.plotting.stiffness import plot_mesh_stiffness
+
+            plot_mesh_stiffness(ds, path=target)
         else:
             from geardyn.plotting.frc import plot_frc
 

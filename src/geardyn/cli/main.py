@@ -14,6 +14,7 @@
     geardyn frc STUDY.toml [--range 0.5:1.5:201] [--branch b.nc] [--out frc.nc] [--plot frc.png]
     geardyn continue STUDY.toml --param Omega --range 0.5:4 [--period K] [--switch]
                      [--over bifurcation.nc] [--out branch.nc] [--plot branch.png]
+    geardyn stiffness STUDY.toml [-o stiffness.nc] [--plot] [--figure stiffness.png] [--yes]
 
 A STUDY argument is a TOML file or the name of a built-in study (``paper_fig3``). Every expected
 error (bad parameters, missing files, invalid TOML, bad values) and every usage error ends the
@@ -330,6 +331,7 @@ __import__("geardyn.cli.basins", fromlist=["register"]).register(app)  # cli/bas
 __import__("geardyn.cli.frc", fromlist=["register"]).register(app)  # cli/frc.py
 __import__("geardyn.cli.continuation", fromlist=["register"]).register(app)  # cli/continuation.py
 __import__("geardyn.cli.explore", fromlist=["register"]).register(app)  # cli/explore.py
+__import__("geardyn.cli.stiffness", fromlist=["register"]).register(app)  # cli/stiffness.py
 
 if __name__ == "__main__":
     main()

@@ -25,6 +25,30 @@ A *study file* holds the device parameters plus run settings::
     [sweep]                         # optional: param, start, stop, num, continuation,
                                     # samples, lyapunov (see SweepSettings)
 
+A spur pair for the potential-energy mesh stiffness (``geardyn stiffness``), with or instead
+of ``[params]``::
+
+    [gears]                         # GearsTable: the pair's common values
+    module = "3.2 mm"
+    pressure_angle = "20 deg"
+    face_width = "16 mm"            # or per gear
+    bore_radius = "12 mm"           # or per gear
+    # addendum = 1.0, dedendum = 1.25, centre_distance, young = 206.8e9, poisson = 0.3
+    [gears.pinion]                  # PairGearTable: teeth, profile_shift, and per-gear values
+    teeth = 19
+    [gears.wheel]
+    teeth = 48
+    bore_radius = "35 mm"
+    [[faults]]                      # FaultTable: kind (FAULT_KINDS) and that fault's fields
+    kind = "root_crack"
+    gear = "pinion"
+    tooth = 0
+    depth = "1 mm"
+    angle = "45 deg"
+    [stiffness]                     # StiffnessTable: angles per mesh cycle, cycles or
+    angles = 360                    #   "hunting", nodes, root_segment
+    cycles = "hunting"
+
 For ``model = "gear_pair"`` the ``[params]`` table holds :class:`~geardyn.GearPair` arguments
 (``zeta``, ``kappa``, ``Fm``, ``Fa``, ``Omega``, ``kappa_phase``, ``error_phase``, ``backlash``).
 For ``model = "planetary"`` it holds :class:`~geardyn.PlanetaryGearSet` arguments
@@ -50,16 +74,18 @@ value, and :func:`geardyn.cli.errors.format_error` renders it as one line.
 
 from __future__ import annotations
 
+import inspect
 import math
 import os
 import tomllib
 from importlib import resources
 from pathlib import Path
-from typing import Any, Literal
+from typing import Annotated, Any, Literal
 
 import tomli_w
 from pydantic import (
     BaseModel,
+    BeforeValidator,
     ConfigDict,
     Field,
     PrivateAttr,
@@ -74,18 +100,32 @@ from geardyn.core.coefficients import CoefficientBlock
 from geardyn.core.settings import DEFAULT_MAX_PERIOD, DEFAULT_TOL
 from geardyn.errors import ParameterError, StudyError
 from geardyn.files import atomic_replace
+from geardyn.gears.geometry import GearMesh, SpurGear
+from geardyn.gears.potential_energy import (
+    DEFAULT_NODES,
+    STEEL_POISSON,
+    STEEL_YOUNG,
+    RootCrack,
+    prepare_pair,
+)
 from geardyn.models.gear_pair_coefficients import GEAR_PAIR
-from geardyn.models.params import PAPER_NAMES, Angle, PlanetaryParams, Real, Whole
+from geardyn.models.params import PAPER_NAMES, Angle, Length, PlanetaryParams, Real, Whole
+from geardyn.units import to_si
 
 __all__ = [
+    "FAULT_KINDS",
+    "FaultTable",
     "GearPairParams",
     "GearTable",
+    "GearsTable",
     "GeometryTable",
     "MemberTable",
+    "PairGearTable",
     "PaperBase",
     "PlanetaryGearSetParams",
     "RunSettings",
     "RunTable",
+    "StiffnessTable",
     "Study",
     "StudyInfo",
     "SweepSettings",
@@ -374,6 +414,211 @@ class PlanetaryGearSetParams(BaseModel):
     length_scale: Quantity = 1e-6
 
 
+# --------------------------------------------------------------------------- gears and faults
+#: The fault kinds of a ``[[faults]]`` table: kind -> the class built with the table's other keys
+#: as keywords (the constructor's parameters are the table's fields; unit strings accepted
+#: where the class takes them).
+FAULT_KINDS: dict[str, type] = {
+    "root_crack": RootCrack,
+}
+
+#: Young's modulus: an SI number [Pa] or a unit string ("206.8 GPa").
+Pressure = Annotated[float, BeforeValidator(lambda v: to_si(v, "pressure")), Field(gt=0)]
+
+
+class PairGearTable(BaseModel):
+    """``[gears.pinion]`` or ``[gears.wheel]``: one gear's teeth and profile shift, and where it
+    differs from the pair's ``[gears]`` values, its face width, bore radius, addendum and
+    dedendum factors."""
+
+    model_config = _CONFIG
+
+    teeth: Whole
+    profile_shift: Real = 0.0
+    face_width: Length | None = None
+    bore_radius: Length | None = None
+    addendum: Real | None = None
+    dedendum: Real | None = None
+
+
+class GearsTable(BaseModel):
+    """``[gears]``: an external spur pair (:class:`~geardyn.gears.GearMesh` of two
+    :class:`~geardyn.gears.SpurGear`) for the potential-energy mesh stiffness: the common
+    module, pressure angle and tooth proportions (addendum and dedendum factors of the basic
+    rack), face width and bore radius (each also per gear), the centre distance (default: that
+    of zero backlash), the material (E, nu), and the ``pinion`` and ``wheel`` sub-tables
+    (:class:`PairGearTable`). SI numbers or unit strings. Values the geometry refuses (undercut,
+    interference, a bore outside the root circle, ...) are errors naming ``gears.<field>``."""
+
+    model_config = _CONFIG
+
+    module: Length
+    pressure_angle: Angle = Field(math.radians(20.0), description="rad or e.g. \"20 deg\"")
+    face_width: Length | None = None
+    bore_radius: Length | None = None
+    addendum: Real = 1.0
+    dedendum: Real = 1.25
+    centre_distance: Length | None = None
+    young: Pressure = STEEL_YOUNG
+    poisson: Real = STEEL_POISSON
+    pinion: PairGearTable
+    wheel: PairGearTable
+
+    def value(self, role: str, name: str) -> tuple[Any, tuple[str, ...]]:
+        """``name`` of gear ``role`` ("pinion" or "wheel") and where it is set: its own table,
+        else ``[gears]``."""
+        own = getattr(getattr(self, role), name, None)
+        if own is not None:
+            return own, ("gears", role, name)
+        return getattr(self, name), ("gears", name)
+
+    def gear(self, role: str) -> SpurGear:
+        """The pinion or the wheel (a ParameterError names the gear's field)."""
+        table = getattr(self, role)
+        kw = {}
+        for name in ("face_width", "addendum", "dedendum"):
+            value = self.value(role, name)[0]
+            if value is None:
+                raise ParameterError(f"{role}.{name}", None, f"required (in [gears] or in "
+                                     f"[gears.{role}])")
+            kw[name] = value
+        return SpurGear(table.teeth, self.module, self.pressure_angle, kw["face_width"],
+                        profile_shift=table.profile_shift, addendum=kw["addendum"],
+                        dedendum=kw["dedendum"], name=role)
+
+    def mesh(self) -> GearMesh:
+        """The pair, pinion driving."""
+        return GearMesh(self.gear("pinion"), self.gear("wheel"),
+                        centre_distance=self.centre_distance)
+
+    def bores(self) -> tuple[float, float]:
+        """The bore radii [m] of pinion and wheel."""
+        out = []
+        for role in ("pinion", "wheel"):
+            value = self.value(role, "bore_radius")[0]
+            if value is None:
+                raise ParameterError(f"{role}.bore_radius", None, f"required (in [gears] or in "
+                                     f"[gears.{role}])")
+            out.append(value)
+        return out[0], out[1]
+
+    def location(self, field: str) -> tuple[str, ...]:
+        """The study location of a :class:`ParameterError`'s ``field`` raised by the gears or
+        the potential-energy method (``pinion.teeth`` -> gears.pinion.teeth; a shared value
+        set in ``[gears]`` -> gears.<name>)."""
+        role, _, name = field.partition(".")
+        if role in ("pinion", "wheel") and name:
+            if name in PairGearTable.model_fields:
+                if name in ("teeth", "profile_shift"):
+                    return ("gears", role, name)
+                return self.value(role, name)[1]
+            if name in GearsTable.model_fields:
+                return ("gears", name)
+            return ("gears", role, name)
+        return ("gears", *field.split("."))
+
+
+class FaultTable(BaseModel):
+    """One ``[[faults]]`` table: ``kind`` (a key of :data:`FAULT_KINDS`) and that fault's
+    fields, e.g. ``kind = "root_crack"``, ``gear``, ``tooth``, ``depth``, ``angle``
+    (:class:`~geardyn.gears.RootCrack`). Checked by :meth:`build`, once the gears are known."""
+
+    model_config = ConfigDict(extra="allow", frozen=True, allow_inf_nan=False)
+
+    kind: str
+
+    def fields(self) -> dict[str, Any]:
+        """The fault's own fields (the table without ``kind``)."""
+        return dict(self.model_extra or {})
+
+    def build(self, where: tuple) -> object:
+        """The fault object; errors name ``where`` + the field (``faults[0].depth``)."""
+        cls = FAULT_KINDS.get(self.kind)
+        if cls is None:
+            raise _study_error(where + ("kind",), self.kind, "unknown fault kind; known: "
+                               + ", ".join(FAULT_KINDS))
+        params = inspect.signature(cls).parameters
+        given = self.fields()
+        for key in given:
+            if key not in params:
+                raise _study_error(where + (key,), given[key],
+                                   f"unknown key (not a field of a {self.kind} fault; fields:"
+                                   f" kind, {', '.join(params)})")
+        for name, p in params.items():
+            if p.default is inspect.Parameter.empty and name not in given:
+                raise _study_error(where + (name,), None, f"required by a {self.kind} fault",
+                                   kind="missing")
+        try:
+            return cls(**given)
+        except ParameterError as exc:  # a field the class names, else the whole table
+            name = exc.field.rpartition(".")[2]
+            if name in params:
+                raise _study_error(where + (name,), exc.value, exc.reason) from None
+            raise _study_error(where, given, exc.reason) from None
+
+
+class StiffnessTable(BaseModel):
+    """``[stiffness]``: the settings of ``geardyn stiffness`` (the potential-energy mesh
+    stiffness of ``[gears]``): ``angles`` per mesh cycle, ``cycles`` (mesh cycles, or
+    ``"hunting"``: lcm(z1, z2), every pinion tooth against every wheel tooth), ``nodes``
+    (Gauss-Legendre nodes of the tooth integrals) and ``root_segment`` (the straight flank
+    between the root and base circles in the cantilever)."""
+
+    model_config = _CONFIG
+
+    angles: Whole = Field(360, ge=1, description="pinion angles per mesh cycle")
+    cycles: Whole | Literal["hunting"] = Field(
+        1, description="mesh cycles from tooth 0's pitch-point passage, or \"hunting\"")
+    nodes: Whole = Field(DEFAULT_NODES, ge=4, description="Gauss-Legendre nodes")
+    root_segment: bool = Field(True, description="straight flank from the root to the base "
+                               "circle in the cantilever")
+
+    @field_validator("cycles", mode="before")
+    @classmethod
+    def _cycles(cls, value: Any) -> Any:
+        if value == "hunting" and isinstance(value, str):
+            return value
+        if isinstance(value, bool) or not isinstance(value, int) or value < 1:
+            raise ValueError("must be a whole number >= 1 or \"hunting\"")
+        return value
+
+    def mesh_cycles(self, mesh: GearMesh) -> int:
+        """The number of mesh cycles: ``cycles``, or lcm(z1, z2) for ``"hunting"``."""
+        if self.cycles == "hunting":
+            return math.lcm(mesh.pinion.teeth, mesh.wheel.teeth)
+        return int(self.cycles)
+
+
+def _check_fault(mesh: GearMesh, kw: dict[str, Any], fault: object, where: tuple) -> None:
+    """:func:`~geardyn.gears.prepare_pair` of the pair with ``fault`` (None: the faults ``kw``
+    holds); a refusal is an error at ``where`` and the fault's field it names."""
+    try:
+        prepare_pair(mesh, **kw, **({} if fault is None else _fault_keywords([fault])))
+    except ParameterError as exc:
+        name = exc.field.rpartition(".")[2]
+        fields = () if fault is None else inspect.signature(type(fault)).parameters
+        raise _study_error(where + ((name,) if name in fields else ()), exc.value,
+                           exc.reason) from None
+
+
+def _fault_keywords(faults: list) -> dict[str, Any]:
+    """The keywords of :func:`~geardyn.gears.potential_energy_stiffness` that put ``faults``
+    (built :data:`FAULT_KINDS` objects) on the pair: at most one, a root crack."""
+    if not faults:
+        return {}
+    if len(faults) > 1 or not isinstance(faults[0], RootCrack):
+        raise _study_error(("faults",), len(faults), "the potential-energy stiffness takes one"
+                           " fault, a root crack")
+    return {"crack": faults[0]}
+
+
+def _study_error(loc: tuple, value: object, reason: str, kind: str = "value_error"
+                 ) -> ValidationError:
+    """A one-error :class:`ValidationError` at ``loc`` of a study."""
+    return ValidationError.from_exception_data("Study", [InitErrorDetails(
+        type=PydanticCustomError(kind, "{msg}", {"msg": reason}), loc=loc, input=value)])
+
+
 def _relocated(exc: ValidationError, loc_of) -> ValidationError:
     """``exc`` with every error's location mapped by ``loc_of(loc) -> loc``."""
     details: list[InitErrorDetails] = []
@@ -435,14 +680,23 @@ class Study(BaseModel):
     ``params`` is a :class:`PlanetaryParams` (full form), a :class:`PaperBase` (paper values plus
     changes) or, for ``model = "gear_pair"``, a :class:`GearPairParams`, for
     ``model = "planetary"`` a :class:`PlanetaryGearSetParams`.
+
+    ``gears`` (:class:`GearsTable`), ``faults`` (:class:`FaultTable` each) and ``stiffness``
+    (:class:`StiffnessTable`) describe a spur pair for the potential-energy mesh stiffness
+    (``geardyn stiffness``); a study may hold them instead of ``params``. They are checked when
+    the study is read: the gears, the faults on them and the settings are built once
+    (:meth:`stiffness_inputs`), and what they refuse is an error naming the field.
     """
 
     model_config = _CONFIG
 
     study: StudyInfo = Field(default_factory=StudyInfo)
-    params: PlanetaryParams | PaperBase | GearPairParams | PlanetaryGearSetParams
+    params: PlanetaryParams | PaperBase | GearPairParams | PlanetaryGearSetParams | None = None
     run: RunTable = Field(default_factory=RunTable)
     sweep: SweepSettings | None = None
+    gears: GearsTable | None = None
+    faults: list[FaultTable] | None = None
+    stiffness: StiffnessTable | None = None
 
     _planetary: PlanetaryParams | None = PrivateAttr(None)
 
@@ -499,6 +753,9 @@ class Study(BaseModel):
 
     @model_validator(mode="after")
     def _check_consistency(self) -> Study:
+        self._check_gears()
+        if self.params is None:
+            return self
         holds = ("gear_pair" if isinstance(self.params, GearPairParams) else "planetary"
                  if isinstance(self.params, PlanetaryGearSetParams) else "catt")
         if holds != self.study.model:
@@ -512,6 +769,56 @@ class Study(BaseModel):
         elif isinstance(self.params, PlanetaryParams):
             self._planetary = self.params
         return self
+
+    def _check_gears(self) -> None:
+        """``[params]`` or ``[gears]`` present; ``[faults]`` and ``[stiffness]`` only with
+        ``[gears]``; the gears, faults and settings buildable (errors name the field)."""
+        if self.gears is None:
+            for name in ("faults", "stiffness"):
+                if getattr(self, name) is not None:
+                    raise _study_error((name,), None, "needs a [gears] table (the pair whose"
+                                       " mesh stiffness it is for)")
+            if self.params is None:
+                raise _study_error(("params",), None, "required (or a [gears] table)", "missing")
+            return
+        self.stiffness_inputs()
+
+    def stiffness_inputs(self, faults: bool = True) -> tuple[GearMesh, dict[str, Any]]:
+        """The ``[gears]`` pair and the keywords of
+        :func:`~geardyn.gears.potential_energy_stiffness` for it: bore radii, material,
+        ``[stiffness]`` settings and (unless ``faults`` is false: the healthy pair) the
+        ``[[faults]]``, built and checked against the teeth; a ValidationError naming the
+        field where they are refused (each fault is checked on its own first, so that an error
+        names its table)."""
+        if self.gears is None:
+            raise StudyError(f"study {self.study.name!r} has no [gears] table")
+        tables = (self.faults or []) if faults else []
+        built = [f.build(("faults", i)) for i, f in enumerate(tables)]
+        settings = self.stiffness or StiffnessTable()
+        try:
+            mesh = self.gears.mesh()
+            kw: dict[str, Any] = {
+                "bore_radius": self.gears.bores(), "young": self.gears.young,
+                "poisson": self.gears.poisson, "root_segment": settings.root_segment,
+                "nodes": settings.nodes}
+            prepare_pair(mesh, **kw)
+        except ParameterError as exc:
+            missing = exc.value is None and exc.reason.startswith("required")
+            raise _study_error(self._location(exc.field), exc.value, exc.reason,
+                               "missing" if missing else "value_error") from None
+        for i, fault in enumerate(built):
+            _check_fault(mesh, kw, fault, ("faults", i))
+        if built:
+            kw.update(_fault_keywords(built))
+            _check_fault(mesh, kw, None, ("faults",))
+        kw.update(angles=settings.angles, cycles=settings.mesh_cycles(mesh))
+        return mesh, kw
+
+    def _location(self, field: str) -> tuple:
+        """Where in the study a :class:`ParameterError` of the gears' ``field`` lies."""
+        if field in StiffnessTable.model_fields:
+            return ("stiffness", field)
+        return self.gears.location(field)  # type: ignore[union-attr]
 
     # ------------------------------------------------------------------ accessors
     @property
@@ -566,7 +873,7 @@ def _read_toml(source: str | os.PathLike[str]) -> tuple[dict[str, Any], str]:
         raise StudyError(f"{label}: invalid TOML: {exc}") from None
 
 
-_STUDY_KEYS = {"study", "params", "run", "sweep"}
+_STUDY_KEYS = {"study", "params", "run", "sweep", "gears", "faults", "stiffness"}
 
 
 def load_params(path_or_text: str | os.PathLike[str]) -> PlanetaryParams:
@@ -608,7 +915,8 @@ def load_study(path_or_text: str | os.PathLike[str]) -> Study:
     """
     doc, label = _read_toml(path_or_text)
     if not doc:
-        raise StudyError(f"{label}: empty study file (needs at least a [params] table)")
+        raise StudyError(f"{label}: empty study file (needs at least a [params] or a [gears]"
+                         " table)")
     doc = _study_document(doc)
     if not _is_text(path_or_text) and isinstance(doc.get("study", {}), dict):
         doc.setdefault("study", {}).setdefault("name", Path(path_or_text).stem)
