@@ -48,7 +48,7 @@ face_width = "18 mm"
 bore_radius = "36 mm"
 
 [[faults]]
-kind = "root_crack"
+kind = "crack"
 gear = "wheel"
 tooth = 2
 depth = "1.5 mm"
@@ -71,7 +71,7 @@ def _shifted_by_api():
     return g.potential_energy_stiffness(
         mesh, bore_radius=("11 mm", "36 mm"), angles=90, cycles=5, young="210 GPa",
         poisson=0.29, nodes=24, root_segment=False,
-        crack=g.RootCrack("1.5 mm", "40 deg", gear="wheel", tooth=2))
+        faults=(g.RootCrack("1.5 mm", "40 deg", gear="wheel", tooth=2),))
 
 
 def _example_by_api():
@@ -80,7 +80,7 @@ def _example_by_api():
                       g.SpurGear(48, "3.2 mm", "20 deg", "16 mm", name="wheel"))
     return g.potential_energy_stiffness(
         mesh, bore_radius=("12 mm", "35 mm"), angles=360, cycles=19, young="206.8 GPa",
-        poisson=0.3, crack=g.RootCrack("2 mm", "45 deg", gear="pinion", tooth=9))
+        poisson=0.3, faults=(g.RootCrack("2 mm", "45 deg", gear="pinion", tooth=9),))
 
 
 def run(capsys, *args) -> subprocess.CompletedProcess:
@@ -150,8 +150,8 @@ BAD = [
     ('depth = "1.5 mm"\n', "", ("faults[0].depth", "required")),
     ("tooth = 2", "tooth = 48", ("faults[0].tooth", "[0, 47]")),
     ('gear = "wheel"', 'gear = "ring"', ("faults[0].gear", "pinion")),
-    ('kind = "root_crack"', 'kind = "pitting"', ("faults[0].kind", "unknown fault kind",
-                                                 "root_crack")),
+    ('kind = "crack"', 'kind = "pitting"', ("faults[0].kind", "unknown fault kind",
+                                                 "crack")),
     ("teeth = 19", "teeth = 9", ("gears.pinion.profile_shift", "undercut", "9 teeth")),
     ('bore_radius = "36 mm"', 'bore_radius = "80 mm"', ("gears.wheel.bore_radius",
                                                          "root radius")),
@@ -165,7 +165,7 @@ BAD = [
     ("nodes = 24", "nodes = 2", ("stiffness.nodes",)),
     ("angles = 90", "angles = 10000000000", ("stiffness.angles", "GiB", "--yes")),
     ('angle = "40 deg"', 'angle = "1 kg"', ("faults[0]:", "rad")),
-    ("[stiffness]", '[[faults]]\nkind = "root_crack"\ngear = "wheel"\ntooth = 2\n'
+    ("[stiffness]", '[[faults]]\nkind = "crack"\ngear = "wheel"\ntooth = 2\n'
      'depth = "1 mm"\n\n[stiffness]', ("faults:",)),  # a second fault on the same tooth
 ]
 
@@ -202,7 +202,7 @@ def test_errors_are_raised_when_the_study_is_read():
 
 
 def test_tables_need_gears_and_models_need_params(tmp_path, capsys):
-    no_gears = '[study]\nname = "x"\n[[faults]]\nkind = "root_crack"\ndepth = "1 mm"\n'
+    no_gears = '[study]\nname = "x"\n[[faults]]\nkind = "crack"\ndepth = "1 mm"\n'
     study = tmp_path / "x.toml"
     study.write_text(no_gears, encoding="utf-8")
     r = run(capsys, "stiffness", study)
@@ -276,3 +276,31 @@ def test_figure_draws_both_flanks_and_the_healthy_drive_flank():
                                faulty.mesh_stiffness_coast.values, rtol=1e-14)
     with pytest.raises(ValueError, match="not a mesh stiffness"):
         plot_mesh_stiffness(faulty.drop_vars("mesh_stiffness_coast"))
+
+
+def test_a_study_holds_several_fault_kinds_each_on_its_tooth(tmp_path):
+    """Every kind of geardyn.gears.FAULT_KINDS is a [[faults]] table; the study's stiffness
+    equals the API's with the same faults."""
+    from geardyn.study import mesh_stiffness
+
+    study = tmp_path / "s.toml"
+    study.write_text(
+        '[study]\nname = "s"\n[gears]\nmodule = "3.2 mm"\npressure_angle = "20 deg"\n'
+        'face_width = "16 mm"\nbore_radius = "12 mm"\n[gears.pinion]\nteeth = 19\n'
+        '[gears.wheel]\nteeth = 48\nbore_radius = "35 mm"\n'
+        '[[faults]]\nkind = "crack"\ntooth = 1\ndepth = "1 mm"\n'
+        '[[faults]]\nkind = "spall"\ntooth = 2\nlength = "1 mm"\nwidth = "4 mm"\n'
+        'depth = "0.2 mm"\n'
+        '[[faults]]\nkind = "wear"\ngear = "wheel"\ntooth = 3\ndepth = "20 um"\n'
+        '[[faults]]\nkind = "broken_tooth"\ntooth = 4\n'
+        '[stiffness]\nangles = 36\ncycles = 6\n')
+    got = mesh_stiffness(load_study(study))
+    mesh = g.GearMesh(g.SpurGear(19, "3.2 mm", "20 deg", "16 mm", name="pinion"),
+                      g.SpurGear(48, "3.2 mm", "20 deg", "16 mm", name="wheel"))
+    want = g.potential_energy_stiffness(
+        mesh, bore_radius=("12 mm", "35 mm"), angles=36, cycles=6,
+        faults=(g.RootCrack("1 mm", tooth=1), g.Spall("1 mm", "4 mm", "0.2 mm", tooth=2),
+                g.Wear("20 um", gear="wheel", tooth=3), g.BrokenTooth("pinion", 4)))
+    assert np.array_equal(got["mesh_stiffness"].values, want["mesh_stiffness"].values)
+    assert np.array_equal(got["mesh_stiffness_coast"].values,
+                          want["mesh_stiffness_coast"].values)

@@ -39,8 +39,8 @@ of ``[params]``::
     [gears.wheel]
     teeth = 48
     bore_radius = "35 mm"
-    [[faults]]                      # FaultTable: kind (FAULT_KINDS) and that fault's fields
-    kind = "root_crack"
+    [[faults]]                      # FaultTable: kind (gears.FAULT_KINDS) and its fields
+    kind = "crack"
     gear = "pinion"
     tooth = 0
     depth = "1 mm"
@@ -100,12 +100,12 @@ from geardyn.core.coefficients import CoefficientBlock
 from geardyn.core.settings import DEFAULT_MAX_PERIOD, DEFAULT_TOL
 from geardyn.errors import ParameterError, StudyError
 from geardyn.files import atomic_replace
+from geardyn.gears.faults import FAULT_KINDS
 from geardyn.gears.geometry import GearMesh, SpurGear
 from geardyn.gears.potential_energy import (
     DEFAULT_NODES,
     STEEL_POISSON,
     STEEL_YOUNG,
-    RootCrack,
     prepare_pair,
 )
 from geardyn.models.gear_pair_coefficients import GEAR_PAIR
@@ -113,7 +113,6 @@ from geardyn.models.params import PAPER_NAMES, Angle, Length, PlanetaryParams, R
 from geardyn.units import to_si
 
 __all__ = [
-    "FAULT_KINDS",
     "FaultTable",
     "GearPairParams",
     "GearTable",
@@ -415,13 +414,6 @@ class PlanetaryGearSetParams(BaseModel):
 
 
 # --------------------------------------------------------------------------- gears and faults
-#: The fault kinds of a ``[[faults]]`` table: kind -> the class built with the table's other keys
-#: as keywords (the constructor's parameters are the table's fields; unit strings accepted
-#: where the class takes them).
-FAULT_KINDS: dict[str, type] = {
-    "root_crack": RootCrack,
-}
-
 #: Young's modulus: an SI number [Pa] or a unit string ("206.8 GPa").
 Pressure = Annotated[float, BeforeValidator(lambda v: to_si(v, "pressure")), Field(gt=0)]
 
@@ -519,9 +511,10 @@ class GearsTable(BaseModel):
 
 
 class FaultTable(BaseModel):
-    """One ``[[faults]]`` table: ``kind`` (a key of :data:`FAULT_KINDS`) and that fault's
-    fields, e.g. ``kind = "root_crack"``, ``gear``, ``tooth``, ``depth``, ``angle``
-    (:class:`~geardyn.gears.RootCrack`). Checked by :meth:`build`, once the gears are known."""
+    """One ``[[faults]]`` table: ``kind`` (a key of :data:`geardyn.gears.FAULT_KINDS`:
+    ``crack``, ``spall``, ``wear``, ``broken_tooth``) and that fault's fields (its class's
+    parameters, e.g. ``gear``, ``tooth``, ``depth``, ``angle`` of a
+    :class:`~geardyn.gears.RootCrack`). Checked by :meth:`build`, once the gears are known."""
 
     model_config = ConfigDict(extra="allow", frozen=True, allow_inf_nan=False)
 
@@ -603,13 +596,8 @@ def _check_fault(mesh: GearMesh, kw: dict[str, Any], fault: object, where: tuple
 
 def _fault_keywords(faults: list) -> dict[str, Any]:
     """The keywords of :func:`~geardyn.gears.potential_energy_stiffness` that put ``faults``
-    (built :data:`FAULT_KINDS` objects) on the pair: at most one, a root crack."""
-    if not faults:
-        return {}
-    if len(faults) > 1 or not isinstance(faults[0], RootCrack):
-        raise _study_error(("faults",), len(faults), "the potential-energy stiffness takes one"
-                           " fault, a root crack")
-    return {"crack": faults[0]}
+    (built :data:`~geardyn.gears.FAULT_KINDS` objects, each on its own tooth) on the pair."""
+    return {"faults": tuple(faults)} if faults else {}
 
 
 def _study_error(loc: tuple, value: object, reason: str, kind: str = "value_error"
