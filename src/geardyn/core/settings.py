@@ -218,6 +218,24 @@ def resolve_run(run: RunSettings | None, legacy: Mapping[str, Any],
     return out
 
 
+def settings_from_named(kind: type, named: Mapping[str, tuple[str, Any]]) -> Any:
+    """The ``kind`` settings built once from ``named`` (field -> (where the value comes from:
+    an option such as ``--transient`` or a study key such as ``run.periods``, value); ``None``
+    values take the default). An invalid value is a one-line
+    :class:`~geardyn.errors.ParameterError` naming where it came from."""
+    from geardyn.errors import ParameterError
+
+    given = {field: value for field, (_, value) in named.items() if value is not None}
+    try:
+        return kind(**given)
+    except (TypeError, ValueError) as exc:
+        field, _, reason = str(exc).partition(" ")
+        if field not in named:
+            raise
+        where, value = named[field]
+        raise ParameterError(where, value, reason.rsplit(" (got ", 1)[0]) from None
+
+
 def replacement(param: str, kind: type, fields: Mapping[str, Any]) -> str:
     """The text ``param=geardyn.Kind(a=1, ...)`` naming the settings that replace keywords."""
     args = ", ".join(f"{k}={v!r}" for k, v in fields.items())
