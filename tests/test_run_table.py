@@ -180,3 +180,13 @@ def test_new_run_keys_are_checked_when_the_study_is_read(line, start):
     with pytest.raises(ValueError) as info:
         load_study(f'[params]\nbase = "paper"\n[run]\n{line}\n')
     assert format_error(info.value).startswith(start), format_error(info.value)
+
+
+def test_the_table_declares_nothing_beside_the_settings():
+    """The table's own additions (bounds, defaults, descriptions) are of RunSettings fields, and
+    its keys are one per field plus omega and transient_periods."""
+    from geardyn.io.toml import RUN_TABLE_EXTRAS, RUN_TABLE_OWN, RunTable
+
+    assert set(RUN_TABLE_EXTRAS) <= set(FIELDS)
+    keys = {RUN_TABLE_NAMES.get(f, f) for f in FIELDS} | set(RUN_TABLE_OWN)
+    assert set(RunTable.model_fields) == keys

@@ -16,12 +16,13 @@ A *study file* holds the device parameters plus run settings::
     base = "paper"                  # PlanetaryParams.paper() ...
     [params.changes]                # ... with changes by the paper's names (xi1, backlash, B1, ...)
     xi1 = 0.05
-    [run]                           # optional: omega, periods, steps_per_period and
+    [run]                           # optional: omega and every geardyn.RunSettings field
     transient = 4000.0              # the transient: a time (tau) ...
     # transient_periods = 20        # ... or forcing periods of the run's lowest Omega
     converge = 1e-6                 # optional: transient by convergence (then a minimum),
     transient_max = 40000.0         #   up to this (default 10 x transient)
-    # continued_transient, max_period, period_tol: as geardyn.RunSettings
+    # periods (samples), steps_per_period, locate_edges, bound, continued_transient,
+    # max_period, period_tol, max_section_periods: as geardyn.RunSettings
     [sweep]                         # optional: param, start, stop, num, continuation,
                                     # samples, lyapunov (see SweepSettings)
 
@@ -35,12 +36,15 @@ mesh stiffnesses); their values are checked when the model is built (errors name
 ``params.<field>``).
 
 The ``[run]`` table (:class:`RunTable`) sets the :class:`geardyn.RunSettings` of the study's
-runs (command-line options win): ``transient`` (tau) or ``transient_periods`` (not both: the
-transient is then that many forcing periods at the lowest Omega of the run, e.g. of a sweep's
-range, so every point gets at least that many), ``periods`` (samples), ``steps_per_period``,
-``converge`` (a relative tolerance in (0, 1): the transient runs on until the Poincare point has
-settled, up to ``transient_max``, which needs ``converge``), ``continued_transient``,
-``max_period`` and ``period_tol`` (the period classifier). Errors name ``run.<field>``.
+runs (command-line options win, see :meth:`Study.run_sources`): one key per RunSettings field,
+generated from RunSettings' declaration (``periods`` for ``samples``, :data:`RUN_TABLE_NAMES`)
+and checked by RunSettings' own rules when the study is read: ``transient`` (tau) or
+``transient_periods`` (not both: the transient is then that many forcing periods at the lowest
+Omega of the run, e.g. of a sweep's range, so every point gets at least that many),
+``periods``, ``steps_per_period``, ``locate_edges``, ``bound``, ``converge`` (a relative
+tolerance in (0, 1): the transient runs on until the Poincare point has settled, up to
+``transient_max``, which needs ``converge``), ``continued_transient``, ``max_period`` and
+``period_tol`` (the period classifier), ``max_section_periods``. Errors name ``run.<key>``.
 
 This module only reads and validates: a study file becomes a :class:`Study` (plain, validated
 data; its device parameters a :class:`~geardyn.PlanetaryParams`). Turning a study into a model is
