@@ -14,6 +14,7 @@ import pytest
 
 import geardyn
 from conformance_cases import IDS, cases, dead_zone_events, dead_zone_rhs, user_model
+from geardyn.core.capabilities import Capabilities
 from geardyn.core.kernel_source import KernelSource
 from geardyn.testing import RULES, ModelContractError, check_model
 
@@ -177,6 +178,24 @@ def _broken(name: str) -> geardyn.Model:
         return _user(_rhs_jump)
     if name == "negative natural frequency":
         return _user(dead_zone_rhs, natural_frequency=lambda p: -1.0)
+    if name.startswith("static mesh forces"):
+        return _static_forces(name)
+    raise KeyError(name)
+
+
+def _static_forces(name: str) -> geardyn.Model:
+    """The dead-zone oscillator (observable F, its mesh force) giving static mesh forces: with
+    no mesh, with a mesh whose force it does not declare, or with the wrong count."""
+    good = user_model()
+    one, two = (lambda: np.array([0.6])), (lambda: np.array([0.6, 0.6]))
+    mesh = (("mesh", 0, 1),)
+    if name == "static mesh forces without meshes":
+        return _with(good, static_mesh_forces=one)
+    if name == "static mesh forces of a mesh without its force":
+        return _with(good, meshes=mesh, static_mesh_forces=one)
+    if name == "static mesh forces of the wrong count":
+        return _with(good, meshes=mesh, capabilities=Capabilities(mesh_forces=True),
+                     static_mesh_forces=two)
     raise KeyError(name)
 
 
@@ -200,6 +219,9 @@ BROKEN = [
     ("kinks without events", 8),
     ("jump in time", 8),
     ("negative natural frequency", 9),
+    ("static mesh forces without meshes", 1),
+    ("static mesh forces of a mesh without its force", 1),
+    ("static mesh forces of the wrong count", 1),
 ]
 
 
@@ -211,6 +233,20 @@ def test_check_names_the_broken_rule(name, rule):
     assert err.value.rules == (rule,), str(err.value)
     broken = next(r for r in RULES if r.number == rule)
     assert f"rule {rule} ({broken.name}): failed" in str(err.value)
+
+
+def test_static_mesh_forces_with_their_declared_meshes_keep_rule_1():
+    """The same model declaring its mesh and its force (the observable F) keeps rule 1; the
+    broken forms name static_mesh_forces."""
+    good = _with(user_model(), meshes=(("mesh", 0, 1),),
+                 capabilities=Capabilities(mesh_forces=True),
+                 static_mesh_forces=lambda: np.array([0.6]))
+    report = check_model(good, run=False, raise_on_failure=False)
+    assert report.results[0].status == "ok", str(report)
+    for name in ("static mesh forces without meshes",
+                 "static mesh forces of a mesh without its force"):
+        text = str(check_model(_broken(name), run=False, raise_on_failure=False))
+        assert "static_mesh_forces() gives 1 mesh forces but the model declares" in text, text
 
 
 def test_check_names_a_run_that_misses_the_reference():

@@ -252,6 +252,31 @@ def test_mesh_forces_are_what_the_meshes_declare_not_a_count_of_observables():
     assert "force_peak" in forced and "force_rms" in forced
 
 
+def test_the_contract_refuses_static_forces_of_meshes_without_their_forces():
+    """static_forces given, but no mesh names its force observable: the dynamic factor would
+    silently be missing from every sweep, so the contract (rule 1) names it."""
+    import gear_pair_model as gp
+
+    def pair(meshes):
+        return geardyn.UserModel.from_one_form(
+            gp.pair_rhs, params=dict(Omega=1.0, zeta=0.05, kappa=0.0, Fm=0.1, Fa=0.05,
+                                     phi_k=0.0, phi_e=0.0, b=1.0),
+            derived={"cos_phi_k": ("phi_k", math.cos), "sin_phi_k": ("phi_k", math.sin),
+                     "cos_phi_e": ("phi_e", math.cos), "sin_phi_e": ("phi_e", math.sin)},
+            states=("x", "v"), events=gp.pair_events, event_names=("x-b", "x+b"),
+            observe=gp.pair_force, observable_names=("F",), meshes=meshes,
+            static_forces=lambda p: (p.Fm,), natural_frequency=1.0)
+
+    for meshes, why in (([("mesh", "x-b", "x+b")], "but not their forces"),
+                        ([], "declares no meshes")):
+        report = check_model(pair(meshes), run=False, raise_on_failure=False)
+        assert [r.rule.number for r in report.failed] == [1], str(report)
+        assert why in str(report), str(report)
+    report = check_model(pair([("mesh", "x-b", "x+b", "F")]), run=False,
+                         raise_on_failure=False)
+    assert report.ok, str(report)
+
+
 def test_the_contract_refuses_mesh_forces_without_one_force_per_mesh():
     model = geardyn.GearPair()
     model.observable_names = ("F", "G")

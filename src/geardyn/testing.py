@@ -63,7 +63,9 @@ class Rule:
 RULES: tuple[Rule, ...] = (
     Rule(1, "names", "state_names is a non-empty tuple of distinct strings; event_names, "
          "observable_names and param_names are tuples of distinct strings; every mesh names "
-         "two events that exist"),
+         "two events that exist; mesh forces go with their meshes: capabilities.mesh_forces "
+         "means one observable per mesh, and static_mesh_forces() is None or one finite force "
+         "per mesh of a model that declares its mesh forces"),
     Rule(2, "coefficients", "params is a 1-D float array of finite numbers laid out as "
          "coefficient_layout declares (param_names: its parameters); omega_index is None "
          "(autonomous) or the index of a finite Omega >= 0"),
@@ -244,10 +246,37 @@ def _check_names(model: Model) -> None:
     for mesh in model.meshes:
         if len(mesh) != 3 or not all(0 <= j < model.n_events for j in mesh[1:]):
             raise _Broken(f"mesh {mesh!r} does not name two of the {model.n_events} events")
-    if model.capabilities.mesh_forces and not (
-            model.meshes and model.n_observables == len(model.meshes)):
+    _check_mesh_forces(model)
+
+
+def _check_mesh_forces(model: Model) -> None:
+    """Mesh forces only with their meshes: a model declaring them (``capabilities.mesh_forces``)
+    has one observable per mesh, and ``static_mesh_forces()`` is None or one finite force per
+    mesh of a model that declares its mesh forces (else the dynamic factor and the peak/RMS
+    forces would silently be left out of every sweep)."""
+    meshes = len(model.meshes)
+    declared = model.capabilities.mesh_forces
+    if declared and not (meshes and model.n_observables == meshes):
         raise _Broken(f"capabilities.mesh_forces: the observables must be the forces of the "
-                      f"{len(model.meshes)} meshes (got {model.n_observables} observables)")
+                      f"{meshes} meshes (got {model.n_observables} observables)")
+    where = ("declares no meshes" if not meshes else
+             f"declares {meshes} meshes but not their forces (capabilities.mesh_forces: no "
+             "mesh names its force observable)" if not declared else
+             f"declares {meshes} meshes with their forces")
+    try:
+        static = model.static_mesh_forces()
+    except Exception as exc:  # noqa: BLE001 - any failure is the finding
+        raise _Broken(f"static_mesh_forces() raised {exc!r}; the model {where}") from exc
+    if static is None:
+        return
+    f = np.asarray(static, dtype=float).ravel()
+    if not declared:
+        raise _Broken(f"static_mesh_forces() gives {f.size} mesh forces but the model {where}: "
+                      "declare each mesh with its force observable, or return None")
+    if f.size != meshes or not np.all(np.isfinite(f)):
+        raise _Broken(f"static_mesh_forces() gives {f.size} values "
+                      f"{np.array2string(f, precision=4)}; expected one finite force per mesh "
+                      f"(the model {where})")
 
 
 def _check_coefficients(model: Model) -> None:

@@ -34,7 +34,7 @@ from geardyn.cli.common import (
     load_study_source,
     make_parents,
     run_option,
-    run_settings,
+    study_run_settings,
     usable_omega,
     write_outputs,
 )
@@ -96,16 +96,20 @@ def basins_command(
     y_axis = _state_axis(y, "--y", model.state_names)
     if x_axis[0] == y_axis[0]:
         raise ParameterError("--y", y, "must name another state than --x")
-    tr = s.run.transient_time(om) if transient is None else transient
-    spp = s.run.steps_per_period if steps_per_period is None else steps_per_period
-    run0 = run_settings({"transient": ("--transient", tr),
-                         "steps_per_period": ("--steps-per-period", spp),
-                         "converge": ("--converge", CONVERGE if converge is None else converge)})
-    n_samples = SAMPLES_PER_PERIOD * run0.max_period + 2 if samples is None else samples
-    check_count("--samples", n_samples)
-    if n_samples < 2:
-        raise ParameterError("--samples", n_samples, "must be >= 2")
-    run = run0.replace(samples=n_samples)
+    if samples is not None:
+        check_count("--samples", samples)
+        if samples < 2:
+            raise ParameterError("--samples", samples, "must be >= 2")
+    # basins' own defaults: convergence CONVERGE, samples enough for the longest period
+    options = {"transient": ("--transient", transient), "samples": ("--samples", samples),
+               "steps_per_period": ("--steps-per-period", steps_per_period),
+               "converge": ("--converge", converge)}
+    first = study_run_settings(s, options, omega=om, defaults={"converge": CONVERGE})
+    run = study_run_settings(s, options, omega=om, defaults={
+        "converge": CONVERGE, "samples": SAMPLES_PER_PERIOD * first.max_period + 2})
+    if run.samples < 2:
+        raise ParameterError("run.periods", run.samples, "must be >= 2")
+    tr, n_samples, spp = run.transient, run.samples, run.steps_per_period
     lanes = x_axis[3] * y_axis[3]
     check_run_cost(model, lanes, [om], 10 * tr, n_samples, spp, False, yes=yes,
                    option="--x/--y/--transient", value=f"{x} x {y}, transient {tr:g}",

@@ -45,9 +45,8 @@ from geardyn.cli.common import (
     load_study_source,
     make_parents,
     run_option,
-    run_settings,
     stderr_console,
-    study_run_options,
+    study_run_settings,
     usable_omega,
     write_outputs,
 )
@@ -280,16 +279,13 @@ def bifurcation_command(
     cont = (continuation.value if continuation is not None
             else sweep.continuation if sweep is not None else "none")
     lyap = lyapunov if lyapunov is not None else bool(sweep is not None and sweep.lyapunov)
-    tr = transient if transient is not None else s.run.transient if (
-        s.run.transient_periods is None) else s.run.transient_time(
-        _lowest_omega(model, name, (start, stop), hold))
-    n_samples = samples if samples is not None else (
-        sweep.samples if sweep is not None and sweep.samples is not None else s.run.periods)
-    spp = s.run.steps_per_period if steps_per_period is None else steps_per_period
-    run = run_settings({"transient": ("--transient", tr), "samples": ("--samples", n_samples),
-                        "steps_per_period": ("--steps-per-period", spp),
-                        **study_run_options(s, converge=converge,
-                                            continued_transient=continued_transient)})
+    run = study_run_settings(
+        s, {"transient": ("--transient", transient), "samples": ("--samples", samples),
+            "steps_per_period": ("--steps-per-period", steps_per_period),
+            "converge": ("--converge", converge),
+            "continued_transient": ("--continued-transient", continued_transient)},
+        sweep=True, omega=lambda: _lowest_omega(model, name, (start, stop), hold))
+    tr, n_samples, spp = run.transient, run.samples, run.steps_per_period
     if n_samples < 2:
         raise ParameterError("--samples", n_samples, "must be >= 2 (the period needs two)")
     if converge is not None and not converge < 1:

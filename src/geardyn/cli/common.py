@@ -139,42 +139,33 @@ def usable_omega(value: float) -> bool:
 
 
 def run_settings(options: dict[str, tuple[str, Any]]):
-    """The :class:`~geardyn.RunSettings` of a command (see :func:`settings_from_options`)."""
+    """The :class:`~geardyn.RunSettings` of command-line options alone (see
+    :func:`settings_from_options`); a command that reads a study takes
+    :func:`study_run_settings`."""
     from geardyn.core.settings import RunSettings
 
     return settings_from_options(RunSettings, options)
 
 
+def study_run_settings(study, options: dict[str, tuple[str, Any]], *, sweep: bool = False,
+                       omega: float | Callable[[], float | None] | None = None,
+                       defaults: dict[str, Any] | None = None):
+    """The :class:`~geardyn.RunSettings` of a command that runs a study: every field from the
+    command-line ``options`` (field -> (option name, value or None)), else the study's
+    ``[run]`` table, else the command's ``defaults``, as
+    :meth:`geardyn.io.toml.Study.run_settings` reads them (``sweep``, ``omega``: there). An
+    invalid value is a one-line error naming the option or the study key it came from."""
+    return study.run_settings(sweep=sweep, omega=omega, given=options, defaults=defaults)
+
+
 def settings_from_options(kind: type, options: dict[str, tuple[str, Any]]):
     """The ``kind`` settings of a command, built once from ``options`` (field -> (option name,
     value); ``None`` values take the default); an invalid value is a one-line
-    :class:`ParameterError` naming the option."""
-    given = {field: value for field, (_, value) in options.items() if value is not None}
-    try:
-        return kind(**given)
-    except (TypeError, ValueError) as exc:
-        text = str(exc)
-        field, _, reason = text.partition(" ")
-        if field not in options:
-            raise
-        option, value = options[field]
-        raise ParameterError(option, value, reason.rsplit(" (got ", 1)[0]) from None
+    :class:`ParameterError` naming the option
+    (:func:`geardyn.core.settings.settings_from_named`)."""
+    from geardyn.core.settings import settings_from_named
 
-
-def study_run_options(study, **given: Any) -> dict[str, tuple[str, Any]]:
-    """The :func:`run_settings` options a command takes from the study's ``[run]`` table
-    (``converge``, ``transient_max``, ``continued_transient``, ``max_period``, ``period_tol``),
-    each named ``run.<field>`` unless its command-line option ``given`` (field -> value or None)
-    sets it, then named ``--<field>``."""
-    out: dict[str, tuple[str, Any]] = {}
-    for field in ("converge", "transient_max", "continued_transient", "max_period",
-                  "period_tol"):
-        value = given.get(field)
-        if value is not None:
-            out[field] = (f"--{field.replace('_', '-')}", value)
-        else:
-            out[field] = (f"run.{field}", getattr(study.run, field))
-    return out
+    return settings_from_named(kind, options)
 
 
 def check_count(option: str, value: int) -> None:

@@ -43,13 +43,14 @@ from geardyn.cli.common import (
     make_parents,
     option_name,
     run_option,
-    run_settings,
     settings_from_options,
     stderr_console,
+    study_run_settings,
     usable_omega,
     write_outputs,
 )
 from geardyn.errors import ParameterError, StudyError
+from geardyn.io.toml import RUN_FIELDS
 from geardyn.study import build_model
 
 __all__ = ["continue_command", "parse_span", "register"]
@@ -115,24 +116,30 @@ def _load_over(path: Path, param: str):
     return ds
 
 
+#: The ``[run]`` keys a branch does not read (the step travels as a keyword without a run): a
+#: study writing only these keeps the continuation's own first guess.
+_NOT_READ = ("periods", "steps_per_period", "continued_transient", "max_period", "period_tol")
+
+
 def _guess_run(s, model, name: str, start: float,
                transient: float | None, spp: int | None):
-    """The :class:`~geardyn.RunSettings` of the branch's first orbit: ``--transient``, else the
-    study's ``[run]`` transient (``transient`` or ``transient_periods`` at the start's Omega)
-    with its ``converge`` and ``transient_max``; None (the continuation's own default guess:
-    200 periods, at most 2000 time units) when neither the option nor the study sets one."""
-    table = s.run
-    fields: dict = {"steps_per_period": ("--steps-per-period", spp)}
-    if transient is not None:
-        fields["transient"] = ("--transient", transient)
-    elif table.transient_periods is not None or "transient" in table.model_fields_set:
-        om = start if name == "Omega" else model.with_params(**{name: start}).omega
-        fields["transient"] = ("run.transient", table.transient_time(om))
-    elif table.converge is None:
+    """The :class:`~geardyn.RunSettings` of the branch (its first orbit's transient, the
+    bound, the section limit): the options and the study's ``[run]`` table as every command
+    reads them (``transient_periods`` at the start's Omega); None (the continuation's own
+    default guess: 200 periods, at most 2000 time units, and the step as a keyword)
+    when neither ``--transient`` nor the study file sets a run setting the branch reads
+    (:data:`_NOT_READ` aside)."""
+    options = {"transient": ("--transient", transient),
+               "steps_per_period": ("--steps-per-period", spp)}
+    written = [key for key in (*RUN_FIELDS, "transient_periods")
+               if key not in _NOT_READ and s.run.written(key)]
+    if transient is None and not written:
         return None
-    for field in ("converge", "transient_max"):
-        fields[field] = (f"run.{field}", getattr(table, field))
-    return run_settings(fields)
+
+    def start_omega() -> float:
+        return start if name == "Omega" else model.with_params(**{name: start}).omega
+
+    return study_run_settings(s, options, omega=start_omega)
 
 
 def _summary(ds) -> str:
@@ -259,7 +266,7 @@ def continue_command(
     if quantity != "section" and not names:
         raise ParameterError("--quantity", quantity, f"{model.name} has no backlash mesh")
     spp = s.run.steps_per_period if steps_per_period is None else steps_per_period
-    run = _guess_run(s, model, name, start, transient, spp)
+    run = _guess_run(s, model, name, start, transient, steps_per_period)
     over_ds = _load_over(over, name) if over is not None else None
     if over_ds is not None and quantity != "section" and not (
             quantity in over_ds and set(over_ds[quantity].dims) <= {name, "mesh"}):

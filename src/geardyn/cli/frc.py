@@ -38,8 +38,7 @@ from geardyn.cli.common import (
     load_study_source,
     make_parents,
     run_option,
-    run_settings,
-    study_run_options,
+    study_run_settings,
     usable_omega,
     write_outputs,
 )
@@ -118,17 +117,16 @@ def frc_command(
     if mesh is not None and mesh not in names:
         raise ParameterError("--mesh", mesh, f"not a mesh of the model; meshes: "
                              f"{', '.join(names)}")
-    tr = s.run.transient_time(min(start, stop)) if transient is None else transient
-    n_samples = samples if samples is not None else (
-        sweep.samples if sweep is not None and sweep.samples is not None else s.run.periods)
-    spp = s.run.steps_per_period if steps_per_period is None else steps_per_period
+    run = study_run_settings(
+        s, {"transient": ("--transient", transient), "samples": ("--samples", samples),
+            "steps_per_period": ("--steps-per-period", steps_per_period),
+            "converge": ("--converge", converge),
+            "continued_transient": ("--continued-transient", continued_transient)},
+        sweep=True, omega=min(start, stop))
+    tr, n_samples, spp = run.transient, run.samples, run.steps_per_period
     check_count("--samples", n_samples)
     if n_samples < 2:
         raise ParameterError("--samples", n_samples, "must be >= 2 (the period needs two)")
-    run = run_settings({"transient": ("--transient", tr), "samples": ("--samples", n_samples),
-                        "steps_per_period": ("--steps-per-period", spp),
-                        **study_run_options(s, converge=converge,
-                                            continued_transient=continued_transient)})
     omegas = np.linspace(start, stop, min(num, ESTIMATE_POINTS))  # Omega, evenly spaced
     check_run_cost(model, 2 * num, omegas,
                    tr if run.converge is None else run.transient_limit, n_samples, spp,

@@ -52,8 +52,8 @@ from geardyn.cli.common import (
     load_study_source,
     make_parents,
     run_option,
-    run_settings,
     stderr_console,
+    study_run_settings,
     usable_omega,
 )
 from geardyn.core.status import Status
@@ -261,11 +261,11 @@ def simulate(
         raise ParameterError("--omega", om, "must be a positive finite number (with a finite "
                              "period)")
     check_plot_path("--plot", plot)
-    tr = s.run.transient_time(om) if transient is None else transient
-    n_periods = s.run.periods if periods is None else periods
-    spp = s.run.steps_per_period if steps_per_period is None else steps_per_period
-    run = run_settings({"transient": ("--transient", tr), "samples": ("--periods", n_periods),
-                        "steps_per_period": ("--steps-per-period", spp)})
+    run = study_run_settings(s, {"transient": ("--transient", transient),
+                                 "samples": ("--periods", periods),
+                                 "steps_per_period": ("--steps-per-period", steps_per_period)},
+                             omega=om)
+    tr, n_periods, spp = run.transient, run.samples, run.steps_per_period
     if n_periods > MAX_COUNT:
         raise ParameterError("--periods", n_periods, f"must be >= 1 and <= {MAX_COUNT}")
     if spp is not None:

@@ -35,7 +35,7 @@ from geardyn.cli.common import (
     refuse_if_costly,
     run_option,
     run_settings,
-    study_run_options,
+    study_run_settings,
     usable_omega,
 )
 from geardyn.errors import ParameterError, StudyError
@@ -129,10 +129,6 @@ def map_command(
                   "steps_per_period": ("--steps-per-period", steps_per_period)})
     s = load_study_source(study)
     model = build_model(s, interpretation=interpretation)
-    n_samples = s.run.periods if samples is None else samples
-    spp = s.run.steps_per_period if steps_per_period is None else steps_per_period
-    if n_samples < 2:
-        raise ParameterError("run.periods", n_samples, "a map needs >= 2 samples per point")
     # the names and both ends of each axis must be valid before anything grid-sized is built
     for (name, start, stop, _), option in ((x_axis, "--x"), (y_axis, "--y")):
         try:
@@ -152,10 +148,15 @@ def map_command(
             raise ParameterError(option, f"{name}:{start}:{stop}", "an end of the axis makes the"
                                  " model's coefficients infinite (a value is too extreme)")
 
-    tr = transient
-    if tr is None:  # [run].transient, or transient_periods of the lowest Omega of the map
-        low = [min(a[1], a[2]) for a in (x_axis, y_axis) if a[0] == "Omega"]
-        tr = s.run.transient_time(low[0] if low else model.omega)
+    # the transient: --transient, [run].transient, or transient_periods of the lowest Omega
+    low = [min(a[1], a[2]) for a in (x_axis, y_axis) if a[0] == "Omega"]
+    run = study_run_settings(s, {"transient": ("--transient", transient),
+                                 "samples": ("--samples", samples),
+                                 "steps_per_period": ("--steps-per-period", steps_per_period)},
+                             omega=low[0] if low else model.omega)
+    tr, n_samples, spp = run.transient, run.samples, run.steps_per_period
+    if n_samples < 2:
+        raise ParameterError("run.periods", n_samples, "a map needs >= 2 samples per point")
     lanes = x_axis[3] * y_axis[3]
     omega_axis = next((a for a in (x_axis, y_axis) if a[0] == "Omega"), None)
     omegas = (np.linspace(omega_axis[1], omega_axis[2], min(omega_axis[3], ESTIMATE_POINTS))
@@ -181,10 +182,6 @@ def map_command(
                                 ns_per_lane_step=ns, parallel=parallel)
         refuse_if_costly(estimate, "--x/--y", f"{x} x {y}", yes, "map")
         err.print(f"map: {estimate.describe()}")
-        run = run_settings({"transient": ("--transient", tr),
-                            "samples": ("--samples", n_samples),
-                            "steps_per_period": ("--steps-per-period", spp),
-                            **study_run_options(s)})
         ds = _run(map2d, model, x_axis, y_axis, run, lyapunov, client, out,
                   chunk, err)
     finally:

@@ -75,7 +75,9 @@ class Model:
     1. **names** -- ``state_names`` is a non-empty tuple of distinct strings, one per state;
        ``event_names``, ``observable_names`` and ``param_names`` are tuples of distinct strings;
        every entry ``(name, i, j)`` of ``meshes`` names two events that exist; a model whose
-       ``capabilities.mesh_forces`` is set has one observable per mesh (its force).
+       ``capabilities.mesh_forces`` is set has one observable per mesh (its force); and
+       ``static_mesh_forces()`` is None, or one finite force per mesh of a model whose
+       ``capabilities.mesh_forces`` is set (mesh forces without their meshes are refused).
     2. **coefficients** -- ``params`` is a 1-D float64 array of finite numbers laid out as
        :attr:`coefficient_layout` declares (:mod:`geardyn.core.coefficients`); ``param_names``
        are the layout's parameters (structure and workspace entries are not parameters: index

@@ -107,8 +107,10 @@ class RunSettings:
         "help": "Poincare points (sections) sampled per point"})
     steps_per_period: int | None = dataclasses.field(default=None, metadata={
         "help": "RK4 steps per forcing period"})
-    locate_edges: bool = True
-    bound: float = DEFAULT_BOUND
+    locate_edges: bool = dataclasses.field(default=True, metadata={
+        "help": "Locate dead-zone edge crossings inside steps (keeps 4th order)"})
+    bound: float = dataclasses.field(default=DEFAULT_BOUND, metadata={
+        "help": "States beyond this magnitude count as diverged"})
     converge: float | None = dataclasses.field(default=None, metadata={
         "help": "Transient by convergence: run on past --transient (a minimum) until the "
                 "section point settles to this relative tolerance"})
@@ -118,7 +120,9 @@ class RunSettings:
                 "attractor (a minimum with --converge)"})
     max_period: int = DEFAULT_MAX_PERIOD
     period_tol: float = DEFAULT_TOL
-    max_section_periods: int | None = None
+    max_section_periods: int | None = dataclasses.field(default=None, metadata={
+        "help": "Longest common period of two forcings (in forcing periods) taken as a "
+                "section"})
 
     def __post_init__(self) -> None:
         put = object.__setattr__
@@ -216,6 +220,24 @@ def resolve_run(run: RunSettings | None, legacy: Mapping[str, Any],
     if where is not None and given:
         warn_deprecated(where, legacy, [replacement("run", RunSettings, fields)], stacklevel)
     return out
+
+
+def settings_from_named(kind: type, named: Mapping[str, tuple[str, Any]]) -> Any:
+    """The ``kind`` settings built once from ``named`` (field -> (where the value comes from:
+    an option such as ``--transient`` or a study key such as ``run.periods``, value); ``None``
+    values take the default). An invalid value is a one-line
+    :class:`~geardyn.errors.ParameterError` naming where it came from."""
+    from geardyn.errors import ParameterError
+
+    given = {field: value for field, (_, value) in named.items() if value is not None}
+    try:
+        return kind(**given)
+    except (TypeError, ValueError) as exc:
+        field, _, reason = str(exc).partition(" ")
+        if field not in named or named[field][0] == field:  # unknown, or named as the field
+            raise
+        where, value = named[field]
+        raise ParameterError(where, value, reason.rsplit(" (got ", 1)[0]) from None
 
 
 def replacement(param: str, kind: type, fields: Mapping[str, Any]) -> str:

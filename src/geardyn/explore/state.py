@@ -274,7 +274,11 @@ class ExplorerState:
 
     # ------------------------------------------------------------------ requests
     def run_settings(self):
-        return self._effective.run_settings(sweep=True)
+        """The run of the current view's sweep (``[run]`` as every command reads it; a
+        ``transient_periods`` counts periods of the window's lowest Omega)."""
+        low = (min(self.window.start, self.window.stop) if self.param == "Omega"
+               else self._model.omega)
+        return self._effective.run_settings(sweep=True, omega=low)
 
     def diagram_request(self) -> DiagramRequest:
         """The computation of the current view's diagram."""

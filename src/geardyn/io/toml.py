@@ -16,12 +16,13 @@ A *study file* holds the device parameters plus run settings::
     base = "paper"                  # PlanetaryParams.paper() ...
     [params.changes]                # ... with changes by the paper's names (xi1, backlash, B1, ...)
     xi1 = 0.05
-    [run]                           # optional: omega, periods, steps_per_period and
+    [run]                           # optional: omega and every geardyn.RunSettings field
     transient = 4000.0              # the transient: a time (tau) ...
     # transient_periods = 20        # ... or forcing periods of the run's lowest Omega
     converge = 1e-6                 # optional: transient by convergence (then a minimum),
     transient_max = 40000.0         #   up to this (default 10 x transient)
-    # continued_transient, max_period, period_tol: as geardyn.RunSettings
+    # periods (samples), steps_per_period, locate_edges, bound, continued_transient,
+    # max_period, period_tol, max_section_periods: as geardyn.RunSettings
     [sweep]                         # optional: param, start, stop, num, continuation,
                                     # samples, lyapunov (see SweepSettings)
 
@@ -59,12 +60,15 @@ mesh stiffnesses); their values are checked when the model is built (errors name
 ``params.<field>``).
 
 The ``[run]`` table (:class:`RunTable`) sets the :class:`geardyn.RunSettings` of the study's
-runs (command-line options win): ``transient`` (tau) or ``transient_periods`` (not both: the
-transient is then that many forcing periods at the lowest Omega of the run, e.g. of a sweep's
-range, so every point gets at least that many), ``periods`` (samples), ``steps_per_period``,
-``converge`` (a relative tolerance in (0, 1): the transient runs on until the Poincare point has
-settled, up to ``transient_max``, which needs ``converge``), ``continued_transient``,
-``max_period`` and ``period_tol`` (the period classifier). Errors name ``run.<field>``.
+runs (command-line options win, see :meth:`Study.run_sources`): one key per RunSettings field,
+generated from RunSettings' declaration (``periods`` for ``samples``, :data:`RUN_TABLE_NAMES`)
+and checked by RunSettings' own rules when the study is read: ``transient`` (tau) or
+``transient_periods`` (not both: the transient is then that many forcing periods at the lowest
+Omega of the run, e.g. of a sweep's range, so every point gets at least that many),
+``periods``, ``steps_per_period``, ``locate_edges``, ``bound``, ``converge`` (a relative
+tolerance in (0, 1): the transient runs on until the Poincare point has settled, up to
+``transient_max``, which needs ``converge``), ``continued_transient``, ``max_period`` and
+``period_tol`` (the period classifier), ``max_section_periods``. Errors name ``run.<key>``.
 
 This module only reads and validates: a study file becomes a :class:`Study` (plain, validated
 data; its device parameters a :class:`~geardyn.PlanetaryParams`). Turning a study into a model is
@@ -78,6 +82,7 @@ import inspect
 import math
 import os
 import tomllib
+from collections.abc import Callable, Mapping
 from importlib import resources
 from pathlib import Path
 from typing import Annotated, Any, Literal
@@ -89,7 +94,9 @@ from pydantic import (
     ConfigDict,
     Field,
     PrivateAttr,
+    StrictBool,
     ValidationError,
+    ValidationInfo,
     create_model,
     field_validator,
     model_validator,
@@ -97,7 +104,14 @@ from pydantic import (
 from pydantic_core import InitErrorDetails, PydanticCustomError
 
 from geardyn.core.coefficients import CoefficientBlock
-from geardyn.core.settings import DEFAULT_MAX_PERIOD, DEFAULT_TOL
+from geardyn.core.settings import (
+    DEFAULT_MAX_PERIOD,
+    DEFAULT_TOL,
+    FIELDS,
+    SettingsError,
+    settings_from_named,
+)
+from geardyn.core.settings import RunSettings as Settings
 from geardyn.errors import ParameterError, StudyError
 from geardyn.files import atomic_replace
 from geardyn.gears.faults import FAULT_KINDS
@@ -166,10 +180,74 @@ class StudyInfo(BaseModel):
     )
 
 
-class RunTable(BaseModel):
-    """The ``[run]`` table: defaults of ``geardyn simulate``, ``bifurcation``, ``frc``, ``map``
-    and ``basins`` (command-line options win). ``omega`` is also the fixed Omega of a sweep of
-    another parameter; the transient, convergence and classifier settings apply to sweeps too.
+#: The ``[run]`` table's name of a :class:`geardyn.RunSettings` field where it differs.
+RUN_TABLE_NAMES: dict[str, str] = {"samples": "periods"}
+#: What the ``[run]`` table adds to a :class:`geardyn.RunSettings` field: its default where the
+#: table has its own (else None: RunSettings' default applies), bounds checked with pydantic's
+#: messages before RunSettings' own check, and its description (else the field's ``help``).
+RUN_TABLE_EXTRAS: dict[str, dict[str, Any]] = {
+    "transient": {"default": 4000.0, "ge": 0, "description": "discarded time, dimensionless tau"},
+    "samples": {"default": 64, "ge": 1, "description": "forcing periods recorded"},
+    "steps_per_period": {"ge": 4, "description": "RK4 steps per period"},
+    "converge": {"gt": 0, "lt": 1, "description": "transient by convergence: relative "
+                 "tolerance to which the Poincare point must settle (the transient is then a "
+                 "minimum)"},
+    "transient_max": {"gt": 0, "description": "longest transient by convergence, tau (default "
+                      "10 x transient)"},
+    "continued_transient": {"ge": 0, "description": "transient of a continued sweep point, tau "
+                            "(default transient)"},
+    "max_period": {"ge": 1, "le": 256, "description": "longest period (in forcing periods) "
+                   f"classified (default {DEFAULT_MAX_PERIOD})"},
+    "period_tol": {"gt": 0, "lt": 1, "description": "relative tolerance of the period "
+                   f"classifier (default {DEFAULT_TOL:g})"},
+}
+#: The ``[run]`` table's keys that are no RunSettings field: the run's Omega and the transient
+#: in forcing periods (instead of ``transient``).
+RUN_TABLE_OWN = ("omega", "transient_periods")
+#: The RunSettings field of each ``[run]`` key that is one.
+RUN_FIELDS: dict[str, str] = {RUN_TABLE_NAMES.get(f, f): f for f in FIELDS}
+
+
+def _table_type(hint: Any) -> Any:
+    """The pydantic type of a RunSettings field of type ``hint`` in the table: bool strict,
+    numbers finite and not booleans (:data:`Real`, :data:`Whole`)."""
+    import typing
+
+    base = next(t for t in (typing.get_args(hint) or (hint,)) if t is not type(None))
+    return {bool: StrictBool, int: Whole, float: Real}[base]
+
+
+def _run_table_fields() -> dict[str, Any]:
+    """The ``[run]`` table's fields: ``omega``, then one per :class:`geardyn.RunSettings` field
+    (named by :data:`RUN_TABLE_NAMES`; ``transient_periods`` after ``transient``), generated
+    from RunSettings' declaration so that every setting is settable from a study."""
+    import dataclasses
+    import typing
+
+    hints = typing.get_type_hints(Settings)
+    out: dict[str, Any] = {"omega": (Real | None, Field(
+        None, gt=0, description="mesh frequency Omega = omega/omega_n"))}
+    for f in dataclasses.fields(Settings):
+        extra = dict(RUN_TABLE_EXTRAS.get(f.name, {}))
+        default = extra.pop("default", None)
+        extra.setdefault("description", f.metadata.get("help", f"RunSettings.{f.name}"))
+        kind = _table_type(hints[f.name])
+        out[RUN_TABLE_NAMES.get(f.name, f.name)] = (
+            kind if default is not None else kind | None, Field(default, **extra))
+        if f.name == "transient":
+            out["transient_periods"] = (Real | None, Field(
+                None, gt=0, description="discarded time in forcing periods of the lowest Omega "
+                "of the run (instead of transient)"))
+    return out
+
+
+class _RunTableRules(BaseModel):
+    """The ``[run]`` table: defaults of the run settings of every command that runs lanes
+    (``geardyn simulate``, ``bifurcation``, ``frc``, ``map``, ``basins``, ``continue``,
+    ``explore``, ``reproduce``; command-line options win). One key per
+    :class:`geardyn.RunSettings` field (``periods`` for ``samples``), checked by RunSettings'
+    own rules when the study is read (errors name ``run.<key>``), plus ``omega`` (also the
+    fixed Omega of a sweep of another parameter) and ``transient_periods``.
     :meth:`Study.run_settings` turns it into the :class:`geardyn.RunSettings` of a run.
 
     The transient is given either as a time (``transient``, dimensionless tau) or in forcing
@@ -180,29 +258,20 @@ class RunTable(BaseModel):
 
     model_config = _CONFIG
 
-    omega: Real | None = Field(None, gt=0, description="mesh frequency Omega = omega/omega_n")
-    transient: Real = Field(4000.0, ge=0, description="discarded time, dimensionless tau")
-    transient_periods: Real | None = Field(
-        None, gt=0, description="discarded time in forcing periods of the lowest Omega of the "
-        "run (instead of transient)")
-    periods: Whole = Field(64, ge=1, description="forcing periods recorded")
-    steps_per_period: Whole | None = Field(None, ge=4, description="RK4 steps per period")
-    converge: Real | None = Field(
-        None, gt=0, lt=1, description="transient by convergence: relative tolerance to which "
-        "the Poincare point must settle (the transient is then a minimum)")
-    transient_max: Real | None = Field(
-        None, gt=0, description="longest transient by convergence, tau (default 10 x transient)")
-    continued_transient: Real | None = Field(
-        None, ge=0, description="transient of a continued sweep point, tau (default transient)")
-    max_period: Whole | None = Field(
-        None, ge=1, le=256, description="longest period (in forcing periods) classified "
-        f"(default {DEFAULT_MAX_PERIOD})")
-    period_tol: Real | None = Field(
-        None, gt=0, lt=1, description=f"relative tolerance of the period classifier (default "
-        f"{DEFAULT_TOL:g})")
+    @field_validator("*", mode="after")
+    @classmethod
+    def _settings_rule(cls, value: Any, info: ValidationInfo) -> Any:
+        """RunSettings' own check of the field (the value it normalises to)."""
+        field = RUN_FIELDS.get(info.field_name or "")
+        if field is None or value is None:
+            return value
+        try:
+            return getattr(Settings(**{field: value}), field)
+        except SettingsError as exc:
+            raise ValueError(str(exc).removeprefix(f"{field} ")) from None
 
     @model_validator(mode="after")
-    def _consistent(self) -> RunTable:
+    def _consistent(self) -> Any:
         if self.transient_periods is not None and "transient" in self.model_fields_set:
             raise ValueError("give the transient either as transient (time) or as "
                              "transient_periods (forcing periods), not both")
@@ -225,16 +294,13 @@ class RunTable(BaseModel):
                              f"(got {omega!r})")
         return self.transient_periods * 2.0 * math.pi / omega
 
-    def settings_fields(self, omega: float | None = None) -> dict[str, Any]:
-        """The :class:`geardyn.RunSettings` fields this table sets (``transient`` at the lowest
-        forcing frequency ``omega``, see :meth:`transient_time`; ``samples`` excluded)."""
-        out: dict[str, Any] = {"transient": self.transient_time(omega),
-                               "steps_per_period": self.steps_per_period}
-        for name in ("converge", "transient_max", "continued_transient", "max_period",
-                     "period_tol"):
-            out[name] = getattr(self, name)
-        return {k: v for k, v in out.items() if v is not None}
+    def written(self, key: str) -> bool:
+        """Whether the study file gives ``key`` (a table default does not count)."""
+        return key in self.model_fields_set and getattr(self, key) is not None
 
+
+RunTable = create_model("RunTable", __base__=_RunTableRules, __module__=__name__,
+                        __doc__=_RunTableRules.__doc__, **_run_table_fields())
 
 #: The old name of :class:`RunTable` (not :class:`geardyn.RunSettings`, which it builds).
 RunSettings = RunTable
@@ -688,24 +754,67 @@ class Study(BaseModel):
 
     _planetary: PlanetaryParams | None = PrivateAttr(None)
 
-    def run_settings(self, sweep: bool = False, omega: float | None = None, **options: Any):
-        """The :class:`geardyn.RunSettings` of this study: the ``[run]`` table's settings
-        (:meth:`RunTable.settings_fields`; ``omega`` the lowest forcing frequency of the run,
-        needed by ``transient_periods``), the samples ``[run].periods`` (with ``sweep``:
-        ``[sweep].samples`` where given), and ``options`` (RunSettings fields; ``None`` keeps
-        the study's value) over them."""
-        from geardyn.core.settings import RunSettings as Settings
+    def run_settings(self, sweep: bool = False,
+                     omega: float | Callable[[], float | None] | None = None, *,
+                     given: Mapping[str, tuple[str, Any]] | None = None,
+                     defaults: Mapping[str, Any] | None = None, **options: Any) -> Settings:
+        """The :class:`geardyn.RunSettings` of a run of this study, every field read the same
+        way for every command (:meth:`run_sources`): ``options`` (RunSettings fields; None
+        keeps the study's value) or ``given`` (field -> (option name, value or None)) win, then
+        the study's ``[run]`` table, then ``defaults``. An invalid value is a
+        :class:`~geardyn.ParameterError` naming the option or study key it came from."""
+        named = {k: (k, v) for k, v in options.items()}
+        named.update(given or {})
+        return settings_from_named(Settings, self.run_sources(named, sweep=sweep, omega=omega,
+                                                              defaults=defaults))
 
-        samples = self.run.periods
-        if sweep and self.sweep is not None and self.sweep.samples is not None:
-            samples = self.sweep.samples
-        given = {k: v for k, v in options.items() if v is not None}
-        base = self.run.settings_fields(omega) if "transient" not in given else {
-            **self.run.model_copy(update={"transient_periods": None}).settings_fields(),
-            "transient": given["transient"]}
-        base["samples"] = samples
-        base.update(given)
-        return Settings(**base)
+    def run_sources(self, given: Mapping[str, tuple[str, Any]] | None = None, *,
+                    sweep: bool = False,
+                    omega: float | Callable[[], float | None] | None = None,
+                    defaults: Mapping[str, Any] | None = None) -> dict[str, tuple[str, Any]]:
+        """Every :class:`geardyn.RunSettings` field of a run of this study with where its value
+        comes from (field -> (source, value)), first found of:
+
+        1. ``given`` (field -> (option name, value); a None value is not given);
+        2. what the study file writes: ``[sweep].samples`` for ``samples`` (with ``sweep``),
+           the ``[run]`` key of the field (:data:`RUN_TABLE_NAMES`), ``transient_periods`` x
+           2 pi / ``omega`` for ``transient`` (``omega``: the lowest forcing frequency of the
+           run, or a function giving it, called only then);
+        3. ``defaults``: the command's own (``basins``' samples and convergence);
+        4. the ``[run]`` table's defaults (``transient`` 4000, ``periods`` 64).
+
+        A field found nowhere is left out (RunSettings' default applies)."""
+        named = {k: v for k, v in (given or {}).items() if v[1] is not None}
+        defaults = dict(defaults or {})
+        unknown = sorted((set(named) | set(defaults)) - set(FIELDS))
+        if unknown:
+            raise TypeError(f"RunSettings has no field {unknown[0]!r}")
+        out: dict[str, tuple[str, Any]] = {}
+        for field in FIELDS:
+            key = RUN_TABLE_NAMES.get(field, field)
+            found = named.get(field) or self._written_run_value(field, sweep, omega)
+            if found is None and field in defaults:
+                found = (f"default {field}", defaults[field])
+            if found is None and getattr(self.run, key) is not None:
+                found = (f"run.{key}", getattr(self.run, key))
+            if found is not None:
+                out[field] = found
+        return out
+
+    def _written_run_value(self, field: str, sweep: bool,
+                           omega: float | Callable[[], float | None] | None
+                           ) -> tuple[str, Any] | None:
+        """The value the study file gives ``field`` and its key, or None (see
+        :meth:`run_sources`)."""
+        table = self.run
+        if field == "transient" and table.transient_periods is not None:
+            om = omega() if callable(omega) else omega
+            return "run.transient_periods", table.transient_time(om)
+        if field == "samples" and sweep and self.sweep is not None and (
+                self.sweep.samples is not None):
+            return "sweep.samples", self.sweep.samples
+        key = RUN_TABLE_NAMES.get(field, field)
+        return (f"run.{key}", getattr(table, key)) if table.written(key) else None
 
     @model_validator(mode="before")
     @classmethod
