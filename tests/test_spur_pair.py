@@ -265,6 +265,7 @@ def test_units_are_taken_and_labelled(tables):
     assert c.mean_force() == pytest.approx(100.0 / RB1, rel=1e-13)
     ds = geardyn.simulate(a, run=geardyn.RunSettings(transient=0.0, samples=1))
     assert ds["time"].attrs["units"] == "s"
+    assert (ds["x"].attrs["units"], ds["v"].attrs["units"]) == ("m", "m/s")
     assert ds["F"].attrs["units"] == "N"
     assert ds.attrs["time_unit"] == "s"
     assert float(ds["F"].mean()) == pytest.approx(TORQUE / RB1, rel=0.05)
@@ -287,6 +288,17 @@ def test_bad_input_names_the_field(tables, kw, field):
     with pytest.raises(ParameterError) as err:
         _pair(mesh, healthy, **kw)
     assert err.value.field == field
+
+
+def test_derived_coefficients_are_refused_by_name(tables):
+    mesh, healthy, _ = tables
+    m = _pair(mesh, healthy, harmonics=Z1)
+    with pytest.raises(ParameterError, match="mesh_stiffness") as err:
+        m.with_params(kd_a3=1.0)
+    assert err.value.field == "kd_a3"
+    with pytest.raises(ParameterError) as err:
+        m.with_params(torque="3 kg")
+    assert err.value.field == "torque"
 
 
 def test_a_crack_needs_whole_revolutions_of_its_gear():
