@@ -181,8 +181,8 @@ def test_trajectory_matches_dop853_on_the_interpolated_table(tables, which):
     """The tabulated stiffness (linear between the 256 angles per mesh cycle, jumps and all)
     against the model with H = 32 z1 = 608 harmonics: within 3 % of the peak-to-peak motion
     over a pinion revolution. The deviation is the series' rounding of the contact jumps,
-    which excite the contact mode: H Omega = 2.4 omega_n here (measured 1.7 % over two
-    revolutions); at H = 12 z1 (H Omega = 0.9 omega_n) 14 %, at H = 2 z1 41 %."""
+    which excite the contact mode: H Omega = 2.4 omega_n here (measured 0.8 %, healthy); at the
+    default H = 16 z1 4.9 %, at 12 z1 (H Omega = 0.9 omega_n) 14 %, at 2 z1 41 % (docs/gears.md)."""
     mesh, healthy, cracked = tables
     table = healthy if which == "healthy" else cracked
     KMEAN[0] = float(table["mesh_stiffness"].mean())
