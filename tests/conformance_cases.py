@@ -81,6 +81,19 @@ def planetary() -> geardyn.PlanetaryGearSet:
         sun_mesh_error=5e-6, ring_mesh_error=5e-6, mesh_frequency=2 * math.pi * 1500)
 
 
+def spur_pair() -> geardyn.SpurPair:
+    """The 19/48 spur pair with a cracked pinion tooth on its potential-energy stiffness (SI),
+    a short series (H = 2 z1) and a 10 um backlash half-width."""
+    from geardyn.gears import GearMesh, RootCrack, SpurGear, potential_energy_stiffness
+    mesh = GearMesh(SpurGear(19, "3.2 mm", "20 deg", "16 mm", name="pinion"),
+                    SpurGear(48, "3.2 mm", "20 deg", "16 mm", name="wheel"))
+    table = potential_energy_stiffness(mesh, bore_radius=(0.012, 0.035), angles=32, cycles=19,
+                                       crack=RootCrack("1.5 mm"))
+    return geardyn.SpurPair(mesh, table, speed="1000 rpm", torque="50 N m",
+                            inertia=(4.3659e-4, 8.3602e-3), backlash="10 um", error="1 um",
+                            harmonics=38)
+
+
 def cases() -> dict[str, tuple[geardyn.Model, np.ndarray]]:
     """Case id -> (model, start state)."""
     reduced = _catt()
@@ -98,8 +111,9 @@ def cases() -> dict[str, tuple[geardyn.Model, np.ndarray]]:
         "UserModel": (user, np.array([1.0, 0.0])),
         "UserModel-one-form": (gear_pair(Omega=1.3, kappa=0.2, Fa=0.2), np.zeros(2)),
         "PlanetaryGearSet": (gs, gs.initial_state() + kick),
+        "SpurPair": (spur_pair(), np.array([-3e-5, 0.0])),  # coast contact: crosses the zone
     }
 
 
 IDS = ("CATTDevice-reduced", "CATTDevice-general", "DimensionalCATT", "GearPair", "UserModel",
-       "UserModel-one-form", "PlanetaryGearSet")
+       "UserModel-one-form", "PlanetaryGearSet", "SpurPair")

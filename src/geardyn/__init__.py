@@ -36,6 +36,7 @@ from geardyn.models.derived import INTERPRETATIONS
 from geardyn.models.gear_pair import GearPair
 from geardyn.models.params import Carrier, Gear, Loads, Mesh, PlanetaryParams, PlanetOverride
 from geardyn.models.planetary import Member, PlanetaryGearSet
+from geardyn.models.spur_pair import SpurPair
 from geardyn.models.user import UserModel
 from geardyn.solvers.reference import reference_solution
 from geardyn.solvers.simulate import default_steps_per_period, simulate
@@ -66,6 +67,7 @@ __all__ = [
     "PlanetaryGearSet",
     "PlanetaryParams",
     "RunSettings",
+    "SpurPair",
     "Status",
     "StudyError",
     "UserModel",

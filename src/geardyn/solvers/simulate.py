@@ -115,8 +115,9 @@ def simulate(
             "state": ("state", list(model.state_names)),
         }
     )
+    units = _state_units(model)
     for j, name in enumerate(model.state_names):
-        ds[name] = ("time", Y[:, j], {"units": model.state_units})
+        ds[name] = ("time", Y[:, j], {"units": units[j]})
     for j, name in enumerate(model.observable_names):
         ds[name] = ("time", O[:, j], {"units": model.observable_units,
                                       "long_name": f"dynamic mesh force {name}"})
@@ -152,3 +153,10 @@ def simulate(
     if other.size and np.isfinite(other[0]):  # a second excitation (the load fluctuation)
         ds.attrs["Lambda"] = float(other[0])
     return finish(ds, "simulation")
+
+
+def _state_units(model: Model) -> list[str]:
+    """The unit of each state: ``model.state_units`` split at ", " where it names one per state
+    (``"m, m/s"``), else the same for every state."""
+    parts = model.state_units.split(", ")
+    return parts if len(parts) == model.n_states else [model.state_units] * model.n_states

@@ -1,0 +1,463 @@
+"""A spur gear pair built from its geometry, in SI units, with the potential-energy mesh stiffness.
+
+One degree of freedom, the mesh deflection x [m] along the line of action (x = r_b1 theta_1 -
+r_b2 theta_2 - e(t), the dynamic transmission error less the static one), time t [s]:
+
+    m x'' + c x' + f(x, theta) = T1 / r_b1 + m e_a (N Omega)^2 cos(N theta + phi_e)
+
+    f = k_d(theta) (x - b)   x > b    (drive flanks in contact)
+        0                    |x| <= b (the dead zone of the backlash, 2b wide)
+        k_c(theta) (x + b)   x < -b   (coast flanks in contact)
+
+m the equivalent mass I1 I2 / (I1 r_b2^2 + I2 r_b1^2), c = 2 zeta sqrt(k_mean m) (k_mean the mean
+drive stiffness; the damping acts in and out of contact), T1 the pinion torque, e_a cos(N theta
++ phi_e) the static transmission error at the mesh frequency. theta = Omega t is the forcing
+phase: the rotation angle of the gear whose revolution is the forcing period (the pinion, or the
+wheel for a fault on the wheel; or one mesh cycle, N = 1), N the mesh cycles per period (the
+gear's teeth). At theta = 0 tooth 0 of either gear passes the pitch point (the stiffness table's
+angle 0, see :func:`~geardyn.gears.potential_energy_stiffness`).
+
+The flanks' stiffnesses k_d, k_c [N/m] are the potential-energy mesh stiffness of the drive and
+the coast flanks over one forcing period, as truncated Fourier series in theta,
+
+    k(theta) = k0 + sum_{h=1..H} a_h cos(h theta) + b_h sin(h theta),
+
+the discrete Fourier series of the table (uniform in the pinion angle) cut after H harmonics of
+Omega (default H = ``DEFAULT_MESH_HARMONICS`` N: every sideband up to the 16th mesh harmonic).
+The series is smooth in time, so fixed-step RK4 keeps its order between the dead-zone edges (the
+events x - b and x + b); the table's jumps where a tooth pair enters or leaves contact are
+rounded over about 1/H of the period (the truncation error is largest there: see
+:meth:`SpurPair.stiffness_error`). A tooth fault on one tooth of the periodic gear is then felt
+once per forcing period.
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+import re
+from collections.abc import Sequence
+
+import numpy as np
+import xarray as xr
+
+from geardyn.core.capabilities import Capabilities
+from geardyn.core.coefficients import CoefficientLayout
+from geardyn.core.model import Model
+from geardyn.core.plan import STEPS_PER_FASTEST_MODE, STEPS_PER_OTHER_FORCING
+from geardyn.errors import ParameterError
+from geardyn.gears.geometry import GearMesh
+from geardyn.gears.potential_energy import (
+    STEEL_POISSON,
+    STEEL_YOUNG,
+    RootCrack,
+    potential_energy_stiffness,
+)
+from geardyn.models.spur_pair_coefficients import HEADER, series_block
+from geardyn.models.spur_pair_kernels import (
+    BACKLASH,
+    K_MEAN,
+    KERNEL,
+    MASS,
+    OMEGA,
+    R_B1,
+    TORQUE,
+)
+from geardyn.units import to_si
+
+__all__ = ["DEFAULT_MESH_HARMONICS", "STEEL_DENSITY", "SpurPair", "disc_inertia"]
+
+#: Harmonics of the mesh frequency each flank's series keeps by default (H = this times the
+#: mesh cycles per period).
+DEFAULT_MESH_HARMONICS = 16
+#: Density of steel [kg/m^3] of the default (solid disc) inertias.
+STEEL_DENSITY = 7850.0
+#: The forcing periods :meth:`SpurPair.from_geometry` takes: one revolution of the pinion or of
+#: the wheel, or one mesh cycle.
+PERIODS = ("pinion", "wheel", "mesh")
+#: Speeds per unit of the ``speed`` input (a plain number is rad/s, as every frequency).
+_RPM = 2.0 * math.pi / 60.0
+
+
+# ---------------------------------------------------------------------------------------------
+# the table -> the series
+
+def disc_inertia(gear_radius: float, face_width: float, bore_radius: float,
+                 density: float = STEEL_DENSITY) -> float:
+    """Polar moment of inertia [kg m^2] of a disc of ``gear_radius`` with a bore of
+    ``bore_radius`` [m], ``face_width`` [m] thick: pi rho b (r^4 - r_i^4) / 2."""
+    return 0.5 * math.pi * density * face_width * (gear_radius ** 4 - bore_radius ** 4)
+
+
+def _period_cycles(stiffness: xr.Dataset) -> int:
+    """The whole number of mesh cycles the table spans (uniform in the angle from 0)."""
+    if "cycle" not in stiffness.coords or "mesh_stiffness" not in stiffness:
+        raise ParameterError("stiffness", type(stiffness).__name__,
+                             "must be a potential_energy_stiffness dataset (mesh_stiffness over"
+                             " cycle)")
+    cyc = np.asarray(stiffness["cycle"].values, dtype=float)
+    step = cyc[1] - cyc[0] if cyc.size > 1 else 0.0
+    span = cyc.size * step
+    if (cyc.size < 8 or cyc[0] != 0.0 or not step > 0
+            or not np.allclose(np.diff(cyc), step, rtol=1e-9, atol=0.0)
+            or abs(span - round(span)) > 1e-9 * span):
+        raise ParameterError("stiffness", f"{cyc.size} angles",
+                             "the table must be uniform in the angle from cycle 0 over a whole "
+                             "number of mesh cycles (potential_energy_stiffness with an integer"
+                             " angles)")
+    return int(round(span))
+
+
+def _faulty_gear(stiffness: xr.Dataset) -> str | None:
+    m = re.match(r"root crack on (pinion|wheel)", str(stiffness.attrs.get("crack", "none")))
+    return m.group(1) if m else None
+
+
+def fourier_series(table: np.ndarray, harmonics: int) -> np.ndarray:
+    """(k0, a1, b1, ..., aH, bH) of the table's discrete Fourier series, cut after ``harmonics``
+    (the samples uniform over one period from phase 0)."""
+    F = np.fft.rfft(np.asarray(table, dtype=float)) / table.size
+    out = np.empty(1 + 2 * harmonics)
+    out[0] = F[0].real
+    out[1::2] = 2.0 * F[1:harmonics + 1].real
+    out[2::2] = -2.0 * F[1:harmonics + 1].imag
+    return out
+
+
+def evaluate_series(series: np.ndarray, theta: np.ndarray) -> np.ndarray:
+    """k(theta) of a series (k0, a1, b1, ...) at the phases ``theta`` [rad]."""
+    th = np.asarray(theta, dtype=float)
+    h = np.arange(1, (series.size - 1) // 2 + 1)
+    arg = h[:, None] * th.reshape(-1)[None, :]
+    k = series[0] + series[1::2] @ np.cos(arg) + series[2::2] @ np.sin(arg)
+    return k.reshape(th.shape)
+
+
+def _quantity(value: object, kind: str, name: str) -> float:
+    try:
+        v = to_si(value, kind)
+    except ValueError as exc:
+        raise ParameterError(name, value, str(exc)) from None
+    if not math.isfinite(v):
+        raise ParameterError(name, value, "must be finite")
+    return v
+
+
+def _harmonics(value: object, cycles: int, samples: int) -> int:
+    if value is None:
+        value = DEFAULT_MESH_HARMONICS * cycles
+    if isinstance(value, bool) or not isinstance(value, int | np.integer) or value < 1:
+        raise ParameterError("harmonics", value, "must be a whole number >= 1")
+    if 2 * int(value) >= samples:
+        raise ParameterError("harmonics", value,
+                             f"the table has {samples} angles per period: at most "
+                             f"{(samples - 1) // 2} harmonics (give more angles per mesh cycle)")
+    return int(value)
+
+
+class SpurPair(Model):
+    """A spur gear pair in SI units whose mesh stiffness is the potential-energy stiffness of its
+    geometry, drive and coast flank (module docstring for the equation).
+
+    Build it with :meth:`from_geometry` (the stiffness computed here) or from a stiffness table of
+    :func:`~geardyn.gears.potential_energy_stiffness` over whole mesh cycles (``angles`` an
+    integer): the forcing period is the table's span, ``cycles`` mesh cycles (the pinion's teeth
+    for one pinion revolution). State x [m], v [m/s]; time [s]; the observable F [N] is the mesh
+    force (elastic and damping). The forcing frequency ``Omega`` [rad/s] is the rotation
+    frequency of the gear whose revolution is the period (mesh frequency / cycles); ``speed``
+    (the pinion's speed, rpm or a unit string) sets it through ``with_params`` and sweeps.
+
+    Parameters
+    ----------
+    mesh
+        The :class:`~geardyn.gears.GearMesh` the table was computed for.
+    stiffness
+        The potential-energy stiffness table (``mesh_stiffness`` and ``mesh_stiffness_coast``
+        [N/m] over ``cycle``).
+    speed
+        Pinion speed: rad/s, or a unit string (``"1500 rpm"``).
+    torque
+        Pinion torque [N m] (or ``"200 N m"``); > 0 loads the drive flanks.
+    inertia
+        (I1, I2) [kg m^2] of pinion and wheel; default solid steel discs of the reference radius,
+        the face width and the bore of the table (:func:`disc_inertia`).
+    zeta
+        Damping ratio (c = 2 zeta sqrt(k_mean m)).
+    backlash
+        Backlash half-width b [m] along the line of action (the dead zone is 2b wide); default
+        half the mesh's backlash on the line of action, j cos(alpha_w) / 2.
+    error, error_phase
+        Static transmission error amplitude [m] at the mesh frequency, and its phase [rad].
+    harmonics
+        Harmonics H of Omega in each flank's series (default ``DEFAULT_MESH_HARMONICS`` times
+        the mesh cycles per period); fewer than half the table's angles.
+    """
+
+    name = "SpurPair"
+    state_names = ("x", "v")
+    state_units = "m, m/s"
+    time_unit = "s"
+    event_names = ("x-b", "x+b")
+    observable_names = ("F",)
+    observable_units = "N"
+    meshes = (("mesh", 0, 1),)
+    capabilities = Capabilities(mesh_forces=True, physical_axes=True)
+    physical_names = ("speed",)
+
+    def __init__(self, mesh: GearMesh, stiffness: xr.Dataset, *, speed: object,
+                 torque: object, inertia: Sequence[object] | None = None, zeta: object = 0.05,
+                 backlash: object = None, error: object = 0.0, error_phase: object = 0.0,
+                 harmonics: int | None = None):
+        if not isinstance(mesh, GearMesh):
+            raise ParameterError("mesh", mesh, "must be a geardyn.gears.GearMesh")
+        if mesh.internal:
+            raise ParameterError("mesh.internal", True, "SpurPair takes an external pair")
+        cycles = _period_cycles(stiffness)
+        faulty = _faulty_gear(stiffness)
+        if faulty is not None:
+            z = (mesh.pinion if faulty == "pinion" else mesh.wheel).teeth
+            if cycles % z:
+                raise ParameterError("stiffness", f"{cycles} mesh cycles",
+                                     f"the crack on the {faulty} returns every {z} mesh cycles;"
+                                     " the table must span whole revolutions of that gear")
+        n_h = _harmonics(harmonics, cycles, int(stiffness.sizes["angle"]))
+        self.mesh, self.stiffness, self.cycles = mesh, stiffness, cycles
+        self.drive_series = fourier_series(stiffness["mesh_stiffness"].values, n_h)
+        self.coast_series = fourier_series(stiffness["mesh_stiffness_coast"].values, n_h)
+        self._check_positive()
+        b = (0.5 * max(mesh.backlash, 0.0) * math.cos(mesh.operating_pressure_angle)
+             if backlash is None else _quantity(backlash, "length", "backlash"))
+        values = {
+            "Omega": self._omega_of_speed(_quantity(speed, "frequency", "speed")),
+            "mass": self._mass(inertia),
+            "torque": _quantity(torque, "torque", "torque"),
+            "zeta": _quantity(zeta, "dimensionless", "zeta"),
+            "backlash": b,
+            "error": _quantity(error, "length", "error"),
+            "error_phase": _quantity(error_phase, "angle", "error_phase"),
+            "k_mean": float(self.drive_series[0]),
+            "cos_error_phase": 0.0, "sin_error_phase": 0.0,
+            "base_radius": mesh.pinion.base_radius, "mesh_order": float(cycles),
+            "n_harmonics": float(n_h),
+        }
+        layout = CoefficientLayout.of(HEADER, series_block("kd", n_h), series_block("kc", n_h),
+                                      model=self.name)
+        for flank, series in (("kd", self.drive_series), ("kc", self.coast_series)):
+            values[f"{flank}0"] = float(series[0])
+            for h in range(1, n_h + 1):
+                values[f"{flank}_a{h}"] = float(series[2 * h - 1])
+                values[f"{flank}_b{h}"] = float(series[2 * h])
+        inputs = ("Omega", "mass", "torque", "zeta", "backlash", "error", "error_phase")
+        layout.validate({k: values[k] for k in inputs})
+        self.coefficient_layout = layout
+        self.params = layout.fill_derived(layout.build(values))
+        self.omega_index = OMEGA
+        self.kernel = KERNEL
+
+    # ------------------------------------------------------------------ construction
+    @classmethod
+    def from_geometry(cls, mesh: GearMesh, *, bore_radius: object, speed: object,
+                      torque: object, crack: RootCrack | None = None, period: str | None = None,
+                      angles: int = 256, young: object = STEEL_YOUNG,
+                      poisson: object = STEEL_POISSON, **dynamics: object) -> SpurPair:
+        """The pair with the potential-energy stiffness of ``mesh`` (:func:`~geardyn.gears.
+        potential_energy_stiffness` with ``bore_radius``, ``young``, ``poisson``, ``crack``,
+        ``angles`` per mesh cycle) over one ``period``: ``"pinion"`` (one pinion revolution,
+        the default; a crack on the pinion is felt once per period), ``"wheel"`` (one wheel
+        revolution; the default for a crack on the wheel) or ``"mesh"`` (one mesh cycle, a
+        healthy pair only). ``dynamics``: the constructor's other keywords (inertia, zeta,
+        backlash, error, error_phase, harmonics)."""
+        if not isinstance(mesh, GearMesh):
+            raise ParameterError("mesh", mesh, "must be a geardyn.gears.GearMesh")
+        if period is None:
+            period = crack.gear if isinstance(crack, RootCrack) else "pinion"
+        if period not in PERIODS:
+            raise ParameterError("period", period, f"must be one of {', '.join(PERIODS)}")
+        cycles = {"pinion": mesh.pinion.teeth, "wheel": mesh.wheel.teeth, "mesh": 1}[period]
+        if crack is not None and isinstance(crack, RootCrack) and period != crack.gear:
+            raise ParameterError("period", period, f"the crack is on the {crack.gear}: the "
+                                 f"period must be one {crack.gear} revolution")
+        table = potential_energy_stiffness(mesh, bore_radius=bore_radius, angles=angles,
+                                           young=young, poisson=poisson, crack=crack,
+                                           cycles=cycles)
+        return cls(mesh, table, speed=speed, torque=torque, **dynamics)
+
+    def _omega_of_speed(self, speed: float) -> float:
+        """Omega [rad/s] at the pinion speed ``speed`` [rad/s]: mesh frequency / cycles."""
+        if not speed >= 0.0:
+            raise ParameterError("speed", speed, "must be >= 0")
+        return speed * self.mesh.pinion.teeth / self.cycles
+
+    def _mass(self, inertia: Sequence[object] | None) -> float:
+        mesh, attrs = self.mesh, self.stiffness.attrs
+        if inertia is None:
+            width = attrs.get("face_width_m", min(mesh.pinion.face_width, mesh.wheel.face_width))
+            i1 = disc_inertia(mesh.pinion.reference_radius, width,
+                              float(attrs.get("pinion_bore_radius_m", 0.0)))
+            i2 = disc_inertia(mesh.wheel.reference_radius, width,
+                              float(attrs.get("wheel_bore_radius_m", 0.0)))
+        else:
+            if isinstance(inertia, str) or len(inertia) != 2:
+                raise ParameterError("inertia", inertia, "give (I1, I2) of pinion and wheel")
+            i1, i2 = (_quantity(v, "inertia", f"inertia[{k}]") for k, v in enumerate(inertia))
+            for k, v in enumerate((i1, i2)):
+                if not v > 0.0:
+                    raise ParameterError(f"inertia[{k}]", v, "must be > 0")
+        self.inertia = (i1, i2)
+        r1, r2 = mesh.pinion.base_radius, mesh.wheel.base_radius
+        return i1 * i2 / (i1 * r2 * r2 + i2 * r1 * r1)
+
+    def _check_positive(self) -> None:
+        theta = self.table_phase()
+        for name, series in (("drive", self.drive_series), ("coast", self.coast_series)):
+            low = float(np.min(evaluate_series(series, theta)))
+            if not low > 0.0:
+                raise ParameterError("harmonics", (series.size - 1) // 2,
+                                     f"the {name}-flank series falls to {low:.4g} N/m <= 0 on "
+                                     "the table's angles; keep more harmonics")
+
+    # ------------------------------------------------------------------ parameters
+    def with_params(self, **values: object) -> SpurPair:
+        """As :meth:`Model.with_params`; ``speed`` (the pinion's, rad/s or a unit string such as
+        ``"3000 rpm"``) sets Omega, and the inputs take unit strings (``torque="80 N m"``,
+        ``backlash="20 um"``)."""
+        return super().with_params(**{k: self._si(k, v) for k, v in values.items()})
+
+    _KINDS = {"Omega": "frequency", "speed": "frequency", "mass": "mass", "torque": "torque",
+              "zeta": "dimensionless", "backlash": "length", "error": "length",
+              "error_phase": "angle"}
+
+    def _si(self, name: str, value: object) -> object:
+        """``value`` in SI where ``name`` is an input that takes a unit string."""
+        if isinstance(value, str) and name in self._KINDS:
+            return _quantity(value, self._KINDS[name], name)
+        return value
+
+    def _with_physical(self, values: dict[str, float]) -> SpurPair:
+        out = copy.copy(self)
+        p = self.params.copy()
+        p[OMEGA] = self._omega_of_speed(float(values["speed"]))
+        out.params = p
+        return out
+
+    def lane_params(self, name: str, values: Sequence[float] | np.ndarray) -> np.ndarray:
+        """Coefficient vectors with ``name`` set to ``values`` (``speed``: the pinion speed
+        [rad/s] sets Omega)."""
+        if name == "speed":
+            speeds = np.asarray(values, dtype=float).ravel()
+            omegas = [self._omega_of_speed(float(v)) for v in speeds]
+            return Model.lane_params(self, "Omega", omegas)
+        return Model.lane_params(self, name, values)
+
+    def param_attrs(self, name: str) -> dict[str, str]:
+        if name == "speed":
+            return {"units": "rad/s", "long_name": "pinion speed"}
+        return super().param_attrs(name)
+
+    # ------------------------------------------------------------------ physics
+    @property
+    def n_harmonics(self) -> int:
+        """H: harmonics of Omega in each flank's stiffness series."""
+        return (self.drive_series.size - 1) // 2
+
+    @property
+    def speed(self) -> float:
+        """The pinion speed [rad/s] at the model's Omega."""
+        return self.omega * self.cycles / self.mesh.pinion.teeth
+
+    @property
+    def mesh_frequency(self) -> float:
+        """The mesh frequency [rad/s]: cycles times Omega."""
+        return self.omega * self.cycles
+
+    def mean_force(self) -> float:
+        """The mean mesh force T1 / r_b1 [N]."""
+        return float(self.params[TORQUE] / self.params[R_B1])
+
+    def static_mesh_forces(self) -> np.ndarray:
+        """The static mesh force T1 / r_b1 [N] (the dynamic factor's reference)."""
+        return np.array([self.mean_force()])
+
+    def natural_frequencies(self) -> np.ndarray:
+        """sqrt(k_mean / m) [rad/s]: the natural frequency in drive-flank contact."""
+        return np.array([math.sqrt(self.params[K_MEAN] / self.params[MASS])])
+
+    def fastest_natural_frequency(self, P: np.ndarray | None = None) -> np.ndarray:
+        """The fastest frequency the step resolves [rad/s], per lane of ``P``: the natural
+        frequency at the tabulated peak stiffness of either flank, sqrt(k_max / m), or, where
+        faster, the top stiffness harmonic H Omega scaled so that its period gets at least
+        ``STEPS_PER_OTHER_FORCING`` steps."""
+        P = np.atleast_2d(self.params if P is None else np.asarray(P, dtype=float))
+        k_max = max(float(self.stiffness["mesh_stiffness"].max()),
+                    float(self.stiffness["mesh_stiffness_coast"].max()))
+        top = self.n_harmonics * P[:, OMEGA] * (STEPS_PER_OTHER_FORCING
+                                                / STEPS_PER_FASTEST_MODE)
+        return np.maximum(np.sqrt(k_max / P[:, MASS]), top)
+
+    def initial_state(self) -> np.ndarray:
+        """Static deflection under the mean force at the mean stiffness of the loaded flank, at
+        rest."""
+        f, b = self.mean_force(), float(self.params[BACKLASH])
+        if f == 0.0:
+            return np.zeros(2)
+        k = self.drive_series[0] if f > 0 else self.coast_series[0]
+        return np.array([f / k + math.copysign(b, f), 0.0])
+
+    @property
+    def state_scale(self) -> np.ndarray:
+        """[m, m/s]: the static deflection under the mean force (or the backlash half-width
+        where larger), and that times the natural frequency."""
+        d = max(abs(self.mean_force()) / float(self.params[K_MEAN]), float(self.params[BACKLASH]),
+                1e-9)
+        return np.array([d, d * float(self.natural_frequencies()[0])])
+
+    def speed_axes(self, omega: np.ndarray) -> dict[str, tuple[np.ndarray, dict]]:
+        """Mesh frequency [Hz] and pinion speed [rpm] at the forcing frequencies ``omega``
+        [rad/s]."""
+        w = np.asarray(omega, dtype=float)
+        return {"mesh_frequency": (w * self.cycles / (2.0 * math.pi),
+                                   {"units": "Hz", "long_name": "mesh frequency"}),
+                "input_speed": (w * self.cycles / self.mesh.pinion.teeth / _RPM,
+                                {"units": "rpm", "long_name": "pinion speed"})}
+
+    def dataset_attrs(self) -> dict[str, object]:
+        """The period and the stiffness series' truncation, recorded with every result."""
+        err = self.stiffness_error()
+        return {"mesh_cycles_per_period": self.cycles, "stiffness_harmonics": self.n_harmonics,
+                "mesh_frequency_rad_s": self.mesh_frequency, "speed_rpm": self.speed / _RPM,
+                "stiffness_rms_error_rel": max(err["drive_rms"], err["coast_rms"]),
+                "crack": str(self.stiffness.attrs.get("crack", "none"))}
+
+    # ------------------------------------------------------------------ the stiffness series
+    def table_phase(self) -> np.ndarray:
+        """The forcing phase theta [rad] of every angle of the stiffness table."""
+        cyc = np.asarray(self.stiffness["cycle"].values, dtype=float)
+        return 2.0 * math.pi * cyc / self.cycles
+
+    def stiffness_at(self, theta: np.ndarray, flank: str = "drive") -> np.ndarray:
+        """The series k(theta) [N/m] of the ``"drive"`` or ``"coast"`` flank."""
+        series = {"drive": self.drive_series, "coast": self.coast_series}[flank]
+        return evaluate_series(series, theta)
+
+    def stiffness_error(self) -> dict[str, float]:
+        """The series against the table at its angles, relative to the mean drive stiffness:
+        ``drive_max``, ``drive_rms``, ``coast_max``, ``coast_rms``. The maximum sits at the
+        table's jumps (a tooth pair entering or leaving contact: about half the jump, the Gibbs
+        overshoot), the rms falls as 1/sqrt(H)."""
+        if "_error" not in self.__dict__:  # the series and the table never change
+            self._error = self._series_error()
+        return dict(self._error)
+
+    def _series_error(self) -> dict[str, float]:
+        theta, k0 = self.table_phase(), float(self.drive_series[0])
+        out = {}
+        for flank, var in (("drive", "mesh_stiffness"), ("coast", "mesh_stiffness_coast")):
+            e = self.stiffness_at(theta, flank) - self.stiffness[var].values
+            out[f"{flank}_max"] = float(np.max(np.abs(e)) / k0)
+            out[f"{flank}_rms"] = float(np.sqrt(np.mean(e * e)) / k0)
+        return out
+
+    def __repr__(self) -> str:
+        return (f"SpurPair({self.mesh.pinion.teeth}/{self.mesh.wheel.teeth}, "
+                f"{self.speed / _RPM:g} rpm, {float(self.params[TORQUE]):g} N m, "
+                f"H={self.n_harmonics}, crack={self.stiffness.attrs.get('crack', 'none')!r})")
