@@ -31,7 +31,7 @@ mesh = GearMesh(SpurGear(19, "3.2 mm", "20 deg", "16 mm", name="pinion"),
 common = dict(bore_radius=("12 mm", "35 mm"), speed="1000 rpm", torque="50 N m",
               inertia=("4.3659e-4 kg m^2", "8.3602e-3 kg m^2"), zeta=0.05, backlash="10 um")
 healthy = geardyn.SpurPair.from_geometry(mesh, **common)
-cracked = geardyn.SpurPair.from_geometry(mesh, crack=RootCrack("1.5 mm", "45 deg"), **common)
+cracked = geardyn.SpurPair.from_geometry(mesh, faults=RootCrack("1.5 mm", "45 deg"), **common)
 print(healthy, cracked, sep="\n")
 print("series against the table (relative to the mean stiffness):", cracked.stiffness_error())
 

@@ -88,7 +88,7 @@ def spur_pair() -> geardyn.SpurPair:
     mesh = GearMesh(SpurGear(19, "3.2 mm", "20 deg", "16 mm", name="pinion"),
                     SpurGear(48, "3.2 mm", "20 deg", "16 mm", name="wheel"))
     table = potential_energy_stiffness(mesh, bore_radius=(0.012, 0.035), angles=32, cycles=19,
-                                       crack=RootCrack("1.5 mm"))
+                                       faults=RootCrack("1.5 mm"))
     return geardyn.SpurPair(mesh, table, speed="1000 rpm", torque="50 N m",
                             inertia=(4.3659e-4, 8.3602e-3), backlash="10 um", error="1 um",
                             harmonics=38)

@@ -37,7 +37,7 @@ def tables():
     mesh = _mesh()
     healthy = potential_energy_stiffness(mesh, bore_radius=BORES, angles=ANGLES, cycles=Z1)
     cracked = potential_energy_stiffness(mesh, bore_radius=BORES, angles=ANGLES, cycles=Z1,
-                                         crack=RootCrack("1.5 mm"))
+                                         faults=RootCrack("1.5 mm"))
     return mesh, healthy, cracked
 
 
@@ -304,12 +304,23 @@ def test_derived_coefficients_are_refused_by_name(tables):
 def test_a_crack_needs_whole_revolutions_of_its_gear():
     mesh = _mesh()
     one = potential_energy_stiffness(mesh, bore_radius=BORES, angles=64, cycles=5,
-                                     crack=RootCrack("1 mm"))
+                                     faults=RootCrack("1 mm"))
     with pytest.raises(ParameterError, match="stiffness"):
         _pair(mesh, one, harmonics=10)
     with pytest.raises(ParameterError, match="period"):
         geardyn.SpurPair.from_geometry(mesh, bore_radius=BORES, speed="1000 rpm", torque=50,
-                                       crack=RootCrack("1 mm"), period="mesh")
+                                       faults=RootCrack("1 mm"), period="mesh")
+    both = (RootCrack("1 mm"), RootCrack("1 mm", gear="wheel"))
+    with pytest.raises(ParameterError, match="both gears") as err:
+        geardyn.SpurPair.from_geometry(mesh, bore_radius=BORES, speed="1000 rpm", torque=50,
+                                       faults=both)
+    assert err.value.field == "faults"
+    hunting = potential_energy_stiffness(mesh, bore_radius=BORES, angles=8,
+                                         cycles=math.lcm(mesh.pinion.teeth, mesh.wheel.teeth),
+                                         faults=both)
+    with pytest.raises(ParameterError, match="both gears") as err:
+        _pair(mesh, hunting, harmonics=10)
+    assert err.value.field == "stiffness"
 
 
 def test_bifurcation_over_speed_runs(tables):

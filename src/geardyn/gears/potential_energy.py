@@ -972,6 +972,7 @@ def _attrs(pair: PotentialEnergyPair, root_segment: bool) -> dict[str, object]:
         "backlash_cycles": mesh.backlash / (2.0 * math.pi * mesh.operating_pitch_radii[0]
                                             / mesh.pinion.teeth),
         "faults": "; ".join(f.describe() for f in pair.faults) or "none",
+        "faulty_gears": ",".join(sorted({f.gear for f in pair.faults})),
     }
     for role, tooth in (("pinion", pair.pinion), ("wheel", pair.wheel)):
         out[f"{role}_bore_radius_m"] = tooth.bore_radius

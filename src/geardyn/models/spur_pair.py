@@ -35,7 +35,6 @@ from __future__ import annotations
 
 import copy
 import math
-import re
 from collections.abc import Sequence
 
 import numpy as np
@@ -50,7 +49,6 @@ from geardyn.gears.geometry import GearMesh
 from geardyn.gears.potential_energy import (
     STEEL_POISSON,
     STEEL_YOUNG,
-    RootCrack,
     potential_energy_stiffness,
 )
 from geardyn.models.spur_pair_coefficients import HEADER, series_block
@@ -109,8 +107,15 @@ def _period_cycles(stiffness: xr.Dataset) -> int:
 
 
 def _faulty_gear(stiffness: xr.Dataset) -> str | None:
-    m = re.match(r"root crack on (pinion|wheel)", str(stiffness.attrs.get("crack", "none")))
-    return m.group(1) if m else None
+    """The gear the table's faults sit on (its ``faulty_gears`` attribute), None if healthy;
+    faults on both gears repeat only over the hunting period, which one gear's revolution does
+    not span."""
+    gears = [g for g in str(stiffness.attrs.get("faulty_gears", "")).split(",") if g]
+    if len(gears) > 1:
+        raise ParameterError("stiffness", stiffness.attrs.get("faults"),
+                             "faults on both gears: SpurPair's period is one revolution of the"
+                             " one faulty gear")
+    return gears[0] if gears else None
 
 
 def fourier_series(table: np.ndarray, harmonics: int) -> np.ndarray:
@@ -218,7 +223,7 @@ class SpurPair(Model):
             z = (mesh.pinion if faulty == "pinion" else mesh.wheel).teeth
             if cycles % z:
                 raise ParameterError("stiffness", f"{cycles} mesh cycles",
-                                     f"the crack on the {faulty} returns every {z} mesh cycles;"
+                                     f"a fault on the {faulty} returns every {z} mesh cycles;"
                                      " the table must span whole revolutions of that gear")
         n_h = _harmonics(harmonics, cycles, int(stiffness.sizes["angle"]))
         self.mesh, self.stiffness, self.cycles = mesh, stiffness, cycles
@@ -257,28 +262,34 @@ class SpurPair(Model):
     # ------------------------------------------------------------------ construction
     @classmethod
     def from_geometry(cls, mesh: GearMesh, *, bore_radius: object, speed: object,
-                      torque: object, crack: RootCrack | None = None, period: str | None = None,
+                      torque: object, faults: object = (), period: str | None = None,
                       angles: int = 256, young: object = STEEL_YOUNG,
                       poisson: object = STEEL_POISSON, **dynamics: object) -> SpurPair:
         """The pair with the potential-energy stiffness of ``mesh`` (:func:`~geardyn.gears.
-        potential_energy_stiffness` with ``bore_radius``, ``young``, ``poisson``, ``crack``,
-        ``angles`` per mesh cycle) over one ``period``: ``"pinion"`` (one pinion revolution,
-        the default; a crack on the pinion is felt once per period), ``"wheel"`` (one wheel
-        revolution; the default for a crack on the wheel) or ``"mesh"`` (one mesh cycle, a
+        potential_energy_stiffness` with ``bore_radius``, ``young``, ``poisson``, ``faults``
+        (one fault object or several, all on one gear), ``angles`` per mesh cycle) over one
+        ``period``: ``"pinion"`` (one pinion revolution, the default for a healthy pair or faults
+        on the pinion: a faulty tooth is felt once per period), ``"wheel"`` (one wheel
+        revolution; the default for faults on the wheel) or ``"mesh"`` (one mesh cycle, a
         healthy pair only). ``dynamics``: the constructor's other keywords (inertia, zeta,
         backlash, error, error_phase, harmonics)."""
         if not isinstance(mesh, GearMesh):
             raise ParameterError("mesh", mesh, "must be a geardyn.gears.GearMesh")
+        listed = tuple(faults) if isinstance(faults, (list, tuple)) else (faults,)
+        gears = sorted({getattr(f, "gear", None) for f in listed} - {None})
+        if len(gears) > 1:
+            raise ParameterError("faults", faults, "faults on both gears: SpurPair's period is"
+                                 " one revolution of the one faulty gear")
         if period is None:
-            period = crack.gear if isinstance(crack, RootCrack) else "pinion"
+            period = gears[0] if gears else "pinion"
         if period not in PERIODS:
             raise ParameterError("period", period, f"must be one of {', '.join(PERIODS)}")
         cycles = {"pinion": mesh.pinion.teeth, "wheel": mesh.wheel.teeth, "mesh": 1}[period]
-        if crack is not None and isinstance(crack, RootCrack) and period != crack.gear:
-            raise ParameterError("period", period, f"the crack is on the {crack.gear}: the "
-                                 f"period must be one {crack.gear} revolution")
+        if gears and period != gears[0]:
+            raise ParameterError("period", period, f"the faults are on the {gears[0]}: the "
+                                 f"period must be one {gears[0]} revolution")
         table = potential_energy_stiffness(mesh, bore_radius=bore_radius, angles=angles,
-                                           young=young, poisson=poisson, crack=crack,
+                                           young=young, poisson=poisson, faults=faults,
                                            cycles=cycles)
         return cls(mesh, table, speed=speed, torque=torque, **dynamics)
 
@@ -426,7 +437,7 @@ class SpurPair(Model):
         return {"mesh_cycles_per_period": self.cycles, "stiffness_harmonics": self.n_harmonics,
                 "mesh_frequency_rad_s": self.mesh_frequency, "speed_rpm": self.speed / _RPM,
                 "stiffness_rms_error_rel": max(err["drive_rms"], err["coast_rms"]),
-                "crack": str(self.stiffness.attrs.get("crack", "none"))}
+                "faults": str(self.stiffness.attrs.get("faults", "none"))}
 
     # ------------------------------------------------------------------ the stiffness series
     def table_phase(self) -> np.ndarray:
@@ -460,4 +471,4 @@ class SpurPair(Model):
     def __repr__(self) -> str:
         return (f"SpurPair({self.mesh.pinion.teeth}/{self.mesh.wheel.teeth}, "
                 f"{self.speed / _RPM:g} rpm, {float(self.params[TORQUE]):g} N m, "
-                f"H={self.n_harmonics}, crack={self.stiffness.attrs.get('crack', 'none')!r})")
+                f"H={self.n_harmonics}, faults={self.stiffness.attrs.get('faults', 'none')!r})")
