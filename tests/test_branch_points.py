@@ -105,6 +105,7 @@ def _duffing(om: float):
     return f
 
 
+@pytest.mark.slow  # ~2.5 min, mostly its five-state model's compile; CI runs it (make test-slow)
 def test_real_pair_product_through_one_is_not_a_neimark_sacker_point():
     """A hardening Duffing oscillator with two uncoupled linear spectators: y' = -c y (the real
     multiplier exp(-c T)) and a damped oscillator (the complex pair exp((-zu +- i sqrt(1 -
