@@ -489,7 +489,7 @@ class PotentialEnergyPair:
     def archard_rate(self, gear: str, position: np.ndarray) -> np.ndarray:
         """Archard's wear per mesh passage of ``gear``'s flank point in contact at ``position``
         [m], up to the wear coefficient over the face width: the load share q = k / sum k of the
-        healthy pairs in contact (equal approach) times the slip |v_1 - v_2| / v of the point
+        healthy pairs in contact (equal approach) times the slip abs(v_1 - v_2) / v of the point
         (v = omega rho, rho the radius of curvature, the distance from the gear's tangent point
         on the line of action). Archard (1953): wear depth = k_w x pressure x sliding distance;
         Flodin & Andersson (1997) integrate it along spur flanks in the same way."""

@@ -265,8 +265,8 @@ class SpurPair(Model):
                       torque: object, faults: object = (), period: str | None = None,
                       angles: int = 256, young: object = STEEL_YOUNG,
                       poisson: object = STEEL_POISSON, **dynamics: object) -> SpurPair:
-        """The pair with the potential-energy stiffness of ``mesh`` (:func:`~geardyn.gears.
-        potential_energy_stiffness` with ``bore_radius``, ``young``, ``poisson``, ``faults``
+        """The pair with the potential-energy stiffness of ``mesh``
+        (:func:`~geardyn.gears.potential_energy_stiffness` with ``bore_radius``, ``young``, ``poisson``, ``faults``
         (one fault object or several, all on one gear), ``angles`` per mesh cycle) over one
         ``period``: ``"pinion"`` (one pinion revolution, the default for a healthy pair or faults
         on the pinion: a faulty tooth is felt once per period), ``"wheel"`` (one wheel
