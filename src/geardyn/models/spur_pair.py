@@ -266,8 +266,9 @@ class SpurPair(Model):
                       angles: int = 256, young: object = STEEL_YOUNG,
                       poisson: object = STEEL_POISSON, **dynamics: object) -> SpurPair:
         """The pair with the potential-energy stiffness of ``mesh``
-        (:func:`~geardyn.gears.potential_energy_stiffness` with ``bore_radius``, ``young``, ``poisson``, ``faults``
-        (one fault object or several, all on one gear), ``angles`` per mesh cycle) over one
+        (:func:`~geardyn.gears.potential_energy_stiffness` with ``bore_radius``, ``young``,
+        ``poisson``, ``faults`` (one fault object or several, all on one gear), ``angles`` per
+        mesh cycle) over one
         ``period``: ``"pinion"`` (one pinion revolution, the default for a healthy pair or faults
         on the pinion: a faulty tooth is felt once per period), ``"wheel"`` (one wheel
         revolution; the default for faults on the wheel) or ``"mesh"`` (one mesh cycle, a
