@@ -99,6 +99,23 @@ def to_si(value: object, kind: str) -> float:
     return magnitude
 
 
+def si_value(field: str, value: object, kind: str, minimum: float | None = None,
+             strict: bool = False) -> float:
+    """``value`` (a number in SI or a unit string, :func:`to_si`) as a finite float, at least
+    (``strict``: above) ``minimum``; else a :class:`~geardyn.ParameterError` naming ``field``."""
+    from geardyn.errors import ParameterError
+
+    try:
+        v = to_si(value, kind)
+    except ValueError as exc:
+        raise ParameterError(field, value, str(exc)) from None
+    if not math.isfinite(v):
+        raise ParameterError(field, value, "must be finite")
+    if minimum is not None and (v <= minimum if strict else v < minimum):
+        raise ParameterError(field, value, f"must be {'>' if strict else '>='} {minimum:g}")
+    return v
+
+
 def _magnitude(q: pint.Quantity, text: str, unit: str) -> float:
     """``q`` in ``unit`` (pint's conversion), rounded to 15 significant digits."""
     try:

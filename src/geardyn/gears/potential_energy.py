@@ -82,7 +82,7 @@ from geardyn.core.settings import warn_deprecated
 from geardyn.errors import ParameterError
 from geardyn.gears.faults import BrokenTooth, Fault, RootCrack, Spall, Wear
 from geardyn.gears.geometry import GearMesh, SpurGear
-from geardyn.units import to_si
+from geardyn.units import si_value, to_si
 
 #: Young's modulus [Pa] and Poisson ratio of the steel of the 19/48 literature pair.
 STEEL_YOUNG = 2.068e11
@@ -608,16 +608,6 @@ class PotentialEnergyPair:
         return out
 
 
-def _positive(value: object, kind: str, name: str) -> float:
-    try:
-        v = to_si(value, kind)
-    except ValueError as exc:
-        raise ParameterError(name, value, str(exc)) from None
-    if not (math.isfinite(v) and v > 0.0):
-        raise ParameterError(name, value, "must be a finite number > 0")
-    return v
-
-
 def _bores(bore_radius: object) -> tuple[object, object]:
     if isinstance(bore_radius, str) or not isinstance(bore_radius, Sequence):
         return bore_radius, bore_radius
@@ -656,7 +646,7 @@ def prepare_pair(mesh: GearMesh, *, bore_radius: object, young: object = STEEL_Y
     if mesh.internal:
         raise ParameterError("mesh.internal", True,
                              "the potential-energy stiffness covers external pairs only")
-    e = _positive(young, "pressure", "young")
+    e = si_value("young", young, "pressure", 0.0, strict=True)
     try:
         nu = to_si(poisson, "dimensionless")
     except ValueError as exc:
@@ -668,7 +658,7 @@ def prepare_pair(mesh: GearMesh, *, bore_radius: object, young: object = STEEL_Y
     bp, bw = _bores(bore_radius)
     teeth = []
     for role, gear, bore in (("pinion", mesh.pinion, bp), ("wheel", mesh.wheel, bw)):
-        r = _positive(bore, "length", f"{role}.bore_radius")
+        r = si_value(f"{role}.bore_radius", bore, "length", 0.0, strict=True)
         teeth.append(tooth_model(gear, r, root_segment=root_segment, role=role))
     # the lowest contacts: the pinion's at the start of the path, the wheel's at its end
     s1 = mesh.pinion.base_radius * math.tan(mesh.operating_pressure_angle)

@@ -48,7 +48,7 @@ from geardyn.models.planetary_coefficients import (
     workspace_entry,
 )
 from geardyn.models.stiffness import fourier_coefficients
-from geardyn.units import to_si
+from geardyn.units import si_value
 
 _KERNEL = KernelSource(pk.planetary_rhs, pk.planetary_events, pk.planetary_observe)
 
@@ -101,16 +101,8 @@ MULTIPLICITY_RTOL = 1e-6
 
 def _si(field: str, value: object, kind: str, minimum: float | None = 0.0,
         strict: bool = False) -> float:
-    """``value`` in SI (a number or a unit string), finite and >= (or >) ``minimum``."""
-    try:
-        v = to_si(value, kind)
-    except ValueError as exc:
-        raise ParameterError(field, value, str(exc)) from None
-    if not math.isfinite(v):
-        raise ParameterError(field, value, "must be finite")
-    if minimum is not None and (v <= minimum if strict else v < minimum):
-        raise ParameterError(field, value, f"must be {'>' if strict else '>='} {minimum:g}")
-    return v
+    """:func:`~geardyn.units.si_value`, at least 0 unless told otherwise."""
+    return si_value(field, value, kind, minimum, strict)
 
 
 @dataclass(frozen=True)

@@ -61,7 +61,7 @@ from geardyn.models.spur_pair_kernels import (
     R_B1,
     TORQUE,
 )
-from geardyn.units import to_si
+from geardyn.units import si_value
 
 __all__ = ["DEFAULT_MESH_HARMONICS", "STEEL_DENSITY", "SpurPair", "disc_inertia"]
 
@@ -136,16 +136,6 @@ def evaluate_series(series: np.ndarray, theta: np.ndarray) -> np.ndarray:
     arg = h[:, None] * th.reshape(-1)[None, :]
     k = series[0] + series[1::2] @ np.cos(arg) + series[2::2] @ np.sin(arg)
     return k.reshape(th.shape)
-
-
-def _quantity(value: object, kind: str, name: str) -> float:
-    try:
-        v = to_si(value, kind)
-    except ValueError as exc:
-        raise ParameterError(name, value, str(exc)) from None
-    if not math.isfinite(v):
-        raise ParameterError(name, value, "must be finite")
-    return v
 
 
 def _harmonics(value: object, cycles: int, samples: int) -> int:
@@ -231,15 +221,15 @@ class SpurPair(Model):
         self.coast_series = fourier_series(stiffness["mesh_stiffness_coast"].values, n_h)
         self._check_positive()
         b = (0.5 * max(mesh.backlash, 0.0) * math.cos(mesh.operating_pressure_angle)
-             if backlash is None else _quantity(backlash, "length", "backlash"))
+             if backlash is None else si_value("backlash", backlash, "length"))
         values = {
-            "Omega": self._omega_of_speed(_quantity(speed, "frequency", "speed")),
+            "Omega": self._omega_of_speed(si_value("speed", speed, "frequency")),
             "mass": self._mass(inertia),
-            "torque": _quantity(torque, "torque", "torque"),
-            "zeta": _quantity(zeta, "dimensionless", "zeta"),
+            "torque": si_value("torque", torque, "torque"),
+            "zeta": si_value("zeta", zeta, "dimensionless"),
             "backlash": b,
-            "error": _quantity(error, "length", "error"),
-            "error_phase": _quantity(error_phase, "angle", "error_phase"),
+            "error": si_value("error", error, "length"),
+            "error_phase": si_value("error_phase", error_phase, "angle"),
             "k_mean": float(self.drive_series[0]),
             "cos_error_phase": 0.0, "sin_error_phase": 0.0,
             "base_radius": mesh.pinion.base_radius, "mesh_order": float(cycles),
@@ -311,7 +301,7 @@ class SpurPair(Model):
         else:
             if isinstance(inertia, str) or len(inertia) != 2:
                 raise ParameterError("inertia", inertia, "give (I1, I2) of pinion and wheel")
-            i1, i2 = (_quantity(v, "inertia", f"inertia[{k}]") for k, v in enumerate(inertia))
+            i1, i2 = (si_value(f"inertia[{k}]", v, "inertia") for k, v in enumerate(inertia))
             for k, v in enumerate((i1, i2)):
                 if not v > 0.0:
                     raise ParameterError(f"inertia[{k}]", v, "must be > 0")
@@ -342,7 +332,7 @@ class SpurPair(Model):
     def _si(self, name: str, value: object) -> object:
         """``value`` in SI where ``name`` is an input that takes a unit string."""
         if isinstance(value, str) and name in self._KINDS:
-            return _quantity(value, self._KINDS[name], name)
+            return si_value(name, value, self._KINDS[name])
         return value
 
     def _with_physical(self, values: dict[str, float]) -> SpurPair:
