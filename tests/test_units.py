@@ -139,3 +139,17 @@ bearing_stiffness = 1e8
     assert gs.time_scale == pytest.approx(TWO_PI * 100.0, rel=1e-13)
     assert gs.omega * gs.time_scale == pytest.approx(TWO_PI * 1000.0, rel=1e-13)
     assert gs.carrier_speed == pytest.approx(TWO_PI * 50.0, rel=1e-13)
+
+
+def test_si_value_reads_a_finite_bounded_quantity_and_names_the_field():
+    from geardyn.units import si_value
+
+    assert si_value("gap", "50 um", "length") == pytest.approx(5e-5, rel=1e-15)
+    assert si_value("gap", 0.0, "length", 0.0) == 0.0
+    for value, bound, strict, message in ((float("nan"), None, False, "^gap: must be finite"),
+                                          (-1e-6, 0.0, False, "^gap: must be >= 0"),
+                                          (0.0, 0.0, True, "^gap: must be > 0"),
+                                          ("3 kg", None, False, "^gap: ")):
+        with pytest.raises(ParameterError, match=message) as err:
+            si_value("gap", value, "length", bound, strict)
+        assert err.value.field == "gap"
