@@ -23,10 +23,7 @@ from geardyn.gears.potential_energy import (
     prepare_pair,
     tooth_compliances,
 )
-
-E, NU, B = 2.068e11, 0.3, 0.016
-M, Z1, Z2, ALPHA = 3.2e-3, 19, 48, math.radians(20.0)
-BORES = (0.012, 0.035)
+from pair_19_48 import ALPHA, BORES, NU, Z1, Z2, B, E, M
 
 
 def _mesh(width: float = B) -> GearMesh:

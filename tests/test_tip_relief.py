@@ -9,18 +9,15 @@ import pytest
 from scipy.optimize import brentq
 
 from geardyn.errors import ParameterError
-from geardyn.gears import GearMesh, SpurGear
+from geardyn.gears import GearMesh
 from geardyn.gears.potential_energy import potential_energy_stiffness
 from geardyn.gears.tip_relief import TipRelief, loaded_contact
-
-M, Z1, Z2, ALPHA, B = 3.2e-3, 19, 48, math.radians(20.0), 0.016
-BORES = (0.012, 0.035)
+from pair_19_48 import ALPHA, BORES, Z1, Z2, M, pair_mesh
 
 
 @pytest.fixture(scope="module")
 def mesh() -> GearMesh:
-    return GearMesh(SpurGear(Z1, M, ALPHA, B, name="pinion"),
-                    SpurGear(Z2, M, ALPHA, B, name="wheel"))
+    return pair_mesh()
 
 
 @pytest.fixture(scope="module")

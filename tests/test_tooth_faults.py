@@ -21,23 +21,19 @@ from geardyn.gears import (
     GearMesh,
     RootCrack,
     Spall,
-    SpurGear,
     Wear,
     loaded_contact,
     potential_energy_stiffness,
 )
 from geardyn.gears.potential_energy import prepare_pair, tooth_compliances
+from pair_19_48 import ALPHA, BORES, NU, Z1, Z2, B, E, M, pair_mesh
 
-E, NU, B = 2.068e11, 0.3, 0.016
-M, Z1, Z2, ALPHA = 3.2e-3, 19, 48, math.radians(20.0)
-BORES = (0.012, 0.035)
 HUNT = Z1 * Z2  # lcm(19, 48)
 
 
 @pytest.fixture(scope="module")
 def mesh() -> GearMesh:
-    return GearMesh(SpurGear(Z1, M, ALPHA, B, name="pinion"),
-                    SpurGear(Z2, M, ALPHA, B, name="wheel"))
+    return pair_mesh()
 
 
 @pytest.fixture(scope="module")
