@@ -228,20 +228,26 @@ def test_mesh_declarations_are_checked():
         geardyn.UserModel.from_one_form(duffing_one, {"de lta": 0.3}, ("x", "v"))
 
 
+def _one_form_pair(meshes, observable: str, **extra) -> geardyn.UserModel:
+    """The gear pair of tests/gear_pair_model.py in the one form, with ``meshes`` and its force
+    read as the observable ``observable``."""
+    import gear_pair_model as gp
+
+    return geardyn.UserModel.from_one_form(
+        gp.pair_rhs, params=dict(Omega=1.0, zeta=0.05, kappa=0.0, Fm=0.1, Fa=0.05,
+                                 phi_k=0.0, phi_e=0.0, b=1.0),
+        derived={"cos_phi_k": ("phi_k", math.cos), "sin_phi_k": ("phi_k", math.sin),
+                 "cos_phi_e": ("phi_e", math.cos), "sin_phi_e": ("phi_e", math.sin)},
+        states=("x", "v"), events=gp.pair_events, event_names=("x-b", "x+b"),
+        observe=gp.pair_force, observable_names=(observable,), meshes=meshes,
+        natural_frequency=1.0, **extra)
+
+
 def test_mesh_forces_are_what_the_meshes_declare_not_a_count_of_observables():
     """One mesh and one observable: the observable is read as the mesh force only where the
     mesh names it (a fourth entry); a mesh without it reports contact, no forces."""
-    import gear_pair_model as gp
-
     def pair(meshes):
-        return geardyn.UserModel.from_one_form(
-            gp.pair_rhs, params=dict(Omega=1.0, zeta=0.05, kappa=0.0, Fm=0.1, Fa=0.05,
-                                     phi_k=0.0, phi_e=0.0, b=1.0),
-            derived={"cos_phi_k": ("phi_k", math.cos), "sin_phi_k": ("phi_k", math.sin),
-                     "cos_phi_e": ("phi_e", math.cos), "sin_phi_e": ("phi_e", math.sin)},
-            states=("x", "v"), events=gp.pair_events, event_names=("x-b", "x+b"),
-            observe=gp.pair_force, observable_names=("energy",), meshes=meshes,
-            natural_frequency=1.0)
+        return _one_form_pair(meshes, "energy")
 
     om = np.linspace(0.8, 1.2, 3)
     plain = geardyn.bifurcation(pair([("mesh", "x-b", "x+b")]), "Omega", om,
@@ -255,17 +261,8 @@ def test_mesh_forces_are_what_the_meshes_declare_not_a_count_of_observables():
 def test_the_contract_refuses_static_forces_of_meshes_without_their_forces():
     """static_forces given, but no mesh names its force observable: the dynamic factor would
     silently be missing from every sweep, so the contract (rule 1) names it."""
-    import gear_pair_model as gp
-
     def pair(meshes):
-        return geardyn.UserModel.from_one_form(
-            gp.pair_rhs, params=dict(Omega=1.0, zeta=0.05, kappa=0.0, Fm=0.1, Fa=0.05,
-                                     phi_k=0.0, phi_e=0.0, b=1.0),
-            derived={"cos_phi_k": ("phi_k", math.cos), "sin_phi_k": ("phi_k", math.sin),
-                     "cos_phi_e": ("phi_e", math.cos), "sin_phi_e": ("phi_e", math.sin)},
-            states=("x", "v"), events=gp.pair_events, event_names=("x-b", "x+b"),
-            observe=gp.pair_force, observable_names=("F",), meshes=meshes,
-            static_forces=lambda p: (p.Fm,), natural_frequency=1.0)
+        return _one_form_pair(meshes, "F", static_forces=lambda p: (p.Fm,))
 
     for meshes, why in (([("mesh", "x-b", "x+b")], "but not their forces"),
                         ([], "declares no meshes")):
