@@ -1,0 +1,412 @@
+"""The potential-energy stiffness against what others computed (issue 35).
+
+1. An independent implementation of the same formulas, written here: the tooth is described by
+   its radius (the involute's polar angle psi(r) = psi_b - inv(arccos(r_b / r))), every energy
+   integral is taken in x along the centre line by SciPy's adaptive ``quad``, with the section
+   half thickness h(x) found by ``brentq`` on x(r) = r cos psi(r), and the pairs are placed on
+   the line of action here. geardyn parametrises the flank by the involute angle alpha and
+   integrates by fixed Gauss-Legendre; the two share only the published formulas (Yang & Lin
+   1987; Tian 2004; Chen & Shao 2011 for the straight root flank and the crack; Sainsot, Velex &
+   Duverger 2004 for the fillet foundation). Issue 35 asks for 1 % over the mesh cycle; both
+   agree to 1e-8 (quad at epsrel 1e-11).
+2. ROSS (petrobras/ross, ``ross/gear_element.py``), an open-source Python implementation of
+   Ma et al. (2014), run here (ross-rotordynamics 2.3.0): its energy terms of five teeth at the
+   reference circle, and its published output, the doctest's largest mesh stiffness
+   429 787 128.434 N/m of a 62/62 pair. ROSS's conventions differ in three named places: the
+   cantilever runs down the trochoidal fillet of the generating rack to the root circle; the
+   fillet-foundation term takes theta_f of the rack-generated root and u_f from the contact
+   point itself; the contact runs from the form circle in equal steps of pressure angle. Each
+   test below isolates one of them (docs/gears.md, "Checked against others", gives the
+   numbers side by side).
+
+No published table of single- or double-pair stiffness, or of stiffness against crack depth,
+spall size or wear depth for the 19/48 pair, was found in the sources searched (listed in
+docs/gears.md, "Checked against others"): the numbers of Tian 2004, Wu, Zuo & Parey 2008, Chen &
+Shao 2011 and the papers after them are in figures whose full texts were not at hand.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import pytest
+from scipy.integrate import quad
+from scipy.optimize import brentq
+
+from geardyn.gears import GearMesh, SpurGear
+from geardyn.gears.potential_energy import RootCrack, potential_energy_stiffness
+from pair_19_48 import BORES, NU, Z1, Z2, B, E, M
+
+TIGHT = dict(epsabs=0.0, epsrel=1e-11, limit=200)
+
+
+def _inv(a: float) -> float:
+    return math.tan(a) - a
+
+
+@dataclass(frozen=True)
+class Tooth:
+    """An unshifted standard tooth (h_a = m, h_f = 1.25 m) described by its radius."""
+
+    z: int
+    m: float
+    alpha0: float
+    bore: float
+
+    @property
+    def r(self) -> float:
+        return self.m * self.z / 2.0
+
+    @property
+    def rb(self) -> float:
+        return self.r * math.cos(self.alpha0)
+
+    @property
+    def ra(self) -> float:
+        return self.r + self.m
+
+    @property
+    def rf(self) -> float:
+        return self.r - 1.25 * self.m
+
+    @property
+    def psi_b(self) -> float:
+        """Half the tooth's angular thickness at the base circle."""
+        return math.pi / (2.0 * self.z) + _inv(self.alpha0)
+
+    def psi(self, radius: float) -> float:
+        """Half the tooth's angular thickness at ``radius`` (on the involute)."""
+        return self.psi_b - _inv(math.acos(min(1.0, self.rb / radius)))
+
+    def x_of_r(self, radius: float) -> float:
+        return radius * math.cos(self.psi(radius))
+
+    def h_of_r(self, radius: float) -> float:
+        return radius * math.sin(self.psi(radius))
+
+    @property
+    def h_b(self) -> float:
+        return self.rb * math.sin(self.psi_b)
+
+    @property
+    def r_low(self) -> float:
+        """The lowest radius of the involute cantilever: the base or the root circle."""
+        return max(self.rb, self.rf)
+
+    def h_of_x(self, x: float, r_hi: float) -> float:
+        """Half thickness of the involute section at x (brentq on x(r) in [r_low, r_hi])."""
+        r = brentq(lambda rr: self.x_of_r(rr) - x, self.r_low, r_hi, xtol=1e-16, rtol=1e-15)
+        return self.h_of_r(r)
+
+    @property
+    def theta_f(self) -> float:
+        """Half angle of the tooth at the root circle."""
+        if self.rf <= self.rb:
+            return math.asin(self.h_b / self.rf)
+        return self.psi(self.rf)
+
+
+SAINSOT = {"L": (-5.574e-5, -1.9986e-3, -2.3015e-4, 4.7702e-3, 0.0271, 6.8045),
+           "M": (60.111e-5, 28.100e-3, -83.431e-4, -9.9256e-3, 0.1624, 0.9086),
+           "P": (-50.952e-5, 185.50e-3, 0.0538e-4, 53.300e-3, 0.2895, 0.9236),
+           "Q": (-6.2042e-5, 9.0889e-3, -4.0964e-4, 7.8297e-3, -0.1472, 0.6904)}
+
+
+def tooth_terms(tooth: Tooth, roll: float, *, young: float, poisson: float, width: float,
+                root_segment: bool = True, crack_reach: float = 0.0) -> dict[str, float]:
+    """Compliances [m/N] of ``tooth`` loaded at roll angle ``roll`` (= tan of the pressure
+    angle of the contact), integrated in x. ``crack_reach`` q sin v: sections whose half
+    thickness exceeds h_q = h_root - q sin v carry h + h_q (Tian's crack limit line)."""
+    g_mod = young / (2.0 * (1.0 + poisson))
+    r_c = tooth.rb * math.sqrt(1.0 + roll * roll)
+    alpha_c = math.atan(roll)
+    a1 = alpha_c - tooth.psi(r_c)  # the force's angle to the normal of the centre line
+    c, s = math.cos(a1), math.sin(a1)
+    x_c, h_c = tooth.x_of_r(r_c), tooth.h_of_r(r_c)
+    segment = root_segment and tooth.rf < tooth.rb
+    h_root = tooth.h_b if tooth.rf <= tooth.rb else tooth.h_of_r(tooth.rf)
+    h_q = h_root - crack_reach
+
+    def carried(h: float) -> float:  # the loaded section's thickness
+        return h + min(h, h_q) if crack_reach > 0.0 else 2.0 * h
+
+    def integrals(h_of: object, x0: float, x1: float) -> tuple[float, float, float]:
+        def bend(x: float) -> float:
+            t = carried(h_of(x))  # type: ignore[operator]
+            return (c * (x_c - x) - s * h_c) ** 2 / (young * t ** 3 * width / 12.0)
+
+        def inv_area(x: float) -> float:
+            return 1.0 / (carried(h_of(x)) * width)  # type: ignore[operator]
+
+        area = quad(inv_area, x0, x1, **TIGHT)[0]
+        return (quad(bend, x0, x1, **TIGHT)[0], 1.2 * c * c / g_mod * area,
+                s * s / young * area)
+
+    x_low = tooth.x_of_r(tooth.r_low)
+    cut = []
+    if crack_reach > 0.0 and tooth.h_of_r(r_c) < h_q < h_root:  # split where h = h_q
+        r_q = brentq(lambda rr: tooth.h_of_r(rr) - h_q, tooth.r_low, r_c, xtol=1e-16)
+        cut = [tooth.x_of_r(r_q)]
+    edges = [x_low, *cut, x_c]
+    total = np.zeros(3)
+    for x0, x1 in zip(edges, edges[1:], strict=False):
+        total += integrals(lambda x: tooth.h_of_x(x, r_c), x0, x1)
+    if segment:
+        x_root = math.sqrt(tooth.rf ** 2 - tooth.h_b ** 2)
+        total += integrals(lambda x: tooth.h_b, x_root, tooth.rb * math.cos(tooth.psi_b))
+    h_fi = tooth.rf / tooth.bore
+    th = tooth.theta_f
+    coef = {k: v[0] / th ** 2 + v[1] * h_fi ** 2 + v[2] * h_fi / th + v[3] / th + v[4] * h_fi
+            + v[5] for k, v in SAINSOT.items()}
+    ratio = (x_c - h_c * math.tan(a1) - tooth.rf) / (2.0 * tooth.rf * th)
+    fillet = (c * c / (young * width) * (coef["L"] * ratio ** 2 + coef["M"] * ratio
+                                         + coef["P"] * (1.0 + coef["Q"] * math.tan(a1) ** 2)))
+    return {"bending": float(total[0]), "shear": float(total[1]), "axial": float(total[2]),
+            "fillet": fillet}
+
+
+def reference_mesh(pinion: Tooth, wheel: Tooth, cycles: np.ndarray, *, young: float,
+                   poisson: float, width: float, root_segment: bool = True,
+                   crack_reach: float = 0.0) -> tuple[np.ndarray, list[list[dict]]]:
+    """Mesh stiffness [N/m] at ``cycles`` mesh cycles of pinion rotation after pinion tooth 0
+    passes the pitch point (standard centre distance), and each pair's terms; ``crack_reach``
+    cracks pinion tooth 1 (the tooth that passes the pitch point at cycle 1)."""
+    alpha0 = pinion.alpha0
+    p_b = 2.0 * math.pi * pinion.rb / pinion.z
+    g_a = math.sqrt(pinion.ra ** 2 - pinion.rb ** 2) - pinion.rb * math.tan(alpha0)
+    g_f = math.sqrt(wheel.ra ** 2 - wheel.rb ** 2) - wheel.rb * math.tan(alpha0)
+    k_h = math.pi * young * width / (4.0 * (1.0 - poisson ** 2))
+    kw = dict(young=young, poisson=poisson, width=width, root_segment=root_segment)
+    out, details = [], []
+    for cyc in cycles:
+        whole = math.floor(cyc)
+        total, pairs = 0.0, []
+        for k in range(-3, 4):
+            pos = (cyc - whole + k) * p_b
+            if not -g_f <= pos < g_a:
+                continue
+            reach = crack_reach if (whole - k) % pinion.z == 1 else 0.0
+            tp = tooth_terms(pinion, math.tan(alpha0) + pos / pinion.rb, crack_reach=reach,
+                             **kw)
+            tw = tooth_terms(wheel, math.tan(alpha0) - pos / wheel.rb, **kw)
+            compliance = 1.0 / k_h + sum(tp.values()) + sum(tw.values())
+            total += 1.0 / compliance
+            pairs.append({"k": k, "pinion": tp, "wheel": tw, "pair": 1.0 / compliance})
+        out.append(total)
+        details.append(pairs)
+    return np.array(out), details
+
+
+PAIRS = {  # name: (z1, z2, module [m], face width [m], bores [m])
+    "19/48": (Z1, Z2, M, B, BORES),
+    "30/60": (30, 60, 4e-3, 0.04, (0.0285, 0.0575)),
+}
+
+
+def _mesh(z1: int, z2: int, m: float, b: float) -> GearMesh:
+    a0 = math.radians(20.0)
+    return GearMesh(SpurGear(z1, m, a0, b, name="pinion"), SpurGear(z2, m, a0, b, name="wheel"))
+
+
+@pytest.mark.parametrize("root_segment", [True, False])
+@pytest.mark.parametrize("name", sorted(PAIRS))
+def test_healthy_mesh_stiffness_against_an_independent_implementation(
+        name: str, root_segment: bool) -> None:
+    """Over a whole mesh cycle (40 angles), the mesh stiffness and every energy term of every
+    pair in contact against the x-integration above."""
+    z1, z2, m, b, bores = PAIRS[name]
+    n = 40
+    ds = potential_energy_stiffness(_mesh(z1, z2, m, b), bore_radius=bores, angles=n,
+                                    young=E, poisson=NU, root_segment=root_segment)
+    a0 = math.radians(20.0)
+    pinion, wheel = Tooth(z1, m, a0, bores[0]), Tooth(z2, m, a0, bores[1])
+    ref, details = reference_mesh(pinion, wheel, ds.cycle.values, young=E, poisson=NU,
+                                  width=b, root_segment=root_segment)
+    rel = np.abs(ds.mesh_stiffness.values / ref - 1.0)
+    assert rel.max() < 0.01  # issue 35's requirement
+    np.testing.assert_allclose(ds.mesh_stiffness.values, ref, rtol=1e-8, atol=0.0)
+    for i, pairs in enumerate(details):
+        assert int(ds.pairs_in_contact.values[i]) == len(pairs)
+        for p in pairs:
+            for gear in ("pinion", "wheel"):
+                for term, compliance in p[gear].items():
+                    got = float(ds[f"k_{term}_{gear}"].sel(pair=p["k"]).values[i])
+                    assert got == pytest.approx(1.0 / compliance, rel=1e-8), (i, gear, term)
+
+
+@pytest.mark.parametrize("depth_mm", [0.5, 1.5, 3.0])
+def test_cracked_pinion_against_the_independent_implementation(depth_mm: float) -> None:
+    """The 19/48 pair with a 45 deg root crack on pinion tooth 1, over mesh cycles 0 and 1 (its
+    whole contact: approach in cycle 0, recess in cycle 1)."""
+    n = 24
+    reach = depth_mm * 1e-3 * math.sin(math.radians(45.0))
+    crack = RootCrack(depth=depth_mm * 1e-3, angle=math.radians(45.0), tooth=1)
+    ds = potential_energy_stiffness(_mesh(Z1, Z2, M, B), bore_radius=BORES, angles=n,
+                                    cycles=2, faults=crack)
+    a0 = math.radians(20.0)
+    ref, _ = reference_mesh(Tooth(Z1, M, a0, BORES[0]), Tooth(Z2, M, a0, BORES[1]),
+                            ds.cycle.values, young=E, poisson=NU, width=B, crack_reach=reach)
+    healthy, _ = reference_mesh(Tooth(Z1, M, a0, BORES[0]), Tooth(Z2, M, a0, BORES[1]),
+                                ds.cycle.values, young=E, poisson=NU, width=B)
+    touched = (ds.tooth_pinion.values == 1) & ds.in_contact.values
+    assert np.array_equal(ref < healthy, touched.any(axis=1))
+    assert touched.any(axis=1).sum() > n  # more than a mesh cycle of contact
+    np.testing.assert_allclose(ds.mesh_stiffness.values, ref, rtol=1e-8, atol=0.0)
+
+
+# -- ROSS (petrobras/ross), an open-source implementation of Ma et al. (2014) ------------------
+#
+# Values produced by ROSS 2.3.0 (pip ross-rotordynamics; GearElementTVMS._inv_kb, _inv_ks,
+# _inv_ka, _inv_kf at tau = tan(20 deg) - theta_b, the contact at the reference circle, and
+# tooth_dict["root_angle"]): the 62-tooth gear of ROSS's Mesh doctest (m 2 mm, b 20 mm, bore
+# radius 17.5 mm, ROSS's steel E 211 GPa, G 81.2 GPa) and the teeth of the two pairs above
+# (E 206.8 GPa, nu 0.3). The commands are in docs/gears.md ("Checked against others").
+
+ROSS_TEETH = {  # z: (m, b, bore radius, E, G, {term: compliance [m/N]}, theta_f [rad])
+    62: (2e-3, 0.02, 0.0175, 211e9, 81.2e9,
+         {"bending": 8.491113899530496e-11, "shear": 4.3598541008577443e-10,
+          "axial": 1.5741243063904357e-11, "fillet": 1.5360238903725487e-09},
+         0.0456584787349235),
+    19: (M, B, BORES[0], E, E / 2.6,
+         {"bending": 2.0817087588238852e-10, "shear": 6.477181792505846e-10,
+          "axial": 1.5458545165327844e-11, "fillet": 1.4596016845562854e-09},
+         0.14899082534553984),
+    48: (M, B, BORES[1], E, E / 2.6,
+         {"bending": 1.1790782822083008e-10, "shear": 5.675107738762034e-10,
+          "axial": 1.9489475483375663e-11, "fillet": 1.4262155454147417e-09},
+         0.05897553503260952),
+    30: (4e-3, 0.04, 0.0285, E, E / 2.6,
+         {"bending": 5.906846170994727e-11, "shear": 2.3919165254208524e-10,
+          "axial": 7.1658790555936364e-12, "fillet": 5.399960048208366e-10},
+         0.09436085605217523),
+    60: (4e-3, 0.04, 0.0575, E, E / 2.6,
+         {"bending": 4.3741153056083106e-11, "shear": 2.2305257159759274e-10,
+          "axial": 8.003728784868898e-12, "fillet": 5.724584847904729e-10},
+         0.047180428026087615),
+}
+#: ROSS's published output: the Mesh doctest of ross/gear_element.py (before 2.3.0), the largest
+#: mesh stiffness of the 62/62 pair over 1000 points of a mesh cycle [N/m]. ROSS 2.3.0 run here
+#: gives 429 787 095 N/m with the doctest's pr_angle 0.349066 (its doctest now prints a closed
+#: form instead).
+ROSS_DOCTEST_MAX = 429787128.434
+
+
+def _geardyn_tooth(z: int, *, root_segment: bool = True) -> tuple[object, dict[str, float]]:
+    from geardyn.gears.potential_energy import tooth_compliances, tooth_model
+
+    m, b, bore, young, shear_mod, _, _ = ROSS_TEETH[z]
+    tooth = tooth_model(SpurGear(z, m, math.radians(20.0), b, name="gear"), bore,
+                        root_segment=root_segment)
+    a1 = np.array([math.tan(math.radians(20.0)) - tooth.half_base_angle])
+    comp = tooth_compliances(tooth, a1, young=young, poisson=young / (2.0 * shear_mod) - 1.0,
+                             face_width=b)
+    return tooth, {k: float(v[0]) for k, v in comp.items()}
+
+
+@pytest.mark.parametrize("z", sorted(ROSS_TEETH))
+def test_ross_shear_and_axial_terms(z: int) -> None:
+    """Shear and axial compression at the reference circle: the integrals of 1/A are dominated
+    by the involute, where both codes have the same sections (measured 0.02-0.9 %); 1 %."""
+    _, got = _geardyn_tooth(z)
+    ross = ROSS_TEETH[z][5]
+    for term in ("shear", "axial"):
+        assert got[term] == pytest.approx(ross[term], rel=0.01), term
+
+
+def _sainsot(young: float, width: float, a1: float, u_f: float, r_f: float, theta_f: float,
+             h_fi: float) -> float:
+    coef = {k: v[0] / theta_f ** 2 + v[1] * h_fi ** 2 + v[2] * h_fi / theta_f + v[3] / theta_f
+            + v[4] * h_fi + v[5] for k, v in SAINSOT.items()}
+    ratio = u_f / (2.0 * r_f * theta_f)
+    return (math.cos(a1) ** 2 / (young * width)
+            * (coef["L"] * ratio ** 2 + coef["M"] * ratio
+               + coef["P"] * (1.0 + coef["Q"] * math.tan(a1) ** 2)))
+
+
+@pytest.mark.parametrize("z", sorted(ROSS_TEETH))
+def test_ross_fillet_term_differs_only_by_two_conventions(z: int) -> None:
+    """Sainsot's formula, written out here, gives ROSS's fillet term with ROSS's conventions
+    and geardyn's with geardyn's (both to 1e-12): the theta_f of the rack-generated root
+    (Ma et al. 2014: [pi/2 + 2 tan a (h_a* - rho*) + 2 rho*/cos a] / z, rho* = c*/(1 - sin a))
+    against asin(h_b / r_f) or the involute's half angle at r_f, and u_f from the contact point
+    (x_c - r_f) against from where the force line crosses the centre line
+    (x_c - h_c tan a1 - r_f)."""
+    m, b, bore, young, _, ross, ross_theta = ROSS_TEETH[z]
+    tooth, got = _geardyn_tooth(z)
+    a0 = math.radians(20.0)
+    t = Tooth(z, m, a0, bore)
+    r_c = t.r  # the contact at the reference circle
+    a1 = a0 - t.psi(r_c)
+    x_c, h_c = t.x_of_r(r_c), t.h_of_r(r_c)
+    rho = 0.25 / (1.0 - math.sin(a0))
+    theta_rack = (math.pi / 2.0 + 2.0 * math.tan(a0) * (1.0 - rho)
+                  + 2.0 * rho / math.cos(a0)) / z
+    assert theta_rack == pytest.approx(ross_theta, rel=1e-12)
+    h_fi = t.rf / bore
+    ross_conv = _sainsot(young, b, a1, x_c - t.rf, t.rf, theta_rack, h_fi)
+    own_conv = _sainsot(young, b, a1, x_c - h_c * math.tan(a1) - t.rf, t.rf, t.theta_f, h_fi)
+    assert ross_conv == pytest.approx(ross["fillet"], rel=1e-12)
+    assert own_conv == pytest.approx(got["fillet"], rel=1e-12)
+
+
+@pytest.mark.parametrize("z", sorted(ROSS_TEETH))
+def test_ross_bending_term_differs_by_the_root_form(z: int) -> None:
+    """Bending at the reference circle. ROSS's cantilever runs down the trochoidal fillet to the
+    root circle, thicker than geardyn's sections there: with the root circle above the base
+    circle (48, 60, 62 teeth: geardyn follows the involute down to r_f) ROSS is 9-11 % less
+    compliant (band 5-15 %); below it (19, 30 teeth) ROSS's fillet lies between geardyn's
+    straight radial flank (root_segment=True, thinnest) and no root flank at all (False)."""
+    _, with_segment = _geardyn_tooth(z)
+    ross = ROSS_TEETH[z][5]["bending"]
+    m, _, bore = ROSS_TEETH[z][:3]
+    t = Tooth(z, m, math.radians(20.0), bore)
+    if t.rf > t.rb:
+        assert 0.85 < ross / with_segment["bending"] < 0.95
+    else:
+        _, without = _geardyn_tooth(z, root_segment=False)
+        assert without["bending"] < ross < with_segment["bending"]
+
+
+def test_ross_published_mesh_stiffness_with_its_contact_path() -> None:
+    """ROSS's doctest pair (62/62, m 2 mm, b 20 mm): ROSS places the pinion's contact from the
+    start of its involute (the form circle of the generating rack, r_c^2 = (r_b tan a -
+    h_a / sin a)^2 + r_b^2) to its tip, linearly in the pressure angle over epsilon mesh cycles,
+    and the wheel's from its tip down by the same steps (Mesh.get_variable_stiffness), not at
+    the true start of contact (the wheel's tip) in equal steps of roll. geardyn's teeth on
+    that path give ROSS's published largest stiffness 429.79 MN/m within 2.5 % (measured
+    -2.2 %: the root forms of the test above); on geardyn's own path of contact 5.6 % below."""
+    from geardyn.gears.potential_energy import hertz_stiffness, tooth_compliances, tooth_model
+
+    z, m, b, bore, young, g_mod = 62, 2e-3, 0.02, 0.0175, 211e9, 81.2e9
+    nu = young / (2.0 * g_mod) - 1.0
+    a0 = 0.349066  # the doctest's pressure angle [rad]
+    gear = SpurGear(z, m, a0, b, name="gear")
+    tooth = tooth_model(gear, bore)
+    r_b, r_a = gear.base_radius, gear.tip_radius
+    alpha_c = math.acos(r_b / math.hypot(r_b * math.tan(a0) - m / math.sin(a0), r_b))
+    alpha_a = math.acos(r_b / r_a)
+    mesh = GearMesh(gear, SpurGear(z, m, a0, b, name="wheel"))
+    eps = mesh.contact_ratio
+    k_h = hertz_stiffness(young, nu, b)
+
+    def compliance(alpha: np.ndarray) -> np.ndarray:
+        comp = tooth_compliances(tooth, np.tan(alpha) - tooth.half_base_angle, young=young,
+                                 poisson=nu, face_width=b)
+        return sum(comp.values())
+
+    def pair(d: np.ndarray) -> np.ndarray:
+        return 1.0 / (1.0 / k_h + compliance(alpha_c + d) + compliance(alpha_a - d))
+
+    step = (alpha_a - alpha_c) / eps  # one mesh cycle in ROSS's pressure-angle steps
+    d = step * np.linspace(0.0, 1.0, 1000)
+    k = pair(d)
+    two = d <= step * (eps - 1.0)
+    k[two] += pair(d[two] + step)
+    on_ross_path = float(k.max())
+    assert on_ross_path == pytest.approx(ROSS_DOCTEST_MAX, rel=0.025)
+    own = potential_energy_stiffness(mesh, bore_radius=bore, young=young, poisson=nu,
+                                     angles=1000)
+    own_max = float(own.mesh_stiffness.max())
+    assert own_max < on_ross_path < ROSS_DOCTEST_MAX
