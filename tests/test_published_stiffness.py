@@ -262,7 +262,7 @@ def test_cracked_pinion_against_the_independent_implementation(depth_mm: float) 
 # _inv_ka, _inv_kf at tau = tan(20 deg) - theta_b, the contact at the reference circle, and
 # tooth_dict["root_angle"]): the 62-tooth gear of ROSS's Mesh doctest (m 2 mm, b 20 mm, bore
 # radius 17.5 mm, ROSS's steel E 211 GPa, G 81.2 GPa) and the teeth of the two pairs above
-# (E 206.8 GPa, nu 0.3). The commands are in docs/gears.md ("Checked against others").
+# (E 206.8 GPa, nu 0.3). bench/ross_crosscheck.py recomputes every ROSS number of this file.
 
 ROSS_TEETH = {  # z: (m, b, bore radius, E, G, {term: compliance [m/N]}, theta_f [rad])
     62: (2e-3, 0.02, 0.0175, 211e9, 81.2e9,
