@@ -8,7 +8,8 @@
    integrates by fixed Gauss-Legendre; the two share only the published formulas (Yang & Lin
    1987; Tian 2004; Chen & Shao 2011 for the straight root flank and the crack; Sainsot, Velex &
    Duverger 2004 for the fillet foundation). Issue 35 asks for 1 % over the mesh cycle; both
-   agree to 1e-8 (quad at epsrel 1e-11).
+   agree to 1e-8 (quad at epsrel 1e-11), healthy and with a root crack, a spall or uniform
+   wear on one pinion tooth (the faulty sections built here).
 2. ROSS (petrobras/ross, ``ross/gear_element.py``), an open-source Python implementation of
    Ma et al. (2014), run here (ross-rotordynamics 2.3.0): its energy terms of five teeth at the
    reference circle, and its published output, the doctest's largest mesh stiffness
@@ -36,7 +37,12 @@ from scipy.integrate import quad
 from scipy.optimize import brentq
 
 from geardyn.gears import GearMesh, SpurGear
-from geardyn.gears.potential_energy import RootCrack, potential_energy_stiffness
+from geardyn.gears.potential_energy import (
+    RootCrack,
+    Spall,
+    Wear,
+    potential_energy_stiffness,
+)
 from pair_19_48 import BORES, NU, Z1, Z2, B, E, M
 
 TIGHT = dict(epsabs=0.0, epsrel=1e-11, limit=200)
@@ -95,11 +101,6 @@ class Tooth:
         """The lowest radius of the involute cantilever: the base or the root circle."""
         return max(self.rb, self.rf)
 
-    def h_of_x(self, x: float, r_hi: float) -> float:
-        """Half thickness of the involute section at x (brentq on x(r) in [r_low, r_hi])."""
-        r = brentq(lambda rr: self.x_of_r(rr) - x, self.r_low, r_hi, xtol=1e-16, rtol=1e-15)
-        return self.h_of_r(r)
-
     @property
     def theta_f(self) -> float:
         """Half angle of the tooth at the root circle."""
@@ -114,48 +115,104 @@ SAINSOT = {"L": (-5.574e-5, -1.9986e-3, -2.3015e-4, 4.7702e-3, 0.0271, 6.8045),
            "Q": (-6.2042e-5, 9.0889e-3, -4.0964e-4, 7.8297e-3, -0.1472, 0.6904)}
 
 
+@dataclass(frozen=True)
+class Damage:
+    """A fault on the pinion's tooth 1, described here independently of geardyn's classes:
+    ``crack_reach`` q sin v [m]; a spall ``spall`` = (length along the profile, width across
+    the face, depth, centre's position along the profile from the reference circle) [m];
+    uniform wear ``wear`` [m] of the active profile."""
+
+    crack_reach: float = 0.0
+    spall: tuple[float, float, float, float] | None = None
+    wear: float = 0.0
+
+
+def _profile_radius(tooth: Tooth, position: float) -> float:
+    """Radius of the flank point ``position`` [m] along the involute from the reference circle
+    (the arc length from the base circle is r_b t^2 / 2 at roll angle t)."""
+    t = math.sqrt(2.0 * position / tooth.rb + math.tan(tooth.alpha0) ** 2)
+    return tooth.rb * math.sqrt(1.0 + t * t)
+
+
+def _sections(tooth: Tooth, width: float, damage: Damage | None,
+              r_start: float) -> tuple[object, list[float], tuple[float, float] | None]:
+    """(section(h, r) -> (I, A) of the involute's sections, the radii where it jumps, the
+    radii of the spall's edges): healthy 2h thick; a crack: h + min(h, h_q); a spall: the
+    2h x b section less a depth x width rectangle at the loaded flank, I about the reduced
+    section's centroid (parallel axes); wear: 2h - h_w above the start of the active profile
+    ``r_start``."""
+    def rect(t: float) -> tuple[float, float]:
+        return t ** 3 * width / 12.0, t * width
+
+    if damage is None:
+        return (lambda h, r: rect(2.0 * h)), [], None
+    if damage.crack_reach > 0.0:
+        h_root = tooth.h_b if tooth.rf <= tooth.rb else tooth.h_of_r(tooth.rf)
+        h_q = h_root - damage.crack_reach
+        breaks = []  # where the crack limit line meets the flank, if below the tip
+        if tooth.h_of_r(tooth.ra) < h_q:
+            breaks = [brentq(lambda rr: tooth.h_of_r(rr) - h_q, tooth.r_low, tooth.ra,
+                             xtol=1e-16)]
+        return (lambda h, r: rect(h + min(h, h_q))), breaks, None
+    if damage.spall is not None:
+        length, w, d, pos = damage.spall
+        edges = (_profile_radius(tooth, pos - 0.5 * length),
+                 _profile_radius(tooth, pos + 0.5 * length))
+
+        def spalled(h: float, r: float) -> tuple[float, float]:
+            if not edges[0] <= r <= edges[1]:
+                return rect(2.0 * h)
+            cut = w * d
+            area = 2.0 * h * width - cut
+            y_c = -cut * (h - 0.5 * d) / area  # centroid, from the centre line
+            inertia = (width * (2.0 * h) ** 3 / 12.0 + 2.0 * h * width * y_c ** 2
+                       - (w * d ** 3 / 12.0 + cut * (h - 0.5 * d - y_c) ** 2))
+            return inertia, area
+
+        return spalled, list(edges), edges
+    h_w = damage.wear
+    return (lambda h, r: rect(2.0 * h - h_w) if r >= r_start else rect(2.0 * h)), [r_start], \
+        None
+
+
 def tooth_terms(tooth: Tooth, roll: float, *, young: float, poisson: float, width: float,
-                root_segment: bool = True, crack_reach: float = 0.0) -> dict[str, float]:
+                root_segment: bool = True, damage: Damage | None = None,
+                r_start: float = 0.0) -> dict[str, float]:
     """Compliances [m/N] of ``tooth`` loaded at roll angle ``roll`` (= tan of the pressure
-    angle of the contact), integrated in x. ``crack_reach`` q sin v: sections whose half
-    thickness exceeds h_q = h_root - q sin v carry h + h_q (Tian's crack limit line)."""
+    angle of the contact), integrated in x, with ``damage`` (None: healthy; ``r_start``: the
+    radius where the flank's active profile starts)."""
     g_mod = young / (2.0 * (1.0 + poisson))
     r_c = tooth.rb * math.sqrt(1.0 + roll * roll)
     alpha_c = math.atan(roll)
     a1 = alpha_c - tooth.psi(r_c)  # the force's angle to the normal of the centre line
     c, s = math.cos(a1), math.sin(a1)
     x_c, h_c = tooth.x_of_r(r_c), tooth.h_of_r(r_c)
-    segment = root_segment and tooth.rf < tooth.rb
-    h_root = tooth.h_b if tooth.rf <= tooth.rb else tooth.h_of_r(tooth.rf)
-    h_q = h_root - crack_reach
+    section, breaks, _ = _sections(tooth, width, damage, r_start)
 
-    def carried(h: float) -> float:  # the loaded section's thickness
-        return h + min(h, h_q) if crack_reach > 0.0 else 2.0 * h
+    def integrals(geom: object, x0: float, x1: float) -> np.ndarray:
+        def props(x: float) -> tuple[float, float]:
+            return section(*geom(x))  # type: ignore[operator,misc]
 
-    def integrals(h_of: object, x0: float, x1: float) -> tuple[float, float, float]:
         def bend(x: float) -> float:
-            t = carried(h_of(x))  # type: ignore[operator]
-            return (c * (x_c - x) - s * h_c) ** 2 / (young * t ** 3 * width / 12.0)
+            return (c * (x_c - x) - s * h_c) ** 2 / (young * props(x)[0])
 
-        def inv_area(x: float) -> float:
-            return 1.0 / (carried(h_of(x)) * width)  # type: ignore[operator]
+        area = quad(lambda x: 1.0 / props(x)[1], x0, x1, **TIGHT)[0]
+        return np.array([quad(bend, x0, x1, **TIGHT)[0], 1.2 * c * c / g_mod * area,
+                         s * s / young * area])
 
-        area = quad(inv_area, x0, x1, **TIGHT)[0]
-        return (quad(bend, x0, x1, **TIGHT)[0], 1.2 * c * c / g_mod * area,
-                s * s / young * area)
+    def involute(x: float) -> tuple[float, float]:  # (h, r) of the section at x
+        r = brentq(lambda rr: tooth.x_of_r(rr) - x, tooth.r_low, r_c, xtol=1e-16, rtol=1e-15)
+        return tooth.h_of_r(r), r
 
-    x_low = tooth.x_of_r(tooth.r_low)
-    cut = []
-    if crack_reach > 0.0 and tooth.h_of_r(r_c) < h_q < h_root:  # split where h = h_q
-        r_q = brentq(lambda rr: tooth.h_of_r(rr) - h_q, tooth.r_low, r_c, xtol=1e-16)
-        cut = [tooth.x_of_r(r_q)]
-    edges = [x_low, *cut, x_c]
+    cuts = sorted(tooth.x_of_r(r) for r in breaks if tooth.r_low < r < r_c)
+    edges = [tooth.x_of_r(tooth.r_low), *cuts, x_c]
     total = np.zeros(3)
-    for x0, x1 in zip(edges, edges[1:], strict=False):
-        total += integrals(lambda x: tooth.h_of_x(x, r_c), x0, x1)
-    if segment:
+    for x0, x1 in zip(edges, edges[1:], strict=False):  # quad between the jumps
+        total += integrals(involute, x0, x1)
+    if root_segment and tooth.rf < tooth.rb:  # the straight flank, h_b thick, below r_b
         x_root = math.sqrt(tooth.rf ** 2 - tooth.h_b ** 2)
-        total += integrals(lambda x: tooth.h_b, x_root, tooth.rb * math.cos(tooth.psi_b))
+        total += integrals(lambda x: (tooth.h_b, tooth.rb), x_root,
+                           tooth.rb * math.cos(tooth.psi_b))
     h_fi = tooth.rf / tooth.bore
     th = tooth.theta_f
     coef = {k: v[0] / th ** 2 + v[1] * h_fi ** 2 + v[2] * h_fi / th + v[3] / th + v[4] * h_fi
@@ -169,15 +226,20 @@ def tooth_terms(tooth: Tooth, roll: float, *, young: float, poisson: float, widt
 
 def reference_mesh(pinion: Tooth, wheel: Tooth, cycles: np.ndarray, *, young: float,
                    poisson: float, width: float, root_segment: bool = True,
-                   crack_reach: float = 0.0) -> tuple[np.ndarray, list[list[dict]]]:
+                   damage: Damage | None = None) -> tuple[np.ndarray, list[list[dict]]]:
     """Mesh stiffness [N/m] at ``cycles`` mesh cycles of pinion rotation after pinion tooth 0
-    passes the pitch point (standard centre distance), and each pair's terms; ``crack_reach``
-    cracks pinion tooth 1 (the tooth that passes the pitch point at cycle 1)."""
+    passes the pitch point (standard centre distance), and each pair's terms; ``damage`` sits
+    on pinion tooth 1 (the tooth that passes the pitch point at cycle 1): its sections, and a
+    spall's lost contact width b - w (Hertz) while the contact lies on the spall."""
     alpha0 = pinion.alpha0
     p_b = 2.0 * math.pi * pinion.rb / pinion.z
     g_a = math.sqrt(pinion.ra ** 2 - pinion.rb ** 2) - pinion.rb * math.tan(alpha0)
     g_f = math.sqrt(wheel.ra ** 2 - wheel.rb ** 2) - wheel.rb * math.tan(alpha0)
-    k_h = math.pi * young * width / (4.0 * (1.0 - poisson ** 2))
+    r_start = math.hypot(pinion.rb, pinion.rb * math.tan(alpha0) - g_f)  # lowest contact
+
+    def k_hertz(b: float) -> float:
+        return math.pi * young * b / (4.0 * (1.0 - poisson ** 2))
+
     kw = dict(young=young, poisson=poisson, width=width, root_segment=root_segment)
     out, details = [], []
     for cyc in cycles:
@@ -187,11 +249,15 @@ def reference_mesh(pinion: Tooth, wheel: Tooth, cycles: np.ndarray, *, young: fl
             pos = (cyc - whole + k) * p_b
             if not -g_f <= pos < g_a:
                 continue
-            reach = crack_reach if (whole - k) % pinion.z == 1 else 0.0
-            tp = tooth_terms(pinion, math.tan(alpha0) + pos / pinion.rb, crack_reach=reach,
-                             **kw)
+            faulty = damage if (whole - k) % pinion.z == 1 else None
+            roll = math.tan(alpha0) + pos / pinion.rb
+            tp = tooth_terms(pinion, roll, damage=faulty, r_start=r_start, **kw)
             tw = tooth_terms(wheel, math.tan(alpha0) - pos / wheel.rb, **kw)
-            compliance = 1.0 / k_h + sum(tp.values()) + sum(tw.values())
+            contact_width = width
+            spall = _sections(pinion, width, faulty, r_start)[2]
+            if spall is not None and spall[0] <= pinion.rb * math.hypot(1.0, roll) <= spall[1]:
+                contact_width = width - faulty.spall[1]  # type: ignore[union-attr]
+            compliance = 1.0 / k_hertz(contact_width) + sum(tp.values()) + sum(tw.values())
             total += 1.0 / compliance
             pairs.append({"k": k, "pinion": tp, "wheel": tw, "pair": 1.0 / compliance})
         out.append(total)
@@ -249,10 +315,38 @@ def test_cracked_pinion_against_the_independent_implementation(depth_mm: float) 
     healthy = potential_energy_stiffness(mesh, bore_radius=BORES, angles=n, cycles=2)
     a0 = math.radians(20.0)
     ref, _ = reference_mesh(Tooth(Z1, M, a0, BORES[0]), Tooth(Z2, M, a0, BORES[1]),
-                            ds.cycle.values, young=E, poisson=NU, width=B, crack_reach=reach)
+                            ds.cycle.values, young=E, poisson=NU, width=B,
+                            damage=Damage(crack_reach=reach))
     touched = ((ds.tooth_pinion.values == 1) & ds.in_contact.values).any(axis=1)
     assert touched.sum() > n  # more than a mesh cycle of contact
     assert np.array_equal(ref < healthy.mesh_stiffness.values * (1.0 - 1e-6), touched)
+    np.testing.assert_allclose(ds.mesh_stiffness.values, ref, rtol=1e-8, atol=0.0)
+
+
+@pytest.mark.parametrize("damage", [
+    Damage(spall=(2e-3, 4e-3, 0.2e-3, 0.0)),
+    Damage(spall=(1e-3, 8e-3, 0.5e-3, -0.5e-3)),
+    Damage(wear=20e-6),
+    Damage(wear=100e-6),
+], ids=["spall-2x4x0.2", "spall-1x8x0.5-low", "wear-20um", "wear-100um"])
+def test_spalled_and_worn_pinion_against_the_independent_implementation(damage: Damage) -> None:
+    """A spall (its sections, and the Hertz contact b - w while the contact lies on it) or
+    uniform wear of the active profile on pinion tooth 1 of the 19/48 pair, over its whole
+    contact (mesh cycles 0 and 1, 16 angles a cycle), against the x-integration with the
+    faulty sections built here."""
+    n = 16
+    if damage.spall is not None:
+        length, w, d, pos = damage.spall
+        fault: object = Spall(length=length, width=w, depth=d, position=pos, tooth=1)
+    else:
+        fault = Wear(depth=damage.wear, tooth=1)
+    mesh = _mesh(Z1, Z2, M, B)
+    ds = potential_energy_stiffness(mesh, bore_radius=BORES, angles=n, cycles=2, faults=fault)
+    healthy = potential_energy_stiffness(mesh, bore_radius=BORES, angles=n, cycles=2)
+    a0 = math.radians(20.0)
+    ref, _ = reference_mesh(Tooth(Z1, M, a0, BORES[0]), Tooth(Z2, M, a0, BORES[1]),
+                            ds.cycle.values, young=E, poisson=NU, width=B, damage=damage)
+    assert np.any(ref < healthy.mesh_stiffness.values * (1.0 - 1e-4))
     np.testing.assert_allclose(ds.mesh_stiffness.values, ref, rtol=1e-8, atol=0.0)
 
 
