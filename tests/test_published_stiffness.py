@@ -38,6 +38,7 @@ from scipy.optimize import brentq
 
 from geardyn.gears import GearMesh, SpurGear
 from geardyn.gears.potential_energy import (
+    BrokenTooth,
     RootCrack,
     Spall,
     Wear,
@@ -120,11 +121,12 @@ class Damage:
     """A fault on the pinion's tooth 1, described here independently of geardyn's classes:
     ``crack_reach`` q sin v [m]; a spall ``spall`` = (length along the profile, width across
     the face, depth, centre's position along the profile from the reference circle) [m];
-    uniform wear ``wear`` [m] of the active profile."""
+    uniform wear ``wear`` [m] of the active profile; ``missing``: the tooth is broken off."""
 
     crack_reach: float = 0.0
     spall: tuple[float, float, float, float] | None = None
     wear: float = 0.0
+    missing: bool = False
 
 
 def _profile_radius(tooth: Tooth, position: float) -> float:
@@ -250,6 +252,8 @@ def reference_mesh(pinion: Tooth, wheel: Tooth, cycles: np.ndarray, *, young: fl
             if not -g_f <= pos < g_a:
                 continue
             faulty = damage if (whole - k) % pinion.z == 1 else None
+            if faulty is not None and faulty.missing:
+                continue
             roll = math.tan(alpha0) + pos / pinion.rb
             tp = tooth_terms(pinion, roll, damage=faulty, r_start=r_start, **kw)
             tw = tooth_terms(wheel, math.tan(alpha0) - pos / wheel.rb, **kw)
@@ -328,16 +332,21 @@ def test_cracked_pinion_against_the_independent_implementation(depth_mm: float) 
     Damage(spall=(1e-3, 8e-3, 0.5e-3, -0.5e-3)),
     Damage(wear=20e-6),
     Damage(wear=100e-6),
-], ids=["spall-2x4x0.2", "spall-1x8x0.5-low", "wear-20um", "wear-100um"])
-def test_spalled_and_worn_pinion_against_the_independent_implementation(damage: Damage) -> None:
-    """A spall (its sections, and the Hertz contact b - w while the contact lies on it) or
-    uniform wear of the active profile on pinion tooth 1 of the 19/48 pair, over its whole
+    Damage(missing=True),
+], ids=["spall-2x4x0.2", "spall-1x8x0.5-low", "wear-20um", "wear-100um", "broken"])
+def test_spalled_worn_broken_pinion_against_the_independent_implementation(
+        damage: Damage) -> None:
+    """A spall (its sections, and the Hertz contact b - w while the contact lies on it),
+    uniform wear of the active profile or a missing tooth (its pair left out: 0 where it would
+    carry alone) on pinion tooth 1 of the 19/48 pair, over its whole
     contact (mesh cycles 0 and 1, 16 angles a cycle), against the x-integration with the
     faulty sections built here."""
     n = 16
     if damage.spall is not None:
         length, w, d, pos = damage.spall
         fault: object = Spall(length=length, width=w, depth=d, position=pos, tooth=1)
+    elif damage.missing:
+        fault = BrokenTooth(tooth=1)
     else:
         fault = Wear(depth=damage.wear, tooth=1)
     mesh = _mesh(Z1, Z2, M, B)
