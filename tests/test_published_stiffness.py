@@ -4,7 +4,8 @@
    its radius (the involute's polar angle psi(r) = psi_b - inv(arccos(r_b / r))), every energy
    integral is taken in x along the centre line by SciPy's adaptive ``quad``, with the section
    half thickness h(x) found by ``brentq`` on x(r) = r cos psi(r), and the pairs are placed on
-   the line of action here. geardyn parametrises the flank by the involute angle alpha and
+   the line of action here (at the operating pressure angle of profile-shifted pairs).
+   geardyn parametrises the flank by the involute angle alpha and
    integrates by fixed Gauss-Legendre; the two share only the published formulas (Yang & Lin
    1987; Tian 2004; Chen & Shao 2011 for the straight root flank and the crack; Sainsot, Velex &
    Duverger 2004 for the fillet foundation). Issue 35 asks for 1 % over the mesh cycle; both
@@ -55,12 +56,14 @@ def _inv(a: float) -> float:
 
 @dataclass(frozen=True)
 class Tooth:
-    """An unshifted standard tooth (h_a = m, h_f = 1.25 m) described by its radius."""
+    """A standard tooth (h_a = m, h_f = 1.25 m) of profile shift ``x``, described by its
+    radius."""
 
     z: int
     m: float
     alpha0: float
     bore: float
+    x: float = 0.0
 
     @property
     def r(self) -> float:
@@ -72,16 +75,18 @@ class Tooth:
 
     @property
     def ra(self) -> float:
-        return self.r + self.m
+        return self.r + (1.0 + self.x) * self.m
 
     @property
     def rf(self) -> float:
-        return self.r - 1.25 * self.m
+        return self.r - (1.25 - self.x) * self.m
 
     @property
     def psi_b(self) -> float:
-        """Half the tooth's angular thickness at the base circle."""
-        return math.pi / (2.0 * self.z) + _inv(self.alpha0)
+        """Half the tooth's angular thickness at the base circle (the reference circle's
+        thickness m (pi/2 + 2 x tan a))."""
+        return (math.pi / 2.0 + 2.0 * self.x * math.tan(self.alpha0)) / self.z \
+            + _inv(self.alpha0)
 
     def psi(self, radius: float) -> float:
         """Half the tooth's angular thickness at ``radius`` (on the involute)."""
@@ -230,14 +235,18 @@ def reference_mesh(pinion: Tooth, wheel: Tooth, cycles: np.ndarray, *, young: fl
                    poisson: float, width: float, root_segment: bool = True,
                    damage: Damage | None = None) -> tuple[np.ndarray, list[list[dict]]]:
     """Mesh stiffness [N/m] at ``cycles`` mesh cycles of pinion rotation after pinion tooth 0
-    passes the pitch point (standard centre distance), and each pair's terms; ``damage`` sits
-    on pinion tooth 1 (the tooth that passes the pitch point at cycle 1): its sections, and a
-    spall's lost contact width b - w (Hertz) while the contact lies on the spall."""
-    alpha0 = pinion.alpha0
+    passes the pitch point (at the centre distance of zero backlash: inv a_w = inv a +
+    2 tan a (x1 + x2) / (z1 + z2)), and each pair's terms; ``damage`` sits on pinion tooth 1
+    (the tooth that passes the pitch point at cycle 1): its sections, and a spall's lost
+    contact width b - w (Hertz) while the contact lies on the spall."""
+    a0 = pinion.alpha0
+    target = _inv(a0) + 2.0 * math.tan(a0) * (pinion.x + wheel.x) / (pinion.z + wheel.z)
+    alpha_w = brentq(lambda a: _inv(a) - target, 1e-3, 1.5, xtol=1e-16)
+    tan_w = math.tan(alpha_w)
     p_b = 2.0 * math.pi * pinion.rb / pinion.z
-    g_a = math.sqrt(pinion.ra ** 2 - pinion.rb ** 2) - pinion.rb * math.tan(alpha0)
-    g_f = math.sqrt(wheel.ra ** 2 - wheel.rb ** 2) - wheel.rb * math.tan(alpha0)
-    r_start = math.hypot(pinion.rb, pinion.rb * math.tan(alpha0) - g_f)  # lowest contact
+    g_a = math.sqrt(pinion.ra ** 2 - pinion.rb ** 2) - pinion.rb * tan_w
+    g_f = math.sqrt(wheel.ra ** 2 - wheel.rb ** 2) - wheel.rb * tan_w
+    r_start = math.hypot(pinion.rb, pinion.rb * tan_w - g_f)  # lowest contact
 
     def k_hertz(b: float) -> float:
         return math.pi * young * b / (4.0 * (1.0 - poisson ** 2))
@@ -254,9 +263,9 @@ def reference_mesh(pinion: Tooth, wheel: Tooth, cycles: np.ndarray, *, young: fl
             faulty = damage if (whole - k) % pinion.z == 1 else None
             if faulty is not None and faulty.missing:
                 continue
-            roll = math.tan(alpha0) + pos / pinion.rb
+            roll = tan_w + pos / pinion.rb
             tp = tooth_terms(pinion, roll, damage=faulty, r_start=r_start, **kw)
-            tw = tooth_terms(wheel, math.tan(alpha0) - pos / wheel.rb, **kw)
+            tw = tooth_terms(wheel, tan_w - pos / wheel.rb, **kw)
             contact_width = width
             spall = _sections(pinion, width, faulty, r_start)[2]
             if spall is not None and spall[0] <= pinion.rb * math.hypot(1.0, roll) <= spall[1]:
@@ -269,15 +278,18 @@ def reference_mesh(pinion: Tooth, wheel: Tooth, cycles: np.ndarray, *, young: fl
     return np.array(out), details
 
 
-PAIRS = {  # name: (z1, z2, module [m], face width [m], bores [m])
-    "19/48": (Z1, Z2, M, B, BORES),
-    "30/60": (30, 60, 4e-3, 0.04, (0.0285, 0.0575)),
+PAIRS = {  # name: (z1, z2, module [m], face width [m], bores [m], profile shifts)
+    "19/48": (Z1, Z2, M, B, BORES, (0.0, 0.0)),
+    "30/60": (30, 60, 4e-3, 0.04, (0.0285, 0.0575), (0.0, 0.0)),
+    "14/40 shifted": (14, 40, 3e-3, 0.02, (0.009, 0.028), (0.3, -0.1)),  # a_w 21.1 deg
 }
 
 
-def _mesh(z1: int, z2: int, m: float, b: float) -> GearMesh:
+def _mesh(z1: int, z2: int, m: float, b: float,
+          shifts: tuple[float, float] = (0.0, 0.0)) -> GearMesh:
     a0 = math.radians(20.0)
-    return GearMesh(SpurGear(z1, m, a0, b, name="pinion"), SpurGear(z2, m, a0, b, name="wheel"))
+    return GearMesh(SpurGear(z1, m, a0, b, profile_shift=shifts[0], name="pinion"),
+                    SpurGear(z2, m, a0, b, profile_shift=shifts[1], name="wheel"))
 
 
 @pytest.mark.parametrize("root_segment", [True, False])
@@ -286,12 +298,13 @@ def test_healthy_mesh_stiffness_against_an_independent_implementation(
         name: str, root_segment: bool) -> None:
     """Over a whole mesh cycle (40 angles), the mesh stiffness and every energy term of every
     pair in contact against the x-integration above."""
-    z1, z2, m, b, bores = PAIRS[name]
+    z1, z2, m, b, bores, shifts = PAIRS[name]
     n = 40
-    ds = potential_energy_stiffness(_mesh(z1, z2, m, b), bore_radius=bores, angles=n,
+    ds = potential_energy_stiffness(_mesh(z1, z2, m, b, shifts), bore_radius=bores, angles=n,
                                     young=E, poisson=NU, root_segment=root_segment)
     a0 = math.radians(20.0)
-    pinion, wheel = Tooth(z1, m, a0, bores[0]), Tooth(z2, m, a0, bores[1])
+    pinion = Tooth(z1, m, a0, bores[0], shifts[0])
+    wheel = Tooth(z2, m, a0, bores[1], shifts[1])
     ref, details = reference_mesh(pinion, wheel, ds.cycle.values, young=E, poisson=NU,
                                   width=b, root_segment=root_segment)
     rel = np.abs(ds.mesh_stiffness.values / ref - 1.0)
