@@ -30,7 +30,9 @@ Shao 2011 and the papers after them are in figures whose full texts were not at 
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import dataclass, replace
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -591,3 +593,80 @@ def test_ross_19_48_lies_between_the_two_root_conventions() -> None:
     high = _on_ross_path(Z1, Z2, M, B, BORES, E, NU, a0, root_segment=False)
     for stat, ross in zip((np.max, np.mean, np.min), ROSS_19_48, strict=True):
         assert float(stat(low)) < ross < float(stat(high))
+
+
+# -- docs/gears.md's tables ------------------------------------------------------------------
+
+#: ROSS 2.3.0's 62/62 doctest pair (pressure angle 0.349066 rad) over Mesh.stiffness_range:
+#: largest, mean, smallest [N/m].
+ROSS_62_62 = (429787095.1002592, 382606376.0385149, 234907804.72695836)
+
+
+def _table(marker: str) -> list[list[str]]:
+    text = (Path(__file__).resolve().parent.parent / "docs" / "gears.md").read_text()
+    body = text.split(f"<!-- {marker}:begin")[1].split(f"<!-- {marker}:end")[0]
+    rows = [line for line in body.splitlines() if line.startswith("| ")][1:]  # no header
+    return [[c.strip() for c in row.strip("|").split("|")] for row in rows]
+
+
+_PAIR = re.compile(r"^([\d.]+) / ([\d.]+) \(([+−-][\d.]+) %\)$")
+
+
+def test_docs_ross_tooth_table_is_computed() -> None:
+    """Every number of the table of ROSS's and geardyn's compliances, recomputed (4 significant
+    digits, percentages to 0.1, stiffness in MN/m to 0.1)."""
+    rows = _table("ross-tooth-table")
+    assert sorted(int(r[0].split()[0]) for r in rows) == sorted(ROSS_TEETH)
+    for row in rows:
+        z = int(row[0].split()[0])
+        _, got = _geardyn_tooth(z)
+        ross = ROSS_TEETH[z][5]
+        pairs = [(ross[t] * 1e12, got[t] * 1e12) for t in ("bending", "shear", "axial", "fillet")]
+        pairs.append((1e-6 / sum(ross.values()), 1e-6 / sum(got.values())))
+        for i, (cell, (r, g)) in enumerate(zip(row[1:], pairs, strict=True)):
+            match = _PAIR.match(cell)
+            assert match, cell
+            doc_r, doc_g, doc_pct = match.groups()
+            if i < 4:
+                assert float(doc_r) == float(f"{r:.4g}") and float(doc_g) == float(f"{g:.4g}")
+            else:
+                assert float(doc_r) == round(r, 1) and float(doc_g) == round(g, 1)
+            assert float(doc_pct.replace("−", "-")) == round(100.0 * (r / g - 1.0), 1), cell
+
+
+def test_docs_ross_mesh_table_is_computed() -> None:
+    """Every number of the table of mesh stiffness (MN/m, 2 decimals), recomputed: ROSS's
+    from the constants above, geardyn's on both paths of contact."""
+    a0 = math.radians(20.0)
+    e62, nu62 = 211e9, 211e9 / (2.0 * 81.2e9) - 1.0
+
+    def stats(k: np.ndarray) -> list[float]:
+        return [float(k.max()), float(k.mean()), float(k.min())]
+
+    def own(z1: int, z2: int, m: float, b: float, bores: tuple[float, float], young: float,
+            nu: float, *, root_segment: bool = True) -> list[float]:
+        ds = potential_energy_stiffness(_mesh(z1, z2, m, b), bore_radius=bores, young=young,
+                                        poisson=nu, angles=1000, root_segment=root_segment)
+        return stats(ds.mesh_stiffness.values)
+
+    p62 = (62, 62, 2e-3, 0.02, (0.0175, 0.0175), e62, nu62)
+    p1948 = (Z1, Z2, M, B, BORES, E, NU)
+    expected = [
+        [ROSS_DOCTEST_MAX, None, None],
+        list(ROSS_62_62),
+        stats(_on_ross_path(*p62, 0.349066)),
+        own(*p62),
+        list(ROSS_19_48),
+        stats(_on_ross_path(*p1948, a0, root_segment=True)),
+        stats(_on_ross_path(*p1948, a0, root_segment=False)),
+        own(*p1948),
+        own(*p1948, root_segment=False),
+    ]
+    rows = _table("ross-mesh-table")
+    assert len(rows) == len(expected)
+    for row, values in zip(rows, expected, strict=True):
+        for cell, value in zip(row[1:], values, strict=True):
+            if value is None:
+                assert cell == "–"
+            else:
+                assert float(cell) == round(value / 1e6, 2), (row[0], cell)
