@@ -3,7 +3,8 @@
 ROSS (petrobras/ross, pip ``ross-rotordynamics``; 2.3.0 gave the numbers in the test) is not a
 dependency of geardyn: run this with a Python that has it, e.g. a separate virtual environment
 (``python -m venv /tmp/rossenv && /tmp/rossenv/bin/pip install ross-rotordynamics "plotly<6"``;
-ROSS 2.3.0 fails to import with plotly 6 or later):
+ROSS 2.3.0 failed to import here with plotly 7.1.0, its template naming "scattermapbox"; with
+plotly<6 it imports):
 
     /tmp/rossenv/bin/python bench/ross_crosscheck.py
 
