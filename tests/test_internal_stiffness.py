@@ -13,13 +13,15 @@ profile outwards, KHK's sign).
 from __future__ import annotations
 
 import math
+import re
+from pathlib import Path
 
 import numpy as np
 import pytest
 from scipy.integrate import quad
 
 from geardyn.errors import ParameterError
-from geardyn.gears import GearMesh, SpurGear
+from geardyn.gears import GearMesh, SpurGear, iso6336_stiffness
 from geardyn.gears.faults import BrokenTooth, RootCrack, Spall
 from geardyn.gears.potential_energy import potential_energy_stiffness, prepare_pair
 
@@ -220,3 +222,33 @@ def test_rim_just_as_thick_as_the_teeth_is_accepted() -> None:
     assert ds.attrs["wheel_bore_radius_m"] == rim
     assert ds.attrs["ring_foundation"] == "rigid"
     assert np.all(np.isfinite(ds.mesh_stiffness.values))
+
+
+_ROW = re.compile(r"^\| (\d+)/(\d+), m ([\d.]+) mm, b (\d+) mm \|(.*)\|$", re.M)
+
+
+def test_docs_internal_iso_table_is_computed() -> None:
+    """Every number of docs/gears.md's planet-ring table, recomputed."""
+    text = (Path(__file__).resolve().parent.parent / "docs" / "gears.md").read_text()
+    table = text.split("<!-- pe-iso-internal:begin")[1].split("<!-- pe-iso-internal:end")[0]
+    rows = _ROW.findall(table)
+    assert len(rows) >= 3
+    for z1, z2, m, b, cells in rows:
+        doc = [float(c) for c in cells.split("|")]
+        planet = SpurGear(int(z1), f"{m} mm", "20 deg", f"{b} mm", name="pinion")
+        ring = SpurGear(int(z2), f"{m} mm", "20 deg", f"{b} mm", internal=True, name="wheel")
+        mesh = GearMesh(planet, ring, internal=True)
+        iso = iso6336_stiffness(mesh)
+        per_width = planet.face_width * 1e9  # N/m -> N/(mm um)
+        rim = ring.root_radius + 3.0 * ring.module
+        means = {}
+        for h_fi in (1.5, 2.0, 3.0):
+            ds = potential_energy_stiffness(mesh, bore_radius=(planet.root_radius / h_fi, rim),
+                                            angles=720)
+            means[h_fi] = float(ds.mesh_stiffness.mean()) / per_width
+        pair = prepare_pair(mesh, bore_radius=(planet.root_radius / 2.0, rim))
+        single = pair.terms(np.array([0.0]))["pair"][0]
+        got = [mesh.contact_ratio, iso.c_prime, iso.c_gamma_alpha, single / per_width,
+               means[1.5], means[2.0], means[3.0], means[2.0] / iso.c_gamma_alpha]
+        digits = [4, 2, 2, 2, 2, 2, 2, 2]
+        assert [round(g, d) for g, d in zip(got, digits, strict=True)] == doc, (z1, z2)

@@ -25,6 +25,7 @@ from geardyn.gears.potential_energy import (
     hertz_stiffness,
     potential_energy_stiffness,
     prepare_pair,
+    ring_tooth_model,
     tooth_compliances,
     tooth_model,
 )
@@ -59,6 +60,7 @@ __all__ = [
     "potential_energy_stiffness",
     "prepare_pair",
     "relief_gap",
+    "ring_tooth_model",
     "sun_ring_phase",
     "surviving_harmonics",
     "tooth_compliances",

@@ -1,4 +1,4 @@
-"""Mesh stiffness of an external spur pair by the potential-energy method.
+"""Mesh stiffness of an external or internal spur pair by the potential-energy method.
 
 Each tooth is a cantilever of variable section on its involute flank (Yang & Lin 1987; Tian
 2004; Wu, Zuo & Parey 2008; Chaari, Fakhfakh & Haddar 2009), of face width b and Young's
@@ -48,7 +48,24 @@ materials is load-independent, k_h = pi E b / (4 (1 - nu^2)) (Yang & Lin 1987). 
     1/k = 1/k_h + sum over both gears (1/k_b + 1/k_s + 1/k_a + 1/k_f)
 
 and the mesh stiffness is the sum over the pairs in contact (pairs act in parallel, load
-sharing by equal deflection). External pairs only; b is the smaller face width.
+sharing by equal deflection); b is the smaller face width.
+
+Internal pairs (a pinion in a ring; the ring's tooth after Chen & Shao 2013 and Liang, Zuo & Feng
+2015, who model it as a variable-section cantilever on its involute fixed at the root circle):
+the ring's flank is the involute of its base circle on the other branch, the same x(alpha),
+h(alpha) at alpha = alpha_2 + t (t >= 0 its roll angle, alpha_2 = pi/z2 less the space's half
+angle on the base circle, negative for large z2), so dx = r_b (alpha - alpha_2) cos alpha dalpha
+> 0: the root circle (alpha_root = alpha_2 + sqrt(r_f^2/r_b^2 - 1)) lies outside the contact
+and the tooth thickens towards it. A contact at distance s_2 from the ring's tangent point T2
+(T2 beyond the pinion's T1 on the same side of the pitch point: s_2 = r_b2 tan alpha_w + s) lies
+at alpha_1 = alpha_2 + s_2 / r_b2; the force along the line of action splits into F cos alpha_1
+across the tooth and F sin alpha_1 along its centre line towards the root, so
+
+    1/k_b = int [cos a1 (x - x_c) - sin a1 h_c]^2 / (E I) dx     (x from x_c out to the root)
+
+with the shear and axial integrals as above, integrated over alpha from alpha_1 to alpha_root.
+The ring body under the teeth is rigid (``ring_foundation="rigid"``; Sainsot's fit describes an
+external gear's body and does not apply), which needs a rim at least as thick as the teeth.
 
 The coast (back) flanks of symmetric teeth mesh on the mirror image of the line of action
 (Guo & Parker 2014, back-side contact): a coast contact at the same distance from the pitch point
