@@ -22,7 +22,7 @@ from scipy.integrate import quad
 
 from geardyn.errors import ParameterError
 from geardyn.gears import GearMesh, SpurGear, iso6336_stiffness
-from geardyn.gears.faults import BrokenTooth, RootCrack, Spall
+from geardyn.gears.faults import BrokenTooth, RootCrack, Spall, Wear
 from geardyn.gears.potential_energy import potential_energy_stiffness, prepare_pair
 
 M, ALPHA, B, E, NU = 2e-3, math.radians(20.0), 20e-3, 2.068e11, 0.3
@@ -99,6 +99,70 @@ def test_ring_tooth_energies_match_quad(shift: tuple[float, float]) -> None:
             assert 1.0 / terms[f"{name}_wheel"][i] == pytest.approx(value, rel=1e-11), name
     assert np.all(np.isinf(terms["fillet_wheel"]))  # rigid ring body
     assert np.all(np.isfinite(terms["fillet_pinion"]))
+
+
+def _cracked_ring_reference(g: dict[str, float], position: float,
+                            reach: float) -> dict[str, float]:
+    """The cracked ring tooth by quad: Tian's crack limit line h_q = h_r - q sin v from the
+    centre line (h_r the half thickness at the root circle) leaves every section
+    h + min(h, h_q) thick."""
+    rb, a2 = g["rb2"], g["a2"]
+    a1 = a2 + (rb * math.tan(g["a_w"]) + position) / rb
+    top = a2 + math.sqrt((g["rf2"] / rb) ** 2 - 1.0)
+    c, s = math.cos(a1), math.sin(a1)
+    xc = rb * (math.cos(a1) + (a1 - a2) * math.sin(a1))
+    hc = rb * (math.sin(a1) - (a1 - a2) * math.cos(a1))
+    hq = rb * (math.sin(top) - (top - a2) * math.cos(top)) - reach
+
+    def geom(a: float) -> tuple[float, float, float]:
+        h = rb * (math.sin(a) - (a - a2) * math.cos(a))
+        x = rb * (math.cos(a) + (a - a2) * math.sin(a))
+        return h + min(h, hq), x, rb * (a - a2) * math.cos(a)
+
+    def bend(a: float) -> float:
+        t, x, dx = geom(a)
+        return (c * (x - xc) - s * hc) ** 2 / (E * t ** 3 * B / 12.0) * dx
+
+    def inv_area(a: float) -> float:
+        t, _, dx = geom(a)
+        return dx / (t * B)
+
+    tight = dict(epsabs=0.0, epsrel=1e-12, limit=400)
+    area = quad(inv_area, a1, top, **tight)[0]
+    return {"bending": quad(bend, a1, top, **tight)[0],
+            "shear": 1.2 * c ** 2 * 2.0 * (1.0 + NU) / E * area, "axial": s ** 2 / E * area}
+
+
+@pytest.mark.parametrize("depth", [0.3e-3, 1.0e-3, 1.8e-3])
+def test_cracked_ring_tooth_matches_quad(depth: float) -> None:
+    g = _internal()
+    pair = prepare_pair(_mesh(), bore_radius=BORES, young=E, poisson=NU)
+    crack = RootCrack(depth, "45 deg", gear="wheel")
+    positions = np.array([-3e-3, 0.0, 2e-3])
+    terms = pair.terms(positions, wheel=crack)
+    for i, s in enumerate(positions):
+        ref = _cracked_ring_reference(g, float(s), depth * math.sin(math.radians(45.0)))
+        for name, value in ref.items():
+            assert 1.0 / terms[f"{name}_wheel"][i] == pytest.approx(value, rel=1e-9), name
+
+
+def test_ring_crack_lowers_its_pairs_once_per_ring_revolution() -> None:
+    """Stiffness falls strictly with crack depth wherever the cracked ring tooth is in contact,
+    is unchanged elsewhere, and zero depth is healthy bitwise."""
+    mesh = _mesh()
+    kw = dict(bore_radius=BORES, angles=12, cycles=Z2 + 10)
+    healthy = potential_energy_stiffness(mesh, **kw)
+    zero = potential_energy_stiffness(mesh, faults=RootCrack(0.0, gear="wheel", tooth=7), **kw)
+    np.testing.assert_array_equal(zero.mesh_stiffness.values, healthy.mesh_stiffness.values)
+    on = ((healthy.tooth_wheel.values == 7) & healthy.in_contact.values).any(axis=1)
+    assert on[: len(on) // 2].any() and on[len(on) // 2:].any()  # tooth 7 at cycles 7 and 78
+    previous = healthy.mesh_stiffness.values
+    for depth in (0.5e-3, 1.0e-3, 1.5e-3):
+        k = potential_energy_stiffness(mesh, faults=RootCrack(depth, gear="wheel", tooth=7),
+                                       **kw).mesh_stiffness.values
+        assert np.all(k[on] < previous[on])
+        np.testing.assert_array_equal(k[~on], healthy.mesh_stiffness.values[~on])
+        previous = k
 
 
 def test_internal_contact_ratio_is_the_closed_form() -> None:
@@ -205,7 +269,8 @@ def test_faults_on_the_planet_tooth() -> None:
     (dict(bore_radius=(8e-3, 0.0760)), "wheel.bore_radius"),  # rim thinner than the teeth
     (dict(bore_radius=(8e-3, 0.0)), "wheel.bore_radius"),
     (dict(bore_radius=BORES, ring_foundation="sainsot"), "ring_foundation"),
-    (dict(bore_radius=BORES, faults=RootCrack(depth=1e-4, gear="wheel")), "crack.gear"),
+    (dict(bore_radius=BORES, faults=Wear(1e-5, gear="wheel")), "wear.gear"),
+    (dict(bore_radius=BORES, faults=RootCrack(4e-3, "90 deg", gear="wheel")), "crack.depth"),
     (dict(bore_radius=BORES, faults=Spall(length=1e-4, width=1e-3, depth=1e-5,
                                           gear="wheel")), "spall.gear"),
 ])

@@ -65,7 +65,9 @@ across the tooth and F sin alpha_1 along its centre line towards the root, so
 
 with the shear and axial integrals as above, integrated over alpha from alpha_1 to alpha_root.
 The ring body under the teeth is rigid (``ring_foundation="rigid"``; Sainsot's fit describes an
-external gear's body and does not apply), which needs a rim at least as thick as the teeth.
+external gear's body and does not apply), which needs a rim at least as thick as the teeth. A
+root crack on a ring tooth narrows the sections between Tian's crack limit line and the root
+circle as on an external tooth; a spall or wear there is refused.
 
 The coast (back) flanks of symmetric teeth mesh on the mirror image of the line of action
 (Guo & Parker 2014, back-side contact): a coast contact at the same distance from the pitch point
@@ -271,7 +273,8 @@ def crack_limit(tooth: ToothModel, h_q: float) -> float:
     """alpha_c: the involute parameter above which (towards the root) the flank's half thickness
     exceeds h_q, the crack tip's distance from the centre line (Tian's crack limit line runs
     from the tip parallel to the centre line until it meets the flank); the tooth tip's alpha if
-    the line reaches the tip. h(alpha) rises with alpha for alpha < 0."""
+    the line reaches the tip. h(alpha) rises with alpha for alpha < 0 (external tooth) and for
+    alpha > 0 (a ring's tooth, up to its root circle)."""
     r_b, a2 = tooth.base_radius, tooth.half_base_angle
 
     def h(a: float) -> float:
@@ -279,7 +282,7 @@ def crack_limit(tooth: ToothModel, h_q: float) -> float:
 
     if h(tooth.tip) >= h_q:
         return tooth.tip
-    lo, hi = tooth.tip, 0.0
+    lo, hi = tooth.tip, (tooth.top if tooth.internal else 0.0)
     for _ in range(200):
         mid = 0.5 * (lo + hi)
         if h(mid) < h_q:
@@ -439,8 +442,9 @@ def tooth_compliances(tooth: ToothModel, alpha1: np.ndarray, *, young: float, po
 
     ``crack=`` is the deprecated spelling of ``fault=`` for a root crack. A
     :class:`BrokenTooth` has no compliance (refused). A ring's tooth (``tooth.internal``) is
-    integrated from alpha = alpha1 to its root circle, takes no fault (refused unless of zero
-    size) and its fillet term is 0 (rigid ring body)."""
+    integrated from alpha = alpha1 to its root circle, takes a root crack (as above, the
+    crack limit line running from the crack tip towards the ring's tooth tip) and no other
+    fault, and its fillet term is 0 (rigid ring body)."""
     fault = _one_fault(fault, crack, "tooth_compliances")
     a1 = np.asarray(alpha1, dtype=float)
     if tooth.internal:
@@ -503,17 +507,30 @@ def tooth_compliances(tooth: ToothModel, alpha1: np.ndarray, *, young: float, po
 def _ring_compliances(tooth: ToothModel, a1: np.ndarray, *, young: float, poisson: float,
                       face_width: float, nodes: int,
                       fault: Fault | None) -> dict[str, np.ndarray]:
-    """:func:`tooth_compliances` of a ring's tooth."""
-    if fault is not None and (isinstance(fault, BrokenTooth) or not fault.is_null):
+    """:func:`tooth_compliances` of a ring's tooth: healthy, or with a :class:`RootCrack`
+    (Tian's crack limit line from the crack tip towards the tip; sections towards the root
+    beyond it h + h_q thick)."""
+    crack = isinstance(fault, RootCrack) and not fault.is_null
+    if fault is not None and not crack and (isinstance(fault, BrokenTooth)
+                                            or not fault.is_null):
         raise ParameterError(f"{getattr(fault, 'kind', 'fault')}.gear", tooth.name,
-                             "faults on a ring's tooth are not modelled (a missing tooth is:"
-                             " see potential_energy_stiffness)")
+                             "on a ring's tooth only a root crack or a missing tooth is"
+                             " modelled")
     if np.any(a1 >= tooth.top):
         raise ParameterError(f"{tooth.name}.dedendum", None,
                              "a contact lies at or beyond the root circle of the ring's tooth")
     g = young / (2.0 * (1.0 + poisson))
-    bending, inv_area = _involute_piece(tooth, a1, a1, np.full(a1.shape, tooth.top), None,
-                                        young, face_width, nodes)
+    top = np.full(a1.shape, tooth.top)
+    if crack:
+        _check_crack(fault, tooth)  # type: ignore[arg-type]
+        h_q = root_half_thickness(tooth) - fault.reach  # type: ignore[union-attr]
+        split = np.maximum(a1, crack_limit(tooth, h_q))
+        bend_h, area_h = _involute_piece(tooth, a1, a1, split, None, young, face_width, nodes)
+        bend_c, area_c = _involute_piece(tooth, a1, split, top, _crack_section(h_q, face_width),
+                                         young, face_width, nodes)
+        bending, inv_area = bend_h + bend_c, area_h + area_c
+    else:
+        bending, inv_area = _involute_piece(tooth, a1, a1, top, None, young, face_width, nodes)
     cos1, sin1 = np.cos(a1), np.sin(a1)
     return {"bending": bending, "shear": 1.2 * cos1 ** 2 / g * inv_area,
             "axial": sin1 ** 2 / young * inv_area,
@@ -803,10 +820,10 @@ def _check_faults(faults: tuple[object, ...], mesh: GearMesh, teeth: list[ToothM
                                  f" has a fault ({seen[key]!r}): one fault a tooth")
         seen[key] = fault
         tooth = teeth[0] if fault.gear == "pinion" else teeth[1]
-        if tooth.internal and not isinstance(fault, BrokenTooth):
+        if tooth.internal and not isinstance(fault, (BrokenTooth, RootCrack)):
             raise ParameterError(f"{kind}.gear", fault.gear,
-                                 "faults on the ring's teeth are not modelled except a missing"
-                                 " tooth (BrokenTooth); put the fault on the pinion")
+                                 "on the ring's teeth only a root crack or a missing tooth"
+                                 " (BrokenTooth) is modelled; put the fault on the pinion")
         if isinstance(fault, RootCrack):
             _check_crack(fault, tooth)
         elif isinstance(fault, Spall):
@@ -1000,8 +1017,8 @@ def potential_energy_stiffness(mesh: GearMesh, *, bore_radius: object, angles: o
     An internal ``mesh`` (``mesh.internal``): the wheel is the ring, its terms (``*_wheel``)
     the ring tooth's (:func:`ring_tooth_model`); ``bore_radius``'s second value is the ring's
     outer (rim) radius; ``ring_foundation`` (:data:`RING_FOUNDATIONS`) treats the ring body
-    (``"rigid"``: ``k_fillet_wheel`` is inf). Faults on the ring's teeth other than a
-    :class:`BrokenTooth` are refused.
+    (``"rigid"``: ``k_fillet_wheel`` is inf). On the ring's teeth a :class:`RootCrack` and a
+    :class:`BrokenTooth` are modelled; a spall or wear there is refused.
     """
     fault_list = _fault_tuple(faults, crack, "potential_energy_stiffness")
     pair = prepare_pair(mesh, bore_radius=bore_radius, young=young, poisson=poisson,
