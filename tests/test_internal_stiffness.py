@@ -265,6 +265,22 @@ def test_faults_on_the_planet_tooth() -> None:
     assert not broken.in_contact.values[gone].any()
 
 
+def test_planet_archard_slip_is_the_internal_kinematics() -> None:
+    """In single contact (the whole load on one pair) Archard's rate of the planet's flank is
+    its slip |v_1 - v_2| / v_1 = |(1 - z1/z2) s| / rho_1: the planet and the ring turn the same
+    way, so the flanks slide at (omega_1 - omega_2) s, not (omega_1 + omega_2) s."""
+    g = _internal()
+    mesh = _mesh()
+    pair = prepare_pair(mesh, bore_radius=BORES)
+    p_b = math.pi * M * math.cos(ALPHA)
+    g_f = g["rb2"] * math.tan(g["a_w"]) - math.sqrt(g["ra2"] ** 2 - g["rb2"] ** 2)
+    g_a = math.sqrt(g["ra1"] ** 2 - g["rb1"] ** 2) - g["rb1"] * math.tan(g["a_w"])
+    s = np.linspace(g_a - p_b, p_b - g_f, 9)[1:-1]
+    assert s[0] < s[-1]
+    slip = np.abs((1.0 - Z1 / Z2) * s) / (g["rb1"] * math.tan(g["a_w"]) + s)
+    np.testing.assert_allclose(pair.archard_rate("pinion", s), slip, rtol=1e-12, atol=1e-15)
+
+
 @pytest.mark.parametrize("kwargs, field", [
     (dict(bore_radius=(8e-3, 0.0760)), "wheel.bore_radius"),  # rim thinner than the teeth
     (dict(bore_radius=(8e-3, 0.0)), "wheel.bore_radius"),
