@@ -24,8 +24,9 @@ from geardyn.gears import (
     helical_stiffness,
     loaded_contact,
     potential_energy_stiffness,
+    prepare_pair,
 )
-from pair_19_48 import B, BORES, Z1, Z2, M, pair_mesh
+from pair_19_48 import BORES, Z1, Z2, B, M, pair_mesh
 
 DEG = math.pi / 180.0
 
@@ -198,10 +199,16 @@ def test_contact_counts_follow_the_contact_ratios():
                                                               abs=2.0 / angles)
     np.testing.assert_allclose(ds.pairs_in_contact.values,
                                ds.contact_fraction.sum("pair").values, rtol=1e-15)
-    # each slice's stiffness is the spur pair's of width b/S at the slice's position
-    spur_pair = potential_energy_stiffness(mesh.transverse, bore_radius=BORES,
-                                           angles=np.array([0.0]))
-    assert spur_pair.attrs["face_width_m"] == mesh.face_width
+    # each slice: the transverse spur pair's stiffness at the slice's position, over S (every
+    # term is proportional to the face width), its position the centre's + y tan(beta_b)
+    pair = prepare_pair(mesh.transverse, bore_radius=BORES)
+    inside = ds.slice_in_contact.values
+    s = ds.slice_position.values
+    np.testing.assert_allclose(ds.slice_stiffness.values[inside],
+                               pair.terms(s[inside])["pair"] / slices, rtol=1e-13)
+    y = ds.axial_position.values
+    np.testing.assert_allclose(s, ds.position.values[..., None]
+                               + y * math.tan(mesh.base_helix_angle), rtol=0, atol=1e-15)
 
 
 def test_root_crack_acts_on_the_whole_face_of_its_tooth():
