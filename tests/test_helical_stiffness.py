@@ -5,6 +5,7 @@ independent load-sharing solves."""
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -315,3 +316,49 @@ def test_crowned_stiffness_approaches_the_uncrowned_one_as_the_load_grows(crowne
     light = helical_loaded_contact(mesh, ds, 50.0, (), crowning)
     ends = light.slice_force.isel(slice=[0, -1]).values
     assert np.all(ends == 0.0) and np.all(light.tangent_stiffness.values < 0.8 * k_mesh)
+
+
+# -- docs/gears.md's numbers --------------------------------------------------------------------
+
+DOCS = Path(__file__).resolve().parent.parent / "docs" / "gears.md"
+
+
+def _table_rows(text: str, header: str) -> list[list[str]]:
+    """The body rows of the markdown table whose header line starts with ``header``."""
+    lines = text[text.index(header):].splitlines()[2:]
+    rows = []
+    for line in lines:
+        if not line.startswith("|"):
+            break
+        rows.append([c.strip() for c in line.strip().strip("|").split("|")])
+    return rows
+
+
+def test_docs_helical_and_crowning_tables():
+    """Every number of docs/gears.md's helical-stiffness and lead-crowning tables, recomputed
+    (19/48 teeth, m_n 3.2 mm, b 16 mm, 20 slices, 360 angles)."""
+    text = DOCS.read_text(encoding="utf-8")
+    stiffness = {}
+    for beta, eps_a, eps_b, mean, pp, ratio in _table_rows(text, "| β | ε_α | ε_β | mean"):
+        deg = float(beta.rstrip("°"))
+        mesh = helical(deg * DEG)
+        ds = helical_stiffness(mesh, bore_radius=BORES, angles=360, slices=20)
+        stiffness[deg] = (mesh, ds)
+        k = ds.mesh_stiffness.values
+        assert f"{mesh.transverse_contact_ratio:.4f}" == eps_a
+        assert f"{mesh.overlap_ratio:.4f}" == eps_b
+        assert f"{k.mean():.4e}".replace("e+0", "e") == mean
+        assert f"{k.max() - k.min():.4e}".replace("e+0", "e") == pp
+        assert f"{(k.max() - k.min()) / k.mean():.3f}" == ratio
+    mesh, ds = stiffness[20.0]
+    for amount, force, mean, pp, tangent, secant, loaded in _table_rows(text, "| C_c | F |"):
+        c = 0.0 if amount == "0" else float(amount.split()[0]) * 1e-6
+        f = float(force.split()[0]) * (1e3 if "kN" in force else 1.0)
+        out = helical_loaded_contact(mesh, ds, f, (), (LeadCrowning(c),))
+        te = out.transmission_error.values * 1e6
+        k = ds.mesh_stiffness.values
+        got = (f"{te.mean():.2f} µm", f"{te.max() - te.min():.2f} µm",
+               f"{np.mean(out.tangent_stiffness.values / k):.3f}",
+               f"{np.mean(out.secant_stiffness.values / k):.3f}",
+               f"{float(out.pairs_loaded.mean()):.2f}")
+        assert got == (mean, pp, tangent, secant, loaded), (amount, force)
