@@ -49,7 +49,6 @@ from geardyn.gears.potential_energy import (
     STEEL_POISSON,
     STEEL_YOUNG,
     PotentialEnergyPair,
-    _attrs,
     _cycle_grid,
     _fault_codes,
     _fault_tuple,
@@ -345,8 +344,7 @@ def helical_stiffness(mesh: HelicalMesh, *, bore_radius: object, angles: object 
     ds["angle"].attrs.update(units="deg", long_name="pinion rotation (face centre)")
     ds["cycle"].attrs.update(units="", long_name="mesh cycles")
     ds["axial_position"].attrs.update(units="m", long_name="slice centre from the face centre")
-    ds.attrs.update(_attrs(pair, root_segment))
-    ds.attrs.update(_helical_attrs(mesh, count))
+    ds.attrs.update(_helical_attrs(mesh, pair, root_segment, count))
     return ds
 
 
@@ -373,8 +371,29 @@ def _flank_variables(flank: dict[str, np.ndarray], count: int,
            f"slice_stiffness{suffix}": (dims3, k_slice)}
 
 
-def _helical_attrs(mesh: HelicalMesh, count: int) -> dict[str, object]:
-    return {
+def _helical_attrs(mesh: HelicalMesh, pair: PotentialEnergyPair, root_segment: bool,
+                   count: int) -> dict[str, object]:
+    """The Dataset's attributes: the method, material, width (the whole face), faults, bores
+    and the helical geometry."""
+    t = mesh.transverse
+    out: dict[str, object] = {
+        "method": "potential energy (Yang & Lin 1987; Tian 2004; Chaari et al. 2009) with the"
+                  " fillet foundation of Sainsot, Velex & Duverger 2004, per slice",
+        "root": ("straight flank from the root to the base circle" if root_segment
+                 else "cantilever from the base circle (or the root circle above it)"),
+        "young_Pa": pair.young, "poisson": pair.poisson, "face_width_m": pair.face_width,
+        "hertz_stiffness_N_per_m": pair.hertz, "contact_ratio": t.contact_ratio,
+        "base_pitch_m": t.base_pitch, "quadrature_nodes": pair.nodes,
+        "coast_phase_cycles": coast_phase(t), "backlash_m": t.backlash,
+        "backlash_cycles": t.backlash / (2.0 * math.pi * t.operating_pitch_radii[0]
+                                         / t.pinion.teeth),
+        "faults": "; ".join(f.describe() for f in pair.faults) or "none",
+        "faulty_gears": ",".join(sorted({f.gear for f in pair.faults})),
+    }
+    for role, tooth in (("pinion", pair.pinion), ("wheel", pair.wheel)):
+        out[f"{role}_bore_radius_m"] = tooth.bore_radius
+        out[f"{role}_h_fi"] = tooth.h_fi
+    return out | {
         "slice_model": "thin slices across the face width, each the potential-energy spur pair"
                        " of the transverse sections of width b/S shifted by y tan(beta_b) along"
                        " the line of action; slices in parallel, no coupling between them",
