@@ -27,6 +27,7 @@ from geardyn.gears.potential_energy import (
     hertz_stiffness,
     potential_energy_stiffness,
     prepare_pair,
+    ring_tooth_model,
     tooth_compliances,
     tooth_model,
 )
@@ -67,6 +68,7 @@ __all__ = [
     "potential_energy_stiffness",
     "prepare_pair",
     "relief_gap",
+    "ring_tooth_model",
     "sun_ring_phase",
     "surviving_harmonics",
     "tooth_compliances",
