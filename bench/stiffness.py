@@ -84,9 +84,11 @@ def measure_helical(repeat: int, angles: int) -> tuple[float, float]:
 def helical_main(args: argparse.Namespace) -> None:
     """The helical case alone (``--helical``), its own row with ``--write``."""
     wall, mean = measure_helical(args.repeat, args.angles)
+    spur, _ = measure(args.repeat, args.angles)
     measured = (f"{wall * 1e3:.1f} ms wall, median of {args.repeat} ({args.angles} angles,"
                 f" 19/48 teeth at m_n 3.2 mm, beta 20 deg, eps_beta 0.544, {HELICAL_SLICES}"
-                f" slices, drive and coast flank; mean stiffness {mean:.4e} N/m)")
+                f" slices, drive and coast flank; mean stiffness {mean:.4e} N/m; the spur"
+                f" pair's cycle in the same run {spur * 1e3:.2f} ms)")
     print(measured)
     if args.write:
         command = (f".venv/bin/python bench/stiffness.py --helical --repeat {args.repeat}"

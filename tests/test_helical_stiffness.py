@@ -229,6 +229,10 @@ def test_root_crack_acts_on_the_whole_face_of_its_tooth():
     gone = ((healthy.tooth_pinion == 2) * healthy.pair_stiffness).sum("pair").values
     np.testing.assert_allclose(broken.mesh_stiffness.values,
                                healthy.mesh_stiffness.values - gone, rtol=1e-13)
+    worn = helical_stiffness(mesh, faults=Wear("5 um", tooth=2), **kw)
+    on_tooth = (worn.tooth_pinion == 2).values[..., None] & worn.slice_in_contact.values
+    assert np.all(worn.fault_gap.values[on_tooth] == 5e-6)
+    assert np.all(worn.fault_gap.values[~on_tooth] == 0.0) and on_tooth.any()
 
 
 # -- lead crowning and the loaded contact -------------------------------------------------------
