@@ -366,3 +366,18 @@ def test_docs_helical_and_crowning_tables():
                f"{np.mean(out.secant_stiffness.values / k):.3f}",
                f"{float(out.pairs_loaded.mean()):.2f}")
         assert got == (mean, pp, tangent, secant, loaded), (amount, force)
+
+
+def test_coast_flank_mirrors_the_drive_flank():
+    """Symmetric slices: K_coast(c) = K_drive(phi - c), as for the spur pair (c in mesh cycles,
+    phi the coast phase), at angles off the grid."""
+    mesh = helical(18 * DEG, b=0.03)
+    rng = np.random.default_rng(3)
+    cycles = rng.uniform(0.0, 3.0, 40)
+    per_cycle = 360.0 / Z1
+    kw = dict(bore_radius=BORES, slices=12)
+    ds = helical_stiffness(mesh, angles=cycles * per_cycle, **kw)
+    phi = ds.attrs["coast_phase_cycles"]
+    mirrored = helical_stiffness(mesh, angles=(phi - cycles) * per_cycle, **kw)
+    np.testing.assert_allclose(ds.mesh_stiffness_coast.values, mirrored.mesh_stiffness.values,
+                               rtol=1e-12)
