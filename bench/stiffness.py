@@ -2,12 +2,15 @@
 12/35 mm), the xarray Dataset included: one mesh cycle at 360 pinion angles (target <= 50 ms),
 and the hunting period (lcm(19, 48) = 912 mesh cycles, 360 angles each) with a 2 mm root crack
 on one pinion tooth (target <= 1 s), and with four faulty teeth at once (a root crack, a spall,
-Archard wear, a missing tooth; no target).
+Archard wear, a missing tooth; no target). ``--helical``: instead, the same teeth as a helical
+pair (m_n 3.2 mm, beta 20 deg) by 20 thin slices, one mesh cycle at 360 angles (no target;
+the spur target's workload with 20 slices).
 
 Wall time: the median of ``--repeat`` calls of
-:func:`geardyn.gears.potential_energy_stiffness` after one warm-up call.
+:func:`geardyn.gears.potential_energy_stiffness` (:func:`geardyn.gears.helical_stiffness`)
+after one warm-up call.
 
-    .venv/bin/python bench/stiffness.py [--repeat 21] [--angles 360] [--write]
+    .venv/bin/python bench/stiffness.py [--repeat 21] [--angles 360] [--helical] [--write]
 """
 
 from __future__ import annotations
@@ -21,10 +24,13 @@ from pathlib import Path
 from geardyn.gears import (
     BrokenTooth,
     GearMesh,
+    HelicalGear,
+    HelicalMesh,
     RootCrack,
     Spall,
     SpurGear,
     Wear,
+    helical_stiffness,
     potential_energy_stiffness,
 )
 
@@ -58,13 +64,51 @@ def measure(repeat: int, angles: int, **options: object) -> tuple[float, float]:
     return statistics.median(times), float(ds.mesh_stiffness.mean())
 
 
+HELICAL_SLICES = 20
+
+
+def measure_helical(repeat: int, angles: int) -> tuple[float, float]:
+    """(median wall seconds of one :func:`helical_stiffness` call, mean mesh stiffness)."""
+    mesh = HelicalMesh(HelicalGear(19, "3.2 mm", "20 deg", "20 deg", "16 mm", name="pinion"),
+                       HelicalGear(48, "3.2 mm", "20 deg", "20 deg", "16 mm", name="wheel"))
+    kw = dict(bore_radius=(0.012, 0.035), angles=angles, slices=HELICAL_SLICES)
+    ds = helical_stiffness(mesh, **kw)
+    times = []
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        helical_stiffness(mesh, **kw)
+        times.append(time.perf_counter() - t0)
+    return statistics.median(times), float(ds.mesh_stiffness.mean())
+
+
+def helical_main(args: argparse.Namespace) -> None:
+    """The helical case alone (``--helical``), its own row with ``--write``."""
+    wall, mean = measure_helical(args.repeat, args.angles)
+    spur, _ = measure(args.repeat, args.angles)
+    measured = (f"{wall * 1e3:.1f} ms wall, median of {args.repeat} ({args.angles} angles,"
+                f" 19/48 teeth at m_n 3.2 mm, beta 20 deg, eps_beta 0.544, {HELICAL_SLICES}"
+                f" slices, drive and coast flank; mean stiffness {mean:.4e} N/m; the spur"
+                f" pair's cycle in the same run {spur * 1e3:.2f} ms)")
+    print(measured)
+    if args.write:
+        command = (f".venv/bin/python bench/stiffness.py --helical --repeat {args.repeat}"
+                   " --write")
+        results.record("pe-stiffness-helical",
+                       f"helical pair by {HELICAL_SLICES} slices, one mesh cycle at 360 angles"
+                       " (no target; the spur pair's is 50 ms)", measured, "-", command)
+
+
 def main(argv: list[str] | None = None) -> None:
     """Run the benchmark; ``--write`` records the figure in bench/RESULTS.md."""
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeat", type=int, default=21)
     ap.add_argument("--angles", type=int, default=360)
+    ap.add_argument("--helical", action="store_true")
     ap.add_argument("--write", action="store_true")
     args = ap.parse_args(argv)
+    if args.helical:
+        helical_main(args)
+        return
     wall, mean = measure(args.repeat, args.angles)
     measured = (f"{wall * 1e3:.2f} ms wall, median of {args.repeat} ({args.angles} angles,"
                 f" 19/48 pair; mean stiffness {mean:.4e} N/m)")

@@ -605,3 +605,29 @@ def test_continue_switches_at_period_doublings(tmp_path):
     assert doublings >= 1 and saved.sizes["branch_id"] == 1 + doublings
     assert list(saved["branch_period"].values) == [1] + [2] * doublings
     assert "period-2" in r.stdout and png.read_bytes()[:8] == PNG
+
+
+def test_help_keeps_bracketed_text(capsys):
+    """Every bracketed word of an option's help ("[rad/s]", "[sweep]") reaches ``--help`` as
+    written: the help is plain text, not rich markup (which drops an unknown "[tag]")."""
+    import re
+
+    import typer.main
+
+    from geardyn.cli.main import app
+
+    group = typer.main.get_command(app)
+    checked = 0
+    for name, command in group.commands.items():
+        if not hasattr(command, "params"):
+            continue
+        texts = [command.help or ""] + [getattr(p, "help", None) or "" for p in command.params]
+        words = {w for text in texts for w in re.findall(r"\[[a-z][^\]\s]*\]", text)}
+        if not words:
+            continue
+        r = geardyn_here(capsys, name, "--help")
+        assert r.returncode == 0, r.stderr
+        for word in words:
+            assert word in r.stdout, f"geardyn {name} --help lost {word}"
+            checked += 1
+    assert checked >= 3

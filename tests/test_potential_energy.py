@@ -278,17 +278,13 @@ def test_bad_inputs_name_the_field(mesh: GearMesh, kwargs: dict, field: str) -> 
     assert info.value.field == field
 
 
-def test_undercut_and_internal_are_refused() -> None:
+def test_undercut_is_refused() -> None:
+    """(Internal pairs: tests/test_internal_stiffness.py.)"""
     p = SpurGear(14, M, ALPHA, B, name="pinion", check_undercut=False)  # x_min = 0.18
     w = SpurGear(25, M, ALPHA, B, name="wheel")
     with pytest.raises(ParameterError) as info:
         potential_energy_stiffness(GearMesh(p, w), bore_radius=0.005)
     assert info.value.field == "pinion.profile_shift"
-    ring = SpurGear(71, "2 mm", "20 deg", B, internal=True, name="ring")
-    sun = SpurGear(23, "2 mm", "20 deg", B, name="planet")
-    with pytest.raises(ParameterError) as info:
-        potential_energy_stiffness(GearMesh(sun, ring, internal=True), bore_radius=0.005)
-    assert info.value.field == "mesh.internal"
     with pytest.raises(ParameterError) as info:
         SpurGear(Z1, M, ALPHA, -B, name="pinion")
     assert info.value.field == "pinion.face_width"

@@ -69,10 +69,12 @@ app = typer.Typer(
     add_completion=False,
     no_args_is_help=True,
     pretty_exceptions_enable=False,
+    rich_markup_mode=None,  # help is plain text: units in brackets ("[rad/s]", "[sweep]") stay
 )
 params_app = typer.Typer(
     help="Show the device's derived quantities, or write its parameters to a TOML file.",
     no_args_is_help=True,
+    rich_markup_mode=None,
 )
 app.add_typer(params_app, name="params")
 

@@ -1,13 +1,15 @@
-"""Gear geometry, ISO 6336-1 and potential-energy mesh stiffness, stiffness waveforms and
-planetary mesh phasing.
+"""Gear geometry, ISO 6336-1 and potential-energy mesh stiffness (spur, and helical by thin
+slices), tip relief and lead crowning, stiffness waveforms and planetary mesh phasing.
 
 Pure numpy: everything here produces plain numbers, arrays and callables that a model's mesh
 takes (mean stiffness, Fourier coefficients, phases); the potential-energy stiffness comes as a
 labelled xarray Dataset. See docs/gears.md.
 """
 
+from geardyn.gears.crowning import LeadCrowning, crowning_gap, helical_loaded_contact
 from geardyn.gears.faults import FAULT_KINDS, BrokenTooth, Spall, Wear
 from geardyn.gears.geometry import GearMesh, SpurGear, inverse_involute, involute
+from geardyn.gears.helical import HelicalGear, HelicalMesh, helical_stiffness
 from geardyn.gears.iso6336 import ISOStiffness, iso6336_stiffness
 from geardyn.gears.phasing import (
     MeshPhases,
@@ -25,6 +27,7 @@ from geardyn.gears.potential_energy import (
     hertz_stiffness,
     potential_energy_stiffness,
     prepare_pair,
+    ring_tooth_model,
     tooth_compliances,
     tooth_model,
 )
@@ -35,7 +38,10 @@ __all__ = [
     "FAULT_KINDS",
     "BrokenTooth",
     "GearMesh",
+    "HelicalGear",
+    "HelicalMesh",
     "ISOStiffness",
+    "LeadCrowning",
     "MeshPhases",
     "PlanetaryGeometry",
     "PotentialEnergyPair",
@@ -47,8 +53,11 @@ __all__ = [
     "ToothModel",
     "Wear",
     "coast_phase",
+    "crowning_gap",
     "double_contact_centre",
     "equally_spaced",
+    "helical_loaded_contact",
+    "helical_stiffness",
     "hertz_stiffness",
     "involute",
     "inverse_involute",
@@ -59,6 +68,7 @@ __all__ = [
     "potential_energy_stiffness",
     "prepare_pair",
     "relief_gap",
+    "ring_tooth_model",
     "sun_ring_phase",
     "surviving_harmonics",
     "tooth_compliances",

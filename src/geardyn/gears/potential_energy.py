@@ -1,4 +1,4 @@
-"""Mesh stiffness of an external spur pair by the potential-energy method.
+"""Mesh stiffness of an external or internal spur pair by the potential-energy method.
 
 Each tooth is a cantilever of variable section on its involute flank (Yang & Lin 1987; Tian
 2004; Wu, Zuo & Parey 2008; Chaari, Fakhfakh & Haddar 2009), of face width b and Young's
@@ -48,7 +48,26 @@ materials is load-independent, k_h = pi E b / (4 (1 - nu^2)) (Yang & Lin 1987). 
     1/k = 1/k_h + sum over both gears (1/k_b + 1/k_s + 1/k_a + 1/k_f)
 
 and the mesh stiffness is the sum over the pairs in contact (pairs act in parallel, load
-sharing by equal deflection). External pairs only; b is the smaller face width.
+sharing by equal deflection); b is the smaller face width.
+
+Internal pairs (a pinion in a ring; the ring's tooth after Chen & Shao 2013 and Liang, Zuo & Feng
+2015, who model it as a variable-section cantilever on its involute fixed at the root circle):
+the ring's flank is the involute of its base circle on the other branch, the same x(alpha),
+h(alpha) at alpha = alpha_2 + t (t >= 0 its roll angle, alpha_2 = pi/z2 less the space's half
+angle on the base circle, negative for large z2), so dx = r_b (alpha - alpha_2) cos alpha dalpha
+> 0: the root circle (alpha_root = alpha_2 + sqrt(r_f^2/r_b^2 - 1)) lies outside the contact
+and the tooth thickens towards it. A contact at distance s_2 from the ring's tangent point T2
+(T2 beyond the pinion's T1 on the same side of the pitch point: s_2 = r_b2 tan alpha_w + s) lies
+at alpha_1 = alpha_2 + s_2 / r_b2; the force along the line of action splits into F cos alpha_1
+across the tooth and F sin alpha_1 along its centre line towards the root, so
+
+    1/k_b = int [cos a1 (x - x_c) - sin a1 h_c]^2 / (E I) dx     (x from x_c out to the root)
+
+with the shear and axial integrals as above, integrated over alpha from alpha_1 to alpha_root.
+The ring body under the teeth is rigid (``ring_foundation="rigid"``; Sainsot's fit describes an
+external gear's body and does not apply), which needs a rim at least as thick as the teeth. A
+root crack on a ring tooth narrows the sections between Tian's crack limit line and the root
+circle as on an external tooth; a spall or wear there is refused.
 
 The coast (back) flanks of symmetric teeth mesh on the mirror image of the line of action
 (Guo & Parker 2014, back-side contact): a coast contact at the same distance from the pitch point
@@ -125,7 +144,13 @@ class ToothModel:
     ``start_roll`` that of the lowest contact of the flank in its mesh (the start of the active
     profile; 0, the base circle, until the mesh is known: :func:`prepare_pair` sets it). A flank
     point at roll angle t lies at alpha = half_base_angle - t, r_b t^2 / 2 along the involute
-    from the base circle."""
+    from the base circle.
+
+    ``internal``: a ring's tooth (:func:`ring_tooth_model`): the same x(alpha), h(alpha) on the
+    other branch of the involute, alpha = half_base_angle + t, with ``half_base_angle`` the
+    tooth's half angle on the base circle (pi/z less half the space's), ``top`` the root circle's
+    alpha, ``bore_radius`` the ring's outer (rim) radius, no straight segment and no fillet
+    foundation (``fillet`` all zero: the ring body is rigid)."""
 
     name: str
     base_radius: float
@@ -139,6 +164,7 @@ class ToothModel:
     fillet: tuple[float, float, float, float]
     pitch_roll: float = math.nan
     start_roll: float = 0.0
+    internal: bool = False
 
     @property
     def h_fi(self) -> float:
@@ -147,13 +173,13 @@ class ToothModel:
 
 
 def tooth_model(gear: SpurGear, bore_radius: float, *, root_segment: bool = True,
-                role: str | None = None) -> ToothModel:
-    """The cantilever and fillet-foundation description of ``gear``'s tooth (external gear)
-    on a bore of radius ``bore_radius`` [m]; ``role`` names the gear in errors."""
+                role: str | None = None, ring_foundation: str = "rigid") -> ToothModel:
+    """The cantilever and fillet-foundation description of ``gear``'s tooth on a bore of radius
+    ``bore_radius`` [m] (an internal gear: :func:`ring_tooth_model`, ``bore_radius`` its outer
+    rim radius); ``role`` names the gear in errors."""
     role = role or gear.name
     if gear.internal:
-        raise ParameterError(f"{role}.internal", True,
-                             "the potential-energy stiffness covers external gears only")
+        return ring_tooth_model(gear, bore_radius, role=role, foundation=ring_foundation)
     if gear.profile_shift < gear.min_profile_shift - 1e-12:
         raise ParameterError(f"{role}.profile_shift", gear.profile_shift,
                              "undercut teeth: the tooth model needs the whole involute flank"
@@ -184,6 +210,40 @@ def tooth_model(gear: SpurGear, bore_radius: float, *, root_segment: bool = True
                       pitch_roll=math.tan(gear.pressure_angle))
 
 
+#: The treatments of the ring body under its teeth that :func:`ring_tooth_model` accepts.
+RING_FOUNDATIONS = ("rigid",)
+
+
+def ring_tooth_model(gear: SpurGear, rim_radius: float, *, role: str | None = None,
+                     foundation: str = "rigid") -> ToothModel:
+    """The cantilever of an internal gear's (ring's) tooth, its rim's outer radius
+    ``rim_radius`` [m] (module docstring). The flanks are involutes of the base circle whose
+    roll angle t grows from the tip (inside) to the root circle (outside), at alpha =
+    alpha_2 + t; the cantilever is fixed at the root circle, alpha_root = alpha_2 +
+    sqrt(r_f^2 / r_b^2 - 1). ``foundation`` (:data:`RING_FOUNDATIONS`): ``"rigid"``, the ring
+    body outside the root circle does not deflect (no fillet-foundation term), which needs a
+    rim at least as thick as the teeth are high (r_rim - r_f >= r_f - r_a; refused otherwise)."""
+    role = role or gear.name
+    if foundation not in RING_FOUNDATIONS:
+        raise ParameterError("ring_foundation", foundation,
+                             f"must be one of {', '.join(RING_FOUNDATIONS)}")
+    r_b, r_f, r_a = gear.base_radius, gear.root_radius, gear.tip_radius
+    height = r_f - r_a
+    if not (math.isfinite(rim_radius) and rim_radius - r_f >= height):
+        raise ParameterError(f"{role}.bore_radius", rim_radius,
+                             f"the ring's outer (rim) radius must be at least the root radius"
+                             f" {r_f:.6g} m plus the tooth height {height:.6g} m (a rim thinner"
+                             f" than the teeth is not a rigid body): >= {r_f + height:.6g} m")
+    a2 = math.pi / gear.teeth - 0.5 * gear.angular_thickness(r_b)
+    t_f = math.sqrt((r_f / r_b) ** 2 - 1.0)
+    t_a = math.sqrt((r_a / r_b) ** 2 - 1.0)
+    return ToothModel(name=role, base_radius=r_b, root_radius=r_f, half_base_angle=a2,
+                      top=a2 + t_f, tip=a2 + t_a, segment=None,
+                      theta_f=a2 + t_f - math.atan(t_f), bore_radius=rim_radius,
+                      fillet=(0.0, 0.0, 0.0, 0.0), pitch_roll=math.tan(gear.pressure_angle),
+                      internal=True)
+
+
 @lru_cache(maxsize=8)
 def _gauss(nodes: int) -> tuple[np.ndarray, np.ndarray]:
     x, w = np.polynomial.legendre.leggauss(nodes)
@@ -191,8 +251,13 @@ def _gauss(nodes: int) -> tuple[np.ndarray, np.ndarray]:
 
 
 def contact_point(tooth: ToothModel, alpha1: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(x_c, h_c) [m] of the contact at load angle ``alpha1`` [rad] in the tooth's frame."""
+    """(x_c, h_c) [m] of the contact at load angle ``alpha1`` [rad] in the tooth's frame (the
+    flank point at alpha = -alpha1, or alpha = alpha1 on a ring's tooth)."""
     r_b, a2 = tooth.base_radius, tooth.half_base_angle
+    if tooth.internal:
+        roll = alpha1 - a2
+        return (r_b * (np.cos(alpha1) + roll * np.sin(alpha1)),
+                r_b * (np.sin(alpha1) - roll * np.cos(alpha1)))
     roll = alpha1 + a2
     return (r_b * (np.cos(alpha1) + roll * np.sin(alpha1)),
             r_b * (roll * np.cos(alpha1) - np.sin(alpha1)))
@@ -208,7 +273,8 @@ def crack_limit(tooth: ToothModel, h_q: float) -> float:
     """alpha_c: the involute parameter above which (towards the root) the flank's half thickness
     exceeds h_q, the crack tip's distance from the centre line (Tian's crack limit line runs
     from the tip parallel to the centre line until it meets the flank); the tooth tip's alpha if
-    the line reaches the tip. h(alpha) rises with alpha for alpha < 0."""
+    the line reaches the tip. h(alpha) rises with alpha for alpha < 0 (external tooth) and for
+    alpha > 0 (a ring's tooth, up to its root circle)."""
     r_b, a2 = tooth.base_radius, tooth.half_base_angle
 
     def h(a: float) -> float:
@@ -216,7 +282,7 @@ def crack_limit(tooth: ToothModel, h_q: float) -> float:
 
     if h(tooth.tip) >= h_q:
         return tooth.tip
-    lo, hi = tooth.tip, 0.0
+    lo, hi = tooth.tip, (tooth.top if tooth.internal else 0.0)
     for _ in range(200):
         mid = 0.5 * (lo + hi)
         if h(mid) < h_q:
@@ -281,10 +347,14 @@ def _involute_piece(tooth: ToothModel, a1: np.ndarray, lower: np.ndarray, upper:
     cos_al, sin_al = np.cos(al), np.sin(al)
     h = r_b * (sin_al + phi * cos_al)
     x = r_b * (cos_al - phi * sin_al)
-    dx = r_b * phi * cos_al * half * wg
     x_c, h_c = contact_point(tooth, a1)
     cos1, sin1 = np.cos(a1), np.sin(a1)
-    arm = cos1[..., None] * (x_c[..., None] - x) - (sin1 * h_c)[..., None]
+    if tooth.internal:  # the root lies outside the contact: x > x_c, dx/dalpha > 0
+        dx = -r_b * phi * cos_al * half * wg
+        arm = cos1[..., None] * (x - x_c[..., None]) - (sin1 * h_c)[..., None]
+    else:
+        dx = r_b * phi * cos_al * half * wg
+        arm = cos1[..., None] * (x_c[..., None] - x) - (sin1 * h_c)[..., None]
     if section is None:
         inertia, area = (2.0 / 3.0) * h ** 3 * b, 2.0 * h * b
     else:
@@ -371,9 +441,15 @@ def tooth_compliances(tooth: ToothModel, alpha1: np.ndarray, *, young: float, po
       (:meth:`PotentialEnergyPair.wear_profile`); fillet unchanged.
 
     ``crack=`` is the deprecated spelling of ``fault=`` for a root crack. A
-    :class:`BrokenTooth` has no compliance (refused)."""
+    :class:`BrokenTooth` has no compliance (refused). A ring's tooth (``tooth.internal``) is
+    integrated from alpha = alpha1 to its root circle, takes a root crack (as above, the
+    crack limit line running from the crack tip towards the ring's tooth tip) and no other
+    fault, and its fillet term is 0 (rigid ring body)."""
     fault = _one_fault(fault, crack, "tooth_compliances")
     a1 = np.asarray(alpha1, dtype=float)
+    if tooth.internal:
+        return _ring_compliances(tooth, a1, young=young, poisson=poisson,
+                                 face_width=face_width, nodes=nodes, fault=fault)
     lower = -a1
     if np.any(lower >= tooth.top):
         raise ParameterError(f"{tooth.name}.dedendum", None,
@@ -428,10 +504,46 @@ def tooth_compliances(tooth: ToothModel, alpha1: np.ndarray, *, young: float, po
             "fillet": fillet_compliance(tooth, a1, young=young, face_width=face_width)}
 
 
+def _ring_compliances(tooth: ToothModel, a1: np.ndarray, *, young: float, poisson: float,
+                      face_width: float, nodes: int,
+                      fault: Fault | None) -> dict[str, np.ndarray]:
+    """:func:`tooth_compliances` of a ring's tooth: healthy, or with a :class:`RootCrack`
+    (Tian's crack limit line from the crack tip towards the tip; sections towards the root
+    beyond it h + h_q thick)."""
+    crack = isinstance(fault, RootCrack) and not fault.is_null
+    if fault is not None and not crack and (isinstance(fault, BrokenTooth)
+                                            or not fault.is_null):
+        raise ParameterError(f"{getattr(fault, 'kind', 'fault')}.gear", tooth.name,
+                             "on a ring's tooth only a root crack or a missing tooth is"
+                             " modelled")
+    if np.any(a1 >= tooth.top):
+        raise ParameterError(f"{tooth.name}.dedendum", None,
+                             "a contact lies at or beyond the root circle of the ring's tooth")
+    g = young / (2.0 * (1.0 + poisson))
+    top = np.full(a1.shape, tooth.top)
+    if crack:
+        _check_crack(fault, tooth)  # type: ignore[arg-type]
+        h_q = root_half_thickness(tooth) - fault.reach  # type: ignore[union-attr]
+        split = np.maximum(a1, crack_limit(tooth, h_q))
+        bend_h, area_h = _involute_piece(tooth, a1, a1, split, None, young, face_width, nodes)
+        bend_c, area_c = _involute_piece(tooth, a1, split, top, _crack_section(h_q, face_width),
+                                         young, face_width, nodes)
+        bending, inv_area = bend_h + bend_c, area_h + area_c
+    else:
+        bending, inv_area = _involute_piece(tooth, a1, a1, top, None, young, face_width, nodes)
+    cos1, sin1 = np.cos(a1), np.sin(a1)
+    return {"bending": bending, "shear": 1.2 * cos1 ** 2 / g * inv_area,
+            "axial": sin1 ** 2 / young * inv_area,
+            "fillet": fillet_compliance(tooth, a1, young=young, face_width=face_width)}
+
+
 def fillet_compliance(tooth: ToothModel, alpha1: np.ndarray, *, young: float,
                       face_width: float) -> np.ndarray:
-    """Sainsot's fillet-foundation compliance 1/k_f [m/N] at the load angles ``alpha1``."""
+    """Sainsot's fillet-foundation compliance 1/k_f [m/N] at the load angles ``alpha1``; 0 on a
+    ring's tooth (rigid ring body)."""
     a1 = np.asarray(alpha1, dtype=float)
+    if tooth.internal:
+        return np.zeros(a1.shape)
     x_c, h_c = contact_point(tooth, a1)
     u_f = x_c - h_c * np.tan(a1) - tooth.root_radius
     s_f = 2.0 * tooth.root_radius * tooth.theta_f
@@ -471,9 +583,12 @@ class PotentialEnergyPair:
         line of action from the pitch point (positive towards the pinion's tip)."""
         mesh = self.mesh
         s1 = self.pinion.base_radius * math.tan(mesh.operating_pressure_angle) + position
+        a_p = s1 / self.pinion.base_radius - self.pinion.half_base_angle
+        if mesh.internal:  # the ring's tangent point lies beyond the pinion's, on the same side
+            s2 = self.wheel.base_radius * math.tan(mesh.operating_pressure_angle) + position
+            return a_p, s2 / self.wheel.base_radius + self.wheel.half_base_angle
         s2 = mesh.line_of_action_length - s1
-        return (s1 / self.pinion.base_radius - self.pinion.half_base_angle,
-                s2 / self.wheel.base_radius - self.wheel.half_base_angle)
+        return (a_p, s2 / self.wheel.base_radius - self.wheel.half_base_angle)
 
     def _flank(self, gear: str) -> tuple[Callable, Callable]:
         """(position of roll, roll of position): the line-of-action position s [m] of the contact
@@ -484,6 +599,9 @@ class PotentialEnergyPair:
             r_b = mesh.pinion.base_radius
             return (lambda t: r_b * t - s_p), (lambda s: (s + s_p) / r_b)
         r_b, length = mesh.wheel.base_radius, mesh.line_of_action_length
+        if mesh.internal:
+            s_w = r_b * math.tan(mesh.operating_pressure_angle)
+            return (lambda t: r_b * t - s_w), (lambda s: (s + s_w) / r_b)
         return (lambda t: length - s_p - r_b * t), (lambda s: (length - s_p - s) / r_b)
 
     def archard_rate(self, gear: str, position: np.ndarray) -> np.ndarray:
@@ -504,7 +622,8 @@ class PotentialEnergyPair:
             if inside.any():
                 total[inside] += self.terms(other[inside])["pair"]
         rho1 = mesh.pinion.base_radius * math.tan(mesh.operating_pressure_angle) + s
-        rho2 = mesh.line_of_action_length - rho1
+        rho2 = (mesh.wheel.base_radius * math.tan(mesh.operating_pressure_angle) + s
+                if mesh.internal else mesh.line_of_action_length - rho1)
         ratio = mesh.pinion.teeth / mesh.wheel.teeth  # omega_2 / omega_1
         slip = (np.abs(1.0 - ratio * rho2 / rho1) if gear == "pinion"
                 else np.abs(1.0 - rho1 / (ratio * rho2)))
@@ -582,7 +701,7 @@ class PotentialEnergyPair:
         healthy). A spall on the loaded flank narrows the Hertz contact to b - w where the
         contact lies on it (Chaari, Baccar, Abbes & Haddar 2008; the wider spall where both
         teeth have one there); ``coast``: the contacts are on the coast flanks, which a spall
-        does not touch."""
+        does not touch. A ring's ``fillet_wheel`` is inf (rigid ring body)."""
         pos = np.asarray(position, dtype=float)
         a_p, a_w = self.load_angles(pos)
         kw = dict(young=self.young, poisson=self.poisson, face_width=self.face_width,
@@ -602,7 +721,8 @@ class PotentialEnergyPair:
             comp = tooth_compliances(tooth, a1, fault=fault, wear_profile=self.profile_of(fault),
                                      **kw)
             for term, c in comp.items():
-                out[f"{term}_{role}"] = 1.0 / c
+                rigid = tooth.internal and term == "fillet"  # the ring body: c = 0
+                out[f"{term}_{role}"] = np.full(c.shape, np.inf) if rigid else 1.0 / c
                 compliance = compliance + c
         out["pair"] = 1.0 / compliance
         return out
@@ -638,14 +758,12 @@ def _fault_tuple(faults: object, crack: object, where: str) -> tuple[object, ...
 def prepare_pair(mesh: GearMesh, *, bore_radius: object, young: object = STEEL_YOUNG,
                  poisson: object = STEEL_POISSON, root_segment: bool = True,
                  nodes: int = DEFAULT_NODES, faults: object = (),
-                 crack: RootCrack | None = None) -> PotentialEnergyPair:
+                 crack: RootCrack | None = None,
+                 ring_foundation: str = "rigid") -> PotentialEnergyPair:
     """Validate the inputs of :func:`potential_energy_stiffness` and build both teeth (their
     ``start_roll`` at the mesh's lowest contacts). ``crack=`` is the deprecated spelling of
     ``faults=(crack,)``."""
     fault_list = _fault_tuple(faults, crack, "prepare_pair")
-    if mesh.internal:
-        raise ParameterError("mesh.internal", True,
-                             "the potential-energy stiffness covers external pairs only")
     e = si_value("young", young, "pressure", 0.0, strict=True)
     try:
         nu = to_si(poisson, "dimensionless")
@@ -659,11 +777,17 @@ def prepare_pair(mesh: GearMesh, *, bore_radius: object, young: object = STEEL_Y
     teeth = []
     for role, gear, bore in (("pinion", mesh.pinion, bp), ("wheel", mesh.wheel, bw)):
         r = si_value(f"{role}.bore_radius", bore, "length", 0.0, strict=True)
-        teeth.append(tooth_model(gear, r, root_segment=root_segment, role=role))
+        teeth.append(tooth_model(gear, r, root_segment=root_segment, role=role,
+                                 ring_foundation=ring_foundation))
     # the lowest contacts: the pinion's at the start of the path, the wheel's at its end
     s1 = mesh.pinion.base_radius * math.tan(mesh.operating_pressure_angle)
-    starts = ((s1 - mesh.approach_length) / mesh.pinion.base_radius,
-              (mesh.line_of_action_length - s1 - mesh.recess_length) / mesh.wheel.base_radius)
+    if mesh.internal:  # the ring's deepest contact (nearest its root) at the end of the path
+        s2 = mesh.wheel.base_radius * math.tan(mesh.operating_pressure_angle)
+        wheel_start = (s2 + mesh.recess_length) / mesh.wheel.base_radius
+    else:
+        wheel_start = ((mesh.line_of_action_length - s1 - mesh.recess_length)
+                       / mesh.wheel.base_radius)
+    starts = ((s1 - mesh.approach_length) / mesh.pinion.base_radius, wheel_start)
     teeth = [replace(t, start_roll=max(start, 0.0)) for t, start in zip(teeth, starts,
                                                                          strict=True)]
     width = min(mesh.pinion.face_width, mesh.wheel.face_width)
@@ -696,6 +820,10 @@ def _check_faults(faults: tuple[object, ...], mesh: GearMesh, teeth: list[ToothM
                                  f" has a fault ({seen[key]!r}): one fault a tooth")
         seen[key] = fault
         tooth = teeth[0] if fault.gear == "pinion" else teeth[1]
+        if tooth.internal and not isinstance(fault, (BrokenTooth, RootCrack)):
+            raise ParameterError(f"{kind}.gear", fault.gear,
+                                 "on the ring's teeth only a root crack or a missing tooth"
+                                 " (BrokenTooth) is modelled; put the fault on the pinion")
         if isinstance(fault, RootCrack):
             _check_crack(fault, tooth)
         elif isinstance(fault, Spall):
@@ -851,11 +979,13 @@ def potential_energy_stiffness(mesh: GearMesh, *, bore_radius: object, angles: o
                                young: object = STEEL_YOUNG, poisson: object = STEEL_POISSON,
                                root_segment: bool = True, nodes: int = DEFAULT_NODES,
                                faults: object = (), cycles: int = 1,
-                               crack: RootCrack | None = None) -> xr.Dataset:
-    """Mesh stiffness of the external spur ``mesh`` over pinion angles by the potential-energy
-    method (module docstring): a Dataset over ``angle`` (pinion rotation [deg]; an int
-    ``angles`` is that many points per mesh cycle, 360/z1 deg, over ``cycles`` mesh cycles from
-    the passage of pinion tooth 0 and wheel tooth 0 through the pitch point; or give the angles)
+                               crack: RootCrack | None = None,
+                               ring_foundation: str = "rigid") -> xr.Dataset:
+    """Mesh stiffness of the spur ``mesh`` (external, or a pinion in a ring) over pinion angles
+    by the potential-energy method (module docstring): a Dataset over ``angle`` (pinion
+    rotation [deg]; an int ``angles`` is that many points per mesh cycle, 360/z1 deg, over
+    ``cycles`` mesh cycles from the passage of pinion tooth 0 and wheel tooth 0 through the
+    pitch point; or give the angles)
     with coordinates ``cycle`` (mesh cycles) and ``pair`` (pair k passes the pitch point k mesh
     cycles before the start of the current cycle n = floor(cycle): its contact lies
     (cycle - n + k) p_b beyond the pitch point, between pinion tooth (n - k) mod z1 and wheel
@@ -883,10 +1013,17 @@ def potential_energy_stiffness(mesh: GearMesh, *, bore_radius: object, angles: o
     zone between the flanks). Faults sit on the drive flank: a crack, a spall or wear thins the
     tooth's sections under either flank's load (crack faces taken open); a spall's contact
     width and wear's gap act on the drive flank only; a missing tooth carries on neither.
+
+    An internal ``mesh`` (``mesh.internal``): the wheel is the ring, its terms (``*_wheel``)
+    the ring tooth's (:func:`ring_tooth_model`); ``bore_radius``'s second value is the ring's
+    outer (rim) radius; ``ring_foundation`` (:data:`RING_FOUNDATIONS`) treats the ring body
+    (``"rigid"``: ``k_fillet_wheel`` is inf). On the ring's teeth a :class:`RootCrack` and a
+    :class:`BrokenTooth` are modelled; a spall or wear there is refused.
     """
     fault_list = _fault_tuple(faults, crack, "potential_energy_stiffness")
     pair = prepare_pair(mesh, bore_radius=bore_radius, young=young, poisson=poisson,
-                        root_segment=root_segment, nodes=nodes, faults=fault_list)
+                        root_segment=root_segment, nodes=nodes, faults=fault_list,
+                        ring_foundation=ring_foundation)
     cyc, n, frac = _cycle_grid(mesh, angles, cycles)
     deg = cyc * (360.0 / mesh.pinion.teeth)
     p_b = mesh.base_pitch
@@ -921,7 +1058,7 @@ def potential_energy_stiffness(mesh: GearMesh, *, bore_radius: object, angles: o
                                    else _units(name))
     ds["angle"].attrs.update(units="deg", long_name="pinion rotation")
     ds["cycle"].attrs.update(units="", long_name="mesh cycles")
-    ds.attrs.update(_attrs(pair, root_segment))
+    ds.attrs.update(_attrs(pair, root_segment, ring_foundation))
     return ds
 
 
@@ -948,7 +1085,8 @@ def _terms_on_grid(pair: PotentialEnergyPair, position: np.ndarray, inside: np.n
     return out
 
 
-def _attrs(pair: PotentialEnergyPair, root_segment: bool) -> dict[str, object]:
+def _attrs(pair: PotentialEnergyPair, root_segment: bool,
+           ring_foundation: str) -> dict[str, object]:
     mesh = pair.mesh
     out: dict[str, object] = {
         "method": "potential energy (Yang & Lin 1987; Tian 2004; Chaari et al. 2009) with the"
@@ -964,6 +1102,12 @@ def _attrs(pair: PotentialEnergyPair, root_segment: bool) -> dict[str, object]:
         "faults": "; ".join(f.describe() for f in pair.faults) or "none",
         "faulty_gears": ",".join(sorted({f.gear for f in pair.faults})),
     }
+    if mesh.internal:
+        out["internal"] = 1
+        out["ring_foundation"] = ring_foundation
+        out["method"] = (f"{out['method']}; the ring's tooth a cantilever on its involute from"
+                         " its root circle (Chen & Shao 2013; Liang, Zuo & Feng 2015), its body"
+                         f" {ring_foundation}")
     for role, tooth in (("pinion", pair.pinion), ("wheel", pair.wheel)):
         out[f"{role}_bore_radius_m"] = tooth.bore_radius
         out[f"{role}_h_fi"] = tooth.h_fi

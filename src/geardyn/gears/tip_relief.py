@@ -113,6 +113,34 @@ def _solve(k: np.ndarray, e: np.ndarray, force: float) -> tuple[np.ndarray, np.n
     return delta, (k > 0.0) & (e < delta[:, None])
 
 
+def force_value(force: object) -> float:
+    """``force`` [N] as a finite float > 0, else a ParameterError naming ``force``."""
+    try:
+        f = float(force)  # type: ignore[arg-type]
+    except (TypeError, ValueError):
+        raise ParameterError("force", force, "must be a number of newtons") from None
+    if not (math.isfinite(f) and f > 0.0):
+        raise ParameterError("force", force, "must be a finite force > 0 N")
+    return f
+
+
+def load_sharing(k: np.ndarray, inside: np.ndarray, e: np.ndarray,
+                 force: float) -> dict[str, np.ndarray]:
+    """The contacts of each row (one pinion angle) of k [N/m] (0 out of contact), ``inside``
+    and gaps e [m] sharing the normal force ``force`` [N] by equal approach (module
+    docstring): ``delta`` [m], ``loaded`` (mask), ``force`` [N] per contact, ``e_min`` [m] (the
+    unloaded transmission error), ``tangent`` and ``secant`` [N/m]. A row without contact is
+    refused (field ``stiffness``)."""
+    if not inside.any(axis=1).all():
+        raise ParameterError("stiffness", None, "an angle has no pair in contact (a missing"
+                             " tooth in single contact leaves the gears free there)")
+    delta, loaded = _solve(k, e, force)
+    e_min = np.min(np.where(inside, e, np.inf), axis=1)
+    return {"delta": delta, "loaded": loaded,
+            "force": np.where(loaded, k * (delta[:, None] - e), 0.0), "e_min": e_min,
+            "tangent": np.where(loaded, k, 0.0).sum(axis=1), "secant": force / (delta - e_min)}
+
+
 def loaded_contact(mesh: GearMesh, stiffness: xr.Dataset, force: float,
                    relief: tuple[TipRelief, ...] = ()) -> xr.Dataset:
     """The loaded static transmission error and mesh stiffness of ``stiffness`` (a Dataset of
@@ -124,34 +152,23 @@ def loaded_contact(mesh: GearMesh, stiffness: xr.Dataset, force: float,
     (delta), ``tangent_stiffness`` and ``secant_stiffness`` [N/m], ``pairs_loaded``; over
     (``angle``, ``pair``): ``gap`` [m] (NaN out of contact), ``pair_force`` [N]. Without relief
     the tangent stiffness is ``mesh_stiffness`` bitwise."""
-    try:
-        f = float(force)
-    except (TypeError, ValueError):
-        raise ParameterError("force", force, "must be a number of newtons") from None
-    if not (math.isfinite(f) and f > 0.0):
-        raise ParameterError("force", force, "must be a finite force > 0 N")
+    f = force_value(force)
     relief = tuple(relief)
     k = stiffness["pair_stiffness"].values
     inside = stiffness["in_contact"].values
-    if not inside.any(axis=1).all():
-        raise ParameterError("stiffness", None, "an angle has no pair in contact (a missing"
-                             " tooth in single contact leaves the gears free there)")
     e = relief_gap(mesh, stiffness["position"].values, relief)
     if "fault_gap" in stiffness:
         e = e + stiffness["fault_gap"].values
-    delta, loaded = _solve(k, e, f)
-    pair_force = np.where(loaded, k * (delta[:, None] - e), 0.0)
-    e_min = np.min(np.where(inside, e, np.inf), axis=1)
-    tangent = np.where(loaded, k, 0.0).sum(axis=1)
+    out = load_sharing(k, inside, e, f)
     dims = ("angle", "pair")
     ds = xr.Dataset(
-        {"unloaded_transmission_error": (("angle",), e_min),
-         "transmission_error": (("angle",), delta),
-         "tangent_stiffness": (("angle",), tangent),
-         "secant_stiffness": (("angle",), f / (delta - e_min)),
-         "pairs_loaded": (("angle",), loaded.sum(axis=1)),
+        {"unloaded_transmission_error": (("angle",), out["e_min"]),
+         "transmission_error": (("angle",), out["delta"]),
+         "tangent_stiffness": (("angle",), out["tangent"]),
+         "secant_stiffness": (("angle",), out["secant"]),
+         "pairs_loaded": (("angle",), out["loaded"].sum(axis=1)),
          "gap": (dims, np.where(inside, e, np.nan)),
-         "pair_force": (dims, pair_force)},
+         "pair_force": (dims, out["force"])},
         coords={c: stiffness.coords[c] for c in ("angle", "cycle", "pair")})
     units = {"unloaded_transmission_error": "m", "transmission_error": "m", "gap": "m",
              "tangent_stiffness": "N/m", "secant_stiffness": "N/m", "pairs_loaded": "",

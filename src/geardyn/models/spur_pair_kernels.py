@@ -84,10 +84,12 @@ def contact_force(x, PT, k, s, c):
     b = PT[BACKLASH, k]
     n = int(PT[N_HARM, k])
     if x > b:
-        return flank_stiffness(PT, k, KD0, n, s, c) * (x - b)
-    if x < -b:
-        return flank_stiffness(PT, k, KD0 + 1 + 2 * n, n, s, c) * (x + b)
-    return 0.0
+        row, deflection = KD0, x - b
+    elif x < -b:
+        row, deflection = KD0 + 1 + 2 * n, x + b
+    else:
+        return 0.0
+    return flank_stiffness(PT, k, row, n, s, c) * deflection
 
 
 @nb.njit(inline="always", **_JIT)
