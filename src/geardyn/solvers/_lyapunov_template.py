@@ -89,14 +89,14 @@ from geardyn.solvers._step_core import (  # CORE-IMPORT
     STATUS_DIVERGED,
     STATUS_OK,
     STATUS_SPLIT_LIMIT,
-    _events_i,
+    _events_columns,
     _events_l,
     _healthy,
     _lane_form,
     _NoAliasCompiler,
     _padded,
     _pick,
-    _rhs_i,
+    _rhs_columns,
     _rhs_l,
     _rows_step,
     _side,
@@ -358,28 +358,6 @@ BLOCK_ROWS = 64
 ROW_PAD = 1
 
 
-@nb.njit(inline="always", **_JIT)
-def _rows_rhs_generic(T, Y, DY, PT, P, LANE, nr, SP, CP, SC, ybuf, dbuf):
-    ns = Y.shape[0]
-    for r in range(nr):
-        for q in range(ns):
-            ybuf[q] = Y[q, r]
-        _rhs_i(T[r], ybuf, dbuf, P[LANE[r]], SP[r], CP[r])
-        for q in range(ns):
-            DY[q, r] = dbuf[q]
-
-
-@nb.njit(inline="always", **_JIT)
-def _rows_events_generic(T, Y, G, PT, P, LANE, nr, SP, CP, ybuf, gb):
-    ns = Y.shape[0]
-    for r in range(nr):
-        for q in range(ns):
-            ybuf[q] = Y[q, r]
-        _events_i(T[r], ybuf, gb, P[LANE[r]], SP[r], CP[r])
-        for j in range(G.shape[0]):
-            G[j, r] = gb[j]
-
-
 if "rhs_lanes" in globals():  # the model's lane-block functions (see .kernels), inlined
     _rhs_lm = nb.njit(**_INLINE)(rhs_lanes.py_func)  # noqa: F821
     _events_lm = nb.njit(**_INLINE)(events_lanes.py_func)  # noqa: F821
@@ -394,8 +372,8 @@ if "rhs_lanes" in globals():  # the model's lane-block functions (see .kernels),
         _events_lm(T, Y, G, PT, nr, SP, CP)
 
 else:
-    _rows_rhs = _rows_rhs_generic
-    _rows_events = _rows_events_generic
+    _rows_rhs = _rhs_columns
+    _rows_events = _events_columns
 
 
 @nb.njit(inline="always", **_JIT)

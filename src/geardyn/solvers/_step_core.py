@@ -343,6 +343,32 @@ def _rk4_stages(t, y, h, p, s1, c1, s2, c2, k1, kst, acc, tmp, out):
 
 
 @nb.njit(inline="always", **_JIT)
+def _rhs_columns(T, Y, DY, PT, P, LANE, nl, S, C, SC, ybuf, dbuf):
+    """The model's rhs of columns 0..nl-1 of Y (one lane or tangent row each, coefficients
+    P[LANE[k]]) into DY, one column at a time through the array form (ybuf, dbuf: one state
+    each); for models without lane-block functions."""
+    ns = Y.shape[0]
+    for k in range(nl):
+        for q in range(ns):
+            ybuf[q] = Y[q, k]
+        _rhs_i(T[k], ybuf, dbuf, P[LANE[k]], S[k], C[k])
+        for q in range(ns):
+            DY[q, k] = dbuf[q]
+
+
+@nb.njit(inline="always", **_JIT)
+def _events_columns(T, Y, G, PT, P, LANE, nl, S, C, ybuf, gb):
+    """The model's events of columns 0..nl-1 of Y into G (as :func:`_rhs_columns`)."""
+    ns = Y.shape[0]
+    for k in range(nl):
+        for q in range(ns):
+            ybuf[q] = Y[q, k]
+        _events_i(T[k], ybuf, gb, P[LANE[k]], S[k], C[k])
+        for j in range(G.shape[0]):
+            G[j, k] = gb[j]
+
+
+@nb.njit(inline="always", **_JIT)
 def _split_rhs(t, y, out, p, s, c):
     """The model's rhs f(t, y) into out, on the split path (for a model with lane-scalar
     functions: the lane form, see below)."""
