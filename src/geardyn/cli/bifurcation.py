@@ -51,7 +51,7 @@ from geardyn.cli.common import (
     write_outputs,
 )
 from geardyn.errors import ParameterError, StudyError
-from geardyn.study import build_model
+from geardyn.study import build_model, study_omega
 
 __all__ = ["bifurcation_command", "parse_range", "plot_command", "register"]
 
@@ -263,6 +263,7 @@ def bifurcation_command(
     interp = interpretation.value if interpretation is not None else None
     model = build_model(s, interpretation=interp, omega=om)
     _check_param_name(model, name)
+    om = study_omega(s, model, om)
     if range_ is not None:
         start, stop, num = parse_range(range_)
         range_text = range_

@@ -58,7 +58,7 @@ from geardyn.cli.common import (
 )
 from geardyn.core.status import Status
 from geardyn.errors import ParameterError, StudyError
-from geardyn.study import build_model
+from geardyn.study import build_model, study_omega
 
 __all__ = ["EXIT_ERROR", "EXPECTED_ERRORS", "app", "main"]
 
@@ -234,7 +234,8 @@ def simulate(
     study: Annotated[str, typer.Argument(help="Study TOML file or built-in study name.")],
     omega: Annotated[
         float | None,
-        typer.Option(help="Mesh frequency Omega = omega/omega_n (default: the study's run.omega)."),
+        typer.Option(help="Mesh frequency Omega = omega/omega_n (default: the study's run.omega; "
+                          "a spur_pair study's: from its params.speed)."),
     ] = None,
     transient: run_option("transient", "default: run.transient") = None,
     periods: run_option("samples", "forcing periods recorded; default: run.periods",
@@ -254,7 +255,12 @@ def simulate(
     from geardyn.solvers.simulate import simulate as run_simulation
 
     s = load_study_source(study)
+    interp = interpretation.value if interpretation is not None else None
     om = omega if omega is not None else s.run.omega
+    base = None
+    if om is None and s.study.model == "spur_pair":  # Omega from the study's params.speed
+        base = build_model(s, interpretation=interp)
+        om = study_omega(s, base)
     if om is None:
         raise StudyError("--omega: not given, and the study has no run.omega")
     if not usable_omega(om):
@@ -271,8 +277,7 @@ def simulate(
     if spp is not None:
         check_count("--steps-per-period", spp)
     plot_state = state or s.plot_state
-    interp = interpretation.value if interpretation is not None else None
-    model = build_model(s, interpretation=interp, omega=om)
+    model = base if base is not None else build_model(s, interpretation=interp, omega=om)
     known = (*model.state_names, *model.observable_names)
     if plot is not None and plot_state not in known and f"{plot_state}1" not in known:
         raise ParameterError("--state" if state else "study.plot_state", plot_state,
