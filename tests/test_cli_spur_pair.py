@@ -242,3 +242,49 @@ def test_errors_when_building_name_the_field(tmp_path, capsys):
 def test_a_spur_pair_study_needs_its_gears():
     with pytest.raises(ValidationError, match="gears"):
         load_study('[study]\nmodel = "spur_pair"\n[params]\nspeed = 100.0\ntorque = 10.0\n')
+
+
+def test_params_show(capsys, by_hand):
+    r = run(capsys, "params", "show", STUDY)
+    assert r.returncode == 0, r.stderr
+    wn = math.sqrt(by_hand.drive_series[0] / by_hand.coefficient_values()["mass"])
+    assert f"sqrt(k_mean / m) = {wn:.6g} rad/s" in r.stdout
+    assert "18000 rpm" in r.stdout and "19 mesh cycles per forcing period" in r.stdout
+
+
+def test_default_transient_is_in_forcing_periods(by_hand):
+    """Without [run], a spur pair study's transient is 50 forcing periods of the run's lowest
+    Omega (not [run].transient's 4000, a dimensionless time: 4000 s here)."""
+    doc = _document()
+    del doc["run"]
+    s = load_study_dict(doc)
+    om = by_hand.omega
+    assert s.run_settings(omega=om).transient == pytest.approx(50 * 2 * math.pi / om,
+                                                               rel=1e-15)
+
+
+def test_save_and_load_round_trip(tmp_path, by_hand):
+    from geardyn.io.toml import save_study
+
+    save_study(builtin_study(STUDY), tmp_path / "s.toml")
+    again = load_study(tmp_path / "s.toml")
+    assert build_model(again).params.tobytes() == by_hand.params.tobytes()
+
+
+def test_explorer_overrides_and_sweeps_speed(tmp_path, by_hand):
+    """The explorer on the study: a speed window in rpm without [run].omega, a torque override
+    as the study file would give it, the diagram's axis in rpm."""
+    from geardyn.cli.errors import format_error
+    from geardyn.explore.compute import compute_diagram, diagram_view
+    from geardyn.explore.state import ExplorerState, Window
+
+    st = ExplorerState(builtin_study(STUDY), STUDY, window=Window(14000.0, 24000.0, 2),
+                       save_dir=tmp_path, describe_error=format_error)
+    assert "torque" in st.main_params()
+    assert st.set_override("torque", "30 N m") is None
+    assert st.model.params.tobytes() == by_hand.with_params(torque=30.0).params.tobytes()
+    assert "N*m" in st.set_override("torque", "30 N")
+    ds = compute_diagram(st.diagram_request())
+    assert ds["speed"].attrs["units"] == "rpm"
+    assert np.array_equal(ds["speed"].values, [14000.0, 24000.0])
+    assert diagram_view(ds).x.size == 2 * ds.sizes["sample"]

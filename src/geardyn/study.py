@@ -89,7 +89,7 @@ def spur_pair_model(study: Study, omega: float | None = None) -> SpurPair:
     dyn = study.params.model_dump()  # type: ignore[union-attr]
     period = dyn.get("period")
     table = study.stiffness
-    if table is not None and "cycles" in table.model_fields_set:
+    if table is not None and table.cycles is not None:
         faulty = sorted({getattr(f, "gear", None) for f in kw.get("faults", ())} - {None})
         try:
             want = period_cycles(mesh, period or (faulty[0] if faulty else "pinion"))

@@ -206,7 +206,8 @@ def bifurcation_command(
     range_: Annotated[
         str | None,
         typer.Option("--range", help="START:STOP:NUM, NUM evenly spaced values (default: the "
-                                     "study's sweep table); SI units for the device's parameters."),
+                                     "study's sweep table); SI units for the device's parameters,"
+                                     " a spur pair's speed in its params.speed_unit."),
     ] = None,
     continuation: Annotated[
         Continuation | None,

@@ -159,6 +159,9 @@ def params_show(
         out.print(table)
         out.print("natural frequency (in contact): 1 (unit of dimensionless time)")
         return
+    if s.study.model == "spur_pair":
+        _show_spur_pair(out, model)
+        return
     if s.study.model == "planetary":
         out.print(f"{escape(repr(model))}: time scale omega_0 = {_fmt(model.time_scale)} rad/s, "
                   f"length scale L = {_fmt(model.length_scale)} m")
@@ -211,6 +214,33 @@ def params_show(
         f"{n} = {_fmt(f)} N" for n, f in zip(model.observable_names, forces, strict=True)
     )
     out.print(f"static mesh forces under the mean loads: {names}")
+
+
+def _show_spur_pair(out: Console, model) -> None:
+    """The spur pair's inputs and derived coefficients (SI; the stiffness series summarised),
+    its natural frequency and the series' truncation error."""
+    from geardyn.models.spur_pair_coefficients import HEADER
+
+    out.print(escape(repr(model)))
+    table = Table(title="SpurPair coefficients (SI)")
+    for col in ("name", "value", "unit", "meaning"):
+        table.add_column(col, justify="right" if col == "value" else "left")
+    values = model.coefficient_values()
+    for c in HEADER.entries:
+        table.add_row(c.name, _fmt(float(values.get(c.name, model.params[HEADER.offset(
+            c.name)]))), escape(c.unit), escape(c.meaning))
+    out.print(table)
+    wn = float(model.natural_frequencies()[0])
+    err = model.stiffness_error()
+    i1, i2 = model.inertia
+    out.print(f"pinion speed {_fmt(model.speed)} rad/s = {_fmt(model.speed * 30 / math.pi)} "
+              f"rpm; mesh frequency {_fmt(model.mesh_frequency / (2 * math.pi))} Hz; "
+              f"{model.cycles} mesh cycles per forcing period")
+    out.print(f"inertias I1 = {_fmt(i1)}, I2 = {_fmt(i2)} kg m^2; natural frequency in "
+              f"contact sqrt(k_mean / m) = {_fmt(wn)} rad/s ({_fmt(wn / (2 * math.pi))} Hz)")
+    out.print(f"stiffness series: {model.n_harmonics} harmonics of Omega per flank; error "
+              f"against the table (of k_mean) rms {err['drive_rms']:.3g}, max "
+              f"{err['drive_max']:.3g} (drive)")
 
 
 @params_app.command("save")

@@ -668,8 +668,9 @@ class StiffnessTable(BaseModel):
     model_config = _CONFIG
 
     angles: Whole = Field(360, ge=1, description="pinion angles per mesh cycle")
-    cycles: Whole | Literal["hunting"] = Field(
-        1, description="mesh cycles from tooth 0's pitch-point passage, or \"hunting\"")
+    cycles: Whole | Literal["hunting"] | None = Field(
+        None, description="mesh cycles from tooth 0's pitch-point passage, or \"hunting\" "
+        "(default 1; a spur_pair model's: its forcing period)")
     nodes: Whole = Field(DEFAULT_NODES, ge=4, description="Gauss-Legendre nodes")
     root_segment: bool = Field(True, description="straight flank from the root to the base "
                                "circle in the cantilever")
@@ -684,7 +685,10 @@ class StiffnessTable(BaseModel):
         return value
 
     def mesh_cycles(self, mesh: GearMesh) -> int:
-        """The number of mesh cycles: ``cycles``, or lcm(z1, z2) for ``"hunting"``."""
+        """The number of mesh cycles: ``cycles`` (default 1), or lcm(z1, z2) for
+        ``"hunting"``."""
+        if self.cycles is None:
+            return 1
         if self.cycles == "hunting":
             return math.lcm(mesh.pinion.teeth, mesh.wheel.teeth)
         return int(self.cycles)
