@@ -288,3 +288,14 @@ def test_explorer_overrides_and_sweeps_speed(tmp_path, by_hand):
     assert ds["speed"].attrs["units"] == "rpm"
     assert np.array_equal(ds["speed"].values, [14000.0, 24000.0])
     assert diagram_view(ds).x.size == 2 * ds.sizes["sample"]
+
+
+def test_the_bifurcation_figure_labels_the_states_unit(tmp_path, by_hand):
+    """x [m], not dimensionless: the sweep records the model's state units."""
+    from geardyn.plotting.bifurcation import plot_bifurcation
+
+    ds = geardyn.bifurcation(by_hand, "speed", np.array([14000.0, 15000.0]) * RPM,
+                             run=geardyn.RunSettings(transient=0.01, samples=2))
+    assert ds.attrs["state_units"] == "m, m/s"
+    fig = plot_bifurcation(ds, state="v")
+    assert "[m/s]" in fig.axes[0].get_ylabel()
