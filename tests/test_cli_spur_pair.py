@@ -191,8 +191,8 @@ def test_params_table_is_the_declared_inputs():
            **inspect.signature(geardyn.SpurPair.from_geometry).parameters}
     for i in INPUTS:
         assert i.name in sig, i.name
-        if not i.required and i.name != "period":
-            assert sig[i.name].default == i.default, i.name
+        assert sig[i.name].default == (inspect.Parameter.empty if i.required else i.default), \
+            i.name
 
 
 def _document(**params: object) -> dict:
@@ -208,7 +208,8 @@ def _document(**params: object) -> dict:
 
 @pytest.mark.parametrize(("key", "value"), [
     ("stiffnes", 1.0), ("inertia", [1e-3]), ("harmonics", 0), ("period", "axle"),
-    ("zeta", -0.1), ("torque", "20 N"), ("speed_unit", "rad/min"),
+    ("zeta", -0.1), ("torque", "20 N"), ("speed_unit", "rad/min"), ("speed", "50 N"),
+    ("speed", -1.0), ("speed", "-3 rpm"), ("backlash", "-1 um"),
 ])
 def test_bad_params_name_the_field(key, value):
     with pytest.raises(ValidationError) as err:

@@ -89,6 +89,7 @@ from typing import Annotated, Any, Literal
 
 import tomli_w
 from pydantic import (
+    AfterValidator,
     BaseModel,
     BeforeValidator,
     ConfigDict,
@@ -385,6 +386,14 @@ GearPairParams = study_table(
     "``[params]`` of a ``gear_pair`` study: the arguments of :class:`~geardyn.GearPair`.")
 
 
+def _frequency_text(value: float | str) -> float | str:
+    """A speed as given: a number >= 0 (in the model's speed_unit), or a unit string that reads
+    as an angular frequency >= 0 (e.g. "3000 rpm")."""
+    if (to_si(value, "frequency") if isinstance(value, str) else value) < 0:
+        raise ValueError("must be >= 0")
+    return value
+
+
 def _input_field(i: PhysicalInput) -> tuple[Any, Any]:
     """The pydantic type and field of one declared physical input."""
     default = ... if i.required else i.default
@@ -396,8 +405,8 @@ def _input_field(i: PhysicalInput) -> tuple[Any, Any]:
         one = Annotated[float, BeforeValidator(lambda v, k=i.unit_kind: to_si(v, k)),
                         Field(gt=0)]
         kind = Annotated[list[one], Field(min_length=2, max_length=2)]  # type: ignore[valid-type]
-    elif i.kind == "frequency":  # a number in speed_unit, or a unit string (rad/s)
-        kind = Real | str
+    elif i.kind == "frequency":  # a number in speed_unit, or a unit string (kept as given)
+        kind = Annotated[Real | str, AfterValidator(_frequency_text)]
     else:
         kind = Annotated[float, BeforeValidator(lambda v, k=i.kind: to_si(v, k)),
                          Field(**i.bounds())]
