@@ -9,7 +9,7 @@ A *study file* holds the device parameters plus run settings::
     [study]
     name = "fig3"
     description = "Paper Fig. 3"
-    model = "catt"                  # or "gear_pair", "planetary"
+    model = "catt"                  # or "gear_pair", "planetary", "spur_pair"
     interpretation = "consistent"   # consistent | carrier-only | as-printed
     plot_state = "X_sq"             # the coordinate figures show
     [params]                        # PlanetaryParams fields (nested tables), or:
@@ -50,6 +50,13 @@ of ``[params]``::
     angles = 360                    #   "hunting", nodes, root_segment
     cycles = "hunting"
 
+For ``model = "spur_pair"`` the model is :meth:`geardyn.SpurPair.from_geometry` of the
+``[gears]``, ``[[faults]]`` and ``[stiffness]`` tables, and ``[params]``
+(:class:`SpurPairParams`, generated from SpurPair's declared inputs) holds its dynamics:
+``speed`` (a number in ``speed_unit``: rad/s, rpm or Hz; or a unit string), ``torque``,
+``inertia`` ([I1, I2]), ``zeta``, ``backlash``, ``error``, ``error_phase``, ``harmonics``,
+``period``; its runs are in seconds, and the default transient is
+:data:`DEFAULT_TRANSIENT_PERIODS` forcing periods.
 For ``model = "gear_pair"`` the ``[params]`` table holds :class:`~geardyn.GearPair` arguments
 (``zeta``, ``kappa``, ``Fm``, ``Fa``, ``Omega``, ``kappa_phase``, ``error_phase``, ``backlash``).
 For ``model = "planetary"`` it holds :class:`~geardyn.PlanetaryGearSet` arguments
@@ -416,8 +423,8 @@ def _input_field(i: PhysicalInput) -> tuple[Any, Any]:
 def spur_pair_table(inputs: tuple[PhysicalInput, ...] = SPUR_PAIR_INPUTS) -> type[BaseModel]:
     """``[params]`` of a ``spur_pair`` study, generated from the declared physical inputs of
     :class:`~geardyn.SpurPair` (:data:`~geardyn.models.spur_pair_coefficients.INPUTS`): one
-    field per input (SI numbers or unit strings; speed a number in ``speed_unit`` or a unit
-    string, checked when the model is built), unknown keys refused naming the field."""
+    field per input (SI numbers or unit strings; speed a number in ``speed_unit`` or the unit
+    string of an angular frequency, kept as given), unknown keys refused naming the field."""
     fields = {i.name: _input_field(i) for i in inputs}
     return create_model("SpurPairParams", __config__=_CONFIG, __module__=__name__,
                         __doc__=spur_pair_table.__doc__, **fields)
