@@ -28,7 +28,9 @@ from geardyn.core.plan import (
 from geardyn.core.settings import (
     LYAPUNOV_BLOCKS,
     LYAPUNOV_DT,
+    LYAPUNOV_PERIODS,
     LYAPUNOV_RENORM_EVERY,
+    LYAPUNOV_TRANSIENT_PERIODS,
     MIN_STEPS,
     LyapunovSettings,
     RunSettings,
@@ -69,13 +71,18 @@ class LyapunovEstimate:
     the edge-location split limit and were integrated unsplit across an edge;
     ``status``: :attr:`~geardyn.Status.OK`, :attr:`~geardyn.Status.DIVERGED` (value NaN) or
     :attr:`~geardyn.Status.SPLIT_LIMIT` (``unresolved`` > 0: the value is kept, but it rests
-    on steps that are not 4th order across an edge)."""
+    on steps that are not 4th order across an edge);
+    ``duration``: the time averaged over (model time units, whole forcing periods) and
+    ``duration_rule`` where it came from (``LyapunovSettings.duration``, or the model's default
+    scale, :meth:`geardyn.Model.lyapunov_duration`)."""
 
     value: float | np.ndarray
     stderr: float | np.ndarray
     n_blocks: int
     unresolved: int = 0
     status: Status = Status.OK
+    duration: float = math.nan
+    duration_rule: str = ""
 
     @property
     def ok(self) -> bool:
@@ -103,6 +110,23 @@ def lyapunov_unresolved_attrs() -> dict[str, str]:
         "meaning": "steps of the state or of a finite-difference neighbour integrated unsplit "
                    "across an edge (chattering); > 0: the exponent is kept but less accurate "
                    "(geardyn.Status.SPLIT_LIMIT)"}
+
+
+def _duration(model: Model, ls: LyapunovSettings) -> tuple[float | None, str]:
+    """The time averaged over (None: :data:`LYAPUNOV_PERIODS` forcing periods of each lane)
+    and its rule: ``ls.duration``, else the model's default scale."""
+    if ls.duration is not None:
+        return ls.duration, "LyapunovSettings.duration"
+    return model.lyapunov_duration()
+
+
+def _periods_transient(model: Model, run: RunSettings | None, keywords: dict[str, Any]
+                       ) -> bool:
+    """Whether the transient is the default in forcing periods
+    (:data:`LYAPUNOV_TRANSIENT_PERIODS`): no run and no transient given, a forced model of
+    physical time (its default of :data:`LYAPUNOV_DEFAULTS` is in dimensionless time)."""
+    return (run is None and "transient" not in keywords and not model.dimensionless_time
+            and model.omega_index is not None)
 
 
 def _check_blocks(n_blocks: int) -> int:
@@ -180,7 +204,9 @@ def lyapunov(
         ``duration``, not ``samples``). Those four as keyword arguments instead (not together
         with ``run``) are deprecated: one DeprecationWarning naming the equivalent
         ``run=geardyn.RunSettings(...)``. Without either, ``transient`` is 100 time units (not
-        RunSettings' 4000) and the rest RunSettings' defaults.
+        RunSettings' 4000; for a forced model of physical time
+        :data:`~geardyn.core.settings.LYAPUNOV_TRANSIENT_PERIODS` forcing periods) and the rest
+        RunSettings' defaults.
     y0
         Initial state (default: ``model.initial_state()``), at time ``t0``.
     t0
@@ -192,7 +218,9 @@ def lyapunov(
         attractor. A state at another forcing phase cannot be started (the phase is tabulated
         on the period-aligned grid from zero).
     settings
-        :class:`~geardyn.LyapunovSettings`: ``duration`` (time averaged over), ``dt`` (step of
+        :class:`~geardyn.LyapunovSettings`: ``duration`` (time averaged over; default the
+        model's scale, :meth:`geardyn.Model.lyapunov_duration`: 2000 time units of a
+        dimensionless model, 200 forcing periods of one in seconds), ``dt`` (step of
         an autonomous model), ``renorm_every``, ``n_blocks``. Its fields given as keyword
         arguments are deprecated (a DeprecationWarning).
     transient, duration
@@ -224,9 +252,11 @@ def lyapunov(
     For a forced model the exponent of the flow's zero direction (along the forcing phase) is not
     included: the phase is not a state, so a forced model with n states has n exponents.
     """
+    in_periods = _periods_transient(model, run, keywords)
     run, ls = _lyapunov_run(run, settings, keywords, "lyapunov")
     transient, steps_per_period, bound = run.transient, run.steps_per_period, run.bound
-    duration, dt, renorm_every, n_blocks = ls.duration, ls.dt, ls.renorm_every, ls.n_blocks
+    dt, renorm_every, n_blocks = ls.dt, ls.renorm_every, ls.n_blocks
+    duration, rule = _duration(model, ls)
     y = _initial(model, y0)
     t0 = float(t0)
     if not math.isfinite(t0):
@@ -252,8 +282,10 @@ def lyapunov(
             raise ValueError(f"steps_per_period must be >= {MIN_STEPS} (got {n_per})")
         period = forcing_period(om)
         h = period / n_per
-        n_tr = periods_covering(transient, period) * n_per
-        n_st = max(1, periods_covering(duration, period)) * n_per
+        n_tr = (LYAPUNOV_TRANSIENT_PERIODS if in_periods
+                else periods_covering(transient, period)) * n_per
+        n_st = (LYAPUNOV_PERIODS if duration is None
+                else max(1, periods_covering(duration, period))) * n_per
     renorm = int(DEFAULT_RENORM_EVERY if renorm_every is None else renorm_every)
     if renorm < 1:
         raise ValueError(f"renorm_every must be >= 1 (got {renorm_every!r})")
@@ -273,7 +305,7 @@ def lyapunov(
     else:
         value, err = float(ex[0]), float(er[0])
     if with_error:
-        return LyapunovEstimate(value, err, int(used), int(unres), status)
+        return LyapunovEstimate(value, err, int(used), int(unres), status, n_st * h, rule)
     if status == Status.SPLIT_LIMIT:
         warnings.warn(f"lyapunov: {int(unres)} grid steps reached the edge-split limit and were "
                       "integrated unsplit across an edge (status SPLIT_LIMIT); the exponent is "
@@ -300,7 +332,9 @@ def lyapunov_lanes(
     ``model.initial_state()``. ``run`` and ``settings`` as in :func:`lyapunov`: of the
     :class:`~geardyn.RunSettings` ``transient``, ``steps_per_period``, ``locate_edges`` and
     ``bound`` are used (as keyword arguments, not together with ``run``: deprecated; without either,
-    ``transient`` is 100 time units), of the :class:`~geardyn.LyapunovSettings` ``duration``,
+    ``transient`` is 100 time units, or for a forced model of physical time
+    :data:`~geardyn.core.settings.LYAPUNOV_TRANSIENT_PERIODS` forcing periods of each lane), of
+    the :class:`~geardyn.LyapunovSettings` ``duration``,
     ``dt``, ``renorm_every`` and ``n_blocks`` (its fields as keyword arguments: deprecated, a
     DeprecationWarning). ``transient`` and ``duration`` are times, rounded up to whole forcing
     periods of each lane (lanes differ in Omega, so their step counts differ). The grid has
@@ -318,9 +352,11 @@ def lyapunov_lanes(
     :class:`~geardyn.Status` code (as in :class:`LyapunovEstimate`; exponents kept where
     SPLIT_LIMIT, NaN where DIVERGED).
     """
+    in_periods = _periods_transient(model, run, keywords)
     run, ls = _lyapunov_run(run, settings, keywords, "lyapunov_lanes")
     transient, steps_per_period, bound = run.transient, run.steps_per_period, run.bound
-    duration, dt, renorm_every, n_blocks = ls.duration, ls.dt, ls.renorm_every, ls.n_blocks
+    dt, renorm_every, n_blocks = ls.dt, ls.renorm_every, ls.n_blocks
+    duration, _ = _duration(model, ls)
     P = np.ascontiguousarray(np.atleast_2d(np.asarray(P, dtype=float)))
     L = P.shape[0]
     if P.shape[1] != model.params.size:
@@ -358,9 +394,11 @@ def lyapunov_lanes(
         n_lane = lane_steps(model, P, steps_per_period)
         periods = forcing_period(OMEGA)
         H = periods / n_lane
-        n_tr = np.array([periods_covering(transient, T) * n
+        n_tr = np.array([(LYAPUNOV_TRANSIENT_PERIODS if in_periods
+                          else periods_covering(transient, T)) * n
                          for T, n in zip(periods, n_lane, strict=True)], dtype=np.int64)
-        n_st = np.array([max(1, periods_covering(duration, T)) * n
+        n_st = np.array([(LYAPUNOV_PERIODS if duration is None
+                          else max(1, periods_covering(duration, T))) * n
                          for T, n in zip(periods, n_lane, strict=True)], dtype=np.int64)
     renorm = int(DEFAULT_RENORM_EVERY if renorm_every is None else renorm_every)
     if renorm < 1:

@@ -372,6 +372,29 @@ class Model:
         """A copy with the forcing frequency set to ``omega``."""
         return self.with_params(Omega=omega)
 
+    @property
+    def dimensionless_time(self) -> bool:
+        """Whether the model's time is dimensionless (``time_unit`` "1", e.g. tau = omega_n t)
+        rather than physical (seconds)."""
+        return self.time_unit in ("1", "")
+
+    def lyapunov_duration(self) -> tuple[float | None, str]:
+        """The default time a Lyapunov estimate averages over, in the model's time unit, and
+        the rule that gave it: :data:`~geardyn.core.settings.LYAPUNOV_DURATION` (2000) time
+        units for a model of dimensionless time; for one of physical time
+        :data:`~geardyn.core.settings.LYAPUNOV_PERIODS` forcing periods (None: that many
+        periods of each lane's own Omega); an autonomous model of physical time has no
+        scale to count (a ValueError: give ``LyapunovSettings(duration=...)``)."""
+        from geardyn.core.settings import LYAPUNOV_DURATION, LYAPUNOV_PERIODS
+
+        if self.dimensionless_time:
+            return LYAPUNOV_DURATION, f"default: {LYAPUNOV_DURATION:g} time units"
+        if self.omega_index is None:
+            raise ValueError(f"{self.name} is autonomous in {self.time_unit}: no forcing period"
+                             " to scale the Lyapunov duration by; give "
+                             "LyapunovSettings(duration=...)")
+        return None, f"default: {LYAPUNOV_PERIODS} forcing periods"
+
     def dataset_attrs(self) -> dict[str, object]:
         """Attributes every dataset of this model records (none here; e.g. the CATT device's
         ``interpretation`` and ``omega_n``)."""

@@ -367,8 +367,12 @@ class ContinuationSettings(_AnalysisSettings):
                                 f"ds={self.ds!r}, ds_max={self.ds_max!r})")
 
 
-#: Defaults of the Lyapunov estimate.
+#: Defaults of the Lyapunov estimate: the time averaged over in a model of dimensionless time
+#: (time unit "1"), and in a model of physical time (seconds) that many forcing periods, and
+#: its default transient (where no run is given) in forcing periods.
 LYAPUNOV_DURATION = 2000.0
+LYAPUNOV_PERIODS = 200
+LYAPUNOV_TRANSIENT_PERIODS = 20
 LYAPUNOV_DT = 0.01
 LYAPUNOV_RENORM_EVERY = 10
 LYAPUNOV_BLOCKS = 16
@@ -380,7 +384,11 @@ class LyapunovSettings(_AnalysisSettings):
     :func:`geardyn.lyapunov_lanes`); the transient, steps and bound are the run's.
 
     duration
-        Time averaged over, in the model's time unit, rounded up to whole forcing periods (> 0).
+        Time averaged over, in the model's time unit, rounded up to whole forcing periods
+        (> 0). None (default): the model's own scale, :meth:`geardyn.Model.lyapunov_duration`:
+        :data:`LYAPUNOV_DURATION` time units for a model of dimensionless time, and
+        :data:`LYAPUNOV_PERIODS` forcing periods for one of physical time (a spur pair in
+        seconds).
     dt
         Step of an autonomous model (> 0; None: :data:`LYAPUNOV_DT`); not for a forced model,
         whose grid has the run's steps per period.
@@ -390,7 +398,8 @@ class LyapunovSettings(_AnalysisSettings):
         Blocks of the measuring window for the standard error (>= 2).
     """
 
-    duration: float = _field(LYAPUNOV_DURATION, "positive", "time averaged over")
+    duration: float | None = _field(None, "optional-positive", "time averaged over (default: "
+                                    "the model's scale)")
     dt: float | None = _field(None, "optional-positive",
                               f"step of an autonomous model (default {LYAPUNOV_DT})")
     renorm_every: int = _field(LYAPUNOV_RENORM_EVERY, "whole",
