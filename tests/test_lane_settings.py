@@ -15,6 +15,7 @@ import geardyn
 from geardyn.core.plan import LanePlan, LaneSettings
 from geardyn.core.settings import RunSettings
 from geardyn.solvers.ensemble import LaneResults, run_lanes
+from test_lyapunov import lorenz_model
 
 PAIR = geardyn.GearPair(zeta=0.05, kappa=0.2, Fm=0.1, Fa=0.2)
 OMEGAS = np.array([0.6, 0.9, 1.3])
@@ -179,3 +180,66 @@ def test_lane_plan_keywords_warn_once():
         np.testing.assert_array_equal(getattr(old, name), getattr(new, name), err_msg=name)
     with pytest.raises(TypeError, match="not both"):
         LanePlan.build(PAIR, P, run, LaneSettings(), t0=np.zeros(3))
+
+
+# ------------------------------------------------------------------ simulate and lyapunov
+@pytest.mark.parametrize("omega", [0.45, 0.92, 1.7])
+def test_simulate_is_the_sweeps_lane_planned_without_the_ladder(omega):
+    """simulate plans its run as a one-lane LanePlan (the step rule's own count): its
+    Poincare points are bitwise the sweep's lane with ladder=False, and its step counts those
+    of the plan; the sweep's default (the ladder) rounds the same rule up."""
+    g = geardyn.GearPair(zeta=0.02, kappa=0.2, Fm=0.1, Fa=0.3)
+    run = RunSettings(transient=37.0, samples=6)
+    ds = geardyn.simulate(g, omega, run)
+    P = g.lane_params("Omega", [omega])
+    plan = LanePlan.build(g, P, run, LaneSettings(ladder=False, sample_every=1))
+    n = geardyn.default_steps_per_period(g, omega)
+    assert ds.attrs["steps_per_period"] == plan.steps_per_period[0] == n
+    assert ds.attrs["step"] == plan.step[0] == 2 * math.pi / omega / n
+    assert ds.attrs["transient_periods"] == plan.transient_periods[0] == math.ceil(
+        37.0 * omega / (2 * math.pi))
+    lane = run_lanes(g, P, g.initial_state(), run=run,
+                     lanes=LaneSettings(ladder=False, sample_every=1))
+    np.testing.assert_array_equal(lane.samples[0], ds["poincare"].values[1:])
+    np.testing.assert_array_equal(lane.final[0], ds["poincare"].values[-1])
+    laddered = LanePlan.build(g, P, run, LaneSettings(sample_every=1))
+    assert laddered.steps_per_period[0] >= n
+
+
+def test_autonomous_lanes_take_an_interval():
+    """An unforced lane (interval in place of the forcing period): the step is the interval
+    over the steps, the transient whole intervals; sample_every and too few steps refused."""
+    lor = lorenz_model()
+    run = RunSettings(transient=1.0, samples=4)
+    plan = LanePlan.build(lor, lor.params[None], run, LaneSettings(interval=0.37, ladder=False))
+    assert plan.omega.tolist() == [0.0] and plan.period.tolist() == [0.37]
+    assert plan.steps_per_period.tolist() == [64]  # the rule's floor: no forcing, no modes
+    assert plan.step[0] == 0.37 / 64 and plan.transient_periods.tolist() == [3]
+    ds = geardyn.simulate(lor, run=run, sample_interval=0.37)
+    assert ds.attrs["step"] == plan.step[0] and ds.attrs["transient_periods"] == 3
+    one = LanePlan.build(lor, lor.params[None], run, LaneSettings(interval=0.01,
+                                                                 steps_per_period=1))
+    assert one.transient_steps.tolist() == [100] and one.window_steps(0.5).tolist() == [50]
+    with pytest.raises(ValueError, match="sample_every applies to forced lanes"):
+        LaneSettings(interval=0.1, sample_every=2)
+    with pytest.raises(ValueError, match=r"steps_per_period must be >= 4 \(got 1\)"):
+        LaneSettings(steps_per_period=1)
+    with pytest.raises(ValueError, match="interval must be a finite time > 0"):
+        LaneSettings(interval=0.0)
+
+
+def test_lyapunov_is_the_lanes_exponent_on_the_same_plan():
+    """lyapunov's one lane and lyapunov_lanes' lane agree when both plan the same steps: the
+    single run's default (the rule's count) given to the lanes as the run's steps."""
+    g = geardyn.GearPair(zeta=0.02, kappa=0.2, Fm=0.1, Fa=0.3)
+    ls = geardyn.LyapunovSettings(duration=120.0, n_blocks=4)
+    omega = 0.92
+    n = geardyn.default_steps_per_period(g, omega)
+    one = geardyn.lyapunov(g.with_omega(omega), run=RunSettings(transient=40.0), settings=ls,
+                           with_error=True)
+    lanes = geardyn.lyapunov_lanes(g, g.lane_params("Omega", [omega]),
+                                   run=RunSettings(transient=40.0, steps_per_period=n),
+                                   settings=ls, with_status=True)
+    np.testing.assert_allclose(lanes[0][0], one.value, rtol=1e-12, atol=1e-14)
+    assert lanes[3][0] == one.status
+

@@ -172,8 +172,15 @@ def test_lyapunov_lanes_use_the_run_as_lyapunov_does():
 #: Names that moved: (old home, name, new home).
 MOVED = [
     ("geardyn.models.base", "Model", "geardyn.core.model"),
+    ("geardyn.models.base", "unique_rows", "geardyn.core.model"),
+    ("geardyn.solvers.simulate", "MIN_STEPS_PER_PERIOD", "geardyn.core.plan"),
+    ("geardyn.solvers.simulate", "STEPS_PER_FASTEST_MODE", "geardyn.core.plan"),
     ("geardyn.solvers.simulate", "STEPS_PER_OTHER_FORCING", "geardyn.core.plan"),
+    ("geardyn.solvers.simulate", "steps_per_period_rule", "geardyn.core.plan"),
+    ("geardyn.solvers.simulate", "default_steps_per_period", "geardyn.core.plan"),
     ("geardyn.solvers.simulate", "DEFAULT_BOUND", "geardyn.core.settings"),
+    ("geardyn.solvers.ensemble", "_LADDER", "geardyn.core.plan"),
+    ("geardyn.solvers.ensemble", "ladder_steps", "geardyn.core.plan"),
     ("geardyn.solvers.ensemble", "lane_steps_per_period", "geardyn.core.plan"),
 ]
 
@@ -196,7 +203,7 @@ print(json.dumps(out))
 def test_old_homes_warn_once_and_nothing_uses_them():
     """In a fresh interpreter (``import geardyn`` itself warns nothing), each old home gives the
     moved object with one DeprecationWarning naming the new home, however often it is asked;
-    src/, docs/ and examples/ import nothing from an old home."""
+    src/, docs/, examples/, tests/ and bench/ import nothing from an old home."""
     import json
     import os
     import re
@@ -214,8 +221,8 @@ def test_old_homes_warn_once_and_nothing_uses_them():
         assert same
         assert record == [["DeprecationWarning", f"{old}.{name} is deprecated: import it "
                                                  f"from {new}"]]
-    files = [p for d in ("src", "docs", "examples") for p in (root / d).rglob("*")
-             if p.suffix in (".py", ".md", ".rst")]
+    files = [p for d in ("src", "docs", "examples", "tests", "bench") for p in (root / d).rglob("*")
+             if p.suffix in (".py", ".md", ".rst") and p.name != Path(__file__).name]
     for old, name, _ in MOVED:
         pattern = re.compile(rf"from {re.escape(old)} import[^\n]*\b{name}\b|"
                              rf"{re.escape(old)}\.{name}\b")

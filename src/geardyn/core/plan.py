@@ -196,11 +196,18 @@ class LaneSettings:
     transient, transient_max
         Times (>= 0) in place of the run's ``transient`` and ``transient_max``.
     steps_per_period
-        RK4 steps per forcing period in place of the run's (>= 4; <= 0: the lane's step
-        rule, :func:`lane_steps_per_period`).
+        RK4 steps per forcing period in place of the run's (>= 4, >= 1 with ``interval``;
+        <= 0: the lane's step rule).
     sample_every
         Forcing periods between samples (>= 1), or ``"auto"``: the common period of the
         model's forcings (:func:`lane_section`).
+    ladder
+        The step rule's count rounded up to the step ladder (:func:`lane_steps_per_period`,
+        as a sweep takes it) or, False, the rule's own count (:func:`default_steps_per_period`,
+        as a single run takes it).
+    interval
+        Unforced lanes (an autonomous model): the time (> 0) that takes the place of the
+        forcing period, sampled once; None: lanes forced at their Omega.
     """
 
     t0: Any = None
@@ -208,6 +215,8 @@ class LaneSettings:
     transient_max: Any = None
     steps_per_period: Any = None
     sample_every: Any = "auto"
+    ladder: bool = True
+    interval: float | None = None
 
     def __post_init__(self) -> None:
         put = object.__setattr__
@@ -220,12 +229,19 @@ class LaneSettings:
         for name in _LANE_TIMES:
             if getattr(self, name) is not None:
                 put(self, name, _lane_times(name, _lane_array(name, getattr(self, name), float)))
+        if self.interval is not None:
+            interval = float(self.interval)
+            if not (math.isfinite(interval) and interval > 0):
+                raise ValueError(f"interval must be a finite time > 0 (got {self.interval!r})")
+            put(self, "interval", interval)
         if self.steps_per_period is not None:
             n = _lane_array("steps_per_period", self.steps_per_period, np.int64)
-            small = (n > 0) & (n < MIN_STEPS)
+            least = MIN_STEPS if self.interval is None else 1
+            small = (n > 0) & (n < least)
             if np.any(small):
-                raise ValueError(f"steps_per_period must be >= {MIN_STEPS} (got {n[small][0]})")
+                raise ValueError(f"steps_per_period must be >= {least} (got {n[small][0]})")
             put(self, "steps_per_period", n)
+        put(self, "ladder", bool(self.ladder))
         if isinstance(self.sample_every, str):
             if self.sample_every != "auto":
                 raise ValueError(f"sample_every must be 'auto' or >= 1 "
@@ -235,6 +251,10 @@ class LaneSettings:
             if np.any(every < 1):
                 raise ValueError(f"sample_every must be >= 1 (got {every[every < 1][0]})")
             put(self, "sample_every", every)
+        if self.interval is not None and not (isinstance(self.sample_every, str)
+                                              or np.all(self.sample_every == 1)):
+            raise ValueError("sample_every applies to forced lanes (an interval is sampled "
+                             "once)")
 
     def per_lane(self, name: str, lanes: int) -> np.ndarray | None:
         """The field ``name`` with one value per lane (``lanes`` of them; a read-only view),
@@ -266,6 +286,20 @@ def _lane_array(name: str, value: Any, dtype: Any) -> np.ndarray:
     return out
 
 
+def _rule_steps(model: Any, P: np.ndarray, omega: np.ndarray, steps: Any) -> np.ndarray:
+    """Steps per period of each lane: ``steps`` (one, or one per lane; None or <= 0: the
+    step rule's own count at the lane's ``omega``, not rounded to the ladder)."""
+    L = P.shape[0]
+    n = np.broadcast_to(np.asarray(0 if steps is None else steps, dtype=np.int64), (L,)).copy()
+    auto = n <= 0
+    if np.any(auto):
+        rule = steps_per_period_rule(model, P[auto], omega[auto])
+        if not np.all(np.isfinite(rule)) or np.any(rule >= 2.0**62):
+            raise OverflowError("steps per period do not fit an integer; check Omega")
+        n[auto] = np.ceil(rule).astype(np.int64)
+    return n
+
+
 def _legacy_lanes(where: str, lanes: LaneSettings | None, overrides: dict[str, Any],
                   stacklevel: int) -> LaneSettings:
     """The :class:`LaneSettings` of ``overrides`` (its fields as deprecated keyword arguments
@@ -285,11 +319,12 @@ def _legacy_lanes(where: str, lanes: LaneSettings | None, overrides: dict[str, A
 class LanePlan:
     """Every lane's integration, in steps: derived once by :meth:`build`, read by the kernels.
 
-    Arrays are per lane (index = row of ``P``); periods are forcing periods of the lane."""
+    Arrays are per lane (index = row of ``P``); periods are forcing periods of the lane (of
+    unforced lanes: the ``interval`` of their :class:`LaneSettings`)."""
 
     settings: RunSettings
-    omega: np.ndarray  # (L,) forcing frequency
-    period: np.ndarray  # (L,) forcing period 2 pi / Omega
+    omega: np.ndarray  # (L,) forcing frequency (0: unforced)
+    period: np.ndarray  # (L,) forcing period 2 pi / Omega (unforced: the interval)
     steps_per_period: np.ndarray  # (L,) int64
     step: np.ndarray  # (L,) RK4 step h = period / steps_per_period
     sample_every: np.ndarray  # (L,) int64 forcing periods between samples (the section)
@@ -312,15 +347,24 @@ class LanePlan:
             raise TypeError(f"lanes must be a LaneSettings (got {type(lanes).__name__})")
         P = np.atleast_2d(P)
         L = P.shape[0]
-        omega = lane_omega(model, P)
-        if isinstance(lanes.sample_every, str):
-            every, commensurate = lane_section(model, P, omega, settings.max_section_periods)
+        if lanes.interval is not None:
+            omega, period = np.zeros(L), np.full(L, lanes.interval)
+            every, commensurate = np.ones(L, np.int64), np.ones(L, bool)
         else:
-            every, commensurate = lanes.per_lane("sample_every", L), np.ones(L, bool)
+            omega = lane_omega(model, P)
+            period = forcing_period(omega)
+            if isinstance(lanes.sample_every, str):
+                every, commensurate = lane_section(model, P, omega,
+                                                   settings.max_section_periods)
+            else:
+                every, commensurate = lanes.per_lane("sample_every", L), np.ones(L, bool)
         every = np.broadcast_to(np.asarray(every, dtype=np.int64), (L,)).copy()
         steps = lanes.per_lane("steps_per_period", L)
-        n = lane_steps(model, P, settings.steps_per_period if steps is None else steps)
-        period = forcing_period(omega)
+        steps = settings.steps_per_period if steps is None else steps
+        if lanes.ladder and lanes.interval is None:
+            n = lane_steps(model, P, steps)
+        else:
+            n = _rule_steps(model, P, omega, steps)
         tr = lanes.per_lane("transient", L)
         tr = np.full(L, settings.transient) if tr is None else tr
         n_tr = whole_multiples(periods_covering(tr, period), every)
@@ -337,6 +381,11 @@ class LanePlan:
                    transient_periods=n_tr, transient_max_periods=n_max, t0=start)
 
     # ------------------------------------------------------------------ in steps
+    def window_steps(self, time: float) -> np.ndarray:
+        """Steps of the whole periods that cover ``time`` (at least one) in each lane."""
+        periods = np.maximum(1, periods_covering(time, self.period))
+        return (periods * self.steps_per_period).astype(np.int64)
+
     @property
     def lanes(self) -> int:
         return int(self.omega.size)
