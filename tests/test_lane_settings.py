@@ -243,3 +243,21 @@ def test_lyapunov_is_the_lanes_exponent_on_the_same_plan():
     np.testing.assert_allclose(lanes[0][0], one.value, rtol=1e-12, atol=1e-14)
     assert lanes[3][0] == one.status
 
+
+
+def test_every_deprecated_keyword_warns_once_per_process():
+    """warn_deprecated serves every deprecated keyword (simulate's here): the first call
+    warns, the same keywords again do not (other values alike), other keywords do; after
+    forget_deprecations (what tests/conftest.py does before each test) it warns again."""
+    from geardyn.core.settings import forget_deprecations
+
+    g = geardyn.GearPair(zeta=0.05, kappa=0.0, Fm=0.1, Fa=0.05)
+    with warnings.catch_warnings(record=True) as record:
+        warnings.simplefilter("always")
+        geardyn.simulate(g, 0.8, periods=2, steps_per_period=64)
+        geardyn.simulate(g, 0.9, periods=3, steps_per_period=64)
+        geardyn.simulate(g, 0.8, periods=2)
+        forget_deprecations()
+        geardyn.simulate(g, 0.8, periods=2)
+    assert [str(w.message).split(" is ")[0] for w in _deprecations(record)] == [
+        "simulate(periods=, steps_per_period=)", "simulate(periods=)", "simulate(periods=)"]
