@@ -169,7 +169,7 @@ def test_lyapunov_lanes_use_the_run_as_lyapunov_does():
     assert np.all(np.abs(lanes[True] - lanes[False]) > 1e-6)
 
 
-#: Names that moved: (old home, name, new home).
+#: Names that moved: (old home, name, new home or ``new home:new name``).
 MOVED = [
     ("geardyn.models.base", "Model", "geardyn.core.model"),
     ("geardyn.models.base", "unique_rows", "geardyn.core.model"),
@@ -182,6 +182,10 @@ MOVED = [
     ("geardyn.solvers.ensemble", "_LADDER", "geardyn.core.plan"),
     ("geardyn.solvers.ensemble", "ladder_steps", "geardyn.core.plan"),
     ("geardyn.solvers.ensemble", "lane_steps_per_period", "geardyn.core.plan"),
+    ("geardyn.analysis.lyapunov", "DEFAULT_DT", "geardyn.core.settings:LYAPUNOV_DT"),
+    ("geardyn.analysis.lyapunov", "DEFAULT_RENORM_EVERY",
+     "geardyn.core.settings:LYAPUNOV_RENORM_EVERY"),
+    ("geardyn.analysis.lyapunov", "DEFAULT_BLOCKS", "geardyn.core.settings:LYAPUNOV_BLOCKS"),
 ]
 
 _OLD_HOMES = """
@@ -190,10 +194,11 @@ warnings.simplefilter("always")
 import geardyn
 out = []
 for old, name, new in json.loads(sys.argv[1]):
+    home, _, new_name = new.partition(":")
     with warnings.catch_warnings(record=True) as record:
         warnings.simplefilter("always")
         same = getattr(importlib.import_module(old), name) is getattr(
-            importlib.import_module(new), name)
+            importlib.import_module(home), new_name or name)
         getattr(importlib.import_module(old), name)
     out.append([same, [(w.category.__name__, str(w.message)) for w in record]])
 print(json.dumps(out))
@@ -218,9 +223,11 @@ def test_old_homes_warn_once_and_nothing_uses_them():
     got = json.loads(out.stdout.strip().splitlines()[-1])
     assert "DeprecationWarning" not in out.stderr  # import geardyn: nothing deprecated used
     for (old, name, new), (same, record) in zip(MOVED, got, strict=True):
+        home, _, new_name = new.partition(":")
+        as_ = f" as {new_name}" if new_name else ""
         assert same
         assert record == [["DeprecationWarning", f"{old}.{name} is deprecated: import it "
-                                                 f"from {new}"]]
+                                                 f"from {home}{as_}"]]
     files = [p for d in ("src", "docs", "examples", "tests", "bench") for p in (root / d).rglob("*")
              if p.suffix in (".py", ".md", ".rst") and p.name != Path(__file__).name]
     for old, name, _ in MOVED:

@@ -19,6 +19,7 @@ from typing import Any
 import numpy as np
 
 from geardyn.core.model import Model
+from geardyn.core.moved import moved
 from geardyn.core.plan import LanePlan, LaneSettings
 from geardyn.core.settings import (
     LYAPUNOV_BLOCKS,
@@ -34,20 +35,19 @@ from geardyn.core.settings import (
 from geardyn.core.status import Status
 from geardyn.solvers.kernels import kernels_for
 
-#: Defaults (LyapunovSettings'): the step of an autonomous model, RK4 steps between
-#: re-orthonormalisations, blocks of the measuring window for the standard error.
-DEFAULT_DT = LYAPUNOV_DT
-DEFAULT_RENORM_EVERY = LYAPUNOV_RENORM_EVERY
-DEFAULT_BLOCKS = LYAPUNOV_BLOCKS
+#: The defaults' earlier names here (deprecated): those of :mod:`geardyn.core.settings`.
+__getattr__ = moved(__name__, {
+    "DEFAULT_DT": "geardyn.core.settings:LYAPUNOV_DT",
+    "DEFAULT_RENORM_EVERY": "geardyn.core.settings:LYAPUNOV_RENORM_EVERY",
+    "DEFAULT_BLOCKS": "geardyn.core.settings:LYAPUNOV_BLOCKS"})
 
 #: Defaults of :func:`lyapunov` where they differ from :class:`~geardyn.RunSettings`'.
 LYAPUNOV_DEFAULTS = {"transient": 100.0}
 #: The :class:`~geardyn.RunSettings` fields that :func:`lyapunov` uses (as keywords: deprecated).
 LYAPUNOV_FIELDS = ("transient", "steps_per_period", "locate_edges", "bound")
 
-__all__ = ["DEFAULT_BLOCKS", "DEFAULT_DT", "DEFAULT_RENORM_EVERY", "LYAPUNOV_DEFAULTS",
-           "LyapunovEstimate", "lyapunov", "lyapunov_err_attrs", "lyapunov_lanes",
-           "lyapunov_unresolved_attrs"]
+__all__ = ["LYAPUNOV_DEFAULTS", "LyapunovEstimate", "lyapunov", "lyapunov_err_attrs",
+           "lyapunov_lanes", "lyapunov_unresolved_attrs"]
 
 
 @dataclass(frozen=True)
@@ -84,7 +84,7 @@ def lyapunov_err_attrs(time_unit: str) -> dict[str, str]:
         "units": f"1/{time_unit}",
         "meaning": "1-sigma statistical error of the finite-time exponent per unit model time; "
                    "NaN where lyapunov is NaN",
-        "method": f"batch means: the measuring window cut into n = {DEFAULT_BLOCKS} blocks of "
+        "method": f"batch means: the measuring window cut into n = {LYAPUNOV_BLOCKS} blocks of "
                   "whole forcing periods (fewer if shorter), std(block rates, ddof=1) / "
                   "sqrt(n); see docs/lyapunov.md, Uncertainty"}
 
@@ -130,11 +130,12 @@ SETTINGS_FIELDS = tuple(f.name for f in dataclasses.fields(LyapunovSettings))
 
 
 def _autonomous_step(steps_per_period: int | None, dt: float | None) -> float:
-    """The step of an autonomous model's Lyapunov run: ``dt`` (default :data:`DEFAULT_DT`);
-    a ValueError where the run gives steps per period instead."""
+    """The step of an autonomous model's Lyapunov run: ``dt`` (default
+    :data:`~geardyn.core.settings.LYAPUNOV_DT`); a ValueError where the run gives steps per
+    period instead."""
     if steps_per_period is not None:
         raise ValueError("steps_per_period applies to forced models; give dt instead")
-    h = DEFAULT_DT if dt is None else float(dt)
+    h = LYAPUNOV_DT if dt is None else float(dt)
     if not (h > 0 and math.isfinite(h)):
         raise ValueError(f"dt must be > 0 (got {dt!r})")
     return h
@@ -250,7 +251,7 @@ def lyapunov(
     plan = LanePlan.build(model, np.asarray(model.params, dtype=float)[None, :], run, lanes)
     n_per, h = int(plan.steps_per_period[0]), float(plan.step[0])
     n_tr, n_st = int(plan.transient_steps[0]), int(plan.window_steps(duration)[0])
-    renorm = int(DEFAULT_RENORM_EVERY if renorm_every is None else renorm_every)
+    renorm = int(LYAPUNOV_RENORM_EVERY if renorm_every is None else renorm_every)
     if renorm < 1:
         raise ValueError(f"renorm_every must be >= 1 (got {renorm_every!r})")
     k = model.n_states if spectrum else 1
@@ -347,7 +348,7 @@ def lyapunov_lanes(
     plan = LanePlan.build(model, P, run, lanes)
     OMEGA, H, n_per = plan.omega, plan.step, plan.steps_per_period
     n_tr, n_st = plan.transient_steps, plan.window_steps(duration)
-    renorm = int(DEFAULT_RENORM_EVERY if renorm_every is None else renorm_every)
+    renorm = int(LYAPUNOV_RENORM_EVERY if renorm_every is None else renorm_every)
     if renorm < 1:
         raise ValueError(f"renorm_every must be >= 1 (got {renorm_every!r})")
     out = np.full(L, np.nan)
