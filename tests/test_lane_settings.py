@@ -155,6 +155,8 @@ def test_both_spellings_at_once_are_errors():
         run_lanes(PAIR, P, y0, sample=3)
     with pytest.raises(TypeError, match="multiple values for argument 'transient'"):
         run_lanes(PAIR, P, y0, 30.0, transient=30.0)
+    with pytest.raises(TypeError, match=r"takes its settings as keywords: .*run=RunSettings"):
+        run_lanes(PAIR, P, y0, RunSettings())
     with pytest.raises(TypeError, match="run must be a RunSettings"):
         run_lanes(PAIR, P, y0, run={"samples": 3})
 

@@ -133,6 +133,9 @@ def _legacy_settings(args: tuple[Any, ...], keywords: dict[str, Any],
     settings as separate arguments (``args`` after ``y0``, ``keywords``), with one
     DeprecationWarning per process naming the replacement. Run fields beside ``run=``, lane
     fields beside ``lanes=``, and unknown or twice-given names are TypeErrors."""
+    if any(isinstance(a, (RunSettings, LaneSettings)) for a in args):
+        raise TypeError("run_lanes takes its settings as keywords: run_lanes(model, P, y0, "
+                        "run=RunSettings(...), lanes=LaneSettings(...))")
     if len(args) > len(LEGACY_ORDER):
         raise TypeError(f"run_lanes() takes at most {3 + len(LEGACY_ORDER)} positional "
                         f"arguments ({3 + len(args)} given)")
