@@ -113,7 +113,7 @@ class Model:
        the model alone; ``fastest_natural_frequency(P)`` gives one value per lane (row of
        ``P``), > 0 or NaN (unknown), and ``other_frequencies(P)`` one row per lane.
     10. **run matches reference** -- a short run of the compiled RK4 kernel at the default step
-        (:func:`~geardyn.solvers.simulate.default_steps_per_period`, which resolves
+        (:func:`~geardyn.core.plan.default_steps_per_period`, which resolves
         ``fastest_natural_frequency``), with edges located, ends ok and matches the reference
         integrator (:func:`~geardyn.reference_solution`, DOP853 at rtol 1e-12) in the states
         and the observables.
@@ -347,7 +347,7 @@ class Model:
         stiffness, no backlash) in each lane of the coefficient matrix ``P`` (default: this
         model's own coefficients), shape ``(lanes,)``; NaN where it is not known.
 
-        The default step (:func:`~geardyn.solvers.simulate.default_steps_per_period`) resolves
+        The default step (:func:`~geardyn.core.plan.default_steps_per_period`) resolves
         this frequency in every lane. The default here: a model that defines
         ``natural_frequencies()`` is asked once per distinct row of ``P`` (a copy of the model
         holding that row), so it must compute them from ``self.params``; any other model gets

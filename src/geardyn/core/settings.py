@@ -240,21 +240,46 @@ def settings_from_named(kind: type, named: Mapping[str, tuple[str, Any]]) -> Any
         raise ParameterError(where, value, reason.rsplit(" (got ", 1)[0]) from None
 
 
-def replacement(param: str, kind: type, fields: Mapping[str, Any]) -> str:
-    """The text ``param=geardyn.Kind(a=1, ...)`` naming the settings that replace keywords."""
-    args = ", ".join(f"{k}={v!r}" for k, v in fields.items())
-    return f"{param}=geardyn.{kind.__name__}({args})"
+def replacement(param: str, kind: type, fields: Mapping[str, Any], home: str = "geardyn"
+                ) -> str:
+    """The text ``param=geardyn.Kind(a=1, ...)`` naming the settings that replace keywords
+    (``home``: the module that exports ``Kind``; an array value is written as its length)."""
+    args = ", ".join(f"{k}={_shown(v)}" for k, v in fields.items())
+    return f"{param}={home}.{kind.__name__}({args})"
+
+
+def _shown(value: Any) -> str:
+    """``value`` as a deprecation message writes it: its repr, an array as ``<n values>``, a
+    zero-dimensional one as its number."""
+    shape = getattr(value, "shape", None)
+    if shape is None:
+        return repr(value)
+    return f"<{math.prod(shape)} values>" if shape else repr(value.item())
+
+
+#: The deprecations warned in this process: (function, its deprecated keywords).
+_WARNED: set[tuple[str, tuple[str, ...]]] = set()
 
 
 def warn_deprecated(where: str, keywords: Iterable[str], replacements: Sequence[str],
                     stacklevel: int) -> None:
-    """One DeprecationWarning: ``where``'s ``keywords`` are deprecated, pass the
-    ``replacements`` (``stacklevel``: the public function's caller, seen from the caller of
-    this function)."""
+    """One DeprecationWarning, once per process for each function and set of keywords:
+    ``where``'s ``keywords`` are deprecated, pass the ``replacements`` (``stacklevel``: the
+    public function's caller, seen from the caller of this function)."""
     import warnings
 
+    keywords = tuple(keywords)
+    if (where, keywords) in _WARNED:
+        return
+    _WARNED.add((where, keywords))
     warnings.warn(f"{where}({', '.join(f'{k}=' for k in keywords)}) is deprecated: pass "
                   f"{', '.join(replacements)}", DeprecationWarning, stacklevel=stacklevel + 1)
+
+
+def forget_deprecations() -> None:
+    """Let every deprecation of :func:`warn_deprecated` warn again (for tests: each test sees
+    the process as fresh)."""
+    _WARNED.clear()
 
 
 # ----------------------------------------------------------------------------- analyses
