@@ -7,8 +7,10 @@ their own module, so that editing a test does not change the generated kernels' 
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 import numba as nb
+import numpy as np
 
 import geardyn
 
@@ -43,7 +45,8 @@ def oscillator_rhs(t, y, dy, p):
     dy[1] = force - damping * v - restoring
 
 
-def oscillator(name: str = "oscillator", natural_frequency=None,
+def oscillator(name: str = "oscillator",
+               natural_frequency: float | Callable[[np.ndarray], float] | None = None,
                **coefficients: float) -> geardyn.UserModel:
     """The oscillator of :func:`oscillator_rhs` as a plain :class:`geardyn.UserModel` (states x,
     v), the coefficients by name (the others at their :data:`OSCILLATOR` defaults)."""
