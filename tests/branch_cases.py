@@ -1,5 +1,6 @@
-"""Compiled right-hand sides for the bifurcation tests of tests/test_branch_points.py, in their
-own module so that editing the tests does not change the generated kernels' digest."""
+"""The five-state compiled right-hand side of the slow bifurcation test of
+tests/test_branch_points.py, in its own module so that editing the tests does not change the
+generated kernels' digest."""
 
 from __future__ import annotations
 
@@ -19,14 +20,3 @@ def duffing_with_spectators(t, y, dy, p):
     dy[2] = -p[4] * y[2]
     dy[3] = y[4]
     dy[4] = -2.0 * p[5] * y[4] - y[3]
-
-
-@nb.njit(cache=True)
-def parametric_rayleigh(t, y, dy, p):
-    """x'' + 2 zeta x' + mu x^2 x' + (1 + kappa cos(Omega t)) x = 0; p = (Omega, zeta, kappa,
-    mu): the damped Mathieu equation about x = 0, with a damping that grows with the
-    amplitude."""
-    dy[0] = y[1]
-    dy[1] = (-2.0 * p[1] * y[1] - p[3] * y[0] * y[0] * y[1]
-             - (1.0 + p[2] * math.cos(p[0] * t)) * y[0])
-

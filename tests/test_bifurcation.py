@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import math
 
-import numba as nb
 import numpy as np
 import pytest
 
@@ -13,13 +12,7 @@ from geardyn.analysis.bifurcation import bifurcation
 from geardyn.analysis.periodicity import classify_period
 from geardyn.solvers.ensemble import run_lanes
 from geardyn.testing import assert_result
-
-
-@nb.njit(cache=True)
-def forced_oscillator(t, y, dy, p):
-    """x'' + 2 c x' + x = cos(Omega t), Omega = p[1]; unstable for c < 0."""
-    dy[0] = y[1]
-    dy[1] = -2.0 * p[0] * y[1] - y[0] + math.cos(p[1] * t)
+from shared_models import oscillator
 
 
 # ------------------------------------------------------------------ period classification
@@ -61,9 +54,9 @@ def test_lanes_reproduce_single_simulations_bitwise():
 
 
 def test_diverging_lane_is_marked_and_sweep_goes_on():
-    u = geardyn.UserModel(forced_oscillator, n_states=2, params=[0.05, 1.3],
-                          param_names=["c", "Omega"])
-    ds = bifurcation(u, param="c", values=[-0.2, 0.05, 0.1],
+    # x'' + 2 c x' + x = cos(Omega t): unstable for c < 0
+    u = oscillator(zeta=0.05, F=1.0, Omega=1.3)
+    ds = bifurcation(u, param="zeta", values=[-0.2, 0.05, 0.1],
                      run=geardyn.RunSettings(transient=500.0, samples=8, steps_per_period=256,
                                              bound=1e3))
     assert_result(ds, "bifurcation")

@@ -17,9 +17,10 @@ from scipy.optimize import brentq
 
 import geardyn
 import geardyn.testing
-from branch_cases import duffing_with_spectators, parametric_rayleigh
+from branch_cases import duffing_with_spectators
 from geardyn import BranchStatus
 from geardyn.plotting.branch import plot_branch
+from shared_models import oscillator
 
 
 def _monodromy(f, n: int, T: float, x0: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -196,9 +197,9 @@ def zone() -> list[float]:
 
 # ----------------------------------------------------------------------------- retrace
 def _parametric(zeta: float, kappa: float, mu: float = 1.0) -> geardyn.UserModel:
-    return geardyn.UserModel(parametric_rayleigh, n_states=2, params=[1.5, zeta, kappa, mu],
-                             param_names=["Omega", "zeta", "kappa", "mu"],
-                             natural_frequency=1.0)
+    """x'' + 2 zeta x' + mu x^2 x' + (1 + kappa cos(Omega t)) x = 0 (mu: the oscillator's
+    Rayleigh damping rho)."""
+    return oscillator(Omega=1.5, zeta=zeta, kappa=kappa, rho=mu, natural_frequency=1.0)
 
 
 def test_period_two_bubble_rejoins_at_the_second_doubling_and_ends_there(zone):

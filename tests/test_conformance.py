@@ -17,6 +17,7 @@ from conformance_cases import IDS, cases, dead_zone_events, dead_zone_rhs, user_
 from geardyn.core.capabilities import Capabilities
 from geardyn.core.kernel_source import KernelSource
 from geardyn.testing import RULES, ModelContractError, check_model
+from shared_models import oscillator
 
 # ---------------------------------------------------------------------------------------------
 # the built-in models keep the contract
@@ -100,13 +101,6 @@ def _observe_outside(t, y, out, p):
 def _rhs_jump(t, y, dy, p):  # a jump in t (square-wave forcing) that no event locates
     dead_zone_rhs(t, y, dy, p)
     dy[1] += 0.5 if math.sin(p[4] * t) > 0.0 else -0.5
-
-
-@numba.njit(**_JIT)
-def _smooth(t, y, dy, p):  # strongly nonlinear but smooth: a cubic and a sharp tanh step
-    dy[0] = y[1]
-    dy[1] = (-2.0 * p[0] * y[1] - y[0] - p[1] * y[0] ** 3 + 0.5 * math.tanh(y[0] / 0.05)
-             + p[3] * math.cos(p[2] * t))
 
 
 def _plain_rhs(t, y, dy, p):
@@ -271,8 +265,10 @@ def test_report_without_raising():
 
 def test_smooth_nonlinear_model_has_no_kinks():
     """The kink scan does not mistake strong smooth nonlinearity for a kink."""
-    model = geardyn.UserModel(_smooth, n_states=2, params=[0.05, 5.0, 1.3, 2.0],
-                              param_names=("zeta", "k3", "Omega", "F"), natural_frequency=4.0)
+    # strongly nonlinear but smooth: a cubic and a sharp tanh step,
+    # x'' + 2 zeta x' + x + 5 x^3 - 0.5 tanh(x / 0.05) = F cos(Omega t)
+    model = oscillator(zeta=0.05, beta=5.0, a=-0.5, w=0.05, Omega=1.3, F=2.0,
+                       natural_frequency=4.0)
     report = check_model(model, y0=np.array([1.5, 0.0]), run=False)
     assert report.ok
 

@@ -14,21 +14,8 @@ from geardyn.analysis.lyapunov import lyapunov, lyapunov_lanes
 from geardyn.io.toml import builtin_study
 from geardyn.models import catt_kernels
 from geardyn.study import build_model
+from shared_models import lorenz, oscillator
 from test_verification_catt import theta_from_mesh
-
-
-@nb.njit(cache=True)
-def lorenz_rhs(t, y, dy, p):
-    dy[0] = p[0] * (y[1] - y[0])
-    dy[1] = y[0] * (p[1] - y[2]) - y[1]
-    dy[2] = y[0] * y[1] - p[2] * y[2]
-
-
-@nb.njit(cache=True)
-def forced_oscillator_rhs(t, y, dy, p):
-    # x'' + 2 zeta x' + x = F cos(Omega t); p = (zeta, F, Omega)
-    dy[0] = y[1]
-    dy[1] = -2.0 * p[0] * y[1] - y[0] + p[1] * math.cos(p[2] * t)
 
 
 @nb.njit(cache=True)
@@ -56,8 +43,7 @@ IMPACTING = dict(zeta=0.1, kappa=0.2, Fm=0.1, Fa=0.15, Omega=1.15)
 
 
 def lorenz_model():
-    return geardyn.UserModel(lorenz_rhs, n_states=3, params=LORENZ, period=None,
-                             state_names=["x", "y", "z"])
+    return lorenz(*LORENZ)
 
 
 def rk4_polynomial(Z):
@@ -98,8 +84,7 @@ def test_linear_oscillator_spectrum(which):
         model = geardyn.GearPair(zeta=zeta, kappa=0.0, backlash=0.0, Fm=0.1, Fa=0.05,
                                  Omega=omega)
     else:
-        model = geardyn.UserModel(forced_oscillator_rhs, 2, params=[zeta, 0.3, omega],
-                                  period=2.0 * math.pi / omega)
+        model = oscillator(zeta=zeta, F=0.3, Omega=omega)  # x'' + 2 zeta x' + x = F cos
     lam = lyapunov(model, y0=[0.3, 0.0], spectrum=True,
                    run=geardyn.RunSettings(transient=100.0, steps_per_period=n))
     # the sum is log|det| of the step map per unit time: exactly that of the RK4 polynomial of

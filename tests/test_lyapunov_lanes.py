@@ -11,7 +11,7 @@ import pytest
 import geardyn
 from geardyn.analysis import lyapunov as lyap_mod
 from geardyn.solvers.kernels import kernels_for
-from test_lyapunov import lorenz_rhs as _lorenz  # one Lorenz kernel for both files
+from shared_models import lorenz_rhs as _lorenz  # one Lorenz kernel for the tests
 
 #: Gear pair lanes: chaotic, period-1 with contact loss (two edge crossings per period).
 CHAOTIC = dict(zeta=0.02, kappa=0.2, Fm=0.1, Fa=0.3)

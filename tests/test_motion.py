@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import math
 
-import numba as nb
 import numpy as np
 import pytest
 
@@ -17,22 +16,8 @@ from geardyn.analysis.motion import (
     lyapunov_uncertainty,
     motion_classes,
 )
-from geardyn.models.user import UserModel
 from geardyn.reproduction.motion import is_nonperiodic
-
-
-@nb.njit(cache=True)
-def oscillator_rhs(t, y, dy, p):
-    # x'' + (2 zeta - mu (1 - x^2)) x' + x = F cos(Omega t) + G cos(Omega t / q)
-    # p = (zeta, mu, F, G, q, Omega): van der Pol (zeta = 0, G = 0) or a damped linear
-    # oscillator with a subharmonic forcing at Omega / q (mu = 0)
-    damping = 2.0 * p[0] - p[1] * (1.0 - y[0] * y[0])
-    dy[0] = y[1]
-    dy[1] = (-damping * y[1] - y[0] + p[2] * math.cos(p[5] * t)
-             + p[3] * math.cos(p[5] * t / p[4]))
-
-
-NAMES = ["zeta", "mu", "F", "G", "q", "Omega"]
+from shared_models import oscillator as shared_oscillator
 
 
 def block_exponent(model, y0, block: float, n: int) -> tuple[float, float, float]:
@@ -82,8 +67,9 @@ def test_labels_from_period_exponent_and_error():
 # --------------------------------------------------------------------------- real motions
 @pytest.fixture(scope="module")
 def oscillator():
-    return UserModel(oscillator_rhs, 2, [0.0, 0.5, 0.2, 0.0, 1.0, math.sqrt(2.0)],
-                     param_names=NAMES)
+    # x'' + (2 zeta - mu (1 - x^2)) x' + x = F cos(Omega t) + G cos(Omega t / q): van der Pol
+    # (zeta = 0, G = 0) or a damped linear oscillator with a subharmonic forcing (mu = 0)
+    return shared_oscillator(zeta=0.0, mu=0.5, F=0.2, G=0.0, q=1.0, Omega=math.sqrt(2.0))
 
 
 def test_torus_is_quasi_periodic(oscillator):

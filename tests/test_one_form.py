@@ -18,9 +18,10 @@ from geardyn.core.one_form import call_tuple, coefficient_type
 from geardyn.solvers.ensemble import LaneResults, run_lanes
 from geardyn.solvers.kernels import kernels_for
 from geardyn.testing import check_model
+from shared_models import oscillator
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "examples"))
-from duffing_model import duffing, duffing_one  # noqa: E402
+from duffing_model import duffing_one  # noqa: E402
 from gear_pair_model import gear_pair  # noqa: E402
 
 LY300 = geardyn.LyapunovSettings(duration=300.0)
@@ -173,9 +174,10 @@ def _duffing_models(delta: float = 0.3, gamma: float = 0.1, omega: float = 1.2):
         duffing_one, params={"delta": delta, "gamma": gamma, "Omega": omega},
         states=("x", "v"), initial_state=(1.0, 0.0), natural_frequency=math.sqrt(2.0),
         name="Duffing")
-    legacy = geardyn.UserModel(duffing, 2, [delta, gamma, omega],
-                               param_names=("delta", "gamma", "Omega"),
-                               natural_frequency=math.sqrt(2.0))
+    # the same double-well Duffing oscillator, x'' + delta x' - x + x^3 = gamma cos(Omega t), in
+    # the legacy plain form
+    legacy = oscillator(zeta=delta / 2, k=-1.0, beta=1.0, F=gamma, Omega=omega,
+                        natural_frequency=math.sqrt(2.0))
     return one, legacy
 
 

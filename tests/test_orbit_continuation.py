@@ -15,8 +15,8 @@ from scipy.optimize import brentq
 
 import geardyn
 import geardyn.io
-from continuation_cases import van_der_pol
 from geardyn import BranchStatus, ContinuedSweep, continued_sweeps
+from shared_models import oscillator
 
 
 def _table(ds, kind: str) -> np.ndarray:
@@ -251,9 +251,8 @@ def test_neimark_sacker_of_the_forced_van_der_pol_oscillator_keeps_liouville():
     Neimark-Sacker point the orbit's mean of x^2 is 1: checked on the reference integrator's
     orbit from the located section point."""
     om, eps = 1.2, 0.1
-    m = geardyn.UserModel(van_der_pol, n_states=2, params=[om, eps, 1.5],
-                          param_names=["Omega", "eps", "gamma"], natural_frequency=1.0)
-    ds = geardyn.continuation(m, "gamma", 1.5, 0.2)
+    m = oscillator(Omega=om, mu=eps, F=1.5, natural_frequency=1.0)  # gamma: F
+    ds = geardyn.continuation(m, "F", 1.5, 0.2)
     ns = np.flatnonzero(ds["bifurcation_kind"].values == "neimark-sacker")
     assert ns.size == 1, ds["bifurcation_kind"].values
     k = int(ns[0])
@@ -272,7 +271,7 @@ def test_neimark_sacker_of_the_forced_van_der_pol_oscillator_keeps_liouville():
     assert np.max(np.abs(sol.y[:2, -1] - x0)) < 1e-7  # a periodic orbit of the exact flow
     assert abs(sol.y[2, -1] / T - 1.0) < 1e-6
     # stable before (strong forcing), unstable after
-    g = ds["gamma"].values
+    g = ds["F"].values
     assert set(ds["stability"].values[g > gamma + 1e-3]) == {"stable"}
     assert set(ds["stability"].values[g < gamma - 1e-3]) == {"unstable"}
 

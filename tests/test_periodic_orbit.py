@@ -22,7 +22,7 @@ from geardyn.analysis.orbits import (
     shooting_problem,
 )
 from geardyn.testing import assert_result
-from orbit_cases import duffing
+from shared_models import oscillator
 
 
 def _sorted(mu: np.ndarray) -> np.ndarray:
@@ -273,8 +273,8 @@ def test_smooth_nonlinear_multipliers_match_the_variational_equations():
     """A user's Duffing oscillator: the monodromy against DOP853 (rtol 1e-12) of the orbit and
     its variational equation, the Jacobian written out here, to 1e-8."""
     om, delta, beta, gamma = 1.2, 0.1, 0.5, 0.3
-    m = geardyn.UserModel(duffing, n_states=2, params=[om, delta, beta, gamma],
-                          param_names=["Omega", "delta", "beta", "gamma"], natural_frequency=1.6)
+    # x'' + delta x' + x + beta x^3 = gamma cos(Omega t)
+    m = oscillator(Omega=om, zeta=delta / 2, beta=beta, F=gamma, natural_frequency=1.6)
     orb = geardyn.periodic_orbit(m)
     assert orb.converged, orb.message
     T = 2 * math.pi / om

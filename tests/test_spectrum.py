@@ -4,13 +4,13 @@ from __future__ import annotations
 
 import math
 
-import numba as nb
 import numpy as np
 import pytest
 import xarray as xr
 
 import geardyn
 from geardyn.analysis.spectrum import amplitude_spectrum, label_peaks
+from shared_models import oscillator
 
 OMEGA = 1.1
 PER_PERIOD = 128
@@ -139,21 +139,13 @@ def test_bad_input_is_named():
         amplitude_spectrum(ds, "y")
 
 
-@nb.njit(cache=True)
-def modulated_oscillator(t, y, dy, p):
-    """x'' + 2 c x' + x = (1 + m cos(Lambda t)) cos(Omega t); p = (c, m, Lambda, Omega)."""
-    dy[0] = y[1]
-    dy[1] = (-2.0 * p[0] * y[1] - y[0]
-             + (1.0 + p[1] * math.cos(p[2] * t)) * math.cos(p[3] * t))
-
-
 def test_simulated_linear_oscillator_spectrum_matches_its_frequency_response():
     """The steady response of a linear oscillator to cos(W t) + m/2 cos((W -+ L) t) has the line
     amplitudes F / |1 - w^2 + 2 i c w|: simulate, take the spectrum, compare line by line."""
     c, m, om, periods = 0.1, 0.6, 1.3, 64
     lam = om * 8 / periods  # sidebands on frequency bins
-    u = geardyn.UserModel(modulated_oscillator, n_states=2, params=[c, m, lam, om],
-                          param_names=["c", "m", "Lambda", "Omega"], state_names=["x", "v"])
+    # x'' + 2 c x' + x = (1 + m cos(Lambda t)) cos(Omega t)
+    u = oscillator(zeta=c, F=1.0, m=m, Lambda=lam, Omega=om)
     ds = geardyn.simulate(u,
                           run=geardyn.RunSettings(transient=400.0, samples=periods,
                                                   steps_per_period=256))

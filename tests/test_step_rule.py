@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import math
 
-import numba
 import numpy as np
 import pytest
 import scipy.linalg
@@ -18,6 +17,7 @@ from geardyn.core.plan import (
     lane_steps_per_period,
 )
 from geardyn.solvers.ensemble import run_lanes
+from shared_models import OSCILLATOR, oscillator
 
 KM_PQ = np.array([1.0e9, 4.0e9, 16.0e9])
 
@@ -112,21 +112,16 @@ def test_explicit_steps_win_and_models_without_modes_keep_the_floor():
     assert default_steps_per_period(g) == math.ceil(STEPS_PER_FASTEST_MODE / 0.5)
 
 
-@numba.njit(cache=False)
-def _oscillator(t, y, dy, p):
-    dy[0] = y[1]
-    dy[1] = -p[0] * y[0] - 0.1 * y[1] + math.cos(p[1] * t)
-
-
 def test_user_model_natural_frequency_sets_the_step():
-    kw = dict(n_states=2, params=[1.0, 1.0], param_names=["k", "Omega"])
-    plain = geardyn.UserModel(_oscillator, **kw)
+    kw = dict(zeta=0.05, k=1.0, F=1.0, Omega=1.0)  # x'' + 0.1 x' + k x = cos(Omega t)
+    k = list(OSCILLATOR).index("k")
+    plain = oscillator(**kw)
     assert default_steps_per_period(plain) == MIN_STEPS_PER_PERIOD  # unknown: the floor
-    known = geardyn.UserModel(_oscillator, natural_frequency=lambda p: math.sqrt(p[0]), **kw)
+    known = oscillator(natural_frequency=lambda p: math.sqrt(p[k]), **kw)
     P = known.lane_params("k", [1.0, 100.0, 10000.0])
     n = lane_steps_per_period(known, P)
     assert n[0] >= STEPS_PER_FASTEST_MODE and n[2] >= STEPS_PER_FASTEST_MODE * 100
-    fixed = geardyn.UserModel(_oscillator, natural_frequency=3.0, **kw)
+    fixed = oscillator(natural_frequency=3.0, **kw)
     assert default_steps_per_period(fixed) == math.ceil(STEPS_PER_FASTEST_MODE * 3.0)
     with pytest.raises(ValueError, match="natural_frequency"):
-        geardyn.UserModel(_oscillator, natural_frequency=-1.0, **kw)
+        oscillator(natural_frequency=-1.0, **kw)

@@ -3,10 +3,11 @@
 Every test worker (pytest-xdist) is a separate process, and numba compiles a kernel in the first
 process that needs it and finds no cached copy; two workers that start on the same model compile
 its kernels twice, side by side, one core each. This script compiles each built-in model's
-kernels (sweep, trajectory, Lyapunov lanes and single lane, monodromy) in its own process, the
-models spread over ``--jobs`` processes, through the public API with the argument types the
-tests use, so that the workers load them from the on-disk cache instead. With a warm cache it
-only loads them (a few seconds). Running it is an optimisation: the tests do not depend on it.
+kernels (sweep, trajectory, Lyapunov lanes and single lane, monodromy), and those of the user
+models the tests share (``tests/shared_models.py``), in its own process, the models spread over
+``--jobs`` processes, through the public API with the argument types the tests use, so that the
+workers load them from the on-disk cache instead. With a warm cache it only loads them (a few
+seconds). Running it is an optimisation: the tests do not depend on it.
 
     python tests/warm_kernels.py --jobs 2
 """
@@ -22,9 +23,9 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 
-#: What the default test suite runs on each conformance case (so the warm-up compiles no kernel
-#: that the tests would not): sweep = bifurcation, trajectory = simulate, lyapunov = one lane,
-#: lanes = Lyapunov lane blocks, orbit = the monodromy kernel.
+#: What the default test suite runs on each conformance case and shared test model (so that the
+#: warm-up compiles no kernel that the tests would not): sweep = bifurcation, trajectory =
+#: simulate, lyapunov = one lane, lanes = Lyapunov lane blocks, orbit = the monodromy kernel.
 WARM = {
     "CATTDevice-reduced": ("trajectory", "sweep", "lyapunov", "lanes", "orbit"),
     "CATTDevice-general": ("trajectory", "lyapunov", "lanes", "orbit"),
@@ -32,19 +33,42 @@ WARM = {
     "GearPair": ("trajectory", "sweep", "lyapunov", "lanes", "orbit"),
     "UserModel": ("trajectory", "lyapunov"),
     "PlanetaryGearSet": ("trajectory", "sweep", "lyapunov", "orbit"),
+    # the user models the tests share (tests/shared_models.py)
+    "oscillator": ("trajectory", "sweep", "lyapunov", "orbit"),
+    "Lorenz": ("lyapunov", "lanes"),
 }
 
 
+def _shared(case: str) -> tuple:
+    """(model, start state) of a shared test model (tests/shared_models.py)."""
+    import numpy as np
+
+    from shared_models import lorenz, oscillator
+
+    if case == "Lorenz":
+        return lorenz(), np.ones(3)
+    return oscillator(zeta=0.05, F=1.0, Omega=1.3), np.zeros(2)
+
+
+#: The shared test models warmed besides the conformance cases.
+SHARED = ("oscillator", "Lorenz")
+
+
 def _warm(case: str) -> tuple[str, float]:
-    """Run each analysis of ``WARM[case]`` once on a tiny workload of the conformance case."""
+    """Run each analysis of ``WARM[case]`` once on a tiny workload of the conformance case or
+    shared test model ``case``."""
     import numpy as np
 
     import geardyn
     from conformance_cases import cases
 
     t0 = time.perf_counter()
-    model, y0 = cases()[case]
-    omega = float(model.params[model.omega_index])
+    model, y0 = _shared(case) if case in SHARED else cases()[case]
+    if model.omega_index is None:  # autonomous: lanes of its own coefficients, from y0
+        omega, lanes, start = 1.0, np.tile(model.params, (2, 1)), {"y0": y0}
+    else:
+        omega = float(model.params[model.omega_index])
+        lanes, start = model.lane_params("Omega", np.array([omega, 1.05 * omega])), {}
     values = np.array([omega, 1.05 * omega])
     runs = {
         "trajectory": lambda: geardyn.simulate(model, omega=omega,
@@ -54,7 +78,7 @@ def _warm(case: str) -> tuple[str, float]:
                                              run=geardyn.RunSettings(transient=0.0, samples=2)),
         "lyapunov": lambda: geardyn.lyapunov(model, y0=y0, run=geardyn.RunSettings(transient=0.0),
                                              settings=geardyn.LyapunovSettings(duration=1.0)),
-        "lanes": lambda: geardyn.lyapunov_lanes(model, model.lane_params("Omega", values),
+        "lanes": lambda: geardyn.lyapunov_lanes(model, lanes, **start,
                                                 run=geardyn.RunSettings(transient=0.0),
                                                 settings=geardyn.LyapunovSettings(duration=1.0)),
         "orbit": lambda: geardyn.periodic_orbit(model, omega=omega, guess=y0,
@@ -79,7 +103,7 @@ def main(argv: list[str] | None = None) -> int:
     t0 = time.perf_counter()
     with ProcessPoolExecutor(max_workers=max(1, args.jobs)) as pool:
         # the longest first, so that the processes end together
-        order = sorted(IDS, key=lambda c: -len(WARM.get(c, ())))
+        order = sorted((*IDS, *SHARED), key=lambda c: -len(WARM.get(c, ())))
         for case, seconds in pool.map(_warm, order):
             print(f"warm_kernels: {case} {seconds:.1f} s", flush=True)
     print(f"warm_kernels: {time.perf_counter() - t0:.1f} s in all", flush=True)
