@@ -83,7 +83,11 @@ contact on it, :class:`Wear` the sections of the active profile (and opens a gap
 ``fault_gap`` that :func:`~geardyn.gears.loaded_contact` adds to the tip relief's), and a
 :class:`BrokenTooth` takes its pairs out of contact (see :func:`tooth_compliances` and
 :meth:`PotentialEnergyPair.terms`); the tooth indices of each pair follow the pitch-point
-passages.
+passages. A spall or wear lies on the drive or the coast flank (``flank``): the sections it
+thins are the tooth's, felt by the contacts of both flanks; its contact-width loss (spall) or
+gap (wear, ``fault_gap_coast`` on the coast flank) only by its own flank's contacts, at the same
+load angles on either flank. A root crack lies at the drive flank's root, its faces open under
+either load.
 """
 
 from __future__ import annotations
@@ -304,8 +308,9 @@ def _crack_section(h_q: float, b: float) -> Section:
 
 
 def _spall_section(width: float, depth: float, b: float) -> Section:
-    """(I, A) of the 2h x b section less a ``depth`` x ``width`` rectangle at the loaded flank,
-    I about the reduced section's own centroid (shifted by y_c towards the other flank)."""
+    """(I, A) of the 2h x b section less a ``depth`` x ``width`` rectangle at the spalled flank
+    (either: the section is the same mirrored), I about the reduced section's own centroid
+    (shifted by y_c towards the other flank)."""
     cut = width * depth
 
     def section(h: np.ndarray, al: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -319,7 +324,7 @@ def _spall_section(width: float, depth: float, b: float) -> Section:
 
 
 def _wear_section(depth: float, b: float) -> Section:
-    """(I, A) of sections thinned by ``depth`` at the loaded flank: 2h - depth thick."""
+    """(I, A) of sections thinned by ``depth`` at the worn flank: 2h - depth thick."""
     return lambda h, al: ((2.0 * h - depth) ** 3 * b / 12.0, (2.0 * h - depth) * b)
 
 
@@ -383,7 +388,7 @@ def half_thickness(tooth: ToothModel, alpha: float) -> float:
 
 @dataclass(frozen=True)
 class WearProfile:
-    """The wear depth along the loaded flank of a worn tooth: ``depth_at(t)`` [m] at the flank's
+    """The wear depth along the worn flank of a tooth: ``depth_at(t)`` [m] at the flank's
     roll angles t [rad] on its active profile, smooth between the roll angles ``rolls``
     (ascending, from the start of the active profile to the tip)."""
 
@@ -431,7 +436,7 @@ def tooth_compliances(tooth: ToothModel, alpha1: np.ndarray, *, young: float, po
       fillet term stays healthy (Chen & Shao 2011). Cracks reaching past the centre line
       (q sin v >= h_r) are refused.
     * :class:`Spall`: the sections whose flank point lies on the spall lose a depth x width
-      rectangle at the loaded flank: A = 2hb - w d, I about the reduced section's centroid
+      rectangle at the spalled flank: A = 2hb - w d, I about the reduced section's centroid
       (after Saxena, Parey & Chouksey 2016; Liang, Zhang, Liu & Zuo 2016); bending arm and
       fillet unchanged. The
       contact width (Hertz) is the pair's: see :class:`PotentialEnergyPair`.
@@ -439,6 +444,10 @@ def tooth_compliances(tooth: ToothModel, alpha1: np.ndarray, *, young: float, po
       thin to 2h - h_w (Chen, Lei, Fu & Hou 2021), h_w the uniform depth or, for Archard's
       profile, ``wear_profile``'s depth at the section's flank point
       (:meth:`PotentialEnergyPair.wear_profile`); fillet unchanged.
+
+    The symmetric tooth's sections are the same whichever flank a spall or wear is on, and the
+    same under either flank's load at the same ``alpha1``: ``fault.flank`` is not looked at
+    here.
 
     ``crack=`` is the deprecated spelling of ``fault=`` for a root crack. A
     :class:`BrokenTooth` has no compliance (refused). A ring's tooth (``tooth.internal``) is
@@ -683,11 +692,11 @@ class PotentialEnergyPair:
                 return profile
         return None
 
-    def _lost_width(self, tooth: ToothModel, fault: Fault | None,
-                    a1: np.ndarray) -> np.ndarray | None:
-        """The face width [m] a spall takes from contacts at load angles ``a1`` on its flank
-        (0 off the spall), or None without a spall."""
-        if not isinstance(fault, Spall) or fault.is_null:
+    def _lost_width(self, tooth: ToothModel, fault: Fault | None, a1: np.ndarray,
+                    flank: str) -> np.ndarray | None:
+        """The face width [m] a spall takes from contacts at load angles ``a1`` on ``flank``
+        (0 off the spall), or None without a spall on that flank."""
+        if not isinstance(fault, Spall) or fault.is_null or fault.flank != flank:
             return None
         t_lo, t_hi = spall_rolls(tooth, fault)
         roll = a1 + tooth.half_base_angle
@@ -698,23 +707,25 @@ class PotentialEnergyPair:
         """Stiffness [N/m] of each energy term (``hertz``, ``bending_pinion``, ...,
         ``fillet_wheel``) and of the pair (``pair``) for contacts at ``position`` [m] between a
         pinion tooth with the fault ``pinion`` and a wheel tooth with ``wheel`` (None:
-        healthy). A spall on the loaded flank narrows the Hertz contact to b - w where the
-        contact lies on it (Chaari, Baccar, Abbes & Haddar 2008; the wider spall where both
-        teeth have one there); ``coast``: the contacts are on the coast flanks, which a spall
-        does not touch. A ring's ``fillet_wheel`` is inf (rigid ring body)."""
+        healthy). ``coast``: the contacts are on the coast flanks (``position`` on the coast
+        line of action, the same load angles as on the drive flank there). A spall on the
+        loaded flank (``flank`` "drive", or "coast" with ``coast``) narrows the Hertz contact to
+        b - w where the contact lies on it (Chaari, Baccar, Abbes & Haddar 2008; the wider
+        spall where both teeth have one there); a spall on the other flank only thins the
+        sections. A ring's ``fillet_wheel`` is inf (rigid ring body)."""
         pos = np.asarray(position, dtype=float)
         a_p, a_w = self.load_angles(pos)
         kw = dict(young=self.young, poisson=self.poisson, face_width=self.face_width,
                   nodes=self.nodes)
         out = {"hertz": np.full(pos.shape, self.hertz)}
-        if not coast:
-            lost = [w for w in (self._lost_width(self.pinion, pinion, a_p),
-                                self._lost_width(self.wheel, wheel, a_w)) if w is not None]
-            if lost:
-                width = self.face_width - np.maximum.reduce(lost)
-                out["hertz"] = np.where(width < self.face_width,
-                                        hertz_stiffness(self.young, self.poisson, width),
-                                        self.hertz)
+        flank = "coast" if coast else "drive"
+        lost = [w for w in (self._lost_width(self.pinion, pinion, a_p, flank),
+                            self._lost_width(self.wheel, wheel, a_w, flank)) if w is not None]
+        if lost:
+            width = self.face_width - np.maximum.reduce(lost)
+            out["hertz"] = np.where(width < self.face_width,
+                                    hertz_stiffness(self.young, self.poisson, width),
+                                    self.hertz)
         compliance = 1.0 / out["hertz"]
         for role, tooth, a1, fault in (("pinion", self.pinion, a_p, pinion),
                                        ("wheel", self.wheel, a_w, wheel)):
@@ -817,7 +828,8 @@ def _check_faults(faults: tuple[object, ...], mesh: GearMesh, teeth: list[ToothM
         key = (fault.gear, fault.tooth)
         if key in seen:
             raise ParameterError("faults", fault, f"{fault.gear} tooth {fault.tooth} already"
-                                 f" has a fault ({seen[key]!r}): one fault a tooth")
+                                 f" has a fault ({seen[key]!r}): one fault a tooth (faults"
+                                 " on both flanks of one tooth are not modelled together)")
         seen[key] = fault
         tooth = teeth[0] if fault.gear == "pinion" else teeth[1]
         if tooth.internal and not isinstance(fault, (BrokenTooth, RootCrack)):
@@ -930,12 +942,14 @@ def _fault_codes(pair: PotentialEnergyPair, tooth_p: np.ndarray,
 
 
 def _wear_gap(pair: PotentialEnergyPair, position: np.ndarray, inside: np.ndarray,
-              tooth_p: np.ndarray, tooth_w: np.ndarray) -> np.ndarray:
-    """The gap [m] the worn teeth open at the drive contacts ``inside`` (0 elsewhere): the
-    wear depth at each contact's point of the worn flank, both teeth's added."""
+              tooth_p: np.ndarray, tooth_w: np.ndarray, *, coast: bool = False) -> np.ndarray:
+    """The gap [m] the worn teeth open at the drive (``coast``: coast) contacts ``inside`` (0
+    elsewhere): the wear depth at each contact's point of the worn flank, both teeth's added;
+    only wear on the flank of the contacts opens one."""
     gap = np.zeros(position.shape)
+    flank = "coast" if coast else "drive"
     for wear, profile in pair.wear_profiles:
-        if wear.is_null:
+        if wear.is_null or wear.flank != flank:
             continue
         mask = inside & ((tooth_p if wear.gear == "pinion" else tooth_w) == wear.tooth)
         if mask.any():
@@ -967,12 +981,13 @@ def _coast(pair: PotentialEnergyPair, n: np.ndarray,
     inside &= ~gone
     k_pair = np.where(inside, _terms_on_grid(pair, position, inside, fp, fw, coast=True)["pair"],
                       0.0)
+    gap = _wear_gap(pair, position, inside, tooth_p, tooth_w, coast=True)
     dims = ("angle", "pair_coast")
     return {"mesh_stiffness_coast": (("angle",), k_pair.sum(axis=1)),
             "pairs_in_contact_coast": (("angle",), inside.sum(axis=1)),
             "in_contact_coast": (dims, inside), "position_coast": (dims, position),
             "tooth_pinion_coast": (dims, tooth_p), "tooth_wheel_coast": (dims, tooth_w),
-            "pair_stiffness_coast": (dims, k_pair)}, ks
+            "pair_stiffness_coast": (dims, k_pair), "fault_gap_coast": (dims, gap)}, ks
 
 
 def potential_energy_stiffness(mesh: GearMesh, *, bore_radius: object, angles: object = 360,
@@ -1007,12 +1022,13 @@ def potential_energy_stiffness(mesh: GearMesh, *, bore_radius: object, angles: o
     The coast flank: ``mesh_stiffness_coast`` [N/m], ``pairs_in_contact_coast`` and per coast
     pair (dimension ``pair_coast``) ``in_contact_coast``, ``position_coast`` [m] (on the coast
     line of action from the pitch point, positive towards the pinion tip),
-    ``tooth_pinion_coast``, ``tooth_wheel_coast``, ``pair_stiffness_coast`` [N/m], at the same
-    pinion angles with the pinion turned onto its coast flanks (see ``_coast``); attrs
-    ``coast_phase_cycles`` (phi), ``backlash_m`` and ``backlash_cycles`` (j / p_w1, the dead
-    zone between the flanks). Faults sit on the drive flank: a crack, a spall or wear thins the
-    tooth's sections under either flank's load (crack faces taken open); a spall's contact
-    width and wear's gap act on the drive flank only; a missing tooth carries on neither.
+    ``tooth_pinion_coast``, ``tooth_wheel_coast``, ``pair_stiffness_coast`` [N/m],
+    ``fault_gap_coast`` [m], at the same pinion angles with the pinion turned onto its coast
+    flanks (see ``_coast``); attrs ``coast_phase_cycles`` (phi), ``backlash_m`` and
+    ``backlash_cycles`` (j / p_w1, the dead zone between the flanks). A crack (at the drive
+    flank's root, faces taken open), a spall or wear thins the tooth's sections under either
+    flank's load; a spall's contact-width loss and wear's gap act on the contacts of its own
+    ``flank`` ("drive" or "coast") only; a missing tooth carries on neither.
 
     An internal ``mesh`` (``mesh.internal``): the wheel is the ring, its terms (``*_wheel``)
     the ring tooth's (:func:`ring_tooth_model`); ``bore_radius``'s second value is the ring's
@@ -1054,7 +1070,7 @@ def potential_energy_stiffness(mesh: GearMesh, *, bore_radius: object, angles: o
     ds = xr.Dataset(data, coords={"angle": deg, "cycle": ("angle", cyc), "pair": ks,
                                   "pair_coast": ks_c})
     for name in ds.data_vars:
-        ds[name].attrs["units"] = ("m" if name.startswith("position") or name == "fault_gap"
+        ds[name].attrs["units"] = ("m" if name.startswith(("position", "fault_gap"))
                                    else _units(name))
     ds["angle"].attrs.update(units="deg", long_name="pinion rotation")
     ds["cycle"].attrs.update(units="", long_name="mesh cycles")
