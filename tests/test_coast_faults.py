@@ -226,7 +226,11 @@ def test_default_flank_is_the_drive_flank(mesh: GearMesh) -> None:
     (lambda: Spall(1e-3, 4e-3, 1e-4, position=5e-3, flank="coast"), "spall.position"),
     (lambda: Spall(1e-3, 16e-3, 1e-4, flank="coast"), "spall.width"),
     (lambda: Wear(1.2e-3, flank="coast"), "wear.depth"),
-    (lambda: [Spall(**SPALL, tooth=3), Wear(1e-5, tooth=3, flank="coast")], "faults"),
+    (lambda: [Spall(**SPALL, tooth=3), Wear(1e-5, tooth=3)], "faults"),  # the same flank
+    (lambda: [Spall(**SPALL, tooth=3), Wear(1e-5, tooth=3, flank="coast"),
+              Wear(1e-5, tooth=3)], "faults"),
+    (lambda: [RootCrack(1e-3, tooth=3), Spall(**SPALL, tooth=3, flank="coast")], "faults"),
+    (lambda: [Wear(1e-5, tooth=3, flank="coast"), g.BrokenTooth(tooth=3)], "faults"),
 ])
 def test_bad_coast_faults_name_the_field(mesh: GearMesh, make, field: str) -> None:
     with pytest.raises(ParameterError) as info:
@@ -364,3 +368,130 @@ def test_the_documented_figures(mesh: GearMesh) -> None:
         rc = coast.mesh_stiffness_coast.values / healthy.mesh_stiffness_coast.values - 1.0
         rd = drive.mesh_stiffness.values / healthy.mesh_stiffness.values - 1.0
         assert rc.min() == pytest.approx(rd.min(), rel=1e-9)
+
+
+# -- a fault on each flank of one tooth -------------------------------------------------------
+
+
+def _strips(h: float, drive: tuple[float, float], coast: tuple[float, float]
+            ) -> tuple[float, float]:
+    """(I, A) of the section 2h x B less a w x d cut at each face (drive at y = h, coast at
+    y = -h), as three strips of the width left at each height, I about their centroid."""
+    (w1, d1), (w2, d2) = drive, coast
+    parts = [(B, -h + d2, h - d1), (B - w1, h - d1, h), (B - w2, -h, -h + d2)]
+    area = sum(b * (top - bot) for b, bot, top in parts)
+    y_c = sum(b * (top - bot) * 0.5 * (top + bot) for b, bot, top in parts) / area
+    return sum(b * ((top - y_c) ** 3 - (bot - y_c) ** 3) / 3.0 for b, bot, top in parts), area
+
+
+@pytest.mark.parametrize("coast", [Wear(30e-6, flank="coast"),
+                                   Wear(30e-6, flank="coast", profile="archard"),
+                                   Spall(2e-3, 6e-3, 0.2e-3, position=0.0, flank="coast")],
+                         ids=["uniform", "archard", "spall"])
+def test_two_flank_tooth_matches_quad(mesh: GearMesh, coast) -> None:
+    """A drive spall and a coast wear or spall on one pinion tooth: the bending, shear and
+    axial compliances against quad with the section built from strips (1e-9)."""
+    drive = Spall(**SPALL)
+    pair = prepare_pair(mesh, bore_radius=BORES, faults=[coast, drive])
+    g_ = _pinion()
+    a2 = g_["a2"]
+
+    def spall_range(sp) -> tuple[float, float]:
+        return (a2 - _roll_at(sp.position + sp.length / 2.0),
+                a2 - _roll_at(sp.position - sp.length / 2.0))
+
+    d_lo, d_hi = spall_range(drive)
+    profile = pair.profile_of(coast)
+    if isinstance(coast, Spall):
+        c_lo, c_hi = spall_range(coast)
+        breaks = (d_lo, d_hi, c_lo, c_hi)
+    else:
+        c_lo, c_hi = -math.inf, a2 - g_["t_low"]
+        breaks = (d_lo, d_hi, *(a2 - t for t in profile.rolls))
+
+    def section(a: float, h: float) -> tuple[float, float]:
+        cut_d = (drive.width, drive.depth) if d_lo <= a <= d_hi else (0.0, 0.0)
+        cut_c = (0.0, 0.0)
+        if c_lo <= a <= c_hi:
+            cut_c = ((coast.width, coast.depth) if isinstance(coast, Spall) else
+                     (B, float(profile.depth_at(np.array([a2 - a]))[0])))
+        return _strips(h, cut_d, cut_c)
+
+    a1 = np.array([g_["t_low"] + 0.01, math.tan(ALPHA), _roll_at(SPALL["position"]),
+                   g_["t_tip"]]) - a2
+    kw = dict(young=E, poisson=NU, face_width=B)
+    got = tooth_compliances(pair.pinion, a1, fault=(drive, coast),
+                            wear_profile=(None, profile), **kw)
+    alone = [tooth_compliances(pair.pinion, a1, fault=f, wear_profile=pair.profile_of(f), **kw)
+             for f in (drive, coast)]
+    for i, alpha1 in enumerate(a1):
+        for name, value in _reference(float(alpha1), section, breaks).items():
+            assert got[name][i] == pytest.approx(value, rel=1e-9, abs=0.0), (name, i)
+            assert got[name][i] >= max(c[name][i] for c in alone)
+
+
+def _swapped(faults):
+    """The faults on the other flank of the mirrored tooth (pinion j -> -j, wheel i -> 1 - i)."""
+    out = []
+    for f in faults:
+        z = Z1 if f.gear == "pinion" else Z2
+        tooth = (-f.tooth if f.gear == "pinion" else 1 - f.tooth) % z
+        out.append(type(f)(**{**f.__dict__, "tooth": tooth,
+                              "flank": "coast" if f.flank == "drive" else "drive"}))
+    return out
+
+
+@pytest.mark.parametrize("faults", [
+    [Spall(**SPALL, tooth=5), Wear(30e-6, tooth=5, flank="coast", profile="archard")],
+    [Spall(**SPALL, gear="wheel", tooth=7),
+     Spall(2e-3, 6e-3, 0.2e-3, position=-0.3e-3, gear="wheel", tooth=7, flank="coast")],
+], ids=["pinion-spall+archard", "wheel-spall+spall"])
+def test_two_flank_tooth_is_its_mirror(mesh: GearMesh, faults) -> None:
+    """A fault on each flank of one tooth: K_coast(c) equals K_drive(phi - c) of the mirrored
+    tooth with the faults' flanks swapped, and K_drive(phi - c) its K_coast(c) (1e-12); each
+    flank's gap is its own wear's; the Hertz width on each flank is its own spall's."""
+    phi = coast_phase(mesh)
+    c = (np.arange(Z1 * 16) + 0.3183) / 16.0
+    deg = 360.0 / Z1
+    one = _run(mesh, faults, angles=c * deg)
+    other = _run(mesh, _swapped(faults), angles=(phi - c) * deg)
+    np.testing.assert_allclose(one.mesh_stiffness_coast.values, other.mesh_stiffness.values,
+                               rtol=1e-12, atol=0.0)
+    one_d = _run(mesh, faults, angles=(phi - c) * deg)
+    other_c = _run(mesh, _swapped(faults), angles=c * deg)
+    np.testing.assert_allclose(other_c.mesh_stiffness_coast.values, one_d.mesh_stiffness.values,
+                               rtol=1e-12, atol=0.0)
+    np.testing.assert_allclose(one.fault_gap_coast.values.sum(axis=1),
+                               other.fault_gap.values.sum(axis=1), rtol=1e-9, atol=1e-15)
+    # both flanks felt: below each single-flank run where the tooth meets
+    for f in faults:
+        alone = _run(mesh, f, angles=c * deg)
+        for v in ("mesh_stiffness", "mesh_stiffness_coast"):
+            assert np.all(one[v].values <= alone[v].values)
+            assert np.count_nonzero(one[v].values < alone[v].values) >= 8
+    pair = prepare_pair(mesh, bore_radius=BORES, faults=faults)
+    entry = tuple(faults)
+    role = faults[0].gear
+    g_ = _pinion()
+    pos = np.linspace(-0.9, 0.9, 41) * g_["rb"] * 0.2
+    for coast, f in ((False, faults[0]), (True, faults[1])):
+        kw = {role: entry}
+        hertz = pair.terms(pos, **kw, coast=coast)["hertz"]
+        single = pair.terms(pos, **{role: f}, coast=coast)["hertz"]
+        np.testing.assert_array_equal(hertz, single)
+
+
+def test_two_flank_zero_fault_is_the_other_alone(mesh: GearMesh) -> None:
+    """A zero-size fault on one flank leaves the other flank's fault's result bitwise; two
+    uniformly worn flanks open both gaps and lower both flanks below either wear alone."""
+    spall = Spall(**SPALL, tooth=2)
+    a = _run(mesh, [spall, Wear(0.0, tooth=2, flank="coast")], angles=24)
+    b = _run(mesh, spall, angles=24)
+    for name in b.variables:
+        np.testing.assert_array_equal(a[name].values, b[name].values, err_msg=name)
+    both = _run(mesh, [Wear(20e-6, tooth=2), Wear(30e-6, tooth=2, flank="coast")], angles=24)
+    drive = _run(mesh, Wear(20e-6, tooth=2), angles=24)
+    assert both.fault_gap.values.max() == 20e-6 and both.fault_gap_coast.values.max() == 30e-6
+    for v in ("mesh_stiffness", "mesh_stiffness_coast"):
+        k, kd = both[v].values, drive[v].values
+        assert np.all(k <= kd) and np.count_nonzero(k < kd) >= 4
