@@ -18,7 +18,8 @@ active flank, a tooth index beyond the tooth count) are made when the pair is pr
 ``flank`` (:data:`FLANKS`): "drive" (the default), the flank loaded when the pinion drives
 forwards, or "coast", the back flank, loaded on reversal and in the backlash's rattle. The
 tooth is symmetric, so a fault on the coast flank acts on the coast contacts as the same fault
-on the drive flank acts on the drive contacts, mirrored along the coast line of action.
+on the drive flank acts on the drive contacts, mirrored along the coast line of action. One
+fault a tooth, or a spall or wear on each of its flanks.
 
 Errors name the field as ``<kind>.<field>`` (``spall.position``), with the kind of
 :data:`FAULT_KINDS` (``crack`` for a root crack).

@@ -77,7 +77,8 @@ flank passes the pitch point phi = s_w1 / p_w1 mesh cycles after its drive flank
 :func:`coast_phase`), so K_coast(c) = K_drive(phi - c) in mesh cycles c of the pinion, each
 flank taken in its own contact (the relative rotation between the two is the backlash).
 
-Faults (:mod:`geardyn.gears.faults`), each on its own tooth: a :class:`RootCrack` narrows the
+Faults (:mod:`geardyn.gears.faults`), each on its own tooth (or a spall or wear on each flank
+of one): a :class:`RootCrack` narrows the
 sections below Tian's crack limit line, a :class:`Spall` the sections under it and the Hertz
 contact on it, :class:`Wear` the sections of the active profile (and opens a gap, the
 ``fault_gap`` that :func:`~geardyn.gears.loaded_contact` adds to the tip relief's), and a
@@ -909,8 +910,8 @@ def prepare_pair(mesh: GearMesh, *, bore_radius: object, young: object = STEEL_Y
 
 def _check_faults(faults: tuple[object, ...], mesh: GearMesh, teeth: list[ToothModel],
                   width: float) -> None:
-    """Each fault a fault object, on a tooth that exists, one fault a tooth, and fitting its
-    tooth (errors name the fault's field)."""
+    """Each fault a fault object, on a tooth that exists, one fault a tooth (or a spall or
+    wear on each flank), and fitting its tooth (errors name the fault's field)."""
     seen: dict[tuple[str, int], object] = {}
     for fault in faults:
         if not isinstance(fault, (RootCrack, Spall, Wear, BrokenTooth)):
@@ -1138,10 +1139,10 @@ def potential_energy_stiffness(mesh: GearMesh, *, bore_radius: object, angles: o
     to its end (excluded), unless one of its teeth is missing. ``bore_radius`` [m]: one radius
     or (pinion, wheel); ``young`` [Pa], ``poisson``; ``nodes``: Gauss-Legendre nodes.
     ``faults``: one fault or a sequence (:class:`RootCrack`, :class:`Spall`, :class:`Wear`,
-    :class:`BrokenTooth`), each on its own tooth (see :func:`tooth_compliances` and
-    :class:`PotentialEnergyPair`); a pinion tooth returns every z1 mesh cycles, a wheel tooth
-    every z2 (the hunting period: lcm(z1, z2) cycles). ``crack=`` is the deprecated spelling of
-    ``faults=(crack,)``.
+    :class:`BrokenTooth`), each on its own tooth, or a spall or wear on each flank of one
+    (see :func:`tooth_compliances` and :class:`PotentialEnergyPair`); a pinion tooth returns
+    every z1 mesh cycles, a wheel tooth every z2 (the hunting period: lcm(z1, z2) cycles).
+    ``crack=`` is the deprecated spelling of ``faults=(crack,)``.
 
     The coast flank: ``mesh_stiffness_coast`` [N/m], ``pairs_in_contact_coast`` and per coast
     pair (dimension ``pair_coast``) ``in_contact_coast``, ``position_coast`` [m] (on the coast
