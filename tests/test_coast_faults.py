@@ -268,6 +268,7 @@ def test_helical_coast_wear_at_zero_helix_angle_is_the_spur_pair(mesh: GearMesh)
     wear; with 5 slices the coast gap is the depth on every slice in coast contact."""
     wear = Wear(15e-6, tooth=2, flank="coast")
     spur = _run(mesh, wear, angles=30, cycles=4)
+    both = [wear, Wear(10e-6, tooth=2)]  # each flank of the tooth worn
     hm = HelicalMesh(HelicalGear(Z1, M, ALPHA, 0.0, B, name="pinion"),
                      HelicalGear(Z2, M, ALPHA, 0.0, B, name="wheel"))
     one = helical_stiffness(hm, bore_radius=BORES, angles=30, slices=1, cycles=4, faults=wear)
@@ -276,6 +277,11 @@ def test_helical_coast_wear_at_zero_helix_angle_is_the_spur_pair(mesh: GearMesh)
     np.testing.assert_array_equal(one.fault_gap_coast.values[..., 0], spur.fault_gap_coast.values)
     np.testing.assert_array_equal(one.fault_gap.values, 0.0)
     assert spur.fault_gap_coast.values.max() == 15e-6
+    spur2 = _run(mesh, both, angles=30, cycles=4)
+    one2 = helical_stiffness(hm, bore_radius=BORES, angles=30, slices=1, cycles=4, faults=both)
+    for name in ("mesh_stiffness", "mesh_stiffness_coast"):
+        np.testing.assert_array_equal(one2[name].values, spur2[name].values, err_msg=name)
+    assert not np.array_equal(spur2.mesh_stiffness.values, spur.mesh_stiffness.values)
     many = helical_stiffness(hm, bore_radius=BORES, angles=30, slices=5, cycles=4, faults=wear)
     worn = many.slice_in_contact_coast.values & (
         many.tooth_pinion_coast.values == 2)[:, :, None]
@@ -338,6 +344,28 @@ def test_a_coast_spall_in_a_study_reaches_the_stiffness(tmp_path) -> None:
     assert not np.array_equal(got.mesh_stiffness.values, drive.mesh_stiffness.values)
     save_study(study, tmp_path / "again.toml")
     assert load_study(tmp_path / "again.toml") == study
+
+
+def test_a_study_wears_both_flanks_of_a_tooth() -> None:
+    """Two [[faults]] on one tooth, a wear on each flank: the API's stiffness bitwise."""
+    from geardyn.io.toml import load_study
+    from geardyn.study import mesh_stiffness
+
+    text = STUDY.replace('kind = "spall"', 'kind = "wear"').replace(
+        'length = "1.2 mm"\nwidth = "4 mm"\ndepth = "0.3 mm"\nposition = "0.4 mm"\n',
+        'depth = "30 um"\n')
+    text = text.replace("[stiffness]", '[[faults]]\nkind = "wear"\ntooth = 2\n'
+                        'depth = "10 um"\nprofile = "archard"\n\n[stiffness]')
+    got = mesh_stiffness(load_study(text))
+    mesh = g.GearMesh(g.SpurGear(19, "3.2 mm", "20 deg", "16 mm", name="pinion"),
+                      g.SpurGear(48, "3.2 mm", "20 deg", "16 mm", name="wheel"))
+    want = g.potential_energy_stiffness(
+        mesh, bore_radius=("12 mm", "35 mm"), angles=36, cycles=19,
+        faults=(g.Wear("30 um", tooth=2, flank="coast"),
+                g.Wear("10 um", tooth=2, profile="archard")))
+    for name in ("mesh_stiffness", "mesh_stiffness_coast", "fault_gap", "fault_gap_coast"):
+        np.testing.assert_array_equal(got[name].values, want[name].values, err_msg=name)
+    assert got.fault_gap.values.max() > 0.0 and got.fault_gap_coast.values.max() == 30e-6
 
 
 def test_cli_names_a_bad_flank(tmp_path, capsys) -> None:
