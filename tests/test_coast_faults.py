@@ -523,3 +523,22 @@ def test_two_flank_zero_fault_is_the_other_alone(mesh: GearMesh) -> None:
     for v in ("mesh_stiffness", "mesh_stiffness_coast"):
         k, kd = both[v].values, drive[v].values
         assert np.all(k <= kd) and np.count_nonzero(k < kd) >= 4
+
+
+def test_spur_pair_from_geometry_feels_the_coast_spall(mesh: GearMesh) -> None:
+    """SpurPair.from_geometry with a coast spall: its coast-flank stiffness series is the
+    Fourier series of the coast spall's mesh_stiffness_coast, changed ten times more than the
+    drive series (which feels the sections only)."""
+    from geardyn.models.spur_pair import SpurPair, fourier_series
+
+    kw = dict(bore_radius=BORES, speed="1000 rpm", torque="100 N m", angles=64)
+    spall = Spall(2e-3, 8e-3, 0.5e-3, flank="coast")
+    healthy = SpurPair.from_geometry(mesh, **kw)
+    faulty = SpurPair.from_geometry(mesh, faults=spall, **kw)
+    table = _run(mesh, spall, angles=64)
+    np.testing.assert_array_equal(
+        faulty.coast_series,
+        fourier_series(table.mesh_stiffness_coast.values, faulty.coast_series.size // 2))
+    dc = np.abs(faulty.coast_series - healthy.coast_series).max()
+    dd = np.abs(faulty.drive_series - healthy.drive_series).max()
+    assert dd > 0.0 and dc > 10.0 * dd
