@@ -78,11 +78,11 @@ flank passes the pitch point phi = s_w1 / p_w1 mesh cycles after its drive flank
 flank taken in its own contact (the relative rotation between the two is the backlash).
 
 Faults (:mod:`geardyn.gears.faults`), each on its own tooth (or a spall or wear on each flank
-of one): a :class:`RootCrack` narrows the
-sections below Tian's crack limit line, a :class:`Spall` the sections under it and the Hertz
-contact on it, :class:`Wear` the sections of the active profile (and opens a gap, the
-``fault_gap`` that :func:`~geardyn.gears.loaded_contact` adds to the tip relief's), and a
-:class:`BrokenTooth` takes its pairs out of contact (see :func:`tooth_compliances` and
+of one): a :class:`RootCrack` narrows the sections below Tian's crack limit line, a
+:class:`Spall` the sections under it and the Hertz contact on it, :class:`Wear` the sections
+of the active profile (and opens a gap, the ``fault_gap`` that
+:func:`~geardyn.gears.loaded_contact` adds to the tip relief's), and a :class:`BrokenTooth`
+takes its pairs out of contact (see :func:`tooth_compliances` and
 :meth:`PotentialEnergyPair.terms`); the tooth indices of each pair follow the pitch-point
 passages. A spall or wear lies on the drive or the coast flank (``flank``): the sections it
 thins are the tooth's, felt by the contacts of both flanks; its contact-width loss (spall) or
@@ -951,9 +951,10 @@ def _second_fault(fault: object, first: object) -> None:
     if (isinstance(fault, flank_faults) and isinstance(first, flank_faults)
             and fault.flank != first.flank):
         return
-    raise ParameterError("faults", fault, f"{fault.gear} tooth {fault.tooth} already has"  # type: ignore[attr-defined]
-                         f" {first!r}: one fault a tooth, or a spall or wear on each of its"
-                         " two flanks (flank='drive' and flank='coast')")
+    where = f"{getattr(fault, 'gear', '?')} tooth {getattr(fault, 'tooth', '?')}"
+    raise ParameterError("faults", fault, f"{where} already has {first!r}: one fault a tooth,"
+                         " or a spall or wear on each of its two flanks (flank='drive' and"
+                         " flank='coast')")
 
 
 def _check_crack(crack: RootCrack, tooth: ToothModel) -> None:
