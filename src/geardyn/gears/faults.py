@@ -7,12 +7,19 @@ What a fault does to the stiffness is in :mod:`geardyn.gears.potential_energy` a
 docs/gears.md; the checks that need the mesh (a crack past the centre line, a spall off the
 active flank, a tooth index beyond the tooth count) are made when the pair is prepared.
 
-* :class:`RootCrack` (``depth``, ``angle``): a straight crack at the root of the loaded flank.
-* :class:`Spall` (``length``, ``width``, ``depth``, ``position``): a rectangular spall or pit on
-  the loaded flank.
-* :class:`Wear` (``depth``, ``profile``): uniform or Archard wear of the loaded flank's active
-  profile.
+* :class:`RootCrack` (``depth``, ``angle``): a straight crack at the root of the drive flank;
+  its faces are taken open under the load of either flank.
+* :class:`Spall` (``length``, ``width``, ``depth``, ``position``, ``flank``): a rectangular spall
+  or pit on the drive or the coast flank.
+* :class:`Wear` (``depth``, ``profile``, ``flank``): uniform or Archard wear of the active
+  profile of the drive or the coast flank.
 * :class:`BrokenTooth`: the tooth is missing.
+
+``flank`` (:data:`FLANKS`): "drive" (the default), the flank loaded when the pinion drives
+forwards, or "coast", the back flank, loaded on reversal and in the backlash's rattle. The
+tooth is symmetric, so a fault on the coast flank acts on the coast contacts as the same fault
+on the drive flank acts on the drive contacts, mirrored along the coast line of action. One
+fault a tooth, or a spall or wear on each of its flanks.
 
 Errors name the field as ``<kind>.<field>`` (``spall.position``), with the kind of
 :data:`FAULT_KINDS` (``crack`` for a root crack).
@@ -28,6 +35,8 @@ from geardyn.errors import ParameterError
 from geardyn.units import to_si
 
 GEARS = ("pinion", "wheel")
+#: The flanks a :class:`Spall` or :class:`Wear` may lie on.
+FLANKS = ("drive", "coast")
 
 
 def _place(fault: object, kind: str) -> None:
@@ -38,6 +47,18 @@ def _place(fault: object, kind: str) -> None:
     if isinstance(tooth, bool) or not isinstance(tooth, numbers.Integral) or tooth < 0:
         raise ParameterError(f"{kind}.tooth", tooth, "must be a whole number >= 0")
     object.__setattr__(fault, "tooth", int(tooth))
+
+
+def _flank(fault: object, kind: str) -> None:
+    """Check the ``flank`` field of ``fault`` (error ``<kind>.flank``)."""
+    flank = fault.flank  # type: ignore[attr-defined]
+    if not isinstance(flank, str) or flank not in FLANKS:
+        raise ParameterError(f"{kind}.flank", flank, f"must be one of {', '.join(FLANKS)}")
+
+
+def _on(fault: object) -> str:
+    """"" on the drive flank, else " the coast flank of" (for :meth:`describe`)."""
+    return "" if fault.flank == "drive" else " the coast flank of"  # type: ignore[attr-defined]
 
 
 def _length(fault: object, kind: str, name: str, *, signed: bool = False) -> None:
@@ -55,11 +76,13 @@ def _length(fault: object, kind: str, name: str, *, signed: bool = False) -> Non
 
 @dataclass(frozen=True)
 class RootCrack:
-    """A straight crack at the root of one tooth's loaded flank (Tian 2004; Wu, Zuo & Parey
+    """A straight crack at the root of one tooth's drive flank (Tian 2004; Wu, Zuo & Parey
     2008; Chen & Shao 2011): ``depth`` q [m] along the crack, ``angle`` v [rad] between the crack
     and the tooth's centre line (q sin v is its reach across the tooth), on tooth ``tooth`` of
     ``gear`` ("pinion" or "wheel"; tooth 0 passes the pitch point at pinion angle 0, tooth j
-    j mesh cycles later). Quantities may be unit strings."""
+    j mesh cycles later). Quantities may be unit strings. The crack's faces are taken open
+    under either flank's load (the coast load, which presses them together, sees the same
+    thinner sections), so the model has no crack side to choose: no ``flank`` field."""
 
     depth: float
     angle: float = math.radians(45.0)
@@ -103,12 +126,12 @@ class RootCrack:
 
 @dataclass(frozen=True)
 class Spall:
-    """A rectangular spall (or pit) on the loaded flank of one tooth: ``length`` [m] along the
-    involute profile, ``width`` [m] across the face (less than the face width), ``depth`` [m]
-    into the tooth across its section, centred ``position`` [m] along the profile from the
-    reference (standard pitch) circle, positive towards the tip; on tooth ``tooth`` of
-    ``gear``. The spall must lie on the flank's active profile (checked with the mesh). A spall
-    of zero length, width or depth is the healthy tooth."""
+    """A rectangular spall (or pit) on flank ``flank`` ("drive" or "coast") of one tooth:
+    ``length`` [m] along the involute profile, ``width`` [m] across the face (less than the face
+    width), ``depth`` [m] into the tooth across its section, centred ``position`` [m] along the
+    profile from the reference (standard pitch) circle, positive towards the tip; on tooth
+    ``tooth`` of ``gear``. The spall must lie on the flank's active profile (checked with the
+    mesh). A spall of zero length, width or depth is the healthy tooth."""
 
     length: float
     width: float
@@ -116,6 +139,7 @@ class Spall:
     position: float = 0.0
     gear: str = "pinion"
     tooth: int = 0
+    flank: str = "drive"
 
     kind = "spall"
 
@@ -124,6 +148,7 @@ class Spall:
             _length(self, "spall", name)
         _length(self, "spall", "position", signed=True)
         _place(self, "spall")
+        _flank(self, "spall")
 
     @property
     def is_null(self) -> bool:
@@ -132,7 +157,8 @@ class Spall:
 
     def describe(self) -> str:
         """One line for the Dataset's attrs."""
-        return (f"spall on {self.gear} tooth {self.tooth}: {self.length:.6g} m along the profile"
+        return (f"spall on{_on(self)} {self.gear} tooth {self.tooth}: {self.length:.6g} m along"
+                f" the profile"
                 f" x {self.width:.6g} m across the face x {self.depth:.6g} m deep, centred"
                 f" {self.position:.6g} m from the reference circle")
 
@@ -143,17 +169,20 @@ WEAR_PROFILES = ("uniform", "archard")
 
 @dataclass(frozen=True)
 class Wear:
-    """Wear of the active profile of one tooth's loaded flank, on tooth ``tooth`` of ``gear``:
-    ``profile`` "uniform" removes ``depth`` [m] everywhere on it, "archard" follows Archard's
-    law along the flank (the sliding distance times the load, zero at the pitch point) with
-    ``depth`` [m] its largest value. The flank's sections thin by the local depth and its
-    contacts open a gap of it (the unloaded transmission error, see
+    """Wear of the active profile of flank ``flank`` ("drive" or "coast") of one tooth, on
+    tooth ``tooth`` of ``gear``: ``profile`` "uniform" removes ``depth`` [m] everywhere on it,
+    "archard" follows Archard's law along the flank (the sliding distance times the load, zero
+    at the pitch point) with ``depth`` [m] its largest value (on the coast flank the mirror of
+    the drive flank's: the same slip and load share at the mirrored contact). The tooth's
+    sections thin by the local depth and the flank's contacts open a gap of it (the unloaded
+    transmission error, ``fault_gap`` or ``fault_gap_coast``, see
     :func:`geardyn.gears.loaded_contact`). Zero depth is the healthy tooth."""
 
     depth: float
     gear: str = "pinion"
     tooth: int = 0
     profile: str = "uniform"
+    flank: str = "drive"
 
     kind = "wear"
 
@@ -163,6 +192,7 @@ class Wear:
         if self.profile not in WEAR_PROFILES:
             raise ParameterError("wear.profile", self.profile,
                                  f"must be one of {', '.join(WEAR_PROFILES)}")
+        _flank(self, "wear")
 
     @property
     def is_null(self) -> bool:
@@ -172,8 +202,8 @@ class Wear:
     def describe(self) -> str:
         """One line for the Dataset's attrs."""
         size = "" if self.profile == "uniform" else " at most"
-        return (f"{self.profile} wear on {self.gear} tooth {self.tooth}:{size} {self.depth:.6g} m"
-                " over the active profile")
+        return (f"{self.profile} wear on{_on(self)} {self.gear} tooth {self.tooth}:{size}"
+                f" {self.depth:.6g} m over the active profile")
 
 
 @dataclass(frozen=True)

@@ -282,8 +282,8 @@ def _flank(pair: PotentialEnergyPair, piece: PotentialEnergyPair, n: np.ndarray,
     position = u * p_b
     fp3, fw3 = (np.broadcast_to(x[:, :, None], u.shape) for x in (fp, fw))
     terms = _terms_on_grid(piece, position, inside, fp3, fw3, coast=coast)
-    gap = (np.zeros(u.shape) if coast else
-           _wear_gap(piece, position, inside, tooth_p[:, :, None], tooth_w[:, :, None]))
+    gap = _wear_gap(piece, position, inside, tooth_p[:, :, None], tooth_w[:, :, None],
+                    coast=coast)
     return {"ks": ks, "centre": centre * p_b, "position": position, "inside": inside,
             "tooth_p": tooth_p, "tooth_w": tooth_w, "terms": terms, "gap": gap}
 
@@ -313,8 +313,8 @@ def helical_stiffness(mesh: HelicalMesh, *, bore_radius: object, angles: object 
     flank likewise (``mesh_stiffness_coast``, ``pairs_in_contact_coast``,
     ``in_contact_coast``, ``tooth_pinion_coast``, ``tooth_wheel_coast``,
     ``pair_stiffness_coast``, ``slice_in_contact_coast``, ``slice_position_coast``,
-    ``slice_stiffness_coast`` over ``pair_coast``), each slice's coast flank shifted as its
-    drive flank.
+    ``slice_stiffness_coast``, ``fault_gap_coast`` over ``pair_coast``), each slice's coast
+    flank shifted as its drive flank.
 
     ``faults``: :class:`~geardyn.gears.RootCrack`, uniform :class:`~geardyn.gears.Wear` and
     :class:`~geardyn.gears.BrokenTooth` act on the whole face width of their tooth (a crack
@@ -336,6 +336,7 @@ def helical_stiffness(mesh: HelicalMesh, *, bore_radius: object, angles: object 
     data = _flank_variables(drive, count, "")
     data.update(_flank_variables(coast, count, "_coast"))
     data["fault_gap"] = (("angle", "pair", "slice"), drive["gap"])
+    data["fault_gap_coast"] = (("angle", "pair_coast", "slice"), coast["gap"])
     drive["terms"].pop("pair")
     for name, k in drive["terms"].items():
         data[f"k_{name}"] = (("angle", "pair", "slice"), np.where(drive["inside"], k, np.nan))

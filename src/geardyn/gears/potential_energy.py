@@ -77,13 +77,18 @@ flank passes the pitch point phi = s_w1 / p_w1 mesh cycles after its drive flank
 :func:`coast_phase`), so K_coast(c) = K_drive(phi - c) in mesh cycles c of the pinion, each
 flank taken in its own contact (the relative rotation between the two is the backlash).
 
-Faults (:mod:`geardyn.gears.faults`), each on its own tooth: a :class:`RootCrack` narrows the
-sections below Tian's crack limit line, a :class:`Spall` the sections under it and the Hertz
-contact on it, :class:`Wear` the sections of the active profile (and opens a gap, the
-``fault_gap`` that :func:`~geardyn.gears.loaded_contact` adds to the tip relief's), and a
-:class:`BrokenTooth` takes its pairs out of contact (see :func:`tooth_compliances` and
+Faults (:mod:`geardyn.gears.faults`), each on its own tooth (or a spall or wear on each flank
+of one): a :class:`RootCrack` narrows the sections below Tian's crack limit line, a
+:class:`Spall` the sections under it and the Hertz contact on it, :class:`Wear` the sections
+of the active profile (and opens a gap, the ``fault_gap`` that
+:func:`~geardyn.gears.loaded_contact` adds to the tip relief's), and a :class:`BrokenTooth`
+takes its pairs out of contact (see :func:`tooth_compliances` and
 :meth:`PotentialEnergyPair.terms`); the tooth indices of each pair follow the pitch-point
-passages.
+passages. A spall or wear lies on the drive or the coast flank (``flank``): the sections it
+thins are the tooth's, felt by the contacts of both flanks; its contact-width loss (spall) or
+gap (wear, ``fault_gap_coast`` on the coast flank) only by its own flank's contacts, at the same
+load angles on either flank. A root crack lies at the drive flank's root, its faces open under
+either load.
 """
 
 from __future__ import annotations
@@ -304,8 +309,9 @@ def _crack_section(h_q: float, b: float) -> Section:
 
 
 def _spall_section(width: float, depth: float, b: float) -> Section:
-    """(I, A) of the 2h x b section less a ``depth`` x ``width`` rectangle at the loaded flank,
-    I about the reduced section's own centroid (shifted by y_c towards the other flank)."""
+    """(I, A) of the 2h x b section less a ``depth`` x ``width`` rectangle at the spalled flank
+    (either: the section is the same mirrored), I about the reduced section's own centroid
+    (shifted by y_c towards the other flank)."""
     cut = width * depth
 
     def section(h: np.ndarray, al: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -319,7 +325,7 @@ def _spall_section(width: float, depth: float, b: float) -> Section:
 
 
 def _wear_section(depth: float, b: float) -> Section:
-    """(I, A) of sections thinned by ``depth`` at the loaded flank: 2h - depth thick."""
+    """(I, A) of sections thinned by ``depth`` at the worn flank: 2h - depth thick."""
     return lambda h, al: ((2.0 * h - depth) ** 3 * b / 12.0, (2.0 * h - depth) * b)
 
 
@@ -383,7 +389,7 @@ def half_thickness(tooth: ToothModel, alpha: float) -> float:
 
 @dataclass(frozen=True)
 class WearProfile:
-    """The wear depth along the loaded flank of a worn tooth: ``depth_at(t)`` [m] at the flank's
+    """The wear depth along the worn flank of a tooth: ``depth_at(t)`` [m] at the flank's
     roll angles t [rad] on its active profile, smooth between the roll angles ``rolls``
     (ascending, from the start of the active profile to the tip)."""
 
@@ -408,6 +414,68 @@ def _section_loss(tooth: ToothModel, fault: Spall | Wear, face_width: float,
     return sorted(a2 - t for t in profile.rolls), _profile_section(profile, a2, face_width)
 
 
+def _removal(tooth: ToothModel, fault: Spall | Wear, face_width: float,
+              profile: WearProfile | None) -> tuple[list[float], float, float, Callable]:
+    """(breaks, lo, hi, cut): the involute parameters (ascending) where ``fault``'s section loss
+    is not smooth, the range [lo, hi] of alpha it covers, and ``cut(al) -> (w, d)``: the width
+    and depth [m] of the rectangle it removes at its flank's face at alpha ``al``."""
+    a2 = tooth.half_base_angle
+    if isinstance(fault, Spall):
+        t_lo, t_hi = spall_rolls(tooth, fault)
+        w, d = fault.width, fault.depth
+        return ([a2 - t_hi, a2 - t_lo], a2 - t_hi, a2 - t_lo,
+                lambda al: (w, np.full(np.shape(al), d)))
+    breaks, _ = _section_loss(tooth, fault, face_width, profile)
+    if fault.profile == "uniform":
+        depth = fault.depth
+        return breaks, breaks[0], breaks[-1], lambda al: (face_width,
+                                                          np.full(np.shape(al), depth))
+    return (breaks, breaks[0], breaks[-1],
+            lambda al: (face_width, profile.depth_at(a2 - al)))  # type: ignore[union-attr]
+
+
+def _two_flank_section(cuts: list[tuple[float, np.ndarray]], b: float, h: np.ndarray
+                       ) -> tuple[np.ndarray, np.ndarray]:
+    """(I, A) of the 2h x b section less a w x d rectangle at each face, ``cuts`` [(w, d) at
+    the drive face, (w, d) at the coast face] (w = 0: nothing cut there), I about the reduced
+    section's centroid."""
+    (w1, d1), (w2, d2) = cuts
+    area = 2.0 * h * b - w1 * d1 - w2 * d2
+    arm1, arm2 = h - 0.5 * d1, h - 0.5 * d2  # the rectangles' centres from the centre line
+    y_c = (w2 * d2 * arm2 - w1 * d1 * arm1) / area
+    inertia = ((2.0 / 3.0) * h ** 3 * b - w1 * d1 ** 3 / 12.0 - w1 * d1 * arm1 ** 2
+               - w2 * d2 ** 3 / 12.0 - w2 * d2 * arm2 ** 2 - area * y_c ** 2)
+    return inertia, area
+
+
+def _two_flank_loss(tooth: ToothModel, faults: tuple[Spall | Wear, Spall | Wear],
+                    face_width: float, profiles: tuple[WearProfile | None, ...]
+                    ) -> tuple[list[float], list[Section | None]]:
+    """(breaks, sections): a drive- and a coast-flank fault on one tooth, the involute
+    parameters (ascending) between which the section is smooth and, between each two, its
+    (I, A), or None where neither fault thins it."""
+    removals = [_removal(tooth, f, face_width, p) for f, p in zip(faults, profiles, strict=True)]
+    if faults[0].flank == "coast":
+        removals = removals[::-1]
+    breaks = sorted({x for r in removals for x in r[0]})
+    sections: list[Section | None] = []
+    for lo, hi in zip(breaks, breaks[1:], strict=False):
+        mid = 0.5 * (lo + hi)
+        on = [r[1] <= mid <= r[2] for r in removals]
+        if not any(on):
+            sections.append(None)
+            continue
+
+        def section(h: np.ndarray, al: np.ndarray, on: list[bool] = on
+                    ) -> tuple[np.ndarray, np.ndarray]:
+            cuts = [r[3](al) if r_on else (0.0, np.zeros(np.shape(al)))
+                    for r, r_on in zip(removals, on, strict=True)]
+            return _two_flank_section(cuts, face_width, h)
+
+        sections.append(section)
+    return breaks, sections
+
+
 def _one_fault(fault: object, crack: object, where: str) -> object:
     """``fault``, or the deprecated ``crack`` keyword's value (one DeprecationWarning)."""
     if crack is None:
@@ -418,9 +486,25 @@ def _one_fault(fault: object, crack: object, where: str) -> object:
     return crack
 
 
+def _piecewise(tooth: ToothModel, a1: np.ndarray, lower: np.ndarray, top: np.ndarray,
+               breaks: list[float], sections: list[Section | None], young: float,
+               face_width: float, nodes: int) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`_involute_piece` from ``lower`` to ``top``, split at ``breaks`` (clipped to
+    that range), ``sections[i]`` between breaks i and i + 1, healthy outside them."""
+    cuts = [np.minimum(np.maximum(lower, x), top) for x in breaks]
+    bending, inv_area = _involute_piece(tooth, a1, lower, cuts[0], None, young, face_width,
+                                        nodes)
+    pieces = [(lo, hi, sec) for lo, hi, sec in zip(cuts, cuts[1:], sections, strict=False)]
+    for lo, hi, sec in [*pieces, (cuts[-1], top, None)]:
+        piece = _involute_piece(tooth, a1, lo, hi, sec, young, face_width, nodes)
+        bending, inv_area = bending + piece[0], inv_area + piece[1]
+    return bending, inv_area
+
+
 def tooth_compliances(tooth: ToothModel, alpha1: np.ndarray, *, young: float, poisson: float,
                       face_width: float, nodes: int = DEFAULT_NODES,
-                      fault: Fault | None = None, wear_profile: WearProfile | None = None,
+                      fault: Fault | tuple[Spall | Wear, Spall | Wear] | None = None,
+                      wear_profile: WearProfile | tuple[WearProfile | None, ...] | None = None,
                       crack: RootCrack | None = None) -> dict[str, np.ndarray]:
     """Compliances 1/k_b, 1/k_s, 1/k_a, 1/k_f [m/N] of ``tooth`` loaded at the load angles
     ``alpha1`` [rad] (any shape), by name (:data:`TOOTH_TERMS`), with ``fault`` (its gear and
@@ -431,7 +515,7 @@ def tooth_compliances(tooth: ToothModel, alpha1: np.ndarray, *, young: float, po
       fillet term stays healthy (Chen & Shao 2011). Cracks reaching past the centre line
       (q sin v >= h_r) are refused.
     * :class:`Spall`: the sections whose flank point lies on the spall lose a depth x width
-      rectangle at the loaded flank: A = 2hb - w d, I about the reduced section's centroid
+      rectangle at the spalled flank: A = 2hb - w d, I about the reduced section's centroid
       (after Saxena, Parey & Chouksey 2016; Liang, Zhang, Liu & Zuo 2016); bending arm and
       fillet unchanged. The
       contact width (Hertz) is the pair's: see :class:`PotentialEnergyPair`.
@@ -439,6 +523,15 @@ def tooth_compliances(tooth: ToothModel, alpha1: np.ndarray, *, young: float, po
       thin to 2h - h_w (Chen, Lei, Fu & Hou 2021), h_w the uniform depth or, for Archard's
       profile, ``wear_profile``'s depth at the section's flank point
       (:meth:`PotentialEnergyPair.wear_profile`); fillet unchanged.
+
+    The symmetric tooth's sections are the same whichever flank a spall or wear is on, and the
+    same under either flank's load at the same ``alpha1``: ``fault.flank`` is not looked at
+    here.
+
+    ``fault`` may also be a tuple (drive-flank fault, coast-flank fault) of a spall or wear
+    on each flank of the tooth (``wear_profile`` then a tuple of their profiles): each section
+    loses a rectangle at each face (a spall's w x d, wear's b x h_w) where that fault lies, I
+    about the reduced section's centroid.
 
     ``crack=`` is the deprecated spelling of ``fault=`` for a root crack. A
     :class:`BrokenTooth` has no compliance (refused). A ring's tooth (``tooth.internal``) is
@@ -460,7 +553,14 @@ def tooth_compliances(tooth: ToothModel, alpha1: np.ndarray, *, young: float, po
     h_q: float | None = None
     if isinstance(fault, BrokenTooth):
         raise ParameterError("fault", fault, "a missing tooth has no compliance")
-    if fault is None or fault.is_null:
+    if isinstance(fault, tuple):
+        if not (len(fault) == 2 and all(isinstance(f, (Spall, Wear)) for f in fault)
+                and {f.flank for f in fault} == {"drive", "coast"}):
+            raise ParameterError("fault", fault, "a tuple of faults must be a spall or wear on"
+                                 " each flank (flank='drive' and flank='coast')")
+        breaks, sections = _two_flank_loss(tooth, fault, b, wear_profile or (None, None))
+        bending, inv_area = _piecewise(tooth, a1, lower, top, breaks, sections, e, b, nodes)
+    elif fault is None or fault.is_null:
         bending, inv_area = _involute_piece(tooth, a1, lower, top, None, e, b, nodes)
     elif isinstance(fault, RootCrack):
         h_r = root_half_thickness(tooth)
@@ -476,12 +576,8 @@ def tooth_compliances(tooth: ToothModel, alpha1: np.ndarray, *, young: float, po
         bending, inv_area = bend_h + bend_c, area_h + area_c
     elif isinstance(fault, (Spall, Wear)):
         breaks, section = _section_loss(tooth, fault, b, wear_profile)
-        cuts = [np.minimum(np.maximum(lower, x), top) for x in breaks]
-        bending, inv_area = _involute_piece(tooth, a1, lower, cuts[0], None, e, b, nodes)
-        pieces = [(lo, hi, section) for lo, hi in zip(cuts, cuts[1:], strict=False)]
-        for lo, hi, sec in [*pieces, (cuts[-1], top, None)]:
-            piece = _involute_piece(tooth, a1, lo, hi, sec, e, b, nodes)
-            bending, inv_area = bending + piece[0], inv_area + piece[1]
+        bending, inv_area = _piecewise(tooth, a1, lower, top, breaks,
+                                       [section] * (len(breaks) - 1), e, b, nodes)
     else:
         raise ParameterError("fault", fault, "must be a RootCrack, Spall, Wear or None")
     cos1, sin1 = np.cos(a1), np.sin(a1)
@@ -511,7 +607,7 @@ def _ring_compliances(tooth: ToothModel, a1: np.ndarray, *, young: float, poisso
     (Tian's crack limit line from the crack tip towards the tip; sections towards the root
     beyond it h + h_q thick)."""
     crack = isinstance(fault, RootCrack) and not fault.is_null
-    if fault is not None and not crack and (isinstance(fault, BrokenTooth)
+    if fault is not None and not crack and (isinstance(fault, (BrokenTooth, tuple))
                                             or not fault.is_null):
         raise ParameterError(f"{getattr(fault, 'kind', 'fault')}.gear", tooth.name,
                              "on a ring's tooth only a root crack or a missing tooth is"
@@ -676,45 +772,56 @@ class PotentialEnergyPair:
 
         return WearProfile(rolls, depth_at)
 
-    def profile_of(self, fault: Fault | None) -> WearProfile | None:
-        """The :class:`WearProfile` of a :class:`Wear` of this pair's ``faults``, else None."""
+    def profile_of(self, fault: Fault | tuple | None
+                   ) -> WearProfile | tuple[WearProfile | None, ...] | None:
+        """The :class:`WearProfile` of a :class:`Wear` of this pair's ``faults``, else None (a
+        tuple of faults on one tooth: a tuple of theirs)."""
+        if isinstance(fault, tuple):
+            return tuple(self.profile_of(f) for f in fault)  # type: ignore[misc]
         for wear, profile in self.wear_profiles:
             if wear is fault:
                 return profile
         return None
 
-    def _lost_width(self, tooth: ToothModel, fault: Fault | None,
-                    a1: np.ndarray) -> np.ndarray | None:
-        """The face width [m] a spall takes from contacts at load angles ``a1`` on its flank
-        (0 off the spall), or None without a spall."""
-        if not isinstance(fault, Spall) or fault.is_null:
+    def _lost_width(self, tooth: ToothModel, fault: Fault | tuple | None, a1: np.ndarray,
+                    flank: str) -> np.ndarray | None:
+        """The face width [m] a spall takes from contacts at load angles ``a1`` on ``flank``
+        (0 off the spall), or None without a spall on that flank (``fault``: one fault, or the
+        faults on the tooth's two flanks)."""
+        if isinstance(fault, tuple):
+            fault = next((f for f in fault if f.flank == flank), None)
+        if not isinstance(fault, Spall) or fault.is_null or fault.flank != flank:
             return None
         t_lo, t_hi = spall_rolls(tooth, fault)
         roll = a1 + tooth.half_base_angle
         return np.where((roll >= t_lo) & (roll <= t_hi), fault.width, 0.0)
 
-    def terms(self, position: np.ndarray, pinion: Fault | None = None,
-              wheel: Fault | None = None, *, coast: bool = False) -> dict[str, np.ndarray]:
+    def terms(self, position: np.ndarray, pinion: Fault | tuple | None = None,
+              wheel: Fault | tuple | None = None, *, coast: bool = False
+              ) -> dict[str, np.ndarray]:
         """Stiffness [N/m] of each energy term (``hertz``, ``bending_pinion``, ...,
         ``fillet_wheel``) and of the pair (``pair``) for contacts at ``position`` [m] between a
         pinion tooth with the fault ``pinion`` and a wheel tooth with ``wheel`` (None:
-        healthy). A spall on the loaded flank narrows the Hertz contact to b - w where the
+        healthy; a tuple: a drive- and a coast-flank fault on that tooth). ``coast``: the
+        contacts are on the coast flanks (``position`` on the coast line of action, the same
+        load angles as on the drive flank there). A spall on the loaded flank (``flank``
+        "drive", or "coast" with ``coast``) narrows the Hertz contact to b - w where the
         contact lies on it (Chaari, Baccar, Abbes & Haddar 2008; the wider spall where both
-        teeth have one there); ``coast``: the contacts are on the coast flanks, which a spall
-        does not touch. A ring's ``fillet_wheel`` is inf (rigid ring body)."""
+        teeth have one there); a spall on the other flank only thins the sections. A ring's
+        ``fillet_wheel`` is inf (rigid ring body)."""
         pos = np.asarray(position, dtype=float)
         a_p, a_w = self.load_angles(pos)
         kw = dict(young=self.young, poisson=self.poisson, face_width=self.face_width,
                   nodes=self.nodes)
         out = {"hertz": np.full(pos.shape, self.hertz)}
-        if not coast:
-            lost = [w for w in (self._lost_width(self.pinion, pinion, a_p),
-                                self._lost_width(self.wheel, wheel, a_w)) if w is not None]
-            if lost:
-                width = self.face_width - np.maximum.reduce(lost)
-                out["hertz"] = np.where(width < self.face_width,
-                                        hertz_stiffness(self.young, self.poisson, width),
-                                        self.hertz)
+        flank = "coast" if coast else "drive"
+        lost = [w for w in (self._lost_width(self.pinion, pinion, a_p, flank),
+                            self._lost_width(self.wheel, wheel, a_w, flank)) if w is not None]
+        if lost:
+            width = self.face_width - np.maximum.reduce(lost)
+            out["hertz"] = np.where(width < self.face_width,
+                                    hertz_stiffness(self.young, self.poisson, width),
+                                    self.hertz)
         compliance = 1.0 / out["hertz"]
         for role, tooth, a1, fault in (("pinion", self.pinion, a_p, pinion),
                                        ("wheel", self.wheel, a_w, wheel)):
@@ -803,8 +910,8 @@ def prepare_pair(mesh: GearMesh, *, bore_radius: object, young: object = STEEL_Y
 
 def _check_faults(faults: tuple[object, ...], mesh: GearMesh, teeth: list[ToothModel],
                   width: float) -> None:
-    """Each fault a fault object, on a tooth that exists, one fault a tooth, and fitting its
-    tooth (errors name the fault's field)."""
+    """Each fault a fault object, on a tooth that exists, one fault a tooth (or a spall or
+    wear on each flank), and fitting its tooth (errors name the fault's field)."""
     seen: dict[tuple[str, int], object] = {}
     for fault in faults:
         if not isinstance(fault, (RootCrack, Spall, Wear, BrokenTooth)):
@@ -816,9 +923,10 @@ def _check_faults(faults: tuple[object, ...], mesh: GearMesh, teeth: list[ToothM
             raise ParameterError(f"{kind}.tooth", fault.tooth, f"must lie in [0, {z - 1}]")
         key = (fault.gear, fault.tooth)
         if key in seen:
-            raise ParameterError("faults", fault, f"{fault.gear} tooth {fault.tooth} already"
-                                 f" has a fault ({seen[key]!r}): one fault a tooth")
-        seen[key] = fault
+            _second_fault(fault, seen[key])
+            seen[key] = (seen[key], fault)
+        else:
+            seen[key] = fault
         tooth = teeth[0] if fault.gear == "pinion" else teeth[1]
         if tooth.internal and not isinstance(fault, (BrokenTooth, RootCrack)):
             raise ParameterError(f"{kind}.gear", fault.gear,
@@ -834,6 +942,19 @@ def _check_faults(faults: tuple[object, ...], mesh: GearMesh, teeth: list[ToothM
                 raise ParameterError("wear.depth", fault.depth,
                                      f"must be less than the half thickness at the tip,"
                                      f" {h_tip:.4g} m")
+
+
+def _second_fault(fault: object, first: object) -> None:
+    """Refuse ``fault`` on a tooth that already has ``first`` unless they are a spall or wear
+    on each flank (error ``faults``)."""
+    flank_faults = (Spall, Wear)
+    if (isinstance(fault, flank_faults) and isinstance(first, flank_faults)
+            and fault.flank != first.flank):
+        return
+    where = f"{getattr(fault, 'gear', '?')} tooth {getattr(fault, 'tooth', '?')}"
+    raise ParameterError("faults", fault, f"{where} already has {first!r}: one fault a tooth,"
+                         " or a spall or wear on each of its two flanks (flank='drive' and"
+                         " flank='coast')")
 
 
 def _check_crack(crack: RootCrack, tooth: ToothModel) -> None:
@@ -912,30 +1033,49 @@ def coast_phase(mesh: GearMesh) -> float:
     return mesh.pinion.angular_thickness(r_w1) * mesh.pinion.teeth / (2.0 * math.pi)
 
 
+def _tooth_faults(pair: PotentialEnergyPair) -> list[tuple[str, int, Fault | tuple]]:
+    """(gear, tooth, fault) of each faulty tooth in the order of ``pair.faults``, zero-size
+    faults and missing teeth left out; a tooth with a fault on each flank holds the tuple
+    (drive fault, coast fault)."""
+    found: dict[tuple[str, int], list] = {}
+    for fault in pair.faults:
+        if not isinstance(fault, BrokenTooth) and not fault.is_null:
+            found.setdefault((fault.gear, fault.tooth), []).append(fault)
+    out = []
+    for (gear, tooth), faults in found.items():
+        if len(faults) == 1:
+            out.append((gear, tooth, faults[0]))
+        else:
+            out.append((gear, tooth, tuple(sorted(faults, key=lambda f: f.flank != "drive"))))
+    return out
+
+
 def _fault_codes(pair: PotentialEnergyPair, tooth_p: np.ndarray,
                  tooth_w: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Per pair slot: the index into ``pair.faults`` of the pinion and the wheel tooth's fault
-    (-1: none, or one of zero size), and whether either tooth is missing."""
+    """Per pair slot: the index into :func:`_tooth_faults` of the pinion and the wheel tooth's
+    fault (-1: none, or of zero size), and whether either tooth is missing."""
     mesh = pair.mesh
     luts = {"pinion": np.full(mesh.pinion.teeth, -1), "wheel": np.full(mesh.wheel.teeth, -1)}
     gone = {"pinion": np.zeros(mesh.pinion.teeth, bool),
             "wheel": np.zeros(mesh.wheel.teeth, bool)}
-    for i, fault in enumerate(pair.faults):
+    for fault in pair.faults:
         if isinstance(fault, BrokenTooth):
             gone[fault.gear][fault.tooth] = True
-        elif not fault.is_null:
-            luts[fault.gear][fault.tooth] = i
+    for i, (gear, tooth, _) in enumerate(_tooth_faults(pair)):
+        luts[gear][tooth] = i
     return (luts["pinion"][tooth_p], luts["wheel"][tooth_w],
             gone["pinion"][tooth_p] | gone["wheel"][tooth_w])
 
 
 def _wear_gap(pair: PotentialEnergyPair, position: np.ndarray, inside: np.ndarray,
-              tooth_p: np.ndarray, tooth_w: np.ndarray) -> np.ndarray:
-    """The gap [m] the worn teeth open at the drive contacts ``inside`` (0 elsewhere): the
-    wear depth at each contact's point of the worn flank, both teeth's added."""
+              tooth_p: np.ndarray, tooth_w: np.ndarray, *, coast: bool = False) -> np.ndarray:
+    """The gap [m] the worn teeth open at the drive (``coast``: coast) contacts ``inside`` (0
+    elsewhere): the wear depth at each contact's point of the worn flank, both teeth's added;
+    only wear on the flank of the contacts opens one."""
     gap = np.zeros(position.shape)
+    flank = "coast" if coast else "drive"
     for wear, profile in pair.wear_profiles:
-        if wear.is_null:
+        if wear.is_null or wear.flank != flank:
             continue
         mask = inside & ((tooth_p if wear.gear == "pinion" else tooth_w) == wear.tooth)
         if mask.any():
@@ -967,12 +1107,13 @@ def _coast(pair: PotentialEnergyPair, n: np.ndarray,
     inside &= ~gone
     k_pair = np.where(inside, _terms_on_grid(pair, position, inside, fp, fw, coast=True)["pair"],
                       0.0)
+    gap = _wear_gap(pair, position, inside, tooth_p, tooth_w, coast=True)
     dims = ("angle", "pair_coast")
     return {"mesh_stiffness_coast": (("angle",), k_pair.sum(axis=1)),
             "pairs_in_contact_coast": (("angle",), inside.sum(axis=1)),
             "in_contact_coast": (dims, inside), "position_coast": (dims, position),
             "tooth_pinion_coast": (dims, tooth_p), "tooth_wheel_coast": (dims, tooth_w),
-            "pair_stiffness_coast": (dims, k_pair)}, ks
+            "pair_stiffness_coast": (dims, k_pair), "fault_gap_coast": (dims, gap)}, ks
 
 
 def potential_energy_stiffness(mesh: GearMesh, *, bore_radius: object, angles: object = 360,
@@ -999,20 +1140,21 @@ def potential_energy_stiffness(mesh: GearMesh, *, bore_radius: object, angles: o
     to its end (excluded), unless one of its teeth is missing. ``bore_radius`` [m]: one radius
     or (pinion, wheel); ``young`` [Pa], ``poisson``; ``nodes``: Gauss-Legendre nodes.
     ``faults``: one fault or a sequence (:class:`RootCrack`, :class:`Spall`, :class:`Wear`,
-    :class:`BrokenTooth`), each on its own tooth (see :func:`tooth_compliances` and
-    :class:`PotentialEnergyPair`); a pinion tooth returns every z1 mesh cycles, a wheel tooth
-    every z2 (the hunting period: lcm(z1, z2) cycles). ``crack=`` is the deprecated spelling of
-    ``faults=(crack,)``.
+    :class:`BrokenTooth`), each on its own tooth, or a spall or wear on each flank of one
+    (see :func:`tooth_compliances` and :class:`PotentialEnergyPair`); a pinion tooth returns
+    every z1 mesh cycles, a wheel tooth every z2 (the hunting period: lcm(z1, z2) cycles).
+    ``crack=`` is the deprecated spelling of ``faults=(crack,)``.
 
     The coast flank: ``mesh_stiffness_coast`` [N/m], ``pairs_in_contact_coast`` and per coast
     pair (dimension ``pair_coast``) ``in_contact_coast``, ``position_coast`` [m] (on the coast
     line of action from the pitch point, positive towards the pinion tip),
-    ``tooth_pinion_coast``, ``tooth_wheel_coast``, ``pair_stiffness_coast`` [N/m], at the same
-    pinion angles with the pinion turned onto its coast flanks (see ``_coast``); attrs
-    ``coast_phase_cycles`` (phi), ``backlash_m`` and ``backlash_cycles`` (j / p_w1, the dead
-    zone between the flanks). Faults sit on the drive flank: a crack, a spall or wear thins the
-    tooth's sections under either flank's load (crack faces taken open); a spall's contact
-    width and wear's gap act on the drive flank only; a missing tooth carries on neither.
+    ``tooth_pinion_coast``, ``tooth_wheel_coast``, ``pair_stiffness_coast`` [N/m],
+    ``fault_gap_coast`` [m], at the same pinion angles with the pinion turned onto its coast
+    flanks (see ``_coast``); attrs ``coast_phase_cycles`` (phi), ``backlash_m`` and
+    ``backlash_cycles`` (j / p_w1, the dead zone between the flanks). A crack (at the drive
+    flank's root, faces taken open), a spall or wear thins the tooth's sections under either
+    flank's load; a spall's contact-width loss and wear's gap act on the contacts of its own
+    ``flank`` ("drive" or "coast") only; a missing tooth carries on neither.
 
     An internal ``mesh`` (``mesh.internal``): the wheel is the ring, its terms (``*_wheel``)
     the ring tooth's (:func:`ring_tooth_model`); ``bore_radius``'s second value is the ring's
@@ -1054,7 +1196,7 @@ def potential_energy_stiffness(mesh: GearMesh, *, bore_radius: object, angles: o
     ds = xr.Dataset(data, coords={"angle": deg, "cycle": ("angle", cyc), "pair": ks,
                                   "pair_coast": ks_c})
     for name in ds.data_vars:
-        ds[name].attrs["units"] = ("m" if name.startswith("position") or name == "fault_gap"
+        ds[name].attrs["units"] = ("m" if name.startswith(("position", "fault_gap"))
                                    else _units(name))
     ds["angle"].attrs.update(units="deg", long_name="pinion rotation")
     ds["cycle"].attrs.update(units="", long_name="mesh cycles")
@@ -1066,7 +1208,8 @@ def _terms_on_grid(pair: PotentialEnergyPair, position: np.ndarray, inside: np.n
                    fp: np.ndarray, fw: np.ndarray, *, coast: bool = False) -> dict[str, np.ndarray]:
     """Every term at the contacts ``inside`` (0 elsewhere), each distinct position evaluated
     once (a grid over many mesh cycles repeats the positions of one cycle exactly), then again
-    for each combination (``fp``, ``fw``) of faults on the teeth in contact that occurs."""
+    for each combination (``fp``, ``fw``: indices into :func:`_tooth_faults`) of faults on the
+    teeth in contact that occurs."""
     where, inverse = np.unique(position[inside], return_inverse=True)
     healthy = pair.terms(where, coast=coast)
     out = {}
@@ -1075,11 +1218,12 @@ def _terms_on_grid(pair: PotentialEnergyPair, position: np.ndarray, inside: np.n
         out[name][inside] = values[inverse]
     faulty = inside & ((fp >= 0) | (fw >= 0))
     if faulty.any():
+        entries = [f for _, _, f in _tooth_faults(pair)]
         for ip, iw in np.unique(np.stack([fp[faulty], fw[faulty]], axis=1), axis=0):
             mask = faulty & (fp == ip) & (fw == iw)
             where, inverse = np.unique(position[mask], return_inverse=True)
-            values = pair.terms(where, pair.faults[ip] if ip >= 0 else None,
-                                pair.faults[iw] if iw >= 0 else None, coast=coast)
+            values = pair.terms(where, entries[ip] if ip >= 0 else None,
+                                entries[iw] if iw >= 0 else None, coast=coast)
             for name, v in values.items():
                 out[name][mask] = v[inverse]
     return out
