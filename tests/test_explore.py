@@ -538,6 +538,7 @@ def test_the_page_shows_the_stiffness_and_a_fault_control(spur):
         page.runner.wait(60)
         assert page.input_messages["faults[0].depth"].text == ""
         assert np.min(page.stiffness_source.data["drive"]) > np.min(drive)  # shallower crack
+        assert "depth 0.0005 m" in page.stiffness_faults.text
         assert page.request.model is spur.model
     finally:
         page.runner.shutdown()

@@ -193,11 +193,11 @@ class ExplorerSession:
             extra.append(column(Div(text="<b>geometry and faults</b> (study-file keys)"),
                                 row(*geometry)))
         self.stiffness_fig = None
-        self.stiffness_fig = self._stiffness_figure(figure, ColumnDataSource)
+        stiffness_panel = self._stiffness_figure(figure, ColumnDataSource, Div, column)
         self.layout = column(
             Div(text=f"<b>geardyn explore</b>: {html.escape(st.study.study.name)}"),
             top, self.progress, self.message, row(*controls), *extra, fig, *self.bands,
-            bands_legend, *([self.stiffness_fig] if self.stiffness_fig is not None else []),
+            bands_legend, *([stiffness_panel] if stiffness_panel is not None else []),
             self.command, self.saved, self.orbit_text,
             row(orbit_figs[0], orbit_figs[1]), row(orbit_figs[2], orbit_figs[3]),
             name="layout")
@@ -214,9 +214,9 @@ class ExplorerSession:
         self.inputs[name], self.input_messages[name] = box, msg
         return column(box, msg)
 
-    def _stiffness_figure(self, figure, ColumnDataSource):  # noqa: N803
+    def _stiffness_figure(self, figure, ColumnDataSource, Div, column):  # noqa: N803
         """The mesh stiffness panel of a model built from geometry (None for other models):
-        drive and coast flank, the table and the model's series."""
+        drive and coast flank, the table and the model's series, and the faults' line."""
         view = stiffness_view(self.state.model)
         if view is None:
             self.stiffness_source = None
@@ -224,23 +224,26 @@ class ExplorerSession:
         self.stiffness_source = ColumnDataSource(
             {"cycle": [], "drive": [], "coast": [], "drive_series": [], "coast_series": []},
             name="stiffness")
-        fig = figure(height=300, width=900, tools="pan,wheel_zoom,box_zoom,reset",
-                     name="stiffness_fig", title=view.title(),
-                     x_axis_label="mesh cycles (of the forcing period)",
+        fig = figure(frame_height=240, frame_width=FRAME_WIDTH, min_border_left=BORDER_LEFT,
+                     tools="pan,wheel_zoom,box_zoom,reset", name="stiffness_fig",
+                     title=view.title(), x_axis_label="mesh cycles (of the forcing period)",
                      y_axis_label="mesh stiffness [N/m]")
         src = self.stiffness_source
         for column_name, color, dash, label in (
                 ("drive", "#1f77b4", "solid", "drive, table"),
-                ("drive_series", "#1f77b4", "dashed", "drive, series (model)"),
+                ("drive_series", "#1f77b4", "dashed", "drive, series"),
                 ("coast", "#ff7f0e", "solid", "coast, table"),
-                ("coast_series", "#ff7f0e", "dashed", "coast, series (model)")):
+                ("coast_series", "#ff7f0e", "dashed", "coast, series")):
             fig.line("cycle", column_name, source=src, color=color, line_dash=dash,
                      legend_label=label)
-        fig.legend.label_text_font_size = "8pt"
-        fig.legend.click_policy = "hide"
+        legend = fig.legend[0]
+        legend.label_text_font_size = "8pt"
+        legend.click_policy = "hide"
+        fig.add_layout(legend, "right")
         self.stiffness_fig = fig
+        self.stiffness_faults = Div(text="", name="stiffness_faults", width=900)
         self._show_stiffness(self.state.model)
-        return fig
+        return column(fig, self.stiffness_faults)
 
     def _show_stiffness(self, model) -> None:
         """The stiffness panel shows ``model``'s stiffness."""
@@ -254,6 +257,7 @@ class ExplorerSession:
             "drive_series": view.drive_series, "coast_series": view.coast_series}
         if self.stiffness_fig is not None:
             self.stiffness_fig.title.text = view.title()
+            self.stiffness_faults.text = "faults: " + html.escape(view.faults)
 
     def _orbit_figures(self, figure, ColumnDataSource) -> list:  # noqa: N803
         from bokeh.models import LabelSet, Range1d

@@ -221,8 +221,8 @@ class StiffnessView:
     faults: str
 
     def title(self) -> str:
-        return (f"mesh stiffness over the forcing period ({self.harmonics} harmonics; faults: "
-                f"{self.faults})")
+        return (f"mesh stiffness over the forcing period: the table and the model's series "
+                f"({self.harmonics} harmonics)")
 
 
 def stiffness_view(model: Any) -> StiffnessView | None:
