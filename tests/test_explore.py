@@ -542,3 +542,34 @@ def test_the_page_shows_the_stiffness_and_a_fault_control(spur):
         assert page.request.model is spur.model
     finally:
         page.runner.shutdown()
+
+
+def test_every_fault_kind_gets_its_numeric_fields_as_controls(tmp_path):
+    """A spall and a wear table: their controls are the numeric fields of Spall and Wear
+    (the text fields gear and profile are not controls); a spall off the flank is refused naming
+    faults[0].position; new wear depth gives SpurPair.from_geometry of the pair by hand."""
+    import geardyn.gears as g
+    from geardyn.io.toml import builtin_study_text
+
+    crack = 'kind = "crack"\ngear = "pinion"\ntooth = 9\ndepth = "2 mm"\nangle = "45 deg"'
+    faults = ('kind = "spall"\ngear = "pinion"\ntooth = 9\nlength = "1 mm"\nwidth = "4 mm"\n'
+              'depth = "0.2 mm"\n\n[[faults]]\nkind = "wear"\ngear = "pinion"\ntooth = 3\n'
+              'depth = "10 um"')
+    text = builtin_study_text("spur_pair_cracked")
+    assert crack in text
+    text = text.replace(crack, faults).replace("angles = 64", "angles = 16").replace(
+        "harmonics = 76", "harmonics = 38")
+    st = ExplorerState(load_study(text), "spur.toml", save_dir=tmp_path,
+                       describe_error=format_error)
+    assert st.geometry_params()[2:] == (
+        "faults[0].length", "faults[0].width", "faults[0].depth", "faults[0].position",
+        "faults[0].tooth", "faults[1].depth", "faults[1].tooth")
+    assert st.current_value("faults[0].position") == 0.0  # Spall's default
+    model = st.model
+    msg = st.set_override("faults[0].position", "20 mm")
+    assert msg.startswith("faults[0].position: off the active flank of pinion"), msg
+    assert st.overrides == {} and st.model is model
+    assert st.set_override("faults[1].depth", "20 um") is None
+    spall = g.Spall("1 mm", "4 mm", "0.2 mm", gear="pinion", tooth=9)
+    wear = g.Wear("20 um", gear="pinion", tooth=3)
+    assert st.model.params.tobytes() == _spur_model_by_hand(spall, wear).params.tobytes()
