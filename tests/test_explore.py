@@ -353,3 +353,223 @@ def test_an_override_keeps_a_transient_in_forcing_periods(tmp_path):
     assert st.set_override("zeta", "0.08") is None
     assert st.effective_study.run.transient_periods == 30
     assert st.run_settings().transient == pytest.approx(30 * 2 * np.pi / 1.6, rel=1e-15)
+
+
+# ---------------------------------------------------------------------- a model built from geometry
+#: The shipped cracked 19/48 spur pair at small sizes: 16 angles per mesh cycle, 38 harmonics,
+#: short runs; the window is 3 speeds in rpm.
+SPUR_WINDOW = Window(16000.0, 20000.0, 3)
+RPM = 2.0 * np.pi / 60.0
+
+
+def _spur_study():
+    from geardyn.io.toml import builtin_study_text
+
+    text = builtin_study_text("spur_pair_cracked")
+    for old, new in (("angles = 64", "angles = 16"), ("harmonics = 76", "harmonics = 38"),
+                     ("transient_periods = 20", "transient_periods = 5"),
+                     ("periods = 32", "periods = 4")):
+        assert old in text, old
+        text = text.replace(old, new)
+    return load_study(text)
+
+
+@pytest.fixture()
+def spur(tmp_path):
+    return ExplorerState(_spur_study(), "spur_pair_cracked", window=SPUR_WINDOW,
+                         save_dir=tmp_path / "saved", describe_error=format_error)
+
+
+def _spur_by_hand(*faults, pinion_bore="12 mm"):
+    """The study's pair from its literal values (not through the study or the explorer):
+    19/48, m 3.2 mm, 20 deg, b 16 mm, bores 12 (or ``pinion_bore``) and 35 mm, steel; 16
+    angles per mesh cycle over one pinion revolution (19 mesh cycles)."""
+    import geardyn.gears as g
+
+    mesh = g.GearMesh(g.SpurGear(19, "3.2 mm", "20 deg", "16 mm", name="pinion"),
+                      g.SpurGear(48, "3.2 mm", "20 deg", "16 mm", name="wheel"))
+    kw = {"bore_radius": (pinion_bore, "35 mm"), "angles": 16, "young": "206.8 GPa",
+          "poisson": 0.3, "faults": faults}
+    return mesh, kw
+
+
+def _spur_model_by_hand(*faults, pinion_bore="12 mm"):
+    import geardyn
+
+    mesh, kw = _spur_by_hand(*faults, pinion_bore=pinion_bore)
+    return geardyn.SpurPair.from_geometry(
+        mesh, **kw, speed=18000.0, speed_unit="rpm", torque=20.0, zeta=0.05, backlash=10e-6,
+        harmonics=38)
+
+
+def test_a_geometry_model_offers_its_faults_and_bores_as_controls(spur):
+    """The controls of the cracked pair: the bores, then the crack's numeric fields (from the
+    RootCrack dataclass: depth, angle, tooth), by their study-file keys, with the study's
+    values; a gear-pair study has none."""
+    assert spur.geometry_params() == ("gears.pinion.bore_radius", "gears.wheel.bore_radius",
+                                      "faults[0].depth", "faults[0].angle", "faults[0].tooth")
+    assert spur.current_value("faults[0].depth") == "2 mm"
+    assert spur.current_value("faults[0].tooth") == 9
+    assert spur.current_value("gears.pinion.bore_radius") == pytest.approx(0.012, rel=1e-15)
+    assert "harmonics" in spur.main_params()
+    assert "harmonics" in spur.param_help("harmonics")
+    assert "crack on the pinion" in spur.param_help("faults[0].depth")
+    assert ExplorerState(load_study(STUDY), "gp.toml").geometry_params() == ()
+
+
+def test_a_crack_depth_rebuilds_the_model_as_from_geometry_by_hand(spur):
+    """A new crack depth through the explorer's state: the model's coefficients are those of
+    SpurPair.from_geometry of the pair built here with that crack (bitwise), the diagram is the
+    one geardyn.bifurcation gives on that model, and it differs from the healthy pair's."""
+    import geardyn
+    import geardyn.gears as g
+
+    assert spur.set_override("faults[0].depth", "1.5 mm") is None
+    crack = g.RootCrack("1.5 mm", "45 deg", gear="pinion", tooth=9)
+    by_hand = _spur_model_by_hand(crack)
+    assert spur.model.params.tobytes() == by_hand.params.tobytes()
+    req = spur.diagram_request()
+    cracked = compute_diagram(req)
+    speeds = SPUR_WINDOW.values()
+    api = geardyn.bifurcation(by_hand, "speed", speeds, req.run)
+    assert cracked["poincare"].values.tobytes() == api["poincare"].values.tobytes()
+    healthy_model = _spur_model_by_hand()
+    assert not np.array_equal(healthy_model.params, by_hand.params)
+    healthy = geardyn.bifurcation(healthy_model, "speed", speeds, req.run)
+    assert np.all(np.isfinite(cracked["poincare"].values))
+    assert not np.allclose(cracked["poincare"].values, healthy["poincare"].values,
+                           rtol=1e-6, atol=0.0)
+    # a zero-depth crack is the healthy pair, bitwise
+    assert spur.set_override("faults[0].depth", "0 mm") is None
+    assert spur.model.params.tobytes() == healthy_model.params.tobytes()
+
+
+def test_an_invalid_geometry_value_names_its_field_and_changes_nothing(spur):
+    model = spur.model
+    msg = spur.set_override("faults[0].depth", "5 mm")  # reach 3.5 mm > root half thickness
+    assert msg.startswith("faults[0].depth: the crack reaches 0.003536 m across the tooth, "
+                          "past its centre line"), msg
+    assert spur.set_override("faults[0].depth", "-1").startswith("faults[0].depth: must be")
+    assert spur.set_override("gears.pinion.bore_radius", "30 mm").startswith(
+        "gears.pinion.bore_radius: must lie between 0 and the root radius")
+    assert spur.set_override("faults[1].depth", "1 mm") == \
+        "faults[1].depth: not a parameter of this explorer"
+    assert spur.overrides == {} and spur.model is model
+
+
+def test_the_stiffness_panel_is_the_potential_energy_stiffness(spur):
+    """The panel's tables are potential_energy_stiffness of the same geometry (computed here),
+    its series a direct Fourier sum of them cut after the model's harmonics."""
+    import geardyn.gears as g
+    from geardyn.explore.compute import stiffness_view
+
+    assert spur.set_override("faults[0].depth", "1 mm") is None
+    assert spur.set_override("gears.pinion.bore_radius", "15 mm") is None
+    view = stiffness_view(spur.model)
+    crack = g.RootCrack("1 mm", "45 deg", gear="pinion", tooth=9)
+    mesh, kw = _spur_by_hand(crack, pinion_bore="15 mm")
+    table = g.potential_energy_stiffness(mesh, **kw, cycles=19)
+    np.testing.assert_array_equal(view.cycle, table["cycle"].values)
+    np.testing.assert_array_equal(view.drive, table["mesh_stiffness"].values)
+    np.testing.assert_array_equal(view.coast, table["mesh_stiffness_coast"].values)
+    assert view.harmonics == 38 and "root crack on pinion tooth 9" in view.faults
+    theta = 2 * np.pi * view.cycle / 19
+    h = np.arange(1, 39)[:, None]
+    for k, series in ((view.drive, view.drive_series), (view.coast, view.coast_series)):
+        a = 2 * np.mean(k * np.cos(h * theta), axis=1)
+        b = 2 * np.mean(k * np.sin(h * theta), axis=1)
+        direct = np.mean(k) + a @ np.cos(h * theta) + b @ np.sin(h * theta)
+        np.testing.assert_allclose(series, direct, rtol=0, atol=1e-10 * np.mean(k))
+    # the crack is felt: the panel changes with its depth, and a gear pair has no panel
+    assert spur.set_override("faults[0].depth", "2 mm") is None
+    deeper = stiffness_view(spur.model)
+    assert np.min(deeper.drive) < np.min(view.drive)
+    assert stiffness_view(ExplorerState(load_study(STUDY), "gp.toml").model) is None
+
+
+def test_save_writes_the_changed_geometry_into_the_study_file(spur, tmp_path):
+    """Save's study file holds the new crack depth, tooth and bore: loaded back with the study
+    loader it builds the explorer's model bitwise, and its command reproduces the view."""
+    from geardyn.cli.main import main
+    from geardyn.io.netcdf import load_dataset
+    from geardyn.study import build_model
+
+    for key, text in (("faults[0].depth", "1.2 mm"), ("faults[0].tooth", "4"),
+                      ("gears.pinion.bore_radius", "0.014")):
+        assert spur.set_override(key, text) is None, key
+    assert spur.overrides["faults[0].tooth"] == 4  # a whole number, as the fault takes it
+    ds = compute_diagram(spur.diagram_request())
+    paths = spur.save(ds)
+    study_file = spur.save_dir / "spur_pair_cracked-explore.toml"
+    assert study_file in paths
+    again = load_study(study_file)
+    assert again.faults[0].fields()["depth"] == "1.2 mm"
+    assert again.faults[0].fields()["tooth"] == 4
+    assert build_model(again).params.tobytes() == spur.model.params.tobytes()
+    saved = next(p for p in paths if p.suffix == ".nc")
+    command = shlex.split(load_dataset(saved).attrs["command"])
+    assert command[:3] == ["geardyn", "bifurcation", str(study_file)]
+    out = tmp_path / "cli.nc"
+    args = command[1:command.index("--out")] + ["--quiet", "--out", str(out)]
+    with pytest.raises(SystemExit) as stop:
+        main(args)
+    assert stop.value.code == 0
+    assert load_dataset(out)["poincare"].values.tobytes() == ds["poincare"].values.tobytes()
+
+
+def test_the_page_shows_the_stiffness_and_a_fault_control(spur):
+    """The page of a geometry model: a control per geometry key; a refused depth shows its
+    message next to the control and changes nothing; a valid one updates the stiffness panel
+    and recomputes the diagram."""
+    from bokeh.document import Document
+
+    from geardyn.explore import app
+
+    ds = compute_diagram(spur.diagram_request())
+    page = app.ExplorerSession(Document(), spur, ds, format_error)
+    page._later = lambda fn, *args: fn(*args)
+    try:
+        assert set(spur.geometry_params()) <= set(page.inputs)
+        drive = np.array(page.stiffness_source.data["drive"])
+        page._on_param("faults[0].depth", "value", "2 mm", "5 mm")
+        assert page.input_messages["faults[0].depth"].text.count("faults[0].depth: the crack")
+        assert page._pending is None and spur.overrides == {}
+        page._on_param("faults[0].depth", "value", "5 mm", "0.5 mm")
+        page.runner.wait(60)
+        assert page.input_messages["faults[0].depth"].text == ""
+        assert np.min(page.stiffness_source.data["drive"]) > np.min(drive)  # shallower crack
+        assert "depth 0.0005 m" in page.stiffness_faults.text
+        assert page.request.model is spur.model
+    finally:
+        page.runner.shutdown()
+
+
+def test_every_fault_kind_gets_its_numeric_fields_as_controls(tmp_path):
+    """A spall and a wear table: their controls are the numeric fields of Spall and Wear
+    (the text fields gear and profile are not controls); a spall off the flank is refused naming
+    faults[0].position; new wear depth gives SpurPair.from_geometry of the pair by hand."""
+    import geardyn.gears as g
+    from geardyn.io.toml import builtin_study_text
+
+    crack = 'kind = "crack"\ngear = "pinion"\ntooth = 9\ndepth = "2 mm"\nangle = "45 deg"'
+    faults = ('kind = "spall"\ngear = "pinion"\ntooth = 9\nlength = "1 mm"\nwidth = "4 mm"\n'
+              'depth = "0.2 mm"\n\n[[faults]]\nkind = "wear"\ngear = "pinion"\ntooth = 3\n'
+              'depth = "10 um"')
+    text = builtin_study_text("spur_pair_cracked")
+    assert crack in text
+    text = text.replace(crack, faults).replace("angles = 64", "angles = 16").replace(
+        "harmonics = 76", "harmonics = 38")
+    st = ExplorerState(load_study(text), "spur.toml", save_dir=tmp_path,
+                       describe_error=format_error)
+    assert st.geometry_params()[2:] == (
+        "faults[0].length", "faults[0].width", "faults[0].depth", "faults[0].position",
+        "faults[0].tooth", "faults[1].depth", "faults[1].tooth")
+    assert st.current_value("faults[0].position") == 0.0  # Spall's default
+    model = st.model
+    msg = st.set_override("faults[0].position", "20 mm")
+    assert msg.startswith("faults[0].position: off the active flank of pinion"), msg
+    assert st.overrides == {} and st.model is model
+    assert st.set_override("faults[1].depth", "20 um") is None
+    spall = g.Spall("1 mm", "4 mm", "0.2 mm", gear="pinion", tooth=9)
+    wear = g.Wear("20 um", gear="pinion", tooth=3)
+    assert st.model.params.tobytes() == _spur_model_by_hand(spall, wear).params.tobytes()

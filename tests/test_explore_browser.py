@@ -68,8 +68,32 @@ def _free_port() -> int:
 @pytest.fixture()
 def server(tmp_path):
     """The explorer serving the tiny study; yields (url, save folder)."""
-    study = tmp_path / "gear-pair.toml"
-    study.write_text(STUDY)
+    yield from _serve(tmp_path, "gear-pair.toml", STUDY)
+
+
+def _spur_study_text() -> str:
+    """The shipped cracked spur pair at small sizes (16 angles per mesh cycle, 38 harmonics,
+    short runs, 6 speeds)."""
+    from geardyn.io.toml import builtin_study_text
+
+    text = builtin_study_text("spur_pair_cracked")
+    for old, new in (("angles = 64", "angles = 16"), ("harmonics = 76", "harmonics = 38"),
+                     ("transient_periods = 20", "transient_periods = 5"),
+                     ("periods = 32", "periods = 4"), ("num = 41", "num = 6")):
+        assert old in text, old
+        text = text.replace(old, new)
+    return text
+
+
+@pytest.fixture()
+def spur_server(tmp_path):
+    """The explorer serving the small cracked spur pair; yields (url, save folder)."""
+    yield from _serve(tmp_path, "spur.toml", _spur_study_text())
+
+
+def _serve(tmp_path: Path, name: str, text: str):
+    study = tmp_path / name
+    study.write_text(text)
     port = _free_port()
     saved = tmp_path / "saved"
     env = dict(os.environ, PYTHONUNBUFFERED="1")
@@ -271,3 +295,36 @@ def test_zoom_click_change_a_parameter_and_save(server, browser):
     browser.save_screenshot(str(ARTIFACTS / "explorer.png"))
     if os.environ.get("GEARDYN_SCREENSHOT"):
         shutil.copyfile(ARTIFACTS / "explorer.png", os.environ["GEARDYN_SCREENSHOT"])
+
+
+def test_a_fault_control_updates_the_stiffness_panel(spur_server, browser):
+    """A model built from geometry: the crack depth is a control; a depth deeper than the tooth
+    is refused next to it, a shallower one raises the stiffness panel's minimum and recomputes
+    the diagram; Save writes the study file with the new depth."""
+    url, saved = spur_server
+    page = Page(browser)
+    browser.get(url)
+    page.ready(14000, 24000)
+    first = page.points()
+    drive = page.column("stiffness", "drive")
+    assert len(drive) == 16 * 19 and len(page.column("stiffness", "drive_series")) == 16 * 19
+    name = "param_faults[0].depth"
+    assert page.shadow(name, "input").get_attribute("value") == "2 mm"
+
+    page.type_into(name, "5 mm")
+    message = page.wait("the validation message", lambda: (
+        (t := page.model(f"{name}_message", "text")) and "faults[0].depth" in t and t))
+    assert "faults[0].depth: the crack reaches" in message and "past its centre line" in message
+    assert page.column("stiffness", "drive") == drive and page.points() == first
+
+    page.type_into(name, "0.5 mm")
+    page.wait("the message to clear", lambda: page.model(f"{name}_message", "text") == "")
+    page.wait("the new stiffness", lambda: min(page.column("stiffness", "drive")) > min(drive))
+    page.wait("the recomputed diagram", lambda: (
+        page.model("progress", "text").startswith("ready") and page.points() != first))
+    assert "spur_pair_cracked-explore.toml" in page.model("command", "text")
+    page.shadow("save", "button").click()
+    page.wait("the saved files", lambda: page.model("saved", "text").startswith("wrote"))
+    assert 'depth = "0.5 mm"' in (saved / "spur_pair_cracked-explore.toml").read_text()
+    ARTIFACTS.mkdir(parents=True, exist_ok=True)
+    browser.save_screenshot(str(ARTIFACTS / "explorer_geometry.png"))

@@ -26,6 +26,7 @@ from geardyn.explore.compute import (
     compute_orbit,
     diagram_view,
     orbit_request,
+    stiffness_view,
 )
 from geardyn.explore.runner import Runner
 from geardyn.explore.state import CONTINUATIONS, INTERPRETATIONS, DiagramRequest, ExplorerState
@@ -166,14 +167,9 @@ class ExplorerSession:
         self.command = Div(text="", name="command", width=900)
 
         self.inputs, self.input_messages = {}, {}
-        controls = []
-        for name in st.main_params():
-            box = TextInput(title=name, value=str(st.current_value(name)), name=f"param_{name}",
-                            width=150, description=st.param_help(name) or None)
-            box.on_change("value", partial(self._on_param, name))
-            msg = Div(text="", name=f"param_{name}_message", width=150)
-            self.inputs[name], self.input_messages[name] = box, msg
-            controls.append(column(box, msg))
+        controls = [self._control(name, TextInput, Div, column) for name in st.main_params()]
+        geometry = [self._control(name, TextInput, Div, column)
+                    for name in st.geometry_params()]
         self.continuation = Select(title="continuation", value=st.continuation,
                                    options=list(CONTINUATIONS), name="continuation", width=120)
         self.continuation.on_change("value", self._on_continuation)
@@ -192,14 +188,76 @@ class ExplorerSession:
                               name="orbit_text", width=900)
         top = row(self.back_button, column(self.window_input, self.window_message),
                   self.save_button)
+        extra = []
+        if geometry:
+            extra.append(column(Div(text="<b>geometry and faults</b> (study-file keys)"),
+                                row(*geometry)))
+        self.stiffness_fig = None
+        stiffness_panel = self._stiffness_figure(figure, ColumnDataSource, Div, column)
         self.layout = column(
             Div(text=f"<b>geardyn explore</b>: {html.escape(st.study.study.name)}"),
-            top, self.progress, self.message, row(*controls), fig, *self.bands, bands_legend,
+            top, self.progress, self.message, row(*controls), *extra, fig, *self.bands,
+            bands_legend, *([stiffness_panel] if stiffness_panel is not None else []),
             self.command, self.saved, self.orbit_text,
             row(orbit_figs[0], orbit_figs[1]), row(orbit_figs[2], orbit_figs[3]),
             name="layout")
         self.doc.add_root(self.layout)
         self.doc.title = f"geardyn explore: {st.study.study.name}"
+
+    def _control(self, name: str, TextInput, Div, column):  # noqa: N803
+        """A text box for the parameter or geometry key ``name`` and its message line."""
+        st = self.state
+        box = TextInput(title=name, value=str(st.current_value(name)), name=f"param_{name}",
+                        width=150, description=st.param_help(name) or None)
+        box.on_change("value", partial(self._on_param, name))
+        msg = Div(text="", name=f"param_{name}_message", width=150)
+        self.inputs[name], self.input_messages[name] = box, msg
+        return column(box, msg)
+
+    def _stiffness_figure(self, figure, ColumnDataSource, Div, column):  # noqa: N803
+        """The mesh stiffness panel of a model built from geometry (None for other models):
+        drive and coast flank, the table and the model's series, and the faults' line."""
+        view = stiffness_view(self.state.model)
+        if view is None:
+            self.stiffness_source = None
+            return None
+        self.stiffness_source = ColumnDataSource(
+            {"cycle": [], "drive": [], "coast": [], "drive_series": [], "coast_series": []},
+            name="stiffness")
+        fig = figure(frame_height=240, frame_width=FRAME_WIDTH, min_border_left=BORDER_LEFT,
+                     tools="pan,wheel_zoom,box_zoom,reset", name="stiffness_fig",
+                     title=view.title(), x_axis_label="mesh cycles (of the forcing period)",
+                     y_axis_label="mesh stiffness [N/m]")
+        src = self.stiffness_source
+        for column_name, color, dash, label in (
+                ("drive", "#1f77b4", "solid", "drive, table"),
+                ("drive_series", "#1f77b4", "dashed", "drive, series"),
+                ("coast", "#ff7f0e", "solid", "coast, table"),
+                ("coast_series", "#ff7f0e", "dashed", "coast, series")):
+            fig.line("cycle", column_name, source=src, color=color, line_dash=dash,
+                     legend_label=label)
+        legend = fig.legend[0]
+        legend.label_text_font_size = "8pt"
+        legend.click_policy = "hide"
+        fig.add_layout(legend, "right")
+        self.stiffness_fig = fig
+        self.stiffness_faults = Div(text="", name="stiffness_faults", width=900)
+        self._show_stiffness(self.state.model)
+        return column(fig, self.stiffness_faults)
+
+    def _show_stiffness(self, model) -> None:
+        """The stiffness panel shows ``model``'s stiffness."""
+        if self.stiffness_source is None:
+            return
+        view = stiffness_view(model)
+        if view is None:
+            return
+        self.stiffness_source.data = {
+            "cycle": view.cycle, "drive": view.drive, "coast": view.coast,
+            "drive_series": view.drive_series, "coast_series": view.coast_series}
+        if self.stiffness_fig is not None:
+            self.stiffness_fig.title.text = view.title()
+            self.stiffness_faults.text = "faults: " + html.escape(view.faults)
 
     def _orbit_figures(self, figure, ColumnDataSource) -> list:  # noqa: N803
         from bokeh.models import LabelSet, Range1d
@@ -241,6 +299,7 @@ class ExplorerSession:
             src.data = _band_data(view, mesh)
         for band in self.bands:
             band.renderers[0].glyph.width = view.width
+        self._show_stiffness(request.model)
         w = request.window
         self._shown = (w.start, w.stop)
         self.x_range.update(start=w.start, end=w.stop)
@@ -412,6 +471,7 @@ class ExplorerSession:
             box.text = f'<span style="{_ERROR_STYLE}">{html.escape(msg)}</span>'
             return
         box.text = ""
+        self._show_stiffness(self.state.model)
         self.recompute()
 
     def _on_continuation(self, _attr, _old, new: str) -> None:

@@ -1,7 +1,8 @@
 """The explorer's computations, each a call of geardyn's public API: the diagram of a window
-(:func:`geardyn.bifurcation`) and one orbit (:func:`geardyn.simulate`, the amplitude spectrum
-and its labelled peaks, :func:`geardyn.periodic_orbit` for the Floquet multipliers). No physics
-here: only the calls and the arrays the figures draw.
+(:func:`geardyn.bifurcation`), one orbit (:func:`geardyn.simulate`, the amplitude spectrum
+and its labelled peaks, :func:`geardyn.periodic_orbit` for the Floquet multipliers) and, for a
+model built from geometry, its mesh stiffness (the table and the series the model uses). No
+physics here: only the calls and the arrays the figures draw.
 """
 
 from __future__ import annotations
@@ -15,7 +16,8 @@ import xarray as xr
 
 from geardyn.explore.state import DiagramRequest
 
-__all__ = ["DiagramView", "OrbitView", "compute_diagram", "compute_orbit", "diagram_view"]
+__all__ = ["DiagramView", "OrbitView", "StiffnessView", "compute_diagram", "compute_orbit",
+           "diagram_view", "stiffness_view"]
 
 #: Highest spectrum order shown (multiples of Omega) and peaks labelled.
 SPECTRUM_MAX_ORDER = 8.0
@@ -202,3 +204,42 @@ def _floquet(view: OrbitView, model, omega: float, req: OrbitRequest, ds: xr.Dat
         view.stability = orb.stability
     else:
         view.floquet_message = f"shooting did not converge ({orb.message})"
+
+
+@dataclass
+class StiffnessView:
+    """The drive and coast mesh stiffness [N/m] of a model built from geometry over its forcing
+    period: the table it was built from and the truncated Fourier series it integrates, at the
+    table's angles (``cycle``: mesh cycles from tooth 0's pitch-point passage)."""
+
+    cycle: np.ndarray
+    drive: np.ndarray
+    coast: np.ndarray
+    drive_series: np.ndarray
+    coast_series: np.ndarray
+    harmonics: int
+    faults: str
+
+    def title(self) -> str:
+        return (f"mesh stiffness over the forcing period: the table and the model's series "
+                f"({self.harmonics} harmonics)")
+
+
+def stiffness_view(model: Any) -> StiffnessView | None:
+    """The stiffness panel's arrays of a model that carries a potential-energy stiffness table
+    (``model.stiffness``, with ``mesh_stiffness`` and ``mesh_stiffness_coast``) and its series
+    (``model.stiffness_at(theta, flank)`` at ``model.table_phase()``, as
+    :class:`~geardyn.SpurPair` does); None for a model without one."""
+    table = getattr(model, "stiffness", None)
+    if not isinstance(table, xr.Dataset) or not {"mesh_stiffness", "mesh_stiffness_coast"} <= set(
+            table.data_vars) or not hasattr(model, "stiffness_at"):
+        return None
+    theta = model.table_phase()
+    return StiffnessView(
+        cycle=np.asarray(table["cycle"].values, dtype=float),
+        drive=np.asarray(table["mesh_stiffness"].values, dtype=float),
+        coast=np.asarray(table["mesh_stiffness_coast"].values, dtype=float),
+        drive_series=model.stiffness_at(theta, "drive"),
+        coast_series=model.stiffness_at(theta, "coast"),
+        harmonics=int(getattr(model, "n_harmonics", 0)),
+        faults=str(table.attrs.get("faults", "none")))

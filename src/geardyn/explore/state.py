@@ -2,14 +2,22 @@
 the parameter window and its history, the parameter overrides, the command line that reproduces
 the view, and the saving of the view.
 
+A study whose model is built from a gear pair's geometry (a ``[gears]`` table) also offers that
+geometry and its faults as controls (:meth:`ExplorerState.geometry_params`), named by their
+study-file keys (``faults[0].depth``, ``gears.pinion.bore_radius``); a new value rebuilds the
+model from the changed study, as the study file would.
+
 Every change goes through :class:`ExplorerState`; a change that is not valid returns the message
 to show and leaves the state as it was. The computations live in :mod:`geardyn.explore.compute`.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
+import re
 import shlex
+import typing
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -19,6 +27,7 @@ import numpy as np
 
 from geardyn.core.model import Model
 from geardyn.errors import ParameterError
+from geardyn.gears.faults import FAULT_KINDS
 from geardyn.io.toml import (
     GearPairParams,
     PaperBase,
@@ -27,8 +36,8 @@ from geardyn.io.toml import (
     Study,
 )
 
-__all__ = ["CONTINUATIONS", "INTERPRETATIONS", "MAIN_PARAMS", "DiagramRequest", "ExplorerState",
-           "Window", "parse_value"]
+__all__ = ["CONTINUATIONS", "GEOMETRY_KEYS", "INTERPRETATIONS", "MAIN_PARAMS", "DiagramRequest",
+           "ExplorerState", "Window", "fault_fields", "key_path", "parse_value"]
 
 #: The main parameters offered as controls, per model kind (``[study].model``): damping ratios,
 #: backlash, meshing error, load (or torque) fluctuation.
@@ -37,8 +46,12 @@ MAIN_PARAMS: dict[str, tuple[str, ...]] = {
     "gear_pair": ("zeta", "backlash", "Fa", "kappa"),
     "planetary": ("mesh_damping", "sun_backlash", "ring_backlash", "sun_mesh_error",
                   "torque_fluctuation"),
-    "spur_pair": ("zeta", "backlash", "torque", "error"),
+    "spur_pair": ("zeta", "backlash", "torque", "error", "harmonics"),
 }
+#: The ``[gears]`` inputs offered as controls of a model built from a pair's geometry (study-file
+#: keys; each gear's own value, which wins over a shared ``[gears]`` one). The faults' controls
+#: come from the study's ``[[faults]]`` (:func:`fault_fields`).
+GEOMETRY_KEYS = ("gears.pinion.bore_radius", "gears.wheel.bore_radius")
 INTERPRETATIONS = ("consistent", "carrier-only", "as-printed")
 CONTINUATIONS = ("none", "up", "down")
 
@@ -80,6 +93,34 @@ def parse_value(text: str) -> float | str:
         return float(text)
     except ValueError:
         return text
+
+
+def fault_fields(kind: str) -> tuple[str, ...]:
+    """The numeric fields (float or int) of the fault class of ``kind``
+    (:data:`geardyn.gears.FAULT_KINDS`), in its declared order; () for an unknown kind."""
+    cls = FAULT_KINDS.get(kind)
+    if cls is None:
+        return ()
+    hints = typing.get_type_hints(cls)
+    return tuple(f.name for f in dataclasses.fields(cls) if hints.get(f.name) in (float, int))
+
+
+def key_path(key: str) -> tuple[str | int, ...]:
+    """The path of a study-file key in the study's TOML tables: ``faults[0].depth`` ->
+    ("faults", 0, "depth")."""
+    out: list[str | int] = []
+    for part in key.split("."):
+        m = re.fullmatch(r"(\w+)\[(\d+)\]", part)
+        out += [m[1], int(m[2])] if m else [part]
+    return tuple(out)
+
+
+def _set_path(doc: dict[str, Any], path: tuple[str | int, ...], value: Any) -> None:
+    """Set ``value`` at ``path`` of the TOML tables ``doc`` (missing tables made)."""
+    target: Any = doc
+    for part in path[:-1]:
+        target = target[part] if isinstance(part, int) else target.setdefault(part, {})
+    target[path[-1]] = value
 
 
 @dataclass(frozen=True)
@@ -158,20 +199,47 @@ class ExplorerState:
         """The parameters offered as controls (the swept one left out)."""
         return tuple(p for p in MAIN_PARAMS.get(self.kind, ()) if p != self.param)
 
+    def geometry_params(self) -> tuple[str, ...]:
+        """The geometry and fault controls of a study with a ``[gears]`` table, as study-file
+        keys: :data:`GEOMETRY_KEYS`, then the numeric fields of each ``[[faults]]`` table's
+        fault class (``faults[0].depth``, ``faults[0].angle``, ``faults[0].tooth``); () for a
+        study without ``[gears]``."""
+        if self.study.gears is None:
+            return ()
+        keys = list(GEOMETRY_KEYS)
+        for i, table in enumerate(self.study.faults or []):
+            keys += [f"faults[{i}].{name}" for name in fault_fields(table.kind)]
+        return tuple(keys)
+
     def param_help(self, name: str) -> str:
         """What a control's parameter is (meaning and unit), from the model's declared
         coefficients (:mod:`geardyn.core.coefficients`; the gear pair's
-        :data:`~geardyn.models.gear_pair_coefficients.GEAR_PAIR`) or the units of its sweep
-        axis; empty where nothing is declared."""
+        :data:`~geardyn.models.gear_pair_coefficients.GEAR_PAIR`), the units of its sweep
+        axis, the ``[params]`` field's description, or, for a geometry control, its table;
+        empty where nothing is declared."""
         from geardyn.models.gear_pair_coefficients import GEAR_PAIR
 
+        if name in self.geometry_params():
+            return self._geometry_help(name)
         layout = self.model.coefficient_layout
         if name in layout.names and layout.slot(name).coefficient.meaning:
             return layout.slot(name).coefficient.describe()
         if self.kind == "gear_pair" and name in GEAR_PAIR.vocabulary():
             return GEAR_PAIR[name].describe()
         units = self.model.param_attrs(name).get("units")
-        return f"[{units}]" if units else ""
+        if units:
+            return f"[{units}]"
+        declared = type(self.study.params).model_fields.get(name)
+        return (declared.description or "") if declared is not None else ""
+
+    def _geometry_help(self, key: str) -> str:
+        path = key_path(key)
+        if path[0] == "faults":
+            table = self.study.faults[path[1]]  # type: ignore[index]
+            gear = table.fields().get("gear", "pinion")
+            kind = "a whole number" if self._whole(key) else "SI number or unit string"
+            return f"{path[2]} of the {table.kind} on the {gear} ([[faults]] {path[1]}; {kind})"
+        return f"{path[-1]} of the {path[1]} ([gears.{path[1]}]; SI number or unit string)"
 
     def _build(self, study: Study, interpretation: str | None) -> Model:
         from geardyn.study import build_model
@@ -196,6 +264,8 @@ class ExplorerState:
         value in SI units)."""
         if name in self.overrides:
             return self.overrides[name]
+        if name in self.geometry_params():
+            return self._geometry_value(key_path(name))
         params = self._effective.params
         if self.kind == "catt":
             from geardyn.models.params import PAPER_NAMES
@@ -207,25 +277,58 @@ class ExplorerState:
         value = getattr(params, name)
         return value[0] if isinstance(value, list | tuple) else value
 
+    def _geometry_value(self, path: tuple[str | int, ...]) -> Any:
+        """A geometry control's value in the current view: a fault field as its table gives
+        it (else the fault class's default), a gear's value (its own, else ``[gears]``'s)."""
+        study = self._effective
+        if path[0] == "faults":
+            table = study.faults[path[1]]  # type: ignore[index]
+            name = str(path[2])
+            given = table.fields()
+            if name in given:
+                return given[name]
+            declared = {f.name: f for f in dataclasses.fields(FAULT_KINDS[table.kind])}
+            return declared[name].default
+        return study.gears.value(str(path[1]), str(path[2]))[0]  # type: ignore[union-attr]
+
     def _with_overrides(self, overrides: dict[str, float | str]) -> Study:
-        """The study with ``overrides`` applied, validated as a study file is."""
+        """The study with ``overrides`` applied, validated as a study file is (a geometry
+        control's value set at its key, a parameter's in ``[params]``)."""
         doc = self.study.to_toml_dict()  # as the file says it (transient_periods alone)
+        geometry = self.geometry_params()
+        for key, value in overrides.items():
+            if key in geometry:
+                _set_path(doc, key_path(key), value)
+        changes = {k: v for k, v in overrides.items() if k not in geometry}
         params = self.study.params
         if isinstance(params, PaperBase):
-            doc["params"]["changes"] = {**doc["params"].get("changes", {}), **overrides}
+            doc["params"]["changes"] = {**doc["params"].get("changes", {}), **changes}
         elif isinstance(params, GearPairParams | PlanetaryGearSetParams | SpurPairParams):
-            doc["params"].update(overrides)
+            doc["params"].update(changes)
         else:  # full PlanetaryParams
-            doc["params"] = params.replace(**overrides).model_dump(exclude_none=True)
+            doc["params"] = params.replace(**changes).model_dump(exclude_none=True)
         return Study.model_validate(doc)
 
     def set_override(self, name: str, text: str) -> str | None:
-        """Set a main parameter from a control's text. Returns None, or the validation message
-        (the state is then unchanged)."""
-        if name not in MAIN_PARAMS.get(self.kind, ()):
+        """Set a main parameter or a geometry control from a control's text. Returns None, or
+        the validation message (the state is then unchanged)."""
+        geometry = self.geometry_params()
+        if name not in MAIN_PARAMS.get(self.kind, ()) and name not in geometry:
             return f"{name}: not a parameter of this explorer"
-        overrides = {**self.overrides, name: parse_value(text)}
+        value = parse_value(text)
+        if name in geometry and isinstance(value, float) and value.is_integer() and (
+                self._whole(name)):
+            value = int(value)  # a tooth index: 3, not 3.0
+        overrides = {**self.overrides, name: value}
         return self._apply(overrides, self.interpretation)
+
+    def _whole(self, key: str) -> bool:
+        """True where the geometry control ``key`` is an int field of its fault class."""
+        path = key_path(key)
+        if path[0] != "faults":
+            return False
+        cls = FAULT_KINDS[self.study.faults[path[1]].kind]  # type: ignore[index]
+        return typing.get_type_hints(cls).get(str(path[2])) is int
 
     def set_interpretation(self, value: str) -> str | None:
         """Change the interpretation (CATT device studies only); None or the message."""
