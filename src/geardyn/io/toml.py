@@ -1072,7 +1072,7 @@ class Study(BaseModel):
             raise _study_error(("stiffness", "force"), settings.force,
                                "give the load as torque or as force, not both")
         if settings.torque is None and settings.force is None:
-            for name, given in (("relief", relief), ("crowning", crowning)):
+            for name, given in (("crowning", crowning), ("relief", relief)):
                 if given:
                     raise _study_error((name,), None, "needs a load for the loaded contact:"
                                        " [stiffness] torque (N m on the pinion) or force (N)")
