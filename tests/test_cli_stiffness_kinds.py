@@ -381,3 +381,26 @@ def test_internal_plot_and_default_output(tmp_path, capsys, monkeypatch):
     assert r.returncode == 0, r.stderr
     assert sorted(p.name for p in tmp_path.iterdir()) == [
         "stiffness_planet_ring_stiffness.nc", "stiffness_planet_ring_stiffness.png"]
+
+
+def test_docs_table_of_the_packaged_studies():
+    """docs/gears.md's table of the packaged studies' loaded contact, recomputed."""
+    import re
+    from pathlib import Path
+
+    from geardyn.study import mesh_stiffness
+
+    text = (Path(__file__).resolve().parent.parent / "docs" / "gears.md").read_text()
+    table = text.split("<!-- study-loaded-table:begin")[1].split("<!-- study-loaded-table:end")[0]
+    rows = [line for line in table.splitlines() if line.startswith("| `")]
+    assert len(rows) == 2
+    for row in rows:
+        cells = [c.strip() for c in row.strip("|").split("|")]
+        ds = mesh_stiffness(builtin_study(re.sub("`", "", cells[0])))
+        te = ds["transmission_error"].values * 1e6
+        got = [f"{float(ds.mesh_stiffness.mean()):.3e}".replace("e+0", "e"),
+               f"{ds.attrs['torque_Nm']:g}", f"{ds.attrs['force_N']:.0f}", f"{te.mean():.2f}",
+               f"{np.ptp(te):.2f}",
+               f"{float(ds.tangent_stiffness.mean()):.3e}".replace("e+0", "e"),
+               f"{float(ds.secant_stiffness.mean()):.3e}".replace("e+0", "e")]
+        assert cells[1:] == got, (cells[0], got)

@@ -47,8 +47,18 @@ of ``[params]``::
     depth = "1 mm"
     angle = "45 deg"
     [stiffness]                     # StiffnessTable: angles per mesh cycle, cycles or
-    angles = 360                    #   "hunting", nodes, root_segment
-    cycles = "hunting"
+    angles = 360                    #   "hunting", nodes, root_segment; slices (helical);
+    cycles = "hunting"              #   the load of the loaded contact: torque or force
+    torque = "50 N m"
+    [[relief]]                      # ReliefTable: a TipRelief's fields
+    amount = "10 um"
+    length = "1.5 mm"
+    [crowning]                      # CrowningTable (or [[crowning]]): a LeadCrowning's
+    amount = "5 um"                 #   fields (helical pairs)
+
+``[gears]`` also takes ``helix_angle`` (a helical pair by thin slices; module, pressure angle
+and profile shifts then in the normal section) or ``internal = true`` (the wheel a ring, its
+``[gears.wheel]`` ``bore_radius`` the ring's outer radius; ``ring_foundation``).
 
 For ``model = "gear_pair"`` the ``[params]`` table holds :class:`~geardyn.GearPair` arguments
 (``zeta``, ``kappa``, ``Fm``, ``Fa``, ``Omega``, ``kappa_phase``, ``error_phase``, ``backlash``).
