@@ -136,15 +136,7 @@ from geardyn.gears.potential_energy import (
 )
 from geardyn.gears.tip_relief import TipRelief, relief_gap
 from geardyn.models.gear_pair_coefficients import GEAR_PAIR
-from geardyn.models.params import (
-    PAPER_NAMES,
-    Angle,
-    Length,
-    PlanetaryParams,
-    Real,
-    Torque,
-    Whole,
-)
+from geardyn.models.params import PAPER_NAMES, Angle, Length, PlanetaryParams, Real, Whole
 from geardyn.units import to_si
 
 __all__ = [
@@ -505,8 +497,9 @@ class PlanetaryGearSetParams(BaseModel):
 # --------------------------------------------------------------------------- gears and faults
 #: Young's modulus: an SI number [Pa] or a unit string ("206.8 GPa").
 Pressure = Annotated[float, BeforeValidator(lambda v: to_si(v, "pressure")), Field(gt=0)]
-#: A force: an SI number [N] or a unit string ("2 kN").
+#: A force: an SI number [N] or a unit string ("2 kN"); a torque [N m] ("50 N m").
 Force = Annotated[float, BeforeValidator(lambda v: to_si(v, "force"))]
+Torque = Annotated[float, BeforeValidator(lambda v: to_si(v, "torque"))]
 
 
 class PairGearTable(BaseModel):
