@@ -166,7 +166,7 @@ def main() -> None:
     # the located crossings are counted while sampling only: their rate over the sampled
     # lane-steps, and the time edge location adds per crossing at that rate over every lane-step
     r = run_lanes(model, model.lane_params("Omega", values), model.initial_state(),
-                  transient=TRANSIENT, samples=SAMPLES)
+                  run=geardyn.RunSettings(transient=TRANSIENT, samples=SAMPLES))
     sampled = int(np.sum(r.steps_per_period.astype(np.int64) * r.sample_every * SAMPLES))
     rate = float(r.crossings.sum()) / sampled
     extra = (wall - wall_off) * threads / (rate * steps) * 1e9

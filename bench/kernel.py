@@ -32,7 +32,7 @@ import numpy as np
 
 import geardyn
 import geardyn.solvers.ensemble as ens
-from geardyn.core.plan import LanePlan
+from geardyn.core.plan import LanePlan, LaneSettings
 from geardyn.core.settings import RunSettings
 from geardyn.solvers import kernels as kmod
 
@@ -230,9 +230,10 @@ class Workload:
         self.n_per = n_per  # None: automatic
 
     def run(self, locate: bool = True):
-        return ens.run_lanes(self.model, self.P, self.model.initial_state(), self.transient,
-                             self.samples, steps_per_period=self.n_per, sample_every=1,
-                             locate_edges=locate)
+        return ens.run_lanes(self.model, self.P, self.model.initial_state(),
+                             run=RunSettings(samples=self.samples, locate_edges=locate),
+                             lanes=LaneSettings(transient=self.transient,
+                                                steps_per_period=self.n_per, sample_every=1))
 
 
 def lane_steps(r) -> tuple[int, int]:
@@ -293,7 +294,8 @@ def vector_report(w: Workload) -> str:
     4), scalar ones (sd), and packed fused multiply-adds (none: no contraction)."""
     mod = fresh_kernels(w.model.kernel)
     with _Use(mod, False):
-        ens.run_lanes(w.model, w.P[:8], w.model.initial_state(), 1.0, 1, steps_per_period=64)
+        ens.run_lanes(w.model, w.P[:8], w.model.initial_state(),
+                      run=RunSettings(transient=1.0, samples=1, steps_per_period=64))
     fn = getattr(mod, "_block_run", getattr(mod, "_sweep_worker", mod.sweep))  # the block loop
     asm = fn.inspect_asm(fn.signatures[0])
     z, y, sd = (len(re.findall(r"\n\s+v\w+" + r, asm))

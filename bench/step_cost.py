@@ -38,13 +38,14 @@ def main() -> None:
     omegas = np.linspace(0.1, 4.0, 1000)[::args.stride]
     P = model.lane_params("Omega", omegas)
     y0 = model.initial_state()
-    run_lanes(model, P[:4], y0, 20.0, 2)  # compile / load
+    run_lanes(model, P[:4], y0, run=geardyn.RunSettings(transient=20.0, samples=2))  # load
     out = {}
     for locate in (True, False):
         times = []
         for _ in range(args.repeat):
             t = time.process_time()
-            r = run_lanes(model, P, y0, 2000.0, 200, locate_edges=locate)
+            r = run_lanes(model, P, y0, run=geardyn.RunSettings(transient=2000.0, samples=200,
+                                                                locate_edges=locate))
             times.append(time.process_time() - t)
         n = r.steps_per_period.astype(np.int64)
         steps = int(np.sum((r.transient_periods + 200 * r.sample_every) * n))

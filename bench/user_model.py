@@ -75,8 +75,8 @@ def _models(legacy: bool) -> dict[str, geardyn.Model]:
 
 def _run(model: geardyn.Model, omegas: np.ndarray):
     P = model.lane_params("Omega", omegas)
-    return run_lanes(model, P, model.initial_state(), TRANSIENT, SAMPLES,
-                     steps_per_period=STEPS)
+    return run_lanes(model, P, model.initial_state(), run=geardyn.RunSettings(
+        transient=TRANSIENT, samples=SAMPLES, steps_per_period=STEPS))
 
 
 def main() -> None:

@@ -47,8 +47,8 @@ def test_lanes_reproduce_single_simulations_bitwise():
     """A lane's arithmetic must not depend on its block or neighbours: run_lanes equals simulate."""
     m = geardyn.CATTDevice(geardyn.PlanetaryParams.paper())
     omegas = np.array([0.7, 1.1, 1.3, 2.2, 3.1, 0.9, 1.7, 2.9, 3.9, 0.45, 1.05])
-    r = run_lanes(m, m.lane_params("Omega", omegas), m.initial_state(), 300.0, 4,
-                  steps_per_period=64)
+    run = geardyn.RunSettings(transient=300.0, samples=4, steps_per_period=64)
+    r = run_lanes(m, m.lane_params("Omega", omegas), m.initial_state(), run=run)
     for j in (0, 1, 8, 10):
         ds = geardyn.simulate(m, omega=omegas[j],
                               run=geardyn.RunSettings(transient=300.0, samples=4,
@@ -56,8 +56,7 @@ def test_lanes_reproduce_single_simulations_bitwise():
         np.testing.assert_array_equal(r.samples[j], ds["poincare"].values[1:])
     # and it does not depend on the order of the lanes
     perm = np.random.default_rng(0).permutation(omegas.size)
-    r2 = run_lanes(m, m.lane_params("Omega", omegas[perm]), m.initial_state(), 300.0, 4,
-                   steps_per_period=64)
+    r2 = run_lanes(m, m.lane_params("Omega", omegas[perm]), m.initial_state(), run=run)
     np.testing.assert_array_equal(r2.samples, r.samples[perm])
 
 

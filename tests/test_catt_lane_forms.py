@@ -14,6 +14,8 @@ import pytest
 
 import geardyn
 from geardyn.core.kernel_source import FORM_GENERAL, FORM_LOAD, FORM_QUIET
+from geardyn.core.plan import LaneSettings
+from geardyn.core.settings import RunSettings
 from geardyn.models import catt_kernels as ck
 from geardyn.solvers.ensemble import run_lanes
 
@@ -62,8 +64,9 @@ def _assert_lanes_equal_simulate(models, omegas, steps=48):
     """run_lanes of the stacked lanes of ``models`` (one model's layout) against simulate."""
     P = np.vstack([m.lane_params("Omega", omegas) for m in models])
     first = models[0]
-    r = run_lanes(first, P, first.initial_state(), 200.0, 3, steps_per_period=steps,
-                  sample_every=1)
+    r = run_lanes(first, P, first.initial_state(),
+                  run=RunSettings(transient=200.0, samples=3, steps_per_period=steps),
+                  lanes=LaneSettings(sample_every=1))
     assert np.all(r.status == 0)
     for j in range(P.shape[0]):
         m = models[j // omegas.size]
@@ -92,7 +95,8 @@ def test_the_load_changes_the_motion():
     """(So that the test above compares lanes that take the load's branch-free form.)"""
     quiet, load = _device(), _device(**_LOAD)
     P = np.vstack([quiet.lane_params("Omega", _OMEGAS[:2]), load.lane_params("Omega", _OMEGAS[:2])])
-    r = run_lanes(quiet, P, quiet.initial_state(), 200.0, 3, steps_per_period=48)
+    r = run_lanes(quiet, P, quiet.initial_state(),
+                  run=RunSettings(transient=200.0, samples=3, steps_per_period=48))
     assert np.max(np.abs(r.samples[:2] - r.samples[2:])) > 1e-3
 
 
@@ -106,13 +110,14 @@ def test_chains_mixing_forms_run_in_the_general_form_and_equal_lane_by_lane_runs
     P = np.vstack([m.lane_params("Omega", omega) for m in rows])
     chain = np.array([1, 2, -1, 4, -1, -1, -1])
     y0 = quiet.initial_state()
-    kw = dict(steps_per_period=48, sample_every=1)
-    r = run_lanes(quiet, P, y0, 100.0, 3, chain=chain, **kw)
+    run = RunSettings(transient=100.0, samples=3, steps_per_period=48)
+    r = run_lanes(quiet, P, y0, run=run, lanes=LaneSettings(sample_every=1), chain=chain)
     assert np.all(r.status == 0)
     for head in (0, 3, 5, 6):
         lane, start, t0 = head, y0, np.zeros(1)
         while lane >= 0:
-            alone = run_lanes(quiet, P[[lane]], start, 100.0, 3, t0=t0, **kw)
+            alone = run_lanes(quiet, P[[lane]], start, run=run,
+                              lanes=LaneSettings(t0=t0, sample_every=1))
             np.testing.assert_array_equal(r.samples[lane], alone.samples[0], err_msg=str(lane))
             np.testing.assert_array_equal(r.final[lane], alone.final[0])
             start, t0, lane = alone.final[0], alone.final_time[:1], chain[lane]
@@ -134,7 +139,6 @@ def test_a_later_form_pass_runs_no_chain_again(workers):
     another worker too, racing with the first run on its outputs (bench/determinism.py found
     the reproduction's Fig. 3 sweep differing between runs). Each lane is run exactly once."""
     from geardyn.core.plan import LanePlan
-    from geardyn.core.settings import RunSettings
     from geardyn.solvers.ensemble import run_plan
 
     quiet, load = _device(), _device(**_LOAD)
@@ -142,12 +146,12 @@ def test_a_later_form_pass_runs_no_chain_again(workers):
     P = np.vstack([quiet.lane_params("Omega", omega), load.lane_params("Omega", omega[:3])])
     chain = np.array([1, 2, 3, -1, -1, -1, -1])  # a quiet chain 0 -> 3, three lone load lanes
     run = RunSettings(samples=3, transient=60.0, steps_per_period=48)
-    plan = LanePlan.build(quiet, P, run, sample_every=1)
+    plan = LanePlan.build(quiet, P, run, LaneSettings(sample_every=1))
     r = run_plan(quiet, P, quiet.initial_state(), plan, chain=chain, workers=workers)
     assert np.all(r.status == 0)
     np.testing.assert_array_equal(r.steps, plan.steps_per_period * plan.total_periods)
-    lone = run_plan(quiet, P[4:], quiet.initial_state(), LanePlan.build(quiet, P[4:], run,
-                                                                         sample_every=1))
+    lone = run_plan(quiet, P[4:], quiet.initial_state(),
+                    LanePlan.build(quiet, P[4:], run, LaneSettings(sample_every=1)))
     np.testing.assert_array_equal(r.samples[4:], lone.samples)
 
 
@@ -159,8 +163,9 @@ def test_a_chain_stops_at_a_lane_that_did_not_end_well_and_says_so():
 
     quiet = _device()
     P = quiet.lane_params("Omega", np.array([1.2, 1.25, 1.3]))
-    r = run_lanes(quiet, P, quiet.initial_state(), 50.0, 3, steps_per_period=48,
-                  sample_every=1, bound=1e-3, chain=np.array([1, 2, -1]))
+    r = run_lanes(quiet, P, quiet.initial_state(),
+                  run=RunSettings(transient=50.0, samples=3, steps_per_period=48, bound=1e-3),
+                  lanes=LaneSettings(sample_every=1), chain=np.array([1, 2, -1]))
     assert r.status[0] == Status.DIVERGED
     assert 0 < r.steps[0] < _planned_steps(r, 3)[0]
     assert list(r.status[1:]) == [Status.NOT_RUN, Status.NOT_RUN]

@@ -11,7 +11,7 @@ import pytest
 import geardyn
 from geardyn import ContinuedSweep, continued_sweeps
 from geardyn.analysis.continuation import Branch
-from geardyn.core.plan import STEPS_PER_OTHER_FORCING, default_steps_per_period
+from geardyn.core.plan import STEPS_PER_OTHER_FORCING, LaneSettings, default_steps_per_period
 from geardyn.solvers.ensemble import run_lanes
 
 VARIABLES = ("poincare", "period", "converged", "transient_periods", "contact", "force_peak",
@@ -105,7 +105,8 @@ def test_fast_load_fluctuation_sets_the_step():
     assert n > default_steps_per_period(quiet, 1.0)
     # the default step against DOP853 at rtol 1e-12: the response to the fast forcing is
     # resolved to the accuracy the natural-mode rule gives elsewhere
-    r = run_lanes(m, m.lane_params("Omega", [1.0]), m.initial_state(), 60.0, 3)
+    r = run_lanes(m, m.lane_params("Omega", [1.0]), m.initial_state(),
+                  run=geardyn.RunSettings(transient=60.0, samples=3))
     T = 2 * math.pi
     t_eval = (r.transient_periods[0] + np.arange(1, 4)) * T
     ref = geardyn.reference_solution(m, m.initial_state(), t_eval)
@@ -136,9 +137,9 @@ def _point_by_point(branch: Branch, run: geardyn.RunSettings) -> list:
     y, t0, cold, out = branch.y0, 0.0, True, []
     for j in range(branch.P.shape[0]):
         lo, hi = branch.transients(j, cold, run.converge is not None)
-        r = run_lanes(branch.model, branch.P[j:j + 1], y, transient=np.array([lo]),
-                      steps_per_period=np.array([branch.steps[j]]), t0=np.array([t0]),
-                      transient_max=np.array([hi]), run=run)
+        lanes = LaneSettings(t0=[t0], transient=[lo], transient_max=[hi],
+                             steps_per_period=[branch.steps[j]])
+        r = run_lanes(branch.model, branch.P[j:j + 1], y, run=run, lanes=lanes)
         out.append(r)
         if r.status[0] == geardyn.Status.OK:
             y, t0, cold = r.final[0], float(r.final_time[0]), False

@@ -14,7 +14,7 @@ import xarray as xr
 
 import geardyn
 from geardyn import RunSettings, Status
-from geardyn.core.plan import LanePlan, default_steps_per_period
+from geardyn.core.plan import LanePlan, LaneSettings, default_steps_per_period
 from geardyn.core.settings import SettingsError
 from geardyn.core.status import status_meaning
 from geardyn.solvers.ensemble import run_lanes
@@ -107,7 +107,7 @@ def test_lane_plan_step_counts_by_hand():
                   [1.3, 0.65, 1.0],  # a second forcing at Omega / 2: sections of 2 periods
                   [0.4, np.nan, 10.0]])  # a fast natural mode: the step rule refines
     run = RunSettings(transient=100.0, samples=5, transient_max=300.0)
-    plan = LanePlan.build(_Forced(), P, run, steps_per_period=np.array([32, 32, 0]))
+    plan = LanePlan.build(_Forced(), P, run, LaneSettings(steps_per_period=[32, 32, 0]))
     T = 2 * math.pi / np.array([1.3, 1.3, 0.4])
     assert plan.period.tolist() == T.tolist()
     n3 = _ladder_by_hand(math.ceil(100 * 10.0 / 0.4))  # 100 steps per natural period
@@ -135,9 +135,9 @@ def test_lane_plan_incommensurate_section_and_bad_lanes():
     with pytest.raises(ValueError, match="Omega must be positive and finite"):
         LanePlan.build(_Forced(), np.array([[0.0, np.nan, 1.0]]), RunSettings())
     with pytest.raises(ValueError, match=r"steps_per_period must be >= 4 \(got 3\)"):
-        LanePlan.build(_Forced(), P, RunSettings(), steps_per_period=np.array([3]))
+        LanePlan.build(_Forced(), P, RunSettings(), LaneSettings(steps_per_period=[3]))
     with pytest.raises(ValueError, match="transient must be a finite time >= 0 in every lane"):
-        LanePlan.build(_Forced(), P, RunSettings(), transient=np.array([-1.0]))
+        LanePlan.build(_Forced(), P, RunSettings(), LaneSettings(transient=[-1.0]))
 
 
 def test_default_steps_per_period_rule_by_hand():
@@ -178,8 +178,9 @@ def test_old_keywords_equal_run_settings_bitwise(device):
     sim_new = geardyn.simulate(device, 1.1, RunSettings(transient=20.0, samples=2))
     xr.testing.assert_identical(sim_old, sim_new)
     P = device.lane_params("Omega", om)
-    a = run_lanes(device, P, device.initial_state(), 60.0, 4, converge_tol=1e-8,
-                  transient_max=120.0)
+    with pytest.warns(DeprecationWarning, match=r"run_lanes\(transient=, samples=, "):
+        a = run_lanes(device, P, device.initial_state(), 60.0, 4, converge_tol=1e-8,
+                      transient_max=120.0)
     b = run_lanes(device, P, device.initial_state(), run=run)
     assert np.array_equal(a.samples, b.samples) and np.array_equal(a.final_time, b.final_time)
 

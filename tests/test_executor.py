@@ -13,7 +13,7 @@ from geardyn.solvers.ensemble import LaneResults, run_lanes
 
 GEAR = geardyn.GearPair(zeta=0.05, kappa=0.2, Fm=0.1, Fa=0.2)
 OMEGAS = np.linspace(0.4, 3.0, 13)
-SETTINGS = dict(transient=150.0, samples=8, steps_per_period=128)
+SETTINGS = dict(run=geardyn.RunSettings(transient=150.0, samples=8, steps_per_period=128))
 MAP = dict(x=("Omega", np.linspace(0.5, 3.0, 7)), y=("zeta", [0.02, 0.05, 0.1]),
            run=geardyn.RunSettings(transient=200.0, samples=16), lyapunov=True, chunk=4)
 

@@ -343,3 +343,13 @@ def test_unbounded_values_are_marked_on_top_of_the_diagram():
     assert sorted(zip(view.x, view.y, view.period_class, strict=True)) == [
         (1.0, 0.1, 1), (1.0, 0.2, 1), (2.0, 0.5, -1), (3.0, 0.3, 0), (3.0, 0.5, 0)]
     assert list(view.contact["mesh"]) == ["none", "unbounded", "single"]
+
+
+def test_an_override_keeps_a_transient_in_forcing_periods(tmp_path):
+    """A study that gives run.transient_periods: an override rebuilds it as the file says
+    (transient_periods alone), not with the table's default transient beside it."""
+    study = load_study(STUDY.replace("transient = 200.0", "transient_periods = 30"))
+    st = ExplorerState(study, "gp.toml", save_dir=tmp_path, describe_error=format_error)
+    assert st.set_override("zeta", "0.08") is None
+    assert st.effective_study.run.transient_periods == 30
+    assert st.run_settings().transient == pytest.approx(30 * 2 * np.pi / 1.6, rel=1e-15)

@@ -163,7 +163,8 @@ def test_phased_and_unphased_lanes_equal_single_simulations_bitwise():
     P = np.array([m.with_params(Omega=float(om), kappa_phase=phases[j % 3][0],
                                 error_phase=phases[j % 3][1]).params
                   for j, om in enumerate(omegas)])
-    r = run_lanes(m, P, m.initial_state(), 300.0, 6, steps_per_period=64)
+    r = run_lanes(m, P, m.initial_state(),
+                  run=geardyn.RunSettings(transient=300.0, samples=6, steps_per_period=64))
     assert np.all(r.status == 0)
     assert np.sum(r.crossings) > 40  # contact lost and regained: the split ran
     for j in range(omegas.size):

@@ -183,8 +183,8 @@ def test_grazing_crossings_and_contact_agree_with_dop853(grazing_sweep):
                     ["edge_crossings"].values for fa, y0 in zip(fas, Y0, strict=True)])
     np.testing.assert_array_equal(got, expected)
     # the sweep kernel: crossing counts of the lanes, and the contact regime of the sweep
-    r = run_lanes(model, model.lane_params("Fa", fas), Y0, transient=0.0, samples=PERIODS,
-                  steps_per_period=n)
+    r = run_lanes(model, model.lane_params("Fa", fas), Y0,
+                  run=geardyn.RunSettings(transient=0.0, samples=PERIODS, steps_per_period=n))
     np.testing.assert_array_equal(r.crossings, expected)
     assert np.all(r.unresolved == 0)
     ds = geardyn.bifurcation(model, "Fa", fas,

@@ -107,7 +107,7 @@ import geardyn
 from geardyn.solvers.ensemble import run_lanes
 m = geardyn.CATTDevice(geardyn.PlanetaryParams.paper(xi1=0.05, xi2=0.05))
 P = m.lane_params("Omega", np.linspace(0.3, 3.9, 40))
-r = run_lanes(m, P, m.initial_state(), 300.0, 16)
+r = run_lanes(m, P, m.initial_state(), run=geardyn.RunSettings(transient=300.0, samples=16))
 print(json.dumps({"samples": r.samples.tobytes().hex(), "crossings": r.crossings.tolist(),
                   "rms": r.obs_rms.tobytes().hex()}))
 """

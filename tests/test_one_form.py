@@ -128,10 +128,9 @@ def test_phased_gear_pair_matches_the_reference_integrator():
 def test_user_gear_pair_equals_gear_pair_bitwise():
     pair, user = geardyn.GearPair(**COEFFS), gear_pair(**COEFFS)
     assert kernels_for(user.kernel).FUSED
-    r_pair = run_lanes(pair, _lanes(pair), pair.initial_state(), 300.0, 6,
-                       steps_per_period=64)
-    r_user = run_lanes(user, _lanes(user), user.initial_state(), 300.0, 6,
-                       steps_per_period=64)
+    run = geardyn.RunSettings(transient=300.0, samples=6, steps_per_period=64)
+    r_pair = run_lanes(pair, _lanes(pair), pair.initial_state(), run=run)
+    r_user = run_lanes(user, _lanes(user), user.initial_state(), run=run)
     for name in LaneResults.__dataclass_fields__:
         np.testing.assert_array_equal(getattr(r_user, name), getattr(r_pair, name),
                                       err_msg=name)
@@ -192,7 +191,8 @@ def test_duffing_one_form_through_simulate_sweep_lyapunov_and_orbits():
     np.testing.assert_allclose(ds["poincare"].values[1:], ref, atol=1e-8)
     # the sweep's lanes equal single simulations bit for bit
     om = np.array([0.9, 1.2, 1.5])
-    r = run_lanes(one, one.lane_params("Omega", om), y0, 60.0, 4, steps_per_period=64)
+    r = run_lanes(one, one.lane_params("Omega", om), y0,
+                  run=geardyn.RunSettings(transient=60.0, samples=4, steps_per_period=64))
     for j, w in enumerate(om):
         d = geardyn.simulate(one, omega=float(w),
                              run=geardyn.RunSettings(transient=60.0, samples=4,

@@ -7,10 +7,9 @@ import numpy as np
 import pytest
 
 import geardyn
-from geardyn.core.plan import lane_steps_per_period
+from geardyn.core.plan import default_steps_per_period, lane_steps_per_period
 from geardyn.errors import ParameterError
 from geardyn.solvers.kernels import kernels_for
-from geardyn.solvers.simulate import default_steps_per_period
 
 #: The coefficients a change of Km_pq moves (omega_n depends on Km_sq only): stiffness, damping
 #: and the relative stiffness variation Ka/Km (the kpq_* harmonics).

@@ -54,8 +54,8 @@ def _continued_against_single(model: geardyn.Model, omegas: np.ndarray, y0: np.n
     the first run on its own from the state the point started from (the previous point's
     final state) at phase 0; both with the same transient (``periods`` of the first point)."""
     P = model.lane_params("Omega", omegas)
-    kw = {"transient": periods * 2 * math.pi / omegas[0], "samples": 4, "locate_edges": True,
-          "steps_per_period": 256}
+    kw = {"run": geardyn.RunSettings(transient=periods * 2 * math.pi / omegas[0], samples=4,
+                                     locate_edges=True, steps_per_period=256)}
     L = omegas.size
     chained = run_lanes(model, P, y0, chain=np.r_[np.arange(1, L), -1], **kw)
     assert np.all(chained.status == geardyn.Status.OK)

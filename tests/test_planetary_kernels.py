@@ -11,6 +11,9 @@ import geardyn
 from geardyn.models import planetary_kernels as pk
 from geardyn.solvers.ensemble import run_lanes
 
+#: A short run of the lane tests: 30 time units discarded, 3 samples, 64 steps per period.
+_RUN = geardyn.RunSettings(transient=30.0, samples=3, steps_per_period=64)
+
 M = geardyn.Member
 
 
@@ -80,8 +83,7 @@ def test_lanes_reproduce_single_simulations_bitwise():
     per-lane functions' result: run_lanes equals simulate."""
     gs = busy_set()
     omegas = np.array([0.4, 0.9, 0.55, 1.3, 0.7])
-    r = run_lanes(gs, gs.lane_params("Omega", omegas), gs.initial_state(), 30.0, 3,
-                  steps_per_period=64)
+    r = run_lanes(gs, gs.lane_params("Omega", omegas), gs.initial_state(), run=_RUN)
     assert np.all(r.status == 0)
     for j in (0, 3):
         ds = geardyn.simulate(gs, omega=omegas[j],
@@ -94,8 +96,7 @@ def test_lanes_with_different_damping_reproduce_single_simulations_bitwise():
     """Lanes whose modal damping differs (each its own Ct, not the block's shared copy)."""
     gs = busy_set()
     zetas = [0.01, 0.04, 0.02]
-    r = run_lanes(gs, gs.lane_params("modal_damping", zetas), gs.initial_state(), 30.0, 3,
-                  steps_per_period=64)
+    r = run_lanes(gs, gs.lane_params("modal_damping", zetas), gs.initial_state(), run=_RUN)
     for j in (0, 1):
         ds = geardyn.simulate(gs.with_params(modal_damping=zetas[j]),
                               run=geardyn.RunSettings(transient=30.0, samples=3,
@@ -112,7 +113,7 @@ def test_rotating_lanes_reproduce_single_simulations_bitwise(name, values):
     if name == "carrier_speed":
         gs = busy_set(carrier=M(5.43, 6.29, 1e8, 0.0, radius=0.08), carrier_speed=1.0)
     P = gs.lane_params(name, values)
-    r = run_lanes(gs, P, gs.initial_state(), 30.0, 3, steps_per_period=64)
+    r = run_lanes(gs, P, gs.initial_state(), run=_RUN)
     assert np.all(r.status == 0)
     assert len({row[gs._layout["gyro"]] for row in P}) == 3  # the lanes' speeds differ
     for j in range(3):

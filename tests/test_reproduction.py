@@ -438,8 +438,7 @@ def test_interpretation_table_in_docs_is_generated():
 
 
 def test_default_steps_at_every_omega_is_the_one_run_rule():
-    from geardyn.core.plan import default_steps_at
-    from geardyn.solvers.simulate import default_steps_per_period
+    from geardyn.core.plan import default_steps_at, default_steps_per_period
 
     omegas = np.linspace(0.1, 4.0, 40)
     for name in ("fig3", "fig13"):  # without and with the load's fluctuation

@@ -9,6 +9,8 @@ import pytest
 
 import geardyn
 from geardyn.analysis.periodicity import classify_period, common_section
+from geardyn.core.plan import LaneSettings
+from geardyn.core.settings import RunSettings
 from geardyn.solvers.ensemble import run_lanes
 
 
@@ -42,7 +44,8 @@ def test_model_reports_the_load_fluctuation(noisy_device):
 def test_samples_every_common_period_match_reference(noisy_device):
     m = noisy_device
     P = m.lane_params("Omega", [0.6])
-    r = run_lanes(m, P, m.initial_state(), 150.0, 4, sample_every=2)
+    r = run_lanes(m, P, m.initial_state(), run=RunSettings(transient=150.0, samples=4),
+                  lanes=LaneSettings(sample_every=2))
     T = 2 * math.pi / 0.6
     n_tr = int(r.transient_periods[0])
     assert n_tr % 2 == 0  # the transient is whole common periods
@@ -54,9 +57,10 @@ def test_samples_every_common_period_match_reference(noisy_device):
 def test_transient_by_convergence_stops_early_on_a_periodic_attractor():
     m = geardyn.CATTDevice(geardyn.PlanetaryParams.paper(xi1=0.05, xi2=0.05))
     P = m.lane_params("Omega", [0.6, 1.1])
-    long = run_lanes(m, P, m.initial_state(), 3000.0, 8)
-    auto = run_lanes(m, P, m.initial_state(), 100.0, 8, transient_max=3000.0,
-                     converge_tol=1e-8)
+    long = run_lanes(m, P, m.initial_state(), run=RunSettings(transient=3000.0, samples=8))
+    auto = run_lanes(m, P, m.initial_state(),
+                     run=RunSettings(transient=100.0, samples=8, transient_max=3000.0,
+                                     converge=1e-8))
     assert auto.converged.tolist() == [1, 1]
     assert np.all(auto.transient_periods < long.transient_periods)
     assert classify_period(auto.samples).tolist() == classify_period(long.samples).tolist()
@@ -73,7 +77,8 @@ def test_transient_by_convergence_stops_early_on_a_periodic_attractor():
 def test_transient_by_convergence_gives_up_on_chaos():
     m = geardyn.CATTDevice(geardyn.PlanetaryParams.paper(xi1=0.05, xi2=0.05))
     P = m.lane_params("Omega", [2.5])  # chaotic (Fig. 3 band 2.3-2.7)
-    r = run_lanes(m, P, m.initial_state(), 100.0, 8, transient_max=600.0, converge_tol=1e-8)
+    r = run_lanes(m, P, m.initial_state(),
+                  run=RunSettings(transient=100.0, samples=8, transient_max=600.0, converge=1e-8))
     T = 2 * math.pi / 2.5
     assert r.converged[0] == 0
     assert r.transient_periods[0] == math.floor(600.0 / T)

@@ -169,12 +169,23 @@ def test_lyapunov_lanes_use_the_run_as_lyapunov_does():
     assert np.all(np.abs(lanes[True] - lanes[False]) > 1e-6)
 
 
-#: Names that moved: (old home, name, new home).
+#: Names that moved: (old home, name, new home or ``new home:new name``).
 MOVED = [
     ("geardyn.models.base", "Model", "geardyn.core.model"),
+    ("geardyn.models.base", "unique_rows", "geardyn.core.model"),
+    ("geardyn.solvers.simulate", "MIN_STEPS_PER_PERIOD", "geardyn.core.plan"),
+    ("geardyn.solvers.simulate", "STEPS_PER_FASTEST_MODE", "geardyn.core.plan"),
     ("geardyn.solvers.simulate", "STEPS_PER_OTHER_FORCING", "geardyn.core.plan"),
+    ("geardyn.solvers.simulate", "steps_per_period_rule", "geardyn.core.plan"),
+    ("geardyn.solvers.simulate", "default_steps_per_period", "geardyn.core.plan"),
     ("geardyn.solvers.simulate", "DEFAULT_BOUND", "geardyn.core.settings"),
+    ("geardyn.solvers.ensemble", "_LADDER", "geardyn.core.plan"),
+    ("geardyn.solvers.ensemble", "ladder_steps", "geardyn.core.plan"),
     ("geardyn.solvers.ensemble", "lane_steps_per_period", "geardyn.core.plan"),
+    ("geardyn.analysis.lyapunov", "DEFAULT_DT", "geardyn.core.settings:LYAPUNOV_DT"),
+    ("geardyn.analysis.lyapunov", "DEFAULT_RENORM_EVERY",
+     "geardyn.core.settings:LYAPUNOV_RENORM_EVERY"),
+    ("geardyn.analysis.lyapunov", "DEFAULT_BLOCKS", "geardyn.core.settings:LYAPUNOV_BLOCKS"),
 ]
 
 _OLD_HOMES = """
@@ -183,10 +194,11 @@ warnings.simplefilter("always")
 import geardyn
 out = []
 for old, name, new in json.loads(sys.argv[1]):
+    home, _, new_name = new.partition(":")
     with warnings.catch_warnings(record=True) as record:
         warnings.simplefilter("always")
         same = getattr(importlib.import_module(old), name) is getattr(
-            importlib.import_module(new), name)
+            importlib.import_module(home), new_name or name)
         getattr(importlib.import_module(old), name)
     out.append([same, [(w.category.__name__, str(w.message)) for w in record]])
 print(json.dumps(out))
@@ -196,7 +208,7 @@ print(json.dumps(out))
 def test_old_homes_warn_once_and_nothing_uses_them():
     """In a fresh interpreter (``import geardyn`` itself warns nothing), each old home gives the
     moved object with one DeprecationWarning naming the new home, however often it is asked;
-    src/, docs/ and examples/ import nothing from an old home."""
+    src/, docs/, examples/, tests/ and bench/ import nothing from an old home."""
     import json
     import os
     import re
@@ -211,11 +223,13 @@ def test_old_homes_warn_once_and_nothing_uses_them():
     got = json.loads(out.stdout.strip().splitlines()[-1])
     assert "DeprecationWarning" not in out.stderr  # import geardyn: nothing deprecated used
     for (old, name, new), (same, record) in zip(MOVED, got, strict=True):
+        home, _, new_name = new.partition(":")
+        as_ = f" as {new_name}" if new_name else ""
         assert same
         assert record == [["DeprecationWarning", f"{old}.{name} is deprecated: import it "
-                                                 f"from {new}"]]
-    files = [p for d in ("src", "docs", "examples") for p in (root / d).rglob("*")
-             if p.suffix in (".py", ".md", ".rst")]
+                                                 f"from {home}{as_}"]]
+    files = [p for d in ("src", "docs", "examples", "tests", "bench") for p in (root / d).rglob("*")
+             if p.suffix in (".py", ".md", ".rst") and p.name != Path(__file__).name]
     for old, name, _ in MOVED:
         pattern = re.compile(rf"from {re.escape(old)} import[^\n]*\b{name}\b|"
                              rf"{re.escape(old)}\.{name}\b")

@@ -42,7 +42,7 @@ def test_the_split_in_the_lane_form_equals_the_array_form_bitwise():
     assert not kernels_for(generic.kernel).FUSED
     omegas = np.array([0.6, 1.1, 1.7, 2.3, 2.9, 3.5])  # contact lost in most of them
     P = model.lane_params("Omega", omegas)
-    kw = {"transient": 60.0, "samples": 8, "locate_edges": True}
+    kw = {"run": geardyn.RunSettings(transient=60.0, samples=8, locate_edges=True)}
     fused = run_lanes(model, P, model.initial_state(), **kw)
     plain = run_lanes(generic, P, model.initial_state(), **kw)
     assert np.all(fused.status == 0)

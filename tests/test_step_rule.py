@@ -97,14 +97,16 @@ def test_km_pq_sweep_at_the_default_step_agrees_with_dop853():
     scale = np.max(np.abs(ref))
     err = np.max(np.abs(ds["poincare"].values[-1] - ref))
     assert err < 1e-6 * scale
-    old = run_lanes(stiff, stiff.params[None], stiff.initial_state(), 60.0, 3, int(n[0]))
+    old = run_lanes(stiff, stiff.params[None], stiff.initial_state(),
+                    run=geardyn.RunSettings(transient=60.0, samples=3, steps_per_period=int(n[0])))
     assert np.max(np.abs(old.samples[0] - ref)) > 1e-6 * scale
 
 
 def test_explicit_steps_win_and_models_without_modes_keep_the_floor():
     m = geardyn.CATTDevice(geardyn.PlanetaryParams.paper(), omega=1.1)
     P = m.lane_params("Km_pq", KM_PQ)
-    r = run_lanes(m, P, m.initial_state(), 0.0, 1, steps_per_period=96)
+    r = run_lanes(m, P, m.initial_state(),
+                  run=geardyn.RunSettings(transient=0.0, samples=1, steps_per_period=96))
     assert r.steps_per_period.tolist() == [96] * 3
     g = geardyn.GearPair(Omega=0.5)
     assert default_steps_per_period(g) == math.ceil(STEPS_PER_FASTEST_MODE / 0.5)

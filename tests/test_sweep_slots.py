@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 import geardyn
-from geardyn.core.plan import LanePlan
+from geardyn.core.plan import LanePlan, LaneSettings
 from geardyn.core.settings import RunSettings
 from geardyn.solvers.ensemble import LaneResults, _schedule, run_plan
 
@@ -31,8 +31,8 @@ def _lanes(n_lanes: int = 23):
 
 
 def _run(model, P, n_per, transient, run, **kw) -> LaneResults:
-    plan = LanePlan.build(model, P, run, transient=transient, steps_per_period=n_per,
-                          sample_every=1)
+    lanes = LaneSettings(transient=transient, steps_per_period=n_per, sample_every=1)
+    plan = LanePlan.build(model, P, run, lanes)
     return run_plan(model, P, model.initial_state(), plan, **kw)
 
 
@@ -103,8 +103,8 @@ def test_block_compaction_keeps_every_lane_bitwise(converge):
     chain[[3, 4, 20]] = [4, 5, 21]  # chains 3 -> 4 -> 5 and 20 -> 21
     run = RunSettings(samples=8, converge=converge,
                       transient_max=None if converge is None else 2000.0)
-    plan = LanePlan.build(model, P, run, transient=transient,
-                          transient_max=None if converge is None else 2 * transient)
+    plan = LanePlan.build(model, P, run, LaneSettings(
+        transient=transient, transient_max=None if converge is None else 2 * transient))
     y0 = model.initial_state()
     wide = run_plan(model, P, y0, plan, width=64, workers=1, chain=chain)
     narrow = run_plan(model, P, y0, plan, width=1, workers=1, chain=chain)

@@ -23,6 +23,7 @@ from geardyn.analysis.orbits import PeriodicOrbit, periodic_orbit
 from geardyn.analysis.periodicity import classify_period, common_section
 from geardyn.analysis.spectrum import amplitude_spectrum, label_peaks
 from geardyn.core.model import Model
+from geardyn.core.plan import default_steps_per_period
 from geardyn.core.settings import (
     ContinuationSettings,
     LyapunovSettings,
@@ -39,7 +40,7 @@ from geardyn.models.planetary import Member, PlanetaryGearSet
 from geardyn.models.spur_pair import SpurPair
 from geardyn.models.user import UserModel
 from geardyn.solvers.reference import reference_solution
-from geardyn.solvers.simulate import default_steps_per_period, simulate
+from geardyn.solvers.simulate import simulate
 from geardyn.study import build_model
 
 __all__ = [

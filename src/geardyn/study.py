@@ -2,10 +2,11 @@
 
 :mod:`geardyn.io.toml` reads and validates a study file (or a packaged one,
 ``geardyn/studies/*.toml``) into a :class:`~geardyn.io.toml.Study`, plain validated data;
-:func:`build_model` makes the :class:`~geardyn.CATTDevice` or :class:`~geardyn.GearPair` it
-describes, :func:`mesh_stiffness` the potential-energy mesh stiffness of its ``[gears]``. This
-module sits above both ``models`` and ``io`` (``tests/test_layers.py``), so that reading a
-study never imports a model's kernels, and the packaged study files stay data.
+:func:`build_model` makes the model it describes (a :class:`~geardyn.SpurPair` of its
+``[gears]`` for a ``spur_pair`` study), :func:`mesh_stiffness` the potential-energy mesh
+stiffness of its ``[gears]``. This module sits above both ``models`` and ``io``
+(``tests/test_layers.py``), so that reading a study never imports a model's kernels, and the
+packaged study files stay data.
 """
 
 from __future__ import annotations
@@ -19,24 +20,27 @@ from pydantic import ValidationError
 
 from geardyn.core.model import Model
 from geardyn.errors import ParameterError, StudyError
-from geardyn.io.toml import GearPairParams, PlanetaryGearSetParams, Study
+from geardyn.io.toml import GearPairParams, PlanetaryGearSetParams, SpurPairParams, Study
 from geardyn.models.catt import CATTDevice
 from geardyn.models.derived import INTERPRETATIONS
 from geardyn.models.gear_pair import GearPair
 from geardyn.models.planetary import Member, PlanetaryGearSet
+from geardyn.models.spur_pair import SpurPair, period_cycles
 from geardyn.units import to_si
 
-__all__ = ["build_model", "check_usable", "mesh_stiffness", "planetary_model"]
+__all__ = ["build_model", "check_usable", "mesh_stiffness", "planetary_model",
+           "spur_pair_model", "study_omega"]
 
 
 def build_model(study: Study, interpretation: str | None = None, omega: float | None = None
                 ) -> Model:
-    """The study's model: a :class:`~geardyn.CATTDevice`, a :class:`~geardyn.GearPair` or a
-    :class:`~geardyn.PlanetaryGearSet`.
+    """The study's model: a :class:`~geardyn.CATTDevice`, a :class:`~geardyn.GearPair`, a
+    :class:`~geardyn.PlanetaryGearSet` or a :class:`~geardyn.SpurPair`.
 
     ``interpretation`` and ``omega`` override the study's (``omega`` defaults to
-    ``[run].omega``, else 1). Raises :class:`~geardyn.ParameterError` for an unknown
-    interpretation or parameters that give no usable model (:func:`check_usable`).
+    ``[run].omega``, else 1; a spur pair's to the Omega of its ``[params].speed``). Raises
+    :class:`~geardyn.ParameterError` for an unknown interpretation or parameters that give no
+    usable model (:func:`check_usable`).
     """
     if interpretation is not None and interpretation not in INTERPRETATIONS:
         raise ParameterError(
@@ -53,6 +57,8 @@ def build_model(study: Study, interpretation: str | None = None, omega: float | 
         return check_usable(lambda: GearPair(**kwargs))
     if isinstance(study.params, PlanetaryGearSetParams):
         return check_usable(lambda: planetary_model(study.params, om))
+    if isinstance(study.params, SpurPairParams):
+        return check_usable(lambda: spur_pair_model(study, om))
     return check_usable(lambda: CATTDevice(
         study.planetary_params,
         interpretation or study.study.interpretation,  # type: ignore[arg-type]
@@ -93,6 +99,49 @@ def mesh_stiffness(study: Study, faults: bool = True, loaded: bool = True) -> xr
             ds.attrs["torque_Nm"] = load["torque"]
     ds.attrs["study"] = study.study.name
     return ds
+
+
+def spur_pair_model(study: Study, omega: float | None = None) -> SpurPair:
+    """:meth:`SpurPair.from_geometry` of a ``spur_pair`` study: the pair, bores, material and
+    faults of ``[gears]`` and ``[[faults]]``, the angles and quadrature of ``[stiffness]``,
+    the dynamics of ``[params]`` (with the forcing frequency Omega [rad/s] ``omega`` where
+    given). ``[stiffness].cycles``, where the study gives it, must be the period's mesh
+    cycles (the table spans one forcing period). Errors name ``params.<field>`` or
+    ``stiffness.cycles``."""
+    mesh, kw = study.stiffness_inputs()
+    dyn = study.params.model_dump()  # type: ignore[union-attr]
+    period = dyn.get("period")
+    table = study.stiffness
+    if table is not None and table.cycles is not None:
+        faulty = sorted({getattr(f, "gear", None) for f in kw.get("faults", ())} - {None})
+        try:
+            want = period_cycles(mesh, period or (faulty[0] if faulty else "pinion"))
+        except ParameterError as exc:
+            raise ParameterError(f"params.{exc.field}", exc.value, exc.reason) from None
+        if kw["cycles"] != want:
+            raise ParameterError("stiffness.cycles", table.cycles, f"a spur_pair model's table"
+                                 f" spans its forcing period ({want} mesh cycles); leave it out"
+                                 " or give that")
+    kw.pop("cycles")
+    inertia = dyn.pop("inertia")
+    try:
+        model = SpurPair.from_geometry(
+            mesh, **kw, **{k: v for k, v in dyn.items() if v is not None},
+            **({} if inertia is None else {"inertia": tuple(inertia)}))
+    except ParameterError as exc:
+        raise ParameterError(f"params.{exc.field}", exc.value, exc.reason) from None
+    return model if omega is None else model.with_omega(float(omega))
+
+
+def study_omega(study: Study, model: Model, given: float | None = None) -> float | None:
+    """The forcing frequency Omega of a run of ``study``: ``given`` (a command's --omega),
+    else ``[run].omega``, else, for a model whose ``[params]`` set it (a spur pair's speed),
+    the model's; None where the study sets none."""
+    if given is not None:
+        return given
+    if study.run.omega is not None:
+        return study.run.omega
+    return model.omega if isinstance(study.params, SpurPairParams) else None
 
 
 def planetary_model(params: PlanetaryGearSetParams, omega: float | None = None

@@ -270,7 +270,7 @@ def branch_dataset(model: Model, param: str, start: float, stop: float,
     coords: dict[str, Any] = {
         "point": ("point", np.arange(len(pts))),
         param: ("point", np.array([p.value for p in pts], float), {
-            "long_name": f"continuation parameter {param}"}),
+            **model.param_attrs(param), "long_name": f"continuation parameter {param}"}),
         "state": ("state", list(model.state_names)),
         "multiplier": ("multiplier", np.arange(n)),
         "branch_id": ("branch_id", np.arange(len(runs))),

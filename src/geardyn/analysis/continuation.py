@@ -29,7 +29,7 @@ from typing import Any
 import numpy as np
 
 from geardyn.core.model import Model
-from geardyn.core.plan import lane_omega, lane_section, lane_steps
+from geardyn.core.plan import LaneSettings, lane_omega, lane_section, lane_steps
 from geardyn.core.settings import RunSettings, resolve_run
 from geardyn.core.status import Status
 from geardyn.solvers.ensemble import LaneResults, run_lanes
@@ -149,9 +149,8 @@ def continue_branches(
                 tmax.append(hi)
                 steps.append(b.steps[j])
                 chain.append(len(P) if q + 1 < len(points[i]) else -1)
-        r = run_lanes(branches[live[0]].model, np.stack(P), np.stack(Y0),
-                      transient=np.array(tr), steps_per_period=np.array(steps),
-                      t0=np.array(T0), transient_max=np.array(tmax), run=run,
+        lanes = LaneSettings(t0=T0, transient=tr, transient_max=tmax, steps_per_period=steps)
+        r = run_lanes(branches[live[0]].model, np.stack(P), np.stack(Y0), run=run, lanes=lanes,
                       chain=np.array(chain, np.int64))
         for i in live:
             b = branches[i]

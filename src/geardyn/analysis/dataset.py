@@ -80,7 +80,8 @@ def sweep_dataset(model: Model, param: str, values: np.ndarray, runs: Sequence[L
     ds["final_time"] = (param, first.final_time, {
         "long_name": "model time at the last Poincare sample (the final state)",
         "units": model.time_unit})
-    ds.attrs.update(model=model.name, param=param, time_unit=model.time_unit)
+    ds.attrs.update(model=model.name, param=param, time_unit=model.time_unit,
+                    state_units=model.state_units)
     ds.attrs.update(model_attrs(model))
     return finish(ds, "bifurcation")
 

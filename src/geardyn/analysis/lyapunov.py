@@ -19,17 +19,14 @@ from typing import Any
 import numpy as np
 
 from geardyn.core.model import Model
-from geardyn.core.plan import (
-    default_steps_per_period,
-    forcing_period,
-    lane_steps,
-    periods_covering,
-)
+from geardyn.core.moved import moved
+from geardyn.core.plan import LanePlan, LaneSettings
 from geardyn.core.settings import (
     LYAPUNOV_BLOCKS,
     LYAPUNOV_DT,
+    LYAPUNOV_PERIODS,
     LYAPUNOV_RENORM_EVERY,
-    MIN_STEPS,
+    LYAPUNOV_TRANSIENT_PERIODS,
     LyapunovSettings,
     RunSettings,
     replacement,
@@ -40,20 +37,19 @@ from geardyn.core.settings import (
 from geardyn.core.status import Status
 from geardyn.solvers.kernels import kernels_for
 
-#: Defaults (LyapunovSettings'): the step of an autonomous model, RK4 steps between
-#: re-orthonormalisations, blocks of the measuring window for the standard error.
-DEFAULT_DT = LYAPUNOV_DT
-DEFAULT_RENORM_EVERY = LYAPUNOV_RENORM_EVERY
-DEFAULT_BLOCKS = LYAPUNOV_BLOCKS
+#: The defaults' earlier names here (deprecated): those of :mod:`geardyn.core.settings`.
+__getattr__ = moved(__name__, {
+    "DEFAULT_DT": "geardyn.core.settings:LYAPUNOV_DT",
+    "DEFAULT_RENORM_EVERY": "geardyn.core.settings:LYAPUNOV_RENORM_EVERY",
+    "DEFAULT_BLOCKS": "geardyn.core.settings:LYAPUNOV_BLOCKS"})
 
 #: Defaults of :func:`lyapunov` where they differ from :class:`~geardyn.RunSettings`'.
 LYAPUNOV_DEFAULTS = {"transient": 100.0}
 #: The :class:`~geardyn.RunSettings` fields that :func:`lyapunov` uses (as keywords: deprecated).
 LYAPUNOV_FIELDS = ("transient", "steps_per_period", "locate_edges", "bound")
 
-__all__ = ["DEFAULT_BLOCKS", "DEFAULT_DT", "DEFAULT_RENORM_EVERY", "LYAPUNOV_DEFAULTS",
-           "LyapunovEstimate", "lyapunov", "lyapunov_err_attrs", "lyapunov_lanes",
-           "lyapunov_unresolved_attrs"]
+__all__ = ["LYAPUNOV_DEFAULTS", "LyapunovEstimate", "lyapunov", "lyapunov_err_attrs",
+           "lyapunov_lanes", "lyapunov_unresolved_attrs"]
 
 
 @dataclass(frozen=True)
@@ -69,13 +65,18 @@ class LyapunovEstimate:
     the edge-location split limit and were integrated unsplit across an edge;
     ``status``: :attr:`~geardyn.Status.OK`, :attr:`~geardyn.Status.DIVERGED` (value NaN) or
     :attr:`~geardyn.Status.SPLIT_LIMIT` (``unresolved`` > 0: the value is kept, but it rests
-    on steps that are not 4th order across an edge)."""
+    on steps that are not 4th order across an edge);
+    ``duration``: the time averaged over (model time units, whole forcing periods) and
+    ``duration_rule`` where it came from (``LyapunovSettings.duration``, or the model's default
+    scale, :meth:`geardyn.Model.lyapunov_duration`)."""
 
     value: float | np.ndarray
     stderr: float | np.ndarray
     n_blocks: int
     unresolved: int = 0
     status: Status = Status.OK
+    duration: float = math.nan
+    duration_rule: str = ""
 
     @property
     def ok(self) -> bool:
@@ -90,7 +91,7 @@ def lyapunov_err_attrs(time_unit: str) -> dict[str, str]:
         "units": f"1/{time_unit}",
         "meaning": "1-sigma statistical error of the finite-time exponent per unit model time; "
                    "NaN where lyapunov is NaN",
-        "method": f"batch means: the measuring window cut into n = {DEFAULT_BLOCKS} blocks of "
+        "method": f"batch means: the measuring window cut into n = {LYAPUNOV_BLOCKS} blocks of "
                   "whole forcing periods (fewer if shorter), std(block rates, ddof=1) / "
                   "sqrt(n); see docs/lyapunov.md, Uncertainty"}
 
@@ -103,6 +104,23 @@ def lyapunov_unresolved_attrs() -> dict[str, str]:
         "meaning": "steps of the state or of a finite-difference neighbour integrated unsplit "
                    "across an edge (chattering); > 0: the exponent is kept but less accurate "
                    "(geardyn.Status.SPLIT_LIMIT)"}
+
+
+def _duration(model: Model, ls: LyapunovSettings) -> tuple[float | None, str]:
+    """The time averaged over (None: :data:`LYAPUNOV_PERIODS` forcing periods of each lane)
+    and its rule: ``ls.duration``, else the model's default scale."""
+    if ls.duration is not None:
+        return ls.duration, "LyapunovSettings.duration"
+    return model.lyapunov_duration()
+
+
+def _periods_transient(model: Model, run: RunSettings | None, keywords: dict[str, Any]
+                       ) -> bool:
+    """Whether the transient is the default in forcing periods
+    (:data:`LYAPUNOV_TRANSIENT_PERIODS`): no run and no transient given, a forced model of
+    physical time (its default of :data:`LYAPUNOV_DEFAULTS` is in dimensionless time)."""
+    return (run is None and "transient" not in keywords and not model.dimensionless_time
+            and model.omega_index is not None)
 
 
 def _check_blocks(n_blocks: int) -> int:
@@ -133,6 +151,18 @@ def _state_scale(model: Model) -> np.ndarray:
 
 #: The :class:`~geardyn.LyapunovSettings` fields (deprecated as keywords of :func:`lyapunov`).
 SETTINGS_FIELDS = tuple(f.name for f in dataclasses.fields(LyapunovSettings))
+
+
+def _autonomous_step(steps_per_period: int | None, dt: float | None) -> float:
+    """The step of an autonomous model's Lyapunov run: ``dt`` (default
+    :data:`~geardyn.core.settings.LYAPUNOV_DT`); a ValueError where the run gives steps per
+    period instead."""
+    if steps_per_period is not None:
+        raise ValueError("steps_per_period applies to forced models; give dt instead")
+    h = LYAPUNOV_DT if dt is None else float(dt)
+    if not (h > 0 and math.isfinite(h)):
+        raise ValueError(f"dt must be > 0 (got {dt!r})")
+    return h
 
 
 def _lyapunov_run(run: RunSettings | None, settings: LyapunovSettings | None,
@@ -180,7 +210,9 @@ def lyapunov(
         ``duration``, not ``samples``). Those four as keyword arguments instead (not together
         with ``run``) are deprecated: one DeprecationWarning naming the equivalent
         ``run=geardyn.RunSettings(...)``. Without either, ``transient`` is 100 time units (not
-        RunSettings' 4000) and the rest RunSettings' defaults.
+        RunSettings' 4000; for a forced model of physical time
+        :data:`~geardyn.core.settings.LYAPUNOV_TRANSIENT_PERIODS` forcing periods) and the rest
+        RunSettings' defaults.
     y0
         Initial state (default: ``model.initial_state()``), at time ``t0``.
     t0
@@ -192,7 +224,9 @@ def lyapunov(
         attractor. A state at another forcing phase cannot be started (the phase is tabulated
         on the period-aligned grid from zero).
     settings
-        :class:`~geardyn.LyapunovSettings`: ``duration`` (time averaged over), ``dt`` (step of
+        :class:`~geardyn.LyapunovSettings`: ``duration`` (time averaged over; default the
+        model's scale, :meth:`geardyn.Model.lyapunov_duration`: 2000 time units of a
+        dimensionless model, 200 forcing periods of one in seconds), ``dt`` (step of
         an autonomous model), ``renorm_every``, ``n_blocks``. Its fields given as keyword
         arguments are deprecated (a DeprecationWarning).
     transient, duration
@@ -206,7 +240,7 @@ def lyapunov(
         ``settings.dt``: step of an autonomous model (``model.omega == 0``; default 0.01).
         Not used for a forced
         model, whose grid has ``run.steps_per_period`` steps per forcing period (default
-        :func:`~geardyn.solvers.simulate.default_steps_per_period`), as in ``simulate``.
+        :func:`~geardyn.core.plan.default_steps_per_period`), as in ``simulate``.
     locate_edges
         ``run.locate_edges``: locate the model's edge crossings inside steps (default True;
         False integrates across them, as ``simulate`` does then).
@@ -224,9 +258,11 @@ def lyapunov(
     For a forced model the exponent of the flow's zero direction (along the forcing phase) is not
     included: the phase is not a state, so a forced model with n states has n exponents.
     """
+    in_periods = _periods_transient(model, run, keywords)
     run, ls = _lyapunov_run(run, settings, keywords, "lyapunov")
-    transient, steps_per_period, bound = run.transient, run.steps_per_period, run.bound
-    duration, dt, renorm_every, n_blocks = ls.duration, ls.dt, ls.renorm_every, ls.n_blocks
+    steps_per_period, bound = run.steps_per_period, run.bound
+    dt, renorm_every, n_blocks = ls.dt, ls.renorm_every, ls.n_blocks
+    duration, rule = _duration(model, ls)
     y = _initial(model, y0)
     t0 = float(t0)
     if not math.isfinite(t0):
@@ -234,27 +270,20 @@ def lyapunov(
     n_blk = _check_blocks(n_blocks)
     om = model.omega
     if om == 0.0:
-        if steps_per_period is not None:
-            raise ValueError("steps_per_period applies to forced models; give dt instead")
-        h = DEFAULT_DT if dt is None else float(dt)
-        if not (h > 0 and math.isfinite(h)):
-            raise ValueError(f"dt must be > 0 (got {dt!r})")
-        n_per = 1
-        n_tr = math.ceil(transient / h - 1e-9)
-        n_st = max(1, math.ceil(duration / h - 1e-9))
+        lanes = LaneSettings(t0=t0, ladder=False, interval=_autonomous_step(steps_per_period, dt),
+                             steps_per_period=1)
     else:
         if not (om > 0 and math.isfinite(om)):
             raise ValueError(f"omega must be a positive finite number (got {om!r})")
         if dt is not None:
             raise ValueError("dt applies to autonomous models; give steps_per_period instead")
-        n_per = int(steps_per_period or default_steps_per_period(model, om))
-        if n_per < MIN_STEPS:
-            raise ValueError(f"steps_per_period must be >= {MIN_STEPS} (got {n_per})")
-        period = forcing_period(om)
-        h = period / n_per
-        n_tr = periods_covering(transient, period) * n_per
-        n_st = max(1, periods_covering(duration, period)) * n_per
-    renorm = int(DEFAULT_RENORM_EVERY if renorm_every is None else renorm_every)
+        lanes = LaneSettings(t0=t0, ladder=False, sample_every=1)
+    plan = LanePlan.build(model, np.asarray(model.params, dtype=float)[None, :], run, lanes)
+    n_per, h = int(plan.steps_per_period[0]), float(plan.step[0])
+    n_tr = LYAPUNOV_TRANSIENT_PERIODS * n_per if in_periods else int(plan.transient_steps[0])
+    n_st = (LYAPUNOV_PERIODS * n_per if duration is None
+            else int(plan.window_steps(duration)[0]))
+    renorm = int(LYAPUNOV_RENORM_EVERY if renorm_every is None else renorm_every)
     if renorm < 1:
         raise ValueError(f"renorm_every must be >= 1 (got {renorm_every!r})")
     k = model.n_states if spectrum else 1
@@ -273,7 +302,7 @@ def lyapunov(
     else:
         value, err = float(ex[0]), float(er[0])
     if with_error:
-        return LyapunovEstimate(value, err, int(used), int(unres), status)
+        return LyapunovEstimate(value, err, int(used), int(unres), status, n_st * h, rule)
     if status == Status.SPLIT_LIMIT:
         warnings.warn(f"lyapunov: {int(unres)} grid steps reached the edge-split limit and were "
                       "integrated unsplit across an edge (status SPLIT_LIMIT); the exponent is "
@@ -300,7 +329,9 @@ def lyapunov_lanes(
     ``model.initial_state()``. ``run`` and ``settings`` as in :func:`lyapunov`: of the
     :class:`~geardyn.RunSettings` ``transient``, ``steps_per_period``, ``locate_edges`` and
     ``bound`` are used (as keyword arguments, not together with ``run``: deprecated; without either,
-    ``transient`` is 100 time units), of the :class:`~geardyn.LyapunovSettings` ``duration``,
+    ``transient`` is 100 time units, or for a forced model of physical time
+    :data:`~geardyn.core.settings.LYAPUNOV_TRANSIENT_PERIODS` forcing periods of each lane), of
+    the :class:`~geardyn.LyapunovSettings` ``duration``,
     ``dt``, ``renorm_every`` and ``n_blocks`` (its fields as keyword arguments: deprecated, a
     DeprecationWarning). ``transient`` and ``duration`` are times, rounded up to whole forcing
     periods of each lane (lanes differ in Omega, so their step counts differ). The grid has
@@ -318,9 +349,11 @@ def lyapunov_lanes(
     :class:`~geardyn.Status` code (as in :class:`LyapunovEstimate`; exponents kept where
     SPLIT_LIMIT, NaN where DIVERGED).
     """
+    in_periods = _periods_transient(model, run, keywords)
     run, ls = _lyapunov_run(run, settings, keywords, "lyapunov_lanes")
-    transient, steps_per_period, bound = run.transient, run.steps_per_period, run.bound
-    duration, dt, renorm_every, n_blocks = ls.duration, ls.dt, ls.renorm_every, ls.n_blocks
+    steps_per_period, bound = run.steps_per_period, run.bound
+    dt, renorm_every, n_blocks = ls.dt, ls.renorm_every, ls.n_blocks
+    duration, _ = _duration(model, ls)
     P = np.ascontiguousarray(np.atleast_2d(np.asarray(P, dtype=float)))
     L = P.shape[0]
     if P.shape[1] != model.params.size:
@@ -340,29 +373,21 @@ def lyapunov_lanes(
         raise ValueError("t0 must be finite")
     n_blk = _check_blocks(n_blocks)
     if model.omega_index is None:
-        if steps_per_period is not None:
-            raise ValueError("steps_per_period applies to forced models; give dt instead")
-        h = DEFAULT_DT if dt is None else float(dt)
-        if not (h > 0 and math.isfinite(h)):
-            raise ValueError(f"dt must be > 0 (got {dt!r})")
-        OMEGA = np.zeros(L)
-        H = np.full(L, h)
-        n_tr = np.full(L, math.ceil(transient / h - 1e-9), dtype=np.int64)
-        n_st = np.full(L, max(1, math.ceil(duration / h - 1e-9)), dtype=np.int64)
+        lanes = LaneSettings(t0=T0, interval=_autonomous_step(steps_per_period, dt),
+                             steps_per_period=1)
     else:
         if dt is not None:
             raise ValueError("dt applies to autonomous models; give steps_per_period instead")
-        OMEGA = np.ascontiguousarray(P[:, model.omega_index])
-        if not np.all(OMEGA > 0):
+        if not np.all(P[:, model.omega_index] > 0):
             raise ValueError("every lane needs a forcing frequency Omega > 0")
-        n_lane = lane_steps(model, P, steps_per_period)
-        periods = forcing_period(OMEGA)
-        H = periods / n_lane
-        n_tr = np.array([periods_covering(transient, T) * n
-                         for T, n in zip(periods, n_lane, strict=True)], dtype=np.int64)
-        n_st = np.array([max(1, periods_covering(duration, T)) * n
-                         for T, n in zip(periods, n_lane, strict=True)], dtype=np.int64)
-    renorm = int(DEFAULT_RENORM_EVERY if renorm_every is None else renorm_every)
+        lanes = LaneSettings(t0=T0, sample_every=1)
+    plan = LanePlan.build(model, P, run, lanes)
+    OMEGA, H, n_per = plan.omega, plan.step, plan.steps_per_period
+    n_tr = (LYAPUNOV_TRANSIENT_PERIODS * n_per).astype(np.int64) if in_periods else (
+        plan.transient_steps)
+    n_st = ((LYAPUNOV_PERIODS * n_per).astype(np.int64) if duration is None
+            else plan.window_steps(duration))
+    renorm = int(LYAPUNOV_RENORM_EVERY if renorm_every is None else renorm_every)
     if renorm < 1:
         raise ValueError(f"renorm_every must be >= 1 (got {renorm_every!r})")
     out = np.full(L, np.nan)
@@ -373,7 +398,6 @@ def lyapunov_lanes(
         scale = _state_scale(model)
         kern = kernels_for(model.kernel, "lyapunov")
         # lanes of every grid together (the kernel blocks them, whatever their steps)
-        n_per = np.ones(L, np.int64) if model.omega_index is None else n_lane.astype(np.int64)
         n_ev = model.n_events if run.locate_edges else 0
         kern.lyapunov_lanes(P, Y0, scale, T0, H, OMEGA, n_per, n_tr, n_st, renorm, float(bound),
                             out, err, n_ev, n_blk, unres, status)

@@ -39,7 +39,7 @@ from geardyn.cli.common import (
     write_outputs,
 )
 from geardyn.errors import ParameterError, StudyError
-from geardyn.study import build_model
+from geardyn.study import build_model, study_omega
 
 __all__ = ["basins_command", "register"]
 
@@ -58,7 +58,8 @@ def basins_command(
     x: Annotated[str, typer.Option("--x", help="x axis STATE:LO:HI:N, e.g. X_sq:-2:2:200")],
     y: Annotated[str, typer.Option("--y", help="y axis STATE:LO:HI:N, e.g. V_sq:-2:2:200")],
     omega: Annotated[
-        float | None, typer.Option(help="Mesh frequency Omega (default: the study's run.omega).")
+        float | None, typer.Option(help="Mesh frequency Omega (default: the study's run.omega; "
+                                        "a spur_pair study's: from its params.speed).")
     ] = None,
     transient: run_option("transient", "the least per cell; default: run.transient") = None,
     samples: run_option("samples", "per cell; default: 2 max_period + 2") = None,
@@ -80,7 +81,12 @@ def basins_command(
     from geardyn.cli.bifurcation import _progress_bar, _stderr_is_terminal
 
     s = load_study_source(study)
+    interp = interpretation.value if interpretation is not None else None
     om = omega if omega is not None else s.run.omega
+    base = None
+    if om is None and s.study.model == "spur_pair":  # Omega from the study's params.speed
+        base = build_model(s, interpretation=interp)
+        om = study_omega(s, base)
     if om is None:
         raise StudyError("--omega: not given, and the study has no run.omega")
     if not usable_omega(om):
@@ -90,8 +96,7 @@ def basins_command(
     check_plot_path("--plot", plot)
     if orbit_period < 0:
         raise ParameterError("--orbit-period", orbit_period, "must be >= 0")
-    interp = interpretation.value if interpretation is not None else None
-    model = build_model(s, interpretation=interp, omega=om)
+    model = base if base is not None else build_model(s, interpretation=interp, omega=om)
     x_axis = _state_axis(x, "--x", model.state_names)
     y_axis = _state_axis(y, "--y", model.state_names)
     if x_axis[0] == y_axis[0]:

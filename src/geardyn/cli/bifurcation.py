@@ -51,7 +51,7 @@ from geardyn.cli.common import (
     write_outputs,
 )
 from geardyn.errors import ParameterError, StudyError
-from geardyn.study import build_model
+from geardyn.study import build_model, study_omega
 
 __all__ = ["bifurcation_command", "parse_range", "plot_command", "register"]
 
@@ -206,7 +206,8 @@ def bifurcation_command(
     range_: Annotated[
         str | None,
         typer.Option("--range", help="START:STOP:NUM, NUM evenly spaced values (default: the "
-                                     "study's sweep table); SI units for the device's parameters."),
+                                     "study's sweep table); SI units for the device's parameters,"
+                                     " a spur pair's speed in its params.speed_unit."),
     ] = None,
     continuation: Annotated[
         Continuation | None,
@@ -263,6 +264,7 @@ def bifurcation_command(
     interp = interpretation.value if interpretation is not None else None
     model = build_model(s, interpretation=interp, omega=om)
     _check_param_name(model, name)
+    om = study_omega(s, model, om)
     if range_ is not None:
         start, stop, num = parse_range(range_)
         range_text = range_

@@ -216,7 +216,7 @@ def check_run_cost(model, lanes: int, omegas, transient: float, samples: int,
     import numpy as np
 
     from geardyn.analysis.map2d import check_steps, estimate_map, measure_ns_per_lane_step
-    from geardyn.solvers.simulate import default_steps_per_period
+    from geardyn.core.plan import default_steps_per_period
 
     omegas = np.asarray(omegas, dtype=float)
     try:

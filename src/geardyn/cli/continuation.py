@@ -51,7 +51,7 @@ from geardyn.cli.common import (
 )
 from geardyn.errors import ParameterError, StudyError
 from geardyn.io.toml import RUN_FIELDS
-from geardyn.study import build_model
+from geardyn.study import build_model, study_omega
 
 __all__ = ["continue_command", "parse_span", "register"]
 
@@ -253,6 +253,7 @@ def continue_command(
     interp = interpretation.value if interpretation is not None else None
     model = build_model(s, interpretation=interp, omega=om)
     _check_param_name(model, name)
+    om = study_omega(s, model, om)
     if name != "Omega" and om is None:
         raise StudyError(f"--omega: not given, and a branch in {name} needs a fixed Omega "
                          "(or [run].omega in the study)")

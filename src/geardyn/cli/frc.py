@@ -2,14 +2,16 @@
 
 ::
 
-    geardyn frc STUDY.toml [--range 0.5:1.5:201] [--param Omega|mesh_frequency|input_speed]
+    geardyn frc STUDY.toml [--range 0.5:1.5:201]
+                [--param Omega|mesh_frequency|input_speed|speed]
                 [--transient T] [--continued-transient T]
                 [--converge TOL] [--samples N] [--steps-per-period N] [--mesh NAME]
                 [--branch branch.nc ...] [--interpretation ...] [--quiet] [--yes]
                 [--out frc.nc] [--plot frc.png]
 
 Unset options come from the study's ``[sweep]`` (param, start, stop, num, samples; the sweep must
-be of Omega, mesh_frequency or input_speed, which are turned into Omega point by point) and
+be of Omega, mesh_frequency, input_speed or a spur pair's speed, which are turned into Omega
+point by point) and
 ``[run]`` tables (transient or transient_periods, converge, transient_max, continued_transient,
 max_period, period_tol, steps_per_period). A progress bar is drawn when stderr is a terminal.
 """
@@ -47,8 +49,9 @@ from geardyn.study import build_model
 
 __all__ = ["frc_command", "register"]
 
-#: The parameters ``geardyn frc`` sweeps: the forcing frequency and its physical forms.
-FREQUENCY_PARAMS = ("Omega", "mesh_frequency", "input_speed")
+#: The parameters ``geardyn frc`` sweeps: the forcing frequency and its physical forms (a spur
+#: pair's ``speed``: the pinion speed in its ``speed_unit``).
+FREQUENCY_PARAMS = ("Omega", "mesh_frequency", "input_speed", "speed")
 
 
 def frc_command(
@@ -59,7 +62,8 @@ def frc_command(
     ] = None,
     param: Annotated[
         str | None, typer.Option(help="The swept frequency: Omega, or mesh_frequency [rad/s] "
-                                      "or input_speed [rpm] of a model that has them (default: "
+                                      "or input_speed [rpm] of a model that has them, or a "
+                                      "spur pair's speed (in its speed_unit) (default: "
                                       "the study's sweep.param when it is one of these, else "
                                       "Omega).")
     ] = None,

@@ -58,7 +58,7 @@ from geardyn.cli.common import (
 )
 from geardyn.core.status import Status
 from geardyn.errors import ParameterError, StudyError
-from geardyn.study import build_model
+from geardyn.study import build_model, study_omega
 
 __all__ = ["EXIT_ERROR", "EXPECTED_ERRORS", "app", "main"]
 
@@ -161,6 +161,9 @@ def params_show(
         out.print(table)
         out.print("natural frequency (in contact): 1 (unit of dimensionless time)")
         return
+    if s.study.model == "spur_pair":
+        _show_spur_pair(out, model)
+        return
     if s.study.model == "planetary":
         out.print(f"{escape(repr(model))}: time scale omega_0 = {_fmt(model.time_scale)} rad/s, "
                   f"length scale L = {_fmt(model.length_scale)} m")
@@ -215,6 +218,33 @@ def params_show(
     out.print(f"static mesh forces under the mean loads: {names}")
 
 
+def _show_spur_pair(out: Console, model) -> None:
+    """The spur pair's inputs and derived coefficients (SI; the stiffness series summarised),
+    its natural frequency and the series' truncation error."""
+    from geardyn.models.spur_pair_coefficients import HEADER
+
+    out.print(escape(repr(model)))
+    table = Table(title="SpurPair coefficients (SI)")
+    for col in ("name", "value", "unit", "meaning"):
+        table.add_column(col, justify="right" if col == "value" else "left")
+    values = model.coefficient_values()
+    for c in HEADER.entries:
+        table.add_row(c.name, _fmt(float(values.get(c.name, model.params[HEADER.offset(
+            c.name)]))), escape(c.unit), escape(c.meaning))
+    out.print(table)
+    wn = float(model.natural_frequencies()[0])
+    err = model.stiffness_error()
+    i1, i2 = model.inertia
+    out.print(f"pinion speed {_fmt(model.speed)} rad/s = {_fmt(model.speed * 30 / math.pi)} "
+              f"rpm; mesh frequency {_fmt(model.mesh_frequency / (2 * math.pi))} Hz; "
+              f"{model.cycles} mesh cycles per forcing period")
+    out.print(f"inertias I1 = {_fmt(i1)}, I2 = {_fmt(i2)} kg m^2; natural frequency in "
+              f"contact sqrt(k_mean / m) = {_fmt(wn)} rad/s ({_fmt(wn / (2 * math.pi))} Hz)")
+    out.print(f"stiffness series: {model.n_harmonics} harmonics of Omega per flank; error "
+              f"against the table (of k_mean) rms {err['drive_rms']:.3g}, max "
+              f"{err['drive_max']:.3g} (drive)")
+
+
 @params_app.command("save")
 def params_save(
     out: Annotated[Path, typer.Argument(help="The TOML file to write.")],
@@ -236,7 +266,8 @@ def simulate(
     study: Annotated[str, typer.Argument(help="Study TOML file or built-in study name.")],
     omega: Annotated[
         float | None,
-        typer.Option(help="Mesh frequency Omega = omega/omega_n (default: the study's run.omega)."),
+        typer.Option(help="Mesh frequency Omega = omega/omega_n (default: the study's run.omega; "
+                          "a spur_pair study's: from its params.speed)."),
     ] = None,
     transient: run_option("transient", "default: run.transient") = None,
     periods: run_option("samples", "forcing periods recorded; default: run.periods",
@@ -256,7 +287,12 @@ def simulate(
     from geardyn.solvers.simulate import simulate as run_simulation
 
     s = load_study_source(study)
+    interp = interpretation.value if interpretation is not None else None
     om = omega if omega is not None else s.run.omega
+    base = None
+    if om is None and s.study.model == "spur_pair":  # Omega from the study's params.speed
+        base = build_model(s, interpretation=interp)
+        om = study_omega(s, base)
     if om is None:
         raise StudyError("--omega: not given, and the study has no run.omega")
     if not usable_omega(om):
@@ -273,8 +309,7 @@ def simulate(
     if spp is not None:
         check_count("--steps-per-period", spp)
     plot_state = state or s.plot_state
-    interp = interpretation.value if interpretation is not None else None
-    model = build_model(s, interpretation=interp, omega=om)
+    model = base if base is not None else build_model(s, interpretation=interp, omega=om)
     known = (*model.state_names, *model.observable_names)
     if plot is not None and plot_state not in known and f"{plot_state}1" not in known:
         raise ParameterError("--state" if state else "study.plot_state", plot_state,

@@ -130,7 +130,8 @@ def map_command(
     s = load_study_source(study)
     model = build_model(s, interpretation=interpretation)
     # the names and both ends of each axis must be valid before anything grid-sized is built
-    for (name, start, stop, _), option in ((x_axis, "--x"), (y_axis, "--y")):
+    forcing: list[tuple[float, float, int]] = []  # the Omega ends of axes that move Omega
+    for (name, start, stop, num), option in ((x_axis, "--x"), (y_axis, "--y")):
         try:
             with np.errstate(all="ignore"):
                 ends = model.lane_params(name, [start, stop])
@@ -147,9 +148,12 @@ def map_command(
         if not np.all(np.isfinite(ends)):
             raise ParameterError(option, f"{name}:{start}:{stop}", "an end of the axis makes the"
                                  " model's coefficients infinite (a value is too extreme)")
+        w = ends[:, model.omega_index]
+        if name == "Omega" or np.any(w != model.omega):  # Omega, or a speed that sets it
+            forcing.append((float(w[0]), float(w[1]), num))
 
     # the transient: --transient, [run].transient, or transient_periods of the lowest Omega
-    low = [min(a[1], a[2]) for a in (x_axis, y_axis) if a[0] == "Omega"]
+    low = [min(a[0], a[1]) for a in forcing]
     run = study_run_settings(s, {"transient": ("--transient", transient),
                                  "samples": ("--samples", samples),
                                  "steps_per_period": ("--steps-per-period", steps_per_period)},
@@ -158,8 +162,8 @@ def map_command(
     if n_samples < 2:
         raise ParameterError("run.periods", n_samples, "a map needs >= 2 samples per point")
     lanes = x_axis[3] * y_axis[3]
-    omega_axis = next((a for a in (x_axis, y_axis) if a[0] == "Omega"), None)
-    omegas = (np.linspace(omega_axis[1], omega_axis[2], min(omega_axis[3], ESTIMATE_POINTS))
+    omega_axis = forcing[0] if forcing else None
+    omegas = (np.linspace(omega_axis[0], omega_axis[1], min(omega_axis[2], ESTIMATE_POINTS))
               if omega_axis else np.array([model.omega]))
     try:
         check_steps(model, omegas, tr, n_samples, spp)

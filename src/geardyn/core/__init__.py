@@ -11,9 +11,9 @@ from geardyn.core.capabilities import Capabilities
 from geardyn.core.coefficients import Coefficient, CoefficientBlock, CoefficientLayout
 from geardyn.core.kernel_source import KernelSource
 from geardyn.core.model import Model
-from geardyn.core.plan import LanePlan
+from geardyn.core.plan import LanePlan, LaneSettings
 from geardyn.core.settings import RunSettings, SettingsError
 from geardyn.core.status import Status
 
 __all__ = ["Capabilities", "Coefficient", "CoefficientBlock", "CoefficientLayout", "KernelSource",
-           "LanePlan", "Model", "RunSettings", "SettingsError", "Status"]
+           "LanePlan", "LaneSettings", "Model", "RunSettings", "SettingsError", "Status"]

@@ -113,7 +113,7 @@ class Model:
        the model alone; ``fastest_natural_frequency(P)`` gives one value per lane (row of
        ``P``), > 0 or NaN (unknown), and ``other_frequencies(P)`` one row per lane.
     10. **run matches reference** -- a short run of the compiled RK4 kernel at the default step
-        (:func:`~geardyn.solvers.simulate.default_steps_per_period`, which resolves
+        (:func:`~geardyn.core.plan.default_steps_per_period`, which resolves
         ``fastest_natural_frequency``), with edges located, ends ok and matches the reference
         integrator (:func:`~geardyn.reference_solution`, DOP853 at rtol 1e-12) in the states
         and the observables.
@@ -347,7 +347,7 @@ class Model:
         stiffness, no backlash) in each lane of the coefficient matrix ``P`` (default: this
         model's own coefficients), shape ``(lanes,)``; NaN where it is not known.
 
-        The default step (:func:`~geardyn.solvers.simulate.default_steps_per_period`) resolves
+        The default step (:func:`~geardyn.core.plan.default_steps_per_period`) resolves
         this frequency in every lane. The default here: a model that defines
         ``natural_frequencies()`` is asked once per distinct row of ``P`` (a copy of the model
         holding that row), so it must compute them from ``self.params``; any other model gets
@@ -371,6 +371,29 @@ class Model:
     def with_omega(self, omega: float) -> Model:
         """A copy with the forcing frequency set to ``omega``."""
         return self.with_params(Omega=omega)
+
+    @property
+    def dimensionless_time(self) -> bool:
+        """Whether the model's time is dimensionless (``time_unit`` "1", e.g. tau = omega_n t)
+        rather than physical (seconds)."""
+        return self.time_unit in ("1", "")
+
+    def lyapunov_duration(self) -> tuple[float | None, str]:
+        """The default time a Lyapunov estimate averages over, in the model's time unit, and
+        the rule that gave it: :data:`~geardyn.core.settings.LYAPUNOV_DURATION` (2000) time
+        units for a model of dimensionless time; for one of physical time
+        :data:`~geardyn.core.settings.LYAPUNOV_PERIODS` forcing periods (None: that many
+        periods of each lane's own Omega); an autonomous model of physical time has no
+        scale to count (a ValueError: give ``LyapunovSettings(duration=...)``)."""
+        from geardyn.core.settings import LYAPUNOV_DURATION, LYAPUNOV_PERIODS
+
+        if self.dimensionless_time:
+            return LYAPUNOV_DURATION, f"default: {LYAPUNOV_DURATION:g} time units"
+        if self.omega_index is None:
+            raise ValueError(f"{self.name} is autonomous in {self.time_unit}: no forcing period"
+                             " to scale the Lyapunov duration by; give "
+                             "LyapunovSettings(duration=...)")
+        return None, f"default: {LYAPUNOV_PERIODS} forcing periods"
 
     def dataset_attrs(self) -> dict[str, object]:
         """Attributes every dataset of this model records (none here; e.g. the CATT device's

@@ -10,6 +10,7 @@ The model is duck-typed: the plan calls only ``model.omega_index``, ``model.para
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 from typing import Any
@@ -17,7 +18,7 @@ from typing import Any
 import numpy as np
 
 from geardyn.core.section import MAX_COMMON_PERIODS, common_section
-from geardyn.core.settings import MIN_STEPS, RunSettings
+from geardyn.core.settings import MIN_STEPS, RunSettings, replacement, warn_deprecated
 
 #: Fewest RK4 steps per forcing period of the step rule.
 MIN_STEPS_PER_PERIOD = 64
@@ -170,12 +171,147 @@ def lane_omega(model: Any, P: np.ndarray) -> np.ndarray:
     return omega
 
 
-def _lane_times(name: str, value: Any, L: int) -> np.ndarray:
-    times = np.broadcast_to(np.asarray(value, dtype=float), (L,))
+def _lane_times(name: str, times: np.ndarray) -> np.ndarray:
+    """``times`` (an array), checked: finite and >= 0."""
     bad = ~(np.isfinite(times) & (times >= 0))
     if np.any(bad):
         raise ValueError(f"{name} must be a finite time >= 0 in every lane (got {times[bad][0]!r})")
     return times
+
+
+# ---------------------------------------------------------------------------- per lane
+#: The fields of :class:`LaneSettings` that are times (finite, >= 0).
+_LANE_TIMES = ("transient", "transient_max")
+
+
+@dataclass(frozen=True, eq=False)
+class LaneSettings:
+    """What the lanes of one run have of their own beside their coefficients, validated at
+    construction. Each field is one value for every lane or one per lane (a 1-D sequence, its
+    length checked against the lanes by :meth:`LanePlan.build`); None: the run's setting
+    (:class:`~geardyn.core.settings.RunSettings`). Arrays are kept as read-only copies.
+
+    t0
+        Start times (model time units; the forcing phase is zero there), default 0.
+    transient, transient_max
+        Times (>= 0) in place of the run's ``transient`` and ``transient_max``.
+    steps_per_period
+        RK4 steps per forcing period in place of the run's (>= 4, >= 1 with ``interval``;
+        <= 0: the lane's step rule).
+    sample_every
+        Forcing periods between samples (>= 1), or ``"auto"``: the common period of the
+        model's forcings (:func:`lane_section`).
+    ladder
+        The step rule's count rounded up to the step ladder (:func:`lane_steps_per_period`,
+        as a sweep takes it) or, False, the rule's own count (:func:`default_steps_per_period`,
+        as a single run takes it).
+    interval
+        Unforced lanes (an autonomous model): the time (> 0) that takes the place of the
+        forcing period, sampled once; None: lanes forced at their Omega.
+    """
+
+    t0: Any = None
+    transient: Any = None
+    transient_max: Any = None
+    steps_per_period: Any = None
+    sample_every: Any = "auto"
+    ladder: bool = True
+    interval: float | None = None
+
+    def __post_init__(self) -> None:
+        put = object.__setattr__
+        if self.t0 is not None:
+            t0 = _lane_array("t0", self.t0, float)
+            bad = ~np.isfinite(t0)
+            if np.any(bad):
+                raise ValueError(f"t0 must be finite in every lane (got {t0[bad][0]!r})")
+            put(self, "t0", t0)
+        for name in _LANE_TIMES:
+            if getattr(self, name) is not None:
+                put(self, name, _lane_times(name, _lane_array(name, getattr(self, name), float)))
+        if self.interval is not None:
+            interval = float(self.interval)
+            if not (math.isfinite(interval) and interval > 0):
+                raise ValueError(f"interval must be a finite time > 0 (got {self.interval!r})")
+            put(self, "interval", interval)
+        if self.steps_per_period is not None:
+            n = _lane_array("steps_per_period", self.steps_per_period, np.int64)
+            least = MIN_STEPS if self.interval is None else 1
+            small = (n > 0) & (n < least)
+            if np.any(small):
+                raise ValueError(f"steps_per_period must be >= {least} (got {n[small][0]})")
+            put(self, "steps_per_period", n)
+        put(self, "ladder", bool(self.ladder))
+        if isinstance(self.sample_every, str):
+            if self.sample_every != "auto":
+                raise ValueError(f"sample_every must be 'auto' or >= 1 "
+                                 f"(got {self.sample_every!r})")
+        else:
+            every = _lane_array("sample_every", self.sample_every, np.int64)
+            if np.any(every < 1):
+                raise ValueError(f"sample_every must be >= 1 (got {every[every < 1][0]})")
+            put(self, "sample_every", every)
+        if self.interval is not None and not (isinstance(self.sample_every, str)
+                                              or np.all(self.sample_every == 1)):
+            raise ValueError("sample_every applies to forced lanes (an interval is sampled "
+                             "once)")
+
+    def per_lane(self, name: str, lanes: int) -> np.ndarray | None:
+        """The field ``name`` with one value per lane (``lanes`` of them; a read-only view),
+        or None where it is not set; a ValueError where its length is not ``lanes``."""
+        value = getattr(self, name)
+        if value is None:
+            return None
+        if value.ndim and value.shape != (lanes,):
+            raise ValueError(f"{name} must have one value per lane ({lanes}), got "
+                             f"{value.shape[0]}")
+        return np.broadcast_to(value, (lanes,))
+
+    def fields(self) -> dict[str, Any]:
+        """The fields that are set (not their defaults), by name."""
+        return {f.name: getattr(self, f.name) for f in dataclasses.fields(self)
+                if not _is_default(getattr(self, f.name), f.default)}
+
+
+def _is_default(value: Any, default: Any) -> bool:
+    return value is default or (isinstance(value, str) and value == default)
+
+
+def _lane_array(name: str, value: Any, dtype: Any) -> np.ndarray:
+    """``value`` (one number or a 1-D sequence) as a read-only array of ``dtype``."""
+    out = np.array(value, dtype=dtype)
+    if out.ndim > 1:
+        raise ValueError(f"{name} must be one value or one per lane (got shape {out.shape})")
+    out.flags.writeable = False
+    return out
+
+
+def _rule_steps(model: Any, P: np.ndarray, omega: np.ndarray, steps: Any) -> np.ndarray:
+    """Steps per period of each lane: ``steps`` (one, or one per lane; None or <= 0: the
+    step rule's own count at the lane's ``omega``, not rounded to the ladder)."""
+    L = P.shape[0]
+    n = np.broadcast_to(np.asarray(0 if steps is None else steps, dtype=np.int64), (L,)).copy()
+    auto = n <= 0
+    if np.any(auto):
+        rule = steps_per_period_rule(model, P[auto], omega[auto])
+        if not np.all(np.isfinite(rule)) or np.any(rule >= 2.0**62):
+            raise OverflowError("steps per period do not fit an integer; check Omega")
+        n[auto] = np.ceil(rule).astype(np.int64)
+    return n
+
+
+def _legacy_lanes(where: str, lanes: LaneSettings | None, overrides: dict[str, Any],
+                  stacklevel: int) -> LaneSettings:
+    """The :class:`LaneSettings` of ``overrides`` (its fields as deprecated keyword arguments
+    of ``where``), with one DeprecationWarning per process naming the replacement; beside
+    ``lanes`` a TypeError."""
+    if lanes is not None:
+        raise TypeError(f"{where}: give lanes=LaneSettings(...) or keyword arguments, not both "
+                        f"(got lanes= and {next(iter(overrides))}=)")
+    out = LaneSettings(**overrides)
+    warn_deprecated(where, overrides, [replacement("lanes", LaneSettings, out.fields(),
+                                                   home="geardyn.core")], stacklevel)
+    return out
 
 
 # ---------------------------------------------------------------------------- the plan
@@ -183,11 +319,12 @@ def _lane_times(name: str, value: Any, L: int) -> np.ndarray:
 class LanePlan:
     """Every lane's integration, in steps: derived once by :meth:`build`, read by the kernels.
 
-    Arrays are per lane (index = row of ``P``); periods are forcing periods of the lane."""
+    Arrays are per lane (index = row of ``P``); periods are forcing periods of the lane (of
+    unforced lanes: the ``interval`` of their :class:`LaneSettings`)."""
 
     settings: RunSettings
-    omega: np.ndarray  # (L,) forcing frequency
-    period: np.ndarray  # (L,) forcing period 2 pi / Omega
+    omega: np.ndarray  # (L,) forcing frequency (0: unforced)
+    period: np.ndarray  # (L,) forcing period 2 pi / Omega (unforced: the interval)
     steps_per_period: np.ndarray  # (L,) int64
     step: np.ndarray  # (L,) RK4 step h = period / steps_per_period
     sample_every: np.ndarray  # (L,) int64 forcing periods between samples (the section)
@@ -197,45 +334,58 @@ class LanePlan:
     t0: np.ndarray  # (L,) start time
 
     @classmethod
-    def build(cls, model: Any, P: np.ndarray, settings: RunSettings, *,
-              transient: Any = None, transient_max: Any = None, steps_per_period: Any = None,
-              sample_every: Any = "auto", t0: Any = None) -> LanePlan:
+    def build(cls, model: Any, P: np.ndarray, settings: RunSettings,
+              lanes: LaneSettings | None = None, **overrides: Any) -> LanePlan:
         """The plan of the lanes ``P`` (coefficient vectors, one row per lane) under
-        ``settings``. Per-lane overrides (one value, or one per lane): ``transient`` and
-        ``transient_max`` (times), ``steps_per_period`` (<= 0: the step rule), ``sample_every``
-        (forcing periods; ``"auto"``: the common period of the forcings, see
-        :func:`lane_section`), ``t0`` (start times, whole periods)."""
+        ``settings``, with the per-lane values ``lanes`` (:class:`LaneSettings`: start times,
+        transients, steps, sampling). ``overrides``: the fields of ``lanes`` as keyword
+        arguments, deprecated (one DeprecationWarning naming ``lanes=LaneSettings(...)``)."""
+        if overrides:
+            lanes = _legacy_lanes("LanePlan.build", lanes, overrides, stacklevel=3)
+        lanes = LaneSettings() if lanes is None else lanes
+        if not isinstance(lanes, LaneSettings):
+            raise TypeError(f"lanes must be a LaneSettings (got {type(lanes).__name__})")
         P = np.atleast_2d(P)
         L = P.shape[0]
-        omega = lane_omega(model, P)
-        if isinstance(sample_every, str):
-            if sample_every != "auto":
-                raise ValueError(f"sample_every must be 'auto' or >= 1 (got {sample_every!r})")
-            sample_every, commensurate = lane_section(model, P, omega,
-                                                      settings.max_section_periods)
+        if lanes.interval is not None:
+            omega, period = np.zeros(L), np.full(L, lanes.interval)
+            every, commensurate = np.ones(L, np.int64), np.ones(L, bool)
         else:
-            commensurate = np.ones(L, bool)
-        every = np.broadcast_to(np.asarray(sample_every, dtype=np.int64), (L,)).copy()
-        if np.any(every < 1):
-            raise ValueError(f"sample_every must be >= 1 (got {every[every < 1][0]})")
-        n = lane_steps(model, P, settings.steps_per_period if steps_per_period is None
-                       else steps_per_period)
-        period = forcing_period(omega)
-        tr = _lane_times("transient", settings.transient if transient is None else transient, L)
+            omega = lane_omega(model, P)
+            period = forcing_period(omega)
+            if isinstance(lanes.sample_every, str):
+                every, commensurate = lane_section(model, P, omega,
+                                                   settings.max_section_periods)
+            else:
+                every, commensurate = lanes.per_lane("sample_every", L), np.ones(L, bool)
+        every = np.broadcast_to(np.asarray(every, dtype=np.int64), (L,)).copy()
+        steps = lanes.per_lane("steps_per_period", L)
+        steps = settings.steps_per_period if steps is None else steps
+        if lanes.ladder and lanes.interval is None:
+            n = lane_steps(model, P, steps)
+        else:
+            n = _rule_steps(model, P, omega, steps)
+        tr = lanes.per_lane("transient", L)
+        tr = np.full(L, settings.transient) if tr is None else tr
         n_tr = whole_multiples(periods_covering(tr, period), every)
-        if transient_max is None:
+        tmax = lanes.per_lane("transient_max", L)
+        if tmax is None:
             tmax = (10.0 * tr if settings.transient_max is None
                     else np.full(L, settings.transient_max))
-        else:
-            tmax = _lane_times("transient_max", transient_max, L)
         n_max = np.maximum(whole_multiples(periods_within(tmax, period), every), n_tr)
-        start = np.zeros(L) if t0 is None else np.broadcast_to(np.asarray(t0, float), (L,)).copy()
+        start = lanes.per_lane("t0", L)
+        start = np.zeros(L) if start is None else start.copy()
         return cls(settings=settings, omega=omega, period=period, steps_per_period=n,
                    step=period / n, sample_every=every, commensurate=np.asarray(commensurate,
                                                                                 bool),
                    transient_periods=n_tr, transient_max_periods=n_max, t0=start)
 
     # ------------------------------------------------------------------ in steps
+    def window_steps(self, time: float) -> np.ndarray:
+        """Steps of the whole periods that cover ``time`` (at least one) in each lane."""
+        periods = np.maximum(1, periods_covering(time, self.period))
+        return (periods * self.steps_per_period).astype(np.int64)
+
     @property
     def lanes(self) -> int:
         return int(self.omega.size)

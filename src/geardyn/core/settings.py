@@ -240,21 +240,46 @@ def settings_from_named(kind: type, named: Mapping[str, tuple[str, Any]]) -> Any
         raise ParameterError(where, value, reason.rsplit(" (got ", 1)[0]) from None
 
 
-def replacement(param: str, kind: type, fields: Mapping[str, Any]) -> str:
-    """The text ``param=geardyn.Kind(a=1, ...)`` naming the settings that replace keywords."""
-    args = ", ".join(f"{k}={v!r}" for k, v in fields.items())
-    return f"{param}=geardyn.{kind.__name__}({args})"
+def replacement(param: str, kind: type, fields: Mapping[str, Any], home: str = "geardyn"
+                ) -> str:
+    """The text ``param=geardyn.Kind(a=1, ...)`` naming the settings that replace keywords
+    (``home``: the module that exports ``Kind``; an array value is written as its length)."""
+    args = ", ".join(f"{k}={_shown(v)}" for k, v in fields.items())
+    return f"{param}={home}.{kind.__name__}({args})"
+
+
+def _shown(value: Any) -> str:
+    """``value`` as a deprecation message writes it: its repr, an array as ``<n values>``, a
+    zero-dimensional one as its number."""
+    shape = getattr(value, "shape", None)
+    if shape is None:
+        return repr(value)
+    return f"<{math.prod(shape)} values>" if shape else repr(value.item())
+
+
+#: The deprecations warned in this process: (function, its deprecated keywords).
+_WARNED: set[tuple[str, tuple[str, ...]]] = set()
 
 
 def warn_deprecated(where: str, keywords: Iterable[str], replacements: Sequence[str],
                     stacklevel: int) -> None:
-    """One DeprecationWarning: ``where``'s ``keywords`` are deprecated, pass the
-    ``replacements`` (``stacklevel``: the public function's caller, seen from the caller of
-    this function)."""
+    """One DeprecationWarning, once per process for each function and set of keywords:
+    ``where``'s ``keywords`` are deprecated, pass the ``replacements`` (``stacklevel``: the
+    public function's caller, seen from the caller of this function)."""
     import warnings
 
+    keywords = tuple(keywords)
+    if (where, keywords) in _WARNED:
+        return
+    _WARNED.add((where, keywords))
     warnings.warn(f"{where}({', '.join(f'{k}=' for k in keywords)}) is deprecated: pass "
                   f"{', '.join(replacements)}", DeprecationWarning, stacklevel=stacklevel + 1)
+
+
+def forget_deprecations() -> None:
+    """Let every deprecation of :func:`warn_deprecated` warn again (for tests: each test sees
+    the process as fresh)."""
+    _WARNED.clear()
 
 
 # ----------------------------------------------------------------------------- analyses
@@ -367,8 +392,12 @@ class ContinuationSettings(_AnalysisSettings):
                                 f"ds={self.ds!r}, ds_max={self.ds_max!r})")
 
 
-#: Defaults of the Lyapunov estimate.
+#: Defaults of the Lyapunov estimate: the time averaged over in a model of dimensionless time
+#: (time unit "1"), and in a model of physical time (seconds) that many forcing periods, and
+#: its default transient (where no run is given) in forcing periods.
 LYAPUNOV_DURATION = 2000.0
+LYAPUNOV_PERIODS = 200
+LYAPUNOV_TRANSIENT_PERIODS = 20
 LYAPUNOV_DT = 0.01
 LYAPUNOV_RENORM_EVERY = 10
 LYAPUNOV_BLOCKS = 16
@@ -380,7 +409,11 @@ class LyapunovSettings(_AnalysisSettings):
     :func:`geardyn.lyapunov_lanes`); the transient, steps and bound are the run's.
 
     duration
-        Time averaged over, in the model's time unit, rounded up to whole forcing periods (> 0).
+        Time averaged over, in the model's time unit, rounded up to whole forcing periods
+        (> 0). None (default): the model's own scale, :meth:`geardyn.Model.lyapunov_duration`:
+        :data:`LYAPUNOV_DURATION` time units for a model of dimensionless time, and
+        :data:`LYAPUNOV_PERIODS` forcing periods for one of physical time (a spur pair in
+        seconds).
     dt
         Step of an autonomous model (> 0; None: :data:`LYAPUNOV_DT`); not for a forced model,
         whose grid has the run's steps per period.
@@ -390,7 +423,8 @@ class LyapunovSettings(_AnalysisSettings):
         Blocks of the measuring window for the standard error (>= 2).
     """
 
-    duration: float = _field(LYAPUNOV_DURATION, "positive", "time averaged over")
+    duration: float | None = _field(None, "optional-positive", "time averaged over (default: "
+                                    "the model's scale)")
     dt: float | None = _field(None, "optional-positive",
                               f"step of an autonomous model (default {LYAPUNOV_DT})")
     renorm_every: int = _field(LYAPUNOV_RENORM_EVERY, "whole",

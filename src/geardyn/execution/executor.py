@@ -35,6 +35,8 @@ from geardyn._version import __version__
 from geardyn.core.kernel_source import KernelSource
 from geardyn.core.model import Model
 from geardyn.core.one_form import OneForm
+from geardyn.core.plan import LaneSettings
+from geardyn.core.settings import RunSettings
 from geardyn.execution.zarr_store import LaneStore
 from geardyn.solvers.ensemble import LaneResults, run_lanes
 
@@ -136,10 +138,12 @@ def _run_portable(task: LaneTask, packed: PortableModel, inputs: dict[str, np.nd
 
 
 # ---------------------------------------------------------------------------- lane tasks
-def run_lanes_task(model: Model, P: np.ndarray, y0: np.ndarray, **settings: Any
+def run_lanes_task(model: Model, P: np.ndarray, y0: np.ndarray, *,
+                   run: RunSettings | None = None, lanes: LaneSettings | None = None
                    ) -> dict[str, np.ndarray]:
-    """The plain lane task: :func:`run_lanes` on the chunk, every field of its result."""
-    r = run_lanes(model, P, y0, **settings)
+    """The plain lane task: :func:`run_lanes` on the chunk (``run``, ``lanes`` as there), every
+    field of its result."""
+    r = run_lanes(model, P, y0, run=run, lanes=lanes)
     return {name: getattr(r, name) for name in LaneResults.__dataclass_fields__}
 
 

@@ -19,7 +19,13 @@ import numpy as np
 
 from geardyn.core.model import Model
 from geardyn.errors import ParameterError
-from geardyn.io.toml import GearPairParams, PaperBase, PlanetaryGearSetParams, Study
+from geardyn.io.toml import (
+    GearPairParams,
+    PaperBase,
+    PlanetaryGearSetParams,
+    SpurPairParams,
+    Study,
+)
 
 __all__ = ["CONTINUATIONS", "INTERPRETATIONS", "MAIN_PARAMS", "DiagramRequest", "ExplorerState",
            "Window", "parse_value"]
@@ -31,6 +37,7 @@ MAIN_PARAMS: dict[str, tuple[str, ...]] = {
     "gear_pair": ("zeta", "backlash", "Fa", "kappa"),
     "planetary": ("mesh_damping", "sun_backlash", "ring_backlash", "sun_mesh_error",
                   "torque_fluctuation"),
+    "spur_pair": ("zeta", "backlash", "torque", "error"),
 }
 INTERPRETATIONS = ("consistent", "carrier-only", "as-printed")
 CONTINUATIONS = ("none", "up", "down")
@@ -135,7 +142,8 @@ class ExplorerState:
         self.continuation = continuation or (sweep.continuation if sweep is not None else "none")
         self.describe_error = describe_error
         self.save_dir = Path(save_dir)
-        if self.param != "Omega" and study.run.omega is None:
+        if (self.param != "Omega" and study.run.omega is None
+                and study.study.model != "spur_pair"):  # a spur pair's speed sets its Omega
             raise ParameterError("--param", self.param, "a sweep of another parameter than "
                                  "Omega needs [run].omega in the study")
         self._effective = study
@@ -201,11 +209,11 @@ class ExplorerState:
 
     def _with_overrides(self, overrides: dict[str, float | str]) -> Study:
         """The study with ``overrides`` applied, validated as a study file is."""
-        doc = self.study.model_dump(exclude_none=True)
+        doc = self.study.to_toml_dict()  # as the file says it (transient_periods alone)
         params = self.study.params
         if isinstance(params, PaperBase):
             doc["params"]["changes"] = {**doc["params"].get("changes", {}), **overrides}
-        elif isinstance(params, GearPairParams | PlanetaryGearSetParams):
+        elif isinstance(params, GearPairParams | PlanetaryGearSetParams | SpurPairParams):
             doc["params"].update(overrides)
         else:  # full PlanetaryParams
             doc["params"] = params.replace(**overrides).model_dump(exclude_none=True)

@@ -9,7 +9,7 @@ A *study file* holds the device parameters plus run settings::
     [study]
     name = "fig3"
     description = "Paper Fig. 3"
-    model = "catt"                  # or "gear_pair", "planetary"
+    model = "catt"                  # or "gear_pair", "planetary", "spur_pair"
     interpretation = "consistent"   # consistent | carrier-only | as-printed
     plot_state = "X_sq"             # the coordinate figures show
     [params]                        # PlanetaryParams fields (nested tables), or:
@@ -60,6 +60,13 @@ of ``[params]``::
 and profile shifts then in the normal section) or ``internal = true`` (the wheel a ring, its
 ``[gears.wheel]`` ``bore_radius`` the ring's outer radius; ``ring_foundation``).
 
+For ``model = "spur_pair"`` the model is :meth:`geardyn.SpurPair.from_geometry` of the
+``[gears]``, ``[[faults]]`` and ``[stiffness]`` tables, and ``[params]``
+(:class:`SpurPairParams`, generated from SpurPair's declared inputs) holds its dynamics:
+``speed`` (a number in ``speed_unit``: rad/s, rpm or Hz; or a unit string), ``torque``,
+``inertia`` ([I1, I2]), ``zeta``, ``backlash``, ``error``, ``error_phase``, ``harmonics``,
+``period``; its runs are in seconds, and the default transient is
+:data:`DEFAULT_TRANSIENT_PERIODS` forcing periods.
 For ``model = "gear_pair"`` the ``[params]`` table holds :class:`~geardyn.GearPair` arguments
 (``zeta``, ``kappa``, ``Fm``, ``Fa``, ``Omega``, ``kappa_phase``, ``error_phase``, ``backlash``).
 For ``model = "planetary"`` it holds :class:`~geardyn.PlanetaryGearSet` arguments
@@ -99,6 +106,7 @@ from typing import Annotated, Any, ClassVar, Literal
 
 import tomli_w
 from pydantic import (
+    AfterValidator,
     BaseModel,
     BeforeValidator,
     ConfigDict,
@@ -137,6 +145,8 @@ from geardyn.gears.potential_energy import (
 from geardyn.gears.tip_relief import TipRelief, relief_gap
 from geardyn.models.gear_pair_coefficients import GEAR_PAIR
 from geardyn.models.params import PAPER_NAMES, Angle, Length, PlanetaryParams, Real, Whole
+from geardyn.models.spur_pair_coefficients import INPUTS as SPUR_PAIR_INPUTS
+from geardyn.models.spur_pair_coefficients import PhysicalInput
 from geardyn.units import to_si
 
 __all__ = [
@@ -153,6 +163,7 @@ __all__ = [
     "ReliefTable",
     "RunSettings",
     "RunTable",
+    "SpurPairParams",
     "StiffnessTable",
     "Study",
     "StudyInfo",
@@ -173,8 +184,9 @@ _HEADER = (
     "# Unit strings such as \"50 um\" or \"20 deg\" are accepted on input.\n\n"
 )
 
-Model = Literal["catt", "gear_pair", "planetary"]
-DEFAULT_PLOT_STATE: dict[str, str] = {"catt": "X_sq", "gear_pair": "x", "planetary": "u_s"}
+Model = Literal["catt", "gear_pair", "planetary", "spur_pair"]
+DEFAULT_PLOT_STATE: dict[str, str] = {"catt": "X_sq", "gear_pair": "x", "planetary": "u_s",
+                                      "spur_pair": "x"}
 
 
 # --------------------------------------------------------------------------- study schema
@@ -185,8 +197,9 @@ class StudyInfo(BaseModel):
 
     name: str = Field("unnamed", min_length=1, description="short name")
     description: str = Field("", description="one-line description")
-    model: Model = Field("catt", description="catt (the paper's device), gear_pair or "
-                         "planetary (Lin & Parker gear set)")
+    model: Model = Field("catt", description="catt (the paper's device), gear_pair, "
+                         "planetary (Lin & Parker gear set) or spur_pair (the SI pair of "
+                         "[gears] on its potential-energy stiffness)")
     interpretation: Literal["consistent", "carrier-only", "as-printed"] = Field(
         "consistent", description="how to read the paper's ambiguous formulas (catt only)"
     )
@@ -216,6 +229,9 @@ RUN_TABLE_EXTRAS: dict[str, dict[str, Any]] = {
     "period_tol": {"gt": 0, "lt": 1, "description": "relative tolerance of the period "
                    f"classifier (default {DEFAULT_TOL:g})"},
 }
+#: Models whose time is in seconds: the default transient of their runs in forcing periods of
+#: the lowest Omega of the run (not ``[run].transient``'s 4000, a dimensionless time).
+DEFAULT_TRANSIENT_PERIODS: dict[str, float] = {"spur_pair": 50.0}
 #: The ``[run]`` table's keys that are no RunSettings field: the run's Omega and the transient
 #: in forcing periods (instead of ``transient``).
 RUN_TABLE_OWN = ("omega", "transient_periods")
@@ -390,6 +406,48 @@ def study_table(name: str, block: CoefficientBlock, doc: str) -> type[BaseModel]
 GearPairParams = study_table(
     "GearPairParams", GEAR_PAIR,
     "``[params]`` of a ``gear_pair`` study: the arguments of :class:`~geardyn.GearPair`.")
+
+
+def _frequency_text(value: float | str) -> float | str:
+    """A speed as given: a number >= 0 (in the model's speed_unit), or a unit string that reads
+    as an angular frequency >= 0 (e.g. "3000 rpm")."""
+    if (to_si(value, "frequency") if isinstance(value, str) else value) < 0:
+        raise ValueError("must be >= 0")
+    return value
+
+
+def _input_field(i: PhysicalInput) -> tuple[Any, Any]:
+    """The pydantic type and field of one declared physical input."""
+    default = ... if i.required else i.default
+    if i.kind == "choice":
+        kind: Any = Literal[i.choices]  # type: ignore[valid-type]
+    elif i.kind == "count":
+        kind = Annotated[Whole, Field(ge=1)]
+    elif i.kind == "pair":
+        one = Annotated[float, BeforeValidator(lambda v, k=i.unit_kind: to_si(v, k)),
+                        Field(gt=0)]
+        kind = Annotated[list[one], Field(min_length=2, max_length=2)]  # type: ignore[valid-type]
+    elif i.kind == "frequency":  # a number in speed_unit, or a unit string (kept as given)
+        kind = Annotated[Real | str, AfterValidator(_frequency_text)]
+    else:
+        kind = Annotated[float, BeforeValidator(lambda v, k=i.kind: to_si(v, k)),
+                         Field(**i.bounds())]
+    return (kind | None if default is None else kind), Field(default, description=i.meaning)
+
+
+def spur_pair_table(inputs: tuple[PhysicalInput, ...] = SPUR_PAIR_INPUTS) -> type[BaseModel]:
+    """``[params]`` of a ``spur_pair`` study, generated from the declared physical inputs of
+    :class:`~geardyn.SpurPair` (:data:`~geardyn.models.spur_pair_coefficients.INPUTS`): one
+    field per input (SI numbers or unit strings; speed a number in ``speed_unit`` or the unit
+    string of an angular frequency, kept as given), unknown keys refused naming the field."""
+    fields = {i.name: _input_field(i) for i in inputs}
+    return create_model("SpurPairParams", __config__=_CONFIG, __module__=__name__,
+                        __doc__=spur_pair_table.__doc__, **fields)
+
+
+#: ``[params]`` of a ``spur_pair`` study: the dynamics of :meth:`geardyn.SpurPair.from_geometry`
+#: of the study's ``[gears]``, ``[[faults]]`` and ``[stiffness]``.
+SpurPairParams = spur_pair_table()
 
 
 #: A quantity: an SI number or a unit string ("24.6 deg", "5e8 N/m").
@@ -728,8 +786,9 @@ class StiffnessTable(BaseModel):
     model_config = _CONFIG
 
     angles: Whole = Field(360, ge=1, description="pinion angles per mesh cycle")
-    cycles: Whole | Literal["hunting"] = Field(
-        1, description="mesh cycles from tooth 0's pitch-point passage, or \"hunting\"")
+    cycles: Whole | Literal["hunting"] | None = Field(
+        None, description="mesh cycles from tooth 0's pitch-point passage, or \"hunting\" "
+        "(default 1; a spur_pair model's: its forcing period)")
     nodes: Whole = Field(DEFAULT_NODES, ge=4, description="Gauss-Legendre nodes")
     root_segment: bool = Field(True, description="straight flank from the root to the base "
                                "circle in the cantilever")
@@ -750,7 +809,10 @@ class StiffnessTable(BaseModel):
         return value
 
     def mesh_cycles(self, mesh: GearMesh) -> int:
-        """The number of mesh cycles: ``cycles``, or lcm(z1, z2) for ``"hunting"``."""
+        """The number of mesh cycles: ``cycles`` (default 1), or lcm(z1, z2) for
+        ``"hunting"``."""
+        if self.cycles is None:
+            return 1
         if self.cycles == "hunting":
             return math.lcm(mesh.pinion.teeth, mesh.wheel.teeth)
         return int(self.cycles)
@@ -868,7 +930,8 @@ class Study(BaseModel):
     model_config = _CONFIG
 
     study: StudyInfo = Field(default_factory=StudyInfo)
-    params: PlanetaryParams | PaperBase | GearPairParams | PlanetaryGearSetParams | None = None
+    params: (PlanetaryParams | PaperBase | GearPairParams | PlanetaryGearSetParams
+             | SpurPairParams | None) = None
     run: RunTable = Field(default_factory=RunTable)
     sweep: SweepSettings | None = None
     gears: GearsTable | None = None
@@ -906,7 +969,9 @@ class Study(BaseModel):
            2 pi / ``omega`` for ``transient`` (``omega``: the lowest forcing frequency of the
            run, or a function giving it, called only then);
         3. ``defaults``: the command's own (``basins``' samples and convergence);
-        4. the ``[run]`` table's defaults (``transient`` 4000, ``periods`` 64).
+        4. the ``[run]`` table's defaults (``transient`` 4000, ``periods`` 64); for a model
+           in seconds (:data:`DEFAULT_TRANSIENT_PERIODS`) the transient is that many forcing
+           periods of the lowest Omega of the run instead.
 
         A field found nowhere is left out (RunSettings' default applies)."""
         named = {k: v for k, v in (given or {}).items() if v[1] is not None}
@@ -920,6 +985,12 @@ class Study(BaseModel):
             found = named.get(field) or self._written_run_value(field, sweep, omega)
             if found is None and field in defaults:
                 found = (f"default {field}", defaults[field])
+            if found is None and field == "transient" and (
+                    self.study.model in DEFAULT_TRANSIENT_PERIODS):
+                om = omega() if callable(omega) else omega
+                periods = DEFAULT_TRANSIENT_PERIODS[self.study.model]
+                found = (f"default transient_periods {periods:g} ({self.study.model})",
+                         RunTable(transient_periods=periods).transient_time(om))
             if found is None and getattr(self.run, key) is not None:
                 found = (f"run.{key}", getattr(self.run, key))
             if found is not None:
@@ -960,6 +1031,8 @@ class Study(BaseModel):
         out = dict(data)
         if kind == "gear_pair":
             target: type[BaseModel] = GearPairParams
+        elif kind == "spur_pair":
+            target = SpurPairParams
         elif kind == "planetary":
             target = PlanetaryGearSetParams
         elif "base" in raw:
@@ -979,10 +1052,11 @@ class Study(BaseModel):
         if self.params is None:
             return self
         holds = ("gear_pair" if isinstance(self.params, GearPairParams) else "planetary"
-                 if isinstance(self.params, PlanetaryGearSetParams) else "catt")
+                 if isinstance(self.params, PlanetaryGearSetParams) else "spur_pair"
+                 if isinstance(self.params, SpurPairParams) else "catt")
         if holds != self.study.model:
             kind = {"gear_pair": "GearPair", "planetary": "PlanetaryGearSet",
-                    "catt": "PlanetaryParams"}[holds]
+                    "catt": "PlanetaryParams", "spur_pair": "SpurPair"}[holds]
             raise ValueError(
                 f"study.model is {self.study.model!r} but [params] holds {kind} parameters"
             )
@@ -994,7 +1068,14 @@ class Study(BaseModel):
 
     def _check_gears(self) -> None:
         """``[params]`` or ``[gears]`` present; ``[faults]`` and ``[stiffness]`` only with
-        ``[gears]``; the gears, faults and settings buildable (errors name the field)."""
+        ``[gears]``; the gears, faults and settings buildable (errors name the field); a
+        ``spur_pair`` study has both ``[gears]`` (its pair) and ``[params]`` (its dynamics)."""
+        if self.study.model == "spur_pair":
+            for name, what in (("gears", "the pair the model is built from"),
+                               ("params", "the pair's speed, torque and dynamics")):
+                if getattr(self, name) is None:
+                    raise _study_error((name,), None, f"required by a spur_pair study ({what})",
+                                       "missing")
         if self.gears is None:
             for name in ("faults", "stiffness", "relief", "crowning"):
                 if getattr(self, name) is not None:

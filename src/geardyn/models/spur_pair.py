@@ -47,11 +47,18 @@ from geardyn.core.plan import STEPS_PER_FASTEST_MODE, STEPS_PER_OTHER_FORCING
 from geardyn.errors import ParameterError
 from geardyn.gears.geometry import GearMesh
 from geardyn.gears.potential_energy import (
+    DEFAULT_NODES,
     STEEL_POISSON,
     STEEL_YOUNG,
     potential_energy_stiffness,
 )
-from geardyn.models.spur_pair_coefficients import HEADER, series_block
+from geardyn.models.spur_pair_coefficients import (
+    HEADER,
+    PERIODS,
+    SPEED_UNITS,
+    UNIT_KINDS,
+    series_block,
+)
 from geardyn.models.spur_pair_kernels import (
     BACKLASH,
     K_MEAN,
@@ -70,15 +77,19 @@ __all__ = ["DEFAULT_MESH_HARMONICS", "STEEL_DENSITY", "SpurPair", "disc_inertia"
 DEFAULT_MESH_HARMONICS = 16
 #: Density of steel [kg/m^3] of the default (solid disc) inertias.
 STEEL_DENSITY = 7850.0
-#: The forcing periods :meth:`SpurPair.from_geometry` takes: one revolution of the pinion or of
-#: the wheel, or one mesh cycle.
-PERIODS = ("pinion", "wheel", "mesh")
-#: Speeds per unit of the ``speed`` input (a plain number is rad/s, as every frequency).
-_RPM = 2.0 * math.pi / 60.0
+#: rad/s per rpm.
+_RPM = SPEED_UNITS["rpm"]
 
 
 # ---------------------------------------------------------------------------------------------
 # the table -> the series
+
+def period_cycles(mesh: GearMesh, period: str) -> int:
+    """The mesh cycles of one forcing ``period`` (:data:`PERIODS`) of ``mesh``."""
+    if period not in PERIODS:
+        raise ParameterError("period", period, f"must be one of {', '.join(PERIODS)}")
+    return {"pinion": mesh.pinion.teeth, "wheel": mesh.wheel.teeth, "mesh": 1}[period]
+
 
 def disc_inertia(gear_radius: float, face_width: float, bore_radius: float,
                  density: float = STEEL_DENSITY) -> float:
@@ -160,7 +171,10 @@ class SpurPair(Model):
     for one pinion revolution). State x [m], v [m/s]; time [s]; the observable F [N] is the mesh
     force (elastic and damping). The forcing frequency ``Omega`` [rad/s] is the rotation
     frequency of the gear whose revolution is the period (mesh frequency / cycles); ``speed``
-    (the pinion's speed, rpm or a unit string) sets it through ``with_params`` and sweeps.
+    (the pinion's speed, a number in ``speed_unit`` or a unit string) sets it through
+    ``with_params`` and sweeps. The physical inputs are declared once,
+    :data:`~geardyn.models.spur_pair_coefficients.INPUTS` (the ``spur_pair`` study table is
+    generated from them).
 
     Parameters
     ----------
@@ -170,7 +184,7 @@ class SpurPair(Model):
         The potential-energy stiffness table (``mesh_stiffness`` and ``mesh_stiffness_coast``
         [N/m] over ``cycle``).
     speed
-        Pinion speed: rad/s, or a unit string (``"1500 rpm"``).
+        Pinion speed: a number in ``speed_unit``, or a unit string (``"1500 rpm"``).
     torque
         Pinion torque [N m] (or ``"200 N m"``); > 0 loads the drive flanks.
     inertia
@@ -186,6 +200,11 @@ class SpurPair(Model):
     harmonics
         Harmonics H of Omega in each flank's series (default ``DEFAULT_MESH_HARMONICS`` times
         the mesh cycles per period); fewer than half the table's angles.
+    speed_unit
+        The unit of a plain number of ``speed`` (here, in ``with_params`` and in
+        ``lane_params``/sweeps of ``speed``) and of a sweep's ``speed`` axis: ``"rad/s"``
+        (default), ``"rpm"`` or ``"Hz"`` (:data:`SPEED_UNITS`); each number is converted to rad/s
+        once, by the unit's exact factor.
     """
 
     name = "SpurPair"
@@ -202,7 +221,7 @@ class SpurPair(Model):
     def __init__(self, mesh: GearMesh, stiffness: xr.Dataset, *, speed: object,
                  torque: object, inertia: Sequence[object] | None = None, zeta: object = 0.05,
                  backlash: object = None, error: object = 0.0, error_phase: object = 0.0,
-                 harmonics: int | None = None):
+                 harmonics: int | None = None, speed_unit: str = "rad/s"):
         if not isinstance(mesh, GearMesh):
             raise ParameterError("mesh", mesh, "must be a geardyn.gears.GearMesh")
         if mesh.internal:
@@ -216,6 +235,10 @@ class SpurPair(Model):
                                      f"a fault on the {faulty} returns every {z} mesh cycles;"
                                      " the table must span whole revolutions of that gear")
         n_h = _harmonics(harmonics, cycles, int(stiffness.sizes["angle"]))
+        if speed_unit not in SPEED_UNITS:
+            raise ParameterError("speed_unit", speed_unit,
+                                 f"must be one of {', '.join(SPEED_UNITS)}")
+        self.speed_unit = speed_unit
         self.mesh, self.stiffness, self.cycles = mesh, stiffness, cycles
         self.drive_series = fourier_series(stiffness["mesh_stiffness"].values, n_h)
         self.coast_series = fourier_series(stiffness["mesh_stiffness_coast"].values, n_h)
@@ -223,7 +246,7 @@ class SpurPair(Model):
         b = (0.5 * max(mesh.backlash, 0.0) * math.cos(mesh.operating_pressure_angle)
              if backlash is None else si_value("backlash", backlash, "length"))
         values = {
-            "Omega": self._omega_of_speed(si_value("speed", speed, "frequency")),
+            "Omega": self._omega_of_speed(self._speed_si(speed)),
             "mass": self._mass(inertia),
             "torque": si_value("torque", torque, "torque"),
             "zeta": si_value("zeta", zeta, "dimensionless"),
@@ -254,16 +277,17 @@ class SpurPair(Model):
     def from_geometry(cls, mesh: GearMesh, *, bore_radius: object, speed: object,
                       torque: object, faults: object = (), period: str | None = None,
                       angles: int = 256, young: object = STEEL_YOUNG,
-                      poisson: object = STEEL_POISSON, **dynamics: object) -> SpurPair:
+                      poisson: object = STEEL_POISSON, root_segment: bool = True,
+                      nodes: int = DEFAULT_NODES, **dynamics: object) -> SpurPair:
         """The pair with the potential-energy stiffness of ``mesh``
         (:func:`~geardyn.gears.potential_energy_stiffness` with ``bore_radius``, ``young``,
-        ``poisson``, ``faults`` (one fault object or several, all on one gear), ``angles`` per
-        mesh cycle) over one
+        ``poisson``, ``root_segment``, ``nodes``, ``faults`` (one fault object or several, all
+        on one gear), ``angles`` per mesh cycle) over one
         ``period``: ``"pinion"`` (one pinion revolution, the default for a healthy pair or faults
         on the pinion: a faulty tooth is felt once per period), ``"wheel"`` (one wheel
         revolution; the default for faults on the wheel) or ``"mesh"`` (one mesh cycle, a
         healthy pair only). ``dynamics``: the constructor's other keywords (inertia, zeta,
-        backlash, error, error_phase, harmonics)."""
+        backlash, error, error_phase, harmonics, speed_unit)."""
         if not isinstance(mesh, GearMesh):
             raise ParameterError("mesh", mesh, "must be a geardyn.gears.GearMesh")
         listed = tuple(faults) if isinstance(faults, (list, tuple)) else (faults,)
@@ -273,16 +297,22 @@ class SpurPair(Model):
                                  " one revolution of the one faulty gear")
         if period is None:
             period = gears[0] if gears else "pinion"
-        if period not in PERIODS:
-            raise ParameterError("period", period, f"must be one of {', '.join(PERIODS)}")
-        cycles = {"pinion": mesh.pinion.teeth, "wheel": mesh.wheel.teeth, "mesh": 1}[period]
+        cycles = period_cycles(mesh, period)
         if gears and period != gears[0]:
             raise ParameterError("period", period, f"the faults are on the {gears[0]}: the "
                                  f"period must be one {gears[0]} revolution")
         table = potential_energy_stiffness(mesh, bore_radius=bore_radius, angles=angles,
                                            young=young, poisson=poisson, faults=faults,
-                                           cycles=cycles)
+                                           cycles=cycles, root_segment=root_segment,
+                                           nodes=nodes)
         return cls(mesh, table, speed=speed, torque=torque, **dynamics)
+
+    def _speed_si(self, value: object) -> float:
+        """The pinion speed [rad/s] of ``value``: a unit string, or a number in
+        :attr:`speed_unit` (times its exact factor, once)."""
+        if isinstance(value, str):
+            return si_value("speed", value, "frequency")
+        return si_value("speed", value, "frequency") * SPEED_UNITS[self.speed_unit]
 
     def _omega_of_speed(self, speed: float) -> float:
         """Omega [rad/s] at the pinion speed ``speed`` [rad/s]: mesh frequency / cycles."""
@@ -320,19 +350,18 @@ class SpurPair(Model):
 
     # ------------------------------------------------------------------ parameters
     def with_params(self, **values: object) -> SpurPair:
-        """As :meth:`Model.with_params`; ``speed`` (the pinion's, rad/s or a unit string such as
-        ``"3000 rpm"``) sets Omega, and the inputs take unit strings (``torque="80 N m"``,
-        ``backlash="20 um"``)."""
+        """As :meth:`Model.with_params`; ``speed`` (the pinion's, a number in
+        :attr:`speed_unit` or a unit string such as ``"3000 rpm"``) sets Omega, and the inputs
+        take unit strings (``torque="80 N m"``, ``backlash="20 um"``)."""
         return super().with_params(**{k: self._si(k, v) for k, v in values.items()})
 
-    _KINDS = {"Omega": "frequency", "speed": "frequency", "mass": "mass", "torque": "torque",
-              "zeta": "dimensionless", "backlash": "length", "error": "length",
-              "error_phase": "angle"}
-
     def _si(self, name: str, value: object) -> object:
-        """``value`` in SI where ``name`` is an input that takes a unit string."""
-        if isinstance(value, str) and name in self._KINDS:
-            return si_value(name, value, self._KINDS[name])
+        """``value`` in SI (speed in rad/s) where ``name`` is an input that takes a unit
+        string (:data:`~geardyn.models.spur_pair_coefficients.UNIT_KINDS`)."""
+        if name == "speed":
+            return self._speed_si(value)
+        if isinstance(value, str) and name in UNIT_KINDS:
+            return si_value(name, value, UNIT_KINDS[name])
         return value
 
     def _with_physical(self, values: dict[str, float]) -> SpurPair:
@@ -343,17 +372,17 @@ class SpurPair(Model):
         return out
 
     def lane_params(self, name: str, values: Sequence[float] | np.ndarray) -> np.ndarray:
-        """Coefficient vectors with ``name`` set to ``values`` (``speed``: the pinion speed
-        [rad/s] sets Omega)."""
+        """Coefficient vectors with ``name`` set to ``values`` (``speed``: the pinion speed in
+        :attr:`speed_unit` sets Omega)."""
         if name == "speed":
             speeds = np.asarray(values, dtype=float).ravel()
-            omegas = [self._omega_of_speed(float(v)) for v in speeds]
+            omegas = [self._omega_of_speed(self._speed_si(float(v))) for v in speeds]
             return Model.lane_params(self, "Omega", omegas)
         return Model.lane_params(self, name, values)
 
     def param_attrs(self, name: str) -> dict[str, str]:
         if name == "speed":
-            return {"units": "rad/s", "long_name": "pinion speed"}
+            return {"units": self.speed_unit, "long_name": "pinion speed"}
         return super().param_attrs(name)
 
     # ------------------------------------------------------------------ physics

@@ -140,6 +140,19 @@ def _title(ds: xr.Dataset, name: str, param: str) -> str:
         f"; {', '.join(settings)}" if settings else "")
 
 
+def _state_unit(ds: xr.Dataset, name: str) -> str | None:
+    """The unit of state ``name`` from the dataset's ``state_units`` (one unit for all
+    states, or one per state separated by commas, as ``Model.state_units``)."""
+    units = ds.attrs.get("state_units")
+    if units is None:
+        return None
+    parts = [u.strip() for u in str(units).split(",")]
+    names = [str(n) for n in ds["state"].values]
+    if len(parts) == 1:
+        return parts[0]
+    return parts[names.index(name)] if len(parts) == len(names) else None
+
+
 def plot_bifurcation(ds: xr.Dataset, state: str | None = None,
                      path: str | os.PathLike | None = None):
     """Bifurcation diagram of a dataset from :func:`geardyn.bifurcation` (or its NetCDF file).
@@ -181,7 +194,7 @@ def plot_bifurcation(ds: xr.Dataset, state: str | None = None,
                             gridspec_kw={"height_ratios": heights}, squeeze=False)[:, 0]
         ax = axes[0]
         _draw_points(ax, x, y, classes)
-        units = ds["poincare"].attrs.get("units", ds.attrs.get("state_units"))
+        units = ds["poincare"].attrs.get("units", _state_unit(ds, name))
         ax.set_ylabel(f"{state_label(name)} {unit_text(units)} (Poincaré points)")
         ax.set_title(_title(ds, name, param))
         if meshes:

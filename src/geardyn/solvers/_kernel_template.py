@@ -47,6 +47,7 @@ from geardyn.solvers._step_core import (  # CORE-IMPORT
     SIMULTANEOUS,
     STATUS_DIVERGED,
     STATUS_OK,
+    _events_columns,
     _events_i,
     _events_l,
     _flat,
@@ -57,6 +58,7 @@ from geardyn.solvers._step_core import (  # CORE-IMPORT
     _NoAliasCompiler,
     _observe_l,
     _padded,
+    _rhs_columns,
     _rhs_i,
     _rhs_l,
     _side,
@@ -247,28 +249,6 @@ def trajectory(p, y0, h, omega, n_per, i0, n_steps, stride, locate, bound, n_ev,
 
 
 @nb.njit(inline="always", **_JIT)
-def _rhs_lanes_generic(T, Y, DY, PT, P, LANE, nl, S, C, SC, ybuf, dbuf):
-    ns = Y.shape[0]
-    for k in range(nl):
-        for q in range(ns):
-            ybuf[q] = Y[q, k]
-        _rhs_i(T[k], ybuf, dbuf, P[LANE[k]], S[k], C[k])
-        for q in range(ns):
-            DY[q, k] = dbuf[q]
-
-
-@nb.njit(inline="always", **_JIT)
-def _events_lanes_generic(T, Y, G, PT, P, LANE, nl, S, C, ybuf, gb):
-    ns = Y.shape[0]
-    for k in range(nl):
-        for q in range(ns):
-            ybuf[q] = Y[q, k]
-        _events_i(T[k], ybuf, gb, P[LANE[k]], S[k], C[k])
-        for j in range(G.shape[0]):
-            G[j, k] = gb[j]
-
-
-@nb.njit(inline="always", **_JIT)
 def _observe_lanes_generic(T, Y, O, PT, P, LANE, nl, S, C, SC, ybuf, ob):
     ns = Y.shape[0]
     for k in range(nl):
@@ -297,8 +277,8 @@ if "rhs_lanes" in globals():  # the model's lane-block functions (see .kernels),
         _observe_lm(T, Y, O, PT, nl, S, C, SC)
 
 else:
-    _rhs_lanes = _rhs_lanes_generic
-    _events_lanes = _events_lanes_generic
+    _rhs_lanes = _rhs_columns
+    _events_lanes = _events_columns
     _observe_lanes = _observe_lanes_generic
 
 

@@ -82,6 +82,8 @@ from geardyn.solvers._step_core import (  # CORE-IMPORT
     _INLINE,
     _JIT,
     BLOCK,
+    FD_DELTA,
+    FD_NORM_CAP,
     FUSED,
     GBUF_ROWS,
     GRAZE_BOUND_STEP,
@@ -89,87 +91,31 @@ from geardyn.solvers._step_core import (  # CORE-IMPORT
     STATUS_DIVERGED,
     STATUS_OK,
     STATUS_SPLIT_LIMIT,
-    _events_i,
+    _events_columns,
     _events_l,
     _healthy,
     _lane_form,
     _NoAliasCompiler,
     _padded,
     _pick,
-    _rhs_i,
+    _rhs_columns,
     _rhs_l,
-    _rows_step,
     _side,
     _split_step,
     _t_axpy,
     _t_comb,
     _t_load,
     _t_store,
+    _tangent_step,
     _tuple_source,
     phase_table,
 )
 from geardyn.solvers._template_model import events, observe, rhs  # MODEL-IMPORT
 
-#: Relative size of the finite-difference perturbation: e |v| = FD_DELTA (1 + min(|y / s|,
-#: FD_NORM_CAP)), in the scaled coordinates z = y / s (s: the model's ``state_scale``).
-FD_DELTA = 2.0**-20
-
-#: Cap on |y / s| in the perturbation size (see the module docstring; no built-in model's
-#: dimensionless state comes near it, so for them it changes nothing).
-FD_NORM_CAP = 2.0**10
-
 # the model interface names are part of the template's namespace (the generated copy re-binds
 # them); only rhs and events are used here
 __all__ = ["BLOCK_ROWS", "events", "lyapunov_block_lanes", "lyapunov_lanes", "lyapunov_lanes_rows",
            "lyapunov_single", "observe", "phase_table", "rhs"]
-
-
-@nb.njit(**_JIT)
-def _tangent_step(i, t0, Z, S, IS, p, h, omega, n_per, s_tab, c_tab, n_ev, YP, E, K, TMP, Y1,
-                  SIDE, G0, G1, W, gbuf, NCR, UNRES):
-    """Advance the state y (row 0 of Z) by one grid step and each tangent vector v (rows 1..,
-    in the scaled coordinates z = y / S; IS = 1 / S) by the derivative of that step map:
-    (Phi(y + e S v) - Phi(y - e S v)) / (2 e S). The 2 k + 1 states are the rows of YP
-    (tangent j: rows 2 j - 2 and 2 j - 1; the state: the last row), stepped by
-    :func:`_rows_step` (row r's crossings counted in NCR[r], its split-limit steps in UNRES[r])."""
-    m, ns = Z.shape
-    ny = 0.0
-    for q in range(ns):
-        zq = Z[0, q] * IS[q]
-        ny += zq * zq
-    scale = FD_DELTA * (1.0 + min(math.sqrt(ny), FD_NORM_CAP))
-    last = 2 * (m - 1)
-    for q in range(ns):
-        YP[last, q] = Z[0, q]
-    for j in range(1, m):
-        nv = 0.0
-        for q in range(ns):
-            nv += Z[j, q] * Z[j, q]
-        nv = math.sqrt(nv)
-        if not (nv > 0.0 and math.isfinite(nv)):
-            E[j] = np.nan  # lost: its rows just follow the state
-            for q in range(ns):
-                YP[2 * j - 2, q] = Z[0, q]
-                YP[2 * j - 1, q] = Z[0, q]
-            continue
-        e = scale / nv
-        E[j] = e
-        for q in range(ns):
-            d = e * (S[q] * Z[j, q])
-            YP[2 * j - 2, q] = Z[0, q] + d
-            YP[2 * j - 1, q] = Z[0, q] - d
-    _rows_step(i, t0, YP, p, h, omega, n_per, s_tab, c_tab, n_ev, K, TMP, Y1, SIDE, G0, G1, W,
-               gbuf, NCR, UNRES)
-    for j in range(1, m):
-        if not math.isfinite(E[j]):
-            for q in range(ns):
-                Z[j, q] = np.nan
-            continue
-        inv = 0.5 / E[j]
-        for q in range(ns):
-            Z[j, q] = ((YP[2 * j - 2, q] - YP[2 * j - 1, q]) * inv) * IS[q]
-    for q in range(ns):
-        Z[0, q] = YP[last, q]
 
 
 @nb.njit(**_JIT)
@@ -358,28 +304,6 @@ BLOCK_ROWS = 64
 ROW_PAD = 1
 
 
-@nb.njit(inline="always", **_JIT)
-def _rows_rhs_generic(T, Y, DY, PT, P, LANE, nr, SP, CP, SC, ybuf, dbuf):
-    ns = Y.shape[0]
-    for r in range(nr):
-        for q in range(ns):
-            ybuf[q] = Y[q, r]
-        _rhs_i(T[r], ybuf, dbuf, P[LANE[r]], SP[r], CP[r])
-        for q in range(ns):
-            DY[q, r] = dbuf[q]
-
-
-@nb.njit(inline="always", **_JIT)
-def _rows_events_generic(T, Y, G, PT, P, LANE, nr, SP, CP, ybuf, gb):
-    ns = Y.shape[0]
-    for r in range(nr):
-        for q in range(ns):
-            ybuf[q] = Y[q, r]
-        _events_i(T[r], ybuf, gb, P[LANE[r]], SP[r], CP[r])
-        for j in range(G.shape[0]):
-            G[j, r] = gb[j]
-
-
 if "rhs_lanes" in globals():  # the model's lane-block functions (see .kernels), inlined
     _rhs_lm = nb.njit(**_INLINE)(rhs_lanes.py_func)  # noqa: F821
     _events_lm = nb.njit(**_INLINE)(events_lanes.py_func)  # noqa: F821
@@ -394,8 +318,8 @@ if "rhs_lanes" in globals():  # the model's lane-block functions (see .kernels),
         _events_lm(T, Y, G, PT, nr, SP, CP)
 
 else:
-    _rows_rhs = _rows_rhs_generic
-    _rows_events = _rows_events_generic
+    _rows_rhs = _rhs_columns
+    _rows_events = _events_columns
 
 
 @nb.njit(inline="always", **_JIT)

@@ -37,55 +37,12 @@ from geardyn.solvers._step_core import (  # CORE-IMPORT
     STATUS_OK,
     _healthy,
     _rows_step,
+    _tangent_step,
     phase_table,
 )
 from geardyn.solvers._template_model import events, observe, rhs  # MODEL-IMPORT
 
-#: Relative size of the finite-difference perturbation (as in the Lyapunov kernel).
-FD_DELTA = 2.0**-20
-
-#: Cap on |y / s| in the perturbation size (as in the Lyapunov kernel).
-FD_NORM_CAP = 2.0**10
-
 __all__ = ["events", "observe", "period_map", "phase_table", "rhs"]
-
-
-@nb.njit(**_JIT)
-def _tangent_step(i, t0, Z, S, IS, p, h, omega, n_per, s_tab, c_tab, n_ev, YP, E, K, TMP, Y1,
-                  SIDE, G0, G1, W, gbuf, NCR, UNRES):
-    """Advance the state y (row 0 of Z) by grid step i and each tangent vector (rows 1..n, in
-    z = y / S; IS = 1 / S) by the central difference of that step's map. The state is row 0
-    of YP, tangent j's perturbed states rows 2 j - 1 and 2 j."""
-    m, ns = Z.shape
-    ny = 0.0
-    for q in range(ns):
-        zq = Z[0, q] * IS[q]
-        ny += zq * zq
-    scale = FD_DELTA * (1.0 + min(math.sqrt(ny), FD_NORM_CAP))
-    for q in range(ns):
-        YP[0, q] = Z[0, q]
-    for j in range(1, m):
-        nv = 0.0
-        for q in range(ns):
-            nv += Z[j, q] * Z[j, q]
-        nv = math.sqrt(nv)
-        if not (nv > 0.0 and math.isfinite(nv)):
-            return False
-        e = scale / nv
-        E[j] = e
-        for q in range(ns):
-            d = e * (S[q] * Z[j, q])
-            YP[2 * j - 1, q] = Z[0, q] + d
-            YP[2 * j, q] = Z[0, q] - d
-    _rows_step(i, t0, YP, p, h, omega, n_per, s_tab, c_tab, n_ev, K, TMP, Y1, SIDE, G0, G1, W,
-               gbuf, NCR, UNRES)
-    for j in range(1, m):
-        inv = 0.5 / E[j]
-        for q in range(ns):
-            Z[j, q] = ((YP[2 * j - 1, q] - YP[2 * j, q]) * inv) * IS[q]
-    for q in range(ns):
-        Z[0, q] = YP[0, q]
-    return True
 
 
 @nb.njit(**_JIT)
@@ -157,4 +114,4 @@ def period_map(p, y0, scale, t0, h, omega, n_per, n_steps, n_ev, bound, stride, 
             for q in range(ns):
                 if not math.isfinite(M[q, j]):
                     status = STATUS_DIVERGED
-    return Z[0].copy(), M, Y, NCR[0, :n_ev].copy(), status, unres
+    return Z[0].copy(), M, Y, NCR[nr - 1, :n_ev].copy(), status, unres  # the state: last row

@@ -30,6 +30,8 @@ costs about 9 evaluations of the model's rhs and 8 of its events (``bench/crossi
 
 from __future__ import annotations
 
+import math
+
 import numba as nb
 import numpy as np
 
@@ -38,6 +40,8 @@ from geardyn.solvers._step_shared import (  # noqa: F401 - the templates import 
     BLOCK,
     BRACKET_TOL,
     CONFIRM_TOL,
+    FD_DELTA,
+    FD_NORM_CAP,
     GBUF_ROWS,
     GRAZE_BOUND,
     GRAZE_BOUND_STEP,
@@ -343,6 +347,32 @@ def _rk4_stages(t, y, h, p, s1, c1, s2, c2, k1, kst, acc, tmp, out):
 
 
 @nb.njit(inline="always", **_JIT)
+def _rhs_columns(T, Y, DY, PT, P, LANE, nl, S, C, SC, ybuf, dbuf):
+    """The model's rhs of columns 0..nl-1 of Y (one lane or tangent row each, coefficients
+    P[LANE[k]]) into DY, one column at a time through the array form (ybuf, dbuf: one state
+    each); for models without lane-block functions."""
+    ns = Y.shape[0]
+    for k in range(nl):
+        for q in range(ns):
+            ybuf[q] = Y[q, k]
+        _rhs_i(T[k], ybuf, dbuf, P[LANE[k]], S[k], C[k])
+        for q in range(ns):
+            DY[q, k] = dbuf[q]
+
+
+@nb.njit(inline="always", **_JIT)
+def _events_columns(T, Y, G, PT, P, LANE, nl, S, C, ybuf, gb):
+    """The model's events of columns 0..nl-1 of Y into G (as :func:`_rhs_columns`)."""
+    ns = Y.shape[0]
+    for k in range(nl):
+        for q in range(ns):
+            ybuf[q] = Y[q, k]
+        _events_i(T[k], ybuf, gb, P[LANE[k]], S[k], C[k])
+        for j in range(G.shape[0]):
+            G[j, k] = gb[j]
+
+
+@nb.njit(inline="always", **_JIT)
 def _split_rhs(t, y, out, p, s, c):
     """The model's rhs f(t, y) into out, on the split path (for a model with lane-scalar
     functions: the lane form, see below)."""
@@ -509,6 +539,59 @@ def _rows_step(i, t0, Y, p, h, omega, n_per, s_tab, c_tab, n_ev, K, TMP, Y1, SID
         else:
             for q in range(ns):
                 Y[r, q] = Y1[r, q]
+
+
+@nb.njit(**_JIT)
+def _tangent_step(i, t0, Z, S, IS, p, h, omega, n_per, s_tab, c_tab, n_ev, YP, E, K, TMP, Y1,
+                  SIDE, G0, G1, W, gbuf, NCR, UNRES):
+    """Advance the state y (row 0 of Z) by one grid step and each tangent vector v (rows 1..,
+    in the scaled coordinates z = y / S; IS = 1 / S) by the derivative of that step map:
+    (Phi(y + e S v) - Phi(y - e S v)) / (2 e S). The 2 k + 1 states are the rows of YP
+    (tangent j: rows 2 j - 2 and 2 j - 1; the state: the last row), stepped by
+    :func:`_rows_step` (row r's crossings counted in NCR[r], its split-limit steps in UNRES[r]).
+    Returns False where a tangent vector was lost (zero or not finite: its rows NaN from here).
+    Both the Lyapunov and the monodromy kernels step their tangents so."""
+    m, ns = Z.shape
+    alive = True
+    ny = 0.0
+    for q in range(ns):
+        zq = Z[0, q] * IS[q]
+        ny += zq * zq
+    scale = FD_DELTA * (1.0 + min(math.sqrt(ny), FD_NORM_CAP))
+    last = 2 * (m - 1)
+    for q in range(ns):
+        YP[last, q] = Z[0, q]
+    for j in range(1, m):
+        nv = 0.0
+        for q in range(ns):
+            nv += Z[j, q] * Z[j, q]
+        nv = math.sqrt(nv)
+        if not (nv > 0.0 and math.isfinite(nv)):
+            E[j] = np.nan  # lost: its rows just follow the state
+            alive = False
+            for q in range(ns):
+                YP[2 * j - 2, q] = Z[0, q]
+                YP[2 * j - 1, q] = Z[0, q]
+            continue
+        e = scale / nv
+        E[j] = e
+        for q in range(ns):
+            d = e * (S[q] * Z[j, q])
+            YP[2 * j - 2, q] = Z[0, q] + d
+            YP[2 * j - 1, q] = Z[0, q] - d
+    _rows_step(i, t0, YP, p, h, omega, n_per, s_tab, c_tab, n_ev, K, TMP, Y1, SIDE, G0, G1, W,
+               gbuf, NCR, UNRES)
+    for j in range(1, m):
+        if not math.isfinite(E[j]):
+            for q in range(ns):
+                Z[j, q] = np.nan
+            continue
+        inv = 0.5 / E[j]
+        for q in range(ns):
+            Z[j, q] = ((YP[2 * j - 2, q] - YP[2 * j - 1, q]) * inv) * IS[q]
+    for q in range(ns):
+        Z[0, q] = YP[last, q]
+    return alive
 
 
 # ---------------------------------------------------------------------------------------------

@@ -46,6 +46,13 @@ BRACKET_TOL = 1e-13
 #: The root of the cubic is taken when the model's event there is within this fraction of the
 #: step (in time) from its zero, by the cubic's slope; else the model's events refine it.
 CONFIRM_TOL = 1e-9
+#: Relative size of the finite-difference perturbation of the tangent steps (Lyapunov
+#: exponents, monodromy matrices): e |v| = FD_DELTA (1 + min(|y / s|, FD_NORM_CAP)), in the
+#: scaled coordinates z = y / s (s: the model's ``state_scale``).
+FD_DELTA = 2.0**-20
+#: Cap on |y / s| in the perturbation size (no built-in model's dimensionless state comes
+#: near it, so for them it changes nothing).
+FD_NORM_CAP = 2.0**10
 #: Largest phase increment (radians) that :func:`_phase_at` takes from its polynomials.
 SMALL_ANGLE = 0.8
 STATUS_OK = 0

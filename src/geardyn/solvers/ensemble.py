@@ -6,21 +6,23 @@ then records stroboscopic samples and statistics. All lanes run in one parallel 
 worker advances its queue of lanes (whatever their steps per period) through a block of
 refilling slots (see ``_kernel_template``). Results do not depend on the schedule, the block
 width or the thread count.
-The settings come as one :class:`~geardyn.core.settings.RunSettings`; every step count is
-derived once by :class:`~geardyn.core.plan.LanePlan` (:func:`run_plan` runs a given plan).
+The settings come as one :class:`~geardyn.core.settings.RunSettings` and what each lane has of
+its own as one :class:`~geardyn.core.plan.LaneSettings`; every step count is derived once by
+:class:`~geardyn.core.plan.LanePlan` (:func:`run_plan` runs a given plan).
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
 from geardyn.core.kernel_args import LaneInputs, LaneOutputs, Schedule, SweepConfig
 from geardyn.core.model import Model
 from geardyn.core.moved import moved
-from geardyn.core.plan import LanePlan
-from geardyn.core.settings import RunSettings
+from geardyn.core.plan import LanePlan, LaneSettings
+from geardyn.core.settings import RunSettings, replacement, warn_deprecated
 from geardyn.core.status import Status
 from geardyn.solvers._step_shared import phase_table_values
 from geardyn.solvers.kernels import kernels_for
@@ -67,38 +69,35 @@ def run_lanes(
     model: Model,
     P: np.ndarray,
     y0: np.ndarray,
-    transient: float | np.ndarray | None = None,
-    samples: int | None = None,
-    steps_per_period: int | np.ndarray | None = None,
-    sample_every: int | np.ndarray | str = "auto",
-    locate_edges: bool | None = None,
-    bound: float | None = None,
-    t0: np.ndarray | None = None,
-    transient_max: float | np.ndarray | None = None,
-    converge_tol: float | None = None,
-    converge_depth: int = 16,
-    max_section_periods: int | None = None,
-    *,
+    *legacy_args: Any,
     run: RunSettings | None = None,
+    lanes: LaneSettings | None = None,
     chain: np.ndarray | None = None,
+    converge_depth: int | None = None,
+    **legacy: Any,
 ) -> LaneResults:
     """Integrate one lane per row of ``P`` (coefficient vectors) from ``y0`` (one state, or one
-    per lane) and return stroboscopic samples (one every ``sample_every`` forcing periods) and
-    statistics over the sampled stretch, under the settings ``run``
-    (:class:`~geardyn.core.settings.RunSettings`) or, for compatibility, the same settings as
-    keyword arguments (``converge_tol``: ``converge``, 0 off). ``t0``: per-lane start times
-    (whole periods); ``transient``, ``transient_max`` and ``steps_per_period`` (<= 0:
-    automatic) may be arrays, one value per lane (then they override ``run``'s), and so may
-    ``sample_every``; ``"auto"`` samples at the common period of the forcings when the model has
-    a second, commensurate excitation (:func:`~geardyn.core.section.common_section`, up to
-    ``max_section_periods``), else every period. The transient is rounded up to whole sampling
-    intervals. Everything is planned once by :class:`~geardyn.core.plan.LanePlan`.
+    per lane) and return stroboscopic samples and statistics over the sampled stretch, under
+    the settings ``run`` (:class:`~geardyn.core.settings.RunSettings`, default its defaults)
+    and the per-lane values ``lanes`` (:class:`~geardyn.core.plan.LaneSettings`: start times
+    ``t0`` (whole periods), per-lane ``transient``, ``transient_max`` and ``steps_per_period``
+    in place of the run's, ``sample_every``). By default a lane is sampled at the common period
+    of the forcings when the model has a second, commensurate excitation
+    (:func:`~geardyn.core.section.common_section`, up to ``run.max_section_periods``), else
+    every period. The transient is rounded up to whole sampling intervals. Everything is
+    planned once by :class:`~geardyn.core.plan.LanePlan`.
 
-    Transient by convergence: with a tolerance ``converge`` the transient (then a minimum) goes
-    on, one sampling interval at a time up to ``transient_max`` (default 10 x transient), until
-    the section point is estimated within ``converge (1 + |point|)`` of a periodic orbit of
-    period <= ``converge_depth`` sections (from the contraction of successive differences,
-    docs/numerics.md); ``converged`` tells per lane whether it was.
+    The settings as separate arguments after ``y0`` (``transient, samples, steps_per_period,
+    sample_every, locate_edges, bound, t0, transient_max, converge_tol, converge_depth,
+    max_section_periods``, positional or keyword; ``converge_tol``: ``converge``, 0 off) are
+    deprecated: one DeprecationWarning per process naming the equivalent ``run=`` and
+    ``lanes=``; the result is the same, bit for bit.
+
+    Transient by convergence: with a tolerance ``run.converge`` the transient (then a minimum)
+    goes on, one sampling interval at a time up to ``transient_max`` (default 10 x
+    transient), until the section point is estimated within ``converge (1 + |point|)`` of a
+    periodic orbit of period <= ``converge_depth`` sections (default 16; from the contraction
+    of successive differences, docs/numerics.md); ``converged`` tells per lane whether it was.
 
     ``chain`` (one int per lane, -1: none) makes sweeps by continuation: lane ``chain[l]``
     starts where lane l ended (its final state, at its end time; its own ``y0`` row and
@@ -106,27 +105,87 @@ def run_lanes(
     did not, the rest of its chain is not run (status ``Status.NOT_RUN``, ``steps`` 0, the
     other results as allocated; the caller restarts them). ``steps`` counts the grid steps
     each lane was integrated: its transient plus its sampled stretch (fewer if it diverged)."""
-    per_lane = {"transient": transient, "transient_max": transient_max,
-                "steps_per_period": steps_per_period}
-    scalars = {k: v for k, v in per_lane.items() if v is not None and np.ndim(v) == 0}
-    overrides = {k: v for k, v in per_lane.items() if v is not None and np.ndim(v) > 0}
-    legacy = dict(scalars, samples=samples, locate_edges=locate_edges, bound=bound,
-                  max_section_periods=max_section_periods)
-    if converge_tol is not None:
-        legacy["converge"] = float(converge_tol) if converge_tol > 0 else None
-        if converge_tol < 0:
-            raise ValueError(f"converge_tol must be >= 0 (got {converge_tol!r})")
-    legacy = {k: v for k, v in legacy.items() if v is not None or k == "converge"}
-    if "steps_per_period" in legacy and int(legacy["steps_per_period"]) <= 0:
-        overrides["steps_per_period"] = legacy.pop("steps_per_period")  # <= 0: automatic
-    if run is None:
-        run = RunSettings(**legacy)
-    elif legacy:
+    if legacy_args or legacy:
+        run, lanes, converge_depth = _legacy_settings(legacy_args, legacy, run, lanes,
+                                                      converge_depth)
+    run = RunSettings() if run is None else run
+    if not isinstance(run, RunSettings):
+        raise TypeError(f"run must be a RunSettings (got {type(run).__name__})")
+    P = np.ascontiguousarray(np.atleast_2d(P), dtype=float)
+    plan = LanePlan.build(model, P, run, lanes)
+    return run_plan(model, P, y0, plan, 16 if converge_depth is None else converge_depth,
+                    chain=chain)
+
+
+#: The settings of :func:`run_lanes` as separate arguments (deprecated), in their old order.
+LEGACY_ORDER = ("transient", "samples", "steps_per_period", "sample_every", "locate_edges",
+                "bound", "t0", "transient_max", "converge_tol", "converge_depth",
+                "max_section_periods")
+#: Of those, the ones that are always run settings (the rest are per lane where arrays).
+_RUN_ONLY = ("samples", "locate_edges", "bound", "max_section_periods")
+
+
+def _legacy_settings(args: tuple[Any, ...], keywords: dict[str, Any],
+                     run: RunSettings | None, lanes: LaneSettings | None,
+                     converge_depth: int | None
+                     ) -> tuple[RunSettings | None, LaneSettings | None, int | None]:
+    """``run``, ``lanes`` and ``converge_depth`` of a :func:`run_lanes` call that gives its
+    settings as separate arguments (``args`` after ``y0``, ``keywords``), with one
+    DeprecationWarning per process naming the replacement. Run fields beside ``run=``, lane
+    fields beside ``lanes=``, and unknown or twice-given names are TypeErrors."""
+    if any(isinstance(a, (RunSettings, LaneSettings)) for a in args):
+        raise TypeError("run_lanes takes its settings as keywords: run_lanes(model, P, y0, "
+                        "run=RunSettings(...), lanes=LaneSettings(...))")
+    if len(args) > len(LEGACY_ORDER):
+        raise TypeError(f"run_lanes() takes at most {3 + len(LEGACY_ORDER)} positional "
+                        f"arguments ({3 + len(args)} given)")
+    given = dict(zip(LEGACY_ORDER, args, strict=False))
+    for name, value in keywords.items():
+        if name not in LEGACY_ORDER:
+            raise TypeError(f"run_lanes() got an unexpected keyword argument {name!r}")
+        if name in given:
+            raise TypeError(f"run_lanes() got multiple values for argument {name!r}")
+        given[name] = value
+    given = {k: v for k, v in given.items()
+             if v is not None and not (k == "sample_every" and isinstance(v, str)
+                                       and v == "auto")}
+    if not given:
+        return run, lanes, converge_depth
+    run_fields: dict[str, Any] = {}
+    lane_fields: dict[str, Any] = {}
+    for name, value in given.items():
+        if name == "converge_depth":
+            if converge_depth is not None:
+                raise TypeError("run_lanes() got multiple values for argument 'converge_depth'")
+            converge_depth = value
+        elif name == "converge_tol":
+            if value < 0:
+                raise ValueError(f"converge_tol must be >= 0 (got {value!r})")
+            run_fields["converge"] = float(value) if value > 0 else None
+        elif name in ("t0", "sample_every") or (name not in _RUN_ONLY and np.ndim(value)):
+            lane_fields[name] = value
+        elif name == "steps_per_period" and int(value) <= 0:
+            continue  # <= 0: the step rule, the run's default
+        else:
+            run_fields[name] = value
+    if run_fields and run is not None:
         raise TypeError(f"run_lanes: give the settings as run= or as keywords, not both "
-                        f"(got run= and {next(iter(legacy))}=)")
-    plan = LanePlan.build(model, np.ascontiguousarray(np.atleast_2d(P), dtype=float), run,
-                          sample_every=sample_every, t0=t0, **overrides)
-    return run_plan(model, P, y0, plan, converge_depth, chain=chain)
+                        f"(got run= and {next(iter(run_fields))}=)")
+    if lane_fields and lanes is not None:
+        raise TypeError(f"run_lanes: give lanes=LaneSettings(...) or keyword arguments, not "
+                        f"both (got lanes= and {next(iter(lane_fields))}=)")
+    replacements = []
+    if run_fields:
+        run = RunSettings(**run_fields)
+        replacements.append(replacement("run", RunSettings, run_fields))
+    if lane_fields:
+        lanes = LaneSettings(**lane_fields)
+        replacements.append(replacement("lanes", LaneSettings, lanes.fields(),
+                                        home="geardyn.core"))
+    if "converge_depth" in given:
+        replacements.append(f"converge_depth={converge_depth!r}")
+    warn_deprecated("run_lanes", given, replacements, stacklevel=3)
+    return run, lanes, converge_depth
 
 
 def run_plan(model: Model, P: np.ndarray, y0: np.ndarray, plan: LanePlan,

@@ -10,7 +10,7 @@ import xarray as xr
 
 from geardyn.core.model import Model
 from geardyn.core.moved import moved
-from geardyn.core.plan import default_steps_per_period, forcing_period, periods_covering
+from geardyn.core.plan import LanePlan, LaneSettings
 from geardyn.core.results import finish
 from geardyn.core.settings import INTEGRATOR, RunSettings, resolve_run
 from geardyn.core.status import Status, status_meaning
@@ -19,7 +19,8 @@ from geardyn.solvers.kernels import kernels_for
 #: Names whose home is now the core layer (deprecated here).
 __getattr__ = moved(__name__, {
     **dict.fromkeys(("MIN_STEPS_PER_PERIOD", "STEPS_PER_FASTEST_MODE",
-                     "STEPS_PER_OTHER_FORCING", "steps_per_period_rule"), "geardyn.core.plan"),
+                     "STEPS_PER_OTHER_FORCING", "steps_per_period_rule",
+                     "default_steps_per_period"), "geardyn.core.plan"),
     "DEFAULT_BOUND": "geardyn.core.settings"})
 
 #: simulate's own defaults of the run settings (a time history from the start, 64 periods).
@@ -45,8 +46,10 @@ def simulate(
     run
         :class:`~geardyn.RunSettings`: ``transient`` (time discarded first, in the model's time
         unit, rounded up to whole forcing periods), ``samples`` (forcing periods recorded),
-        ``steps_per_period`` (default :func:`default_steps_per_period`), ``locate_edges``,
-        ``bound``. Without ``run``: transient 0 and 64 periods. The keywords ``transient``,
+        ``steps_per_period`` (default :func:`~geardyn.core.plan.default_steps_per_period`),
+        ``locate_edges``, ``bound``; planned as a one-lane
+        :class:`~geardyn.core.plan.LanePlan` (the step rule's own count, not the sweep's
+        ladder). Without ``run``: transient 0 and 64 periods. The keywords ``transient``,
         ``periods`` (the samples), ``steps_per_period``, ``locate_edges`` and ``bound`` still
         build it but are deprecated (one DeprecationWarning naming the equivalent
         ``run=geardyn.RunSettings(...)``, these defaults included).
@@ -63,7 +66,7 @@ def simulate(
     """
     run = resolve_run(run, settings, SIMULATE_DEFAULTS, aliases={"periods": "samples"},
                       where="simulate")
-    transient, periods, bound = run.transient, run.samples, run.bound
+    periods, bound = run.samples, run.bound
     locate_edges = run.locate_edges
     if omega is not None:
         model = model.with_omega(float(omega))
@@ -71,16 +74,16 @@ def simulate(
     if om == 0.0:
         if not sample_interval or sample_interval <= 0:
             raise ValueError("an autonomous model needs sample_interval > 0")
-        period = float(sample_interval)
+        lanes = LaneSettings(ladder=False, interval=float(sample_interval))
     else:
         if not math.isfinite(om) or om < 0:
             raise ValueError(f"omega must be a positive finite number (got {om!r})")
-        period = forcing_period(om)
-    n = int(run.steps_per_period or default_steps_per_period(model, om))
+        lanes = LaneSettings(ladder=False, sample_every=1)
+    plan = LanePlan.build(model, np.asarray(model.params, dtype=float)[None, :], run, lanes)
+    period, n, h = float(plan.period[0]), int(plan.steps_per_period[0]), float(plan.step[0])
     if record_every < 1 or n % record_every:
         raise ValueError(f"record_every ({record_every}) must divide steps_per_period ({n})")
-    h = period / n
-    n_tr = periods_covering(transient, period)
+    n_tr = int(plan.transient_periods[0])
     y = np.asarray(model.initial_state() if y0 is None else y0, dtype=float).copy()
     if y.shape != (model.n_states,):
         raise ValueError(f"y0 must have {model.n_states} entries ({', '.join(model.state_names)})")
