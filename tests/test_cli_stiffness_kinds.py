@@ -404,3 +404,13 @@ def test_docs_table_of_the_packaged_studies():
                f"{float(ds.tangent_stiffness.mean()):.3e}".replace("e+0", "e"),
                f"{float(ds.secant_stiffness.mean()):.3e}".replace("e+0", "e")]
         assert cells[1:] == got, (cells[0], got)
+
+
+def test_relief_and_crowning_need_gears(tmp_path, capsys):
+    for table in ('[[relief]]\namount = "5 um"\nlength = "1 mm"\n',
+                  '[crowning]\namount = "5 um"\n'):
+        study = tmp_path / "x.toml"
+        study.write_text('[study]\nname = "x"\n' + table, encoding="utf-8")
+        r = run(capsys, "stiffness", study)
+        name = "relief" if "relief" in table else "crowning"
+        assert r.returncode == 2 and f"{name}: needs a [gears] table" in r.stderr, r.stderr
