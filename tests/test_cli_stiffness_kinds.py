@@ -414,3 +414,26 @@ def test_relief_and_crowning_need_gears(tmp_path, capsys):
         r = run(capsys, "stiffness", study)
         name = "relief" if "relief" in table else "crowning"
         assert r.returncode == 2 and f"{name}: needs a [gears] table" in r.stderr, r.stderr
+
+
+@pytest.mark.parametrize(("old", "new", "field"), [
+    ('face_width = "16 mm"', 'face_width = "16 mm"\nhelix_angle = "20 deg"',
+     ("gears", "helix_angle")),
+    ('face_width = "16 mm"', 'face_width = "16 mm"\ninternal = true', ("gears", "internal")),
+    ("angles = 64", "angles = 64\nslices = 4", ("stiffness", "slices")),
+    ("angles = 64", 'angles = 64\ntorque = "5 N m"', ("stiffness", "torque")),
+    ("angles = 64", 'angles = 64\nforce = "5 N"', ("stiffness", "force")),
+    ("\n[params]", '\n[[relief]]\namount = "5 um"\nlength = "1 mm"\n\n[params]', ("relief",)),
+])
+def test_a_spur_pair_model_refuses_what_it_does_not_model(old, new, field):
+    """A spur_pair study's model is an external spur pair on its unloaded stiffness: the
+    helical, internal and loaded-contact fields are refused where the study is read, not
+    dropped."""
+    from importlib import resources
+
+    text = resources.files("geardyn.studies").joinpath("spur_pair_cracked.toml").read_text()
+    assert old in text
+    with pytest.raises(ValidationError) as info:
+        load_study(text.replace(old, new, 1))
+    err = info.value.errors()[0]
+    assert err["loc"] == field and "not part of a spur_pair model" in err["msg"]

@@ -1084,8 +1084,28 @@ class Study(BaseModel):
             if self.params is None:
                 raise _study_error(("params",), None, "required (or a [gears] table)", "missing")
             return
+        if self.study.model == "spur_pair":
+            self._check_spur_pair_gears()
         mesh, _ = self.stiffness_inputs()
         self.contact_inputs(mesh)
+
+    def _check_spur_pair_gears(self) -> None:
+        """A ``spur_pair`` model is an external spur pair on its unloaded mesh stiffness: the
+        fields of a helical or internal pair and of the loaded contact are refused, naming the
+        field (they are ``geardyn stiffness``'s)."""
+        gears, table = self.gears, self.stiffness
+        given = [(("gears", "helix_angle"), gears.helix_angle),  # type: ignore[union-attr]
+                 (("gears", "internal"), gears.internal or None),  # type: ignore[union-attr]
+                 (("gears", "ring_foundation"), gears.ring_foundation),  # type: ignore[union-attr]
+                 (("relief",), self.relief), (("crowning",), self.crowning)]
+        if table is not None:
+            given += [(("stiffness", name), getattr(table, name))
+                      for name in ("slices", "torque", "force")]
+        for loc, value in given:
+            if value is not None:
+                raise _study_error(loc, value, "not part of a spur_pair model (an external spur"
+                                   " pair on its unloaded mesh stiffness; geardyn stiffness"
+                                   " takes it)")
 
     def stiffness_inputs(self, faults: bool = True) -> tuple[GearMesh, dict[str, Any]]:
         """The ``[gears]`` pair and the keywords of
