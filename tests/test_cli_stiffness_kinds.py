@@ -370,7 +370,7 @@ def test_plot_draws_the_loaded_contact(tmp_path, capsys):
                                rtol=1e-14)
     steps = {line.get_label(): line.get_ydata() for line in fig.axes[1].get_lines()}
     np.testing.assert_array_equal(steps["drive flank"], ds["pairs_in_contact"].values)
-    assert "10 slices" in fig._suptitle.get_text()
+    assert "10 slices" in fig.get_suptitle()
     r = run(capsys, "plot", out, "--out", tmp_path / "again.pdf")
     assert r.returncode == 0, r.stderr
 
