@@ -239,7 +239,9 @@ def test_cli_writes_what_the_api_computes(tmp_path, capsys, source):
 
 def test_packaged_studies_are_what_the_docs_say():
     """The internal study's ring is a ring with a rigid body; the helical one's overlap."""
-    ring = load_dataset_from(builtin_study("stiffness_planet_ring"))
+    from geardyn.study import mesh_stiffness
+
+    ring = mesh_stiffness(builtin_study("stiffness_planet_ring"))
     assert ring.attrs["internal"] == 1 and ring.attrs["ring_foundation"] == "rigid"
     assert np.all(np.isinf(ring["k_fillet_wheel"].values[ring["in_contact"].values]))
     mesh, kw = builtin_study("stiffness_helical").stiffness_inputs()
@@ -247,12 +249,6 @@ def test_packaged_studies_are_what_the_docs_say():
     np.testing.assert_allclose(mesh.overlap_ratio,
                                0.016 * math.sin(math.radians(20.0)) / (math.pi * 0.0032),
                                rtol=1e-14)
-
-
-def load_dataset_from(study):
-    from geardyn.study import mesh_stiffness
-
-    return mesh_stiffness(study)
 
 
 def test_study_tables_round_trip(tmp_path):
