@@ -66,14 +66,37 @@ def build_model(study: Study, interpretation: str | None = None, omega: float | 
     ))
 
 
-def mesh_stiffness(study: Study, faults: bool = True) -> xr.Dataset:
+def mesh_stiffness(study: Study, faults: bool = True, loaded: bool = True) -> xr.Dataset:
     """The potential-energy mesh stiffness of the study's ``[gears]`` pair
-    (:func:`~geardyn.gears.potential_energy_stiffness` with the ``[stiffness]`` settings and the
-    ``[[faults]]``; ``faults=False``: the healthy pair), the study's name in its attrs."""
-    from geardyn.gears import potential_energy_stiffness
+    (:func:`~geardyn.gears.potential_energy_stiffness`, or
+    :func:`~geardyn.gears.helical_stiffness` for a helical pair, with the ``[stiffness]``
+    settings and the ``[[faults]]``; ``faults=False``: the healthy pair), the study's name in
+    its attrs. With a load (``[stiffness]`` torque or force) and ``loaded``, the variables of
+    the loaded contact (:func:`~geardyn.gears.loaded_contact`, or
+    :func:`~geardyn.gears.helical_loaded_contact`, with ``[[relief]]`` and ``[crowning]``)
+    join it, and its attrs ``force_N``, ``relief``, ``crowning`` (and ``torque_Nm``)."""
+    from geardyn.gears import (
+        HelicalMesh,
+        helical_loaded_contact,
+        helical_stiffness,
+        loaded_contact,
+        potential_energy_stiffness,
+    )
 
     mesh, kw = study.stiffness_inputs(faults=faults)
-    ds = potential_energy_stiffness(mesh, **kw)
+    helical = isinstance(mesh, HelicalMesh)
+    ds = (helical_stiffness if helical else potential_energy_stiffness)(mesh, **kw)
+    load = study.contact_inputs(mesh) if loaded else None
+    if load is not None:
+        if helical:
+            contact = helical_loaded_contact(mesh, ds, load["force"], load["relief"],
+                                             load["crowning"])
+        else:
+            contact = loaded_contact(mesh, ds, load["force"], load["relief"])
+        ds = ds.assign(contact.data_vars)
+        ds.attrs.update(contact.attrs)
+        if load["torque"] is not None:
+            ds.attrs["torque_Nm"] = load["torque"]
     ds.attrs["study"] = study.study.name
     return ds
 

@@ -29,6 +29,7 @@ SI_UNITS: dict[str, str] = {
     "mass": "kg",
     "density": "kg/m**3",
     "torque": "N*m",
+    "force": "N",
     "pressure": "Pa",
     "dimensionless": "",
     "frequency": "rad/s",

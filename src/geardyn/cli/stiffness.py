@@ -4,13 +4,18 @@
 
     geardyn stiffness STUDY.toml [-o stiffness.nc] [--plot] [--figure stiffness.png] [--yes]
 
-The pair comes from the study's ``[gears]``, the faults on its teeth from ``[[faults]]`` and
-the angles, cycles and quadrature from ``[stiffness]`` (:class:`~geardyn.io.toml.GearsTable`,
-:class:`~geardyn.io.toml.FaultTable`, :class:`~geardyn.io.toml.StiffnessTable`); the result
-is :func:`geardyn.gears.potential_energy_stiffness`'s Dataset, written as NetCDF (default
-``<study name>_stiffness.nc``). ``--plot`` draws it (``--figure``, default OUT with .png): drive
-and coast flank, pairs in contact, and with a fault the healthy pair's drive stiffness. A grid
-whose result would not fit in half the machine's memory is refused unless ``--yes``.
+The pair comes from the study's ``[gears]`` (external or internal spur, or helical), the
+faults on its teeth from ``[[faults]]``, the angles, cycles, quadrature, slices and load from
+``[stiffness]``, tip reliefs and lead crowning from ``[[relief]]`` and ``[crowning]``
+(:class:`~geardyn.io.toml.GearsTable`, :class:`~geardyn.io.toml.FaultTable`,
+:class:`~geardyn.io.toml.StiffnessTable`, :class:`~geardyn.io.toml.ReliefTable`,
+:class:`~geardyn.io.toml.CrowningTable`); the result is :func:`geardyn.study.mesh_stiffness`'s
+Dataset (:func:`geardyn.gears.potential_energy_stiffness` or
+:func:`geardyn.gears.helical_stiffness`, with a load the loaded contact's variables), written
+as NetCDF (default ``<study name>_stiffness.nc``). ``--plot`` draws it (``--figure``, default
+OUT with .png): drive and coast flank, pairs in contact, with a fault the healthy pair's drive
+stiffness, with a load the transmission error and the loaded stiffness. A grid whose result
+would not fit in half the machine's memory is refused unless ``--yes``.
 """
 
 from __future__ import annotations
@@ -19,6 +24,7 @@ import math
 from pathlib import Path
 from typing import Annotated
 
+import numpy as np
 import typer
 
 from geardyn.cli.common import (
@@ -35,6 +41,9 @@ __all__ = ["register", "stiffness_command"]
 #: Bytes per pinion angle and variable row, peak while computing: an upper bound (the 19/48
 #: pair, 10 rows, peaks at about 1.2 kB per angle against the 2 kB this gives).
 BYTES_PER_VALUE = 200.0
+#: Variable rows per slice and pair of a helical pair, relative to a spur pair's one per pair
+#: (its per-slice variables: the terms, positions, masks, gaps and loaded forces).
+SLICE_ROWS = 2
 
 
 def stiffness_command(
@@ -51,9 +60,9 @@ def stiffness_command(
     ] = None,
     yes: YesOption = False,
 ) -> None:
-    """Mesh stiffness of a study's spur pair by the potential-energy method: drive and coast
-    flank over the pinion angle, every energy term, the faults on its teeth; NetCDF and a
-    figure."""
+    """Mesh stiffness of a study's gear pair (spur, internal or helical) by the
+    potential-energy method: drive and coast flank over the pinion angle, every energy term,
+    the faults on its teeth, with a load the transmission error; NetCDF and a figure."""
     from geardyn.study import mesh_stiffness
 
     s = load_study_source(study)
@@ -77,7 +86,7 @@ def stiffness_command(
     if drawn is not None:
         from geardyn.plotting.stiffness import plot_mesh_stiffness
 
-        healthy = mesh_stiffness(s, faults=False) if s.faults else None
+        healthy = mesh_stiffness(s, faults=False, loaded=False) if s.faults else None
         plot_mesh_stiffness(ds, path=drawn, healthy=healthy)
         written.append(str(drawn))
     typer.echo(f"{_summary(s.study.name, ds)}; wrote {', '.join(written)}")
@@ -86,10 +95,17 @@ def stiffness_command(
 def _check_memory(study, yes: bool) -> None:
     """Refuse (unless ``yes``) a grid whose result would take more than
     :func:`~geardyn.cli.common.memory_limit`: about :data:`BYTES_PER_VALUE` per pinion angle
-    and per variable row (the pairs of both flanks and the per-angle variables)."""
+    and per variable row (the pairs of both flanks and the per-angle variables; a helical
+    pair's rows are its pairs' slices, :data:`SLICE_ROWS` each)."""
+    from geardyn.gears.helical import DEFAULT_SLICES
+
     mesh, kw = study.stiffness_inputs()
     angles = kw["angles"] * kw["cycles"]
-    rows = 2 * (math.ceil(mesh.contact_ratio) + 2) + 2
+    ratio = getattr(mesh, "total_contact_ratio", None)
+    if ratio is None:
+        rows = 2 * (math.ceil(mesh.contact_ratio) + 2) + 2
+    else:
+        rows = 2 * (math.ceil(ratio) + 2) * kw.get("slices", DEFAULT_SLICES) * SLICE_ROWS + 2
     need = float(angles) * rows * BYTES_PER_VALUE
     if need > memory_limit() and not yes:
         raise ParameterError("stiffness.angles", kw["angles"],
@@ -99,16 +115,27 @@ def _check_memory(study, yes: bool) -> None:
 
 
 def _summary(name: str, ds) -> str:
-    """One line: the pair, the grid and the drive and coast mesh stiffness."""
+    """One line: the pair, the grid and the drive and coast mesh stiffness (a helical pair:
+    its overlap ratio and slices; with a load: the transmission error and loaded stiffness)."""
     k, kc = ds["mesh_stiffness"].values, ds["mesh_stiffness_coast"].values
     c = ds["cycle"].values
     cycles = float(c[-1] - c[0] + (c[1] - c[0] if c.size > 1 else 0.0))
     from geardyn.plotting.stiffness import fault_text
 
-    return (f"{name}: contact ratio {ds.attrs['contact_ratio']:.5f}, {k.size} pinion angles"
+    pair = f"contact ratio {ds.attrs['contact_ratio']:.5f}"
+    if "slices" in ds.attrs:
+        pair += (f", overlap ratio {ds.attrs['overlap_ratio']:.5f},"
+                 f" {ds.attrs['slices']} slices")
+    text = (f"{name}: {pair}, {k.size} pinion angles"
             f" over {cycles:.4g} mesh cycles; mesh stiffness drive {k.mean():.4g} N/m"
             f" ({k.min():.4g}..{k.max():.4g}), coast {kc.mean():.4g} N/m"
             f" ({kc.min():.4g}..{kc.max():.4g}); faults: {fault_text(ds)}")
+    if "transmission_error" in ds:
+        te, kt = ds["transmission_error"].values, ds["tangent_stiffness"].values
+        text += (f"; under {ds.attrs['force_N']:.4g} N transmission error {te.mean() * 1e6:.4g}"
+                 f" um (peak-to-peak {np.ptp(te) * 1e6:.4g} um), loaded stiffness"
+                 f" {kt.mean():.4g} N/m")
+    return text
 
 
 def register(app: typer.Typer) -> None:

@@ -57,6 +57,7 @@ from geardyn.gears.potential_energy import (
     coast_phase,
     prepare_pair,
 )
+from geardyn.gears.slice_terms import DEGREE, TOLERANCE, ChebyshevTerms
 from geardyn.units import si_value
 
 #: Largest helix angle accepted [rad].
@@ -251,14 +252,16 @@ def _slices(slices: object, face_width: float) -> np.ndarray:
 
 
 def _flank(pair: PotentialEnergyPair, piece: PotentialEnergyPair, n: np.ndarray,
-           frac: np.ndarray, shift: np.ndarray, *, coast: bool) -> dict[str, np.ndarray]:
+           frac: np.ndarray, shift: np.ndarray, *, coast: bool,
+           terms_of: PotentialEnergyPair | ChebyshevTerms | None = None
+           ) -> dict[str, np.ndarray]:
     """The slices of one flank over (angle, pair, slice): the pair indices ``ks``, contact
     positions [m], contact mask, tooth indices, each slice's terms (``piece``: the pair of one
-    slice's width) and the wear gap; slice j lies ``shift[j]`` mesh cycles ahead of the face
-    centre. Drive: pair k holds pinion and wheel tooth (n - k), its slice in contact from the
-    start of the path (included) to its end. Coast (as in potential_energy._coast): pinion
-    tooth (n - k), wheel tooth (n - k + 1), in contact from the end of the path (included) to
-    its start."""
+    slice's width; evaluated by ``terms_of``, default ``piece``) and the wear gap; slice j lies
+    ``shift[j]`` mesh cycles ahead of the face centre. Drive: pair k holds pinion and wheel
+    tooth (n - k), its slice in contact from the start of the path (included) to its end.
+    Coast (as in potential_energy._coast): pinion tooth (n - k), wheel tooth (n - k + 1), in
+    contact from the end of the path (included) to its start."""
     mesh = pair.mesh
     p_b = mesh.base_pitch
     start, end = -mesh.approach_length / p_b, mesh.recess_length / p_b
@@ -281,7 +284,8 @@ def _flank(pair: PotentialEnergyPair, piece: PotentialEnergyPair, n: np.ndarray,
     inside &= ~gone[:, :, None]
     position = u * p_b
     fp3, fw3 = (np.broadcast_to(x[:, :, None], u.shape) for x in (fp, fw))
-    terms = _terms_on_grid(piece, position, inside, fp3, fw3, coast=coast)
+    terms = _terms_on_grid(terms_of or piece, position, inside, fp3, fw3,  # type: ignore[arg-type]
+                           coast=coast)
     gap = _wear_gap(piece, position, inside, tooth_p[:, :, None], tooth_w[:, :, None],
                     coast=coast)
     return {"ks": ks, "centre": centre * p_b, "position": position, "inside": inside,
@@ -292,7 +296,7 @@ def helical_stiffness(mesh: HelicalMesh, *, bore_radius: object, angles: object 
                       slices: int = DEFAULT_SLICES, young: object = STEEL_YOUNG,
                       poisson: object = STEEL_POISSON, root_segment: bool = True,
                       nodes: int = DEFAULT_NODES, faults: object = (),
-                      cycles: int = 1) -> xr.Dataset:
+                      cycles: int = 1, exact: bool = False) -> xr.Dataset:
     """Mesh stiffness of the helical ``mesh`` by ``slices`` thin slices (module docstring),
     each the potential-energy spur pair of the transverse sections
     (:func:`~geardyn.gears.potential_energy_stiffness`: ``bore_radius``, ``angles``,
@@ -320,7 +324,13 @@ def helical_stiffness(mesh: HelicalMesh, *, bore_radius: object, angles: object 
     :class:`~geardyn.gears.BrokenTooth` act on the whole face width of their tooth (a crack
     across the whole face); a :class:`~geardyn.gears.Spall` (field ``faults``) and Archard wear
     (``wear.profile``) are refused. At beta = 0 with one slice the result is
-    :func:`~geardyn.gears.potential_energy_stiffness`'s bitwise."""
+    :func:`~geardyn.gears.potential_energy_stiffness`'s bitwise.
+
+    Evaluation: where the slices' contacts differ (beta > 0, more than one slice) and not
+    ``exact``, the healthy pairs' terms come from Chebyshev interpolants along the path of
+    contact (:class:`~geardyn.gears.slice_terms.ChebyshevTerms`, used where its check against
+    quadrature is within :data:`~geardyn.gears.slice_terms.TOLERANCE`), the faulty teeth's
+    from quadrature; else every contact by quadrature. Attr ``slice_terms`` says which."""
     if not isinstance(mesh, HelicalMesh):
         raise ParameterError("mesh", mesh, "must be a HelicalMesh")
     fault_list = _helical_faults(faults)
@@ -331,8 +341,9 @@ def helical_stiffness(mesh: HelicalMesh, *, bore_radius: object, angles: object 
     piece = replace(pair, face_width=pair.face_width / count)
     shift = mesh.overlap_ratio * (axial / pair.face_width)  # mesh cycles ahead of the centre
     cyc, n, frac = _cycle_grid(mesh.transverse, angles, cycles)
-    drive = _flank(pair, piece, n, frac, shift, coast=False)
-    coast = _flank(pair, piece, n, frac, shift, coast=True)
+    terms_of, how = _slice_evaluation(piece, count, mesh.overlap_ratio, exact)
+    drive = _flank(pair, piece, n, frac, shift, coast=False, terms_of=terms_of)
+    coast = _flank(pair, piece, n, frac, shift, coast=True, terms_of=terms_of)
     data = _flank_variables(drive, count, "")
     data.update(_flank_variables(coast, count, "_coast"))
     data["fault_gap"] = (("angle", "pair", "slice"), drive["gap"])
@@ -351,7 +362,24 @@ def helical_stiffness(mesh: HelicalMesh, *, bore_radius: object, angles: object 
     ds["cycle"].attrs.update(units="", long_name="mesh cycles")
     ds["axial_position"].attrs.update(units="m", long_name="slice centre from the face centre")
     ds.attrs.update(_helical_attrs(mesh, pair, root_segment, count))
+    ds.attrs["slice_terms"] = how
     return ds
+
+
+def _slice_evaluation(piece: PotentialEnergyPair, count: int, overlap: float,
+                      exact: bool) -> tuple[PotentialEnergyPair | ChebyshevTerms, str]:
+    """What evaluates the slices' terms (the pair of one slice's width ``piece`` by
+    quadrature, or its Chebyshev interpolants where the slices' contacts differ and they pass
+    their check) and the attr ``slice_terms`` saying so."""
+    if exact or count == 1 or overlap == 0.0:
+        return piece, "quadrature at every contact"
+    table = ChebyshevTerms.build(piece)
+    if table.error <= TOLERANCE:
+        return table, (f"healthy pairs: Chebyshev interpolants of degree {DEGREE} along the"
+                       f" path of contact (largest error at the check points {table.error:.2g}"
+                       " of the pair's compliance); faulty teeth: quadrature")
+    return piece, (f"quadrature at every contact (the Chebyshev interpolants' error"
+                   f" {table.error:.2g} exceeds {TOLERANCE:g})")
 
 
 def _flank_variables(flank: dict[str, np.ndarray], count: int,

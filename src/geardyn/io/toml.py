@@ -47,8 +47,18 @@ of ``[params]``::
     depth = "1 mm"
     angle = "45 deg"
     [stiffness]                     # StiffnessTable: angles per mesh cycle, cycles or
-    angles = 360                    #   "hunting", nodes, root_segment
-    cycles = "hunting"
+    angles = 360                    #   "hunting", nodes, root_segment; slices (helical);
+    cycles = "hunting"              #   the load of the loaded contact: torque or force
+    torque = "50 N m"
+    [[relief]]                      # ReliefTable: a TipRelief's fields
+    amount = "10 um"
+    length = "1.5 mm"
+    [crowning]                      # CrowningTable (or [[crowning]]): a LeadCrowning's
+    amount = "5 um"                 #   fields (helical pairs)
+
+``[gears]`` also takes ``helix_angle`` (a helical pair by thin slices; module, pressure angle
+and profile shifts then in the normal section) or ``internal = true`` (the wheel a ring, its
+``[gears.wheel]`` ``bore_radius`` the ring's outer radius; ``ring_foundation``).
 
 For ``model = "spur_pair"`` the model is :meth:`geardyn.SpurPair.from_geometry` of the
 ``[gears]``, ``[[faults]]`` and ``[stiffness]`` tables, and ``[params]``
@@ -92,7 +102,7 @@ import tomllib
 from collections.abc import Callable, Mapping
 from importlib import resources
 from pathlib import Path
-from typing import Annotated, Any, Literal
+from typing import Annotated, Any, ClassVar, Literal
 
 import tomli_w
 from pydantic import (
@@ -122,14 +132,17 @@ from geardyn.core.settings import (
 from geardyn.core.settings import RunSettings as Settings
 from geardyn.errors import ParameterError, StudyError
 from geardyn.files import atomic_replace
+from geardyn.gears.crowning import LeadCrowning
 from geardyn.gears.faults import FAULT_KINDS
 from geardyn.gears.geometry import GearMesh, SpurGear
+from geardyn.gears.helical import HelicalGear, HelicalMesh, _helical_faults
 from geardyn.gears.potential_energy import (
     DEFAULT_NODES,
     STEEL_POISSON,
     STEEL_YOUNG,
     prepare_pair,
 )
+from geardyn.gears.tip_relief import TipRelief, relief_gap
 from geardyn.models.gear_pair_coefficients import GEAR_PAIR
 from geardyn.models.params import PAPER_NAMES, Angle, Length, PlanetaryParams, Real, Whole
 from geardyn.models.spur_pair_coefficients import INPUTS as SPUR_PAIR_INPUTS
@@ -137,6 +150,7 @@ from geardyn.models.spur_pair_coefficients import PhysicalInput
 from geardyn.units import to_si
 
 __all__ = [
+    "CrowningTable",
     "FaultTable",
     "GearPairParams",
     "GearTable",
@@ -146,6 +160,7 @@ __all__ = [
     "PairGearTable",
     "PaperBase",
     "PlanetaryGearSetParams",
+    "ReliefTable",
     "RunSettings",
     "RunTable",
     "SpurPairParams",
@@ -540,6 +555,9 @@ class PlanetaryGearSetParams(BaseModel):
 # --------------------------------------------------------------------------- gears and faults
 #: Young's modulus: an SI number [Pa] or a unit string ("206.8 GPa").
 Pressure = Annotated[float, BeforeValidator(lambda v: to_si(v, "pressure")), Field(gt=0)]
+#: A force: an SI number [N] or a unit string ("2 kN"); a torque [N m] ("50 N m").
+Force = Annotated[float, BeforeValidator(lambda v: to_si(v, "force"))]
+Torque = Annotated[float, BeforeValidator(lambda v: to_si(v, "torque"))]
 
 
 class PairGearTable(BaseModel):
@@ -558,13 +576,20 @@ class PairGearTable(BaseModel):
 
 
 class GearsTable(BaseModel):
-    """``[gears]``: an external spur pair (:class:`~geardyn.gears.GearMesh` of two
+    """``[gears]``: a spur pair (:class:`~geardyn.gears.GearMesh` of two
     :class:`~geardyn.gears.SpurGear`) for the potential-energy mesh stiffness: the common
     module, pressure angle and tooth proportions (addendum and dedendum factors of the basic
     rack), face width and bore radius (each also per gear), the centre distance (default: that
     of zero backlash), the material (E, nu), and the ``pinion`` and ``wheel`` sub-tables
     (:class:`PairGearTable`). SI numbers or unit strings. Values the geometry refuses (undercut,
-    interference, a bore outside the root circle, ...) are errors naming ``gears.<field>``."""
+    interference, a bore outside the root circle, ...) are errors naming ``gears.<field>``.
+
+    ``helix_angle``: a helical pair (:class:`~geardyn.gears.HelicalMesh` of two
+    :class:`~geardyn.gears.HelicalGear`; module, pressure angle, profile shifts and factors in
+    the normal section). ``internal = true``: the wheel is a ring (``GearMesh(...,
+    internal=True)``), its ``bore_radius`` (in ``[gears.wheel]``) the ring's outer (rim)
+    radius and ``ring_foundation`` the treatment of its body
+    (:data:`~geardyn.gears.potential_energy.RING_FOUNDATIONS`; default ``"rigid"``)."""
 
     model_config = _CONFIG
 
@@ -577,8 +602,26 @@ class GearsTable(BaseModel):
     centre_distance: Length | None = None
     young: Pressure = STEEL_YOUNG
     poisson: Real = STEEL_POISSON
+    helix_angle: Angle | None = Field(None, description="helical pair: rad or e.g. \"20 deg\"")
+    internal: StrictBool = Field(False, description="the wheel is a ring (internal pair)")
+    ring_foundation: str | None = Field(None, description="the ring body (internal pairs)")
     pinion: PairGearTable
     wheel: PairGearTable
+
+    @property
+    def helical(self) -> bool:
+        """A helical pair (``helix_angle`` given)."""
+        return self.helix_angle is not None
+
+    def check_kind(self) -> None:
+        """The pair's kind consistent: no internal helical pair, ``ring_foundation`` only on a
+        ring (a ParameterError naming the field)."""
+        if self.internal and self.helical:
+            raise ParameterError("internal", True, "an internal helical pair is not covered"
+                                 " (give helix_angle or internal, not both)")
+        if self.ring_foundation is not None and not self.internal:
+            raise ParameterError("ring_foundation", self.ring_foundation,
+                                 "applies to a ring only (internal = true)")
 
     def value(self, role: str, name: str) -> tuple[Any, tuple[str, ...]]:
         """``name`` of gear ``role`` ("pinion" or "wheel") and where it is set: its own table,
@@ -598,17 +641,31 @@ class GearsTable(BaseModel):
                 raise ParameterError(f"{role}.{name}", None, f"required (in [gears] or in "
                                      f"[gears.{role}])")
             kw[name] = value
+        if self.helical:
+            return HelicalGear(table.teeth, self.module, self.pressure_angle,
+                               self.helix_angle, kw["face_width"],
+                               profile_shift=table.profile_shift, addendum=kw["addendum"],
+                               dedendum=kw["dedendum"], name=role)
         return SpurGear(table.teeth, self.module, self.pressure_angle, kw["face_width"],
                         profile_shift=table.profile_shift, addendum=kw["addendum"],
-                        dedendum=kw["dedendum"], name=role)
+                        dedendum=kw["dedendum"], internal=self.internal and role == "wheel",
+                        name=role)
 
-    def mesh(self) -> GearMesh:
+    def mesh(self) -> GearMesh | HelicalMesh:
         """The pair, pinion driving."""
+        self.check_kind()
+        if self.helical:
+            return HelicalMesh(self.gear("pinion"), self.gear("wheel"),
+                               centre_distance=self.centre_distance)
         return GearMesh(self.gear("pinion"), self.gear("wheel"),
-                        centre_distance=self.centre_distance)
+                        centre_distance=self.centre_distance, internal=self.internal)
 
     def bores(self) -> tuple[float, float]:
-        """The bore radii [m] of pinion and wheel."""
+        """The bore radii [m] of pinion and wheel (a ring: its outer radius, from
+        ``[gears.wheel]`` only)."""
+        if self.internal and self.wheel.bore_radius is None:
+            raise ParameterError("wheel.bore_radius", None, "required in [gears.wheel] for a"
+                                 " ring: its outer (rim) radius")
         out = []
         for role in ("pinion", "wheel"):
             value = self.value(role, "bore_radius")[0]
@@ -625,13 +682,38 @@ class GearsTable(BaseModel):
         role, _, name = field.partition(".")
         if role in ("pinion", "wheel") and name:
             if name in PairGearTable.model_fields:
-                if name in ("teeth", "profile_shift"):
+                if name in ("teeth", "profile_shift") or (self.internal and role == "wheel"
+                                                           and name == "bore_radius"):
                     return ("gears", role, name)
                 return self.value(role, name)[1]
             if name in GearsTable.model_fields:
                 return ("gears", name)
             return ("gears", role, name)
         return ("gears", *field.split("."))
+
+
+def _build_from_fields(cls: type, given: dict[str, Any], where: tuple, what: str,
+                       listed: str = "") -> object:
+    """``cls(**given)``, the table's keys being the class's keyword arguments (its dataclass
+    fields: one declaration); an unknown key, a missing one or a value the class refuses is an
+    error at ``where`` + the key (``what`` names the object in the message, ``listed`` the
+    table's other keys)."""
+    params = inspect.signature(cls).parameters
+    for key in given:
+        if key not in params:
+            raise _study_error(where + (key,), given[key],
+                               f"unknown key (not a field of {what}; fields:"
+                               f" {listed}{', '.join(params)})")
+    for name, p in params.items():
+        if p.default is inspect.Parameter.empty and name not in given:
+            raise _study_error(where + (name,), None, f"required by {what}", kind="missing")
+    try:
+        return cls(**given)
+    except ParameterError as exc:  # a field the class names, else the whole table
+        name = exc.field.rpartition(".")[2]
+        if name in params:
+            raise _study_error(where + (name,), exc.value, exc.reason) from None
+        raise _study_error(where, given, exc.reason) from None
 
 
 class FaultTable(BaseModel):
@@ -654,24 +736,44 @@ class FaultTable(BaseModel):
         if cls is None:
             raise _study_error(where + ("kind",), self.kind, "unknown fault kind; known: "
                                + ", ".join(FAULT_KINDS))
-        params = inspect.signature(cls).parameters
-        given = self.fields()
-        for key in given:
-            if key not in params:
-                raise _study_error(where + (key,), given[key],
-                                   f"unknown key (not a field of a {self.kind} fault; fields:"
-                                   f" kind, {', '.join(params)})")
-        for name, p in params.items():
-            if p.default is inspect.Parameter.empty and name not in given:
-                raise _study_error(where + (name,), None, f"required by a {self.kind} fault",
-                                   kind="missing")
-        try:
-            return cls(**given)
-        except ParameterError as exc:  # a field the class names, else the whole table
-            name = exc.field.rpartition(".")[2]
-            if name in params:
-                raise _study_error(where + (name,), exc.value, exc.reason) from None
-            raise _study_error(where, given, exc.reason) from None
+        return _build_from_fields(cls, self.fields(), where, f"a {self.kind} fault", "kind, ")
+
+
+class _ClassTable(BaseModel):
+    """A table whose keys are the keyword arguments of :attr:`OF` (its dataclass fields,
+    declared there once), checked by :meth:`build`."""
+
+    model_config = ConfigDict(extra="allow", frozen=True, allow_inf_nan=False)
+
+    OF: ClassVar[type]
+    WHAT: ClassVar[str]
+
+    def build(self, where: tuple) -> Any:
+        """The object; errors name ``where`` + the field (``relief[0].length``)."""
+        return _build_from_fields(self.OF, dict(self.model_extra or {}), where, self.WHAT)
+
+
+class ReliefTable(_ClassTable):
+    """One ``[[relief]]`` table: a :class:`~geardyn.gears.TipRelief` (``amount``, ``length``,
+    ``shape`` "linear" or "parabolic", ``gear`` "pinion" or "wheel"; lengths in m or unit
+    strings), for the loaded contact under ``[stiffness]``'s ``torque`` or ``force``."""
+
+    OF: ClassVar[type] = TipRelief
+    WHAT: ClassVar[str] = "a tip relief"
+
+
+class CrowningTable(_ClassTable):
+    """A ``[crowning]`` table (or each of ``[[crowning]]``): a
+    :class:`~geardyn.gears.LeadCrowning` (``amount`` at each face end, ``gear``), on a helical
+    pair under ``[stiffness]``'s ``torque`` or ``force``."""
+
+    OF: ClassVar[type] = LeadCrowning
+    WHAT: ClassVar[str] = "a lead crowning"
+
+
+def _one_or_many(value: Any) -> Any:
+    """A single table as a list of one (``[crowning]`` and ``[[crowning]]`` alike)."""
+    return [value] if isinstance(value, dict) else value
 
 
 class StiffnessTable(BaseModel):
@@ -690,6 +792,12 @@ class StiffnessTable(BaseModel):
     nodes: Whole = Field(DEFAULT_NODES, ge=4, description="Gauss-Legendre nodes")
     root_segment: bool = Field(True, description="straight flank from the root to the base "
                                "circle in the cantilever")
+    slices: Whole | None = Field(None, ge=1, description="thin slices across the face width "
+                                 "(helical pairs; default 20)")
+    torque: Torque | None = Field(None, gt=0, description="pinion torque [N m] of the loaded "
+                                  "contact")
+    force: Force | None = Field(None, gt=0, description="normal force [N] along the "
+                                "(transverse) line of action of the loaded contact")
 
     @field_validator("cycles", mode="before")
     @classmethod
@@ -720,6 +828,18 @@ def _check_fault(mesh: GearMesh, kw: dict[str, Any], fault: object, where: tuple
         fields = () if fault is None else inspect.signature(type(fault)).parameters
         raise _study_error(where + ((name,) if name in fields else ()), exc.value,
                            exc.reason) from None
+
+
+def _check_helical_faults(faults: list) -> None:
+    """The faults a helical pair takes (a spall or Archard wear: an error at its table)."""
+    for i, fault in enumerate(faults):
+        try:
+            _helical_faults((fault,))
+        except ParameterError as exc:
+            name = exc.field.rpartition(".")[2]
+            raise _study_error(("faults", i, "kind" if name == "faults" else name),
+                               exc.value if name != "faults" else type(fault).__name__,
+                               exc.reason) from None
 
 
 def _fault_keywords(faults: list) -> dict[str, Any]:
@@ -801,7 +921,10 @@ class Study(BaseModel):
     (:class:`StiffnessTable`) describe a spur pair for the potential-energy mesh stiffness
     (``geardyn stiffness``); a study may hold them instead of ``params``. They are checked when
     the study is read: the gears, the faults on them and the settings are built once
-    (:meth:`stiffness_inputs`), and what they refuse is an error naming the field.
+    (:meth:`stiffness_inputs`), and what they refuse is an error naming the field. ``relief``
+    (:class:`ReliefTable` each) and ``crowning`` (:class:`CrowningTable` each) with a load
+    (``[stiffness]`` ``torque`` or ``force``) add the loaded contact
+    (:meth:`contact_inputs`).
     """
 
     model_config = _CONFIG
@@ -814,6 +937,8 @@ class Study(BaseModel):
     gears: GearsTable | None = None
     faults: list[FaultTable] | None = None
     stiffness: StiffnessTable | None = None
+    relief: Annotated[list[ReliefTable], BeforeValidator(_one_or_many)] | None = None
+    crowning: Annotated[list[CrowningTable], BeforeValidator(_one_or_many)] | None = None
 
     _planetary: PlanetaryParams | None = PrivateAttr(None)
 
@@ -952,14 +1077,35 @@ class Study(BaseModel):
                     raise _study_error((name,), None, f"required by a spur_pair study ({what})",
                                        "missing")
         if self.gears is None:
-            for name in ("faults", "stiffness"):
+            for name in ("faults", "stiffness", "relief", "crowning"):
                 if getattr(self, name) is not None:
                     raise _study_error((name,), None, "needs a [gears] table (the pair whose"
                                        " mesh stiffness it is for)")
             if self.params is None:
                 raise _study_error(("params",), None, "required (or a [gears] table)", "missing")
             return
-        self.stiffness_inputs()
+        if self.study.model == "spur_pair":
+            self._check_spur_pair_gears()
+        mesh, _ = self.stiffness_inputs()
+        self.contact_inputs(mesh)
+
+    def _check_spur_pair_gears(self) -> None:
+        """A ``spur_pair`` model is an external spur pair on its unloaded mesh stiffness: the
+        fields of a helical or internal pair and of the loaded contact are refused, naming the
+        field (they are ``geardyn stiffness``'s)."""
+        gears, table = self.gears, self.stiffness
+        given = [(("gears", "helix_angle"), gears.helix_angle),  # type: ignore[union-attr]
+                 (("gears", "internal"), gears.internal or None),  # type: ignore[union-attr]
+                 (("gears", "ring_foundation"), gears.ring_foundation),  # type: ignore[union-attr]
+                 (("relief",), self.relief), (("crowning",), self.crowning)]
+        if table is not None:
+            given += [(("stiffness", name), getattr(table, name))
+                      for name in ("slices", "torque", "force")]
+        for loc, value in given:
+            if value is not None:
+                raise _study_error(loc, value, "not part of a spur_pair model (an external spur"
+                                   " pair on its unloaded mesh stiffness; geardyn stiffness"
+                                   " takes it)")
 
     def stiffness_inputs(self, faults: bool = True) -> tuple[GearMesh, dict[str, Any]]:
         """The ``[gears]`` pair and the keywords of
@@ -979,18 +1125,66 @@ class Study(BaseModel):
                 "bore_radius": self.gears.bores(), "young": self.gears.young,
                 "poisson": self.gears.poisson, "root_segment": settings.root_segment,
                 "nodes": settings.nodes}
-            prepare_pair(mesh, **kw)
+            if self.gears.internal:
+                kw["ring_foundation"] = self.gears.ring_foundation or "rigid"
+            spur = mesh.transverse if isinstance(mesh, HelicalMesh) else mesh
+            prepare_pair(spur, **kw)
         except ParameterError as exc:
             missing = exc.value is None and exc.reason.startswith("required")
             raise _study_error(self._location(exc.field), exc.value, exc.reason,
                                "missing" if missing else "value_error") from None
+        if isinstance(mesh, HelicalMesh):
+            _check_helical_faults(built)
+        elif settings.slices is not None:
+            raise _study_error(("stiffness", "slices"), settings.slices, "slices the face width"
+                               " of a helical pair: give gears.helix_angle (0 deg for spur"
+                               " teeth by slices)")
         for i, fault in enumerate(built):
-            _check_fault(mesh, kw, fault, ("faults", i))
+            _check_fault(spur, kw, fault, ("faults", i))
         if built:
             kw.update(_fault_keywords(built))
-            _check_fault(mesh, kw, None, ("faults",))
-        kw.update(angles=settings.angles, cycles=settings.mesh_cycles(mesh))
+            _check_fault(spur, kw, None, ("faults",))
+        kw.update(angles=settings.angles, cycles=settings.mesh_cycles(spur))
+        if isinstance(mesh, HelicalMesh) and settings.slices is not None:
+            kw["slices"] = settings.slices
         return mesh, kw
+
+    def contact_inputs(self, mesh: GearMesh | HelicalMesh | None = None
+                       ) -> dict[str, Any] | None:
+        """The loaded contact of the ``[gears]`` pair (``mesh``, else built), or None without
+        a load: ``force`` [N] (``[stiffness].force``, or ``torque`` / r_b1 with r_b1 the
+        pinion's (transverse) base radius), ``relief`` and ``crowning`` (tuples of
+        :class:`~geardyn.gears.TipRelief`, :class:`~geardyn.gears.LeadCrowning`) and
+        ``torque`` [N m] (None where the force is given). A relief or crowning without a
+        load, a crowning on a spur pair, both torque and force are errors naming the field."""
+        if mesh is None:
+            mesh = self.stiffness_inputs(faults=False)[0]
+        settings = self.stiffness or StiffnessTable()
+        relief = tuple(r.build(("relief", i)) for i, r in enumerate(self.relief or []))
+        crowning = tuple(c.build(("crowning", i)) for i, c in enumerate(self.crowning or []))
+        spur = mesh.transverse if isinstance(mesh, HelicalMesh) else mesh
+        for i, r in enumerate(relief):
+            try:
+                relief_gap(spur, [0.0], (r,))
+            except ParameterError as exc:
+                raise _study_error(("relief", i, exc.field.rpartition(".")[2]), exc.value,
+                                   exc.reason) from None
+        if crowning and not isinstance(mesh, HelicalMesh):
+            raise _study_error(("crowning",), None, "lead crowning needs the slices of a"
+                               " helical pair: give gears.helix_angle (0 deg for spur teeth)")
+        if settings.torque is not None and settings.force is not None:
+            raise _study_error(("stiffness", "force"), settings.force,
+                               "give the load as torque or as force, not both")
+        if settings.torque is None and settings.force is None:
+            for name, given in (("crowning", crowning), ("relief", relief)):
+                if given:
+                    raise _study_error((name,), None, "needs a load for the loaded contact:"
+                                       " [stiffness] torque (N m on the pinion) or force (N)")
+            return None
+        force = (settings.force if settings.torque is None
+                 else settings.torque / spur.pinion.base_radius)
+        return {"force": force, "relief": relief, "crowning": crowning,
+                "torque": settings.torque}
 
     def _location(self, field: str) -> tuple:
         """Where in the study a :class:`ParameterError` of the gears' ``field`` lies."""
@@ -1051,7 +1245,8 @@ def _read_toml(source: str | os.PathLike[str]) -> tuple[dict[str, Any], str]:
         raise StudyError(f"{label}: invalid TOML: {exc}") from None
 
 
-_STUDY_KEYS = {"study", "params", "run", "sweep", "gears", "faults", "stiffness"}
+_STUDY_KEYS = {"study", "params", "run", "sweep", "gears", "faults", "stiffness", "relief",
+               "crowning"}
 
 
 def load_params(path_or_text: str | os.PathLike[str]) -> PlanetaryParams:
