@@ -47,6 +47,12 @@ from geardyn.models.planetary_coefficients import (
     structure_entry,
     workspace_entry,
 )
+from geardyn.models.planetary_stiffness import (
+    flank_series,
+    potential_energy_options,
+    potential_energy_tables,
+    stiffness_method,
+)
 from geardyn.models.stiffness import fourier_coefficients
 from geardyn.units import si_value
 
@@ -146,7 +152,7 @@ _FROM_GEOMETRY = ("n_planets", "planet_angles", "sun_pressure_angle", "ring_pres
 
 
 #: Attributes :meth:`PlanetaryGearSet.from_geometry` attaches, kept by ``with_params``.
-_FROM_BUILD = ("geometry", "stiffness_waveforms", "held")
+_FROM_BUILD = ("geometry", "stiffness_waveforms", "stiffness_tables", "stiffness_method", "held")
 #: The sweep parameter of a set built from geometry: the input member's speed [rpm].
 INPUT_SPEED = "input_speed"
 #: Units of the swept inputs, by kind (dataset axis attributes; see ``param_attrs``).
@@ -338,6 +344,14 @@ class PlanetaryGearSet(Model):
     geometry: Any = None
     #: The member a set built by :meth:`from_geometry` holds fixed (None otherwise).
     held: str | None = None
+    #: How a set built by :meth:`from_geometry` got its mesh stiffness (``"iso"``,
+    #: ``"potential_energy"``; None otherwise).
+    stiffness_method: str | None = None
+    #: The ISO 6336-1 waves (sun, ring) of a set built from geometry with ``stiffness="iso"``.
+    stiffness_waveforms: Any = None
+    #: The potential-energy Datasets (sun, ring) of a set built with
+    #: ``stiffness="potential_energy"`` (None otherwise).
+    stiffness_tables: Any = None
 
     def __init__(self, n_planets: int = 3, sun_pressure_angle: Any = "24.6 deg",
                  ring_pressure_angle: Any = "24.6 deg", *, sun: Member, ring: Member,
@@ -510,7 +524,9 @@ class PlanetaryGearSet(Model):
     def from_geometry(cls, geometry: Any, *, sun: Member, ring: Member, carrier: Member,
                       planet: Member, harmonics: int = 9,
                       waveform_options: Mapping[str, Any] | None = None,
-                      held: str | None = None, **kw: Any) -> PlanetaryGearSet:
+                      held: str | None = None, stiffness: str = "iso",
+                      stiffness_options: Mapping[str, Any] | None = None,
+                      **kw: Any) -> PlanetaryGearSet:
         """The gear set of a :class:`geardyn.gears.PlanetaryGeometry` (see ``docs/planetary.md``,
         "From gear geometry").
 
@@ -531,6 +547,16 @@ class PlanetaryGearSet(Model):
         ``held`` (:func:`_kinematic_ratio`), so the carrier speed follows the input speed.
         ``held``: the member held still in the kinematics of :attr:`input_speed` (``"ring"``,
         ``"carrier"`` or ``"sun"``; default the one member in ``fixed``, else the ring).
+
+        ``stiffness="potential_energy"``: the mean mesh stiffnesses and their relative Fourier
+        coefficients come instead from :func:`geardyn.gears.potential_energy_stiffness` of
+        ``geometry.sun_mesh`` and ``geometry.ring_mesh`` over one mesh cycle (the discrete
+        Fourier series of the tables, :mod:`geardyn.models.planetary_stiffness`), the phases as
+        above. ``stiffness_options``: ``sun_bore_radius``, ``planet_bore_radius``,
+        ``ring_rim_radius`` [m] (needed), ``young`` [Pa], ``poisson``, ``angles`` (points per
+        mesh cycle, default 360, > 2 ``harmonics``), ``nodes``, ``root_segment``. The tables
+        are kept as :attr:`stiffness_tables` (sun, ring), the method as
+        :attr:`stiffness_method`.
         """
         from geardyn.gears import PlanetaryGeometry
 
@@ -541,7 +567,12 @@ class PlanetaryGearSet(Model):
             if f in kw:
                 raise ParameterError(f, kw[f], "comes from the geometry; change the gears "
                                      "(or build PlanetaryGearSet directly)")
-        w_sun, w_ring = geometry.waveforms(**dict(waveform_options or {}))
+        method = stiffness_method(stiffness, stiffness_options)
+        if isinstance(harmonics, bool) or not isinstance(harmonics, int) \
+                or not 1 <= harmonics <= 200:
+            raise ParameterError("harmonics", harmonics, "must be an integer from 1 to 200")
+        series, tables, waves = _geometry_stiffness(geometry, method, stiffness_options,
+                                                    waveform_options, harmonics)
         held_member = _held(held, tuple(kw.get("fixed", ())))
         phases = geometry.phases_turning(_sun_turns(held_member))
         meshes = {"sun": geometry.sun_mesh, "ring": geometry.ring_mesh}
@@ -563,23 +594,29 @@ class PlanetaryGearSet(Model):
         for g, mesh in meshes.items():
             kw.setdefault(f"{g}_backlash",
                           0.5 * max(mesh.backlash, 0.0) * math.cos(mesh.operating_pressure_angle))
-        if isinstance(harmonics, bool) or not isinstance(harmonics, int) \
-                or not 1 <= harmonics <= 200:
-            raise ParameterError("harmonics", harmonics, "must be an integer from 1 to 200")
         model = cls(
             n_planets=geometry.n_planets, planet_angles=list(geometry.planet_angles),
             sun_pressure_angle=meshes["sun"].operating_pressure_angle,
             ring_pressure_angle=meshes["ring"].operating_pressure_angle,
-            sun_mesh_stiffness=w_sun.mean, ring_mesh_stiffness=w_ring.mean,
-            waveform={"sun": w_sun.fourier(harmonics), "ring": w_ring.fourier(harmonics)},
+            sun_mesh_stiffness=series["sun"][0], ring_mesh_stiffness=series["ring"][0],
+            waveform={"sun": series["sun"][1], "ring": series["ring"][1]},
             harmonics=harmonics,
             sun_mesh_phase=[-2.0 * math.pi * float(g) for g in phases.sun],
             ring_mesh_phase=[-2.0 * math.pi * float(g) for g in phases.ring],
             **members, **kw)
         model.geometry = geometry
-        model.stiffness_waveforms = (w_sun, w_ring)
+        model.stiffness_waveforms = waves
+        model.stiffness_tables = tables
+        model.stiffness_method = method
         model.held = _held(held, model.fixed)
         return model
+
+    def dataset_attrs(self) -> dict[str, object]:
+        """A set built from geometry records its mesh stiffness method (``"iso"``: ISO 6336-1
+        waves; ``"potential_energy"``: the potential-energy tables)."""
+        if self.geometry is None:
+            return {}
+        return {"mesh_stiffness_method": self.stiffness_method}
 
     # ------------------------------------------------------------------ input speed
     @property
@@ -1191,6 +1228,27 @@ class PlanetaryGearSet(Model):
         form = "rotational-only" if self.rotational_only else "rotational-translational"
         return (f"PlanetaryGearSet(N={self.n_planets}, {form}, dofs={len(self.dof_names())}, "
                 f"Omega={self.omega:g})")
+
+
+def _geometry_stiffness(geometry: Any, method: str, options: Mapping[str, Any] | None,
+                        waveform_options: Mapping[str, Any] | None, harmonics: int
+                        ) -> tuple[dict[str, tuple[float, Any]], Any, Any]:
+    """Per mesh group (sun, ring): the mean stiffness [N/m] and the relative Fourier pair (a, b)
+    of the drive flank; the potential-energy tables (or None) and the ISO waves (or None)."""
+    if method == "iso":
+        w_sun, w_ring = geometry.waveforms(**dict(waveform_options or {}))
+        return ({"sun": (w_sun.mean, w_sun.fourier(harmonics)),
+                 "ring": (w_ring.mean, w_ring.fourier(harmonics))}, None, (w_sun, w_ring))
+    if waveform_options:
+        raise ParameterError("waveform_options", dict(waveform_options),
+                             "only with stiffness='iso' (the ISO waves)")
+    opts = potential_energy_options(options, geometry, harmonics)
+    tables = potential_energy_tables(geometry, opts)
+    out = {}
+    for g, table in zip(("sun", "ring"), tables, strict=True):
+        drive = flank_series(table["mesh_stiffness"].values, harmonics)
+        out[g] = (drive.mean, drive.pair)
+    return out, tables, None
 
 
 def _held(held: str | None, fixed: tuple[str, ...]) -> str:
