@@ -542,17 +542,21 @@ def planetary_rhs_lanes(T, Y, DY, PT, nl, S, C, SC):
             for k in range(nl):
                 DY[i, k] -= (PT[g, k] * PT[r, k]) * Y[j, k]
     kr = _lanes_cached_stiffness(PT, nl, S, C, SC, mz + nm * 3 * MESH_NZ, mesh, bs, nh, nm, two)
+    if two:
+        for m in range(nm):
+            _lanes_mesh_two(Y, DY, PT, nl, S, C, SC, n, mesh + m * bs, mz + m * 3 * MESH_NZ,
+                            kr + m, True, kr + nm + m)
+        return
     for m in range(nm):
         _lanes_mesh(Y, DY, PT, nl, S, C, SC, n, mesh + m * bs, mz + m * 3 * MESH_NZ, kr + m,
-                    True, kr + nm + m, two)
+                    True)
 
 
 @nb.njit(inline="always", **_JIT)
-def _lanes_mesh(Y, DY, PT, nl, S, C, SC, n, o, q, row, apply, rowc, two):
-    """Mesh force of the block at o (structure at q, relative stiffness in PT[row], the coast
-    flank's in PT[rowc], read with ``two``) for every lane, into SC[0], then subtracted from the
-    accelerations DY (``apply``) or copied to DY[0] (observables). One store stream per lane
-    loop, so that the loops vectorise."""
+def _lanes_mesh(Y, DY, PT, nl, S, C, SC, n, o, q, row, apply):
+    """Mesh force of the block at o (structure at q, relative stiffness in PT[row]) for every
+    lane, into SC[0], then subtracted from the accelerations DY (``apply``) or copied to DY[0]
+    (observables). One store stream per lane loop, so that the loops vectorise."""
     i0 = int(PT[q, 0])
     i1 = int(PT[q + 1, 0])
     i2 = int(PT[q + 2, 0])
@@ -560,28 +564,32 @@ def _lanes_mesh(Y, DY, PT, nl, S, C, SC, n, o, q, row, apply, rowc, two):
     i4 = int(PT[q + 4, 0])
     i5 = int(PT[q + 5, 0])
     w = q + MESH_NZ
-    if two:
-        _lanes_mesh_two(Y, PT, nl, S, C, SC, n, o, q, row, rowc)
-    else:
-        for k in range(nl):
-            d = 0.0
-            v = 0.0
-            d += PT[w, k] * Y[i0, k]
-            v += PT[w, k] * Y[n + i0, k]
-            d += PT[w + 1, k] * Y[i1, k]
-            v += PT[w + 1, k] * Y[n + i1, k]
-            d += PT[w + 2, k] * Y[i2, k]
-            v += PT[w + 2, k] * Y[n + i2, k]
-            d += PT[w + 3, k] * Y[i3, k]
-            v += PT[w + 3, k] * Y[n + i3, k]
-            d += PT[w + 4, k] * Y[i4, k]
-            v += PT[w + 4, k] * Y[n + i4, k]
-            d += PT[w + 5, k] * Y[i5, k]
-            v += PT[w + 5, k] * Y[n + i5, k]
-            d -= PT[o + M_ES, k] * S[k] + PT[o + M_EC, k] * C[k]
-            v -= PT[OMEGA, k] * (PT[o + M_ES, k] * C[k] - PT[o + M_EC, k] * S[k])
-            SC[0, k] = (PT[o + M_KF, k] * PT[row, k] * _dead_zone(d, PT[o + M_B, k])
-                        + PT[o + M_CF, k] * v)
+    for k in range(nl):
+        d = 0.0
+        v = 0.0
+        d += PT[w, k] * Y[i0, k]
+        v += PT[w, k] * Y[n + i0, k]
+        d += PT[w + 1, k] * Y[i1, k]
+        v += PT[w + 1, k] * Y[n + i1, k]
+        d += PT[w + 2, k] * Y[i2, k]
+        v += PT[w + 2, k] * Y[n + i2, k]
+        d += PT[w + 3, k] * Y[i3, k]
+        v += PT[w + 3, k] * Y[n + i3, k]
+        d += PT[w + 4, k] * Y[i4, k]
+        v += PT[w + 4, k] * Y[n + i4, k]
+        d += PT[w + 5, k] * Y[i5, k]
+        v += PT[w + 5, k] * Y[n + i5, k]
+        d -= PT[o + M_ES, k] * S[k] + PT[o + M_EC, k] * C[k]
+        v -= PT[OMEGA, k] * (PT[o + M_ES, k] * C[k] - PT[o + M_EC, k] * S[k])
+        SC[0, k] = (PT[o + M_KF, k] * PT[row, k] * _dead_zone(d, PT[o + M_B, k])
+                    + PT[o + M_CF, k] * v)
+    _lanes_apply(DY, PT, nl, SC, n, q, apply)
+
+
+@nb.njit(inline="always", **_JIT)
+def _lanes_apply(DY, PT, nl, SC, n, q, apply):
+    """The mesh force in SC[0] subtracted from the accelerations DY through the mesh's G
+    (structure at q; ``apply``) or copied to DY[0] (observables)."""
     if not apply:
         for k in range(nl):
             DY[0, k] = SC[0, k]
@@ -594,10 +602,10 @@ def _lanes_mesh(Y, DY, PT, nl, S, C, SC, n, o, q, row, apply, rowc, two):
 
 
 @nb.njit(inline="always", **_JIT)
-def _lanes_mesh_two(Y, PT, nl, S, C, SC, n, o, q, row, rowc):
-    """The mesh force of :func:`_lanes_mesh` into SC[0] with two flanks: the coast flank's
-    KF_coast c_m(theta) where the dead zone's output is negative (the drive flank's arithmetic
-    otherwise, operation for operation)."""
+def _lanes_mesh_two(Y, DY, PT, nl, S, C, SC, n, o, q, row, apply, rowc):
+    """:func:`_lanes_mesh` with two flanks: the coast flank's KF_coast c_m(theta) (relative
+    stiffness in PT[rowc]) where the dead zone's output is negative, the drive flank's
+    arithmetic otherwise, operation for operation."""
     i0 = int(PT[q, 0])
     i1 = int(PT[q + 1, 0])
     i2 = int(PT[q + 2, 0])
@@ -627,6 +635,7 @@ def _lanes_mesh_two(Y, PT, nl, S, C, SC, n, o, q, row, rowc):
         if g < 0.0:
             kf = PT[o + M_KFC, k] * PT[rowc, k]
         SC[0, k] = kf * g + PT[o + M_CF, k] * v
+    _lanes_apply(DY, PT, nl, SC, n, q, apply)
 
 
 @nb.njit(**_JIT)
@@ -667,5 +676,9 @@ def planetary_observe_lanes(T, Y, O, PT, nl, S, C, SC):
         two |= PT[TWO_FLANK, k] != 0.0
     kr = _lanes_cached_stiffness(PT, nl, S, C, SC, mz + nm * 3 * MESH_NZ, mesh, bs, nh, nm, two)
     for m in range(nm):
-        _lanes_mesh(Y, O[m:m + 1], PT, nl, S, C, SC, n, mesh + m * bs, mz + m * 3 * MESH_NZ,
-                    kr + m, False, kr + nm + m, two)
+        if two:
+            _lanes_mesh_two(Y, O[m:m + 1], PT, nl, S, C, SC, n, mesh + m * bs,
+                            mz + m * 3 * MESH_NZ, kr + m, False, kr + nm + m)
+        else:
+            _lanes_mesh(Y, O[m:m + 1], PT, nl, S, C, SC, n, mesh + m * bs,
+                        mz + m * 3 * MESH_NZ, kr + m, False)
