@@ -111,6 +111,10 @@ def test_kernel_stiffness_is_the_tables_fourier_series(geo, pe_tables):
     assert gs.dataset_attrs() == {"mesh_stiffness_method": "potential_energy"}
     assert gs.k_s == pytest.approx(k[0].mean(), rel=1e-12)
     assert gs.k_r == pytest.approx(k[4].mean(), rel=1e-12)
+    changed = gs.with_params(sun_backlash="5 um")  # rebuilt from the inputs, tables kept
+    assert changed.stiffness_tables is gs.stiffness_tables
+    assert changed.stiffness_method == "potential_energy"
+    np.testing.assert_array_equal(kernel_stiffness(changed, thetas), kernel_stiffness(gs, thetas))
 
 
 def _jump_distance(table, var: str) -> np.ndarray:
@@ -387,3 +391,21 @@ def test_raw_overrides_and_the_flag():
     assert two.params[pk.TWO_FLANK] == 1.0
     same = two.with_params(sun_coast_stiffness=5e8, ring_coast_stiffness=6e8)
     assert same.params[pk.TWO_FLANK] == 0.0  # given, but equal to the drive flank
+
+
+@pytest.mark.parametrize(("kw", "field"), [
+    ({"coast_waveform": "sine"}, "coast_waveform"),
+    ({"coast_waveform": ([1.5], [0.0])}, "coast_waveform"),  # 1 + 1.5 cos < 0 somewhere
+    ({"sun_coast_stiffness": -1.0}, "sun_coast_stiffness"),
+    ({"ring_coast_stiffness": "5 m"}, "ring_coast_stiffness"),
+])
+def test_bad_coast_inputs_name_the_field(kw, field):
+    with pytest.raises(ParameterError) as err:
+        _loaded_set(1.0).with_params(**kw)
+    assert err.value.field == field
+
+
+def test_from_geometry_refuses_coast_inputs(geo):
+    with pytest.raises(ParameterError) as err:
+        pe_set(geo, sun_coast_stiffness=1e8)
+    assert err.value.field == "sun_coast_stiffness"
