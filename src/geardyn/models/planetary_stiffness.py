@@ -11,7 +11,6 @@ k0 and the relative coefficients (a_h, b_h) the model's ``waveform`` takes.
 
 from __future__ import annotations
 
-import math
 import numbers
 from collections.abc import Mapping
 from dataclasses import dataclass
@@ -156,7 +155,3 @@ def flank_series(table: np.ndarray, harmonics: int) -> FlankSeries:
     b = -2.0 * F[1:harmonics + 1].imag / k0
     return FlankSeries(k0, a, b)
 
-
-def table_phase(table: Any) -> np.ndarray:
-    """The mesh phase theta [rad] of every angle of a potential-energy table."""
-    return 2.0 * math.pi * np.asarray(table["cycle"].values, dtype=float)
