@@ -43,9 +43,16 @@ from geardyn.models.planetary_coefficients import (
     MATRICES,
     MESH,
     MESH_ROW,
+    coast_harmonics_block,
     harmonics_block,
     structure_entry,
     workspace_entry,
+)
+from geardyn.models.planetary_stiffness import (
+    flank_series,
+    potential_energy_options,
+    potential_energy_tables,
+    stiffness_method,
 )
 from geardyn.models.stiffness import fourier_coefficients
 from geardyn.units import si_value
@@ -69,12 +76,13 @@ def planetary_layout(dofs: tuple[str, ...], mesh_names: tuple[str, ...], nh: int
         for a in dofs:
             for b in dofs:
                 out.extend((c,), f"_{a}_{b}")
-    harmonics = harmonics_block(nh)
+    harmonics, coast = harmonics_block(nh), coast_harmonics_block(nh)
     for m in mesh_names:
         out.extend(MESH.entries + harmonics.entries, prefix=f"{m}_")
         for c in MESH_ROW.entries:
             for d in dofs:
                 out.extend((c,), f"_{d}", prefix=f"{m}_")
+        out.extend(coast.entries, prefix=f"{m}_")
     index = structure_entry("structure", "sparse index or count of the kernel's structure")
     copy_ = workspace_entry("structure copy", "the kernel's copy of a structural value "
                             "(written from the dense entries)")
@@ -92,7 +100,7 @@ def planetary_layout(dofs: tuple[str, ...], mesh_names: tuple[str, ...], nh: int
 CENTRAL = ("carrier", "ring", "sun")
 _SHORT = {"carrier": "c", "ring": "r", "sun": "s"}
 #: Constructor inputs that fix the model's layout or are not numbers: not swept by name.
-_NOT_SWEPT = {"n_planets", "waveform", "harmonics", "rotational_only", "fixed",
+_NOT_SWEPT = {"n_planets", "waveform", "coast_waveform", "harmonics", "rotational_only", "fixed",
               "centrifugal_preload", "planet_angles", "sun", "ring", "carrier", "planet",
               "time_scale", "length_scale"}
 #: Relative tolerance within which two natural frequencies count as one repeated frequency.
@@ -143,17 +151,21 @@ _FROM_GEOMETRY = ("n_planets", "planet_angles", "sun_pressure_angle", "ring_pres
                   "sun_mesh_stiffness", "ring_mesh_stiffness", "waveform", "contact_ratio",
                   "sun_stiffness_fluctuation", "ring_stiffness_fluctuation", "sun_mesh_phase",
                   "ring_mesh_phase")
+#: The coast-flank inputs :meth:`PlanetaryGearSet.from_geometry` sets (from the
+#: potential-energy tables; with the ISO waves none: one stiffness on both flanks).
+_COAST_FROM_GEOMETRY = ("sun_coast_stiffness", "ring_coast_stiffness", "coast_waveform")
 
 
 #: Attributes :meth:`PlanetaryGearSet.from_geometry` attaches, kept by ``with_params``.
-_FROM_BUILD = ("geometry", "stiffness_waveforms", "held")
+_FROM_BUILD = ("geometry", "stiffness_waveforms", "stiffness_tables", "stiffness_method", "held")
 #: The sweep parameter of a set built from geometry: the input member's speed [rpm].
 INPUT_SPEED = "input_speed"
 #: Units of the swept inputs, by kind (dataset axis attributes; see ``param_attrs``).
 _UNITS = {"mesh_frequency": "rad/s", INPUT_SPEED: "rpm", "carrier_speed": "rad/s",
           "carrier_speed_ratio": "1", "torque_phase": "rad",
           "sun_pressure_angle": "rad", "ring_pressure_angle": "rad"}
-_UNIT_SUFFIXES = (("_torque", "N m"), ("_mesh_stiffness", "N/m"), ("_backlash", "m"),
+_UNIT_SUFFIXES = (("_torque", "N m"), ("_mesh_stiffness", "N/m"), ("_coast_stiffness", "N/m"),
+                  ("_backlash", "m"),
                   ("_mesh_error", "m"), ("_phase", "rad"))
 
 
@@ -236,6 +248,19 @@ def _waveforms(field: str, waveform: Any, rel: np.ndarray, phase: np.ndarray,
     return np.vstack([np.pad(p, ((0, 0), (0, width - p.shape[1]))) for p in parts])
 
 
+def _flank_index(lay: dict[str, int], n: int, nm: int, nh: int, coast: bool) -> np.ndarray:
+    """Indices into the coefficient vector of every mesh's flank entries: KF and the 2 nh
+    harmonics of the drive flank, or KF_coast and the coast harmonics (``coast``), mesh by
+    mesh in the same order."""
+    first = pk.MESH_FIXED + 2 * nh + 2 * n if coast else pk.MESH_FIXED
+    out = []
+    for m in range(nm):
+        o = lay["mesh"] + m * lay["block"]
+        out += [o + (pk.M_KFC if coast else pk.M_KF)] + list(range(o + first,
+                                                                    o + first + 2 * nh))
+    return np.array(out, dtype=np.intp)
+
+
 def _clean(A: np.ndarray, rel: float = 1e-12) -> np.ndarray:
     """``A`` with entries below ``rel`` times its largest magnitude set to 0: the rounding
     residue of trigonometric sums (cos(pi/2) = 6e-17), which would couple coordinates that
@@ -281,6 +306,12 @@ class PlanetaryGearSet(Model):
         the fluctuations are ignored), or a mapping {"sun": (a, b), "ring": (a, b)} of one
         pair per mesh group (:meth:`from_geometry`). Mesh m's stiffness is
         k_m (1 + w(Omega tau + phase_m)).
+    sun_coast_stiffness, ring_coast_stiffness, coast_waveform
+        The coast (back) flank, acting where a mesh's deflection leaves the dead zone on the other
+        side (x < -b): its mean stiffness [N/m] (None: the drive flank's) and relative Fourier
+        coefficients, a pair (a, b) or a mapping {"sun": (a, b), "ring": (a, b)} as ``waveform``
+        (None: the drive flank's), shifted by the same mesh phases. All None (default): one
+        stiffness on both flanks.
     sun_mesh_phase, ring_mesh_phase
         Mesh phases [rad of the mesh cycle], scalar or one per planet (e.g. Parker & Lin 2004).
     sun_backlash, ring_backlash
@@ -338,6 +369,14 @@ class PlanetaryGearSet(Model):
     geometry: Any = None
     #: The member a set built by :meth:`from_geometry` holds fixed (None otherwise).
     held: str | None = None
+    #: How a set built by :meth:`from_geometry` got its mesh stiffness (``"iso"``,
+    #: ``"potential_energy"``; None otherwise).
+    stiffness_method: str | None = None
+    #: The ISO 6336-1 waves (sun, ring) of a set built from geometry with ``stiffness="iso"``.
+    stiffness_waveforms: Any = None
+    #: The potential-energy Datasets (sun, ring) of a set built with
+    #: ``stiffness="potential_energy"`` (None otherwise).
+    stiffness_tables: Any = None
 
     def __init__(self, n_planets: int = 3, sun_pressure_angle: Any = "24.6 deg",
                  ring_pressure_angle: Any = "24.6 deg", *, sun: Member, ring: Member,
@@ -345,6 +384,8 @@ class PlanetaryGearSet(Model):
                  ring_mesh_stiffness: Any, planet_angles: Sequence[Any] | None = None,
                  sun_stiffness_fluctuation: Any = 0.0, ring_stiffness_fluctuation: Any = 0.0,
                  waveform: Any = "sine", contact_ratio: float = 1.6, harmonics: int = 9,
+                 sun_coast_stiffness: Any = None, ring_coast_stiffness: Any = None,
+                 coast_waveform: Any = None,
                  sun_mesh_phase: Any = 0.0, ring_mesh_phase: Any = 0.0,
                  sun_backlash: Any = 0.0, ring_backlash: Any = 0.0,
                  sun_mesh_error: Any = 0.0, ring_mesh_error: Any = 0.0,
@@ -414,6 +455,8 @@ class PlanetaryGearSet(Model):
             raise ParameterError("sun_stiffness_fluctuation", sun_stiffness_fluctuation,
                                  "the stiffness fluctuation makes a mesh stiffness negative; "
                                  "it must stay > 0")
+        self._coast_inputs(sun_coast_stiffness, ring_coast_stiffness, coast_waveform,
+                           float(contact_ratio), harmonics)
         self.backlash = both("backlash")
         self.error = both("mesh_error")
         self.error_phase = both("error_phase") + self.mesh_phase
@@ -434,6 +477,38 @@ class PlanetaryGearSet(Model):
         mf = self.time_scale if mesh_frequency is None else _si("mesh_frequency",
                                                                 mesh_frequency, "frequency")
         self._build(mf / self.time_scale)
+
+    def _coast_inputs(self, sun_k: Any, ring_k: Any, waveform: Any, contact_ratio: float,
+                      harmonics: int) -> None:
+        """The coast flank's mean stiffnesses ``k_s_coast``, ``k_r_coast`` [N/m] and relative
+        Fourier coefficients ``fourier_coast`` (meshes, 2 nh; ``fourier`` padded with zeros to
+        the same width where the two differ), see the class doc."""
+        self.k_s_coast = self.k_s if sun_k is None else _si("sun_coast_stiffness", sun_k,
+                                                            "stiffness", strict=True)
+        self.k_r_coast = self.k_r if ring_k is None else _si("ring_coast_stiffness", ring_k,
+                                                             "stiffness", strict=True)
+        if waveform is None:
+            self.fourier_coast = self.fourier
+            return
+        if isinstance(waveform, str):
+            raise ParameterError("coast_waveform", waveform, "must be a pair (a, b) of relative "
+                                 "Fourier coefficients or a mapping {'sun': (a, b), 'ring': "
+                                 "(a, b)} (None: the drive flank's)")
+        zero = np.zeros(self.mesh_phase.size)
+        coast = _waveforms("coast_waveform", waveform, zero, self.mesh_phase, contact_ratio,
+                           harmonics)
+        if _minimum_relative_stiffness(coast) <= 0.0:
+            raise ParameterError("coast_waveform", "(coefficients)", "makes a coast-flank "
+                                 "stiffness negative; it must stay > 0")
+        width = max(coast.shape[1], self.fourier.shape[1])
+        self.fourier = np.pad(self.fourier, ((0, 0), (0, width - self.fourier.shape[1])))
+        self.fourier_coast = np.pad(coast, ((0, 0), (0, width - coast.shape[1])))
+
+    def coast_stiffnesses(self) -> np.ndarray:
+        """Mean coast-flank stiffness [N/m] of every mesh (sun-planet meshes, then
+        ring-planet)."""
+        n = self.n_planets
+        return np.concatenate([np.full(n, self.k_s_coast), np.full(n, self.k_r_coast)])
 
     def _carrier_inputs(self, speed: Any, ratio: Any, preload: Any) -> None:
         """Validate the rotating carrier's inputs (see the class doc)."""
@@ -510,7 +585,9 @@ class PlanetaryGearSet(Model):
     def from_geometry(cls, geometry: Any, *, sun: Member, ring: Member, carrier: Member,
                       planet: Member, harmonics: int = 9,
                       waveform_options: Mapping[str, Any] | None = None,
-                      held: str | None = None, **kw: Any) -> PlanetaryGearSet:
+                      held: str | None = None, stiffness: str = "iso",
+                      stiffness_options: Mapping[str, Any] | None = None,
+                      **kw: Any) -> PlanetaryGearSet:
         """The gear set of a :class:`geardyn.gears.PlanetaryGeometry` (see ``docs/planetary.md``,
         "From gear geometry").
 
@@ -531,17 +608,35 @@ class PlanetaryGearSet(Model):
         ``held`` (:func:`_kinematic_ratio`), so the carrier speed follows the input speed.
         ``held``: the member held still in the kinematics of :attr:`input_speed` (``"ring"``,
         ``"carrier"`` or ``"sun"``; default the one member in ``fixed``, else the ring).
+
+        ``stiffness="potential_energy"``: the mean mesh stiffnesses and their relative Fourier
+        coefficients come instead from :func:`geardyn.gears.potential_energy_stiffness` of
+        ``geometry.sun_mesh`` and ``geometry.ring_mesh`` over one mesh cycle (the discrete Fourier
+        series of the tables, :mod:`geardyn.models.planetary_stiffness`), the phases as above; and
+        so do the coast flank's (``sun_coast_stiffness``, ``ring_coast_stiffness``,
+        ``coast_waveform``: the tables' ``mesh_stiffness_coast`` at the same angles, so their phase,
+        ``coast_phase_cycles``, is in the coefficients), acting where a mesh's deflection leaves the
+        dead zone on the other side. ``stiffness_options``: ``sun_bore_radius``,
+        ``planet_bore_radius``, ``ring_rim_radius`` [m] (needed), ``young`` [Pa], ``poisson``,
+        ``angles`` (points per mesh cycle, default 360, > 2 ``harmonics``), ``nodes``,
+        ``root_segment``. The tables are kept as :attr:`stiffness_tables` (sun, ring), the method as
+        :attr:`stiffness_method`.
         """
         from geardyn.gears import PlanetaryGeometry
 
         if not isinstance(geometry, PlanetaryGeometry):
             raise ParameterError("geometry", type(geometry).__name__,
                                  "must be a geardyn.gears.PlanetaryGeometry")
-        for f in _FROM_GEOMETRY:
+        for f in _FROM_GEOMETRY + _COAST_FROM_GEOMETRY:
             if f in kw:
                 raise ParameterError(f, kw[f], "comes from the geometry; change the gears "
                                      "(or build PlanetaryGearSet directly)")
-        w_sun, w_ring = geometry.waveforms(**dict(waveform_options or {}))
+        method = stiffness_method(stiffness, stiffness_options)
+        if isinstance(harmonics, bool) or not isinstance(harmonics, int) \
+                or not 1 <= harmonics <= 200:
+            raise ParameterError("harmonics", harmonics, "must be an integer from 1 to 200")
+        inputs, tables, waves = _geometry_stiffness(geometry, method, stiffness_options,
+                                                    waveform_options, harmonics)
         held_member = _held(held, tuple(kw.get("fixed", ())))
         phases = geometry.phases_turning(_sun_turns(held_member))
         meshes = {"sun": geometry.sun_mesh, "ring": geometry.ring_mesh}
@@ -563,23 +658,27 @@ class PlanetaryGearSet(Model):
         for g, mesh in meshes.items():
             kw.setdefault(f"{g}_backlash",
                           0.5 * max(mesh.backlash, 0.0) * math.cos(mesh.operating_pressure_angle))
-        if isinstance(harmonics, bool) or not isinstance(harmonics, int) \
-                or not 1 <= harmonics <= 200:
-            raise ParameterError("harmonics", harmonics, "must be an integer from 1 to 200")
         model = cls(
             n_planets=geometry.n_planets, planet_angles=list(geometry.planet_angles),
             sun_pressure_angle=meshes["sun"].operating_pressure_angle,
             ring_pressure_angle=meshes["ring"].operating_pressure_angle,
-            sun_mesh_stiffness=w_sun.mean, ring_mesh_stiffness=w_ring.mean,
-            waveform={"sun": w_sun.fourier(harmonics), "ring": w_ring.fourier(harmonics)},
-            harmonics=harmonics,
+            **inputs, harmonics=harmonics,
             sun_mesh_phase=[-2.0 * math.pi * float(g) for g in phases.sun],
             ring_mesh_phase=[-2.0 * math.pi * float(g) for g in phases.ring],
             **members, **kw)
         model.geometry = geometry
-        model.stiffness_waveforms = (w_sun, w_ring)
+        model.stiffness_waveforms = waves
+        model.stiffness_tables = tables
+        model.stiffness_method = method
         model.held = _held(held, model.fixed)
         return model
+
+    def dataset_attrs(self) -> dict[str, object]:
+        """A set built from geometry records its mesh stiffness method (``"iso"``: ISO 6336-1
+        waves; ``"potential_energy"``: the potential-energy tables)."""
+        if self.geometry is None:
+            return {}
+        return {"mesh_stiffness_method": self.stiffness_method}
 
     # ------------------------------------------------------------------ input speed
     @property
@@ -814,6 +913,7 @@ class PlanetaryGearSet(Model):
         p[pk.DAMPED] = float(np.any(p[lay["Ct"]:lay["Ct"] + n * n] != 0.0))
         W = self.mesh_rows()
         k, c = self.mesh_stiffnesses(), self._mesh_damping()
+        kc = self.coast_stiffnesses()
         for m in range(nm):
             o = lay["mesh"] + m * lay["block"]
             blk = p[o:o + lay["block"]]
@@ -822,10 +922,17 @@ class PlanetaryGearSet(Model):
             blk[pk.M_EC] = self.error[m] * math.sin(self.error_phase[m]) / L
             blk[pk.M_KF] = k[m] * L
             blk[pk.M_CF] = c[m] * L * w0
+            blk[pk.M_KFC] = kc[m] * L
             f = pk.MESH_FIXED
             blk[f:f + 2 * nh] = self.fourier[m]
             blk[f + 2 * nh:f + 2 * nh + n] = W[m]
-            blk[f + 2 * nh + n:] = Minv @ W[m] / (L * w0 * w0)
+            blk[f + 2 * nh + n:f + 2 * nh + 2 * n] = Minv @ W[m] / (L * w0 * w0)
+            blk[f + 2 * nh + 2 * n:] = self.fourier_coast[m]
+        self._layout = lay
+        self._coast_given = any(self.inputs[k] is not None for k in (
+            "sun_coast_stiffness", "ring_coast_stiffness", "coast_waveform"))
+        self._coast_built = p[_flank_index(lay, n, nm, nh, True)].copy()
+        p[pk.TWO_FLANK] = self._two_flank(p[None, :])[0]
         self._structure = (kt_entries, mesh_dofs)
         pk.fill_structure(p, kt_entries, mesh_dofs)
         p[lay["cache"]:lay["gyro"]] = pk.cache_entries(nm)[1]
@@ -958,11 +1065,27 @@ class PlanetaryGearSet(Model):
         lay, n = self._layout, int(P[0, pk.N_DOF])
         P[:, pk.DAMPED] = np.any(P[:, lay["Ct"]:lay["Ct"] + n * n] != 0.0, axis=1)
         P[:, pk.TORQUE_ON] = np.any(P[:, lay["F1"]:lay["F1"] + n] != 0.0, axis=1)
+        P[:, pk.TWO_FLANK] = self._two_flank(P)
         pk.fill_structure(P, *self._structure)
 
+    def _two_flank(self, P: np.ndarray) -> np.ndarray:
+        """The kernel's ``TWO_FLANK`` of every row of ``P``: 1.0 where a coast flank was given
+        and differs from its drive flank, or where a coast entry was set (a raw override) away
+        from its built value; else 0.0 (a set built without a coast flank: one stiffness on
+        both flanks, also after a raw override of the drive entries)."""
+        lay = self._layout
+        n, nm, nh = (int(P[0, i]) for i in (pk.N_DOF, pk.N_MESH, pk.N_HARM))
+        coast = P[:, _flank_index(lay, n, nm, nh, True)]
+        out = np.any(coast != self._coast_built, axis=1)
+        if self._coast_given:
+            out |= np.any(coast != P[:, _flank_index(lay, n, nm, nh, False)], axis=1)
+        return out.astype(float)
+
     # ------------------------------------------------------------------ linear analysis
-    def _lane_matrix(self, P: np.ndarray) -> np.ndarray:
-        """Dimensionless mean-stiffness matrices A (lanes, n, n) of X'' = -A X from ``P``."""
+    def _lane_matrix(self, P: np.ndarray, stiffest: bool = False) -> np.ndarray:
+        """Dimensionless mean-stiffness matrices A (lanes, n, n) of X'' = -A X from ``P``: the
+        drive flanks' mean stiffness, or with ``stiffest`` each mesh's stiffer flank's (where a
+        lane has two flanks)."""
         lay = self._layout
         n, nm, nh = int(P[0, pk.N_DOF]), int(P[0, pk.N_MESH]), int(P[0, pk.N_HARM])
         A = P[:, lay["Kt"]:lay["Kt"] + n * n].reshape(-1, n, n).copy()
@@ -971,7 +1094,10 @@ class PlanetaryGearSet(Model):
             o = lay["mesh"] + m * lay["block"]
             W = P[:, o + f:o + f + n]
             G = P[:, o + f + n:o + f + 2 * n]
-            A += P[:, o + pk.M_KF, None, None] * G[:, :, None] * W[:, None, :]
+            kf = P[:, o + pk.M_KF]
+            if stiffest:
+                kf = np.where(P[:, pk.TWO_FLANK] != 0.0, np.maximum(kf, P[:, o + pk.M_KFC]), kf)
+            A += kf[:, None, None] * G[:, :, None] * W[:, None, :]
         return A
 
     def _gyro_ct(self, P: np.ndarray) -> np.ndarray:
@@ -987,10 +1113,11 @@ class PlanetaryGearSet(Model):
 
     def fastest_natural_frequency(self, P: np.ndarray | None = None) -> np.ndarray:
         """Fastest natural frequency [omega_0] of the linear model at mean stiffness in every
-        lane of ``P`` (from the lane's coefficients; one eigenproblem per distinct row)."""
+        lane of ``P`` (from the lane's coefficients; one eigenproblem per distinct row), each
+        mesh at its stiffer flank's mean stiffness (so that the step resolves either flank)."""
         P = np.atleast_2d(self.params if P is None else np.asarray(P, dtype=float))
         rows, inverse = unique_rows(P)
-        A = self._lane_matrix(rows)
+        A = self._lane_matrix(rows, stiffest=True)
         if self.carrier_speed is None and self.carrier_speed_ratio is None:
             return np.sqrt(np.max(np.abs(np.linalg.eigvals(A)), axis=1))[inverse]
         # a rotating carrier: |lambda| of the first-order matrix with Ct (gyroscopic, damping)
@@ -1121,7 +1248,8 @@ class PlanetaryGearSet(Model):
     def static_state(self) -> np.ndarray:
         """Dimensionless coordinates X of the quasi-static state under the mean torques (mean
         stiffness, no error), each loaded mesh on its loaded flank: A X = F0 + sum kf b s G,
-        the flank signs s iterated; least squares where a rigid-body mode leaves A singular."""
+        the flank signs s iterated (a mesh on its coast flank, s < 0, with the coast flank's
+        mean stiffness); least squares where a rigid-body mode leaves A singular."""
         lay = self._layout
         n, nm, nh = int(self.params[pk.N_DOF]), int(self.params[pk.N_MESH]), \
             int(self.params[pk.N_HARM])
@@ -1131,8 +1259,15 @@ class PlanetaryGearSet(Model):
         blocks = [self.params[lay["mesh"] + m * lay["block"]:][:lay["block"]] for m in range(nm)]
         sign = np.zeros(nm)
         X = np.zeros(n)
+        two = self.params[pk.TWO_FLANK] != 0.0
         for _ in range(4):
-            rhs = F0 + sum(b[pk.M_KF] * b[pk.M_B] * sign[m] * b[f + n:f + 2 * n]
+            kf = [b[pk.M_KFC] if two and sign[m] < 0.0 else b[pk.M_KF]
+                  for m, b in enumerate(blocks)]
+            if two:  # each mesh's flank stiffness in A
+                A = self.params[lay["Kt"]:lay["Kt"] + n * n].reshape(n, n).copy()
+                for m, b in enumerate(blocks):
+                    A += kf[m] * b[f + n:f + 2 * n, None] * b[None, f:f + n]
+            rhs = F0 + sum(kf[m] * b[pk.M_B] * sign[m] * b[f + n:f + 2 * n]
                            for m, b in enumerate(blocks))
             X = _clean(np.linalg.lstsq(A, rhs, rcond=None)[0])
             d = np.array([b[f:f + n] @ X for b in blocks])
@@ -1184,13 +1319,40 @@ class PlanetaryGearSet(Model):
         for m in range(nm):
             b = self.params[lay["mesh"] + m * lay["block"]:][:lay["block"]]
             d = b[f:f + n] @ X
-            out[m] = b[pk.M_KF] * (d - min(max(d, -b[pk.M_B]), b[pk.M_B]))
+            two = self.params[pk.TWO_FLANK] != 0.0
+            kf = b[pk.M_KFC] if two and d < -b[pk.M_B] else b[pk.M_KF]
+            out[m] = kf * (d - min(max(d, -b[pk.M_B]), b[pk.M_B]))
         return out
 
     def __repr__(self) -> str:
         form = "rotational-only" if self.rotational_only else "rotational-translational"
         return (f"PlanetaryGearSet(N={self.n_planets}, {form}, dofs={len(self.dof_names())}, "
                 f"Omega={self.omega:g})")
+
+
+def _geometry_stiffness(geometry: Any, method: str, options: Mapping[str, Any] | None,
+                        waveform_options: Mapping[str, Any] | None, harmonics: int
+                        ) -> tuple[dict[str, Any], Any, Any]:
+    """The stiffness inputs of the set (``*_mesh_stiffness``, ``waveform`` and, from the
+    potential-energy tables, the coast flank's ``*_coast_stiffness``, ``coast_waveform``); the
+    potential-energy tables (or None) and the ISO waves (or None)."""
+    if method == "iso":
+        w_sun, w_ring = geometry.waveforms(**dict(waveform_options or {}))
+        return ({"sun_mesh_stiffness": w_sun.mean, "ring_mesh_stiffness": w_ring.mean,
+                 "waveform": {"sun": w_sun.fourier(harmonics),
+                              "ring": w_ring.fourier(harmonics)}}, None, (w_sun, w_ring))
+    if waveform_options:
+        raise ParameterError("waveform_options", dict(waveform_options),
+                             "only with stiffness='iso' (the ISO waves)")
+    opts = potential_energy_options(options, geometry, harmonics)
+    tables = potential_energy_tables(geometry, opts)
+    out: dict[str, Any] = {"waveform": {}, "coast_waveform": {}}
+    for g, table in zip(("sun", "ring"), tables, strict=True):
+        drive = flank_series(table["mesh_stiffness"].values, harmonics)
+        coast = flank_series(table["mesh_stiffness_coast"].values, harmonics)
+        out[f"{g}_mesh_stiffness"], out["waveform"][g] = drive.mean, drive.pair
+        out[f"{g}_coast_stiffness"], out["coast_waveform"][g] = coast.mean, coast.pair
+    return out, tables, None
 
 
 def _held(held: str | None, fixed: tuple[str, ...]) -> str:

@@ -34,6 +34,8 @@ HEADER = CoefficientBlock((
     Coefficient("torque_order", "1", "order of the input torque fluctuation"),
     Coefficient("torque_phase", "rad", "phase of the input torque fluctuation"),
     workspace_entry("damped", "1 where Ct is not zero (kernel flag)"),
+    workspace_entry("two_flank", "1 where a mesh's coast flank differs from its drive flank "
+                    "(KF_coast or the coast harmonics; kernel flag)", constant="TWO_FLANK"),
 ))
 #: Per coordinate d: F0_d, F1_d (names suffixed _d); per pair (a, b): Kt_a_b, Ct_a_b.
 FORCES = CoefficientBlock((
@@ -59,6 +61,9 @@ MESH = CoefficientBlock((
        "ring_mesh_stiffness", "length_scale", constant="M_KF"),
     _d("CF", "N", "mesh force per unit deflection rate X' (c_m L omega_0)", "mesh_damping",
        "sun_mesh_stiffness", "ring_mesh_stiffness", "length_scale", constant="M_CF"),
+    _d("KF_coast", "N", "coast-flank mesh force per unit deflection X (k_c,m L), acting where "
+       "the deflection is below -b", "sun_coast_stiffness", "ring_coast_stiffness",
+       "sun_mesh_stiffness", "ring_mesh_stiffness", "length_scale", constant="M_KFC"),
 ))
 #: Per coordinate d of a mesh: its deflection row W_d and M^-1 W / (L omega_0^2), G_d.
 MESH_ROW = CoefficientBlock((
@@ -77,4 +82,15 @@ def harmonics_block(nh: int) -> CoefficientBlock:
         _d(f"{ab}{h}", "1", f"{'cosine' if ab == 'a' else 'sine'} part of harmonic {h} of the "
            "relative mesh stiffness", "waveform", "sun_stiffness_fluctuation",
            "ring_stiffness_fluctuation", "sun_mesh_phase", "ring_mesh_phase")
+        for h in range(1, nh + 1) for ab in "ab"))
+
+
+def coast_harmonics_block(nh: int) -> CoefficientBlock:
+    """A mesh's coast-flank relative-stiffness Fourier coefficients ac1, bc1, ..., bc_nh (of
+    k_c / k_c,mean - 1)."""
+    return CoefficientBlock(tuple(
+        _d(f"{ab}c{h}", "1", f"{'cosine' if ab == 'a' else 'sine'} part of harmonic {h} of the "
+           "relative coast-flank mesh stiffness", "coast_waveform", "waveform",
+           "sun_stiffness_fluctuation", "ring_stiffness_fluctuation", "sun_mesh_phase",
+           "ring_mesh_phase")
         for h in range(1, nh + 1) for ab in "ab"))

@@ -4,13 +4,17 @@ Dimensionless form (see :mod:`geardyn.models.planetary`): state ``(X, X')`` with
 generalised coordinates over the length scale L and ' = d/dtau, tau = omega_0 t::
 
     X'' = F0 + F1 sin(r theta + psi) - Kt X - Ct X' - sum_m f_m G_m
-    f_m = KF_m k_m(Omega tau) g(W_m . X - e_m, b_m) + CF_m (W_m . X' - e_m')
+    f_m = KF_m k_m(Omega tau) g(W_m . X - e_m, b_m) + CF_m (W_m . X' - e_m')   (g >= 0)
+    f_m = KC_m c_m(Omega tau) g(W_m . X - e_m, b_m) + CF_m (W_m . X' - e_m')   (g < 0)
 
 Kt, Ct: the linear (bearing, support) stiffness and the modal damping matrices premultiplied by
 M^-1; per mesh m: W_m the deflection row, G_m = M^-1 W_m / (L omega_0^2) [1/N], KF_m and CF_m [N]
 the force per unit deflection and deflection rate, k_m the relative stiffness (Fourier series in
-the mesh phase), e_m = ES_m sin(theta) + EC_m cos(theta) the transmission error. f_m is
-the dynamic mesh force [N], the observable.
+the mesh phase), e_m = ES_m sin(theta) + EC_m cos(theta) the transmission error; KC_m and
+c_m the same of the coast flank, which acts where the deflection has left the dead zone on the
+other side (x < -b). f_m is the dynamic mesh force [N], the observable. Where no mesh's coast
+flank differs from its drive flank (the header flag ``TWO_FLANK`` 0) the coast entries are not
+read: the arithmetic is the one-flank form's, operation for operation.
 
 theta is the mesh (forcing) phase the solver supplies as ``s, c`` = sin, cos theta (Omega tau
 from the start of a run or of a continued lane): the stiffness, the transmission error in the
@@ -19,18 +23,18 @@ right-hand side and in the switching functions, and a torque fluctuation of inte
 order r is a second, incommensurate excitation: its phase is r Omega tau + psi from the time tau
 the solver passes (the time since the start of the sweep's chain or of the run).
 
-Coefficient vector: a header (``DAMPED`` is 1 where Ct is not zero), the dof vectors F0, F1,
-the matrices Kt, Ct (row-major), one block per mesh (fixed entries, 2 nh Fourier coefficients,
-W, G), then the *structure* the kernels read (:func:`fill_structure`, derived from the dense
-parts): the count nk of the structural entries of Kt, their rows, columns and values, and per
-mesh ``MESH_NZ`` dof indices with the W and G values there (a mesh row touches at most six
-coordinates: the sun or ring and the planet, three each). So a right-hand side costs
-O(nk + n_mesh (MESH_NZ + n_harm)) instead of O(n^2 + n_mesh n): the dense Kt product and the
-dense mesh rows are the same sums without their structural zeros, term for term in the same order
-(results equal the dense evaluation's). Ct (modal damping) stays dense. A rotating carrier's
-Coriolis term -w_c (M^-1 G) X' (``docs/planetary.md``, "Rotating carrier") has its own
-structural section at the very end (:func:`_gyro_offset`), so that Ct stays the same in every lane
-of a sweep in which the carrier speed w_c follows the mesh frequency.
+Coefficient vector: a header (``DAMPED`` is 1 where Ct is not zero), the dof vectors F0, F1, the
+matrices Kt, Ct (row-major), one block per mesh (fixed entries, 2 nh Fourier coefficients, W, G, 2
+nh coast-flank Fourier coefficients), then the *structure* the kernels read
+(:func:`fill_structure`, derived from the dense parts): the count nk of the structural entries of
+Kt, their rows, columns and values, and per mesh ``MESH_NZ`` dof indices with the W and G values
+there (a mesh row touches at most six coordinates: the sun or ring and the planet, three each). So
+a right-hand side costs O(nk + n_mesh (MESH_NZ + n_harm)) instead of O(n^2 + n_mesh n): the dense
+Kt product and the dense mesh rows are the same sums without their structural zeros, term for term
+in the same order (results equal the dense evaluation's). Ct (modal damping) stays dense. A
+rotating carrier's Coriolis term -w_c (M^-1 G) X' (``docs/planetary.md``, "Rotating carrier") has
+its own structural section at the very end (:func:`_gyro_offset`), so that Ct stays the same in
+every lane of a sweep in which the carrier speed w_c follows the mesh frequency.
 
 The ``*_lanes`` forms evaluate the same arithmetic, operation for operation, on a block of lanes
 in structure-of-arrays layout (state Y[q, k], coefficients PT[j, k], the forcing phase S[k],
@@ -56,15 +60,18 @@ _H = HEADER_BLOCK.offset
 OMEGA, N_DOF, N_MESH, N_HARM = _H("Omega"), _H("n_dof"), _H("n_meshes"), _H("n_harmonics")
 TORQUE_ON, TORQUE_ORDER = _H("torque_on"), _H("torque_order")
 TORQUE_PHASE, DAMPED = _H("torque_phase"), _H("damped")
+TWO_FLANK = _H("two_flank")
 HEADER = HEADER_BLOCK.size
 # mesh block fixed entries
 _M = MESH.offset
 M_B, M_ES, M_EC, M_KF, M_CF = _M("b"), _M("E_s"), _M("E_c"), _M("KF"), _M("CF")
+M_KFC = _M("KF_coast")
 MESH_FIXED = MESH.size
 #: Structural entries per mesh row in the structure section (padded with zero weights).
 MESH_NZ = 6
-#: Entries of the lane-block functions' relative-stiffness cache, and the key of an empty one (no
-#: sine or cosine equals it).
+#: Entries of the lane-block functions' relative-stiffness cache (each: the key, then the drive
+#: and the coast relative stiffness of every mesh), and the key of an empty one (no sine or
+#: cosine equals it).
 CACHE_ENTRIES = 2
 EMPTY = 2.0
 #: The last row of the vector: 0 in a freshly loaded slot; the lane-block rhs then checks
@@ -82,14 +89,27 @@ def layout(n: int, n_mesh: int, nh: int, nk: int = 0, ng: int = 0) -> dict[str, 
     kt = f1 + n
     ct = kt + n * n
     mesh = ct + n * n
-    bs = MESH_FIXED + 2 * nh + 2 * n
+    bs = block_size(n, nh)
     st = mesh + n_mesh * bs
     mz = st + 1 + 3 * nk
     cache = mz + n_mesh * 3 * MESH_NZ
-    gyro = cache + 1 + CACHE_ENTRIES * (2 + n_mesh) + CT_ROWS
+    gyro = cache + 1 + CACHE_ENTRIES * (2 + 2 * n_mesh) + CT_ROWS
     return {"F0": f0, "F1": f1, "Kt": kt, "Ct": ct, "mesh": mesh, "block": bs,
             "structure": st, "mesh_nz": mz, "cache": cache, "gyro": gyro,
             "size": gyro + 2 + 3 * ng}
+
+
+@nb.njit(inline="always", **_JIT)
+def block_size(n, nh):
+    """Entries of one mesh block: the fixed ones, 2 nh drive coefficients, W and G (n each),
+    2 nh coast coefficients."""
+    return MESH_FIXED + 4 * nh + 2 * n
+
+
+@nb.njit(inline="always", **_JIT)
+def coast_offset(n, nh):
+    """Offset of the coast-flank coefficients in a mesh block."""
+    return MESH_FIXED + 2 * nh + 2 * n
 
 
 def gyro_names(dofs: tuple[str, ...], entries: list[tuple[int, int]]) -> list[str]:
@@ -104,12 +124,14 @@ def gyro_names(dofs: tuple[str, ...], entries: list[tuple[int, int]]) -> list[st
 def cache_entries(n_mesh: int) -> tuple[list[str], list[float]]:
     """Names and initial values of the stiffness cache rows (see :func:`_lanes_cached_stiffness`):
     the entry used last, then per entry the forcing phase (sin, cos; 2.0: empty) and the
-    relative stiffness of every mesh there. Workspace of the lane-block functions, not inputs."""
+    drive and the coast relative stiffness of every mesh there. Workspace of the lane-block
+    functions, not inputs."""
     names = ["cache_last"]
     values = [0.0]
     for e in range(CACHE_ENTRIES):
         names += [f"cache{e}_sin", f"cache{e}_cos"] + [f"cache{e}_k{m}" for m in range(n_mesh)]
-        values += [EMPTY, EMPTY] + [0.0] * n_mesh
+        names += [f"cache{e}_kc{m}" for m in range(n_mesh)]
+        values += [EMPTY, EMPTY] + [0.0] * (2 * n_mesh)
     return names + ["cache_ct_checked"], values + [0.0]
 
 
@@ -194,7 +216,7 @@ def _offsets(p):
     nm = int(p[N_MESH])
     nh = int(p[N_HARM])
     mesh = HEADER + 2 * n + 2 * n * n
-    bs = MESH_FIXED + 2 * nh + 2 * n
+    bs = block_size(n, nh)
     st = mesh + nm * bs
     mz = st + 1 + 3 * int(p[st])
     return n, nm, nh, mesh, bs, st, mz
@@ -206,7 +228,7 @@ def _gyro_offset(nm, mz):
     omega_0, the count ng, then ng rows, columns and values of M^-1 G (the Coriolis term is
     -w_c (M^-1 G) X' in X''); structural, so the same in every lane of a sweep, while w_c may
     differ per lane (a carrier speed that follows the mesh frequency)."""
-    return mz + nm * 3 * MESH_NZ + 1 + CACHE_ENTRIES * (2 + nm) + CT_ROWS
+    return mz + nm * 3 * MESH_NZ + 1 + CACHE_ENTRIES * (2 + 2 * nm) + CT_ROWS
 
 
 @nb.njit(inline="always", **_JIT)
@@ -229,8 +251,12 @@ def _mesh_state(y, p, o, q, n, s, c):
 @nb.njit(inline="always", **_JIT)
 def _mesh_force(y, p, o, q, n, nh, s, c):
     d, v = _mesh_state(y, p, o, q, n, s, c)
+    g = _dead_zone(d, p[o + M_B])
+    if g < 0.0 and p[TWO_FLANK] != 0.0:  # the coast flank
+        kc = _relative_stiffness(p, o + coast_offset(n, nh), nh, s, c)
+        return p[o + M_KFC] * kc * g + p[o + M_CF] * v
     k = _relative_stiffness(p, o + MESH_FIXED, nh, s, c)
-    return p[o + M_KF] * k * _dead_zone(d, p[o + M_B]) + p[o + M_CF] * v
+    return p[o + M_KF] * k * g + p[o + M_CF] * v
 
 
 @nb.njit(inline="always", **_JIT)
@@ -275,7 +301,8 @@ def planetary_rhs(t, y, dy, p, s, c):
     fl = 0.0
     if p[TORQUE_ON] != 0.0:
         fl = _torque_wave(t, p[TORQUE_ORDER], p[OMEGA], p[TORQUE_PHASE], s, c)
-    shared = nm <= n  # the mesh forces first, into dy[:nm] (scratch until the end)
+    # the mesh forces first, into dy[:nm] (scratch until the end); per mesh with two flanks
+    shared = nm <= n and p[TWO_FLANK] == 0.0
     if shared:
         _mesh_forces_shared(y, dy, p, n, nm, nh, mesh, bs, mz, s, c)
     f1 = HEADER + n
@@ -324,7 +351,11 @@ def planetary_events(t, y, g, p, s, c):
 def planetary_observe(t, y, out, p, s, c):
     """Dynamic mesh forces [N], one per mesh (sun-planet meshes, then ring-planet meshes)."""
     n, nm, nh, mesh, bs, st, mz = _offsets(p)
-    _mesh_forces_shared(y, out, p, n, nm, nh, mesh, bs, mz, s, c)
+    if p[TWO_FLANK] == 0.0:
+        _mesh_forces_shared(y, out, p, n, nm, nh, mesh, bs, mz, s, c)
+        return
+    for m in range(nm):
+        out[m] = _mesh_force(y, p, mesh + m * bs, mz + m * 3 * MESH_NZ, n, nh, s, c)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -338,23 +369,24 @@ def _lanes_offsets(PT):
     nm = int(PT[N_MESH, 0])
     nh = int(PT[N_HARM, 0])
     mesh = HEADER + 2 * n + 2 * n * n
-    bs = MESH_FIXED + 2 * nh + 2 * n
+    bs = block_size(n, nh)
     st = mesh + nm * bs
     mz = st + 1 + 3 * int(PT[st, 0])
     return n, nm, nh, mesh, bs, st, mz
 
 
 @nb.njit(inline="always", **_JIT)
-def _lanes_stiffness(PT, nl, S, C, SC, rb, mesh, bs, nh, nm):
+def _lanes_stiffness(PT, nl, S, C, SC, rb, mesh, bs, nh, nm, first):
     """:func:`_relative_stiffness` of every mesh m into PT[rb + m] (the harmonic recurrence in
-    SC rows 0, 1), the same operations in the same order."""
+    SC rows 0, 1), the same operations in the same order; ``first``: the offset of the
+    coefficients in a mesh block (``MESH_FIXED``: the drive flank's)."""
     if nh == 0:
         for m in range(nm):
             for k in range(nl):
                 PT[rb + m, k] = 1.0
         return
     for m in range(nm):
-        f = mesh + m * bs + MESH_FIXED
+        f = mesh + m * bs + first
         for k in range(nl):
             PT[rb + m, k] = PT[f, k] * C[k] + PT[f + 1, k] * S[k]
     for k in range(nl):
@@ -367,7 +399,7 @@ def _lanes_stiffness(PT, nl, S, C, SC, rb, mesh, bs, nh, nm):
             SC[0, k] = ch * C[k] - sh * S[k]
             SC[1, k] = sh * C[k] + ch * S[k]
         for m in range(nm):
-            f = mesh + m * bs + MESH_FIXED + 2 * h
+            f = mesh + m * bs + first + 2 * h
             for k in range(nl):
                 PT[rb + m, k] += PT[f, k] * SC[0, k] + PT[f + 1, k] * SC[1, k]
     for m in range(nm):
@@ -376,14 +408,16 @@ def _lanes_stiffness(PT, nl, S, C, SC, rb, mesh, bs, nh, nm):
 
 
 @nb.njit(inline="always", **_JIT)
-def _lanes_cached_stiffness(PT, nl, S, C, SC, cache, mesh, bs, nh, nm):
-    """Row of PT from which the relative stiffness of mesh m is row + m, at the forcing phase
-    (S, C) of every lane. The block's PT carries a small cache (rows from ``cache``; reset to
-    empty whenever a slot is loaded with a lane's coefficients): the four RK4 stages of a step
-    see two new phases (the mid-step one twice, the end one again as the next step's start and
-    for the observables), so half the evaluations are found there. An entry is used only where
-    every lane's phase equals its key exactly, so the values are those computed anew."""
-    width = 2 + nm
+def _lanes_cached_stiffness(PT, nl, S, C, SC, cache, mesh, bs, nh, nm, two):
+    """Row of PT from which the relative stiffness of mesh m is row + m (its coast flank's row + nm,
+    computed only with ``two``), at the forcing phase (S, C) of every lane. The block's PT carries a
+    small cache (rows from ``cache``; reset to empty whenever a slot is loaded with a lane's
+    coefficients): the four RK4 stages of a step see two new phases (the mid-step one twice, the end
+    one again as the next step's start and for the observables), so half the evaluations are found
+    there. An entry is used only where every lane's phase equals its key exactly, so the values are
+    those computed anew (a slot loaded with a two-flank lane empties its keys, so an entry filled
+    without the coast rows is not found by it)."""
+    width = 2 + 2 * nm
     for e in range(CACHE_ENTRIES):
         b = cache + 1 + e * width
         hit = True
@@ -394,7 +428,10 @@ def _lanes_cached_stiffness(PT, nl, S, C, SC, cache, mesh, bs, nh, nm):
             return b + 2
     e = (int(PT[cache, 0]) + 1) % CACHE_ENTRIES  # not the entry used last
     b = cache + 1 + e * width
-    _lanes_stiffness(PT, nl, S, C, SC, b + 2, mesh, bs, nh, nm)
+    _lanes_stiffness(PT, nl, S, C, SC, b + 2, mesh, bs, nh, nm, MESH_FIXED)
+    if two:
+        n = int(PT[N_DOF, 0])
+        _lanes_stiffness(PT, nl, S, C, SC, b + 2 + nm, mesh, bs, nh, nm, coast_offset(n, nh))
     for k in range(nl):
         PT[b, k] = S[k]
         PT[b + 1, k] = C[k]
@@ -407,7 +444,7 @@ def _lanes_ct_uniform(PT, nl, cache, n):
     """Whether every lane of the block has the same Ct (e.g. a sweep in Omega), so that one
     copy serves all. Checked again only after a slot was loaded (its row ``CT_CHECKED`` of the
     cache section is then 0); the answer is kept in that row of slot 0."""
-    chk = cache + 1 + CACHE_ENTRIES * (2 + int(PT[N_MESH, 0]))
+    chk = cache + 1 + CACHE_ENTRIES * (2 + 2 * int(PT[N_MESH, 0]))
     fresh = False
     for k in range(nl):
         fresh |= PT[chk, k] == 0.0
@@ -452,9 +489,11 @@ def planetary_rhs_lanes(T, Y, DY, PT, nl, S, C, SC):
     n, nm, nh, mesh, bs, st, mz = _lanes_offsets(PT)
     torque = False
     damped = False
+    two = False
     for k in range(nl):
         torque |= PT[TORQUE_ON, k] != 0.0
         damped |= PT[DAMPED, k] != 0.0
+        two |= PT[TWO_FLANK, k] != 0.0
     for k in range(nl):
         SC[0, k] = 0.0
     if torque:
@@ -502,7 +541,12 @@ def planetary_rhs_lanes(T, Y, DY, PT, nl, S, C, SC):
             r = g + 2 + 2 * ng + e
             for k in range(nl):
                 DY[i, k] -= (PT[g, k] * PT[r, k]) * Y[j, k]
-    kr = _lanes_cached_stiffness(PT, nl, S, C, SC, mz + nm * 3 * MESH_NZ, mesh, bs, nh, nm)
+    kr = _lanes_cached_stiffness(PT, nl, S, C, SC, mz + nm * 3 * MESH_NZ, mesh, bs, nh, nm, two)
+    if two:
+        for m in range(nm):
+            _lanes_mesh_two(Y, DY, PT, nl, S, C, SC, n, mesh + m * bs, mz + m * 3 * MESH_NZ,
+                            kr + m, True, kr + nm + m)
+        return
     for m in range(nm):
         _lanes_mesh(Y, DY, PT, nl, S, C, SC, n, mesh + m * bs, mz + m * 3 * MESH_NZ, kr + m,
                     True)
@@ -539,6 +583,13 @@ def _lanes_mesh(Y, DY, PT, nl, S, C, SC, n, o, q, row, apply):
         v -= PT[OMEGA, k] * (PT[o + M_ES, k] * C[k] - PT[o + M_EC, k] * S[k])
         SC[0, k] = (PT[o + M_KF, k] * PT[row, k] * _dead_zone(d, PT[o + M_B, k])
                     + PT[o + M_CF, k] * v)
+    _lanes_apply(DY, PT, nl, SC, n, q, apply)
+
+
+@nb.njit(inline="always", **_JIT)
+def _lanes_apply(DY, PT, nl, SC, n, q, apply):
+    """The mesh force in SC[0] subtracted from the accelerations DY through the mesh's G
+    (structure at q; ``apply``) or copied to DY[0] (observables)."""
     if not apply:
         for k in range(nl):
             DY[0, k] = SC[0, k]
@@ -548,6 +599,43 @@ def _lanes_mesh(Y, DY, PT, nl, S, C, SC, n, o, q, row, apply):
         r = n + int(PT[q + j, 0])
         for k in range(nl):
             DY[r, k] -= SC[0, k] * PT[g + j, k]
+
+
+@nb.njit(inline="always", **_JIT)
+def _lanes_mesh_two(Y, DY, PT, nl, S, C, SC, n, o, q, row, apply, rowc):
+    """:func:`_lanes_mesh` with two flanks: the coast flank's KF_coast c_m(theta) (relative
+    stiffness in PT[rowc]) where the dead zone's output is negative, the drive flank's
+    arithmetic otherwise, operation for operation."""
+    i0 = int(PT[q, 0])
+    i1 = int(PT[q + 1, 0])
+    i2 = int(PT[q + 2, 0])
+    i3 = int(PT[q + 3, 0])
+    i4 = int(PT[q + 4, 0])
+    i5 = int(PT[q + 5, 0])
+    w = q + MESH_NZ
+    for k in range(nl):
+        d = 0.0
+        v = 0.0
+        d += PT[w, k] * Y[i0, k]
+        v += PT[w, k] * Y[n + i0, k]
+        d += PT[w + 1, k] * Y[i1, k]
+        v += PT[w + 1, k] * Y[n + i1, k]
+        d += PT[w + 2, k] * Y[i2, k]
+        v += PT[w + 2, k] * Y[n + i2, k]
+        d += PT[w + 3, k] * Y[i3, k]
+        v += PT[w + 3, k] * Y[n + i3, k]
+        d += PT[w + 4, k] * Y[i4, k]
+        v += PT[w + 4, k] * Y[n + i4, k]
+        d += PT[w + 5, k] * Y[i5, k]
+        v += PT[w + 5, k] * Y[n + i5, k]
+        d -= PT[o + M_ES, k] * S[k] + PT[o + M_EC, k] * C[k]
+        v -= PT[OMEGA, k] * (PT[o + M_ES, k] * C[k] - PT[o + M_EC, k] * S[k])
+        g = _dead_zone(d, PT[o + M_B, k])
+        kf = PT[o + M_KF, k] * PT[row, k]
+        if g < 0.0:
+            kf = PT[o + M_KFC, k] * PT[rowc, k]
+        SC[0, k] = kf * g + PT[o + M_CF, k] * v
+    _lanes_apply(DY, PT, nl, SC, n, q, apply)
 
 
 @nb.njit(**_JIT)
@@ -583,7 +671,14 @@ def planetary_events_lanes(T, Y, G, PT, nl, S, C):
 def planetary_observe_lanes(T, Y, O, PT, nl, S, C, SC):
     """:func:`planetary_observe` for lanes 0..nl-1 of a block (O: one row per mesh)."""
     n, nm, nh, mesh, bs, st, mz = _lanes_offsets(PT)
-    kr = _lanes_cached_stiffness(PT, nl, S, C, SC, mz + nm * 3 * MESH_NZ, mesh, bs, nh, nm)
+    two = False
+    for k in range(nl):
+        two |= PT[TWO_FLANK, k] != 0.0
+    kr = _lanes_cached_stiffness(PT, nl, S, C, SC, mz + nm * 3 * MESH_NZ, mesh, bs, nh, nm, two)
     for m in range(nm):
-        _lanes_mesh(Y, O[m:m + 1], PT, nl, S, C, SC, n, mesh + m * bs, mz + m * 3 * MESH_NZ,
-                    kr + m, False)
+        if two:
+            _lanes_mesh_two(Y, O[m:m + 1], PT, nl, S, C, SC, n, mesh + m * bs,
+                            mz + m * 3 * MESH_NZ, kr + m, False, kr + nm + m)
+        else:
+            _lanes_mesh(Y, O[m:m + 1], PT, nl, S, C, SC, n, mesh + m * bs,
+                        mz + m * 3 * MESH_NZ, kr + m, False)

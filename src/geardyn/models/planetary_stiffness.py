@@ -1,0 +1,157 @@
+"""The mesh stiffness of a planetary gear set built from its geometry
+(:meth:`geardyn.PlanetaryGearSet.from_geometry`): ISO 6336-1 waves, or the potential-energy
+stiffness (:func:`geardyn.gears.potential_energy_stiffness`) of the sun-planet and the
+planet-ring mesh over one mesh cycle, drive and coast flank, as truncated Fourier series.
+
+A table k(theta_j) [N/m], uniform over one mesh cycle (theta_j = 2 pi j / n from the passage
+of a tooth pair through the pitch point, the phase origin of the ISO waves too), becomes its
+discrete Fourier series k0 (1 + sum_h a_h cos(h theta) + b_h sin(h theta)), h = 1..H: the mean
+k0 and the relative coefficients (a_h, b_h) the model's ``waveform`` takes.
+"""
+
+from __future__ import annotations
+
+import numbers
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from geardyn.errors import ParameterError
+from geardyn.units import si_value
+
+#: The stiffness methods of :meth:`geardyn.PlanetaryGearSet.from_geometry`.
+STIFFNESS_METHODS = ("iso", "potential_energy")
+#: Points per mesh cycle of the potential-energy tables by default.
+DEFAULT_ANGLES = 360
+_FIELD = "stiffness_options"
+_REQUIRED = ("sun_bore_radius", "planet_bore_radius", "ring_rim_radius")
+_OPTIONAL = ("young", "poisson", "angles", "nodes", "root_segment")
+
+
+@dataclass(frozen=True)
+class PotentialEnergyOptions:
+    """The inputs of the potential-energy tables, SI: bore radii of sun and planet and the
+    ring's outer (rim) radius [m], Young's modulus [Pa], Poisson's ratio, points per mesh cycle,
+    Gauss-Legendre nodes, the root form (see :func:`~geardyn.gears.potential_energy_stiffness`)."""
+
+    sun_bore_radius: float
+    planet_bore_radius: float
+    ring_rim_radius: float
+    young: float
+    poisson: float
+    angles: int
+    nodes: int
+    root_segment: bool
+
+
+@dataclass(frozen=True)
+class FlankSeries:
+    """One flank's stiffness series of one mesh group: mean k0 [N/m] and relative Fourier
+    coefficients a, b (harmonics 1..H) of k / k0 - 1."""
+
+    mean: float
+    a: np.ndarray
+    b: np.ndarray
+
+    @property
+    def pair(self) -> tuple[np.ndarray, np.ndarray]:
+        """(a, b), the form of the model's ``waveform``."""
+        return self.a, self.b
+
+
+def stiffness_method(stiffness: Any, options: Mapping[str, Any] | None) -> str:
+    """``stiffness`` checked (one of :data:`STIFFNESS_METHODS`); options only with
+    ``"potential_energy"``."""
+    if not isinstance(stiffness, str) or stiffness not in STIFFNESS_METHODS:
+        raise ParameterError("stiffness", stiffness,
+                             f"must be one of {', '.join(map(repr, STIFFNESS_METHODS))}")
+    if stiffness == "iso" and options:
+        raise ParameterError(_FIELD, dict(options), "only with stiffness='potential_energy' "
+                             "(the ISO waves take waveform_options)")
+    return stiffness
+
+
+def _whole(field: str, value: Any, minimum: int) -> int:
+    if isinstance(value, bool) or not isinstance(value, numbers.Integral) or value < minimum:
+        raise ParameterError(field, value, f"must be a whole number >= {minimum}")
+    return int(value)
+
+
+def potential_energy_options(options: Mapping[str, Any] | None, geometry: Any,
+                             harmonics: int) -> PotentialEnergyOptions:
+    """``stiffness_options`` validated against the geometry (errors name
+    ``stiffness_options.<key>``): the bores inside the sun's and the planet's root circles, the
+    rim outside the ring's root circle, more than 2 ``harmonics`` angles per mesh cycle."""
+    from geardyn.gears.potential_energy import DEFAULT_NODES, STEEL_POISSON, STEEL_YOUNG
+
+    if not isinstance(options, Mapping | None):
+        raise ParameterError(_FIELD, options, "must be a mapping (sun_bore_radius, ...)")
+    opts = dict(options or {})
+    for key in opts:
+        if key not in _REQUIRED + _OPTIONAL:
+            raise ParameterError(f"{_FIELD}.{key}", opts[key],
+                                 f"unknown; known: {', '.join(_REQUIRED + _OPTIONAL)}")
+    for key in _REQUIRED:
+        if key not in opts:
+            raise ParameterError(f"{_FIELD}.{key}", None,
+                                 "needed for stiffness='potential_energy' [m]")
+    radii = {k: si_value(f"{_FIELD}.{k}", opts[k], "length", 0.0, strict=True)
+             for k in _REQUIRED}
+    for key, gear, inside in (("sun_bore_radius", geometry.sun, True),
+                              ("planet_bore_radius", geometry.planet, True),
+                              ("ring_rim_radius", geometry.ring, False)):
+        root = gear.root_radius
+        if (radii[key] >= root) if inside else (radii[key] <= root):
+            where = "inside" if inside else "outside"
+            raise ParameterError(f"{_FIELD}.{key}", opts[key],
+                                 f"must lie {where} the {gear.name}'s root circle "
+                                 f"(radius {root:.6g} m)")
+    young = si_value(f"{_FIELD}.young", opts.get("young", STEEL_YOUNG), "pressure", 0.0,
+                     strict=True)
+    poisson = si_value(f"{_FIELD}.poisson", opts.get("poisson", STEEL_POISSON),
+                       "dimensionless", 0.0)
+    if not poisson < 0.5:
+        raise ParameterError(f"{_FIELD}.poisson", opts["poisson"], "must lie in [0, 0.5)")
+    angles = _whole(f"{_FIELD}.angles", opts.get("angles", DEFAULT_ANGLES), 8)
+    if angles <= 2 * harmonics:
+        raise ParameterError(f"{_FIELD}.angles", angles,
+                             f"must exceed 2 harmonics = {2 * harmonics} (the series of "
+                             f"{harmonics} harmonics needs more points per mesh cycle)")
+    root_segment = opts.get("root_segment", True)
+    if not isinstance(root_segment, bool | np.bool_):
+        raise ParameterError(f"{_FIELD}.root_segment", root_segment, "must be true or false")
+    return PotentialEnergyOptions(
+        **radii, young=young, poisson=poisson, angles=angles,
+        nodes=_whole(f"{_FIELD}.nodes", opts.get("nodes", DEFAULT_NODES), 4),
+        root_segment=bool(root_segment))
+
+
+def potential_energy_tables(geometry: Any, opts: PotentialEnergyOptions) -> tuple[Any, Any]:
+    """The potential-energy stiffness Datasets of the sun-planet and the planet-ring mesh over
+    one mesh cycle (``opts.angles`` points; the ring's body rigid)."""
+    from geardyn.gears.potential_energy import potential_energy_stiffness
+
+    common = dict(angles=opts.angles, young=opts.young, poisson=opts.poisson,
+                  nodes=opts.nodes, root_segment=opts.root_segment)
+    sun = potential_energy_stiffness(
+        geometry.sun_mesh, bore_radius=(opts.sun_bore_radius, opts.planet_bore_radius), **common)
+    ring = potential_energy_stiffness(
+        geometry.ring_mesh, bore_radius=(opts.planet_bore_radius, opts.ring_rim_radius),
+        ring_foundation="rigid", **common)
+    return sun, ring
+
+
+def flank_series(table: np.ndarray, harmonics: int) -> FlankSeries:
+    """The discrete Fourier series of ``table`` (uniform over one mesh cycle from phase 0), cut
+    after ``harmonics``: mean and relative coefficients."""
+    k = np.asarray(table, dtype=float)
+    F = np.fft.rfft(k) / k.size
+    k0 = float(F[0].real)
+    if not k0 > 0.0:
+        raise ParameterError("stiffness", k0, "the mean mesh stiffness must be > 0")
+    a = 2.0 * F[1:harmonics + 1].real / k0
+    b = -2.0 * F[1:harmonics + 1].imag / k0
+    return FlankSeries(k0, a, b)
+
