@@ -29,7 +29,7 @@ from geardyn.study import build_model
 
 GEAR = geardyn.GearPair(zeta=0.05, kappa=0.2, Fm=0.1, Fa=0.2)
 OMEGAS = np.linspace(0.4, 3.0, 10)
-SETTINGS = dict(transient=100.0, samples=8, steps_per_period=128)
+SETTINGS = dict(run=geardyn.RunSettings(transient=100.0, samples=8, steps_per_period=128))
 CALLS: list[int] = []  # lanes each task call ran (the task reads no settings from here)
 FAIL_AFTER: list[int] = []  # when set, the task raises once this many chunks ran
 
