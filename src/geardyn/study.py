@@ -196,8 +196,20 @@ def _from_geometry(table: dict, kw: dict, held: str | None = None) -> PlanetaryG
         centre_distance=None if table["centre_distance"] is None
         else to_si(table["centre_distance"], "length"))
     extra = {k: v for k, v in kw.items() if k not in _FROM_GEOMETRY}
-    return PlanetaryGearSet.from_geometry(
-        stage, waveform_options={"transition": table["transition"]}, held=held, **extra)
+    waves = {"waveform_options": {"transition": table["transition"]}}
+    if table["stiffness"] == "potential_energy":
+        if table["transition"] != 0.0:
+            raise ParameterError("geometry.transition", table["transition"],
+                                 "shapes the ISO waves; the potential-energy stiffness has none")
+        waves = {}
+    try:
+        return PlanetaryGearSet.from_geometry(
+            stage, held=held, stiffness=table["stiffness"],
+            stiffness_options=table["stiffness_options"] or None, **waves, **extra)
+    except ParameterError as exc:
+        if exc.field.split(".")[0] in ("stiffness", "stiffness_options", "waveform_options"):
+            raise ParameterError(f"geometry.{exc.field}", exc.value, exc.reason) from None
+        raise
 
 
 def check_usable(build: Callable[[], Model]) -> Model:

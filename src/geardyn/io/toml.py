@@ -493,6 +493,11 @@ class GeometryTable(BaseModel):
     dedendum: float = 1.25
     centre_distance: Quantity | None = None
     transition: float = 0.0
+    stiffness: str = Field("iso", description="mesh stiffness: 'iso' (ISO 6336-1 waves) or "
+                           "'potential_energy' (from the teeth, drive and coast flanks)")
+    stiffness_options: dict[str, Any] = Field(
+        default_factory=dict, description="the potential-energy inputs "
+        "(PlanetaryGearSet.from_geometry's stiffness_options: bores, rim, material, angles)")
     sun: GearTable
     planet: GearTable
     ring: GearTable

@@ -1,0 +1,68 @@
+"""A planetary study built from geometry on the potential-energy stiffness
+(``[params.geometry] stiffness = "potential_energy"`` with ``stiffness_options``)."""
+
+from __future__ import annotations
+
+import tomllib
+
+import numpy as np
+import pytest
+
+import geardyn
+from geardyn.errors import ParameterError
+from geardyn.gears import PlanetaryGeometry, SpurGear
+from geardyn.io.toml import builtin_study_text, load_study_dict
+from geardyn.study import build_model
+
+OPTIONS = {"sun_bore_radius": "10 mm", "planet_bore_radius": "8 mm",
+           "ring_rim_radius": "85 mm", "angles": 64}
+
+
+def _doc(**geometry: object) -> dict:
+    doc = tomllib.loads(builtin_study_text("planetary_example"))
+    doc["params"]["geometry"].update(geometry)
+    return doc
+
+
+def _by_hand() -> geardyn.PlanetaryGearSet:
+    """The example study's set, built from the API with the same literal inputs."""
+    doc = tomllib.loads(builtin_study_text("planetary_example"))
+    p, g = doc["params"], doc["params"]["geometry"]
+    gears = {n: SpurGear(g[n]["teeth"], g["module"], g["pressure_angle"], g["face_width"],
+                         internal=n == "ring", name=f"geometry.{n}")
+             for n in ("sun", "planet", "ring")}
+    stage = PlanetaryGeometry(gears["sun"], gears["planet"], gears["ring"],
+                              n_planets=p["n_planets"])
+    members = {n: geardyn.Member(**p[n]) for n in ("sun", "ring", "carrier", "planet")}
+    kw = {k: p[k] for k in ("sun_backlash", "ring_backlash", "mesh_damping", "modal_damping",
+                            "sun_torque", "harmonics")}
+    return geardyn.PlanetaryGearSet.from_geometry(
+        stage, stiffness="potential_energy", stiffness_options=OPTIONS, **members, **kw)
+
+
+def test_study_equals_the_api_bitwise():
+    doc = _doc(stiffness="potential_energy", stiffness_options=OPTIONS, transition=0.0)
+    model = build_model(load_study_dict(doc))
+    hand = _by_hand().with_omega(float(model.params[model.omega_index]))  # the study's run
+    assert model.stiffness_method == "potential_energy"
+    assert np.array_equal(model.params, hand.params)
+    iso = build_model(load_study_dict(_doc(transition=0.0)))
+    assert iso.stiffness_method == "iso"
+    assert not np.array_equal(model.params, iso.params)
+
+
+@pytest.mark.parametrize(("geometry", "field"), [
+    ({"stiffness": "fem"}, "params.geometry.stiffness"),
+    ({"stiffness": "potential_energy", "stiffness_options": {**OPTIONS, "bore": 1.0},
+      "transition": 0.0}, "params.geometry.stiffness_options.bore"),
+    ({"stiffness": "potential_energy",
+      "stiffness_options": {k: v for k, v in OPTIONS.items() if k != "ring_rim_radius"},
+      "transition": 0.0}, "params.geometry.stiffness_options.ring_rim_radius"),
+    ({"stiffness": "potential_energy", "stiffness_options": OPTIONS},
+     "params.geometry.transition"),
+    ({"stiffness_options": OPTIONS}, "params.geometry.stiffness_options"),
+])
+def test_bad_stiffness_input_names_the_field(geometry, field):
+    with pytest.raises(ParameterError) as info:
+        build_model(load_study_dict(_doc(**geometry)))
+    assert info.value.field == field, info.value
