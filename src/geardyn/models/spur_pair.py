@@ -309,7 +309,7 @@ class SpurPair(Model):
 
     def _speed_si(self, value: object) -> float:
         """The pinion speed [rad/s] of ``value``: a unit string, or a number in
-        :attr:`speed_unit` (times its exact factor, once)."""
+        ``speed_unit`` (times its exact factor, once)."""
         if isinstance(value, str):
             return si_value("speed", value, "frequency")
         return si_value("speed", value, "frequency") * SPEED_UNITS[self.speed_unit]
@@ -351,7 +351,7 @@ class SpurPair(Model):
     # ------------------------------------------------------------------ parameters
     def with_params(self, **values: object) -> SpurPair:
         """As :meth:`Model.with_params`; ``speed`` (the pinion's, a number in
-        :attr:`speed_unit` or a unit string such as ``"3000 rpm"``) sets Omega, and the inputs
+        ``speed_unit`` or a unit string such as ``"3000 rpm"``) sets Omega, and the inputs
         take unit strings (``torque="80 N m"``, ``backlash="20 um"``)."""
         return super().with_params(**{k: self._si(k, v) for k, v in values.items()})
 
@@ -373,7 +373,7 @@ class SpurPair(Model):
 
     def lane_params(self, name: str, values: Sequence[float] | np.ndarray) -> np.ndarray:
         """Coefficient vectors with ``name`` set to ``values`` (``speed``: the pinion speed in
-        :attr:`speed_unit` sets Omega)."""
+        ``speed_unit`` sets Omega)."""
         if name == "speed":
             speeds = np.asarray(values, dtype=float).ravel()
             omegas = [self._omega_of_speed(self._speed_si(float(v))) for v in speeds]
