@@ -304,3 +304,14 @@ def test_a_study_holds_several_fault_kinds_each_on_its_tooth(tmp_path):
     assert np.array_equal(got["mesh_stiffness"].values, want["mesh_stiffness"].values)
     assert np.array_equal(got["mesh_stiffness_coast"].values,
                           want["mesh_stiffness_coast"].values)
+
+
+@pytest.mark.parametrize("command", [("simulate",), ("bifurcation",), ("frc",), ("continue",),
+                                     ("explore",), ("params", "show")])
+def test_commands_that_run_a_model_refuse_a_gears_only_study_first(capsys, command):
+    """A study of gears alone (no [params]) is refused by name before any option is resolved
+    (``simulate`` asked for --omega, ``explore`` for --range)."""
+    r = run(capsys, *command, "stiffness_19_48")
+    assert r.returncode == 2, (r.stdout, r.stderr)
+    err = r.stderr.strip()
+    assert len(err.splitlines()) == 1 and "has no [params]" in err, err

@@ -32,6 +32,14 @@ __all__ = ["build_model", "check_usable", "mesh_stiffness", "planetary_model",
            "spur_pair_model", "study_omega"]
 
 
+def require_model(study: Study) -> None:
+    """A :class:`~geardyn.StudyError` unless ``study`` describes a model (has ``[params]``): a
+    study of gears alone is for ``geardyn stiffness``."""
+    if study.params is None:
+        raise StudyError(f"study {study.study.name!r} has no [params]: it describes gears"
+                         " ([gears]) for geardyn stiffness, not a model")
+
+
 def build_model(study: Study, interpretation: str | None = None, omega: float | None = None
                 ) -> Model:
     """The study's model: a :class:`~geardyn.CATTDevice`, a :class:`~geardyn.GearPair`, a
@@ -46,9 +54,7 @@ def build_model(study: Study, interpretation: str | None = None, omega: float | 
         raise ParameterError(
             "interpretation", interpretation, f"must be one of {', '.join(INTERPRETATIONS)}"
         )
-    if study.params is None:
-        raise StudyError(f"study {study.study.name!r} has no [params]: it describes gears"
-                         " ([gears]) for geardyn stiffness, not a model")
+    require_model(study)
     om = omega if omega is not None else study.run.omega
     if isinstance(study.params, GearPairParams):
         kwargs = study.params.model_dump()

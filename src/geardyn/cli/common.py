@@ -106,9 +106,11 @@ NetCDFOutOption = Annotated[Path | None, typer.Option(help="NetCDF file to write
 PlotOption = Annotated[Path | None, typer.Option(help="Figure to write (.png, .pdf or .svg).")]
 
 
-def load_study_source(source: str | None):
-    """A study from a file, a built-in study name, or (None) the paper's device."""
+def load_study_source(source: str | None, *, model: bool = True):
+    """A study from a file, a built-in study name, or (None) the paper's device; with ``model``
+    (the commands that run one) a study of gears alone is refused before any option is read."""
     from geardyn.io.toml import builtin_study, builtin_study_names, load_study, paper_study
+    from geardyn.study import require_model
 
     if source is None:
         return paper_study()
@@ -116,10 +118,14 @@ def load_study_source(source: str | None):
         raise ParameterError("STUDY", source, "not a file name or built-in study name")
     path = Path(source)
     if path.exists() or path.suffix == ".toml" or "/" in source:
-        return load_study(path)
-    if source in builtin_study_names():
-        return builtin_study(source)
-    raise FileNotFoundError(2, "No such file or built-in study", source)
+        study = load_study(path)
+    elif source in builtin_study_names():
+        study = builtin_study(source)
+    else:
+        raise FileNotFoundError(2, "No such file or built-in study", source)
+    if model:
+        require_model(study)
+    return study
 
 
 def stderr_console() -> Console:

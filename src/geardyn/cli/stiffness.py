@@ -65,7 +65,7 @@ def stiffness_command(
     the faults on its teeth, with a load the transmission error; NetCDF and a figure."""
     from geardyn.study import mesh_stiffness
 
-    s = load_study_source(study)
+    s = load_study_source(study, model=False)
     if s.gears is None:
         raise ParameterError("STUDY", study, "has no [gears] table (the pair whose mesh "
                              "stiffness to compute)")
