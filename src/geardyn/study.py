@@ -197,7 +197,8 @@ def _from_geometry(table: dict, kw: dict, held: str | None = None) -> PlanetaryG
         else to_si(table["centre_distance"], "length"))
     extra = {k: v for k, v in kw.items() if k not in _FROM_GEOMETRY}
     return PlanetaryGearSet.from_geometry(
-        stage, waveform_options={"transition": table["transition"]}, held=held, **extra)
+        stage, waveform_options={"transition": table["transition"]}, held=held,
+        coast=table["coast"], **extra)
 
 
 def check_usable(build: Callable[[], Model]) -> Model:

@@ -493,6 +493,7 @@ class GeometryTable(BaseModel):
     dedendum: float = 1.25
     centre_distance: Quantity | None = None
     transition: float = 0.0
+    coast: Literal["mirror", "symmetric"] = "mirror"  # the coast flank (from_geometry's coast)
     sun: GearTable
     planet: GearTable
     ring: GearTable
