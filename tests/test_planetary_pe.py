@@ -308,8 +308,9 @@ def test_two_flank_form_with_equal_flanks_is_the_one_flank_form_bitwise():
     P0 = gs.lane_params("Omega", [0.8, 1.1, 1.3])
     P1 = P0.copy()
     P1[:, pk.TWO_FLANK] = 1.0
-    r0 = run_lanes(gs, P0, y0, 10.0, 3, steps_per_period=64)
-    r1 = run_lanes(gs, P1, y0, 10.0, 3, steps_per_period=64)
+    run = geardyn.RunSettings(transient=10.0, samples=3, steps_per_period=64)
+    r0 = run_lanes(gs, P0, y0, run=run)
+    r1 = run_lanes(gs, P1, y0, run=run)
     np.testing.assert_array_equal(r0.samples, r1.samples)
 
 
@@ -373,8 +374,8 @@ def test_lanes_reproduce_single_simulations_bitwise_with_two_flanks(geo):
     lane the per-lane functions' result, with contact lost on both sides."""
     gs = pe_set(geo, harmonics=12, sun_mesh_error="15 um", ring_mesh_error="15 um")
     omegas = np.array([0.5, 0.8, 1.1])
-    r = run_lanes(gs, gs.lane_params("Omega", omegas), gs.initial_state(), 10.0, 3,
-                  steps_per_period=64)
+    r = run_lanes(gs, gs.lane_params("Omega", omegas), gs.initial_state(),
+                  run=geardyn.RunSettings(transient=10.0, samples=3, steps_per_period=64))
     assert np.all(r.status == 0)
     for j in (0, 2):
         ds = geardyn.simulate(gs, omega=omegas[j], y0=gs.initial_state(),
