@@ -111,7 +111,8 @@ def test_kernel_stiffness_is_the_tables_fourier_series(geo, pe_tables):
             want = series(k[m], H, np.array([theta - 2.0 * math.pi * gam[m]]))[0]
             assert got[m] == pytest.approx(want, rel=1e-10)
     assert gs.stiffness_method == "potential_energy"
-    assert gs.dataset_attrs() == {"mesh_stiffness_method": "potential_energy"}
+    assert gs.dataset_attrs() == {"mesh_stiffness_method": "potential_energy",
+                                  "mesh_coast_flank": "mirror"}
     assert gs.k_s == pytest.approx(k[0].mean(), rel=1e-12)
     assert gs.k_r == pytest.approx(k[4].mean(), rel=1e-12)
     changed = gs.with_params(sun_backlash="5 um")  # rebuilt from the inputs, tables kept
@@ -159,11 +160,13 @@ def test_series_converges_to_the_table_away_from_the_jumps(geo):
         assert far[0] > 1e-2  # the short series is visibly off: the check can fail
 
 
-def test_iso_default_is_the_iso_waves_bitwise(geo):
-    """The default (and stiffness="iso") builds the set from the ISO waves exactly as a direct
-    construction from the waves here does."""
-    gs = geardyn.PlanetaryGearSet.from_geometry(geo, **MEMBERS, **KW)
-    iso = geardyn.PlanetaryGearSet.from_geometry(geo, stiffness="iso", **MEMBERS, **KW)
+def test_iso_symmetric_is_the_iso_waves_bitwise(geo):
+    """The ISO waves with coast="symmetric" (one stiffness on both flanks) build the set exactly
+    as a direct construction from the waves here does; the default (stiffness="iso", coast
+    "mirror") differs from it only in its coast flank (tests/test_planetary_iso_flanks.py)."""
+    gs = geardyn.PlanetaryGearSet.from_geometry(geo, coast="symmetric", **MEMBERS, **KW)
+    iso = geardyn.PlanetaryGearSet.from_geometry(geo, stiffness="iso", coast="symmetric",
+                                                 **MEMBERS, **KW)
     ws, wr = geo.waveforms()
     members = {k: m.__class__(**{**m.__dict__, "radius": r}) for (k, m), r in zip(
         MEMBERS.items(), (geo.sun.base_radius, geo.ring.base_radius,
@@ -179,7 +182,10 @@ def test_iso_default_is_the_iso_waves_bitwise(geo):
     np.testing.assert_array_equal(gs.params, direct.params)
     np.testing.assert_array_equal(iso.params, direct.params)
     assert gs.stiffness_method == "iso" and gs.stiffness_tables is None
-    assert gs.dataset_attrs() == {"mesh_stiffness_method": "iso"}
+    assert gs.dataset_attrs() == {"mesh_stiffness_method": "iso",
+                                  "mesh_coast_flank": "symmetric"}
+    mirror = geardyn.PlanetaryGearSet.from_geometry(geo, **MEMBERS, **KW)
+    assert mirror.coast_flank == "mirror" and mirror.params[pk.TWO_FLANK] == 1.0
 
 
 def test_natural_frequencies_follow_the_mean_stiffness(geo, pe_tables):

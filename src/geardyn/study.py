@@ -211,9 +211,11 @@ def _from_geometry(table: dict, kw: dict, held: str | None = None) -> PlanetaryG
     try:
         return PlanetaryGearSet.from_geometry(
             stage, held=held, stiffness=table["stiffness"],
-            stiffness_options=table["stiffness_options"] or None, **waves, **extra)
+            stiffness_options=table["stiffness_options"] or None, coast=table["coast"],
+            **waves, **extra)
     except ParameterError as exc:
-        if exc.field.split(".")[0] in ("stiffness", "stiffness_options", "waveform_options"):
+        if exc.field.split(".")[0] in ("stiffness", "stiffness_options", "waveform_options",
+                                        "coast"):
             raise ParameterError(f"geometry.{exc.field}", exc.value, exc.reason) from None
         raise
 

@@ -498,6 +498,7 @@ class GeometryTable(BaseModel):
     stiffness_options: dict[str, Any] = Field(
         default_factory=dict, description="the potential-energy inputs "
         "(PlanetaryGearSet.from_geometry's stiffness_options: bores, rim, material, angles)")
+    coast: Literal["mirror", "symmetric"] = "mirror"  # the coast flank (from_geometry's coast)
     sun: GearTable
     planet: GearTable
     ring: GearTable

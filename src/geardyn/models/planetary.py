@@ -49,7 +49,9 @@ from geardyn.models.planetary_coefficients import (
     workspace_entry,
 )
 from geardyn.models.planetary_stiffness import (
+    coast_flank,
     flank_series,
+    mirrored,
     potential_energy_options,
     potential_energy_tables,
     stiffness_method,
@@ -151,13 +153,15 @@ _FROM_GEOMETRY = ("n_planets", "planet_angles", "sun_pressure_angle", "ring_pres
                   "sun_mesh_stiffness", "ring_mesh_stiffness", "waveform", "contact_ratio",
                   "sun_stiffness_fluctuation", "ring_stiffness_fluctuation", "sun_mesh_phase",
                   "ring_mesh_phase")
-#: The coast-flank inputs :meth:`PlanetaryGearSet.from_geometry` sets (from the
-#: potential-energy tables; with the ISO waves none: one stiffness on both flanks).
+#: The coast-flank inputs :meth:`PlanetaryGearSet.from_geometry` sets (``coast="mirror"``: the
+#: mirrored ISO waves or the potential-energy tables' coast flank; ``"symmetric"``: none, one
+#: stiffness on both flanks).
 _COAST_FROM_GEOMETRY = ("sun_coast_stiffness", "ring_coast_stiffness", "coast_waveform")
 
 
 #: Attributes :meth:`PlanetaryGearSet.from_geometry` attaches, kept by ``with_params``.
-_FROM_BUILD = ("geometry", "stiffness_waveforms", "stiffness_tables", "stiffness_method", "held")
+_FROM_BUILD = ("geometry", "stiffness_waveforms", "stiffness_tables", "stiffness_method", "held",
+               "coast_flank")
 #: The sweep parameter of a set built from geometry: the input member's speed [rpm].
 INPUT_SPEED = "input_speed"
 #: Units of the swept inputs, by kind (dataset axis attributes; see ``param_attrs``).
@@ -372,6 +376,9 @@ class PlanetaryGearSet(Model):
     #: How a set built by :meth:`from_geometry` got its mesh stiffness (``"iso"``,
     #: ``"potential_energy"``; None otherwise).
     stiffness_method: str | None = None
+    #: The coast flank of a set built by :meth:`from_geometry` (``"mirror"``, ``"symmetric"``;
+    #: None otherwise).
+    coast_flank: str | None = None
     #: The ISO 6336-1 waves (sun, ring) of a set built from geometry with ``stiffness="iso"``.
     stiffness_waveforms: Any = None
     #: The potential-energy Datasets (sun, ring) of a set built with
@@ -587,7 +594,7 @@ class PlanetaryGearSet(Model):
                       waveform_options: Mapping[str, Any] | None = None,
                       held: str | None = None, stiffness: str = "iso",
                       stiffness_options: Mapping[str, Any] | None = None,
-                      **kw: Any) -> PlanetaryGearSet:
+                      coast: str = "mirror", **kw: Any) -> PlanetaryGearSet:
         """The gear set of a :class:`geardyn.gears.PlanetaryGeometry` (see ``docs/planetary.md``,
         "From gear geometry").
 
@@ -621,6 +628,16 @@ class PlanetaryGearSet(Model):
         ``angles`` (points per mesh cycle, default 360, > 2 ``harmonics``), ``nodes``,
         ``root_segment``. The tables are kept as :attr:`stiffness_tables` (sun, ring), the method as
         :attr:`stiffness_method`.
+
+        ``coast``: the coast (back) flank. ``"mirror"`` (default): its own stiffness, for
+        symmetric teeth the mirror image of the drive flank's, K_coast(theta) = K_drive(2 pi phi -
+        theta) with phi = :func:`geardyn.gears.potential_energy.coast_phase` of the mesh (from the
+        geometry alone); with the ISO waves ``coast_waveform`` is the drive series mirrored
+        exactly (:func:`~geardyn.models.planetary_stiffness.mirrored`; the same mean, so
+        ``sun_coast_stiffness``/``ring_coast_stiffness`` stay None and follow the drive flank's),
+        with the potential-energy method the tables' own coast flank (above). ``"symmetric"``: the
+        drive flank's stiffness on both flanks (no coast inputs). The choice is kept as
+        :attr:`coast_flank`.
         """
         from geardyn.gears import PlanetaryGeometry
 
@@ -632,11 +649,12 @@ class PlanetaryGearSet(Model):
                 raise ParameterError(f, kw[f], "comes from the geometry; change the gears "
                                      "(or build PlanetaryGearSet directly)")
         method = stiffness_method(stiffness, stiffness_options)
+        coast = coast_flank(coast)
         if isinstance(harmonics, bool) or not isinstance(harmonics, int) \
                 or not 1 <= harmonics <= 200:
             raise ParameterError("harmonics", harmonics, "must be an integer from 1 to 200")
         inputs, tables, waves = _geometry_stiffness(geometry, method, stiffness_options,
-                                                    waveform_options, harmonics)
+                                                    waveform_options, harmonics, coast)
         held_member = _held(held, tuple(kw.get("fixed", ())))
         phases = geometry.phases_turning(_sun_turns(held_member))
         meshes = {"sun": geometry.sun_mesh, "ring": geometry.ring_mesh}
@@ -670,15 +688,18 @@ class PlanetaryGearSet(Model):
         model.stiffness_waveforms = waves
         model.stiffness_tables = tables
         model.stiffness_method = method
+        model.coast_flank = coast
         model.held = _held(held, model.fixed)
         return model
 
     def dataset_attrs(self) -> dict[str, object]:
         """A set built from geometry records its mesh stiffness method (``"iso"``: ISO 6336-1
-        waves; ``"potential_energy"``: the potential-energy tables)."""
+        waves; ``"potential_energy"``: the potential-energy tables) and its coast flank
+        (``"mirror"``, ``"symmetric"``)."""
         if self.geometry is None:
             return {}
-        return {"mesh_stiffness_method": self.stiffness_method}
+        return {"mesh_stiffness_method": self.stiffness_method,
+                "mesh_coast_flank": self.coast_flank}
 
     # ------------------------------------------------------------------ input speed
     @property
@@ -1331,27 +1352,38 @@ class PlanetaryGearSet(Model):
 
 
 def _geometry_stiffness(geometry: Any, method: str, options: Mapping[str, Any] | None,
-                        waveform_options: Mapping[str, Any] | None, harmonics: int
-                        ) -> tuple[dict[str, Any], Any, Any]:
-    """The stiffness inputs of the set (``*_mesh_stiffness``, ``waveform`` and, from the
-    potential-energy tables, the coast flank's ``*_coast_stiffness``, ``coast_waveform``); the
-    potential-energy tables (or None) and the ISO waves (or None)."""
+                        waveform_options: Mapping[str, Any] | None, harmonics: int,
+                        coast: str) -> tuple[dict[str, Any], Any, Any]:
+    """The stiffness inputs of the set (``*_mesh_stiffness``, ``waveform`` and with ``coast =
+    "mirror"`` the coast flank's: ``coast_waveform``, the ISO series mirrored about each mesh's
+    coast phase, or ``*_coast_stiffness`` and ``coast_waveform`` from the potential-energy
+    tables); the potential-energy tables (or None) and the ISO waves (or None)."""
     if method == "iso":
+        from geardyn.gears.potential_energy import coast_phase
+
         w_sun, w_ring = geometry.waveforms(**dict(waveform_options or {}))
-        return ({"sun_mesh_stiffness": w_sun.mean, "ring_mesh_stiffness": w_ring.mean,
-                 "waveform": {"sun": w_sun.fourier(harmonics),
-                              "ring": w_ring.fourier(harmonics)}}, None, (w_sun, w_ring))
+        drive = {"sun": w_sun.fourier(harmonics), "ring": w_ring.fourier(harmonics)}
+        out: dict[str, Any] = {"sun_mesh_stiffness": w_sun.mean,
+                               "ring_mesh_stiffness": w_ring.mean, "waveform": drive}
+        if coast == "mirror":
+            out["coast_waveform"] = {
+                g: mirrored(*drive[g], coast_phase(mesh))
+                for g, mesh in (("sun", geometry.sun_mesh), ("ring", geometry.ring_mesh))}
+        return out, None, (w_sun, w_ring)
     if waveform_options:
         raise ParameterError("waveform_options", dict(waveform_options),
                              "only with stiffness='iso' (the ISO waves)")
     opts = potential_energy_options(options, geometry, harmonics)
     tables = potential_energy_tables(geometry, opts)
-    out: dict[str, Any] = {"waveform": {}, "coast_waveform": {}}
+    out = {"waveform": {}, "coast_waveform": {}}
     for g, table in zip(("sun", "ring"), tables, strict=True):
-        drive = flank_series(table["mesh_stiffness"].values, harmonics)
-        coast = flank_series(table["mesh_stiffness_coast"].values, harmonics)
-        out[f"{g}_mesh_stiffness"], out["waveform"][g] = drive.mean, drive.pair
-        out[f"{g}_coast_stiffness"], out["coast_waveform"][g] = coast.mean, coast.pair
+        series = flank_series(table["mesh_stiffness"].values, harmonics)
+        out[f"{g}_mesh_stiffness"], out["waveform"][g] = series.mean, series.pair
+        series = flank_series(table["mesh_stiffness_coast"].values, harmonics)
+        out[f"{g}_coast_stiffness"], out["coast_waveform"][g] = series.mean, series.pair
+    if coast == "symmetric":
+        for key in _COAST_FROM_GEOMETRY:
+            out.pop(key)
     return out, tables, None
 
 

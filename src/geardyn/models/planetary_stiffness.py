@@ -7,6 +7,12 @@ A table k(theta_j) [N/m], uniform over one mesh cycle (theta_j = 2 pi j / n from
 of a tooth pair through the pitch point, the phase origin of the ISO waves too), becomes its
 discrete Fourier series k0 (1 + sum_h a_h cos(h theta) + b_h sin(h theta)), h = 1..H: the mean
 k0 and the relative coefficients (a_h, b_h) the model's ``waveform`` takes.
+
+The coast (back) flank (``coast``): ``"mirror"`` gives it its own stiffness, the mirror image of
+the drive flank's about the coast phase phi (:func:`geardyn.gears.potential_energy.coast_phase`,
+geometry only): K_coast(theta) = K_drive(2 pi phi - theta) (:func:`mirrored`) for the ISO waves,
+the tables' own coast flank for the potential-energy method; ``"symmetric"`` the drive flank's
+stiffness on both flanks.
 """
 
 from __future__ import annotations
@@ -25,6 +31,8 @@ from geardyn.units import si_value
 STIFFNESS_METHODS = ("iso", "potential_energy")
 #: Points per mesh cycle of the potential-energy tables by default.
 DEFAULT_ANGLES = 360
+#: The coast-flank choices of :meth:`geardyn.PlanetaryGearSet.from_geometry` (``coast``).
+COAST_FLANKS = ("mirror", "symmetric")
 _FIELD = "stiffness_options"
 _REQUIRED = ("sun_bore_radius", "planet_bore_radius", "ring_rim_radius")
 _OPTIONAL = ("young", "poisson", "angles", "nodes", "root_segment")
@@ -71,6 +79,25 @@ def stiffness_method(stiffness: Any, options: Mapping[str, Any] | None) -> str:
         raise ParameterError(_FIELD, dict(options), "only with stiffness='potential_energy' "
                              "(the ISO waves take waveform_options)")
     return stiffness
+
+
+def coast_flank(coast: Any) -> str:
+    """``coast`` checked: one of :data:`COAST_FLANKS`."""
+    if not isinstance(coast, str) or coast not in COAST_FLANKS:
+        raise ParameterError("coast", coast,
+                             f"must be one of {', '.join(map(repr, COAST_FLANKS))}")
+    return coast
+
+
+def mirrored(a: np.ndarray, b: np.ndarray, phase_cycles: float) -> tuple[np.ndarray, np.ndarray]:
+    """The relative Fourier coefficients of k(2 pi phi - theta) from those (a_h, b_h), h = 1..H,
+    of k(theta) = k0 (1 + sum a_h cos(h theta) + b_h sin(h theta)), phi = ``phase_cycles``
+    [mesh cycles]: a'_h = a_h cos(h Phi) + b_h sin(h Phi), b'_h = a_h sin(h Phi) - b_h cos(h Phi),
+    Phi = 2 pi phi (the mean is unchanged)."""
+    a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
+    P = 2.0 * np.pi * np.arange(1, a.size + 1) * float(phase_cycles)
+    c, s = np.cos(P), np.sin(P)
+    return a * c + b * s, a * s - b * c
 
 
 def _whole(field: str, value: Any, minimum: int) -> int:
