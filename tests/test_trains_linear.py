@@ -1,0 +1,289 @@
+"""The linear model of a gear train described from elements (geardyn.trains), checked against
+independent computations: the closed form of a gear pair, a stiffness matrix written out by hand,
+and the Lin & Parker planetary set of geardyn.PlanetaryGearSet."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from scipy.linalg import eigh
+
+import geardyn
+from geardyn.errors import ParameterError
+from geardyn.gears import SpurGear
+from geardyn.trains import GROUND, Bearing, Gear, GearTrain, Inertia, Mesh, Shaft
+
+ALPHA = math.radians(20.0)
+
+
+def _rb(module: float, teeth: int, alpha: float = ALPHA) -> float:
+    return 0.5 * module * teeth * math.cos(alpha)
+
+
+# ---------------------------------------------------------------- (a) one gear pair
+def test_gear_pair_matches_two_inertia_closed_form():
+    i1, i2, r1, r2, k = 2e-3, 9e-3, 0.03, 0.055, 3.2e8
+    train = GearTrain(
+        [Gear("pinion", i1, base_radius=r1), Gear("wheel", i2, base_radius=r2)],
+        bearings=[Bearing("b1", "pinion", math.inf), Bearing("b2", "wheel", math.inf)],
+        meshes=[Mesh("m", "pinion", "wheel", k)], free=True)
+    m_e = i1 * i2 / (i1 * r2 ** 2 + i2 * r1 ** 2)
+    f = train.natural_frequencies()
+    assert f[0] == 0.0 and train.rigid_body_modes == 1
+    assert f[1] == pytest.approx(math.sqrt(k / m_e) / (2 * math.pi), rel=1e-12)
+    modes = train.modes()
+    assert bool(modes.rigid_body[0]) and not bool(modes.rigid_body[1])
+    assert float(modes.energy_share.sel(element="m")[1]) == pytest.approx(1.0, rel=1e-12)
+
+
+def test_gear_pair_on_stiff_lateral_bearings_tends_to_the_torsional_frequency():
+    """Lateral dofs along the line of action soften the mesh: with bearings 1e4 times the mesh
+    stiffness the torsional mode is within 1e-3 of the rigid-bearing value, and below it."""
+    i1, i2, r1, r2, k = 2e-3, 9e-3, 0.03, 0.055, 3.2e8
+    train = GearTrain(
+        [Gear("pinion", i1, mass=1.5, base_radius=r1), Gear("wheel", i2, mass=3.0,
+                                                            base_radius=r2)],
+        bearings=[Bearing("b1", "pinion", 1e4 * k), Bearing("b2", "wheel", 1e4 * k)],
+        meshes=[Mesh("m", "pinion", "wheel", k, angle=0.7)], free=True)
+    f0 = math.sqrt(k * (i1 * r2 ** 2 + i2 * r1 ** 2) / (i1 * i2)) / (2 * math.pi)
+    f = train.natural_frequencies()
+    assert train.dof_names() == ("pinion.theta", "pinion.x", "pinion.y", "wheel.theta",
+                                 "wheel.x", "wheel.y")
+    torsional = f[np.argmin(np.abs(f - f0))]
+    assert torsional < f0 and torsional == pytest.approx(f0, rel=1e-3)
+
+
+# ---------------------------------------------------------------- (b) two parallel stages
+MODULE = 3e-3
+Z = (19, 61, 23, 71)
+INERTIA = (0.01, 0.35, 0.02, 0.6)
+K_IN, K_MID, K_OUT, KA, KB = 4e4, 9e5, 2.5e5, 6e8, 8e8
+
+
+def _two_stage(**kw) -> GearTrain:
+    g = [Gear(f"g{i + 1}", INERTIA[i], base_radius=_rb(MODULE, Z[i]), n_teeth=Z[i])
+         for i in range(4)]
+    return GearTrain(
+        g,
+        shafts=[Shaft("input", "g1", GROUND, K_IN), Shaft("mid", "g2", "g3", K_MID),
+                Shaft("output", "g4", GROUND, K_OUT)],
+        bearings=[Bearing(f"b{i + 1}", f"g{i + 1}", math.inf) for i in range(4)],
+        meshes=[Mesh("stage1", "g1", "g2", KA), Mesh("stage2", "g3", "g4", KB)],
+        driven="g1", **kw)
+
+
+def _hand_matrices() -> tuple[np.ndarray, np.ndarray]:
+    r1, r2, r3, r4 = (_rb(MODULE, z) for z in Z)
+    K = np.array([
+        [K_IN + KA * r1 ** 2, KA * r1 * r2, 0.0, 0.0],
+        [KA * r1 * r2, KA * r2 ** 2 + K_MID, -K_MID, 0.0],
+        [0.0, -K_MID, K_MID + KB * r3 ** 2, KB * r3 * r4],
+        [0.0, 0.0, KB * r3 * r4, KB * r4 ** 2 + K_OUT]])
+    return K, np.diag(INERTIA)
+
+
+def test_two_stage_train_matches_hand_assembled_matrices():
+    train = _two_stage()
+    K, M = _hand_matrices()
+    lam = eigh(K, M, eigvals_only=True)
+    assert train.dof_names() == ("g1.theta", "g2.theta", "g3.theta", "g4.theta")
+    assert train.natural_frequencies() == pytest.approx(np.sqrt(lam) / (2 * math.pi),
+                                                        rel=1e-10)
+    assert train.rigid_body_modes == 0
+
+
+def test_two_stage_energy_shares_sum_to_one_and_match_hand_computation():
+    modes = _two_stage().modes()
+    share = modes.energy_share
+    assert share.sum("element").values == pytest.approx(np.ones(4), rel=1e-12)
+    K, M = _hand_matrices()
+    lam, phi = eigh(K, M)
+    r1, r2 = _rb(MODULE, Z[0]), _rb(MODULE, Z[1])
+    stage1 = [0.5 * KA * (r1 * p[0] + r2 * p[1]) ** 2 / (0.5 * p @ K @ p) for p in phi.T]
+    mid = [0.5 * K_MID * (p[1] - p[2]) ** 2 / (0.5 * p @ K @ p) for p in phi.T]
+    assert share.sel(element="stage1").values == pytest.approx(stage1, rel=1e-9)
+    assert share.sel(element="mid").values == pytest.approx(mid, rel=1e-9)
+    assert list(modes.element_kind.values) == ["mesh", "mesh", "shaft", "shaft", "shaft"]
+
+
+def test_two_stage_campbell_orders_and_crossings_from_tooth_counts():
+    train = _two_stage()
+    ratios = train.speed_ratios()
+    assert ratios["g2"] == pytest.approx(-Z[0] / Z[1], rel=1e-12)
+    assert ratios["g4"] == pytest.approx(Z[0] * Z[2] / (Z[1] * Z[3]), rel=1e-12)
+    order2 = Z[2] * Z[0] / Z[1]
+    ds = train.campbell(np.linspace(0.0, 3000.0, 301), harmonics=2)
+    assert list(ds.order.values) == pytest.approx([Z[0], Z[0], order2, order2], rel=1e-12)
+    K, M = _hand_matrices()
+    f_n = np.sqrt(eigh(K, M, eigvals_only=True)) / (2 * math.pi)
+    expected = 60.0 * f_n[None, :] / np.array([Z[0], 2 * Z[0], order2, 2 * order2])[:, None]
+    expected = np.where(expected <= 3000.0, expected, np.nan)
+    np.testing.assert_allclose(ds.crossing_speed.values, expected, rtol=1e-10)
+    assert np.isfinite(ds.crossing_speed.values).any()
+    assert float(ds.excitation_frequency.isel(excitation=2, speed=-1)) == pytest.approx(
+        order2 * 3000.0 / 60.0, rel=1e-12)
+
+
+def test_rayleigh_and_element_damping():
+    train = _two_stage(rayleigh=(0.5, 1e-5))
+    K, M = _hand_matrices()
+    np.testing.assert_allclose(train.damping_matrix(), 0.5 * M + 1e-5 * K, rtol=1e-12)
+
+
+# ---------------------------------------------------------------- (c) one planetary stage
+LP = {"sun": (0.4, 0.39), "ring": (2.35, 3.0), "carrier": (5.43, 6.29), "planet": (0.66, 0.61)}
+K_BEARING, K_PLANET, K_MESH, K_RING_U, K_CARRIER_U = 1e8, 1e8, 5e8, 1e9, 2e8
+ZS, ZP = 23, 19
+ZR = ZS + 2 * ZP
+M_P = 2e-3
+A_S = A_R = math.radians(24.6)
+
+
+def _lp_set(n: int, fixed: tuple[str, ...], rotational_only: bool) -> geardyn.PlanetaryGearSet:
+    member = {k: geardyn.Member(mass=m, inertia_over_r2=i, bearing_stiffness=K_BEARING)
+              for k, (m, i) in LP.items()}
+    member["ring"] = geardyn.Member(*LP["ring"], K_BEARING, torsional_stiffness=K_RING_U)
+    member["carrier"] = geardyn.Member(*LP["carrier"], K_BEARING,
+                                       torsional_stiffness=K_CARRIER_U)
+    member["planet"] = geardyn.Member(*LP["planet"], K_PLANET)
+    return geardyn.PlanetaryGearSet(n, A_S, A_R, **member, sun_mesh_stiffness=K_MESH,
+                                    ring_mesh_stiffness=K_MESH, fixed=fixed,
+                                    rotational_only=rotational_only)
+
+
+def _element_set(n: int, fixed: tuple[str, ...], rotational_only: bool) -> GearTrain:
+    """The same stage from elements; rotations in rad, so inertias I = (I/r^2) r^2 and torsional
+    stiffnesses k_u r^2 (LP's u = r theta)."""
+    rb = {"sun": _rb(M_P, ZS, A_S), "ring": _rb(M_P, ZR, A_R), "planet": _rb(M_P, ZP, A_S)}
+    rc = 0.5 * M_P * (ZS + ZP)  # planet-centre radius
+    teeth = {"sun": ZS, "ring": ZR}
+    mass = (lambda k: None) if rotational_only else (lambda k: LP[k][0])  # noqa: E731
+    bodies: list[Inertia] = [Gear(k, LP[k][1] * rb[k] ** 2, mass=mass(k), base_radius=rb[k],
+                                  n_teeth=teeth[k]) for k in ("sun", "ring")]
+    bodies.append(Inertia("carrier", LP["carrier"][1] * rc ** 2, mass=mass("carrier")))
+    planet_k = math.inf if rotational_only else K_PLANET
+    bearings = [] if rotational_only else [Bearing(f"{k}_bearing", k, K_BEARING)
+                                           for k in ("sun", "ring", "carrier")]
+    meshes = []
+    for i in range(n):
+        psi = 2 * math.pi * i / n
+        p = f"planet{i + 1}"
+        bodies.append(Gear(p, LP["planet"][1] * rb["planet"] ** 2, mass=LP["planet"][0],
+                           base_radius=rb["planet"], n_teeth=ZP))
+        bearings.append(Bearing(f"pin{i + 1}", p, planet_k, host="carrier", radius=rc,
+                                angle=psi))
+        meshes += [Mesh(f"sun_{p}", "sun", p, K_MESH, angle=psi, pressure_angle=A_S),
+                   Mesh(f"{p}_ring", p, "ring", K_MESH, internal=True, angle=psi + math.pi,
+                        pressure_angle=A_R)]
+    shafts = [Shaft("ring_support", "ring", GROUND, K_RING_U * rb["ring"] ** 2),
+              Shaft("output", "carrier", GROUND, K_CARRIER_U * rc ** 2)]
+    if "ring" in fixed:
+        shafts = shafts[1:]
+    return GearTrain(bodies, shafts, bearings, meshes, fixed=fixed, driven="sun")
+
+
+@pytest.mark.parametrize(("n", "fixed", "rotational_only"),
+                         [(3, ("ring",), False), (4, (), False), (5, ("ring",), True)])
+def test_planetary_stage_from_elements_matches_planetary_gear_set(n, fixed, rotational_only):
+    train = _element_set(n, fixed, rotational_only)
+    lp = _lp_set(n, fixed, rotational_only)
+    f = train.natural_frequencies()
+    assert f.size == lp.natural_frequencies().size
+    np.testing.assert_allclose(f, lp.natural_frequencies(), rtol=1e-9)
+    shares = train.modes().energy_share.sum("element").values
+    np.testing.assert_allclose(shares, 1.0, rtol=1e-10)
+
+
+def test_planetary_mesh_order_from_tooth_counts():
+    """Ring fixed, sun input: the carrier turns at Z_s / (Z_s + Z_r) of the sun and the mesh
+    frequency over the sun's speed is Z_s Z_r / (Z_s + Z_r) (both meshes)."""
+    train = _element_set(3, ("ring",), False)
+    assert train.speed_ratios()["carrier"] == pytest.approx(ZS / (ZS + ZR), rel=1e-9)
+    orders = train.mesh_orders()
+    assert len(orders) == 6
+    for value in orders.values():
+        assert value == pytest.approx(ZS * ZR / (ZS + ZR), rel=1e-9)
+
+
+def test_star_arrangement_turns_the_ring_backwards():
+    """Carrier held, sun input: the ring turns at -Z_s / Z_r of the sun, the planets at
+    -Z_s / Z_p, and the mesh order is Z_s."""
+    train = _element_set(3, ("carrier",), False)
+    ratios = train.speed_ratios()
+    assert ratios["ring"] == pytest.approx(-ZS / ZR, rel=1e-9)
+    assert ratios["planet2"] == pytest.approx(-ZS / ZP, rel=1e-9)
+    assert list(train.mesh_orders().values()) == pytest.approx([ZS] * 6, rel=1e-9)
+
+
+# ---------------------------------------------------------------- (d) errors
+def _spur(z: int, module: float, name: str) -> SpurGear:
+    return SpurGear(z, module, ALPHA, 0.02, name=name)
+
+
+def _pair(mesh: Mesh, g1: SpurGear, g2: SpurGear) -> GearTrain:
+    return GearTrain([Gear("p", 1e-3, geometry=g1), Gear("w", 4e-3, geometry=g2)],
+                     shafts=[Shaft("s", "p", GROUND, 1e4)], meshes=[mesh])
+
+
+def test_mesh_between_different_modules_is_refused_naming_the_mesh():
+    with pytest.raises(ParameterError) as err:
+        _pair(Mesh("stage", "p", "w", 1e8), _spur(20, 2e-3, "p"), _spur(40, 3e-3, "w"))
+    assert err.value.field == "stage.wheel.module"
+
+
+def test_inconsistent_centre_distance_is_refused_naming_the_mesh():
+    with pytest.raises(ParameterError) as err:
+        _pair(Mesh("stage", "p", "w", 1e8, centre_distance=0.07), _spur(20, 2e-3, "p"),
+              _spur(40, 2e-3, "w"))
+    assert err.value.field == "stage.centre_distance"
+    with pytest.raises(ParameterError) as err:  # without geometry: against radii and angle
+        GearTrain([Gear("p", 1e-3, base_radius=0.02), Gear("w", 4e-3, base_radius=0.04)],
+                  shafts=[Shaft("s", "p", GROUND, 1e4)],
+                  meshes=[Mesh("stage", "p", "w", 1e8, centre_distance=0.07)])
+    assert err.value.field == "stage.centre_distance"
+
+
+def test_iso_stiffness_from_geometry():
+    g1, g2 = _spur(20, 2e-3, "p"), _spur(40, 2e-3, "w")
+    train = _pair(Mesh("stage", "p", "w", "iso"), g1, g2)
+    expected = geardyn.gears.iso6336_stiffness(geardyn.gears.GearMesh(g1, g2)).mesh_stiffness
+    assert train.mesh_data["stage"].stiffness == expected
+    assert train.mesh_data["stage"].method == "iso"
+
+
+def test_gear_on_no_shaft_is_refused():
+    with pytest.raises(ParameterError) as err:
+        GearTrain([Gear("p", 1e-3, base_radius=0.02), Gear("w", 4e-3, base_radius=0.04),
+                   Gear("idle", 1e-3, base_radius=0.02)],
+                  shafts=[Shaft("s", "p", GROUND, 1e4)], meshes=[Mesh("m", "p", "w", 1e8)])
+    assert err.value.field == "idle"
+
+
+@pytest.mark.parametrize(("make", "field"), [
+    (lambda: Shaft("s", "a", GROUND, -5.0), "s.stiffness"),
+    (lambda: Mesh("m", "a", "b", float("nan")), "m.stiffness"),
+    (lambda: Bearing("brg", "a", "-1 N/m"), "brg.stiffness"),
+    (lambda: Inertia("a", 0.0), "a.inertia"),
+    (lambda: Mesh("m", "a", "b", 1e8, backlash=(1e-5, -1e-5)), "m.backlash"),
+])
+def test_bad_element_values_name_the_element_and_field(make, field):
+    with pytest.raises(ParameterError) as err:
+        make()
+    assert err.value.field == field
+
+
+def test_topology_errors_name_the_element_and_field():
+    a, b = Gear("a", 1e-3, base_radius=0.02), Gear("b", 4e-3, base_radius=0.04)
+    shaft = Shaft("s", "a", GROUND, 1e4)
+    with pytest.raises(ParameterError) as err:
+        GearTrain([a, b], [shaft], meshes=[Mesh("m", "a", "c", 1e8)])
+    assert err.value.field == "m.b"
+    with pytest.raises(ParameterError) as err:  # a free rigid-body mode, not accepted
+        GearTrain([a, b], meshes=[Mesh("m", "a", "b", 1e8)],
+                  bearings=[Bearing("ba", "a", math.inf)])
+    assert err.value.field == "fixed"
+    with pytest.raises(ParameterError) as err:  # lateral dofs need a mass
+        GearTrain([a, b], [shaft], [Bearing("bb", "b", 1e8)], [Mesh("m", "a", "b", 1e8)])
+    assert err.value.field == "b.mass"
