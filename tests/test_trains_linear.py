@@ -287,3 +287,29 @@ def test_topology_errors_name_the_element_and_field():
     with pytest.raises(ParameterError) as err:  # lateral dofs need a mass
         GearTrain([a, b], [shaft], [Bearing("bb", "b", 1e8)], [Mesh("m", "a", "b", 1e8)])
     assert err.value.field == "b.mass"
+
+
+def test_potential_energy_stiffness_is_the_mean_over_a_mesh_cycle():
+    """The mean of the potential-energy wave on a finer grid (720 points a cycle) agrees to
+    1e-3, and lies within 40 % of ISO 6336-1's mean stiffness."""
+    g1, g2 = _spur(20, 2e-3, "p"), _spur(40, 2e-3, "w")
+    train = _pair(Mesh("stage", "p", "w", "potential_energy", bore_radius=8e-3), g1, g2)
+    k = train.mesh_data["stage"].stiffness
+    fine = geardyn.gears.potential_energy_stiffness(geardyn.gears.GearMesh(g1, g2),
+                                                    bore_radius=8e-3, angles=720)
+    assert k == pytest.approx(float(fine.mesh_stiffness.mean()), rel=1e-3)
+    iso = geardyn.gears.iso6336_stiffness(geardyn.gears.GearMesh(g1, g2)).mesh_stiffness
+    assert 0.6 < k / iso < 1.4
+
+
+def test_docs_example_gives_the_hand_assembled_frequencies():
+    from pathlib import Path
+
+    text = (Path(__file__).resolve().parent.parent / "docs" / "trains.md").read_text()
+    block = text.split("```python\n", 1)[1].split("```", 1)[0]
+    scope: dict = {}
+    exec(block, scope)  # noqa: S102 - the documented example, run as written
+    K, M = _hand_matrices()
+    np.testing.assert_allclose(scope["train"].natural_frequencies(),
+                               np.sqrt(eigh(K, M, eigvals_only=True)) / (2 * math.pi),
+                               rtol=1e-10)

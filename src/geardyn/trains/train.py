@@ -33,7 +33,7 @@ from geardyn.errors import ParameterError
 from geardyn.trains.elements import GROUND, Bearing, Gear, Inertia, Mesh, Shaft
 
 #: Relative size (to the largest eigenvalue) below which an eigenvalue is a rigid-body mode.
-RIGID_BODY_RTOL = 1e-10
+RIGID_BODY_RTOL = 1e-12
 
 
 @dataclass(frozen=True)
