@@ -126,10 +126,23 @@ def test_two_stage_campbell_orders_and_crossings_from_tooth_counts():
         order2 * 3000.0 / 60.0, rel=1e-12)
 
 
-def test_rayleigh_and_element_damping():
+def test_rayleigh_damping():
     train = _two_stage(rayleigh=(0.5, 1e-5))
     K, M = _hand_matrices()
     np.testing.assert_allclose(train.damping_matrix(), 0.5 * M + 1e-5 * K, rtol=1e-12)
+
+
+def test_element_damping_acts_on_the_element_deflections():
+    r3, r4 = _rb(MODULE, Z[2]), _rb(MODULE, Z[3])
+    g = [Gear(f"g{i + 1}", INERTIA[i], base_radius=_rb(MODULE, Z[i])) for i in range(4)]
+    train = GearTrain(
+        g, shafts=[Shaft("input", "g1", GROUND, K_IN), Shaft("mid", "g2", "g3", K_MID, 7.0),
+                   Shaft("output", "g4", GROUND, K_OUT)],
+        meshes=[Mesh("stage1", "g1", "g2", KA), Mesh("stage2", "g3", "g4", KB, damping=900.0)])
+    C = np.zeros((4, 4))
+    C[1:3, 1:3] += 7.0 * np.array([[1.0, -1.0], [-1.0, 1.0]])
+    C[2:, 2:] += 900.0 * np.array([[r3 * r3, r3 * r4], [r3 * r4, r4 * r4]])
+    np.testing.assert_allclose(train.damping_matrix(), C, rtol=1e-12, atol=1e-15)
 
 
 # ---------------------------------------------------------------- (c) one planetary stage
@@ -287,6 +300,20 @@ def test_topology_errors_name_the_element_and_field():
     with pytest.raises(ParameterError) as err:  # lateral dofs need a mass
         GearTrain([a, b], [shaft], [Bearing("bb", "b", 1e8)], [Mesh("m", "a", "b", 1e8)])
     assert err.value.field == "b.mass"
+    with pytest.raises(ParameterError) as err:
+        GearTrain([a, b], [shaft], meshes=[Mesh("m", "a", "b", 1e8)], driven="b",
+                  fixed=("b",))
+    assert err.value.field == "driven"
+    with pytest.raises(ParameterError) as err:  # not a gear
+        GearTrain([a, Inertia("rotor", 1.0)], [shaft], meshes=[Mesh("m", "a", "rotor", 1e8)])
+    assert err.value.field == "m.b"
+    with pytest.raises(ParameterError) as err:  # a pair joined neither to the rest nor ground
+        GearTrain([a, b, Gear("c", 1e-3, base_radius=0.02), Gear("d", 1e-3, base_radius=0.02)],
+                  [shaft], meshes=[Mesh("m", "a", "b", 1e8), Mesh("m2", "c", "d", 1e8)])
+    assert err.value.field == "c"
+    with pytest.raises(ParameterError) as err:
+        Mesh("m", "a", "b", 1e8, pressure_angle="95 deg")
+    assert err.value.field == "m.pressure_angle"
 
 
 def test_potential_energy_stiffness_is_the_mean_over_a_mesh_cycle():

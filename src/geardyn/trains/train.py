@@ -186,7 +186,7 @@ class GearTrain:
                 raise ParameterError(f"{rigid[1].name}.stiffness", math.inf,
                                      f"{name} has two rigid bearings")
             flexible = any(b.body == name and not b.rigid for b in self.bearings)
-            if flexible and not rigid and body.mass is None:
+            if flexible and not rigid and body.mass is None and name not in self.fixed:
                 raise ParameterError(f"{name}.mass", None,
                                      "a body on a flexible bearing needs a mass")
 
@@ -210,8 +210,8 @@ class GearTrain:
         first = next(iter(self.bodies))
         for name in self.bodies:
             if root(name) != root(first):
-                raise ParameterError(name, name, f"is not connected to {first}: the train falls"
-                                     " apart into separate pieces")
+                raise ParameterError(name, name, f"is connected neither to {first} nor to the"
+                                     " ground: the train falls apart into separate pieces")
 
     # ------------------------------------------------------------------ coordinates
     def _coordinates(self) -> tuple[tuple[str, ...], np.ndarray]:
@@ -402,7 +402,7 @@ class GearTrain:
         return {name: float(v[3 * i]) for name, i in self._index.items()}
 
     def mesh_orders(self) -> dict[str, float]:
-        """Mesh frequency over the input speed of every mesh: z |ratio - ratio_arm| of gear a
+        """Mesh frequency over the input speed of every mesh: z abs(ratio - ratio_arm) of gear a
         (or b, where a has no tooth count), the arm being the carrier on which one of the two
         gears' bearings sits (a planet's carrier; 0 where both bear on the ground)."""
         ratios = self.speed_ratios()
