@@ -205,8 +205,13 @@ def test_planetary_stage_from_elements_matches_planetary_gear_set(n, fixed, rota
     f = train.natural_frequencies()
     assert f.size == lp.natural_frequencies().size
     np.testing.assert_allclose(f, lp.natural_frequencies(), rtol=1e-9)
-    shares = train.modes().energy_share.sum("element").values
-    np.testing.assert_allclose(shares, 1.0, rtol=1e-10)
+    modes, lp_modes = train.modes(), lp.modes()
+    np.testing.assert_allclose(modes.energy_share.sum("element").values, 1.0, rtol=1e-10)
+    assert list(modes.multiplicity.values) == list(lp_modes.multiplicity.values)
+    assert list(modes.type.values) == list(lp_modes.type.values)
+    kinds = {"rotational"} | ({"planet"} if n >= 4 else set())
+    assert kinds | ({"translational"} if not rotational_only else set()) <= set(
+        modes.type.values)
 
 
 def test_planetary_mesh_order_from_tooth_counts():

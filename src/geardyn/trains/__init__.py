@@ -8,10 +8,19 @@ no plots. See docs/trains.md.
 """
 
 from geardyn.trains.elements import GROUND, STIFFNESS_METHODS, Bearing, Gear, Inertia, Mesh, Shaft
-from geardyn.trains.train import RIGID_BODY_RTOL, GearTrain, MeshData, resolve_mesh
+from geardyn.trains.train import (
+    MODE_TYPE_TOL,
+    MULTIPLICITY_RTOL,
+    RIGID_BODY_RTOL,
+    GearTrain,
+    MeshData,
+    resolve_mesh,
+)
 
 __all__ = [
     "GROUND",
+    "MODE_TYPE_TOL",
+    "MULTIPLICITY_RTOL",
     "RIGID_BODY_RTOL",
     "STIFFNESS_METHODS",
     "Bearing",

@@ -34,6 +34,11 @@ from geardyn.trains.elements import GROUND, Bearing, Gear, Inertia, Mesh, Shaft
 
 #: Relative size (to the largest eigenvalue) below which an eigenvalue is a rigid-body mode.
 RIGID_BODY_RTOL = 1e-12
+#: Relative tolerance within which two natural frequencies count as one repeated frequency.
+MULTIPLICITY_RTOL = 1e-6
+#: Share of a mode's kinetic energy below which a part of the train counts as still (mode
+#: types).
+MODE_TYPE_TOL = 1e-6
 
 
 @dataclass(frozen=True)
@@ -349,11 +354,14 @@ class GearTrain:
     def modes(self) -> Any:
         """Natural frequencies, shapes and strain-energy shares (xarray Dataset over ``mode``).
 
-        Variables: ``frequency`` [Hz]; ``rigid_body`` (a zero mode of a free train);
+        Variables: ``frequency`` [Hz]; ``multiplicity`` (of the frequency, within
+        :data:`MULTIPLICITY_RTOL`); ``rigid_body`` (a zero mode of a free train);
         ``shape`` (mode, dof), mass-normalised [kg^-1/2 on translations, (kg m^2)^-1/2 on
         rotations]; ``energy_share`` (mode, element): the part of the mode's strain energy
         phi^T K phi / 2 held by each mesh, shaft and flexible bearing (sums to 1 over the
         elements; NaN for a rigid-body mode). Coordinate ``element_kind``: mesh, shaft, bearing.
+        A train with planets (bodies on bearings on a carrier) has ``type``, the classes of Lin
+        & Parker (1999) (:meth:`mode_type`).
         """
         import xarray as xr
 
@@ -364,15 +372,64 @@ class GearTrain:
         total = energy.sum(axis=1, keepdims=True)
         with np.errstate(invalid="ignore", divide="ignore"):
             share = np.where(lam[:, None] > 0.0, energy / total, np.nan)
+        f = np.sqrt(lam) / (2.0 * math.pi)
+        mult = np.zeros(f.size, int)
+        kind = np.empty(f.size, object)
+        for g in _groups(f):
+            mult[g] = len(g)
+            kind[g] = self.mode_type(phi[:, g]) if self._planets() else ""
+        extra = {"type": ("mode", kind.astype(str))} if self._planets() else {}
         return xr.Dataset(
-            {"frequency": ("mode", np.sqrt(lam) / (2.0 * math.pi), {"units": "Hz"}),
-             "rigid_body": ("mode", lam == 0.0),
+            {"frequency": ("mode", f, {"units": "Hz"}),
+             "multiplicity": ("mode", mult),
+             "rigid_body": ("mode", lam == 0.0), **extra,
              "shape": (("mode", "dof"), phi.T),
              "energy_share": (("mode", "element"), share, {"units": "1"})},
             coords={"mode": np.arange(lam.size), "dof": list(self._dofs),
                     "element": [e[1] for e in elements],
                     "element_kind": ("element", [e[0] for e in elements])},
             attrs={"model": "GearTrain", "rigid_body_modes": self.rigid_body_modes})
+
+    def _planets(self) -> dict[str, Bearing]:
+        """The planets: bodies on a bearing on a carrier, with that bearing."""
+        return {b.body: b for b in self.bearings if b.host != GROUND}
+
+    def mode_type(self, shapes: np.ndarray, tol: float = MODE_TYPE_TOL) -> str:
+        """Class of the eigenspace spanned by ``shapes`` (model dofs x k), as Lin & Parker
+        (1999): ``"planet"`` (only the planets move), ``"rotational"`` (no centre of a body other
+        than a planet moves and every planet of a carrier moves alike in that carrier's frame),
+        ``"translational"`` (no body other than a planet turns), else ``"mixed"``. Judged by
+        the kinetic energy of each part, summed over the space."""
+        full = self._T @ shapes
+        d = np.concatenate([[b.inertia, b.mass or 0.0, b.mass or 0.0]
+                            for b in self.bodies.values()])
+        weighted = np.sqrt(d)[:, None] * full  # coordinates scaled to sqrt(kinetic energy)
+        e = np.sum(np.abs(weighted) ** 2, axis=1)
+        planets = self._planets()
+        central = np.array([name not in planets for name in self.bodies for _ in range(3)])
+        rot = central & np.tile([True, False, False], len(self.bodies))
+        total = e.sum()
+        if e[central].sum() <= tol * total:
+            return "planet"
+        if e[central & ~rot].sum() <= tol * total and self._planets_alike(weighted, tol):
+            return "rotational"
+        if e[rot].sum() <= tol * total:
+            return "translational"
+        return "mixed"
+
+    def _planets_alike(self, weighted: np.ndarray, tol: float) -> bool:
+        """Every planet of each carrier moves alike in the carrier's frame (its radial,
+        tangential and rotational coordinates) in every shape."""
+        scale = max(float(np.max(np.abs(weighted))), 1e-300)
+        by_carrier: dict[str, list[np.ndarray]] = {}
+        for name, b in self._planets().items():
+            i = 3 * self._index[name]
+            c, s = math.cos(b.angle), math.sin(b.angle)
+            x, y = weighted[i + 1], weighted[i + 2]
+            by_carrier.setdefault(b.host, []).append(
+                np.array([weighted[i], c * x + s * y, -s * x + c * y]))
+        return all(np.max(np.abs(p - group[0])) <= math.sqrt(tol) * scale
+                   for group in by_carrier.values() for p in group[1:])
 
     # ------------------------------------------------------------------ kinematics
     def speed_ratios(self) -> dict[str, float]:
@@ -463,6 +520,19 @@ class GearTrain:
         return (f"GearTrain({len(self.bodies)} bodies, {len(self.meshes)} meshes, "
                 f"{len(self.shafts)} shafts, {len(self.bearings)} bearings, "
                 f"{len(self._dofs)} dofs)")
+
+
+def _groups(f: np.ndarray) -> list[list[int]]:
+    """Indices of ascending frequencies grouped into repeated values (:data:`MULTIPLICITY_RTOL`,
+    relative; near 0 relative to 1e-3 of the largest)."""
+    scale = max(float(np.max(f)), 1e-300) if f.size else 1.0
+    groups: list[list[int]] = []
+    for i, v in enumerate(f):
+        if groups and abs(v - f[groups[-1][0]]) <= MULTIPLICITY_RTOL * max(v, 1e-3 * scale):
+            groups[-1].append(i)
+        else:
+            groups.append([i])
+    return groups
 
 
 def _typed(field: str, items: Sequence[Any], cls: type) -> list[Any]:
