@@ -317,6 +317,10 @@ def test_topology_errors_name_the_element_and_field():
                   [shaft], meshes=[Mesh("m", "a", "b", 1e8), Mesh("m2", "c", "d", 1e8)])
     assert err.value.field == "c"
     with pytest.raises(ParameterError) as err:
+        GearTrain([a, b], [shaft], meshes=[Mesh("m", "a", "b", 1e8)],
+                  rayleigh=(0.0, float("nan")))
+    assert err.value.field == "rayleigh[1]"
+    with pytest.raises(ParameterError) as err:
         Mesh("m", "a", "b", 1e8, pressure_angle="95 deg")
     assert err.value.field == "m.pressure_angle"
 

@@ -31,6 +31,7 @@ import numpy as np
 
 from geardyn.errors import ParameterError
 from geardyn.trains.elements import GROUND, Bearing, Gear, Inertia, Mesh, Shaft
+from geardyn.units import si_value
 
 #: Relative size (to the largest eigenvalue) below which an eigenvalue is a rigid-body mode.
 RIGID_BODY_RTOL = 1e-12
@@ -135,7 +136,7 @@ class GearTrain:
         :meth:`modes` as such (frequency 0, ``rigid_body`` True). False (default): a train with
         one is refused.
     rayleigh
-        (a, b) of the Rayleigh damping a M + b K added to the elements' damping.
+        (a [1/s], b [s]) of the Rayleigh damping a M + b K added to the elements' damping.
     """
 
     def __init__(self, bodies: Sequence[Inertia], shafts: Sequence[Shaft] = (),
@@ -150,7 +151,10 @@ class GearTrain:
         self.fixed = tuple(fixed)
         self.driven = driven
         self.free = bool(free)
-        self.rayleigh = tuple(float(v) for v in rayleigh)
+        if not isinstance(rayleigh, tuple | list) or len(rayleigh) != 2:
+            raise ParameterError("rayleigh", rayleigh, "must be a pair (a, b)")
+        self.rayleigh = tuple(si_value(f"rayleigh[{i}]", v, "dimensionless", 0.0)
+                              for i, v in enumerate(rayleigh))
         self._check_references()
         self.mesh_data = {m.name: resolve_mesh(m, self.bodies[m.a], self.bodies[m.b])
                           for m in self.meshes}
