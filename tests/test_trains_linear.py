@@ -349,3 +349,19 @@ def test_docs_example_gives_the_hand_assembled_frequencies():
     np.testing.assert_allclose(scope["train"].natural_frequencies(),
                                np.sqrt(eigh(K, M, eigvals_only=True)) / (2 * math.pi),
                                rtol=1e-10)
+
+
+def test_campbell_plot_marks_every_crossing(tmp_path):
+    from geardyn.plotting.campbell import plot_campbell
+
+    ds = _two_stage().campbell(np.linspace(0.0, 3000.0, 61), harmonics=2)
+    fig = plot_campbell(ds, tmp_path / "campbell.png")
+    assert (tmp_path / "campbell.png").stat().st_size > 0
+    marks = [ln for ln in fig.axes[0].lines if ln.get_label() == "crossing"][0]
+    x, y = marks.get_data()
+    finite = np.isfinite(ds.crossing_speed.values)
+    assert len(x) == finite.sum() > 0
+    np.testing.assert_allclose(np.sort(x), np.sort(ds.crossing_speed.values[finite]))
+    # each crossing lies on its excitation ray: frequency = harmonic * order * rpm / 60
+    rays = (ds.harmonic * ds.order).values[:, None] * ds.crossing_speed.values / 60.0
+    np.testing.assert_allclose(np.sort(y), np.sort(rays[finite]), rtol=1e-12)
