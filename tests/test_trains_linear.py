@@ -316,6 +316,13 @@ def test_topology_errors_name_the_element_and_field():
         GearTrain([a, b, Gear("c", 1e-3, base_radius=0.02), Gear("d", 1e-3, base_radius=0.02)],
                   [shaft], meshes=[Mesh("m", "a", "b", 1e8), Mesh("m2", "c", "d", 1e8)])
     assert err.value.field == "c"
+    with pytest.raises(ParameterError) as err:  # a name used twice, bodies given by an iterator
+        GearTrain(iter([a, b, Gear("a", 1e-3, base_radius=0.02)]), [shaft],
+                  meshes=[Mesh("m", "a", "b", 1e8)])
+    assert err.value.field == "a.name"
+    wheel = Gear("wheel", 4e-3, base_radius=0.04)
+    held = GearTrain([a, wheel], meshes=[Mesh("m", "a", "wheel", 1e8)], fixed="wheel")
+    assert held.fixed == ("wheel",) and held.dof_names() == ("a.theta",)
     with pytest.raises(ParameterError) as err:
         GearTrain([a, b], [shaft], meshes=[Mesh("m", "a", "b", 1e8)],
                   rayleigh=(0.0, float("nan")))

@@ -143,12 +143,13 @@ class GearTrain:
                  bearings: Sequence[Bearing] = (), meshes: Sequence[Mesh] = (), *,
                  fixed: Sequence[str] = (), driven: str | None = None, free: bool = False,
                  rayleigh: tuple[float, float] = (0.0, 0.0)):
-        self.bodies = {b.name: b for b in _typed("bodies", bodies, Inertia)}
+        body_list = _typed("bodies", bodies, Inertia)
         self.shafts = _typed("shafts", shafts, Shaft)
         self.bearings = _typed("bearings", bearings, Bearing)
         self.meshes = _typed("meshes", meshes, Mesh)
-        _unique_names(bodies, self.shafts, self.bearings, self.meshes)
-        self.fixed = tuple(fixed)
+        _unique_names(body_list, self.shafts, self.bearings, self.meshes)
+        self.bodies = {b.name: b for b in body_list}
+        self.fixed = (fixed,) if isinstance(fixed, str) else tuple(fixed)
         self.driven = driven
         self.free = bool(free)
         if not isinstance(rayleigh, tuple | list) or len(rayleigh) != 2:
