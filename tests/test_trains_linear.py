@@ -372,3 +372,58 @@ def test_campbell_plot_marks_every_crossing(tmp_path):
     # each crossing lies on its excitation ray: frequency = harmonic * order * rpm / 60
     rays = (ds.harmonic * ds.order).values[:, None] * ds.crossing_speed.values / 60.0
     np.testing.assert_allclose(np.sort(y), np.sort(rays[finite]), rtol=1e-12)
+
+
+def test_planetary_stage_helper_matches_planetary_gear_set():
+    from geardyn.trains import planetary_stage
+
+    n = 4
+    rb = {"sun": _rb(M_P, ZS, A_S), "ring": _rb(M_P, ZR, A_R), "planet": _rb(M_P, ZP, A_S)}
+    rc = 0.5 * M_P * (ZS + ZP)
+    stage = planetary_stage(
+        sun=Gear("sun", LP["sun"][1] * rb["sun"] ** 2, LP["sun"][0], rb["sun"], n_teeth=ZS),
+        ring=Gear("ring", LP["ring"][1] * rb["ring"] ** 2, LP["ring"][0], rb["ring"],
+                  n_teeth=ZR),
+        carrier=Inertia("carrier", LP["carrier"][1] * rc ** 2, LP["carrier"][0]),
+        planet=Gear("p", LP["planet"][1] * rb["planet"] ** 2, LP["planet"][0], rb["planet"],
+                    n_teeth=ZP),
+        n_planets=n, pin_stiffness=K_PLANET, sun_mesh_stiffness=K_MESH,
+        ring_mesh_stiffness=K_MESH, sun_pressure_angle=A_S, ring_pressure_angle=A_R)
+    assert stage.carrier_radius == pytest.approx(rc, rel=1e-12)
+    assert stage.planets == ("p1", "p2", "p3", "p4")
+    train = GearTrain(
+        stage.bodies,
+        [Shaft("ring_support", "ring", GROUND, K_RING_U * rb["ring"] ** 2),
+         Shaft("output", "carrier", GROUND, K_CARRIER_U * rc ** 2)],
+        [*stage.bearings, *(Bearing(f"{k}_bearing", k, K_BEARING)
+                            for k in ("sun", "ring", "carrier"))],
+        stage.meshes, driven="sun")
+    lp = _lp_set(n, (), False)
+    np.testing.assert_allclose(train.natural_frequencies(), lp.natural_frequencies(), rtol=1e-9)
+    assert list(train.modes().type.values) == list(lp.modes().type.values)
+
+
+def test_planetary_stage_from_geometry_takes_iso_stiffness_and_orders():
+    """Gears with geometry: ISO 6336-1 stiffness of each mesh as geardyn.gears computes it for
+    the same pair, the carrier radius the sun-planet centre distance, and the mesh order of a
+    ring-held stage Z_s Z_r / (Z_s + Z_r)."""
+    from geardyn.gears import GearMesh, iso6336_stiffness
+    from geardyn.trains import planetary_stage
+
+    zs, zp, zr = 21, 33, 87
+    s, p = _spur(zs, 2e-3, "sun"), _spur(zp, 2e-3, "planet")
+    r = SpurGear(zr, 2e-3, ALPHA, 0.02, internal=True, name="ring")
+    stage = planetary_stage(
+        sun=Gear("sun", 1e-3, 1.0, geometry=s), ring=Gear("ring", 0.05, 3.0, geometry=r),
+        carrier=Inertia("carrier", 0.02, 4.0), planet=Gear("p", 2e-4, 0.3, geometry=p),
+        n_planets=3, pin_stiffness=1e8, sun_mesh_stiffness="iso", ring_mesh_stiffness="iso")
+    assert stage.carrier_radius == pytest.approx(1e-3 * (zs + zp), rel=1e-12)
+    train = GearTrain(stage.bodies, [Shaft("out", "carrier", GROUND, 1e5)],
+                      [*stage.bearings, Bearing("sun_bearing", "sun", 1e8)], stage.meshes,
+                      fixed="ring", driven="sun")
+    k_sun = iso6336_stiffness(GearMesh(s, p)).mesh_stiffness
+    k_ring = iso6336_stiffness(GearMesh(p, r, internal=True)).mesh_stiffness
+    assert train.mesh_data["sun_p2"].stiffness == k_sun
+    assert train.mesh_data["p2_ring"].stiffness == k_ring
+    assert list(train.mesh_orders().values()) == pytest.approx([zs * zr / (zs + zr)] * 6,
+                                                                rel=1e-9)

@@ -8,6 +8,7 @@ no plots. See docs/trains.md.
 """
 
 from geardyn.trains.elements import GROUND, STIFFNESS_METHODS, Bearing, Gear, Inertia, Mesh, Shaft
+from geardyn.trains.stages import PlanetaryStage, planetary_stage
 from geardyn.trains.train import (
     MODE_TYPE_TOL,
     MULTIPLICITY_RTOL,
@@ -29,6 +30,8 @@ __all__ = [
     "Inertia",
     "Mesh",
     "MeshData",
+    "PlanetaryStage",
     "Shaft",
+    "planetary_stage",
     "resolve_mesh",
 ]
