@@ -1,7 +1,8 @@
 """The elements a gear train is described from: bodies, shafts, bearings and meshes.
 
 Each element is a frozen dataclass with a ``name``; its inputs are SI numbers or unit strings
-(:func:`geardyn.units.si_value`), validated and stored as SI floats when the element is made.
+(:func:`geardyn.units.si_value`; damping coefficients plain SI numbers), validated and stored
+as SI floats when the element is made.
 An error is a :class:`~geardyn.ParameterError` naming the element and the field
 (``"stage1.stiffness"``). Bodies are joined by name; :data:`GROUND` is the fixed frame.
 """
