@@ -14,9 +14,10 @@ import pytest
 import geardyn
 import geardyn.gears
 import geardyn.testing
+import geardyn.trains
 
 ROOT = Path(__file__).resolve().parent.parent
-PUBLIC: tuple[ModuleType, ...] = (geardyn, geardyn.gears, geardyn.testing)
+PUBLIC: tuple[ModuleType, ...] = (geardyn, geardyn.gears, geardyn.testing, geardyn.trains)
 
 
 def _public() -> list[tuple[ModuleType, str]]:

@@ -1,0 +1,253 @@
+"""The elements a gear train is described from: bodies, shafts, bearings and meshes.
+
+Each element is a frozen dataclass with a ``name``; its inputs are SI numbers or unit strings
+(:func:`geardyn.units.si_value`; damping coefficients plain SI numbers), validated and stored
+as SI floats when the element is made.
+An error is a :class:`~geardyn.ParameterError` naming the element and the field
+(``"stage1.stiffness"``). Bodies are joined by name; :data:`GROUND` is the fixed frame.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+from geardyn.errors import ParameterError
+from geardyn.gears.geometry import SpurGear
+from geardyn.units import si_value
+
+#: The name of the fixed frame: a shaft or bearing whose other end is ``GROUND`` is held by it.
+GROUND = "ground"
+
+#: How a mesh's mean stiffness may be obtained besides a number [N/m].
+STIFFNESS_METHODS = ("iso", "potential_energy")
+
+
+def _name(kind: str, name: object) -> str:
+    if not isinstance(name, str) or not name.strip():
+        raise ParameterError(f"{kind}.name", name, "must be a non-empty string")
+    if name == GROUND:
+        raise ParameterError(f"{name}.name", name, f"{GROUND!r} is the fixed frame's name")
+    return name
+
+
+def _set(obj: object, attr: str, value: object) -> None:
+    object.__setattr__(obj, attr, value)
+
+
+def _si(obj: Any, attr: str, kind: str, minimum: float | None = 0.0, strict: bool = False,
+        allow_inf: bool = False) -> None:
+    """Store ``obj.<attr>`` as an SI float; errors name ``<obj.name>.<attr>``."""
+    value = getattr(obj, attr)
+    field = f"{obj.name}.{attr}"
+    if allow_inf and (value == math.inf or value == "inf"):
+        _set(obj, attr, math.inf)
+        return
+    _set(obj, attr, si_value(field, value, kind, minimum, strict))
+
+
+def _body_ref(obj: Any, attr: str, ground: bool = False) -> None:
+    value = getattr(obj, attr)
+    if not isinstance(value, str) or not value:
+        raise ParameterError(f"{obj.name}.{attr}", value, "must name a body")
+    if value == GROUND and not ground:
+        raise ParameterError(f"{obj.name}.{attr}", value, "must name a body, not the ground")
+
+
+@dataclass(frozen=True)
+class Inertia:
+    """A rigid body that turns about its axis: rotational inertia ``inertia`` [kg m^2] and,
+    for lateral (x, y) degrees of freedom on a flexible bearing, its ``mass`` [kg] (None: no
+    lateral motion of its own)."""
+
+    name: str
+    inertia: Any
+    mass: Any = None
+
+    def __post_init__(self) -> None:
+        _name(type(self).__name__, self.name)
+        _si(self, "inertia", "inertia", strict=True)
+        if self.mass is not None:
+            _si(self, "mass", "mass", strict=True)
+
+    @property
+    def teeth(self) -> int | None:
+        """Tooth count (None: not a gear)."""
+        return None
+
+    @property
+    def radius(self) -> float | None:
+        """Base radius [m] (None: not a gear)."""
+        return None
+
+
+@dataclass(frozen=True)
+class Gear(Inertia):
+    """A gear body: an :class:`Inertia` with a base radius [m] and tooth count, or with a
+    :class:`~geardyn.gears.SpurGear` ``geometry`` that gives both (and lets a mesh take its
+    stiffness from ISO 6336-1 or the potential-energy method). ``teeth`` is needed only for
+    the mesh orders of a Campbell diagram."""
+
+    base_radius: Any = None
+    geometry: SpurGear | None = None
+    n_teeth: int | None = None
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        g = self.geometry
+        if g is not None:
+            if not isinstance(g, SpurGear):
+                raise ParameterError(f"{self.name}.geometry", g, "must be a geardyn.gears.SpurGear")
+            for attr, value in (("base_radius", g.base_radius), ("n_teeth", g.teeth)):
+                given = getattr(self, attr)
+                if given is not None and not math.isclose(float(given), value, rel_tol=1e-9):
+                    raise ParameterError(f"{self.name}.{attr}", given,
+                                         f"differs from the geometry's {value:.6g}")
+            _set(self, "base_radius", g.base_radius)
+            _set(self, "n_teeth", g.teeth)
+        if self.base_radius is None:
+            raise ParameterError(f"{self.name}.base_radius", None,
+                                 "a gear needs a base radius or a geometry")
+        _si(self, "base_radius", "length", strict=True)
+        z = self.n_teeth
+        if z is not None and (isinstance(z, bool) or not isinstance(z, int) or z < 1):
+            raise ParameterError(f"{self.name}.n_teeth", z, "must be a whole number >= 1")
+
+    @property
+    def teeth(self) -> int | None:
+        """Tooth count (None: not given)."""
+        return self.n_teeth
+
+    @property
+    def radius(self) -> float | None:
+        """Base radius [m]."""
+        return self.base_radius
+
+
+@dataclass(frozen=True)
+class Shaft:
+    """A torsional spring between bodies ``a`` and ``b`` (``b`` may be :data:`GROUND`):
+    ``stiffness`` [N m/rad] and ``damping`` [N m s/rad] on the twist theta_a - theta_b."""
+
+    name: str
+    a: str
+    b: str
+    stiffness: Any
+    damping: Any = 0.0
+
+    def __post_init__(self) -> None:
+        _name("Shaft", self.name)
+        _body_ref(self, "a")
+        _body_ref(self, "b", ground=True)
+        if self.a == self.b:
+            raise ParameterError(f"{self.name}.b", self.b, "a shaft joins two different bodies")
+        _si(self, "stiffness", "torque", strict=True)  # N m/rad: a torque per radian
+        _si(self, "damping", "dimensionless")  # N m s/rad, a number
+
+
+@dataclass(frozen=True)
+class Bearing:
+    """The bearing of ``body`` on ``host`` (:data:`GROUND`, or a carrier body): isotropic
+    radial ``stiffness`` [N/m] (``math.inf``: rigid) and ``damping`` [N s/m].
+
+    On a carrier, the bearing's pin sits at ``radius`` [m] and ``angle`` [rad] from the
+    carrier's axis, so the carrier's rotation moves it tangentially by radius * theta_carrier.
+    ``clearance`` [m] (radial, a dead zone) is recorded for the nonlinear model; the linear
+    model ignores it. A finite stiffness gives ``body`` lateral degrees of freedom (x, y), which
+    need its mass; a rigid bearing carries the body with the host.
+    """
+
+    name: str
+    body: str
+    stiffness: Any
+    host: str = GROUND
+    damping: Any = 0.0
+    radius: Any = 0.0
+    angle: Any = 0.0
+    clearance: Any = 0.0
+
+    def __post_init__(self) -> None:
+        _name("Bearing", self.name)
+        _body_ref(self, "body")
+        _body_ref(self, "host", ground=True)
+        if self.body == self.host:
+            raise ParameterError(f"{self.name}.host", self.host, "a body cannot bear on itself")
+        _si(self, "stiffness", "stiffness", strict=True, allow_inf=True)
+        _si(self, "damping", "dimensionless")  # N s/m, a number
+        _si(self, "radius", "length")
+        _si(self, "angle", "angle", None)
+        _si(self, "clearance", "length")
+
+    @property
+    def rigid(self) -> bool:
+        """Whether the bearing is rigid (infinite stiffness)."""
+        return math.isinf(self.stiffness)
+
+
+@dataclass(frozen=True)
+class Mesh:
+    """The mesh of gear ``a`` with gear ``b`` (``internal=True``: ``b`` is the ring).
+
+    ``stiffness``: the mean mesh stiffness [N/m] along the line of action, or ``"iso"`` (ISO
+    6336-1 method B, :func:`~geardyn.gears.iso6336_stiffness`) or ``"potential_energy"``
+    (the mean of :func:`~geardyn.gears.potential_energy_stiffness` over a mesh cycle;
+    ``bore_radius`` [m] needed), both from the two gears' geometries. ``angle`` [rad] is the
+    direction of the line from a's centre to b's centre; ``pressure_angle`` [rad] the operating
+    pressure angle (None: from the geometries, else 20 deg). ``centre_distance`` [m] (None: the
+    zero-backlash one of the geometries) is checked against the geometries. The line of action
+    is that of the flank on which ``a`` turning in the positive sense drives ``b``.
+
+    Recorded for the nonlinear model, unused by the linear one: ``backlash`` [m] per flank
+    (drive, coast), a number for both, and the transmission-error amplitude ``error`` [m].
+    ``damping`` [N s/m] acts on the mesh deflection rate.
+    """
+
+    name: str
+    a: str
+    b: str
+    stiffness: Any
+    internal: bool = False
+    angle: Any = 0.0
+    pressure_angle: Any = None
+    centre_distance: Any = None
+    bore_radius: Any = None
+    damping: Any = 0.0
+    backlash: Any = 0.0
+    error: Any = 0.0
+
+    def __post_init__(self) -> None:
+        _name("Mesh", self.name)
+        _body_ref(self, "a")
+        _body_ref(self, "b")
+        if self.a == self.b:
+            raise ParameterError(f"{self.name}.b", self.b, "a mesh joins two different gears")
+        if not isinstance(self.internal, bool):
+            raise ParameterError(f"{self.name}.internal", self.internal, "must be True or False")
+        if isinstance(self.stiffness, str) and self.stiffness in STIFFNESS_METHODS:
+            if self.stiffness == "potential_energy" and self.bore_radius is None:
+                raise ParameterError(f"{self.name}.bore_radius", None,
+                                     "the potential-energy stiffness needs the bore radius")
+        else:
+            _si(self, "stiffness", "stiffness", strict=True)
+        _si(self, "angle", "angle", None)
+        if self.pressure_angle is not None:
+            _si(self, "pressure_angle", "angle", strict=True)
+            if not self.pressure_angle < math.pi / 2:
+                raise ParameterError(f"{self.name}.pressure_angle", self.pressure_angle,
+                                     "must be below 90 deg")
+        for attr in ("centre_distance", "bore_radius"):
+            if getattr(self, attr) is not None:
+                _si(self, attr, "length", strict=True)
+        _si(self, "damping", "dimensionless")  # N s/m, a number
+        _si(self, "error", "length")
+        self._backlash()
+
+    def _backlash(self) -> None:
+        value = self.backlash
+        pair = tuple(value) if isinstance(value, tuple | list) else (value, value)
+        if len(pair) != 2:
+            raise ParameterError(f"{self.name}.backlash", value,
+                                 "one value or two (drive flank, coast flank)")
+        _set(self, "backlash", tuple(si_value(f"{self.name}.backlash", v, "length", 0.0)
+                                     for v in pair))

@@ -1,0 +1,71 @@
+"""Building blocks: a planetary stage's planets, pins and meshes from its members."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, replace
+from typing import Any
+
+from geardyn.errors import ParameterError
+from geardyn.trains.elements import Bearing, Gear, Inertia, Mesh
+from geardyn.trains.train import resolve_mesh
+from geardyn.units import si_value
+
+
+@dataclass(frozen=True)
+class PlanetaryStage:
+    """The elements of one planetary stage: ``bodies`` (sun, ring, carrier, planets),
+    ``bearings`` (the planets' pins on the carrier) and ``meshes`` (sun-planet, then
+    planet-ring). The central members' own bearings and shafts are the train's to add."""
+
+    bodies: tuple[Inertia, ...]
+    bearings: tuple[Bearing, ...]
+    meshes: tuple[Mesh, ...]
+    planets: tuple[str, ...]
+    carrier_radius: float
+
+
+def planetary_stage(*, sun: Gear, ring: Gear, carrier: Inertia, planet: Gear, n_planets: int,
+                    pin_stiffness: Any, sun_mesh_stiffness: Any, ring_mesh_stiffness: Any,
+                    planet_angles: Sequence[Any] | None = None, carrier_radius: Any = None,
+                    sun_pressure_angle: Any = None, ring_pressure_angle: Any = None,
+                    pin_damping: Any = 0.0, mesh_damping: Any = 0.0) -> PlanetaryStage:
+    """A single planetary stage as elements (Lin & Parker 1999): ``n_planets`` copies of
+    ``planet`` named ``<planet.name>1`` ..., each on a pin of ``pin_stiffness`` [N/m]
+    (``math.inf``: rigid) on ``carrier`` at ``carrier_radius`` [m] and angle psi_n [rad]
+    (default equally spaced, 2 pi (n - 1) / N), meshing with ``sun`` (external) and ``ring``
+    (internal). Mesh stiffnesses are numbers [N/m] or a method (``"iso"``, ...) as
+    :class:`Mesh`; pressure angles None take the geometries' operating ones (else 20 deg).
+    ``carrier_radius`` None: (r_b,sun + r_b,planet) / cos(alpha_sun), the centre distance of
+    the sun-planet mesh."""
+    if isinstance(n_planets, bool) or not isinstance(n_planets, int) or not 1 <= n_planets <= 32:
+        raise ParameterError("n_planets", n_planets, "must be a whole number from 1 to 32")
+    if planet_angles is None:
+        psi = [2.0 * math.pi * i / n_planets for i in range(n_planets)]
+    else:
+        psi = [si_value(f"planet_angles[{i}]", a, "angle") for i, a in enumerate(planet_angles)]
+        if len(psi) != n_planets:
+            raise ParameterError("planet_angles", planet_angles, f"needs {n_planets} angles")
+    first = Mesh("sun_mesh", sun.name, planet.name, sun_mesh_stiffness,
+                 pressure_angle=sun_pressure_angle)
+    alpha_s = resolve_mesh(first, sun, planet).pressure_angle
+    if carrier_radius is None:
+        rc = (sun.base_radius + planet.base_radius) / math.cos(alpha_s)
+    else:
+        rc = si_value("carrier_radius", carrier_radius, "length", 0.0, strict=True)
+    planets, bearings, sun_meshes, ring_meshes = [], [], [], []
+    for i, angle in enumerate(psi):
+        p = replace(planet, name=f"{planet.name}{i + 1}")
+        planets.append(p)
+        bearings.append(Bearing(f"{p.name}_pin", p.name, pin_stiffness, host=carrier.name,
+                                damping=pin_damping, radius=rc, angle=angle))
+        sun_meshes.append(Mesh(f"{sun.name}_{p.name}", sun.name, p.name, sun_mesh_stiffness,
+                               angle=angle, pressure_angle=sun_pressure_angle,
+                               damping=mesh_damping))
+        ring_meshes.append(Mesh(f"{p.name}_{ring.name}", p.name, ring.name, ring_mesh_stiffness,
+                                internal=True, angle=angle + math.pi,
+                                pressure_angle=ring_pressure_angle, damping=mesh_damping))
+    return PlanetaryStage(bodies=(sun, ring, carrier, *planets), bearings=tuple(bearings),
+                          meshes=(*sun_meshes, *ring_meshes),
+                          planets=tuple(p.name for p in planets), carrier_radius=rc)
