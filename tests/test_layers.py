@@ -32,6 +32,8 @@ LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
     ("gears", ("geardyn.gears",)),
     # the models: CATT device, gear pair, user models, parameter records
     ("models", ("geardyn.models",)),
+    # gear trains from elements: their linear model (built on gears and models)
+    ("trains", ("geardyn.trains",)),
     # numerics: the kernel generator and templates, lane ensembles, simulate, the reference
     ("solvers", ("geardyn.solvers",)),
     # chunking, Dask, the resumable Zarr store

@@ -36,6 +36,7 @@ from geardyn.core.kernel_source import KernelSource
 from geardyn.core.model import Model, unique_rows
 from geardyn.errors import ParameterError
 from geardyn.models import planetary_kernels as pk
+from geardyn.models.modal import frequency_groups
 from geardyn.models.planetary_coefficients import (
     CARRIER_SPEED,
     FORCES,
@@ -105,8 +106,6 @@ _SHORT = {"carrier": "c", "ring": "r", "sun": "s"}
 _NOT_SWEPT = {"n_planets", "waveform", "coast_waveform", "harmonics", "rotational_only", "fixed",
               "centrifugal_preload", "planet_angles", "sun", "ring", "carrier", "planet",
               "time_scale", "length_scale"}
-#: Relative tolerance within which two natural frequencies count as one repeated frequency.
-MULTIPLICITY_RTOL = 1e-6
 
 
 def _si(field: str, value: object, kind: str, minimum: float | None = 0.0,
@@ -1202,7 +1201,8 @@ class PlanetaryGearSet(Model):
         """Natural frequencies and mode shapes, classified (xarray Dataset over ``mode``).
 
         Variables: ``frequency`` [Hz], ``multiplicity`` (of the frequency, within
-        :data:`MULTIPLICITY_RTOL`), ``type`` (``"rotational"``: no member centre moves;
+        :data:`~geardyn.trains.MULTIPLICITY_RTOL`), ``type`` (``"rotational"``: no member
+        centre moves;
         ``"translational"``: the carrier, ring and sun do not rotate; ``"planet"``: only the
         planets move; ``"mixed"`` otherwise, e.g. unequal spacing), ``shape`` (mode, dof):
         mass-normalised shapes [kg^-1/2] in the model's coordinates. A repeated frequency's
@@ -1221,7 +1221,7 @@ class PlanetaryGearSet(Model):
         else:
             lam, phi = self._eig()
             f = np.sqrt(lam) / (2.0 * math.pi)
-        groups = _groups(f)
+        groups = frequency_groups(f)
         names = self.dof_names()
         mult = np.zeros(f.size, int)
         kind = np.empty(f.size, object)
@@ -1410,15 +1410,3 @@ def _kinematic_ratio(held: str, geometry: Any) -> float:
     Z_s abs(w_s - w_c))."""
     return {"ring": 1.0 / geometry.ring.teeth, "sun": 1.0 / geometry.sun.teeth,
             "carrier": 0.0}[held]
-
-
-def _groups(f: np.ndarray) -> list[list[int]]:
-    """Indices of ascending frequencies grouped into repeated values (relative tolerance)."""
-    scale = max(float(np.max(f)), 1e-300) if f.size else 1.0
-    groups: list[list[int]] = []
-    for i, v in enumerate(f):
-        if groups and abs(v - f[groups[-1][0]]) <= MULTIPLICITY_RTOL * max(v, 1e-3 * scale):
-            groups[-1].append(i)
-        else:
-            groups.append([i])
-    return groups

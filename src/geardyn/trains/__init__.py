@@ -7,11 +7,11 @@ element, speed ratios, mesh orders and Campbell (interference) data. Physics onl
 no plots. See docs/trains.md.
 """
 
+from geardyn.models.modal import MULTIPLICITY_RTOL
 from geardyn.trains.elements import GROUND, STIFFNESS_METHODS, Bearing, Gear, Inertia, Mesh, Shaft
 from geardyn.trains.stages import PlanetaryStage, planetary_stage
 from geardyn.trains.train import (
     MODE_TYPE_TOL,
-    MULTIPLICITY_RTOL,
     RIGID_BODY_RTOL,
     GearTrain,
     MeshData,

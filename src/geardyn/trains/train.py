@@ -30,13 +30,12 @@ from typing import Any
 import numpy as np
 
 from geardyn.errors import ParameterError
+from geardyn.models.modal import frequency_groups
 from geardyn.trains.elements import GROUND, Bearing, Gear, Inertia, Mesh, Shaft
 from geardyn.units import si_value
 
 #: Relative size (to the largest eigenvalue) below which an eigenvalue is a rigid-body mode.
 RIGID_BODY_RTOL = 1e-12
-#: Relative tolerance within which two natural frequencies count as one repeated frequency.
-MULTIPLICITY_RTOL = 1e-6
 #: Share of a mode's kinetic energy below which a part of the train counts as still (mode
 #: types).
 MODE_TYPE_TOL = 1e-6
@@ -360,7 +359,8 @@ class GearTrain:
         """Natural frequencies, shapes and strain-energy shares (xarray Dataset over ``mode``).
 
         Variables: ``frequency`` [Hz]; ``multiplicity`` (of the frequency, within
-        :data:`MULTIPLICITY_RTOL`); ``rigid_body`` (a zero mode of a free train);
+        :data:`~geardyn.trains.MULTIPLICITY_RTOL`); ``rigid_body`` (a zero mode of a free
+        train);
         ``shape`` (mode, dof), mass-normalised [kg^-1/2 on translations, (kg m^2)^-1/2 on
         rotations]; ``energy_share`` (mode, element): the part of the mode's strain energy
         phi^T K phi / 2 held by each mesh, shaft and flexible bearing (sums to 1 over the
@@ -380,7 +380,7 @@ class GearTrain:
         f = np.sqrt(lam) / (2.0 * math.pi)
         mult = np.zeros(f.size, int)
         kind = np.empty(f.size, object)
-        for g in _groups(f):
+        for g in frequency_groups(f):
             mult[g] = len(g)
             kind[g] = self.mode_type(phi[:, g]) if self._planets() else ""
         extra = {"type": ("mode", kind.astype(str))} if self._planets() else {}
@@ -525,19 +525,6 @@ class GearTrain:
         return (f"GearTrain({len(self.bodies)} bodies, {len(self.meshes)} meshes, "
                 f"{len(self.shafts)} shafts, {len(self.bearings)} bearings, "
                 f"{len(self._dofs)} dofs)")
-
-
-def _groups(f: np.ndarray) -> list[list[int]]:
-    """Indices of ascending frequencies grouped into repeated values (:data:`MULTIPLICITY_RTOL`,
-    relative; near 0 relative to 1e-3 of the largest)."""
-    scale = max(float(np.max(f)), 1e-300) if f.size else 1.0
-    groups: list[list[int]] = []
-    for i, v in enumerate(f):
-        if groups and abs(v - f[groups[-1][0]]) <= MULTIPLICITY_RTOL * max(v, 1e-3 * scale):
-            groups[-1].append(i)
-        else:
-            groups.append([i])
-    return groups
 
 
 def _typed(field: str, items: Sequence[Any], cls: type) -> list[Any]:
