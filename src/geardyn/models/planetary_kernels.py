@@ -542,47 +542,58 @@ def planetary_rhs_lanes(T, Y, DY, PT, nl, S, C, SC):
             for k in range(nl):
                 DY[i, k] -= (PT[g, k] * PT[r, k]) * Y[j, k]
     kr = _lanes_cached_stiffness(PT, nl, S, C, SC, mz + nm * 3 * MESH_NZ, mesh, bs, nh, nm, two)
-    if two:
-        for m in range(nm):
-            _lanes_mesh_two(Y, DY, PT, nl, S, C, SC, n, mesh + m * bs, mz + m * 3 * MESH_NZ,
-                            kr + m, True, kr + nm + m)
-        return
     for m in range(nm):
         _lanes_mesh(Y, DY, PT, nl, S, C, SC, n, mesh + m * bs, mz + m * 3 * MESH_NZ, kr + m,
-                    True)
+                    True, two, kr + nm + m)
 
 
 @nb.njit(inline="always", **_JIT)
-def _lanes_mesh(Y, DY, PT, nl, S, C, SC, n, o, q, row, apply):
+def _mesh_dofs(PT, q):
+    """The six dof indices of the mesh whose structure starts at row q (column 0)."""
+    return (int(PT[q, 0]), int(PT[q + 1, 0]), int(PT[q + 2, 0]), int(PT[q + 3, 0]),
+            int(PT[q + 4, 0]), int(PT[q + 5, 0]))
+
+
+@nb.njit(inline="always", **_JIT)
+def _lane_deflection(Y, PT, k, n, o, w, i0, i1, i2, i3, i4, i5, s, c):
+    """Lane k's mesh deflection d less the mesh error, and its rate v (block at o, projection
+    weights at row w, dofs i0..i5; s, c: the lane's mesh phase), in the order every form sums
+    them."""
+    d = 0.0
+    v = 0.0
+    d += PT[w, k] * Y[i0, k]
+    v += PT[w, k] * Y[n + i0, k]
+    d += PT[w + 1, k] * Y[i1, k]
+    v += PT[w + 1, k] * Y[n + i1, k]
+    d += PT[w + 2, k] * Y[i2, k]
+    v += PT[w + 2, k] * Y[n + i2, k]
+    d += PT[w + 3, k] * Y[i3, k]
+    v += PT[w + 3, k] * Y[n + i3, k]
+    d += PT[w + 4, k] * Y[i4, k]
+    v += PT[w + 4, k] * Y[n + i4, k]
+    d += PT[w + 5, k] * Y[i5, k]
+    v += PT[w + 5, k] * Y[n + i5, k]
+    d -= PT[o + M_ES, k] * s + PT[o + M_EC, k] * c
+    v -= PT[OMEGA, k] * (PT[o + M_ES, k] * c - PT[o + M_EC, k] * s)
+    return d, v
+
+
+@nb.njit(inline="always", **_JIT)
+def _lanes_mesh(Y, DY, PT, nl, S, C, SC, n, o, q, row, apply, two, rowc):
     """Mesh force of the block at o (structure at q, relative stiffness in PT[row]) for every
     lane, into SC[0], then subtracted from the accelerations DY (``apply``) or copied to DY[0]
-    (observables). One store stream per lane loop, so that the loops vectorise."""
-    i0 = int(PT[q, 0])
-    i1 = int(PT[q + 1, 0])
-    i2 = int(PT[q + 2, 0])
-    i3 = int(PT[q + 3, 0])
-    i4 = int(PT[q + 4, 0])
-    i5 = int(PT[q + 5, 0])
+    (observables). One store stream per lane loop, so that the loops vectorise. With ``two``
+    the coast flank's KF_coast c_m(theta) (relative stiffness in PT[rowc]) acts where the dead
+    zone's output is negative; the drive flank's arithmetic is the same either way."""
+    i0, i1, i2, i3, i4, i5 = _mesh_dofs(PT, q)
     w = q + MESH_NZ
     for k in range(nl):
-        d = 0.0
-        v = 0.0
-        d += PT[w, k] * Y[i0, k]
-        v += PT[w, k] * Y[n + i0, k]
-        d += PT[w + 1, k] * Y[i1, k]
-        v += PT[w + 1, k] * Y[n + i1, k]
-        d += PT[w + 2, k] * Y[i2, k]
-        v += PT[w + 2, k] * Y[n + i2, k]
-        d += PT[w + 3, k] * Y[i3, k]
-        v += PT[w + 3, k] * Y[n + i3, k]
-        d += PT[w + 4, k] * Y[i4, k]
-        v += PT[w + 4, k] * Y[n + i4, k]
-        d += PT[w + 5, k] * Y[i5, k]
-        v += PT[w + 5, k] * Y[n + i5, k]
-        d -= PT[o + M_ES, k] * S[k] + PT[o + M_EC, k] * C[k]
-        v -= PT[OMEGA, k] * (PT[o + M_ES, k] * C[k] - PT[o + M_EC, k] * S[k])
-        SC[0, k] = (PT[o + M_KF, k] * PT[row, k] * _dead_zone(d, PT[o + M_B, k])
-                    + PT[o + M_CF, k] * v)
+        d, v = _lane_deflection(Y, PT, k, n, o, w, i0, i1, i2, i3, i4, i5, S[k], C[k])
+        g = _dead_zone(d, PT[o + M_B, k])
+        kf = PT[o + M_KF, k] * PT[row, k]
+        if two and g < 0.0:
+            kf = PT[o + M_KFC, k] * PT[rowc, k]
+        SC[0, k] = kf * g + PT[o + M_CF, k] * v
     _lanes_apply(DY, PT, nl, SC, n, q, apply)
 
 
@@ -599,43 +610,6 @@ def _lanes_apply(DY, PT, nl, SC, n, q, apply):
         r = n + int(PT[q + j, 0])
         for k in range(nl):
             DY[r, k] -= SC[0, k] * PT[g + j, k]
-
-
-@nb.njit(inline="always", **_JIT)
-def _lanes_mesh_two(Y, DY, PT, nl, S, C, SC, n, o, q, row, apply, rowc):
-    """:func:`_lanes_mesh` with two flanks: the coast flank's KF_coast c_m(theta) (relative
-    stiffness in PT[rowc]) where the dead zone's output is negative, the drive flank's
-    arithmetic otherwise, operation for operation."""
-    i0 = int(PT[q, 0])
-    i1 = int(PT[q + 1, 0])
-    i2 = int(PT[q + 2, 0])
-    i3 = int(PT[q + 3, 0])
-    i4 = int(PT[q + 4, 0])
-    i5 = int(PT[q + 5, 0])
-    w = q + MESH_NZ
-    for k in range(nl):
-        d = 0.0
-        v = 0.0
-        d += PT[w, k] * Y[i0, k]
-        v += PT[w, k] * Y[n + i0, k]
-        d += PT[w + 1, k] * Y[i1, k]
-        v += PT[w + 1, k] * Y[n + i1, k]
-        d += PT[w + 2, k] * Y[i2, k]
-        v += PT[w + 2, k] * Y[n + i2, k]
-        d += PT[w + 3, k] * Y[i3, k]
-        v += PT[w + 3, k] * Y[n + i3, k]
-        d += PT[w + 4, k] * Y[i4, k]
-        v += PT[w + 4, k] * Y[n + i4, k]
-        d += PT[w + 5, k] * Y[i5, k]
-        v += PT[w + 5, k] * Y[n + i5, k]
-        d -= PT[o + M_ES, k] * S[k] + PT[o + M_EC, k] * C[k]
-        v -= PT[OMEGA, k] * (PT[o + M_ES, k] * C[k] - PT[o + M_EC, k] * S[k])
-        g = _dead_zone(d, PT[o + M_B, k])
-        kf = PT[o + M_KF, k] * PT[row, k]
-        if g < 0.0:
-            kf = PT[o + M_KFC, k] * PT[rowc, k]
-        SC[0, k] = kf * g + PT[o + M_CF, k] * v
-    _lanes_apply(DY, PT, nl, SC, n, q, apply)
 
 
 @nb.njit(**_JIT)
@@ -676,9 +650,5 @@ def planetary_observe_lanes(T, Y, O, PT, nl, S, C, SC):
         two |= PT[TWO_FLANK, k] != 0.0
     kr = _lanes_cached_stiffness(PT, nl, S, C, SC, mz + nm * 3 * MESH_NZ, mesh, bs, nh, nm, two)
     for m in range(nm):
-        if two:
-            _lanes_mesh_two(Y, O[m:m + 1], PT, nl, S, C, SC, n, mesh + m * bs,
-                            mz + m * 3 * MESH_NZ, kr + m, False, kr + nm + m)
-        else:
-            _lanes_mesh(Y, O[m:m + 1], PT, nl, S, C, SC, n, mesh + m * bs,
-                        mz + m * 3 * MESH_NZ, kr + m, False)
+        _lanes_mesh(Y, O[m:m + 1], PT, nl, S, C, SC, n, mesh + m * bs, mz + m * 3 * MESH_NZ,
+                    kr + m, False, two, kr + nm + m)
