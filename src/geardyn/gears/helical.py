@@ -49,6 +49,7 @@ from geardyn.gears.potential_energy import (
     STEEL_POISSON,
     STEEL_YOUNG,
     PotentialEnergyPair,
+    _attrs,
     _cycle_grid,
     _fault_codes,
     _fault_tuple,
@@ -409,24 +410,8 @@ def _helical_attrs(mesh: HelicalMesh, pair: PotentialEnergyPair, root_segment: b
                    count: int) -> dict[str, object]:
     """The Dataset's attributes: the method, material, width (the whole face), faults, bores
     and the helical geometry."""
-    t = mesh.transverse
-    out: dict[str, object] = {
-        "method": "potential energy (Yang & Lin 1987; Tian 2004; Chaari et al. 2009) with the"
-                  " fillet foundation of Sainsot, Velex & Duverger 2004, per slice",
-        "root": ("straight flank from the root to the base circle" if root_segment
-                 else "cantilever from the base circle (or the root circle above it)"),
-        "young_Pa": pair.young, "poisson": pair.poisson, "face_width_m": pair.face_width,
-        "hertz_stiffness_N_per_m": pair.hertz, "contact_ratio": t.contact_ratio,
-        "base_pitch_m": t.base_pitch, "quadrature_nodes": pair.nodes,
-        "coast_phase_cycles": coast_phase(t), "backlash_m": t.backlash,
-        "backlash_cycles": t.backlash / (2.0 * math.pi * t.operating_pitch_radii[0]
-                                         / t.pinion.teeth),
-        "faults": "; ".join(f.describe() for f in pair.faults) or "none",
-        "faulty_gears": ",".join(sorted({f.gear for f in pair.faults})),
-    }
-    for role, tooth in (("pinion", pair.pinion), ("wheel", pair.wheel)):
-        out[f"{role}_bore_radius_m"] = tooth.bore_radius
-        out[f"{role}_h_fi"] = tooth.h_fi
+    out = _attrs(pair, root_segment, "rigid")  # pair.mesh: the transverse section's pair
+    out["method"] = f"{out['method']}, per slice"
     return out | {
         "slice_model": "thin slices across the face width, each the potential-energy spur pair"
                        " of the transverse sections of width b/S shifted by y tan(beta_b) along"
