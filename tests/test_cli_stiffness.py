@@ -15,6 +15,7 @@ import geardyn.gears as g
 from geardyn.cli.main import main
 from geardyn.io.netcdf import load_dataset
 from geardyn.io.toml import builtin_study, load_study, save_study
+from test_cli import assert_one_line_error
 
 #: Every field away from its default, so that a field the study layer drops or mixes up
 #: changes the result: profile shifts, per-gear tooth proportions, face widths and bores, a
@@ -183,11 +184,7 @@ def test_bad_tables_are_one_line_errors_naming_the_field(tmp_path, capsys, old, 
         assert r.returncode == 0, r.stderr
         assert load_study(study).gears.gear("wheel").dedendum == 1.3
         return
-    assert r.returncode == 2, r.stdout
-    err = r.stderr.strip()
-    assert len(err.splitlines()) == 1 and err.startswith("error: "), err
-    for fragment in fragments:
-        assert fragment in err, err
+    assert_one_line_error(r, *fragments)
     assert not out.exists()
 
 
@@ -312,6 +309,4 @@ def test_commands_that_run_a_model_refuse_a_gears_only_study_first(capsys, comma
     """A study of gears alone (no [params]) is refused by name before any option is resolved
     (``simulate`` asked for --omega, ``explore`` for --range)."""
     r = run(capsys, *command, "stiffness_19_48")
-    assert r.returncode == 2, (r.stdout, r.stderr)
-    err = r.stderr.strip()
-    assert len(err.splitlines()) == 1 and "has no [params]" in err, err
+    assert_one_line_error(r, "has no [params]")

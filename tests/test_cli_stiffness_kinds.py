@@ -17,6 +17,7 @@ from pydantic import ValidationError
 import geardyn.gears as g
 from geardyn.io.netcdf import load_dataset
 from geardyn.io.toml import builtin_study, load_study, save_study
+from test_cli import assert_one_line_error
 from test_cli_stiffness import assert_bitwise_equal, run
 
 
@@ -326,11 +327,7 @@ def test_bad_tables_are_one_line_errors_naming_the_field(tmp_path, capsys, text,
     study.write_text(text.replace(old, new, 1), encoding="utf-8")
     out = tmp_path / "k.nc"
     r = run(capsys, "stiffness", study, "-o", out)
-    assert r.returncode == 2, r.stdout
-    err = r.stderr.strip()
-    assert len(err.splitlines()) == 1 and err.startswith("error: "), err
-    for fragment in fragments:
-        assert fragment in err, err
+    assert_one_line_error(r, *fragments)
     assert not out.exists()
 
 

@@ -27,6 +27,7 @@ from geardyn.errors import ParameterError
 from geardyn.gears.potential_energy import coast_phase
 from geardyn.models import planetary_kernels as pk
 from geardyn.models.planetary_stiffness import flank_series, mirrored
+from test_planetary_pe import kernel_stiffness
 
 M = geardyn.Member
 MEMBERS = dict(
@@ -61,23 +62,6 @@ def wave(a: np.ndarray, b: np.ndarray, x: np.ndarray) -> np.ndarray:
     """1 + sum a_h cos(h x) + b_h sin(h x), by direct sums."""
     h = np.arange(1, a.size + 1)
     return 1.0 + a @ np.cos(np.outer(h, x)) + b @ np.sin(np.outer(h, x))
-
-
-def kernel_stiffness(gs: geardyn.PlanetaryGearSet, thetas: np.ndarray,
-                     sign: float) -> np.ndarray:
-    """k_m [N/m] of every mesh (columns) at the mesh phases ``thetas`` (rows) from the compiled
-    observable at a state with dimensionless deflection ``sign`` in every mesh, at rest, no
-    backlash (as tests/test_planetary_pe.py)."""
-    gs = gs.with_params(sun_backlash=0.0, ring_backlash=0.0)
-    W = gs.mesh_rows()
-    X = np.linalg.lstsq(W, np.full(W.shape[0], sign), rcond=None)[0]
-    assert np.allclose(W @ X, sign)
-    y = np.r_[X, np.zeros_like(X)]
-    out = np.empty((np.size(thetas), W.shape[0]))
-    for i, theta in enumerate(np.ravel(thetas)):
-        gs.kernel.observe(theta / gs.omega, y, out[i], gs.params, math.sin(theta),
-                          math.cos(theta))
-    return out / (sign * gs.length_scale)
 
 
 def test_mirrored_series_is_the_wave_at_phi_minus_theta():
