@@ -20,7 +20,6 @@ import math
 
 import numpy as np
 import xarray as xr
-from scipy.signal import get_window
 
 __all__ = ["amplitude_spectrum", "label_peaks", "time_series"]
 
@@ -110,6 +109,8 @@ def amplitude_spectrum(
         raise ValueError(f"signal: at least 4 samples are needed (got {n})")
     if not np.all(np.isfinite(x)):
         raise ValueError("signal: holds NaN or inf (a diverged run has no spectrum)")
+    from scipy.signal import get_window  # imported here: scipy.signal takes ~1 s to import
+
     w = get_window(window, n, fftbins=True)
     mean = float(np.mean(x))
     amp = 2.0 * np.abs(np.fft.rfft(w * (x - mean))) / np.sum(w)

@@ -9,7 +9,6 @@ when it leaves that side, so a restart on the edge does not fire again.
 from __future__ import annotations
 
 import numpy as np
-from scipy.integrate import solve_ivp
 
 from geardyn.core.model import Model
 from geardyn.solvers.kernels import kernels_for
@@ -49,6 +48,8 @@ def reference_solution(
     Every requested time is the end of an integration (not a point of the solver's interpolant,
     which is less accurate than its steps); every switching-function crossing ends one too.
     """
+    from scipy.integrate import solve_ivp  # imported here: ~1 s, needed by this call only
+
     f, ev = _functions(model)
     t_eval = np.asarray(t_eval, dtype=float)
     out = np.full((t_eval.size, model.n_states), np.nan)
