@@ -11,11 +11,14 @@ Elements act through deflection rows w (full coordinates), each a spring k w w^T
 - shaft: theta_a - theta_b;
 - bearing of body p on host h (pin at radius R, angle psi on h): x_p - x_h + R sin(psi) theta_h
   and y_p - y_h - R cos(psi) theta_h (the host's terms absent on the ground);
-- mesh of a with b (Lin & Parker 1999; Kahraman 1994): delta = s . (c_a - c_b) + r_a theta_a
-  + sigma r_b theta_b, with c the centres, r the base radii, sigma = +1 external, -1 internal
-  (b the ring), and s the unit vector of the line of action: at angle phi + 90 deg - alpha of
-  an external mesh, phi - 90 deg + alpha of an internal one (phi the direction from a's centre
-  to b's, alpha the pressure angle).
+- mesh of a with b (Lin & Parker 1999; Kahraman 1994): delta = cos(beta_b) [s . (c_a - c_b)
+  + r_a theta_a + sigma r_b theta_b], with c the centres, r the (transverse) base radii, sigma
+  = +1 external, -1 internal (b the ring), s the unit vector of the transverse line of action:
+  at angle phi + 90 deg - alpha of an external mesh, phi - 90 deg + alpha of an internal one
+  (phi the direction from a's centre to b's, alpha the pressure angle), and beta_b the base
+  helix angle (0 for spur gears): the deflection along a helical mesh's line of action, which
+  is inclined by beta_b to the transverse plane, from the transverse motion. The axial part
+  of that deflection is not modelled (no axial coordinates: the bodies are held axially).
 
 M = T^T diag(I, m, m) T, K = T^T (sum k w w^T) T, C = T^T (sum c w w^T) T + a M + b K.
 """
@@ -43,14 +46,16 @@ MODE_TYPE_TOL = 1e-6
 
 @dataclass(frozen=True)
 class MeshData:
-    """A mesh as the linear model uses it: mean ``stiffness`` [N/m], operating
-    ``pressure_angle`` [rad], base radii [m] and the method the stiffness came from."""
+    """A mesh as the linear model uses it: mean ``stiffness`` [N/m] along the line of action,
+    operating transverse ``pressure_angle`` [rad], base radii [m], the method the stiffness
+    came from and the ``base_helix_angle`` [rad] (0: spur)."""
 
     stiffness: float
     pressure_angle: float
     radius_a: float
     radius_b: float
     method: str
+    base_helix_angle: float = 0.0
 
 
 def _line_of_action(mesh: Mesh, alpha: float) -> tuple[float, float]:
@@ -61,11 +66,23 @@ def _line_of_action(mesh: Mesh, alpha: float) -> tuple[float, float]:
 
 
 def _gear_mesh(mesh: Mesh, ga: Gear, gb: Gear) -> Any:
-    """The :class:`~geardyn.gears.GearMesh` of two gears with geometry; its errors re-raised
-    naming the mesh."""
+    """The :class:`~geardyn.gears.GearMesh` (or :class:`~geardyn.gears.HelicalMesh`) of two
+    gears with geometry; its errors re-raised naming the mesh."""
     from geardyn.gears.geometry import GearMesh
+    from geardyn.gears.helical import HelicalMesh
 
+    if ga.helical != gb.helical:
+        spur = mesh.a if gb.helical else mesh.b
+        raise ParameterError(f"{mesh.name}.{'a' if spur == mesh.a else 'b'}", spur,
+                             f"is a spur gear and {mesh.b if spur == mesh.a else mesh.a} a"
+                             " helical one: they cannot mesh")
+    if ga.helical and mesh.internal:
+        raise ParameterError(f"{mesh.name}.internal", True,
+                             "an internal helical mesh is not covered")
     try:
+        if ga.helical:
+            return HelicalMesh(pinion=ga.geometry, wheel=gb.geometry,
+                               centre_distance=mesh.centre_distance)
         return GearMesh(pinion=ga.geometry, wheel=gb.geometry,
                         centre_distance=mesh.centre_distance, internal=mesh.internal)
     except ParameterError as exc:
@@ -73,20 +90,27 @@ def _gear_mesh(mesh: Mesh, ga: Gear, gb: Gear) -> Any:
                              f"{exc.reason} (mesh of {mesh.a} with {mesh.b})") from None
 
 
-def _mesh_stiffness(mesh: Mesh, gear_mesh: Any) -> tuple[float, str]:
+def _mesh_stiffness(mesh: Mesh, gear_mesh: Any, beta_b: float) -> tuple[float, str]:
+    """The mesh stiffness along the line of action [N/m] and its method. ISO 6336-1 and the
+    sliced potential-energy method give it along the transverse line of action: divided by
+    cos^2(beta_b) (a helical mesh) for the normal one."""
     if not isinstance(mesh.stiffness, str):
         return float(mesh.stiffness), "given"
     if gear_mesh is None:
         raise ParameterError(f"{mesh.name}.stiffness", mesh.stiffness,
                              f"needs the geometry of both gears ({mesh.a}, {mesh.b})")
+    normal = 1.0 / math.cos(beta_b) ** 2
     if mesh.stiffness == "iso":
         from geardyn.gears.iso6336 import iso6336_stiffness
 
-        return iso6336_stiffness(gear_mesh).mesh_stiffness, "iso"
+        return iso6336_stiffness(gear_mesh).mesh_stiffness * normal, "iso"
+    from geardyn.gears.helical import HelicalMesh, helical_stiffness
     from geardyn.gears.potential_energy import potential_energy_stiffness
 
-    ds = potential_energy_stiffness(gear_mesh, bore_radius=mesh.bore_radius)
-    return float(ds["mesh_stiffness"].mean()), "potential_energy"
+    method = helical_stiffness if isinstance(gear_mesh, HelicalMesh) else (
+        potential_energy_stiffness)
+    ds = method(gear_mesh, bore_radius=mesh.bore_radius)
+    return float(ds["mesh_stiffness"].mean()) * normal, "potential_energy"
 
 
 def resolve_mesh(mesh: Mesh, ga: Gear, gb: Gear) -> MeshData:
@@ -100,7 +124,7 @@ def resolve_mesh(mesh: Mesh, ga: Gear, gb: Gear) -> MeshData:
         raise ParameterError(f"{mesh.name}.internal", True, f"{mesh.b} is not an internal gear")
     alpha = mesh.pressure_angle
     if gear_mesh is not None:
-        alpha_w = gear_mesh.operating_pressure_angle
+        alpha_w = getattr(gear_mesh, "transverse", gear_mesh).operating_pressure_angle
         if alpha is not None and not math.isclose(alpha, alpha_w, rel_tol=1e-6):
             raise ParameterError(f"{mesh.name}.pressure_angle", alpha,
                                  f"differs from the geometries' operating {alpha_w:.6g} rad")
@@ -113,8 +137,24 @@ def resolve_mesh(mesh: Mesh, ga: Gear, gb: Gear) -> MeshData:
             raise ParameterError(f"{mesh.name}.centre_distance", mesh.centre_distance,
                                  f"inconsistent with the base radii and pressure angle"
                                  f" ({a0:.6g} m)")
-    k, method = _mesh_stiffness(mesh, gear_mesh)
-    return MeshData(k, alpha, ga.base_radius, gb.base_radius, method)
+    beta_b = _base_helix_angle(mesh, gear_mesh, alpha)
+    k, method = _mesh_stiffness(mesh, gear_mesh, beta_b)
+    return MeshData(k, alpha, ga.base_radius, gb.base_radius, method, beta_b)
+
+
+def _base_helix_angle(mesh: Mesh, gear_mesh: Any, alpha: float) -> float:
+    """beta_b [rad] of ``mesh``: the geometries' (a helical pair), checked against a given
+    ``helix_angle``; else from ``helix_angle`` and the pressure angle; else 0."""
+    beta = mesh.helix_angle
+    if gear_mesh is not None:
+        own = getattr(gear_mesh, "helix_angle", 0.0)
+        if beta is not None and not math.isclose(beta, own, rel_tol=1e-9, abs_tol=1e-12):
+            raise ParameterError(f"{mesh.name}.helix_angle", beta,
+                                 f"differs from the geometries' {own:.6g} rad")
+        return float(getattr(gear_mesh, "base_helix_angle", 0.0))
+    if beta is None:
+        return 0.0
+    return math.atan(math.tan(beta) * math.cos(alpha))
 
 
 class GearTrain:
@@ -282,8 +322,9 @@ class GearTrain:
         sx, sy = _line_of_action(m, d.pressure_angle)
         sigma = -1.0 if m.internal else 1.0
         u = self._unit
-        return (sx * (u(m.a, 1) - u(m.b, 1)) + sy * (u(m.a, 2) - u(m.b, 2))
-                + d.radius_a * u(m.a, 0) + sigma * d.radius_b * u(m.b, 0))[None, :]
+        return math.cos(d.base_helix_angle) * (
+            sx * (u(m.a, 1) - u(m.b, 1)) + sy * (u(m.a, 2) - u(m.b, 2))
+            + d.radius_a * u(m.a, 0) + sigma * d.radius_b * u(m.b, 0))[None, :]
 
     def elements(self) -> list[tuple[str, str, np.ndarray, float, float]]:
         """(kind, name, deflection rows in the model's coordinates, stiffness, damping) of every
