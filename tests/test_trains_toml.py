@@ -380,3 +380,21 @@ def test_docs_train_table_reads():
     assert block is not None
     train = load_study(block.group(1)).gear_train
     assert train.mesh_data["stage1"].method == "iso" and train.driven == "g1"
+
+
+def test_campbell_plot_draws_one_ray_per_order_and_harmonic(tmp_path):
+    """A planetary stage's sun and ring meshes share their order: one ray each harmonic,
+    labelled with the meshes it stands for; every crossing still marked."""
+    from geardyn.plotting.campbell import plot_campbell
+
+    train = load_study(PLANETARY).gear_train
+    ds = train.campbell(np.linspace(0.0, 3000.0, 31), harmonics=2)
+    fig = plot_campbell(ds)
+    rays = [ln for ln in fig.axes[0].lines if len(ln.get_xdata()) == ds.sizes["speed"]]
+    orders = sorted({round(float(o), 9) for o in ds["order"].values})
+    assert len(ds["order"]) == 16 and len(orders) == 2 and len(rays) == 4
+    labels = [ln.get_label() for ln in rays if not ln.get_label().startswith("_")]
+    assert labels == [f"sun_planet1 and 3 more (order {orders[0]:.4g})",
+                      f"planet1_ring and 3 more (order {orders[1]:.4g})"]
+    marks = [ln for ln in fig.axes[0].lines if ln.get_label() == "crossing"][0]
+    assert len(marks.get_xdata()) == int(np.isfinite(ds["crossing_speed"].values).sum())
