@@ -104,7 +104,7 @@ def test_first_drivetrain_mode_against_the_published_frequency(train):
     the two-inertia value of the rigid gearbox, sqrt(k (1/J_R + 1/J_G,eq)) with J_G,eq the
     kinetic energy of every other body referred to the rotor speed (a Rayleigh bound: the
     gearbox's own compliance only lowers it), and lies within 15 % of the published 2.18 Hz.
-    The tolerance: the gearbox's body inertias are stand-ins (they make about a tenth of
+    The tolerance: the gearbox's body inertias are stand-ins (they make 12 % of
     J_G,eq) and the published value comes from a turbine model with flexible blades."""
     modes = train.modes()
     f = modes["frequency"].values
