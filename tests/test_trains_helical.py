@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 import pytest
 
 from geardyn.errors import ParameterError
@@ -105,3 +106,47 @@ def test_bad_helical_meshes_are_refused_naming_the_field(case, field):
     with pytest.raises(ParameterError) as err:
         _pair((p, w), stiffness=1e9, **extra)
     assert err.value.field == field
+
+
+def test_potential_energy_helical_mesh_is_the_sliced_transverse_mean():
+    """A helical pair on "potential_energy": the transverse stiffness k_n cos^2(beta_b)
+    is the mean of geardyn.gears.helical_stiffness over a mesh cycle (transverse), so the
+    torsional mode is the closed form on that mean."""
+    from geardyn.gears import helical_stiffness
+
+    p = HelicalGear(19, "3.2 mm", "20 deg", "20 deg", "16 mm", name="pinion")
+    w = HelicalGear(48, "3.2 mm", "20 deg", "20 deg", "16 mm", name="wheel")
+    train = _pair((p, w), stiffness="potential_energy", bore_radius="12 mm")
+    mean = float(helical_stiffness(HelicalMesh(p, w), bore_radius="12 mm")["mesh_stiffness"]
+                 .mean())
+    assert train.mesh_data["m"].method == "potential_energy"
+    f = train.natural_frequencies()[1]
+    assert f == pytest.approx(_torsional(mean, p.transverse.base_radius,
+                                         w.transverse.base_radius), rel=1e-12)
+
+
+def test_helical_pair_on_flexible_bearings_matches_a_hand_assembled_matrix():
+    """Six coordinates (theta, x, y of each gear): K written out from the mesh's transverse
+    line of action s (at phi + 90 deg - alpha, phi = 0 here) and cos(beta_b), plus isotropic
+    bearings; the eigenvalues of (K, M) are the train's."""
+    from scipy.linalg import eigh
+
+    k, kb, beta, alpha = 4e9, 2e9, math.radians(12.0), math.radians(20.0)
+    r1, r2, m1, m2 = 0.16, 0.63, 170.0, 3700.0
+    train = GearTrain(
+        [Gear("pinion", I1, mass=m1, base_radius=r1), Gear("wheel", I2, mass=m2,
+                                                           base_radius=r2)],
+        bearings=[Bearing("b1", "pinion", kb), Bearing("b2", "wheel", kb)],
+        meshes=[Mesh("m", "pinion", "wheel", k, helix_angle=beta, pressure_angle=alpha)],
+        free=True)
+    cb = math.cos(math.atan(math.tan(beta) * math.cos(alpha)))
+    sx, sy = math.cos(math.pi / 2 - alpha), math.sin(math.pi / 2 - alpha)
+    v = cb * np.array([r1, sx, sy, r2, -sx, -sy])
+    K = k * np.outer(v, v) + np.diag([0.0, kb, kb, 0.0, kb, kb])
+    M = np.diag([I1, m1, m1, I2, m2, m2])
+    lam = np.clip(eigh(K, M, eigvals_only=True), 0.0, None)
+    expected = np.sqrt(lam) / (2 * math.pi)
+    expected[0] = 0.0
+    assert train.dof_names() == ("pinion.theta", "pinion.x", "pinion.y", "wheel.theta",
+                                 "wheel.x", "wheel.y")
+    np.testing.assert_allclose(train.natural_frequencies(), expected, rtol=1e-9, atol=1e-6)
