@@ -355,6 +355,9 @@ def test_modes_command_runs_a_study_without_outputs(tmp_path, capsys):
     (("{study}", "--speed", "50..0 rpm"), ("--speed", "from a speed >= 0")),
     (("{study}", "--speed", "0..50 1/s"), ("--speed",)),
     (("{study}", "-o", "m.txt"), ("--out", ".nc")),
+    (("{study}", "--harmonics", "2"), ("--harmonics", "needs the speed range")),
+    (("{study}", "--speed", "0..50 rpm", "--harmonics", "0"), ("--harmonics", "1..100")),
+    (("{study}", "--speed", "0..50 rpm", "--points", "1"), ("--points", "2..")),
 ])
 def test_modes_command_errors_are_one_line(tmp_path, capsys, args, fragments):
     study = tmp_path / "two_stage.toml"

@@ -31,8 +31,12 @@ __all__ = ["modes_command", "register", "speed_range"]
 
 #: Elements listed per mode in the printed table (the largest energy shares).
 SHOWN_SHARES = 3
-#: Most speeds of a Campbell diagram.
+#: Most speeds of a Campbell diagram, and the speeds unless told.
 MAX_POINTS = 100_000
+DEFAULT_POINTS = 401
+#: Most mesh-frequency harmonics, and the harmonics unless told.
+MAX_HARMONICS = 100
+DEFAULT_HARMONICS = 3
 
 
 def speed_range(text: str, points: int) -> np.ndarray:
@@ -67,8 +71,10 @@ def modes_command(
                                               " .svg).")] = None,
     speed: Annotated[str | None, typer.Option(help='Input-speed range of the Campbell diagram,'
                                               ' "A..B UNIT" (e.g. "0..1500 rpm").')] = None,
-    points: Annotated[int, typer.Option(help="Speeds in the range.")] = 401,
-    harmonics: Annotated[int, typer.Option(help="Mesh-frequency harmonics drawn.")] = 3,
+    points: Annotated[int | None, typer.Option(help="Speeds in the range (default 401).")
+                      ] = None,
+    harmonics: Annotated[int | None, typer.Option(help="Mesh-frequency harmonics (default 3)."
+                                                  )] = None,
     campbell: Annotated[Path | None, typer.Option(help="Campbell diagram to write (.png, .pdf"
                                                   " or .svg; needs --speed).")] = None,
 ) -> None:
@@ -82,12 +88,20 @@ def modes_command(
         raise ParameterError("--out", str(out), "suffix must be .nc (NetCDF)")
     check_plot_path("--plot", plot)
     check_plot_path("--campbell", campbell)
-    if campbell is not None and speed is None:
-        raise ParameterError("--campbell", str(campbell), "needs the speed range (--speed)")
-    rpm = speed_range(speed, points) if speed is not None else None
+    if speed is None:
+        for option, value in (("--campbell", campbell), ("--points", points),
+                              ("--harmonics", harmonics)):
+            if value is not None:
+                raise ParameterError(option, str(value), "needs the speed range (--speed)")
+    if harmonics is not None and not 1 <= harmonics <= MAX_HARMONICS:
+        raise ParameterError("--harmonics", harmonics, f"must be in 1..{MAX_HARMONICS}")
+    rpm = speed_range(speed, DEFAULT_POINTS if points is None else points) if speed else None
     train = s.gear_train
     ds = train.modes()
-    cds = train.campbell(rpm, harmonics=harmonics) if rpm is not None else None
+    cds = None
+    if rpm is not None:
+        cds = train.campbell(rpm, harmonics=DEFAULT_HARMONICS if harmonics is None
+                             else harmonics)
     make_parents(out, plot, campbell)
     written = []
     if out is not None:
