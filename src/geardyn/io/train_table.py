@@ -16,12 +16,14 @@
     [train.bearings.b1]            # a Bearing: body, stiffness ("inf": rigid), host, ...
     [train.meshes.stage1]          # a Mesh: a, b, stiffness (N/m, "iso", "potential_energy"), ...
     [train.planetary.stage1]       # planetary_stage(): sun, ring, carrier, planet name bodies
+                                   #   (ring_planet: a compound stage's second planet gear)
 
 Every sub-table's keys are the keyword arguments of its element (one declaration: the element's
 dataclass fields, :func:`geardyn.trains.planetary_stage`'s parameters), the table's own key
 its name; values are SI numbers or unit strings. The bodies are the gears, then the inertias, in
-the order written, a planetary stage's planet replaced where it stands by the stage's planets
-(``<planet>1`` ...); then the bearings and meshes written, then each stage's pins and meshes. An
+the order written, a planetary stage's planet (and ring planet) replaced where it stands by the
+stage's copies (``<planet>1`` ...); then the shafts, bearings and meshes written, each followed
+by the stages' own (joints, pins and hubs, meshes). An
 unknown key, a missing one or a value an element refuses is an error naming
 ``train.<group>.<name>.<field>``; what the train as a whole refuses (a reference to no body, a
 free rigid-body mode, a mesh of gears that cannot mesh) names the element's table likewise.
@@ -56,7 +58,8 @@ GROUPS: dict[str, tuple[Any, str]] = {
     "gears": (Gear, "a Gear"), "inertias": (Inertia, "an Inertia"),
     "shafts": (Shaft, "a Shaft"), "bearings": (Bearing, "a Bearing"),
     "meshes": (Mesh, "a Mesh")}
-#: The keys of a ``[train.planetary.<name>]`` table that name bodies of the train.
+#: The keys of a ``[train.planetary.<name>]`` table that name bodies of the train (and the
+#: optional ``ring_planet``, a compound stage's second planet gear).
 STAGE_MEMBERS = ("sun", "ring", "carrier", "planet")
 
 Tables = dict[str, dict[str, Any]]
@@ -96,21 +99,20 @@ class TrainTable(BaseModel):
                 located[name] = loc
                 made[group].append(_element(cls, what, name, table, loc))
         bodies = {b.name: b for b in made["gears"] + made["inertias"]}
-        templates: dict[str, PlanetaryStage] = {}
+        templates: dict[str, list[Any]] = {}  # a stage's planet (or ring_planet): its copies
+        stages: list[PlanetaryStage] = []
         for name, table in self.planetary.items():
             stage = self._stage(name, table, bodies, where + ("planetary", name), located)
-            templates[str(table["planet"])] = stage
-        stages = list(templates.values())
+            stages.append(stage)
+            for key, names in (("planet", stage.planets), ("ring_planet", stage.compound)):
+                if key in table:
+                    templates[str(table[key])] = [b for b in stage.bodies if b.name in names]
         order: list[Any] = []
         for name, body in bodies.items():
-            stage = templates.get(name)
-            if stage is None:
-                order.append(body)
-            else:
-                order.extend(b for b in stage.bodies if b.name in stage.planets)
+            order.extend(templates.get(name, [body]))
         try:
             return GearTrain(
-                order, made["shafts"],
+                order, [*made["shafts"], *(s for st in stages for s in st.shafts)],
                 [*made["bearings"], *(b for s in stages for b in s.bearings)],
                 [*made["meshes"], *(m for s in stages for m in s.meshes)],
                 fixed=tuple(self.fixed), driven=self.driven, free=self.free,
@@ -131,6 +133,11 @@ class TrainTable(BaseModel):
                 raise study_error(loc + (key,), given[key], "names no gear or inertia of the"
                                   " train")
             given[key] = bodies[given[key]]
+        if "ring_planet" in given:
+            if given["ring_planet"] not in bodies:
+                raise study_error(loc + ("ring_planet",), given["ring_planet"], "names no gear"
+                                  " of the train")
+            given["ring_planet"] = bodies[given["ring_planet"]]
         for key in given:
             if key not in params:
                 raise study_error(loc + (key,), given[key], "unknown key (not a parameter of"
@@ -142,7 +149,7 @@ class TrainTable(BaseModel):
             raise study_error(loc + ((head,) if head in params else ()), exc.value,
                               f"{exc.field}: {exc.reason}" if head not in params
                               else exc.reason) from None
-        for element in (*stage.bodies[3:], *stage.bearings, *stage.meshes):
+        for element in (*stage.bodies[3:], *stage.bearings, *stage.meshes, *stage.shafts):
             if element.name in located:
                 raise study_error(loc, element.name, f"the stage's element {element.name!r}"
                                   " has the name of another element")

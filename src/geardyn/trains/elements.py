@@ -137,7 +137,9 @@ class Gear(Inertia):
 @dataclass(frozen=True)
 class Shaft:
     """A torsional spring between bodies ``a`` and ``b`` (``b`` may be :data:`GROUND`):
-    ``stiffness`` [N m/rad] and ``damping`` [N m s/rad] on the twist theta_a - theta_b."""
+    ``stiffness`` [N m/rad] and ``damping`` [N m s/rad] on the twist theta_a - theta_b.
+    ``math.inf`` (or ``"inf"``): a rigid joint, the two bodies turn as one (the two gears of a
+    compound planet); it has no damping."""
 
     name: str
     a: str
@@ -151,8 +153,16 @@ class Shaft:
         _body_ref(self, "b", ground=True)
         if self.a == self.b:
             raise ParameterError(f"{self.name}.b", self.b, "a shaft joins two different bodies")
-        _si(self, "stiffness", "torque", strict=True)  # N m/rad: a torque per radian
+        _si(self, "stiffness", "torque", strict=True, allow_inf=True)  # N m/rad
         _si(self, "damping", "dimensionless")  # N m s/rad, a number
+        if self.rigid and self.damping != 0.0:
+            raise ParameterError(f"{self.name}.damping", self.damping,
+                                 "a rigid shaft (infinite stiffness) has no damping")
+
+    @property
+    def rigid(self) -> bool:
+        """Whether the shaft is a rigid joint (infinite stiffness)."""
+        return math.isinf(self.stiffness)
 
 
 @dataclass(frozen=True)

@@ -1,10 +1,11 @@
 """A gear train assembled from its elements, and its linear model at mean mesh stiffness.
 
 Coordinates. Every body has a rotation theta [rad] (positive counter-clockwise) and a centre
-displacement x, y [m] in the fixed frame. The model keeps theta of every body that is not fixed,
-and x, y of a body on a flexible bearing (it then needs a mass); a body on a rigid bearing on a
-carrier is carried by it (its centre moves with the carrier's pin), any other body's centre is
-held. ``T`` maps the model's coordinates q to the full ones: full = T q.
+displacement x, y [m] in the fixed frame. The model keeps theta of every body that is not fixed
+(bodies joined by rigid shafts share one, the first one's; joined rigidly to the ground or a
+fixed body, none), and x, y of a body on a flexible bearing (it then needs a mass); a body on a
+rigid bearing on a carrier is carried by it (its centre moves with the carrier's pin), any other
+body's centre is held. ``T`` maps the model's coordinates q to the full ones: full = T q.
 
 Elements act through deflection rows w (full coordinates), each a spring k w w^T:
 
@@ -200,6 +201,7 @@ class GearTrain:
                           for m in self.meshes}
         self._check_connected()
         self._index = {name: i for i, name in enumerate(self.bodies)}
+        self._turns_with = self._rigid_rotations()
         self._dofs, self._T = self._coordinates()
         self.rigid_body_modes = self._count_rigid_body_modes()
 
@@ -263,12 +265,35 @@ class GearTrain:
                                      " ground: the train falls apart into separate pieces")
 
     # ------------------------------------------------------------------ coordinates
+    def _rigid_rotations(self) -> dict[str, str | None]:
+        """The body whose rotation each body shares through rigid shafts (the first of its
+        group; None: held, by the ground or a fixed body)."""
+        parent = {name: name for name in [GROUND, *self.bodies]}
+
+        def root(n: str) -> str:
+            while parent[n] != n:
+                n = parent[n]
+            return n
+
+        for s in self.shafts:
+            if s.rigid:
+                parent[root(s.a)] = root(s.b)
+        for f in self.fixed:
+            parent[root(f)] = root(GROUND)
+        first: dict[str, str] = {}
+        for name in self.bodies:
+            first.setdefault(root(name), name)
+        held = root(GROUND)
+        return {name: None if root(name) == held else first[root(name)]
+                for name in self.bodies}
+
     def _coordinates(self) -> tuple[tuple[str, ...], np.ndarray]:
         names: list[str] = []
         for name in self.bodies:
             if name in self.fixed:
                 continue
-            names.append(f"{name}.theta")
+            if self._turns_with[name] == name:
+                names.append(f"{name}.theta")
             if self._lateral(name):
                 names += [f"{name}.x", f"{name}.y"]
         col = {n: j for j, n in enumerate(names)}
@@ -288,7 +313,9 @@ class GearTrain:
         i = 3 * self._index[name]
         if name in self.fixed or T[i:i + 3].any():
             return
-        T[i, col[f"{name}.theta"]] = 1.0
+        turns = self._turns_with[name]
+        if turns is not None:
+            T[i, col[f"{turns}.theta"]] = 1.0
         if self._lateral(name):
             T[i + 1, col[f"{name}.x"]] = 1.0
             T[i + 2, col[f"{name}.y"]] = 1.0
@@ -334,6 +361,8 @@ class GearTrain:
             out.append(("mesh", m.name, self._mesh_row(m) @ self._T,
                         self.mesh_data[m.name].stiffness, float(m.damping)))
         for s in self.shafts:
+            if s.rigid:
+                continue
             row = (self._unit(s.a, 0) - self._unit(s.b, 0))[None, :]
             out.append(("shaft", s.name, row @ self._T, s.stiffness, s.damping))
         for b in self.bearings:
@@ -437,8 +466,22 @@ class GearTrain:
             attrs={"model": "GearTrain", "rigid_body_modes": self.rigid_body_modes})
 
     def _planets(self) -> dict[str, Bearing]:
-        """The planets: bodies on a bearing on a carrier, with that bearing."""
-        return {b.body: b for b in self.bearings if b.host != GROUND}
+        """The planets: bodies on a bearing on a carrier, with their pin on the carrier (a
+        body carried by a planet, the second gear of a compound planet, with that planet's
+        pin)."""
+        return {b.body: self._pin(b.body) for b in self.bearings if b.host != GROUND}
+
+    def _pin(self, body: str) -> Bearing:
+        """The bearing on a carrier that carries ``body``, up the chain of bearings on
+        bodies (a planet's own pin; a compound planet's second gear: the planet's pin)."""
+        pin = next(b for b in self.bearings if b.body == body and b.host != GROUND)
+        for _ in range(len(self.bearings)):
+            up = next((b for b in self.bearings if b.body == pin.host and b.host != GROUND),
+                      None)
+            if up is None:
+                break
+            pin = up
+        return pin
 
     def mode_type(self, shapes: np.ndarray, tol: float = MODE_TYPE_TOL) -> str:
         """Class of the eigenspace spanned by ``shapes`` (model dofs x k), as Lin & Parker
@@ -465,14 +508,18 @@ class GearTrain:
 
     def _planets_alike(self, weighted: np.ndarray, tol: float) -> bool:
         """Every planet of each carrier moves alike in the carrier's frame (its radial,
-        tangential and rotational coordinates) in every shape."""
+        tangential and rotational coordinates) in every shape: the planets alike in inertia,
+        mass and base radius (the copies of one planet; a compound planet's two gears are two
+        such sets) are compared."""
         scale = max(float(np.max(np.abs(weighted))), 1e-300)
-        by_carrier: dict[str, list[np.ndarray]] = {}
+        by_carrier: dict[tuple, list[np.ndarray]] = {}
         for name, b in self._planets().items():
             i = 3 * self._index[name]
             c, s = math.cos(b.angle), math.sin(b.angle)
             x, y = weighted[i + 1], weighted[i + 2]
-            by_carrier.setdefault(b.host, []).append(
+            body = self.bodies[name]
+            key = (b.host, body.inertia, body.mass, body.radius)
+            by_carrier.setdefault(key, []).append(
                 np.array([weighted[i], c * x + s * y, -s * x + c * y]))
         return all(np.max(np.abs(p - group[0])) <= math.sqrt(tol) * scale
                    for group in by_carrier.values() for p in group[1:])
@@ -484,7 +531,8 @@ class GearTrain:
         if self.driven is None:
             raise ParameterError("driven", None, "speed ratios need the driven (input) body")
         rows = [self._mesh_row(m)[0] for m in self.meshes]
-        rows += [self._unit(s.a, 0) - self._unit(s.b, 0) for s in self.shafts if s.b != GROUND]
+        rows += [self._unit(s.a, 0) - self._unit(s.b, 0) for s in self.shafts
+                 if s.b != GROUND or s.rigid]
         for b in self.bearings:
             rows += list(self._bearing_rows(b))
         for name in self.bodies:
@@ -515,7 +563,8 @@ class GearTrain:
             if gear is None:
                 raise ParameterError(f"{m.a}.n_teeth", None,
                                      f"the order of mesh {m.name} needs a tooth count")
-            hosts = [b.host for b in self.bearings if b.body in (m.a, m.b) and b.host != GROUND]
+            hosts = [self._pin(b.body).host for b in self.bearings
+                     if b.body in (m.a, m.b) and b.host != GROUND]
             arm = ratios[hosts[0]] if hosts else 0.0
             out[m.name] = self.bodies[gear].teeth * abs(ratios[gear] - arm)
         return out
