@@ -366,6 +366,14 @@ def test_modes_command_errors_are_one_line(tmp_path, capsys, args, fragments):
     assert_one_line_error(r, *fragments)
 
 
+def test_campbell_without_an_input_body_is_refused_naming_train_driven(tmp_path, capsys):
+    study = tmp_path / "undriven.toml"
+    study.write_text(_bad(TWO_STAGE, 'driven = "g1"\n', ""), encoding="utf-8")
+    assert run(capsys, "modes", study).returncode == 0
+    r = run(capsys, "modes", study, "--speed", "0..10 Hz")
+    assert_one_line_error(r, "train.driven", "needs the input body")
+
+
 def test_modes_command_refuses_a_bad_train_in_one_line(tmp_path, capsys):
     study = tmp_path / "bad.toml"
     study.write_text(_bad(TWO_STAGE, 'stiffness = 1e5', 'stiffness = -1e5'), encoding="utf-8")

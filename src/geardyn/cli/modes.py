@@ -97,6 +97,9 @@ def modes_command(
         raise ParameterError("--harmonics", harmonics, f"must be in 1..{MAX_HARMONICS}")
     rpm = speed_range(speed, DEFAULT_POINTS if points is None else points) if speed else None
     train = s.gear_train
+    if rpm is not None and train.driven is None:
+        raise ParameterError("train.driven", None, "the Campbell diagram (--speed) needs the"
+                             " input body: give driven in the study's [train] table")
     ds = train.modes()
     cds = None
     if rpm is not None:
