@@ -34,10 +34,13 @@ __all__ = ["build_model", "check_usable", "mesh_stiffness", "planetary_model",
 
 def require_model(study: Study) -> None:
     """A :class:`~geardyn.StudyError` unless ``study`` describes a model (has ``[params]``): a
-    study of gears alone is for ``geardyn stiffness``."""
+    study of gears alone is for ``geardyn stiffness``, one of a gear train (``[train]``)
+    alone for ``geardyn modes``."""
     if study.params is None:
-        raise StudyError(f"study {study.study.name!r} has no [params]: it describes gears"
-                         " ([gears]) for geardyn stiffness, not a model")
+        what = ("a gear train ([train]) for geardyn modes" if study.train is not None
+                else "gears ([gears]) for geardyn stiffness")
+        raise StudyError(f"study {study.study.name!r} has no [params]: it describes {what},"
+                         " not a model")
 
 
 def build_model(study: Study, interpretation: str | None = None, omega: float | None = None

@@ -369,6 +369,7 @@ __import__("geardyn.cli.frc", fromlist=["register"]).register(app)  # cli/frc.py
 __import__("geardyn.cli.continuation", fromlist=["register"]).register(app)  # cli/continuation.py
 __import__("geardyn.cli.explore", fromlist=["register"]).register(app)  # cli/explore.py
 __import__("geardyn.cli.stiffness", fromlist=["register"]).register(app)  # cli/stiffness.py
+__import__("geardyn.cli.modes", fromlist=["register"]).register(app)  # cli/modes.py
 
 if __name__ == "__main__":
     main()

@@ -1,4 +1,4 @@
-"""Single-tooth and mesh stiffness of spur gears by ISO 6336-1, method B.
+"""Single-tooth and mesh stiffness of spur and helical gears by ISO 6336-1, method B.
 
 ISO 6336-1:2006, clause 9 (tooth stiffness parameters c' and c_gamma), method B:
 
@@ -15,6 +15,12 @@ ISO 6336-1:2006, clause 9 (tooth stiffness parameters c' and c_gamma), method B:
 
 1 N/(mm um) = 1e9 N/m per metre of face width. The internal gear's profile shift enters q' in
 the sign convention of ISO 21771 (x_ISO = -x of :mod:`geardyn.gears.geometry`).
+
+A helical pair (:class:`~geardyn.gears.HelicalMesh`) enters with its normal-section values
+(z_n, the normal profile shifts x_n, the basic rack's normal dedendum and pressure angle), the
+factor cos(beta) and the transverse contact ratio eps_alpha. ISO 6336-1 uses c_gamma_alpha
+with the transverse base radii (the reduced mass of the resonance speed, clause 6): the
+stiffness is referred to the transverse line of action.
 """
 
 from __future__ import annotations
@@ -24,6 +30,7 @@ from dataclasses import asdict, dataclass
 
 from geardyn.errors import ParameterError
 from geardyn.gears.geometry import GearMesh
+from geardyn.gears.helical import HelicalMesh
 
 #: ISO 6336-1 method B coefficients C1..C9 of q' [mm um/N].
 C_COEFFS: tuple[float, ...] = (0.04723, 0.15551, 0.25791, -0.00635, -0.11654, -0.00193,
@@ -86,10 +93,11 @@ def blank_factor(web_ratio: float | None, rim_ratio: float | None) -> float:
     return 1.0 + math.log(web_ratio) / (5.0 * math.exp(rim_ratio / 5.0))
 
 
-def iso6336_stiffness(mesh: GearMesh, *, line_load: float | None = None,
+def iso6336_stiffness(mesh: GearMesh | HelicalMesh, *, line_load: float | None = None,
                       web_ratio: float | None = None,
                       rim_ratio: float | None = None) -> ISOStiffness:
-    """Single stiffness c' and mesh stiffness c_gamma_alpha of a spur mesh, ISO 6336-1 method B.
+    """Single stiffness c' and mesh stiffness c_gamma_alpha of a spur or helical mesh, ISO
+    6336-1 method B (a helical pair: the module docstring).
 
     ``line_load`` is F_t K_A / b [N/m] (None: >= 100 N/mm, no load correction); ``web_ratio``
     b_s/b and ``rim_ratio`` s_R/m_n describe a webbed blank (None: solid). The face width is the
@@ -97,13 +105,19 @@ def iso6336_stiffness(mesh: GearMesh, *, line_load: float | None = None,
     with fewer teeth, whichever of ``mesh.pinion`` and ``mesh.wheel`` that is (a planetary set's
     sun may have more teeth than its planets); of an internal pair, the external gear.
     """
+    helical = isinstance(mesh, HelicalMesh)
+    internal = False if helical else mesh.internal
     p, w = mesh.pinion, mesh.wheel
-    if not mesh.internal and w.teeth < p.teeth:
+    if not internal and w.teeth < p.teeth:
         p, w = w, p  # ISO's gear 1 is the pinion: the gear with fewer teeth, driving or not
-    z1 = float(p.teeth)
-    z2 = math.inf if mesh.internal else float(w.teeth)
+    cos_beta, virtual = 1.0, 1.0
+    if helical:
+        cos_beta = math.cos(mesh.helix_angle)
+        virtual = 1.0 / (math.cos(mesh.base_helix_angle) ** 2 * cos_beta)  # z_n / z
+    z1 = p.teeth * virtual
+    z2 = math.inf if internal else w.teeth * virtual
     x1 = p.profile_shift
-    x2 = -w.profile_shift if mesh.internal else w.profile_shift
+    x2 = -w.profile_shift if internal else w.profile_shift
     q = flexibility_q(z1, z2, x1, x2)
     c_th = 1.0 / q
     c_b = 0.5 * (basic_rack_factor(p.dedendum, p.pressure_angle)
@@ -115,9 +129,8 @@ def iso6336_stiffness(mesh: GearMesh, *, line_load: float | None = None,
             raise ParameterError("line_load", line_load, "must be > 0")
         per_mm = line_load * 1e-3  # N/m -> N/mm
         load = (per_mm / 100.0) ** 0.25 if per_mm < 100.0 else 1.0
-    cos_beta = 1.0  # spur gears
     c_prime = c_th * C_M * c_r * c_b * cos_beta * load
-    eps = mesh.contact_ratio
+    eps = mesh.transverse_contact_ratio if helical else mesh.contact_ratio
     c_ga = c_prime * (0.75 * eps + 0.25)
     b = min(p.face_width, w.face_width)
     return ISOStiffness(

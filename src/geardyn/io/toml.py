@@ -60,6 +60,9 @@ of ``[params]``::
 and profile shifts then in the normal section) or ``internal = true`` (the wheel a ring, its
 ``[gears.wheel]`` ``bore_radius`` the ring's outer radius; ``ring_foundation``).
 
+A gear train from elements (``geardyn modes``), with or instead of ``[params]``: the
+``[train]`` table (:mod:`geardyn.io.train_table`).
+
 For ``model = "spur_pair"`` the model is :meth:`geardyn.SpurPair.from_geometry` of the
 ``[gears]``, ``[[faults]]`` and ``[stiffness]`` tables, and ``[params]``
 (:class:`SpurPairParams`, generated from SpurPair's declared inputs) holds its dynamics:
@@ -143,6 +146,9 @@ from geardyn.gears.potential_energy import (
     prepare_pair,
 )
 from geardyn.gears.tip_relief import TipRelief, relief_gap
+from geardyn.io._tables import build_from_fields as _build_from_fields
+from geardyn.io._tables import study_error as _study_error
+from geardyn.io.train_table import TrainTable
 from geardyn.models.gear_pair_coefficients import GEAR_PAIR
 from geardyn.models.params import PAPER_NAMES, Angle, Length, PlanetaryParams, Real, Whole
 from geardyn.models.spur_pair_coefficients import INPUTS as SPUR_PAIR_INPUTS
@@ -698,30 +704,6 @@ class GearsTable(BaseModel):
         return ("gears", *field.split("."))
 
 
-def _build_from_fields(cls: type, given: dict[str, Any], where: tuple, what: str,
-                       listed: str = "") -> object:
-    """``cls(**given)``, the table's keys being the class's keyword arguments (its dataclass
-    fields: one declaration); an unknown key, a missing one or a value the class refuses is an
-    error at ``where`` + the key (``what`` names the object in the message, ``listed`` the
-    table's other keys)."""
-    params = inspect.signature(cls).parameters
-    for key in given:
-        if key not in params:
-            raise _study_error(where + (key,), given[key],
-                               f"unknown key (not a field of {what}; fields:"
-                               f" {listed}{', '.join(params)})")
-    for name, p in params.items():
-        if p.default is inspect.Parameter.empty and name not in given:
-            raise _study_error(where + (name,), None, f"required by {what}", kind="missing")
-    try:
-        return cls(**given)
-    except ParameterError as exc:  # a field the class names, else the whole table
-        name = exc.field.rpartition(".")[2]
-        if name in params:
-            raise _study_error(where + (name,), exc.value, exc.reason) from None
-        raise _study_error(where, given, exc.reason) from None
-
-
 class FaultTable(BaseModel):
     """One ``[[faults]]`` table: ``kind`` (a key of :data:`geardyn.gears.FAULT_KINDS`:
     ``crack``, ``spall``, ``wear``, ``broken_tooth``) and that fault's fields (its class's
@@ -854,13 +836,6 @@ def _fault_keywords(faults: list) -> dict[str, Any]:
     return {"faults": tuple(faults)} if faults else {}
 
 
-def _study_error(loc: tuple, value: object, reason: str, kind: str = "value_error"
-                 ) -> ValidationError:
-    """A one-error :class:`ValidationError` at ``loc`` of a study."""
-    return ValidationError.from_exception_data("Study", [InitErrorDetails(
-        type=PydanticCustomError(kind, "{msg}", {"msg": reason}), loc=loc, input=value)])
-
-
 def _relocated(exc: ValidationError, loc_of) -> ValidationError:
     """``exc`` with every error's location mapped by ``loc_of(loc) -> loc``."""
     details: list[InitErrorDetails] = []
@@ -931,6 +906,11 @@ class Study(BaseModel):
     (:class:`ReliefTable` each) and ``crowning`` (:class:`CrowningTable` each) with a load
     (``[stiffness]`` ``torque`` or ``force``) add the loaded contact
     (:meth:`contact_inputs`).
+
+    ``train`` (:class:`~geardyn.io.train_table.TrainTable`) describes a gear train from its
+    elements (``geardyn modes``), with or instead of ``params``; it is built when the study is
+    read (:attr:`gear_train`), and what it refuses is an error naming ``train.<group>.<name>.
+    <field>``.
     """
 
     model_config = _CONFIG
@@ -945,8 +925,10 @@ class Study(BaseModel):
     stiffness: StiffnessTable | None = None
     relief: Annotated[list[ReliefTable], BeforeValidator(_one_or_many)] | None = None
     crowning: Annotated[list[CrowningTable], BeforeValidator(_one_or_many)] | None = None
+    train: TrainTable | None = None
 
     _planetary: PlanetaryParams | None = PrivateAttr(None)
+    _train: Any = PrivateAttr(None)
 
     def run_settings(self, sweep: bool = False,
                      omega: float | Callable[[], float | None] | None = None, *,
@@ -1055,6 +1037,8 @@ class Study(BaseModel):
     @model_validator(mode="after")
     def _check_consistency(self) -> Study:
         self._check_gears()
+        if self.train is not None:
+            self._train = self.train.build()
         if self.params is None:
             return self
         holds = ("gear_pair" if isinstance(self.params, GearPairParams) else "planetary"
@@ -1087,8 +1071,9 @@ class Study(BaseModel):
                 if getattr(self, name) is not None:
                     raise _study_error((name,), None, "needs a [gears] table (the pair whose"
                                        " mesh stiffness it is for)")
-            if self.params is None:
-                raise _study_error(("params",), None, "required (or a [gears] table)", "missing")
+            if self.params is None and self.train is None:
+                raise _study_error(("params",), None, "required (or a [gears] or [train]"
+                                   " table)", "missing")
             return
         if self.study.model == "spur_pair":
             self._check_spur_pair_gears()
@@ -1208,6 +1193,14 @@ class Study(BaseModel):
         return self._planetary
 
     @property
+    def gear_train(self) -> Any:
+        """The :class:`~geardyn.trains.GearTrain` of the ``[train]`` table (built once, when
+        the study is read)."""
+        if self._train is None:
+            raise StudyError(f"study {self.study.name!r} has no [train] table")
+        return self._train
+
+    @property
     def plot_state(self) -> str:
         return self.study.plot_state or DEFAULT_PLOT_STATE[self.study.model]
 
@@ -1252,7 +1245,7 @@ def _read_toml(source: str | os.PathLike[str]) -> tuple[dict[str, Any], str]:
 
 
 _STUDY_KEYS = {"study", "params", "run", "sweep", "gears", "faults", "stiffness", "relief",
-               "crowning"}
+               "crowning", "train"}
 
 
 def load_params(path_or_text: str | os.PathLike[str]) -> PlanetaryParams:

@@ -15,6 +15,7 @@ from typing import Any
 
 from geardyn.errors import ParameterError
 from geardyn.gears.geometry import SpurGear
+from geardyn.gears.helical import HelicalGear
 from geardyn.units import si_value
 
 #: The name of the fixed frame: a shaft or bearing whose other end is ``GROUND`` is held by it.
@@ -85,26 +86,29 @@ class Inertia:
 @dataclass(frozen=True)
 class Gear(Inertia):
     """A gear body: an :class:`Inertia` with a base radius [m] and tooth count, or with a
-    :class:`~geardyn.gears.SpurGear` ``geometry`` that gives both (and lets a mesh take its
-    stiffness from ISO 6336-1 or the potential-energy method). ``teeth`` is needed only for
-    the mesh orders of a Campbell diagram."""
+    :class:`~geardyn.gears.SpurGear` or :class:`~geardyn.gears.HelicalGear` ``geometry`` that
+    gives both (a helical gear: its transverse base radius) and lets a mesh take its stiffness
+    from ISO 6336-1 or the potential-energy method. ``teeth`` is needed only for the mesh
+    orders of a Campbell diagram."""
 
     base_radius: Any = None
-    geometry: SpurGear | None = None
+    geometry: SpurGear | HelicalGear | None = None
     n_teeth: int | None = None
 
     def __post_init__(self) -> None:
         super().__post_init__()
         g = self.geometry
         if g is not None:
-            if not isinstance(g, SpurGear):
-                raise ParameterError(f"{self.name}.geometry", g, "must be a geardyn.gears.SpurGear")
-            for attr, value in (("base_radius", g.base_radius), ("n_teeth", g.teeth)):
+            if not isinstance(g, SpurGear | HelicalGear):
+                raise ParameterError(f"{self.name}.geometry", g,
+                                     "must be a geardyn.gears.SpurGear or HelicalGear")
+            spur = g.transverse if isinstance(g, HelicalGear) else g
+            for attr, value in (("base_radius", spur.base_radius), ("n_teeth", g.teeth)):
                 given = getattr(self, attr)
                 if given is not None and not math.isclose(float(given), value, rel_tol=1e-9):
                     raise ParameterError(f"{self.name}.{attr}", given,
                                          f"differs from the geometry's {value:.6g}")
-            _set(self, "base_radius", g.base_radius)
+            _set(self, "base_radius", spur.base_radius)
             _set(self, "n_teeth", g.teeth)
         if self.base_radius is None:
             raise ParameterError(f"{self.name}.base_radius", None,
@@ -120,6 +124,11 @@ class Gear(Inertia):
         return self.n_teeth
 
     @property
+    def helical(self) -> bool:
+        """Whether the geometry is a helical gear."""
+        return isinstance(self.geometry, HelicalGear)
+
+    @property
     def radius(self) -> float | None:
         """Base radius [m]."""
         return self.base_radius
@@ -128,7 +137,9 @@ class Gear(Inertia):
 @dataclass(frozen=True)
 class Shaft:
     """A torsional spring between bodies ``a`` and ``b`` (``b`` may be :data:`GROUND`):
-    ``stiffness`` [N m/rad] and ``damping`` [N m s/rad] on the twist theta_a - theta_b."""
+    ``stiffness`` [N m/rad] and ``damping`` [N m s/rad] on the twist theta_a - theta_b.
+    ``math.inf`` (or ``"inf"``): a rigid joint, the two bodies turn as one (the two gears of a
+    compound planet); it has no damping."""
 
     name: str
     a: str
@@ -142,8 +153,16 @@ class Shaft:
         _body_ref(self, "b", ground=True)
         if self.a == self.b:
             raise ParameterError(f"{self.name}.b", self.b, "a shaft joins two different bodies")
-        _si(self, "stiffness", "torque", strict=True)  # N m/rad: a torque per radian
+        _si(self, "stiffness", "torque", strict=True, allow_inf=True)  # N m/rad
         _si(self, "damping", "dimensionless")  # N m s/rad, a number
+        if self.rigid and self.damping != 0.0:
+            raise ParameterError(f"{self.name}.damping", self.damping,
+                                 "a rigid shaft (infinite stiffness) has no damping")
+
+    @property
+    def rigid(self) -> bool:
+        """Whether the shaft is a rigid joint (infinite stiffness)."""
+        return math.isinf(self.stiffness)
 
 
 @dataclass(frozen=True)
@@ -191,12 +210,19 @@ class Mesh:
 
     ``stiffness``: the mean mesh stiffness [N/m] along the line of action, or ``"iso"`` (ISO
     6336-1 method B, :func:`~geardyn.gears.iso6336_stiffness`) or ``"potential_energy"``
-    (the mean of :func:`~geardyn.gears.potential_energy_stiffness` over a mesh cycle;
-    ``bore_radius`` [m] needed), both from the two gears' geometries. ``angle`` [rad] is the
-    direction of the line from a's centre to b's centre; ``pressure_angle`` [rad] the operating
-    pressure angle (None: from the geometries, else 20 deg). ``centre_distance`` [m] (None: the
-    zero-backlash one of the geometries) is checked against the geometries. The line of action
-    is that of the flank on which ``a`` turning in the positive sense drives ``b``.
+    (the mean of :func:`~geardyn.gears.potential_energy_stiffness`, or of
+    :func:`~geardyn.gears.helical_stiffness`, over a mesh cycle; ``bore_radius`` [m] needed),
+    both from the two gears' geometries. A helical mesh's line of action is inclined by the
+    base helix angle beta_b to the transverse plane and ``stiffness`` is along it (the normal
+    stiffness k_n); the planar model sees k_n cos^2(beta_b) on the transverse deflection.
+    ``helix_angle`` [rad] (None: from the geometries, else 0) gives beta of a mesh without
+    geometry, beta_b = atan(tan(beta) cos(alpha)) with alpha its pressure angle.
+
+    ``angle`` [rad] is the direction of the line from a's centre to b's centre;
+    ``pressure_angle`` [rad] the operating (transverse) pressure angle (None: from the
+    geometries, else 20 deg). ``centre_distance`` [m] (None: the zero-backlash one of the
+    geometries) is checked against the geometries. The line of action is that of the flank on
+    which ``a`` turning in the positive sense drives ``b``.
 
     Recorded for the nonlinear model, unused by the linear one: ``backlash`` [m] per flank
     (drive, coast), a number for both, and the transmission-error amplitude ``error`` [m].
@@ -215,6 +241,7 @@ class Mesh:
     damping: Any = 0.0
     backlash: Any = 0.0
     error: Any = 0.0
+    helix_angle: Any = None
 
     def __post_init__(self) -> None:
         _name("Mesh", self.name)
@@ -239,6 +266,11 @@ class Mesh:
         for attr in ("centre_distance", "bore_radius"):
             if getattr(self, attr) is not None:
                 _si(self, attr, "length", strict=True)
+        if self.helix_angle is not None:
+            _si(self, "helix_angle", "angle")
+            if not self.helix_angle < math.pi / 2:
+                raise ParameterError(f"{self.name}.helix_angle", self.helix_angle,
+                                     "must be below 90 deg")
         _si(self, "damping", "dimensionless")  # N s/m, a number
         _si(self, "error", "length")
         self._backlash()

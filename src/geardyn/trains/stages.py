@@ -8,29 +8,35 @@ from dataclasses import dataclass, replace
 from typing import Any
 
 from geardyn.errors import ParameterError
-from geardyn.trains.elements import Bearing, Gear, Inertia, Mesh
+from geardyn.trains.elements import Bearing, Gear, Inertia, Mesh, Shaft
 from geardyn.trains.train import resolve_mesh
 from geardyn.units import si_value
 
 
 @dataclass(frozen=True)
 class PlanetaryStage:
-    """The elements of one planetary stage: ``bodies`` (sun, ring, carrier, planets),
-    ``bearings`` (the planets' pins on the carrier) and ``meshes`` (sun-planet, then
-    planet-ring). The central members' own bearings and shafts are the train's to add."""
+    """The elements of one planetary stage: ``bodies`` (sun, ring, carrier, planets, then a
+    compound stage's ring-side planet gears), ``bearings`` (the planets' pins on the carrier,
+    then the ring-side gears' rigid hubs on their planets), ``meshes`` (sun-planet, then
+    planet-ring) and ``shafts`` (a compound stage's rigid joints of each planet's two gears).
+    ``planets`` names the planets, ``compound`` the ring-side gears. The central members' own
+    bearings and shafts are the train's to add."""
 
     bodies: tuple[Inertia, ...]
     bearings: tuple[Bearing, ...]
     meshes: tuple[Mesh, ...]
     planets: tuple[str, ...]
     carrier_radius: float
+    shafts: tuple[Shaft, ...] = ()
+    compound: tuple[str, ...] = ()
 
 
 def planetary_stage(*, sun: Gear, ring: Gear, carrier: Inertia, planet: Gear, n_planets: int,
                     pin_stiffness: Any, sun_mesh_stiffness: Any, ring_mesh_stiffness: Any,
                     planet_angles: Sequence[Any] | None = None, carrier_radius: Any = None,
                     sun_pressure_angle: Any = None, ring_pressure_angle: Any = None,
-                    pin_damping: Any = 0.0, mesh_damping: Any = 0.0) -> PlanetaryStage:
+                    pin_damping: Any = 0.0, mesh_damping: Any = 0.0,
+                    ring_planet: Gear | None = None) -> PlanetaryStage:
     """A single planetary stage as elements (Lin & Parker 1999): ``n_planets`` copies of
     ``planet`` named ``<planet.name>1`` ..., each on a pin of ``pin_stiffness`` [N/m]
     (``math.inf``: rigid) on ``carrier`` at ``carrier_radius`` [m] and angle psi_n [rad]
@@ -38,7 +44,12 @@ def planetary_stage(*, sun: Gear, ring: Gear, carrier: Inertia, planet: Gear, n_
     (internal). Mesh stiffnesses are numbers [N/m] or a method (``"iso"``, ...) as
     :class:`Mesh`; pressure angles None take the geometries' operating ones (else 20 deg).
     ``carrier_radius`` None: (r_b,sun + r_b,planet) / cos(alpha_sun), the centre distance of
-    the sun-planet mesh."""
+    the sun-planet mesh.
+
+    ``ring_planet``: a compound stage (Kiracofe & Parker 2007). Each planet then carries a
+    copy of this second gear (``<ring_planet.name>1`` ...), joined to it rigidly (a rigid hub
+    ``<name>_hub`` at the planet's centre and a rigid shaft ``<name>_joint``): the planet
+    meshes the sun, the second gear the ring."""
     if isinstance(n_planets, bool) or not isinstance(n_planets, int) or not 1 <= n_planets <= 32:
         raise ParameterError("n_planets", n_planets, "must be a whole number from 1 to 32")
     if planet_angles is None:
@@ -54,7 +65,10 @@ def planetary_stage(*, sun: Gear, ring: Gear, carrier: Inertia, planet: Gear, n_
         rc = (sun.base_radius + planet.base_radius) / math.cos(alpha_s)
     else:
         rc = si_value("carrier_radius", carrier_radius, "length", 0.0, strict=True)
+    if ring_planet is not None and not isinstance(ring_planet, Gear):
+        raise ParameterError("ring_planet", ring_planet, "must be a Gear")
     planets, bearings, sun_meshes, ring_meshes = [], [], [], []
+    seconds, hubs, joints = [], [], []
     for i, angle in enumerate(psi):
         p = replace(planet, name=f"{planet.name}{i + 1}")
         planets.append(p)
@@ -63,9 +77,16 @@ def planetary_stage(*, sun: Gear, ring: Gear, carrier: Inertia, planet: Gear, n_
         sun_meshes.append(Mesh(f"{sun.name}_{p.name}", sun.name, p.name, sun_mesh_stiffness,
                                angle=angle, pressure_angle=sun_pressure_angle,
                                damping=mesh_damping))
-        ring_meshes.append(Mesh(f"{p.name}_{ring.name}", p.name, ring.name, ring_mesh_stiffness,
+        q = p
+        if ring_planet is not None:
+            q = replace(ring_planet, name=f"{ring_planet.name}{i + 1}")
+            seconds.append(q)
+            hubs.append(Bearing(f"{q.name}_hub", q.name, math.inf, host=p.name))
+            joints.append(Shaft(f"{q.name}_joint", q.name, p.name, math.inf))
+        ring_meshes.append(Mesh(f"{q.name}_{ring.name}", q.name, ring.name, ring_mesh_stiffness,
                                 internal=True, angle=angle + math.pi,
                                 pressure_angle=ring_pressure_angle, damping=mesh_damping))
-    return PlanetaryStage(bodies=(sun, ring, carrier, *planets), bearings=tuple(bearings),
-                          meshes=(*sun_meshes, *ring_meshes),
-                          planets=tuple(p.name for p in planets), carrier_radius=rc)
+    return PlanetaryStage(bodies=(sun, ring, carrier, *planets, *seconds),
+                          bearings=(*bearings, *hubs), meshes=(*sun_meshes, *ring_meshes),
+                          planets=tuple(p.name for p in planets), carrier_radius=rc,
+                          shafts=tuple(joints), compound=tuple(q.name for q in seconds))

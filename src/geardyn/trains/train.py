@@ -1,21 +1,25 @@
 """A gear train assembled from its elements, and its linear model at mean mesh stiffness.
 
 Coordinates. Every body has a rotation theta [rad] (positive counter-clockwise) and a centre
-displacement x, y [m] in the fixed frame. The model keeps theta of every body that is not fixed,
-and x, y of a body on a flexible bearing (it then needs a mass); a body on a rigid bearing on a
-carrier is carried by it (its centre moves with the carrier's pin), any other body's centre is
-held. ``T`` maps the model's coordinates q to the full ones: full = T q.
+displacement x, y [m] in the fixed frame. The model keeps theta of every body that is not fixed
+(bodies joined by rigid shafts share one, the first one's; joined rigidly to the ground or a
+fixed body, none), and x, y of a body on a flexible bearing (it then needs a mass); a body on a
+rigid bearing on a carrier is carried by it (its centre moves with the carrier's pin), any other
+body's centre is held. ``T`` maps the model's coordinates q to the full ones: full = T q.
 
 Elements act through deflection rows w (full coordinates), each a spring k w w^T:
 
 - shaft: theta_a - theta_b;
 - bearing of body p on host h (pin at radius R, angle psi on h): x_p - x_h + R sin(psi) theta_h
   and y_p - y_h - R cos(psi) theta_h (the host's terms absent on the ground);
-- mesh of a with b (Lin & Parker 1999; Kahraman 1994): delta = s . (c_a - c_b) + r_a theta_a
-  + sigma r_b theta_b, with c the centres, r the base radii, sigma = +1 external, -1 internal
-  (b the ring), and s the unit vector of the line of action: at angle phi + 90 deg - alpha of
-  an external mesh, phi - 90 deg + alpha of an internal one (phi the direction from a's centre
-  to b's, alpha the pressure angle).
+- mesh of a with b (Lin & Parker 1999; Kahraman 1994): delta = cos(beta_b) [s . (c_a - c_b)
+  + r_a theta_a + sigma r_b theta_b], with c the centres, r the (transverse) base radii, sigma
+  = +1 external, -1 internal (b the ring), s the unit vector of the transverse line of action:
+  at angle phi + 90 deg - alpha of an external mesh, phi - 90 deg + alpha of an internal one
+  (phi the direction from a's centre to b's, alpha the pressure angle), and beta_b the base
+  helix angle (0 for spur gears): the deflection along a helical mesh's line of action, which
+  is inclined by beta_b to the transverse plane, from the transverse motion. The axial part
+  of that deflection is not modelled (no axial coordinates: the bodies are held axially).
 
 M = T^T diag(I, m, m) T, K = T^T (sum k w w^T) T, C = T^T (sum c w w^T) T + a M + b K.
 """
@@ -43,14 +47,16 @@ MODE_TYPE_TOL = 1e-6
 
 @dataclass(frozen=True)
 class MeshData:
-    """A mesh as the linear model uses it: mean ``stiffness`` [N/m], operating
-    ``pressure_angle`` [rad], base radii [m] and the method the stiffness came from."""
+    """A mesh as the linear model uses it: mean ``stiffness`` [N/m] along the line of action,
+    operating transverse ``pressure_angle`` [rad], base radii [m], the method the stiffness
+    came from and the ``base_helix_angle`` [rad] (0: spur)."""
 
     stiffness: float
     pressure_angle: float
     radius_a: float
     radius_b: float
     method: str
+    base_helix_angle: float = 0.0
 
 
 def _line_of_action(mesh: Mesh, alpha: float) -> tuple[float, float]:
@@ -61,11 +67,23 @@ def _line_of_action(mesh: Mesh, alpha: float) -> tuple[float, float]:
 
 
 def _gear_mesh(mesh: Mesh, ga: Gear, gb: Gear) -> Any:
-    """The :class:`~geardyn.gears.GearMesh` of two gears with geometry; its errors re-raised
-    naming the mesh."""
+    """The :class:`~geardyn.gears.GearMesh` (or :class:`~geardyn.gears.HelicalMesh`) of two
+    gears with geometry; its errors re-raised naming the mesh."""
     from geardyn.gears.geometry import GearMesh
+    from geardyn.gears.helical import HelicalMesh
 
+    if ga.helical != gb.helical:
+        spur = mesh.a if gb.helical else mesh.b
+        raise ParameterError(f"{mesh.name}.{'a' if spur == mesh.a else 'b'}", spur,
+                             f"is a spur gear and {mesh.b if spur == mesh.a else mesh.a} a"
+                             " helical one: they cannot mesh")
+    if ga.helical and mesh.internal:
+        raise ParameterError(f"{mesh.name}.internal", True,
+                             "an internal helical mesh is not covered")
     try:
+        if ga.helical:
+            return HelicalMesh(pinion=ga.geometry, wheel=gb.geometry,
+                               centre_distance=mesh.centre_distance)
         return GearMesh(pinion=ga.geometry, wheel=gb.geometry,
                         centre_distance=mesh.centre_distance, internal=mesh.internal)
     except ParameterError as exc:
@@ -73,20 +91,27 @@ def _gear_mesh(mesh: Mesh, ga: Gear, gb: Gear) -> Any:
                              f"{exc.reason} (mesh of {mesh.a} with {mesh.b})") from None
 
 
-def _mesh_stiffness(mesh: Mesh, gear_mesh: Any) -> tuple[float, str]:
+def _mesh_stiffness(mesh: Mesh, gear_mesh: Any, beta_b: float) -> tuple[float, str]:
+    """The mesh stiffness along the line of action [N/m] and its method. ISO 6336-1 and the
+    sliced potential-energy method give it along the transverse line of action: divided by
+    cos^2(beta_b) (a helical mesh) for the normal one."""
     if not isinstance(mesh.stiffness, str):
         return float(mesh.stiffness), "given"
     if gear_mesh is None:
         raise ParameterError(f"{mesh.name}.stiffness", mesh.stiffness,
                              f"needs the geometry of both gears ({mesh.a}, {mesh.b})")
+    normal = 1.0 / math.cos(beta_b) ** 2
     if mesh.stiffness == "iso":
         from geardyn.gears.iso6336 import iso6336_stiffness
 
-        return iso6336_stiffness(gear_mesh).mesh_stiffness, "iso"
+        return iso6336_stiffness(gear_mesh).mesh_stiffness * normal, "iso"
+    from geardyn.gears.helical import HelicalMesh, helical_stiffness
     from geardyn.gears.potential_energy import potential_energy_stiffness
 
-    ds = potential_energy_stiffness(gear_mesh, bore_radius=mesh.bore_radius)
-    return float(ds["mesh_stiffness"].mean()), "potential_energy"
+    method = helical_stiffness if isinstance(gear_mesh, HelicalMesh) else (
+        potential_energy_stiffness)
+    ds = method(gear_mesh, bore_radius=mesh.bore_radius)
+    return float(ds["mesh_stiffness"].mean()) * normal, "potential_energy"
 
 
 def resolve_mesh(mesh: Mesh, ga: Gear, gb: Gear) -> MeshData:
@@ -100,7 +125,7 @@ def resolve_mesh(mesh: Mesh, ga: Gear, gb: Gear) -> MeshData:
         raise ParameterError(f"{mesh.name}.internal", True, f"{mesh.b} is not an internal gear")
     alpha = mesh.pressure_angle
     if gear_mesh is not None:
-        alpha_w = gear_mesh.operating_pressure_angle
+        alpha_w = getattr(gear_mesh, "transverse", gear_mesh).operating_pressure_angle
         if alpha is not None and not math.isclose(alpha, alpha_w, rel_tol=1e-6):
             raise ParameterError(f"{mesh.name}.pressure_angle", alpha,
                                  f"differs from the geometries' operating {alpha_w:.6g} rad")
@@ -113,8 +138,24 @@ def resolve_mesh(mesh: Mesh, ga: Gear, gb: Gear) -> MeshData:
             raise ParameterError(f"{mesh.name}.centre_distance", mesh.centre_distance,
                                  f"inconsistent with the base radii and pressure angle"
                                  f" ({a0:.6g} m)")
-    k, method = _mesh_stiffness(mesh, gear_mesh)
-    return MeshData(k, alpha, ga.base_radius, gb.base_radius, method)
+    beta_b = _base_helix_angle(mesh, gear_mesh, alpha)
+    k, method = _mesh_stiffness(mesh, gear_mesh, beta_b)
+    return MeshData(k, alpha, ga.base_radius, gb.base_radius, method, beta_b)
+
+
+def _base_helix_angle(mesh: Mesh, gear_mesh: Any, alpha: float) -> float:
+    """beta_b [rad] of ``mesh``: the geometries' (a helical pair), checked against a given
+    ``helix_angle``; else from ``helix_angle`` and the pressure angle; else 0."""
+    beta = mesh.helix_angle
+    if gear_mesh is not None:
+        own = getattr(gear_mesh, "helix_angle", 0.0)
+        if beta is not None and not math.isclose(beta, own, rel_tol=1e-9, abs_tol=1e-12):
+            raise ParameterError(f"{mesh.name}.helix_angle", beta,
+                                 f"differs from the geometries' {own:.6g} rad")
+        return float(getattr(gear_mesh, "base_helix_angle", 0.0))
+    if beta is None:
+        return 0.0
+    return math.atan(math.tan(beta) * math.cos(alpha))
 
 
 class GearTrain:
@@ -160,6 +201,7 @@ class GearTrain:
                           for m in self.meshes}
         self._check_connected()
         self._index = {name: i for i, name in enumerate(self.bodies)}
+        self._turns_with = self._rigid_rotations()
         self._dofs, self._T = self._coordinates()
         self.rigid_body_modes = self._count_rigid_body_modes()
 
@@ -223,12 +265,35 @@ class GearTrain:
                                      " ground: the train falls apart into separate pieces")
 
     # ------------------------------------------------------------------ coordinates
+    def _rigid_rotations(self) -> dict[str, str | None]:
+        """The body whose rotation each body shares through rigid shafts (the first of its
+        group; None: held, by the ground or a fixed body)."""
+        parent = {name: name for name in [GROUND, *self.bodies]}
+
+        def root(n: str) -> str:
+            while parent[n] != n:
+                n = parent[n]
+            return n
+
+        for s in self.shafts:
+            if s.rigid:
+                parent[root(s.a)] = root(s.b)
+        for f in self.fixed:
+            parent[root(f)] = root(GROUND)
+        first: dict[str, str] = {}
+        for name in self.bodies:
+            first.setdefault(root(name), name)
+        held = root(GROUND)
+        return {name: None if root(name) == held else first[root(name)]
+                for name in self.bodies}
+
     def _coordinates(self) -> tuple[tuple[str, ...], np.ndarray]:
         names: list[str] = []
         for name in self.bodies:
             if name in self.fixed:
                 continue
-            names.append(f"{name}.theta")
+            if self._turns_with[name] == name:
+                names.append(f"{name}.theta")
             if self._lateral(name):
                 names += [f"{name}.x", f"{name}.y"]
         col = {n: j for j, n in enumerate(names)}
@@ -248,7 +313,9 @@ class GearTrain:
         i = 3 * self._index[name]
         if name in self.fixed or T[i:i + 3].any():
             return
-        T[i, col[f"{name}.theta"]] = 1.0
+        turns = self._turns_with[name]
+        if turns is not None:
+            T[i, col[f"{turns}.theta"]] = 1.0
         if self._lateral(name):
             T[i + 1, col[f"{name}.x"]] = 1.0
             T[i + 2, col[f"{name}.y"]] = 1.0
@@ -282,8 +349,9 @@ class GearTrain:
         sx, sy = _line_of_action(m, d.pressure_angle)
         sigma = -1.0 if m.internal else 1.0
         u = self._unit
-        return (sx * (u(m.a, 1) - u(m.b, 1)) + sy * (u(m.a, 2) - u(m.b, 2))
-                + d.radius_a * u(m.a, 0) + sigma * d.radius_b * u(m.b, 0))[None, :]
+        return math.cos(d.base_helix_angle) * (
+            sx * (u(m.a, 1) - u(m.b, 1)) + sy * (u(m.a, 2) - u(m.b, 2))
+            + d.radius_a * u(m.a, 0) + sigma * d.radius_b * u(m.b, 0))[None, :]
 
     def elements(self) -> list[tuple[str, str, np.ndarray, float, float]]:
         """(kind, name, deflection rows in the model's coordinates, stiffness, damping) of every
@@ -293,6 +361,8 @@ class GearTrain:
             out.append(("mesh", m.name, self._mesh_row(m) @ self._T,
                         self.mesh_data[m.name].stiffness, float(m.damping)))
         for s in self.shafts:
+            if s.rigid:
+                continue
             row = (self._unit(s.a, 0) - self._unit(s.b, 0))[None, :]
             out.append(("shaft", s.name, row @ self._T, s.stiffness, s.damping))
         for b in self.bearings:
@@ -396,8 +466,22 @@ class GearTrain:
             attrs={"model": "GearTrain", "rigid_body_modes": self.rigid_body_modes})
 
     def _planets(self) -> dict[str, Bearing]:
-        """The planets: bodies on a bearing on a carrier, with that bearing."""
-        return {b.body: b for b in self.bearings if b.host != GROUND}
+        """The planets: bodies on a bearing on a carrier, with their pin on the carrier (a
+        body carried by a planet, the second gear of a compound planet, with that planet's
+        pin)."""
+        return {b.body: self._pin(b.body) for b in self.bearings if b.host != GROUND}
+
+    def _pin(self, body: str) -> Bearing:
+        """The bearing on a carrier that carries ``body``, up the chain of bearings on
+        bodies (a planet's own pin; a compound planet's second gear: the planet's pin)."""
+        pin = next(b for b in self.bearings if b.body == body and b.host != GROUND)
+        for _ in range(len(self.bearings)):
+            up = next((b for b in self.bearings if b.body == pin.host and b.host != GROUND),
+                      None)
+            if up is None:
+                break
+            pin = up
+        return pin
 
     def mode_type(self, shapes: np.ndarray, tol: float = MODE_TYPE_TOL) -> str:
         """Class of the eigenspace spanned by ``shapes`` (model dofs x k), as Lin & Parker
@@ -424,14 +508,18 @@ class GearTrain:
 
     def _planets_alike(self, weighted: np.ndarray, tol: float) -> bool:
         """Every planet of each carrier moves alike in the carrier's frame (its radial,
-        tangential and rotational coordinates) in every shape."""
+        tangential and rotational coordinates) in every shape: the planets alike in inertia,
+        mass and base radius (the copies of one planet; a compound planet's two gears are two
+        such sets) are compared."""
         scale = max(float(np.max(np.abs(weighted))), 1e-300)
-        by_carrier: dict[str, list[np.ndarray]] = {}
+        by_carrier: dict[tuple, list[np.ndarray]] = {}
         for name, b in self._planets().items():
             i = 3 * self._index[name]
             c, s = math.cos(b.angle), math.sin(b.angle)
             x, y = weighted[i + 1], weighted[i + 2]
-            by_carrier.setdefault(b.host, []).append(
+            body = self.bodies[name]
+            key = (b.host, body.inertia, body.mass, body.radius)
+            by_carrier.setdefault(key, []).append(
                 np.array([weighted[i], c * x + s * y, -s * x + c * y]))
         return all(np.max(np.abs(p - group[0])) <= math.sqrt(tol) * scale
                    for group in by_carrier.values() for p in group[1:])
@@ -443,7 +531,8 @@ class GearTrain:
         if self.driven is None:
             raise ParameterError("driven", None, "speed ratios need the driven (input) body")
         rows = [self._mesh_row(m)[0] for m in self.meshes]
-        rows += [self._unit(s.a, 0) - self._unit(s.b, 0) for s in self.shafts if s.b != GROUND]
+        rows += [self._unit(s.a, 0) - self._unit(s.b, 0) for s in self.shafts
+                 if s.b != GROUND or s.rigid]
         for b in self.bearings:
             rows += list(self._bearing_rows(b))
         for name in self.bodies:
@@ -474,7 +563,8 @@ class GearTrain:
             if gear is None:
                 raise ParameterError(f"{m.a}.n_teeth", None,
                                      f"the order of mesh {m.name} needs a tooth count")
-            hosts = [b.host for b in self.bearings if b.body in (m.a, m.b) and b.host != GROUND]
+            hosts = [self._pin(b.body).host for b in self.bearings
+                     if b.body in (m.a, m.b) and b.host != GROUND]
             arm = ratios[hosts[0]] if hosts else 0.0
             out[m.name] = self.bodies[gear].teeth * abs(ratios[gear] - arm)
         return out
