@@ -918,6 +918,10 @@ def _check_faults(faults: tuple[object, ...], mesh: GearMesh, teeth: list[ToothM
             raise ParameterError("faults", fault,
                                  "must be RootCrack, Spall, Wear or BrokenTooth objects")
         kind = fault.kind
+        if fault.gear not in ("pinion", "wheel"):
+            raise ParameterError(f"{kind}.gear", fault.gear, "a pair's faults lie on the "
+                                 "'pinion' or the 'wheel' (sun, ring and planets: "
+                                 "PlanetaryGearSet.from_geometry)")
         z = (mesh.pinion if fault.gear == "pinion" else mesh.wheel).teeth
         if not 0 <= fault.tooth < z:
             raise ParameterError(f"{kind}.tooth", fault.tooth, f"must lie in [0, {z - 1}]")

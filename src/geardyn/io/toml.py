@@ -468,6 +468,29 @@ class MemberTable(BaseModel):
     radius: Quantity | None = None
 
 
+class FaultTable(BaseModel):
+    """One ``[[faults]]`` table: ``kind`` (a key of :data:`geardyn.gears.FAULT_KINDS`:
+    ``crack``, ``spall``, ``wear``, ``broken_tooth``) and that fault's fields (its class's
+    parameters, e.g. ``gear``, ``tooth``, ``depth``, ``angle`` of a
+    :class:`~geardyn.gears.RootCrack`). Checked by :meth:`build`, once the gears are known."""
+
+    model_config = ConfigDict(extra="allow", frozen=True, allow_inf_nan=False)
+
+    kind: str
+
+    def fields(self) -> dict[str, Any]:
+        """The fault's own fields (the table without ``kind``)."""
+        return dict(self.model_extra or {})
+
+    def build(self, where: tuple) -> object:
+        """The fault object; errors name ``where`` + the field (``faults[0].depth``)."""
+        cls = FAULT_KINDS.get(self.kind)
+        if cls is None:
+            raise _study_error(where + ("kind",), self.kind, "unknown fault kind; known: "
+                               + ", ".join(FAULT_KINDS))
+        return _build_from_fields(cls, self.fields(), where, f"a {self.kind} fault", "kind, ")
+
+
 class GearTable(BaseModel):
     """A ``[params.geometry.<sun|planet|ring>]`` table: one gear's teeth and profile shift
     (module, pressure angle, face width and tooth proportions default to the stage's)."""
@@ -499,6 +522,10 @@ class GeometryTable(BaseModel):
         default_factory=dict, description="the potential-energy inputs "
         "(PlanetaryGearSet.from_geometry's stiffness_options: bores, rim, material, angles)")
     coast: Literal["mirror", "symmetric"] = "mirror"  # the coast flank (from_geometry's coast)
+    faults: list[FaultTable] | None = Field(
+        None, description="[[params.geometry.faults]]: tooth faults on one gear of the set "
+        "(kind and the fault's fields; gear 'sun', 'ring' or 'planet<n>'), with stiffness = "
+        "'potential_energy': the forcing period is then that gear's revolution")
     sun: GearTable
     planet: GearTable
     ring: GearTable
@@ -720,29 +747,6 @@ def _build_from_fields(cls: type, given: dict[str, Any], where: tuple, what: str
         if name in params:
             raise _study_error(where + (name,), exc.value, exc.reason) from None
         raise _study_error(where, given, exc.reason) from None
-
-
-class FaultTable(BaseModel):
-    """One ``[[faults]]`` table: ``kind`` (a key of :data:`geardyn.gears.FAULT_KINDS`:
-    ``crack``, ``spall``, ``wear``, ``broken_tooth``) and that fault's fields (its class's
-    parameters, e.g. ``gear``, ``tooth``, ``depth``, ``angle`` of a
-    :class:`~geardyn.gears.RootCrack`). Checked by :meth:`build`, once the gears are known."""
-
-    model_config = ConfigDict(extra="allow", frozen=True, allow_inf_nan=False)
-
-    kind: str
-
-    def fields(self) -> dict[str, Any]:
-        """The fault's own fields (the table without ``kind``)."""
-        return dict(self.model_extra or {})
-
-    def build(self, where: tuple) -> object:
-        """The fault object; errors name ``where`` + the field (``faults[0].depth``)."""
-        cls = FAULT_KINDS.get(self.kind)
-        if cls is None:
-            raise _study_error(where + ("kind",), self.kind, "unknown fault kind; known: "
-                               + ", ".join(FAULT_KINDS))
-        return _build_from_fields(cls, self.fields(), where, f"a {self.kind} fault", "kind, ")
 
 
 class _ClassTable(BaseModel):
