@@ -232,6 +232,9 @@ def test_bad_fault_specs_name_the_field(geo):
         geardyn.PlanetaryGearSet.from_geometry(geo, faults=[g.RootCrack(**CRACK, gear="sun")],
                                                **MEMBERS)
     assert err.value.field == "faults"
+    with pytest.raises(ParameterError) as err:  # no pair in contact: a zero stiffness
+        pe_set(geo, [g.BrokenTooth(gear="planet1", tooth=2)])
+    assert err.value.field == "faults"
     with pytest.raises(ParameterError) as err:
         pe_set(geo, [g.RootCrack(**CRACK, gear="sun")], sun_mesh_error="1 um")
     assert err.value.field == "sun_mesh_error"

@@ -512,6 +512,9 @@ class PlanetaryGearSet(Model):
                                  self.mesh_phase, float(contact_ratio), harmonics,
                                  self.mesh_order)
         if _minimum_relative_stiffness(self.fourier) <= 0.0:
+            if not isinstance(waveform, str):
+                raise ParameterError("waveform", "(coefficients)", "makes a mesh stiffness "
+                                     "negative; it must stay > 0")
             raise ParameterError("sun_stiffness_fluctuation", sun_stiffness_fluctuation,
                                  "the stiffness fluctuation makes a mesh stiffness negative; "
                                  "it must stay > 0")
@@ -708,7 +711,9 @@ class PlanetaryGearSet(Model):
 
         ``faults`` (with ``stiffness="potential_energy"``): one fault or a sequence
         (:class:`~geardyn.gears.RootCrack`, :class:`~geardyn.gears.Spall`,
-        :class:`~geardyn.gears.Wear`, :class:`~geardyn.gears.BrokenTooth`), all on one gear, its
+        :class:`~geardyn.gears.Wear`; a :class:`~geardyn.gears.BrokenTooth` leaves no pair in
+        contact over part of its passage, a zero stiffness no series keeps positive: refused),
+        all on one gear, its
         ``gear`` ``"sun"``, ``"ring"`` or ``"planet<n>"`` (n = 1 .. N) and ``tooth`` numbered as
         in :mod:`geardyn.models.planetary_faults` (which also says which meshes and flanks a
         faulty tooth takes part in). The forcing period is then one revolution of the faulty
@@ -780,11 +785,22 @@ class PlanetaryGearSet(Model):
         for g, mesh in meshes.items():
             kw.setdefault(f"{g}_backlash",
                           0.5 * max(mesh.backlash, 0.0) * math.cos(mesh.operating_pressure_angle))
-        model = cls(
-            n_planets=geometry.n_planets, planet_angles=list(geometry.planet_angles),
-            sun_pressure_angle=meshes["sun"].operating_pressure_angle,
-            ring_pressure_angle=meshes["ring"].operating_pressure_angle,
-            **inputs, harmonics=harmonics, **members, **kw)
+        try:
+            model = cls(
+                n_planets=geometry.n_planets, planet_angles=list(geometry.planet_angles),
+                sun_pressure_angle=meshes["sun"].operating_pressure_angle,
+                ring_pressure_angle=meshes["ring"].operating_pressure_angle,
+                **inputs, harmonics=harmonics, **members, **kw)
+        except ParameterError as exc:
+            if exc.field not in ("waveform", "coast_waveform"):
+                raise
+            if placement is None:
+                raise ParameterError("harmonics", harmonics, "the series of a mesh's "
+                                     "stiffness falls to 0 or below; keep more") from None
+            raise ParameterError("faults", placement.describe(), "the stiffness series of a "
+                                 "faulty mesh falls to 0 or below (a missing tooth leaves no "
+                                 "pair in contact over its single-contact zone: not modelled; "
+                                 "otherwise keep more harmonics)") from None
         model.geometry = geometry
         model.stiffness_waveforms = waves
         model.stiffness_tables = tables
