@@ -174,13 +174,10 @@ def test_series_error_is_the_truncation(geo):
         max(e1["drive_rms"], e1["coast_rms"]))
 
 
-def test_fault_is_felt_once_per_revolution_at_the_tooth_contact(geo):
-    """Nearly quasi-static (mesh frequency below the first natural frequency), a deep crack on sun
-    tooth 7: each sun-planet mesh's deflection peaks once per sun revolution, while the cracked
-    tooth is loaded (its contact from the start to the end of the path of contact around its
-    pitch-point passage, computed from the planet angles here)."""
-    tooth = 7
-    gs = pe_set(geo, [g.RootCrack(depth="2 mm", gear="sun", tooth=tooth)], harmonics=8,
+def _quasi_static_run(geo, depth: str, tooth: int):
+    """One sun revolution, after one of transient, of the set with a crack of ``depth`` on sun
+    tooth ``tooth``, nearly quasi-static (mesh frequency below the first natural frequency)."""
+    gs = pe_set(geo, [g.RootCrack(depth=depth, gear="sun", tooth=tooth)], harmonics=8,
                 angles=90, sun_backlash=0.0, ring_backlash=0.0, modal_damping=0.1,
                 rotational_only=True).with_params(input_speed=500.0)
     first = gs.natural_frequencies()[gs.natural_frequencies() > 0][0] * 2.0 * math.pi
@@ -189,6 +186,17 @@ def test_fault_is_felt_once_per_revolution_at_the_tooth_contact(geo):
     ds = geardyn.simulate(gs, run=geardyn.RunSettings(transient=revolution, samples=1,
                                                       steps_per_period=25 * 512))
     assert ds.attrs["status"] == geardyn.Status.OK
+    return gs, ds
+
+
+def test_fault_is_felt_once_per_revolution_at_the_tooth_contact(geo):
+    """A deep crack on sun tooth 7: each sun-planet mesh's deflection peaks once per sun
+    revolution, while the cracked tooth is loaded (its contact from the start to the end of the
+    path of contact around its pitch-point passage, computed from the planet angles here); the
+    mesh force's spectrum gains sidebands at the sun's relative rotation frequency (Omega)
+    around the mesh frequency (25 Omega), which the zero-size crack does not have."""
+    tooth = 7
+    gs, ds = _quasi_static_run(geo, "2 mm", tooth)
     y = np.stack([ds[s].values for s in gs.state_names[:len(gs.dof_names())]], axis=1)
     deflection = y @ gs.mesh_rows().T
     cycles = (ds["time"].values * gs.omega * gs.mesh_order / (2.0 * math.pi)) % 25
@@ -202,6 +210,38 @@ def test_fault_is_felt_once_per_revolution_at_the_tooth_contact(geo):
         assert start <= offset <= end, (m, at, passage)
         peaks.append(at)
     assert len({round(p, 3) for p in peaks}) == geo.n_planets  # each planet at its own time
+
+    def lines(data):  # amplitudes at the harmonics k Omega of one revolution (whole period)
+        return np.abs(np.fft.rfft(data["F_s1"].values[:-1])) / (data.sizes["time"] - 1)
+
+    cracked, healthy = lines(ds), lines(_quasi_static_run(geo, "0 mm", tooth)[1])
+    mesh_line = healthy[25]
+    # sidebands at 25 Omega -3, -2, +1, +2 Omega; at 25 - 1 = 24, a multiple of N = 4, the four
+    # equally spaced planets' contributions cancel
+    for k in (22, 23, 26, 27):
+        assert cracked[k] > 1e-3 * mesh_line > 1e3 * healthy[k], k
+    assert cracked[24] < 1e-2 * cracked[23]
+
+
+def test_analyses_run_on_it(geo):
+    """A sweep in the input speed, the modes and the static forces of a set with a cracked
+    planet tooth; the datasets say what Omega is."""
+    gs = pe_set(geo, [g.RootCrack(**CRACK, gear="planet3", tooth=1)])
+    revolution = 2.0 * math.pi / gs.with_params(input_speed=2000.0).omega
+    br = geardyn.bifurcation(gs, "input_speed", [2000.0, 3000.0],
+                             run=geardyn.RunSettings(transient=revolution, samples=2,
+                                                     steps_per_period=23 * 128))
+    assert np.all(br["status"].values == 0) and np.all(np.isfinite(br["poincare"].values))
+    assert br.attrs["mesh_cycles_per_period"] == 23 and br.attrs["faulty_gear"] == "planet3"
+    assert br["input_speed"].attrs["units"] == "rpm"
+    axes = gs.speed_axes(np.array([gs.omega]))  # Omega's axes: the mesh frequency, the speed
+    assert axes["mesh_frequency"][0][0] == pytest.approx(gs.mesh_frequency / (2.0 * math.pi))
+    assert axes["input_speed"][0][0] == pytest.approx(gs.input_speed)
+    assert gs.mesh_frequency == pytest.approx(23 * gs.omega * gs.time_scale, rel=1e-14)
+    modes = gs.modes()
+    assert np.all(np.isfinite(modes["frequency"].values))
+    forces = gs.static_mesh_forces()
+    assert np.all(forces[:4] > 0.0) and np.all(np.isfinite(forces))
 
 
 @pytest.mark.parametrize(("fault", "field"), [
