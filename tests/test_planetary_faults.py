@@ -69,6 +69,21 @@ def test_zero_size_fault_simulates_as_the_one_mesh_cycle_set(geo):
                                    atol=1e-8 * scale)
 
 
+def test_kinematic_carrier_speed_follows_the_mesh_frequency(geo):
+    """With the carrier's gyroscopic terms tied to the input speed, a zero-size fault keeps the
+    carrier speed and the rotating-frame frequencies of the one-mesh-cycle set."""
+    kw = dict(carrier_speed="kinematic", carrier=MEMBERS["carrier"])
+    healthy = pe_set(geo, **kw).with_params(input_speed=4000.0)
+    zero = pe_set(geo, [g.RootCrack(depth=0.0, gear="planet1", tooth=0)], **kw).with_params(
+        input_speed=4000.0)
+    assert zero.carrier_omega() == pytest.approx(healthy.carrier_omega(), rel=1e-14)
+    assert zero.carrier_omega() == pytest.approx(
+        4000.0 * 2.0 * math.pi / 60.0 * 25 / (25 + 71), rel=1e-12)  # ring held, sun input
+    np.testing.assert_allclose(zero.natural_frequencies(), healthy.natural_frequencies(),
+                               rtol=1e-10)
+    assert zero.param_attrs("Omega")["long_name"] == "forcing frequency / time_scale"
+
+
 def _passage(geo, gear: str, tooth: int, mesh: int, sun_turns: int = 1) -> float:
     """The mesh cycle [0, Z_f) at which ``tooth`` of ``gear`` passes the pitch point of mesh
     ``mesh`` (0 .. N-1 sun-planet, N .. 2N-1 ring-planet), from the carrier-frame kinematics:

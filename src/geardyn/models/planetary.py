@@ -424,8 +424,7 @@ class PlanetaryGearSet(Model):
     #: The ISO 6336-1 waves (sun, ring) of a set built from geometry with ``stiffness="iso"``.
     stiffness_waveforms: Any = None
     #: The potential-energy Datasets (sun, ring) of a set built with
-    #: ``stiffness="potential_energy"`` (None otherwise; with faults the faulty gear's meshes'
-    #: tables over its revolution where it has them).
+    #: ``stiffness="potential_energy"`` over one mesh cycle, healthy (None otherwise).
     stiffness_tables: Any = None
     #: Every mesh's potential-energy table (sun-planet meshes, then ring-planet; with faults
     #: the faulty meshes' over the faulty gear's revolution), None without them.
@@ -764,8 +763,7 @@ class PlanetaryGearSet(Model):
             revolution = revolution_stiffness(geometry, opts, placement, harmonics,
                                               _sun_turns(held_member))
             inputs, waves = revolution.inputs(geometry.n_planets, coast), None
-            n = geometry.n_planets
-            tables = (revolution.tables[0], revolution.tables[n])
+            tables = revolution.healthy
         meshes = {"sun": geometry.sun_mesh, "ring": geometry.ring_mesh}
         radii = {"sun": geometry.sun.base_radius, "ring": geometry.ring.base_radius,
                  "carrier": geometry.sun_mesh.centre_distance,
@@ -899,7 +897,11 @@ class PlanetaryGearSet(Model):
         if name == "mesh_frequency":
             return {"units": "rad/s", "long_name": "mesh frequency"}
         if name == "Omega":
-            return {}
+            if self.mesh_order == 1:
+                return {}
+            return {"units": "1", "long_name": "forcing frequency / time_scale",
+                    "meaning": f"mesh frequency / ({self.mesh_order} time_scale): one forcing "
+                               f"period is {self.mesh_order} mesh cycles"}
         unit = _UNITS.get(name) or next((u for suffix, u in _UNIT_SUFFIXES
                                          if name.endswith(suffix)), None)
         if unit is None and name in self.inputs and name not in _NOT_SWEPT:

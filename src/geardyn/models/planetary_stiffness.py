@@ -200,11 +200,13 @@ class RevolutionStiffness:
     gear relative to the carrier (:mod:`geardyn.models.planetary_faults`): per mesh (sun-planet
     meshes, then ring-planet) its table over ``order`` mesh cycles (``tables``; a healthy mesh's
     one-cycle table repeated), its shift [mesh cycles] and its drive and coast series, unshifted,
-    in the revolution angle (``harmonics`` = mesh harmonics x ``order``)."""
+    in the revolution angle (``harmonics`` = mesh harmonics x ``order``); ``healthy`` the healthy
+    one-cycle tables (sun-planet, planet-ring)."""
 
     order: int
     harmonics: int
     tables: tuple[Any, ...]
+    healthy: tuple[Any, Any]
     shifts: np.ndarray
     drive: tuple[FlankSeries, ...]
     coast: tuple[FlankSeries, ...]
@@ -249,10 +251,11 @@ def revolution_stiffness(geometry: Any, opts: PotentialEnergyOptions, placement:
     extra = {"sun": {}, "ring": {"ring_foundation": "rigid"}}
     faults = {"sun": placement.sun_faults, "ring": placement.ring_faults}
     n = geometry.n_planets
-    tables, drive, coast = [], [], []
+    tables, drive, coast, healthy_tables = [], [], [], []
     for g in ("sun", "ring"):
         healthy = potential_energy_stiffness(meshes[g], bore_radius=bores[g], **common,
                                              **extra[g])
+        healthy_tables.append(healthy)
         faulty = (potential_energy_stiffness(meshes[g], bore_radius=bores[g], faults=faults[g],
                                              cycles=order, **common, **extra[g])
                   if faults[g] else None)
@@ -269,8 +272,8 @@ def revolution_stiffness(geometry: Any, opts: PotentialEnergyOptions, placement:
                 coast.append(embedded(flank_series(healthy["mesh_stiffness_coast"].values,
                                                    harmonics), order, n_h))
     sun, ring = mesh_shifts(geometry, sun_turns, placement)
-    return RevolutionStiffness(order, n_h, tuple(tables), np.concatenate([sun, ring]),
-                               tuple(drive), tuple(coast))
+    return RevolutionStiffness(order, n_h, tuple(tables), tuple(healthy_tables),
+                               np.concatenate([sun, ring]), tuple(drive), tuple(coast))
 
 
 def series_error(table: np.ndarray, cycles: int, mean: float, coefficients: np.ndarray,
