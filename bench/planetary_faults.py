@@ -12,10 +12,11 @@ the sweep at least two samples),
 default steps per period (at least 64 steps a mesh cycle in every build). Prints per build the
 steps per mesh cycle, the wall time (median of ``--repeat`` warm runs) and ns per lane-step, and
 the ratio to the healthy build's. Single-threaded (``NUMBA_NUM_THREADS`` as set; the sweep's
-threads with ``--threads``).
+threads with ``--threads``). ``--write`` records the ratios in bench/RESULTS.md (row
+``planetary-faults``, no target).
 
     .venv/bin/python bench/planetary_faults.py [--repeat 3] [--cycles 100] [--lanes 8]
-        [--harmonics 9] [--threads 1]
+        [--harmonics 9] [--threads 1] [--write]
 """
 
 from __future__ import annotations
@@ -75,6 +76,7 @@ def main() -> None:
     ap.add_argument("--lanes", type=int, default=8)
     ap.add_argument("--harmonics", type=int, default=9)
     ap.add_argument("--threads", type=int, default=1)
+    ap.add_argument("--write", action="store_true", help="record in bench/RESULTS.md")
     args = ap.parse_args()
     numba.set_num_threads(args.threads)
     geo = stage()
@@ -89,6 +91,7 @@ def main() -> None:
     print("build | Z_f | H per mesh | steps per mesh cycle | simulate s | ns/step | "
           "sweep s | ns/lane-step | ratio sim | ratio sweep")
     base = None
+    summary = []
     for name, fault in builds:
         t = time.perf_counter()
         model = build(geo, fault, args.harmonics).with_params(input_speed=3000.0)
@@ -114,6 +117,21 @@ def main() -> None:
         print(f"{name} | {z} | {model.fourier.shape[1] // 2} | {n / z:.0f} | {sim:.3f} | "
               f"{sim_ns:.0f} | {sweep:.3f} | {sweep_ns:.0f} | {sim_ns / base[0]:.2f} | "
               f"{sweep_ns / base[1]:.2f}   (built in {built:.2f} s)")
+        summary.append(f"{name.split(' (')[0]} (H {model.fourier.shape[1] // 2}): "
+                       f"{sim_ns:.0f} / {sweep_ns:.0f} ns, {sim_ns / base[0]:.1f}x / "
+                       f"{sweep_ns / base[1]:.1f}x")
+    if args.write:
+        import sys
+
+        sys.path.insert(0, os.path.dirname(__file__))
+        from _results import record
+
+        record("planetary-faults", "planetary set (25/23/71, N = 4) with a cracked tooth: ns "
+               "per step of a simulate / per lane-step of a sweep against the healthy "
+               "one-mesh-cycle build (no target)",
+               "; ".join(summary) + f" (median of {args.repeat}, {args.threads} thread)",
+               "no target",
+               "`.venv/bin/python bench/planetary_faults.py " + " ".join(sys.argv[1:]) + "`")
 
 
 if __name__ == "__main__":

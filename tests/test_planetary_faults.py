@@ -179,6 +179,26 @@ def test_planet_fault_weakens_its_own_two_meshes(geo):
     assert faulty.k_s[1] < faulty.k_s[0] == pytest.approx(healthy.k_s, rel=1e-12)
 
 
+def test_planet_spall_acts_on_its_flank_in_both_meshes(geo):
+    """A spall on the flank of a planet tooth that the sun drives narrows the sun-planet mesh's
+    drive contacts and the ring-planet mesh's coast contacts (the same flank meets the ring on
+    reversal); on the other flank the reverse, the mirror image to round-off (symmetric teeth).
+    Mean stiffnesses of planet 1's meshes [N/m], against the healthy set's."""
+    spall = dict(length="1 mm", width="4 mm", depth="0.2 mm", position="0 mm", gear="planet1",
+                 tooth=2)
+    healthy = pe_set(geo, angles=90)
+    k0 = np.r_[healthy.mesh_stiffnesses()[[0, 4]], healthy.coast_stiffnesses()[[0, 4]]]
+
+    def loss(flank: str) -> np.ndarray:  # sun drive, ring drive, sun coast, ring coast
+        gs = pe_set(geo, [g.Spall(**spall, flank=flank)], angles=90)
+        return k0 - np.r_[gs.mesh_stiffnesses()[[0, 4]], gs.coast_stiffnesses()[[0, 4]]]
+
+    drive, coast = loss("drive"), loss("coast")
+    assert np.all(drive > 0.0)  # the thinned sections: every contact of the tooth
+    assert drive[0] > 5.0 * drive[2] and drive[3] > 5.0 * drive[1]  # the narrowed contacts
+    np.testing.assert_allclose(coast, drive[[2, 3, 0, 1]], rtol=1e-9)
+
+
 def test_series_error_is_the_truncation(geo):
     """stiffness_error: the series against the tables; it falls as the harmonics grow."""
     crack = [g.RootCrack(**CRACK, gear="sun", tooth=2)]
@@ -287,6 +307,9 @@ def test_bad_fault_specs_name_the_field(geo):
         geardyn.PlanetaryGearSet.from_geometry(geo, faults=[g.RootCrack(**CRACK, gear="sun")],
                                                **MEMBERS)
     assert err.value.field == "faults"
+    with pytest.raises(ParameterError) as err:  # one mesh's sliding, two meshes
+        pe_set(geo, [g.Wear(depth="20 um", gear="planet2", profile="archard")])
+    assert err.value.field == "wear.profile"
     with pytest.raises(ParameterError) as err:  # no pair in contact: a zero stiffness
         pe_set(geo, [g.BrokenTooth(gear="planet1", tooth=2)])
     assert err.value.field == "faults"

@@ -41,6 +41,8 @@ drive flank, which is the sun-planet mesh's coast flank). So
   coast contacts; ``"coast"`` the other flank (the sun-planet mesh's coast contacts and the
   ring-planet mesh's drive contacts). The thinned sections of the tooth soften the contacts of
   both flanks, so both meshes feel them (as on a pair's tooth, :mod:`geardyn.gears.faults`);
+* Archard wear on a planet is refused (its profile follows one mesh's sliding; the tables of
+  the two meshes would each derive their own), uniform wear is taken;
 * on the sun the flanks are the sun-planet mesh's; on the ring only a root crack or a missing
   tooth is modelled (:mod:`geardyn.gears.potential_energy`).
 """
@@ -121,6 +123,10 @@ def place_faults(faults: object, geometry: Any) -> FaultPlacement | None:
         if not 0 <= fault.tooth < z:
             raise ParameterError(f"{kind}.tooth", fault.tooth,
                                  f"must lie in [0, {z - 1}] ({gear} has {z} teeth)")
+        if number is not None and isinstance(fault, Wear) and fault.profile != "uniform":
+            raise ParameterError("wear.profile", fault.profile, "Archard's profile follows one "
+                                 "mesh's sliding, and a planet's flank meets two (the sun and, "
+                                 "on reversal, the ring): give uniform wear on a planet")
         if gear == "ring" and isinstance(fault, (Spall, Wear)):
             raise ParameterError(f"{kind}.gear", gear, "on the ring's teeth only a root crack "
                                  "or a missing tooth (broken_tooth) is modelled")
