@@ -90,6 +90,10 @@ def test_study_faults_equal_the_api_bitwise():
                                        "modal_damping", "sun_torque")},
         harmonics=15).with_omega(float(model.params[model.omega_index]))
     assert np.array_equal(model.params, hand.params)
+    from geardyn.io.toml import study_to_toml
+
+    again = build_model(load_study_dict(tomllib.loads(study_to_toml(load_study_dict(doc)))))
+    assert np.array_equal(again.params, model.params)  # a saved study keeps its faults
 
 
 @pytest.mark.parametrize(("fault", "field"), [
