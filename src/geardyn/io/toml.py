@@ -1089,8 +1089,10 @@ class Study(BaseModel):
         if self.gears is None:
             for name in ("faults", "stiffness", "relief", "crowning"):
                 if getattr(self, name) is not None:
+                    where = (" (a planetary set's faults: [[params.geometry.faults]])"
+                             if name == "faults" else "")
                     raise _study_error((name,), None, "needs a [gears] table (the pair whose"
-                                       " mesh stiffness it is for)")
+                                       f" mesh stiffness it is for){where}")
             if self.params is None:
                 raise _study_error(("params",), None, "required (or a [gears] table)", "missing")
             return
