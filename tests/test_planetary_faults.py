@@ -199,6 +199,19 @@ def test_planet_spall_acts_on_its_flank_in_both_meshes(geo):
     np.testing.assert_allclose(coast, drive[[2, 3, 0, 1]], rtol=1e-9)
 
 
+def test_ring_spall_acts_on_the_ring_meshes_drive_contacts(geo):
+    """A spall on a ring tooth's drive flank: every ring-planet mesh's drive mean falls more
+    than its coast mean, the sun-planet meshes keep theirs."""
+    healthy = pe_set(geo, angles=90)
+    gs = pe_set(geo, [g.Spall(length="1 mm", width="4 mm", depth="0.2 mm", position="0.6 mm",
+                              gear="ring", tooth=9)], angles=90)
+    assert gs.mesh_order == 71
+    drive = healthy.mesh_stiffnesses() - gs.mesh_stiffnesses()
+    coast = healthy.coast_stiffnesses() - gs.coast_stiffnesses()
+    np.testing.assert_array_equal(drive[:4], 0.0)
+    assert np.all(drive[4:] > 5.0 * coast[4:]) and np.all(coast[4:] > 0.0)
+
+
 def test_series_error_is_the_truncation(geo):
     """stiffness_error: the series against the tables; it falls as the harmonics grow."""
     crack = [g.RootCrack(**CRACK, gear="sun", tooth=2)]
@@ -297,9 +310,10 @@ def test_bad_fault_specs_name_the_field(geo):
     with pytest.raises(ParameterError) as err:
         g.RootCrack(depth="1 mm", gear="moon")
     assert err.value.field == "crack.gear"
-    with pytest.raises(ParameterError) as err:
-        pe_set(geo, [g.Spall(length="1 mm", width="2 mm", depth="0.1 mm", gear="ring")])
-    assert err.value.field == "spall.gear"
+    with pytest.raises(ParameterError) as err:  # off the ring tooth's active flank
+        pe_set(geo, [g.Spall(length="1 mm", width="2 mm", depth="0.1 mm", position="3 mm",
+                             gear="ring")])
+    assert err.value.field == "spall.position"
     with pytest.raises(ParameterError) as err:
         pe_set(geo, [g.RootCrack(**CRACK, gear="sun"), g.BrokenTooth(gear="planet1")])
     assert err.value.field == "faults"

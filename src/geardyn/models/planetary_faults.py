@@ -43,8 +43,7 @@ drive flank, which is the sun-planet mesh's coast flank). So
   both flanks, so both meshes feel them (as on a pair's tooth, :mod:`geardyn.gears.faults`);
 * Archard wear on a planet is refused (its profile follows one mesh's sliding; the tables of
   the two meshes would each derive their own), uniform wear is taken;
-* on the sun the flanks are the sun-planet mesh's; on the ring only a root crack or a missing
-  tooth is modelled (:mod:`geardyn.gears.potential_energy`).
+* on the sun the flanks are the sun-planet mesh's, on the ring the ring-planet mesh's.
 """
 
 from __future__ import annotations
@@ -99,9 +98,9 @@ def _listed(faults: object) -> tuple[Any, ...]:
 def place_faults(faults: object, geometry: Any) -> FaultPlacement | None:
     """The :class:`FaultPlacement` of ``faults`` (one fault or a sequence) on the gears of
     ``geometry`` (a :class:`~geardyn.gears.PlanetaryGeometry`), None without faults. Errors name
-    the fault's field: ``<kind>.gear`` (not a gear of the set, a planet beyond N, a spall or
-    wear on the ring), ``<kind>.tooth`` (beyond the gear's teeth), or ``faults`` (not a fault,
-    faults on more than one gear)."""
+    the fault's field: ``<kind>.gear`` (not a gear of the set, a planet beyond N),
+    ``<kind>.tooth`` (beyond the gear's teeth), ``wear.profile`` (Archard wear on a planet), or
+    ``faults`` (not a fault, faults on more than one gear)."""
     listed = _listed(faults)
     if not listed:
         return None
@@ -127,9 +126,6 @@ def place_faults(faults: object, geometry: Any) -> FaultPlacement | None:
             raise ParameterError("wear.profile", fault.profile, "Archard's profile follows one "
                                  "mesh's sliding, and a planet's flank meets two (the sun and, "
                                  "on reversal, the ring): give uniform wear on a planet")
-        if gear == "ring" and isinstance(fault, (Spall, Wear)):
-            raise ParameterError(f"{kind}.gear", gear, "on the ring's teeth only a root crack "
-                                 "or a missing tooth (broken_tooth) is modelled")
         where[gear] = fault
     if len(where) > 1:
         raise ParameterError("faults", ", ".join(sorted(where)),
