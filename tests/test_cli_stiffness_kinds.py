@@ -301,7 +301,7 @@ BAD = [
     (RING, 'bore_radius = "140 mm"\n', "", ("gears.wheel.bore_radius", "required")),
     (RING, 'kind = "crack"\ngear = "wheel"\ntooth = 0\ndepth = "1.5 mm"\nangle = "30 deg"',
      'kind = "spall"\ngear = "wheel"\ntooth = 0\nlength = "1 mm"\nwidth = "4 mm"\n'
-     'depth = "0.1 mm"', ("faults[1].gear", "ring")),
+     'depth = "0.1 mm"\nposition = "3 mm"', ("faults[1].position", "active")),
     (HELICAL, 'amount = "6 um"', 'amout = "6 um"',
      ("relief[0].amout", "unknown key", "amount, length, shape, gear")),
     (HELICAL, 'amount = "6 um"\n', "", ("relief[0].amount", "required")),

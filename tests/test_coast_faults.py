@@ -251,13 +251,14 @@ def test_crack_has_no_flank_and_loads_both_flanks(mesh: GearMesh) -> None:
         np.testing.assert_array_equal(k[~hit], k0[~hit])
 
 
-def test_ring_tooth_refuses_a_coast_spall() -> None:
+def test_ring_tooth_refuses_a_coast_spall_off_its_flank() -> None:
     mesh = GearMesh(SpurGear(23, 2e-3, ALPHA, 20e-3, name="pinion"),
                     SpurGear(71, 2e-3, ALPHA, 20e-3, internal=True, name="wheel"), internal=True)
     with pytest.raises(ParameterError) as info:
         potential_energy_stiffness(mesh, bore_radius=(8e-3, 85e-3), angles=4,
-                                   faults=Spall(**SPALL, gear="wheel", flank="coast"))
-    assert info.value.field == "spall.gear"
+                                   faults=Spall(**{**SPALL, "position": 3e-3}, gear="wheel",
+                                                flank="coast"))
+    assert info.value.field == "spall.position"
 
 
 # -- helical slices ---------------------------------------------------------------------------

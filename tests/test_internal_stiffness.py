@@ -285,10 +285,12 @@ def test_planet_archard_slip_is_the_internal_kinematics() -> None:
     (dict(bore_radius=(8e-3, 0.0760)), "wheel.bore_radius"),  # rim thinner than the teeth
     (dict(bore_radius=(8e-3, 0.0)), "wheel.bore_radius"),
     (dict(bore_radius=BORES, ring_foundation="sainsot"), "ring_foundation"),
-    (dict(bore_radius=BORES, faults=Wear(1e-5, gear="wheel")), "wear.gear"),
+    (dict(bore_radius=BORES, faults=Wear(1e-3, gear="wheel")), "wear.depth"),
     (dict(bore_radius=BORES, faults=RootCrack(4e-3, "90 deg", gear="wheel")), "crack.depth"),
     (dict(bore_radius=BORES, faults=Spall(length=1e-4, width=1e-3, depth=1e-5,
-                                          gear="wheel")), "spall.gear"),
+                                          position=3e-3, gear="wheel")), "spall.position"),
+    (dict(bore_radius=BORES, faults=Spall(length=1e-4, width=30e-3, depth=1e-5,
+                                          gear="wheel")), "spall.width"),
 ])
 def test_bad_inputs_name_the_field(kwargs: dict, field: str) -> None:
     with pytest.raises(ParameterError) as info:
@@ -333,3 +335,117 @@ def test_docs_internal_iso_table_is_computed() -> None:
                means[1.5], means[2.0], means[3.0], means[2.0] / iso.c_gamma_alpha]
         digits = [4, 2, 2, 2, 2, 2, 2, 2]
         assert [round(g, d) for g, d in zip(got, digits, strict=True)] == doc, (z1, z2)
+
+
+# ---------------------------------------------------------------------------------------------
+# a spall or wear on a ring tooth
+
+
+def _worn_ring_reference(g: dict[str, float], position: float, cut: object) -> dict[str, float]:
+    """The ring tooth by quad with the sections between the roll angles ``cut.rolls`` (t from
+    the base circle, alpha = a2 + t) losing ``cut.area(h)`` and with ``cut.inertia(h)`` about
+    their own centroid (module docstring; healthy I = (2/3) h^3 b, A = 2 h b elsewhere)."""
+    rb, a2 = g["rb2"], g["a2"]
+    a1 = a2 + (rb * math.tan(g["a_w"]) + position) / rb
+    top = a2 + math.sqrt((g["rf2"] / rb) ** 2 - 1.0)
+    c, s = math.cos(a1), math.sin(a1)
+    xc = rb * (math.cos(a1) + (a1 - a2) * math.sin(a1))
+    hc = rb * (math.sin(a1) - (a1 - a2) * math.cos(a1))
+    lo, hi = (a2 + t for t in cut.rolls)
+
+    def geom(a: float) -> tuple[float, float, float, float]:
+        h = rb * (math.sin(a) - (a - a2) * math.cos(a))
+        x = rb * (math.cos(a) + (a - a2) * math.sin(a))
+        inertia, area = (cut.section(h) if lo <= a <= hi
+                         else ((2.0 / 3.0) * h ** 3 * B, 2.0 * h * B))
+        return inertia, area, x, rb * (a - a2) * math.cos(a)
+
+    def bend(a: float) -> float:
+        inertia, _, x, dx = geom(a)
+        return (c * (x - xc) - s * hc) ** 2 / (E * inertia) * dx
+
+    def inv_area(a: float) -> float:
+        _, area, _, dx = geom(a)
+        return dx / area
+
+    points = [p for p in (lo, hi) if a1 < p < top]
+    tight = dict(epsabs=0.0, epsrel=1e-12, limit=400, points=points or None)
+    area = quad(inv_area, a1, top, **tight)[0]
+    return {"bending": quad(bend, a1, top, **tight)[0],
+            "shear": 1.2 * c ** 2 * 2.0 * (1.0 + NU) / E * area, "axial": s ** 2 / E * area}
+
+
+class _Cut:
+    def __init__(self, rolls: tuple[float, float], section) -> None:  # noqa: ANN001
+        self.rolls, self.section = rolls, section
+
+
+def test_worn_and_spalled_ring_tooth_match_quad() -> None:
+    """Uniform wear d over the ring tooth's active profile (from its tip to the deepest contact,
+    the end of the path) leaves sections 2h - d thick; a w x d spall centred ``position`` along
+    the profile (positive towards the ring's tip, i.e. inwards) removes a rectangle at the
+    flank, I about the remaining section's centroid (parallel axes) - each by quad against the
+    ring tooth's compliance terms at contacts on and off the fault."""
+    g = _internal()
+    mesh = _mesh()
+    rb = g["rb2"]
+    g_a = math.sqrt(g["ra1"] ** 2 - g["rb1"] ** 2) - g["rb1"] * math.tan(g["a_w"])
+    t_tip = math.sqrt((g["ra2"] / rb) ** 2 - 1.0)
+    t_deep = (rb * math.tan(g["a_w"]) + g_a) / rb
+    d = 20e-6
+    wear = Wear(d, gear="wheel")
+    worn = _Cut((t_tip, t_deep), lambda h: ((2.0 * h - d) ** 3 * B / 12.0, (2.0 * h - d) * B))
+    length, width, depth, centre = 1e-3, 4e-3, 0.2e-3, 0.6e-3  # edges off the contacts
+    p = math.tan(ALPHA)  # the reference circle's roll; towards the tip the roll falls
+
+    def roll(along: float) -> float:
+        return math.sqrt(p * p - 2.0 * along / rb)
+
+    spall = Spall(length=length, width=width, depth=depth, position=centre, gear="wheel")
+
+    def spalled(h: float) -> tuple[float, float]:
+        cut_area = width * depth
+        area = 2.0 * h * B - cut_area
+        y_c = -cut_area * (h - 0.5 * depth) / area  # the centroid moves away from the cut
+        inertia = ((2.0 * h) ** 3 * B / 12.0 + 2.0 * h * B * y_c ** 2
+                   - (width * depth ** 3 / 12.0 + cut_area * (h - 0.5 * depth - y_c) ** 2))
+        return inertia, area
+
+    pitted = _Cut((roll(centre + 0.5 * length), roll(centre - 0.5 * length)), spalled)
+    positions = np.array([-3e-3, -1e-3, 0.0, 1e-3, 2e-3])
+    for fault, cut in ((wear, worn), (spall, pitted)):
+        pair = prepare_pair(mesh, bore_radius=BORES, young=E, poisson=NU, faults=[fault])
+        terms = pair.terms(positions, wheel=fault)
+        healthy = pair.terms(positions)
+        for i, s in enumerate(positions):
+            ref = _worn_ring_reference(g, float(s), cut)
+            for name, value in ref.items():
+                got = 1.0 / terms[f"{name}_wheel"][i]
+                assert got == pytest.approx(value, rel=1e-9), (fault.kind, name, s)
+                assert got >= (1.0 - 1e-12) / healthy[f"{name}_wheel"][i]  # never stiffer
+        # the spall narrows the Hertz contact where the contact lies on it
+        on = [cut.rolls[0] <= (rb * math.tan(g["a_w"]) + s) / rb <= cut.rolls[1]
+              for s in positions]
+        narrowed = math.pi * E * (B - (width if fault is spall else 0.0)) / (4.0 * (1 - NU ** 2))
+        for i in range(positions.size):
+            want = narrowed if on[i] else math.pi * E * B / (4.0 * (1 - NU ** 2))
+            assert terms["hertz"][i] == pytest.approx(want, rel=1e-12)
+    assert any(on) and not all(on)  # the check has teeth
+
+
+def test_ring_flank_faults_mirror_between_the_flanks() -> None:
+    """A spall (or wear) on the ring tooth's coast flank acts on the coast contacts as the same
+    fault on the drive flank acts on the drive contacts, over a ring revolution."""
+    mesh = _mesh()
+    kw = dict(bore_radius=BORES, young=E, poisson=NU, angles=60, cycles=Z2)
+    spall = dict(length=1e-3, width=4e-3, depth=0.2e-3, position=0.5e-3, gear="wheel", tooth=5)
+    drive = potential_energy_stiffness(mesh, faults=[Spall(**spall)], **kw)
+    coast = potential_energy_stiffness(mesh, faults=[Spall(**spall, flank="coast")], **kw)
+    base = potential_energy_stiffness(mesh, **kw)
+    for a, b in (("mesh_stiffness", "mesh_stiffness_coast"),
+                 ("mesh_stiffness_coast", "mesh_stiffness")):
+        da = drive[a].values - base[a].values
+        db = coast[b].values - base[b].values
+        assert da.min() < -1e5
+        np.testing.assert_allclose(np.sort(da), np.sort(db), rtol=0.0,
+                                   atol=1e-6 * np.ptp(da))

@@ -211,16 +211,40 @@ def _from_geometry(table: dict, kw: dict, held: str | None = None) -> PlanetaryG
             raise ParameterError("geometry.transition", table["transition"],
                                  "shapes the ISO waves; the potential-energy stiffness has none")
         waves = {}
+    faults = _geometry_faults(table.get("faults") or [])
     try:
         return PlanetaryGearSet.from_geometry(
             stage, held=held, stiffness=table["stiffness"],
             stiffness_options=table["stiffness_options"] or None, coast=table["coast"],
-            **waves, **extra)
+            faults=faults, **waves, **extra)
     except ParameterError as exc:
         if exc.field.split(".")[0] in ("stiffness", "stiffness_options", "waveform_options",
-                                        "coast"):
+                                        "coast", "faults"):
             raise ParameterError(f"geometry.{exc.field}", exc.value, exc.reason) from None
+        kind, _, name = exc.field.partition(".")
+        hit = [i for i, f in enumerate(faults) if f.kind == kind]
+        if hit and name:
+            same = [i for i in hit if getattr(faults[i], name, None) == exc.value]
+            i = (same or hit)[0]
+            raise ParameterError(f"geometry.faults[{i}].{name}", exc.value,
+                                 exc.reason) from None
         raise
+
+
+def _geometry_faults(tables: list[dict]) -> list:
+    """The fault objects of ``[[params.geometry.faults]]`` (:class:`~geardyn.io.toml.FaultTable`
+    each); errors name ``geometry.faults[<i>].<field>``."""
+    from geardyn.io.toml import FaultTable
+
+    out = []
+    for i, t in enumerate(tables):
+        try:
+            out.append(FaultTable(**t).build(("faults", i)))
+        except ValidationError as exc:
+            err = exc.errors(include_url=False)[0]
+            field = f"geometry.faults[{i}]" + "".join(f".{p}" for p in err["loc"][2:])
+            raise ParameterError(field, err.get("input"), err["msg"]) from None
+    return out
 
 
 def check_usable(build: Callable[[], Model]) -> Model:

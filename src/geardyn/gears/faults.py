@@ -1,7 +1,9 @@
 """Tooth faults of a spur pair for the potential-energy mesh stiffness.
 
-Each fault sits on tooth ``tooth`` of ``gear`` ("pinion" or "wheel"; tooth 0 passes the pitch
-point at pinion angle 0, tooth j j mesh cycles later) and is built from keyword arguments whose
+Each fault sits on tooth ``tooth`` of ``gear`` ("pinion" or "wheel" of a pair, tooth 0 passing
+the pitch point at pinion angle 0, tooth j j mesh cycles later; or "sun", "ring", "planet1",
+"planet2", ... of a planetary set, :data:`PLANETARY_GEARS` and
+:mod:`geardyn.models.planetary_faults`) and is built from keyword arguments whose
 names are its fields; lengths and angles may be unit strings (:func:`geardyn.units.to_si`).
 What a fault does to the stiffness is in :mod:`geardyn.gears.potential_energy` and
 docs/gears.md; the checks that need the mesh (a crack past the centre line, a spall off the
@@ -35,15 +37,36 @@ from geardyn.errors import ParameterError
 from geardyn.units import to_si
 
 GEARS = ("pinion", "wheel")
+#: The gears of a planetary set a fault may sit on: "sun", "ring" or "planet<n>" (n = 1 .. N,
+#: the planet at the n-th planet angle; checked against N where the set is built).
+PLANETARY_GEARS = ("sun", "ring", "planet<n>")
+_GEAR_NAMES = ("'pinion' or 'wheel' (a pair), or 'sun', 'ring', 'planet1', 'planet2', ... (a"
+               " planetary set)")
+
+
+def planet_number(gear: object) -> int | None:
+    """n of a gear name "planet<n>" (n >= 1, no leading zeros), else None."""
+    if not isinstance(gear, str) or not gear.startswith("planet"):
+        return None
+    digits = gear[len("planet"):]
+    if not digits.isdigit() or not digits.isascii() or digits.startswith("0"):
+        return None
+    return int(digits)
+
+
+def _check_gear(gear: object, kind: str) -> None:
+    """``gear`` a gear name of a pair or of a planetary set (error ``<kind>.gear``)."""
+    if gear in GEARS or gear in ("sun", "ring") or planet_number(gear) is not None:
+        return
+    raise ParameterError(f"{kind}.gear", gear, f"must be {_GEAR_NAMES}")
 #: The flanks a :class:`Spall` or :class:`Wear` may lie on.
 FLANKS = ("drive", "coast")
 
 
 def _place(fault: object, kind: str) -> None:
     """Check the ``gear`` and ``tooth`` fields of ``fault`` (errors ``<kind>.gear`` ...)."""
-    gear, tooth = fault.gear, fault.tooth  # type: ignore[attr-defined]
-    if gear not in GEARS:
-        raise ParameterError(f"{kind}.gear", gear, "must be 'pinion' or 'wheel'")
+    tooth = fault.tooth  # type: ignore[attr-defined]
+    _check_gear(fault.gear, kind)  # type: ignore[attr-defined]
     if isinstance(tooth, bool) or not isinstance(tooth, numbers.Integral) or tooth < 0:
         raise ParameterError(f"{kind}.tooth", tooth, "must be a whole number >= 0")
     object.__setattr__(fault, "tooth", int(tooth))
@@ -102,8 +125,7 @@ class RootCrack:
             raise ParameterError("crack.depth", self.depth, "must be a finite length >= 0")
         if not 0.0 < self.angle <= 0.5 * math.pi * (1.0 + 1e-12):  # "90 deg" in float
             raise ParameterError("crack.angle", self.angle, "must lie in (0, 90 deg]")
-        if self.gear not in GEARS:
-            raise ParameterError("crack.gear", self.gear, "must be 'pinion' or 'wheel'")
+        _check_gear(self.gear, "crack")
         if isinstance(self.tooth, bool) or not isinstance(self.tooth, numbers.Integral):
             raise ParameterError("crack.tooth", self.tooth, "must be a whole number")
 

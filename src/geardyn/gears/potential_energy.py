@@ -67,7 +67,10 @@ with the shear and axial integrals as above, integrated over alpha from alpha_1 
 The ring body under the teeth is rigid (``ring_foundation="rigid"``; Sainsot's fit describes an
 external gear's body and does not apply), which needs a rim at least as thick as the teeth. A
 root crack on a ring tooth narrows the sections between Tian's crack limit line and the root
-circle as on an external tooth; a spall or wear there is refused.
+circle as on an external tooth; a spall or wear thins the sections under it and narrows its
+flank's contacts as on an external tooth, its flank points at roll t at alpha = alpha_2 + t
+(``position`` along the profile positive towards the ring's tip, inwards; the active profile
+from the tip to the deepest contact, at the end of the path).
 
 The coast (back) flanks of symmetric teeth mesh on the mirror image of the line of action
 (Guo & Parker 2014, back-side contact): a coast contact at the same distance from the pitch point
@@ -98,6 +101,7 @@ import numbers
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 from functools import lru_cache
+from typing import Any
 
 import numpy as np
 import xarray as xr
@@ -329,11 +333,12 @@ def _wear_section(depth: float, b: float) -> Section:
     return lambda h, al: ((2.0 * h - depth) ** 3 * b / 12.0, (2.0 * h - depth) * b)
 
 
-def _profile_section(profile: WearProfile, a2: float, b: float) -> Section:
-    """(I, A) of sections thinned by the wear depth ``profile`` at their flank point."""
+def _profile_section(profile: WearProfile, roll: Callable, b: float) -> Section:
+    """(I, A) of sections thinned by the wear depth ``profile`` at their flank point (``roll``:
+    its roll angle from alpha, :func:`alpha_roll`)."""
 
     def section(h: np.ndarray, al: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        t = 2.0 * h - profile.depth_at(a2 - al)
+        t = 2.0 * h - profile.depth_at(roll(al))
         return t ** 3 * b / 12.0, t * b
 
     return section
@@ -370,21 +375,53 @@ def _involute_piece(tooth: ToothModel, a1: np.ndarray, lower: np.ndarray, upper:
 
 def profile_roll(tooth: ToothModel, position: float) -> float:
     """The roll angle of the flank point ``position`` [m] along the involute from the reference
-    circle (positive towards the tip); NaN below the base circle."""
-    s = 0.5 * tooth.base_radius * tooth.pitch_roll ** 2 + position
+    circle (positive towards the tip: outwards on an external tooth, inwards on a ring's); NaN
+    below the base circle."""
+    toward_tip = -position if tooth.internal else position
+    s = 0.5 * tooth.base_radius * tooth.pitch_roll ** 2 + toward_tip
     return math.sqrt(2.0 * s / tooth.base_radius) if s >= 0.0 else math.nan
 
 
 def spall_rolls(tooth: ToothModel, spall: Spall) -> tuple[float, float]:
-    """(t_lo, t_hi): the roll angles of the root- and tip-side edges of ``spall``."""
-    return (profile_roll(tooth, spall.position - 0.5 * spall.length),
-            profile_roll(tooth, spall.position + 0.5 * spall.length))
+    """(t_lo, t_hi): the roll angles of ``spall``'s edges, ascending (the root- and the tip-side
+    edge on an external tooth, the other way round on a ring's)."""
+    edges = (profile_roll(tooth, spall.position - 0.5 * spall.length),
+             profile_roll(tooth, spall.position + 0.5 * spall.length))
+    return min(edges), max(edges)
 
 
 def half_thickness(tooth: ToothModel, alpha: float) -> float:
     """h(alpha) [m] of the involute flank."""
     a2 = tooth.half_base_angle
     return tooth.base_radius * (math.sin(alpha) + (a2 - alpha) * math.cos(alpha))
+
+
+def roll_alpha(tooth: ToothModel, roll: Any) -> Any:
+    """The involute parameter alpha of the flank point at roll angle ``roll``: alpha_2 - t on an
+    external tooth, alpha_2 + t on a ring's (the other branch); its own inverse up to the sign
+    of alpha_2 (:func:`alpha_roll`)."""
+    a2 = tooth.half_base_angle
+    return a2 + roll if tooth.internal else a2 - roll
+
+
+def alpha_roll(tooth: ToothModel, alpha: Any) -> Any:
+    """The roll angle of the flank point at involute parameter ``alpha`` (:func:`roll_alpha`'s
+    inverse)."""
+    a2 = tooth.half_base_angle
+    return alpha - a2 if tooth.internal else a2 - alpha
+
+
+def tip_roll(tooth: ToothModel) -> float:
+    """The roll angle of the tooth's tip."""
+    return float(alpha_roll(tooth, tooth.tip))
+
+
+def active_rolls(tooth: ToothModel) -> tuple[float, float]:
+    """(lo, hi): the roll angles of the active profile's ends, ascending (from ``start_roll`` to
+    the tip on an external tooth; from the tip to ``start_roll``, the deepest contact, on a
+    ring's)."""
+    ends = (tooth.start_roll, tip_roll(tooth))
+    return min(ends), max(ends)
 
 
 @dataclass(frozen=True)
@@ -401,17 +438,21 @@ def _section_loss(tooth: ToothModel, fault: Spall | Wear, face_width: float,
                   profile: WearProfile | None) -> tuple[list[float], Section]:
     """(breaks, section): the involute parameters (ascending) from where ``fault`` thins the
     sections to where it stops, the section smooth between them, and its (I, A)."""
-    a2 = tooth.half_base_angle
+    def alphas(rolls: Sequence[float]) -> list[float]:
+        return sorted(float(roll_alpha(tooth, t)) for t in rolls)
+
     if isinstance(fault, Spall):
-        t_lo, t_hi = spall_rolls(tooth, fault)
-        return [a2 - t_hi, a2 - t_lo], _spall_section(fault.width, fault.depth, face_width)
-    if fault.profile == "uniform":
-        return [tooth.tip, a2 - tooth.start_roll], _wear_section(fault.depth, face_width)
+        return (alphas(spall_rolls(tooth, fault)),
+                _spall_section(fault.width, fault.depth, face_width))
+    if fault.profile == "uniform":  # from the tip to the lowest (deepest) contact
+        return (sorted([tooth.tip, float(roll_alpha(tooth, tooth.start_roll))]),
+                _wear_section(fault.depth, face_width))
     if profile is None:
         raise ParameterError("wear.profile", fault.profile,
                              "Archard's profile needs the mesh: pass wear_profile="
                              "PotentialEnergyPair.wear_profile(wear)")
-    return sorted(a2 - t for t in profile.rolls), _profile_section(profile, a2, face_width)
+    return alphas(profile.rolls), _profile_section(
+        profile, lambda al: alpha_roll(tooth, al), face_width)
 
 
 def _removal(tooth: ToothModel, fault: Spall | Wear, face_width: float,
@@ -419,19 +460,17 @@ def _removal(tooth: ToothModel, fault: Spall | Wear, face_width: float,
     """(breaks, lo, hi, cut): the involute parameters (ascending) where ``fault``'s section loss
     is not smooth, the range [lo, hi] of alpha it covers, and ``cut(al) -> (w, d)``: the width
     and depth [m] of the rectangle it removes at its flank's face at alpha ``al``."""
-    a2 = tooth.half_base_angle
     if isinstance(fault, Spall):
-        t_lo, t_hi = spall_rolls(tooth, fault)
+        lo, hi = sorted(float(roll_alpha(tooth, t)) for t in spall_rolls(tooth, fault))
         w, d = fault.width, fault.depth
-        return ([a2 - t_hi, a2 - t_lo], a2 - t_hi, a2 - t_lo,
-                lambda al: (w, np.full(np.shape(al), d)))
+        return [lo, hi], lo, hi, lambda al: (w, np.full(np.shape(al), d))
     breaks, _ = _section_loss(tooth, fault, face_width, profile)
     if fault.profile == "uniform":
         depth = fault.depth
         return breaks, breaks[0], breaks[-1], lambda al: (face_width,
                                                           np.full(np.shape(al), depth))
-    return (breaks, breaks[0], breaks[-1],
-            lambda al: (face_width, profile.depth_at(a2 - al)))  # type: ignore[union-attr]
+    return (breaks, breaks[0], breaks[-1],  # type: ignore[union-attr]
+            lambda al: (face_width, profile.depth_at(alpha_roll(tooth, al))))
 
 
 def _two_flank_section(cuts: list[tuple[float, np.ndarray]], b: float, h: np.ndarray
@@ -536,13 +575,15 @@ def tooth_compliances(tooth: ToothModel, alpha1: np.ndarray, *, young: float, po
     ``crack=`` is the deprecated spelling of ``fault=`` for a root crack. A
     :class:`BrokenTooth` has no compliance (refused). A ring's tooth (``tooth.internal``) is
     integrated from alpha = alpha1 to its root circle, takes a root crack (as above, the
-    crack limit line running from the crack tip towards the ring's tooth tip) and no other
-    fault, and its fillet term is 0 (rigid ring body)."""
+    crack limit line running from the crack tip towards the ring's tooth tip), a spall or wear
+    (the sections of its flank points, alpha = alpha_2 + t), and its fillet term is 0 (rigid
+    ring body)."""
     fault = _one_fault(fault, crack, "tooth_compliances")
     a1 = np.asarray(alpha1, dtype=float)
     if tooth.internal:
         return _ring_compliances(tooth, a1, young=young, poisson=poisson,
-                                 face_width=face_width, nodes=nodes, fault=fault)
+                                 face_width=face_width, nodes=nodes, fault=fault,
+                                 wear_profile=wear_profile)
     lower = -a1
     if np.any(lower >= tooth.top):
         raise ParameterError(f"{tooth.name}.dedendum", None,
@@ -601,23 +642,31 @@ def tooth_compliances(tooth: ToothModel, alpha1: np.ndarray, *, young: float, po
 
 
 def _ring_compliances(tooth: ToothModel, a1: np.ndarray, *, young: float, poisson: float,
-                      face_width: float, nodes: int,
-                      fault: Fault | None) -> dict[str, np.ndarray]:
+                      face_width: float, nodes: int, fault: Fault | tuple | None,
+                      wear_profile: Any = None) -> dict[str, np.ndarray]:
     """:func:`tooth_compliances` of a ring's tooth: healthy, or with a :class:`RootCrack`
     (Tian's crack limit line from the crack tip towards the tip; sections towards the root
-    beyond it h + h_q thick)."""
+    beyond it h + h_q thick), or a :class:`Spall` or :class:`Wear` (or one on each flank):
+    the sections under it thinned as on an external tooth, integrated from the contact out to
+    the root circle."""
     crack = isinstance(fault, RootCrack) and not fault.is_null
-    if fault is not None and not crack and (isinstance(fault, (BrokenTooth, tuple))
-                                            or not fault.is_null):
-        raise ParameterError(f"{getattr(fault, 'kind', 'fault')}.gear", tooth.name,
-                             "on a ring's tooth only a root crack or a missing tooth is"
-                             " modelled")
+    if isinstance(fault, BrokenTooth):
+        raise ParameterError("fault", fault, "a missing tooth has no compliance")
     if np.any(a1 >= tooth.top):
         raise ParameterError(f"{tooth.name}.dedendum", None,
                              "a contact lies at or beyond the root circle of the ring's tooth")
     g = young / (2.0 * (1.0 + poisson))
     top = np.full(a1.shape, tooth.top)
-    if crack:
+    if isinstance(fault, tuple) or (isinstance(fault, (Spall, Wear)) and not fault.is_null):
+        if isinstance(fault, tuple):
+            breaks, sections = _two_flank_loss(tooth, fault, face_width,
+                                               wear_profile or (None, None))
+        else:
+            breaks, section = _section_loss(tooth, fault, face_width, wear_profile)
+            sections = [section] * (len(breaks) - 1)
+        bending, inv_area = _piecewise(tooth, a1, a1, top, breaks, sections, young,
+                                       face_width, nodes)
+    elif crack:
         _check_crack(fault, tooth)  # type: ignore[arg-type]
         h_q = root_half_thickness(tooth) - fault.reach  # type: ignore[union-attr]
         split = np.maximum(a1, crack_limit(tooth, h_q))
@@ -734,10 +783,9 @@ class PotentialEnergyPair:
         smooth and is evaluated by its Chebyshev interpolant of degree
         :data:`ARCHARD_DEGREE` in the roll angle."""
         tooth = self.pinion if wear.gear == "pinion" else self.wheel
-        t_start, t_tip = tooth.start_roll, tooth.half_base_angle - tooth.tip
         depth = wear.depth
         if wear.profile == "uniform":
-            return WearProfile((t_start, t_tip), lambda t: np.full(np.shape(t), depth))
+            return WearProfile(active_rolls(tooth), lambda t: np.full(np.shape(t), depth))
         mesh = self.mesh
         p_b, g_f, g_a = mesh.base_pitch, mesh.approach_length, mesh.recess_length
         at, roll = self._flank(wear.gear)
@@ -793,7 +841,7 @@ class PotentialEnergyPair:
         if not isinstance(fault, Spall) or fault.is_null or fault.flank != flank:
             return None
         t_lo, t_hi = spall_rolls(tooth, fault)
-        roll = a1 + tooth.half_base_angle
+        roll = a1 - tooth.half_base_angle if tooth.internal else a1 + tooth.half_base_angle
         return np.where((roll >= t_lo) & (roll <= t_hi), fault.width, 0.0)
 
     def terms(self, position: np.ndarray, pinion: Fault | tuple | None = None,
@@ -918,6 +966,10 @@ def _check_faults(faults: tuple[object, ...], mesh: GearMesh, teeth: list[ToothM
             raise ParameterError("faults", fault,
                                  "must be RootCrack, Spall, Wear or BrokenTooth objects")
         kind = fault.kind
+        if fault.gear not in ("pinion", "wheel"):
+            raise ParameterError(f"{kind}.gear", fault.gear, "a pair's faults lie on the "
+                                 "'pinion' or the 'wheel' (sun, ring and planets: "
+                                 "PlanetaryGearSet.from_geometry)")
         z = (mesh.pinion if fault.gear == "pinion" else mesh.wheel).teeth
         if not 0 <= fault.tooth < z:
             raise ParameterError(f"{kind}.tooth", fault.tooth, f"must lie in [0, {z - 1}]")
@@ -928,10 +980,6 @@ def _check_faults(faults: tuple[object, ...], mesh: GearMesh, teeth: list[ToothM
         else:
             seen[key] = fault
         tooth = teeth[0] if fault.gear == "pinion" else teeth[1]
-        if tooth.internal and not isinstance(fault, (BrokenTooth, RootCrack)):
-            raise ParameterError(f"{kind}.gear", fault.gear,
-                                 "on the ring's teeth only a root crack or a missing tooth"
-                                 " (BrokenTooth) is modelled; put the fault on the pinion")
         if isinstance(fault, RootCrack):
             _check_crack(fault, tooth)
         elif isinstance(fault, Spall):
@@ -971,23 +1019,26 @@ def _check_spall(spall: Spall, tooth: ToothModel, width: float) -> None:
     if not spall.width < width:
         raise ParameterError("spall.width", spall.width,
                              f"must be less than the face width {width:.6g} m")
-    r_b, a2 = tooth.base_radius, tooth.half_base_angle
-    t_start, t_tip = tooth.start_roll, a2 - tooth.tip
+    r_b = tooth.base_radius
+    t_start, t_end = active_rolls(tooth)
+    sign = -1.0 if tooth.internal else 1.0  # towards the tip: inwards on a ring's tooth
 
     def along(t: float) -> float:  # from the reference circle along the involute [m]
-        return 0.5 * r_b * (t * t - tooth.pitch_roll ** 2)
+        return sign * 0.5 * r_b * (t * t - tooth.pitch_roll ** 2)
 
-    active = f"[{along(t_start):.6g}, {along(t_tip):.6g}] m from the reference circle"
-    if not along(t_start) <= spall.position <= along(t_tip):
+    lo, hi = sorted((along(t_start), along(t_end)))
+    active = f"[{lo:.6g}, {hi:.6g}] m from the reference circle"
+    if not lo <= spall.position <= hi:
         raise ParameterError("spall.position", spall.position,
                              f"off the active flank of {tooth.name}: the active profile lies"
                              f" {active}")
     t_lo, t_hi = spall_rolls(tooth, spall)
-    if not (t_lo >= t_start * (1.0 - 1e-12) and t_hi <= t_tip * (1.0 + 1e-12)):
+    if not (t_lo >= t_start * (1.0 - 1e-12) and t_hi <= t_end * (1.0 + 1e-12)):
         raise ParameterError("spall.length", spall.length,
                              f"the spall reaches off the active flank of {tooth.name}: the"
                              f" active profile lies {active}")
-    h_min = half_thickness(tooth, a2 - t_hi)
+    tip_side = t_lo if tooth.internal else t_hi
+    h_min = half_thickness(tooth, float(roll_alpha(tooth, tip_side)))
     if not spall.depth < h_min:
         raise ParameterError("spall.depth", spall.depth,
                              f"must be less than the half thickness {h_min:.4g} m at the"
@@ -1159,8 +1210,8 @@ def potential_energy_stiffness(mesh: GearMesh, *, bore_radius: object, angles: o
     An internal ``mesh`` (``mesh.internal``): the wheel is the ring, its terms (``*_wheel``)
     the ring tooth's (:func:`ring_tooth_model`); ``bore_radius``'s second value is the ring's
     outer (rim) radius; ``ring_foundation`` (:data:`RING_FOUNDATIONS`) treats the ring body
-    (``"rigid"``: ``k_fillet_wheel`` is inf). On the ring's teeth a :class:`RootCrack` and a
-    :class:`BrokenTooth` are modelled; a spall or wear there is refused.
+    (``"rigid"``: ``k_fillet_wheel`` is inf). Every fault is modelled on the ring's teeth too
+    (module docstring).
     """
     fault_list = _fault_tuple(faults, crack, "potential_energy_stiffness")
     pair = prepare_pair(mesh, bore_radius=bore_radius, young=young, poisson=poisson,

@@ -474,6 +474,29 @@ class MemberTable(BaseModel):
     radius: Quantity | None = None
 
 
+class FaultTable(BaseModel):
+    """One ``[[faults]]`` table: ``kind`` (a key of :data:`geardyn.gears.FAULT_KINDS`:
+    ``crack``, ``spall``, ``wear``, ``broken_tooth``) and that fault's fields (its class's
+    parameters, e.g. ``gear``, ``tooth``, ``depth``, ``angle`` of a
+    :class:`~geardyn.gears.RootCrack`). Checked by :meth:`build`, once the gears are known."""
+
+    model_config = ConfigDict(extra="allow", frozen=True, allow_inf_nan=False)
+
+    kind: str
+
+    def fields(self) -> dict[str, Any]:
+        """The fault's own fields (the table without ``kind``)."""
+        return dict(self.model_extra or {})
+
+    def build(self, where: tuple) -> object:
+        """The fault object; errors name ``where`` + the field (``faults[0].depth``)."""
+        cls = FAULT_KINDS.get(self.kind)
+        if cls is None:
+            raise _study_error(where + ("kind",), self.kind, "unknown fault kind; known: "
+                               + ", ".join(FAULT_KINDS))
+        return _build_from_fields(cls, self.fields(), where, f"a {self.kind} fault", "kind, ")
+
+
 class GearTable(BaseModel):
     """A ``[params.geometry.<sun|planet|ring>]`` table: one gear's teeth and profile shift
     (module, pressure angle, face width and tooth proportions default to the stage's)."""
@@ -505,6 +528,10 @@ class GeometryTable(BaseModel):
         default_factory=dict, description="the potential-energy inputs "
         "(PlanetaryGearSet.from_geometry's stiffness_options: bores, rim, material, angles)")
     coast: Literal["mirror", "symmetric"] = "mirror"  # the coast flank (from_geometry's coast)
+    faults: list[FaultTable] | None = Field(
+        None, description="[[params.geometry.faults]]: tooth faults on one gear of the set "
+        "(kind and the fault's fields; gear 'sun', 'ring' or 'planet<n>'), with stiffness = "
+        "'potential_energy': the forcing period is then that gear's revolution")
     sun: GearTable
     planet: GearTable
     ring: GearTable
@@ -704,27 +731,6 @@ class GearsTable(BaseModel):
         return ("gears", *field.split("."))
 
 
-class FaultTable(BaseModel):
-    """One ``[[faults]]`` table: ``kind`` (a key of :data:`geardyn.gears.FAULT_KINDS`:
-    ``crack``, ``spall``, ``wear``, ``broken_tooth``) and that fault's fields (its class's
-    parameters, e.g. ``gear``, ``tooth``, ``depth``, ``angle`` of a
-    :class:`~geardyn.gears.RootCrack`). Checked by :meth:`build`, once the gears are known."""
-
-    model_config = ConfigDict(extra="allow", frozen=True, allow_inf_nan=False)
-
-    kind: str
-
-    def fields(self) -> dict[str, Any]:
-        """The fault's own fields (the table without ``kind``)."""
-        return dict(self.model_extra or {})
-
-    def build(self, where: tuple) -> object:
-        """The fault object; errors name ``where`` + the field (``faults[0].depth``)."""
-        cls = FAULT_KINDS.get(self.kind)
-        if cls is None:
-            raise _study_error(where + ("kind",), self.kind, "unknown fault kind; known: "
-                               + ", ".join(FAULT_KINDS))
-        return _build_from_fields(cls, self.fields(), where, f"a {self.kind} fault", "kind, ")
 
 
 class _ClassTable(BaseModel):
@@ -1069,8 +1075,10 @@ class Study(BaseModel):
         if self.gears is None:
             for name in ("faults", "stiffness", "relief", "crowning"):
                 if getattr(self, name) is not None:
+                    where = (" (a planetary set's faults: [[params.geometry.faults]])"
+                             if name == "faults" else "")
                     raise _study_error((name,), None, "needs a [gears] table (the pair whose"
-                                       " mesh stiffness it is for)")
+                                       f" mesh stiffness it is for){where}")
             if self.params is None and self.train is None:
                 raise _study_error(("params",), None, "required (or a [gears] or [train]"
                                    " table)", "missing")

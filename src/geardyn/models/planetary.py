@@ -34,6 +34,7 @@ from geardyn.core.capabilities import Capabilities
 from geardyn.core.coefficients import CoefficientLayout
 from geardyn.core.kernel_source import KernelSource
 from geardyn.core.model import Model, unique_rows
+from geardyn.core.plan import MIN_STEPS_PER_PERIOD, STEPS_PER_FASTEST_MODE
 from geardyn.errors import ParameterError
 from geardyn.models import planetary_kernels as pk
 from geardyn.models.modal import frequency_groups
@@ -49,12 +50,15 @@ from geardyn.models.planetary_coefficients import (
     structure_entry,
     workspace_entry,
 )
+from geardyn.models.planetary_faults import place_faults
 from geardyn.models.planetary_stiffness import (
     coast_flank,
     flank_series,
     mirrored,
     potential_energy_options,
     potential_energy_tables,
+    revolution_stiffness,
+    series_error,
     stiffness_method,
 )
 from geardyn.models.stiffness import fourier_coefficients
@@ -103,7 +107,8 @@ def planetary_layout(dofs: tuple[str, ...], mesh_names: tuple[str, ...], nh: int
 CENTRAL = ("carrier", "ring", "sun")
 _SHORT = {"carrier": "c", "ring": "r", "sun": "s"}
 #: Constructor inputs that fix the model's layout or are not numbers: not swept by name.
-_NOT_SWEPT = {"n_planets", "waveform", "coast_waveform", "harmonics", "rotational_only", "fixed",
+_NOT_SWEPT = {"n_planets", "waveform", "coast_waveform", "harmonics", "mesh_order",
+              "rotational_only", "fixed",
               "centrifugal_preload", "planet_angles", "sun", "ring", "carrier", "planet",
               "time_scale", "length_scale"}
 
@@ -160,7 +165,7 @@ _COAST_FROM_GEOMETRY = ("sun_coast_stiffness", "ring_coast_stiffness", "coast_wa
 
 #: Attributes :meth:`PlanetaryGearSet.from_geometry` attaches, kept by ``with_params``.
 _FROM_BUILD = ("geometry", "stiffness_waveforms", "stiffness_tables", "stiffness_method", "held",
-               "coast_flank")
+               "coast_flank", "faults", "mesh_tables")
 #: The sweep parameter of a set built from geometry: the input member's speed [rpm].
 INPUT_SPEED = "input_speed"
 #: Units of the swept inputs, by kind (dataset axis attributes; see ``param_attrs``).
@@ -191,6 +196,17 @@ def _with_radius(name: str, member: Member, radius: float) -> Member:
     return member
 
 
+def _stiffness(field: str, value: Any, n: int) -> float | np.ndarray:
+    """A mean mesh stiffness [N/m] > 0: a float for a scalar, else one per planet."""
+    if isinstance(value, str | int | float) and not isinstance(value, bool):
+        return _si(field, value, "stiffness", strict=True)
+    out = _per_planet(field, value, n, "stiffness")
+    for i, k in enumerate(out):
+        if not k > 0.0:
+            raise ParameterError(f"{field}[{i}]", k, "must be > 0")
+    return out
+
+
 def _per_planet(field: str, value: Any, n: int, kind: str, minimum: float | None = 0.0
                 ) -> np.ndarray:
     """A scalar or a sequence of n values, in SI."""
@@ -203,9 +219,14 @@ def _per_planet(field: str, value: Any, n: int, kind: str, minimum: float | None
 
 
 def _waveform(field: str, waveform: Any, rel: np.ndarray, phase: np.ndarray, contact_ratio: float,
-              harmonics: int) -> np.ndarray:
+              harmonics: int, order: int = 1) -> np.ndarray:
     """Relative Fourier coefficients (meshes, 2 nh) [a_1, b_1, a_2, ...] of k(theta) - 1 per
-    mesh, for the mesh phase theta + phase_m."""
+    mesh, for the forcing phase theta + phase_m / ``order`` (``phase`` in rad of the mesh cycle,
+    ``order`` mesh cycles per forcing period)."""
+    if isinstance(waveform, str) and order != 1:
+        raise ParameterError(field, waveform, f"is a wave over one mesh cycle; with mesh_order "
+                             f"{order} give the relative Fourier coefficients in the forcing "
+                             "angle")
     if isinstance(waveform, str):
         if waveform not in ("sine", "rectangular"):
             raise ParameterError(field, waveform, "must be 'sine', 'rectangular' or a pair "
@@ -228,25 +249,33 @@ def _waveform(field: str, waveform: Any, rel: np.ndarray, phase: np.ndarray, con
         raise ParameterError(field, waveform, "a and b must be finite, of equal length >= 1")
     h = np.arange(1, a0.size + 1)
     out = np.zeros((rel.size, 2 * a0.size))
-    for m in range(rel.size):  # the waveform shifted by phase_m: harmonic h turns by h phase_m
-        cs, sn = np.cos(h * phase[m]), np.sin(h * phase[m])
+    for m in range(rel.size):  # shifted by phase_m / order: harmonic h turns by h phase_m / order
+        turn = h * phase[m] if order == 1 else h * (phase[m] / order)
+        cs, sn = np.cos(turn), np.sin(turn)
         out[m, 0::2] = a0 * cs + b0 * sn
         out[m, 1::2] = b0 * cs - a0 * sn
     return out
 
 
 def _waveforms(field: str, waveform: Any, rel: np.ndarray, phase: np.ndarray,
-               contact_ratio: float, harmonics: int) -> np.ndarray:
+               contact_ratio: float, harmonics: int, order: int = 1) -> np.ndarray:
     """:func:`_waveform`, or for a mapping ``{"sun": (a, b), "ring": (a, b)}`` one pair of
-    relative Fourier coefficients per mesh group (the shorter padded with zeros)."""
+    relative Fourier coefficients per mesh group, for a mapping ``{"s1": (a, b), ..., "rN":
+    (a, b)}`` one per mesh (the shorter padded with zeros)."""
     if not isinstance(waveform, Mapping):
-        return _waveform(field, waveform, rel, phase, contact_ratio, harmonics)
-    if set(waveform) != {"sun", "ring"}:
-        raise ParameterError(field, dict(waveform), "a mapping needs exactly the keys 'sun' "
-                             "and 'ring', each a pair (a, b) of relative Fourier coefficients")
+        return _waveform(field, waveform, rel, phase, contact_ratio, harmonics, order)
     n = rel.size // 2
+    meshes = [f"s{i + 1}" for i in range(n)] + [f"r{i + 1}" for i in range(n)]
+    if set(waveform) == set(meshes):
+        groups = [(m, slice(i, i + 1)) for i, m in enumerate(meshes)]
+    elif set(waveform) == {"sun", "ring"}:
+        groups = [("sun", slice(0, n)), ("ring", slice(n, None))]
+    else:
+        raise ParameterError(field, dict(waveform), "a mapping needs exactly the keys 'sun' "
+                             "and 'ring', or one per mesh ('s1' .. 'rN'), each a pair (a, b) "
+                             "of relative Fourier coefficients")
     parts = [_waveform(f"{field}.{g}", waveform[g], rel[sl], phase[sl], contact_ratio,
-                       harmonics) for g, sl in (("sun", slice(0, n)), ("ring", slice(n, None)))]
+                       harmonics, order) for g, sl in groups]
     width = max(p.shape[1] for p in parts)
     return np.vstack([np.pad(p, ((0, 0), (0, width - p.shape[1]))) for p in parts])
 
@@ -275,11 +304,15 @@ def _clean(A: np.ndarray, rel: float = 1e-12) -> np.ndarray:
 
 
 def _minimum_relative_stiffness(coef: np.ndarray) -> float:
-    theta = np.linspace(0.0, 2.0 * math.pi, 2048, endpoint=False)
-    h = np.arange(1, coef.shape[1] // 2 + 1)[:, None]
-    C, S = np.cos(h * theta), np.sin(h * theta)
-    k = 1.0 + coef[:, 0::2] @ C + coef[:, 1::2] @ S
-    return float(k.min()) if k.size else 1.0
+    """The least relative stiffness 1 + sum a_h cos(h theta) + b_h sin(h theta) of any mesh
+    (rows of ``coef``: a_1, b_1, ...) at max(2048, 4 nh) uniform phases (one inverse FFT)."""
+    if coef.size == 0:
+        return 1.0
+    nh = coef.shape[1] // 2
+    n = max(2048, 4 * nh)
+    spectrum = np.zeros((coef.shape[0], n // 2 + 1), dtype=complex)
+    spectrum[:, 1:nh + 1] = 0.5 * n * (coef[:, 0::2] - 1j * coef[:, 1::2])
+    return float(1.0 + np.fft.irfft(spectrum, n, axis=1).min())
 
 
 class PlanetaryGearSet(Model):
@@ -301,26 +334,29 @@ class PlanetaryGearSet(Model):
     sun, ring, carrier, planet
         :class:`Member` data (the planet's ``bearing_stiffness`` is its bearing on the carrier).
     sun_mesh_stiffness, ring_mesh_stiffness
-        Mean mesh stiffnesses [N/m].
+        Mean mesh stiffnesses [N/m], scalar or one per planet.
     sun_stiffness_fluctuation, ring_stiffness_fluctuation
         Relative amplitude of the stiffness fluctuation (half peak-to-peak over the mean, as in
         :class:`~geardyn.Mesh`); ``waveform`` ``"sine"``, ``"rectangular"`` (``contact_ratio``,
         ``harmonics``) or a pair (a, b) of relative Fourier coefficients of k/k_mean - 1 (then
         the fluctuations are ignored), or a mapping {"sun": (a, b), "ring": (a, b)} of one
-        pair per mesh group (:meth:`from_geometry`). Mesh m's stiffness is
-        k_m (1 + w(Omega tau + phase_m)).
+        pair per mesh group (:meth:`from_geometry`), or {"s1": (a, b), ..., "rN": (a, b)} of
+        one pair per mesh. Mesh m's stiffness is k_m (1 + w(Omega tau + phase_m / mesh_order)).
     sun_coast_stiffness, ring_coast_stiffness, coast_waveform
         The coast (back) flank, acting where a mesh's deflection leaves the dead zone on the other
-        side (x < -b): its mean stiffness [N/m] (None: the drive flank's) and relative Fourier
+        side (x < -b): its mean stiffness [N/m], scalar or per planet (None: the drive flank's),
+        and relative Fourier
         coefficients, a pair (a, b) or a mapping {"sun": (a, b), "ring": (a, b)} as ``waveform``
         (None: the drive flank's), shifted by the same mesh phases. All None (default): one
         stiffness on both flanks.
     sun_mesh_phase, ring_mesh_phase
-        Mesh phases [rad of the mesh cycle], scalar or one per planet (e.g. Parker & Lin 2004).
+        Mesh phases [rad of the mesh cycle], scalar or one per planet (e.g. Parker & Lin 2004):
+        mesh m's stiffness is delayed by -phase_m / (2 pi) mesh cycles.
     sun_backlash, ring_backlash
         Backlash half-width b of each mesh [m] (dead zone), scalar or per planet.
     sun_mesh_error, ring_mesh_error, sun_error_phase, ring_error_phase
-        Transmission error e_m = E sin(Omega tau + phase_m + error_phase) [m] of each mesh.
+        Transmission error e_m = E sin(Omega tau + phase_m + error_phase) [m] of each mesh (at
+        the mesh frequency: only with ``mesh_order`` 1).
     mesh_damping, modal_damping
         Viscous damping: per mesh ratio zeta_m (c_m = 2 zeta_m sqrt(k_m m_e), m_e the equivalent
         rotational mass of the mesh's two gears; acting on the deflection rate, also in the
@@ -329,12 +365,19 @@ class PlanetaryGearSet(Model):
     sun_torque, ring_torque, carrier_torque
         Mean external torques [N m] on the members (need the member's ``radius``).
     torque_fluctuation, torque_order, torque_phase
-        The sun (input) torque fluctuates as T_s (1 + A sin(order Omega tau + phase)). An
+        The sun (input) torque fluctuates as T_s (1 + A sin(order Omega tau + phase)) (the
+        order counts the forcing frequency Omega: mesh orders times ``mesh_order``). An
         integer order is locked to the mesh phase (the phase the mesh stiffness and error take,
         0 at the start of a run or of a continued sweep's point); a non-integer order is a
         second excitation whose phase runs with the time of the run (or of the sweep's chain).
     mesh_frequency
-        Mesh frequency [rad/s] (the forcing); default omega_0 (Omega = 1).
+        Mesh frequency [rad/s]; the forcing frequency is mesh_frequency / ``mesh_order``;
+        default omega_0 (Omega = 1 / ``mesh_order``).
+    mesh_order
+        Mesh cycles per forcing period (default 1: the forcing period is one mesh cycle).
+        :meth:`from_geometry` with ``faults`` sets it to the faulty gear's teeth Z_f: the forcing
+        period is then one revolution of that gear relative to the carrier, Omega = mesh
+        frequency / (Z_f omega_0), and the waveforms are series in that revolution's angle.
     rotational_only
         The purely torsional model: member centres fixed, planets carried rigidly by the
         carrier (eta_n = u_c, zeta_n = 0).
@@ -381,8 +424,13 @@ class PlanetaryGearSet(Model):
     #: The ISO 6336-1 waves (sun, ring) of a set built from geometry with ``stiffness="iso"``.
     stiffness_waveforms: Any = None
     #: The potential-energy Datasets (sun, ring) of a set built with
-    #: ``stiffness="potential_energy"`` (None otherwise).
+    #: ``stiffness="potential_energy"`` over one mesh cycle, healthy (None otherwise).
     stiffness_tables: Any = None
+    #: Every mesh's potential-energy table (sun-planet meshes, then ring-planet; with faults
+    #: the faulty meshes' over the faulty gear's revolution), None without them.
+    mesh_tables: Any = None
+    #: The :class:`~geardyn.models.planetary_faults.FaultPlacement` of a set built with faults.
+    faults: Any = None
 
     def __init__(self, n_planets: int = 3, sun_pressure_angle: Any = "24.6 deg",
                  ring_pressure_angle: Any = "24.6 deg", *, sun: Member, ring: Member,
@@ -400,7 +448,7 @@ class PlanetaryGearSet(Model):
                  sun_torque: Any = 0.0, ring_torque: Any = 0.0, carrier_torque: Any = 0.0,
                  torque_fluctuation: float = 0.0, torque_order: float = 1.0,
                  torque_phase: float = 0.0, mesh_frequency: Any = None,
-                 rotational_only: bool = False, fixed: Sequence[str] = (),
+                 mesh_order: int = 1, rotational_only: bool = False, fixed: Sequence[str] = (),
                  carrier_speed: Any = None, carrier_speed_ratio: Any = None,
                  centrifugal_preload: bool = True, time_scale: Any = None,
                  length_scale: Any = 1e-6):
@@ -436,8 +484,12 @@ class PlanetaryGearSet(Model):
             self.psi = 2.0 * math.pi * np.arange(n) / n
         else:
             self.psi = _per_planet("planet_angles", planet_angles, n, "angle", None)
-        self.k_s = _si("sun_mesh_stiffness", sun_mesh_stiffness, "stiffness", strict=True)
-        self.k_r = _si("ring_mesh_stiffness", ring_mesh_stiffness, "stiffness", strict=True)
+        if isinstance(mesh_order, bool) or not isinstance(mesh_order, int | np.integer) \
+                or mesh_order < 1:
+            raise ParameterError("mesh_order", mesh_order, "must be a whole number >= 1")
+        self.mesh_order = int(mesh_order)
+        self.k_s = _stiffness("sun_mesh_stiffness", sun_mesh_stiffness, n)
+        self.k_r = _stiffness("ring_mesh_stiffness", ring_mesh_stiffness, n)
         per = {}
         for f, kind in (("sun_stiffness_fluctuation", "dimensionless"),
                         ("ring_stiffness_fluctuation", "dimensionless"),
@@ -456,8 +508,12 @@ class PlanetaryGearSet(Model):
             raise ParameterError("harmonics", harmonics, "must be an integer from 1 to 200")
         self.mesh_phase = both("mesh_phase")
         self.fourier = _waveforms("waveform", waveform, both("stiffness_fluctuation"),
-                                 self.mesh_phase, float(contact_ratio), harmonics)
+                                 self.mesh_phase, float(contact_ratio), harmonics,
+                                 self.mesh_order)
         if _minimum_relative_stiffness(self.fourier) <= 0.0:
+            if not isinstance(waveform, str):
+                raise ParameterError("waveform", "(coefficients)", "makes a mesh stiffness "
+                                     "negative; it must stay > 0")
             raise ParameterError("sun_stiffness_fluctuation", sun_stiffness_fluctuation,
                                  "the stiffness fluctuation makes a mesh stiffness negative; "
                                  "it must stay > 0")
@@ -465,6 +521,12 @@ class PlanetaryGearSet(Model):
                            float(contact_ratio), harmonics)
         self.backlash = both("backlash")
         self.error = both("mesh_error")
+        if self.mesh_order != 1 and np.any(self.error != 0.0):
+            field = "sun_mesh_error" if np.any(per["sun_mesh_error"] != 0.0) else \
+                "ring_mesh_error"
+            raise ParameterError(field, self.inputs[field], "acts at the forcing frequency; "
+                                 f"with mesh_order {self.mesh_order} (the forcing period a "
+                                 "revolution, not a mesh cycle) it must be 0")
         self.error_phase = both("error_phase") + self.mesh_phase
         self.mesh_damping = per["mesh_damping"]
         self.modal_damping = _si("modal_damping", modal_damping, "dimensionless")
@@ -477,22 +539,23 @@ class PlanetaryGearSet(Model):
         self.torque_order = _si("torque_order", torque_order, "dimensionless", strict=True)
         self.torque_phase = _si("torque_phase", torque_phase, "angle", None)
         self.length_scale = _si("length_scale", length_scale, "length", strict=True)
-        default_w0 = math.sqrt(self.k_s / self.members["planet"].inertia_over_r2)
+        default_w0 = math.sqrt(float(np.max(self.k_s)) / self.members["planet"].inertia_over_r2)
         self.time_scale = (default_w0 if time_scale is None
                            else _si("time_scale", time_scale, "frequency", strict=True))
         mf = self.time_scale if mesh_frequency is None else _si("mesh_frequency",
                                                                 mesh_frequency, "frequency")
-        self._build(mf / self.time_scale)
+        self._build(mf / (self.time_scale * self.mesh_order))
 
     def _coast_inputs(self, sun_k: Any, ring_k: Any, waveform: Any, contact_ratio: float,
                       harmonics: int) -> None:
         """The coast flank's mean stiffnesses ``k_s_coast``, ``k_r_coast`` [N/m] and relative
         Fourier coefficients ``fourier_coast`` (meshes, 2 nh; ``fourier`` padded with zeros to
         the same width where the two differ), see the class doc."""
-        self.k_s_coast = self.k_s if sun_k is None else _si("sun_coast_stiffness", sun_k,
-                                                            "stiffness", strict=True)
-        self.k_r_coast = self.k_r if ring_k is None else _si("ring_coast_stiffness", ring_k,
-                                                             "stiffness", strict=True)
+        n = self.n_planets
+        self.k_s_coast = self.k_s if sun_k is None else _stiffness("sun_coast_stiffness",
+                                                                   sun_k, n)
+        self.k_r_coast = self.k_r if ring_k is None else _stiffness("ring_coast_stiffness",
+                                                                    ring_k, n)
         if waveform is None:
             self.fourier_coast = self.fourier
             return
@@ -502,7 +565,7 @@ class PlanetaryGearSet(Model):
                                  "(a, b)} (None: the drive flank's)")
         zero = np.zeros(self.mesh_phase.size)
         coast = _waveforms("coast_waveform", waveform, zero, self.mesh_phase, contact_ratio,
-                           harmonics)
+                           harmonics, self.mesh_order)
         if _minimum_relative_stiffness(coast) <= 0.0:
             raise ParameterError("coast_waveform", "(coefficients)", "makes a coast-flank "
                                  "stiffness negative; it must stay > 0")
@@ -514,7 +577,8 @@ class PlanetaryGearSet(Model):
         """Mean coast-flank stiffness [N/m] of every mesh (sun-planet meshes, then
         ring-planet)."""
         n = self.n_planets
-        return np.concatenate([np.full(n, self.k_s_coast), np.full(n, self.k_r_coast)])
+        return np.concatenate([np.full(n, self.k_s_coast, dtype=float),
+                               np.full(n, self.k_r_coast, dtype=float)])
 
     def _carrier_inputs(self, speed: Any, ratio: Any, preload: Any) -> None:
         """Validate the rotating carrier's inputs (see the class doc)."""
@@ -549,8 +613,13 @@ class PlanetaryGearSet(Model):
             return self.carrier_speed
         if self.carrier_speed_ratio is None:
             return 0.0
-        mf = self.omega * self.time_scale if mesh_frequency is None else mesh_frequency
+        mf = self.mesh_frequency if mesh_frequency is None else mesh_frequency
         return self.carrier_speed_ratio * mf
+
+    @property
+    def mesh_frequency(self) -> float:
+        """The mesh frequency [rad/s]: ``mesh_order`` Omega omega_0."""
+        return self.omega * self.time_scale * self.mesh_order
 
     @property
     def omega_is_entry(self) -> bool:
@@ -593,9 +662,10 @@ class PlanetaryGearSet(Model):
                       waveform_options: Mapping[str, Any] | None = None,
                       held: str | None = None, stiffness: str = "iso",
                       stiffness_options: Mapping[str, Any] | None = None,
-                      coast: str = "mirror", **kw: Any) -> PlanetaryGearSet:
+                      coast: str = "mirror", faults: object = (),
+                      **kw: Any) -> PlanetaryGearSet:
         """The gear set of a :class:`geardyn.gears.PlanetaryGeometry` (see ``docs/planetary.md``,
-        "From gear geometry").
+        "From gear geometry" and "Tooth faults").
 
         From the geometry: ``n_planets`` and ``planet_angles``; the operating pressure angles
         of the sun-planet and ring-planet meshes; the mean mesh stiffnesses (the means of the
@@ -637,6 +707,27 @@ class PlanetaryGearSet(Model):
         with the potential-energy method the tables' own coast flank (above). ``"symmetric"``: the
         drive flank's stiffness on both flanks (no coast inputs). The choice is kept as
         :attr:`coast_flank`.
+
+        ``faults`` (with ``stiffness="potential_energy"``): one fault or a sequence
+        (:class:`~geardyn.gears.RootCrack`, :class:`~geardyn.gears.Spall`,
+        :class:`~geardyn.gears.Wear`; a :class:`~geardyn.gears.BrokenTooth` leaves no pair in
+        contact over part of its passage, a zero stiffness no series keeps positive: refused),
+        all on one gear, its
+        ``gear`` ``"sun"``, ``"ring"`` or ``"planet<n>"`` (n = 1 .. N) and ``tooth`` numbered as
+        in :mod:`geardyn.models.planetary_faults` (which also says which meshes and flanks a
+        faulty tooth takes part in). The forcing period is then one revolution of the faulty
+        gear relative to the carrier, Z_f mesh cycles (``mesh_order`` = Z_f, Omega = mesh
+        frequency / (Z_f omega_0); ``mesh_frequency``, ``input_speed`` and the sweeps' speed
+        axes stay the mesh frequency and the input speed), and every mesh's stiffness is the
+        Fourier series of its potential-energy table over that revolution in the revolution's
+        angle, ``harmonics`` x Z_f harmonics (every sideband up to mesh harmonic
+        ``harmonics``): the faulty gear's meshes from the tables with the fault, the others'
+        the healthy one-cycle series at harmonics l Z_f, each shifted by its tooth passages
+        (mesh phases in rad of the mesh cycle, unreduced for the faulty meshes). Mean
+        stiffnesses are per planet. :meth:`stiffness_error` gives the truncation error; the
+        tables are kept as :attr:`mesh_tables`, the placement as :attr:`faults`. A static
+        transmission error (``*_mesh_error``) is refused with faults (it would act once per
+        revolution).
         """
         from geardyn.gears import PlanetaryGeometry
 
@@ -649,13 +740,30 @@ class PlanetaryGearSet(Model):
                                      "(or build PlanetaryGearSet directly)")
         method = stiffness_method(stiffness, stiffness_options)
         coast = coast_flank(coast)
+        if "mesh_order" in kw:
+            raise ParameterError("mesh_order", kw["mesh_order"], "comes from the faults (the "
+                                 "faulty gear's teeth)")
+        placement = place_faults(faults, geometry)
+        if placement is not None and method != "potential_energy":
+            raise ParameterError("faults", placement.describe(), "need stiffness="
+                                 "'potential_energy' (the ISO waves know no teeth)")
         if isinstance(harmonics, bool) or not isinstance(harmonics, int) \
                 or not 1 <= harmonics <= 200:
             raise ParameterError("harmonics", harmonics, "must be an integer from 1 to 200")
-        inputs, tables, waves = _geometry_stiffness(geometry, method, stiffness_options,
-                                                    waveform_options, harmonics, coast)
         held_member = _held(held, tuple(kw.get("fixed", ())))
         phases = geometry.phases_turning(_sun_turns(held_member))
+        revolution = None
+        if placement is None:
+            inputs, tables, waves = _geometry_stiffness(geometry, method, stiffness_options,
+                                                        waveform_options, harmonics, coast)
+            inputs["sun_mesh_phase"] = [-2.0 * math.pi * float(g) for g in phases.sun]
+            inputs["ring_mesh_phase"] = [-2.0 * math.pi * float(g) for g in phases.ring]
+        else:
+            opts = potential_energy_options(stiffness_options, geometry, harmonics)
+            revolution = revolution_stiffness(geometry, opts, placement, harmonics,
+                                              _sun_turns(held_member))
+            inputs, waves = revolution.inputs(geometry.n_planets, coast), None
+            tables = revolution.healthy
         meshes = {"sun": geometry.sun_mesh, "ring": geometry.ring_mesh}
         radii = {"sun": geometry.sun.base_radius, "ring": geometry.ring.base_radius,
                  "carrier": geometry.sun_mesh.centre_distance,
@@ -675,20 +783,34 @@ class PlanetaryGearSet(Model):
         for g, mesh in meshes.items():
             kw.setdefault(f"{g}_backlash",
                           0.5 * max(mesh.backlash, 0.0) * math.cos(mesh.operating_pressure_angle))
-        model = cls(
-            n_planets=geometry.n_planets, planet_angles=list(geometry.planet_angles),
-            sun_pressure_angle=meshes["sun"].operating_pressure_angle,
-            ring_pressure_angle=meshes["ring"].operating_pressure_angle,
-            **inputs, harmonics=harmonics,
-            sun_mesh_phase=[-2.0 * math.pi * float(g) for g in phases.sun],
-            ring_mesh_phase=[-2.0 * math.pi * float(g) for g in phases.ring],
-            **members, **kw)
+        try:
+            model = cls(
+                n_planets=geometry.n_planets, planet_angles=list(geometry.planet_angles),
+                sun_pressure_angle=meshes["sun"].operating_pressure_angle,
+                ring_pressure_angle=meshes["ring"].operating_pressure_angle,
+                **inputs, harmonics=harmonics, **members, **kw)
+        except ParameterError as exc:
+            if exc.field not in ("waveform", "coast_waveform"):
+                raise
+            if placement is None:
+                raise ParameterError("harmonics", harmonics, "the series of a mesh's "
+                                     "stiffness falls to 0 or below; keep more") from None
+            raise ParameterError("faults", placement.describe(), "the stiffness series of a "
+                                 "faulty mesh falls to 0 or below (a missing tooth leaves no "
+                                 "pair in contact over its single-contact zone: not modelled; "
+                                 "otherwise keep more harmonics)") from None
         model.geometry = geometry
         model.stiffness_waveforms = waves
         model.stiffness_tables = tables
         model.stiffness_method = method
         model.coast_flank = coast
         model.held = _held(held, model.fixed)
+        model.faults = placement
+        if revolution is not None:
+            model.mesh_tables = revolution.tables
+        elif tables is not None:
+            n = geometry.n_planets
+            model.mesh_tables = (tables[0],) * n + (tables[1],) * n
         return model
 
     def dataset_attrs(self) -> dict[str, object]:
@@ -697,8 +819,46 @@ class PlanetaryGearSet(Model):
         (``"mirror"``, ``"symmetric"``)."""
         if self.geometry is None:
             return {}
-        return {"mesh_stiffness_method": self.stiffness_method,
-                "mesh_coast_flank": self.coast_flank}
+        out: dict[str, object] = {"mesh_stiffness_method": self.stiffness_method,
+                                  "mesh_coast_flank": self.coast_flank}
+        if self.faults is not None:
+            err = self.stiffness_error()
+            out.update(
+                faults=self.faults.describe(), faulty_gear=self.faults.gear,
+                mesh_cycles_per_period=self.mesh_order,
+                forcing_period=f"one revolution of {self.faults.gear} relative to the carrier "
+                               f"({self.mesh_order} mesh cycles)",
+                Omega_meaning=f"mesh frequency / ({self.mesh_order} time_scale)",
+                stiffness_harmonics=self.fourier.shape[1] // 2,
+                stiffness_rms_error_rel=max(err["drive_rms"], err["coast_rms"]))
+        return out
+
+    def stiffness_error(self) -> dict[str, float]:
+        """A potential-energy set's stiffness series against its tables at the tables' angles
+        (every mesh, relative to its mean stiffness; :func:`~geardyn.models.planetary_stiffness.
+        series_error`): ``drive_max``, ``drive_rms``, ``coast_max``, ``coast_rms`` (the coast
+        flank's with ``coast="mirror"``, else 0), the largest over the meshes. The maximum sits
+        at the tables' jumps (a tooth pair entering or leaving contact), the rms falls as the
+        harmonics grow."""
+        if self.mesh_tables is None:
+            raise ParameterError("stiffness_method", self.stiffness_method,
+                                 "the series error needs the potential-energy tables")
+        out = {"drive_max": 0.0, "drive_rms": 0.0, "coast_max": 0.0, "coast_rms": 0.0}
+        flanks = [("drive", "mesh_stiffness", self.fourier, self.mesh_stiffnesses())]
+        if self.coast_flank == "mirror":
+            flanks.append(("coast", "mesh_stiffness_coast", self.fourier_coast,
+                           self.coast_stiffnesses()))
+        for flank, var, coef, mean in flanks:
+            for m, table in enumerate(self.mesh_tables):
+                cyc = table["cycle"].values
+                cycles = int(round(float(cyc[-1] + cyc[1] - cyc[0])))
+                e = series_error(table[var].values, cycles, float(mean[m]), coef[m],
+                                 -self.mesh_phase[m] / (2.0 * math.pi), self.mesh_order)
+                out[f"{flank}_max"] = max(out[f"{flank}_max"],
+                                          float(np.max(np.abs(e))) / float(mean[m]))
+                out[f"{flank}_rms"] = max(out[f"{flank}_rms"],
+                                          float(np.sqrt(np.mean(e * e))) / float(mean[m]))
+        return out
 
     # ------------------------------------------------------------------ input speed
     @property
@@ -723,7 +883,7 @@ class PlanetaryGearSet(Model):
     @property
     def input_speed(self) -> float:
         """The input member's speed [rpm] at the model's mesh frequency (set from geometry)."""
-        w = self.omega * self.time_scale / self.mesh_frequency_per_input_speed()
+        w = self.mesh_frequency / self.mesh_frequency_per_input_speed()
         return w * 60.0 / (2.0 * math.pi)
 
     def param_attrs(self, name: str) -> dict[str, str]:
@@ -737,7 +897,11 @@ class PlanetaryGearSet(Model):
         if name == "mesh_frequency":
             return {"units": "rad/s", "long_name": "mesh frequency"}
         if name == "Omega":
-            return {}
+            if self.mesh_order == 1:
+                return {}
+            return {"units": "1", "long_name": "forcing frequency / time_scale",
+                    "meaning": f"mesh frequency / ({self.mesh_order} time_scale): one forcing "
+                               f"period is {self.mesh_order} mesh cycles"}
         unit = _UNITS.get(name) or next((u for suffix, u in _UNIT_SUFFIXES
                                          if name.endswith(suffix)), None)
         if unit is None and name in self.inputs and name not in _NOT_SWEPT:
@@ -747,7 +911,7 @@ class PlanetaryGearSet(Model):
     def speed_axes(self, omega: np.ndarray) -> dict[str, tuple[np.ndarray, dict]]:
         """Mesh frequency [Hz] and, for a set built from geometry, input speed [rpm] at the
         dimensionless mesh frequencies ``omega`` (coordinates along Omega)."""
-        w = np.asarray(omega, dtype=float) * self.time_scale
+        w = np.asarray(omega, dtype=float) * self.time_scale * self.mesh_order
         out = {"mesh_frequency": (w / (2.0 * math.pi),
                                   {"units": "Hz", "long_name": "mesh frequency"})}
         if self.geometry is not None:
@@ -851,7 +1015,8 @@ class PlanetaryGearSet(Model):
     def mesh_stiffnesses(self) -> np.ndarray:
         """Mean stiffness [N/m] of every mesh (sun-planet meshes, then ring-planet)."""
         n = self.n_planets
-        return np.concatenate([np.full(n, self.k_s), np.full(n, self.k_r)])
+        return np.concatenate([np.full(n, self.k_s, dtype=float),
+                               np.full(n, self.k_r, dtype=float)])
 
     def stiffness_matrix(self, meshes: bool = True) -> np.ndarray:
         """K [N/m] in the model's coordinates at mean mesh stiffness (no backlash); without the
@@ -886,7 +1051,7 @@ class PlanetaryGearSet(Model):
         out = []
         for k, gear in ((self.k_s, "sun"), (self.k_r, "ring")):
             jg = self.members[gear].inertia_over_r2
-            out.append(np.full(self.n_planets, 2.0 * math.sqrt(k * jg * jp / (jg + jp))))
+            out.append(np.full(self.n_planets, 2.0 * np.sqrt(k * jg * jp / (jg + jp))))
         return np.concatenate(out) * np.tile(self.mesh_damping, 2)
 
     def _forces(self) -> np.ndarray:
@@ -919,7 +1084,7 @@ class PlanetaryGearSet(Model):
         p[pk.N_DOF], p[pk.N_MESH], p[pk.N_HARM] = n, nm, nh
         F = self._forces()
         K, C = self.stiffness_matrix(False), self._damping_matrix()
-        wc = self.carrier_omega(omega * w0)
+        wc = self.carrier_omega(omega * w0 * self.mesh_order)
         if wc != 0.0:  # the rotating carrier (see rotating_frame_matrices); G: the gyro section
             K = _clean(K - wc * wc * K_omega)
             F = F.copy()
@@ -1028,7 +1193,8 @@ class PlanetaryGearSet(Model):
             if "mesh_frequency" in values or INPUT_SPEED in values:
                 raise ParameterError("Omega", om, "sets the mesh frequency: give it, "
                                      "mesh_frequency or input_speed, one of them")
-            out = self.with_params(mesh_frequency=om * self.time_scale, **values)
+            out = self.with_params(mesh_frequency=om * self.time_scale * self.mesh_order,
+                                   **values)
             out.params[pk.OMEGA] = om
             return out
         if INPUT_SPEED in values:
@@ -1048,7 +1214,7 @@ class PlanetaryGearSet(Model):
             kw = {**self.inputs, "time_scale": self.time_scale,
                   "length_scale": self.length_scale, **physical}
             if "mesh_frequency" not in physical:
-                kw["mesh_frequency"] = self.omega * self.time_scale
+                kw["mesh_frequency"] = self.mesh_frequency
             out = type(self)(**kw)
             if "mesh_frequency" not in physical:  # Omega as it was, not (Omega w0) / w0
                 out.params[pk.OMEGA] = self.omega
@@ -1139,13 +1305,24 @@ class PlanetaryGearSet(Model):
         rows, inverse = unique_rows(P)
         A = self._lane_matrix(rows, stiffest=True)
         if self.carrier_speed is None and self.carrier_speed_ratio is None:
-            return np.sqrt(np.max(np.abs(np.linalg.eigvals(A)), axis=1))[inverse]
+            return self._mesh_floor(P, np.sqrt(np.max(np.abs(np.linalg.eigvals(A)),
+                                                      axis=1))[inverse])
         # a rotating carrier: |lambda| of the first-order matrix with Ct (gyroscopic, damping)
         n, lay = A.shape[1], self._layout
         Ct = rows[:, lay["Ct"]:lay["Ct"] + n * n].reshape(-1, n, n) + self._gyro_ct(rows)
         Z, eye = np.zeros_like(A), np.broadcast_to(np.eye(n), A.shape)
         first = np.concatenate([np.concatenate([Z, eye], 2), np.concatenate([-A, -Ct], 2)], 1)
-        return np.max(np.abs(np.linalg.eigvals(first)), axis=1)[inverse]
+        return self._mesh_floor(P, np.max(np.abs(np.linalg.eigvals(first)), axis=1)[inverse])
+
+    def _mesh_floor(self, P: np.ndarray, w: np.ndarray) -> np.ndarray:
+        """``w``, or with ``mesh_order`` > 1 at least the frequency that gives every mesh cycle
+        as many steps as a one-mesh-cycle period gets at the least (MIN_STEPS_PER_PERIOD): the
+        step then resolves the mesh harmonics as in the set built over one mesh cycle."""
+        if self.mesh_order == 1:
+            return w
+        floor = (self.mesh_order * P[:, pk.OMEGA] * MIN_STEPS_PER_PERIOD
+                 / STEPS_PER_FASTEST_MODE)
+        return np.maximum(w, floor)
 
     def other_frequencies(self, P: np.ndarray) -> np.ndarray:
         """The torque fluctuation's frequency order * Omega where it acts and differs from the

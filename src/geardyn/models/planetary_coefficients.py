@@ -26,7 +26,8 @@ def workspace_entry(name: str, meaning: str, constant: str | None = None) -> Coe
 _MASSES = ("mass", "inertia_over_r2")
 #: The header of the coefficient vector (offsets: :mod:`planetary_kernels`' constants).
 HEADER = CoefficientBlock((
-    Coefficient("Omega", "1", "mesh frequency / omega_0"),
+    Coefficient("Omega", "1", "forcing frequency / omega_0: the mesh frequency / (mesh_order "
+                "omega_0), mesh_order 1 unless a tooth fault makes the period a revolution"),
     structure_entry("n_dof", "number of coordinates"),
     structure_entry("n_meshes", "number of meshes", constant="N_MESH"),
     structure_entry("n_harmonics", "number of stiffness harmonics", constant="N_HARM"),

@@ -182,3 +182,113 @@ def flank_series(table: np.ndarray, harmonics: int) -> FlankSeries:
     b = -2.0 * F[1:harmonics + 1].imag / k0
     return FlankSeries(k0, a, b)
 
+
+
+def embedded(series: FlankSeries, order: int, harmonics: int) -> FlankSeries:
+    """A one-mesh-cycle series as a series in the revolution angle of ``order`` mesh cycles:
+    mesh harmonic l at harmonic l ``order``, ``harmonics`` (a multiple of ``order``) in all."""
+    a, b = np.zeros(harmonics), np.zeros(harmonics)
+    count = min(series.a.size, harmonics // order)
+    a[order - 1::order][:count] = series.a[:count]
+    b[order - 1::order][:count] = series.b[:count]
+    return FlankSeries(series.mean, a, b)
+
+
+@dataclass(frozen=True)
+class RevolutionStiffness:
+    """The potential-energy stiffness of a set with a faulty gear over one revolution of that
+    gear relative to the carrier (:mod:`geardyn.models.planetary_faults`): per mesh (sun-planet
+    meshes, then ring-planet) its table over ``order`` mesh cycles (``tables``; a healthy mesh's
+    one-cycle table repeated), its shift [mesh cycles] and its drive and coast series, unshifted,
+    in the revolution angle (``harmonics`` = mesh harmonics x ``order``); ``healthy`` the healthy
+    one-cycle tables (sun-planet, planet-ring)."""
+
+    order: int
+    harmonics: int
+    tables: tuple[Any, ...]
+    healthy: tuple[Any, Any]
+    shifts: np.ndarray
+    drive: tuple[FlankSeries, ...]
+    coast: tuple[FlankSeries, ...]
+
+    def inputs(self, n_planets: int, coast: str) -> dict[str, Any]:
+        """The :class:`~geardyn.PlanetaryGearSet` inputs: per-planet mean stiffnesses, one
+        series per mesh (``waveform``, ``coast_waveform`` keyed by mesh name), the shifts as
+        mesh phases (-2 pi delta, in rad of the mesh cycle) and ``mesh_order``."""
+        names = [f"s{i + 1}" for i in range(n_planets)] + [f"r{i + 1}" for i in
+                                                            range(n_planets)]
+        sun, ring = slice(0, n_planets), slice(n_planets, None)
+        out: dict[str, Any] = {
+            "mesh_order": self.order,
+            "sun_mesh_stiffness": [s.mean for s in self.drive[sun]],
+            "ring_mesh_stiffness": [s.mean for s in self.drive[ring]],
+            "waveform": {m: s.pair for m, s in zip(names, self.drive, strict=True)},
+            "sun_mesh_phase": list(-2.0 * np.pi * self.shifts[sun]),
+            "ring_mesh_phase": list(-2.0 * np.pi * self.shifts[ring]),
+        }
+        if coast == "mirror":
+            out["sun_coast_stiffness"] = [s.mean for s in self.coast[sun]]
+            out["ring_coast_stiffness"] = [s.mean for s in self.coast[ring]]
+            out["coast_waveform"] = {m: s.pair for m, s in zip(names, self.coast, strict=True)}
+        return out
+
+
+def revolution_stiffness(geometry: Any, opts: PotentialEnergyOptions, placement: Any,
+                         harmonics: int, sun_turns: int) -> RevolutionStiffness:
+    """The :class:`RevolutionStiffness` of ``geometry`` with the faults of ``placement`` (a
+    :class:`~geardyn.models.planetary_faults.FaultPlacement`), ``harmonics`` mesh harmonics
+    (every sideband up to the last: ``harmonics`` x Z_f in the revolution angle)."""
+    from geardyn.gears.potential_energy import potential_energy_stiffness
+    from geardyn.models.planetary_faults import mesh_shifts
+
+    order = placement.teeth
+    n_h = harmonics * order
+    common = dict(angles=opts.angles, young=opts.young, poisson=opts.poisson,
+                  nodes=opts.nodes, root_segment=opts.root_segment)
+    bores = {"sun": (opts.sun_bore_radius, opts.planet_bore_radius),
+             "ring": (opts.planet_bore_radius, opts.ring_rim_radius)}
+    meshes = {"sun": geometry.sun_mesh, "ring": geometry.ring_mesh}
+    extra = {"sun": {}, "ring": {"ring_foundation": "rigid"}}
+    faults = {"sun": placement.sun_faults, "ring": placement.ring_faults}
+    n = geometry.n_planets
+    tables, drive, coast, healthy_tables = [], [], [], []
+    for g in ("sun", "ring"):
+        healthy = potential_energy_stiffness(meshes[g], bore_radius=bores[g], **common,
+                                             **extra[g])
+        healthy_tables.append(healthy)
+        faulty = (potential_energy_stiffness(meshes[g], bore_radius=bores[g], faults=faults[g],
+                                             cycles=order, **common, **extra[g])
+                  if faults[g] else None)
+        for i in range(n):
+            hit = faulty is not None and placement.planet in (None, i)
+            if hit:
+                tables.append(faulty)
+                drive.append(flank_series(faulty["mesh_stiffness"].values, n_h))
+                coast.append(flank_series(faulty["mesh_stiffness_coast"].values, n_h))
+            else:
+                tables.append(healthy)
+                drive.append(embedded(flank_series(healthy["mesh_stiffness"].values,
+                                                   harmonics), order, n_h))
+                coast.append(embedded(flank_series(healthy["mesh_stiffness_coast"].values,
+                                                   harmonics), order, n_h))
+    sun, ring = mesh_shifts(geometry, sun_turns, placement)
+    return RevolutionStiffness(order, n_h, tuple(tables), tuple(healthy_tables),
+                               np.concatenate([sun, ring]), tuple(drive), tuple(coast))
+
+
+def series_error(table: np.ndarray, cycles: int, mean: float, coefficients: np.ndarray,
+                 shift: float, order: int) -> np.ndarray:
+    """The mesh's series against its table [N/m] at the table's angles: ``table`` uniform over
+    ``cycles`` mesh cycles (repeated to ``order`` cycles when shorter), the mesh's series k0 (1 +
+    sum a_h cos(h Theta) + b_h sin(h Theta)) in the forcing angle Theta = 2 pi c / ``order``
+    (``coefficients`` [a_1, b_1, ...], shifted by ``shift`` mesh cycles: K(c) = T(c - shift)),
+    evaluated at c = shift + the table's cycles by one inverse FFT."""
+    t = np.tile(np.asarray(table, dtype=float), order // cycles)
+    n = t.size
+    a, b = coefficients[0::2], coefficients[1::2]
+    h = np.arange(1, a.size + 1)
+    spectrum = np.zeros(n // 2 + 1, dtype=complex)
+    spectrum[0] = mean * n
+    turn = np.exp(1j * 2.0 * np.pi * h * shift / order)
+    spectrum[1:a.size + 1] = 0.5 * n * mean * (a - 1j * b) * turn
+    return np.fft.irfft(spectrum, n) - t

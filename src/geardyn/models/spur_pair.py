@@ -292,6 +292,10 @@ class SpurPair(Model):
             raise ParameterError("mesh", mesh, "must be a geardyn.gears.GearMesh")
         listed = tuple(faults) if isinstance(faults, (list, tuple)) else (faults,)
         gears = sorted({getattr(f, "gear", None) for f in listed} - {None})
+        for f in listed:
+            if getattr(f, "gear", "pinion") not in ("pinion", "wheel"):
+                raise ParameterError(f"{f.kind}.gear", f.gear, "a pair's faults lie on the "
+                                     "'pinion' or the 'wheel'")
         if len(gears) > 1:
             raise ParameterError("faults", faults, "faults on both gears: SpurPair's period is"
                                  " one revolution of the one faulty gear")

@@ -1,0 +1,179 @@
+"""Tooth faults of a planetary gear set built from its geometry
+(:meth:`geardyn.PlanetaryGearSet.from_geometry` with ``faults``): where a faulty tooth meets
+which mesh, and when.
+
+A fault (:mod:`geardyn.gears.faults`) sits on tooth ``tooth`` of ``gear``: ``"sun"``,
+``"ring"`` or ``"planet<n>"`` (n = 1 .. N, the planet at the n-th planet angle psi_n). All the
+faults of a set lie on one gear, whose revolution relative to the carrier, Z_f mesh cycles
+(Z_f its teeth), is then the forcing period: every mesh's stiffness is a Fourier series in that
+revolution's angle Theta = 2 pi c / Z_f (c: mesh cycles since the start), mesh harmonic l at
+harmonic l Z_f, its sidebands between.
+
+Tooth numbers (the carrier frame; s = +1 when the sun turns in the sense of psi relative to the
+carrier, -1 when against it; rel_n = psi_n - psi_1; gamma: the Parker & Lin phases of
+:func:`geardyn.gears.mesh_phases`):
+
+* sun tooth j passes the pitch point of the sun-planet mesh of planet 1 at c = j, of planet n
+  at c = j + s Z_s rel_n / (2 pi) (mod Z_s);
+* ring tooth j passes the pitch point of the ring-planet mesh of planet 1 at c = gamma_r1 + j,
+  of planet n at c = gamma_rs + j - s Z_r rel_n / (2 pi) (mod Z_r);
+* tooth j of planet n passes the sun-side pitch point at c = gamma_sn + j and the ring-side one
+  D = Z_p / 2 - Z_p (psi_s + psi_r) / (4 pi) mesh cycles later (half a planet turn less half
+  the tooth's angular thicknesses psi_s, psi_r at its two operating pitch radii: the sun loads
+  the tooth's trailing flank, the tooth the ring with its leading one; D mod 1 is gamma_rs).
+
+Reduced mod 1 these are the Parker & Lin phases, so a healthy set built over the revolution is
+the one-mesh-cycle set.
+
+Which meshes a faulty tooth takes part in: a sun tooth meets every sun-planet mesh, a ring tooth
+every ring-planet mesh (each once per revolution, at the times above), a tooth of planet n the
+sun-planet and the ring-planet mesh of planet n. A planet tooth meets the sun with one flank
+and the ring with the other: in forward drive the sun loads its trailing flank (the sun-planet
+mesh's drive flank) and the tooth loads the ring with its leading flank (the ring-planet mesh's
+drive flank, which is the sun-planet mesh's coast flank). So
+
+* a root crack (its faces open under either flank's load) weakens both of planet n's meshes
+  (a missing tooth would take out both, but leaves no pair in contact over part of its
+  passage: :meth:`~geardyn.PlanetaryGearSet.from_geometry` refuses the zero stiffness);
+* a spall or wear on the planet tooth's ``flank`` ``"drive"`` (the flank the sun drives; the
+  ring meets it on reversal, the ring-planet mesh's coast flank) narrows the contacts and opens
+  the gap of that flank only: the sun-planet mesh's drive contacts and the ring-planet mesh's
+  coast contacts; ``"coast"`` the other flank (the sun-planet mesh's coast contacts and the
+  ring-planet mesh's drive contacts). The thinned sections of the tooth soften the contacts of
+  both flanks, so both meshes feel them (as on a pair's tooth, :mod:`geardyn.gears.faults`);
+* Archard wear on a planet is refused (its profile follows one mesh's sliding; the tables of
+  the two meshes would each derive their own), uniform wear is taken;
+* on the sun the flanks are the sun-planet mesh's, on the ring the ring-planet mesh's.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, replace
+from typing import Any
+
+import numpy as np
+
+from geardyn.errors import ParameterError
+from geardyn.gears.faults import BrokenTooth, RootCrack, Spall, Wear, planet_number
+
+_KINDS = (RootCrack, Spall, Wear, BrokenTooth)
+_OTHER_FLANK = {"drive": "coast", "coast": "drive"}
+
+
+@dataclass(frozen=True)
+class FaultPlacement:
+    """The faults of a set on one gear: ``member`` (``"sun"``, ``"planet"``, ``"ring"``),
+    ``planet`` (0-based index of the faulty planet, None otherwise), ``teeth`` Z_f (mesh cycles
+    per forcing period), the faults as given and as the pair tables take them: ``sun_faults``
+    on the sun-planet mesh (pinion the sun, wheel the planet), ``ring_faults`` on the
+    planet-ring mesh (pinion the planet, wheel the ring)."""
+
+    member: str
+    planet: int | None
+    teeth: int
+    faults: tuple[Any, ...]
+    sun_faults: tuple[Any, ...]
+    ring_faults: tuple[Any, ...]
+
+    @property
+    def gear(self) -> str:
+        """The faulty gear's name as the faults give it (``"sun"``, ``"planet2"``, ...)."""
+        return self.member if self.planet is None else f"planet{self.planet + 1}"
+
+    def describe(self) -> str:
+        """One line for the model's attrs."""
+        return "; ".join(f.describe() for f in self.faults)
+
+
+def _listed(faults: object) -> tuple[Any, ...]:
+    if faults is None:
+        return ()
+    if isinstance(faults, Sequence) and not isinstance(faults, str):
+        return tuple(faults)
+    return (faults,)
+
+
+def place_faults(faults: object, geometry: Any) -> FaultPlacement | None:
+    """The :class:`FaultPlacement` of ``faults`` (one fault or a sequence) on the gears of
+    ``geometry`` (a :class:`~geardyn.gears.PlanetaryGeometry`), None without faults. Errors name
+    the fault's field: ``<kind>.gear`` (not a gear of the set, a planet beyond N),
+    ``<kind>.tooth`` (beyond the gear's teeth), ``wear.profile`` (Archard wear on a planet), or
+    ``faults`` (not a fault, faults on more than one gear)."""
+    listed = _listed(faults)
+    if not listed:
+        return None
+    n = geometry.n_planets
+    where: dict[str, Any] = {}
+    for fault in listed:
+        if not isinstance(fault, _KINDS):
+            raise ParameterError("faults", fault,
+                                 "must be RootCrack, Spall, Wear or BrokenTooth objects")
+        kind, gear = fault.kind, fault.gear
+        number = planet_number(gear)
+        if gear not in ("sun", "ring") and number is None:
+            raise ParameterError(f"{kind}.gear", gear, "must be 'sun', 'ring' or 'planet1' .. "
+                                 f"'planet{n}' (a gear of the set)")
+        if number is not None and not 1 <= number <= n:
+            raise ParameterError(f"{kind}.gear", gear, f"the set has {n} planets: 'planet1' .."
+                                 f" 'planet{n}'")
+        z = {"sun": geometry.sun, "ring": geometry.ring}.get(gear, geometry.planet).teeth
+        if not 0 <= fault.tooth < z:
+            raise ParameterError(f"{kind}.tooth", fault.tooth,
+                                 f"must lie in [0, {z - 1}] ({gear} has {z} teeth)")
+        if number is not None and isinstance(fault, Wear) and fault.profile != "uniform":
+            raise ParameterError("wear.profile", fault.profile, "Archard's profile follows one "
+                                 "mesh's sliding, and a planet's flank meets two (the sun and, "
+                                 "on reversal, the ring): give uniform wear on a planet")
+        where[gear] = fault
+    if len(where) > 1:
+        raise ParameterError("faults", ", ".join(sorted(where)),
+                             "faults on more than one gear: the forcing period is one "
+                             "revolution of the one faulty gear")
+    gear = next(iter(where))
+    number = planet_number(gear)
+    if gear == "sun":
+        sun = tuple(replace(f, gear="pinion") for f in listed)
+        return FaultPlacement("sun", None, geometry.sun.teeth, listed, sun, ())
+    if gear == "ring":
+        ring = tuple(replace(f, gear="wheel") for f in listed)
+        return FaultPlacement("ring", None, geometry.ring.teeth, listed, (), ring)
+    sun = tuple(replace(f, gear="wheel") for f in listed)
+    ring = tuple(replace(f, gear="pinion", flank=_OTHER_FLANK[f.flank])
+                 if isinstance(f, (Spall, Wear)) else replace(f, gear="pinion")
+                 for f in listed)
+    return FaultPlacement("planet", number - 1, geometry.planet.teeth, listed, sun, ring)
+
+
+def planet_passage_delay(geometry: Any) -> float:
+    """D [mesh cycles]: how long after a planet tooth passes the sun-side pitch point it passes
+    the ring-side one, Z_p / 2 - Z_p (psi_s + psi_r) / (4 pi) (module docstring; D mod 1 is
+    gamma_rs)."""
+    planet = geometry.planet
+    psi_s = planet.angular_thickness(geometry.sun_mesh.operating_pitch_radii[1])
+    psi_r = planet.angular_thickness(geometry.ring_mesh.operating_pitch_radii[0])
+    z = planet.teeth
+    return 0.5 * z - z * (psi_s + psi_r) / (4.0 * math.pi)
+
+
+def mesh_shifts(geometry: Any, sun_turns: int, placement: FaultPlacement | None
+                ) -> tuple[np.ndarray, np.ndarray]:
+    """The shifts delta [mesh cycles] of every sun-planet and ring-planet mesh: mesh m's
+    stiffness is K_m(c) = T_m(c - delta_m), T_m its table (tooth 0 of either gear at the pitch
+    point at c = 0). Without faults the Parker & Lin phases gamma; a faulty gear's meshes take
+    the unreduced passage times of the module docstring (mod Z_f)."""
+    ph = geometry.phases_turning(sun_turns)
+    sun, ring = np.array(ph.sun, dtype=float), np.array(ph.ring, dtype=float)
+    if placement is None:
+        return sun, ring
+    rel = np.asarray(geometry.planet_angles, dtype=float) - geometry.planet_angles[0]
+    z = placement.teeth
+    if placement.member == "sun":
+        sun = np.mod(sun_turns * geometry.sun.teeth * rel / (2.0 * math.pi), z)
+    elif placement.member == "ring":
+        ring = np.mod(ph.sun_ring - sun_turns * geometry.ring.teeth * rel / (2.0 * math.pi), z)
+    else:
+        p = placement.planet
+        ring[p] = (sun[p] + planet_passage_delay(geometry)) % z
+    return sun, ring
