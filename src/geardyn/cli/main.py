@@ -266,8 +266,11 @@ def simulate(
     study: Annotated[str, typer.Argument(help="Study TOML file or built-in study name.")],
     omega: Annotated[
         float | None,
-        typer.Option(help="Mesh frequency Omega = omega/omega_n (default: the study's run.omega; "
-                          "a spur_pair study's: from its params.speed)."),
+        typer.Option(help="Forcing frequency Omega, dimensionless (the mesh frequency over the "
+                          "model's frequency scale, or a revolution's where a tooth fault sets "
+                          "the forcing period: the dataset's Omega attributes say which; "
+                          "default: the study's run.omega; a spur_pair study's: from its "
+                          "params.speed)."),
     ] = None,
     transient: run_option("transient", "default: run.transient") = None,
     periods: run_option("samples", "forcing periods recorded; default: run.periods",
@@ -281,7 +284,7 @@ def simulate(
     out: NetCDFOutOption = None,
     plot: PlotOption = None,
 ) -> None:
-    """Simulate a study at one mesh frequency; save the time history and a figure."""
+    """Simulate a study at one forcing frequency; save the time history and a figure."""
     from geardyn.io.netcdf import save_dataset
     from geardyn.plotting.simulation import count_distinct
     from geardyn.solvers.simulate import simulate as run_simulation
