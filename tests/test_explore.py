@@ -403,11 +403,13 @@ def _spur_model_by_hand(*faults, pinion_bore="12 mm"):
 
 
 def test_a_geometry_model_offers_its_faults_and_bores_as_controls(spur):
-    """The controls of the cracked pair: the bores, then the crack's numeric fields (from the
-    RootCrack dataclass: depth, angle, tooth), by their study-file keys, with the study's
-    values; a gear-pair study has none."""
+    """The controls of the cracked pair: the bores, then the crack's gear and numeric fields
+    (from the RootCrack dataclass: depth, angle, tooth), by their study-file keys, with the
+    study's values; a gear-pair study has none."""
     assert spur.geometry_params() == ("gears.pinion.bore_radius", "gears.wheel.bore_radius",
-                                      "faults[0].depth", "faults[0].angle", "faults[0].tooth")
+                                      "faults[0].gear", "faults[0].depth", "faults[0].angle",
+                                      "faults[0].tooth")
+    assert spur.choices("faults[0].gear") == ("pinion", "wheel")
     assert spur.current_value("faults[0].depth") == "2 mm"
     assert spur.current_value("faults[0].tooth") == 9
     assert spur.current_value("gears.pinion.bore_radius") == pytest.approx(0.012, rel=1e-15)
@@ -465,14 +467,16 @@ def test_the_stiffness_panel_is_the_potential_energy_stiffness(spur):
 
     assert spur.set_override("faults[0].depth", "1 mm") is None
     assert spur.set_override("gears.pinion.bore_radius", "15 mm") is None
-    view = stiffness_view(spur.model)
+    view = stiffness_view(spur.model).meshes[0]
     crack = g.RootCrack("1 mm", "45 deg", gear="pinion", tooth=9)
     mesh, kw = _spur_by_hand(crack, pinion_bore="15 mm")
     table = g.potential_energy_stiffness(mesh, **kw, cycles=19)
     np.testing.assert_array_equal(view.cycle, table["cycle"].values)
     np.testing.assert_array_equal(view.drive, table["mesh_stiffness"].values)
     np.testing.assert_array_equal(view.coast, table["mesh_stiffness_coast"].values)
-    assert view.harmonics == 38 and "root crack on pinion tooth 9" in view.faults
+    whole = stiffness_view(spur.model)
+    assert whole.harmonics == 38 and "root crack on pinion tooth 9" in whole.faults
+    assert view.faulty
     theta = 2 * np.pi * view.cycle / 19
     h = np.arange(1, 39)[:, None]
     for k, series in ((view.drive, view.drive_series), (view.coast, view.coast_series)):
@@ -482,7 +486,7 @@ def test_the_stiffness_panel_is_the_potential_energy_stiffness(spur):
         np.testing.assert_allclose(series, direct, rtol=0, atol=1e-10 * np.mean(k))
     # the crack is felt: the panel changes with its depth, and a gear pair has no panel
     assert spur.set_override("faults[0].depth", "2 mm") is None
-    deeper = stiffness_view(spur.model)
+    deeper = stiffness_view(spur.model).meshes[0]
     assert np.min(deeper.drive) < np.min(view.drive)
     assert stiffness_view(ExplorerState(load_study(STUDY), "gp.toml").model) is None
 
@@ -530,14 +534,15 @@ def test_the_page_shows_the_stiffness_and_a_fault_control(spur):
     page._later = lambda fn, *args: fn(*args)
     try:
         assert set(spur.geometry_params()) <= set(page.inputs)
-        drive = np.array(page.stiffness_source.data["drive"])
+        source = page.stiffness_sources["mesh"]
+        drive = np.array(source.data["drive"])
         page._on_param("faults[0].depth", "value", "2 mm", "5 mm")
         assert page.input_messages["faults[0].depth"].text.count("faults[0].depth: the crack")
         assert page._pending is None and spur.overrides == {}
         page._on_param("faults[0].depth", "value", "5 mm", "0.5 mm")
         page.runner.wait(60)
         assert page.input_messages["faults[0].depth"].text == ""
-        assert np.min(page.stiffness_source.data["drive"]) > np.min(drive)  # shallower crack
+        assert np.min(source.data["drive"]) > np.min(drive)  # shallower crack
         assert "depth 0.0005 m" in page.stiffness_faults.text
         assert page.request.model is spur.model
     finally:
@@ -562,8 +567,9 @@ def test_every_fault_kind_gets_its_numeric_fields_as_controls(tmp_path):
     st = ExplorerState(load_study(text), "spur.toml", save_dir=tmp_path,
                        describe_error=format_error)
     assert st.geometry_params()[2:] == (
-        "faults[0].length", "faults[0].width", "faults[0].depth", "faults[0].position",
-        "faults[0].tooth", "faults[1].depth", "faults[1].tooth")
+        "faults[0].gear", "faults[0].length", "faults[0].width", "faults[0].depth",
+        "faults[0].position", "faults[0].tooth", "faults[1].gear", "faults[1].depth",
+        "faults[1].tooth")
     assert st.current_value("faults[0].position") == 0.0  # Spall's default
     model = st.model
     msg = st.set_override("faults[0].position", "20 mm")
@@ -573,3 +579,228 @@ def test_every_fault_kind_gets_its_numeric_fields_as_controls(tmp_path):
     spall = g.Spall("1 mm", "4 mm", "0.2 mm", gear="pinion", tooth=9)
     wear = g.Wear("20 um", gear="pinion", tooth=3)
     assert st.model.params.tobytes() == _spur_model_by_hand(spall, wear).params.tobytes()
+
+
+# ------------------------------------------------------------- a planetary set from geometry
+#: The shipped planetary stage (25/23/71, four planets) on the potential-energy stiffness with a
+#: root crack on planet 2, at small sizes: 16 angles per mesh cycle, 3 mesh harmonics, short
+#: runs; the window is 2 input speeds in rpm.
+PLANETARY_WINDOW = Window(8000.0, 9000.0, 2)
+PLANETARY_HARMONICS = 3
+PLANETARY_OPTIONS = {"sun_bore_radius": "10 mm", "planet_bore_radius": "8 mm",
+                     "ring_rim_radius": "85 mm", "angles": 16}
+PLANETARY_CRACK = {"kind": "crack", "gear": "planet2", "tooth": 4, "depth": "1 mm"}
+
+
+def _planetary_doc() -> dict:
+    import tomllib
+
+    from geardyn.io.toml import builtin_study_text
+
+    doc = tomllib.loads(builtin_study_text("planetary_example"))
+    doc["params"]["geometry"].update(stiffness="potential_energy", transition=0.0,
+                                     stiffness_options=dict(PLANETARY_OPTIONS),
+                                     faults=[dict(PLANETARY_CRACK)])
+    doc["params"]["harmonics"] = PLANETARY_HARMONICS
+    doc["run"].update(transient_periods=2, periods=4)
+    doc["run"].pop("converge")
+    return doc
+
+
+@pytest.fixture()
+def planetary(tmp_path):
+    from geardyn.io.toml import load_study_dict
+
+    return ExplorerState(load_study_dict(_planetary_doc()), "planetary.toml",
+                         window=PLANETARY_WINDOW, save_dir=tmp_path / "saved",
+                         describe_error=format_error)
+
+
+def _planetary_by_hand(*faults, coast="mirror", **options):
+    """The study's set from its literal values through PlanetaryGearSet.from_geometry (not
+    through the study or the explorer), at the study's [run].omega."""
+    import geardyn
+    from geardyn.gears import PlanetaryGeometry, SpurGear
+
+    doc = _planetary_doc()
+    p, g = doc["params"], doc["params"]["geometry"]
+    gears = {n: SpurGear(g[n]["teeth"], g["module"], g["pressure_angle"], g["face_width"],
+                         internal=n == "ring", name=f"geometry.{n}")
+             for n in ("sun", "planet", "ring")}
+    stage = PlanetaryGeometry(gears["sun"], gears["planet"], gears["ring"],
+                              n_planets=p["n_planets"])
+    members = {n: geardyn.Member(**p[n]) for n in ("sun", "ring", "carrier", "planet")}
+    kw = {k: p[k] for k in ("sun_backlash", "ring_backlash", "mesh_damping", "modal_damping",
+                            "sun_torque", "harmonics")}
+    model = geardyn.PlanetaryGearSet.from_geometry(
+        stage, stiffness="potential_energy", stiffness_options={**PLANETARY_OPTIONS, **options},
+        coast=coast, faults=list(faults), **members, **kw)
+    return model.with_omega(doc["run"]["omega"])
+
+
+def test_a_planetary_geometry_offers_its_stiffness_and_fault_controls(planetary):
+    """The controls of a set built from [params.geometry]: the stiffness method and coast flank
+    (choices), the bores and the ring's rim, then the fault's gear (sun, planet<n>, ring) and
+    the crack's numeric fields, by their study-file keys, with the study's values."""
+    assert planetary.geometry_params() == (
+        "params.geometry.stiffness", "params.geometry.coast",
+        "params.geometry.stiffness_options.sun_bore_radius",
+        "params.geometry.stiffness_options.planet_bore_radius",
+        "params.geometry.stiffness_options.ring_rim_radius",
+        "params.geometry.faults[0].gear", "params.geometry.faults[0].depth",
+        "params.geometry.faults[0].angle", "params.geometry.faults[0].tooth")
+    assert planetary.choices("params.geometry.stiffness") == ("iso", "potential_energy")
+    assert planetary.choices("params.geometry.coast") == ("mirror", "symmetric")
+    assert planetary.choices("params.geometry.faults[0].gear") == (
+        "sun", "planet1", "planet2", "planet3", "planet4", "ring")
+    assert planetary.choices("params.geometry.faults[0].depth") == ()
+    assert planetary.current_value("params.geometry.stiffness") == "potential_energy"
+    assert planetary.current_value("params.geometry.faults[0].gear") == "planet2"
+    assert planetary.current_value("params.geometry.faults[0].tooth") == 4
+    assert planetary.current_value("params.geometry.stiffness_options.ring_rim_radius") == \
+        "85 mm"
+    assert "crack on the planet2" in planetary.param_help("params.geometry.faults[0].depth")
+    # the shipped example (ISO waves, no faults) offers the set's controls without faults
+    plain = ExplorerState(builtin_study("planetary_example"), "planetary_example")
+    assert plain.geometry_params() == planetary.geometry_params()[:5]
+    assert plain.current_value("params.geometry.stiffness_options.sun_bore_radius") == ""
+
+
+def test_planetary_controls_rebuild_the_set_as_from_geometry_by_hand(planetary):
+    """New fault gear, tooth and depth, bore and coast flank through the explorer's state: the
+    model's coefficients are PlanetaryGearSet.from_geometry's of the set built here with them
+    (bitwise), and the diagram is geardyn.bifurcation's on that model."""
+    import geardyn
+    import geardyn.gears as g
+
+    for key, text in (("params.geometry.faults[0].gear", "sun"),
+                      ("params.geometry.faults[0].tooth", "7"),
+                      ("params.geometry.faults[0].depth", "1.5 mm"),
+                      ("params.geometry.stiffness_options.planet_bore_radius", "9 mm"),
+                      ("params.geometry.coast", "symmetric")):
+        assert planetary.set_override(key, text) is None, key
+    assert planetary.overrides["params.geometry.faults[0].tooth"] == 7
+    crack = g.RootCrack("1.5 mm", gear="sun", tooth=7)
+    by_hand = _planetary_by_hand(crack, coast="symmetric", planet_bore_radius="9 mm")
+    model = planetary.model
+    assert model.faults.gear == "sun" and model.coast_flank == "symmetric"
+    assert model.params.tobytes() == by_hand.params.tobytes()
+    req = planetary.diagram_request()
+    ds = compute_diagram(req)
+    api = geardyn.bifurcation(by_hand, "input_speed", PLANETARY_WINDOW.values(), req.run)
+    assert np.all(np.isfinite(ds["poincare"].values))
+    assert ds["poincare"].values.tobytes() == api["poincare"].values.tobytes()
+
+
+def test_a_zero_size_planetary_fault_is_the_healthy_set(planetary):
+    """A crack of depth 0 on planet 2: every mesh's stiffness over the revolution, table and
+    series, is the healthy set's (from_geometry without faults) repeated every mesh cycle; the
+    means are equal (to round-off: a mean over 23 cycles of the same values)."""
+    from geardyn.explore.compute import stiffness_view
+
+    assert planetary.set_override("params.geometry.faults[0].depth", "0 mm") is None
+    zero = stiffness_view(planetary.model)
+    healthy_model = _planetary_by_hand()
+    healthy = stiffness_view(healthy_model)
+    assert healthy_model.mesh_order == 1 and planetary.model.mesh_order == 23
+    np.testing.assert_allclose(planetary.model.mesh_stiffnesses(),
+                               healthy_model.mesh_stiffnesses(), rtol=1e-14, atol=0)
+    for z, h in zip(zero.meshes, healthy.meshes, strict=True):
+        assert z.mesh == h.mesh
+        first = z.cycle < 1.0 - 1e-9  # the revolution's first mesh cycle
+        np.testing.assert_allclose(z.cycle[first], h.cycle, rtol=0, atol=1e-9)
+        scale = float(np.mean(h.drive))
+        for name in ("drive", "coast", "drive_series", "coast_series"):
+            period = getattr(z, name).reshape(23, -1)  # every mesh cycle the same
+            np.testing.assert_allclose(period, np.broadcast_to(getattr(h, name), period.shape),
+                                       rtol=0, atol=1e-9 * scale, err_msg=f"{z.mesh} {name}")
+
+
+@pytest.mark.parametrize(("key", "text", "message"), [
+    ("params.geometry.faults[0].depth", "-1 mm", "params.geometry.faults[0].depth: must be"),
+    ("params.geometry.faults[0].gear", "moon", "params.geometry.faults[0].gear: must be"),
+    ("params.geometry.faults[0].tooth", "30", "params.geometry.faults[0].tooth: must lie in"),
+    ("params.geometry.stiffness_options.sun_bore_radius", "30 mm",
+     "params.geometry.stiffness_options.sun_bore_radius: must lie inside"),
+    ("params.geometry.stiffness", "iso",
+     "params.geometry.stiffness_options: only with stiffness='potential_energy'"),
+    ("params.geometry.coast", "both", "params.geometry.coast: "),
+    ("params.geometry.faults[1].depth", "1 mm",
+     "params.geometry.faults[1].depth: not a parameter of this explorer"),
+])
+def test_a_bad_planetary_value_names_its_field_and_changes_nothing(planetary, key, text,
+                                                                   message):
+    model = planetary.model
+    msg = planetary.set_override(key, text)
+    assert msg is not None and msg.startswith(message), msg
+    assert "\n" not in msg and "Traceback" not in msg
+    assert planetary.overrides == {} and planetary.model is model
+
+
+def test_the_planetary_stiffness_panel_marks_the_faulty_meshes(planetary):
+    """The panel has every mesh over the revolution (23 mesh cycles of planet 2); planet 2's
+    two meshes are the faulty ones, then the sun's four after the gear control moves the crack
+    there; each mesh's series is a direct Fourier sum of its table in the revolution's angle,
+    cut after the model's harmonics (3 x 23)."""
+    from geardyn.explore.compute import stiffness_view
+
+    view = stiffness_view(planetary.model)
+    assert [m.mesh for m in view.meshes] == ["s1", "s2", "s3", "s4", "r1", "r2", "r3", "r4"]
+    assert [m.mesh for m in view.meshes if m.faulty] == ["s2", "r2"]
+    assert view.harmonics == PLANETARY_HARMONICS * 23
+    assert "root crack on planet2 tooth 4" in view.faults
+    h = np.arange(1, view.harmonics + 1)[:, None]
+    for mesh in view.meshes:
+        assert mesh.cycle.size == 16 * 23 and np.all(np.diff(mesh.cycle) > 0)
+        theta = 2 * np.pi * mesh.cycle / 23
+        for k, series in ((mesh.drive, mesh.drive_series), (mesh.coast, mesh.coast_series)):
+            a = 2 * np.mean(k * np.cos(h * theta), axis=1)
+            b = 2 * np.mean(k * np.sin(h * theta), axis=1)
+            direct = np.mean(k) + a @ np.cos(h * theta) + b @ np.sin(h * theta)
+            np.testing.assert_allclose(series, direct, rtol=0, atol=1e-9 * np.mean(k),
+                                       err_msg=mesh.mesh)
+    s2 = view.meshes[1]
+    assert np.min(s2.drive) < np.min(view.meshes[0].drive)  # the crack is felt
+    assert planetary.set_override("params.geometry.faults[0].gear", "sun") is None
+    moved = stiffness_view(planetary.model)
+    assert [m.mesh for m in moved.meshes if m.faulty] == ["s1", "s2", "s3", "s4"]
+    assert view.meshes[1].mesh == "s2" and moved.meshes[0].cycle.size == 16 * 25
+
+
+def test_the_planetary_page_offers_choices_and_highlights_the_faulty_meshes(planetary, tmp_path):
+    """The page of a planetary set from geometry: choices for the method, coast flank and
+    fault gear; a refused tooth shows its message; a new gear thickens that gear's meshes; the
+    saved study file holds the change and builds the same model."""
+    from bokeh.document import Document
+    from bokeh.models import Select
+
+    from geardyn.explore import app
+    from geardyn.study import build_model
+
+    ds = compute_diagram(planetary.diagram_request())
+    page = app.ExplorerSession(Document(), planetary, ds, format_error)
+    page._later = lambda fn, *args: fn(*args)
+    gear = "params.geometry.faults[0].gear"
+    try:
+        assert isinstance(page.inputs[gear], Select)
+        assert page.inputs[gear].options[-1] == "ring"
+        assert isinstance(page.inputs["params.geometry.stiffness"], Select)
+        width = {m: lines[0].glyph.line_width for m, lines in page.stiffness_lines.items()}
+        assert width == {"s1": 1, "s2": 3, "s3": 1, "s4": 1, "r1": 1, "r2": 3, "r3": 1, "r4": 1}
+        page._on_param("params.geometry.faults[0].tooth", "value", "4", "30")
+        assert "faults[0].tooth: must lie in" in page.input_messages[
+            "params.geometry.faults[0].tooth"].text
+        assert page._pending is None and planetary.overrides == {}
+        page._on_param(gear, "value", "planet2", "planet3")
+        page.runner.wait(120)
+        assert page.input_messages[gear].text == ""
+        width = {m: lines[0].glyph.line_width for m, lines in page.stiffness_lines.items()}
+        assert [m for m, w in width.items() if w == 3] == ["s3", "r3"]
+        assert "faulty meshes: s3, r3" in page.stiffness_faults.text
+        assert page.request.model is planetary.model
+        saved = planetary.save(page.ds, tmp_path / "view")
+        again = load_study(saved[0])
+        assert again.params.geometry.faults[0].fields()["gear"] == "planet3"
+        assert build_model(again).params.tobytes() == planetary.model.params.tobytes()
+    finally:
+        page.runner.shutdown()

@@ -306,8 +306,8 @@ def test_a_fault_control_updates_the_stiffness_panel(spur_server, browser):
     browser.get(url)
     page.ready(14000, 24000)
     first = page.points()
-    drive = page.column("stiffness", "drive")
-    assert len(drive) == 16 * 19 and len(page.column("stiffness", "drive_series")) == 16 * 19
+    drive = page.column("stiffness_mesh", "drive")
+    assert len(drive) == 16 * 19 and len(page.column("stiffness_mesh", "drive_series")) == 16 * 19
     name = "param_faults[0].depth"
     assert page.shadow(name, "input").get_attribute("value") == "2 mm"
 
@@ -315,11 +315,11 @@ def test_a_fault_control_updates_the_stiffness_panel(spur_server, browser):
     message = page.wait("the validation message", lambda: (
         (t := page.model(f"{name}_message", "text")) and "faults[0].depth" in t and t))
     assert "faults[0].depth: the crack reaches" in message and "past its centre line" in message
-    assert page.column("stiffness", "drive") == drive and page.points() == first
+    assert page.column("stiffness_mesh", "drive") == drive and page.points() == first
 
     page.type_into(name, "0.5 mm")
     page.wait("the message to clear", lambda: page.model(f"{name}_message", "text") == "")
-    page.wait("the new stiffness", lambda: min(page.column("stiffness", "drive")) > min(drive))
+    page.wait("the new stiffness", lambda: min(page.column("stiffness_mesh", "drive")) > min(drive))
     page.wait("the recomputed diagram", lambda: (
         page.model("progress", "text").startswith("ready") and page.points() != first))
     assert "spur_pair_cracked-explore.toml" in page.model("command", "text")

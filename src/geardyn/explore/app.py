@@ -168,7 +168,7 @@ class ExplorerSession:
 
         self.inputs, self.input_messages = {}, {}
         controls = [self._control(name, TextInput, Div, column) for name in st.main_params()]
-        geometry = [self._control(name, TextInput, Div, column)
+        geometry = [self._control(name, Select if st.choices(name) else TextInput, Div, column)
                     for name in st.geometry_params()]
         self.continuation = Select(title="continuation", value=st.continuation,
                                    options=list(CONTINUATIONS), name="continuation", width=120)
@@ -204,11 +204,14 @@ class ExplorerSession:
         self.doc.add_root(self.layout)
         self.doc.title = f"geardyn explore: {st.study.study.name}"
 
-    def _control(self, name: str, TextInput, Div, column):  # noqa: N803
-        """A text box for the parameter or geometry key ``name`` and its message line."""
+    def _control(self, name: str, widget, Div, column):  # noqa: N803
+        """A text box (``widget`` TextInput) or a choice (Select, for a control with
+        :meth:`~ExplorerState.choices`) for the parameter or geometry key ``name`` and its
+        message line."""
         st = self.state
-        box = TextInput(title=name, value=str(st.current_value(name)), name=f"param_{name}",
-                        width=150, description=st.param_help(name) or None)
+        kw = {"options": list(st.choices(name))} if st.choices(name) else {}
+        box = widget(title=name, value=str(st.current_value(name)), name=f"param_{name}",
+                     width=150, description=st.param_help(name) or None, **kw)
         box.on_change("value", partial(self._on_param, name))
         msg = Div(text="", name=f"param_{name}_message", width=150)
         self.inputs[name], self.input_messages[name] = box, msg
@@ -216,48 +219,67 @@ class ExplorerSession:
 
     def _stiffness_figure(self, figure, ColumnDataSource, Div, column):  # noqa: N803
         """The mesh stiffness panel of a model built from geometry (None for other models):
-        drive and coast flank, the table and the model's series, and the faults' line."""
-        view = stiffness_view(self.state.model)
-        if view is None:
-            self.stiffness_source = None
+        per mesh (its colour) the drive and coast flank, the table and the model's series, the
+        faulty meshes thick, and the faults' line."""
+        from bokeh.palettes import Category10_10
+
+        st = self.state
+        view = stiffness_view(st.model)
+        self.stiffness_sources, self.stiffness_lines = {}, {}
+        if view is None and not st.geometry_params():
             return None
-        self.stiffness_source = ColumnDataSource(
-            {"cycle": [], "drive": [], "coast": [], "drive_series": [], "coast_series": []},
-            name="stiffness")
+        meshes = ([m.mesh for m in view.meshes] if view is not None
+                  else [str(m) for m in getattr(st.model, "mesh_names", ())])
         fig = figure(frame_height=240, frame_width=FRAME_WIDTH, min_border_left=BORDER_LEFT,
                      tools="pan,wheel_zoom,box_zoom,reset", name="stiffness_fig",
-                     title=view.title(), x_axis_label="mesh cycles (of the forcing period)",
+                     title=view.title() if view is not None else "mesh stiffness",
+                     x_axis_label="mesh cycles (of the forcing period)",
                      y_axis_label="mesh stiffness [N/m]")
-        src = self.stiffness_source
-        for column_name, color, dash, label in (
-                ("drive", "#1f77b4", "solid", "drive, table"),
-                ("drive_series", "#1f77b4", "dashed", "drive, series"),
-                ("coast", "#ff7f0e", "solid", "coast, table"),
-                ("coast_series", "#ff7f0e", "dashed", "coast, series")):
-            fig.line("cycle", column_name, source=src, color=color, line_dash=dash,
-                     legend_label=label)
+        for k, mesh in enumerate(meshes):
+            src = ColumnDataSource({"cycle": [], "drive": [], "coast": [], "drive_series": [],
+                                    "coast_series": []}, name=f"stiffness_{mesh}")
+            self.stiffness_sources[mesh] = src
+            color = Category10_10[k % 10]
+            self.stiffness_lines[mesh] = [
+                fig.line("cycle", column_name, source=src, color=color, line_dash=dash,
+                         legend_label=f"{mesh} {flank}")
+                for column_name, dash, flank in (
+                    ("drive", "solid", "drive"), ("drive_series", "dashed", "drive"),
+                    ("coast", "dotted", "coast"), ("coast_series", "dotdash", "coast"))]
         legend = fig.legend[0]
         legend.label_text_font_size = "8pt"
         legend.click_policy = "hide"
         fig.add_layout(legend, "right")
         self.stiffness_fig = fig
         self.stiffness_faults = Div(text="", name="stiffness_faults", width=900)
-        self._show_stiffness(self.state.model)
-        return column(fig, self.stiffness_faults)
+        self._show_stiffness(st.model)
+        return column(fig, Div(text="solid: the table; dashed: the model's series (drive "
+                               "flank); dotted, dash-dot: the coast flank's; thick: a faulty "
+                               "mesh"), self.stiffness_faults)
 
     def _show_stiffness(self, model) -> None:
-        """The stiffness panel shows ``model``'s stiffness."""
-        if self.stiffness_source is None:
+        """The stiffness panel shows ``model``'s stiffness (empty, said so, for a model
+        without potential-energy tables)."""
+        if self.stiffness_fig is None:
             return
         view = stiffness_view(model)
         if view is None:
+            for src in self.stiffness_sources.values():
+                src.data = {k: [] for k in src.data}
+            self.stiffness_fig.title.text = "mesh stiffness"
+            self.stiffness_faults.text = ("no potential-energy stiffness tables in this model "
+                                          "(stiffness = iso: the ISO 6336-1 waves)")
             return
-        self.stiffness_source.data = {
-            "cycle": view.cycle, "drive": view.drive, "coast": view.coast,
-            "drive_series": view.drive_series, "coast_series": view.coast_series}
-        if self.stiffness_fig is not None:
-            self.stiffness_fig.title.text = view.title()
-            self.stiffness_faults.text = "faults: " + html.escape(view.faults)
+        for mesh in view.meshes:
+            self.stiffness_sources[mesh.mesh].data = {
+                "cycle": mesh.cycle, "drive": mesh.drive, "coast": mesh.coast,
+                "drive_series": mesh.drive_series, "coast_series": mesh.coast_series}
+            for line in self.stiffness_lines[mesh.mesh]:
+                line.glyph.line_width = 3 if mesh.faulty else 1
+        self.stiffness_fig.title.text = view.title()
+        faulty = ", ".join(m.mesh for m in view.meshes if m.faulty)
+        self.stiffness_faults.text = "faults: " + html.escape(view.faults) + (
+            f" (faulty meshes: {html.escape(faulty)})" if faulty else "")
 
     def _orbit_figures(self, figure, ColumnDataSource) -> list:  # noqa: N803
         from bokeh.models import LabelSet, Range1d

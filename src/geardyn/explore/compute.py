@@ -16,8 +16,8 @@ import xarray as xr
 
 from geardyn.explore.state import DiagramRequest
 
-__all__ = ["DiagramView", "OrbitView", "StiffnessView", "compute_diagram", "compute_orbit",
-           "diagram_view", "stiffness_view"]
+__all__ = ["DiagramView", "MeshStiffness", "OrbitView", "StiffnessView", "compute_diagram",
+           "compute_orbit", "diagram_view", "stiffness_view"]
 
 #: Highest spectrum order shown (multiples of Omega) and peaks labelled.
 SPECTRUM_MAX_ORDER = 8.0
@@ -207,16 +207,26 @@ def _floquet(view: OrbitView, model, omega: float, req: OrbitRequest, ds: xr.Dat
 
 
 @dataclass
-class StiffnessView:
-    """The drive and coast mesh stiffness [N/m] of a model built from geometry over its forcing
-    period: the table it was built from and the truncated Fourier series it integrates, at the
-    table's angles (``cycle``: mesh cycles from tooth 0's pitch-point passage)."""
+class MeshStiffness:
+    """One mesh's drive and coast stiffness [N/m] over the forcing period: the table the model
+    was built from and the truncated Fourier series it integrates, at the table's angles
+    (``cycle``: mesh cycles from t = 0); ``faulty`` where a fault's tooth takes part."""
 
+    mesh: str
     cycle: np.ndarray
     drive: np.ndarray
     coast: np.ndarray
     drive_series: np.ndarray
     coast_series: np.ndarray
+    faulty: bool
+
+
+@dataclass
+class StiffnessView:
+    """The stiffness panel of a model built from geometry: every mesh's stiffness over the
+    forcing period (:class:`MeshStiffness`), the series' harmonics and the faults' line."""
+
+    meshes: list[MeshStiffness]
     harmonics: int
     faults: str
 
@@ -226,20 +236,30 @@ class StiffnessView:
 
 
 def stiffness_view(model: Any) -> StiffnessView | None:
-    """The stiffness panel's arrays of a model that carries a potential-energy stiffness table
-    (``model.stiffness``, with ``mesh_stiffness`` and ``mesh_stiffness_coast``) and its series
-    (``model.stiffness_at(theta, flank)`` at ``model.table_phase()``, as
-    :class:`~geardyn.SpurPair` does); None for a model without one."""
+    """The stiffness panel's arrays of a model that carries potential-energy stiffness tables:
+    a :class:`~geardyn.SpurPair` (its ``stiffness`` table and ``stiffness_at`` series at
+    ``table_phase()``; one mesh, ``"mesh"``) or a :class:`~geardyn.PlanetaryGearSet` built with
+    them (``period_stiffness``; a faulty mesh's table spans the faulty gear's revolution);
+    None for a model without them."""
+    if getattr(model, "mesh_tables", None) is not None and hasattr(model, "period_stiffness"):
+        drive, coast = model.period_stiffness("drive"), model.period_stiffness("coast")
+        faults = model.faults
+        faulty = () if faults is None else faults.meshes(model.n_planets)
+        meshes = [MeshStiffness(name, d[0], d[1], c[1], d[2], c[2], name in faulty)
+                  for name, d, c in zip(model.mesh_names, drive, coast, strict=True)]
+        return StiffnessView(meshes, model.fourier.shape[1] // 2,
+                             "none" if faults is None else faults.describe())
     table = getattr(model, "stiffness", None)
     if not isinstance(table, xr.Dataset) or not {"mesh_stiffness", "mesh_stiffness_coast"} <= set(
             table.data_vars) or not hasattr(model, "stiffness_at"):
         return None
     theta = model.table_phase()
-    return StiffnessView(
-        cycle=np.asarray(table["cycle"].values, dtype=float),
-        drive=np.asarray(table["mesh_stiffness"].values, dtype=float),
-        coast=np.asarray(table["mesh_stiffness_coast"].values, dtype=float),
-        drive_series=model.stiffness_at(theta, "drive"),
-        coast_series=model.stiffness_at(theta, "coast"),
-        harmonics=int(getattr(model, "n_harmonics", 0)),
-        faults=str(table.attrs.get("faults", "none")))
+    faults = str(table.attrs.get("faults", "none"))
+    mesh = MeshStiffness(
+        "mesh", np.asarray(table["cycle"].values, dtype=float),
+        np.asarray(table["mesh_stiffness"].values, dtype=float),
+        np.asarray(table["mesh_stiffness_coast"].values, dtype=float),
+        model.stiffness_at(theta, "drive"), model.stiffness_at(theta, "coast"),
+        faults != "none")
+    return StiffnessView([mesh], int(getattr(model, "n_harmonics", 0)), faults)
+

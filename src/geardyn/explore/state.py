@@ -2,10 +2,12 @@
 the parameter window and its history, the parameter overrides, the command line that reproduces
 the view, and the saving of the view.
 
-A study whose model is built from a gear pair's geometry (a ``[gears]`` table) also offers that
-geometry and its faults as controls (:meth:`ExplorerState.geometry_params`), named by their
-study-file keys (``faults[0].depth``, ``gears.pinion.bore_radius``); a new value rebuilds the
-model from the changed study, as the study file would.
+A study whose model is built from geometry also offers that geometry and its faults as
+controls (:meth:`ExplorerState.geometry_params`), named by their study-file keys: a gear pair's
+(a ``[gears]`` table: ``gears.pinion.bore_radius``, ``faults[0].depth``), a planetary set's (a
+``[params.geometry]`` table: ``params.geometry.stiffness``,
+``params.geometry.stiffness_options.sun_bore_radius``, ``params.geometry.faults[0].gear``); a
+new value rebuilds the model from the changed study, as the study file would.
 
 Every change goes through :class:`ExplorerState`; a change that is not valid returns the message
 to show and leaves the state as it was. The computations live in :mod:`geardyn.explore.compute`.
@@ -29,15 +31,18 @@ from geardyn.core.model import Model
 from geardyn.errors import ParameterError
 from geardyn.gears.faults import FAULT_KINDS
 from geardyn.io.toml import (
+    FaultTable,
     GearPairParams,
     PaperBase,
     PlanetaryGearSetParams,
     SpurPairParams,
     Study,
 )
+from geardyn.models.planetary_stiffness import COAST_FLANKS, STIFFNESS_METHODS
 
-__all__ = ["CONTINUATIONS", "GEOMETRY_KEYS", "INTERPRETATIONS", "MAIN_PARAMS", "DiagramRequest",
-           "ExplorerState", "Window", "fault_fields", "key_path", "parse_value"]
+__all__ = ["CONTINUATIONS", "GEOMETRY_KEYS", "INTERPRETATIONS", "MAIN_PARAMS",
+           "PLANETARY_GEOMETRY_KEYS", "DiagramRequest", "ExplorerState", "Window",
+           "fault_fields", "key_path", "parse_value"]
 
 #: The main parameters offered as controls, per model kind (``[study].model``): damping ratios,
 #: backlash, meshing error, load (or torque) fluctuation.
@@ -52,6 +57,13 @@ MAIN_PARAMS: dict[str, tuple[str, ...]] = {
 #: keys; each gear's own value, which wins over a shared ``[gears]`` one). The faults' controls
 #: come from the study's ``[[faults]]`` (:func:`fault_fields`).
 GEOMETRY_KEYS = ("gears.pinion.bore_radius", "gears.wheel.bore_radius")
+#: The ``[params.geometry]`` inputs offered as controls of a planetary set built from geometry:
+#: the stiffness method, the coast flank, the bores and the ring's rim (``stiffness_options``).
+#: The faults' controls come from ``[[params.geometry.faults]]``.
+PLANETARY_GEOMETRY_KEYS = ("params.geometry.stiffness", "params.geometry.coast",
+                           "params.geometry.stiffness_options.sun_bore_radius",
+                           "params.geometry.stiffness_options.planet_bore_radius",
+                           "params.geometry.stiffness_options.ring_rim_radius")
 INTERPRETATIONS = ("consistent", "carrier-only", "as-printed")
 CONTINUATIONS = ("none", "up", "down")
 
@@ -143,6 +155,27 @@ def _error_text(exc: BaseException) -> str:
     return str(exc)
 
 
+def _geometry_tables(study: Study) -> tuple[tuple[str, ...], str, list[FaultTable]]:
+    """The fixed geometry controls of ``study``, the key of its fault tables and the tables:
+    a pair's ``[gears]`` and ``[[faults]]``, a planetary set's ``[params.geometry]`` and
+    ``[[params.geometry.faults]]``; ((), "", []) for a study without geometry."""
+    if study.gears is not None:
+        return GEOMETRY_KEYS, "faults", list(study.faults or [])
+    geometry = getattr(study.params, "geometry", None)
+    if isinstance(study.params, PlanetaryGearSetParams) and geometry is not None:
+        return PLANETARY_GEOMETRY_KEYS, "params.geometry.faults", list(geometry.faults or [])
+    return (), "", []
+
+
+def _fault_table(study: Study, path: tuple[str | int, ...]) -> FaultTable | None:
+    """The fault table of the control at ``path`` (``(..., "faults", i, field)``), None for a
+    control of another table."""
+    _, prefix, tables = _geometry_tables(study)
+    if not prefix or path[:-2] != key_path(prefix) or not isinstance(path[-2], int):
+        return None
+    return tables[path[-2]] if path[-2] < len(tables) else None
+
+
 class ExplorerState:
     """The explorer's view of one study.
 
@@ -200,16 +233,33 @@ class ExplorerState:
         return tuple(p for p in MAIN_PARAMS.get(self.kind, ()) if p != self.param)
 
     def geometry_params(self) -> tuple[str, ...]:
-        """The geometry and fault controls of a study with a ``[gears]`` table, as study-file
-        keys: :data:`GEOMETRY_KEYS`, then the numeric fields of each ``[[faults]]`` table's
-        fault class (``faults[0].depth``, ``faults[0].angle``, ``faults[0].tooth``); () for a
-        study without ``[gears]``."""
-        if self.study.gears is None:
+        """The geometry and fault controls of a study built from geometry, as study-file keys:
+        :data:`GEOMETRY_KEYS` (a ``[gears]`` table) or :data:`PLANETARY_GEOMETRY_KEYS` (a
+        planetary ``[params.geometry]``), then, per fault table, its gear and the numeric
+        fields of its fault class (``faults[0].gear``, ``faults[0].depth``,
+        ``faults[0].angle``, ``faults[0].tooth``); () for a study without geometry."""
+        keys, prefix, tables = _geometry_tables(self.study)
+        out = list(keys)
+        for i, table in enumerate(tables):
+            out += [f"{prefix}[{i}].{name}" for name in ("gear", *fault_fields(table.kind))]
+        return tuple(out)
+
+    def choices(self, name: str) -> tuple[str, ...]:
+        """The values a text control takes (a planetary set's stiffness method and coast flank,
+        a fault's gear); () for a control that takes a number."""
+        path = key_path(name)
+        if name not in self.geometry_params():
             return ()
-        keys = list(GEOMETRY_KEYS)
-        for i, table in enumerate(self.study.faults or []):
-            keys += [f"faults[{i}].{name}" for name in fault_fields(table.kind)]
-        return tuple(keys)
+        if path[-1] == "stiffness":
+            return STIFFNESS_METHODS
+        if path[-1] == "coast":
+            return COAST_FLANKS
+        if path[-1] == "gear":
+            if self.study.gears is not None:
+                return ("pinion", "wheel")
+            n = self.study.params.n_planets  # type: ignore[union-attr]
+            return ("sun", *(f"planet{i + 1}" for i in range(n)), "ring")
+        return ()
 
     def param_help(self, name: str) -> str:
         """What a control's parameter is (meaning and unit), from the model's declared
@@ -234,12 +284,14 @@ class ExplorerState:
 
     def _geometry_help(self, key: str) -> str:
         path = key_path(key)
-        if path[0] == "faults":
-            table = self.study.faults[path[1]]  # type: ignore[index]
+        kind = ("one of " + ", ".join(self.choices(key)) if self.choices(key)
+                else "a whole number" if self._whole(key) else "SI number or unit string")
+        table = _fault_table(self.study, path)
+        if table is not None:
             gear = table.fields().get("gear", "pinion")
-            kind = "a whole number" if self._whole(key) else "SI number or unit string"
-            return f"{path[2]} of the {table.kind} on the {gear} ([[faults]] {path[1]}; {kind})"
-        return f"{path[-1]} of the {path[1]} ([gears.{path[1]}]; SI number or unit string)"
+            where = ".".join(str(p) for p in path[:-2])
+            return f"{path[-1]} of the {table.kind} on the {gear} ([[{where}]] {path[-2]}; {kind})"
+        return f"{path[-1]} ([{'.'.join(str(p) for p in path[:-1])}]; {kind})"
 
     def _build(self, study: Study, interpretation: str | None) -> Model:
         from geardyn.study import build_model
@@ -279,17 +331,24 @@ class ExplorerState:
 
     def _geometry_value(self, path: tuple[str | int, ...]) -> Any:
         """A geometry control's value in the current view: a fault field as its table gives
-        it (else the fault class's default), a gear's value (its own, else ``[gears]``'s)."""
+        it (else the fault class's default), a gear's value (its own, else ``[gears]``'s), a
+        ``[params.geometry]`` value as the study gives it ("" where it gives none)."""
         study = self._effective
-        if path[0] == "faults":
-            table = study.faults[path[1]]  # type: ignore[index]
-            name = str(path[2])
+        table = _fault_table(study, path)
+        if table is not None:
+            name = str(path[-1])
             given = table.fields()
             if name in given:
                 return given[name]
             declared = {f.name: f for f in dataclasses.fields(FAULT_KINDS[table.kind])}
             return declared[name].default
-        return study.gears.value(str(path[1]), str(path[2]))[0]  # type: ignore[union-attr]
+        if path[0] == "gears":
+            return study.gears.value(str(path[1]), str(path[2]))[0]  # type: ignore[union-attr]
+        target: Any = study
+        for part in path:
+            target = (target.get(part) if isinstance(target, dict)
+                      else getattr(target, str(part), None))
+        return "" if target is None else target
 
     def _with_overrides(self, overrides: dict[str, float | str]) -> Study:
         """The study with ``overrides`` applied, validated as a study file is (a geometry
@@ -315,7 +374,7 @@ class ExplorerState:
         geometry = self.geometry_params()
         if name not in MAIN_PARAMS.get(self.kind, ()) and name not in geometry:
             return f"{name}: not a parameter of this explorer"
-        value = parse_value(text)
+        value: float | str = text.strip() if self.choices(name) else parse_value(text)
         if name in geometry and isinstance(value, float) and value.is_integer() and (
                 self._whole(name)):
             value = int(value)  # a tooth index: 3, not 3.0
@@ -325,10 +384,10 @@ class ExplorerState:
     def _whole(self, key: str) -> bool:
         """True where the geometry control ``key`` is an int field of its fault class."""
         path = key_path(key)
-        if path[0] != "faults":
+        table = _fault_table(self.study, path)
+        if table is None:
             return False
-        cls = FAULT_KINDS[self.study.faults[path[1]].kind]  # type: ignore[index]
-        return typing.get_type_hints(cls).get(str(path[2])) is int
+        return typing.get_type_hints(FAULT_KINDS[table.kind]).get(str(path[-1])) is int
 
     def set_interpretation(self, value: str) -> str | None:
         """Change the interpretation (CATT device studies only); None or the message."""

@@ -61,7 +61,7 @@ from geardyn.models.planetary_stiffness import (
     series_error,
     stiffness_method,
 )
-from geardyn.models.stiffness import fourier_coefficients
+from geardyn.models.stiffness import evaluate, fourier_coefficients
 from geardyn.units import si_value
 
 _KERNEL = KernelSource(pk.planetary_rhs, pk.planetary_events, pk.planetary_observe)
@@ -858,6 +858,40 @@ class PlanetaryGearSet(Model):
                                           float(np.max(np.abs(e))) / float(mean[m]))
                 out[f"{flank}_rms"] = max(out[f"{flank}_rms"],
                                           float(np.sqrt(np.mean(e * e))) / float(mean[m]))
+        return out
+
+    def period_stiffness(self, flank: str = "drive"
+                         ) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
+        """Every mesh's stiffness over one forcing period, of a set built with the
+        potential-energy tables (:attr:`mesh_tables`): per mesh (:attr:`mesh_names` order) the
+        mesh cycles c from t = 0 (ascending in [0, ``mesh_order``)), its table at them (repeated
+        over the period and delayed by the mesh's phase: K(c) = T(c + mesh_phase / 2 pi)) and
+        the model's series k_m (1 + sum a_h cos(h Theta) + b_h sin(h Theta)) at Theta = 2 pi c
+        / ``mesh_order`` [N/m]. ``flank``: ``"drive"`` or ``"coast"`` (with ``coast =
+        "symmetric"`` the coast flank is the drive flank's table and series)."""
+        if self.mesh_tables is None:
+            raise ParameterError("stiffness_method", self.stiffness_method,
+                                 "the stiffness over the period needs the potential-energy tables")
+        if flank not in ("drive", "coast"):
+            raise ParameterError("flank", flank, "must be 'drive' or 'coast'")
+        coast = flank == "coast"
+        var = "mesh_stiffness_coast" if coast and self.coast_flank == "mirror" \
+            else "mesh_stiffness"
+        coef, mean = ((self.fourier_coast, self.coast_stiffnesses()) if coast
+                      else (self.fourier, self.mesh_stiffnesses()))
+        out = []
+        for m, table in enumerate(self.mesh_tables):
+            cyc = np.asarray(table["cycle"].values, dtype=float)
+            cycles = int(round(float(cyc[-1] + cyc[1] - cyc[0])))
+            reps = self.mesh_order // cycles
+            c = np.concatenate([cyc + r * cycles for r in range(reps)])
+            c = (c - self.mesh_phase[m] / (2.0 * math.pi)) % self.mesh_order
+            k = np.tile(np.asarray(table[var].values, dtype=float), reps)
+            order = np.argsort(c, kind="stable")
+            c, k = c[order], k[order]
+            series = float(mean[m]) * evaluate(coef[m, 0::2], coef[m, 1::2],
+                                               2.0 * math.pi * c / self.mesh_order)
+            out.append((c, k, series))
         return out
 
     # ------------------------------------------------------------------ input speed

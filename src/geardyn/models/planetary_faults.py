@@ -86,6 +86,14 @@ class FaultPlacement:
         """One line for the model's attrs."""
         return "; ".join(f.describe() for f in self.faults)
 
+    def meshes(self, n_planets: int) -> tuple[str, ...]:
+        """The meshes the faulty teeth take part in, by the set's mesh names (``s1`` ..
+        ``sN``, ``r1`` .. ``rN``): every sun-planet mesh for the sun, every ring-planet mesh
+        for the ring, planet n's two meshes for planet n."""
+        planets = range(n_planets) if self.planet is None else (self.planet,)
+        return (tuple(f"s{i + 1}" for i in planets if self.sun_faults)
+                + tuple(f"r{i + 1}" for i in planets if self.ring_faults))
+
 
 def _listed(faults: object) -> tuple[Any, ...]:
     if faults is None:
