@@ -619,22 +619,12 @@ def planetary(tmp_path):
 def _planetary_by_hand(*faults, coast="mirror", **options):
     """The study's set from its literal values through PlanetaryGearSet.from_geometry (not
     through the study or the explorer), at the study's [run].omega."""
-    import geardyn
-    from geardyn.gears import PlanetaryGeometry, SpurGear
+    from planetary_example_set import planetary_by_hand
 
     doc = _planetary_doc()
-    p, g = doc["params"], doc["params"]["geometry"]
-    gears = {n: SpurGear(g[n]["teeth"], g["module"], g["pressure_angle"], g["face_width"],
-                         internal=n == "ring", name=f"geometry.{n}")
-             for n in ("sun", "planet", "ring")}
-    stage = PlanetaryGeometry(gears["sun"], gears["planet"], gears["ring"],
-                              n_planets=p["n_planets"])
-    members = {n: geardyn.Member(**p[n]) for n in ("sun", "ring", "carrier", "planet")}
-    kw = {k: p[k] for k in ("sun_backlash", "ring_backlash", "mesh_damping", "modal_damping",
-                            "sun_torque", "harmonics")}
-    model = geardyn.PlanetaryGearSet.from_geometry(
-        stage, stiffness="potential_energy", stiffness_options={**PLANETARY_OPTIONS, **options},
-        coast=coast, faults=list(faults), **members, **kw)
+    model = planetary_by_hand(doc, stiffness="potential_energy",
+                              stiffness_options={**PLANETARY_OPTIONS, **options}, coast=coast,
+                              faults=list(faults))
     return model.with_omega(doc["run"]["omega"])
 
 

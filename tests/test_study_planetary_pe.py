@@ -10,9 +10,9 @@ import pytest
 
 import geardyn
 from geardyn.errors import ParameterError
-from geardyn.gears import PlanetaryGeometry, SpurGear
 from geardyn.io.toml import builtin_study_text, load_study_dict
 from geardyn.study import build_model
+from planetary_example_set import planetary_by_hand
 
 OPTIONS = {"sun_bore_radius": "10 mm", "planet_bore_radius": "8 mm",
            "ring_rim_radius": "85 mm", "angles": 64}
@@ -26,18 +26,8 @@ def _doc(**geometry: object) -> dict:
 
 def _by_hand() -> geardyn.PlanetaryGearSet:
     """The example study's set, built from the API with the same literal inputs."""
-    doc = tomllib.loads(builtin_study_text("planetary_example"))
-    p, g = doc["params"], doc["params"]["geometry"]
-    gears = {n: SpurGear(g[n]["teeth"], g["module"], g["pressure_angle"], g["face_width"],
-                         internal=n == "ring", name=f"geometry.{n}")
-             for n in ("sun", "planet", "ring")}
-    stage = PlanetaryGeometry(gears["sun"], gears["planet"], gears["ring"],
-                              n_planets=p["n_planets"])
-    members = {n: geardyn.Member(**p[n]) for n in ("sun", "ring", "carrier", "planet")}
-    kw = {k: p[k] for k in ("sun_backlash", "ring_backlash", "mesh_damping", "modal_damping",
-                            "sun_torque", "harmonics")}
-    return geardyn.PlanetaryGearSet.from_geometry(
-        stage, stiffness="potential_energy", stiffness_options=OPTIONS, **members, **kw)
+    return planetary_by_hand(tomllib.loads(builtin_study_text("planetary_example")),
+                             stiffness="potential_energy", stiffness_options=OPTIONS)
 
 
 def test_study_equals_the_api_bitwise():
