@@ -794,3 +794,34 @@ def test_the_planetary_page_offers_choices_and_highlights_the_faulty_meshes(plan
         assert build_model(again).params.tobytes() == planetary.model.params.tobytes()
     finally:
         page.runner.shutdown()
+
+
+def test_the_page_of_a_planetary_set_on_the_iso_waves(tmp_path):
+    """The shipped planetary example (ISO waves, no faults): its stiffness panel says it has no
+    tables; the coast flank is a choice whose new value rebuilds the set with it; switching the
+    method is refused naming the field that the other method refuses (its transition)."""
+    from bokeh.document import Document
+
+    from geardyn.explore import app
+    from geardyn.io.toml import builtin_study_text
+
+    text = builtin_study_text("planetary_example")
+    assert "periods = 32" in text
+    st = ExplorerState(load_study(text.replace("periods = 32", "periods = 4")),
+                       "planetary_example", window=PLANETARY_WINDOW, save_dir=tmp_path,
+                       describe_error=format_error)
+    ds = compute_diagram(st.diagram_request())
+    page = app.ExplorerSession(Document(), st, ds, format_error)
+    page._later = lambda fn, *args: fn(*args)
+    try:
+        assert "no potential-energy stiffness tables" in page.stiffness_faults.text
+        page._on_param("params.geometry.stiffness", "value", "iso", "potential_energy")
+        assert page.input_messages["params.geometry.stiffness"].text.count(
+            "params.geometry.transition: shapes the ISO waves")
+        assert st.overrides == {}
+        page._on_param("params.geometry.coast", "value", "mirror", "symmetric")
+        page.runner.wait(120)
+        assert page.message.text == "" and page.request.model is st.model
+        assert st.model.coast_flank == "symmetric" and st.model.stiffness_method == "iso"
+    finally:
+        page.runner.shutdown()

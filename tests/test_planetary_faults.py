@@ -334,3 +334,32 @@ def test_bad_fault_specs_name_the_field(geo):
         geardyn.SpurPair.from_geometry(geo.sun_mesh, bore_radius="10 mm", speed=100.0,
                                        torque=10.0, faults=[g.RootCrack(**CRACK, gear="sun")])
     assert err.value.field == "crack.gear"
+
+
+@pytest.mark.parametrize("gear", ["sun", "planet3", "ring"])
+def test_period_stiffness_is_the_compiled_series_and_the_faulty_meshes_are_named(geo, gear):
+    """PlanetaryGearSet.period_stiffness: every mesh's series at its cycles is the compiled
+    kernel's stiffness at the same forcing phase (drive flank: deflection +1, coast: -1); its
+    table lies under the series as stiffness_error (an inverse FFT of the coefficients) says
+    (the largest rms over the meshes); the table differs from the healthy set's one-cycle
+    table, repeated, exactly on the meshes FaultPlacement.meshes names (every sun mesh, every
+    ring mesh, planet 3's two)."""
+    faulty = pe_set(geo, [g.RootCrack(**CRACK, gear=gear, tooth=2)], harmonics=3, angles=16)
+    healthy = pe_set(geo, harmonics=3, angles=16)
+    z = faulty.mesh_order
+    expected = {"sun": {"s1", "s2", "s3", "s4"}, "planet3": {"s3", "r3"},
+                "ring": {"r1", "r2", "r3", "r4"}}[gear]
+    assert set(faulty.faults.meshes(geo.n_planets)) == expected
+    error = faulty.stiffness_error()
+    for flank, sign in (("drive", 1.0), ("coast", -1.0)):
+        differ, rms = set(), []
+        for m, ((c, k, series), (_, k_h, _)) in enumerate(zip(
+                faulty.period_stiffness(flank), healthy.period_stiffness(flank), strict=True)):
+            pick = slice(None, None, 9)
+            compiled = kernel_stiffness(faulty, 2.0 * math.pi * c[pick] / z, sign)[:, m]
+            np.testing.assert_allclose(series[pick], compiled, rtol=1e-9, err_msg=flank)
+            rms.append(np.sqrt(np.mean((series - k) ** 2)) / np.mean(k))
+            if not np.allclose(k.reshape(z, -1), k_h, rtol=1e-12, atol=0.0):
+                differ.add(faulty.mesh_names[m])
+        assert max(rms) == pytest.approx(error[f"{flank}_rms"], rel=1e-6), flank
+        assert differ == expected, flank
