@@ -47,13 +47,20 @@ print(json.dumps(out))
 """
 
 
-#: The modules other than geardyn's that ``import geardyn`` imports.
+#: The modules other than geardyn's that ``import geardyn`` imports, and with ``run`` those the
+#: probe's first run imports too (geardyn imports some, e.g. SciPy's, where they are used; numba's
+#: own are left to the run: which of them set up its CPU target is what the probe looks at).
 _DEPENDENCIES = """
 import json, sys
 before = set(sys.modules)
 import geardyn
-print(json.dumps(sorted(m for m in set(sys.modules) - before
-                        if m.split(".")[0] not in ("geardyn", "__main__"))))
+imported = set(sys.modules)
+if sys.argv[1] == "run":
+    g = geardyn.GearPair(zeta=0.05, kappa=0.0, Fm=0.1, Fa=0.0)
+    geardyn.simulate(g, omega=1.2, run=geardyn.RunSettings(transient=10.0, samples=4))
+ran = {m for m in set(sys.modules) - imported if not m.startswith(("numba", "llvmlite"))}
+print(json.dumps(sorted(m for m in (imported | ran) - before
+                        if not m.startswith(("geardyn", "__main__")))))
 """
 
 
@@ -66,7 +73,7 @@ def _run(code: str, env: dict[str, str], *args: str) -> object:
 
 
 def _states(env: dict[str, str], mode: str) -> dict:
-    dependencies = _run(_DEPENDENCIES, env)
+    dependencies = _run(_DEPENDENCIES, env, mode)
     return _run(_PROBE, env, mode, json.dumps(dependencies))
 
 
