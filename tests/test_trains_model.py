@@ -7,6 +7,7 @@ linear natural frequency for where a speed sweep loses contact."""
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -215,6 +216,18 @@ def test_step_size_convergence_is_fourth_order():
     assert min(orders) > 3.3, orders
 
 
+def test_sweep_lanes_give_the_single_runs_bitwise():
+    """The lane-block kernels' own-phase path (a mesh order not 1) computes what the per-lane
+    functions do: a sweep's Poincare points are simulate's at each speed, bit for bit."""
+    model = _parallel(input_speed=2500.0, backlash=20e-6)
+    run = geardyn.RunSettings(transient=100.0, samples=8, steps_per_period=128)
+    speeds = (2500.0, 3300.0)
+    ds = geardyn.bifurcation(model, "input_speed", speeds, run=run)
+    for j, v in enumerate(speeds):
+        sim = geardyn.simulate(model.with_params(input_speed=v), run=run)
+        np.testing.assert_array_equal(ds.poincare.values[j], sim.poincare.values[-8:])
+
+
 def test_speed_sweep_loses_contact_at_the_linear_resonance():
     """Backlash and a stiffness fluctuation: sweeping the input speed, the stage-1 mesh's
     peak force peaks, and contact is lost, near the speed at which its mesh frequency meets
@@ -275,3 +288,46 @@ def test_input_speed_sets_omega_alone_in_a_sweep():
                                   np.delete(P[1], model.omega_index))
     assert model.input_speed == pytest.approx(1500.0, rel=1e-12)
     assert model.with_params(input_speed=3000.0).omega == pytest.approx(2 * model.omega)
+
+
+# ---------------------------------------------------------------- the study file
+def test_train_study_builds_the_model_the_api_builds():
+    """The packaged study's [train] and [params] give the TrainModel built in Python from the
+    same inputs (coefficients bitwise)."""
+    from geardyn.io.toml import builtin_study
+
+    study = builtin_study("two_stage_train")
+    model = geardyn.build_model(study)
+    direct = TrainModel(study.gear_train, input_speed=3000.0, torques={"g1": 60.0}, load="g4",
+                        backlash=20e-6, mesh_damping=0.03, stiffness_fluctuation=0.25)
+    np.testing.assert_array_equal(model.params, direct.params)
+    assert model.dof_names() == direct.dof_names() and len(model.dof_names()) == 8
+    assert model.input_speed == pytest.approx(3000.0, rel=1e-12)
+
+
+def test_train_study_bad_params_name_the_field():
+    from geardyn.io.toml import load_study
+
+    text = (Path(geardyn.__file__).parent / "studies" / "two_stage_train.toml").read_text()
+    bad = load_study(text.replace('load = "g4"', 'load = "g9"'))
+    with pytest.raises(ParameterError, match="params.load"):
+        geardyn.build_model(bad)
+
+
+def test_cli_bifurcation_in_rpm_writes_what_the_api_computes(tmp_path):
+    from geardyn.io.netcdf import load_dataset
+    from geardyn.io.toml import builtin_study
+    from test_cli import TINY, invoke
+
+    nc = tmp_path / "train.nc"
+    r = invoke("bifurcation", "two_stage_train", "--range", "2000:4000:3", *TINY, "--out", nc)
+    assert r.returncode == 0, r.stderr
+    saved = load_dataset(nc)
+    assert saved.attrs["forcing"] == "quasi-periodic"
+    assert saved.attrs["reference_mesh"] == "stage1"
+    np.testing.assert_allclose(saved["input_speed"].values, [2000.0, 3000.0, 4000.0])
+    direct = geardyn.bifurcation(geardyn.build_model(builtin_study("two_stage_train")),
+                                 "input_speed", [2000.0, 3000.0, 4000.0],
+                                 run=geardyn.RunSettings(transient=60.0, samples=6,
+                                                         steps_per_period=64))
+    np.testing.assert_array_equal(saved["poincare"].values, direct["poincare"].values)

@@ -563,11 +563,9 @@ def planetary_rhs_lanes(T, Y, DY, PT, nl, S, C, SC):
             for k in range(nl):
                 DY[i, k] -= (PT[g, k] * PT[r, k]) * Y[j, k]
     if _lanes_multi_order(PT, nl):
-        kr = _lanes_order_stiffness(PT, nl, T, S, C, mz + nm * 3 * MESH_NZ, mesh, bs, nh, nm,
-                                    two)
         for m in range(nm):
-            _lanes_mesh_orders(Y, DY, PT, nl, T, S, C, SC, n, mesh + m * bs,
-                               mz + m * 3 * MESH_NZ, kr + m, True, two, kr + nm + m)
+            _lanes_mesh_orders(Y, DY, PT, nl, T, S, C, SC, n, nh, mesh + m * bs,
+                               mz + m * 3 * MESH_NZ, True, two)
         return
     kr = _lanes_cached_stiffness(PT, nl, S, C, SC, mz + nm * 3 * MESH_NZ, mesh, bs, nh, nm, two)
     for m in range(nm):
@@ -681,11 +679,9 @@ def planetary_observe_lanes(T, Y, O, PT, nl, S, C, SC):
     for k in range(nl):
         two |= PT[TWO_FLANK, k] != 0.0
     if _lanes_multi_order(PT, nl):
-        kr = _lanes_order_stiffness(PT, nl, T, S, C, mz + nm * 3 * MESH_NZ, mesh, bs, nh, nm,
-                                    two)
         for m in range(nm):
-            _lanes_mesh_orders(Y, O[m:m + 1], PT, nl, T, S, C, SC, n, mesh + m * bs,
-                               mz + m * 3 * MESH_NZ, kr + m, False, two, kr + nm + m)
+            _lanes_mesh_orders(Y, O[m:m + 1], PT, nl, T, S, C, SC, n, nh, mesh + m * bs,
+                               mz + m * 3 * MESH_NZ, False, two)
         return
     kr = _lanes_cached_stiffness(PT, nl, S, C, SC, mz + nm * 3 * MESH_NZ, mesh, bs, nh, nm, two)
     for m in range(nm):
@@ -695,7 +691,7 @@ def planetary_observe_lanes(T, Y, O, PT, nl, S, C, SC):
 
 # ---------------------------------------------------------------------------------------------
 # Lane-block forms where a mesh's order differs from 1 (a gear train's stages): each mesh at its
-# own phase (:func:`_mesh_phase`) per lane, the relative stiffness computed anew (no cache).
+# own phase (:func:`_mesh_phase`) per lane, its relative stiffness computed there (no cache).
 
 
 @nb.njit(inline="always", **_JIT)
@@ -722,41 +718,20 @@ def _lane_relative_stiffness(PT, k, f, nh, s, c):
 
 
 @nb.njit(inline="always", **_JIT)
-def _lanes_order_stiffness(PT, nl, T, S, C, cache, mesh, bs, nh, nm, two):
-    """Row of PT from which the relative stiffness of mesh m is row + m (its coast flank's row +
-    nm, with ``two``), each mesh at its own phase: written into a cache entry whose key is then
-    left empty (so :func:`_lanes_cached_stiffness` never finds it)."""
-    width = 2 + 2 * nm
-    e = (int(PT[cache, 0]) + 1) % CACHE_ENTRIES
-    b = cache + 1 + e * width
-    n = int(PT[N_DOF, 0])
-    for m in range(nm):
-        o = mesh + m * bs
-        for k in range(nl):
-            s, c, _ = _mesh_phase(T[k], PT[o + M_ORDER, k], PT[OMEGA, k], S[k], C[k])
-            PT[b + 2 + m, k] = _lane_relative_stiffness(PT, k, o + MESH_FIXED, nh, s, c)
-            if two:
-                PT[b + 2 + nm + m, k] = _lane_relative_stiffness(
-                    PT, k, o + coast_offset(n, nh), nh, s, c)
-    for k in range(nl):
-        PT[b, k] = EMPTY
-        PT[b + 1, k] = EMPTY
-    PT[cache, 0] = e
-    return b + 2
-
-
-@nb.njit(inline="always", **_JIT)
-def _lanes_mesh_orders(Y, DY, PT, nl, T, S, C, SC, n, o, q, row, apply, two, rowc):
-    """:func:`_lanes_mesh` with the mesh at its own phase in every lane (:func:`_mesh_phase`)."""
+def _lanes_mesh_orders(Y, DY, PT, nl, T, S, C, SC, n, nh, o, q, apply, two):
+    """:func:`_lanes_mesh` with the mesh at its own phase in every lane (:func:`_mesh_phase`):
+    the phase, the acting flank's relative stiffness and the force in one pass per lane."""
     i0, i1, i2, i3, i4, i5 = _mesh_dofs(PT, q)
     w = q + MESH_NZ
+    fc = o + coast_offset(n, nh)
     for k in range(nl):
         s, c, om = _mesh_phase(T[k], PT[o + M_ORDER, k], PT[OMEGA, k], S[k], C[k])
         d, v = _lane_deflection(Y, PT, k, n, o, w, i0, i1, i2, i3, i4, i5, s, c, om)
         g = _dead_zone(d, PT[o + M_B, k])
-        kf = PT[o + M_KF, k] * PT[row, k]
         if two and g < 0.0:
-            kf = PT[o + M_KFC, k] * PT[rowc, k]
+            kf = PT[o + M_KFC, k] * _lane_relative_stiffness(PT, k, fc, nh, s, c)
+        else:
+            kf = PT[o + M_KF, k] * _lane_relative_stiffness(PT, k, o + MESH_FIXED, nh, s, c)
         SC[0, k] = kf * g + PT[o + M_CF, k] * v
     _lanes_apply(DY, PT, nl, SC, n, q, apply)
 
