@@ -122,15 +122,24 @@ MODULE = 3e-3
 Z = (19, 61, 23, 71)
 INERTIA = (0.01, 0.35, 0.02, 0.6)
 K_MID, KA, KB = 9e5, 6e8, 8e8
-RBP = tuple(_rb(MODULE, z, math.radians(20.0)) for z in Z)
+#: Stage 2 meshing at twice stage 1's frequency: a whole order, periodic forcing.
+Z_WHOLE = (19, 31, 62, 41)
 T_IN = 60.0
 C_MESH = 300.0
 
 
-def _parallel(**kw) -> TrainModel:
-    """Two spur stages on a flexible intermediate shaft, free (one rigid-body mode), the
-    output torque balancing the input's (``load``)."""
-    g = [Gear(f"g{i + 1}", INERTIA[i], base_radius=RBP[i], n_teeth=Z[i]) for i in range(4)]
+def _radii(z: tuple[int, ...]) -> tuple[float, ...]:
+    return tuple(_rb(MODULE, zi, math.radians(20.0)) for zi in z)
+
+
+RBP = _radii(Z)
+
+
+def _parallel(z: tuple[int, ...] = Z, **kw) -> TrainModel:
+    """Two spur stages (tooth counts ``z``) on a flexible intermediate shaft, free (one
+    rigid-body mode), the output torque balancing the input's (``load``)."""
+    rb = _radii(z)
+    g = [Gear(f"g{i + 1}", INERTIA[i], base_radius=rb[i], n_teeth=z[i]) for i in range(4)]
     train = GearTrain(g, shafts=[Shaft("mid", "g2", "g3", K_MID)],
                       bearings=[Bearing(f"b{i + 1}", f"g{i + 1}", math.inf) for i in range(4)],
                       meshes=[Mesh("stage1", "g1", "g2", KA, damping=C_MESH),
@@ -140,18 +149,19 @@ def _parallel(**kw) -> TrainModel:
     return TrainModel(train, **{**args, **kw})
 
 
-def _hand_rhs(model: TrainModel, backlash: float):
+def _hand_rhs(model: TrainModel, backlash: float, z: tuple[int, ...]):
     """dq/dt in SI, written out from M, K and the mesh rows (not from the model's vectors):
     q = theta_1..4 [rad]; mesh m's phase r_m w t (w: stage 1's mesh frequency, r_2 = Z_3 (Z_1 /
     Z_2) / Z_1), stiffness k_m (1 + 0.25 sin phase), force through the dead zone."""
+    rb = _radii(z)
     M = np.diag(INERTIA)
     K = np.zeros((4, 4))
     K[1, 1] = K[2, 2] = K_MID
     K[1, 2] = K[2, 1] = -K_MID
-    W = np.array([[RBP[0], RBP[1], 0.0, 0.0], [0.0, 0.0, RBP[2], RBP[3]]])
+    W = np.array([[rb[0], rb[1], 0.0, 0.0], [0.0, 0.0, rb[2], rb[3]]])
     k = np.array([KA, KB])
-    order = np.array([1.0, Z[2] * Z[0] / Z[1] / Z[0]])
-    t_load = -T_IN * (Z[1] / Z[0]) * (Z[3] / Z[2])
+    order = np.array([1.0, z[2] * z[0] / z[1] / z[0]])
+    t_load = -T_IN * (z[1] / z[0]) * (z[3] / z[2])
     F = np.array([T_IN, 0.0, 0.0, t_load])
     w = model.omega * model.time_scale
     Minv = np.linalg.inv(M)
@@ -172,18 +182,20 @@ def _hand_rhs(model: TrainModel, backlash: float):
     return rhs, forces
 
 
-@pytest.mark.parametrize("backlash", [0.0, 20e-6])
-def test_two_stage_train_matches_dop853_on_hand_written_equations(backlash):
+@pytest.mark.parametrize(("backlash", "z"), [(0.0, Z), (20e-6, Z), (20e-6, Z_WHOLE)])
+def test_two_stage_train_matches_dop853_on_hand_written_equations(backlash, z):
+    """Stage 2 at 23/61 of stage 1's mesh frequency (quasi-periodic; its phase from the time)
+    or at twice it (periodic; its phase locked to stage 1's)."""
     rpm = 60.0 * 1190.0 / Z[0]  # stage 1's mesh near the train's second mode
-    model = _parallel(input_speed=rpm, backlash=backlash)
-    assert model.quasi_periodic
-    assert model.orders[1] == pytest.approx(Z[2] / Z[1], rel=1e-12)
+    model = _parallel(z, input_speed=rpm, backlash=backlash)
+    assert model.quasi_periodic == (z == Z)
+    assert model.orders[1] == (pytest.approx(Z[2] / Z[1], rel=1e-12) if z == Z else 2.0)
     L, w0 = model.length_scale, model.time_scale
     y0 = model.initial_state()
     run = geardyn.RunSettings(transient=0, samples=30, steps_per_period=256)
     ds = geardyn.simulate(model, run=run)
     tau = ds.time.values
-    rhs, forces = _hand_rhs(model, backlash)
+    rhs, forces = _hand_rhs(model, backlash, z)
     t = tau / w0
     y0_si = np.concatenate([L * y0[:4], L * w0 * y0[4:]])
     ref = solve_ivp(rhs, (0.0, t[-1]), y0_si, method="DOP853", rtol=1e-10, atol=1e-16,
@@ -193,7 +205,7 @@ def test_two_stage_train_matches_dop853_on_hand_written_equations(backlash):
     f = np.array([ds["F_stage1"].values, ds["F_stage2"].values])
     scale = np.max(np.abs(f_ref))
     d_ref = np.array([[RBP[0], RBP[1], 0.0, 0.0]]) @ ref.y[:4]
-    if backlash > 0.0:  # the teeth separate: the dead zone acts
+    if backlash > 0.0 and z == Z:  # the teeth separate: the dead zone acts
         assert np.any(np.abs(d_ref) < backlash) and int(ds.edge_crossings.sum()) > 0
     np.testing.assert_allclose(f, f_ref, rtol=0, atol=5e-6 * scale)
     q = np.array([ds[s].values for s in model.state_names[:4]]) * L
@@ -252,11 +264,13 @@ def test_speed_sweep_loses_contact_at_the_linear_resonance():
 
 
 # ---------------------------------------------------------------- inputs and refusals
-def test_quasi_periodic_forcing_refuses_periodic_orbits():
+def test_quasi_periodic_forcing_refuses_periodic_orbits_and_their_continuation():
     model = _parallel(input_speed=2000.0)
     assert model.dataset_attrs()["forcing"] == "quasi-periodic"
     with pytest.raises(ValueError, match="no common period"):
         geardyn.periodic_orbit(model)
+    with pytest.raises(ValueError, match="no common period"):
+        geardyn.continuation(model, "Omega", model.omega, 1.1 * model.omega)
 
 
 def test_unbalanced_torques_and_unknown_names_are_refused():

@@ -562,15 +562,15 @@ def planetary_rhs_lanes(T, Y, DY, PT, nl, S, C, SC):
             r = g + 2 + 2 * ng + e
             for k in range(nl):
                 DY[i, k] -= (PT[g, k] * PT[r, k]) * Y[j, k]
-    if _lanes_multi_order(PT, nl):
-        for m in range(nm):
-            _lanes_mesh_orders(Y, DY, PT, nl, T, S, C, SC, n, nh, mesh + m * bs,
-                               mz + m * 3 * MESH_NZ, True, two)
-        return
+    multi = _lanes_multi_order(PT, nl)
     kr = _lanes_cached_stiffness(PT, nl, S, C, SC, mz + nm * 3 * MESH_NZ, mesh, bs, nh, nm, two)
     for m in range(nm):
-        _lanes_mesh(Y, DY, PT, nl, S, C, SC, n, mesh + m * bs, mz + m * 3 * MESH_NZ, kr + m,
-                    True, two, kr + nm + m)
+        if multi and not _lanes_order_one(PT, nl, mesh + m * bs):
+            _lanes_mesh_orders(Y, DY, PT, nl, T, S, C, SC, n, nh, mesh + m * bs,
+                               mz + m * 3 * MESH_NZ, True, two)
+        else:
+            _lanes_mesh(Y, DY, PT, nl, S, C, SC, n, mesh + m * bs, mz + m * 3 * MESH_NZ,
+                        kr + m, True, two, kr + nm + m)
 
 
 @nb.njit(inline="always", **_JIT)
@@ -643,12 +643,13 @@ def _lanes_apply(DY, PT, nl, SC, n, q, apply):
 def planetary_events_lanes(T, Y, G, PT, nl, S, C):
     """:func:`planetary_events` for lanes 0..nl-1 of a block (the mesh phase S[k], C[k])."""
     n, nm, nh, mesh, bs, st, mz = _lanes_offsets(PT)
-    if _lanes_multi_order(PT, nl):
-        _events_lanes_orders(T, Y, G, PT, nl, S, C, n, nm, mesh, bs, mz)
-        return
+    multi = _lanes_multi_order(PT, nl)
     for m in range(nm):
         o = mesh + m * bs
         q = mz + m * 3 * MESH_NZ
+        if multi and not _lanes_order_one(PT, nl, o):
+            _events_lanes_orders(T, Y, G, PT, nl, S, C, n, m, o, q)
+            continue
         w = q + MESH_NZ
         i0 = int(PT[q, 0])
         i1 = int(PT[q + 1, 0])
@@ -678,20 +679,21 @@ def planetary_observe_lanes(T, Y, O, PT, nl, S, C, SC):
     two = False
     for k in range(nl):
         two |= PT[TWO_FLANK, k] != 0.0
-    if _lanes_multi_order(PT, nl):
-        for m in range(nm):
-            _lanes_mesh_orders(Y, O[m:m + 1], PT, nl, T, S, C, SC, n, nh, mesh + m * bs,
-                               mz + m * 3 * MESH_NZ, False, two)
-        return
+    multi = _lanes_multi_order(PT, nl)
     kr = _lanes_cached_stiffness(PT, nl, S, C, SC, mz + nm * 3 * MESH_NZ, mesh, bs, nh, nm, two)
     for m in range(nm):
-        _lanes_mesh(Y, O[m:m + 1], PT, nl, S, C, SC, n, mesh + m * bs, mz + m * 3 * MESH_NZ,
-                    kr + m, False, two, kr + nm + m)
+        if multi and not _lanes_order_one(PT, nl, mesh + m * bs):
+            _lanes_mesh_orders(Y, O[m:m + 1], PT, nl, T, S, C, SC, n, nh, mesh + m * bs,
+                               mz + m * 3 * MESH_NZ, False, two)
+        else:
+            _lanes_mesh(Y, O[m:m + 1], PT, nl, S, C, SC, n, mesh + m * bs,
+                        mz + m * 3 * MESH_NZ, kr + m, False, two, kr + nm + m)
 
 
 # ---------------------------------------------------------------------------------------------
-# Lane-block forms where a mesh's order differs from 1 (a gear train's stages): each mesh at its
-# own phase (:func:`_mesh_phase`) per lane, its relative stiffness computed there (no cache).
+# Lane-block forms of a mesh whose order differs from 1 in a lane (a gear train's other stages):
+# the mesh at its own phase (:func:`_mesh_phase`) per lane, its relative stiffness computed
+# there (not cached); a mesh of order 1 in every lane keeps the shared-phase forms.
 
 
 @nb.njit(inline="always", **_JIT)
@@ -701,6 +703,16 @@ def _lanes_multi_order(PT, nl):
     for k in range(nl):
         multi |= PT[MULTI_ORDER, k] != 0.0
     return multi
+
+
+@nb.njit(inline="always", **_JIT)
+def _lanes_order_one(PT, nl, o):
+    """Whether the mesh whose block is at o has order 1 in every lane of the block (then the
+    shared-phase forms serve it)."""
+    one = True
+    for k in range(nl):
+        one &= PT[o + M_ORDER, k] == 1.0
+    return one
 
 
 @nb.njit(inline="always", **_JIT)
@@ -737,15 +749,13 @@ def _lanes_mesh_orders(Y, DY, PT, nl, T, S, C, SC, n, nh, o, q, apply, two):
 
 
 @nb.njit(inline="always", **_JIT)
-def _events_lanes_orders(T, Y, G, PT, nl, S, C, n, nm, mesh, bs, mz):
-    """:func:`planetary_events_lanes` with every mesh at its own phase (:func:`_mesh_phase`)."""
-    for m in range(nm):
-        o = mesh + m * bs
-        q = mz + m * 3 * MESH_NZ
-        i0, i1, i2, i3, i4, i5 = _mesh_dofs(PT, q)
-        w = q + MESH_NZ
-        for k in range(nl):
-            s, c, om = _mesh_phase(T[k], PT[o + M_ORDER, k], PT[OMEGA, k], S[k], C[k])
-            d, _ = _lane_deflection(Y, PT, k, n, o, w, i0, i1, i2, i3, i4, i5, s, c, om)
-            G[2 * m, k] = d - PT[o + M_B, k]
-            G[2 * m + 1, k] = d + PT[o + M_B, k]
+def _events_lanes_orders(T, Y, G, PT, nl, S, C, n, m, o, q):
+    """:func:`planetary_events_lanes`' rows of mesh m (block at o, structure at q) at the
+    mesh's own phase (:func:`_mesh_phase`)."""
+    i0, i1, i2, i3, i4, i5 = _mesh_dofs(PT, q)
+    w = q + MESH_NZ
+    for k in range(nl):
+        s, c, om = _mesh_phase(T[k], PT[o + M_ORDER, k], PT[OMEGA, k], S[k], C[k])
+        d, _ = _lane_deflection(Y, PT, k, n, o, w, i0, i1, i2, i3, i4, i5, s, c, om)
+        G[2 * m, k] = d - PT[o + M_B, k]
+        G[2 * m + 1, k] = d + PT[o + M_B, k]
