@@ -9,10 +9,12 @@ Omega alone), no continuation, through ``geardyn.bifurcation``, a transient of
 periods at higher speeds), ``--samples`` (32) Poincare points, default steps per period. Prints
 the workload (lane-steps), the median of ``--repeat`` warm runs (wall and process CPU time), ns
 per lane-step and a checksum of the Poincare points; ``--write`` records the median in the
-current-figures table of bench/RESULTS.md (row ``train-sweep``).
+current-figures table of bench/RESULTS.md (row ``train-sweep``). ``--order-one`` sets stage 2's
+order to 1 (one mesh frequency: the planetary kernels' shared-phase path) to show what the
+second frequency costs; not with ``--write``.
 
     .venv/bin/python bench/train.py [--threads 2] [--repeat 3] [--transient-periods 200]
-        [--samples 32] [--write]
+        [--samples 32] [--order-one] [--write]
 """
 
 from __future__ import annotations
@@ -41,10 +43,16 @@ def main() -> None:
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--transient-periods", type=float, default=200.0)
     ap.add_argument("--samples", type=int, default=32)
+    ap.add_argument("--order-one", action="store_true",
+                    help="stage 2's order set to 1 (one mesh frequency), for comparison")
     ap.add_argument("--write", action="store_true", help="record the figure in RESULTS.md")
     args = ap.parse_args()
+    if args.order_one and args.write:
+        ap.error("--order-one is a comparison, not the benchmark: not with --write")
     numba.set_num_threads(args.threads)
     model = geardyn.build_model(builtin_study("two_stage_train"))
+    if args.order_one:
+        model = model.with_params(stage2_order=1.0)
     rpm = np.linspace(1000.0, 6000.0, 400)
     P = model.lane_params("input_speed", rpm)
     omegas = P[:, model.omega_index]

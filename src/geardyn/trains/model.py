@@ -139,7 +139,7 @@ class TrainModel(PlanetaryGearSet):
         names = tuple(m.name for m in train.meshes)
         self._mesh_names = names
         self.reference_mesh = self._reference(reference_mesh)
-        self.orders = self._orders()
+        self._kinematic_orders = self._orders()
         self.fixed = tuple(train.fixed)
         if isinstance(harmonics, bool) or not isinstance(harmonics, int) \
                 or not 1 <= harmonics <= 200:
@@ -203,6 +203,14 @@ class TrainModel(PlanetaryGearSet):
             bad = self._mesh_names[int(np.argmax(r <= 0.0))]
             raise ParameterError(f"{bad}", 0.0, "the mesh does not turn with the input")
         return np.where(snap, whole, r)
+
+    @property
+    def orders(self) -> np.ndarray:
+        """r_m of every mesh: its mesh frequency over the reference mesh's (the coefficient
+        vector's, so a raw override of ``<mesh>_order`` shows)."""
+        lay = self._layout
+        return np.array([self.params[lay["mesh"] + m * lay["block"] + pk.M_ORDER]
+                         for m in range(len(self._mesh_names))])
 
     @property
     def quasi_periodic(self) -> bool:
@@ -405,7 +413,7 @@ class TrainModel(PlanetaryGearSet):
             blk[pk.M_KF] = k[m] * L
             blk[pk.M_CF] = c[m] * L * w0
             blk[pk.M_KFC] = k[m] * L
-            blk[pk.M_ORDER] = self.orders[m]
+            blk[pk.M_ORDER] = self._kinematic_orders[m]
             f = pk.MESH_FIXED
             blk[f:f + 2 * nh] = self.fourier[m]
             blk[f + 2 * nh:f + 2 * nh + n] = W[m]
@@ -487,7 +495,7 @@ class TrainModel(PlanetaryGearSet):
         P = np.atleast_2d(P)
         torque = PlanetaryGearSet.other_frequencies(self, P)
         lay = self._layout
-        idx = [lay["mesh"] + m * lay["block"] + pk.M_ORDER for m in range(len(self.orders))]
+        idx = [lay["mesh"] + m * lay["block"] + pk.M_ORDER for m in range(len(self._mesh_names))]
         r = P[:, idx]
         return np.hstack([torque, np.where(r != 1.0, r * P[:, pk.OMEGA, None], np.nan)])
 
