@@ -345,3 +345,15 @@ def test_cli_bifurcation_in_rpm_writes_what_the_api_computes(tmp_path):
                                  run=geardyn.RunSettings(transient=60.0, samples=6,
                                                          steps_per_period=64))
     np.testing.assert_array_equal(saved["poincare"].values, direct["poincare"].values)
+
+
+def test_cli_params_show_and_simulate_take_the_speed_from_params(tmp_path):
+    from test_cli import invoke
+
+    r = invoke("params", "show", "two_stage_train")
+    assert r.returncode == 0, r.stderr
+    assert "stage2 0.377049 (quasi-periodic forcing)" in r.stdout
+    r = invoke("simulate", "two_stage_train", "--periods", "4", "--transient", "10",
+               "--out", tmp_path / "s.nc")
+    assert r.returncode == 0, r.stderr
+    assert "Omega = 0.989278" in r.stdout  # [params].input_speed 3000 rpm
