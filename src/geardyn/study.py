@@ -20,7 +20,13 @@ from pydantic import ValidationError
 
 from geardyn.core.model import Model
 from geardyn.errors import ParameterError, StudyError
-from geardyn.io.toml import GearPairParams, PlanetaryGearSetParams, SpurPairParams, Study
+from geardyn.io.toml import (
+    GearPairParams,
+    PlanetaryGearSetParams,
+    SpurPairParams,
+    Study,
+    TrainModelParams,
+)
 from geardyn.models.catt import CATTDevice
 from geardyn.models.derived import INTERPRETATIONS
 from geardyn.models.gear_pair import GearPair
@@ -29,7 +35,7 @@ from geardyn.models.spur_pair import SpurPair, period_cycles
 from geardyn.units import to_si
 
 __all__ = ["build_model", "check_usable", "mesh_stiffness", "planetary_model",
-           "spur_pair_model", "study_omega"]
+           "spur_pair_model", "study_omega", "train_model"]
 
 
 def require_model(study: Study) -> None:
@@ -68,6 +74,8 @@ def build_model(study: Study, interpretation: str | None = None, omega: float | 
         return check_usable(lambda: planetary_model(study.params, om))
     if isinstance(study.params, SpurPairParams):
         return check_usable(lambda: spur_pair_model(study, om))
+    if isinstance(study.params, TrainModelParams):
+        return check_usable(lambda: train_model(study, om))
     return check_usable(lambda: CATTDevice(
         study.planetary_params,
         interpretation or study.study.interpretation,  # type: ignore[arg-type]
@@ -110,6 +118,20 @@ def mesh_stiffness(study: Study, faults: bool = True, loaded: bool = True) -> xr
     return ds
 
 
+def train_model(study: Study, omega: float | None = None) -> Model:
+    """The :class:`~geardyn.trains.TrainModel` of a ``train`` study: the ``[train]`` table's
+    gear train with the inputs of ``[params]`` (at the forcing frequency Omega ``omega`` where
+    given). Errors name ``params.<field>``."""
+    from geardyn.trains import TrainModel
+
+    kw = study.params.model_dump()  # type: ignore[union-attr]
+    try:
+        model = TrainModel(study.gear_train, **kw)
+    except ParameterError as exc:
+        raise ParameterError(f"params.{exc.field}", exc.value, exc.reason) from None
+    return model if omega is None else model.with_omega(float(omega))
+
+
 def spur_pair_model(study: Study, omega: float | None = None) -> SpurPair:
     """:meth:`SpurPair.from_geometry` of a ``spur_pair`` study: the pair, bores, material and
     faults of ``[gears]`` and ``[[faults]]``, the angles and quadrature of ``[stiffness]``,
@@ -145,12 +167,13 @@ def spur_pair_model(study: Study, omega: float | None = None) -> SpurPair:
 def study_omega(study: Study, model: Model, given: float | None = None) -> float | None:
     """The forcing frequency Omega of a run of ``study``: ``given`` (a command's --omega),
     else ``[run].omega``, else, for a model whose ``[params]`` set it (a spur pair's speed),
-    the model's; None where the study sets none."""
+    the model's (a spur pair's speed, a train's input speed); None where the study sets
+    none."""
     if given is not None:
         return given
     if study.run.omega is not None:
         return study.run.omega
-    return model.omega if isinstance(study.params, SpurPairParams) else None
+    return model.omega if isinstance(study.params, SpurPairParams | TrainModelParams) else None
 
 
 def planetary_model(params: PlanetaryGearSetParams, omega: float | None = None

@@ -84,7 +84,7 @@ def basins_command(
     interp = interpretation.value if interpretation is not None else None
     om = omega if omega is not None else s.run.omega
     base = None
-    if om is None and s.study.model == "spur_pair":  # Omega from the study's params.speed
+    if om is None and s.study.model in ("spur_pair", "train"):  # Omega from [params]
         base = build_model(s, interpretation=interp)
         om = study_omega(s, base)
     if om is None:

@@ -164,16 +164,22 @@ def params_show(
     if s.study.model == "spur_pair":
         _show_spur_pair(out, model)
         return
-    if s.study.model == "planetary":
+    if s.study.model in ("planetary", "train"):
         out.print(f"{escape(repr(model))}: time scale omega_0 = {_fmt(model.time_scale)} rad/s, "
                   f"length scale L = {_fmt(model.length_scale)} m")
+        if s.study.model == "train":
+            orders = ", ".join(f"{m} {_fmt(r)}" for m, r in zip(model.mesh_names, model.orders,
+                                                                 strict=True))
+            out.print(f"mesh orders over {model.reference_mesh}: {escape(orders)} "
+                      f"({model.dataset_attrs()['forcing']} forcing)")
         modes = model.modes()
+        kinds = "type" in modes
         table = Table(title="Natural frequencies (linear model, mean stiffness)")
-        for col in ("f [Hz]", "multiplicity", "type"):
+        for col in ("f [Hz]", "multiplicity", *(("type",) if kinds else ())):
             table.add_column(col, justify="right")
         for k in range(modes.sizes["mode"]):
             table.add_row(_fmt(float(modes["frequency"][k])), str(int(modes["multiplicity"][k])),
-                          str(modes["type"].values[k]))
+                          *((str(modes["type"].values[k]),) if kinds else ()))
         out.print(table)
         return
 
@@ -293,7 +299,7 @@ def simulate(
     interp = interpretation.value if interpretation is not None else None
     om = omega if omega is not None else s.run.omega
     base = None
-    if om is None and s.study.model == "spur_pair":  # Omega from the study's params.speed
+    if om is None and s.study.model in ("spur_pair", "train"):  # Omega from [params]
         base = build_model(s, interpretation=interp)
         om = study_omega(s, base)
     if om is None:

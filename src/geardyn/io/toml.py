@@ -61,7 +61,11 @@ and profile shifts then in the normal section) or ``internal = true`` (the wheel
 ``[gears.wheel]`` ``bore_radius`` the ring's outer radius; ``ring_foundation``).
 
 A gear train from elements (``geardyn modes``), with or instead of ``[params]``: the
-``[train]`` table (:mod:`geardyn.io.train_table`).
+``[train]`` table (:mod:`geardyn.io.train_table`). For ``model = "train"`` the model is that
+train's nonlinear model, :class:`~geardyn.trains.TrainModel`, and ``[params]``
+(:class:`TrainModelParams`) holds its inputs: ``input_speed`` [rpm], ``torques`` (``{body =
+torque}``), ``load``, ``backlash``, ``mesh_damping``, ``stiffness_fluctuation``, ``mesh_phase``,
+``mesh_error`` (each a scalar or ``{mesh = value}``), ...
 
 For ``model = "spur_pair"`` the model is :meth:`geardyn.SpurPair.from_geometry` of the
 ``[gears]``, ``[[faults]]`` and ``[stiffness]`` tables, and ``[params]``
@@ -190,7 +194,7 @@ _HEADER = (
     "# Unit strings such as \"50 um\" or \"20 deg\" are accepted on input.\n\n"
 )
 
-Model = Literal["catt", "gear_pair", "planetary", "spur_pair"]
+Model = Literal["catt", "gear_pair", "planetary", "spur_pair", "train"]
 DEFAULT_PLOT_STATE: dict[str, str] = {"catt": "X_sq", "gear_pair": "x", "planetary": "u_s",
                                       "spur_pair": "x"}
 
@@ -591,6 +595,40 @@ class PlanetaryGearSetParams(BaseModel):
     length_scale: Quantity = 1e-6
 
 
+#: A quantity for every mesh, or one per mesh by name ({mesh = value}).
+PerMesh = float | str | dict[str, float | str]
+
+
+class TrainModelParams(BaseModel):
+    """``[params]`` of a ``train`` study: the arguments of :class:`~geardyn.trains.TrainModel`
+    but the train (the study's ``[train]`` table); types checked here, values when the model
+    is built (errors name ``params.<field>``)."""
+
+    model_config = _CONFIG
+
+    reference_mesh: str | None = None
+    input_speed: Quantity | None = Field(None, description="driven body's speed (rpm, or a "
+                                         "unit string)")
+    mesh_frequency: Quantity | None = None
+    torques: dict[str, Quantity] = Field(default_factory=dict)
+    load: str | None = None
+    backlash: PerMesh = 0.0
+    mesh_damping: PerMesh = 0.0
+    modal_damping: float = 0.0
+    stiffness_fluctuation: PerMesh = 0.0
+    waveform: Literal["sine", "rectangular"] = "sine"
+    contact_ratio: float = 1.6
+    harmonics: int = 9
+    mesh_phase: PerMesh = 0.0
+    mesh_error: PerMesh = 0.0
+    error_phase: PerMesh = 0.0
+    torque_fluctuation: float = 0.0
+    torque_order: float = 1.0
+    torque_phase: Quantity = 0.0
+    time_scale: Quantity | None = None
+    length_scale: Quantity = 1e-6
+
+
 # --------------------------------------------------------------------------- gears and faults
 #: Young's modulus: an SI number [Pa] or a unit string ("206.8 GPa").
 Pressure = Annotated[float, BeforeValidator(lambda v: to_si(v, "pressure")), Field(gt=0)]
@@ -923,7 +961,7 @@ class Study(BaseModel):
 
     study: StudyInfo = Field(default_factory=StudyInfo)
     params: (PlanetaryParams | PaperBase | GearPairParams | PlanetaryGearSetParams
-             | SpurPairParams | None) = None
+             | SpurPairParams | TrainModelParams | None) = None
     run: RunTable = Field(default_factory=RunTable)
     sweep: SweepSettings | None = None
     gears: GearsTable | None = None
@@ -1029,6 +1067,8 @@ class Study(BaseModel):
             target = SpurPairParams
         elif kind == "planetary":
             target = PlanetaryGearSetParams
+        elif kind == "train":
+            target = TrainModelParams
         elif "base" in raw:
             out["params"] = _resolve_paper(raw)[0]
             return out
@@ -1049,13 +1089,18 @@ class Study(BaseModel):
             return self
         holds = ("gear_pair" if isinstance(self.params, GearPairParams) else "planetary"
                  if isinstance(self.params, PlanetaryGearSetParams) else "spur_pair"
-                 if isinstance(self.params, SpurPairParams) else "catt")
+                 if isinstance(self.params, SpurPairParams) else "train"
+                 if isinstance(self.params, TrainModelParams) else "catt")
         if holds != self.study.model:
             kind = {"gear_pair": "GearPair", "planetary": "PlanetaryGearSet",
-                    "catt": "PlanetaryParams", "spur_pair": "SpurPair"}[holds]
+                    "catt": "PlanetaryParams", "spur_pair": "SpurPair",
+                    "train": "TrainModel"}[holds]
             raise ValueError(
                 f"study.model is {self.study.model!r} but [params] holds {kind} parameters"
             )
+        if holds == "train" and self.train is None:
+            raise _study_error(("train",), None, "required by a train study (the gear train "
+                               "whose model [params] describes)", "missing")
         if isinstance(self.params, PaperBase):
             self._planetary = _resolve_paper(self.params.model_dump())[1]
         elif isinstance(self.params, PlanetaryParams):

@@ -1142,6 +1142,7 @@ class PlanetaryGearSet(Model):
             blk[pk.M_KF] = k[m] * L
             blk[pk.M_CF] = c[m] * L * w0
             blk[pk.M_KFC] = kc[m] * L
+            blk[pk.M_ORDER] = 1.0
             f = pk.MESH_FIXED
             blk[f:f + 2 * nh] = self.fourier[m]
             blk[f + 2 * nh:f + 2 * nh + n] = W[m]
@@ -1286,7 +1287,16 @@ class PlanetaryGearSet(Model):
         P[:, pk.DAMPED] = np.any(P[:, lay["Ct"]:lay["Ct"] + n * n] != 0.0, axis=1)
         P[:, pk.TORQUE_ON] = np.any(P[:, lay["F1"]:lay["F1"] + n] != 0.0, axis=1)
         P[:, pk.TWO_FLANK] = self._two_flank(P)
+        P[:, pk.MULTI_ORDER] = self._multi_order(P)
         pk.fill_structure(P, *self._structure)
+
+    def _multi_order(self, P: np.ndarray) -> np.ndarray:
+        """The kernel's ``MULTI_ORDER`` of every row of ``P``: 1.0 where a mesh's order differs
+        from 1, else 0.0."""
+        lay = self._layout
+        nm = int(P[0, pk.N_MESH])
+        idx = [lay["mesh"] + m * lay["block"] + pk.M_ORDER for m in range(nm)]
+        return np.any(P[:, idx] != 1.0, axis=1).astype(float)
 
     def _two_flank(self, P: np.ndarray) -> np.ndarray:
         """The kernel's ``TWO_FLANK`` of every row of ``P``: 1.0 where a coast flank was given

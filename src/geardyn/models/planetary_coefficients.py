@@ -37,6 +37,8 @@ HEADER = CoefficientBlock((
     workspace_entry("damped", "1 where Ct is not zero (kernel flag)"),
     workspace_entry("two_flank", "1 where a mesh's coast flank differs from its drive flank "
                     "(KF_coast or the coast harmonics; kernel flag)", constant="TWO_FLANK"),
+    workspace_entry("multi_order", "1 where a mesh's order differs from 1 (kernel flag)",
+                    constant="MULTI_ORDER"),
 ))
 #: Per coordinate d: F0_d, F1_d (names suffixed _d); per pair (a, b): Kt_a_b, Ct_a_b.
 FORCES = CoefficientBlock((
@@ -65,6 +67,9 @@ MESH = CoefficientBlock((
     _d("KF_coast", "N", "coast-flank mesh force per unit deflection X (k_c,m L), acting where "
        "the deflection is below -b", "sun_coast_stiffness", "ring_coast_stiffness",
        "sun_mesh_stiffness", "ring_mesh_stiffness", "length_scale", constant="M_KFC"),
+    Coefficient("order", "1", "the mesh's frequency over the forcing frequency Omega (1: the "
+                "forcing mesh's; a gear train's other stages differ)", default=1.0,
+                exclusive_minimum=0.0, constant="M_ORDER"),
 ))
 #: Per coordinate d of a mesh: its deflection row W_d and M^-1 W / (L omega_0^2), G_d.
 MESH_ROW = CoefficientBlock((

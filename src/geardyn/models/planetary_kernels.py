@@ -23,6 +23,12 @@ right-hand side and in the switching functions, and a torque fluctuation of inte
 order r is a second, incommensurate excitation: its phase is r Omega tau + psi from the time tau
 the solver passes (the time since the start of the sweep's chain or of the run).
 
+A mesh's ``order`` r_m (its frequency over Omega; 1 in a planetary set, a gear train's other
+stages differ) moves its phase the same way (:func:`_mesh_phase`): theta for r_m = 1 (the
+arithmetic above, operation for operation), r_m theta for another integer, r_m Omega tau from
+the time tau otherwise (quasi-periodic forcing). The header flag ``MULTI_ORDER`` (1 where a mesh's
+order differs from 1) takes the kernels off the shared-stiffness and cached paths.
+
 Coefficient vector: a header (``DAMPED`` is 1 where Ct is not zero), the dof vectors F0, F1, the
 matrices Kt, Ct (row-major), one block per mesh (fixed entries, 2 nh Fourier coefficients, W, G, 2
 nh coast-flank Fourier coefficients), then the *structure* the kernels read
@@ -60,12 +66,12 @@ _H = HEADER_BLOCK.offset
 OMEGA, N_DOF, N_MESH, N_HARM = _H("Omega"), _H("n_dof"), _H("n_meshes"), _H("n_harmonics")
 TORQUE_ON, TORQUE_ORDER = _H("torque_on"), _H("torque_order")
 TORQUE_PHASE, DAMPED = _H("torque_phase"), _H("damped")
-TWO_FLANK = _H("two_flank")
+TWO_FLANK, MULTI_ORDER = _H("two_flank"), _H("multi_order")
 HEADER = HEADER_BLOCK.size
 # mesh block fixed entries
 _M = MESH.offset
 M_B, M_ES, M_EC, M_KF, M_CF = _M("b"), _M("E_s"), _M("E_c"), _M("KF"), _M("CF")
-M_KFC = _M("KF_coast")
+M_KFC, M_ORDER = _M("KF_coast"), _M("order")
 MESH_FIXED = MESH.size
 #: Structural entries per mesh row in the structure section (padded with zero weights).
 MESH_NZ = 6
@@ -232,9 +238,23 @@ def _gyro_offset(nm, mz):
 
 
 @nb.njit(inline="always", **_JIT)
-def _mesh_state(y, p, o, q, n, s, c):
+def _mesh_phase(t, order, omega, s, c):
+    """sin, cos and rate of a mesh's phase: the forcing phase (s, c; rate omega) for order 1;
+    order theta for another integer order (locked to the forcing phase theta); order omega t
+    otherwise (from the time t, as :func:`_torque_wave`: quasi-periodic forcing)."""
+    if order == 1.0:
+        return s, c, omega
+    if order == math.floor(order):
+        th = order * math.atan2(s, c)
+    else:
+        th = order * omega * t
+    return math.sin(th), math.cos(th), order * omega
+
+
+@nb.njit(inline="always", **_JIT)
+def _mesh_state(y, p, o, q, n, s, c, om):
     """Deflection minus error and its rate (W . X - e, W . X' - e') of the mesh block at o, its
-    structure at q."""
+    structure at q, at the mesh phase s, c turning at om."""
     d = 0.0
     v = 0.0
     for j in range(MESH_NZ):
@@ -242,15 +262,15 @@ def _mesh_state(y, p, o, q, n, s, c):
         w = p[q + MESH_NZ + j]
         d += w * y[i]
         v += w * y[n + i]
-    om = p[OMEGA]
     d -= p[o + M_ES] * s + p[o + M_EC] * c
     v -= om * (p[o + M_ES] * c - p[o + M_EC] * s)
     return d, v
 
 
 @nb.njit(inline="always", **_JIT)
-def _mesh_force(y, p, o, q, n, nh, s, c):
-    d, v = _mesh_state(y, p, o, q, n, s, c)
+def _mesh_force(t, y, p, o, q, n, nh, s, c):
+    s, c, om = _mesh_phase(t, p[o + M_ORDER], p[OMEGA], s, c)
+    d, v = _mesh_state(y, p, o, q, n, s, c, om)
     g = _dead_zone(d, p[o + M_B])
     if g < 0.0 and p[TWO_FLANK] != 0.0:  # the coast flank
         kc = _relative_stiffness(p, o + coast_offset(n, nh), nh, s, c)
@@ -280,7 +300,7 @@ def _mesh_forces_shared(y, out, p, n, nm, nh, mesh, bs, mz, s, c):
             out[m] = 1.0 + out[m]
     for m in range(nm):
         o = mesh + m * bs
-        d, v = _mesh_state(y, p, o, mz + m * 3 * MESH_NZ, n, s, c)
+        d, v = _mesh_state(y, p, o, mz + m * 3 * MESH_NZ, n, s, c, p[OMEGA])
         out[m] = p[o + M_KF] * out[m] * _dead_zone(d, p[o + M_B]) + p[o + M_CF] * v
 
 
@@ -302,7 +322,7 @@ def planetary_rhs(t, y, dy, p, s, c):
     if p[TORQUE_ON] != 0.0:
         fl = _torque_wave(t, p[TORQUE_ORDER], p[OMEGA], p[TORQUE_PHASE], s, c)
     # the mesh forces first, into dy[:nm] (scratch until the end); per mesh with two flanks
-    shared = nm <= n and p[TWO_FLANK] == 0.0
+    shared = nm <= n and p[TWO_FLANK] == 0.0 and p[MULTI_ORDER] == 0.0
     if shared:
         _mesh_forces_shared(y, dy, p, n, nm, nh, mesh, bs, mz, s, c)
     f1 = HEADER + n
@@ -328,7 +348,7 @@ def planetary_rhs(t, y, dy, p, s, c):
             dy[n + int(p[g + 2 + e])] -= (wc * p[g + 2 + 2 * ng + e]) * y[j]
     for m in range(nm):
         q = mz + m * 3 * MESH_NZ
-        f = dy[m] if shared else _mesh_force(y, p, mesh + m * bs, q, n, nh, s, c)
+        f = dy[m] if shared else _mesh_force(t, y, p, mesh + m * bs, q, n, nh, s, c)
         for j in range(MESH_NZ):
             dy[n + int(p[q + j])] -= f * p[q + 2 * MESH_NZ + j]
     for i in range(n):
@@ -338,11 +358,12 @@ def planetary_rhs(t, y, dy, p, s, c):
 @nb.njit(**_JIT)
 def planetary_events(t, y, g, p, s, c):
     """Dead-zone edges: x_m - b_m and x_m + b_m of every mesh (x_m = W_m . X - e_m, the error
-    at the mesh phase s, c)."""
+    at the mesh's phase, :func:`_mesh_phase`)."""
     n, nm, nh, mesh, bs, st, mz = _offsets(p)
     for m in range(nm):
         o = mesh + m * bs
-        d, _ = _mesh_state(y, p, o, mz + m * 3 * MESH_NZ, n, s, c)
+        sm, cm, om = _mesh_phase(t, p[o + M_ORDER], p[OMEGA], s, c)
+        d, _ = _mesh_state(y, p, o, mz + m * 3 * MESH_NZ, n, sm, cm, om)
         g[2 * m] = d - p[o + M_B]
         g[2 * m + 1] = d + p[o + M_B]
 
@@ -351,11 +372,11 @@ def planetary_events(t, y, g, p, s, c):
 def planetary_observe(t, y, out, p, s, c):
     """Dynamic mesh forces [N], one per mesh (sun-planet meshes, then ring-planet meshes)."""
     n, nm, nh, mesh, bs, st, mz = _offsets(p)
-    if p[TWO_FLANK] == 0.0:
+    if p[TWO_FLANK] == 0.0 and p[MULTI_ORDER] == 0.0:
         _mesh_forces_shared(y, out, p, n, nm, nh, mesh, bs, mz, s, c)
         return
     for m in range(nm):
-        out[m] = _mesh_force(y, p, mesh + m * bs, mz + m * 3 * MESH_NZ, n, nh, s, c)
+        out[m] = _mesh_force(t, y, p, mesh + m * bs, mz + m * 3 * MESH_NZ, n, nh, s, c)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -541,10 +562,15 @@ def planetary_rhs_lanes(T, Y, DY, PT, nl, S, C, SC):
             r = g + 2 + 2 * ng + e
             for k in range(nl):
                 DY[i, k] -= (PT[g, k] * PT[r, k]) * Y[j, k]
+    multi = _lanes_multi_order(PT, nl)
     kr = _lanes_cached_stiffness(PT, nl, S, C, SC, mz + nm * 3 * MESH_NZ, mesh, bs, nh, nm, two)
     for m in range(nm):
-        _lanes_mesh(Y, DY, PT, nl, S, C, SC, n, mesh + m * bs, mz + m * 3 * MESH_NZ, kr + m,
-                    True, two, kr + nm + m)
+        if multi and not _lanes_order_one(PT, nl, mesh + m * bs):
+            _lanes_mesh_orders(Y, DY, PT, nl, T, S, C, SC, n, nh, mesh + m * bs,
+                               mz + m * 3 * MESH_NZ, True, two)
+        else:
+            _lanes_mesh(Y, DY, PT, nl, S, C, SC, n, mesh + m * bs, mz + m * 3 * MESH_NZ,
+                        kr + m, True, two, kr + nm + m)
 
 
 @nb.njit(inline="always", **_JIT)
@@ -555,10 +581,10 @@ def _mesh_dofs(PT, q):
 
 
 @nb.njit(inline="always", **_JIT)
-def _lane_deflection(Y, PT, k, n, o, w, i0, i1, i2, i3, i4, i5, s, c):
+def _lane_deflection(Y, PT, k, n, o, w, i0, i1, i2, i3, i4, i5, s, c, om):
     """Lane k's mesh deflection d less the mesh error, and its rate v (block at o, projection
-    weights at row w, dofs i0..i5; s, c: the lane's mesh phase), in the order every form sums
-    them."""
+    weights at row w, dofs i0..i5; s, c: the lane's mesh phase, turning at om), in the order
+    every form sums them."""
     d = 0.0
     v = 0.0
     d += PT[w, k] * Y[i0, k]
@@ -574,7 +600,7 @@ def _lane_deflection(Y, PT, k, n, o, w, i0, i1, i2, i3, i4, i5, s, c):
     d += PT[w + 5, k] * Y[i5, k]
     v += PT[w + 5, k] * Y[n + i5, k]
     d -= PT[o + M_ES, k] * s + PT[o + M_EC, k] * c
-    v -= PT[OMEGA, k] * (PT[o + M_ES, k] * c - PT[o + M_EC, k] * s)
+    v -= om * (PT[o + M_ES, k] * c - PT[o + M_EC, k] * s)
     return d, v
 
 
@@ -588,7 +614,8 @@ def _lanes_mesh(Y, DY, PT, nl, S, C, SC, n, o, q, row, apply, two, rowc):
     i0, i1, i2, i3, i4, i5 = _mesh_dofs(PT, q)
     w = q + MESH_NZ
     for k in range(nl):
-        d, v = _lane_deflection(Y, PT, k, n, o, w, i0, i1, i2, i3, i4, i5, S[k], C[k])
+        d, v = _lane_deflection(Y, PT, k, n, o, w, i0, i1, i2, i3, i4, i5, S[k], C[k],
+                                PT[OMEGA, k])
         g = _dead_zone(d, PT[o + M_B, k])
         kf = PT[o + M_KF, k] * PT[row, k]
         if two and g < 0.0:
@@ -616,9 +643,13 @@ def _lanes_apply(DY, PT, nl, SC, n, q, apply):
 def planetary_events_lanes(T, Y, G, PT, nl, S, C):
     """:func:`planetary_events` for lanes 0..nl-1 of a block (the mesh phase S[k], C[k])."""
     n, nm, nh, mesh, bs, st, mz = _lanes_offsets(PT)
+    multi = _lanes_multi_order(PT, nl)
     for m in range(nm):
         o = mesh + m * bs
         q = mz + m * 3 * MESH_NZ
+        if multi and not _lanes_order_one(PT, nl, o):
+            _events_lanes_orders(T, Y, G, PT, nl, S, C, n, m, o, q)
+            continue
         w = q + MESH_NZ
         i0 = int(PT[q, 0])
         i1 = int(PT[q + 1, 0])
@@ -648,7 +679,83 @@ def planetary_observe_lanes(T, Y, O, PT, nl, S, C, SC):
     two = False
     for k in range(nl):
         two |= PT[TWO_FLANK, k] != 0.0
+    multi = _lanes_multi_order(PT, nl)
     kr = _lanes_cached_stiffness(PT, nl, S, C, SC, mz + nm * 3 * MESH_NZ, mesh, bs, nh, nm, two)
     for m in range(nm):
-        _lanes_mesh(Y, O[m:m + 1], PT, nl, S, C, SC, n, mesh + m * bs, mz + m * 3 * MESH_NZ,
-                    kr + m, False, two, kr + nm + m)
+        if multi and not _lanes_order_one(PT, nl, mesh + m * bs):
+            _lanes_mesh_orders(Y, O[m:m + 1], PT, nl, T, S, C, SC, n, nh, mesh + m * bs,
+                               mz + m * 3 * MESH_NZ, False, two)
+        else:
+            _lanes_mesh(Y, O[m:m + 1], PT, nl, S, C, SC, n, mesh + m * bs,
+                        mz + m * 3 * MESH_NZ, kr + m, False, two, kr + nm + m)
+
+
+# ---------------------------------------------------------------------------------------------
+# Lane-block forms of a mesh whose order differs from 1 in a lane (a gear train's other stages):
+# the mesh at its own phase (:func:`_mesh_phase`) per lane, its relative stiffness computed
+# there (not cached); a mesh of order 1 in every lane keeps the shared-phase forms.
+
+
+@nb.njit(inline="always", **_JIT)
+def _lanes_multi_order(PT, nl):
+    """Whether a lane of the block has a mesh whose order differs from 1."""
+    multi = False
+    for k in range(nl):
+        multi |= PT[MULTI_ORDER, k] != 0.0
+    return multi
+
+
+@nb.njit(inline="always", **_JIT)
+def _lanes_order_one(PT, nl, o):
+    """Whether the mesh whose block is at o has order 1 in every lane of the block (then the
+    shared-phase forms serve it)."""
+    one = True
+    for k in range(nl):
+        one &= PT[o + M_ORDER, k] == 1.0
+    return one
+
+
+@nb.njit(inline="always", **_JIT)
+def _lane_relative_stiffness(PT, k, f, nh, s, c):
+    """:func:`_relative_stiffness` of lane k (coefficients from row f), the same operations."""
+    if nh == 0:
+        return 1.0
+    acc = PT[f, k] * c + PT[f + 1, k] * s
+    ch = c
+    sh = s
+    for h in range(1, nh):
+        ch, sh = ch * c - sh * s, sh * c + ch * s
+        acc += PT[f + 2 * h, k] * ch + PT[f + 2 * h + 1, k] * sh
+    return 1.0 + acc
+
+
+@nb.njit(inline="always", **_JIT)
+def _lanes_mesh_orders(Y, DY, PT, nl, T, S, C, SC, n, nh, o, q, apply, two):
+    """:func:`_lanes_mesh` with the mesh at its own phase in every lane (:func:`_mesh_phase`):
+    the phase, the acting flank's relative stiffness and the force in one pass per lane."""
+    i0, i1, i2, i3, i4, i5 = _mesh_dofs(PT, q)
+    w = q + MESH_NZ
+    fc = o + coast_offset(n, nh)
+    for k in range(nl):
+        s, c, om = _mesh_phase(T[k], PT[o + M_ORDER, k], PT[OMEGA, k], S[k], C[k])
+        d, v = _lane_deflection(Y, PT, k, n, o, w, i0, i1, i2, i3, i4, i5, s, c, om)
+        g = _dead_zone(d, PT[o + M_B, k])
+        if two and g < 0.0:
+            kf = PT[o + M_KFC, k] * _lane_relative_stiffness(PT, k, fc, nh, s, c)
+        else:
+            kf = PT[o + M_KF, k] * _lane_relative_stiffness(PT, k, o + MESH_FIXED, nh, s, c)
+        SC[0, k] = kf * g + PT[o + M_CF, k] * v
+    _lanes_apply(DY, PT, nl, SC, n, q, apply)
+
+
+@nb.njit(inline="always", **_JIT)
+def _events_lanes_orders(T, Y, G, PT, nl, S, C, n, m, o, q):
+    """:func:`planetary_events_lanes`' rows of mesh m (block at o, structure at q) at the
+    mesh's own phase (:func:`_mesh_phase`)."""
+    i0, i1, i2, i3, i4, i5 = _mesh_dofs(PT, q)
+    w = q + MESH_NZ
+    for k in range(nl):
+        s, c, om = _mesh_phase(T[k], PT[o + M_ORDER, k], PT[OMEGA, k], S[k], C[k])
+        d, _ = _lane_deflection(Y, PT, k, n, o, w, i0, i1, i2, i3, i4, i5, s, c, om)
+        G[2 * m, k] = d - PT[o + M_B, k]
+        G[2 * m + 1, k] = d + PT[o + M_B, k]

@@ -3,12 +3,15 @@
 :class:`GearTrain` validates the description once (names, references, meshing geometry,
 connectedness, rigid-body modes) and assembles the linear model at mean mesh stiffness: named
 coordinates, M, K, C, natural frequencies, mode shapes with the strain-energy share of every
-element, speed ratios, mesh orders and Campbell (interference) data. Physics only: no files,
+element, speed ratios, mesh orders and Campbell (interference) data; :class:`TrainModel`
+is its nonlinear model (backlash, time-varying mesh stiffness,
+transmission error, torques) on the planetary gear set's compiled kernels. Physics only: no files,
 no plots. See docs/trains.md.
 """
 
 from geardyn.models.modal import MULTIPLICITY_RTOL
 from geardyn.trains.elements import GROUND, STIFFNESS_METHODS, Bearing, Gear, Inertia, Mesh, Shaft
+from geardyn.trains.model import TrainModel
 from geardyn.trains.stages import PlanetaryStage, planetary_stage
 from geardyn.trains.train import (
     MODE_TYPE_TOL,
@@ -32,6 +35,7 @@ __all__ = [
     "MeshData",
     "PlanetaryStage",
     "Shaft",
+    "TrainModel",
     "planetary_stage",
     "resolve_mesh",
 ]

@@ -1,0 +1,527 @@
+"""The nonlinear model of a gear train: its linear structure with every mesh nonlinear.
+
+:class:`TrainModel` takes a :class:`~geardyn.trains.GearTrain` (M, K, C at mean stiffness, the
+mesh deflection rows, speed ratios and mesh orders) and writes the coefficient vector of the
+planetary gear set's compiled kernels (:mod:`geardyn.models.planetary_kernels`), which are a
+general "linear structure + meshes" form: no kernel is compiled per train. Dimensionless as
+there: X = q / L (q: the train's coordinates, rad and m), tau = omega_0 t::
+
+    X'' = F0 + F1 sin(order Omega tau + phase) - Kt X - Ct X' - sum_m f_m G_m
+    f_m = KF_m k_m(theta_m) g(W_m . X - e_m, b_m) + CF_m (W_m . X' - e_m')
+
+Kt = M^-1 K_s / omega_0^2 with K_s the shafts' and flexible bearings' stiffness (the meshes act
+only through f_m), Ct = M^-1 C / omega_0 with C the shafts', bearings' and Rayleigh damping (the
+meshes' own damping c_m acts in f_m, on the deflection rate, also inside the backlash), W_m the
+mesh's deflection row along its line of action [m per model coordinate], G_m = M^-1 W_m^T /
+(L omega_0^2), g the dead zone of half-width b_m (backlash), k_m the relative stiffness (a
+Fourier series), e_m the transmission error. The forcing frequency Omega is the reference mesh's
+mesh frequency over omega_0; mesh m turns at r_m = order_m / order_ref times it (the train's
+:meth:`~geardyn.trains.GearTrain.mesh_orders`), theta_m = r_m Omega tau: a non-integer r_m makes
+the forcing quasi-periodic (no common period; sections are then taken once per period of the
+reference mesh, and periodic orbits and their continuation are refused).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+
+from geardyn.core.capabilities import Capabilities
+from geardyn.errors import ParameterError
+from geardyn.models import planetary_kernels as pk
+from geardyn.models.planetary import (
+    _KERNEL,
+    PlanetaryGearSet,
+    _clean,
+    _minimum_relative_stiffness,
+    _waveform,
+    planetary_layout,
+)
+from geardyn.trains.train import GearTrain
+from geardyn.units import si_value
+
+#: The sweep parameter of a train's input speed [rpm].
+INPUT_SPEED = "input_speed"
+#: Relative distance of a mesh order ratio from a whole number within which it is that number
+#: (speed ratios come from an SVD, so a stage's equal orders agree to about 1e-12).
+ORDER_RTOL = 1e-9
+#: Inputs a sweep takes by name (scalars only; a per-mesh mapping is not swept).
+_SWEPT = ("mesh_frequency", INPUT_SPEED, "backlash", "mesh_damping", "modal_damping",
+          "stiffness_fluctuation", "mesh_error", "torque_fluctuation", "torque_order",
+          "torque_phase")
+_UNITS = {"mesh_frequency": "rad/s", INPUT_SPEED: "rpm", "backlash": "m", "mesh_damping": "1",
+          "modal_damping": "1", "stiffness_fluctuation": "1", "mesh_error": "m",
+          "torque_fluctuation": "1", "torque_order": "1", "torque_phase": "rad"}
+
+
+def _per_mesh(field: str, value: Any, meshes: tuple[str, ...], kind: str,
+              minimum: float | None = 0.0) -> np.ndarray:
+    """A scalar for every mesh, or a mapping mesh name -> value (meshes not named: 0)."""
+    if isinstance(value, Mapping):
+        unknown = sorted(set(value) - set(meshes))
+        if unknown:
+            raise ParameterError(f"{field}.{unknown[0]}", value[unknown[0]],
+                                 f"is not a mesh of the train ({', '.join(meshes)})")
+        return np.array([si_value(f"{field}.{m}", value.get(m, 0.0), kind, minimum)
+                         for m in meshes])
+    return np.full(len(meshes), si_value(field, value, kind, minimum))
+
+
+class TrainModel(PlanetaryGearSet):
+    """The nonlinear model of a :class:`~geardyn.trains.GearTrain` (module doc), on the
+    planetary gear set's kernels. Inputs are SI (numbers or unit strings).
+
+    Parameters
+    ----------
+    train
+        The gear train (its ``driven`` body and tooth counts give the mesh orders; without
+        them every mesh turns at the forcing frequency).
+    reference_mesh
+        The mesh whose mesh frequency is the forcing Omega (default: the first mesh of the
+        driven body, else the train's first mesh).
+    input_speed, mesh_frequency
+        The driven body's speed [rpm, or a unit string] or the reference mesh's frequency
+        [rad/s]; one of them (default omega_0: Omega = 1).
+    torques
+        Mean torques [N m] on bodies by name (each acts on the body's rotation).
+    load
+        A body whose torque is set so that the torques balance on the train's rigid-body mode
+        (a free train, one rigid-body mode): the output load for a given input torque.
+    backlash
+        Backlash half-width b [m] of every mesh (dead zone), scalar or {mesh: value}.
+    mesh_damping
+        Damping ratio zeta_m of every mesh, scalar or {mesh: value}: c_m = 2 zeta_m sqrt(k_m
+        m_e), m_e = 1 / sum (w_j^2 / I_j) over the rotations the mesh row w touches; added to
+        the mesh element's own ``damping`` [N s/m].
+    modal_damping
+        Modal damping ratio of every mode of the linear model at mean stiffness.
+    stiffness_fluctuation, waveform, contact_ratio, harmonics, mesh_phase
+        The relative stiffness k_m(theta) = 1 + w(theta + phase_m): ``waveform`` ``"sine"`` or
+        ``"rectangular"`` of relative amplitude ``stiffness_fluctuation`` (scalar or per mesh;
+        ``contact_ratio``, ``harmonics``), or a pair (a, b) of relative Fourier coefficients,
+        or {mesh: (a, b)} (ISO 6336-1 waves' ``fourier(n)``); ``mesh_phase`` [rad of the mesh
+        cycle], scalar or per mesh.
+    mesh_error, error_phase
+        Transmission error e_m = E_m sin(theta_m + phase_m + error_phase_m) [m].
+    torque_fluctuation, torque_order, torque_phase
+        The driven body's torque fluctuates as T (1 + A sin(order Omega tau + phase)).
+    time_scale, length_scale
+        omega_0 [rad/s] (default sqrt(k_ref / m_e,ref) of the reference mesh) and L [m].
+    """
+
+    name = "TrainModel"
+    capabilities = Capabilities(physical_inputs=True, physical_axes=True, mesh_forces=True)
+    raw_overrides: dict[str, float] = {}
+    carrier_speed = None
+    carrier_speed_ratio = None
+    centrifugal_preload = False
+    rotational_only = False
+
+    def __init__(self, train: Any, *, reference_mesh: str | None = None,
+                 input_speed: Any = None, mesh_frequency: Any = None,
+                 torques: Mapping[str, Any] | None = None, load: str | None = None,
+                 backlash: Any = 0.0, mesh_damping: Any = 0.0, modal_damping: Any = 0.0,
+                 stiffness_fluctuation: Any = 0.0, waveform: Any = "sine",
+                 contact_ratio: float = 1.6, harmonics: int = 9, mesh_phase: Any = 0.0,
+                 mesh_error: Any = 0.0, error_phase: Any = 0.0, torque_fluctuation: Any = 0.0,
+                 torque_order: Any = 1.0, torque_phase: Any = 0.0, time_scale: Any = None,
+                 length_scale: Any = 1e-6):
+        if not isinstance(train, GearTrain):
+            raise ParameterError("train", type(train).__name__, "must be a GearTrain")
+        if not train.meshes:
+            raise ParameterError("train.meshes", (), "a train model needs at least one mesh")
+        self.inputs: dict[str, Any] = {k: v for k, v in locals().items()
+                                       if k not in ("self", "__class__")}
+        self.train = train
+        names = tuple(m.name for m in train.meshes)
+        self._mesh_names = names
+        self.reference_mesh = self._reference(reference_mesh)
+        self._kinematic_orders = self._orders()
+        self.fixed = tuple(train.fixed)
+        if isinstance(harmonics, bool) or not isinstance(harmonics, int) \
+                or not 1 <= harmonics <= 200:
+            raise ParameterError("harmonics", harmonics, "must be an integer from 1 to 200")
+        if not isinstance(contact_ratio, int | float) or not 1.0 < contact_ratio < 2.0:
+            raise ParameterError("contact_ratio", contact_ratio, "must be between 1 and 2")
+        self.mesh_phase = _per_mesh("mesh_phase", mesh_phase, names, "angle", None)
+        self.fourier = self._fourier(waveform, stiffness_fluctuation, float(contact_ratio),
+                                     harmonics)
+        self.fourier_coast = self.fourier
+        self.backlash = _per_mesh("backlash", backlash, names, "length")
+        self.error = _per_mesh("mesh_error", mesh_error, names, "length")
+        self.error_phase = _per_mesh("error_phase", error_phase, names, "angle",
+                                     None) + self.mesh_phase
+        self.mesh_damping = _per_mesh("mesh_damping", mesh_damping, names, "dimensionless")
+        self.modal_damping = si_value("modal_damping", modal_damping, "dimensionless", 0.0)
+        self.torque_fluctuation = si_value("torque_fluctuation", torque_fluctuation,
+                                           "dimensionless", 0.0)
+        self.torque_order = si_value("torque_order", torque_order, "dimensionless", 0.0,
+                                     True)
+        self.torque_phase = si_value("torque_phase", torque_phase, "angle", None)
+        if self.torque_fluctuation != 0.0 and train.driven is None:
+            raise ParameterError("torque_fluctuation", torque_fluctuation,
+                                 "fluctuates the driven body's torque: the train needs driven")
+        self.torques = self._torques(torques, load)
+        self.length_scale = si_value("length_scale", length_scale, "length", 0.0, True)
+        ref = names.index(self.reference_mesh)
+        k_ref = train.mesh_data[self.reference_mesh].stiffness
+        w0 = math.sqrt(k_ref / self._equivalent_masses()[ref])
+        self.time_scale = w0 if time_scale is None else si_value("time_scale", time_scale,
+                                                                 "frequency", 0.0, True)
+        mf = self._mesh_frequency(input_speed, mesh_frequency)
+        self.inputs["input_speed"], self.inputs["mesh_frequency"] = None, mf
+        self._build(mf / self.time_scale)
+
+    # ------------------------------------------------------------------ inputs
+    def _reference(self, name: str | None) -> str:
+        names = self._mesh_names
+        if name is not None:
+            if name not in names:
+                raise ParameterError("reference_mesh", name,
+                                     f"is not a mesh of the train ({', '.join(names)})")
+            return name
+        driven = self.train.driven
+        return next((m.name for m in self.train.meshes if driven in (m.a, m.b)), names[0])
+
+    def _orders(self) -> np.ndarray:
+        """r_m = order_m / order_ref of every mesh, whole numbers within ``ORDER_RTOL`` snapped
+        to them; all 1 without a driven body."""
+        if self.train.driven is None:
+            return np.ones(len(self._mesh_names))
+        orders = self.train.mesh_orders()
+        ref = orders[self.reference_mesh]
+        if not ref > 0.0:
+            raise ParameterError("reference_mesh", self.reference_mesh,
+                                 "does not turn with the input (mesh order 0)")
+        r = np.array([orders[m] / ref for m in self._mesh_names])
+        whole = np.round(r)
+        snap = (whole > 0) & (np.abs(r - whole) <= ORDER_RTOL * r)
+        if np.any(r <= 0.0):
+            bad = self._mesh_names[int(np.argmax(r <= 0.0))]
+            raise ParameterError(f"{bad}", 0.0, "the mesh does not turn with the input")
+        return np.where(snap, whole, r)
+
+    @property
+    def orders(self) -> np.ndarray:
+        """r_m of every mesh: its mesh frequency over the reference mesh's (the coefficient
+        vector's, so a raw override of ``<mesh>_order`` shows)."""
+        lay = self._layout
+        return np.array([self.params[lay["mesh"] + m * lay["block"] + pk.M_ORDER]
+                         for m in range(len(self._mesh_names))])
+
+    @property
+    def quasi_periodic(self) -> bool:
+        """Whether a mesh's order over the reference mesh's is not a whole number."""
+        return bool(np.any(self.orders != np.round(self.orders)))
+
+    def _fourier(self, waveform: Any, amplitude: Any, contact_ratio: float,
+                 harmonics: int) -> np.ndarray:
+        names = self._mesh_names
+        rel = _per_mesh("stiffness_fluctuation", amplitude, names, "dimensionless")
+        if isinstance(waveform, Mapping):
+            unknown = sorted(set(waveform) - set(names))
+            if unknown:
+                raise ParameterError(f"waveform.{unknown[0]}", "(coefficients)",
+                                     f"is not a mesh of the train ({', '.join(names)})")
+            rows = [_waveform(f"waveform.{m}", waveform[m], rel[i:i + 1],
+                              self.mesh_phase[i:i + 1], contact_ratio, harmonics)
+                    if m in waveform else np.zeros((1, 2)) for i, m in enumerate(names)]
+            width = max(r.shape[1] for r in rows)
+            out = np.vstack([np.pad(r, ((0, 0), (0, width - r.shape[1]))) for r in rows])
+        else:
+            out = _waveform("waveform", waveform, rel, self.mesh_phase, contact_ratio,
+                            harmonics)
+        if _minimum_relative_stiffness(out) <= 0.0:
+            raise ParameterError("stiffness_fluctuation", amplitude, "makes a mesh stiffness "
+                                 "negative; it must stay > 0")
+        return out
+
+    def _torques(self, torques: Mapping[str, Any] | None, load: str | None) -> np.ndarray:
+        """Mean generalised forces [N m, N] on the model's coordinates; with ``load`` its
+        torque balancing the others on the rigid-body mode."""
+        train = self.train
+        full = {}
+        for body, value in dict(torques or {}).items():
+            if body not in train.bodies:
+                raise ParameterError(f"torques.{body}", value, "is not a body of the train")
+            full[body] = si_value(f"torques.{body}", value, "torque", None)
+        F = self._torque_vector(full)
+        lam, phi = train._eig()
+        rigid = phi[:, lam == 0.0]
+        if load is not None:
+            if load not in train.bodies:
+                raise ParameterError("load", load, "is not a body of the train")
+            if rigid.shape[1] != 1:
+                raise ParameterError("load", load, f"balances the torques on one rigid-body "
+                                     f"mode; the train has {rigid.shape[1]}")
+            unit = self._torque_vector({load: 1.0})
+            per = float(unit @ rigid[:, 0])
+            if per == 0.0:
+                raise ParameterError("load", load, "does not turn in the rigid-body mode")
+            full[load] = full.get(load, 0.0) - float(F @ rigid[:, 0]) / per
+            F = self._torque_vector(full)
+        if rigid.size:
+            work = np.abs(F @ rigid)
+            scale = max(sum(abs(v) for v in full.values()), 1e-300)
+            if np.any(work > 1e-9 * scale * np.max(np.abs(rigid))):
+                raise ParameterError("torques", dict(torques or {}), "do not balance on the "
+                                     "train's rigid-body mode (the train would accelerate): "
+                                     "name the output body as load")
+        self.body_torques = full
+        return F
+
+    def _torque_vector(self, torques: Mapping[str, float]) -> np.ndarray:
+        train = self.train
+        full = np.zeros(3 * len(train.bodies))
+        for body, t in torques.items():
+            full[3 * train._index[body]] = t
+        return train._T.T @ full
+
+    def _mesh_frequency(self, input_speed: Any, mesh_frequency: Any) -> float:
+        if input_speed is not None and mesh_frequency is not None:
+            raise ParameterError(INPUT_SPEED, input_speed, "sets the mesh frequency: give it "
+                                 "or mesh_frequency, one of them")
+        if input_speed is not None:
+            rpm = (si_value(INPUT_SPEED, input_speed, "frequency", 0.0) * 60.0 / (2 * math.pi)
+                   if isinstance(input_speed, str)
+                   else si_value(INPUT_SPEED, input_speed, "dimensionless", 0.0))
+            return rpm * 2.0 * math.pi / 60.0 * self.mesh_frequency_per_input_speed()
+        if mesh_frequency is None:
+            return self.time_scale
+        return si_value("mesh_frequency", mesh_frequency, "frequency", 0.0)
+
+    def mesh_frequency_per_input_speed(self) -> float:
+        """The reference mesh's order: its mesh frequency over the driven body's speed."""
+        if self.train.driven is None:
+            raise ParameterError(INPUT_SPEED, None, "needs the train's driven body (and tooth "
+                                 "counts); sweep mesh_frequency [rad/s] instead")
+        return float(self.train.mesh_orders()[self.reference_mesh])
+
+    # ------------------------------------------------------------------ assembly (SI)
+    def dof_names(self) -> tuple[str, ...]:
+        return self.train.dof_names()
+
+    def mass_matrix(self) -> np.ndarray:
+        return self.train.mass_matrix()
+
+    @property
+    def mesh_names(self) -> tuple[str, ...]:
+        return self._mesh_names
+
+    def mesh_rows(self) -> np.ndarray:
+        """Mesh deflection rows (meshes x model coordinates) [m per rad, 1 per m]."""
+        return np.vstack([W for kind, _, W, _, _ in self.train.elements() if kind == "mesh"])
+
+    def mesh_stiffnesses(self) -> np.ndarray:
+        return np.array([self.train.mesh_data[m].stiffness for m in self._mesh_names])
+
+    coast_stiffnesses = mesh_stiffnesses
+
+    def stiffness_matrix(self, meshes: bool = True) -> np.ndarray:
+        """K [N/m, N m/rad] at mean mesh stiffness; without the meshes when ``meshes`` is
+        False."""
+        if meshes:
+            return self.train.stiffness_matrix()
+        n = len(self.dof_names())
+        K = np.zeros((n, n))
+        for kind, _, W, k, _ in self.train.elements():
+            if kind != "mesh":
+                K += k * W.T @ W
+        return K
+
+    def _equivalent_masses(self) -> np.ndarray:
+        """m_e of every mesh [kg]: 1 / m_e = sum w_j^2 / I_j over the rotations its row
+        touches."""
+        M = np.diag(self.mass_matrix())
+        rot = np.array([d.endswith(".theta") for d in self.dof_names()])
+        W = self.mesh_rows()
+        return 1.0 / (W[:, rot] ** 2 / M[rot]).sum(axis=1)
+
+    def _mesh_damping(self) -> np.ndarray:
+        own = np.array([m.damping for m in self.train.meshes], dtype=float)
+        return own + 2.0 * self.mesh_damping * np.sqrt(self.mesh_stiffnesses()
+                                                        * self._equivalent_masses())
+
+    def _damping_matrix(self) -> np.ndarray:
+        """The shafts', bearings' and Rayleigh damping plus the modal damping [N s/m] (the
+        meshes' own damping acts in the mesh force)."""
+        train = self.train
+        n = len(self.dof_names())
+        C = np.zeros((n, n))
+        for kind, _, W, _, c in train.elements():
+            if kind != "mesh":
+                C += c * W.T @ W
+        a, b = train.rayleigh
+        C += a * self.mass_matrix() + b * self.stiffness_matrix()
+        if self.modal_damping:
+            M = self.mass_matrix()
+            lam, phi = self._eig()
+            C += M @ phi @ np.diag(2.0 * self.modal_damping * np.sqrt(lam)) @ phi.T @ M
+        return _clean(C)
+
+    def _forces(self) -> np.ndarray:
+        F = self.torques
+        Fl = np.zeros_like(F)
+        if self.torque_fluctuation != 0.0:
+            t = self.body_torques.get(self.train.driven, 0.0)
+            Fl = self._torque_vector({self.train.driven: t * self.torque_fluctuation})
+        return np.stack([F, Fl])
+
+    def _build(self, omega: float) -> None:
+        names = self.dof_names()
+        n, nm = len(names), len(self._mesh_names)
+        nh = self.fourier.shape[1] // 2
+        M = self.mass_matrix()
+        Minv = np.linalg.inv(M)
+        Minv[np.abs(Minv) < 1e-12 * np.max(np.abs(Minv))] = 0.0
+        K, C = self.stiffness_matrix(False), self._damping_matrix()
+        Kt = _clean(Minv @ K)
+        kt_entries = [(int(i), int(j)) for i, j in zip(*np.nonzero(Kt), strict=True)]
+        W = self.mesh_rows()
+        mesh_dofs = []
+        for m in range(nm):
+            touched = sorted({int(j) for j in np.nonzero(W[m])[0]}
+                             | {int(j) for j in np.nonzero(_clean(Minv @ W[m]))[0]})
+            if len(touched) > pk.MESH_NZ:
+                raise ParameterError(f"{self._mesh_names[m]}", len(touched),
+                                     f"the mesh row touches {len(touched)} coordinates; the "
+                                     f"kernels take at most {pk.MESH_NZ} per mesh")
+            mesh_dofs.append(touched)
+        lay = pk.layout(n, nm, nh, len(kt_entries), 0)
+        L, w0 = self.length_scale, self.time_scale
+        p = np.zeros(lay["size"])
+        p[pk.OMEGA] = omega
+        p[pk.N_DOF], p[pk.N_MESH], p[pk.N_HARM] = n, nm, nh
+        F = self._forces()
+        p[pk.TORQUE_ON] = float(np.any(F[1] != 0.0))
+        p[pk.TORQUE_ORDER], p[pk.TORQUE_PHASE] = self.torque_order, self.torque_phase
+        p[lay["F0"]:lay["F0"] + n] = _clean(Minv @ F[0]) / (L * w0 * w0)
+        p[lay["F1"]:lay["F1"] + n] = _clean(Minv @ F[1]) / (L * w0 * w0)
+        p[lay["Kt"]:lay["Kt"] + n * n] = Kt.ravel() / w0**2
+        p[lay["Ct"]:lay["Ct"] + n * n] = _clean(Minv @ C).ravel() / w0
+        p[pk.DAMPED] = float(np.any(p[lay["Ct"]:lay["Ct"] + n * n] != 0.0))
+        k, c = self.mesh_stiffnesses(), self._mesh_damping()
+        for m in range(nm):
+            o = lay["mesh"] + m * lay["block"]
+            blk = p[o:o + lay["block"]]
+            blk[pk.M_B] = self.backlash[m] / L
+            blk[pk.M_ES] = self.error[m] * math.cos(self.error_phase[m]) / L
+            blk[pk.M_EC] = self.error[m] * math.sin(self.error_phase[m]) / L
+            blk[pk.M_KF] = k[m] * L
+            blk[pk.M_CF] = c[m] * L * w0
+            blk[pk.M_KFC] = k[m] * L
+            blk[pk.M_ORDER] = self._kinematic_orders[m]
+            f = pk.MESH_FIXED
+            blk[f:f + 2 * nh] = self.fourier[m]
+            blk[f + 2 * nh:f + 2 * nh + n] = W[m]
+            blk[f + 2 * nh + n:f + 2 * nh + 2 * n] = _clean(Minv @ W[m]) / (L * w0 * w0)
+            blk[f + 2 * nh + 2 * n:] = self.fourier[m]
+        self._layout = lay
+        self._coast_given = False
+        from geardyn.models.planetary import _flank_index
+
+        self._coast_built = p[_flank_index(lay, n, nm, nh, True)].copy()
+        self._structure = (kt_entries, mesh_dofs)
+        self._refresh_workspace(p)
+        p[lay["cache"]:lay["gyro"]] = pk.cache_entries(nm)[1]
+        self.coefficient_layout = planetary_layout(names, self._mesh_names, nh,
+                                                   tuple(kt_entries), ())
+        self.params = p
+        self.omega_index = pk.OMEGA
+        self.kernel = _KERNEL
+        self.state_names = names + tuple(f"d{d}" for d in names)
+        self.observable_names = tuple(f"F_{m}" for m in self._mesh_names)
+        self.event_names = tuple(f"x_{m}{s}b_{m}" for m in self._mesh_names for s in "-+")
+        self.meshes = tuple((m, 2 * i, 2 * i + 1) for i, m in enumerate(self._mesh_names))
+
+    # ------------------------------------------------------------------ sweeps and axes
+    @property
+    def physical_names(self) -> tuple[str, ...]:
+        """The inputs a sweep takes by name: ``input_speed`` [rpm] (with a driven body),
+        ``mesh_frequency`` [rad/s], and the scalar ones of ``backlash``, ``mesh_damping``,
+        ``modal_damping``, ``stiffness_fluctuation``, ``mesh_error`` and the torque
+        fluctuation's."""
+        out = []
+        for k in _SWEPT:
+            if k == INPUT_SPEED:
+                if self.train.driven is not None:
+                    out.append(k)
+            elif not isinstance(self.inputs.get(k), Mapping):
+                out.append(k)
+        return tuple(out)
+
+    def lane_params(self, name: str, values: Any) -> np.ndarray:
+        """Coefficient vectors (lanes x n_params) with ``name`` set to ``values``; the speeds
+        (``input_speed`` [rpm], ``mesh_frequency`` [rad/s]) set Omega alone."""
+        if name in (INPUT_SPEED, "mesh_frequency"):
+            vals = np.asarray(values, dtype=float).ravel()
+            if name == INPUT_SPEED:
+                vals = vals * 2.0 * math.pi / 60.0 * self.mesh_frequency_per_input_speed()
+            return PlanetaryGearSet.lane_params(self, "Omega", vals / self.time_scale)
+        return PlanetaryGearSet.lane_params(self, name, values)
+
+    @property
+    def input_speed(self) -> float:
+        """The driven body's speed [rpm] at the model's Omega."""
+        w = self.omega * self.time_scale / self.mesh_frequency_per_input_speed()
+        return w * 60.0 / (2.0 * math.pi)
+
+    def param_attrs(self, name: str) -> dict[str, str]:
+        if name == INPUT_SPEED:
+            return {"units": "rpm", "long_name": f"input ({self.train.driven}) speed",
+                    "meaning": f"mesh frequency of {self.reference_mesh} / "
+                               f"{self.mesh_frequency_per_input_speed():.6g}, in rpm"}
+        if name == "mesh_frequency":
+            return {"units": "rad/s", "long_name": f"mesh frequency of {self.reference_mesh}"}
+        return {"units": _UNITS[name]} if name in _UNITS else {}
+
+    def speed_axes(self, omega: np.ndarray) -> dict[str, tuple[np.ndarray, dict]]:
+        """The reference mesh's frequency [Hz] and, with a driven body, the input speed [rpm]
+        at the dimensionless forcing frequencies ``omega``."""
+        w = np.asarray(omega, dtype=float) * self.time_scale
+        out = {"mesh_frequency": (w / (2.0 * math.pi), {
+            "units": "Hz", "long_name": f"mesh frequency of {self.reference_mesh}"})}
+        if self.train.driven is not None:
+            out[INPUT_SPEED] = (w / self.mesh_frequency_per_input_speed() * 60.0
+                                / (2.0 * math.pi), self.param_attrs(INPUT_SPEED))
+        return out
+
+    def other_frequencies(self, P: np.ndarray) -> np.ndarray:
+        """The torque fluctuation's frequency (as the planetary set's), then every mesh's
+        r_m Omega where r_m differs from 1 (NaN where it does not)."""
+        P = np.atleast_2d(P)
+        torque = PlanetaryGearSet.other_frequencies(self, P)
+        lay = self._layout
+        idx = [lay["mesh"] + m * lay["block"] + pk.M_ORDER for m in range(len(self._mesh_names))]
+        r = P[:, idx]
+        return np.hstack([torque, np.where(r != 1.0, r * P[:, pk.OMEGA, None], np.nan)])
+
+    def dataset_attrs(self) -> dict[str, object]:
+        """The reference mesh, every mesh's order over it, and the forcing: ``periodic`` or
+        ``quasi-periodic`` (sections sampled once per period of the reference mesh)."""
+        section = (f"once per mesh period of {self.reference_mesh}" if self.quasi_periodic
+                   else f"common period of the meshes, in periods of {self.reference_mesh}")
+        return {"reference_mesh": self.reference_mesh,
+                "mesh_names": ",".join(self._mesh_names),
+                "mesh_orders": ",".join(f"{r:.12g}" for r in self.orders),
+                "forcing": "quasi-periodic" if self.quasi_periodic else "periodic",
+                "section": section}
+
+    # ------------------------------------------------------------------ linear analysis
+    def natural_frequencies(self) -> np.ndarray:
+        return self.train.natural_frequencies()
+
+    def modes(self):
+        return self.train.modes()
+
+    def bearing_forces(self, y: np.ndarray) -> dict[str, np.ndarray]:
+        raise ParameterError("bearing_forces", None, "a train model has mesh forces as its "
+                             "observables; its bearings' forces are not computed")
+
+    def __repr__(self) -> str:
+        kind = "quasi-periodic" if self.quasi_periodic else "periodic"
+        return (f"TrainModel({len(self.train.bodies)} bodies, {len(self._mesh_names)} meshes, "
+                f"dofs={len(self.dof_names())}, Omega={self.omega:g}, {kind} forcing)")
