@@ -119,6 +119,8 @@ class TrainModel(PlanetaryGearSet):
     carrier_speed_ratio = None
     centrifugal_preload = False
     rotational_only = False
+    #: The forcing period is one cycle of the reference mesh (no tooth fault sets a longer one).
+    mesh_order = 1
 
     def __init__(self, train: Any, *, reference_mesh: str | None = None,
                  input_speed: Any = None, mesh_frequency: Any = None,
