@@ -9,6 +9,10 @@ there: X = q / L (q: the train's coordinates, rad and m), tau = omega_0 t::
     X'' = F0 + F1 sin(order Omega tau + phase) - Kt X - Ct X' - sum_m f_m G_m
     f_m = KF_m k_m(theta_m) g(W_m . X - e_m, b_m) + CF_m (W_m . X' - e_m')
 
+with k_m the drive flank's relative stiffness where g > 0 and the coast flank's, kc_m, where
+g < 0 (``coast="mirror"``, meshes whose two gears have geometry: the drive flank's mirror image
+about the mesh's coast phase; else kc_m = k_m).
+
 Kt = M^-1 K_s / omega_0^2 with K_s the shafts' and flexible bearings' stiffness (the meshes act
 only through f_m), Ct = M^-1 C / omega_0 with C the shafts', bearings' and Rayleigh damping (the
 meshes' own damping c_m acts in f_m, on the deflection rate, also inside the backlash), W_m the
@@ -40,6 +44,7 @@ from geardyn.models.planetary import (
     _waveform,
     planetary_layout,
 )
+from geardyn.models.planetary_stiffness import coast_flank, mirrored
 from geardyn.trains.train import GearTrain
 from geardyn.units import si_value
 
@@ -108,6 +113,14 @@ class TrainModel(PlanetaryGearSet):
         Transmission error e_m = E_m sin(theta_m + phase_m + error_phase_m) [m].
     torque_fluctuation, torque_order, torque_phase
         The driven body's torque fluctuates as T (1 + A sin(order Omega tau + phase)).
+    coast
+        The coast (back) flank of a mesh whose two gears have geometry: ``"mirror"``
+        (default) for symmetric teeth the mirror image of the drive flank's relative stiffness,
+        kc(theta) = k0(2 pi phi - theta - phase) with k(theta) = k0(theta + phase), phi =
+        :func:`geardyn.gears.potential_energy.coast_phase` of the gear pair (from the geometry
+        alone; :func:`~geardyn.models.planetary_stiffness.mirrored`), the same mean stiffness;
+        ``"symmetric"``: the drive flank's stiffness on both flanks. A mesh with a gear
+        without geometry has one stiffness on both flanks. Kept as :attr:`coast_flank`.
     time_scale, length_scale
         omega_0 [rad/s] (default sqrt(k_ref / m_e,ref) of the reference mesh) and L [m].
     """
@@ -129,8 +142,8 @@ class TrainModel(PlanetaryGearSet):
                  stiffness_fluctuation: Any = 0.0, waveform: Any = "sine",
                  contact_ratio: float = 1.6, harmonics: int = 9, mesh_phase: Any = 0.0,
                  mesh_error: Any = 0.0, error_phase: Any = 0.0, torque_fluctuation: Any = 0.0,
-                 torque_order: Any = 1.0, torque_phase: Any = 0.0, time_scale: Any = None,
-                 length_scale: Any = 1e-6):
+                 torque_order: Any = 1.0, torque_phase: Any = 0.0, coast: str = "mirror",
+                 time_scale: Any = None, length_scale: Any = 1e-6):
         if not isinstance(train, GearTrain):
             raise ParameterError("train", type(train).__name__, "must be a GearTrain")
         if not train.meshes:
@@ -151,7 +164,8 @@ class TrainModel(PlanetaryGearSet):
         self.mesh_phase = _per_mesh("mesh_phase", mesh_phase, names, "angle", None)
         self.fourier = self._fourier(waveform, stiffness_fluctuation, float(contact_ratio),
                                      harmonics)
-        self.fourier_coast = self.fourier
+        self.coast_flank = coast_flank(coast)
+        self.fourier_coast, self._mirrored = self._coast_fourier()
         self.backlash = _per_mesh("backlash", backlash, names, "length")
         self.error = _per_mesh("mesh_error", mesh_error, names, "length")
         self.error_phase = _per_mesh("error_phase", error_phase, names, "angle",
@@ -240,6 +254,38 @@ class TrainModel(PlanetaryGearSet):
             raise ParameterError("stiffness_fluctuation", amplitude, "makes a mesh stiffness "
                                  "negative; it must stay > 0")
         return out
+
+    def coast_phases(self) -> dict[str, float]:
+        """phi [mesh cycles] of every mesh whose two gears have geometry:
+        :func:`~geardyn.gears.potential_energy.coast_phase` of the pair (its transverse one
+        for helical gears)."""
+        from geardyn.gears.potential_energy import coast_phase
+        from geardyn.trains.train import _gear_mesh
+
+        out = {}
+        for mesh in self.train.meshes:
+            ga, gb = self.train.bodies[mesh.a], self.train.bodies[mesh.b]
+            if getattr(ga, "geometry", None) is None or getattr(gb, "geometry", None) is None:
+                continue
+            pair = _gear_mesh(mesh, ga, gb)
+            out[mesh.name] = coast_phase(getattr(pair, "transverse", pair))
+        return out
+
+    def _coast_fourier(self) -> tuple[np.ndarray, bool]:
+        """The coast flank's relative Fourier coefficients (meshes, 2 nh) and whether any
+        mesh's differs from its drive flank's by construction (``coast="mirror"``)."""
+        if self.coast_flank == "symmetric":
+            return self.fourier, False
+        phases = self.coast_phases()
+        if not phases:
+            return self.fourier, False
+        out = self.fourier.copy()
+        for m, name in enumerate(self._mesh_names):
+            if name in phases:  # k(theta) = k0(theta + psi): mirror about phi - psi / pi
+                phi = phases[name] - self.mesh_phase[m] / math.pi
+                out[m, 0::2], out[m, 1::2] = mirrored(self.fourier[m, 0::2],
+                                                      self.fourier[m, 1::2], phi)
+        return out, True
 
     def _torques(self, torques: Mapping[str, Any] | None, load: str | None) -> np.ndarray:
         """Mean generalised forces [N m, N] on the model's coordinates; with ``load`` its
@@ -420,9 +466,9 @@ class TrainModel(PlanetaryGearSet):
             blk[f:f + 2 * nh] = self.fourier[m]
             blk[f + 2 * nh:f + 2 * nh + n] = W[m]
             blk[f + 2 * nh + n:f + 2 * nh + 2 * n] = _clean(Minv @ W[m]) / (L * w0 * w0)
-            blk[f + 2 * nh + 2 * n:] = self.fourier[m]
+            blk[f + 2 * nh + 2 * n:] = self.fourier_coast[m]
         self._layout = lay
-        self._coast_given = False
+        self._coast_given = self._mirrored
         from geardyn.models.planetary import _flank_index
 
         self._coast_built = p[_flank_index(lay, n, nm, nh, True)].copy()
