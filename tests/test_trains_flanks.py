@@ -132,3 +132,88 @@ def test_coast_contact_matches_dop853_on_hand_written_equations():
     f_ref = force(t, ref.y[:4], ref.y[4:])
     f = np.array([ds["F_stage1"].values, ds["F_stage2"].values])
     np.testing.assert_allclose(f, f_ref, rtol=0, atol=5e-6 * np.max(np.abs(f_ref)))
+
+
+# ---------------------------------------------------------------- phasing from the geometry
+def _wrapped(a, b) -> np.ndarray:
+    """a - b folded into [-1/2, 1/2) mesh cycles."""
+    return (np.asarray(a) - np.asarray(b) + 0.5) % 1.0 - 0.5
+
+
+def _idler(**kw) -> TrainModel:
+    """g1 drives idler g2 (31 teeth), which drives g3 a quarter turn further round g2."""
+    z = (19, 31, 23)
+    g = [Gear(f"g{i + 1}", INERTIA[i], geometry=_spur(z[i])) for i in range(3)]
+    train = GearTrain(g, bearings=[Bearing(f"b{i + 1}", f"g{i + 1}", math.inf)
+                                   for i in range(3)],
+                      meshes=[Mesh("m1", "g1", "g2", KA, angle=0.0),
+                              Mesh("m2", "g2", "g3", KB, angle=math.pi / 2)],
+                      driven="g1", free=True)
+    return TrainModel(train, torques={"g1": T_IN}, load="g3", stiffness_fluctuation=0.2, **kw)
+
+
+def test_idler_mesh_phase_is_the_fractional_tooth_count_between_its_pitch_points():
+    """The idler turns clockwise: a tooth leaving m1's pitch point (at 180 deg from its centre)
+    reaches m2's (at 90 deg) after a quarter turn, 31 / 4 = 7.75 pitches: m2 lags m1 by 0.75
+    of a mesh cycle (both meshes load the idler's counter-clockwise flanks, equal thickness)."""
+    model = _idler(mesh_phase="geometry")
+    gamma = model.geometry_phases()
+    assert gamma["m1"] == 0.0
+    assert _wrapped(gamma["m2"], 0.75) == pytest.approx(0.0, abs=1e-12)
+    np.testing.assert_allclose(model.mesh_phase, [0.0, -2 * math.pi * gamma["m2"]])
+    assert np.array_equal(_idler(mesh_phase=0.3).mesh_phase, [0.3, 0.3])  # the user's wins
+
+
+def test_geometry_phasing_without_geometry_is_refused():
+    with pytest.raises(ParameterError, match="geometry of both gears of mesh stage1"):
+        TrainModel(_train(geometry=False), torques={"g1": T_IN}, load="g4",
+                   mesh_phase="geometry")
+
+
+def _stage(shifted: bool):
+    """25/23/71, m 2 mm: unshifted at the standard centre distance (3 planets), or the sun and
+    ring shifted (+0.2, +0.3) at a widened one (4 planets; coast phases away from 1/2)."""
+    from geardyn.gears import PlanetaryGeometry
+
+    def gear(z: int, x: float = 0.0, internal: bool = False) -> SpurGear:
+        return SpurGear(z, 2e-3, math.radians(20.0), 0.02, profile_shift=x, internal=internal)
+    if shifted:
+        return PlanetaryGeometry(gear(25, 0.2), gear(23), gear(71, 0.3, True), n_planets=4,
+                                 centre_distance=0.0484)
+    return PlanetaryGeometry(gear(25), gear(23), gear(71, internal=True), n_planets=3)
+
+
+@pytest.mark.parametrize("shifted", [False, True])
+def test_planetary_stage_phases_are_parker_and_lins(shifted):
+    """Sun-planet phases gamma_sn = Z_s psi_n / 2 pi as Parker & Lin's; a ring-planet row's
+    drive flank (positive deflection) is the planet's flank the ring does not load in Parker &
+    Lin's convention, so its phase is theirs plus the planet's coast phase in the ring mesh."""
+    from geardyn.gears.potential_energy import coast_phase
+
+    geo = _stage(shifted)
+    sun, planet, ring, n = geo.sun, geo.planet, geo.ring, geo.n_planets
+    rc = geo.sun_mesh.centre_distance
+    bodies = [Gear("sun", 1e-3, mass=0.5, geometry=sun),
+              Gear("ring", 1.0, mass=3.0, geometry=ring),
+              geardyn.trains.Inertia("carrier", 0.1, mass=5.0)]
+    bearings = [Bearing(f"{k}_bearing", k, 1e8) for k in ("sun", "ring", "carrier")]
+    meshes = []
+    for i, psi in enumerate(geo.planet_angles):
+        bodies.append(Gear(f"p{i + 1}", 1e-3, mass=0.3, geometry=planet))
+        bearings.append(Bearing(f"pin{i + 1}", f"p{i + 1}", 1e8, host="carrier", radius=rc,
+                                angle=psi))
+        meshes.append(Mesh(f"s{i + 1}", "sun", f"p{i + 1}", 5e8, angle=psi,
+                           centre_distance=rc))
+    meshes += [Mesh(f"r{i + 1}", f"p{i + 1}", "ring", 5e8, internal=True, angle=psi + math.pi,
+                    centre_distance=rc) for i, psi in enumerate(geo.planet_angles)]
+    train = GearTrain(bodies, [Shaft("output", "carrier", geardyn.trains.GROUND, 1e6)],
+                      bearings, meshes, fixed=("ring",), driven="sun")
+    model = TrainModel(train, torques={"sun": 5.0}, mesh_phase="geometry")
+    gamma = model.geometry_phases()
+    pl = geo.phases_turning(1)
+    phi_r = coast_phase(geo.ring_mesh)
+    assert _wrapped([gamma[f"s{i + 1}"] for i in range(n)], pl.sun) == \
+        pytest.approx(np.zeros(n), abs=1e-9)
+    assert _wrapped([gamma[f"r{i + 1}"] for i in range(n)], pl.ring + phi_r) == \
+        pytest.approx(np.zeros(n), abs=1e-9)
+    assert np.any(np.abs(_wrapped(pl.sun[1:], 0.0)) > 0.1)  # the phases are not all 0

@@ -45,6 +45,7 @@ from geardyn.models.planetary import (
     planetary_layout,
 )
 from geardyn.models.planetary_stiffness import coast_flank, mirrored
+from geardyn.trains.elements import GROUND
 from geardyn.trains.train import GearTrain
 from geardyn.units import si_value
 
@@ -108,7 +109,8 @@ class TrainModel(PlanetaryGearSet):
         ``"rectangular"`` of relative amplitude ``stiffness_fluctuation`` (scalar or per mesh;
         ``contact_ratio``, ``harmonics``), or a pair (a, b) of relative Fourier coefficients,
         or {mesh: (a, b)} (ISO 6336-1 waves' ``fourier(n)``); ``mesh_phase`` [rad of the mesh
-        cycle], scalar or per mesh.
+        cycle], scalar or per mesh, or ``"geometry"``: -2 pi gamma_m of
+        :meth:`geometry_phases` (default 0: the phases are the user's unless asked for).
     mesh_error, error_phase
         Transmission error e_m = E_m sin(theta_m + phase_m + error_phase_m) [m].
     torque_fluctuation, torque_order, torque_phase
@@ -161,7 +163,11 @@ class TrainModel(PlanetaryGearSet):
             raise ParameterError("harmonics", harmonics, "must be an integer from 1 to 200")
         if not isinstance(contact_ratio, int | float) or not 1.0 < contact_ratio < 2.0:
             raise ParameterError("contact_ratio", contact_ratio, "must be between 1 and 2")
-        self.mesh_phase = _per_mesh("mesh_phase", mesh_phase, names, "angle", None)
+        if isinstance(mesh_phase, str) and mesh_phase == "geometry":
+            gamma = self.geometry_phases()
+            self.mesh_phase = np.array([-2.0 * math.pi * gamma[m] for m in names])
+        else:
+            self.mesh_phase = _per_mesh("mesh_phase", mesh_phase, names, "angle", None)
         self.fourier = self._fourier(waveform, stiffness_fluctuation, float(contact_ratio),
                                      harmonics)
         self.coast_flank = coast_flank(coast)
@@ -270,6 +276,69 @@ class TrainModel(PlanetaryGearSet):
             pair = _gear_mesh(mesh, ga, gb)
             out[mesh.name] = coast_phase(getattr(pair, "transverse", pair))
         return out
+
+    def geometry_phases(self) -> dict[str, float]:
+        """gamma_m [mesh cycles, in [0, 1)] of every mesh: how much later than the first mesh
+        of its group (meshes joined through shared gears) a tooth's drive flank (the one in
+        contact at a positive mesh deflection) passes the mesh's pitch point. Two meshes on
+        gear g (Z teeth, turning with sign sigma relative to the meshes' carrier, or the
+        ground), their pitch points at angles beta_1, beta_2 from its centre, its loaded flank
+        on the side e = +-1 (counter-clockwise: +) of a tooth of angular thickness s at each
+        mesh's operating pitch radius: gamma_2 - gamma_1 = Z sigma [beta_2 - beta_1 -
+        (e_2 s_2 - e_1 s_1) / 2] / (2 pi) (e: +1 on every mesh of an external gear, -1 on a
+        ring's). Stages joined only by shafts are separate groups (their gears' clocking on
+        the shaft is no input): each starts at 0. Needs the train's driven body and the
+        geometry of every meshing gear."""
+        from geardyn.trains.train import _gear_mesh
+
+        train = self.train
+        if train.driven is None:
+            raise ParameterError("mesh_phase", "geometry", "needs the train's driven body (the "
+                                 "gears' senses of rotation)")
+        ratios, pairs = train.speed_ratios(), {}
+        for m in train.meshes:
+            ga, gb = train.bodies[m.a], train.bodies[m.b]
+            if getattr(ga, "geometry", None) is None or getattr(gb, "geometry", None) is None:
+                raise ParameterError("mesh_phase", "geometry", f"needs the geometry of both "
+                                     f"gears of mesh {m.name} ({m.a}, {m.b})")
+            pair = _gear_mesh(m, ga, gb)
+            pairs[m.name] = getattr(pair, "transverse", pair)
+        arms = {}
+        for m in train.meshes:
+            hosts = [train._pin(b.body).host for b in train.bearings
+                     if b.body in (m.a, m.b) and b.host != GROUND]
+            arms[m.name] = ratios[hosts[0]] if hosts else 0.0
+
+        def side(m: Any, g: str) -> tuple[float, float, float]:
+            """beta [rad], e and s [rad] of gear g in mesh m."""
+            pair, first = pairs[m.name], g == m.a
+            beta = m.angle if first and not m.internal else m.angle + math.pi
+            e = -1.0 if (m.internal and not first) else 1.0
+            gear = pair.pinion if first else pair.wheel
+            r_w = pair.operating_pitch_radii[0 if first else 1]
+            return beta, e, gear.angular_thickness(r_w)
+
+        gamma: dict[str, float] = {}
+        for start in train.meshes:
+            if start.name in gamma:
+                continue
+            gamma[start.name], todo = 0.0, [start]
+            while todo:
+                m1 = todo.pop()
+                for m2 in train.meshes:
+                    shared = {m1.a, m1.b} & {m2.a, m2.b}
+                    if m2.name in gamma or not shared:
+                        continue
+                    g = shared.pop()
+                    b1, e1, s1 = side(m1, g)
+                    b2, e2, s2 = side(m2, g)
+                    sigma = math.copysign(1.0, ratios[g] - arms[m1.name])
+                    z = train.bodies[g].teeth
+                    step = z * sigma * (b2 - b1 - 0.5 * (e2 * s2 - e1 * s1)) / (2.0 * math.pi)
+                    g2 = (gamma[m1.name] + step) % 1.0
+                    gamma[m2.name] = 0.0 if math.isclose(g2, 1.0, abs_tol=1e-9) else g2
+                    todo.append(m2)
+        return gamma
 
     def _coast_fourier(self) -> tuple[np.ndarray, bool]:
         """The coast flank's relative Fourier coefficients (meshes, 2 nh) and whether any
