@@ -67,6 +67,14 @@ def test_symmetric_coast_is_the_one_stiffness_model_bitwise():
         plain.params.tobytes()  # no geometry: no coast flank to mirror
 
 
+def test_a_sine_mirrored_about_half_a_cycle_keeps_one_flank():
+    """sin(pi - theta) = sin(theta): phi = 1/2 (to round-off) leaves the one-flank model."""
+    kw = dict(torques={"g1": T_IN}, load="g4", stiffness_fluctuation=0.25)
+    mirror = TrainModel(_train(), **kw)
+    assert np.array_equal(mirror.params, TrainModel(_train(), coast="symmetric", **kw).params)
+    assert mirror.params[geardyn.models.planetary_kernels.TWO_FLANK] == 0.0
+
+
 def test_mirrored_coast_flank_is_the_drive_flank_reflected_about_half_a_cycle():
     """Unshifted teeth at the standard centre distance: s = p / 2, phi = 1/2, so kc(theta) =
     k0(pi - theta - psi) with the drive flank k0(theta + psi)."""

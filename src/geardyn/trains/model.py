@@ -54,6 +54,9 @@ INPUT_SPEED = "input_speed"
 #: Relative distance of a mesh order ratio from a whole number within which it is that number
 #: (speed ratios come from an SVD, so a stage's equal orders agree to about 1e-12).
 ORDER_RTOL = 1e-9
+#: Largest difference [relative stiffness] between a mirrored coast series and its drive series
+#: that is round-off (a sine mirrored about half a mesh cycle): the mesh keeps one flank.
+MIRROR_ATOL = 1e-12
 #: Inputs a sweep takes by name (scalars only; a per-mesh mapping is not swept).
 _SWEPT = ("mesh_frequency", INPUT_SPEED, "backlash", "mesh_damping", "modal_damping",
           "stiffness_fluctuation", "mesh_error", "torque_fluctuation", "torque_order",
@@ -352,9 +355,12 @@ class TrainModel(PlanetaryGearSet):
         for m, name in enumerate(self._mesh_names):
             if name in phases:  # k(theta) = k0(theta + psi): mirror about phi - psi / pi
                 phi = phases[name] - self.mesh_phase[m] / math.pi
-                out[m, 0::2], out[m, 1::2] = mirrored(self.fourier[m, 0::2],
-                                                      self.fourier[m, 1::2], phi)
-        return out, True
+                a, b = mirrored(self.fourier[m, 0::2], self.fourier[m, 1::2], phi)
+                row = np.empty_like(out[m])
+                row[0::2], row[1::2] = a, b
+                if np.max(np.abs(row - out[m]), initial=0.0) > MIRROR_ATOL:
+                    out[m] = row
+        return out, not np.array_equal(out, self.fourier)
 
     def _torques(self, torques: Mapping[str, Any] | None, load: str | None) -> np.ndarray:
         """Mean generalised forces [N m, N] on the model's coordinates; with ``load`` its
