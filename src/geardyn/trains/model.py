@@ -45,7 +45,6 @@ from geardyn.models.planetary import (
     planetary_layout,
 )
 from geardyn.models.planetary_stiffness import coast_flank, mirrored
-from geardyn.trains.elements import GROUND
 from geardyn.trains.train import GearTrain
 from geardyn.units import si_value
 
@@ -306,11 +305,7 @@ class TrainModel(PlanetaryGearSet):
                                      f"gears of mesh {m.name} ({m.a}, {m.b})")
             pair = _gear_mesh(m, ga, gb)
             pairs[m.name] = getattr(pair, "transverse", pair)
-        arms = {}
-        for m in train.meshes:
-            hosts = [train._pin(b.body).host for b in train.bearings
-                     if b.body in (m.a, m.b) and b.host != GROUND]
-            arms[m.name] = ratios[hosts[0]] if hosts else 0.0
+        arms = {m.name: train.mesh_frame_ratio(m, ratios) for m in train.meshes}
 
         def side(m: Any, g: str) -> tuple[float, float, float]:
             """beta [rad], e and s [rad] of gear g in mesh m."""
