@@ -319,6 +319,18 @@ def test_train_study_builds_the_model_the_api_builds():
     assert model.input_speed == pytest.approx(3000.0, rel=1e-12)
 
 
+def test_train_study_takes_the_coast_flank_and_geometry_phasing():
+    """``coast`` and ``mesh_phase = "geometry"`` in [params] reach the model."""
+    from geardyn.io.toml import builtin_study
+
+    study = builtin_study("two_stage_train")
+    params = type(study.params).model_validate({**study.params.model_dump(),
+                                                "coast": "symmetric", "mesh_phase": "geometry"})
+    study = study.model_copy(update={"params": params})
+    model = geardyn.build_model(study)
+    assert model.coast_flank == "symmetric" and model.inputs["mesh_phase"] == "geometry"
+
+
 def test_train_study_bad_params_name_the_field():
     from geardyn.io.toml import load_study
 

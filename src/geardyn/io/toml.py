@@ -625,6 +625,7 @@ class TrainModelParams(BaseModel):
     torque_fluctuation: float = 0.0
     torque_order: float = 1.0
     torque_phase: Quantity = 0.0
+    coast: Literal["mirror", "symmetric"] = "mirror"
     time_scale: Quantity | None = None
     length_scale: Quantity = 1e-6
 

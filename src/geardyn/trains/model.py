@@ -9,6 +9,10 @@ there: X = q / L (q: the train's coordinates, rad and m), tau = omega_0 t::
     X'' = F0 + F1 sin(order Omega tau + phase) - Kt X - Ct X' - sum_m f_m G_m
     f_m = KF_m k_m(theta_m) g(W_m . X - e_m, b_m) + CF_m (W_m . X' - e_m')
 
+with k_m the drive flank's relative stiffness where g > 0 and the coast flank's, kc_m, where
+g < 0 (``coast="mirror"``, meshes whose two gears have geometry: the drive flank's mirror image
+about the mesh's coast phase; else kc_m = k_m).
+
 Kt = M^-1 K_s / omega_0^2 with K_s the shafts' and flexible bearings' stiffness (the meshes act
 only through f_m), Ct = M^-1 C / omega_0 with C the shafts', bearings' and Rayleigh damping (the
 meshes' own damping c_m acts in f_m, on the deflection rate, also inside the backlash), W_m the
@@ -40,6 +44,7 @@ from geardyn.models.planetary import (
     _waveform,
     planetary_layout,
 )
+from geardyn.models.planetary_stiffness import coast_flank, mirrored
 from geardyn.trains.train import GearTrain
 from geardyn.units import si_value
 
@@ -48,6 +53,9 @@ INPUT_SPEED = "input_speed"
 #: Relative distance of a mesh order ratio from a whole number within which it is that number
 #: (speed ratios come from an SVD, so a stage's equal orders agree to about 1e-12).
 ORDER_RTOL = 1e-9
+#: Largest difference [relative stiffness] between a mirrored coast series and its drive series
+#: that is round-off (a sine mirrored about half a mesh cycle): the mesh keeps one flank.
+MIRROR_ATOL = 1e-12
 #: Inputs a sweep takes by name (scalars only; a per-mesh mapping is not swept).
 _SWEPT = ("mesh_frequency", INPUT_SPEED, "backlash", "mesh_damping", "modal_damping",
           "stiffness_fluctuation", "mesh_error", "torque_fluctuation", "torque_order",
@@ -103,11 +111,20 @@ class TrainModel(PlanetaryGearSet):
         ``"rectangular"`` of relative amplitude ``stiffness_fluctuation`` (scalar or per mesh;
         ``contact_ratio``, ``harmonics``), or a pair (a, b) of relative Fourier coefficients,
         or {mesh: (a, b)} (ISO 6336-1 waves' ``fourier(n)``); ``mesh_phase`` [rad of the mesh
-        cycle], scalar or per mesh.
+        cycle], scalar or per mesh, or ``"geometry"``: -2 pi gamma_m of
+        :meth:`geometry_phases` (default 0: the phases are the user's unless asked for).
     mesh_error, error_phase
         Transmission error e_m = E_m sin(theta_m + phase_m + error_phase_m) [m].
     torque_fluctuation, torque_order, torque_phase
         The driven body's torque fluctuates as T (1 + A sin(order Omega tau + phase)).
+    coast
+        The coast (back) flank of a mesh whose two gears have geometry: ``"mirror"``
+        (default) for symmetric teeth the mirror image of the drive flank's relative stiffness,
+        kc(theta) = k0(2 pi phi - theta - phase) with k(theta) = k0(theta + phase), phi =
+        :func:`geardyn.gears.potential_energy.coast_phase` of the gear pair (from the geometry
+        alone; :func:`~geardyn.models.planetary_stiffness.mirrored`), the same mean stiffness;
+        ``"symmetric"``: the drive flank's stiffness on both flanks. A mesh with a gear
+        without geometry has one stiffness on both flanks. Kept as :attr:`coast_flank`.
     time_scale, length_scale
         omega_0 [rad/s] (default sqrt(k_ref / m_e,ref) of the reference mesh) and L [m].
     """
@@ -129,8 +146,8 @@ class TrainModel(PlanetaryGearSet):
                  stiffness_fluctuation: Any = 0.0, waveform: Any = "sine",
                  contact_ratio: float = 1.6, harmonics: int = 9, mesh_phase: Any = 0.0,
                  mesh_error: Any = 0.0, error_phase: Any = 0.0, torque_fluctuation: Any = 0.0,
-                 torque_order: Any = 1.0, torque_phase: Any = 0.0, time_scale: Any = None,
-                 length_scale: Any = 1e-6):
+                 torque_order: Any = 1.0, torque_phase: Any = 0.0, coast: str = "mirror",
+                 time_scale: Any = None, length_scale: Any = 1e-6):
         if not isinstance(train, GearTrain):
             raise ParameterError("train", type(train).__name__, "must be a GearTrain")
         if not train.meshes:
@@ -148,10 +165,15 @@ class TrainModel(PlanetaryGearSet):
             raise ParameterError("harmonics", harmonics, "must be an integer from 1 to 200")
         if not isinstance(contact_ratio, int | float) or not 1.0 < contact_ratio < 2.0:
             raise ParameterError("contact_ratio", contact_ratio, "must be between 1 and 2")
-        self.mesh_phase = _per_mesh("mesh_phase", mesh_phase, names, "angle", None)
+        if isinstance(mesh_phase, str) and mesh_phase == "geometry":
+            gamma = self.geometry_phases()
+            self.mesh_phase = np.array([-2.0 * math.pi * gamma[m] for m in names])
+        else:
+            self.mesh_phase = _per_mesh("mesh_phase", mesh_phase, names, "angle", None)
         self.fourier = self._fourier(waveform, stiffness_fluctuation, float(contact_ratio),
                                      harmonics)
-        self.fourier_coast = self.fourier
+        self.coast_flank = coast_flank(coast)
+        self.fourier_coast, self._mirrored = self._coast_fourier()
         self.backlash = _per_mesh("backlash", backlash, names, "length")
         self.error = _per_mesh("mesh_error", mesh_error, names, "length")
         self.error_phase = _per_mesh("error_phase", error_phase, names, "angle",
@@ -240,6 +262,100 @@ class TrainModel(PlanetaryGearSet):
             raise ParameterError("stiffness_fluctuation", amplitude, "makes a mesh stiffness "
                                  "negative; it must stay > 0")
         return out
+
+    def coast_phases(self) -> dict[str, float]:
+        """phi [mesh cycles] of every mesh whose two gears have geometry:
+        :func:`~geardyn.gears.potential_energy.coast_phase` of the pair (its transverse one
+        for helical gears)."""
+        from geardyn.gears.potential_energy import coast_phase
+        from geardyn.trains.train import _gear_mesh
+
+        out = {}
+        for mesh in self.train.meshes:
+            ga, gb = self.train.bodies[mesh.a], self.train.bodies[mesh.b]
+            if getattr(ga, "geometry", None) is None or getattr(gb, "geometry", None) is None:
+                continue
+            pair = _gear_mesh(mesh, ga, gb)
+            out[mesh.name] = coast_phase(getattr(pair, "transverse", pair))
+        return out
+
+    def geometry_phases(self) -> dict[str, float]:
+        """gamma_m [mesh cycles, in [0, 1)] of every mesh: how much later than the first mesh
+        of its group (meshes joined through shared gears) a tooth's drive flank (the one in
+        contact at a positive mesh deflection) passes the mesh's pitch point. Two meshes on
+        gear g (Z teeth, turning with sign sigma relative to the meshes' carrier, or the
+        ground), their pitch points at angles beta_1, beta_2 from its centre, its loaded flank
+        on the side e = +-1 (counter-clockwise: +) of a tooth of angular thickness s at each
+        mesh's operating pitch radius: gamma_2 - gamma_1 = Z sigma [beta_2 - beta_1 -
+        (e_2 s_2 - e_1 s_1) / 2] / (2 pi) (e: +1 on every mesh of an external gear, -1 on a
+        ring's). Stages joined only by shafts are separate groups (their gears' clocking on
+        the shaft is no input): each starts at 0. Needs the train's driven body and the
+        geometry of every meshing gear."""
+        from geardyn.trains.train import _gear_mesh
+
+        train = self.train
+        if train.driven is None:
+            raise ParameterError("mesh_phase", "geometry", "needs the train's driven body (the "
+                                 "gears' senses of rotation)")
+        ratios, pairs = train.speed_ratios(), {}
+        for m in train.meshes:
+            ga, gb = train.bodies[m.a], train.bodies[m.b]
+            if getattr(ga, "geometry", None) is None or getattr(gb, "geometry", None) is None:
+                raise ParameterError("mesh_phase", "geometry", f"needs the geometry of both "
+                                     f"gears of mesh {m.name} ({m.a}, {m.b})")
+            pair = _gear_mesh(m, ga, gb)
+            pairs[m.name] = getattr(pair, "transverse", pair)
+        arms = {m.name: train.mesh_frame_ratio(m, ratios) for m in train.meshes}
+
+        def side(m: Any, g: str) -> tuple[float, float, float]:
+            """beta [rad], e and s [rad] of gear g in mesh m."""
+            pair, first = pairs[m.name], g == m.a
+            beta = m.angle if first and not m.internal else m.angle + math.pi
+            e = -1.0 if (m.internal and not first) else 1.0
+            gear = pair.pinion if first else pair.wheel
+            r_w = pair.operating_pitch_radii[0 if first else 1]
+            return beta, e, gear.angular_thickness(r_w)
+
+        gamma: dict[str, float] = {}
+        for start in train.meshes:
+            if start.name in gamma:
+                continue
+            gamma[start.name], todo = 0.0, [start]
+            while todo:
+                m1 = todo.pop()
+                for m2 in train.meshes:
+                    shared = {m1.a, m1.b} & {m2.a, m2.b}
+                    if m2.name in gamma or not shared:
+                        continue
+                    g = shared.pop()
+                    b1, e1, s1 = side(m1, g)
+                    b2, e2, s2 = side(m2, g)
+                    sigma = math.copysign(1.0, ratios[g] - arms[m1.name])
+                    z = train.bodies[g].teeth
+                    step = z * sigma * (b2 - b1 - 0.5 * (e2 * s2 - e1 * s1)) / (2.0 * math.pi)
+                    g2 = (gamma[m1.name] + step) % 1.0
+                    gamma[m2.name] = 0.0 if math.isclose(g2, 1.0, abs_tol=1e-9) else g2
+                    todo.append(m2)
+        return gamma
+
+    def _coast_fourier(self) -> tuple[np.ndarray, bool]:
+        """The coast flank's relative Fourier coefficients (meshes, 2 nh) and whether any
+        mesh's differs from its drive flank's by construction (``coast="mirror"``)."""
+        if self.coast_flank == "symmetric":
+            return self.fourier, False
+        phases = self.coast_phases()
+        if not phases:
+            return self.fourier, False
+        out = self.fourier.copy()
+        for m, name in enumerate(self._mesh_names):
+            if name in phases:  # k(theta) = k0(theta + psi): mirror about phi - psi / pi
+                phi = phases[name] - self.mesh_phase[m] / math.pi
+                a, b = mirrored(self.fourier[m, 0::2], self.fourier[m, 1::2], phi)
+                row = np.empty_like(out[m])
+                row[0::2], row[1::2] = a, b
+                if np.max(np.abs(row - out[m]), initial=0.0) > MIRROR_ATOL:
+                    out[m] = row
+        return out, not np.array_equal(out, self.fourier)
 
     def _torques(self, torques: Mapping[str, Any] | None, load: str | None) -> np.ndarray:
         """Mean generalised forces [N m, N] on the model's coordinates; with ``load`` its
@@ -420,9 +536,9 @@ class TrainModel(PlanetaryGearSet):
             blk[f:f + 2 * nh] = self.fourier[m]
             blk[f + 2 * nh:f + 2 * nh + n] = W[m]
             blk[f + 2 * nh + n:f + 2 * nh + 2 * n] = _clean(Minv @ W[m]) / (L * w0 * w0)
-            blk[f + 2 * nh + 2 * n:] = self.fourier[m]
+            blk[f + 2 * nh + 2 * n:] = self.fourier_coast[m]
         self._layout = lay
-        self._coast_given = False
+        self._coast_given = self._mirrored
         from geardyn.models.planetary import _flank_index
 
         self._coast_built = p[_flank_index(lay, n, nm, nh, True)].copy()

@@ -563,11 +563,16 @@ class GearTrain:
             if gear is None:
                 raise ParameterError(f"{m.a}.n_teeth", None,
                                      f"the order of mesh {m.name} needs a tooth count")
-            hosts = [self._pin(b.body).host for b in self.bearings
-                     if b.body in (m.a, m.b) and b.host != GROUND]
-            arm = ratios[hosts[0]] if hosts else 0.0
+            arm = self.mesh_frame_ratio(m, ratios)
             out[m.name] = self.bodies[gear].teeth * abs(ratios[gear] - arm)
         return out
+
+    def mesh_frame_ratio(self, mesh: Mesh, ratios: dict[str, float]) -> float:
+        """Speed ratio of the frame ``mesh`` turns in: the carrier on which one of its gears'
+        bearings sits (a planet's carrier), 0 where both bear on the ground."""
+        hosts = [self._pin(b.body).host for b in self.bearings
+                 if b.body in (mesh.a, mesh.b) and b.host != GROUND]
+        return ratios[hosts[0]] if hosts else 0.0
 
     def campbell(self, speeds: Any, harmonics: int = 3) -> Any:
         """Campbell (interference) data over input speeds [rpm] (xarray Dataset).
