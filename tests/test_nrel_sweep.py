@@ -1,0 +1,42 @@
+"""The nonlinear NREL 5 MW gearbox study (``nrel_5mw_gearbox_sweep``): its train is the linear
+study's, its inputs are the stated ones (rated torque from Jonkman et al. 2009, ISO/TR 10064-2
+backlash)."""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from importlib import resources
+
+import pytest
+
+from geardyn.io.toml import builtin_study
+from geardyn.units import si_value
+
+
+def _table(name: str) -> dict:
+    text = resources.files("geardyn.studies").joinpath(f"{name}.toml").read_text()
+    return tomllib.loads(text)
+
+
+def test_train_table_is_the_linear_studys():
+    assert _table("nrel_5mw_gearbox_sweep")["train"] == _table("nrel_5mw_gearbox")["train"]
+
+
+def test_rated_torque_is_5_mw_at_12_1_rpm():
+    """Jonkman et al. 2009, Table 1-1: rated power 5 MW, rated rotor speed 12.1 rpm."""
+    torque = si_value("rotor", builtin_study("nrel_5mw_gearbox_sweep").params.torques["rotor"],
+                      "torque", 0.0)
+    assert torque == pytest.approx(5e6 / (12.1 * 2.0 * math.pi / 60.0), rel=1e-3)
+
+
+@pytest.mark.parametrize(("meshes", "centre_distance", "module"),
+                         [(("sun1_pa1", "pa1_ring1"), 863.0, 45.0),
+                          (("sun2_pb1", "pb1_ring2"), 584.0, 21.0), (("stage3",), 861.0, 14.0)])
+def test_backlash_is_half_the_iso_minimum(meshes, centre_distance, module):
+    """ISO/TR 10064-2: j_bn,min = 2/3 (0.06 + 0.0005 a + 0.03 m_n) mm; the model's backlash is
+    the half-width of the dead zone."""
+    backlash = builtin_study("nrel_5mw_gearbox_sweep").params.backlash
+    j_bn = 2.0 / 3.0 * (0.06 + 0.0005 * centre_distance + 0.03 * module) * 1e-3
+    for mesh in meshes:
+        assert si_value(mesh, backlash[mesh], "length", 0.0) == pytest.approx(j_bn / 2.0, rel=0.01)
