@@ -8,6 +8,7 @@ import math
 import tomllib
 from importlib import resources
 
+import numpy as np
 import pytest
 
 from geardyn.io.toml import builtin_study
@@ -40,3 +41,23 @@ def test_backlash_is_half_the_iso_minimum(meshes, centre_distance, module):
     j_bn = 2.0 / 3.0 * (0.06 + 0.0005 * centre_distance + 0.03 * module) * 1e-3
     for mesh in meshes:
         assert si_value(mesh, backlash[mesh], "length", 0.0) == pytest.approx(j_bn / 2.0, rel=0.01)
+
+
+def test_stage2_resonance_is_at_its_campbell_crossing():
+    """Near rated speed the planetary stage 2 meshes respond most where their mesh frequency
+    crosses a natural frequency of the linear model (GearTrain.campbell: the eigenproblem at
+    mean stiffness), within the sweep's resolution."""
+    import geardyn
+
+    study = builtin_study("nrel_5mw_gearbox_sweep")
+    model = geardyn.build_model(study)
+    rpm = np.arange(14.0, 16.21, 0.1)
+    omega_min = float(model.lane_params("input_speed", rpm)[:, model.omega_index].min())
+    run = geardyn.RunSettings(transient=200 * 2.0 * math.pi / omega_min, samples=8)
+    ds = geardyn.bifurcation(model, "input_speed", rpm, run)
+    peak = rpm[int(np.argmax(ds["dynamic_factor"].sel(mesh="sun2_pb1").values))]
+    campbell = study.gear_train.campbell(rpm, harmonics=1)
+    crossings = campbell["crossing_speed"].where(campbell["mesh"] == "sun2_pb1").values
+    crossings = crossings[np.isfinite(crossings)]
+    assert crossings.size >= 1
+    assert np.min(np.abs(crossings - peak)) <= 0.1
