@@ -1,4 +1,4 @@
-"""The planetary set's lane blocks, old kernels against the working tree's in one run.
+"""The planetary set's lane blocks (and the paper workload), old kernels against new in one run.
 
 The planetary set (the built-in study ``planetary_example``, N = 4, 42 states) is the model
 whose lane-block functions (``rhs_lanes``, ``events_lanes``) the kernels use: the sweep's block
@@ -9,9 +9,11 @@ module's entry point swapped), alternating, in this process; reported: the CPU s
 (median of ``--repeat``, after a first round that compiles) and whether the results are
 bitwise equal. Workloads: ``sweep``, 20 Omega in [0.05, 1.2] (every 20th of
 ``bench/planetary.py``'s 400), 50 mesh periods of transient at the lowest, 32 samples;
-``lanes``, the largest Lyapunov exponent of 24 Omega in [0.3, 1.1], transient 20, duration 200.
+``lanes``, the largest Lyapunov exponent of 24 Omega in [0.3, 1.1], transient 20, duration 200;
+``paper``, for scale, ``bench/bifurcation.py``'s workload (the reduced CATT device, 1000 Omega,
+transient 2000, 200 samples: its fused sweep loop).
 
-    .venv/bin/python bench/lane_blocks.py [--old REV] [--repeat 5] [--what sweep lanes]
+    .venv/bin/python bench/lane_blocks.py [--old REV] [--repeat 5] [--what sweep lanes paper]
 """
 
 from __future__ import annotations
@@ -36,6 +38,11 @@ from kernel import old_kernels  # noqa: E402
 
 def workload(model, what: str):
     """(template, entry point name, run: a function returning the results as one array)."""
+    if what == "paper":
+        values = np.linspace(0.1, 4.0, 1000)
+        run = geardyn.RunSettings(transient=2000.0, samples=200)
+        return "rk4", "sweep", lambda: geardyn.bifurcation(model, "Omega", values,
+                                                           run)["poincare"].values
     if what == "sweep":
         omegas = np.linspace(0.05, 1.2, 400)[::20]
         run = geardyn.RunSettings(transient=50 * 2 * math.pi / omegas.min(), samples=32)
@@ -56,12 +63,14 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--old", default="54378d3")
     ap.add_argument("--repeat", type=int, default=5)
-    ap.add_argument("--what", nargs="*", default=["sweep", "lanes"], choices=["sweep", "lanes"])
+    ap.add_argument("--what", nargs="*", default=["sweep", "lanes"],
+                    choices=["sweep", "lanes", "paper"])
     args = ap.parse_args()
-    model = geardyn.build_model(builtin_study("planetary_example"))
-    print(f"# planetary_example, old kernels {args.old} against the working tree; CPU s, "
-          f"median of {args.repeat}")
+    planetary = geardyn.build_model(builtin_study("planetary_example"))
+    paper = geardyn.CATTDevice(geardyn.PlanetaryParams.paper(xi1=0.05, xi2=0.05))
+    print(f"# old kernels {args.old} against the working tree; CPU s, median of {args.repeat}")
     for what in args.what:
+        model = paper if what == "paper" else planetary
         template, entry, run = workload(model, what)
         new = kmod.kernels_for(model.kernel, template)
         fns = {"old": getattr(old_kernels(model.kernel, args.old, template), entry),
