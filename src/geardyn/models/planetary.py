@@ -835,11 +835,11 @@ class PlanetaryGearSet(Model):
 
     def stiffness_error(self) -> dict[str, float]:
         """A potential-energy set's stiffness series against its tables at the tables' angles
-        (every mesh, relative to its mean stiffness; :func:`~geardyn.models.planetary_stiffness.
-        series_error`): ``drive_max``, ``drive_rms``, ``coast_max``, ``coast_rms`` (the coast
-        flank's with ``coast="mirror"``, else 0), the largest over the meshes. The maximum sits
-        at the tables' jumps (a tooth pair entering or leaving contact), the rms falls as the
-        harmonics grow."""
+        (every mesh, relative to its mean stiffness, by
+        ``geardyn.models.planetary_stiffness.series_error``): ``drive_max``, ``drive_rms``,
+        ``coast_max``, ``coast_rms`` (the coast flank's with ``coast="mirror"``, else 0), the
+        largest over the meshes. The maximum sits at the tables' jumps (a tooth pair entering or
+        leaving contact), the rms falls as the harmonics grow."""
         if self.mesh_tables is None:
             raise ParameterError("stiffness_method", self.stiffness_method,
                                  "the series error needs the potential-energy tables")
