@@ -45,9 +45,11 @@ def _git_show(rev: str, path: str) -> str:
                           capture_output=True, text=True).stdout
 
 
-def old_kernels(source: kmod.KernelSource, rev: str):
-    """The sweep kernel module of revision ``rev`` for a model (compiled, cached on disk)."""
-    tmpl = _git_show(rev, "src/geardyn/solvers/_kernel_template.py")
+def old_kernels(source: kmod.KernelSource, rev: str, template: str = "rk4"):
+    """The kernel module of ``template`` (``rk4``: the sweep's, or ``lyapunov``) of revision
+    ``rev`` for a model (compiled, cached on disk)."""
+    path = kmod.TEMPLATES[template].replace(".", "/")
+    tmpl = _git_show(rev, f"src/{path}.py")
     core = [ln for ln in _git_show(rev, "src/geardyn/solvers/_step_core.py").splitlines()
             if not ln.startswith("from __future__")]
     lines = tmpl.splitlines()
@@ -65,7 +67,7 @@ def old_kernels(source: kmod.KernelSource, rev: str):
     funcs = source.functions()
     funcs.update(_old_lane_functions(funcs, rev))
     code = kmod._replace_import(text, kmod._import_line(funcs))
-    name = "geardyn_rk4old_" + hashlib.sha256(code.encode()).hexdigest()[:16]
+    name = f"geardyn_{template}old_" + hashlib.sha256(code.encode()).hexdigest()[:16]
     folder = kmod.cache_dir()
     folder.mkdir(parents=True, exist_ok=True)
     path = folder / f"{name}.py"

@@ -339,7 +339,7 @@ def _load_terms(T, PT, nl, SC):
             SC[3, k] = load_sin(PT[LAMBDA, k] * T[k] + PT[PSI1, k])
 
 
-@nb.njit(**_JIT)
+@nb.njit(_nrt=False, **_JIT)  # allocates nothing (called once per block step)
 def catt_rhs_one_lanes(T, Y, DY, PT, nl, S, C, SC):
     """:func:`catt_rhs_one` for lanes 0..nl-1 of a block (see above)."""
     _lane_forcing(T, PT, nl, S, C, SC)
@@ -366,7 +366,7 @@ def catt_rhs_one_lanes(T, Y, DY, PT, nl, S, C, SC):
                     + om2 * (PT[o + E_PQ_S, k] * S[k] + PT[o + E_PQ_C, k] * C[k]))
 
 
-@nb.njit(**_JIT)
+@nb.njit(_nrt=False, **_JIT)  # allocates nothing (called once per block step)
 def catt_events_one_lanes(T, Y, G, PT, nl, S, C):
     """:func:`catt_events_one` for lanes 0..nl-1 of a block."""
     o = HEADER
@@ -377,7 +377,7 @@ def catt_events_one_lanes(T, Y, G, PT, nl, S, C):
         G[3, k] = Y[2, k] + PT[o + B_PQ, k]
 
 
-@nb.njit(**_JIT)
+@nb.njit(_nrt=False, **_JIT)  # allocates nothing (called once per block step)
 def catt_observe_one_lanes(T, Y, O, PT, nl, S, C, SC):
     """:func:`catt_observe_one` for lanes 0..nl-1 of a block."""
     _lane_forcing(T, PT, nl, S, C, SC)

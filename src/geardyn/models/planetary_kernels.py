@@ -85,6 +85,9 @@ EMPTY = 2.0
 CT_ROWS = 1
 
 _JIT = {"cache": True, "error_model": "numpy", "boundscheck": False}
+#: The lane-block functions allocate nothing: compiled without reference counting (the kernels
+#: call them, once per block step, rather than inline them).
+_JIT_LANES = {**_JIT, "_nrt": False}
 
 
 def layout(n: int, n_mesh: int, nh: int, nk: int = 0, ng: int = 0) -> dict[str, int]:
@@ -504,7 +507,7 @@ def _lanes_ct_broadcast(Y, DY, PT, nl, n):
                 DY[n + i, k] -= c0 * Y[n + j, k]
 
 
-@nb.njit(**_JIT)
+@nb.njit(**_JIT_LANES)
 def planetary_rhs_lanes(T, Y, DY, PT, nl, S, C, SC):
     """:func:`planetary_rhs` for lanes 0..nl-1 of a block."""
     n, nm, nh, mesh, bs, st, mz = _lanes_offsets(PT)
@@ -639,7 +642,7 @@ def _lanes_apply(DY, PT, nl, SC, n, q, apply):
             DY[r, k] -= SC[0, k] * PT[g + j, k]
 
 
-@nb.njit(**_JIT)
+@nb.njit(**_JIT_LANES)
 def planetary_events_lanes(T, Y, G, PT, nl, S, C):
     """:func:`planetary_events` for lanes 0..nl-1 of a block (the mesh phase S[k], C[k])."""
     n, nm, nh, mesh, bs, st, mz = _lanes_offsets(PT)
@@ -672,7 +675,7 @@ def planetary_events_lanes(T, Y, G, PT, nl, S, C):
             G[2 * m + 1, k] = d + PT[o + M_B, k]
 
 
-@nb.njit(**_JIT)
+@nb.njit(**_JIT_LANES)
 def planetary_observe_lanes(T, Y, O, PT, nl, S, C, SC):
     """:func:`planetary_observe` for lanes 0..nl-1 of a block (O: one row per mesh)."""
     n, nm, nh, mesh, bs, st, mz = _lanes_offsets(PT)

@@ -2,7 +2,7 @@
 
 This file is a template: :func:`geardyn.solvers.kernels.kernels_for` copies it with the import
 line marked ``MODEL-IMPORT`` replaced by the model's compiled functions, so that numba compiles
-(and caches on disk) one kernel per model with the right-hand side inlined. As it stands it is a
+(and caches on disk) one kernel per model with the model's functions. As it stands it is a
 valid module bound to a small test oscillator.
 
 Numerics
@@ -37,7 +37,6 @@ import numpy as np
 from geardyn.core.kernel_source import FORM_GENERAL, FORM_LOAD, FORM_QUIET, LANE_FORMS
 from geardyn.solvers._parallel import run_workers
 from geardyn.solvers._step_core import (  # CORE-IMPORT
-    _INLINE,
     _JIT,
     BLOCK,
     FUSED,
@@ -85,7 +84,7 @@ from geardyn.solvers._sweep_books import (  # compiled once for every model
 )
 from geardyn.solvers._template_model import events, observe, rhs  # MODEL-IMPORT
 
-_observe_i = nb.njit(**_INLINE)(observe.py_func)
+_observe_i = nb.njit(forceinline=True, _nrt=False, **_JIT)(observe.py_func)  # (as ._step_core's)
 
 __all__ = ["BLOCK", "MAX_SPLITS", "SIMULTANEOUS", "events", "observe", "phase_table", "rhs",
            "sweep", "trajectory"]
@@ -241,7 +240,9 @@ def trajectory(p, y0, h, omega, n_per, i0, n_steps, stride, locate, bound, n_ev,
 # tail. The RK4 stages, the phase gathers, the side test and the statistics are loops over
 # slots without calls, which LLVM vectorises; a built-in model's ``*_lanes`` functions
 # (generated module: ``rhs_lanes``, ``events_lanes``, ``observe_lanes``) evaluate the model the
-# same way, with the forcing phase per slot (S[k], C[k]). A model without them is evaluated lane
+# same way, with the forcing phase per slot (S[k], C[k]), called once per block step (compiled
+# once per model, shared with the Lyapunov kernel's lane blocks; the call's cost is spread over
+# the block's slots). A model without them is evaluated lane
 # by lane (the per-lane functions, gathered). Lanes that leave a side of an edge are finished
 # one by one on the scalar path (:func:`_split_step`). No fastmath: each lane's arithmetic is
 # the scalar kernel's, so a lane's result does not depend on its slot, its neighbours, its
@@ -259,22 +260,19 @@ def _observe_lanes_generic(T, Y, O, PT, P, LANE, nl, S, C, SC, ybuf, ob):
             O[j, k] = ob[j]
 
 
-if "rhs_lanes" in globals():  # the model's lane-block functions (see .kernels), inlined
-    _rhs_lm = nb.njit(**_INLINE)(rhs_lanes.py_func)  # noqa: F821
-    _events_lm = nb.njit(**_INLINE)(events_lanes.py_func)  # noqa: F821
-    _observe_lm = nb.njit(**_INLINE)(observe_lanes.py_func)  # noqa: F821
+if "rhs_lanes" in globals():  # the model's lane-block functions (see .kernels), called
 
     @nb.njit(inline="always", **_JIT)
     def _rhs_lanes(T, Y, DY, PT, P, LANE, nl, S, C, SC, ybuf, dbuf):
-        _rhs_lm(T, Y, DY, PT, nl, S, C, SC)
+        rhs_lanes(T, Y, DY, PT, nl, S, C, SC)  # noqa: F821
 
     @nb.njit(inline="always", **_JIT)
     def _events_lanes(T, Y, G, PT, P, LANE, nl, S, C, ybuf, gb):
-        _events_lm(T, Y, G, PT, nl, S, C)
+        events_lanes(T, Y, G, PT, nl, S, C)  # noqa: F821
 
     @nb.njit(inline="always", **_JIT)
     def _observe_lanes(T, Y, O, PT, P, LANE, nl, S, C, SC, ybuf, ob):
-        _observe_lm(T, Y, O, PT, nl, S, C, SC)
+        observe_lanes(T, Y, O, PT, nl, S, C, SC)  # noqa: F821
 
 else:
     _rhs_lanes = _rhs_columns

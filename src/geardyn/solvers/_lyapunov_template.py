@@ -79,7 +79,6 @@ from geardyn.solvers._lyapunov_books import (  # compiled once for every model
 )
 from geardyn.solvers._parallel import run_workers
 from geardyn.solvers._step_core import (  # CORE-IMPORT
-    _INLINE,
     _JIT,
     BLOCK,
     FD_DELTA,
@@ -280,20 +279,21 @@ def _lanes_rows(P, Y0, scale, T0, H, OMEGA, n_per, n_transient, n_steps, renorm_
 
 
 # ---------------------------------------------------------------------------------------------
-# Lane blocks, structure of arrays: the integrations of several lanes (each lane's state row and
-# its 2 k perturbed rows) advance as the rows of one block, state Y[q, r] with the row index r
-# innermost and contiguous, the block's width a runtime value, so that the RK4 stages, the
-# model's lane-block functions (``rhs_lanes``, ``events_lanes``; see :mod:`.kernels`), the side
-# test, the finite-difference set-up and its combination are loops over rows without calls,
-# which LLVM vectorises. Row r = slot nl + l holds slot ``slot`` of lane l of the block (slots
-# 2 j - 2, 2 j - 1: tangent j's y + e s v and y - e s v; slot 2 k: the state), so that a lane's
-# rows lie nl apart. Each row gets its own coefficients (PT[:, r]), times and forcing phase
-# (SP[r], CP[r]). A row whose trial step leaves a side of an edge (or may graze one) is finished
-# on the scalar path (:func:`_split_step`). Gram-Schmidt, the block statistics and the health
-# check run per lane, at its renormalisations, on a gathered copy with the functions of the
-# one-lane kernel. Every row's arithmetic is that of :func:`_rows_step`, operation for
-# operation (no fastmath), so results are bitwise those of :func:`lyapunov_single`, whatever the
-# blocking, position or thread.
+# Lane blocks, structure of arrays: the integrations of several lanes (each lane's state row and its
+# 2 k perturbed rows) advance as the rows of one block, state Y[q, r] with the row index r innermost
+# and contiguous, the block's width a runtime value, so that the RK4 stages, the side test, the
+# finite-difference set-up and its combination are loops over rows without calls, which LLVM
+# vectorises; the model's lane-block functions (``rhs_lanes``, ``events_lanes``; see
+# :mod:`.kernels`) are such loops too, called once per stage of a block step (compiled once per
+# model, shared with the sweep kernel: inlined at each of the seven call sites they would be typed
+# and compiled seven times). Row r = slot nl + l holds slot ``slot`` of lane l of the block (slots
+# 2 j - 2, 2 j - 1: tangent j's y + e s v and y - e s v; slot 2 k: the state), so that a lane's rows
+# lie nl apart. Each row gets its own coefficients (PT[:, r]), times and forcing phase (SP[r],
+# CP[r]). A row whose trial step leaves a side of an edge (or may graze one) is finished on the
+# scalar path (:func:`_split_step`). Gram-Schmidt, the block statistics and the health check run per
+# lane, at its renormalisations, on a gathered copy with the functions of the one-lane kernel. Every
+# row's arithmetic is that of :func:`_rows_step`, operation for operation (no fastmath), so results
+# are bitwise those of :func:`lyapunov_single`, whatever the blocking, position or thread.
 
 #: Most rows of a lane block (lanes of 2 k + 1 rows each; at least one lane).
 BLOCK_ROWS = 64
@@ -304,18 +304,16 @@ BLOCK_ROWS = 64
 ROW_PAD = 1
 
 
-if "rhs_lanes" in globals():  # the model's lane-block functions (see .kernels), inlined
-    _rhs_lm = nb.njit(**_INLINE)(rhs_lanes.py_func)  # noqa: F821
-    _events_lm = nb.njit(**_INLINE)(events_lanes.py_func)  # noqa: F821
+if "rhs_lanes" in globals():  # the model's lane-block functions (see .kernels), called
     ROW_PAD = 32
 
     @nb.njit(inline="always", **_JIT)
     def _rows_rhs(T, Y, DY, PT, P, LANE, nr, SP, CP, SC, ybuf, dbuf):
-        _rhs_lm(T, Y, DY, PT, nr, SP, CP, SC)
+        rhs_lanes(T, Y, DY, PT, nr, SP, CP, SC)  # noqa: F821
 
     @nb.njit(inline="always", **_JIT)
     def _rows_events(T, Y, G, PT, P, LANE, nr, SP, CP, ybuf, gb):
-        _events_lm(T, Y, G, PT, nr, SP, CP)
+        events_lanes(T, Y, G, PT, nr, SP, CP)  # noqa: F821
 
 else:
     _rows_rhs = _rhs_columns

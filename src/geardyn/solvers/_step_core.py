@@ -80,11 +80,14 @@ from geardyn.solvers._template_model import events, rhs  # MODEL-IMPORT
 _CACHE = True
 _JIT = {"cache": _CACHE, "error_model": "numpy", "boundscheck": False}
 # MODEL-ADAPTERS (a user's plain functions are adapted to the kernel interface here)
-# The model's functions inlined (numba IR inlining) where they are called in a loop: a call with
-# array arguments would otherwise cost reference counting on every stage of every step.
-_INLINE = {"inline": "always", "error_model": "numpy", "boundscheck": False}
-_rhs_i = nb.njit(**_INLINE)(rhs.py_func)
-_events_i = nb.njit(**_INLINE)(events.py_func)
+# The model's functions where they are called in a loop: compiled once (per argument types) and
+# inlined by LLVM at every call site (``forceinline``; a call with array arguments would cost
+# reference counting on every stage of every step), not by numba's frontend, which would copy
+# and type the model's IR anew at each call site (the bulk of a big model's compile).
+# Without reference counting, as inlined into the split step (``_nrt=False``; a model's
+# functions allocate nothing).
+_rhs_i = nb.njit(forceinline=True, _nrt=False, **_JIT)(rhs.py_func)
+_events_i = nb.njit(forceinline=True, _nrt=False, **_JIT)(events.py_func)
 # The split path (a step with a located crossing: :func:`_split_step`, :func:`_rk4_stages` and
 # the root finders) inlines them too; a model with lane-scalar functions takes those there
 # instead, the state in registers (see :func:`_split_rhs` and the FUSED block below).
@@ -400,9 +403,9 @@ def _split_step(i, t0, y, y_trial, p, h, omega, n_per, sa, ca, s_end, c_end, sid
     (:func:`_cubic_locate`: no model evaluations but one per located event), then RK4 to the
     crossing (k1 reused) and from there to the grid point; after that last sub-step only the
     end's side is tested unless an event may graze. The forcing phase at the fractional points
-    comes from that at the grid point by angle addition. The model's rhs and events are inlined
-    here and in the helpers (``_rhs_i``, ``_events_i``: no calls, no reference counting; the
-    same arithmetic), except in the rare fallbacks :func:`_illinois` and :func:`_beyond`,
+    comes from that at the grid point by angle addition. The model's rhs and events are inlined by
+    LLVM here and in the helpers (``_rhs_i``, ``_events_i``: no calls, no reference counting;
+    the same arithmetic), except in the rare fallbacks :func:`_illinois` and :func:`_beyond`,
     compiled once and called (each inlined copy costs compile time, see docs/engine.md).
     sa, ca and s_end, c_end: sin and cos of the forcing phase at the step's start and end,
     the caller's phase-table values (:func:`phase_table`), so a split sees the phases of the
