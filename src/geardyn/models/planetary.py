@@ -1135,19 +1135,8 @@ class PlanetaryGearSet(Model):
         kc = self.coast_stiffnesses()
         for m in range(nm):
             o = lay["mesh"] + m * lay["block"]
-            blk = p[o:o + lay["block"]]
-            blk[pk.M_B] = self.backlash[m] / L
-            blk[pk.M_ES] = self.error[m] * math.cos(self.error_phase[m]) / L
-            blk[pk.M_EC] = self.error[m] * math.sin(self.error_phase[m]) / L
-            blk[pk.M_KF] = k[m] * L
-            blk[pk.M_CF] = c[m] * L * w0
-            blk[pk.M_KFC] = kc[m] * L
-            blk[pk.M_ORDER] = 1.0
-            f = pk.MESH_FIXED
-            blk[f:f + 2 * nh] = self.fourier[m]
-            blk[f + 2 * nh:f + 2 * nh + n] = W[m]
-            blk[f + 2 * nh + n:f + 2 * nh + 2 * n] = Minv @ W[m] / (L * w0 * w0)
-            blk[f + 2 * nh + 2 * n:] = self.fourier_coast[m]
+            self._fill_mesh_block(p[o:o + lay["block"]], m, L, w0, k[m], c[m], kc[m], 1.0, W[m],
+                                  Minv @ W[m] / (L * w0 * w0))
         self._layout = lay
         self._coast_given = any(self.inputs[k] is not None for k in (
             "sun_coast_stiffness", "ring_coast_stiffness", "coast_waveform"))
@@ -1173,6 +1162,28 @@ class PlanetaryGearSet(Model):
         self.event_names = tuple(f"x_{m}{s}b_{m}" for m in self.mesh_names for s in "-+")
         self.meshes = tuple((m, 2 * i, 2 * i + 1) for i, m in enumerate(self.mesh_names))
         self._layout = lay
+
+    def _fill_mesh_block(self, blk: np.ndarray, m: int, L: float, w0: float, drive: float,
+                         damping: float, coast: float, order: float, row: np.ndarray,
+                         force_row: np.ndarray) -> None:
+        """Mesh m's block of the coefficient vector (:mod:`~geardyn.models.planetary_kernels`'s
+        mesh block): its backlash, error, drive and coast force per deflection ``drive``,
+        ``coast`` [N/m] and per rate ``damping`` [N s/m], ``order``, Fourier coefficients,
+        deflection ``row`` and ``force_row`` (M^-1 W^T / (L omega_0^2)); ``L`` [m], ``w0``
+        [rad/s] the length and frequency scales."""
+        blk[pk.M_B] = self.backlash[m] / L
+        blk[pk.M_ES] = self.error[m] * math.cos(self.error_phase[m]) / L
+        blk[pk.M_EC] = self.error[m] * math.sin(self.error_phase[m]) / L
+        blk[pk.M_KF] = drive * L
+        blk[pk.M_CF] = damping * L * w0
+        blk[pk.M_KFC] = coast * L
+        blk[pk.M_ORDER] = order
+        nh, n = self.fourier.shape[1] // 2, row.size
+        f = pk.MESH_FIXED
+        blk[f:f + 2 * nh] = self.fourier[m]
+        blk[f + 2 * nh:f + 2 * nh + n] = row
+        blk[f + 2 * nh + n:f + 2 * nh + 2 * n] = force_row
+        blk[f + 2 * nh + 2 * n:] = self.fourier_coast[m]
 
     def _kernel_structure(self) -> tuple[list[tuple[int, int]], list[list[int]]]:
         """The entries of Kt that the supports can make non-zero (row-major) and the model dofs

@@ -524,19 +524,9 @@ class TrainModel(PlanetaryGearSet):
         k, c = self.mesh_stiffnesses(), self._mesh_damping()
         for m in range(nm):
             o = lay["mesh"] + m * lay["block"]
-            blk = p[o:o + lay["block"]]
-            blk[pk.M_B] = self.backlash[m] / L
-            blk[pk.M_ES] = self.error[m] * math.cos(self.error_phase[m]) / L
-            blk[pk.M_EC] = self.error[m] * math.sin(self.error_phase[m]) / L
-            blk[pk.M_KF] = k[m] * L
-            blk[pk.M_CF] = c[m] * L * w0
-            blk[pk.M_KFC] = k[m] * L
-            blk[pk.M_ORDER] = self._kinematic_orders[m]
-            f = pk.MESH_FIXED
-            blk[f:f + 2 * nh] = self.fourier[m]
-            blk[f + 2 * nh:f + 2 * nh + n] = W[m]
-            blk[f + 2 * nh + n:f + 2 * nh + 2 * n] = _clean(Minv @ W[m]) / (L * w0 * w0)
-            blk[f + 2 * nh + 2 * n:] = self.fourier_coast[m]
+            self._fill_mesh_block(p[o:o + lay["block"]], m, L, w0, k[m], c[m], k[m],
+                                  self._kinematic_orders[m], W[m],
+                                  _clean(Minv @ W[m]) / (L * w0 * w0))
         self._layout = lay
         self._coast_given = self._mirrored
         from geardyn.models.planetary import _flank_index
