@@ -35,17 +35,19 @@ import numpy as np
 
 from geardyn.core.capabilities import Capabilities
 from geardyn.errors import ParameterError
+from geardyn.gears.potential_energy import coast_phase
 from geardyn.models import planetary_kernels as pk
 from geardyn.models.planetary import (
     _KERNEL,
     PlanetaryGearSet,
     _clean,
+    _flank_index,
     _minimum_relative_stiffness,
     _waveform,
     planetary_layout,
 )
 from geardyn.models.planetary_stiffness import coast_flank, mirrored
-from geardyn.trains.train import GearTrain
+from geardyn.trains.train import GearTrain, _gear_mesh
 from geardyn.units import si_value
 
 #: The sweep parameter of a train's input speed [rpm].
@@ -267,9 +269,6 @@ class TrainModel(PlanetaryGearSet):
         """phi [mesh cycles] of every mesh whose two gears have geometry:
         :func:`~geardyn.gears.potential_energy.coast_phase` of the pair (its transverse one
         for helical gears)."""
-        from geardyn.gears.potential_energy import coast_phase
-        from geardyn.trains.train import _gear_mesh
-
         out = {}
         for mesh in self.train.meshes:
             ga, gb = self.train.bodies[mesh.a], self.train.bodies[mesh.b]
@@ -291,8 +290,6 @@ class TrainModel(PlanetaryGearSet):
         ring's). Stages joined only by shafts are separate groups (their gears' clocking on
         the shaft is no input): each starts at 0. Needs the train's driven body and the
         geometry of every meshing gear."""
-        from geardyn.trains.train import _gear_mesh
-
         train = self.train
         if train.driven is None:
             raise ParameterError("mesh_phase", "geometry", "needs the train's driven body (the "
@@ -529,8 +526,6 @@ class TrainModel(PlanetaryGearSet):
                                   _clean(Minv @ W[m]) / (L * w0 * w0))
         self._layout = lay
         self._coast_given = self._mirrored
-        from geardyn.models.planetary import _flank_index
-
         self._coast_built = p[_flank_index(lay, n, nm, nh, True)].copy()
         self._structure = (kt_entries, mesh_dofs)
         self._refresh_workspace(p)
