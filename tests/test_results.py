@@ -95,6 +95,27 @@ def _branch() -> xr.Dataset:
     return ds
 
 
+def _curve() -> xr.Dataset:
+    n = 3
+    ds = xr.Dataset(coords={"point": ("point", np.arange(n)),
+                            "Omega": ("point", [0.5, 0.6, 0.7]),
+                            "torque": ("point", [10.0, 11.0, 12.5]),
+                            "state": ("state", ["x", "v"]), "multiplier": ("multiplier", [0, 1]),
+                            "special": ("special", [0])})
+    ds["section_point"] = (("point", "state"), np.zeros((n, 2)))
+    ds["multiplier_real"] = (("point", "multiplier"), np.full((n, 2), -1.0))
+    ds["multiplier_imag"] = (("point", "multiplier"), np.zeros((n, 2)))
+    ds["period_time"] = ("point", np.full(n, 2.0), {"units": "tau"})
+    ds["special_kind"] = ("special", ["cusp"], {"meaning": "codimension-2 point"})
+    ds["special_x"] = ("special", [0.6])
+    ds["special_y"] = ("special", [11.0])
+    ds["special_error"] = ("special", [1e-6])
+    ds.attrs.update(geardyn_kind="curve", curve_kind="period_doubling", x="Omega", y="torque",
+                    period=1, status=0, message="reached torque=12.5",
+                    status_meaning="0 completed", time_unit="tau")
+    return ds
+
+
 def _basins() -> xr.Dataset:
     ds = xr.Dataset(coords={"v": ("v", [0.0, 1.0]), "x": ("x", [1.0, 2.0, 3.0]),
                             "attractor": ("attractor", [0, 1]), "point": ("point", [0]),
@@ -129,7 +150,7 @@ def _frc() -> xr.Dataset:
 
 BUILD = {"simulation": _simulation, "bifurcation": _sweep, "map2d": _map,
          "reproduction-case": _case, "periodic-orbit": _orbit, "continuation": _branch,
-         "basins": _basins, "frequency-response": _frc}
+         "basins": _basins, "frequency-response": _frc, "curve": _curve}
 
 
 @pytest.mark.parametrize("kind", KINDS)
@@ -142,6 +163,7 @@ def test_well_formed_results_pass(kind):
                                        ("map2d", "status"), ("reproduction-case", "poincare"),
                                        ("periodic-orbit", "monodromy"),
                                        ("continuation", "bifurcation_value"),
+                                       ("curve", "special_error"),
                                        ("basins", "attractor_id"),
                                        ("frequency-response", "dte_rms")])
 def test_a_removed_variable_is_named(kind, name):

@@ -25,6 +25,7 @@ VARIABLE_ATTRS: Mapping[str, tuple[str, ...]] = {
     "final_time": ("units",), "poincare_time": ("units",), "time": ("units",),
     "attractor_id": ("meaning",), "attractor_fraction": ("meaning",), "unresolved": ("meaning",),
     "dte_rms": ("units",), "dte_peak": ("units",), "jump_omega": ("meaning",),
+    "period_time": ("units",), "special_kind": ("meaning",),
     "bifurcation_kind": ("meaning",), "bifurcation_located": ("meaning",)}
 
 
@@ -113,6 +114,18 @@ SCHEMAS: dict[str, ResultSchema] = {s.kind: s for s in (
          "bifurcation_value": ("bifurcation",), "bifurcation_error": ("bifurcation",),
          "bifurcation_located": ("bifurcation",), "branch_status": ("branch_id",),
          "branch_message": ("branch_id",)}),
+    ResultSchema(
+        "curve",
+        ("curve_kind", "x", "y", "period", "status", "message", "status_meaning",
+         "time_unit"),
+        {"point": ("point",), "{x}": ("point",), "{y}": ("point",), "state": ("state",),
+         "multiplier": ("multiplier",), "special": ("special",)},
+        {"section_point": ("point", "state"),
+         "multiplier_real": ("point", "multiplier"),
+         "multiplier_imag": ("point", "multiplier"), "period_time": ("point",),
+         "special_kind": ("special",), "special_x": ("special",), "special_y": ("special",),
+         "special_error": ("special",)},
+        status_attrs=("status",)),
     ResultSchema(
         "basins",
         ("x", "y", "Omega", "time_unit", "diverged_fraction", "unresolved_fraction",
