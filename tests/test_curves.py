@@ -1,0 +1,152 @@
+"""Two-parameter curves of fold and period-doubling points (geardyn.curve) against independent
+results: the damped Mathieu equation's instability boundary by an adaptive integrator, and the
+hysteresis of up and down sweeps on a grid."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+from scipy.optimize import brentq
+
+import geardyn
+from geardyn import ContinuedSweep, continued_sweeps
+from geardyn.analysis.curve_systems import compound2
+from geardyn.testing import assert_result
+
+ZETA = 0.02
+
+
+@pytest.fixture(scope="module")
+def mathieu():
+    """The gear pair kept in contact (mean load 1, no transmission error): about its
+    periodic orbit u = x - 1 obeys u'' + 2 zeta u' + (1 + kappa cos(Omega t)) u = Fm, whose
+    variational equation is the damped Mathieu equation."""
+    m = geardyn.GearPair(zeta=ZETA, Fm=1.0, Fa=0.0, kappa=0.3)
+    br = geardyn.continuation(m, "Omega", 1.6, 2.4)
+    return m, br
+
+
+@pytest.fixture(scope="module")
+def softening():
+    """The gear pair with contact loss (a softening response with a hysteresis loop)."""
+    m = geardyn.GearPair(zeta=0.05, Fm=0.1, Fa=0.05, kappa=0.0)
+    br = geardyn.continuation(m, "Omega", 0.6, 1.4)
+    return m, br
+
+
+def _mathieu_pd_test(omega: float, kappa: float) -> float:
+    """det(M + I) of the damped Mathieu equation over one period 2 pi / Omega (DOP853, rtol
+    1e-10): zero where a Floquet multiplier is -1."""
+    T = 2 * math.pi / omega
+
+    def f(t, y):
+        return [y[1], -2 * ZETA * y[1] - (1 + kappa * math.cos(omega * t)) * y[0]]
+
+    cols = [solve_ivp(f, (0.0, T), e, method="DOP853", rtol=1e-10, atol=1e-12).y[:, -1]
+            for e in ([1.0, 0.0], [0.0, 1.0])]
+    return float(np.linalg.det(np.column_stack(cols) + np.eye(2)))
+
+
+def test_period_doubling_curve_is_the_mathieu_instability_boundary(mathieu):
+    m, br = mathieu
+    kinds = br["bifurcation_kind"].values.tolist()
+    assert kinds == ["period-doubling", "period-doubling"]
+    c = geardyn.curve(m, br, 0, "kappa", 0.0)
+    assert_result(c, "curve")
+    assert c.attrs["curve_kind"] == "period_doubling"
+    # from one edge of the principal zone round its tip (kappa ~ 4 zeta) to the other edge
+    assert c.attrs["status"] == int(geardyn.BranchStatus.COMPLETED), c.attrs["message"]
+    assert float(c["kappa"].min()) < 0.1
+    assert float(c["Omega"][-1]) == pytest.approx(float(br["bifurcation_value"][1]), abs=1e-6)
+    mu = c["multiplier_real"].values + 1j * c["multiplier_imag"].values
+    assert np.all(np.min(np.abs(mu + 1.0), axis=1) < 1e-6)
+    # the boundary by an independent integrator, root-found in Omega at the curve's kappa
+    om, kap = c["Omega"].values, c["kappa"].values
+    picks = [i for i in np.linspace(0, om.size - 1, 9).astype(int) if kap[i] > 0.12]
+    assert {bool(om[i] < 2.0) for i in picks} == {True, False}  # both edges
+    for i in picks:
+        ref = brentq(lambda w, k=kap[i]: _mathieu_pd_test(w, k), om[i] - 0.01, om[i] + 0.01,
+                     xtol=1e-12)
+        assert abs(om[i] - ref) < 1e-6, (kap[i], om[i], ref)
+    # contact kept along the curve (the Mathieu reduction holds): no crossings of an edge
+    for i in picks[:2]:
+        orb = geardyn.periodic_orbit(m.with_params(kappa=float(kap[i])), omega=float(om[i]))
+        assert set(orb.mesh_crossings().values()) == {0}
+    # a linear system's doubling is degenerate (c = 0 to round-off): no codimension-2 point
+    assert c.sizes["special"] == 0
+
+
+def test_fold_curves_meet_in_a_cusp_that_bounds_the_hysteresis(softening):
+    m, br = softening
+    folds = [i for i, k in enumerate(br["bifurcation_kind"].values) if k == "fold"]
+    assert len(folds) == 2
+    c = geardyn.curve(m, br, folds[0], "Fa", 0.0)
+    assert_result(c, "curve")
+    # down from one fold, round the cusp, up to the branch's other fold at Fa = 0.05
+    assert c.attrs["status"] == int(geardyn.BranchStatus.COMPLETED), c.attrs["message"]
+    assert float(c["Fa"][-1]) == pytest.approx(0.05, abs=1e-12)
+    assert float(c["Omega"][-1]) == pytest.approx(float(br["bifurcation_value"][folds[1]]),
+                                                  abs=1e-6)
+    kinds = c["special_kind"].values.tolist()
+    assert kinds == ["cusp"]
+    cusp_om, cusp_fa = float(c["special_x"][0]), float(c["special_y"][0])
+    assert c["special_error"].values[0] < 1e-4
+    # the two arms of the curve, either side of its lowest Fa
+    om, fa = c["Omega"].values, c["Fa"].values
+    tip = int(np.argmin(fa))
+    assert abs(fa[tip] - cusp_fa) < 1e-3 and abs(om[tip] - cusp_om) < 0.01
+    arms = [(fa[: tip + 1][::-1], om[: tip + 1][::-1]), (fa[tip:], om[tip:])]
+    for f, _ in arms:
+        assert np.all(np.diff(f) > 0)
+    # up and down sweeps on a grid: coexisting responses exactly between the fold curves
+    grid = np.arange(0.60, 1.0001, 0.01)
+    rows = [0.005, 0.01, 0.02, 0.03, 0.04, 0.05]
+    run = geardyn.RunSettings(transient=400.0, continued_transient=100.0, converge=1e-8,
+                              transient_max=1500.0, samples=2)
+    sweeps = [ContinuedSweep(m.with_params(Fa=f), "Omega", grid, d, run=run)
+              for f in rows for d in ("up", "down")]
+    out = continued_sweeps(sweeps, run=run)
+    for k, f in enumerate(rows):
+        up, down = out[2 * k], out[2 * k + 1]
+        assert up["converged"].values.min() == 1 and down["converged"].values.min() == 1
+        both = np.max(np.abs(up["poincare"].values - down["poincare"].values), axis=(1, 2)) > 1e-3
+        if f < cusp_fa:
+            assert not both.any(), f
+            continue
+        lo, hi = sorted(float(np.interp(f, fa_arm, om_arm)) for fa_arm, om_arm in arms)
+        inside = (grid > lo) & (grid < hi)
+        near = np.minimum(np.abs(grid - lo), np.abs(grid - hi)) < 0.01
+        assert both.any(), f
+        assert np.array_equal(both[~near], inside[~near]), (f, lo, hi, both.astype(int))
+
+
+def test_bad_input_names_the_value(softening):
+    m, br = softening
+    contact = int(np.flatnonzero(br["bifurcation_kind"].values == "contact")[0])
+    fold = int(np.flatnonzero(br["bifurcation_kind"].values == "fold")[0])
+    with pytest.raises(KeyError, match="nonsense"):
+        geardyn.curve(m, br, fold, "nonsense", 1.0)
+    with pytest.raises(ValueError, match=f"bifurcation={contact} is a contact change.*grazing"):
+        geardyn.curve(m, br, contact, "Fa", 0.0)
+    with pytest.raises(ValueError, match="bifurcation=17 is not an index"):
+        geardyn.curve(m, br, 17, "Fa", 0.0)
+    with pytest.raises(ValueError, match="y_stop=0.05"):
+        geardyn.curve(m, br, fold, "Fa", 0.05)
+    with pytest.raises(ValueError, match="'Omega'"):
+        geardyn.curve(m, br, fold, "Omega", 1.0)
+    with pytest.raises(ValueError, match="geardyn_kind='frequency-response'"):
+        geardyn.curve(m, br.assign_attrs(geardyn_kind="frequency-response"), fold, "Fa", 0.0)
+    with pytest.raises(ValueError, match="locate_tol"):
+        geardyn.CurveSettings(locate_tol=-1.0)
+
+
+def test_second_compound_matrix_has_the_pair_products():
+    rng = np.random.default_rng(3)
+    M = rng.normal(size=(4, 4))
+    mu = np.linalg.eigvals(M)
+    products = [mu[i] * mu[j] for i in range(4) for j in range(i + 1, 4)]
+    got = np.linalg.eigvals(compound2(M))
+    assert np.allclose(np.sort_complex(got), np.sort_complex(np.array(products)), atol=1e-10)
