@@ -150,3 +150,55 @@ def test_second_compound_matrix_has_the_pair_products():
     products = [mu[i] * mu[j] for i in range(4) for j in range(i + 1, 4)]
     got = np.linalg.eigvals(compound2(M))
     assert np.allclose(np.sort_complex(got), np.sort_complex(np.array(products)), atol=1e-10)
+
+
+def test_neimark_sacker_curve_of_the_forced_van_der_pol_oscillator_and_its_1_1_points():
+    """x'' - mu (1 - x^2) x' + x = F cos(Omega t): the entrained orbit loses stability to a
+    torus as F falls (a complex pair through |mu| = 1). Its Neimark-Sacker curve in (F, Omega)
+    ends, near Omega = 1 either side, at a 1:1 resonance (the pair at +1), where it goes on as
+    a neutral saddle. Checked by DOP853 at rtol 1e-10 from the curve's section points: the
+    orbit closes, det M = 1 with a complex pair on the curve, tr M = 2 at the 1:1 points."""
+    from shared_models import oscillator
+
+    mu, om0 = 0.2, 1.1
+    m = oscillator(Omega=om0, mu=mu, F=0.5, natural_frequency=1.0)
+    br = geardyn.continuation(m, "F", 0.5, 0.2)
+    ns = [i for i, k in enumerate(br["bifurcation_kind"].values) if k == "neimark-sacker"]
+    assert len(ns) == 1
+    c = geardyn.curve(m, br, ns[0], "Omega", 0.9)
+    assert_result(c, "curve")
+    assert c.attrs["curve_kind"] == "neimark_sacker"
+    assert c.attrs["status"] == int(geardyn.BranchStatus.COMPLETED), c.attrs["message"]
+    assert c["special_kind"].values.tolist() == ["resonance_1_1", "resonance_1_1"]
+    sy = c["special_y"].values
+    assert sy[0] > 1.0 > sy[1]
+
+    def monodromy(x0, F, om):
+        T = 2 * math.pi / om
+
+        def f(t, y):
+            x, v = y[0], y[1]
+            Phi = y[2:].reshape(2, 2)
+            A = np.array([[0.0, 1.0], [-1.0 - 2 * mu * x * v, mu * (1 - x * x)]])
+            return np.concatenate([[v, mu * (1 - x * x) * v - x + F * math.cos(om * t)],
+                                   (A @ Phi).ravel()])
+
+        y = solve_ivp(f, (0.0, T), np.concatenate([x0, np.eye(2).ravel()]), method="DOP853",
+                      rtol=1e-10, atol=1e-12).y[:, -1]
+        return y[:2], y[2:].reshape(2, 2)
+
+    F, om = c["F"].values, c["Omega"].values
+    cos_theta = c["test_resonance_1_1"].values + 1.0
+    on_ns = [i for i in range(0, F.size, 7) if abs(cos_theta[i]) < 0.99]
+    assert len(on_ns) >= 3
+    for i in on_ns:
+        x0 = c["section_point"].values[i]
+        end, M = monodromy(x0, F[i], om[i])
+        assert np.max(np.abs(end - x0)) < 1e-6
+        assert abs(np.linalg.det(M) - 1.0) < 1e-6
+        assert np.trace(M) ** 2 < 4 * np.linalg.det(M)  # a complex pair
+    for j in range(2):
+        x0 = c["special_section_point"].values[j]
+        end, M = monodromy(x0, float(c["special_x"][j]), float(sy[j]))
+        assert np.max(np.abs(end - x0)) < 1e-6
+        assert abs(np.linalg.det(M) - 1.0) < 1e-6 and abs(np.trace(M) - 2.0) < 1e-5

@@ -262,6 +262,9 @@ def curve_dataset(sys: CurveSystem, cr: CurveRun, tests: list[dict[str, tuple[fl
         "long_name": "location error in the scaled parameters: max over the bracket ends of "
                      "|dx| / x_scale and |dy| / y_scale, plus the test function's error "
                      "estimate over its slope"})
+    ds["special_section_point"] = (("special", "state"), np.array(
+        [sys.state(sp.z) for sp in specials]).reshape(len(specials), n), {
+        "units": m.state_units, "long_name": "section point at the codimension-2 point"})
     ds["special_point"] = ("special", np.array([s.index for s in specials], np.int64),
                            {"long_name": "index of the curve point before it"})
     ds["special_located"] = ("special", np.array([int(s.located) for s in specials], np.int64),
