@@ -202,3 +202,17 @@ def test_neimark_sacker_curve_of_the_forced_van_der_pol_oscillator_and_its_1_1_p
         end, M = monodromy(x0, float(c["special_x"][j]), float(sy[j]))
         assert np.max(np.abs(end - x0)) < 1e-6
         assert abs(np.linalg.det(M) - 1.0) < 1e-6 and abs(np.trace(M) - 2.0) < 1e-5
+
+
+def test_curve_ends_on_the_x_bound_and_reports_progress(softening):
+    m, br = softening
+    fold = int(np.flatnonzero(br["bifurcation_kind"].values == "fold")[0])
+    seen: list[tuple[int, float, float]] = []
+    c = geardyn.curve(m, br, fold, "Fa", 0.0, x_range=(0.6, 0.9),
+                      progress=lambda k, x, y: seen.append((k, x, y)))
+    assert c.attrs["status"] == int(geardyn.BranchStatus.COMPLETED)
+    assert float(c["Omega"][-1]) == pytest.approx(0.9, abs=1e-12), c.attrs["message"]
+    assert "reached Omega=0.9" in c.attrs["message"]
+    assert [k for k, _, _ in seen] == list(range(1, c.sizes["point"] + 1))
+    with pytest.raises(ValueError, match="x_range"):
+        geardyn.curve(m, br, fold, "Fa", 0.0, x_range=(0.9, 1.0))

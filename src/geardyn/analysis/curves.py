@@ -138,10 +138,13 @@ def curve(model: Model, branch: xr.Dataset, bifurcation: int, y: str, y_stop: fl
         return curve_dataset(sys, cr, [], [], y0, y1)
     sys.set_border(first.info)
 
+    accepted = [0]
+
     def on_point(pt: CurvePoint) -> None:
         sys.set_border(pt.info)
+        accepted[0] += 1
         if progress is not None:
-            progress(0, *sys.xy(pt.z))
+            progress(accepted[0], *sys.xy(pt.z))
 
     def stop(_prev: CurvePoint, new: CurvePoint) -> str | None:
         nx, ny = sys.xy(new.z)
