@@ -216,3 +216,27 @@ def test_curve_ends_on_the_x_bound_and_reports_progress(softening):
     assert [k for k, _, _ in seen] == list(range(1, c.sizes["point"] + 1))
     with pytest.raises(ValueError, match="x_range"):
         geardyn.curve(m, br, fold, "Fa", 0.0, x_range=(0.9, 1.0))
+
+
+def test_generalised_period_doubling_of_the_mathieu_oscillator_with_cubic_damping():
+    """x'' + 2 zeta x' + rho x^2 x' + (1 + kappa cos(Omega t)) x = 0: x = 0 doubles its period
+    on the damped Mathieu equation's zone boundary whatever rho (a vertical curve in
+    (Omega, rho)); rho alone makes the map cubic, so the normal-form coefficient c is exactly
+    linear in rho: positive (supercritical) for rho > 0, zero at rho = 0, the generalised
+    period doubling."""
+    from shared_models import oscillator
+
+    m = oscillator(Omega=1.6, zeta=ZETA, kappa=0.3, rho=0.5, natural_frequency=1.0)
+    br = geardyn.continuation(m, "Omega", 1.6, 2.4, guess=np.zeros(2))
+    assert br["bifurcation_kind"].values[0] == "period-doubling"
+    c = geardyn.curve(m, br, 0, "rho", -0.5)
+    assert c.attrs["status"] == int(geardyn.BranchStatus.COMPLETED), c.attrs["message"]
+    edge = brentq(lambda w: _mathieu_pd_test(w, 0.3), 1.8, 1.9, xtol=1e-12)
+    assert np.max(np.abs(c["Omega"].values - edge)) < 1e-6
+    assert c["special_kind"].values.tolist() == ["generalised_period_doubling"]
+    assert abs(float(c["special_y"][0])) < 1e-6 and abs(float(c["special_x"][0]) - edge) < 1e-6
+    rho, coef = c["rho"].values, c["test_generalised_period_doubling"].values
+    far = np.abs(rho) > 0.05
+    assert np.all(coef[far] * rho[far] > 0)
+    ratio = coef[far] / rho[far]
+    assert np.ptp(ratio) < 1e-3 * abs(ratio.mean())
