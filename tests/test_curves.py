@@ -240,3 +240,22 @@ def test_generalised_period_doubling_of_the_mathieu_oscillator_with_cubic_dampin
     assert np.all(coef[far] * rho[far] > 0)
     ratio = coef[far] / rho[far]
     assert np.ptp(ratio) < 1e-3 * abs(ratio.mean())
+
+
+def test_curve_at_from_a_guess_without_a_branch(mathieu):
+    m, br = mathieu
+    from_branch = geardyn.curve(m, br, 0, "kappa", 0.5)
+    x0 = br["bifurcation_section_point"].values[0]
+    om0 = float(br["bifurcation_value"][0])
+    c = geardyn.curve_at(m, "period_doubling", "Omega", om0 + 0.01, x0 * 1.01, "kappa", 0.5)
+    assert c.attrs["status"] == int(geardyn.BranchStatus.COMPLETED), c.attrs["message"]
+    assert float(c["Omega"][0]) == pytest.approx(om0, abs=1e-6)
+    assert float(c["Omega"][-1]) == pytest.approx(float(from_branch["Omega"][-1]), abs=1e-6)
+    with pytest.raises(ValueError, match="kind must be one of.*'flip'"):
+        geardyn.curve_at(m, "flip", "Omega", om0, x0, "kappa", 0.5)
+    with pytest.raises(ValueError, match="guess must be 2 finite numbers"):
+        geardyn.curve_at(m, "fold", "Omega", om0, [1.0], "kappa", 0.5)
+    lost = geardyn.curve_at(m, "fold", "Omega", om0, x0, "kappa", 0.5)  # no fold there
+    assert lost.attrs["status"] == int(geardyn.BranchStatus.START_FAILED)
+    assert lost.sizes["point"] == 0 and "no fold point at Omega=1.85" in lost.attrs["message"]
+    assert_result(lost, "curve")

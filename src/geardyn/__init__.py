@@ -15,7 +15,7 @@ from geardyn._version import __version__ as __version__
 from geardyn.analysis.basins import basins
 from geardyn.analysis.bifurcation import ContinuedSweep, bifurcation, continued_sweeps
 from geardyn.analysis.branch import BifurcationPoint, BranchStatus, continuation
-from geardyn.analysis.curves import CurveSettings, curve
+from geardyn.analysis.curves import CurveSettings, curve, curve_at
 from geardyn.analysis.frc import frequency_response
 from geardyn.analysis.lyapunov import LyapunovEstimate, lyapunov, lyapunov_lanes
 from geardyn.analysis.map2d import map2d
@@ -83,6 +83,7 @@ __all__ = [
     "continuation",
     "continued_sweeps",
     "curve",
+    "curve_at",
     "frequency_response",
     "gears",
     "label_peaks",

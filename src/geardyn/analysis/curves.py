@@ -26,10 +26,12 @@ from geardyn.analysis.arclength import (
     start,
     tangent,
 )
+from geardyn.analysis.branch import BRANCH_STEP_FACTOR
 from geardyn.analysis.branch_data import BranchStatus, branch_status_meaning
 from geardyn.analysis.codim2 import SPECIAL_KINDS, TESTS, Special, detect_and_locate, special_tests
 from geardyn.analysis.curve_systems import CURVE_KINDS, CurveSystem
 from geardyn.core.model import Model
+from geardyn.core.plan import default_steps_per_period
 from geardyn.core.results import finish
 from geardyn.core.settings import LOCATE_TOL, RunSettings
 
@@ -98,10 +100,52 @@ def curve(model: Model, branch: xr.Dataset, bifurcation: int, y: str, y_stop: fl
     curve ended in ``status`` (a :class:`~geardyn.BranchStatus` code) and ``message``. A
     failure along the curve is not an exception.
     """
-    st = settings if settings is not None else CurveSettings()
     kind, x, px, u0, period, steps, x_scale = _bifurcation(branch, bifurcation)
+    if branch.attrs.get("model") not in (None, model.name):
+        raise ValueError(f"model is a {model.name}, the branch was computed with a "
+                         f"{branch.attrs['model']}")
+    return _follow(model, kind, x, px, u0, period, steps, x_scale, y, y_stop, y_start,
+                   x_range, settings, run, progress)
+
+
+def curve_at(model: Model, kind: str, x: str, x_value: float, guess: np.ndarray, y: str,
+             y_stop: float, *, period: int = 1, y_start: float | None = None,
+             x_range: tuple[float, float] | None = None, settings: CurveSettings | None = None,
+             run: RunSettings | None = None,
+             progress: Callable[[int, float, float], None] | None = None) -> xr.Dataset:
+    """:func:`curve` without a continuation result: the ``kind`` (``"fold"``,
+    ``"period_doubling"``, ``"neimark_sacker"``) curve of ``model``'s period-``period`` orbits in
+    ``x`` and ``y``, its first point converged at y = ``y_start`` from ``x_value`` and the
+    section point ``guess`` (both near a bifurcation of that kind, e.g. read from a brute-force
+    map). The step is ``run.steps_per_period`` or twice the step rule at ``x_value`` (as a
+    branch's); x_scale default ``max(abs(x_value), 1)``. The other arguments are
+    :func:`curve`'s."""
+    if kind not in CURVE_KINDS:
+        raise ValueError(f"kind must be one of {', '.join(CURVE_KINDS)} (got {kind!r})")
+    px = float(x_value)
+    if not math.isfinite(px):
+        raise ValueError(f"x_value must be finite (got {x_value!r})")
+    at = model.with_params(**{x: px})  # an unknown x: the model's KeyError naming the known
+    u0 = np.asarray(guess, dtype=float)
+    if u0.shape != (model.n_states,) or not np.all(np.isfinite(u0)):
+        raise ValueError(f"guess must be {model.n_states} finite numbers (got shape "
+                         f"{u0.shape})")
+    if isinstance(period, bool) or int(period) != period or period < 1:
+        raise ValueError(f"period must be a whole number >= 1 (got {period!r})")
+    steps = BRANCH_STEP_FACTOR * default_steps_per_period(at)
+    return _follow(model, kind, x, px, u0, int(period), steps, max(abs(px), 1.0), y, y_stop,
+                   y_start, x_range, settings, run, progress)
+
+
+def _follow(model: Model, kind: str, x: str, px: float, u0: np.ndarray, period: int,
+            steps: int, x_scale: float, y: str, y_stop: float, y_start: float | None,
+            x_range: tuple[float, float] | None, settings: CurveSettings | None,
+            run: RunSettings | None, progress: Callable[[int, float, float], None] | None
+            ) -> xr.Dataset:
+    """The curve from (u0, px) at y_start (see :func:`curve`)."""
+    st = settings if settings is not None else CurveSettings()
     if y == x:
-        raise ValueError(f"y must differ from the branch's parameter (both {y!r})")
+        raise ValueError(f"y must differ from x (both {y!r})")
     if y_start is None:
         try:
             y_start = float(model.params[model.param_index(y)])
