@@ -259,3 +259,11 @@ def test_curve_at_from_a_guess_without_a_branch(mathieu):
     assert lost.attrs["status"] == int(geardyn.BranchStatus.START_FAILED)
     assert lost.sizes["point"] == 0 and "no fold point at Omega=1.85" in lost.attrs["message"]
     assert_result(lost, "curve")
+
+
+def test_a_curve_leaving_the_valid_region_ends_with_a_message(mathieu):
+    m, br = mathieu
+    c = geardyn.curve(m, br, 1, "kappa", 1.5)  # |kappa| < 1 keeps the stiffness positive
+    assert c.attrs["status"] == int(geardyn.BranchStatus.INVALID)
+    assert "kappa: must be < 1" in c.attrs["message"]
+    assert 0.999 < float(c["kappa"].max()) < 1.0
