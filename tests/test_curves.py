@@ -94,6 +94,13 @@ def test_fold_curves_meet_in_a_cusp_that_bounds_the_hysteresis(softening):
     assert kinds == ["cusp"]
     cusp_om, cusp_fa = float(c["special_x"][0]), float(c["special_y"][0])
     assert c["special_error"].values[0] < 1e-4
+    # one-parameter continuation in Omega 0.5 % above the cusp folds twice near it, 0.5 % below
+    # not at all
+    for f, folds_wanted in ((cusp_fa * 1.005, 2), (cusp_fa * 0.995, 0)):
+        near = geardyn.continuation(m.with_params(Fa=f), "Omega", 0.85, 1.1)
+        got = near["bifurcation_value"].values[near["bifurcation_kind"].values == "fold"]
+        assert got.size == folds_wanted, (f, got)
+        assert np.all(np.abs(got - cusp_om) < 0.005)
     # the two arms of the curve, either side of its lowest Fa
     om, fa = c["Omega"].values, c["Fa"].values
     tip = int(np.argmin(fa))
