@@ -480,6 +480,21 @@ def _from_branch(model: Model, x: str, y: str, branch: xr.Dataset, bifurcation: 
     return X0, Y0, guess, period, param
 
 
+def kept_side(gp: GrazingProblem, J: np.ndarray) -> np.ndarray:
+    """The unit normal to the curve, in the scaled plane (x / x_scale, y / y_scale), towards
+    the side where the orbit's extremum moves off the edge: the gradient of ``sense h`` along
+    the orbits (G = 0), dh/dp - dh/dx0 (M - I)^-1 dG/dp, from the point's Jacobian ``J``."""
+    n = gp.n
+    A, B = J[:n, :n], J[:n, n:]
+    try:
+        dx = -np.linalg.lstsq(A, B, rcond=None)[0]
+    except np.linalg.LinAlgError:
+        return np.full(2, np.nan)
+    g = gp.sense * (J[n, n:] + J[n, :n] @ dx)
+    norm = float(np.linalg.norm(g))
+    return g / norm if norm > 0 else np.full(2, np.nan)
+
+
 def _dataset(gp: GrazingProblem, mesh: str, flank: str, points: list[CurvePoint],
              status: BranchStatus, message: str) -> xr.Dataset:
     """The ``"curve"`` dataset of a grazing curve."""
@@ -518,6 +533,12 @@ def _dataset(gp: GrazingProblem, mesh: str, flank: str, points: list[CurvePoint]
     ds["grazing_value"] = ("point", np.array([p.info.h for p in points]), {
         "units": m.state_units, "long_name": f"extremum of the {flank} flank's switching "
                                              f"function (zero on the curve)"})
+    normal = np.array([kept_side(gp, p.jac) for p in points]).reshape(len(points), 2)
+    ds["kept_x"] = ("point", normal[:, 0], {"units": "1", "long_name": (
+        f"x component of the unit normal (in {gp.x} / x_scale, {gp.y} / y_scale) towards the "
+        f"side where the orbit keeps off the {flank} flank's edge ({SEPARATES[flank][0]})")})
+    ds["kept_y"] = ("point", normal[:, 1], {"units": "1", "long_name": "y component of it"})
+    ds.attrs.update(x_scale=gp.x_scale, y_scale=gp.y_scale)
     ds.attrs.update(mesh=mesh, flank=flank, event=m.event_names[gp.event],
                     extremum="min" if gp.sense > 0 else "max",
                     separates=" / ".join(SEPARATES[flank]),
