@@ -379,6 +379,7 @@ __import__("geardyn.cli.continuation", fromlist=["register"]).register(app)  # c
 __import__("geardyn.cli.explore", fromlist=["register"]).register(app)  # cli/explore.py
 __import__("geardyn.cli.stiffness", fromlist=["register"]).register(app)  # cli/stiffness.py
 __import__("geardyn.cli.modes", fromlist=["register"]).register(app)  # cli/modes.py
+__import__("geardyn.cli.envelope", fromlist=["register"]).register(app)  # cli/envelope.py
 
 if __name__ == "__main__":
     main()
