@@ -9,7 +9,7 @@ import pytest
 import xarray as xr
 
 import geardyn
-from geardyn.analysis.envelope import contact_labels, envelope, intersect
+from geardyn.analysis.envelope import contact_labels, envelope, intersect_curves
 from geardyn.analysis.grazing import grazing_curve
 from geardyn.core.results import finish
 
@@ -102,7 +102,7 @@ def _line_curve(omega: float, fa: np.ndarray) -> xr.Dataset:
 @pytest.mark.parametrize("omega", [0.9, 1.5])
 def test_intersect_locates_a_known_crossing(drive_curve, omega):
     line = _line_curve(omega, np.linspace(0.0, 0.5, 7))
-    out = intersect(drive_curve, line)
+    out = intersect_curves(drive_curve, line)
     geardyn.testing.assert_result(out, "curve")
     assert list(out["special_kind"].values) == ["grazing-fold"]
     x, y, err = (float(out[k].values[0]) for k in ("special_x", "special_y", "special_error"))
@@ -114,7 +114,7 @@ def test_intersect_locates_a_known_crossing(drive_curve, omega):
 
 
 def test_no_crossing_gives_no_special_point(drive_curve):
-    out = intersect(drive_curve, _line_curve(3.0, np.linspace(0.0, 0.5, 4)))
+    out = intersect_curves(drive_curve, _line_curve(3.0, np.linspace(0.0, 0.5, 4)))
     assert out.sizes["special"] == 0
 
 

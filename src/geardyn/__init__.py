@@ -15,7 +15,9 @@ from geardyn._version import __version__ as __version__
 from geardyn.analysis.basins import basins
 from geardyn.analysis.bifurcation import ContinuedSweep, bifurcation, continued_sweeps
 from geardyn.analysis.branch import BifurcationPoint, BranchStatus, continuation
+from geardyn.analysis.envelope import Envelope, envelope, intersect_curves
 from geardyn.analysis.frc import frequency_response
+from geardyn.analysis.grazing import grazing_curve
 from geardyn.analysis.lyapunov import LyapunovEstimate, lyapunov, lyapunov_lanes
 from geardyn.analysis.map2d import map2d
 from geardyn.analysis.motion import motion_classes
@@ -52,6 +54,7 @@ __all__ = [
     "ContinuationSettings",
     "ContinuedSweep",
     "DimensionalCATT",
+    "Envelope",
     "GearPair",
     "GeardynError",
     "Gear",
@@ -89,6 +92,9 @@ __all__ = [
     "motion_classes",
     "periodic_orbit",
     "default_steps_per_period",
+    "envelope",
+    "grazing_curve",
+    "intersect_curves",
     "reference_solution",
     "simulate",
     "testing",

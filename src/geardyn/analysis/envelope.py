@@ -16,8 +16,8 @@ values of x sees the flank's extremum change sign: :func:`find_starts`) and labe
 The labels are those of the curves' periodic orbit (period k), stable or not: a brute-force map
 shows the attractor a start falls on, which may be another one where responses coexist.
 
-:func:`intersect` locates where two curves cross (e.g. a grazing curve and a fold curve: the
-codimension-2 point ``grazing-fold``).
+:func:`intersect_curves` locates where two curves cross (e.g. a grazing curve and a fold
+curve: the codimension-2 point ``grazing-fold``).
 """
 
 from __future__ import annotations
@@ -46,7 +46,7 @@ from geardyn.core.settings import RunSettings
 if TYPE_CHECKING:
     from geardyn.core.model import Model
 
-__all__ = ["CONTACT_REGIONS", "Envelope", "envelope", "find_starts", "intersect"]
+__all__ = ["CONTACT_REGIONS", "Envelope", "envelope", "find_starts", "intersect_curves"]
 
 #: The contact regions' codes (``Envelope.contact``), in order.
 CONTACT_REGIONS = ("none", "single", "double")
@@ -74,7 +74,7 @@ def _sagitta(P: np.ndarray, i: int) -> float:
     return out
 
 
-def intersect(a: xr.Dataset, b: xr.Dataset, kind: str | None = None) -> xr.Dataset:
+def intersect_curves(a: xr.Dataset, b: xr.Dataset, kind: str | None = None) -> xr.Dataset:
     """``a`` with the points where it crosses ``b`` (two ``"curve"`` datasets in the same
     plane) appended along ``special``: ``special_kind`` (``kind``, default from the curves'
     kinds, e.g. ``"grazing-fold"``), ``special_x``, ``special_y`` and ``special_error``.
@@ -378,7 +378,7 @@ def envelope(model: Model, x: str, y: str, x_range: tuple[float, float],
     for i, g in enumerate(found):
         for c in given:
             if c.attrs["curve_kind"] in CROSSING_KINDS:
-                found[i] = g = intersect(g, c)
+                found[i] = g = intersect_curves(g, c)
     all_curves = found + given
     xv = np.linspace(xr_[0], xr_[1], int(resolution))
     yv = np.linspace(yr_[0], yr_[1], int(resolution))

@@ -89,7 +89,7 @@ GRAZING_STEP_FACTOR = ORBIT_STEP_FACTOR
 #: The codimension-2 points a grazing curve records (``special_kind``).
 SPECIAL_MEANING = ("grazing-fold: the grazing curve meets a fold curve; grazing-period-doubling: "
                    "it meets a period-doubling curve; grazing-neimark-sacker: a Neimark-Sacker "
-                   "curve (geardyn.analysis.envelope.intersect)")
+                   "curve (geardyn.analysis.envelope.intersect_curves)")
 #: What a grazing curve separates, per flank (the contact labels on its two sides).
 SEPARATES = {"drive": ("none", "single"), "back": ("single", "double")}
 
