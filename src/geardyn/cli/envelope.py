@@ -124,9 +124,9 @@ def envelope_command(
     run = study_run_settings(s, {}, omega=x_range[0] if x_name == "Omega" else None)
     mp = None
     if points is not None:
-        import geardyn
+        from geardyn.analysis.map2d import map2d
 
-        mp = geardyn.map2d(model, (x_name, np.linspace(*x_range, points[0])),
+        mp = map2d(model, (x_name, np.linspace(*x_range, points[0])),
                            (y_name, np.linspace(*y_range, points[1])),
                            run.replace(samples=max(run.samples, 16)))
     env = _run(model, x_name, y_name, x_range, y_range, table, flanks, mesh, given, mp,
