@@ -370,8 +370,8 @@ def envelope(model: Model, x: str, y: str, x_range: tuple[float, float],
                     if progress is not None:
                         progress(f"{flank} curve", points, X, Y)
 
-                ds = grazing_curve(model.with_params(**{y: Y0}), x, y, xr_, yr_, mesh=mesh,
-                                   flank=flank, period=period, at=float(v), guess=x0, run=run,
+                ds = grazing_curve(model, x, y, xr_, yr_, mesh=mesh, flank=flank,
+                                   period=period, at=(float(v), Y0), guess=x0, run=run,
                                    settings=settings, progress=step)
                 if ds.sizes["point"]:
                     found.append(ds)

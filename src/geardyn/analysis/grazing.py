@@ -292,7 +292,8 @@ def _range(name: str, value: Any) -> tuple[float, float]:
 
 def grazing_curve(model: Model, x: str, y: str, x_range: tuple[float, float],
                   y_range: tuple[float, float], *, mesh: str | None = None,
-                  flank: str = "drive", period: int = 1, at: float | None = None,
+                  flank: str = "drive", period: int = 1,
+                  at: tuple[float, float] | None = None,
                   branch: xr.Dataset | None = None, bifurcation: int | None = None,
                   guess: np.ndarray | None = None, run: RunSettings | None = None,
                   settings: ArclengthSettings | None = None,
@@ -312,8 +313,9 @@ def grazing_curve(model: Model, x: str, y: str, x_range: tuple[float, float],
     period
         k: orbits of the k-th iterate of the section map.
     at
-        Start where ``x = at`` (default the model's value of x), solving for y from the model's
-        value of y (a guess: the orbit there should be close to grazing).
+        ``(x, y)``: start at this x, solving for y from this y (a guess: the orbit there should
+        be close to grazing; else y is first approached by the secant method). Default the
+        model's values (a physical input such as a torque must be given).
     branch, bifurcation
         Instead of ``at``: start from the contact point ``bifurcation`` (an index along
         ``bifurcation``) of a :func:`geardyn.continuation` dataset of ``model`` in ``x`` or
@@ -343,12 +345,16 @@ def grazing_curve(model: Model, x: str, y: str, x_range: tuple[float, float],
     st = GRAZING_SETTINGS if settings is None else settings
     fixed = x
     if branch is not None:
-        X0, Y0, guess, period, fixed = _from_branch(model, x, y, branch, bifurcation)
+        X0, Y0, guess, period, fixed = _from_branch(model, x, y, branch, bifurcation, at)
     else:
         if bifurcation is not None:
             raise ValueError("bifurcation: give it with branch= (a continuation dataset)")
-        X0 = float(model.params[model._param_index(x)]) if at is None else float(at)
-        Y0 = float(model.params[model._param_index(y)])
+        if at is None:
+            at = (_current(model, x), _current(model, y))
+        try:
+            X0, Y0 = (float(v) for v in at)
+        except (TypeError, ValueError) as err:
+            raise ValueError(f"at: give ({x}, {y}) of the start (got {at!r})") from err
     if not (x_lo <= X0 <= x_hi and y_lo <= Y0 <= y_hi):
         raise ValueError(f"the start {x}={X0:g}, {y}={Y0:g} lies outside x_range {x_range} "
                          f"and y_range {y_range}")
@@ -445,13 +451,23 @@ def _approach(gp: GrazingProblem, x0: np.ndarray, X: float, Y: float, x_fixed: b
     return None
 
 
+def _current(model: Model, name: str) -> float:
+    """The model's value of the coefficient ``name``; a ValueError naming ``at`` for a physical
+    input (the model keeps only the coefficients derived from it)."""
+    if name in model.physical_names:
+        raise ValueError(f"at: give (x, y) of the start: {name} is a physical input of "
+                         f"{model.name}, whose value the coefficients do not keep")
+    return float(model.params[model.param_index(name)])
+
+
 def _joined(behind: CurveRun, ahead: CurveRun) -> tuple[BranchStatus, str]:
     """One status for the curve's two ends (the worse one: any but COMPLETED), both messages."""
     status = ahead.status if ahead.status != BranchStatus.COMPLETED else behind.status
     return status, f"one end: {behind.message}; other end: {ahead.message}"
 
 
-def _from_branch(model: Model, x: str, y: str, branch: xr.Dataset, bifurcation: int | None
+def _from_branch(model: Model, x: str, y: str, branch: xr.Dataset, bifurcation: int | None,
+                 at: tuple[float, float] | None = None
                  ) -> tuple[float, float, np.ndarray, int, str]:
     """(X0, Y0, guess, period, the parameter the branch fixes) of a branch's contact point."""
     if branch.attrs.get("geardyn_kind") != "continuation":
@@ -473,7 +489,7 @@ def _from_branch(model: Model, x: str, y: str, branch: xr.Dataset, bifurcation: 
                          f"contact change (contact entries: {contacts})")
     value = float(branch["bifurcation_value"].values[bifurcation])
     other = y if param == x else x
-    v_other = float(model.params[model._param_index(other)])
+    v_other = _current(model, other) if at is None else float(at[0 if other == x else 1])
     X0, Y0 = (value, v_other) if param == x else (v_other, value)
     guess = np.asarray(branch["bifurcation_section_point"].values[bifurcation], float)
     period = int(branch["bifurcation_period"].values[bifurcation])
