@@ -9,7 +9,7 @@ import pytest
 import xarray as xr
 
 import geardyn
-from geardyn.analysis.envelope import contact_labels, envelope, intersect_curves
+from geardyn.analysis.envelope import envelope, intersect_curves
 from geardyn.analysis.grazing import grazing_curve
 from geardyn.core.results import finish
 
@@ -190,7 +190,7 @@ def test_curves_agree_with_the_brute_force_map(coarse_map):
     assert checked["drive"] >= 5 and checked["back"] >= 5, checked
     # the regions the curves give agree with the map away from the curves too
     X, Y = np.meshgrid(coarse_map["Omega"].values, coarse_map["Fa"].values)
-    codes = contact_labels(env.curves, X, Y, env.x_range, env.y_range)
+    codes = env.contact_at(X, Y)
     names = np.array(["none", "single", "double"])[codes]
     same = period == 1
     assert np.mean(names[same] == labels[same]) > 0.9
@@ -225,3 +225,15 @@ def test_bad_input_names_the_field(pair, kwargs, match):
 def test_bad_envelope_input_names_the_field(pair, kwargs, match):
     with pytest.raises(ValueError, match=match):
         envelope(pair, "Omega", "Fa", (0.5, 2.0), (0.0, 0.5), **kwargs)
+
+
+@pytest.mark.parametrize("fa_box,code", [((0.0, 0.03), 0), ((0.2, 0.3), 1)])
+def test_a_box_no_curve_crosses_takes_the_orbit_s_regime(pair, fa_box, code):
+    """No grazing curve in the box (the closed form puts the drive flank's at Fa 0.057 to
+    0.076 for Omega in [1.5, 2]): the whole box takes the regime of the orbit at its centre,
+    contact kept below the curve, one-sided impacts above it."""
+    assert _closed_form_fa(1.5) > 0.03 and _closed_form_fa(2.0) < 0.2
+    env = envelope(pair, "Omega", "Fa", (1.5, 2.0), fa_box, flanks=("drive", "back"),
+                   scan=6, resolution=8)
+    assert env.grazing() == []
+    assert np.all(env.contact == code)

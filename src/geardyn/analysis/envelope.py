@@ -2,13 +2,15 @@
 
 :func:`envelope` finds the grazing curves of a mesh's two flanks in the box
 (:func:`geardyn.analysis.grazing.grazing_curve`, started where a scan of the orbit in y at a few
-values of x sees the flank's extremum change sign: :func:`find_starts`) and labels the plane:
+values of x, or in x at a few values of y, sees the flank's extremum change sign:
+:func:`find_starts`) and labels the plane:
 
-* the contact regime from the grazing curves: a point's side of the nearest point of the
-  nearest curve of each flank (``kept_x``, ``kept_y``: the normal towards the side where the
-  orbit keeps off that flank's edge). Contact kept (``none``) on the kept side of the drive
-  flank's curve, else double-sided impacts on the far side of the back flank's curve, else
-  single-sided impacts;
+* the contact regime from the grazing curves: each flank's curves cut the plane into regions,
+  and a region's side of them comes from the curves' normals (``kept_x``, ``kept_y``: towards
+  the side where the orbit keeps off that flank's edge) at its cells next to a curve, or, for
+  a region no curve of the flank bounds, from the orbit at one of its points
+  (:func:`kept_regions`). Contact kept (``none``) where the drive flank's edge is kept off,
+  else double-sided impacts where the back flank's is crossed, else single-sided impacts;
 * coexisting responses inside fold curves, period doubled inside period-doubling curves (the
   ``"curve"`` datasets of ``geardyn.curve`` given as ``curves``, each closed between its ends);
 * chaotic (no period <= max_period) where a brute-force map is given (``period == 0``).
@@ -46,7 +48,8 @@ from geardyn.core.settings import RunSettings
 if TYPE_CHECKING:
     from geardyn.core.model import Model
 
-__all__ = ["CONTACT_REGIONS", "Envelope", "envelope", "find_starts", "intersect_curves"]
+__all__ = ["CONTACT_REGIONS", "Envelope", "contact_codes", "envelope", "find_starts",
+           "intersect_curves", "kept_regions"]
 
 #: The contact regions' codes (``Envelope.contact``), in order.
 CONTACT_REGIONS = ("none", "single", "double")
@@ -134,6 +137,10 @@ def intersect_curves(a: xr.Dataset, b: xr.Dataset, kind: str | None = None) -> x
 
 
 # ----------------------------------------------------------------------------- starts
+#: Where the plane is scanned by default: these fractions of each range (x scanned in y, y in
+#: x).
+SCAN_AT = (0.125, 0.375, 0.625, 0.875)
+
 def _margin(gp: GrazingProblem, pr: Any, x0: np.ndarray) -> float:
     """How far the orbit keeps off the flank's edge (negative: it crosses it), over the
     orbit's range of h: min h where the orbit's mean h is >= 0, else -max h."""
@@ -185,16 +192,17 @@ def find_starts(model: Model, x: str, y: str, at: float, y_values: Sequence[floa
     return out
 
 
-def _passes(ds: xr.Dataset, X: float, y_lo: float, y_hi: float) -> bool:
-    """Whether the curve's polyline crosses the segment x = X, y in [y_lo, y_hi] (a scan's
-    bracket: the start it gave is on this curve)."""
-    cx, cy = ds[ds.attrs["x"]].values, ds[ds.attrs["y"]].values
-    for i in range(cx.size - 1):
-        a, b = cx[i] - X, cx[i + 1] - X
+def _passes(ds: xr.Dataset, axis: str, at: float, lo: float, hi: float) -> bool:
+    """Whether the curve's polyline crosses the segment ``axis`` = ``at``, the other
+    parameter in [lo, hi] (a scan's bracket: the start it gave is on this curve)."""
+    other = ds.attrs["y"] if axis == ds.attrs["x"] else ds.attrs["x"]
+    ca, cb = ds[axis].values, ds[other].values
+    for i in range(ca.size - 1):
+        a, b = ca[i] - at, ca[i + 1] - at
         if a * b > 0 or a == b:
             continue
-        yc = cy[i] + (cy[i + 1] - cy[i]) * (a / (a - b))
-        if y_lo <= yc <= y_hi:
+        v = cb[i] + (cb[i + 1] - cb[i]) * (a / (a - b))
+        if lo <= v <= hi:
             return True
     return False
 
@@ -228,20 +236,20 @@ class Envelope:
                 and (flank is None or c.attrs["flank"] == flank)]
 
     def contact_at(self, X: np.ndarray, Y: np.ndarray) -> np.ndarray:
-        """The contact codes the curves give at points (X, Y) (any shape)."""
-        return contact_labels(self.curves, np.asarray(X, float), np.asarray(Y, float),
-                              self.x_range, self.y_range)
+        """The contact codes at points (X, Y) (any shape): those of the nearest grid point."""
+        ix = np.abs(np.asarray(X, float)[..., None] - self.xv).argmin(axis=-1)
+        iy = np.abs(np.asarray(Y, float)[..., None] - self.yv).argmin(axis=-1)
+        return self.contact[iy, ix]
 
 
 def _side(curves: list[xr.Dataset], X: np.ndarray, Y: np.ndarray, sx: float, sy: float
-          ) -> np.ndarray:
-    """+1 on the kept side of the nearest point of the nearest curve, -1 beyond it; 0 where
-    there is no curve."""
+          ) -> tuple[np.ndarray, np.ndarray]:
+    """(side, distance): +1 on the kept side of the nearest point of the nearest curve, -1
+    beyond it, 0 where there is no curve; the distance to that point in the plane scaled by
+    (sx, sy)."""
     out = np.zeros(X.shape)
     best = np.full(X.shape, np.inf)
     for c in curves:
-        if c.sizes["point"] == 0:
-            continue
         cx, cy = c[c.attrs["x"]].values, c[c.attrs["y"]].values
         nx, ny = c["kept_x"].values, c["kept_y"].values
         ok = np.isfinite(nx) & np.isfinite(ny)
@@ -260,17 +268,81 @@ def _side(curves: list[xr.Dataset], X: np.ndarray, Y: np.ndarray, sx: float, sy:
         closer = dk < best
         out[closer] = np.where(s[closer] == 0, 1.0, s[closer])
         best[closer] = dk[closer]
+    return out, best
+
+
+def _barrier(curves: list[xr.Dataset], xv: np.ndarray, yv: np.ndarray) -> np.ndarray:
+    """The grid cells (y, x) the curves' polylines pass through (sampled at a quarter cell)."""
+    out = np.zeros((yv.size, xv.size), dtype=bool)
+    hx, hy = xv[1] - xv[0], yv[1] - yv[0]
+    for c in curves:
+        px, py = c[c.attrs["x"]].values, c[c.attrs["y"]].values
+        for i in range(px.size - 1):
+            n = int(np.ceil(4 * max(abs(px[i + 1] - px[i]) / hx,
+                                    abs(py[i + 1] - py[i]) / hy))) + 1
+            t = np.linspace(0.0, 1.0, n)
+            ix = np.rint((px[i] + t * (px[i + 1] - px[i]) - xv[0]) / hx).astype(int)
+            iy = np.rint((py[i] + t * (py[i + 1] - py[i]) - yv[0]) / hy).astype(int)
+            ok = (ix >= 0) & (ix < xv.size) & (iy >= 0) & (iy < yv.size)
+            out[iy[ok], ix[ok]] = True
     return out
 
 
-def contact_labels(curves: Sequence[xr.Dataset], X: np.ndarray, Y: np.ndarray,
-                   x_range: tuple[float, float], y_range: tuple[float, float]) -> np.ndarray:
-    """Contact codes (:data:`CONTACT_REGIONS`; -1 unknown) at (X, Y) from the grazing curves
-    (see the module docs)."""
-    sx, sy = x_range[1] - x_range[0], y_range[1] - y_range[0]
-    graz = [c for c in curves if c.attrs["curve_kind"] == "grazing"]
-    drive = _side([c for c in graz if c.attrs["flank"] == "drive"], X, Y, sx, sy)
-    back = _side([c for c in graz if c.attrs["flank"] == "back"], X, Y, sx, sy)
+#: Cells within this many grid steps of a curve take its side by the normal there.
+NEAR_CELLS = 3.0
+#: A region takes the curves' side where its cells next to them agree this well (the mean of
+#: their +-1 sides); else (curves of different orbits around one region) the probe decides.
+AGREE = 0.8
+
+#: ``probe(flank, x, y)``: whether the orbit at (x, y) keeps off the flank's edge (None:
+#: unknown), for a region of the plane no curve of the flank bounds.
+Probe = Callable[[str, float, float], "bool | None"]
+
+
+def kept_regions(curves: Sequence[xr.Dataset], xv: np.ndarray, yv: np.ndarray,
+                 probe: Probe | None = None) -> dict[str, np.ndarray]:
+    """Per flank, +1 where the orbit keeps off the flank's edge, -1 where it crosses it, 0
+    unknown, on the grid (y, x) ``yv`` x ``xv``.
+
+    The curves of the flank cut the grid into connected regions (the cells they pass through
+    are borders); each region takes the side, by the curves' ``kept`` normals, of its cells
+    within :data:`NEAR_CELLS` grid steps of a curve where they agree (:data:`AGREE`), else (no
+    curve bounds it, or curves of different orbits disagree about it) ``probe``'s verdict at
+    its cell nearest its centre (0: unknown without one); border cells take their own side."""
+    from scipy import ndimage
+
+    X, Y = np.meshgrid(xv, yv)
+    sx, sy = float(xv[-1] - xv[0]), float(yv[-1] - yv[0])
+    near = NEAR_CELLS * max((xv[1] - xv[0]) / sx, (yv[1] - yv[0]) / sy)
+    out: dict[str, np.ndarray] = {}
+    for flank in FLANKS:
+        mine = [c for c in curves if c.attrs["curve_kind"] == "grazing"
+                and c.attrs["flank"] == flank and c.sizes["point"] >= 2]
+        side, dist = _side(mine, X, Y, sx, sy)
+        border = _barrier(mine, xv, yv)
+        regions, count = ndimage.label(~border)
+        kept = np.zeros(X.shape)
+        for r in range(1, count + 1):
+            cells = regions == r
+            close = cells & (dist <= near)
+            agree = abs(float(np.mean(side[close]))) if np.any(close) else 0.0
+            if agree >= AGREE:
+                kept[cells] = 1.0 if np.sum(side[close]) >= 0 else -1.0
+            elif probe is not None:
+                iy, ix = np.nonzero(cells)
+                j = int(np.argmin((ix - ix.mean()) ** 2 + (iy - iy.mean()) ** 2))
+                verdict = probe(flank, float(xv[ix[j]]), float(yv[iy[j]]))
+                kept[cells] = 0.0 if verdict is None else (1.0 if verdict else -1.0)
+        kept[border] = side[border]
+        out[flank] = kept
+    return out
+
+
+def contact_codes(kept: dict[str, np.ndarray]) -> np.ndarray:
+    """Contact codes (:data:`CONTACT_REGIONS`; -1 unknown) from :func:`kept_regions`: contact
+    kept where the drive flank's edge is kept off, else two-sided impacts where the back
+    flank's is crossed, else one-sided impacts."""
+    drive, back = kept["drive"], kept["back"]
     out = np.where(back < 0, 2, 1)
     out = np.where(drive > 0, 0, out)
     return np.where(drive == 0, -1, out).astype(np.int64)
@@ -307,6 +379,7 @@ def _curve_in(ds: xr.Dataset, x: str, y: str) -> xr.Dataset:
 def envelope(model: Model, x: str, y: str, x_range: tuple[float, float],
              y_range: tuple[float, float], *, mesh: str | None = None,
              flanks: Sequence[str] = FLANKS, starts: Sequence[float] | None = None,
+             y_starts: Sequence[float] | None = None,
              scan: int = 24, period: int = 1, curves: Sequence[xr.Dataset] = (),
              map: xr.Dataset | None = None, resolution: int = 200,
              run: RunSettings | None = None, settings: ArclengthSettings | None = None,
@@ -318,11 +391,12 @@ def envelope(model: Model, x: str, y: str, x_range: tuple[float, float],
     ----------
     mesh, flanks
         The mesh (default the model's first) and the flanks whose grazing curves are followed.
-    starts
-        The values of x where the orbit is scanned in y for starting points (default three:
-        1/4, 1/2 and 3/4 of ``x_range``).
+    starts, y_starts
+        The values of x where the orbit is scanned in y for starting points (default at the
+        fractions :data:`SCAN_AT` of ``x_range``), and of y where it is scanned in x (default
+        none).
     scan
-        Values of y per scan, evenly over ``y_range``.
+        Values per scan, evenly over the other parameter's range.
     period
         k of the orbits.
     curves
@@ -348,22 +422,27 @@ def envelope(model: Model, x: str, y: str, x_range: tuple[float, float],
     if int(resolution) < 2:
         raise ValueError(f"resolution: at least 2 grid points per axis (got {resolution!r})")
     given = [_curve_in(c, x, y) for c in curves]
-    at = list(starts) if starts is not None else [xr_[0] + f * (xr_[1] - xr_[0])
-                                                  for f in (0.25, 0.5, 0.75)]
-    for v in at:
-        if not xr_[0] <= float(v) <= xr_[1]:
-            raise ValueError(f"starts: {x}={v!r} lies outside x_range {x_range}")
-    yscan = np.linspace(yr_[0], yr_[1], int(scan))
+    scans: list[tuple[str, float]] = []
+    for name, axis, given_at, box in (("starts", x, starts, xr_), ("y_starts", y, y_starts, yr_)):
+        values = given_at if given_at is not None else [box[0] + f * (box[1] - box[0])
+                                                        for f in SCAN_AT] if axis == x else []
+        for v in values:
+            if not box[0] <= float(v) <= box[1]:
+                raise ValueError(f"{name}: {axis}={v!r} lies outside {box}")
+            scans.append((axis, float(v)))
     found: list[xr.Dataset] = []
     for flank in flanks:
-        for k, v in enumerate(at):
-            for y_lo, y_hi, x0 in find_starts(model, x, y, float(v), yscan, mesh=mesh,
-                                              flank=flank, period=period, run=run):
-                Y0 = 0.5 * (y_lo + y_hi)
+        for k, (axis, v) in enumerate(scans):
+            other, other_box = (y, yr_) if axis == x else (x, xr_)
+            values = np.linspace(other_box[0], other_box[1], int(scan))
+            for lo, hi, x0 in find_starts(model, axis, other, v, values, mesh=mesh,
+                                          flank=flank, period=period, run=run):
+                w = 0.5 * (lo + hi)
+                X0, Y0 = (v, w) if axis == x else (w, v)
                 if progress is not None:
-                    progress("scan", k + 1, float(v), Y0)
-                if any(c.attrs["flank"] == flank and _passes(c, float(v), min(y_lo, y_hi),
-                                                             max(y_lo, y_hi)) for c in found):
+                    progress("scan", k + 1, X0, Y0)
+                if any(c.attrs["flank"] == flank and _passes(c, axis, v, min(lo, hi),
+                                                             max(lo, hi)) for c in found):
                     continue
 
                 def step(points: int, X: float, Y: float, flank: str = flank) -> None:
@@ -371,7 +450,7 @@ def envelope(model: Model, x: str, y: str, x_range: tuple[float, float],
                         progress(f"{flank} curve", points, X, Y)
 
                 ds = grazing_curve(model, x, y, xr_, yr_, mesh=mesh, flank=flank,
-                                   period=period, at=(float(v), Y0), guess=x0, run=run,
+                                   period=period, at=(X0, Y0), hold=axis, guess=x0, run=run,
                                    settings=settings, progress=step)
                 if ds.sizes["point"]:
                     found.append(ds)
@@ -383,7 +462,8 @@ def envelope(model: Model, x: str, y: str, x_range: tuple[float, float],
     xv = np.linspace(xr_[0], xr_[1], int(resolution))
     yv = np.linspace(yr_[0], yr_[1], int(resolution))
     X, Y = np.meshgrid(xv, yv)
-    contact = contact_labels(all_curves, X, Y, xr_, yr_)
+    contact = contact_codes(kept_regions(all_curves, xv, yv, _prober(
+        model, x, y, mesh, period, run)))
     chaotic = np.zeros(X.shape, dtype=bool)
     if map is not None:
         chaotic = _map_chaotic(map, x, y, X, Y)
@@ -391,6 +471,31 @@ def envelope(model: Model, x: str, y: str, x_range: tuple[float, float],
     return Envelope(model.name, x, y, xr_, yr_, all_curves, xv, yv, contact,
                     _inside(all_curves, "fold", x, X, Y),
                     _inside(all_curves, "period_doubling", x, X, Y), chaotic, map, axes)
+
+
+def _prober(model: Model, x: str, y: str, mesh: str | None, period: int,
+            run: RunSettings | None) -> Probe:
+    """A :data:`Probe`: the period-k orbit at (x, y) by Newton shooting from a transient run,
+    and whether its margin (:func:`_margin`) from the flank's edge is positive (None where no
+    orbit converges)."""
+    def probe(flank: str, X: float, Y: float) -> bool | None:
+        _, event = _flank_event(model, mesh, flank)
+        try:
+            at = model.with_params(**{x: X, y: Y})
+        except (ValueError, KeyError):
+            return None
+        steps = run.steps_per_period if run is not None and run.steps_per_period else (
+            ORBIT_STEP_FACTOR * default_steps_per_period(at))
+        pr = problem_with_steps(at, None, period, run, steps)
+        res = newton_shooting(pr, default_guess(pr, transient=None if run is None
+                                                else run.transient))
+        if res.status != OrbitStatus.CONVERGED:
+            return None
+        gp = GrazingProblem(at, x, y, event, pr, 1.0, 1.0)
+        m = _margin(gp, pr, res.x)
+        return None if not np.isfinite(m) else bool(m > 0)
+
+    return probe
 
 
 def _map_chaotic(mp: xr.Dataset, x: str, y: str, X: np.ndarray, Y: np.ndarray) -> np.ndarray:

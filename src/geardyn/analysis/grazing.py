@@ -293,7 +293,7 @@ def _range(name: str, value: Any) -> tuple[float, float]:
 def grazing_curve(model: Model, x: str, y: str, x_range: tuple[float, float],
                   y_range: tuple[float, float], *, mesh: str | None = None,
                   flank: str = "drive", period: int = 1,
-                  at: tuple[float, float] | None = None,
+                  at: tuple[float, float] | None = None, hold: str | None = None,
                   branch: xr.Dataset | None = None, bifurcation: int | None = None,
                   guess: np.ndarray | None = None, run: RunSettings | None = None,
                   settings: ArclengthSettings | None = None,
@@ -316,6 +316,9 @@ def grazing_curve(model: Model, x: str, y: str, x_range: tuple[float, float],
         ``(x, y)``: start at this x, solving for y from this y (a guess: the orbit there should
         be close to grazing; else y is first approached by the secant method). Default the
         model's values (a physical input such as a torque must be given).
+    hold
+        The parameter held at its ``at`` value while the first point converges (default x;
+        y where the curve is closer to parallel to the x axis there).
     branch, bifurcation
         Instead of ``at``: start from the contact point ``bifurcation`` (an index along
         ``bifurcation``) of a :func:`geardyn.continuation` dataset of ``model`` in ``x`` or
@@ -343,7 +346,9 @@ def grazing_curve(model: Model, x: str, y: str, x_range: tuple[float, float],
     y_lo, y_hi = _range("y_range", y_range)
     mesh, event = _flank_event(model, mesh, flank)
     st = GRAZING_SETTINGS if settings is None else settings
-    fixed = x
+    if hold not in (None, x, y):
+        raise ValueError(f"hold: {x!r} or {y!r} (got {hold!r})")
+    fixed = x if hold is None else hold
     if branch is not None:
         X0, Y0, guess, period, fixed = _from_branch(model, x, y, branch, bifurcation, at)
     else:
