@@ -207,6 +207,37 @@ def _passes(ds: xr.Dataset, axis: str, at: float, lo: float, hi: float) -> bool:
     return False
 
 
+def _segment_distance(P: np.ndarray, Q: np.ndarray) -> np.ndarray:
+    """Distance of each point of P (n, 2) to the polyline Q (m, 2)."""
+    if len(Q) == 1:
+        return np.hypot(*(P - Q[0]).T)
+    a, b = Q[:-1], Q[1:]
+    ab = b - a
+    t = np.einsum("pmk,mk->pm", P[:, None, :] - a[None], ab) / np.maximum(
+        np.einsum("mk,mk->m", ab, ab), 1e-300)
+    c = a[None] + np.clip(t, 0.0, 1.0)[..., None] * ab[None]
+    return np.min(np.hypot(*(P[:, None, :] - c).transpose(2, 0, 1)), axis=1)
+
+
+#: A curve with 90 % of its points within this distance (plane scaled by the box) of a curve
+#: already found is that curve again (its ends, past the box, may differ).
+SAME_CURVE = 1e-3
+
+
+def _known(ds: xr.Dataset, found: list[xr.Dataset]) -> bool:
+    """Whether ``ds`` retraces a curve of its flank in ``found``."""
+    x, y = ds.attrs["x"], ds.attrs["y"]
+    sx, sy = float(ds.attrs["x_scale"]), float(ds.attrs["y_scale"])
+    P = np.column_stack([ds[x].values / sx, ds[y].values / sy])
+    for c in found:
+        if c.attrs["flank"] != ds.attrs["flank"] or c.sizes["point"] == 0:
+            continue
+        Q = np.column_stack([c[x].values / sx, c[y].values / sy])
+        if np.quantile(_segment_distance(P, Q), 0.9) < SAME_CURVE:
+            return True
+    return False
+
+
 # ----------------------------------------------------------------------------- regions
 @dataclass
 class Envelope:
@@ -392,9 +423,9 @@ def envelope(model: Model, x: str, y: str, x_range: tuple[float, float],
     mesh, flanks
         The mesh (default the model's first) and the flanks whose grazing curves are followed.
     starts, y_starts
-        The values of x where the orbit is scanned in y for starting points (default at the
-        fractions :data:`SCAN_AT` of ``x_range``), and of y where it is scanned in x (default
-        none).
+        The values of x where the orbit is scanned in y for starting points, and of y where
+        it is scanned in x (default each at the fractions :data:`SCAN_AT` of its range; a
+        curve nearly parallel to one axis is found by the scans along the other).
     scan
         Values per scan, evenly over the other parameter's range.
     period
@@ -425,7 +456,7 @@ def envelope(model: Model, x: str, y: str, x_range: tuple[float, float],
     scans: list[tuple[str, float]] = []
     for name, axis, given_at, box in (("starts", x, starts, xr_), ("y_starts", y, y_starts, yr_)):
         values = given_at if given_at is not None else [box[0] + f * (box[1] - box[0])
-                                                        for f in SCAN_AT] if axis == x else []
+                                                        for f in SCAN_AT]
         for v in values:
             if not box[0] <= float(v) <= box[1]:
                 raise ValueError(f"{name}: {axis}={v!r} lies outside {box}")
@@ -452,7 +483,7 @@ def envelope(model: Model, x: str, y: str, x_range: tuple[float, float],
                 ds = grazing_curve(model, x, y, xr_, yr_, mesh=mesh, flank=flank,
                                    period=period, at=(X0, Y0), hold=axis, guess=x0, run=run,
                                    settings=settings, progress=step)
-                if ds.sizes["point"]:
+                if ds.sizes["point"] and not _known(ds, found):
                     found.append(ds)
     for i, g in enumerate(found):
         for c in given:
