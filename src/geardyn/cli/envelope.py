@@ -24,7 +24,7 @@ import typer
 from geardyn.cli.common import load_study_source, study_run_settings
 from geardyn.errors import ParameterError
 
-__all__ = ["envelope_command", "parse_plane_axis", "register"]
+__all__ = ["envelope_command", "load_curve", "parse_plane_axis", "register"]
 
 _PLOT_SUFFIXES = (".png", ".pdf", ".svg")
 
@@ -111,7 +111,7 @@ def envelope_command(
     if resolution is not None and not 2 <= resolution <= 4000:
         raise ParameterError("--resolution", resolution, "must lie in [2, 4000]")
     points = _map_points(map_points) if map_points else table.map
-    given = [_load_curve(p) for p in (curve or [])]
+    given = [load_curve(p) for p in (curve or [])]
     model = build_model(s)
     for name, ends, option in ((x_name, x_range, "--x"), (y_name, y_range, "--y")):
         try:  # the name, and both ends of its range, before anything runs
@@ -146,7 +146,8 @@ def envelope_command(
                + f"; wrote {', '.join(written)}")
 
 
-def _load_curve(path: Path):
+def load_curve(path: Path):
+    """A ``"curve"`` dataset from its NetCDF file; a one-line error naming ``--curve``."""
     from geardyn.io.netcdf import load_dataset
 
     if not path.exists():
