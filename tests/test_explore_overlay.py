@@ -86,3 +86,12 @@ def test_the_page_marks_the_curves_over_the_diagram(tmp_path):
             [2.0 - np.sqrt(0.05), 2.0 + np.sqrt(0.05)], abs=2e-4)
     finally:
         page.runner.shutdown()
+
+
+def test_explore_refuses_a_missing_curve_file_in_one_line(capsys):
+    from geardyn.cli.main import main
+
+    with pytest.raises(SystemExit) as stop:
+        main(["explore", "paper_fig3", "--curve", "missing.nc"])
+    assert stop.value.code == 2
+    assert capsys.readouterr().err.strip() == "error: --curve: no such file (got 'missing.nc')"

@@ -237,3 +237,22 @@ def test_a_box_no_curve_crosses_takes_the_orbit_s_regime(pair, fa_box, code):
                    scan=6, resolution=8)
     assert env.grazing() == []
     assert np.all(env.contact == code)
+
+
+def test_a_fold_curve_given_marks_the_coexisting_region(pair):
+    """A fold curve's wedge (closed between its ends) is the coexisting region; the envelope
+    intersects it with the grazing curves it crosses."""
+    wedge_om = np.array([1.6, 1.75, 1.9])
+    wedge = _line_curve(1.75, np.array([0.01, 0.45, 0.01]))
+    wedge = wedge.assign_coords(Omega=("point", wedge_om))
+    env = envelope(pair, "Omega", "Fa", (1.5, 2.0), (0.0, 0.5), flanks=("drive",),
+                   starts=[1.55], y_starts=[], scan=12, resolution=41, curves=[wedge])
+    row = np.argmin(abs(env.yv - 0.2))
+    assert env.coexisting[row, np.argmin(abs(env.xv - 1.75))]
+    assert not env.coexisting[row, np.argmin(abs(env.xv - 1.55))]
+    (drive,) = env.grazing("drive")
+    kinds = list(drive["special_kind"].values)
+    assert kinds == ["grazing-fold", "grazing-fold"]
+    # both crossings on the closed-form curve
+    np.testing.assert_allclose(drive["special_y"].values,
+                               _closed_form_fa(drive["special_x"].values), rtol=1e-3)
