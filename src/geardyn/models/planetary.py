@@ -406,7 +406,8 @@ class PlanetaryGearSet(Model):
     time_unit = "1"
     state_units = "1"
     observable_units = "N"
-    capabilities = Capabilities(physical_inputs=True, physical_axes=True, mesh_forces=True)
+    capabilities = Capabilities(physical_inputs=True, physical_axes=True, mesh_forces=True,
+                                natural_frequencies="Hz")
     raw_overrides_allowed = True
     #: Raw coefficients set by name through ``with_params`` (name -> value), applied again on
     #: top of a rebuild from changed inputs.

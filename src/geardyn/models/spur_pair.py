@@ -215,7 +215,8 @@ class SpurPair(Model):
     observable_names = ("F",)
     observable_units = "N"
     meshes = (("mesh", 0, 1),)
-    capabilities = Capabilities(mesh_forces=True, physical_axes=True)
+    capabilities = Capabilities(mesh_forces=True, physical_axes=True,
+                                natural_frequencies="rad/time")
     physical_names = ("speed",)
 
     def __init__(self, mesh: GearMesh, stiffness: xr.Dataset, *, speed: object,
