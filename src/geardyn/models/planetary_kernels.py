@@ -384,8 +384,9 @@ def _lanes_offsets(PT):
 @nb.njit(inline="always", **_JIT)
 def _lanes_stiffness(PT, nl, S, C, SC, rb, mesh, bs, nh, nm, first):
     """:func:`~geardyn.models.elements.harmonic_factor` of every mesh m into PT[rb + m] (the
-    harmonic recurrence in SC rows 0, 1), the same operations in the same order; ``first``: the
-    offset of the coefficients in a mesh block (``MESH_FIXED``: the drive flank's)."""
+    harmonic recurrence in SC rows 0, 1), the same operations in the same order, clipped at 0
+    alike; ``first``: the offset of the coefficients in a mesh block (``MESH_FIXED``: the drive
+    flank's)."""
     if nh == 0:
         for m in range(nm):
             for k in range(nl):
@@ -410,7 +411,8 @@ def _lanes_stiffness(PT, nl, S, C, SC, rb, mesh, bs, nh, nm, first):
                 PT[rb + m, k] += PT[f, k] * SC[0, k] + PT[f + 1, k] * SC[1, k]
     for m in range(nm):
         for k in range(nl):
-            PT[rb + m, k] = 1.0 + PT[rb + m, k]
+            v = 1.0 + PT[rb + m, k]
+            PT[rb + m, k] = v if v > 0.0 else 0.0
 
 
 @nb.njit(inline="always", **_JIT)
