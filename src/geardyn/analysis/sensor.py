@@ -18,7 +18,7 @@ identical planets on a held ring F_n(t) = sum_m A_m e^{i m Z_r (phi + psi_n)}, t
 carrier orders q = m Z_r + k with amplitude c_k A_m sum_n e^{i q psi_n}. For N equally spaced
 planets the sum is N where q is a multiple of N and 0 elsewhere: only the orders q = 0 (mod N)
 survive (:func:`surviving_orders`), so the sidebands of mesh harmonic m are at
-k = -(m Z_r mod N) + j N, asymmetric about m Z_r unless m Z_r is a multiple of N.
+k = -(m Z_r mod N) + j N, asymmetric about m Z_r unless 2 m Z_r is a multiple of N.
 """
 
 from __future__ import annotations
@@ -106,7 +106,8 @@ def planetary_sensor_signal(ds: xr.Dataset, model, sensor_angle: float = 0.0,
 
     Returns a Dataset over ``time`` (the run's, in the model's time unit) with ``signal`` [N],
     ``carrier_angle`` [rad], ``carrier_revolutions`` and the forces (``force``, (time,
-    planet)); attributes the window, its width, the sensor angle, Z_r, N and the carrier
+    planet)); attributes the window, its width, the sensor angle, Z_r, N, the planet angles
+    psi_n [rad] and the carrier
     frequency in the time unit (``carrier_frequency``, cycles per unit time)."""
     geo = getattr(model, "geometry", None)
     if geo is None:
@@ -136,7 +137,7 @@ def planetary_sensor_signal(ds: xr.Dataset, model, sensor_angle: float = 0.0,
         coords={"time": ("time", t, dict(ds["time"].attrs)),
                 "planet": ("planet", np.arange(1, len(names) + 1))})
     out.attrs.update(window=window, width=float(width), sensor_angle=float(sensor_angle),
-                     ring_teeth=z_r, n_planets=int(model.n_planets),
+                     ring_teeth=z_r, n_planets=int(model.n_planets), planet_angles=psi.tolist(),
                      carrier_frequency=abs(omega_mesh) / z_r / (2.0 * math.pi),
                      transfer="McFadden & Smith 1985; Inalpolat & Kahraman 2009 (window model)")
     return out
