@@ -150,3 +150,17 @@ def test_bad_inputs_name_the_field():
                    stiffness="fem")
     with pytest.raises(geardyn.ParameterError, match="torque"):
         iso_inputs(_pair(), base_pitch_deviation=1.0, profile_form_deviation=1.0, torque=0.0)
+
+
+def test_plot_dynamic_factor(tmp_path):
+    from geardyn.plotting.dynamic_factor import plot_dynamic_factor
+
+    ds = dynamic_factor_sweep(_pair(), [5000.0, 20000.0], None,
+                              geardyn.RunSettings(transient=0.02, samples=8),
+                              base_pitch_deviation=8.0, profile_form_deviation=7.0)
+    fig = plot_dynamic_factor(ds, tmp_path / "df.pdf")
+    assert (tmp_path / "df.pdf").stat().st_size > 0
+    labels = [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
+    assert any("ISO 6336-1" in t for t in labels) and any("N_M" in t for t in labels)
+    with pytest.raises(ValueError, match="dynamic-factor sweep"):
+        plot_dynamic_factor(ds.drop_vars("K_v"))

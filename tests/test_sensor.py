@@ -132,3 +132,23 @@ def test_lanes_go_through_at_once():
     for lane in range(5):
         np.testing.assert_allclose(many[lane], sensor_signal(F[lane], phi, psi, 0.3, 1.0,
                                                              "gaussian"))
+
+
+def test_plot_sensor_draws_the_signal_and_labelled_sidebands(tmp_path):
+    import xarray as xr
+
+    from geardyn.plotting.sensor import plot_sensor
+
+    R, per_rev, n_p = 2, 1920, 4
+    phi = uniform_angle(R, per_rev)
+    psi = 2.0 * math.pi * np.arange(n_p) / n_p
+    F = 100.0 + 5.0 * np.cos(ZR * (phi[:, None] + psi))
+    s = sensor_signal(F, phi, psi, 0.0, math.pi / 2)
+    sig = xr.Dataset({"signal": ("time", s), "carrier_angle": ("time", phi),
+                      "carrier_revolutions": ("time", phi / (2 * math.pi))},
+                     attrs={"ring_teeth": ZR, "n_planets": n_p, "planet_angles": psi.tolist(),
+                            "window": "hann", "width": math.pi / 2, "sensor_angle": 0.0})
+    fig = plot_sensor(sig, tmp_path / "sensor.png", harmonics=1)
+    assert (tmp_path / "sensor.png").stat().st_size > 0
+    texts = {t.get_text() for ax in fig.axes for t in ax.texts}
+    assert {"1Zr-3", "1Zr+1"} <= texts and "1Zr" not in texts
