@@ -103,14 +103,14 @@ def test_resonance_speed_is_the_eigenvalue_of_the_two_inertias_on_the_mesh_sprin
     r1, r2 = m.mesh.pinion.base_radius, m.mesh.wheel.base_radius
     for source in ("model", "iso"):
         inp = iso_inputs(m, base_pitch_deviation=8.0, profile_form_deviation=7.0,
-                         stiffness=source)
+                         stiffness=source)["mesh"]
         k = inp.mesh_stiffness * 1e9 * 0.016  # N/(mm um) * b -> N/m
         K = k * np.array([[r1 * r1, -r1 * r2], [-r1 * r2, r2 * r2]])
         w2 = scipy.linalg.eigh(K, np.diag([i1, i2]), eigvals_only=True)
         f = math.sqrt(max(w2)) / (2.0 * math.pi)  # Hz; the other root is the rigid rotation
         assert resonance_speed(inp) == pytest.approx(f * 60.0 / 19, rel=1e-9)
     model_inputs = iso_inputs(m, base_pitch_deviation=8.0, profile_form_deviation=7.0,
-                              stiffness="model")
+                              stiffness="model")["mesh"]
     assert linear_resonance_speed(m) == pytest.approx(resonance_speed(model_inputs), rel=1e-9)
 
 
@@ -120,21 +120,22 @@ def test_sweep_dataset_holds_both_factors_and_n_m():
                               geardyn.RunSettings(transient=0.02, samples=8),
                               base_pitch_deviation=8.0, profile_form_deviation=7.0,
                               tip_relief=5.0)
-    assert ds["dynamic_factor"].dims == ("torque", "speed")
+    assert ds["dynamic_factor"].dims == ("torque", "speed", "group")
     assert ds["speed"].attrs["units"] == "rpm"
     for j, t1 in enumerate((20.0, 200.0)):
         inp = iso_inputs(m, torque=t1, base_pitch_deviation=8.0, profile_form_deviation=7.0,
-                         tip_relief=5.0)
+                         tip_relief=5.0)["mesh"]
         kv, regime = dynamic_factor_iso(inp, ds["speed"].values)
-        np.testing.assert_allclose(ds["K_v"].values[j], kv)
-        np.testing.assert_array_equal(ds["iso_range"].values[j], regime)
-        assert float(ds["resonance_speed"][j]) == pytest.approx(resonance_speed(inp))
-        np.testing.assert_allclose(
-            ds["dynamic_factor"].values[j] * t1 / m.mesh.pinion.base_radius,
-            ds["force_peak"].values[j])
+        np.testing.assert_allclose(ds["K_v"].values[j, :, 0], kv)
+        np.testing.assert_array_equal(ds["iso_range"].values[j, :, 0], regime)
+        assert float(ds["resonance_speed"][j, 0]) == pytest.approx(resonance_speed(inp))
+        alone = geardyn.bifurcation(m.with_params(torque=t1), "speed", ds["speed"].values,
+                                    geardyn.RunSettings(transient=0.02, samples=8))
+        np.testing.assert_allclose(ds["dynamic_factor"].values[j, :, 0],
+                                   alone["dynamic_factor"].values[:, 0])
     assert np.all(ds["dynamic_factor"].values > 1.0)
     # a heavier load stiffens ISO's c' below 100 N/mm: N_M moves up
-    assert float(ds["resonance_speed"][1]) > float(ds["resonance_speed"][0])
+    assert float(ds["resonance_speed"][1, 0]) > float(ds["resonance_speed"][0, 0])
 
 
 def test_bad_inputs_name_the_field():
@@ -164,3 +165,60 @@ def test_plot_dynamic_factor(tmp_path):
     assert any("ISO 6336-1" in t for t in labels) and any("N_M" in t for t in labels)
     with pytest.raises(ValueError, match="dynamic-factor sweep"):
         plot_dynamic_factor(ds.drop_vars("K_v"))
+
+
+def _planetary():
+    import tomllib
+    from importlib.resources import files
+
+    from planetary_example_set import planetary_by_hand
+
+    doc = tomllib.loads(files("geardyn.studies").joinpath("planetary_example.toml").read_text())
+    return planetary_by_hand(doc)
+
+
+def test_planetary_sun_resonance_is_the_in_phase_mode_of_sun_and_planets():
+    gs = _planetary()
+    inp = iso_inputs(gs, base_pitch_deviation=8.0, profile_form_deviation=7.0)
+    geo, n = gs.geometry, gs.n_planets
+    b = 0.02
+    k = inp["sun"].mesh_stiffness * 1e9 * b  # one sun-planet mesh [N/m]
+    ms = gs.members["sun"].inertia_over_r2  # I / r_b^2 [kg]
+    mp = gs.members["planet"].inertia_over_r2
+    # rotations on the base radii u_s, u_1..u_N; sun-planet springs on u_s + u_n; carrier and
+    # ring held, no ring mesh: ISO's idealisation of clause 6.5.9
+    K = np.zeros((n + 1, n + 1))
+    for p in range(1, n + 1):
+        e = np.zeros(n + 1)
+        e[0] = e[p] = 1.0
+        K += k * np.outer(e, e)
+    w2 = scipy.linalg.eigh(K, np.diag([ms] + [mp] * n), eigvals_only=True)
+    f_mesh = math.sqrt(max(w2)) / (2.0 * math.pi)  # Hz, the in-phase mode
+    ds = dynamic_factor_sweep(gs, [3000.0], None, geardyn.RunSettings(transient=50.0, samples=8),
+                              base_pitch_deviation=8.0, profile_form_deviation=7.0)
+    n_m = float(ds["resonance_speed"].sel(group="sun")[0])  # input speed [rpm]
+    assert n_m / 60.0 * gs.mesh_frequency_per_input_speed() == pytest.approx(f_mesh, rel=1e-9)
+    # the ring-planet mesh: the planet alone on the ring mesh spring (ring infinitely heavy)
+    k_r = inp["ring"].mesh_stiffness * 1e9 * b
+    n_r = float(ds["resonance_speed"].sel(group="ring")[0])
+    assert n_r / 60.0 * gs.mesh_frequency_per_input_speed() \
+        == pytest.approx(math.sqrt(k_r / mp) / (2.0 * math.pi), rel=1e-9)
+    assert geo.sun.teeth == inp["sun"].pinion_teeth and geo.planet.teeth == \
+        inp["ring"].pinion_teeth
+
+
+def test_planetary_sweep_groups_the_meshes():
+    gs = _planetary()
+    run = geardyn.RunSettings(transient=200.0, samples=8)
+    speeds = [4000.0, 14000.0]
+    ds = dynamic_factor_sweep(gs, speeds, [20.0, 60.0], run, base_pitch_deviation=8.0,
+                              profile_form_deviation=7.0)
+    assert list(ds["group"].values) == ["sun", "ring"]
+    alone = geardyn.bifurcation(gs.with_params(sun_torque=60.0), "input_speed", speeds, run)
+    df = alone["dynamic_factor"].values
+    np.testing.assert_allclose(ds["dynamic_factor"].sel(torque=60.0, group="sun"),
+                               df[:, :4].max(axis=1))
+    np.testing.assert_allclose(ds["dynamic_factor"].sel(torque=60.0, group="ring"),
+                               df[:, 4:].max(axis=1))
+    np.testing.assert_allclose(ds["mesh_frequency"].values,
+                               np.array(speeds) / 60.0 * gs.mesh_frequency_per_input_speed())
