@@ -30,9 +30,10 @@ the deviations less their running-in allowances; C_a the tip relief) the factor 
 
 K_v is continuous at N = 1.15 and N = 1.5 (by Eq. 22); at N_S it jumps (the subcritical value
 N_S K + 1 against the main-resonance value), as the standard has it. The factors C_v1 .. C_v7
-depend on the total contact ratio eps_gamma (Table 8): :func:`cv_factors`. Checked against an
-independent implementation of the same clauses (MATISO_6336, gfsReboucas/Drivetrain on
-GitHub, a MATLAB code following ISO 6336-1:2006); the standard's own text was not available.
+depend on the total contact ratio eps_gamma (Table 8): :func:`cv_factors`. The equations were
+compared with an independent implementation of the same clauses (MATISO_6336 of the GitHub
+repository gfsReboucas/Drivetrain, MATLAB, ISO 6336-1:2006 equation numbers); the standard's own
+text was not at hand.
 """
 
 from __future__ import annotations
