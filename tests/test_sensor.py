@@ -15,6 +15,7 @@ from scipy.integrate import quad
 
 import geardyn
 from geardyn.analysis.sensor import (
+    carrier_angle,
     label_sidebands,
     planet_window,
     planetary_sensor_signal,
@@ -152,3 +153,29 @@ def test_plot_sensor_draws_the_signal_and_labelled_sidebands(tmp_path):
     assert (tmp_path / "sensor.png").stat().st_size > 0
     texts = {t.get_text() for ax in fig.axes for t in ax.texts}
     assert {"1Zr-3", "1Zr+1"} <= texts and "1Zr" not in texts
+
+
+def test_unequal_spacing_weighs_each_order_by_the_phasor_sum():
+    """For planets at any angles psi_n the line at order q is |sum_n e^{i q psi_n}| times one
+    planet's (the derivation in docs/sensor.md before the equal-spacing step)."""
+    R, per_rev = 2, 2048
+    phi = uniform_angle(R, per_rev)
+    psi = 2.0 * math.pi * np.array([0, 47, 101]) / per_rev * 8  # on the sampling grid
+    F = 50.0 + 4.0 * np.cos(ZR * (phi[:, None] + psi))
+    amp = sensor_spectrum(sensor_signal(F, phi, psi, 0.0, 1.2), R)["amplitude"].values
+    one = sensor_spectrum(sensor_signal(F[:, :1], phi, psi[:1], 0.0, 1.2), R)["amplitude"].values
+    for q in range(ZR - 10, ZR + 11):
+        gain = abs(np.sum(np.exp(1j * q * psi)))
+        assert amp[q * R] == pytest.approx(gain * one[q * R], rel=1e-8, abs=1e-9 * amp.max())
+
+
+def test_carrier_angle_follows_the_mesh_angle_over_the_ring_teeth():
+    doc = tomllib.loads(files("geardyn.studies").joinpath("planetary_example.toml").read_text())
+    model = planetary_by_hand(doc)
+    t = np.linspace(0.0, 10.0, 5)
+    np.testing.assert_allclose(carrier_angle(model, t, 0.3), 0.3 * t / ZR)
+    lanes = carrier_angle(model, t, np.array([0.1, 0.2]))
+    assert lanes.shape == (2, 5)
+    np.testing.assert_allclose(lanes[1], 0.2 * t / ZR)
+    with pytest.raises(geardyn.ParameterError, match="geometry"):
+        carrier_angle(geardyn.GearPair(zeta=0.05, kappa=0.2, Fm=0.1, Fa=0.05), t)

@@ -30,8 +30,8 @@ import xarray as xr
 
 from geardyn.errors import ParameterError
 
-__all__ = ["WINDOWS", "label_sidebands", "planet_window", "planetary_sensor_signal",
-           "sensor_signal", "sensor_spectrum", "surviving_orders"]
+__all__ = ["WINDOWS", "carrier_angle", "label_sidebands", "planet_window",
+           "planetary_sensor_signal", "sensor_signal", "sensor_spectrum", "surviving_orders"]
 
 #: Window shapes of :func:`planet_window`.
 WINDOWS = ("hann", "gaussian")
@@ -95,34 +95,45 @@ def surviving_orders(ring_teeth: int, n_planets: int, harmonic: int, span: int
     return [k for k in range(-span, span + 1) if (q0 + k) % n_planets == 0]
 
 
+def carrier_angle(model, time: np.ndarray, omega: np.ndarray | float | None = None
+                  ) -> np.ndarray:
+    """phi [rad]: the carrier's angle relative to the ring of a
+    :class:`~geardyn.PlanetaryGearSet` built from geometry at the model times ``time`` (its
+    time unit), at the forcing frequency ``omega`` (default the model's Omega; an array of one
+    per lane broadcasts against ``time``'s leading dims): phi = +-(mesh angle) / Z_r with the
+    mesh angle = mesh_order Omega t, 0 at t = 0 (the first planet at psi_1 there); + unless the
+    sun is held (then the planets turn against psi relative to the ring)."""
+    geo = getattr(model, "geometry", None)
+    if geo is None:
+        raise ParameterError("model", type(model).__name__, "needs a PlanetaryGearSet built "
+                             "from geometry (the ring's teeth)")
+    om = np.asarray(model.omega if omega is None else omega, dtype=float)
+    t = np.asarray(time, dtype=float)
+    scale = (-1.0 if model.held == "sun" else 1.0) * model.mesh_order / int(geo.ring.teeth)
+    return scale * (float(om) if om.ndim == 0 else om[..., None]) * t
+
+
 def planetary_sensor_signal(ds: xr.Dataset, model, sensor_angle: float = 0.0,
                             width: float = math.pi / 2, window: str = "hann") -> xr.Dataset:
     """The sensor signal of a :func:`~geardyn.simulate` run ``ds`` of a
     :class:`~geardyn.PlanetaryGearSet` built from geometry (:meth:`from_geometry`: the ring's
-    teeth): the ring-planet forces ``F_r1`` .. ``F_rN`` through :func:`sensor_signal`. The
-    carrier angle relative to the ring is phi = +-(mesh angle) / Z_r (the mesh angle = mesh
-    frequency times time, 0 at t = 0 where the first planet sits at psi_1 = 0; the sign + unless
-    the sun is held, when the planets turn against psi relative to the ring).
+    teeth): the ring-planet forces ``F_r1`` .. ``F_rN`` through :func:`sensor_signal`, the
+    carrier angle by :func:`carrier_angle` at the run's Omega.
 
     Returns a Dataset over ``time`` (the run's, in the model's time unit) with ``signal`` [N],
     ``carrier_angle`` [rad], ``carrier_revolutions`` and the forces (``force``, (time,
     planet)); attributes the window, its width, the sensor angle, Z_r, N, the planet angles
     psi_n [rad] and the carrier
     frequency in the time unit (``carrier_frequency``, cycles per unit time)."""
-    geo = getattr(model, "geometry", None)
-    if geo is None:
-        raise ParameterError("model", type(model).__name__, "needs a PlanetaryGearSet built "
-                             "from geometry (the ring's teeth)")
+    t = np.asarray(ds["time"].values, dtype=float)
+    phi = carrier_angle(model, t, float(ds.attrs["Omega"]))
     names = [f"F_r{n + 1}" for n in range(model.n_planets)]
     missing = [n for n in names if n not in ds]
     if missing:
         raise ParameterError("ds", ", ".join(missing), "not in the simulation: give a "
                              "geardyn.simulate run of this model")
-    z_r = int(geo.ring.teeth)
+    z_r = int(model.geometry.ring.teeth)
     omega_mesh = float(ds.attrs["Omega"]) * model.mesh_order  # mesh rad per time unit
-    t = np.asarray(ds["time"].values, dtype=float)
-    sense = -1.0 if model.held == "sun" else 1.0
-    phi = sense * omega_mesh * t / z_r
     forces = np.stack([np.asarray(ds[n].values, dtype=float) for n in names], axis=-1)
     psi = np.asarray(model.psi, dtype=float)
     s = sensor_signal(forces, phi, psi, sensor_angle, width, window)
