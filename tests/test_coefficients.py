@@ -309,6 +309,26 @@ def test_capabilities_are_declared_not_probed():
     assert deflection_units(device)["length_scale"] == device.params_in.b_c
 
 
+def test_natural_frequencies_are_declared_with_their_unit():
+    """Each model with natural_frequencies() declares their unit; a class that defines the
+    method without declaring it is refused where it is defined, and an undeclared model gets no
+    natural frequency in the step rule (NaN), however it is written."""
+    units = {"gear-pair": "rad/time", "catt-reduced": "rad/time"}
+    for key, unit in units.items():
+        assert MODELS[key].capabilities.natural_frequencies == unit
+    assert geardyn.PlanetaryGearSet.capabilities.natural_frequencies == "Hz"
+    assert geardyn.SpurPair.capabilities.natural_frequencies == "rad/time"
+    with pytest.raises(TypeError, match="_Undeclared defines natural_frequencies"):
+        class _Undeclared(geardyn.UserModel):
+            def natural_frequencies(self):
+                return np.array([1.0])
+    probed = _Probed(user_model().kernel.rhs, n_states=2, params=[1.0, 0.1],
+                     param_names=("Omega", "zeta"))
+    assert np.isnan(probed.fastest_natural_frequency()).all()
+    with pytest.raises(ValueError, match="natural_frequencies='rpm'"):
+        Capabilities(natural_frequencies="rpm")
+
+
 # ------------------------------------------------------------------------------ vocabularies
 def test_explorer_and_cli_read_the_declared_vocabulary(tmp_path):
     from typer.testing import CliRunner

@@ -16,12 +16,16 @@ from geardyn.analysis.basins import basins
 from geardyn.analysis.bifurcation import ContinuedSweep, bifurcation, continued_sweeps
 from geardyn.analysis.branch import BifurcationPoint, BranchStatus, continuation
 from geardyn.analysis.curves import CurveSettings, curve, curve_at
+from geardyn.analysis.dynamic_factor import dynamic_factor_sweep
+from geardyn.analysis.envelope import Envelope, envelope, intersect_curves
 from geardyn.analysis.frc import frequency_response
+from geardyn.analysis.grazing import grazing_curve
 from geardyn.analysis.lyapunov import LyapunovEstimate, lyapunov, lyapunov_lanes
 from geardyn.analysis.map2d import map2d
 from geardyn.analysis.motion import motion_classes
 from geardyn.analysis.orbits import PeriodicOrbit, periodic_orbit
 from geardyn.analysis.periodicity import classify_period, common_section
+from geardyn.analysis.sensor import planetary_sensor_signal, sensor_signal, sensor_spectrum
 from geardyn.analysis.spectrum import amplitude_spectrum, label_peaks
 from geardyn.core.model import Model
 from geardyn.core.plan import default_steps_per_period
@@ -54,6 +58,7 @@ __all__ = [
     "ContinuedSweep",
     "CurveSettings",
     "DimensionalCATT",
+    "Envelope",
     "GearPair",
     "GeardynError",
     "Gear",
@@ -84,6 +89,7 @@ __all__ = [
     "continued_sweeps",
     "curve",
     "curve_at",
+    "dynamic_factor_sweep",
     "frequency_response",
     "gears",
     "label_peaks",
@@ -92,8 +98,14 @@ __all__ = [
     "map2d",
     "motion_classes",
     "periodic_orbit",
+    "planetary_sensor_signal",
     "default_steps_per_period",
+    "envelope",
+    "grazing_curve",
+    "intersect_curves",
     "reference_solution",
+    "sensor_signal",
+    "sensor_spectrum",
     "simulate",
     "testing",
 ]

@@ -282,7 +282,7 @@ def check_usable(build: Callable[[], Model]) -> Model:
         try:
             model = build()
             checks = [(f"coefficient {n}", v) for n, v in model.coefficient_values().items()]
-            if hasattr(model, "natural_frequencies"):
+            if model.capabilities.natural_frequencies:
                 checks += [("natural frequency", w) for w in model.natural_frequencies()]
             checks += [(f"initial state {n}", v)
                        for n, v in zip(model.state_names, model.initial_state(), strict=True)]

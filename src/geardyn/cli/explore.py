@@ -4,7 +4,7 @@
 
     geardyn explore STUDY.toml [--param Omega] [--range a:b:n] [--port 5006]
                     [--host 127.0.0.1] [--continuation none|up|down] [--interpretation ...]
-                    [--save-dir out/explore] [--show]
+                    [--save-dir out/explore] [--show] [--curve curve.nc ...]
 """
 
 from __future__ import annotations
@@ -41,6 +41,9 @@ def explore_command(
         Path, typer.Option(help="Folder the Save button writes to.")
     ] = Path("out/explore"),
     show: Annotated[bool, typer.Option("--show", help="Open a browser tab.")] = False,
+    curve: Annotated[list[Path] | None, typer.Option(
+        "--curve", help="A two-parameter curve (.nc, e.g. from geardyn envelope) marked where "
+                        "it crosses the diagram (repeatable).")] = None,
 ) -> None:
     """Explore a study's bifurcation diagram in the browser: zoom into windows, click orbits,
     change parameters (a local Bokeh server; prints its address)."""
@@ -56,11 +59,14 @@ def explore_command(
         raise ParameterError("--continuation", continuation,
                              f"must be one of {', '.join(CONTINUATIONS)}")
     interp = interpretation.value if interpretation is not None else None
+    from geardyn.cli.envelope import load_curve
+
+    curves = [load_curve(p) for p in (curve or [])]
 
     def make_state() -> ExplorerState:
         return ExplorerState(s, study, param, window, interpretation=interp,
                              continuation=continuation, save_dir=save_dir,
-                             describe_error=format_error)
+                             describe_error=format_error, curves=curves)
 
     make_state()  # a bad study, parameter or range fails here, as one line
     serve(make_state, port=port, host=host, show=show, describe_error=format_error,

@@ -15,6 +15,8 @@
     geardyn continue STUDY.toml --param Omega --range 0.5:4 [--period K] [--switch]
                      [--over bifurcation.nc] [--out branch.nc] [--plot branch.png]
     geardyn stiffness STUDY.toml [-o stiffness.nc] [--plot] [--figure stiffness.png] [--yes]
+    geardyn dynamic-factor STUDY.toml --f-pb UM --f-falpha UM [--range 2000:44000:85]
+                     [--torque T ...] [--out df.nc] [--plot df.png]
 
 A STUDY argument is a TOML file or the name of a built-in study (``paper_fig3``). Every expected
 error (bad parameters, missing files, invalid TOML, bad values) and every usage error ends the
@@ -379,6 +381,8 @@ __import__("geardyn.cli.continuation", fromlist=["register"]).register(app)  # c
 __import__("geardyn.cli.explore", fromlist=["register"]).register(app)  # cli/explore.py
 __import__("geardyn.cli.stiffness", fromlist=["register"]).register(app)  # cli/stiffness.py
 __import__("geardyn.cli.modes", fromlist=["register"]).register(app)  # cli/modes.py
+__import__("geardyn.cli.dynamic_factor", fromlist=["register"]).register(app)  # dynamic-factor
+__import__("geardyn.cli.envelope", fromlist=["register"]).register(app)  # cli/envelope.py
 
 if __name__ == "__main__":
     main()

@@ -34,6 +34,11 @@ class Capabilities:
         The observables are the meshes' forces: one per entry of ``model.meshes``, in mesh
         order (sweeps report peak and RMS mesh forces, and the dynamic factor where the model
         gives its static mesh forces).
+    ``natural_frequencies``
+        The unit of ``model.natural_frequencies()``, the linearised model's natural
+        frequencies (mean stiffness, no backlash), ascending: ``"rad/time"`` (rad per model
+        time unit: rad/s for a model in seconds, omega / omega_n for a dimensionless one) or
+        ``"Hz"``; empty: the model gives none.
     """
 
     frequency_scale: bool = False
@@ -42,3 +47,13 @@ class Capabilities:
     physical_axes: bool = False
     paper_device: bool = False
     mesh_forces: bool = False
+    natural_frequencies: str = ""
+
+    def __post_init__(self) -> None:
+        if self.natural_frequencies not in NATURAL_FREQUENCY_UNITS:
+            raise ValueError(f"natural_frequencies={self.natural_frequencies!r}: one of "
+                             f"{NATURAL_FREQUENCY_UNITS}")
+
+
+#: The units a model's ``natural_frequencies()`` may be declared in ("" none).
+NATURAL_FREQUENCY_UNITS = ("", "rad/time", "Hz")

@@ -156,6 +156,15 @@ class Model:
     #: over a scale (None: none declared).
     length_scale: float | None = None
 
+    def __init_subclass__(cls, **kwargs: object) -> None:
+        """A class that defines ``natural_frequencies()`` declares their unit in its
+        capabilities (analyses read the declaration, never probe the method)."""
+        super().__init_subclass__(**kwargs)
+        if "natural_frequencies" in vars(cls) and not cls.capabilities.natural_frequencies:
+            raise TypeError(f"{cls.__name__} defines natural_frequencies(): declare their unit "
+                            "in its capabilities (Capabilities(natural_frequencies='rad/time' "
+                            "or 'Hz'))")
+
     # ------------------------------------------------------------------ sizes
     @property
     def n_states(self) -> int:
@@ -348,17 +357,17 @@ class Model:
         model's own coefficients), shape ``(lanes,)``; NaN where it is not known.
 
         The default step (:func:`~geardyn.core.plan.default_steps_per_period`) resolves
-        this frequency in every lane. The default here: a model that defines
-        ``natural_frequencies()`` is asked once per distinct row of ``P`` (a copy of the model
-        holding that row), so it must compute them from ``self.params``; any other model gets
-        NaN (unknown: the step then follows only the forcing frequencies, at least
-        ``MIN_STEPS_PER_PERIOD`` per period). Built-in models override it with a vectorised
-        computation from the coefficients.
+        this frequency in every lane. The default here: a model that declares
+        ``capabilities.natural_frequencies = "rad/time"`` is asked for ``natural_frequencies()``
+        once per distinct row of ``P`` (a copy of the model holding that row), so it must
+        compute them from ``self.params``; any other model gets NaN (unknown: the step then
+        follows only the forcing frequencies, at least ``MIN_STEPS_PER_PERIOD`` per period).
+        Built-in models override it with a vectorised computation from the coefficients.
         """
         P = np.atleast_2d(self.params if P is None else np.asarray(P, dtype=float))
-        fn = getattr(type(self), "natural_frequencies", None)
-        if fn is None:
+        if self.capabilities.natural_frequencies != "rad/time":
             return np.full(P.shape[0], np.nan)
+        fn = type(self).natural_frequencies
         rows, inverse = unique_rows(P)
         out = np.empty(rows.shape[0])
         for k, row in enumerate(rows):

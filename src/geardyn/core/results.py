@@ -124,7 +124,7 @@ SCHEMAS: dict[str, ResultSchema] = {s.kind: s for s in (
          "multiplier_real": ("point", "multiplier"),
          "multiplier_imag": ("point", "multiplier"), "period_time": ("point",),
          "special_kind": ("special",), "special_x": ("special",), "special_y": ("special",),
-         "special_error": ("special",)}),
+         "special_error": ("special",)}),  # its status: a BranchStatus code, not a Status
     ResultSchema(
         "basins",
         ("x", "y", "Omega", "time_unit", "diverged_fraction", "unresolved_fraction",

@@ -28,6 +28,7 @@ from geardyn.explore.compute import (
     orbit_request,
     stiffness_view,
 )
+from geardyn.explore.overlay import curve_marks
 from geardyn.explore.runner import Runner
 from geardyn.explore.state import CONTINUATIONS, INTERPRETATIONS, DiagramRequest, ExplorerState
 from geardyn.plotting.bifurcation import PERIOD_CLASSES, REGIME_COLORS
@@ -131,6 +132,12 @@ class ExplorerSession:
                 line_dash="dashed")
         fig.add_tools(HoverTool(tooltips=[(st.param, "@x{0.0000}"), ("point", "@y{0.0000}")],
                                 renderers=fig.renderers[:len(PERIOD_CLASSES)]))
+        # the given two-parameter curves where they cross the diagram (geardyn.explore.overlay)
+        self.curve_source = ColumnDataSource({"x": [], "label": [], "color": []},
+                                             name="curve_marks")
+        for angle in (np.pi / 2, -np.pi / 2):
+            fig.ray("x", 0, source=self.curve_source, length=0, angle=angle, color="color",
+                    line_width=1.5, line_alpha=0.8)
         fig.on_event(RangesUpdate, self._on_ranges)
         fig.on_event(Tap, self._on_tap)
         self.diagram = fig
@@ -322,6 +329,8 @@ class ExplorerSession:
         for band in self.bands:
             band.renderers[0].glyph.width = view.width
         self._show_stiffness(request.model)
+        self.curve_source.data = curve_marks(self.state.curves, request.param,
+                                             self.state.current_value)
         w = request.window
         self._shown = (w.start, w.stop)
         self.x_range.update(start=w.start, end=w.stop)

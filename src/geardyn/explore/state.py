@@ -20,7 +20,7 @@ import math
 import re
 import shlex
 import typing
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
@@ -192,12 +192,16 @@ class ExplorerState:
         Where :meth:`save` writes the view (and the study with the overrides).
     describe_error
         Turns an exception into the one-line message shown (the CLI passes its formatter).
+    curves
+        Two-parameter ``"curve"`` datasets (grazing, fold, period doubling) drawn over the
+        diagram where they cross it (:mod:`geardyn.explore.overlay`).
     """
 
     def __init__(self, study: Study, source: str, param: str | None = None,
                  window: Window | None = None, *, interpretation: str | None = None,
                  continuation: str | None = None, save_dir: Path | str = Path("out/explore"),
-                 describe_error: Callable[[BaseException], str] = _error_text):
+                 describe_error: Callable[[BaseException], str] = _error_text,
+                 curves: Sequence[Any] = ()):
         sweep = study.sweep
         self.study = study
         self.source = source
@@ -215,6 +219,7 @@ class ExplorerState:
         self.interpretation = interpretation
         self.continuation = continuation or (sweep.continuation if sweep is not None else "none")
         self.describe_error = describe_error
+        self.curves = tuple(curves)
         self.save_dir = Path(save_dir)
         if (self.param != "Omega" and study.run.omega is None
                 and study.study.model != "spur_pair"):  # a spur pair's speed sets its Omega

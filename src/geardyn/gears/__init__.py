@@ -1,5 +1,6 @@
 """Gear geometry, ISO 6336-1 and potential-energy mesh stiffness (spur, and helical by thin
-slices), tip relief and lead crowning, stiffness waveforms and planetary mesh phasing.
+slices), the ISO 6336-1 dynamic factor K_v (method B), tip relief and lead crowning, stiffness
+waveforms and planetary mesh phasing.
 
 Pure numpy: everything here produces plain numbers, arrays and callables that a model's mesh
 takes (mean stiffness, Fourier coefficients, phases); the potential-energy stiffness comes as a
@@ -11,6 +12,13 @@ from geardyn.gears.faults import FAULT_KINDS, BrokenTooth, Spall, Wear
 from geardyn.gears.geometry import GearMesh, SpurGear, inverse_involute, involute
 from geardyn.gears.helical import HelicalGear, HelicalMesh, helical_stiffness
 from geardyn.gears.iso6336 import ISOStiffness, iso6336_stiffness
+from geardyn.gears.iso6336_kv import (
+    DynamicFactorInputs,
+    dynamic_factor_iso,
+    planetary_reduced_masses,
+    reduced_mass,
+    resonance_speed,
+)
 from geardyn.gears.phasing import (
     MeshPhases,
     PlanetaryGeometry,
@@ -37,6 +45,7 @@ from geardyn.gears.waveform import StiffnessWaveform, double_contact_centre, mes
 __all__ = [
     "FAULT_KINDS",
     "BrokenTooth",
+    "DynamicFactorInputs",
     "GearMesh",
     "HelicalGear",
     "HelicalMesh",
@@ -55,6 +64,7 @@ __all__ = [
     "coast_phase",
     "crowning_gap",
     "double_contact_centre",
+    "dynamic_factor_iso",
     "equally_spaced",
     "helical_loaded_contact",
     "helical_stiffness",
@@ -65,9 +75,12 @@ __all__ = [
     "loaded_contact",
     "mesh_phases",
     "mesh_stiffness_waveform",
+    "planetary_reduced_masses",
     "potential_energy_stiffness",
     "prepare_pair",
+    "reduced_mass",
     "relief_gap",
+    "resonance_speed",
     "ring_tooth_model",
     "sun_ring_phase",
     "surviving_harmonics",

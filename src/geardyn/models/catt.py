@@ -109,6 +109,7 @@ class CATTDevice(Model):
     state_units = "1"
     observable_units = "N"
     capabilities = Capabilities(frequency_scale=True, interpretation=True,
+                                natural_frequencies="rad/time",
                                 physical_inputs=True, paper_device=True, mesh_forces=True)
     raw_overrides_allowed = True
     #: The paper's names of the physical parameters (``with_params`` re-derives from them;

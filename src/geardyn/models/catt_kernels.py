@@ -27,6 +27,7 @@ import numba as nb
 
 from geardyn.core.kernel_source import FORM_GENERAL, FORM_LOAD, FORM_QUIET
 from geardyn.models.derived import CATT_BLOCK, CATT_HEADER, THETA_BLOCK, THETA_HEADER
+from geardyn.models.elements import dead_zone, harmonic_factor, harmonic_factor_lane
 
 # Index constants: the offsets of the declared coefficients (geardyn.models.derived).
 # header
@@ -50,12 +51,6 @@ def block_size(n_harmonics: int) -> int:
 
 
 _JIT = {"cache": True, "error_model": "numpy", "boundscheck": False}
-
-
-@nb.njit(inline="always", **_JIT)
-def dead_zone(x, b):
-    """g(x, b) of Eq. (3): x - b above b, x + b below -b, 0 between (branch-free, exact)."""
-    return x - min(max(x, -b), b)
 
 
 # The load fluctuation's sine, as arithmetic (no libm call), so that the sweep kernel's fused
@@ -94,19 +89,6 @@ def load_sin(x):
     return -c if q == 3.0 else v
 
 
-@nb.njit(inline="always", **_JIT)
-def _stiffness(p, f, nh, s, c):
-    """1 + the stiffness variation sum_h p[f+2h] cos(h theta) + p[f+2h+1] sin(h theta), h < nh,
-    for the mesh phase theta with sin s, cos c (harmonics by the angle-addition recurrence)."""
-    acc = p[f] * c + p[f + 1] * s
-    ch = c
-    sh = s
-    for h in range(1, nh):
-        ch, sh = ch * c - sh * s, sh * c + ch * s
-        acc += p[f + 2 * h] * ch + p[f + 2 * h + 1] * sh
-    return 1.0 + acc
-
-
 # Each function below is written once, inline, for n_sets planet sets, and compiled twice: for
 # the general model (n_sets read from p) and for the reduced model (n_sets = 1, a constant, so the
 # loop over sets disappears: twice as fast). Helpers take arrays only when inlined.
@@ -130,8 +112,8 @@ def _rhs(t, y, dy, p, s, c, n_sets):
         vs = y[j + 1]
         xp = y[j + 2]
         vp = y[j + 3]
-        gs = _stiffness(p, o + BLOCK_FIXED, nh, s, c) * dead_zone(xs, p[o + B_SQ])
-        gp = _stiffness(p, o + BLOCK_FIXED + 2 * nh, nh, s, c) * dead_zone(xp, p[o + B_PQ])
+        gs = harmonic_factor(p, o + BLOCK_FIXED, nh, s, c) * dead_zone(xs, p[o + B_SQ])
+        gp = harmonic_factor(p, o + BLOCK_FIXED + 2 * nh, nh, s, c) * dead_zone(xp, p[o + B_PQ])
         carrier += p[o + K_SQ_C] * gs + p[o + C_SQ_C] * vs
         f_sq = p[o + K_SQ_Q] * gs + p[o + C_SQ_Q] * vs
         f_pq = p[o + K_PQ_Q] * gp + p[o + C_PQ_Q] * vp
@@ -164,8 +146,9 @@ def _observe(y, out, p, s, c, n_sets):
     for i in range(n_sets):
         o = HEADER + i * bs
         j = 4 * i
-        gs = _stiffness(p, o + BLOCK_FIXED, nh, s, c) * dead_zone(y[j], p[o + B_SQ])
-        gp = _stiffness(p, o + BLOCK_FIXED + 2 * nh, nh, s, c) * dead_zone(y[j + 2], p[o + B_PQ])
+        gs = harmonic_factor(p, o + BLOCK_FIXED, nh, s, c) * dead_zone(y[j], p[o + B_SQ])
+        gp = (harmonic_factor(p, o + BLOCK_FIXED + 2 * nh, nh, s, c)
+              * dead_zone(y[j + 2], p[o + B_PQ]))
         scale = p[o + FORCE_SCALE]
         out[2 * i] = scale * (p[o + K_SQ_Q] * gs + p[o + C_SQ_Q] * y[j + 1])
         out[2 * i + 1] = scale * (p[o + K_PQ_Q] * gp + p[o + C_PQ_Q] * y[j + 3])
@@ -250,8 +233,8 @@ def theta_rhs(t, y, dy, p, s, c):
         dx_sq = w_c * p[T_RC1] - w_q * p[o + T_RBQ] - de_sq
         x_pq = th_q * p[o + T_RBQ] - th_p * p[o + T_RBP] - e_pq
         dx_pq = w_q * p[o + T_RBQ] - w_p * p[o + T_RBP] - de_pq
-        k_sq = p[o + T_KM_SQ] * _stiffness(p, o + T_BLOCK_FIXED, nh, s, c)
-        k_pq = p[o + T_KM_PQ] * _stiffness(p, o + T_BLOCK_FIXED + 2 * nh, nh, s, c)
+        k_sq = p[o + T_KM_SQ] * harmonic_factor(p, o + T_BLOCK_FIXED, nh, s, c)
+        k_pq = p[o + T_KM_PQ] * harmonic_factor(p, o + T_BLOCK_FIXED + 2 * nh, nh, s, c)
         f_sq = k_sq * dead_zone(x_sq, p[o + T_B_SQ]) + p[o + T_C_SQ] * dx_sq
         f_pq = k_pq * dead_zone(x_pq, p[o + T_B_PQ]) + p[o + T_C_PQ] * dx_pq
         dy[j] = w_q
@@ -316,7 +299,7 @@ def _lane_forcing(T, PT, nl, S, C, SC):
         SC[1, k] = PT[fp, k] * C[k] + PT[fp + 1, k] * S[k]
         ch = C[k]
         sh = S[k]
-        for h in range(1, nh):  # the harmonics by the recurrence of _stiffness, per lane
+        for h in range(1, nh):  # the harmonics by the recurrence of harmonic_factor, per lane
             ch, sh = ch * C[k] - sh * S[k], sh * C[k] + ch * S[k]
             SC[0, k] += PT[fs + 2 * h, k] * ch + PT[fs + 2 * h + 1, k] * sh
             SC[1, k] += PT[fp + 2 * h, k] * ch + PT[fp + 2 * h + 1, k] * sh
@@ -406,18 +389,6 @@ catt_rhs_one_lane_states = 4
 
 
 @nb.njit(inline="always", **_JIT)
-def _stiffness_lane(PT, k, f, nh, s, c):
-    """:func:`_stiffness` of lane k (coefficient rows f.. of PT)."""
-    acc = PT[f, k] * c + PT[f + 1, k] * s
-    ch = c
-    sh = s
-    for h in range(1, nh):
-        ch, sh = ch * c - sh * s, sh * c + ch * s
-        acc += PT[f + 2 * h, k] * ch + PT[f + 2 * h + 1, k] * sh
-    return 1.0 + acc
-
-
-@nb.njit(inline="always", **_JIT)
 def _factors_quiet(t, PT, k, s, c):
     """Stiffness factors (sun-inside, inside-outside) and load terms (load_c, sin_l1) of lane k,
     as :func:`_rhs` computes them for one planet set, in the lane form FORM_QUIET."""
@@ -447,8 +418,8 @@ def _factors_general(t, PT, k, s, c):
     if PT[F_C1, k] != 0.0 or PT[HEADER + F_P1, k] != 0.0:
         load_c += PT[F_C1, k] * load_sin(PT[LAMBDA, k] * t + PT[PSI2, k])
         sin_l1 = load_sin(PT[LAMBDA, k] * t + PT[PSI1, k])
-    return (_stiffness_lane(PT, k, fs, nh, s, c), _stiffness_lane(PT, k, fs + 2 * nh, nh, s, c),
-            load_c, sin_l1)
+    return (harmonic_factor_lane(PT, k, fs, nh, s, c),
+            harmonic_factor_lane(PT, k, fs + 2 * nh, nh, s, c), load_c, sin_l1)
 
 
 @nb.njit(inline="always", **_JIT)

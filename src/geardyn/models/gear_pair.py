@@ -80,7 +80,7 @@ class GearPair(Model):
     event_names = ("x-b", "x+b")
     observable_names = ("F",)
     meshes = (("mesh", 0, 1),)
-    capabilities = Capabilities(mesh_forces=True)
+    capabilities = Capabilities(mesh_forces=True, natural_frequencies="rad/time")
     derived = DERIVED
     #: The declared coefficients (:data:`~geardyn.models.gear_pair_coefficients.GEAR_PAIR`):
     #: the parameters, then the derived coefficients (:data:`DERIVED`), in the kernel's order.

@@ -36,6 +36,7 @@ from geardyn.core.kernel_source import KernelSource
 from geardyn.core.model import Model, unique_rows
 from geardyn.core.plan import MIN_STEPS_PER_PERIOD, STEPS_PER_FASTEST_MODE
 from geardyn.errors import ParameterError
+from geardyn.gears.faults import BrokenTooth
 from geardyn.models import planetary_kernels as pk
 from geardyn.models.modal import frequency_groups
 from geardyn.models.planetary_coefficients import (
@@ -108,7 +109,7 @@ CENTRAL = ("carrier", "ring", "sun")
 _SHORT = {"carrier": "c", "ring": "r", "sun": "s"}
 #: Constructor inputs that fix the model's layout or are not numbers: not swept by name.
 _NOT_SWEPT = {"n_planets", "waveform", "coast_waveform", "harmonics", "mesh_order",
-              "rotational_only", "fixed",
+              "rotational_only", "fixed", "stiffness_gaps",
               "centrifugal_preload", "planet_angles", "sun", "ring", "carrier", "planet",
               "time_scale", "length_scale"}
 
@@ -393,6 +394,11 @@ class PlanetaryGearSet(Model):
         ``carrier_speed="kinematic"``. Both None (default): the terms are omitted (the
         carrier-frame model at low carrier speed). Not with ``rotational_only`` (no
         translations to act on).
+    stiffness_gaps
+        False (default): a mesh stiffness series that falls to 0 or below is refused. True: a
+        mesh may have no pair in contact over part of the period (a missing tooth,
+        :meth:`from_geometry` sets it): the series' ringing below 0 about such a gap is clipped
+        at 0 (the kernels clip every series at 0; a positive one is unchanged, bitwise).
     centrifugal_preload
         With a carrier speed: True (default) adds the planets' centrifugal load
         m_p Omega_c^2 r_c on their bearings (needs ``carrier.radius`` r_c) and lets it turn
@@ -406,7 +412,8 @@ class PlanetaryGearSet(Model):
     time_unit = "1"
     state_units = "1"
     observable_units = "N"
-    capabilities = Capabilities(physical_inputs=True, physical_axes=True, mesh_forces=True)
+    capabilities = Capabilities(physical_inputs=True, physical_axes=True, mesh_forces=True,
+                                natural_frequencies="Hz")
     raw_overrides_allowed = True
     #: Raw coefficients set by name through ``with_params`` (name -> value), applied again on
     #: top of a rebuild from changed inputs.
@@ -451,7 +458,7 @@ class PlanetaryGearSet(Model):
                  mesh_order: int = 1, rotational_only: bool = False, fixed: Sequence[str] = (),
                  carrier_speed: Any = None, carrier_speed_ratio: Any = None,
                  centrifugal_preload: bool = True, time_scale: Any = None,
-                 length_scale: Any = 1e-6):
+                 length_scale: Any = 1e-6, stiffness_gaps: bool = False):
         self.inputs: dict[str, Any] = {k: v for k, v in locals().items()
                                        if k not in ("self", "__class__")}
         if isinstance(n_planets, bool) or not isinstance(n_planets, int | np.integer) \
@@ -510,7 +517,10 @@ class PlanetaryGearSet(Model):
         self.fourier = _waveforms("waveform", waveform, both("stiffness_fluctuation"),
                                  self.mesh_phase, float(contact_ratio), harmonics,
                                  self.mesh_order)
-        if _minimum_relative_stiffness(self.fourier) <= 0.0:
+        if not isinstance(stiffness_gaps, bool):
+            raise ParameterError("stiffness_gaps", stiffness_gaps, "must be true or false")
+        self.stiffness_gaps = stiffness_gaps
+        if not stiffness_gaps and _minimum_relative_stiffness(self.fourier) <= 0.0:
             if not isinstance(waveform, str):
                 raise ParameterError("waveform", "(coefficients)", "makes a mesh stiffness "
                                      "negative; it must stay > 0")
@@ -566,7 +576,7 @@ class PlanetaryGearSet(Model):
         zero = np.zeros(self.mesh_phase.size)
         coast = _waveforms("coast_waveform", waveform, zero, self.mesh_phase, contact_ratio,
                            harmonics, self.mesh_order)
-        if _minimum_relative_stiffness(coast) <= 0.0:
+        if not self.stiffness_gaps and _minimum_relative_stiffness(coast) <= 0.0:
             raise ParameterError("coast_waveform", "(coefficients)", "makes a coast-flank "
                                  "stiffness negative; it must stay > 0")
         width = max(coast.shape[1], self.fourier.shape[1])
@@ -710,8 +720,9 @@ class PlanetaryGearSet(Model):
 
         ``faults`` (with ``stiffness="potential_energy"``): one fault or a sequence
         (:class:`~geardyn.gears.RootCrack`, :class:`~geardyn.gears.Spall`,
-        :class:`~geardyn.gears.Wear`; a :class:`~geardyn.gears.BrokenTooth` leaves no pair in
-        contact over part of its passage, a zero stiffness no series keeps positive: refused),
+        :class:`~geardyn.gears.Wear`, :class:`~geardyn.gears.BrokenTooth`: a missing tooth
+        leaves no pair in contact over part of its passage, where the stiffness is 0; the set
+        is then built with ``stiffness_gaps=True``, its series clipped at 0),
         all on one gear, its
         ``gear`` ``"sun"``, ``"ring"`` or ``"planet<n>"`` (n = 1 .. N) and ``tooth`` numbered as
         in :mod:`geardyn.models.planetary_faults` (which also says which meshes and flanks a
@@ -783,6 +794,8 @@ class PlanetaryGearSet(Model):
         for g, mesh in meshes.items():
             kw.setdefault(f"{g}_backlash",
                           0.5 * max(mesh.backlash, 0.0) * math.cos(mesh.operating_pressure_angle))
+        if placement is not None and any(isinstance(f, BrokenTooth) for f in placement.faults):
+            kw["stiffness_gaps"] = True
         try:
             model = cls(
                 n_planets=geometry.n_planets, planet_angles=list(geometry.planet_angles),
@@ -796,9 +809,8 @@ class PlanetaryGearSet(Model):
                 raise ParameterError("harmonics", harmonics, "the series of a mesh's "
                                      "stiffness falls to 0 or below; keep more") from None
             raise ParameterError("faults", placement.describe(), "the stiffness series of a "
-                                 "faulty mesh falls to 0 or below (a missing tooth leaves no "
-                                 "pair in contact over its single-contact zone: not modelled; "
-                                 "otherwise keep more harmonics)") from None
+                                 "faulty mesh falls to 0 or below; keep more harmonics"
+                                 ) from None
         model.geometry = geometry
         model.stiffness_waveforms = waves
         model.stiffness_tables = tables
@@ -866,7 +878,8 @@ class PlanetaryGearSet(Model):
         potential-energy tables (:attr:`mesh_tables`): per mesh (:attr:`mesh_names` order) the
         mesh cycles c from t = 0 (ascending in [0, ``mesh_order``)), its table at them (repeated
         over the period and delayed by the mesh's phase: K(c) = T(c + mesh_phase / 2 pi)) and
-        the model's series k_m (1 + sum a_h cos(h Theta) + b_h sin(h Theta)) at Theta = 2 pi c
+        the model's series k_m (1 + sum a_h cos(h Theta) + b_h sin(h Theta), clipped at 0 as in
+        the kernels) at Theta = 2 pi c
         / ``mesh_order`` [N/m]. ``flank``: ``"drive"`` or ``"coast"`` (with ``coast =
         "symmetric"`` the coast flank is the drive flank's table and series)."""
         if self.mesh_tables is None:
@@ -889,8 +902,8 @@ class PlanetaryGearSet(Model):
             k = np.tile(np.asarray(table[var].values, dtype=float), reps)
             order = np.argsort(c, kind="stable")
             c, k = c[order], k[order]
-            series = float(mean[m]) * evaluate(coef[m, 0::2], coef[m, 1::2],
-                                               2.0 * math.pi * c / self.mesh_order)
+            series = float(mean[m]) * np.maximum(evaluate(
+                coef[m, 0::2], coef[m, 1::2], 2.0 * math.pi * c / self.mesh_order), 0.0)
             out.append((c, k, series))
         return out
 

@@ -33,8 +33,8 @@ mesh's drive flank) and the tooth loads the ring with its leading flank (the rin
 drive flank, which is the sun-planet mesh's coast flank). So
 
 * a root crack (its faces open under either flank's load) weakens both of planet n's meshes
-  (a missing tooth would take out both, but leaves no pair in contact over part of its
-  passage: :meth:`~geardyn.PlanetaryGearSet.from_geometry` refuses the zero stiffness);
+  (a missing tooth takes out both, and leaves no pair in contact over part of its passage: a
+  zero stiffness there, the series clipped at 0);
 * a spall or wear on the planet tooth's ``flank`` ``"drive"`` (the flank the sun drives; the
   ring meets it on reversal, the ring-planet mesh's coast flank) narrows the contacts and opens
   the gap of that flank only: the sun-planet mesh's drive contacts and the ring-planet mesh's

@@ -57,6 +57,7 @@ import math
 import numba as nb
 import numpy as np
 
+from geardyn.models.elements import dead_zone, harmonic_factor, harmonic_factor_lane
 from geardyn.models.planetary_coefficients import HEADER as HEADER_BLOCK
 from geardyn.models.planetary_coefficients import MESH
 
@@ -200,25 +201,6 @@ def fill_structure(P: np.ndarray, kt_entries: list[tuple[int, int]],
 
 
 @nb.njit(inline="always", **_JIT)
-def _dead_zone(x, b):
-    return x - min(max(x, -b), b)
-
-
-@nb.njit(inline="always", **_JIT)
-def _relative_stiffness(p, f, nh, s, c):
-    """1 + sum_h p[f+2h] cos(h theta) + p[f+2h+1] sin(h theta), theta the forcing phase."""
-    if nh == 0:
-        return 1.0
-    acc = p[f] * c + p[f + 1] * s
-    ch = c
-    sh = s
-    for h in range(1, nh):
-        ch, sh = ch * c - sh * s, sh * c + ch * s
-        acc += p[f + 2 * h] * ch + p[f + 2 * h + 1] * sh
-    return 1.0 + acc
-
-
-@nb.njit(inline="always", **_JIT)
 def _offsets(p):
     """n, n_mesh, nh, the mesh blocks' offset and size, the structure's and its mesh part's."""
     n = int(p[N_DOF])
@@ -274,11 +256,11 @@ def _mesh_state(y, p, o, q, n, s, c, om):
 def _mesh_force(t, y, p, o, q, n, nh, s, c):
     s, c, om = _mesh_phase(t, p[o + M_ORDER], p[OMEGA], s, c)
     d, v = _mesh_state(y, p, o, q, n, s, c, om)
-    g = _dead_zone(d, p[o + M_B])
+    g = dead_zone(d, p[o + M_B])
     if g < 0.0 and p[TWO_FLANK] != 0.0:  # the coast flank
-        kc = _relative_stiffness(p, o + coast_offset(n, nh), nh, s, c)
+        kc = harmonic_factor(p, o + coast_offset(n, nh), nh, s, c)
         return p[o + M_KFC] * kc * g + p[o + M_CF] * v
-    k = _relative_stiffness(p, o + MESH_FIXED, nh, s, c)
+    k = harmonic_factor(p, o + MESH_FIXED, nh, s, c)
     return p[o + M_KF] * k * g + p[o + M_CF] * v
 
 
@@ -304,7 +286,7 @@ def _mesh_forces_shared(y, out, p, n, nm, nh, mesh, bs, mz, s, c):
     for m in range(nm):
         o = mesh + m * bs
         d, v = _mesh_state(y, p, o, mz + m * 3 * MESH_NZ, n, s, c, p[OMEGA])
-        out[m] = p[o + M_KF] * out[m] * _dead_zone(d, p[o + M_B]) + p[o + M_CF] * v
+        out[m] = p[o + M_KF] * out[m] * dead_zone(d, p[o + M_B]) + p[o + M_CF] * v
 
 
 @nb.njit(inline="always", **_JIT)
@@ -401,9 +383,10 @@ def _lanes_offsets(PT):
 
 @nb.njit(inline="always", **_JIT)
 def _lanes_stiffness(PT, nl, S, C, SC, rb, mesh, bs, nh, nm, first):
-    """:func:`_relative_stiffness` of every mesh m into PT[rb + m] (the harmonic recurrence in
-    SC rows 0, 1), the same operations in the same order; ``first``: the offset of the
-    coefficients in a mesh block (``MESH_FIXED``: the drive flank's)."""
+    """:func:`~geardyn.models.elements.harmonic_factor` of every mesh m into PT[rb + m] (the
+    harmonic recurrence in SC rows 0, 1), the same operations in the same order, clipped at 0
+    alike; ``first``: the offset of the coefficients in a mesh block (``MESH_FIXED``: the drive
+    flank's)."""
     if nh == 0:
         for m in range(nm):
             for k in range(nl):
@@ -428,7 +411,8 @@ def _lanes_stiffness(PT, nl, S, C, SC, rb, mesh, bs, nh, nm, first):
                 PT[rb + m, k] += PT[f, k] * SC[0, k] + PT[f + 1, k] * SC[1, k]
     for m in range(nm):
         for k in range(nl):
-            PT[rb + m, k] = 1.0 + PT[rb + m, k]
+            v = 1.0 + PT[rb + m, k]
+            PT[rb + m, k] = v if v > 0.0 else 0.0
 
 
 @nb.njit(inline="always", **_JIT)
@@ -619,7 +603,7 @@ def _lanes_mesh(Y, DY, PT, nl, S, C, SC, n, o, q, row, apply, two, rowc):
     for k in range(nl):
         d, v = _lane_deflection(Y, PT, k, n, o, w, i0, i1, i2, i3, i4, i5, S[k], C[k],
                                 PT[OMEGA, k])
-        g = _dead_zone(d, PT[o + M_B, k])
+        g = dead_zone(d, PT[o + M_B, k])
         kf = PT[o + M_KF, k] * PT[row, k]
         if two and g < 0.0:
             kf = PT[o + M_KFC, k] * PT[rowc, k]
@@ -719,20 +703,6 @@ def _lanes_order_one(PT, nl, o):
 
 
 @nb.njit(inline="always", **_JIT)
-def _lane_relative_stiffness(PT, k, f, nh, s, c):
-    """:func:`_relative_stiffness` of lane k (coefficients from row f), the same operations."""
-    if nh == 0:
-        return 1.0
-    acc = PT[f, k] * c + PT[f + 1, k] * s
-    ch = c
-    sh = s
-    for h in range(1, nh):
-        ch, sh = ch * c - sh * s, sh * c + ch * s
-        acc += PT[f + 2 * h, k] * ch + PT[f + 2 * h + 1, k] * sh
-    return 1.0 + acc
-
-
-@nb.njit(inline="always", **_JIT)
 def _lanes_mesh_orders(Y, DY, PT, nl, T, S, C, SC, n, nh, o, q, apply, two):
     """:func:`_lanes_mesh` with the mesh at its own phase in every lane (:func:`_mesh_phase`):
     the phase, the acting flank's relative stiffness and the force in one pass per lane."""
@@ -742,11 +712,11 @@ def _lanes_mesh_orders(Y, DY, PT, nl, T, S, C, SC, n, nh, o, q, apply, two):
     for k in range(nl):
         s, c, om = _mesh_phase(T[k], PT[o + M_ORDER, k], PT[OMEGA, k], S[k], C[k])
         d, v = _lane_deflection(Y, PT, k, n, o, w, i0, i1, i2, i3, i4, i5, s, c, om)
-        g = _dead_zone(d, PT[o + M_B, k])
+        g = dead_zone(d, PT[o + M_B, k])
         if two and g < 0.0:
-            kf = PT[o + M_KFC, k] * _lane_relative_stiffness(PT, k, fc, nh, s, c)
+            kf = PT[o + M_KFC, k] * harmonic_factor_lane(PT, k, fc, nh, s, c)
         else:
-            kf = PT[o + M_KF, k] * _lane_relative_stiffness(PT, k, o + MESH_FIXED, nh, s, c)
+            kf = PT[o + M_KF, k] * harmonic_factor_lane(PT, k, o + MESH_FIXED, nh, s, c)
         SC[0, k] = kf * g + PT[o + M_CF, k] * v
     _lanes_apply(DY, PT, nl, SC, n, q, apply)
 

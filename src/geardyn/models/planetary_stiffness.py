@@ -282,7 +282,8 @@ def series_error(table: np.ndarray, cycles: int, mean: float, coefficients: np.n
     ``cycles`` mesh cycles (repeated to ``order`` cycles when shorter), the mesh's series k0 (1 +
     sum a_h cos(h Theta) + b_h sin(h Theta)) in the forcing angle Theta = 2 pi c / ``order``
     (``coefficients`` [a_1, b_1, ...], shifted by ``shift`` mesh cycles: K(c) = T(c - shift)),
-    evaluated at c = shift + the table's cycles by one inverse FFT."""
+    evaluated at c = shift + the table's cycles by one inverse FFT, clipped at 0 as the kernels
+    clip it (a table with a gap, a missing tooth, rings below 0 about it)."""
     t = np.tile(np.asarray(table, dtype=float), order // cycles)
     n = t.size
     a, b = coefficients[0::2], coefficients[1::2]
@@ -291,4 +292,4 @@ def series_error(table: np.ndarray, cycles: int, mean: float, coefficients: np.n
     spectrum[0] = mean * n
     turn = np.exp(1j * 2.0 * np.pi * h * shift / order)
     spectrum[1:a.size + 1] = 0.5 * n * mean * (a - 1j * b) * turn
-    return np.fft.irfft(spectrum, n) - t
+    return np.maximum(np.fft.irfft(spectrum, n), 0.0) - t

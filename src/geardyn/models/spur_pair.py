@@ -215,7 +215,8 @@ class SpurPair(Model):
     observable_names = ("F",)
     observable_units = "N"
     meshes = (("mesh", 0, 1),)
-    capabilities = Capabilities(mesh_forces=True, physical_axes=True)
+    capabilities = Capabilities(mesh_forces=True, physical_axes=True,
+                                natural_frequencies="rad/time")
     physical_names = ("speed",)
 
     def __init__(self, mesh: GearMesh, stiffness: xr.Dataset, *, speed: object,
@@ -344,8 +345,15 @@ class SpurPair(Model):
         return i1 * i2 / (i1 * r2 * r2 + i2 * r1 * r1)
 
     def _check_positive(self) -> None:
+        """A flank whose table is positive at every angle must keep a positive series there
+        (else more harmonics are needed). A table that falls to 0 (a missing tooth: no pair in
+        contact over part of its passage) is taken: the kernels clip the series at 0
+        (:meth:`stiffness_at`), so its ringing below 0 about the gap carries no force."""
         theta = self.table_phase()
-        for name, series in (("drive", self.drive_series), ("coast", self.coast_series)):
+        for name, series, var in (("drive", self.drive_series, "mesh_stiffness"),
+                                  ("coast", self.coast_series, "mesh_stiffness_coast")):
+            if float(np.min(self.stiffness[var].values)) <= 0.0:
+                continue
             low = float(np.min(evaluate_series(series, theta)))
             if not low > 0.0:
                 raise ParameterError("harmonics", (series.size - 1) // 2,
@@ -470,9 +478,11 @@ class SpurPair(Model):
         return 2.0 * math.pi * cyc / self.cycles
 
     def stiffness_at(self, theta: np.ndarray, flank: str = "drive") -> np.ndarray:
-        """The series k(theta) [N/m] of the ``"drive"`` or ``"coast"`` flank."""
+        """The stiffness k(theta) [N/m] of the ``"drive"`` or ``"coast"`` flank that the
+        kernels use: the series, clipped at 0 (only a table that falls to 0, a missing tooth,
+        gives a series below 0)."""
         series = {"drive": self.drive_series, "coast": self.coast_series}[flank]
-        return evaluate_series(series, theta)
+        return np.maximum(evaluate_series(series, theta), 0.0)
 
     def stiffness_error(self) -> dict[str, float]:
         """The series against the table at its angles, relative to the mean drive stiffness:

@@ -89,7 +89,10 @@ def contact_force(x, PT, k, s, c):
         row, deflection = KD0 + 1 + 2 * n, x + b
     else:
         return 0.0
-    return flank_stiffness(PT, k, row, n, s, c) * deflection
+    stiffness = flank_stiffness(PT, k, row, n, s, c)
+    if stiffness < 0.0:  # the series' ringing below 0 where no pair is in contact (a gap)
+        stiffness = 0.0
+    return stiffness * deflection
 
 
 @nb.njit(inline="always", **_JIT)

@@ -132,7 +132,8 @@ class TrainModel(PlanetaryGearSet):
     """
 
     name = "TrainModel"
-    capabilities = Capabilities(physical_inputs=True, physical_axes=True, mesh_forces=True)
+    capabilities = Capabilities(physical_inputs=True, physical_axes=True, mesh_forces=True,
+                                natural_frequencies="Hz")
     raw_overrides: dict[str, float] = {}
     carrier_speed = None
     carrier_speed_ratio = None
