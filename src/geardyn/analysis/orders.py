@@ -16,8 +16,8 @@ import math
 import numpy as np
 import xarray as xr
 
-from geardyn.errors import ParameterError
 from geardyn.core.results import problems
+from geardyn.errors import ParameterError
 
 __all__ = ["order_spectrum", "waterfall"]
 
@@ -45,9 +45,10 @@ def _windows(n: int, size: int, overlap: float) -> np.ndarray:
     if not 0.0 <= overlap < 1.0:
         raise ParameterError("overlap", overlap, "must be in [0, 1)")
     if size < 8:
-        raise ParameterError("window", size, "must span at least 8 samples")
+        raise ParameterError("window", size, "must span at least 8 samples (got that many)")
     if size > n:
-        raise ParameterError("window", size, f"is longer than the run ({n} samples)")
+        raise ParameterError("window", size, f"is longer than the run ({n} samples; got "
+                             "that many)")
     hop = max(1, int(round(size * (1.0 - overlap))))
     return np.arange(0, n - size + 1, hop)
 
@@ -93,28 +94,29 @@ def _attrs(ds: xr.Dataset, output: str, what: str) -> dict:
     return out
 
 
-def waterfall(ds: xr.Dataset, output: str, *, periods: float = 16.0, overlap: float = 0.5
-              ) -> xr.Dataset:
+def waterfall(ds: xr.Dataset, output: str, *, window: float | None = None,
+              overlap: float = 0.5) -> xr.Dataset:
     """Short-time amplitude spectra of ``output`` along a run-up.
 
-    Windows of ``periods`` forcing periods at the run's lowest speed (Hann, ``overlap``
-    between windows). Returns a Dataset over (``window``, ``frequency``): ``amplitude``
-    [output units], ``frequency`` in Omega's units (rad per time unit: the order-k line is
-    ``k Omega``) and, where the run-up has them, ``frequency_hz`` [Hz]; per window its
-    centre ``time``, ``Omega`` (and ``input_speed`` [rpm]). Attributes carry the model's
-    ``natural_frequencies`` (Omega's units) and ``hz_per_omega``.
+    Windows of ``window`` time units (default: a 32nd of the run; Hann, ``overlap`` between
+    windows): the frequency resolution is 2 pi / window in Omega's units, and the speed
+    moves by rate x window within one. Returns a Dataset over (``window``, ``frequency``):
+    ``amplitude`` [output units], ``frequency`` in Omega's units (rad per time unit: the
+    order-k line is ``k Omega``) and, where the run-up has them, ``frequency_hz`` [Hz]; per
+    window its centre ``time``, ``Omega`` (and ``input_speed`` [rpm]). Attributes carry the
+    model's ``natural_frequencies`` (Omega's units) and ``hz_per_omega``.
     """
     x = _signal(ds, output)
     t = ds["time"].values
     if t.size < 2:
         raise ParameterError("ds", t.size, "a run-up of at least 2 samples")
     dt = float(t[1] - t[0])
-    wmin = float(np.min(np.abs(ds["Omega"].values)))
-    if not (isinstance(periods, int | float) and math.isfinite(periods) and periods > 0):
-        raise ParameterError("periods", periods, "must be a positive number")
-    if wmin <= 0.0:
-        wmin = float(np.max(np.abs(ds["Omega"].values))) / 10.0
-    size = int(math.ceil(periods * 2.0 * math.pi / wmin / dt))
+    if window is None:
+        window = (t[-1] - t[0]) / 32.0
+    if isinstance(window, bool) or not isinstance(window, int | float) \
+            or not math.isfinite(window) or window <= 0:
+        raise ParameterError("window", window, "must be a positive time")
+    size = int(math.ceil(window / dt))
     starts = _windows(x.size, size, overlap)
     idx = starts[:, None] + np.arange(size)[None, :]
     A = _amplitudes(x[idx])
@@ -139,7 +141,7 @@ def waterfall(ds: xr.Dataset, output: str, *, periods: float = 16.0, overlap: fl
 def order_spectrum(ds: xr.Dataset, output: str, *, cycles: int = 32,
                    samples_per_cycle: int = 32, overlap: float = 0.5) -> xr.Dataset:
     """Order tracking: ``output`` resampled at ``samples_per_cycle`` equal steps of the forcing
-    phase per forcing cycle (linear interpolation in the phase), then amplitude spectra of
+    phase per forcing cycle (a cubic spline in the phase), then amplitude spectra of
     windows of ``cycles`` cycles (Hann, ``overlap``). Orders are multiples of the forcing
     frequency (order 1: the mesh frequency), exact at every speed. Returns a Dataset over
     (``window``, ``order``): ``amplitude``; per window its centre ``time``, ``Omega``."""
@@ -153,8 +155,10 @@ def order_spectrum(ds: xr.Dataset, output: str, *, cycles: int = 32,
                              "never reaches 0)")
     sign = 1.0 if th[-1] > th[0] else -1.0
     grid = th[0] + sign * np.arange(0.0, abs(th[-1] - th[0]), 2.0 * math.pi / samples_per_cycle)
+    from scipy.interpolate import CubicSpline
+
     order_ = np.argsort(th)
-    xs = np.interp(grid, th[order_], x[order_])
+    xs = CubicSpline(th[order_], x[order_])(grid)
     size = cycles * samples_per_cycle
     starts = _windows(xs.size, size, overlap)
     A = _amplitudes(xs[starts[:, None] + np.arange(size)[None, :]])

@@ -15,7 +15,7 @@ One call is one lane (one speed range, one model): a labelled-data generator cal
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 from typing import Any
 
@@ -27,16 +27,18 @@ from geardyn.core.model import Model
 from geardyn.core.plan import default_steps_at
 from geardyn.core.results import finish
 from geardyn.core.settings import DEFAULT_BOUND
-from geardyn.core.status import status_meaning
+from geardyn.core.status import Status, status_meaning
 from geardyn.errors import ParameterError
 from geardyn.solvers.kernels import kernels_for
 
-__all__ = ["MIN_RUNUP_STEPS", "RunupSettings", "natural_frequencies", "runup",
+__all__ = ["MIN_RUNUP_STEPS", "PROGRESS_PIECES", "RunupSettings", "natural_frequencies", "runup",
            "speed_coefficients"]
 
 #: Fewest RK4 steps per forcing period at the highest speed (the split path rotates the phase
 #: by angle addition, exact in its small-angle form up to 2 pi / 8 per step).
 MIN_RUNUP_STEPS = 8
+#: Calls of the kernel a run-up with a progress callback is cut into.
+PROGRESS_PIECES = 50
 #: The integrator, as the datasets record it.
 INTEGRATOR = "RK4, fixed step; forcing phase = integral of the ramped Omega"
 #: Relative residual within which a coefficient counts as a quadratic in Omega.
@@ -228,7 +230,8 @@ def _outputs(model: Model, wanted: Sequence[str] | None) -> list[str]:
     return list(dict.fromkeys(wanted))
 
 
-def runup(model: Model, settings: RunupSettings, *, y0: np.ndarray | None = None) -> xr.Dataset:
+def runup(model: Model, settings: RunupSettings, *, y0: np.ndarray | None = None,
+          progress: Callable[[int, int], None] | None = None) -> xr.Dataset:
     """Integrate ``model`` through a run-up (or run-down) of its forcing frequency.
 
     The forcing frequency is ``settings.start`` for the ``transient`` (not recorded), then moves
@@ -237,14 +240,17 @@ def runup(model: Model, settings: RunupSettings, *, y0: np.ndarray | None = None
     n)``, ``n`` = ``steps_per_period`` at the highest speed (default: the model's step rule
     there), refined to divide the sample interval; backlash-edge crossings located inside
     steps (see :mod:`geardyn.solvers._runup_template`). Starts from ``y0`` (default the model's
-    initial state) at time 0.
+    initial state) at time 0. ``progress(done, total)`` (steps) is called as the run goes; the
+    run is then integrated in :data:`PROGRESS_PIECES` calls of the kernel (the same steps; a
+    piece starts without the previous grid values the graze screen keeps, so a rare graze may
+    be checked once more).
 
     Returns
     -------
     xarray.Dataset (kind ``"runup"``) over ``time`` (from the ramp's start): ``Omega`` (the
-    instantaneous forcing frequency), ``phase`` [rad], ``order_1_frequency`` [Hz] and
-    ``input_speed`` [rpm] where the model has physical axes, and one variable per output
-    (states, mesh forces); attributes: the settings, ``integrator``, ``step``,
+    instantaneous forcing frequency), ``phase`` [rad], the coordinates ``mesh_frequency``
+    [Hz] and ``input_speed`` [rpm] where the model has physical axes, and one variable per
+    output (states, mesh forces); attributes: the settings, ``integrator``, ``step``,
     ``steps_per_period`` (at the highest speed), ``status`` (:class:`~geardyn.Status`: 1 when
     the state left ``bound``; the rows after are NaN), ``unresolved_steps``, the model's
     natural frequencies (``natural_frequencies``, Omega's units) where it has them.
@@ -262,16 +268,41 @@ def runup(model: Model, settings: RunupSettings, *, y0: np.ndarray | None = None
                              f"({', '.join(model.state_names)})")
     k = kernels_for(model.kernel, "runup")
     p = np.ascontiguousarray(model.params, dtype=float).copy()
+    coef = np.ascontiguousarray(coef)
     t_on = n_tr * h
     t_off = t_on + s.ramp_duration
-    Y, O, W, TH, ncross, status, unresolved, done = k.runup_trajectory(
-        p, np.ascontiguousarray(y), h, n_tr, n_tr + n_ramp, stride, s.start, s.acceleration,
-        t_on, t_off, cols, np.ascontiguousarray(coef), s.locate_edges, s.bound,
-        model.n_events, model.n_observables)
-    t = (np.arange(W.size) * stride) * h
-    W = np.where(np.isfinite(W), W, np.minimum(s.start + s.acceleration * t, top))
-    return _dataset(model, s, outputs, t, W, TH, Y, O, h, stride, int(status),
-                    int(unresolved), int(done), ncross, top)
+    total = n_tr + n_ramp
+    pieces = 1 if progress is None else max(1, min(PROGRESS_PIECES, total // 1000))
+    bounds = np.linspace(0, total, pieces + 1).round().astype(np.int64)
+    parts: list[tuple] = []
+    ncross = np.zeros(model.n_events, np.int64)
+    status, unresolved, done = int(Status.OK), 0, 0
+    for c in range(pieces):
+        Y, O, W, TH, nc, st, un, dn, y = k.runup_trajectory(
+            p, np.ascontiguousarray(y), h, int(bounds[c]), int(bounds[c + 1]), n_tr, stride,
+            c == pieces - 1, s.start, s.acceleration, t_on, t_off, cols, coef, s.locate_edges,
+            s.bound, model.n_events, model.n_observables)
+        parts.append((Y, O, W, TH))
+        ncross += nc
+        unresolved += int(un)
+        done += int(dn)
+        status = int(st)
+        if progress is not None:
+            progress(int(bounds[c + 1]) if status == Status.OK else total, total)
+        if status != Status.OK:
+            break
+    Y, O, W, TH = (np.concatenate([q[j] for q in parts]) for j in range(4))
+    n_rec = n_ramp // stride + 1
+    if W.size < n_rec:  # the run diverged in an earlier piece: the rows after it are NaN
+        pad = n_rec - W.size
+        Y = np.vstack([Y, np.full((pad, Y.shape[1]), np.nan)])
+        O = np.vstack([O, np.full((pad, O.shape[1]), np.nan)])
+        W, TH = (np.concatenate([a, np.full(pad, np.nan)]) for a in (W, TH))
+    t = (np.arange(n_rec) * stride) * h
+    W = np.where(np.isfinite(W), W, np.clip(s.start + s.acceleration * t, min(s.start, s.stop),
+                                            top))
+    return _dataset(model, s, outputs, t, W, TH, Y, O, h, stride, status, unresolved, done,
+                    ncross, top)
 
 
 def _dataset(model: Model, s: RunupSettings, outputs: list[str], t: np.ndarray,

@@ -72,21 +72,24 @@ def set_speed(p, om, cols, coef):
 
 
 @nb.njit(**_JIT)
-def runup_trajectory(p0, y0, h, i0, n_steps, stride, start, accel, t_on, t_off, cols, coef,
-                     locate, bound, n_ev, n_obs):
-    """Integrate one lane from t = 0 over n_steps steps of h through the ramp, recording every
-    stride-th grid point from grid point i0 on.
+def runup_trajectory(p0, y0, h, i_begin, i_end, i0, stride, last, start, accel, t_on, t_off,
+                     cols, coef, locate, bound, n_ev, n_obs):
+    """Integrate one lane from grid point i_begin (time i_begin h, state y0) to i_end through
+    the ramp, recording every stride-th grid point counted from i0 (none before it; the point
+    i_end only if ``last``: a run cut into pieces records each point once).
 
     Returns (Y[n_rec, ns], O[n_rec, n_obs], W[n_rec] (Omega), TH[n_rec] (the phase),
-    ncross[n_ev], status, unresolved, steps_done); n_rec = (n_steps - i0) // stride + 1. Rows
-    after a divergence are NaN.
+    ncross[n_ev], status, unresolved, steps_done, y_end). Rows after a divergence are NaN.
     """
     ns = y0.size
     p = p0.copy()
     Y, Y1, K1, K2, K3, K4, TMP, TT, G, SIDE, work, ybuf, gbuf = _alloc(1, ns, n_ev)
     ACTIVE = np.ones(1, np.bool_)
     ncross = np.zeros(max(n_ev, 1), np.int64)
-    n_rec = (n_steps - i0) // stride + 1
+    first = max(i_begin, i0)
+    r0 = (first - i0 + stride - 1) // stride  # the first recorded point's number
+    stop_rec = i_end if last else i_end - 1
+    n_rec = max(0, (stop_rec - i0) // stride - r0 + 1) if stop_rec >= i0 else 0
     out_y = np.full((n_rec, ns), np.nan)
     out_o = np.full((n_rec, max(n_obs, 1)), np.nan)
     out_w = np.full(n_rec, np.nan)
@@ -101,23 +104,23 @@ def runup_trajectory(p0, y0, h, i0, n_steps, stride, start, accel, t_on, t_off, 
     tmp = TMP[0]
     for q in range(ns):
         y[q] = y0[q]
-    om, th = speed_phase(0.0, start, accel, t_on, t_off)
+    om, th = speed_phase(i_begin * h, start, accel, t_on, t_off)
     set_speed(p, om, cols, coef)
-    _events_i(0.0, y, G[0], p, math.sin(th), math.cos(th))
+    _events_i(i_begin * h, y, G[0], p, math.sin(th), math.cos(th))
     for j in range(n_ev):
         SIDE[0, j] = _side(G[0, j])
     status = STATUS_OK
     unresolved = 0
     done = 0
     hh = 0.5 * h
-    for i in range(n_steps + 1):
+    for i in range(i_begin, i_end + 1):
         t = i * h
         om, th = speed_phase(t, start, accel, t_on, t_off)
         sa = math.sin(th)
         ca = math.cos(th)
         set_speed(p, om, cols, coef)
-        if i >= i0 and (i - i0) % stride == 0:
-            r = (i - i0) // stride
+        if i >= i0 and (i - i0) % stride == 0 and i <= stop_rec:
+            r = (i - i0) // stride - r0
             for q in range(ns):
                 out_y[r, q] = y[q]
             out_w[r] = om
@@ -126,7 +129,7 @@ def runup_trajectory(p0, y0, h, i0, n_steps, stride, start, accel, t_on, t_off, 
                 _observe_i(t, y, obuf, p, sa, ca)
                 for q in range(n_obs):
                     out_o[r, q] = obuf[q]
-        if i == n_steps:
+        if i == i_end:
             break
         _rhs_i(t, y, k1, p, sa, ca)
         om_m, th_m = speed_phase(t + hh, start, accel, t_on, t_off)
@@ -168,8 +171,9 @@ def runup_trajectory(p0, y0, h, i0, n_steps, stride, start, accel, t_on, t_off, 
                         ncross[j] += 1
             for q in range(ns):
                 y[q] = y1[q]
-        done = i + 1
+        done = i + 1 - i_begin
         if not _healthy(y, bound):
             status = STATUS_DIVERGED
             break
-    return (out_y, out_o[:, :n_obs], out_w, out_th, ncross[:n_ev], status, unresolved, done)
+    return (out_y, out_o[:, :n_obs], out_w, out_th, ncross[:n_ev], status, unresolved, done,
+            y.copy())
