@@ -20,7 +20,9 @@ from geardyn.analysis.lyapunov import LyapunovEstimate, lyapunov, lyapunov_lanes
 from geardyn.analysis.map2d import map2d
 from geardyn.analysis.motion import motion_classes
 from geardyn.analysis.orbits import PeriodicOrbit, periodic_orbit
+from geardyn.analysis.orders import order_spectrum, waterfall
 from geardyn.analysis.periodicity import classify_period, common_section
+from geardyn.analysis.runup import RunupSettings, runup
 from geardyn.analysis.spectrum import amplitude_spectrum, label_peaks
 from geardyn.core.model import Model
 from geardyn.core.plan import default_steps_per_period
@@ -68,6 +70,7 @@ __all__ = [
     "PlanetaryGearSet",
     "PlanetaryParams",
     "RunSettings",
+    "RunupSettings",
     "SpurPair",
     "Status",
     "StudyError",
@@ -87,9 +90,12 @@ __all__ = [
     "lyapunov_lanes",
     "map2d",
     "motion_classes",
+    "order_spectrum",
     "periodic_orbit",
     "default_steps_per_period",
     "reference_solution",
+    "runup",
     "simulate",
     "testing",
+    "waterfall",
 ]

@@ -204,7 +204,9 @@ def natural_frequencies(model: Model) -> np.ndarray | None:
 
 
 def _grid(model: Model, s: RunupSettings) -> tuple[float, int, int, int]:
-    """(step h, transient steps, ramp steps, stride) of a run-up."""
+    """(step h, transient steps, ramp steps, stride) of a run-up: the ramp's steps a whole
+    number of sample intervals, so that the last sample is at the ramp's end or just after it
+    (at the stop speed)."""
     top = max(s.start, s.stop)
     n = s.steps_per_period or max(int(default_steps_at(model, np.array([top]))[0]),
                                   MIN_RUNUP_STEPS)
@@ -215,7 +217,7 @@ def _grid(model: Model, s: RunupSettings) -> tuple[float, int, int, int]:
         stride = max(1, math.ceil(dt / h * (1.0 - 1e-12)))
         h = dt / stride
     n_tr = math.ceil(s.transient / h * (1.0 - 1e-12)) if s.transient > 0 else 0
-    n_ramp = math.ceil(s.ramp_duration / h * (1.0 - 1e-12))
+    n_ramp = stride * math.ceil(s.ramp_duration / (h * stride) * (1.0 - 1e-12))
     return h, n_tr, n_ramp, stride
 
 
@@ -335,7 +337,9 @@ def _dataset(model: Model, s: RunupSettings, outputs: list[str], t: np.ndarray,
     ds.attrs.update(
         model=model.name, start=s.start, stop=s.stop, rate=abs(s.acceleration),
         acceleration=s.acceleration, ramp_duration=s.ramp_duration, transient=s.transient,
-        sample_interval=stride * h, outputs=",".join(outputs), integrator=INTEGRATOR,
+        sample_interval=stride * h, outputs=",".join(outputs),
+        observables=",".join(o for o in outputs if o in model.observable_names),
+        integrator=INTEGRATOR,
         step=h, steps_per_period=int(round(2.0 * math.pi / (top * h))),
         step_rule="fixed step: steps_per_period RK4 steps per forcing period at the highest "
                   "speed, refined to divide the sample interval",
@@ -349,7 +353,7 @@ def _dataset(model: Model, s: RunupSettings, outputs: list[str], t: np.ndarray,
 
 
 def _omega_units(model: Model) -> str:
-    return "rad/s" if model.time_unit == "s" else f"rad per time unit ({model.time_unit})"
+    return "rad/s" if model.time_unit == "s" else "1"
 
 
 def _state_units(model: Model) -> list[str]:

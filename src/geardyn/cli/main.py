@@ -15,6 +15,7 @@
     geardyn continue STUDY.toml --param Omega --range 0.5:4 [--period K] [--switch]
                      [--over bifurcation.nc] [--out branch.nc] [--plot branch.png]
     geardyn stiffness STUDY.toml [-o stiffness.nc] [--plot] [--figure stiffness.png] [--yes]
+    geardyn runup STUDY.toml [--start A --stop B --rate R] [--out runup.nc] [--plot wf.png]
 
 A STUDY argument is a TOML file or the name of a built-in study (``paper_fig3``). Every expected
 error (bad parameters, missing files, invalid TOML, bad values) and every usage error ends the
@@ -379,6 +380,7 @@ __import__("geardyn.cli.continuation", fromlist=["register"]).register(app)  # c
 __import__("geardyn.cli.explore", fromlist=["register"]).register(app)  # cli/explore.py
 __import__("geardyn.cli.stiffness", fromlist=["register"]).register(app)  # cli/stiffness.py
 __import__("geardyn.cli.modes", fromlist=["register"]).register(app)  # cli/modes.py
+__import__("geardyn.cli.runup", fromlist=["register"]).register(app)  # cli/runup.py
 
 if __name__ == "__main__":
     main()

@@ -25,6 +25,8 @@ A *study file* holds the device parameters plus run settings::
     # max_period, period_tol, max_section_periods: as geardyn.RunSettings
     [sweep]                         # optional: param, start, stop, num, continuation,
                                     # samples, lyapunov (see SweepSettings)
+    [runup]                         # optional: geardyn runup's ramp: param, start, stop,
+                                    # rate or duration, sample_rate, outputs (RunupTable)
 
 A spur pair for the potential-energy mesh stiffness (``geardyn stiffness``), with or instead
 of ``[params]``::
@@ -152,6 +154,7 @@ from geardyn.gears.potential_energy import (
 from geardyn.gears.tip_relief import TipRelief, relief_gap
 from geardyn.io._tables import build_from_fields as _build_from_fields
 from geardyn.io._tables import study_error as _study_error
+from geardyn.io.runup_table import RunupTable
 from geardyn.io.train_table import TrainTable
 from geardyn.models.gear_pair_coefficients import GEAR_PAIR
 from geardyn.models.params import PAPER_NAMES, Angle, Length, PlanetaryParams, Real, Whole
@@ -971,6 +974,7 @@ class Study(BaseModel):
     relief: Annotated[list[ReliefTable], BeforeValidator(_one_or_many)] | None = None
     crowning: Annotated[list[CrowningTable], BeforeValidator(_one_or_many)] | None = None
     train: TrainTable | None = None
+    runup: RunupTable | None = None
 
     _planetary: PlanetaryParams | None = PrivateAttr(None)
     _train: Any = PrivateAttr(None)
@@ -1299,7 +1303,7 @@ def _read_toml(source: str | os.PathLike[str]) -> tuple[dict[str, Any], str]:
 
 
 _STUDY_KEYS = {"study", "params", "run", "sweep", "gears", "faults", "stiffness", "relief",
-               "crowning", "train"}
+               "crowning", "train", "runup"}
 
 
 def load_params(path_or_text: str | os.PathLike[str]) -> PlanetaryParams:
