@@ -36,6 +36,8 @@ def _synthetic(start: float = 1.0, stop: float = 3.0, duration: float = 4000.0,
         ds = ds.assign_coords(mesh_frequency=("time", omega * hz_per_omega, {"units": "Hz"}),
                               input_speed=("time", omega * hz_per_omega * 60.0 / 20.0,
                                            {"units": "rpm"}))
+    if hz_per_omega is not None:
+        ds.attrs["hz_per_rad"] = hz_per_omega
     ds.attrs.update(status=0, status_meaning=status_meaning(), integrator="synthetic",
                     step=1.0 / fs, steps_per_period=1, time_unit="1", start=start, stop=stop,
                     rate=a, outputs="x", natural_frequencies=np.array([4.0]))
@@ -75,7 +77,7 @@ def test_waterfall_peaks_on_the_order_lines():
             # the speed moves by rate x window = 0.1 within a window: the line smears over
             # k * 0.1 / df bins, so the peak reads less than the amplitude
             assert 0.2 * amp < A[i, j] <= 1.01 * amp
-    assert wf.attrs["hz_per_omega"] == pytest.approx(50.0)
+    assert wf.attrs["hz_per_rad"] == pytest.approx(50.0)
     np.testing.assert_allclose(wf["frequency_hz"].values, f * 50.0)
     assert "input_speed" in wf.coords and list(wf.attrs["natural_frequencies"]) == [4.0]
 

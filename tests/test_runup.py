@@ -247,3 +247,21 @@ def test_progress_cuts_the_run_into_pieces_with_the_same_result():
     assert whole.sizes == pieces.sizes
     np.testing.assert_allclose(pieces["x"].values, whole["x"].values, rtol=0, atol=1e-9)
     assert int(pieces["edge_crossings"].sum()) == int(whole["edge_crossings"].sum())
+
+
+def test_frequency_scale_of_a_physical_pair_and_a_planetary_set():
+    """The spur pair's Omega is the pinion's rotation [rad/s]: 1 / (2 pi) Hz per rad/s, the
+    mesh 19 (the pinion's teeth) times faster; the planetary set's Omega is the dimensionless
+    mesh frequency, tau = omega_0 t: omega_0 / (2 pi) Hz per unit."""
+    from geardyn.analysis.runup import frequency_scale
+    from geardyn.io import builtin_study
+
+    pair = geardyn.build_model(builtin_study("spur_pair_cracked"))
+    hz, order = frequency_scale(pair)
+    assert hz == pytest.approx(1.0 / (2.0 * math.pi), rel=1e-15)
+    assert order == pytest.approx(pair.dataset_attrs()["mesh_cycles_per_period"], rel=1e-12)
+    assert order == pytest.approx(19.0, rel=1e-12)
+    gs = geardyn.build_model(builtin_study("planetary_example"))
+    hz, order = frequency_scale(gs)
+    assert order == 1.0 and hz == pytest.approx(gs.time_scale / (2.0 * math.pi), rel=1e-12)
+    assert frequency_scale(_linear_pair()) == (None, 1.0)

@@ -2,11 +2,12 @@
 and the order spectrum (order tracking: the signal resampled on the forcing phase).
 
 Both read a :func:`geardyn.analysis.runup.runup` dataset (kind ``"runup"``). Frequencies are
-in the units of the model's Omega (rad per time unit), so that the mesh orders are the rays
-``k Omega`` and the natural frequencies (``attrs["natural_frequencies"]``) horizontal lines;
-where the run-up has physical axes (``mesh_frequency`` [Hz], ``input_speed`` [rpm]) the
-waterfall carries them too. Amplitudes are single-sided sine amplitudes (a Hann window,
-amplitude-corrected: a steady sine of amplitude A in one bin reads A).
+in the units of the model's Omega (rad per time unit), so that the orders are the rays
+``k Omega`` (the mesh frequency is ``attrs["mesh_order"]`` Omega) and the natural
+frequencies (``attrs["natural_frequencies"]``) horizontal lines; where the run-up has physical
+axes (``hz_per_rad``, ``input_speed`` [rpm]) the waterfall carries them too. Amplitudes are
+single-sided sine amplitudes (a Hann window, amplitude-corrected: a steady sine of amplitude A
+in one bin reads A).
 """
 
 from __future__ import annotations
@@ -73,24 +74,15 @@ def _speed_coords(ds: xr.Dataset, omega: np.ndarray, t: np.ndarray) -> dict:
     return coords
 
 
-def _hz_per_omega(ds: xr.Dataset) -> float | None:
-    """Hz of one unit of Omega, where the run-up has the physical mesh frequency."""
-    if "mesh_frequency" not in ds.coords:
-        return None
-    w = ds["Omega"].values
-    k = int(np.argmax(np.abs(w)))
-    return float(ds["mesh_frequency"].values[k] / w[k]) if w[k] != 0 else None
-
-
 def _attrs(ds: xr.Dataset, output: str, what: str) -> dict:
     out = {"output": output, "analysis": what, "model": ds.attrs.get("model", ""),
            "omega_units": ds.attrs.get("omega_units", ""),
            "output_units": ds[output].attrs.get("units", "")}
     if "natural_frequencies" in ds.attrs:
         out["natural_frequencies"] = np.atleast_1d(ds.attrs["natural_frequencies"])
-    hz = _hz_per_omega(ds)
-    if hz is not None:
-        out["hz_per_omega"] = hz
+    out["mesh_order"] = float(ds.attrs.get("mesh_order", 1.0))
+    if "hz_per_rad" in ds.attrs:
+        out["hz_per_rad"] = float(ds.attrs["hz_per_rad"])
     return out
 
 
@@ -104,7 +96,7 @@ def waterfall(ds: xr.Dataset, output: str, *, window: float | None = None,
     ``amplitude`` [output units], ``frequency`` in Omega's units (rad per time unit: the
     order-k line is ``k Omega``) and, where the run-up has them, ``frequency_hz`` [Hz]; per
     window its centre ``time``, ``Omega`` (and ``input_speed`` [rpm]). Attributes carry the
-    model's ``natural_frequencies`` (Omega's units) and ``hz_per_omega``.
+    model's ``natural_frequencies`` (Omega's units), ``mesh_order`` and ``hz_per_rad``.
     """
     x = _signal(ds, output)
     t = ds["time"].values
@@ -125,7 +117,7 @@ def waterfall(ds: xr.Dataset, output: str, *, window: float | None = None,
     coords = _speed_coords(ds, ds["Omega"].values[centre], t[centre])
     coords["frequency"] = ("frequency", freq, {"units": ds["Omega"].attrs.get("units", ""),
                                                "long_name": "angular frequency"})
-    hz = _hz_per_omega(ds)
+    hz = ds.attrs.get("hz_per_rad")
     if hz is not None:
         coords["frequency_hz"] = ("frequency", freq * hz, {"units": "Hz",
                                                            "long_name": "frequency"})

@@ -31,8 +31,8 @@ from geardyn.core.status import Status, status_meaning
 from geardyn.errors import ParameterError
 from geardyn.solvers.kernels import kernels_for
 
-__all__ = ["MIN_RUNUP_STEPS", "PROGRESS_PIECES", "RunupSettings", "natural_frequencies", "runup",
-           "speed_coefficients"]
+__all__ = ["MIN_RUNUP_STEPS", "PROGRESS_PIECES", "RunupSettings", "frequency_scale",
+           "natural_frequencies", "runup", "speed_coefficients"]
 
 #: Fewest RK4 steps per forcing period at the highest speed (the split path rotates the phase
 #: by angle addition, exact in its small-angle form up to 2 pi / 8 per step).
@@ -203,6 +203,21 @@ def natural_frequencies(model: Model) -> np.ndarray | None:
     return f if f.size else None
 
 
+def frequency_scale(model: Model) -> tuple[float | None, float]:
+    """(Hz of one rad per model time unit, or None without physical axes; the mesh order: the
+    mesh frequency over the forcing frequency Omega). A model in seconds (the SI spur pair,
+    whose Omega is a gear's rotation, its mesh ``cycles`` times faster) gives 1 / (2 pi) and
+    its mesh order; a dimensionless one whose Omega is the mesh frequency (CATT device,
+    planetary set) the physical mesh frequency per unit Omega and 1."""
+    axes = physical_axes(model, np.array([1.0]))
+    if not axes or "mesh_frequency" not in axes:
+        return None, 1.0
+    f_mesh = float(np.asarray(axes["mesh_frequency"][0])[0])  # Hz at Omega = 1
+    if model.time_unit == "s":
+        return 1.0 / (2.0 * math.pi), f_mesh * 2.0 * math.pi
+    return f_mesh, 1.0
+
+
 def _grid(model: Model, s: RunupSettings) -> tuple[float, int, int, int]:
     """(step h, transient steps, ramp steps, stride) of a run-up: the ramp's steps a whole
     number of sample intervals, so that the last sample is at the ramp's end or just after it
@@ -255,7 +270,9 @@ def runup(model: Model, settings: RunupSettings, *, y0: np.ndarray | None = None
     output (states, mesh forces); attributes: the settings, ``integrator``, ``step``,
     ``steps_per_period`` (at the highest speed), ``status`` (:class:`~geardyn.Status`: 1 when
     the state left ``bound``; the rows after are NaN), ``unresolved_steps``, the model's
-    natural frequencies (``natural_frequencies``, Omega's units) where it has them.
+    natural frequencies (``natural_frequencies``, Omega's units) where it has them,
+    ``mesh_order`` (the mesh frequency over Omega) and ``hz_per_rad`` (Hz of one rad per time
+    unit, :func:`frequency_scale`) where it has physical axes.
     """
     if not isinstance(settings, RunupSettings):
         raise TypeError(f"settings must be a RunupSettings (got {type(settings).__name__})")
@@ -348,6 +365,10 @@ def _dataset(model: Model, s: RunupSettings, outputs: list[str], t: np.ndarray,
         time_unit=model.time_unit, omega_units=_omega_units(model))
     if nat is not None:
         ds.attrs["natural_frequencies"] = nat
+    hz, mesh_order = frequency_scale(model)
+    ds.attrs["mesh_order"] = mesh_order
+    if hz is not None:
+        ds.attrs["hz_per_rad"] = hz
     ds.attrs.update(model.dataset_attrs())
     return finish(ds, "runup")
 

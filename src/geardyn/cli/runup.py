@@ -11,7 +11,8 @@
 Unset options come from the study's ``[runup]`` table (:class:`geardyn.io.runup_table.
 RunupTable`); ``--start`` and ``--stop`` are in ``--param``'s units (rpm for ``input_speed``),
 ``--rate`` in them per model time unit. Without a sample rate the run is sampled fast enough
-for the drawn harmonics (4 samples per period of order ``harmonics + 1`` at the top speed).
+for the drawn harmonics (4 samples per period of mesh harmonic ``harmonics + 1`` at the top
+speed).
 A progress bar is drawn when stderr is a terminal.
 """
 
@@ -83,7 +84,7 @@ def runup_command(
     writes the time history (NetCDF) and its waterfall with the mesh orders and natural
     frequencies (Campbell-style figure)."""
     from geardyn.analysis.orders import order_spectrum, waterfall
-    from geardyn.analysis.runup import runup
+    from geardyn.analysis.runup import frequency_scale, runup
     from geardyn.cli.bifurcation import _progress_bar, _stderr_is_terminal
 
     s = load_study_source(study)
@@ -120,7 +121,8 @@ def runup_command(
     fs = pick(sample_rate, "sample_rate")
     top = max(a, b) * per
     if fs is None:
-        fs = SAMPLES_PER_TOP_PERIOD * (n_harm + 1) * top / (2.0 * math.pi)
+        fs = SAMPLES_PER_TOP_PERIOD * (n_harm + 1) * frequency_scale(model)[1] * top / (
+            2.0 * math.pi)
     settings = _settings(
         start=a * per, stop=b * per,
         rate=None if ramp_rate is None else _number("--rate", ramp_rate) * per,
@@ -153,7 +155,8 @@ def runup_command(
     if order_map is not None:
         from geardyn.plotting.orders import plot_order_map
 
-        plot_order_map(order_spectrum(ds, plotted), max_order=n_harm + 0.5, path=order_map)
+        plot_order_map(order_spectrum(ds, plotted), path=order_map,
+                       max_order=(n_harm + 0.5) * ds.attrs["mesh_order"])
         wrote += f", {order_map}" if "wrote" in wrote else f"; wrote {order_map}"
     state = f"diverged at t = {_diverged_at(ds):.6g}, no figure" if diverged else "ok"
     typer.echo(f"{s.study.name}: run-up of {name} {a:g} -> {b:g} (Omega {settings.start:.6g}"

@@ -59,10 +59,11 @@ def plot_waterfall(wf: xr.Dataset, run: xr.Dataset | None = None, *, harmonics: 
                          "geardyn.analysis.orders.waterfall)")
     output = wf.attrs.get("output", "output")
     speed, xlabel, per_omega = _speed_axis(wf)
-    hz = wf.attrs.get("hz_per_omega")
+    hz = wf.attrs.get("hz_per_rad")
     yscale = float(hz) if hz is not None else 1.0
     ylabel = "frequency [Hz]" if hz is not None else \
         f"frequency [{wf['frequency'].attrs.get('units', '')}]"
+    m = float(wf.attrs.get("mesh_order", 1.0))
     freq = wf["frequency"].values * yscale
     A = wf["amplitude"].values
     order = np.argsort(speed)
@@ -70,7 +71,7 @@ def plot_waterfall(wf: xr.Dataset, run: xr.Dataset | None = None, *, harmonics: 
         fig = Figure(figsize=(7.2, 6.4 if run is not None else 4.8), layout="constrained")
         if run is not None:
             top, ax = fig.subplots(2, 1, height_ratios=(1, 2.4), sharex=True)
-            _output_panel(top, run, output, per_omega)
+            _output_panel(top, run, output)
         else:
             ax = fig.subplots()
         lo, hi = _colour_limits(A)
@@ -80,30 +81,39 @@ def plot_waterfall(wf: xr.Dataset, run: xr.Dataset | None = None, *, harmonics: 
         fig.colorbar(mesh, ax=ax, label=f"amplitude of {output} "
                      f"[{wf['amplitude'].attrs.get('units', '')}]")
         s_lo, s_hi = float(speed.min()), float(speed.max())
-        f_top = min(float(freq.max()), (harmonics + 1) * s_hi / per_omega * yscale)
+
+        def ray(k: float, s_: np.ndarray | float) -> np.ndarray | float:
+            """Frequency (axis units) of order k of Omega at speed s_ (axis units)."""
+            return k * np.asarray(s_) / per_omega * yscale
+
+        f_top = min(float(freq.max()), float(ray((harmonics + 1) * m, s_hi)))
         ss = np.array([s_lo, s_hi])
+        if m != 1.0:  # Omega is a shaft's rotation: its own order, thin
+            ax.plot(ss, ray(1.0, ss), color="w", lw=0.5, ls=":", alpha=0.8)
         for k in range(1, harmonics + 1):
-            ax.plot(ss, k * ss / per_omega * yscale, color="w", lw=0.9,
-                    ls="-" if k == 1 else "--", alpha=0.9)
-            y_end = k * s_hi / per_omega * yscale
-            if y_end <= f_top:
-                ax.annotate(f"{k}×", (s_hi, y_end), color="w", fontsize=7,
-                            xytext=(-12, 2), textcoords="offset points")
+            ax.plot(ss, ray(k * m, ss), color="w", lw=0.9, ls="-" if k == 1 else "--",
+                    alpha=0.9)
+            label = f"{k}×" if m == 1.0 else f"{k}× mesh"
+            if ray(k * m, s_hi) <= f_top:
+                ax.annotate(label, (s_hi, ray(k * m, s_hi)), color="w", fontsize=7,
+                            xytext=(-12 if m == 1.0 else -36, 2), textcoords="offset points")
             else:
-                ax.annotate(f"{k}×", (f_top * per_omega / (k * yscale), f_top), color="w",
+                ax.annotate(label, (f_top * per_omega / (k * m * yscale), f_top), color="w",
                             fontsize=7, xytext=(2, -10), textcoords="offset points")
         nat = np.atleast_1d(wf.attrs.get("natural_frequencies", np.array([])))
         nat = nat[nat * yscale <= f_top]
         for j, f in enumerate(nat):
             ax.axhline(f * yscale, color="#ff7f0e", lw=0.9, ls=":",
                        label="natural frequency (linear)" if j == 0 else None)
-            for k in range(1, harmonics + 1):  # ray k crosses it at speed f / k
-                s_x = f / k * per_omega
+            for k in range(1, harmonics + 1):  # mesh harmonic k crosses it at speed f / (k m)
+                s_x = f / (k * m) * per_omega
                 if s_lo <= s_x <= s_hi:
                     ax.plot(s_x, f * yscale, "o", ms=5, mfc="none", color="#ff7f0e")
+        what = "of the forcing frequency Omega" if m == 1.0 else \
+            f"of the mesh frequency, {m:g} Omega; dotted: Omega"
         ax.set(xlim=(s_lo, s_hi), ylim=(0.0, f_top), xlabel=xlabel, ylabel=ylabel,
-               title=f"{wf.attrs.get('model', '')} run-up: waterfall of {output} "
-                     f"(white: orders 1–{harmonics} of the mesh frequency)")
+               title=f"{wf.attrs.get('model', '')} run-up: waterfall of {output}\n"
+                     f"(white: harmonics 1–{harmonics} {what})")
         ax.grid(False)
         if nat.size:
             ax.legend(loc="upper left", fontsize="small")
@@ -112,22 +122,20 @@ def plot_waterfall(wf: xr.Dataset, run: xr.Dataset | None = None, *, harmonics: 
     return fig
 
 
-def _output_panel(ax, run: xr.Dataset, output: str, per_omega: float) -> None:
+def _output_panel(ax, run: xr.Dataset, output: str) -> None:
     w = run["Omega"].values
     speed = run["input_speed"].values if "input_speed" in run.coords else w
     ax.plot(speed, run[output].values, lw=0.3, color="k")
     ax.set(ylabel=f"{output} [{run[output].attrs.get('units', '')}]",
            title=f"{output} through the run-up (rate {run.attrs.get('rate', float('nan')):.3g} "
                  f"per time unit)")
-    if "mesh_frequency" in run.coords and per_omega != 1.0:
-        ax.set_xlabel("")
 
 
 def plot_order_map(spec: xr.Dataset, *, max_order: float | None = None,
                    path: str | os.PathLike | None = None):
     """Figure of a :func:`geardyn.analysis.orders.order_spectrum`: amplitude (log colour)
-    against speed and order, the whole orders marked. Saved to ``path`` when given; returns
-    a matplotlib Figure."""
+    against speed and order, the harmonics of the mesh frequency (``mesh_order``) marked.
+    Saved to ``path`` when given; returns a matplotlib Figure."""
     import matplotlib
     from matplotlib.colors import LogNorm
     from matplotlib.figure import Figure
@@ -150,9 +158,10 @@ def plot_order_map(spec: xr.Dataset, *, max_order: float | None = None,
                              rasterized=True)
         fig.colorbar(mesh, ax=ax, label=f"amplitude of {spec.attrs.get('output', '')} "
                      f"[{spec['amplitude'].attrs.get('units', '')}]")
-        for k in range(1, int(top) + 1):
-            ax.axvline(k, color="w", lw=0.5, alpha=0.5)
-        ax.set(xlim=(0.0, top), xlabel="order (multiples of the mesh frequency)",
+        m = float(spec.attrs.get("mesh_order", 1.0))
+        for k in range(1, int(top / m) + 1):
+            ax.axvline(k * m, color="w", lw=0.5, alpha=0.5)
+        ax.set(xlim=(0.0, top), xlabel="order (multiples of Omega; white: mesh harmonics)",
                ylabel=xlabel, title=f"{spec.attrs.get('model', '')} run-up: order map of "
                                     f"{spec.attrs.get('output', '')}")
         ax.grid(False)
