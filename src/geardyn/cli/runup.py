@@ -65,7 +65,7 @@ def runup_command(
     outputs: Annotated[str | None, typer.Option(help="Comma-separated states and observables "
                                                      "recorded (default: all).")] = None,
     steps_per_period: Annotated[int | None, typer.Option(
-        help="RK4 steps per forcing period at the highest speed (default: the step rule).")
+        help="RK4 steps in one forcing period of the top speed (default: the step rule).")
     ] = None,
     output: Annotated[str | None, typer.Option(help="The output the waterfall analyses "
                                                     "(default: the first mesh force, else "
