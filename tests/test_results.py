@@ -148,9 +148,22 @@ def _frc() -> xr.Dataset:
     return ds
 
 
+def _runup() -> xr.Dataset:
+    t = np.arange(4.0)
+    ds = xr.Dataset(coords={"time": ("time", t, {"units": "tau"})})
+    ds["Omega"] = ("time", 0.5 + 0.1 * t)
+    ds["phase"] = ("time", 0.5 * t + 0.05 * t * t, {"units": "rad"})
+    ds["x"] = ("time", np.zeros(4))
+    ds.attrs.update(geardyn_kind="runup", status=0, status_meaning="0 ok",
+                    integrator="RK4", step=0.25, steps_per_period=64, time_unit="tau",
+                    start=0.5, stop=0.8, rate=0.1, outputs="x")
+    return ds
+
+
 BUILD = {"simulation": _simulation, "bifurcation": _sweep, "map2d": _map,
          "reproduction-case": _case, "periodic-orbit": _orbit, "continuation": _branch,
-         "basins": _basins, "frequency-response": _frc, "curve": _curve}
+         "basins": _basins, "frequency-response": _frc, "curve": _curve,
+         "runup": _runup}
 
 
 @pytest.mark.parametrize("kind", KINDS)
@@ -165,7 +178,8 @@ def test_well_formed_results_pass(kind):
                                        ("continuation", "bifurcation_value"),
                                        ("curve", "special_error"),
                                        ("basins", "attractor_id"),
-                                       ("frequency-response", "dte_rms")])
+                                       ("frequency-response", "dte_rms"),
+                                       ("runup", "phase")])
 def test_a_removed_variable_is_named(kind, name):
     ds = BUILD[kind]().drop_vars(name)
     with pytest.raises(AssertionError, match=f"'{name}' missing"):

@@ -24,7 +24,9 @@ from geardyn.analysis.lyapunov import LyapunovEstimate, lyapunov, lyapunov_lanes
 from geardyn.analysis.map2d import map2d
 from geardyn.analysis.motion import motion_classes
 from geardyn.analysis.orbits import PeriodicOrbit, periodic_orbit
+from geardyn.analysis.orders import order_spectrum, waterfall
 from geardyn.analysis.periodicity import classify_period, common_section
+from geardyn.analysis.runup import RunupSettings, runup
 from geardyn.analysis.sensor import planetary_sensor_signal, sensor_signal, sensor_spectrum
 from geardyn.analysis.spectrum import amplitude_spectrum, label_peaks
 from geardyn.core.model import Model
@@ -75,6 +77,7 @@ __all__ = [
     "PlanetaryGearSet",
     "PlanetaryParams",
     "RunSettings",
+    "RunupSettings",
     "SpurPair",
     "Status",
     "StudyError",
@@ -97,6 +100,7 @@ __all__ = [
     "lyapunov_lanes",
     "map2d",
     "motion_classes",
+    "order_spectrum",
     "periodic_orbit",
     "planetary_sensor_signal",
     "default_steps_per_period",
@@ -106,6 +110,8 @@ __all__ = [
     "reference_solution",
     "sensor_signal",
     "sensor_spectrum",
+    "runup",
     "simulate",
     "testing",
+    "waterfall",
 ]

@@ -348,7 +348,8 @@ def bifurcation_command(
 #: What ``geardyn plot`` calls each result kind (``attrs["geardyn_kind"]``).
 _PLOT_KIND = {"simulation": "simulation", "bifurcation": "bifurcation", "map2d": "map",
               "reproduction-case": "reproduction", "basins": "basins",
-              "frequency-response": "frequency response", "continuation": "continuation"}
+              "frequency-response": "frequency response", "continuation": "continuation",
+              "runup": "run-up"}
 
 
 def _dataset_kind(ds) -> str:
@@ -411,8 +412,8 @@ def _load_result(result: Path):
 def plot_command(
     result: Annotated[Path, typer.Argument(help="A NetCDF file written by geardyn simulate, "
                                                 "bifurcation, map, reproduce, basins, frc, "
-                                                "continue or stiffness, or a map's .zarr "
-                                                "store.")],
+                                                "continue, stiffness or runup, or a map's "
+                                                ".zarr store.")],
     out: Annotated[
         Path | None, typer.Option(help="Figure to write, .png, .pdf or .svg (default: RESULT "
                                        "with .png).")
@@ -456,6 +457,17 @@ def plot_command(
 
             plot_frc(ds, path=target)
         typer.echo(f"{result}: {kind} dataset; wrote {target}")
+        return
+    if kind == "run-up":
+        from geardyn.analysis.orders import waterfall
+        from geardyn.plotting.orders import plot_waterfall
+
+        recorded = ds.attrs["outputs"].split(",")
+        forces = [o for o in ds.attrs.get("observables", "").split(",") if o]
+        shown = _check_state(recorded, state or (forces or recorded)[0], "--state")
+        make_parents(target)
+        plot_waterfall(waterfall(ds, shown), ds, path=target)
+        typer.echo(f"{result}: run-up dataset ({shown}); wrote {target}")
         return
     if kind == "continuation":
         from geardyn.plotting.branch import plot_branch

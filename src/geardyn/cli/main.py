@@ -17,6 +17,7 @@
     geardyn stiffness STUDY.toml [-o stiffness.nc] [--plot] [--figure stiffness.png] [--yes]
     geardyn dynamic-factor STUDY.toml --f-pb UM --f-falpha UM [--range 2000:44000:85]
                      [--torque T ...] [--out df.nc] [--plot df.png]
+    geardyn runup STUDY.toml [--start A --stop B --rate R] [--out runup.nc] [--plot wf.png]
 
 A STUDY argument is a TOML file or the name of a built-in study (``paper_fig3``). Every expected
 error (bad parameters, missing files, invalid TOML, bad values) and every usage error ends the
@@ -383,6 +384,7 @@ __import__("geardyn.cli.stiffness", fromlist=["register"]).register(app)  # cli/
 __import__("geardyn.cli.modes", fromlist=["register"]).register(app)  # cli/modes.py
 __import__("geardyn.cli.dynamic_factor", fromlist=["register"]).register(app)  # dynamic-factor
 __import__("geardyn.cli.envelope", fromlist=["register"]).register(app)  # cli/envelope.py
+__import__("geardyn.cli.runup", fromlist=["register"]).register(app)  # cli/runup.py
 
 if __name__ == "__main__":
     main()

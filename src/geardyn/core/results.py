@@ -141,6 +141,12 @@ SCHEMAS: dict[str, ResultSchema] = {s.kind: s for s in (
         {"dte_rms": (*_FRC, "mesh"), "dte_peak": (*_FRC, "mesh"), "dte_mean": (*_FRC, "mesh"),
          "period": _FRC, "status": _FRC, "hysteresis": ("Omega",), "jump_omega": ("jump",),
          "jump_sweep": ("jump",)}, ("status",)),
+    ResultSchema(
+        "runup",
+        ("status", "status_meaning", "integrator", "step", "steps_per_period", "time_unit",
+         "start", "stop", "rate", "outputs"),
+        {"time": ("time",)}, {"Omega": ("time",), "phase": ("time",)},
+        status_attrs=("status",)),
 )}
 
 #: The kinds of result, as recorded in ``attrs["geardyn_kind"]``.

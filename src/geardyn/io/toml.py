@@ -27,6 +27,8 @@ A *study file* holds the device parameters plus run settings::
                                     # samples, lyapunov (see SweepSettings)
     [envelope]                      # optional: geardyn envelope's plane, box, flanks, ...
                                     # (see geardyn.io.envelope_table)
+    [runup]                         # optional: geardyn runup's ramp: param, start, stop,
+                                    # rate or duration, sample_rate, outputs (RunupTable)
 
 A spur pair for the potential-energy mesh stiffness (``geardyn stiffness``), with or instead
 of ``[params]``::
@@ -155,6 +157,7 @@ from geardyn.gears.tip_relief import TipRelief, relief_gap
 from geardyn.io._tables import build_from_fields as _build_from_fields
 from geardyn.io._tables import study_error as _study_error
 from geardyn.io.envelope_table import EnvelopeTable
+from geardyn.io.runup_table import RunupTable
 from geardyn.io.train_table import TrainTable
 from geardyn.models.gear_pair_coefficients import GEAR_PAIR
 from geardyn.models.params import PAPER_NAMES, Angle, Length, PlanetaryParams, Real, Whole
@@ -975,6 +978,7 @@ class Study(BaseModel):
     crowning: Annotated[list[CrowningTable], BeforeValidator(_one_or_many)] | None = None
     train: TrainTable | None = None
     envelope: EnvelopeTable | None = None
+    runup: RunupTable | None = None
 
     _planetary: PlanetaryParams | None = PrivateAttr(None)
     _train: Any = PrivateAttr(None)
@@ -1303,7 +1307,7 @@ def _read_toml(source: str | os.PathLike[str]) -> tuple[dict[str, Any], str]:
 
 
 _STUDY_KEYS = {"study", "params", "run", "sweep", "gears", "faults", "stiffness", "relief",
-               "crowning", "train", "envelope"}
+               "crowning", "train", "envelope", "runup"}
 
 
 def load_params(path_or_text: str | os.PathLike[str]) -> PlanetaryParams:

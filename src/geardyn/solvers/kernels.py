@@ -162,6 +162,7 @@ TEMPLATES: dict[str, str] = {
     "rk4": "geardyn.solvers._kernel_template",
     "lyapunov": "geardyn.solvers._lyapunov_template",
     "monodromy": "geardyn.solvers._monodromy_template",
+    "runup": "geardyn.solvers._runup_template",
 }
 
 
