@@ -27,6 +27,11 @@ def test_writes_the_sweep_and_its_figure(capsys, tmp_path):
         profile_form_deviation=8.0, pitch_running_in=0.7, profile_running_in=0.7)
     for name in ("dynamic_factor", "K_v", "resonance_speed", "iso_range"):
         np.testing.assert_array_equal(written[name].values, ds[name].values)
+    assert written.attrs["geardyn_kind"] == "dynamic-factor"
+    redrawn = tmp_path / "again.png"
+    r = geardyn_here(capsys, "plot", out, "--out", redrawn)
+    assert r.returncode == 0, r.stderr
+    assert "dynamic factor dataset" in r.stdout and redrawn.stat().st_size > 0
 
 
 def test_bad_input_is_one_line(capsys):

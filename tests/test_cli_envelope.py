@@ -59,6 +59,10 @@ def test_envelope_writes_the_curves_and_the_figure(study, tmp_path):
     om, fa = ds["Omega"].values, ds["Fa"].values
     # the linear pair's contact-loss curve (tests/test_grazing_curves.py derives it)
     np.testing.assert_allclose(fa, 0.1 * np.abs(1 - om**2 + 0.1j * om) / om**2, rtol=2e-5)
+    redrawn = tmp_path / "curve.png"
+    r = invoke("plot", out / "grazing_drive_0.nc", "--out", redrawn)
+    assert r.returncode == 0, r.stderr
+    assert "curve dataset" in r.stdout and redrawn.read_bytes()[:4] == b"\x89PNG"
 
 
 @pytest.mark.parametrize("args,message", [

@@ -160,10 +160,25 @@ def _runup() -> xr.Dataset:
     return ds
 
 
+def _dynamic_factor() -> xr.Dataset:
+    dims = ("torque", "speed", "group")
+    ds = xr.Dataset(coords={"torque": ("torque", [20.0, 80.0]),
+                            "speed": ("speed", [1000.0, 2000.0, 3000.0]),
+                            "group": ("group", ["mesh"])})
+    ds["dynamic_factor"] = (dims, np.ones((2, 3, 1)))
+    ds["K_v"] = (dims, np.full((2, 3, 1), 1.1))
+    ds["contact"] = (dims, np.full((2, 3, 1), "none"))
+    ds["period"] = (("torque", "speed"), np.ones((2, 3), dtype=int), PERIOD)
+    ds["resonance_speed"] = (("torque", "group"), np.full((2, 1), 2500.0))
+    ds.attrs.update(geardyn_kind="dynamic-factor", standard="ISO 6336-1:2006",
+                    stiffness_source="model")
+    return ds
+
+
 BUILD = {"simulation": _simulation, "bifurcation": _sweep, "map2d": _map,
          "reproduction-case": _case, "periodic-orbit": _orbit, "continuation": _branch,
          "basins": _basins, "frequency-response": _frc, "curve": _curve,
-         "runup": _runup}
+         "runup": _runup, "dynamic-factor": _dynamic_factor}
 
 
 @pytest.mark.parametrize("kind", KINDS)

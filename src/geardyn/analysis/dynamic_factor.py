@@ -22,6 +22,7 @@ import xarray as xr
 from geardyn.analysis.bifurcation import bifurcation
 from geardyn.analysis.lanes import CONTACT_LABELS
 from geardyn.core.model import Model
+from geardyn.core.results import finish
 from geardyn.core.settings import RunSettings
 from geardyn.errors import ParameterError
 from geardyn.gears.iso6336 import N_PER_MM_UM, iso6336_stiffness
@@ -230,7 +231,7 @@ def dynamic_factor_sweep(model: Model, speeds: Sequence[float] | np.ndarray,
                             g.inputs.single_stiffness, g.inputs.mesh_stiffness))
         rows.append(xr.Dataset(
             {k: (("speed", "group"), np.stack(v, axis=1)) for k, v in cols.items()}
-            | {"period": ("speed", ds["period"].values)}))
+            | {"period": ("speed", ds["period"].values, dict(ds["period"].attrs))}))
         per_torque.append(scalars)
     out = xr.concat(rows, dim="torque")
     table = np.array(per_torque)  # torque, group, quantity
@@ -255,7 +256,7 @@ def dynamic_factor_sweep(model: Model, speeds: Sequence[float] | np.ndarray,
     else:
         f = np.asarray(model.natural_frequencies(), dtype=float)
         out.attrs["natural_speeds"] = np.unique(np.round(f[f > 0.0] * 60.0 / per_mesh_hz, 3))
-    return out
+    return finish(out, "dynamic-factor")
 
 
 def _describe(ds: xr.Dataset) -> None:

@@ -349,7 +349,7 @@ def bifurcation_command(
 _PLOT_KIND = {"simulation": "simulation", "bifurcation": "bifurcation", "map2d": "map",
               "reproduction-case": "reproduction", "basins": "basins",
               "frequency-response": "frequency response", "continuation": "continuation",
-              "runup": "run-up"}
+              "runup": "run-up", "dynamic-factor": "dynamic factor", "curve": "curve"}
 
 
 def _dataset_kind(ds) -> str:
@@ -412,8 +412,8 @@ def _load_result(result: Path):
 def plot_command(
     result: Annotated[Path, typer.Argument(help="A NetCDF file written by geardyn simulate, "
                                                 "bifurcation, map, reproduce, basins, frc, "
-                                                "continue, stiffness or runup, or a map's "
-                                                ".zarr store.")],
+                                                "continue, stiffness, runup, envelope or "
+                                                "dynamic-factor, or a map's .zarr store.")],
     out: Annotated[
         Path | None, typer.Option(help="Figure to write, .png, .pdf or .svg (default: RESULT "
                                        "with .png).")
@@ -426,7 +426,8 @@ def plot_command(
     ] = SweepDirection.up,
 ) -> None:
     """Redraw the figure of a saved simulation, bifurcation, map, reproduction case, basins,
-    frequency response, continued branch or mesh stiffness."""
+    frequency response, continued branch, two-parameter curve, run-up, dynamic factor or mesh
+    stiffness."""
     target = out if out is not None else result.with_suffix(".png")
     check_plot_path("--out", target)
     ds = _load_result(result)
@@ -440,7 +441,7 @@ def plot_command(
         plot_map(ds, path=target)
         typer.echo(f"{result}: map dataset; wrote {target}")
         return
-    if kind in ("basins", "frequency response", "mesh stiffness"):
+    if kind in ("basins", "frequency response", "mesh stiffness", "dynamic factor", "curve"):
         if state is not None:
             raise ParameterError("--state", state, f"a {kind} figure shows no state; leave it out")
         make_parents(target)
@@ -448,6 +449,14 @@ def plot_command(
             from geardyn.plotting.basins import plot_basins
 
             plot_basins(ds, path=target)
+        elif kind == "dynamic factor":
+            from geardyn.plotting.dynamic_factor import plot_dynamic_factor
+
+            plot_dynamic_factor(ds, path=target)
+        elif kind == "curve":
+            from geardyn.plotting.envelope import plot_curves
+
+            plot_curves([ds], path=target)
         elif kind == "mesh stiffness":
             from geardyn.plotting.stiffness import plot_mesh_stiffness
 

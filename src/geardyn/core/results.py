@@ -126,6 +126,12 @@ SCHEMAS: dict[str, ResultSchema] = {s.kind: s for s in (
          "special_kind": ("special",), "special_x": ("special",), "special_y": ("special",),
          "special_error": ("special",)}),  # its status: a BranchStatus code, not a Status
     ResultSchema(
+        "dynamic-factor", ("standard", "stiffness_source"),
+        {"torque": ("torque",), "speed": ("speed",), "group": ("group",)},
+        {"dynamic_factor": ("torque", "speed", "group"), "K_v": ("torque", "speed", "group"),
+         "contact": ("torque", "speed", "group"), "period": ("torque", "speed"),
+         "resonance_speed": ("torque", "group")}),
+    ResultSchema(
         "basins",
         ("x", "y", "Omega", "time_unit", "diverged_fraction", "unresolved_fraction",
          "n_attractors"),

@@ -16,7 +16,7 @@ from geardyn.analysis.envelope import CONTACT_REGIONS, Envelope
 from geardyn.plotting.bifurcation import REGIME_COLORS
 from geardyn.plotting.style import RC, param_label
 
-__all__ = ["CURVE_STYLES", "draw_curves", "plot_envelope"]
+__all__ = ["CURVE_STYLES", "draw_curves", "plot_curves", "plot_envelope"]
 
 #: Region names of the legend, by contact code.
 REGION_LABELS = {"none": "contact kept", "single": "one-sided impacts",
@@ -114,6 +114,32 @@ def plot_envelope(env: Envelope, path: str | os.PathLike | None = None, *,
         ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.02, 1.0),
                   frameon=False)
         ax.set_title(title or f"{env.model_name}: contact regions in ({x}, {y})")
+        if path is not None:
+            fig.savefig(Path(path))
+    return fig
+
+
+def plot_curves(curves: list[xr.Dataset], path: str | os.PathLike | None = None):
+    """Figure of two-parameter ``curves`` (``"curve"`` datasets) in the plane of the first one,
+    each kind in its style, codimension-2 points labelled, each curve's end status in the
+    title when it did not complete. Saved to ``path`` (.png, .pdf, .svg) when given; returns
+    a matplotlib Figure (created without pyplot)."""
+    import matplotlib
+    from matplotlib.figure import Figure
+
+    if not curves:
+        raise ValueError("no curve to draw")
+    x, y = curves[0].attrs["x"], curves[0].attrs["y"]
+    with matplotlib.rc_context(RC):
+        fig = Figure(figsize=(6.4, 4.4), layout="constrained")
+        ax = fig.add_subplot()
+        handles = draw_curves(ax, curves, x, y)
+        ax.set_xlabel(x)
+        ax.set_ylabel(y)
+        ax.legend(handles=handles, loc="best", frameon=False)
+        ended = [str(c.attrs.get("message", "")) for c in curves
+                 if int(c.attrs.get("status", 0)) != 0]
+        ax.set_title(f"curves in ({x}, {y})" + (f"; ended: {ended[0]}"[:90] if ended else ""))
         if path is not None:
             fig.savefig(Path(path))
     return fig
