@@ -43,7 +43,6 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import xarray as xr
-from scipy.optimize import minimize_scalar
 
 from geardyn.analysis.arclength import (
     ArclengthSettings,
@@ -205,6 +204,8 @@ class GrazingProblem:
         are ``Y`` (every grid point, the last one the end of the orbit period)."""
         if not np.all(np.isfinite(Y)):
             raise FloatingPointError("the orbit's integration diverged")
+        from scipy.optimize import minimize_scalar  # here: import geardyn stays free of SciPy
+
         hs = self.sense * self.h_along(pr, Y[:-1])
         N = hs.size
         i = int(np.argmin(hs))
