@@ -175,10 +175,28 @@ def _dynamic_factor() -> xr.Dataset:
     return ds
 
 
+def _fault_dataset() -> xr.Dataset:
+    dims = ("fault", "speed", "torque")
+    ds = xr.Dataset(coords={"fault": ("fault", [0, 1]),
+                            "fault_kind": ("fault", ["healthy", "crack"]),
+                            "fault_size": ("fault", [np.nan, 1e-3]),
+                            "fault_gear": ("fault", ["none", "pinion"]),
+                            "fault_tooth": ("fault", [-1, 0]), "speed": ("speed", [1e3]),
+                            "torque": ("torque", [50.0, 60.0]), "seed": ("seed", [0]),
+                            "time": ("time", [0.0, 1e-4, 2e-4], {"units": "s"})})
+    ds["signal"] = ((*dims, "seed", "time"), np.ones((2, 1, 2, 1, 3)), {"units": "N"})
+    ds["status"] = (dims, np.zeros((2, 1, 2), dtype=np.int8), status_attrs())
+    ds["unresolved"] = (dims, np.zeros((2, 1, 2), dtype=int), {"meaning": "steps"})
+    ds["noise_std"] = (dims, np.full((2, 1, 2), 0.1), {"units": "N"})
+    ds.attrs.update(geardyn_kind="fault-dataset", model="SpurPair", time_unit="s", snr_db=20.0,
+                    duration=3e-4, sample_rate=1e4)
+    return ds
+
+
 BUILD = {"simulation": _simulation, "bifurcation": _sweep, "map2d": _map,
          "reproduction-case": _case, "periodic-orbit": _orbit, "continuation": _branch,
          "basins": _basins, "frequency-response": _frc, "curve": _curve,
-         "runup": _runup, "dynamic-factor": _dynamic_factor}
+         "runup": _runup, "dynamic-factor": _dynamic_factor, "fault-dataset": _fault_dataset}
 
 
 @pytest.mark.parametrize("kind", KINDS)

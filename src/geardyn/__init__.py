@@ -18,6 +18,7 @@ from geardyn.analysis.branch import BifurcationPoint, BranchStatus, continuation
 from geardyn.analysis.curves import CurveSettings, curve, curve_at
 from geardyn.analysis.dynamic_factor import dynamic_factor_sweep
 from geardyn.analysis.envelope import Envelope, envelope, intersect_curves
+from geardyn.analysis.fault_dataset import FaultDatasetSpec, fault_dataset
 from geardyn.analysis.frc import frequency_response
 from geardyn.analysis.grazing import grazing_curve
 from geardyn.analysis.lyapunov import LyapunovEstimate, lyapunov, lyapunov_lanes
@@ -109,6 +110,8 @@ __all__ = [
     "intersect_curves",
     "reference_solution",
     "sensor_signal",
+    "FaultDatasetSpec",
+    "fault_dataset",
     "sensor_spectrum",
     "runup",
     "simulate",

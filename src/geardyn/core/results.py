@@ -153,6 +153,14 @@ SCHEMAS: dict[str, ResultSchema] = {s.kind: s for s in (
          "start", "stop", "rate", "outputs"),
         {"time": ("time",)}, {"Omega": ("time",), "phase": ("time",)},
         status_attrs=("status",)),
+    ResultSchema(
+        "fault-dataset", ("model", "time_unit", "snr_db", "duration", "sample_rate"),
+        {"fault": ("fault",), "fault_kind": ("fault",), "fault_size": ("fault",),
+         "fault_gear": ("fault",), "fault_tooth": ("fault",), "speed": ("speed",),
+         "torque": ("torque",), "seed": ("seed",), "time": ("time",)},
+        {"signal": ("fault", "speed", "torque", "seed", "time"),
+         "status": ("fault", "speed", "torque"), "unresolved": ("fault", "speed", "torque"),
+         "noise_std": ("fault", "speed", "torque")}, ("status",)),
 )}
 
 #: The kinds of result, as recorded in ``attrs["geardyn_kind"]``.

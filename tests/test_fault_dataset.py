@@ -1,0 +1,152 @@
+"""Labelled fault datasets (geardyn.fault_dataset): labels, resuming, one lane against the direct
+run, the noise's SNR and seed, Dask, bad fields."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+import xarray as xr
+
+import geardyn
+from geardyn.errors import ParameterError
+from geardyn.gears import BrokenTooth, GearMesh, RootCrack, SpurGear
+from geardyn.testing import assert_result
+
+Z1, Z2, M, ALPHA, B = 19, 48, 3.2e-3, math.radians(20.0), 0.016
+INERTIA, BORES = (4.3659e-4, 8.3602e-3), (0.012, 0.035)
+MESH = GearMesh(SpurGear(Z1, M, ALPHA, B, name="pinion"), SpurGear(Z2, M, ALPHA, B, name="wheel"))
+FAULTS = (None, RootCrack("1.5 mm"), BrokenTooth("pinion", 3))
+SPEEDS, TORQUES, SEEDS = (1000.0, 1500.0), (40.0, 60.0), (0, 7)
+DURATION, RATE = 0.02, 20_000.0
+
+
+def build(faults):
+    return geardyn.SpurPair.from_geometry(MESH, bore_radius=BORES, speed=1000, torque=50.0,
+                                          faults=faults, inertia=INERTIA, backlash=10e-6,
+                                          speed_unit="rpm")
+
+
+def spec(**kw) -> geardyn.FaultDatasetSpec:
+    args = dict(build=build, faults=FAULTS, speeds=SPEEDS, torques=TORQUES, seeds=SEEDS,
+                snr_db=10.0, duration=DURATION, sample_rate=RATE, chunk=5)
+    args.update(kw)
+    return geardyn.FaultDatasetSpec(**args)
+
+
+@pytest.fixture(scope="module")
+def reference():
+    """One uninterrupted run in memory (12 conditions, chunks of 5)."""
+    return geardyn.fault_dataset(spec())
+
+
+def _same(a: xr.Dataset, b: xr.Dataset) -> None:
+    for name in a.data_vars:
+        assert np.array_equal(a[name].values, b[name].values, equal_nan=True), name
+
+
+def test_the_store_opens_with_xarray_and_its_labels_are_the_spec(reference, tmp_path):
+    path = tmp_path / "faults.zarr"
+    geardyn.fault_dataset(spec(), store=path)
+    ds = xr.open_zarr(path)
+    assert_result(reference, "fault-dataset")
+    assert ds.sizes == {"fault": 3, "speed": 2, "torque": 2, "seed": 2, "time": 400}
+    assert [str(k) for k in ds["fault_kind"].values] == ["healthy", "crack", "broken_tooth"]
+    assert ds["fault_size"].values[1] == pytest.approx(1.5e-3)
+    assert np.isnan(ds["fault_size"].values[[0, 2]]).all()
+    assert [str(g) for g in ds["fault_gear"].values] == ["none", "pinion", "pinion"]
+    assert ds["fault_tooth"].values.tolist() == [-1, 0, 3]
+    assert ds["speed"].values.tolist() == list(SPEEDS)
+    assert ds["torque"].values.tolist() == list(TORQUES)
+    assert ds["seed"].values.tolist() == list(SEEDS)
+    assert ds["time"].values[1] == 1.0 / RATE
+    assert ds.attrs["snr_db"] == 10.0 and ds.attrs["sample_rate"] == RATE
+    assert ds.attrs["duration"] == DURATION and ds.attrs["n_signals"] == 24
+    assert (ds["status"].values == 0).all()
+    assert (ds["stiffness_error_drive_max"].values > 0).all()
+    _same(reference, ds.load())
+
+
+def test_a_killed_run_resumes_to_the_same_bits(reference, tmp_path):
+    from geardyn.execution.zarr_store import LaneStore, load_zarr_dataset
+
+    path = tmp_path / "killed.zarr"
+    calls = []
+
+    def kill_after_first_chunk(done, total):
+        calls.append(done)
+        if done > 0:
+            raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        geardyn.fault_dataset(spec(), store=path, progress=kill_after_first_chunk)
+    with pytest.raises(FileNotFoundError):
+        load_zarr_dataset(path)  # no dataset yet
+    resumed = []
+    ds = geardyn.fault_dataset(spec(), store=path, progress=lambda d, t: resumed.append(d))
+    assert resumed[0] == 5  # the first chunk was read back, not recomputed
+    assert LaneStore(path).chunk_runs().tolist() == [1, 2, 2]
+    _same(reference, ds)
+    _same(reference, xr.open_zarr(path).load())
+
+
+def test_one_lane_is_the_direct_simulation_and_transfer():
+    """Without noise, condition (crack, 1500 rpm, 60 N m) is simulate() of the same model and
+    its mesh force sampled at k / rate, bit for bit."""
+    ds = geardyn.fault_dataset(spec(snr_db=math.inf, seeds=(0,)))
+    model = build((FAULTS[1],)).with_params(speed=1500.0, torque=60.0)
+    period = 2.0 * math.pi / model.omega
+    run = geardyn.RunSettings(transient=0.0, samples=math.ceil(DURATION / period) + 1)
+    sim = geardyn.simulate(model, run=run)
+    t = sim["time"].values - sim["time"].values[0]
+    expected = np.interp(np.arange(400) / RATE, t, sim["F"].values)
+    got = ds["signal"].sel(speed=1500.0, torque=60.0).values[1, 0]
+    assert np.array_equal(got, expected)
+    assert np.ptp(expected) > 0.1 * np.mean(expected)  # the crack's dynamic force is there
+
+
+def test_noise_has_the_requested_snr_and_follows_the_seed(reference):
+    clean = geardyn.fault_dataset(spec(snr_db=math.inf))
+    noise = reference["signal"] - clean["signal"]  # (fault, speed, torque, seed, time)
+    rms = clean["signal"].std("time").isel(seed=0)  # about the mean
+    n = noise.sizes["time"]
+    snr_power = (rms ** 2 / (noise ** 2).mean("time")).values
+    tol = 4.0 * math.sqrt(2.0 / n)  # sampling error of a variance from n normal samples
+    assert np.all(np.abs(snr_power / 10.0 - 1.0) < tol)
+    assert np.allclose(reference["noise_std"], rms / 10.0 ** 0.5, rtol=1e-12)
+    a, b = noise.isel(seed=0).values, noise.isel(seed=1).values
+    assert not np.allclose(a, b)
+    again = geardyn.fault_dataset(spec(seeds=(7,)))
+    assert np.array_equal(again["signal"].values[..., 0, :],
+                          reference["signal"].sel(seed=7).values)
+
+
+def test_a_dask_run_is_bitwise_the_local_run(reference):
+    distributed = pytest.importorskip("dask.distributed")
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                  dashboard_address=None) as cluster, \
+            distributed.Client(cluster) as client:
+        remote = geardyn.fault_dataset(spec(), client=client)
+    _same(reference, remote)
+
+
+@pytest.mark.parametrize("kw,field", [
+    (dict(speeds=[]), "speeds"), (dict(speeds=[1000.0, 1000.0]), "speeds"),
+    (dict(torques=["x"]), "torques"), (dict(seeds=[-1]), "seeds"), (dict(seeds=[1.5]), "seeds"),
+    (dict(snr_db=float("nan")), "snr_db"), (dict(duration=0.0), "duration"),
+    (dict(sample_rate=-1.0), "sample_rate"), (dict(transient=-1.0), "transient"),
+    (dict(faults=()), "faults"), (dict(faults=(None, "crack")), "faults"),
+    (dict(chunk=0), "chunk"), (dict(steps_per_period=2), "steps_per_period"),
+    (dict(build=None), "build")])
+def test_bad_spec_fields_are_named(kw, field):
+    with pytest.raises((ParameterError, ValueError), match=field):
+        spec(**kw)
+
+
+def test_a_fault_the_model_refuses_is_named_before_any_work():
+    calls = []
+    bad = spec(faults=(None, RootCrack("1 mm", gear="sun")))
+    with pytest.raises(ParameterError, match=r"faults\[1\]"):
+        geardyn.fault_dataset(bad, progress=lambda d, t: calls.append(d))
+    assert calls == []
