@@ -116,9 +116,10 @@ def carrier_angle(model, time: np.ndarray, omega: np.ndarray | float | None = No
 def planetary_sensor_signal(ds: xr.Dataset, model, sensor_angle: float = 0.0,
                             width: float = math.pi / 2, window: str = "hann") -> xr.Dataset:
     """The sensor signal of a :func:`~geardyn.simulate` run ``ds`` of a
-    :class:`~geardyn.PlanetaryGearSet` built from geometry (:meth:`from_geometry`: the ring's
-    teeth): the ring-planet forces ``F_r1`` .. ``F_rN`` through :func:`sensor_signal`, the
-    carrier angle by :func:`carrier_angle` at the run's Omega.
+    :class:`~geardyn.PlanetaryGearSet` built from geometry
+    (:meth:`~geardyn.PlanetaryGearSet.from_geometry`: the ring's teeth): the ring-planet
+    forces ``F_r1`` .. ``F_rN`` through :func:`sensor_signal`, the carrier angle by
+    :func:`carrier_angle` at the run's Omega.
 
     Returns a Dataset over ``time`` (the run's, in the model's time unit) with ``signal`` [N],
     ``carrier_angle`` [rad], ``carrier_revolutions`` and the forces (``force``, (time,

@@ -19,8 +19,9 @@ intermediate 1.15 < N < 1.5, supercritical N >= 1.5, with the lower limit (Eqs. 
     N_S = 0.5 + 0.35 sqrt(F_t K_A / b / 100 N/mm)   (F_t K_A / b < 100 N/mm),  else 0.85.
 
 With B_p = c' f_pb,eff / (F_t K_A / b), B_f = c' f_f,eff / (F_t K_A / b) and
-B_k = |1 - c' C_a / (F_t K_A / b)| (Eqs. 15-17; f_pb,eff = f_pb - y_p, f_f,eff = f_falpha - y_f,
-the deviations less their running-in allowances; C_a the tip relief) the factor is
+B_k = abs(1 - c' C_a / (F_t K_A / b)) (Eqs. 15-17; f_pb,eff = f_pb - y_p,
+f_f,eff = f_falpha - y_f, the deviations less their running-in allowances; C_a the tip
+relief) the factor is
 
 * subcritical (6.5.4, Eqs. 13, 14): K_v = N (C_v1 B_p + C_v2 B_f + C_v3 B_k) + 1;
 * main resonance (6.5.5, Eq. 20): K_v = C_v1 B_p + C_v2 B_f + C_v4 B_k + 1;
@@ -146,7 +147,7 @@ class DynamicFactorInputs:
 
     @property
     def B_k(self) -> float:
-        """|1 - c' C_a / (F_t K_A / b)| (Eq. 17)."""
+        """abs(1 - c' C_a / (F_t K_A / b)) (Eq. 17)."""
         return abs(1.0 - self.single_stiffness * self.tip_relief / self.line_load)
 
 
