@@ -258,9 +258,9 @@ def runup(model: Model, settings: RunupSettings, *, y0: np.ndarray | None = None
     there), refined to divide the sample interval; backlash-edge crossings located inside
     steps (see :mod:`geardyn.solvers._runup_template`). Starts from ``y0`` (default the model's
     initial state) at time 0. ``progress(done, total)`` (steps) is called as the run goes; the
-    run is then integrated in :data:`PROGRESS_PIECES` calls of the kernel (the same steps; a
-    piece starts without the previous grid values the graze screen keeps, so a rare graze may
-    be checked once more).
+    run is then integrated in :data:`PROGRESS_PIECES` calls of the kernel, each going on with
+    the edge sides and graze-screen history of the one before (bitwise the result of one
+    call).
 
     Returns
     -------
@@ -296,11 +296,13 @@ def runup(model: Model, settings: RunupSettings, *, y0: np.ndarray | None = None
     parts: list[tuple] = []
     ncross = np.zeros(model.n_events, np.int64)
     status, unresolved, done = int(Status.OK), 0, 0
+    hist = np.full((2, max(model.n_events, 1)), np.nan)
+    side = np.ones(model.n_events, np.int64)
     for c in range(pieces):
-        Y, O, W, TH, nc, st, un, dn, y = k.runup_trajectory(
+        Y, O, W, TH, nc, st, un, dn, y, hist, side = k.runup_trajectory(
             p, np.ascontiguousarray(y), h, int(bounds[c]), int(bounds[c + 1]), n_tr, stride,
             c == pieces - 1, s.start, s.acceleration, t_on, t_off, cols, coef, s.locate_edges,
-            s.bound, model.n_events, model.n_observables)
+            s.bound, model.n_events, model.n_observables, c > 0, hist, side)
         parts.append((Y, O, W, TH))
         ncross += nc
         unresolved += int(un)

@@ -32,6 +32,7 @@ import numpy as np
 
 from geardyn.solvers._step_core import (  # CORE-IMPORT
     _JIT,
+    GBUF_ROWS,
     STATUS_DIVERGED,
     STATUS_OK,
     _events_i,
@@ -73,13 +74,17 @@ def set_speed(p, om, cols, coef):
 
 @nb.njit(**_JIT)
 def runup_trajectory(p0, y0, h, i_begin, i_end, i0, stride, last, start, accel, t_on, t_off,
-                     cols, coef, locate, bound, n_ev, n_obs):
+                     cols, coef, locate, bound, n_ev, n_obs, resume, hist, side):
     """Integrate one lane from grid point i_begin (time i_begin h, state y0) to i_end through
     the ramp, recording every stride-th grid point counted from i0 (none before it; the point
-    i_end only if ``last``: a run cut into pieces records each point once).
+    i_end only if ``last``: a run cut into pieces records each point once). ``resume``: the
+    run goes on from an earlier piece, whose edge sides ``side`` (n_ev) and graze-screen
+    history ``hist`` (2, max(n_ev, 1): the events at the last even and odd grid points) it
+    takes, so that pieces give bitwise the steps of one call; else both start afresh.
 
     Returns (Y[n_rec, ns], O[n_rec, n_obs], W[n_rec] (Omega), TH[n_rec] (the phase),
-    ncross[n_ev], status, unresolved, steps_done, y_end). Rows after a divergence are NaN.
+    ncross[n_ev], status, unresolved, steps_done, y_end, hist, side). Rows after a divergence
+    are NaN.
     """
     ns = y0.size
     p = p0.copy()
@@ -108,7 +113,11 @@ def runup_trajectory(p0, y0, h, i_begin, i_end, i0, stride, last, start, accel, 
     set_speed(p, om, cols, coef)
     _events_i(i_begin * h, y, G[0], p, math.sin(th), math.cos(th))
     for j in range(n_ev):
-        SIDE[0, j] = _side(G[0, j])
+        SIDE[0, j] = side[j] if resume else _side(G[0, j])
+    if resume:
+        for r in range(2):
+            for j in range(hist.shape[1]):
+                gbuf[GBUF_ROWS + r, j] = hist[r, j]
     status = STATUS_OK
     unresolved = 0
     done = 0
@@ -176,4 +185,4 @@ def runup_trajectory(p0, y0, h, i_begin, i_end, i0, stride, last, start, accel, 
             status = STATUS_DIVERGED
             break
     return (out_y, out_o[:, :n_obs], out_w, out_th, ncross[:n_ev], status, unresolved, done,
-            y.copy())
+            y.copy(), gbuf[GBUF_ROWS:GBUF_ROWS + 2].copy(), SIDE[0, :n_ev].copy())
