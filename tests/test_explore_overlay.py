@@ -13,24 +13,7 @@ from geardyn.explore.compute import compute_diagram
 from geardyn.explore.overlay import curve_marks
 from geardyn.explore.state import ExplorerState
 from geardyn.io.toml import load_study
-
-STUDY = """
-[study]
-name = "gp"
-model = "gear_pair"
-[params]
-zeta = 0.1
-kappa = 0.2
-Fa = 0.1
-[run]
-transient = 200.0
-[sweep]
-param = "Omega"
-start = 1.6
-stop = 2.4
-num = 6
-samples = 8
-"""
+from test_explore import STUDY  # the explorer tests' tiny gear-pair study
 
 
 def _curve(kind: str, omega: np.ndarray, fa: np.ndarray, **attrs) -> xr.Dataset:
