@@ -35,6 +35,7 @@ import numpy as np
 
 from geardyn.core.capabilities import Capabilities
 from geardyn.errors import ParameterError
+from geardyn.gears.iso6336_kv import KvMeshGroup, group_reduced_mass
 from geardyn.gears.potential_energy import coast_phase
 from geardyn.models import planetary_kernels as pk
 from geardyn.models.planetary import (
@@ -133,7 +134,7 @@ class TrainModel(PlanetaryGearSet):
 
     name = "TrainModel"
     capabilities = Capabilities(physical_inputs=True, physical_axes=True, mesh_forces=True,
-                                natural_frequencies="Hz")
+                                dynamic_factor=True, natural_frequencies="Hz")
     raw_overrides: dict[str, float] = {}
     carrier_speed = None
     carrier_speed_ratio = None
@@ -613,6 +614,96 @@ class TrainModel(PlanetaryGearSet):
                 "mesh_orders": ",".join(f"{r:.12g}" for r in self.orders),
                 "forcing": "quasi-periodic" if self.quasi_periodic else "periodic",
                 "section": section}
+
+    # ------------------------------------------------------------------ ISO 6336-1 K_v
+    @property
+    def input_torque(self) -> float:
+        """The magnitude of the driven body's mean torque [N m]."""
+        driven = self.train.driven
+        if driven is None:
+            raise ParameterError("driven", None, "the input torque is the driven body's: the "
+                                 "train needs driven")
+        t = abs(float(self.body_torques.get(driven, 0.0)))
+        if t == 0.0:
+            raise ParameterError(f"torques.{driven}", 0.0, "the driven body carries no torque")
+        return t
+
+    def at_input_torque(self, torque: float) -> TrainModel:
+        """The train with every mean torque scaled so that the driven body's has magnitude
+        ``torque`` [N m] (the load balancing it scaled alike)."""
+        s = float(torque) / self.input_torque
+        return self.with_params(torques={k: v * s for k, v in self.body_torques.items()},
+                                load=None)
+
+    def kv_groups(self, torque: float) -> tuple[KvMeshGroup, ...]:
+        """The meshes whose two gears have geometry, grouped as clause 6.5.9 groups a
+        planetary stage's: meshes that share one gear (a sun, a ring) with equal other gears
+        (the planets: same geometry and inertia) form one group named after the shared gear;
+        every other mesh is a group of its own, named after it. Gear 1 is a group's gear
+        ``a`` (a sun, a planet on a ring) or a single external pair's smaller gear, its speed
+        relative to the mesh's frame (a planet's carrier). F_t = F_n cos(beta_b) r_b1 / r_1
+        from the static mesh force F_n at ``torque`` (along the line of action, normal to a
+        helical tooth); m_red of :func:`~geardyn.gears.iso6336_kv.group_reduced_mass` from the
+        gears' own inertias (an internal gear taken as infinitely heavy)."""
+        train = self.train
+        names = self._mesh_names
+        index = {m: k for k, m in enumerate(names)}
+        geometric = [m for m in train.meshes if train.bodies[m.a].geometry is not None
+                     and train.bodies[m.b].geometry is not None]
+        if not geometric:
+            raise ParameterError("train.meshes", names, "K_v needs meshes whose two gears have "
+                                 "geometry")
+        forces = np.abs(self.at_input_torque(torque).static_mesh_forces())
+        orders = train.mesh_orders()
+
+        def signature(mesh: Any, gear: str) -> tuple:
+            g = train.bodies[gear]
+            return (g.geometry, g.inertia, mesh.internal)
+
+        groups: list[tuple[str, str, list[Any]]] = []  # (name, common gear, meshes)
+        left = list(geometric)
+        shared: dict[tuple[str, tuple], list[Any]] = {}
+        for m in geometric:
+            for common, other in ((m.b, m.a),) if m.internal else ((m.a, m.b), (m.b, m.a)):
+                shared.setdefault((common, signature(m, other)), []).append(m)
+        for (common, _), members in sorted(shared.items(), key=lambda kv: -len(kv[1])):
+            members = [m for m in members if m in left]
+            if len(members) > 1:
+                groups.append((common, common, members))
+                left = [m for m in left if m not in members]
+        groups += [(m.name, m.b, [m]) for m in left]
+        groups.sort(key=lambda g: min(index[m.name] for m in g[2]))
+        out = []
+        for name, common, members in groups:
+            first = members[0]
+            ga, gb = train.bodies[first.a], train.bodies[first.b]
+            if len(members) == 1 and not first.internal \
+                    and ga.geometry.teeth > gb.geometry.teeth:
+                ga, gb = gb, ga  # ISO's gear 1 of a single pair: the pinion
+            mesh = _gear_mesh(first, ga, gb)
+            transverse = getattr(mesh, "transverse", mesh)
+            other = first.a if common == first.b else first.b
+            gc, go = train.bodies[common], train.bodies[other]
+            idx = tuple(index[m.name] for m in members)
+            force = float(np.mean(forces[list(idx)]))
+            if not force > 0.0:
+                raise ParameterError(f"{first.name}.load", force, "the mesh carries no static "
+                                     "load at this torque: K_v needs a loaded mesh")
+            data = train.mesh_data[first.name]
+            b = min(mesh.pinion.face_width, mesh.wheel.face_width)
+            m_red = group_reduced_mass(gc.inertia, go.inertia, gc.base_radius, go.base_radius,
+                                       len(members), b, first.internal)
+            out.append(KvMeshGroup(
+                name, mesh, idx,
+                force * math.cos(data.base_helix_angle) * transverse.pinion.base_radius
+                / transverse.pinion.reference_radius,
+                m_red, orders[first.name] / mesh.pinion.teeth,
+                data.stiffness * math.cos(data.base_helix_angle) ** 2))
+        return tuple(out)
+
+    def input_speed_sweep(self, rpm: np.ndarray) -> tuple[str, np.ndarray]:
+        """``input_speed`` [rpm] itself."""
+        return INPUT_SPEED, np.asarray(rpm, dtype=float)
 
     # ------------------------------------------------------------------ linear analysis
     def natural_frequencies(self) -> np.ndarray:
