@@ -11,7 +11,6 @@ import numpy as np
 import pytest
 
 import geardyn
-
 from geardyn.cli.errors import format_error
 from geardyn.explore.compute import (
     compute_diagram,
