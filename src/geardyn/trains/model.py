@@ -495,18 +495,24 @@ class TrainModel(PlanetaryGearSet):
         Minv = np.linalg.inv(M)
         Minv[np.abs(Minv) < 1e-12 * np.max(np.abs(Minv))] = 0.0
         K, C = self.stiffness_matrix(False), self._damping_matrix()
+        plays = self.play_elements()
+        for _, row, k_play, _ in plays:  # acts through its dead zone instead
+            K -= k_play * np.outer(row, row)
         Kt = _clean(Minv @ K)
         kt_entries = [(int(i), int(j)) for i, j in zip(*np.nonzero(Kt), strict=True)]
         W = self.mesh_rows()
+        contacts = self._mesh_names + tuple(name for name, _, _, _ in plays)
+        rows = list(W) + [row for _, row, _, _ in plays]
         mesh_dofs = []
-        for m in range(nm):
-            touched = sorted({int(j) for j in np.nonzero(W[m])[0]}
-                             | {int(j) for j in np.nonzero(_clean(Minv @ W[m]))[0]})
+        for m, row in enumerate(rows):
+            touched = sorted({int(j) for j in np.nonzero(row)[0]}
+                             | {int(j) for j in np.nonzero(_clean(Minv @ row))[0]})
             if len(touched) > pk.MESH_NZ:
-                raise ParameterError(f"{self._mesh_names[m]}", len(touched),
-                                     f"the mesh row touches {len(touched)} coordinates; the "
-                                     f"kernels take at most {pk.MESH_NZ} per mesh")
+                raise ParameterError(f"{contacts[m]}", len(touched),
+                                     f"the element's row touches {len(touched)} coordinates; "
+                                     f"the kernels take at most {pk.MESH_NZ} per contact")
             mesh_dofs.append(touched)
+        nm_gears, nm = nm, len(contacts)
         lay = pk.layout(n, nm, nh, len(kt_entries), 0)
         L, w0 = self.length_scale, self.time_scale
         p = np.zeros(lay["size"])
@@ -521,26 +527,48 @@ class TrainModel(PlanetaryGearSet):
         p[lay["Ct"]:lay["Ct"] + n * n] = _clean(Minv @ C).ravel() / w0
         p[pk.DAMPED] = float(np.any(p[lay["Ct"]:lay["Ct"] + n * n] != 0.0))
         k, c = self.mesh_stiffnesses(), self._mesh_damping()
-        for m in range(nm):
+        for m in range(nm_gears):
             o = lay["mesh"] + m * lay["block"]
             self._fill_mesh_block(p[o:o + lay["block"]], m, L, w0, k[m], c[m], k[m],
                                   self._kinematic_orders[m], W[m],
                                   _clean(Minv @ W[m]) / (L * w0 * w0))
+        for j, (_, row, k_play, half_width) in enumerate(plays):
+            o = lay["mesh"] + (nm_gears + j) * lay["block"]
+            _fill_play_block(p[o:o + lay["block"]], nh, row, _clean(Minv @ row) / (L * w0 * w0),
+                             k_play * L, half_width / L)
         self._layout = lay
         self._coast_given = self._mirrored
         self._coast_built = p[_flank_index(lay, n, nm, nh, True)].copy()
         self._structure = (kt_entries, mesh_dofs)
         self._refresh_workspace(p)
         p[lay["cache"]:lay["gyro"]] = pk.cache_entries(nm)[1]
-        self.coefficient_layout = planetary_layout(names, self._mesh_names, nh,
-                                                   tuple(kt_entries), ())
+        self.coefficient_layout = planetary_layout(names, contacts, nh, tuple(kt_entries), ())
         self.params = p
         self.omega_index = pk.OMEGA
         self.kernel = _KERNEL
         self.state_names = names + tuple(f"d{d}" for d in names)
-        self.observable_names = tuple(f"F_{m}" for m in self._mesh_names)
-        self.event_names = tuple(f"x_{m}{s}b_{m}" for m in self._mesh_names for s in "-+")
-        self.meshes = tuple((m, 2 * i, 2 * i + 1) for i, m in enumerate(self._mesh_names))
+        self.observable_names = tuple(f"F_{m}" for m in contacts)
+        self.event_names = tuple(f"x_{m}{s}b_{m}" for m in contacts for s in "-+")
+        self.meshes = tuple((m, 2 * i, 2 * i + 1) for i, m in enumerate(contacts))
+
+    def play_elements(self) -> list[tuple[str, np.ndarray, float, float]]:
+        """The elements with play besides the meshes, as the kernels' contacts after the
+        meshes: (name, deflection row in the model's coordinates [m or rad per coordinate],
+        stiffness [N/m or N m/rad], half-width [m or rad]). A flexible bearing with a
+        ``clearance`` gives two, ``<bearing>_x`` and ``<bearing>_y`` (its deflection in x and in
+        y, each through a dead zone of the clearance); a shaft (coupling) with ``backlash`` one,
+        ``<shaft>`` (its twist). The element's damping stays linear (it acts in the play too)."""
+        train, out = self.train, []
+        for b in train.bearings:
+            if b.clearance > 0.0:
+                rx, ry = train._bearing_rows(b) @ train._T
+                out += [(f"{b.name}_x", rx, b.stiffness, b.clearance),
+                        (f"{b.name}_y", ry, b.stiffness, b.clearance)]
+        for s in train.shafts:
+            if s.backlash > 0.0:
+                row = (train._unit(s.a, 0) - train._unit(s.b, 0)) @ train._T
+                out.append((s.name, row, s.stiffness, s.backlash))
+        return out
 
     # ------------------------------------------------------------------ sweeps and axes
     @property
@@ -720,3 +748,18 @@ class TrainModel(PlanetaryGearSet):
         kind = "quasi-periodic" if self.quasi_periodic else "periodic"
         return (f"TrainModel({len(self.train.bodies)} bodies, {len(self._mesh_names)} meshes, "
                 f"dofs={len(self.dof_names())}, Omega={self.omega:g}, {kind} forcing)")
+
+
+def _fill_play_block(blk: np.ndarray, nh: int, row: np.ndarray, force_row: np.ndarray,
+                     force_per_deflection: float, half_width: float) -> None:
+    """A play element's block of the coefficient vector (a mesh block of
+    :mod:`~geardyn.models.planetary_kernels` with constant stiffness): its half-width, force
+    per dimensionless deflection on both flanks, order 1 and no harmonics (relative stiffness
+    1), its ``row`` and ``force_row``; no error, no own damping."""
+    n = row.size
+    f = pk.MESH_FIXED
+    blk[pk.M_B] = half_width
+    blk[pk.M_KF] = blk[pk.M_KFC] = force_per_deflection
+    blk[pk.M_ORDER] = 1.0
+    blk[f + 2 * nh:f + 2 * nh + n] = row
+    blk[f + 2 * nh + n:f + 2 * nh + 2 * n] = force_row
