@@ -53,6 +53,9 @@ from geardyn.units import si_value
 
 #: The sweep parameter of a train's input speed [rpm].
 INPUT_SPEED = "input_speed"
+#: The sweep parameter of a train's input torque [N m]: the driven body's mean torque, every
+#: other mean torque scaled with it (the load's balance kept).
+INPUT_TORQUE = "input_torque"
 #: Relative distance of a mesh order ratio from a whole number within which it is that number
 #: (speed ratios come from an SVD, so a stage's equal orders agree to about 1e-12).
 ORDER_RTOL = 1e-9
@@ -63,7 +66,7 @@ MIRROR_ATOL = 1e-12
 _SWEPT = ("mesh_frequency", INPUT_SPEED, "backlash", "mesh_damping", "modal_damping",
           "stiffness_fluctuation", "mesh_error", "torque_fluctuation", "torque_order",
           "torque_phase")
-_UNITS = {"mesh_frequency": "rad/s", INPUT_SPEED: "rpm", "backlash": "m", "mesh_damping": "1",
+_UNITS = {"mesh_frequency": "rad/s", INPUT_SPEED: "rpm", INPUT_TORQUE: "N m", "backlash": "m", "mesh_damping": "1",
           "modal_damping": "1", "stiffness_fluctuation": "1", "mesh_error": "m",
           "torque_fluctuation": "1", "torque_order": "1", "torque_phase": "rad"}
 
@@ -576,7 +579,7 @@ class TrainModel(PlanetaryGearSet):
         """The inputs a sweep takes by name: ``input_speed`` [rpm] (with a driven body),
         ``mesh_frequency`` [rad/s], and the scalar ones of ``backlash``, ``mesh_damping``,
         ``modal_damping``, ``stiffness_fluctuation``, ``mesh_error`` and the torque
-        fluctuation's."""
+        fluctuation's; ``input_torque`` [N m] where the driven body carries a torque."""
         out = []
         for k in _SWEPT:
             if k == INPUT_SPEED:
@@ -584,11 +587,31 @@ class TrainModel(PlanetaryGearSet):
                     out.append(k)
             elif not isinstance(self.inputs.get(k), Mapping):
                 out.append(k)
+        if self.train.driven is not None and self.body_torques.get(self.train.driven):
+            out.append(INPUT_TORQUE)
         return tuple(out)
+
+    def with_params(self, **values: Any) -> TrainModel:
+        """A copy with inputs changed by name (:class:`~geardyn.PlanetaryGearSet`'s
+        ``with_params``); ``input_torque`` [N m] scales every mean torque so that the driven
+        body's has that magnitude (:meth:`at_input_torque`)."""
+        if INPUT_TORQUE in values:
+            values = dict(values)
+            torque = si_value(INPUT_TORQUE, values.pop(INPUT_TORQUE), "torque", 0.0, True)
+            if "torques" in values or "load" in values:
+                raise ParameterError(INPUT_TORQUE, torque, "scales the torques: give it or "
+                                     "torques, one of them")
+            s = torque / self.input_torque
+            values["torques"] = {k: v * s for k, v in self.body_torques.items()}
+            values["load"] = None
+        return PlanetaryGearSet.with_params(self, **values)
 
     def lane_params(self, name: str, values: Any) -> np.ndarray:
         """Coefficient vectors (lanes x n_params) with ``name`` set to ``values``; the speeds
         (``input_speed`` [rpm], ``mesh_frequency`` [rad/s]) set Omega alone."""
+        if name == INPUT_TORQUE:
+            vals = np.asarray(values, dtype=float).ravel()
+            return np.array([self.with_params(**{name: float(v)}).params for v in vals])
         if name in (INPUT_SPEED, "mesh_frequency"):
             vals = np.asarray(values, dtype=float).ravel()
             if name == INPUT_SPEED:
@@ -609,6 +632,9 @@ class TrainModel(PlanetaryGearSet):
                                f"{self.mesh_frequency_per_input_speed():.6g}, in rpm"}
         if name == "mesh_frequency":
             return {"units": "rad/s", "long_name": f"mesh frequency of {self.reference_mesh}"}
+        if name == INPUT_TORQUE:
+            return {"units": "N m", "long_name": f"input ({self.train.driven}) torque",
+                    "meaning": "the driven body's mean torque, every mean torque scaled with it"}
         return {"units": _UNITS[name]} if name in _UNITS else {}
 
     def speed_axes(self, omega: np.ndarray) -> dict[str, tuple[np.ndarray, dict]]:
@@ -659,9 +685,7 @@ class TrainModel(PlanetaryGearSet):
     def at_input_torque(self, torque: float) -> TrainModel:
         """The train with every mean torque scaled so that the driven body's has magnitude
         ``torque`` [N m] (the load balancing it scaled alike)."""
-        s = float(torque) / self.input_torque
-        return self.with_params(torques={k: v * s for k, v in self.body_torques.items()},
-                                load=None)
+        return self.with_params(**{INPUT_TORQUE: float(torque)})
 
     def kv_groups(self, torque: float) -> tuple[KvMeshGroup, ...]:
         """The meshes whose two gears have geometry, grouped as clause 6.5.9 groups a
