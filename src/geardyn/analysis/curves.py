@@ -306,9 +306,10 @@ def curve_dataset(sys: CurveSystem, cr: CurveRun, tests: list[dict[str, tuple[fl
     ds["special_y"] = ("special", np.array([s.y for s in specials], float),
                        {"long_name": f"{sys.y} of the codimension-2 point"})
     ds["special_error"] = ("special", np.array([s.error for s in specials], float), {
-        "long_name": "location error in the scaled parameters: max over the bracket ends of "
-                     "|dx| / x_scale and |dy| / y_scale, plus the test function's error "
-                     "estimate over its slope"})
+        "long_name": "bound on the location error in the scaled parameters (x / x_scale, "
+                     "y / y_scale) on the discretised system: the distance in the scaled "
+                     "unknowns to the bracket's farther end, plus the test function's error "
+                     "estimate over its slope (geardyn.analysis.codim2)"})
     ds["special_section_point"] = (("special", "state"), np.array(
         [sys.state(sp.z) for sp in specials]).reshape(len(specials), n), {
         "units": m.state_units, "long_name": "section point at the codimension-2 point"})
