@@ -46,8 +46,8 @@ if TYPE_CHECKING:
 #: The curve kinds whose crossing with a grazing curve is located here.
 LOCATED_KINDS = ("fold", "period_doubling")
 #: Samples on the kept side, and the lowest margin sampled (a share of the orbit's range of
-#: the switching function; far above the band where the fixed-step monodromy is unsmooth,
-#: ~1e-4 of it at the default step).
+#: the switching function; far above the band where the fixed-step monodromy is unsmooth:
+#: ~5e-5 of it for the gear pair at a branch's default step, docs/envelope.md).
 SAMPLES, FLOOR = 4, 1e-3
 #: The highest sample margin, a share of the kept end's margin.
 SAMPLE_MARGINS = 0.5
