@@ -105,3 +105,44 @@ def test_curves_without_the_attrs_keep_the_polyline_crossing(crossing):
     out = intersect_curves(g, bare, model=m)
     assert int(out["special_located"][0]) == 0
     assert "steps_per_period" in str(out["special_detail"].values[0])
+
+
+def _pair_minimum(x0: np.ndarray, omega: float, fa: float) -> float:
+    """min over one period of x + b (b = 1) of the softening pair's orbit from x0 (DOP853,
+    rtol 1e-10; x'' + 0.1 x' + g(x) = 0.1 + Fa Omega^2 cos(Omega t), g the dead zone)."""
+    def f(t, y):
+        g = y[0] - 1.0 if y[0] > 1.0 else (y[0] + 1.0 if y[0] < -1.0 else 0.0)
+        return [y[1], 0.1 + fa * omega**2 * math.cos(omega * t) - 0.1 * y[1] - g]
+
+    sol = solve_ivp(f, (0.0, 2 * math.pi / omega), x0, method="DOP853", rtol=1e-10,
+                    atol=1e-12, dense_output=True, max_step=0.01)
+    assert np.max(np.abs(sol.y[:, -1] - x0)) < 1e-5  # the orbit closes
+    return float(np.min(sol.sol(np.linspace(0.0, 2 * math.pi / omega, 20001))[0])) + 1.0
+
+
+def test_curves_of_different_orbits_cross_without_a_codimension_2_point():
+    """The softening pair's upper fold curve crosses, in (Omega, Fa), the back flank's grazing
+    curve of a larger coexisting orbit: no codimension-2 point. The polylines report a crossing;
+    with the model it is not located (the fold's orbit keeps far off the back edge on both
+    sides), checked by DOP853 from the two curves' section points nearest the crossing."""
+    from geardyn.analysis.envelope import find_starts
+
+    m = geardyn.GearPair(zeta=0.05, Fm=0.1, Fa=0.05, kappa=0.0)
+    br = geardyn.continuation(m, "Omega", 0.6, 1.4)
+    fold = geardyn.curve(m, br, 1, "Fa", 0.6)
+    assert fold.attrs["curve_kind"] == "fold"
+    ((lo, hi, x0),) = find_starts(m, "Omega", "Fa", 0.45, np.linspace(0.05, 1.5, 30),
+                                  flank="back")
+    back = grazing_curve(m, "Omega", "Fa", (0.3, 1.5), (0.0, 2.0), flank="back",
+                         at=(0.45, 0.5 * (lo + hi)), guess=x0)
+    out = intersect_curves(back, fold, model=m)
+    assert out["special_kind"].values.tolist() == ["grazing-fold"]
+    assert int(out["special_located"][0]) == 0
+    assert "different orbits" in str(out["special_detail"].values[0])
+    at = np.array([float(out["special_x"][0]), float(out["special_y"][0])])
+    for curve, want_far in ((fold, True), (back, False)):
+        d = np.hypot(curve["Omega"].values - at[0], curve["Fa"].values - at[1])
+        i = int(np.argmin(d))
+        low = _pair_minimum(curve["section_point"].values[i], float(curve["Omega"][i]),
+                            float(curve["Fa"][i]))
+        assert (low > 0.5) if want_far else abs(low) < 1e-3, (curve.attrs["curve_kind"], low)

@@ -110,8 +110,9 @@ def locate_crossing(model: Model, grazing: xr.Dataset, curve: xr.Dataset, segmen
     """The crossing of ``grazing`` with ``curve`` (fold or period doubling, of ``model``) whose
     polyline estimate ``(x, y, error)`` lies on ``curve``'s segment [``segment``,
     ``segment`` + 1]; ``scales`` the plane's (x_scale, y_scale) for the error (module
-    docstring). Not located (the polyline's estimate) where no point of the segment's ends
-    keeps off the edge or a sample's corrector fails."""
+    docstring). Not located (the polyline's estimate) where the segment's ends are not on
+    both sides of the edge (e.g. the curves are of different coexisting orbits) or a sample's
+    corrector fails."""
     missing = [k for k in ("steps_per_period", "x_scale", "y_scale") if k not in curve.attrs]
     missing += [k for k in ("event", "extremum", "flank") if k not in grazing.attrs]
     if missing:
@@ -135,8 +136,11 @@ def locate_crossing(model: Model, grazing: xr.Dataset, curve: xr.Dataset, segmen
         if ma <= 0 < mb:
             zs, (ma, mb), ends = zs[::-1], (mb, ma), ends[::-1]
         if not (ma > 0 >= mb):
-            return failed(f"the margin has one sign at the segment's ends ({ma:.3g}, "
-                          f"{mb:.3g})")
+            where = "keeps off" if ma > 0 else "crosses"
+            return failed(f"the {sys.kind} curve's orbit {where} the "
+                          f"{grazing.attrs['flank']} flank's edge at both ends of the "
+                          f"segment (margins {ma:.3g}, {mb:.3g}): the two curves are of "
+                          f"different orbits there, or cross within the step")
         floor = FLOOR * span
         step = ends[0] - ends[1]
         i = ends[0]
