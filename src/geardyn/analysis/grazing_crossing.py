@@ -53,8 +53,8 @@ SAMPLES, FLOOR = 4, 1e-3
 SAMPLE_MARGINS = 0.5
 #: Most attempts at a sample set.
 TRIES = 6
-#: The corrector of the samples (on C's defining system).
-SAMPLE_SETTINGS = ArclengthSettings(tol=1e-10, max_iter=15)
+#: The corrector of the samples (on C's defining system; the tolerance of CurveSettings).
+SAMPLE_SETTINGS = ArclengthSettings(tol=1e-9, max_iter=15)
 
 
 @dataclass
