@@ -66,7 +66,8 @@ MIRROR_ATOL = 1e-12
 _SWEPT = ("mesh_frequency", INPUT_SPEED, "backlash", "mesh_damping", "modal_damping",
           "stiffness_fluctuation", "mesh_error", "torque_fluctuation", "torque_order",
           "torque_phase")
-_UNITS = {"mesh_frequency": "rad/s", INPUT_SPEED: "rpm", INPUT_TORQUE: "N m", "backlash": "m", "mesh_damping": "1",
+_UNITS = {"mesh_frequency": "rad/s", INPUT_SPEED: "rpm", INPUT_TORQUE: "N m", "backlash": "m",
+          "mesh_damping": "1",
           "modal_damping": "1", "stiffness_fluctuation": "1", "mesh_error": "m",
           "torque_fluctuation": "1", "torque_order": "1", "torque_phase": "rad"}
 
