@@ -334,3 +334,27 @@ def test_iso_train_keeps_the_mesh_cycle_period():
     assert model.mesh_order == 1 and model.faults is None
     assert model.fourier.shape == (1, 2)
     assert model.dataset_attrs()["mesh_stiffness_methods"] == "iso"
+
+
+def test_analyses_run_on_a_cracked_train():
+    """A sweep in the input speed, its axes, the modes and the static forces of the pair with a
+    cracked pinion tooth; the forcing period is the pinion's revolution (periodic: one stage)."""
+    model = _pair_model((g.RootCrack(**CRACK, gear="p", tooth=1),), backlash=5e-6,
+                        mesh_damping=0.05)
+    assert not model.quasi_periodic and model.mesh_order == 19
+    fast = model.with_params(input_speed=2000.0)
+    assert fast.input_speed == pytest.approx(2000.0, rel=1e-12)
+    assert fast.mesh_frequency == pytest.approx(2000.0 * 19 * 2 * math.pi / 60, rel=1e-12)
+    assert fast.omega * fast.time_scale == pytest.approx(2000.0 * 2 * math.pi / 60, rel=1e-12)
+    revolution = 2.0 * math.pi / fast.omega
+    br = geardyn.bifurcation(model, "input_speed", [2000.0, 3000.0],
+                             run=geardyn.RunSettings(transient=revolution, samples=2,
+                                                     steps_per_period=19 * 128))
+    assert np.all(br["status"].values == 0) and np.all(np.isfinite(br["poincare"].values))
+    assert br.attrs["faulty_gear"] == "p" and br.attrs["forcing"] == "periodic"
+    assert br["input_speed"].attrs["units"] == "rpm"
+    axes = fast.speed_axes(np.array([fast.omega]))
+    assert axes["input_speed"][0][0] == pytest.approx(2000.0, rel=1e-12)
+    assert axes["mesh_frequency"][0][0] == pytest.approx(fast.mesh_frequency / (2 * math.pi))
+    assert np.all(np.isfinite(model.modes()["frequency"].values))
+    assert model.static_mesh_forces()[0] == pytest.approx(40.0 / PINION.base_radius, rel=1e-9)

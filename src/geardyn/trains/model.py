@@ -11,7 +11,10 @@ there: X = q / L (q: the train's coordinates, rad and m), tau = omega_0 t::
 
 with k_m the drive flank's relative stiffness where g > 0 and the coast flank's, kc_m, where
 g < 0 (``coast="mirror"``, meshes whose two gears have geometry: the drive flank's mirror image
-about the mesh's coast phase; else kc_m = k_m).
+about the mesh's coast phase; else kc_m = k_m). A mesh on the potential-energy stiffness
+(``stiffness="potential_energy"``) takes both flanks, means and waveforms, from its table over
+the mesh cycle (the discrete Fourier series of ``mesh_stiffness`` and ``mesh_stiffness_coast``,
+``harmonics`` terms; the coast flank with its own phase, the table's).
 
 Kt = M^-1 K_s / omega_0^2 with K_s the shafts' and flexible bearings' stiffness (the meshes act
 only through f_m), Ct = M^-1 C / omega_0 with C the shafts', bearings' and Rayleigh damping (the
@@ -23,6 +26,15 @@ mesh frequency over omega_0; mesh m turns at r_m = order_m / order_ref times it 
 :meth:`~geardyn.trains.GearTrain.mesh_orders`), theta_m = r_m Omega tau: a non-integer r_m makes
 the forcing quasi-periodic (no common period; sections are then taken once per period of the
 reference mesh, and periodic orbits and their continuation are refused).
+
+Tooth faults (the train's ``faults``, :mod:`geardyn.trains.faults`) on gear f (Z_f teeth, its
+meshes at r_f) make the forcing period one revolution of f relative to its meshes' frame:
+``mesh_order`` N = Z_f / r_f reference-mesh cycles, Omega = the reference mesh frequency / (N
+omega_0). f's meshes' stiffness is the series of their tables over the revolution, in its angle
+(``harmonics`` x Z_f terms, every sideband up to mesh harmonic ``harmonics``), so the fault acts
+once per revolution; every other mesh's phase turns at r_m N Omega. A non-integer r_m N (f on
+another stage than the reference mesh, or stages with a non-integer ratio) is quasi-periodic
+forcing, as above, sections once per revolution of f.
 """
 
 from __future__ import annotations
@@ -115,9 +127,14 @@ class TrainModel(PlanetaryGearSet):
         ``contact_ratio``, ``harmonics``), or a pair (a, b) of relative Fourier coefficients,
         or {mesh: (a, b)} (ISO 6336-1 waves' ``fourier(n)``); ``mesh_phase`` [rad of the mesh
         cycle], scalar or per mesh, or ``"geometry"``: -2 pi gamma_m of
-        :meth:`geometry_phases` (default 0: the phases are the user's unless asked for).
+        :meth:`geometry_phases` (default 0: the phases are the user's unless asked for). A
+        mesh on the potential-energy stiffness takes w from its table instead (``harmonics``
+        terms over the mesh cycle, x Z_f over a faulty gear's revolution; at most half the
+        table's angles per cycle), shifted by its ``mesh_phase``: a fluctuation or waveform
+        given for it is refused (give the others' per mesh).
     mesh_error, error_phase
-        Transmission error e_m = E_m sin(theta_m + phase_m + error_phase_m) [m].
+        Transmission error e_m = E_m sin(theta_m + phase_m + error_phase_m) [m] (refused on a
+        faulty gear's meshes, whose phase is the revolution's).
     torque_fluctuation, torque_order, torque_phase
         The driven body's torque fluctuates as T (1 + A sin(order Omega tau + phase)).
     coast
@@ -127,7 +144,9 @@ class TrainModel(PlanetaryGearSet):
         :func:`geardyn.gears.potential_energy.coast_phase` of the gear pair (from the geometry
         alone; :func:`~geardyn.models.planetary_stiffness.mirrored`), the same mean stiffness;
         ``"symmetric"``: the drive flank's stiffness on both flanks. A mesh with a gear
-        without geometry has one stiffness on both flanks. Kept as :attr:`coast_flank`.
+        without geometry has one stiffness on both flanks; a mesh on the potential-energy
+        stiffness takes its table's coast flank with ``"mirror"``. Kept as
+        :attr:`coast_flank`.
     time_scale, length_scale
         omega_0 [rad/s] (default sqrt(k_ref / m_e,ref) of the reference mesh) and L [m].
     """
