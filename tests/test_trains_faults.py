@@ -358,3 +358,53 @@ def test_analyses_run_on_a_cracked_train():
     assert axes["mesh_frequency"][0][0] == pytest.approx(fast.mesh_frequency / (2 * math.pi))
     assert np.all(np.isfinite(model.modes()["frequency"].values))
     assert model.static_mesh_forces()[0] == pytest.approx(40.0 / PINION.base_radius, rel=1e-9)
+
+
+# ---------------------------------------------------------------- a planetary stage's sun
+def test_cracked_sun_of_a_train_stage_is_the_planetary_sets():
+    """A planetary stage built from elements (25/23/71, four planets, ring held, sun driven,
+    sun-planet meshes on the potential-energy stiffness, mesh_phase="geometry") with a crack on
+    sun tooth 7: every sun-planet mesh's stiffness over the sun's revolution relative to the
+    carrier equals that of PlanetaryGearSet.from_geometry with the same crack, whose tooth
+    passages come from the planet angles (geardyn.models.planetary_faults): the train's, from
+    its unreduced passage steps across the sun between the meshes, put the crack on each mesh
+    at the same time. Drive and coast flank, to 1e-10 of the mean."""
+    from test_planetary_pe import MEMBERS, stage
+
+    geo = stage()
+    z, n, h = geo.sun.teeth, geo.n_planets, 3
+    crack = dict(**CRACK, gear="sun", tooth=7)
+    rc = geo.sun_mesh.centre_distance
+    bodies = [Gear("sun", 1e-3, mass=0.5, geometry=geo.sun),
+              Gear("ring", 1.0, mass=3.0, geometry=geo.ring),
+              geardyn.trains.Inertia("carrier", 0.1, mass=5.0)]
+    bearings = [Bearing(f"{k}_bearing", k, 1e8) for k in ("sun", "ring", "carrier")]
+    meshes = []
+    for i, psi in enumerate(geo.planet_angles):
+        bodies.append(Gear(f"p{i + 1}", 1e-3, mass=0.3, geometry=geo.planet))
+        bearings.append(Bearing(f"pin{i + 1}", f"p{i + 1}", 1e8, host="carrier", radius=rc,
+                                angle=psi))
+        meshes.append(Mesh(f"s{i + 1}", "sun", f"p{i + 1}", "potential_energy", angle=psi,
+                           bore_radius=10e-3))
+    meshes += [Mesh(f"r{i + 1}", f"p{i + 1}", "ring", 5e8, internal=True, angle=psi + math.pi)
+               for i, psi in enumerate(geo.planet_angles)]
+    train = GearTrain(bodies, [geardyn.trains.Shaft("output", "carrier", "ground", 1e6)],
+                      bearings, meshes, fixed=("ring",), driven="sun",
+                      faults=g.RootCrack(**crack))
+    model = TrainModel(train, torques={"sun": 5.0}, mesh_phase="geometry", harmonics=h)
+    assert model.faults.meshes == tuple(f"s{i + 1}" for i in range(n))
+    assert model.mesh_order == z and model._kernel_orders[0] == 1.0
+    gs = geardyn.PlanetaryGearSet.from_geometry(
+        geo, harmonics=h, stiffness="potential_energy",
+        stiffness_options={"sun_bore_radius": "10 mm", "planet_bore_radius": "10 mm",
+                           "ring_rim_radius": "85 mm"},
+        faults=[g.RootCrack(**crack)], **MEMBERS)
+    assert gs.mesh_order == z
+    theta = np.linspace(0.0, 2.0 * math.pi, 1001)
+    for coast in (False, True):
+        coef = gs.fourier_coast if coast else gs.fourier
+        mean = gs.coast_stiffnesses() if coast else gs.mesh_stiffnesses()
+        for m in range(n):
+            want = mean[m] * evaluate_series(np.concatenate([[1.0], coef[m]]), theta)
+            got = _train_stiffness(model, m, theta, coast)
+            np.testing.assert_allclose(got, want, rtol=0.0, atol=1e-10 * mean[m])
