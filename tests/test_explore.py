@@ -889,3 +889,36 @@ def test_the_page_of_a_planetary_set_on_the_iso_waves(tmp_path):
         assert st.model.coast_flank == "symmetric" and st.model.stiffness_method == "iso"
     finally:
         page.runner.shutdown()
+
+
+def test_a_train_offers_its_fault_controls():
+    """The two_stage_train study on the potential-energy stiffness with a crack on g1: the
+    fault's kind, gear (a choice of the train's gears) and the crack's fields as controls; the
+    crack moved to g4 and made a missing tooth gives the model of the study file written so."""
+    import geardyn.gears as g
+    from geardyn.io.toml import builtin_study_text
+    from geardyn.study import build_model
+
+    text = builtin_study_text("two_stage_train").replace(
+        'stiffness = "iso"', 'stiffness = "potential_energy"\nbore_radius = "10 mm"').replace(
+        "stiffness_fluctuation = 0.25\n", "").replace(
+        "[run]\n", "[run]\nomega = 0.07\nperiods = 2\n")
+    crack = '\n[[train.faults]]\nkind = "crack"\ngear = "g1"\ntooth = 3\ndepth = "1 mm"\n'
+    st = ExplorerState(load_study(text + crack), "two.toml", param="Omega",
+                       window=Window(0.07, 0.075, 2), describe_error=format_error)
+    assert st.geometry_params() == (
+        "train.faults[0].kind", "train.faults[0].gear", "train.faults[0].depth",
+        "train.faults[0].angle", "train.faults[0].tooth")
+    assert st.choices("train.faults[0].gear") == ("g1", "g2", "g3", "g4")
+    assert st.current_value("train.faults[0].depth") == "1 mm"
+    assert st.model.faults.gear == "g1" and st.model.mesh_order == 19
+    assert st.set_override("train.faults[0].gear", "g4") is None
+    assert st.set_override("train.faults[0].kind", "broken_tooth") is None
+    assert st.model.faults.gear == "g4"
+    assert st.model.faults.faults == (g.BrokenTooth(gear="g4", tooth=3),)
+    by_hand = build_model(load_study(
+        text + '\n[[train.faults]]\nkind = "broken_tooth"\ngear = "g4"\ntooth = 3\n'),
+        omega=0.07)
+    assert st.model.params.tobytes() == by_hand.params.tobytes()
+    msg = st.set_override("train.faults[0].gear", "g9")
+    assert msg.startswith("train.faults[0].gear") and "g9" in msg, msg

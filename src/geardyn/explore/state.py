@@ -37,6 +37,7 @@ from geardyn.io.toml import (
     PlanetaryGearSetParams,
     SpurPairParams,
     Study,
+    TrainModelParams,
 )
 from geardyn.models.planetary_stiffness import COAST_FLANKS, STIFFNESS_METHODS
 
@@ -185,9 +186,12 @@ def _error_text(exc: BaseException) -> str:
 def _geometry_tables(study: Study) -> tuple[tuple[str, ...], str, list[FaultTable]]:
     """The fixed geometry controls of ``study``, the key of its fault tables and the tables:
     a pair's ``[gears]`` and ``[[faults]]``, a planetary set's ``[params.geometry]`` and
-    ``[[params.geometry.faults]]``; ((), "", []) for a study without geometry."""
+    ``[[params.geometry.faults]]``, a gear train's ``[[train.faults]]`` (no fixed controls);
+    ((), "", []) for a study without geometry."""
     if study.gears is not None:
         return GEOMETRY_KEYS, "faults", list(study.faults or [])
+    if study.train is not None and study.train.faults:
+        return (), "train.faults", [FaultTable(**t) for t in study.train.faults]
     geometry = getattr(study.params, "geometry", None)
     if isinstance(study.params, PlanetaryGearSetParams) and geometry is not None:
         return PLANETARY_GEOMETRY_KEYS, "params.geometry.faults", list(geometry.faults or [])
@@ -293,6 +297,11 @@ class ExplorerState:
         if path[-1] == "gear":
             if self.study.gears is not None:
                 return ("pinion", "wheel")
+            if self.study.train is not None:  # the train's gears
+                from geardyn.trains import Gear
+
+                return tuple(name for name, body in self._effective.gear_train.bodies.items()
+                             if isinstance(body, Gear))
             n = self.study.params.n_planets  # type: ignore[union-attr]
             return ("sun", *(f"planet{i + 1}" for i in range(n)), "ring")
         return ()
@@ -404,7 +413,8 @@ class ExplorerState:
         params = self.study.params
         if isinstance(params, PaperBase):
             doc["params"]["changes"] = {**doc["params"].get("changes", {}), **changes}
-        elif isinstance(params, GearPairParams | PlanetaryGearSetParams | SpurPairParams):
+        elif isinstance(params, GearPairParams | PlanetaryGearSetParams | SpurPairParams
+                        | TrainModelParams):
             doc["params"].update(changes)
         else:  # full PlanetaryParams
             doc["params"] = params.replace(**changes).model_dump(exclude_none=True)
