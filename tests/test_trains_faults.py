@@ -408,3 +408,17 @@ def test_cracked_sun_of_a_train_stage_is_the_planetary_sets():
             want = mean[m] * evaluate_series(np.concatenate([[1.0], coef[m]]), theta)
             got = _train_stiffness(model, m, theta, coast)
             np.testing.assert_allclose(got, want, rtol=0.0, atol=1e-10 * mean[m])
+
+
+def test_symmetric_coast_puts_the_drive_table_on_both_flanks():
+    """coast="symmetric" on the potential-energy stiffness: the coast flank is the drive
+    flank's series and mean (one flank), "mirror" the coast table's (two flanks); a waveform
+    pair for every mesh is refused where a mesh takes its waveform from its teeth."""
+    sym, mirror = _pair_model(coast="symmetric"), _pair_model()
+    assert sym.fourier_coast is sym.fourier and not sym._mirrored
+    assert np.array_equal(sym.coast_stiffnesses(), sym.mesh_stiffnesses())
+    assert np.array_equal(sym.fourier, mirror.fourier) and mirror._mirrored
+    assert not np.array_equal(mirror.fourier_coast, mirror.fourier)
+    with pytest.raises(ParameterError) as err:
+        TrainModel(_pair_train(), torques={"p": 1.0}, load="w", waveform=([0.1], [0.0]))
+    assert err.value.field == "waveform"

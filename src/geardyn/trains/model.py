@@ -319,6 +319,10 @@ class TrainModel(PlanetaryGearSet):
         names = self._mesh_names
         rel = _per_mesh("stiffness_fluctuation", amplitude, names, "dimensionless")
         teeth = [m for m in names if self.train.mesh_data[m].table is not None]
+        if teeth and not isinstance(waveform, str | Mapping):
+            raise ParameterError("waveform", "(coefficients)", f"mesh {teeth[0]} takes its "
+                                 "waveform from the potential-energy method (its teeth); give "
+                                 "the pairs per mesh ({mesh: (a, b)}) for the others")
         for m in teeth:
             if rel[names.index(m)] != 0.0 or (isinstance(waveform, Mapping) and m in waveform):
                 raise ParameterError("stiffness_fluctuation" if rel[names.index(m)] != 0.0
