@@ -10,6 +10,7 @@ import threading
 import numpy as np
 import pytest
 
+import geardyn
 from geardyn.cli.errors import format_error
 from geardyn.explore.compute import (
     compute_diagram,
@@ -922,3 +923,27 @@ def test_a_train_offers_its_fault_controls():
     assert st.model.params.tobytes() == by_hand.params.tobytes()
     msg = st.set_override("train.faults[0].gear", "g9")
     assert msg.startswith("train.faults[0].gear") and "g9" in msg, msg
+
+
+def test_a_train_study_is_explored_in_input_speed():
+    from geardyn.explore.compute import compute_diagram, compute_orbit, orbit_request
+
+    st = ExplorerState(builtin_study("two_stage_train"), "two_stage_train",
+                       window=Window(1500.0, 2500.0, 3))
+    assert st.param == "input_speed"
+    assert {"mesh_damping", "backlash", "modal_damping"} <= set(st.main_params())
+    assert st.set_override("mesh_damping", "0.08") is None
+    assert "backlash" in st.set_override("backlash", "-1")
+    req = st.diagram_request()
+    # transient_periods count periods of the window's lowest speed, as the CLI counts them
+    low = st.model.with_params(input_speed=1500.0).omega
+    assert req.run == st.effective_study.run_settings(sweep=True, omega=low)
+    ds = compute_diagram(req)
+    cli = geardyn.bifurcation(geardyn.build_model(st.effective_study), "input_speed",
+                              [1500.0, 2000.0, 2500.0], req.run)
+    np.testing.assert_array_equal(ds["poincare"].values, cli["poincare"].values)
+    view = compute_orbit(orbit_request(req, ds, 2000.0))
+    assert view.status == "ok" and view.value == 2000.0
+    nrel = builtin_study("nrel_5mw_gearbox_sweep")  # per-mesh backlash: not a control
+    assert "backlash" not in ExplorerState(nrel, "nrel", window=Window(10.0, 12.0, 2)
+                                           ).main_params()

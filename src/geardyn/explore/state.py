@@ -46,13 +46,16 @@ __all__ = ["CONTINUATIONS", "GEOMETRY_KEYS", "INTERPRETATIONS", "MAIN_PARAMS",
            "fault_fields", "key_path", "parse_value", "switched_fault"]
 
 #: The main parameters offered as controls, per model kind (``[study].model``): damping ratios,
-#: backlash, meshing error, load (or torque) fluctuation.
+#: backlash, meshing error, load (or torque) fluctuation. A train's are offered where its study
+#: gives them as one number for every mesh (a per-mesh table is not a control).
 MAIN_PARAMS: dict[str, tuple[str, ...]] = {
     "catt": ("xi1", "xi2", "backlash", "error", "B1", "Lambda"),
     "gear_pair": ("zeta", "backlash", "Fa", "kappa"),
     "planetary": ("mesh_damping", "sun_backlash", "ring_backlash", "sun_mesh_error",
                   "torque_fluctuation"),
     "spur_pair": ("zeta", "backlash", "torque", "error", "harmonics"),
+    "train": ("mesh_damping", "modal_damping", "backlash", "stiffness_fluctuation",
+              "mesh_error", "torque_fluctuation"),
 }
 #: The ``[gears]`` inputs offered as controls of a model built from a pair's geometry (study-file
 #: keys; each gear's own value, which wins over a shared ``[gears]`` one). The faults' controls
@@ -252,12 +255,13 @@ class ExplorerState:
         self.describe_error = describe_error
         self.curves = tuple(curves)
         self.save_dir = Path(save_dir)
-        if (self.param != "Omega" and study.run.omega is None
-                and study.study.model != "spur_pair"):  # a spur pair's speed sets its Omega
-            raise ParameterError("--param", self.param, "a sweep of another parameter than "
-                                 "Omega needs [run].omega in the study")
+        from geardyn.study import study_omega
+
         self._effective = study
         self._model = self._build(study, interpretation)
+        if self.param != "Omega" and study_omega(study, self._model) is None:
+            raise ParameterError("--param", self.param, "a sweep of another parameter than "
+                                 "Omega needs [run].omega in the study")
 
     # ------------------------------------------------------------------ model
     @property
@@ -266,7 +270,10 @@ class ExplorerState:
 
     def main_params(self) -> tuple[str, ...]:
         """The parameters offered as controls (the swept one left out)."""
-        return tuple(p for p in MAIN_PARAMS.get(self.kind, ()) if p != self.param)
+        offered = MAIN_PARAMS.get(self.kind, ())
+        if self.kind == "train":
+            offered = tuple(p for p in offered if p in self.model.physical_names)
+        return tuple(p for p in offered if p != self.param)
 
     def geometry_params(self) -> tuple[str, ...]:
         """The geometry and fault controls of a study built from geometry, as study-file keys:
@@ -424,7 +431,7 @@ class ExplorerState:
         """Set a main parameter or a geometry control from a control's text. Returns None, or
         the validation message (the state is then unchanged)."""
         geometry = self.geometry_params()
-        if name not in MAIN_PARAMS.get(self.kind, ()) and name not in geometry:
+        if name not in self.main_params() and name not in geometry:
             return f"{name}: not a parameter of this explorer"
         value: float | str = text.strip() if self.choices(name) else parse_value(text)
         if name in geometry and isinstance(value, float) and value.is_integer() and (
@@ -504,9 +511,17 @@ class ExplorerState:
     # ------------------------------------------------------------------ requests
     def run_settings(self):
         """The run of the current view's sweep (``[run]`` as every command reads it; a
-        ``transient_periods`` counts periods of the window's lowest Omega)."""
-        low = (min(self.window.start, self.window.stop) if self.param == "Omega"
-               else self._model.omega)
+        ``transient_periods`` counts periods of the window's lowest Omega, also where the swept
+        parameter is a speed that sets Omega)."""
+        from geardyn.analysis.bifurcation import lane_params_held
+
+        model = self._model
+        ends = [self.window.start, self.window.stop]
+        if self.param == "Omega" or model.omega_index is None:
+            low = min(ends) if self.param == "Omega" else model.omega
+        else:  # a speed sweep moves Omega: the window's lowest
+            low = float(min(lane_params_held(model, self.param, ends, "Omega")
+                            [:, model.omega_index]))
         return self._effective.run_settings(sweep=True, omega=low)
 
     def diagram_request(self) -> DiagramRequest:

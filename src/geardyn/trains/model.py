@@ -47,6 +47,7 @@ import numpy as np
 
 from geardyn.core.capabilities import Capabilities
 from geardyn.errors import ParameterError
+from geardyn.gears.iso6336_kv import KvMeshGroup, group_reduced_mass
 from geardyn.gears.potential_energy import coast_phase
 from geardyn.models import planetary_kernels as pk
 from geardyn.models.planetary import (
@@ -65,6 +66,9 @@ from geardyn.units import si_value
 
 #: The sweep parameter of a train's input speed [rpm].
 INPUT_SPEED = "input_speed"
+#: The sweep parameter of a train's input torque [N m]: the driven body's mean torque, every
+#: other mean torque scaled with it (the load's balance kept).
+INPUT_TORQUE = "input_torque"
 #: Relative distance of a mesh order ratio from a whole number within which it is that number
 #: (speed ratios come from an SVD, so a stage's equal orders agree to about 1e-12).
 ORDER_RTOL = 1e-9
@@ -75,7 +79,8 @@ MIRROR_ATOL = 1e-12
 _SWEPT = ("mesh_frequency", INPUT_SPEED, "backlash", "mesh_damping", "modal_damping",
           "stiffness_fluctuation", "mesh_error", "torque_fluctuation", "torque_order",
           "torque_phase")
-_UNITS = {"mesh_frequency": "rad/s", INPUT_SPEED: "rpm", "backlash": "m", "mesh_damping": "1",
+_UNITS = {"mesh_frequency": "rad/s", INPUT_SPEED: "rpm", INPUT_TORQUE: "N m", "backlash": "m",
+          "mesh_damping": "1",
           "modal_damping": "1", "stiffness_fluctuation": "1", "mesh_error": "m",
           "torque_fluctuation": "1", "torque_order": "1", "torque_phase": "rad"}
 
@@ -153,7 +158,7 @@ class TrainModel(PlanetaryGearSet):
 
     name = "TrainModel"
     capabilities = Capabilities(physical_inputs=True, physical_axes=True, mesh_forces=True,
-                                natural_frequencies="Hz")
+                                dynamic_factor=True, natural_frequencies="Hz")
     raw_overrides: dict[str, float] = {}
     carrier_speed = None
     carrier_speed_ratio = None
@@ -685,18 +690,24 @@ class TrainModel(PlanetaryGearSet):
         Minv = np.linalg.inv(M)
         Minv[np.abs(Minv) < 1e-12 * np.max(np.abs(Minv))] = 0.0
         K, C = self.stiffness_matrix(False), self._damping_matrix()
+        plays = self.play_elements()
+        for _, row, k_play, _ in plays:  # acts through its dead zone instead
+            K -= k_play * np.outer(row, row)
         Kt = _clean(Minv @ K)
         kt_entries = [(int(i), int(j)) for i, j in zip(*np.nonzero(Kt), strict=True)]
         W = self.mesh_rows()
+        contacts = self._mesh_names + tuple(name for name, _, _, _ in plays)
+        rows = list(W) + [row for _, row, _, _ in plays]
         mesh_dofs = []
-        for m in range(nm):
-            touched = sorted({int(j) for j in np.nonzero(W[m])[0]}
-                             | {int(j) for j in np.nonzero(_clean(Minv @ W[m]))[0]})
+        for m, row in enumerate(rows):
+            touched = sorted({int(j) for j in np.nonzero(row)[0]}
+                             | {int(j) for j in np.nonzero(_clean(Minv @ row))[0]})
             if len(touched) > pk.MESH_NZ:
-                raise ParameterError(f"{self._mesh_names[m]}", len(touched),
-                                     f"the mesh row touches {len(touched)} coordinates; the "
-                                     f"kernels take at most {pk.MESH_NZ} per mesh")
+                raise ParameterError(f"{contacts[m]}", len(touched),
+                                     f"the element's row touches {len(touched)} coordinates; "
+                                     f"the kernels take at most {pk.MESH_NZ} per contact")
             mesh_dofs.append(touched)
+        nm_gears, nm = nm, len(contacts)
         lay = pk.layout(n, nm, nh, len(kt_entries), 0)
         L, w0 = self.length_scale, self.time_scale
         p = np.zeros(lay["size"])
@@ -711,46 +722,92 @@ class TrainModel(PlanetaryGearSet):
         p[lay["Ct"]:lay["Ct"] + n * n] = _clean(Minv @ C).ravel() / w0
         p[pk.DAMPED] = float(np.any(p[lay["Ct"]:lay["Ct"] + n * n] != 0.0))
         k, c, kc = self.mesh_stiffnesses(), self._mesh_damping(), self.coast_stiffnesses()
-        for m in range(nm):
+        for m in range(nm_gears):
             o = lay["mesh"] + m * lay["block"]
             self._fill_mesh_block(p[o:o + lay["block"]], m, L, w0, k[m], c[m], kc[m],
                                   self._phase_orders[m], W[m],
                                   _clean(Minv @ W[m]) / (L * w0 * w0))
+        for j, (_, row, k_play, half_width) in enumerate(plays):
+            o = lay["mesh"] + (nm_gears + j) * lay["block"]
+            _fill_play_block(p[o:o + lay["block"]], nh, row, _clean(Minv @ row) / (L * w0 * w0),
+                             k_play * L, half_width / L)
         self._layout = lay
         self._coast_given = self._mirrored
         self._coast_built = p[_flank_index(lay, n, nm, nh, True)].copy()
         self._structure = (kt_entries, mesh_dofs)
         self._refresh_workspace(p)
         p[lay["cache"]:lay["gyro"]] = pk.cache_entries(nm)[1]
-        self.coefficient_layout = planetary_layout(names, self._mesh_names, nh,
-                                                   tuple(kt_entries), ())
+        self.coefficient_layout = planetary_layout(names, contacts, nh, tuple(kt_entries), ())
         self.params = p
         self.omega_index = pk.OMEGA
         self.kernel = _KERNEL
         self.state_names = names + tuple(f"d{d}" for d in names)
-        self.observable_names = tuple(f"F_{m}" for m in self._mesh_names)
-        self.event_names = tuple(f"x_{m}{s}b_{m}" for m in self._mesh_names for s in "-+")
-        self.meshes = tuple((m, 2 * i, 2 * i + 1) for i, m in enumerate(self._mesh_names))
+        self.observable_names = tuple(f"F_{m}" for m in contacts)
+        self.event_names = tuple(f"x_{m}{s}b_{m}" for m in contacts for s in "-+")
+        self.meshes = tuple((m, 2 * i, 2 * i + 1) for i, m in enumerate(contacts))
+
+    def play_elements(self) -> list[tuple[str, np.ndarray, float, float]]:
+        """The elements with play besides the meshes, as the kernels' contacts after the
+        meshes: (name, deflection row in the model's coordinates [m or rad per coordinate],
+        stiffness [N/m or N m/rad], half-width [m or rad]). A flexible bearing with a
+        ``clearance`` gives two, ``<bearing>_x`` and ``<bearing>_y`` (its deflection in x and in
+        y, each through a dead zone of the clearance); a shaft (coupling) with ``backlash`` one,
+        ``<shaft>`` (its twist). The element's damping stays linear (it acts in the play too)."""
+        train, out = self.train, []
+        for b in train.bearings:
+            if b.clearance > 0.0:
+                rx, ry = train._bearing_rows(b) @ train._T
+                out += [(f"{b.name}_x", rx, b.stiffness, b.clearance),
+                        (f"{b.name}_y", ry, b.stiffness, b.clearance)]
+        for s in train.shafts:
+            if s.backlash > 0.0:
+                row = (train._unit(s.a, 0) - train._unit(s.b, 0)) @ train._T
+                out.append((s.name, row, s.stiffness, s.backlash))
+        return out
 
     # ------------------------------------------------------------------ sweeps and axes
     @property
     def physical_names(self) -> tuple[str, ...]:
         """The inputs a sweep takes by name: ``input_speed`` [rpm] (with a driven body),
         ``mesh_frequency`` [rad/s], and the scalar ones of ``backlash``, ``mesh_damping``,
-        ``modal_damping``, ``stiffness_fluctuation``, ``mesh_error`` and the torque
-        fluctuation's."""
+        ``modal_damping``, ``stiffness_fluctuation`` (not where a mesh takes its waveform from
+        its teeth), ``mesh_error`` and the torque fluctuation's; ``input_torque`` [N m] where
+        the driven body carries a torque."""
+        teeth = any(d.table is not None for d in self.train.mesh_data.values())
         out = []
         for k in _SWEPT:
             if k == INPUT_SPEED:
                 if self.train.driven is not None:
                     out.append(k)
+            elif k == "stiffness_fluctuation" and teeth:
+                continue
             elif not isinstance(self.inputs.get(k), Mapping):
                 out.append(k)
+        if self.train.driven is not None and self.body_torques.get(self.train.driven):
+            out.append(INPUT_TORQUE)
         return tuple(out)
+
+    def with_params(self, **values: Any) -> TrainModel:
+        """A copy with inputs changed by name (:class:`~geardyn.PlanetaryGearSet`'s
+        ``with_params``); ``input_torque`` [N m] scales every mean torque so that the driven
+        body's has that magnitude (:meth:`at_input_torque`)."""
+        if INPUT_TORQUE in values:
+            values = dict(values)
+            torque = si_value(INPUT_TORQUE, values.pop(INPUT_TORQUE), "torque", 0.0, True)
+            if "torques" in values or "load" in values:
+                raise ParameterError(INPUT_TORQUE, torque, "scales the torques: give it or "
+                                     "torques, one of them")
+            s = torque / self.input_torque
+            values["torques"] = {k: v * s for k, v in self.body_torques.items()}
+            values["load"] = None
+        return PlanetaryGearSet.with_params(self, **values)
 
     def lane_params(self, name: str, values: Any) -> np.ndarray:
         """Coefficient vectors (lanes x n_params) with ``name`` set to ``values``; the speeds
         (``input_speed`` [rpm], ``mesh_frequency`` [rad/s]) set Omega alone."""
+        if name == INPUT_TORQUE:
+            vals = np.asarray(values, dtype=float).ravel()
+            return np.array([self.with_params(**{name: float(v)}).params for v in vals])
         if name in (INPUT_SPEED, "mesh_frequency"):
             vals = np.asarray(values, dtype=float).ravel()
             if name == INPUT_SPEED:
@@ -773,6 +830,9 @@ class TrainModel(PlanetaryGearSet):
                                f"{self.mesh_frequency_per_input_speed():.6g}, in rpm"}
         if name == "mesh_frequency":
             return {"units": "rad/s", "long_name": f"mesh frequency of {self.reference_mesh}"}
+        if name == INPUT_TORQUE:
+            return {"units": "N m", "long_name": f"input ({self.train.driven}) torque",
+                    "meaning": "the driven body's mean torque, every mean torque scaled with it"}
         if name == "Omega" and self.faults is not None:
             return {"units": "1", "long_name": "forcing frequency / time_scale",
                     "meaning": f"{self.faults.gear}'s revolution frequency: mesh frequency of "
@@ -827,6 +887,94 @@ class TrainModel(PlanetaryGearSet):
                        stiffness_harmonics=self.fourier.shape[1] // 2)
         return out
 
+    # ------------------------------------------------------------------ ISO 6336-1 K_v
+    @property
+    def input_torque(self) -> float:
+        """The magnitude of the driven body's mean torque [N m]."""
+        driven = self.train.driven
+        if driven is None:
+            raise ParameterError("driven", None, "the input torque is the driven body's: the "
+                                 "train needs driven")
+        t = abs(float(self.body_torques.get(driven, 0.0)))
+        if t == 0.0:
+            raise ParameterError(f"torques.{driven}", 0.0, "the driven body carries no torque")
+        return t
+
+    def at_input_torque(self, torque: float) -> TrainModel:
+        """The train with every mean torque scaled so that the driven body's has magnitude
+        ``torque`` [N m] (the load balancing it scaled alike)."""
+        return self.with_params(**{INPUT_TORQUE: float(torque)})
+
+    def kv_groups(self, torque: float) -> tuple[KvMeshGroup, ...]:
+        """The meshes whose two gears have geometry, grouped as clause 6.5.9 groups a
+        planetary stage's: meshes that share one gear (a sun, a ring) with equal other gears
+        (the planets: same geometry and inertia) form one group named after the shared gear;
+        every other mesh is a group of its own, named after it. Gear 1 is a group's gear
+        ``a`` (a sun, a planet on a ring) or a single external pair's smaller gear, its speed
+        relative to the mesh's frame (a planet's carrier). F_t = F_n cos(beta_b) r_b1 / r_1
+        from the static mesh force F_n at ``torque`` (along the line of action, normal to a
+        helical tooth); m_red of :func:`~geardyn.gears.iso6336_kv.group_reduced_mass` from the
+        gears' own inertias (an internal gear taken as infinitely heavy)."""
+        train = self.train
+        names = self._mesh_names
+        index = {m: k for k, m in enumerate(names)}
+        geometric = [m for m in train.meshes if train.bodies[m.a].geometry is not None
+                     and train.bodies[m.b].geometry is not None]
+        if not geometric:
+            raise ParameterError("train.meshes", names, "K_v needs meshes whose two gears have "
+                                 "geometry")
+        forces = np.abs(self.at_input_torque(torque).static_mesh_forces())
+        orders = train.mesh_orders()
+
+        def signature(mesh: Any, gear: str) -> tuple:
+            g = train.bodies[gear]
+            return (g.geometry, g.inertia, mesh.internal)
+
+        groups: list[tuple[str, str, list[Any]]] = []  # (name, common gear, meshes)
+        left = list(geometric)
+        shared: dict[tuple[str, tuple], list[Any]] = {}
+        for m in geometric:
+            for common, other in ((m.b, m.a),) if m.internal else ((m.a, m.b), (m.b, m.a)):
+                shared.setdefault((common, signature(m, other)), []).append(m)
+        for (common, _), members in sorted(shared.items(), key=lambda kv: -len(kv[1])):
+            members = [m for m in members if m in left]
+            if len(members) > 1:
+                groups.append((common, common, members))
+                left = [m for m in left if m not in members]
+        groups += [(m.name, m.b, [m]) for m in left]
+        groups.sort(key=lambda g: min(index[m.name] for m in g[2]))
+        out = []
+        for name, common, members in groups:
+            first = members[0]
+            ga, gb = train.bodies[first.a], train.bodies[first.b]
+            if len(members) == 1 and not first.internal \
+                    and ga.geometry.teeth > gb.geometry.teeth:
+                ga, gb = gb, ga  # ISO's gear 1 of a single pair: the pinion
+            mesh = _gear_mesh(first, ga, gb)
+            transverse = getattr(mesh, "transverse", mesh)
+            other = first.a if common == first.b else first.b
+            gc, go = train.bodies[common], train.bodies[other]
+            idx = tuple(index[m.name] for m in members)
+            force = float(np.mean(forces[list(idx)]))
+            if not force > 0.0:
+                raise ParameterError(f"{first.name}.load", force, "the mesh carries no static "
+                                     "load at this torque: K_v needs a loaded mesh")
+            data = train.mesh_data[first.name]
+            b = min(mesh.pinion.face_width, mesh.wheel.face_width)
+            m_red = group_reduced_mass(gc.inertia, go.inertia, gc.base_radius, go.base_radius,
+                                       len(members), b, first.internal)
+            out.append(KvMeshGroup(
+                name, mesh, idx,
+                force * math.cos(data.base_helix_angle) * transverse.pinion.base_radius
+                / transverse.pinion.reference_radius,
+                m_red, orders[first.name] / mesh.pinion.teeth,
+                data.stiffness * math.cos(data.base_helix_angle) ** 2))
+        return tuple(out)
+
+    def input_speed_sweep(self, rpm: np.ndarray) -> tuple[str, np.ndarray]:
+        """``input_speed`` [rpm] itself."""
+        return INPUT_SPEED, np.asarray(rpm, dtype=float)
+
     # ------------------------------------------------------------------ linear analysis
     def natural_frequencies(self) -> np.ndarray:
         return self.train.natural_frequencies()
@@ -842,3 +990,18 @@ class TrainModel(PlanetaryGearSet):
         kind = "quasi-periodic" if self.quasi_periodic else "periodic"
         return (f"TrainModel({len(self.train.bodies)} bodies, {len(self._mesh_names)} meshes, "
                 f"dofs={len(self.dof_names())}, Omega={self.omega:g}, {kind} forcing)")
+
+
+def _fill_play_block(blk: np.ndarray, nh: int, row: np.ndarray, force_row: np.ndarray,
+                     force_per_deflection: float, half_width: float) -> None:
+    """A play element's block of the coefficient vector (a mesh block of
+    :mod:`~geardyn.models.planetary_kernels` with constant stiffness): its half-width, force
+    per dimensionless deflection on both flanks, order 1 and no harmonics (relative stiffness
+    1), its ``row`` and ``force_row``; no error, no own damping."""
+    n = row.size
+    f = pk.MESH_FIXED
+    blk[pk.M_B] = half_width
+    blk[pk.M_KF] = blk[pk.M_KFC] = force_per_deflection
+    blk[pk.M_ORDER] = 1.0
+    blk[f + 2 * nh:f + 2 * nh + n] = row
+    blk[f + 2 * nh + n:f + 2 * nh + 2 * n] = force_row
