@@ -241,13 +241,13 @@ def test_idler_fault_is_felt_on_each_mesh_at_its_tooth_passage():
         assert np.max(np.abs(drop[away, m])) < 0.05 * np.max(drop[:, m])
 
 # ---------------------------------------------------------------- the two-stage study
-def _two_stage(depth: str, tmp_path: Path) -> TrainModel:
+def _two_stage(depth: str, tmp_path: Path, gear: str = "g1") -> TrainModel:
     text = STUDY.read_text()
     text = text.replace('stiffness = "iso"', 'stiffness = "potential_energy"\n'
                         'bore_radius = "10 mm"').replace("stiffness_fluctuation = 0.25\n", "")
-    text += ('\n[[train.faults]]\nkind = "crack"\ngear = "g1"\ntooth = 3\n'
+    text += (f'\n[[train.faults]]\nkind = "crack"\ngear = "{gear}"\ntooth = 3\n'
              f'depth = "{depth}"\nangle = "45 deg"\n')
-    path = tmp_path / f"two_stage_{depth.split()[0]}.toml"
+    path = tmp_path / f"two_stage_{gear}_{depth.split()[0]}.toml"
     path.write_text(text)
     return build_model(load_study(path))
 
@@ -277,6 +277,24 @@ def test_cracked_input_pinion_puts_sidebands_round_the_stage1_mesh_frequency(tmp
     for k in (18, 20):
         assert lines["2 mm"][k * revs] > 3e-3 * mesh_line, k
         assert lines["0 mm"][k * revs] < 1e-4 * mesh_line, k
+
+
+def test_the_forcing_says_whether_the_revolution_is_a_common_period(tmp_path):
+    """A crack on the output wheel g4 (71 teeth, stage 2 at 23/61 of stage 1): the period is
+    g4's revolution, 71 x 61 / 23 stage-1 mesh cycles, not a whole number, so stage 1's phase
+    does not close on it: quasi-periodic, and the datasets say so. The one-stage pair with a
+    crack on its wheel: one wheel revolution, 48 mesh cycles, periodic."""
+    model = _two_stage("1 mm", tmp_path, gear="g4")
+    assert model.mesh_order == pytest.approx(71 * 61 / 23, rel=1e-12)
+    np.testing.assert_allclose(model._kernel_orders, [71 * 61 / 23, 1.0], rtol=1e-12)
+    np.testing.assert_allclose(model.orders, [1.0, 23 / 61], rtol=1e-12)
+    attrs = model.dataset_attrs()
+    assert model.quasi_periodic and attrs["forcing"] == "quasi-periodic"
+    assert attrs["section"] == "once per revolution of g4"
+    assert attrs["faulty_meshes"] == "stage2" and attrs["mesh_cycles_per_period"] == 71
+    pair = _pair_model((g.RootCrack(**CRACK, gear="w", tooth=5),))
+    assert pair.mesh_order == 48 and not pair.quasi_periodic
+    assert pair.dataset_attrs()["forcing"] == "periodic"
 
 
 # ---------------------------------------------------------------- errors
@@ -419,6 +437,7 @@ def test_symmetric_coast_puts_the_drive_table_on_both_flanks():
     assert np.array_equal(sym.coast_stiffnesses(), sym.mesh_stiffnesses())
     assert np.array_equal(sym.fourier, mirror.fourier) and mirror._mirrored
     assert not np.array_equal(mirror.fourier_coast, mirror.fourier)
+    assert "stiffness_fluctuation" not in mirror.physical_names  # the teeth give it
     with pytest.raises(ParameterError) as err:
         TrainModel(_pair_train(), torques={"p": 1.0}, load="w", waveform=([0.1], [0.0]))
     assert err.value.field == "waveform"
