@@ -329,12 +329,12 @@ class TrainModel(PlanetaryGearSet):
                                  "waveform from the potential-energy method (its teeth); give "
                                  "the pairs per mesh ({mesh: (a, b)}) for the others")
         for m in teeth:
-            if rel[names.index(m)] != 0.0 or (isinstance(waveform, Mapping) and m in waveform):
-                raise ParameterError("stiffness_fluctuation" if rel[names.index(m)] != 0.0
-                                     else f"waveform.{m}", amplitude if rel[names.index(m)]
-                                     else "(coefficients)", f"mesh {m} takes its waveform "
-                                     "from the potential-energy method (its teeth); give the "
-                                     "fluctuation per mesh ({mesh: value}) for the others")
+            reason = (f"mesh {m} takes its waveform from the potential-energy method (its "
+                      "teeth); give the others theirs per mesh ({mesh: value})")
+            if rel[names.index(m)] != 0.0:
+                raise ParameterError("stiffness_fluctuation", amplitude, reason)
+            if isinstance(waveform, Mapping) and m in waveform:
+                raise ParameterError(f"waveform.{m}", "(coefficients)", reason)
         if isinstance(waveform, Mapping):
             unknown = sorted(set(waveform) - set(names))
             if unknown:
