@@ -225,10 +225,12 @@ class Mesh:
     ``stiffness``: the mean mesh stiffness [N/m] along the line of action, or ``"iso"`` (ISO
     6336-1 method B, :func:`~geardyn.gears.iso6336_stiffness`) or ``"potential_energy"``
     (the mean of :func:`~geardyn.gears.potential_energy_stiffness`, or of
-    :func:`~geardyn.gears.helical_stiffness`, over a mesh cycle; ``bore_radius`` [m] needed),
-    both from the two gears' geometries. A helical mesh's line of action is inclined by the
-    base helix angle beta_b to the transverse plane and ``stiffness`` is along it (the normal
-    stiffness k_n); the planar model sees k_n cos^2(beta_b) on the transverse deflection.
+    :func:`~geardyn.gears.helical_stiffness`, over a mesh cycle; ``bore_radius`` [m] needed,
+    for both gears; :class:`~geardyn.trains.TrainModel` takes the waveform of both flanks from
+    the same table, and tooth faults act through it), both from the two gears' geometries. A
+    helical mesh's line of action is inclined by the base helix angle beta_b to the transverse
+    plane and ``stiffness`` is along it (the normal stiffness k_n); the planar model sees k_n
+    cos^2(beta_b) on the transverse deflection.
     ``helix_angle`` [rad] (None: from the geometries, else 0) gives beta of a mesh without
     geometry, beta_b = atan(tan(beta) cos(alpha)) with alpha its pressure angle.
 
