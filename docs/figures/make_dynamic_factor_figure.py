@@ -72,8 +72,9 @@ def nrel() -> None:
     from geardyn.io import builtin_study
 
     model = geardyn.build_model(builtin_study("nrel_5mw_gearbox_sweep"))
-    speeds = np.linspace(2.0, 25.0, 47)
-    run = geardyn.RunSettings(transient=200.0, samples=16)
+    speeds = np.linspace(2.0, 25.0, 24)
+    low = model.with_params(input_speed=2.0).omega  # the study's transient_periods there
+    run = geardyn.RunSettings(transient=200 * 2.0 * math.pi / low, samples=16)
     ds = dynamic_factor_sweep(model, speeds, None, run, base_pitch_deviation=15.0,
                               profile_form_deviation=15.0)
     plot_dynamic_factor(ds, "docs/figures/dynamic-factor-nrel.png")
@@ -94,7 +95,8 @@ def train() -> None:
 
     model = geardyn.build_model(builtin_study("two_stage_train"))
     speeds = np.linspace(500.0, 6000.0, 45)
-    run = geardyn.RunSettings(transient=200.0, samples=16)
+    low = model.with_params(input_speed=500.0).omega  # the study's transient_periods there
+    run = geardyn.RunSettings(transient=300 * 2.0 * math.pi / low, samples=32)
     ds = dynamic_factor_sweep(model, speeds, [60.0, 240.0], run, **ACCURACY)
     plot_dynamic_factor(ds, "docs/figures/dynamic-factor-train.png")
     print("train natural frequencies as input speeds [rpm]:", ds.attrs["natural_speeds"])
