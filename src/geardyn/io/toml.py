@@ -625,7 +625,9 @@ class TrainModelParams(BaseModel):
     waveform: Literal["sine", "rectangular"] = "sine"
     contact_ratio: float = 1.6
     harmonics: int = 9
-    mesh_phase: PerMesh = 0.0
+    mesh_phase: PerMesh | None = Field(None, description="rad of the mesh cycle, per mesh or "
+                                       "\"geometry\"; default: from the geometry where every "
+                                       "meshing gear has it, else 0")
     mesh_error: PerMesh = 0.0
     error_phase: PerMesh = 0.0
     torque_fluctuation: float = 0.0

@@ -132,7 +132,9 @@ class TrainModel(PlanetaryGearSet):
         ``contact_ratio``, ``harmonics``), or a pair (a, b) of relative Fourier coefficients,
         or {mesh: (a, b)} (ISO 6336-1 waves' ``fourier(n)``); ``mesh_phase`` [rad of the mesh
         cycle], scalar or per mesh, or ``"geometry"``: -2 pi gamma_m of
-        :meth:`geometry_phases` (default 0: the phases are the user's unless asked for). A
+        :meth:`geometry_phases`; default (None) ``"geometry"`` where the train has a driven
+        body and every meshing gear has geometry, else 0 (a train of base radii and tooth
+        counts has no tooth positions to phase from). A
         mesh on the potential-energy stiffness takes w from its table instead (``harmonics``
         terms over the mesh cycle, x Z_f over a faulty gear's revolution; at most half the
         table's angles per cycle), shifted by its ``mesh_phase``: a fluctuation or waveform
@@ -173,7 +175,7 @@ class TrainModel(PlanetaryGearSet):
                  torques: Mapping[str, Any] | None = None, load: str | None = None,
                  backlash: Any = 0.0, mesh_damping: Any = 0.0, modal_damping: Any = 0.0,
                  stiffness_fluctuation: Any = 0.0, waveform: Any = "sine",
-                 contact_ratio: float = 1.6, harmonics: int = 9, mesh_phase: Any = 0.0,
+                 contact_ratio: float = 1.6, harmonics: int = 9, mesh_phase: Any = None,
                  mesh_error: Any = 0.0, error_phase: Any = 0.0, torque_fluctuation: Any = 0.0,
                  torque_order: Any = 1.0, torque_phase: Any = 0.0, coast: str = "mirror",
                  time_scale: Any = None, length_scale: Any = 1e-6):
@@ -194,6 +196,8 @@ class TrainModel(PlanetaryGearSet):
             raise ParameterError("harmonics", harmonics, "must be an integer from 1 to 200")
         if not isinstance(contact_ratio, int | float) or not 1.0 < contact_ratio < 2.0:
             raise ParameterError("contact_ratio", contact_ratio, "must be between 1 and 2")
+        if mesh_phase is None:  # from the geometry where the train has it
+            mesh_phase = "geometry" if self._phases_known() else 0.0
         if isinstance(mesh_phase, str) and mesh_phase == "geometry":
             gamma = self.geometry_phases()
             self.mesh_phase = np.array([-2.0 * math.pi * gamma[m] for m in names])
@@ -365,6 +369,14 @@ class TrainModel(PlanetaryGearSet):
             pair = _gear_mesh(mesh, ga, gb)
             out[mesh.name] = coast_phase(getattr(pair, "transverse", pair))
         return out
+
+    def _phases_known(self) -> bool:
+        """Whether :meth:`geometry_phases` applies: a driven body and the geometry of every
+        meshing gear."""
+        train = self.train
+        return train.driven is not None and all(
+            getattr(train.bodies[g], "geometry", None) is not None
+            for m in train.meshes for g in (m.a, m.b))
 
     def geometry_phases(self) -> dict[str, float]:
         """gamma_m [mesh cycles, in [0, 1)] of every mesh: how much later than the first mesh
