@@ -225,3 +225,19 @@ def test_planetary_stage_phases_are_parker_and_lins(shifted):
     assert _wrapped([gamma[f"r{i + 1}"] for i in range(n)], pl.ring + phi_r) == \
         pytest.approx(np.zeros(n), abs=1e-9)
     assert np.any(np.abs(_wrapped(pl.sun[1:], 0.0)) > 0.1)  # the phases are not all 0
+
+
+def test_the_default_phases_come_from_the_geometry_where_there_is_one():
+    """Not given, the mesh phases are the geometry's (every meshing gear with geometry) and the
+    datasets say so; a train of base radii keeps every mesh in phase, said so too."""
+    model = _idler()
+    asked = _idler(mesh_phase="geometry")
+    np.testing.assert_array_equal(model.mesh_phase, asked.mesh_phase)
+    assert np.any(model.mesh_phase != 0.0)
+    assert model.dataset_attrs()["mesh_phases"] == "geometry"
+    assert _idler(mesh_phase=0.0).dataset_attrs()["mesh_phases"] == "given"
+    from test_trains_model import _parallel
+
+    plain = _parallel()
+    assert np.all(plain.mesh_phase == 0.0)
+    assert plain.dataset_attrs()["mesh_phases"] == "all meshes in phase (no geometry)"

@@ -196,8 +196,13 @@ class TrainModel(PlanetaryGearSet):
             raise ParameterError("harmonics", harmonics, "must be an integer from 1 to 200")
         if not isinstance(contact_ratio, int | float) or not 1.0 < contact_ratio < 2.0:
             raise ParameterError("contact_ratio", contact_ratio, "must be between 1 and 2")
+        self.phase_source = "given"
         if mesh_phase is None:  # from the geometry where the train has it
-            mesh_phase = "geometry" if self._phases_known() else 0.0
+            known = self._phases_known()
+            mesh_phase = "geometry" if known else 0.0
+            self.phase_source = "geometry" if known else "all meshes in phase (no geometry)"
+        elif isinstance(mesh_phase, str) and mesh_phase == "geometry":
+            self.phase_source = "geometry"
         if isinstance(mesh_phase, str) and mesh_phase == "geometry":
             gamma = self.geometry_phases()
             self.mesh_phase = np.array([-2.0 * math.pi * gamma[m] for m in names])
@@ -873,14 +878,16 @@ class TrainModel(PlanetaryGearSet):
         return np.hstack([torque, np.where(r != 1.0, r * P[:, pk.OMEGA, None], np.nan)])
 
     def dataset_attrs(self) -> dict[str, object]:
-        """The reference mesh, every mesh's order over it, and the forcing: ``periodic`` or
-        ``quasi-periodic`` (sections sampled once per period of the reference mesh)."""
+        """The reference mesh, where the mesh phases come from (``mesh_phases``), every mesh's
+        order over it, and the forcing: ``periodic`` or ``quasi-periodic`` (sections sampled
+        once per period of the reference mesh)."""
         period = (f"revolution of {self.faults.gear}" if self.faults is not None
                   else f"mesh period of {self.reference_mesh}")
         section = (f"once per {period}" if self.quasi_periodic
                    else f"common period of the meshes, in {period}s")
         out: dict[str, object] = {
-            "reference_mesh": self.reference_mesh, "mesh_names": ",".join(self._mesh_names),
+            "reference_mesh": self.reference_mesh, "mesh_phases": self.phase_source,
+            "mesh_names": ",".join(self._mesh_names),
             "mesh_orders": ",".join(f"{r:.12g}" for r in self.orders),
             "forcing": "quasi-periodic" if self.quasi_periodic else "periodic",
             "section": section,
