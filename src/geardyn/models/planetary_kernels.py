@@ -27,7 +27,10 @@ A mesh's ``order`` r_m (its frequency over Omega; 1 in a planetary set, a gear t
 stages differ) moves its phase the same way (:func:`_mesh_phase`): theta for r_m = 1 (the
 arithmetic above, operation for operation), r_m theta for another integer, r_m Omega tau from
 the time tau otherwise (quasi-periodic forcing). The header flag ``MULTI_ORDER`` (1 where a mesh's
-order differs from 1) takes the kernels off the shared-stiffness and cached paths.
+order differs from 1) takes the kernels off the shared-stiffness path; the lane-block forms then
+take each mesh's own phase and relative stiffnesses from an own-phase cache
+(:func:`_lanes_own_phases`: one sin and cos per distinct order, at the two new times of an RK4
+step), the values the per-lane functions compute anew.
 
 Coefficient vector: a header (``DAMPED`` is 1 where Ct is not zero), the dof vectors F0, F1, the
 matrices Kt, Ct (row-major), one block per mesh (fixed entries, 2 nh Fourier coefficients, W, G, 2
@@ -45,9 +48,10 @@ every lane of a sweep in which the carrier speed w_c follows the mesh frequency.
 The ``*_lanes`` forms evaluate the same arithmetic, operation for operation, on a block of lanes
 in structure-of-arrays layout (state Y[q, k], coefficients PT[j, k], the forcing phase S[k],
 C[k]; SC: >= 2 scratch rows) for the sweep kernel; the structure (indices) is the same in every
-lane of a sweep (it depends only on inputs that are not swept). The vector ends with the rows
-of a relative-stiffness cache (:func:`cache_entries`), workspace of the lane-block functions in
-the block's own copy PT (:func:`_lanes_cached_stiffness`).
+lane of a sweep (it depends only on inputs that are not swept). The vector carries the rows
+of a relative-stiffness cache (:func:`cache_entries`) before the gyroscopic section and those of
+the own-phase cache (:func:`own_cache_names`) at its end, workspace of the lane-block functions
+in the block's own copy PT (:func:`_lanes_cached_stiffness`, :func:`_lanes_own_phases`).
 """
 
 from __future__ import annotations
