@@ -67,9 +67,10 @@ def timed_sweep(model: geardyn.Model, label: str, rpm: np.ndarray, args: argpars
     if args.write:
         results.record(
             row, f"<= {target_s:g} s warm, 2 cores",
-            f"{wall:.2f} s wall (median of {args.repeat}; {cpu:.2f} s CPU; "
-            f"{wall * 1e9 / steps:.0f} ns per lane-step, {steps:.3g} lane-steps; load "
-            f"{os.getloadavg()[0]:.1f})", results.against(wall, target_s),
+            f"{wall:.2f} s wall (median of {args.repeat}; {cpu:.2f} s CPU, "
+            f"{cpu * 1e9 / steps:.0f} ns CPU per lane-step, {cpu / args.threads:.1f} s of "
+            f"CPU per thread; {wall * 1e9 / steps:.0f} ns wall per lane-step, {steps:.3g} "
+            f"lane-steps; load {os.getloadavg()[0]:.1f})", results.against(wall, target_s),
             f".venv/bin/python bench/{script} --threads {args.threads} --repeat {args.repeat} "
             "--write")
     return ds

@@ -14,7 +14,7 @@ import pytest
 import geardyn
 from geardyn.core.plan import LanePlan, LaneSettings
 from geardyn.core.settings import RunSettings
-from geardyn.solvers.ensemble import LaneResults, _schedule, run_plan
+from geardyn.solvers.ensemble import LaneResults, _schedule, block_width, run_plan
 
 _FIELDS = [f for f in LaneResults.__dataclass_fields__ if f != "final_time"]
 
@@ -83,6 +83,21 @@ def test_schedule_balances_lane_steps_and_runs_longest_first():
         assert np.all(np.diff(q) <= 0)
     start, queue = _schedule(cost[:2], workers=8)  # no more workers than lanes
     assert start.size == 3 and sorted(queue) == [0, 1]
+
+
+def test_block_width_fills_the_workers_rounds_evenly():
+    """The default width: at most the block, as few slots as hold the most lanes queued on a
+    worker in as many rounds as the block would (100 lanes: two rounds of 50, not 64 + 36)."""
+    assert block_width(np.array([100, 100]), 64) == 50
+    assert block_width(np.array([200, 199]), 64) == 50
+    assert block_width(np.array([65]), 64) == 33
+    assert block_width(np.array([64, 63]), 64) == 64
+    assert block_width(np.array([3]), 64) == 3
+    assert block_width(np.array([128]), 64) == 64
+    for most in range(1, 400):
+        w = block_width(np.array([most]), 64)
+        rounds = -(-most // w)
+        assert w <= 64 and rounds == -(-most // 64) and (rounds - 1) * w < most
 
 
 @pytest.mark.parametrize("converge", [None, 1e-7])

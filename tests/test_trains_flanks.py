@@ -14,6 +14,7 @@ from scipy.integrate import solve_ivp
 import geardyn
 from geardyn.errors import ParameterError
 from geardyn.gears import SpurGear
+from geardyn.models import planetary_kernels as pk
 from geardyn.trains import Bearing, Gear, GearTrain, Mesh, Shaft, TrainModel
 
 MODULE = 3e-3
@@ -89,7 +90,7 @@ def test_mirrored_coast_flank_is_the_drive_flank_reflected_about_half_a_cycle():
         kc = 1.0 + (fc[0::2, None] * np.cos(h * theta) + fc[1::2, None] * np.sin(h * theta)
                     ).sum(0)
         np.testing.assert_allclose(kc, _k0(math.pi - theta - psi), rtol=0, atol=1e-14)
-    assert model.params[geardyn.models.planetary_kernels.TWO_FLANK] == 1.0
+    assert model.params[pk.TWO_FLANK] == 1.0
 
 
 def test_bad_coast_is_refused():
@@ -241,3 +242,20 @@ def test_the_default_phases_come_from_the_geometry_where_there_is_one():
     plain = _parallel()
     assert np.all(plain.mesh_phase == 0.0)
     assert plain.dataset_attrs()["mesh_phases"] == "all meshes in phase (no geometry)"
+
+
+def test_lanes_of_other_mesh_orders_and_errors_give_the_single_runs_bitwise():
+    """The lane-block kernels' own-phase cache (each distinct mesh order's sin and cos computed
+    twice a step per lane, the relative stiffnesses of both flanks with them) holds what the
+    per-lane functions compute anew: lanes whose stage 2 turns at another order (whole,
+    fractional, 1) share a block, with a transmission error and the teeth striking the coast
+    flanks, and each lane's Poincare points are simulate's at its order, bit for bit."""
+    model = _model(_train(), mesh_error={"stage2": 2e-6})
+    assert model.params[pk.TWO_FLANK] == 1.0
+    orders = (model.orders[1], 23.0 / 61.0, 1.0, 3.0, 0.61)
+    run = geardyn.RunSettings(transient=60.0, samples=6, steps_per_period=96)
+    ds = geardyn.bifurcation(model, "stage2_order", orders, run=run)
+    assert int((ds["contact"] != "none").sum()) > 0
+    for j, r in enumerate(orders):
+        sim = geardyn.simulate(model.with_params(stage2_order=r), run=run)
+        np.testing.assert_array_equal(ds.poincare.values[j], sim.poincare.values[-6:])

@@ -240,6 +240,27 @@ def test_sweep_lanes_give_the_single_runs_bitwise():
         np.testing.assert_array_equal(ds.poincare.values[j], sim.poincare.values[-8:])
 
 
+def test_speed_sweep_builds_no_model_per_point(monkeypatch):
+    """A bifurcation in input speed (Omega alone differs between the lanes) takes the model's
+    own initial state and static mesh forces, building no model per point; a sweep of the
+    backlash (more than Omega) builds one per point, as before."""
+    model = _parallel(input_speed=2500.0, backlash=20e-6)
+    built = []
+    build = TrainModel._build
+
+    def counted(self, omega):
+        built.append(omega)
+        build(self, omega)
+
+    monkeypatch.setattr(TrainModel, "_build", counted)
+    run = geardyn.RunSettings(transient=10.0, samples=2, steps_per_period=64)
+    ds = geardyn.bifurcation(model, "input_speed", [2000.0, 2500.0, 3000.0], run=run)
+    assert built == []
+    np.testing.assert_array_equal(ds["force_peak"].values[0] > 0.0, [True, True])
+    geardyn.bifurcation(model, "backlash", [10e-6, 20e-6], run=run)
+    assert len(built) >= 2
+
+
 def test_speed_sweep_loses_contact_at_the_linear_resonance():
     """Backlash and a stiffness fluctuation: sweeping the input speed, the stage-1 mesh's
     peak force peaks, and contact is lost, near the speed at which its mesh frequency meets

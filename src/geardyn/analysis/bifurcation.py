@@ -148,7 +148,7 @@ def bifurcation(
     if continuation and (client is not None or store is not None):
         raise ValueError("client and store apply to independent starts, not to continuation")
     P = lane_params_held(model, param, values, hold)
-    base_y0 = _initial_states(model, param, values, y0)
+    base_y0 = _initial_states(model, param, values, y0, P)
     if continuation:
         sweep = ContinuedSweep(model, param, values, continuation, y0=base_y0, hold=hold,
                                run=run)
@@ -162,7 +162,7 @@ def bifurcation(
                              progress, client, store, run=run)
         runs = [every.take(slice(s * L, (s + 1) * L)) for s in range(starts)]
         last = runs[0]
-        ds = _dataset(model, param, values, runs, run.max_period, run.period_tol)
+        ds = _dataset(model, param, values, runs, run.max_period, run.period_tol, P)
         ds.attrs.update(run.attrs(), continuation="none", starts=int(starts))
         ds = _record_hold(ds, model, param, P, hold)
     if lyapunov:
@@ -301,12 +301,12 @@ def _continued(sweeps: Sequence[ContinuedSweep], run: RunSettings,
         order = np.argsort(values, kind="stable")
         if sw.direction == "down":
             order = order[::-1]
-        start = _initial_states(sw.model, sw.param, values, sw.y0)
+        P = lane_params_held(sw.model, sw.param, values, sw.hold)
+        start = _initial_states(sw.model, sw.param, values, sw.y0, P)
         start = start if start.ndim == 1 else start[order[0]]
         sr = _sweep_run(sw, run)
-        branch = Branch(sw.model, lane_params_held(sw.model, sw.param, values, sw.hold)[order],
-                        start, sr.transient, sr.continued_transient, sr.transient_max,
-                        sr.steps_per_period, run.max_section_periods)
+        branch = Branch(sw.model, P[order], start, sr.transient, sr.continued_transient,
+                        sr.transient_max, sr.steps_per_period, run.max_section_periods)
         prepared.append((sw, values, order, branch))
     groups: dict[int, list[int]] = {}
     for i, (sw, *_rest) in enumerate(prepared):
@@ -331,7 +331,8 @@ def _continued(sweeps: Sequence[ContinuedSweep], run: RunSettings,
         back = np.empty_like(order)
         back[order] = np.arange(order.size)
         r = r.take(back)
-        ds = _dataset(sw.model, sw.param, values, [r], run.max_period, run.period_tol)
+        ds = _dataset(sw.model, sw.param, values, [r], run.max_period, run.period_tol,
+                      branch.P[back])
         sr = _sweep_run(sw, run)
         ds.attrs.update(sr.attrs(), continuation=sw.direction, starts=1)
         if sr.continued_transient is not None:
@@ -409,20 +410,37 @@ def _check_values(values: Sequence[float] | np.ndarray) -> np.ndarray:
     return values
 
 
-def _initial_states(model: Model, param: str, values: np.ndarray, y0: np.ndarray | None
-                    ) -> np.ndarray:
-    """``y0``, or the model's initial state (one per value when ``param`` changes it)."""
+def _omega_alone(model: Model, param: str, P: np.ndarray | None) -> bool:
+    """Whether the sweep's lanes ``P`` differ from the model's own coefficients in Omega alone
+    (``param`` Omega, or a speed that sets it, e.g. a gear train's ``input_speed``): then every
+    point's initial state and static forces are the model's own."""
+    if param == "Omega":
+        return True
+    i = model.omega_index
+    if P is None or i is None:
+        return False
+    rest = np.delete(np.atleast_2d(P), i, axis=1)
+    own = np.delete(np.asarray(model.params, dtype=float), i)
+    return rest.shape[1] == own.size and bool(np.array_equal(
+        rest, np.broadcast_to(own, rest.shape), equal_nan=True))
+
+
+def _initial_states(model: Model, param: str, values: np.ndarray, y0: np.ndarray | None,
+                    P: np.ndarray | None = None) -> np.ndarray:
+    """``y0``, or the model's initial state (one per value when ``param`` changes more than
+    Omega in the lanes ``P``)."""
     if y0 is not None:
         return np.asarray(y0, dtype=float)
-    if param == "Omega":
+    if _omega_alone(model, param, P):
         return model.initial_state()
     return np.array([model.with_params(**{param: float(v)}).initial_state() for v in values])
 
 
 def _dataset(model: Model, param: str, values: np.ndarray, runs: list[LaneResults],
-             max_period: int, tol: float) -> xr.Dataset:
-    """The sweep dataset of one or more starts' lane results (without the settings)."""
-    static = _static_forces(model, param, values) if has_mesh_forces(model) else None
+             max_period: int, tol: float, P: np.ndarray | None = None) -> xr.Dataset:
+    """The sweep dataset of one or more starts' lane results (without the settings; ``P``:
+    the lanes' coefficients)."""
+    static = _static_forces(model, param, values, P) if has_mesh_forces(model) else None
     return sweep_dataset(model, param, values, runs, max_period, tol, static)
 
 
@@ -430,11 +448,12 @@ def _mean_period(model: Model, P: np.ndarray) -> float:
     return float(np.mean(forcing_period(P[:, model.omega_index])))
 
 
-def _static_forces(model: Model, param: str, values: np.ndarray) -> np.ndarray | None:
+def _static_forces(model: Model, param: str, values: np.ndarray,
+                   P: np.ndarray | None = None) -> np.ndarray | None:
     base = model.static_mesh_forces()
     if base is None:
         return None
-    if param == "Omega":
+    if _omega_alone(model, param, P):
         return np.broadcast_to(base, (values.size, base.size))
     rows = [model.with_params(**{param: float(v)}).static_mesh_forces() for v in values]
     return np.array(rows)

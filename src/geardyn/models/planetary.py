@@ -76,7 +76,8 @@ def planetary_layout(dofs: tuple[str, ...], mesh_names: tuple[str, ...], nh: int
     """The coefficient vector of a gear set (:func:`planetary_kernels.layout`): parameters,
     then the structure the kernels read (sparse indices and counts: structure; their copies of
     the Kt, W and G values: workspace), the stiffness cache (workspace), the gyroscopic section
-    (the carrier speed a parameter, the M^-1 G pattern structure)."""
+    (the carrier speed a parameter, the M^-1 G pattern structure), the own-phase cache
+    (workspace)."""
     out = CoefficientLayout.of(HEADER, model="PlanetaryGearSet")
     for c in FORCES.entries:
         for d in dofs:
@@ -105,6 +106,9 @@ def planetary_layout(dofs: tuple[str, ...], mesh_names: tuple[str, ...], nh: int
     pattern = structure_entry("gyro", "the Coriolis pattern M^-1 G (rows, columns, values; "
                               "every lane alike)")
     out.place(gyro_names[1:], pattern)
+    own = workspace_entry("own-phase cache", "of the lane-block functions (meshes whose "
+                          "order differs from 1)")
+    out.place(pk.own_cache_names(len(mesh_names)), own)
     return out
 CENTRAL = ("carrier", "ring", "sun")
 _SHORT = {"carrier": "c", "ring": "r", "sun": "s"}

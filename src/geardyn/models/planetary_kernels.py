@@ -27,7 +27,10 @@ A mesh's ``order`` r_m (its frequency over Omega; 1 in a planetary set, a gear t
 stages differ) moves its phase the same way (:func:`_mesh_phase`): theta for r_m = 1 (the
 arithmetic above, operation for operation), r_m theta for another integer, r_m Omega tau from
 the time tau otherwise (quasi-periodic forcing). The header flag ``MULTI_ORDER`` (1 where a mesh's
-order differs from 1) takes the kernels off the shared-stiffness and cached paths.
+order differs from 1) takes the kernels off the shared-stiffness path; the lane-block forms then
+take each mesh's own phase and relative stiffnesses from an own-phase cache
+(:func:`_lanes_own_phases`: one sin and cos per distinct order, at the two new times of an RK4
+step), the values the per-lane functions compute anew.
 
 Coefficient vector: a header (``DAMPED`` is 1 where Ct is not zero), the dof vectors F0, F1, the
 matrices Kt, Ct (row-major), one block per mesh (fixed entries, 2 nh Fourier coefficients, W, G, 2
@@ -45,9 +48,10 @@ every lane of a sweep in which the carrier speed w_c follows the mesh frequency.
 The ``*_lanes`` forms evaluate the same arithmetic, operation for operation, on a block of lanes
 in structure-of-arrays layout (state Y[q, k], coefficients PT[j, k], the forcing phase S[k],
 C[k]; SC: >= 2 scratch rows) for the sweep kernel; the structure (indices) is the same in every
-lane of a sweep (it depends only on inputs that are not swept). The vector ends with the rows
-of a relative-stiffness cache (:func:`cache_entries`), workspace of the lane-block functions in
-the block's own copy PT (:func:`_lanes_cached_stiffness`).
+lane of a sweep (it depends only on inputs that are not swept). The vector carries the rows
+of a relative-stiffness cache (:func:`cache_entries`) before the gyroscopic section and those of
+the own-phase cache (:func:`own_cache_names`) at its end, workspace of the lane-block functions
+in the block's own copy PT (:func:`_lanes_cached_stiffness`, :func:`_lanes_own_phases`).
 """
 
 from __future__ import annotations
@@ -57,7 +61,7 @@ import math
 import numba as nb
 import numpy as np
 
-from geardyn.models.elements import dead_zone, harmonic_factor, harmonic_factor_lane
+from geardyn.models.elements import dead_zone, harmonic_factor
 from geardyn.models.planetary_coefficients import HEADER as HEADER_BLOCK
 from geardyn.models.planetary_coefficients import MESH
 
@@ -81,7 +85,12 @@ MESH_NZ = 6
 #: cosine equals it).
 CACHE_ENTRIES = 2
 EMPTY = 2.0
-#: The last row of the vector: 0 in a freshly loaded slot; the lane-block rhs then checks
+#: Entries of the lane-block functions' own-phase cache (:func:`_lanes_own_phases`): each the
+#: key (time, sin and cos of the forcing phase), then the sin and cos of every mesh's own phase
+#: and its drive and coast relative stiffness there. All zero is empty (no phase has sin and
+#: cos 0).
+OWN_ENTRIES = 2
+#: The last row of the cache section: 0 in a freshly loaded slot; the lane-block rhs then checks
 #: whether the block's lanes share one Ct (:func:`_lanes_ct_uniform`).
 CT_ROWS = 1
 
@@ -104,9 +113,10 @@ def layout(n: int, n_mesh: int, nh: int, nk: int = 0, ng: int = 0) -> dict[str, 
     mz = st + 1 + 3 * nk
     cache = mz + n_mesh * 3 * MESH_NZ
     gyro = cache + 1 + CACHE_ENTRIES * (2 + 2 * n_mesh) + CT_ROWS
+    own = gyro + 2 + 3 * ng
     return {"F0": f0, "F1": f1, "Kt": kt, "Ct": ct, "mesh": mesh, "block": bs,
-            "structure": st, "mesh_nz": mz, "cache": cache, "gyro": gyro,
-            "size": gyro + 2 + 3 * ng}
+            "structure": st, "mesh_nz": mz, "cache": cache, "gyro": gyro, "own": own,
+            "size": own + 3 + OWN_ENTRIES * (3 + 4 * n_mesh)}
 
 
 @nb.njit(inline="always", **_JIT)
@@ -143,6 +153,19 @@ def cache_entries(n_mesh: int) -> tuple[list[str], list[float]]:
         names += [f"cache{e}_kc{m}" for m in range(n_mesh)]
         values += [EMPTY, EMPTY] + [0.0] * (2 * n_mesh)
     return names + ["cache_ct_checked"], values + [0.0]
+
+
+def own_cache_names(n_mesh: int) -> list[str]:
+    """Names of the own-phase cache rows (:func:`_lanes_own_phases`; workspace, initially 0:
+    empty): the entry used last, two scratch rows, then per entry its key (the time, sin and
+    cos of the forcing phase) and per mesh the sin and cos of its own phase, its drive and
+    coast relative stiffness."""
+    names = ["own_last", "own_scratch_cos", "own_scratch_sin"]
+    for e in range(OWN_ENTRIES):
+        names += [f"own{e}_t", f"own{e}_sin", f"own{e}_cos"]
+        for part in ("sin", "cos", "k", "kc"):
+            names += [f"own{e}_{part}{m}" for m in range(n_mesh)]
+    return names
 
 
 def structure_names(dofs: tuple[str, ...], mesh_names: tuple[str, ...],
@@ -220,6 +243,14 @@ def _gyro_offset(nm, mz):
     -w_c (M^-1 G) X' in X''); structural, so the same in every lane of a sweep, while w_c may
     differ per lane (a carrier speed that follows the mesh frequency)."""
     return mz + nm * 3 * MESH_NZ + 1 + CACHE_ENTRIES * (2 + 2 * nm) + CT_ROWS
+
+
+@nb.njit(inline="always", **_JIT)
+def _own_offset(PT, nm, mz):
+    """Offset of the own-phase cache section (:func:`_lanes_own_phases`), after the gyroscopic
+    section (its count in row 1 of that section, column 0)."""
+    g = _gyro_offset(nm, mz)
+    return g + 2 + 3 * int(PT[g + 1, 0])
 
 
 @nb.njit(inline="always", **_JIT)
@@ -472,10 +503,44 @@ def _lanes_ct_uniform(PT, nl, cache, n):
 @nb.njit(inline="always", **_JIT)
 def _lanes_ct_broadcast(Y, DY, PT, nl, n):
     """DY[n + i] -= sum_j Ct[i, j] Y[n + j] with slot 0's Ct for every lane (all equal), in the
-    per-lane order."""
+    per-lane order: four terms per pass over the lanes, and four rows i at a time (each row's
+    terms in the same order), so that every load of Y serves four rows."""
     ct = HEADER + 2 * n + n * n
     n4 = n - n % 4
-    for i in range(n):
+    for i in range(0, n4, 4):
+        r = ct + i * n
+        for j in range(0, n4, 4):
+            a0 = PT[r + j, 0]
+            a1 = PT[r + j + 1, 0]
+            a2 = PT[r + j + 2, 0]
+            a3 = PT[r + j + 3, 0]
+            b0 = PT[r + n + j, 0]
+            b1 = PT[r + n + j + 1, 0]
+            b2 = PT[r + n + j + 2, 0]
+            b3 = PT[r + n + j + 3, 0]
+            c0 = PT[r + 2 * n + j, 0]
+            c1 = PT[r + 2 * n + j + 1, 0]
+            c2 = PT[r + 2 * n + j + 2, 0]
+            c3 = PT[r + 2 * n + j + 3, 0]
+            d0 = PT[r + 3 * n + j, 0]
+            d1 = PT[r + 3 * n + j + 1, 0]
+            d2 = PT[r + 3 * n + j + 2, 0]
+            d3 = PT[r + 3 * n + j + 3, 0]
+            for k in range(nl):
+                y0 = Y[n + j, k]
+                y1 = Y[n + j + 1, k]
+                y2 = Y[n + j + 2, k]
+                y3 = Y[n + j + 3, k]
+                DY[n + i, k] = DY[n + i, k] - a0 * y0 - a1 * y1 - a2 * y2 - a3 * y3
+                DY[n + i + 1, k] = DY[n + i + 1, k] - b0 * y0 - b1 * y1 - b2 * y2 - b3 * y3
+                DY[n + i + 2, k] = DY[n + i + 2, k] - c0 * y0 - c1 * y1 - c2 * y2 - c3 * y3
+                DY[n + i + 3, k] = DY[n + i + 3, k] - d0 * y0 - d1 * y1 - d2 * y2 - d3 * y3
+        for j in range(n4, n):
+            for q in range(4):
+                c = PT[r + q * n + j, 0]
+                for k in range(nl):
+                    DY[n + i + q, k] -= c * Y[n + j, k]
+    for i in range(n4, n):
         r = ct + i * n
         for j in range(0, n4, 4):
             c0 = PT[r + j, 0]
@@ -551,10 +616,12 @@ def planetary_rhs_lanes(T, Y, DY, PT, nl, S, C, SC):
                 DY[i, k] -= (PT[g, k] * PT[r, k]) * Y[j, k]
     multi = _lanes_multi_order(PT, nl)
     kr = _lanes_cached_stiffness(PT, nl, S, C, SC, mz + nm * 3 * MESH_NZ, mesh, bs, nh, nm, two)
+    ko = _lanes_own_phases(T, PT, nl, S, C, _own_offset(PT, nm, mz), n, nh, nm, mesh, bs) \
+        if multi else 0
     for m in range(nm):
         if multi and not _lanes_order_one(PT, nl, mesh + m * bs):
-            _lanes_mesh_orders(Y, DY, PT, nl, T, S, C, SC, n, nh, mesh + m * bs,
-                               mz + m * 3 * MESH_NZ, True, two)
+            _lanes_mesh_own(Y, DY, PT, nl, SC, n, nm, mesh + m * bs, mz + m * 3 * MESH_NZ,
+                            ko + m, True)
         else:
             _lanes_mesh(Y, DY, PT, nl, S, C, SC, n, mesh + m * bs, mz + m * 3 * MESH_NZ,
                         kr + m, True, two, kr + nm + m)
@@ -631,11 +698,13 @@ def planetary_events_lanes(T, Y, G, PT, nl, S, C):
     """:func:`planetary_events` for lanes 0..nl-1 of a block (the mesh phase S[k], C[k])."""
     n, nm, nh, mesh, bs, st, mz = _lanes_offsets(PT)
     multi = _lanes_multi_order(PT, nl)
+    ko = _lanes_own_phases(T, PT, nl, S, C, _own_offset(PT, nm, mz), n, nh, nm, mesh, bs) \
+        if multi else 0
     for m in range(nm):
         o = mesh + m * bs
         q = mz + m * 3 * MESH_NZ
         if multi and not _lanes_order_one(PT, nl, o):
-            _events_lanes_orders(T, Y, G, PT, nl, S, C, n, m, o, q)
+            _events_lanes_own(Y, G, PT, nl, n, nm, m, o, q, ko + m)
             continue
         w = q + MESH_NZ
         i0 = int(PT[q, 0])
@@ -668,10 +737,12 @@ def planetary_observe_lanes(T, Y, O, PT, nl, S, C, SC):
         two |= PT[TWO_FLANK, k] != 0.0
     multi = _lanes_multi_order(PT, nl)
     kr = _lanes_cached_stiffness(PT, nl, S, C, SC, mz + nm * 3 * MESH_NZ, mesh, bs, nh, nm, two)
+    ko = _lanes_own_phases(T, PT, nl, S, C, _own_offset(PT, nm, mz), n, nh, nm, mesh, bs) \
+        if multi else 0
     for m in range(nm):
         if multi and not _lanes_order_one(PT, nl, mesh + m * bs):
-            _lanes_mesh_orders(Y, O[m:m + 1], PT, nl, T, S, C, SC, n, nh, mesh + m * bs,
-                               mz + m * 3 * MESH_NZ, False, two)
+            _lanes_mesh_own(Y, O[m:m + 1], PT, nl, SC, n, nm, mesh + m * bs,
+                            mz + m * 3 * MESH_NZ, ko + m, False)
         else:
             _lanes_mesh(Y, O[m:m + 1], PT, nl, S, C, SC, n, mesh + m * bs,
                         mz + m * 3 * MESH_NZ, kr + m, False, two, kr + nm + m)
@@ -679,8 +750,8 @@ def planetary_observe_lanes(T, Y, O, PT, nl, S, C, SC):
 
 # ---------------------------------------------------------------------------------------------
 # Lane-block forms of a mesh whose order differs from 1 in a lane (a gear train's other stages):
-# the mesh at its own phase (:func:`_mesh_phase`) per lane, its relative stiffness computed
-# there (not cached); a mesh of order 1 in every lane keeps the shared-phase forms.
+# the mesh at its own phase (:func:`_mesh_phase`) per lane, from the own-phase cache
+# (:func:`_lanes_own_phases`); a mesh of order 1 in every lane keeps the shared-phase forms.
 
 
 @nb.njit(inline="always", **_JIT)
@@ -703,32 +774,138 @@ def _lanes_order_one(PT, nl, o):
 
 
 @nb.njit(inline="always", **_JIT)
-def _lanes_mesh_orders(Y, DY, PT, nl, T, S, C, SC, n, nh, o, q, apply, two):
-    """:func:`_lanes_mesh` with the mesh at its own phase in every lane (:func:`_mesh_phase`):
-    the phase, the acting flank's relative stiffness and the force in one pass per lane."""
+def _own_phases_lane(PT, k, t, s, c, r, nm, mesh, bs):
+    """Sin and cos of every mesh's own phase (:func:`_mesh_phase`) in lane k at the time t and
+    the forcing phase s, c into rows r + m and r + nm + m; a mesh whose order equals the
+    previous mesh's in the lane (a stage's meshes) takes that mesh's values (the same)."""
+    om = PT[OMEGA, k]
+    last = 1.0
+    sm = s
+    cm = c
+    for m in range(nm):
+        order = PT[mesh + m * bs + M_ORDER, k]
+        if order == 1.0:
+            PT[r + m, k] = s
+            PT[r + nm + m, k] = c
+            continue
+        if order != last:
+            sm, cm, _ = _mesh_phase(t, order, om, s, c)
+            last = order
+        PT[r + m, k] = sm
+        PT[r + nm + m, k] = cm
+
+
+@nb.njit(inline="always", **_JIT)
+def _lanes_own_stiffness(PT, nl, rs, rc, out, f, nh, x):
+    """:func:`~geardyn.models.elements.harmonic_factor_lane` of the coefficients at row f for
+    every lane at the phase whose sin and cos are in rows rs and rc, into row out (the harmonic
+    recurrence in rows x, x + 1): the same operations in the same order, clipped at 0 alike."""
+    if nh == 0:
+        for k in range(nl):
+            PT[out, k] = 1.0
+        return
+    for k in range(nl):
+        PT[out, k] = PT[f, k] * PT[rc, k] + PT[f + 1, k] * PT[rs, k]
+        PT[x, k] = PT[rc, k]
+        PT[x + 1, k] = PT[rs, k]
+    for h in range(1, nh):
+        for k in range(nl):
+            ch = PT[x, k]
+            sh = PT[x + 1, k]
+            PT[x, k] = ch * PT[rc, k] - sh * PT[rs, k]
+            PT[x + 1, k] = sh * PT[rc, k] + ch * PT[rs, k]
+        for k in range(nl):
+            PT[out, k] += PT[f + 2 * h, k] * PT[x, k] + PT[f + 2 * h + 1, k] * PT[x + 1, k]
+    for k in range(nl):
+        v = 1.0 + PT[out, k]
+        PT[out, k] = v if v > 0.0 else 0.0
+
+
+@nb.njit(inline="always", **_JIT)
+def _own_key(PT, b, k, t, s, c):
+    """Whether lane k's cache entry at row b has the key (t, s, c)."""
+    return (PT[b, k] == t) & (PT[b + 1, k] == s) & (PT[b + 2, k] == c)
+
+
+@nb.njit(inline="always", **_JIT)
+def _lanes_own_phases(T, PT, nl, S, C, own, n, nh, nm, mesh, bs):
+    """Row r of the own-phase cache entry at the lanes' times T and forcing phases (S, C): row
+    r + m holds the sin of mesh m's own phase, r + nm + m its cos, r + 2 nm + m its drive
+    relative stiffness there, r + 3 nm + m its coast one (computed where a lane of the block
+    has two flanks). The block's PT carries ``OWN_ENTRIES`` (2) entries after two scratch rows
+    from row ``own`` + 1 (all zero, empty, whenever a slot is loaded with a lane's
+    coefficients): the four RK4 stages of a step see two new times (the mid-step one twice,
+    the end one again for the events, the observables and as the next step's start), so the
+    sin and cos of each distinct mesh order are computed twice a step per lane, not five times
+    per mesh. A lane's phases are reused only where its key (time and forcing phase) equals
+    the call's exactly, so the values are those computed anew."""
+    width = 3 + 4 * nm
+    x = own + 1  # scratch of the harmonic recurrence
+    for e in range(OWN_ENTRIES):
+        b = own + 3 + e * width
+        hit = True
+        for k in range(nl):
+            hit &= _own_key(PT, b, k, T[k], S[k], C[k])
+        if hit:
+            PT[own, 0] = e
+            return b + 3
+    e = (int(PT[own, 0]) + 1) % OWN_ENTRIES  # not the entry used last
+    b = own + 3 + e * width
+    a = own + 3 + ((e + 1) % OWN_ENTRIES) * width  # the other one
+    r = b + 3
+    for k in range(nl):
+        if _own_key(PT, b, k, T[k], S[k], C[k]):
+            continue
+        if _own_key(PT, a, k, T[k], S[k], C[k]):
+            for j in range(3, 3 + 2 * nm):
+                PT[b + j, k] = PT[a + j, k]
+        else:
+            _own_phases_lane(PT, k, T[k], S[k], C[k], r, nm, mesh, bs)
+        PT[b, k] = T[k]
+        PT[b + 1, k] = S[k]
+        PT[b + 2, k] = C[k]
+    two = False
+    for k in range(nl):
+        two |= PT[TWO_FLANK, k] != 0.0
+    for m in range(nm):
+        o = mesh + m * bs
+        _lanes_own_stiffness(PT, nl, r + m, r + nm + m, r + 2 * nm + m, o + MESH_FIXED, nh, x)
+        if two:
+            _lanes_own_stiffness(PT, nl, r + m, r + nm + m, r + 3 * nm + m,
+                                 o + coast_offset(n, nh), nh, x)
+    PT[own, 0] = e
+    return r
+
+
+@nb.njit(inline="always", **_JIT)
+def _lanes_mesh_own(Y, DY, PT, nl, SC, n, nm, o, q, r, apply):
+    """:func:`_lanes_mesh` with the mesh at its own phase in every lane (:func:`_mesh_phase`),
+    its sin, cos and relative stiffnesses at rows r, r + nm, r + 2 nm, r + 3 nm of the
+    own-phase cache (:func:`_lanes_own_phases`); the coast flank's where the lane has two
+    flanks and the dead zone's output is negative."""
     i0, i1, i2, i3, i4, i5 = _mesh_dofs(PT, q)
     w = q + MESH_NZ
-    fc = o + coast_offset(n, nh)
     for k in range(nl):
-        s, c, om = _mesh_phase(T[k], PT[o + M_ORDER, k], PT[OMEGA, k], S[k], C[k])
-        d, v = _lane_deflection(Y, PT, k, n, o, w, i0, i1, i2, i3, i4, i5, s, c, om)
+        order = PT[o + M_ORDER, k]
+        om = PT[OMEGA, k] if order == 1.0 else order * PT[OMEGA, k]
+        d, v = _lane_deflection(Y, PT, k, n, o, w, i0, i1, i2, i3, i4, i5, PT[r, k],
+                                PT[r + nm, k], om)
         g = dead_zone(d, PT[o + M_B, k])
-        if two and g < 0.0:
-            kf = PT[o + M_KFC, k] * harmonic_factor_lane(PT, k, fc, nh, s, c)
-        else:
-            kf = PT[o + M_KF, k] * harmonic_factor_lane(PT, k, o + MESH_FIXED, nh, s, c)
+        kd = PT[o + M_KF, k] * PT[r + 2 * nm, k]
+        kc = PT[o + M_KFC, k] * PT[r + 3 * nm, k]
+        kf = kc if (PT[TWO_FLANK, k] != 0.0) & (g < 0.0) else kd
         SC[0, k] = kf * g + PT[o + M_CF, k] * v
     _lanes_apply(DY, PT, nl, SC, n, q, apply)
 
 
 @nb.njit(inline="always", **_JIT)
-def _events_lanes_orders(T, Y, G, PT, nl, S, C, n, m, o, q):
+def _events_lanes_own(Y, G, PT, nl, n, nm, m, o, q, r):
     """:func:`planetary_events_lanes`' rows of mesh m (block at o, structure at q) at the
-    mesh's own phase (:func:`_mesh_phase`)."""
+    mesh's own phase (sin and cos at rows r, r + nm of the own-phase cache)."""
     i0, i1, i2, i3, i4, i5 = _mesh_dofs(PT, q)
     w = q + MESH_NZ
     for k in range(nl):
-        s, c, om = _mesh_phase(T[k], PT[o + M_ORDER, k], PT[OMEGA, k], S[k], C[k])
-        d, _ = _lane_deflection(Y, PT, k, n, o, w, i0, i1, i2, i3, i4, i5, s, c, om)
+        d, _ = _lane_deflection(Y, PT, k, n, o, w, i0, i1, i2, i3, i4, i5, PT[r, k],
+                                PT[r + nm, k], 0.0)
         G[2 * m, k] = d - PT[o + M_B, k]
         G[2 * m + 1, k] = d + PT[o + M_B, k]

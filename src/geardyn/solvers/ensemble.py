@@ -248,7 +248,7 @@ def run_plan(model: Model, P: np.ndarray, y0: np.ndarray, plan: LanePlan,
                        lane_array(plan.sample_steps, np.int64))
     cfg = SweepConfig(float(run.converge_tol), int(converge_depth), int(samples),
                       bool(run.locate_edges), float(run.bound), int(n_ev), int(n_obs),
-                      int(width or k.BLOCK))
+                      int(width or block_width(np.diff(start), k.BLOCK)))
     if cfg.width < 1:
         raise ValueError(f"width must be >= 1 (got {width!r})")
     sched = Schedule(start, queue, n_lane, lane_tab, s_tab, c_tab, chain)
@@ -259,6 +259,15 @@ def run_plan(model: Model, P: np.ndarray, y0: np.ndarray, plan: LanePlan,
     out.transient_periods = tr_steps // n_lane
     out.final_time = plan.final_time(out.transient_periods, T0)
     return out
+
+
+def block_width(queued: np.ndarray, block: int) -> int:
+    """Slots of a worker's block: at most ``block``, and as few as fill the rounds that the
+    most lanes (or chains) ``queued`` on one worker take evenly (e.g. 100 lanes in blocks of
+    64: two rounds of 50, not 64 then 36 with 28 slots stepped idle to the end)."""
+    most = int(np.max(queued, initial=1))
+    rounds = -(-most // block)
+    return max(1, -(-most // max(rounds, 1)))
 
 
 def _check_chain(chain: np.ndarray, lanes: int) -> np.ndarray:
