@@ -1,14 +1,17 @@
-"""Cost of labelled fault data (geardyn.fault_dataset): the 19/48 SpurPair of the
-cracked-tooth literature (potential-energy stiffness over a pinion revolution), healthy and
-three faults x ``--speeds`` speeds in [1000, 3000] rpm x ``--torques`` torques in [20, 100] N m
-x ``--seeds`` noise seeds, ``--duration`` s signals at ``--rate`` Hz. The stiffness in the
-``--form`` given (``fourier``, with ``--harmonics`` or the default; ``table``), the step by the
-rule or ``--per-mode`` steps per contact-mode period; run on ``--workers`` local processes or a
-Dask LocalCluster of ``--dask`` single-threaded processes. ``--repeat`` runs, the median
-printed with seconds per condition (one simulation) and per signal, and the time 10 000
-one-second signals would take at the same rate (10 000 distinct conditions, and 10 seeds per
-condition). Without ``--form``, ``--per-mode`` and ``--workers`` it runs on an older geardyn as
-well (the "before" of bench/RESULTS.md: run it with that tree first on PYTHONPATH).
+"""Cost of labelled fault data (geardyn.fault_dataset): the 19/48 SpurPair of the cracked-tooth
+literature (potential-energy stiffness over a pinion revolution), healthy and three faults x
+``--speeds`` speeds in [1000, 3000] rpm x ``--torques`` torques in [20, 100] N m x ``--seeds``
+noise seeds, ``--duration`` s signals at ``--rate`` Hz. The stiffness in the ``--form`` given
+(``fourier``, with ``--harmonics`` or the default; ``table``), the step by the rule or
+``--per-mode`` steps per contact-mode period; run on ``--workers`` local processes or a Dask
+LocalCluster of ``--dask`` single-threaded processes. ``--repeat`` runs, the median printed with
+seconds per condition (one simulation) and per signal, and the time 10 000 one-second signals
+would take at the same rate (10 000 distinct conditions, and 10 seeds per condition); and the
+CPU time (this process and its finished children: the local worker processes) per condition,
+which a machine shared with other jobs does not inflate as it does the wall time, with the wall
+time it gives on two idle cores (CPU time / 2). Without ``--form``, ``--per-mode`` and
+``--workers`` it runs on an older geardyn as well (the "before" of bench/RESULTS.md: run it with
+that tree first on PYTHONPATH).
 
     .venv/bin/python bench/fault_dataset.py [--speeds 5] [--torques 2] [--seeds 10]
         [--duration 1.0] [--rate 20000] [--form table] [--per-mode 50] [--workers 2]
@@ -20,6 +23,7 @@ from __future__ import annotations
 import argparse
 import math
 import os
+import resource
 import statistics
 import tempfile
 import time
@@ -75,13 +79,14 @@ def main() -> None:
     m = build((), a.harmonics, a.form)
     one = geardyn.RunSettings(transient=0.0, samples=1)
     steps = geardyn.simulate(m.with_params(speed=3000.0), run=one).attrs["steps_per_period"]
-    walls = []
+    walls, cpus = [], []
     for _ in range(a.repeat):
         with tempfile.TemporaryDirectory() as tmp:
-            t0 = time.perf_counter()
+            c0, t0 = _cpu(), time.perf_counter()
             ds = geardyn.fault_dataset(spec, store=f"{tmp}/d.zarr", client=client, **run_kw)
             walls.append(time.perf_counter() - t0)
-    wall = statistics.median(walls)
+            cpus.append(_cpu() - c0)
+    wall, cpu = statistics.median(walls), statistics.median(cpus)
     n_cond, n_sig = ds.attrs["n_conditions"], ds.attrs["n_signals"]
     err = float(ds["stiffness_error_drive_max"].max())
     form = a.form or "fourier"
@@ -96,6 +101,16 @@ def main() -> None:
           f" 10 000 signals ({a.seeds} seeds each condition): {wall / n_sig * 1e4 / 60:.2f} min; "
           f"10 000 conditions: {wall / n_cond * 1e4 / 60:.2f} min; diverged "
           f"{ds.attrs['diverged']}")
+    print(f"CPU time: median {cpu:.2f} s ({' '.join(f'{c:.2f}' for c in cpus)}), "
+          f"{cpu / n_cond * 1e3:.1f} ms per condition; 10 000 conditions on two idle cores: "
+          f"{cpu / n_cond * 1e4 / 2 / 60:.2f} min")
+
+
+def _cpu() -> float:
+    """User + system CPU seconds of this process and its finished children."""
+    own, kids = (resource.getrusage(w) for w in (resource.RUSAGE_SELF,
+                                                  resource.RUSAGE_CHILDREN))
+    return own.ru_utime + own.ru_stime + kids.ru_utime + kids.ru_stime
 
 
 class _Build:

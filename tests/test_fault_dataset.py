@@ -211,3 +211,58 @@ def test_a_fault_the_model_refuses_is_named_before_any_work():
 def test_workers_must_be_a_whole_number():
     with pytest.raises(ParameterError, match="workers"):
         geardyn.fault_dataset(spec(), workers=0)
+
+
+# ---------------------------------------------------------------------------------------------
+# a planetary stage: the ring sensor's signal
+
+
+def planetary_build(faults):
+    """The shipped 25/23/71 four-planet stage on its potential-energy stiffness (a fault's
+    period: one revolution of the sun)."""
+    import tomllib
+    from importlib.resources import files
+
+    from planetary_example_set import planetary_by_hand
+
+    doc = tomllib.loads(files("geardyn.studies").joinpath("planetary_example.toml").read_text())
+    return planetary_by_hand(doc, stiffness="potential_energy", faults=faults,
+                             stiffness_options=dict(sun_bore_radius="12 mm",
+                                                    planet_bore_radius="10 mm",
+                                                    ring_rim_radius="85 mm", angles=32))
+
+
+def test_a_planetary_dataset_is_the_ring_sensor_signal_of_a_simulation():
+    """Healthy (a zero-size crack on the sun: the same period) and a 1.5 mm sun crack, 3000
+    rpm, 20 N m: each condition's clean signal is the ring sensor signal
+    (planetary_sensor_signal, width pi/2) of geardyn.simulate of the same model on the same
+    grid (the sample rate a whole number K of samples per forcing period, K | the steps), to
+    1e-8 of its peak-to-peak (the run-up kernel's libm phase against simulate's rotated phase
+    table; each fault its own time scale); the crack changes the signal."""
+    from geardyn.analysis.fault_dataset import seconds_per_time_unit
+    from geardyn.analysis.sensor import planetary_sensor_signal
+
+    faults = (RootCrack("0 mm", gear="sun"), RootCrack("1.5 mm", gear="sun"))
+    m = planetary_build((faults[1],)).with_params(input_speed=3000.0, sun_torque=20.0)
+    unit = seconds_per_time_unit(m)
+    period = 2.0 * math.pi / m.omega
+    K = round(20_000.0 * period * unit)  # samples per forcing period
+    n = K * math.ceil(geardyn.default_steps_per_period(m) / K)
+    rate = K / (period * unit)
+    s = geardyn.FaultDatasetSpec(planetary_build, faults, speeds=[3000.0], torques=[20.0],
+                                 seeds=[0], snr_db=math.inf, duration=0.01, sample_rate=rate,
+                                 steps_per_period=n, sensor={"width": math.pi / 2})
+    ds = dataset(s)
+    assert ds.attrs["speed_input"] == "input_speed" and (ds["status"].values == 0).all()
+    assert [str(k) for k in ds["fault_kind"].values] == ["crack", "crack"]
+    samples = ds.sizes["time"]
+    for i, fault in enumerate(faults):
+        model = planetary_build((fault,)).with_params(input_speed=3000.0, sun_torque=20.0)
+        sim = geardyn.simulate(model, run=geardyn.RunSettings(
+            transient=0.0, samples=math.ceil(samples / K), steps_per_period=n))
+        expected = planetary_sensor_signal(sim, model, width=math.pi / 2)["signal"].values[
+            : samples * (n // K): n // K]
+        got = ds["signal"].values[i, 0, 0, 0]
+        assert np.max(np.abs(got - expected)) < 1e-8 * np.ptp(expected)
+    crack = ds["signal"].values[1, 0, 0, 0] - ds["signal"].values[0, 0, 0, 0]
+    assert np.max(np.abs(crack)) > 0.02 * np.ptp(ds["signal"].values[0, 0, 0, 0])  # meas. 0.04

@@ -245,12 +245,13 @@ def lane_noise(clean: np.ndarray, snr_db: float, seed: int, key: Sequence[int]
 
 
 def _dataset_task(model: Model, head: np.ndarray, y0: np.ndarray, steps: np.ndarray,
-                  key: np.ndarray, *, spec: dict[str, Any]) -> dict[str, np.ndarray]:
+                  unit: np.ndarray, key: np.ndarray, *, spec: dict[str, Any]
+                  ) -> dict[str, np.ndarray]:
     """The lane task: per condition, its coefficient vector (the fault's ``bases`` row with the
-    columns ``cols`` from ``head``), the steady record, the sensor signal, each seed's noise."""
+    columns ``cols`` from ``head``), the steady record (seconds per model time unit ``unit``:
+    a planetary set's time scale is its own), the sensor signal, each seed's noise."""
     n, seeds = int(spec["n_samples"]), spec["seeds"]
     bases, cols = spec["bases"], spec["cols"]
-    unit = seconds_per_time_unit(model)
     out_signal = np.zeros((head.shape[0], len(seeds), n))
     status = np.zeros(head.shape[0], dtype=np.int8)
     unresolved = np.zeros(head.shape[0], dtype=np.int64)
@@ -260,8 +261,8 @@ def _dataset_task(model: Model, head: np.ndarray, y0: np.ndarray, steps: np.ndar
         p = np.array(bases[int(key[i, 0])], dtype=float)
         p[cols] = head[i]
         m.params = p
-        rec = steady_record(m, n, spec["sample_rate"] * unit,
-                            transient=spec["transient"] / unit,
+        rec = steady_record(m, n, spec["sample_rate"] * unit[i],
+                            transient=spec["transient"] / unit[i],
                             steps_per_period=int(steps[i]), y0=y0[i])
         status[i], unresolved[i] = rec.status, rec.unresolved
         if status[i] != Status.OK:
@@ -279,8 +280,9 @@ def _dataset_task(model: Model, head: np.ndarray, y0: np.ndarray, steps: np.ndar
 class _Conditions:
     """Every condition of a spec, compact: ``bases`` (fault, coefficient) each fault's
     vector; per condition (fault, speed, torque; C order) the columns ``cols`` that speed and
-    torque set (``head``), its initial state ``y0``, steps per period ``steps`` and indices
-    ``key``; per fault the stiffness truncation errors ``errors`` (where the model has them)."""
+    torque set (``head``), its initial state ``y0``, steps per period ``steps``, seconds per
+    model time unit ``unit`` and indices ``key``; per fault the stiffness truncation errors
+    ``errors`` (where the model has them)."""
 
     model: Model
     bases: np.ndarray
@@ -288,6 +290,7 @@ class _Conditions:
     head: np.ndarray
     y0: np.ndarray
     steps: np.ndarray
+    unit: np.ndarray
     key: np.ndarray
     errors: dict[str, list[float]]
 
@@ -295,7 +298,7 @@ class _Conditions:
 def _conditions(spec: FaultDatasetSpec) -> _Conditions:
     """The conditions of ``spec`` (:class:`_Conditions`). A fault the model refuses raises
     here, before any work."""
-    bases, changes, y0, steps, key = [], [], [], [], []
+    bases, changes, y0, steps, unit, key = [], [], [], [], [], []
     errors: dict[str, list[float]] = {}
     first = None
     for fi, fault in enumerate(spec.faults):
@@ -324,6 +327,7 @@ def _conditions(spec: FaultDatasetSpec) -> _Conditions:
                 changes.append((changed, p[changed]))
                 y0.append(np.asarray(m.initial_state(), dtype=float))
                 steps.append(lane_steps(m, spec))
+                unit.append(seconds_per_time_unit(m))
                 key.append((fi, si, ti))
     assert first is not None
     B = np.array(bases)
@@ -333,7 +337,7 @@ def _conditions(spec: FaultDatasetSpec) -> _Conditions:
     for i, (c, v) in enumerate(changes):
         head[i, np.searchsorted(cols, c)] = v
     return _Conditions(first, B, cols.astype(np.int64), head, np.array(y0),
-                       np.array(steps, dtype=np.int64), K, errors)
+                       np.array(steps, dtype=np.int64), np.array(unit), K, errors)
 
 
 def default_workers() -> int:
@@ -374,7 +378,7 @@ def fault_dataset(spec: FaultDatasetSpec, store: Any = None, client: Any = None,
                  "n_samples": spec.n_samples, "bases": c.bases, "cols": c.cols,
                  "bases_sha256": hashlib.sha256(c.bases.tobytes()).hexdigest()}
     task = functools.partial(_dataset_task, spec=task_spec)
-    inputs = {"head": c.head, "y0": c.y0, "steps": c.steps, "key": c.key}
+    inputs = {"head": c.head, "y0": c.y0, "steps": c.steps, "unit": c.unit, "key": c.key}
     n_workers = min(default_workers() if workers is None else workers, c.key.shape[0])
     meta = {"kind": "fault-dataset", **settings}
     if client is not None or n_workers == 1:

@@ -258,7 +258,8 @@ class SpurPair(Model):
             raise ParameterError("harmonics", harmonics, "sets the Fourier form's series; the"
                                  " table form evaluates the table itself (leave it out)")
         self.stiffness_form = stiffness_form
-        n_h = _harmonics(harmonics, cycles, int(stiffness.sizes["angle"]))
+        n_h = (0 if stiffness_form == "table"  # no series: its mean k0 only
+               else _harmonics(harmonics, cycles, int(stiffness.sizes["angle"])))
         if speed_unit not in SPEED_UNITS:
             raise ParameterError("speed_unit", speed_unit,
                                  f"must be one of {', '.join(SPEED_UNITS)}")
@@ -435,7 +436,7 @@ class SpurPair(Model):
     # ------------------------------------------------------------------ physics
     @property
     def n_harmonics(self) -> int:
-        """H: harmonics of Omega in each flank's stiffness series."""
+        """H: harmonics of Omega in each flank's stiffness series (0 in the table form)."""
         return (self.drive_series.size - 1) // 2
 
     @property
