@@ -82,7 +82,7 @@ def dataset_command(
     """Labelled fault data: the study's spur pair over [dataset]'s faults x speeds x torques x
     noise seeds, the sensor signals (the mesh force with white noise) and their labels in a
     chunked Zarr store that xarray.open_zarr opens; a rerun resumes."""
-    import geardyn
+    from geardyn.analysis.fault_dataset import FaultDatasetSpec, fault_dataset
     from geardyn.cli.bifurcation import _progress_bar, _stderr_is_terminal
     from geardyn.io.toml import SpurPairParams
 
@@ -101,7 +101,7 @@ def dataset_command(
             raise ParameterError(option, value, "must be a whole number >= 1")
     conditions = fault_conditions(s)
     try:
-        spec = geardyn.FaultDatasetSpec(
+        spec = FaultDatasetSpec(
             StudyFaultBuilder(s, conditions), [f for f, _ in conditions], speeds=table.speeds,
             torques=table.torques, seeds=table.seed_list(), snr_db=table.snr(),
             duration=table.duration, sample_rate=table.sample_rate, transient=table.transient,
@@ -113,8 +113,8 @@ def dataset_command(
     show_bar = not quiet and _stderr_is_terminal()
     t0 = time.perf_counter()
     with _progress_bar(show_bar, escape(f"{s.study.name}: dataset")) as callback:
-        ds = geardyn.fault_dataset(spec, store=path, progress=callback,
-                                   workers=workers if workers is not None else table.workers)
+        ds = fault_dataset(spec, store=path, progress=callback,
+                           workers=workers if workers is not None else table.workers)
     elapsed = time.perf_counter() - t0
     typer.echo(f"{s.study.name}: {ds.attrs['n_conditions']} conditions, "
                f"{ds.attrs['n_signals']} signals of {spec.duration:g} s at "
