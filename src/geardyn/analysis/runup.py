@@ -390,7 +390,8 @@ def _state_units(model: Model) -> list[str]:
 @dataclass(frozen=True)
 class SteadyRecord:
     """What :func:`steady_record` returns: ``states`` (n, n_states) and ``observables`` (n,
-    n_obs) at the sample times ``time`` (n,) [model time, from the end of the transient];
+    n_obs) at the sample times ``time`` (n,) [model time from the run's start, the transient
+    included: the forcing phase there is Omega time];
     ``status`` (:class:`~geardyn.Status`; rows after a divergence NaN), ``unresolved`` (steps
     that reached the split limit), ``step`` and ``stride`` (steps per sample)."""
 
@@ -431,4 +432,5 @@ def steady_record(model: Model, samples: int, sample_rate: float, *, transient: 
         p, y, h, 0, n_tr + (samples - 1) * stride, n_tr, stride, True, om, 0.0, 0.0, 0.0,
         cols, coef, locate_edges, bound, n_ev, model.n_observables, False,
         np.full((2, max(n_ev, 1)), np.nan), np.ones(n_ev, np.int64))
-    return SteadyRecord(np.arange(samples) * dt, Y, O, int(status), int(unresolved), h, stride)
+    t = (n_tr + np.arange(samples) * stride) * h
+    return SteadyRecord(t, Y, O, int(status), int(unresolved), h, stride)
