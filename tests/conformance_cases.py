@@ -94,6 +94,23 @@ def spur_pair() -> geardyn.SpurPair:
                             harmonics=38)
 
 
+def train() -> geardyn.Model:
+    """A spur pair as a gear train (:class:`geardyn.trains.TrainModel`): the pinion on a
+    flexible bearing with a 15 um clearance (two contacts besides the mesh), the wheel on a
+    rigid one, 10 um backlash, a 30 % stiffness fluctuation; the wheel's torque balances the
+    pinion's (a free rigid-body rotation)."""
+    from geardyn.trains import Bearing, Gear, GearTrain, Mesh, TrainModel
+
+    rb = [0.5 * 3e-3 * z * math.cos(math.radians(20.0)) for z in (19, 48)]
+    gears = [Gear("p", 2e-4, base_radius=rb[0], n_teeth=19, mass=0.6),
+             Gear("w", 6e-3, base_radius=rb[1], n_teeth=48)]
+    t = GearTrain(gears, bearings=[Bearing("bp", "p", 1e8, clearance="15 um", damping=100.0),
+                                   Bearing("bw", "w", math.inf)],
+                  meshes=[Mesh("mesh", "p", "w", 3e8, damping=100.0)], driven="p", free=True)
+    return TrainModel(t, torques={"p": 2.0}, load="w", backlash="10 um",
+                      stiffness_fluctuation=0.3, input_speed=5500.0)
+
+
 def cases() -> dict[str, tuple[geardyn.Model, np.ndarray]]:
     """Case id -> (model, start state)."""
     reduced = _catt()
@@ -102,6 +119,7 @@ def cases() -> dict[str, tuple[geardyn.Model, np.ndarray]]:
     pair = geardyn.GearPair(Omega=1.3, kappa=0.2, Fa=0.2)
     user = user_model()
     gs = planetary()
+    tm = train()
     kick = np.random.default_rng(1).normal(0.0, 1.0, gs.n_states) * np.r_[[3.0] * 18, [1.0] * 18]
     return {
         "CATTDevice-reduced": (reduced, _kicked(reduced, [0.3, 0.1, -0.2, 0.05])),
@@ -112,8 +130,10 @@ def cases() -> dict[str, tuple[geardyn.Model, np.ndarray]]:
         "UserModel-one-form": (gear_pair(Omega=1.3, kappa=0.2, Fa=0.2), np.zeros(2)),
         "PlanetaryGearSet": (gs, gs.initial_state() + kick),
         "SpurPair": (spur_pair(), np.array([-3e-5, 0.0])),  # coast contact: crosses the zone
+        "TrainModel": (tm, tm.initial_state() + np.r_[0.0, 20.0, -20.0, 0.0, 0.0, 0.0, 0.0,
+                                                      0.0]),
     }
 
 
 IDS = ("CATTDevice-reduced", "CATTDevice-general", "DimensionalCATT", "GearPair", "UserModel",
-       "UserModel-one-form", "PlanetaryGearSet", "SpurPair")
+       "UserModel-one-form", "PlanetaryGearSet", "SpurPair", "TrainModel")

@@ -44,3 +44,19 @@ def test_bad_input_is_one_line(capsys):
     r = geardyn_here(capsys, "dynamic-factor", "paper_fig3", "--f-pb", 9, "--f-falpha", 8,
                      "--range", "1000:2000:2")
     assert_one_line_error(r, "geometry")
+
+
+def test_a_train_study_gives_one_group_per_stage(capsys, tmp_path):
+    out = tmp_path / "train.nc"
+    r = geardyn_here(capsys, "dynamic-factor", "two_stage_train", "--f-pb", 9, "--f-falpha",
+                     8, "--range", "1000:2000:2", "--transient", 200, "--samples", 8,
+                     "--out", out)
+    assert r.returncode == 0, r.stderr
+    written = load_dataset(out)
+    assert list(written["group"].values) == ["stage1", "stage2"]
+    ds = geardyn.dynamic_factor_sweep(
+        geardyn.build_model(builtin_study("two_stage_train")), [1000.0, 2000.0], None,
+        geardyn.RunSettings(transient=200.0, samples=8), base_pitch_deviation=9.0,
+        profile_form_deviation=8.0)
+    np.testing.assert_array_equal(written["dynamic_factor"].values, ds["dynamic_factor"].values)
+    assert "stage2" in r.stdout

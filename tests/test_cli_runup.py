@@ -123,6 +123,13 @@ def test_without_a_table_the_range_is_asked_for(tmp_path):
     assert r.returncode == 2 and "--start: not given, and the study has no [runup]" in r.stderr
 
 
-def test_a_model_it_cannot_drive_is_one_line(tmp_path):
-    r = invoke("runup", "two_stage_train", "--start", "0.5", "--stop", "1", "--rate", "0.01")
-    assert r.returncode == 2 and "a run-up cannot drive it" in r.stderr
+def test_a_train_with_a_non_whole_stage_ratio_runs_up_in_rpm(tmp_path):
+    out = tmp_path / "train.nc"
+    r = invoke("runup", "two_stage_train", "--param", "input_speed", "--start", "1000",
+               "--stop", "1100", "--duration", "20", "--outputs", "F_stage1,F_stage2",
+               "--quiet", "--out", out)
+    assert r.returncode == 0, r.stderr
+    from geardyn.io.netcdf import load_dataset
+
+    ds = load_dataset(out)
+    assert np.all(np.isfinite(ds["F_stage2"].values)) and ds.attrs["status"] == 0

@@ -136,8 +136,10 @@ def test_bad_input_names_the_value(softening):
     fold = int(np.flatnonzero(br["bifurcation_kind"].values == "fold")[0])
     with pytest.raises(KeyError, match="nonsense"):
         geardyn.curve(m, br, fold, "nonsense", 1.0)
-    with pytest.raises(ValueError, match=f"bifurcation={contact} is a contact change.*grazing"):
-        geardyn.curve(m, br, contact, "Fa", 0.0)
+    with pytest.raises(ValueError, match="leave x_scale, y_scale and locate_tol unset"):
+        geardyn.curve(m, br, contact, "Fa", 0.0, settings=geardyn.CurveSettings(x_scale=1.0))
+    with pytest.raises(ValueError, match="y_stop must be finite"):
+        geardyn.curve(m, br, contact, "Fa", 0.05)
     with pytest.raises(ValueError, match="bifurcation=17 is not an index"):
         geardyn.curve(m, br, 17, "Fa", 0.0)
     with pytest.raises(ValueError, match="y_stop=0.05"):
@@ -274,3 +276,27 @@ def test_a_curve_leaving_the_valid_region_ends_with_a_message(mathieu):
     assert c.attrs["status"] == int(geardyn.BranchStatus.INVALID)
     assert "kappa: must be < 1" in c.attrs["message"]
     assert 0.999 < float(c["kappa"].max()) < 1.0
+
+
+def test_a_contact_change_gives_its_grazing_curve(softening):
+    """geardyn.curve from a branch's contact change follows the edge its orbit grazes: for the
+    softening pair's first one (contact lost), the drive flank's contact-loss curve, whose
+    closed form for kappa = 0 is Fa = Fm |1 - Omega^2 + 2 i zeta Omega| / Omega^2 (see
+    tests/test_grazing_curves.py)."""
+    m, br = softening
+    contacts = np.flatnonzero(br["bifurcation_kind"].values == "contact")
+    first = int(contacts[0])
+    seen: list[int] = []
+    c = geardyn.curve(m, br, first, "Fa", 0.3, progress=lambda k, x, y: seen.append(k))
+    assert_result(c, "curve")
+    assert c.attrs["curve_kind"] == "grazing" and c.attrs["flank"] == "drive"
+    om, fa = c["Omega"].values, c["Fa"].values
+    inside = (fa >= 0.05) & (fa <= 0.3)
+    assert inside.sum() > 5 and seen
+    exact = 0.1 * np.abs(1 - om**2 + 2j * 0.05 * om) / om**2
+    np.testing.assert_allclose(fa, exact, rtol=2e-5)
+    at = float(br["bifurcation_value"][first])
+    assert np.min(np.hypot(om - at, fa - 0.05)) < 1e-3
+    # in the box the branch's range of Omega by [0.05, 0.3], left at both ends
+    assert c.attrs["status"] == int(geardyn.BranchStatus.COMPLETED), c.attrs["message"]
+    assert c.attrs["message"].count("left the box Omega in [0.6, 1.4], Fa in [0.05, 0.3]") == 2

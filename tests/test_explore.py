@@ -10,6 +10,7 @@ import threading
 import numpy as np
 import pytest
 
+import geardyn
 from geardyn.cli.errors import format_error
 from geardyn.explore.compute import (
     compute_diagram,
@@ -407,8 +408,8 @@ def test_a_geometry_model_offers_its_faults_and_bores_as_controls(spur):
     (from the RootCrack dataclass: depth, angle, tooth), by their study-file keys, with the
     study's values; a gear-pair study has none."""
     assert spur.geometry_params() == ("gears.pinion.bore_radius", "gears.wheel.bore_radius",
-                                      "faults[0].gear", "faults[0].depth", "faults[0].angle",
-                                      "faults[0].tooth")
+                                      "faults[0].kind", "faults[0].gear", "faults[0].depth",
+                                      "faults[0].angle", "faults[0].tooth")
     assert spur.choices("faults[0].gear") == ("pinion", "wheel")
     assert spur.current_value("faults[0].depth") == "2 mm"
     assert spur.current_value("faults[0].tooth") == 9
@@ -567,9 +568,9 @@ def test_every_fault_kind_gets_its_numeric_fields_as_controls(tmp_path):
     st = ExplorerState(load_study(text), "spur.toml", save_dir=tmp_path,
                        describe_error=format_error)
     assert st.geometry_params()[2:] == (
-        "faults[0].gear", "faults[0].length", "faults[0].width", "faults[0].depth",
-        "faults[0].position", "faults[0].tooth", "faults[1].gear", "faults[1].depth",
-        "faults[1].tooth")
+        "faults[0].kind", "faults[0].gear", "faults[0].length", "faults[0].width",
+        "faults[0].depth", "faults[0].position", "faults[0].tooth", "faults[1].kind",
+        "faults[1].gear", "faults[1].depth", "faults[1].tooth")
     assert st.current_value("faults[0].position") == 0.0  # Spall's default
     model = st.model
     msg = st.set_override("faults[0].position", "20 mm")
@@ -579,6 +580,66 @@ def test_every_fault_kind_gets_its_numeric_fields_as_controls(tmp_path):
     spall = g.Spall("1 mm", "4 mm", "0.2 mm", gear="pinion", tooth=9)
     wear = g.Wear("20 um", gear="pinion", tooth=3)
     assert st.model.params.tobytes() == _spur_model_by_hand(spall, wear).params.tobytes()
+
+
+def test_a_fault_changes_kind_through_its_control(spur):
+    """The crack's kind is a choice: as a spall it keeps its gear and tooth, starts at zero
+    size (the healthy tooth: the crack's depth is dropped) and offers Spall's fields, whose
+    values then give SpurPair of the pair with that spall built here; as a missing tooth it
+    has no size; an unknown kind is refused naming the control, the state kept."""
+    import geardyn.gears as g
+
+    assert spur.choices("faults[0].kind") == ("crack", "spall", "wear", "broken_tooth")
+    assert spur.current_value("faults[0].kind") == "crack"
+    assert spur.set_override("faults[0].depth", "1 mm") is None
+    assert spur.set_override("faults[0].kind", "spall") is None
+    assert spur.geometry_params()[2:] == (
+        "faults[0].kind", "faults[0].gear", "faults[0].length", "faults[0].width",
+        "faults[0].depth", "faults[0].position", "faults[0].tooth")
+    assert spur.current_value("faults[0].length") == 0.0  # zero size until set
+    assert spur.current_value("faults[0].depth") == 0.0  # not the crack's
+    assert spur.current_value("faults[0].tooth") == 9
+    assert "spall on the pinion" in spur.param_help("faults[0].width")
+    zero = g.Spall(0.0, 0.0, 0.0, gear="pinion", tooth=9)
+    assert spur.model.params.tobytes() == _spur_model_by_hand(zero).params.tobytes()
+    for key, text in (("faults[0].length", "1 mm"), ("faults[0].width", "4 mm"),
+                      ("faults[0].depth", "0.1 mm")):
+        assert spur.set_override(key, text) is None, key
+    spall = g.Spall("1 mm", "4 mm", "0.1 mm", gear="pinion", tooth=9)
+    assert spur.model.params.tobytes() == _spur_model_by_hand(spall).params.tobytes()
+    assert spur.effective_study.faults[0].kind == "spall"
+    assert spur.set_override("faults[0].kind", "broken_tooth") is None
+    assert spur.geometry_params()[2:] == ("faults[0].kind", "faults[0].gear",
+                                          "faults[0].tooth")
+    assert set(spur.overrides) == {"faults[0].kind"}  # the spall's sizes went with it
+    missing = g.BrokenTooth(gear="pinion", tooth=9)
+    assert spur.model.params.tobytes() == _spur_model_by_hand(missing).params.tobytes()
+    model = spur.model
+    msg = spur.set_override("faults[0].kind", "dent")
+    assert msg.startswith("faults[0].kind"), msg
+    assert spur.model is model and spur.overrides == {"faults[0].kind": "broken_tooth"}
+
+
+def test_the_page_rebuilds_the_fault_controls_for_a_new_kind(spur):
+    """Choosing wear for the crack on the page: the controls are Wear's fields (no angle)."""
+    from bokeh.document import Document
+
+    from geardyn.explore import app
+
+    ds = compute_diagram(spur.diagram_request())
+    page = app.ExplorerSession(Document(), spur, ds, format_error)
+    page._later = lambda fn, *args: fn(*args)
+    try:
+        assert "faults[0].angle" in page.inputs
+        page._on_param("faults[0].kind", "value", "crack", "wear")
+        page.runner.wait(60)
+        assert page.input_messages["faults[0].kind"].text == ""
+        assert "faults[0].angle" not in page.inputs and "faults[0].depth" in page.inputs
+        titles = [c.children[0].title for c in page.geometry_row.children]
+        assert titles == list(spur.geometry_params())
+        assert "wear on pinion tooth 9" in page.stiffness_faults.text
+    finally:
+        page.runner.shutdown()
 
 
 # ------------------------------------------------------------- a planetary set from geometry
@@ -637,8 +698,12 @@ def test_a_planetary_geometry_offers_its_stiffness_and_fault_controls(planetary)
         "params.geometry.stiffness_options.sun_bore_radius",
         "params.geometry.stiffness_options.planet_bore_radius",
         "params.geometry.stiffness_options.ring_rim_radius",
-        "params.geometry.faults[0].gear", "params.geometry.faults[0].depth",
-        "params.geometry.faults[0].angle", "params.geometry.faults[0].tooth")
+        "params.geometry.faults[0].kind", "params.geometry.faults[0].gear",
+        "params.geometry.faults[0].depth", "params.geometry.faults[0].angle",
+        "params.geometry.faults[0].tooth")
+    assert planetary.choices("params.geometry.faults[0].kind") == (
+        "crack", "spall", "wear", "broken_tooth")
+    assert planetary.current_value("params.geometry.faults[0].kind") == "crack"
     assert planetary.choices("params.geometry.stiffness") == ("iso", "potential_energy")
     assert planetary.choices("params.geometry.coast") == ("mirror", "symmetric")
     assert planetary.choices("params.geometry.faults[0].gear") == (
@@ -825,3 +890,60 @@ def test_the_page_of_a_planetary_set_on_the_iso_waves(tmp_path):
         assert st.model.coast_flank == "symmetric" and st.model.stiffness_method == "iso"
     finally:
         page.runner.shutdown()
+
+
+def test_a_train_offers_its_fault_controls():
+    """The two_stage_train study on the potential-energy stiffness with a crack on g1: the
+    fault's kind, gear (a choice of the train's gears) and the crack's fields as controls; the
+    crack moved to g4 and made a missing tooth gives the model of the study file written so."""
+    import geardyn.gears as g
+    from geardyn.io.toml import builtin_study_text
+    from geardyn.study import build_model
+
+    text = builtin_study_text("two_stage_train").replace(
+        'stiffness = "iso"', 'stiffness = "potential_energy"\nbore_radius = "10 mm"').replace(
+        "stiffness_fluctuation = 0.25\n", "").replace(
+        "[run]\n", "[run]\nomega = 0.07\nperiods = 2\n")
+    crack = '\n[[train.faults]]\nkind = "crack"\ngear = "g1"\ntooth = 3\ndepth = "1 mm"\n'
+    st = ExplorerState(load_study(text + crack), "two.toml", param="Omega",
+                       window=Window(0.07, 0.075, 2), describe_error=format_error)
+    assert st.geometry_params() == (
+        "train.faults[0].kind", "train.faults[0].gear", "train.faults[0].depth",
+        "train.faults[0].angle", "train.faults[0].tooth")
+    assert st.choices("train.faults[0].gear") == ("g1", "g2", "g3", "g4")
+    assert st.current_value("train.faults[0].depth") == "1 mm"
+    assert st.model.faults.gear == "g1" and st.model.mesh_order == 19
+    assert st.set_override("train.faults[0].gear", "g4") is None
+    assert st.set_override("train.faults[0].kind", "broken_tooth") is None
+    assert st.model.faults.gear == "g4"
+    assert st.model.faults.faults == (g.BrokenTooth(gear="g4", tooth=3),)
+    by_hand = build_model(load_study(
+        text + '\n[[train.faults]]\nkind = "broken_tooth"\ngear = "g4"\ntooth = 3\n'),
+        omega=0.07)
+    assert st.model.params.tobytes() == by_hand.params.tobytes()
+    msg = st.set_override("train.faults[0].gear", "g9")
+    assert msg.startswith("train.faults[0].gear") and "g9" in msg, msg
+
+
+def test_a_train_study_is_explored_in_input_speed():
+    from geardyn.explore.compute import compute_diagram, compute_orbit, orbit_request
+
+    st = ExplorerState(builtin_study("two_stage_train"), "two_stage_train",
+                       window=Window(1500.0, 2500.0, 3))
+    assert st.param == "input_speed"
+    assert {"mesh_damping", "backlash", "modal_damping"} <= set(st.main_params())
+    assert st.set_override("mesh_damping", "0.08") is None
+    assert "backlash" in st.set_override("backlash", "-1")
+    req = st.diagram_request()
+    # transient_periods count periods of the window's lowest speed, as the CLI counts them
+    low = st.model.with_params(input_speed=1500.0).omega
+    assert req.run == st.effective_study.run_settings(sweep=True, omega=low)
+    ds = compute_diagram(req)
+    cli = geardyn.bifurcation(geardyn.build_model(st.effective_study), "input_speed",
+                              [1500.0, 2000.0, 2500.0], req.run)
+    np.testing.assert_array_equal(ds["poincare"].values, cli["poincare"].values)
+    view = compute_orbit(orbit_request(req, ds, 2000.0))
+    assert view.status == "ok" and view.value == 2000.0
+    nrel = builtin_study("nrel_5mw_gearbox_sweep")  # per-mesh backlash: not a control
+    assert "backlash" not in ExplorerState(nrel, "nrel", window=Window(10.0, 12.0, 2)
+                                           ).main_params()

@@ -307,8 +307,11 @@ def test_bad_fault_names_the_field(geo, fault, field):
 
 
 def test_bad_fault_specs_name_the_field(geo):
-    with pytest.raises(ParameterError) as err:
-        g.RootCrack(depth="1 mm", gear="moon")
+    with pytest.raises(ParameterError) as err:  # no gear of the set
+        pe_set(geo, [g.RootCrack(depth="1 mm", gear="moon")])
+    assert err.value.field == "crack.gear"
+    with pytest.raises(ParameterError) as err:  # no gear's name at all
+        g.RootCrack(depth="1 mm", gear="")
     assert err.value.field == "crack.gear"
     with pytest.raises(ParameterError) as err:  # off the ring tooth's active flank
         pe_set(geo, [g.Spall(length="1 mm", width="2 mm", depth="0.1 mm", position="3 mm",

@@ -3,7 +3,9 @@
 pinion speed at three torques, its dynamic factor beside ISO 6336-1 K_v (method B; f_pb 9 um,
 f_falpha 8 um, y_p = y_f = 0.7 um, no tip relief), and the peak dynamic factor near N = 1 at
 three damping ratios; then the built-in planetary_example stage (sun 20 N m, input speed
-1000-20 000 rpm), its sun-planet and ring-planet meshes beside ISO's K_v of each.
+1000-20 000 rpm), its sun-planet and ring-planet meshes beside ISO's K_v of each; then the
+built-in two_stage_train (60 and 240 N m on the input pinion, 500-6000 rpm), both stages; then
+the NREL 5 MW gearbox at rated torque over 2-25 rpm (f_pb = f_falpha = 15 um, stand-ins).
 
     python docs/figures/make_dynamic_factor_figure.py   (from the repository root; ~2 min)
 """
@@ -36,7 +38,7 @@ def main() -> None:
     speeds = np.linspace(2000.0, 44000.0, 85)
     ds = dynamic_factor_sweep(pair(), speeds, [20.0, 80.0, 200.0], RUN, **ACCURACY)
     plot_dynamic_factor(ds, "docs/figures/dynamic-factor.png")
-    print(f"model linear resonance {ds.attrs['linear_resonance_speed']:.0f} rpm")
+    print(f"model linear resonance {ds.attrs['natural_speeds'][0]:.0f} rpm")
     for j, t1 in enumerate(ds["torque"].values):
         row = ds.isel(torque=j, group=0)
         df, kv = row["dynamic_factor"].values, row["K_v"].values
@@ -62,6 +64,52 @@ def main() -> None:
               f"K_v peak {float(d['K_v'].max()):.2f}")
 
     planetary()
+    train()
+    nrel()
+
+
+def nrel() -> None:
+    from geardyn.io import builtin_study
+
+    model = geardyn.build_model(builtin_study("nrel_5mw_gearbox_sweep"))
+    speeds = np.linspace(2.0, 25.0, 24)
+    low = model.with_params(input_speed=2.0).omega  # the study's transient_periods there
+    run = geardyn.RunSettings(transient=200 * 2.0 * math.pi / low, samples=16)
+    ds = dynamic_factor_sweep(model, speeds, None, run, base_pitch_deviation=15.0,
+                              profile_form_deviation=15.0)
+    plot_dynamic_factor(ds, "docs/figures/dynamic-factor-nrel.png")
+    for g in ds["group"].values:
+        row = ds.sel(group=g).isel(torque=0)
+        df, kv = row["dynamic_factor"].values, row["K_v"].values
+        rated = {k: float(row[k].interp(speed=12.1)) for k in ("dynamic_factor", "K_v")}
+        print(f"{g}: N_M {float(row['resonance_speed']):.1f} rpm, line load "
+              f"{float(row['line_load']):.0f} N/mm, c_gamma {float(row['mesh_stiffness']):.2f};"
+              f" model max {np.nanmax(df):.3f} at {speeds[np.nanargmax(df)]:.2f} rpm, K_v "
+              f"{kv.min():.3f}-{kv.max():.3f}; at 12.1 rpm model {rated['dynamic_factor']:.3f},"
+              f" K_v {rated['K_v']:.3f}; contact lost at "
+              f"{speeds[row['contact'].values.astype(str) != 'none'].tolist()}")
+
+
+def train() -> None:
+    from geardyn.io import builtin_study
+
+    model = geardyn.build_model(builtin_study("two_stage_train"))
+    speeds = np.linspace(500.0, 6000.0, 45)
+    low = model.with_params(input_speed=500.0).omega  # the study's transient_periods there
+    run = geardyn.RunSettings(transient=300 * 2.0 * math.pi / low, samples=32)
+    ds = dynamic_factor_sweep(model, speeds, [60.0, 240.0], run, **ACCURACY)
+    plot_dynamic_factor(ds, "docs/figures/dynamic-factor-train.png")
+    print("train natural frequencies as input speeds [rpm]:", ds.attrs["natural_speeds"])
+    for j, t1 in enumerate(ds["torque"].values):
+        for g in ds["group"].values:
+            row = ds.sel(group=g).isel(torque=j)
+            df, kv = row["dynamic_factor"].values, row["K_v"].values
+            lost = row["contact"].values.astype(str) != "none"
+            print(f"{t1:g} N m {g}: N_M {float(row['resonance_speed']):.0f} rpm, line load "
+                  f"{float(row['line_load']):.1f} N/mm, c_gamma "
+                  f"{float(row['mesh_stiffness']):.2f}; model max {np.nanmax(df):.2f} at "
+                  f"{speeds[np.nanargmax(df)]:.0f} rpm, K_v {kv.min():.2f}-{kv.max():.2f}; "
+                  f"contact lost at {speeds[lost].round().tolist()}")
 
 
 def planetary() -> None:

@@ -28,9 +28,15 @@ round-off: no point is reported there).
 A sign change between two curve points is located by regula falsi (Illinois) on the arclength
 fraction between them, each trial corrected onto the curve on the hyperplane normal to the chord,
 until the bracket is shorter than ``locate_tol`` in the scaled unknowns. The location error
-(``special_error``) is the larger of |x - x_end| / x_scale and |y - y_end| / y_scale over the
-bracket's two ends, plus the test function's error estimate at the located point over its
-slope between the two curve points (in the same measure).
+(``special_error``) bounds the distance, in the scaled parameters (x / x_scale, y / y_scale),
+of the located point from the zero of the discretised system's test function: the distance in
+the scaled unknowns z from the located point to the bracket's farther end (the zero lies on the
+arc between the ends, and the scaled parameters are coordinates of z: a bound also where the
+curve turns in a parameter inside the bracket, e.g. a period-doubling curve at a fold-flip
+point), plus the test function's error estimate at the located point over its slope between
+the two curve points (per unit distance in z). It does not hold the discretisation error of the
+fixed step (the difference from the exact flow's point, which falls as the step's fourth
+power).
 """
 
 from __future__ import annotations
@@ -175,10 +181,9 @@ def detect_and_locate(sys: CurveSystem, points: list[CurvePoint],
     return found
 
 
-def _error(sys: CurveSystem, z: np.ndarray, ends: tuple[np.ndarray, np.ndarray]) -> float:
-    x, y = sys.xy(z)
-    return max(max(abs(x - sys.xy(e)[0]) / sys.x_scale, abs(y - sys.xy(e)[1]) / sys.y_scale)
-               for e in ends)
+def _error(z: np.ndarray, ends: tuple[np.ndarray, np.ndarray]) -> float:
+    """The distance in the scaled unknowns from z to the farther of ``ends``."""
+    return max(float(np.linalg.norm(z - e)) for e in ends)
 
 
 def locate(sys: CurveSystem, a: CurvePoint, b: CurvePoint, name: str, index: int,
@@ -187,7 +192,7 @@ def locate(sys: CurveSystem, a: CurvePoint, b: CurvePoint, name: str, index: int
     """The zero of the test function ``name`` between the curve points a and b (module
     docstring); not located (the bracket's midpoint) where a trial's corrector fails."""
     fa, fb = values
-    slope = abs(fb - fa) / max(_error(sys, a.z, (b.z, b.z)), 1e-300)
+    slope = abs(fb - fa) / max(_error(a.z, (b.z, b.z)), 1e-300)
     sa, sb = 0.0, 1.0
     za, zb = a.z, b.z
     chord = b.z - a.z
@@ -225,10 +230,10 @@ def locate(sys: CurveSystem, a: CurvePoint, b: CurvePoint, name: str, index: int
     if best is None:
         z = 0.5 * (za + zb)
         x, y = sys.xy(z)
-        return Special(name, x, y, _error(sys, z, (za, zb)), index, z,
+        return Special(name, x, y, _error(z, (za, zb)), index, z,
                        f"not located ({why or 'no trial'}): the test function changed sign "
                        f"between points {index} and {index + 1}", located=False)
     z = best[2]
     x, y = sys.xy(z)
-    return Special(name, x, y, _error(sys, z, (za, zb)) + best[1] / slope, index, z,
+    return Special(name, x, y, _error(z, (za, zb)) + best[1] / slope, index, z,
                    f"{SPECIAL_KINDS[name]}; test function {best[0]:.3g} at the located point")

@@ -5,7 +5,9 @@ the branch's parameter x and a second parameter y by pseudo-arclength continuati
 (:mod:`geardyn.analysis.arclength`) of its minimally augmented defining system
 (:mod:`geardyn.analysis.curve_systems`), detecting and locating codimension-2 points on the way
 (:mod:`geardyn.analysis.codim2`). The result is a ``"curve"`` dataset
-(:data:`geardyn.core.results.SCHEMAS`).
+(:data:`geardyn.core.results.SCHEMAS`). From a contact change it follows the grazing curve
+(:func:`geardyn.analysis.grazing.grazing_curve`, the lower-level function with the box, mesh
+and flank as arguments).
 """
 
 from __future__ import annotations
@@ -30,6 +32,8 @@ from geardyn.analysis.branch import BRANCH_STEP_FACTOR
 from geardyn.analysis.branch_data import BranchStatus, branch_status_meaning
 from geardyn.analysis.codim2 import SPECIAL_KINDS, TESTS, Special, detect_and_locate, special_tests
 from geardyn.analysis.curve_systems import CURVE_KINDS, CurveSystem
+from geardyn.analysis.grazing import grazing_curve, nearest_flank
+from geardyn.analysis.orbits import problem_with_steps
 from geardyn.core.model import Model
 from geardyn.core.plan import default_steps_per_period
 from geardyn.core.results import finish
@@ -77,8 +81,12 @@ def curve(model: Model, branch: xr.Dataset, bifurcation: int, y: str, y_stop: fl
     branch
         A :func:`geardyn.continuation` result.
     bifurcation
-        Index along its ``bifurcation`` dimension of a fold, period doubling or Neimark-Sacker
-        point (a contact change: use the grazing curve).
+        Index along its ``bifurcation`` dimension of a fold, period doubling, Neimark-Sacker or
+        contact-change point. A contact change is followed as the grazing curve of the edge its
+        orbit grazes (the mesh and flank whose switching function's extremum lies nearest zero
+        there, :func:`~geardyn.analysis.grazing.nearest_flank`) by
+        :func:`~geardyn.analysis.grazing.grazing_curve` in the box ``x_range`` (default the
+        branch's range of x) by [y_start, y_stop], both ways from the start.
     y, y_stop
         The second parameter (any name the model's ``with_params``/``lane_params`` accept) and
         the value the curve heads for; it ends where y leaves [y_start, y_stop].
@@ -87,7 +95,9 @@ def curve(model: Model, branch: xr.Dataset, bifurcation: int, y: str, y_stop: fl
     x_range
         (lo, hi): the curve also ends where x leaves it (default: no bound).
     settings
-        :class:`CurveSettings`.
+        :class:`CurveSettings` (for a contact change: default the grazing curve's
+        :data:`~geardyn.analysis.grazing.GRAZING_SETTINGS`; its scales are the box's spans and
+        ``locate_tol``, ``x_scale``, ``y_scale`` must be left unset).
     run
         ``run.steps_per_period`` fixes the step (default: the branch's at the bifurcation),
         ``bound`` and ``max_section_periods`` as for the shooting problem.
@@ -98,12 +108,16 @@ def curve(model: Model, branch: xr.Dataset, bifurcation: int, y: str, y_stop: fl
     with x and y, the section point, multipliers, orbit period and the test functions
     ``test_<name>`` of the codimension-2 points, which are listed along ``special``; how the
     curve ended in ``status`` (a :class:`~geardyn.BranchStatus` code) and ``message``. A
-    failure along the curve is not an exception.
+    failure along the curve is not an exception. For a contact change: the grazing curve's
+    dataset (``curve_kind = "grazing"``, see :func:`~geardyn.analysis.grazing.grazing_curve`).
     """
-    kind, x, px, u0, period, steps, x_scale = _bifurcation(branch, bifurcation)
     if branch.attrs.get("model") not in (None, model.name):
         raise ValueError(f"model is a {model.name}, the branch was computed with a "
                          f"{branch.attrs['model']}")
+    if _is_contact(branch, bifurcation):
+        return _contact_curve(model, branch, int(bifurcation), y, y_stop, y_start, x_range,
+                              settings, run, progress)
+    kind, x, px, u0, period, steps, x_scale = _bifurcation(branch, bifurcation)
     return _follow(model, kind, x, px, u0, period, steps, x_scale, y, y_stop, y_start,
                    x_range, settings, run, progress)
 
@@ -219,18 +233,65 @@ def _bifurcation(branch: xr.Dataset, index: int
                          f"bifurcations")
     i = int(index)
     found = str(branch["bifurcation_kind"].values[i])
-    if found == "contact":
-        raise ValueError(f"bifurcation={i} is a contact change: follow it with the grazing "
-                         f"(contact-change) curve, not a bifurcation curve")
     if found not in STARTS:
         raise ValueError(f"bifurcation={i} is a {found!r}: a curve starts from a "
-                         f"{', '.join(STARTS)} point")
+                         f"{', '.join(STARTS)} or contact point")
     x = str(branch.attrs["param"])
     pt = int(branch["bifurcation_point"].values[i])
     return (STARTS[found], x, float(branch["bifurcation_value"].values[i]),
             np.asarray(branch["bifurcation_section_point"].values[i], dtype=float),
             int(branch["bifurcation_period"].values[i]),
             int(branch["steps_per_period"].values[pt]), float(branch.attrs["p_scale"]))
+
+
+def _is_contact(branch: xr.Dataset, index: int) -> bool:
+    """Whether ``index`` names a contact change of a continuation result (any other index:
+    :func:`_bifurcation` checks it)."""
+    if branch.attrs.get("geardyn_kind") != "continuation" or isinstance(index, bool):
+        return False
+    kinds = branch["bifurcation_kind"].values if "bifurcation_kind" in branch else []
+    return (isinstance(index, int | np.integer) and 0 <= int(index) < len(kinds)
+            and str(kinds[int(index)]) == "contact")
+
+
+def _contact_curve(model: Model, branch: xr.Dataset, index: int, y: str, y_stop: float,
+                   y_start: float | None, x_range: tuple[float, float] | None,
+                   settings: CurveSettings | None, run: RunSettings | None,
+                   progress: Callable[[int, float, float], None] | None) -> xr.Dataset:
+    """The grazing curve of the contact change ``index`` (see :func:`curve`)."""
+    x = str(branch.attrs["param"])
+    if y == x:
+        raise ValueError(f"y must differ from x (both {y!r})")
+    if settings is not None and (settings.x_scale is not None or settings.y_scale is not None
+                                 or settings.locate_tol != LOCATE_TOL):
+        raise ValueError("settings: a contact change's grazing curve takes the box's spans as "
+                         "its scales and locates no points; leave x_scale, y_scale and "
+                         "locate_tol unset")
+    if y_start is None:
+        try:
+            y_start = float(model.params[model.param_index(y)])
+        except KeyError as err:
+            raise KeyError(f"y={y!r}: {err.args[0] if err.args else err}; a physical input "
+                           f"needs y_start (its value at the contact change)") from err
+    y0, y1 = float(y_start), float(y_stop)
+    if not (math.isfinite(y0) and math.isfinite(y1)) or y0 == y1:
+        raise ValueError(f"y_stop must be finite and differ from y_start (got y_start={y0!r}, "
+                         f"y_stop={y1!r})")
+    px = float(branch["bifurcation_value"].values[index])
+    if x_range is None:
+        values = branch[x].values
+        x_range = (float(np.nanmin(values)), float(np.nanmax(values)))
+    at = model.with_params(**{x: px, y: y0})
+    pt = int(branch["bifurcation_point"].values[index])
+    steps = (run.steps_per_period if run is not None and run.steps_per_period
+             else int(branch["steps_per_period"].values[pt]))
+    problem = problem_with_steps(at, None, int(branch["bifurcation_period"].values[index]),
+                                 run, steps)
+    mesh, flank = nearest_flank(at, problem,
+                                branch["bifurcation_section_point"].values[index])
+    return grazing_curve(model, x, y, x_range, (min(y0, y1), max(y0, y1)), mesh=mesh,
+                         flank=flank, at=(px, y0), branch=branch, bifurcation=index, run=run,
+                         settings=settings, progress=progress)
 
 
 def _onto_bound(sys: CurveSystem, cr: CurveRun, st: CurveSettings,
@@ -306,9 +367,10 @@ def curve_dataset(sys: CurveSystem, cr: CurveRun, tests: list[dict[str, tuple[fl
     ds["special_y"] = ("special", np.array([s.y for s in specials], float),
                        {"long_name": f"{sys.y} of the codimension-2 point"})
     ds["special_error"] = ("special", np.array([s.error for s in specials], float), {
-        "long_name": "location error in the scaled parameters: max over the bracket ends of "
-                     "|dx| / x_scale and |dy| / y_scale, plus the test function's error "
-                     "estimate over its slope"})
+        "long_name": "bound on the location error in the scaled parameters (x / x_scale, "
+                     "y / y_scale) on the discretised system: the distance in the scaled "
+                     "unknowns to the bracket's farther end, plus the test function's error "
+                     "estimate over its slope (geardyn.analysis.codim2)"})
     ds["special_section_point"] = (("special", "state"), np.array(
         [sys.state(sp.z) for sp in specials]).reshape(len(specials), n), {
         "units": m.state_units, "long_name": "section point at the codimension-2 point"})

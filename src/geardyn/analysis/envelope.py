@@ -34,6 +34,7 @@ import xarray as xr
 
 from geardyn.analysis.arclength import ArclengthSettings, OutsideDomain
 from geardyn.analysis.grazing import FLANKS, GrazingProblem, _flank_event, _range, grazing_curve
+from geardyn.analysis.grazing_crossing import LOCATED_KINDS, Crossing, locate_crossing
 from geardyn.analysis.orbits import (
     ORBIT_STEP_FACTOR,
     OrbitStatus,
@@ -77,16 +78,24 @@ def _sagitta(P: np.ndarray, i: int) -> float:
     return out
 
 
-def intersect_curves(a: xr.Dataset, b: xr.Dataset, kind: str | None = None) -> xr.Dataset:
+def intersect_curves(a: xr.Dataset, b: xr.Dataset, kind: str | None = None, *,
+                     model: Model | None = None) -> xr.Dataset:
     """``a`` with the points where it crosses ``b`` (two ``"curve"`` datasets in the same
     plane) appended along ``special``: ``special_kind`` (``kind``, default from the curves'
-    kinds, e.g. ``"grazing-fold"``), ``special_x``, ``special_y`` and ``special_error``.
+    kinds, e.g. ``"grazing-fold"``), ``special_x``, ``special_y``, ``special_error``,
+    ``special_located``, ``special_detail`` and ``special_section_point`` (NaN where not
+    known).
 
-    The crossing is that of the two polylines (segments' intersection, in the plane scaled by
-    ``a``'s ``x_scale`` and ``y_scale``, default the spans of the two curves);
-    ``special_error`` bounds its distance from the smooth curves' crossing in that scaled
-    plane: the sagittas of the two segments (a quarter of the polylines' second differences
-    there) over the sine of the angle between them."""
+    The crossing is first that of the two polylines (segments' intersection, in the plane
+    scaled by ``a``'s ``x_scale`` and ``y_scale``, default the spans of the two curves), its
+    error a bound on its distance from the smooth curves' crossing in that scaled plane: the
+    sagittas of the two segments (a quarter of the polylines' second differences there) over
+    the sine of the angle between them (``special_located`` 0). Given the ``model`` of the
+    curves, a grazing curve's crossing with a fold or period-doubling curve is then located on
+    that curve from the side where the orbit keeps off the edge
+    (:func:`geardyn.analysis.grazing_crossing.locate_crossing`; ``special_located`` 1, its error
+    that of the extrapolation; 0 with the polyline's where that fails, ``special_detail`` says
+    why)."""
     for name, ds in (("a", a), ("b", b)):
         if ds.attrs.get("geardyn_kind") != "curve":
             raise ValueError(f"{name}: not a curve dataset (geardyn_kind "
@@ -102,7 +111,7 @@ def intersect_curves(a: xr.Dataset, b: xr.Dataset, kind: str | None = None) -> x
     sx = float(a.attrs.get("x_scale") or np.ptp(both[0]) or 1.0)
     sy = float(a.attrs.get("y_scale") or np.ptp(both[1]) or 1.0)
     P, Q = _polyline(a, x, y, sx, sy), _polyline(b, x, y, sx, sy)
-    found: list[tuple[float, float, float]] = []
+    found: list[tuple[float, float, float, int, int]] = []
     for i in range(len(P) - 1):
         p, r = P[i], P[i + 1] - P[i]
         for j in range(len(Q) - 1):
@@ -117,13 +126,19 @@ def intersect_curves(a: xr.Dataset, b: xr.Dataset, kind: str | None = None) -> x
                 c = p + t * r
                 sine = abs(den) / (np.linalg.norm(r) * np.linalg.norm(s))
                 err = (_sagitta(P, i) + _sagitta(Q, j)) / max(sine, 1e-12)
-                found.append((float(c[0] * sx), float(c[1] * sy), err))
+                found.append((float(c[0] * sx), float(c[1] * sy), err, i, j))
+    n = a.sizes["state"]
+    old = [Crossing(float(u), float(v), float(e), p, bool(ok), str(d))
+           for u, v, e, p, ok, d in zip(
+               a["special_x"].values, a["special_y"].values, a["special_error"].values,
+               _special(a, "special_section_point", np.full((a.sizes["special"], n), np.nan)),
+               _special(a, "special_located", np.ones(a.sizes["special"], np.int64)),
+               _special(a, "special_detail", np.full(a.sizes["special"], "")), strict=True)]
+    new = [_crossing(model, a, b, *f, (sx, sy)) for f in found]
+    kinds = [str(k) for k in a["special_kind"].values] + [kind] * len(new)
     out = a.drop_dims("special")
-    old = [(str(k), float(u), float(v), float(e)) for k, u, v, e in zip(
-        a["special_kind"].values, a["special_x"].values, a["special_y"].values,
-        a["special_error"].values, strict=True)]
-    rows = old + [(kind, u, v, e) for u, v, e in found]
-    out = out.assign_coords(special=("special", np.arange(len(rows))))
+    out = out.assign_coords(special=("special", np.arange(len(kinds))))
+    rows = [(k, r.x, r.y, r.error) for k, r in zip(kinds, old + new, strict=True)]
     out["special_kind"] = ("special", np.array([r[0] for r in rows], dtype=str),
                            a["special_kind"].attrs)
     out["special_x"] = ("special", np.array([r[1] for r in rows], float), {
@@ -131,9 +146,36 @@ def intersect_curves(a: xr.Dataset, b: xr.Dataset, kind: str | None = None) -> x
     out["special_y"] = ("special", np.array([r[2] for r in rows], float), {
         "long_name": f"{y} at the codimension-2 point"})
     out["special_error"] = ("special", np.array([r[3] for r in rows], float), {
-        "long_name": "bound on the location error (distance in the plane scaled by x_scale, "
-                     "y_scale)"})
+        "long_name": "location error in the plane scaled by x_scale, y_scale (a crossing: "
+                     "see geardyn.analysis.envelope.intersect_curves)"})
+    out["special_located"] = ("special", np.array([int(r.located) for r in old + new],
+                                                   np.int64),
+                              {"meaning": "1 located; 0 not located (special_detail says why)"})
+    out["special_detail"] = ("special", np.array([r.detail for r in old + new], dtype=str))
+    out["special_section_point"] = (("special", "state"), np.array(
+        [r.section_point for r in old + new], float).reshape(len(rows), n), {
+        "units": a["section_point"].attrs.get("units", ""),
+        "long_name": "section point at the codimension-2 point (NaN: not known)"})
     return finish(out, "curve")
+
+
+def _special(ds: xr.Dataset, name: str, default: np.ndarray) -> np.ndarray:
+    return ds[name].values if name in ds else default
+
+
+def _crossing(model: Model | None, a: xr.Dataset, b: xr.Dataset, x: float, y: float,
+              err: float, i: int, j: int, scales: tuple[float, float]) -> Crossing:
+    """The polylines' crossing (x, y, err) on a's segment i and b's segment j, located where
+    the pair is a grazing curve and a fold or period-doubling curve and ``model`` is given."""
+    n = a.sizes["state"]
+    ka, kb = a.attrs["curve_kind"], b.attrs["curve_kind"]
+    if model is not None and ka == "grazing" and kb in LOCATED_KINDS:
+        return locate_crossing(model, a, b, j, (x, y, err), scales)
+    if model is not None and kb == "grazing" and ka in LOCATED_KINDS:
+        return locate_crossing(model, b, a, i, (x, y, err), scales)
+    return Crossing(x, y, err, np.full(n, np.nan), False,
+                    "the polylines' crossing (not located: no model, or a pair of curve "
+                    "kinds the locator does not take)")
 
 
 # ----------------------------------------------------------------------------- starts
@@ -488,7 +530,7 @@ def envelope(model: Model, x: str, y: str, x_range: tuple[float, float],
     for i, g in enumerate(found):
         for c in given:
             if c.attrs["curve_kind"] in CROSSING_KINDS:
-                found[i] = g = intersect_curves(g, c)
+                found[i] = g = intersect_curves(g, c, model=model)
     all_curves = found + given
     xv = np.linspace(xr_[0], xr_[1], int(resolution))
     yv = np.linspace(yr_[0], yr_[1], int(resolution))

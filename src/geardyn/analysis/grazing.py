@@ -283,6 +283,28 @@ def _flank_event(model: Model, mesh: str | None, flank: str) -> tuple[str, int]:
     return mesh, (i if flank == "drive" else j)
 
 
+def nearest_flank(model: Model, problem: ShootingProblem, x0: np.ndarray) -> tuple[str, str]:
+    """(mesh, flank) whose switching function's extremum towards its edge along the orbit from
+    ``x0`` (the minimum where its mean is >= 0, else the maximum) lies nearest zero, over its
+    range along the orbit: the edge a contact change of that orbit grazes."""
+    if not model.meshes:
+        raise ValueError(f"mesh: {model.name} has no meshes (no dead-zone switching functions)")
+    ev = problem.evaluate(np.asarray(x0, float), jacobian=False, stride=1)
+    if not np.all(np.isfinite(ev.states)):
+        raise FloatingPointError("the orbit's integration diverged")
+    best: tuple[float, str, str] | None = None
+    for name, i, j in model.meshes:
+        for flank, event in zip(FLANKS, (i, j), strict=True):
+            gp = GrazingProblem(model, "Omega", "Omega", event, problem, 1.0, 1.0)
+            h = gp.h_along(problem, ev.states[:-1])
+            edge = float(np.min(h)) if float(np.mean(h)) >= 0.0 else float(np.max(h))
+            share = abs(edge) / max(float(np.ptp(h)), 1e-300)
+            if best is None or share < best[0]:
+                best = (share, name, flank)
+    assert best is not None
+    return best[1], best[2]
+
+
 def _range(name: str, value: Any) -> tuple[float, float]:
     try:
         lo, hi = (float(v) for v in value)
@@ -570,4 +592,4 @@ def _dataset(gp: GrazingProblem, mesh: str, flank: str, points: list[CurvePoint]
     return finish(ds, "curve")
 
 
-__all__ = ["FLANKS", "GrazingProblem", "grazing_curve"]
+__all__ = ["FLANKS", "GrazingProblem", "grazing_curve", "nearest_flank"]

@@ -33,8 +33,8 @@ from geardyn.errors import ParameterError
 from geardyn.solvers.kernels import kernels_for
 
 __all__ = ["MIN_RUNUP_STEPS", "PROGRESS_PIECES", "RunupSettings", "SteadyRecord",
-           "frequency_scale", "natural_frequencies", "runup", "speed_coefficients",
-           "steady_record"]
+           "frequency_scale", "natural_frequencies", "phase_from_time", "runup",
+           "speed_coefficients", "steady_record"]
 
 #: Fewest RK4 steps per forcing period at the highest speed (the split path rotates the phase
 #: by angle addition, exact in its small-angle form up to 2 pi / 8 per step).
@@ -141,28 +141,51 @@ def _refuse(model: Model, why: str) -> ParameterError:
     return ParameterError("model", model.name, f"a run-up cannot drive it: {why}")
 
 
+def _speeds(top: float) -> np.ndarray:
+    """The forcing frequencies up to ``top`` at which a model's dependence on Omega is read."""
+    return top * np.array([0.2, 0.45, 0.7, 0.85, 1.0])
+
+
+def phase_from_time(model: Model, top: float) -> bool:
+    """Whether the model reads a forcing at a non-whole order r of Omega from the time (r Omega
+    t: a gear train's other stages, a torque fluctuation of non-whole order): the run-up then
+    gives its functions the time theta / Omega, so that the phase is r theta, the integral of
+    r Omega (:mod:`geardyn.solvers._runup_template`). A :class:`~geardyn.errors.ParameterError`
+    naming the model where it also reads a forcing of a fixed frequency from the time (that
+    one needs the true time)."""
+    w = _speeds(top)
+    others = np.asarray(model.other_frequencies(model.lane_params("Omega", w)),
+                        dtype=float).reshape(w.size, -1)
+    scaled = fixed = False
+    for j in range(others.shape[1]):
+        f = others[:, j]
+        if not np.all(np.isfinite(f)):
+            continue
+        if np.ptp(f) == 0.0:
+            fixed = fixed or f[0] != 0.0
+            continue
+        r = f / w
+        if np.ptp(r) <= 1e-9 * abs(r[0]) and abs(r[0] - round(r[0])) > 1e-9:
+            scaled = True
+    if scaled and fixed:
+        raise _refuse(model, "it has a forcing at a non-whole order of Omega and one of a "
+                      "fixed frequency, both read from the time")
+    return scaled
+
+
 def speed_coefficients(model: Model, top: float) -> tuple[np.ndarray, np.ndarray]:
     """The coefficient entries that move with Omega and their quadratics in it: ``cols``
     (indices into ``params``) and ``coef`` (cols x 3: c0 + c1 Omega + c2 Omega^2), found from
     ``model.lane_params("Omega", ...)`` at five speeds up to ``top``. A
     :class:`~geardyn.errors.ParameterError` naming the model where one is not such a
-    quadratic, where the model is autonomous or plain (it reads ``Omega t`` itself), or where
-    a forcing at a non-whole order of Omega is read from the time (not the phase)."""
+    quadratic, or where the model is autonomous or plain (it reads ``Omega t`` itself)."""
     if model.omega_index is None:
         raise _refuse(model, "it is autonomous (no forcing frequency)")
     if model.kernel.plain:
         raise _refuse(model, "a plain UserModel computes its forcing from Omega t itself; "
                       "write it with (s, c), the sine and cosine of the forcing phase")
-    w = top * np.array([0.2, 0.45, 0.7, 0.85, 1.0])
+    w = _speeds(top)
     P = model.lane_params("Omega", w)
-    others = np.asarray(model.other_frequencies(P), dtype=float).reshape(w.size, -1)
-    for j in range(others.shape[1]):
-        f = others[:, j]
-        if np.all(np.isfinite(f)) and np.ptp(f) > 0.0:
-            r = f / w
-            if np.ptp(r) <= 1e-9 * abs(r[0]) and abs(r[0] - round(r[0])) > 1e-9:
-                raise _refuse(model, f"a forcing at order {r[0]:.6g} of Omega (not a whole "
-                              "number) takes its phase from the time, not from the phase")
     cols = np.flatnonzero(np.any(P != P[:1], axis=0))
     if model.omega_index not in cols:
         cols = np.sort(np.append(cols, model.omega_index))
@@ -282,6 +305,7 @@ def runup(model: Model, settings: RunupSettings, *, y0: np.ndarray | None = None
     outputs = _outputs(model, s.outputs)
     top = max(s.start, s.stop)
     cols, coef = speed_coefficients(model, top)
+    time_phase = phase_from_time(model, top)
     h, n_tr, n_ramp, stride = _grid(model, s)
     y = np.asarray(model.initial_state() if y0 is None else y0, dtype=float).copy()
     if y.shape != (model.n_states,):
@@ -304,7 +328,7 @@ def runup(model: Model, settings: RunupSettings, *, y0: np.ndarray | None = None
         Y, O, W, TH, nc, st, un, dn, y, hist, side = k.runup_trajectory(
             p, np.ascontiguousarray(y), h, int(bounds[c]), int(bounds[c + 1]), n_tr, stride,
             c == pieces - 1, s.start, s.acceleration, t_on, t_off, cols, coef, s.locate_edges,
-            s.bound, model.n_events, model.n_observables, c > 0, hist, side)
+            s.bound, model.n_events, model.n_observables, c > 0, hist, side, time_phase)
         parts.append((Y, O, W, TH))
         ncross += nc
         unresolved += int(un)
@@ -431,6 +455,6 @@ def steady_record(model: Model, samples: int, sample_rate: float, *, transient: 
     Y, O, _, _, _, status, unresolved, _, _, _, _ = k.runup_trajectory(
         p, y, h, 0, n_tr + (samples - 1) * stride, n_tr, stride, True, om, 0.0, 0.0, 0.0,
         cols, coef, locate_edges, bound, n_ev, model.n_observables, False,
-        np.full((2, max(n_ev, 1)), np.nan), np.ones(n_ev, np.int64))
+        np.full((2, max(n_ev, 1)), np.nan), np.ones(n_ev, np.int64), False)  # t = theta/Omega
     t = (n_tr + np.arange(samples) * stride) * h
     return SteadyRecord(t, Y, O, int(status), int(unresolved), h, stride)

@@ -6,10 +6,11 @@
                 [--ka K_A] [--stiffness iso|model] [--range START:STOP:NUM] [--torque T ...]
                 [--transient T] [--converge TOL] [--samples N] [--out df.nc] [--plot df.png]
 
-The study's model must be built from geometry (``spur_pair``, or ``planetary`` with
-``[params.geometry]``). ``--range`` is the input speed in rpm (the pinion's, or the planetary
-stage's input member's; default the study's ``[sweep]`` of ``speed`` or ``input_speed``),
-``--torque`` the pinion's or the sun's torque [N m] (repeatable; default the study's). Unset
+The study's model must be built from geometry (``spur_pair``, ``planetary`` with
+``[params.geometry]``, or a train whose meshed gears have geometry). ``--range`` is the input
+speed in rpm (the pinion's, the planetary stage's input member's, the train's driven body's;
+default the study's ``[sweep]`` of ``speed`` or ``input_speed``), ``--torque`` the input torque
+[N m] (repeatable; default the study's). Unset
 run options come from the study's ``[run]`` table.
 """
 
@@ -58,7 +59,8 @@ def dynamic_factor_command(
                                                  "the study's [sweep] of its speed).")
     ] = None,
     torque: Annotated[list[float] | None, typer.Option(
-        help="Input (pinion or sun) torque [N m]; repeatable (default: the study's).")] = None,
+        help="Input (pinion, sun or driven body) torque [N m]; repeatable (default: the "
+             "study's).")] = None,
     transient: run_option("transient", "default: run.transient") = None,
     converge: ConvergeOption = None,
     samples: run_option("samples", "default: the study's") = None,
@@ -72,14 +74,14 @@ def dynamic_factor_command(
 
     from geardyn.analysis.dynamic_factor import dynamic_factor_sweep
     from geardyn.cli.bifurcation import parse_range
-    from geardyn.models.spur_pair import SpurPair
-    from geardyn.models.spur_pair_coefficients import SPEED_UNITS
 
     s = load_study_source(study)
     model = build_model(s)
-    speed_param = "speed" if isinstance(model, SpurPair) else "input_speed"
-    to_rpm = (SPEED_UNITS[model.speed_unit] / SPEED_UNITS["rpm"]
-              if isinstance(model, SpurPair) else 1.0)
+    if not model.capabilities.dynamic_factor:
+        raise ParameterError("STUDY", study, "the model must be built from geometry (a "
+                             "spur_pair, a planetary study with [params.geometry], or a train)")
+    speed_param, one_rpm = model.input_speed_sweep(np.array([1.0]))
+    to_rpm = 1.0 / float(one_rpm[0])
     if range_ is not None:
         start, stop, num = parse_range(range_)
     elif s.sweep is not None and s.sweep.param == speed_param:
@@ -92,11 +94,7 @@ def dynamic_factor_command(
     rpm = np.linspace(start, stop, num)
     if not np.all(rpm > 0.0):
         raise ParameterError("--range", f"{start:g}:{stop:g}", "input speeds must be > 0 rpm")
-    try:
-        lowest = model.with_params(**{speed_param: float(rpm.min()) / to_rpm}).omega
-    except (KeyError, ParameterError):
-        raise ParameterError("STUDY", study, "the model must be built from geometry (a "
-                             "spur_pair, or a planetary study with [params.geometry])") from None
+    lowest = model.with_params(**{speed_param: float(rpm.min()) / to_rpm}).omega
     run = study_run_settings(
         s, {"transient": ("--transient", transient), "samples": ("--samples", samples),
             "converge": ("--converge", converge)}, sweep=True, omega=lowest)

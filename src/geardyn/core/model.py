@@ -35,7 +35,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from geardyn.core.capabilities import Capabilities
+from geardyn.core.capabilities import DYNAMIC_FACTOR_MEMBERS, Capabilities
 from geardyn.core.coefficients import CoefficientLayout
 from geardyn.core.kernel_source import KernelSource
 from geardyn.core.plan import forcing_period
@@ -164,6 +164,12 @@ class Model:
             raise TypeError(f"{cls.__name__} defines natural_frequencies(): declare their unit "
                             "in its capabilities (Capabilities(natural_frequencies='rad/time' "
                             "or 'Hz'))")
+        caps = cls.capabilities
+        if caps.dynamic_factor:
+            missing = [m for m in DYNAMIC_FACTOR_MEMBERS if not hasattr(cls, m)]
+            if missing:
+                raise TypeError(f"{cls.__name__} declares the dynamic_factor capability but "
+                                f"lacks {', '.join(missing)}")
 
     # ------------------------------------------------------------------ sizes
     @property

@@ -175,8 +175,8 @@ class ExplorerSession:
 
         self.inputs, self.input_messages = {}, {}
         controls = [self._control(name, TextInput, Div, column) for name in st.main_params()]
-        geometry = [self._control(name, Select if st.choices(name) else TextInput, Div, column)
-                    for name in st.geometry_params()]
+        self._widgets = (Select, TextInput, Div, column)
+        geometry = self._geometry_controls()
         self.continuation = Select(title="continuation", value=st.continuation,
                                    options=list(CONTINUATIONS), name="continuation", width=120)
         self.continuation.on_change("value", self._on_continuation)
@@ -196,9 +196,10 @@ class ExplorerSession:
         top = row(self.back_button, column(self.window_input, self.window_message),
                   self.save_button)
         extra = []
+        self.geometry_row = row(*geometry, name="geometry")
         if geometry:
             extra.append(column(Div(text="<b>geometry and faults</b> (study-file keys)"),
-                                row(*geometry)))
+                                self.geometry_row))
         self.stiffness_fig = None
         stiffness_panel = self._stiffness_figure(figure, ColumnDataSource, Div, column)
         self.layout = column(
@@ -210,6 +211,14 @@ class ExplorerSession:
             name="layout")
         self.doc.add_root(self.layout)
         self.doc.title = f"geardyn explore: {st.study.study.name}"
+
+    def _geometry_controls(self) -> list:
+        """The geometry and fault controls of the current view (a choice where the key has
+        :meth:`~ExplorerState.choices`, else a text box)."""
+        Select, TextInput, Div, column = self._widgets  # noqa: N806
+        st = self.state
+        return [self._control(name, Select if st.choices(name) else TextInput, Div, column)
+                for name in st.geometry_params()]
 
     def _control(self, name: str, widget, Div, column):  # noqa: N803
         """A text box (``widget`` TextInput) or a choice (Select, for a control with
@@ -502,6 +511,12 @@ class ExplorerSession:
             box.text = f'<span style="{_ERROR_STYLE}">{html.escape(msg)}</span>'
             return
         box.text = ""
+        if name.endswith(".kind"):  # the fault's fields are the new kind's
+            stale = [n for n in self.inputs if n not in self.state.geometry_params()
+                     and n not in self.state.main_params()]
+            for n in stale:
+                del self.inputs[n], self.input_messages[n]
+            self.geometry_row.children = self._geometry_controls()
         self._show_stiffness(self.state.model)
         self.recompute()
 

@@ -37,21 +37,25 @@ from geardyn.io.toml import (
     PlanetaryGearSetParams,
     SpurPairParams,
     Study,
+    TrainModelParams,
 )
 from geardyn.models.planetary_stiffness import COAST_FLANKS, STIFFNESS_METHODS
 
 __all__ = ["CONTINUATIONS", "GEOMETRY_KEYS", "INTERPRETATIONS", "MAIN_PARAMS",
            "PLANETARY_GEOMETRY_KEYS", "DiagramRequest", "ExplorerState", "Window",
-           "fault_fields", "key_path", "parse_value"]
+           "fault_fields", "key_path", "parse_value", "switched_fault"]
 
 #: The main parameters offered as controls, per model kind (``[study].model``): damping ratios,
-#: backlash, meshing error, load (or torque) fluctuation.
+#: backlash, meshing error, load (or torque) fluctuation. A train's are offered where its study
+#: gives them as one number for every mesh (a per-mesh table is not a control).
 MAIN_PARAMS: dict[str, tuple[str, ...]] = {
     "catt": ("xi1", "xi2", "backlash", "error", "B1", "Lambda"),
     "gear_pair": ("zeta", "backlash", "Fa", "kappa"),
     "planetary": ("mesh_damping", "sun_backlash", "ring_backlash", "sun_mesh_error",
                   "torque_fluctuation"),
     "spur_pair": ("zeta", "backlash", "torque", "error", "harmonics"),
+    "train": ("mesh_damping", "modal_damping", "backlash", "stiffness_fluctuation",
+              "mesh_error", "torque_fluctuation"),
 }
 #: The ``[gears]`` inputs offered as controls of a model built from a pair's geometry (study-file
 #: keys; each gear's own value, which wins over a shared ``[gears]`` one). The faults' controls
@@ -117,6 +121,25 @@ def fault_fields(kind: str) -> tuple[str, ...]:
     return tuple(f.name for f in dataclasses.fields(cls) if hints.get(f.name) in (float, int))
 
 
+#: The fields that place a fault (kept when it changes kind); the others are its size.
+PLACEMENT_FIELDS = ("gear", "tooth", "flank")
+
+
+def switched_fault(table: dict[str, Any], kind: str) -> dict[str, Any]:
+    """A fault table (``kind`` and fields) as a fault of ``kind``: where it sits (its
+    :data:`PLACEMENT_FIELDS` that the new kind has) kept, its size dropped, and every field the
+    new kind needs without a default at 0: a fault of zero size (the healthy tooth; a missing
+    tooth has no size), whose size the controls then set (a crack's depth is no wear depth)."""
+    cls = FAULT_KINDS[kind]
+    fields = {f.name: f for f in dataclasses.fields(cls)}
+    out: dict[str, Any] = {"kind": kind}
+    out.update({k: v for k, v in table.items() if k in fields and k in PLACEMENT_FIELDS})
+    for name, f in fields.items():
+        if name not in out and f.default is dataclasses.MISSING:
+            out[name] = 0.0
+    return out
+
+
 def key_path(key: str) -> tuple[str | int, ...]:
     """The path of a study-file key in the study's TOML tables: ``faults[0].depth`` ->
     ("faults", 0, "depth")."""
@@ -125,6 +148,14 @@ def key_path(key: str) -> tuple[str | int, ...]:
         m = re.fullmatch(r"(\w+)\[(\d+)\]", part)
         out += [m[1], int(m[2])] if m else [part]
     return tuple(out)
+
+
+def _get_path(doc: dict[str, Any], path: tuple[str | int, ...]) -> Any:
+    """The value at ``path`` of the TOML tables ``doc``."""
+    target: Any = doc
+    for part in path:
+        target = target[part]
+    return target
 
 
 def _set_path(doc: dict[str, Any], path: tuple[str | int, ...], value: Any) -> None:
@@ -158,9 +189,12 @@ def _error_text(exc: BaseException) -> str:
 def _geometry_tables(study: Study) -> tuple[tuple[str, ...], str, list[FaultTable]]:
     """The fixed geometry controls of ``study``, the key of its fault tables and the tables:
     a pair's ``[gears]`` and ``[[faults]]``, a planetary set's ``[params.geometry]`` and
-    ``[[params.geometry.faults]]``; ((), "", []) for a study without geometry."""
+    ``[[params.geometry.faults]]``, a gear train's ``[[train.faults]]`` (no fixed controls);
+    ((), "", []) for a study without geometry."""
     if study.gears is not None:
         return GEOMETRY_KEYS, "faults", list(study.faults or [])
+    if study.train is not None and study.train.faults:
+        return (), "train.faults", [FaultTable(**t) for t in study.train.faults]
     geometry = getattr(study.params, "geometry", None)
     if isinstance(study.params, PlanetaryGearSetParams) and geometry is not None:
         return PLANETARY_GEOMETRY_KEYS, "params.geometry.faults", list(geometry.faults or [])
@@ -221,12 +255,13 @@ class ExplorerState:
         self.describe_error = describe_error
         self.curves = tuple(curves)
         self.save_dir = Path(save_dir)
-        if (self.param != "Omega" and study.run.omega is None
-                and study.study.model != "spur_pair"):  # a spur pair's speed sets its Omega
-            raise ParameterError("--param", self.param, "a sweep of another parameter than "
-                                 "Omega needs [run].omega in the study")
+        from geardyn.study import study_omega
+
         self._effective = study
         self._model = self._build(study, interpretation)
+        if self.param != "Omega" and study_omega(study, self._model) is None:
+            raise ParameterError("--param", self.param, "a sweep of another parameter than "
+                                 "Omega needs [run].omega in the study")
 
     # ------------------------------------------------------------------ model
     @property
@@ -235,26 +270,33 @@ class ExplorerState:
 
     def main_params(self) -> tuple[str, ...]:
         """The parameters offered as controls (the swept one left out)."""
-        return tuple(p for p in MAIN_PARAMS.get(self.kind, ()) if p != self.param)
+        offered = MAIN_PARAMS.get(self.kind, ())
+        if self.kind == "train":
+            offered = tuple(p for p in offered if p in self.model.physical_names)
+        return tuple(p for p in offered if p != self.param)
 
     def geometry_params(self) -> tuple[str, ...]:
         """The geometry and fault controls of a study built from geometry, as study-file keys:
         :data:`GEOMETRY_KEYS` (a ``[gears]`` table) or :data:`PLANETARY_GEOMETRY_KEYS` (a
-        planetary ``[params.geometry]``), then, per fault table, its gear and the numeric
-        fields of its fault class (``faults[0].gear``, ``faults[0].depth``,
-        ``faults[0].angle``, ``faults[0].tooth``); () for a study without geometry."""
-        keys, prefix, tables = _geometry_tables(self.study)
+        planetary ``[params.geometry]``), then, per fault table of the current view, its kind,
+        its gear and the numeric fields of its fault class (``faults[0].kind``,
+        ``faults[0].gear``, ``faults[0].depth``, ``faults[0].angle``, ``faults[0].tooth``); ()
+        for a study without geometry."""
+        keys, prefix, tables = _geometry_tables(self._effective)
         out = list(keys)
         for i, table in enumerate(tables):
-            out += [f"{prefix}[{i}].{name}" for name in ("gear", *fault_fields(table.kind))]
+            out += [f"{prefix}[{i}].{name}"
+                    for name in ("kind", "gear", *fault_fields(table.kind))]
         return tuple(out)
 
     def choices(self, name: str) -> tuple[str, ...]:
         """The values a text control takes (a planetary set's stiffness method and coast flank,
-        a fault's gear); () for a control that takes a number."""
+        a fault's kind and gear); () for a control that takes a number."""
         path = key_path(name)
         if name not in self.geometry_params():
             return ()
+        if path[-1] == "kind" and _fault_table(self._effective, path) is not None:
+            return tuple(FAULT_KINDS)
         if path[-1] == "stiffness":
             return STIFFNESS_METHODS
         if path[-1] == "coast":
@@ -262,6 +304,11 @@ class ExplorerState:
         if path[-1] == "gear":
             if self.study.gears is not None:
                 return ("pinion", "wheel")
+            if self.study.train is not None:  # the train's gears
+                from geardyn.trains import Gear
+
+                return tuple(name for name, body in self._effective.gear_train.bodies.items()
+                             if isinstance(body, Gear))
             n = self.study.params.n_planets  # type: ignore[union-attr]
             return ("sun", *(f"planet{i + 1}" for i in range(n)), "ring")
         return ()
@@ -291,7 +338,7 @@ class ExplorerState:
         path = key_path(key)
         kind = ("one of " + ", ".join(self.choices(key)) if self.choices(key)
                 else "a whole number" if self._whole(key) else "SI number or unit string")
-        table = _fault_table(self.study, path)
+        table = _fault_table(self._effective, path)
         if table is not None:
             gear = table.fields().get("gear", "pinion")
             where = ".".join(str(p) for p in path[:-2])
@@ -342,6 +389,8 @@ class ExplorerState:
         table = _fault_table(study, path)
         if table is not None:
             name = str(path[-1])
+            if name == "kind":
+                return table.kind
             given = table.fields()
             if name in given:
                 return given[name]
@@ -361,13 +410,18 @@ class ExplorerState:
         doc = self.study.to_toml_dict()  # as the file says it (transient_periods alone)
         geometry = self.geometry_params()
         for key, value in overrides.items():
-            if key in geometry:
-                _set_path(doc, key_path(key), value)
+            path = key_path(key)
+            if key in geometry and path[-1] == "kind" and value in FAULT_KINDS:
+                # the table as a fault of that kind (an unknown kind: the study refuses it)
+                _set_path(doc, path[:-1], switched_fault(_get_path(doc, path[:-1]), value))
+            elif key in geometry:
+                _set_path(doc, path, value)
         changes = {k: v for k, v in overrides.items() if k not in geometry}
         params = self.study.params
         if isinstance(params, PaperBase):
             doc["params"]["changes"] = {**doc["params"].get("changes", {}), **changes}
-        elif isinstance(params, GearPairParams | PlanetaryGearSetParams | SpurPairParams):
+        elif isinstance(params, GearPairParams | PlanetaryGearSetParams | SpurPairParams
+                        | TrainModelParams):
             doc["params"].update(changes)
         else:  # full PlanetaryParams
             doc["params"] = params.replace(**changes).model_dump(exclude_none=True)
@@ -377,19 +431,26 @@ class ExplorerState:
         """Set a main parameter or a geometry control from a control's text. Returns None, or
         the validation message (the state is then unchanged)."""
         geometry = self.geometry_params()
-        if name not in MAIN_PARAMS.get(self.kind, ()) and name not in geometry:
+        if name not in self.main_params() and name not in geometry:
             return f"{name}: not a parameter of this explorer"
         value: float | str = text.strip() if self.choices(name) else parse_value(text)
         if name in geometry and isinstance(value, float) and value.is_integer() and (
                 self._whole(name)):
             value = int(value)  # a tooth index: 3, not 3.0
         overrides = {**self.overrides, name: value}
+        path = key_path(name)
+        if name in geometry and path[-1] == "kind" and value in FAULT_KINDS:
+            # the old fault's size goes with it; where it sits stays
+            table = ".".join(name.split(".")[:-1]) + "."
+            keep = {"kind", *PLACEMENT_FIELDS}
+            overrides = {k: v for k, v in overrides.items()
+                         if not k.startswith(table) or k.rpartition(".")[2] in keep}
         return self._apply(overrides, self.interpretation)
 
     def _whole(self, key: str) -> bool:
         """True where the geometry control ``key`` is an int field of its fault class."""
         path = key_path(key)
-        table = _fault_table(self.study, path)
+        table = _fault_table(self._effective, path)
         if table is None:
             return False
         return typing.get_type_hints(FAULT_KINDS[table.kind]).get(str(path[-1])) is int
@@ -450,9 +511,17 @@ class ExplorerState:
     # ------------------------------------------------------------------ requests
     def run_settings(self):
         """The run of the current view's sweep (``[run]`` as every command reads it; a
-        ``transient_periods`` counts periods of the window's lowest Omega)."""
-        low = (min(self.window.start, self.window.stop) if self.param == "Omega"
-               else self._model.omega)
+        ``transient_periods`` counts periods of the window's lowest Omega, also where the swept
+        parameter is a speed that sets Omega)."""
+        from geardyn.analysis.bifurcation import lane_params_held
+
+        model = self._model
+        ends = [self.window.start, self.window.stop]
+        if self.param == "Omega" or model.omega_index is None:
+            low = min(ends) if self.param == "Omega" else model.omega
+        else:  # a speed sweep moves Omega: the window's lowest
+            low = float(min(lane_params_held(model, self.param, ends, "Omega")
+                            [:, model.omega_index]))
         return self._effective.run_settings(sweep=True, omega=low)
 
     def diagram_request(self) -> DiagramRequest:

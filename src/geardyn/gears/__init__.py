@@ -14,7 +14,10 @@ from geardyn.gears.helical import HelicalGear, HelicalMesh, helical_stiffness
 from geardyn.gears.iso6336 import ISOStiffness, iso6336_stiffness
 from geardyn.gears.iso6336_kv import (
     DynamicFactorInputs,
+    KvMeshGroup,
     dynamic_factor_iso,
+    group_inputs,
+    group_reduced_mass,
     planetary_reduced_masses,
     reduced_mass,
     resonance_speed,
@@ -46,6 +49,7 @@ __all__ = [
     "FAULT_KINDS",
     "BrokenTooth",
     "DynamicFactorInputs",
+    "KvMeshGroup",
     "GearMesh",
     "HelicalGear",
     "HelicalMesh",
@@ -65,6 +69,8 @@ __all__ = [
     "crowning_gap",
     "double_contact_centre",
     "dynamic_factor_iso",
+    "group_inputs",
+    "group_reduced_mass",
     "equally_spaced",
     "helical_loaded_contact",
     "helical_stiffness",

@@ -1,9 +1,11 @@
 """Tooth faults of a spur pair for the potential-energy mesh stiffness.
 
 Each fault sits on tooth ``tooth`` of ``gear`` ("pinion" or "wheel" of a pair, tooth 0 passing
-the pitch point at pinion angle 0, tooth j j mesh cycles later; or "sun", "ring", "planet1",
+the pitch point at pinion angle 0, tooth j j mesh cycles later; "sun", "ring", "planet1",
 "planet2", ... of a planetary set, :data:`PLANETARY_GEARS` and
-:mod:`geardyn.models.planetary_faults`) and is built from keyword arguments whose
+:mod:`geardyn.models.planetary_faults`; or the name of a gear of a
+:class:`~geardyn.trains.GearTrain`, :mod:`geardyn.trains.faults`) and is built from keyword
+arguments whose
 names are its fields; lengths and angles may be unit strings (:func:`geardyn.units.to_si`).
 What a fault does to the stiffness is in :mod:`geardyn.gears.potential_energy` and
 docs/gears.md; the checks that need the mesh (a crack past the centre line, a spall off the
@@ -40,8 +42,8 @@ GEARS = ("pinion", "wheel")
 #: The gears of a planetary set a fault may sit on: "sun", "ring" or "planet<n>" (n = 1 .. N,
 #: the planet at the n-th planet angle; checked against N where the set is built).
 PLANETARY_GEARS = ("sun", "ring", "planet<n>")
-_GEAR_NAMES = ("'pinion' or 'wheel' (a pair), or 'sun', 'ring', 'planet1', 'planet2', ... (a"
-               " planetary set)")
+_GEAR_NAMES = ("'pinion' or 'wheel' (a pair), 'sun', 'ring', 'planet1', 'planet2', ... (a"
+               " planetary set), or a gear train's gear name")
 
 
 def planet_number(gear: object) -> int | None:
@@ -55,8 +57,10 @@ def planet_number(gear: object) -> int | None:
 
 
 def _check_gear(gear: object, kind: str) -> None:
-    """``gear`` a gear name of a pair or of a planetary set (error ``<kind>.gear``)."""
-    if gear in GEARS or gear in ("sun", "ring") or planet_number(gear) is not None:
+    """``gear`` a gear's name: a non-empty string (error ``<kind>.gear``). Which names are
+    valid depends on where the fault is placed, which checks it: a pair's ``"pinion"`` or
+    ``"wheel"``, a planetary set's gears, a gear train's gears."""
+    if isinstance(gear, str) and gear.strip():
         return
     raise ParameterError(f"{kind}.gear", gear, f"must be {_GEAR_NAMES}")
 #: The flanks a :class:`Spall` or :class:`Wear` may lie on.

@@ -41,14 +41,21 @@ from __future__ import annotations
 
 import math
 from dataclasses import asdict, dataclass
+from typing import Any
 
 import numpy as np
 
 from geardyn.errors import ParameterError
+from geardyn.gears.helical import HelicalMesh
+from geardyn.gears.iso6336 import N_PER_MM_UM, iso6336_stiffness
 
-__all__ = ["REGIMES", "DynamicFactorInputs", "cv_factors", "dynamic_factor_iso",
-           "lower_resonance_limit", "planetary_reduced_masses", "reduced_mass",
-           "resonance_ratio", "resonance_speed"]
+__all__ = ["REGIMES", "DynamicFactorInputs", "KvMeshGroup", "cv_factors", "dynamic_factor_iso",
+           "group_inputs", "group_reduced_mass", "lower_resonance_limit",
+           "planetary_reduced_masses", "reduced_mass", "resonance_ratio", "resonance_speed"]
+
+#: Where c' and c_gamma_alpha of K_v come from: ISO 6336-1 method B (clause 9), or the model's
+#: own mean drive stiffness (c_gamma_alpha = k_mean / b, c' = c_gamma_alpha / (0.75 eps + 0.25)).
+STIFFNESS_SOURCES = ("iso", "model")
 
 #: The ranges of the resonance ratio N, in code order (the ``regime`` of
 #: :func:`dynamic_factor_iso`).
@@ -174,6 +181,99 @@ def planetary_reduced_masses(sun_inertia: float, planet_inertia: float, sun_base
     if isinstance(n_planets, bool) or not isinstance(n_planets, int | np.integer) or n_planets < 1:
         raise ParameterError("n_planets", n_planets, "must be a whole number >= 1")
     return mp * ms / (n_planets * mp + ms) / b, mp / b
+
+
+def group_reduced_mass(common_inertia: float, other_inertia: float, common_base_radius: float,
+                       other_base_radius: float, n_meshes: int, face_width: float,
+                       internal: bool) -> float:
+    """m_red [kg/mm] of ``n_meshes`` equal meshes that share one gear (the common member, e.g. a
+    sun) with ``n_meshes`` equal other gears (e.g. planets): external meshes m_O* m_C* /
+    (n m_O* + m_C*), clause 6.5.9's sun-planet rule, which for one mesh is Eq. 30; internal
+    meshes the external gear's m* alone (the internal gear taken as infinitely heavy, 6.5.9's
+    ring-planet rule). ``internal``: the common gear or the other is the internal one; then
+    ``other_*`` must be the external gear's."""
+    b = 1000.0 * _positive("face_width", face_width)
+    mo = _positive("other_inertia", other_inertia) \
+        / _positive("other_base_radius", other_base_radius) ** 2
+    if internal:
+        return mo / b
+    mc = _positive("common_inertia", common_inertia) \
+        / _positive("common_base_radius", common_base_radius) ** 2
+    if isinstance(n_meshes, bool) or not isinstance(n_meshes, int | np.integer) or n_meshes < 1:
+        raise ParameterError("n_meshes", n_meshes, "must be a whole number >= 1")
+    return mo * mc / (n_meshes * mo + mc) / b
+
+
+@dataclass(frozen=True)
+class KvMeshGroup:
+    """Meshes of a model that K_v treats as one (a gear pair's mesh; a planetary stage's
+    sun-planet or ring-planet meshes), as a model gives them at one input torque.
+
+    Attributes
+    ----------
+    name
+        The group's label (e.g. ``"mesh"``, ``"sun"``, a train mesh's name).
+    mesh
+        The pair's geometry (:class:`~geardyn.gears.GearMesh` or
+        :class:`~geardyn.gears.HelicalMesh`), gear 1 its pinion.
+    meshes
+        Indices of the group's meshes among the model's meshes.
+    tangential_force
+        F_t [N], the nominal tangential force per mesh at gear 1's reference circle.
+    reduced_mass
+        m_red [kg/mm] (:func:`reduced_mass`, :func:`group_reduced_mass`).
+    speed_per_input
+        Gear 1's speed over the model's input speed (a planet's relative to its carrier).
+    model_stiffness
+        The model's mean drive-flank stiffness of one of the group's meshes [N/m], along the
+        transverse line of action (the ``"model"`` stiffness source).
+    """
+
+    name: str
+    mesh: Any
+    meshes: tuple[int, ...]
+    tangential_force: float
+    reduced_mass: float
+    speed_per_input: float
+    model_stiffness: float
+
+    @property
+    def face_width(self) -> float:
+        """b [m]: the narrower gear's face width."""
+        return min(self.mesh.pinion.face_width, self.mesh.wheel.face_width)
+
+    @property
+    def pinion_teeth(self) -> int:
+        """z1, gear 1's teeth."""
+        return int(self.mesh.pinion.teeth)
+
+
+def group_inputs(group: KvMeshGroup, *, application_factor: float = 1.0, stiffness: str = "iso",
+                 **accuracy: float) -> DynamicFactorInputs:
+    """The method B inputs of ``group``: the line load F_t K_A / b, c', c_gamma_alpha and
+    eps_alpha by ISO 6336-1 method B at that load (``stiffness="iso"``) or from the group's
+    ``model_stiffness`` (``"model"``: c_gamma_alpha = k / b, c' = c_gamma_alpha / (0.75
+    eps_alpha + 0.25)); eps_gamma = eps_alpha + eps_beta (a helical pair's overlap ratio); the
+    accuracy inputs [um] (``base_pitch_deviation``, ...) as :class:`DynamicFactorInputs`."""
+    if stiffness not in STIFFNESS_SOURCES:
+        raise ParameterError("stiffness", stiffness, f"must be one of {STIFFNESS_SOURCES}")
+    k_a = float(application_factor)
+    if not (math.isfinite(k_a) and k_a >= 1.0):
+        raise ParameterError("application_factor", application_factor, "K_A must be >= 1")
+    b = group.face_width
+    load = _positive("tangential_force", group.tangential_force) * k_a / b  # N/m
+    iso = iso6336_stiffness(group.mesh, line_load=load)
+    eps_alpha = iso.contact_ratio
+    if stiffness == "iso":
+        c_prime, c_gamma = iso.c_prime, iso.c_gamma_alpha
+    else:
+        c_gamma = group.model_stiffness / b / N_PER_MM_UM
+        c_prime = c_gamma / (0.75 * eps_alpha + 0.25)
+    eps_gamma = (group.mesh.total_contact_ratio if isinstance(group.mesh, HelicalMesh)
+                 else eps_alpha)
+    return DynamicFactorInputs(pinion_teeth=group.pinion_teeth, reduced_mass=group.reduced_mass,
+                               single_stiffness=c_prime, mesh_stiffness=c_gamma,
+                               line_load=load * 1e-3, contact_ratio=eps_gamma, **accuracy)
 
 
 def resonance_speed(inputs: DynamicFactorInputs) -> float:

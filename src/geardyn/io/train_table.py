@@ -17,16 +17,24 @@
     [train.meshes.stage1]          # a Mesh: a, b, stiffness (N/m, "iso", "potential_energy"), ...
     [train.planetary.stage1]       # planetary_stage(): sun, ring, carrier, planet name bodies
                                    #   (ring_planet: a compound stage's second planet gear)
+    [[train.faults]]               # a tooth fault (geardyn.trains.faults): kind (crack, spall,
+    kind = "crack"                 #   wear, broken_tooth) and its fields, its gear a gear of
+    gear = "g1"                    #   the train (all faults on one gear, whose meshes take
+    tooth = 3                      #   stiffness = "potential_energy")
+    depth = "1 mm"
 
 Every sub-table's keys are the keyword arguments of its element (one declaration: the element's
 dataclass fields, :func:`geardyn.trains.planetary_stage`'s parameters), the table's own key
-its name; values are SI numbers or unit strings. The bodies are the gears, then the inertias, in
-the order written, a planetary stage's planet (and ring planet) replaced where it stands by the
-stage's copies (``<planet>1`` ...); then the shafts, bearings and meshes written, each followed
-by the stages' own (joints, pins and hubs, meshes). An
-unknown key, a missing one or a value an element refuses is an error naming
-``train.<group>.<name>.<field>``; what the train as a whole refuses (a reference to no body, a
-free rigid-body mode, a mesh of gears that cannot mesh) names the element's table likewise.
+its name; values are SI numbers or unit strings. A ``[[train.faults]]`` table's keys are
+``kind`` (a key of :data:`geardyn.gears.FAULT_KINDS`) and that fault's fields. The bodies are
+the gears, then the inertias, in the order written, a planetary stage's planet (and ring
+planet) replaced where it stands by the stage's copies (``<planet>1`` ...); then the shafts,
+bearings and meshes written, each followed by the stages' own (joints, pins and hubs, meshes).
+An unknown key, a missing one or a value an element refuses is an error naming
+``train.<group>.<name>.<field>`` (a fault's ``train.faults[<i>].<field>``); what the train as a
+whole refuses (a reference to no body, a free rigid-body mode, a mesh of gears that cannot mesh,
+a fault on a gear without the potential-energy stiffness) names the element's (or the fault's)
+table likewise.
 """
 
 from __future__ import annotations
@@ -37,6 +45,7 @@ from typing import Any
 from pydantic import BaseModel, ConfigDict, Field, StrictBool
 
 from geardyn.errors import ParameterError
+from geardyn.gears.faults import FAULT_KINDS
 from geardyn.gears.geometry import SpurGear
 from geardyn.gears.helical import HelicalGear
 from geardyn.io._tables import build_from_fields, study_error
@@ -83,6 +92,8 @@ class TrainTable(BaseModel):
     bearings: Tables = Field(default_factory=dict)
     meshes: Tables = Field(default_factory=dict)
     planetary: Tables = Field(default_factory=dict)
+    faults: list[Any] = Field(default_factory=list, description="[[train.faults]]: tooth "
+                              "faults on one gear (kind and the fault's fields)")
 
     def build(self, where: tuple = ("train",)) -> GearTrain:
         """The :class:`~geardyn.trains.GearTrain` (a ValidationError at ``where`` + the table
@@ -110,15 +121,16 @@ class TrainTable(BaseModel):
         order: list[Any] = []
         for name, body in bodies.items():
             order.extend(templates.get(name, [body]))
+        faults = [_fault(t, where + ("faults", i)) for i, t in enumerate(self.faults)]
         try:
             return GearTrain(
                 order, [*made["shafts"], *(s for st in stages for s in st.shafts)],
                 [*made["bearings"], *(b for s in stages for b in s.bearings)],
                 [*made["meshes"], *(m for s in stages for m in s.meshes)],
                 fixed=tuple(self.fixed), driven=self.driven, free=self.free,
-                rayleigh=tuple(self.rayleigh))
+                rayleigh=tuple(self.rayleigh), faults=faults)
         except ParameterError as exc:
-            raise _located(exc, located, where) from None
+            raise _located(exc, located, where, faults) from None
 
     def _stage(self, name: str, table: dict[str, Any], bodies: dict[str, Any], loc: tuple,
                located: dict[str, tuple]) -> PlanetaryStage:
@@ -179,11 +191,34 @@ def _geometry(name: str, table: dict[str, Any], loc: tuple) -> SpurGear | Helica
     return build_from_fields(cls, {**table, "name": name}, loc, what)
 
 
-def _located(exc: ParameterError, located: dict[str, tuple], where: tuple) -> Exception:
+def _fault(table: Any, loc: tuple) -> object:
+    """The fault of a ``[[train.faults]]`` table (``kind`` and the fault's fields)."""
+    if not isinstance(table, dict):
+        raise study_error(loc, table, "must be a table: kind and the fault's fields")
+    given = dict(table)
+    if "kind" not in given:
+        raise study_error(loc + ("kind",), None, "required: one of " + ", ".join(FAULT_KINDS),
+                          kind="missing")
+    kind = given.pop("kind")
+    cls = FAULT_KINDS.get(kind)
+    if cls is None:
+        raise study_error(loc + ("kind",), kind, "unknown fault kind; known: "
+                          + ", ".join(FAULT_KINDS))
+    return build_from_fields(cls, given, loc, f"a {kind} fault", "kind, ")
+
+
+def _located(exc: ParameterError, located: dict[str, tuple], where: tuple,
+             faults: list[Any]) -> Exception:
     """The study error of a ParameterError the train raised: its field's first part is an
-    element's name (that element's table, then the rest of the field) or a GearTrain
+    element's name (that element's table, then the rest of the field), a fault's kind (the
+    first fault of that kind holding the value: its table and field) or a GearTrain
     argument."""
     head, _, rest = exc.field.partition(".")
+    kinds = [f.kind for f in faults]
+    if head in kinds and rest:
+        hit = [i for i, k in enumerate(kinds) if k == head]
+        i = next((i for i in hit if getattr(faults[i], rest, None) == exc.value), hit[0])
+        return study_error(where + ("faults", i, rest), exc.value, exc.reason)
     if head in located:
         loc = located[head]
         if rest and loc[-2] != "planetary":

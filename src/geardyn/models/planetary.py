@@ -37,6 +37,7 @@ from geardyn.core.model import Model, unique_rows
 from geardyn.core.plan import MIN_STEPS_PER_PERIOD, STEPS_PER_FASTEST_MODE
 from geardyn.errors import ParameterError
 from geardyn.gears.faults import BrokenTooth
+from geardyn.gears.iso6336_kv import KvMeshGroup, planetary_reduced_masses
 from geardyn.models import planetary_kernels as pk
 from geardyn.models.modal import frequency_groups
 from geardyn.models.planetary_coefficients import (
@@ -413,7 +414,7 @@ class PlanetaryGearSet(Model):
     state_units = "1"
     observable_units = "N"
     capabilities = Capabilities(physical_inputs=True, physical_axes=True, mesh_forces=True,
-                                natural_frequencies="Hz")
+                                dynamic_factor=True, natural_frequencies="Hz")
     raw_overrides_allowed = True
     #: Raw coefficients set by name through ``with_params`` (name -> value), applied again on
     #: top of a rebuild from changed inputs.
@@ -913,6 +914,48 @@ class PlanetaryGearSet(Model):
         """The member whose speed :attr:`input_speed` is: the sun, or the carrier when the
         sun is held."""
         return "carrier" if self.held == "sun" else "sun"
+
+    # ------------------------------------------------------------------ ISO 6336-1 K_v
+    @property
+    def input_torque(self) -> float:
+        """The magnitude of the sun's torque [N m]."""
+        return abs(float(self.torques["sun"]))
+
+    def at_input_torque(self, torque: float) -> PlanetaryGearSet:
+        """The set with the sun's torque of magnitude ``torque`` [N m] (its sign kept)."""
+        return self.with_params(sun_torque=math.copysign(float(torque), self.torques["sun"]))
+
+    def kv_groups(self, torque: float) -> tuple[KvMeshGroup, ...]:
+        """A set built from geometry: ``"sun"`` (the sun-planet meshes, gear 1 the sun) and
+        ``"ring"`` (the planet-ring meshes, gear 1 the planet, speeds relative to the carrier),
+        F_t = T_s / (r_s N) per planet at the sun's reference radius r_s (the ring-planet force
+        equals the sun-planet force, the planet in moment balance), m_red of clause 6.5.9 from
+        the members' I / r^2 on their base radii
+        (:func:`~geardyn.gears.iso6336_kv.planetary_reduced_masses`)."""
+        geo = self.geometry
+        if geo is None:
+            raise ParameterError("model", self.name, "K_v needs a PlanetaryGearSet built from "
+                                 "geometry (from_geometry or [params.geometry])")
+        n, sun, planet, ring = self.n_planets, geo.sun, geo.planet, geo.ring
+        per_input = self.mesh_frequency_per_input_speed()
+        f_t = float(torque) / (sun.reference_radius * n)
+        k_mean = self.mesh_stiffnesses()
+        out = []
+        for name, mesh, z1, other in (("sun", geo.sun_mesh, sun.teeth, sun),
+                                      ("ring", geo.ring_mesh, planet.teeth, ring)):
+            b = min(planet.face_width, other.face_width)
+            m_sp, m_rp = planetary_reduced_masses(
+                self.members["sun"].inertia_over_r2 * sun.base_radius ** 2,
+                self.members["planet"].inertia_over_r2 * planet.base_radius ** 2,
+                sun.base_radius, planet.base_radius, n, b)
+            idx = tuple(range(n)) if name == "sun" else tuple(range(n, 2 * n))
+            out.append(KvMeshGroup(name, mesh, idx, f_t, m_sp if name == "sun" else m_rp,
+                                   per_input / z1, float(np.mean(k_mean[list(idx)]))))
+        return tuple(out)
+
+    def input_speed_sweep(self, rpm: np.ndarray) -> tuple[str, np.ndarray]:
+        """``input_speed`` [rpm] itself."""
+        return INPUT_SPEED, np.asarray(rpm, dtype=float)
 
     def mesh_frequency_per_input_speed(self) -> float:
         """Mesh frequency over input speed (both rad/s) of a set built from geometry. The mesh

@@ -53,6 +53,7 @@ from geardyn.core.model import Model
 from geardyn.core.plan import STEPS_PER_FASTEST_MODE, STEPS_PER_OTHER_FORCING
 from geardyn.errors import ParameterError
 from geardyn.gears.geometry import GearMesh
+from geardyn.gears.iso6336_kv import KvMeshGroup, reduced_mass
 from geardyn.gears.potential_energy import (
     DEFAULT_NODES,
     STEEL_POISSON,
@@ -230,7 +231,7 @@ class SpurPair(Model):
     observable_names = ("F",)
     observable_units = "N"
     meshes = (("mesh", 0, 1),)
-    capabilities = Capabilities(mesh_forces=True, physical_axes=True,
+    capabilities = Capabilities(mesh_forces=True, physical_axes=True, dynamic_factor=True,
                                 natural_frequencies="rad/time")
     physical_names = ("speed",)
 
@@ -456,6 +457,36 @@ class SpurPair(Model):
     def static_mesh_forces(self) -> np.ndarray:
         """The static mesh force T1 / r_b1 [N] (the dynamic factor's reference)."""
         return np.array([self.mean_force()])
+
+    # ------------------------------------------------------------------ ISO 6336-1 K_v
+    @property
+    def input_torque(self) -> float:
+        """The pinion torque T1 [N m]."""
+        return float(self.params[TORQUE])
+
+    def at_input_torque(self, torque: float) -> SpurPair:
+        """The pair at pinion torque ``torque`` [N m]."""
+        return self.with_params(torque=float(torque))
+
+    def kv_groups(self, torque: float) -> tuple[KvMeshGroup, ...]:
+        """One group, ``"mesh"``: F_t = T1 / r1 (r1 the pinion's reference radius), m_red from
+        the model's inertias (:func:`~geardyn.gears.iso6336_kv.reduced_mass`), gear 1 the
+        pinion."""
+        mesh = self.mesh
+        b = min(mesh.pinion.face_width, mesh.wheel.face_width)
+        i1, i2 = self.inertia
+        m_red = reduced_mass(i1, i2, mesh.pinion.base_radius, mesh.wheel.base_radius, b)
+        return (KvMeshGroup("mesh", mesh, (0,), float(torque) / mesh.pinion.reference_radius,
+                            m_red, 1.0, float(self.drive_series[0])),)
+
+    def input_speed_sweep(self, rpm: np.ndarray) -> tuple[str, np.ndarray]:
+        """``speed`` in the model's ``speed_unit`` at pinion speeds ``rpm``."""
+        return "speed", np.asarray(rpm, dtype=float) * SPEED_UNITS["rpm"] \
+            / SPEED_UNITS[self.speed_unit]
+
+    def mesh_frequency_per_input_speed(self) -> float:
+        """The mesh order: the pinion's teeth."""
+        return float(self.mesh.pinion.teeth)
 
     def natural_frequencies(self) -> np.ndarray:
         """sqrt(k_mean / m) [rad/s]: the natural frequency in drive-flank contact."""

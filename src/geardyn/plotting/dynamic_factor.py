@@ -19,6 +19,18 @@ from geardyn.plotting.style import RC
 
 __all__ = ["plot_dynamic_factor"]
 
+#: Curves (model and K_v per torque and group) above which the legend goes below the axes (a
+#: train's many groups).
+LEGEND_INSIDE_MAX = 7
+
+
+def _torque_text(t: float) -> str:
+    """A torque [N m] with an SI prefix: 60 N m, 3.95 MN m."""
+    for scale, prefix in ((1e6, "M"), (1e3, "k")):
+        if abs(t) >= scale:
+            return f"{t / scale:.3g} {prefix}N m"
+    return f"{t:g} N m"
+
 
 def plot_dynamic_factor(ds: xr.Dataset, path: str | os.PathLike | None = None):
     """Figure of a dynamic-factor sweep ``ds``; saved to ``path`` (.png, .pdf, .svg) when
@@ -37,14 +49,16 @@ def plot_dynamic_factor(ds: xr.Dataset, path: str | os.PathLike | None = None):
                 max(3.0 * kv_max, 6.0)) * 1.08
     colours = matplotlib.rcParams["axes.prop_cycle"].by_key()["color"]
     with matplotlib.rc_context(RC):
-        fig = Figure(figsize=(7.2, 4.4), layout="constrained")
-        ax = fig.subplots()
         groups = [str(g) for g in ds["group"].values]
+        below = 2 * ds.sizes["torque"] * len(groups) > LEGEND_INSIDE_MAX
+        fig = Figure(figsize=(7.2, 5.6 if below else 4.4), layout="constrained")
+        ax = fig.subplots()
         for j, t1 in enumerate(ds["torque"].values):
             for g, group in enumerate(groups):
                 c = colours[(j * len(groups) + g) % len(colours)]
                 row = ds.isel(torque=j, group=g)
-                what = f"{t1:g} N m" + ("" if len(groups) == 1 else f", {group} meshes")
+                what = _torque_text(float(t1)) + ("" if len(groups) == 1
+                                                  else f", {group} meshes")
                 df = row["dynamic_factor"].values
                 lost = row["contact"].values.astype(str) != "none"
                 ax.plot(rpm, df, "-", color=c, lw=1.0, label=f"model, {what}")
@@ -61,10 +75,11 @@ def plot_dynamic_factor(ds: xr.Dataset, path: str | os.PathLike | None = None):
                 else:  # beyond the axis: named at its right edge
                     ax.annotate(f"$N_M$ {n_m:.0f} rpm →", (1.0, 0.02 + 0.06 * g),
                                 xycoords="axes fraction", ha="right", color=c, fontsize=7)
-        for k, n in enumerate(np.atleast_1d(ds.attrs.get("natural_speeds", []))):
-            if rpm.min() <= n <= rpm.max():
-                ax.axvline(float(n), color="0.75", lw=0.6, zorder=0,
-                           label="model natural frequencies" if k == 0 else None)
+        shown = [float(n) for n in np.atleast_1d(ds.attrs.get("natural_speeds", []))
+                 if rpm.min() <= n <= rpm.max()]
+        for k, n in enumerate(shown):
+            ax.axvline(n, color="0.75", lw=0.6, zorder=0,
+                       label="model natural frequencies" if k == 0 else None)
         lin = ds.attrs.get("linear_resonance_speed")
         if lin is not None:
             ax.axvline(float(lin), color="k", ls="-.", lw=0.8,
@@ -77,7 +92,11 @@ def plot_dynamic_factor(ds: xr.Dataset, path: str | os.PathLike | None = None):
         ax.set_xlim(rpm.min(), rpm.max())
         low = min(1.0, float(finite.min()) if finite.size else 1.0, float(np.nanmin(ds["K_v"])))
         ax.set_ylim(low - 0.05, y_top)
-        ax.legend(loc="upper left", ncols=2)
+        if below:
+            ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.14), ncols=3,
+                      fontsize="x-small")
+        else:
+            ax.legend(loc="upper left", ncols=2)
         if "mesh_frequency" in ds.coords:
             per_rpm = float(ds["mesh_frequency"].values[0] / rpm[0])
             top = ax.secondary_xaxis("top", functions=(lambda x: x * per_rpm,

@@ -19,6 +19,11 @@ Numerics
   dead-zone edge, the model's ``events``) is redone split at the located crossings by the
   model's split step (:mod:`._step_core`), which takes the coefficients at the step's middle
   and the phase rotated linearly across the step (phase error at most ``accel h^2 / 8``).
+* A model that reads a forcing from the time, at a non-whole order r of Omega (a gear train's
+  stage at r Omega t, a torque fluctuation of non-whole order), runs with ``time_phase``: its
+  functions get the time theta(t) / Omega(t) instead of t, so that r Omega t is r theta(t), the
+  integral of r Omega (in a split step the time origin moves so that Omega at the step's
+  middle times the time is the phase rotated linearly across the step).
 * A state that leaves ``|y| <= bound`` or stops being finite ends the run (status 1); the rows
   after it are NaN.
 """
@@ -48,7 +53,8 @@ from geardyn.solvers._template_model import events, observe, rhs  # MODEL-IMPORT
 
 _observe_i = nb.njit(forceinline=True, _nrt=False, **_JIT)(observe.py_func)  # (as ._step_core's)
 
-__all__ = ["events", "observe", "rhs", "runup_trajectory", "set_speed", "speed_phase"]
+__all__ = ["events", "observe", "phase_time", "rhs", "runup_trajectory", "set_speed",
+           "speed_phase"]
 
 
 @nb.njit(inline="always", **_JIT)
@@ -72,15 +78,25 @@ def set_speed(p, om, cols, coef):
         p[cols[j]] = coef[j, 0] + om * (coef[j, 1] + om * coef[j, 2])
 
 
+@nb.njit(inline="always", **_JIT)
+def phase_time(t, om, th, time_phase):
+    """The time the model's functions get: t, or with ``time_phase`` theta / Omega (module
+    docs; t where Omega is 0)."""
+    if time_phase and om != 0.0:
+        return th / om
+    return t
+
+
 @nb.njit(**_JIT)
 def runup_trajectory(p0, y0, h, i_begin, i_end, i0, stride, last, start, accel, t_on, t_off,
-                     cols, coef, locate, bound, n_ev, n_obs, resume, hist, side):
+                     cols, coef, locate, bound, n_ev, n_obs, resume, hist, side, time_phase):
     """Integrate one lane from grid point i_begin (time i_begin h, state y0) to i_end through
     the ramp, recording every stride-th grid point counted from i0 (none before it; the point
     i_end only if ``last``: a run cut into pieces records each point once). ``resume``: the
     run goes on from an earlier piece, whose edge sides ``side`` (n_ev) and graze-screen
     history ``hist`` (2, max(n_ev, 1): the events at the last even and odd grid points) it
     takes, so that pieces give bitwise the steps of one call; else both start afresh.
+    ``time_phase``: the model's functions get the time theta / Omega (module docs).
 
     Returns (Y[n_rec, ns], O[n_rec, n_obs], W[n_rec] (Omega), TH[n_rec] (the phase),
     ncross[n_ev], status, unresolved, steps_done, y_end, hist, side). Rows after a divergence
@@ -111,7 +127,8 @@ def runup_trajectory(p0, y0, h, i_begin, i_end, i0, stride, last, start, accel, 
         y[q] = y0[q]
     om, th = speed_phase(i_begin * h, start, accel, t_on, t_off)
     set_speed(p, om, cols, coef)
-    _events_i(i_begin * h, y, G[0], p, math.sin(th), math.cos(th))
+    _events_i(phase_time(i_begin * h, om, th, time_phase), y, G[0], p, math.sin(th),
+              math.cos(th))
     for j in range(n_ev):
         SIDE[0, j] = side[j] if resume else _side(G[0, j])
     if resume:
@@ -135,41 +152,45 @@ def runup_trajectory(p0, y0, h, i_begin, i_end, i0, stride, last, start, accel, 
             out_w[r] = om
             out_th[r] = th
             if n_obs > 0:
-                _observe_i(t, y, obuf, p, sa, ca)
+                _observe_i(phase_time(t, om, th, time_phase), y, obuf, p, sa, ca)
                 for q in range(n_obs):
                     out_o[r, q] = obuf[q]
         if i == i_end:
             break
-        _rhs_i(t, y, k1, p, sa, ca)
+        _rhs_i(phase_time(t, om, th, time_phase), y, k1, p, sa, ca)
         om_m, th_m = speed_phase(t + hh, start, accel, t_on, t_off)
         sb = math.sin(th_m)
         cb = math.cos(th_m)
         set_speed(p, om_m, cols, coef)
+        tm = phase_time(t + hh, om_m, th_m, time_phase)
         for q in range(ns):
             tmp[q] = y[q] + hh * k1[q]
-        _rhs_i(t + hh, tmp, k2, p, sb, cb)
+        _rhs_i(tm, tmp, k2, p, sb, cb)
         for q in range(ns):
             tmp[q] = y[q] + hh * k2[q]
-        _rhs_i(t + hh, tmp, k3, p, sb, cb)
+        _rhs_i(tm, tmp, k3, p, sb, cb)
         om_e, th_e = speed_phase(t + h, start, accel, t_on, t_off)
         se = math.sin(th_e)
         ce = math.cos(th_e)
         set_speed(p, om_e, cols, coef)
+        te = phase_time(t + h, om_e, th_e, time_phase)
         for q in range(ns):
             tmp[q] = y[q] + h * k3[q]
-        _rhs_i(t + h, tmp, k4, p, se, ce)
+        _rhs_i(te, tmp, k4, p, se, ce)
         h6 = h / 6.0
         for q in range(ns):
             y1[q] = y[q] + h6 * (k1[q] + 2.0 * k2[q] + 2.0 * k3[q] + k4[q])
         if n_ev > 0:
             _keep_start(i, 1, ACTIVE, G, gbuf)
-            _events_i(t + h, y1, G[0], p, se, ce)
+            _events_i(te, y1, G[0], p, se, ce)
             crossed = _leaves_side(i, 0, G, SIDE, locate, gbuf)
         else:
             crossed = 0
         if crossed and locate:
             set_speed(p, om_m, cols, coef)
-            unresolved += _split_step(i, 0.0, y, y1, p, h, (th_e - th) / h, 1, sa, ca, se, ce,
+            # with time_phase, Omega_m (t0 + i h) is theta at the step's start
+            t0 = th / om_m - i * h if time_phase and om_m != 0.0 else 0.0
+            unresolved += _split_step(i, t0, y, y1, p, h, (th_e - th) / h, 1, sa, ca, se, ce,
                                       SIDE[0], G[0], ncross, work, ybuf, gbuf)
         else:
             if crossed:

@@ -5,12 +5,14 @@ connectedness, rigid-body modes) and assembles the linear model at mean mesh sti
 coordinates, M, K, C, natural frequencies, mode shapes with the strain-energy share of every
 element, speed ratios, mesh orders and Campbell (interference) data; :class:`TrainModel`
 is its nonlinear model (backlash, time-varying mesh stiffness,
-transmission error, torques) on the planetary gear set's compiled kernels. Physics only: no files,
-no plots. See docs/trains.md.
+transmission error, torques) on the planetary gear set's compiled kernels; tooth faults on a gear
+of the train (:mod:`geardyn.trains.faults`) act in its potential-energy mesh stiffness over that
+gear's revolution. Physics only: no files, no plots. See docs/trains.md.
 """
 
 from geardyn.models.modal import MULTIPLICITY_RTOL
 from geardyn.trains.elements import GROUND, STIFFNESS_METHODS, Bearing, Gear, Inertia, Mesh, Shaft
+from geardyn.trains.faults import TrainFaults
 from geardyn.trains.model import TrainModel
 from geardyn.trains.stages import PlanetaryStage, planetary_stage
 from geardyn.trains.train import (
@@ -35,6 +37,7 @@ __all__ = [
     "MeshData",
     "PlanetaryStage",
     "Shaft",
+    "TrainFaults",
     "TrainModel",
     "planetary_stage",
     "resolve_mesh",

@@ -139,13 +139,17 @@ class Shaft:
     """A torsional spring between bodies ``a`` and ``b`` (``b`` may be :data:`GROUND`):
     ``stiffness`` [N m/rad] and ``damping`` [N m s/rad] on the twist theta_a - theta_b.
     ``math.inf`` (or ``"inf"``): a rigid joint, the two bodies turn as one (the two gears of a
-    compound planet); it has no damping."""
+    compound planet); it has no damping. A coupling is a shaft: ``backlash`` [rad] its
+    torsional play (a spline's, a gear coupling's), in the nonlinear model
+    (:class:`~geardyn.trains.TrainModel`) a dead zone of that half-width on the twist; the
+    linear model ignores it."""
 
     name: str
     a: str
     b: str
     stiffness: Any
     damping: Any = 0.0
+    backlash: Any = 0.0
 
     def __post_init__(self) -> None:
         _name("Shaft", self.name)
@@ -158,6 +162,10 @@ class Shaft:
         if self.rigid and self.damping != 0.0:
             raise ParameterError(f"{self.name}.damping", self.damping,
                                  "a rigid shaft (infinite stiffness) has no damping")
+        _si(self, "backlash", "angle")
+        if self.rigid and self.backlash > 0.0:
+            raise ParameterError(f"{self.name}.backlash", self.backlash, "a rigid joint has no "
+                                 "play: give the shaft a finite stiffness")
 
     @property
     def rigid(self) -> bool:
@@ -172,9 +180,12 @@ class Bearing:
 
     On a carrier, the bearing's pin sits at ``radius`` [m] and ``angle`` [rad] from the
     carrier's axis, so the carrier's rotation moves it tangentially by radius * theta_carrier.
-    ``clearance`` [m] (radial, a dead zone) is recorded for the nonlinear model; the linear
-    model ignores it. A finite stiffness gives ``body`` lateral degrees of freedom (x, y), which
-    need its mass; a rigid bearing carries the body with the host.
+    ``clearance`` [m]: the play of a flexible bearing, in the nonlinear model
+    (:class:`~geardyn.trains.TrainModel`) a dead zone of that half-width in each of x and y
+    (a square clearance: the body touches at c on the axes, at c sqrt(2) on the diagonals); the
+    linear model ignores it (bearing in contact). A finite stiffness gives ``body`` lateral
+    degrees of freedom (x, y), which need its mass; a rigid bearing carries the body with the
+    host and has no clearance.
     """
 
     name: str
@@ -197,6 +208,9 @@ class Bearing:
         _si(self, "radius", "length")
         _si(self, "angle", "angle", None)
         _si(self, "clearance", "length")
+        if self.rigid and self.clearance > 0.0:
+            raise ParameterError(f"{self.name}.clearance", self.clearance, "a rigid bearing has "
+                                 "no play: give the bearing a finite stiffness")
 
     @property
     def rigid(self) -> bool:
@@ -211,10 +225,12 @@ class Mesh:
     ``stiffness``: the mean mesh stiffness [N/m] along the line of action, or ``"iso"`` (ISO
     6336-1 method B, :func:`~geardyn.gears.iso6336_stiffness`) or ``"potential_energy"``
     (the mean of :func:`~geardyn.gears.potential_energy_stiffness`, or of
-    :func:`~geardyn.gears.helical_stiffness`, over a mesh cycle; ``bore_radius`` [m] needed),
-    both from the two gears' geometries. A helical mesh's line of action is inclined by the
-    base helix angle beta_b to the transverse plane and ``stiffness`` is along it (the normal
-    stiffness k_n); the planar model sees k_n cos^2(beta_b) on the transverse deflection.
+    :func:`~geardyn.gears.helical_stiffness`, over a mesh cycle; ``bore_radius`` [m] needed,
+    for both gears; :class:`~geardyn.trains.TrainModel` takes the waveform of both flanks from
+    the same table, and tooth faults act through it), both from the two gears' geometries. A
+    helical mesh's line of action is inclined by the base helix angle beta_b to the transverse
+    plane and ``stiffness`` is along it (the normal stiffness k_n); the planar model sees k_n
+    cos^2(beta_b) on the transverse deflection.
     ``helix_angle`` [rad] (None: from the geometries, else 0) gives beta of a mesh without
     geometry, beta_b = atan(tan(beta) cos(alpha)) with alpha its pressure angle.
 

@@ -11,7 +11,10 @@ there: X = q / L (q: the train's coordinates, rad and m), tau = omega_0 t::
 
 with k_m the drive flank's relative stiffness where g > 0 and the coast flank's, kc_m, where
 g < 0 (``coast="mirror"``, meshes whose two gears have geometry: the drive flank's mirror image
-about the mesh's coast phase; else kc_m = k_m).
+about the mesh's coast phase; else kc_m = k_m). A mesh on the potential-energy stiffness
+(``stiffness="potential_energy"``) takes both flanks, means and waveforms, from its table over
+the mesh cycle (the discrete Fourier series of ``mesh_stiffness`` and ``mesh_stiffness_coast``,
+``harmonics`` terms; the coast flank with its own phase, the table's).
 
 Kt = M^-1 K_s / omega_0^2 with K_s the shafts' and flexible bearings' stiffness (the meshes act
 only through f_m), Ct = M^-1 C / omega_0 with C the shafts', bearings' and Rayleigh damping (the
@@ -23,6 +26,15 @@ mesh frequency over omega_0; mesh m turns at r_m = order_m / order_ref times it 
 :meth:`~geardyn.trains.GearTrain.mesh_orders`), theta_m = r_m Omega tau: a non-integer r_m makes
 the forcing quasi-periodic (no common period; sections are then taken once per period of the
 reference mesh, and periodic orbits and their continuation are refused).
+
+Tooth faults (the train's ``faults``, :mod:`geardyn.trains.faults`) on gear f (Z_f teeth, its
+meshes at r_f) make the forcing period one revolution of f relative to its meshes' frame:
+``mesh_order`` N = Z_f / r_f reference-mesh cycles, Omega = the reference mesh frequency / (N
+omega_0). f's meshes' stiffness is the series of their tables over the revolution, in its angle
+(``harmonics`` x Z_f terms, every sideband up to mesh harmonic ``harmonics``), so the fault acts
+once per revolution; every other mesh's phase turns at r_m N Omega. A non-integer r_m N (f on
+another stage than the reference mesh, or stages with a non-integer ratio) is quasi-periodic
+forcing, as above, sections once per revolution of f.
 """
 
 from __future__ import annotations
@@ -35,6 +47,7 @@ import numpy as np
 
 from geardyn.core.capabilities import Capabilities
 from geardyn.errors import ParameterError
+from geardyn.gears.iso6336_kv import KvMeshGroup, group_reduced_mass
 from geardyn.gears.potential_energy import coast_phase
 from geardyn.models import planetary_kernels as pk
 from geardyn.models.planetary import (
@@ -46,12 +59,16 @@ from geardyn.models.planetary import (
     _waveform,
     planetary_layout,
 )
-from geardyn.models.planetary_stiffness import coast_flank, mirrored
+from geardyn.models.planetary_stiffness import FlankSeries, coast_flank, flank_series, mirrored
+from geardyn.trains.faults import faulty_table, revolution_series
 from geardyn.trains.train import GearTrain, _gear_mesh
 from geardyn.units import si_value
 
 #: The sweep parameter of a train's input speed [rpm].
 INPUT_SPEED = "input_speed"
+#: The sweep parameter of a train's input torque [N m]: the driven body's mean torque, every
+#: other mean torque scaled with it (the load's balance kept).
+INPUT_TORQUE = "input_torque"
 #: Relative distance of a mesh order ratio from a whole number within which it is that number
 #: (speed ratios come from an SVD, so a stage's equal orders agree to about 1e-12).
 ORDER_RTOL = 1e-9
@@ -62,7 +79,8 @@ MIRROR_ATOL = 1e-12
 _SWEPT = ("mesh_frequency", INPUT_SPEED, "backlash", "mesh_damping", "modal_damping",
           "stiffness_fluctuation", "mesh_error", "torque_fluctuation", "torque_order",
           "torque_phase")
-_UNITS = {"mesh_frequency": "rad/s", INPUT_SPEED: "rpm", "backlash": "m", "mesh_damping": "1",
+_UNITS = {"mesh_frequency": "rad/s", INPUT_SPEED: "rpm", INPUT_TORQUE: "N m", "backlash": "m",
+          "mesh_damping": "1",
           "modal_damping": "1", "stiffness_fluctuation": "1", "mesh_error": "m",
           "torque_fluctuation": "1", "torque_order": "1", "torque_phase": "rad"}
 
@@ -114,9 +132,14 @@ class TrainModel(PlanetaryGearSet):
         ``contact_ratio``, ``harmonics``), or a pair (a, b) of relative Fourier coefficients,
         or {mesh: (a, b)} (ISO 6336-1 waves' ``fourier(n)``); ``mesh_phase`` [rad of the mesh
         cycle], scalar or per mesh, or ``"geometry"``: -2 pi gamma_m of
-        :meth:`geometry_phases` (default 0: the phases are the user's unless asked for).
+        :meth:`geometry_phases` (default 0: the phases are the user's unless asked for). A
+        mesh on the potential-energy stiffness takes w from its table instead (``harmonics``
+        terms over the mesh cycle, x Z_f over a faulty gear's revolution; at most half the
+        table's angles per cycle), shifted by its ``mesh_phase``: a fluctuation or waveform
+        given for it is refused (give the others' per mesh).
     mesh_error, error_phase
-        Transmission error e_m = E_m sin(theta_m + phase_m + error_phase_m) [m].
+        Transmission error e_m = E_m sin(theta_m + phase_m + error_phase_m) [m] (refused on a
+        faulty gear's meshes, whose phase is the revolution's).
     torque_fluctuation, torque_order, torque_phase
         The driven body's torque fluctuates as T (1 + A sin(order Omega tau + phase)).
     coast
@@ -126,21 +149,24 @@ class TrainModel(PlanetaryGearSet):
         :func:`geardyn.gears.potential_energy.coast_phase` of the gear pair (from the geometry
         alone; :func:`~geardyn.models.planetary_stiffness.mirrored`), the same mean stiffness;
         ``"symmetric"``: the drive flank's stiffness on both flanks. A mesh with a gear
-        without geometry has one stiffness on both flanks. Kept as :attr:`coast_flank`.
+        without geometry has one stiffness on both flanks; a mesh on the potential-energy
+        stiffness takes its table's coast flank with ``"mirror"``. Kept as
+        :attr:`coast_flank`.
     time_scale, length_scale
         omega_0 [rad/s] (default sqrt(k_ref / m_e,ref) of the reference mesh) and L [m].
     """
 
     name = "TrainModel"
     capabilities = Capabilities(physical_inputs=True, physical_axes=True, mesh_forces=True,
-                                natural_frequencies="Hz")
+                                dynamic_factor=True, natural_frequencies="Hz")
     raw_overrides: dict[str, float] = {}
     carrier_speed = None
     carrier_speed_ratio = None
     centrifugal_preload = False
     rotational_only = False
-    #: The forcing period is one cycle of the reference mesh (no tooth fault sets a longer one).
-    mesh_order = 1
+    #: The forcing period in cycles of the reference mesh: 1, or with tooth faults one
+    #: revolution of the faulty gear (:meth:`_forcing_period`).
+    mesh_order: float = 1
 
     def __init__(self, train: Any, *, reference_mesh: str | None = None,
                  input_speed: Any = None, mesh_frequency: Any = None,
@@ -173,12 +199,21 @@ class TrainModel(PlanetaryGearSet):
             self.mesh_phase = np.array([-2.0 * math.pi * gamma[m] for m in names])
         else:
             self.mesh_phase = _per_mesh("mesh_phase", mesh_phase, names, "angle", None)
-        self.fourier = self._fourier(waveform, stiffness_fluctuation, float(contact_ratio),
-                                     harmonics)
         self.coast_flank = coast_flank(coast)
-        self.fourier_coast, self._mirrored = self._coast_fourier()
+        self.faults = train.faults
+        self.mesh_order, self._phase_scale = self._forcing_period()
+        self._phase_orders = self._snapped(self._kinematic_orders * self._phase_scale)
+        self._stiffness_series(self._fourier(waveform, stiffness_fluctuation,
+                                             float(contact_ratio), harmonics), harmonics)
         self.backlash = _per_mesh("backlash", backlash, names, "length")
         self.error = _per_mesh("mesh_error", mesh_error, names, "length")
+        if self.faults is not None:
+            hit = [m for m in self.faults.meshes if self.error[names.index(m)] != 0.0]
+            if hit:
+                raise ParameterError(f"mesh_error.{hit[0]}", mesh_error, "a static transmission "
+                                     f"error on a mesh of the faulty gear {self.faults.gear} "
+                                     "would act once per revolution (its phase is the "
+                                     "revolution's); leave it 0")
         self.error_phase = _per_mesh("error_phase", error_phase, names, "angle",
                                      None) + self.mesh_phase
         self.mesh_damping = _per_mesh("mesh_damping", mesh_damping, names, "dimensionless")
@@ -200,7 +235,7 @@ class TrainModel(PlanetaryGearSet):
                                                                  "frequency", 0.0, True)
         mf = self._mesh_frequency(input_speed, mesh_frequency)
         self.inputs["input_speed"], self.inputs["mesh_frequency"] = None, mf
-        self._build(mf / self.time_scale)
+        self._build(mf / (self.time_scale * self.mesh_order))
 
     # ------------------------------------------------------------------ inputs
     def _reference(self, name: str | None) -> str:
@@ -231,23 +266,75 @@ class TrainModel(PlanetaryGearSet):
             raise ParameterError(f"{bad}", 0.0, "the mesh does not turn with the input")
         return np.where(snap, whole, r)
 
+    @staticmethod
+    def _snapped(r: np.ndarray) -> np.ndarray:
+        """``r`` with the entries within ``ORDER_RTOL`` of a whole number > 0 set to it."""
+        whole = np.round(r)
+        return np.where((whole > 0) & (np.abs(r - whole) <= ORDER_RTOL * r), whole, r)
+
     @property
-    def orders(self) -> np.ndarray:
-        """r_m of every mesh: its mesh frequency over the reference mesh's (the coefficient
-        vector's, so a raw override of ``<mesh>_order`` shows)."""
+    def _kernel_orders(self) -> np.ndarray:
+        """Every mesh's phase frequency over Omega, as the coefficient vector holds it (so a raw
+        override of ``<mesh>_order`` shows): r_m times the reference-mesh cycles per forcing
+        period (``mesh_order``), over Z_f for the faulty gear's meshes (their series are in
+        its revolution angle)."""
         lay = self._layout
         return np.array([self.params[lay["mesh"] + m * lay["block"] + pk.M_ORDER]
                          for m in range(len(self._mesh_names))])
 
     @property
+    def orders(self) -> np.ndarray:
+        """r_m of every mesh: its mesh frequency over the reference mesh's (from the
+        coefficient vector's orders)."""
+        return self._kernel_orders / self._phase_scale
+
+    @property
     def quasi_periodic(self) -> bool:
-        """Whether a mesh's order over the reference mesh's is not a whole number."""
-        return bool(np.any(self.orders != np.round(self.orders)))
+        """Whether a mesh's phase does not turn a whole number of times per forcing period."""
+        r = self._kernel_orders
+        return bool(np.any(r != np.round(r)))
+
+    def _forcing_period(self) -> tuple[float, np.ndarray]:
+        """The reference-mesh cycles per forcing period N and every mesh's phase scale (its
+        phase frequency over Omega is r_m times it). Healthy: 1 and 1. With tooth faults on gear
+        f (Z_f teeth, its meshes at r_f): the period is one revolution of f relative to its
+        meshes' frame, N = Z_f / r_f (a whole number within ``ORDER_RTOL`` snapped to it); the
+        other meshes' phases turn at r_m N, f's meshes' series are in the revolution angle
+        (scale N / Z_f, r_f N / Z_f = 1)."""
+        scale = np.ones(len(self._mesh_names))
+        placement = self.faults
+        if placement is None:
+            return 1, scale
+        idx = [self._mesh_names.index(m) for m in placement.meshes]
+        r = self._kinematic_orders[idx]
+        if np.any(np.abs(r - r[0]) > ORDER_RTOL * r[0]):
+            raise ParameterError("faults", placement.gear, "the faulty gear's meshes turn at "
+                                 "different mesh frequencies (frames): one revolution is no "
+                                 "common period")
+        n = placement.teeth / float(r[0])
+        whole = round(n)
+        if abs(n - whole) <= ORDER_RTOL * n:
+            n = whole
+        scale[:] = n
+        scale[idx] = n / placement.teeth
+        return n, scale
 
     def _fourier(self, waveform: Any, amplitude: Any, contact_ratio: float,
                  harmonics: int) -> np.ndarray:
         names = self._mesh_names
         rel = _per_mesh("stiffness_fluctuation", amplitude, names, "dimensionless")
+        teeth = [m for m in names if self.train.mesh_data[m].table is not None]
+        if teeth and not isinstance(waveform, str | Mapping):
+            raise ParameterError("waveform", "(coefficients)", f"mesh {teeth[0]} takes its "
+                                 "waveform from the potential-energy method (its teeth); give "
+                                 "the pairs per mesh ({mesh: (a, b)}) for the others")
+        for m in teeth:
+            reason = (f"mesh {m} takes its waveform from the potential-energy method (its "
+                      "teeth); give the others theirs per mesh ({mesh: value})")
+            if rel[names.index(m)] != 0.0:
+                raise ParameterError("stiffness_fluctuation", amplitude, reason)
+            if isinstance(waveform, Mapping) and m in waveform:
+                raise ParameterError(f"waveform.{m}", "(coefficients)", reason)
         if isinstance(waveform, Mapping):
             unknown = sorted(set(waveform) - set(names))
             if unknown:
@@ -295,25 +382,11 @@ class TrainModel(PlanetaryGearSet):
         if train.driven is None:
             raise ParameterError("mesh_phase", "geometry", "needs the train's driven body (the "
                                  "gears' senses of rotation)")
-        ratios, pairs = train.speed_ratios(), {}
         for m in train.meshes:
             ga, gb = train.bodies[m.a], train.bodies[m.b]
             if getattr(ga, "geometry", None) is None or getattr(gb, "geometry", None) is None:
                 raise ParameterError("mesh_phase", "geometry", f"needs the geometry of both "
                                      f"gears of mesh {m.name} ({m.a}, {m.b})")
-            pair = _gear_mesh(m, ga, gb)
-            pairs[m.name] = getattr(pair, "transverse", pair)
-        arms = {m.name: train.mesh_frame_ratio(m, ratios) for m in train.meshes}
-
-        def side(m: Any, g: str) -> tuple[float, float, float]:
-            """beta [rad], e and s [rad] of gear g in mesh m."""
-            pair, first = pairs[m.name], g == m.a
-            beta = m.angle if first and not m.internal else m.angle + math.pi
-            e = -1.0 if (m.internal and not first) else 1.0
-            gear = pair.pinion if first else pair.wheel
-            r_w = pair.operating_pitch_radii[0 if first else 1]
-            return beta, e, gear.angular_thickness(r_w)
-
         gamma: dict[str, float] = {}
         for start in train.meshes:
             if start.name in gamma:
@@ -325,28 +398,146 @@ class TrainModel(PlanetaryGearSet):
                     shared = {m1.a, m1.b} & {m2.a, m2.b}
                     if m2.name in gamma or not shared:
                         continue
-                    g = shared.pop()
-                    b1, e1, s1 = side(m1, g)
-                    b2, e2, s2 = side(m2, g)
-                    sigma = math.copysign(1.0, ratios[g] - arms[m1.name])
-                    z = train.bodies[g].teeth
-                    step = z * sigma * (b2 - b1 - 0.5 * (e2 * s2 - e1 * s1)) / (2.0 * math.pi)
+                    step = self.tooth_passage_step(m1, m2, shared.pop())
                     g2 = (gamma[m1.name] + step) % 1.0
                     gamma[m2.name] = 0.0 if math.isclose(g2, 1.0, abs_tol=1e-9) else g2
                     todo.append(m2)
         return gamma
 
-    def _coast_fourier(self) -> tuple[np.ndarray, bool]:
-        """The coast flank's relative Fourier coefficients (meshes, 2 nh) and whether any
-        mesh's differs from its drive flank's by construction (``coast="mirror"``)."""
+    def tooth_passage_step(self, first: Any, second: Any, gear: str) -> float:
+        """D [mesh cycles, unreduced]: how much later a tooth of ``gear`` (a gear of both
+        meshes) passes the pitch point of mesh ``second`` than that of mesh ``first``, Z sigma
+        [beta_2 - beta_1 - (e_2 s_2 - e_1 s_1) / 2] / (2 pi) (:meth:`geometry_phases`). Needs the
+        train's driven body and the geometry of both meshes' gears."""
+        train = self.train
+        if train.driven is None:
+            raise ParameterError("driven", None, "the tooth passages between two meshes of "
+                                 f"{gear} need the train's driven body (its sense of rotation)")
+        ratios = train.speed_ratios()
+        b1, e1, s1 = self._pitch_side(first, gear)
+        b2, e2, s2 = self._pitch_side(second, gear)
+        sigma = math.copysign(1.0, ratios[gear] - train.mesh_frame_ratio(first, ratios))
+        z = train.bodies[gear].teeth
+        return z * sigma * (b2 - b1 - 0.5 * (e2 * s2 - e1 * s1)) / (2.0 * math.pi)
+
+    def _pitch_side(self, m: Any, g: str) -> tuple[float, float, float]:
+        """beta [rad] (the direction of mesh m's pitch point from gear g's centre), e (the side
+        of g's loaded flank) and s [rad] (g's tooth angular thickness at m's operating pitch
+        radius) of gear g in mesh m."""
+        ga, gb = self.train.bodies[m.a], self.train.bodies[m.b]
+        pair = _gear_mesh(m, ga, gb)
+        pair, first = getattr(pair, "transverse", pair), g == m.a
+        beta = m.angle if first and not m.internal else m.angle + math.pi
+        e = -1.0 if (m.internal and not first) else 1.0
+        gear = pair.pinion if first else pair.wheel
+        r_w = pair.operating_pitch_radii[0 if first else 1]
+        return beta, e, gear.angular_thickness(r_w)
+
+    def _stiffness_series(self, user: np.ndarray, harmonics: int) -> None:
+        """Every mesh's drive and coast flank: :attr:`fourier`, :attr:`fourier_coast`
+        (meshes, 2 nh, zero-padded to the widest), the mean stiffnesses [N/m] of
+        :meth:`mesh_stiffnesses` and :meth:`coast_stiffnesses`, and whether any coast flank
+        differs from its drive flank by construction. The potential-energy meshes' from their
+        tables (:meth:`_tooth_series`), the others' from ``user`` (the waveform given), the
+        coast flank mirrored (:meth:`_coast_fourier`)."""
+        names = self._mesh_names
+        mean = np.array([self.train.mesh_data[m].stiffness for m in names])
+        teeth = self._tooth_series(harmonics)
+        width = max([user.shape[1]] + [r[0].size for r in teeth.values()])
+        drive = np.pad(user, ((0, 0), (0, width - user.shape[1])))
+        coast = drive.copy()
+        coast_mean = mean.copy()
+        for m, (d, c, kd, kc) in teeth.items():
+            drive[m], mean[m] = np.pad(d, (0, width - d.size)), kd
+            coast[m], coast_mean[m] = np.pad(c, (0, width - c.size)), kc
+        gaps = self.faults.meshes if self.faults is not None and self.faults.missing_tooth \
+            else ()
+        for m in teeth:
+            rows = (drive[m], coast[m]) if self.coast_flank == "mirror" else (drive[m],)
+            if names[m] not in gaps and min(_minimum_relative_stiffness(r[None, :])
+                                            for r in rows) <= 0.0:
+                raise ParameterError("harmonics", harmonics, f"the series of mesh {names[m]}'s "
+                                     "potential-energy stiffness falls to 0 or below; keep "
+                                     "more")
+        self.fourier = drive
+        self._drive_mean = mean
         if self.coast_flank == "symmetric":
-            return self.fourier, False
+            self.fourier_coast, self._coast_mean, self._mirrored = drive, mean, False
+            return
+        self.fourier_coast, self._mirrored = self._coast_fourier(coast, set(teeth))
+        self._coast_mean = coast_mean
+
+    def _tooth_series(self, harmonics: int) -> dict[int, tuple[np.ndarray, np.ndarray,
+                                                               float, float]]:
+        """The potential-energy meshes' relative series (drive, coast; shifted by the mesh
+        phase) and mean stiffnesses [N/m along the line of action] by mesh index: the discrete
+        Fourier series of the one-cycle tables (``harmonics`` terms), a faulty gear's meshes
+        over its revolution (:func:`~geardyn.trains.faults.revolution_series`, ``harmonics`` x
+        Z_f terms in the revolution angle)."""
+        out: dict[int, tuple[np.ndarray, np.ndarray, float, float]] = {}
+        offsets = self._fault_offsets()
+        for i, mesh in enumerate(self.train.meshes):
+            data = self.train.mesh_data[mesh.name]
+            if data.table is None:
+                continue
+            angles = int(data.table.sizes["angle"])
+            if 2 * harmonics >= angles:
+                raise ParameterError("harmonics", harmonics, f"mesh {mesh.name}'s potential-"
+                                     f"energy table has {angles} angles per mesh cycle: at "
+                                     f"most {(angles - 1) // 2} harmonics")
+            normal = 1.0 / math.cos(data.base_helix_angle) ** 2
+            faulty = mesh.name in offsets
+            flanks: list[FlankSeries] = []
+            for var in ("mesh_stiffness", "mesh_stiffness_coast"):
+                healthy = data.table[var].values
+                if faulty:
+                    z = self.faults.teeth
+                    role = "pinion" if self.faults.gear == mesh.a else "wheel"
+                    pair = _gear_mesh(mesh, self.train.bodies[mesh.a],
+                                      self.train.bodies[mesh.b])
+                    table = faulty_table(self.train, mesh, pair,
+                                         self.faults.on_mesh(role, offsets[mesh.name]), z)
+                    flanks.append(revolution_series(healthy, table[var].values, harmonics, z))
+                else:
+                    flanks.append(flank_series(healthy, harmonics))
+            order = self.faults.teeth if faulty else 1
+            rows = [_waveform(f"waveform.{mesh.name}", s.pair, np.zeros(1),
+                              self.mesh_phase[i:i + 1], 1.6, harmonics, order)[0]
+                    for s in flanks]
+            out[i] = (rows[0], rows[1], flanks[0].mean * normal, flanks[1].mean * normal)
+        return out
+
+    def _fault_offsets(self) -> dict[str, int]:
+        """The tooth offset [teeth] of the faults on every mesh of the faulty gear, from its
+        first mesh (:mod:`geardyn.trains.faults`): round(D_m + (psi_m - psi_0) / 2 pi), D_m
+        the tooth passage step (:meth:`tooth_passage_step`)."""
+        placement = self.faults
+        if placement is None:
+            return {}
+        names = self._mesh_names
+        meshes = {m.name: m for m in self.train.meshes}
+        first = meshes[placement.meshes[0]]
+        i0 = names.index(first.name)
+        out = {first.name: 0}
+        for name in placement.meshes[1:]:
+            i = names.index(name)
+            d = self.tooth_passage_step(first, meshes[name], placement.gear)
+            out[name] = int(round(d + (self.mesh_phase[i] - self.mesh_phase[i0])
+                                  / (2.0 * math.pi)))
+        return out
+
+    def _coast_fourier(self, coast: np.ndarray, own: set[int]) -> tuple[np.ndarray, bool]:
+        """The coast flank's relative Fourier coefficients (meshes, 2 nh) and whether any
+        mesh's differs from its drive flank's (``coast="mirror"``): the rows ``own`` (the
+        potential-energy meshes) from ``coast``, every other mesh whose two gears have geometry
+        the drive flank's mirror image."""
         phases = self.coast_phases()
-        if not phases:
-            return self.fourier, False
         out = self.fourier.copy()
+        for m in own:
+            out[m] = coast[m]
         for m, name in enumerate(self._mesh_names):
-            if name in phases:  # k(theta) = k0(theta + psi): mirror about phi - psi / pi
+            if name in phases and m not in own:
+                # k(theta) = k0(theta + psi): mirror about phi - psi / pi
                 phi = phases[name] - self.mesh_phase[m] / math.pi
                 a, b = mirrored(self.fourier[m, 0::2], self.fourier[m, 1::2], phi)
                 row = np.empty_like(out[m])
@@ -432,9 +623,14 @@ class TrainModel(PlanetaryGearSet):
         return np.vstack([W for kind, _, W, _, _ in self.train.elements() if kind == "mesh"])
 
     def mesh_stiffnesses(self) -> np.ndarray:
-        return np.array([self.train.mesh_data[m].stiffness for m in self._mesh_names])
+        """Mean drive-flank stiffness [N/m] of every mesh: the train's, the mean of the
+        potential-energy series (over the faulty gear's revolution for its meshes)."""
+        return self._drive_mean.copy()
 
-    coast_stiffnesses = mesh_stiffnesses
+    def coast_stiffnesses(self) -> np.ndarray:
+        """Mean coast-flank stiffness [N/m] of every mesh (the drive flank's but for the
+        potential-energy meshes with ``coast="mirror"``: their coast tables')."""
+        return self._coast_mean.copy()
 
     def stiffness_matrix(self, meshes: bool = True) -> np.ndarray:
         """K [N/m, N m/rad] at mean mesh stiffness; without the meshes when ``meshes`` is
@@ -494,18 +690,24 @@ class TrainModel(PlanetaryGearSet):
         Minv = np.linalg.inv(M)
         Minv[np.abs(Minv) < 1e-12 * np.max(np.abs(Minv))] = 0.0
         K, C = self.stiffness_matrix(False), self._damping_matrix()
+        plays = self.play_elements()
+        for _, row, k_play, _ in plays:  # acts through its dead zone instead
+            K -= k_play * np.outer(row, row)
         Kt = _clean(Minv @ K)
         kt_entries = [(int(i), int(j)) for i, j in zip(*np.nonzero(Kt), strict=True)]
         W = self.mesh_rows()
+        contacts = self._mesh_names + tuple(name for name, _, _, _ in plays)
+        rows = list(W) + [row for _, row, _, _ in plays]
         mesh_dofs = []
-        for m in range(nm):
-            touched = sorted({int(j) for j in np.nonzero(W[m])[0]}
-                             | {int(j) for j in np.nonzero(_clean(Minv @ W[m]))[0]})
+        for m, row in enumerate(rows):
+            touched = sorted({int(j) for j in np.nonzero(row)[0]}
+                             | {int(j) for j in np.nonzero(_clean(Minv @ row))[0]})
             if len(touched) > pk.MESH_NZ:
-                raise ParameterError(f"{self._mesh_names[m]}", len(touched),
-                                     f"the mesh row touches {len(touched)} coordinates; the "
-                                     f"kernels take at most {pk.MESH_NZ} per mesh")
+                raise ParameterError(f"{contacts[m]}", len(touched),
+                                     f"the element's row touches {len(touched)} coordinates; "
+                                     f"the kernels take at most {pk.MESH_NZ} per contact")
             mesh_dofs.append(touched)
+        nm_gears, nm = nm, len(contacts)
         lay = pk.layout(n, nm, nh, len(kt_entries), 0)
         L, w0 = self.length_scale, self.time_scale
         p = np.zeros(lay["size"])
@@ -519,58 +721,106 @@ class TrainModel(PlanetaryGearSet):
         p[lay["Kt"]:lay["Kt"] + n * n] = Kt.ravel() / w0**2
         p[lay["Ct"]:lay["Ct"] + n * n] = _clean(Minv @ C).ravel() / w0
         p[pk.DAMPED] = float(np.any(p[lay["Ct"]:lay["Ct"] + n * n] != 0.0))
-        k, c = self.mesh_stiffnesses(), self._mesh_damping()
-        for m in range(nm):
+        k, c, kc = self.mesh_stiffnesses(), self._mesh_damping(), self.coast_stiffnesses()
+        for m in range(nm_gears):
             o = lay["mesh"] + m * lay["block"]
-            self._fill_mesh_block(p[o:o + lay["block"]], m, L, w0, k[m], c[m], k[m],
-                                  self._kinematic_orders[m], W[m],
+            self._fill_mesh_block(p[o:o + lay["block"]], m, L, w0, k[m], c[m], kc[m],
+                                  self._phase_orders[m], W[m],
                                   _clean(Minv @ W[m]) / (L * w0 * w0))
+        for j, (_, row, k_play, half_width) in enumerate(plays):
+            o = lay["mesh"] + (nm_gears + j) * lay["block"]
+            _fill_play_block(p[o:o + lay["block"]], nh, row, _clean(Minv @ row) / (L * w0 * w0),
+                             k_play * L, half_width / L)
         self._layout = lay
         self._coast_given = self._mirrored
         self._coast_built = p[_flank_index(lay, n, nm, nh, True)].copy()
         self._structure = (kt_entries, mesh_dofs)
         self._refresh_workspace(p)
         p[lay["cache"]:lay["gyro"]] = pk.cache_entries(nm)[1]
-        self.coefficient_layout = planetary_layout(names, self._mesh_names, nh,
-                                                   tuple(kt_entries), ())
+        self.coefficient_layout = planetary_layout(names, contacts, nh, tuple(kt_entries), ())
         self.params = p
         self.omega_index = pk.OMEGA
         self.kernel = _KERNEL
         self.state_names = names + tuple(f"d{d}" for d in names)
-        self.observable_names = tuple(f"F_{m}" for m in self._mesh_names)
-        self.event_names = tuple(f"x_{m}{s}b_{m}" for m in self._mesh_names for s in "-+")
-        self.meshes = tuple((m, 2 * i, 2 * i + 1) for i, m in enumerate(self._mesh_names))
+        self.observable_names = tuple(f"F_{m}" for m in contacts)
+        self.event_names = tuple(f"x_{m}{s}b_{m}" for m in contacts for s in "-+")
+        self.meshes = tuple((m, 2 * i, 2 * i + 1) for i, m in enumerate(contacts))
+
+    def play_elements(self) -> list[tuple[str, np.ndarray, float, float]]:
+        """The elements with play besides the meshes, as the kernels' contacts after the
+        meshes: (name, deflection row in the model's coordinates [m or rad per coordinate],
+        stiffness [N/m or N m/rad], half-width [m or rad]). A flexible bearing with a
+        ``clearance`` gives two, ``<bearing>_x`` and ``<bearing>_y`` (its deflection in x and in
+        y, each through a dead zone of the clearance); a shaft (coupling) with ``backlash`` one,
+        ``<shaft>`` (its twist). The element's damping stays linear (it acts in the play too)."""
+        train, out = self.train, []
+        for b in train.bearings:
+            if b.clearance > 0.0:
+                rx, ry = train._bearing_rows(b) @ train._T
+                out += [(f"{b.name}_x", rx, b.stiffness, b.clearance),
+                        (f"{b.name}_y", ry, b.stiffness, b.clearance)]
+        for s in train.shafts:
+            if s.backlash > 0.0:
+                row = (train._unit(s.a, 0) - train._unit(s.b, 0)) @ train._T
+                out.append((s.name, row, s.stiffness, s.backlash))
+        return out
 
     # ------------------------------------------------------------------ sweeps and axes
     @property
     def physical_names(self) -> tuple[str, ...]:
         """The inputs a sweep takes by name: ``input_speed`` [rpm] (with a driven body),
         ``mesh_frequency`` [rad/s], and the scalar ones of ``backlash``, ``mesh_damping``,
-        ``modal_damping``, ``stiffness_fluctuation``, ``mesh_error`` and the torque
-        fluctuation's."""
+        ``modal_damping``, ``stiffness_fluctuation`` (not where a mesh takes its waveform from
+        its teeth), ``mesh_error`` and the torque fluctuation's; ``input_torque`` [N m] where
+        the driven body carries a torque."""
+        teeth = any(d.table is not None for d in self.train.mesh_data.values())
         out = []
         for k in _SWEPT:
             if k == INPUT_SPEED:
                 if self.train.driven is not None:
                     out.append(k)
+            elif k == "stiffness_fluctuation" and teeth:
+                continue
             elif not isinstance(self.inputs.get(k), Mapping):
                 out.append(k)
+        if self.train.driven is not None and self.body_torques.get(self.train.driven):
+            out.append(INPUT_TORQUE)
         return tuple(out)
+
+    def with_params(self, **values: Any) -> TrainModel:
+        """A copy with inputs changed by name (:class:`~geardyn.PlanetaryGearSet`'s
+        ``with_params``); ``input_torque`` [N m] scales every mean torque so that the driven
+        body's has that magnitude (:meth:`at_input_torque`)."""
+        if INPUT_TORQUE in values:
+            values = dict(values)
+            torque = si_value(INPUT_TORQUE, values.pop(INPUT_TORQUE), "torque", 0.0, True)
+            if "torques" in values or "load" in values:
+                raise ParameterError(INPUT_TORQUE, torque, "scales the torques: give it or "
+                                     "torques, one of them")
+            s = torque / self.input_torque
+            values["torques"] = {k: v * s for k, v in self.body_torques.items()}
+            values["load"] = None
+        return PlanetaryGearSet.with_params(self, **values)
 
     def lane_params(self, name: str, values: Any) -> np.ndarray:
         """Coefficient vectors (lanes x n_params) with ``name`` set to ``values``; the speeds
         (``input_speed`` [rpm], ``mesh_frequency`` [rad/s]) set Omega alone."""
+        if name == INPUT_TORQUE:
+            vals = np.asarray(values, dtype=float).ravel()
+            return np.array([self.with_params(**{name: float(v)}).params for v in vals])
         if name in (INPUT_SPEED, "mesh_frequency"):
             vals = np.asarray(values, dtype=float).ravel()
             if name == INPUT_SPEED:
                 vals = vals * 2.0 * math.pi / 60.0 * self.mesh_frequency_per_input_speed()
-            return PlanetaryGearSet.lane_params(self, "Omega", vals / self.time_scale)
+            return PlanetaryGearSet.lane_params(self, "Omega",
+                                                vals / (self.time_scale * self.mesh_order))
         return PlanetaryGearSet.lane_params(self, name, values)
 
     @property
     def input_speed(self) -> float:
         """The driven body's speed [rpm] at the model's Omega."""
-        w = self.omega * self.time_scale / self.mesh_frequency_per_input_speed()
+        w = (self.omega * self.time_scale * self.mesh_order
+             / self.mesh_frequency_per_input_speed())
         return w * 60.0 / (2.0 * math.pi)
 
     def param_attrs(self, name: str) -> dict[str, str]:
@@ -580,12 +830,19 @@ class TrainModel(PlanetaryGearSet):
                                f"{self.mesh_frequency_per_input_speed():.6g}, in rpm"}
         if name == "mesh_frequency":
             return {"units": "rad/s", "long_name": f"mesh frequency of {self.reference_mesh}"}
+        if name == INPUT_TORQUE:
+            return {"units": "N m", "long_name": f"input ({self.train.driven}) torque",
+                    "meaning": "the driven body's mean torque, every mean torque scaled with it"}
+        if name == "Omega" and self.faults is not None:
+            return {"units": "1", "long_name": "forcing frequency / time_scale",
+                    "meaning": f"{self.faults.gear}'s revolution frequency: mesh frequency of "
+                               f"{self.reference_mesh} / ({self.mesh_order:.12g} time_scale)"}
         return {"units": _UNITS[name]} if name in _UNITS else {}
 
     def speed_axes(self, omega: np.ndarray) -> dict[str, tuple[np.ndarray, dict]]:
         """The reference mesh's frequency [Hz] and, with a driven body, the input speed [rpm]
         at the dimensionless forcing frequencies ``omega``."""
-        w = np.asarray(omega, dtype=float) * self.time_scale
+        w = np.asarray(omega, dtype=float) * self.time_scale * self.mesh_order
         out = {"mesh_frequency": (w / (2.0 * math.pi), {
             "units": "Hz", "long_name": f"mesh frequency of {self.reference_mesh}"})}
         if self.train.driven is not None:
@@ -606,13 +863,117 @@ class TrainModel(PlanetaryGearSet):
     def dataset_attrs(self) -> dict[str, object]:
         """The reference mesh, every mesh's order over it, and the forcing: ``periodic`` or
         ``quasi-periodic`` (sections sampled once per period of the reference mesh)."""
-        section = (f"once per mesh period of {self.reference_mesh}" if self.quasi_periodic
-                   else f"common period of the meshes, in periods of {self.reference_mesh}")
-        return {"reference_mesh": self.reference_mesh,
-                "mesh_names": ",".join(self._mesh_names),
-                "mesh_orders": ",".join(f"{r:.12g}" for r in self.orders),
-                "forcing": "quasi-periodic" if self.quasi_periodic else "periodic",
-                "section": section}
+        period = (f"revolution of {self.faults.gear}" if self.faults is not None
+                  else f"mesh period of {self.reference_mesh}")
+        section = (f"once per {period}" if self.quasi_periodic
+                   else f"common period of the meshes, in {period}s")
+        out: dict[str, object] = {
+            "reference_mesh": self.reference_mesh, "mesh_names": ",".join(self._mesh_names),
+            "mesh_orders": ",".join(f"{r:.12g}" for r in self.orders),
+            "forcing": "quasi-periodic" if self.quasi_periodic else "periodic",
+            "section": section,
+            "mesh_stiffness_methods": ",".join(self.train.mesh_data[m].method
+                                               for m in self._mesh_names)}
+        if self.faults is not None:
+            out.update(faults=self.faults.describe(), faulty_gear=self.faults.gear,
+                       faulty_meshes=",".join(self.faults.meshes),
+                       mesh_cycles_per_period=self.faults.teeth,
+                       forcing_period=f"one revolution of {self.faults.gear} relative to its "
+                                      f"meshes' frame ({self.faults.teeth} of their mesh "
+                                      f"cycles, {self.mesh_order:.12g} of "
+                                      f"{self.reference_mesh})",
+                       Omega_meaning=f"mesh frequency of {self.reference_mesh} / "
+                                     f"({self.mesh_order:.12g} time_scale)",
+                       stiffness_harmonics=self.fourier.shape[1] // 2)
+        return out
+
+    # ------------------------------------------------------------------ ISO 6336-1 K_v
+    @property
+    def input_torque(self) -> float:
+        """The magnitude of the driven body's mean torque [N m]."""
+        driven = self.train.driven
+        if driven is None:
+            raise ParameterError("driven", None, "the input torque is the driven body's: the "
+                                 "train needs driven")
+        t = abs(float(self.body_torques.get(driven, 0.0)))
+        if t == 0.0:
+            raise ParameterError(f"torques.{driven}", 0.0, "the driven body carries no torque")
+        return t
+
+    def at_input_torque(self, torque: float) -> TrainModel:
+        """The train with every mean torque scaled so that the driven body's has magnitude
+        ``torque`` [N m] (the load balancing it scaled alike)."""
+        return self.with_params(**{INPUT_TORQUE: float(torque)})
+
+    def kv_groups(self, torque: float) -> tuple[KvMeshGroup, ...]:
+        """The meshes whose two gears have geometry, grouped as clause 6.5.9 groups a
+        planetary stage's: meshes that share one gear (a sun, a ring) with equal other gears
+        (the planets: same geometry and inertia) form one group named after the shared gear;
+        every other mesh is a group of its own, named after it. Gear 1 is a group's gear
+        ``a`` (a sun, a planet on a ring) or a single external pair's smaller gear, its speed
+        relative to the mesh's frame (a planet's carrier). F_t = F_n cos(beta_b) r_b1 / r_1
+        from the static mesh force F_n at ``torque`` (along the line of action, normal to a
+        helical tooth); m_red of :func:`~geardyn.gears.iso6336_kv.group_reduced_mass` from the
+        gears' own inertias (an internal gear taken as infinitely heavy)."""
+        train = self.train
+        names = self._mesh_names
+        index = {m: k for k, m in enumerate(names)}
+        geometric = [m for m in train.meshes if train.bodies[m.a].geometry is not None
+                     and train.bodies[m.b].geometry is not None]
+        if not geometric:
+            raise ParameterError("train.meshes", names, "K_v needs meshes whose two gears have "
+                                 "geometry")
+        forces = np.abs(self.at_input_torque(torque).static_mesh_forces())
+        orders = train.mesh_orders()
+
+        def signature(mesh: Any, gear: str) -> tuple:
+            g = train.bodies[gear]
+            return (g.geometry, g.inertia, mesh.internal)
+
+        groups: list[tuple[str, str, list[Any]]] = []  # (name, common gear, meshes)
+        left = list(geometric)
+        shared: dict[tuple[str, tuple], list[Any]] = {}
+        for m in geometric:
+            for common, other in ((m.b, m.a),) if m.internal else ((m.a, m.b), (m.b, m.a)):
+                shared.setdefault((common, signature(m, other)), []).append(m)
+        for (common, _), members in sorted(shared.items(), key=lambda kv: -len(kv[1])):
+            members = [m for m in members if m in left]
+            if len(members) > 1:
+                groups.append((common, common, members))
+                left = [m for m in left if m not in members]
+        groups += [(m.name, m.b, [m]) for m in left]
+        groups.sort(key=lambda g: min(index[m.name] for m in g[2]))
+        out = []
+        for name, common, members in groups:
+            first = members[0]
+            ga, gb = train.bodies[first.a], train.bodies[first.b]
+            if len(members) == 1 and not first.internal \
+                    and ga.geometry.teeth > gb.geometry.teeth:
+                ga, gb = gb, ga  # ISO's gear 1 of a single pair: the pinion
+            mesh = _gear_mesh(first, ga, gb)
+            transverse = getattr(mesh, "transverse", mesh)
+            other = first.a if common == first.b else first.b
+            gc, go = train.bodies[common], train.bodies[other]
+            idx = tuple(index[m.name] for m in members)
+            force = float(np.mean(forces[list(idx)]))
+            if not force > 0.0:
+                raise ParameterError(f"{first.name}.load", force, "the mesh carries no static "
+                                     "load at this torque: K_v needs a loaded mesh")
+            data = train.mesh_data[first.name]
+            b = min(mesh.pinion.face_width, mesh.wheel.face_width)
+            m_red = group_reduced_mass(gc.inertia, go.inertia, gc.base_radius, go.base_radius,
+                                       len(members), b, first.internal)
+            out.append(KvMeshGroup(
+                name, mesh, idx,
+                force * math.cos(data.base_helix_angle) * transverse.pinion.base_radius
+                / transverse.pinion.reference_radius,
+                m_red, orders[first.name] / mesh.pinion.teeth,
+                data.stiffness * math.cos(data.base_helix_angle) ** 2))
+        return tuple(out)
+
+    def input_speed_sweep(self, rpm: np.ndarray) -> tuple[str, np.ndarray]:
+        """``input_speed`` [rpm] itself."""
+        return INPUT_SPEED, np.asarray(rpm, dtype=float)
 
     # ------------------------------------------------------------------ linear analysis
     def natural_frequencies(self) -> np.ndarray:
@@ -629,3 +990,18 @@ class TrainModel(PlanetaryGearSet):
         kind = "quasi-periodic" if self.quasi_periodic else "periodic"
         return (f"TrainModel({len(self.train.bodies)} bodies, {len(self._mesh_names)} meshes, "
                 f"dofs={len(self.dof_names())}, Omega={self.omega:g}, {kind} forcing)")
+
+
+def _fill_play_block(blk: np.ndarray, nh: int, row: np.ndarray, force_row: np.ndarray,
+                     force_per_deflection: float, half_width: float) -> None:
+    """A play element's block of the coefficient vector (a mesh block of
+    :mod:`~geardyn.models.planetary_kernels` with constant stiffness): its half-width, force
+    per dimensionless deflection on both flanks, order 1 and no harmonics (relative stiffness
+    1), its ``row`` and ``force_row``; no error, no own damping."""
+    n = row.size
+    f = pk.MESH_FIXED
+    blk[pk.M_B] = half_width
+    blk[pk.M_KF] = blk[pk.M_KFC] = force_per_deflection
+    blk[pk.M_ORDER] = 1.0
+    blk[f + 2 * nh:f + 2 * nh + n] = row
+    blk[f + 2 * nh + n:f + 2 * nh + 2 * n] = force_row

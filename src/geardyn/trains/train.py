@@ -36,6 +36,7 @@ import numpy as np
 from geardyn.errors import ParameterError
 from geardyn.models.modal import frequency_groups
 from geardyn.trains.elements import GROUND, Bearing, Gear, Inertia, Mesh, Shaft
+from geardyn.trains.faults import place_train_faults
 from geardyn.units import si_value
 
 #: Relative size (to the largest eigenvalue) below which an eigenvalue is a rigid-body mode.
@@ -49,7 +50,10 @@ MODE_TYPE_TOL = 1e-6
 class MeshData:
     """A mesh as the linear model uses it: mean ``stiffness`` [N/m] along the line of action,
     operating transverse ``pressure_angle`` [rad], base radii [m], the method the stiffness
-    came from and the ``base_helix_angle`` [rad] (0: spur)."""
+    came from and the ``base_helix_angle`` [rad] (0: spur); with the potential-energy method
+    its ``table`` (the Dataset of :func:`~geardyn.gears.potential_energy_stiffness`, or of
+    :func:`~geardyn.gears.helical_stiffness`, over one mesh cycle: drive and coast flank along
+    the transverse line of action), else None."""
 
     stiffness: float
     pressure_angle: float
@@ -57,6 +61,7 @@ class MeshData:
     radius_b: float
     method: str
     base_helix_angle: float = 0.0
+    table: Any = None
 
 
 def _line_of_action(mesh: Mesh, alpha: float) -> tuple[float, float]:
@@ -91,12 +96,13 @@ def _gear_mesh(mesh: Mesh, ga: Gear, gb: Gear) -> Any:
                              f"{exc.reason} (mesh of {mesh.a} with {mesh.b})") from None
 
 
-def _mesh_stiffness(mesh: Mesh, gear_mesh: Any, beta_b: float) -> tuple[float, str]:
-    """The mesh stiffness along the line of action [N/m] and its method. ISO 6336-1 and the
-    sliced potential-energy method give it along the transverse line of action: divided by
-    cos^2(beta_b) (a helical mesh) for the normal one."""
+def _mesh_stiffness(mesh: Mesh, gear_mesh: Any, beta_b: float) -> tuple[float, str, Any]:
+    """The mesh stiffness along the line of action [N/m], its method and the potential-energy
+    table (None for the other methods). ISO 6336-1 and the sliced potential-energy method give
+    it along the transverse line of action: divided by cos^2(beta_b) (a helical mesh) for the
+    normal one."""
     if not isinstance(mesh.stiffness, str):
-        return float(mesh.stiffness), "given"
+        return float(mesh.stiffness), "given", None
     if gear_mesh is None:
         raise ParameterError(f"{mesh.name}.stiffness", mesh.stiffness,
                              f"needs the geometry of both gears ({mesh.a}, {mesh.b})")
@@ -104,14 +110,14 @@ def _mesh_stiffness(mesh: Mesh, gear_mesh: Any, beta_b: float) -> tuple[float, s
     if mesh.stiffness == "iso":
         from geardyn.gears.iso6336 import iso6336_stiffness
 
-        return iso6336_stiffness(gear_mesh).mesh_stiffness * normal, "iso"
+        return iso6336_stiffness(gear_mesh).mesh_stiffness * normal, "iso", None
     from geardyn.gears.helical import HelicalMesh, helical_stiffness
     from geardyn.gears.potential_energy import potential_energy_stiffness
 
     method = helical_stiffness if isinstance(gear_mesh, HelicalMesh) else (
         potential_energy_stiffness)
     ds = method(gear_mesh, bore_radius=mesh.bore_radius)
-    return float(ds["mesh_stiffness"].mean()) * normal, "potential_energy"
+    return float(ds["mesh_stiffness"].mean()) * normal, "potential_energy", ds
 
 
 def resolve_mesh(mesh: Mesh, ga: Gear, gb: Gear) -> MeshData:
@@ -139,8 +145,8 @@ def resolve_mesh(mesh: Mesh, ga: Gear, gb: Gear) -> MeshData:
                                  f"inconsistent with the base radii and pressure angle"
                                  f" ({a0:.6g} m)")
     beta_b = _base_helix_angle(mesh, gear_mesh, alpha)
-    k, method = _mesh_stiffness(mesh, gear_mesh, beta_b)
-    return MeshData(k, alpha, ga.base_radius, gb.base_radius, method, beta_b)
+    k, method, table = _mesh_stiffness(mesh, gear_mesh, beta_b)
+    return MeshData(k, alpha, ga.base_radius, gb.base_radius, method, beta_b, table)
 
 
 def _base_helix_angle(mesh: Mesh, gear_mesh: Any, alpha: float) -> float:
@@ -177,12 +183,20 @@ class GearTrain:
         one is refused.
     rayleigh
         (a [1/s], b [s]) of the Rayleigh damping a M + b K added to the elements' damping.
+    faults
+        Tooth faults (:class:`~geardyn.gears.RootCrack`, :class:`~geardyn.gears.Spall`,
+        :class:`~geardyn.gears.Wear`, :class:`~geardyn.gears.BrokenTooth`), one or a sequence,
+        all on one gear named by their ``gear`` (:mod:`geardyn.trains.faults`; its meshes need
+        the potential-energy stiffness). They act in :class:`TrainModel`'s mesh stiffness over
+        the faulty gear's revolution; the linear model here stays at the healthy mean
+        stiffness. Kept as :attr:`faults` (a :class:`~geardyn.trains.faults.TrainFaults`, None
+        without).
     """
 
     def __init__(self, bodies: Sequence[Inertia], shafts: Sequence[Shaft] = (),
                  bearings: Sequence[Bearing] = (), meshes: Sequence[Mesh] = (), *,
                  fixed: Sequence[str] = (), driven: str | None = None, free: bool = False,
-                 rayleigh: tuple[float, float] = (0.0, 0.0)):
+                 rayleigh: tuple[float, float] = (0.0, 0.0), faults: Any = ()):
         body_list = _typed("bodies", bodies, Inertia)
         self.shafts = _typed("shafts", shafts, Shaft)
         self.bearings = _typed("bearings", bearings, Bearing)
@@ -200,6 +214,7 @@ class GearTrain:
         self.mesh_data = {m.name: resolve_mesh(m, self.bodies[m.a], self.bodies[m.b])
                           for m in self.meshes}
         self._check_connected()
+        self.faults = place_train_faults(self, faults)
         self._index = {name: i for i, name in enumerate(self.bodies)}
         self._turns_with = self._rigid_rotations()
         self._dofs, self._T = self._coordinates()
