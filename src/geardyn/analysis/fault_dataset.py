@@ -2,10 +2,12 @@
 
 Every condition (fault, speed, torque) is one lane of a chunked run
 (:func:`~geardyn.execution.executor.run_chunks`): the model built for the fault, at that speed
-and torque, integrated by :func:`~geardyn.simulate` (its transient, then whole forcing periods
-covering ``duration``), its sensor signal taken and sampled at ``sample_rate``, and one noisy
-copy per seed added. Lanes are independent and deterministic, so the chunks may run here or on
-a Dask cluster, be resumed from a Zarr store, and give the same bits.
+and torque, integrated at that constant speed by
+:func:`~geardyn.analysis.runup.steady_record` (its transient, then the signal's duration), the
+sensor signal taken at the sample times k / ``sample_rate`` (grid points: the step divides the
+sample interval) and one noisy copy per seed added. Lanes are independent and deterministic, so
+the chunks may run here, on local processes (``workers``) or on a Dask cluster, be resumed from
+a Zarr store, and give the same bits.
 
 The sensor signal (see ``docs/datasets.md``):
 
@@ -15,18 +17,19 @@ The sensor signal (see ``docs/datasets.md``):
 * a :class:`~geardyn.SpurPair`: the stand-in is the dynamic mesh force F [N] (elastic and
   damping), the force that a bearing and the housing carry to a sensor.
 
-Each signal is taken at the model's grid times (every integration step) and sampled at the
-times k / ``sample_rate`` after the transient by linear interpolation. Measurement noise is
-white Gaussian with standard deviation sigma = rms / 10^(snr_db / 20), rms the clean signal's
-RMS about its mean, drawn from ``numpy.random.default_rng([seed, fault, speed, torque])``
-(indices into the spec's lists): the same seed gives the same bits.
+Measurement noise is white Gaussian with standard deviation sigma = rms / 10^(snr_db / 20), rms
+the clean signal's RMS about its mean, drawn from ``numpy.random.default_rng([seed, fault,
+speed, torque])`` (indices into the spec's lists): the same seed gives the same bits.
 """
 
 from __future__ import annotations
 
 import copy
 import functools
+import hashlib
 import math
+import multiprocessing
+import os
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
@@ -34,15 +37,17 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
+from geardyn.analysis.runup import SteadyRecord, steady_record
 from geardyn.core.model import Model
+from geardyn.core.plan import MIN_STEPS_PER_PERIOD, default_steps_per_period
 from geardyn.core.results import finish
 from geardyn.core.settings import RunSettings
 from geardyn.core.status import Status, status_attrs
 from geardyn.errors import ParameterError
 from geardyn.execution.executor import run_chunks
 
-__all__ = ["FaultDatasetSpec", "clean_signal", "fault_dataset", "fault_labels", "lane_noise",
-           "lane_run", "record_periods", "seconds_per_time_unit"]
+__all__ = ["FaultDatasetSpec", "clean_signal", "default_workers", "fault_dataset", "fault_labels",
+           "lane_noise", "lane_steps", "seconds_per_time_unit"]
 
 #: Speed and torque inputs of each model kind (with_params names, units).
 _INPUTS = {"SpurPair": ("speed", "torque"), "PlanetaryGearSet": ("input_speed", "sun_torque")}
@@ -96,8 +101,10 @@ class FaultDatasetSpec:
     ``torque``, a planetary set's ``sun_torque``); ``seeds`` the noise seeds; ``snr_db`` the
     signal-to-noise ratio [dB] (``inf``: no noise); ``duration`` [s] and ``sample_rate`` [Hz] of
     each signal; ``transient`` [s] discarded first (rounded up to whole forcing periods);
-    ``steps_per_period`` (None: the step rule); ``chunk`` conditions per chunk (None: the
-    executor's default)."""
+    ``steps_per_period`` RK4 steps per forcing period, or ``steps_per_mode`` steps per period
+    of the fastest natural mode (the model's ``fastest_natural_frequency``), at most one (both
+    None: the step rule, 100 per mode); the step is then shortened to divide the sample
+    interval; ``chunk`` conditions per chunk (None: the executor's default)."""
 
     build: Callable[[tuple[Any, ...]], Model]
     faults: Sequence[Any]
@@ -109,6 +116,7 @@ class FaultDatasetSpec:
     sample_rate: float = 10_000.0
     transient: float = 0.0
     steps_per_period: int | None = None
+    steps_per_mode: float | None = None
     chunk: int | None = None
     sensor: dict[str, Any] = field(default_factory=dict)
 
@@ -139,6 +147,15 @@ class FaultDatasetSpec:
         if self.chunk is not None and (isinstance(self.chunk, bool) or int(self.chunk) < 1):
             raise ParameterError("chunk", self.chunk, "must be a whole number >= 1")
         RunSettings(steps_per_period=self.steps_per_period)  # names the field when bad
+        if self.steps_per_mode is not None:
+            if self.steps_per_period is not None:
+                raise ParameterError("steps_per_mode", self.steps_per_mode,
+                                     "give steps_per_period or steps_per_mode, not both")
+            n = _positive("steps_per_mode", self.steps_per_mode)
+            if n < 8.0:
+                raise ParameterError("steps_per_mode", self.steps_per_mode,
+                                     "must be >= 8 (RK4 is unstable near 2.8 / (omega h))")
+            object.__setattr__(self, "steps_per_mode", n)
 
     @property
     def n_samples(self) -> int:
@@ -151,7 +168,8 @@ class FaultDatasetSpec:
                 "torques": list(self.torques), "seeds": list(self.seeds),
                 "snr_db": self.snr_db, "duration": self.duration,
                 "sample_rate": self.sample_rate, "transient": self.transient,
-                "steps_per_period": self.steps_per_period, "sensor": dict(self.sensor)}
+                "steps_per_period": self.steps_per_period,
+                "steps_per_mode": self.steps_per_mode, "sensor": dict(self.sensor)}
 
 
 def _describe(fault: Any) -> str:
@@ -186,30 +204,32 @@ def seconds_per_time_unit(model: Model) -> float:
     return 1.0 / float(model.time_scale)
 
 
-def record_periods(duration: float, period: float) -> int:
-    """Forcing periods recorded to cover ``duration`` (both in the model's time unit), plus one
-    so the last sample time lies inside the record."""
-    return int(math.ceil(duration / period)) + 1
+def lane_steps(model: Model, spec: FaultDatasetSpec) -> int:
+    """RK4 steps per forcing period of one condition before the shortening to the sample
+    interval: ``spec.steps_per_period``, else ``spec.steps_per_mode`` per period of the
+    model's fastest natural mode (at least ``MIN_STEPS_PER_PERIOD``), else the step rule."""
+    if spec.steps_per_period is not None:
+        return int(spec.steps_per_period)
+    if spec.steps_per_mode is None:
+        return default_steps_per_period(model)
+    w = float(np.asarray(model.fastest_natural_frequency(), dtype=float).ravel()[0])
+    return max(MIN_STEPS_PER_PERIOD, math.ceil(spec.steps_per_mode * w / float(model.omega)))
 
 
-def clean_signal(ds: xr.Dataset, model: Model, n_samples: int, sample_rate: float,
-                 sensor: dict[str, Any] | None = None) -> np.ndarray:
-    """The sensor signal of the :func:`~geardyn.simulate` run ``ds`` of ``model`` at the times
-    k / ``sample_rate`` (k < ``n_samples``) after its start [N]: the planetary ring sensor
-    (``sensor``: :func:`~geardyn.analysis.sensor.sensor_signal`'s sensor_angle, width,
-    window) or the pair's mesh force F, linearly interpolated from the grid."""
+def clean_signal(rec: SteadyRecord, model: Model, sensor: dict[str, Any] | None = None
+                 ) -> np.ndarray:
+    """The sensor signal [N] of the steady record ``rec`` of ``model`` at its sample times:
+    the planetary ring sensor (``sensor``: :func:`~geardyn.analysis.sensor.sensor_signal`'s
+    sensor_angle, width, window) or the pair's mesh force F."""
     from geardyn.analysis.sensor import carrier_angle, sensor_signal
 
-    t = np.asarray(ds["time"].values, dtype=float)
+    names = list(model.observable_names)
     if _model_kind(model) == "SpurPair":
-        s = np.asarray(ds["F"].values, dtype=float)
-    else:
-        forces = np.stack([np.asarray(ds[f"F_r{n + 1}"].values, dtype=float)
-                           for n in range(model.n_planets)], axis=-1)
-        phi = carrier_angle(model, t, float(ds.attrs["Omega"]))
-        s = sensor_signal(forces, phi, np.asarray(model.psi, dtype=float), **(sensor or {}))
-    seconds = (t - t[0]) * seconds_per_time_unit(model)
-    return np.interp(np.arange(n_samples) / sample_rate, seconds, s)
+        return np.array(rec.observables[:, names.index("F")], dtype=float)
+    forces = np.stack([rec.observables[:, names.index(f"F_r{n + 1}")]
+                       for n in range(model.n_planets)], axis=-1)
+    phi = carrier_angle(model, rec.time, float(model.omega))
+    return sensor_signal(forces, phi, np.asarray(model.psi, dtype=float), **(sensor or {}))
 
 
 def lane_noise(clean: np.ndarray, snr_db: float, seed: int, key: Sequence[int]
@@ -224,51 +244,61 @@ def lane_noise(clean: np.ndarray, snr_db: float, seed: int, key: Sequence[int]
     return sigma * rng.standard_normal(clean.shape), sigma
 
 
-def _dataset_task(model: Model, P: np.ndarray, y0: np.ndarray, key: np.ndarray, *,
-                  spec: dict[str, Any]) -> dict[str, np.ndarray]:
-    """The lane task: per condition, simulate, take the sensor signal, add each seed's noise."""
-    from geardyn.solvers.simulate import simulate
-
+def _dataset_task(model: Model, head: np.ndarray, y0: np.ndarray, steps: np.ndarray,
+                  unit: np.ndarray, key: np.ndarray, *, spec: dict[str, Any]
+                  ) -> dict[str, np.ndarray]:
+    """The lane task: per condition, its coefficient vector (the fault's ``bases`` row with the
+    columns ``cols`` from ``head``), the steady record (seconds per model time unit ``unit``:
+    a planetary set's time scale is its own), the sensor signal, each seed's noise."""
     n, seeds = int(spec["n_samples"]), spec["seeds"]
-    out_signal = np.zeros((P.shape[0], len(seeds), n))
-    status = np.zeros(P.shape[0], dtype=np.int8)
-    unresolved = np.zeros(P.shape[0], dtype=np.int64)
-    sigma = np.zeros(P.shape[0])
-    for i in range(P.shape[0]):
+    bases, cols = spec["bases"], spec["cols"]
+    out_signal = np.zeros((head.shape[0], len(seeds), n))
+    status = np.zeros(head.shape[0], dtype=np.int8)
+    unresolved = np.zeros(head.shape[0], dtype=np.int64)
+    sigma = np.zeros(head.shape[0])
+    for i in range(head.shape[0]):
         m = copy.copy(model)
-        m.params = np.array(P[i], dtype=float)
-        run = lane_run(m, spec["duration"], spec["transient"], spec["steps_per_period"])
-        ds = simulate(m, run=run, y0=y0[i])
-        status[i], unresolved[i] = int(ds.attrs["status"]), int(ds.attrs["unresolved_steps"])
+        p = np.array(bases[int(key[i, 0])], dtype=float)
+        p[cols] = head[i]
+        m.params = p
+        rec = steady_record(m, n, spec["sample_rate"] * unit[i],
+                            transient=spec["transient"] / unit[i],
+                            steps_per_period=int(steps[i]), y0=y0[i])
+        status[i], unresolved[i] = rec.status, rec.unresolved
         if status[i] != Status.OK:
             out_signal[i] = np.nan
             sigma[i] = np.nan
             continue
-        clean = clean_signal(ds, m, n, spec["sample_rate"], spec["sensor"])
+        clean = clean_signal(rec, m, spec["sensor"])
         for j, seed in enumerate(seeds):
             noise, sigma[i] = lane_noise(clean, spec["snr_db"], seed, key[i])
             out_signal[i, j] = clean + noise
     return {"signal": out_signal, "status": status, "unresolved": unresolved, "sigma": sigma}
 
 
-def lane_run(model: Model, duration: float, transient: float,
-             steps_per_period: int | None) -> RunSettings:
-    """The :class:`~geardyn.RunSettings` of one condition: ``transient`` [s] and enough whole
-    forcing periods to cover ``duration`` [s] (:func:`record_periods`)."""
-    unit = seconds_per_time_unit(model)
-    period = 2.0 * math.pi / float(model.omega)
-    return RunSettings(transient=transient / unit,
-                       samples=record_periods(duration / unit, period),
-                       steps_per_period=steps_per_period)
+@dataclass
+class _Conditions:
+    """Every condition of a spec, compact: ``bases`` (fault, coefficient) each fault's
+    vector; per condition (fault, speed, torque; C order) the columns ``cols`` that speed and
+    torque set (``head``), its initial state ``y0``, steps per period ``steps``, seconds per
+    model time unit ``unit`` and indices ``key``; per fault the stiffness truncation errors
+    ``errors`` (where the model has them)."""
+
+    model: Model
+    bases: np.ndarray
+    cols: np.ndarray
+    head: np.ndarray
+    y0: np.ndarray
+    steps: np.ndarray
+    unit: np.ndarray
+    key: np.ndarray
+    errors: dict[str, list[float]]
 
 
-def _conditions(spec: FaultDatasetSpec
-                ) -> tuple[Model, np.ndarray, np.ndarray, np.ndarray, dict[str, list[float]]]:
-    """The first model, per fault its stiffness series' truncation error (the model's
-    ``stiffness_error()``, where it has one) and, per condition (fault, speed, torque; C
-    order), its coefficient vector, initial state and indices. A fault the model refuses
-    raises here, before any work."""
-    P, y0, key = [], [], []
+def _conditions(spec: FaultDatasetSpec) -> _Conditions:
+    """The conditions of ``spec`` (:class:`_Conditions`). A fault the model refuses raises
+    here, before any work."""
+    bases, changes, y0, steps, unit, key = [], [], [], [], [], []
     errors: dict[str, list[float]] = {}
     first = None
     for fi, fault in enumerate(spec.faults):
@@ -287,48 +317,95 @@ def _conditions(spec: FaultDatasetSpec
         err = getattr(base, "stiffness_error", None)
         for name, value in (err() if callable(err) else {}).items():
             errors.setdefault(name, []).append(float(value))
+        b = np.asarray(base.params, dtype=float)
+        bases.append(b)
         for si, speed in enumerate(spec.speeds):
             for ti, torque in enumerate(spec.torques):
                 m = base.with_params(**{speed_name: speed, torque_name: torque})
-                P.append(np.asarray(m.params, dtype=float))
+                p = np.asarray(m.params, dtype=float)
+                changed = np.flatnonzero(p != b)
+                changes.append((changed, p[changed]))
                 y0.append(np.asarray(m.initial_state(), dtype=float))
+                steps.append(lane_steps(m, spec))
+                unit.append(seconds_per_time_unit(m))
                 key.append((fi, si, ti))
     assert first is not None
-    return first, np.array(P), np.array(y0), np.array(key, dtype=np.int64), errors
+    B = np.array(bases)
+    cols = np.unique(np.concatenate([c for c, _ in changes] + [np.zeros(0, np.int64)]))
+    K = np.array(key, dtype=np.int64)
+    head = B[K[:, 0]][:, cols]
+    for i, (c, v) in enumerate(changes):
+        head[i, np.searchsorted(cols, c)] = v
+    return _Conditions(first, B, cols.astype(np.int64), head, np.array(y0),
+                       np.array(steps, dtype=np.int64), np.array(unit), K, errors)
+
+
+def default_workers() -> int:
+    """Processes a local run uses by default: the cores this process may run on."""
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except AttributeError:  # not on Linux
+        return max(1, os.cpu_count() or 1)
 
 
 def fault_dataset(spec: FaultDatasetSpec, store: Any = None, client: Any = None,
-                  progress: Callable[[int, int], None] | None = None) -> xr.Dataset:
+                  progress: Callable[[int, int], None] | None = None,
+                  workers: int | None = None) -> xr.Dataset:
     """The labelled dataset of ``spec``: ``signal`` (fault, speed, torque, seed, time) [N], the
     noisy sensor signals; ``status`` and ``unresolved`` (fault, speed, torque) of every
-    condition (a diverged condition is kept, its signal NaN); ``noise_std`` [N]. Coordinates
-    the labels (``fault_kind``, ``fault_size``, ``fault_gear``, ``fault_tooth``,
-    ``fault_description`` on ``fault``; ``speed``, ``torque``, ``seed``, ``time`` [s]),
-    attributes every setting.
+    condition (a diverged condition is kept, its signal NaN); ``noise_std`` [N]; ``steps`` the
+    RK4 steps per sample interval. Coordinates the labels (``fault_kind``, ``fault_size``,
+    ``fault_gear``, ``fault_tooth``, ``fault_description`` on ``fault``; ``speed``,
+    ``torque``, ``seed``, ``time`` [s]), attributes every setting.
 
     ``store``: a Zarr path; the conditions' results are kept there chunk by chunk as they finish
     (a rerun resumes, computing only the missing chunks) and the dataset is written to it at the
     end (``xarray.open_zarr(store)`` opens it). ``client``: a ``dask.distributed.Client`` (one
-    task per chunk) or None (here). ``progress(done, total)`` after each chunk."""
+    task per chunk) or None (this machine). ``workers``: without a client, the local processes
+    (None: :func:`default_workers`, every core; 1: this process only); each integrates one
+    condition at a time, so more than one is how a local run uses several cores (the processes
+    are spawned: a script calling this needs the ``if __name__ == "__main__":`` guard).
+    ``progress(done, total)`` after each chunk. Every way gives the same bits."""
     from geardyn.execution.zarr_store import save_zarr_dataset
 
-    model, P, y0, key, errors = _conditions(spec)
+    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int)
+                                or workers < 1):
+        raise ParameterError("workers", workers, "must be a whole number >= 1 (or None)")
+    c = _conditions(spec)
     settings = spec.settings()
-    task_spec = {**{k: settings[k] for k in ("seeds", "snr_db", "duration", "sample_rate",
-                                             "transient", "steps_per_period", "sensor")},
-                 "n_samples": spec.n_samples}
+    task_spec = {**{k: settings[k] for k in ("seeds", "snr_db", "sample_rate", "transient",
+                                             "sensor")},
+                 "n_samples": spec.n_samples, "bases": c.bases, "cols": c.cols,
+                 "bases_sha256": hashlib.sha256(c.bases.tobytes()).hexdigest()}
     task = functools.partial(_dataset_task, spec=task_spec)
-    out = run_chunks(task, model, {"P": P, "y0": y0, "key": key}, chunk=spec.chunk,
-                     client=client, store=store, progress=progress,
-                     meta={"kind": "fault-dataset", **settings})
-    ds = _assemble(spec, model, out, errors)
+    inputs = {"head": c.head, "y0": c.y0, "steps": c.steps, "unit": c.unit, "key": c.key}
+    n_workers = min(default_workers() if workers is None else workers, c.key.shape[0])
+    meta = {"kind": "fault-dataset", **settings}
+    if client is not None or n_workers == 1:
+        out = run_chunks(task, c.model, inputs, chunk=spec.chunk, client=client, store=store,
+                         progress=progress, meta=meta)
+    else:
+        from concurrent.futures import ProcessPoolExecutor
+
+        chunk = spec.chunk or _local_chunk(c.key.shape[0], n_workers)
+        with ProcessPoolExecutor(n_workers, mp_context=multiprocessing.get_context("spawn")
+                                 ) as pool:
+            out = run_chunks(task, c.model, inputs, chunk=chunk, client=pool, store=store,
+                             progress=progress, meta=meta)
+    ds = _assemble(spec, c.model, out, c.errors, c.steps)
     if store is not None:
         save_zarr_dataset(ds, store)
     return ds
 
 
+def _local_chunk(n_conditions: int, workers: int) -> int:
+    """Conditions per chunk on local processes: about 20 chunks per process (the progress
+    bar's grain; the last chunks' wait short), at least one condition."""
+    return max(1, math.ceil(n_conditions / (20 * workers)))
+
+
 def _assemble(spec: FaultDatasetSpec, model: Model, out: dict[str, np.ndarray],
-              errors: dict[str, list[float]]) -> xr.Dataset:
+              errors: dict[str, list[float]], steps: np.ndarray) -> xr.Dataset:
     nf, ns, nt = len(spec.faults), len(spec.speeds), len(spec.torques)
     shape = (nf, ns, nt)
     labels = [fault_labels(f) for f in spec.faults]
@@ -345,7 +422,10 @@ def _assemble(spec: FaultDatasetSpec, model: Model, out: dict[str, np.ndarray],
          "unresolved": (dims, out["unresolved"].reshape(shape),
                         {"meaning": "integration steps that reached the split limit"}),
          "noise_std": (dims, out["sigma"].reshape(shape),
-                       {"units": "N", "long_name": "measurement noise standard deviation"})},
+                       {"units": "N", "long_name": "measurement noise standard deviation"}),
+         "steps_per_period": (dims, steps.reshape(shape), {
+             "long_name": "RK4 steps per forcing period asked for (the step is then shortened "
+                          "to divide the sample interval)"})},
         coords={
             "fault": ("fault", np.arange(nf)),
             "fault_kind": ("fault", [lb["kind"] for lb in labels]),
@@ -363,12 +443,18 @@ def _assemble(spec: FaultDatasetSpec, model: Model, out: dict[str, np.ndarray],
     ds.attrs.update(model=model.name, time_unit="s", speed_input=speed_name,
                     torque_input=torque_name, snr_db=spec.snr_db, duration=spec.duration,
                     sample_rate=spec.sample_rate, transient=spec.transient,
-                    steps_per_period=("rule" if spec.steps_per_period is None
-                                      else spec.steps_per_period),
+                    step_choice=("steps_per_period" if spec.steps_per_period is not None
+                                 else "steps_per_mode" if spec.steps_per_mode is not None
+                                 else "the step rule"),
+                    steps_per_mode=("none" if spec.steps_per_mode is None
+                                    else spec.steps_per_mode),
+                    integrator="RK4, fixed step dividing the sample interval; forcing phase "
+                               "Omega t (geardyn.analysis.runup.steady_record)",
                     sensor=str(settings["sensor"]),
                     noise="white Gaussian, sigma = rms about the mean / 10^(snr_db/20), "
                           "default_rng([seed, fault, speed, torque])",
-                    sampling="linear interpolation of the integration grid at k / sample_rate",
+                    sampling="the integration grid's points k / sample_rate (no "
+                             "interpolation)",
                     n_conditions=nf * ns * nt, n_signals=nf * ns * nt * len(spec.seeds),
                     diverged=int(np.count_nonzero(out["status"] != Status.OK)))
     for name, values in errors.items():

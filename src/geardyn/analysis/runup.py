@@ -9,7 +9,8 @@ path (:mod:`geardyn.solvers._runup_template`). The result is a labelled dataset 
 (mesh frequency [Hz], input speed [rpm]) where the model has them, and the chosen outputs.
 
 One call is one lane (one speed range, one model): a labelled-data generator calls it per
-(speed range, torque, seed) lane.
+(speed range, torque, seed) lane. :func:`steady_record` is the same kernel at a constant speed
+(zero acceleration), recording at a sample rate: the labelled fault data's integration.
 """
 
 from __future__ import annotations
@@ -31,8 +32,9 @@ from geardyn.core.status import Status, status_meaning
 from geardyn.errors import ParameterError
 from geardyn.solvers.kernels import kernels_for
 
-__all__ = ["MIN_RUNUP_STEPS", "PROGRESS_PIECES", "RunupSettings", "frequency_scale",
-           "natural_frequencies", "phase_from_time", "runup", "speed_coefficients"]
+__all__ = ["MIN_RUNUP_STEPS", "PROGRESS_PIECES", "RunupSettings", "SteadyRecord",
+           "frequency_scale", "natural_frequencies", "phase_from_time", "runup",
+           "speed_coefficients", "steady_record"]
 
 #: Fewest RK4 steps per forcing period at the highest speed (the split path rotates the phase
 #: by angle addition, exact in its small-angle form up to 2 pi / 8 per step).
@@ -407,3 +409,52 @@ def _state_units(model: Model) -> list[str]:
     parts = model.state_units.split(", ")
     return parts if len(parts) == model.n_states else [model.state_units] * model.n_states
 
+
+
+@dataclass(frozen=True)
+class SteadyRecord:
+    """What :func:`steady_record` returns: ``states`` (n, n_states) and ``observables`` (n,
+    n_obs) at the sample times ``time`` (n,) [model time from the run's start, the transient
+    included: the forcing phase there is Omega time];
+    ``status`` (:class:`~geardyn.Status`; rows after a divergence NaN), ``unresolved`` (steps
+    that reached the split limit), ``step`` and ``stride`` (steps per sample)."""
+
+    time: np.ndarray
+    states: np.ndarray
+    observables: np.ndarray
+    status: int
+    unresolved: int
+    step: float
+    stride: int
+
+
+def steady_record(model: Model, samples: int, sample_rate: float, *, transient: float = 0.0,
+                  steps_per_period: int | None = None, y0: np.ndarray | None = None,
+                  locate_edges: bool = True, bound: float = DEFAULT_BOUND) -> SteadyRecord:
+    """Integrate ``model`` at its own constant forcing frequency and record its states and
+    observables at the times k / ``sample_rate`` (k < ``samples``, model time units) after a
+    ``transient`` (rounded up to whole steps, not recorded), from ``y0`` (default the model's
+    initial state) at time 0: the run-up kernel at zero acceleration (forcing phase Omega t).
+    The step is 2 pi / (Omega n), n = ``steps_per_period`` (None: the model's step rule),
+    shortened to the largest step that divides the sample interval, so every sample is a grid
+    point (no interpolation)."""
+    om = float(model.omega)
+    if not (math.isfinite(om) and om > 0.0):
+        raise ParameterError("Omega", om, "a steady record needs a forcing frequency > 0")
+    n = steps_per_period or int(default_steps_at(model, np.array([om]))[0])
+    h = 2.0 * math.pi / (om * n)
+    dt = 1.0 / sample_rate
+    stride = max(1, math.ceil(dt / h * (1.0 - 1e-12)))
+    h = dt / stride
+    n_tr = math.ceil(transient / h * (1.0 - 1e-12)) if transient > 0 else 0
+    y = np.asarray(model.initial_state() if y0 is None else y0, dtype=float).copy()
+    k = kernels_for(model.kernel, "runup")
+    p = np.ascontiguousarray(model.params, dtype=float).copy()
+    cols, coef = np.zeros(0, np.int64), np.zeros((0, 3))
+    n_ev = model.n_events
+    Y, O, _, _, _, status, unresolved, _, _, _, _ = k.runup_trajectory(
+        p, y, h, 0, n_tr + (samples - 1) * stride, n_tr, stride, True, om, 0.0, 0.0, 0.0,
+        cols, coef, locate_edges, bound, n_ev, model.n_observables, False,
+        np.full((2, max(n_ev, 1)), np.nan), np.ones(n_ev, np.int64), False)  # t = theta/Omega
+    t = (n_tr + np.arange(samples) * stride) * h
+    return SteadyRecord(t, Y, O, int(status), int(unresolved), h, stride)

@@ -18,6 +18,7 @@
     geardyn dynamic-factor STUDY.toml --f-pb UM --f-falpha UM [--range 2000:44000:85]
                      [--torque T ...] [--out df.nc] [--plot df.png]
     geardyn runup STUDY.toml [--start A --stop B --rate R] [--out runup.nc] [--plot wf.png]
+    geardyn dataset STUDY.toml [--store faults.zarr] [--workers N] [--chunk N]
 
 A STUDY argument is a TOML file or the name of a built-in study (``paper_fig3``). Every expected
 error (bad parameters, missing files, invalid TOML, bad values) and every usage error ends the
@@ -385,6 +386,7 @@ __import__("geardyn.cli.modes", fromlist=["register"]).register(app)  # cli/mode
 __import__("geardyn.cli.dynamic_factor", fromlist=["register"]).register(app)  # dynamic-factor
 __import__("geardyn.cli.envelope", fromlist=["register"]).register(app)  # cli/envelope.py
 __import__("geardyn.cli.runup", fromlist=["register"]).register(app)  # cli/runup.py
+__import__("geardyn.cli.dataset", fromlist=["register"]).register(app)  # cli/dataset.py
 
 if __name__ == "__main__":
     main()

@@ -11,6 +11,8 @@ run them anywhere and in any order, and the assembled result is bitwise the same
 * ``client=dask.distributed.Client(...)``: every chunk is one Dask task carrying the packed
   model and its lanes' inputs. Workers import the model's compiled functions by name and build
   (or load from ``$GEARDYN_CACHE_DIR``) their own kernels, see :func:`portable`.
+* ``client=concurrent.futures.ProcessPoolExecutor(...)``: the same, on local processes (a task
+  whose kernel call runs one lane at a time uses every core this way).
 * ``store``: a :class:`~geardyn.execution.zarr_store.LaneStore` (or a path to one): every
   finished chunk is written there as it completes, then marked done; a rerun with the same
   inputs computes only the chunks not marked done. See ``docs/scaling.md``.
@@ -18,6 +20,7 @@ run them anywhere and in any order, and the assembled result is bitwise the same
 
 from __future__ import annotations
 
+import concurrent.futures
 import copy
 import functools
 import hashlib
@@ -237,7 +240,8 @@ def run_chunks(
         core waits for another's last lanes, is lost time: the gear pair's 400-lane sweep of
         bench/peers.py in 7 chunks took 1.13x one call), else :func:`default_chunk`.
     client
-        ``None`` (run here) or a ``dask.distributed.Client`` (one task per chunk).
+        ``None`` (run here), a ``dask.distributed.Client`` or a ``concurrent.futures.Executor``
+        (e.g. a ``ProcessPoolExecutor``; one task per chunk).
     store
         A :class:`~geardyn.execution.zarr_store.LaneStore`, or the path of a Zarr store to create or
         resume: finished chunks are read from it instead of being run, new ones written to it as
@@ -291,6 +295,15 @@ def run_chunks(
     if client is None:
         for i in todo:
             complete(i, task(model, **chunk_inputs(i)))
+    elif todo and isinstance(client, concurrent.futures.Executor):
+        packed = portable(model)
+        pending = {client.submit(_run_portable, task, packed, chunk_inputs(i)): i for i in todo}
+        try:
+            for fut in concurrent.futures.as_completed(pending):
+                complete(pending[fut], fut.result())
+        finally:  # an interrupted run leaves no queued chunk behind
+            for fut in pending:
+                fut.cancel()
     elif todo:
         from dask.distributed import as_completed
 

@@ -29,6 +29,8 @@ A *study file* holds the device parameters plus run settings::
                                     # (see geardyn.io.envelope_table)
     [runup]                         # optional: geardyn runup's ramp: param, start, stop,
                                     # rate or duration, sample_rate, outputs (RunupTable)
+    [dataset]                       # optional: geardyn dataset's labelled fault data: faults,
+                                    # speeds, torques, seeds, ... (DatasetTable)
 
 A spur pair for the potential-energy mesh stiffness (``geardyn stiffness``), with or instead
 of ``[params]``::
@@ -156,6 +158,7 @@ from geardyn.gears.potential_energy import (
 from geardyn.gears.tip_relief import TipRelief, relief_gap
 from geardyn.io._tables import build_from_fields as _build_from_fields
 from geardyn.io._tables import study_error as _study_error
+from geardyn.io.dataset_table import DatasetTable
 from geardyn.io.envelope_table import EnvelopeTable
 from geardyn.io.runup_table import RunupTable
 from geardyn.io.train_table import TrainTable
@@ -981,6 +984,7 @@ class Study(BaseModel):
     train: TrainTable | None = None
     envelope: EnvelopeTable | None = None
     runup: RunupTable | None = None
+    dataset: DatasetTable | None = None
 
     _planetary: PlanetaryParams | None = PrivateAttr(None)
     _train: Any = PrivateAttr(None)
@@ -1309,7 +1313,7 @@ def _read_toml(source: str | os.PathLike[str]) -> tuple[dict[str, Any], str]:
 
 
 _STUDY_KEYS = {"study", "params", "run", "sweep", "gears", "faults", "stiffness", "relief",
-               "crowning", "train", "envelope", "runup"}
+               "crowning", "train", "envelope", "runup", "dataset"}
 
 
 def load_params(path_or_text: str | os.PathLike[str]) -> PlanetaryParams:

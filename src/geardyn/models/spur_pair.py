@@ -29,6 +29,13 @@ events x - b and x + b); the table's jumps where a tooth pair enters or leaves c
 rounded over about 1/H of the period (the truncation error is largest there: see
 :meth:`SpurPair.stiffness_error`). A tooth fault on one tooth of the periodic gear is then felt
 once per forcing period.
+
+``stiffness_form="table"`` evaluates the table itself instead, linear between its angles
+(theta_j = 2 pi j / n over the period): O(1) per evaluation instead of O(H), and the jumps stay
+jumps one table interval wide (no Gibbs ringing), exact at the table's angles. The step rule
+then resolves the contact mode only (the series' top harmonic sets no step); RK4 loses its
+order across a jump, so its error is set by the step there (a step-convergence study in
+``docs/datasets.md``).
 """
 
 from __future__ import annotations
@@ -57,8 +64,10 @@ from geardyn.models.spur_pair_coefficients import (
     HEADER,
     PERIODS,
     SPEED_UNITS,
+    STIFFNESS_FORMS,
     UNIT_KINDS,
     series_block,
+    table_block,
 )
 from geardyn.models.spur_pair_kernels import (
     BACKLASH,
@@ -200,7 +209,13 @@ class SpurPair(Model):
         Static transmission error amplitude [m] at the mesh frequency, and its phase [rad].
     harmonics
         Harmonics H of Omega in each flank's series (default ``DEFAULT_MESH_HARMONICS`` times
-        the mesh cycles per period); fewer than half the table's angles.
+        the mesh cycles per period); fewer than half the table's angles. The Fourier form's
+        only (the table form refuses it).
+    stiffness_form
+        How the kernels evaluate each flank's stiffness: ``"fourier"`` (default) its series of
+        ``harmonics`` harmonics, smooth in time, the table's jumps rounded over 1/H of the
+        period; ``"table"`` the table, linear between its angles (jumps one angle wide, O(1) per
+        evaluation: several times faster, see ``docs/datasets.md``).
     speed_unit
         The unit of a plain number of ``speed`` (here, in ``with_params`` and in
         ``lane_params``/sweeps of ``speed``) and of a sweep's ``speed`` axis: ``"rad/s"``
@@ -223,7 +238,8 @@ class SpurPair(Model):
     def __init__(self, mesh: GearMesh, stiffness: xr.Dataset, *, speed: object,
                  torque: object, inertia: Sequence[object] | None = None, zeta: object = 0.05,
                  backlash: object = None, error: object = 0.0, error_phase: object = 0.0,
-                 harmonics: int | None = None, speed_unit: str = "rad/s"):
+                 harmonics: int | None = None, speed_unit: str = "rad/s",
+                 stiffness_form: str = "fourier"):
         if not isinstance(mesh, GearMesh):
             raise ParameterError("mesh", mesh, "must be a geardyn.gears.GearMesh")
         if mesh.internal:
@@ -236,7 +252,15 @@ class SpurPair(Model):
                 raise ParameterError("stiffness", f"{cycles} mesh cycles",
                                      f"a fault on the {faulty} returns every {z} mesh cycles;"
                                      " the table must span whole revolutions of that gear")
-        n_h = _harmonics(harmonics, cycles, int(stiffness.sizes["angle"]))
+        if stiffness_form not in STIFFNESS_FORMS:
+            raise ParameterError("stiffness_form", stiffness_form,
+                                 f"must be one of {', '.join(STIFFNESS_FORMS)}")
+        if stiffness_form == "table" and harmonics is not None:
+            raise ParameterError("harmonics", harmonics, "sets the Fourier form's series; the"
+                                 " table form evaluates the table itself (leave it out)")
+        self.stiffness_form = stiffness_form
+        n_h = (0 if stiffness_form == "table"  # no series: its mean k0 only
+               else _harmonics(harmonics, cycles, int(stiffness.sizes["angle"])))
         if speed_unit not in SPEED_UNITS:
             raise ParameterError("speed_unit", speed_unit,
                                  f"must be one of {', '.join(SPEED_UNITS)}")
@@ -244,7 +268,8 @@ class SpurPair(Model):
         self.mesh, self.stiffness, self.cycles = mesh, stiffness, cycles
         self.drive_series = fourier_series(stiffness["mesh_stiffness"].values, n_h)
         self.coast_series = fourier_series(stiffness["mesh_stiffness_coast"].values, n_h)
-        self._check_positive()
+        if stiffness_form == "fourier":
+            self._check_positive()
         b = (0.5 * max(mesh.backlash, 0.0) * math.cos(mesh.operating_pressure_angle)
              if backlash is None else si_value("backlash", backlash, "length"))
         values = {
@@ -259,14 +284,25 @@ class SpurPair(Model):
             "cos_error_phase": 0.0, "sin_error_phase": 0.0,
             "base_radius": mesh.pinion.base_radius, "mesh_order": float(cycles),
             "n_harmonics": float(n_h),
+            "stiffness_form": STIFFNESS_FORMS[stiffness_form],
         }
-        layout = CoefficientLayout.of(HEADER, series_block("kd", n_h), series_block("kc", n_h),
-                                      model=self.name)
-        for flank, series in (("kd", self.drive_series), ("kc", self.coast_series)):
-            values[f"{flank}0"] = float(series[0])
-            for h in range(1, n_h + 1):
-                values[f"{flank}_a{h}"] = float(series[2 * h - 1])
-                values[f"{flank}_b{h}"] = float(series[2 * h])
+        if stiffness_form == "table":
+            n_t = int(stiffness.sizes["angle"])
+            values["table_points"] = float(n_t)
+            layout = CoefficientLayout.of(HEADER, table_block("kd", n_t), table_block("kc", n_t),
+                                          model=self.name)
+            for flank, var in (("kd", "mesh_stiffness"), ("kc", "mesh_stiffness_coast")):
+                for j, v in enumerate(np.asarray(stiffness[var].values, dtype=float)):
+                    values[f"{flank}_t{j}"] = float(v)
+        else:
+            values["table_points"] = 0.0
+            layout = CoefficientLayout.of(HEADER, series_block("kd", n_h),
+                                          series_block("kc", n_h), model=self.name)
+            for flank, series in (("kd", self.drive_series), ("kc", self.coast_series)):
+                values[f"{flank}0"] = float(series[0])
+                for h in range(1, n_h + 1):
+                    values[f"{flank}_a{h}"] = float(series[2 * h - 1])
+                    values[f"{flank}_b{h}"] = float(series[2 * h])
         inputs = ("Omega", "mass", "torque", "zeta", "backlash", "error", "error_phase")
         layout.validate({k: values[k] for k in inputs})
         self.coefficient_layout = layout
@@ -401,7 +437,7 @@ class SpurPair(Model):
     # ------------------------------------------------------------------ physics
     @property
     def n_harmonics(self) -> int:
-        """H: harmonics of Omega in each flank's stiffness series."""
+        """H: harmonics of Omega in each flank's stiffness series (0 in the table form)."""
         return (self.drive_series.size - 1) // 2
 
     @property
@@ -460,10 +496,12 @@ class SpurPair(Model):
         """The fastest frequency the step resolves [rad/s], per lane of ``P``: the natural
         frequency at the tabulated peak stiffness of either flank, sqrt(k_max / m), or, where
         faster, the top stiffness harmonic H Omega scaled so that its period gets at least
-        ``STEPS_PER_OTHER_FORCING`` steps."""
+        ``STEPS_PER_OTHER_FORCING`` steps (the Fourier form only)."""
         P = np.atleast_2d(self.params if P is None else np.asarray(P, dtype=float))
         k_max = max(float(self.stiffness["mesh_stiffness"].max()),
                     float(self.stiffness["mesh_stiffness_coast"].max()))
+        if self.stiffness_form == "table":  # no series: the contact mode alone
+            return np.sqrt(k_max / P[:, MASS])
         top = self.n_harmonics * P[:, OMEGA] * (STEPS_PER_OTHER_FORCING
                                                 / STEPS_PER_FASTEST_MODE)
         return np.maximum(np.sqrt(k_max / P[:, MASS]), top)
@@ -497,7 +535,8 @@ class SpurPair(Model):
     def dataset_attrs(self) -> dict[str, object]:
         """The period and the stiffness series' truncation, recorded with every result."""
         err = self.stiffness_error()
-        return {"mesh_cycles_per_period": self.cycles, "stiffness_harmonics": self.n_harmonics,
+        return {"mesh_cycles_per_period": self.cycles, "stiffness_form": self.stiffness_form,
+                "stiffness_harmonics": self.n_harmonics,
                 "mesh_frequency_rad_s": self.mesh_frequency, "speed_rpm": self.speed / _RPM,
                 "stiffness_rms_error_rel": max(err["drive_rms"], err["coast_rms"]),
                 "faults": str(self.stiffness.attrs.get("faults", "none"))}
@@ -511,7 +550,12 @@ class SpurPair(Model):
     def stiffness_at(self, theta: np.ndarray, flank: str = "drive") -> np.ndarray:
         """The stiffness k(theta) [N/m] of the ``"drive"`` or ``"coast"`` flank that the
         kernels use: the series, clipped at 0 (only a table that falls to 0, a missing tooth,
-        gives a series below 0)."""
+        gives a series below 0); in the table form the table, linear between its angles."""
+        if self.stiffness_form == "table":
+            var = {"drive": "mesh_stiffness", "coast": "mesh_stiffness_coast"}[flank]
+            table = np.asarray(self.stiffness[var].values, dtype=float)
+            u = np.mod(np.asarray(theta, dtype=float) / (2.0 * math.pi), 1.0) * table.size
+            return np.interp(u, np.arange(table.size + 1), np.append(table, table[0]))
         series = {"drive": self.drive_series, "coast": self.coast_series}[flank]
         return np.maximum(evaluate_series(series, theta), 0.0)
 
@@ -519,7 +563,8 @@ class SpurPair(Model):
         """The series against the table at its angles, relative to the mean drive stiffness:
         ``drive_max``, ``drive_rms``, ``coast_max``, ``coast_rms``. The maximum sits at the
         table's jumps (a tooth pair entering or leaving contact: about half the jump, the Gibbs
-        overshoot), the rms falls as 1/sqrt(H)."""
+        overshoot), the rms falls as 1/sqrt(H). The table form is the table at its angles
+        (every error 0)."""
         if "_error" not in self.__dict__:  # the series and the table never change
             self._error = self._series_error()
         return dict(self._error)
@@ -536,4 +581,5 @@ class SpurPair(Model):
     def __repr__(self) -> str:
         return (f"SpurPair({self.mesh.pinion.teeth}/{self.mesh.wheel.teeth}, "
                 f"{self.speed / _RPM:g} rpm, {float(self.params[TORQUE]):g} N m, "
-                f"H={self.n_harmonics}, faults={self.stiffness.attrs.get('faults', 'none')!r})")
+                + (f"H={self.n_harmonics}" if self.stiffness_form == "fourier" else "table")
+                + f", faults={self.stiffness.attrs.get('faults', 'none')!r})")

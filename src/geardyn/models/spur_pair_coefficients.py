@@ -1,6 +1,7 @@
 """The SI spur pair's coefficients, declared once (:mod:`geardyn.core.coefficients`): the header
-of :class:`~geardyn.SpurPair`'s vector, then the drive and the coast flank's stiffness as Fourier
-series in the forcing phase (:func:`series_block`, one per flank, of the model's length)."""
+of :class:`~geardyn.SpurPair`'s vector, then the drive and the coast flank's stiffness, as
+Fourier series in the forcing phase (:func:`series_block`, one per flank, of the model's length)
+or as tables over the forcing period (:func:`table_block`)."""
 
 from __future__ import annotations
 
@@ -38,7 +39,15 @@ HEADER = CoefficientBlock((
                 "mesh_order Omega)", kind="structure"),
     Coefficient("n_harmonics", "1", "harmonics H of each flank's stiffness series",
                 kind="structure", constant="N_HARM"),
+    Coefficient("stiffness_form", "1", "how the kernels evaluate each flank's stiffness: "
+                "0 its Fourier series, 1 its table, linear between the angles",
+                kind="structure"),
+    Coefficient("table_points", "1", "angles per forcing period of each flank's table (the "
+                "table form; 0 for the Fourier form)", kind="structure"),
 ))
+
+#: ``stiffness_form`` values: the names of :class:`~geardyn.SpurPair`'s ``stiffness_form``.
+STIFFNESS_FORMS = {"fourier": 0.0, "table": 1.0}
 
 
 def series_block(flank: str, harmonics: int) -> CoefficientBlock:
@@ -53,6 +62,15 @@ def series_block(flank: str, harmonics: int) -> CoefficientBlock:
                 f"{flank}_{ab}{h}", "N/m", f"{trig} part of harmonic {h} of the {what}-flank "
                 "mesh stiffness", kind="derived", derived_from=_GEOMETRY))
     return CoefficientBlock(tuple(entries))
+
+
+def table_block(flank: str, points: int) -> CoefficientBlock:
+    """One flank's stiffness at the ``points`` angles theta_j = 2 pi j / points of the forcing
+    period (``{flank}_t0``, ``{flank}_t1``, ...), in N/m; the kernels interpolate linearly."""
+    what = {"kd": "drive", "kc": "coast"}[flank]
+    return CoefficientBlock(tuple(
+        Coefficient(f"{flank}_t{j}", "N/m", f"{what}-flank mesh stiffness at angle {j} of the "
+                    "table", kind="derived", derived_from=_GEOMETRY) for j in range(points)))
 
 
 #: Units of the pinion speed a SpurPair reads plain numbers in (``speed_unit``): rad/s per unit,
@@ -119,6 +137,9 @@ INPUTS: tuple[PhysicalInput, ...] = (
                   coefficient="error_phase"),
     PhysicalInput("harmonics", "count", "harmonics of Omega in each flank's stiffness series "
                   "(default 16 per mesh cycle of the period)", None),
+    PhysicalInput("stiffness_form", "choice", "how the kernels evaluate the stiffness: its "
+                  "Fourier series (\"fourier\") or its table, linear between the angles "
+                  "(\"table\")", "fourier", choices=("fourier", "table")),
     PhysicalInput("period", "choice", "forcing period: one pinion or wheel revolution or one "
                   "mesh cycle (default: that of the faulty gear, else the pinion)", None,
                   choices=PERIODS),

@@ -20,8 +20,12 @@ ERROR, PHI_E, K_MEAN, COS_E, SIN_E = (HEADER.offset(n) for n in
                                        "sin_error_phase"))
 R_B1, MESH_ORDER, N_HARM = (HEADER.offset(n) for n in ("base_radius", "mesh_order",
                                                          "n_harmonics"))
-#: Offset of the drive flank's series (k0, a1, b1, ..., aH, bH); the coast flank's follows it.
+FORM, N_TABLE = HEADER.offset("stiffness_form"), HEADER.offset("table_points")
+#: Offset of the drive flank's series (k0, a1, b1, ..., aH, bH) or table (n values); the coast
+#: flank's follows it.
 KD0 = HEADER.size
+#: 1 / (2 pi): the forcing phase in periods.
+_INV_TWO_PI = 0.5 / math.pi
 
 
 # ---------------------------------------------------------------------------------------------
@@ -66,6 +70,23 @@ def flank_stiffness(PT, k, o, n, s, c):
 
 
 @nb.njit(inline="always", **_JIT)
+def flank_table(PT, k, o, n, s, c):
+    """The n-point table at row o of lane k (the stiffness at theta_j = 2 pi j / n), linear
+    between its angles, at the forcing phase theta = atan2(s, c): O(1) per evaluation."""
+    u = math.atan2(s, c) * _INV_TWO_PI * n  # in [-n/2, n/2]
+    if u < 0.0:
+        u += n
+    j = int(u)
+    f = u - j
+    if j >= n:  # u == n after the wrap, by rounding
+        j -= n
+    j1 = j + 1
+    if j1 == n:
+        j1 = 0
+    return PT[o + j, k] * (1.0 - f) + PT[o + j1, k] * f
+
+
+@nb.njit(inline="always", **_JIT)
 def rotate_power(n, s, c):
     """(cos, sin) of n theta from those of theta (n >= 0, by repeated squaring)."""
     rc, rs = 1.0, 0.0
@@ -82,6 +103,15 @@ def rotate_power(n, s, c):
 def contact_force(x, PT, k, s, c):
     """The flanks' elastic force f(x, theta) [N] (module docstring)."""
     b = PT[BACKLASH, k]
+    if PT[FORM, k] != 0.0:  # the tables
+        n = int(PT[N_TABLE, k])
+        if x > b:
+            row, deflection = KD0, x - b
+        elif x < -b:
+            row, deflection = KD0 + n, x + b
+        else:
+            return 0.0
+        return flank_table(PT, k, row, n, s, c) * deflection
     n = int(PT[N_HARM, k])
     if x > b:
         row, deflection = KD0, x - b
