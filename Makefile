@@ -7,6 +7,14 @@ STAMP := $(VENV)/.installed
 # $GEARDYN_CACHE_DIR (default ~/.cache/geardyn; numba's code in its numba/ unless NUMBA_CACHE_DIR
 # is set), see src/geardyn/_cache.py.
 
+# Python keeps its bytecode cache (__pycache__, in the venv and in src/) for these commands even
+# where the environment turns it off (PYTHONDONTWRITEBYTECODE=1, set in some container images;
+# pip installs with --no-compile to keep the install short): without it every Python process,
+# each test worker and each subprocess a test starts, compiles the source of numba, pandas,
+# xarray and the rest anew (`import geardyn` 4.7 s CPU instead of 1.5 s, measured on the 2-core
+# machine; bench/RESULTS.md).
+unexport PYTHONDONTWRITEBYTECODE
+
 .PHONY: venv demo test test-slow bench bench-peers reproduce reproduce-verdicts lint clean clean-cache docs
 
 $(STAMP): pyproject.toml

@@ -79,6 +79,19 @@ def test_make_does_not_move_the_cache():
     assert out.stdout.strip() == "[][]"
 
 
+@pytest.mark.skipif(shutil.which("make") is None, reason="make is not installed")
+def test_make_keeps_pythons_bytecode_cache():
+    """``make test`` / ``make demo`` let Python write and read its bytecode cache even where the
+    environment turns it off (PYTHONDONTWRITEBYTECODE=1): else every test worker and every
+    subprocess compiles the source of numba, pandas and xarray again."""
+    env = {**os.environ, "PYTHONDONTWRITEBYTECODE": "1"}
+    out = subprocess.run(
+        ["make", "-s", "--no-print-directory", "-f", str(ROOT / "Makefile"), "--eval",
+         'show-bytecode-env: ; @echo "[$${PYTHONDONTWRITEBYTECODE-unset}]"', "show-bytecode-env"],
+        cwd=ROOT, env=env, capture_output=True, text=True, timeout=60, check=True)
+    assert out.stdout.strip() == "[unset]"
+
+
 def test_a_shared_modules_edit_renames_every_generated_kernel(tmp_path, monkeypatch):
     """numba's cache of a generated module holds the compiled code of the shared modules it
     imports and checks only the generated file: an edit of a shared module must give every
