@@ -102,3 +102,24 @@ def test_periodic_train_continuation_follows_the_orbits_newton_finds():
         orbit = geardyn.periodic_orbit(model, omega=w, guess=x)
         assert orbit.converged
         np.testing.assert_allclose(x, orbit.x, rtol=0, atol=1e-6 * np.max(np.abs(orbit.x)))
+
+
+def test_periodic_train_frequency_response_and_basins_meet_the_orbit_newton_finds():
+    """Up and down sweeps agree with the periodic orbit of Newton shooting (its peak mesh
+    forces), and every start of a basin grid ends on that one attractor."""
+    model = _periodic()
+    w = model.omega
+    omegas = np.array([0.95 * w, w])
+    run = geardyn.RunSettings(transient=2000.0, samples=8)
+    frc = geardyn.frequency_response(model, omegas, run)
+    for k, om in enumerate(omegas):
+        orbit = geardyn.periodic_orbit(model, omega=float(om), run=RUN)
+        assert orbit.converged
+        peak = np.max(np.abs(orbit.observables), axis=0)
+        for sweep in ("up", "down"):
+            np.testing.assert_allclose(frc["force_peak"].sel(sweep=sweep).values[k], peak,
+                                       rtol=2e-3)
+    basins = geardyn.basins(model, None, ("g1.theta", -1e3, 1e3, 3),
+                            ("dg1.theta", -50.0, 50.0, 3), RUN)
+    assert basins.sizes["attractor"] == 1
+    assert float(basins["attractor_fraction"].values[0]) == 1.0
