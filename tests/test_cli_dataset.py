@@ -4,17 +4,14 @@ chunk and rerun gives the bits of one uninterrupted run; bad input names the fie
 
 from __future__ import annotations
 
-import subprocess
-
 import numpy as np
 import pytest
 import xarray as xr
-from typer.testing import CliRunner
 
 import geardyn
-from geardyn.cli.main import app
 from geardyn.execution.zarr_store import LaneStore
 from geardyn.gears import GearMesh, RootCrack, SpurGear
+from test_cli import invoke
 
 GEARS = """[study]
 name = "tiny_dataset"
@@ -57,13 +54,6 @@ gear = "pinion"
 tooth = 2
 depth = "1.5 mm"
 """
-
-
-def invoke(*args) -> subprocess.CompletedProcess:
-    result = CliRunner().invoke(app, [str(a) for a in args])
-    if result.exception is not None and not isinstance(result.exception, SystemExit):
-        raise result.exception
-    return subprocess.CompletedProcess(args, result.exit_code, result.stdout, result.stderr)
 
 
 @pytest.fixture

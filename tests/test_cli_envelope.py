@@ -3,14 +3,11 @@ naming the option or the table's field."""
 
 from __future__ import annotations
 
-import subprocess
-
 import numpy as np
 import pytest
-from typer.testing import CliRunner
 
-from geardyn.cli.main import app
 from geardyn.io import load_dataset, load_study
+from test_cli import invoke
 
 STUDY = """
 [study]
@@ -32,13 +29,6 @@ starts = [1.2]
 scan = 12
 resolution = 30
 """
-
-
-def invoke(*args) -> subprocess.CompletedProcess:
-    result = CliRunner().invoke(app, [str(a) for a in args])
-    if result.exception is not None and not isinstance(result.exception, SystemExit):
-        raise result.exception
-    return subprocess.CompletedProcess(args, result.exit_code, result.stdout, result.stderr)
 
 
 @pytest.fixture

@@ -3,17 +3,14 @@ run-up, bit for bit), ``geardyn plot`` of the result, and errors naming the fiel
 
 from __future__ import annotations
 
-import subprocess
-
 import numpy as np
 import pytest
-from typer.testing import CliRunner
 
 import geardyn
 from geardyn.analysis.runup import RunupSettings, runup
-from geardyn.cli.main import app
 from geardyn.io.netcdf import load_dataset
 from geardyn.testing import assert_result
+from test_cli import invoke
 
 PNG = b"\x89PNG\r\n\x1a\n"
 STUDY = """[study]
@@ -31,13 +28,6 @@ rate = 4e-3
 sample_rate = 4.0
 outputs = ["x", "F"]
 """
-
-
-def invoke(*args) -> subprocess.CompletedProcess:
-    result = CliRunner().invoke(app, [str(a) for a in args])
-    if result.exception is not None and not isinstance(result.exception, SystemExit):
-        raise result.exception
-    return subprocess.CompletedProcess(args, result.exit_code, result.stdout, result.stderr)
 
 
 @pytest.fixture

@@ -33,7 +33,9 @@ from __future__ import annotations
 
 import math
 import numbers
+from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Any
 
 from geardyn.errors import ParameterError
 from geardyn.units import to_si
@@ -260,3 +262,12 @@ Fault = RootCrack | Spall | Wear | BrokenTooth
 #: The fault classes by kind (the ``kind`` of a study file's fault table).
 FAULT_KINDS: dict[str, type] = {"crack": RootCrack, "spall": Spall, "wear": Wear,
                                 "broken_tooth": BrokenTooth}
+
+
+def listed_faults(faults: object) -> tuple[Any, ...]:
+    """``faults`` as a tuple: None gives (), one fault a 1-tuple, a sequence its items."""
+    if faults is None:
+        return ()
+    if isinstance(faults, Sequence) and not isinstance(faults, str):
+        return tuple(faults)
+    return (faults,)

@@ -49,14 +49,20 @@ drive flank, which is the sun-planet mesh's coast flank). So
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
 from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
 
 from geardyn.errors import ParameterError
-from geardyn.gears.faults import BrokenTooth, RootCrack, Spall, Wear, planet_number
+from geardyn.gears.faults import (
+    BrokenTooth,
+    RootCrack,
+    Spall,
+    Wear,
+    listed_faults,
+    planet_number,
+)
 
 _KINDS = (RootCrack, Spall, Wear, BrokenTooth)
 _OTHER_FLANK = {"drive": "coast", "coast": "drive"}
@@ -95,21 +101,13 @@ class FaultPlacement:
                 + tuple(f"r{i + 1}" for i in planets if self.ring_faults))
 
 
-def _listed(faults: object) -> tuple[Any, ...]:
-    if faults is None:
-        return ()
-    if isinstance(faults, Sequence) and not isinstance(faults, str):
-        return tuple(faults)
-    return (faults,)
-
-
 def place_faults(faults: object, geometry: Any) -> FaultPlacement | None:
     """The :class:`FaultPlacement` of ``faults`` (one fault or a sequence) on the gears of
     ``geometry`` (a :class:`~geardyn.gears.PlanetaryGeometry`), None without faults. Errors name
     the fault's field: ``<kind>.gear`` (not a gear of the set, a planet beyond N),
     ``<kind>.tooth`` (beyond the gear's teeth), ``wear.profile`` (Archard wear on a planet), or
     ``faults`` (not a fault, faults on more than one gear)."""
-    listed = _listed(faults)
+    listed = listed_faults(faults)
     if not listed:
         return None
     n = geometry.n_planets

@@ -34,14 +34,13 @@ series bitwise the embedded healthy one.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
 from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
 
 from geardyn.errors import ParameterError
-from geardyn.gears.faults import BrokenTooth, RootCrack, Spall, Wear
+from geardyn.gears.faults import BrokenTooth, RootCrack, Spall, Wear, listed_faults
 from geardyn.models.planetary_stiffness import FlankSeries, embedded, flank_series
 from geardyn.trains.elements import Gear
 
@@ -75,14 +74,6 @@ class TrainFaults:
                      for f in self.faults)
 
 
-def _listed(faults: object) -> tuple[Any, ...]:
-    if faults is None:
-        return ()
-    if isinstance(faults, Sequence) and not isinstance(faults, str):
-        return tuple(faults)
-    return (faults,)
-
-
 def place_train_faults(train: Any, faults: object) -> TrainFaults | None:
     """The :class:`TrainFaults` of ``faults`` (one fault or a sequence) on ``train`` (a
     :class:`~geardyn.trains.GearTrain` whose bodies, meshes and mesh data are set), None without
@@ -90,7 +81,7 @@ def place_train_faults(train: Any, faults: object) -> TrainFaults | None:
     beyond its teeth; ``wear.profile``: Archard wear on a gear of several meshes), ``faults``
     (not a fault, faults on two gears, a faulty gear without meshes) or the faulty gear's mesh
     (``<mesh>.stiffness``: not the potential-energy method; ``<mesh>.a``/``.b``: helical)."""
-    listed = _listed(faults)
+    listed = listed_faults(faults)
     if not listed:
         return None
     gears = [name for name, b in train.bodies.items() if isinstance(b, Gear)]
