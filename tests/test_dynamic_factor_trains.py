@@ -14,21 +14,13 @@ import geardyn
 from geardyn.analysis.dynamic_factor import dynamic_factor_sweep, iso_inputs
 from geardyn.core.capabilities import Capabilities
 from geardyn.core.model import Model
-from geardyn.gears import GearMesh, SpurGear
 from geardyn.gears.iso6336_kv import resonance_speed
 from geardyn.io.toml import builtin_study
 from geardyn.trains import Bearing, Gear, GearTrain, Mesh, TrainModel
+from test_dynamic_factor import _pair
 
 ACCURACY = dict(base_pitch_deviation=9.0, profile_form_deviation=8.0, pitch_running_in=0.5,
                 profile_running_in=0.5, tip_relief=3.0)
-
-
-def _pair(torque: float = 50.0) -> geardyn.SpurPair:
-    mesh = GearMesh(SpurGear(19, 3.2e-3, math.radians(20.0), 0.016, name="pinion"),
-                    SpurGear(48, 3.2e-3, math.radians(20.0), 0.016, name="wheel"))
-    return geardyn.SpurPair.from_geometry(mesh, bore_radius=(0.012, 0.035), speed=3000.0,
-                                          torque=torque, speed_unit="rpm", backlash="10 um",
-                                          period="mesh", angles=64, harmonics=16)
 
 
 def _one_stage(pair: geardyn.SpurPair, torque: float, wheel_first: bool) -> TrainModel:

@@ -151,6 +151,14 @@ def test_cracked_one_stage_train_matches_dop853_on_the_spur_pair_equation():
                                atol=2e-5 * np.max(np.abs(f_ref)))
 
 
+def _embedded(series: np.ndarray, z: int) -> np.ndarray:
+    """A one-mesh-cycle series (1, 2 H) as harmonics l z of the revolution (1, 2 H z)."""
+    out = np.zeros((1, 2 * H * z))
+    out[0, 2 * z - 2::2 * z] = series[0, 0::2]
+    out[0, 2 * z - 1::2 * z] = series[0, 1::2]
+    return out
+
+
 def test_zero_size_fault_is_the_healthy_train():
     """A zero-depth crack: the series bitwise the healthy one at harmonics l Z of the
     revolution (the healthy mean, the stage's other series untouched), the compiled stiffness
@@ -165,9 +173,7 @@ def test_zero_size_fault_is_the_healthy_train():
                                                          healthy.fourier_coast)):
         # the healthy harmonic h of the mesh cycle is harmonic h z of the revolution, its
         # phase shift h psi the revolution's h z (psi / z)
-        embedded = np.zeros((1, 2 * H * z))
-        embedded[0, 2 * z - 2::2 * z] = want[0, 0::2]
-        embedded[0, 2 * z - 1::2 * z] = want[0, 1::2]
+        embedded = _embedded(want, z)
         np.testing.assert_allclose(got, embedded, rtol=1e-13, atol=1e-15)
     assert zero.mesh_stiffnesses()[0] == healthy.mesh_stiffnesses()[0]
     assert zero.coast_stiffnesses()[0] == healthy.coast_stiffnesses()[0]
@@ -194,9 +200,7 @@ def test_zero_size_fault_series_is_bitwise_the_embedded_healthy_series():
     z = PINION.teeth
     for got, want in ((zero.fourier, healthy.fourier), (zero.fourier_coast,
                                                          healthy.fourier_coast)):
-        embedded = np.zeros((1, 2 * H * z))
-        embedded[0, 2 * z - 2::2 * z] = want[0, 0::2]
-        embedded[0, 2 * z - 1::2 * z] = want[0, 1::2]
+        embedded = _embedded(want, z)
         assert np.array_equal(got, embedded)
 
 

@@ -151,6 +151,23 @@ def curve_at(model: Model, kind: str, x: str, x_value: float, guess: np.ndarray,
                    y_start, x_range, settings, run, progress)
 
 
+def _y_span(model: Model, y: str, y_start: float | None, y_stop: float, where: str
+            ) -> tuple[float, float]:
+    """(y_start, y_stop) of a curve: y_start default the model's coefficient ``y`` (a KeyError
+    asking for it where ``y`` is a physical input), both finite and different."""
+    if y_start is None:
+        try:
+            y_start = float(model.params[model.param_index(y)])
+        except KeyError as err:
+            raise KeyError(f"y={y!r}: {err.args[0] if err.args else err}; a physical input "
+                           f"needs y_start (its value at the {where})") from err
+    y0, y1 = float(y_start), float(y_stop)
+    if not (math.isfinite(y0) and math.isfinite(y1)) or y0 == y1:
+        raise ValueError(f"y_stop must be finite and differ from y_start (got y_start={y0!r}, "
+                         f"y_stop={y1!r})")
+    return y0, y1
+
+
 def _follow(model: Model, kind: str, x: str, px: float, u0: np.ndarray, period: int,
             steps: int, x_scale: float, y: str, y_stop: float, y_start: float | None,
             x_range: tuple[float, float] | None, settings: CurveSettings | None,
@@ -160,16 +177,7 @@ def _follow(model: Model, kind: str, x: str, px: float, u0: np.ndarray, period: 
     st = settings if settings is not None else CurveSettings()
     if y == x:
         raise ValueError(f"y must differ from x (both {y!r})")
-    if y_start is None:
-        try:
-            y_start = float(model.params[model.param_index(y)])
-        except KeyError as err:
-            raise KeyError(f"y={y!r}: {err.args[0] if err.args else err}; a physical input "
-                           f"needs y_start (its value at the bifurcation)") from err
-    y0, y1 = float(y_start), float(y_stop)
-    if not (math.isfinite(y0) and math.isfinite(y1)) or y0 == y1:
-        raise ValueError(f"y_stop must be finite and differ from y_start (got y_start={y0!r}, "
-                         f"y_stop={y1!r})")
+    y0, y1 = _y_span(model, y, y_start, y_stop, "bifurcation")
     model.with_params(**{y: y0})  # an unknown y: the model's KeyError naming the known ones
     if x_range is not None:
         lo, hi = sorted(float(v) for v in x_range)
@@ -267,16 +275,7 @@ def _contact_curve(model: Model, branch: xr.Dataset, index: int, y: str, y_stop:
         raise ValueError("settings: a contact change's grazing curve takes the box's spans as "
                          "its scales and locates no points; leave x_scale, y_scale and "
                          "locate_tol unset")
-    if y_start is None:
-        try:
-            y_start = float(model.params[model.param_index(y)])
-        except KeyError as err:
-            raise KeyError(f"y={y!r}: {err.args[0] if err.args else err}; a physical input "
-                           f"needs y_start (its value at the contact change)") from err
-    y0, y1 = float(y_start), float(y_stop)
-    if not (math.isfinite(y0) and math.isfinite(y1)) or y0 == y1:
-        raise ValueError(f"y_stop must be finite and differ from y_start (got y_start={y0!r}, "
-                         f"y_stop={y1!r})")
+    y0, y1 = _y_span(model, y, y_start, y_stop, "contact change")
     px = float(branch["bifurcation_value"].values[index])
     if x_range is None:
         values = branch[x].values
