@@ -49,10 +49,10 @@ def _pair(mesh, table, **kw) -> geardyn.SpurPair:
     return geardyn.SpurPair(mesh, table, **args)
 
 
-def _rhs(kd, kc, omega, torque, error=0.0):
+def _rhs(kd, kc, omega, torque, kmean, error=0.0):
     """dy/dt of m x'' + c x' + f(x, theta) = T / r_b1 + m e (z1 Omega)^2 cos(z1 Omega t), the
     flank stiffnesses kd(theta), kc(theta) given as functions of theta = Omega t."""
-    c = 2.0 * ZETA * math.sqrt(KMEAN[0] * MASS)  # k_mean: the table's mean drive stiffness
+    c = 2.0 * ZETA * math.sqrt(kmean * MASS)  # kmean: the table's mean drive stiffness [N/m]
     wm = Z1 * omega
 
     def f(t, y):
@@ -66,10 +66,6 @@ def _rhs(kd, kc, omega, torque, error=0.0):
             fe = 0.0
         return [v, (torque / RB1 - c * v - fe) / MASS + error * wm * wm * math.cos(wm * t)]
     return f
-
-
-#: The mean drive stiffness of the table in use [N/m] (the damping's reference).
-KMEAN = [0.0]
 
 
 def _interp(table: np.ndarray):
@@ -145,16 +141,16 @@ def test_stated_truncation_error_of_the_default_series(tables):
 # the trajectory against independent integrations
 
 
-def _compare(model, kd, kc, revs: int, every: int = 8,
-             y0: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+def _compare(model, kd, kc, revs: int, every: int = 8, y0: np.ndarray | None = None, *,
+             kmean: float) -> tuple[np.ndarray, np.ndarray]:
     """(geardyn's x, DOP853's x) on the geardyn grid (every ``every``-th point) from ``y0``
-    (default the static deflection at rest)."""
+    (default the static deflection at rest); ``kmean`` is the table's mean drive stiffness."""
     if y0 is None:
-        y0 = np.array([TORQUE / RB1 / KMEAN[0] + HALF_B, 0.0])
+        y0 = np.array([TORQUE / RB1 / kmean + HALF_B, 0.0])
     ds = geardyn.simulate(model, run=geardyn.RunSettings(transient=0.0, samples=revs), y0=y0)
     t = ds["time"].values[::every]
     err = model.params[model.param_index("error")]
-    ref = solve_ivp(_rhs(kd, kc, model.omega, TORQUE, err), (0.0, t[-1]), y0,
+    ref = solve_ivp(_rhs(kd, kc, model.omega, TORQUE, kmean, err), (0.0, t[-1]), y0,
                     method="DOP853", rtol=1e-10, atol=1e-16, t_eval=t)
     assert ref.status == 0
     assert ds.attrs["status"] == 0
@@ -167,12 +163,12 @@ def test_trajectory_matches_dop853_on_the_same_series(tables):
     started in coast-flank contact so that the teeth cross the dead zone onto the drive flanks
     (both flanks and the dead zone used)."""
     mesh, _, cracked = tables
-    KMEAN[0] = float(cracked["mesh_stiffness"].mean())
+    kmean = float(cracked["mesh_stiffness"].mean())
     H = 4 * Z1
     m = _pair(mesh, cracked, harmonics=H, error="3 um")
     kd = _series_fn(*_quadrature_series(cracked["mesh_stiffness"].values, H))
     kc = _series_fn(*_quadrature_series(cracked["mesh_stiffness_coast"].values, H))
-    x, ref = _compare(m, kd, kc, revs=1, y0=np.array([-3.0 * HALF_B, 0.0]))
+    x, ref = _compare(m, kd, kc, revs=1, kmean=kmean, y0=np.array([-3.0 * HALF_B, 0.0]))
     assert (ref < -HALF_B).any() and (ref > HALF_B).any()  # both flanks in contact
     assert np.max(np.abs(x - ref)) < 1e-6 * np.ptp(ref)  # measured 2.6e-7
 
@@ -186,10 +182,10 @@ def test_trajectory_matches_dop853_on_the_interpolated_table(tables, which):
     default H = 16 z1 4.9 %, at 12 z1 (H Omega = 0.9 omega_n) 14 %, at 2 z1 41 % (docs/gears.md)."""
     mesh, healthy, cracked = tables
     table = healthy if which == "healthy" else cracked
-    KMEAN[0] = float(table["mesh_stiffness"].mean())
+    kmean = float(table["mesh_stiffness"].mean())
     m = _pair(mesh, table, harmonics=32 * Z1)
     x, ref = _compare(m, _interp(table["mesh_stiffness"].values),
-                      _interp(table["mesh_stiffness_coast"].values), revs=1)
+                      _interp(table["mesh_stiffness_coast"].values), revs=1, kmean=kmean)
     assert np.max(np.abs(x - ref)) < 0.03 * np.ptp(ref)
 
 
@@ -363,7 +359,7 @@ def test_a_missing_tooth_runs_on_the_series_clipped_at_zero(missing):
     mesh, table = missing
     k_table = table["mesh_stiffness"].values
     assert k_table.min() == 0.0 and k_table.max() > 0.0
-    KMEAN[0] = float(k_table.mean())
+    kmean = float(k_table.mean())
     H = 4 * Z1
     m = _pair(mesh, table, harmonics=H)
     raw_d = _series_fn(*_quadrature_series(k_table, H))
@@ -372,18 +368,18 @@ def test_a_missing_tooth_runs_on_the_series_clipped_at_zero(missing):
     raw = np.array([raw_d(t) for t in theta])
     assert raw.min() < 0.0  # the ringing the kernels clip
     np.testing.assert_allclose(m.stiffness_at(theta), np.maximum(raw, 0.0), rtol=0,
-                               atol=1e-9 * KMEAN[0])
+                               atol=1e-9 * kmean)
 
     def clipped(fn):
         return lambda th: max(fn(th), 0.0)
 
-    x, ref = _compare(m, clipped(raw_d), clipped(raw_c), revs=1, every=1)
+    x, ref = _compare(m, clipped(raw_d), clipped(raw_c), revs=1, kmean=kmean, every=1)
     err = np.max(np.abs(x - ref))
     assert err < 3e-6 * np.ptp(ref)
     n = default_steps_per_period(m)
     x2 = geardyn.simulate(m, run=geardyn.RunSettings(transient=0.0, samples=1,
                                                      steps_per_period=2 * n),
-                          y0=np.array([TORQUE / RB1 / KMEAN[0] + HALF_B, 0.0]))["x"].values
+                          y0=np.array([TORQUE / RB1 / kmean + HALF_B, 0.0]))["x"].values
     assert np.max(np.abs(x2[::2] - ref)) < err / 1.5
 
 
@@ -398,7 +394,8 @@ def test_a_missing_tooth_sets_the_gears_free_where_its_pair_would_carry(missing)
     assert ratio == pytest.approx(1.0 - 1.0 / Z1, rel=1e-6)
     theta = 2.0 * math.pi * np.arange(table.sizes["angle"]) / table.sizes["angle"]
     gap = table["mesh_stiffness"].values == 0.0
-    assert np.all(m.stiffness_at(theta[gap]) < 0.25 * KMEAN[0])  # the series' rounding only
+    kmean = float(table["mesh_stiffness"].mean())
+    assert np.all(m.stiffness_at(theta[gap]) < 0.25 * kmean)  # the series' rounding only
 
 
 # ---------------------------------------------------------------------------------------------
@@ -425,10 +422,10 @@ def test_table_form_matches_dop853_on_the_same_table(tables, which):
     1e-4 of the peak-to-peak motion (measured 2.1e-5)."""
     mesh, healthy, cracked = tables
     table = healthy if which == "healthy" else cracked
-    KMEAN[0] = float(table["mesh_stiffness"].mean())
+    kmean = float(table["mesh_stiffness"].mean())
     m = _pair(mesh, table, stiffness_form="table")
     x, ref = _compare(m, _interp(table["mesh_stiffness"].values),
-                      _interp(table["mesh_stiffness_coast"].values), revs=1,
+                      _interp(table["mesh_stiffness_coast"].values), revs=1, kmean=kmean,
                       y0=np.array([-3.0 * HALF_B, 0.0]))
     assert (ref < -HALF_B).any() and (ref > HALF_B).any()
     assert np.max(np.abs(x - ref)) < 1e-4 * np.ptp(ref)
@@ -459,13 +456,13 @@ def test_table_form_error_falls_at_least_second_order_with_the_step(tables):
     than 3 (second order, RK4's fourth lost at the table's kinks: measured 3.9, 4.6, 5.8),
     and at 32768 steps it is under 2e-4 of the motion (measured 9e-5)."""
     mesh, _, cracked = tables
-    KMEAN[0] = float(cracked["mesh_stiffness"].mean())
+    kmean = float(cracked["mesh_stiffness"].mean())
     m = _pair(mesh, cracked, stiffness_form="table")
     y0 = m.initial_state()
     n0 = 4096
     t = np.arange(n0 // 4 + 1) * (2.0 * math.pi / m.omega) / n0
     ref = solve_ivp(_rhs(_interp(cracked["mesh_stiffness"].values),
-                         _interp(cracked["mesh_stiffness_coast"].values), m.omega, TORQUE),
+                         _interp(cracked["mesh_stiffness_coast"].values), m.omega, TORQUE, kmean),
                     (0.0, t[-1]), y0, method="DOP853", rtol=1e-10, atol=1e-16, t_eval=t).y[0]
     errors = []
     for k in (2, 4, 8, 16):
