@@ -246,8 +246,11 @@ def _static_mesh_deflections(gs: geardyn.PlanetaryGearSet, theta: float) -> np.n
         pk.planetary_rhs(t, np.r_[X, np.zeros(n)], dy, gs.params, s, c)
         return dy[n:]
 
-    X, info, ok, msg = fsolve(accel, gs.static_state(), xtol=1e-13, full_output=True)
-    assert ok == 1, msg
+    x0 = gs.static_state()
+    X, info, ok, msg = fsolve(accel, x0, xtol=1e-13, full_output=True)
+    # converged to rounding: fsolve may stop with "not making good progress" (ier 5) there,
+    # so the residual is what is checked (measured ~4e-15 of the start's)
+    assert np.max(np.abs(accel(X))) <= 1e-11 * np.max(np.abs(accel(x0))), msg
     return gs.mesh_rows() @ X * gs.length_scale
 
 
