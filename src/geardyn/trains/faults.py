@@ -4,7 +4,11 @@ revolution.
 
 A fault (:mod:`geardyn.gears.faults`) sits on tooth ``tooth`` of ``gear``, the name of a
 :class:`~geardyn.trains.Gear` of the train. All the faults of a train lie on one gear f (Z_f
-teeth), whose meshes all take their stiffness from the potential-energy method (spur gears).
+teeth), whose meshes all take their stiffness from the potential-energy method: a spur gear's
+from :func:`~geardyn.gears.potential_energy_stiffness`, a helical gear's from
+:func:`~geardyn.gears.helical_stiffness` (the slices and angles of the mesh's healthy table),
+where a crack, uniform wear and a missing tooth act across the whole face width and a spall or
+Archard wear is refused (as there).
 
 Tooth numbers: tooth j of f passes the pitch point of f's first mesh m_0 (in the train's order)
 j mesh cycles after tooth 0, which passes it at the mesh's phase origin (the stiffness table's
@@ -78,9 +82,10 @@ def place_train_faults(train: Any, faults: object) -> TrainFaults | None:
     """The :class:`TrainFaults` of ``faults`` (one fault or a sequence) on ``train`` (a
     :class:`~geardyn.trains.GearTrain` whose bodies, meshes and mesh data are set), None without
     faults. Errors name the fault's field (``crack.gear``: no gear of the train; ``crack.tooth``:
-    beyond its teeth; ``wear.profile``: Archard wear on a gear of several meshes), ``faults``
-    (not a fault, faults on two gears, a faulty gear without meshes) or the faulty gear's mesh
-    (``<mesh>.stiffness``: not the potential-energy method; ``<mesh>.a``/``.b``: helical)."""
+    beyond its teeth; ``spall.gear``: a spall on a helical gear; ``wear.profile``: Archard wear
+    on a helical gear or on a gear of several meshes), ``faults`` (not a fault, faults on two
+    gears, a faulty gear without meshes) or the faulty gear's mesh (``<mesh>.stiffness``: not
+    the potential-energy method)."""
     listed = listed_faults(faults)
     if not listed:
         return None
@@ -107,13 +112,20 @@ def place_train_faults(train: Any, faults: object) -> TrainFaults | None:
     if not meshes:
         raise ParameterError("faults", gear, "the faulty gear takes part in no mesh")
     for m in meshes:
-        if body.helical:
-            raise ParameterError(f"{m.name}.{'a' if m.a == gear else 'b'}", gear,
-                                 "tooth faults on a helical gear of a train are not covered")
         if train.mesh_data[m.name].table is None:
             raise ParameterError(f"{m.name}.stiffness", m.stiffness,
                                  f"a fault on {gear} needs the potential-energy stiffness of its"
                                  " meshes (stiffness='potential_energy')")
+    if body.helical:
+        for fault in listed:
+            if isinstance(fault, Spall):
+                raise ParameterError(f"{fault.kind}.gear", gear, "a spall on a helical gear is not "
+                                     "modelled: Spall does not place it across the face width "
+                                     "(helical_stiffness refuses it)")
+            if isinstance(fault, Wear) and fault.profile != "uniform":
+                raise ParameterError("wear.profile", fault.profile, f"{gear} is helical: a "
+                                     "helical pair takes uniform wear only (Archard's profile "
+                                     "is the spur pair's load share); give uniform wear")
     if len(meshes) > 1:
         for fault in listed:
             if isinstance(fault, Wear) and fault.profile != "uniform":
@@ -128,13 +140,21 @@ def faulty_table(train: Any, mesh: Any, pair: Any, faults: tuple[Any, ...],
     """The potential-energy stiffness Dataset of train ``mesh`` (its gears' pair ``pair``) over
     ``cycles`` mesh cycles with ``faults`` on the pair's pinion or wheel (the mesh's own inputs,
     as its healthy one-cycle table), kept on the train for the models rebuilt from it."""
+    from geardyn.gears.helical import HelicalMesh, helical_stiffness
     from geardyn.gears.potential_energy import potential_energy_stiffness
 
     cache = train.__dict__.setdefault("_fault_tables", {})
     key = (mesh.name, faults, cycles)
     if key not in cache:
-        cache[key] = potential_energy_stiffness(pair, bore_radius=mesh.bore_radius,
-                                                faults=faults, cycles=cycles)
+        if isinstance(pair, HelicalMesh):
+            healthy = train.mesh_data[mesh.name].table
+            cache[key] = helical_stiffness(pair, bore_radius=mesh.bore_radius,
+                                           angles=int(healthy.sizes["angle"]),
+                                           slices=int(healthy.attrs["slices"]),
+                                           faults=faults, cycles=cycles)
+        else:
+            cache[key] = potential_energy_stiffness(pair, bore_radius=mesh.bore_radius,
+                                                    faults=faults, cycles=cycles)
     return cache[key]
 
 
