@@ -98,7 +98,7 @@ from __future__ import annotations
 
 import math
 import numbers
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, replace
 from functools import lru_cache
 from typing import Any
@@ -806,19 +806,17 @@ class PotentialEnergyPair:
 
             pieces.append((mid, half, np.polynomial.chebyshev.chebinterpolate(
                 rate, ARCHARD_DEGREE)))
-        inner = np.array(rolls[1:-1])
+        return WearProfile(rolls, _piecewise_depth(rolls, pieces))
 
-        def depth_at(t: np.ndarray) -> np.ndarray:
-            t = np.asarray(t, dtype=float)
-            which = np.searchsorted(inner, t, side="right")
-            out = np.zeros(t.shape)
-            for i, (mid, half, coef) in enumerate(pieces):
-                mask = which == i
-                if mask.any():
-                    out[mask] = np.polynomial.chebyshev.chebval((t[mask] - mid) / half, coef)
-            return out
-
-        return WearProfile(rolls, depth_at)
+    def archard_rolls(self, gear: str) -> tuple[float, ...]:
+        """The roll angles [rad] of ``gear``'s flank, ascending, between which
+        :meth:`archard_rate` is smooth: the contacts at the path's ends, the single-contact
+        ends and the pitch point."""
+        mesh = self.mesh
+        p_b, g_f, g_a = mesh.base_pitch, mesh.approach_length, mesh.recess_length
+        roll = self._flank(gear)[1]
+        ends = [x for x in sorted({-g_f, g_a - p_b, 0.0, p_b - g_f, g_a}) if -g_f <= x <= g_a]
+        return tuple(sorted(float(roll(x)) for x in ends))
 
     def profile_of(self, fault: Fault | tuple | None
                    ) -> WearProfile | tuple[WearProfile | None, ...] | None:
@@ -883,6 +881,80 @@ class PotentialEnergyPair:
         return out
 
 
+def _piecewise_depth(rolls: Sequence[float], pieces: Sequence[tuple[float, float, np.ndarray]]
+                     ) -> Callable[[np.ndarray], np.ndarray]:
+    """depth_at(t) of a :class:`WearProfile`: on each stretch between the ``rolls`` its
+    Chebyshev series (mid, half, coefficients) in (t - mid) / half."""
+    inner = np.array(rolls[1:-1])
+
+    def depth_at(t: np.ndarray) -> np.ndarray:
+        t = np.asarray(t, dtype=float)
+        which = np.searchsorted(inner, t, side="right")
+        out = np.zeros(t.shape)
+        for i, (mid, half, coef) in enumerate(pieces):
+            mask = which == i
+            if mask.any():
+                out[mask] = np.polynomial.chebyshev.chebval((t[mask] - mid) / half, coef)
+        return out
+
+    return depth_at
+
+
+def combined_wear_profile(parts: Sequence[tuple[PotentialEnergyPair, str, float]],
+                          depth: float) -> WearProfile:
+    """Archard's depth along the flank of one gear's tooth that several meshes wear, ``parts``
+    (pair, gear, w): the gear is ``gear`` ("pinion" or "wheel") of each ``pair`` and w >= 0
+    the weight of that mesh's wear (its load on the flank per unit face width: a passage wears
+    k_w F / b r). h(t) = depth R(t) / max R at the flank's roll angle t [rad], R(t) = sum of
+    w r(t) over the parts whose path of contact reaches t, r = the pair's
+    :meth:`~PotentialEnergyPair.archard_rate` (one passage of the tooth through each mesh: the
+    wear of one revolution of the gear). The stretches lie between all the parts'
+    :meth:`~PotentialEnergyPair.archard_rolls` (those closer than 1e-9 of the whole span
+    merged): the maximum over 129 points of each (its ends nudged in), each interpolated by
+    its Chebyshev series of degree :data:`ARCHARD_DEGREE`, as
+    :meth:`~PotentialEnergyPair.wear_profile`."""
+    own = [(pair, gear, float(w), pair.archard_rolls(gear), pair._flank(gear)[0])
+           for pair, gear, w in parts]
+    breaks = sorted(t for *_, rolls, _ in own for t in rolls)
+    span = breaks[-1] - breaks[0]
+    rolls = [breaks[0]]
+    for t in breaks[1:]:
+        if t - rolls[-1] > 1e-9 * span:
+            rolls.append(t)
+    stretches = list(zip(rolls, rolls[1:], strict=False))
+
+    def rate_on(lo: float, hi: float) -> Callable[[np.ndarray], np.ndarray]:
+        mid = 0.5 * (lo + hi)
+        live = [(pair, gear, w, at) for pair, gear, w, r, at in own
+                if w > 0.0 and r[0] < mid < r[-1]]
+
+        def rate(t: np.ndarray) -> np.ndarray:
+            out = np.zeros(np.shape(t))
+            for pair, gear, w, at in live:
+                out = out + w * pair.archard_rate(gear, at(t))
+            return out
+
+        return rate
+
+    nudge = 1e-9 * span
+    peak = max(float(np.max(rate_on(lo, hi)(np.linspace(lo + nudge, hi - nudge, 129))))
+               for lo, hi in stretches)
+    if not peak > 0.0:
+        raise ParameterError("wear.flank", peak, "no mesh wears the flank (every weight 0)")
+    scale = depth / peak
+    pieces = []
+    for lo, hi in stretches:
+        mid, half, rate = 0.5 * (hi + lo), 0.5 * (hi - lo), rate_on(lo, hi)
+
+        def scaled(x: np.ndarray, mid: float = mid, half: float = half,
+                   rate: Callable = rate) -> np.ndarray:
+            return scale * rate(mid + half * x)
+
+        pieces.append((mid, half, np.polynomial.chebyshev.chebinterpolate(scaled,
+                                                                          ARCHARD_DEGREE)))
+    return WearProfile(tuple(rolls), _piecewise_depth(rolls, pieces))
+
+
 def _bores(bore_radius: object) -> tuple[object, object]:
     if isinstance(bore_radius, str) or not isinstance(bore_radius, Sequence):
         return bore_radius, bore_radius
@@ -914,10 +986,15 @@ def prepare_pair(mesh: GearMesh, *, bore_radius: object, young: object = STEEL_Y
                  poisson: object = STEEL_POISSON, root_segment: bool = True,
                  nodes: int = DEFAULT_NODES, faults: object = (),
                  crack: RootCrack | None = None,
-                 ring_foundation: str = "rigid") -> PotentialEnergyPair:
+                 ring_foundation: str = "rigid",
+                 wear_profiles: Mapping[Wear, WearProfile] | None = None
+                 ) -> PotentialEnergyPair:
     """Validate the inputs of :func:`potential_energy_stiffness` and build both teeth (their
     ``start_roll`` at the mesh's lowest contacts). ``crack=`` is the deprecated spelling of
-    ``faults=(crack,)``."""
+    ``faults=(crack,)``. ``wear_profiles``: the depth along the flank of Archard
+    :class:`Wear` faults of ``faults`` (keys equal to them) in place of this mesh's own
+    (:meth:`PotentialEnergyPair.wear_profile`): the wear of a gear that several meshes wear
+    (:func:`combined_wear_profile`)."""
     fault_list = _fault_tuple(faults, crack, "prepare_pair")
     e = si_value("young", young, "pressure", 0.0, strict=True)
     try:
@@ -951,9 +1028,16 @@ def prepare_pair(mesh: GearMesh, *, bore_radius: object, young: object = STEEL_Y
                                poisson=nu, face_width=width, nodes=int(nodes),
                                faults=fault_list)  # type: ignore[arg-type]
     wears = [f for f in fault_list if isinstance(f, Wear)]
+    given = dict(wear_profiles or {})
+    for wear, profile in given.items():
+        if not (isinstance(wear, Wear) and wear.profile == "archard" and wear in wears
+                and isinstance(profile, WearProfile)):
+            raise ParameterError("wear_profiles", wear, "must map Archard Wear faults of "
+                                 "faults to their WearProfile")
     if not wears:
         return pair
-    return replace(pair, wear_profiles=tuple((w, pair.wear_profile(w)) for w in wears))
+    return replace(pair, wear_profiles=tuple(
+        (w, given[w] if w in given else pair.wear_profile(w)) for w in wears))
 
 
 def _check_faults(faults: tuple[object, ...], mesh: GearMesh, teeth: list[ToothModel],
@@ -1172,7 +1256,9 @@ def potential_energy_stiffness(mesh: GearMesh, *, bore_radius: object, angles: o
                                root_segment: bool = True, nodes: int = DEFAULT_NODES,
                                faults: object = (), cycles: int = 1,
                                crack: RootCrack | None = None,
-                               ring_foundation: str = "rigid") -> xr.Dataset:
+                               ring_foundation: str = "rigid",
+                               wear_profiles: Mapping[Wear, WearProfile] | None = None
+                               ) -> xr.Dataset:
     """Mesh stiffness of the spur ``mesh`` (external, or a pinion in a ring) over pinion angles
     by the potential-energy method (module docstring): a Dataset over ``angle`` (pinion
     rotation [deg]; an int ``angles`` is that many points per mesh cycle, 360/z1 deg, over
@@ -1211,12 +1297,12 @@ def potential_energy_stiffness(mesh: GearMesh, *, bore_radius: object, angles: o
     the ring tooth's (:func:`ring_tooth_model`); ``bore_radius``'s second value is the ring's
     outer (rim) radius; ``ring_foundation`` (:data:`RING_FOUNDATIONS`) treats the ring body
     (``"rigid"``: ``k_fillet_wheel`` is inf). Every fault is modelled on the ring's teeth too
-    (module docstring).
+    (module docstring). ``wear_profiles``: see :func:`prepare_pair`.
     """
     fault_list = _fault_tuple(faults, crack, "potential_energy_stiffness")
     pair = prepare_pair(mesh, bore_radius=bore_radius, young=young, poisson=poisson,
                         root_segment=root_segment, nodes=nodes, faults=fault_list,
-                        ring_foundation=ring_foundation)
+                        ring_foundation=ring_foundation, wear_profiles=wear_profiles)
     cyc, n, frac = _cycle_grid(mesh, angles, cycles)
     deg = cyc * (360.0 / mesh.pinion.teeth)
     p_b = mesh.base_pitch

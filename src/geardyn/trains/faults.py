@@ -4,7 +4,11 @@ revolution.
 
 A fault (:mod:`geardyn.gears.faults`) sits on tooth ``tooth`` of ``gear``, the name of a
 :class:`~geardyn.trains.Gear` of the train. All the faults of a train lie on one gear f (Z_f
-teeth), whose meshes all take their stiffness from the potential-energy method (spur gears).
+teeth), whose meshes all take their stiffness from the potential-energy method: a spur gear's
+from :func:`~geardyn.gears.potential_energy_stiffness`, a helical gear's from
+:func:`~geardyn.gears.helical_stiffness` (the slices and angles of the mesh's healthy table),
+where a crack, uniform wear and a missing tooth act across the whole face width and a spall or
+Archard wear is refused (as there).
 
 Tooth numbers: tooth j of f passes the pitch point of f's first mesh m_0 (in the train's order)
 j mesh cycles after tooth 0, which passes it at the mesh's phase origin (the stiffness table's
@@ -20,9 +24,12 @@ Flanks: a fault's ``flank`` ``"drive"`` is the flank in contact at a positive de
 meshes. A train's mesh rows make that the same flank of f's teeth in every mesh (the
 counter-clockwise-facing flank of an external gear, the clockwise-facing one of a ring: the e of
 :meth:`~geardyn.trains.TrainModel.geometry_phases`), so a spall or wear acts on the drive
-contacts of every mesh of f, and Archard wear (whose profile follows one mesh's sliding) is
-refused on a gear with more than one mesh. A crack weakens the contacts of both flanks; a missing
-tooth takes out both (its meshes' series then ring below 0 about the gap, which the kernels clip).
+contacts of every mesh of f. Archard wear on a gear of several meshes is the wear of one
+revolution of f (:func:`shared_wear_profiles`): each mesh wears the flank it loads under the
+model's mean torques, its Archard rate weighted by its load per unit face width, so an idler's
+or a planet's flank takes the wear of the one mesh that loads it. A crack weakens the contacts
+of both flanks; a missing tooth takes out both (its meshes' series then ring below 0 about the
+gap, which the kernels clip).
 
 The stiffness over the revolution (:func:`revolution_series`): a faulty mesh's table over Z_f
 mesh cycles, the fault on its tooth, becomes the Fourier series in the revolution angle Theta =
@@ -34,6 +41,7 @@ series bitwise the embedded healthy one.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, replace
 from typing import Any
 
@@ -78,9 +86,10 @@ def place_train_faults(train: Any, faults: object) -> TrainFaults | None:
     """The :class:`TrainFaults` of ``faults`` (one fault or a sequence) on ``train`` (a
     :class:`~geardyn.trains.GearTrain` whose bodies, meshes and mesh data are set), None without
     faults. Errors name the fault's field (``crack.gear``: no gear of the train; ``crack.tooth``:
-    beyond its teeth; ``wear.profile``: Archard wear on a gear of several meshes), ``faults``
-    (not a fault, faults on two gears, a faulty gear without meshes) or the faulty gear's mesh
-    (``<mesh>.stiffness``: not the potential-energy method; ``<mesh>.a``/``.b``: helical)."""
+    beyond its teeth; ``spall.gear``: a spall on a helical gear; ``wear.profile``: Archard wear
+    on a helical gear), ``faults`` (not a fault, faults on two
+    gears, a faulty gear without meshes) or the faulty gear's mesh (``<mesh>.stiffness``: not
+    the potential-energy method)."""
     listed = listed_faults(faults)
     if not listed:
         return None
@@ -107,34 +116,94 @@ def place_train_faults(train: Any, faults: object) -> TrainFaults | None:
     if not meshes:
         raise ParameterError("faults", gear, "the faulty gear takes part in no mesh")
     for m in meshes:
-        if body.helical:
-            raise ParameterError(f"{m.name}.{'a' if m.a == gear else 'b'}", gear,
-                                 "tooth faults on a helical gear of a train are not covered")
         if train.mesh_data[m.name].table is None:
             raise ParameterError(f"{m.name}.stiffness", m.stiffness,
                                  f"a fault on {gear} needs the potential-energy stiffness of its"
                                  " meshes (stiffness='potential_energy')")
-    if len(meshes) > 1:
+    if body.helical:
         for fault in listed:
+            if isinstance(fault, Spall):
+                raise ParameterError(f"{fault.kind}.gear", gear, "a spall on a helical gear is not "
+                                     "modelled: Spall does not place it across the face width "
+                                     "(helical_stiffness refuses it)")
             if isinstance(fault, Wear) and fault.profile != "uniform":
-                raise ParameterError("wear.profile", fault.profile, "Archard's profile follows "
-                                     f"one mesh's sliding, and {gear} meets "
-                                     f"{len(meshes)}: give uniform wear")
+                raise ParameterError("wear.profile", fault.profile, f"{gear} is helical: a "
+                                     "helical pair takes uniform wear only (Archard's profile "
+                                     "is the spur pair's load share); give uniform wear")
     return TrainFaults(gear, z, listed, tuple(m.name for m in meshes))
 
 
+def shared_wear_profiles(train: Any, placement: TrainFaults, loads: Mapping[str, float]
+                         ) -> dict[Any, Any]:
+    """The depth along the flank of each Archard :class:`~geardyn.gears.Wear` of
+    ``placement`` (keyed by the fault as given) on a gear of several meshes: the wear of one
+    revolution of the gear, every mesh wearing the flank it loads
+    (:func:`~geardyn.gears.potential_energy.combined_wear_profile`), weighted by its load per
+    unit face width on the worn flank, max(F_m, 0) / b_m on the drive flank, max(-F_m, 0) /
+    b_m on the coast flank (``loads``: F_m [N] by mesh name, positive on the drive flank). An
+    idler's or a planet's two meshes load opposite flanks, so each flank takes the wear of one
+    of them; a gear that drives or is driven by several meshes takes their sum. {} on a gear of
+    one mesh (its own profile, as a pair's) or without Archard wear. Error ``wear.flank``: no
+    mesh loads the worn flank."""
+    from geardyn.gears.potential_energy import combined_wear_profile, prepare_pair
+    from geardyn.trains.train import _gear_mesh
+
+    wears = [f for f in placement.faults if isinstance(f, Wear) and f.profile == "archard"]
+    if len(placement.meshes) < 2 or not wears:
+        return {}
+    cache = train.__dict__.setdefault("_shared_wear", {})
+    meshes = {m.name: m for m in train.meshes}
+    out = {}
+    for wear in wears:
+        sign = 1.0 if wear.flank == "drive" else -1.0
+        raw = [max(sign * float(loads[m]), 0.0) for m in placement.meshes]
+        if not max(raw) > 0.0:
+            raise ParameterError("wear.flank", wear.flank, f"no mesh of {placement.gear} "
+                                 f"loads its {wear.flank} flank under the mean torques "
+                                 f"(static mesh forces {dict(loads)} N): Archard wear on a "
+                                 "gear of several meshes follows the meshes that load the "
+                                 "worn flank")
+        # relative to the largest, to 12 digits: the same profile at every torque scale
+        weights = tuple(round(w / max(raw), 12) for w in raw)
+        key = (wear, weights)
+        if key not in cache:
+            parts = []
+            for name, w in zip(placement.meshes, weights, strict=True):
+                mesh = meshes[name]
+                pair = prepare_pair(_gear_mesh(mesh, train.bodies[mesh.a],
+                                               train.bodies[mesh.b]),
+                                    bore_radius=mesh.bore_radius)
+                role = "pinion" if placement.gear == mesh.a else "wheel"
+                parts.append((pair, role, w / pair.face_width))
+            cache[key] = combined_wear_profile(parts, wear.depth)
+        out[wear] = cache[key]
+    return out
+
+
 def faulty_table(train: Any, mesh: Any, pair: Any, faults: tuple[Any, ...],
-                 cycles: int) -> Any:
+                 cycles: int, wear_profiles: Mapping[Any, Any] | None = None) -> Any:
     """The potential-energy stiffness Dataset of train ``mesh`` (its gears' pair ``pair``) over
     ``cycles`` mesh cycles with ``faults`` on the pair's pinion or wheel (the mesh's own inputs,
-    as its healthy one-cycle table), kept on the train for the models rebuilt from it."""
+    as its healthy one-cycle table; ``wear_profiles``: the depth along the flank of its
+    Archard wear, :func:`shared_wear_profiles`), kept on the train for the models rebuilt from
+    it."""
+    from geardyn.gears.helical import HelicalMesh, helical_stiffness
     from geardyn.gears.potential_energy import potential_energy_stiffness
 
     cache = train.__dict__.setdefault("_fault_tables", {})
-    key = (mesh.name, faults, cycles)
+    shared = dict(wear_profiles or {})
+    key = (mesh.name, faults, cycles, tuple(shared.items()))
     if key not in cache:
-        cache[key] = potential_energy_stiffness(pair, bore_radius=mesh.bore_radius,
-                                                faults=faults, cycles=cycles)
+        if isinstance(pair, HelicalMesh):
+            healthy = train.mesh_data[mesh.name].table
+            cache[key] = helical_stiffness(pair, bore_radius=mesh.bore_radius,
+                                           angles=int(healthy.sizes["angle"]),
+                                           slices=int(healthy.attrs["slices"]),
+                                           faults=faults, cycles=cycles)
+        else:
+            cache[key] = potential_energy_stiffness(pair, bore_radius=mesh.bore_radius,
+                                                    faults=faults, cycles=cycles,
+                                                    wear_profiles=shared)
     return cache[key]
 
 

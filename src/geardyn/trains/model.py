@@ -60,7 +60,7 @@ from geardyn.models.planetary import (
     planetary_layout,
 )
 from geardyn.models.planetary_stiffness import FlankSeries, coast_flank, flank_series, mirrored
-from geardyn.trains.faults import faulty_table, revolution_series
+from geardyn.trains.faults import faulty_table, revolution_series, shared_wear_profiles
 from geardyn.trains.train import GearTrain, _gear_mesh
 from geardyn.units import si_value
 
@@ -212,6 +212,7 @@ class TrainModel(PlanetaryGearSet):
         self.faults = train.faults
         self.mesh_order, self._phase_scale = self._forcing_period()
         self._phase_orders = self._snapped(self._kinematic_orders * self._phase_scale)
+        self.torques = self._torques(torques, load)  # before the series: the wear's loads
         self._stiffness_series(self._fourier(waveform, stiffness_fluctuation,
                                              float(contact_ratio), harmonics), harmonics)
         self.backlash = _per_mesh("backlash", backlash, names, "length")
@@ -235,7 +236,6 @@ class TrainModel(PlanetaryGearSet):
         if self.torque_fluctuation != 0.0 and train.driven is None:
             raise ParameterError("torque_fluctuation", torque_fluctuation,
                                  "fluctuates the driven body's torque: the train needs driven")
-        self.torques = self._torques(torques, load)
         self.length_scale = si_value("length_scale", length_scale, "length", 0.0, True)
         ref = names.index(self.reference_mesh)
         k_ref = train.mesh_data[self.reference_mesh].stiffness
@@ -493,6 +493,9 @@ class TrainModel(PlanetaryGearSet):
         Z_f terms in the revolution angle)."""
         out: dict[int, tuple[np.ndarray, np.ndarray, float, float]] = {}
         offsets = self._fault_offsets()
+        shared = {} if self.faults is None else shared_wear_profiles(
+            self.train, self.faults, self.static_loads())
+        self._fault_tables: dict[str, Any] = {}
         for i, mesh in enumerate(self.train.meshes):
             data = self.train.mesh_data[mesh.name]
             if data.table is None:
@@ -512,8 +515,11 @@ class TrainModel(PlanetaryGearSet):
                     role = "pinion" if self.faults.gear == mesh.a else "wheel"
                     pair = _gear_mesh(mesh, self.train.bodies[mesh.a],
                                       self.train.bodies[mesh.b])
-                    table = faulty_table(self.train, mesh, pair,
-                                         self.faults.on_mesh(role, offsets[mesh.name]), z)
+                    on = self.faults.on_mesh(role, offsets[mesh.name])
+                    table = faulty_table(self.train, mesh, pair, on, z, {
+                        f: shared[g] for f, g in zip(on, self.faults.faults, strict=True)
+                        if g in shared})
+                    self._fault_tables[mesh.name] = table
                     flanks.append(revolution_series(healthy, table[var].values, harmonics, z))
                 else:
                     flanks.append(flank_series(healthy, harmonics))
@@ -523,6 +529,20 @@ class TrainModel(PlanetaryGearSet):
                     for s in flanks]
             out[i] = (rows[0], rows[1], flanks[0].mean * normal, flanks[1].mean * normal)
         return out
+
+    def static_loads(self) -> dict[str, float]:
+        """The static mesh forces [N] of the linear train at mean stiffness (no backlash)
+        under the mean torques, by mesh: K q = F (least squares on the rigid-body modes), F_m
+        = k_m w_m q; positive on the drive flank."""
+        q = np.linalg.lstsq(self.train.stiffness_matrix(), self.torques, rcond=None)[0]
+        return {name: k * float((W @ q)[0])
+                for kind, name, W, k, _ in self.train.elements() if kind == "mesh"}
+
+    def fault_tables(self) -> dict[str, Any]:
+        """The potential-energy stiffness Datasets of the faulty gear's meshes over its
+        revolution (Z_f mesh cycles, the faults on each mesh's teeth as placed), by mesh; {}
+        without faults."""
+        return dict(self._fault_tables)
 
     def _fault_offsets(self) -> dict[str, int]:
         """The tooth offset [teeth] of the faults on every mesh of the faulty gear, from its
