@@ -143,3 +143,22 @@ def test_every_study_kind_has_a_builtin_study():
     """Each generated table is read by at least one built-in study (so the test above runs for
     all three)."""
     assert {d["study"].get("model") for _, d in BUILTIN} >= set(TABLES)
+
+
+@pytest.mark.parametrize(("kw", "message"), [
+    ({"kind": "velocity"}, "kind must be one of"),
+    ({"kind": "number", "form": "per_gear"}, "form must be one of"),
+    ({"kind": "choice"}, "declares its choices"),
+    ({"kind": "choice", "choices": ("a", "b"), "default": "c"}, "not one of the choices"),
+    ({"kind": "table"}, "names its table"),
+    ({"kind": "pair"}, "declares its unit_kind"),
+    ({"kind": "pair", "unit_kind": "colour"}, "unit_kind must be one of"),
+])
+def test_a_malformed_declaration_is_refused(kw, message):
+    with pytest.raises(ValueError, match=message):
+        PhysicalInput("x", meaning="an input", **kw)
+
+
+def test_a_name_declared_twice_is_refused():
+    with pytest.raises(ValueError, match="'zeta' is declared twice"):
+        by_name((*spur_pair_coefficients.INPUTS, spur_pair_coefficients.INPUTS[3]))

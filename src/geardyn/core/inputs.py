@@ -105,11 +105,6 @@ class PhysicalInput:
         """Whether the builder requires the input (no default)."""
         return self.default is REQUIRED
 
-    @property
-    def unit(self) -> str:
-        """The SI unit of a quantity (of each value of a pair), else ""."""
-        return SI_UNITS.get(self.unit_kind or self.kind, "")
-
     def bounds(self) -> dict[str, float]:
         """The admissible range (pydantic's ``ge``/``gt``/... keywords): the declared
         coefficient's range, or ``minimum``."""
@@ -119,13 +114,6 @@ class PhysicalInput:
         return {k: v for k, v in (("ge", c.minimum), ("le", c.maximum),
                                   ("gt", c.exclusive_minimum), ("lt", c.exclusive_maximum))
                 if v is not None}
-
-    def describe(self) -> str:
-        """One line: the meaning, and the SI unit of a quantity where the meaning gives none."""
-        unit = self.unit
-        if unit and "[" not in self.meaning:
-            return f"{self.meaning} [{unit}]"
-        return self.meaning
 
 
 def by_name(inputs: Iterable[PhysicalInput]) -> dict[str, PhysicalInput]:
