@@ -9,6 +9,7 @@ import dataclasses
 import inspect
 import tomllib
 
+import numpy as np
 import pytest
 from pydantic import ValidationError
 
@@ -162,3 +163,18 @@ def test_a_malformed_declaration_is_refused(kw, message):
 def test_a_name_declared_twice_is_refused():
     with pytest.raises(ValueError, match="'zeta' is declared twice"):
         by_name((*spur_pair_coefficients.INPUTS, spur_pair_coefficients.INPUTS[3]))
+
+
+def test_a_planetary_study_takes_one_mesh_stiffness_per_planet():
+    """The per-planet form the declaration gives sun_mesh_stiffness (the constructor's): a list
+    in the study is the set's per-planet stiffness."""
+    from geardyn.study import build_model
+
+    doc = tomllib.loads(builtin_study_text("planetary_example"))
+    params = {k: v for k, v in doc["params"].items()
+              if k not in ("geometry", "held", "carrier_speed") and not k.endswith("torque")}
+    params.update(n_planets=3, sun_mesh_stiffness=["5e8 N/m", 5e8, "0.55 GN/m"],
+                  ring_mesh_stiffness=6e8)
+    model = build_model(load_study_dict({**doc, "params": params}))
+    assert np.asarray(model.k_s).tolist() == [5e8, 5e8, 5.5e8]
+    assert np.broadcast_to(model.k_r, 3).tolist() == [6e8] * 3
