@@ -31,6 +31,7 @@ from geardyn.models.catt import CATTDevice
 from geardyn.models.derived import INTERPRETATIONS
 from geardyn.models.gear_pair import GearPair
 from geardyn.models.planetary import Member, PlanetaryGearSet
+from geardyn.models.planetary_coefficients import INPUTS as PLANETARY_INPUTS
 from geardyn.models.spur_pair import SpurPair, period_cycles
 from geardyn.units import to_si
 
@@ -192,9 +193,9 @@ def planetary_model(params: PlanetaryGearSetParams, omega: float | None = None
             if held is not None:
                 raise ParameterError("held", held, "sets the input-speed kinematics of a set "
                                      "built from [params.geometry]; give that table")
-            for name in ("sun_mesh_stiffness", "ring_mesh_stiffness"):
-                if kw[name] is None:
-                    raise ParameterError(name, None, "required (or give [params.geometry])")
+            for i in PLANETARY_INPUTS:  # required unless [params.geometry] stands for them
+                if i.alternative == "geometry" and kw[i.name] is None:
+                    raise ParameterError(i.name, None, "required (or give [params.geometry])")
             model = PlanetaryGearSet(**kw)
         else:
             model = _from_geometry(geometry, kw, held)

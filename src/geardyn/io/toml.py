@@ -119,7 +119,6 @@ from typing import Annotated, Any, ClassVar, Literal
 
 import tomli_w
 from pydantic import (
-    AfterValidator,
     BaseModel,
     BeforeValidator,
     ConfigDict,
@@ -135,6 +134,7 @@ from pydantic import (
 from pydantic_core import InitErrorDetails, PydanticCustomError
 
 from geardyn.core.coefficients import CoefficientBlock
+from geardyn.core.inputs import PhysicalInput
 from geardyn.core.settings import (
     DEFAULT_MAX_PERIOD,
     DEFAULT_TOL,
@@ -160,12 +160,16 @@ from geardyn.io._tables import build_from_fields as _build_from_fields
 from geardyn.io._tables import study_error as _study_error
 from geardyn.io.dataset_table import DatasetTable
 from geardyn.io.envelope_table import EnvelopeTable
+from geardyn.io.params_table import PerMesh as PerMesh  # the types of a quantity's forms
+from geardyn.io.params_table import PerPlanet as PerPlanet
+from geardyn.io.params_table import Quantity, params_table
 from geardyn.io.runup_table import RunupTable
 from geardyn.io.train_table import TrainTable
 from geardyn.models.gear_pair_coefficients import GEAR_PAIR
 from geardyn.models.params import PAPER_NAMES, Angle, Length, PlanetaryParams, Real, Whole
+from geardyn.models.planetary_coefficients import INPUTS as PLANETARY_INPUTS
 from geardyn.models.spur_pair_coefficients import INPUTS as SPUR_PAIR_INPUTS
-from geardyn.models.spur_pair_coefficients import PhysicalInput
+from geardyn.trains.inputs import INPUTS as TRAIN_INPUTS
 from geardyn.units import to_si
 
 __all__ = [
@@ -427,52 +431,17 @@ GearPairParams = study_table(
     "``[params]`` of a ``gear_pair`` study: the arguments of :class:`~geardyn.GearPair`.")
 
 
-def _frequency_text(value: float | str) -> float | str:
-    """A speed as given: a number >= 0 (in the model's speed_unit), or a unit string that reads
-    as an angular frequency >= 0 (e.g. "3000 rpm")."""
-    if (to_si(value, "frequency") if isinstance(value, str) else value) < 0:
-        raise ValueError("must be >= 0")
-    return value
-
-
-def _input_field(i: PhysicalInput) -> tuple[Any, Any]:
-    """The pydantic type and field of one declared physical input."""
-    default = ... if i.required else i.default
-    if i.kind == "choice":
-        kind: Any = Literal[i.choices]  # type: ignore[valid-type]
-    elif i.kind == "count":
-        kind = Annotated[Whole, Field(ge=1)]
-    elif i.kind == "pair":
-        one = Annotated[float, BeforeValidator(lambda v, k=i.unit_kind: to_si(v, k)),
-                        Field(gt=0)]
-        kind = Annotated[list[one], Field(min_length=2, max_length=2)]  # type: ignore[valid-type]
-    elif i.kind == "frequency":  # a number in speed_unit, or a unit string (kept as given)
-        kind = Annotated[Real | str, AfterValidator(_frequency_text)]
-    else:
-        kind = Annotated[float, BeforeValidator(lambda v, k=i.kind: to_si(v, k)),
-                         Field(**i.bounds())]
-    return (kind | None if default is None else kind), Field(default, description=i.meaning)
-
-
 def spur_pair_table(inputs: tuple[PhysicalInput, ...] = SPUR_PAIR_INPUTS) -> type[BaseModel]:
     """``[params]`` of a ``spur_pair`` study, generated from the declared physical inputs of
     :class:`~geardyn.SpurPair` (:data:`~geardyn.models.spur_pair_coefficients.INPUTS`): one
     field per input (SI numbers or unit strings; speed a number in ``speed_unit`` or the unit
     string of an angular frequency, kept as given), unknown keys refused naming the field."""
-    fields = {i.name: _input_field(i) for i in inputs}
-    return create_model("SpurPairParams", __config__=_CONFIG, __module__=__name__,
-                        __doc__=spur_pair_table.__doc__, **fields)
+    return params_table("SpurPairParams", inputs, spur_pair_table.__doc__ or "", values="si")
 
 
 #: ``[params]`` of a ``spur_pair`` study: the dynamics of :meth:`geardyn.SpurPair.from_geometry`
 #: of the study's ``[gears]``, ``[[faults]]`` and ``[stiffness]``.
 SpurPairParams = spur_pair_table()
-
-
-#: A quantity: an SI number or a unit string ("24.6 deg", "5e8 N/m").
-Quantity = float | str
-#: A quantity, or one per planet.
-PerPlanet = float | str | list[float | str]
 
 
 class MemberTable(BaseModel):
@@ -550,95 +519,26 @@ class GeometryTable(BaseModel):
     ring: GearTable
 
 
-class PlanetaryGearSetParams(BaseModel):
+#: ``[params]`` of a ``planetary`` study: the arguments of :class:`~geardyn.PlanetaryGearSet`,
+#: generated from its declared inputs (:data:`geardyn.models.planetary_coefficients.INPUTS`).
+PlanetaryGearSetParams = params_table(
+    "PlanetaryGearSetParams", PLANETARY_INPUTS,
     """``[params]`` of a ``planetary`` study: the arguments of :class:`~geardyn.PlanetaryGearSet`
-    (types checked here; values when the model is built)."""
+    (types checked here; values when the model is built), generated from its declared inputs
+    (:data:`geardyn.models.planetary_coefficients.INPUTS`); ``[params.sun]``, ``[params.ring]``,
+    ``[params.carrier]``, ``[params.planet]`` are :class:`MemberTable` s, ``[params.geometry]``
+    a :class:`GeometryTable`.""",
+    values="given", tables={"member": MemberTable, "planetary_geometry": GeometryTable})
 
-    model_config = _CONFIG
-
-    n_planets: int = 3
-    sun_pressure_angle: Quantity = "24.6 deg"
-    ring_pressure_angle: Quantity = "24.6 deg"
-    sun: MemberTable
-    ring: MemberTable
-    carrier: MemberTable
-    planet: MemberTable
-    sun_mesh_stiffness: Quantity | None = None  # required unless [params.geometry]
-    ring_mesh_stiffness: Quantity | None = None
-    geometry: GeometryTable | None = None
-    planet_angles: list[Quantity] | None = None
-    sun_stiffness_fluctuation: PerPlanet = 0.0
-    ring_stiffness_fluctuation: PerPlanet = 0.0
-    waveform: Literal["sine", "rectangular"] = "sine"
-    contact_ratio: float = 1.6
-    harmonics: int = 9
-    sun_mesh_phase: PerPlanet = 0.0
-    ring_mesh_phase: PerPlanet = 0.0
-    sun_backlash: PerPlanet = 0.0
-    ring_backlash: PerPlanet = 0.0
-    sun_mesh_error: PerPlanet = 0.0
-    ring_mesh_error: PerPlanet = 0.0
-    sun_error_phase: PerPlanet = 0.0
-    ring_error_phase: PerPlanet = 0.0
-    mesh_damping: PerPlanet = 0.05
-    modal_damping: float = 0.0
-    sun_torque: Quantity = 0.0
-    ring_torque: Quantity = 0.0
-    carrier_torque: Quantity = 0.0
-    torque_fluctuation: float = 0.0
-    torque_order: float = 1.0
-    torque_phase: Quantity = 0.0
-    mesh_frequency: Quantity | None = None
-    rotational_only: bool = False
-    fixed: list[Literal["carrier", "ring", "sun"]] = Field(default_factory=list)
-    carrier_speed: Quantity | None = Field(
-        None, description="carrier speed (rad/s or e.g. \"300 rpm\"; \"kinematic\": from the "
-        "tooth counts of [params.geometry], following the input speed): gyroscopic and "
-        "centripetal terms")
-    carrier_speed_ratio: float | None = None
-    centrifugal_preload: bool = True
-    held: Literal["carrier", "ring", "sun"] | None = Field(
-        None, description="member held in the input_speed kinematics (with [params.geometry]; "
-        "default: the one fixed member, else the ring)")
-    time_scale: Quantity | None = None
-    length_scale: Quantity = 1e-6
-
-
-#: A quantity for every mesh, or one per mesh by name ({mesh = value}).
-PerMesh = float | str | dict[str, float | str]
-
-
-class TrainModelParams(BaseModel):
+#: ``[params]`` of a ``train`` study: the arguments of :class:`~geardyn.trains.TrainModel` but
+#: the train, generated from its declared inputs (:data:`geardyn.trains.inputs.INPUTS`).
+TrainModelParams = params_table(
+    "TrainModelParams", TRAIN_INPUTS,
     """``[params]`` of a ``train`` study: the arguments of :class:`~geardyn.trains.TrainModel`
-    but the train (the study's ``[train]`` table); types checked here, values when the model
-    is built (errors name ``params.<field>``)."""
-
-    model_config = _CONFIG
-
-    reference_mesh: str | None = None
-    input_speed: Quantity | None = Field(None, description="driven body's speed (rpm, or a "
-                                         "unit string)")
-    mesh_frequency: Quantity | None = None
-    torques: dict[str, Quantity] = Field(default_factory=dict)
-    load: str | None = None
-    backlash: PerMesh = 0.0
-    mesh_damping: PerMesh = 0.0
-    modal_damping: float = 0.0
-    stiffness_fluctuation: PerMesh = 0.0
-    waveform: Literal["sine", "rectangular"] = "sine"
-    contact_ratio: float = 1.6
-    harmonics: int = 9
-    mesh_phase: PerMesh | None = Field(None, description="rad of the mesh cycle, per mesh or "
-                                       "\"geometry\"; default: from the geometry where every "
-                                       "meshing gear has it, else 0")
-    mesh_error: PerMesh = 0.0
-    error_phase: PerMesh = 0.0
-    torque_fluctuation: float = 0.0
-    torque_order: float = 1.0
-    torque_phase: Quantity = 0.0
-    coast: Literal["mirror", "symmetric"] = "mirror"
-    time_scale: Quantity | None = None
-    length_scale: Quantity = 1e-6
+    but the train (the study's ``[train]`` table), generated from its declared inputs
+    (:data:`geardyn.trains.inputs.INPUTS`); types checked here, values when the model is built
+    (errors name ``params.<field>``).""",
+    values="given")
 
 
 # --------------------------------------------------------------------------- gears and faults

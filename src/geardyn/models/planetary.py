@@ -42,6 +42,7 @@ from geardyn.models import planetary_kernels as pk
 from geardyn.models.modal import frequency_groups
 from geardyn.models.planetary_coefficients import (
     CARRIER_SPEED,
+    CENTRAL,
     FORCES,
     HEADER,
     MATRICES,
@@ -110,7 +111,6 @@ def planetary_layout(dofs: tuple[str, ...], mesh_names: tuple[str, ...], nh: int
                           "order differs from 1)")
     out.place(pk.own_cache_names(len(mesh_names)), own)
     return out
-CENTRAL = ("carrier", "ring", "sun")
 _SHORT = {"carrier": "c", "ring": "r", "sun": "s"}
 #: Constructor inputs that fix the model's layout or are not numbers: not swept by name.
 _NOT_SWEPT = {"n_planets", "waveform", "coast_waveform", "harmonics", "mesh_order",

@@ -1,11 +1,13 @@
 """The planetary gear set's coefficients, declared once (:mod:`geardyn.core.coefficients`): the
 header and mesh-block offsets are :mod:`geardyn.models.planetary_kernels`' index constants; the
 whole vector (:func:`geardyn.models.planetary.planetary_layout`) places these with the structure
-and workspace the kernel reads."""
+and workspace the kernel reads. The set's physical inputs are declared here too (:data:`INPUTS`,
+:mod:`geardyn.core.inputs`)."""
 
 from __future__ import annotations
 
 from geardyn.core.coefficients import Coefficient, CoefficientBlock
+from geardyn.core.inputs import PhysicalInput
 
 
 def _d(name: str, unit: str, meaning: str, *inputs: str, constant: str | None = None
@@ -100,3 +102,117 @@ def coast_harmonics_block(nh: int) -> CoefficientBlock:
            "sun_stiffness_fluctuation", "ring_stiffness_fluctuation", "sun_mesh_phase",
            "ring_mesh_phase")
         for h in range(1, nh + 1) for ab in "ab"))
+
+
+#: The central members (those a set may hold fixed or take as the held member).
+CENTRAL = ("carrier", "ring", "sun")
+#: The stiffness waveforms a study names (the constructor also takes Fourier coefficients).
+WAVEFORMS = ("sine", "rectangular")
+
+
+def _member(name: str, what: str) -> PhysicalInput:
+    return PhysicalInput(name, "table", f"the {what} (a geardyn.Member: mass, inertia_over_r2, "
+                         "bearing_stiffness, torsional_stiffness, radius)", table="member")
+
+
+#: The physical inputs of :class:`~geardyn.PlanetaryGearSet` (SI numbers or unit strings),
+#: declared once: the ``[params]`` table of a ``planetary`` study is generated from them
+#: (:data:`geardyn.io.toml.PlanetaryGearSetParams`), and they are the constructor's keywords
+#: (``geometry`` and ``held`` those of :meth:`~geardyn.PlanetaryGearSet.from_geometry`).
+INPUTS: tuple[PhysicalInput, ...] = (
+    PhysicalInput("n_planets", "count", "number of planets N", 3),
+    PhysicalInput("sun_pressure_angle", "angle", "pressure angle of the sun-planet meshes "
+                  "[rad, or e.g. \"24.6 deg\"]", "24.6 deg"),
+    PhysicalInput("ring_pressure_angle", "angle", "pressure angle of the ring-planet meshes "
+                  "[rad, or e.g. \"24.6 deg\"]", "24.6 deg"),
+    _member("sun", "sun"),
+    _member("ring", "ring"),
+    _member("carrier", "carrier"),
+    _member("planet", "planets (bearing_stiffness: the planet bearing on the carrier)"),
+    PhysicalInput("sun_mesh_stiffness", "stiffness", "mean sun-planet mesh stiffness [N/m], "
+                  "one or one per planet", form="per_planet", alternative="geometry"),
+    PhysicalInput("ring_mesh_stiffness", "stiffness", "mean ring-planet mesh stiffness [N/m], "
+                  "one or one per planet", form="per_planet", alternative="geometry"),
+    PhysicalInput("geometry", "table", "the stage the set is built from "
+                  "(PlanetaryGearSet.from_geometry; n_planets and planet_angles place the "
+                  "planets), instead of the mesh stiffnesses", table="planetary_geometry",
+                  of="from_geometry", alternative="sun_mesh_stiffness"),
+    PhysicalInput("planet_angles", "angle", "planet angles psi_n [rad] (default equally "
+                  "spaced, psi_n = 2 pi (n - 1) / N)", None, form="list"),
+    PhysicalInput("sun_stiffness_fluctuation", "dimensionless", "relative amplitude of the "
+                  "sun-planet stiffness fluctuation (half peak-to-peak over the mean), one or "
+                  "one per planet", 0.0, form="per_planet"),
+    PhysicalInput("ring_stiffness_fluctuation", "dimensionless", "relative amplitude of the "
+                  "ring-planet stiffness fluctuation, one or one per planet", 0.0,
+                  form="per_planet"),
+    PhysicalInput("waveform", "choice", "shape of the stiffness fluctuation: \"sine\" or "
+                  "\"rectangular\" (contact_ratio, harmonics)", "sine", choices=WAVEFORMS),
+    PhysicalInput("contact_ratio", "number", "contact ratio of the rectangular waveform", 1.6),
+    PhysicalInput("harmonics", "count", "harmonics of the rectangular waveform's series", 9),
+    PhysicalInput("sun_coast_stiffness", "stiffness", "mean coast-flank stiffness of the "
+                  "sun-planet meshes [N/m] (None: the drive flank's); not a study key: "
+                  "from_geometry sets it", None, form="per_planet", study=False),
+    PhysicalInput("ring_coast_stiffness", "stiffness", "mean coast-flank stiffness of the "
+                  "ring-planet meshes [N/m] (None: the drive flank's); not a study key: "
+                  "from_geometry sets it", None, form="per_planet", study=False),
+    PhysicalInput("coast_waveform", "number", "relative Fourier coefficients of the coast "
+                  "flank, a pair (a, b) or {\"sun\": (a, b), \"ring\": (a, b)} (None: the "
+                  "drive flank's); not a study key: from_geometry sets it", None, form="list",
+                  study=False),
+    PhysicalInput("sun_mesh_phase", "angle", "sun-planet mesh phases [rad of the mesh cycle], "
+                  "one or one per planet", 0.0, form="per_planet"),
+    PhysicalInput("ring_mesh_phase", "angle", "ring-planet mesh phases [rad of the mesh "
+                  "cycle], one or one per planet", 0.0, form="per_planet"),
+    PhysicalInput("sun_backlash", "length", "backlash half-width b of the sun-planet meshes "
+                  "[m], one or one per planet", 0.0, form="per_planet"),
+    PhysicalInput("ring_backlash", "length", "backlash half-width b of the ring-planet meshes "
+                  "[m], one or one per planet", 0.0, form="per_planet"),
+    PhysicalInput("sun_mesh_error", "length", "transmission error amplitude of the sun-planet "
+                  "meshes [m], one or one per planet", 0.0, form="per_planet"),
+    PhysicalInput("ring_mesh_error", "length", "transmission error amplitude of the "
+                  "ring-planet meshes [m], one or one per planet", 0.0, form="per_planet"),
+    PhysicalInput("sun_error_phase", "angle", "transmission error phase of the sun-planet "
+                  "meshes [rad], one or one per planet", 0.0, form="per_planet"),
+    PhysicalInput("ring_error_phase", "angle", "transmission error phase of the ring-planet "
+                  "meshes [rad], one or one per planet", 0.0, form="per_planet"),
+    PhysicalInput("mesh_damping", "dimensionless", "mesh damping ratio zeta_m (c_m = 2 zeta_m "
+                  "sqrt(k_m m_e)), one or one per planet", 0.05, form="per_planet"),
+    PhysicalInput("modal_damping", "number", "modal damping ratio of every mode of the linear "
+                  "model at mean stiffness", 0.0),
+    PhysicalInput("sun_torque", "torque", "mean torque on the sun [N m] (needs sun.radius)",
+                  0.0),
+    PhysicalInput("ring_torque", "torque", "mean torque on the ring [N m] (needs "
+                  "ring.radius)", 0.0),
+    PhysicalInput("carrier_torque", "torque", "mean torque on the carrier [N m] (needs "
+                  "carrier.radius)", 0.0),
+    PhysicalInput("torque_fluctuation", "number", "relative amplitude A of the sun torque's "
+                  "fluctuation T_s (1 + A sin(order Omega tau + phase))", 0.0),
+    PhysicalInput("torque_order", "number", "order of the sun torque's fluctuation (in "
+                  "forcing frequencies Omega)", 1.0),
+    PhysicalInput("torque_phase", "angle", "phase of the sun torque's fluctuation [rad]", 0.0),
+    PhysicalInput("mesh_frequency", "frequency", "mesh frequency [rad/s] (default omega_0)",
+                  None),
+    PhysicalInput("mesh_order", "count", "mesh cycles per forcing period (1; not a study key: "
+                  "from_geometry with faults sets it)", 1, study=False),
+    PhysicalInput("rotational_only", "flag", "the purely torsional model (member centres "
+                  "fixed)", False),
+    PhysicalInput("fixed", "choice", "members held fixed (all their coordinates removed)", (),
+                  form="list", choices=CENTRAL),
+    PhysicalInput("carrier_speed", "frequency", "carrier speed (rad/s or e.g. \"300 rpm\"; "
+                  "\"kinematic\": from the tooth counts of [params.geometry], following the "
+                  "input speed): gyroscopic and centripetal terms", None),
+    PhysicalInput("carrier_speed_ratio", "number", "carrier speed Omega_c / mesh_frequency "
+                  "(the carrier speed then follows the mesh frequency in a sweep)", None),
+    PhysicalInput("centrifugal_preload", "flag", "with a carrier speed: the planets' "
+                  "centrifugal load on their bearings, turning with the carrier", True),
+    PhysicalInput("held", "choice", "member held in the input_speed kinematics (with "
+                  "[params.geometry]; default: the one fixed member, else the ring)", None,
+                  choices=CENTRAL, of="from_geometry"),
+    PhysicalInput("time_scale", "frequency", "time scale omega_0 [rad/s] (default "
+                  "sqrt(sun_mesh_stiffness / planet.inertia_over_r2))", None),
+    PhysicalInput("length_scale", "length", "length scale L [m] of the dimensionless "
+                  "displacements", 1e-6),
+    PhysicalInput("stiffness_gaps", "flag", "whether a mesh may have no pair in contact over "
+                  "part of the period (not a study key: from_geometry sets it)", False,
+                  study=False),
+)

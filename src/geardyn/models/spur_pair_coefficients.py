@@ -6,9 +6,10 @@ or as tables over the forcing period (:func:`table_block`)."""
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 from geardyn.core.coefficients import Coefficient, CoefficientBlock
+from geardyn.core.inputs import REQUIRED as REQUIRED  # the default of a required input
+from geardyn.core.inputs import PhysicalInput
 
 _GEOMETRY = ("mesh_stiffness",)
 
@@ -79,70 +80,35 @@ SPEED_UNITS: dict[str, float] = {"rad/s": 1.0, "rpm": 2.0 * math.pi / 60.0, "Hz"
 #: The forcing periods of :meth:`SpurPair.from_geometry`: one revolution of the pinion or of
 #: the wheel, or one mesh cycle.
 PERIODS = ("pinion", "wheel", "mesh")
-#: The default of a required input.
-REQUIRED = object()
-
-
-@dataclass(frozen=True)
-class PhysicalInput:
-    """One keyword input of :class:`~geardyn.SpurPair` (and of ``from_geometry``) beyond the
-    gears: ``kind`` a :data:`geardyn.units.SI_UNITS` kind (a number in SI or a unit string),
-    ``"pair"`` (two values of ``unit_kind``: pinion and wheel), ``"count"`` (a whole number
-    >= 1) or ``"choice"`` (one of ``choices``); ``coefficient`` the header entry it sets, whose
-    declared range applies; ``default`` :data:`REQUIRED` or the value (None: derived, see
-    ``meaning``)."""
-
-    name: str
-    kind: str
-    meaning: str
-    default: object = REQUIRED
-    coefficient: str | None = None
-    unit_kind: str | None = None
-    choices: tuple[str, ...] = ()
-    minimum: float | None = None
-
-    @property
-    def required(self) -> bool:
-        return self.default is REQUIRED
-
-    def bounds(self) -> dict[str, float]:
-        """The admissible range (pydantic's ``ge``/``gt``/... keywords): the header
-        coefficient's declared range, or ``minimum``."""
-        if self.coefficient is None:
-            return {} if self.minimum is None else {"ge": self.minimum}
-        c = HEADER[self.coefficient]
-        return {k: v for k, v in (("ge", c.minimum), ("le", c.maximum),
-                                  ("gt", c.exclusive_minimum), ("lt", c.exclusive_maximum))
-                if v is not None}
-
-
-#: The physical inputs of :class:`~geardyn.SpurPair`, declared once: its ``with_params`` reads
-#: unit strings by their kinds, and the ``[params]`` table of a ``spur_pair`` study is generated
-#: from them (:func:`geardyn.io.toml.spur_pair_table`).
+#: The physical inputs of :class:`~geardyn.SpurPair` (and of ``from_geometry``) beyond the gears
+#: (:class:`~geardyn.core.inputs.PhysicalInput`), declared once: its ``with_params`` reads unit
+#: strings by their kinds, and the ``[params]`` table of a ``spur_pair`` study is generated from
+#: them (:func:`geardyn.io.toml.spur_pair_table`).
 INPUTS: tuple[PhysicalInput, ...] = (
     PhysicalInput("speed", "frequency", "pinion speed: a number in speed_unit, or a unit "
                   "string (\"3000 rpm\")", minimum=0.0),
     PhysicalInput("torque", "torque", "pinion torque [N m] (> 0 loads the drive flanks)",
-                  coefficient="torque"),
+                  coefficient=HEADER["torque"]),
     PhysicalInput("inertia", "pair", "(I1, I2) of pinion and wheel [kg m^2]; default solid "
                   "steel discs of the reference radius, face width and bore", None,
                   unit_kind="inertia"),
-    PhysicalInput("zeta", "dimensionless", HEADER["zeta"].meaning, 0.05, coefficient="zeta"),
+    PhysicalInput("zeta", "dimensionless", HEADER["zeta"].meaning, 0.05,
+                  coefficient=HEADER["zeta"]),
     PhysicalInput("backlash", "length", "backlash half-width b along the line of action [m]; "
                   "default half the mesh's backlash on the line of action", None,
-                  coefficient="backlash"),
+                  coefficient=HEADER["backlash"]),
     PhysicalInput("error", "length", HEADER["error"].meaning + " [m]", 0.0,
-                  coefficient="error"),
+                  coefficient=HEADER["error"]),
     PhysicalInput("error_phase", "angle", HEADER["error_phase"].meaning + " [rad]", 0.0,
-                  coefficient="error_phase"),
+                  coefficient=HEADER["error_phase"]),
     PhysicalInput("harmonics", "count", "harmonics of Omega in each flank's stiffness series "
-                  "(default 16 per mesh cycle of the period)", None),
+                  "(default 16 per mesh cycle of the period)", None, minimum=1),
     PhysicalInput("stiffness_form", "choice", "how the kernels evaluate the stiffness: its "
                   "Fourier series (\"fourier\") or its table, linear between the angles "
                   "(\"table\")", "fourier", choices=("fourier", "table")),
     PhysicalInput("period", "choice", "forcing period: one pinion or wheel revolution or one "
                   "mesh cycle (default: that of the faulty gear, else the pinion)", None,
-                  choices=PERIODS),
+                  choices=PERIODS, of="from_geometry"),
     PhysicalInput("speed_unit", "choice", "unit of a plain number of speed, of a sweep of "
                   "speed and of its axis", "rad/s", choices=tuple(SPEED_UNITS)),
 )
@@ -150,3 +116,6 @@ INPUTS: tuple[PhysicalInput, ...] = (
 UNIT_KINDS: dict[str, str] = {"Omega": "frequency", "mass": "mass", **{
     i.name: i.kind for i in INPUTS if i.kind in ("frequency", "torque", "dimensionless",
                                                  "length", "angle")}}
+#: The constructor's arguments that are no physical input: the structure the model is built on
+#: (the gear mesh of ``[gears]`` and its stiffness table).
+BUILT_ON = ("mesh", "stiffness")

@@ -1,0 +1,126 @@
+"""Physical inputs declared once: what a user passes to a model's constructor (or writes under
+``[params]`` in a study file).
+
+A model's coefficients (:mod:`geardyn.core.coefficients`) are what its kernels read; its
+*physical inputs* are what a user gives (SI numbers or unit strings, counts, choices, nested
+tables), from which the model derives the coefficients. Each input is declared once, by a
+:class:`PhysicalInput` (name, kind and unit, meaning, default, form, choices), in a tuple next to
+the model's coefficient declarations. From the declarations come:
+
+* the ``[params]`` table of the model's study files (:func:`geardyn.io.params_table.params_table`:
+  one field per input, its type from the kind and form, its default and description);
+* the unit kinds ``with_params`` reads unit strings by;
+* a check that the declaration and the model's constructor agree: every declared input a
+  keyword of its builder (``of``) with the declared default, every keyword of the constructor
+  declared (``tests/test_model_inputs.py``).
+
+Kinds (:data:`INPUT_KINDS`): a :data:`geardyn.units.SI_UNITS` kind (an SI number or a unit
+string of that kind), ``"pair"`` (two values of ``unit_kind``), ``"number"`` (a plain real
+number), ``"count"`` (a whole number), ``"flag"`` (True or False), ``"choice"`` (one of
+``choices``), ``"name"`` (the name of a part of the model, e.g. a mesh or a body) or ``"table"``
+(a nested table, named by ``table``; the study layer maps that name to its table).
+
+Forms (:data:`FORMS`): ``"one"`` (one value), ``"per_planet"`` (one value for every planet or a
+list of one per planet), ``"per_mesh"`` (one value for every mesh or ``{mesh: value}``),
+``"list"`` (a list of values) and ``"by_name"`` (``{name: value}``).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from dataclasses import dataclass
+
+from geardyn.core.coefficients import Coefficient
+from geardyn.units import SI_UNITS
+
+__all__ = ["FORMS", "INPUT_KINDS", "REQUIRED", "PhysicalInput", "by_name"]
+
+
+class _Required:
+    """The default of a required input (a singleton)."""
+
+    def __repr__(self) -> str:
+        return "REQUIRED"
+
+
+#: The default of a required input.
+REQUIRED = _Required()
+#: The kinds of physical input (see the module doc).
+INPUT_KINDS: tuple[str, ...] = (*SI_UNITS, "pair", "number", "count", "flag", "choice", "name",
+                                "table")
+#: The forms of physical input (see the module doc).
+FORMS: tuple[str, ...] = ("one", "per_planet", "per_mesh", "list", "by_name")
+
+
+@dataclass(frozen=True)
+class PhysicalInput:
+    """One physical input of a model: a keyword of its constructor (or of the builder named by
+    ``of``, e.g. ``"from_geometry"``).
+
+    ``kind`` one of :data:`INPUT_KINDS` (``unit_kind`` the SI kind of each value of a
+    ``"pair"``), ``form`` one of :data:`FORMS`; ``default`` :data:`REQUIRED` or the value
+    (None: derived or left out, see ``meaning``); ``coefficient`` the declared coefficient the
+    input sets directly, whose range applies, or ``minimum`` (inclusive); ``choices`` the
+    values of a ``"choice"``; ``table`` the name of a ``"table"`` input's nested table;
+    ``alternative`` the input that stands for this one (a required input the study may leave
+    out where it gives that one: the study table's default is then None and the model's builder
+    says which is missing); ``study`` False for a constructor keyword a study's ``[params]`` does
+    not take (``meaning`` says where it comes from)."""
+
+    name: str
+    kind: str
+    meaning: str
+    default: object = REQUIRED
+    form: str = "one"
+    coefficient: Coefficient | None = None
+    unit_kind: str | None = None
+    choices: tuple[str, ...] = ()
+    minimum: float | None = None
+    table: str | None = None
+    of: str = "__init__"
+    alternative: str | None = None
+    study: bool = True
+
+    def __post_init__(self) -> None:
+        if self.kind not in INPUT_KINDS:
+            raise ValueError(f"{self.name}: kind must be one of {', '.join(INPUT_KINDS)}; "
+                             f"got {self.kind!r}")
+        if self.form not in FORMS:
+            raise ValueError(f"{self.name}: form must be one of {', '.join(FORMS)}; "
+                             f"got {self.form!r}")
+        if (self.kind == "choice") != bool(self.choices):
+            raise ValueError(f"{self.name}: a choice (and only a choice) declares its choices")
+        if (self.kind == "table") != (self.table is not None):
+            raise ValueError(f"{self.name}: a table input (and only one) names its table")
+        if (self.kind == "pair") != (self.unit_kind is not None):
+            raise ValueError(f"{self.name}: a pair (and only a pair) declares its unit_kind")
+        if self.unit_kind is not None and self.unit_kind not in SI_UNITS:
+            raise ValueError(f"{self.name}: unit_kind must be one of {', '.join(SI_UNITS)}")
+        if (self.kind == "choice" and self.form == "one" and self.default not in (
+                REQUIRED, None, *self.choices)):
+            raise ValueError(f"{self.name}: default {self.default!r} is not one of the choices")
+
+    @property
+    def required(self) -> bool:
+        """Whether the builder requires the input (no default)."""
+        return self.default is REQUIRED
+
+    def bounds(self) -> dict[str, float]:
+        """The admissible range (pydantic's ``ge``/``gt``/... keywords): the declared
+        coefficient's range, or ``minimum``."""
+        c = self.coefficient
+        if c is None:
+            return {} if self.minimum is None else {"ge": self.minimum}
+        return {k: v for k, v in (("ge", c.minimum), ("le", c.maximum),
+                                  ("gt", c.exclusive_minimum), ("lt", c.exclusive_maximum))
+                if v is not None}
+
+
+def by_name(inputs: Iterable[PhysicalInput]) -> dict[str, PhysicalInput]:
+    """The declared inputs by name; a ValueError where a name is declared twice."""
+    out: dict[str, PhysicalInput] = {}
+    for i in inputs:
+        if i.name in out:
+            raise ValueError(f"input {i.name!r} is declared twice")
+        out[i.name] = i
+    return out
