@@ -14,8 +14,8 @@ from dataclasses import dataclass
 from typing import Any
 
 from geardyn.errors import ParameterError
-from geardyn.gears.geometry import SpurGear
-from geardyn.gears.helical import HelicalGear
+from geardyn.gears.geometry import GearMesh, SpurGear
+from geardyn.gears.helical import HelicalGear, HelicalMesh
 from geardyn.units import si_value
 
 #: The name of the fixed frame: a shaft or bearing whose other end is ``GROUND`` is held by it.
@@ -299,3 +299,25 @@ class Mesh:
                                  "one value or two (drive flank, coast flank)")
         _set(self, "backlash", tuple(si_value(f"{self.name}.backlash", v, "length", 0.0)
                                      for v in pair))
+
+
+def pair_geometry(mesh: Mesh, ga: Gear, gb: Gear) -> Any:
+    """The :class:`~geardyn.gears.GearMesh` (or :class:`~geardyn.gears.HelicalMesh`) of two
+    gears with geometry; its errors re-raised naming the mesh."""
+    if ga.helical != gb.helical:
+        spur = mesh.a if gb.helical else mesh.b
+        raise ParameterError(f"{mesh.name}.{'a' if spur == mesh.a else 'b'}", spur,
+                             f"is a spur gear and {mesh.b if spur == mesh.a else mesh.a} a"
+                             " helical one: they cannot mesh")
+    if ga.helical and mesh.internal:
+        raise ParameterError(f"{mesh.name}.internal", True,
+                             "an internal helical mesh is not covered")
+    try:
+        if ga.helical:
+            return HelicalMesh(pinion=ga.geometry, wheel=gb.geometry,
+                               centre_distance=mesh.centre_distance)
+        return GearMesh(pinion=ga.geometry, wheel=gb.geometry,
+                        centre_distance=mesh.centre_distance, internal=mesh.internal)
+    except ParameterError as exc:
+        raise ParameterError(f"{mesh.name}.{exc.field}", exc.value,
+                             f"{exc.reason} (mesh of {mesh.a} with {mesh.b})") from None

@@ -50,7 +50,7 @@ import numpy as np
 from geardyn.errors import ParameterError
 from geardyn.gears.faults import BrokenTooth, RootCrack, Spall, Wear, listed_faults
 from geardyn.models.planetary_stiffness import FlankSeries, embedded, flank_series
-from geardyn.trains.elements import Gear
+from geardyn.trains.elements import Gear, pair_geometry
 
 _KINDS = (RootCrack, Spall, Wear, BrokenTooth)
 
@@ -146,7 +146,6 @@ def shared_wear_profiles(train: Any, placement: TrainFaults, loads: Mapping[str,
     one mesh (its own profile, as a pair's) or without Archard wear. Error ``wear.flank``: no
     mesh loads the worn flank."""
     from geardyn.gears.potential_energy import combined_wear_profile, prepare_pair
-    from geardyn.trains.train import _gear_mesh
 
     wears = [f for f in placement.faults if isinstance(f, Wear) and f.profile == "archard"]
     if len(placement.meshes) < 2 or not wears:
@@ -170,7 +169,7 @@ def shared_wear_profiles(train: Any, placement: TrainFaults, loads: Mapping[str,
             parts = []
             for name, w in zip(placement.meshes, weights, strict=True):
                 mesh = meshes[name]
-                pair = prepare_pair(_gear_mesh(mesh, train.bodies[mesh.a],
+                pair = prepare_pair(pair_geometry(mesh, train.bodies[mesh.a],
                                                train.bodies[mesh.b]),
                                     bore_radius=mesh.bore_radius)
                 role = "pinion" if placement.gear == mesh.a else "wheel"

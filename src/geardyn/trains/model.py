@@ -60,8 +60,9 @@ from geardyn.models.planetary import (
     planetary_layout,
 )
 from geardyn.models.planetary_stiffness import FlankSeries, coast_flank, flank_series, mirrored
+from geardyn.trains.elements import pair_geometry
 from geardyn.trains.faults import faulty_table, revolution_series, shared_wear_profiles
-from geardyn.trains.train import GearTrain, _gear_mesh
+from geardyn.trains.train import GearTrain
 from geardyn.units import si_value
 
 #: The sweep parameter of a train's input speed [rpm].
@@ -371,7 +372,7 @@ class TrainModel(PlanetaryGearSet):
             ga, gb = self.train.bodies[mesh.a], self.train.bodies[mesh.b]
             if getattr(ga, "geometry", None) is None or getattr(gb, "geometry", None) is None:
                 continue
-            pair = _gear_mesh(mesh, ga, gb)
+            pair = pair_geometry(mesh, ga, gb)
             out[mesh.name] = coast_phase(getattr(pair, "transverse", pair))
         return out
 
@@ -442,7 +443,7 @@ class TrainModel(PlanetaryGearSet):
         of g's loaded flank) and s [rad] (g's tooth angular thickness at m's operating pitch
         radius) of gear g in mesh m."""
         ga, gb = self.train.bodies[m.a], self.train.bodies[m.b]
-        pair = _gear_mesh(m, ga, gb)
+        pair = pair_geometry(m, ga, gb)
         pair, first = getattr(pair, "transverse", pair), g == m.a
         beta = m.angle if first and not m.internal else m.angle + math.pi
         e = -1.0 if (m.internal and not first) else 1.0
@@ -513,7 +514,7 @@ class TrainModel(PlanetaryGearSet):
                 if faulty:
                     z = self.faults.teeth
                     role = "pinion" if self.faults.gear == mesh.a else "wheel"
-                    pair = _gear_mesh(mesh, self.train.bodies[mesh.a],
+                    pair = pair_geometry(mesh, self.train.bodies[mesh.a],
                                       self.train.bodies[mesh.b])
                     on = self.faults.on_mesh(role, offsets[mesh.name])
                     table = faulty_table(self.train, mesh, pair, on, z, {
@@ -989,7 +990,7 @@ class TrainModel(PlanetaryGearSet):
             if len(members) == 1 and not first.internal \
                     and ga.geometry.teeth > gb.geometry.teeth:
                 ga, gb = gb, ga  # ISO's gear 1 of a single pair: the pinion
-            mesh = _gear_mesh(first, ga, gb)
+            mesh = pair_geometry(first, ga, gb)
             transverse = getattr(mesh, "transverse", mesh)
             other = first.a if common == first.b else first.b
             gc, go = train.bodies[common], train.bodies[other]

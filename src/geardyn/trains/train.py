@@ -35,7 +35,15 @@ import numpy as np
 
 from geardyn.errors import ParameterError
 from geardyn.models.modal import frequency_groups
-from geardyn.trains.elements import GROUND, Bearing, Gear, Inertia, Mesh, Shaft
+from geardyn.trains.elements import (
+    GROUND,
+    Bearing,
+    Gear,
+    Inertia,
+    Mesh,
+    Shaft,
+    pair_geometry,
+)
 from geardyn.trains.faults import place_train_faults
 from geardyn.units import si_value
 
@@ -71,31 +79,6 @@ def _line_of_action(mesh: Mesh, alpha: float) -> tuple[float, float]:
     return math.cos(beta), math.sin(beta)
 
 
-def _gear_mesh(mesh: Mesh, ga: Gear, gb: Gear) -> Any:
-    """The :class:`~geardyn.gears.GearMesh` (or :class:`~geardyn.gears.HelicalMesh`) of two
-    gears with geometry; its errors re-raised naming the mesh."""
-    from geardyn.gears.geometry import GearMesh
-    from geardyn.gears.helical import HelicalMesh
-
-    if ga.helical != gb.helical:
-        spur = mesh.a if gb.helical else mesh.b
-        raise ParameterError(f"{mesh.name}.{'a' if spur == mesh.a else 'b'}", spur,
-                             f"is a spur gear and {mesh.b if spur == mesh.a else mesh.a} a"
-                             " helical one: they cannot mesh")
-    if ga.helical and mesh.internal:
-        raise ParameterError(f"{mesh.name}.internal", True,
-                             "an internal helical mesh is not covered")
-    try:
-        if ga.helical:
-            return HelicalMesh(pinion=ga.geometry, wheel=gb.geometry,
-                               centre_distance=mesh.centre_distance)
-        return GearMesh(pinion=ga.geometry, wheel=gb.geometry,
-                        centre_distance=mesh.centre_distance, internal=mesh.internal)
-    except ParameterError as exc:
-        raise ParameterError(f"{mesh.name}.{exc.field}", exc.value,
-                             f"{exc.reason} (mesh of {mesh.a} with {mesh.b})") from None
-
-
 def _mesh_stiffness(mesh: Mesh, gear_mesh: Any, beta_b: float) -> tuple[float, str, Any]:
     """The mesh stiffness along the line of action [N/m], its method and the potential-energy
     table (None for the other methods). ISO 6336-1 and the sliced potential-energy method give
@@ -126,7 +109,7 @@ def resolve_mesh(mesh: Mesh, ga: Gear, gb: Gear) -> MeshData:
     sigma = -1.0 if mesh.internal else 1.0
     gear_mesh = None
     if ga.geometry is not None and gb.geometry is not None:
-        gear_mesh = _gear_mesh(mesh, ga, gb)
+        gear_mesh = pair_geometry(mesh, ga, gb)
     elif mesh.internal and gb.geometry is not None and not gb.geometry.internal:
         raise ParameterError(f"{mesh.name}.internal", True, f"{mesh.b} is not an internal gear")
     alpha = mesh.pressure_angle
