@@ -194,12 +194,18 @@ def test_the_diagonal_touches_at_radius_c_not_at_c_on_each_axis():
     assert contact.sel(mesh="bp_x").values.astype(str)[0] == "none"
 
 
-def test_a_sweep_reports_the_bearing_losing_contact():
-    ds = geardyn.bifurcation(_pair(), "input_speed", [3000.0, 5500.0],
-                             geardyn.RunSettings(transient=300, samples=16))
+def test_a_sweep_reports_the_bearing_losing_contact_and_equals_single_runs():
+    """The sweep's lane-block kernels (the radial contact's lane forms) give the single runs'
+    Poincare points bit for bit."""
+    run = geardyn.RunSettings(transient=300, samples=16, steps_per_period=128)
+    speeds = [3000.0, 5500.0]
+    ds = geardyn.bifurcation(_pair(), "input_speed", speeds, run)
     for row in ("bp_x", "bp_y"):  # one radial contact: both rows report it
         contact = ds["contact"].sel(mesh=row).values.astype(str)
         assert contact[0] == "none" and contact[1] != "none"
+    for j, rpm in enumerate(speeds):
+        sim = geardyn.simulate(_pair(rpm=rpm), run=run)
+        np.testing.assert_array_equal(ds["poincare"].values[j], sim["poincare"].values[-16:])
 
 
 def _coupled(backlash: float) -> TrainModel:
