@@ -705,23 +705,14 @@ def _lane_deflection(Y, PT, k, n, o, w, i0, i1, i2, i3, i4, i5, s, c, om):
 
 
 @nb.njit(inline="always", **_JIT)
-def _lane_other_row(Y, PT, k, n, o, q, s, c, om):
-    """Lane k's deflection of the other row of the radial contact whose block is at o (its
-    structure at q): the block ``radial`` blocks away, as :func:`_lane_deflection`."""
-    j = int(PT[o + M_RADIAL, k])
-    op = o + j * block_size(n, int(PT[N_HARM, k]))
+def _other_row(PT, n, o, q):
+    """The other row of the radial contact whose block is at o (structure at q): its block's
+    offset, its weights' row and its six dofs, from column 0 (structure: the same in every
+    lane), so that the lane loops index it as they index the contact's own row."""
+    j = int(PT[o + M_RADIAL, 0])
     qp = q + j * 3 * MESH_NZ
     i0, i1, i2, i3, i4, i5 = _mesh_dofs(PT, qp)
-    d, _ = _lane_deflection(Y, PT, k, n, op, qp + MESH_NZ, i0, i1, i2, i3, i4, i5, s, c, om)
-    return d
-
-
-@nb.njit(inline="always", **_JIT)
-def _lane_radial(Y, PT, k, n, o, q, d, s, c, om):
-    """Lane k's g of the radial contact whose block is at o (structure at q) at its row's
-    deflection d: :func:`_zone`'s radial branch, the same operations."""
-    dp = _lane_other_row(Y, PT, k, n, o, q, s, c, om)
-    return radial_zone(d, _radius(d, dp, PT[o + M_RADIAL, k]), PT[o + M_B, k])
+    return o + j * block_size(n, int(PT[N_HARM, 0])), qp + MESH_NZ, i0, i1, i2, i3, i4, i5
 
 
 @nb.njit(inline="always", **_JIT)
@@ -731,14 +722,18 @@ def _lanes_mesh(Y, DY, PT, nl, S, C, SC, n, o, q, row, apply, two, rowc):
     (observables). One store stream per lane loop, so that the loops vectorise. With ``two``
     the coast flank's KF_coast c_m(theta) (relative stiffness in PT[rowc]) acts where the dead
     zone's output is negative; the drive flank's arithmetic is the same either way. A radial
-    contact takes its g from :func:`_lane_radial`."""
+    contact's g takes its other row's deflection (:func:`_other_row`), as :func:`_zone`."""
     i0, i1, i2, i3, i4, i5 = _mesh_dofs(PT, q)
     w = q + MESH_NZ
-    if PT[o + M_RADIAL, 0] != 0.0:
+    kind = PT[o + M_RADIAL, 0]
+    if kind != 0.0:
+        op, wp, j0, j1, j2, j3, j4, j5 = _other_row(PT, n, o, q)
         for k in range(nl):
             d, v = _lane_deflection(Y, PT, k, n, o, w, i0, i1, i2, i3, i4, i5, S[k], C[k],
                                     PT[OMEGA, k])
-            g = _lane_radial(Y, PT, k, n, o, q, d, S[k], C[k], PT[OMEGA, k])
+            dp, _ = _lane_deflection(Y, PT, k, n, op, wp, j0, j1, j2, j3, j4, j5, S[k], C[k],
+                                     PT[OMEGA, k])
+            g = radial_zone(d, _radius(d, dp, kind), PT[o + M_B, k])
             kf = PT[o + M_KF, k] * PT[row, k]
             if two and g < 0.0:
                 kf = PT[o + M_KFC, k] * PT[rowc, k]
@@ -846,8 +841,11 @@ def _lanes_multi_order(PT, nl):
 
 @nb.njit(inline="always", **_JIT)
 def _lanes_order_one(PT, nl, o):
-    """Whether the mesh whose block is at o has order 1 in every lane of the block (then the
-    shared-phase forms serve it)."""
+    """Whether the mesh whose block is at o has order 1 in every lane of the block, or is a
+    radial contact (no error, relative stiffness 1: its phase is unused, and its values are
+    those at any phase), so that the shared-phase forms serve it."""
+    if PT[o + M_RADIAL, 0] != 0.0:
+        return True
     one = True
     for k in range(nl):
         one &= PT[o + M_ORDER, k] == 1.0
@@ -966,16 +964,12 @@ def _lanes_mesh_own(Y, DY, PT, nl, SC, n, nm, o, q, r, apply):
     flanks and the dead zone's output is negative."""
     i0, i1, i2, i3, i4, i5 = _mesh_dofs(PT, q)
     w = q + MESH_NZ
-    radial = PT[o + M_RADIAL, 0] != 0.0
     for k in range(nl):
         order = PT[o + M_ORDER, k]
         om = PT[OMEGA, k] if order == 1.0 else order * PT[OMEGA, k]
         d, v = _lane_deflection(Y, PT, k, n, o, w, i0, i1, i2, i3, i4, i5, PT[r, k],
                                 PT[r + nm, k], om)
-        if radial:
-            g = _lane_radial(Y, PT, k, n, o, q, d, PT[r, k], PT[r + nm, k], om)
-        else:
-            g = dead_zone(d, PT[o + M_B, k])
+        g = dead_zone(d, PT[o + M_B, k])
         kd = PT[o + M_KF, k] * PT[r + 2 * nm, k]
         kc = PT[o + M_KFC, k] * PT[r + 3 * nm, k]
         kf = kc if (PT[TWO_FLANK, k] != 0.0) & (g < 0.0) else kd
@@ -989,13 +983,9 @@ def _events_lanes_own(Y, G, PT, nl, n, nm, m, o, q, r):
     mesh's own phase (sin and cos at rows r, r + nm of the own-phase cache)."""
     i0, i1, i2, i3, i4, i5 = _mesh_dofs(PT, q)
     w = q + MESH_NZ
-    radial = PT[o + M_RADIAL, 0] != 0.0
     for k in range(nl):
         d, _ = _lane_deflection(Y, PT, k, n, o, w, i0, i1, i2, i3, i4, i5, PT[r, k],
                                 PT[r + nm, k], 0.0)
-        if radial:
-            dp = _lane_other_row(Y, PT, k, n, o, q, PT[r, k], PT[r + nm, k], 0.0)
-            d = _radius(d, dp, PT[o + M_RADIAL, k])
         G[2 * m, k] = d - PT[o + M_B, k]
         G[2 * m + 1, k] = d + PT[o + M_B, k]
 
@@ -1006,10 +996,13 @@ def _events_lanes_radial(Y, G, PT, nl, n, m, o, q, S, C):
     q): r - b and r + b, r the radius of its two rows' deflections (:func:`_radius`)."""
     i0, i1, i2, i3, i4, i5 = _mesh_dofs(PT, q)
     w = q + MESH_NZ
+    kind = PT[o + M_RADIAL, 0]
+    op, wp, j0, j1, j2, j3, j4, j5 = _other_row(PT, n, o, q)
     for k in range(nl):
         d, _ = _lane_deflection(Y, PT, k, n, o, w, i0, i1, i2, i3, i4, i5, S[k], C[k],
                                 PT[OMEGA, k])
-        dp = _lane_other_row(Y, PT, k, n, o, q, S[k], C[k], PT[OMEGA, k])
-        r = _radius(d, dp, PT[o + M_RADIAL, k])
+        dp, _ = _lane_deflection(Y, PT, k, n, op, wp, j0, j1, j2, j3, j4, j5, S[k], C[k],
+                                 PT[OMEGA, k])
+        r = _radius(d, dp, kind)
         G[2 * m, k] = r - PT[o + M_B, k]
         G[2 * m + 1, k] = r + PT[o + M_B, k]
