@@ -111,6 +111,12 @@ def planetary_layout(dofs: tuple[str, ...], mesh_names: tuple[str, ...], nh: int
                           "order differs from 1)")
     out.place(pk.own_cache_names(len(mesh_names)), own)
     return out
+
+
+#: Newton steps of :meth:`PlanetaryGearSet.static_state` with a radial contact, and the step
+#: (relative to the largest coordinate) at which it has converged.
+STATIC_ITERATIONS = 50
+STATIC_STEP_TOL = 1e-13
 _SHORT = {"carrier": "c", "ring": "r", "sun": "s"}
 #: Constructor inputs that fix the model's layout or are not numbers: not swept by name.
 _NOT_SWEPT = {"n_planets", "waveform", "coast_waveform", "harmonics", "mesh_order",
@@ -1562,7 +1568,8 @@ class PlanetaryGearSet(Model):
         """Dimensionless coordinates X of the quasi-static state under the mean torques (mean
         stiffness, no error), each loaded mesh on its loaded flank: A X = F0 + sum kf b s G,
         the flank signs s iterated (a mesh on its coast flank, s < 0, with the coast flank's
-        mean stiffness); least squares where a rigid-body mode leaves A singular."""
+        mean stiffness); least squares where a rigid-body mode leaves A singular. With a
+        radial contact (:mod:`~geardyn.models.planetary_kernels`): :meth:`_radial_static`."""
         lay = self._layout
         n, nm, nh = int(self.params[pk.N_DOF]), int(self.params[pk.N_MESH]), \
             int(self.params[pk.N_HARM])
@@ -1570,6 +1577,8 @@ class PlanetaryGearSet(Model):
         F0 = self.params[lay["F0"]:lay["F0"] + n]
         f = pk.MESH_FIXED + 2 * nh
         blocks = [self.params[lay["mesh"] + m * lay["block"]:][:lay["block"]] for m in range(nm)]
+        if any(b[pk.M_RADIAL] != 0.0 for b in blocks):
+            return self._radial_static(A, F0, blocks, f, n)
         sign = np.zeros(nm)
         X = np.zeros(n)
         two = self.params[pk.TWO_FLANK] != 0.0
@@ -1589,6 +1598,67 @@ class PlanetaryGearSet(Model):
                 break
             sign = new
         return X
+
+    def _radial_static(self, A0: np.ndarray, F0: np.ndarray, blocks: list[np.ndarray], f: int,
+                       n: int) -> np.ndarray:
+        """:meth:`static_state` with radial contacts (x row m, y row m + 1): in A X = F0 + sum
+        kf b s G, s of a radial row is its deflection over max(r, b) (kf (1 - b / r) (x, y) in
+        contact, no force inside the clearance), a dead zone's s its sign. Every contact starts
+        in contact along the linear state's deflection (one step of the sign iteration), then
+        Newton's method (least squares) until the step is below ``STATIC_STEP_TOL`` of X with
+        the signs settled."""
+        W = np.array([b[f:f + n] for b in blocks])
+        G = np.array([b[f + n:f + 2 * n] for b in blocks])
+        kind = np.array([b[pk.M_RADIAL] for b in blocks])
+        kfd = np.array([b[pk.M_KF] for b in blocks])
+        kfc = np.array([b[pk.M_KFC] for b in blocks])
+        half = np.array([b[pk.M_B] for b in blocks])
+        lay = self._layout
+        Kt = self.params[lay["Kt"]:lay["Kt"] + n * n].reshape(n, n)
+        two = self.params[pk.TWO_FLANK] != 0.0
+        xs = np.flatnonzero(kind > 0.0)
+
+        def shares(X: np.ndarray, start: bool) -> tuple[np.ndarray, np.ndarray]:
+            """s of every contact at X and the dead zones' signs (``start``: every radial
+            contact in contact along its deflection)."""
+            d = W @ X
+            s = np.sign(d)
+            for m in xs:
+                r = math.hypot(d[m], d[m + 1])
+                scale = r if start else max(r, half[m])
+                s[m:m + 2] = d[m:m + 2] / scale if scale > 0.0 else 0.0
+            return s, np.sign(d)
+
+        def matrix(sign: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+            kf = np.where(two & (sign < 0.0) & (kind == 0.0), kfc, kfd)
+            return (Kt + (kf[:, None] * G).T @ W if two else A0), kf
+
+        X = _clean(np.linalg.lstsq(A0, F0, rcond=None)[0])
+        s, sign = shares(X, True)
+        A, kf = matrix(sign)
+        X = np.linalg.lstsq(A, F0 + (kf * half * s) @ G, rcond=None)[0]
+        for _ in range(STATIC_ITERATIONS):
+            s, new = shares(X, False)
+            A, kf = matrix(new)
+            J = A.copy()
+            d = W @ X
+            for m in xs:
+                x, y = d[m], d[m + 1]
+                r = math.hypot(x, y)
+                if r > half[m]:  # d(x / r) / dX and d(y / r) / dX
+                    gx = (y * y * W[m] - x * y * W[m + 1]) / r**3
+                    gy = (x * x * W[m + 1] - x * y * W[m]) / r**3
+                else:  # d / b
+                    gx, gy = W[m] / half[m], W[m + 1] / half[m]
+                J -= kf[m] * half[m] * (np.outer(G[m], gx) + np.outer(G[m + 1], gy))
+            step = np.linalg.lstsq(J, A @ X - F0 - (kf * half * s) @ G, rcond=None)[0]
+            X = X - step
+            if np.max(np.abs(step)) <= STATIC_STEP_TOL * np.max(np.abs(X)) \
+                    and np.array_equal(new, sign):
+                return _clean(X)
+            sign = new
+        raise ParameterError("static_state", None, "the quasi-static state with a radial "
+                             f"contact did not converge in {STATIC_ITERATIONS} Newton steps")
 
     def bearing_forces(self, y: np.ndarray) -> dict[str, np.ndarray]:
         """Bearing forces [N] at states ``y`` (..., n_states; e.g. stacked from a
@@ -1635,6 +1705,11 @@ class PlanetaryGearSet(Model):
             two = self.params[pk.TWO_FLANK] != 0.0
             kf = b[pk.M_KFC] if two and d < -b[pk.M_B] else b[pk.M_KF]
             out[m] = kf * (d - min(max(d, -b[pk.M_B]), b[pk.M_B]))
+            j = int(b[pk.M_RADIAL])
+            if j:  # a radial contact: its component of kf (1 - b / r) (x, y)
+                other = self.params[lay["mesh"] + (m + j) * lay["block"]:][:lay["block"]]
+                r = math.hypot(d, other[f:f + n] @ X)
+                out[m] = b[pk.M_KF] * (1.0 - b[pk.M_B] / r) * d if r > b[pk.M_B] else 0.0
         return out
 
     def __repr__(self) -> str:

@@ -72,6 +72,11 @@ MESH = CoefficientBlock((
     Coefficient("order", "1", "the mesh's frequency over the forcing frequency Omega (1: the "
                 "forcing mesh's; a gear train's other stages differ)", default=1.0,
                 exclusive_minimum=0.0, constant="M_ORDER"),
+    structure_entry("radial", "the contact's kind: 0 a dead zone g(x, b) of its own deflection x "
+                    "(a mesh, a coupling's backlash); +1 or -1 the x or the y row of a radial "
+                    "(circular) clearance of radius b, whose other row is the next (+1) or the "
+                    "previous (-1) block: g = (1 - b / r) x for r = sqrt(x^2 + y^2) > b, else 0",
+                    constant="M_RADIAL"),
 ))
 #: Per coordinate d of a mesh: its deflection row W_d and M^-1 W / (L omega_0^2), G_d.
 MESH_ROW = CoefficientBlock((

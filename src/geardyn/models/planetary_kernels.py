@@ -16,6 +16,12 @@ other side (x < -b). f_m is the dynamic mesh force [N], the observable. Where no
 flank differs from its drive flank (the header flag ``TWO_FLANK`` 0) the coast entries are not
 read: the arithmetic is the one-flank form's, operation for operation.
 
+A contact may be radial (the block's ``radial`` entry +1 or -1, structure: a gear train's bearing
+clearance): two consecutive blocks are the x and the y row of one circular dead zone of radius
+b, g = (1 - b / r) x and (1 - b / r) y for r = sqrt(x^2 + y^2) > b, else 0 (each block's g from
+both rows' deflections, :func:`radial_zone`; continuous at r = b, its derivative not). Both
+blocks' switching functions are r - b and r + b (the pair crosses them together).
+
 theta is the mesh (forcing) phase the solver supplies as ``s, c`` = sin, cos theta (Omega tau
 from the start of a run or of a continued lane): the stiffness, the transmission error in the
 right-hand side and in the switching functions, and a torque fluctuation of integer order r
@@ -76,7 +82,7 @@ HEADER = HEADER_BLOCK.size
 # mesh block fixed entries
 _M = MESH.offset
 M_B, M_ES, M_EC, M_KF, M_CF = _M("b"), _M("E_s"), _M("E_c"), _M("KF"), _M("CF")
-M_KFC, M_ORDER = _M("KF_coast"), _M("order")
+M_KFC, M_ORDER, M_RADIAL = _M("KF_coast"), _M("order"), _M("radial")
 MESH_FIXED = MESH.size
 #: Structural entries per mesh row in the structure section (padded with zero weights).
 MESH_NZ = 6
@@ -284,10 +290,41 @@ def _mesh_state(y, p, o, q, n, s, c, om):
 
 
 @nb.njit(inline="always", **_JIT)
+def radial_zone(x, r, b):
+    """The radial dead zone's component along x: (1 - b / r) x for r > b, else 0 (r the
+    radius sqrt(x^2 + y^2) of the deflection, b the clearance); continuous at r = b."""
+    if r > b:
+        return (1.0 - b / r) * x
+    return 0.0
+
+
+@nb.njit(inline="always", **_JIT)
+def _radius(d, dp, kind):
+    """r = sqrt(x^2 + y^2) of a radial contact from its row's deflection d and its other row's
+    dp, x first (``kind`` +1: d is x), so that both rows get the same r bitwise."""
+    if kind > 0.0:
+        return math.sqrt(d * d + dp * dp)
+    return math.sqrt(dp * dp + d * d)
+
+
+@nb.njit(inline="always", **_JIT)
+def _zone(y, p, o, q, n, bs, d, s, c, om):
+    """The contact's g at its deflection d (block at o, structure at q): the dead zone g(d, b),
+    or for a radial contact (``radial`` +-1) its component of the radial dead zone, with its
+    other row's deflection from the block ``radial`` blocks away (:func:`radial_zone`)."""
+    kind = p[o + M_RADIAL]
+    if kind == 0.0:
+        return dead_zone(d, p[o + M_B])
+    j = int(kind)
+    dp, _ = _mesh_state(y, p, o + j * bs, q + j * 3 * MESH_NZ, n, s, c, om)
+    return radial_zone(d, _radius(d, dp, kind), p[o + M_B])
+
+
+@nb.njit(inline="always", **_JIT)
 def _mesh_force(t, y, p, o, q, n, nh, s, c):
     s, c, om = _mesh_phase(t, p[o + M_ORDER], p[OMEGA], s, c)
     d, v = _mesh_state(y, p, o, q, n, s, c, om)
-    g = dead_zone(d, p[o + M_B])
+    g = _zone(y, p, o, q, n, block_size(n, nh), d, s, c, om)
     if g < 0.0 and p[TWO_FLANK] != 0.0:  # the coast flank
         kc = harmonic_factor(p, o + coast_offset(n, nh), nh, s, c)
         return p[o + M_KFC] * kc * g + p[o + M_CF] * v
@@ -316,8 +353,10 @@ def _mesh_forces_shared(y, out, p, n, nm, nh, mesh, bs, mz, s, c):
             out[m] = 1.0 + out[m]
     for m in range(nm):
         o = mesh + m * bs
-        d, v = _mesh_state(y, p, o, mz + m * 3 * MESH_NZ, n, s, c, p[OMEGA])
-        out[m] = p[o + M_KF] * out[m] * dead_zone(d, p[o + M_B]) + p[o + M_CF] * v
+        q = mz + m * 3 * MESH_NZ
+        d, v = _mesh_state(y, p, o, q, n, s, c, p[OMEGA])
+        out[m] = p[o + M_KF] * out[m] * _zone(y, p, o, q, n, bs, d, s, c, p[OMEGA]) \
+            + p[o + M_CF] * v
 
 
 @nb.njit(inline="always", **_JIT)
@@ -374,12 +413,19 @@ def planetary_rhs(t, y, dy, p, s, c):
 @nb.njit(**_JIT)
 def planetary_events(t, y, g, p, s, c):
     """Dead-zone edges: x_m - b_m and x_m + b_m of every mesh (x_m = W_m . X - e_m, the error
-    at the mesh's phase, :func:`_mesh_phase`)."""
+    at the mesh's phase, :func:`_mesh_phase`); x_m is the radius r of a radial contact (both
+    its rows: r - b, r + b)."""
     n, nm, nh, mesh, bs, st, mz = _offsets(p)
     for m in range(nm):
         o = mesh + m * bs
+        q = mz + m * 3 * MESH_NZ
         sm, cm, om = _mesh_phase(t, p[o + M_ORDER], p[OMEGA], s, c)
-        d, _ = _mesh_state(y, p, o, mz + m * 3 * MESH_NZ, n, sm, cm, om)
+        d, _ = _mesh_state(y, p, o, q, n, sm, cm, om)
+        kind = p[o + M_RADIAL]
+        if kind != 0.0:
+            j = int(kind)
+            dp, _ = _mesh_state(y, p, o + j * bs, q + j * 3 * MESH_NZ, n, sm, cm, om)
+            d = _radius(d, dp, kind)
         g[2 * m] = d - p[o + M_B]
         g[2 * m + 1] = d + p[o + M_B]
 
@@ -659,14 +705,41 @@ def _lane_deflection(Y, PT, k, n, o, w, i0, i1, i2, i3, i4, i5, s, c, om):
 
 
 @nb.njit(inline="always", **_JIT)
+def _other_row(PT, n, o, q):
+    """The other row of the radial contact whose block is at o (structure at q): its block's
+    offset, its weights' row and its six dofs, from column 0 (structure: the same in every
+    lane), so that the lane loops index it as they index the contact's own row."""
+    j = int(PT[o + M_RADIAL, 0])
+    qp = q + j * 3 * MESH_NZ
+    i0, i1, i2, i3, i4, i5 = _mesh_dofs(PT, qp)
+    return o + j * block_size(n, int(PT[N_HARM, 0])), qp + MESH_NZ, i0, i1, i2, i3, i4, i5
+
+
+@nb.njit(inline="always", **_JIT)
 def _lanes_mesh(Y, DY, PT, nl, S, C, SC, n, o, q, row, apply, two, rowc):
     """Mesh force of the block at o (structure at q, relative stiffness in PT[row]) for every
     lane, into SC[0], then subtracted from the accelerations DY (``apply``) or copied to DY[0]
     (observables). One store stream per lane loop, so that the loops vectorise. With ``two``
     the coast flank's KF_coast c_m(theta) (relative stiffness in PT[rowc]) acts where the dead
-    zone's output is negative; the drive flank's arithmetic is the same either way."""
+    zone's output is negative; the drive flank's arithmetic is the same either way. A radial
+    contact's g takes its other row's deflection (:func:`_other_row`), as :func:`_zone`."""
     i0, i1, i2, i3, i4, i5 = _mesh_dofs(PT, q)
     w = q + MESH_NZ
+    kind = PT[o + M_RADIAL, 0]
+    if kind != 0.0:
+        op, wp, j0, j1, j2, j3, j4, j5 = _other_row(PT, n, o, q)
+        for k in range(nl):
+            d, v = _lane_deflection(Y, PT, k, n, o, w, i0, i1, i2, i3, i4, i5, S[k], C[k],
+                                    PT[OMEGA, k])
+            dp, _ = _lane_deflection(Y, PT, k, n, op, wp, j0, j1, j2, j3, j4, j5, S[k], C[k],
+                                     PT[OMEGA, k])
+            g = radial_zone(d, _radius(d, dp, kind), PT[o + M_B, k])
+            kf = PT[o + M_KF, k] * PT[row, k]
+            if two and g < 0.0:
+                kf = PT[o + M_KFC, k] * PT[rowc, k]
+            SC[0, k] = kf * g + PT[o + M_CF, k] * v
+        _lanes_apply(DY, PT, nl, SC, n, q, apply)
+        return
     for k in range(nl):
         d, v = _lane_deflection(Y, PT, k, n, o, w, i0, i1, i2, i3, i4, i5, S[k], C[k],
                                 PT[OMEGA, k])
@@ -705,6 +778,9 @@ def planetary_events_lanes(T, Y, G, PT, nl, S, C):
         q = mz + m * 3 * MESH_NZ
         if multi and not _lanes_order_one(PT, nl, o):
             _events_lanes_own(Y, G, PT, nl, n, nm, m, o, q, ko + m)
+            continue
+        if PT[o + M_RADIAL, 0] != 0.0:
+            _events_lanes_radial(Y, G, PT, nl, n, m, o, q, S, C)
             continue
         w = q + MESH_NZ
         i0 = int(PT[q, 0])
@@ -765,8 +841,11 @@ def _lanes_multi_order(PT, nl):
 
 @nb.njit(inline="always", **_JIT)
 def _lanes_order_one(PT, nl, o):
-    """Whether the mesh whose block is at o has order 1 in every lane of the block (then the
-    shared-phase forms serve it)."""
+    """Whether the mesh whose block is at o has order 1 in every lane of the block, or is a
+    radial contact (no error, relative stiffness 1: its phase is unused, and its values are
+    those at any phase), so that the shared-phase forms serve it."""
+    if PT[o + M_RADIAL, 0] != 0.0:
+        return True
     one = True
     for k in range(nl):
         one &= PT[o + M_ORDER, k] == 1.0
@@ -909,3 +988,21 @@ def _events_lanes_own(Y, G, PT, nl, n, nm, m, o, q, r):
                                 PT[r + nm, k], 0.0)
         G[2 * m, k] = d - PT[o + M_B, k]
         G[2 * m + 1, k] = d + PT[o + M_B, k]
+
+
+@nb.njit(inline="always", **_JIT)
+def _events_lanes_radial(Y, G, PT, nl, n, m, o, q, S, C):
+    """:func:`planetary_events_lanes`' rows of the radial contact m (block at o, structure at
+    q): r - b and r + b, r the radius of its two rows' deflections (:func:`_radius`)."""
+    i0, i1, i2, i3, i4, i5 = _mesh_dofs(PT, q)
+    w = q + MESH_NZ
+    kind = PT[o + M_RADIAL, 0]
+    op, wp, j0, j1, j2, j3, j4, j5 = _other_row(PT, n, o, q)
+    for k in range(nl):
+        d, _ = _lane_deflection(Y, PT, k, n, o, w, i0, i1, i2, i3, i4, i5, S[k], C[k],
+                                PT[OMEGA, k])
+        dp, _ = _lane_deflection(Y, PT, k, n, op, wp, j0, j1, j2, j3, j4, j5, S[k], C[k],
+                                 PT[OMEGA, k])
+        r = _radius(d, dp, kind)
+        G[2 * m, k] = r - PT[o + M_B, k]
+        G[2 * m + 1, k] = r + PT[o + M_B, k]

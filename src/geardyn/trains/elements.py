@@ -180,10 +180,12 @@ class Bearing:
 
     On a carrier, the bearing's pin sits at ``radius`` [m] and ``angle`` [rad] from the
     carrier's axis, so the carrier's rotation moves it tangentially by radius * theta_carrier.
-    ``clearance`` [m]: the play of a flexible bearing, in the nonlinear model
-    (:class:`~geardyn.trains.TrainModel`) a dead zone of that half-width in each of x and y
-    (a square clearance: the body touches at c on the axes, at c sqrt(2) on the diagonals); the
-    linear model ignores it (bearing in contact). A finite stiffness gives ``body`` lateral
+    ``clearance`` [m]: the radial play c of a flexible bearing, in the nonlinear model
+    (:class:`~geardyn.trains.TrainModel`) a circular dead zone on the journal's deflection
+    (x, y) relative to its host: no force for r = sqrt(x^2 + y^2) <= c, k (1 - c / r) (x, y)
+    beyond (the journal touches at radius c in every direction); ``damping`` acts on the
+    deflection rate at all times, inside the clearance too. The linear model ignores it
+    (bearing in contact). A finite stiffness gives ``body`` lateral
     degrees of freedom (x, y), which need its mass; a rigid bearing carries the body with the
     host and has no clearance.
     """

@@ -27,6 +27,11 @@ mesh frequency over omega_0; mesh m turns at r_m = order_m / order_ref times it 
 the forcing quasi-periodic (no common period; sections are then taken once per period of the
 reference mesh, and periodic orbits and their continuation are refused).
 
+Play besides the meshes (:meth:`TrainModel.play_elements`) is contacts after the meshes with
+constant stiffness: a coupling's backlash a dead zone on its twist, a bearing's clearance c a
+radial contact of two rows (x, y), force -k (1 - c / r) (x, y) for r = sqrt(x^2 + y^2) > c,
+else 0, switching on r - c; the elements' damping stays linear, in Ct.
+
 Tooth faults (the train's ``faults``, :mod:`geardyn.trains.faults`) on gear f (Z_f teeth, its
 meshes at r_f) make the forcing period one revolution of f relative to its meshes' frame:
 ``mesh_order`` N = Z_f / r_f reference-mesh cycles, Omega = the reference mesh frequency / (N
@@ -41,7 +46,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -84,6 +89,22 @@ _UNITS = {"mesh_frequency": "rad/s", INPUT_SPEED: "rpm", INPUT_TORQUE: "N m", "b
           "mesh_damping": "1",
           "modal_damping": "1", "stiffness_fluctuation": "1", "mesh_error": "m",
           "torque_fluctuation": "1", "torque_order": "1", "torque_phase": "rad"}
+
+
+class PlayElement(NamedTuple):
+    """An element with play besides the meshes (:meth:`TrainModel.play_elements`)."""
+
+    #: The contact's name.
+    name: str
+    #: Its deflection row in the model's coordinates [m or rad per coordinate].
+    row: np.ndarray
+    #: Its stiffness [N/m or N m/rad].
+    stiffness: float
+    #: The dead zone's half-width, or the radial contact's radius [m or rad].
+    half_width: float
+    #: 0: a dead zone on the row's deflection; 1 or -1: the x or the y row of a radial
+    #: contact whose other row is the next or the previous element.
+    radial: int
 
 
 def _per_mesh(field: str, value: Any, meshes: tuple[str, ...], kind: str,
@@ -729,13 +750,13 @@ class TrainModel(PlanetaryGearSet):
         Minv[np.abs(Minv) < 1e-12 * np.max(np.abs(Minv))] = 0.0
         K, C = self.stiffness_matrix(False), self._damping_matrix()
         plays = self.play_elements()
-        for _, row, k_play, _ in plays:  # acts through its dead zone instead
+        for _, row, k_play, _, _ in plays:  # acts through its dead zone instead
             K -= k_play * np.outer(row, row)
         Kt = _clean(Minv @ K)
         kt_entries = [(int(i), int(j)) for i, j in zip(*np.nonzero(Kt), strict=True)]
         W = self.mesh_rows()
-        contacts = self._mesh_names + tuple(name for name, _, _, _ in plays)
-        rows = list(W) + [row for _, row, _, _ in plays]
+        contacts = self._mesh_names + tuple(play.name for play in plays)
+        rows = list(W) + [play.row for play in plays]
         mesh_dofs = []
         for m, row in enumerate(rows):
             touched = sorted({int(j) for j in np.nonzero(row)[0]}
@@ -765,10 +786,10 @@ class TrainModel(PlanetaryGearSet):
             self._fill_mesh_block(p[o:o + lay["block"]], m, L, w0, k[m], c[m], kc[m],
                                   self._phase_orders[m], W[m],
                                   _clean(Minv @ W[m]) / (L * w0 * w0))
-        for j, (_, row, k_play, half_width) in enumerate(plays):
+        for j, (_, row, k_play, half_width, radial) in enumerate(plays):
             o = lay["mesh"] + (nm_gears + j) * lay["block"]
             _fill_play_block(p[o:o + lay["block"]], nh, row, _clean(Minv @ row) / (L * w0 * w0),
-                             k_play * L, half_width / L)
+                             k_play * L, half_width / L, radial)
         self._layout = lay
         self._coast_given = self._mirrored
         self._coast_built = p[_flank_index(lay, n, nm, nh, True)].copy()
@@ -784,23 +805,24 @@ class TrainModel(PlanetaryGearSet):
         self.event_names = tuple(f"x_{m}{s}b_{m}" for m in contacts for s in "-+")
         self.meshes = tuple((m, 2 * i, 2 * i + 1) for i, m in enumerate(contacts))
 
-    def play_elements(self) -> list[tuple[str, np.ndarray, float, float]]:
+    def play_elements(self) -> list[PlayElement]:
         """The elements with play besides the meshes, as the kernels' contacts after the
-        meshes: (name, deflection row in the model's coordinates [m or rad per coordinate],
-        stiffness [N/m or N m/rad], half-width [m or rad]). A flexible bearing with a
-        ``clearance`` gives two, ``<bearing>_x`` and ``<bearing>_y`` (its deflection in x and in
-        y, each through a dead zone of the clearance); a shaft (coupling) with ``backlash`` one,
-        ``<shaft>`` (its twist). The element's damping stays linear (it acts in the play too)."""
+        meshes (:class:`PlayElement`). A flexible bearing with a ``clearance`` c gives two,
+        ``<bearing>_x`` and ``<bearing>_y``, the x and y rows of one radial contact (radial 1
+        and -1): a circular dead zone of radius c on the journal's deflection (x, y) relative
+        to its host, force k (1 - c / r) (x, y) for r = sqrt(x^2 + y^2) > c, else 0. A shaft
+        (coupling) with ``backlash`` gives one, ``<shaft>``, a dead zone of that half-width on
+        its twist (radial 0). The element's damping stays linear (it acts in the play too)."""
         train, out = self.train, []
         for b in train.bearings:
             if b.clearance > 0.0:
                 rx, ry = train._bearing_rows(b) @ train._T
-                out += [(f"{b.name}_x", rx, b.stiffness, b.clearance),
-                        (f"{b.name}_y", ry, b.stiffness, b.clearance)]
+                out += [PlayElement(f"{b.name}_x", rx, b.stiffness, b.clearance, 1),
+                        PlayElement(f"{b.name}_y", ry, b.stiffness, b.clearance, -1)]
         for s in train.shafts:
             if s.backlash > 0.0:
                 row = (train._unit(s.a, 0) - train._unit(s.b, 0)) @ train._T
-                out.append((s.name, row, s.stiffness, s.backlash))
+                out.append(PlayElement(s.name, row, s.stiffness, s.backlash, 0))
         return out
 
     # ------------------------------------------------------------------ sweeps and axes
@@ -1033,14 +1055,16 @@ class TrainModel(PlanetaryGearSet):
 
 
 def _fill_play_block(blk: np.ndarray, nh: int, row: np.ndarray, force_row: np.ndarray,
-                     force_per_deflection: float, half_width: float) -> None:
+                     force_per_deflection: float, half_width: float, radial: int) -> None:
     """A play element's block of the coefficient vector (a mesh block of
-    :mod:`~geardyn.models.planetary_kernels` with constant stiffness): its half-width, force
-    per dimensionless deflection on both flanks, order 1 and no harmonics (relative stiffness
-    1), its ``row`` and ``force_row``; no error, no own damping."""
+    :mod:`~geardyn.models.planetary_kernels` with constant stiffness): its half-width (a
+    radial contact's radius), force per dimensionless deflection on both flanks, order 1 and
+    no harmonics (relative stiffness 1), its kind ``radial`` (0: a dead zone; 1, -1: the x, y
+    row of a radial contact), its ``row`` and ``force_row``; no error, no own damping."""
     n = row.size
     f = pk.MESH_FIXED
     blk[pk.M_B] = half_width
+    blk[pk.M_RADIAL] = radial
     blk[pk.M_KF] = blk[pk.M_KFC] = force_per_deflection
     blk[pk.M_ORDER] = 1.0
     blk[f + 2 * nh:f + 2 * nh + n] = row
