@@ -157,3 +157,150 @@ def test_a_study_without_a_store_or_a_dataset_is_refused(tmp_path):
     path.write_text(GEARS + DATASET)
     r = invoke("dataset", path, "-q")
     assert r.returncode == 2 and "error: --store" in r.stderr
+
+
+# ---------------------------------------------------------------------------------------------
+# a planetary study: the ring sensor's dataset of the stage built from [params.geometry]
+
+PLANETARY = """[study]
+name = "tiny_planetary_dataset"
+model = "planetary"
+[params]
+n_planets = 4
+sun_backlash = "10 um"
+ring_backlash = "10 um"
+mesh_damping = 0.03
+modal_damping = 0.02
+sun_torque = "20 N m"
+harmonics = 15
+[params.geometry]
+module = "2 mm"
+pressure_angle = "20 deg"
+face_width = "20 mm"
+stiffness = "potential_energy"
+[params.geometry.stiffness_options]
+sun_bore_radius = "12 mm"
+planet_bore_radius = "10 mm"
+ring_rim_radius = "85 mm"
+angles = 32
+[params.geometry.sun]
+teeth = 25
+[params.geometry.planet]
+teeth = 23
+[params.geometry.ring]
+teeth = 71
+[params.sun]
+mass = 0.31
+inertia_over_r2 = 0.17
+bearing_stiffness = 1e8
+[params.planet]
+mass = 0.26
+inertia_over_r2 = 0.15
+bearing_stiffness = 1e8
+[params.ring]
+mass = 0.67
+inertia_over_r2 = 0.86
+bearing_stiffness = 1e8
+torsional_stiffness = 1e9
+[params.carrier]
+mass = 1.5
+inertia_over_r2 = 1.0
+bearing_stiffness = 1e8
+torsional_stiffness = 1e9
+"""
+PLANETARY_DATASET = """[dataset]
+speeds = [3000.0]
+torques = [30.0]
+seeds = [0, 5]
+snr_db = 20.0
+duration = 0.004
+sample_rate = 20000.0
+chunk = 1
+workers = 1
+sensor = { width = 1.5707963267948966 }  # pi / 2 (a unit string rounds to 15 digits)
+[[dataset.faults]]
+kind = "crack"
+gear = "sun"
+tooth = 0
+depth = "0 mm"
+[[dataset.faults]]
+kind = "crack"
+gear = "sun"
+tooth = 0
+depth = "1.5 mm"
+"""
+
+
+def planetary_api_dataset() -> xr.Dataset:
+    """The same dataset by the Python API: the stage built by hand
+    (tests/planetary_example_set.py, not through the study loader)."""
+    import math
+    import tomllib
+    from importlib.resources import files
+
+    from planetary_example_set import planetary_by_hand
+
+    doc = tomllib.loads(files("geardyn.studies").joinpath("planetary_example.toml").read_text())
+
+    def build(faults):
+        return planetary_by_hand(doc, stiffness="potential_energy", faults=faults,
+                                 stiffness_options=dict(sun_bore_radius="12 mm",
+                                                        planet_bore_radius="10 mm",
+                                                        ring_rim_radius="85 mm", angles=32))
+
+    faults = [RootCrack("0 mm", gear="sun"), RootCrack("1.5 mm", gear="sun")]
+    spec = geardyn.FaultDatasetSpec(build, faults, speeds=[3000.0], torques=[30.0],
+                                    seeds=[0, 5], snr_db=20.0, duration=0.004,
+                                    sample_rate=20000.0, chunk=1,
+                                    sensor={"width": math.pi / 2})
+    return geardyn.fault_dataset(spec, workers=1)
+
+
+def test_a_planetary_study_gives_the_ring_sensor_dataset_the_api_computes(tmp_path):
+    """Two conditions (a zero-size and a 1.5 mm sun crack: the same forcing period) of the
+    example stage on its potential-energy stiffness, the conditions' faults in place of
+    [[params.geometry.faults]]: the store holds the labels and, bit for bit, the dataset of
+    the stage built by hand through the API (which tests/test_fault_dataset.py checks against
+    geardyn.simulate and the ring sensor signal)."""
+    study = tmp_path / "planetary.toml"
+    study.write_text(PLANETARY + PLANETARY_DATASET)
+    store = tmp_path / "p.zarr"
+    r = invoke("dataset", study, "-q", "--store", store)
+    assert r.returncode == 0, r.stderr
+    assert "tiny_planetary_dataset: 2 conditions, 4 signals of 0.004 s" in r.stdout
+    ds = xr.open_zarr(store).load()
+    assert ds.sizes == {"fault": 2, "speed": 1, "torque": 1, "seed": 2, "time": 80}
+    assert [str(k) for k in ds["fault_kind"].values] == ["crack", "crack"]
+    assert [str(g) for g in ds["fault_gear"].values] == ["sun", "sun"]
+    assert ds["fault_size"].values.tolist() == [0.0, 1.5e-3]
+    assert ds.attrs["speed_input"] == "input_speed" and ds["speed"].attrs["units"] == "rpm"
+    assert ds.attrs["torque_input"] == "sun_torque" and ds.attrs["signal"] == "ring_sensor"
+    assert (ds["status"].values == 0).all()
+    api = planetary_api_dataset()
+    for name in ("signal", "status", "noise_std"):
+        np.testing.assert_array_equal(ds[name].values, api[name].values)
+    assert not np.array_equal(ds["signal"].values[0], ds["signal"].values[1])  # the crack
+
+
+@pytest.mark.parametrize(("change", "field"), [
+    (("gear = \"sun\"\ntooth = 0\ndepth = \"1.5 mm\"",
+      "gear = \"planet9\"\ntooth = 0\ndepth = \"1.5 mm\""), "dataset.faults[1].gear"),
+    (("width = 1.5707963267948966", "width = \"-1 deg\""), "dataset.sensor.width"),
+    (("width = 1.5707963267948966", "mesh = \"s1\""), "dataset.sensor.mesh"),
+])
+def test_bad_planetary_dataset_input_names_the_field(tmp_path, change, field):
+    path = tmp_path / "bad.toml"
+    path.write_text(PLANETARY + PLANETARY_DATASET.replace(*change))
+    r = invoke("dataset", path, "-q", "--store", tmp_path / "x.zarr")
+    assert r.returncode == 2, r.stderr
+    assert f"error: {field}" in r.stderr
+
+
+def test_a_planetary_study_without_geometry_is_refused(tmp_path):
+    path = tmp_path / "s.toml"
+    text = PLANETARY.split("[params.geometry]")[0] + (
+        "sun_mesh_stiffness = 5e8\nring_mesh_stiffness = 5e8\n"
+        + PLANETARY.split("teeth = 71\n")[1] + PLANETARY_DATASET)
+    path.write_text(text)
+    r = invoke("dataset", path, "-q", "--store", tmp_path / "x.zarr")
+    assert r.returncode == 2 and "[params.geometry]" in r.stderr

@@ -402,9 +402,12 @@ def _conditions(spec: FaultDatasetSpec) -> _Conditions:
         if first is None:
             first = base
         elif type(base) is not type(first) or base.params.size != first.params.size:
+            hint = ("; a model with a fault may run over a revolution of the faulty gear: give"
+                    " the healthy condition as a zero-size fault on that gear (e.g. a 0 mm "
+                    "crack)") if (fault is None) != (spec.faults[0] is None) else ""
             raise ParameterError(f"faults[{fi}]", _describe(fault),
                                  "builds a model of another kind or size than faults[0]: every"
-                                 " condition must share one kernel layout")
+                                 f" condition must share one kernel layout{hint}")
         for name, value in (base.stiffness_error() if decl.stiffness_error else {}).items():
             errors.setdefault(name, []).append(float(value))
         b = np.asarray(base.params, dtype=float)
