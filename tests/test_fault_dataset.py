@@ -336,3 +336,63 @@ def test_a_planetary_dataset_is_the_ring_sensor_signal_of_a_simulation():
         assert np.max(np.abs(got - expected)) < 1e-8 * np.ptp(expected)
     crack = ds["signal"].values[1, 0, 0, 0] - ds["signal"].values[0, 0, 0, 0]
     assert np.max(np.abs(crack)) > 0.02 * np.ptp(ds["signal"].values[0, 0, 0, 0])  # meas. 0.04
+
+
+# ---------------------------------------------------------------------------------------------
+# a gear train: the mesh force of its declared observables
+
+
+def train_build(faults):
+    """The one-stage pinion/wheel train of tests/test_trains_faults.py on the potential-energy
+    stiffness (H = 6 mesh harmonics; a fault's period: one pinion revolution)."""
+    from test_trains_faults import _pair_model
+
+    return _pair_model(tuple(faults), backlash=10e-6, mesh_damping=0.04)
+
+
+def test_a_train_dataset_is_the_mesh_force_of_a_simulation():
+    """A zero-size and a 1.5 mm crack on pinion tooth 2, 1500 rpm, 30 N m (the train's
+    declared input_speed [rpm] and input_torque [N m]): each condition's clean signal is the
+    mesh force F_m of geardyn.simulate of the same model on the same grid (K samples per
+    forcing period, K | the steps), to 1e-8 of its peak-to-peak; the crack changes it."""
+    from geardyn.analysis.fault_dataset import seconds_per_time_unit
+
+    faults = (RootCrack("0 mm", gear="p", tooth=2), RootCrack("1.5 mm", gear="p", tooth=2))
+    m = train_build((faults[1],)).with_params(input_speed=1500.0, input_torque=30.0)
+    unit = seconds_per_time_unit(m)
+    period = 2.0 * math.pi / m.omega
+    K = round(20_000.0 * period * unit)
+    n = K * math.ceil(geardyn.default_steps_per_period(m) / K)
+    rate = K / (period * unit)
+    s = geardyn.FaultDatasetSpec(train_build, faults, speeds=[1500.0], torques=[30.0],
+                                 seeds=[0], snr_db=math.inf, duration=0.005, sample_rate=rate,
+                                 steps_per_period=n)
+    ds = dataset(s)
+    assert (ds.attrs["speed_input"], ds.attrs["torque_input"]) == ("input_speed",
+                                                                   "input_torque")
+    assert ds["speed"].attrs["units"] == "rpm" and ds.attrs["signal"] == "mesh_force"
+    assert ds["signal"].attrs["meaning"] == "dynamic mesh force F_m"
+    assert (ds["status"].values == 0).all()
+    assert [str(g) for g in ds["fault_gear"].values] == ["p", "p"]
+    samples = ds.sizes["time"]
+    for i, fault in enumerate(faults):
+        model = train_build((fault,)).with_params(input_speed=1500.0, input_torque=30.0)
+        sim = geardyn.simulate(model, run=geardyn.RunSettings(
+            transient=0.0, samples=math.ceil(samples / K), steps_per_period=n))
+        expected = sim["F_m"].values[: samples * (n // K): n // K]
+        got = ds["signal"].values[i, 0, 0, 0]
+        assert np.max(np.abs(got - expected)) < 1e-8 * np.ptp(expected)
+    crack = ds["signal"].values[1, 0, 0, 0] - ds["signal"].values[0, 0, 0, 0]
+    assert np.max(np.abs(crack)) > 0.01 * np.ptp(ds["signal"].values[0, 0, 0, 0])
+
+
+def test_a_train_without_a_driven_torque_lacks_the_torque_input():
+    from geardyn.trains import TrainModel
+    from test_trains_faults import _pair_train
+
+    def unloaded(faults):
+        return TrainModel(_pair_train(tuple(faults)), harmonics=6)
+
+    with pytest.raises(ParameterError, match="build") as err:
+        dataset(spec(build=unloaded, faults=(None,)), progress=_progress_never)
+    assert "'input_torque'" in str(err.value) and "input_speed" not in str(err.value)
