@@ -304,3 +304,96 @@ def test_a_planetary_study_without_geometry_is_refused(tmp_path):
     path.write_text(text)
     r = invoke("dataset", path, "-q", "--store", tmp_path / "x.zarr")
     assert r.returncode == 2 and "[params.geometry]" in r.stderr
+
+
+# ---------------------------------------------------------------------------------------------
+# a train study: the mesh force of the two-stage train with a cracked input pinion
+
+
+def train_study_text(depth: str | None = None) -> str:
+    """The shipped two_stage_train on the potential-energy stiffness (as
+    tests/test_trains_faults.py builds it); with ``depth``, its own [[train.faults]]: a crack
+    of that depth on g1's tooth 3."""
+    from importlib.resources import files
+
+    text = files("geardyn.studies").joinpath("two_stage_train.toml").read_text()
+    text = text.replace('stiffness = "iso"', 'stiffness = "potential_energy"\n'
+                        'bore_radius = "10 mm"').replace("stiffness_fluctuation = 0.25\n", "")
+    if depth is not None:
+        text += (f'\n[[train.faults]]\nkind = "crack"\ngear = "g1"\ntooth = 3\n'
+                 f'depth = "{depth}"\nangle = "45 deg"\n')
+    return text
+
+
+TRAIN_DATASET = """
+[dataset]
+speeds = [3000.0]
+torques = [40.0, 60.0]
+seeds = 1
+snr_db = 20.0
+duration = 0.003
+sample_rate = 20000.0
+chunk = 1
+workers = 1
+sensor = { mesh = "stage2" }
+[[dataset.faults]]
+kind = "crack"
+gear = "g1"
+tooth = 3
+depth = "0 mm"
+angle = "45 deg"
+[[dataset.faults]]
+kind = "crack"
+gear = "g1"
+tooth = 3
+depth = "2 mm"
+angle = "45 deg"
+"""
+
+
+def test_a_train_study_gives_the_mesh_force_dataset_of_its_own_faults(tmp_path):
+    """Two conditions (a zero-size and a 2 mm crack on g1) x two input torques: the store holds
+    the labels and, bit for bit, the API's dataset of the models that study files with those
+    faults in their own [[train.faults]] give (geardyn.study.build_model)."""
+    from geardyn.io.toml import load_study
+    from geardyn.study import build_model
+
+    path = tmp_path / "train.toml"
+    path.write_text(train_study_text() + TRAIN_DATASET)
+    store = tmp_path / "t.zarr"
+    r = invoke("dataset", path, "-q", "--store", store)
+    assert r.returncode == 0, r.stderr
+    ds = xr.open_zarr(store).load()
+    assert ds.sizes == {"fault": 2, "speed": 1, "torque": 2, "seed": 1, "time": 60}
+    assert ds["fault_size"].values.tolist() == [0.0, 2e-3]
+    assert [str(g) for g in ds["fault_gear"].values] == ["g1", "g1"]
+    assert ds.attrs["torque_input"] == "input_torque" and ds["speed"].attrs["units"] == "rpm"
+    assert ds["signal"].attrs["meaning"] == "dynamic mesh force F_stage2"
+    assert (ds["status"].values == 0).all()
+    studies = {}
+    for depth in ("0 mm", "2 mm"):
+        own = tmp_path / f"own_{depth.split()[0]}.toml"
+        own.write_text(train_study_text(depth))
+        studies[depth] = load_study(own)
+    faults = [RootCrack(depth, gear="g1", tooth=3, angle="45 deg") for depth in studies]
+    spec = geardyn.FaultDatasetSpec(
+        lambda f: build_model(studies["0 mm" if f[0].depth == 0.0 else "2 mm"]), faults,
+        speeds=[3000.0], torques=[40.0, 60.0], seeds=[0], snr_db=20.0, duration=0.003,
+        sample_rate=20000.0, chunk=1, sensor={"mesh": "stage2"})
+    api = geardyn.fault_dataset(spec, workers=1)
+    for name in ("signal", "status", "noise_std"):
+        np.testing.assert_array_equal(ds[name].values, api[name].values)
+
+
+@pytest.mark.parametrize(("change", "field"), [
+    (("tooth = 3\ndepth = \"2 mm\"", "tooth = 30\ndepth = \"2 mm\""), "dataset.faults[1].tooth"),
+    (("gear = \"g1\"\ntooth = 3\ndepth = \"2 mm\"", "gear = \"g9\"\ntooth = 3\ndepth = \"2 mm\""),
+     "dataset.faults[1].gear"),
+    (("mesh = \"stage2\"", "mesh = \"stage3\""), "dataset.sensor.mesh"),
+])
+def test_bad_train_dataset_input_names_the_field(tmp_path, change, field):
+    path = tmp_path / "bad.toml"
+    path.write_text(train_study_text() + TRAIN_DATASET.replace(*change))
+    r = invoke("dataset", path, "-q", "--store", tmp_path / "x.zarr")
+    assert r.returncode == 2, r.stderr
+    assert f"error: {field}" in r.stderr
