@@ -397,3 +397,14 @@ def test_bad_train_dataset_input_names_the_field(tmp_path, change, field):
     r = invoke("dataset", path, "-q", "--store", tmp_path / "x.zarr")
     assert r.returncode == 2, r.stderr
     assert f"error: {field}" in r.stderr
+
+
+def test_a_train_without_an_input_torque_is_refused_saying_so(tmp_path):
+    path = tmp_path / "free.toml"
+    text = train_study_text().replace('torques = { g1 = "60 N m" }\nload = "g4"\n', "")
+    assert "\ntorques" not in text
+    path.write_text(text + TRAIN_DATASET)
+    r = invoke("dataset", path, "-q", "--store", tmp_path / "x.zarr")
+    assert r.returncode == 2
+    assert "its model (TrainModel) lacks what a fault dataset needs" in r.stderr
+    assert "'input_torque'" in r.stderr

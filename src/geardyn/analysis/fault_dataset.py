@@ -197,10 +197,10 @@ def _declared(model: Model) -> FaultDatasetInputs:
     decl = model.capabilities.fault_dataset
     if decl is None:
         raise ParameterError("build", type(model).__name__,
-                             "returns a model whose class does not declare the fault_dataset "
-                             "capability (Capabilities(fault_dataset=FaultDatasetInputs(...)))"
-                             ": missing its speed input, its torque input and its sensor "
-                             "signal")
+                             "returns a model that does not declare the fault_dataset "
+                             "capability (its class's Capabilities(fault_dataset="
+                             "FaultDatasetInputs(...))): missing its speed input, its torque "
+                             "input and its sensor signal")
     return decl
 
 

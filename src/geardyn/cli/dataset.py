@@ -217,6 +217,9 @@ def dataset_command(
             ds = fault_dataset(spec, store=path, progress=callback,
                                workers=workers if workers is not None else table.workers)
         except ParameterError as exc:  # checked before any work: the table's fields
+            if exc.field == "build":  # the study's model lacks an input or its signal
+                raise StudyError(f"study {s.study.name!r}: its model ({exc.value}) "
+                                 f"{exc.reason.removeprefix('returns a model that ')}") from None
             if not exc.field.startswith(("sensor", "faults[")):
                 raise
             raise ParameterError(f"dataset.{exc.field}", exc.value, exc.reason) from None
