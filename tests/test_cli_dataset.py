@@ -408,3 +408,13 @@ def test_a_train_without_an_input_torque_is_refused_saying_so(tmp_path):
     assert r.returncode == 2
     assert "its model (TrainModel) lacks what a fault dataset needs" in r.stderr
     assert "'input_torque'" in r.stderr
+
+
+def test_a_study_of_another_model_is_refused_naming_the_ones_taken(tmp_path):
+    from importlib.resources import files
+
+    path = tmp_path / "fig3.toml"
+    path.write_text(files("geardyn.studies").joinpath("paper_fig3.toml").read_text() + DATASET)
+    r = invoke("dataset", path, "-q", "--store", tmp_path / "x.zarr")
+    assert r.returncode == 2
+    assert "takes a spur_pair, planetary or train study" in r.stderr

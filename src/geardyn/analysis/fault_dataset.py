@@ -17,9 +17,10 @@ truncation error. The sensor signals (see ``docs/datasets.md``):
 * ``"ring_sensor"`` (a :class:`~geardyn.PlanetaryGearSet` built from geometry): the ring sensor
   signal of :func:`~geardyn.analysis.sensor.sensor_signal` (the ring-planet mesh forces through
   the planet-pass window), in N;
-* ``"mesh_force"`` (a :class:`~geardyn.SpurPair`): the stand-in is the dynamic force of one of
-  the model's meshes (elastic and damping; ``sensor={"mesh": name}``, default the first), the
-  force that a bearing and the housing carry to a sensor.
+* ``"mesh_force"`` (a :class:`~geardyn.SpurPair`, a :class:`~geardyn.trains.TrainModel`): the
+  stand-in is the dynamic force of one of the model's meshes (elastic and damping, its
+  observable; ``sensor={"mesh": name}``, default the first), the force that a bearing and the
+  housing carry to a sensor.
 
 Measurement noise is white Gaussian with standard deviation sigma = rms / 10^(snr_db / 20), rms
 the clean signal's RMS about its mean, drawn from ``numpy.random.default_rng([seed, fault,
@@ -100,8 +101,9 @@ class FaultDatasetSpec:
     faults=f)``; ``faults`` lists the conditions, each ``None`` (healthy) or a fault object of
     :mod:`geardyn.gears.faults`; ``speeds`` in the model's declared speed input
     (``capabilities.fault_dataset``: SpurPair ``speed`` in its ``speed_unit``, a planetary
-    set's ``input_speed`` in rpm); ``torques`` [N m] in its declared torque input (SpurPair
-    ``torque``, a planetary set's ``sun_torque``); ``seeds`` the noise seeds; ``snr_db`` the
+    set's or a train's ``input_speed`` in rpm); ``torques`` [N m] in its declared torque input
+    (SpurPair ``torque``, a planetary set's ``sun_torque``, a train's ``input_torque``);
+    ``seeds`` the noise seeds; ``snr_db`` the
     signal-to-noise ratio [dB] (``inf``: no noise); ``duration`` [s] and ``sample_rate`` [Hz] of
     each signal; ``transient`` [s] discarded first (rounded up to whole forcing periods);
     ``steps_per_period`` RK4 steps per forcing period, or ``steps_per_mode`` steps per period

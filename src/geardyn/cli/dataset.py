@@ -39,22 +39,18 @@ STUDY_FAULTS = {"spur_pair": "[[faults]]", "planetary": "[[params.geometry.fault
 
 
 def _kind(study: Any) -> str:
-    """The study's model, if ``geardyn dataset`` takes it; else a StudyError."""
-    from geardyn.io.toml import PlanetaryGearSetParams, SpurPairParams, TrainModelParams
-
-    params = study.params
-    if isinstance(params, SpurPairParams):
-        return "spur_pair"
-    if isinstance(params, PlanetaryGearSetParams):
-        if params.geometry is None:
-            raise StudyError(f"study {study.study.name!r}: geardyn dataset takes a planetary "
-                             "set built from [params.geometry] (the ring sensor's ring, the "
-                             "faults' teeth)")
-        return "planetary"
-    if isinstance(params, TrainModelParams):
-        return "train"
-    raise StudyError(f"study {study.study.name!r}: geardyn dataset takes a "
-                     f"{', '.join(STUDY_FAULTS)} study (model = {study.study.model!r})")
+    """The study's model (``[study].model``), if ``geardyn dataset`` takes it; else a
+    StudyError."""
+    kind = study.study.model
+    if kind not in STUDY_FAULTS:
+        *head, last = STUDY_FAULTS
+        raise StudyError(f"study {study.study.name!r}: geardyn dataset takes a "
+                         f"{', '.join(head)} or {last} study (model = {kind!r})")
+    if kind == "planetary" and study.params.geometry is None:
+        raise StudyError(f"study {study.study.name!r}: geardyn dataset takes a planetary set "
+                         "built from [params.geometry] (the ring sensor's ring, the faults' "
+                         "teeth)")
+    return kind
 
 
 class StudyFaultBuilder:
