@@ -282,6 +282,32 @@ def test_a_planetary_study_gives_the_ring_sensor_dataset_the_api_computes(tmp_pa
     assert not np.array_equal(ds["signal"].values[0], ds["signal"].values[1])  # the crack
 
 
+def test_a_killed_planetary_run_resumes_to_the_bits_of_one_run(tmp_path, monkeypatch):
+    path = tmp_path / "planetary.toml"
+    path.write_text(PLANETARY + PLANETARY_DATASET)
+    whole = tmp_path / "whole.zarr"
+    assert invoke("dataset", path, "-q", "--store", whole).returncode == 0
+    killed = tmp_path / "killed.zarr"
+    write = LaneStore.write_chunk
+
+    def kill_after_first(self, *args, **kw):
+        monkeypatch.setattr(LaneStore, "write_chunk", _raise_interrupt)
+        return write(self, *args, **kw)
+
+    monkeypatch.setattr(LaneStore, "write_chunk", kill_after_first)
+    assert invoke("dataset", path, "-q", "--store", killed).returncode != 0
+    monkeypatch.setattr(LaneStore, "write_chunk", write)
+    assert invoke("dataset", path, "-q", "--store", killed).returncode == 0
+    assert LaneStore(killed).chunk_runs().tolist() == [1, 2]  # the first not recomputed
+    a, b = xr.open_zarr(whole).load(), xr.open_zarr(killed).load()
+    for name in a.data_vars:
+        np.testing.assert_array_equal(a[name].values, b[name].values)
+
+
+def _raise_interrupt(*args, **kw):
+    raise KeyboardInterrupt
+
+
 @pytest.mark.parametrize(("change", "field"), [
     (("gear = \"sun\"\ntooth = 0\ndepth = \"1.5 mm\"",
       "gear = \"planet9\"\ntooth = 0\ndepth = \"1.5 mm\""), "dataset.faults[1].gear"),
