@@ -68,6 +68,7 @@ def test_the_store_opens_with_xarray_and_its_labels_are_the_spec(reference, tmp_
     assert [str(g) for g in ds["fault_gear"].values] == ["none", "pinion", "pinion"]
     assert ds["fault_tooth"].values.tolist() == [-1, 0, 3]
     assert ds["speed"].values.tolist() == list(SPEEDS)
+    assert ds["speed"].attrs["units"] == "rpm" and ds.attrs["speed_input"] == "speed"
     assert ds["torque"].values.tolist() == list(TORQUES)
     assert ds["seed"].values.tolist() == list(SEEDS)
     assert ds["time"].values[1] == 1.0 / RATE
@@ -214,6 +215,75 @@ def test_workers_must_be_a_whole_number():
 
 
 # ---------------------------------------------------------------------------------------------
+# the declaration: what a model needs for a dataset is declared by its class
+
+
+def test_the_inputs_and_units_are_the_classes_declarations():
+    """The spec's speeds and torques go to the inputs each class declares, in their units: a
+    spur pair's ``speed`` in its own speed_unit, a planetary set's ``input_speed`` in rpm."""
+    from geardyn.analysis.fault_dataset import dataset_inputs, speed_unit
+
+    pair = dataset_inputs(build(()))
+    assert (pair.speed, pair.torque, pair.signal) == ("speed", "torque", "mesh_force")
+    assert speed_unit(build(())) == "rpm"
+    assert speed_unit(geardyn.SpurPair.from_geometry(MESH, bore_radius=BORES, speed=100.0,
+                                                     torque=50.0)) == "rad/s"
+    decl = geardyn.PlanetaryGearSet.capabilities.fault_dataset
+    assert (decl.speed, decl.torque, decl.speed_unit, decl.signal) == (
+        "input_speed", "sun_torque", "rpm", "ring_sensor")
+
+
+def _progress_never(done, total):
+    raise AssertionError("work started")
+
+
+def test_a_model_without_the_capability_is_refused_naming_build_and_what_is_missing():
+    bad = spec(build=lambda faults: geardyn.GearPair())
+    with pytest.raises(ParameterError, match="build") as err:
+        dataset(bad, progress=_progress_never)
+    assert "speed input" in str(err.value) and "torque input" in str(err.value)
+    assert "sensor signal" in str(err.value)
+
+
+def test_a_declared_class_whose_instance_lacks_the_inputs_lists_them():
+    """A planetary set given mesh stiffnesses (no geometry) has no input_speed and no ring
+    to place a sensor on: both are listed."""
+    M = geardyn.Member
+
+    def no_geometry(faults):
+        return geardyn.PlanetaryGearSet(
+            n_planets=3, sun=M(0.4, 0.39, 1e8, 0.0, radius=0.03), ring=M(2.35, 3.0, 1e8, 1e9),
+            carrier=M(5.43, 6.29, 1e8, 0.0), planet=M(0.66, 0.61, 1e8),
+            sun_mesh_stiffness=5e8, ring_mesh_stiffness=5e8, sun_torque=10.0)
+
+    with pytest.raises(ParameterError, match="build") as err:
+        dataset(spec(build=no_geometry, faults=(None,)), progress=_progress_never)
+    assert "'input_speed'" in str(err.value) and "ring_sensor signal" in str(err.value)
+    assert "sun_torque" not in str(err.value)
+
+
+@pytest.mark.parametrize(("sensor", "field"), [
+    ({"width": 1.0}, "sensor.width"), ({"mesh": "stage1"}, "sensor.mesh")])
+def test_a_sensor_setting_the_signal_does_not_take_is_named(sensor, field):
+    with pytest.raises(ParameterError, match=field):
+        dataset(spec(sensor=sensor), progress=_progress_never)
+
+
+def test_a_declaration_is_checked_where_the_class_is_defined():
+    from geardyn.core.capabilities import Capabilities, FaultDatasetInputs
+
+    with pytest.raises(ValueError, match="mesh_forces"):
+        Capabilities(fault_dataset=FaultDatasetInputs("speed", "torque", "mesh_force"))
+    with pytest.raises(ValueError, match="signal"):
+        FaultDatasetInputs("speed", "torque", "microphone")
+    with pytest.raises(TypeError, match="stiffness_error"):
+        type("NoErrors", (geardyn.GearPair,), {"capabilities": Capabilities(
+            mesh_forces=True, natural_frequencies="rad/time",
+            fault_dataset=FaultDatasetInputs("Omega", "F0", "mesh_force",
+                                             stiffness_error=True))})
+
+
+# ---------------------------------------------------------------------------------------------
 # a planetary stage: the ring sensor's signal
 
 
@@ -266,3 +336,63 @@ def test_a_planetary_dataset_is_the_ring_sensor_signal_of_a_simulation():
         assert np.max(np.abs(got - expected)) < 1e-8 * np.ptp(expected)
     crack = ds["signal"].values[1, 0, 0, 0] - ds["signal"].values[0, 0, 0, 0]
     assert np.max(np.abs(crack)) > 0.02 * np.ptp(ds["signal"].values[0, 0, 0, 0])  # meas. 0.04
+
+
+# ---------------------------------------------------------------------------------------------
+# a gear train: the mesh force of its declared observables
+
+
+def train_build(faults):
+    """The one-stage pinion/wheel train of tests/test_trains_faults.py on the potential-energy
+    stiffness (H = 6 mesh harmonics; a fault's period: one pinion revolution)."""
+    from test_trains_faults import _pair_model
+
+    return _pair_model(tuple(faults), backlash=10e-6, mesh_damping=0.04)
+
+
+def test_a_train_dataset_is_the_mesh_force_of_a_simulation():
+    """A zero-size and a 1.5 mm crack on pinion tooth 2, 1500 rpm, 30 N m (the train's
+    declared input_speed [rpm] and input_torque [N m]): each condition's clean signal is the
+    mesh force F_m of geardyn.simulate of the same model on the same grid (K samples per
+    forcing period, K | the steps), to 1e-8 of its peak-to-peak; the crack changes it."""
+    from geardyn.analysis.fault_dataset import seconds_per_time_unit
+
+    faults = (RootCrack("0 mm", gear="p", tooth=2), RootCrack("1.5 mm", gear="p", tooth=2))
+    m = train_build((faults[1],)).with_params(input_speed=1500.0, input_torque=30.0)
+    unit = seconds_per_time_unit(m)
+    period = 2.0 * math.pi / m.omega
+    K = round(20_000.0 * period * unit)
+    n = K * math.ceil(geardyn.default_steps_per_period(m) / K)
+    rate = K / (period * unit)
+    s = geardyn.FaultDatasetSpec(train_build, faults, speeds=[1500.0], torques=[30.0],
+                                 seeds=[0], snr_db=math.inf, duration=0.005, sample_rate=rate,
+                                 steps_per_period=n)
+    ds = dataset(s)
+    assert (ds.attrs["speed_input"], ds.attrs["torque_input"]) == ("input_speed",
+                                                                   "input_torque")
+    assert ds["speed"].attrs["units"] == "rpm" and ds.attrs["signal"] == "mesh_force"
+    assert ds["signal"].attrs["meaning"] == "dynamic mesh force F_m"
+    assert (ds["status"].values == 0).all()
+    assert [str(g) for g in ds["fault_gear"].values] == ["p", "p"]
+    samples = ds.sizes["time"]
+    for i, fault in enumerate(faults):
+        model = train_build((fault,)).with_params(input_speed=1500.0, input_torque=30.0)
+        sim = geardyn.simulate(model, run=geardyn.RunSettings(
+            transient=0.0, samples=math.ceil(samples / K), steps_per_period=n))
+        expected = sim["F_m"].values[: samples * (n // K): n // K]
+        got = ds["signal"].values[i, 0, 0, 0]
+        assert np.max(np.abs(got - expected)) < 1e-8 * np.ptp(expected)
+    crack = ds["signal"].values[1, 0, 0, 0] - ds["signal"].values[0, 0, 0, 0]
+    assert np.max(np.abs(crack)) > 0.01 * np.ptp(ds["signal"].values[0, 0, 0, 0])
+
+
+def test_a_train_without_a_driven_torque_lacks_the_torque_input():
+    from geardyn.trains import TrainModel
+    from test_trains_faults import _pair_train
+
+    def unloaded(faults):
+        return TrainModel(_pair_train(tuple(faults)), harmonics=6)
+
+    with pytest.raises(ParameterError, match="build") as err:
+        dataset(spec(build=unloaded, faults=(None,)), progress=_progress_never)
+    assert "'input_torque'" in str(err.value) and "input_speed" not in str(err.value)

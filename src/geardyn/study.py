@@ -119,15 +119,16 @@ def mesh_stiffness(study: Study, faults: bool = True, loaded: bool = True) -> xr
     return ds
 
 
-def train_model(study: Study, omega: float | None = None) -> Model:
+def train_model(study: Study, omega: float | None = None, train: object = None) -> Model:
     """The :class:`~geardyn.trains.TrainModel` of a ``train`` study: the ``[train]`` table's
-    gear train with the inputs of ``[params]`` (at the forcing frequency Omega ``omega`` where
-    given). Errors name ``params.<field>``."""
+    gear train (or ``train``, a :class:`~geardyn.trains.GearTrain` in its place) with the
+    inputs of ``[params]`` (at the forcing frequency Omega ``omega`` where given). Errors name
+    ``params.<field>``."""
     from geardyn.trains import TrainModel
 
     kw = study.params.model_dump()  # type: ignore[union-attr]
     try:
-        model = TrainModel(study.gear_train, **kw)
+        model = TrainModel(study.gear_train if train is None else train, **kw)
     except ParameterError as exc:
         raise ParameterError(f"params.{exc.field}", exc.value, exc.reason) from None
     return model if omega is None else model.with_omega(float(omega))

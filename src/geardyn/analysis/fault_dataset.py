@@ -9,13 +9,18 @@ sample interval) and one noisy copy per seed added. Lanes are independent and de
 the chunks may run here, on local processes (``workers``) or on a Dask cluster, be resumed from
 a Zarr store, and give the same bits.
 
-The sensor signal (see ``docs/datasets.md``):
+What a model needs for it is declared by its class (``capabilities.fault_dataset``, a
+:class:`~geardyn.core.capabilities.FaultDatasetInputs`): the ``with_params`` names of its speed
+and torque inputs, their units, its sensor signal and whether it reports its stiffness series'
+truncation error. The sensor signals (see ``docs/datasets.md``):
 
-* a :class:`~geardyn.PlanetaryGearSet` built from geometry: the ring sensor signal of
-  :func:`~geardyn.analysis.sensor.sensor_signal` (the ring-planet mesh forces through the
-  planet-pass window), in N;
-* a :class:`~geardyn.SpurPair`: the stand-in is the dynamic mesh force F [N] (elastic and
-  damping), the force that a bearing and the housing carry to a sensor.
+* ``"ring_sensor"`` (a :class:`~geardyn.PlanetaryGearSet` built from geometry): the ring sensor
+  signal of :func:`~geardyn.analysis.sensor.sensor_signal` (the ring-planet mesh forces through
+  the planet-pass window), in N;
+* ``"mesh_force"`` (a :class:`~geardyn.SpurPair`, a :class:`~geardyn.trains.TrainModel`): the
+  stand-in is the dynamic force of one of the model's meshes (elastic and damping, its
+  observable; ``sensor={"mesh": name}``, default the first), the force that a bearing and the
+  housing carry to a sensor.
 
 Measurement noise is white Gaussian with standard deviation sigma = rms / 10^(snr_db / 20), rms
 the clean signal's RMS about its mean, drawn from ``numpy.random.default_rng([seed, fault,
@@ -38,6 +43,7 @@ import numpy as np
 import xarray as xr
 
 from geardyn.analysis.runup import SteadyRecord, steady_record
+from geardyn.core.capabilities import FaultDatasetInputs
 from geardyn.core.model import Model
 from geardyn.core.plan import MIN_STEPS_PER_PERIOD, default_steps_per_period
 from geardyn.core.results import finish
@@ -46,11 +52,8 @@ from geardyn.core.status import Status, status_attrs
 from geardyn.errors import ParameterError
 from geardyn.execution.executor import run_chunks
 
-__all__ = ["FaultDatasetSpec", "clean_signal", "default_workers", "fault_dataset", "fault_labels",
-           "lane_noise", "lane_steps", "seconds_per_time_unit"]
-
-#: Speed and torque inputs of each model kind (with_params names, units).
-_INPUTS = {"SpurPair": ("speed", "torque"), "PlanetaryGearSet": ("input_speed", "sun_torque")}
+__all__ = ["FaultDatasetSpec", "clean_signal", "dataset_inputs", "default_workers",
+           "fault_dataset", "fault_labels", "lane_noise", "lane_steps", "seconds_per_time_unit"]
 
 
 def _whole_list(name: str, values: Sequence[Any]) -> tuple[int, ...]:
@@ -96,15 +99,19 @@ class FaultDatasetSpec:
     ``build(faults)`` returns the model for a tuple of faults (``()``: healthy), e.g.
     ``lambda f: geardyn.SpurPair.from_geometry(mesh, bore_radius=..., speed=0, torque=0,
     faults=f)``; ``faults`` lists the conditions, each ``None`` (healthy) or a fault object of
-    :mod:`geardyn.gears.faults`; ``speeds`` in the model's speed input (SpurPair ``speed`` in its
-    ``speed_unit``, a planetary set's ``input_speed`` in rpm); ``torques`` [N m] (SpurPair
-    ``torque``, a planetary set's ``sun_torque``); ``seeds`` the noise seeds; ``snr_db`` the
+    :mod:`geardyn.gears.faults`; ``speeds`` in the model's declared speed input
+    (``capabilities.fault_dataset``: SpurPair ``speed`` in its ``speed_unit``, a planetary
+    set's or a train's ``input_speed`` in rpm); ``torques`` [N m] in its declared torque input
+    (SpurPair ``torque``, a planetary set's ``sun_torque``, a train's ``input_torque``);
+    ``seeds`` the noise seeds; ``snr_db`` the
     signal-to-noise ratio [dB] (``inf``: no noise); ``duration`` [s] and ``sample_rate`` [Hz] of
     each signal; ``transient`` [s] discarded first (rounded up to whole forcing periods);
     ``steps_per_period`` RK4 steps per forcing period, or ``steps_per_mode`` steps per period
     of the fastest natural mode (the model's ``fastest_natural_frequency``), at most one (both
     None: the step rule, 100 per mode); the step is then shortened to divide the sample
-    interval; ``chunk`` conditions per chunk (None: the executor's default)."""
+    interval; ``chunk`` conditions per chunk (None: the executor's default); ``sensor`` the
+    settings of the model's sensor signal (:data:`~geardyn.core.capabilities.DATASET_SIGNALS`:
+    a mesh force's ``mesh``, a ring sensor's ``sensor_angle``, ``width``, ``window``)."""
 
     build: Callable[[tuple[Any, ...]], Model]
     faults: Sequence[Any]
@@ -187,13 +194,81 @@ def fault_labels(fault: Any) -> dict[str, Any]:
             "tooth": int(fault.tooth)}
 
 
-def _model_kind(model: Model) -> str:
-    for kind in _INPUTS:
-        if type(model).__name__ == kind:
-            return kind
-    raise ParameterError("build", type(model).__name__,
-                         f"must return one of {', '.join(_INPUTS)} (models with a sensor "
-                         "signal)")
+def _declared(model: Model) -> FaultDatasetInputs:
+    """The model class's declaration; a ParameterError naming ``build`` where it has none."""
+    decl = model.capabilities.fault_dataset
+    if decl is None:
+        raise ParameterError("build", type(model).__name__,
+                             "returns a model that does not declare the fault_dataset "
+                             "capability (its class's Capabilities(fault_dataset="
+                             "FaultDatasetInputs(...))): missing its speed input, its torque "
+                             "input and its sensor signal")
+    return decl
+
+
+def dataset_inputs(model: Model, sensor: dict[str, Any] | None = None) -> FaultDatasetInputs:
+    """The fault-dataset inputs ``model``'s class declares
+    (:class:`~geardyn.core.capabilities.FaultDatasetInputs`), checked against this model and
+    the sensor settings ``sensor``: a model that lacks the declaration, or a declared input or
+    the sensor signal, is a :class:`~geardyn.errors.ParameterError` naming ``build`` and
+    listing what is missing; a bad sensor setting one naming ``sensor.<setting>``."""
+    decl = _declared(model)
+    name = type(model).__name__
+    takes = set(model.physical_names) | set(model.param_names)
+    missing = [f"its {what} input {input_name!r} (not an input of this {name})"
+               for what, input_name in (("speed", decl.speed), ("torque", decl.torque))
+               if input_name not in takes]
+    if decl.speed_unit is None and not isinstance(getattr(model, "speed_unit", None), str):
+        missing.append("the unit of its speed input (declared as the model's speed_unit)")
+    why = _signal_missing(model, decl)
+    if why:
+        missing.append(f"its {decl.signal} signal ({why})")
+    if missing:
+        raise ParameterError("build", name, "returns a model that lacks what a fault dataset "
+                             f"needs: {'; '.join(missing)}")
+    settings = dict(sensor or {})
+    unknown = sorted(set(settings) - set(decl.sensor_settings))
+    if unknown:
+        takes_text = ", ".join(decl.sensor_settings) or "none"
+        raise ParameterError(f"sensor.{unknown[0]}", settings[unknown[0]],
+                             f"not a setting of {name}'s {decl.signal} signal (it takes "
+                             f"{takes_text})")
+    try:
+        clean_signal(_probe_record(model), model, settings)
+    except ParameterError as exc:
+        field = exc.field if exc.field.startswith("sensor") else f"sensor.{exc.field}"
+        raise ParameterError(field, exc.value, exc.reason) from None
+    return decl
+
+
+def _signal_missing(model: Model, decl: FaultDatasetInputs) -> str:
+    """Why ``model`` cannot give its declared signal ("" where it can)."""
+    if decl.signal == "ring_sensor":
+        from geardyn.analysis.sensor import carrier_angle
+
+        try:
+            carrier_angle(model, np.zeros(1), 0.0)
+        except ParameterError as exc:
+            return exc.reason
+        return ""
+    if not model.meshes:
+        return "the model has no meshes"
+    return ""
+
+
+def _probe_record(model: Model) -> SteadyRecord:
+    """A one-sample record of zeros: the signal's settings are checked on it before any
+    work."""
+    return SteadyRecord(time=np.zeros(1), states=np.zeros((1, model.n_states)),
+                        observables=np.zeros((1, len(model.observable_names))),
+                        status=0, unresolved=0, step=1.0, stride=1)
+
+
+def speed_unit(model: Model) -> str:
+    """The unit of the model's declared speed input (a model declaring None: its own
+    ``speed_unit``)."""
+    decl = _declared(model)
+    return str(model.speed_unit) if decl.speed_unit is None else decl.speed_unit
 
 
 def seconds_per_time_unit(model: Model) -> float:
@@ -218,18 +293,36 @@ def lane_steps(model: Model, spec: FaultDatasetSpec) -> int:
 
 def clean_signal(rec: SteadyRecord, model: Model, sensor: dict[str, Any] | None = None
                  ) -> np.ndarray:
-    """The sensor signal [N] of the steady record ``rec`` of ``model`` at its sample times:
-    the planetary ring sensor (``sensor``: :func:`~geardyn.analysis.sensor.sensor_signal`'s
-    sensor_angle, width, window) or the pair's mesh force F."""
+    """The sensor signal of the steady record ``rec`` of ``model`` at its sample times, the
+    signal its class declares (``capabilities.fault_dataset.signal``): ``"ring_sensor"``, the
+    planetary ring sensor (``sensor``: :func:`~geardyn.analysis.sensor.sensor_signal`'s
+    sensor_angle, width, window); ``"mesh_force"``, the force observable of the mesh
+    ``sensor["mesh"]`` (default the first)."""
+    decl = _declared(model)
+    settings = dict(sensor or {})
+    names = list(model.observable_names)
+    if decl.signal == "mesh_force":
+        meshes = [m[0] for m in model.meshes]
+        mesh = settings.get("mesh", meshes[0] if meshes else None)
+        if mesh not in meshes:
+            raise ParameterError("sensor.mesh", mesh, f"must be a mesh of the model "
+                                 f"({', '.join(meshes)})")
+        return np.array(rec.observables[:, meshes.index(mesh)], dtype=float)
     from geardyn.analysis.sensor import carrier_angle, sensor_signal
 
-    names = list(model.observable_names)
-    if _model_kind(model) == "SpurPair":
-        return np.array(rec.observables[:, names.index("F")], dtype=float)
     forces = np.stack([rec.observables[:, names.index(f"F_r{n + 1}")]
                        for n in range(model.n_planets)], axis=-1)
     phi = carrier_angle(model, rec.time, float(model.omega))
-    return sensor_signal(forces, phi, np.asarray(model.psi, dtype=float), **(sensor or {}))
+    return sensor_signal(forces, phi, np.asarray(model.psi, dtype=float), **settings)
+
+
+def _signal_meaning(model: Model, sensor: dict[str, Any]) -> str:
+    decl = _declared(model)
+    if decl.signal == "ring_sensor":
+        return "ring sensor signal sum_n w(phi + psi_n - theta_s) F_rn"
+    meshes = [m[0] for m in model.meshes]
+    index = meshes.index(sensor.get("mesh", meshes[0]))
+    return f"dynamic mesh force {model.observable_names[index]}"
 
 
 def lane_noise(clean: np.ndarray, snr_db: float, seed: int, key: Sequence[int]
@@ -306,16 +399,18 @@ def _conditions(spec: FaultDatasetSpec) -> _Conditions:
             base = spec.build(() if fault is None else (fault,))
         except ParameterError as err:
             raise ParameterError(f"faults[{fi}]", _describe(fault), str(err)) from err
-        kind = _model_kind(base)
-        speed_name, torque_name = _INPUTS[kind]
+        decl = dataset_inputs(base, spec.sensor)
+        speed_name, torque_name = decl.speed, decl.torque
         if first is None:
             first = base
         elif type(base) is not type(first) or base.params.size != first.params.size:
+            hint = ("; a model with a fault may run over a revolution of the faulty gear: give"
+                    " the healthy condition as a zero-size fault on that gear (e.g. a 0 mm "
+                    "crack)") if (fault is None) != (spec.faults[0] is None) else ""
             raise ParameterError(f"faults[{fi}]", _describe(fault),
                                  "builds a model of another kind or size than faults[0]: every"
-                                 " condition must share one kernel layout")
-        err = getattr(base, "stiffness_error", None)
-        for name, value in (err() if callable(err) else {}).items():
+                                 f" condition must share one kernel layout{hint}")
+        for name, value in (base.stiffness_error() if decl.stiffness_error else {}).items():
             errors.setdefault(name, []).append(float(value))
         b = np.asarray(base.params, dtype=float)
         bases.append(b)
@@ -409,20 +504,21 @@ def _assemble(spec: FaultDatasetSpec, model: Model, out: dict[str, np.ndarray],
     nf, ns, nt = len(spec.faults), len(spec.speeds), len(spec.torques)
     shape = (nf, ns, nt)
     labels = [fault_labels(f) for f in spec.faults]
-    kind = _model_kind(model)
-    speed_name, torque_name = _INPUTS[kind]
+    decl = _declared(model)
+    speed_name, torque_name = decl.speed, decl.torque
     dims = ("fault", "speed", "torque")
     ds = xr.Dataset(
         {"signal": ((*dims, "seed", "time"),
                     out["signal"].reshape(*shape, len(spec.seeds), spec.n_samples),
-                    {"units": "N", "long_name": "sensor signal with measurement noise",
-                     "meaning": ("ring sensor signal sum_n w(phi + psi_n - theta_s) F_rn"
-                                 if kind != "SpurPair" else "dynamic mesh force F")}),
+                    {"units": decl.signal_units,
+                     "long_name": "sensor signal with measurement noise",
+                     "meaning": _signal_meaning(model, spec.sensor)}),
          "status": (dims, out["status"].reshape(shape), status_attrs()),
          "unresolved": (dims, out["unresolved"].reshape(shape),
                         {"meaning": "integration steps that reached the split limit"}),
          "noise_std": (dims, out["sigma"].reshape(shape),
-                       {"units": "N", "long_name": "measurement noise standard deviation"}),
+                       {"units": decl.signal_units,
+                        "long_name": "measurement noise standard deviation"}),
          "steps_per_period": (dims, steps.reshape(shape), {
              "long_name": "RK4 steps per forcing period asked for (the step is then shortened "
                           "to divide the sample interval)"})},
@@ -433,15 +529,18 @@ def _assemble(spec: FaultDatasetSpec, model: Model, out: dict[str, np.ndarray],
             "fault_gear": ("fault", [lb["gear"] for lb in labels]),
             "fault_tooth": ("fault", [lb["tooth"] for lb in labels]),
             "fault_description": ("fault", [_describe(f) for f in spec.faults]),
-            "speed": ("speed", np.array(spec.speeds), {"long_name": speed_name}),
-            "torque": ("torque", np.array(spec.torques), {"units": "N m",
+            "speed": ("speed", np.array(spec.speeds), {"units": speed_unit(model),
+                                                       "long_name": speed_name}),
+            "torque": ("torque", np.array(spec.torques), {"units": decl.torque_unit,
                                                           "long_name": torque_name}),
             "seed": ("seed", np.array(spec.seeds)),
             "time": ("time", np.arange(spec.n_samples) / spec.sample_rate,
                      {"units": "s", "long_name": "time after the transient"})})
     settings = spec.settings()
     ds.attrs.update(model=model.name, time_unit="s", speed_input=speed_name,
-                    torque_input=torque_name, snr_db=spec.snr_db, duration=spec.duration,
+                    speed_unit=speed_unit(model), torque_input=torque_name,
+                    torque_unit=decl.torque_unit, signal=decl.signal, snr_db=spec.snr_db,
+                    duration=spec.duration,
                     sample_rate=spec.sample_rate, transient=spec.transient,
                     step_choice=("steps_per_period" if spec.steps_per_period is not None
                                  else "steps_per_mode" if spec.steps_per_mode is not None

@@ -8,6 +8,57 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+#: The sensor signals a model may declare for a fault dataset, each with the sensor settings it
+#: takes (``FaultDatasetSpec.sensor``): ``"mesh_force"``, the force observable of one of the
+#: model's meshes (``mesh``: its name; default the first mesh); ``"ring_sensor"``, a planetary
+#: stage's ring sensor (:func:`geardyn.analysis.sensor.sensor_signal`, the ring-planet forces
+#: through the planet-pass window).
+DATASET_SIGNALS: dict[str, tuple[str, ...]] = {
+    "mesh_force": ("mesh",),
+    "ring_sensor": ("sensor_angle", "width", "window"),
+}
+
+
+@dataclass(frozen=True)
+class FaultDatasetInputs:
+    """What a model class offers a labelled fault dataset (:func:`geardyn.fault_dataset`).
+
+    ``speed``, ``torque``
+        The ``with_params`` names of its speed input and its torque input.
+    ``speed_unit``
+        The unit a number of the speed input is in (``"rpm"``), or None: the instance's own
+        ``speed_unit`` (a model that reads plain numbers in a unit it was built with).
+    ``torque_unit``
+        The unit of the torque input (``"N m"``).
+    ``signal``
+        Its sensor signal, a key of :data:`DATASET_SIGNALS` (``"mesh_force"`` needs the
+        ``mesh_forces`` capability).
+    ``signal_units``
+        The signal's unit.
+    ``stiffness_error``
+        ``model.stiffness_error()`` gives the truncation errors of its stiffness series (name
+        -> relative error), recorded per fault.
+    """
+
+    speed: str
+    torque: str
+    signal: str
+    speed_unit: str | None = "rpm"
+    torque_unit: str = "N m"
+    signal_units: str = "N"
+    stiffness_error: bool = False
+
+    def __post_init__(self) -> None:
+        if self.signal not in DATASET_SIGNALS:
+            raise ValueError(f"signal={self.signal!r}: one of {', '.join(DATASET_SIGNALS)}")
+        if not (self.speed and self.torque):
+            raise ValueError("a fault dataset needs the names of the speed and torque inputs")
+
+    @property
+    def sensor_settings(self) -> tuple[str, ...]:
+        """The sensor settings the signal takes."""
+        return DATASET_SIGNALS[self.signal]
+
 
 @dataclass(frozen=True)
 class Capabilities:
@@ -50,6 +101,10 @@ class Capabilities:
         frequencies (mean stiffness, no backlash), ascending: ``"rad/time"`` (rad per model
         time unit: rad/s for a model in seconds, omega / omega_n for a dimensionless one) or
         ``"Hz"``; empty: the model gives none.
+    ``fault_dataset``
+        The model's inputs and sensor signal for a labelled fault dataset
+        (:class:`FaultDatasetInputs`; None: it makes none). A model whose time is
+        dimensionless has ``time_scale``, omega_0 [rad/s] (its time unit is 1 / omega_0).
     """
 
     frequency_scale: bool = False
@@ -60,6 +115,7 @@ class Capabilities:
     mesh_forces: bool = False
     dynamic_factor: bool = False
     natural_frequencies: str = ""
+    fault_dataset: FaultDatasetInputs | None = None
 
     def __post_init__(self) -> None:
         if self.dynamic_factor and not (self.mesh_forces and self.natural_frequencies):
@@ -67,6 +123,9 @@ class Capabilities:
         if self.natural_frequencies not in NATURAL_FREQUENCY_UNITS:
             raise ValueError(f"natural_frequencies={self.natural_frequencies!r}: one of "
                              f"{NATURAL_FREQUENCY_UNITS}")
+        ds = self.fault_dataset
+        if ds is not None and ds.signal == "mesh_force" and not self.mesh_forces:
+            raise ValueError("fault_dataset's mesh_force signal needs mesh_forces")
 
 
 #: What a model class with the ``dynamic_factor`` capability defines.

@@ -158,7 +158,10 @@ class Model:
 
     def __init_subclass__(cls, **kwargs: object) -> None:
         """A class that defines ``natural_frequencies()`` declares their unit in its
-        capabilities (analyses read the declaration, never probe the method)."""
+        capabilities (analyses read the declaration, never probe the method); a class that
+        declares a capability defines what it needs (``dynamic_factor``: the members of
+        ``DYNAMIC_FACTOR_MEMBERS``; a ``fault_dataset`` with ``stiffness_error``: that
+        method)."""
         super().__init_subclass__(**kwargs)
         if "natural_frequencies" in vars(cls) and not cls.capabilities.natural_frequencies:
             raise TypeError(f"{cls.__name__} defines natural_frequencies(): declare their unit "
@@ -170,6 +173,10 @@ class Model:
             if missing:
                 raise TypeError(f"{cls.__name__} declares the dynamic_factor capability but "
                                 f"lacks {', '.join(missing)}")
+        if caps.fault_dataset is not None and caps.fault_dataset.stiffness_error \
+                and not callable(getattr(cls, "stiffness_error", None)):
+            raise TypeError(f"{cls.__name__} declares the fault dataset's stiffness_error but "
+                            "defines no stiffness_error()")
 
     # ------------------------------------------------------------------ sizes
     @property

@@ -2,8 +2,10 @@
 (:func:`geardyn.fault_dataset` over the study's model; command-line options win)::
 
     [dataset]
-    speeds = [1000, 2000, 3000]    # the model's speed input (a spur pair's params.speed_unit)
-    torques = [20, 60, 100]        # [N m]
+    speeds = [1000, 2000, 3000]    # the model's speed input (a spur pair's params.speed_unit;
+                                   # a planetary set's or a train's input speed [rpm])
+    torques = [20, 60, 100]        # [N m]: a spur pair's torque, a planetary set's
+                                   # sun_torque, a train's input_torque
     seeds = 10                     # noise seeds 0..9 (or a list: [0, 7, 11])
     snr_db = 20.0                  # signal-to-noise ratio [dB]; "inf": no noise
     duration = 1.0                 # each signal [s]
@@ -14,6 +16,9 @@
     chunk = 50                     # conditions per chunk (the store's and the bar's grain)
     store = "faults.zarr"          # the Zarr store (relative to the working directory)
     workers = 2                    # local processes (default: every core)
+    sensor = { width = 1.5708 }    # the model's sensor signal's settings (a planetary
+                                   # set's ring sensor: sensor_angle, width [rad], window;
+                                   # a spur pair's or a train's mesh force: mesh)
 
     [[dataset.faults]]             # one table per condition; kind "healthy" or a fault kind
     kind = "healthy"               # of geardyn.gears.FAULT_KINDS with that fault's fields
@@ -62,6 +67,8 @@ class DatasetTable(BaseModel):
     chunk: Whole | None = Field(None, ge=1, description="conditions per chunk")
     store: str | None = Field(None, min_length=1, description="the Zarr store's path")
     workers: Whole | None = Field(None, ge=1, description="local processes")
+    sensor: dict[str, Any] = Field(default_factory=dict,
+                                   description="the sensor signal's settings")
 
     @field_validator("faults")
     @classmethod

@@ -30,7 +30,7 @@ from typing import Any
 
 import numpy as np
 
-from geardyn.core.capabilities import Capabilities
+from geardyn.core.capabilities import Capabilities, FaultDatasetInputs
 from geardyn.core.coefficients import CoefficientLayout
 from geardyn.core.kernel_source import KernelSource
 from geardyn.core.model import Model, unique_rows
@@ -424,7 +424,10 @@ class PlanetaryGearSet(Model):
     state_units = "1"
     observable_units = "N"
     capabilities = Capabilities(physical_inputs=True, physical_axes=True, mesh_forces=True,
-                                dynamic_factor=True, natural_frequencies="Hz")
+                                dynamic_factor=True, natural_frequencies="Hz",
+                                fault_dataset=FaultDatasetInputs(
+                                    "input_speed", "sun_torque", "ring_sensor",
+                                    stiffness_error=True))
     raw_overrides_allowed = True
     #: Raw coefficients set by name through ``with_params`` (name -> value), applied again on
     #: top of a rebuild from changed inputs.

@@ -47,7 +47,7 @@ from collections.abc import Sequence
 import numpy as np
 import xarray as xr
 
-from geardyn.core.capabilities import Capabilities
+from geardyn.core.capabilities import Capabilities, FaultDatasetInputs
 from geardyn.core.coefficients import CoefficientLayout
 from geardyn.core.model import Model
 from geardyn.core.plan import STEPS_PER_FASTEST_MODE, STEPS_PER_OTHER_FORCING
@@ -232,7 +232,10 @@ class SpurPair(Model):
     observable_units = "N"
     meshes = (("mesh", 0, 1),)
     capabilities = Capabilities(mesh_forces=True, physical_axes=True, dynamic_factor=True,
-                                natural_frequencies="rad/time")
+                                natural_frequencies="rad/time",
+                                fault_dataset=FaultDatasetInputs(
+                                    "speed", "torque", "mesh_force", speed_unit=None,
+                                    stiffness_error=True))
     physical_names = ("speed",)
 
     def __init__(self, mesh: GearMesh, stiffness: xr.Dataset, *, speed: object,

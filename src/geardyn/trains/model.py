@@ -50,7 +50,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from geardyn.core.capabilities import Capabilities
+from geardyn.core.capabilities import Capabilities, FaultDatasetInputs
 from geardyn.errors import ParameterError
 from geardyn.gears.iso6336_kv import KvMeshGroup, group_reduced_mass
 from geardyn.gears.potential_energy import coast_phase
@@ -181,8 +181,13 @@ class TrainModel(PlanetaryGearSet):
     """
 
     name = "TrainModel"
+    #: A fault dataset's signal is a mesh force (a train has no housing sensor model: the
+    #: stand-in is the force the mesh's bearings carry), its inputs the driven body's speed
+    #: [rpm] and torque [N m].
     capabilities = Capabilities(physical_inputs=True, physical_axes=True, mesh_forces=True,
-                                dynamic_factor=True, natural_frequencies="Hz")
+                                dynamic_factor=True, natural_frequencies="Hz",
+                                fault_dataset=FaultDatasetInputs(INPUT_SPEED, INPUT_TORQUE,
+                                                                 "mesh_force"))
     raw_overrides: dict[str, float] = {}
     carrier_speed = None
     carrier_speed_ratio = None
