@@ -245,17 +245,6 @@ def test_bad_method_names_the_field(geo):
 # ---------------------------------------------------------------------------------------------
 # the back (coast) flank
 
-#: sha256 of ``poincare`` (float64, C order) of the conformance planetary case
-#: (``conformance_cases.planetary()``, the kick of ``conformance_cases.cases()``), computed once
-#: with main's code at commit 80f1e94 (one stiffness on both flanks, before the coast flank
-#: entered the kernels) by :func:`_fingerprints`: simulate (the per-lane kernel) and a 3-lane
-#: bifurcation in Omega (the lane-block kernel).
-MAIN_FINGERPRINTS = {
-    "simulate": "7580ef6cb42edd97b7dc472c37bd60b8e8171de17ad964602e3e9fd42b5b1f7d",
-    "bifurcation": "91d69c973acccc3af46575609819c8a34ff81c5fa121a40db25c11f6b2ba61f1",
-}
-
-
 def _conformance_case() -> tuple[geardyn.PlanetaryGearSet, np.ndarray]:
     from conformance_cases import planetary
 
@@ -263,24 +252,6 @@ def _conformance_case() -> tuple[geardyn.PlanetaryGearSet, np.ndarray]:
     kick = np.random.default_rng(1).normal(0.0, 1.0, gs.n_states) * np.r_[[3.0] * 18,
                                                                          [1.0] * 18]
     return gs, gs.initial_state() + kick
-
-
-def _fingerprints(gs: geardyn.PlanetaryGearSet, y0: np.ndarray) -> dict[str, str]:
-    import hashlib
-
-    ds = geardyn.simulate(gs, run=geardyn.RunSettings(transient=5.0, samples=6), y0=y0)
-    br = geardyn.bifurcation(gs, "Omega", [0.8, 1.0, 1.2],
-                             run=geardyn.RunSettings(transient=5.0, samples=4))
-    return {k: hashlib.sha256(np.ascontiguousarray(v, dtype=np.float64).tobytes()).hexdigest()
-            for k, v in (("simulate", ds["poincare"].values),
-                         ("bifurcation", br["poincare"].values))}
-
-
-def test_one_flank_results_are_mains_bitwise():
-    """A set without a coast flank (TWO_FLANK 0) integrates bitwise as main's code did."""
-    gs, y0 = _conformance_case()
-    assert gs.params[pk.TWO_FLANK] == 0.0
-    assert _fingerprints(gs, y0) == MAIN_FINGERPRINTS
 
 
 def test_two_flank_form_with_equal_flanks_is_the_one_flank_form_bitwise():
