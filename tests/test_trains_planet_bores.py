@@ -113,22 +113,102 @@ def test_stage_on_potential_energy_stiffness_runs_on_the_tables_means():
         assert np.all(np.isfinite(ds[f"F_{m}"].values))
 
 
-def test_sun_meshes_are_the_planetary_sets():
-    """Every sun-planet mesh's series (drive and coast) is PlanetaryGearSet.from_geometry's
-    with the same bores (mesh phases from the geometry: the set's Parker & Lin phases) to 1e-10
-    of the mean."""
+def test_stage_meshes_are_the_planetary_sets():
+    """Every mesh's series is PlanetaryGearSet.from_geometry's with the same bores (mesh phases
+    from the geometry: the set's Parker & Lin phases) to 1e-10 of the mean: a sun-planet mesh
+    flank by flank; a planet-ring mesh with the flanks named the other way round (the train's
+    drive flank of the ring mesh is the planet's flank the sun loads, the set's coast flank
+    there), its table read backwards in time (the planet, gear a, turns in the negative sense
+    relative to the carrier)."""
     geo = stage()
     model = _model()
+    n = geo.n_planets
+    assert model.backward_meshes() == tuple(f"p{i + 1}_ring" for i in range(n))
     gs = geardyn.PlanetaryGearSet.from_geometry(
         geo, harmonics=H, stiffness="potential_energy", stiffness_options=BORES, **MEMBERS)
     theta = np.linspace(0.0, 2.0 * math.pi, 721)
     for coast in (False, True):
-        coef = gs.fourier_coast if coast else gs.fourier
-        mean = gs.coast_stiffnesses() if coast else gs.mesh_stiffnesses()
-        for m in range(geo.n_planets):
-            want = mean[m] * evaluate_series(np.concatenate([[1.0], coef[m]]), theta)
+        for m in range(2 * n):
+            theirs = coast if m < n else not coast
+            coef = gs.fourier_coast if theirs else gs.fourier
+            mean = (gs.coast_stiffnesses() if theirs else gs.mesh_stiffnesses())[m]
+            want = mean * evaluate_series(np.concatenate([[1.0], coef[m]]), theta)
             got = _train_stiffness(model, m, theta, coast)
-            np.testing.assert_allclose(got, want, rtol=0.0, atol=1e-10 * mean[m])
+            np.testing.assert_allclose(got, want, rtol=0.0, atol=1e-10 * mean)
+
+
+@pytest.mark.parametrize("shift", [0.0, 0.3])
+def test_pair_driven_from_the_wheel_is_the_spur_pairs_mirror_image(shift):
+    """A one-stage train driven from its wheel w (w turns in the positive sense, the pinion p,
+    gear a, in the negative): its mirror image is SpurPair of the same gears (pinion turning
+    positive) with p's flanks swapped, so the train's drive flank is SpurPair's coast flank and
+    its coast flank SpurPair's drive flank, each moved by the coast phase phi (SpurPair's coast
+    flank of tooth 0 passes phi mesh cycles after its drive flank, where the train's drive flank
+    passes at 0). Unshifted gears (phi = 1/2, on the tables' 360 angles) to 1e-12 of the peak;
+    pinion profile shift 0.3 (phi = 0.556, off the grid: the two flanks' tables are sampled at
+    different points of the stiffness, whose jumps the series then resolve differently) to
+    1e-2 (read forwards the train is off by half the peak). Driven from the pinion: flank by
+    flank."""
+    from geardyn.gears.potential_energy import coast_phase
+
+    pinion = g.SpurGear(19, 3.2e-3, math.radians(20.0), 0.016, profile_shift=shift)
+    wheel = g.SpurGear(48, 3.2e-3, math.radians(20.0), 0.016, profile_shift=-shift / 3.0)
+    phi = coast_phase(GearMesh(pinion, wheel))
+    assert (abs(phi - 0.5) > 0.05) == (shift > 0.0)
+    tol = 1e-2 if shift else 1e-12
+    pair = geardyn.SpurPair.from_geometry(GearMesh(pinion, wheel), bore_radius=8e-3,
+                                          speed=100.0, torque=40.0, harmonics=H,
+                                          period="mesh", angles=360,
+                                          inertia=(2.4e-4, 8.5e-3))
+    theta = np.linspace(0.0, 2.0 * math.pi, 997)
+    for driven, other in (("p", "w"), ("w", "p")):
+        train = GearTrain([Gear("p", 2.4e-4, geometry=pinion), Gear("w", 8.5e-3, geometry=wheel)],
+                          bearings=[Bearing("bp", "p", math.inf), Bearing("bw", "w", math.inf)],
+                          meshes=[Mesh("m", "p", "w", "potential_energy", bore_radius=8e-3)],
+                          driven=driven, free=True)
+        model = TrainModel(train, torques={driven: 40.0}, load=other, harmonics=H)
+        back = driven == "w"
+        assert model.backward_meshes() == (("m",) if back else ())
+        for coast in (False, True):
+            theirs = pair.coast_series if coast != back else pair.drive_series
+            want = evaluate_series(theirs, theta + (2.0 * math.pi * phi if back else 0.0))
+            got = _train_stiffness(model, 0, theta, coast)
+            np.testing.assert_allclose(got, want, rtol=0.0,
+                                       atol=(tol if back else 1e-12) * np.max(want))
+
+
+def test_backward_mesh_mirrors_its_coast_flank_about_minus_the_coast_phase():
+    """Driven from the wheel, the profile-shifted pair (coast phase phi = 0.556) meets a
+    tooth's coast flank phi mesh cycles before its drive flank: the coast flank of its
+    potential-energy tables, read backwards, is the drive flank's mirror image about -phi,
+    k_c(theta) = k_d(-2 pi phi - theta), to 1e-2 of the peak (the tables' sampling, as above;
+    about +phi it is off by more than 5e-2); a mesh of the same gears with a given stiffness
+    and waveform takes that mirror image for its coast flank, to 1e-12."""
+    from geardyn.gears.potential_energy import coast_phase
+
+    pinion = g.SpurGear(19, 3.2e-3, math.radians(20.0), 0.016, profile_shift=0.3)
+    wheel = g.SpurGear(48, 3.2e-3, math.radians(20.0), 0.016, profile_shift=-0.1)
+    phi = coast_phase(GearMesh(pinion, wheel))
+    theta = np.linspace(0.0, 2.0 * math.pi, 997)
+
+    def model(stiffness, **kw):
+        train = GearTrain([Gear("p", 2.4e-4, geometry=pinion), Gear("w", 8.5e-3, geometry=wheel)],
+                          bearings=[Bearing("bp", "p", math.inf), Bearing("bw", "w", math.inf)],
+                          meshes=[Mesh("m", "p", "w", stiffness, bore_radius=8e-3)],
+                          driven="w", free=True)
+        return TrainModel(train, torques={"w": 40.0}, load="p", harmonics=H, **kw)
+
+    pe = model("potential_energy")
+    peak = np.max(_train_stiffness(pe, 0, theta))
+    coast = _train_stiffness(pe, 0, theta, coast=True)
+    for sign, within in ((-1.0, True), (1.0, False)):
+        mirror = _train_stiffness(pe, 0, sign * 2.0 * math.pi * phi - theta)
+        assert (np.max(np.abs(coast - mirror)) < 1e-2 * peak) == within
+        assert within or np.max(np.abs(coast - mirror)) > 5e-2 * peak
+    given = model(3e8, waveform=([0.15, 0.05], [0.2, -0.04]))
+    np.testing.assert_allclose(_train_stiffness(given, 0, theta, coast=True),
+                               _train_stiffness(given, 0, -2.0 * math.pi * phi - theta),
+                               rtol=1e-12)
 
 
 def test_bad_bores_are_named():
@@ -274,9 +354,12 @@ def test_planet_flank_takes_the_wear_of_the_mesh_that_loads_it(flank):
                                                                        rel=1e-9)
     assert model.faults.meshes == ("sun_p1", "p1_ring") and model.mesh_order == z
     offsets = model._fault_offsets()
+    # the planet, gear a of p1_ring, turns in the negative sense relative to the carrier: that
+    # mesh's table is read backwards in time, the tooth passing at c = j the table's tooth -j
+    assert "p1_ring" in model.backward_meshes() and "sun_p1" not in model.backward_meshes()
     on = {"sun_p1": ("wheel", GearMesh(geo.sun, geo.planet), (SUN_BORE, PLANET_BORE), tooth),
           "p1_ring": ("pinion", GearMesh(geo.planet, geo.ring, internal=True),
-                      (PLANET_BORE, RIM), (tooth + offsets["p1_ring"]) % z)}
+                      (PLANET_BORE, RIM), -(tooth + offsets["p1_ring"]) % z)}
     loading, other = ("sun_p1", "p1_ring") if flank == "drive" else ("p1_ring", "sun_p1")
     role, pair, bores, at = on[loading]
     own = g.Wear(depth=DEPTH, gear=role, tooth=at, profile="archard", flank=flank)
