@@ -3,13 +3,15 @@
 stiffness on a planetary stage's ring meshes, and Archard wear on a planet of a train.
 
 Checks: a ring-planet mesh's table is potential_energy_stiffness of that internal pair with the
-same bores (called here); a stage on the potential-energy stiffness of both meshes has, on every
-mesh, PlanetaryGearSet.from_geometry's series with the same bores (drive and coast), mean
-stiffnesses equal to the means of tables computed here, and runs; Archard wear on a planet's
-flank (the sun mesh loads one flank, the ring mesh the other) is, in the mesh that loads it,
-that pair's own Archard wear (its table computed here) and, in the other mesh, opens that
-mesh's depth at the flank point of its contacts; bad bores are refused naming the field, in
-Python and in a study file.
+same bores (called here); a stage on the potential-energy stiffness of both meshes has mean
+stiffnesses equal to the means of tables computed here and runs, and on every mesh
+PlanetaryGearSet.from_geometry's series with the same bores (drive and coast), healthy and with a
+cracked planet; a mesh whose gear a turns in the negative sense reads its tables backwards in
+time (a pair driven from its wheel is SpurPair's mirror image; its mirrored coast flank lies
+about -phi); Archard wear on a planet's flank (the sun mesh loads one flank, the ring mesh the
+other) is, in the mesh that loads it, that pair's own Archard wear (its table computed here)
+and, in the other mesh, opens that mesh's depth at the flank point of its contacts; bad bores
+are refused naming the field, in Python and in a study file.
 """
 
 from __future__ import annotations
@@ -385,3 +387,31 @@ def test_planet_flank_takes_the_wear_of_the_mesh_that_loads_it(flank):
     assert np.all(gap[~worn] == 0.0)
     # the other planets' meshes are healthy
     assert set(tables) == {"sun_p1", "p1_ring"}
+
+
+def test_cracked_planet_of_a_train_stage_is_the_planetary_sets():
+    """A crack on tooth 7 of planet p1: over p1's revolution relative to the carrier (23 mesh
+    cycles) every mesh's stiffness equals PlanetaryGearSet.from_geometry's with the same crack
+    on planet1 (its tooth passages from the planet's half turn between its two pitch points,
+    geardyn.models.planetary_faults): the train's, from its passage step across the planet and
+    the ring mesh read backwards, put the crack on p1_ring's table at the same time. Drive and
+    coast (the ring meshes' flanks named the other way round), the healthy planets' meshes at
+    their orders, to 1e-10 of the mean."""
+    geo = stage()
+    n = geo.n_planets
+    crack = dict(depth="1.5 mm", angle="45 deg", tooth=7)
+    model = _model((g.RootCrack(**crack, gear="p1"),))
+    assert model.mesh_order == geo.planet.teeth
+    gs = geardyn.PlanetaryGearSet.from_geometry(
+        geo, harmonics=H, stiffness="potential_energy", stiffness_options=BORES,
+        faults=[g.RootCrack(**crack, gear="planet1")], **MEMBERS)
+    assert gs.mesh_order == geo.planet.teeth
+    theta = np.linspace(0.0, 2.0 * math.pi, 2001)
+    for coast in (False, True):
+        for m in range(2 * n):
+            theirs = coast if m < n else not coast
+            coef = gs.fourier_coast if theirs else gs.fourier
+            mean = (gs.coast_stiffnesses() if theirs else gs.mesh_stiffnesses())[m]
+            want = mean * evaluate_series(np.concatenate([[1.0], coef[m]]), theta)
+            got = _train_stiffness(model, m, theta * model._kernel_orders[m], coast)
+            np.testing.assert_allclose(got, want, rtol=0.0, atol=1e-10 * mean)
