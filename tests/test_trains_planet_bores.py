@@ -415,3 +415,37 @@ def test_cracked_planet_of_a_train_stage_is_the_planetary_sets():
             want = mean * evaluate_series(np.concatenate([[1.0], coef[m]]), theta)
             got = _train_stiffness(model, m, theta * model._kernel_orders[m], coast)
             np.testing.assert_allclose(got, want, rtol=0.0, atol=1e-10 * mean)
+
+
+@pytest.mark.parametrize("flank, torque", [("drive", 5.0), ("coast", 5.0), ("drive", -5.0)])
+def test_planet_archard_wear_of_the_planetary_set_is_the_trains(flank, torque):
+    """PlanetaryGearSet.from_geometry with Archard wear on planet1 (each of its meshes wearing
+    the flank it loads under the mean torques, from the healthy set's static mesh forces) has,
+    on every mesh, the series of the train stage with the same wear on p1 (checked above
+    against single-pair tables), drive and coast (the ring meshes' flanks named the other way
+    round), to 1e-10 of the mean; a reversed sun torque moves the drive flank's wear to the
+    ring mesh in both. Without torques the set refuses it naming ``wear.flank``."""
+    geo = stage()
+    n = geo.n_planets
+    wear = dict(depth=DEPTH, tooth=5, profile="archard", flank=flank)
+    model = TrainModel(_train((g.Wear(**wear, gear="p1"),)), torques={"sun": torque},
+                       mesh_phase="geometry", harmonics=H)
+    gs = geardyn.PlanetaryGearSet.from_geometry(
+        geo, harmonics=H, stiffness="potential_energy", stiffness_options=BORES,
+        faults=[g.Wear(**wear, gear="planet1")], sun_torque=torque, **MEMBERS)
+    assert np.all(np.sign(gs.static_mesh_forces()) == np.sign(torque))
+    theta = np.linspace(0.0, 2.0 * math.pi, 2001)
+    for coast in (False, True):
+        for m in range(2 * n):
+            theirs = coast if m < n else not coast
+            coef = gs.fourier_coast if theirs else gs.fourier
+            mean = (gs.coast_stiffnesses() if theirs else gs.mesh_stiffnesses())[m]
+            want = mean * evaluate_series(np.concatenate([[1.0], coef[m]]), theta)
+            got = _train_stiffness(model, m, theta * model._kernel_orders[m], coast)
+            np.testing.assert_allclose(got, want, rtol=0.0, atol=1e-10 * mean)
+    if torque > 0.0 and flank == "drive":
+        with pytest.raises(ParameterError) as err:
+            geardyn.PlanetaryGearSet.from_geometry(
+                geo, harmonics=H, stiffness="potential_energy", stiffness_options=BORES,
+                faults=[g.Wear(**wear, gear="planet1")], **MEMBERS)
+        assert err.value.field == "wear.flank"
