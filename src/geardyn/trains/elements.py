@@ -226,8 +226,8 @@ class Mesh:
     6336-1 method B, :func:`~geardyn.gears.iso6336_stiffness`) or ``"potential_energy"``
     (the mean of :func:`~geardyn.gears.potential_energy_stiffness`, or of
     :func:`~geardyn.gears.helical_stiffness`, over a mesh cycle; ``bore_radius`` [m] needed:
-    one radius for both gears or the pair (a's bore, b's bore; an internal mesh: b's, the
-    ring's, outer rim radius), stored as the pair; :class:`~geardyn.trains.TrainModel` takes
+    one radius for both gears or the pair (a's bore, b's bore; on an internal mesh b's is the
+    ring's outer rim radius), stored as the pair; :class:`~geardyn.trains.TrainModel` takes
     the waveform of both flanks from the same table, and tooth faults act through it), both
     from the two gears' geometries. A
     helical mesh's line of action is inclined by the base helix angle beta_b to the transverse
