@@ -63,8 +63,11 @@ def test_idler_flank_takes_the_wear_of_the_mesh_that_loads_it(flank):
     assert loads["m1"] == pytest.approx(f1, rel=1e-9)
     assert loads["m2"] == pytest.approx(-f1, rel=1e-9)
     offsets = model._fault_offsets()
+    # g2, gear a of m2, turns in the negative sense: m2's table is read backwards in time, the
+    # tooth passing its pitch point at c = j the table's tooth -j
+    assert model.backward_meshes() == ("m2",)
     on = {"m1": ("wheel", GearMesh(g1, g2), 5), "m2": ("pinion", GearMesh(g2, g3),
-                                                      (5 + offsets["m2"]) % 31)}
+                                                      -(5 + offsets["m2"]) % 31)}
     loading, other = ("m1", "m2") if flank == "drive" else ("m2", "m1")
     role, pair, tooth = on[loading]
     own = g.Wear(depth=DEPTH, gear=role, tooth=tooth, profile="archard", flank=flank)

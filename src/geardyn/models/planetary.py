@@ -53,7 +53,7 @@ from geardyn.models.planetary_coefficients import (
     structure_entry,
     workspace_entry,
 )
-from geardyn.models.planetary_faults import place_faults
+from geardyn.models.planetary_faults import place_faults, planet_wear_profiles
 from geardyn.models.planetary_stiffness import (
     coast_flank,
     flank_series,
@@ -752,7 +752,10 @@ class PlanetaryGearSet(Model):
         stiffnesses are per planet. :meth:`stiffness_error` gives the truncation error; the
         tables are kept as :attr:`mesh_tables`, the placement as :attr:`faults`. A static
         transmission error (``*_mesh_error``) is refused with faults (it would act once per
-        revolution).
+        revolution). Archard wear on a planet follows the mesh that loads the worn flank under
+        the mean torques (the static mesh forces of the healthy set:
+        :func:`~geardyn.models.planetary_faults.planet_wear_profiles`); a flank no mesh loads
+        (no torques) is refused (``wear.flank``).
         """
         from geardyn.gears import PlanetaryGeometry
 
@@ -785,8 +788,17 @@ class PlanetaryGearSet(Model):
             inputs["ring_mesh_phase"] = [-2.0 * math.pi * float(g) for g in phases.ring]
         else:
             opts = potential_energy_options(stiffness_options, geometry, harmonics)
+            shared = {}
+            if placement.planet_archard:  # the static mesh forces of the healthy set
+                healthy = cls.from_geometry(
+                    geometry, sun=sun, ring=ring, carrier=carrier, planet=planet,
+                    harmonics=harmonics, waveform_options=waveform_options, held=held,
+                    stiffness=stiffness, stiffness_options=stiffness_options, coast=coast,
+                    **kw)
+                shared = planet_wear_profiles(placement, geometry, opts,
+                                              healthy.static_mesh_forces())
             revolution = revolution_stiffness(geometry, opts, placement, harmonics,
-                                              _sun_turns(held_member))
+                                              _sun_turns(held_member), shared)
             inputs, waves = revolution.inputs(geometry.n_planets, coast), None
             tables = revolution.healthy
         meshes = {"sun": geometry.sun_mesh, "ring": geometry.ring_mesh}

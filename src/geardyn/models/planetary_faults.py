@@ -41,8 +41,11 @@ drive flank, which is the sun-planet mesh's coast flank). So
   coast contacts; ``"coast"`` the other flank (the sun-planet mesh's coast contacts and the
   ring-planet mesh's drive contacts). The thinned sections of the tooth soften the contacts of
   both flanks, so both meshes feel them (as on a pair's tooth, :mod:`geardyn.gears.faults`);
-* Archard wear on a planet is refused (its profile follows one mesh's sliding; the tables of
-  the two meshes would each derive their own), uniform wear is taken;
+* Archard wear on a planet is the wear of one revolution of the planet in which each of its
+  meshes wears the flank it loads under the mean torques (:func:`planet_wear_profiles`, the
+  convention of :func:`geardyn.trains.faults.shared_wear_profiles`): in forward drive the sun
+  mesh wears the ``"drive"`` flank and the ring mesh the ``"coast"`` flank, each by its own
+  sliding, and both meshes' tables take that one depth along the flank;
 * on the sun the flanks are the sun-planet mesh's, on the ring the ring-planet mesh's.
 """
 
@@ -84,6 +87,13 @@ class FaultPlacement:
     ring_faults: tuple[Any, ...]
 
     @property
+    def planet_archard(self) -> bool:
+        """Whether Archard wear lies on a planet (its depth then follows the loads:
+        :func:`planet_wear_profiles`)."""
+        return self.planet is not None and any(
+            isinstance(f, Wear) and f.profile == "archard" for f in self.faults)
+
+    @property
     def gear(self) -> str:
         """The faulty gear's name as the faults give it (``"sun"``, ``"planet2"``, ...)."""
         return self.member if self.planet is None else f"planet{self.planet + 1}"
@@ -105,8 +115,8 @@ def place_faults(faults: object, geometry: Any) -> FaultPlacement | None:
     """The :class:`FaultPlacement` of ``faults`` (one fault or a sequence) on the gears of
     ``geometry`` (a :class:`~geardyn.gears.PlanetaryGeometry`), None without faults. Errors name
     the fault's field: ``<kind>.gear`` (not a gear of the set, a planet beyond N),
-    ``<kind>.tooth`` (beyond the gear's teeth), ``wear.profile`` (Archard wear on a planet), or
-    ``faults`` (not a fault, faults on more than one gear)."""
+    ``<kind>.tooth`` (beyond the gear's teeth), or ``faults`` (not a fault, faults on more than
+    one gear)."""
     listed = listed_faults(faults)
     if not listed:
         return None
@@ -128,10 +138,6 @@ def place_faults(faults: object, geometry: Any) -> FaultPlacement | None:
         if not 0 <= fault.tooth < z:
             raise ParameterError(f"{kind}.tooth", fault.tooth,
                                  f"must lie in [0, {z - 1}] ({gear} has {z} teeth)")
-        if number is not None and isinstance(fault, Wear) and fault.profile != "uniform":
-            raise ParameterError("wear.profile", fault.profile, "Archard's profile follows one "
-                                 "mesh's sliding, and a planet's flank meets two (the sun and, "
-                                 "on reversal, the ring): give uniform wear on a planet")
         where[gear] = fault
     if len(where) > 1:
         raise ParameterError("faults", ", ".join(sorted(where)),
@@ -183,3 +189,45 @@ def mesh_shifts(geometry: Any, sun_turns: int, placement: FaultPlacement | None
         p = placement.planet
         ring[p] = (sun[p] + planet_passage_delay(geometry)) % z
     return sun, ring
+
+
+def planet_wear_profiles(placement: FaultPlacement, geometry: Any, opts: Any,
+                         forces: np.ndarray) -> dict[Any, Any]:
+    """The depth along the flank of each Archard :class:`~geardyn.gears.Wear` of a planet's
+    ``placement`` (keyed by the fault as given): the wear of one planet revolution, each of its
+    two meshes wearing the flank it loads (:func:`~geardyn.gears.potential_energy.
+    combined_wear_profile`), weighted by its load per unit face width on the worn flank.
+    ``forces``: the set's static mesh forces [N] (sun-planet meshes, then ring-planet; positive
+    on the drive flank); the planet's ``"drive"`` flank is the sun-planet mesh's drive flank
+    and the ring-planet mesh's coast flank. ``opts``: the
+    :class:`~geardyn.models.planetary_stiffness.PotentialEnergyOptions` of the tables. {}
+    without Archard wear on a planet. Error ``wear.flank``: no mesh loads the worn flank."""
+    from geardyn.gears.potential_energy import combined_wear_profile, prepare_pair
+
+    if not placement.planet_archard:
+        return {}
+    n, p = geometry.n_planets, placement.planet
+    f_sun, f_ring = float(forces[p]), float(forces[n + p])
+    common = dict(young=opts.young, poisson=opts.poisson, nodes=opts.nodes,
+                  root_segment=opts.root_segment)
+    pairs = (prepare_pair(geometry.sun_mesh, bore_radius=(opts.sun_bore_radius,
+                                                          opts.planet_bore_radius), **common),
+             prepare_pair(geometry.ring_mesh, bore_radius=(opts.planet_bore_radius,
+                                                           opts.ring_rim_radius),
+                          ring_foundation="rigid", **common))
+    out = {}
+    for wear in placement.faults:
+        if not (isinstance(wear, Wear) and wear.profile == "archard"):
+            continue
+        sign = 1.0 if wear.flank == "drive" else -1.0
+        raw = (max(sign * f_sun, 0.0), max(-sign * f_ring, 0.0))
+        if not max(raw) > 0.0:
+            raise ParameterError("wear.flank", wear.flank, f"no mesh of {placement.gear} loads "
+                                 f"its {wear.flank} flank under the mean torques (static mesh "
+                                 f"forces {f_sun:.6g} N sun-side, {f_ring:.6g} N ring-side): "
+                                 "Archard wear on a planet follows the mesh that loads the "
+                                 "worn flank")
+        parts = [(pair, role, w / max(raw) / pair.face_width)
+                 for pair, role, w in zip(pairs, ("wheel", "pinion"), raw, strict=True)]
+        out[wear] = combined_wear_profile(parts, wear.depth)
+    return out

@@ -234,10 +234,14 @@ class RevolutionStiffness:
 
 
 def revolution_stiffness(geometry: Any, opts: PotentialEnergyOptions, placement: Any,
-                         harmonics: int, sun_turns: int) -> RevolutionStiffness:
+                         harmonics: int, sun_turns: int,
+                         wear_profiles: Mapping[Any, Any] | None = None) -> RevolutionStiffness:
     """The :class:`RevolutionStiffness` of ``geometry`` with the faults of ``placement`` (a
     :class:`~geardyn.models.planetary_faults.FaultPlacement`), ``harmonics`` mesh harmonics
-    (every sideband up to the last: ``harmonics`` x Z_f in the revolution angle)."""
+    (every sideband up to the last: ``harmonics`` x Z_f in the revolution angle).
+    ``wear_profiles``: the depth along the flank of Archard wear of ``placement.faults`` (keyed
+    by the fault as given) in place of each mesh's own
+    (:func:`~geardyn.models.planetary_faults.planet_wear_profiles`)."""
     from geardyn.gears.potential_energy import potential_energy_stiffness
     from geardyn.models.planetary_faults import mesh_shifts
 
@@ -250,6 +254,9 @@ def revolution_stiffness(geometry: Any, opts: PotentialEnergyOptions, placement:
     meshes = {"sun": geometry.sun_mesh, "ring": geometry.ring_mesh}
     extra = {"sun": {}, "ring": {"ring_foundation": "rigid"}}
     faults = {"sun": placement.sun_faults, "ring": placement.ring_faults}
+    shared = dict(wear_profiles or {})
+    profiles = {g: {on: shared[f] for f, on in zip(placement.faults, faults[g], strict=False)
+                    if f in shared} for g in faults}
     n = geometry.n_planets
     tables, drive, coast, healthy_tables = [], [], [], []
     for g in ("sun", "ring"):
@@ -257,7 +264,8 @@ def revolution_stiffness(geometry: Any, opts: PotentialEnergyOptions, placement:
                                              **extra[g])
         healthy_tables.append(healthy)
         faulty = (potential_energy_stiffness(meshes[g], bore_radius=bores[g], faults=faults[g],
-                                             cycles=order, **common, **extra[g])
+                                             cycles=order, wear_profiles=profiles[g], **common,
+                                             **extra[g])
                   if faults[g] else None)
         for i in range(n):
             hit = faulty is not None and placement.planet in (None, i)

@@ -227,9 +227,11 @@ class Mesh:
     ``stiffness``: the mean mesh stiffness [N/m] along the line of action, or ``"iso"`` (ISO
     6336-1 method B, :func:`~geardyn.gears.iso6336_stiffness`) or ``"potential_energy"``
     (the mean of :func:`~geardyn.gears.potential_energy_stiffness`, or of
-    :func:`~geardyn.gears.helical_stiffness`, over a mesh cycle; ``bore_radius`` [m] needed,
-    for both gears; :class:`~geardyn.trains.TrainModel` takes the waveform of both flanks from
-    the same table, and tooth faults act through it), both from the two gears' geometries. A
+    :func:`~geardyn.gears.helical_stiffness`, over a mesh cycle; ``bore_radius`` [m] needed:
+    one radius for both gears or the pair (a's bore, b's bore; on an internal mesh b's is the
+    ring's outer rim radius), stored as the pair; :class:`~geardyn.trains.TrainModel` takes
+    the waveform of both flanks from the same table, and tooth faults act through it), both
+    from the two gears' geometries. A
     helical mesh's line of action is inclined by the base helix angle beta_b to the transverse
     plane and ``stiffness`` is along it (the normal stiffness k_n); the planar model sees k_n
     cos^2(beta_b) on the transverse deflection.
@@ -281,9 +283,10 @@ class Mesh:
             if not self.pressure_angle < math.pi / 2:
                 raise ParameterError(f"{self.name}.pressure_angle", self.pressure_angle,
                                      "must be below 90 deg")
-        for attr in ("centre_distance", "bore_radius"):
-            if getattr(self, attr) is not None:
-                _si(self, attr, "length", strict=True)
+        if self.centre_distance is not None:
+            _si(self, "centre_distance", "length", strict=True)
+        if self.bore_radius is not None:
+            self._bores()
         if self.helix_angle is not None:
             _si(self, "helix_angle", "angle")
             if not self.helix_angle < math.pi / 2:
@@ -292,6 +295,30 @@ class Mesh:
         _si(self, "damping", "dimensionless")  # N s/m, a number
         _si(self, "error", "length")
         self._backlash()
+
+    def _bores(self) -> None:
+        """``bore_radius`` as the pair (a's bore, b's bore or rim radius) [m]; errors name
+        ``<mesh>.bore_radius`` and the gear."""
+        value = self.bore_radius
+        field = f"{self.name}.bore_radius"
+        if isinstance(value, tuple | list):
+            if len(value) != 2:
+                raise ParameterError(field, value, f"one radius for both gears or two ({self.a}"
+                                     f"'s bore, {self.b}'s {self._b_radius})")
+            pair = tuple(value)
+        else:
+            pair = (value, value)
+        out = []
+        for gear, what, v in ((self.a, "bore", pair[0]), (self.b, self._b_radius, pair[1])):
+            try:
+                out.append(si_value(field, v, "length", 0.0, strict=True))
+            except ParameterError as exc:
+                raise ParameterError(field, v, f"{gear}'s {what}: {exc.reason}") from None
+        _set(self, "bore_radius", tuple(out))
+
+    @property
+    def _b_radius(self) -> str:
+        return "rim radius" if self.internal else "bore"
 
     def _backlash(self) -> None:
         value = self.backlash

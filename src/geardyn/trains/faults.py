@@ -18,7 +18,9 @@ D_m mesh cycles later (the unreduced passage step across f,
 :meth:`~geardyn.trains.TrainModel.tooth_passage_step`, from the geometry); on m's table, whose
 pairs pass at c = -psi_m / 2 pi + whole cycles, it is tooth (j + round(D_m + (psi_m - psi_0) /
 2 pi)) mod Z_f of f: exact with ``mesh_phase="geometry"``, the passage nearest the geometric one
-with other phases.
+with other phases. A mesh whose gear a turns in the negative sense relative to its frame reads
+its tables backwards in time (:meth:`~geardyn.trains.TrainModel.backward_meshes`): the tooth
+passing its pitch point at c = j is its table's tooth -j.
 
 Flanks: a fault's ``flank`` ``"drive"`` is the flank in contact at a positive deflection of f's
 meshes. A train's mesh rows make that the same flank of f's teeth in every mesh (the
@@ -75,10 +77,12 @@ class TrainFaults:
         """One line for the datasets' attrs."""
         return "; ".join(f.describe() for f in self.faults)
 
-    def on_mesh(self, role: str, offset: int) -> tuple[Any, ...]:
+    def on_mesh(self, role: str, offset: int, backward: bool = False) -> tuple[Any, ...]:
         """The faults as a pair's table takes them: on its ``role`` (``"pinion"``,
-        ``"wheel"``), each tooth moved by ``offset`` (mod Z_f)."""
-        return tuple(replace(f, gear=role, tooth=(f.tooth + offset) % self.teeth)
+        ``"wheel"``), each tooth moved by ``offset`` (mod Z_f); ``backward`` (a table read
+        backwards in time): on the table's tooth -(tooth + offset) (mod Z_f)."""
+        sign = -1 if backward else 1
+        return tuple(replace(f, gear=role, tooth=sign * (f.tooth + offset) % self.teeth)
                      for f in self.faults)
 
 

@@ -171,10 +171,12 @@ class TrainModel(PlanetaryGearSet):
         (default) for symmetric teeth the mirror image of the drive flank's relative stiffness,
         kc(theta) = k0(2 pi phi - theta - phase) with k(theta) = k0(theta + phase), phi =
         :func:`geardyn.gears.potential_energy.coast_phase` of the gear pair (from the geometry
-        alone; :func:`~geardyn.models.planetary_stiffness.mirrored`), the same mean stiffness;
+        alone; -phi on a mesh whose gear a turns in the negative sense, :meth:`backward_meshes`;
+        :func:`~geardyn.models.planetary_stiffness.mirrored`), the same mean stiffness;
         ``"symmetric"``: the drive flank's stiffness on both flanks. A mesh with a gear
         without geometry has one stiffness on both flanks; a mesh on the potential-energy
-        stiffness takes its table's coast flank with ``"mirror"``. Kept as
+        stiffness takes its table's coast flank with ``"mirror"`` (both flanks' tables read
+        backwards in time on such a mesh). Kept as
         :attr:`coast_flank`.
     time_scale, length_scale
         omega_0 [rad/s] (default sqrt(k_ref / m_e,ref) of the reference mesh) and L [m].
@@ -517,9 +519,13 @@ class TrainModel(PlanetaryGearSet):
         phase) and mean stiffnesses [N/m along the line of action] by mesh index: the discrete
         Fourier series of the one-cycle tables (``harmonics`` terms), a faulty gear's meshes
         over its revolution (:func:`~geardyn.trains.faults.revolution_series`, ``harmonics`` x
-        Z_f terms in the revolution angle)."""
+        Z_f terms in the revolution angle). A table is in the pinion's (gear a's) rotation in
+        the positive sense; a mesh whose gear a turns in the negative sense relative to its
+        frame (:meth:`backward_meshes`) reads it backwards, K(c) = T(-c), and a fault on the
+        tooth passing its pitch point at c = j sits on the table's tooth -j."""
         out: dict[int, tuple[np.ndarray, np.ndarray, float, float]] = {}
         offsets = self._fault_offsets()
+        backward = self.backward_meshes()
         shared = {} if self.faults is None else shared_wear_profiles(
             self.train, self.faults, self.static_loads())
         self._fault_tables: dict[str, Any] = {}
@@ -535,19 +541,21 @@ class TrainModel(PlanetaryGearSet):
             normal = 1.0 / math.cos(data.base_helix_angle) ** 2
             faulty = mesh.name in offsets
             flanks: list[FlankSeries] = []
+            back = mesh.name in backward
             for var in ("mesh_stiffness", "mesh_stiffness_coast"):
-                healthy = data.table[var].values
+                healthy = _in_time(data.table[var].values, back)
                 if faulty:
                     z = self.faults.teeth
                     role = "pinion" if self.faults.gear == mesh.a else "wheel"
                     pair = pair_geometry(mesh, self.train.bodies[mesh.a],
                                       self.train.bodies[mesh.b])
-                    on = self.faults.on_mesh(role, offsets[mesh.name])
+                    on = self.faults.on_mesh(role, offsets[mesh.name], backward=back)
                     table = faulty_table(self.train, mesh, pair, on, z, {
                         f: shared[g] for f, g in zip(on, self.faults.faults, strict=True)
                         if g in shared})
                     self._fault_tables[mesh.name] = table
-                    flanks.append(revolution_series(healthy, table[var].values, harmonics, z))
+                    flanks.append(revolution_series(healthy, _in_time(table[var].values, back),
+                                                    harmonics, z))
                 else:
                     flanks.append(flank_series(healthy, harmonics))
             order = self.faults.teeth if faulty else 1
@@ -556,6 +564,19 @@ class TrainModel(PlanetaryGearSet):
                     for s in flanks]
             out[i] = (rows[0], rows[1], flanks[0].mean * normal, flanks[1].mean * normal)
         return out
+
+    def backward_meshes(self) -> tuple[str, ...]:
+        """The meshes whose gear a turns in the negative sense relative to the mesh's frame
+        (the carrier of a planet, else the ground) when the driven body turns in the positive
+        sense: an idler's mesh with the gear it drives, where the idler is a; a planet's mesh
+        with the ring. Their potential-energy tables, in gear a's positive rotation, are read
+        backwards in time (:meth:`_tooth_series`). () without a driven body."""
+        train = self.train
+        if train.driven is None:
+            return ()
+        ratios = train.speed_ratios()
+        return tuple(m.name for m in train.meshes
+                     if ratios[m.a] - train.mesh_frame_ratio(m, ratios) < 0.0)
 
     def static_loads(self) -> dict[str, float]:
         """The static mesh forces [N] of the linear train at mean stiffness (no backlash)
@@ -594,15 +615,19 @@ class TrainModel(PlanetaryGearSet):
         """The coast flank's relative Fourier coefficients (meshes, 2 nh) and whether any
         mesh's differs from its drive flank's (``coast="mirror"``): the rows ``own`` (the
         potential-energy meshes) from ``coast``, every other mesh whose two gears have geometry
-        the drive flank's mirror image."""
+        the drive flank's mirror image about its coast phase phi (-phi on a mesh read
+        backwards, :meth:`backward_meshes`)."""
         phases = self.coast_phases()
+        backward = self.backward_meshes()
         out = self.fourier.copy()
         for m in own:
             out[m] = coast[m]
         for m, name in enumerate(self._mesh_names):
             if name in phases and m not in own:
-                # k(theta) = k0(theta + psi): mirror about phi - psi / pi
-                phi = phases[name] - self.mesh_phase[m] / math.pi
+                # k(theta) = k0(theta + psi): mirror about phi - psi / pi; a mesh read
+                # backwards meets the coast flank phi before the drive flank: about -phi
+                phi = (-1.0 if name in backward else 1.0) * phases[name] - (
+                    self.mesh_phase[m] / math.pi)
                 a, b = mirrored(self.fourier[m, 0::2], self.fourier[m, 1::2], phi)
                 row = np.empty_like(out[m])
                 row[0::2], row[1::2] = a, b
@@ -1057,6 +1082,12 @@ class TrainModel(PlanetaryGearSet):
         kind = "quasi-periodic" if self.quasi_periodic else "periodic"
         return (f"TrainModel({len(self.train.bodies)} bodies, {len(self._mesh_names)} meshes, "
                 f"dofs={len(self.dof_names())}, Omega={self.omega:g}, {kind} forcing)")
+
+
+def _in_time(table: np.ndarray, backward: bool) -> np.ndarray:
+    """A table uniform in gear a's rotation, c_i = i / n over its cycles, as the mesh meets it
+    in time: itself, or read backwards, T(-c_i) = T[(-i) mod n]."""
+    return np.roll(table[::-1], 1) if backward else table
 
 
 def _fill_play_block(blk: np.ndarray, nh: int, row: np.ndarray, force_row: np.ndarray,

@@ -36,7 +36,9 @@ def planetary_stage(*, sun: Gear, ring: Gear, carrier: Inertia, planet: Gear, n_
                     planet_angles: Sequence[Any] | None = None, carrier_radius: Any = None,
                     sun_pressure_angle: Any = None, ring_pressure_angle: Any = None,
                     pin_damping: Any = 0.0, mesh_damping: Any = 0.0,
-                    ring_planet: Gear | None = None) -> PlanetaryStage:
+                    ring_planet: Gear | None = None, sun_bore_radius: Any = None,
+                    planet_bore_radius: Any = None, ring_rim_radius: Any = None,
+                    ring_planet_bore_radius: Any = None) -> PlanetaryStage:
     """A single planetary stage as elements (Lin & Parker 1999): ``n_planets`` copies of
     ``planet`` named ``<planet.name>1`` ..., each on a pin of ``pin_stiffness`` [N/m]
     (``math.inf``: rigid) on ``carrier`` at ``carrier_radius`` [m] and angle psi_n [rad]
@@ -49,7 +51,13 @@ def planetary_stage(*, sun: Gear, ring: Gear, carrier: Inertia, planet: Gear, n_
     ``ring_planet``: a compound stage (Kiracofe & Parker 2007). Each planet then carries a
     copy of this second gear (``<ring_planet.name>1`` ...), joined to it rigidly (a rigid hub
     ``<name>_hub`` at the planet's centre and a rigid shaft ``<name>_joint``): the planet
-    meshes the sun, the second gear the ring."""
+    meshes the sun, the second gear the ring.
+
+    Bore radii [m], for a mesh stiffness ``"potential_energy"`` (needed by the meshes that take
+    it): ``sun_bore_radius``, ``planet_bore_radius``, ``ring_rim_radius`` (the ring's outer
+    radius) and, in a compound stage, ``ring_planet_bore_radius``; the sun-planet meshes take
+    (sun's, planet's), the planet-ring meshes (planet's or ring planet's, ring's) as their
+    ``bore_radius`` pair."""
     if isinstance(n_planets, bool) or not isinstance(n_planets, int) or not 1 <= n_planets <= 32:
         raise ParameterError("n_planets", n_planets, "must be a whole number from 1 to 32")
     if planet_angles is None:
@@ -58,15 +66,23 @@ def planetary_stage(*, sun: Gear, ring: Gear, carrier: Inertia, planet: Gear, n_
         psi = [si_value(f"planet_angles[{i}]", a, "angle") for i, a in enumerate(planet_angles)]
         if len(psi) != n_planets:
             raise ParameterError("planet_angles", planet_angles, f"needs {n_planets} angles")
+    if ring_planet is not None and not isinstance(ring_planet, Gear):
+        raise ParameterError("ring_planet", ring_planet, "must be a Gear")
+    if ring_planet is None and ring_planet_bore_radius is not None:
+        raise ParameterError("ring_planet_bore_radius", ring_planet_bore_radius,
+                             "only a compound stage (ring_planet) has a ring planet")
+    sun_bores = _bores(sun_mesh_stiffness, (("sun_bore_radius", sun_bore_radius),
+                                            ("planet_bore_radius", planet_bore_radius)))
+    ring_side = (("ring_planet_bore_radius", ring_planet_bore_radius) if ring_planet
+                 else ("planet_bore_radius", planet_bore_radius))
+    ring_bores = _bores(ring_mesh_stiffness, (ring_side, ("ring_rim_radius", ring_rim_radius)))
     first = Mesh("sun_mesh", sun.name, planet.name, sun_mesh_stiffness,
-                 pressure_angle=sun_pressure_angle)
+                 pressure_angle=sun_pressure_angle, bore_radius=sun_bores)
     alpha_s = resolve_mesh(first, sun, planet).pressure_angle
     if carrier_radius is None:
         rc = (sun.base_radius + planet.base_radius) / math.cos(alpha_s)
     else:
         rc = si_value("carrier_radius", carrier_radius, "length", 0.0, strict=True)
-    if ring_planet is not None and not isinstance(ring_planet, Gear):
-        raise ParameterError("ring_planet", ring_planet, "must be a Gear")
     planets, bearings, sun_meshes, ring_meshes = [], [], [], []
     seconds, hubs, joints = [], [], []
     for i, angle in enumerate(psi):
@@ -76,7 +92,7 @@ def planetary_stage(*, sun: Gear, ring: Gear, carrier: Inertia, planet: Gear, n_
                                 damping=pin_damping, radius=rc, angle=angle))
         sun_meshes.append(Mesh(f"{sun.name}_{p.name}", sun.name, p.name, sun_mesh_stiffness,
                                angle=angle, pressure_angle=sun_pressure_angle,
-                               damping=mesh_damping))
+                               damping=mesh_damping, bore_radius=sun_bores))
         q = p
         if ring_planet is not None:
             q = replace(ring_planet, name=f"{ring_planet.name}{i + 1}")
@@ -85,8 +101,25 @@ def planetary_stage(*, sun: Gear, ring: Gear, carrier: Inertia, planet: Gear, n_
             joints.append(Shaft(f"{q.name}_joint", q.name, p.name, math.inf))
         ring_meshes.append(Mesh(f"{q.name}_{ring.name}", q.name, ring.name, ring_mesh_stiffness,
                                 internal=True, angle=angle + math.pi,
-                                pressure_angle=ring_pressure_angle, damping=mesh_damping))
+                                pressure_angle=ring_pressure_angle, damping=mesh_damping,
+                                bore_radius=ring_bores))
     return PlanetaryStage(bodies=(sun, ring, carrier, *planets, *seconds),
                           bearings=(*bearings, *hubs), meshes=(*sun_meshes, *ring_meshes),
                           planets=tuple(p.name for p in planets), carrier_radius=rc,
                           shafts=tuple(joints), compound=tuple(q.name for q in seconds))
+
+
+def _bores(stiffness: Any, radii: tuple[tuple[str, Any], tuple[str, Any]]
+           ) -> tuple[float, float] | None:
+    """A stage mesh's ``bore_radius`` pair from its two gears' radii ``(name, value)``, each
+    checked as a length [m] naming its parameter. The potential-energy stiffness needs both;
+    another stiffness takes them only when both are given (else None: it does not use them)."""
+    if stiffness != "potential_energy" and any(v is None for _, v in radii):
+        return None
+    out = []
+    for name, value in radii:
+        if value is None:
+            raise ParameterError(name, None, "needed by the potential-energy stiffness of the "
+                                 "stage's meshes that gear takes part in")
+        out.append(si_value(name, value, "length", 0.0, strict=True))
+    return out[0], out[1]

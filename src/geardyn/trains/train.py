@@ -99,8 +99,29 @@ def _mesh_stiffness(mesh: Mesh, gear_mesh: Any, beta_b: float) -> tuple[float, s
 
     method = helical_stiffness if isinstance(gear_mesh, HelicalMesh) else (
         potential_energy_stiffness)
-    ds = method(gear_mesh, bore_radius=mesh.bore_radius)
+    try:
+        ds = method(gear_mesh, bore_radius=mesh.bore_radius)
+    except ParameterError as exc:
+        raise _gear_error(mesh, exc) from None
     return float(ds["mesh_stiffness"].mean()) * normal, "potential_energy", ds
+
+
+def _gear_error(mesh: Mesh, exc: ParameterError) -> ParameterError:
+    """``exc`` of a pair's table (its field ``pinion.<x>`` or ``wheel.<x>``) naming
+    ``<mesh>.<x>`` and the gear (a the pinion, b the wheel); other errors as they are."""
+    role, _, rest = exc.field.partition(".")
+    if role not in ("pinion", "wheel") or not rest:
+        return exc
+    gear = mesh.a if role == "pinion" else mesh.b
+    hint = ""
+    if rest == "bore_radius" and mesh.bore_radius[0] == mesh.bore_radius[1]:
+        hint = (f" (one bore_radius is both gears'; give two: {mesh.a}'s bore, {mesh.b}'s "
+                f"{'rim radius' if mesh.internal else 'bore'})")
+    what = rest
+    if rest == "bore_radius":
+        what = "rim radius" if role == "wheel" and mesh.internal else "bore"
+    return ParameterError(f"{mesh.name}.{rest}", exc.value,
+                          f"{gear}'s {what}: {exc.reason}{hint}")
 
 
 def resolve_mesh(mesh: Mesh, ga: Gear, gb: Gear) -> MeshData:
