@@ -174,6 +174,9 @@ _COAST_FROM_GEOMETRY = ("sun_coast_stiffness", "ring_coast_stiffness", "coast_wa
 #: Attributes :meth:`PlanetaryGearSet.from_geometry` attaches, kept by ``with_params``.
 _FROM_BUILD = ("geometry", "stiffness_waveforms", "stiffness_tables", "stiffness_method", "held",
                "coast_flank", "faults", "mesh_tables")
+#: The declared per-planet inputs but the stiffnesses (read by their declared kinds; the mesh
+#: stiffnesses are read on their own, the coast ones where the coast flank is built).
+_PER_PLANET = {i.name: i.kind for i in INPUTS if i.form == "per_planet" and i.kind != "stiffness"}
 #: The sweep parameter of a set built from geometry: the input member's speed [rpm].
 INPUT_SPEED = "input_speed"
 
@@ -499,13 +502,7 @@ class PlanetaryGearSet(Model):
         self.k_s = _stiffness("sun_mesh_stiffness", sun_mesh_stiffness, n)
         self.k_r = _stiffness("ring_mesh_stiffness", ring_mesh_stiffness, n)
         per = {}
-        for f, kind in (("sun_stiffness_fluctuation", "dimensionless"),
-                        ("ring_stiffness_fluctuation", "dimensionless"),
-                        ("sun_mesh_phase", "angle"), ("ring_mesh_phase", "angle"),
-                        ("sun_backlash", "length"), ("ring_backlash", "length"),
-                        ("sun_mesh_error", "length"), ("ring_mesh_error", "length"),
-                        ("sun_error_phase", "angle"), ("ring_error_phase", "angle"),
-                        ("mesh_damping", "dimensionless")):
+        for f, kind in _PER_PLANET.items():
             minimum = 0.0 if kind in ("length", "dimensionless") else None
             per[f] = _per_planet(f, self.inputs[f], n, kind, minimum)
         both = lambda f: np.concatenate([per[f"sun_{f}"], per[f"ring_{f}"]])  # noqa: E731
