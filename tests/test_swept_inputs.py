@@ -211,3 +211,22 @@ def test_axis_units_of_the_declarations():
             assert to_si(f"2.5 {unit}", kind) == 2.5, kind
     speed = by_name(train_inputs.INPUTS)["input_speed"]
     assert speed.axis_unit == "rpm"
+
+
+@pytest.mark.parametrize("study", ["planetary_example", "two_stage_train"])
+def test_the_explorers_controls_are_declared_swept_inputs_with_their_meanings(study):
+    """The explorer's main controls of a planetary or train study are swept inputs of the
+    model, and their help is the declaration's meaning (or the coefficient's, for a name that
+    is also a coefficient)."""
+    from geardyn.explore.state import MAIN_PARAMS, ExplorerState, Window
+
+    state = ExplorerState(builtin_study(study), study, window=Window(1000.0, 2000.0, 2))
+    declared = by_name(state.model.input_declarations)
+    offered = MAIN_PARAMS[state.kind]
+    assert set(state.main_params()) <= set(offered)
+    for name in offered:
+        assert declared[name].swept, name
+        layout = state.model.coefficient_layout
+        expected = (layout.slot(name).coefficient.describe() if name in layout.names
+                    else declared[name].meaning)
+        assert state.param_help(name) == expected
