@@ -13,7 +13,6 @@ import math
 
 import numpy as np
 import pytest
-from test_trains_model import _parallel
 
 import geardyn
 from geardyn.core.inputs import PhysicalInput, by_name
@@ -22,6 +21,7 @@ from geardyn.io.toml import builtin_study
 from geardyn.models import planetary_coefficients
 from geardyn.study import build_model
 from geardyn.trains import inputs as train_inputs
+from test_trains_model import _parallel
 
 #: Two admissible values of an input of each kind (in the axis unit of its sweep).
 KIND_VALUES = {"length": (1e-6, 2.5e-6), "angle": (0.1, 0.3), "stiffness": (4e8, 6e8),
@@ -32,7 +32,7 @@ NAME_VALUES = {"sun_pressure_angle": (0.35, 0.42), "ring_pressure_angle": (0.35,
                "contact_ratio": (1.4, 1.7), "torque_order": (1.0, 2.0),
                "carrier_speed": (10.0, 20.0), "carrier_speed_ratio": (1e-3, 2e-3),
                "input_speed": (1000.0, 2000.0), "input_torque": (50.0, 80.0)}
-#: Units a plain number may be written in as a unit string ("1" has none).
+#: The axis unit of a dimensionless input (no unit string: written in percent instead).
 DIMENSIONLESS = "1"
 
 
