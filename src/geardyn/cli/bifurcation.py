@@ -98,16 +98,26 @@ def _sweepable(model) -> list[str]:
                        if n != "Omega" and layout.slot(n).coefficient.kind == "input")]
 
 
+def sweep_vocabulary(model) -> list[tuple[str, str]]:
+    """The names a sweep of ``model`` takes (:func:`_sweepable`), each with the unit of its axis
+    where the model declares its inputs (:attr:`~geardyn.core.model.Model.input_declarations`:
+    ``("sun_backlash", "m")``); else the unit is empty."""
+    declared = bool(model.input_declarations)
+    return [(n, model.param_attrs(n).get("units", "") if declared and n != "Omega" else "")
+            for n in _sweepable(model)]
+
+
 def _check_param_name(model, param: str) -> None:
-    """A one-line error naming ``--param`` unless ``model`` can sweep ``param``."""
+    """A one-line error naming ``--param`` unless ``model`` can sweep ``param`` (the known
+    names listed with their units, :func:`sweep_vocabulary`)."""
     known = _sweepable(model)
     try:
         ok = param in known or model.lane_params(param, [1.0]).shape[0] == 1
     except KeyError:
         ok = False
     if not ok:
-        raise ParameterError("--param", param,
-                             f"not a parameter of {model.name}; known: {', '.join(known)}")
+        names = ", ".join(f"{n} [{u}]" if u else n for n, u in sweep_vocabulary(model))
+        raise ParameterError("--param", param, f"not a parameter of {model.name}; known: {names}")
 
 
 def _check_param_values(model, param: str, ends: tuple[float, float], range_text: str) -> None:
@@ -200,8 +210,9 @@ def _summary(ds) -> str:
 def bifurcation_command(
     study: Annotated[str, typer.Argument(help="Study TOML file or built-in study name.")],
     param: Annotated[
-        str | None, typer.Option(help="Swept parameter: Omega or a paper name (default: "
-                                      "sweep.param).")
+        str | None, typer.Option(help="Swept parameter: Omega or a parameter of the study's "
+                                      "model (an unknown name lists them, with their units; "
+                                      "default: sweep.param).")
     ] = None,
     range_: Annotated[
         str | None,

@@ -185,6 +185,7 @@ def params_show(
             table.add_row(_fmt(float(modes["frequency"][k])), str(int(modes["multiplicity"][k])),
                           *((str(modes["type"].values[k]),) if kinds else ()))
         out.print(table)
+        _show_swept(out, model)
         return
 
     out.print(f"[bold]interpretation[/bold] {model.interpretation}")
@@ -226,6 +227,31 @@ def params_show(
         f"{n} = {_fmt(f)} N" for n, f in zip(model.observable_names, forces, strict=True)
     )
     out.print(f"static mesh forces under the mean loads: {names}")
+
+
+def _show_swept(out: Console, model) -> None:
+    """The parameters a sweep of ``model`` takes (``--param``) with their units and meanings,
+    from its declared inputs (:func:`geardyn.cli.bifurcation.sweep_vocabulary`), and the value
+    the model holds (empty: none given, the default or derived)."""
+    from geardyn.cli.bifurcation import sweep_vocabulary
+    from geardyn.core.inputs import by_name
+
+    declared = by_name(model.input_declarations)
+    table = Table(title="Swept parameters (--param)")
+    for col in ("name", "value", "unit", "meaning"):
+        table.add_column(col)
+    for name, unit in sweep_vocabulary(model):
+        value = model.omega if name == "Omega" else model.inputs.get(name)
+        if name == "Omega":
+            meaning = "forcing frequency / time scale omega_0"
+        elif name in declared:
+            meaning = declared[name].meaning
+        else:
+            meaning = model.param_attrs(name).get("meaning", "")
+        text = ("" if value is None else _fmt(value) if isinstance(value, int | float)
+                else str(value))
+        table.add_row(name, escape(text), escape(unit), escape(meaning))
+    out.print(table)
 
 
 def _show_spur_pair(out: Console, model) -> None:

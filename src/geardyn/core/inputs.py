@@ -10,6 +10,9 @@ the model's coefficient declarations. From the declarations come:
 * the ``[params]`` table of the model's study files (:func:`geardyn.io.params_table.params_table`:
   one field per input, its type from the kind and form, its default and description);
 * the unit kinds ``with_params`` reads unit strings by;
+* the names a sweep takes (``swept``: :func:`swept`, a model's ``physical_names``), the units of
+  their axes (:attr:`PhysicalInput.axis_unit`) and the refusal, naming the input, of a sweep of
+  any other declared input;
 * a check that the declaration and the model's constructor agree: every declared input a
   keyword of its builder (``of``) with the declared default, every keyword of the constructor
   declared (``tests/test_model_inputs.py``).
@@ -23,17 +26,24 @@ number), ``"count"`` (a whole number), ``"flag"`` (True or False), ``"choice"`` 
 Forms (:data:`FORMS`): ``"one"`` (one value), ``"per_planet"`` (one value for every planet or a
 list of one per planet), ``"per_mesh"`` (one value for every mesh or ``{mesh: value}``),
 ``"list"`` (a list of values) and ``"by_name"`` (``{name: value}``).
+
+A swept input (``swept=True``) is a number of its kind, one value (for every planet or mesh where
+its form is ``"per_planet"`` or ``"per_mesh"``): a sweep re-derives the coefficients from each
+value. Counts, flags, choices, names, tables, lists and the model's scales are not swept.
 """
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
+
+import numpy as np
 
 from geardyn.core.coefficients import Coefficient
 from geardyn.units import SI_UNITS
 
-__all__ = ["FORMS", "INPUT_KINDS", "REQUIRED", "PhysicalInput", "by_name"]
+__all__ = ["AXIS_UNITS", "FORMS", "INPUT_KINDS", "REQUIRED", "SWEPT_FORMS", "SWEPT_KINDS",
+           "PhysicalInput", "by_name", "one_value", "swept"]
 
 
 class _Required:
@@ -50,6 +60,15 @@ INPUT_KINDS: tuple[str, ...] = (*SI_UNITS, "pair", "number", "count", "flag", "c
                                 "table")
 #: The forms of physical input (see the module doc).
 FORMS: tuple[str, ...] = ("one", "per_planet", "per_mesh", "list", "by_name")
+#: The unit of a sweep's axis (dataset attribute ``units``) of each kind of swept input.
+AXIS_UNITS: dict[str, str] = {
+    "length": "m", "angle": "rad", "stiffness": "N/m", "inertia": "kg m^2", "mass": "kg",
+    "density": "kg/m^3", "torque": "N m", "force": "N", "pressure": "Pa", "dimensionless": "1",
+    "frequency": "rad/s", "number": "1"}
+#: The kinds of input a sweep may take (numbers: an SI kind or a plain number).
+SWEPT_KINDS: tuple[str, ...] = tuple(AXIS_UNITS)
+#: The forms of input a sweep may take (one value, for every planet or mesh).
+SWEPT_FORMS: tuple[str, ...] = ("one", "per_planet", "per_mesh")
 
 
 @dataclass(frozen=True)
@@ -65,7 +84,10 @@ class PhysicalInput:
     ``alternative`` the input that stands for this one (a required input the study may leave
     out where it gives that one: the study table's default is then None and the model's builder
     says which is missing); ``study`` False for a constructor keyword a study's ``[params]`` does
-    not take (``meaning`` says where it comes from)."""
+    not take (``meaning`` says where it comes from); ``swept`` whether a sweep takes it by name
+    (a number of one of :data:`SWEPT_KINDS` in one of :data:`SWEPT_FORMS`); ``unit`` the unit
+    a plain number, a sweep's values and its axis are in where it is not the kind's SI unit
+    (e.g. ``"rpm"``)."""
 
     name: str
     kind: str
@@ -80,6 +102,8 @@ class PhysicalInput:
     of: str = "__init__"
     alternative: str | None = None
     study: bool = True
+    swept: bool = False
+    unit: str | None = None
 
     def __post_init__(self) -> None:
         if self.kind not in INPUT_KINDS:
@@ -99,11 +123,22 @@ class PhysicalInput:
         if (self.kind == "choice" and self.form == "one" and self.default not in (
                 REQUIRED, None, *self.choices)):
             raise ValueError(f"{self.name}: default {self.default!r} is not one of the choices")
+        if self.swept and (self.kind not in SWEPT_KINDS or self.form not in SWEPT_FORMS):
+            raise ValueError(f"{self.name}: a swept input is a number ({', '.join(SWEPT_KINDS)}) "
+                             f"of form {', '.join(SWEPT_FORMS)}; got {self.kind} {self.form}")
+        if self.unit is not None and self.kind not in SWEPT_KINDS:
+            raise ValueError(f"{self.name}: only a number of a unit kind declares its unit")
 
     @property
     def required(self) -> bool:
         """Whether the builder requires the input (no default)."""
         return self.default is REQUIRED
+
+    @property
+    def axis_unit(self) -> str | None:
+        """The unit of a sweep's axis in the input: ``unit``, else its kind's
+        (:data:`AXIS_UNITS`); None for a kind that is no number."""
+        return self.unit or AXIS_UNITS.get(self.kind)
 
     def bounds(self) -> dict[str, float]:
         """The admissible range (pydantic's ``ge``/``gt``/... keywords): the declared
@@ -124,3 +159,14 @@ def by_name(inputs: Iterable[PhysicalInput]) -> dict[str, PhysicalInput]:
             raise ValueError(f"input {i.name!r} is declared twice")
         out[i.name] = i
     return out
+
+
+def swept(inputs: Iterable[PhysicalInput]) -> dict[str, PhysicalInput]:
+    """The swept inputs (``swept``) by name, in declared order."""
+    return {i.name: i for i in by_name(inputs).values() if i.swept}
+
+
+def one_value(value: object) -> bool:
+    """Whether an input's value is one value (a number, a unit string or None), not one per
+    planet or mesh (a list, a tuple, an array or a mapping) nor a flag."""
+    return not isinstance(value, bool | Mapping | list | tuple | np.ndarray)

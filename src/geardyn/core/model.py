@@ -37,6 +37,7 @@ import numpy as np
 
 from geardyn.core.capabilities import DYNAMIC_FACTOR_MEMBERS, Capabilities
 from geardyn.core.coefficients import CoefficientLayout
+from geardyn.core.inputs import PhysicalInput
 from geardyn.core.kernel_source import KernelSource
 from geardyn.core.plan import forcing_period
 from geardyn.errors import ParameterError
@@ -152,6 +153,9 @@ class Model:
     raw_overrides_allowed: bool = False
     #: Names that ``with_params`` takes as physical inputs (they re-derive the coefficients).
     physical_names: tuple[str, ...] = ()
+    #: The model's physical inputs, declared once (:mod:`geardyn.core.inputs`), where it
+    #: declares them: the names a sweep takes (``swept``), their units and meanings.
+    input_declarations: tuple[PhysicalInput, ...] = ()
     #: Length [m] of one unit of the model's displacement states, where it integrates lengths
     #: over a scale (None: none declared).
     length_scale: float | None = None

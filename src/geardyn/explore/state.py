@@ -316,9 +316,10 @@ class ExplorerState:
     def param_help(self, name: str) -> str:
         """What a control's parameter is (meaning and unit), from the model's declared
         coefficients (:mod:`geardyn.core.coefficients`; the gear pair's
-        :data:`~geardyn.models.gear_pair_coefficients.GEAR_PAIR`), the units of its sweep
-        axis, the ``[params]`` field's description, or, for a geometry control, its table;
-        empty where nothing is declared."""
+        :data:`~geardyn.models.gear_pair_coefficients.GEAR_PAIR`), its declared physical input
+        (:mod:`geardyn.core.inputs`), the units of its sweep axis, the ``[params]`` field's
+        description, or, for a geometry control, its table; empty where nothing is
+        declared."""
         from geardyn.models.gear_pair_coefficients import GEAR_PAIR
 
         if name in self.geometry_params():
@@ -328,6 +329,9 @@ class ExplorerState:
             return layout.slot(name).coefficient.describe()
         if self.kind == "gear_pair" and name in GEAR_PAIR.vocabulary():
             return GEAR_PAIR[name].describe()
+        declared = {i.name: i for i in self.model.input_declarations}.get(name)
+        if declared is not None:
+            return declared.meaning
         units = self.model.param_attrs(name).get("units")
         if units:
             return f"[{units}]"

@@ -32,6 +32,7 @@ import numpy as np
 
 from geardyn.core.capabilities import Capabilities, FaultDatasetInputs
 from geardyn.core.coefficients import CoefficientLayout
+from geardyn.core.inputs import PhysicalInput, by_name, one_value, swept
 from geardyn.core.kernel_source import KernelSource
 from geardyn.core.model import Model, unique_rows
 from geardyn.core.plan import MIN_STEPS_PER_PERIOD, STEPS_PER_FASTEST_MODE
@@ -45,6 +46,7 @@ from geardyn.models.planetary_coefficients import (
     CENTRAL,
     FORCES,
     HEADER,
+    INPUTS,
     MATRICES,
     MESH,
     MESH_ROW,
@@ -68,6 +70,11 @@ from geardyn.models.stiffness import evaluate, fourier_coefficients
 from geardyn.units import si_value
 
 _KERNEL = KernelSource(pk.planetary_rhs, pk.planetary_events, pk.planetary_observe)
+
+
+@functools.lru_cache(maxsize=8)
+def _swept(inputs: tuple[PhysicalInput, ...]) -> dict[str, PhysicalInput]:
+    return swept(inputs)
 
 
 @functools.lru_cache(maxsize=32)
@@ -118,11 +125,6 @@ def planetary_layout(dofs: tuple[str, ...], mesh_names: tuple[str, ...], nh: int
 STATIC_ITERATIONS = 50
 STATIC_STEP_TOL = 1e-13
 _SHORT = {"carrier": "c", "ring": "r", "sun": "s"}
-#: Constructor inputs that fix the model's layout or are not numbers: not swept by name.
-_NOT_SWEPT = {"n_planets", "waveform", "coast_waveform", "harmonics", "mesh_order",
-              "rotational_only", "fixed", "stiffness_gaps",
-              "centrifugal_preload", "planet_angles", "sun", "ring", "carrier", "planet",
-              "time_scale", "length_scale"}
 
 
 def _si(field: str, value: object, kind: str, minimum: float | None = 0.0,
@@ -178,15 +180,11 @@ _COAST_FROM_GEOMETRY = ("sun_coast_stiffness", "ring_coast_stiffness", "coast_wa
 #: Attributes :meth:`PlanetaryGearSet.from_geometry` attaches, kept by ``with_params``.
 _FROM_BUILD = ("geometry", "stiffness_waveforms", "stiffness_tables", "stiffness_method", "held",
                "coast_flank", "faults", "mesh_tables")
+#: The declared per-planet inputs but the stiffnesses (read by their declared kinds; the mesh
+#: stiffnesses are read on their own, the coast ones where the coast flank is built).
+_PER_PLANET = {i.name: i.kind for i in INPUTS if i.form == "per_planet" and i.kind != "stiffness"}
 #: The sweep parameter of a set built from geometry: the input member's speed [rpm].
 INPUT_SPEED = "input_speed"
-#: Units of the swept inputs, by kind (dataset axis attributes; see ``param_attrs``).
-_UNITS = {"mesh_frequency": "rad/s", INPUT_SPEED: "rpm", "carrier_speed": "rad/s",
-          "carrier_speed_ratio": "1", "torque_phase": "rad",
-          "sun_pressure_angle": "rad", "ring_pressure_angle": "rad"}
-_UNIT_SUFFIXES = (("_torque", "N m"), ("_mesh_stiffness", "N/m"), ("_coast_stiffness", "N/m"),
-                  ("_backlash", "m"),
-                  ("_mesh_error", "m"), ("_phase", "rad"))
 
 
 def _rpm(field: str, value: object) -> float:
@@ -429,6 +427,7 @@ class PlanetaryGearSet(Model):
                                     "input_speed", "sun_torque", "ring_sensor",
                                     stiffness_error=True))
     raw_overrides_allowed = True
+    input_declarations = INPUTS
     #: Raw coefficients set by name through ``with_params`` (name -> value), applied again on
     #: top of a rebuild from changed inputs.
     raw_overrides: dict[str, float] = {}
@@ -512,13 +511,7 @@ class PlanetaryGearSet(Model):
         self.k_s = _stiffness("sun_mesh_stiffness", sun_mesh_stiffness, n)
         self.k_r = _stiffness("ring_mesh_stiffness", ring_mesh_stiffness, n)
         per = {}
-        for f, kind in (("sun_stiffness_fluctuation", "dimensionless"),
-                        ("ring_stiffness_fluctuation", "dimensionless"),
-                        ("sun_mesh_phase", "angle"), ("ring_mesh_phase", "angle"),
-                        ("sun_backlash", "length"), ("ring_backlash", "length"),
-                        ("sun_mesh_error", "length"), ("ring_mesh_error", "length"),
-                        ("sun_error_phase", "angle"), ("ring_error_phase", "angle"),
-                        ("mesh_damping", "dimensionless")):
+        for f, kind in _PER_PLANET.items():
             minimum = 0.0 if kind in ("length", "dimensionless") else None
             per[f] = _per_planet(f, self.inputs[f], n, kind, minimum)
         both = lambda f: np.concatenate([per[f"sun_{f}"], per[f"ring_{f}"]])  # noqa: E731
@@ -1009,19 +1002,16 @@ class PlanetaryGearSet(Model):
             return {"units": "rpm", "long_name": f"input ({self.input_member}) speed",
                     "meaning": f"mesh frequency / {self.mesh_frequency_per_input_speed():.6g} "
                                f"({held} held), in rpm"}
+        declared = self.swept_inputs().get(name)
         if name == "mesh_frequency":
-            return {"units": "rad/s", "long_name": "mesh frequency"}
+            return {"units": declared.axis_unit, "long_name": "mesh frequency"}
         if name == "Omega":
             if self.mesh_order == 1:
                 return {}
             return {"units": "1", "long_name": "forcing frequency / time_scale",
                     "meaning": f"mesh frequency / ({self.mesh_order} time_scale): one forcing "
                                f"period is {self.mesh_order} mesh cycles"}
-        unit = _UNITS.get(name) or next((u for suffix, u in _UNIT_SUFFIXES
-                                         if name.endswith(suffix)), None)
-        if unit is None and name in self.inputs and name not in _NOT_SWEPT:
-            unit = "1"
-        return {} if unit is None else {"units": unit}
+        return {} if declared is None else {"units": declared.axis_unit}
 
     def speed_axes(self, omega: np.ndarray) -> dict[str, tuple[np.ndarray, dict]]:
         """Mesh frequency [Hz] and, for a set built from geometry, input speed [rpm] at the
@@ -1291,13 +1281,18 @@ class PlanetaryGearSet(Model):
             dofs.append([int(j) for j in np.nonzero(r @ T)[0]])
         return kt, dofs
 
+    def swept_inputs(self) -> dict[str, PhysicalInput]:
+        """The declared inputs a sweep takes by name (``swept``, :attr:`input_declarations`),
+        in declared order."""
+        return _swept(type(self).input_declarations)
+
     @property
     def physical_names(self) -> tuple[str, ...]:
-        """The numeric constructor inputs a sweep accepts by name (SI), e.g. ``sun_backlash``,
-        ``mesh_frequency``, ``sun_torque`` (raw coefficients are in ``param_names``)."""
-        names = tuple(k for k, v in self.inputs.items() if k not in _NOT_SWEPT
-                      and (v is None or isinstance(v, int | float | str))
-                      and not isinstance(v, bool))
+        """The swept inputs (:meth:`swept_inputs`: e.g. ``sun_backlash``, ``mesh_frequency``,
+        ``sun_torque``; SI) given as one value for every planet, and ``input_speed`` [rpm] of
+        a set built from geometry (raw coefficients are in ``param_names``)."""
+        names = tuple(k for k in self.swept_inputs() if k in self.inputs
+                      and one_value(self.inputs[k]))
         return names + ((INPUT_SPEED,) if self.geometry is not None else ())
 
     @property
@@ -1359,7 +1354,14 @@ class PlanetaryGearSet(Model):
 
     def lane_params(self, name: str, values: Sequence[float] | np.ndarray) -> np.ndarray:
         """Coefficient vectors (lanes x n_params) with ``name`` set to ``values`` (a physical
-        input re-derives every coefficient, as :meth:`with_params`)."""
+        input re-derives every coefficient, as :meth:`with_params`); a declared input that is
+        not swept (:meth:`swept_inputs`: a count, a choice, a table, a list, a scale) is a
+        :class:`~geardyn.errors.ParameterError` naming it."""
+        if name in self.inputs and name not in self.swept_inputs():
+            declared = by_name(self.input_declarations)[name]
+            raise ParameterError(name, values, f"not swept ({declared.kind} input of "
+                                 f"{self.name}: set it with with_params or in the study); "
+                                 f"swept: {', '.join(('Omega', *self.physical_names))}")
         if name in self.inputs or name == INPUT_SPEED or (name == "Omega"
                                                            and not self.omega_is_entry):
             vals = np.asarray(values, dtype=float).ravel()

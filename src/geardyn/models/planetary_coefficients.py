@@ -127,17 +127,17 @@ def _member(name: str, what: str) -> PhysicalInput:
 INPUTS: tuple[PhysicalInput, ...] = (
     PhysicalInput("n_planets", "count", "number of planets N", 3),
     PhysicalInput("sun_pressure_angle", "angle", "pressure angle of the sun-planet meshes "
-                  "[rad, or e.g. \"24.6 deg\"]", "24.6 deg"),
+                  "[rad, or e.g. \"24.6 deg\"]", "24.6 deg", swept=True),
     PhysicalInput("ring_pressure_angle", "angle", "pressure angle of the ring-planet meshes "
-                  "[rad, or e.g. \"24.6 deg\"]", "24.6 deg"),
+                  "[rad, or e.g. \"24.6 deg\"]", "24.6 deg", swept=True),
     _member("sun", "sun"),
     _member("ring", "ring"),
     _member("carrier", "carrier"),
     _member("planet", "planets (bearing_stiffness: the planet bearing on the carrier)"),
     PhysicalInput("sun_mesh_stiffness", "stiffness", "mean sun-planet mesh stiffness [N/m], "
-                  "one or one per planet", form="per_planet", alternative="geometry"),
+                  "one or one per planet", form="per_planet", alternative="geometry", swept=True),
     PhysicalInput("ring_mesh_stiffness", "stiffness", "mean ring-planet mesh stiffness [N/m], "
-                  "one or one per planet", form="per_planet", alternative="geometry"),
+                  "one or one per planet", form="per_planet", alternative="geometry", swept=True),
     PhysicalInput("geometry", "table", "the stage the set is built from "
                   "(PlanetaryGearSet.from_geometry; n_planets and planet_angles place the "
                   "planets), instead of the mesh stiffnesses", table="planetary_geometry",
@@ -146,57 +146,60 @@ INPUTS: tuple[PhysicalInput, ...] = (
                   "spaced, psi_n = 2 pi (n - 1) / N)", None, form="list"),
     PhysicalInput("sun_stiffness_fluctuation", "dimensionless", "relative amplitude of the "
                   "sun-planet stiffness fluctuation (half peak-to-peak over the mean), one or "
-                  "one per planet", 0.0, form="per_planet"),
+                  "one per planet", 0.0, form="per_planet", swept=True),
     PhysicalInput("ring_stiffness_fluctuation", "dimensionless", "relative amplitude of the "
                   "ring-planet stiffness fluctuation, one or one per planet", 0.0,
-                  form="per_planet"),
+                  form="per_planet", swept=True),
     PhysicalInput("waveform", "choice", "shape of the stiffness fluctuation: \"sine\" or "
                   "\"rectangular\" (contact_ratio, harmonics)", "sine", choices=WAVEFORMS),
-    PhysicalInput("contact_ratio", "number", "contact ratio of the rectangular waveform", 1.6),
+    PhysicalInput("contact_ratio", "number", "contact ratio of the rectangular waveform", 1.6,
+                  swept=True),
     PhysicalInput("harmonics", "count", "harmonics of the rectangular waveform's series", 9),
     PhysicalInput("sun_coast_stiffness", "stiffness", "mean coast-flank stiffness of the "
                   "sun-planet meshes [N/m] (None: the drive flank's); not a study key: "
-                  "from_geometry sets it", None, form="per_planet", study=False),
+                  "from_geometry sets it", None, form="per_planet", study=False, swept=True),
     PhysicalInput("ring_coast_stiffness", "stiffness", "mean coast-flank stiffness of the "
                   "ring-planet meshes [N/m] (None: the drive flank's); not a study key: "
-                  "from_geometry sets it", None, form="per_planet", study=False),
+                  "from_geometry sets it", None, form="per_planet", study=False, swept=True),
     PhysicalInput("coast_waveform", "number", "relative Fourier coefficients of the coast "
                   "flank, a pair (a, b) or {\"sun\": (a, b), \"ring\": (a, b)} (None: the "
                   "drive flank's); not a study key: from_geometry sets it", None, form="list",
                   study=False),
     PhysicalInput("sun_mesh_phase", "angle", "sun-planet mesh phases [rad of the mesh cycle], "
-                  "one or one per planet", 0.0, form="per_planet"),
+                  "one or one per planet", 0.0, form="per_planet", swept=True),
     PhysicalInput("ring_mesh_phase", "angle", "ring-planet mesh phases [rad of the mesh "
-                  "cycle], one or one per planet", 0.0, form="per_planet"),
+                  "cycle], one or one per planet", 0.0, form="per_planet", swept=True),
     PhysicalInput("sun_backlash", "length", "backlash half-width b of the sun-planet meshes "
-                  "[m], one or one per planet", 0.0, form="per_planet"),
+                  "[m], one or one per planet", 0.0, form="per_planet", swept=True),
     PhysicalInput("ring_backlash", "length", "backlash half-width b of the ring-planet meshes "
-                  "[m], one or one per planet", 0.0, form="per_planet"),
+                  "[m], one or one per planet", 0.0, form="per_planet", swept=True),
     PhysicalInput("sun_mesh_error", "length", "transmission error amplitude of the sun-planet "
-                  "meshes [m], one or one per planet", 0.0, form="per_planet"),
+                  "meshes [m], one or one per planet", 0.0, form="per_planet", swept=True),
     PhysicalInput("ring_mesh_error", "length", "transmission error amplitude of the "
-                  "ring-planet meshes [m], one or one per planet", 0.0, form="per_planet"),
+                  "ring-planet meshes [m], one or one per planet", 0.0, form="per_planet",
+                  swept=True),
     PhysicalInput("sun_error_phase", "angle", "transmission error phase of the sun-planet "
-                  "meshes [rad], one or one per planet", 0.0, form="per_planet"),
+                  "meshes [rad], one or one per planet", 0.0, form="per_planet", swept=True),
     PhysicalInput("ring_error_phase", "angle", "transmission error phase of the ring-planet "
-                  "meshes [rad], one or one per planet", 0.0, form="per_planet"),
+                  "meshes [rad], one or one per planet", 0.0, form="per_planet", swept=True),
     PhysicalInput("mesh_damping", "dimensionless", "mesh damping ratio zeta_m (c_m = 2 zeta_m "
-                  "sqrt(k_m m_e)), one or one per planet", 0.05, form="per_planet"),
+                  "sqrt(k_m m_e)), one or one per planet", 0.05, form="per_planet", swept=True),
     PhysicalInput("modal_damping", "number", "modal damping ratio of every mode of the linear "
-                  "model at mean stiffness", 0.0),
+                  "model at mean stiffness", 0.0, swept=True),
     PhysicalInput("sun_torque", "torque", "mean torque on the sun [N m] (needs sun.radius)",
-                  0.0),
+                  0.0, swept=True),
     PhysicalInput("ring_torque", "torque", "mean torque on the ring [N m] (needs "
-                  "ring.radius)", 0.0),
+                  "ring.radius)", 0.0, swept=True),
     PhysicalInput("carrier_torque", "torque", "mean torque on the carrier [N m] (needs "
-                  "carrier.radius)", 0.0),
+                  "carrier.radius)", 0.0, swept=True),
     PhysicalInput("torque_fluctuation", "number", "relative amplitude A of the sun torque's "
-                  "fluctuation T_s (1 + A sin(order Omega tau + phase))", 0.0),
+                  "fluctuation T_s (1 + A sin(order Omega tau + phase))", 0.0, swept=True),
     PhysicalInput("torque_order", "number", "order of the sun torque's fluctuation (in "
-                  "forcing frequencies Omega)", 1.0),
-    PhysicalInput("torque_phase", "angle", "phase of the sun torque's fluctuation [rad]", 0.0),
+                  "forcing frequencies Omega)", 1.0, swept=True),
+    PhysicalInput("torque_phase", "angle", "phase of the sun torque's fluctuation [rad]", 0.0,
+                  swept=True),
     PhysicalInput("mesh_frequency", "frequency", "mesh frequency [rad/s] (default omega_0)",
-                  None),
+                  None, swept=True),
     PhysicalInput("mesh_order", "count", "mesh cycles per forcing period (1; not a study key: "
                   "from_geometry with faults sets it)", 1, study=False),
     PhysicalInput("rotational_only", "flag", "the purely torsional model (member centres "
@@ -205,9 +208,10 @@ INPUTS: tuple[PhysicalInput, ...] = (
                   form="list", choices=CENTRAL),
     PhysicalInput("carrier_speed", "frequency", "carrier speed (rad/s or e.g. \"300 rpm\"; "
                   "\"kinematic\": from the tooth counts of [params.geometry], following the "
-                  "input speed): gyroscopic and centripetal terms", None),
+                  "input speed): gyroscopic and centripetal terms", None, swept=True),
     PhysicalInput("carrier_speed_ratio", "number", "carrier speed Omega_c / mesh_frequency "
-                  "(the carrier speed then follows the mesh frequency in a sweep)", None),
+                  "(the carrier speed then follows the mesh frequency in a sweep)", None,
+                  swept=True),
     PhysicalInput("centrifugal_preload", "flag", "with a carrier speed: the planets' "
                   "centrifugal load on their bearings, turning with the carrier", True),
     PhysicalInput("held", "choice", "member held in the input_speed kinematics (with "

@@ -17,38 +17,41 @@ INPUTS: tuple[PhysicalInput, ...] = (
                   "Omega (default: the first mesh of the driven body, else the train's first "
                   "mesh)", None),
     PhysicalInput("input_speed", "frequency", "driven body's speed (rpm, or a unit string)",
-                  None),
+                  None, unit="rpm", swept=True),
     PhysicalInput("mesh_frequency", "frequency", "the reference mesh's frequency [rad/s] "
-                  "(instead of input_speed; default omega_0: Omega = 1)", None),
+                  "(instead of input_speed; default omega_0: Omega = 1)", None, swept=True),
     PhysicalInput("torques", "torque", "mean torques [N m] on bodies by name (each acts on "
                   "the body's rotation)", None, form="by_name"),
     PhysicalInput("load", "name", "a body whose torque balances the others on the train's "
                   "rigid-body mode (the output load for a given input torque)", None),
     PhysicalInput("backlash", "length", "backlash half-width b [m] of every mesh, or per "
-                  "mesh", 0.0, form="per_mesh"),
+                  "mesh", 0.0, form="per_mesh", swept=True),
     PhysicalInput("mesh_damping", "dimensionless", "damping ratio zeta_m of every mesh, or "
-                  "per mesh (added to the mesh element's own damping)", 0.0, form="per_mesh"),
+                  "per mesh (added to the mesh element's own damping)", 0.0, form="per_mesh",
+                  swept=True),
     PhysicalInput("modal_damping", "number", "modal damping ratio of every mode of the linear "
-                  "model at mean stiffness", 0.0),
+                  "model at mean stiffness", 0.0, swept=True),
     PhysicalInput("stiffness_fluctuation", "dimensionless", "relative amplitude of the "
-                  "stiffness fluctuation of every mesh, or per mesh", 0.0, form="per_mesh"),
+                  "stiffness fluctuation of every mesh, or per mesh", 0.0, form="per_mesh",
+                  swept=True),
     PhysicalInput("waveform", "choice", "shape of the stiffness fluctuation: \"sine\" or "
                   "\"rectangular\" (contact_ratio, harmonics)", "sine", choices=WAVEFORMS),
-    PhysicalInput("contact_ratio", "number", "contact ratio of the rectangular waveform", 1.6),
+    PhysicalInput("contact_ratio", "number", "contact ratio of the rectangular waveform", 1.6,
+                  swept=True),
     PhysicalInput("harmonics", "count", "harmonics of the stiffness series", 9),
     PhysicalInput("mesh_phase", "angle", "rad of the mesh cycle, per mesh or \"geometry\"; "
                   "default: from the geometry where every meshing gear has it, else 0", None,
-                  form="per_mesh"),
+                  form="per_mesh", swept=True),
     PhysicalInput("mesh_error", "length", "transmission error amplitude E_m [m] of every "
-                  "mesh, or per mesh", 0.0, form="per_mesh"),
+                  "mesh, or per mesh", 0.0, form="per_mesh", swept=True),
     PhysicalInput("error_phase", "angle", "transmission error phase [rad] of every mesh, or "
-                  "per mesh", 0.0, form="per_mesh"),
+                  "per mesh", 0.0, form="per_mesh", swept=True),
     PhysicalInput("torque_fluctuation", "number", "relative amplitude A of the driven body's "
-                  "torque fluctuation T (1 + A sin(order Omega tau + phase))", 0.0),
+                  "torque fluctuation T (1 + A sin(order Omega tau + phase))", 0.0, swept=True),
     PhysicalInput("torque_order", "number", "order of the driven body's torque fluctuation",
-                  1.0),
+                  1.0, swept=True),
     PhysicalInput("torque_phase", "angle", "phase of the driven body's torque fluctuation "
-                  "[rad]", 0.0),
+                  "[rad]", 0.0, swept=True),
     PhysicalInput("coast", "choice", "the coast flank of a mesh whose gears have geometry: "
                   "\"mirror\" (the drive flank's mirror image) or \"symmetric\" (the drive "
                   "flank's stiffness)", "mirror", choices=COAST_FLANKS),

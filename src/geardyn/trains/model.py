@@ -51,6 +51,7 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from geardyn.core.capabilities import Capabilities, FaultDatasetInputs
+from geardyn.core.inputs import by_name, one_value
 from geardyn.errors import ParameterError
 from geardyn.gears.iso6336_kv import KvMeshGroup, group_reduced_mass
 from geardyn.gears.potential_energy import coast_phase
@@ -67,6 +68,7 @@ from geardyn.models.planetary import (
 from geardyn.models.planetary_stiffness import FlankSeries, coast_flank, flank_series, mirrored
 from geardyn.trains.elements import pair_geometry
 from geardyn.trains.faults import faulty_table, revolution_series, shared_wear_profiles
+from geardyn.trains.inputs import INPUTS
 from geardyn.trains.train import GearTrain
 from geardyn.units import si_value
 
@@ -81,14 +83,8 @@ ORDER_RTOL = 1e-9
 #: Largest difference [relative stiffness] between a mirrored coast series and its drive series
 #: that is round-off (a sine mirrored about half a mesh cycle): the mesh keeps one flank.
 MIRROR_ATOL = 1e-12
-#: Inputs a sweep takes by name (scalars only; a per-mesh mapping is not swept).
-_SWEPT = ("mesh_frequency", INPUT_SPEED, "backlash", "mesh_damping", "modal_damping",
-          "stiffness_fluctuation", "mesh_error", "torque_fluctuation", "torque_order",
-          "torque_phase")
-_UNITS = {"mesh_frequency": "rad/s", INPUT_SPEED: "rpm", INPUT_TORQUE: "N m", "backlash": "m",
-          "mesh_damping": "1",
-          "modal_damping": "1", "stiffness_fluctuation": "1", "mesh_error": "m",
-          "torque_fluctuation": "1", "torque_order": "1", "torque_phase": "rad"}
+#: The declared mean torques (``input_torque`` is in their unit).
+_TORQUES = by_name(INPUTS)["torques"]
 
 
 class PlayElement(NamedTuple):
@@ -190,6 +186,7 @@ class TrainModel(PlanetaryGearSet):
                                 dynamic_factor=True, natural_frequencies="Hz",
                                 fault_dataset=FaultDatasetInputs(INPUT_SPEED, INPUT_TORQUE,
                                                                  "mesh_force"))
+    input_declarations = INPUTS
     raw_overrides: dict[str, float] = {}
     carrier_speed = None
     carrier_speed_ratio = None
@@ -858,20 +855,19 @@ class TrainModel(PlanetaryGearSet):
     # ------------------------------------------------------------------ sweeps and axes
     @property
     def physical_names(self) -> tuple[str, ...]:
-        """The inputs a sweep takes by name: ``input_speed`` [rpm] (with a driven body),
-        ``mesh_frequency`` [rad/s], and the scalar ones of ``backlash``, ``mesh_damping``,
-        ``modal_damping``, ``stiffness_fluctuation`` (not where a mesh takes its waveform from
-        its teeth), ``mesh_error`` and the torque fluctuation's; ``input_torque`` [N m] where
-        the driven body carries a torque."""
+        """The inputs a sweep takes by name: the swept inputs (:meth:`swept_inputs`) given as
+        one value for every mesh, ``input_speed`` [rpm] only with a driven body,
+        ``stiffness_fluctuation`` not where a mesh takes its waveform from its teeth; then
+        ``input_torque`` [N m] where the driven body carries a torque."""
         teeth = any(d.table is not None for d in self.train.mesh_data.values())
         out = []
-        for k in _SWEPT:
+        for k in self.swept_inputs():
             if k == INPUT_SPEED:
                 if self.train.driven is not None:
                     out.append(k)
             elif k == "stiffness_fluctuation" and teeth:
                 continue
-            elif not isinstance(self.inputs.get(k), Mapping):
+            elif one_value(self.inputs.get(k)):
                 out.append(k)
         if self.train.driven is not None and self.body_torques.get(self.train.driven):
             out.append(INPUT_TORQUE)
@@ -914,20 +910,27 @@ class TrainModel(PlanetaryGearSet):
         return w * 60.0 / (2.0 * math.pi)
 
     def param_attrs(self, name: str) -> dict[str, str]:
+        """Attributes of a swept input's axis: its declared unit (``input_speed`` in rpm,
+        ``input_torque`` in the torques' unit) and, for the speeds and the input torque,
+        ``long_name`` and ``meaning``; empty for another name."""
+        declared = self.swept_inputs().get(name)
         if name == INPUT_SPEED:
-            return {"units": "rpm", "long_name": f"input ({self.train.driven}) speed",
+            unit = declared.axis_unit
+            return {"units": unit, "long_name": f"input ({self.train.driven}) speed",
                     "meaning": f"mesh frequency of {self.reference_mesh} / "
-                               f"{self.mesh_frequency_per_input_speed():.6g}, in rpm"}
+                               f"{self.mesh_frequency_per_input_speed():.6g}, in {unit}"}
         if name == "mesh_frequency":
-            return {"units": "rad/s", "long_name": f"mesh frequency of {self.reference_mesh}"}
+            return {"units": declared.axis_unit,
+                    "long_name": f"mesh frequency of {self.reference_mesh}"}
         if name == INPUT_TORQUE:
-            return {"units": "N m", "long_name": f"input ({self.train.driven}) torque",
+            return {"units": _TORQUES.axis_unit,
+                    "long_name": f"input ({self.train.driven}) torque",
                     "meaning": "the driven body's mean torque, every mean torque scaled with it"}
         if name == "Omega" and self.faults is not None:
             return {"units": "1", "long_name": "forcing frequency / time_scale",
                     "meaning": f"{self.faults.gear}'s revolution frequency: mesh frequency of "
                                f"{self.reference_mesh} / ({self.mesh_order:.12g} time_scale)"}
-        return {"units": _UNITS[name]} if name in _UNITS else {}
+        return {} if declared is None else {"units": declared.axis_unit}
 
     def speed_axes(self, omega: np.ndarray) -> dict[str, tuple[np.ndarray, dict]]:
         """The reference mesh's frequency [Hz] and, with a driven body, the input speed [rpm]
