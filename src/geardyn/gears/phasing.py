@@ -95,12 +95,13 @@ def mesh_phases(sun_teeth: int, ring_teeth: int, planet_angles: np.ndarray | int
         raise ParameterError("planet_angles", planet_angles, "need at least one planet")
     _check_assembly(sun_teeth, ring_teeth, angles)
     rel = sun_turns * (angles - angles[0])
+    sun_ring = sun_turns * sun_ring_phase  # the planet turning the other way: -gamma_rs
     gamma_s = (sun_teeth * rel / (2.0 * np.pi)) % 1.0
-    gamma_r = (sun_ring_phase - ring_teeth * rel / (2.0 * np.pi)) % 1.0
+    gamma_r = (sun_ring - ring_teeth * rel / (2.0 * np.pi)) % 1.0
     # whole cycles come out as 1 - 1e-16: fold them to 0
     gamma_s[np.isclose(gamma_s, 1.0, atol=1e-9)] = 0.0
     gamma_r[np.isclose(gamma_r, 1.0, atol=1e-9)] = 0.0
-    return MeshPhases(sun=gamma_s, ring=gamma_r, sun_ring=float(sun_ring_phase % 1.0),
+    return MeshPhases(sun=gamma_s, ring=gamma_r, sun_ring=float(sun_ring % 1.0),
                       planet_angles=angles)
 
 

@@ -60,9 +60,11 @@ from geardyn.models.planetary_stiffness import (
     mirrored,
     potential_energy_options,
     potential_energy_tables,
+    reversed_in_time,
     revolution_stiffness,
     series_error,
     stiffness_method,
+    table_in_time,
 )
 from geardyn.models.stiffness import evaluate, fourier_coefficients
 from geardyn.units import si_value
@@ -784,6 +786,14 @@ class PlanetaryGearSet(Model):
         if placement is None:
             inputs, tables, waves = _geometry_stiffness(geometry, method, stiffness_options,
                                                         waveform_options, harmonics, coast)
+            if _sun_turns(held_member) < 0:  # every mesh reads its tables backwards in time
+                for key in ("waveform", "coast_waveform"):
+                    if key in inputs:
+                        inputs[key] = {g: reversed_in_time(w) for g, w in inputs[key].items()}
+                tables_met = None if tables is None else tuple(
+                    table_in_time(t, True) for t in tables)
+            else:
+                tables_met = tables
             inputs["sun_mesh_phase"] = [-2.0 * math.pi * float(g) for g in phases.sun]
             inputs["ring_mesh_phase"] = [-2.0 * math.pi * float(g) for g in phases.ring]
         else:
@@ -800,7 +810,7 @@ class PlanetaryGearSet(Model):
             revolution = revolution_stiffness(geometry, opts, placement, harmonics,
                                               _sun_turns(held_member), shared)
             inputs, waves = revolution.inputs(geometry.n_planets, coast), None
-            tables = revolution.healthy
+            tables = tables_met = revolution.healthy
         meshes = {"sun": geometry.sun_mesh, "ring": geometry.ring_mesh}
         radii = {"sun": geometry.sun.base_radius, "ring": geometry.ring.base_radius,
                  "carrier": geometry.sun_mesh.centre_distance,
@@ -846,9 +856,9 @@ class PlanetaryGearSet(Model):
         model.faults = placement
         if revolution is not None:
             model.mesh_tables = revolution.tables
-        elif tables is not None:
+        elif tables_met is not None:
             n = geometry.n_planets
-            model.mesh_tables = (tables[0],) * n + (tables[1],) * n
+            model.mesh_tables = (tables_met[0],) * n + (tables_met[1],) * n
         return model
 
     def dataset_attrs(self) -> dict[str, object]:

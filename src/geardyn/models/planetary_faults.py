@@ -187,7 +187,7 @@ def mesh_shifts(geometry: Any, sun_turns: int, placement: FaultPlacement | None
         ring = np.mod(ph.sun_ring - sun_turns * geometry.ring.teeth * rel / (2.0 * math.pi), z)
     else:
         p = placement.planet
-        ring[p] = (sun[p] + planet_passage_delay(geometry)) % z
+        ring[p] = (sun[p] + sun_turns * planet_passage_delay(geometry)) % z
     return sun, ring
 
 

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import numbers
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -184,6 +184,26 @@ def flank_series(table: np.ndarray, harmonics: int) -> FlankSeries:
 
 
 
+def reversed_in_time(pair: tuple[np.ndarray, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+    """The relative Fourier coefficients of k(-theta) from those (a, b) of k(theta): (a, -b)
+    (the series of a table read backwards in time, T(-c))."""
+    a, b = pair
+    return np.asarray(a, dtype=float), -np.asarray(b, dtype=float)
+
+
+def table_in_time(table: Any, backward: bool) -> Any:
+    """A table uniform over its cycles (c_i = i / n per cycle, along ``angle``) as the mesh meets
+    it in time: itself, or read backwards, every variable at c_i taken from the table's
+    (-c_i) (index (-i) mod n; the coordinates kept), with attrs ``read_backward`` = 1."""
+    if not backward:
+        return table
+    n = table.sizes["angle"]
+    out = table.isel(angle=(-np.arange(n)) % n)
+    out = out.assign_coords(angle=table["angle"].values, cycle=("angle", table["cycle"].values))
+    out.attrs = {**table.attrs, "read_backward": 1}
+    return out
+
+
 def embedded(series: FlankSeries, order: int, harmonics: int) -> FlankSeries:
     """A one-mesh-cycle series as a series in the revolution angle of ``order`` mesh cycles:
     mesh harmonic l at harmonic l ``order``, ``harmonics`` (a multiple of ``order``) in all."""
@@ -253,19 +273,22 @@ def revolution_stiffness(geometry: Any, opts: PotentialEnergyOptions, placement:
              "ring": (opts.planet_bore_radius, opts.ring_rim_radius)}
     meshes = {"sun": geometry.sun_mesh, "ring": geometry.ring_mesh}
     extra = {"sun": {}, "ring": {"ring_foundation": "rigid"}}
-    faults = {"sun": placement.sun_faults, "ring": placement.ring_faults}
+    backward = sun_turns < 0  # every mesh reads its tables backwards in time
+    faults = {"sun": _on_table(placement.sun_faults, placement.teeth, backward),
+              "ring": _on_table(placement.ring_faults, placement.teeth, backward)}
     shared = dict(wear_profiles or {})
     profiles = {g: {on: shared[f] for f, on in zip(placement.faults, faults[g], strict=False)
                     if f in shared} for g in faults}
     n = geometry.n_planets
     tables, drive, coast, healthy_tables = [], [], [], []
     for g in ("sun", "ring"):
-        healthy = potential_energy_stiffness(meshes[g], bore_radius=bores[g], **common,
-                                             **extra[g])
-        healthy_tables.append(healthy)
-        faulty = (potential_energy_stiffness(meshes[g], bore_radius=bores[g], faults=faults[g],
-                                             cycles=order, wear_profiles=profiles[g], **common,
-                                             **extra[g])
+        table = potential_energy_stiffness(meshes[g], bore_radius=bores[g], **common,
+                                           **extra[g])
+        healthy_tables.append(table)
+        healthy = table_in_time(table, backward)
+        faulty = (table_in_time(potential_energy_stiffness(
+            meshes[g], bore_radius=bores[g], faults=faults[g], cycles=order,
+            wear_profiles=profiles[g], **common, **extra[g]), backward)
                   if faults[g] else None)
         for i in range(n):
             hit = faulty is not None and placement.planet in (None, i)
@@ -282,6 +305,15 @@ def revolution_stiffness(geometry: Any, opts: PotentialEnergyOptions, placement:
     sun, ring = mesh_shifts(geometry, sun_turns, placement)
     return RevolutionStiffness(order, n_h, tuple(tables), tuple(healthy_tables),
                                np.concatenate([sun, ring]), tuple(drive), tuple(coast))
+
+
+def _on_table(faults: tuple[Any, ...], teeth: int, backward: bool) -> tuple[Any, ...]:
+    """The faults as a table takes them: on their own tooth j, or on a table read backwards
+    in time (the tooth passing the pitch point at c = j is the table's tooth -j) on (-j) mod
+    ``teeth``."""
+    if not backward:
+        return faults
+    return tuple(replace(f, tooth=(-f.tooth) % teeth) for f in faults)
 
 
 def series_error(table: np.ndarray, cycles: int, mean: float, coefficients: np.ndarray,
