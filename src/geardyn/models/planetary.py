@@ -700,8 +700,11 @@ class PlanetaryGearSet(Model):
         the waves' ``transition`` ramps) as ``waveform={"sun": ..., "ring": ...}``; the Parker &
         Lin phases gamma as ``sun_mesh_phase``/``ring_mesh_phase`` = -2 pi gamma (mesh n's
         stiffness is k(theta - 2 pi gamma_n); the input turning in the sense of psi, so with
-        the sun held the sun turns against psi relative to the carrier and the phases are
-        ``geometry.phases_turning(-1)``, else ``geometry.phases``); the members' ``radius``
+        the sun held the sun turns against psi relative to the carrier and a planet with it, the
+        phases are ``geometry.phases_turning(-1)``, else ``geometry.phases``, and every mesh
+        reads its wave or table backwards in time, k(-(theta - 2 pi gamma_n)), both flanks, its
+        faults on the table's tooth -j: ``docs/planetary.md``, "Which way a mesh meets its
+        teeth"); the members' ``radius``
         where None (base radius of sun, ring and planet, the carrier's: the centre distance);
         ``sun_backlash`` and ``ring_backlash`` where not given: half the geometry's normal
         backlash j cos(alpha_w) / 2 of each mesh [m] (0 at the default, tight centre distance).
@@ -721,7 +724,9 @@ class PlanetaryGearSet(Model):
         dead zone on the other side. ``stiffness_options``: ``sun_bore_radius``,
         ``planet_bore_radius``, ``ring_rim_radius`` [m] (needed), ``young`` [Pa], ``poisson``,
         ``angles`` (points per mesh cycle, default 360, > 2 ``harmonics``), ``nodes``,
-        ``root_segment``. The tables are kept as :attr:`stiffness_tables` (sun, ring), the method as
+        ``root_segment``. The tables are kept as :attr:`stiffness_tables` (sun, ring; as
+        computed, in gear a's rotation; each mesh's as it meets it in time, read backwards with
+        the sun held, attrs ``read_backward``, as :attr:`mesh_tables`), the method as
         :attr:`stiffness_method`.
 
         ``coast``: the coast (back) flank. ``"mirror"`` (default): its own stiffness, for

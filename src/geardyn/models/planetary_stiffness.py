@@ -13,6 +13,13 @@ the drive flank's about the coast phase phi (:func:`geardyn.gears.potential_ener
 geometry only): K_coast(theta) = K_drive(2 pi phi - theta) (:func:`mirrored`) for the ISO waves,
 the tables' own coast flank for the potential-energy method; ``"symmetric"`` the drive flank's
 stiffness on both flanks.
+
+A table is in gear a's rotation (the sun of a sun-planet mesh, the planet of a planet-ring mesh)
+in the positive sense; the set takes the planet-ring table as its mirror image (its positive
+deflection loads the flank the table calls coast), which is the mesh itself while the planet
+turns in the negative sense relative to the carrier. With the sun held both turn the other
+way and every mesh reads its tables backwards in time, T(-c) (:func:`reversed_in_time`,
+:func:`table_in_time`; ``docs/planetary.md``, "Which way a mesh meets its teeth").
 """
 
 from __future__ import annotations
@@ -218,8 +225,9 @@ def embedded(series: FlankSeries, order: int, harmonics: int) -> FlankSeries:
 class RevolutionStiffness:
     """The potential-energy stiffness of a set with a faulty gear over one revolution of that
     gear relative to the carrier (:mod:`geardyn.models.planetary_faults`): per mesh (sun-planet
-    meshes, then ring-planet) its table over ``order`` mesh cycles (``tables``; a healthy mesh's
-    one-cycle table repeated), its shift [mesh cycles] and its drive and coast series, unshifted,
+    meshes, then ring-planet) its table over ``order`` mesh cycles as the mesh meets it in time
+    (``tables``, :func:`table_in_time`; a healthy mesh's one-cycle table repeated), its shift
+    [mesh cycles] and its drive and coast series, unshifted,
     in the revolution angle (``harmonics`` = mesh harmonics x ``order``); ``healthy`` the healthy
     one-cycle tables (sun-planet, planet-ring)."""
 
@@ -261,7 +269,8 @@ def revolution_stiffness(geometry: Any, opts: PotentialEnergyOptions, placement:
     (every sideband up to the last: ``harmonics`` x Z_f in the revolution angle).
     ``wear_profiles``: the depth along the flank of Archard wear of ``placement.faults`` (keyed
     by the fault as given) in place of each mesh's own
-    (:func:`~geardyn.models.planetary_faults.planet_wear_profiles`)."""
+    (:func:`~geardyn.models.planetary_faults.planet_wear_profiles`). ``sun_turns`` -1 (the sun
+    held): every table read backwards in time, the faults on the tables' tooth -j."""
     from geardyn.gears.potential_energy import potential_energy_stiffness
     from geardyn.models.planetary_faults import mesh_shifts
 
