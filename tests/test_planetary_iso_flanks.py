@@ -97,8 +97,9 @@ def test_coast_phase_is_the_geometry_s_tooth_thickness(mesh):
 @pytest.mark.parametrize("held", ["ring", "sun"])
 def test_kernel_coast_stiffness_is_the_mirrored_wave(held):
     """Deflected onto the coast flank every mesh's stiffness is the drive ISO series (computed
-    here from the wave's coefficients) at 2 pi phi_g - (theta - 2 pi gamma_n), phi_g the coast
-    phase of its mesh group; onto the drive flank the series at theta - 2 pi gamma_n."""
+    here from the wave's coefficients) at 2 pi phi_g - x, phi_g the coast phase of its mesh
+    group; onto the drive flank the series at x = s (theta - 2 pi gamma_n), s = -1 with the sun
+    held (every mesh reads its wave backwards in time; tests/test_planetary_held_sun.py)."""
     geo = shifted_stage()
     gs = geardyn.PlanetaryGearSet.from_geometry(geo, harmonics=H, held=held,
                                                 waveform_options={"transition": 0.05},
@@ -115,7 +116,7 @@ def test_kernel_coast_stiffness_is_the_mirrored_wave(held):
     for m in range(8):
         grp = "sun" if m < 4 else "ring"
         w = waves[grp]
-        x = thetas - 2.0 * math.pi * gam[m]
+        x = (-1.0 if held == "sun" else 1.0) * (thetas - 2.0 * math.pi * gam[m])
         np.testing.assert_allclose(drive[:, m], w.mean * wave(*w.fourier(H), x), rtol=1e-10)
         want = w.mean * wave(*w.fourier(H), 2.0 * math.pi * phi[grp] - x)
         np.testing.assert_allclose(coast[:, m], want, rtol=1e-10)

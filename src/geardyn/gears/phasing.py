@@ -11,9 +11,10 @@ stiffness is k(t - gamma T_m). Then
 
 where gamma_rs is the ring-planet phase relative to the sun-planet phase of the same planet.
 When the sun turns against psi relative to the carrier (the sun held and the carrier driven in
-the sense of psi: the sun, loaded backwards too, still drives the planets in the carrier frame)
-the set is the mirror image of one with the planets at -psi_n: gamma_sn = -Z_s psi_n / (2 pi),
-gamma_rn = gamma_rs + Z_r psi_n / (2 pi) (mod 1), gamma_rs unchanged (symmetric teeth). A
+the sense of psi) the planets turn the other way too: the same flanks pass the pitch points
+(those of the first case), gamma_sn = -Z_s psi_n / (2 pi), gamma_rn = -gamma_rs + Z_r psi_n /
+(2 pi) (mod 1), the planet turning pi + (psi_s + psi_r) / 2 from the one flank's sun-side
+passage to the other's ring-side one where it turned pi - (psi_s + psi_r) / 2. A
 planet can be assembled only where (Z_s + Z_r) psi_n / (2 pi) is a whole number, which makes
 the two expressions agree for every planet. gamma_rs follows from the planet's tooth thickness:
 the sun loads one flank of a planet tooth at the sun-side pitch point, the ring the opposite
@@ -81,7 +82,8 @@ def mesh_phases(sun_teeth: int, ring_teeth: int, planet_angles: np.ndarray | int
     ``planet_angles`` [rad] or a planet count (equally spaced). ``sun_ring_phase`` is gamma_rs
     (see :func:`sun_ring_phase`; :class:`PlanetaryGeometry` computes it from the teeth).
     ``sun_turns``: +1 when the sun turns in the sense of psi relative to the carrier, -1 when
-    against it (the mirrored set, see the module doc).
+    against it (the planets' flanks then meet the ring -gamma_rs after the sun: the module
+    doc); ``MeshPhases.sun_ring`` is the one used.
     """
     if sun_turns not in (1, -1) or isinstance(sun_turns, bool):
         raise ParameterError("sun_turns", sun_turns, "must be +1 or -1 (the sense in which "
@@ -95,12 +97,13 @@ def mesh_phases(sun_teeth: int, ring_teeth: int, planet_angles: np.ndarray | int
         raise ParameterError("planet_angles", planet_angles, "need at least one planet")
     _check_assembly(sun_teeth, ring_teeth, angles)
     rel = sun_turns * (angles - angles[0])
+    sun_ring = sun_turns * sun_ring_phase  # the planet turning the other way: -gamma_rs
     gamma_s = (sun_teeth * rel / (2.0 * np.pi)) % 1.0
-    gamma_r = (sun_ring_phase - ring_teeth * rel / (2.0 * np.pi)) % 1.0
+    gamma_r = (sun_ring - ring_teeth * rel / (2.0 * np.pi)) % 1.0
     # whole cycles come out as 1 - 1e-16: fold them to 0
     gamma_s[np.isclose(gamma_s, 1.0, atol=1e-9)] = 0.0
     gamma_r[np.isclose(gamma_r, 1.0, atol=1e-9)] = 0.0
-    return MeshPhases(sun=gamma_s, ring=gamma_r, sun_ring=float(sun_ring_phase % 1.0),
+    return MeshPhases(sun=gamma_s, ring=gamma_r, sun_ring=float(sun_ring % 1.0),
                       planet_angles=angles)
 
 

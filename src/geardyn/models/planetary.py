@@ -62,9 +62,11 @@ from geardyn.models.planetary_stiffness import (
     mirrored,
     potential_energy_options,
     potential_energy_tables,
+    reversed_in_time,
     revolution_stiffness,
     series_error,
     stiffness_method,
+    table_in_time,
 )
 from geardyn.models.stiffness import evaluate, fourier_coefficients
 from geardyn.units import si_value
@@ -691,8 +693,11 @@ class PlanetaryGearSet(Model):
         the waves' ``transition`` ramps) as ``waveform={"sun": ..., "ring": ...}``; the Parker &
         Lin phases gamma as ``sun_mesh_phase``/``ring_mesh_phase`` = -2 pi gamma (mesh n's
         stiffness is k(theta - 2 pi gamma_n); the input turning in the sense of psi, so with
-        the sun held the sun turns against psi relative to the carrier and the phases are
-        ``geometry.phases_turning(-1)``, else ``geometry.phases``); the members' ``radius``
+        the sun held the sun turns against psi relative to the carrier and a planet with it, the
+        phases are ``geometry.phases_turning(-1)``, else ``geometry.phases``, and every mesh
+        reads its wave or table backwards in time, k(-(theta - 2 pi gamma_n)), both flanks, its
+        faults on the table's tooth -j: ``docs/planetary.md``, "Which way a mesh meets its
+        teeth"); the members' ``radius``
         where None (base radius of sun, ring and planet, the carrier's: the centre distance);
         ``sun_backlash`` and ``ring_backlash`` where not given: half the geometry's normal
         backlash j cos(alpha_w) / 2 of each mesh [m] (0 at the default, tight centre distance).
@@ -712,7 +717,9 @@ class PlanetaryGearSet(Model):
         dead zone on the other side. ``stiffness_options``: ``sun_bore_radius``,
         ``planet_bore_radius``, ``ring_rim_radius`` [m] (needed), ``young`` [Pa], ``poisson``,
         ``angles`` (points per mesh cycle, default 360, > 2 ``harmonics``), ``nodes``,
-        ``root_segment``. The tables are kept as :attr:`stiffness_tables` (sun, ring), the method as
+        ``root_segment``. The tables are kept as :attr:`stiffness_tables` (sun, ring; as
+        computed, in gear a's rotation; each mesh's as it meets it in time, read backwards with
+        the sun held, attrs ``read_backward``, as :attr:`mesh_tables`), the method as
         :attr:`stiffness_method`.
 
         ``coast``: the coast (back) flank. ``"mirror"`` (default): its own stiffness, for
@@ -777,6 +784,14 @@ class PlanetaryGearSet(Model):
         if placement is None:
             inputs, tables, waves = _geometry_stiffness(geometry, method, stiffness_options,
                                                         waveform_options, harmonics, coast)
+            if _sun_turns(held_member) < 0:  # every mesh reads its tables backwards in time
+                for key in ("waveform", "coast_waveform"):
+                    if key in inputs:
+                        inputs[key] = {g: reversed_in_time(w) for g, w in inputs[key].items()}
+                tables_met = None if tables is None else tuple(
+                    table_in_time(t, True) for t in tables)
+            else:
+                tables_met = tables
             inputs["sun_mesh_phase"] = [-2.0 * math.pi * float(g) for g in phases.sun]
             inputs["ring_mesh_phase"] = [-2.0 * math.pi * float(g) for g in phases.ring]
         else:
@@ -793,7 +808,7 @@ class PlanetaryGearSet(Model):
             revolution = revolution_stiffness(geometry, opts, placement, harmonics,
                                               _sun_turns(held_member), shared)
             inputs, waves = revolution.inputs(geometry.n_planets, coast), None
-            tables = revolution.healthy
+            tables = tables_met = revolution.healthy
         meshes = {"sun": geometry.sun_mesh, "ring": geometry.ring_mesh}
         radii = {"sun": geometry.sun.base_radius, "ring": geometry.ring.base_radius,
                  "carrier": geometry.sun_mesh.centre_distance,
@@ -839,9 +854,9 @@ class PlanetaryGearSet(Model):
         model.faults = placement
         if revolution is not None:
             model.mesh_tables = revolution.tables
-        elif tables is not None:
+        elif tables_met is not None:
             n = geometry.n_planets
-            model.mesh_tables = (tables[0],) * n + (tables[1],) * n
+            model.mesh_tables = (tables_met[0],) * n + (tables_met[1],) * n
         return model
 
     def dataset_attrs(self) -> dict[str, object]:

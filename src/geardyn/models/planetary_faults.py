@@ -18,9 +18,15 @@ carrier, -1 when against it; rel_n = psi_n - psi_1; gamma: the Parker & Lin phas
 * ring tooth j passes the pitch point of the ring-planet mesh of planet 1 at c = gamma_r1 + j,
   of planet n at c = gamma_rs + j - s Z_r rel_n / (2 pi) (mod Z_r);
 * tooth j of planet n passes the sun-side pitch point at c = gamma_sn + j and the ring-side one
-  D = Z_p / 2 - Z_p (psi_s + psi_r) / (4 pi) mesh cycles later (half a planet turn less half
-  the tooth's angular thicknesses psi_s, psi_r at its two operating pitch radii: the sun loads
-  the tooth's trailing flank, the tooth the ring with its leading one; D mod 1 is gamma_rs).
+  s D mesh cycles later (mod Z_p), D = Z_p / 2 - Z_p (psi_s + psi_r) / (4 pi) (half a planet
+  turn less half the tooth's angular thicknesses psi_s, psi_r at its two operating pitch radii:
+  the sun loads the tooth's trailing flank, the tooth the ring with its leading one; D mod 1 is
+  gamma_rs; with s = -1 the planet turns the other way, Z_p - D, half a turn and the two half
+  thicknesses).
+
+With s = -1 every mesh reads its tables backwards in time
+(:func:`~geardyn.models.planetary_stiffness.table_in_time`): the tooth passing a pitch point at
+the times above is the table's tooth -j (mod the gear's teeth).
 
 Reduced mod 1 these are the Parker & Lin phases, so a healthy set built over the revolution is
 the one-mesh-cycle set.
@@ -187,7 +193,7 @@ def mesh_shifts(geometry: Any, sun_turns: int, placement: FaultPlacement | None
         ring = np.mod(ph.sun_ring - sun_turns * geometry.ring.teeth * rel / (2.0 * math.pi), z)
     else:
         p = placement.planet
-        ring[p] = (sun[p] + planet_passage_delay(geometry)) % z
+        ring[p] = (sun[p] + sun_turns * planet_passage_delay(geometry)) % z
     return sun, ring
 
 

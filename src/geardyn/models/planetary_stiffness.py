@@ -13,13 +13,20 @@ the drive flank's about the coast phase phi (:func:`geardyn.gears.potential_ener
 geometry only): K_coast(theta) = K_drive(2 pi phi - theta) (:func:`mirrored`) for the ISO waves,
 the tables' own coast flank for the potential-energy method; ``"symmetric"`` the drive flank's
 stiffness on both flanks.
+
+A table is in gear a's rotation (the sun of a sun-planet mesh, the planet of a planet-ring mesh)
+in the positive sense; the set takes the planet-ring table as its mirror image (its positive
+deflection loads the flank the table calls coast), which is the mesh itself while the planet
+turns in the negative sense relative to the carrier. With the sun held both turn the other
+way and every mesh reads its tables backwards in time, T(-c) (:func:`reversed_in_time`,
+:func:`table_in_time`; ``docs/planetary.md``, "Which way a mesh meets its teeth").
 """
 
 from __future__ import annotations
 
 import numbers
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -184,6 +191,26 @@ def flank_series(table: np.ndarray, harmonics: int) -> FlankSeries:
 
 
 
+def reversed_in_time(pair: tuple[np.ndarray, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+    """The relative Fourier coefficients of k(-theta) from those (a, b) of k(theta): (a, -b)
+    (the series of a table read backwards in time, T(-c))."""
+    a, b = pair
+    return np.asarray(a, dtype=float), -np.asarray(b, dtype=float)
+
+
+def table_in_time(table: Any, backward: bool) -> Any:
+    """A table uniform over its cycles (c_i = i / n per cycle, along ``angle``) as the mesh meets
+    it in time: itself, or read backwards, every variable at c_i taken from the table's
+    (-c_i) (index (-i) mod n; the coordinates kept), with attrs ``read_backward`` = 1."""
+    if not backward:
+        return table
+    n = table.sizes["angle"]
+    out = table.isel(angle=(-np.arange(n)) % n)
+    out = out.assign_coords(angle=table["angle"].values, cycle=("angle", table["cycle"].values))
+    out.attrs = {**table.attrs, "read_backward": 1}
+    return out
+
+
 def embedded(series: FlankSeries, order: int, harmonics: int) -> FlankSeries:
     """A one-mesh-cycle series as a series in the revolution angle of ``order`` mesh cycles:
     mesh harmonic l at harmonic l ``order``, ``harmonics`` (a multiple of ``order``) in all."""
@@ -198,8 +225,9 @@ def embedded(series: FlankSeries, order: int, harmonics: int) -> FlankSeries:
 class RevolutionStiffness:
     """The potential-energy stiffness of a set with a faulty gear over one revolution of that
     gear relative to the carrier (:mod:`geardyn.models.planetary_faults`): per mesh (sun-planet
-    meshes, then ring-planet) its table over ``order`` mesh cycles (``tables``; a healthy mesh's
-    one-cycle table repeated), its shift [mesh cycles] and its drive and coast series, unshifted,
+    meshes, then ring-planet) its table over ``order`` mesh cycles as the mesh meets it in time
+    (``tables``, :func:`table_in_time`; a healthy mesh's one-cycle table repeated), its shift
+    [mesh cycles] and its drive and coast series, unshifted,
     in the revolution angle (``harmonics`` = mesh harmonics x ``order``); ``healthy`` the healthy
     one-cycle tables (sun-planet, planet-ring)."""
 
@@ -241,7 +269,8 @@ def revolution_stiffness(geometry: Any, opts: PotentialEnergyOptions, placement:
     (every sideband up to the last: ``harmonics`` x Z_f in the revolution angle).
     ``wear_profiles``: the depth along the flank of Archard wear of ``placement.faults`` (keyed
     by the fault as given) in place of each mesh's own
-    (:func:`~geardyn.models.planetary_faults.planet_wear_profiles`)."""
+    (:func:`~geardyn.models.planetary_faults.planet_wear_profiles`). ``sun_turns`` -1 (the sun
+    held): every table read backwards in time, the faults on the tables' tooth -j."""
     from geardyn.gears.potential_energy import potential_energy_stiffness
     from geardyn.models.planetary_faults import mesh_shifts
 
@@ -253,19 +282,22 @@ def revolution_stiffness(geometry: Any, opts: PotentialEnergyOptions, placement:
              "ring": (opts.planet_bore_radius, opts.ring_rim_radius)}
     meshes = {"sun": geometry.sun_mesh, "ring": geometry.ring_mesh}
     extra = {"sun": {}, "ring": {"ring_foundation": "rigid"}}
-    faults = {"sun": placement.sun_faults, "ring": placement.ring_faults}
+    backward = sun_turns < 0  # every mesh reads its tables backwards in time
+    faults = {"sun": _on_table(placement.sun_faults, placement.teeth, backward),
+              "ring": _on_table(placement.ring_faults, placement.teeth, backward)}
     shared = dict(wear_profiles or {})
     profiles = {g: {on: shared[f] for f, on in zip(placement.faults, faults[g], strict=False)
                     if f in shared} for g in faults}
     n = geometry.n_planets
     tables, drive, coast, healthy_tables = [], [], [], []
     for g in ("sun", "ring"):
-        healthy = potential_energy_stiffness(meshes[g], bore_radius=bores[g], **common,
-                                             **extra[g])
-        healthy_tables.append(healthy)
-        faulty = (potential_energy_stiffness(meshes[g], bore_radius=bores[g], faults=faults[g],
-                                             cycles=order, wear_profiles=profiles[g], **common,
-                                             **extra[g])
+        table = potential_energy_stiffness(meshes[g], bore_radius=bores[g], **common,
+                                           **extra[g])
+        healthy_tables.append(table)
+        healthy = table_in_time(table, backward)
+        faulty = (table_in_time(potential_energy_stiffness(
+            meshes[g], bore_radius=bores[g], faults=faults[g], cycles=order,
+            wear_profiles=profiles[g], **common, **extra[g]), backward)
                   if faults[g] else None)
         for i in range(n):
             hit = faulty is not None and placement.planet in (None, i)
@@ -282,6 +314,15 @@ def revolution_stiffness(geometry: Any, opts: PotentialEnergyOptions, placement:
     sun, ring = mesh_shifts(geometry, sun_turns, placement)
     return RevolutionStiffness(order, n_h, tuple(tables), tuple(healthy_tables),
                                np.concatenate([sun, ring]), tuple(drive), tuple(coast))
+
+
+def _on_table(faults: tuple[Any, ...], teeth: int, backward: bool) -> tuple[Any, ...]:
+    """The faults as a table takes them: on their own tooth j, or on a table read backwards
+    in time (the tooth passing the pitch point at c = j is the table's tooth -j) on (-j) mod
+    ``teeth``."""
+    if not backward:
+        return faults
+    return tuple(replace(f, tooth=(-f.tooth) % teeth) for f in faults)
 
 
 def series_error(table: np.ndarray, cycles: int, mean: float, coefficients: np.ndarray,
