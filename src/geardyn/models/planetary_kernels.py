@@ -82,7 +82,7 @@ HEADER = HEADER_BLOCK.size
 # mesh block fixed entries
 _M = MESH.offset
 M_B, M_ES, M_EC, M_KF, M_CF = _M("b"), _M("E_s"), _M("E_c"), _M("KF"), _M("CF")
-M_KFC, M_ORDER, M_RADIAL = _M("KF_coast"), _M("order"), _M("radial")
+M_KFC, M_ORDER, M_RADIAL, M_NH = _M("KF_coast"), _M("order"), _M("radial"), _M("harmonics")
 MESH_FIXED = MESH.size
 #: Structural entries per mesh row in the structure section (padded with zero weights).
 MESH_NZ = 6
@@ -190,8 +190,9 @@ def fill_structure(P: np.ndarray, kt_entries: list[tuple[int, int]],
                    mesh_dofs: list[list[int]]) -> None:
     """Write the structure section of every row of ``P`` (lanes x size, in place) from its dense
     parts: the Kt entries ``kt_entries`` (row-major order) and per mesh the dofs ``mesh_dofs[m]``
-    (ascending, at most ``MESH_NZ``). A dense Kt, W or G entry outside the structure that is not
-    zero (e.g. a raw coefficient override) is a ``ValueError``."""
+    (ascending, at most ``MESH_NZ``); and every mesh block's harmonic count
+    (:func:`fill_harmonics`). A dense Kt, W or G entry outside the structure that is not zero
+    (e.g. a raw coefficient override) is a ``ValueError``."""
     P = np.atleast_2d(P)
     n, nm, nh = int(P[0, N_DOF]), int(P[0, N_MESH]), int(P[0, N_HARM])
     nk = len(kt_entries)
@@ -227,6 +228,30 @@ def fill_structure(P: np.ndarray, kt_entries: list[tuple[int, int]],
         P[:, q:q + k] = dofs
         P[:, q + MESH_NZ:q + MESH_NZ + k] = W[:, list(dofs)]
         P[:, q + 2 * MESH_NZ:q + 2 * MESH_NZ + k] = G[:, list(dofs)]
+    fill_harmonics(P)
+
+
+def fill_harmonics(P: np.ndarray) -> None:
+    """Write every mesh block's ``harmonics`` entry in every row of ``P`` (lanes x size, in
+    place) from the row's own Fourier coefficients: the last harmonic h (1 .. nh) whose drive or
+    coast coefficients are not both zero, at least 1 (0 where nh is 0). The kernels sum a
+    block's series up to it (:func:`_harmonics`): the terms past it have zero coefficients, so
+    leaving them out changes no sum's bits (each adds +-0 to the partial sum, which changes at
+    most the sign of a zero partial sum, and 1 + acc maps both zeros to 1)."""
+    P = np.atleast_2d(P)
+    n, nm, nh = int(P[0, N_DOF]), int(P[0, N_MESH]), int(P[0, N_HARM])
+    lay = layout(n, nm, nh)
+    for m in range(nm):
+        o = lay["mesh"] + m * lay["block"]
+        if nh == 0:
+            P[:, o + M_NH] = 0.0
+            continue
+        d = P[:, o + MESH_FIXED:o + MESH_FIXED + 2 * nh].reshape(-1, nh, 2)
+        c0 = o + coast_offset(n, nh)
+        c = P[:, c0:c0 + 2 * nh].reshape(-1, nh, 2)
+        nonzero = np.any(d != 0.0, axis=2) | np.any(c != 0.0, axis=2)
+        last = np.where(nonzero.any(axis=1), nh - np.argmax(nonzero[:, ::-1], axis=1), 0)
+        P[:, o + M_NH] = np.maximum(last, 1)
 
 
 @nb.njit(inline="always", **_JIT)
@@ -240,6 +265,26 @@ def _offsets(p):
     st = mesh + nm * bs
     mz = st + 1 + 3 * int(p[st])
     return n, nm, nh, mesh, bs, st, mz
+
+
+@nb.njit(inline="always", **_JIT)
+def _harmonics(p, o, nh):
+    """The harmonics summed of the mesh block at o (both flanks): its ``harmonics`` entry
+    (:func:`fill_harmonics`), or all nh where that is unset (0) or not below nh."""
+    h = int(p[o + M_NH])
+    return h if 0 < h < nh else nh
+
+
+@nb.njit(inline="always", **_JIT)
+def _lanes_harmonics(PT, nl, o, nh):
+    """The most harmonics :func:`_harmonics` gives the mesh block at o in a lane of the block:
+    every lane's sum runs that far (a lane's terms past its own count are zeros)."""
+    top = 0
+    for k in range(nl):
+        h = int(PT[o + M_NH, k])
+        h = h if 0 < h < nh else nh
+        top = max(top, h)
+    return top
 
 
 @nb.njit(inline="always", **_JIT)
@@ -326,29 +371,33 @@ def _mesh_force(t, y, p, o, q, n, nh, s, c):
     d, v = _mesh_state(y, p, o, q, n, s, c, om)
     g = _zone(y, p, o, q, n, block_size(n, nh), d, s, c, om)
     if g < 0.0 and p[TWO_FLANK] != 0.0:  # the coast flank
-        kc = harmonic_factor(p, o + coast_offset(n, nh), nh, s, c)
+        kc = harmonic_factor(p, o + coast_offset(n, nh), _harmonics(p, o, nh), s, c)
         return p[o + M_KFC] * kc * g + p[o + M_CF] * v
-    k = harmonic_factor(p, o + MESH_FIXED, nh, s, c)
+    k = harmonic_factor(p, o + MESH_FIXED, _harmonics(p, o, nh), s, c)
     return p[o + M_KF] * k * g + p[o + M_CF] * v
 
 
 @nb.njit(inline="always", **_JIT)
 def _mesh_forces_shared(y, out, p, n, nm, nh, mesh, bs, mz, s, c):
     """The mesh forces into out[:nm]: :func:`_mesh_force` of every mesh with one harmonic
-    recurrence for all (the same operations per mesh; the relative stiffnesses first, in out)."""
+    recurrence for all (the same operations per mesh, each mesh's sum to its own harmonic
+    count :func:`_harmonics`; the relative stiffnesses first, in out)."""
     for m in range(nm):
         out[m] = 1.0
     if nh > 0:
+        top = 0
         for m in range(nm):
             f = mesh + m * bs + MESH_FIXED
             out[m] = p[f] * c + p[f + 1] * s
+            top = max(top, _harmonics(p, mesh + m * bs, nh))
         ch = c
         sh = s
-        for h in range(1, nh):
+        for h in range(1, top):
             ch, sh = ch * c - sh * s, sh * c + ch * s
             for m in range(nm):
-                f = mesh + m * bs + MESH_FIXED + 2 * h
-                out[m] += p[f] * ch + p[f + 1] * sh
+                if h < _harmonics(p, mesh + m * bs, nh):
+                    f = mesh + m * bs + MESH_FIXED + 2 * h
+                    out[m] += p[f] * ch + p[f + 1] * sh
         for m in range(nm):
             out[m] = 1.0 + out[m]
     for m in range(nm):
@@ -463,26 +512,35 @@ def _lanes_stiffness(PT, nl, S, C, SC, rb, mesh, bs, nh, nm, first):
     """:func:`~geardyn.models.elements.harmonic_factor` of every mesh m into PT[rb + m] (the
     harmonic recurrence in SC rows 0, 1), the same operations in the same order, clipped at 0
     alike; ``first``: the offset of the coefficients in a mesh block (``MESH_FIXED``: the drive
-    flank's)."""
+    flank's). Each mesh's sum runs to the block's count (:func:`_lanes_harmonics`), which is
+    kept in the mesh's ``harmonics`` entry of lane 0 (at least that lane's own count, so its
+    sum is bitwise the same)."""
     if nh == 0:
         for m in range(nm):
             for k in range(nl):
                 PT[rb + m, k] = 1.0
         return
+    top = 0
     for m in range(nm):
-        f = mesh + m * bs + first
+        o = mesh + m * bs
+        hm = _lanes_harmonics(PT, nl, o, nh)
+        PT[o + M_NH, 0] = hm
+        top = max(top, hm)
+        f = o + first
         for k in range(nl):
             PT[rb + m, k] = PT[f, k] * C[k] + PT[f + 1, k] * S[k]
     for k in range(nl):
         SC[0, k] = C[k]
         SC[1, k] = S[k]
-    for h in range(1, nh):
+    for h in range(1, top):
         for k in range(nl):
             ch = SC[0, k]
             sh = SC[1, k]
             SC[0, k] = ch * C[k] - sh * S[k]
             SC[1, k] = sh * C[k] + ch * S[k]
         for m in range(nm):
+            if h >= PT[mesh + m * bs + M_NH, 0]:
+                continue
             f = mesh + m * bs + first + 2 * h
             for k in range(nl):
                 PT[rb + m, k] += PT[f, k] * SC[0, k] + PT[f + 1, k] * SC[1, k]
@@ -948,10 +1006,11 @@ def _lanes_own_phases(T, PT, nl, S, C, own, n, nh, nm, mesh, bs):
         two |= PT[TWO_FLANK, k] != 0.0
     for m in range(nm):
         o = mesh + m * bs
-        _lanes_own_stiffness(PT, nl, r + m, r + nm + m, r + 2 * nm + m, o + MESH_FIXED, nh, x)
+        hm = _lanes_harmonics(PT, nl, o, nh)
+        _lanes_own_stiffness(PT, nl, r + m, r + nm + m, r + 2 * nm + m, o + MESH_FIXED, hm, x)
         if two:
             _lanes_own_stiffness(PT, nl, r + m, r + nm + m, r + 3 * nm + m,
-                                 o + coast_offset(n, nh), nh, x)
+                                 o + coast_offset(n, nh), hm, x)
     PT[own, 0] = e
     return r
 
