@@ -1,19 +1,25 @@
-"""Each mesh's own harmonic count (the planetary kernels' ``harmonics`` entry of a mesh block):
-the kernels sum a mesh's stiffness series only up to its last harmonic with a coefficient that
-is not zero, and the results are bitwise those of summing every mesh to the longest series.
+"""Each mesh's own harmonic count and step (the planetary kernels' ``harmonics`` and
+``harmonic_step`` entries of a mesh block): the kernels sum a mesh's stiffness series only up to
+its last harmonic with a coefficient that is not zero, and past the first only over the
+multiples of the step that all its nonzero harmonics are (a healthy mesh of a faulty set: the
+faulty gear's teeth Z_f), and the results are bitwise those of summing every term of every mesh
+to the longest series.
 
-Checks: the counts equal the last nonzero harmonic found here from the model's own series (a
-cracked two-stage train: stage 1 over g1's revolution, H x 19 harmonics, stage 2 H; a planetary
-set with a longer sun than ring series; signed zeros); simulate (the per-lane functions: shared
-recurrence, two flanks, own phases) and run_lanes (the lane-block forms, lanes whose counts
-differ in one block) give bitwise the trajectories of the same vectors with every count unset
-(the kernels then sum all ``n_harmonics``, the padded path), and a count one short of a mesh's
-series changes them (the comparison sees a dropped harmonic).
+Checks: the counts and steps equal the last nonzero harmonic and the greatest common divisor of
+the nonzero harmonics found here from the model's own series (a cracked two-stage train: stage
+1 over g1's revolution, H x 19 harmonics, stage 2 H; a planetary set with a longer sun than ring
+series, signed zeros; a set over Z_f = 5 mesh cycles whose ring series has only every 5th
+harmonic); simulate (the per-lane functions: shared recurrence, two flanks, own phases) and
+run_lanes (the lane-block forms, lanes whose counts and steps differ in one block) give bitwise
+the trajectories of the same vectors with every count and step unset (the kernels then add
+every one of the ``n_harmonics`` terms: the padded path), and a count one short of a mesh's
+series or a step twice its own changes them (the comparison sees a dropped harmonic).
 """
 
 from __future__ import annotations
 
 import copy
+import math
 
 import numpy as np
 import pytest
@@ -27,10 +33,18 @@ H = 3  # mesh harmonics of the train's potential-energy series (short runs)
 RUN = geardyn.RunSettings(transient=20.0, samples=3, steps_per_period=64)
 
 
-def _count_rows(model: geardyn.Model) -> list[int]:
+def _count_rows(model: geardyn.Model, entry: int = pk.M_NH) -> list[int]:
+    """Per mesh the index of its ``harmonics`` entry (or of the block entry ``entry``)."""
     lay = model._layout
     nm = int(model.params[pk.N_MESH])
-    return [lay["mesh"] + m * lay["block"] + pk.M_NH for m in range(nm)]
+    return [lay["mesh"] + m * lay["block"] + entry for m in range(nm)]
+
+
+def _unset(P: np.ndarray, model: geardyn.Model, lanes: slice | int = slice(None)) -> np.ndarray:
+    """A copy of ``P`` with every mesh's count and step unset in ``lanes`` (the padded path)."""
+    out = P.copy()
+    out[lanes, _count_rows(model) + _count_rows(model, pk.M_HSTEP)] = 0.0
+    return out
 
 
 def _last_nonzero(model: geardyn.Model) -> np.ndarray:
@@ -42,18 +56,35 @@ def _last_nonzero(model: geardyn.Model) -> np.ndarray:
     return np.maximum(np.array(out), 1)
 
 
-def _with_counts(model: geardyn.Model, counts: dict[int, float] | float) -> geardyn.Model:
-    """A copy whose mesh ``harmonics`` entries are set (a number: every mesh; 0 unsets them,
-    so that the kernels sum all ``n_harmonics``, the padded path)."""
+def _gcd_nonzero(model: geardyn.Model) -> np.ndarray:
+    """Per mesh: the greatest common divisor of the harmonics (1-based) whose drive or coast
+    coefficients are not both zero in the model's own series, 1 where there is none."""
+    both = np.abs(model.fourier) + np.abs(model.fourier_coast)
+    pairs = both[:, 0::2] + both[:, 1::2]
+    return np.array([max(math.gcd(*(np.nonzero(row)[0] + 1).tolist()), 1) for row in pairs])
+
+
+def _with_counts(model: geardyn.Model, counts: dict[int, float] | float,
+                 entry: int = pk.M_NH) -> geardyn.Model:
+    """A copy whose mesh ``harmonics`` entries (or the block entry ``entry``) are set (a
+    number: every mesh; 0 unsets them)."""
     out = copy.copy(model)
     out.params = model.params.copy()
-    rows = _count_rows(model)
+    rows = _count_rows(model, entry)
     for m, row in enumerate(rows):
         if isinstance(counts, dict):
             if m in counts:
                 out.params[row] = counts[m]
         else:
             out.params[row] = counts
+    return out
+
+
+def _padded(model: geardyn.Model) -> geardyn.Model:
+    """A copy with every mesh's count and step unset: the kernels add all ``n_harmonics``
+    terms of every mesh (the padded path)."""
+    out = copy.copy(model)
+    out.params = _unset(model.params[None, :], model)[0]
     return out
 
 
@@ -84,6 +115,8 @@ def test_train_counts_are_each_meshs_last_harmonic(cracked_train):
     counts = model.params[_count_rows(model)]
     np.testing.assert_array_equal(counts, _last_nonzero(model))
     assert counts[0] > 18 * H and counts[1] == H  # stage 1 over the revolution; stage 2 not
+    np.testing.assert_array_equal(model.params[_count_rows(model, pk.M_HSTEP)],
+                                  _gcd_nonzero(model))
 
 
 def test_cracked_train_trajectory_is_bitwise_the_padded_ones(cracked_train):
@@ -91,7 +124,7 @@ def test_cracked_train_trajectory_is_bitwise_the_padded_ones(cracked_train):
     the counts as with every mesh summed to n_harmonics; stage 1 one harmonic short differs."""
     model = cracked_train
     got = _trajectory(model)
-    np.testing.assert_array_equal(got, _trajectory(_with_counts(model, 0.0)))
+    np.testing.assert_array_equal(got, _trajectory(_padded(model)))
     short = model.params[_count_rows(model)[0]] - 1
     assert not np.array_equal(got, _trajectory(_with_counts(model, {0: short})))
 
@@ -102,10 +135,8 @@ def test_cracked_train_sweep_lanes_are_bitwise_the_padded_ones(cracked_train):
     model = cracked_train
     P = model.lane_params("input_speed", [2000.0, 3000.0, 4500.0])
     rows = _count_rows(model)
-    padded = P.copy()
-    padded[:, rows] = 0.0
-    mixed = P.copy()
-    mixed[0, rows] = 0.0
+    padded = _unset(P, model)
+    mixed = _unset(P, model, 0)
     y0 = model.initial_state()
     run = geardyn.RunSettings(transient=2.0 * 2.0 * np.pi / P[:, pk.OMEGA].min(), samples=2,
                               steps_per_period=19 * 64)
@@ -145,8 +176,9 @@ def test_planetary_simulate_is_bitwise_the_padded_one(kw):
     counts = gs.params[_count_rows(gs)]
     np.testing.assert_array_equal(counts, _last_nonzero(gs))
     assert counts.min() < nh  # a mesh sums fewer harmonics than the longest
+    np.testing.assert_array_equal(gs.params[_count_rows(gs, pk.M_HSTEP)], _gcd_nonzero(gs))
     got = _trajectory(gs)
-    np.testing.assert_array_equal(got, _trajectory(_with_counts(gs, 0.0)))
+    np.testing.assert_array_equal(got, _trajectory(_padded(gs)))
     np.testing.assert_array_equal(got, _trajectory(_with_counts(gs, float(nh))))
     short = {m: c - 1 for m, c in enumerate(counts) if c == nh}
     assert not np.array_equal(got, _trajectory(_with_counts(gs, short)))
@@ -162,8 +194,7 @@ def test_planetary_lanes_whose_counts_differ_are_bitwise_the_padded_ones():
     P = gs.lane_params("sun_stiffness_fluctuation", values)
     rows = _count_rows(gs)
     assert np.all(P[0, rows[:3]] == 1.0) and np.all(P[1:, rows[:3]] > 1.0)
-    padded = P.copy()
-    padded[:, rows] = 0.0
+    padded = _unset(P, gs)
     y0 = gs.initial_state()
     got = run_lanes(gs, P, y0, run=RUN)
     assert np.all(got.status == 0)
@@ -172,3 +203,61 @@ def test_planetary_lanes_whose_counts_differ_are_bitwise_the_padded_ones():
         ds = geardyn.simulate(gs.with_params(sun_stiffness_fluctuation=values[j]), run=RUN,
                               y0=y0)
         np.testing.assert_array_equal(got.samples[j], ds["poincare"].values[1:])
+
+
+Z = 5  # mesh cycles per forcing period of the stepped set
+#: A coast flank at harmonic Z alone (the ring meshes keep their step).
+COAST = ([0.0] * (Z - 1) + [0.05], [0.0] * (Z - 1) + [0.02])
+
+
+def _stepped(**kw) -> geardyn.PlanetaryGearSet:
+    """A set over Z mesh cycles (``mesh_order``): the sun meshes' series has every harmonic up
+    to 2 Z, the ring meshes' only the harmonics Z and 2 Z (a healthy mesh of a faulty set)."""
+    h = np.arange(1, 2 * Z + 1)
+    sun = (0.04 / h, 0.02 * np.cos(h))
+    ring = (np.where(h % Z == 0, 0.1 / h, 0.0), np.where(h % Z == 0, -0.03, 0.0))
+    return _planetary(mesh_order=Z, waveform={"sun": sun, "ring": ring}, **kw)
+
+
+@pytest.mark.parametrize("kw", [{}, {"coast_waveform": COAST}])
+def test_stepped_series_simulate_is_bitwise_the_padded_one(kw):
+    gs = _stepped(**kw)
+    steps = gs.params[_count_rows(gs, pk.M_HSTEP)]
+    np.testing.assert_array_equal(steps, _gcd_nonzero(gs))
+    np.testing.assert_array_equal(gs.params[_count_rows(gs)], _last_nonzero(gs))
+    assert list(steps) == [1] * 3 + [Z] * 3
+    got = _trajectory(gs)
+    np.testing.assert_array_equal(got, _trajectory(_padded(gs)))
+    assert not np.array_equal(got, _trajectory(_with_counts(gs, {3: 2 * Z}, pk.M_HSTEP)))
+
+
+def test_stepped_series_at_its_own_phase_is_bitwise_the_padded_one():
+    """A ring mesh at order 2 (a raw override: the own-phase forms) with its step Z."""
+    gs = _stepped().with_params(r1_order=2.0)
+    assert gs.params[pk.MULTI_ORDER] == 1.0
+    got = _trajectory(gs)
+    np.testing.assert_array_equal(got, _trajectory(_padded(gs)))
+    assert not np.array_equal(got, _trajectory(_with_counts(gs, {3: 2 * Z}, pk.M_HSTEP)))
+    P = gs.lane_params("Omega", [0.15, 0.2, 0.25])
+    y0 = gs.initial_state()
+    want = run_lanes(gs, _unset(P, gs), y0, run=RUN)
+    assert np.all(want.status == 0) and np.all(np.isfinite(want.samples))
+    for Q in (P, _unset(P, gs, 1)):
+        np.testing.assert_array_equal(run_lanes(gs, Q, y0, run=RUN).samples, want.samples)
+
+
+@pytest.mark.parametrize("kw", [{}, {"coast_waveform": COAST}])
+def test_stepped_series_lanes_are_bitwise_the_padded_ones(kw):
+    """run_lanes of the stepped set (shared phase: one or two flanks), with the lanes' own
+    counts and steps, and with lane 1's unset (the block then adds every term): the padded
+    lanes' bits; the ring's step doubled in every lane differs."""
+    gs = _stepped(**kw)
+    P = gs.lane_params("Omega", [0.15, 0.2, 0.25])
+    y0 = gs.initial_state()
+    want = run_lanes(gs, _unset(P, gs), y0, run=RUN)
+    assert np.all(want.status == 0) and np.all(np.isfinite(want.samples))
+    for Q in (P, _unset(P, gs, 1)):
+        np.testing.assert_array_equal(run_lanes(gs, Q, y0, run=RUN).samples, want.samples)
+    wrong = P.copy()
+    wrong[:, _count_rows(gs, pk.M_HSTEP)[3:]] = 2 * Z
+    assert not np.array_equal(run_lanes(gs, wrong, y0, run=RUN).samples, want.samples)

@@ -81,6 +81,10 @@ MESH = CoefficientBlock((
                     "flanks): its last harmonic whose coefficients are not both zero, at least 1 "
                     "(``n_harmonics`` > 0); 0 (unset) sums all ``n_harmonics``",
                     constant="M_NH"),
+    workspace_entry("harmonic_step", "every harmonic of this block's series whose coefficients "
+                    "are not both zero is a multiple of it (their greatest common divisor; 1 "
+                    "where there is none); the kernels add only those terms; 0 (unset) adds "
+                    "every term", constant="M_HSTEP"),
 ))
 #: Per coordinate d of a mesh: its deflection row W_d and M^-1 W / (L omega_0^2), G_d.
 MESH_ROW = CoefficientBlock((

@@ -83,6 +83,7 @@ HEADER = HEADER_BLOCK.size
 _M = MESH.offset
 M_B, M_ES, M_EC, M_KF, M_CF = _M("b"), _M("E_s"), _M("E_c"), _M("KF"), _M("CF")
 M_KFC, M_ORDER, M_RADIAL, M_NH = _M("KF_coast"), _M("order"), _M("radial"), _M("harmonics")
+M_HSTEP = _M("harmonic_step")
 MESH_FIXED = MESH.size
 #: Structural entries per mesh row in the structure section (padded with zero weights).
 MESH_NZ = 6
@@ -190,7 +191,7 @@ def fill_structure(P: np.ndarray, kt_entries: list[tuple[int, int]],
                    mesh_dofs: list[list[int]]) -> None:
     """Write the structure section of every row of ``P`` (lanes x size, in place) from its dense
     parts: the Kt entries ``kt_entries`` (row-major order) and per mesh the dofs ``mesh_dofs[m]``
-    (ascending, at most ``MESH_NZ``); and every mesh block's harmonic count
+    (ascending, at most ``MESH_NZ``); and every mesh block's harmonic count and step
     (:func:`fill_harmonics`). A dense Kt, W or G entry outside the structure that is not zero
     (e.g. a raw coefficient override) is a ``ValueError``."""
     P = np.atleast_2d(P)
@@ -232,12 +233,16 @@ def fill_structure(P: np.ndarray, kt_entries: list[tuple[int, int]],
 
 
 def fill_harmonics(P: np.ndarray) -> None:
-    """Write every mesh block's ``harmonics`` entry in every row of ``P`` (lanes x size, in
-    place) from the row's own Fourier coefficients: the last harmonic h (1 .. nh) whose drive or
-    coast coefficients are not both zero, at least 1 (0 where nh is 0). The kernels sum a
-    block's series up to it (:func:`_harmonics`): the terms past it have zero coefficients, so
-    leaving them out changes no sum's bits (each adds +-0 to the partial sum, which changes at
-    most the sign of a zero partial sum, and 1 + acc maps both zeros to 1)."""
+    """Write every mesh block's ``harmonics`` and ``harmonic_step`` entries in every row of
+    ``P`` (lanes x size, in place) from the row's own Fourier coefficients: the last harmonic h
+    (1 .. nh) whose drive or coast coefficients are not both zero, at least 1 (0 where nh is
+    0), and the greatest common divisor of those harmonics (1 where there is none). The kernels
+    sum a block's series up to its count and, past the first harmonic, only the multiples of
+    its step (:func:`_harmonics`, :func:`_step`): every term left out has zero coefficients,
+    so leaving it out changes no sum's bits (x + (+-0) is x for x != 0, and a zero for a zero
+    x, so the partial sums with and without it are equal or both zeros; the next nonzero term
+    and 1 + acc give the same value from either zero). The recurrence of cos h theta and
+    sin h theta still runs over every h, so the terms kept are the same values."""
     P = np.atleast_2d(P)
     n, nm, nh = int(P[0, N_DOF]), int(P[0, N_MESH]), int(P[0, N_HARM])
     lay = layout(n, nm, nh)
@@ -245,6 +250,7 @@ def fill_harmonics(P: np.ndarray) -> None:
         o = lay["mesh"] + m * lay["block"]
         if nh == 0:
             P[:, o + M_NH] = 0.0
+            P[:, o + M_HSTEP] = 1.0
             continue
         d = P[:, o + MESH_FIXED:o + MESH_FIXED + 2 * nh].reshape(-1, nh, 2)
         c0 = o + coast_offset(n, nh)
@@ -252,6 +258,8 @@ def fill_harmonics(P: np.ndarray) -> None:
         nonzero = np.any(d != 0.0, axis=2) | np.any(c != 0.0, axis=2)
         last = np.where(nonzero.any(axis=1), nh - np.argmax(nonzero[:, ::-1], axis=1), 0)
         P[:, o + M_NH] = np.maximum(last, 1)
+        P[:, o + M_HSTEP] = np.maximum(np.gcd.reduce(
+            np.where(nonzero, np.arange(1, nh + 1), 0), axis=1), 1)
 
 
 @nb.njit(inline="always", **_JIT)
@@ -285,6 +293,47 @@ def _lanes_harmonics(PT, nl, o, nh):
         h = h if 0 < h < nh else nh
         top = max(top, h)
     return top
+
+
+@nb.njit(inline="always", **_JIT)
+def _step(p, o):
+    """The harmonic step of the mesh block at o: its ``harmonic_step`` entry
+    (:func:`fill_harmonics`), 1 where that is unset (0)."""
+    s = int(p[o + M_HSTEP])
+    return s if s > 1 else 1
+
+
+@nb.njit(inline="always", **_JIT)
+def _lanes_step(PT, nl, o):
+    """The greatest common divisor of the harmonic steps (:func:`_step`) of the mesh block at o
+    in the block's lanes: a step every lane's series keeps."""
+    g = 0
+    for k in range(nl):
+        a = int(PT[o + M_HSTEP, k])
+        a = a if a > 1 else 1
+        while a != 0:
+            g, a = a, g % a
+    return g
+
+
+@nb.njit(inline="always", **_JIT)
+def _stepped_factor(p, f, nh, step, s, c):
+    """:func:`~geardyn.models.elements.harmonic_factor` that adds, past the first harmonic, only
+    the terms of the harmonics that are multiples of ``step`` (the recurrence runs over every
+    harmonic: the terms added are the same values); ``harmonic_factor`` itself for step 1."""
+    if step == 1 or nh == 0:
+        return harmonic_factor(p, f, nh, s, c)
+    acc = p[f] * c + p[f + 1] * s
+    ch = c
+    sh = s
+    nxt = step - 1
+    for h in range(1, nh):
+        ch, sh = ch * c - sh * s, sh * c + ch * s
+        if h == nxt:
+            acc += p[f + 2 * h] * ch + p[f + 2 * h + 1] * sh
+            nxt += step
+    v = 1.0 + acc
+    return v if v > 0.0 else 0.0
 
 
 @nb.njit(inline="always", **_JIT)
@@ -371,9 +420,10 @@ def _mesh_force(t, y, p, o, q, n, nh, s, c):
     d, v = _mesh_state(y, p, o, q, n, s, c, om)
     g = _zone(y, p, o, q, n, block_size(n, nh), d, s, c, om)
     if g < 0.0 and p[TWO_FLANK] != 0.0:  # the coast flank
-        kc = harmonic_factor(p, o + coast_offset(n, nh), _harmonics(p, o, nh), s, c)
+        kc = _stepped_factor(p, o + coast_offset(n, nh), _harmonics(p, o, nh), _step(p, o),
+                             s, c)
         return p[o + M_KFC] * kc * g + p[o + M_CF] * v
-    k = harmonic_factor(p, o + MESH_FIXED, _harmonics(p, o, nh), s, c)
+    k = _stepped_factor(p, o + MESH_FIXED, _harmonics(p, o, nh), _step(p, o), s, c)
     return p[o + M_KF] * k * g + p[o + M_CF] * v
 
 
@@ -381,7 +431,8 @@ def _mesh_force(t, y, p, o, q, n, nh, s, c):
 def _mesh_forces_shared(y, out, p, n, nm, nh, mesh, bs, mz, s, c):
     """The mesh forces into out[:nm]: :func:`_mesh_force` of every mesh with one harmonic
     recurrence for all (the same operations per mesh, each mesh's sum to its own harmonic
-    count :func:`_harmonics`; the relative stiffnesses first, in out)."""
+    count :func:`_harmonics` over the multiples of its step :func:`_step`; the relative
+    stiffnesses first, in out)."""
     for m in range(nm):
         out[m] = 1.0
     if nh > 0:
@@ -395,8 +446,9 @@ def _mesh_forces_shared(y, out, p, n, nm, nh, mesh, bs, mz, s, c):
         for h in range(1, top):
             ch, sh = ch * c - sh * s, sh * c + ch * s
             for m in range(nm):
-                if h < _harmonics(p, mesh + m * bs, nh):
-                    f = mesh + m * bs + MESH_FIXED + 2 * h
+                o = mesh + m * bs
+                if h < _harmonics(p, o, nh) and (h + 1) % _step(p, o) == 0:
+                    f = o + MESH_FIXED + 2 * h
                     out[m] += p[f] * ch + p[f + 1] * sh
         for m in range(nm):
             out[m] = 1.0 + out[m]
@@ -512,9 +564,10 @@ def _lanes_stiffness(PT, nl, S, C, SC, rb, mesh, bs, nh, nm, first):
     """:func:`~geardyn.models.elements.harmonic_factor` of every mesh m into PT[rb + m] (the
     harmonic recurrence in SC rows 0, 1), the same operations in the same order, clipped at 0
     alike; ``first``: the offset of the coefficients in a mesh block (``MESH_FIXED``: the drive
-    flank's). Each mesh's sum runs to the block's count (:func:`_lanes_harmonics`), which is
-    kept in the mesh's ``harmonics`` entry of lane 0 (at least that lane's own count, so its
-    sum is bitwise the same)."""
+    flank's). Each mesh's sum runs to the block's count (:func:`_lanes_harmonics`) over the
+    multiples of the block's step (:func:`_lanes_step`), which are kept in the mesh's
+    ``harmonics`` and ``harmonic_step`` entries of lane 0 (a count at least that lane's own, a
+    step that divides its own: its sum is bitwise the same)."""
     if nh == 0:
         for m in range(nm):
             for k in range(nl):
@@ -525,6 +578,7 @@ def _lanes_stiffness(PT, nl, S, C, SC, rb, mesh, bs, nh, nm, first):
         o = mesh + m * bs
         hm = _lanes_harmonics(PT, nl, o, nh)
         PT[o + M_NH, 0] = hm
+        PT[o + M_HSTEP, 0] = _lanes_step(PT, nl, o)
         top = max(top, hm)
         f = o + first
         for k in range(nl):
@@ -539,7 +593,8 @@ def _lanes_stiffness(PT, nl, S, C, SC, rb, mesh, bs, nh, nm, first):
             SC[0, k] = ch * C[k] - sh * S[k]
             SC[1, k] = sh * C[k] + ch * S[k]
         for m in range(nm):
-            if h >= PT[mesh + m * bs + M_NH, 0]:
+            o = mesh + m * bs
+            if h >= PT[o + M_NH, 0] or (h + 1) % int(PT[o + M_HSTEP, 0]) != 0:
                 continue
             f = mesh + m * bs + first + 2 * h
             for k in range(nl):
@@ -933,10 +988,11 @@ def _own_phases_lane(PT, k, t, s, c, r, nm, mesh, bs):
 
 
 @nb.njit(inline="always", **_JIT)
-def _lanes_own_stiffness(PT, nl, rs, rc, out, f, nh, x):
+def _lanes_own_stiffness(PT, nl, rs, rc, out, f, nh, step, x):
     """:func:`~geardyn.models.elements.harmonic_factor_lane` of the coefficients at row f for
     every lane at the phase whose sin and cos are in rows rs and rc, into row out (the harmonic
-    recurrence in rows x, x + 1): the same operations in the same order, clipped at 0 alike."""
+    recurrence in rows x, x + 1): the same operations in the same order, clipped at 0 alike;
+    past the first harmonic only the multiples of ``step`` added (:func:`_stepped_factor`)."""
     if nh == 0:
         for k in range(nl):
             PT[out, k] = 1.0
@@ -951,6 +1007,8 @@ def _lanes_own_stiffness(PT, nl, rs, rc, out, f, nh, x):
             sh = PT[x + 1, k]
             PT[x, k] = ch * PT[rc, k] - sh * PT[rs, k]
             PT[x + 1, k] = sh * PT[rc, k] + ch * PT[rs, k]
+        if (h + 1) % step != 0:
+            continue
         for k in range(nl):
             PT[out, k] += PT[f + 2 * h, k] * PT[x, k] + PT[f + 2 * h + 1, k] * PT[x + 1, k]
     for k in range(nl):
@@ -1007,10 +1065,12 @@ def _lanes_own_phases(T, PT, nl, S, C, own, n, nh, nm, mesh, bs):
     for m in range(nm):
         o = mesh + m * bs
         hm = _lanes_harmonics(PT, nl, o, nh)
-        _lanes_own_stiffness(PT, nl, r + m, r + nm + m, r + 2 * nm + m, o + MESH_FIXED, hm, x)
+        hs = _lanes_step(PT, nl, o)
+        _lanes_own_stiffness(PT, nl, r + m, r + nm + m, r + 2 * nm + m, o + MESH_FIXED, hm, hs,
+                             x)
         if two:
             _lanes_own_stiffness(PT, nl, r + m, r + nm + m, r + 3 * nm + m,
-                                 o + coast_offset(n, nh), hm, x)
+                                 o + coast_offset(n, nh), hm, hs, x)
     PT[own, 0] = e
     return r
 
