@@ -40,7 +40,10 @@ step), the values the per-lane functions compute anew.
 
 Coefficient vector: a header (``DAMPED`` is 1 where Ct is not zero), the dof vectors F0, F1, the
 matrices Kt, Ct (row-major), one block per mesh (fixed entries, 2 nh Fourier coefficients, W, G, 2
-nh coast-flank Fourier coefficients), then the *structure* the kernels read
+nh coast-flank Fourier coefficients; of these a mesh's sums add only the terms up to its own
+harmonic count over the multiples of its harmonic step, the fixed workspace entries
+``harmonics`` and ``harmonic_step`` written from the coefficients by :func:`fill_harmonics`,
+bitwise the sums of all nh terms), then the *structure* the kernels read
 (:func:`fill_structure`, derived from the dense parts): the count nk of the structural entries of
 Kt, their rows, columns and values, and per mesh ``MESH_NZ`` dof indices with the W and G values
 there (a mesh row touches at most six coordinates: the sun or ring and the planet, three each). So
