@@ -28,6 +28,7 @@ import geardyn
 from geardyn.io.toml import builtin_study_text, load_study
 from geardyn.models import planetary_kernels as pk
 from geardyn.solvers.ensemble import run_lanes
+from geardyn.solvers.kernels import kernels_for
 
 H = 3  # mesh harmonics of the train's potential-energy series (short runs)
 RUN = geardyn.RunSettings(transient=20.0, samples=3, steps_per_period=64)
@@ -261,3 +262,34 @@ def test_stepped_series_lanes_are_bitwise_the_padded_ones(kw):
     wrong = P.copy()
     wrong[:, _count_rows(gs, pk.M_HSTEP)[3:]] = 2 * Z
     assert not np.array_equal(run_lanes(gs, wrong, y0, run=RUN).samples, want.samples)
+
+
+def test_sets_and_trains_of_any_counts_share_one_compiled_kernel(cracked_train):
+    """The counts and steps are entries of the vector, not of the code: sets of 3 and 5 planets,
+    stepped or not, and the cracked train run on one kernel module and one compiled trajectory
+    signature."""
+    models = [_planetary(), _stepped(), cracked_train,
+              _planetary(n_planets=5, sun_mesh_phase=0.0, ring_mesh_phase=0.0)]
+    modules = {id(kernels_for(m.kernel)) for m in models}
+    assert len(modules) == 1
+    for m in models:
+        _trajectory(m)
+    assert len(kernels_for(models[0].kernel).trajectory.signatures) == 1
+
+
+def test_reloaded_slots_take_their_lanes_counts_anew():
+    """400 lanes (more than the blocks of 64: slots refilled as lanes finish, at different Omega),
+    the first 300 without sun fluctuation (sun counts 1), the others with the rectangular series:
+    the lanes' bits are the padded lanes' (whatever slots the full lanes are loaded into)."""
+    gs = _planetary(waveform="rectangular", harmonics=7, sun_stiffness_fluctuation=0.1,
+                    ring_stiffness_fluctuation=0.05)
+    flat = gs.with_params(sun_stiffness_fluctuation=0.0)
+    omegas = np.linspace(0.5, 1.4, 400)
+    P = np.vstack([flat.lane_params("Omega", omegas[:300]), gs.lane_params("Omega", omegas[300:])])
+    rows = _count_rows(gs)
+    assert np.all(P[:300, rows[0]] == 1.0) and np.all(P[300:, rows[0]] == 7.0)
+    y0 = gs.initial_state()
+    run = RUN.replace(transient=5.0)
+    want = run_lanes(gs, _unset(P, gs), y0, run=run)
+    assert np.all(want.status == 0) and np.all(np.isfinite(want.samples))
+    np.testing.assert_array_equal(run_lanes(gs, P, y0, run=run).samples, want.samples)

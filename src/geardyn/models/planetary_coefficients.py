@@ -85,6 +85,8 @@ MESH = CoefficientBlock((
                     "are not both zero is a multiple of it (their greatest common divisor; 1 "
                     "where there is none); the kernels add only those terms; 0 (unset) adds "
                     "every term", constant="M_HSTEP"),
+    workspace_entry("harmonic_next", "scratch of the lane-block functions: the next harmonic "
+                    "of a stepped series to add", constant="M_HNEXT"),
 ))
 #: Per coordinate d of a mesh: its deflection row W_d and M^-1 W / (L omega_0^2), G_d.
 MESH_ROW = CoefficientBlock((

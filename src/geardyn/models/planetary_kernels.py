@@ -86,7 +86,7 @@ HEADER = HEADER_BLOCK.size
 _M = MESH.offset
 M_B, M_ES, M_EC, M_KF, M_CF = _M("b"), _M("E_s"), _M("E_c"), _M("KF"), _M("CF")
 M_KFC, M_ORDER, M_RADIAL, M_NH = _M("KF_coast"), _M("order"), _M("radial"), _M("harmonics")
-M_HSTEP = _M("harmonic_step")
+M_HSTEP, M_HNEXT = _M("harmonic_step"), _M("harmonic_next")
 MESH_FIXED = MESH.size
 #: Structural entries per mesh row in the structure section (padded with zero weights).
 MESH_NZ = 6
@@ -100,9 +100,10 @@ EMPTY = 2.0
 #: and its drive and coast relative stiffness there. All zero is empty (no phase has sin and
 #: cos 0).
 OWN_ENTRIES = 2
-#: The last row of the cache section: 0 in a freshly loaded slot; the lane-block rhs then checks
-#: whether the block's lanes share one Ct (:func:`_lanes_ct_uniform`).
-CT_ROWS = 1
+#: The last rows of the cache section, 0 in a freshly loaded slot: the lane-block rhs then checks
+#: whether the block's lanes share one Ct (:func:`_lanes_ct_uniform`), and the lane-block
+#: functions take the block's harmonic counts and steps anew (:func:`_lanes_prepare_harmonics`).
+CT_ROWS = 2
 
 _JIT = {"cache": True, "error_model": "numpy", "boundscheck": False}
 #: The lane-block functions allocate nothing: compiled without reference counting (the kernels
@@ -162,7 +163,7 @@ def cache_entries(n_mesh: int) -> tuple[list[str], list[float]]:
         names += [f"cache{e}_sin", f"cache{e}_cos"] + [f"cache{e}_k{m}" for m in range(n_mesh)]
         names += [f"cache{e}_kc{m}" for m in range(n_mesh)]
         values += [EMPTY, EMPTY] + [0.0] * (2 * n_mesh)
-    return names + ["cache_ct_checked"], values + [0.0]
+    return names + ["cache_ct_checked", "cache_harmonics_checked"], values + [0.0, 0.0]
 
 
 def own_cache_names(n_mesh: int) -> list[str]:
@@ -450,7 +451,8 @@ def _mesh_forces_shared(y, out, p, n, nm, nh, mesh, bs, mz, s, c):
             ch, sh = ch * c - sh * s, sh * c + ch * s
             for m in range(nm):
                 o = mesh + m * bs
-                if h < _harmonics(p, o, nh) and (h + 1) % _step(p, o) == 0:
+                st = _step(p, o)
+                if h < _harmonics(p, o, nh) and (st == 1 or (h + 1) % st == 0):
                     f = o + MESH_FIXED + 2 * h
                     out[m] += p[f] * ch + p[f + 1] * sh
         for m in range(nm):
@@ -563,26 +565,23 @@ def _lanes_offsets(PT):
 
 
 @nb.njit(inline="always", **_JIT)
-def _lanes_stiffness(PT, nl, S, C, SC, rb, mesh, bs, nh, nm, first):
+def _lanes_stiffness(PT, nl, S, C, SC, rb, mesh, bs, nh, nm, first, top, uniform):
     """:func:`~geardyn.models.elements.harmonic_factor` of every mesh m into PT[rb + m] (the
     harmonic recurrence in SC rows 0, 1), the same operations in the same order, clipped at 0
     alike; ``first``: the offset of the coefficients in a mesh block (``MESH_FIXED``: the drive
-    flank's). Each mesh's sum runs to the block's count (:func:`_lanes_harmonics`) over the
-    multiples of the block's step (:func:`_lanes_step`), which are kept in the mesh's
-    ``harmonics`` and ``harmonic_step`` entries of lane 0 (a count at least that lane's own, a
-    step that divides its own: its sum is bitwise the same)."""
+    flank's). Each mesh's sum runs to the block's count over the multiples of the block's step
+    (lane 0's ``harmonics`` and ``harmonic_step`` entries, :func:`_lanes_prepare_harmonics`;
+    ``top``: the largest count, ``uniform``: every count ``top`` and every step 1, the loop
+    then checks neither); a stepped mesh's next harmonic in its ``harmonic_next`` entry of lane
+    0 (no division in the loop)."""
     if nh == 0:
         for m in range(nm):
             for k in range(nl):
                 PT[rb + m, k] = 1.0
         return
-    top = 0
     for m in range(nm):
         o = mesh + m * bs
-        hm = _lanes_harmonics(PT, nl, o, nh)
-        PT[o + M_NH, 0] = hm
-        PT[o + M_HSTEP, 0] = _lanes_step(PT, nl, o)
-        top = max(top, hm)
+        PT[o + M_HNEXT, 0] = PT[o + M_HSTEP, 0]
         f = o + first
         for k in range(nl):
             PT[rb + m, k] = PT[f, k] * C[k] + PT[f + 1, k] * S[k]
@@ -596,9 +595,14 @@ def _lanes_stiffness(PT, nl, S, C, SC, rb, mesh, bs, nh, nm, first):
             SC[0, k] = ch * C[k] - sh * S[k]
             SC[1, k] = sh * C[k] + ch * S[k]
         for m in range(nm):
-            o = mesh + m * bs
-            if h >= PT[o + M_NH, 0] or (h + 1) % int(PT[o + M_HSTEP, 0]) != 0:
-                continue
+            if not uniform:
+                o = mesh + m * bs
+                if h >= PT[o + M_NH, 0]:
+                    continue
+                if PT[o + M_HSTEP, 0] != 1.0:  # a stepped series: its next harmonic only
+                    if h + 1 != PT[o + M_HNEXT, 0]:
+                        continue
+                    PT[o + M_HNEXT, 0] += PT[o + M_HSTEP, 0]
             f = mesh + m * bs + first + 2 * h
             for k in range(nl):
                 PT[rb + m, k] += PT[f, k] * SC[0, k] + PT[f + 1, k] * SC[1, k]
@@ -606,6 +610,39 @@ def _lanes_stiffness(PT, nl, S, C, SC, rb, mesh, bs, nh, nm, first):
         for k in range(nl):
             v = 1.0 + PT[rb + m, k]
             PT[rb + m, k] = v if v > 0.0 else 0.0
+
+
+@nb.njit(inline="always", **_JIT)
+def _lanes_prepare_harmonics(PT, nl, chk, mesh, bs, nh, nm):
+    """The block's harmonic counts and steps: per mesh the most harmonics of its lanes
+    (:func:`_lanes_harmonics`) and the greatest common divisor of their steps
+    (:func:`_lanes_step`), kept in lane 0's ``harmonics`` and ``harmonic_step`` entries (a
+    count at least lane 0's own, a step that divides its own: its sums are bitwise the same).
+    Taken anew only after a slot was loaded (the row ``chk``, ``cache_harmonics_checked``, is
+    then 0 in its column); the answer in that row of slot 0: 1 + the largest count, negative
+    where some count is below it or some step above 1. Returns the largest count and whether
+    every count is it and every step 1."""
+    fresh = False
+    for k in range(nl):
+        fresh |= PT[chk, k] == 0.0
+    if fresh:
+        top = 0
+        uniform = True
+        for m in range(nm):
+            o = mesh + m * bs
+            hm = _lanes_harmonics(PT, nl, o, nh)
+            hs = _lanes_step(PT, nl, o)
+            PT[o + M_NH, 0] = hm
+            PT[o + M_HSTEP, 0] = hs
+            uniform &= hs == 1
+            if m > 0 and hm != top:
+                uniform = False
+            top = max(top, hm)
+        for k in range(nl):
+            PT[chk, k] = 1.0
+        PT[chk, 0] = (1.0 + top) if uniform else -(1.0 + top)
+    v = PT[chk, 0]
+    return int(abs(v)) - 1, v > 0.0
 
 
 @nb.njit(inline="always", **_JIT)
@@ -629,10 +666,13 @@ def _lanes_cached_stiffness(PT, nl, S, C, SC, cache, mesh, bs, nh, nm, two):
             return b + 2
     e = (int(PT[cache, 0]) + 1) % CACHE_ENTRIES  # not the entry used last
     b = cache + 1 + e * width
-    _lanes_stiffness(PT, nl, S, C, SC, b + 2, mesh, bs, nh, nm, MESH_FIXED)
+    top, uniform = _lanes_prepare_harmonics(PT, nl, cache + 1 + CACHE_ENTRIES * width + 1, mesh,
+                                            bs, nh, nm)
+    _lanes_stiffness(PT, nl, S, C, SC, b + 2, mesh, bs, nh, nm, MESH_FIXED, top, uniform)
     if two:
         n = int(PT[N_DOF, 0])
-        _lanes_stiffness(PT, nl, S, C, SC, b + 2 + nm, mesh, bs, nh, nm, coast_offset(n, nh))
+        _lanes_stiffness(PT, nl, S, C, SC, b + 2 + nm, mesh, bs, nh, nm, coast_offset(n, nh),
+                         top, uniform)
     for k in range(nl):
         PT[b, k] = S[k]
         PT[b + 1, k] = C[k]
@@ -778,7 +818,8 @@ def planetary_rhs_lanes(T, Y, DY, PT, nl, S, C, SC):
                 DY[i, k] -= (PT[g, k] * PT[r, k]) * Y[j, k]
     multi = _lanes_multi_order(PT, nl)
     kr = _lanes_cached_stiffness(PT, nl, S, C, SC, mz + nm * 3 * MESH_NZ, mesh, bs, nh, nm, two)
-    ko = _lanes_own_phases(T, PT, nl, S, C, _own_offset(PT, nm, mz), n, nh, nm, mesh, bs) \
+    ko = _lanes_own_phases(T, PT, nl, S, C, _own_offset(PT, nm, mz), n, nh, nm, mesh, bs,
+                           _gyro_offset(nm, mz) - 1) \
         if multi else 0
     for m in range(nm):
         if multi and not _lanes_order_one(PT, nl, mesh + m * bs):
@@ -887,7 +928,8 @@ def planetary_events_lanes(T, Y, G, PT, nl, S, C):
     """:func:`planetary_events` for lanes 0..nl-1 of a block (the mesh phase S[k], C[k])."""
     n, nm, nh, mesh, bs, st, mz = _lanes_offsets(PT)
     multi = _lanes_multi_order(PT, nl)
-    ko = _lanes_own_phases(T, PT, nl, S, C, _own_offset(PT, nm, mz), n, nh, nm, mesh, bs) \
+    ko = _lanes_own_phases(T, PT, nl, S, C, _own_offset(PT, nm, mz), n, nh, nm, mesh, bs,
+                           _gyro_offset(nm, mz) - 1) \
         if multi else 0
     for m in range(nm):
         o = mesh + m * bs
@@ -929,7 +971,8 @@ def planetary_observe_lanes(T, Y, O, PT, nl, S, C, SC):
         two |= PT[TWO_FLANK, k] != 0.0
     multi = _lanes_multi_order(PT, nl)
     kr = _lanes_cached_stiffness(PT, nl, S, C, SC, mz + nm * 3 * MESH_NZ, mesh, bs, nh, nm, two)
-    ko = _lanes_own_phases(T, PT, nl, S, C, _own_offset(PT, nm, mz), n, nh, nm, mesh, bs) \
+    ko = _lanes_own_phases(T, PT, nl, S, C, _own_offset(PT, nm, mz), n, nh, nm, mesh, bs,
+                           _gyro_offset(nm, mz) - 1) \
         if multi else 0
     for m in range(nm):
         if multi and not _lanes_order_one(PT, nl, mesh + m * bs):
@@ -1000,6 +1043,7 @@ def _lanes_own_stiffness(PT, nl, rs, rc, out, f, nh, step, x):
         for k in range(nl):
             PT[out, k] = 1.0
         return
+    nxt = step if step > 1 else 2  # the next harmonic to add
     for k in range(nl):
         PT[out, k] = PT[f, k] * PT[rc, k] + PT[f + 1, k] * PT[rs, k]
         PT[x, k] = PT[rc, k]
@@ -1010,8 +1054,9 @@ def _lanes_own_stiffness(PT, nl, rs, rc, out, f, nh, step, x):
             sh = PT[x + 1, k]
             PT[x, k] = ch * PT[rc, k] - sh * PT[rs, k]
             PT[x + 1, k] = sh * PT[rc, k] + ch * PT[rs, k]
-        if (h + 1) % step != 0:
+        if h + 1 != nxt:
             continue
+        nxt += step
         for k in range(nl):
             PT[out, k] += PT[f + 2 * h, k] * PT[x, k] + PT[f + 2 * h + 1, k] * PT[x + 1, k]
     for k in range(nl):
@@ -1026,17 +1071,20 @@ def _own_key(PT, b, k, t, s, c):
 
 
 @nb.njit(inline="always", **_JIT)
-def _lanes_own_phases(T, PT, nl, S, C, own, n, nh, nm, mesh, bs):
+def _lanes_own_phases(T, PT, nl, S, C, own, n, nh, nm, mesh, bs, chk):
     """Row r of the own-phase cache entry at the lanes' times T and forcing phases (S, C): row
     r + m holds the sin of mesh m's own phase, r + nm + m its cos, r + 2 nm + m its drive
     relative stiffness there, r + 3 nm + m its coast one (computed where a lane of the block
-    has two flanks). The block's PT carries ``OWN_ENTRIES`` (2) entries after two scratch rows
-    from row ``own`` + 1 (all zero, empty, whenever a slot is loaded with a lane's
-    coefficients): the four RK4 stages of a step see two new times (the mid-step one twice,
-    the end one again for the events, the observables and as the next step's start), so the
-    sin and cos of each distinct mesh order are computed twice a step per lane, not five times
-    per mesh. A lane's phases are reused only where its key (time and forcing phase) equals
-    the call's exactly, so the values are those computed anew."""
+    has two flanks, and only for the meshes that take the own-phase forms: not
+    :func:`_lanes_order_one`; each to the block's harmonic count over its step,
+    :func:`_lanes_prepare_harmonics`, whose checked row is ``chk``). The block's PT carries
+    ``OWN_ENTRIES`` (2) entries after two scratch rows from row ``own`` + 1 (all zero, empty,
+    whenever a slot is loaded with a lane's coefficients): the four RK4 stages of a step see
+    two new times (the mid-step one twice, the end one again for the events, the observables
+    and as the next step's start), so the sin and cos of each distinct mesh order are computed
+    twice a step per lane, not five times per mesh. A lane's phases are reused only where its
+    key (time and forcing phase) equals the call's exactly, so the values are those computed
+    anew."""
     width = 3 + 4 * nm
     x = own + 1  # scratch of the harmonic recurrence
     for e in range(OWN_ENTRIES):
@@ -1065,10 +1113,13 @@ def _lanes_own_phases(T, PT, nl, S, C, own, n, nh, nm, mesh, bs):
     two = False
     for k in range(nl):
         two |= PT[TWO_FLANK, k] != 0.0
+    _lanes_prepare_harmonics(PT, nl, chk, mesh, bs, nh, nm)
     for m in range(nm):
         o = mesh + m * bs
-        hm = _lanes_harmonics(PT, nl, o, nh)
-        hs = _lanes_step(PT, nl, o)
+        if _lanes_order_one(PT, nl, o):  # the shared-phase forms': these rows are not read
+            continue
+        hm = int(PT[o + M_NH, 0])
+        hs = int(PT[o + M_HSTEP, 0])
         _lanes_own_stiffness(PT, nl, r + m, r + nm + m, r + 2 * nm + m, o + MESH_FIXED, hm, hs,
                              x)
         if two:
