@@ -77,6 +77,16 @@ MESH = CoefficientBlock((
                     "(circular) clearance of radius b, whose other row is the next (+1) or the "
                     "previous (-1) block: g = (1 - b / r) x for r = sqrt(x^2 + y^2) > b, else 0",
                     constant="M_RADIAL"),
+    workspace_entry("harmonics", "the harmonics the kernels sum of this block's series (both "
+                    "flanks): its last harmonic whose coefficients are not both zero, at least 1 "
+                    "(``n_harmonics`` > 0); 0 (unset) sums all ``n_harmonics``",
+                    constant="M_NH"),
+    workspace_entry("harmonic_step", "every harmonic of this block's series whose coefficients "
+                    "are not both zero is a multiple of it (their greatest common divisor; 1 "
+                    "where there is none); the kernels add only those terms; 0 (unset) adds "
+                    "every term", constant="M_HSTEP"),
+    workspace_entry("harmonic_next", "scratch of the lane-block functions: the next harmonic "
+                    "of a stepped series to add", constant="M_HNEXT"),
 ))
 #: Per coordinate d of a mesh: its deflection row W_d and M^-1 W / (L omega_0^2), G_d.
 MESH_ROW = CoefficientBlock((

@@ -40,7 +40,10 @@ step), the values the per-lane functions compute anew.
 
 Coefficient vector: a header (``DAMPED`` is 1 where Ct is not zero), the dof vectors F0, F1, the
 matrices Kt, Ct (row-major), one block per mesh (fixed entries, 2 nh Fourier coefficients, W, G, 2
-nh coast-flank Fourier coefficients), then the *structure* the kernels read
+nh coast-flank Fourier coefficients; of these a mesh's sums add only the terms up to its own
+harmonic count over the multiples of its harmonic step, the fixed workspace entries
+``harmonics`` and ``harmonic_step`` written from the coefficients by :func:`fill_harmonics`,
+bitwise the sums of all nh terms), then the *structure* the kernels read
 (:func:`fill_structure`, derived from the dense parts): the count nk of the structural entries of
 Kt, their rows, columns and values, and per mesh ``MESH_NZ`` dof indices with the W and G values
 there (a mesh row touches at most six coordinates: the sun or ring and the planet, three each). So
@@ -82,7 +85,8 @@ HEADER = HEADER_BLOCK.size
 # mesh block fixed entries
 _M = MESH.offset
 M_B, M_ES, M_EC, M_KF, M_CF = _M("b"), _M("E_s"), _M("E_c"), _M("KF"), _M("CF")
-M_KFC, M_ORDER, M_RADIAL = _M("KF_coast"), _M("order"), _M("radial")
+M_KFC, M_ORDER, M_RADIAL, M_NH = _M("KF_coast"), _M("order"), _M("radial"), _M("harmonics")
+M_HSTEP, M_HNEXT = _M("harmonic_step"), _M("harmonic_next")
 MESH_FIXED = MESH.size
 #: Structural entries per mesh row in the structure section (padded with zero weights).
 MESH_NZ = 6
@@ -96,9 +100,10 @@ EMPTY = 2.0
 #: and its drive and coast relative stiffness there. All zero is empty (no phase has sin and
 #: cos 0).
 OWN_ENTRIES = 2
-#: The last row of the cache section: 0 in a freshly loaded slot; the lane-block rhs then checks
-#: whether the block's lanes share one Ct (:func:`_lanes_ct_uniform`).
-CT_ROWS = 1
+#: The last rows of the cache section, 0 in a freshly loaded slot: the lane-block rhs then checks
+#: whether the block's lanes share one Ct (:func:`_lanes_ct_uniform`), and the lane-block
+#: functions take the block's harmonic counts and steps anew (:func:`_lanes_prepare_harmonics`).
+CT_ROWS = 2
 
 _JIT = {"cache": True, "error_model": "numpy", "boundscheck": False}
 #: The lane-block functions allocate nothing: compiled without reference counting (the kernels
@@ -158,7 +163,7 @@ def cache_entries(n_mesh: int) -> tuple[list[str], list[float]]:
         names += [f"cache{e}_sin", f"cache{e}_cos"] + [f"cache{e}_k{m}" for m in range(n_mesh)]
         names += [f"cache{e}_kc{m}" for m in range(n_mesh)]
         values += [EMPTY, EMPTY] + [0.0] * (2 * n_mesh)
-    return names + ["cache_ct_checked"], values + [0.0]
+    return names + ["cache_ct_checked", "cache_harmonics_checked"], values + [0.0, 0.0]
 
 
 def own_cache_names(n_mesh: int) -> list[str]:
@@ -190,8 +195,9 @@ def fill_structure(P: np.ndarray, kt_entries: list[tuple[int, int]],
                    mesh_dofs: list[list[int]]) -> None:
     """Write the structure section of every row of ``P`` (lanes x size, in place) from its dense
     parts: the Kt entries ``kt_entries`` (row-major order) and per mesh the dofs ``mesh_dofs[m]``
-    (ascending, at most ``MESH_NZ``). A dense Kt, W or G entry outside the structure that is not
-    zero (e.g. a raw coefficient override) is a ``ValueError``."""
+    (ascending, at most ``MESH_NZ``); and every mesh block's harmonic count and step
+    (:func:`fill_harmonics`). A dense Kt, W or G entry outside the structure that is not zero
+    (e.g. a raw coefficient override) is a ``ValueError``."""
     P = np.atleast_2d(P)
     n, nm, nh = int(P[0, N_DOF]), int(P[0, N_MESH]), int(P[0, N_HARM])
     nk = len(kt_entries)
@@ -227,6 +233,37 @@ def fill_structure(P: np.ndarray, kt_entries: list[tuple[int, int]],
         P[:, q:q + k] = dofs
         P[:, q + MESH_NZ:q + MESH_NZ + k] = W[:, list(dofs)]
         P[:, q + 2 * MESH_NZ:q + 2 * MESH_NZ + k] = G[:, list(dofs)]
+    fill_harmonics(P)
+
+
+def fill_harmonics(P: np.ndarray) -> None:
+    """Write every mesh block's ``harmonics`` and ``harmonic_step`` entries in every row of
+    ``P`` (lanes x size, in place) from the row's own Fourier coefficients: the last harmonic h
+    (1 .. nh) whose drive or coast coefficients are not both zero, at least 1 (0 where nh is
+    0), and the greatest common divisor of those harmonics (1 where there is none). The kernels
+    sum a block's series up to its count and, past the first harmonic, only the multiples of
+    its step (:func:`_harmonics`, :func:`_step`): every term left out has zero coefficients,
+    so leaving it out changes no sum's bits (x + (+-0) is x for x != 0, and a zero for a zero
+    x, so the partial sums with and without it are equal or both zeros; the next nonzero term
+    and 1 + acc give the same value from either zero). The recurrence of cos h theta and
+    sin h theta still runs over every h, so the terms kept are the same values."""
+    P = np.atleast_2d(P)
+    n, nm, nh = int(P[0, N_DOF]), int(P[0, N_MESH]), int(P[0, N_HARM])
+    lay = layout(n, nm, nh)
+    for m in range(nm):
+        o = lay["mesh"] + m * lay["block"]
+        if nh == 0:
+            P[:, o + M_NH] = 0.0
+            P[:, o + M_HSTEP] = 1.0
+            continue
+        d = P[:, o + MESH_FIXED:o + MESH_FIXED + 2 * nh].reshape(-1, nh, 2)
+        c0 = o + coast_offset(n, nh)
+        c = P[:, c0:c0 + 2 * nh].reshape(-1, nh, 2)
+        nonzero = np.any(d != 0.0, axis=2) | np.any(c != 0.0, axis=2)
+        last = np.where(nonzero.any(axis=1), nh - np.argmax(nonzero[:, ::-1], axis=1), 0)
+        P[:, o + M_NH] = np.maximum(last, 1)
+        P[:, o + M_HSTEP] = np.maximum(np.gcd.reduce(
+            np.where(nonzero, np.arange(1, nh + 1), 0), axis=1), 1)
 
 
 @nb.njit(inline="always", **_JIT)
@@ -240,6 +277,67 @@ def _offsets(p):
     st = mesh + nm * bs
     mz = st + 1 + 3 * int(p[st])
     return n, nm, nh, mesh, bs, st, mz
+
+
+@nb.njit(inline="always", **_JIT)
+def _harmonics(p, o, nh):
+    """The harmonics summed of the mesh block at o (both flanks): its ``harmonics`` entry
+    (:func:`fill_harmonics`), or all nh where that is unset (0) or not below nh."""
+    h = int(p[o + M_NH])
+    return h if 0 < h < nh else nh
+
+
+@nb.njit(inline="always", **_JIT)
+def _lanes_harmonics(PT, nl, o, nh):
+    """The most harmonics :func:`_harmonics` gives the mesh block at o in a lane of the block:
+    every lane's sum runs that far (a lane's terms past its own count are zeros)."""
+    top = 0
+    for k in range(nl):
+        h = int(PT[o + M_NH, k])
+        h = h if 0 < h < nh else nh
+        top = max(top, h)
+    return top
+
+
+@nb.njit(inline="always", **_JIT)
+def _step(p, o):
+    """The harmonic step of the mesh block at o: its ``harmonic_step`` entry
+    (:func:`fill_harmonics`), 1 where that is unset (0)."""
+    s = int(p[o + M_HSTEP])
+    return s if s > 1 else 1
+
+
+@nb.njit(inline="always", **_JIT)
+def _lanes_step(PT, nl, o):
+    """The greatest common divisor of the harmonic steps (:func:`_step`) of the mesh block at o
+    in the block's lanes: a step every lane's series keeps."""
+    g = 0
+    for k in range(nl):
+        a = int(PT[o + M_HSTEP, k])
+        a = a if a > 1 else 1
+        while a != 0:
+            g, a = a, g % a
+    return g
+
+
+@nb.njit(inline="always", **_JIT)
+def _stepped_factor(p, f, nh, step, s, c):
+    """:func:`~geardyn.models.elements.harmonic_factor` that adds, past the first harmonic, only
+    the terms of the harmonics that are multiples of ``step`` (the recurrence runs over every
+    harmonic: the terms added are the same values); ``harmonic_factor`` itself for step 1."""
+    if step == 1 or nh == 0:
+        return harmonic_factor(p, f, nh, s, c)
+    acc = p[f] * c + p[f + 1] * s
+    ch = c
+    sh = s
+    nxt = step - 1
+    for h in range(1, nh):
+        ch, sh = ch * c - sh * s, sh * c + ch * s
+        if h == nxt:
+            acc += p[f + 2 * h] * ch + p[f + 2 * h + 1] * sh
+            nxt += step
+    v = 1.0 + acc
+    return v if v > 0.0 else 0.0
 
 
 @nb.njit(inline="always", **_JIT)
@@ -326,29 +424,37 @@ def _mesh_force(t, y, p, o, q, n, nh, s, c):
     d, v = _mesh_state(y, p, o, q, n, s, c, om)
     g = _zone(y, p, o, q, n, block_size(n, nh), d, s, c, om)
     if g < 0.0 and p[TWO_FLANK] != 0.0:  # the coast flank
-        kc = harmonic_factor(p, o + coast_offset(n, nh), nh, s, c)
+        kc = _stepped_factor(p, o + coast_offset(n, nh), _harmonics(p, o, nh), _step(p, o),
+                             s, c)
         return p[o + M_KFC] * kc * g + p[o + M_CF] * v
-    k = harmonic_factor(p, o + MESH_FIXED, nh, s, c)
+    k = _stepped_factor(p, o + MESH_FIXED, _harmonics(p, o, nh), _step(p, o), s, c)
     return p[o + M_KF] * k * g + p[o + M_CF] * v
 
 
 @nb.njit(inline="always", **_JIT)
 def _mesh_forces_shared(y, out, p, n, nm, nh, mesh, bs, mz, s, c):
     """The mesh forces into out[:nm]: :func:`_mesh_force` of every mesh with one harmonic
-    recurrence for all (the same operations per mesh; the relative stiffnesses first, in out)."""
+    recurrence for all (the same operations per mesh, each mesh's sum to its own harmonic
+    count :func:`_harmonics` over the multiples of its step :func:`_step`; the relative
+    stiffnesses first, in out)."""
     for m in range(nm):
         out[m] = 1.0
     if nh > 0:
+        top = 0
         for m in range(nm):
             f = mesh + m * bs + MESH_FIXED
             out[m] = p[f] * c + p[f + 1] * s
+            top = max(top, _harmonics(p, mesh + m * bs, nh))
         ch = c
         sh = s
-        for h in range(1, nh):
+        for h in range(1, top):
             ch, sh = ch * c - sh * s, sh * c + ch * s
             for m in range(nm):
-                f = mesh + m * bs + MESH_FIXED + 2 * h
-                out[m] += p[f] * ch + p[f + 1] * sh
+                o = mesh + m * bs
+                st = _step(p, o)
+                if h < _harmonics(p, o, nh) and (st == 1 or (h + 1) % st == 0):
+                    f = o + MESH_FIXED + 2 * h
+                    out[m] += p[f] * ch + p[f + 1] * sh
         for m in range(nm):
             out[m] = 1.0 + out[m]
     for m in range(nm):
@@ -459,30 +565,44 @@ def _lanes_offsets(PT):
 
 
 @nb.njit(inline="always", **_JIT)
-def _lanes_stiffness(PT, nl, S, C, SC, rb, mesh, bs, nh, nm, first):
+def _lanes_stiffness(PT, nl, S, C, SC, rb, mesh, bs, nh, nm, first, top, uniform):
     """:func:`~geardyn.models.elements.harmonic_factor` of every mesh m into PT[rb + m] (the
     harmonic recurrence in SC rows 0, 1), the same operations in the same order, clipped at 0
     alike; ``first``: the offset of the coefficients in a mesh block (``MESH_FIXED``: the drive
-    flank's)."""
+    flank's). Each mesh's sum runs to the block's count over the multiples of the block's step
+    (lane 0's ``harmonics`` and ``harmonic_step`` entries, :func:`_lanes_prepare_harmonics`;
+    ``top``: the largest count, ``uniform``: every count ``top`` and every step 1, the loop
+    then checks neither); a stepped mesh's next harmonic in its ``harmonic_next`` entry of lane
+    0 (no division in the loop)."""
     if nh == 0:
         for m in range(nm):
             for k in range(nl):
                 PT[rb + m, k] = 1.0
         return
     for m in range(nm):
-        f = mesh + m * bs + first
+        o = mesh + m * bs
+        PT[o + M_HNEXT, 0] = PT[o + M_HSTEP, 0]
+        f = o + first
         for k in range(nl):
             PT[rb + m, k] = PT[f, k] * C[k] + PT[f + 1, k] * S[k]
     for k in range(nl):
         SC[0, k] = C[k]
         SC[1, k] = S[k]
-    for h in range(1, nh):
+    for h in range(1, top):
         for k in range(nl):
             ch = SC[0, k]
             sh = SC[1, k]
             SC[0, k] = ch * C[k] - sh * S[k]
             SC[1, k] = sh * C[k] + ch * S[k]
         for m in range(nm):
+            if not uniform:
+                o = mesh + m * bs
+                if h >= PT[o + M_NH, 0]:
+                    continue
+                if PT[o + M_HSTEP, 0] != 1.0:  # a stepped series: its next harmonic only
+                    if h + 1 != PT[o + M_HNEXT, 0]:
+                        continue
+                    PT[o + M_HNEXT, 0] += PT[o + M_HSTEP, 0]
             f = mesh + m * bs + first + 2 * h
             for k in range(nl):
                 PT[rb + m, k] += PT[f, k] * SC[0, k] + PT[f + 1, k] * SC[1, k]
@@ -490,6 +610,39 @@ def _lanes_stiffness(PT, nl, S, C, SC, rb, mesh, bs, nh, nm, first):
         for k in range(nl):
             v = 1.0 + PT[rb + m, k]
             PT[rb + m, k] = v if v > 0.0 else 0.0
+
+
+@nb.njit(inline="always", **_JIT)
+def _lanes_prepare_harmonics(PT, nl, chk, mesh, bs, nh, nm):
+    """The block's harmonic counts and steps: per mesh the most harmonics of its lanes
+    (:func:`_lanes_harmonics`) and the greatest common divisor of their steps
+    (:func:`_lanes_step`), kept in lane 0's ``harmonics`` and ``harmonic_step`` entries (a
+    count at least lane 0's own, a step that divides its own: its sums are bitwise the same).
+    Taken anew only after a slot was loaded (the row ``chk``, ``cache_harmonics_checked``, is
+    then 0 in its column); the answer in that row of slot 0: 1 + the largest count, negative
+    where some count is below it or some step above 1. Returns the largest count and whether
+    every count is it and every step 1."""
+    fresh = False
+    for k in range(nl):
+        fresh |= PT[chk, k] == 0.0
+    if fresh:
+        top = 0
+        uniform = True
+        for m in range(nm):
+            o = mesh + m * bs
+            hm = _lanes_harmonics(PT, nl, o, nh)
+            hs = _lanes_step(PT, nl, o)
+            PT[o + M_NH, 0] = hm
+            PT[o + M_HSTEP, 0] = hs
+            uniform &= hs == 1
+            if m > 0 and hm != top:
+                uniform = False
+            top = max(top, hm)
+        for k in range(nl):
+            PT[chk, k] = 1.0
+        PT[chk, 0] = (1.0 + top) if uniform else -(1.0 + top)
+    v = PT[chk, 0]
+    return int(abs(v)) - 1, v > 0.0
 
 
 @nb.njit(inline="always", **_JIT)
@@ -513,10 +666,13 @@ def _lanes_cached_stiffness(PT, nl, S, C, SC, cache, mesh, bs, nh, nm, two):
             return b + 2
     e = (int(PT[cache, 0]) + 1) % CACHE_ENTRIES  # not the entry used last
     b = cache + 1 + e * width
-    _lanes_stiffness(PT, nl, S, C, SC, b + 2, mesh, bs, nh, nm, MESH_FIXED)
+    top, uniform = _lanes_prepare_harmonics(PT, nl, cache + 1 + CACHE_ENTRIES * width + 1, mesh,
+                                            bs, nh, nm)
+    _lanes_stiffness(PT, nl, S, C, SC, b + 2, mesh, bs, nh, nm, MESH_FIXED, top, uniform)
     if two:
         n = int(PT[N_DOF, 0])
-        _lanes_stiffness(PT, nl, S, C, SC, b + 2 + nm, mesh, bs, nh, nm, coast_offset(n, nh))
+        _lanes_stiffness(PT, nl, S, C, SC, b + 2 + nm, mesh, bs, nh, nm, coast_offset(n, nh),
+                         top, uniform)
     for k in range(nl):
         PT[b, k] = S[k]
         PT[b + 1, k] = C[k]
@@ -662,7 +818,8 @@ def planetary_rhs_lanes(T, Y, DY, PT, nl, S, C, SC):
                 DY[i, k] -= (PT[g, k] * PT[r, k]) * Y[j, k]
     multi = _lanes_multi_order(PT, nl)
     kr = _lanes_cached_stiffness(PT, nl, S, C, SC, mz + nm * 3 * MESH_NZ, mesh, bs, nh, nm, two)
-    ko = _lanes_own_phases(T, PT, nl, S, C, _own_offset(PT, nm, mz), n, nh, nm, mesh, bs) \
+    ko = _lanes_own_phases(T, PT, nl, S, C, _own_offset(PT, nm, mz), n, nh, nm, mesh, bs,
+                           _gyro_offset(nm, mz) - 1) \
         if multi else 0
     for m in range(nm):
         if multi and not _lanes_order_one(PT, nl, mesh + m * bs):
@@ -771,7 +928,8 @@ def planetary_events_lanes(T, Y, G, PT, nl, S, C):
     """:func:`planetary_events` for lanes 0..nl-1 of a block (the mesh phase S[k], C[k])."""
     n, nm, nh, mesh, bs, st, mz = _lanes_offsets(PT)
     multi = _lanes_multi_order(PT, nl)
-    ko = _lanes_own_phases(T, PT, nl, S, C, _own_offset(PT, nm, mz), n, nh, nm, mesh, bs) \
+    ko = _lanes_own_phases(T, PT, nl, S, C, _own_offset(PT, nm, mz), n, nh, nm, mesh, bs,
+                           _gyro_offset(nm, mz) - 1) \
         if multi else 0
     for m in range(nm):
         o = mesh + m * bs
@@ -813,7 +971,8 @@ def planetary_observe_lanes(T, Y, O, PT, nl, S, C, SC):
         two |= PT[TWO_FLANK, k] != 0.0
     multi = _lanes_multi_order(PT, nl)
     kr = _lanes_cached_stiffness(PT, nl, S, C, SC, mz + nm * 3 * MESH_NZ, mesh, bs, nh, nm, two)
-    ko = _lanes_own_phases(T, PT, nl, S, C, _own_offset(PT, nm, mz), n, nh, nm, mesh, bs) \
+    ko = _lanes_own_phases(T, PT, nl, S, C, _own_offset(PT, nm, mz), n, nh, nm, mesh, bs,
+                           _gyro_offset(nm, mz) - 1) \
         if multi else 0
     for m in range(nm):
         if multi and not _lanes_order_one(PT, nl, mesh + m * bs):
@@ -875,14 +1034,16 @@ def _own_phases_lane(PT, k, t, s, c, r, nm, mesh, bs):
 
 
 @nb.njit(inline="always", **_JIT)
-def _lanes_own_stiffness(PT, nl, rs, rc, out, f, nh, x):
+def _lanes_own_stiffness(PT, nl, rs, rc, out, f, nh, step, x):
     """:func:`~geardyn.models.elements.harmonic_factor_lane` of the coefficients at row f for
     every lane at the phase whose sin and cos are in rows rs and rc, into row out (the harmonic
-    recurrence in rows x, x + 1): the same operations in the same order, clipped at 0 alike."""
+    recurrence in rows x, x + 1): the same operations in the same order, clipped at 0 alike;
+    past the first harmonic only the multiples of ``step`` added (:func:`_stepped_factor`)."""
     if nh == 0:
         for k in range(nl):
             PT[out, k] = 1.0
         return
+    nxt = step if step > 1 else 2  # the next harmonic to add
     for k in range(nl):
         PT[out, k] = PT[f, k] * PT[rc, k] + PT[f + 1, k] * PT[rs, k]
         PT[x, k] = PT[rc, k]
@@ -893,6 +1054,9 @@ def _lanes_own_stiffness(PT, nl, rs, rc, out, f, nh, x):
             sh = PT[x + 1, k]
             PT[x, k] = ch * PT[rc, k] - sh * PT[rs, k]
             PT[x + 1, k] = sh * PT[rc, k] + ch * PT[rs, k]
+        if h + 1 != nxt:
+            continue
+        nxt += step
         for k in range(nl):
             PT[out, k] += PT[f + 2 * h, k] * PT[x, k] + PT[f + 2 * h + 1, k] * PT[x + 1, k]
     for k in range(nl):
@@ -907,17 +1071,20 @@ def _own_key(PT, b, k, t, s, c):
 
 
 @nb.njit(inline="always", **_JIT)
-def _lanes_own_phases(T, PT, nl, S, C, own, n, nh, nm, mesh, bs):
+def _lanes_own_phases(T, PT, nl, S, C, own, n, nh, nm, mesh, bs, chk):
     """Row r of the own-phase cache entry at the lanes' times T and forcing phases (S, C): row
     r + m holds the sin of mesh m's own phase, r + nm + m its cos, r + 2 nm + m its drive
     relative stiffness there, r + 3 nm + m its coast one (computed where a lane of the block
-    has two flanks). The block's PT carries ``OWN_ENTRIES`` (2) entries after two scratch rows
-    from row ``own`` + 1 (all zero, empty, whenever a slot is loaded with a lane's
-    coefficients): the four RK4 stages of a step see two new times (the mid-step one twice,
-    the end one again for the events, the observables and as the next step's start), so the
-    sin and cos of each distinct mesh order are computed twice a step per lane, not five times
-    per mesh. A lane's phases are reused only where its key (time and forcing phase) equals
-    the call's exactly, so the values are those computed anew."""
+    has two flanks, and only for the meshes that take the own-phase forms: not
+    :func:`_lanes_order_one`; each to the block's harmonic count over its step,
+    :func:`_lanes_prepare_harmonics`, whose checked row is ``chk``). The block's PT carries
+    ``OWN_ENTRIES`` (2) entries after two scratch rows from row ``own`` + 1 (all zero, empty,
+    whenever a slot is loaded with a lane's coefficients): the four RK4 stages of a step see
+    two new times (the mid-step one twice, the end one again for the events, the observables
+    and as the next step's start), so the sin and cos of each distinct mesh order are computed
+    twice a step per lane, not five times per mesh. A lane's phases are reused only where its
+    key (time and forcing phase) equals the call's exactly, so the values are those computed
+    anew."""
     width = 3 + 4 * nm
     x = own + 1  # scratch of the harmonic recurrence
     for e in range(OWN_ENTRIES):
@@ -946,12 +1113,18 @@ def _lanes_own_phases(T, PT, nl, S, C, own, n, nh, nm, mesh, bs):
     two = False
     for k in range(nl):
         two |= PT[TWO_FLANK, k] != 0.0
+    _lanes_prepare_harmonics(PT, nl, chk, mesh, bs, nh, nm)
     for m in range(nm):
         o = mesh + m * bs
-        _lanes_own_stiffness(PT, nl, r + m, r + nm + m, r + 2 * nm + m, o + MESH_FIXED, nh, x)
+        if _lanes_order_one(PT, nl, o):  # the shared-phase forms': these rows are not read
+            continue
+        hm = int(PT[o + M_NH, 0])
+        hs = int(PT[o + M_HSTEP, 0])
+        _lanes_own_stiffness(PT, nl, r + m, r + nm + m, r + 2 * nm + m, o + MESH_FIXED, hm, hs,
+                             x)
         if two:
             _lanes_own_stiffness(PT, nl, r + m, r + nm + m, r + 3 * nm + m,
-                                 o + coast_offset(n, nh), nh, x)
+                                 o + coast_offset(n, nh), hm, hs, x)
     PT[own, 0] = e
     return r
 
