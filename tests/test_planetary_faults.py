@@ -367,14 +367,17 @@ def test_period_stiffness_is_the_compiled_series_and_the_faulty_meshes_are_named
         assert differ == expected, flank
 
 
-def test_a_missing_planet_tooth_runs_on_the_series_clipped_at_zero(geo):
+@pytest.mark.parametrize("coast", ["mirror", "symmetric"])
+def test_a_missing_planet_tooth_runs_on_the_series_clipped_at_zero(geo, coast):
     """A missing planet tooth leaves no pair in contact over part of its passage in its two
     meshes (the tables fall to 0 there): the set is built with ``stiffness_gaps``, the compiled
-    stiffness is the series summed here with numpy from the set's coefficients and clipped at
-    0 (it rings below 0 about the gaps), 0 where the clip acts, and a trajectory through the
-    gaps agrees with DOP853 on the model (rtol 1e-10) to 1e-5 of its motion (the clip is a kink
-    in time that RK4 does not locate). Without the flag the same coefficients are refused."""
-    gs = pe_set(geo, [g.BrokenTooth(gear="planet1", tooth=2)], harmonics=3, angles=16)
+    stiffness is the series summed here with numpy from the set's coefficients and clipped at 0
+    (it rings below 0 about the gaps), 0 where the clip acts, and a trajectory through the gaps
+    agrees with DOP853 on the model (rtol 1e-10) to 1e-5 of its motion (the clip is a kink in
+    time that RK4 does not locate). Without the flag the same coefficients are refused. Both
+    coast forms: ``symmetric`` runs the kernels' one-flank path."""
+    gs = pe_set(geo, [g.BrokenTooth(gear="planet1", tooth=2)], harmonics=3, angles=16,
+                coast=coast)
     assert gs.stiffness_gaps and gs.faults.meshes(geo.n_planets) == ("s1", "r1")
     z = gs.mesh_order
     theta = np.linspace(0.0, 2.0 * math.pi, 4 * gs.fourier.shape[1] + 1)

@@ -436,7 +436,8 @@ def _mesh_forces_shared(y, out, p, n, nm, nh, mesh, bs, mz, s, c):
     """The mesh forces into out[:nm]: :func:`_mesh_force` of every mesh with one harmonic
     recurrence for all (the same operations per mesh, each mesh's sum to its own harmonic
     count :func:`_harmonics` over the multiples of its step :func:`_step`; the relative
-    stiffnesses first, in out)."""
+    stiffnesses first, in out, clipped at 0 as
+    :func:`~geardyn.models.elements.harmonic_factor`)."""
     for m in range(nm):
         out[m] = 1.0
     if nh > 0:
@@ -456,7 +457,8 @@ def _mesh_forces_shared(y, out, p, n, nm, nh, mesh, bs, mz, s, c):
                     f = o + MESH_FIXED + 2 * h
                     out[m] += p[f] * ch + p[f + 1] * sh
         for m in range(nm):
-            out[m] = 1.0 + out[m]
+            v = 1.0 + out[m]
+            out[m] = v if v > 0.0 else 0.0  # clipped at 0 as harmonic_factor
     for m in range(nm):
         o = mesh + m * bs
         q = mz + m * 3 * MESH_NZ
