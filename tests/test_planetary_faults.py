@@ -89,17 +89,35 @@ def _passage(geo, gear: str, tooth: int, mesh: int, sun_turns: int = 1) -> float
     ``mesh`` (0 .. N-1 sun-planet, N .. 2N-1 ring-planet), from the carrier-frame kinematics:
     the sun turns in the sense of psi by 2 pi / Z_s a mesh cycle, the ring against it by
     2 pi / Z_r (``sun_turns`` -1: the other way round, the sun held and the carrier driven);
-    sun tooth 0 sits at psi_1 at c = 0, ring tooth 0 at psi_1 at c = gamma_rs."""
+    sun tooth 0 sits at psi_1 at c = 0. A ring tooth is numbered by its clockwise-facing flank
+    (the planet-ring table's drive flank), ring tooth 0's passing psi_1 first in [0, 1), at
+    gamma_T: a planet tooth's counter-clockwise-facing flank at the sun-side pitch point at
+    c = 0 reaches the ring side after Z_p sigma (pi - (psi_r - psi_s) / 2) / 2 pi mesh cycles
+    (sigma = -s the planet's sense, psi its angular thickness at each operating pitch radius).
+    For the ring the time returned is that of the table's pair of the cracked tooth, whose
+    clockwise-facing flank passes s (1 - phi_r) mesh cycles earlier (phi_r the ring mesh's
+    coast phase: the table's coast flank of wheel tooth j passes 1 - phi_r before its drive
+    pair; a table read forwards is the ring mesh's mirror image, s = +1, or it is read
+    backwards, s = -1)."""
+    from geardyn.gears.potential_energy import coast_phase
+
     n = geo.n_planets
     psi = sun_turns * (np.asarray(geo.planet_angles) - geo.planet_angles[0])
     if gear == "sun":  # tooth j sits at angle 2 pi (c - j) / Z_s
         zs = geo.sun.teeth
         return (tooth + zs * psi[mesh] / (2.0 * math.pi)) % zs
-    zr = geo.ring.teeth  # tooth j sits at 2 pi (j + gamma_rs - c) / Z_r
-    return (tooth + geo.phases.sun_ring - zr * psi[mesh - n] / (2.0 * math.pi)) % zr
+    planet = geo.planet
+    thick_s = planet.angular_thickness(geo.sun_mesh.operating_pitch_radii[1])
+    thick_r = planet.angular_thickness(geo.ring_mesh.operating_pitch_radii[0])
+    gamma_t = (planet.teeth * -sun_turns * (math.pi - 0.5 * (thick_r - thick_s))
+               / (2.0 * math.pi)) % 1.0
+    pair = gamma_t + sun_turns * (1.0 - coast_phase(geo.ring_mesh))
+    zr = geo.ring.teeth  # the pair of tooth j at 2 pi (j + pair - c) / Z_r
+    return (tooth + pair - zr * psi[mesh - n] / (2.0 * math.pi)) % zr
 
 
-@pytest.mark.parametrize(("gear", "held"), [("sun", "ring"), ("ring", "ring"), ("sun", "sun")])
+@pytest.mark.parametrize(("gear", "held"), [("sun", "ring"), ("ring", "ring"), ("sun", "sun"),
+                                            ("ring", "sun")])
 def test_faulty_meshes_are_the_tables_with_the_tooth_in_contact(geo, gear, held):
     """Each mesh of the faulty gear against the table computed here over the revolution with
     the crack on tooth 0 of the table's pinion (sun) or wheel (ring), shifted so that the cracked

@@ -15,8 +15,15 @@ carrier, -1 when against it; rel_n = psi_n - psi_1; gamma: the Parker & Lin phas
 
 * sun tooth j passes the pitch point of the sun-planet mesh of planet 1 at c = j, of planet n
   at c = j + s Z_s rel_n / (2 pi) (mod Z_s);
-* ring tooth j passes the pitch point of the ring-planet mesh of planet 1 at c = gamma_r1 + j,
-  of planet n at c = gamma_rs + j - s Z_r rel_n / (2 pi) (mod Z_r);
+* ring tooth j passes the pitch point of the ring-planet mesh of planet 1 at c = gamma_T + j,
+  of planet n at c = gamma_T + j - s Z_r rel_n / (2 pi) (mod Z_r), a ring tooth numbered by
+  its clockwise-facing flank (the flank the planet-ring table calls drive; the drive flank of
+  a gear train's ring mesh, :mod:`geardyn.trains.faults`), ring tooth 0 the first to pass in
+  [0, 1): gamma_T = (-s (Z_p / 2 - Z_p (psi_r - psi_s) / (4 pi))) mod 1 (a planet tooth's
+  counter-clockwise-facing flank carried from the sun-side pitch point to the ring side); the
+  ring mesh's table (its tooth j at the pitch point at c = delta + j) then lies delta = gamma_rs
+  + round(gamma_T + s (1 - phi_r) - gamma_rs) (:func:`ring_origin`; gamma_rs of the turning
+  sun, phi_r the ring mesh's coast phase);
 * tooth j of planet n passes the sun-side pitch point at c = gamma_sn + j and the ring-side one
   s D mesh cycles later (mod Z_p), D = Z_p / 2 - Z_p (psi_s + psi_r) / (4 pi) (half a planet
   turn less half the tooth's angular thicknesses psi_s, psi_r at its two operating pitch radii:
@@ -28,8 +35,8 @@ With s = -1 every mesh reads its tables backwards in time
 (:func:`~geardyn.models.planetary_stiffness.table_in_time`): the tooth passing a pitch point at
 the times above is the table's tooth -j (mod the gear's teeth).
 
-Reduced mod 1 these are the Parker & Lin phases, so a healthy set built over the revolution is
-the one-mesh-cycle set.
+Reduced mod 1 these (the ring's: its table's delta) are the Parker & Lin phases, so a healthy
+set built over the revolution is the one-mesh-cycle set.
 
 Which meshes a faulty tooth takes part in: a sun tooth meets every sun-planet mesh, a ring tooth
 every ring-planet mesh (each once per revolution, at the times above), a tooth of planet n the
@@ -175,6 +182,35 @@ def planet_passage_delay(geometry: Any) -> float:
     return 0.5 * z - z * (psi_s + psi_r) / (4.0 * math.pi)
 
 
+def ring_origin(geometry: Any, sun_turns: int) -> float:
+    """When ring tooth 0 meets planet 1's ring mesh [mesh cycles]: the shift of that mesh's
+    table (whose tooth j then passes at c = origin + j) numbering the ring's teeth as a gear
+    train does (:mod:`geardyn.trains.faults`), by the passage of the ring flank the planet-ring
+    table calls drive (its clockwise-facing flank), ring tooth 0 the first to pass in [0, 1):
+    at gamma_T = (-s (Z_p / 2 - Z_p (psi_r - psi_s) / (4 pi))) mod 1, the planet's
+    counter-clockwise-facing flank carried from the sun-side pitch point (at c = 0) to the ring
+    side (the step of :meth:`geardyn.trains.TrainModel.geometry_phases`). The set's mesh of
+    shift origin puts its table's tooth j (read forwards, the table's mirror image, s = +1;
+    backwards, the sun held, s = -1: its tooth -j) at the pitch point at c = origin + j, where
+    that flank of the ring tooth passes at c = origin + j - s (1 - phi_r) (phi_r the ring
+    mesh's coast phase: the table's coast flank of wheel tooth j passes 1 - phi_r before its
+    drive pair), so origin = gamma_rs + round(gamma_T + s (1 - phi_r) - gamma_rs) (gamma_rs
+    the set's ring phase, ``sun_ring`` of ``phases_turning(s)``; the rounded number is whole
+    to round-off)."""
+    from geardyn.gears.potential_energy import coast_phase
+
+    planet = geometry.planet
+    psi_s = planet.angular_thickness(geometry.sun_mesh.operating_pitch_radii[1])
+    psi_r = planet.angular_thickness(geometry.ring_mesh.operating_pitch_radii[0])
+    z = planet.teeth
+    gamma_t = (-sun_turns * (0.5 * z - z * (psi_r - psi_s) / (4.0 * math.pi))) % 1.0
+    if math.isclose(gamma_t, 1.0, abs_tol=1e-9):
+        gamma_t = 0.0
+    base = float(geometry.phases_turning(sun_turns).sun_ring)
+    lead = sun_turns * (1.0 - coast_phase(geometry.ring_mesh))
+    return base + round(gamma_t + lead - base)
+
+
 def mesh_shifts(geometry: Any, sun_turns: int, placement: FaultPlacement | None
                 ) -> tuple[np.ndarray, np.ndarray]:
     """The shifts delta [mesh cycles] of every sun-planet and ring-planet mesh: mesh m's
@@ -190,7 +226,8 @@ def mesh_shifts(geometry: Any, sun_turns: int, placement: FaultPlacement | None
     if placement.member == "sun":
         sun = np.mod(sun_turns * geometry.sun.teeth * rel / (2.0 * math.pi), z)
     elif placement.member == "ring":
-        ring = np.mod(ph.sun_ring - sun_turns * geometry.ring.teeth * rel / (2.0 * math.pi), z)
+        ring = np.mod(ring_origin(geometry, sun_turns)
+                      - sun_turns * geometry.ring.teeth * rel / (2.0 * math.pi), z)
     else:
         p = placement.planet
         ring[p] = (sun[p] + sun_turns * planet_passage_delay(geometry)) % z

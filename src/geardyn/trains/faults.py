@@ -20,7 +20,10 @@ pairs pass at c = -psi_m / 2 pi + whole cycles, it is tooth (j + round(D_m + (ps
 2 pi)) mod Z_f of f: exact with ``mesh_phase="geometry"``, the passage nearest the geometric one
 with other phases. A mesh whose gear a turns in the negative sense relative to its frame reads
 its tables backwards in time (:meth:`~geardyn.trains.TrainModel.backward_meshes`): the tooth
-passing its pitch point at c = j is its table's tooth -j.
+passing its pitch point at c = j is its table's tooth -j. A tooth passes with its drive flank
+(below; a ring's clockwise-facing one), so on a planetary stage ring tooth j is the
+:class:`~geardyn.PlanetaryGearSet`'s ring tooth j
+(:func:`~geardyn.models.planetary_faults.ring_origin`).
 
 Flanks: a fault's ``flank`` ``"drive"`` is the flank in contact at a positive deflection of f's
 meshes. A train's mesh rows make that the same flank of f's teeth in every mesh (the

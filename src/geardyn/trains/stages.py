@@ -38,15 +38,22 @@ def planetary_stage(*, sun: Gear, ring: Gear, carrier: Inertia, planet: Gear, n_
                     pin_damping: Any = 0.0, mesh_damping: Any = 0.0,
                     ring_planet: Gear | None = None, sun_bore_radius: Any = None,
                     planet_bore_radius: Any = None, ring_rim_radius: Any = None,
-                    ring_planet_bore_radius: Any = None) -> PlanetaryStage:
+                    ring_planet_bore_radius: Any = None,
+                    centre_distance: Any = None) -> PlanetaryStage:
     """A single planetary stage as elements (Lin & Parker 1999): ``n_planets`` copies of
     ``planet`` named ``<planet.name>1`` ..., each on a pin of ``pin_stiffness`` [N/m]
     (``math.inf``: rigid) on ``carrier`` at ``carrier_radius`` [m] and angle psi_n [rad]
     (default equally spaced, 2 pi (n - 1) / N), meshing with ``sun`` (external) and ``ring``
     (internal). Mesh stiffnesses are numbers [N/m] or a method (``"iso"``, ...) as
     :class:`Mesh`; pressure angles None take the geometries' operating ones (else 20 deg).
-    ``carrier_radius`` None: (r_b,sun + r_b,planet) / cos(alpha_sun), the centre distance of
-    the sun-planet mesh.
+    ``carrier_radius`` None: ``centre_distance`` where given, else (r_b,sun + r_b,planet) /
+    cos(alpha_sun), the centre distance of the sun-planet mesh.
+
+    ``centre_distance`` [m]: the centre distance of every mesh (each planet's two meshes about
+    its pin, as :class:`~geardyn.gears.PlanetaryGeometry`'s ``centre_distance``; a widened stage
+    of shifted gears, its meshes with backlash and their contact ratios at that distance); a
+    ``carrier_radius`` given with it must equal it. None: each mesh at its own gears'
+    zero-backlash distance (:class:`Mesh`), whatever the carrier radius.
 
     ``ring_planet``: a compound stage (Kiracofe & Parker 2007). Each planet then carries a
     copy of this second gear (``<ring_planet.name>1`` ...), joined to it rigidly (a rigid hub
@@ -76,13 +83,19 @@ def planetary_stage(*, sun: Gear, ring: Gear, carrier: Inertia, planet: Gear, n_
     ring_side = (("ring_planet_bore_radius", ring_planet_bore_radius) if ring_planet
                  else ("planet_bore_radius", planet_bore_radius))
     ring_bores = _bores(ring_mesh_stiffness, (ring_side, ("ring_rim_radius", ring_rim_radius)))
+    a_w = None if centre_distance is None else si_value("centre_distance", centre_distance,
+                                                        "length", 0.0, strict=True)
     first = Mesh("sun_mesh", sun.name, planet.name, sun_mesh_stiffness,
-                 pressure_angle=sun_pressure_angle, bore_radius=sun_bores)
+                 pressure_angle=sun_pressure_angle, bore_radius=sun_bores, centre_distance=a_w)
     alpha_s = resolve_mesh(first, sun, planet).pressure_angle
     if carrier_radius is None:
-        rc = (sun.base_radius + planet.base_radius) / math.cos(alpha_s)
+        rc = (sun.base_radius + planet.base_radius) / math.cos(alpha_s) if a_w is None else a_w
     else:
         rc = si_value("carrier_radius", carrier_radius, "length", 0.0, strict=True)
+        if a_w is not None and not math.isclose(rc, a_w, rel_tol=1e-9):
+            raise ParameterError("carrier_radius", carrier_radius, f"differs from the stage's "
+                                 f"centre_distance {a_w:.6g} m: the planets' pins sit at the "
+                                 "meshes' centre distance (give one of them)")
     planets, bearings, sun_meshes, ring_meshes = [], [], [], []
     seconds, hubs, joints = [], [], []
     for i, angle in enumerate(psi):
@@ -92,7 +105,8 @@ def planetary_stage(*, sun: Gear, ring: Gear, carrier: Inertia, planet: Gear, n_
                                 damping=pin_damping, radius=rc, angle=angle))
         sun_meshes.append(Mesh(f"{sun.name}_{p.name}", sun.name, p.name, sun_mesh_stiffness,
                                angle=angle, pressure_angle=sun_pressure_angle,
-                               damping=mesh_damping, bore_radius=sun_bores))
+                               centre_distance=a_w, damping=mesh_damping,
+                               bore_radius=sun_bores))
         q = p
         if ring_planet is not None:
             q = replace(ring_planet, name=f"{ring_planet.name}{i + 1}")
@@ -101,8 +115,8 @@ def planetary_stage(*, sun: Gear, ring: Gear, carrier: Inertia, planet: Gear, n_
             joints.append(Shaft(f"{q.name}_joint", q.name, p.name, math.inf))
         ring_meshes.append(Mesh(f"{q.name}_{ring.name}", q.name, ring.name, ring_mesh_stiffness,
                                 internal=True, angle=angle + math.pi,
-                                pressure_angle=ring_pressure_angle, damping=mesh_damping,
-                                bore_radius=ring_bores))
+                                pressure_angle=ring_pressure_angle, centre_distance=a_w,
+                                damping=mesh_damping, bore_radius=ring_bores))
     return PlanetaryStage(bodies=(sun, ring, carrier, *planets, *seconds),
                           bearings=(*bearings, *hubs), meshes=(*sun_meshes, *ring_meshes),
                           planets=tuple(p.name for p in planets), carrier_radius=rc,
