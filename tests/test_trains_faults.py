@@ -68,6 +68,26 @@ def _train_stiffness(model: TrainModel, m: int, theta: np.ndarray, coast: bool =
     return mean * evaluate_series(series, theta)
 
 
+def set_series_misses(model: TrainModel, gs: geardyn.PlanetaryGearSet,
+                      points: int = 2001) -> tuple[float, float]:
+    """The largest difference of a train's planetary stage ``model`` from the
+    :class:`~geardyn.PlanetaryGearSet` ``gs`` of the same stage, series against series at
+    ``points`` phases over a forcing period, drive and coast (the ring meshes' flanks named the
+    other way round), relative to each mesh's mean: (sun meshes, ring meshes)."""
+    n = gs.n_planets
+    theta = np.linspace(0.0, 2.0 * math.pi, points)
+    out = [0.0, 0.0]
+    for coast in (False, True):
+        for m in range(2 * n):
+            theirs = coast if m < n else not coast
+            coef = gs.fourier_coast if theirs else gs.fourier
+            mean = (gs.coast_stiffnesses() if theirs else gs.mesh_stiffnesses())[m]
+            want = mean * evaluate_series(np.concatenate([[1.0], coef[m]]), theta)
+            got = _train_stiffness(model, m, theta * model._kernel_orders[m], coast)
+            out[m >= n] = max(out[m >= n], float(np.max(np.abs(got - want))) / mean)
+    return out[0], out[1]
+
+
 def kernel_stiffness(model: TrainModel, thetas: np.ndarray, sign: float = 1.0) -> np.ndarray:
     """k_m [N/m] of every mesh (columns) at the forcing phases ``thetas`` (rows) from the
     compiled observable: at a state of dimensionless deflection ``sign`` in every mesh, at

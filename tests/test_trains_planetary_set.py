@@ -46,12 +46,11 @@ import geardyn.gears as g
 from geardyn.errors import ParameterError
 from geardyn.gears import GearMesh, potential_energy_stiffness
 from geardyn.models.planetary_stiffness import table_in_time
-from geardyn.models.spur_pair import evaluate_series
 from geardyn.trains import Bearing, Gear, GearTrain, Inertia, Shaft, TrainModel, planetary_stage
 from test_planetary_held_sun import vzero_stage
 from test_planetary_iso_flanks import shifted_stage
 from test_planetary_pe import MEMBERS, stage
-from test_trains_faults import _train_stiffness
+from test_trains_faults import set_series_misses
 
 BORES = dict(sun_bore_radius="12 mm", planet_bore_radius="10 mm", ring_rim_radius="85 mm")
 H = 4
@@ -88,24 +87,6 @@ def _set(geo, held: str, faults=(), **kw) -> geardyn.PlanetaryGearSet:
     return geardyn.PlanetaryGearSet.from_geometry(
         geo, harmonics=H, stiffness="potential_energy", stiffness_options=BORES, held=held,
         faults=faults, **MEMBERS, **kw)
-
-
-def _misses(model: TrainModel, gs: geardyn.PlanetaryGearSet) -> tuple[float, float]:
-    """The largest difference of the two models' series over the meshes, sun meshes and ring
-    meshes, drive and coast (the ring meshes' flanks named the other way round), relative to
-    the mean."""
-    n = gs.n_planets
-    theta = np.linspace(0.0, 2.0 * math.pi, 2001)
-    out = [0.0, 0.0]
-    for coast in (False, True):
-        for m in range(2 * n):
-            theirs = coast if m < n else not coast
-            coef = gs.fourier_coast if theirs else gs.fourier
-            mean = (gs.coast_stiffnesses() if theirs else gs.mesh_stiffnesses())[m]
-            want = mean * evaluate_series(np.concatenate([[1.0], coef[m]]), theta)
-            got = _train_stiffness(model, m, theta * model._kernel_orders[m], coast)
-            out[m >= n] = max(out[m >= n], float(np.max(np.abs(got - want))) / mean)
-    return out[0], out[1]
 
 
 # ---------------------------------------------------------------- ring tooth numbers
@@ -179,7 +160,7 @@ def test_cracked_ring_of_the_set_is_the_train_stages(geometry, held):
     model = _stage(geo, held, (g.RootCrack(**crack, gear="ring"),))
     gs = _set(geo, held, [g.RootCrack(**crack, gear="ring")])
     assert gs.mesh_order == model.mesh_order == geo.ring.teeth
-    sun, ring = _misses(model, gs)
+    sun, ring = set_series_misses(model, gs)
     assert sun < 1e-10
     assert ring < (1e-10 if geometry == "unshifted" else 1e-2)
 
@@ -218,7 +199,7 @@ def test_widened_stage_builds_its_meshes_at_its_centre_distance():
             "p1_ring": GearMesh(geo.planet, geo.ring, internal=True)}
     assert abs(zero["sun_p1"].centre_distance - zero["p1_ring"].centre_distance) > 1e-4
     assert abs(want["sun_p1"] - zero["sun_p1"].contact_ratio) > 5e-3
-    sun, ring = _misses(model, _set(geo, "ring"))
+    sun, ring = set_series_misses(model, _set(geo, "ring"))
     assert sun < 1e-10 and ring < 5e-3
     pins = _stage(geo, "ring", place={"carrier_radius": a})
     for name, mesh in zero.items():
@@ -305,5 +286,5 @@ def test_planet_archard_wear_with_the_sun_held_is_the_trains(flank, torque):
                                    atol=1e-8 * np.max(np.abs(want)))
     assert np.max(ref["fault_gap" if flank == "drive" else "fault_gap_coast"].values) > 0.9 * (
         wear["depth"])
-    sun, ring = _misses(model, gs)
+    sun, ring = set_series_misses(model, gs)
     assert sun < 1e-10 and ring < 1e-10
