@@ -21,7 +21,9 @@ carrier driven; geardyn.trains, whose meshes read their tables backwards where g
 the negative sense from the train's own speed ratios) on every mesh, healthy and with a crack on
 the sun, the ring or a planet and a spall on a planet's flank, to 1e-10 of the mean; on a
 V-zero shifted stage (gamma_rs = 0.954) its ring meshes lie -gamma_rs after its sun meshes, as
-the train's and as a planet tooth drawn from its angular thicknesses gives.
+the train's and as a planet tooth drawn from its angular thicknesses gives. Held in the
+kinematics only (no sun support), the set's static mesh forces under a carrier torque are
+round-off, and Archard wear on a planet is refused (``wear.flank``).
 """
 
 from __future__ import annotations
@@ -33,6 +35,7 @@ import pytest
 
 import geardyn
 import geardyn.gears as g
+from geardyn.errors import ParameterError
 from geardyn.gears.potential_energy import coast_phase, prepare_pair
 from geardyn.models.spur_pair import evaluate_series
 from geardyn.trains import Bearing, Gear, GearTrain, Inertia, Shaft, TrainModel, planetary_stage
@@ -343,3 +346,23 @@ def test_sun_held_set_is_the_train_stage_with_a_ring_phase():
             got = _train_stiffness(model, m, theta, coast)
             np.testing.assert_allclose(got, want, rtol=0.0,
                                        atol=(1e-10 if m < n else 1e-2) * mean)
+
+
+@pytest.mark.parametrize("flank", ["drive", "coast"])
+def test_planet_archard_wear_under_round_off_forces_is_refused(flank):
+    """The sun held only in the kinematics (no ``fixed=("sun",)``, no sun torsional
+    stiffness), the carrier driven: nothing reacts a planet's moment at the sun, so no mesh can
+    carry a force (the planet's moment balance), and the static mesh forces are round-off,
+    below 1e-12 of the torque's force scale T_c / r_c; Archard wear on a planet's either flank
+    is refused naming ``wear.flank`` and the forces."""
+    geo = stage()
+    kw = dict(harmonics=4, stiffness="potential_energy", stiffness_options=BORES, held="sun",
+              carrier_torque=100.0, **MEMBERS)
+    forces = geardyn.PlanetaryGearSet.from_geometry(geo, **kw).static_mesh_forces()
+    assert np.max(np.abs(forces)) < 1e-12 * 100.0 / geo.sun_mesh.centre_distance
+    with pytest.raises(ParameterError) as err:
+        geardyn.PlanetaryGearSet.from_geometry(
+            geo, faults=[g.Wear(depth="20 um", gear="planet1", profile="archard", flank=flank)],
+            **kw)
+    assert err.value.field == "wear.flank"
+    assert "round-off" in str(err.value) and "ring-side" in str(err.value)

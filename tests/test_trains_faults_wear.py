@@ -13,8 +13,8 @@ pair with the same wear, and the other mesh's contacts on the worn flank open th
 mesh's wear depth at their flank point (0 below its path of contact); a pinion driving two
 wheels at loads set here by the torques takes the load-weighted sum of the two meshes' Archard
 rates (computed here mesh by mesh from the pairs, on a grid of their own), in the gap of every
-contact of the worn tooth in both meshes; a flank that no mesh loads is refused naming
-``wear.flank``.
+contact of the worn tooth in both meshes; a flank that no mesh loads (no torques, or an idler
+on an unloaded branch whose forces are round-off) is refused naming ``wear.flank``.
 """
 
 from __future__ import annotations
@@ -174,6 +174,38 @@ def test_archard_wear_on_a_flank_no_mesh_loads_is_refused():
     with pytest.raises(ParameterError) as err:
         _splitter(None)
     assert err.value.field == "wear.flank"
+
+
+def _branch(faults=()) -> TrainModel:
+    """Pinion g1 (19) drives the loaded g2 (31) and, on its other side, the idler g3 (23),
+    which drives g4 (29), free (no torque, no shaft)."""
+    gears = _gears(19, 31, 23, 29)
+    bodies = [Gear(f"g{i + 1}", 0.01 * (i + 1), geometry=gears[i]) for i in range(4)]
+    train = GearTrain(bodies, bearings=[Bearing(f"b{i + 1}", f"g{i + 1}", math.inf)
+                                        for i in range(4)],
+                      meshes=[Mesh("m1", "g1", "g2", "potential_energy", bore_radius=BORE),
+                              Mesh("m2", "g1", "g3", "potential_energy", bore_radius=BORE,
+                                   angle=math.pi),
+                              Mesh("m3", "g3", "g4", "potential_energy", bore_radius=BORE,
+                                   angle=math.pi)],
+                      driven="g1", free=True, faults=faults)
+    return TrainModel(train, torques={"g1": 20.0}, load="g2", harmonics=4,
+                      mesh_phase="geometry")
+
+
+@pytest.mark.parametrize("flank", ["drive", "coast"])
+def test_archard_wear_on_an_idler_under_round_off_forces_is_refused(flank):
+    """g4 is free, so the idler g3's branch carries nothing (g4's and then g3's torque
+    balance): m2's and m3's static forces are round-off, below 1e-12 of m1's T_1 / r_b1, and
+    Archard wear on the idler's either flank is refused naming ``wear.flank``."""
+    loads = _branch().static_loads()
+    f1 = 20.0 / _gears(19)[0].base_radius
+    assert loads["m1"] == pytest.approx(f1, rel=1e-9)
+    assert max(abs(loads["m2"]), abs(loads["m3"])) < 1e-12 * f1
+    with pytest.raises(ParameterError) as err:
+        _branch((g.Wear(DEPTH, gear="g3", tooth=5, profile="archard", flank=flank),))
+    assert err.value.field == "wear.flank"
+    assert "round-off" in str(err.value)
 
 
 def test_wear_profiles_must_belong_to_archard_wear_of_the_faults():

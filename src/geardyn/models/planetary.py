@@ -755,7 +755,8 @@ class PlanetaryGearSet(Model):
         revolution). Archard wear on a planet follows the mesh that loads the worn flank under
         the mean torques (the static mesh forces of the healthy set:
         :func:`~geardyn.models.planetary_faults.planet_wear_profiles`); a flank no mesh loads
-        (no torques) is refused (``wear.flank``).
+        (no torques, or forces of round-off against max |T_k| / r_k, as with a held sun without
+        support) is refused (``wear.flank``).
         """
         from geardyn.gears import PlanetaryGeometry
 
@@ -803,8 +804,10 @@ class PlanetaryGearSet(Model):
                     harmonics=harmonics, waveform_options=waveform_options, held=held,
                     stiffness=stiffness, stiffness_options=stiffness_options, coast=coast,
                     **kw)
+                scale = max((abs(t) / healthy.members[k].radius
+                             for k, t in healthy.torques.items() if t != 0.0), default=0.0)
                 shared = planet_wear_profiles(placement, geometry, opts,
-                                              healthy.static_mesh_forces())
+                                              healthy.static_mesh_forces(), scale)
             revolution = revolution_stiffness(geometry, opts, placement, harmonics,
                                               _sun_turns(held_member), shared)
             inputs, waves = revolution.inputs(geometry.n_planets, coast), None

@@ -82,6 +82,9 @@ from geardyn.gears.faults import (
 
 _KINDS = (RootCrack, Spall, Wear, BrokenTooth)
 _OTHER_FLANK = {"drive": "coast", "coast": "drive"}
+LOAD_RTOL = 1e-9
+"""A mesh loads a worn flank when its static force on it exceeds this fraction of the applied
+torques' force scale (:func:`planet_wear_profiles`); smaller forces are round-off."""
 
 
 @dataclass(frozen=True)
@@ -235,7 +238,7 @@ def mesh_shifts(geometry: Any, sun_turns: int, placement: FaultPlacement | None
 
 
 def planet_wear_profiles(placement: FaultPlacement, geometry: Any, opts: Any,
-                         forces: np.ndarray) -> dict[Any, Any]:
+                         forces: np.ndarray, force_scale: float) -> dict[Any, Any]:
     """The depth along the flank of each Archard :class:`~geardyn.gears.Wear` of a planet's
     ``placement`` (keyed by the fault as given): the wear of one planet revolution, each of its
     two meshes wearing the flank it loads (:func:`~geardyn.gears.potential_energy.
@@ -243,8 +246,11 @@ def planet_wear_profiles(placement: FaultPlacement, geometry: Any, opts: Any,
     ``forces``: the set's static mesh forces [N] (sun-planet meshes, then ring-planet; positive
     on the drive flank); the planet's ``"drive"`` flank is the sun-planet mesh's drive flank
     and the ring-planet mesh's coast flank. ``opts``: the
-    :class:`~geardyn.models.planetary_stiffness.PotentialEnergyOptions` of the tables. {}
-    without Archard wear on a planet. Error ``wear.flank``: no mesh loads the worn flank."""
+    :class:`~geardyn.models.planetary_stiffness.PotentialEnergyOptions` of the tables.
+    ``force_scale`` [N]: the applied torques' force scale, max |T_k| / r_k over the members
+    (torque T_k, radius r_k). {} without Archard wear on a planet. Error ``wear.flank``: no
+    mesh loads the worn flank by more than :data:`LOAD_RTOL` x ``force_scale`` (a smaller
+    force is round-off, as in a set whose sun has no support)."""
     from geardyn.gears.potential_energy import combined_wear_profile, prepare_pair
 
     if not placement.planet_archard:
@@ -264,12 +270,13 @@ def planet_wear_profiles(placement: FaultPlacement, geometry: Any, opts: Any,
             continue
         sign = 1.0 if wear.flank == "drive" else -1.0
         raw = (max(sign * f_sun, 0.0), max(-sign * f_ring, 0.0))
-        if not max(raw) > 0.0:
+        if not max(raw) > LOAD_RTOL * force_scale:
             raise ParameterError("wear.flank", wear.flank, f"no mesh of {placement.gear} loads "
                                  f"its {wear.flank} flank under the mean torques (static mesh "
-                                 f"forces {f_sun:.6g} N sun-side, {f_ring:.6g} N ring-side): "
-                                 "Archard wear on a planet follows the mesh that loads the "
-                                 "worn flank")
+                                 f"forces {f_sun:.6g} N sun-side, {f_ring:.6g} N ring-side, "
+                                 f"round-off below {LOAD_RTOL:g} x {force_scale:.6g} N, the "
+                                 "torques' force scale): Archard wear on a planet follows the "
+                                 "mesh that loads the worn flank")
         parts = [(pair, role, w / max(raw) / pair.face_width)
                  for pair, role, w in zip(pairs, ("wheel", "pinion"), raw, strict=True)]
         out[wear] = combined_wear_profile(parts, wear.depth)

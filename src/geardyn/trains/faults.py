@@ -54,6 +54,7 @@ import numpy as np
 
 from geardyn.errors import ParameterError
 from geardyn.gears.faults import BrokenTooth, RootCrack, Spall, Wear, listed_faults
+from geardyn.models.planetary_faults import LOAD_RTOL
 from geardyn.models.planetary_stiffness import FlankSeries, embedded, flank_series
 from geardyn.trains.elements import Gear, pair_geometry
 
@@ -140,8 +141,8 @@ def place_train_faults(train: Any, faults: object) -> TrainFaults | None:
     return TrainFaults(gear, z, listed, tuple(m.name for m in meshes))
 
 
-def shared_wear_profiles(train: Any, placement: TrainFaults, loads: Mapping[str, float]
-                         ) -> dict[Any, Any]:
+def shared_wear_profiles(train: Any, placement: TrainFaults, loads: Mapping[str, float],
+                         force_scale: float) -> dict[Any, Any]:
     """The depth along the flank of each Archard :class:`~geardyn.gears.Wear` of
     ``placement`` (keyed by the fault as given) on a gear of several meshes: the wear of one
     revolution of the gear, every mesh wearing the flank it loads
@@ -150,8 +151,11 @@ def shared_wear_profiles(train: Any, placement: TrainFaults, loads: Mapping[str,
     b_m on the coast flank (``loads``: F_m [N] by mesh name, positive on the drive flank). An
     idler's or a planet's two meshes load opposite flanks, so each flank takes the wear of one
     of them; a gear that drives or is driven by several meshes takes their sum. {} on a gear of
-    one mesh (its own profile, as a pair's) or without Archard wear. Error ``wear.flank``: no
-    mesh loads the worn flank."""
+    one mesh (its own profile, as a pair's) or without Archard wear. ``force_scale`` [N]: the
+    applied torques' force scale, max |T| over the bodies / the largest base radius of the
+    train's gears. Error ``wear.flank``: no mesh loads the worn flank by more than
+    :data:`~geardyn.models.planetary_faults.LOAD_RTOL` x ``force_scale`` (a smaller force is
+    round-off)."""
     from geardyn.gears.potential_energy import combined_wear_profile, prepare_pair
 
     wears = [f for f in placement.faults if isinstance(f, Wear) and f.profile == "archard"]
@@ -163,12 +167,13 @@ def shared_wear_profiles(train: Any, placement: TrainFaults, loads: Mapping[str,
     for wear in wears:
         sign = 1.0 if wear.flank == "drive" else -1.0
         raw = [max(sign * float(loads[m]), 0.0) for m in placement.meshes]
-        if not max(raw) > 0.0:
+        if not max(raw) > LOAD_RTOL * force_scale:
             raise ParameterError("wear.flank", wear.flank, f"no mesh of {placement.gear} "
                                  f"loads its {wear.flank} flank under the mean torques "
-                                 f"(static mesh forces {dict(loads)} N): Archard wear on a "
-                                 "gear of several meshes follows the meshes that load the "
-                                 "worn flank")
+                                 f"(static mesh forces {dict(loads)} N, round-off below "
+                                 f"{LOAD_RTOL:g} x {force_scale:.6g} N, the torques' force "
+                                 "scale): Archard wear on a gear of several meshes follows "
+                                 "the meshes that load the worn flank")
         # relative to the largest, to 12 digits: the same profile at every torque scale
         weights = tuple(round(w / max(raw), 12) for w in raw)
         key = (wear, weights)

@@ -524,7 +524,7 @@ class TrainModel(PlanetaryGearSet):
         offsets = self._fault_offsets()
         backward = self.backward_meshes()
         shared = {} if self.faults is None else shared_wear_profiles(
-            self.train, self.faults, self.static_loads())
+            self.train, self.faults, self.static_loads(), self.torque_force_scale())
         self._fault_tables: dict[str, Any] = {}
         for i, mesh in enumerate(self.train.meshes):
             data = self.train.mesh_data[mesh.name]
@@ -582,6 +582,13 @@ class TrainModel(PlanetaryGearSet):
         q = np.linalg.lstsq(self.train.stiffness_matrix(), self.torques, rcond=None)[0]
         return {name: k * float((W @ q)[0])
                 for kind, name, W, k, _ in self.train.elements() if kind == "mesh"}
+
+    def torque_force_scale(self) -> float:
+        """The mean torques' force scale [N]: max |T| over the bodies / the largest base radius
+        of the train's gears (0 without torques or gears)."""
+        radius = max((b.radius for b in self.train.bodies.values() if b.radius is not None),
+                     default=math.inf)
+        return max((abs(t) for t in self.body_torques.values()), default=0.0) / radius
 
     def fault_tables(self) -> dict[str, Any]:
         """The potential-energy stiffness Datasets of the faulty gear's meshes over its
