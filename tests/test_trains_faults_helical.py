@@ -16,16 +16,14 @@ import math
 
 import numpy as np
 import pytest
-from scipy.integrate import solve_ivp
 
-import geardyn
 import geardyn.gears as g
 from geardyn.errors import ParameterError
 from geardyn.gears import HelicalGear, HelicalMesh, helical_stiffness
 from geardyn.io.toml import load_study
 from geardyn.models.spur_pair import evaluate_series
 from geardyn.trains import Bearing, Gear, GearTrain, Mesh, TrainModel
-from test_trains_faults import _train_stiffness, kernel_stiffness
+from test_trains_faults import _train_stiffness, assert_one_mesh_matches_dop853, kernel_stiffness
 
 #: The 19/48 pair (m_n 3.2 mm, 20 deg) at a 15 deg helix, 16 mm face (overlap ratio 0.41).
 PINION = HelicalGear(19, "3.2 mm", "20 deg", "15 deg", "16 mm", name="pinion")
@@ -116,35 +114,12 @@ def test_cracked_helical_train_matches_dop853_on_the_one_mesh_equation():
     model = _model((g.RootCrack(**CRACK, gear="p", tooth=2),), mesh_damping=zeta, backlash=b,
                    input_speed=rpm)
     assert model.static_mesh_forces()[0] == pytest.approx(TORQUE / (r1 * cb), rel=1e-9)
-    L, w0 = model.length_scale, model.time_scale
-    omega = model.omega * w0
+    omega = model.omega * model.time_scale
     assert omega == pytest.approx(rpm * 2.0 * math.pi / 60.0, rel=1e-12)
-    c = 2.0 * zeta * math.sqrt(k0 * m_n)
-
-    def force(t, x, v):
-        gap = x - np.clip(x, -b, b)
-        theta = omega * np.asarray(t, dtype=float)
-        k = np.where(gap > 0.0, evaluate_series(series["drive"], theta),
-                     evaluate_series(series["coast"], theta))
-        return k * gap + c * v
-
-    def rhs(t, y):
-        return [y[1], (TORQUE / (r1 * cb) - force(t, y[0], y[1])) / m_n]
-
-    ds = geardyn.simulate(model, run=geardyn.RunSettings(transient=0, samples=2,
-                                                         steps_per_period=19 * 400))
-    t = ds.time.values / w0
-    W = model.mesh_rows()[0]
-    y0 = model.initial_state()
-    n = W.size
-    x0, v0 = L * (W @ y0[:n]), L * w0 * (W @ y0[n:])
-    ref = solve_ivp(rhs, (0.0, t[-1]), [x0, v0], method="DOP853", rtol=1e-10, atol=1e-16,
-                    t_eval=t)
-    assert ref.success
-    assert np.any(ref.y[0] < b)  # the teeth leave the drive flank
-    f_ref = force(t, ref.y[0], ref.y[1])
-    np.testing.assert_allclose(ds["F_m"].values, f_ref, rtol=0.0,
-                               atol=2e-5 * np.max(np.abs(f_ref)))
+    assert_one_mesh_matches_dop853(
+        model, lambda theta: evaluate_series(series["drive"], theta),
+        lambda theta: evaluate_series(series["coast"], theta), m_n,
+        2.0 * zeta * math.sqrt(k0 * m_n), b, TORQUE / (r1 * cb))
 
 
 @pytest.mark.parametrize("fault", [g.RootCrack(depth=0.0, gear="p", tooth=4),

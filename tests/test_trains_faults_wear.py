@@ -66,33 +66,46 @@ def test_idler_flank_takes_the_wear_of_the_mesh_that_loads_it(flank):
     # g2, gear a of m2, turns in the negative sense: m2's table is read backwards in time, the
     # tooth passing its pitch point at c = j the table's tooth -j
     assert model.backward_meshes() == ("m2",)
-    on = {"m1": ("wheel", GearMesh(g1, g2), 5), "m2": ("pinion", GearMesh(g2, g3),
-                                                      -(5 + offsets["m2"]) % 31)}
-    loading, other = ("m1", "m2") if flank == "drive" else ("m2", "m1")
-    role, pair, tooth = on[loading]
-    own = g.Wear(depth=DEPTH, gear=role, tooth=tooth, profile="archard", flank=flank)
-    ref = potential_energy_stiffness(pair, bore_radius=BORE, faults=(own,), cycles=31)
+    on = {"m1": ("wheel", GearMesh(g1, g2), BORE, 5),
+          "m2": ("pinion", GearMesh(g2, g3), BORE, -(5 + offsets["m2"]) % 31)}
+    assert_wear_follows_the_loading_mesh(model, on, flank, DEPTH, 31)
+
+
+def assert_wear_follows_the_loading_mesh(model: TrainModel, on, flank: str, depth: float,
+                                         cycles: int) -> None:
+    """Archard wear of ``depth`` [m] on ``flank`` of a gear of two meshes, ``on``: {mesh:
+    (the gear's role in the mesh's pair, the pair, its bore radii, the worn tooth's number in
+    the mesh's table)}, the first mesh loading the drive flank, the second the coast flank.
+    The loading mesh's table over ``cycles`` mesh cycles equals potential_energy_stiffness of
+    its pair with the same wear (to 1e-8 of its largest value; its deepest gap within 0.9 to 1
+    of ``depth``), and the other mesh's contacts on the worn flank open the loading mesh's
+    depth at their flank point (rtol 1e-8; 0 below the loading mesh's lowest contact on the
+    flank)."""
+    first, second = on
+    loading, other = (first, second) if flank == "drive" else (second, first)
+    role, pair, bores, tooth = on[loading]
+    own = g.Wear(depth=depth, gear=role, tooth=tooth, profile="archard", flank=flank)
+    ref = potential_energy_stiffness(pair, bore_radius=bores, faults=(own,), cycles=cycles)
     tables = model.fault_tables()
     for var in ("mesh_stiffness", "mesh_stiffness_coast", "fault_gap", "fault_gap_coast"):
         got, want = tables[loading][var].values, ref[var].values
         np.testing.assert_allclose(got, want, rtol=0.0, atol=1e-8 * np.max(np.abs(want)))
     deepest = np.max(ref["fault_gap_coast" if flank == "coast" else "fault_gap"].values)
-    assert 0.9 * DEPTH < deepest <= DEPTH * (1.0 + 1e-9)
+    assert 0.9 * depth < deepest <= depth * (1.0 + 1e-9)
     # the other mesh's contacts on the worn flank: the loading mesh's depth at their flank point
     # (0 below the loading mesh's lowest contact on the flank)
-    depth_at = prepare_pair(pair, bore_radius=BORE, faults=(own,)).wear_profiles[0][1].depth_at
-    mesh = pair
-    s_p = mesh.pinion.base_radius * math.tan(mesh.operating_pressure_angle)
+    depth_at = prepare_pair(pair, bore_radius=bores, faults=(own,)).wear_profiles[0][1].depth_at
+    s_p = pair.pinion.base_radius * math.tan(pair.operating_pressure_angle)
     if role == "pinion":
-        lowest = (s_p - mesh.approach_length) / mesh.pinion.base_radius
+        lowest = (s_p - pair.approach_length) / pair.pinion.base_radius
     else:
-        lowest = (mesh.line_of_action_length - s_p - mesh.recess_length) / mesh.wheel.base_radius
-    o_role, o_pair, o_tooth = on[other]
-    t, gap = _roll_and_gap(tables[other], prepare_pair(o_pair, bore_radius=BORE), o_role,
+        lowest = (pair.line_of_action_length - s_p - pair.recess_length) / pair.wheel.base_radius
+    o_role, o_pair, o_bores, o_tooth = on[other]
+    t, gap = _roll_and_gap(tables[other], prepare_pair(o_pair, bore_radius=o_bores), o_role,
                            o_tooth, coast=flank == "coast")
     worn = t > lowest
     assert worn.sum() > 20
-    np.testing.assert_allclose(gap[worn], depth_at(t[worn]), rtol=1e-8, atol=1e-12 * DEPTH)
+    np.testing.assert_allclose(gap[worn], depth_at(t[worn]), rtol=1e-8, atol=1e-12 * depth)
     assert np.all(gap[~worn] == 0.0)
 
 

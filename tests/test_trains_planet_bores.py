@@ -27,7 +27,6 @@ import geardyn
 import geardyn.gears as g
 from geardyn.errors import ParameterError
 from geardyn.gears import GearMesh, potential_energy_stiffness
-from geardyn.gears.potential_energy import prepare_pair
 from geardyn.io.toml import load_study
 from geardyn.models.spur_pair import evaluate_series
 from geardyn.trains import (
@@ -42,7 +41,7 @@ from geardyn.trains import (
 )
 from test_planetary_pe import MEMBERS, stage
 from test_trains_faults import _train_stiffness, set_series_misses
-from test_trains_faults_wear import _roll_and_gap
+from test_trains_faults_wear import assert_wear_follows_the_loading_mesh
 
 #: Bores [m]: sun, planet, the ring's rim radius (those of tests/test_planetary_pe.py).
 SUN_BORE, PLANET_BORE, RIM = 12e-3, 10e-3, 85e-3
@@ -355,31 +354,9 @@ def test_planet_flank_takes_the_wear_of_the_mesh_that_loads_it(flank):
     on = {"sun_p1": ("wheel", GearMesh(geo.sun, geo.planet), (SUN_BORE, PLANET_BORE), tooth),
           "p1_ring": ("pinion", GearMesh(geo.planet, geo.ring, internal=True),
                       (PLANET_BORE, RIM), -(tooth + offsets["p1_ring"]) % z)}
-    loading, other = ("sun_p1", "p1_ring") if flank == "drive" else ("p1_ring", "sun_p1")
-    role, pair, bores, at = on[loading]
-    own = g.Wear(depth=DEPTH, gear=role, tooth=at, profile="archard", flank=flank)
-    ref = potential_energy_stiffness(pair, bore_radius=bores, faults=(own,), cycles=z)
-    tables = model.fault_tables()
-    for var in ("mesh_stiffness", "mesh_stiffness_coast", "fault_gap", "fault_gap_coast"):
-        got, want = tables[loading][var].values, ref[var].values
-        np.testing.assert_allclose(got, want, rtol=0.0, atol=1e-8 * np.max(np.abs(want)))
-    deepest = np.max(ref["fault_gap_coast" if flank == "coast" else "fault_gap"].values)
-    assert 0.9 * DEPTH < deepest <= DEPTH * (1.0 + 1e-9)
-    depth_at = prepare_pair(pair, bore_radius=bores, faults=(own,)).wear_profiles[0][1].depth_at
-    s_p = pair.pinion.base_radius * math.tan(pair.operating_pressure_angle)
-    if role == "pinion":
-        lowest = (s_p - pair.approach_length) / pair.pinion.base_radius
-    else:
-        lowest = (pair.line_of_action_length - s_p - pair.recess_length) / pair.wheel.base_radius
-    o_role, o_pair, o_bores, o_tooth = on[other]
-    t, gap = _roll_and_gap(tables[other], prepare_pair(o_pair, bore_radius=o_bores), o_role,
-                           o_tooth, coast=flank == "coast")
-    worn = t > lowest
-    assert worn.sum() > 20
-    np.testing.assert_allclose(gap[worn], depth_at(t[worn]), rtol=1e-8, atol=1e-12 * DEPTH)
-    assert np.all(gap[~worn] == 0.0)
+    assert_wear_follows_the_loading_mesh(model, on, flank, DEPTH, z)
     # the other planets' meshes are healthy
-    assert set(tables) == {"sun_p1", "p1_ring"}
+    assert set(model.fault_tables()) == {"sun_p1", "p1_ring"}
 
 
 def test_cracked_planet_of_a_train_stage_is_the_planetary_sets():
