@@ -755,7 +755,7 @@ class PlanetaryGearSet(Model):
         revolution). Archard wear on a planet follows the mesh that loads the worn flank under
         the mean torques (the static mesh forces of the healthy set:
         :func:`~geardyn.models.planetary_faults.planet_wear_profiles`); a flank no mesh loads
-        (no torques, or forces of round-off against max |T_k| / r_k, as with a held sun without
+        (no torques, or forces of round-off against max abs(T_k) / r_k, as with a held sun without
         support) is refused (``wear.flank``).
         """
         from geardyn.gears import PlanetaryGeometry

@@ -247,7 +247,7 @@ def planet_wear_profiles(placement: FaultPlacement, geometry: Any, opts: Any,
     on the drive flank); the planet's ``"drive"`` flank is the sun-planet mesh's drive flank
     and the ring-planet mesh's coast flank. ``opts``: the
     :class:`~geardyn.models.planetary_stiffness.PotentialEnergyOptions` of the tables.
-    ``force_scale`` [N]: the applied torques' force scale, max |T_k| / r_k over the members
+    ``force_scale`` [N]: the applied torques' force scale, max abs(T_k) / r_k over the members
     (torque T_k, radius r_k). {} without Archard wear on a planet. Error ``wear.flank``: no
     mesh loads the worn flank by more than :data:`LOAD_RTOL` x ``force_scale`` (a smaller
     force is round-off, as in a set whose sun has no support)."""

@@ -152,7 +152,7 @@ def shared_wear_profiles(train: Any, placement: TrainFaults, loads: Mapping[str,
     idler's or a planet's two meshes load opposite flanks, so each flank takes the wear of one
     of them; a gear that drives or is driven by several meshes takes their sum. {} on a gear of
     one mesh (its own profile, as a pair's) or without Archard wear. ``force_scale`` [N]: the
-    applied torques' force scale, max |T| over the bodies / the largest base radius of the
+    applied torques' force scale, max abs(T) over the bodies / the largest base radius of the
     train's gears. Error ``wear.flank``: no mesh loads the worn flank by more than
     :data:`~geardyn.models.planetary_faults.LOAD_RTOL` x ``force_scale`` (a smaller force is
     round-off)."""

@@ -584,7 +584,7 @@ class TrainModel(PlanetaryGearSet):
                 for kind, name, W, k, _ in self.train.elements() if kind == "mesh"}
 
     def torque_force_scale(self) -> float:
-        """The mean torques' force scale [N]: max |T| over the bodies / the largest base radius
+        """The mean torques' force scale [N]: max abs(T) over the bodies / the largest base radius
         of the train's gears (0 without torques or gears)."""
         radius = max((b.radius for b in self.train.bodies.values() if b.radius is not None),
                      default=math.inf)
