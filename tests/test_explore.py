@@ -317,7 +317,7 @@ def test_another_parameter_is_swept_at_the_studys_omega():
     study = load_study(STUDY.replace("[run]", "[run]\nomega = 2.0"))
     state = ExplorerState(study, "gp.toml", "zeta", Window(0.05, 0.15, 3),
                           describe_error=format_error)
-    assert state.main_params() == ("backlash", "Fa", "kappa")  # the swept one left out
+    assert state.main_params() == ("kappa", "Fa", "backlash")  # the swept one left out
     req = state.diagram_request()
     ds = compute_diagram(req)
     np.testing.assert_allclose(ds["zeta"].values, [0.05, 0.1, 0.15])

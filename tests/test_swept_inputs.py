@@ -1,8 +1,9 @@
 """The inputs a sweep takes, declared once (``PhysicalInput.swept`` and its unit,
 geardyn.core.inputs), checked against what the models do: every declared swept input of the
-planetary set and of a gear train is swept by ``lane_params`` (each lane the model
-``with_params`` builds at that value, the lanes differing), a plain number is read in the unit
-its axis is labelled with (the same model as the unit string "<number> <unit>", pint's
+planetary set, of a gear train, of the SI spur pair and of the CATT device (its paper names) is
+swept by ``lane_params`` (each lane
+the model ``with_params`` builds at that value, the lanes differing), a plain number is read in
+the unit its axis is labelled with (the same model as the unit string "<number> <unit>", pint's
 conversion), and every other declared input is refused naming it. A drifted declaration (the
 wrong unit kind) is caught."""
 
@@ -15,7 +16,7 @@ import numpy as np
 import pytest
 
 import geardyn
-from geardyn.core.inputs import PhysicalInput, by_name
+from geardyn.core.inputs import PhysicalInput, by_name, rederived
 from geardyn.errors import ParameterError
 from geardyn.io.toml import builtin_study
 from geardyn.models import planetary_coefficients
@@ -31,7 +32,8 @@ KIND_VALUES = {"length": (1e-6, 2.5e-6), "angle": (0.1, 0.3), "stiffness": (4e8,
 NAME_VALUES = {"sun_pressure_angle": (0.35, 0.42), "ring_pressure_angle": (0.35, 0.42),
                "contact_ratio": (1.4, 1.7), "torque_order": (1.0, 2.0),
                "carrier_speed": (10.0, 20.0), "carrier_speed_ratio": (1e-3, 2e-3),
-               "input_speed": (1000.0, 2000.0), "input_torque": (50.0, 80.0)}
+               "input_speed": (1000.0, 2000.0), "input_torque": (50.0, 80.0),
+               "Lambda": (0.5, 0.8)}
 #: The axis unit of a dimensionless input (no unit string: written in percent instead).
 DIMENSIONLESS = "1"
 
@@ -60,6 +62,23 @@ def _planetary_from_geometry():
     return build_model(builtin_study("planetary_example"))
 
 
+def _spur_pair(speed_unit: str = "rpm") -> geardyn.SpurPair:
+    """The cracked pair of the built-in study (speed in rpm), or with its speed in another
+    unit; a transmission error so that its phase acts."""
+    model = build_model(builtin_study("spur_pair_cracked"))
+    if speed_unit == model.speed_unit:
+        return model.with_params(error=1e-6)
+    return geardyn.SpurPair(model.mesh, model.stiffness, speed=f"{model.speed} rad/s",
+                            torque=20.0, error=1e-6, speed_unit=speed_unit)
+
+
+def _catt() -> geardyn.CATTDevice:
+    """The paper's device with its load fluctuations on (so that their phases act)."""
+    from geardyn.models.params import PlanetaryParams
+
+    return geardyn.CATTDevice(PlanetaryParams.paper(B1="100 N m", B2="150 N m", Lambda=0.5))
+
+
 def _values(model, name: str) -> tuple[float, float]:
     if name in NAME_VALUES:
         return NAME_VALUES[name]
@@ -68,14 +87,15 @@ def _values(model, name: str) -> tuple[float, float]:
 
 def sweep_disagreements(model, names) -> list[str]:
     """Where sweeping ``names`` of ``model`` disagrees with its declarations, one line each:
-    a name refused or not in ``physical_names``; a lane that is not the model ``with_params``
-    builds at the value; lanes that do not differ; a plain number not read in the unit of the
-    name's axis (``param_attrs``), or, for a dimensionless kind, not a unit string in percent."""
+    a name refused, or neither in ``physical_names`` nor a parameter; a lane that is not the
+    model ``with_params`` builds at the value; lanes that do not differ; a plain number not
+    read in the unit of the name's axis (``param_attrs``), or, for a dimensionless kind, not a
+    unit string in percent."""
     out = []
     for name in names:
         lo, hi = _values(model, name)
-        if name not in model.physical_names:
-            out.append(f"{name}: not in physical_names")
+        if name not in model.physical_names and name not in model.param_names:
+            out.append(f"{name}: neither in physical_names nor a parameter")
         try:
             P = model.lane_params(name, [lo, hi])
             rows = [model.with_params(**{name: v}).params for v in (lo, hi)]
@@ -143,14 +163,69 @@ def test_a_per_mesh_or_per_planet_value_is_not_offered_as_a_sweep():
     assert "sun_backlash" not in lp.physical_names and "ring_backlash" in lp.physical_names
 
 
-@pytest.mark.parametrize("build", [_planetary, _train], ids=["planetary", "train"])
-def test_every_other_declared_input_is_refused_by_a_sweep_naming_it(build):
+@pytest.mark.parametrize("speed_unit", ["rpm", "rad/s", "Hz"])
+def test_every_declared_swept_input_of_the_spur_pair_sweeps_in_its_unit(speed_unit):
+    """speed (in the pair's speed_unit, its axis unit) and the inputs that are coefficients of
+    their names (torque, zeta, backlash, error, error_phase: the coefficient's unit on the axis,
+    the declared kind reading unit strings); physical_names is speed alone, the input the
+    coefficients are re-derived from."""
+    model = _spur_pair(speed_unit)
+    names = _declared_swept(model)
+    assert names == ["speed", "torque", "zeta", "backlash", "error", "error_phase"]
+    assert model.param_attrs("speed")["units"] == speed_unit
+    assert sweep_disagreements(model, names) == []
+    assert model.physical_names == ("speed",) == rederived(model.input_declarations)
+    for name in names[1:]:
+        declared = by_name(model.input_declarations)[name]
+        assert declared.coefficient.name == name
+        assert model.param_attrs(name)["units"] == declared.axis_unit
+
+
+def test_the_spur_pairs_speed_sweep_sets_omega_by_the_tooth_counts():
+    """A lane of speed is the pinion speed in rpm times 2 pi / 60 (mesh frequency: its teeth
+    times that), Omega that over the period's mesh cycles."""
+    model = _spur_pair("rpm")
+    P = model.lane_params("speed", [1000.0, 3000.0])
+    rad_s = np.array([1000.0, 3000.0]) * 2.0 * math.pi / 60.0
+    omega = P[:, model.param_index("Omega")]
+    np.testing.assert_allclose(omega, rad_s * model.mesh.pinion.teeth / model.cycles,
+                               rtol=1e-15)
+
+
+def test_every_declared_swept_input_of_the_catt_device_sweeps_in_its_unit():
+    """The paper's names but the count N and the choice waveform, each in the SI unit of its
+    kind (b_sq and b_pq too, which are also the reduced form's dimensionless coefficients: the
+    paper name is what a sweep and with_params take); physical_names is the swept names."""
+    model = _catt()
+    names = _declared_swept(model)
+    assert len(names) == 23 and {"N", "waveform"}.isdisjoint(names)
+    assert sweep_disagreements(model, names) == []
+    assert list(model.physical_names) == names
+    assert model.param_attrs("b_sq")["units"] == "m" and model.param_attrs("xi1")["units"] == "1"
+
+
+def _others(model) -> list[str]:
+    """The declared inputs the model was built with that a sweep does not take."""
+    given = getattr(model, "inputs", None)
+    return [i.name for i in model.input_declarations
+            if not i.swept and (given is None or i.name in given)]
+
+
+#: Declared inputs each model must refuse to sweep (among others).
+REFUSED = {"planetary": {"time_scale", "length_scale", "harmonics", "waveform"},
+           "train": {"time_scale", "length_scale", "harmonics", "waveform"},
+           "spur_pair": {"inertia", "harmonics", "stiffness_form", "period", "speed_unit"},
+           "catt": {"N", "waveform"}}
+
+
+@pytest.mark.parametrize(("kind", "build"), [("planetary", _planetary), ("train", _train),
+                                             ("spur_pair", _spur_pair), ("catt", _catt)])
+def test_every_other_declared_input_is_refused_by_a_sweep_naming_it(kind, build):
     """Counts, choices, flags, names, tables, lists and the scales: a sweep is a
     ParameterError naming the input, with one value or several; no unit on its axis."""
     model = build()
-    others = [i.name for i in model.input_declarations
-              if not i.swept and i.name in model.inputs]
-    assert {"time_scale", "length_scale", "harmonics", "waveform"} <= set(others)
+    others = _others(model)
+    assert REFUSED[kind] <= set(others)
     for name in others:
         for values in ([1.0], [1.0, 2.0]):
             with pytest.raises(ParameterError, match="not swept") as e:

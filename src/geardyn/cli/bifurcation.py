@@ -90,12 +90,15 @@ def parse_range(text: str, option: str = "--range") -> tuple[float, float, int]:
 
 
 def _sweepable(model) -> list[str]:
-    """Names a sweep of ``model`` accepts, for error messages."""
+    """Names a sweep of ``model`` accepts, for error messages: Omega and its physical names,
+    then (a model that takes its input coefficients too, e.g. the spur pair's torque) its input
+    coefficients."""
     if model.capabilities.physical_inputs:  # models with named physical inputs
         return ["Omega", *model.physical_names]
     layout = model.coefficient_layout
-    return ["Omega", *(n for n in model.param_names
-                       if n != "Omega" and layout.slot(n).coefficient.kind == "input")]
+    return ["Omega", *model.physical_names,
+            *(n for n in model.param_names
+              if n != "Omega" and layout.slot(n).coefficient.kind == "input")]
 
 
 def sweep_vocabulary(model) -> list[tuple[str, str]]:

@@ -91,7 +91,8 @@ class Coefficient:
     ``minimum``/``maximum`` (inclusive) and ``exclusive_*`` the admissible range; ``derive``,
     for a derived coefficient of one input, the function of that input's value that gives it
     (computed once per distinct value, in Python: ``math.cos`` is the libm the compiled code
-    calls, so the same bits)."""
+    calls, so the same bits); ``explore`` whether the explorer offers an input coefficient as
+    a control (a model whose inputs are its coefficients, no declared physical inputs)."""
 
     name: str
     unit: str = "1"
@@ -106,6 +107,7 @@ class Coefficient:
     exclusive_minimum: float | None = None
     exclusive_maximum: float | None = None
     derive: Callable[[float], float] | None = None
+    explore: bool = False
 
     def __post_init__(self) -> None:
         for label in ("name", "unit", "meaning"):
@@ -129,6 +131,8 @@ class Coefficient:
             object.__setattr__(self, "per_lane", self.kind in PARAMETER_KINDS)
         if self.per_lane and self.kind == "structure":
             raise ValueError(f"{self.name}: structure is the same in every lane")
+        if self.explore and self.kind != "input":
+            raise ValueError(f"{self.name}: the explorer offers input coefficients only")
 
     @property
     def is_parameter(self) -> bool:

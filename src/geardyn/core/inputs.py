@@ -10,9 +10,11 @@ the model's coefficient declarations. From the declarations come:
 * the ``[params]`` table of the model's study files (:func:`geardyn.io.params_table.params_table`:
   one field per input, its type from the kind and form, its default and description);
 * the unit kinds ``with_params`` reads unit strings by;
-* the names a sweep takes (``swept``: :func:`swept`, a model's ``physical_names``), the units of
-  their axes (:attr:`PhysicalInput.axis_unit`) and the refusal, naming the input, of a sweep of
-  any other declared input;
+* the names a sweep takes (``swept``: :func:`swept`; a model's ``physical_names``, those that
+  re-derive its coefficients, :func:`rederived`), the units of their axes
+  (:attr:`PhysicalInput.axis_unit`) and the refusal, naming the input, of a sweep of any other
+  declared input (:meth:`geardyn.core.model.Model.lane_params`);
+* the explorer's controls (``explore``: :func:`explored`);
 * a check that the declaration and the model's constructor agree: every declared input a
   keyword of its builder (``of``) with the declared default, every keyword of the constructor
   declared (``tests/test_model_inputs.py``).
@@ -29,7 +31,10 @@ list of one per planet), ``"per_mesh"`` (one value for every mesh or ``{mesh: va
 
 A swept input (``swept=True``) is a number of its kind, one value (for every planet or mesh where
 its form is ``"per_planet"`` or ``"per_mesh"``): a sweep re-derives the coefficients from each
-value. Counts, flags, choices, names, tables, lists and the model's scales are not swept.
+value. Counts, flags, choices, names, tables, lists and the model's scales are not swept. A swept
+input declared with the coefficient of its own name (``coefficient``) is that coefficient: a
+sweep or ``with_params`` sets the entry (in range), and the input is no physical name
+(:func:`rederived`); any other swept input re-derives the coefficients from its value.
 """
 
 from __future__ import annotations
@@ -43,7 +48,8 @@ from geardyn.core.coefficients import Coefficient
 from geardyn.units import SI_UNITS
 
 __all__ = ["AXIS_UNITS", "FORMS", "INPUT_KINDS", "REQUIRED", "SWEPT_FORMS", "SWEPT_KINDS",
-           "PhysicalInput", "by_name", "one_value", "swept"]
+           "PhysicalInput", "by_name", "explored", "one_value", "rederived", "swept",
+           "unit_kind"]
 
 
 class _Required:
@@ -87,7 +93,9 @@ class PhysicalInput:
     not take (``meaning`` says where it comes from); ``swept`` whether a sweep takes it by name
     (a number of one of :data:`SWEPT_KINDS` in one of :data:`SWEPT_FORMS`); ``unit`` the unit
     a plain number, a sweep's values and its axis are in where it is not the kind's SI unit
-    (e.g. ``"rpm"``)."""
+    (e.g. ``"rpm"``); ``explore`` whether the explorer offers the input as a control (a number,
+    a count or a choice of the study's ``[params]``, where the study gives it one value), in
+    declared order."""
 
     name: str
     kind: str
@@ -104,6 +112,7 @@ class PhysicalInput:
     study: bool = True
     swept: bool = False
     unit: str | None = None
+    explore: bool = False
 
     def __post_init__(self) -> None:
         if self.kind not in INPUT_KINDS:
@@ -128,6 +137,10 @@ class PhysicalInput:
                              f"of form {', '.join(SWEPT_FORMS)}; got {self.kind} {self.form}")
         if self.unit is not None and self.kind not in SWEPT_KINDS:
             raise ValueError(f"{self.name}: only a number of a unit kind declares its unit")
+        if self.explore and (self.kind not in (*SWEPT_KINDS, "count", "choice")
+                             or not self.study):
+            raise ValueError(f"{self.name}: an explorer control is a number, a count or a "
+                             f"choice of the study's [params]; got {self.kind}")
 
     @property
     def required(self) -> bool:
@@ -164,6 +177,31 @@ def by_name(inputs: Iterable[PhysicalInput]) -> dict[str, PhysicalInput]:
 def swept(inputs: Iterable[PhysicalInput]) -> dict[str, PhysicalInput]:
     """The swept inputs (``swept``) by name, in declared order."""
     return {i.name: i for i in by_name(inputs).values() if i.swept}
+
+
+def rederived(inputs: Iterable[PhysicalInput]) -> tuple[str, ...]:
+    """The swept inputs the coefficients are re-derived from, in declared order: every swept
+    input but one declared with the coefficient of its own name (that coefficient itself)."""
+    return tuple(n for n, i in swept(inputs).items()
+                 if i.coefficient is None or i.coefficient.name != n)
+
+
+def explored(inputs: Iterable[PhysicalInput]) -> tuple[str, ...]:
+    """The inputs the explorer offers as controls (``explore``), in declared order."""
+    return tuple(n for n, i in by_name(inputs).items() if i.explore)
+
+
+#: The SI kind of each axis unit (:data:`AXIS_UNITS`), "1" the dimensionless kind.
+_KIND_OF_UNIT: dict[str, str] = {u: k for k, u in AXIS_UNITS.items() if k in SI_UNITS}
+
+
+def unit_kind(unit: str) -> str:
+    """The SI kind (:data:`geardyn.units.SI_UNITS`) of a declared coefficient's ``unit`` (its
+    axis unit, :data:`AXIS_UNITS`: ``"N m"`` -> ``"torque"``, ``"1"`` -> ``"dimensionless"``);
+    a ValueError for a unit of no kind."""
+    if unit not in _KIND_OF_UNIT:
+        raise ValueError(f"unit {unit!r} is none of {', '.join(_KIND_OF_UNIT)}")
+    return _KIND_OF_UNIT[unit]
 
 
 def one_value(value: object) -> bool:

@@ -37,7 +37,7 @@ import numpy as np
 
 from geardyn.core.capabilities import DYNAMIC_FACTOR_MEMBERS, Capabilities
 from geardyn.core.coefficients import CoefficientLayout
-from geardyn.core.inputs import PhysicalInput
+from geardyn.core.inputs import PhysicalInput, explored
 from geardyn.core.kernel_source import KernelSource
 from geardyn.core.plan import forcing_period
 from geardyn.errors import ParameterError
@@ -301,6 +301,7 @@ class Model:
         every lane cannot be swept), the derived coefficients declared with their function
         following it; physical models override it to re-derive every coefficient.
         """
+        self._refuse_unswept(name, values)
         values = np.asarray(values, dtype=float).ravel()
         idx = self._raw_target(name)
         if not self.coefficient_layout.at(idx).coefficient.per_lane and values.size > 1:
@@ -309,6 +310,26 @@ class Model:
         P = np.tile(self.params, (values.size, 1))
         P[:, idx] = values
         return self.coefficient_layout.fill_derived(P)
+
+    @property
+    def explorer_names(self) -> tuple[str, ...]:
+        """The inputs the explorer offers as controls, in declared order: the declared inputs
+        flagged ``explore`` (:attr:`input_declarations`), or, for a model whose inputs are its
+        coefficients (none declared), the input coefficients flagged ``explore``."""
+        if self.input_declarations:
+            return explored(self.input_declarations)
+        layout = self.coefficient_layout
+        return tuple(n for n in layout.names if layout.slot(n).coefficient.explore)
+
+    def _refuse_unswept(self, name: str, values: object) -> None:
+        """A :class:`~geardyn.errors.ParameterError` naming ``name`` where it is a declared
+        input (:attr:`input_declarations`) that a sweep does not take (not ``swept``)."""
+        declared = next((i for i in self.input_declarations if i.name == name), None)
+        if declared is not None and not declared.swept:
+            swept = [i.name for i in self.input_declarations if i.swept]
+            raise ParameterError(name, values, f"not swept ({declared.kind} input of "
+                                 f"{self.name}: set it with with_params or in the study); "
+                                 f"swept: {', '.join(('Omega', *swept))}")
 
     def lane_params_grid(self, x: str, x_values: Sequence[float] | np.ndarray, y: str,
                          y_values: Sequence[float] | np.ndarray) -> np.ndarray:

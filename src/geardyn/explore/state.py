@@ -27,6 +27,7 @@ from typing import Any
 
 import numpy as np
 
+from geardyn.core.inputs import explored
 from geardyn.core.model import Model
 from geardyn.errors import ParameterError
 from geardyn.gears.faults import FAULT_KINDS
@@ -39,23 +40,28 @@ from geardyn.io.toml import (
     Study,
     TrainModelParams,
 )
+from geardyn.models.gear_pair_coefficients import GEAR_PAIR
+from geardyn.models.params import PAPER_INPUTS
+from geardyn.models.planetary_coefficients import INPUTS as PLANETARY_INPUTS
 from geardyn.models.planetary_stiffness import COAST_FLANKS, STIFFNESS_METHODS
+from geardyn.models.spur_pair_coefficients import INPUTS as SPUR_PAIR_INPUTS
+from geardyn.trains.inputs import INPUTS as TRAIN_INPUTS
 
 __all__ = ["CONTINUATIONS", "GEOMETRY_KEYS", "INTERPRETATIONS", "MAIN_PARAMS",
            "PLANETARY_GEOMETRY_KEYS", "DiagramRequest", "ExplorerState", "Window",
            "fault_fields", "key_path", "parse_value", "switched_fault"]
 
-#: The main parameters offered as controls, per model kind (``[study].model``): damping ratios,
-#: backlash, meshing error, load (or torque) fluctuation. A train's are offered where its study
-#: gives them as one number for every mesh (a per-mesh table is not a control).
+#: The main parameters offered as controls, per model kind (``[study].model``), in declared
+#: order: the model's declared inputs flagged ``explore``
+#: (:attr:`~geardyn.core.model.Model.explorer_names`; damping ratios, backlash, meshing error,
+#: load or torque fluctuation). A train's are offered where its study gives them as one number
+#: for every mesh (a per-mesh table is not a control).
 MAIN_PARAMS: dict[str, tuple[str, ...]] = {
-    "catt": ("xi1", "xi2", "backlash", "error", "B1", "Lambda"),
-    "gear_pair": ("zeta", "backlash", "Fa", "kappa"),
-    "planetary": ("mesh_damping", "sun_backlash", "ring_backlash", "sun_mesh_error",
-                  "torque_fluctuation"),
-    "spur_pair": ("zeta", "backlash", "torque", "error", "harmonics"),
-    "train": ("mesh_damping", "modal_damping", "backlash", "stiffness_fluctuation",
-              "mesh_error", "torque_fluctuation"),
+    "catt": explored(PAPER_INPUTS),
+    "gear_pair": tuple(c.name for c in GEAR_PAIR.entries if c.explore),
+    "planetary": explored(PLANETARY_INPUTS),
+    "spur_pair": explored(SPUR_PAIR_INPUTS),
+    "train": explored(TRAIN_INPUTS),
 }
 #: The ``[gears]`` inputs offered as controls of a model built from a pair's geometry (study-file
 #: keys; each gear's own value, which wins over a shared ``[gears]`` one). The faults' controls
@@ -269,8 +275,9 @@ class ExplorerState:
         return self.study.study.model
 
     def main_params(self) -> tuple[str, ...]:
-        """The parameters offered as controls (the swept one left out)."""
-        offered = MAIN_PARAMS.get(self.kind, ())
+        """The parameters offered as controls (the model's
+        :attr:`~geardyn.core.model.Model.explorer_names`; the swept one left out)."""
+        offered = self.model.explorer_names
         if self.kind == "train":
             offered = tuple(p for p in offered if p in self.model.physical_names)
         return tuple(p for p in offered if p != self.param)
@@ -320,8 +327,6 @@ class ExplorerState:
         (:mod:`geardyn.core.inputs`), the units of its sweep axis, the ``[params]`` field's
         description, or, for a geometry control, its table; empty where nothing is
         declared."""
-        from geardyn.models.gear_pair_coefficients import GEAR_PAIR
-
         if name in self.geometry_params():
             return self._geometry_help(name)
         layout = self.model.coefficient_layout

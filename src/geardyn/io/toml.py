@@ -371,7 +371,9 @@ class SweepSettings(BaseModel):
 
     model_config = _CONFIG
 
-    param: str = Field("Omega", min_length=1, description="swept parameter (Omega or paper name)")
+    param: str = Field("Omega", min_length=1, description="swept parameter: Omega or a swept "
+                       "input of the model (its declared physical inputs, e.g. a CATT study's "
+                       "paper names, or its input coefficients)")
     start: Real
     stop: Real
     num: Whole = Field(ge=2, description="number of parameter values")

@@ -33,6 +33,7 @@ import numpy as np
 
 from geardyn.core.capabilities import Capabilities
 from geardyn.core.coefficients import CoefficientLayout
+from geardyn.core.inputs import by_name, rederived
 from geardyn.core.kernel_source import KernelSource
 from geardyn.core.model import Model, unique_rows
 from geardyn.errors import ParameterError
@@ -49,7 +50,7 @@ from geardyn.models.derived import (
     coefficients,
     derive,
 )
-from geardyn.models.params import PAPER_NAMES, PlanetaryParams
+from geardyn.models.params import PAPER_INPUTS, PAPER_NAMES, PlanetaryParams
 from geardyn.models.stiffness import fourier_coefficients, harmonics_needed
 
 _KERNEL = KernelSource(ck.catt_rhs, ck.catt_events, ck.catt_observe)
@@ -112,9 +113,12 @@ class CATTDevice(Model):
                                 natural_frequencies="rad/time",
                                 physical_inputs=True, paper_device=True, mesh_forces=True)
     raw_overrides_allowed = True
-    #: The paper's names of the physical parameters (``with_params`` re-derives from them;
-    #: ``waveform`` is not a number, so not swept).
-    physical_names = tuple(n for n in PAPER_NAMES if n != "waveform")
+    #: The paper's names of the physical parameters, declared once
+    #: (:data:`~geardyn.models.params.PAPER_INPUTS`): ``with_params`` re-derives the
+    #: coefficients from every one of them, a sweep takes the swept ones (not the count ``N``
+    #: nor the choice ``waveform``).
+    input_declarations = PAPER_INPUTS
+    physical_names = rederived(PAPER_INPUTS)
 
     def __init__(
         self,
@@ -313,13 +317,30 @@ class CATTDevice(Model):
         return co
 
     def lane_params(self, name: str, values: Sequence[float] | np.ndarray) -> np.ndarray:
+        """Coefficient vectors (lanes x n_params) with ``name`` set to ``values``: a swept
+        paper name re-derives every coefficient (as :meth:`with_params`), another name sets
+        that raw coefficient; ``N`` and ``waveform`` (not swept) are a
+        :class:`~geardyn.errors.ParameterError` naming them."""
+        self._refuse_unswept(name, values)
         values = np.asarray(values, dtype=float).ravel()
         if name in PAPER_NAMES:
             rows = [self.replace(**{name: float(v)}).params for v in values]
             if len({r.size for r in rows}) != 1:
-                raise ValueError(f"sweeping {name!r} changes the model's size; sweep N separately")
+                raise ValueError(f"sweeping {name!r} changes the model's size")
             return np.array(rows)
         return Model.lane_params(self, name, values)
+
+    def param_attrs(self, name: str) -> dict[str, str]:
+        """Attributes of a sweep's axis: a swept paper name's (the name a sweep and
+        ``with_params`` take first: ``units`` the SI unit of its declared kind, ``long_name``
+        its meaning), else a coefficient's (:meth:`Model.param_attrs`); empty for a paper name
+        that is not swept."""
+        declared = by_name(PAPER_INPUTS).get(name)
+        if declared is None:
+            return super().param_attrs(name)
+        if not declared.swept:
+            return {}
+        return {"units": str(declared.axis_unit), "long_name": declared.meaning}
 
     # ------------------------------------------------------------------ linear analysis
     def other_frequencies(self, P: np.ndarray) -> np.ndarray:

@@ -24,6 +24,7 @@ from pydantic import (
     model_validator,
 )
 
+from geardyn.core.inputs import PhysicalInput
 from geardyn.errors import ParameterError, UnknownParameterError
 from geardyn.units import to_si
 
@@ -215,34 +216,71 @@ class Loads(BaseModel):
     Lambda: Ratio = Field(0.0, description="load fluctuation frequency omega_l/omega_n")
 
 
+def _paper(name: str, kind: str, meaning: str, paths: tuple[tuple[str, ...], ...],
+           **kw: Any) -> tuple[PhysicalInput, tuple[tuple[str, ...], ...]]:
+    """One of the paper's names: its declaration (a keyword of :meth:`PlanetaryParams.replace`
+    and of a study's ``[params.changes]``, default the device's value) and the field paths it
+    sets."""
+    return PhysicalInput(name, kind, meaning, None, of="replace", **kw), paths
+
+
+_SQ, _PQ = ("sun_mesh",), ("planet_mesh",)
+#: The paper's names, declared once: each a physical input with the field paths it sets.
+_PAPER = (
+    _paper("xi1", "dimensionless", "damping ratio of the sun-planet meshes",
+           (_SQ + ("damping_ratio",),), swept=True, explore=True),
+    _paper("xi2", "dimensionless", "damping ratio of the planet-planet meshes",
+           (_PQ + ("damping_ratio",),), swept=True, explore=True),
+    _paper("xi", "dimensionless", "damping ratio of both meshes",
+           (_SQ + ("damping_ratio",), _PQ + ("damping_ratio",)), swept=True),
+    _paper("backlash", "length", "backlash half-width b of both meshes [m]",
+           (_SQ + ("backlash",), _PQ + ("backlash",)), swept=True, explore=True),
+    _paper("b_sq", "length", "backlash half-width of the sun-planet meshes [m]",
+           (_SQ + ("backlash",),), swept=True),
+    _paper("b_pq", "length", "backlash half-width of the planet-planet meshes [m]",
+           (_PQ + ("backlash",),), swept=True),
+    _paper("error", "length", "meshing error amplitude E of both meshes [m]",
+           (_SQ + ("error",), _PQ + ("error",)), swept=True, explore=True),
+    _paper("E_sq", "length", "meshing error amplitude of the sun-planet meshes [m]",
+           (_SQ + ("error",),), swept=True),
+    _paper("E_pq", "length", "meshing error amplitude of the planet-planet meshes [m]",
+           (_PQ + ("error",),), swept=True),
+    _paper("Km_sq", "stiffness", "mean stiffness of the sun-planet meshes [N/m]",
+           (_SQ + ("mean_stiffness",),), swept=True),
+    _paper("Km_pq", "stiffness", "mean stiffness of the planet-planet meshes [N/m]",
+           (_PQ + ("mean_stiffness",),), swept=True),
+    _paper("Ka", "stiffness", "alternating stiffness Ka of both meshes [N/m]",
+           (_SQ + ("stiffness_amplitude",), _PQ + ("stiffness_amplitude",)), swept=True),
+    _paper("Ka_sq", "stiffness", "alternating stiffness of the sun-planet meshes [N/m]",
+           (_SQ + ("stiffness_amplitude",),), swept=True),
+    _paper("Ka_pq", "stiffness", "alternating stiffness of the planet-planet meshes [N/m]",
+           (_PQ + ("stiffness_amplitude",),), swept=True),
+    _paper("waveform", "choice", "shape of both meshes' stiffness fluctuation",
+           (_SQ + ("waveform",), _PQ + ("waveform",)), choices=("sine", "rectangular")),
+    _paper("T_D", "torque", "input torque on the carrier [N m]", (("loads", "T_D"),),
+           swept=True),
+    _paper("A1", "torque", "mean load torque on each outside planet [N m]",
+           (("loads", "A1"),), swept=True),
+    _paper("A2", "torque", "mean load torque on the carrier [N m]", (("loads", "A2"),),
+           swept=True),
+    _paper("B1", "torque", "fluctuating part of the load torque T_L1 [N m]",
+           (("loads", "B1"),), swept=True, explore=True),
+    _paper("B2", "torque", "fluctuating part of the load torque T_L2 [N m]",
+           (("loads", "B2"),), swept=True),
+    _paper("psi1", "angle", "phase of T_L1 [rad]", (("loads", "psi1"),), swept=True),
+    _paper("psi2", "angle", "phase of T_L2 [rad]", (("loads", "psi2"),), swept=True),
+    _paper("Lambda", "dimensionless", "load fluctuation frequency omega_l / omega_n",
+           (("loads", "Lambda"),), swept=True, explore=True),
+    _paper("N", "count", "number of planet sets", (("n_planets",),)),
+    _paper("b_c", "length", "nominal displacement b_c [m]", (("b_c",),), swept=True),
+)
+#: The device's physical inputs by the paper's symbols (:class:`PhysicalInput`), declared once:
+#: ``CATTDevice.with_params`` re-derives the coefficients from them, a sweep takes the swept ones
+#: (not the count N nor the choice waveform; their axes in the declared kinds' SI units) and
+#: the explorer offers the ``explore`` ones.
+PAPER_INPUTS: tuple[PhysicalInput, ...] = tuple(i for i, _ in _PAPER)
 #: Names a user may use to change parameters (the paper's symbols), mapped to field paths.
-PAPER_NAMES: dict[str, tuple[tuple[str, ...], ...]] = {
-    "xi1": (("sun_mesh", "damping_ratio"),),
-    "xi2": (("planet_mesh", "damping_ratio"),),
-    "xi": (("sun_mesh", "damping_ratio"), ("planet_mesh", "damping_ratio")),
-    "backlash": (("sun_mesh", "backlash"), ("planet_mesh", "backlash")),
-    "b_sq": (("sun_mesh", "backlash"),),
-    "b_pq": (("planet_mesh", "backlash"),),
-    "error": (("sun_mesh", "error"), ("planet_mesh", "error")),
-    "E_sq": (("sun_mesh", "error"),),
-    "E_pq": (("planet_mesh", "error"),),
-    "Km_sq": (("sun_mesh", "mean_stiffness"),),
-    "Km_pq": (("planet_mesh", "mean_stiffness"),),
-    "Ka": (("sun_mesh", "stiffness_amplitude"), ("planet_mesh", "stiffness_amplitude")),
-    "Ka_sq": (("sun_mesh", "stiffness_amplitude"),),
-    "Ka_pq": (("planet_mesh", "stiffness_amplitude"),),
-    "waveform": (("sun_mesh", "waveform"), ("planet_mesh", "waveform")),
-    "T_D": (("loads", "T_D"),),
-    "A1": (("loads", "A1"),),
-    "A2": (("loads", "A2"),),
-    "B1": (("loads", "B1"),),
-    "B2": (("loads", "B2"),),
-    "psi1": (("loads", "psi1"),),
-    "psi2": (("loads", "psi2"),),
-    "Lambda": (("loads", "Lambda"),),
-    "N": (("n_planets",),),
-    "b_c": (("b_c",),),
-}
+PAPER_NAMES: dict[str, tuple[tuple[str, ...], ...]] = {i.name: paths for i, paths in _PAPER}
 
 
 class PlanetaryParams(BaseModel):

@@ -180,11 +180,12 @@ INPUTS: tuple[PhysicalInput, ...] = (
     PhysicalInput("ring_mesh_phase", "angle", "ring-planet mesh phases [rad of the mesh "
                   "cycle], one or one per planet", 0.0, form="per_planet", swept=True),
     PhysicalInput("sun_backlash", "length", "backlash half-width b of the sun-planet meshes "
-                  "[m], one or one per planet", 0.0, form="per_planet", swept=True),
+                  "[m], one or one per planet", 0.0, form="per_planet", swept=True, explore=True),
     PhysicalInput("ring_backlash", "length", "backlash half-width b of the ring-planet meshes "
-                  "[m], one or one per planet", 0.0, form="per_planet", swept=True),
+                  "[m], one or one per planet", 0.0, form="per_planet", swept=True, explore=True),
     PhysicalInput("sun_mesh_error", "length", "transmission error amplitude of the sun-planet "
-                  "meshes [m], one or one per planet", 0.0, form="per_planet", swept=True),
+                  "meshes [m], one or one per planet", 0.0, form="per_planet", swept=True,
+                  explore=True),
     PhysicalInput("ring_mesh_error", "length", "transmission error amplitude of the "
                   "ring-planet meshes [m], one or one per planet", 0.0, form="per_planet",
                   swept=True),
@@ -193,7 +194,8 @@ INPUTS: tuple[PhysicalInput, ...] = (
     PhysicalInput("ring_error_phase", "angle", "transmission error phase of the ring-planet "
                   "meshes [rad], one or one per planet", 0.0, form="per_planet", swept=True),
     PhysicalInput("mesh_damping", "dimensionless", "mesh damping ratio zeta_m (c_m = 2 zeta_m "
-                  "sqrt(k_m m_e)), one or one per planet", 0.05, form="per_planet", swept=True),
+                  "sqrt(k_m m_e)), one or one per planet", 0.05, form="per_planet", swept=True,
+                  explore=True),
     PhysicalInput("modal_damping", "number", "modal damping ratio of every mode of the linear "
                   "model at mean stiffness", 0.0, swept=True),
     PhysicalInput("sun_torque", "torque", "mean torque on the sun [N m] (needs sun.radius)",
@@ -203,7 +205,8 @@ INPUTS: tuple[PhysicalInput, ...] = (
     PhysicalInput("carrier_torque", "torque", "mean torque on the carrier [N m] (needs "
                   "carrier.radius)", 0.0, swept=True),
     PhysicalInput("torque_fluctuation", "number", "relative amplitude A of the sun torque's "
-                  "fluctuation T_s (1 + A sin(order Omega tau + phase))", 0.0, swept=True),
+                  "fluctuation T_s (1 + A sin(order Omega tau + phase))", 0.0, swept=True,
+                  explore=True),
     PhysicalInput("torque_order", "number", "order of the sun torque's fluctuation (in "
                   "forcing frequencies Omega)", 1.0, swept=True),
     PhysicalInput("torque_phase", "angle", "phase of the sun torque's fluctuation [rad]", 0.0,

@@ -62,7 +62,9 @@ from geardyn.gears.potential_energy import (
 )
 from geardyn.models.spur_pair_coefficients import (
     HEADER,
+    INPUTS,
     PERIODS,
+    PHYSICAL_NAMES,
     SPEED_UNITS,
     STIFFNESS_FORMS,
     UNIT_KINDS,
@@ -236,7 +238,10 @@ class SpurPair(Model):
                                 fault_dataset=FaultDatasetInputs(
                                     "speed", "torque", "mesh_force", speed_unit=None,
                                     stiffness_error=True))
-    physical_names = ("speed",)
+    input_declarations = INPUTS
+    #: ``speed`` (it re-derives Omega); the other swept inputs are coefficients of their names
+    #: (:data:`~geardyn.models.spur_pair_coefficients.PHYSICAL_NAMES`).
+    physical_names = PHYSICAL_NAMES
 
     def __init__(self, mesh: GearMesh, stiffness: xr.Dataset, *, speed: object,
                  torque: object, inertia: Sequence[object] | None = None, zeta: object = 0.05,

@@ -9,7 +9,7 @@ import math
 
 from geardyn.core.coefficients import Coefficient, CoefficientBlock
 from geardyn.core.inputs import REQUIRED as REQUIRED  # the default of a required input
-from geardyn.core.inputs import PhysicalInput
+from geardyn.core.inputs import PhysicalInput, rederived, unit_kind
 
 _GEOMETRY = ("mesh_stiffness",)
 
@@ -82,27 +82,29 @@ SPEED_UNITS: dict[str, float] = {"rad/s": 1.0, "rpm": 2.0 * math.pi / 60.0, "Hz"
 PERIODS = ("pinion", "wheel", "mesh")
 #: The physical inputs of :class:`~geardyn.SpurPair` (and of ``from_geometry``) beyond the gears
 #: (:class:`~geardyn.core.inputs.PhysicalInput`), declared once: its ``with_params`` reads unit
-#: strings by their kinds, and the ``[params]`` table of a ``spur_pair`` study is generated from
-#: them (:func:`geardyn.io.toml.spur_pair_table`).
+#: strings by their kinds, a sweep takes the swept ones (``speed`` re-derives Omega; the others
+#: are the header's coefficients of their names), the explorer offers the ``explore`` ones, and
+#: the ``[params]`` table of a ``spur_pair`` study is generated from them
+#: (:func:`geardyn.io.toml.spur_pair_table`).
 INPUTS: tuple[PhysicalInput, ...] = (
     PhysicalInput("speed", "frequency", "pinion speed: a number in speed_unit, or a unit "
-                  "string (\"3000 rpm\")", minimum=0.0),
+                  "string (\"3000 rpm\")", minimum=0.0, swept=True),
     PhysicalInput("torque", "torque", "pinion torque [N m] (> 0 loads the drive flanks)",
-                  coefficient=HEADER["torque"]),
+                  coefficient=HEADER["torque"], swept=True, explore=True),
     PhysicalInput("inertia", "pair", "(I1, I2) of pinion and wheel [kg m^2]; default solid "
                   "steel discs of the reference radius, face width and bore", None,
                   unit_kind="inertia"),
     PhysicalInput("zeta", "dimensionless", HEADER["zeta"].meaning, 0.05,
-                  coefficient=HEADER["zeta"]),
+                  coefficient=HEADER["zeta"], swept=True, explore=True),
     PhysicalInput("backlash", "length", "backlash half-width b along the line of action [m]; "
                   "default half the mesh's backlash on the line of action", None,
-                  coefficient=HEADER["backlash"]),
+                  coefficient=HEADER["backlash"], swept=True, explore=True),
     PhysicalInput("error", "length", HEADER["error"].meaning + " [m]", 0.0,
-                  coefficient=HEADER["error"]),
+                  coefficient=HEADER["error"], swept=True, explore=True),
     PhysicalInput("error_phase", "angle", HEADER["error_phase"].meaning + " [rad]", 0.0,
-                  coefficient=HEADER["error_phase"]),
+                  coefficient=HEADER["error_phase"], swept=True),
     PhysicalInput("harmonics", "count", "harmonics of Omega in each flank's stiffness series "
-                  "(default 16 per mesh cycle of the period)", None, minimum=1),
+                  "(default 16 per mesh cycle of the period)", None, minimum=1, explore=True),
     PhysicalInput("stiffness_form", "choice", "how the kernels evaluate the stiffness: its "
                   "Fourier series (\"fourier\") or its table, linear between the angles "
                   "(\"table\")", "fourier", choices=("fourier", "table")),
@@ -112,10 +114,13 @@ INPUTS: tuple[PhysicalInput, ...] = (
     PhysicalInput("speed_unit", "choice", "unit of a plain number of speed, of a sweep of "
                   "speed and of its axis", "rad/s", choices=tuple(SPEED_UNITS)),
 )
-#: The unit kind of each input that takes a unit string (``with_params``), Omega and mass too.
-UNIT_KINDS: dict[str, str] = {"Omega": "frequency", "mass": "mass", **{
-    i.name: i.kind for i in INPUTS if i.kind in ("frequency", "torque", "dimensionless",
-                                                 "length", "angle")}}
+#: The inputs the coefficients are re-derived from (:func:`~geardyn.core.inputs.rederived`):
+#: ``SpurPair.physical_names``.
+PHYSICAL_NAMES: tuple[str, ...] = rederived(INPUTS)
+#: The unit kind of each input coefficient of the header (Omega, mass and the inputs set
+#: directly), by its declared unit: ``with_params`` reads unit strings of that kind.
+UNIT_KINDS: dict[str, str] = {c.name: unit_kind(c.unit) for c in HEADER.entries
+                              if c.kind == "input"}
 #: The constructor's arguments that are no physical input: the structure the model is built on
 #: (the gear mesh of ``[gears]`` and its stiffness table).
 BUILT_ON = ("mesh", "stiffness")

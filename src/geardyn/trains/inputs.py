@@ -25,15 +25,15 @@ INPUTS: tuple[PhysicalInput, ...] = (
     PhysicalInput("load", "name", "a body whose torque balances the others on the train's "
                   "rigid-body mode (the output load for a given input torque)", None),
     PhysicalInput("backlash", "length", "backlash half-width b [m] of every mesh, or per "
-                  "mesh", 0.0, form="per_mesh", swept=True),
+                  "mesh", 0.0, form="per_mesh", swept=True, explore=True),
     PhysicalInput("mesh_damping", "dimensionless", "damping ratio zeta_m of every mesh, or "
                   "per mesh (added to the mesh element's own damping)", 0.0, form="per_mesh",
-                  swept=True),
+                  swept=True, explore=True),
     PhysicalInput("modal_damping", "number", "modal damping ratio of every mode of the linear "
-                  "model at mean stiffness", 0.0, swept=True),
+                  "model at mean stiffness", 0.0, swept=True, explore=True),
     PhysicalInput("stiffness_fluctuation", "dimensionless", "relative amplitude of the "
                   "stiffness fluctuation of every mesh, or per mesh", 0.0, form="per_mesh",
-                  swept=True),
+                  swept=True, explore=True),
     PhysicalInput("waveform", "choice", "shape of the stiffness fluctuation: \"sine\" or "
                   "\"rectangular\" (contact_ratio, harmonics)", "sine", choices=WAVEFORMS),
     PhysicalInput("contact_ratio", "number", "contact ratio of the rectangular waveform", 1.6,
@@ -43,11 +43,12 @@ INPUTS: tuple[PhysicalInput, ...] = (
                   "default: from the geometry where every meshing gear has it, else 0", None,
                   form="per_mesh", swept=True),
     PhysicalInput("mesh_error", "length", "transmission error amplitude E_m [m] of every "
-                  "mesh, or per mesh", 0.0, form="per_mesh", swept=True),
+                  "mesh, or per mesh", 0.0, form="per_mesh", swept=True, explore=True),
     PhysicalInput("error_phase", "angle", "transmission error phase [rad] of every mesh, or "
                   "per mesh", 0.0, form="per_mesh", swept=True),
     PhysicalInput("torque_fluctuation", "number", "relative amplitude A of the driven body's "
-                  "torque fluctuation T (1 + A sin(order Omega tau + phase))", 0.0, swept=True),
+                  "torque fluctuation T (1 + A sin(order Omega tau + phase))", 0.0, swept=True,
+                  explore=True),
     PhysicalInput("torque_order", "number", "order of the driven body's torque fluctuation",
                   1.0, swept=True),
     PhysicalInput("torque_phase", "angle", "phase of the driven body's torque fluctuation "
