@@ -208,17 +208,20 @@ def natural_frequencies(model: Model) -> np.ndarray | None:
     """The model's linear natural frequencies (mean stiffness, no backlash) in the units of its
     Omega (rad per model time unit), zeros dropped; None where it has none. The planetary
     sets and trains give Hz over the time scale omega_0 (tau = omega_0 t); the others give
-    rad per time unit; a model that knows only its fastest one gives that."""
-    fn = getattr(model, "natural_frequencies", None)
+    rad per time unit (the unit each declares, ``capabilities.natural_frequencies``); a model
+    that knows only its fastest one gives that."""
+    unit = model.capabilities.natural_frequencies
     f: np.ndarray | None = None
-    if fn is not None:
+    if unit:
         try:
-            f = np.asarray(fn(), dtype=float).ravel()
+            f = np.asarray(model.natural_frequencies(),  # type: ignore[attr-defined]
+                           dtype=float).ravel()
         except (ValueError, np.linalg.LinAlgError):
             f = None
-        scale = getattr(model, "time_scale", None)
-        if f is not None and scale is not None:
-            f = 2.0 * math.pi * f / float(scale)
+        if f is not None and unit == "Hz":  # rad/s; per time unit 1 / omega_0 where scaled
+            f = 2.0 * math.pi * f
+            if model.dimensionless_time:
+                f = f / float(model.time_scale)  # type: ignore[attr-defined]
     if f is None:
         w = np.asarray(model.fastest_natural_frequency(), dtype=float).ravel()
         f = w if w.size and np.all(np.isfinite(w)) else None

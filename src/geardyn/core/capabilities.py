@@ -100,7 +100,8 @@ class Capabilities:
         The unit of ``model.natural_frequencies()``, the linearised model's natural
         frequencies (mean stiffness, no backlash), ascending: ``"rad/time"`` (rad per model
         time unit: rad/s for a model in seconds, omega / omega_n for a dimensionless one) or
-        ``"Hz"``; empty: the model gives none.
+        ``"Hz"`` (a model of dimensionless time that gives Hz has ``time_scale``, omega_0
+        [rad/s], its time unit 1 / omega_0); empty: the model gives none.
     ``fault_dataset``
         The model's inputs and sensor signal for a labelled fault dataset
         (:class:`FaultDatasetInputs`; None: it makes none). A model whose time is
