@@ -329,6 +329,45 @@ def test_natural_frequencies_are_declared_with_their_unit():
         Capabilities(natural_frequencies="rpm")
 
 
+class _StiffnessLike(geardyn.UserModel):
+    """A user model declaring its natural frequencies in rad per time unit, with a time_scale
+    and stiffness-table look-alikes (what the old probes looked for), no stiffness tables."""
+
+    capabilities = Capabilities(natural_frequencies="rad/time")
+    time_scale = 50.0
+    mesh_tables = ("a table",)
+    n_harmonics = 3
+
+    def natural_frequencies(self):
+        return np.array([2.0, 5.0])
+
+    def period_stiffness(self, flank="drive"):
+        raise AssertionError("probed")
+
+
+def test_runup_and_the_stiffness_panel_read_the_declarations():
+    """The run-up's natural frequencies are the declared method's in its declared unit (a
+    time_scale attribute does not rescale rad per time unit; Hz over the planetary set's
+    time_scale is 2 pi f / omega_0); the stiffness panel needs declared stiffness tables."""
+    from geardyn.analysis.runup import natural_frequencies
+    from geardyn.explore.compute import stiffness_view
+
+    model = _StiffnessLike(user_model().kernel.rhs, n_states=2, params=[1.0, 0.1],
+                           param_names=("Omega", "zeta"))
+    np.testing.assert_array_equal(natural_frequencies(model), [2.0, 5.0])
+    assert stiffness_view(model) is None
+    assert geardyn.SpurPair.capabilities.stiffness_tables == "pair"
+    assert geardyn.PlanetaryGearSet.capabilities.stiffness_tables == "meshes"
+    with pytest.raises(ValueError, match="stiffness_tables='table'"):
+        Capabilities(stiffness_tables="table")
+    from test_swept_inputs import _planetary
+
+    lp = _planetary()
+    hz = np.sort(np.asarray(lp.natural_frequencies(), dtype=float))
+    expected = 2.0 * math.pi * hz[hz > 1e-9 * hz.max()] / lp.time_scale
+    np.testing.assert_allclose(natural_frequencies(lp), np.unique(expected), rtol=1e-15)
+
+
 # ------------------------------------------------------------------------------ vocabularies
 def test_explorer_and_cli_read_the_declared_vocabulary(tmp_path):
     from typer.testing import CliRunner

@@ -102,6 +102,14 @@ class Capabilities:
         time unit: rad/s for a model in seconds, omega / omega_n for a dimensionless one) or
         ``"Hz"`` (a model of dimensionless time that gives Hz has ``time_scale``, omega_0
         [rad/s], its time unit 1 / omega_0); empty: the model gives none.
+    ``stiffness_tables``
+        The potential-energy stiffness tables the model carries (the explorer's stiffness
+        panel, :func:`geardyn.explore.compute.stiffness_view`): ``"pair"``, one mesh
+        (``model.stiffness`` a :func:`~geardyn.gears.potential_energy_stiffness` table over the
+        forcing period, ``model.table_phase()``, ``model.stiffness_at(theta, flank)``,
+        ``model.n_harmonics``); ``"meshes"``, one per mesh where the instance was built from
+        them (``model.mesh_tables`` not None, ``model.period_stiffness(flank)``,
+        ``model.faults``, ``model.fourier``); empty: none.
     ``fault_dataset``
         The model's inputs and sensor signal for a labelled fault dataset
         (:class:`FaultDatasetInputs`; None: it makes none). A model whose time is
@@ -117,6 +125,7 @@ class Capabilities:
     dynamic_factor: bool = False
     natural_frequencies: str = ""
     fault_dataset: FaultDatasetInputs | None = None
+    stiffness_tables: str = ""
 
     def __post_init__(self) -> None:
         if self.dynamic_factor and not (self.mesh_forces and self.natural_frequencies):
@@ -124,6 +133,9 @@ class Capabilities:
         if self.natural_frequencies not in NATURAL_FREQUENCY_UNITS:
             raise ValueError(f"natural_frequencies={self.natural_frequencies!r}: one of "
                              f"{NATURAL_FREQUENCY_UNITS}")
+        if self.stiffness_tables not in STIFFNESS_TABLES:
+            raise ValueError(f"stiffness_tables={self.stiffness_tables!r}: one of "
+                             f"{STIFFNESS_TABLES}")
         ds = self.fault_dataset
         if ds is not None and ds.signal == "mesh_force" and not self.mesh_forces:
             raise ValueError("fault_dataset's mesh_force signal needs mesh_forces")
@@ -135,3 +147,5 @@ DYNAMIC_FACTOR_MEMBERS = ("input_torque", "at_input_torque", "kv_groups", "input
 
 #: The units a model's ``natural_frequencies()`` may be declared in ("" none).
 NATURAL_FREQUENCY_UNITS = ("", "rad/time", "Hz")
+#: The stiffness tables a model may declare it carries ("" none).
+STIFFNESS_TABLES = ("", "pair", "meshes")

@@ -236,12 +236,14 @@ class StiffnessView:
 
 
 def stiffness_view(model: Any) -> StiffnessView | None:
-    """The stiffness panel's arrays of a model that carries potential-energy stiffness tables:
-    a :class:`~geardyn.SpurPair` (its ``stiffness`` table and ``stiffness_at`` series at
-    ``table_phase()``; one mesh, ``"mesh"``) or a :class:`~geardyn.PlanetaryGearSet` built with
-    them (``period_stiffness``; a faulty mesh's table spans the faulty gear's revolution);
-    None for a model without them."""
-    if getattr(model, "mesh_tables", None) is not None and hasattr(model, "period_stiffness"):
+    """The stiffness panel's arrays of a model that carries potential-energy stiffness tables,
+    as its class declares (``capabilities.stiffness_tables``): a :class:`~geardyn.SpurPair`'s
+    (``"pair"``: its ``stiffness`` table and ``stiffness_at`` series at ``table_phase()``; one
+    mesh, ``"mesh"``) or a :class:`~geardyn.PlanetaryGearSet`'s built with them (``"meshes"``:
+    ``period_stiffness``; a faulty mesh's table spans the faulty gear's revolution); None for a
+    model without them."""
+    tables = model.capabilities.stiffness_tables
+    if tables == "meshes" and model.mesh_tables is not None:
         drive, coast = model.period_stiffness("drive"), model.period_stiffness("coast")
         faults = model.faults
         faulty = () if faults is None else faults.meshes(model.n_planets)
@@ -249,10 +251,9 @@ def stiffness_view(model: Any) -> StiffnessView | None:
                   for name, d, c in zip(model.mesh_names, drive, coast, strict=True)]
         return StiffnessView(meshes, model.fourier.shape[1] // 2,
                              "none" if faults is None else faults.describe())
-    table = getattr(model, "stiffness", None)
-    if not isinstance(table, xr.Dataset) or not {"mesh_stiffness", "mesh_stiffness_coast"} <= set(
-            table.data_vars) or not hasattr(model, "stiffness_at"):
+    if tables != "pair":
         return None
+    table = model.stiffness
     theta = model.table_phase()
     faults = str(table.attrs.get("faults", "none"))
     mesh = MeshStiffness(
@@ -261,5 +262,5 @@ def stiffness_view(model: Any) -> StiffnessView | None:
         np.asarray(table["mesh_stiffness_coast"].values, dtype=float),
         model.stiffness_at(theta, "drive"), model.stiffness_at(theta, "coast"),
         faults != "none")
-    return StiffnessView([mesh], int(getattr(model, "n_harmonics", 0)), faults)
+    return StiffnessView([mesh], int(model.n_harmonics), faults)
 

@@ -425,6 +425,7 @@ class PlanetaryGearSet(Model):
     observable_units = "N"
     capabilities = Capabilities(physical_inputs=True, physical_axes=True, mesh_forces=True,
                                 dynamic_factor=True, natural_frequencies="Hz",
+                                stiffness_tables="meshes",
                                 fault_dataset=FaultDatasetInputs(
                                     "input_speed", "sun_torque", "ring_sensor",
                                     stiffness_error=True))

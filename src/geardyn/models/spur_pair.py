@@ -234,7 +234,7 @@ class SpurPair(Model):
     observable_units = "N"
     meshes = (("mesh", 0, 1),)
     capabilities = Capabilities(mesh_forces=True, physical_axes=True, dynamic_factor=True,
-                                natural_frequencies="rad/time",
+                                natural_frequencies="rad/time", stiffness_tables="pair",
                                 fault_dataset=FaultDatasetInputs(
                                     "speed", "torque", "mesh_force", speed_unit=None,
                                     stiffness_error=True))
