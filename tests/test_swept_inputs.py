@@ -204,6 +204,18 @@ def test_every_declared_swept_input_of_the_catt_device_sweeps_in_its_unit():
     assert model.param_attrs("b_sq")["units"] == "m" and model.param_attrs("xi1")["units"] == "1"
 
 
+def test_a_sweep_of_the_catt_devices_planet_count_is_deprecated():
+    """N is a count (not swept, not in physical_names): its sweep of the reduced form warns
+    and gives each lane the device built with that many planet sets."""
+    model = _catt()
+    assert "N" not in model.physical_names and not by_name(model.input_declarations)["N"].swept
+    with pytest.warns(DeprecationWarning, match="sweeping N"):
+        P = model.lane_params("N", [3.0, 5.0])
+    for row, n in zip(P, (3, 5), strict=True):
+        np.testing.assert_array_equal(row, model.with_params(N=n).params)
+    assert not np.array_equal(P[0], P[1])
+
+
 def _others(model) -> list[str]:
     """The declared inputs the model was built with that a sweep does not take."""
     given = getattr(model, "inputs", None)
@@ -215,7 +227,7 @@ def _others(model) -> list[str]:
 REFUSED = {"planetary": {"time_scale", "length_scale", "harmonics", "waveform"},
            "train": {"time_scale", "length_scale", "harmonics", "waveform"},
            "spur_pair": {"inertia", "harmonics", "stiffness_form", "period", "speed_unit"},
-           "catt": {"N", "waveform"}}
+           "catt": {"waveform"}}
 
 
 @pytest.mark.parametrize(("kind", "build"), [("planetary", _planetary), ("train", _train),
@@ -224,7 +236,7 @@ def test_every_other_declared_input_is_refused_by_a_sweep_naming_it(kind, build)
     """Counts, choices, flags, names, tables, lists and the scales: a sweep is a
     ParameterError naming the input, with one value or several; no unit on its axis."""
     model = build()
-    others = _others(model)
+    others = [n for n in _others(model) if not (kind == "catt" and n == "N")]
     assert REFUSED[kind] <= set(others)
     for name in others:
         for values in ([1.0], [1.0, 2.0]):

@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import functools
 import math
+import warnings
 from collections.abc import Sequence
 
 import numpy as np
@@ -319,9 +320,16 @@ class CATTDevice(Model):
     def lane_params(self, name: str, values: Sequence[float] | np.ndarray) -> np.ndarray:
         """Coefficient vectors (lanes x n_params) with ``name`` set to ``values``: a swept
         paper name re-derives every coefficient (as :meth:`with_params`), another name sets
-        that raw coefficient; ``N`` and ``waveform`` (not swept) are a
-        :class:`~geardyn.errors.ParameterError` naming them."""
-        self._refuse_unswept(name, values)
+        that raw coefficient; ``waveform`` (not swept) is a
+        :class:`~geardyn.errors.ParameterError` naming it. ``N``, a count, is not swept either:
+        a sweep of it (the reduced form's lanes, whose size N does not change) is deprecated
+        (a DeprecationWarning) and still computed."""
+        if name == "N":
+            warnings.warn("sweeping N (a count, not a swept input of CATTDevice) is deprecated:"
+                          " build one model per number of planet sets", DeprecationWarning,
+                          stacklevel=2)
+        else:
+            self._refuse_unswept(name, values)
         values = np.asarray(values, dtype=float).ravel()
         if name in PAPER_NAMES:
             rows = [self.replace(**{name: float(v)}).params for v in values]

@@ -276,8 +276,8 @@ _PAPER = (
 )
 #: The device's physical inputs by the paper's symbols (:class:`PhysicalInput`), declared once:
 #: ``CATTDevice.with_params`` re-derives the coefficients from them, a sweep takes the swept ones
-#: (not the count N nor the choice waveform; their axes in the declared kinds' SI units) and
-#: the explorer offers the ``explore`` ones.
+#: (their axes in the declared kinds' SI units; not the choice waveform, nor the count N, whose
+#: sweep is deprecated) and the explorer offers the ``explore`` ones.
 PAPER_INPUTS: tuple[PhysicalInput, ...] = tuple(i for i, _ in _PAPER)
 #: Names a user may use to change parameters (the paper's symbols), mapped to field paths.
 PAPER_NAMES: dict[str, tuple[tuple[str, ...], ...]] = {i.name: paths for i, paths in _PAPER}
