@@ -169,3 +169,27 @@ def test_quiet_compiles_on_threads_leave_the_filters_as_they_were():
     for th in threads:
         th.join()
     assert warnings.filters == filters
+
+
+def test_helpers_left_running_at_exit_leave_the_filters_as_they_were(monkeypatch):
+    """At exit, a compile helper still running is released unwaited: without a ResourceWarning,
+    and with no warning filter left installed."""
+    import signal
+    import warnings
+
+    from geardyn.solvers import compile_share
+
+    proc = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(60)"])
+    pid = proc.pid
+    monkeypatch.setattr(compile_share, "_STARTED", {("kernels", ("f",)): proc})
+    del proc
+    try:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            filters = list(warnings.filters)
+            compile_share._leave_helpers_running()
+            assert warnings.filters == filters
+        assert not compile_share._STARTED
+        assert not [w for w in caught if issubclass(w.category, ResourceWarning)]
+    finally:
+        os.kill(pid, signal.SIGTERM)
