@@ -54,16 +54,18 @@ def axpy(a, b):
         a[i] = 1.5 * a[i] + b[i]
 """
 
-#: In a fresh interpreter: numba's CPU settings before and after ``import geardyn``, the same
-#: loop compiled by geardyn (argv[1]: the folder of :data:`_GEARDYN_MODULE`) and by plain numba,
-#: whether geardyn's came from the cache, its LLVM IR (when compiled here) and whether its
-#: machine code, as numba's cache file holds it, and plain numba's use zmm registers.
+#: In a fresh interpreter, where numba compiled before geardyn was imported: numba's CPU
+#: settings before and after ``import geardyn``, the same loop compiled by geardyn (argv[1]: the
+#: folder of :data:`_GEARDYN_MODULE`) and by plain numba, whether geardyn's came from the cache,
+#: its LLVM IR (when compiled here) and whether its machine code, as numba's cache file holds
+#: it, and plain numba's use zmm registers.
 _PROBE = """
 import json, shutil, subprocess, sys, tempfile
 import numba
 import numpy as np
 from numba.core import config
 
+numba.njit(lambda x: x + 1)(1)  # numba's CPU target set up before geardyn is imported
 before = (config.CPU_NAME, config.CPU_FEATURES)
 import geardyn
 after_import = (config.CPU_NAME, config.CPU_FEATURES)
@@ -129,11 +131,11 @@ def test_each_mode_names_its_attribute():
 @pytest.mark.parametrize("cpu", [None, INTEL_TUNED])
 @pytest.mark.parametrize("mode", ["512", "256", "native"])
 def test_geardyns_functions_get_the_width_and_nothing_else_does(tmp_path, mode, cpu):
-    """In a fresh interpreter, with this CPU's own tuning and with Intel's (``prefer-256-bit``):
-    ``import geardyn`` leaves numba's CPU settings alone; geardyn's function carries the
-    attribute of the mode; with AVX-512 its machine code has zmm registers at 512 bits, none
-    at 256, and at ``native`` what plain numba's has, and plain numba's code keeps LLVM's
-    choice for the CPU."""
+    """In a fresh interpreter, with this CPU's own tuning and with Intel's (``prefer-256-bit``),
+    numba used before geardyn: ``import geardyn`` leaves numba's CPU settings alone; geardyn's
+    function carries the attribute of the mode; with AVX-512 its machine code has zmm
+    registers at 512 bits, none at 256, and at ``native`` what plain numba's has, and plain
+    numba's code keeps LLVM's choice for the CPU."""
     if cpu and not _has_avx512():
         pytest.skip("the Intel tuning needs an AVX-512 host")
     got = _probe(tmp_path, mode, cpu)
