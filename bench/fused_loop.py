@@ -20,7 +20,8 @@ names combine them. ``--gear-pair``: bench/peers.py's gear pair instead of the p
     .venv/bin/python bench/fused_loop.py [--variants base,nostats,noscreen] [--steps 20000]
                                          [--repeat 9] [--asm]
 
-The vector width is numba's CPU target (``GEARDYN_SIMD_WIDTH``, see ``geardyn._jit_target``).
+The vector width is geardyn's (``GEARDYN_SIMD_WIDTH``, see ``geardyn._jit_target``), the
+driver's too (compiled with the kernels' pipeline).
 """
 
 from __future__ import annotations
@@ -119,8 +120,9 @@ def driver(m):
             flagged += nf
         return flagged
 
-    return nb.njit(_nrt=False, pipeline_class=m._NoAliasCompiler, boundscheck=False,
-                   error_model="numpy", fastmath=m._JIT.get("fastmath", False))(drive)
+    return nb.njit(_nrt=False, pipeline_class=m._JIT_NOALIAS["pipeline_class"],
+                   boundscheck=False, error_model="numpy",
+                   fastmath=m._JIT.get("fastmath", False))(drive)
 
 
 def main() -> None:

@@ -50,9 +50,9 @@ from pathlib import Path
 import numba as nb
 import numpy as np
 
-# first, before this module defines a numba function: geardyn sets numba's CPU target at its
-# import (geardyn._jit_target: 512-bit vectors by default), and a target set up before that is
-# kept, so geardyn's kernels (and the plain ones here) would be built at another width
+# geardyn's kernels get geardyn's vector width (geardyn._jit_target: 512-bit vectors by default)
+# on their own; the plain numba functions here get LLVM's choice for the CPU (256 bits on most
+# Intel server CPUs with AVX-512, 512 on AMD Zen 4 and 5)
 import geardyn  # noqa: E402, I001
 
 OMEGA_RANGE = (0.2, 3.0)

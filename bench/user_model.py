@@ -29,7 +29,7 @@ from pathlib import Path
 import numba as nb
 import numpy as np
 
-import geardyn  # noqa: I001 - first: it sets numba's CPU target
+import geardyn
 from geardyn.solvers.ensemble import run_lanes
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))

@@ -1,7 +1,7 @@
 """``import geardyn`` changes no process-wide setting: no warning filter, no environment
-variable, no numba configuration value (numba's CPU features aside, see :mod:`geardyn._jit_target`
-for why), neither at import nor after a first run (geardyn's compile-time warning filters are
-scoped to its own compiles)."""
+variable, no numba configuration value (numba's CPU name and features included: the kernels'
+vector width is set on geardyn's own functions, :mod:`geardyn._jit_target`), neither at import
+nor after a first run (geardyn's compile-time warning filters are scoped to its own compiles)."""
 
 from __future__ import annotations
 
@@ -64,8 +64,12 @@ print(json.dumps(sorted(m for m in (imported | ran) - before
 """
 
 
+#: The caller's settings a probe starts without: the width and numba's own CPU and cache settings.
+_SETTINGS = ("GEARDYN_SIMD_WIDTH", "NUMBA_CPU_NAME", "NUMBA_CPU_FEATURES", "NUMBA_CACHE_DIR")
+
+
 def _run(code: str, env: dict[str, str], *args: str) -> object:
-    base = {k: v for k, v in os.environ.items() if k != "NUMBA_CACHE_DIR"}
+    base = {k: v for k, v in os.environ.items() if k not in _SETTINGS}
     base["PYTHONPATH"] = os.pathsep.join([str(ROOT / "src"), base.get("PYTHONPATH", "")])
     out = subprocess.run([sys.executable, "-c", code, *args], env={**base, **env},
                          capture_output=True, text=True, timeout=600, check=True)
@@ -91,24 +95,23 @@ def _changes(a: dict, b: dict) -> dict:
 _NONE = {"filters": [], "environ": [], "config": []}
 
 
-def test_import_and_first_run_change_no_global_state():
-    """Default vector width: only numba's CPU features change (the one process-wide numba
-    setting, documented in :mod:`geardyn._jit_target`); warning filters, the environment and
-    every other numba configuration value are as before the import and after a first run."""
-    got = _states({}, "run")
-    expected = {**_NONE, "config": ["CPU_FEATURES"]}
-    assert _changes(got["before"], got["imported"]) == expected
-    assert _changes(got["before"], got["ran"]) == expected
+@pytest.mark.parametrize("width", ["default", "256", "native"])
+def test_import_and_first_run_change_no_global_state(width):
+    """At every vector width (the default 512 bits included): warning filters, the environment
+    and every numba configuration value (CPU name and features too) are as before the import,
+    and after a first run (which compiles or loads kernels)."""
+    env = {} if width == "default" else {"GEARDYN_SIMD_WIDTH": width}
+    got = _states(env, "run" if width == "default" else "import")
+    assert _changes(got["before"], got["imported"]) == _NONE
+    if "ran" in got:
+        assert _changes(got["before"], got["ran"]) == _NONE
 
 
 @pytest.mark.parametrize("cache_var", ["unset", "set"])
-def test_native_width_import_changes_nothing(tmp_path, cache_var):
-    """With ``GEARDYN_SIMD_WIDTH=native`` (numba's own CPU target) ``import geardyn`` changes no
-    warning filter, environment variable or numba configuration value at all, whether or not
-    ``NUMBA_CACHE_DIR`` is set."""
-    env = {"GEARDYN_SIMD_WIDTH": "native"}
-    if cache_var == "set":
-        env["NUMBA_CACHE_DIR"] = str(tmp_path)
+def test_import_changes_nothing_whether_or_not_numbas_cache_is_set(tmp_path, cache_var):
+    """``import geardyn`` changes no warning filter, environment variable or numba
+    configuration value, whether or not ``NUMBA_CACHE_DIR`` is set."""
+    env = {"NUMBA_CACHE_DIR": str(tmp_path)} if cache_var == "set" else {}
     got = _states(env, "import")
     assert _changes(got["before"], got["imported"]) == _NONE
 
@@ -166,3 +169,27 @@ def test_quiet_compiles_on_threads_leave_the_filters_as_they_were():
     for th in threads:
         th.join()
     assert warnings.filters == filters
+
+
+def test_helpers_left_running_at_exit_leave_the_filters_as_they_were(monkeypatch):
+    """At exit, a compile helper still running is released unwaited: without a ResourceWarning,
+    and with no warning filter left installed."""
+    import signal
+    import warnings
+
+    from geardyn.solvers import compile_share
+
+    proc = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(60)"])
+    pid = proc.pid
+    monkeypatch.setattr(compile_share, "_STARTED", {("kernels", ("f",)): proc})
+    del proc
+    try:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            filters = list(warnings.filters)
+            compile_share._leave_helpers_running()
+            assert warnings.filters == filters
+        assert not compile_share._STARTED
+        assert not [w for w in caught if issubclass(w.category, ResourceWarning)]
+    finally:
+        os.kill(pid, signal.SIGTERM)

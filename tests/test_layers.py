@@ -22,8 +22,8 @@ ROOT = Path(geardyn.__file__).resolve().parent
 #: after it. Each entry names the modules (or packages, with everything in them) of the layer.
 LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
     # modules with no geardyn imports: exceptions, unit parsing, the version, file primitives
-    # (atomic writes, attribute encoding), the packaged study files (data only), numba's CPU
-    # target (the kernels' vector width, set up before any kernel is defined), the cache folder
+    # (atomic writes, attribute encoding), the packaged study files (data only), the kernels'
+    # vector width (their compiler pipeline), the cache folder (keyed by that width)
     ("base", ("geardyn._version", "geardyn.errors", "geardyn.files", "geardyn.units",
               "geardyn.studies", "geardyn._jit_target", "geardyn._cache")),
     # the model interface, the kernel source, run settings, the lane plan, the section, status

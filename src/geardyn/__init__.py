@@ -8,8 +8,8 @@ The public API::
     ds = geardyn.simulate(m, omega=1.1, run=geardyn.RunSettings(transient=4000.0, samples=64))
 """
 
-# _cache, then _jit_target, before anything else: the cache locator of geardyn's numba functions
-# and numba's CPU target (their docstrings say why)
+# _cache (with _jit_target) before anything else: the cache locator of geardyn's numba functions,
+# keyed by their vector width (their docstrings say why)
 from geardyn import _cache, _jit_target, gears, testing  # noqa: F401
 from geardyn._version import __version__ as __version__
 from geardyn.analysis.basins import basins

@@ -8,12 +8,14 @@ names.
 
 geardyn changes no numba setting and no environment variable for this: it registers a cache
 locator (:class:`GeardynCacheLocator`, first in numba's list of locators) that answers only for
-geardyn's own functions (files in the geardyn package and the generated kernels) and only while
-``NUMBA_CACHE_DIR`` is unset; every other function keeps numba's own locators. numba picks the
-locator of a function when it is decorated, so this module runs before geardyn defines any numba
-function. Subprocesses that import geardyn (test workers, Dask workers) register it too. Where
-``NUMBA_CACHE_LOCATOR_CLASSES`` is set, numba uses only the classes it names (numba's setting
-wins).
+geardyn's own functions (files in the geardyn package and the generated kernels); every other
+function keeps numba's own locators. Where ``NUMBA_CACHE_DIR`` is set, it keeps geardyn's code
+there, in numba's own layout. The names of the cache files carry the vector width the code was
+compiled at (:func:`geardyn._jit_target.cache_tag`), so that each width has its own entries.
+numba picks the locator of a function when it is decorated, so this module runs before geardyn
+defines any numba function. Subprocesses that import geardyn (test workers, Dask workers)
+register it too. Where ``NUMBA_CACHE_LOCATOR_CLASSES`` is set, numba uses only the classes it
+names (numba's setting wins).
 """
 
 from __future__ import annotations
@@ -23,6 +25,8 @@ from collections.abc import Mapping
 from pathlib import Path
 
 from numba.core import caching, config
+
+from geardyn import _jit_target
 
 #: The environment variable that names geardyn's cache folder.
 ENV = "GEARDYN_CACHE_DIR"
@@ -60,18 +64,23 @@ def is_geardyn_file(py_file: str | os.PathLike[str]) -> bool:
 
 class GeardynCacheLocator(caching.UserProvidedCacheLocator):
     """numba's cache locator for geardyn's functions: the layout of numba's own
-    ``NUMBA_CACHE_DIR`` locator, rooted at :func:`numba_cache_dir`. It declines (numba's other
-    locators decide) for any other file, and where ``NUMBA_CACHE_DIR`` is set."""
+    ``NUMBA_CACHE_DIR`` locator, rooted at numba's ``NUMBA_CACHE_DIR`` where set, else at
+    :func:`numba_cache_dir`; the vector width in the file names. It declines (numba's other
+    locators decide) for any other file."""
 
     def __init__(self, py_func, py_file):  # noqa: ANN001 (numba's signature)
         self._py_file = py_file
         self._lineno = py_func.__code__.co_firstlineno
-        self._cache_path = os.path.join(str(numba_cache_dir()),
+        self._cache_path = os.path.join(config.CACHE_DIR or str(numba_cache_dir()),
                                         self.get_suitable_cache_subpath(py_file))
+
+    def get_disambiguator(self) -> str:
+        """The function's first line and the vector width (``12-simd512``)."""
+        return f"{self._lineno}-{_jit_target.cache_tag()}"
 
     @classmethod
     def from_function(cls, py_func, py_file):  # noqa: ANN001, ANN206 (numba's signature)
-        if config.CACHE_DIR or not is_geardyn_file(py_file):
+        if not is_geardyn_file(py_file):
             return None
         return super(caching.UserProvidedCacheLocator, cls).from_function(py_func, py_file)
 

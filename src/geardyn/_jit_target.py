@@ -1,48 +1,51 @@
-"""The vector width of geardyn's compiled kernels: numba's CPU target, set up at import.
+"""The vector width of geardyn's compiled kernels, set on geardyn's own functions only.
 
 LLVM tunes code for most Intel server CPUs with AVX-512 (Skylake-SP to Emerald Rapids) to
 prefer 256-bit vectors (``prefer-256-bit``, against the clock drop of 512-bit code on the
-first of them), while for AMD Zen 4 it prefers 512 bits. geardyn's fused step loops are
-vector code over lanes and gain from the wider registers (the figures are in
-``bench/RESULTS.md``). The kernels are compiled without fastmath, every lane's
-arithmetic is elementwise, so results are bitwise the same at any width
-(``tests/test_jit_target.py``).
+first of them), while for AMD Zen 4 and Zen 5 it prefers 512 bits. geardyn's fused step loops
+are vector code over lanes and gain from the wider registers (the figures are in
+``bench/RESULTS.md``). The kernels are compiled without fastmath, every lane's arithmetic is
+elementwise, so results are bitwise the same at any width (``tests/test_jit_target.py``).
 
-``GEARDYN_SIMD_WIDTH`` (environment) chooses:
+``GEARDYN_SIMD_WIDTH`` (environment, read at ``import geardyn``) chooses:
 
 ``512`` (default)
-    512-bit vectors where the CPU has them: LLVM's ``prefer-256-bit`` tuning turned off.
+    512-bit vectors where the CPU has them (AVX-512), whatever LLVM's tuning for the CPU.
 ``256``
-    256-bit vectors at most (``prefer-256-bit`` on), on any CPU.
+    256-bit vectors at most, on any CPU.
 ``native``
     LLVM's own choice for this CPU (numba's default).
 
-numba reads its CPU features when its CPU target is first set up (at the first ``njit``
-function defined), so this module runs before geardyn defines any kernel, and it changes
-nothing where that has happened already (numba was used before geardyn was imported), or where
-the user set ``NUMBA_CPU_NAME`` or ``NUMBA_CPU_FEATURES`` (numba's own settings win).
-:data:`APPLIED` says what was done. numba's kernel cache is keyed by the features, so kernels
-compiled at one width are never loaded at another.
+geardyn compiles its numba functions with its own compiler pipeline, :class:`WidthCompiler`
+(numba's ``pipeline_class``, in the ``_JIT`` options of geardyn's modules and generated
+kernels), which puts LLVM's function attribute ``"prefer-vector-width"`` (:data:`ATTRIBUTE`)
+on every function it lowers, their Python and C wrappers included. The x86 backend reads it
+per function, over the CPU's tuning: the width the loop and SLP vectorisers aim at and whether
+512-bit registers are used. A model function inlined into a kernel (a user's own, too) is
+vectorised at the kernel's width. Nothing process-wide is changed: numba's CPU target, its
+configuration and every numba function of other code keep LLVM's choice for the CPU, whether
+numba was used before ``import geardyn`` or not, and numba's own ``NUMBA_CPU_NAME`` /
+``NUMBA_CPU_FEATURES`` still choose the CPU (the attribute only sets the width within it).
 
-This is the one process-wide setting ``import geardyn`` makes (``numba.config.CPU_FEATURES``,
-except with ``native``): numba has one CPU target per process, whose LLVM target machine is
-created once, with these features, when the first function is compiled; a width for geardyn's
-kernels alone would need a numba target of geardyn's own, for every kernel and model function.
-numba functions of other code compiled in the same process get the same tuning (their results
-are bitwise the same at any width, as above, unless compiled with fastmath).
+The width is part of the cache key of geardyn's functions (:func:`cache_tag`, in the name of
+their cache files, :mod:`geardyn._cache`): kernels compiled at one width are never loaded at
+another.
 """
 
 from __future__ import annotations
 
 import os
-import warnings
 from collections.abc import Mapping
+from typing import Any
+
+from numba.core.compiler import Compiler
+from numba.core.compiler_machinery import LoweringPass, register_pass
+from numba.core.typed_passes import AnnotateTypes
 
 #: The environment variable that chooses the vector width.
 ENV = "GEARDYN_SIMD_WIDTH"
-#: Its values (see above) and the tuning each appends to the host's CPU features.
-MODES: dict[str, str | None] = {"512": "-prefer-256-bit", "256": "+prefer-256-bit",
-                                "native": None}
+#: Its values (see above) and the preferred vector width in bits each sets (None: no attribute).
+MODES: dict[str, int | None] = {"512": 512, "256": 256, "native": None}
 DEFAULT = "512"
 
 
@@ -56,33 +59,75 @@ def mode_from_env(environ: Mapping[str, str]) -> str:
     return value
 
 
-def features_for(host_features: str, mode: str) -> str | None:
-    """numba's CPU feature string for ``mode``: the host's features with the mode's tuning
-    appended, or None (leave numba's default) for ``native``."""
-    tuning = MODES[mode]
-    return None if tuning is None else f"{host_features},{tuning}"
+def attribute_for(mode: str) -> str | None:
+    """The LLVM function attribute for ``mode`` (``"prefer-vector-width"="<bits>"``), or None
+    for ``native``."""
+    bits = MODES[mode]
+    return None if bits is None else f'"prefer-vector-width"="{bits}"'
 
 
-def _configure() -> str:
-    """Set numba's CPU features for the requested width; returns what was done (see
-    :data:`APPLIED`)."""
-    mode = mode_from_env(os.environ)
-    if mode == "native":
-        return "native: LLVM's default vector width for this CPU"
-    if os.environ.get("NUMBA_CPU_NAME") or os.environ.get("NUMBA_CPU_FEATURES"):
-        return "numba: NUMBA_CPU_NAME / NUMBA_CPU_FEATURES are set and take precedence"
-    import llvmlite.binding as ll
-    from numba.core import config, registry
-
-    if "_toplevel_target_context" in vars(registry.cpu_target):
-        if ENV in os.environ:
-            warnings.warn(f"{ENV}={os.environ[ENV]} not applied: numba's CPU target was set "
-                          "up before geardyn was imported (import geardyn first)",
-                          RuntimeWarning, stacklevel=3)
-        return "too late: numba's CPU target was set up before geardyn was imported"
-    config.CPU_FEATURES = features_for(ll.get_host_cpu_features().flatten(), mode)
-    return f"{mode}: {MODES[mode]} appended to the host's CPU features"
+#: The mode of this process (``GEARDYN_SIMD_WIDTH`` at import).
+MODE: str = mode_from_env(os.environ)
+#: The attribute geardyn's functions are compiled with (None: ``native``).
+ATTRIBUTE: str | None = attribute_for(MODE)
 
 
-#: What :func:`_configure` did at import (the mode and how it was applied, or why not).
-APPLIED: str = _configure()
+def cache_tag() -> str:
+    """The width's part of the cache key of geardyn's functions (``simd512``, ``simd256``,
+    ``simdnative``)."""
+    return f"simd{MODE}"
+
+
+def _mark(library: Any, attribute: str) -> None:
+    """Make ``library`` (a numba code library) put ``attribute`` on every function defined in
+    an LLVM IR module added to it (the function, its wrappers); other libraries are untouched."""
+    add = library.add_ir_module
+
+    def add_ir_module(ir_module: Any) -> None:
+        for fn in ir_module.functions:
+            if fn.blocks:
+                # llvmlite's FunctionAttributes checks names against LLVM's enum attributes; a
+                # string attribute is printed into the function's definition as it is
+                set.add(fn.attributes, attribute)
+        add(ir_module)
+
+    library.add_ir_module = add_ir_module
+
+
+@register_pass(mutates_CFG=False, analysis_only=False)
+class VectorWidthPass(LoweringPass):
+    """Before numba's lowering: the function's code library (created here, as numba's
+    lowering would) puts :data:`ATTRIBUTE` on the functions lowered into it."""
+
+    _name = "geardyn_vector_width"
+
+    def __init__(self) -> None:
+        LoweringPass.__init__(self)
+
+    def run_pass(self, state: Any) -> bool:
+        if ATTRIBUTE is None:
+            return False
+        if state.library is None:
+            state.library = state.targetctx.codegen().create_library(
+                state.func_id.func_qualname)
+            state.library.enable_object_caching()
+        _mark(state.library, ATTRIBUTE)
+        return True
+
+
+class WidthCompiler(Compiler):
+    """numba's pipeline with :class:`VectorWidthPass` before the lowering: the compiled
+    function gets geardyn's vector width (``pipeline_class=WidthCompiler``)."""
+
+    def define_pipelines(self) -> list:
+        pipelines = super().define_pipelines()
+        for pm in pipelines:
+            if any(pss is AnnotateTypes for pss, _ in pm.passes):  # nopython pipelines
+                pm.add_pass_after(VectorWidthPass, AnnotateTypes)
+                pm.finalize()
+        return pipelines
+
+
+#: What geardyn's kernels are compiled with (the mode and how, for the benchmarks' reports).
+APPLIED: str = (f"{MODE}: {ATTRIBUTE} on geardyn's compiled functions" if ATTRIBUTE else
+                f"{MODE}: LLVM's default vector width for this CPU")

@@ -134,8 +134,9 @@ def adapters(form: OneForm) -> str:
         "from geardyn.core.kernel_source import FORM_QUIET as _ONE_FORM",
         "from geardyn.core.one_form import coefficient_type as _coefficient_type",
         f"_Coef = _coefficient_type({tuple(form.coefficients)!r})",
+        "from geardyn._jit_target import WidthCompiler as _WidthCompiler",
         "_ONE_INLINE = {\"inline\": \"always\", \"error_model\": \"numpy\", "
-        "\"boundscheck\": False}",
+        "\"boundscheck\": False, \"pipeline_class\": _WidthCompiler}",
     ]
     for name, n in (("rhs", ns), ("events", ne), ("observe", no)):
         if name == "rhs" or n > 0:

@@ -25,6 +25,7 @@ import math
 
 import numba as nb
 
+from geardyn._jit_target import WidthCompiler
 from geardyn.core.kernel_source import FORM_GENERAL, FORM_LOAD, FORM_QUIET
 from geardyn.models.derived import CATT_BLOCK, CATT_HEADER, THETA_BLOCK, THETA_HEADER
 from geardyn.models.elements import dead_zone, harmonic_factor, harmonic_factor_lane
@@ -50,7 +51,8 @@ def block_size(n_harmonics: int) -> int:
     return BLOCK_FIXED + 4 * n_harmonics
 
 
-_JIT = {"cache": True, "error_model": "numpy", "boundscheck": False}
+_JIT = {"cache": True, "error_model": "numpy", "boundscheck": False,
+        "pipeline_class": WidthCompiler}
 
 
 # The load fluctuation's sine, as arithmetic (no libm call), so that the sweep kernel's fused

@@ -4,7 +4,10 @@ from __future__ import annotations
 
 import numba as nb
 
-_JIT = {"cache": True, "error_model": "numpy", "boundscheck": False}
+from geardyn._jit_target import WidthCompiler
+
+_JIT = {"cache": True, "error_model": "numpy", "boundscheck": False,
+        "pipeline_class": WidthCompiler}
 
 
 @nb.njit(inline="always", **_JIT)

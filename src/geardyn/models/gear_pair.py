@@ -16,6 +16,7 @@ from types import MappingProxyType
 import numba as nb
 import numpy as np
 
+from geardyn._jit_target import WidthCompiler
 from geardyn.core.capabilities import Capabilities
 from geardyn.core.coefficients import CoefficientLayout
 from geardyn.core.kernel_source import KernelSource
@@ -24,7 +25,8 @@ from geardyn.core.one_form import OneForm
 from geardyn.models.elements import dead_zone
 from geardyn.models.gear_pair_coefficients import GEAR_PAIR
 
-_JIT = {"cache": True, "error_model": "numpy", "boundscheck": False}
+_JIT = {"cache": True, "error_model": "numpy", "boundscheck": False,
+        "pipeline_class": WidthCompiler}
 #: Index constants of the declared coefficients (models/gear_pair_coefficients.py).
 OMEGA, ZETA, KAPPA, FM, FA, PHI_K, PHI_E, BACKLASH, COS_K, SIN_K, COS_E, SIN_E = (
     GEAR_PAIR.offset(n) for n in GEAR_PAIR.names)

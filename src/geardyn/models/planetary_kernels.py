@@ -70,6 +70,7 @@ import math
 import numba as nb
 import numpy as np
 
+from geardyn._jit_target import WidthCompiler
 from geardyn.models.elements import dead_zone, harmonic_factor
 from geardyn.models.planetary_coefficients import HEADER as HEADER_BLOCK
 from geardyn.models.planetary_coefficients import MESH
@@ -105,7 +106,8 @@ OWN_ENTRIES = 2
 #: functions take the block's harmonic counts and steps anew (:func:`_lanes_prepare_harmonics`).
 CT_ROWS = 2
 
-_JIT = {"cache": True, "error_model": "numpy", "boundscheck": False}
+_JIT = {"cache": True, "error_model": "numpy", "boundscheck": False,
+        "pipeline_class": WidthCompiler}
 #: The lane-block functions allocate nothing: compiled without reference counting (the kernels
 #: call them, once per block step, rather than inline them).
 _JIT_LANES = {**_JIT, "_nrt": False}

@@ -9,10 +9,12 @@ import math
 
 import numba as nb
 
+from geardyn._jit_target import WidthCompiler
 from geardyn.core.kernel_source import FORM_GENERAL, KernelSource
 from geardyn.models.spur_pair_coefficients import HEADER
 
-_JIT = {"cache": True, "error_model": "numpy", "boundscheck": False}
+_JIT = {"cache": True, "error_model": "numpy", "boundscheck": False,
+        "pipeline_class": WidthCompiler}
 OMEGA, MASS, TORQUE, ZETA, BACKLASH = (HEADER.offset(n) for n in
                                        ("Omega", "mass", "torque", "zeta", "backlash"))
 ERROR, PHI_E, K_MEAN, COS_E, SIN_E = (HEADER.offset(n) for n in

@@ -38,6 +38,7 @@ from geardyn.core.kernel_source import FORM_GENERAL, FORM_LOAD, FORM_QUIET, LANE
 from geardyn.solvers._parallel import run_workers
 from geardyn.solvers._step_core import (  # CORE-IMPORT
     _JIT,
+    _JIT_NOALIAS,
     BLOCK,
     FUSED,
     GRAZE_BOUND,
@@ -54,7 +55,6 @@ from geardyn.solvers._step_core import (  # CORE-IMPORT
     _keep_start,
     _lane_form,
     _leaves_side,
-    _NoAliasCompiler,
     _observe_l,
     _padded,
     _rhs_columns,
@@ -991,19 +991,19 @@ def _fused_run(form, q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch):
 
 # One compiled copy of the loop per lane form (a second copy in the same function, or a branch
 # around it, stops LLVM's alias analysis).
-@nb.njit(_nrt=False, pipeline_class=_NoAliasCompiler, **_JIT)
+@nb.njit(_nrt=False, **_JIT_NOALIAS)
 def _block_run_form0(q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch):
     """:func:`_fused_run` in the model's general lane form (FORM_GENERAL)."""
     _fused_run(FORM_GENERAL, q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch)
 
 
-@nb.njit(_nrt=False, pipeline_class=_NoAliasCompiler, **_JIT)
+@nb.njit(_nrt=False, **_JIT_NOALIAS)
 def _block_run_form1(q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch):
     """:func:`_fused_run` in the lane form FORM_QUIET."""
     _fused_run(FORM_QUIET, q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch)
 
 
-@nb.njit(_nrt=False, pipeline_class=_NoAliasCompiler, **_JIT)
+@nb.njit(_nrt=False, **_JIT_NOALIAS)
 def _block_run_form2(q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch):
     """:func:`_fused_run` in the lane form FORM_LOAD."""
     _fused_run(FORM_LOAD, q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch)

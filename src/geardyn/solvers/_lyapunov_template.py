@@ -80,6 +80,7 @@ from geardyn.solvers._lyapunov_books import (  # compiled once for every model
 from geardyn.solvers._parallel import run_workers
 from geardyn.solvers._step_core import (  # CORE-IMPORT
     _JIT,
+    _JIT_NOALIAS,
     BLOCK,
     FD_DELTA,
     FD_NORM_CAP,
@@ -94,7 +95,6 @@ from geardyn.solvers._step_core import (  # CORE-IMPORT
     _events_l,
     _healthy,
     _lane_form,
-    _NoAliasCompiler,
     _padded,
     _pick,
     _rhs_columns,
@@ -841,7 +841,7 @@ def _lyap_fused_run(form, first, nl, max_total, due, renorm, bound, P, OMEGA, H,
                                    ENDS, BLK, ACC, ACT, ACTR, status)
 
 
-@nb.njit(_nrt=False, pipeline_class=_NoAliasCompiler, **_JIT)
+@nb.njit(_nrt=False, **_JIT_NOALIAS)
 def _lyap_run_form1(first, nl, max_total, due, renorm, bound, P, OMEGA, H, S, IS, PT, lanes,
                     rows, books, out, err, used, status, scratch):
     """:func:`_lyap_fused_run` in the lane form FORM_QUIET (compiled on its own, noalias)."""
@@ -849,7 +849,7 @@ def _lyap_run_form1(first, nl, max_total, due, renorm, bound, P, OMEGA, H, S, IS
                     PT, lanes, rows, books, out, err, used, status, scratch)
 
 
-@nb.njit(_nrt=False, pipeline_class=_NoAliasCompiler, **_JIT)
+@nb.njit(_nrt=False, **_JIT_NOALIAS)
 def _lyap_run_form2(first, nl, max_total, due, renorm, bound, P, OMEGA, H, S, IS, PT, lanes,
                     rows, books, out, err, used, status, scratch):
     """:func:`_lyap_fused_run` in the lane form FORM_LOAD."""

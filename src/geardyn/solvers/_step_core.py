@@ -35,6 +35,7 @@ import math
 import numba as nb
 import numpy as np
 
+from geardyn._jit_target import WidthCompiler
 from geardyn.core.kernel_source import FORM_GENERAL
 from geardyn.solvers._step_shared import (  # noqa: F401 - the templates import them from here
     BLOCK,
@@ -78,7 +79,8 @@ from geardyn.solvers._step_shared import (  # noqa: F401 - the templates import 
 from geardyn.solvers._template_model import events, rhs  # MODEL-IMPORT
 
 _CACHE = True
-_JIT = {"cache": _CACHE, "error_model": "numpy", "boundscheck": False}
+_JIT = {"cache": _CACHE, "error_model": "numpy", "boundscheck": False,
+        "pipeline_class": WidthCompiler}
 # MODEL-ADAPTERS (a user's plain functions are adapted to the kernel interface here)
 # The model's functions where they are called in a loop: compiled once (per argument types) and
 # inlined by LLVM at every call site (``forceinline``; a call with array arguments would cost
@@ -828,7 +830,7 @@ def _flat(arrays):
             e.reshape(e.size))
 
 
-class _NoAliasCompiler(nb.core.compiler.Compiler):
+class _NoAliasCompiler(WidthCompiler):
     """numba's pipeline with the function's array arguments declared ``noalias`` (LLVM), so
     that the fused loop needs no runtime overlap checks of its ~30 block arrays (there are too
     many: LLVM would not vectorise it). The caller guarantees it: no two array arguments of
@@ -839,3 +841,7 @@ class _NoAliasCompiler(nb.core.compiler.Compiler):
     def define_pipelines(self):
         self.state.flags.noalias = True
         return super().define_pipelines()
+
+
+#: ``_JIT`` with :class:`_NoAliasCompiler` (geardyn's vector width, noalias array arguments).
+_JIT_NOALIAS = {**_JIT, "pipeline_class": _NoAliasCompiler}

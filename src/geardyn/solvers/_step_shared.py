@@ -17,8 +17,11 @@ import math
 import numba as nb
 import numpy as np
 
+from geardyn._jit_target import WidthCompiler
+
 _CACHE = True
-_JIT = {"cache": _CACHE, "error_model": "numpy", "boundscheck": False}
+_JIT = {"cache": _CACHE, "error_model": "numpy", "boundscheck": False,
+        "pipeline_class": WidthCompiler}
 MAX_SPLITS = 16
 SIMULTANEOUS = 1e-9
 #: Rows of the events scratch buffer ``gbuf`` that :func:`_split_step` needs (events at the start,

@@ -146,8 +146,9 @@ def compile_ahead(module: types.ModuleType, signatures: dict[str, str]) -> subpr
 
 def _leave_helpers_running() -> None:
     """At exit, a helper still compiling goes on and fills the disk cache for the next process;
-    its ``Popen`` object is then deleted unwaited, which is meant: no ResourceWarning for it."""
-    for proc in _STARTED.values():
-        if proc.poll() is None:
-            warnings.filterwarnings("ignore", message=f"subprocess {proc.pid} is still running",
-                                    category=ResourceWarning)
+    its ``Popen`` object is released here, unwaited, which is meant: its ResourceWarning is
+    ignored while it is released (the warning filters are as before afterwards)."""
+    with warnings.catch_warnings():
+        warnings.filterwarnings("ignore", message=r"subprocess \d+ is still running",
+                                category=ResourceWarning)
+        _STARTED.clear()
