@@ -317,9 +317,13 @@ def _leaves_side_step(r, t0, t1, Y, K1, G0, G1, SIDE, p, ybuf, gbuf, s1, c1):
 
 
 @nb.njit(inline="always", **_JIT)
-def _rk4_stages(t, y, h, p, s1, c1, s2, c2, k1, kst, acc, tmp, out):
-    """:func:`_rk4` with k1 given, the model's rhs inlined once (one call site for the three
-    stages: each stage's k in kst, their weighted sum in acc), the same arithmetic."""
+def _rk4_stages(y, h, tm, pm, sm, cm, te, pe, se, ce, k1, kst, acc, tmp, out):
+    """One classic RK4 step of size h from y into out, k1 (the rhs at the step's start) given:
+    the middle stages at time tm with coefficients pm and forcing phase sm, cm, the last at te
+    with pe, se, ce (for a step from t: tm = t + h / 2, te = t + h; a run-up passes the
+    coefficients and phase of its ramped speed at each stage). The model's rhs is inlined once
+    (one call site for the three stages: each stage's k in kst, their weighted sum in acc):
+    out = y + h / 6 (k1 + 2 k2 + 2 k3 + k4), summed left to right."""
     ns = y.size
     hh = 0.5 * h
     for q in range(ns):
@@ -330,14 +334,16 @@ def _rk4_stages(t, y, h, p, s1, c1, s2, c2, k1, kst, acc, tmp, out):
             a = h if st == 3 else hh
             for q in range(ns):
                 tmp[q] = y[q] + a * kst[q]
-        ts = t + hh
-        ss = s1
-        cc = c1
+        ts = tm
+        ps = pm
+        ss = sm
+        cc = cm
         if st == 3:
-            ts = t + h
-            ss = s2
-            cc = c2
-        _rhs_i(ts, tmp, kst, p, ss, cc)
+            ts = te
+            ps = pe
+            ss = se
+            cc = ce
+        _rhs_i(ts, tmp, kst, ps, ss, cc)
         if st == 3:
             for q in range(ns):
                 acc[q] = acc[q] + kst[q]
@@ -441,7 +447,8 @@ def _split_step(i, t0, y, y_trial, p, h, omega, n_per, sa, ca, s_end, c_end, sid
             need = need or flag or _side(g1[j]) != side[j]
         if u > 0.0:
             sm, cm = _phase_at(sa, ca, wh, i_mod, 0.5 * (1.0 + u))
-            _rk4_stages(t, y, dt, p, sm, cm, s_end, c_end, k1, kst, acc, tmp, y_trial)
+            _rk4_stages(y, dt, t + 0.5 * dt, p, sm, cm, t + dt, p, s_end, c_end, k1, kst, acc,
+                        tmp, y_trial)
             _events_i(t_end, y_trial, g1, p, s_end, c_end)
             need = graze
             for j in range(n_ev):
@@ -473,7 +480,8 @@ def _split_step(i, t0, y, y_trial, p, h, omega, n_per, sa, ca, s_end, c_end, sid
         tu = u + theta * (1.0 - u)
         sm, cm = _phase_at(sa, ca, wh, i_mod, tm)
         s0, c0 = _phase_at(sa, ca, wh, i_mod, tu)
-        _rk4_stages(t, ystart, theta * dt, p, sm, cm, s0, c0, k1, kst, acc, tmp, y)
+        hs = theta * dt
+        _rk4_stages(ystart, hs, t + 0.5 * hs, p, sm, cm, t + hs, p, s0, c0, k1, kst, acc, tmp, y)
         for j in range(n_ev):
             if gbuf[2, j] <= theta + SIMULTANEOUS:
                 side[j] = -side[j]
@@ -795,14 +803,15 @@ if "rhs_lane" in globals():  # the model's lane-scalar functions (see .kernels)
         _t_put(dst, _t_get(src))
 
     @nb.njit(inline="always", **_JIT)
-    def _rk4_stages(t, y, h, p, s1, c1, s2, c2, k1, kst, acc, tmp, out):  # noqa: F811
-        pt = p[None, :].T  # PT[j, 0] = p[j]: the lane functions' coefficient layout, a view
+    def _rk4_stages(y, h, tm, pm, sm, cm, te, pe, se, ce, k1, kst, acc, tmp, out):  # noqa: F811
+        ptm = pm[None, :].T  # PT[j, 0] = p[j]: the lane functions' coefficient layout, a view
+        pte = pe[None, :].T
         yt = _t_get(y)
         k1t = _t_get(k1)
         hh = 0.5 * h
-        k2 = _rhs_l(t + hh, _t_axpy(yt, hh, k1t), pt, 0, s1, c1, FORM_GENERAL)
-        k3 = _rhs_l(t + hh, _t_axpy(yt, hh, k2), pt, 0, s1, c1, FORM_GENERAL)
-        k4 = _rhs_l(t + h, _t_axpy(yt, h, k3), pt, 0, s2, c2, FORM_GENERAL)
+        k2 = _rhs_l(tm, _t_axpy(yt, hh, k1t), ptm, 0, sm, cm, FORM_GENERAL)
+        k3 = _rhs_l(tm, _t_axpy(yt, hh, k2), ptm, 0, sm, cm, FORM_GENERAL)
+        k4 = _rhs_l(te, _t_axpy(yt, h, k3), pte, 0, se, ce, FORM_GENERAL)
         _t_put(out, _t_comb(yt, h / 6.0, k1t, k2, k3, k4))
 
     @nb.njit(inline="always", **_JIT)
