@@ -107,7 +107,8 @@ def runup_trajectory(p0, y0, h, i_begin, i_end, i0, stride, last, start, accel, 
     ns = y0.size
     PS = np.empty((3, p0.size))  # the coefficients at the step's start, middle, end
     for r in range(3):
-        PS[r] = p0
+        for j in range(p0.size):
+            PS[r, j] = p0[j]
     p = PS[0]
     pm = PS[1]
     pe = PS[2]
