@@ -46,7 +46,6 @@ from geardyn.solvers._step_core import (  # CORE-IMPORT
     SIMULTANEOUS,
     STATUS_DIVERGED,
     STATUS_OK,
-    _commit_step,
     _events_columns,
     _events_i,
     _events_l,
@@ -54,6 +53,7 @@ from geardyn.solvers._step_core import (  # CORE-IMPORT
     _healthy,
     _keep_start,
     _lane_form,
+    _leaves_side,
     _NoAliasCompiler,
     _observe_l,
     _padded,
@@ -114,6 +114,7 @@ def _block_step(i, first, nl, active, Y, Y1, K1, K2, K3, K4, TMP, TT, G, SIDE, P
     with the crossing located. G holds the events at the new states afterwards; inactive lanes
     (finished or diverged) stay as they are."""
     ns = Y.shape[1]
+    n_ev = G.shape[1]
     for k in range(nl):
         lane = first + k
         TT[k] = T0[lane] + i * H[lane]
@@ -144,11 +145,23 @@ def _block_step(i, first, nl, active, Y, Y1, K1, K2, K3, K4, TMP, TT, G, SIDE, P
     _keep_start(i, nl, active, G, gbuf)
     _events_block(TT, Y1, G, P, first, nl, active, se, ce)
     for k in range(nl):
-        if active[k]:
-            lane = first + k
-            UNRES[lane] += _commit_step(i, k, T0[lane], Y, Y1, G, SIDE, P, lane, H[lane],
-                                        OMEGA[lane], n_per, sa, ca, se, ce, locate, NCROSS,
-                                        lane, work, ybuf, gbuf)
+        if not active[k]:
+            continue
+        lane = first + k
+        crossed = _leaves_side(i, k, G, SIDE, locate, gbuf)
+        if crossed and locate:
+            UNRES[lane] += _split_step(i, T0[lane], Y[k], Y1[k], P[lane], H[lane], OMEGA[lane],
+                                       n_per, sa, ca, se, ce, SIDE[k], G[k], NCROSS[lane], work,
+                                       ybuf, gbuf)
+            continue
+        if crossed:
+            for j in range(n_ev):
+                s_new = _side(G[k, j])
+                if s_new != SIDE[k, j]:
+                    SIDE[k, j] = s_new
+                    NCROSS[first + k, j] += 1
+        for q in range(ns):
+            Y[k, q] = Y1[k, q]
 
 
 @nb.njit(**_JIT)

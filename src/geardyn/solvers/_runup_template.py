@@ -42,13 +42,14 @@ from geardyn.solvers._step_core import (  # CORE-IMPORT
     GBUF_ROWS,
     STATUS_DIVERGED,
     STATUS_OK,
-    _commit_step,
     _events_i,
     _healthy,
     _keep_start,
+    _leaves_side,
     _rhs_i,
     _rk4_stages,
     _side,
+    _split_step,
 )
 from geardyn.solvers._sweep_books import _alloc  # compiled once for every model
 from geardyn.solvers._template_model import events, observe, rhs  # MODEL-IMPORT
@@ -105,17 +106,13 @@ def runup_trajectory(p0, y0, h, i_begin, i_end, i0, stride, last, start, accel, 
     are NaN.
     """
     ns = y0.size
-    PS = np.empty((3, p0.size))  # the coefficients at the step's start, middle, end
-    for r in range(3):
-        for j in range(p0.size):
-            PS[r, j] = p0[j]
-    p = PS[0]
-    pm = PS[1]
-    pe = PS[2]
+    p = p0.copy()  # the coefficients at the step's start, middle and end (set_speed)
+    pm = p0.copy()
+    pe = p0.copy()
     n_per = np.int64(1)  # the split step's phase-table period (int64, its compiled signature)
     Y, Y1, K1, K2, K3, K4, TMP, TT, G, SIDE, work, ybuf, gbuf = _alloc(1, ns, n_ev)
     ACTIVE = np.ones(1, np.bool_)
-    NCROSS = np.zeros((1, max(n_ev, 1)), np.int64)
+    ncross = np.zeros(max(n_ev, 1), np.int64)
     first = max(i_begin, i0)
     r0 = (first - i0 + stride - 1) // stride  # the first recorded point's number
     stop_rec = i_end if last else i_end - 1
@@ -178,13 +175,26 @@ def runup_trajectory(p0, y0, h, i_begin, i_end, i0, stride, last, start, accel, 
         if n_ev > 0:
             _keep_start(i, 1, ACTIVE, G, gbuf)
             _events_i(te, y1, G[0], pe, se, ce)
-        # with time_phase, Omega_m (t0 + i h) is theta at the step's start
-        t0 = th / om_m - i * h if time_phase and om_m != 0.0 else 0.0
-        unresolved += _commit_step(i, 0, t0, Y, Y1, G, SIDE, PS, 1, h, (th_e - th) / h, n_per,
-                                   sa, ca, se, ce, locate, NCROSS, 0, work, ybuf, gbuf)
+            crossed = _leaves_side(i, 0, G, SIDE, locate, gbuf)
+        else:
+            crossed = 0
+        if crossed and locate:
+            # with time_phase, Omega_m (t0 + i h) is theta at the step's start
+            t0 = th / om_m - i * h if time_phase and om_m != 0.0 else 0.0
+            unresolved += _split_step(i, t0, y, y1, pm, h, (th_e - th) / h, n_per, sa, ca, se,
+                                      ce, SIDE[0], G[0], ncross, work, ybuf, gbuf)
+        else:
+            if crossed:
+                for j in range(n_ev):
+                    s_new = _side(G[0, j])
+                    if s_new != SIDE[0, j]:
+                        SIDE[0, j] = s_new
+                        ncross[j] += 1
+            for q in range(ns):
+                y[q] = y1[q]
         done = i + 1 - i_begin
         if not _healthy(y, bound):
             status = STATUS_DIVERGED
             break
-    return (out_y, out_o[:, :n_obs], out_w, out_th, NCROSS[0, :n_ev].copy(), status, unresolved,
-            done, y.copy(), gbuf[GBUF_ROWS:GBUF_ROWS + 2].copy(), SIDE[0, :n_ev].copy())
+    return (out_y, out_o[:, :n_obs], out_w, out_th, ncross[:n_ev], status, unresolved, done,
+            y.copy(), gbuf[GBUF_ROWS:GBUF_ROWS + 2].copy(), SIDE[0, :n_ev].copy())

@@ -451,30 +451,6 @@ def _split_step(i, t0, y, y_trial, p, h, omega, n_per, sa, ca, s_end, c_end, sid
     return 1
 
 
-@nb.njit(inline="always", **_JIT)
-def _commit_step(i, k, t0, Y, Y1, G, SIDE, P, row, h, omega, n_per, sa, ca, se, ce, locate,
-                 NCROSS, lane, work, ybuf, gbuf):
-    """Finish block row k's trial grid step i (start Y[k], trial end Y1[k], events there
-    G[k]; coefficients P[row], crossings counted in NCROSS[lane]): the screen
-    (:func:`_leaves_side`, after :func:`_keep_start`), then, where the step may leave a side of
-    an edge, the step redone split at the located crossings (:func:`_split_step`; with
-    ``locate`` off, the sides at the step's end taken and the changes counted), else the trial
-    committed. Returns 1 if the split limit was reached, else 0."""
-    crossed = _leaves_side(i, k, G, SIDE, locate, gbuf)
-    if crossed and locate:
-        return _split_step(i, t0, Y[k], Y1[k], P[row], h, omega, n_per, sa, ca, se, ce,
-                           SIDE[k], G[k], NCROSS[lane], work, ybuf, gbuf)
-    if crossed:
-        for j in range(G.shape[1]):
-            s_new = _side(G[k, j])
-            if s_new != SIDE[k, j]:
-                SIDE[k, j] = s_new
-                NCROSS[lane, j] += 1
-    for q in range(Y.shape[1]):
-        Y[k, q] = Y1[k, q]
-    return 0
-
-
 @nb.njit(**_JIT)
 def _rows_step(i, t0, Y, p, h, omega, n_per, s_tab, c_tab, n_ev, K, TMP, Y1, SIDE, G0, G1, W,
                gbuf, NCR, UNRES):
