@@ -31,14 +31,24 @@ from geardyn.core.plan import lane_steps_per_period
 from geardyn.solvers import kernels as kmod
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))
 import _results as results  # noqa: E402
+from _reference_step import step_pieces  # noqa: E402
 from kernel import old_kernels  # noqa: E402
 
 
 def drivers(mod):
     """(record, replay, rhs_loop) njit functions bound to a kernel module's step core."""
     rhs, events = mod.rhs, mod.events
-    rk4, split, keep, leaves = mod._rk4, mod._split_step, mod._keep_start, mod._leaves_side
+    split, keep, leaves = mod._split_step, mod._keep_start, mod._leaves_side
+    if hasattr(mod, "_rk4"):  # a step core that had its own one-step RK4 (old kernels)
+        rk4 = mod._rk4
+    else:  # the kernels' RK4 (_rk4_stages), wrapped on the test side
+        piece = step_pieces(mod).rk4
+
+        @nb.njit(inline="always")
+        def rk4(t, y, h, p, s0, c0, s1, c1, s2, c2, k1, k2, k3, k4, tmp, out, have_k1):
+            piece(t, y, h, p, s0, c0, s1, c1, s2, c2, k1, k2, k3, tmp, out)
     phase_table, event_buffer, graze_row = mod.phase_table, mod.event_buffer, mod.GRAZE_ROW
     # the split takes the step's start and end phase (sin, cos) from the caller since the
     # session-15 step core; before, it computed them (libm)

@@ -40,7 +40,7 @@ def test_templates_share_one_core_module_per_model():
     model = geardyn.GearPair(Omega=1.3, kappa=0.2, Fa=0.2)
     mods = [kernels_for(model.kernel, t) for t in TEMPLATES if t != "core"]
     core = kernels_for(model.kernel, "core")
-    for name in ("_split_step", "_rows_step", "phase_table", "_rk4"):
+    for name in ("_split_step", "_rows_step", "phase_table", "_rk4_stages"):
         assert all(getattr(m, name) is getattr(core, name) for m in mods), name
     # and another model has its own
     other = kernels_for(paper_device().kernel, "core")

@@ -13,6 +13,8 @@ import time
 import types
 from pathlib import Path
 
+import pytest
+
 from geardyn.solvers import compile_share
 
 TESTS = Path(__file__).resolve().parent
@@ -82,12 +84,17 @@ import geardyn
 from conformance_cases import user_model
 from geardyn.solvers import compile_share, kernels
 
-model = user_model()
-kernels.kernels_for(model.kernel)
+ramp = sys.argv[1] == "runup"
+model = geardyn.GearPair() if ramp else user_model()
+kernels.kernels_for(model.kernel, "runup" if ramp else "rk4")
 helpers = list(compile_share._STARTED.values())
 for proc in helpers:
     proc.wait()
-geardyn.simulate(model, omega=1.2, run=geardyn.RunSettings(samples=3), y0=[1.0, 0.0])
+if ramp:
+    from geardyn.analysis.runup import RunupSettings, runup
+    runup(model, RunupSettings(start=0.8, stop=0.9, duration=5.0))
+else:
+    geardyn.simulate(model, omega=1.2, run=geardyn.RunSettings(samples=3), y0=[1.0, 0.0])
 core = kernels.kernels_for(model.kernel, "core")
 stats = core._split_step.stats
 print(json.dumps({"helpers": len(helpers), "codes": [p.returncode for p in helpers],
@@ -99,18 +106,21 @@ print(json.dumps({"helpers": len(helpers), "codes": [p.returncode for p in helpe
 """
 
 
-def _run(tmp_path: Path, **env: str) -> dict:
+def _run(tmp_path: Path, analysis: str = "simulate", **env: str) -> dict:
     environ = {k: v for k, v in os.environ.items() if k != "NUMBA_CACHE_DIR"}
     environ.update(GEARDYN_CACHE_DIR=str(tmp_path), PYTHONPATH=os.pathsep.join(
         [str(TESTS), *sys.path]), **env)
-    out = subprocess.run([sys.executable, "-c", _SCRIPT], env=environ, capture_output=True,
-                         text=True, timeout=900)
+    out = subprocess.run([sys.executable, "-c", _SCRIPT, analysis], env=environ,
+                         capture_output=True, text=True, timeout=900)
     assert out.returncode == 0, out.stderr[-3000:]
     return json.loads(out.stdout.strip().splitlines()[-1])
 
 
-def test_the_split_step_compiled_ahead_is_the_one_the_kernels_load(tmp_path):
-    r = _run(tmp_path)
+@pytest.mark.parametrize("analysis", ["simulate", "runup"])
+def test_the_split_step_compiled_ahead_is_the_one_the_kernels_load(tmp_path, analysis):
+    """The trajectory kernel (simulate) and the run-up call the split step with the signature
+    compiled ahead: no other is compiled (a literal argument would compile a second one)."""
+    r = _run(tmp_path, analysis)
     assert r["helpers"] == 1 and r["codes"] == [0]
     assert r["misses"] == [] and r["hits"] == [r["ahead"]]
     assert len(r["locks"]) == 1

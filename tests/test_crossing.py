@@ -13,6 +13,7 @@ import pytest
 from scipy.integrate import solve_ivp
 
 import geardyn
+from _reference_step import step_pieces
 from geardyn.solvers.kernels import kernels_for
 
 ZETA, KAPPA, FM, OMEGA = 0.05, 0.2, 0.1, 0.9
@@ -40,20 +41,21 @@ def located(k, p, om, y0, h, j=0):
     sc = [(math.sin(om * t), math.cos(om * t)) for t in (0.0, 0.5 * h, h)]
     w = np.zeros((5, y0.size))
     y1 = np.zeros(y0.size)
-    k._rk4(0.0, y0, h, p, *sc[0], *sc[1], *sc[2], w[0], w[1], w[2], w[3], w[4], y1, False)
+    step = step_pieces(k)
+    step.rk4(0.0, y0, h, p, *sc[0], *sc[1], *sc[2], w[0], w[1], w[2], w[3], y1)
     f0, f1 = f(0.0, y0), f(h, y1)
     n_ev = 2
     g1 = np.zeros(n_ev)
     k.events(h, y1, g1, p, *sc[2])
     pc = (*sc[0], om * h, 0, 0.0, 1.0)  # the step's forcing phase (_step_core._phase_in)
     ybuf, gbuf = np.zeros(y0.size), np.zeros((k.GBUF_ROWS, n_ev))
-    k.interpolant_events(y0, f0, y1, f1, h, 0.0, p, ybuf, gbuf, pc)
+    step.interpolant_events(y0, f0, y1, f1, h, 0.0, p, ybuf, gbuf, pc)
     side = 1 if gbuf[0, j] > 0 else -1
-    theta = k.first_crossing(j, side, g1[j], y0, f0, y1, f1, h, 0.0, p, ybuf, gbuf, pc)
+    theta = step.first_crossing(j, side, g1[j], y0, f0, y1, f1, h, 0.0, p, ybuf, gbuf, pc)
     ill = np.nan
     if (g1[j] > 0) != (side > 0):
-        ill = k._locate(j, side, gbuf[0, j], 1.0, g1[j], y0, f0, y1, f1, h, 0.0, p, ybuf,
-                        gbuf[1], pc) * h
+        ill = step.illinois(j, side, gbuf[0, j], 1.0, g1[j], y0, f0, y1, f1, h, 0.0, p, ybuf,
+                            gbuf[1], pc) * h
     return theta * h, ill
 
 

@@ -13,6 +13,7 @@ import pytest
 from scipy.integrate import solve_ivp
 
 import geardyn
+from _reference_step import step_pieces
 from geardyn.solvers import _step_core as core
 from geardyn.solvers.ensemble import run_lanes
 
@@ -36,11 +37,12 @@ def _core_step(roots_of_x_minus_b, scale=1.0):
     ybuf, gbuf, g1 = np.zeros(2), np.zeros((core.GBUF_ROWS, 2)), np.zeros(2)
     core.events(1.0, y1, g1, p, 0.0, 1.0)
     pc = core.NO_PHASE
-    core.interpolant_events(y0, f0, y1, f1, 1.0, 0.0, p, ybuf, gbuf, pc)
+    step = step_pieces(core)
+    step.interpolant_events(y0, f0, y1, f1, 1.0, 0.0, p, ybuf, gbuf, pc)
     side = 1 if gbuf[0, 0] > 0 else -1
-    new = core.first_crossing(0, side, g1[0], y0, f0, y1, f1, 1.0, 0.0, p, ybuf, gbuf, pc)
-    old = (core._locate(0, side, gbuf[0, 0], 1.0, g1[0], y0, f0, y1, f1, 1.0, 0.0, p, ybuf,
-                        gbuf[1], pc) if (g1[0] > 0) != (side > 0) else 2.0)
+    new = step.first_crossing(0, side, g1[0], y0, f0, y1, f1, 1.0, 0.0, p, ybuf, gbuf, pc)
+    old = (step.illinois(0, side, gbuf[0, 0], 1.0, g1[0], y0, f0, y1, f1, 1.0, 0.0, p, ybuf,
+                         gbuf[1], pc) if (g1[0] > 0) != (side > 0) else 2.0)
     return new, old
 
 

@@ -218,10 +218,6 @@ class CATTDevice(Model):
                     values[f"{m}_b{h + 1}{sfx}"] = b[h]
         return self.coefficient_layout.build(values)
 
-    def _names(self) -> tuple[str, ...]:
-        """The parameters' names (:func:`catt_layout`; structural entries left out)."""
-        return self.coefficient_layout.names
-
     # ------------------------------------------------------------------ parameters by name
     @property
     def omega_n(self) -> float:

@@ -174,11 +174,6 @@ def _chaos_persists(case: str) -> Callable[[Evidence], Verdict]:
     return check
 
 
-def _summary_line(b: Branch) -> str:
-    return (f"{b.case}: chaotic over {b.length(b.chaotic):.3g}, without period over "
-            f"{b.length(b.nonperiodic):.3g} (Omega-length)")
-
-
 # --------------------------------------------------------------------------- Fig. 3
 def _fig3_periodic_below(ev: Evidence) -> Verdict:
     b = ev["fig3"]

@@ -107,13 +107,6 @@ def _events_block(T, Y, G, P, first, nl, active, s, c):
 
 
 @nb.njit(**_JIT)
-def _observe_block(T, Y, O, P, first, nl, active, s, c):
-    for k in range(nl):
-        if active[k]:
-            _observe_i(T[k], Y[k], O[k], P[first + k], s, c)
-
-
-@nb.njit(**_JIT)
 def _block_step(i, first, nl, active, Y, Y1, K1, K2, K3, K4, TMP, TT, G, SIDE, P, H, OMEGA, T0,
                 n_per, sa, ca, sb, cb, se, ce, locate, NCROSS, UNRES, work, ybuf, gbuf):
     """Advance the active lanes of first..first+nl-1 (rows 0..nl-1 of the block arrays) by grid

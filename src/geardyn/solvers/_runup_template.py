@@ -15,10 +15,12 @@ Numerics
 * Coefficients that move with Omega (Omega's own entry, and e.g. a carrier speed that follows
   it) are quadratics in Omega, ``p[cols[j]] = coef[j, 0] + coef[j, 1] Omega + coef[j, 2]
   Omega^2``, set at each stage's time (:func:`set_speed`).
-* Classic RK4 with a fixed step ``h``; a step that leaves a side of an edge (a backlash
-  dead-zone edge, the model's ``events``) is redone split at the located crossings by the
-  model's split step (:mod:`._step_core`), which takes the coefficients at the step's middle
-  and the phase rotated linearly across the step (phase error at most ``accel h^2 / 8``).
+* Classic RK4 with a fixed step ``h``: the step core's RK4 (``_rk4_stages``, the one of the
+  split step), given each stage's time, coefficients and phase (start, middle, end: three
+  coefficient vectors). A step that leaves a side of an edge (a backlash dead-zone edge, the
+  model's ``events``) is redone split at the located crossings by the model's split step
+  (:mod:`._step_core`), which takes the coefficients at the step's middle and the phase
+  rotated linearly across the step (phase error at most ``accel h^2 / 8``).
 * A model that reads a forcing from the time, at a non-whole order r of Omega (a gear train's
   stage at r Omega t, a torque fluctuation of non-whole order), runs with ``time_phase``: its
   functions get the time theta(t) / Omega(t) instead of t, so that r Omega t is r theta(t), the
@@ -45,6 +47,7 @@ from geardyn.solvers._step_core import (  # CORE-IMPORT
     _keep_start,
     _leaves_side,
     _rhs_i,
+    _rk4_stages,
     _side,
     _split_step,
 )
@@ -103,7 +106,10 @@ def runup_trajectory(p0, y0, h, i_begin, i_end, i0, stride, last, start, accel, 
     are NaN.
     """
     ns = y0.size
-    p = p0.copy()
+    p = p0.copy()  # the coefficients at the step's start, middle and end (set_speed)
+    pm = p0.copy()
+    pe = p0.copy()
+    n_per = np.int64(1)  # the split step's phase-table period (int64, its compiled signature)
     Y, Y1, K1, K2, K3, K4, TMP, TT, G, SIDE, work, ybuf, gbuf = _alloc(1, ns, n_ev)
     ACTIVE = np.ones(1, np.bool_)
     ncross = np.zeros(max(n_ev, 1), np.int64)
@@ -119,9 +125,8 @@ def runup_trajectory(p0, y0, h, i_begin, i_end, i0, stride, last, start, accel, 
     y = Y[0]
     y1 = Y1[0]
     k1 = K1[0]
-    k2 = K2[0]
-    k3 = K3[0]
-    k4 = K4[0]
+    kst = K2[0]
+    acc = K3[0]
     tmp = TMP[0]
     for q in range(ns):
         y[q] = y0[q]
@@ -159,39 +164,25 @@ def runup_trajectory(p0, y0, h, i_begin, i_end, i0, stride, last, start, accel, 
             break
         _rhs_i(phase_time(t, om, th, time_phase), y, k1, p, sa, ca)
         om_m, th_m = speed_phase(t + hh, start, accel, t_on, t_off)
-        sb = math.sin(th_m)
-        cb = math.cos(th_m)
-        set_speed(p, om_m, cols, coef)
-        tm = phase_time(t + hh, om_m, th_m, time_phase)
-        for q in range(ns):
-            tmp[q] = y[q] + hh * k1[q]
-        _rhs_i(tm, tmp, k2, p, sb, cb)
-        for q in range(ns):
-            tmp[q] = y[q] + hh * k2[q]
-        _rhs_i(tm, tmp, k3, p, sb, cb)
+        set_speed(pm, om_m, cols, coef)
         om_e, th_e = speed_phase(t + h, start, accel, t_on, t_off)
         se = math.sin(th_e)
         ce = math.cos(th_e)
-        set_speed(p, om_e, cols, coef)
+        set_speed(pe, om_e, cols, coef)
         te = phase_time(t + h, om_e, th_e, time_phase)
-        for q in range(ns):
-            tmp[q] = y[q] + h * k3[q]
-        _rhs_i(te, tmp, k4, p, se, ce)
-        h6 = h / 6.0
-        for q in range(ns):
-            y1[q] = y[q] + h6 * (k1[q] + 2.0 * k2[q] + 2.0 * k3[q] + k4[q])
+        _rk4_stages(y, h, phase_time(t + hh, om_m, th_m, time_phase), pm, math.sin(th_m),
+                    math.cos(th_m), te, pe, se, ce, k1, kst, acc, tmp, y1)
         if n_ev > 0:
             _keep_start(i, 1, ACTIVE, G, gbuf)
-            _events_i(te, y1, G[0], p, se, ce)
+            _events_i(te, y1, G[0], pe, se, ce)
             crossed = _leaves_side(i, 0, G, SIDE, locate, gbuf)
         else:
             crossed = 0
         if crossed and locate:
-            set_speed(p, om_m, cols, coef)
             # with time_phase, Omega_m (t0 + i h) is theta at the step's start
             t0 = th / om_m - i * h if time_phase and om_m != 0.0 else 0.0
-            unresolved += _split_step(i, t0, y, y1, p, h, (th_e - th) / h, 1, sa, ca, se, ce,
-                                      SIDE[0], G[0], ncross, work, ybuf, gbuf)
+            unresolved += _split_step(i, t0, y, y1, pm, h, (th_e - th) / h, n_per, sa, ca, se,
+                                      ce, SIDE[0], G[0], ncross, work, ybuf, gbuf)
         else:
             if crossed:
                 for j in range(n_ev):

@@ -16,7 +16,7 @@ event once), and integrated in sub-steps, so every RK4 stage sees a smooth
 right-hand side and the method keeps 4th order. A step leaves a side when its end lies on the
 other side, or when it grazes the edge: crosses it twice (or any even number of times) inside the
 step. A graze is found from the interior extrema of the edge function along the interpolant
-(:func:`first_crossing`); the first crossing of a step is always the one located. A step is split
+(:func:`_first_crossing`); the first crossing of a step is always the one located. A step is split
 at most ``MAX_SPLITS`` times (chattering); a step that reaches the limit falls back unsplit and is
 counted (``unresolved_steps`` in every result). Crossings located within ``SIMULTANEOUS`` of a
 step of the earliest are taken together (identical planet sets cross their edges at the same
@@ -95,27 +95,6 @@ _events_i = nb.njit(forceinline=True, _nrt=False, **_JIT)(events.py_func)
 # instead, the state in registers (see :func:`_split_rhs` and the FUSED block below).
 
 
-@nb.njit(**_JIT)
-def _rk4(t, y, h, p, s0, c0, s1, c1, s2, c2, k1, k2, k3, k4, tmp, out, have_k1):
-    """One RK4 step of size h from (t, y) into out; k1 holds f(t, y) if have_k1."""
-    ns = y.size
-    if not have_k1:
-        rhs(t, y, k1, p, s0, c0)
-    hh = 0.5 * h
-    for q in range(ns):
-        tmp[q] = y[q] + hh * k1[q]
-    rhs(t + hh, tmp, k2, p, s1, c1)
-    for q in range(ns):
-        tmp[q] = y[q] + hh * k2[q]
-    rhs(t + hh, tmp, k3, p, s1, c1)
-    for q in range(ns):
-        tmp[q] = y[q] + h * k3[q]
-    rhs(t + h, tmp, k4, p, s2, c2)
-    h6 = h / 6.0
-    for q in range(ns):
-        out[q] = y[q] + h6 * (k1[q] + 2.0 * k2[q] + 2.0 * k3[q] + k4[q])
-
-
 @nb.njit(inline="always", **_JIT)
 def _hermite(y0, f0, y1, f1, dt, theta, out):
     """Cubic Hermite interpolant of a step of length dt at fraction theta."""
@@ -154,18 +133,6 @@ def _illinois(j, side_j, a, fa, b, fb, y0, f0, y1, f1, dt, t, p, ybuf, g, pc):
         if b - a < 1e-13:
             break
     return b
-
-
-@nb.njit(**_JIT)
-def _locate(j, side_j, g0j, b, fb, y0, f0, y1, f1, dt, t, p, ybuf, gbuf, pc):
-    """Fraction in (0, b] of the step where event j leaves side side_j (Illinois method on the
-    step's interpolant, the model's event evaluated at every iterate), given a bracket [0, b]
-    that holds exactly one crossing: g0j the event at the start (taken as on side side_j), fb
-    its value at b (on the other side). The split path uses :func:`_cubic_locate`; this is its
-    fallback for events that are not affine in the state. pc: the step's forcing phase
-    (:func:`_phase_in`)."""
-    return _illinois(j, side_j, 0.0, _forced(g0j, side_j), b, fb, y0, f0, y1, f1, dt, t, p,
-                     ybuf, gbuf, pc)
 
 
 @nb.njit(inline="always", **_JIT)
@@ -229,7 +196,9 @@ def _beyond(th, e, j, side_j, tol, y0, f0, y1, f1, dt, t, p, ybuf, g, pc):
 
 @nb.njit(inline="always", **_JIT)
 def _interpolant_events(y0, f0, y1, f1, dt, t, p, ybuf, g0, g13, g23, pc):
-    """:func:`interpolant_events` into the rows g0, g13, g23 (theta = 0, 1/3, 2/3)."""
+    """The events along a step's cubic Hermite interpolant (start y0, end y1, derivatives f0, f1,
+    length dt, from time t; forcing phase pc, see :func:`_phase_in`) at theta = 0, 1/3, 2/3
+    into the rows g0, g13, g23."""
     sx, cx = _phase_in(pc, 0.0)
     _events_i(t, y0, g0, p, sx, cx)
     _hermite(y0, f0, y1, f1, dt, 1.0 / 3.0, ybuf)
@@ -240,18 +209,22 @@ def _interpolant_events(y0, f0, y1, f1, dt, t, p, ybuf, g0, g13, g23, pc):
     _events_i(t + 2.0 / 3.0 * dt, ybuf, g23, p, sx, cx)
 
 
-@nb.njit(**_JIT)
-def interpolant_events(y0, f0, y1, f1, dt, t, p, ybuf, gbuf, pc):
-    """The events along a step's cubic Hermite interpolant (start y0, end y1, derivatives f0, f1,
-    length dt, from time t; forcing phase pc, see :func:`_phase_in`) at theta = 0, 1/3, 2/3
-    into rows 0, 3, 4 of gbuf (GBUF_ROWS rows)."""
-    _interpolant_events(y0, f0, y1, f1, dt, t, p, ybuf, gbuf[0], gbuf[3], gbuf[4], pc)
-
-
 @nb.njit(inline="always", **_JIT)
 def _first_crossing(j, side_j, graze, g1j, y0, f0, y1, f1, dt, t, p, ybuf, gbuf, gsc, pc):
-    """:func:`first_crossing`; without ``graze`` the end's side alone decides (one crossing at
-    most: the caller's prefilter ruled a graze out)."""
+    """Fraction in (0, 1] of the step where event j first leaves side side_j along the step's
+    cubic Hermite interpolant, or 2.0 if it stays on its side. g1j: the event at the end; gbuf
+    rows 0, 3, 4: the events at theta = 0, 1/3, 2/3 (:func:`_interpolant_events`); gsc: a
+    scratch row.
+
+    Along the interpolant an event that is affine in time and state is exactly the cubic
+    through those four values (in general: to the interpolant's O(h^4)). With ``graze``, an
+    interior extremum of that cubic beyond the edge (by more than GRAZE_TOL of the event's size
+    over the step), confirmed by the event on the interpolant there, has a crossing before it:
+    the orbit grazes the edge (an even number of crossings in the step) or crosses it several
+    times. Otherwise (and without ``graze``: the caller's prefilter ruled a graze out) the
+    end's side decides. The bracket [0, b] handed to the root finder ends at the first such
+    extremum (or the end), so it holds exactly one crossing, the first; the root is found on
+    the cubic (:func:`_cubic_locate`). pc: the step's forcing phase (:func:`_phase_in`)."""
     v0 = gbuf[0, j]
     v1 = gbuf[3, j]
     v2 = gbuf[4, j]
@@ -273,25 +246,6 @@ def _first_crossing(j, side_j, graze, g1j, y0, f0, y1, f1, dt, t, p, ybuf, gbuf,
     c0, c1, c2, c3 = _cubic_coeffs(v0, v1, v2, g1j)
     return _cubic_locate(j, side_j, c0, c1, c2, c3, b, gb, y0, f0, y1, f1, dt, t, p, ybuf, gsc,
                          pc)
-
-
-@nb.njit(**_JIT)
-def first_crossing(j, side_j, g1j, y0, f0, y1, f1, dt, t, p, ybuf, gbuf, pc):
-    """Fraction in (0, 1] of the step where event j first leaves side side_j along the step's
-    cubic Hermite interpolant, or 2.0 if it stays on its side. g1j: the event at the end; gbuf
-    rows 0, 3, 4: the events at theta = 0, 1/3, 2/3 (:func:`interpolant_events`); row 1 is
-    scratch.
-
-    Along the interpolant an event that is affine in time and state is exactly the cubic
-    through those four values (in general: to the interpolant's O(h^4)). An interior extremum
-    of that cubic beyond the edge (by more than GRAZE_TOL of the event's size over the step),
-    confirmed by the event on the interpolant there, has a crossing before it: the orbit grazes
-    the edge (an even number of crossings in the step) or crosses it several times. Otherwise
-    the end's side decides. The bracket [0, b] handed to the root finder ends at the first such
-    extremum (or the end), so it holds exactly one crossing, the first; the root is found on
-    the cubic (:func:`_cubic_locate`). pc: the step's forcing phase (:func:`_phase_in`)."""
-    return _first_crossing(j, side_j, True, g1j, y0, f0, y1, f1, dt, t, p, ybuf, gbuf, gbuf[1],
-                           pc)
 
 
 @nb.njit(inline="always", **_JIT)
@@ -319,9 +273,13 @@ def _leaves_side_step(r, t0, t1, Y, K1, G0, G1, SIDE, p, ybuf, gbuf, s1, c1):
 
 
 @nb.njit(inline="always", **_JIT)
-def _rk4_stages(t, y, h, p, s1, c1, s2, c2, k1, kst, acc, tmp, out):
-    """:func:`_rk4` with k1 given, the model's rhs inlined once (one call site for the three
-    stages: each stage's k in kst, their weighted sum in acc), the same arithmetic."""
+def _rk4_stages(y, h, tm, pm, sm, cm, te, pe, se, ce, k1, kst, acc, tmp, out):
+    """One classic RK4 step of size h from y into out, k1 (the rhs at the step's start) given:
+    the middle stages at time tm with coefficients pm and forcing phase sm, cm, the last at te
+    with pe, se, ce (for a step from t: tm = t + h / 2, te = t + h; a run-up passes the
+    coefficients and phase of its ramped speed at each stage). The model's rhs is inlined once
+    (one call site for the three stages: each stage's k in kst, their weighted sum in acc):
+    out = y + h / 6 (k1 + 2 k2 + 2 k3 + k4), summed left to right."""
     ns = y.size
     hh = 0.5 * h
     for q in range(ns):
@@ -332,14 +290,16 @@ def _rk4_stages(t, y, h, p, s1, c1, s2, c2, k1, kst, acc, tmp, out):
             a = h if st == 3 else hh
             for q in range(ns):
                 tmp[q] = y[q] + a * kst[q]
-        ts = t + hh
-        ss = s1
-        cc = c1
+        ts = tm
+        ps = pm
+        ss = sm
+        cc = cm
         if st == 3:
-            ts = t + h
-            ss = s2
-            cc = c2
-        _rhs_i(ts, tmp, kst, p, ss, cc)
+            ts = te
+            ps = pe
+            ss = se
+            cc = ce
+        _rhs_i(ts, tmp, kst, ps, ss, cc)
         if st == 3:
             for q in range(ns):
                 acc[q] = acc[q] + kst[q]
@@ -396,7 +356,7 @@ def _split_step(i, t0, y, y_trial, p, h, omega, n_per, sa, ca, s_end, c_end, sid
                 work, ybuf, gbuf):
     """Finish grid step i of one lane with edge crossings located; y holds the start, and
     y_trial/g1 the unsplit trial step; gbuf has GBUF_ROWS rows, row GRAZE_ROW flagging the
-    events that may graze (set by the caller's prefilter: those get :func:`first_crossing`,
+    events that may graze (set by the caller's prefilter: those get :func:`_first_crossing`,
     the others a crossing only where the end's side differs). Returns 1 if the split limit was
     reached, else 0.
 
@@ -443,7 +403,8 @@ def _split_step(i, t0, y, y_trial, p, h, omega, n_per, sa, ca, s_end, c_end, sid
             need = need or flag or _side(g1[j]) != side[j]
         if u > 0.0:
             sm, cm = _phase_at(sa, ca, wh, i_mod, 0.5 * (1.0 + u))
-            _rk4_stages(t, y, dt, p, sm, cm, s_end, c_end, k1, kst, acc, tmp, y_trial)
+            _rk4_stages(y, dt, t + 0.5 * dt, p, sm, cm, t + dt, p, s_end, c_end, k1, kst, acc,
+                        tmp, y_trial)
             _events_i(t_end, y_trial, g1, p, s_end, c_end)
             need = graze
             for j in range(n_ev):
@@ -475,7 +436,8 @@ def _split_step(i, t0, y, y_trial, p, h, omega, n_per, sa, ca, s_end, c_end, sid
         tu = u + theta * (1.0 - u)
         sm, cm = _phase_at(sa, ca, wh, i_mod, tm)
         s0, c0 = _phase_at(sa, ca, wh, i_mod, tu)
-        _rk4_stages(t, ystart, theta * dt, p, sm, cm, s0, c0, k1, kst, acc, tmp, y)
+        hs = theta * dt
+        _rk4_stages(ystart, hs, t + 0.5 * hs, p, sm, cm, t + hs, p, s0, c0, k1, kst, acc, tmp, y)
         for j in range(n_ev):
             if gbuf[2, j] <= theta + SIMULTANEOUS:
                 side[j] = -side[j]
@@ -797,14 +759,15 @@ if "rhs_lane" in globals():  # the model's lane-scalar functions (see .kernels)
         _t_put(dst, _t_get(src))
 
     @nb.njit(inline="always", **_JIT)
-    def _rk4_stages(t, y, h, p, s1, c1, s2, c2, k1, kst, acc, tmp, out):  # noqa: F811
-        pt = p[None, :].T  # PT[j, 0] = p[j]: the lane functions' coefficient layout, a view
+    def _rk4_stages(y, h, tm, pm, sm, cm, te, pe, se, ce, k1, kst, acc, tmp, out):  # noqa: F811
+        ptm = pm[None, :].T  # PT[j, 0] = p[j]: the lane functions' coefficient layout, a view
+        pte = pe[None, :].T
         yt = _t_get(y)
         k1t = _t_get(k1)
         hh = 0.5 * h
-        k2 = _rhs_l(t + hh, _t_axpy(yt, hh, k1t), pt, 0, s1, c1, FORM_GENERAL)
-        k3 = _rhs_l(t + hh, _t_axpy(yt, hh, k2), pt, 0, s1, c1, FORM_GENERAL)
-        k4 = _rhs_l(t + h, _t_axpy(yt, h, k3), pt, 0, s2, c2, FORM_GENERAL)
+        k2 = _rhs_l(tm, _t_axpy(yt, hh, k1t), ptm, 0, sm, cm, FORM_GENERAL)
+        k3 = _rhs_l(tm, _t_axpy(yt, hh, k2), ptm, 0, sm, cm, FORM_GENERAL)
+        k4 = _rhs_l(te, _t_axpy(yt, h, k3), pte, 0, se, ce, FORM_GENERAL)
         _t_put(out, _t_comb(yt, h / 6.0, k1t, k2, k3, k4))
 
     @nb.njit(inline="always", **_JIT)
