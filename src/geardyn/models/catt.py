@@ -37,6 +37,7 @@ from geardyn.core.kernel_source import KernelSource
 from geardyn.core.model import Model, unique_rows
 from geardyn.errors import ParameterError
 from geardyn.models import catt_kernels as ck
+from geardyn.models.catt_reduced import reduced_kernel
 from geardyn.models.derived import (
     CATT_BLOCK,
     CATT_HEADER,
@@ -53,8 +54,6 @@ from geardyn.models.params import PAPER_NAMES, PlanetaryParams
 from geardyn.models.stiffness import fourier_coefficients, harmonics_needed
 
 _KERNEL = KernelSource(ck.catt_rhs, ck.catt_events, ck.catt_observe)
-#: The reduced model's kernel: the same functions compiled for one planet set.
-_KERNEL_ONE = KernelSource(ck.catt_rhs_one, ck.catt_events_one, ck.catt_observe_one)
 _THETA_KERNEL = KernelSource(ck.theta_rhs, ck.theta_events)
 #: The block coefficients :meth:`CATTDevice._coefficients_of` reads back per planet set.
 _READ_BACK = ("k_sq_c", "c_sq_c", "k_sq_q", "c_sq_q", "k_pq_q", "c_pq_q", "k_pq_p", "c_pq_p",
@@ -162,9 +161,11 @@ class CATTDevice(Model):
                 for i in range(n_sets) for k, m in enumerate(("sq", "pq"))
             )
         self.name = "CATTDevice"
-        self.kernel = _KERNEL_ONE if n_sets == 1 else _KERNEL
+        nh = self._n_harmonics()
+        # one planet-set block (the reduced form, or one set): the one form, per harmonics count
+        self.kernel = reduced_kernel(nh) if n_sets == 1 else _KERNEL
         self.omega_index = CATT_HEADER.offset("Omega")
-        self.coefficient_layout = catt_layout(n_sets, self.reduced, self._n_harmonics())
+        self.coefficient_layout = catt_layout(n_sets, self.reduced, nh)
         self.params = self._coefficient_vector(omega)
         #: Raw coefficients set by name through ``with_params`` (name -> value), applied on top
         #: of the coefficients derived from ``params_in``.
