@@ -178,16 +178,12 @@ def adapters(form: OneForm) -> str:
         text += _fn("_coef_quiet(PT, k)", [
             f"return _Coef{_quiet_tuple(form.coefficients, form.quiet, 'PT[{q}, k]')}"],
             inline=True)
-        text += _fn("_coef_form(PT, k, form)", [
-            "if form == _ONE_FORM:", "    return _coef_quiet(PT, k)",
-            "return _coef_lane(PT, k)"], inline=True)
+        text += _forms(form)
     y_arr, y_blk = _tuple_text("y[{q}]", ns), _tuple_text("Y[{q}, k]", ns)
     specs = (("rhs", "dy", "DY", ns, ", SC"), ("events", "g", "G", ne, ""),
              ("observe", "out", "O", no, ", SC"))
     for name, arr, blk, n, sc in specs:
         call = f"_one_{name}" if n > 0 or name == "rhs" else None
-        lane_coef = "_coef_form(PT, k, form)" if quiet and name != "events" else \
-            "_coef_lane(PT, k)"
         if call is None:
             body: list[str] = ["pass"]
             blk_body = ["pass"]
@@ -203,7 +199,12 @@ def adapters(form: OneForm) -> str:
                                                                     "_coef_quiet")),
                             "    return",
                             *blk_body]
-            lane_body = [f"return {call}(t, y, {lane_coef}, s, c)"]
+            lane_body = [f"return {call}(t, y, _coef_lane(PT, k), s, c)"]
+            if quiet:  # the form's own compiled function (see _forms)
+                lane_body = ([f"return _{name}_lane_all(t, y, PT, k, s, c)"] if name == "events"
+                             else ["if form == _ONE_FORM:",
+                                   f"    return _{name}_lane_quiet(t, y, PT, k, s, c)",
+                                   f"return _{name}_lane_all(t, y, PT, k, s, c)"])
         text += _fn(f"{name}(t, y, {arr}, p, s, c)", body)
         text += _fn(f"{name}_lanes(T, Y, {blk}, PT, nl, S, C{sc})", blk_body)
         form_arg = "" if name == "events" else ", form"
@@ -215,6 +216,26 @@ def adapters(form: OneForm) -> str:
             "return _ONE_LOUD"])
     else:
         text += _fn("rhs_lane_form(PT, k)", ["return _ONE_FORM"])
+    return text
+
+
+def _forms(form: OneForm) -> str:
+    """The lane-scalar functions of a model with ``quiet`` coefficients, one compiled function
+    per lane form (``_rhs_lane_quiet``: the quiet coefficients constant zeros; ``_rhs_lane_all``:
+    every coefficient the lane's) and so for ``observe`` (``events`` in the second only). Each
+    is compiled once and inlined by LLVM where it is called (``forceinline``: the fused loops
+    still vectorise); ``rhs_lane(..., form)``, which numba inlines, calls the one of ``form``,
+    so that a kernel's copy of its fused loop for a constant form types that call alone."""
+    text = ""
+    for name, n in (("rhs", form.n_states), ("events", form.n_events),
+                    ("observe", form.n_observables)):
+        if name != "rhs" and n == 0:
+            continue
+        kinds = (("all", "_coef_lane"),) if name == "events" else \
+            (("quiet", "_coef_quiet"), ("all", "_coef_lane"))
+        for kind, coef in kinds:
+            text += f"\n\n@nb.njit(forceinline=True, **_JIT)\ndef _{name}_lane_{kind}" \
+                    f"(t, y, PT, k, s, c):\n    return _one_{name}(t, y, {coef}(PT, k), s, c)\n"
     return text
 
 
