@@ -22,6 +22,7 @@ from geardyn.core.plan import LaneSettings
 from geardyn.core.settings import RunSettings
 from geardyn.models import catt_kernels as ck
 from geardyn.models.catt_reduced import coefficient_names
+from geardyn.models.elements import harmonic_factors
 from geardyn.solvers.ensemble import run_lanes
 from geardyn.solvers.kernels import kernels_for
 
@@ -248,3 +249,27 @@ def test_a_quiet_coefficient_must_be_a_coefficient_of_the_form():
         OneForm(coefficient_names(1), 4, 4, 2, quiet=("f_c1", "B1"))
     with pytest.raises(ValueError, match="quiet"):
         OneForm(coefficient_names(1), 4, 4, 2, quiet=("f_c1", "f_c1"))
+
+
+@nb.njit
+def _three_meshes(h, s, c):
+    return harmonic_factors(h, 3, s, c)
+
+
+@pytest.mark.parametrize("nh", [1, 2, 7])
+def test_harmonic_factors_sum_the_series_of_each_mesh(nh):
+    """The written-out series of three meshes against numpy's cos(h theta), sin(h theta)
+    (:func:`geardyn.models.stiffness.evaluate`), and bitwise against harmonic_factor's loop."""
+    from geardyn.models.elements import harmonic_factor
+    from geardyn.models.stiffness import evaluate
+
+    rng = np.random.default_rng(nh)
+    coef = rng.uniform(-0.3, 0.3, (3, nh, 2)) / nh
+    flat = coef.reshape(-1)
+    for theta in (0.0, 0.4, 2.9, -1.7):
+        s, c = math.sin(theta), math.cos(theta)
+        got = _three_meshes(tuple(flat), s, c)
+        for m in range(3):
+            ref = evaluate(coef[m, :, 0], coef[m, :, 1], np.array([theta]))[0]
+            assert got[m] == pytest.approx(max(ref, 0.0), abs=1e-14)
+            assert got[m] == harmonic_factor(flat, 2 * nh * m, nh, s, c)
