@@ -27,8 +27,10 @@ computed, then selected: ``a * v if a != 0.0 else 0.0``, no branch in the lane l
 where they are all 0 takes FORM_QUIET, where the generated layouts give the functions those
 coefficients as the constant 0.0 (so the compiler drops the term: the same values, bitwise, as
 the lane's own zeros give), any other lane FORM_LOAD (the term taken per lane, by its
-coefficients, as in FORM_GENERAL, which a queue mixing the two takes; both vectorise); the
-lane-block forms pick the quiet copy of their loop where every lane of the block is quiet.
+coefficients; it vectorises). FORM_GENERAL (the split path, a queue mixing the two) and the
+array form pick the quiet or the full function per lane by a test (a branch: the scalar paths
+skip the term where it is off), and the lane-block forms the quiet copy of their loop where
+every lane of the block is quiet.
 
 This module belongs to the core: it imports nothing of geardyn outside :mod:`geardyn.core`.
 """
@@ -178,6 +180,9 @@ def adapters(form: OneForm) -> str:
         text += _fn("_coef_quiet(PT, k)", [
             f"return _Coef{_quiet_tuple(form.coefficients, form.quiet, 'PT[{q}, k]')}"],
             inline=True)
+        text += _fn("_coef_quiet_arr(p)", [
+            f"return _Coef{_quiet_tuple(form.coefficients, form.quiet, 'p[{q}]')}"],
+            inline=True)
         text += _forms(form)
     y_arr, y_blk = _tuple_text("y[{q}]", ns), _tuple_text("Y[{q}, k]", ns)
     specs = (("rhs", "dy", "DY", ns, ", SC"), ("events", "g", "G", ne, ""),
@@ -190,6 +195,11 @@ def adapters(form: OneForm) -> str:
             lane_body = ["return ()"]
         else:
             body = [f"v = {call}(t, {y_arr}, _coef(p), s, c)", *_stores(arr + "[{q}]", n)]
+            if quiet and name == "rhs":  # a scalar path: the quiet lane's term skipped
+                body = [f"if {_quiet_test(form, 'p[{q}]')}:",
+                        f"    v = {call}(t, {y_arr}, _coef_quiet_arr(p), s, c)",
+                        "else:", f"    v = {call}(t, {y_arr}, _coef(p), s, c)",
+                        *_stores(arr + "[{q}]", n)]
             blk_body = _block_loop(call, y_blk, blk, n, "_coef_lane")
             if quiet and name != "events":
                 blk_body = ["quiet = True", "for k in range(nl):",
@@ -201,8 +211,13 @@ def adapters(form: OneForm) -> str:
                             *blk_body]
             lane_body = [f"return {call}(t, y, _coef_lane(PT, k), s, c)"]
             if quiet:  # the form's own compiled function (see _forms)
-                lane_body = ([f"return _{name}_lane_all(t, y, PT, k, s, c)"] if name == "events"
+                lane_body = (lane_body if name == "events"
                              else ["if form == _ONE_FORM:",
+                                   f"    return _{name}_lane_quiet(t, y, PT, k, s, c)",
+                                   "if form == _ONE_LOUD:",
+                                   f"    return _{name}_lane_all(t, y, PT, k, s, c)",
+                                   # FORM_GENERAL (the split path, a mixed queue): by lane
+                                   f"if {_quiet_test(form, 'PT[{q}, k]')}:",
                                    f"    return _{name}_lane_quiet(t, y, PT, k, s, c)",
                                    f"return _{name}_lane_all(t, y, PT, k, s, c)"])
         text += _fn(f"{name}(t, y, {arr}, p, s, c)", body)
@@ -231,8 +246,9 @@ def _forms(form: OneForm) -> str:
                     ("observe", form.n_observables)):
         if name != "rhs" and n == 0:
             continue
-        kinds = (("all", "_coef_lane"),) if name == "events" else \
-            (("quiet", "_coef_quiet"), ("all", "_coef_lane"))
+        if name == "events":
+            continue
+        kinds = (("quiet", "_coef_quiet"), ("all", "_coef_lane"))
         for kind, coef in kinds:
             text += f"\n\n@nb.njit(forceinline=True, **_JIT)\ndef _{name}_lane_{kind}" \
                     f"(t, y, PT, k, s, c):\n    return _one_{name}(t, y, {coef}(PT, k), s, c)\n"
