@@ -1,11 +1,8 @@
-"""The CATT model's lane forms (see :data:`geardyn.core.kernel_source.LANE_FORMS`): the reduced
-device is written once (:mod:`geardyn.models.catt_reduced`, the one form); lanes with the load
-quiet take FORM_QUIET (the load term compiled away), lanes with it fluctuating FORM_LOAD, each
-in its own compiled copy of the fused loop, any number of stiffness harmonics; every lane's
-result is bitwise that of the one-lane path (``simulate``) and every generated layout gives the
-bits of the general model's hand-written array form (:func:`~geardyn.models.catt_kernels.catt_rhs`
-with one planet set). The load's sine (:func:`~geardyn.models.catt_kernels.load_sin`) is checked
-against libm's."""
+"""The CATT model's lane forms (see :data:`geardyn.core.kernel_source.LANE_FORMS`): the sweep
+kernel runs a queue of quiet lanes, of lanes with the load fluctuating, of several stiffness
+harmonics or a mixture, each in its own compiled copy of the fused loop, and every lane's
+result is bitwise that of the one-lane path (``simulate``). The load's sine
+(:func:`~geardyn.models.catt_kernels.load_sin`) is checked against libm's."""
 
 from __future__ import annotations
 
@@ -17,14 +14,10 @@ import pytest
 
 import geardyn
 from geardyn.core.kernel_source import FORM_GENERAL, FORM_LOAD, FORM_QUIET
-from geardyn.core.one_form import OneForm
 from geardyn.core.plan import LaneSettings
 from geardyn.core.settings import RunSettings
 from geardyn.models import catt_kernels as ck
-from geardyn.models.catt_reduced import coefficient_names
-from geardyn.models.elements import harmonic_factors
 from geardyn.solvers.ensemble import run_lanes
-from geardyn.solvers.kernels import kernels_for
 
 _OMEGAS = np.array([0.7, 1.3, 2.2, 3.1, 0.45])
 
@@ -83,20 +76,15 @@ def _assert_lanes_equal_simulate(models, omegas, steps=48):
         np.testing.assert_array_equal(r.samples[j], ds["poincare"].values[1:], err_msg=str(j))
 
 
-def _gen(model):
-    """The model's generated functions (the kernels' shared core, compiled on first call)."""
-    return kernels_for(model.kernel, "core")
-
-
 def _form(model):
     P = np.ascontiguousarray(model.lane_params("Omega", _OMEGAS[:1]).T)
-    return _gen(model).rhs_lane_form(P, 0)
+    return ck.catt_rhs_one_lane_form(P, 0)
 
 
 def test_each_lane_form_equals_the_one_lane_path_bitwise():
     quiet, load = _device(), _device(**_LOAD)
     rect = _device(waveform="rectangular")
-    assert (_form(quiet), _form(load), _form(rect)) == (FORM_QUIET, FORM_LOAD, FORM_QUIET)
+    assert (_form(quiet), _form(load), _form(rect)) == (FORM_QUIET, FORM_LOAD, FORM_GENERAL)
     _assert_lanes_equal_simulate([load], _OMEGAS)
     _assert_lanes_equal_simulate([rect], _OMEGAS[:3])
     # quiet and fluctuating lanes in one queue run in the general form: still the same results
@@ -184,92 +172,61 @@ def test_a_chain_stops_at_a_lane_that_did_not_end_well_and_says_so():
     assert list(r.steps[1:]) == [0, 0]
 
 
-_DEVICES = {"quiet": {}, "load": _LOAD, "rectangular": {"waveform": "rectangular"},
-            "rectangular-load": {"waveform": "rectangular", **_LOAD},
-            "load-outside-only": {"B1": "100 N m", "Lambda": 0.3, "psi1": 0.4}}
-
-
-@pytest.mark.parametrize("case", list(_DEVICES))
-def test_every_generated_layout_equals_the_general_models_array_form(case):
-    """The reduced device's generated layouts (array, lane-scalar in its form and in the general
-    form, lane block) against the general model's own array form :func:`ck.catt_rhs` for one
-    planet set (written separately, with harmonic_factor's loop and the load's branch), bit for
-    bit, at random states, times and mesh phases; the forces likewise."""
-    m = _device(**_DEVICES[case]).with_omega(1.3)
-    gen = _gen(m)
-    p = m.params
-    nl = 3
-    PT = np.ascontiguousarray(np.tile(p[:, None], (1, nl)))
-    form = gen.rhs_lane_form(PT, 0)
-    rng = np.random.default_rng(7)
-    T, ph = rng.uniform(0.0, 80.0, nl), rng.uniform(-3.0, 3.0, nl)
-    S, C = np.sin(ph), np.cos(ph)
-    Y = rng.normal(0.0, 3.0, (4, nl))
-    DY, O, SC = np.zeros((4, nl)), np.zeros((2, nl)), np.zeros((4, nl))
-    gen.rhs_lanes(T, Y, DY, PT, nl, S, C, SC)
-    gen.observe_lanes(T, Y, O, PT, nl, S, C, SC)
-    for k in range(nl):
-        y = Y[:, k].copy()
-        ref, oref, dy = np.empty(4), np.empty(2), np.empty(4)
-        ck.catt_rhs(T[k], y, ref, p, S[k], C[k])
-        ck.catt_observe(T[k], y, oref, p, S[k], C[k])
-        gen.rhs(T[k], y, dy, p, S[k], C[k])
-        for got in (dy, DY[:, k], gen.rhs_lane(T[k], tuple(y), PT, k, S[k], C[k], form),
-                    gen.rhs_lane(T[k], tuple(y), PT, k, S[k], C[k], FORM_GENERAL)):
-            np.testing.assert_array_equal(np.asarray(got), ref, err_msg=case)
-        np.testing.assert_array_equal(O[:, k], oref)
-        np.testing.assert_array_equal(np.asarray(
-            gen.observe_lane(T[k], tuple(y), PT, k, S[k], C[k], form)), oref)
-
-
-def _llvm_of_lane_call(gen, form):
-    """The optimised LLVM IR of a function that calls the generated ``rhs_lane`` in ``form``."""
-    rhs_lane = gen.rhs_lane
-
-    @nb.njit
-    def call(y, PT, s, c):
-        return rhs_lane(0.1, y, PT, 0, s, c, form)
-
-    P = np.ascontiguousarray(_device().lane_params("Omega", _OMEGAS[:1]).T)
-    call((0.01, 0.0, -0.02, 0.0), P, 0.3, 0.9)
-    return next(iter(call.inspect_llvm().values()))
-
-
-def test_the_quiet_form_compiles_the_load_term_away():
-    """A quiet lane's copy holds no load sine (its floor is the marker), the general one does:
-    the one form's ``quiet`` coefficients are constant zeros in the quiet copy."""
-    gen = _gen(_device())
-    assert "llvm.floor" not in _llvm_of_lane_call(gen, FORM_QUIET)
-    assert "llvm.floor" in _llvm_of_lane_call(gen, FORM_LOAD)
-    assert "llvm.floor" in _llvm_of_lane_call(gen, FORM_GENERAL)
-
-
-def test_a_quiet_coefficient_must_be_a_coefficient_of_the_form():
-    with pytest.raises(ValueError, match="quiet"):
-        OneForm(coefficient_names(1), 4, 4, 2, quiet=("f_c1", "B1"))
-    with pytest.raises(ValueError, match="quiet"):
-        OneForm(coefficient_names(1), 4, 4, 2, quiet=("f_c1", "f_c1"))
+@nb.njit
+def _lane_calls_quiet(y, PT, s, c):
+    """Four rhs calls and an observation at a constant lane form, as a kernel's fused loop."""
+    a = ck.catt_rhs_one_lane(0.1, y, PT, 0, s, c, FORM_QUIET)
+    b = ck.catt_rhs_one_lane(0.2, a, PT, 0, s, c, FORM_QUIET)
+    return b, ck.catt_observe_one_lane(0.2, b, PT, 0, s, c, FORM_QUIET)
 
 
 @nb.njit
-def _three_meshes(h, s, c):
-    return harmonic_factors(h, 3, s, c)
+def _lane_calls_load(y, PT, s, c):
+    a = ck.catt_rhs_one_lane(0.1, y, PT, 0, s, c, FORM_LOAD)
+    return a, ck.catt_observe_one_lane(0.1, a, PT, 0, s, c, FORM_LOAD)
 
 
-@pytest.mark.parametrize("nh", [1, 2, 7])
-def test_harmonic_factors_sum_the_series_of_each_mesh(nh):
-    """The written-out series of three meshes against numpy's cos(h theta), sin(h theta)
-    (:func:`geardyn.models.stiffness.evaluate`), and bitwise against harmonic_factor's loop."""
-    from geardyn.models.elements import harmonic_factor
-    from geardyn.models.stiffness import evaluate
+@nb.njit
+def _lane_calls_general(y, PT, s, c):
+    a = ck.catt_rhs_one_lane(0.1, y, PT, 0, s, c, FORM_GENERAL)
+    return a, ck.catt_observe_one_lane(0.1, a, PT, 0, s, c, FORM_GENERAL)
 
-    rng = np.random.default_rng(nh)
-    coef = rng.uniform(-0.3, 0.3, (3, nh, 2)) / nh
-    flat = coef.reshape(-1)
-    for theta in (0.0, 0.4, 2.9, -1.7):
-        s, c = math.sin(theta), math.cos(theta)
-        got = _three_meshes(tuple(flat), s, c)
-        for m in range(3):
-            ref = evaluate(coef[m, :, 0], coef[m, :, 1], np.array([theta]))[0]
-            assert got[m] == pytest.approx(max(ref, 0.0), abs=1e-14)
-            assert got[m] == harmonic_factor(flat, 2 * nh * m, nh, s, c)
+
+def _model_functions_typed(fn, *args):
+    """The names of the model module's compiled functions that numba typed in compiling ``fn``
+    (those inlined into it and those it calls)."""
+    fn(*args)
+    (ov,) = fn.overloads.values()
+    return {t.dispatcher.py_func.__name__ for t in ov.type_annotation.typemap.values()
+            if isinstance(t, nb.core.types.Dispatcher)
+            and t.dispatcher.py_func.__module__ == ck.__name__}
+
+
+@pytest.mark.parametrize(("fn", "own"), [(_lane_calls_quiet, {"_rhs_quiet", "_observe_quiet"}),
+                                         (_lane_calls_load, {"_rhs_load", "_observe_quiet"}),
+                                         (_lane_calls_general,
+                                          {"_rhs_general", "_observe_general"})])
+def test_a_constant_lane_form_compiles_that_forms_code_only(fn, own):
+    """A kernel's compile time goes with the code numba inlines and types: a call site of a
+    constant form holds that form's functions only (no other form's, no load sine where the
+    load is quiet, no harmonics loop outside the general form)."""
+    P = np.ascontiguousarray(_device().lane_params("Omega", _OMEGAS[:1]).T)
+    typed = _model_functions_typed(fn, (0.01, 0.0, -0.02, 0.0), P, 0.3, math.sqrt(0.91))
+    assert typed == {"catt_rhs_one_lane", "catt_observe_one_lane"} | own
+
+
+@nb.njit
+def _rhs_at_form(y, PT, s, c, form):
+    return ck.catt_rhs_one_lane(0.7, y, PT, 0, s, c, form)
+
+
+def test_every_form_of_a_quiet_lane_equals_the_array_form_with_form_a_variable():
+    """``form`` need not be a constant: each form of a lane that all may take (one harmonic, the
+    load quiet) gives the bits of the array form :func:`catt_rhs_one`."""
+    p = _device().lane_params("Omega", _OMEGAS[1:2])[0]
+    PT = np.ascontiguousarray(p[:, None])
+    y, s, c = np.array([2e-3, -0.1, -1e-3, 0.05]), 0.6, 0.8
+    ref = np.empty(4)
+    ck.catt_rhs_one(0.7, y, ref, p, s, c)
+    for form in (FORM_QUIET, FORM_LOAD, FORM_GENERAL):
+        np.testing.assert_array_equal(np.array(_rhs_at_form(tuple(y), PT, s, c, form)), ref)

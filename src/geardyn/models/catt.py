@@ -54,6 +54,8 @@ from geardyn.models.params import PAPER_NAMES, PlanetaryParams
 from geardyn.models.stiffness import fourier_coefficients, harmonics_needed
 
 _KERNEL = KernelSource(ck.catt_rhs, ck.catt_events, ck.catt_observe)
+#: The reduced model's hand-written kernel: the same functions compiled for one planet set.
+_KERNEL_ONE = KernelSource(ck.catt_rhs_one, ck.catt_events_one, ck.catt_observe_one)
 _THETA_KERNEL = KernelSource(ck.theta_rhs, ck.theta_events)
 #: The block coefficients :meth:`CATTDevice._coefficients_of` reads back per planet set.
 _READ_BACK = ("k_sq_c", "c_sq_c", "k_sq_q", "c_sq_q", "k_pq_q", "c_pq_q", "k_pq_p", "c_pq_p",
@@ -102,6 +104,12 @@ class CATTDevice(Model):
     omega
         Dimensionless mesh frequency Omega = omega / omega_n stored in the model (solvers and
         sweeps set it).
+    one_form
+        Run one planet-set block (the reduced form) through its one form
+        (:mod:`geardyn.models.catt_reduced`: every kernel layout generated from the physics
+        written once) instead of the hand-written kernel; the same results, bitwise. Off by
+        default while its fluctuating-load sweeps are slower (the paper's quiet workload runs
+        as fast).
     """
 
     time_unit = "1"
@@ -121,6 +129,7 @@ class CATTDevice(Model):
         interpretation: Interpretation = "consistent",
         reduced: bool | None = None,
         omega: float = 1.0,
+        one_form: bool = False,
     ):
         if interpretation not in INTERPRETATIONS:
             raise ValueError(
@@ -162,8 +171,13 @@ class CATTDevice(Model):
             )
         self.name = "CATTDevice"
         nh = self._n_harmonics()
-        # one planet-set block (the reduced form, or one set): the one form, per harmonics count
-        self.kernel = reduced_kernel(nh) if n_sets == 1 else _KERNEL
+        #: Whether one planet-set block runs the one form (:mod:`geardyn.models.catt_reduced`)
+        #: instead of the hand-written kernel (the same results, bitwise).
+        self.one_form = bool(one_form)
+        if n_sets > 1:
+            self.kernel = _KERNEL
+        else:
+            self.kernel = reduced_kernel(nh) if self.one_form else _KERNEL_ONE
         self.omega_index = CATT_HEADER.offset("Omega")
         self.coefficient_layout = catt_layout(n_sets, self.reduced, nh)
         self.params = self._coefficient_vector(omega)
@@ -238,7 +252,8 @@ class CATTDevice(Model):
         reduced = None if params.identical_planets else False
         if not self.reduced:
             reduced = False
-        out = CATTDevice(params, self.interpretation, reduced=reduced, omega=omega)
+        out = CATTDevice(params, self.interpretation, reduced=reduced, omega=omega,
+                         one_form=self.one_form)
         if self.raw_overrides:
             plain = CATTDevice(self.params_in, self.interpretation, reduced=self.reduced,
                                omega=omega).params
