@@ -17,10 +17,20 @@ step loop), and so for ``events`` and ``observe``. The one form's functions are 
 each (numba IR inlining); a lane's named tuple is built from the coefficient vector there, its
 unused fields never loaded.
 
-Every lane takes the one form FORM_QUIET: the fused loop vectorises wherever the functions call
+Every lane takes the lane form FORM_QUIET: the fused loop vectorises wherever the functions call
 no libm routine per lane (a model precomputes cos/sin of a coefficient as coefficients of its
 own: derived coefficients declared with their function, filled by the coefficient layout; see
-:mod:`geardyn.core.coefficients` and :class:`geardyn.models.gear_pair.GearPair`).
+:mod:`geardyn.core.coefficients` and :class:`geardyn.models.gear_pair.GearPair`). A model whose
+physics has a dear term switched off by coefficients (the CATT device's load fluctuation) names
+them ``OneForm.quiet`` and writes the term so that it is dead code where they are 0 (the term
+computed, then selected: ``a * v if a != 0.0 else 0.0``, no branch in the lane loop): a lane
+where they are all 0 takes FORM_QUIET, where the generated layouts give the functions those
+coefficients as the constant 0.0 (so the compiler drops the term: the same values, bitwise, as
+the lane's own zeros give), any other lane FORM_LOAD (the term taken per lane, by its
+coefficients; it vectorises). FORM_GENERAL (the split path, a queue mixing the two) and the
+array form pick the quiet or the full function per lane by a test (a branch: the scalar paths
+skip the term where it is off), and the lane-block forms the quiet copy of their loop where
+every lane of the block is quiet.
 
 This module belongs to the core: it imports nothing of geardyn outside :mod:`geardyn.core`.
 """
@@ -47,9 +57,16 @@ class OneForm:
     n_states: int
     n_events: int = 0
     n_observables: int = 0
+    #: Coefficients whose zeros switch a term off: lanes with all of them 0 take FORM_QUIET,
+    #: where the functions see them as the constant 0.0 (see the module docstring).
+    quiet: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
         check_names(self.coefficients)
+        unknown = [n for n in self.quiet if n not in self.coefficients]
+        if unknown or len(set(self.quiet)) != len(self.quiet):
+            raise ValueError(f"quiet names distinct coefficients of the one form "
+                             f"(got {', '.join(map(repr, self.quiet))})")
         if self.n_states < 1 or self.n_events < 0 or self.n_observables < 0:
             raise ValueError(f"one form sizes must be n_states >= 1, n_events >= 0, "
                              f"n_observables >= 0 (got {self.n_states}, {self.n_events}, "
@@ -123,12 +140,25 @@ def _fn(head: str, body: list[str], inline: bool = False) -> str:
     return f"\n\n{deco}\ndef {head}:\n" + "".join(f"    {line}\n" for line in body)
 
 
+def _quiet_tuple(names: tuple[str, ...], quiet: tuple[str, ...], row: str) -> str:
+    """The coefficient tuple's text with the ``quiet`` fields the constant 0.0."""
+    return "(" + "".join(("0.0" if n in quiet else row.format(q=q)) + ", "
+                         for q, n in enumerate(names)) + ")"
+
+
+def _quiet_test(form: OneForm, row: str) -> str:
+    """The text of the test that the lane's ``quiet`` coefficients are all 0."""
+    return " & ".join(f"({row.format(q=form.coefficients.index(n))} == 0.0)"
+                      for n in form.quiet)
+
+
 def adapters(form: OneForm) -> str:
     """Python source defining the kernel interface's functions (every layout, see the module
     docstring) from the one form's ``one_rhs``, ``one_events`` and ``one_observe`` (names the
     generated module imports), for a model of ``form``'s sizes and coefficients."""
     ns, ne, no = form.n_states, form.n_events, form.n_observables
     nc = len(form.coefficients)
+    quiet = bool(form.quiet)
     out = [
         "\n# The model's one form (geardyn.core.one_form): every layout generated from it.",
         "from geardyn.core.kernel_source import FORM_QUIET as _ONE_FORM",
@@ -138,6 +168,8 @@ def adapters(form: OneForm) -> str:
         "_ONE_INLINE = {\"inline\": \"always\", \"error_model\": \"numpy\", "
         "\"boundscheck\": False, \"pipeline_class\": _WidthCompiler}",
     ]
+    if quiet:
+        out.append("from geardyn.core.kernel_source import FORM_LOAD as _ONE_LOUD")
     for name, n in (("rhs", ns), ("events", ne), ("observe", no)):
         if name == "rhs" or n > 0:
             out.append(f"_one_{name} = nb.njit(**_ONE_INLINE)(one_{name}.py_func)")
@@ -145,6 +177,14 @@ def adapters(form: OneForm) -> str:
     text += _fn("_coef(p)", [f"return _Coef{_tuple_text('p[{q}]', nc)}"], inline=True)
     text += _fn("_coef_lane(PT, k)", [f"return _Coef{_tuple_text('PT[{q}, k]', nc)}"],
                 inline=True)
+    if quiet:
+        text += _fn("_coef_quiet(PT, k)", [
+            f"return _Coef{_quiet_tuple(form.coefficients, form.quiet, 'PT[{q}, k]')}"],
+            inline=True)
+        text += _fn("_coef_quiet_arr(p)", [
+            f"return _Coef{_quiet_tuple(form.coefficients, form.quiet, 'p[{q}]')}"],
+            inline=True)
+        text += _forms(form)
     y_arr, y_blk = _tuple_text("y[{q}]", ns), _tuple_text("Y[{q}, k]", ns)
     specs = (("rhs", "dy", "DY", ns, ", SC"), ("events", "g", "G", ne, ""),
              ("observe", "out", "O", no, ", SC"))
@@ -156,14 +196,68 @@ def adapters(form: OneForm) -> str:
             lane_body = ["return ()"]
         else:
             body = [f"v = {call}(t, {y_arr}, _coef(p), s, c)", *_stores(arr + "[{q}]", n)]
-            blk_body = ["for k in range(nl):",
-                        f"    v = {call}(T[k], {y_blk}, _coef_lane(PT, k), S[k], C[k])",
-                        *("    " + line for line in _stores(blk + "[{q}, k]", n))]
+            if quiet and name == "rhs":  # a scalar path: the quiet lane's term skipped
+                body = [f"if {_quiet_test(form, 'p[{q}]')}:",
+                        f"    v = {call}(t, {y_arr}, _coef_quiet_arr(p), s, c)",
+                        "else:", f"    v = {call}(t, {y_arr}, _coef(p), s, c)",
+                        *_stores(arr + "[{q}]", n)]
+            blk_body = _block_loop(call, y_blk, blk, n, "_coef_lane")
+            if quiet and name != "events":
+                blk_body = ["quiet = True", "for k in range(nl):",
+                            f"    quiet &= {_quiet_test(form, 'PT[{q}, k]')}",
+                            "if quiet:",
+                            *("    " + line for line in _block_loop(call, y_blk, blk, n,
+                                                                    "_coef_quiet")),
+                            "    return",
+                            *blk_body]
             lane_body = [f"return {call}(t, y, _coef_lane(PT, k), s, c)"]
+            if quiet:  # the form's own compiled function (see _forms)
+                lane_body = (lane_body if name == "events"
+                             else ["if form == _ONE_FORM:",
+                                   f"    return _{name}_lane_quiet(t, y, PT, k, s, c)",
+                                   "if form == _ONE_LOUD:",
+                                   f"    return _{name}_lane_all(t, y, PT, k, s, c)",
+                                   # FORM_GENERAL (the split path, a mixed queue): by lane
+                                   f"if {_quiet_test(form, 'PT[{q}, k]')}:",
+                                   f"    return _{name}_lane_quiet(t, y, PT, k, s, c)",
+                                   f"return _{name}_lane_all(t, y, PT, k, s, c)"])
         text += _fn(f"{name}(t, y, {arr}, p, s, c)", body)
         text += _fn(f"{name}_lanes(T, Y, {blk}, PT, nl, S, C{sc})", blk_body)
         form_arg = "" if name == "events" else ", form"
         text += _fn(f"{name}_lane(t, y, PT, k, s, c{form_arg})", lane_body, inline=True)
     text += f"\n\n#: The state size of the lane-scalar forms.\nrhs_lane_states = {ns}\n"
-    text += _fn("rhs_lane_form(PT, k)", ["return _ONE_FORM"])
+    if quiet:
+        text += _fn("rhs_lane_form(PT, k)", [
+            f"if {_quiet_test(form, 'PT[{q}, k]')}:", "    return _ONE_FORM",
+            "return _ONE_LOUD"])
+    else:
+        text += _fn("rhs_lane_form(PT, k)", ["return _ONE_FORM"])
     return text
+
+
+def _forms(form: OneForm) -> str:
+    """The lane-scalar functions of a model with ``quiet`` coefficients, one compiled function
+    per lane form (``_rhs_lane_quiet``: the quiet coefficients constant zeros; ``_rhs_lane_all``:
+    every coefficient the lane's) and so for ``observe`` (``events`` in the second only). Each
+    is compiled once and inlined by LLVM where it is called (``forceinline``: the fused loops
+    still vectorise); ``rhs_lane(..., form)``, which numba inlines, calls the one of ``form``,
+    so that a kernel's copy of its fused loop for a constant form types that call alone."""
+    text = ""
+    for name, n in (("rhs", form.n_states), ("events", form.n_events),
+                    ("observe", form.n_observables)):
+        if name != "rhs" and n == 0:
+            continue
+        if name == "events":
+            continue
+        kinds = (("quiet", "_coef_quiet"), ("all", "_coef_lane"))
+        for kind, coef in kinds:
+            text += f"\n\n@nb.njit(forceinline=True, **_JIT)\ndef _{name}_lane_{kind}" \
+                    f"(t, y, PT, k, s, c):\n    return _one_{name}(t, y, {coef}(PT, k), s, c)\n"
+    return text
+
+
+def _block_loop(call: str, y_blk: str, blk: str, n: int, coef: str) -> list[str]:
+    """The lane-block form's loop over lanes 0..nl-1, the coefficients by ``coef``."""
+    return ["for k in range(nl):",
+            f"    v = {call}(T[k], {y_blk}, {coef}(PT, k), S[k], C[k])",
+            *("    " + line for line in _stores(blk + "[{q}, k]", n))]

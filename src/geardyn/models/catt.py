@@ -39,6 +39,7 @@ from geardyn.core.kernel_source import KernelSource
 from geardyn.core.model import Model, unique_rows
 from geardyn.errors import ParameterError
 from geardyn.models import catt_kernels as ck
+from geardyn.models.catt_reduced import reduced_kernel
 from geardyn.models.derived import (
     CATT_BLOCK,
     CATT_HEADER,
@@ -55,7 +56,7 @@ from geardyn.models.params import PAPER_INPUTS, PAPER_NAMES, PlanetaryParams
 from geardyn.models.stiffness import fourier_coefficients, harmonics_needed
 
 _KERNEL = KernelSource(ck.catt_rhs, ck.catt_events, ck.catt_observe)
-#: The reduced model's kernel: the same functions compiled for one planet set.
+#: The reduced model's hand-written kernel: the same functions compiled for one planet set.
 _KERNEL_ONE = KernelSource(ck.catt_rhs_one, ck.catt_events_one, ck.catt_observe_one)
 _THETA_KERNEL = KernelSource(ck.theta_rhs, ck.theta_events)
 #: The block coefficients :meth:`CATTDevice._coefficients_of` reads back per planet set.
@@ -105,6 +106,12 @@ class CATTDevice(Model):
     omega
         Dimensionless mesh frequency Omega = omega / omega_n stored in the model (solvers and
         sweeps set it).
+    one_form
+        Run one planet-set block (the reduced form) through its one form
+        (:mod:`geardyn.models.catt_reduced`: every kernel layout generated from the physics
+        written once) instead of the hand-written kernel; the same results, bitwise. Off by
+        default while its fluctuating-load sweeps are slower (the paper's quiet workload runs
+        as fast).
     """
 
     time_unit = "1"
@@ -127,6 +134,7 @@ class CATTDevice(Model):
         interpretation: Interpretation = "consistent",
         reduced: bool | None = None,
         omega: float = 1.0,
+        one_form: bool = False,
     ):
         if interpretation not in INTERPRETATIONS:
             raise ValueError(
@@ -167,9 +175,16 @@ class CATTDevice(Model):
                 for i in range(n_sets) for k, m in enumerate(("sq", "pq"))
             )
         self.name = "CATTDevice"
-        self.kernel = _KERNEL_ONE if n_sets == 1 else _KERNEL
+        nh = self._n_harmonics()
+        #: Whether one planet-set block runs the one form (:mod:`geardyn.models.catt_reduced`)
+        #: instead of the hand-written kernel (the same results, bitwise).
+        self.one_form = bool(one_form)
+        if n_sets > 1:
+            self.kernel = _KERNEL
+        else:
+            self.kernel = reduced_kernel(nh) if self.one_form else _KERNEL_ONE
         self.omega_index = CATT_HEADER.offset("Omega")
-        self.coefficient_layout = catt_layout(n_sets, self.reduced, self._n_harmonics())
+        self.coefficient_layout = catt_layout(n_sets, self.reduced, nh)
         self.params = self._coefficient_vector(omega)
         #: Raw coefficients set by name through ``with_params`` (name -> value), applied on top
         #: of the coefficients derived from ``params_in``.
@@ -238,7 +253,8 @@ class CATTDevice(Model):
         reduced = None if params.identical_planets else False
         if not self.reduced:
             reduced = False
-        out = CATTDevice(params, self.interpretation, reduced=reduced, omega=omega)
+        out = CATTDevice(params, self.interpretation, reduced=reduced, omega=omega,
+                         one_form=self.one_form)
         if self.raw_overrides:
             plain = CATTDevice(self.params_in, self.interpretation, reduced=self.reduced,
                                omega=omega).params

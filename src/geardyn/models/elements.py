@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import numba as nb
+from numba.core import errors, types
+from numba.extending import overload
 
 from geardyn._jit_target import WidthCompiler
 
@@ -51,3 +53,43 @@ def harmonic_factor_lane(PT, k, f, nh, s, c):
         acc += PT[f + 2 * h, k] * ch + PT[f + 2 * h + 1, k] * sh
     v = 1.0 + acc
     return v if v > 0.0 else 0.0
+
+
+def harmonic_factors(h, n_meshes, s, c):
+    """The relative stiffness of each of ``n_meshes`` meshes, as :func:`harmonic_factor` gives
+    it, from the tuple ``h`` of their Fourier coefficients one mesh after the other (a1, b1,
+    .., a_nh, b_nh of the first, then of the next): a tuple of ``n_meshes`` values (clipped at
+    0), for the phase with sin ``s`` and cos ``c``. In compiled code only (a one-form model's
+    functions, ``h`` a static slice of its coefficients, ``n_meshes`` a constant): the number
+    of harmonics follows from the tuple's length, and the series is written out term by term
+    (the same operations in the same order as :func:`harmonic_factor`, so the same bits; the
+    harmonics' cos and sin by the one recurrence for every mesh), with no loop and no libm call,
+    so that a lane loop over it vectorises."""
+    raise NotImplementedError("harmonic_factors is compiled code's (numba) only")
+
+
+@overload(harmonic_factors, inline="always")
+def _harmonic_factors(h, n_meshes, s, c):
+    if not isinstance(n_meshes, types.IntegerLiteral):
+        raise errors.TypingError("harmonic_factors: n_meshes must be a constant")
+    m = n_meshes.literal_value
+    if not isinstance(h, types.BaseTuple) or m < 1 or len(h) % (2 * m):
+        raise errors.TypingError(f"harmonic_factors: a tuple of 2 nh coefficients per mesh "
+                                 f"for {m} meshes (got {h})")
+    nh = len(h) // (2 * m)
+    lines = ["def impl(h, n_meshes, s, c):"]
+    if nh == 0:
+        lines.append(f"    return {(1.0,) * m!r}")
+    else:
+        lines += [f"    a{j} = h[{2 * nh * j}] * c + h[{2 * nh * j + 1}] * s" for j in range(m)]
+        lines += ["    ch = c", "    sh = s"]
+        for q in range(1, nh):
+            lines.append("    ch, sh = ch * c - sh * s, sh * c + ch * s")
+            lines += [f"    a{j} += h[{2 * nh * j + 2 * q}] * ch + h[{2 * nh * j + 2 * q + 1}] * sh"
+                      for j in range(m)]
+        lines += [f"    v{j} = 1.0 + a{j}" for j in range(m)]
+        lines.append("    return (" + "".join(f"v{j} if v{j} > 0.0 else 0.0, "
+                                             for j in range(m)) + ")")
+    env: dict = {}
+    exec(compile("\n".join(lines) + "\n", "<harmonic_factors>", "exec"), env)
+    return env["impl"]

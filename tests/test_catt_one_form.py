@@ -1,0 +1,180 @@
+"""The reduced CATT device in the one form (:mod:`geardyn.models.catt_reduced`, selected by
+``CATTDevice(..., one_form=True)``): every generated layout gives the bits of the general
+model's hand-written array form (:func:`~geardyn.models.catt_kernels.catt_rhs` with one planet
+set); lanes with the load quiet take FORM_QUIET (the load term compiled away), lanes with it
+fluctuating FORM_LOAD, any number of stiffness harmonics; every lane's result is bitwise that of
+the one-lane path (``simulate``) and of the hand-written reduced kernel."""
+
+from __future__ import annotations
+
+import math
+
+import numba as nb
+import numpy as np
+import pytest
+
+import geardyn
+from geardyn.core.kernel_source import FORM_GENERAL, FORM_LOAD, FORM_QUIET
+from geardyn.core.one_form import OneForm
+from geardyn.core.plan import LaneSettings
+from geardyn.core.settings import RunSettings
+from geardyn.models import catt_kernels as ck
+from geardyn.models.catt_reduced import coefficient_names
+from geardyn.models.elements import harmonic_factors
+from geardyn.solvers.ensemble import run_lanes
+from geardyn.solvers.kernels import kernels_for
+
+_OMEGAS = np.array([0.7, 1.3, 2.2, 3.1, 0.45])
+
+
+def _device(one_form=True, **changes):
+    return geardyn.CATTDevice(geardyn.PlanetaryParams.paper(xi1=0.1, xi2=0.1, **changes),
+                              one_form=one_form)
+
+
+_LOAD = {"B1": "100 N m", "B2": "100 N m", "Lambda": 0.1}
+
+
+def _assert_lanes_equal_simulate(models, omegas, steps=48):
+    """run_lanes of the stacked lanes of ``models`` (one model's layout) against simulate."""
+    P = np.vstack([m.lane_params("Omega", omegas) for m in models])
+    first = models[0]
+    r = run_lanes(first, P, first.initial_state(),
+                  run=RunSettings(transient=200.0, samples=3, steps_per_period=steps),
+                  lanes=LaneSettings(sample_every=1))
+    assert np.all(r.status == 0)
+    for j in range(P.shape[0]):
+        m = models[j // omegas.size]
+        ds = geardyn.simulate(m, omega=float(omegas[j % omegas.size]),
+                              run=geardyn.RunSettings(transient=200.0, samples=3,
+                                                      steps_per_period=steps))
+        np.testing.assert_array_equal(r.samples[j], ds["poincare"].values[1:], err_msg=str(j))
+
+
+def _gen(model):
+    """The model's generated functions (the kernels' shared core, compiled on first call)."""
+    return kernels_for(model.kernel, "core")
+
+
+def _form(model):
+    P = np.ascontiguousarray(model.lane_params("Omega", _OMEGAS[:1]).T)
+    return _gen(model).rhs_lane_form(P, 0)
+
+
+def test_each_lane_form_equals_the_one_lane_path_bitwise():
+    quiet, load = _device(), _device(**_LOAD)
+    rect = _device(waveform="rectangular")
+    assert (_form(quiet), _form(load), _form(rect)) == (FORM_QUIET, FORM_LOAD, FORM_QUIET)
+    _assert_lanes_equal_simulate([load], _OMEGAS)
+    _assert_lanes_equal_simulate([rect], _OMEGAS[:3])
+    # quiet and fluctuating lanes in one queue run in the general form: still the same results
+    _assert_lanes_equal_simulate([quiet, load], _OMEGAS[:3])
+
+
+def test_the_one_form_runs_the_hand_written_kernels_lanes_bitwise():
+    """Quiet and fluctuating lanes in one sweep, through the one form and through the
+    hand-written reduced kernel (catt_kernels.catt_rhs_one and its lane forms)."""
+    omega = np.array([0.6, 1.3, 2.7])
+    run = RunSettings(transient=200.0, samples=3, steps_per_period=48)
+    out = []
+    for one in (True, False):
+        quiet, load = _device(one_form=one), _device(one_form=one, **_LOAD)
+        assert quiet.one_form is one and quiet.with_omega(1.1).one_form is one
+        P = np.vstack([quiet.lane_params("Omega", omega), load.lane_params("Omega", omega)])
+        r = run_lanes(quiet, P, quiet.initial_state(), run=run,
+                      lanes=LaneSettings(sample_every=1))
+        assert np.all(r.status == 0)
+        out.append(r)
+    np.testing.assert_array_equal(out[0].samples, out[1].samples)
+    np.testing.assert_array_equal(out[0].final, out[1].final)
+
+
+_DEVICES = {"quiet": {}, "load": _LOAD, "rectangular": {"waveform": "rectangular"},
+            "rectangular-load": {"waveform": "rectangular", **_LOAD},
+            "load-outside-only": {"B1": "100 N m", "Lambda": 0.3, "psi1": 0.4}}
+
+
+@pytest.mark.parametrize("case", list(_DEVICES))
+def test_every_generated_layout_equals_the_general_models_array_form(case):
+    """The reduced device's generated layouts (array, lane-scalar in its form and in the general
+    form, lane block) against the general model's own array form :func:`ck.catt_rhs` for one
+    planet set (written separately, with harmonic_factor's loop and the load's branch), bit for
+    bit, at random states, times and mesh phases; the forces likewise."""
+    m = _device(**_DEVICES[case]).with_omega(1.3)
+    gen = _gen(m)
+    p = m.params
+    nl = 3
+    PT = np.ascontiguousarray(np.tile(p[:, None], (1, nl)))
+    form = gen.rhs_lane_form(PT, 0)
+    rng = np.random.default_rng(7)
+    T, ph = rng.uniform(0.0, 80.0, nl), rng.uniform(-3.0, 3.0, nl)
+    S, C = np.sin(ph), np.cos(ph)
+    Y = rng.normal(0.0, 3.0, (4, nl))
+    DY, O, SC = np.zeros((4, nl)), np.zeros((2, nl)), np.zeros((4, nl))
+    gen.rhs_lanes(T, Y, DY, PT, nl, S, C, SC)
+    gen.observe_lanes(T, Y, O, PT, nl, S, C, SC)
+    for k in range(nl):
+        y = Y[:, k].copy()
+        ref, oref, dy = np.empty(4), np.empty(2), np.empty(4)
+        ck.catt_rhs(T[k], y, ref, p, S[k], C[k])
+        ck.catt_observe(T[k], y, oref, p, S[k], C[k])
+        gen.rhs(T[k], y, dy, p, S[k], C[k])
+        for got in (dy, DY[:, k], gen.rhs_lane(T[k], tuple(y), PT, k, S[k], C[k], form),
+                    gen.rhs_lane(T[k], tuple(y), PT, k, S[k], C[k], FORM_GENERAL)):
+            np.testing.assert_array_equal(np.asarray(got), ref, err_msg=case)
+        np.testing.assert_array_equal(O[:, k], oref)
+        np.testing.assert_array_equal(np.asarray(
+            gen.observe_lane(T[k], tuple(y), PT, k, S[k], C[k], form)), oref)
+
+
+def _llvm_of_lane_call(gen, form):
+    """The optimised LLVM IR of a function that calls the generated ``rhs_lane`` in ``form``."""
+    rhs_lane = gen.rhs_lane
+
+    @nb.njit
+    def call(y, PT, s, c):
+        return rhs_lane(0.1, y, PT, 0, s, c, form)
+
+    P = np.ascontiguousarray(_device().lane_params("Omega", _OMEGAS[:1]).T)
+    call((0.01, 0.0, -0.02, 0.0), P, 0.3, 0.9)
+    return next(iter(call.inspect_llvm().values()))
+
+
+def test_the_quiet_form_compiles_the_load_term_away():
+    """A quiet lane's copy holds no load sine (its floor is the marker), the general one does:
+    the one form's ``quiet`` coefficients are constant zeros in the quiet copy."""
+    gen = _gen(_device())
+    assert "llvm.floor" not in _llvm_of_lane_call(gen, FORM_QUIET)
+    assert "llvm.floor" in _llvm_of_lane_call(gen, FORM_LOAD)
+    assert "llvm.floor" in _llvm_of_lane_call(gen, FORM_GENERAL)
+
+
+def test_a_quiet_coefficient_must_be_a_coefficient_of_the_form():
+    with pytest.raises(ValueError, match="quiet"):
+        OneForm(coefficient_names(1), 4, 4, 2, quiet=("f_c1", "B1"))
+    with pytest.raises(ValueError, match="quiet"):
+        OneForm(coefficient_names(1), 4, 4, 2, quiet=("f_c1", "f_c1"))
+
+
+@nb.njit
+def _three_meshes(h, s, c):
+    return harmonic_factors(h, 3, s, c)
+
+
+@pytest.mark.parametrize("nh", [1, 2, 7])
+def test_harmonic_factors_sum_the_series_of_each_mesh(nh):
+    """The written-out series of three meshes against numpy's cos(h theta), sin(h theta)
+    (:func:`geardyn.models.stiffness.evaluate`), and bitwise against harmonic_factor's loop."""
+    from geardyn.models.elements import harmonic_factor
+    from geardyn.models.stiffness import evaluate
+
+    rng = np.random.default_rng(nh)
+    coef = rng.uniform(-0.3, 0.3, (3, nh, 2)) / nh
+    flat = coef.reshape(-1)
+    for theta in (0.0, 0.4, 2.9, -1.7):
+        s, c = math.sin(theta), math.cos(theta)
+        got = _three_meshes(tuple(flat), s, c)
+        for m in range(3):
+            ref = evaluate(coef[m, :, 0], coef[m, :, 1], np.array([theta]))[0]
+            assert got[m] == pytest.approx(max(ref, 0.0), abs=1e-14)
+            assert got[m] == harmonic_factor(flat, 2 * nh * m, nh, s, c)
