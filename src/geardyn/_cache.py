@@ -16,10 +16,20 @@ numba picks the locator of a function when it is decorated, so this module runs 
 defines any numba function. Subprocesses that import geardyn (test workers, Dask workers)
 register it too. Where ``NUMBA_CACHE_LOCATOR_CLASSES`` is set, numba uses only the classes it
 names (numba's setting wins).
+
+numba checks a cached function against its own file only, while its compiled code also holds
+what it took from other modules: functions it inlined or called (:mod:`geardyn.models.elements`'
+dead zone), and module constants frozen in at compile time (coefficient offsets from
+:mod:`geardyn.models.derived`). For geardyn's functions the stamp numba keeps with their code
+(:func:`source_stamp`) is therefore a hash of the file and of every geardyn module it imports,
+transitively: an edit to any of them recompiles the function rather than loading stale code.
 """
 
 from __future__ import annotations
 
+import ast
+import functools
+import hashlib
 import os
 from collections.abc import Mapping
 from pathlib import Path
@@ -62,6 +72,82 @@ def is_geardyn_file(py_file: str | os.PathLike[str]) -> bool:
                for folder in (PACKAGE_DIR, Path(os.path.abspath(cache_root() / "kernels"))))
 
 
+def _module_file(name: str) -> Path | None:
+    """The source file of geardyn's module ``name`` (None: not a module of the package)."""
+    parts = name.split(".")
+    if parts[0] != "geardyn":
+        return None
+    base = PACKAGE_DIR.joinpath(*parts[1:])
+    for path in (base.with_suffix(".py"), base / "__init__.py"):
+        if path.is_file():
+            return path
+    return None
+
+
+@functools.cache
+def _imports(path: Path, mtime: float, size: int) -> frozenset[Path]:
+    """The files of the geardyn modules ``path`` imports at its top level (``mtime`` and
+    ``size`` key the memo: an edited file is parsed again)."""
+    package = "geardyn" + "".join("." + p for p in path.relative_to(PACKAGE_DIR).parent.parts) \
+        if path.is_relative_to(PACKAGE_DIR) else ""
+    found: set[Path] = set()
+    for node in ast.parse(path.read_bytes()).body:
+        names: list[str] = []
+        if isinstance(node, ast.Import):
+            names = [a.name for a in node.names]
+        elif isinstance(node, ast.ImportFrom):
+            module = node.module or ""
+            if node.level:
+                parent = package.rsplit(".", node.level - 1)[0] if node.level > 1 else package
+                module = f"{parent}.{module}" if module else parent
+            names = [module, *(f"{module}.{a.name}" for a in node.names)]
+        # the package itself is no dependency (its __init__ imports every layer)
+        found.update(f for f in map(_module_file, names)
+                     if f is not None and f != PACKAGE_DIR / "__init__.py")
+    return frozenset(found)
+
+
+@functools.cache
+def _code_digest(path: Path, mtime: float, size: int) -> bytes:
+    """A hash of ``path``'s code: its syntax tree without docstrings and positions (comments,
+    docstrings and layout change nothing)."""
+    tree = ast.parse(path.read_bytes())
+    for node in ast.walk(tree):
+        body = getattr(node, "body", None)
+        if (isinstance(body, list) and body and isinstance(body[0], ast.Expr)
+                and isinstance(body[0].value, ast.Constant)
+                and isinstance(body[0].value.value, str)):
+            body[0] = ast.Pass()
+    return hashlib.sha256(ast.dump(tree, include_attributes=False).encode()).digest()
+
+
+def dependency_files(py_file: str | os.PathLike[str]) -> tuple[Path, ...]:
+    """``py_file`` and the files of every geardyn module it imports, transitively (top-level
+    ``import``/``from ... import`` statements), sorted."""
+    seen: set[Path] = set()
+    todo = [Path(os.path.abspath(py_file))]
+    while todo:
+        path = todo.pop()
+        if path in seen:
+            continue
+        seen.add(path)
+        st = os.stat(path)
+        todo.extend(_imports(path, st.st_mtime, st.st_size))
+    return tuple(sorted(seen))
+
+
+def source_stamp(py_file: str | os.PathLike[str]) -> bytes:
+    """numba's stamp of a cached function of ``py_file``: the code of ``py_file`` and of its
+    :func:`dependency_files` (:func:`_code_digest`), so its cached code is loaded only while
+    none of them changed but in comments and docstrings."""
+    h = hashlib.sha256()
+    for path in dependency_files(py_file):
+        st = os.stat(path)
+        h.update(str(path.relative_to(path.anchor)).encode())
+        h.update(_code_digest(path, st.st_mtime, st.st_size))
+    return h.digest()
+
+
 class GeardynCacheLocator(caching.UserProvidedCacheLocator):
     """numba's cache locator for geardyn's functions: the layout of numba's own
     ``NUMBA_CACHE_DIR`` locator, rooted at numba's ``NUMBA_CACHE_DIR`` where set, else at
@@ -73,6 +159,10 @@ class GeardynCacheLocator(caching.UserProvidedCacheLocator):
         self._lineno = py_func.__code__.co_firstlineno
         self._cache_path = os.path.join(config.CACHE_DIR or str(numba_cache_dir()),
                                         self.get_suitable_cache_subpath(py_file))
+
+    def get_source_stamp(self) -> bytes:
+        """:func:`source_stamp` of the function's file (numba's own: of the file alone)."""
+        return source_stamp(self._py_file)
 
     def get_disambiguator(self) -> str:
         """The function's first line and the vector width (``12-simd512``)."""
