@@ -3,11 +3,13 @@
 Every test worker (pytest-xdist) is a separate process, and numba compiles a kernel in the first
 process that needs it and finds no cached copy; two workers that start on the same model compile
 its kernels twice, side by side, one core each. This script compiles each built-in model's
-kernels (sweep, trajectory, Lyapunov lanes and single lane, monodromy), and those of the user
-models the tests share (``tests/shared_models.py``), in its own process, the models spread over
-``--jobs`` processes, through the public API with the argument types the tests use, so that the
-workers load them from the on-disk cache instead. With a warm cache it only loads them (a few
-seconds). Running it is an optimisation: the tests do not depend on it.
+kernels that the tests use (``WARM``: sweep, trajectory, Lyapunov lanes and single lane,
+monodromy, run-up), and those of the user models the tests share (``tests/shared_models.py``), in
+its own process, the models spread over ``--jobs`` processes (longest first, ``COST``), through
+the public API with the argument types the tests use, so that the workers load them from the
+on-disk cache instead (a worker that needs a kernel the other is compiling waits for it,
+idle). With a warm cache it only loads them (a few seconds). Running it is an optimisation:
+the tests do not depend on it.
 
     python tests/warm_kernels.py --jobs 2
 """
@@ -28,8 +30,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 #: simulate, lyapunov = one lane, lanes = Lyapunov lane blocks, orbit = the monodromy kernel,
 #: runup = the run-up kernel (run-ups, fault datasets; tests in both workers use those of the gear
 #: pair, the spur pair and the planetary set, whose models share these cases' kernels).
-#: The one-form gear pair's and the train's lane blocks are left out: no test of the default run
-#: loads them (their Lyapunov lane blocks compile ~12 and ~25 s CPU).
+#: The one-form gear pair's and the train's (the planetary set's) Lyapunov lane blocks are left
+#: out: no test of the default run loads them (they compile ~12 and ~25 s CPU).
 WARM = {
     "CATTDevice-reduced": ("trajectory", "sweep", "lyapunov", "lanes", "orbit"),
     "CATTDevice-general": ("trajectory", "lyapunov", "lanes", "orbit"),
@@ -45,13 +47,15 @@ WARM = {
     "Lorenz": ("lyapunov", "lanes"),
 }
 
-#: CPU seconds of each case's warm-up with an empty cache (2-core AMD EPYC machine, two jobs;
-#: the first case of a process also compiles the kernels' shared functions). The cases start
-#: longest first, so that the two processes end together instead of one compiling alone.
+#: CPU seconds of each case's warm-up with an empty cache (2-core AMD EPYC machine, two jobs, the
+#: machine shared; the run-up kernels' share estimated from the tests that compiled them: gear
+#: pair ~10, planetary set ~19, spur pair ~25). The first case of a process also compiles the
+#: kernels' shared functions; the train shares the planetary set's kernels (it runs after it).
+#: The cases start longest first, so that the two processes end together.
 COST = {
-    "PlanetaryGearSet": 108, "SpurPair": 61, "GearPair": 44, "CATTDevice-reduced": 42,
-    "UserModel-one-form": 25, "CATTDevice-general": 27, "oscillator": 24, "Lorenz": 19,
-    "DimensionalCATT": 16, "UserModel": 14, "TrainModel": 10,
+    "PlanetaryGearSet": 137, "SpurPair": 92, "GearPair": 48, "CATTDevice-reduced": 44,
+    "CATTDevice-general": 27, "oscillator": 25, "UserModel-one-form": 24, "Lorenz": 19,
+    "DimensionalCATT": 16, "UserModel": 14, "TrainModel": 1,
 }
 
 
