@@ -21,7 +21,8 @@ from geardyn.solvers.reference import reference_solution
 
 #: Modules a generated kernel may import besides the model's own (the shared modules: kernel
 #: code that does not evaluate the model, compiled once for every model).
-_ALLOWED = {"__future__", "math", "numba", "numpy", "llvmlite", "geardyn.core._noop",
+_ALLOWED = {"__future__", "math", "numba", "numpy", "llvmlite", "geardyn._jit_target",
+            "geardyn.core._noop",
             "geardyn.core.kernel_source", "geardyn.core.one_form", "geardyn.solvers._parallel",
             *SHARED_MODULES}
 #: Packages whose submodules a generated kernel may import too (numba.extending, numba.core:
