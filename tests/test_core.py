@@ -207,8 +207,9 @@ def _geardyn_imports(path: Path) -> list[str]:
     return [n for n in names if n.startswith(("geardyn", "."))]
 
 
-#: The base modules below the core (they import nothing of geardyn; see tests/test_layers.py).
-_BASE = {"geardyn.errors", "geardyn.units", "geardyn._version"}
+#: The base modules below the core (they import nothing of geardyn; see tests/test_layers.py),
+#: ``_jit_target`` among them: the compiler pipeline of geardyn's numba functions.
+_BASE = {"geardyn.errors", "geardyn.units", "geardyn._version", "geardyn._jit_target"}
 
 
 def test_core_imports_nothing_above_it():
