@@ -23,6 +23,7 @@ from geardyn.models.catt_reduced import coefficient_names
 from geardyn.models.elements import harmonic_factors
 from geardyn.solvers.ensemble import run_lanes
 from geardyn.solvers.kernels import kernels_for
+from test_catt_lane_forms import _LOAD, _assert_lanes_equal_simulate
 
 _OMEGAS = np.array([0.7, 1.3, 2.2, 3.1, 0.45])
 
@@ -30,25 +31,6 @@ _OMEGAS = np.array([0.7, 1.3, 2.2, 3.1, 0.45])
 def _device(one_form=True, **changes):
     return geardyn.CATTDevice(geardyn.PlanetaryParams.paper(xi1=0.1, xi2=0.1, **changes),
                               one_form=one_form)
-
-
-_LOAD = {"B1": "100 N m", "B2": "100 N m", "Lambda": 0.1}
-
-
-def _assert_lanes_equal_simulate(models, omegas, steps=48):
-    """run_lanes of the stacked lanes of ``models`` (one model's layout) against simulate."""
-    P = np.vstack([m.lane_params("Omega", omegas) for m in models])
-    first = models[0]
-    r = run_lanes(first, P, first.initial_state(),
-                  run=RunSettings(transient=200.0, samples=3, steps_per_period=steps),
-                  lanes=LaneSettings(sample_every=1))
-    assert np.all(r.status == 0)
-    for j in range(P.shape[0]):
-        m = models[j // omegas.size]
-        ds = geardyn.simulate(m, omega=float(omegas[j % omegas.size]),
-                              run=geardyn.RunSettings(transient=200.0, samples=3,
-                                                      steps_per_period=steps))
-        np.testing.assert_array_equal(r.samples[j], ds["poincare"].values[1:], err_msg=str(j))
 
 
 def _gen(model):
