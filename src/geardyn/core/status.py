@@ -12,8 +12,6 @@ from __future__ import annotations
 
 from enum import IntEnum
 
-import numpy as np
-
 
 class Status(IntEnum):
     """Outcome of one integration (one lane)."""
@@ -49,7 +47,3 @@ def status_attrs(suffix: str = "") -> dict[str, str]:
     ``flag_meanings``, which the Zarr store reads as a categorical variable's labels)."""
     return {"meaning": status_meaning(suffix)}
 
-
-def is_ok(status: np.ndarray | int) -> np.ndarray:
-    """True where ``status`` is :attr:`Status.OK` (element-wise)."""
-    return np.asarray(status) == Status.OK
