@@ -20,13 +20,8 @@ from pydantic import ValidationError
 
 from geardyn.core.model import Model
 from geardyn.errors import ParameterError, StudyError
-from geardyn.io.toml import (
-    GearPairParams,
-    PlanetaryGearSetParams,
-    SpurPairParams,
-    Study,
-    TrainModelParams,
-)
+from geardyn.io.study_models import STUDY_MODELS, study_model
+from geardyn.io.toml import FaultTable, PlanetaryGearSetParams, Study
 from geardyn.models.catt import CATTDevice
 from geardyn.models.derived import INTERPRETATIONS
 from geardyn.models.gear_pair import GearPair
@@ -35,8 +30,8 @@ from geardyn.models.planetary_coefficients import INPUTS as PLANETARY_INPUTS
 from geardyn.models.spur_pair import SpurPair, period_cycles
 from geardyn.units import to_si
 
-__all__ = ["build_model", "check_usable", "mesh_stiffness", "planetary_model",
-           "spur_pair_model", "study_omega", "train_model"]
+__all__ = ["BUILDERS", "FAULTED", "build_model", "check_usable", "faulted_model",
+           "mesh_stiffness", "planetary_model", "spur_pair_model", "study_omega", "train_model"]
 
 
 def require_model(study: Study) -> None:
@@ -53,7 +48,9 @@ def require_model(study: Study) -> None:
 def build_model(study: Study, interpretation: str | None = None, omega: float | None = None
                 ) -> Model:
     """The study's model: a :class:`~geardyn.CATTDevice`, a :class:`~geardyn.GearPair`, a
-    :class:`~geardyn.PlanetaryGearSet` or a :class:`~geardyn.SpurPair`.
+    :class:`~geardyn.PlanetaryGearSet`, a :class:`~geardyn.SpurPair` or a gear train's
+    ``TrainModel``, as the builder of its ``[study].model`` makes it (``BUILDERS``, one per
+    kind of ``geardyn.io.study_models.STUDY_MODELS``).
 
     ``interpretation`` and ``omega`` override the study's (``omega`` defaults to
     ``[run].omega``, else 1; a spur pair's to the Omega of its ``[params].speed``). Raises
@@ -66,22 +63,71 @@ def build_model(study: Study, interpretation: str | None = None, omega: float | 
         )
     require_model(study)
     om = omega if omega is not None else study.run.omega
-    if isinstance(study.params, GearPairParams):
-        kwargs = study.params.model_dump()
-        if om is not None:
-            kwargs["Omega"] = float(om)
-        return check_usable(lambda: GearPair(**kwargs))
-    if isinstance(study.params, PlanetaryGearSetParams):
-        return check_usable(lambda: planetary_model(study.params, om))
-    if isinstance(study.params, SpurPairParams):
-        return check_usable(lambda: spur_pair_model(study, om))
-    if isinstance(study.params, TrainModelParams):
-        return check_usable(lambda: train_model(study, om))
-    return check_usable(lambda: CATTDevice(
-        study.planetary_params,
-        interpretation or study.study.interpretation,  # type: ignore[arg-type]
-        omega=1.0 if om is None else float(om),
-    ))
+    build = BUILDERS[study_model(study.study.model).name]
+    return check_usable(lambda: build(study, om, interpretation))
+
+
+def _catt_model(study: Study, omega: float | None, interpretation: str | None) -> Model:
+    return CATTDevice(study.planetary_params,
+                      interpretation or study.study.interpretation,  # type: ignore[arg-type]
+                      omega=1.0 if omega is None else float(omega))
+
+
+def _gear_pair_model(study: Study, omega: float | None, interpretation: str | None) -> Model:
+    kwargs = study.params.model_dump()  # type: ignore[union-attr]
+    if omega is not None:
+        kwargs["Omega"] = float(omega)
+    return GearPair(**kwargs)
+
+
+#: What builds the model of each study model kind (:data:`~geardyn.io.study_models.STUDY_MODELS`)
+#: from a study: ``(study, omega or None, interpretation or None) -> model``.
+BUILDERS: dict[str, Callable[[Study, float | None, str | None], Model]] = {
+    "catt": _catt_model,
+    "gear_pair": _gear_pair_model,
+    "spur_pair": lambda study, omega, _: spur_pair_model(study, omega),
+    "planetary": lambda study, omega, _: planetary_model(study.params, omega),  # type: ignore
+    "train": lambda study, omega, _: train_model(study, omega),
+}
+
+
+def _spur_pair_faulted(study: Study, tables: list[dict]) -> Model:
+    faults = [FaultTable(**t) for t in tables]
+    return spur_pair_model(study.model_copy(update={"faults": faults or None}))
+
+
+def _planetary_faulted(study: Study, tables: list[dict]) -> Model:
+    params = study.params
+    faults = [FaultTable(**t) for t in tables]
+    geometry = params.geometry.model_copy(update={"faults": faults or None})  # type: ignore
+    return planetary_model(params.model_copy(update={"geometry": geometry}))  # type: ignore
+
+
+def _train_faulted(study: Study, tables: list[dict]) -> Model:
+    train = study.train.model_copy(update={"faults": list(tables)}).build()  # type: ignore
+    return train_model(study, train=train)
+
+
+#: What builds the model of a study with other faults, per study model kind that takes them
+#: (``StudyModel.dataset``): ``(study, fault tables) -> model``, the tables (``[]``: healthy) in
+#: place of the study's own (``StudyModel.dataset.table``).
+FAULTED: dict[str, Callable[[Study, list[dict]], Model]] = {
+    "spur_pair": _spur_pair_faulted,
+    "planetary": _planetary_faulted,
+    "train": _train_faulted,
+}
+
+
+def faulted_model(study: Study, tables: list[dict]) -> Model:
+    """The study's model with the fault ``tables`` (each a fault table's fields; ``[]``:
+    healthy) in place of the study's own faults (:data:`FAULTED`); a
+    :class:`~geardyn.StudyError` for a kind that takes none."""
+    kind = study_model(study.study.model)
+    if kind.name not in FAULTED:
+        takes = ", ".join(k for k, m in STUDY_MODELS.items() if m.dataset is not None)
+        raise StudyError(f"study {study.study.name!r}: a {kind.name} study takes no other "
+                         f"faults (one of {takes} does)")
+    return FAULTED[kind.name](study, tables)
 
 
 def mesh_stiffness(study: Study, faults: bool = True, loaded: bool = True) -> xr.Dataset:
@@ -175,7 +221,7 @@ def study_omega(study: Study, model: Model, given: float | None = None) -> float
         return given
     if study.run.omega is not None:
         return study.run.omega
-    return model.omega if isinstance(study.params, SpurPairParams | TrainModelParams) else None
+    return model.omega if study_model(study.study.model).omega_from_params else None
 
 
 def planetary_model(params: PlanetaryGearSetParams, omega: float | None = None

@@ -39,6 +39,7 @@ from geardyn.cli.common import (
     write_outputs,
 )
 from geardyn.errors import ParameterError, StudyError
+from geardyn.io.study_models import study_model
 from geardyn.study import build_model, study_omega
 
 __all__ = ["basins_command", "register"]
@@ -84,7 +85,7 @@ def basins_command(
     interp = interpretation.value if interpretation is not None else None
     om = omega if omega is not None else s.run.omega
     base = None
-    if om is None and s.study.model in ("spur_pair", "train"):  # Omega from [params]
+    if om is None and study_model(s.study.model).omega_from_params:
         base = build_model(s, interpretation=interp)
         om = study_omega(s, base)
     if om is None:

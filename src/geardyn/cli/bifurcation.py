@@ -22,9 +22,10 @@ import contextlib
 import math
 import sys
 import time
+from collections.abc import Callable
 from enum import StrEnum
 from pathlib import Path
-from typing import Annotated
+from typing import Annotated, Any
 
 import typer
 from rich.markup import escape
@@ -50,6 +51,7 @@ from geardyn.cli.common import (
     usable_omega,
     write_outputs,
 )
+from geardyn.core.results import SCHEMAS
 from geardyn.errors import ParameterError, StudyError
 from geardyn.study import build_model, study_omega
 
@@ -359,11 +361,131 @@ def bifurcation_command(
     )
 
 
-#: What ``geardyn plot`` calls each result kind (``attrs["geardyn_kind"]``).
-_PLOT_KIND = {"simulation": "simulation", "bifurcation": "bifurcation", "map2d": "map",
-              "reproduction-case": "reproduction", "basins": "basins",
-              "frequency-response": "frequency response", "continuation": "continuation",
-              "runup": "run-up", "dynamic-factor": "dynamic factor", "curve": "curve"}
+def _stateless(label: str, draw: Callable[[Any, Path], None], figure: str = ""
+               ) -> Callable[..., str]:
+    """The redraw of a figure of ``label`` that shows no state: ``draw(ds, path)``; a
+    ``--state`` is refused naming the ``figure`` (default: a <label> figure)."""
+    def redraw(ds: Any, target: Path, state: str | None, sweep: SweepDirection) -> str:
+        if state is not None:
+            raise ParameterError("--state", state, f"{figure or f'a {label} figure'} shows no"
+                                 " state; leave it out")
+        make_parents(target)
+        draw(ds, target)
+        return f"{label} dataset"
+    return redraw
+
+
+def _plot_map(ds: Any, path: Path) -> None:
+    from geardyn.plotting.map2d import plot_map
+
+    plot_map(ds, path=path)
+
+
+def _plot_basins(ds: Any, path: Path) -> None:
+    from geardyn.plotting.basins import plot_basins
+
+    plot_basins(ds, path=path)
+
+
+def _plot_frc(ds: Any, path: Path) -> None:
+    from geardyn.plotting.frc import plot_frc
+
+    plot_frc(ds, path=path)
+
+
+def _plot_stiffness(ds: Any, path: Path) -> None:
+    from geardyn.plotting.stiffness import plot_mesh_stiffness
+
+    plot_mesh_stiffness(ds, path=path)
+
+
+def _plot_dynamic_factor(ds: Any, path: Path) -> None:
+    from geardyn.plotting.dynamic_factor import plot_dynamic_factor
+
+    plot_dynamic_factor(ds, path=path)
+
+
+def _plot_curve(ds: Any, path: Path) -> None:
+    from geardyn.plotting.envelope import plot_curves
+
+    plot_curves([ds], path=path)
+
+
+def _plot_simulation(ds: Any, state: str, path: Path) -> None:
+    from geardyn.plotting.simulation import plot_simulation
+
+    plot_simulation(ds, state=state, path=path)
+
+
+def _plot_bifurcation(ds: Any, state: str, path: Path) -> None:
+    from geardyn.plotting.bifurcation import plot_bifurcation
+
+    plot_bifurcation(ds, state=state, path=path)
+
+
+def _redraw_runup(ds: Any, target: Path, state: str | None, sweep: SweepDirection) -> str:
+    from geardyn.analysis.orders import waterfall
+    from geardyn.plotting.orders import plot_waterfall
+
+    recorded = ds.attrs["outputs"].split(",")
+    forces = [o for o in ds.attrs.get("observables", "").split(",") if o]
+    shown = _check_state(recorded, state or (forces or recorded)[0], "--state")
+    make_parents(target)
+    plot_waterfall(waterfall(ds, shown), ds, path=target)
+    return f"run-up dataset ({shown})"
+
+
+def _redraw_continuation(ds: Any, target: Path, state: str | None,
+                         sweep: SweepDirection) -> str:
+    from geardyn.plotting.branch import plot_branch
+
+    names = [str(v) for v in ds["state"].values]
+    shown = _check_state(names, state, "--state") if state is not None else None
+    make_parents(target)
+    plot_branch(ds, path=target, state=shown)
+    return "continuation dataset"
+
+
+def _of_state(label: str, draw: Callable[[Any, str, Path], None], sweeps: bool = False
+              ) -> Callable[..., str]:
+    """The redraw of a figure of one state, ``draw(ds, state, path)``: the state given, else
+    the one the dataset names (``plot_state``), else X_sq or x, else its first; ``sweeps``: a
+    reproduction case's, of the sweep ``--sweep``."""
+    def redraw(ds: Any, target: Path, state: str | None, sweep: SweepDirection) -> str:
+        if sweeps:
+            attrs = dict(ds.attrs, continuation=sweep.value)
+            ds = ds.sel(sweep=sweep.value, drop=True)
+            ds.attrs = attrs
+        names = [str(v) for v in ds["state"].values]
+        default = ds.attrs.get("plot_state") or next(
+            (n for n in ("X_sq", "x") if n in names), names[0])
+        shown = _check_state(names, state or default, "--state")
+        make_parents(target)
+        draw(ds, shown, target)
+        return f"{label} dataset"
+    return redraw
+
+
+#: How ``geardyn plot`` redraws each kind of result, by its name in messages (the result
+#: schema's, :attr:`geardyn.core.results.ResultSchema.name`; ``"mesh stiffness"``, a dataset of
+#: :func:`geardyn.gears.potential_energy_stiffness`, has no schema): ``(dataset, figure path,
+#: --state, --sweep) -> what was drawn``.
+REDRAWS: dict[str, Callable[..., str]] = {
+    "simulation": _of_state("simulation", _plot_simulation),
+    "bifurcation": _of_state("bifurcation", _plot_bifurcation),
+    "reproduction": _of_state("reproduction", _plot_bifurcation, sweeps=True),
+    "map": _stateless("map", _plot_map, figure="a map"),
+    "basins": _stateless("basins", _plot_basins),
+    "frequency response": _stateless("frequency response", _plot_frc),
+    "mesh stiffness": _stateless("mesh stiffness", _plot_stiffness),
+    "dynamic factor": _stateless("dynamic factor", _plot_dynamic_factor),
+    "curve": _stateless("curve", _plot_curve),
+    "run-up": _redraw_runup,
+    "continuation": _redraw_continuation,
+}
+
+#: What ``geardyn plot`` calls each result kind it redraws (``attrs["geardyn_kind"]``).
+_PLOT_KIND = {kind: s.name for kind, s in SCHEMAS.items() if s.name in REDRAWS}
 
 
 def _dataset_kind(ds) -> str:
@@ -445,80 +567,8 @@ def plot_command(
     target = out if out is not None else result.with_suffix(".png")
     check_plot_path("--out", target)
     ds = _load_result(result)
-    kind = _dataset_kind(ds)
-    if kind == "map":
-        if state is not None:
-            raise ParameterError("--state", state, "a map shows no state; leave it out")
-        from geardyn.plotting.map2d import plot_map
-
-        make_parents(target)
-        plot_map(ds, path=target)
-        typer.echo(f"{result}: map dataset; wrote {target}")
-        return
-    if kind in ("basins", "frequency response", "mesh stiffness", "dynamic factor", "curve"):
-        if state is not None:
-            raise ParameterError("--state", state, f"a {kind} figure shows no state; leave it out")
-        make_parents(target)
-        if kind == "basins":
-            from geardyn.plotting.basins import plot_basins
-
-            plot_basins(ds, path=target)
-        elif kind == "dynamic factor":
-            from geardyn.plotting.dynamic_factor import plot_dynamic_factor
-
-            plot_dynamic_factor(ds, path=target)
-        elif kind == "curve":
-            from geardyn.plotting.envelope import plot_curves
-
-            plot_curves([ds], path=target)
-        elif kind == "mesh stiffness":
-            from geardyn.plotting.stiffness import plot_mesh_stiffness
-
-            plot_mesh_stiffness(ds, path=target)
-        else:
-            from geardyn.plotting.frc import plot_frc
-
-            plot_frc(ds, path=target)
-        typer.echo(f"{result}: {kind} dataset; wrote {target}")
-        return
-    if kind == "run-up":
-        from geardyn.analysis.orders import waterfall
-        from geardyn.plotting.orders import plot_waterfall
-
-        recorded = ds.attrs["outputs"].split(",")
-        forces = [o for o in ds.attrs.get("observables", "").split(",") if o]
-        shown = _check_state(recorded, state or (forces or recorded)[0], "--state")
-        make_parents(target)
-        plot_waterfall(waterfall(ds, shown), ds, path=target)
-        typer.echo(f"{result}: run-up dataset ({shown}); wrote {target}")
-        return
-    if kind == "continuation":
-        from geardyn.plotting.branch import plot_branch
-
-        names = [str(v) for v in ds["state"].values]
-        shown = _check_state(names, state, "--state") if state is not None else None
-        make_parents(target)
-        plot_branch(ds, path=target, state=shown)
-        typer.echo(f"{result}: continuation dataset; wrote {target}")
-        return
-    if kind == "reproduction":
-        attrs = dict(ds.attrs, continuation=sweep.value)
-        ds = ds.sel(sweep=sweep.value, drop=True)
-        ds.attrs = attrs
-    names = [str(v) for v in ds["state"].values]
-    default = ds.attrs.get("plot_state") or next((n for n in ("X_sq", "x") if n in names),
-                                                 names[0])
-    shown = _check_state(names, state or default, "--state")
-    make_parents(target)
-    if kind in ("bifurcation", "reproduction"):
-        from geardyn.plotting.bifurcation import plot_bifurcation
-
-        plot_bifurcation(ds, state=shown, path=target)
-    else:
-        from geardyn.plotting.simulation import plot_simulation
-
-        plot_simulation(ds, state=shown, path=target)
-    typer.echo(f"{result}: {kind} dataset; wrote {target}")
+    drawn = REDRAWS[_dataset_kind(ds)](ds, target, state, sweep)
+    typer.echo(f"{result}: {drawn}; wrote {target}")
 
 
 def register(app: typer.Typer) -> None:

@@ -9,10 +9,11 @@ DatasetTable`): ``[[dataset.faults]]`` (``kind = "healthy"`` or a fault of the s
 speeds (in the study model's speed unit: a spur pair's ``params.speed_unit``, a planetary set's
 or a train's input speed in rpm), torques [N m], seeds, signal length, sample rate, noise,
 step, sensor settings. The model is the study's (:data:`STUDY_FAULTS`: a ``spur_pair``, a
-``planetary`` set built from ``[params.geometry]`` or a ``train``) with each condition's fault
-in place of the study's own faults. A rerun with the same study resumes from the store (the
-chunks it holds are read back, not computed again). A progress bar is drawn when stderr is a
-terminal.
+``planetary`` set built from ``[params.geometry]`` or a ``train``, the study models that declare
+a ``dataset``, :data:`geardyn.io.study_models.STUDY_MODELS`) with each condition's fault in
+place of the study's own faults (:func:`geardyn.study.faulted_model`). A rerun with the same
+study resumes from the store (the chunks it holds are read back, not computed again). A
+progress bar is drawn when stderr is a terminal.
 """
 
 from __future__ import annotations
@@ -28,28 +29,29 @@ from rich.markup import escape
 
 from geardyn.cli.common import load_study_source, make_parents
 from geardyn.errors import ParameterError, StudyError
+from geardyn.io.study_models import STUDY_MODELS, StudyModel
 
 __all__ = ["STUDY_FAULTS", "StudyFaultBuilder", "dataset_command", "fault_conditions",
            "register"]
 
 #: The studies ``geardyn dataset`` takes: model -> the table of the study's own faults, which
-#: each condition's fault replaces.
-STUDY_FAULTS = {"spur_pair": "[[faults]]", "planetary": "[[params.geometry.faults]]",
-                "train": "[[train.faults]]"}
+#: each condition's fault replaces (``StudyModel.dataset``).
+STUDY_FAULTS = {k: m.dataset.table for k, m in STUDY_MODELS.items() if m.dataset is not None}
 
 
-def _kind(study: Any) -> str:
-    """The study's model (``[study].model``), if ``geardyn dataset`` takes it; else a
+def _kind(study: Any) -> StudyModel:
+    """The study's model kind (``[study].model``), if ``geardyn dataset`` takes it; else a
     StudyError."""
-    kind = study.study.model
-    if kind not in STUDY_FAULTS:
+    kind = STUDY_MODELS[study.study.model]
+    if kind.dataset is None:
         *head, last = STUDY_FAULTS
         raise StudyError(f"study {study.study.name!r}: geardyn dataset takes a "
-                         f"{', '.join(head)} or {last} study (model = {kind!r})")
-    if kind == "planetary" and study.params.geometry is None:
-        raise StudyError(f"study {study.study.name!r}: geardyn dataset takes a planetary set "
-                         "built from [params.geometry] (the ring sensor's ring, the faults' "
-                         "teeth)")
+                         f"{', '.join(head)} or {last} study (model = {kind.name!r})")
+    target: Any = study
+    for part in kind.dataset.needs.split(".") if kind.dataset.needs else ():
+        target = getattr(target, part)
+    if target is None:
+        raise StudyError(f"study {study.study.name!r}: {kind.dataset.refusal}")
     return kind
 
 
@@ -59,7 +61,7 @@ class StudyFaultBuilder:
 
     def __init__(self, study: Any, conditions: list[tuple[Any, dict[str, Any] | None]]):
         self.study = study
-        self.kind = _kind(study)
+        self.kind = _kind(study).name
         self.tables = {id(f): t for f, t in conditions if f is not None}
         self._built: dict[str, Any] = {}
 
@@ -75,19 +77,9 @@ class StudyFaultBuilder:
         return self._built[key]
 
     def _model(self, tables: list[dict[str, Any]]) -> Any:
-        from geardyn.io.toml import FaultTable
-        from geardyn.study import planetary_model, spur_pair_model, train_model
+        from geardyn.study import faulted_model
 
-        s = self.study
-        if self.kind == "spur_pair":
-            faults = [FaultTable(**t) for t in tables]
-            return spur_pair_model(s.model_copy(update={"faults": faults or None}))
-        if self.kind == "planetary":
-            faults = [FaultTable(**t) for t in tables]
-            geometry = s.params.geometry.model_copy(update={"faults": faults or None})
-            return planetary_model(s.params.model_copy(update={"geometry": geometry}))
-        train = s.train.model_copy(update={"faults": list(tables)}).build()
-        return train_model(s, train=train)
+        return faulted_model(self.study, tables)
 
 
 def _spur_pair_check(study: Any, table: dict[str, Any], where: tuple) -> None:
@@ -144,7 +136,7 @@ def fault_conditions(study: Any, builder: StudyFaultBuilder | None = None
             out.append((None, None))
             continue
         fault = FaultTable(**table).build(where)
-        if builder.kind == "spur_pair":
+        if STUDY_MODELS[builder.kind].dataset.check == "gears":  # type: ignore[union-attr]
             _spur_pair_check(study, table, where)
         else:
             _built_check(builder, table, where)

@@ -62,6 +62,7 @@ from geardyn.cli.common import (
 )
 from geardyn.core.status import Status
 from geardyn.errors import ParameterError, StudyError
+from geardyn.io.study_models import study_model
 from geardyn.study import build_model, study_omega
 
 __all__ = ["EXIT_ERROR", "EXPECTED_ERRORS", "app", "main"]
@@ -141,52 +142,59 @@ def params_show(
 ) -> None:
     """Print every derived quantity and dimensionless coefficient, omega_n and the natural
     frequencies."""
-    from geardyn.models.derived import COEFFICIENT_FORMULAS, DERIVED_FORMULAS
-
     s = load_study_source(study)
     interp = interpretation.value if interpretation is not None else None
     model = build_model(s, interpretation=interp)
     out = _stdout()
     out.print(f"[bold]study[/bold] {escape(s.study.name)}: "
               f"{escape(s.study.description or s.study.model)}")
-    if s.study.model == "gear_pair":
-        from geardyn.models.gear_pair_coefficients import GEAR_PAIR
+    PARAMS_VIEWS[study_model(s.study.model).params_view](out, s, model)
 
-        table = Table(title="GearPair parameters (dimensionless)")
-        table.add_column("name")
-        table.add_column("value", justify="right")
-        table.add_column("unit")
-        table.add_column("meaning")
-        vocabulary = GEAR_PAIR.vocabulary()
-        for name, value in model.coefficient_values().items():
-            c = vocabulary.get(name)
-            table.add_row(name, _fmt(float(value)), escape(c.unit if c else ""),
-                          escape(c.meaning if c else ""))
-        out.print(table)
-        out.print("natural frequency (in contact): 1 (unit of dimensionless time)")
-        return
-    if s.study.model == "spur_pair":
-        _show_spur_pair(out, model)
-        return
-    if s.study.model in ("planetary", "train"):
-        out.print(f"{escape(repr(model))}: time scale omega_0 = {_fmt(model.time_scale)} rad/s, "
-                  f"length scale L = {_fmt(model.length_scale)} m")
-        if s.study.model == "train":
-            orders = ", ".join(f"{m} {_fmt(r)}" for m, r in zip(model.mesh_names, model.orders,
-                                                                 strict=True))
-            out.print(f"mesh orders over {model.reference_mesh}: {escape(orders)} "
-                      f"({model.dataset_attrs()['forcing']} forcing)")
-        modes = model.modes()
-        kinds = "type" in modes
-        table = Table(title="Natural frequencies (linear model, mean stiffness)")
-        for col in ("f [Hz]", "multiplicity", *(("type",) if kinds else ())):
-            table.add_column(col, justify="right")
-        for k in range(modes.sizes["mode"]):
-            table.add_row(_fmt(float(modes["frequency"][k])), str(int(modes["multiplicity"][k])),
-                          *((str(modes["type"].values[k]),) if kinds else ()))
-        out.print(table)
-        _show_swept(out, model)
-        return
+
+def _show_coefficients(out: Console, s, model) -> None:
+    """A model's declared dimensionless coefficients (the gear pair's)."""
+    kind = study_model(s.study.model)
+    table = Table(title=f"{kind.label} parameters (dimensionless)")
+    table.add_column("name")
+    table.add_column("value", justify="right")
+    table.add_column("unit")
+    table.add_column("meaning")
+    block = kind.coefficients
+    vocabulary = block.vocabulary() if block is not None else {}
+    for name, value in model.coefficient_values().items():
+        c = vocabulary.get(name)
+        table.add_row(name, _fmt(float(value)), escape(c.unit if c else ""),
+                      escape(c.meaning if c else ""))
+    out.print(table)
+    out.print("natural frequency (in contact): 1 (unit of dimensionless time)")
+
+
+def _show_modes(out: Console, s, model, orders: bool = False) -> None:
+    """A model's time and length scales, (with ``orders``) its meshes' orders over the reference
+    mesh, its linear natural frequencies and the parameters a sweep takes."""
+    out.print(f"{escape(repr(model))}: time scale omega_0 = {_fmt(model.time_scale)} rad/s, "
+              f"length scale L = {_fmt(model.length_scale)} m")
+    if orders:
+        text = ", ".join(f"{m} {_fmt(r)}" for m, r in zip(model.mesh_names, model.orders,
+                                                           strict=True))
+        out.print(f"mesh orders over {model.reference_mesh}: {escape(text)} "
+                  f"({model.dataset_attrs()['forcing']} forcing)")
+    modes = model.modes()
+    kinds = "type" in modes
+    table = Table(title="Natural frequencies (linear model, mean stiffness)")
+    for col in ("f [Hz]", "multiplicity", *(("type",) if kinds else ())):
+        table.add_column(col, justify="right")
+    for k in range(modes.sizes["mode"]):
+        table.add_row(_fmt(float(modes["frequency"][k])), str(int(modes["multiplicity"][k])),
+                      *((str(modes["type"].values[k]),) if kinds else ()))
+    out.print(table)
+    _show_swept(out, model)
+
+
+def _show_paper(out: Console, s, model) -> None:
+    """The paper's device: its derived quantities, the coefficients of Eq. (10), omega_n, the
+    natural frequencies and the static mesh forces."""
+    from geardyn.models.derived import COEFFICIENT_FORMULAS, DERIVED_FORMULAS
 
     out.print(f"[bold]interpretation[/bold] {model.interpretation}")
     table = Table(title="Derived quantities (SI)")
@@ -281,6 +289,18 @@ def _show_spur_pair(out: Console, model) -> None:
               f"{err['drive_max']:.3g} (drive)")
 
 
+#: What ``geardyn params show`` prints per view of a study model
+#: (:data:`geardyn.io.study_models.PARAMS_VIEWS`, its ``params_view``): ``(console, study,
+#: model)``.
+PARAMS_VIEWS = {
+    "paper": _show_paper,
+    "coefficients": _show_coefficients,
+    "spur_pair": lambda out, s, model: _show_spur_pair(out, model),
+    "modes": _show_modes,
+    "train": lambda out, s, model: _show_modes(out, s, model, orders=True),
+}
+
+
 @params_app.command("save")
 def params_save(
     out: Annotated[Path, typer.Argument(help="The TOML file to write.")],
@@ -329,7 +349,7 @@ def simulate(
     interp = interpretation.value if interpretation is not None else None
     om = omega if omega is not None else s.run.omega
     base = None
-    if om is None and s.study.model in ("spur_pair", "train"):  # Omega from [params]
+    if om is None and study_model(s.study.model).omega_from_params:
         base = build_model(s, interpretation=interp)
         om = study_omega(s, base)
     if om is None:

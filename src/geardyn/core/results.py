@@ -47,6 +47,13 @@ class ResultSchema:
     status_attrs: tuple[str, ...] = ()
     defaults: Mapping[str, str] = field(default_factory=lambda: {"param": "Omega", "x": "x",
                                                                  "y": "y"})
+    #: What a result of the kind is called in messages ("" the kind itself).
+    label: str = ""
+
+    @property
+    def name(self) -> str:
+        """What a result of the kind is called in messages (``"map"`` for ``"map2d"``)."""
+        return self.label or self.kind
 
     def _name(self, ds: Any, text: str) -> str:
         if text.startswith("{") and text.endswith("}"):
@@ -90,10 +97,11 @@ SCHEMAS: dict[str, ResultSchema] = {s.kind: s for s in (
         "reproduction-case", ("param", "time_unit"),
         {"{param}": _LEAD, "sample": ("sample",), "state": ("state",), "sweep": ("sweep",)},
         {"poincare": ("sweep", *_LEAD, "sample", "state"), "period": ("sweep", *_LEAD),
-         "status": ("sweep", *_LEAD), "final_time": ("sweep", *_LEAD)}, ("status",)),
+         "status": ("sweep", *_LEAD), "final_time": ("sweep", *_LEAD)}, ("status",),
+        label="reproduction"),
     ResultSchema(
         "map2d", ("x", "y", "time_unit"), {"{y}": ("{y}",), "{x}": ("{x}",)},
-        {"period": ("{y}", "{x}"), "status": ("{y}", "{x}")}, ("status",)),
+        {"period": ("{y}", "{x}"), "status": ("{y}", "{x}")}, ("status",), label="map"),
     ResultSchema(
         "periodic-orbit",
         ("status", "status_meaning", "steps_per_period", "time_unit", "Omega", "period",
@@ -102,7 +110,7 @@ SCHEMAS: dict[str, ResultSchema] = {s.kind: s for s in (
         {"section_point": ("state",), "monodromy": ("state", "state_in"),
          "multiplier_real": ("multiplier",), "multiplier_imag": ("multiplier",),
          "{state}": ("time",)},
-        status_attrs=("status",)),
+        status_attrs=("status",), label="periodic orbit"),
     ResultSchema(
         "continuation",
         ("param", "start", "stop", "period", "status", "message", "status_meaning", "time_unit"),
@@ -130,7 +138,7 @@ SCHEMAS: dict[str, ResultSchema] = {s.kind: s for s in (
         {"torque": ("torque",), "speed": ("speed",), "group": ("group",)},
         {"dynamic_factor": ("torque", "speed", "group"), "K_v": ("torque", "speed", "group"),
          "contact": ("torque", "speed", "group"), "period": ("torque", "speed"),
-         "resonance_speed": ("torque", "group")}),
+         "resonance_speed": ("torque", "group")}, label="dynamic factor"),
     ResultSchema(
         "basins",
         ("x", "y", "Omega", "time_unit", "diverged_fraction", "unresolved_fraction",
@@ -146,13 +154,13 @@ SCHEMAS: dict[str, ResultSchema] = {s.kind: s for s in (
         {"sweep": ("sweep",), "Omega": ("Omega",), "mesh": ("mesh",), "jump": ("jump",)},
         {"dte_rms": (*_FRC, "mesh"), "dte_peak": (*_FRC, "mesh"), "dte_mean": (*_FRC, "mesh"),
          "period": _FRC, "status": _FRC, "hysteresis": ("Omega",), "jump_omega": ("jump",),
-         "jump_sweep": ("jump",)}, ("status",)),
+         "jump_sweep": ("jump",)}, ("status",), label="frequency response"),
     ResultSchema(
         "runup",
         ("status", "status_meaning", "integrator", "step", "steps_per_period", "time_unit",
          "start", "stop", "rate", "outputs"),
         {"time": ("time",)}, {"Omega": ("time",), "phase": ("time",)},
-        status_attrs=("status",)),
+        status_attrs=("status",), label="run-up"),
     ResultSchema(
         "fault-dataset", ("model", "time_unit", "snr_db", "duration", "sample_rate"),
         {"fault": ("fault",), "fault_kind": ("fault",), "fault_size": ("fault",),
@@ -160,7 +168,7 @@ SCHEMAS: dict[str, ResultSchema] = {s.kind: s for s in (
          "torque": ("torque",), "seed": ("seed",), "time": ("time",)},
         {"signal": ("fault", "speed", "torque", "seed", "time"),
          "status": ("fault", "speed", "torque"), "unresolved": ("fault", "speed", "torque"),
-         "noise_std": ("fault", "speed", "torque")}, ("status",)),
+         "noise_std": ("fault", "speed", "torque")}, ("status",), label="fault dataset"),
 )}
 
 #: The kinds of result, as recorded in ``attrs["geardyn_kind"]``.

@@ -27,10 +27,10 @@ from typing import Any
 
 import numpy as np
 
-from geardyn.core.inputs import explored
 from geardyn.core.model import Model
 from geardyn.errors import ParameterError
 from geardyn.gears.faults import FAULT_KINDS
+from geardyn.io.study_models import STUDY_MODELS, StudyModel, study_model
 from geardyn.io.toml import (
     FaultTable,
     GearPairParams,
@@ -40,12 +40,7 @@ from geardyn.io.toml import (
     Study,
     TrainModelParams,
 )
-from geardyn.models.gear_pair_coefficients import GEAR_PAIR
-from geardyn.models.params import PAPER_INPUTS
-from geardyn.models.planetary_coefficients import INPUTS as PLANETARY_INPUTS
 from geardyn.models.planetary_stiffness import COAST_FLANKS, STIFFNESS_METHODS
-from geardyn.models.spur_pair_coefficients import INPUTS as SPUR_PAIR_INPUTS
-from geardyn.trains.inputs import INPUTS as TRAIN_INPUTS
 
 __all__ = ["CONTINUATIONS", "GEOMETRY_KEYS", "INTERPRETATIONS", "MAIN_PARAMS",
            "PLANETARY_GEOMETRY_KEYS", "DiagramRequest", "ExplorerState", "Window",
@@ -54,15 +49,10 @@ __all__ = ["CONTINUATIONS", "GEOMETRY_KEYS", "INTERPRETATIONS", "MAIN_PARAMS",
 #: The main parameters offered as controls, per model kind (``[study].model``), in declared
 #: order: the model's declared inputs flagged ``explore``
 #: (:attr:`~geardyn.core.model.Model.explorer_names`; damping ratios, backlash, meshing error,
-#: load or torque fluctuation). A train's are offered where its study gives them as one number
-#: for every mesh (a per-mesh table is not a control).
-MAIN_PARAMS: dict[str, tuple[str, ...]] = {
-    "catt": explored(PAPER_INPUTS),
-    "gear_pair": tuple(c.name for c in GEAR_PAIR.entries if c.explore),
-    "planetary": explored(PLANETARY_INPUTS),
-    "spur_pair": explored(SPUR_PAIR_INPUTS),
-    "train": explored(TRAIN_INPUTS),
-}
+#: load or torque fluctuation; ``StudyModel.explored``). A train's are offered where its study
+#: gives them as one number for every mesh (``StudyModel.explore_given_only``: a per-mesh table
+#: is not a control).
+MAIN_PARAMS: dict[str, tuple[str, ...]] = {k: m.explored for k, m in STUDY_MODELS.items()}
 #: The ``[gears]`` inputs offered as controls of a model built from a pair's geometry (study-file
 #: keys; each gear's own value, which wins over a shared ``[gears]`` one). The faults' controls
 #: come from the study's ``[[faults]]`` (:func:`fault_fields`).
@@ -274,11 +264,16 @@ class ExplorerState:
     def kind(self) -> str:
         return self.study.study.model
 
+    @property
+    def model_kind(self) -> StudyModel:
+        """What the study's model kind declares (:mod:`geardyn.io.study_models`)."""
+        return study_model(self.kind)
+
     def main_params(self) -> tuple[str, ...]:
         """The parameters offered as controls (the model's
         :attr:`~geardyn.core.model.Model.explorer_names`; the swept one left out)."""
         offered = self.model.explorer_names
-        if self.kind == "train":
+        if self.model_kind.explore_given_only:
             offered = tuple(p for p in offered if p in self.model.physical_names)
         return tuple(p for p in offered if p != self.param)
 
@@ -332,8 +327,9 @@ class ExplorerState:
         layout = self.model.coefficient_layout
         if name in layout.names and layout.slot(name).coefficient.meaning:
             return layout.slot(name).coefficient.describe()
-        if self.kind == "gear_pair" and name in GEAR_PAIR.vocabulary():
-            return GEAR_PAIR[name].describe()
+        block = self.model_kind.coefficients
+        if block is not None and name in block.vocabulary():
+            return block[name].describe()
         declared = {i.name: i for i in self.model.input_declarations}.get(name)
         if declared is not None:
             return declared.meaning
@@ -380,7 +376,7 @@ class ExplorerState:
         if name in self.geometry_params():
             return self._geometry_value(key_path(name))
         params = self._effective.params
-        if self.kind == "catt":
+        if self.model_kind.interpretation:  # the paper's names
             from geardyn.models.params import PAPER_NAMES
 
             target: Any = self._effective.planetary_params
@@ -466,7 +462,7 @@ class ExplorerState:
 
     def set_interpretation(self, value: str) -> str | None:
         """Change the interpretation (CATT device studies only); None or the message."""
-        if self.kind != "catt":
+        if not self.model_kind.interpretation:
             return f"interpretation: a {self.kind} study has none"
         if value not in INTERPRETATIONS:
             return f"interpretation: must be one of {', '.join(INTERPRETATIONS)} (got {value!r})"

@@ -9,7 +9,7 @@ A *study file* holds the device parameters plus run settings::
     [study]
     name = "fig3"
     description = "Paper Fig. 3"
-    model = "catt"                  # or "gear_pair", "planetary", "spur_pair"
+    model = "catt"                  # or "gear_pair", "planetary", "spur_pair", "train"
     interpretation = "consistent"   # consistent | carrier-only | as-printed
     plot_state = "X_sq"             # the coordinate figures show
     [params]                        # PlanetaryParams fields (nested tables), or:
@@ -164,6 +164,7 @@ from geardyn.io.params_table import PerMesh as PerMesh  # the types of a quantit
 from geardyn.io.params_table import PerPlanet as PerPlanet
 from geardyn.io.params_table import Quantity, params_table
 from geardyn.io.runup_table import RunupTable
+from geardyn.io.study_models import STUDY_MODELS, StudyModel, study_model
 from geardyn.io.train_table import TrainTable
 from geardyn.models.gear_pair_coefficients import GEAR_PAIR
 from geardyn.models.params import PAPER_NAMES, Angle, Length, PlanetaryParams, Real, Whole
@@ -207,9 +208,11 @@ _HEADER = (
     "# Unit strings such as \"50 um\" or \"20 deg\" are accepted on input.\n\n"
 )
 
-Model = Literal["catt", "gear_pair", "planetary", "spur_pair", "train"]
-DEFAULT_PLOT_STATE: dict[str, str] = {"catt": "X_sq", "gear_pair": "x", "planetary": "u_s",
-                                      "spur_pair": "x"}
+#: The kinds of study model (:data:`~geardyn.io.study_models.STUDY_MODELS`), by name.
+Model = Literal[tuple(sorted(STUDY_MODELS))]  # type: ignore[valid-type]
+#: The coordinate figures show by default, per study model that has one.
+DEFAULT_PLOT_STATE: dict[str, str] = {k: m.plot_state for k, m in STUDY_MODELS.items()
+                                      if m.plot_state}
 
 
 # --------------------------------------------------------------------------- study schema
@@ -254,7 +257,8 @@ RUN_TABLE_EXTRAS: dict[str, dict[str, Any]] = {
 }
 #: Models whose time is in seconds: the default transient of their runs in forcing periods of
 #: the lowest Omega of the run (not ``[run].transient``'s 4000, a dimensionless time).
-DEFAULT_TRANSIENT_PERIODS: dict[str, float] = {"spur_pair": 50.0}
+DEFAULT_TRANSIENT_PERIODS: dict[str, float] = {
+    k: m.transient_periods for k, m in STUDY_MODELS.items() if m.transient_periods is not None}
 #: The ``[run]`` table's keys that are no RunSettings field: the run's Omega and the transient
 #: in forcing periods (instead of ``transient``).
 RUN_TABLE_OWN = ("omega", "transient_periods")
@@ -541,6 +545,25 @@ TrainModelParams = params_table(
     (:data:`geardyn.trains.inputs.INPUTS`); types checked here, values when the model is built
     (errors name ``params.<field>``).""",
     values="given")
+
+
+#: The ``[params]`` table classes of the study models, by class name (``StudyModel.params``).
+_PARAMS_CLASSES: dict[str, type[BaseModel]] = {c.__name__: c for c in (
+    PlanetaryParams, GearPairParams, SpurPairParams, PlanetaryGearSetParams, TrainModelParams)}
+
+
+def params_class(kind: StudyModel | str) -> type[BaseModel]:
+    """The class of the ``[params]`` table of a study model ``kind`` (a
+    :class:`~geardyn.io.study_models.StudyModel` or its name)."""
+    declared = study_model(kind) if isinstance(kind, str) else kind
+    return _PARAMS_CLASSES[declared.params]
+
+
+def params_kind(params: BaseModel) -> StudyModel:
+    """The study model whose ``[params]`` table ``params`` is (the paper's device for any
+    other, a ``base = "paper"`` table)."""
+    return next((m for m in STUDY_MODELS.values()
+                 if isinstance(params, _PARAMS_CLASSES[m.params])), STUDY_MODELS["catt"])
 
 
 # --------------------------------------------------------------------------- gears and faults
@@ -978,19 +1001,13 @@ class Study(BaseModel):
                 type=PydanticCustomError("dict_type", "must be a table of parameters"),
                 loc=("params",), input=raw)])
         out = dict(data)
-        if kind == "gear_pair":
-            target: type[BaseModel] = GearPairParams
-        elif kind == "spur_pair":
-            target = SpurPairParams
-        elif kind == "planetary":
-            target = PlanetaryGearSetParams
-        elif kind == "train":
-            target = TrainModelParams
-        elif "base" in raw:
+        # an unknown kind is read as the paper's device (study.model's own check names it)
+        declared = STUDY_MODELS.get(kind) if isinstance(kind, str) else None
+        declared = declared or STUDY_MODELS["catt"]
+        if declared.interpretation and "base" in raw:
             out["params"] = _resolve_paper(raw)[0]
             return out
-        else:
-            target = PlanetaryParams
+        target = params_class(declared)
         try:
             out["params"] = target.model_validate(raw)
         except ValidationError as exc:
@@ -1004,20 +1021,11 @@ class Study(BaseModel):
             self._train = self.train.build()
         if self.params is None:
             return self
-        holds = ("gear_pair" if isinstance(self.params, GearPairParams) else "planetary"
-                 if isinstance(self.params, PlanetaryGearSetParams) else "spur_pair"
-                 if isinstance(self.params, SpurPairParams) else "train"
-                 if isinstance(self.params, TrainModelParams) else "catt")
-        if holds != self.study.model:
-            kind = {"gear_pair": "GearPair", "planetary": "PlanetaryGearSet",
-                    "catt": "PlanetaryParams", "spur_pair": "SpurPair",
-                    "train": "TrainModel"}[holds]
+        holds = params_kind(self.params)
+        if holds.name != self.study.model:
             raise ValueError(
-                f"study.model is {self.study.model!r} but [params] holds {kind} parameters"
+                f"study.model is {self.study.model!r} but [params] holds {holds.label} parameters"
             )
-        if holds == "train" and self.train is None:
-            raise _study_error(("train",), None, "required by a train study (the gear train "
-                               "whose model [params] describes)", "missing")
         if isinstance(self.params, PaperBase):
             self._planetary = _resolve_paper(self.params.model_dump())[1]
         elif isinstance(self.params, PlanetaryParams):
@@ -1027,13 +1035,13 @@ class Study(BaseModel):
     def _check_gears(self) -> None:
         """``[params]`` or ``[gears]`` present; ``[faults]`` and ``[stiffness]`` only with
         ``[gears]``; the gears, faults and settings buildable (errors name the field); a
-        ``spur_pair`` study has both ``[gears]`` (its pair) and ``[params]`` (its dynamics)."""
-        if self.study.model == "spur_pair":
-            for name, what in (("gears", "the pair the model is built from"),
-                               ("params", "the pair's speed, torque and dynamics")):
-                if getattr(self, name) is None:
-                    raise _study_error((name,), None, f"required by a spur_pair study ({what})",
-                                       "missing")
+        ``spur_pair`` study has both ``[gears]`` (its pair) and ``[params]`` (its dynamics), a
+        ``train`` study ``[train]`` (the tables its kind requires, ``StudyModel.requires``)."""
+        kind = study_model(self.study.model)
+        for name, what in kind.requires:
+            if getattr(self, name) is None:
+                raise _study_error((name,), None, f"required by a {kind.name} study ({what})",
+                                   "missing")
         if self.gears is None:
             for name in ("faults", "stiffness", "relief", "crowning"):
                 if getattr(self, name) is not None:
@@ -1045,7 +1053,7 @@ class Study(BaseModel):
                 raise _study_error(("params",), None, "required (or a [gears] or [train]"
                                    " table)", "missing")
             return
-        if self.study.model == "spur_pair":
+        if kind.spur_pair_gears:
             self._check_spur_pair_gears()
         mesh, _ = self.stiffness_inputs()
         self.contact_inputs(mesh)
