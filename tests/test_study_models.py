@@ -109,3 +109,19 @@ def test_plot_redraws_the_registered_result_kinds():
     ds = xr.Dataset(attrs={"geardyn_kind": "periodic-orbit"})
     with pytest.raises(ParameterError, match="unknown result kind 'periodic-orbit'"):
         cli_bifurcation._dataset_kind(ds)
+
+
+def test_faulted_model_replaces_the_study_faults_or_refuses_the_kind():
+    """A spur pair with no fault tables is the study's pair built without its [[faults]]; a
+    kind that takes no faults is refused naming those that do."""
+    from geardyn.errors import StudyError
+    from geardyn.study import faulted_model
+
+    study = _example("spur_pair")
+    assert study.faults  # the example is a cracked pair
+    healthy = build_model(study.model_copy(update={"faults": None}))
+    assert faulted_model(study, []).coefficient_values() == healthy.coefficient_values()
+    assert faulted_model(study, []).coefficient_values() != build_model(
+        study).coefficient_values()
+    with pytest.raises(StudyError, match="spur_pair, planetary, train"):
+        faulted_model(_example("catt"), [])

@@ -181,7 +181,7 @@ class ExplorerSession:
                                    options=list(CONTINUATIONS), name="continuation", width=120)
         self.continuation.on_change("value", self._on_continuation)
         controls.append(self.continuation)
-        if st.model_kind.interpretation:
+        if st.model_kind.paper_device:
             interp = st.interpretation or st.study.study.interpretation
             self.interpretation = Select(title="interpretation", value=interp,
                                          options=list(INTERPRETATIONS), name="interpretation",
@@ -430,7 +430,7 @@ class ExplorerSession:
             for name, box in self.inputs.items():
                 box.value = str(self.state.current_value(name))
             self.continuation.value = self.state.continuation
-            if self.state.model_kind.interpretation:
+            if self.state.model_kind.paper_device:
                 self.interpretation.value = (self.state.interpretation
                                              or self.state.study.study.interpretation)
         finally:

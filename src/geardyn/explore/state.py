@@ -376,7 +376,7 @@ class ExplorerState:
         if name in self.geometry_params():
             return self._geometry_value(key_path(name))
         params = self._effective.params
-        if self.model_kind.interpretation:  # the paper's names
+        if self.model_kind.paper_device:  # by the paper's names
             from geardyn.models.params import PAPER_NAMES
 
             target: Any = self._effective.planetary_params
@@ -462,7 +462,7 @@ class ExplorerState:
 
     def set_interpretation(self, value: str) -> str | None:
         """Change the interpretation (CATT device studies only); None or the message."""
-        if not self.model_kind.interpretation:
+        if not self.model_kind.paper_device:
             return f"interpretation: a {self.kind} study has none"
         if value not in INTERPRETATIONS:
             return f"interpretation: must be one of {', '.join(INTERPRETATIONS)} (got {value!r})"

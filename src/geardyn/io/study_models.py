@@ -81,9 +81,10 @@ class StudyModel:
     ``omega_from_params``
         ``[params]`` sets the forcing frequency (a speed): a run without ``--omega`` or
         ``[run].omega`` runs at the model's Omega.
-    ``interpretation``
+    ``paper_device``
         The paper's device: ``[study].interpretation`` applies (the explorer offers it), and
-        ``[params]`` names are the paper's (:data:`~geardyn.models.params.PAPER_NAMES`).
+        ``[params]`` is the device's parameters, in full or as ``base = "paper"`` with changes
+        by the paper's names (:data:`~geardyn.models.params.PAPER_NAMES`).
     ``requires``
         Tables a study of the kind must have, each with what it holds.
     ``spur_pair_gears``
@@ -109,7 +110,7 @@ class StudyModel:
     plot_state: str = ""
     transient_periods: float | None = None
     omega_from_params: bool = False
-    interpretation: bool = False
+    paper_device: bool = False
     requires: tuple[tuple[str, str], ...] = ()
     spur_pair_gears: bool = False
     explore_given_only: bool = False
@@ -147,7 +148,7 @@ omega = 1.3
 #: takes in this order.
 STUDY_MODELS: dict[str, StudyModel] = {m.name: m for m in (
     StudyModel("catt", "PlanetaryParams", "PlanetaryParams", PAPER_INPUTS, "paper_fig3",
-               "paper", plot_state="X_sq", interpretation=True),
+               "paper", plot_state="X_sq", paper_device=True),
     StudyModel("gear_pair", "GearPairParams", "GearPair", GEAR_PAIR, _GEAR_PAIR_EXAMPLE,
                "coefficients", plot_state="x"),
     StudyModel("spur_pair", "SpurPairParams", "SpurPair", SPUR_PAIR_INPUTS, "spur_pair_cracked",

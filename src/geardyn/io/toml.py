@@ -1004,7 +1004,7 @@ class Study(BaseModel):
         # an unknown kind is read as the paper's device (study.model's own check names it)
         declared = STUDY_MODELS.get(kind) if isinstance(kind, str) else None
         declared = declared or STUDY_MODELS["catt"]
-        if declared.interpretation and "base" in raw:
+        if declared.paper_device and "base" in raw:
             out["params"] = _resolve_paper(raw)[0]
             return out
         target = params_class(declared)
