@@ -87,7 +87,7 @@ def block_arrays(m, model, omegas):
     nper = lane_steps_per_period(model, P)
     nw, ns, n_g, n_o = BLOCK, len(model.state_names), len(model.event_names), \
         len(model.observable_names)
-    _, _, lane_tab = _phase_tables(m, nper)
+    _, _, lane_tab = _phase_tables(nper)
     rot = np.array([m.phase_increments(int(n)) for n in nper]).T
     Y = np.repeat(np.asarray(model.initial_state(), float)[:, None], nw, axis=1)
     HB = 2 * np.pi / omegas / nper
