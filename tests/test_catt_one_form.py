@@ -64,6 +64,8 @@ def test_one_form_keyword_is_deprecated_and_chooses_nothing():
         old = geardyn.CATTDevice(geardyn.PlanetaryParams.paper(xi1=0.1, xi2=0.1), one_form=False)
     assert old.kernel == m.kernel and m.kernel.one_form is not None
     np.testing.assert_array_equal(old.params, m.params)
+    with pytest.warns(DeprecationWarning, match="one_form"):
+        assert m.one_form and not m.general().one_form
 
 
 _DEVICES = {"quiet": {}, "load": _LOAD, "rectangular": {"waveform": "rectangular"},

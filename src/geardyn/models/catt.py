@@ -190,6 +190,14 @@ class CATTDevice(Model):
             raise ParameterError("params", bad, "the parameters give a dimensionless "
                                  "coefficient that is not finite (extreme magnitudes)")
 
+    @property
+    def one_form(self) -> bool:
+        """Deprecated: whether the device runs a one form (the reduced form always does, the
+        general one never)."""
+        warnings.warn("CATTDevice.one_form is deprecated: the reduced form always runs its one "
+                      "form", DeprecationWarning, stacklevel=2)
+        return self.kernel.one_form is not None
+
     # ------------------------------------------------------------------ coefficient vector
     def _n_harmonics(self) -> int:
         sets = [self.params_in.planet_set(i) for i in range(self.params_in.n_planets)]
