@@ -106,6 +106,31 @@ def test_every_generated_layout_equals_the_general_models_array_form(case):
             gen.observe_lane(T[k], tuple(y), PT, k, S[k], C[k], form)), oref)
 
 
+def test_a_stiffness_series_below_zero_is_clipped_in_every_layout():
+    """Where a mesh's stiffness series rings below 0 (a raw first harmonic of 1.8, at the phase
+    where its cosine is -1) the mesh carries no stiffness force, in every layout, as the general
+    model's array form (harmonic_factor's clip) gives it: the bits of the same state with that
+    mesh's stiffness coefficients 0."""
+    m = _device().with_params(ksq_a1=1.8).with_omega(1.3)
+    stiff0 = m.with_params(k_sq_q=0.0, k_sq_c=0.0)
+    gen = _gen(m)
+    p = m.params
+    PT = np.ascontiguousarray(p[:, None])
+    b_sq, b_pq = p[ck.HEADER + ck.B_SQ], p[ck.HEADER + ck.B_PQ]
+    y = np.array([3.5 + b_sq, 0.1, -3.3 - b_pq, 0.2])  # both meshes in contact
+    s, c = 0.0, -1.0
+    ref, ref0, dy, DY = np.empty(4), np.empty(4), np.empty(4), np.empty((4, 1))
+    ck.catt_rhs(0.3, y, ref, p, s, c)
+    ck.catt_rhs(0.3, y, ref0, stiff0.params, s, c)
+    np.testing.assert_array_equal(ref, ref0)
+    gen.rhs(0.3, y, dy, p, s, c)
+    gen.rhs_lanes(np.array([0.3]), np.ascontiguousarray(y[:, None]), DY, PT, 1, np.array([s]),
+                  np.array([c]), np.zeros((4, 1)))
+    for got in (dy, DY[:, 0], *(gen.rhs_lane(0.3, tuple(y), PT, 0, s, c, form)
+                                for form in (FORM_QUIET, FORM_GENERAL))):
+        np.testing.assert_array_equal(np.asarray(got), ref)
+
+
 def _llvm_of_lane_call(gen, form):
     """The optimised LLVM IR of a function that calls the generated ``rhs_lane`` in ``form``."""
     rhs_lane = gen.rhs_lane
