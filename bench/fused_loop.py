@@ -16,9 +16,17 @@ multiply-adds where LLVM sees them; results change at the rounding level, and ac
 paths differently, so not geardyn's setting); ``nochain``: the RK4 stages made independent of
 each other (wrong results, the same operations: is the loop latency-bound?); ``+``-joined
 names combine them. ``--gear-pair``: bench/peers.py's gear pair instead of the paper's device.
+``--form load``: the device with the load fluctuating (Fig. 13's B1 = B2 = 100 N m, Lambda =
+0.1) in the lane form FORM_LOAD; ``--form general``: those lanes in FORM_GENERAL.
+
+``--asm`` counts the zmm / ymm instructions of the driver and, of its hot loop (the loop with
+the most zmm instructions: the fused loop's vector body), the instructions, the zmm ones, the
+memory operands (loads and stores), the calls and each opcode (``--asm-ops``), so that two
+versions of a model's code can be compared instruction by instruction where timings are noisy.
 
     .venv/bin/python bench/fused_loop.py [--variants base,nostats,noscreen] [--steps 20000]
-                                         [--repeat 9] [--asm]
+                                         [--repeat 9] [--asm [--asm-ops]]
+                                         [--form quiet|load|general]
 
 The vector width is geardyn's (``GEARDYN_SIMD_WIDTH``, see ``geardyn._jit_target``), the
 driver's too (compiled with the kernels' pipeline).
@@ -27,6 +35,7 @@ driver's too (compiled with the kernels' pipeline).
 from __future__ import annotations
 
 import argparse
+import collections
 import importlib.util
 import re
 import statistics
@@ -87,7 +96,7 @@ def block_arrays(m, model, omegas):
     nper = lane_steps_per_period(model, P)
     nw, ns, n_g, n_o = BLOCK, len(model.state_names), len(model.event_names), \
         len(model.observable_names)
-    _, _, lane_tab = _phase_tables(m, nper)
+    _, _, lane_tab = _phase_tables(nper)
     rot = np.array([m.phase_increments(int(n)) for n in nper]).T
     Y = np.repeat(np.asarray(model.initial_state(), float)[:, None], nw, axis=1)
     HB = 2 * np.pi / omegas / nper
@@ -107,9 +116,9 @@ def block_arrays(m, model, omegas):
             np.ones(nw), HB / 6.0, np.zeros(nw), G, ST, slots, ROT, PH)
 
 
-def driver(m):
-    """A compiled caller of module m's fused loop in its quiet lane form."""
-    form = m.FORM_QUIET
+def driver(m, form_name="quiet"):
+    """A compiled caller of module m's fused loop in the lane form ``form_name``."""
+    form = getattr(m, f"FORM_{form_name.upper()}")
     steps = m._fused_steps
 
     def drive(n, nv, locate, bound, Yf, Y1f, PT, SE, CE, H6, FLAG, G, ST, slots, ROT, PH):
@@ -125,12 +134,46 @@ def driver(m):
                    fastmath=m._JIT.get("fastmath", False))(drive)
 
 
+def hot_loop(asm: list[str]) -> list[str]:
+    """The instructions of the loop with the most zmm instructions in the assembly ``asm``
+    (a label and the backward jump to it)."""
+    labels = {}
+    spans = []
+    for i, line in enumerate(asm):
+        if m := re.match(r"^(\.LBB\S+):", line):
+            labels[m.group(1)] = i
+        elif (m := re.match(r"^\s+j\w+\s+(\.LBB\S+)", line)) and m.group(1) in labels:
+            spans.append((labels[m.group(1)], i))
+    if not spans:
+        return []
+    a, b = max(spans, key=lambda ab: sum("zmm" in s for s in asm[ab[0]:ab[1] + 1]))
+    return [s.strip() for s in asm[a:b + 1]
+            if s.startswith("\t") and not s.strip().startswith((".", "#"))]
+
+
+def _memory(ins: str) -> bool:
+    return "(" in ins and not ins.startswith(("lea", "nop"))
+
+
+def opcodes(loop: list[str]) -> collections.Counter:
+    """Opcode counts of ``loop``: ``{k}`` marks a masked one, ``[mem]`` a memory operand."""
+    out: collections.Counter = collections.Counter()
+    for ins in loop:
+        op = ins.split()[0] + ("{k}" if "{%k" in ins else "") + ("[mem]" if _memory(ins) else "")
+        out[op] += 1
+    return out
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--variants", default="base,nostats,noscreen,nobook")
     ap.add_argument("--steps", type=int, default=20000)
     ap.add_argument("--repeat", type=int, default=9)
-    ap.add_argument("--asm", action="store_true", help="count zmm / ymm instructions")
+    ap.add_argument("--asm", action="store_true", help="count zmm / ymm instructions, and "
+                    "the hot loop's")
+    ap.add_argument("--asm-ops", action="store_true", help="with --asm: the hot loop's opcodes")
+    ap.add_argument("--form", choices=("quiet", "load", "general"), default="quiet",
+                    help="the lane form (load, general: the paper's device with Fig. 13's load)")
     ap.add_argument("--gear-pair", action="store_true", help="bench/peers.py's gear pair "
                     "(Omega in [0.2, 3]) instead of the paper's device")
     args = ap.parse_args()
@@ -139,7 +182,8 @@ def main() -> None:
 
         model, omegas = peers.model(), peers.workload().omega[::6]
     else:
-        model = geardyn.CATTDevice(geardyn.PlanetaryParams.paper(xi1=0.05, xi2=0.05))
+        load = {} if args.form == "quiet" else {"B1": "100 N m", "B2": "100 N m", "Lambda": 0.1}
+        model = geardyn.CATTDevice(geardyn.PlanetaryParams.paper(xi1=0.05, xi2=0.05, **load))
         omegas = np.linspace(0.1, 4.0, 1000)[::15]
     omegas = omegas[:BLOCK]
     source = Path(kernels_for(model.kernel).__file__).read_text()
@@ -151,7 +195,7 @@ def main() -> None:
     with tempfile.TemporaryDirectory() as tmp:
         for name in names:
             m = variant_module(source, name, Path(tmp))
-            d = driver(m)
+            d = driver(m, args.form)
             d(2, BLOCK, True, 1e6, *block_arrays(m, model, omegas))
             runs[name] = (d, m)
         times = {n: [] for n in names}
@@ -169,8 +213,14 @@ def main() -> None:
         if args.asm:
             d, _ = runs[name]
             asm = d.inspect_asm(d.signatures[0]).splitlines()
+            loop = hot_loop(asm)
             line += (f"; zmm {sum('zmm' in s for s in asm)}, ymm {sum('ymm' in s for s in asm)}"
-                     " instructions")
+                     f" instructions; hot loop {len(loop)} instructions, zmm "
+                     f"{sum('zmm' in s for s in loop)}, memory operands "
+                     f"{sum(_memory(s) for s in loop)}, calls "
+                     f"{sum(s.startswith('call') for s in loop)}")
+            if args.asm_ops:
+                line += "\n  " + ", ".join(f"{k} {v}" for k, v in sorted(opcodes(loop).items()))
         print(line)
 
 

@@ -1,8 +1,9 @@
-"""The CATT model's lane forms (see :data:`geardyn.core.kernel_source.LANE_FORMS`): the sweep
-kernel runs a queue of quiet lanes, of lanes with the load fluctuating, of several stiffness
-harmonics or a mixture, each in its own compiled copy of the fused loop, and every lane's
-result is bitwise that of the one-lane path (``simulate``). The load's sine
-(:func:`~geardyn.models.catt_kernels.load_sin`) is checked against libm's."""
+"""The reduced CATT device's lane forms (see :data:`geardyn.core.kernel_source.LANE_FORMS`;
+generated from its one form, :mod:`geardyn.models.catt_reduced`): the sweep kernel runs a queue
+of quiet lanes, of lanes with the load fluctuating, of several stiffness harmonics or a mixture,
+each in its own compiled copy of the fused loop, and every lane's result is bitwise that of the
+one-lane path (``simulate``). The load's sine (:func:`~geardyn.models.catt_kernels.load_sin`)
+is checked against libm's."""
 
 from __future__ import annotations
 
@@ -18,6 +19,7 @@ from geardyn.core.plan import LaneSettings
 from geardyn.core.settings import RunSettings
 from geardyn.models import catt_kernels as ck
 from geardyn.solvers.ensemble import run_lanes
+from geardyn.solvers.kernels import kernels_for
 
 _OMEGAS = np.array([0.7, 1.3, 2.2, 3.1, 0.45])
 
@@ -76,15 +78,22 @@ def _assert_lanes_equal_simulate(models, omegas, steps=48):
         np.testing.assert_array_equal(r.samples[j], ds["poincare"].values[1:], err_msg=str(j))
 
 
+def _gen(model):
+    """The model's generated functions (the kernels' shared core, compiled on first call)."""
+    return kernels_for(model.kernel, "core")
+
+
 def _form(model):
     P = np.ascontiguousarray(model.lane_params("Omega", _OMEGAS[:1]).T)
-    return ck.catt_rhs_one_lane_form(P, 0)
+    return _gen(model).rhs_lane_form(P, 0)
 
 
 def test_each_lane_form_equals_the_one_lane_path_bitwise():
+    """Quiet lanes take FORM_QUIET, fluctuating ones FORM_LOAD, with any number of stiffness
+    harmonics (the rectangular waveform's 25: its own one form, the series written out)."""
     quiet, load = _device(), _device(**_LOAD)
     rect = _device(waveform="rectangular")
-    assert (_form(quiet), _form(load), _form(rect)) == (FORM_QUIET, FORM_LOAD, FORM_GENERAL)
+    assert (_form(quiet), _form(load), _form(rect)) == (FORM_QUIET, FORM_LOAD, FORM_QUIET)
     _assert_lanes_equal_simulate([load], _OMEGAS)
     _assert_lanes_equal_simulate([rect], _OMEGAS[:3])
     # quiet and fluctuating lanes in one queue run in the general form: still the same results
@@ -172,61 +181,66 @@ def test_a_chain_stops_at_a_lane_that_did_not_end_well_and_says_so():
     assert list(r.steps[1:]) == [0, 0]
 
 
-@nb.njit
-def _lane_calls_quiet(y, PT, s, c):
-    """Four rhs calls and an observation at a constant lane form, as a kernel's fused loop."""
-    a = ck.catt_rhs_one_lane(0.1, y, PT, 0, s, c, FORM_QUIET)
-    b = ck.catt_rhs_one_lane(0.2, a, PT, 0, s, c, FORM_QUIET)
-    return b, ck.catt_observe_one_lane(0.2, b, PT, 0, s, c, FORM_QUIET)
+def _lane_calls(gen, form):
+    """Four rhs calls and an observation at the constant lane form ``form`` of the generated
+    functions ``gen``, as a kernel's fused loop."""
+    rhs_lane, observe_lane = gen.rhs_lane, gen.observe_lane
+
+    @nb.njit
+    def calls(y, PT, s, c):
+        a = rhs_lane(0.1, y, PT, 0, s, c, form)
+        b = rhs_lane(0.2, a, PT, 0, s, c, form)
+        return b, observe_lane(0.2, b, PT, 0, s, c, form)
+
+    return calls
 
 
-@nb.njit
-def _lane_calls_load(y, PT, s, c):
-    a = ck.catt_rhs_one_lane(0.1, y, PT, 0, s, c, FORM_LOAD)
-    return a, ck.catt_observe_one_lane(0.1, a, PT, 0, s, c, FORM_LOAD)
-
-
-@nb.njit
-def _lane_calls_general(y, PT, s, c):
-    a = ck.catt_rhs_one_lane(0.1, y, PT, 0, s, c, FORM_GENERAL)
-    return a, ck.catt_observe_one_lane(0.1, a, PT, 0, s, c, FORM_GENERAL)
-
-
-def _model_functions_typed(fn, *args):
-    """The names of the model module's compiled functions that numba typed in compiling ``fn``
-    (those inlined into it and those it calls)."""
+def _model_functions_typed(gen, fn, *args):
+    """The names of the generated module's compiled functions that numba typed in compiling
+    ``fn`` (those inlined into it and those it calls)."""
     fn(*args)
     (ov,) = fn.overloads.values()
     return {t.dispatcher.py_func.__name__ for t in ov.type_annotation.typemap.values()
             if isinstance(t, nb.core.types.Dispatcher)
-            and t.dispatcher.py_func.__module__ == ck.__name__}
+            and t.dispatcher.py_func.__module__ == gen.__name__}
 
 
-@pytest.mark.parametrize(("fn", "own"), [(_lane_calls_quiet, {"_rhs_quiet", "_observe_quiet"}),
-                                         (_lane_calls_load, {"_rhs_load", "_observe_quiet"}),
-                                         (_lane_calls_general,
-                                          {"_rhs_general", "_observe_general"})])
-def test_a_constant_lane_form_compiles_that_forms_code_only(fn, own):
+@pytest.mark.parametrize(("form", "own"), [(FORM_QUIET, "quiet"), (FORM_LOAD, "loud"),
+                                           (FORM_GENERAL, "general")])
+def test_a_constant_lane_form_compiles_that_forms_code_only(form, own):
     """A kernel's compile time goes with the code numba inlines and types: a call site of a
-    constant form holds that form's functions only (no other form's, no load sine where the
-    load is quiet, no harmonics loop outside the general form)."""
+    constant form holds that form's functions only (no other form's: no load sine where the
+    load is quiet, no test of the load where it fluctuates)."""
+    gen = _gen(_device())
     P = np.ascontiguousarray(_device().lane_params("Omega", _OMEGAS[:1]).T)
-    typed = _model_functions_typed(fn, (0.01, 0.0, -0.02, 0.0), P, 0.3, math.sqrt(0.91))
-    assert typed == {"catt_rhs_one_lane", "catt_observe_one_lane"} | own
+    typed = _model_functions_typed(gen, _lane_calls(gen, form), (0.01, 0.0, -0.02, 0.0), P, 0.3,
+                                   math.sqrt(0.91))
+    assert typed == {"rhs_lane", "observe_lane", f"_rhs_lane_{own}", f"_observe_lane_{own}"}
 
 
-@nb.njit
-def _rhs_at_form(y, PT, s, c, form):
-    return ck.catt_rhs_one_lane(0.7, y, PT, 0, s, c, form)
+def _at_form(gen):
+    """The generated ``rhs_lane`` at t = 0.7 of lane 0 in a lane form given at run time."""
+    rhs_lane = gen.rhs_lane
+
+    @nb.njit
+    def at_form(y, PT, s, c, form):
+        return rhs_lane(0.7, y, PT, 0, s, c, form)
+
+    return at_form
 
 
 def test_every_form_of_a_quiet_lane_equals_the_array_form_with_form_a_variable():
-    """``form`` need not be a constant: each form of a lane that all may take (one harmonic, the
-    load quiet) gives the bits of the array form :func:`catt_rhs_one`."""
-    p = _device().lane_params("Omega", _OMEGAS[1:2])[0]
-    PT = np.ascontiguousarray(p[:, None])
-    y, s, c = np.array([2e-3, -0.1, -1e-3, 0.05]), 0.6, 0.8
-    ref = np.empty(4)
-    ck.catt_rhs_one(0.7, y, ref, p, s, c)
-    for form in (FORM_QUIET, FORM_LOAD, FORM_GENERAL):
-        np.testing.assert_array_equal(np.array(_rhs_at_form(tuple(y), PT, s, c, form)), ref)
+    """``form`` need not be a constant: each form of a quiet lane gives the bits of the general
+    model's array form :func:`catt_rhs` with one planet set; a lane with the load on gives them
+    in its forms (FORM_LOAD, FORM_GENERAL)."""
+    for changes, forms in (({}, (FORM_QUIET, FORM_LOAD, FORM_GENERAL)),
+                           (_LOAD, (FORM_LOAD, FORM_GENERAL))):
+        m = _device(**changes)
+        at_form = _at_form(_gen(m))
+        p = m.lane_params("Omega", _OMEGAS[1:2])[0]
+        PT = np.ascontiguousarray(p[:, None])
+        y, s, c = np.array([2e-3, -0.1, -1e-3, 0.05]), 0.6, 0.8
+        ref = np.empty(4)
+        ck.catt_rhs(0.7, y, ref, p, s, c)
+        for form in forms:
+            np.testing.assert_array_equal(np.array(at_form(tuple(y), PT, s, c, form)), ref)

@@ -149,21 +149,24 @@ def test_public_lanes_equal_one_lane_kernel(monkeypatch):
 
 @pytest.mark.parametrize("waveform", ["sine", "rectangular"])
 def test_lane_block_functions_take_a_phase_per_lane(waveform):
-    # rhs_lanes / observe_lanes with S[k], C[k] per lane (25 stiffness harmonics for the
-    # rectangular waveform: the harmonic recurrence per lane) against the per-lane functions
+    # the reduced device's generated rhs_lanes / observe_lanes with S[k], C[k] per lane (25
+    # stiffness harmonics for the rectangular waveform) against the general model's array
+    # functions with one planet set
     from geardyn.models import catt_kernels as ck
+    from geardyn.solvers.kernels import kernels_for
 
     m = geardyn.CATTDevice(geardyn.PlanetaryParams.paper(waveform=waveform)).with_omega(0.9)
+    gen = kernels_for(m.kernel, "core")
     nl, rng = 11, np.random.default_rng(0)
     PT = np.ascontiguousarray(np.tile(m.params[:, None], (1, nl)))
     Y, DY, O, SC = rng.uniform(-2, 2, (4, nl)), np.zeros((4, nl)), np.zeros((2, nl)), np.zeros(
         (8, nl))
     ph, T = rng.uniform(0, 2 * np.pi, nl), rng.uniform(0, 10, nl)
     S, C = np.sin(ph), np.cos(ph)
-    ck.catt_rhs_one_lanes(T, Y, DY, PT, nl, S, C, SC)
-    ck.catt_observe_one_lanes(T, Y, O, PT, nl, S, C, SC)
+    gen.rhs_lanes(T, Y, DY, PT, nl, S, C, SC)
+    gen.observe_lanes(T, Y, O, PT, nl, S, C, SC)
     for k in range(nl):
         dy, o = np.zeros(4), np.zeros(2)
-        ck.catt_rhs_one(T[k], Y[:, k].copy(), dy, m.params, S[k], C[k])
-        ck.catt_observe_one(T[k], Y[:, k].copy(), o, m.params, S[k], C[k])
+        ck.catt_rhs(T[k], Y[:, k].copy(), dy, m.params, S[k], C[k])
+        ck.catt_observe(T[k], Y[:, k].copy(), o, m.params, S[k], C[k])
         assert np.array_equal(dy, DY[:, k]) and np.array_equal(o, O[:, k])

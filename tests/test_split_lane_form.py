@@ -2,7 +2,8 @@
 functions evaluates them, with the state and the stages in registers (``_split_rhs``,
 ``_rk4_stages``, ``_hermite`` in :mod:`geardyn.solvers._step_core`); its results are bitwise
 those of the split on the model's array functions. The reference here is the same reduced CATT
-model through wrappers that hide its lane functions, so its kernel takes the generic path
+device through the general model's array functions (``catt_kernels.catt_rhs``, one planet set
+in the coefficient vector), which have no lane forms, so its kernel takes the generic path
 (structure-of-arrays blocks, the array forms of the split's helpers)."""
 
 from __future__ import annotations
@@ -21,17 +22,17 @@ from geardyn.solvers.kernels import kernels_for
 
 @nb.njit(cache=True)
 def _rhs(t, y, dy, p, s, c):
-    ck.catt_rhs_one(t, y, dy, p, s, c)
+    ck.catt_rhs(t, y, dy, p, s, c)
 
 
 @nb.njit(cache=True)
 def _events(t, y, g, p, s, c):
-    ck.catt_events_one(t, y, g, p, s, c)
+    ck.catt_events(t, y, g, p, s, c)
 
 
 @nb.njit(cache=True)
 def _observe(t, y, out, p, s, c):
-    ck.catt_observe_one(t, y, out, p, s, c)
+    ck.catt_observe(t, y, out, p, s, c)
 
 
 def test_the_split_in_the_lane_form_equals_the_array_form_bitwise():

@@ -23,8 +23,9 @@ __all__ = ["FORM_GENERAL", "FORM_LOAD", "FORM_QUIET", "LANE_FORMS", "KernelSourc
 #: compiles its fused step loop once per form, with ``form`` a constant there, and runs a queue
 #: of lanes in the form ``rhs_lane_form`` gives all of them (else FORM_GENERAL). FORM_GENERAL
 #: must serve every lane; the others are a model's specialisations without inner loops or libm
-#: calls, which the vectoriser needs (for the CATT model: one stiffness harmonic, the load
-#: quiet or fluctuating). A model may leave any but FORM_GENERAL unused.
+#: calls, which the vectoriser needs (for the reduced CATT device's one form: the load quiet
+#: or fluctuating, see :func:`geardyn.core.one_form.loud`). A model may leave any but
+#: FORM_GENERAL unused.
 FORM_GENERAL, FORM_QUIET, FORM_LOAD = 0, 1, 2
 LANE_FORMS = 3
 

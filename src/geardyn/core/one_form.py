@@ -22,15 +22,16 @@ no libm routine per lane (a model precomputes cos/sin of a coefficient as coeffi
 own: derived coefficients declared with their function, filled by the coefficient layout; see
 :mod:`geardyn.core.coefficients` and :class:`geardyn.models.gear_pair.GearPair`). A model whose
 physics has a dear term switched off by coefficients (the CATT device's load fluctuation) names
-them ``OneForm.quiet`` and writes the term so that it is dead code where they are 0 (the term
-computed, then selected: ``a * v if a != 0.0 else 0.0``, no branch in the lane loop): a lane
-where they are all 0 takes FORM_QUIET, where the generated layouts give the functions those
-coefficients as the constant 0.0 (so the compiler drops the term: the same values, bitwise, as
-the lane's own zeros give), any other lane FORM_LOAD (the term taken per lane, by its
-coefficients; it vectorises). FORM_GENERAL (the split path, a queue mixing the two) and the
-array form pick the quiet or the full function per lane by a test (a branch: the scalar paths
-skip the term where it is off), and the lane-block forms the quiet copy of their loop where
-every lane of the block is quiet.
+them ``OneForm.quiet`` and takes the term under ``if loud(p):`` (:func:`loud`: any of them
+non-zero), a plain branch of the scalar code. The lane's named tuple says which lane form it is
+in (its class, see :func:`coefficient_type`), and ``loud(p)`` is a constant where the form
+fixes it: a lane where the quiet coefficients are all 0 takes FORM_QUIET, where ``loud(p)`` is
+False (the term is dead code) and those coefficients are the constant 0.0 (the compiler folds
+what they multiply: the same values, bitwise, as the lane's own zeros give); any other lane
+takes FORM_LOAD, where ``loud(p)`` is True (the term taken with no test: it vectorises).
+FORM_GENERAL (the split path, a queue mixing the two), the array form and the lane-block forms
+test the coefficients per lane (the scalar paths skip the term where it is off); the lane-block
+forms run their loop in FORM_QUIET where every lane of the block is quiet.
 
 This module belongs to the core: it imports nothing of geardyn outside :mod:`geardyn.core`.
 """
@@ -42,11 +43,18 @@ import keyword
 from dataclasses import dataclass
 from typing import Any
 
+from numba.core import errors
+from numba.extending import overload
+
 from geardyn.core.coefficients import Derivations
 
-__all__ = ["Derivations", "OneForm", "adapters", "call_tuple", "coefficient_type"]
+__all__ = ["Derivations", "OneForm", "adapters", "call_tuple", "coefficient_type", "loud"]
 
 _TYPE_PREFIX = "Coefficients_"
+#: The lane forms a coefficient type of a one form with ``quiet`` coefficients is made for
+#: (:func:`coefficient_type`) and the prefix of its class name.
+MODES = {"general": "CoefficientsGeneral_", "quiet": "CoefficientsQuiet_",
+         "loud": "CoefficientsLoud_"}
 
 
 @dataclass(frozen=True)
@@ -85,22 +93,34 @@ def check_names(names: tuple[str, ...]) -> None:
         raise ValueError(f"coefficient names repeat {', '.join(dup)}")
 
 
-def _type_name(names: tuple[str, ...]) -> str:
-    return _TYPE_PREFIX + ",".join(names).encode().hex()
+def _type_name(names: tuple[str, ...], quiet: tuple[str, ...] = (),
+               mode: str = "general") -> str:
+    if not quiet:
+        return _TYPE_PREFIX + ",".join(names).encode().hex()
+    return MODES[mode] + (",".join(quiet) + ";" + ",".join(names)).encode().hex()
 
 
-def coefficient_type(names: tuple[str, ...]) -> type:
+def coefficient_type(names: tuple[str, ...], quiet: tuple[str, ...] = (),
+                     mode: str = "general") -> type:
     """The named tuple of a lane's coefficients with fields ``names`` (one class per tuple of
     names, an attribute of this module, so that it pickles by reference: numba's cache index
-    keeps the argument types of the functions it caches)."""
-    names = tuple(names)
-    attr = _type_name(names)
+    keeps the argument types of the functions it caches). For a one form with ``quiet``
+    coefficients, one class per lane form ``mode`` (:data:`MODES`), which :func:`loud` reads:
+    ``"general"`` (tested per lane), ``"quiet"`` (False), ``"loud"`` (True)."""
+    names, quiet = tuple(names), tuple(quiet)
+    if mode not in MODES:
+        raise ValueError(f"mode must be one of {', '.join(MODES)} (got {mode!r})")
+    attr = _type_name(names, quiet, mode)
     cls = globals().get(attr)
     if cls is None:
         check_names(names)
+        if any(n not in names for n in quiet):
+            raise ValueError(f"quiet names coefficients of the tuple (got {quiet!r})")
         cls = collections.namedtuple("Coefficients", names)
         cls.__module__ = __name__
         cls.__qualname__ = attr
+        cls.quiet_fields = quiet
+        cls.lane_form = mode if quiet else None
         globals()[attr] = cls
     return cls
 
@@ -113,14 +133,53 @@ def __getattr__(attr: str) -> type:
         except ValueError:
             raise AttributeError(attr) from None
         return coefficient_type(tuple(names.split(",")) if names else ())
+    for mode, prefix in MODES.items():
+        if attr.startswith(prefix):
+            try:
+                quiet, names = bytes.fromhex(attr[len(prefix):]).decode().split(";")
+            except ValueError:
+                raise AttributeError(attr) from None
+            return coefficient_type(tuple(names.split(",")), tuple(quiet.split(",")), mode)
     raise AttributeError(f"module {__name__!r} has no attribute {attr!r}")
 
 
+def loud(p: Any) -> bool:
+    """Whether the term a one form switches by its ``quiet`` coefficients is on in the lane of
+    the coefficients ``p``: any of them non-zero (NaN counts as on). In a lane form that fixes
+    it (a constant: False in FORM_QUIET, True in FORM_LOAD) and tested per lane elsewhere; see
+    the module docstring. The one form writes the term under ``if loud(p):``."""
+    quiet = getattr(type(p), "quiet_fields", ())
+    if not quiet:
+        raise TypeError("loud(p): the coefficients' one form declares no quiet coefficients")
+    mode = type(p).lane_form
+    if mode != "general":
+        return mode == "loud"
+    return not all(getattr(p, n) == 0.0 for n in quiet)
+
+
+@overload(loud, inline="always")
+def _loud(p):
+    cls = getattr(p, "instance_class", None)
+    quiet = getattr(cls, "quiet_fields", ())
+    if not quiet:
+        raise errors.TypingError("loud(p): p must be the coefficients of a one form that "
+                                 f"declares quiet coefficients (got {p})")
+    if cls.lane_form == "quiet":
+        return lambda p: False
+    if cls.lane_form == "loud":
+        return lambda p: True
+    test = " & ".join(f"(p.{n} == 0.0)" for n in quiet)
+    scope: dict[str, Any] = {}
+    exec(f"def impl(p):\n    return not ({test})\n", scope)  # noqa: S102 (names checked)
+    return scope["impl"]
+
+
 def call_tuple(fn: Any, names: tuple[str, ...], t: float, y: Any, p: Any, s: float,
-               c: float) -> tuple:
+               c: float, quiet: tuple[str, ...] = ()) -> tuple:
     """``fn(t, y, p, s, c)`` of a one-form function from arrays (``y`` and ``p`` as tuples),
-    for tests and checks outside the kernels."""
-    coef = coefficient_type(names)(*(float(v) for v in p))
+    for tests and checks outside the kernels (``quiet``: the form's quiet coefficients, tested
+    per lane)."""
+    coef = coefficient_type(names, quiet)(*(float(v) for v in p))
     return fn(float(t), tuple(float(v) for v in y), coef, float(s), float(c))
 
 
@@ -159,17 +218,20 @@ def adapters(form: OneForm) -> str:
     ns, ne, no = form.n_states, form.n_events, form.n_observables
     nc = len(form.coefficients)
     quiet = bool(form.quiet)
+    type_args = repr(tuple(form.coefficients)) + (f", {tuple(form.quiet)!r}" if quiet else "")
     out = [
         "\n# The model's one form (geardyn.core.one_form): every layout generated from it.",
         "from geardyn.core.kernel_source import FORM_QUIET as _ONE_FORM",
         "from geardyn.core.one_form import coefficient_type as _coefficient_type",
-        f"_Coef = _coefficient_type({tuple(form.coefficients)!r})",
+        f"_Coef = _coefficient_type({type_args})",
         "from geardyn._jit_target import WidthCompiler as _WidthCompiler",
         "_ONE_INLINE = {\"inline\": \"always\", \"error_model\": \"numpy\", "
         "\"boundscheck\": False, \"pipeline_class\": _WidthCompiler}",
     ]
     if quiet:
-        out.append("from geardyn.core.kernel_source import FORM_LOAD as _ONE_LOUD")
+        out += ["from geardyn.core.kernel_source import FORM_LOAD as _ONE_LOUD",
+                f"_CoefQuiet = _coefficient_type({type_args}, \"quiet\")",
+                f"_CoefLoud = _coefficient_type({type_args}, \"loud\")"]
     for name, n in (("rhs", ns), ("events", ne), ("observe", no)):
         if name == "rhs" or n > 0:
             out.append(f"_one_{name} = nb.njit(**_ONE_INLINE)(one_{name}.py_func)")
@@ -179,11 +241,10 @@ def adapters(form: OneForm) -> str:
                 inline=True)
     if quiet:
         text += _fn("_coef_quiet(PT, k)", [
-            f"return _Coef{_quiet_tuple(form.coefficients, form.quiet, 'PT[{q}, k]')}"],
+            f"return _CoefQuiet{_quiet_tuple(form.coefficients, form.quiet, 'PT[{q}, k]')}"],
             inline=True)
-        text += _fn("_coef_quiet_arr(p)", [
-            f"return _Coef{_quiet_tuple(form.coefficients, form.quiet, 'p[{q}]')}"],
-            inline=True)
+        text += _fn("_coef_loud(PT, k)", [
+            f"return _CoefLoud{_tuple_text('PT[{q}, k]', nc)}"], inline=True)
         text += _forms(form)
     y_arr, y_blk = _tuple_text("y[{q}]", ns), _tuple_text("Y[{q}, k]", ns)
     specs = (("rhs", "dy", "DY", ns, ", SC"), ("events", "g", "G", ne, ""),
@@ -196,11 +257,6 @@ def adapters(form: OneForm) -> str:
             lane_body = ["return ()"]
         else:
             body = [f"v = {call}(t, {y_arr}, _coef(p), s, c)", *_stores(arr + "[{q}]", n)]
-            if quiet and name == "rhs":  # a scalar path: the quiet lane's term skipped
-                body = [f"if {_quiet_test(form, 'p[{q}]')}:",
-                        f"    v = {call}(t, {y_arr}, _coef_quiet_arr(p), s, c)",
-                        "else:", f"    v = {call}(t, {y_arr}, _coef(p), s, c)",
-                        *_stores(arr + "[{q}]", n)]
             blk_body = _block_loop(call, y_blk, blk, n, "_coef_lane")
             if quiet and name != "events":
                 blk_body = ["quiet = True", "for k in range(nl):",
@@ -211,16 +267,13 @@ def adapters(form: OneForm) -> str:
                             "    return",
                             *blk_body]
             lane_body = [f"return {call}(t, y, _coef_lane(PT, k), s, c)"]
-            if quiet:  # the form's own compiled function (see _forms)
-                lane_body = (lane_body if name == "events"
-                             else ["if form == _ONE_FORM:",
-                                   f"    return _{name}_lane_quiet(t, y, PT, k, s, c)",
-                                   "if form == _ONE_LOUD:",
-                                   f"    return _{name}_lane_all(t, y, PT, k, s, c)",
-                                   # FORM_GENERAL (the split path, a mixed queue): by lane
-                                   f"if {_quiet_test(form, 'PT[{q}, k]')}:",
-                                   f"    return _{name}_lane_quiet(t, y, PT, k, s, c)",
-                                   f"return _{name}_lane_all(t, y, PT, k, s, c)"])
+            if quiet and name != "events":  # the form's own compiled function (see _forms)
+                lane_body = ["if form == _ONE_FORM:",
+                             f"    return _{name}_lane_quiet(t, y, PT, k, s, c)",
+                             "if form == _ONE_LOUD:",
+                             f"    return _{name}_lane_loud(t, y, PT, k, s, c)",
+                             # FORM_GENERAL (the split path, a mixed queue): tested by lane
+                             f"return _{name}_lane_general(t, y, PT, k, s, c)"]
         text += _fn(f"{name}(t, y, {arr}, p, s, c)", body)
         text += _fn(f"{name}_lanes(T, Y, {blk}, PT, nl, S, C{sc})", blk_body)
         form_arg = "" if name == "events" else ", form"
@@ -237,19 +290,17 @@ def adapters(form: OneForm) -> str:
 
 def _forms(form: OneForm) -> str:
     """The lane-scalar functions of a model with ``quiet`` coefficients, one compiled function
-    per lane form (``_rhs_lane_quiet``: the quiet coefficients constant zeros; ``_rhs_lane_all``:
-    every coefficient the lane's) and so for ``observe`` (``events`` in the second only). Each
-    is compiled once and inlined by LLVM where it is called (``forceinline``: the fused loops
-    still vectorise); ``rhs_lane(..., form)``, which numba inlines, calls the one of ``form``,
-    so that a kernel's copy of its fused loop for a constant form types that call alone."""
+    per lane form (``_rhs_lane_quiet``: :func:`loud` False, the quiet coefficients constant
+    zeros; ``_rhs_lane_loud``: :func:`loud` True; ``_rhs_lane_general``: tested) and so for
+    ``observe``. Each is compiled once and inlined by LLVM where it is called (``forceinline``:
+    the fused loops still vectorise); ``rhs_lane(..., form)``, which numba inlines, calls the
+    one of ``form``, so that a kernel's copy of its fused loop for a constant form types that
+    call alone."""
     text = ""
-    for name, n in (("rhs", form.n_states), ("events", form.n_events),
-                    ("observe", form.n_observables)):
+    for name, n in (("rhs", form.n_states), ("observe", form.n_observables)):
         if name != "rhs" and n == 0:
             continue
-        if name == "events":
-            continue
-        kinds = (("quiet", "_coef_quiet"), ("all", "_coef_lane"))
+        kinds = (("quiet", "_coef_quiet"), ("loud", "_coef_loud"), ("general", "_coef_lane"))
         for kind, coef in kinds:
             text += f"\n\n@nb.njit(forceinline=True, **_JIT)\ndef _{name}_lane_{kind}" \
                     f"(t, y, PT, k, s, c):\n    return _one_{name}(t, y, {coef}(PT, k), s, c)\n"

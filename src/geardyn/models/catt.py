@@ -56,8 +56,6 @@ from geardyn.models.params import PAPER_INPUTS, PAPER_NAMES, PlanetaryParams
 from geardyn.models.stiffness import fourier_coefficients, harmonics_needed
 
 _KERNEL = KernelSource(ck.catt_rhs, ck.catt_events, ck.catt_observe)
-#: The reduced model's hand-written kernel: the same functions compiled for one planet set.
-_KERNEL_ONE = KernelSource(ck.catt_rhs_one, ck.catt_events_one, ck.catt_observe_one)
 _THETA_KERNEL = KernelSource(ck.theta_rhs, ck.theta_events)
 #: The block coefficients :meth:`CATTDevice._coefficients_of` reads back per planet set.
 _READ_BACK = ("k_sq_c", "c_sq_c", "k_sq_q", "c_sq_q", "k_pq_q", "c_pq_q", "k_pq_p", "c_pq_p",
@@ -107,11 +105,10 @@ class CATTDevice(Model):
         Dimensionless mesh frequency Omega = omega / omega_n stored in the model (solvers and
         sweeps set it).
     one_form
-        Run one planet-set block (the reduced form) through its one form
-        (:mod:`geardyn.models.catt_reduced`: every kernel layout generated from the physics
-        written once) instead of the hand-written kernel; the same results, bitwise. Off by
-        default while its fluctuating-load sweeps are slower (the paper's quiet workload runs
-        as fast).
+        Deprecated; chooses nothing (a DeprecationWarning where given). The reduced form runs
+        its one form (:mod:`geardyn.models.catt_reduced`: every kernel layout generated from
+        the physics written once), the general form the kernel of
+        :func:`~geardyn.models.catt_kernels.catt_rhs`.
     """
 
     time_unit = "1"
@@ -134,8 +131,12 @@ class CATTDevice(Model):
         interpretation: Interpretation = "consistent",
         reduced: bool | None = None,
         omega: float = 1.0,
-        one_form: bool = False,
+        one_form: bool | None = None,
     ):
+        if one_form is not None:
+            warnings.warn("CATTDevice(one_form=...) chooses nothing and will be removed: the "
+                          "reduced form always runs its one form (geardyn.models.catt_reduced)",
+                          DeprecationWarning, stacklevel=2)
         if interpretation not in INTERPRETATIONS:
             raise ValueError(
                 f"interpretation must be one of {', '.join(INTERPRETATIONS)};"
@@ -176,13 +177,7 @@ class CATTDevice(Model):
             )
         self.name = "CATTDevice"
         nh = self._n_harmonics()
-        #: Whether one planet-set block runs the one form (:mod:`geardyn.models.catt_reduced`)
-        #: instead of the hand-written kernel (the same results, bitwise).
-        self.one_form = bool(one_form)
-        if n_sets > 1:
-            self.kernel = _KERNEL
-        else:
-            self.kernel = reduced_kernel(nh) if self.one_form else _KERNEL_ONE
+        self.kernel = _KERNEL if n_sets > 1 else reduced_kernel(nh)
         self.omega_index = CATT_HEADER.offset("Omega")
         self.coefficient_layout = catt_layout(n_sets, self.reduced, nh)
         self.params = self._coefficient_vector(omega)
@@ -194,6 +189,14 @@ class CATTDevice(Model):
             bad = names[int(np.argmax(~np.isfinite(self.params)))]
             raise ParameterError("params", bad, "the parameters give a dimensionless "
                                  "coefficient that is not finite (extreme magnitudes)")
+
+    @property
+    def one_form(self) -> bool:
+        """Deprecated: whether the device runs a one form (the reduced form always does, the
+        general one never)."""
+        warnings.warn("CATTDevice.one_form is deprecated: the reduced form always runs its one "
+                      "form", DeprecationWarning, stacklevel=2)
+        return self.kernel.one_form is not None
 
     # ------------------------------------------------------------------ coefficient vector
     def _n_harmonics(self) -> int:
@@ -253,8 +256,7 @@ class CATTDevice(Model):
         reduced = None if params.identical_planets else False
         if not self.reduced:
             reduced = False
-        out = CATTDevice(params, self.interpretation, reduced=reduced, omega=omega,
-                         one_form=self.one_form)
+        out = CATTDevice(params, self.interpretation, reduced=reduced, omega=omega)
         if self.raw_overrides:
             plain = CATTDevice(self.params_in, self.interpretation, reduced=self.reduced,
                                omega=omega).params

@@ -16,7 +16,8 @@ Kernel interface shared by every geardyn model (see :mod:`geardyn.models.base`):
 Mesh-coordinate form (Eq. 10 corrected), state per planet set i: X_sq, X_sq', X_pq, X_pq'.
 The coefficient vector is a header followed by one block per planet set. The reduced model for N
 identical planet sets is the same right-hand side with one block whose carrier-coupling
-coefficients are multiplied by N.
+coefficients are multiplied by N, written in the one form (:mod:`geardyn.models.catt_reduced`);
+with one block in ``p`` the functions here give its bits (``tests/test_catt_one_form.py``).
 """
 
 from __future__ import annotations
@@ -26,9 +27,8 @@ import math
 import numba as nb
 
 from geardyn._jit_target import WidthCompiler
-from geardyn.core.kernel_source import FORM_GENERAL, FORM_LOAD, FORM_QUIET
 from geardyn.models.derived import CATT_BLOCK, CATT_HEADER, THETA_BLOCK, THETA_HEADER
-from geardyn.models.elements import dead_zone, harmonic_factor, harmonic_factor_lane
+from geardyn.models.elements import dead_zone, harmonic_factor
 
 # Index constants: the offsets of the declared coefficients (geardyn.models.derived).
 # header
@@ -61,7 +61,8 @@ _JIT = {"cache": True, "error_model": "numpy", "boundscheck": False,
 # __kernel_cos (coefficients from Sun's fdlibm, k_sin.c / k_cos.c) and a branch-free quadrant
 # select. Within 2 ulp of sin(x) there; beyond, the reduction rounds by about ulp(x), the
 # rounding of the argument Lambda t + psi itself (tests/test_catt_lane_forms.py). Every form of
-# the load term (scalar, lanes, lane-scalar) calls it, so they stay bitwise equal.
+# the load term (this general model's, the reduced one form's every layout) calls it, so they
+# stay bitwise equal.
 _S1, _S2, _S3 = -1.66666666666666324348e-01, 8.33333333332248946124e-03, -1.98412698298579493134e-04
 _S4, _S5, _S6 = 2.75573137070700676789e-06, -2.50507602534068634195e-08, 1.58969099521155010221e-10
 _C1, _C2, _C3 = 4.16666666666666019037e-02, -1.38888888888741095749e-03, 2.48015872894767294178e-05
@@ -91,9 +92,9 @@ def load_sin(x):
     return -c if q == 3.0 else v
 
 
-# Each function below is written once, inline, for n_sets planet sets, and compiled twice: for
-# the general model (n_sets read from p) and for the reduced model (n_sets = 1, a constant, so the
-# loop over sets disappears: twice as fast). Helpers take arrays only when inlined.
+# Each function below is written once, inline, for n_sets planet sets (the general model reads
+# n_sets from p; the reduced model, one set, is its one form: geardyn.models.catt_reduced).
+# Helpers take arrays only when inlined.
 
 
 @nb.njit(inline="always", **_JIT)
@@ -174,22 +175,6 @@ def catt_observe(t, y, out, p, s, c):
     _observe(y, out, p, s, c, int(p[N_BLOCKS]))
 
 
-@nb.njit(**_JIT)
-def catt_rhs_one(t, y, dy, p, s, c):
-    """:func:`catt_rhs` for one (equivalent) planet set: the reduced model."""
-    _rhs(t, y, dy, p, s, c, 1)
-
-
-@nb.njit(**_JIT)
-def catt_events_one(t, y, g, p, s, c):
-    _events(y, g, p, 1)
-
-
-@nb.njit(**_JIT)
-def catt_observe_one(t, y, out, p, s, c):
-    _observe(y, out, p, s, c, 1)
-
-
 # ---------------------------------------------------------------------------------------------
 # Dimensional form, Eq. (1), in the body angles (SI units, time in seconds).
 # State: theta_c, theta_c', then per planet set theta_q, theta_q', theta_p, theta_p'.
@@ -266,260 +251,3 @@ def theta_events(t, y, g, p, s, c):
         g[4 * i + 1] = x_sq + p[o + T_B_SQ]
         g[4 * i + 2] = x_pq - p[o + T_B_PQ]
         g[4 * i + 3] = x_pq + p[o + T_B_PQ]
-
-
-# ---------------------------------------------------------------------------------------------
-# Lane-block forms of the reduced model (one planet set) for the sweep kernel: the same
-# arithmetic as catt_rhs_one / catt_events_one / catt_observe_one, operation for operation (so
-# results are bitwise equal), on a block of lanes in structure-of-arrays layout: state Y[q, k],
-# coefficients PT[j, k] (lane k of the block innermost), nl lanes, the forcing phase per lane
-# (S[k], C[k]: sin and cos of Omega t). The lane loops have no calls and vectorise. SC: scratch
-# rows (>= 4, width of the block). The kernel generator picks them up by name
-# (``<function>_lanes``).
-
-
-@nb.njit(inline="always", **_JIT)
-def _lane_forcing(T, PT, nl, S, C, SC):
-    """Per-lane stiffness factors (rows 0, 1: sun-inside, inside-outside) and the load terms
-    (rows 2, 3: load_c, sin_l1) of :func:`_rhs` for one planet set, into SC."""
-    nh = int(PT[N_HARM, 0])  # the same in every lane: it fixes the vector's layout
-    fs = HEADER + BLOCK_FIXED
-    fp = fs + 2 * nh
-    fluctuates = False
-    if nh == 1:  # one loop (the same arithmetic as below)
-        for k in range(nl):
-            SC[0, k] = 1.0 + (PT[fs, k] * C[k] + PT[fs + 1, k] * S[k])
-            SC[1, k] = 1.0 + (PT[fp, k] * C[k] + PT[fp + 1, k] * S[k])
-            SC[2, k] = PT[F_C0, k]
-            SC[3, k] = 0.0
-            fluctuates |= (PT[F_C1, k] != 0.0) | (PT[HEADER + F_P1, k] != 0.0)
-        if fluctuates:
-            _load_terms(T, PT, nl, SC)
-        return
-    for k in range(nl):
-        SC[0, k] = PT[fs, k] * C[k] + PT[fs + 1, k] * S[k]
-        SC[1, k] = PT[fp, k] * C[k] + PT[fp + 1, k] * S[k]
-        ch = C[k]
-        sh = S[k]
-        for h in range(1, nh):  # the harmonics by the recurrence of harmonic_factor, per lane
-            ch, sh = ch * C[k] - sh * S[k], sh * C[k] + ch * S[k]
-            SC[0, k] += PT[fs + 2 * h, k] * ch + PT[fs + 2 * h + 1, k] * sh
-            SC[1, k] += PT[fp + 2 * h, k] * ch + PT[fp + 2 * h + 1, k] * sh
-    for k in range(nl):
-        SC[0, k] = 1.0 + SC[0, k]
-        SC[1, k] = 1.0 + SC[1, k]
-        SC[2, k] = PT[F_C0, k]
-        SC[3, k] = 0.0
-        fluctuates |= (PT[F_C1, k] != 0.0) | (PT[HEADER + F_P1, k] != 0.0)
-    if fluctuates:  # no libm call in the common case (a guarded call may be speculated)
-        _load_terms(T, PT, nl, SC)
-
-
-@nb.njit(inline="always", **_JIT)
-def _load_terms(T, PT, nl, SC):
-    """The load fluctuation of :func:`_rhs` (rows 2, 3 of SC: load_c, sin_l1) where it is on."""
-    for k in range(nl):
-        if PT[F_C1, k] != 0.0 or PT[HEADER + F_P1, k] != 0.0:
-            SC[2, k] += PT[F_C1, k] * load_sin(PT[LAMBDA, k] * T[k] + PT[PSI2, k])
-            SC[3, k] = load_sin(PT[LAMBDA, k] * T[k] + PT[PSI1, k])
-
-
-@nb.njit(_nrt=False, **_JIT)  # allocates nothing (called once per block step)
-def catt_rhs_one_lanes(T, Y, DY, PT, nl, S, C, SC):
-    """:func:`catt_rhs_one` for lanes 0..nl-1 of a block (see above)."""
-    _lane_forcing(T, PT, nl, S, C, SC)
-    o = HEADER
-    for k in range(nl):
-        om2 = PT[OMEGA, k] * PT[OMEGA, k]
-        xs = Y[0, k]
-        vs = Y[1, k]
-        xp = Y[2, k]
-        vp = Y[3, k]
-        gs = SC[0, k] * dead_zone(xs, PT[o + B_SQ, k])
-        gp = SC[1, k] * dead_zone(xp, PT[o + B_PQ, k])
-        carrier = 0.0
-        carrier += PT[o + K_SQ_C, k] * gs + PT[o + C_SQ_C, k] * vs
-        f_sq = PT[o + K_SQ_Q, k] * gs + PT[o + C_SQ_Q, k] * vs
-        f_pq = PT[o + K_PQ_Q, k] * gp + PT[o + C_PQ_Q, k] * vp
-        f_pp = PT[o + K_PQ_P, k] * gp + PT[o + C_PQ_P, k] * vp
-        load_p = PT[o + F_P0, k] + PT[o + F_P1, k] * SC[3, k]
-        d1 = -f_sq + f_pq + om2 * (PT[o + E_SQ_S, k] * S[k] + PT[o + E_SQ_C, k] * C[k])
-        DY[0, k] = vs
-        DY[1, k] = d1 + (SC[2, k] - carrier)
-        DY[2, k] = vp
-        DY[3, k] = (f_sq - f_pq - f_pp + load_p
-                    + om2 * (PT[o + E_PQ_S, k] * S[k] + PT[o + E_PQ_C, k] * C[k]))
-
-
-@nb.njit(_nrt=False, **_JIT)  # allocates nothing (called once per block step)
-def catt_events_one_lanes(T, Y, G, PT, nl, S, C):
-    """:func:`catt_events_one` for lanes 0..nl-1 of a block."""
-    o = HEADER
-    for k in range(nl):
-        G[0, k] = Y[0, k] - PT[o + B_SQ, k]
-        G[1, k] = Y[0, k] + PT[o + B_SQ, k]
-        G[2, k] = Y[2, k] - PT[o + B_PQ, k]
-        G[3, k] = Y[2, k] + PT[o + B_PQ, k]
-
-
-@nb.njit(_nrt=False, **_JIT)  # allocates nothing (called once per block step)
-def catt_observe_one_lanes(T, Y, O, PT, nl, S, C, SC):
-    """:func:`catt_observe_one` for lanes 0..nl-1 of a block."""
-    _lane_forcing(T, PT, nl, S, C, SC)
-    o = HEADER
-    for k in range(nl):
-        gs = SC[0, k] * dead_zone(Y[0, k], PT[o + B_SQ, k])
-        gp = SC[1, k] * dead_zone(Y[2, k], PT[o + B_PQ, k])
-        scale = PT[o + FORCE_SCALE, k]
-        O[0, k] = scale * (PT[o + K_SQ_Q, k] * gs + PT[o + C_SQ_Q, k] * Y[1, k])
-        O[1, k] = scale * (PT[o + K_PQ_Q, k] * gp + PT[o + C_PQ_Q, k] * Y[3, k])
-
-
-# ---------------------------------------------------------------------------------------------
-# Lane-scalar forms of the reduced model for the sweep kernel's fused step loop: lane k of a
-# block (coefficients PT[j, k]), the state and the result as tuples (local scalars, registers),
-# the same arithmetic as catt_rhs_one / catt_events_one / catt_observe_one operation for
-# operation (bitwise equal). ``form`` (a constant in each compiled copy of the kernel's loop,
-# see :data:`geardyn.core.kernel_source.LANE_FORMS`): FORM_QUIET, one stiffness harmonic and no
-# load fluctuation; FORM_LOAD, one harmonic with the load fluctuating (its sine by
-# :func:`load_sin`, branch-free); in both no inner loop and no libm call stop the vectoriser.
-# FORM_GENERAL: any lane (a harmonics loop; scalar). ``catt_rhs_one_lane_form`` says which a
-# lane may take. Picked up by name (``<function>_lane``).
-
-#: State size of the lane-scalar forms (the tuples' length).
-catt_rhs_one_lane_states = 4
-
-
-@nb.njit(inline="always", **_JIT)
-def _factors_quiet(t, PT, k, s, c):
-    """Stiffness factors (sun-inside, inside-outside) and load terms (load_c, sin_l1) of lane k,
-    as :func:`_rhs` computes them for one planet set, in the lane form FORM_QUIET."""
-    fs = HEADER + BLOCK_FIXED
-    return (1.0 + (PT[fs, k] * c + PT[fs + 1, k] * s),
-            1.0 + (PT[fs + 2, k] * c + PT[fs + 3, k] * s), PT[F_C0, k], 0.0)
-
-
-@nb.njit(inline="always", **_JIT)
-def _factors_load(t, PT, k, s, c):
-    """:func:`_factors_quiet` in the lane form FORM_LOAD: the load on (no branch: the scalar
-    path takes it too)."""
-    fs = HEADER + BLOCK_FIXED
-    return (1.0 + (PT[fs, k] * c + PT[fs + 1, k] * s),
-            1.0 + (PT[fs + 2, k] * c + PT[fs + 3, k] * s),
-            PT[F_C0, k] + PT[F_C1, k] * load_sin(PT[LAMBDA, k] * t + PT[PSI2, k]),
-            load_sin(PT[LAMBDA, k] * t + PT[PSI1, k]))
-
-
-@nb.njit(inline="always", **_JIT)
-def _factors_general(t, PT, k, s, c):
-    """:func:`_factors_quiet` in the lane form FORM_GENERAL (any lane)."""
-    fs = HEADER + BLOCK_FIXED
-    nh = int(PT[N_HARM, k])
-    load_c = PT[F_C0, k]
-    sin_l1 = 0.0
-    if PT[F_C1, k] != 0.0 or PT[HEADER + F_P1, k] != 0.0:
-        load_c += PT[F_C1, k] * load_sin(PT[LAMBDA, k] * t + PT[PSI2, k])
-        sin_l1 = load_sin(PT[LAMBDA, k] * t + PT[PSI1, k])
-    return (harmonic_factor_lane(PT, k, fs, nh, s, c),
-            harmonic_factor_lane(PT, k, fs + 2 * nh, nh, s, c), load_c, sin_l1)
-
-
-@nb.njit(inline="always", **_JIT)
-def _rhs_lane(t, y, PT, k, s, c, factors):
-    """:func:`catt_rhs_one` of lane k with the mesh factors ``factors`` (of a lane form)."""
-    o = HEADER
-    ks, kp, load_c, sin_l1 = factors
-    om2 = PT[OMEGA, k] * PT[OMEGA, k]
-    xs, vs, xp, vp = y
-    gs = ks * dead_zone(xs, PT[o + B_SQ, k])
-    gp = kp * dead_zone(xp, PT[o + B_PQ, k])
-    carrier = 0.0
-    carrier += PT[o + K_SQ_C, k] * gs + PT[o + C_SQ_C, k] * vs
-    f_sq = PT[o + K_SQ_Q, k] * gs + PT[o + C_SQ_Q, k] * vs
-    f_pq = PT[o + K_PQ_Q, k] * gp + PT[o + C_PQ_Q, k] * vp
-    f_pp = PT[o + K_PQ_P, k] * gp + PT[o + C_PQ_P, k] * vp
-    load_p = PT[o + F_P0, k] + PT[o + F_P1, k] * sin_l1
-    d1 = -f_sq + f_pq + om2 * (PT[o + E_SQ_S, k] * s + PT[o + E_SQ_C, k] * c)
-    d3 = (f_sq - f_pq - f_pp + load_p + om2 * (PT[o + E_PQ_S, k] * s + PT[o + E_PQ_C, k] * c))
-    return (vs, d1 + (load_c - carrier), vp, d3)
-
-
-@nb.njit(inline="always", **_JIT)
-def _observe_lane(t, y, PT, k, s, c, factors):
-    """:func:`catt_observe_one` of lane k with the mesh factors ``factors``."""
-    o = HEADER
-    ks, kp, _, _ = factors
-    gs = ks * dead_zone(y[0], PT[o + B_SQ, k])
-    gp = kp * dead_zone(y[2], PT[o + B_PQ, k])
-    scale = PT[o + FORCE_SCALE, k]
-    return (scale * (PT[o + K_SQ_Q, k] * gs + PT[o + C_SQ_Q, k] * y[1]),
-            scale * (PT[o + K_PQ_Q, k] * gp + PT[o + C_PQ_Q, k] * y[3]))
-
-
-# The lane-scalar functions of each lane form, compiled on their own (once per argument types,
-# and cached) and inlined by LLVM where they are called (``forceinline``: the fused loops
-# vectorise as with numba's inlining). ``catt_rhs_one_lane`` and ``catt_observe_one_lane``,
-# which numba inlines, call the one of ``form``: where ``form`` is a constant (each compiled copy
-# of a kernel's fused loop, the split path), numba's branch pruning leaves that call only, so
-# that a kernel's compile types one call per site and its code holds its own form's arithmetic.
-@nb.njit(forceinline=True, **_JIT)
-def _rhs_quiet(t, y, PT, k, s, c):
-    return _rhs_lane(t, y, PT, k, s, c, _factors_quiet(t, PT, k, s, c))
-
-
-@nb.njit(forceinline=True, **_JIT)
-def _rhs_load(t, y, PT, k, s, c):
-    return _rhs_lane(t, y, PT, k, s, c, _factors_load(t, PT, k, s, c))
-
-
-@nb.njit(forceinline=True, **_JIT)
-def _rhs_general(t, y, PT, k, s, c):
-    return _rhs_lane(t, y, PT, k, s, c, _factors_general(t, PT, k, s, c))
-
-
-@nb.njit(forceinline=True, **_JIT)
-def _observe_quiet(t, y, PT, k, s, c):
-    return _observe_lane(t, y, PT, k, s, c, _factors_quiet(t, PT, k, s, c))
-
-
-@nb.njit(forceinline=True, **_JIT)
-def _observe_general(t, y, PT, k, s, c):
-    return _observe_lane(t, y, PT, k, s, c, _factors_general(t, PT, k, s, c))
-
-
-@nb.njit(**_JIT)
-def catt_rhs_one_lane_form(PT, k):
-    """The lane form lane k may take: FORM_QUIET (one stiffness harmonic, no load fluctuation),
-    FORM_LOAD (one harmonic, the load fluctuating), else FORM_GENERAL (a harmonics loop)."""
-    if PT[N_HARM, k] != 1.0:
-        return FORM_GENERAL
-    if (PT[F_C1, k] == 0.0) & (PT[HEADER + F_P1, k] == 0.0):
-        return FORM_QUIET
-    return FORM_LOAD
-
-
-@nb.njit(inline="always", **_JIT)
-def catt_rhs_one_lane(t, y, PT, k, s, c, form):
-    """:func:`catt_rhs_one` of lane k in the lane form ``form``: dy/dt as a tuple."""
-    if form == FORM_QUIET:
-        return _rhs_quiet(t, y, PT, k, s, c)
-    if form == FORM_LOAD:
-        return _rhs_load(t, y, PT, k, s, c)
-    return _rhs_general(t, y, PT, k, s, c)
-
-
-@nb.njit(inline="always", **_JIT)
-def catt_events_one_lane(t, y, PT, k, s, c):
-    """:func:`catt_events_one` of lane k, as a tuple."""
-    o = HEADER
-    return (y[0] - PT[o + B_SQ, k], y[0] + PT[o + B_SQ, k], y[2] - PT[o + B_PQ, k],
-            y[2] + PT[o + B_PQ, k])
-
-
-@nb.njit(inline="always", **_JIT)
-def catt_observe_one_lane(t, y, PT, k, s, c, form):
-    """:func:`catt_observe_one` of lane k, as a tuple (the load terms unused: FORM_LOAD lanes
-    take the quiet form's factors)."""
-    if form == FORM_GENERAL:
-        return _observe_general(t, y, PT, k, s, c)
-    return _observe_quiet(t, y, PT, k, s, c)

@@ -13,10 +13,12 @@ sweep's fused loop).
   :func:`~geardyn.models.elements.harmonic_factors` writes out term by term (no loop, no libm
   call: every lane vectorises, one harmonic or many).
 * The load fluctuation at Lambda: its sines by :func:`~geardyn.models.catt_kernels.load_sin`
-  (arithmetic), each term selected where its amplitude (``f_c1``, ``f_p1``) is non-zero, so
-  that the lane loop has no branch; the amplitudes are the one form's ``quiet`` coefficients,
-  so a lane without the fluctuation (the paper's workload) runs a copy of the loop where they
-  are the constant 0 and the sines dead code.
+  (arithmetic), taken where either amplitude (``f_c1``, ``f_p1``) is non-zero, as the general
+  model takes them: under ``if loud(p):`` (:func:`geardyn.core.one_form.loud`), the amplitudes
+  being the one form's ``quiet`` coefficients. A lane without the fluctuation (the paper's
+  workload) runs a copy of the sweep's loop where the test is the constant False (the sines
+  dead code), a lane with it a copy where it is True (no test, no select: the loop vectorises
+  as the general model's arithmetic).
 """
 
 from __future__ import annotations
@@ -26,7 +28,7 @@ import functools
 import numba as nb
 
 from geardyn.core.kernel_source import KernelSource
-from geardyn.core.one_form import OneForm
+from geardyn.core.one_form import OneForm, loud
 from geardyn.models.catt_kernels import load_sin
 from geardyn.models.derived import CATT_BLOCK, CATT_HEADER, catt_harmonics
 from geardyn.models.elements import dead_zone, harmonic_factors
@@ -46,12 +48,12 @@ def catt_reduced_rhs(t, y, p, s, c):
     xs, vs, xp, vp = y
     ks, kp = harmonic_factors(p[HARMONICS:], 2, s, c)
     om2 = p.Omega * p.Omega
-    # the load fluctuation: each sine taken where its amplitude is non-zero (a select: the lane
-    # loop stays branch-free; where the amplitudes are the constant 0, the sines are dead code)
-    sin2 = load_sin(p.Lambda * t + p.psi2)
-    sin1 = load_sin(p.Lambda * t + p.psi1)
-    load_c = p.f_c0 + (p.f_c1 * sin2 if p.f_c1 != 0.0 else 0.0)
-    load_p = p.f_p0 + (p.f_p1 * sin1 if p.f_p1 != 0.0 else 0.0)
+    load_c = p.f_c0
+    sin_l1 = 0.0
+    if loud(p):  # the load fluctuates (f_c1 or f_p1 non-zero; a constant in the lane forms)
+        load_c += p.f_c1 * load_sin(p.Lambda * t + p.psi2)
+        sin_l1 = load_sin(p.Lambda * t + p.psi1)
+    load_p = p.f_p0 + p.f_p1 * sin_l1
     gs = ks * dead_zone(xs, p.b_sq)
     gp = kp * dead_zone(xp, p.b_pq)
     carrier = 0.0 + (p.k_sq_c * gs + p.c_sq_c * vs)  # as the general model sums its sets
