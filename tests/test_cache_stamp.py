@@ -4,6 +4,7 @@ to a helper they inline (the dead zone) or to a module whose constants they free
 
 from __future__ import annotations
 
+import os
 import textwrap
 from pathlib import Path
 
@@ -70,3 +71,50 @@ def test_stamp_follows_imported_modules(tmp_path, monkeypatch):
     helpers.write_text(helpers.read_text().replace("x - consts.B", "x + consts.B"))
     stamps.append(locator.get_source_stamp())
     assert len(set(stamps[2:])) == 3  # each code edit: a new stamp
+
+
+def test_each_files_facts_are_kept_in_the_cache_for_its_state(tmp_path, monkeypatch):
+    """A file's digest and imports are kept in the cache (``stamps/``) for its state (times,
+    size, inode), so that other processes read them instead of parsing the file: a memo is read
+    while the file is as it was, and ignored once it is edited or another file is put in its
+    place (even one of the same size with the same modified time); where the cache cannot be
+    written, the stamp is computed all the same."""
+    pkg = _package(tmp_path)
+    monkeypatch.setattr(gc, "PACKAGE_DIR", pkg)
+    kernels, consts = pkg / "models" / "kernels.py", pkg / "models" / "consts.py"
+
+    def stamp_with(cache: str) -> bytes:
+        """The stamp of kernels.py as a new process would take it, with the cache ``cache``."""
+        monkeypatch.setenv("GEARDYN_CACHE_DIR", str(tmp_path / cache))
+        gc._facts.cache_clear()
+        return source_stamp(kernels)
+
+    stamp = stamp_with("cache")
+    memos = sorted((tmp_path / "cache" / "stamps").iterdir())
+    assert {gc._memo_path(p) for p in dependency_files(kernels)} == set(memos)
+    assert stamp_with("cache") == stamp
+    # the memo is what another process reads: a forged digest in it changes the stamp
+    memo = gc._memo_path(consts)
+    data = memo.read_bytes()
+    head = gc._memo_key() + f"{consts}\0{gc._state(consts.stat())}\0".encode()
+    assert data.startswith(head)
+    memo.write_bytes(head + bytes(32) + data[len(head) + 32:])
+    assert stamp_with("cache") != stamp
+    # another file put in its place, of the same size, its modified time kept: parsed again
+    before = consts.stat()
+    other = tmp_path / "consts.py"
+    other.write_text("B = 3.0  # the backlash\n")
+    os.utime(other, ns=(before.st_atime_ns, before.st_mtime_ns))
+    other.replace(consts)
+    assert (consts.stat().st_mtime_ns, consts.stat().st_size) == (before.st_mtime_ns,
+                                                                  before.st_size)
+    replaced = stamp_with("cache")
+    assert replaced == stamp_with("fresh") != stamp
+    # an edit: parsed again
+    consts.write_text("B = 2.0\n")
+    edited = stamp_with("cache")
+    assert edited == stamp_with("fresh2") not in (stamp, replaced)
+    # no writable cache (its folder would be below a file): computed, nothing kept
+    (tmp_path / "file").write_text("")
+    assert stamp_with("file/cache") == edited
+    gc._facts.cache_clear()

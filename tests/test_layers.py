@@ -10,6 +10,7 @@ here, and the source the code generator splices from them is checked as well.
 from __future__ import annotations
 
 import ast
+import functools
 from pathlib import Path
 
 import pytest
@@ -124,7 +125,11 @@ def imports_of(module: str, source: str) -> set[str]:
     return found
 
 
-GRAPH = {m: imports_of(m, p.read_text(encoding="utf-8")) for m, p in ALL.items()}
+@functools.cache
+def import_graph() -> dict[str, set[str]]:
+    """Module -> the geardyn modules it imports (read when a test first needs it, not at
+    collection: each test worker collects this file, one runs its tests)."""
+    return {m: imports_of(m, p.read_text(encoding="utf-8")) for m, p in ALL.items()}
 
 
 def test_every_module_has_a_layer():
@@ -135,7 +140,7 @@ def test_every_module_has_a_layer():
 def test_no_module_imports_a_higher_layer():
     upward = [
         f"{m} ({layer_of(m)}) imports {t} ({layer_of(t)})"
-        for m, targets in GRAPH.items() for t in sorted(targets)
+        for m, targets in import_graph().items() for t in sorted(targets)
         if _RANK[layer_of(t)] > _RANK[layer_of(m)]
     ]
     assert not upward, "imports against the layer order:\n" + "\n".join(upward)
@@ -177,7 +182,7 @@ def _package(module: str) -> str:
 
 def test_packages_import_each_other_without_cycle():
     graph: dict[str, set[str]] = {}
-    for m, targets in GRAPH.items():
+    for m, targets in import_graph().items():
         graph.setdefault(_package(m), set()).update(
             _package(t) for t in targets if _package(t) != _package(m))
     assert _cycle(graph) is None, " -> ".join(_cycle(graph) or [])
@@ -185,7 +190,7 @@ def test_packages_import_each_other_without_cycle():
 
 def test_modules_import_each_other_without_cycle():
     # a package's __init__ re-exports its modules; an import of the package stands for them
-    assert _cycle(GRAPH) is None, " -> ".join(_cycle(GRAPH) or [])
+    assert _cycle(import_graph()) is None, " -> ".join(_cycle(import_graph()) or [])
 
 
 @pytest.mark.parametrize("template", ["rk4", "lyapunov"])

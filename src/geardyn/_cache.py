@@ -2,9 +2,9 @@
 API, the tests), set up at import.
 
 ``$GEARDYN_CACHE_DIR`` (default ``$XDG_CACHE_HOME/geardyn``, i.e. ``~/.cache/geardyn``) holds
-the generated kernel modules (``kernels/``) and numba's compiled code of geardyn's functions
-(``numba/``). Explicitly set variables win: ``NUMBA_CACHE_DIR`` keeps numba's code wherever it
-names.
+the generated kernel modules (``kernels/``), numba's compiled code of geardyn's functions
+(``numba/``) and the digests of geardyn's source files (``stamps/``, below). Explicitly set
+variables win: ``NUMBA_CACHE_DIR`` keeps numba's code wherever it names.
 
 geardyn changes no numba setting and no environment variable for this: it registers a cache
 locator (:class:`GeardynCacheLocator`, first in numba's list of locators) that answers only for
@@ -23,11 +23,15 @@ dead zone), and module constants frozen in at compile time (coefficient offsets 
 :mod:`geardyn.models.derived`). For geardyn's functions the stamp numba keeps with their code
 (:func:`source_stamp`) is therefore a hash of the file and of every geardyn module it imports,
 transitively: an edit to any of them recompiles the function rather than loading stale code.
+Each file's digest and imports are kept in ``stamps/`` for the file's state (times, size,
+inode; as Python keeps a module's bytecode for its source's), so that a process (each test
+worker, each ``geardyn`` command) reads them instead of parsing every module at import.
 """
 
 from __future__ import annotations
 
 import ast
+import contextlib
 import functools
 import hashlib
 import os
@@ -84,14 +88,13 @@ def _module_file(name: str) -> Path | None:
     return None
 
 
-@functools.cache
-def _imports(path: Path, mtime: float, size: int) -> frozenset[Path]:
-    """The files of the geardyn modules ``path`` imports at its top level (``mtime`` and
-    ``size`` key the memo: an edited file is parsed again)."""
+def _parse_imports(tree: ast.Module, path: Path) -> frozenset[Path]:
+    """The files of the geardyn modules that the module ``tree`` (the file ``path``) imports at
+    its top level."""
     package = "geardyn" + "".join("." + p for p in path.relative_to(PACKAGE_DIR).parent.parts) \
         if path.is_relative_to(PACKAGE_DIR) else ""
     found: set[Path] = set()
-    for node in ast.parse(path.read_bytes()).body:
+    for node in tree.body:
         names: list[str] = []
         if isinstance(node, ast.Import):
             names = [a.name for a in node.names]
@@ -107,11 +110,9 @@ def _imports(path: Path, mtime: float, size: int) -> frozenset[Path]:
     return frozenset(found)
 
 
-@functools.cache
-def _code_digest(path: Path, mtime: float, size: int) -> bytes:
-    """A hash of ``path``'s code: its syntax tree without docstrings and positions (comments,
-    docstrings and layout change nothing)."""
-    tree = ast.parse(path.read_bytes())
+def _parse_digest(tree: ast.Module) -> bytes:
+    """A hash of the module ``tree``'s code: its syntax tree without docstrings and positions
+    (comments, docstrings and layout change nothing)."""
     for node in ast.walk(tree):
         body = getattr(node, "body", None)
         if (isinstance(body, list) and body and isinstance(body[0], ast.Expr)
@@ -119,6 +120,55 @@ def _code_digest(path: Path, mtime: float, size: int) -> bytes:
                 and isinstance(body[0].value.value, str)):
             body[0] = ast.Pass()
     return hashlib.sha256(ast.dump(tree, include_attributes=False).encode()).digest()
+
+
+@functools.cache
+def _memo_key() -> bytes:
+    """What a memo of :func:`_facts` holds for besides its file's state: this module's code
+    (which defines the digest) and the package folder (which resolves the imports)."""
+    return hashlib.sha256(Path(__file__).read_bytes() + str(PACKAGE_DIR).encode()).digest()
+
+
+def _memo_path(path: Path) -> Path:
+    """The memo of ``path``'s :func:`_facts` in the cache (one file per source file)."""
+    return cache_root() / "stamps" / hashlib.sha256(str(path).encode()).hexdigest()[:32]
+
+
+def _state(st: os.stat_result) -> tuple[int, int, int, int]:
+    """A file's state for :func:`_facts`: modified and changed time (ns), size, inode (a write,
+    or a file put in its place, even with its modified time kept, is a new state)."""
+    return st.st_mtime_ns, st.st_ctime_ns, st.st_size, st.st_ino
+
+
+@functools.cache
+def _facts(path: Path, state: tuple[int, int, int, int]) -> tuple[bytes, frozenset[Path]]:
+    """``path``'s code digest (:func:`_parse_digest`) and the files of the geardyn modules it
+    imports at its top level, for the file's :func:`_state` ``state`` (an edited file is
+    parsed again). Parsing and hashing the modules of every cached function costs ~0.3 s CPU
+    per process (at ``import geardyn``), so the result is also kept in the cache
+    (:func:`_memo_path`) for that state of the file and the same :func:`_memo_key`, as Python
+    keeps a module's bytecode for the state of its source: other processes read it."""
+    head = _memo_key() + f"{path}\0{state}\0".encode()
+    memo = _memo_path(path)
+    try:
+        data = memo.read_bytes()
+    except OSError:
+        data = b""
+    if data.startswith(head) and len(data) >= len(head) + 32:
+        found = data[len(head) + 32:].decode()
+        return data[len(head):len(head) + 32], frozenset(map(Path, filter(None, found.split("\0"))))
+    tree = ast.parse(path.read_bytes())
+    imports = _parse_imports(tree, path)
+    digest = _parse_digest(tree)
+    tmp = memo.with_name(f"{memo.name}.{os.getpid()}.tmp")
+    try:  # an optimisation: where the cache cannot be written, each process parses
+        memo.parent.mkdir(parents=True, exist_ok=True)
+        tmp.write_bytes(head + digest + "\0".join(map(str, sorted(imports))).encode())
+        os.replace(tmp, memo)
+    except OSError:
+        with contextlib.suppress(OSError):
+            tmp.unlink()
+    return digest, imports
 
 
 def dependency_files(py_file: str | os.PathLike[str]) -> tuple[Path, ...]:
@@ -132,19 +182,19 @@ def dependency_files(py_file: str | os.PathLike[str]) -> tuple[Path, ...]:
             continue
         seen.add(path)
         st = os.stat(path)
-        todo.extend(_imports(path, st.st_mtime, st.st_size))
+        todo.extend(_facts(path, _state(st))[1])
     return tuple(sorted(seen))
 
 
 def source_stamp(py_file: str | os.PathLike[str]) -> bytes:
     """numba's stamp of a cached function of ``py_file``: the code of ``py_file`` and of its
-    :func:`dependency_files` (:func:`_code_digest`), so its cached code is loaded only while
+    :func:`dependency_files` (:func:`_facts`), so its cached code is loaded only while
     none of them changed but in comments and docstrings."""
     h = hashlib.sha256()
     for path in dependency_files(py_file):
         st = os.stat(path)
         h.update(str(path.relative_to(path.anchor)).encode())
-        h.update(_code_digest(path, st.st_mtime, st.st_size))
+        h.update(_facts(path, _state(st))[0])
     return h.digest()
 
 
