@@ -4,16 +4,18 @@ of it taken out: what each part costs, and what is vectorised.
 One block of 64 slots of the paper's device (xi = 0.05; 64 Omega of [0.1, 4], 19 step counts,
 each slot its own phase increments), every slot active and sampling, the loop called ``--steps``
 times by a driver compiled like the kernel's (``noalias`` arrays, no reference counting), one
-thread; the variants' calls alternate, median of ``--repeat``. Nothing out of line runs: a
+thread; the variants' calls alternate, median of ``--repeat`` (CPU time of this process, so
+that other processes on a shared machine count as little as possible). Nothing out of line runs: a
 flagged slot keeps its state (the loop's cost does not depend on the values), so the numbers
 are a floor for the loop, not a model of a sweep. A variant is the generated kernel's source
 with lines replaced (checked, so a template change that moves them fails loudly):
 
 ``base``: the loop as it is; ``nostats``: without the observables and statistics;
 ``noscreen``: without the side test and graze screen (nothing flagged); ``nobook``: without the
-health check and due test; ``contract``: compiled with ``fastmath={"contract"}`` (fused
-multiply-adds where LLVM sees them; results change at the rounding level, and across code
-paths differently, so not geardyn's setting); ``nochain``: the RK4 stages made independent of
+health check and due test; ``fission``: the statistics in a loop of their own after the
+step loop; ``phasefuse``: the phase rotations in the step loop (no loop of their own);
+``norotate``: the slots' phase rotations left out (wrong phases, the loads and stores kept);
+``nochain``: the RK4 stages made independent of
 each other (wrong results, the same operations: is the loop latency-bound?); ``+``-joined
 names combine them. ``--gear-pair``: bench/peers.py's gear pair instead of the paper's device.
 ``--form load``: the device with the load fluctuating (Fig. 13's B1 = B2 = 100 N m, Lambda =
@@ -25,8 +27,11 @@ memory operands (loads and stores), the calls and each opcode (``--asm-ops``), s
 versions of a model's code can be compared instruction by instruction where timings are noisy.
 
     .venv/bin/python bench/fused_loop.py [--variants base,nostats,noscreen] [--steps 20000]
-                                         [--repeat 9] [--asm [--asm-ops]]
+                                         [--repeat 9] [--asm [--asm-ops]] [--check]
                                          [--form quiet|load|general]
+
+``--check``: whether each variant leaves the block's arrays (state, phase, events, statistics)
+bitwise as the first variant does after ``--steps`` loop calls (an exact rewrite: True).
 
 The vector width is geardyn's (``GEARDYN_SIMD_WIDTH``, see ``geardyn._jit_target``), the
 driver's too (compiled with the kernels' pipeline).
@@ -60,9 +65,37 @@ EDITS = {
                   "        hit = False\n")],
     "nobook": [("        due = act & (((ph1 == 0) & (not _t_healthy(y1, bound))) | "
                 "(st1 >= DUE[k]))\n", "        due = False\n")],
-    "contract": [('_JIT = {"cache": _CACHE, "error_model": "numpy", "boundscheck": False}',
-                  '_JIT = {"cache": _CACHE, "error_model": "numpy", "boundscheck": False, '
-                  '"fastmath": {"contract"}}')],
+    # the statistics in a loop of their own after the step loop (the events from GS, the end
+    # state from Y1; the loop-fission layout; for a model with as many events as states)
+    "fission": [("        o = _observe_l(te, y1, PT, k, se, ce, form)\n"
+                 "        _t_stats(GMIN, GMAX, OMAX, OMIN, OSQ, k, g1, o, stat)\n",
+                 "        STAT[k] = stat\n"),
+                ("    return n_flag, n_out\n",
+                 "    for k in range(nl):\n"
+                 "        te = T0B[k] + STEP[k] * HB[k]\n"
+                 "        o = _observe_l(te, _t_load(Y1, k), PT, k, SE[k], CE[k], form)\n"
+                 "        _t_stats(GMIN, GMAX, OMAX, OMIN, OSQ, k, _t_load(GS, k), o, STAT[k])\n"
+                 "    return n_flag, n_out\n")],
+    # the slots' phase rotations left out (the phase at the step's start used throughout:
+    # wrong results, the loads and stores kept): what rotating a phase per slot costs
+    "norotate": [("        sb, cb = phase_rotate(s0, c0, AH[k], BH[k])\n"
+                  "        se, ce = phase_rotate(s0, c0, AD[k], BD[k])\n",
+                  "        sb, cb = s0, c0\n        se, ce = s0, c0\n")],
+    # the phase rotations in the step loop (no loop of their own, no rows SB, CB, SN, CN;
+    # exact: the same arithmetic)
+    "phasefuse": [("    for k in range(nl):\n        s0 = SE[k]\n        c0 = CE[k]\n"
+                   "        sb, cb = phase_rotate(s0, c0, AH[k], BH[k])\n"
+                   "        se, ce = phase_rotate(s0, c0, AD[k], BD[k])\n"
+                   "        end = PHASE[k] + 1 == NPER[k]  # the period's end, as in the table\n"
+                   "        SB[k] = sb\n        CB[k] = cb\n        SN[k] = 0.0 if end else se\n"
+                   "        CN[k] = 1.0 if end else ce\n", ""),
+                  ("        sb = SB[k]\n        cb = CB[k]\n        se = SN[k]\n"
+                   "        ce = CN[k]\n",
+                   "        s0 = SE[k]\n        c0 = CE[k]\n"
+                   "        sb, cb = phase_rotate(s0, c0, AH[k], BH[k])\n"
+                   "        se, ce = phase_rotate(s0, c0, AD[k], BD[k])\n"
+                   "        end = ph + 1 == NPER[k]\n"
+                   "        se = 0.0 if end else se\n        ce = 1.0 if end else ce\n")],
     "nochain": [("_t_axpy(y, hh, k1)", "_t_axpy(y, hh, y)"),
                 ("_t_axpy(y, hh, k2)", "_t_axpy(y, hh, y)"),
                 ("_t_axpy(y, h, k3)", "_t_axpy(y, h, y)")],
@@ -130,8 +163,7 @@ def driver(m, form_name="quiet"):
         return flagged
 
     return nb.njit(_nrt=False, pipeline_class=m._JIT_NOALIAS["pipeline_class"],
-                   boundscheck=False, error_model="numpy",
-                   fastmath=m._JIT.get("fastmath", False))(drive)
+                   boundscheck=False, error_model="numpy")(drive)
 
 
 def hot_loop(asm: list[str]) -> list[str]:
@@ -174,6 +206,8 @@ def main() -> None:
     ap.add_argument("--asm-ops", action="store_true", help="with --asm: the hot loop's opcodes")
     ap.add_argument("--form", choices=("quiet", "load", "general"), default="quiet",
                     help="the lane form (load, general: the paper's device with Fig. 13's load)")
+    ap.add_argument("--check", action="store_true",
+                    help="compare each variant's end state bitwise with the first variant's")
     ap.add_argument("--gear-pair", action="store_true", help="bench/peers.py's gear pair "
                     "(Omega in [0.2, 3]) instead of the paper's device")
     args = ap.parse_args()
@@ -203,9 +237,16 @@ def main() -> None:
             for name in names:
                 d, m = runs[name]
                 a = block_arrays(m, model, omegas)
-                t0 = time.perf_counter()
+                t0 = time.process_time()
                 d(args.steps, BLOCK, True, 1e6, *a)
-                times[name].append((time.perf_counter() - t0) * 1e9 / (args.steps * BLOCK))
+                times[name].append((time.process_time() - t0) * 1e9 / (args.steps * BLOCK))
+        ends = {}
+        if args.check:
+            for name in names:
+                d, m = runs[name]
+                a = block_arrays(m, model, omegas)
+                d(args.steps, BLOCK, True, 1e6, *a)
+                ends[name] = [np.array(x) for x in (a[0], a[3], a[4], *a[7], *a[8])]
     base = statistics.median(times[names[0]])
     for name in names:
         med = statistics.median(times[name])
@@ -221,6 +262,10 @@ def main() -> None:
                      f"{sum(s.startswith('call') for s in loop)}")
             if args.asm_ops:
                 line += "\n  " + ", ".join(f"{k} {v}" for k, v in sorted(opcodes(loop).items()))
+        if args.check:
+            same = all(np.array_equal(x, y, equal_nan=True)
+                       for x, y in zip(ends[name], ends[names[0]], strict=True))
+            line += f"; end state bitwise as {names[0]}'s: {same}"
         print(line)
 
 
