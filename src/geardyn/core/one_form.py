@@ -44,7 +44,8 @@ from typing import Any
 
 from geardyn.core.coefficients import Derivations
 
-__all__ = ["Derivations", "OneForm", "adapters", "call_tuple", "coefficient_type"]
+__all__ = ["Derivations", "OneForm", "adapters", "call_tuple", "coefficient_type",
+           "tangent_adapters"]
 
 _TYPE_PREFIX = "Coefficients_"
 
@@ -261,3 +262,48 @@ def _block_loop(call: str, y_blk: str, blk: str, n: int, coef: str) -> list[str]
     return ["for k in range(nl):",
             f"    v = {call}(T[k], {y_blk}, {coef}(PT, k), S[k], C[k])",
             *("    " + line for line in _stores(blk + "[{q}, k]", n))]
+
+
+def tangent_adapters(form: OneForm) -> str:
+    """Python source defining the tangent forms of the one form's ``rhs`` (for the variational
+    Lyapunov kernel; spliced after :func:`adapters`' text, whose names it uses): the array form
+    ``rhs_tangent(t, y, v, dy, dv, p, s, c)`` (dy = f(t, y), dv = J(t, y) v, J the Jacobian in
+    the state) and the lane-scalar form ``rhs_lane_tangent(t, y, v, PT, k, s, c, form)`` (the
+    tuples (f, J v)). Both call the one form's ``rhs`` with the state a tuple of duals
+    (:mod:`geardyn.core.dual`): the same physics, differentiated exactly; f bitwise that of
+    ``rhs``. Every compiled function's arguments and results are floats (the duals live
+    inside)."""
+    ns = form.n_states
+    quiet = bool(form.quiet)
+    duals = "(" + "".join(f"_dual(y[{q}], v[{q}]), " for q in range(ns)) + ")"
+    out = ("\n# The tangent forms of the one form's rhs (geardyn.core.one_form.tangent_adapters).\n"
+           "from geardyn.core.dual import dual as _dual\n"
+           "from geardyn.core.dual import tangent_of as _tangent_of\n"
+           "from geardyn.core.dual import value_of as _value_of\n")
+    out += _fn("_tangent_parts(d)", [
+        "return (" + _tuple_text("_value_of(d[{q}])", ns) + ", "
+        + _tuple_text("_tangent_of(d[{q}])", ns) + ")"], inline=True)
+    body = [f"d = _one_rhs(t, {duals}, _coef(p), s, c)"]
+    if quiet:  # a scalar path: the quiet lane's term skipped (as ``rhs``)
+        body = [f"if {_quiet_test(form, 'p[{q}]')}:",
+                f"    d = _one_rhs(t, {duals}, _coef_quiet_arr(p), s, c)",
+                "else:", f"    d = _one_rhs(t, {duals}, _coef(p), s, c)"]
+    body += ["f, w = _tangent_parts(d)", *(f"dy[{q}] = f[{q}]" for q in range(ns)),
+             *(f"dv[{q}] = w[{q}]" for q in range(ns))]
+    out += _fn("rhs_tangent(t, y, v, dy, dv, p, s, c)", body)
+    if quiet:
+        for kind, coef in (("quiet", "_coef_quiet"), ("all", "_coef_lane")):
+            out += (f"\n\n@nb.njit(forceinline=True, **_JIT)\ndef _rhs_tangent_lane_{kind}"
+                    f"(t, y, v, PT, k, s, c):\n    return _tangent_parts(_one_rhs(t, {duals}, "
+                    f"{coef}(PT, k), s, c))\n")
+        lane_body = ["if form == _ONE_FORM:",
+                     "    return _rhs_tangent_lane_quiet(t, y, v, PT, k, s, c)",
+                     "if form == _ONE_LOUD:",
+                     "    return _rhs_tangent_lane_all(t, y, v, PT, k, s, c)",
+                     f"if {_quiet_test(form, 'PT[{q}, k]')}:",
+                     "    return _rhs_tangent_lane_quiet(t, y, v, PT, k, s, c)",
+                     "return _rhs_tangent_lane_all(t, y, v, PT, k, s, c)"]
+    else:
+        lane_body = [f"return _tangent_parts(_one_rhs(t, {duals}, _coef_lane(PT, k), s, c))"]
+    out += _fn("rhs_lane_tangent(t, y, v, PT, k, s, c, form)", lane_body, inline=True)
+    return out
