@@ -290,7 +290,10 @@ def tangent_adapters(form: OneForm) -> str:
                 "else:", f"    d = _one_rhs(t, {duals}, _coef(p), s, c)"]
     body += ["f, w = _tangent_parts(d)", *(f"dy[{q}] = f[{q}]" for q in range(ns)),
              *(f"dv[{q}] = w[{q}]" for q in range(ns))]
-    out += _fn("rhs_tangent(t, y, v, dy, dv, p, s, c)", body)
+    # compiled once and inlined by LLVM where it is called (as the array form ``rhs`` is in
+    # the kernels' step core: ``_rhs_i``)
+    out += _fn("rhs_tangent(t, y, v, dy, dv, p, s, c)", body).replace(
+        "@nb.njit(**_JIT)", "@nb.njit(forceinline=True, _nrt=False, **_JIT)")
     if quiet:
         for kind, coef in (("quiet", "_coef_quiet"), ("all", "_coef_lane")):
             out += (f"\n\n@nb.njit(forceinline=True, **_JIT)\ndef _rhs_tangent_lane_{kind}"
