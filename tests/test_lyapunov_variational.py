@@ -106,7 +106,7 @@ def test_gear_pair_exponent_against_dop853_variational_equations(case):
         assert abs(lam_v - lam_f) < 0.1 * tol
 
 
-def _lanes(model, oms, n_per, n_tr, n_st, variational, rows=False):
+def _lanes(model, oms, n_per, n_tr, n_st, variational, rows=False, n_ev=None):
     kern = kernels_for(model.kernel, "lyapunov")
     L = oms.size
     P = np.ascontiguousarray(model.lane_params("Omega", oms))
@@ -117,7 +117,7 @@ def _lanes(model, oms, n_per, n_tr, n_st, variational, rows=False):
     fn = kern.lyapunov_lanes_rows if rows else kern.lyapunov_lanes
     fn(P, Y0, np.ones(model.n_states), np.zeros(L), H, oms, np.full(L, n_per, np.int64),
        np.full(L, n_tr, np.int64), np.asarray(n_st, np.int64), 10, 1e6, out, err,
-       model.n_events, 16, un, st, variational, fd)
+       model.n_events if n_ev is None else n_ev, 16, un, st, variational, fd)
     return P, Y0, H, out, err, un, st, fd
 
 
@@ -140,6 +140,14 @@ def test_variational_lanes_are_bitwise_the_one_lane_kernel():
         assert got == (ex[0], er[0], unres, status, n_fd), lane
         assert tuple(a[lane] for a in rows[3:]) == got, lane
     assert np.all(fd > 0) and np.all(np.isfinite(out))
+    # without edge location (n_ev = 0: no screen, no split) too
+    P, Y0, H, out0, err0, un0, st0, fd0 = _lanes(model, oms, n_per, n_tr, n_st, True, n_ev=0)
+    for lane in range(oms.size):
+        ex, er, _, status, unres, n_fd = kern.lyapunov_single(
+            P[lane].copy(), Y0[lane].copy(), np.ones(2), 0.0, H[lane], oms[lane], n_per, n_tr,
+            int(n_st[lane]), 10, 1, 1e6, 0, 16, True)
+        assert (out0[lane], err0[lane], un0[lane], st0[lane], fd0[lane]) == (
+            ex[0], er[0], unres, status, n_fd) == (ex[0], er[0], 0, 0, 0), lane
     # the difference rows through the same blocks: another method, close
     diff = _lanes(model, oms, n_per, n_tr, n_st, False)
     np.testing.assert_allclose(out, diff[3], rtol=0, atol=1e-7)

@@ -1171,8 +1171,9 @@ if VARIATIONAL:
                          FLAG, GR):
         """Grid step i of every lane of the block (see above): Z0, Z1 the state and the
         tangent vector (flat rows of BLOCK lanes), committed where the lane is active and its
-        state's trial unflagged (``locate``: the edges screened); FLAG[l] = 1 where an active
-        lane is flagged. Returns the number of flagged lanes."""
+        state's trial unflagged (``locate``: the edges screened; GR: the graze flags, a row of
+        BLOCK per switching function of the model); FLAG[l] = 1 where an active lane is flagged.
+        Returns the number of flagged lanes."""
         P0, P1, P2, P3, P4, P5 = PH
         n_flag = 0
         for l in range(nl):
@@ -1187,7 +1188,7 @@ if VARIATIONAL:
             ph = (P0[l], P1[l], P2[l], P3[l], P4[l], P5[l])
             y1, w1, g0, g1, ge = _var_row_trial(form, y, _t_scale(v, S), PT, l, ts, tm, te, hh,
                                                 h, H6L[l], hd, ph)
-            hit = _t_screen_rows(g0, g1, ge, GR, l) & locate
+            hit = _t_screen_rows(g0, g1, ge, GR, l) & locate  # (no branch in the lane loop)
             act = ACT[l]
             flagged = act & hit
             keep = act & (not hit)
@@ -1311,7 +1312,6 @@ def _lyap_block_var(form, first, nl, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB,
     ACTR = np.zeros(3 * nl, np.bool_)  # (written by _lane_books; unused here)
     FLAG = np.zeros(BLOCK)
     ne = max(n_ev, 1)
-    GR = np.zeros(ne * BLOCK)
     UNRR = np.zeros(BLOCK, np.int64)
     FDL = np.zeros(BLOCK, np.int64)
     IST, ENDS, BLK, ACC, Zl, Cl, logs, max_total = _lanes_init(first, nl, 1, Y0, NPER,
@@ -1320,6 +1320,9 @@ def _lyap_block_var(form, first, nl, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB,
                                                                 err, used, status, ZT, ACT)
     for l in range(nl):
         _set_column(l, first + l, P, T0, H, NPER, OFF, PT, T0L, HL, HHL, H6L, NPL, IDX, ENDL)
+    # the graze flags of every switching function of the model (screened even where n_ev = 0,
+    # then ignored: no branch in the lane loop)
+    GR = np.zeros(max(len(_events_l(0.0, _t_load(Z0, 0), PT, 0, 0.0, 1.0)), 1) * BLOCK)
     renorm = max(renorm_every, 1)
     due = max_total
     for l in range(nl):
