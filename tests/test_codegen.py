@@ -23,7 +23,8 @@ from geardyn.solvers.reference import reference_solution
 #: code that does not evaluate the model, compiled once for every model).
 _ALLOWED = {"__future__", "math", "numba", "numpy", "llvmlite", "geardyn._jit_target",
             "geardyn.core._noop",
-            "geardyn.core.kernel_source", "geardyn.core.one_form", "geardyn.solvers._parallel",
+            "geardyn.core.kernel_source", "geardyn.core.one_form", "geardyn.core.dual",
+            "geardyn.solvers._parallel",
             *SHARED_MODULES}
 #: Packages whose submodules a generated kernel may import too (numba.extending, numba.core:
 #: the sweep template's prefetch intrinsic).
