@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import math
 
+import numba as nb
 import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
@@ -183,3 +184,17 @@ def test_tangent_setting_is_checked():
     with pytest.raises(geardyn.errors.ParameterError, match="settings.tangent"):
         geardyn.lyapunov_lanes(dev, dev.lane_params("Omega", [1.0]),
                                settings=geardyn.LyapunovSettings(tangent="variational"))
+
+
+@nb.njit(cache=True)
+def atan_rhs(t, y, p, s, c):
+    """A one-form rhs with an operation the dual numbers lack (atan2)."""
+    return (y[1], -p.k * math.atan2(y[0], 1.0) - 0.1 * y[1] + p.F * c)
+
+
+def test_a_rhs_the_duals_cannot_take_is_named():
+    m = geardyn.UserModel.from_one_form(atan_rhs, params={"k": 1.0, "F": 0.2, "Omega": 1.1},
+                                        states=("x", "v"), initial_state=(0.1, 0.0))
+    with pytest.raises(geardyn.errors.ParameterError, match="settings.tangent") as info:
+        geardyn.lyapunov(m, settings=geardyn.LyapunovSettings(duration=20.0))
+    assert "atan2" in str(info.value.__cause__)

@@ -13,9 +13,12 @@ from __future__ import annotations
 import dataclasses
 import math
 import warnings
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import Any
 
+import numba.core.errors
 import numpy as np
 
 from geardyn.core.model import Model
@@ -125,6 +128,22 @@ def lyapunov_variational(model: Model, settings: LyapunovSettings | None = None)
                              f"{type(model).__name__} is not written in the one form (no rhs "
                              "to differentiate); give 'difference' or 'auto'")
     return has and tangent != "difference"
+
+
+@contextmanager
+def _dual_typing(variational: bool, ls: LyapunovSettings) -> Iterator[None]:
+    """A ParameterError naming ``settings.tangent`` where the variational kernel does not
+    compile because the model's one-form rhs does not take dual numbers (an operation that
+    :mod:`geardyn.core.dual` lacks); numba's error chained."""
+    try:
+        yield
+    except numba.core.errors.TypingError as exc:
+        if not variational:
+            raise
+        raise ParameterError("settings.tangent", ls.tangent,
+                             "the model's one-form rhs does not take dual numbers (an operation "
+                             "geardyn.core.dual lacks: see the chained error); give "
+                             "'difference'") from exc
 
 
 def lyapunov_tangent(variational: bool) -> str:
@@ -323,10 +342,10 @@ def lyapunov(
     kern = kernels_for(model.kernel, "lyapunov")
     p = np.ascontiguousarray(model.params, dtype=float)
     n_ev = model.n_events if run.locate_edges else 0
-    ex, er, used, code, unres, n_fd = kern.lyapunov_single(p, y, _state_scale(model), t0, h, om,
-                                                           n_per, n_tr, n_st, renorm, k,
-                                                           float(bound), n_ev, n_blk,
-                                                           variational)
+    with _dual_typing(variational, ls):
+        ex, er, used, code, unres, n_fd = kern.lyapunov_single(
+            p, y, _state_scale(model), t0, h, om, n_per, n_tr, n_st, renorm, k, float(bound),
+            n_ev, n_blk, variational)
     status = Status(int(code))
     ex = np.asarray(ex, dtype=float)
     er = np.asarray(er, dtype=float)
@@ -435,8 +454,9 @@ def lyapunov_lanes(
         kern = kernels_for(model.kernel, "lyapunov")
         # lanes of every grid together (the kernel blocks them, whatever their steps)
         n_ev = model.n_events if run.locate_edges else 0
-        kern.lyapunov_lanes(P, Y0, scale, T0, H, OMEGA, n_per, n_tr, n_st, renorm, float(bound),
-                            out, err, n_ev, n_blk, unres, status, variational)
+        with _dual_typing(variational, ls):
+            kern.lyapunov_lanes(P, Y0, scale, T0, H, OMEGA, n_per, n_tr, n_st, renorm,
+                                float(bound), out, err, n_ev, n_blk, unres, status, variational)
     if with_status:
         return out, err, unres, status
     return (out, err) if with_error else out
