@@ -330,3 +330,19 @@ def _d_tanh(x, v):
 for _f, _d in ((math.sqrt, _d_sqrt), (math.sin, _d_sin), (math.cos, _d_cos),
                (math.exp, _d_exp), (math.log, _d_log), (math.tanh, _d_tanh)):
     overload(_f, **_INLINE)(_unary(_f, _d))
+
+
+def _install() -> None:
+    """Install the overloads above in numba's CPU typing and target contexts now. numba installs
+    pending registrations at its next refresh, which may fall inside another function's compile
+    (a callee's): a builtin such as ``math.sin`` then gets a new function type halfway through
+    that function's typing, and unification fails. Under numba's compiler lock."""
+    from numba.core.compiler_lock import global_compiler_lock
+    from numba.core.registry import cpu_target
+
+    with global_compiler_lock:
+        cpu_target.typing_context.refresh()
+        cpu_target.target_context.refresh()
+
+
+_install()

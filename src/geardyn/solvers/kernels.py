@@ -36,6 +36,7 @@ import numba
 import numba.core.bytecode
 from numba.core.compiler_lock import global_compiler_lock
 
+import geardyn.core.dual  # noqa: F401 - its overloads installed before any kernel compiles
 from geardyn._cache import cache_root
 from geardyn.core.kernel_source import KernelSource
 from geardyn.core.one_form import adapters as one_form_adapters
