@@ -11,8 +11,10 @@ rows) and ``difference`` (per lane the state and two perturbed rows, central dif
 step map), alternately, in this process. Reports per method: warm wall time and CPU time
 (medians of ``--repeat``), ns per lane-step per thread (one lane-step: one grid step of one lane
 with its tangent vector; wall time x threads / lane-steps, and CPU time / lane-steps), the ratio
-of the two, the largest difference of the exponents (relative to their error) and whether the
-variational blocks are bitwise the one-lane-at-a-time rows (``lyapunov_lanes_rows``).
+of the two, the largest difference of the exponents (relative to their error), the CPU time of
+each without edge location (``n_ev = 0``: the stepping alone; the difference rows then run the
+row blocks) and whether the variational blocks are bitwise the one-lane-at-a-time rows
+(``lyapunov_lanes_rows``).
 
     .venv/bin/python bench/lyapunov.py [--repeat 3] [--lanes 42] [--threads N]
 """
@@ -43,6 +45,28 @@ def count_lane_steps(model, P, transient: float, duration: float) -> int:
     periods = forcing_period(P[:, model.omega_index])
     return int(sum((periods_covering(transient, T) + max(1, periods_covering(duration, T))) * k
                    for T, k in zip(periods, n, strict=True)))
+
+
+def kernel_args(model, P, transient: float, duration: float):
+    """The kernel's lane arrays, as ``lyapunov_lanes`` builds them."""
+    n = lane_steps(model, P, None).astype(np.int64)
+    om = np.ascontiguousarray(P[:, model.omega_index])
+    periods = forcing_period(om)
+    n_tr = np.array([periods_covering(transient, T) * k for T, k in zip(periods, n, strict=True)],
+                    dtype=np.int64)
+    n_st = np.array([max(1, periods_covering(duration, T)) * k
+                     for T, k in zip(periods, n, strict=True)], dtype=np.int64)
+    Y0 = np.ascontiguousarray(np.tile(model.initial_state(), (P.shape[0], 1)))
+    return P, Y0, np.ones(model.n_states), np.zeros(P.shape[0]), periods / n, om, n, n_tr, n_st
+
+
+def run_kernel(fn, args, variational: bool) -> float:
+    """CPU time of one call of the kernel's ``lyapunov_lanes`` without edge location."""
+    L = args[0].shape[0]
+    out, err = np.full(L, np.nan), np.full(L, np.nan)
+    t_cpu = time.process_time()
+    fn(*args, 10, 1e6, out, err, 0, 16, None, None, variational)
+    return time.process_time() - t_cpu
 
 
 def run(model, P, transient, duration, tangent):
@@ -101,6 +125,18 @@ def main() -> None:
           f"{gap.max() if gap.size else np.nan:.3g} ({rel.max() if rel.size else np.nan:.3g} "
           f"standard errors)")
     kern = kernels_for(model.kernel, "lyapunov")
+    # the same lanes without edge location (n_ev = 0): the cost of stepping alone (the
+    # difference rows then run the row blocks, not the fused loop, which needs the events)
+    args = kernel_args(model, P, a.transient, a.duration)
+    plain = {name: [] for name in methods}
+    for rep in range(a.repeat + 1):
+        for name in methods:
+            cpu = run_kernel(kern.lyapunov_lanes, args, name == "variational")
+            if rep:
+                plain[name].append(cpu)
+    for name, tt in plain.items():
+        print(f"  {name:12s} no edge location: {statistics.median(tt) / steps * 1e9:7.1f} "
+              f"ns/lane-step (cpu)")
     blocks = kern.lyapunov_lanes
     kern.lyapunov_lanes = kern.lyapunov_lanes_rows
     try:
