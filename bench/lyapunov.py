@@ -1,15 +1,20 @@
-"""Lyapunov kernel benchmark: lanes in SoA blocks against one lane at a time, in one run (issue 11).
+"""Lyapunov kernel benchmark: the variational tangent against the difference rows, in one run.
 
-Workload: the paper's device (Tables 1-2, consistent interpretation, reduced model, xi1 = xi2 =
-0.05), ``--lanes`` values of Omega in [``--lo``, ``--hi``], the largest exponent (k = 1, as
-``bifurcation(..., lyapunov=True)`` computes it: one state row and two perturbed rows per lane)
-over ``--transient`` + ``--duration`` time units at the default steps per period, with edge
-location. Both kernels run the same lanes through ``geardyn.lyapunov_lanes`` (the generated
-module's ``lyapunov_lanes`` swapped for the one-lane-at-a-time ``lyapunov_lanes_rows``, the
-kernel of main before the lane blocks), alternately, in this process. Reports per kernel: warm
-wall time (median of ``--repeat``), CPU time, and ns per lane-step per thread (one lane-step:
-one grid step of one lane with its 2k tangent rows; wall time x threads / lane-steps, and CPU
-time / lane-steps), and whether the exponents and errors are bitwise equal.
+Workload: the paper's device (Tables 1-2, consistent interpretation, reduced model (written in the
+one form), xi1 = xi2 = 0.05), ``--lanes`` values of Omega in
+[``--lo``, ``--hi``], the largest exponent (k = 1, as ``bifurcation(..., lyapunov=True)``
+computes it) over ``--transient`` + ``--duration`` time units at the default steps per period,
+with edge location, through ``geardyn.lyapunov_lanes`` (the lane blocks) with
+``LyapunovSettings(tangent=...)``: ``variational`` (the state and its tangent vector stepped
+together, J v from dual numbers through the one form; a step split at an edge by the difference
+rows) and ``difference`` (per lane the state and two perturbed rows, central differences of the
+step map), alternately, in this process. Reports per method: warm wall time and CPU time
+(medians of ``--repeat``), ns per lane-step per thread (one lane-step: one grid step of one lane
+with its tangent vector; wall time x threads / lane-steps, and CPU time / lane-steps), the ratio
+of the two, the largest difference of the exponents (relative to their error), the CPU time of
+each without edge location (``n_ev = 0``: the stepping alone; the difference rows then run the
+row blocks) and whether the variational blocks are bitwise the one-lane-at-a-time rows
+(``lyapunov_lanes_rows``).
 
     .venv/bin/python bench/lyapunov.py [--repeat 3] [--lanes 42] [--threads N]
 """
@@ -55,17 +60,20 @@ def kernel_args(model, P, transient: float, duration: float):
     return P, Y0, np.ones(model.n_states), np.zeros(P.shape[0]), periods / n, om, n, n_tr, n_st
 
 
-def run_kernel(fn, args, n_ev):
-    out, err = np.full(args[0].shape[0], np.nan), np.full(args[0].shape[0], np.nan)
-    t_wall, t_cpu = time.perf_counter(), time.process_time()
-    fn(*args, 10, 1e6, out, err, n_ev, 16)
-    return time.perf_counter() - t_wall, time.process_time() - t_cpu
+def run_kernel(fn, args, variational: bool) -> float:
+    """CPU time of one call of the kernel's ``lyapunov_lanes`` without edge location."""
+    L = args[0].shape[0]
+    out, err = np.full(L, np.nan), np.full(L, np.nan)
+    t_cpu = time.process_time()
+    fn(*args, 10, 1e6, out, err, 0, 16, None, None, variational)
+    return time.process_time() - t_cpu
 
 
-def run(model, P, transient, duration):
+def run(model, P, transient, duration, tangent):
     t_wall, t_cpu = time.perf_counter(), time.process_time()
     lam, err = lyapunov_lanes(model, P, run=geardyn.RunSettings(transient=transient),
-                              settings=geardyn.LyapunovSettings(duration=duration),
+                              settings=geardyn.LyapunovSettings(duration=duration,
+                                                                tangent=tangent),
                               with_error=True)
     return time.perf_counter() - t_wall, time.process_time() - t_cpu, lam, err
 
@@ -86,56 +94,65 @@ def main() -> None:
     model = device()
     P = np.ascontiguousarray(model.lane_params("Omega", np.linspace(a.lo, a.hi, a.lanes)))
     steps = count_lane_steps(model, P, a.transient, a.duration)
-    kern = kernels_for(model.kernel, "lyapunov")
-    kernels = {"blocks": kern.lyapunov_lanes, "rows (main)": kern.lyapunov_lanes_rows}
-    times = {name: [] for name in kernels}
+    methods = ("variational", "difference")
+    times = {name: [] for name in methods}
     exponents = {}
     for rep in range(a.repeat + 1):  # the first round compiles / warms up
-        for name, fn in kernels.items():
-            kern.lyapunov_lanes = fn
-            try:
-                wall, cpu, lam, err = run(model, P, a.transient, a.duration)
-            finally:
-                kern.lyapunov_lanes = kernels["blocks"]
+        for name in methods:
+            wall, cpu, lam, err = run(model, P, a.transient, a.duration, name)
             exponents[name] = (lam, err)
             if rep:
                 times[name].append((wall, cpu))
-    print(f"paper device, reduced, {a.lanes} lanes Omega in [{a.lo}, {a.hi}], transient "
-          f"{a.transient}, duration {a.duration}: {steps} lane-steps (k = 1: 3 rows each), "
+    print(f"paper device, reduced, one form, {a.lanes} lanes Omega in [{a.lo}, {a.hi}], "
+          f"transient {a.transient}, duration {a.duration}: {steps} lane-steps (k = 1), "
           f"{a.threads} thread(s), median of {a.repeat}")
+    per = {}
     for name, tt in times.items():
         wall = statistics.median(t[0] for t in tt)
         cpu = statistics.median(t[1] for t in tt)
+        per[name] = (wall * a.threads / steps * 1e9, cpu / steps * 1e9)
         print(f"  {name:12s} wall {wall:8.4f} s  cpu {cpu:8.4f} s  "
-              f"{wall * a.threads / steps * 1e9:7.1f} ns/lane-step/thread (wall)  "
-              f"{cpu / steps * 1e9:7.1f} ns/lane-step (cpu)")
-    # the same lanes without edge location (n_ev = 0): the cost of stepping alone
+              f"{per[name][0]:7.1f} ns/lane-step/thread (wall)  "
+              f"{per[name][1]:7.1f} ns/lane-step (cpu)")
+    ratio_wall = per["difference"][0] / per["variational"][0]
+    ratio_cpu = per["difference"][1] / per["variational"][1]
+    print(f"  difference / variational: {ratio_wall:.2f}x (wall), {ratio_cpu:.2f}x (cpu)")
+    (lv, ev), (lf, ef) = exponents["variational"], exponents["difference"]
+    ok = np.isfinite(lv) & np.isfinite(lf)
+    gap = np.abs(lv - lf)[ok]
+    rel = (gap / np.maximum(np.maximum(ev, ef)[ok], 1e-300)) if ok.any() else gap
+    print(f"  exponents: finite {ok.sum()}/{lv.size}; max |variational - difference| "
+          f"{gap.max() if gap.size else np.nan:.3g} ({rel.max() if rel.size else np.nan:.3g} "
+          f"standard errors)")
+    kern = kernels_for(model.kernel, "lyapunov")
+    # the same lanes without edge location (n_ev = 0): the cost of stepping alone (the
+    # difference rows then run the row blocks, not the fused loop, which needs the events)
     args = kernel_args(model, P, a.transient, a.duration)
-    plain = {name: [] for name in kernels}
+    plain = {name: [] for name in methods}
     for rep in range(a.repeat + 1):
-        for name, fn in kernels.items():
-            wall, cpu = run_kernel(fn, args, 0)
+        for name in methods:
+            cpu = run_kernel(kern.lyapunov_lanes, args, name == "variational")
             if rep:
-                plain[name].append((wall, cpu))
+                plain[name].append(cpu)
     for name, tt in plain.items():
-        wall = statistics.median(t[0] for t in tt)
-        cpu = statistics.median(t[1] for t in tt)
-        print(f"  {name:12s} no edge location: wall {wall:8.4f} s  "
-              f"{wall * a.threads / steps * 1e9:7.1f} ns/lane-step/thread (wall)  "
-              f"{cpu / steps * 1e9:7.1f} ns/lane-step (cpu)")
-    (la, ea), (lb, eb) = exponents["blocks"], exponents["rows (main)"]
-    same = np.array_equal(la, lb, equal_nan=True) and np.array_equal(ea, eb, equal_nan=True)
-    print(f"  exponents and errors bitwise equal: {same}; finite {np.isfinite(la).sum()}/{la.size}")
+        print(f"  {name:12s} no edge location: {statistics.median(tt) / steps * 1e9:7.1f} "
+              f"ns/lane-step (cpu)")
+    blocks = kern.lyapunov_lanes
+    kern.lyapunov_lanes = kern.lyapunov_lanes_rows
+    try:
+        _, _, lr, er = run(model, P, a.transient, a.duration, "variational")
+    finally:
+        kern.lyapunov_lanes = blocks
+    same = np.array_equal(lv, lr, equal_nan=True) and np.array_equal(ev, er, equal_nan=True)
+    print(f"  variational blocks and rows bitwise equal: {same}")
     if a.write:
-        tt = times["blocks"]
-        wall = statistics.median(t[0] for t in tt)
-        cpu = statistics.median(t[1] for t in tt)
-        per = wall * a.threads / steps * 1e9
+        wall_ns, cpu_ns = per["variational"]
         results.record(
             "lyapunov", "Lyapunov kernel <= 30 ns per lane-step",
-            f"{per:.1f} ns wall per lane-step per thread, {cpu / steps * 1e9:.1f} ns CPU "
-            f"(median of {a.repeat}, {a.threads} threads); block and row kernels bitwise equal: "
-            f"{same}", results.against(per, 30.0),
+            f"{wall_ns:.1f} ns wall per lane-step per thread, {cpu_ns:.1f} ns CPU, variational "
+            f"tangent, one-form reduced device (median of {a.repeat}, {a.threads} threads; "
+            f"difference rows {ratio_cpu:.2f}x the CPU); blocks and rows bitwise equal: {same}",
+            results.against(wall_ns, 30.0),
             f".venv/bin/python bench/lyapunov.py --repeat {a.repeat} --write")
 
 

@@ -14,6 +14,7 @@ import numpy as np
 import pytest
 
 from conformance_cases import IDS, cases
+from geardyn.analysis.lyapunov import lyapunov_variational
 from geardyn.core.plan import default_steps_per_period
 from geardyn.core.settings import DEFAULT_BOUND
 from geardyn.solvers.kernels import SHARED_MODULES, TEMPLATES, cache_dir, kernels_for
@@ -23,7 +24,8 @@ from geardyn.solvers.reference import reference_solution
 #: code that does not evaluate the model, compiled once for every model).
 _ALLOWED = {"__future__", "math", "numba", "numpy", "llvmlite", "geardyn._jit_target",
             "geardyn.core._noop",
-            "geardyn.core.kernel_source", "geardyn.core.one_form", "geardyn.solvers._parallel",
+            "geardyn.core.kernel_source", "geardyn.core.one_form", "geardyn.core.dual",
+            "geardyn.solvers._parallel",
             *SHARED_MODULES}
 #: Packages whose submodules a generated kernel may import too (numba.extending, numba.core:
 #: the sweep template's prefetch intrinsic).
@@ -136,8 +138,9 @@ def test_generated_lyapunov_exponents_sum_to_the_divergence(all_cases, case):
     scale = np.ascontiguousarray(model.state_scale, dtype=float)
     # every argument given, with the types geardyn.lyapunov passes: the kernel it compiled (and
     # tests/warm_kernels.py warmed) is loaded, not another overload compiled
-    exps, _, _, status, _ = k.lyapunov_single(p, y0, scale, 0.0, h, model.omega, n, 0, steps, 8,
-                                           model.n_states, DEFAULT_BOUND, model.n_events, 16)
+    exps, _, _, status, _, _ = k.lyapunov_single(p, y0, scale, 0.0, h, model.omega, n, 0,
+                                              steps, 8, model.n_states, DEFAULT_BOUND,
+                                              model.n_events, 16, lyapunov_variational(model))
     assert status == 0
     tr = _trace(model, y0)
     assert abs(np.sum(exps) - tr) <= 1e-6 * abs(tr), (np.sum(exps), tr)

@@ -16,7 +16,12 @@ from geardyn.analysis.dataset import sweep_dataset
 from geardyn.analysis.lanes import (
     has_mesh_forces,
 )
-from geardyn.analysis.lyapunov import lyapunov_err_attrs, lyapunov_unresolved_attrs
+from geardyn.analysis.lyapunov import (
+    lyapunov_err_attrs,
+    lyapunov_tangent,
+    lyapunov_unresolved_attrs,
+    lyapunov_variational,
+)
 from geardyn.analysis.motion import averaging_time, motion_variable
 from geardyn.core.model import Model
 from geardyn.core.plan import forcing_period
@@ -184,7 +189,8 @@ def bifurcation(
                   f"{LYAPUNOV_ALIGN:g} time units to align, then as long as the sampling")
         ds["lyapunov"] = (param, np.where(ok, exps, np.nan), {
             "long_name": "largest Lyapunov exponent", "units": f"1/{model.time_unit}",
-            "method": method})
+            "method": method,
+            "tangent": lyapunov_tangent(lyapunov_variational(model, LyapunovSettings()))})
         ds["lyapunov_err"] = (param, np.where(ok & np.isfinite(exps), errs, np.nan),
                               lyapunov_err_attrs(model.time_unit))
         ds["lyapunov_unresolved"] = (param, unres, lyapunov_unresolved_attrs())

@@ -13,9 +13,12 @@ from __future__ import annotations
 import dataclasses
 import math
 import warnings
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import Any
 
+import numba.core.errors
 import numpy as np
 
 from geardyn.core.model import Model
@@ -35,6 +38,7 @@ from geardyn.core.settings import (
     warn_deprecated,
 )
 from geardyn.core.status import Status
+from geardyn.errors import ParameterError
 from geardyn.solvers.kernels import kernels_for
 
 #: The defaults' earlier names here (deprecated): those of :mod:`geardyn.core.settings`.
@@ -49,7 +53,8 @@ LYAPUNOV_DEFAULTS = {"transient": 100.0}
 LYAPUNOV_FIELDS = ("transient", "steps_per_period", "locate_edges", "bound")
 
 __all__ = ["LYAPUNOV_DEFAULTS", "LyapunovEstimate", "lyapunov", "lyapunov_err_attrs",
-           "lyapunov_lanes", "lyapunov_unresolved_attrs"]
+           "lyapunov_lanes", "lyapunov_tangent", "lyapunov_unresolved_attrs",
+           "lyapunov_variational"]
 
 
 @dataclass(frozen=True)
@@ -68,7 +73,10 @@ class LyapunovEstimate:
     on steps that are not 4th order across an edge);
     ``duration``: the time averaged over (model time units, whole forcing periods) and
     ``duration_rule`` where it came from (``LyapunovSettings.duration``, or the model's default
-    scale, :meth:`geardyn.Model.lyapunov_duration`)."""
+    scale, :meth:`geardyn.Model.lyapunov_duration`);
+    ``tangent``: how the tangent vectors were advanced (:func:`lyapunov_tangent`) and
+    ``difference_steps`` the grid steps that took the finite-difference rows (all with
+    ``"difference"``; with ``"variational"`` those split at an edge crossing)."""
 
     value: float | np.ndarray
     stderr: float | np.ndarray
@@ -77,6 +85,8 @@ class LyapunovEstimate:
     status: Status = Status.OK
     duration: float = math.nan
     duration_rule: str = ""
+    tangent: str = ""
+    difference_steps: int = 0
 
     @property
     def ok(self) -> bool:
@@ -104,6 +114,45 @@ def lyapunov_unresolved_attrs() -> dict[str, str]:
         "meaning": "steps of the state or of a finite-difference neighbour integrated unsplit "
                    "across an edge (chattering); > 0: the exponent is kept but less accurate "
                    "(geardyn.Status.SPLIT_LIMIT)"}
+
+
+def lyapunov_variational(model: Model, settings: LyapunovSettings | None = None) -> bool:
+    """Whether the tangent vectors of ``model`` are advanced by the variational RK4 under
+    ``settings.tangent`` (``"auto"``: where the model is written in the one form); a
+    :class:`~geardyn.errors.ParameterError` naming ``settings.tangent`` where it asks for
+    ``"variational"`` of a model without a one form."""
+    tangent = (settings or LyapunovSettings()).tangent
+    has = getattr(model.kernel, "one_form", None) is not None
+    if tangent == "variational" and not has:
+        raise ParameterError("settings.tangent", tangent,
+                             f"{type(model).__name__} is not written in the one form (no rhs "
+                             "to differentiate); give 'difference' or 'auto'")
+    return has and tangent != "difference"
+
+
+@contextmanager
+def _dual_typing(variational: bool, ls: LyapunovSettings) -> Iterator[None]:
+    """A ParameterError naming ``settings.tangent`` where the variational kernel does not
+    compile because the model's one-form rhs does not take dual numbers (an operation that
+    :mod:`geardyn.core.dual` lacks); numba's error chained."""
+    try:
+        yield
+    except numba.core.errors.TypingError as exc:
+        if not variational:
+            raise
+        raise ParameterError("settings.tangent", ls.tangent,
+                             "the model's one-form rhs does not take dual numbers (an operation "
+                             "geardyn.core.dual lacks: see the chained error); give "
+                             "'difference'") from exc
+
+
+def lyapunov_tangent(variational: bool) -> str:
+    """The ``tangent`` attribute of a Lyapunov result: how its tangent vectors were advanced."""
+    if variational:
+        return ("variational: the exact derivative of the RK4 step map (dual numbers through "
+                "the model's one form); a step split at an edge crossing by central "
+                "differences of its step map")
+    return "difference: central differences of the RK4 step map at every step"
 
 
 def _duration(model: Model, ls: LyapunovSettings) -> tuple[float | None, str]:
@@ -227,7 +276,9 @@ def lyapunov(
         :class:`~geardyn.LyapunovSettings`: ``duration`` (time averaged over; default the
         model's scale, :meth:`geardyn.Model.lyapunov_duration`: 2000 time units of a
         dimensionless model, 200 forcing periods of one in seconds), ``dt`` (step of
-        an autonomous model), ``renorm_every``, ``n_blocks``. Its fields given as keyword
+        an autonomous model), ``renorm_every``, ``n_blocks``, ``tangent`` (how the tangent
+        vectors are advanced: ``"auto"``, variational where the model is written in the one
+        form; see :class:`~geardyn.LyapunovSettings`). Its fields given as keyword
         arguments are deprecated (a DeprecationWarning).
     transient, duration
         Time discarded first (``run.transient``) and time averaged over (``settings.duration``),
@@ -260,6 +311,7 @@ def lyapunov(
     """
     in_periods = _periods_transient(model, run, keywords)
     run, ls = _lyapunov_run(run, settings, keywords, "lyapunov")
+    variational = lyapunov_variational(model, ls)
     steps_per_period, bound = run.steps_per_period, run.bound
     dt, renorm_every, n_blocks = ls.dt, ls.renorm_every, ls.n_blocks
     duration, rule = _duration(model, ls)
@@ -290,9 +342,10 @@ def lyapunov(
     kern = kernels_for(model.kernel, "lyapunov")
     p = np.ascontiguousarray(model.params, dtype=float)
     n_ev = model.n_events if run.locate_edges else 0
-    ex, er, used, code, unres = kern.lyapunov_single(p, y, _state_scale(model), t0, h, om, n_per,
-                                                     n_tr, n_st, renorm, k, float(bound), n_ev,
-                                                     n_blk)
+    with _dual_typing(variational, ls):
+        ex, er, used, code, unres, n_fd = kern.lyapunov_single(
+            p, y, _state_scale(model), t0, h, om, n_per, n_tr, n_st, renorm, k, float(bound),
+            n_ev, n_blk, variational)
     status = Status(int(code))
     ex = np.asarray(ex, dtype=float)
     er = np.asarray(er, dtype=float)
@@ -302,7 +355,8 @@ def lyapunov(
     else:
         value, err = float(ex[0]), float(er[0])
     if with_error:
-        return LyapunovEstimate(value, err, int(used), int(unres), status, n_st * h, rule)
+        return LyapunovEstimate(value, err, int(used), int(unres), status, n_st * h, rule,
+                                lyapunov_tangent(variational), int(n_fd))
     if status == Status.SPLIT_LIMIT:
         warnings.warn(f"lyapunov: {int(unres)} grid steps reached the edge-split limit and were "
                       "integrated unsplit across an edge (status SPLIT_LIMIT); the exponent is "
@@ -331,10 +385,10 @@ def lyapunov_lanes(
     ``bound`` are used (as keyword arguments, not together with ``run``: deprecated; without either,
     ``transient`` is 100 time units, or for a forced model of physical time
     :data:`~geardyn.core.settings.LYAPUNOV_TRANSIENT_PERIODS` forcing periods of each lane), of
-    the :class:`~geardyn.LyapunovSettings` ``duration``,
-    ``dt``, ``renorm_every`` and ``n_blocks`` (its fields as keyword arguments: deprecated, a
-    DeprecationWarning). ``transient`` and ``duration`` are times, rounded up to whole forcing
-    periods of each lane (lanes differ in Omega, so their step counts differ). The grid has
+    the :class:`~geardyn.LyapunovSettings` ``duration``, ``dt``, ``renorm_every``, ``n_blocks``
+    and ``tangent`` (its fields as keyword arguments: deprecated, a DeprecationWarning).
+    ``transient`` and ``duration`` are times, rounded up to whole forcing periods of each lane
+    (lanes differ in Omega, so their step counts differ). The grid has
     ``steps_per_period`` steps per period (default: each lane's own
     :func:`default_steps_per_period`, rounded up to the sweep's step ladder, as in
     :func:`~geardyn.solvers.ensemble.run_lanes`); an autonomous model uses the step ``dt``
@@ -351,6 +405,7 @@ def lyapunov_lanes(
     """
     in_periods = _periods_transient(model, run, keywords)
     run, ls = _lyapunov_run(run, settings, keywords, "lyapunov_lanes")
+    variational = lyapunov_variational(model, ls)
     steps_per_period, bound = run.steps_per_period, run.bound
     dt, renorm_every, n_blocks = ls.dt, ls.renorm_every, ls.n_blocks
     duration, _ = _duration(model, ls)
@@ -399,8 +454,9 @@ def lyapunov_lanes(
         kern = kernels_for(model.kernel, "lyapunov")
         # lanes of every grid together (the kernel blocks them, whatever their steps)
         n_ev = model.n_events if run.locate_edges else 0
-        kern.lyapunov_lanes(P, Y0, scale, T0, H, OMEGA, n_per, n_tr, n_st, renorm, float(bound),
-                            out, err, n_ev, n_blk, unres, status)
+        with _dual_typing(variational, ls):
+            kern.lyapunov_lanes(P, Y0, scale, T0, H, OMEGA, n_per, n_tr, n_st, renorm,
+                                float(bound), out, err, n_ev, n_blk, unres, status, variational)
     if with_status:
         return out, err, unres, status
     return (out, err) if with_error else out

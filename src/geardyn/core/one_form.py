@@ -48,7 +48,8 @@ from numba.extending import overload
 
 from geardyn.core.coefficients import Derivations
 
-__all__ = ["Derivations", "OneForm", "adapters", "call_tuple", "coefficient_type", "loud"]
+__all__ = ["Derivations", "OneForm", "adapters", "call_tuple", "coefficient_type", "loud",
+           "tangent_adapters"]
 
 _TYPE_PREFIX = "Coefficients_"
 #: The lane forms a coefficient type of a one form with ``quiet`` coefficients is made for
@@ -312,3 +313,47 @@ def _block_loop(call: str, y_blk: str, blk: str, n: int, coef: str) -> list[str]
     return ["for k in range(nl):",
             f"    v = {call}(T[k], {y_blk}, {coef}(PT, k), S[k], C[k])",
             *("    " + line for line in _stores(blk + "[{q}, k]", n))]
+
+
+def tangent_adapters(form: OneForm) -> str:
+    """Python source defining the tangent forms of the one form's ``rhs`` (for the variational
+    Lyapunov kernel; spliced after :func:`adapters`' text, whose names it uses): the array form
+    ``rhs_tangent(t, y, v, dy, dv, p, s, c)`` (dy = f(t, y), dv = J(t, y) v, J the Jacobian in
+    the state) and the lane-scalar form ``rhs_lane_tangent(t, y, v, PT, k, s, c, form)`` (the
+    tuples (f, J v)). Both call the one form's ``rhs`` with the state a tuple of duals
+    (:mod:`geardyn.core.dual`): the same physics, differentiated exactly; f bitwise that of
+    ``rhs``. Every compiled function's arguments and results are floats (the duals live
+    inside)."""
+    ns = form.n_states
+    quiet = bool(form.quiet)
+    duals = "(" + "".join(f"_dual(y[{q}], v[{q}]), " for q in range(ns)) + ")"
+    out = ("\n# The tangent forms of the one form's rhs (geardyn.core.one_form.tangent_adapters).\n"
+           "from geardyn.core.dual import dual as _dual\n"
+           "from geardyn.core.dual import tangent_of as _tangent_of\n"
+           "from geardyn.core.dual import value_of as _value_of\n")
+    out += _fn("_tangent_parts(d)", [
+        "return (" + _tuple_text("_value_of(d[{q}])", ns) + ", "
+        + _tuple_text("_tangent_of(d[{q}])", ns) + ")"], inline=True)
+    # a quiet term is tested per lane (``loud``) in the array form, as in ``rhs``
+    body = [f"d = _one_rhs(t, {duals}, _coef(p), s, c)", "f, w = _tangent_parts(d)",
+            *(f"dy[{q}] = f[{q}]" for q in range(ns)), *(f"dv[{q}] = w[{q}]" for q in range(ns))]
+    # compiled once and inlined by LLVM where it is called (as the array form ``rhs`` is in
+    # the kernels' step core: ``_rhs_i``)
+    out += _fn("rhs_tangent(t, y, v, dy, dv, p, s, c)", body).replace(
+        "@nb.njit(**_JIT)", "@nb.njit(forceinline=True, _nrt=False, **_JIT)")
+    if quiet:
+        for kind, coef in (("quiet", "_coef_quiet"), ("loud", "_coef_loud"),
+                           ("general", "_coef_lane")):
+            out += (f"\n\n@nb.njit(forceinline=True, **_JIT)\ndef _rhs_tangent_lane_{kind}"
+                    f"(t, y, v, PT, k, s, c):\n    return _tangent_parts(_one_rhs(t, {duals}, "
+                    f"{coef}(PT, k), s, c))\n")
+        # the lane forms as in ``rhs_lane`` (FORM_GENERAL: ``loud`` tested by lane)
+        lane_body = ["if form == _ONE_FORM:",
+                     "    return _rhs_tangent_lane_quiet(t, y, v, PT, k, s, c)",
+                     "if form == _ONE_LOUD:",
+                     "    return _rhs_tangent_lane_loud(t, y, v, PT, k, s, c)",
+                     "return _rhs_tangent_lane_general(t, y, v, PT, k, s, c)"]
+    else:
+        lane_body = [f"return _tangent_parts(_one_rhs(t, {duals}, _coef_lane(PT, k), s, c))"]
+    out += _fn("rhs_lane_tangent(t, y, v, PT, k, s, c, form)", lane_body, inline=True)
+    return out

@@ -401,6 +401,8 @@ LYAPUNOV_TRANSIENT_PERIODS = 20
 LYAPUNOV_DT = 0.01
 LYAPUNOV_RENORM_EVERY = 10
 LYAPUNOV_BLOCKS = 16
+#: How the tangent vectors are advanced (:attr:`LyapunovSettings.tangent`).
+LYAPUNOV_TANGENTS = ("auto", "variational", "difference")
 
 
 @dataclass(frozen=True)
@@ -421,6 +423,12 @@ class LyapunovSettings(_AnalysisSettings):
         RK4 steps between re-orthonormalisations (>= 1).
     n_blocks
         Blocks of the measuring window for the standard error (>= 2).
+    tangent
+        How the tangent vectors are advanced: ``"variational"``, the exact derivative of the
+        RK4 step map from the model's one form (dual numbers through its rhs; a step split at
+        an edge crossing by the difference rows; a model written in the one form only),
+        ``"difference"``, central differences of the step map at every step (every model), or
+        ``"auto"`` (default): variational where the model has a one form.
     """
 
     duration: float | None = _field(None, "optional-positive", "time averaged over (default: "
@@ -430,6 +438,12 @@ class LyapunovSettings(_AnalysisSettings):
     renorm_every: int = _field(LYAPUNOV_RENORM_EVERY, "whole",
                                "RK4 steps between re-orthonormalisations")
     n_blocks: int = _field(LYAPUNOV_BLOCKS, "whole", "blocks for the standard error", least=2)
+    tangent: str = _field("auto", "choice", "tangent vectors: variational, difference or auto")
+
+    def _check(self) -> None:
+        if self.tangent not in LYAPUNOV_TANGENTS:
+            raise SettingsError(f"tangent must be one of {', '.join(LYAPUNOV_TANGENTS)} "
+                                f"(got {self.tangent!r})")
 
 
 def resolve_settings(kind: type, settings: Any, legacy: Mapping[str, Any], where: str,

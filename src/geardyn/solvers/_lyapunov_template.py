@@ -32,6 +32,16 @@ Numerics
   (linear models) up to rounding (~ eps / FD_DELTA ~ 1e-10 relative per step). The vector
   field is continuous across the dead-zone edges, so the flow is C^1 there and no saltation
   matrix is needed.
+* Variational tangent (``variational``; a model written in the one form, whose kernel modules
+  get the tangent forms of its rhs, :func:`geardyn.core.one_form.tangent_adapters`): the state
+  and each tangent vector w = S v are stepped together, the RK4 stages of the pair from f and
+  J w (dual numbers through the one form's rhs, :mod:`geardyn.core.dual`). That is the exact
+  derivative of the RK4 step map (not a difference quotient of it), and the state is bitwise
+  the difference rows' state row. A step whose state leaves a side of an edge (or may graze
+  one) is split at the crossing; that step is taken by the difference rows above (each row
+  split at its own crossing), and counted (``fd_steps``). No saltation term is needed across
+  an edge: the vector field is continuous there (the dead zone), so the flow is C^1, and
+  ``min``/``max`` in the model give the derivative of the side they pick.
 * Every ``renorm_every`` steps (and at the end of the transient and of the run) the tangent
   vectors are re-orthonormalised by modified Gram-Schmidt (a QR factorisation); the logs of the
   diagonal of R are summed over the measuring window (Benettin et al. 1980; Shimada & Nagashima
@@ -49,7 +59,9 @@ Numerics
   (:func:`_block_stderr`). The exponent itself is summed as before, untouched.
 * A lane whose state leaves ``|y| <= bound`` (checked at each renormalisation) or whose tangent
   vectors stop being finite is marked diverged (status 1) and its exponents are NaN.
-* Cost per step: (2 k + 1) RK4 steps for k tangent vectors. They are independent integrations
+* Cost per step: (2 k + 1) RK4 steps for k tangent vectors by the difference rows; one
+  RK4 step of the state and its tangent vector (f and J w in one inlined call) by the
+  variational tangent, k = 1. They are independent integrations
   of one grid step, so they run as the rows of one lockstep block (their RK4 stages interleaved,
   the model's functions inlined once), which overlaps their dependency chains; each row's
   arithmetic is that of a lone step, so the result does not depend on it.
@@ -92,9 +104,11 @@ from geardyn.solvers._step_core import (  # CORE-IMPORT
     STATUS_OK,
     STATUS_SPLIT_LIMIT,
     _events_columns,
+    _events_i,
     _events_l,
     _healthy,
     _lane_form,
+    _leaves_side_step,
     _padded,
     _pick,
     _rhs_columns,
@@ -111,21 +125,114 @@ from geardyn.solvers._step_core import (  # CORE-IMPORT
 )
 from geardyn.solvers._template_model import events, observe, rhs  # MODEL-IMPORT
 
+# TANGENT-ADAPTERS (a one-form model's tangent forms of its rhs: see .kernels)
+
 # the model interface names are part of the template's namespace (the generated copy re-binds
 # them); only rhs and events are used here
 __all__ = ["BLOCK_ROWS", "events", "lyapunov_block_lanes", "lyapunov_lanes", "lyapunov_lanes_rows",
            "lyapunov_single", "observe", "phase_table", "rhs"]
 
 
+#: Whether the model has the tangent forms of its rhs (a one-form model: ``rhs_tangent``,
+#: ``rhs_lane_tangent``, see :func:`geardyn.core.one_form.tangent_adapters`), so that its
+#: tangent vectors can be stepped by the variational RK4 (:func:`_var_step`).
+VARIATIONAL = "rhs_tangent" in globals()
+
+
+if VARIATIONAL:
+    _rhs_t = rhs_tangent  # noqa: F821
+
+    @nb.njit(inline="always", **_JIT)
+    def _var_trial(t, hh, h, y, w, p, s0, c0, s1, c1, s2, c2, KS, KV, TMP, TV, y1, w1):
+        """The variational RK4 trial of one grid step: the state y into y1 and the tangent w
+        (in y) into w1 = (dPhi/dy) w, Phi the RK4 step map (the stages of the pair (y, w) by
+        the rhs's tangent form: f and J w at each stage); KS[0] is the state's k1. y1 is
+        bitwise :func:`_rows_step`'s trial (the same operations)."""
+        ns = y.size
+        _rhs_t(t, y, w, KS[0], KV[0], p, s0, c0)
+        for st in range(1, 4):
+            a = h if st == 3 else hh
+            for q in range(ns):
+                TMP[q] = y[q] + a * KS[st - 1, q]
+                TV[q] = w[q] + a * KV[st - 1, q]
+            if st < 3:
+                _rhs_t(t + hh, TMP, TV, KS[st], KV[st], p, s1, c1)
+            else:
+                _rhs_t(t + h, TMP, TV, KS[st], KV[st], p, s2, c2)
+        h6 = h / 6.0
+        for q in range(ns):
+            y1[q] = y[q] + h6 * (KS[0, q] + 2.0 * KS[1, q] + 2.0 * KS[2, q] + KS[3, q])
+            w1[q] = w[q] + h6 * (KV[0, q] + 2.0 * KV[1, q] + 2.0 * KV[2, q] + KV[3, q])
+
+    @nb.njit(**_JIT)
+    def _var_step(i, t0, Z, S, IS, p, h, omega, n_per, s_tab, c_tab, n_ev, YP, E, K, TMP,
+                  Y1, SIDE, G0, G1, W, gbuf, NCR, UNRES, VW):
+        """Advance the state y (row 0 of Z) by grid step i and each tangent vector v (rows 1..,
+        in z = y / S) by the exact derivative of the RK4 step map: the variational RK4
+        (:func:`_var_trial`, w = S v). A step whose state leaves a side of an edge (or may graze
+        one; :func:`_leaves_side_step`, as :func:`_rows_step` screens it) is split at the
+        crossing: that step is redone by :func:`_tangent_step` (the state split as everywhere,
+        the tangent vectors by the difference rows through their own splits). Returns 1 where
+        the step took the difference rows, else 0. VW: scratch, (2 m + 10, ns)."""
+        m, ns = Z.shape
+        t = t0 + i * h
+        hh = 0.5 * h
+        j0 = 2 * (i % n_per)
+        last = 2 * (m - 1)
+        y = YP[last]
+        for q in range(ns):
+            y[q] = Z[0, q]
+        KS = VW[0:4]
+        KV = VW[4:8]
+        TV = VW[8]
+        w = VW[9]
+        WN = VW[10:10 + m]  # the trial's tangent vectors (in z), row j for tangent j
+        for j in range(1, m):
+            for q in range(ns):
+                w[q] = S[q] * Z[j, q]
+            _var_trial(t, hh, h, y, w, p, s_tab[j0], c_tab[j0], s_tab[j0 + 1], c_tab[j0 + 1],
+                       s_tab[j0 + 2], c_tab[j0 + 2], KS, KV, TMP[last], TV, Y1[last], WN[j])
+        if n_ev > 0:
+            for q in range(ns):
+                K[0, last, q] = KS[0, q]
+            _events_i(t, y, G0[last], p, s_tab[j0], c_tab[j0])
+            for j in range(n_ev):
+                SIDE[last, j] = _side(G0[last, j])
+            _events_i(t + h, Y1[last], G1[last], p, s_tab[j0 + 2], c_tab[j0 + 2])
+            if _leaves_side_step(last, t, t + h, YP, K[0], G0, G1, SIDE, p, W[8], gbuf,
+                                 s_tab[j0 + 2], c_tab[j0 + 2]):
+                _tangent_step(i, t0, Z, S, IS, p, h, omega, n_per, s_tab, c_tab, n_ev, YP, E,
+                              K, TMP, Y1, SIDE, G0, G1, W, gbuf, NCR, UNRES)
+                return 1
+        for j in range(1, m):
+            for q in range(ns):
+                Z[j, q] = WN[j, q] * IS[q]
+        for q in range(ns):
+            Z[0, q] = Y1[last, q]
+        return 0
+
+else:
+    @nb.njit(**_JIT)
+    def _var_step(i, t0, Z, S, IS, p, h, omega, n_per, s_tab, c_tab, n_ev, YP, E, K, TMP,
+                  Y1, SIDE, G0, G1, W, gbuf, NCR, UNRES, VW):
+        """A model without tangent forms has no variational step (its callers refuse)."""
+        if n_ev >= 0:
+            raise ValueError("this model has no tangent form of its rhs (no one form)")
+        return 0
+
+
 @nb.njit(**_JIT)
 def _run(p, y0, S, t0, h, omega, n_per, s_tab, c_tab, n_transient, n_steps, renorm_every, k,
-         bound, n_ev, n_blocks):
+         bound, n_ev, n_blocks, variational):
     """Exponents (sum of logs / measured time), their standard errors (from up to ``n_blocks``
     blocks of whole forcing periods of the measuring window), the number of blocks, the
     status (STATUS_SPLIT_LIMIT where a step of any row reached the split limit, the exponents
-    kept; STATUS_DIVERGED, exponents NaN) and the number of such steps (all rows) of one
+    kept; STATUS_DIVERGED, exponents NaN), the number of such steps (all rows) and the number
+    of grid steps whose tangent vectors took the difference rows of one
     lane, started at time t0 (forcing phase zero there); tangent vectors in the
-    coordinates y / S (S: the state scale)."""
+    coordinates y / S (S: the state scale). ``variational``: the tangent vectors by the
+    variational RK4 (:func:`_var_step`; split steps by the difference rows), else by the
+    difference rows (:func:`_tangent_step`) at every step."""
     ns = y0.size
     IS = np.empty(ns)
     for q in range(ns):
@@ -152,6 +259,8 @@ def _run(p, y0, S, t0, h, omega, n_per, s_tab, c_tab, n_transient, n_steps, reno
     nbk = ends.size
     blk = np.zeros((nbk, k))  # log stretch per block of the measuring window
     C = np.zeros((m, ns))
+    VW = np.zeros((10 + m, ns))
+    n_fd = 0
     out = np.full(k, np.nan)
     err = np.full(k, np.nan)
     for q in range(ns):
@@ -166,17 +275,22 @@ def _run(p, y0, S, t0, h, omega, n_per, s_tab, c_tab, n_transient, n_steps, reno
     since = 0
     cur = 0  # the block being measured
     for i in range(total):
-        _tangent_step(i, t0, Z, S, IS, p, h, omega, n_per, s_tab, c_tab, n_ev, YP, E, K, TMP, Y1,
-                      SIDE, G0, G1, W, gbuf, NCR, UNRES)
+        if variational:
+            n_fd += _var_step(i, t0, Z, S, IS, p, h, omega, n_per, s_tab, c_tab, n_ev, YP, E, K,
+                              TMP, Y1, SIDE, G0, G1, W, gbuf, NCR, UNRES, VW)
+        else:
+            _tangent_step(i, t0, Z, S, IS, p, h, omega, n_per, s_tab, c_tab, n_ev, YP, E, K,
+                          TMP, Y1, SIDE, G0, G1, W, gbuf, NCR, UNRES)
+            n_fd += 1
         since += 1
         step = i + 1
         measure = step > n_transient
         if since == renorm or step == n_transient or step == total:
             since = 0
             if not _healthy(Z[0], bound):
-                return out, err, 0, STATUS_DIVERGED, UNRES.sum()
+                return out, err, 0, STATUS_DIVERGED, UNRES.sum(), n_fd
             if not _orthonormalise(Z, logs, measure):
-                return out, err, 0, STATUS_DIVERGED, UNRES.sum()
+                return out, err, 0, STATUS_DIVERGED, UNRES.sum(), n_fd
             if measure:
                 for j in range(k):
                     acc[j] += logs[j]
@@ -194,17 +308,17 @@ def _run(p, y0, S, t0, h, omega, n_per, s_tab, c_tab, n_transient, n_steps, reno
     unres = UNRES.sum()
     status = STATUS_SPLIT_LIMIT if unres > 0 else STATUS_OK
     if n_steps <= 0:
-        return out, err, 0, status, unres
+        return out, err, 0, status, unres, n_fd
     tm = n_steps * h
     for j in range(k):
         out[j] = acc[j] / tm
     _block_stderr(blk, ends, h, err)
-    return out, err, nbk, status, unres
+    return out, err, nbk, status, unres, n_fd
 
 
 @nb.njit(**_JIT)
 def lyapunov_single(p, y0, scale, t0, h, omega, n_per, n_transient, n_steps, renorm_every, k,
-                    bound, n_ev=0, n_blocks=16):
+                    bound, n_ev=0, n_blocks=16, variational=False):
     """The k leading Lyapunov exponents (per unit time of the model) of one parameter set.
 
     ``scale``: the characteristic scale of each state (``Model.state_scale``, positive; ones give
@@ -217,32 +331,43 @@ def lyapunov_single(p, y0, scale, t0, h, omega, n_per, n_transient, n_steps, ren
     (:func:`_block_stderr`; ``blocks`` of them used); exponents are NaN if diverged (status
     STATUS_DIVERGED); ``unresolved``: grid steps of the state or a perturbed row that reached
     the split limit (MAX_SPLITS) and fell back unsplit, the status then STATUS_SPLIT_LIMIT
-    (exponents kept) unless diverged.
+    (exponents kept) unless diverged; ``fd_steps``: the grid steps whose tangent vectors took
+    the difference rows (every step, or with ``variational`` the split ones: see
+    :func:`_var_step`; ``variational`` needs the model's tangent forms, :data:`VARIATIONAL`).
+    Returns (exponents, stderr, blocks, status, unresolved, fd_steps).
     """
     s_tab, c_tab = phase_table(n_per, omega != 0.0)
     # copies and int64 casts: a read-only array, a literal or an omitted argument would compile
     # _run once more for each such caller
     return _run(p.copy(), y0.copy(), scale.copy(), t0, h, omega, n_per, s_tab, c_tab,
                 n_transient, n_steps, renorm_every, np.int64(k), bound, np.int64(n_ev),
-                np.int64(n_blocks))
+                np.int64(n_blocks), bool(variational))
 
 
 def lyapunov_lanes_rows(P, Y0, scale, T0, H, OMEGA, n_per, n_transient, n_steps, renorm_every,
-                        bound, out, err, n_ev=0, n_blocks=16, unresolved=None, status=None):
+                        bound, out, err, n_ev=0, n_blocks=16, unresolved=None, status=None,
+                        variational=False, fd_steps=None):
     """:func:`lyapunov_lanes` one lane at a time (the rows of :func:`lyapunov_single`), the
     lanes of each grid (n_per: one for all lanes or one per lane) in parallel: the kernel before
     the lane blocks, kept as their reference."""
+    if variational and not VARIATIONAL:
+        raise ValueError("the variational tangent needs a model with the tangent forms of its "
+                         "rhs (a one-form model)")
     L = Y0.shape[0]
     nper = np.broadcast_to(np.asarray(n_per, np.int64), (L,))
     for n in np.unique(nper):
         idx = np.nonzero(nper == n)[0]
         part, part_err = np.full(idx.size, np.nan), np.full(idx.size, np.nan)
         part_u, part_s = np.zeros(idx.size, np.int64), np.zeros(idx.size, np.int64)
+        part_f = np.zeros(idx.size, np.int64)
         sel = [np.ascontiguousarray(np.asarray(a)[idx])
                for a in (P, Y0, T0, H, OMEGA, n_transient, n_steps)]
         _lanes_rows(sel[0], sel[1], scale, sel[2], sel[3], sel[4], int(n), sel[5], sel[6],
-                    renorm_every, bound, part, part_err, part_u, part_s, n_ev, n_blocks)
+                    renorm_every, bound, part, part_err, part_u, part_s, part_f, n_ev,
+                    n_blocks, bool(variational))
         out[idx], err[idx] = part, part_err
+        if fd_steps is not None:
+            fd_steps[idx] = part_f
         if unresolved is not None:
             unresolved[idx] = part_u
         if status is not None:
@@ -251,7 +376,7 @@ def lyapunov_lanes_rows(P, Y0, scale, T0, H, OMEGA, n_per, n_transient, n_steps,
 
 @nb.njit(parallel=True, **_JIT)
 def _lanes_rows(P, Y0, scale, T0, H, OMEGA, n_per, n_transient, n_steps, renorm_every, bound, out,
-                err, unres, status, n_ev=0, n_blocks=16):
+                err, unres, status, fd_steps, n_ev, n_blocks, variational):
     """Largest exponent of every lane (row of P, Y0; n_per steps per period), in parallel over
     lanes, one lane at a time (the rows of :func:`lyapunov_single`).
 
@@ -259,7 +384,8 @@ def _lanes_rows(P, Y0, scale, T0, H, OMEGA, n_per, n_transient, n_steps, renorm_
     time (forcing phase zero there, as in :func:`lyapunov_single`) per lane; H, OMEGA:
     step and forcing frequency per lane; n_transient, n_steps: per-lane step counts (int
     arrays); n_ev and n_blocks as in :func:`lyapunov_single`. Fills out[L] and err[L] (the
-    standard error; NaN for diverged lanes), unres[L] and status[L] (see :func:`_run`).
+    standard error; NaN for diverged lanes), unres[L], status[L] and fd_steps[L] (see
+    :func:`_run`; ``variational`` as there).
     """
     L, ns = Y0.shape
     forced = False
@@ -268,10 +394,11 @@ def _lanes_rows(P, Y0, scale, T0, H, OMEGA, n_per, n_transient, n_steps, renorm_
             forced = True
     s_tab, c_tab = phase_table(n_per, forced)
     for lane in nb.prange(L):
-        ex, er, _nb, st, un = _run(P[lane], Y0[lane], scale, T0[lane], H[lane], OMEGA[lane],
-                                   n_per, s_tab, c_tab, n_transient[lane], n_steps[lane],
-                                   renorm_every, np.int64(1), bound, np.int64(n_ev),
-                                   np.int64(n_blocks))
+        ex, er, _nb, st, un, fd = _run(P[lane], Y0[lane], scale, T0[lane], H[lane],
+                                       OMEGA[lane], n_per, s_tab, c_tab, n_transient[lane],
+                                       n_steps[lane], renorm_every, np.int64(1), bound,
+                                       np.int64(n_ev), np.int64(n_blocks), variational)
+        fd_steps[lane] = fd
         out[lane] = ex[0] if st != STATUS_DIVERGED else np.nan
         err[lane] = er[0] if st != STATUS_DIVERGED else np.nan
         unres[lane] = un
@@ -992,9 +1119,287 @@ def _lyap_block_local(form, lo, hi, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TA
         unres[lo + i] = un[i]
 
 
+# ---------------------------------------------------------------------------------------------
+# The variational block (k = 1, a model with the tangent forms of its rhs: :data:`VARIATIONAL`):
+# one loop over the block's lanes per grid step advances each lane's state and its tangent
+# vector together, the RK4 stages of the pair (y, w = S v) from the lane-scalar tangent form
+# ``rhs_lane_tangent`` (f and J w in one inlined call; :func:`_var_row_trial`), then screens the
+# state's trial as the fused loop does and commits the unflagged lanes. A flagged lane (its state
+# leaves a side of an edge or may graze one) is finished out of line by the difference rows
+# (:func:`_tangent_step`, as :func:`_var_step` does it for one lane). Each lane's arithmetic is
+# that of :func:`_var_step`, operation for operation: the exponents are bitwise those of
+# :func:`lyapunov_single` with ``variational``.
+
+
+def _t_scale(v, S):
+    """(v_q S[q]), elementwise."""
+
+
+def _ov_t_scale(v, S):
+    return _tuple_source("v, S", ["return (" + "".join(f"S[{q}] * v[{q}], "
+                                                       for q in range(len(v))) + ")"])
+
+
+def _t_unscale(w, IS):
+    """(w_q IS[q]), elementwise."""
+
+
+def _ov_t_unscale(w, IS):
+    return _tuple_source("w, IS", ["return (" + "".join(f"w[{q}] * IS[{q}], "
+                                                        for q in range(len(w))) + ")"])
+
+
+if VARIATIONAL:
+    nb.extending.overload(_t_scale, inline="always")(_ov_t_scale)
+    nb.extending.overload(_t_unscale, inline="always")(_ov_t_unscale)
+    _rhs_lt = rhs_lane_tangent  # noqa: F821
+
+    @nb.njit(inline="always", **_JIT)
+    def _var_row_trial(form, y, w, PT, l, ts, tm, te, hh, h, h6, hd, ph):
+        """One lane's variational RK4 trial (as :func:`_var_trial`) and its state's events at
+        the start, the end and y + hd f (the graze predictor): (y1, w1, g0, g1, ge)."""
+        s0, c0, s1, c1, s2, c2 = ph
+        k1, q1 = _rhs_lt(ts, y, w, PT, l, s0, c0, form)
+        k2, q2 = _rhs_lt(tm, _t_axpy(y, hh, k1), _t_axpy(w, hh, q1), PT, l, s1, c1, form)
+        k3, q3 = _rhs_lt(tm, _t_axpy(y, hh, k2), _t_axpy(w, hh, q2), PT, l, s1, c1, form)
+        k4, q4 = _rhs_lt(te, _t_axpy(y, h, k3), _t_axpy(w, h, q3), PT, l, s2, c2, form)
+        y1 = _t_comb(y, h6, k1, k2, k3, k4)
+        w1 = _t_comb(w, h6, q1, q2, q3, q4)
+        return (y1, w1, _events_l(ts, y, PT, l, s0, c0), _events_l(te, y1, PT, l, s2, c2),
+                _events_l(te, _t_axpy(y, hd, k1), PT, l, s2, c2))
+
+    @nb.njit(inline="always", **_JIT)
+    def _var_fused_steps(form, i, nl, locate, Z0, Z1, S, IS, PT, T0L, HL, HHL, H6L, PH, ACT,
+                         FLAG, GR):
+        """Grid step i of every lane of the block (see above): Z0, Z1 the state and the
+        tangent vector (flat rows of BLOCK lanes), committed where the lane is active and its
+        state's trial unflagged (``locate``: the edges screened; GR: the graze flags, a row of
+        BLOCK per switching function of the model); FLAG[l] = 1 where an active lane is flagged.
+        Returns the number of flagged lanes."""
+        P0, P1, P2, P3, P4, P5 = PH
+        n_flag = 0
+        for l in range(nl):
+            y = _t_load(Z0, l)
+            v = _t_load(Z1, l)
+            h = HL[l]
+            ts = T0L[l] + i * h
+            hh = HHL[l]
+            tm = ts + hh
+            te = ts + h
+            hd = te - ts
+            ph = (P0[l], P1[l], P2[l], P3[l], P4[l], P5[l])
+            y1, w1, g0, g1, ge = _var_row_trial(form, y, _t_scale(v, S), PT, l, ts, tm, te, hh,
+                                                h, H6L[l], hd, ph)
+            hit = _t_screen_rows(g0, g1, ge, GR, l) & locate  # (no branch in the lane loop)
+            act = ACT[l]
+            flagged = act & hit
+            keep = act & (not hit)
+            _t_store(Z1, l, _t_unscale(w1, IS), v, keep)
+            _t_store(Z0, l, y1, y, keep)
+            FLAG[l] = 1.0 if flagged else 0.0
+            n_flag += 1 if flagged else 0
+        return n_flag
+
+
+@nb.njit(**_JIT)
+def _var_flagged(i, nl, first, n_ev, P, Z0, Z1, S, IS, T0L, HL, OMEGA, NPL, IDX, S_TAB, C_TAB,
+                 FLAG, UNRR, FDL, fd):
+    """The flagged lanes of step i (:func:`_var_fused_steps`) by the difference rows, each as
+    :func:`_var_step` takes such a step (:func:`_tangent_step` from the lane's state and
+    tangent vector; its rows' split-limit steps into UNRR[l], the step counted in FDL[l])."""
+    Zl, YP, E, K, TMP, Y1, SIDE, G0, G1, W, gbuf, NCR, UNRES = fd
+    ns = Zl.shape[1]
+    for l in range(nl):
+        if FLAG[l] == 0.0:
+            continue
+        lane = first + l
+        for q in range(ns):
+            Zl[0, q] = Z0[q * BLOCK + l]
+            Zl[1, q] = Z1[q * BLOCK + l]
+        off = IDX[l] - 2 * (i % NPL[l])  # the lane's phase table in S_TAB, C_TAB
+        for r in range(UNRES.size):
+            UNRES[r] = 0
+        _tangent_step(i, T0L[l], Zl, S, IS, P[lane], HL[l], OMEGA[lane], NPL[l], S_TAB[off:],
+                      C_TAB[off:], n_ev, YP, E, K, TMP, Y1, SIDE, G0, G1, W, gbuf, NCR, UNRES)
+        for q in range(ns):
+            Z0[q * BLOCK + l] = Zl[0, q]
+            Z1[q * BLOCK + l] = Zl[1, q]
+        UNRR[l] += UNRES.sum()
+        FDL[l] += 1
+
+
+@nb.njit(inline="always", **_JIT)
+def _lyap_var_run(form, first, nl, n_ev, max_total, due, renorm, bound, P, OMEGA, H, S, IS, PT,
+                  lanes, books, out, err, used, status, scratch, fd):
+    """The time loop of a variational block (see above): every grid step of the block's lanes,
+    their flagged lanes out of line, their bookkeeping where due (:func:`_lane_books`)."""
+    (Z0, Z1, ZT, T0L, HL, HHL, H6L, IDX, NPL, ENDL, PH, ACT, ACTR, FLAG, GR, UNRR, FDL) = lanes
+    IST, ENDS, BLK, ACC, Zl, Cl, logs = books
+    S_TAB, C_TAB = scratch
+    nv = _padded(nl)
+    locate = n_ev > 0
+    for i in range(max_total):
+        live = False
+        for l in range(nl):
+            live = live | ACT[l]
+        if not live:
+            break
+        for l in range(nl):
+            j = IDX[l]
+            for d in range(3):
+                PH[2 * d][l] = S_TAB[j + d]
+                PH[2 * d + 1][l] = C_TAB[j + d]
+        n_flag = _var_fused_steps(form, i, nv, locate, Z0, Z1, S, IS, PT, T0L, HL, HHL, H6L,
+                                  PH, ACT, FLAG, GR)
+        if n_flag > 0:
+            _var_flagged(i, nl, first, n_ev, P, Z0, Z1, S, IS, T0L, HL, OMEGA, NPL, IDX, S_TAB,
+                         C_TAB, FLAG, UNRR, FDL, fd)
+        for l in range(nl):
+            IDX[l] = IDX[l] + 2 if IDX[l] + 2 < ENDL[l] else IDX[l] + 2 - 2 * NPL[l]
+        step = i + 1
+        if step >= due:
+            due = _lane_books_core(step, first, nl, 1, renorm, bound, ZT, Zl, Cl, logs, IST,
+                                   ENDS, BLK, ACC, ACT, ACTR, status)
+
+
+@nb.njit(_nrt=False, **_JIT_NOALIAS)
+def _lyap_var_form0(first, nl, n_ev, max_total, due, renorm, bound, P, OMEGA, H, S, IS, PT,
+                    lanes, books, out, err, used, status, scratch, fd):
+    """:func:`_lyap_var_run` in the lane form FORM_GENERAL (a block of mixed forms)."""
+    _lyap_var_run(FORM_GENERAL, first, nl, n_ev, max_total, due, renorm, bound, P, OMEGA, H, S,
+                  IS, PT, lanes, books, out, err, used, status, scratch, fd)
+
+
+@nb.njit(_nrt=False, **_JIT_NOALIAS)
+def _lyap_var_form1(first, nl, n_ev, max_total, due, renorm, bound, P, OMEGA, H, S, IS, PT,
+                    lanes, books, out, err, used, status, scratch, fd):
+    """:func:`_lyap_var_run` in the lane form FORM_QUIET."""
+    _lyap_var_run(FORM_QUIET, first, nl, n_ev, max_total, due, renorm, bound, P, OMEGA, H, S,
+                  IS, PT, lanes, books, out, err, used, status, scratch, fd)
+
+
+@nb.njit(_nrt=False, **_JIT_NOALIAS)
+def _lyap_var_form2(first, nl, n_ev, max_total, due, renorm, bound, P, OMEGA, H, S, IS, PT,
+                    lanes, books, out, err, used, status, scratch, fd):
+    """:func:`_lyap_var_run` in the lane form FORM_LOAD."""
+    _lyap_var_run(FORM_LOAD, first, nl, n_ev, max_total, due, renorm, bound, P, OMEGA, H, S,
+                  IS, PT, lanes, books, out, err, used, status, scratch, fd)
+
+
+@nb.njit(**_JIT)
+def _lyap_block_var(form, first, nl, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
+                    n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err, used,
+                    status, unres, fd_steps):
+    """:func:`_lyap_block` with k = 1 by the variational block of lane form ``form`` (nl <=
+    BLOCK lanes): per lane what :func:`_run` with ``variational`` computes, bitwise; the
+    lanes' steps by the difference rows into fd_steps[lane]."""
+    ns = Y0.shape[1]
+    IS = np.empty(ns)
+    for q in range(ns):
+        IS[q] = 1.0 / S[q]
+    ZT = np.zeros((2, ns, BLOCK))
+    Z0 = ZT[0].reshape(ns * BLOCK)
+    Z1 = ZT[1].reshape(ns * BLOCK)
+    PT = np.zeros((P.shape[1], BLOCK))
+    T0L = np.zeros(BLOCK)
+    HL = np.zeros(BLOCK)
+    HHL = np.zeros(BLOCK)
+    H6L = np.zeros(BLOCK)
+    IDX = np.zeros(BLOCK, np.int64)
+    NPL = np.ones(BLOCK, np.int64)
+    ENDL = np.zeros(BLOCK, np.int64)
+    PH6 = np.zeros((6, BLOCK))
+    PH = (PH6[0], PH6[1], PH6[2], PH6[3], PH6[4], PH6[5])
+    ACT = np.zeros(BLOCK, np.bool_)
+    ACTR = np.zeros(3 * nl, np.bool_)  # (written by _lane_books; unused here)
+    FLAG = np.zeros(BLOCK)
+    ne = max(n_ev, 1)
+    UNRR = np.zeros(BLOCK, np.int64)
+    FDL = np.zeros(BLOCK, np.int64)
+    IST, ENDS, BLK, ACC, Zl, Cl, logs, max_total = _lanes_init(first, nl, 1, Y0, NPER,
+                                                                n_transient, n_steps,
+                                                                renorm_every, n_blocks, out,
+                                                                err, used, status, ZT, ACT)
+    for l in range(nl):
+        _set_column(l, first + l, P, T0, H, NPER, OFF, PT, T0L, HL, HHL, H6L, NPL, IDX, ENDL)
+    # the graze flags of every switching function of the model (screened even where n_ev = 0,
+    # then ignored: no branch in the lane loop)
+    GR = np.zeros(max(len(_events_l(0.0, _t_load(Z0, 0), PT, 0, 0.0, 1.0)), 1) * BLOCK)
+    renorm = max(renorm_every, 1)
+    due = max_total
+    for l in range(nl):
+        if ACT[l]:
+            due = min(due, IST[l, _DUE])
+    fd = (np.zeros((2, ns)), np.zeros((3, ns)), np.zeros(2), np.zeros((4, 3, ns)),
+          np.zeros((3, ns)), np.zeros((3, ns)), np.ones((3, ne), np.int64), np.zeros((3, ne)),
+          np.zeros((3, ne)), np.zeros((9, ns)), np.zeros((GBUF_ROWS, ne)),
+          np.zeros((3, ne), np.int64), np.zeros(3, np.int64))
+    lanes = (Z0, Z1, ZT, T0L, HL, HHL, H6L, IDX, NPL, ENDL, PH, ACT, ACTR, FLAG, GR, UNRR, FDL)
+    books = (IST, ENDS, BLK, ACC, Zl, Cl, logs)
+    args = (first, nl, n_ev, max_total, due, renorm, bound, P, OMEGA, H, S, IS, PT, lanes, books,
+            out, err, used, status, (S_TAB, C_TAB), fd)
+    if form == FORM_QUIET:
+        _lyap_var_form1(*args)
+    elif form == FORM_LOAD:
+        _lyap_var_form2(*args)
+    else:
+        _lyap_var_form0(*args)
+    for l in range(nl):
+        lane = first + l
+        if status[lane] != STATUS_DIVERGED:
+            _lane_result(l, lane, 1, IST[l, _NST], H[lane], ENDS, IST[l, _NBK], BLK, ACC, out,
+                         err, used)
+        unres[lane] = UNRR[l]
+        fd_steps[lane] = FDL[l]
+        if UNRR[l] > 0 and status[lane] == STATUS_OK:
+            status[lane] = STATUS_SPLIT_LIMIT
+
+
+@nb.njit(nogil=True, **_JIT)
+def _lyap_var_worker(b, n_blk, form, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
+                     n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err, used,
+                     status, unres, fd_steps):
+    """Block b of n_blk of :func:`lyapunov_block_lanes` with ``variational`` (lanes lo..hi-1,
+    :func:`_block_lanes`), on copies of its inputs and outputs (as :func:`_lyap_block_local`);
+    ``form``: the lane form of the block (:func:`_block_form`)."""
+    lo, hi = _block_lanes(b, n_blk, Y0.shape[0])
+    n = hi - lo
+    if n <= 0:
+        return
+    o = np.full((n, 1), np.nan)
+    e = np.full((n, 1), np.nan)
+    u = np.zeros(n, np.int64)
+    st = np.zeros(n, np.int64)
+    un = np.zeros(n, np.int64)
+    fs = np.zeros(n, np.int64)
+    _lyap_block_var(form, 0, n, P[lo:hi].copy(), Y0[lo:hi].copy(), S.copy(), T0[lo:hi].copy(),
+                    H[lo:hi].copy(), OMEGA[lo:hi].copy(), NPER[lo:hi].copy(), S_TAB.copy(),
+                    C_TAB.copy(), OFF[lo:hi].copy(), n_transient[lo:hi].copy(),
+                    n_steps[lo:hi].copy(), renorm_every, bound, n_ev, n_blocks, o, e, u, st, un,
+                    fs)
+    for i in range(n):
+        out[lo + i, 0] = o[i, 0]
+        err[lo + i, 0] = e[i, 0]
+        used[lo + i] = u[i]
+        status[lo + i] = st[i]
+        unres[lo + i] = un[i]
+        fd_steps[lo + i] = fs[i]
+
+
+@nb.njit(**_JIT)
+def _var_block_forms(P, n_blk):
+    """The lane form of each block of :func:`lyapunov_block_lanes` (:func:`_block_form`)."""
+    forms = np.full(n_blk, FORM_GENERAL, np.int64)
+    for b in range(n_blk):
+        lo, hi = _block_lanes(b, n_blk, P.shape[0])
+        if hi > lo:
+            forms[b] = _block_form(P, lo, hi - lo)
+    return forms
+
+
 def lyapunov_block_lanes(P, Y0, scale, T0, H, OMEGA, NPER, n_transient, n_steps, renorm_every, k,
                          bound, out, err, used, status, unres, n_ev=0, n_blocks=16,
-                         block_rows=BLOCK_ROWS, min_blocks=1):
+                         block_rows=BLOCK_ROWS, min_blocks=1, variational=False, fd_steps=None):
     """The k leading exponents of every lane (row of P, Y0; NPER[lane] steps per period: lanes
     of different grids may share a block), the lanes' rows in blocks of at most ``block_rows``
     rows (2 k + 1 per lane, at least one lane), consecutive lanes in a block, blocks in
@@ -1003,7 +1408,13 @@ def lyapunov_block_lanes(P, Y0, scale, T0, H, OMEGA, NPER, n_transient, n_steps,
     of the standard error), status[L] and unres[L] (steps at the split limit; see
     :func:`_run`). Each lane's result is bitwise that of :func:`lyapunov_single` with the same
     arguments, whatever the lanes beside it, ``block_rows`` and ``min_blocks`` (see
-    :func:`_block_count`)."""
+    :func:`_block_count`). ``variational`` (k = 1, a model with :data:`VARIATIONAL`): the
+    tangent vectors by the variational block (bitwise :func:`lyapunov_single` with
+    ``variational``), the steps each lane took by the difference rows into ``fd_steps[L]``
+    where given."""
+    if variational and not (VARIATIONAL and k == 1):
+        raise ValueError("the variational tangent needs k = 1 and a model with the tangent "
+                         "forms of its rhs (a one-form model)")
     # writable contiguous copies and int64 casts: a read-only array or another integer type
     # would compile the block kernel once more for each such caller
     i64 = np.int64
@@ -1014,6 +1425,15 @@ def lyapunov_block_lanes(P, Y0, scale, T0, H, OMEGA, NPER, n_transient, n_steps,
     args = (i64(n_blk), i64(k), P_w, Y0_w, scale_w, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
             n_transient, n_steps, renorm_every, bound, i64(n_ev), i64(n_blocks), out, err, used,
             status, unres)
+    if variational:
+        fds = np.zeros(P_w.shape[0], np.int64) if fd_steps is None else fd_steps
+        forms = _var_block_forms(P_w, i64(n_blk))
+
+        def var_block(b, n_blk, k, *rest):
+            _lyap_var_worker(b, n_blk, forms[b], *rest, fds)
+
+        run_workers(var_block, int(n_blk), args)
+        return
     paths = _block_paths(P_w, n_blk, i64(k), i64(n_ev))
 
     def block(b, *args):
@@ -1087,7 +1507,8 @@ _BLOCK_WORKERS = {FORM_GENERAL: _lyap_block_worker, FORM_QUIET: _lyap_block_work
 
 
 def lyapunov_lanes(P, Y0, scale, T0, H, OMEGA, n_per, n_transient, n_steps, renorm_every, bound,
-                   out, err, n_ev=0, n_blocks=16, unresolved=None, status=None):
+                   out, err, n_ev=0, n_blocks=16, unresolved=None, status=None,
+                   variational=False, fd_steps=None):
     """Largest exponent of every lane (row of P, Y0), the lanes in blocks in parallel
     (:func:`lyapunov_block_lanes` with k = 1, lanes ordered by their step count so that a
     block's lanes end together; bitwise :func:`lyapunov_lanes_rows`).
@@ -1098,7 +1519,9 @@ def lyapunov_lanes(P, Y0, scale, T0, H, OMEGA, n_per, n_transient, n_steps, reno
     lane; n_transient, n_steps: per-lane step counts (int arrays); n_ev and n_blocks as in
     :func:`lyapunov_single`. Fills out[L] and err[L] (the standard error; NaN for diverged
     lanes) and, where given, unresolved[L] (steps at the split limit) and status[L] (see
-    :func:`_run`).
+    :func:`_run`). ``variational``: the tangent vectors by the variational block (see
+    :func:`lyapunov_block_lanes`; bitwise :func:`lyapunov_single` with ``variational``), the
+    steps each lane took by the difference rows into ``fd_steps[L]`` where given.
     """
     L = Y0.shape[0]
     nper = np.ascontiguousarray(np.broadcast_to(np.asarray(n_per, np.int64), (L,)))
@@ -1108,12 +1531,14 @@ def lyapunov_lanes(P, Y0, scale, T0, H, OMEGA, n_per, n_transient, n_steps, reno
     used = np.zeros(L, np.int64)
     st2 = np.zeros(L, np.int64)
     un2 = np.zeros(L, np.int64)
+    fd2 = np.zeros(L, np.int64)
     if L > 0:
         p_, y_, t_, h_, w_, n_, tr_, st_ = (
             np.ascontiguousarray(np.asarray(a)[order])
             for a in (P, Y0, T0, H, OMEGA, nper, n_transient, n_steps))
         lyapunov_block_lanes(p_, y_, scale, t_, h_, w_, n_, tr_, st_, renorm_every, 1, bound, o2,
-                             e2, used, st2, un2, n_ev, n_blocks, BLOCK_ROWS, nb.get_num_threads())
+                             e2, used, st2, un2, n_ev, n_blocks, BLOCK_ROWS, nb.get_num_threads(),
+                             variational, fd2)
     ok = st2 != STATUS_DIVERGED
     out[order] = np.where(ok, o2[:, 0], np.nan)
     err[order] = np.where(ok, e2[:, 0], np.nan)
@@ -1121,3 +1546,5 @@ def lyapunov_lanes(P, Y0, scale, T0, H, OMEGA, n_per, n_transient, n_steps, reno
         unresolved[order] = un2
     if status is not None:
         status[order] = st2
+    if fd_steps is not None:
+        fd_steps[order] = fd2

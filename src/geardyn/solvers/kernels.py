@@ -36,9 +36,11 @@ import numba
 import numba.core.bytecode
 from numba.core.compiler_lock import global_compiler_lock
 
+import geardyn.core.dual  # noqa: F401 - its overloads installed before any kernel compiles
 from geardyn._cache import cache_root
 from geardyn.core.kernel_source import KernelSource
 from geardyn.core.one_form import adapters as one_form_adapters
+from geardyn.core.one_form import tangent_adapters
 from geardyn.solvers import compile_share
 
 _IMPORT_MARK = "# MODEL-IMPORT"
@@ -206,9 +208,26 @@ def _template_text(template: str, source: KernelSource | None = None,
     if template == CORE:
         return _core_text(adapters) + "\n"
     text = inspect.getsource(importlib.import_module(TEMPLATES[template]))
+    if source is not None and source.one_form is not None and _TANGENT_MARK in text:
+        text = _splice_tangent(text, tangent_adapters(source.one_form))
     if core is not None:
         return _splice(text, _core_import(core))
     return _splice_core(text, adapters)
+
+
+_TANGENT_MARK = "# TANGENT-ADAPTERS"
+#: Modules whose source a generated module's hash covers where its text imports them (numba's
+#: cache of the generated module holds code inlined from them and checks only its own file).
+_DIGEST_IMPORTS = ("geardyn.core.dual",)
+
+
+def _splice_tangent(text: str, adapters: str) -> str:
+    """The template's ``TANGENT-ADAPTERS`` line replaced by a one-form model's tangent forms
+    (:func:`geardyn.core.one_form.tangent_adapters`: the variational Lyapunov kernel's; only
+    that template has the line, so the model's other kernels do not change with them)."""
+    lines = text.splitlines()
+    out = [adapters if line.startswith(_TANGENT_MARK) else line for line in lines]
+    return "\n".join(out) + "\n"
 
 
 # The model's step machinery (:mod:`._step_core` with the model's functions: the split step,
@@ -257,6 +276,8 @@ def _source_digest(text: str, funcs: dict[str, Any]) -> str:
     h.update(numba.__version__.encode())
     paths = [sys.modules[fn.py_func.__module__].__file__ for fn in funcs.values()]
     paths += [importlib.import_module(name).__file__ for name in SHARED_MODULES]
+    paths += [importlib.import_module(name).__file__ for name in _DIGEST_IMPORTS
+              if f"from {name} import" in text]
     for path in paths:
         h.update(Path(path).read_bytes())
     return h.hexdigest()[:20]

@@ -1,0 +1,200 @@
+"""The variational tangent (dual numbers through a one-form model's rhs: the exact derivative of
+the RK4 step map) against an independent computation: scipy's DOP853 of the gear pair's state and
+variational equations (its Jacobian written by hand, every edge crossing ended and restarted, rtol
+1e-10), and against the finite-difference rows of the same kernel."""
+
+from __future__ import annotations
+
+import math
+
+import numba as nb
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+
+import geardyn
+from geardyn.solvers.kernels import kernels_for
+
+#: A period-1 orbit with contact loss (two crossings per period), and a chaotic one.
+IMPACTING = dict(zeta=0.1, kappa=0.2, Fm=0.1, Fa=0.15, Omega=1.15)
+CHAOTIC = dict(zeta=0.02, kappa=0.2, Fm=0.1, Fa=0.3, Omega=0.92)
+
+
+def _gear_pair_reference(pars, y0, v0, t_marks, b=1.0):
+    """|v| at the times ``t_marks`` of the tangent v of the gear pair's variational equation
+    v' = J(t, y) v along y' = f(t, y) from (y0, v0) at t = 0 (DOP853, rtol 1e-10; each segment
+    between edge crossings integrated with the contact region fixed, so that f is smooth on it;
+    v renormalised at each mark, the log stretches returned)."""
+    zeta, kappa, fm, fa, om = (pars[k] for k in ("zeta", "kappa", "Fm", "Fa", "Omega"))
+
+    def fun(t, u, reg):
+        x, xd, w0, w1 = u
+        g = (x - b) if reg == 1 else ((x + b) if reg == -1 else 0.0)
+        gp = 1.0 if reg else 0.0
+        k = 1.0 + kappa * math.cos(om * t)
+        return [xd, fm + fa * om * om * math.cos(om * t) - 2 * zeta * xd - k * g,
+                w1, -k * gp * w0 - 2 * zeta * w1]
+
+    def edge(sign, direction):
+        def ev(t, u, reg):
+            return u[0] - sign * b
+        ev.terminal = True
+        ev.direction = direction
+        return ev
+
+    # the edges a region can be left by, and the region entered there
+    leave = {0: [(edge(1.0, 1.0), 1), (edge(-1.0, -1.0), -1)], 1: [(edge(1.0, -1.0), 0)],
+             -1: [(edge(-1.0, 1.0), 0)]}
+    t = 0.0
+    u = np.concatenate([y0, v0 / np.linalg.norm(v0)])
+    x = u[0]
+    reg = 1 if x > b else (-1 if x < -b else 0)
+    logs = []
+    for mark in t_marks:
+        while t < mark:
+            evs = leave[reg]
+            sol = solve_ivp(fun, (t, mark), u, method="DOP853", rtol=1e-10, atol=1e-12,
+                            args=(reg,), events=[e for e, _ in evs])
+            t, u = sol.t[-1], sol.y[:, -1].copy()
+            if sol.status == 1:
+                hit = [j for j, te in enumerate(sol.t_events) if te.size]
+                reg = evs[hit[0]][1]
+        nv = np.linalg.norm(u[2:])
+        logs.append(math.log(nv))
+        u[2:] /= nv
+    return np.array(logs)
+
+
+def _kernel_exponent(model, n_per, n_tr_periods, n_periods, variational):
+    kern = kernels_for(model.kernel, "lyapunov")
+    om = model.params[model.omega_index]
+    h = 2 * math.pi / om / n_per
+    out = kern.lyapunov_single(np.ascontiguousarray(model.params), model.initial_state(),
+                               np.ones(2), 0.0, h, om, n_per, n_tr_periods * n_per,
+                               n_periods * n_per, 10, 1, 1e6, 2, 16, variational)
+    return out
+
+
+#: (parameters, transient and measured forcing periods, {steps per period: tolerance}): the
+#: kernels' distance to the reference measured 1.7e-8 and 2.9e-9 (impacting, 128 and 256 steps),
+#: 2.6e-6 and 1.4e-7 (chaotic, a short window: 256 and 512 steps), both tangents alike.
+CASES = {"impacting": (IMPACTING, 10, 40, {128: 5e-8, 256: 1e-8}),
+         "chaotic": (CHAOTIC, 2, 10, {256: 8e-6, 512: 5e-7})}
+
+
+@pytest.mark.parametrize("case", CASES)
+def test_gear_pair_exponent_against_dop853_variational_equations(case):
+    """The finite-time exponent of the same trajectory and start vector (e_1 + 0.1 (1, 1),
+    normalised, as the kernel starts it) over the same window: the variational kernel within
+    RK4's error of the DOP853 reference, as the difference rows are; the two tangents differ
+    (two methods) by far less than that error."""
+    pars, n_tr, n_m, tols = CASES[case]
+    model = geardyn.GearPair(**pars)
+    T = model.period
+    logs = _gear_pair_reference(pars, model.initial_state(), np.array([1.1, 0.1]),
+                                [n_tr * T, (n_tr + n_m) * T])
+    ref = logs[1] / (n_m * T)
+    for n_per, tol in tols.items():
+        var = _kernel_exponent(model, n_per, n_tr, n_m, True)
+        fd = _kernel_exponent(model, n_per, n_tr, n_m, False)
+        assert var[3] == 0 and fd[3] == 0  # status OK
+        assert 0 < var[5] < (n_tr + n_m) * n_per // 10  # split steps took the difference rows
+        assert fd[5] == (n_tr + n_m) * n_per
+        lam_v, lam_f = var[0][0], fd[0][0]
+        assert abs(lam_v - ref) < tol, (n_per, lam_v, ref)
+        assert abs(lam_f - ref) < tol, (n_per, lam_f, ref)
+        assert lam_v != lam_f
+        assert abs(lam_v - lam_f) < 0.1 * tol
+
+
+def _lanes(model, oms, n_per, n_tr, n_st, variational, rows=False, n_ev=None):
+    kern = kernels_for(model.kernel, "lyapunov")
+    L = oms.size
+    P = np.ascontiguousarray(model.lane_params("Omega", oms))
+    H = 2 * np.pi / oms / n_per
+    Y0 = np.ascontiguousarray(np.tile(model.initial_state(), (L, 1)))
+    out, err = np.full(L, np.nan), np.full(L, np.nan)
+    un, st, fd = (np.zeros(L, np.int64) for _ in range(3))
+    fn = kern.lyapunov_lanes_rows if rows else kern.lyapunov_lanes
+    fn(P, Y0, np.ones(model.n_states), np.zeros(L), H, oms, np.full(L, n_per, np.int64),
+       np.full(L, n_tr, np.int64), np.asarray(n_st, np.int64), 10, 1e6, out, err,
+       model.n_events if n_ev is None else n_ev, 16, un, st, variational, fd)
+    return P, Y0, H, out, err, un, st, fd
+
+
+def test_variational_lanes_are_bitwise_the_one_lane_kernel():
+    """The variational block (lanes of different lengths and grids side by side) and the
+    one-lane-at-a-time rows give each lane's exponent, error, counts and status of
+    ``lyapunov_single`` with ``variational``, bitwise."""
+    model = geardyn.GearPair(**IMPACTING)
+    oms = np.array([0.8, 1.15, 1.5, 0.92, 2.0])
+    n_per, n_tr = 64, 10 * 64
+    n_st = np.array([30, 40, 25, 35, 20]) * n_per
+    P, Y0, H, out, err, un, st, fd = _lanes(model, oms, n_per, n_tr, n_st, True)
+    rows = _lanes(model, oms, n_per, n_tr, n_st, True, rows=True)
+    kern = kernels_for(model.kernel, "lyapunov")
+    for lane in range(oms.size):
+        ex, er, _, status, unres, n_fd = kern.lyapunov_single(
+            P[lane].copy(), Y0[lane].copy(), np.ones(2), 0.0, H[lane], oms[lane], n_per, n_tr,
+            int(n_st[lane]), 10, 1, 1e6, 2, 16, True)
+        got = (out[lane], err[lane], un[lane], st[lane], fd[lane])
+        assert got == (ex[0], er[0], unres, status, n_fd), lane
+        assert tuple(a[lane] for a in rows[3:]) == got, lane
+    assert np.all(fd > 0) and np.all(np.isfinite(out))
+    # without edge location (n_ev = 0: no screen, no split) too
+    P, Y0, H, out0, err0, un0, st0, fd0 = _lanes(model, oms, n_per, n_tr, n_st, True, n_ev=0)
+    for lane in range(oms.size):
+        ex, er, _, status, unres, n_fd = kern.lyapunov_single(
+            P[lane].copy(), Y0[lane].copy(), np.ones(2), 0.0, H[lane], oms[lane], n_per, n_tr,
+            int(n_st[lane]), 10, 1, 1e6, 0, 16, True)
+        assert (out0[lane], err0[lane], un0[lane], st0[lane], fd0[lane]) == (
+            ex[0], er[0], unres, status, n_fd) == (ex[0], er[0], 0, 0, 0), lane
+    # the difference rows through the same blocks: another method, close
+    diff = _lanes(model, oms, n_per, n_tr, n_st, False)
+    np.testing.assert_allclose(out, diff[3], rtol=0, atol=1e-7)
+    assert not np.array_equal(out, diff[3])
+
+
+def test_tangent_setting_through_the_public_functions():
+    g = geardyn.GearPair(**IMPACTING)
+    run = geardyn.RunSettings(transient=50.0, steps_per_period=64)
+    var = geardyn.LyapunovSettings(duration=200.0, tangent="variational")
+    diff = var.replace(tangent="difference")
+    auto = var.replace(tangent="auto")
+    ev = geardyn.lyapunov(g, run=run, settings=var, with_error=True)
+    ed = geardyn.lyapunov(g, run=run, settings=diff, with_error=True)
+    assert ev.tangent.startswith("variational") and ed.tangent.startswith("difference")
+    assert 0 < ev.difference_steps < ed.difference_steps
+    assert abs(ev.value - ed.value) < 1e-7 and ev.value != ed.value
+    assert geardyn.lyapunov(g, run=run, settings=auto) == ev.value
+    P = g.lane_params("Omega", [1.15, 1.3])
+    lanes = geardyn.lyapunov_lanes(g, P, run=run, settings=var)
+    assert lanes[0] == ev.value
+    np.testing.assert_array_equal(geardyn.lyapunov_lanes(g, P, run=run, settings=auto), lanes)
+    assert not np.array_equal(geardyn.lyapunov_lanes(g, P, run=run, settings=diff), lanes)
+
+
+def test_tangent_setting_is_checked():
+    with pytest.raises(ValueError, match="tangent"):
+        geardyn.LyapunovSettings(tangent="exact")
+    # a model without a one form (the hand-written CATT kernel) has no variational tangent
+    dev = geardyn.CATTDevice(geardyn.PlanetaryParams.paper())
+    with pytest.raises(geardyn.errors.ParameterError, match="settings.tangent"):
+        geardyn.lyapunov(dev, settings=geardyn.LyapunovSettings(tangent="variational"))
+    with pytest.raises(geardyn.errors.ParameterError, match="settings.tangent"):
+        geardyn.lyapunov_lanes(dev, dev.lane_params("Omega", [1.0]),
+                               settings=geardyn.LyapunovSettings(tangent="variational"))
+
+
+@nb.njit(cache=True)
+def atan_rhs(t, y, p, s, c):
+    """A one-form rhs with an operation the dual numbers lack (atan2)."""
+    return (y[1], -p.k * math.atan2(y[0], 1.0) - 0.1 * y[1] + p.F * c)
+
+
+def test_a_rhs_the_duals_cannot_take_is_named():
+    m = geardyn.UserModel.from_one_form(atan_rhs, params={"k": 1.0, "F": 0.2, "Omega": 1.1},
+                                        states=("x", "v"), initial_state=(0.1, 0.0))
+    with pytest.raises(geardyn.errors.ParameterError, match="settings.tangent") as info:
+        geardyn.lyapunov(m, settings=geardyn.LyapunovSettings(duration=20.0))
+    assert "atan2" in str(info.value.__cause__)
