@@ -64,7 +64,8 @@ dev = geardyn.CATTDevice(geardyn.PlanetaryParams.paper(xi1=0.05, xi2=0.05))
 sweep = ["trajectory", "_sweep_worker", "_sweep_worker_form0", "_sweep_worker_form1",
          "_sweep_worker_form2"]
 lyap = ["lyapunov_single", "_lyap_block_worker", "_lyap_block_worker_form1",
-        "_lyap_block_worker_form2"]
+        "_lyap_block_worker_form2", "_lyap_var_worker_form0", "_lyap_var_worker_form1",
+        "_lyap_var_worker_form2"]
 out = {}
 geardyn.simulate(pair, omega=1.3, run=geardyn.RunSettings(transient=0.0, samples=2))
 out["simulate"] = census(pair, "rk4", sweep)
@@ -107,12 +108,13 @@ def test_sweep_compiles_the_lane_forms_its_lanes_take_only(census):
 
 
 def test_lyapunov_lanes_compile_the_lane_form_they_take_only(census):
-    """The Lyapunov lane blocks of FORM_QUIET lanes run that form's fused loop only (not the
-    FORM_LOAD copy, nor the row blocks, nor the one-lane kernel; before, the block kernel
-    compiled both forms' loops and the row blocks whatever its lanes)."""
+    """The Lyapunov lane blocks of FORM_QUIET lanes of the paper's device (a one-form model:
+    the variational tangent) run that form's variational fused loop only (not the other
+    forms' copies, nor the difference-row blocks, nor the one-lane kernel)."""
     c = census["lanes"]
     assert census["lanes_finite"]
-    assert c["_lyap_block_worker_form1"] == 1, c
-    for n in ("_lyap_block_worker", "_lyap_block_worker_form2", "lyapunov_single"):
+    assert c["_lyap_var_worker_form1"] == 1, c
+    for n in ("_lyap_var_worker_form0", "_lyap_var_worker_form2", "_lyap_block_worker",
+              "_lyap_block_worker_form1", "_lyap_block_worker_form2", "lyapunov_single"):
         assert c[n] == 0, (n, c)
     assert FORM_LOAD != FORM_QUIET != FORM_GENERAL

@@ -1286,7 +1286,7 @@ def _lyap_var_form2(first, nl, n_ev, max_total, due, renorm, bound, P, OMEGA, H,
                   IS, PT, lanes, books, out, err, used, status, scratch, fd)
 
 
-@nb.njit(**_JIT)
+@nb.njit(inline="always", **_JIT)
 def _lyap_block_var(form, first, nl, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
                     n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err, used,
                     status, unres, fd_steps):
@@ -1355,13 +1355,14 @@ def _lyap_block_var(form, first, nl, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB,
             status[lane] = STATUS_SPLIT_LIMIT
 
 
-@nb.njit(nogil=True, **_JIT)
+@nb.njit(inline="always", **_JIT)
 def _lyap_var_worker(b, n_blk, form, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
                      n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err, used,
                      status, unres, fd_steps):
     """Block b of n_blk of :func:`lyapunov_block_lanes` with ``variational`` (lanes lo..hi-1,
     :func:`_block_lanes`), on copies of its inputs and outputs (as :func:`_lyap_block_local`);
-    ``form``: the lane form of the block (:func:`_block_form`)."""
+    ``form``: the lane form of the block (:func:`_block_form`), a constant of each worker
+    below, so that a worker compiles its form's fused loop alone."""
     lo, hi = _block_lanes(b, n_blk, Y0.shape[0])
     n = hi - lo
     if n <= 0:
@@ -1384,6 +1385,42 @@ def _lyap_var_worker(b, n_blk, form, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB,
         status[lo + i] = st[i]
         unres[lo + i] = un[i]
         fd_steps[lo + i] = fs[i]
+
+
+@nb.njit(nogil=True, **_JIT)
+def _lyap_var_worker_form0(b, n_blk, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
+                           n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err,
+                           used, status, unres, fd_steps):
+    """:func:`_lyap_var_worker` in the lane form FORM_GENERAL."""
+    _lyap_var_worker(b, n_blk, FORM_GENERAL, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
+                     n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err, used,
+                     status, unres, fd_steps)
+
+
+@nb.njit(nogil=True, **_JIT)
+def _lyap_var_worker_form1(b, n_blk, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
+                           n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err,
+                           used, status, unres, fd_steps):
+    """:func:`_lyap_var_worker` in the lane form FORM_QUIET."""
+    _lyap_var_worker(b, n_blk, FORM_QUIET, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
+                     n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err, used,
+                     status, unres, fd_steps)
+
+
+@nb.njit(nogil=True, **_JIT)
+def _lyap_var_worker_form2(b, n_blk, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
+                           n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err,
+                           used, status, unres, fd_steps):
+    """:func:`_lyap_var_worker` in the lane form FORM_LOAD."""
+    _lyap_var_worker(b, n_blk, FORM_LOAD, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
+                     n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err, used,
+                     status, unres, fd_steps)
+
+
+#: The variational block workers by the lane form of their block, each compiled on its first
+#: call.
+_VAR_WORKERS = {FORM_GENERAL: _lyap_var_worker_form0, FORM_QUIET: _lyap_var_worker_form1,
+                FORM_LOAD: _lyap_var_worker_form2}
 
 
 @nb.njit(**_JIT)
@@ -1430,7 +1467,7 @@ def lyapunov_block_lanes(P, Y0, scale, T0, H, OMEGA, NPER, n_transient, n_steps,
         forms = _var_block_forms(P_w, i64(n_blk))
 
         def var_block(b, n_blk, k, *rest):
-            _lyap_var_worker(b, n_blk, forms[b], *rest, fds)
+            _VAR_WORKERS[int(forms[b])](b, n_blk, *rest, fds)
 
         run_workers(var_block, int(n_blk), args)
         return
