@@ -78,8 +78,8 @@ def _jv4(t, y, v, p, s, c):
 
 
 def _coef(model):
-    names = model.kernel.one_form.coefficients
-    return coefficient_type(names)(*(float(v) for v in model.params))
+    form = model.kernel.one_form
+    return coefficient_type(form.coefficients, form.quiet)(*(float(v) for v in model.params))
 
 
 @pytest.mark.parametrize("x", [1.7, 0.3, -2.2])
@@ -107,7 +107,7 @@ def _catt(**load):
                          ids=["quiet", "load"])
 def test_reduced_catt_jv_against_central_differences(load):
     m = _catt(**load)
-    names = m.kernel.one_form.coefficients
+    names, quiet = m.kernel.one_form.coefficients, m.kernel.one_form.quiet
     p = _coef(m)
     assert (p.f_c1 != 0.0) == bool(load)
     b_sq = p.b_sq
@@ -117,14 +117,16 @@ def test_reduced_catt_jv_against_central_differences(load):
     rng = np.random.default_rng(4)
     for xs, xp in ((1.8 * b_sq, 1.5 * b_pq), (0.4 * b_sq, -2.5 * b_pq), (-3.0 * b_sq, 0.1 * b_pq)):
         y = np.array([xs, 0.2, xp, -0.1])
-        f0 = np.array(call_tuple(catt_reduced_rhs, names, t, y, m.params, s, c))
+        f0 = np.array(call_tuple(catt_reduced_rhs, names, t, y, m.params, s, c, quiet))
         J = np.empty((4, 4))
         for q in range(4):
             h = 1e-6 * max(1.0, abs(y[q]))
             e = np.zeros(4)
             e[q] = h
-            fp = np.array(call_tuple(catt_reduced_rhs, names, t, y + e, m.params, s, c))
-            fm = np.array(call_tuple(catt_reduced_rhs, names, t, y - e, m.params, s, c))
+            fp = np.array(call_tuple(catt_reduced_rhs, names, t, y + e, m.params, s, c,
+                                    quiet))
+            fm = np.array(call_tuple(catt_reduced_rhs, names, t, y - e, m.params, s, c,
+                                    quiet))
             J[:, q] = (fp - fm) / (2 * h)
         for v in (*np.eye(4), rng.standard_normal(4)):
             f, jv = _jv4(t, tuple(y), tuple(v), p, s, c)

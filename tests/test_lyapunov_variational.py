@@ -177,8 +177,9 @@ def test_tangent_setting_through_the_public_functions():
 def test_tangent_setting_is_checked():
     with pytest.raises(ValueError, match="tangent"):
         geardyn.LyapunovSettings(tangent="exact")
-    # a model without a one form (the hand-written CATT kernel) has no variational tangent
-    dev = geardyn.CATTDevice(geardyn.PlanetaryParams.paper())
+    # a model without a one form (the general N-set CATT kernel) has no variational tangent
+    dev = geardyn.CATTDevice(geardyn.PlanetaryParams.paper(), reduced=False)
+    assert dev.kernel.one_form is None
     with pytest.raises(geardyn.errors.ParameterError, match="settings.tangent"):
         geardyn.lyapunov(dev, settings=geardyn.LyapunovSettings(tangent="variational"))
     with pytest.raises(geardyn.errors.ParameterError, match="settings.tangent"):
