@@ -996,12 +996,13 @@ def _block_form(P, first, nl):
 
 
 @nb.njit(inline="always", **_JIT)
-def _lyap_block_fused(form, first, nl, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
-                      n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err, used,
-                      status, unres):
-    """:func:`_lyap_block` with k = 1 in the fused loop of lane form ``form`` (FORM_QUIET or
-    FORM_LOAD, a constant: one form compiled per caller; nl <= BLOCK lanes): the same
-    results, bitwise."""
+def _fused_block_start(first, nl, P, Y0, S, T0, H, NPER, OFF, n_transient, n_steps,
+                       renorm_every, n_blocks, out, err, used, status):
+    """The start of a fused Lyapunov block of k = 1 (:func:`_lyap_block_fused`,
+    :func:`_lyap_block_var`; nl <= BLOCK lanes): the inverse scale IS, the state and tangent
+    columns (ZT and its rows Z0, Z1), the lanes' coefficients, clocks, phase-table indices and
+    phases, the activity and flag columns, the lanes' books (:func:`_lanes_init`), the
+    renormalisation interval and the first due step."""
     ns = Y0.shape[1]
     IS = np.empty(ns)
     for q in range(ns):
@@ -1022,12 +1023,6 @@ def _lyap_block_fused(form, first, nl, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TA
     ACT = np.zeros(BLOCK, np.bool_)
     ACTR = np.zeros(3 * nl, np.bool_)  # (written by _lane_books; unused here)
     FLAG = np.zeros(BLOCK)
-    EL = np.zeros(BLOCK)
-    UNRR = np.zeros(3 * BLOCK, np.int64)
-    R6 = np.zeros((6, ns * BLOCK))
-    ROWS = (R6[0], R6[1], R6[2], R6[3], R6[4], R6[5])
-    E9 = np.zeros((9, max(n_ev, 1) * BLOCK))
-    EV = (E9[0], E9[1], E9[2], E9[3], E9[4], E9[5], E9[6], E9[7], E9[8])
     IST, ENDS, BLK, ACC, Zl, Cl, logs, max_total = _lanes_init(first, nl, 1, Y0, NPER,
                                                                 n_transient, n_steps,
                                                                 renorm_every, n_blocks, out,
@@ -1039,6 +1034,28 @@ def _lyap_block_fused(form, first, nl, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TA
     for l in range(nl):
         if ACT[l]:
             due = min(due, IST[l, _DUE])
+    return (IS, ZT, Z0, Z1, PT, T0L, HL, HHL, H6L, IDX, NPL, ENDL, PH, ACT, ACTR, FLAG, IST, ENDS,
+            BLK, ACC, Zl, Cl, logs, max_total, renorm, due)
+
+
+@nb.njit(inline="always", **_JIT)
+def _lyap_block_fused(form, first, nl, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
+                      n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err, used,
+                      status, unres):
+    """:func:`_lyap_block` with k = 1 in the fused loop of lane form ``form`` (FORM_QUIET or
+    FORM_LOAD, a constant: one form compiled per caller; nl <= BLOCK lanes): the same
+    results, bitwise."""
+    ns = Y0.shape[1]
+    (IS, ZT, Z0, Z1, PT, T0L, HL, HHL, H6L, IDX, NPL, ENDL, PH, ACT, ACTR, FLAG, IST, ENDS, BLK,
+     ACC, Zl, Cl, logs, max_total, renorm, due) = _fused_block_start(
+        first, nl, P, Y0, S, T0, H, NPER, OFF, n_transient, n_steps, renorm_every, n_blocks, out,
+        err, used, status)
+    EL = np.zeros(BLOCK)
+    UNRR = np.zeros(3 * BLOCK, np.int64)
+    R6 = np.zeros((6, ns * BLOCK))
+    ROWS = (R6[0], R6[1], R6[2], R6[3], R6[4], R6[5])
+    E9 = np.zeros((9, max(n_ev, 1) * BLOCK))
+    EV = (E9[0], E9[1], E9[2], E9[3], E9[4], E9[5], E9[6], E9[7], E9[8])
     ne = max(n_ev, 1)
     scratch = (S_TAB, C_TAB, np.zeros(ns), np.zeros(ns), np.ones(ne, np.int64), np.zeros(ne),
                np.zeros(ne, np.int64), np.zeros((9, ns)), np.zeros((GBUF_ROWS, ne)))
@@ -1294,42 +1311,16 @@ def _lyap_block_var(form, first, nl, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB,
     BLOCK lanes): per lane what :func:`_run` with ``variational`` computes, bitwise; the
     lanes' steps by the difference rows into fd_steps[lane]."""
     ns = Y0.shape[1]
-    IS = np.empty(ns)
-    for q in range(ns):
-        IS[q] = 1.0 / S[q]
-    ZT = np.zeros((2, ns, BLOCK))
-    Z0 = ZT[0].reshape(ns * BLOCK)
-    Z1 = ZT[1].reshape(ns * BLOCK)
-    PT = np.zeros((P.shape[1], BLOCK))
-    T0L = np.zeros(BLOCK)
-    HL = np.zeros(BLOCK)
-    HHL = np.zeros(BLOCK)
-    H6L = np.zeros(BLOCK)
-    IDX = np.zeros(BLOCK, np.int64)
-    NPL = np.ones(BLOCK, np.int64)
-    ENDL = np.zeros(BLOCK, np.int64)
-    PH6 = np.zeros((6, BLOCK))
-    PH = (PH6[0], PH6[1], PH6[2], PH6[3], PH6[4], PH6[5])
-    ACT = np.zeros(BLOCK, np.bool_)
-    ACTR = np.zeros(3 * nl, np.bool_)  # (written by _lane_books; unused here)
-    FLAG = np.zeros(BLOCK)
+    (IS, ZT, Z0, Z1, PT, T0L, HL, HHL, H6L, IDX, NPL, ENDL, PH, ACT, ACTR, FLAG, IST, ENDS, BLK,
+     ACC, Zl, Cl, logs, max_total, renorm, due) = _fused_block_start(
+        first, nl, P, Y0, S, T0, H, NPER, OFF, n_transient, n_steps, renorm_every, n_blocks, out,
+        err, used, status)
     ne = max(n_ev, 1)
     UNRR = np.zeros(BLOCK, np.int64)
     FDL = np.zeros(BLOCK, np.int64)
-    IST, ENDS, BLK, ACC, Zl, Cl, logs, max_total = _lanes_init(first, nl, 1, Y0, NPER,
-                                                                n_transient, n_steps,
-                                                                renorm_every, n_blocks, out,
-                                                                err, used, status, ZT, ACT)
-    for l in range(nl):
-        _set_column(l, first + l, P, T0, H, NPER, OFF, PT, T0L, HL, HHL, H6L, NPL, IDX, ENDL)
     # the graze flags of every switching function of the model (screened even where n_ev = 0,
     # then ignored: no branch in the lane loop)
     GR = np.zeros(max(len(_events_l(0.0, _t_load(Z0, 0), PT, 0, 0.0, 1.0)), 1) * BLOCK)
-    renorm = max(renorm_every, 1)
-    due = max_total
-    for l in range(nl):
-        if ACT[l]:
-            due = min(due, IST[l, _DUE])
     fd = (np.zeros((2, ns)), np.zeros((3, ns)), np.zeros(2), np.zeros((4, 3, ns)),
           np.zeros((3, ns)), np.zeros((3, ns)), np.ones((3, ne), np.int64), np.zeros((3, ne)),
           np.zeros((3, ne)), np.zeros((9, ns)), np.zeros((GBUF_ROWS, ne)),
