@@ -187,6 +187,24 @@ def test_tangent_setting_is_checked():
                                settings=geardyn.LyapunovSettings(tangent="variational"))
 
 
+def test_the_tangent_follows_the_kernels_declared_one_form():
+    """``lyapunov_variational`` reads ``model.kernel.one_form`` (declared by every
+    KernelSource): a kernel that does not declare it is an error, not a silent fall back to
+    the difference rows."""
+    from types import SimpleNamespace
+
+    from geardyn.analysis.lyapunov import lyapunov_variational
+
+    pair = geardyn.GearPair(**IMPACTING)
+    dev = geardyn.CATTDevice(geardyn.PlanetaryParams.paper(), reduced=False)
+    diff = geardyn.LyapunovSettings(tangent="difference")
+    assert pair.kernel.one_form is not None and lyapunov_variational(pair)
+    assert not lyapunov_variational(pair, diff)
+    assert dev.kernel.one_form is None and not lyapunov_variational(dev)
+    with pytest.raises(AttributeError, match="one_form"):
+        lyapunov_variational(SimpleNamespace(kernel=SimpleNamespace(rhs=None)))
+
+
 @nb.njit(cache=True)
 def atan_rhs(t, y, p, s, c):
     """A one-form rhs with an operation the dual numbers lack (atan2)."""

@@ -122,7 +122,7 @@ def lyapunov_variational(model: Model, settings: LyapunovSettings | None = None)
     :class:`~geardyn.errors.ParameterError` naming ``settings.tangent`` where it asks for
     ``"variational"`` of a model without a one form."""
     tangent = (settings or LyapunovSettings()).tangent
-    has = getattr(model.kernel, "one_form", None) is not None
+    has = model.kernel.one_form is not None
     if tangent == "variational" and not has:
         raise ParameterError("settings.tangent", tangent,
                              f"{type(model).__name__} is not written in the one form (no rhs "
