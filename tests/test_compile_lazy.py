@@ -77,6 +77,12 @@ lam = geardyn.lyapunov_lanes(dev, dev.lane_params("Omega", np.linspace(0.8, 1.6,
                              settings=geardyn.LyapunovSettings(duration=10.0))
 out["lanes"] = census(dev, "lyapunov", lyap)
 out["lanes_finite"] = bool(np.all(np.isfinite(lam)))
+gen = geardyn.CATTDevice(geardyn.PlanetaryParams.paper(xi1=0.05, xi2=0.05), reduced=False)
+lam = geardyn.lyapunov_lanes(gen, gen.lane_params("Omega", np.linspace(0.8, 1.6, 4)),
+                             run=geardyn.RunSettings(transient=5.0),
+                             settings=geardyn.LyapunovSettings(duration=10.0))
+out["general_lanes"] = census(gen, "lyapunov", lyap)
+out["general_finite"] = bool(np.all(np.isfinite(lam)))
 print(json.dumps(out))
 """
 
@@ -118,3 +124,20 @@ def test_lyapunov_lanes_compile_the_lane_form_they_take_only(census):
               "_lyap_block_worker_form1", "_lyap_block_worker_form2", "lyapunov_single"):
         assert c[n] == 0, (n, c)
     assert FORM_LOAD != FORM_QUIET != FORM_GENERAL
+
+
+def test_lyapunov_lanes_of_a_model_without_a_one_form_compile_its_lane_form_only(census):
+    """The Lyapunov lanes of a model without a one form (the general N-set CATT kernel: its
+    lanes take FORM_GENERAL, no fused loop, no variational tangent) run the difference-row
+    block worker of FORM_GENERAL only: not the fused loops of the other forms, not the
+    variational workers, not the one-lane kernel."""
+    model = geardyn.CATTDevice(geardyn.PlanetaryParams.paper(xi1=0.05, xi2=0.05), reduced=False)
+    assert model.kernel.one_form is None
+    assert _lane_forms(model, model.lane_params("Omega", np.linspace(0.8, 1.6, 4))) == {
+        FORM_GENERAL}
+    c = census["general_lanes"]
+    assert census["general_finite"]
+    assert c["_lyap_block_worker"] == 1, c
+    for n in ("_lyap_block_worker_form1", "_lyap_block_worker_form2", "_lyap_var_worker_form0",
+              "_lyap_var_worker_form1", "_lyap_var_worker_form2", "lyapunov_single"):
+        assert c[n] == 0, (n, c)
