@@ -93,6 +93,57 @@ def test_a_valid_parameter_changes_the_model_as_the_study_file_would(state):
     assert state.current_value("zeta") == 0.08 and state.current_value("Fa") == 0.1
 
 
+#: A new value of each study kind's first main parameter: the control's text and its SI value.
+_FIRST_CONTROL = {"xi1": ("0.07", 0.07), "zeta": ("0.07", 0.07), "torque": ("25", 25.0),
+                  "sun_backlash": ("12 um", 12e-6), "backlash": ("25 um", 25e-6)}
+
+
+def _kind_study(kind: str):
+    from geardyn.io.study_models import STUDY_MODELS
+
+    example = STUDY_MODELS[kind].example
+    return load_study(example) if "\n" in example else builtin_study(example)
+
+
+def _explore(study) -> ExplorerState:
+    window = Window(0.9, 1.1, 3) if study.sweep is None else None
+    return ExplorerState(study, "x.toml", window=window, describe_error=format_error)
+
+
+@pytest.mark.parametrize("kind", ["catt", "gear_pair", "spur_pair", "planetary", "train"])
+def test_every_study_kind_takes_a_main_parameter_as_with_params_does(kind):
+    """A main parameter's control rebuilds the model as ``with_params`` of that input does, for
+    every registered study kind (the kind's declarations say where the value goes in
+    ``[params]``: by name, or as a change of the paper's device)."""
+    from geardyn.io.study_models import STUDY_MODELS
+    from geardyn.study import build_model
+
+    assert set(STUDY_MODELS) == {"catt", "gear_pair", "spur_pair", "planetary", "train"}
+    study = _kind_study(kind)
+    state = _explore(study)
+    name = state.main_params()[0]
+    text, value = _FIRST_CONTROL[name]
+    assert state.set_override(name, text) is None
+    base = build_model(study)
+    expected = base.with_params(**{name: value}).params
+    assert not np.array_equal(base.params, expected)
+    np.testing.assert_array_equal(state.model.params, expected)
+
+
+def test_the_full_device_parameters_take_a_main_parameter():
+    """A ``catt`` study whose ``[params]`` is the device's PlanetaryParams in full (not
+    ``base = "paper"``): a control changes that field."""
+    from geardyn.io.toml import Study
+
+    doc = builtin_study("paper_fig3").to_toml_dict()
+    doc["params"] = geardyn.PlanetaryParams.paper().model_dump(exclude_none=True)
+    study = Study.model_validate(doc)
+    state = _explore(study)
+    assert state.set_override("xi1", "0.07") is None
+    expected = geardyn.CATTDevice(geardyn.PlanetaryParams.paper(xi1=0.07))
+    np.testing.assert_array_equal(state.model.params, expected.params)
+
+
 def test_device_parameters_take_paper_names_and_unit_strings():
     state = ExplorerState(builtin_study("paper_fig3"), "paper_fig3",
                           describe_error=format_error)

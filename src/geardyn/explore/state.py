@@ -33,12 +33,9 @@ from geardyn.gears.faults import FAULT_KINDS
 from geardyn.io.study_models import STUDY_MODELS, StudyModel, study_model
 from geardyn.io.toml import (
     FaultTable,
-    GearPairParams,
     PaperBase,
     PlanetaryGearSetParams,
-    SpurPairParams,
     Study,
-    TrainModelParams,
 )
 from geardyn.models.planetary_stiffness import COAST_FLANKS, STIFFNESS_METHODS
 
@@ -423,12 +420,11 @@ class ExplorerState:
                 _set_path(doc, path, value)
         changes = {k: v for k, v in overrides.items() if k not in geometry}
         params = self.study.params
-        if isinstance(params, PaperBase):
-            doc["params"]["changes"] = {**doc["params"].get("changes", {}), **changes}
-        elif isinstance(params, GearPairParams | PlanetaryGearSetParams | SpurPairParams
-                        | TrainModelParams):
+        if not self.model_kind.paper_device:  # [params] names the kind's declared inputs
             doc["params"].update(changes)
-        else:  # full PlanetaryParams
+        elif isinstance(params, PaperBase):  # base = "paper", changes by the paper's names
+            doc["params"]["changes"] = {**doc["params"].get("changes", {}), **changes}
+        else:  # the device's PlanetaryParams in full
             doc["params"] = params.replace(**changes).model_dump(exclude_none=True)
         return Study.model_validate(doc)
 
