@@ -201,6 +201,17 @@ def test_newton_failures_are_reported_not_raised():
     assert bad.status == OrbitStatus.DIVERGED and "diverged" in bad.message
 
 
+def test_a_shooting_evaluation_says_whether_it_ended_cleanly():
+    """``ShootingEval.ok``: the integration's status is OK; a start past the state bound
+    (|x| > 2 at the start) diverges and is not ok, with the status saying so."""
+    m = geardyn.GearPair(zeta=0.05, Fm=0.1, Fa=0.05).with_omega(0.9)
+    ev = shooting_problem(m).evaluate(np.array([1.0, 0.1]), jacobian=False)
+    assert ev.ok and ev.status == geardyn.Status.OK
+    far = shooting_problem(m, run=geardyn.RunSettings(bound=2.0)).evaluate(
+        np.array([3.0, 2.0]), jacobian=False)
+    assert not far.ok and far.status == geardyn.Status.DIVERGED
+
+
 def test_shooting_problem_gives_residual_and_jacobian_for_continuation():
     m = geardyn.GearPair(zeta=0.05, Fm=0.1, Fa=0.05).with_omega(0.9)
     prob = shooting_problem(m)

@@ -69,7 +69,6 @@ from geardyn.analysis.orbits import (
 from geardyn.core.model import Model
 from geardyn.core.plan import default_steps_per_period
 from geardyn.core.settings import ContinuationSettings, RunSettings, resolve_settings
-from geardyn.core.status import Status
 
 #: Most corrector iterations per step.
 CORRECTOR_MAX_ITER = 12
@@ -300,7 +299,7 @@ class _Tracer:
         x = self.x_of(z)
         up = self.problem_at(p + h).evaluate(x, jacobian=False)
         dn = self.problem_at(p - h).evaluate(x, jacobian=False)
-        if up.status != Status.OK or dn.status != Status.OK:
+        if not (up.ok and dn.ok):
             raise FloatingPointError("the period map diverged in the parameter difference")
         gp = (up.residual - dn.residual) / (2.0 * h)
         s = self.scale
@@ -325,7 +324,7 @@ class _Tracer:
             try:
                 r, ev, pr = self.evaluate(z, jacobian=fresh)
                 self.iterates.append((z, ev.crossings))
-                if ev.status != Status.OK:
+                if not ev.ok:
                     return _Failure(BranchStatus.DIVERGED, f"the period map diverged at "
                                                            f"{self.param}={self.p_of(z):.8g}")
                 done = self.converged(r, z)

@@ -180,7 +180,7 @@ class CurveSystem:
 
     def _eval(self, pr: ShootingProblem, u: np.ndarray, jacobian: bool = True) -> ShootingEval:
         ev = pr.evaluate(u, jacobian=jacobian)
-        if ev.status != Status.OK or not np.all(np.isfinite(ev.end)) or (
+        if not ev.ok or not np.all(np.isfinite(ev.end)) or (
                 jacobian and not np.all(np.isfinite(ev.monodromy))):
             raise FloatingPointError(f"the period map diverged ({Status(int(ev.status)).message})")
         return ev

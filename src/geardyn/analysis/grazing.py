@@ -65,7 +65,6 @@ from geardyn.analysis.orbits import (
 from geardyn.core.plan import default_steps_per_period
 from geardyn.core.results import finish
 from geardyn.core.settings import RunSettings
-from geardyn.core.status import Status
 from geardyn.solvers.kernels import kernels_for
 
 if TYPE_CHECKING:
@@ -233,7 +232,7 @@ class GrazingProblem:
                ) -> tuple[np.ndarray, float, float, ShootingEval]:
         pr = self.problem_at(X, Y)
         ev = pr.evaluate(x0, jacobian=jacobian, stride=1)
-        if ev.status != Status.OK:
+        if not ev.ok:
             raise FloatingPointError(f"the integration diverged at {self.x}={X:.8g}, "
                                      f"{self.y}={Y:.8g}")
         h, t_g = self.extremum(pr, ev.states)

@@ -130,6 +130,11 @@ class ShootingEval:
     unresolved: int
 
     @property
+    def ok(self) -> bool:
+        """Whether the integration ended cleanly (:attr:`~geardyn.Status.OK`)."""
+        return self.status == Status.OK
+
+    @property
     def residual(self) -> np.ndarray:
         return self.end - self.x
 
@@ -331,7 +336,7 @@ def newton_shooting(problem: ShootingProblem, x0: np.ndarray, tol: float = NEWTO
                             msg)
 
     for it in range(max_iter + 1):
-        if ev.status != Status.OK:
+        if not ev.ok:
             return done(OrbitStatus.DIVERGED, f"the period map diverged from x={_fmt(x)} "
                                               f"(iteration {it})")
         r = _norm(ev.residual, s)
@@ -353,7 +358,7 @@ def newton_shooting(problem: ShootingProblem, x0: np.ndarray, tol: float = NEWTO
         lam = 1.0
         while True:
             trial = problem.evaluate(x + lam * dx)
-            if trial.status == Status.OK and _norm(trial.residual, s) < r:
+            if trial.ok and _norm(trial.residual, s) < r:
                 x, ev = trial.x, trial
                 break
             lam *= 0.5
@@ -697,7 +702,7 @@ def build_orbit(problem: ShootingProblem, res: NewtonResult) -> PeriodicOrbit:
     else:
         ev = res.evaluation
     n = m.n_states
-    if ev.status == Status.OK:
+    if ev.ok:
         mu, V = np.linalg.eig(ev.monodromy)
         order = np.argsort(-np.abs(mu), kind="stable")
         mu, V = mu[order], V[:, order]
