@@ -12,7 +12,8 @@ import numpy as np
 import pytest
 
 import geardyn
-from geardyn.analysis.periodicity import DEFAULT_TOL, classify_period
+from geardyn.analysis.periodicity import classify_period
+from geardyn.core.settings import DEFAULT_TOL
 from geardyn.solvers.reference import reference_solution
 
 PAIR = dict(zeta=0.05, kappa=0.2, Fm=0.1, Fa=0.2)

@@ -14,7 +14,8 @@ from pydantic import ValidationError
 
 from geardyn import CATTDevice, GearPair, PlanetaryParams, PlanetOverride, StudyError
 from geardyn.cli.errors import format_error
-from geardyn.io.netcdf import load_dataset, netcdf_attrs, save_dataset
+from geardyn.files import netcdf_attrs
+from geardyn.io.netcdf import load_dataset, save_dataset
 from geardyn.io.toml import (
     GearPairParams,
     PaperBase,

@@ -8,8 +8,9 @@ import numpy as np
 import pytest
 
 import geardyn
-from geardyn.analysis.periodicity import classify_period, common_section
+from geardyn.analysis.periodicity import classify_period
 from geardyn.core.plan import LaneSettings
+from geardyn.core.section import common_section
 from geardyn.core.settings import RunSettings
 from geardyn.solvers.ensemble import run_lanes
 

@@ -186,6 +186,14 @@ MOVED = [
     ("geardyn.analysis.lyapunov", "DEFAULT_RENORM_EVERY",
      "geardyn.core.settings:LYAPUNOV_RENORM_EVERY"),
     ("geardyn.analysis.lyapunov", "DEFAULT_BLOCKS", "geardyn.core.settings:LYAPUNOV_BLOCKS"),
+    ("geardyn.analysis.periodicity", "DEFAULT_MAX_PERIOD", "geardyn.core.settings"),
+    ("geardyn.analysis.periodicity", "DEFAULT_TOL", "geardyn.core.settings"),
+    ("geardyn.analysis.periodicity", "MAX_COMMON_PERIODS", "geardyn.core.section"),
+    ("geardyn.analysis.periodicity", "common_section", "geardyn.core.section"),
+    ("geardyn.io.netcdf", "netcdf_attrs", "geardyn.files"),
+    *(("geardyn.reproduction.motion", name, "geardyn.analysis.motion") for name in (
+        "CHAOTIC", "LYAPUNOV_FLOOR", "LYAPUNOV_Z", "NONPERIODIC", "QUASI_PERIODIC", "UNBOUNDED",
+        "UNRESOLVED", "period_label")),
 ]
 
 _OLD_HOMES = """

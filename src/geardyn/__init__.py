@@ -26,12 +26,13 @@ from geardyn.analysis.map2d import map2d
 from geardyn.analysis.motion import motion_classes
 from geardyn.analysis.orbits import PeriodicOrbit, periodic_orbit
 from geardyn.analysis.orders import order_spectrum, waterfall
-from geardyn.analysis.periodicity import classify_period, common_section
+from geardyn.analysis.periodicity import classify_period
 from geardyn.analysis.runup import RunupSettings, runup
 from geardyn.analysis.sensor import planetary_sensor_signal, sensor_signal, sensor_spectrum
 from geardyn.analysis.spectrum import amplitude_spectrum, label_peaks
 from geardyn.core.model import Model
 from geardyn.core.plan import default_steps_per_period
+from geardyn.core.section import common_section
 from geardyn.core.settings import (
     ContinuationSettings,
     LyapunovSettings,

@@ -94,7 +94,7 @@ def bifurcation(
     samples
         Poincare points recorded after the transient: one per forcing period, or per common
         period of the excitations when the model has a second one at a commensurate frequency
-        (``section_periods``; see :func:`geardyn.analysis.periodicity.common_section`).
+        (``section_periods``; see :func:`geardyn.core.section.common_section`).
     continuation
         ``None``: every point starts from ``y0``; ``"up"``/``"down"``: each point starts from the
         final state of the previous one in ascending/descending order (shows hysteresis; see

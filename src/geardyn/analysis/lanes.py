@@ -10,8 +10,9 @@ from __future__ import annotations
 import numpy as np
 
 from geardyn.analysis.contact import REGIMES, UNBOUNDED_LABEL, contact_regime
-from geardyn.analysis.periodicity import DEFAULT_MAX_PERIOD, DEFAULT_TOL, classify_period
+from geardyn.analysis.periodicity import classify_period
 from geardyn.core.model import Model
+from geardyn.core.settings import DEFAULT_MAX_PERIOD, DEFAULT_TOL
 from geardyn.solvers.ensemble import LaneResults
 
 __all__ = ["CONTACT_LABELS", "has_mesh_forces", "lane_periods", "lane_variables", "variable_attrs",

@@ -26,11 +26,16 @@ from __future__ import annotations
 
 import numpy as np
 
-from geardyn.core.section import MAX_COMMON_PERIODS, common_section
-from geardyn.core.settings import DEFAULT_MAX_PERIOD, DEFAULT_TOL
+from geardyn.core.moved import moved
+from geardyn.core.settings import DEFAULT_MAX_PERIOD as _MAX_PERIOD
+from geardyn.core.settings import DEFAULT_TOL as _TOL
 
-__all__ = ["APERIODIC", "DEFAULT_MAX_PERIOD", "DEFAULT_TOL", "MAX_COMMON_PERIODS", "UNBOUNDED",
-           "classify_period", "common_section", "distinct_points"]
+__all__ = ["APERIODIC", "UNBOUNDED", "classify_period", "distinct_points"]
+
+__getattr__ = moved(__name__, {"DEFAULT_MAX_PERIOD": "geardyn.core.settings",
+                               "DEFAULT_TOL": "geardyn.core.settings",
+                               "MAX_COMMON_PERIODS": "geardyn.core.section",
+                               "common_section": "geardyn.core.section"})
 
 UNBOUNDED = -1
 APERIODIC = 0
@@ -39,8 +44,8 @@ APERIODIC = 0
 _BATCH = 4096
 
 
-def classify_period(samples: np.ndarray, max_period: int = DEFAULT_MAX_PERIOD,
-                    tol: float = DEFAULT_TOL) -> np.ndarray:
+def classify_period(samples: np.ndarray, max_period: int = _MAX_PERIOD,
+                    tol: float = _TOL) -> np.ndarray:
     """Period of each lane of ``samples`` (lanes, samples, states): k >= 1, 0 or -1 (see module)."""
     x = np.asarray(samples, dtype=float)
     if x.ndim == 2:
@@ -65,7 +70,7 @@ def classify_period(samples: np.ndarray, max_period: int = DEFAULT_MAX_PERIOD,
     return out
 
 
-def distinct_points(samples: np.ndarray, tol: float = DEFAULT_TOL) -> int:
+def distinct_points(samples: np.ndarray, tol: float = _TOL) -> int:
     """Number of distinct points among the samples of one lane (samples, states)."""
     x = np.asarray(samples, dtype=float)
     scale = tol * max(1.0, float(np.max(np.abs(x))))

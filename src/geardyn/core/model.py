@@ -386,7 +386,7 @@ class Model:
         lane of ``P``, shape ``(lanes, m)``; NaN where one does not act. None here; a model with
         a second excitation (the CATT device's load fluctuation Lambda) overrides it, so that
         sweeps can sample at the common period (see
-        :func:`geardyn.analysis.periodicity.common_section`)."""
+        :func:`geardyn.core.section.common_section`)."""
         return np.zeros((np.atleast_2d(P).shape[0], 0))
 
     def fastest_natural_frequency(self, P: np.ndarray | None = None) -> np.ndarray:

@@ -14,18 +14,22 @@ from pathlib import Path
 
 import xarray as xr
 
-from geardyn.files import atomic_replace, netcdf_attrs
+from geardyn.core.moved import moved
+from geardyn.files import atomic_replace
+from geardyn.files import netcdf_attrs as _netcdf_attrs
 
-__all__ = ["load_dataset", "netcdf_attrs", "save_dataset"]
+__all__ = ["load_dataset", "save_dataset"]
+
+__getattr__ = moved(__name__, {"netcdf_attrs": "geardyn.files"})
 
 ENGINE = "h5netcdf"
 
 
 def _converted(ds: xr.Dataset) -> xr.Dataset:
     out = ds.copy(deep=False)
-    out.attrs = netcdf_attrs(ds.attrs)
+    out.attrs = _netcdf_attrs(ds.attrs)
     for name in out.variables:
-        out[name].attrs = netcdf_attrs(ds[name].attrs)
+        out[name].attrs = _netcdf_attrs(ds[name].attrs)
     return out
 
 

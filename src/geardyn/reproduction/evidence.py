@@ -15,7 +15,8 @@ from functools import cached_property
 import numpy as np
 import xarray as xr
 
-from geardyn.reproduction.motion import CHAOTIC, intervals, is_nonperiodic, period_label
+from geardyn.analysis.motion import CHAOTIC, period_label
+from geardyn.reproduction.motion import intervals, is_nonperiodic
 
 __all__ = ["QUASI_STATIC", "Branch", "Evidence", "MissingCase", "back_flank_contact",
            "format_intervals"]

@@ -14,32 +14,16 @@ from __future__ import annotations
 
 import numpy as np
 
-from geardyn.analysis.motion import (
-    CHAOTIC,
-    LYAPUNOV_FLOOR,
-    LYAPUNOV_Z,
-    NONPERIODIC,
-    QUASI_PERIODIC,
-    UNBOUNDED,
-    UNRESOLVED,
-    motion_classes,
-    period_label,
-)
+from geardyn.analysis import motion as _motion
+from geardyn.core.moved import moved
 
-__all__ = [
-    "CHAOTIC",
-    "LYAPUNOV_CHAOS",
-    "LYAPUNOV_FLOOR",
-    "LYAPUNOV_Z",
-    "NONPERIODIC",
-    "QUASI_PERIODIC",
-    "UNBOUNDED",
-    "UNRESOLVED",
-    "intervals",
-    "is_nonperiodic",
-    "motion_labels",
-    "period_label",
-]
+__all__ = ["LYAPUNOV_CHAOS", "intervals", "is_nonperiodic", "motion_labels"]
+
+# The labels and the rule live in :mod:`geardyn.analysis.motion`; their names here answer for
+# one deprecation cycle.
+__getattr__ = moved(__name__, dict.fromkeys(
+    ("CHAOTIC", "LYAPUNOV_FLOOR", "LYAPUNOV_Z", "NONPERIODIC", "QUASI_PERIODIC", "UNBOUNDED",
+     "UNRESOLVED", "period_label"), "geardyn.analysis.motion"))
 
 #: The former fixed chaos threshold [1/tau]; no label uses it any more (the exponent's
 #: uncertainty decides, see :mod:`geardyn.analysis.motion`). Kept for old callers.
@@ -48,19 +32,20 @@ LYAPUNOV_CHAOS = 2.0e-3
 
 def motion_labels(period: np.ndarray, lyapunov: np.ndarray, *,
                   lyapunov_err: np.ndarray | None, duration: np.ndarray | float,
-                  section: np.ndarray | bool = True, z: float = LYAPUNOV_Z,
-                  floor: float = LYAPUNOV_FLOOR) -> np.ndarray:
+                  section: np.ndarray | bool = True, z: float = _motion.LYAPUNOV_Z,
+                  floor: float = _motion.LYAPUNOV_FLOOR) -> np.ndarray:
     """Label per point: :func:`geardyn.analysis.motion.motion_classes` (``period`` k >= 1, 0
     none found, -1 unbounded; exponent, its standard error and averaging time ``duration``;
     ``section`` False where a second excitation is incommensurate)."""
-    return motion_classes(period, lyapunov, lyapunov_err, duration, section, z, floor)
+    return _motion.motion_classes(period, lyapunov, lyapunov_err, duration, section, z, floor)
 
 
 def is_nonperiodic(labels: np.ndarray) -> np.ndarray:
     """No period found: chaotic, quasi-periodic, unresolved or without an exponent (the paper's
     diagrams show these as clouds of points)."""
     labels = np.asarray(labels)
-    return np.isin(labels, (CHAOTIC, QUASI_PERIODIC, UNRESOLVED, NONPERIODIC))
+    return np.isin(labels, (_motion.CHAOTIC, _motion.QUASI_PERIODIC, _motion.UNRESOLVED,
+                            _motion.NONPERIODIC))
 
 
 def intervals(x: np.ndarray, mask: np.ndarray) -> list[tuple[float, float, int]]:
