@@ -195,6 +195,41 @@ def test_readme_names_the_cache_every_entry_point_uses(monkeypatch):
     assert Path(default.group(1)).expanduser() == cache_root()
 
 
+def _current_figure(row_id: str) -> str:
+    """The measured column of the current-figures row ``row_id`` of bench/RESULTS.md."""
+    for line in (ROOT / "bench" / "RESULTS.md").read_text(encoding="utf-8").splitlines():
+        cells = [c.strip() for c in line.strip().strip("|").split("|")]
+        if len(cells) > 2 and cells[0] == row_id:
+            return cells[2]
+    raise AssertionError(f"bench/RESULTS.md has no current figure {row_id!r}")
+
+
+#: The README's compile and demo figures: (what it says, with the figure as a group; the
+#: bench/RESULTS.md row; the figure in that row's measured column).
+README_FIGURES = [
+    (r"`make demo` on a fresh clone took (\d+) s end to end", "demo", r"^(\d+) s wall"),
+    (r"the point with their first compile (\d+) s", "demo", r"first compile (\d+) s"),
+    (r"every analysis of the gear pair: (\d+) s of CPU", "compile-GearPair", r"^(\d+) s CPU"),
+    (r"`SpurPair`: (\d+) s", "compile-SpurPair", r"^(\d+) s CPU"),
+    (r"the code every model shares already cached: (\d+) s", "compile-UserModel-one-form-own",
+     r"^(\d+) s CPU"),
+]
+
+
+@pytest.mark.parametrize(("said", "row", "measured"), README_FIGURES,
+                         ids=[f"{row}-{i}" for i, (_, row, _) in enumerate(README_FIGURES)])
+def test_readme_figures_are_the_benchmarks_current_ones(said, row, measured):
+    """A compile or demo figure the README states is the one bench/RESULTS.md holds now (the
+    row its command writes), so that a new measurement cannot leave the README behind."""
+    text = " ".join(README.split())
+    got = re.search(said, text)
+    assert got, f"the README no longer says {said!r}"
+    figure = re.search(measured, _current_figure(row))
+    assert figure, (row, _current_figure(row))
+    assert got.group(1) == figure.group(1), (
+        f"README: {got.group(0)!r}; bench/RESULTS.md {row}: {figure.group(0)!r}")
+
+
 def test_readme_python_snippet_runs(tmp_path, monkeypatch):
     """The README's Python blocks run as printed (in a scratch folder: they write files)."""
     blocks = _readme_blocks("python")
