@@ -1,7 +1,7 @@
 """The command line's settings options are generated from the settings' fields: every option of
-every command that sets a RunSettings or ContinuationSettings field has the field's name (with
-dashes; ``simulate --periods`` is the one other name), its type and its help, declared once in
-the settings."""
+every command that sets a RunSettings or ContinuationSettings field has the
+field's name (with dashes; ``simulate --periods`` is the one other name), its type and its help,
+declared once in the settings."""
 
 from __future__ import annotations
 
@@ -73,3 +73,44 @@ def test_settings_options_are_declared_nowhere_else():
         text = path.read_text()
         for h in helps:
             assert h not in text, f"{path.name} repeats the help of a settings field"
+
+
+@pytest.mark.parametrize(("command", "kind", "field", "option"), list(_cases()))
+def test_a_commands_options_name_its_generated_option(command, kind, field, option):
+    """``named_options`` (what a command hands the settings, so that an error names the option
+    it came from) names each field's option as the generated option itself is named."""
+    from geardyn.cli.common import named_options
+
+    if option == "--periods":  # simulate's other name for samples, given by hand
+        return
+    assert named_options(kind, **{field: 3}) == {field: (option, 3)}
+
+
+def test_named_options_refuse_a_field_without_an_option():
+    from geardyn.cli.common import named_options, run_options
+
+    with pytest.raises(KeyError, match="no command-line field bogus"):
+        run_options(transient=1.0, bogus=2)
+    with pytest.raises(KeyError, match="ContinuationSettings"):
+        named_options(ContinuationSettings, transient=1.0)
+
+
+def test_settings_option_names_are_spelled_nowhere_else():
+    """No command module maps a settings field to its option's name by hand
+    (``{"transient": ("--transient", transient)}``): ``run_options``/``named_options`` name
+    them from the fields; simulate's ``--periods`` (samples) is the one other name."""
+    import re
+    from pathlib import Path
+
+    import geardyn.cli
+    from geardyn.cli.common import option_name
+
+    folder = Path(geardyn.cli.__file__).parent
+    names = {option_name(f.name) for kind in (RunSettings, ContinuationSettings)
+             for f in dataclasses.fields(kind) if "help" in f.metadata}
+    pattern = re.compile(r":\s*\(\s*(?:\"(--[a-z-]+)\"|option_name\()")
+    for path in folder.glob("*.py"):
+        if path.name == "common.py":  # where run_options and named_options name them
+            continue
+        for m in pattern.finditer(path.read_text()):
+            assert m.group(1) is not None and m.group(1) not in names, (path.name, m.group(0))

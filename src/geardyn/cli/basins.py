@@ -34,6 +34,7 @@ from geardyn.cli.common import (
     load_study_source,
     make_parents,
     run_option,
+    run_options,
     study_run_settings,
     usable_omega,
     write_outputs,
@@ -107,9 +108,8 @@ def basins_command(
         if samples < 2:
             raise ParameterError("--samples", samples, "must be >= 2")
     # basins' own defaults: convergence CONVERGE, samples enough for the longest period
-    options = {"transient": ("--transient", transient), "samples": ("--samples", samples),
-               "steps_per_period": ("--steps-per-period", steps_per_period),
-               "converge": ("--converge", converge)}
+    options = run_options(transient=transient, samples=samples,
+                          steps_per_period=steps_per_period, converge=converge)
     first = study_run_settings(s, options, omega=om, defaults={"converge": CONVERGE})
     run = study_run_settings(s, options, omega=om, defaults={
         "converge": CONVERGE, "samples": SAMPLES_PER_PERIOD * first.max_period + 2})

@@ -46,6 +46,7 @@ from geardyn.cli.common import (
     load_study_source,
     make_parents,
     run_option,
+    run_options,
     stderr_console,
     study_run_settings,
     usable_omega,
@@ -298,10 +299,8 @@ def bifurcation_command(
             else sweep.continuation if sweep is not None else "none")
     lyap = lyapunov if lyapunov is not None else bool(sweep is not None and sweep.lyapunov)
     run = study_run_settings(
-        s, {"transient": ("--transient", transient), "samples": ("--samples", samples),
-            "steps_per_period": ("--steps-per-period", steps_per_period),
-            "converge": ("--converge", converge),
-            "continued_transient": ("--continued-transient", continued_transient)},
+        s, run_options(transient=transient, samples=samples, steps_per_period=steps_per_period,
+                       converge=converge, continued_transient=continued_transient),
         sweep=True, omega=lambda: _lowest_omega(model, name, (start, stop), hold))
     tr, n_samples, spp = run.transient, run.samples, run.steps_per_period
     if n_samples < 2:

@@ -74,6 +74,28 @@ def settings_option(kind: type, field: str, default: str, option: str | None = N
                                                help=f"{f.metadata['help']} ({default}).")]
 
 
+def named_options(kind: type, **values: Any) -> dict[str, tuple[str, Any]]:
+    """The ``options`` of :func:`settings_from_options` (field -> (option name, value)) for
+    values of the options :func:`settings_option` generates from ``kind``'s fields: each named
+    :func:`option_name` of its field, as the option itself is. A field without command-line
+    help is a ``KeyError`` naming it."""
+    import dataclasses
+
+    fields = {f.name for f in dataclasses.fields(kind) if "help" in f.metadata}
+    unknown = sorted(set(values) - fields)
+    if unknown:
+        raise KeyError(f"{kind.__name__} has no command-line field {', '.join(unknown)}")
+    return {field: (option_name(field), value) for field, value in values.items()}
+
+
+def run_options(**values: Any) -> dict[str, tuple[str, Any]]:
+    """:func:`named_options` of :class:`~geardyn.RunSettings`: the run settings a command got
+    as the options :func:`run_option` declares, e.g. ``run_options(transient=transient)``."""
+    from geardyn.core.settings import RunSettings
+
+    return named_options(RunSettings, **values)
+
+
 def run_option(field: str, default: str, option: str | None = None) -> Any:
     from geardyn.core.settings import RunSettings
 

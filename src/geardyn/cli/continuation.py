@@ -41,8 +41,9 @@ from geardyn.cli.common import (
     check_plot_path,
     load_study_source,
     make_parents,
-    option_name,
+    named_options,
     run_option,
+    run_options,
     settings_from_options,
     stderr_console,
     study_run_settings,
@@ -129,8 +130,7 @@ def _guess_run(s, model, name: str, start: float,
     default guess: 200 periods, at most 2000 time units, and the step as a keyword)
     when neither ``--transient`` nor the study file sets a run setting the branch reads
     (:data:`_NOT_READ` aside)."""
-    options = {"transient": ("--transient", transient),
-               "steps_per_period": ("--steps-per-period", spp)}
+    options = run_options(transient=transient, steps_per_period=spp)
     written = [key for key in (*RUN_FIELDS, "transient_periods")
                if key not in _NOT_READ and s.run.written(key)]
     if transient is None and not written:
@@ -238,9 +238,8 @@ def continue_command(
         raise StudyError(f"--range: not given, and {why}")
     if period < 1:
         raise ParameterError("--period", period, "must be >= 1")
-    cset = settings_from_options(ContinuationSettings,
-                                 {"max_period": (option_name("max_period"), max_period),
-                                  "max_points": (option_name("max_points"), max_points)})
+    cset = settings_from_options(ContinuationSettings, named_options(
+        ContinuationSettings, max_period=max_period, max_points=max_points))
     if cset.max_period < period:
         raise ParameterError("--max-period", cset.max_period,
                              f"must be >= --period ({period})")

@@ -30,6 +30,7 @@ from geardyn.cli.common import (
     load_study_source,
     make_parents,
     run_option,
+    run_options,
     study_run_settings,
     write_outputs,
 )
@@ -96,8 +97,8 @@ def dynamic_factor_command(
         raise ParameterError("--range", f"{start:g}:{stop:g}", "input speeds must be > 0 rpm")
     lowest = model.with_params(**{speed_param: float(rpm.min()) / to_rpm}).omega
     run = study_run_settings(
-        s, {"transient": ("--transient", transient), "samples": ("--samples", samples),
-            "converge": ("--converge", converge)}, sweep=True, omega=lowest)
+        s, run_options(transient=transient, samples=samples, converge=converge), sweep=True,
+        omega=lowest)
     make_parents(out, plot)
     t0 = time.perf_counter()
     ds = dynamic_factor_sweep(model, rpm, torque or None, run, base_pitch_deviation=f_pb,

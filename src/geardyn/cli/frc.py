@@ -40,6 +40,7 @@ from geardyn.cli.common import (
     load_study_source,
     make_parents,
     run_option,
+    run_options,
     study_run_settings,
     usable_omega,
     write_outputs,
@@ -122,10 +123,8 @@ def frc_command(
         raise ParameterError("--mesh", mesh, f"not a mesh of the model; meshes: "
                              f"{', '.join(names)}")
     run = study_run_settings(
-        s, {"transient": ("--transient", transient), "samples": ("--samples", samples),
-            "steps_per_period": ("--steps-per-period", steps_per_period),
-            "converge": ("--converge", converge),
-            "continued_transient": ("--continued-transient", continued_transient)},
+        s, run_options(transient=transient, samples=samples, steps_per_period=steps_per_period,
+                       converge=converge, continued_transient=continued_transient),
         sweep=True, omega=min(start, stop))
     tr, n_samples, spp = run.transient, run.samples, run.steps_per_period
     check_count("--samples", n_samples)

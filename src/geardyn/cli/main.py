@@ -56,6 +56,7 @@ from geardyn.cli.common import (
     load_study_source,
     make_parents,
     run_option,
+    run_options,
     stderr_console,
     study_run_settings,
     usable_omega,
@@ -358,10 +359,9 @@ def simulate(
         raise ParameterError("--omega", om, "must be a positive finite number (with a finite "
                              "period)")
     check_plot_path("--plot", plot)
-    run = study_run_settings(s, {"transient": ("--transient", transient),
-                                 "samples": ("--periods", periods),
-                                 "steps_per_period": ("--steps-per-period", steps_per_period)},
-                             omega=om)
+    run = study_run_settings(s, {**run_options(transient=transient,
+                                               steps_per_period=steps_per_period),
+                                 "samples": ("--periods", periods)}, omega=om)
     tr, n_periods, spp = run.transient, run.samples, run.steps_per_period
     if n_periods > MAX_COUNT:
         raise ParameterError("--periods", n_periods, f"must be >= 1 and <= {MAX_COUNT}")

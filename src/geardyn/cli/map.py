@@ -34,6 +34,7 @@ from geardyn.cli.common import (
     load_study_source,
     refuse_if_costly,
     run_option,
+    run_options,
     run_settings,
     study_run_settings,
     usable_omega,
@@ -125,8 +126,7 @@ def map_command(
             check_count(option, count)
     if samples is not None and samples < 2:
         raise ParameterError("--samples", samples, "must be >= 2")
-    run_settings({"transient": ("--transient", transient),
-                  "steps_per_period": ("--steps-per-period", steps_per_period)})
+    run_settings(run_options(transient=transient, steps_per_period=steps_per_period))
     s = load_study_source(study)
     model = build_model(s, interpretation=interpretation)
     # the names and both ends of each axis must be valid before anything grid-sized is built
@@ -154,9 +154,8 @@ def map_command(
 
     # the transient: --transient, [run].transient, or transient_periods of the lowest Omega
     low = [min(a[0], a[1]) for a in forcing]
-    run = study_run_settings(s, {"transient": ("--transient", transient),
-                                 "samples": ("--samples", samples),
-                                 "steps_per_period": ("--steps-per-period", steps_per_period)},
+    run = study_run_settings(s, run_options(transient=transient, samples=samples,
+                                            steps_per_period=steps_per_period),
                              omega=low[0] if low else model.omega)
     tr, n_samples, spp = run.transient, run.samples, run.steps_per_period
     if n_samples < 2:
