@@ -1,5 +1,5 @@
 """The command line's settings options are generated from the settings' fields: every option of
-every command that sets a RunSettings or ContinuationSettings field has the
+every command that sets a RunSettings, ContinuationSettings or RunupSettings field has the
 field's name (with dashes; ``simulate --periods`` is the one other name), its type and its help,
 declared once in the settings."""
 
@@ -11,6 +11,7 @@ import typing
 import pytest
 import typer
 
+from geardyn.analysis.runup import RunupSettings
 from geardyn.core.settings import ContinuationSettings, RunSettings
 
 #: Which settings each command's options set (command -> (kind, field -> option)).
@@ -33,6 +34,10 @@ COMMANDS: dict[str, tuple[type, dict[str, str]]] = {
                                "steps_per_period": "--steps-per-period"}),
 }
 CONTINUE = (ContinuationSettings, {"max_points": "--max-points", "max_period": "--max-period"})
+#: The run-up's options that set its settings' fields as they are (--start, --stop and --rate
+#: are in the unit of --param, converted by the command).
+RUNUP = (RunupSettings, {"duration": "--duration", "transient": "--transient",
+                         "sample_rate": "--sample-rate", "steps_per_period": "--steps-per-period"})
 
 def _commands() -> dict:
     from geardyn.cli.main import app
@@ -41,7 +46,7 @@ def _commands() -> dict:
 
 
 def _cases():
-    for name, (kind, fields) in [*COMMANDS.items(), ("continue", CONTINUE)]:
+    for name, (kind, fields) in [*COMMANDS.items(), ("continue", CONTINUE), ("runup", RUNUP)]:
         for field, option in fields.items():
             yield pytest.param(name, kind, field, option, id=f"{name}{option}")
 
@@ -67,7 +72,7 @@ def test_settings_options_are_declared_nowhere_else():
     import geardyn.cli
 
     folder = Path(geardyn.cli.__file__).parent
-    helps = {f.metadata["help"] for kind in (RunSettings, ContinuationSettings)
+    helps = {f.metadata["help"] for kind in (RunSettings, ContinuationSettings, RunupSettings)
              for f in dataclasses.fields(kind) if "help" in f.metadata}
     for path in folder.glob("*.py"):
         text = path.read_text()
@@ -106,7 +111,7 @@ def test_settings_option_names_are_spelled_nowhere_else():
     from geardyn.cli.common import option_name
 
     folder = Path(geardyn.cli.__file__).parent
-    names = {option_name(f.name) for kind in (RunSettings, ContinuationSettings)
+    names = {option_name(f.name) for kind in (RunSettings, ContinuationSettings, RunupSettings)
              for f in dataclasses.fields(kind) if "help" in f.metadata}
     pattern = re.compile(r":\s*\(\s*(?:\"(--[a-z-]+)\"|option_name\()")
     for path in folder.glob("*.py"):

@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -78,11 +78,15 @@ class RunupSettings:
     start: float
     stop: float
     rate: float | None = None
-    duration: float | None = None
-    transient: float = 0.0
-    sample_rate: float | None = None
+    duration: float | None = field(default=None, metadata={
+        "help": "Ramp time [model time units]"})
+    transient: float = field(default=0.0, metadata={
+        "help": "Time held at the start speed first, not recorded"})
+    sample_rate: float | None = field(default=None, metadata={
+        "help": "Samples per model time unit"})
     outputs: tuple[str, ...] | None = None
-    steps_per_period: int | None = None
+    steps_per_period: int | None = field(default=None, metadata={
+        "help": "RK4 steps in one forcing period of the top speed"})
     locate_edges: bool = True
     bound: float = DEFAULT_BOUND
 

@@ -102,6 +102,12 @@ def run_option(field: str, default: str, option: str | None = None) -> Any:
     return settings_option(RunSettings, field, default, option)
 
 
+def runup_option(field: str, default: str) -> Any:
+    from geardyn.analysis.runup import RunupSettings
+
+    return settings_option(RunupSettings, field, default)
+
+
 def continuation_option(field: str, default: str) -> Any:
     from geardyn.core.settings import ContinuationSettings
 

@@ -33,6 +33,7 @@ from geardyn.cli.common import (
     check_plot_path,
     load_study_source,
     make_parents,
+    runup_option,
     write_outputs,
 )
 from geardyn.errors import ParameterError, StudyError
@@ -57,16 +58,13 @@ def runup_command(
     start: _float_option("Start value of --param (default: runup.start).") = None,
     stop: _float_option("Stop value of --param (default: runup.stop).") = None,
     rate: _float_option("Ramp rate: --param per model time unit (or --duration).") = None,
-    duration: _float_option("Ramp time [model time units] (or --rate).") = None,
-    transient: _float_option("Time held at the start speed first, not recorded (default: "
-                             "runup.transient, else 0).") = None,
-    sample_rate: _float_option("Samples per model time unit (default: runup.sample_rate, "
-                               "else enough for the drawn harmonics).") = None,
+    duration: runup_option("duration", "or --rate") = None,
+    transient: runup_option("transient", "default: runup.transient, else 0") = None,
+    sample_rate: runup_option("sample_rate", "default: runup.sample_rate, else enough for the "
+                                             "drawn harmonics") = None,
     outputs: Annotated[str | None, typer.Option(help="Comma-separated states and observables "
                                                      "recorded (default: all).")] = None,
-    steps_per_period: Annotated[int | None, typer.Option(
-        help="RK4 steps in one forcing period of the top speed (default: the step rule).")
-    ] = None,
+    steps_per_period: runup_option("steps_per_period", "default: the step rule") = None,
     output: Annotated[str | None, typer.Option(help="The output the waterfall analyses "
                                                     "(default: the first mesh force, else "
                                                     "the first state).")] = None,
