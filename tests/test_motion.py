@@ -106,3 +106,20 @@ def test_chaotic_gear_pair_is_chaotic():
     lam, err, duration = block_exponent(model, y, 20 * 2 * math.pi / omega, 8)
     assert lam > 0.05
     assert motion_classes(np.array([period]), lam, err, duration)[0] == "chaotic"
+
+
+def test_the_retired_chaos_threshold_warns_once_and_keeps_its_value(monkeypatch):
+    """``geardyn.reproduction.motion.LYAPUNOV_CHAOS`` (no label uses it) answers with its
+    former value and one DeprecationWarning saying why."""
+    import warnings
+
+    import geardyn.reproduction.motion as rm
+
+    monkeypatch.setattr(rm, "_warned", set())
+    with pytest.warns(DeprecationWarning, match="LYAPUNOV_CHAOS is deprecated: no label"):
+        assert rm.LYAPUNOV_CHAOS == 2.0e-3
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert rm.LYAPUNOV_CHAOS == 2.0e-3  # warned once
+    with pytest.raises(AttributeError, match="no attribute 'LYAPUNOV_CHAOTIC'"):
+        rm.LYAPUNOV_CHAOTIC  # noqa: B018

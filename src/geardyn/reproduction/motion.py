@@ -12,22 +12,40 @@ separates chaos from quasi-periodic motion.
 
 from __future__ import annotations
 
+import warnings
+from typing import Any
+
 import numpy as np
 
 from geardyn.analysis import motion as _motion
 from geardyn.core.moved import moved
 
-__all__ = ["LYAPUNOV_CHAOS", "intervals", "is_nonperiodic", "motion_labels"]
+__all__ = ["intervals", "is_nonperiodic", "motion_labels"]
 
 # The labels and the rule live in :mod:`geardyn.analysis.motion`; their names here answer for
 # one deprecation cycle.
-__getattr__ = moved(__name__, dict.fromkeys(
+_moved = moved(__name__, dict.fromkeys(
     ("CHAOTIC", "LYAPUNOV_FLOOR", "LYAPUNOV_Z", "NONPERIODIC", "QUASI_PERIODIC", "UNBOUNDED",
      "UNRESOLVED", "period_label"), "geardyn.analysis.motion"))
+#: Names that no label uses any more, with their values and why, answered for one deprecation
+#: cycle: ``LYAPUNOV_CHAOS``, the former fixed chaos threshold [1/tau] (the exponent's
+#: uncertainty decides, :mod:`geardyn.analysis.motion`).
+_RETIRED: dict[str, tuple[float, str]] = {
+    "LYAPUNOV_CHAOS": (2.0e-3, "no label uses a fixed chaos threshold: the exponent's "
+                               "uncertainty decides (geardyn.analysis.motion)")}
+_warned: set[str] = set()
 
-#: The former fixed chaos threshold [1/tau]; no label uses it any more (the exponent's
-#: uncertainty decides, see :mod:`geardyn.analysis.motion`). Kept for old callers.
-LYAPUNOV_CHAOS = 2.0e-3
+
+def __getattr__(name: str) -> Any:
+    """A moved or retired name, with one DeprecationWarning per name."""
+    if name not in _RETIRED:
+        return _moved(name)
+    value, why = _RETIRED[name]
+    if name not in _warned:
+        _warned.add(name)
+        warnings.warn(f"{__name__}.{name} is deprecated: {why}", DeprecationWarning,
+                      stacklevel=2)
+    return value
 
 
 def motion_labels(period: np.ndarray, lyapunov: np.ndarray, *,
