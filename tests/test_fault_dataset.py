@@ -201,6 +201,32 @@ def test_bad_spec_fields_are_named(kw, field):
         spec(**kw)
 
 
+def test_each_fault_kind_declares_its_size_label():
+    """A condition's ``fault_size`` label is the size its fault class declares: a crack's depth,
+    a spall's length (not its depth), wear's depth, NaN for a missing tooth; every kind of
+    ``FAULT_KINDS`` declares one, and an object that only looks like a fault is refused."""
+    from types import SimpleNamespace
+
+    from geardyn.analysis.fault_dataset import fault_labels
+    from geardyn.gears import Spall, Wear
+    from geardyn.gears.faults import FAULT_KINDS
+
+    faults = {"crack": RootCrack("1.5 mm", tooth=2), "spall": Spall("2 mm", "1 mm", "0.1 mm"),
+              "wear": Wear("20 um", gear="wheel"), "broken_tooth": BrokenTooth(tooth=3)}
+    assert set(faults) == set(FAULT_KINDS)
+    expected = {"crack": 1.5e-3, "spall": 2e-3, "wear": 20e-6}
+    for kind, fault in faults.items():
+        labels = fault_labels(fault)
+        assert labels["kind"] == kind and labels["tooth"] == fault.tooth
+        if kind in expected:
+            assert labels["size"] == pytest.approx(expected[kind], rel=1e-12)
+        else:
+            assert math.isnan(labels["size"])
+    fake = SimpleNamespace(kind="crack", depth=1e-3, gear="pinion", tooth=0)
+    with pytest.raises(ParameterError, match="faults.*RootCrack, Spall, Wear, BrokenTooth"):
+        spec(faults=(None, fake))
+
+
 def test_a_fault_the_model_refuses_is_named_before_any_work():
     calls = []
     bad = spec(faults=(None, RootCrack("1 mm", gear="sun")))

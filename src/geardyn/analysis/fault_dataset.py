@@ -51,6 +51,7 @@ from geardyn.core.settings import RunSettings
 from geardyn.core.status import Status, status_attrs
 from geardyn.errors import ParameterError
 from geardyn.execution.executor import run_chunks
+from geardyn.gears.faults import FAULT_KINDS
 
 __all__ = ["FaultDatasetSpec", "clean_signal", "dataset_inputs", "default_workers",
            "fault_dataset", "fault_labels", "lane_noise", "lane_steps", "seconds_per_time_unit"]
@@ -134,10 +135,11 @@ class FaultDatasetSpec:
         if not self.faults:
             raise ParameterError("faults", self.faults, "needs at least one condition "
                                  "(None for healthy)")
+        kinds = tuple(FAULT_KINDS.values())
         for f in self.faults:
-            if f is not None and not hasattr(f, "kind"):
+            if f is not None and not isinstance(f, kinds):
                 raise ParameterError("faults", f, "must be None (healthy) or a fault of "
-                                     "geardyn.gears (RootCrack, Spall, Wear, BrokenTooth)")
+                                     f"geardyn.gears ({', '.join(k.__name__ for k in kinds)})")
         object.__setattr__(self, "speeds", _real_list("speeds", self.speeds))
         object.__setattr__(self, "torques", _real_list("torques", self.torques))
         object.__setattr__(self, "seeds", _whole_list("seeds", self.seeds))
@@ -184,13 +186,12 @@ def _describe(fault: Any) -> str:
 
 
 def fault_labels(fault: Any) -> dict[str, Any]:
-    """kind, size [m] (crack depth, spall length, wear depth; NaN for healthy or a broken
-    tooth), gear and tooth (-1 for healthy) of one fault condition."""
+    """kind, size [m] (the fault's declared ``size``: crack depth, spall length, wear depth;
+    NaN for healthy or a broken tooth), gear and tooth (-1 for healthy) of one fault
+    condition."""
     if fault is None:
         return {"kind": "healthy", "size": math.nan, "gear": "none", "tooth": -1}
-    size = next((float(getattr(fault, a)) for a in ("depth", "length") if hasattr(fault, a)
-                 and not (fault.kind == "spall" and a == "depth")), math.nan)
-    return {"kind": str(fault.kind), "size": size, "gear": str(fault.gear),
+    return {"kind": str(fault.kind), "size": float(fault.size), "gear": str(fault.gear),
             "tooth": int(fault.tooth)}
 
 

@@ -136,6 +136,11 @@ class RootCrack:
             raise ParameterError("crack.tooth", self.tooth, "must be a whole number")
 
     @property
+    def size(self) -> float:
+        """The crack's size in a fault dataset's labels: its depth q [m]."""
+        return self.depth
+
+    @property
     def reach(self) -> float:
         """q sin v [m]: how far the crack tip lies inside the flank, across the tooth."""
         return self.depth * math.sin(self.angle)
@@ -177,6 +182,11 @@ class Spall:
         _length(self, "spall", "position", signed=True)
         _place(self, "spall")
         _flank(self, "spall")
+
+    @property
+    def size(self) -> float:
+        """The spall's size in a fault dataset's labels: its length along the profile [m]."""
+        return self.length
 
     @property
     def is_null(self) -> bool:
@@ -223,6 +233,11 @@ class Wear:
         _flank(self, "wear")
 
     @property
+    def size(self) -> float:
+        """The wear's size in a fault dataset's labels: its (largest) depth [m]."""
+        return self.depth
+
+    @property
     def is_null(self) -> bool:
         """True for zero wear."""
         return self.depth == 0.0
@@ -246,6 +261,11 @@ class BrokenTooth:
 
     def __post_init__(self) -> None:
         _place(self, "broken_tooth")
+
+    @property
+    def size(self) -> float:
+        """A missing tooth has no size in a fault dataset's labels: NaN."""
+        return math.nan
 
     @property
     def is_null(self) -> bool:
