@@ -179,3 +179,23 @@ def test_carrier_angle_follows_the_mesh_angle_over_the_ring_teeth():
     np.testing.assert_allclose(lanes[1], 0.2 * t / ZR)
     with pytest.raises(geardyn.ParameterError, match="geometry"):
         carrier_angle(geardyn.GearPair(zeta=0.05, kappa=0.2, Fm=0.1, Fa=0.05), t)
+
+
+def test_the_carrier_angle_needs_the_declared_ring_sensor_not_a_geometry_attribute():
+    """A model whose class does not declare the ring sensor is refused even where the instance
+    carries a ``geometry`` with a ring (the capability is read, not the attribute probed); a
+    planetary set built without geometry is refused too."""
+    from types import SimpleNamespace
+
+    t = np.linspace(0.0, 10.0, 5)
+    pair = geardyn.GearPair(zeta=0.05, kappa=0.2, Fm=0.1, Fa=0.05)
+    pair.geometry = SimpleNamespace(ring=SimpleNamespace(teeth=ZR))
+    pair.held, pair.mesh_order = "ring", 1.0
+    with pytest.raises(geardyn.ParameterError, match="model.*geometry"):
+        carrier_angle(pair, t)
+    doc = tomllib.loads(files("geardyn.studies").joinpath("planetary_example.toml").read_text())
+    bare = planetary_by_hand(doc)
+    bare.geometry = None
+    assert bare.capabilities.fault_dataset.signal == "ring_sensor"
+    with pytest.raises(geardyn.ParameterError, match="model.*geometry"):
+        carrier_angle(bare, t)

@@ -102,8 +102,11 @@ def carrier_angle(model, time: np.ndarray, omega: np.ndarray | float | None = No
     time unit), at the forcing frequency ``omega`` (default the model's Omega; an array of one
     per lane broadcasts against ``time``'s leading dims): phi = +-(mesh angle) / Z_r with the
     mesh angle = mesh_order Omega t, 0 at t = 0 (the first planet at psi_1 there); + unless the
-    sun is held (then the planets turn against psi relative to the ring)."""
-    geo = getattr(model, "geometry", None)
+    sun is held (then the planets turn against psi relative to the ring). A model whose class
+    does not declare the ring sensor (``capabilities.fault_dataset``), or one built without
+    geometry, is a :class:`~geardyn.errors.ParameterError` naming ``model``."""
+    declared = model.capabilities.fault_dataset
+    geo = model.geometry if declared is not None and declared.signal == "ring_sensor" else None
     if geo is None:
         raise ParameterError("model", type(model).__name__, "needs a PlanetaryGearSet built "
                              "from geometry (the ring's teeth)")
