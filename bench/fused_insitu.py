@@ -10,6 +10,12 @@ the crossing counts and contact statistics differ, not the Poincare points). Eac
 compiled afresh (minutes on a loaded machine).
 
     .venv/bin/python bench/fused_insitu.py [--variants base,noscreen] [--edges] [--repeat 5]
+
+What edge location's parts cost (``bench/flag_census.py`` counts the flagged steps by kind):
+``--edges --variants base,nograze,nosplit,nosplit+loopcommit,screenonly,noscreen``: base -
+nosplit the splits, nosplit - screenonly the out-of-line handling of the flagged slots
+(nosplit - nosplit+loopcommit of it: their state written out of line), screenonly -
+noscreen the screen in the loop, base - nograze what the graze flags cost.
 """
 
 from __future__ import annotations

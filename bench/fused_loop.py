@@ -14,6 +14,12 @@ with lines replaced (checked, so a template change that moves them fails loudly)
 ``noscreen``: without the side test and graze screen (nothing flagged); ``nobook``: without the
 health check and due test; ``fission``: the statistics in a loop of their own after the
 step loop; ``phasefuse``: the phase rotations in the step loop (no loop of their own);
+``alwaysout``: the out-of-line call at every block step; ``screenonly``: the screen
+computed and stored, nothing flagged; ``nograze`` (with edge location): the graze screen off,
+only a side left at a step's end flagged; ``nosplit``: a flagged step committed, its
+crossings counted at its end (no split); ``loopcommit`` (with ``nosplit``): that commit in
+the loop, none out of line (these five for bench/fused_insitu.py, where the out-of-line path
+runs);
 ``norotate``: the slots' phase rotations left out (wrong phases, the loads and stores kept);
 ``nochain``: the RK4 stages made independent of
 each other (wrong results, the same operations: is the loop latency-bound?); ``+``-joined
@@ -96,6 +102,31 @@ EDITS = {
                    "        se, ce = phase_rotate(s0, c0, AD[k], BD[k])\n"
                    "        end = ph + 1 == NPER[k]\n"
                    "        se = 0.0 if end else se\n        ce = 1.0 if end else ce\n")],
+    # edge location (bench/fused_insitu.py --edges): the graze screen off (only a side left at
+    # the step's end is flagged; grazes missed): what the graze flags cost, false alarms included
+    "nograze": [("        hit = _t_screen(g1, GS, GP, SIDE, GR, k, locate)\n",
+                 "        hit = _t_screen(g1, GS, GP, SIDE, GR, k, False)\n")],
+    # the side test and graze screen computed (the events' history and graze flags stored),
+    # nothing flagged: the screen's cost in the loop (with noscreen: what flagging costs)
+    "screenonly": [("        hit = _t_screen(g1, GS, GP, SIDE, GR, k, locate)\n",
+                    "        hit = _t_screen(g1, GS, GP, SIDE, GR, k, locate) & False\n")],
+    # the out-of-line call made at every block step (with noscreen: what a call costs where
+    # it has nothing or little to do)
+    "alwaysout": [("        if n_out > 0:\n", "        if n_out >= 0:\n")],
+    # a flagged step committed, its crossings counted at its end (no split): what the split
+    # costs beyond the out-of-line handling of a flagged slot
+    "nosplit": [("                          locate, ncross, unresolved, ys, y1s, sides, g1s, "
+                 "work, ybuf, gbuf,\n",
+                 "                          False, ncross, unresolved, ys, y1s, sides, g1s, "
+                 "work, ybuf, gbuf,\n")],
+    # (with nosplit) a flagged slot's trial step committed in the loop, not out of line: the
+    # out-of-line path writes no state the next loop step loads as a vector (a store that
+    # cannot be forwarded to the wider load)
+    "loopcommit": [("        _t_store(Y, k, y1, y, act & (not hit))\n",
+                    "        _t_store(Y, k, y1, y, act)\n"),
+                   ("                NCROSS[lane, j] += 1\n        for q in range(ns):\n"
+                    "            Y[q, k] = Y1[q, k]\n        return\n",
+                    "                NCROSS[lane, j] += 1\n        return\n")],
     "nochain": [("_t_axpy(y, hh, k1)", "_t_axpy(y, hh, y)"),
                 ("_t_axpy(y, hh, k2)", "_t_axpy(y, hh, y)"),
                 ("_t_axpy(y, h, k3)", "_t_axpy(y, h, y)")],
