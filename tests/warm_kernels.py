@@ -49,11 +49,11 @@ WARM = {
 
 #: CPU seconds of each case's warm-up with an empty cache (2-core AMD EPYC machine, two jobs, the
 #: machine shared; the run-up kernels' share estimated from the tests that compiled them: gear
-#: pair ~10, planetary set ~19, spur pair ~25). The first case of a process also compiles the
+#: pair ~10, planetary set ~19, spur pair ~3). The first case of a process also compiles the
 #: kernels' shared functions; the train shares the planetary set's kernels (it runs after it).
 #: The cases start longest first, so that the two processes end together.
 COST = {
-    "PlanetaryGearSet": 137, "SpurPair": 92, "GearPair": 48, "CATTDevice-reduced": 44,
+    "PlanetaryGearSet": 137, "SpurPair": 55, "GearPair": 48, "CATTDevice-reduced": 44,
     "CATTDevice-general": 27, "oscillator": 25, "UserModel-one-form": 24, "Lorenz": 19,
     "DimensionalCATT": 16, "UserModel": 14, "TrainModel": 1,
 }

@@ -133,8 +133,16 @@ def damping_coefficient(PT, k):
     return 2.0 * PT[ZETA, k] * math.sqrt(PT[K_MEAN, k] * PT[MASS, k])
 
 
-@nb.njit(inline="always", **_JIT)
-def spur_pair_rhs_lane(t, y, PT, k, s, c, form):
+# The lane-scalar rhs and observables compiled once per argument types and inlined by LLVM
+# where they are called (``forceinline``), not by numba's frontend, which would copy and type
+# the flanks' series and table at every call site of the kernels (the RK4 stages of the split
+# step, of the fused step loop and of the Lyapunov rows); without reference counting (they
+# allocate nothing). The lane-scalar interface functions below are thin numba-inlined calls.
+_JIT_ONCE = {**_JIT, "forceinline": True, "_nrt": False}
+
+
+@nb.njit(**_JIT_ONCE)
+def _rhs_lane_once(t, y, PT, k, s, c):
     x, v = y
     order = PT[MESH_ORDER, k]
     cn, sn = rotate_power(int(order), s, c)
@@ -143,6 +151,16 @@ def spur_pair_rhs_lane(t, y, PT, k, s, c, form):
     m = PT[MASS, k]
     f = PT[TORQUE, k] / PT[R_B1, k] - damping_coefficient(PT, k) * v - contact_force(x, PT, k, s, c)
     return (v, f / m + PT[ERROR, k] * wm * wm * ce)
+
+
+@nb.njit(**_JIT_ONCE)
+def _observe_lane_once(t, y, PT, k, s, c):
+    return (contact_force(y[0], PT, k, s, c) + damping_coefficient(PT, k) * y[1],)
+
+
+@nb.njit(inline="always", **_JIT)
+def spur_pair_rhs_lane(t, y, PT, k, s, c, form):
+    return _rhs_lane_once(t, y, PT, k, s, c)
 
 
 #: The state size of the lane-scalar forms.
@@ -162,7 +180,7 @@ def spur_pair_events_lane(t, y, PT, k, s, c):
 
 @nb.njit(inline="always", **_JIT)
 def spur_pair_observe_lane(t, y, PT, k, s, c, form):
-    return (contact_force(y[0], PT, k, s, c) + damping_coefficient(PT, k) * y[1],)
+    return _observe_lane_once(t, y, PT, k, s, c)
 
 
 # the array interface, on the lane-scalar forms

@@ -42,6 +42,7 @@ from geardyn.core.kernel_source import KernelSource
 from geardyn.core.one_form import adapters as one_form_adapters
 from geardyn.core.one_form import tangent_adapters
 from geardyn.solvers import compile_share
+from geardyn.solvers._inline_copy import block_copy
 
 _IMPORT_MARK = "# MODEL-IMPORT"
 _CORE_MARK = "# CORE-IMPORT"
@@ -124,7 +125,7 @@ def _quiet_compile(dispatcher: Any, cached: bool = False) -> None:
         dispatcher.compile)
 
     def compile(sig: Any) -> Any:
-        with _COMPILE_LOCK, unique_names(), warnings.catch_warnings():
+        with _COMPILE_LOCK, unique_names(), block_copy(), warnings.catch_warnings():
             for category in QUIET_WARNINGS:
                 warnings.filterwarnings("ignore", category=category)
             return compile_(sig)

@@ -1,0 +1,112 @@
+"""numba's IR inlining with the callee's blocks copied in one pass (geardyn.solvers._inline_copy):
+the same copies, each object copied once; installed only inside geardyn's own compiles."""
+
+from __future__ import annotations
+
+import copy
+
+import numba as nb
+import numpy as np
+import pytest
+from numba.core import inline_closurecall as icc
+from numba.core.compiler import run_frontend
+from numba.core.compiler_lock import global_compiler_lock
+
+from geardyn.solvers import _inline_copy
+from geardyn.solvers._inline_copy import block_copy
+
+_SOURCE = '''
+@nb.njit(inline="always")
+def callee(x, n):
+    acc = 0.0
+    for j in range(n):
+        if x > j:
+            acc += x * j
+        else:
+            acc -= j / (1.0 + x * x)
+    return acc
+
+
+@nb.njit
+def caller(x, n):
+    return callee(x, n) + 2.0 * callee(-x, n + 1) - callee(0.5 * x, 2 * n)
+'''
+
+
+def _caller():
+    """A fresh compiled function with an inlined callee of several blocks, called three times."""
+    scope = {"nb": nb}
+    exec(compile(_SOURCE, "<test_inline_copy>", "exec"), scope)  # noqa: S102 (fixed text)
+    return scope["caller"]
+
+
+def _numba_untouched() -> bool:
+    return icc.copy is copy and icc.InlineWorker.inline_ir is _inline_copy._ORIGINAL
+
+
+def test_the_callee_blocks_share_one_scope_and_equal_numbas_copies():
+    def f(x, n):
+        acc = 0.0
+        for j in range(n):
+            if x > j:
+                acc += x
+            else:
+                acc -= j
+        return acc
+
+    ir = run_frontend(f)
+    assert len(ir.blocks) > 3
+    plain = {k: copy.deepcopy(b) for k, b in ir.blocks.items()}  # numba's own: a memo per block
+    _inline_copy._SHIM.memos = {}
+    try:
+        shared = {k: _inline_copy._SHIM.deepcopy(b) for k, b in ir.blocks.items()}
+    finally:
+        _inline_copy._SHIM.memos = None
+    assert len({id(b.scope) for b in plain.values()}) == len(plain)  # the scope copied per block
+    assert len({id(b.scope) for b in shared.values()}) == 1  # once, as in the original
+    assert all(b.scope is not ir.blocks[k].scope for k, b in shared.items())  # a copy
+    for k, b in ir.blocks.items():
+        assert shared[k] == plain[k] == b
+        assert [str(s) for s in shared[k].body] == [str(s) for s in b.body]
+
+
+def test_a_function_compiled_with_the_block_copy_gives_the_same_results():
+    xs = np.linspace(-3.0, 7.0, 41)
+    own = _caller()
+    with global_compiler_lock, block_copy():
+        assert not _numba_untouched()
+        shared = _caller()
+        shared.compile("float64(float64, int64)")
+    assert _numba_untouched()
+    own.compile("float64(float64, int64)")
+    for x in xs:
+        for n in (0, 1, 5, 9):
+            ref = own.py_func(x, n)  # the Python function, uncompiled
+            assert shared(x, n) == own(x, n)
+            assert shared(x, n) == pytest.approx(ref, rel=1e-12, abs=1e-12)
+    # the two compiled functions are the same code: their assembly differs only in names
+    asm_own = own.inspect_asm(own.signatures[0])
+    asm_shared = shared.inspect_asm(shared.signatures[0])
+    assert len(asm_own.splitlines()) == len(asm_shared.splitlines())
+
+
+def test_numba_is_restored_after_each_compile_and_on_errors():
+    assert _numba_untouched()
+    with global_compiler_lock, block_copy():
+        with block_copy():  # re-entrant: a compile inside a compile
+            assert icc.copy is _inline_copy._SHIM
+        assert icc.copy is _inline_copy._SHIM
+    assert _numba_untouched()
+    with pytest.raises(RuntimeError, match="inside"):
+        with global_compiler_lock, block_copy():
+            raise RuntimeError("inside")
+    assert _numba_untouched()
+
+
+def test_geardyns_compiles_leave_numba_untouched():
+    import geardyn
+    from shared_models import oscillator
+
+    geardyn.simulate(oscillator(zeta=0.1, F=1.0, Omega=1.3), y0=np.zeros(2),
+                     run=geardyn.RunSettings(transient=0.0, samples=2))
+    assert _numba_untouched()
