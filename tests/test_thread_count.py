@@ -24,8 +24,8 @@ from geardyn.solvers.ensemble import LaneResults, _schedule, run_lanes
 pytestmark = pytest.mark.skipif(numba.config.NUMBA_NUM_THREADS < 2,
                                 reason="needs two numba threads (NUMBA_NUM_THREADS >= 2)")
 
-#: The softening pair of tests/test_basins.py: contact loss, back-flank impacts and two
-#: attractors in 0.72 <= Omega <= 0.82.
+#: The gear pair of the conformance case and tests/test_sweep_slots.py: contact lost over the
+#: sweep (the basins below take the softening pair of tests/test_basins.py, two attractors).
 PAIR = dict(zeta=0.05, kappa=0.2, Fm=0.1, Fa=0.2)
 OMEGA = np.linspace(0.3, 3.0, 24)
 
