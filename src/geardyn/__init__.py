@@ -47,7 +47,7 @@ from geardyn.models.gear_pair import GearPair
 from geardyn.models.params import Carrier, Gear, Loads, Mesh, PlanetaryParams, PlanetOverride
 from geardyn.models.planetary import Member, PlanetaryGearSet
 from geardyn.models.spur_pair import SpurPair
-from geardyn.models.user import UserModel
+from geardyn.models.user import DynamicFactorDeclaration, UserModel
 from geardyn.solvers.reference import reference_solution
 from geardyn.solvers.simulate import simulate
 from geardyn.study import build_model
@@ -62,6 +62,7 @@ __all__ = [
     "ContinuedSweep",
     "CurveSettings",
     "DimensionalCATT",
+    "DynamicFactorDeclaration",
     "Envelope",
     "GearPair",
     "GeardynError",

@@ -2,8 +2,9 @@
 
 A model with the ``dynamic_factor`` capability (:class:`~geardyn.core.capabilities.
 Capabilities`: :class:`~geardyn.SpurPair`, :class:`~geardyn.PlanetaryGearSet` built from
-geometry, :class:`~geardyn.trains.TrainModel`) gives its mesh groups at an input torque
-(:class:`~geardyn.gears.iso6336_kv.KvMeshGroup`); :func:`iso_inputs` turns them and the
+geometry, :class:`~geardyn.trains.TrainModel`, a :class:`~geardyn.UserModel` that declares it
+with :class:`~geardyn.DynamicFactorDeclaration`) gives its mesh groups at an input
+torque (:class:`~geardyn.gears.iso6336_kv.KvMeshGroup`); :func:`iso_inputs` turns them and the
 accuracy-grade inputs into :class:`~geardyn.gears.iso6336_kv.DynamicFactorInputs`.
 :func:`dynamic_factor_sweep` sweeps the input speed (one :func:`~geardyn.bifurcation` per
 torque) and returns the model's dynamic factor (peak dynamic mesh force over the static one,
@@ -43,9 +44,12 @@ __all__ = ["STIFFNESS_SOURCES", "dynamic_factor_sweep", "iso_inputs", "linear_re
 
 def _checked(model: Model) -> Model:
     if not model.capabilities.dynamic_factor:
-        raise ParameterError("model", type(model).__name__, "K_v needs a model built from gear "
-                             "geometry under load (SpurPair, PlanetaryGearSet.from_geometry, "
-                             "a TrainModel; the dynamic_factor capability)")
+        raise ParameterError("model", model.name, "K_v needs the dynamic_factor capability: a "
+                             "model built from gear geometry under load (SpurPair, "
+                             "PlanetaryGearSet.from_geometry, a TrainModel), or a "
+                             "UserModel.from_one_form that declares it (dynamic_factor="
+                             "DynamicFactorDeclaration(...): its input speed and torque "
+                             "coefficients, mesh groups and natural frequencies)")
     return model
 
 

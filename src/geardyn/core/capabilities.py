@@ -95,7 +95,9 @@ class Capabilities:
         [rpm], ``model.mesh_frequency_per_input_speed()`` the reference mesh's order over the
         input speed, and natural frequencies (``natural_frequencies`` in Hz, or in rad/s for a
         model whose time unit is the second). An instance without the needed geometry raises
-        :class:`~geardyn.errors.ParameterError` from ``kv_groups``.
+        :class:`~geardyn.errors.ParameterError` from ``kv_groups``. A one-form
+        :class:`~geardyn.UserModel` declares these with
+        :class:`~geardyn.DynamicFactorDeclaration` (its natural frequencies in Hz).
     ``natural_frequencies``
         The unit of ``model.natural_frequencies()``, the linearised model's natural
         frequencies (mean stiffness, no backlash), ascending: ``"rad/time"`` (rad per model

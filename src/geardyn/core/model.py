@@ -148,6 +148,10 @@ class Model:
     #: What the model offers beyond the interface (frequency scale, dataset attributes, ...):
     #: analyses read this declaration, never probe attributes.
     capabilities: Capabilities = Capabilities()
+    #: Each instance declares its own ``capabilities`` as it is built (a user model's follow
+    #: what it declares): the class-level checks of ``__init_subclass__`` are then the
+    #: instance's builder's to make. Set on the class itself; its subclasses are checked.
+    capabilities_per_instance: bool = False
     #: ``with_params`` may set a derived coefficient directly (a raw override) instead of
     #: refusing it; such a model records them in ``raw_overrides``.
     raw_overrides_allowed: bool = False
@@ -165,8 +169,11 @@ class Model:
         capabilities (analyses read the declaration, never probe the method); a class that
         declares a capability defines what it needs (``dynamic_factor``: the members of
         ``DYNAMIC_FACTOR_MEMBERS``; a ``fault_dataset`` with ``stiffness_error``: that
-        method)."""
+        method). A class that sets :attr:`capabilities_per_instance` itself (its instances
+        declare their own) is left to its builder; its subclasses are checked."""
         super().__init_subclass__(**kwargs)
+        if vars(cls).get("capabilities_per_instance"):
+            return
         if "natural_frequencies" in vars(cls) and not cls.capabilities.natural_frequencies:
             raise TypeError(f"{cls.__name__} defines natural_frequencies(): declare their unit "
                             "in its capabilities (Capabilities(natural_frequencies='rad/time' "

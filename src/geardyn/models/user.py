@@ -10,12 +10,17 @@ A one-form model declares its coefficients as a built-in does (``coefficients=``
 :class:`~geardyn.core.coefficients.Coefficient` per parameter, with unit, meaning and range):
 ``model.coefficient_layout``, ``with_params`` (range checks naming the field), the explorer's
 help and a sweep's axis attributes (``units``, ``long_name``) read them.
+
+A one-form model with force meshes and static forces may declare the dynamic factor against
+ISO 6336-1 K_v (``dynamic_factor=``: a :class:`DynamicFactorDeclaration`): then
+:func:`~geardyn.dynamic_factor_sweep` takes it as it takes a built-in model built from geometry.
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -25,10 +30,65 @@ from geardyn.core.coefficients import Coefficient, CoefficientBlock, Coefficient
 from geardyn.core.kernel_source import KernelSource
 from geardyn.core.model import Model, unique_rows
 from geardyn.core.one_form import Derivations, OneForm, check_names, coefficient_type
+from geardyn.errors import ParameterError
+from geardyn.gears.iso6336_kv import KvMeshGroup
 
 #: A mesh of :meth:`UserModel.from_one_form`: (name, drive event, back event) or (name, drive
 #: event, back event, force observable), events and observables by name or index.
 MeshSpec = tuple[str, str | int, str | int] | tuple[str, str | int, str | int, str | int]
+
+
+@dataclass(frozen=True)
+class DynamicFactorDeclaration:
+    """What a one-form model declares for its dynamic factor against ISO 6336-1 K_v
+    (:func:`~geardyn.dynamic_factor_sweep`, the ``dynamic_factor`` capability of
+    :class:`~geardyn.core.capabilities.Capabilities`): how its coefficients follow the physical
+    input speed and torque, the mesh groups K_v treats and the natural frequencies.
+
+    ``speed``
+        (coefficient, its value per rpm of input speed): the coefficient an input speed sets,
+        in proportion (``("Omega", z1 * 2 pi / 60)`` for a model in seconds forced at the mesh
+        frequency of a pinion of z1 teeth; over the time scale for a dimensionless one).
+    ``torque``
+        (coefficient, its value per N m of input torque): the coefficient an input torque sets,
+        in proportion (``("torque", 1.0)``; a dimensionless mean load: its value per N m).
+    ``groups``
+        ``groups(p, torque)``: the mesh groups (:class:`~geardyn.gears.iso6336_kv.KvMeshGroup`:
+        geometry, mesh indices, tangential force, reduced mass, mean stiffness) at an input
+        torque [N m], from the coefficients ``p`` (named tuple); the first group's mesh is the
+        reference mesh (its mesh frequency: gear 1's speed times its teeth).
+    ``natural_frequencies``
+        ``natural_frequencies(p)``: the linearised model's natural frequencies [Hz],
+        ascending.
+    ``time_scale``
+        omega_0 [rad/s]: the model's time unit is 1 / omega_0 (1: the model runs in seconds).
+    """
+
+    speed: tuple[str, float]
+    torque: tuple[str, float]
+    groups: Callable[[Any, float], Sequence[KvMeshGroup]]
+    natural_frequencies: Callable[[Any], Sequence[float]]
+    time_scale: float = 1.0
+
+    def __post_init__(self) -> None:
+        for field, unit in (("speed", "rpm"), ("torque", "N m")):
+            spec = getattr(self, field)
+            if not (isinstance(spec, tuple) and len(spec) == 2 and isinstance(spec[0], str)):
+                raise ParameterError(f"dynamic_factor.{field}", spec,
+                                     f"give (coefficient name, its value per {unit})")
+            _positive(f"dynamic_factor.{field}", spec[1])
+        for field in ("groups", "natural_frequencies"):
+            if not callable(getattr(self, field)):
+                raise ParameterError(f"dynamic_factor.{field}", getattr(self, field),
+                                     "must be a function of the coefficients")
+        _positive("dynamic_factor.time_scale", self.time_scale)
+
+
+def _positive(field: str, value: object) -> None:
+    """ParameterError naming ``field`` unless ``value`` is a finite number > 0."""
+    if isinstance(value, bool) or not isinstance(value, int | float) \
+            or not (math.isfinite(value) and value > 0.0):
+        raise ParameterError(field, value, "must be a finite number > 0")
 
 
 class UserModel(Model):
@@ -64,6 +124,9 @@ class UserModel(Model):
         which is accurate only for modes slower than about Omega / 1.5; give it (or
         ``steps_per_period``) for a stiffer model.
     """
+
+    #: A user model's capabilities follow what it declares (:meth:`from_one_form`).
+    capabilities_per_instance = True
 
     def __init__(
         self,
@@ -124,6 +187,7 @@ class UserModel(Model):
         self.natural_frequency = natural_frequency
         self._declared: frozenset[str] = frozenset()
         self._static_forces: Callable[[Any], Sequence[float]] | None = None
+        self._dynamic_factor: DynamicFactorDeclaration | None = None
         self._initial: Sequence[float] | Callable[[Any], Sequence[float]] | None = None
 
     @classmethod
@@ -139,6 +203,7 @@ class UserModel(Model):
         observable_names: Sequence[str] = (),
         meshes: Sequence[MeshSpec] = (),
         static_forces: Callable[[Any], Sequence[float]] | None = None,
+        dynamic_factor: DynamicFactorDeclaration | None = None,
         derived: Derivations | None = None,
         coefficients: Sequence[Coefficient] = (),
         initial_state: Sequence[float] | Callable[[Any], Sequence[float]] | None = None,
@@ -176,6 +241,12 @@ class UserModel(Model):
         static_forces
             ``static_forces(p)``: the static force of each mesh from the coefficients (named
             tuple), for the dynamic factor.
+        dynamic_factor
+            The dynamic factor against ISO 6336-1 K_v
+            (:class:`DynamicFactorDeclaration`: input speed and torque coefficients, mesh
+            groups, natural frequencies, time scale), for
+            :func:`~geardyn.dynamic_factor_sweep`; needs meshes that name their forces and
+            ``static_forces``.
         derived
             Derived coefficients: ``{"cos_phi": ("phi", math.cos)}``; each is a coefficient
             (after ``params``) that follows its parameter (computed once per value with the
@@ -222,8 +293,10 @@ class UserModel(Model):
         model.event_names = event_names
         model.observable_names = tuple(observable_names) if observe is not None else ()
         model.meshes, forces = _meshes(meshes, model.event_names, model.observable_names)
-        model.capabilities = Capabilities(mesh_forces=forces)
         model._static_forces = static_forces
+        model.capabilities = Capabilities(mesh_forces=forces)
+        if dynamic_factor is not None:
+            model._declare_dynamic_factor(dynamic_factor)
         model._initial = initial_state
         model.kernel = KernelSource(rhs, events, observe, one_form=OneForm(
             model.param_names, model.n_states, model.n_events, model.n_observables))
@@ -267,6 +340,79 @@ class UserModel(Model):
             raise ValueError(f"static_forces gives {f.size} values for {len(self.meshes)} "
                              f"meshes")
         return f
+
+    # ------------------------------------------------------------------ ISO 6336-1 K_v
+    def _declare_dynamic_factor(self, spec: DynamicFactorDeclaration) -> None:
+        """Take ``spec`` (``dynamic_factor`` of :meth:`from_one_form`): ParameterError naming
+        the field for a declaration the model cannot serve."""
+        if not isinstance(spec, DynamicFactorDeclaration):
+            raise ParameterError("dynamic_factor", spec, "a geardyn.models.user."
+                                 "DynamicFactorDeclaration")
+        if not self.capabilities.mesh_forces:
+            raise ParameterError("meshes", self.meshes, "the dynamic factor needs meshes that "
+                                 "name their force observables (name, drive, back, force)")
+        if self._static_forces is None:
+            raise ParameterError("static_forces", None, "the dynamic factor needs the static "
+                                 "mesh forces (static_forces(p))")
+        inputs = [n for n in self.param_names if n not in self.derived]
+        for field in ("speed", "torque"):
+            name = getattr(spec, field)[0]
+            if name not in inputs:
+                raise ParameterError(f"dynamic_factor.{field}", name,
+                                     f"not an input coefficient ({', '.join(inputs)})")
+        self._dynamic_factor = spec
+        self.time_scale = float(spec.time_scale)
+        self.capabilities = Capabilities(mesh_forces=True, dynamic_factor=True,
+                                         natural_frequencies="Hz")
+
+    def _kv(self) -> DynamicFactorDeclaration:
+        """The declaration, or a ParameterError naming what is missing."""
+        if self._dynamic_factor is None:
+            raise ParameterError("dynamic_factor", None, f"{self.name} declares no dynamic "
+                                 "factor: give UserModel.from_one_form(..., dynamic_factor="
+                                 "DynamicFactorDeclaration(...))")
+        return self._dynamic_factor
+
+    @property
+    def input_torque(self) -> float:
+        """The input torque [N m]: the declared torque coefficient over its value per N m."""
+        name, per = self._kv().torque
+        return float(self.params[self.param_index(name)]) / per
+
+    def at_input_torque(self, torque: float) -> UserModel:
+        """The model at the input torque ``torque`` [N m]."""
+        name, per = self._kv().torque
+        return self.with_params(**{name: float(torque) * per})
+
+    def kv_groups(self, torque: float) -> tuple[KvMeshGroup, ...]:
+        """The declared mesh groups at the input torque ``torque`` [N m]."""
+        groups = tuple(self._kv().groups(self.coefficients(), float(torque)))
+        if not groups:
+            raise ParameterError("dynamic_factor.groups", groups, "gives no mesh group")
+        for g in groups:
+            if not isinstance(g, KvMeshGroup):
+                raise ParameterError("dynamic_factor.groups", g, "gives geardyn.gears."
+                                     "iso6336_kv.KvMeshGroup entries")
+            if not g.meshes or any(not 0 <= k < len(self.meshes) for k in g.meshes):
+                raise ParameterError(f"dynamic_factor.groups[{g.name!r}].meshes", g.meshes,
+                                     f"indices of the model's {len(self.meshes)} meshes")
+        return groups
+
+    def input_speed_sweep(self, rpm: np.ndarray) -> tuple[str, np.ndarray]:
+        """The declared speed coefficient and its values at input speeds ``rpm``."""
+        name, per = self._kv().speed
+        return name, np.asarray(rpm, dtype=float) * per
+
+    def mesh_frequency_per_input_speed(self) -> float:
+        """The reference mesh's (the first group's) cycles per input revolution: gear 1's
+        speed over the input speed times its teeth."""
+        g = self.kv_groups(self.input_torque)[0]
+        return float(g.speed_per_input) * g.pinion_teeth
+
+    def natural_frequencies(self) -> np.ndarray:
+        """The declared natural frequencies [Hz] at the model's coefficients."""
+        return np.asarray(self._kv().natural_frequencies(self.coefficients()),
+                          dtype=float).ravel()
 
     def fastest_natural_frequency(self, P: np.ndarray | None = None) -> np.ndarray:
         """``natural_frequency`` in every lane of ``P`` (NaN when it was not given; see the
