@@ -35,10 +35,7 @@ SPLIT = """    UNRES[lane] += _split_step(i, T0B[k], ys, y1s, P[lane], HB[k], OM
 """
 # Counts (15 bits each; the paper's lanes flag at most ~4500 steps): bits 0-14 a side left at
 # the step's end, 15-29 none, 30-44 of those a crossing located (a graze), 45-59 a side left
-# and a graze flag set (the split looks for more crossings in the step). The guarded print
-# reads UNRES after the store: without a read there, the added counts were lost (numba 0.68:
-# the stores after _split_step's call in the inlined _finish_flagged vanished; the print
-# never runs).
+# and a graze flag set (the split looks for more crossings in the step).
 
 
 def census_edit() -> list[tuple[str, str]]:
@@ -52,8 +49,7 @@ def census_edit() -> list[tuple[str, str]]:
            "    zci = 1 if zx > 0 else 0\n    zg = 1 if zc1 > zc0 else 0\n"
            "    zgf = 1 if zf > 0 else 0\n"
            "    UNRES[lane] += (zci + ((1 - zci) << 15) + (((1 - zci) * zg) << 30)\n"
-           "                    + ((zci * zgf) << 45) + (zu << 60))\n"
-           "    if zc1 == -12345:\n        print(UNRES[lane])\n")
+           "                    + ((zci * zgf) << 45) + (zu << 60))\n")
     return [(SPLIT, new)]
 
 
@@ -81,6 +77,8 @@ def main() -> None:
         raise SystemExit("a lane's count fills its 15 bits: the counts are not separable")
     crossed, other, graze, crossed_gr = (int(f.sum()) for f in fields)
     flagged = crossed + other
+    if flagged == 0 and out.crossings.any():  # every crossing is located by a flagged step
+        raise SystemExit("crossings located but no flagged step counted: the counts were lost")
     steps = int(out.steps.sum())
     print(f"# paper workload, {args.points} points, edge location on, one thread "
           f"(census run, compile included: {cpu:.1f} s CPU)")

@@ -26,7 +26,8 @@ LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
     # (atomic writes, attribute encoding), the packaged study files (data only), the kernels'
     # vector width (their compiler pipeline), the cache folder (keyed by that width)
     ("base", ("geardyn._version", "geardyn.errors", "geardyn.files", "geardyn.units",
-              "geardyn.studies", "geardyn._jit_target", "geardyn._cache")),
+              "geardyn.studies", "geardyn._jit_target", "geardyn._tuple_alias",
+              "geardyn._cache")),
     # the model interface, the kernel source, run settings, the lane plan, the section, status
     ("core", ("geardyn.core",)),
     # gear geometry, ISO 6336 stiffness, stiffness waves, planetary mesh phasing (pure numpy)

@@ -42,6 +42,8 @@ from numba.core.compiler import Compiler
 from numba.core.compiler_machinery import LoweringPass, register_pass
 from numba.core.typed_passes import AnnotateTypes
 
+from geardyn._tuple_alias import tuple_aliases
+
 #: The environment variable that chooses the vector width.
 ENV = "GEARDYN_SIMD_WIDTH"
 #: Its values (see above) and the preferred vector width in bits each sets (None: no attribute).
@@ -117,7 +119,13 @@ class VectorWidthPass(LoweringPass):
 
 class WidthCompiler(Compiler):
     """numba's pipeline with :class:`VectorWidthPass` before the lowering: the compiled
-    function gets geardyn's vector width (``pipeline_class=WidthCompiler``)."""
+    function gets geardyn's vector width (``pipeline_class=WidthCompiler``). It runs with
+    numba's alias analysis following tuples (:func:`geardyn._tuple_alias.tuple_aliases`), so
+    that its dead-code elimination keeps the stores into arrays passed in tuples."""
+
+    def _compile_core(self) -> Any:
+        with tuple_aliases():
+            return super()._compile_core()
 
     def define_pipelines(self) -> list:
         pipelines = super().define_pipelines()
