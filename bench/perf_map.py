@@ -8,7 +8,10 @@ symbols (``nm``) and load addresses, runs the workload under ``perf record -p <p
 prints ``perf report``'s top symbols.
 
     .venv/bin/python bench/perf_map.py [--points 1000] [--threads 1] [--top 25]
-                                       [--annotate _split_step]
+                                       [--annotate _split_step] [--dump DIR]
+
+``--dump DIR``: each hot function's disassembly with its samples per instruction, and the
+words pushed onto the stack at each of its call sites with the samples they take.
 
 Workload: bench/bifurcation.py's paper reference workload (``--points`` values of Omega), or
 with ``--gear-pair`` bench/peers.py's (the gear pair at 128 steps per period, 400 Omega).
@@ -18,6 +21,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import re
 import subprocess
 import sys
 import tempfile
@@ -156,6 +160,53 @@ def annotate(rows: dict, data: Path, needle: str, top: int) -> None:
                                               for k, v in sorted(kinds.items())))
 
 
+def dump(rows: dict, data: Path, folder: Path, least: float = 0.5) -> None:
+    """Each mapped function with at least ``least`` % of the samples, disassembled into
+    ``folder/<name>.s`` with each instruction's samples (``perf script``) in front, and per call
+    site the words its arguments push onto the stack and the samples from the last branch
+    before it to the call (what a call with many arguments costs the caller)."""
+    ips = [int(ip, 16) for ip in subprocess.run(
+        ["perf", "script", "-i", str(data), "-F", "ip"], capture_output=True,
+        text=True).stdout.split()]
+    folder.mkdir(parents=True, exist_ok=True)
+    for start, (size, name, obj, off) in sorted(rows.items()):
+        counts: dict[int, int] = {}
+        for a in ips:
+            if start <= a < start + size:
+                counts[a - start + off] = counts.get(a - start + off, 0) + 1
+        total = sum(counts.values())
+        if not ips or 100 * total / len(ips) < least:
+            continue
+        with tempfile.NamedTemporaryFile(suffix=".o") as f:
+            f.write(obj)
+            f.flush()
+            dis = subprocess.run(["objdump", "-d", "--no-show-raw-insn",
+                                  f"--start-address={off}", f"--stop-address={off + size}",
+                                  f.name], capture_output=True, text=True).stdout
+        lines = []
+        for line in dis.splitlines():
+            head, _, ins = line.partition(":")
+            h = head.strip()
+            if ins and h and all(c in "0123456789abcdef" for c in h):
+                ins = re.sub(r"<_ZN[^>]*>", "<...>", " ".join(ins.split()))
+                lines.append((counts.get(int(h, 16), 0), int(h, 16) - off, ins))
+        short = name.split(".")[-1]
+        (folder / f"{short}.s").write_text(
+            "\n".join(f"{n:6d} {a:6x}  {ins}" for n, a, ins in lines) + "\n")
+        print(f"{short}: {total} samples ({100 * total / len(ips):.1f} %) -> {folder}/{short}.s")
+        for i, (_, a, ins) in enumerate(lines):
+            if not ins.startswith("call"):
+                continue
+            j = i - 1
+            while j >= 0 and not lines[j][2].startswith(("j", "ret")):
+                j -= 1
+            pushes = sum(ins2.startswith("push") for _, _, ins2 in lines[j + 1:i])
+            if pushes > 4:
+                n = sum(c for c, _, _ in lines[j + 1:i + 1])
+                print(f"  call at +{a:#x}: {pushes} words pushed, {n} samples "
+                      f"({100 * n / max(total, 1):.1f} % of the function)")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--points", type=int, default=1000)
@@ -165,6 +216,8 @@ def main() -> None:
     ap.add_argument("--gear-pair", action="store_true", help="bench/peers.py's workload")
     ap.add_argument("--annotate", action="append", default=[],
                     help="the hottest instructions of the function whose name contains this")
+    ap.add_argument("--dump", type=Path, default=None,
+                    help="folder for each hot function's disassembly with its samples")
     args = ap.parse_args()
     _record_cache_loads()
     numba.set_num_threads(args.threads)
@@ -199,6 +252,8 @@ def main() -> None:
     print("\n".join(lines[: args.top]))
     for needle in args.annotate:
         annotate(rows, data, needle, args.top)
+    if args.dump is not None:
+        dump(rows, data, args.dump)
 
 
 if __name__ == "__main__":

@@ -195,3 +195,70 @@ def test_results_are_bitwise_the_same_at_every_vector_width():
     narrow = _fresh(_SWEEP, timeout=1500.0, **{jt.ENV: "256"})
     assert np.sum(wide["crossings"]) > 0
     assert wide == narrow
+
+
+def test_a_numba_symbols_function_name_is_its_last_part():
+    assert jt._function_name("_ZN32geardyn_rk4_0808e8c3f0e66deb132010_slots_outB20v36E5Array") \
+        == "_slots_out"
+    assert jt._function_name("_ZN7geardyn7solvers12_sweep_books8_compactB46c8tJTE") == "_compact"
+    assert jt._function_name("cfunc._ZN5numba3fooB2v1E") == ""
+
+
+def _ool_plain(a, b, c, d, e, k):
+    """sum_j a[j] e[k - j] (b, c, d unread)."""
+    s = 0.0
+    for j in range(k + 1):
+        s += a[j] * e[k - j]
+    return s
+
+
+def _ool_marked(a, b, c, d, e, k):
+    """:func:`_ool_plain`, to be marked out of line."""
+    s = 0.0
+    for j in range(k + 1):
+        s += a[j] * e[k - j]
+    return s
+
+
+def _ool_params(ir: str, name: str, internal: bool) -> int:
+    """The number of parameters of the numba function ``name`` (its internal copy, or its own
+    definition) defined in the LLVM IR ``ir``."""
+    import re
+
+    head = next(line for line in ir.splitlines()
+                if line.startswith("define ") and "@_ZN" in line
+                and f"{len(name)}{name}B" in line and (" internal " in line) == internal)
+    return len(re.findall(r"%[\w.]+(?=[,)])", head[head.index("@"):]))
+
+
+def test_an_out_of_line_callee_is_called_with_only_the_arguments_it_reads():
+    """A callee marked :func:`geardyn._jit_target.out_of_line` stays a call (noinline) of an
+    internal copy whose signature LLVM has cut to the array fields it reads; its caller's
+    results are those of a plain call and of numpy."""
+    import numba as nb
+
+    jit = {"pipeline_class": jt.WidthCompiler, "_nrt": False}
+    plain = nb.njit(**jit)(_ool_plain)
+    marked = jt.out_of_line(nb.njit(**jit)(_ool_marked))
+
+    def caller(f):
+        def run(a, b, c, d, e):
+            s = 0.0
+            for k in range(a.size):
+                s += f(a, b, c, d, e, k)
+            return s
+        return nb.njit(**jit)(run)
+
+    rng = np.random.default_rng(3)
+    arrays = [rng.standard_normal(40) for _ in range(5)]
+    by_marked = caller(marked)
+    assert by_marked(*arrays) == caller(plain)(*arrays)
+    a, e = arrays[0], arrays[4]
+    expected = sum(float(np.dot(a[:k + 1], e[k::-1])) for k in range(a.size))
+    assert by_marked(*arrays) == pytest.approx(expected, rel=1e-12)
+    ir = next(iter(by_marked.inspect_llvm().values()))
+    own = next(iter(marked.inspect_llvm().values()))
+    n_own = _ool_params(own, "_ool_marked", internal=False)
+    n_local = _ool_params(ir, "_ool_marked", internal=True)
+    assert any(" call " in line and "_ool_marked" in line for line in ir.splitlines())
+    assert n_local < n_own // 2, (n_local, n_own)
