@@ -27,9 +27,6 @@ configuration and every numba function of other code keep LLVM's choice for the 
 numba was used before ``import geardyn`` or not, and numba's own ``NUMBA_CPU_NAME`` /
 ``NUMBA_CPU_FEATURES`` still choose the CPU (the attribute only sets the width within it).
 
-The same pipeline calls the functions marked :func:`out_of_line` (the sweep's out-of-line
-bookkeeping, the split step) with only the arguments they read.
-
 The width is part of the cache key of geardyn's functions (:func:`cache_tag`, in the name of
 their cache files, :mod:`geardyn._cache`): kernels compiled at one width are never loaded at
 another.
@@ -41,7 +38,6 @@ import os
 from collections.abc import Mapping
 from typing import Any
 
-import llvmlite.binding as ll
 from numba.core.compiler import Compiler
 from numba.core.compiler_machinery import LoweringPass, register_pass
 from numba.core.typed_passes import AnnotateTypes
@@ -100,66 +96,10 @@ def _mark(library: Any, attribute: str) -> None:
     library.add_ir_module = add_ir_module
 
 
-#: Names of the functions called out of line with only the arguments they use (see
-#: :func:`out_of_line`).
-OUT_OF_LINE: set[str] = set()
-
-
-def out_of_line(dispatcher: Any) -> Any:
-    """Mark a numba function (a decorator, above ``nb.njit``) as called out of line, with only
-    the arguments it uses, by geardyn's functions that call it.
-
-    numba passes every field of every array argument (data pointer, shape, strides, and four
-    more words) by value, and links a callee into its caller's module with ``linkonce_odr``
-    linkage, which keeps its signature: a call passing a sweep block's ~80 arrays pushed 744
-    words onto the stack. In the module of a caller compiled with :class:`WidthCompiler`, a
-    marked callee is made ``internal`` and ``noinline`` before the module's optimisation, so
-    that LLVM's dead-argument elimination drops the fields and arrays it does not read (the
-    caller's copy only; the callee's own library is unchanged). The code of both is otherwise
-    the same: the results are bitwise those of the plain call."""
-    OUT_OF_LINE.add(dispatcher.py_func.__name__)
-    return dispatcher
-
-
-def _function_name(symbol: str) -> str:
-    """The function's name in a numba symbol (``_ZN<len><module part>...<len><name>B...``):
-    the last length-prefixed part."""
-    if not symbol.startswith("_ZN"):
-        return ""
-    j = 3
-    name = ""
-    while j < len(symbol) and symbol[j].isdigit():
-        k = j
-        while symbol[k].isdigit():
-            k += 1
-        n = int(symbol[j:k])
-        name = symbol[k:k + n]
-        j = k + n
-    return name
-
-
-def _localise(library: Any) -> None:
-    """Make ``library`` (a numba code library) turn the functions marked :func:`out_of_line`
-    that are linked into its final module into ``internal``, ``noinline`` ones before the
-    module's optimisation (see there)."""
-    optimize = library._optimize_final_module
-
-    def _optimize_final_module() -> None:
-        for fn in library._final_module.functions:
-            if (not fn.is_declaration and fn.linkage == ll.Linkage.linkonce_odr
-                    and _function_name(fn.name) in OUT_OF_LINE):
-                fn.linkage = ll.Linkage.internal
-                fn.add_function_attribute("noinline")
-        optimize()
-
-    library._optimize_final_module = _optimize_final_module
-
-
 @register_pass(mutates_CFG=False, analysis_only=False)
 class VectorWidthPass(LoweringPass):
     """Before numba's lowering: the function's code library (created here, as numba's
-    lowering would) puts :data:`ATTRIBUTE` on the functions lowered into it and calls the
-    functions marked :func:`out_of_line` with only the arguments they use."""
+    lowering would) puts :data:`ATTRIBUTE` on the functions lowered into it."""
 
     _name = "geardyn_vector_width"
 
@@ -167,13 +107,13 @@ class VectorWidthPass(LoweringPass):
         LoweringPass.__init__(self)
 
     def run_pass(self, state: Any) -> bool:
+        if ATTRIBUTE is None:
+            return False
         if state.library is None:
             state.library = state.targetctx.codegen().create_library(
                 state.func_id.func_qualname)
             state.library.enable_object_caching()
-        if ATTRIBUTE is not None:
-            _mark(state.library, ATTRIBUTE)
-        _localise(state.library)
+        _mark(state.library, ATTRIBUTE)
         return True
 
 

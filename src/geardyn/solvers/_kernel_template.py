@@ -34,7 +34,6 @@ from __future__ import annotations
 import numba as nb
 import numpy as np
 
-from geardyn._jit_target import out_of_line
 from geardyn.core.kernel_source import FORM_GENERAL, FORM_LOAD, FORM_QUIET, LANE_FORMS
 from geardyn.solvers._parallel import run_workers
 from geardyn.solvers._step_core import (  # CORE-IMPORT
@@ -859,11 +858,10 @@ _finish_flagged_i = nb.njit(inline="always", **_JIT)(_finish_flagged.py_func)
 _slot_sample_i = nb.njit(inline="always", **_JIT)(_slot_sample.py_func)
 
 
-@out_of_line  # called with only the arrays it reads
 @nb.njit(_nrt=False, **_JIT)
 def _slots_out(nl, G1, SE, CE, TABS, lanes, cfg, out, blk, slots, scratch):
-    """:func:`_slot_out` for every marked slot (MSK), in one call per block step, not one per
-    slot; called with only the array fields it reads (:func:`out_of_line`). The marked slots
+    """:func:`_slot_out` for every marked slot (MSK), in one call per block step (a call
+    passes every block array by value: one per slot cost a fifth of the run). The marked slots
     are gathered first, in a loop of their own: the loop over the block's slots with the
     bookkeeping inlined in it kept a dozen pointers stepping on the stack, half of this
     function's time on the paper's lanes, where ~1 slot in 60 is marked. Returns the number

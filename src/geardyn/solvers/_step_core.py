@@ -35,7 +35,7 @@ import math
 import numba as nb
 import numpy as np
 
-from geardyn._jit_target import WidthCompiler, out_of_line
+from geardyn._jit_target import WidthCompiler
 from geardyn.core.kernel_source import FORM_GENERAL
 from geardyn.solvers._step_shared import (  # noqa: F401 - the templates import them from here
     BLOCK,
@@ -351,7 +351,6 @@ def _split_copy(dst, src):
         dst[q] = src[q]
 
 
-@out_of_line  # called with only the arguments it reads
 @nb.njit(_nrt=False, **_JIT)  # it allocates nothing: no reference counting of its views
 def _split_step(i, t0, y, y_trial, p, h, omega, n_per, sa, ca, s_end, c_end, side, g1, ncross,
                 work, ybuf, gbuf):
