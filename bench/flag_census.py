@@ -7,7 +7,10 @@ The generated kernel module with a census in ``_finish_flagged`` (bench/fused_lo
 variant mechanism; compiled afresh, not cached), counts in the lanes' ``unresolved`` entries
 (checked: no field full, no step at the split limit). One thread.
 
-    .venv/bin/python bench/flag_census.py [--points 1000]
+    .venv/bin/python bench/flag_census.py [--points 1000] [--calls]
+
+``--calls``: instead, how many block steps of the fused loop there are and how many of them
+call out of line (``_slots_out``: a slot flagged or with bookkeeping due), one or more slots.
 """
 
 from __future__ import annotations
@@ -53,14 +56,33 @@ def census_edit() -> list[tuple[str, str]]:
     return [(SPLIT, new)]
 
 
+# --calls: per block step of the fused loop, into the unresolved entry of the lane in slot 0
+# (21 bits each): bits 0-20 block steps, 21-41 those with a marked slot (a call of _slots_out),
+# 42-62 those with two or more marked slots.
+CALLS = ("        if n_out > 0:\n",
+         "        out[9][LANE[0]] += (1 + ((1 if n_out > 0 else 0) << 21)\n"
+         "                            + ((1 if n_out > 1 else 0) << 42))\n"
+         "        if n_out > 0:\n")
+
+
+def calls(u: np.ndarray, out) -> None:
+    """Print the --calls census (see CALLS) of the lanes' unresolved entries ``u``."""
+    steps, called, several = (int(((u >> s) & 0x1FFFFF).sum()) for s in (0, 21, 42))
+    print(f"block steps {steps}, with a marked slot (a call out of line) {called} "
+          f"({called / steps:.3f}), with two or more {several} ({several / steps:.3f}); "
+          f"lane-steps {int(out.steps.sum())} ({int(out.steps.sum()) / steps:.1f} per block step)")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--points", type=int, default=1000)
+    ap.add_argument("--calls", action="store_true",
+                    help="count the block steps and the calls out of line instead")
     args = ap.parse_args()
     numba.set_num_threads(1)
     model = device()
     source = Path(kernels_for(model.kernel).__file__).read_text()
-    fused_loop.EDITS["census"] = census_edit()
+    fused_loop.EDITS["census"] = [CALLS] if args.calls else census_edit()
     with tempfile.TemporaryDirectory() as tmp:
         mod = fused_loop.variant_module(source, "census", Path(tmp))
         ens.kernels_for = lambda kernel: mod
@@ -70,6 +92,9 @@ def main() -> None:
         out = ens.run_lanes(model, P, model.initial_state(), run=run)
         cpu = time.process_time() - t0
     u = out.unresolved
+    if args.calls:
+        calls(u, out)
+        return
     if np.any(u >> 60):
         raise SystemExit("a step reached the split limit: the counts are not separable")
     fields = [(u >> s) & 0x7FFF for s in (0, 15, 30, 45)]
