@@ -1,7 +1,6 @@
 """One stepping machinery: the RK4 combination and its weight h / 6 written once
 (:mod:`geardyn.solvers._step_shared`) and used by every kernel, the parameter difference step
-declared once, the one-lane-at-a-time Lyapunov reference kept with the tests, and the sweep's
-slot move touching only the arrays the fused loop reads (its arguments are ``noalias``)."""
+declared once, and the one-lane-at-a-time Lyapunov reference kept with the tests."""
 
 from __future__ import annotations
 
@@ -11,7 +10,7 @@ from pathlib import Path
 import numpy as np
 
 from geardyn.core import settings
-from geardyn.solvers import _step_shared, _sweep_books
+from geardyn.solvers import _step_shared
 
 SRC = Path(__file__).resolve().parent.parent / "src" / "geardyn"
 #: An RK4 combination written out (``k1 + 2.0 * k2 + 2.0 * k3 + k4`` in any layout) and a step
@@ -66,45 +65,3 @@ def test_parameter_difference_step_is_declared_once():
 
 def test_lyapunov_rows_reference_is_in_the_tests():
     assert _hits(re.compile(r"lyapunov_lanes_rows|_lanes_rows\b")) == []
-
-
-def _block(ns=3, nw=16, n_par=4, depth=2):
-    """A block of the sweep (``blk``, ``slots``) with distinct values everywhere, its views PH
-    and HW separate arrays (not rows of PH6, HW3), PH6 and HW3 NaN."""
-    rng = np.random.default_rng(7)
-
-    def r(*shape):
-        return rng.standard_normal(shape)
-
-    Y, Y1, K1, K2, K3, K4, TMP = (r(ns, nw) for _ in range(7))
-    PH6, HW3 = np.full((4, nw), np.nan), np.full((3, ns, nw), np.nan)
-    PH = tuple(r(nw) for _ in range(4))
-    HW = tuple(r(ns * nw) for _ in range(3))
-    FL = tuple(a.reshape(ns * nw) for a in (Y, Y1, K1, K2, K3, K4, TMP))
-    blk = (r(nw, depth, ns), r(nw, 3 * depth, depth), Y, Y1, K1, K2, K3, K4, TMP, r(n_par, nw),
-           r(8, nw), PH6, PH, r(nw), r(2, nw), r(2, nw), r(2, nw), r(2, nw), r(2, nw), r(nw),
-           r(2, nw), r(2, nw), r(1, nw), r(1, nw), r(1, nw), r(1, nw), HW3, FL, HW)
-    flags = [np.ones(nw, np.bool_) for _ in range(4)]
-    ints = [rng.integers(0, 100, nw) for _ in range(11)]
-    slots = (*flags, *ints[:5], r(nw), r(nw), *ints[5:])
-    return blk, slots
-
-
-def test_slot_move_touches_only_the_views_the_fused_loop_reads():
-    # _block_run_form* take blk's arrays as noalias arguments: of PH6 and its rows PH (HW3 and
-    # its flat rows HW) only one may be touched there. The fused loop reads PH and HW, so the
-    # compaction (_compact -> _move_slot) moves a slot's phases and step weights through them.
-    blk, slots = _block()
-    PH, HW = blk[12], blk[28]
-    before = [a.copy() for a in (*PH, *HW)]
-    src, dst = 13, 2
-    _sweep_books._move_slot.py_func(src, dst, blk, slots)
-    assert np.all(np.isnan(blk[11])) and np.all(np.isnan(blk[26]))  # PH6, HW3 untouched
-    ns, nw = blk[2].shape
-    for old, new in zip(before[:4], PH, strict=True):
-        assert new[dst] == old[src]
-        np.testing.assert_array_equal(np.delete(new, dst), np.delete(old, dst))
-    for old, new in zip(before[4:], HW, strict=True):
-        for q in range(ns):
-            assert new[q * nw + dst] == old[q * nw + src]
-    assert not slots[2][src] and not slots[3][src]  # src freed (ACT, END)

@@ -256,24 +256,17 @@ def _move_slot(src, dst, blk, slots):
     """Slot src's lane into the free slot dst: every column that lives from one step to the next
     (state, coefficients, phase, events and their history, statistics, convergence ring,
     clocks); src is left free (not running, not to be refilled, nothing marked, no lane
-    held). The phases and the step weights are moved through ``blk``'s views PH and HW (the
-    arrays the fused loop reads), not through PH6 and HW3 whose rows they are: the fused
-    loop's functions take their array arguments as ``noalias`` (see
-    :class:`._step_core._NoAliasCompiler`), so they may touch only one of two arrays that
-    share memory."""
+    held)."""
     (R, D, Y, Y1, K1, K2, K3, K4, TMP, PT, SC, PH6, PH, TT, GP, GS, G1, GR, SIDE, FLAG,
      GMIN, GMAX, O, OMAX, OMIN, OSQ, HW3, FL, HW) = blk
     (STAT, MSK, ACT, END, LANE, STEP, PHASE, NPER, OFF, HB, T0B, n_end, n_tr, next_sample, DUE,
      n_stat, n_ring) = slots
-    for A in (Y, PT, SC, GP, GS, G1, GR, SIDE, GMIN, GMAX, OMAX, OMIN, OSQ):
+    for A in (Y, PT, PH6, SC, GP, GS, G1, GR, SIDE, GMIN, GMAX, OMAX, OMIN, OSQ):
         for j in range(A.shape[0]):
             A[j, dst] = A[j, src]
-    for V in PH:
-        V[dst] = V[src]
-    nw = Y.shape[1]
-    for V in HW:  # flat rows of (state, slot): slot k of state q at q nw + k
-        for q in range(Y.shape[0]):
-            V[q * nw + dst] = V[q * nw + src]
+    for j in range(HW3.shape[0]):
+        for q in range(HW3.shape[1]):
+            HW3[j, q, dst] = HW3[j, q, src]
     for j in range(R.shape[1]):
         for q in range(R.shape[2]):
             R[dst, j, q] = R[src, j, q]
