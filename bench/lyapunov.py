@@ -14,7 +14,7 @@ with its tangent vector; wall time x threads / lane-steps, and CPU time / lane-s
 of the two, the largest difference of the exponents (relative to their error), the CPU time of
 each without edge location (``n_ev = 0``: the stepping alone; the difference rows then run the
 row blocks) and whether the variational blocks are bitwise the one-lane-at-a-time rows
-(``lyapunov_lanes_rows``).
+(``tests/_lyapunov_rows.py``).
 
     .venv/bin/python bench/lyapunov.py [--repeat 3] [--lanes 42] [--threads N]
 """
@@ -23,16 +23,22 @@ from __future__ import annotations
 
 import argparse
 import statistics
+import sys
 import time
+from pathlib import Path
 
 import numba
 import numpy as np
 
-import _results as results
 import geardyn
 from geardyn.analysis.lyapunov import lyapunov_lanes
 from geardyn.core.plan import forcing_period, lane_steps, periods_covering
 from geardyn.solvers.kernels import kernels_for
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))
+import _results as results  # noqa: E402
+from _lyapunov_rows import rows_for  # noqa: E402
 
 
 def device() -> geardyn.CATTDevice:
@@ -138,7 +144,7 @@ def main() -> None:
         print(f"  {name:12s} no edge location: {statistics.median(tt) / steps * 1e9:7.1f} "
               f"ns/lane-step (cpu)")
     blocks = kern.lyapunov_lanes
-    kern.lyapunov_lanes = kern.lyapunov_lanes_rows
+    kern.lyapunov_lanes = rows_for(kern)
     try:
         _, _, lr, er = run(model, P, a.transient, a.duration, "variational")
     finally:

@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 import geardyn
+from _lyapunov_rows import rows_for
 from geardyn.analysis import lyapunov as lyap_mod
 from geardyn.solvers.kernels import kernels_for
 from shared_models import lorenz_rhs as _lorenz  # one Lorenz kernel for the tests
@@ -140,7 +141,7 @@ def test_public_lanes_equal_one_lane_kernel(monkeypatch):
         new = lyap_mod.lyapunov_lanes(model, P, with_error=True, **run)
         kern = kernels_for(model.kernel, "lyapunov")
         with monkeypatch.context() as mp:
-            mp.setattr(kern, "lyapunov_lanes", kern.lyapunov_lanes_rows)
+            mp.setattr(kern, "lyapunov_lanes", rows_for(kern))
             old = lyap_mod.lyapunov_lanes(model, P, with_error=True, **run)
         _assert_bitwise(new, old)
         assert np.all(np.isfinite(new[0]))

@@ -13,6 +13,7 @@ import pytest
 from scipy.integrate import solve_ivp
 
 import geardyn
+from _lyapunov_rows import rows_for
 from geardyn.solvers.kernels import kernels_for
 
 #: A period-1 orbit with contact loss (two crossings per period), and a chaotic one.
@@ -115,7 +116,7 @@ def _lanes(model, oms, n_per, n_tr, n_st, variational, rows=False, n_ev=None):
     Y0 = np.ascontiguousarray(np.tile(model.initial_state(), (L, 1)))
     out, err = np.full(L, np.nan), np.full(L, np.nan)
     un, st, fd = (np.zeros(L, np.int64) for _ in range(3))
-    fn = kern.lyapunov_lanes_rows if rows else kern.lyapunov_lanes
+    fn = rows_for(kern) if rows else kern.lyapunov_lanes
     fn(P, Y0, np.ones(model.n_states), np.zeros(L), H, oms, np.full(L, n_per, np.int64),
        np.full(L, n_tr, np.int64), np.asarray(n_st, np.int64), 10, 1e6, out, err,
        model.n_events if n_ev is None else n_ev, 16, un, st, variational, fd)

@@ -8,7 +8,7 @@ p), followed in the arclength of the scaled unknowns z = (x / state_scale, p / p
   along the previous tangent);
 * **corrector** Newton on G(z) = 0 together with t . (z - z_pred) = 0 (Keller's bordered
   system): dG/dx = M - I from the monodromy kernel, dG/dp by a central difference of the
-  residual (step 1e-6 (1 + |p|));
+  residual (step :data:`~geardyn.core.settings.PARAM_STEP_REL` (1 + |p|));
 * **step control** the step grows after a corrector of at most 2 iterations, shrinks after a
   slow one, is halved after a failure or a turn of the tangent by more than ~25 degrees, and
   the branch ends when it would fall below ``ds_min``.
@@ -68,7 +68,12 @@ from geardyn.analysis.orbits import (
 )
 from geardyn.core.model import Model
 from geardyn.core.plan import default_steps_per_period
-from geardyn.core.settings import ContinuationSettings, RunSettings, resolve_settings
+from geardyn.core.settings import (
+    PARAM_STEP_REL,
+    ContinuationSettings,
+    RunSettings,
+    resolve_settings,
+)
 
 #: Most corrector iterations per step.
 CORRECTOR_MAX_ITER = 12
@@ -76,8 +81,6 @@ CORRECTOR_MAX_ITER = 12
 #: least SHRINK_ITER (chord iterations: each costs one period map).
 GROW_ITER = 5
 SHRINK_ITER = 9
-#: Relative step of the central difference dG/dp.
-DP_REL = 1e-6
 #: Least cosine between successive tangents for a step to be accepted.
 MIN_COS = 0.9
 #: Most movement of any Floquet multiplier (to the nearest of the last point's) in a step:
@@ -295,7 +298,7 @@ class _Tracer:
     def jacobian(self, z: np.ndarray, ev: ShootingEval) -> np.ndarray:
         """The scaled Jacobian [dG/dx, dG/dp] (n x n+1) at z, dG/dp by a central difference."""
         p = self.p_of(z)
-        h = DP_REL * (1.0 + abs(p))
+        h = PARAM_STEP_REL * (1.0 + abs(p))
         x = self.x_of(z)
         up = self.problem_at(p + h).evaluate(x, jacobian=False)
         dn = self.problem_at(p - h).evaluate(x, jacobian=False)

@@ -19,9 +19,10 @@ right null vectors of A (reset at every accepted point of the curve; the zero se
 depend on them). Its derivative is g_z = -w^T A_z v, w from the transposed system; A_z comes
 from central differences of the monodromy: for fold and period doubling one difference along v
 in the state (D^2 P (v, .) is symmetric: step :data:`STATE_STEP` in the scaled state) and one per
-parameter (step :data:`PARAM_REL` (1 + |p|)); for Neimark-Sacker one per state coordinate and
-parameter. The same parameter differences give dG/dx and dG/dy. A Jacobian thus costs 1 + 2 + 4
-period maps with monodromy for fold and period doubling, 1 + 2 n + 4 for Neimark-Sacker.
+parameter (step :data:`~geardyn.core.settings.PARAM_STEP_REL` (1 + |p|)); for Neimark-Sacker one
+per state coordinate and parameter. The same parameter differences give dG/dx and dG/dy. A
+Jacobian thus costs 1 + 2 + 4 period maps with monodromy for fold and period doubling, 1 + 2 n + 4
+for Neimark-Sacker.
 
 The steps per forcing period stay fixed along a curve (the residual is then one smooth
 function of z).
@@ -38,7 +39,7 @@ import numpy as np
 from geardyn.analysis.arclength import OutsideDomain
 from geardyn.analysis.orbits import ShootingEval, ShootingProblem, problem_with_steps
 from geardyn.core.model import Model
-from geardyn.core.settings import RunSettings
+from geardyn.core.settings import PARAM_STEP_REL, RunSettings
 from geardyn.core.status import Status
 
 #: The curve kinds (``curve_kind``) this module defines, in words.
@@ -50,8 +51,6 @@ CURVE_KINDS = {
 }
 #: Central-difference step of the monodromy along v, in the scaled state.
 STATE_STEP = 1e-5
-#: Relative central-difference step of a parameter: h = PARAM_REL (1 + |p|).
-PARAM_REL = 1e-6
 
 
 def compound2(M: np.ndarray) -> np.ndarray:
@@ -242,7 +241,7 @@ class CurveSystem:
             Mm = self.scaled_monodromy(self._eval(info.problem, u - h * s * v))
             J[n, :n] = -(w @ (Mp - Mm)) / (2 * h)
         for col, (p, ps) in enumerate(((px, self.x_scale), (py, self.y_scale))):
-            h = PARAM_REL * (1.0 + abs(p))
+            h = PARAM_STEP_REL * (1.0 + abs(p))
             at = (p + h, py) if col == 0 else (px, p + h)
             bt = (p - h, py) if col == 0 else (px, p - h)
             up = self._eval(self.problem_at(*at), u)

@@ -28,7 +28,8 @@ system (G = 0, h = 0, dh/dt = 0) in (x0, t_g, X, Y) with the last equation solve
 
 Jacobian: the monodromy M - I from :meth:`ShootingProblem.evaluate` for dG/dx0; the other
 columns by finite differences: forward for dh/dx0 (step :data:`FD_STATE` in x0 / state_scale),
-central for the parameters (step :data:`FD_PARAM` (1 + abs(value)) in model units).
+central for the parameters (step :data:`~geardyn.core.settings.PARAM_STEP_REL` (1 + abs(value))
+in model units).
 
 The curve is followed by :mod:`geardyn.analysis.arclength` from its first point both ways,
 until it leaves the box ``x_range`` x ``y_range`` or fails (status and message, as a branch).
@@ -64,7 +65,7 @@ from geardyn.analysis.orbits import (
 )
 from geardyn.core.plan import default_steps_per_period
 from geardyn.core.results import finish
-from geardyn.core.settings import RunSettings
+from geardyn.core.settings import PARAM_STEP_REL, RunSettings
 from geardyn.solvers.kernels import kernels_for
 
 if TYPE_CHECKING:
@@ -74,8 +75,6 @@ if TYPE_CHECKING:
 FLANKS = ("drive", "back")
 #: Forward-difference step of dh/dx0, in x0 / state_scale.
 FD_STATE = 1e-6
-#: Central-difference step of the parameters, relative: FD_PARAM (1 + abs(value)).
-FD_PARAM = 1e-6
 #: The curve's default arclength settings (steps in the scaled unknowns).
 #: The tolerance is looser than a branch's: near the edge the located-edge RK4 map is smooth
 #: only to about 1e-7 of the state at :data:`GRAZING_STEP_FACTOR` times the step rule (the
@@ -256,7 +255,7 @@ class GrazingProblem:
             _, hp, _, _ = self._parts(xp, X, Y, False)
             J[n, j] = (hp - h) / FD_STATE
         for col, (v, sc) in enumerate(((X, self.x_scale), (Y, self.y_scale))):
-            d = FD_PARAM * (1.0 + abs(v))
+            d = PARAM_STEP_REL * (1.0 + abs(v))
             ends = []
             for sign in (1.0, -1.0):
                 XY = (X + sign * d, Y) if col == 0 else (X, Y + sign * d)

@@ -353,6 +353,9 @@ class NewtonSettings(_AnalysisSettings):
 #: Defaults of the continuation corrector and of bifurcation location.
 CORRECTOR_TOL = 1e-10
 LOCATE_TOL = 1e-7
+#: Relative step of every central difference in a model parameter p (the continuation's dG/dp,
+#: the bifurcation and grazing curves' parameter columns): p +- PARAM_STEP_REL (1 + |p|).
+PARAM_STEP_REL = 1e-6
 
 
 @dataclass(frozen=True)

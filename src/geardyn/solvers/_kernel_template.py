@@ -75,6 +75,7 @@ from geardyn.solvers._step_core import (  # CORE-IMPORT
     phase_rotate,
     phase_table,
 )
+from geardyn.solvers._step_shared import rk4_comb, rk4_sixth
 from geardyn.solvers._sweep_books import (  # compiled once for every model
     _alloc,
     _chained,
@@ -139,9 +140,9 @@ def _block_step(i, first, nl, active, Y, Y1, K1, K2, K3, K4, TMP, TT, G, SIDE, P
         TT[k] = T0[lane] + (i + 1) * h
     _rhs_block(TT, TMP, K4, P, first, nl, active, se, ce)
     for k in range(nl):
-        h6 = H[first + k] / 6.0
+        h6 = rk4_sixth(H[first + k])
         for q in range(ns):
-            Y1[k, q] = Y[k, q] + h6 * (K1[k, q] + 2.0 * K2[k, q] + 2.0 * K3[k, q] + K4[k, q])
+            Y1[k, q] = rk4_comb(Y[k, q], h6, K1[k, q], K2[k, q], K3[k, q], K4[k, q])
     _keep_start(i, nl, active, G, gbuf)
     _events_block(TT, Y1, G, P, first, nl, active, se, ce)
     for k in range(nl):
@@ -323,7 +324,7 @@ def _lanes_rk4(STEP, nl, Y, Y1, K1, K2, K3, K4, TMP, FL, HW, TT, HB, T0B, PT, P,
             for k in range(nl):
                 TT[k] = T0B[k] + (STEP[k] + 1) * HB[k]
     for m in range(m_all):
-        Y1f[m] = Yf[m] + H6f[m] * (K1f[m] + 2.0 * K2f[m] + 2.0 * K3f[m] + K4f[m])
+        Y1f[m] = rk4_comb(Yf[m], H6f[m], K1f[m], K2f[m], K3f[m], K4f[m])
 
 
 @nb.njit(inline="always", **_JIT)
@@ -698,7 +699,7 @@ def _block_run_soa(q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch):
                 for q in range(ns):
                     HW3[0, q, k] = 0.5 * H[lane]
                     HW3[1, q, k] = H[lane]
-                    HW3[2, q, k] = H[lane] / 6.0
+                    HW3[2, q, k] = rk4_sixth(H[lane])
             if loaded and n_ev > 0:  # the events at the new lanes' start (G1: scratch here)
                 _events_lanes(TT, Y, G1, PT, P, LANE, nl, SE, CE, ybuf, gb)
                 for k in range(nl):
@@ -942,7 +943,7 @@ def _fused_run(form, q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch):
     Yf, Y1f = _flat((Y, Y1, Y, Y, Y))[:2]
     GSf, GPf, GRf, SIDEf, _ = _flat((GS, GP, GR, SIDE, GR))
     nxt = q0  # the next lane of the queue
-    n_act = 0  # slots holding a running lane
+    n_act = np.int64(0)  # slots holding a running lane (not the literal 0: see _compact)
     nv = _padded(nl)  # the fused loop's slots: nl and idle ones (never filled, never active)
     for k in range(nl):  # every slot is free (an earlier pass, of another form, has ended)
         END[k] = True
@@ -965,12 +966,14 @@ def _fused_run(form, q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch):
                 SE[k] = S_TAB[OFF[k]]  # the phase at the start
                 CE[k] = C_TAB[OFF[k]]
                 ROT[0][k], ROT[1][k], ROT[2][k], ROT[3][k] = phase_increments(NPER[k])
-                H6[k] = HB[k] / 6.0
+                H6[k] = rk4_sixth(HB[k])
                 _t_side(GS, SIDE, k, _events_l(TT[k], _t_load(Y, k), PT, k, SE[k], CE[k]))
         if n_act == 0:
             break
         if nxt >= q1 and _padded(n_act) < nv:  # the queue is out: no slot empties for a lane
             _compact(nv, n_act, blk, slots)  # of it, so the block's running lanes move down
+            # (n_act an int64 from the start: typed from a literal 0 first, numba compiled
+            # _compact for Literal[int](0) as well)
             nv = _padded(n_act)
         n_flag, n_out = _fused_steps(form, nv, locate, cfg[4], Yf, Y1f, PT, SE, CE, H6, FLAG,
                                      (GSf, GPf, GRf, SIDEf), stats, slots, ROT, phx)

@@ -123,14 +123,15 @@ from geardyn.solvers._step_core import (  # CORE-IMPORT
     _tuple_source,
     phase_table,
 )
+from geardyn.solvers._step_shared import rk4_comb, rk4_sixth
 from geardyn.solvers._template_model import events, observe, rhs  # MODEL-IMPORT
 
 # TANGENT-ADAPTERS (a one-form model's tangent forms of its rhs: see .kernels)
 
 # the model interface names are part of the template's namespace (the generated copy re-binds
 # them); only rhs and events are used here
-__all__ = ["BLOCK_ROWS", "events", "lyapunov_block_lanes", "lyapunov_lanes", "lyapunov_lanes_rows",
-           "lyapunov_single", "observe", "phase_table", "rhs"]
+__all__ = ["BLOCK_ROWS", "events", "lyapunov_block_lanes", "lyapunov_lanes", "lyapunov_single",
+           "observe", "phase_table", "rhs"]
 
 
 #: Whether the model has the tangent forms of its rhs (a one-form model: ``rhs_tangent``,
@@ -159,10 +160,10 @@ if VARIATIONAL:
                 _rhs_t(t + hh, TMP, TV, KS[st], KV[st], p, s1, c1)
             else:
                 _rhs_t(t + h, TMP, TV, KS[st], KV[st], p, s2, c2)
-        h6 = h / 6.0
+        h6 = rk4_sixth(h)
         for q in range(ns):
-            y1[q] = y[q] + h6 * (KS[0, q] + 2.0 * KS[1, q] + 2.0 * KS[2, q] + KS[3, q])
-            w1[q] = w[q] + h6 * (KV[0, q] + 2.0 * KV[1, q] + 2.0 * KV[2, q] + KV[3, q])
+            y1[q] = rk4_comb(y[q], h6, KS[0, q], KS[1, q], KS[2, q], KS[3, q])
+            w1[q] = rk4_comb(w[q], h6, KV[0, q], KV[1, q], KV[2, q], KV[3, q])
 
     @nb.njit(**_JIT)
     def _var_step(i, t0, Z, S, IS, p, h, omega, n_per, s_tab, c_tab, n_ev, YP, E, K, TMP,
@@ -344,67 +345,6 @@ def lyapunov_single(p, y0, scale, t0, h, omega, n_per, n_transient, n_steps, ren
                 np.int64(n_blocks), bool(variational))
 
 
-def lyapunov_lanes_rows(P, Y0, scale, T0, H, OMEGA, n_per, n_transient, n_steps, renorm_every,
-                        bound, out, err, n_ev=0, n_blocks=16, unresolved=None, status=None,
-                        variational=False, fd_steps=None):
-    """:func:`lyapunov_lanes` one lane at a time (the rows of :func:`lyapunov_single`), the
-    lanes of each grid (n_per: one for all lanes or one per lane) in parallel: the kernel before
-    the lane blocks, kept as their reference."""
-    if variational and not VARIATIONAL:
-        raise ValueError("the variational tangent needs a model with the tangent forms of its "
-                         "rhs (a one-form model)")
-    L = Y0.shape[0]
-    nper = np.broadcast_to(np.asarray(n_per, np.int64), (L,))
-    for n in np.unique(nper):
-        idx = np.nonzero(nper == n)[0]
-        part, part_err = np.full(idx.size, np.nan), np.full(idx.size, np.nan)
-        part_u, part_s = np.zeros(idx.size, np.int64), np.zeros(idx.size, np.int64)
-        part_f = np.zeros(idx.size, np.int64)
-        sel = [np.ascontiguousarray(np.asarray(a)[idx])
-               for a in (P, Y0, T0, H, OMEGA, n_transient, n_steps)]
-        _lanes_rows(sel[0], sel[1], scale, sel[2], sel[3], sel[4], int(n), sel[5], sel[6],
-                    renorm_every, bound, part, part_err, part_u, part_s, part_f, n_ev,
-                    n_blocks, bool(variational))
-        out[idx], err[idx] = part, part_err
-        if fd_steps is not None:
-            fd_steps[idx] = part_f
-        if unresolved is not None:
-            unresolved[idx] = part_u
-        if status is not None:
-            status[idx] = part_s
-
-
-@nb.njit(parallel=True, **_JIT)
-def _lanes_rows(P, Y0, scale, T0, H, OMEGA, n_per, n_transient, n_steps, renorm_every, bound, out,
-                err, unres, status, fd_steps, n_ev, n_blocks, variational):
-    """Largest exponent of every lane (row of P, Y0; n_per steps per period), in parallel over
-    lanes, one lane at a time (the rows of :func:`lyapunov_single`).
-
-    scale: the state scale (one vector for all lanes, as in :func:`lyapunov_single`); T0: start
-    time (forcing phase zero there, as in :func:`lyapunov_single`) per lane; H, OMEGA:
-    step and forcing frequency per lane; n_transient, n_steps: per-lane step counts (int
-    arrays); n_ev and n_blocks as in :func:`lyapunov_single`. Fills out[L] and err[L] (the
-    standard error; NaN for diverged lanes), unres[L], status[L] and fd_steps[L] (see
-    :func:`_run`; ``variational`` as there).
-    """
-    L, ns = Y0.shape
-    forced = False
-    for lane in range(L):
-        if OMEGA[lane] != 0.0:
-            forced = True
-    s_tab, c_tab = phase_table(n_per, forced)
-    for lane in nb.prange(L):
-        ex, er, _nb, st, un, fd = _run(P[lane], Y0[lane], scale, T0[lane], H[lane],
-                                       OMEGA[lane], n_per, s_tab, c_tab, n_transient[lane],
-                                       n_steps[lane], renorm_every, np.int64(1), bound,
-                                       np.int64(n_ev), np.int64(n_blocks), variational)
-        fd_steps[lane] = fd
-        out[lane] = ex[0] if st != STATUS_DIVERGED else np.nan
-        err[lane] = er[0] if st != STATUS_DIVERGED else np.nan
-        unres[lane] = un
-        status[lane] = st
-
-
 # ---------------------------------------------------------------------------------------------
 # Lane blocks, structure of arrays: the integrations of several lanes (each lane's state row and its
 # 2 k perturbed rows) advance as the rows of one block, state Y[q, r] with the row index r innermost
@@ -537,7 +477,7 @@ def _rows_rk4(nr, Y, Y1, K1, K2, K3, K4, TMP, TS, TM, TE, HR, HH, H6, PT, P, LAN
     _rows_rhs(TE, TMP, K4, PT, P, LANE, nr, PH[4], PH[5], SC, ybuf, dbuf)
     for q in range(ns):
         for r in range(nr):
-            Y1[q, r] = Y[q, r] + H6[r] * (K1[q, r] + 2.0 * K2[q, r] + 2.0 * K3[q, r] + K4[q, r])
+            Y1[q, r] = rk4_comb(Y[q, r], H6[r], K1[q, r], K2[q, r], K3[q, r], K4[q, r])
 
 
 @nb.njit(inline="always", **_JIT)
@@ -601,7 +541,7 @@ def _set_column(r, lane, P, T0, H, NPER, OFF, PT, T0R, HR, HH, H6, NPR, IDX, END
     T0R[r] = T0[lane]
     HR[r] = H[lane]
     HH[r] = 0.5 * H[lane]
-    H6[r] = H[lane] / 6.0
+    H6[r] = rk4_sixth(H[lane])
     NPR[r] = NPER[lane]
     IDX[r] = OFF[lane]
     END[r] = OFF[lane] + 2 * NPER[lane]
@@ -1539,7 +1479,8 @@ def lyapunov_lanes(P, Y0, scale, T0, H, OMEGA, n_per, n_transient, n_steps, reno
                    variational=False, fd_steps=None):
     """Largest exponent of every lane (row of P, Y0), the lanes in blocks in parallel
     (:func:`lyapunov_block_lanes` with k = 1, lanes ordered by their step count so that a
-    block's lanes end together; bitwise :func:`lyapunov_lanes_rows`).
+    block's lanes end together; bitwise each lane's :func:`lyapunov_single`, as the tests'
+    one-lane-at-a-time reference, ``tests/_lyapunov_rows.py``, shows).
 
     scale: the state scale (one vector for all lanes, as in :func:`lyapunov_single`); T0: start
     time (forcing phase zero there, as in :func:`lyapunov_single`) per lane; H, OMEGA:

@@ -75,6 +75,9 @@ from geardyn.solvers._step_shared import (  # noqa: F401 - the templates import 
     phase_increments,
     phase_rotate,
     phase_table,
+    rk4_comb,
+    rk4_sixth,
+    rk4_update,
 )
 from geardyn.solvers._template_model import events, rhs  # MODEL-IMPORT
 
@@ -278,8 +281,9 @@ def _rk4_stages(y, h, tm, pm, sm, cm, te, pe, se, ce, k1, kst, acc, tmp, out):
     the middle stages at time tm with coefficients pm and forcing phase sm, cm, the last at te
     with pe, se, ce (for a step from t: tm = t + h / 2, te = t + h; a run-up passes the
     coefficients and phase of its ramped speed at each stage). The model's rhs is inlined once
-    (one call site for the three stages: each stage's k in kst, their weighted sum in acc):
-    out = y + h / 6 (k1 + 2 k2 + 2 k3 + k4), summed left to right."""
+    (one call site for the three stages: each stage's k in kst, their weighted sum in acc,
+    added as they come in the order of :func:`rk4_comb`, ((k1 + 2 k2) + 2 k3) + k4):
+    out = y + h / 6 (k1 + 2 k2 + 2 k3 + k4) by :func:`rk4_update`."""
     ns = y.size
     hh = 0.5 * h
     for q in range(ns):
@@ -306,9 +310,9 @@ def _rk4_stages(y, h, tm, pm, sm, cm, te, pe, se, ce, k1, kst, acc, tmp, out):
         else:
             for q in range(ns):
                 acc[q] = acc[q] + 2.0 * kst[q]
-    h6 = h / 6.0
+    h6 = rk4_sixth(h)
     for q in range(ns):
-        out[q] = y[q] + h6 * acc[q]
+        out[q] = rk4_update(y[q], h6, acc[q])
 
 
 @nb.njit(inline="always", **_JIT)
@@ -488,11 +492,10 @@ def _rows_step(i, t0, Y, p, h, omega, n_per, s_tab, c_tab, n_ev, K, TMP, Y1, SID
                 for q in range(ns):
                     TMP[r, q] = Y[r, q] + a * K[st - 1, r, q]
             _rhs_i(ts, Y[r] if st == 0 else TMP[r], K[st, r], p, s_tab[jj], c_tab[jj])
-    h6 = h / 6.0
+    h6 = rk4_sixth(h)
     for r in range(nr):
         for q in range(ns):
-            Y1[r, q] = Y[r, q] + h6 * (K[0, r, q] + 2.0 * K[1, r, q] + 2.0 * K[2, r, q]
-                                       + K[3, r, q])
+            Y1[r, q] = rk4_comb(Y[r, q], h6, K[0, r, q], K[1, r, q], K[2, r, q], K[3, r, q])
     for r in range(nr):
         crossed = 0
         if n_ev > 0:
@@ -595,7 +598,7 @@ def _t_axpy(y, a, x):
 
 
 def _t_comb(y, h6, k1, k2, k3, k4):
-    """The RK4 combination y + h6 (k1 + 2 k2 + 2 k3 + k4), elementwise."""
+    """The RK4 combination y + h6 (k1 + 2 k2 + 2 k3 + k4), elementwise (:func:`rk4_comb`)."""
 
 
 def _t_screen(g1, GS, GP, SIDE, GR, k, locate):
@@ -669,9 +672,9 @@ def _ov_t_axpy(y, a, x):
 
 
 def _ov_t_comb(y, h6, k1, k2, k3, k4):
-    terms = "".join(f"y[{q}] + h6 * (k1[{q}] + 2.0 * k2[{q}] + 2.0 * k3[{q}] + k4[{q}]), "
+    terms = "".join(f"rk4_comb(y[{q}], h6, k1[{q}], k2[{q}], k3[{q}], k4[{q}]), "
                     for q in range(len(y)))
-    return _tuple_source("y, h6, k1, k2, k3, k4", [f"return ({terms})"])
+    return _tuple_source("y, h6, k1, k2, k3, k4", [f"return ({terms})"], {"rk4_comb": rk4_comb})
 
 
 def _ov_t_screen(g1, GS, GP, SIDE, GR, k, locate):
@@ -768,7 +771,7 @@ if "rhs_lane" in globals():  # the model's lane-scalar functions (see .kernels)
         k2 = _rhs_l(tm, _t_axpy(yt, hh, k1t), ptm, 0, sm, cm, FORM_GENERAL)
         k3 = _rhs_l(tm, _t_axpy(yt, hh, k2), ptm, 0, sm, cm, FORM_GENERAL)
         k4 = _rhs_l(te, _t_axpy(yt, h, k3), pte, 0, se, ce, FORM_GENERAL)
-        _t_put(out, _t_comb(yt, h / 6.0, k1t, k2, k3, k4))
+        _t_put(out, _t_comb(yt, rk4_sixth(h), k1t, k2, k3, k4))
 
     @nb.njit(inline="always", **_JIT)
     def _hermite(y0, f0, y1, f1, dt, theta, out):  # noqa: F811
@@ -799,7 +802,13 @@ class _NoAliasCompiler(WidthCompiler):
     many: LLVM would not vectorise it). The caller guarantees it: no two array arguments of
     a function compiled with it (the sweep's ``_block_run_form*``, the Lyapunov kernel's
     ``_lyap_run_form*``) that it touches share memory (``blk``'s views ``PH``,
-    ``HW`` and ``FL`` of ``PH6``, ``HW3`` and the state arrays are used there, not those)."""
+    ``HW`` and ``FL`` of ``PH6``, ``HW3`` and the state arrays are used there, not those), with
+    one exception: the compaction (:func:`._sweep_books._compact`, called there) moves a slot's
+    phase and step weights through ``PH6`` and ``HW3``, which the fused loop reads as ``PH``
+    and ``HW``. Made honest (moved through ``PH`` and ``HW``, or the loop reading ``PH6`` and
+    ``HW3``, or the phases recomputed from the tables after the move), the paper workload ran
+    ~3x slower (the fused loop's speed depends on LLVM taking the compaction's stores to be
+    apart from its arrays); the compaction runs between loop calls, never inside one."""
 
     def define_pipelines(self):
         self.state.flags.noalias = True

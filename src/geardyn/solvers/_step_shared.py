@@ -1,12 +1,12 @@
 """The parts of the step machinery that do not depend on the model, compiled once for every model.
 
-The split step's constants, the forcing-phase table and its rotations, the phase at a fraction
-of a grid step, the cubic Hermite weights, the cubic of an edge function along a step and its
-extrema, the sides of the edges and the block screen that flags a step, the events' scratch
-buffer. A model's generated core module (:mod:`._step_core`) imports them beside the functions
-that evaluate the model (the split step, its root finders, the rows of a lane), which it
-compiles with the model's functions inlined; the sweep's and the Lyapunov kernels' bookkeeping
-(:mod:`._sweep_books`, :mod:`._lyapunov_books`) imports them too.
+The RK4 combination of a step's stages, the split step's constants, the forcing-phase table and
+its rotations, the phase at a fraction of a grid step, the cubic Hermite weights, the cubic of an
+edge function along a step and its extrema, the sides of the edges and the block screen that flags
+a step, the events' scratch buffer. A model's generated core module (:mod:`._step_core`) imports
+them beside the functions that evaluate the model (the split step, its root finders, the rows of
+a lane), which it compiles with the model's functions inlined; the sweep's and the Lyapunov
+kernels' bookkeeping (:mod:`._sweep_books`, :mod:`._lyapunov_books`) imports them too.
 """
 
 from __future__ import annotations
@@ -125,6 +125,30 @@ def phase_table_values(n_per: int, forced: bool) -> tuple[np.ndarray, np.ndarray
     s.setflags(write=False)
     c.setflags(write=False)
     return s, c
+
+
+@nb.njit(inline="always", **_JIT)
+def rk4_sixth(h):
+    """The weight h / 6 of the RK4 combination (:func:`rk4_comb`) of a step of size h."""
+    return h / 6.0
+
+
+@nb.njit(inline="always", **_JIT)
+def rk4_update(y, h6, ksum):
+    """The end of an RK4 step, one component: y + h6 ksum, ksum the stages' weighted sum
+    k1 + 2 k2 + 2 k3 + k4 (summed left to right) and h6 = h / 6 (:func:`rk4_sixth`)."""
+    return y + h6 * ksum
+
+
+@nb.njit(inline="always", **_JIT)
+def rk4_comb(y, h6, k1, k2, k3, k4):
+    """The RK4 combination, one component: y + h6 (k1 + 2 k2 + 2 k3 + k4), summed left to right
+    (((k1 + 2 k2) + 2 k3) + k4), h6 = h / 6 (:func:`rk4_sixth`). Every RK4 step of every
+    kernel (rows, flat slot rows, lane tuples, tangent pairs) ends with it, so the order of the
+    floating-point operations, and with it every result, is the same on every path. A step
+    that sums its stages as they come (the split path's :func:`_rk4_stages`: one call site of
+    the model for three stages) adds them in this order and ends with :func:`rk4_update`."""
+    return rk4_update(y, h6, k1 + 2.0 * k2 + 2.0 * k3 + k4)
 
 
 @nb.njit(inline="always", **_JIT)
