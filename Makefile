@@ -37,11 +37,14 @@ demo: $(STAMP)
 
 # warm_kernels compiles the built-in models' kernels once, two models at a time, before the two
 # test workers start (else both compile the same kernels side by side); with a warm cache it
-# only loads them.
+# only loads them. The workers take the tests by work stealing: each starts on its half of the
+# collection (whole files, in order) and takes half of the other's remaining tests when it runs
+# out, so that a file's tests, which share its test models' kernels, mostly run in one worker
+# (with --dist load they alternate, and a worker waits, idle, for the kernel the other compiles).
 test: $(STAMP)
 	$(BIN)/ruff check src tests examples bench
 	$(BIN)/python tests/warm_kernels.py --jobs 2
-	$(BIN)/python -m pytest -n 2 -q --durations=15
+	$(BIN)/python -m pytest -n 2 --dist worksteal -q --durations=15
 
 # The long studies only (marked @pytest.mark.slow; pyproject's addopts keep them out of
 # `make test`, and this -m replaces that selection): results bitwise the same at 512- and
