@@ -4,6 +4,7 @@ the same copies, each object copied once; installed only inside geardyn's own co
 from __future__ import annotations
 
 import copy
+import re
 
 import numba as nb
 import numpy as np
@@ -41,7 +42,17 @@ def _caller():
 
 
 def _numba_untouched() -> bool:
-    return icc.copy is copy and icc.InlineWorker.inline_ir is _inline_copy._ORIGINAL
+    return (icc.copy is copy and icc.InlineWorker.inline_ir is _inline_copy._ORIGINAL
+            and icc.InlineWorker.run_untyped_passes is _inline_copy._ORIGINAL_UNTYPED
+            and not _inline_copy._UNTYPED)
+
+
+def _asm_without_names(dispatcher) -> list[str]:
+    """The assembly of ``dispatcher``'s one compiled signature, symbol names replaced (numba
+    numbers its symbols per compile)."""
+    asm = dispatcher.inspect_asm(dispatcher.signatures[0])
+    return [re.sub(r"_ZN[0-9A-Za-z_$.]*", "SYM", s) for s in asm.splitlines()
+            if not s.lstrip().startswith(".file")]
 
 
 def test_the_callee_blocks_share_one_scope_and_equal_numbas_copies():
@@ -88,6 +99,36 @@ def test_a_function_compiled_with_the_block_copy_gives_the_same_results():
     asm_own = own.inspect_asm(own.signatures[0])
     asm_shared = shared.inspect_asm(shared.signatures[0])
     assert len(asm_own.splitlines()) == len(asm_shared.splitlines())
+
+
+def test_the_untyped_pipeline_runs_once_per_inlined_function_and_the_code_is_the_same():
+    """numba runs its untyped pipeline on an inlined callee at every call site (three here);
+    inside a geardyn compile it runs once, and the machine code is numba's own, instruction
+    for instruction."""
+    calls: list = []
+
+    def counting(self, func, enable_ssa=False):
+        calls.append(func.__name__)
+        return original(self, func, enable_ssa)
+
+    original = _inline_copy._ORIGINAL_UNTYPED
+    own, shared = _caller(), _caller()
+    try:
+        icc.InlineWorker.run_untyped_passes = counting
+        own.compile("float64(float64, int64)")
+        assert calls.count("callee") == 3  # numba's own: one run per call site
+        del calls[:]
+        _inline_copy._ORIGINAL_UNTYPED = counting
+        with global_compiler_lock, block_copy():
+            shared.compile("float64(float64, int64)")
+        assert calls.count("callee") == 1
+    finally:
+        _inline_copy._ORIGINAL_UNTYPED = original
+        icc.InlineWorker.run_untyped_passes = original
+    assert _numba_untouched()
+    assert _asm_without_names(shared) == _asm_without_names(own)
+    for x in np.linspace(-3.0, 7.0, 11):
+        assert shared(x, 4) == own(x, 4)
 
 
 def test_numba_is_restored_after_each_compile_and_on_errors():

@@ -11,6 +11,16 @@ each object of the callee is copied once, and the copy keeps the sharing of the 
 scope for all blocks, as numba's own IR has). The copied IR is otherwise the same, so the
 compiled code is the same.
 
+numba also runs its whole untyped pipeline (bytecode analysis, closure inlining, rewrites,
+nested inlining, SSA) on an ``inline="always"`` function once per call site
+(``InlineWorker.run_untyped_passes``): a helper inlined at 40 sites is analysed 40 times. Inside
+geardyn's compiles the result is kept per function (and per the flags the untyped pipeline
+reads) for the outermost compile: each later call site takes a copy of the FunctionIR (blocks
+copied, a fresh ``FunctionIdentity``, so that the inlined variables are named per call site as
+numba names them), which ``inline_ir`` copies again before it changes anything. The IR of an
+untyped pipeline depends only on the function, its globals (fixed during a compile) and those
+flags, so the inlined code is the same.
+
 It is installed only inside geardyn's own compiles (:func:`block_copy`, entered under numba's
 compiler lock by :func:`geardyn.solvers.kernels._quiet_compile`); numba outside them is
 untouched.
@@ -23,6 +33,7 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from typing import Any
 
+from numba.core import bytecode as _bytecode
 from numba.core import inline_closurecall as _icc
 from numba.core import ir as _ir
 
@@ -46,7 +57,31 @@ class _SharedBlockCopy:
 
 _SHIM = _SharedBlockCopy()
 _ORIGINAL = _icc.InlineWorker.inline_ir
+_ORIGINAL_UNTYPED = _icc.InlineWorker.run_untyped_passes
 _DEPTH = [0]
+#: Untyped IR per (function, flags the untyped pipeline reads), for the outermost compile.
+_UNTYPED: dict[tuple, Any] = {}
+
+
+def _untyped_key(worker: Any, func: Any, enable_ssa: bool) -> tuple:
+    flags = worker.flags
+    return (func, bool(enable_ssa), bool(flags.no_rewrites), bool(flags.enable_looplift),
+            bool(flags.enable_pyobject), bool(flags.force_pyobject))
+
+
+def _run_untyped_passes(self: Any, func: Any, enable_ssa: bool = False) -> Any:
+    """numba's ``run_untyped_passes`` run once per function and flags; a copy per call."""
+    if self._permit_update_type_and_call_maps:  # a typed inliner may change its callee's maps
+        return _ORIGINAL_UNTYPED(self, func, enable_ssa)
+    key = _untyped_key(self, func, enable_ssa)
+    kept = _UNTYPED.get(key)
+    if kept is None:
+        kept = _UNTYPED[key] = _ORIGINAL_UNTYPED(self, func, enable_ssa)
+    else:
+        self.flags.enable_ssa = enable_ssa  # as numba's own run sets it on the caller's flags
+    ir = kept.copy()
+    ir.func_id = _bytecode.FunctionIdentity.from_function(func)
+    return ir
 
 
 def _inline_ir(self: Any, *args: Any, **kwargs: Any) -> Any:
@@ -64,11 +99,14 @@ def block_copy() -> Iterator[None]:
     if _DEPTH[0] == 0:
         _icc.copy = _SHIM
         _icc.InlineWorker.inline_ir = _inline_ir
+        _icc.InlineWorker.run_untyped_passes = _run_untyped_passes
     _DEPTH[0] += 1
     try:
         yield
     finally:
         _DEPTH[0] -= 1
         if _DEPTH[0] == 0:
+            _UNTYPED.clear()
+            _icc.InlineWorker.run_untyped_passes = _ORIGINAL_UNTYPED
             _icc.InlineWorker.inline_ir = _ORIGINAL
             _icc.copy = _copy

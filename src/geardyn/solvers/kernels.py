@@ -42,6 +42,7 @@ from geardyn.core.kernel_source import KernelSource
 from geardyn.core.one_form import adapters as one_form_adapters
 from geardyn.core.one_form import tangent_adapters
 from geardyn.solvers import compile_share
+from geardyn.solvers._compile_gc import young_collections
 from geardyn.solvers._inline_copy import block_copy
 
 _IMPORT_MARK = "# MODEL-IMPORT"
@@ -118,14 +119,16 @@ def unique_names() -> Iterator[None]:
 
 def _quiet_compile(dispatcher: Any, cached: bool = False) -> None:
     """Make ``dispatcher`` compile with :data:`QUIET_WARNINGS` ignored; the warning filters are
-    restored when its compile returns (nothing is filtered outside geardyn's compiles). A
+    restored when its compile returns (nothing is filtered outside geardyn's compiles), as are
+    the garbage collector's thresholds (:func:`._compile_gc.young_collections`). A
     ``cached`` module's functions compile under their lock (:mod:`.compile_share`): one process
     compiles a function, the others load it from the cache."""
     compile_ = compile_share.shared(dispatcher, dispatcher.compile) if cached else (
         dispatcher.compile)
 
     def compile(sig: Any) -> Any:
-        with _COMPILE_LOCK, unique_names(), block_copy(), warnings.catch_warnings():
+        with (_COMPILE_LOCK, unique_names(), block_copy(), young_collections(),
+              warnings.catch_warnings()):
             for category in QUIET_WARNINGS:
                 warnings.filterwarnings("ignore", category=category)
             return compile_(sig)
