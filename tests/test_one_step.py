@@ -65,3 +65,76 @@ def test_parameter_difference_step_is_declared_once():
 
 def test_lyapunov_rows_reference_is_in_the_tests():
     assert _hits(re.compile(r"lyapunov_lanes_rows|_lanes_rows\b")) == []
+
+
+#: The graze bound of an edge screen written out (``min(abs(g0), abs(g1)) > ...``, any names).
+SCREEN = re.compile(r"min\(abs\([^()]+\), abs\([^()]+\)\) > GRAZE_BOUND")
+
+
+def test_the_edge_screen_is_written_once():
+    assert _hits(SCREEN) == [
+        "solvers/_step_shared.py: near = not min(abs(g0), abs(g1)) > GRAZE_BOUND * abs(d2)",
+        "solvers/_step_shared.py: graze = not min(abs(g0), abs(g1)) > GRAZE_BOUND_STEP * "
+        "abs(ge - g1)"]
+    # the pattern finds the kernels' former spellings
+    for line in ("if (crossed or not s * d2 < 0.0) and not min(abs(g0), abs(g1)) > GRAZE_BOUND "
+                 "* abs(d2):",
+                 "if not min(abs(G0[r, j]), abs(g1)) > GRAZE_BOUND_STEP * abs(gbuf[1, j] - g1):",
+                 'f"graze = not min(abs(a), abs(b)) > GRAZE_BOUND_STEP * abs(ge[{j}] - b)",'):
+        assert SCREEN.search(line), line
+    # every kernel layout screens through them
+    solvers = SRC / "solvers"
+    for name, calls in (("_step_shared.py", ("screen_grid(",)),
+                        ("_step_core.py", ("screen_grid(", "screen_lone(")),
+                        ("_kernel_template.py", ("screen_grid(",)),
+                        ("_lyapunov_template.py", ("screen_lone(",))):
+        text = (solvers / name).read_text()
+        for call in calls:
+            assert text.count(call) >= (2 if name == "_step_shared.py" else 1), (name, call)
+
+
+def _dipping_quadratics(rng, n):
+    """Quadratics g(s) = c0 + c1 s + c2 s^2 that stay positive at s = 0 and s = 1 and dip below
+    zero in between (an edge grazed within a step, no sign change at its ends)."""
+    out = []
+    while len(out) < n:
+        c2 = 10.0 ** rng.uniform(-6, 3)
+        s_min = rng.uniform(0.02, 0.98)
+        depth = -c2 * rng.uniform(1e-6, 1.0) * min(s_min, 1.0 - s_min) ** 2
+        c1 = -2.0 * c2 * s_min
+        c0 = depth + c2 * s_min**2
+        g0, g1 = c0, c0 + c1 + c2
+        if g0 > 0.0 and g1 > 0.0:
+            out.append((c0, c1, c2))
+    return out
+
+
+def test_grid_screen_flags_every_graze_between_grid_points():
+    # a quadratic event sampled on the grid s = -1, 0, 1 that dips across the edge in (0, 1)
+    # without leaving its side at the grid points: the screen must flag the step (locate), and
+    # a sign change at the end is always flagged
+    screen = _step_shared.screen_grid.py_func
+    rng = np.random.default_rng(34)
+    for c0, c1, c2 in _dipping_quadratics(rng, 2000):
+        gp, g0, g1 = c0 - c1 + c2, c0, c0 + c1 + c2
+        assert screen(g1, 1.0, g0, gp, True) == (True, True)
+        assert screen(g1, 1.0, g0, gp, False) == (False, False)
+        assert screen(-g1, -1.0, -g0, -gp, True) == (True, True)  # the mirror image
+        assert screen(-g1, 1.0, g0, gp, False) == (False, True)
+    # far from the edge and bending away from it: nothing flagged
+    assert screen(5.0, 1.0, 4.0, 3.5, True) == (False, False)
+    assert screen(-5.0, -1.0, -4.0, -3.5, True) == (False, False)
+
+
+def test_lone_step_screen_flags_every_graze_within_the_step():
+    # the same quadratics over a lone step s in [0, 1]: ge = g(0) + g'(0) (the event at the Euler
+    # point, exact for an event linear in the state) must flag each of them
+    screen = _step_shared.screen_lone.py_func
+    rng = np.random.default_rng(35)
+    for c0, c1, c2 in _dipping_quadratics(rng, 2000):
+        g0, g1, ge = c0, c0 + c1 + c2, c0 + c1
+        assert screen(g1, 1.0, g0, ge) == (True, True)
+        assert screen(-g1, -1.0, -g0, -ge) == (True, True)
+        assert screen(-g1, 1.0, g0, ge)[1]
+    # a straight event far from the edge: nothing flagged
+    assert screen(3.0, 1.0, 2.0, 3.0) == (False, False)

@@ -41,7 +41,6 @@ from geardyn.solvers._step_core import (  # CORE-IMPORT
     _JIT_NOALIAS,
     BLOCK,
     FUSED,
-    GRAZE_BOUND,
     GRAZE_ROW,
     MAX_SPLITS,
     SIMULTANEOUS,
@@ -75,7 +74,7 @@ from geardyn.solvers._step_core import (  # CORE-IMPORT
     phase_rotate,
     phase_table,
 )
-from geardyn.solvers._step_shared import rk4_comb, rk4_sixth
+from geardyn.solvers._step_shared import rk4_comb, rk4_sixth, screen_grid
 from geardyn.solvers._sweep_books import (  # compiled once for every model
     _alloc,
     _chained,
@@ -329,23 +328,17 @@ def _lanes_rk4(STEP, nl, Y, Y1, K1, K2, K3, K4, TMP, FL, HW, TT, HB, T0B, PT, P,
 
 @nb.njit(inline="always", **_JIT)
 def _lanes_screen(nl, G1, GS, GP, SIDE, GR, FLAG, locate):
-    """The side test of a block's trial step, vectorised over slots (:func:`_leaves_side` for
-    every lane): FLAG[k] != 0 where slot k's step ends on another side of an edge or, with
-    ``locate``, may graze one (GR[j, k] = 1: edge j may; from the grid values g_{i-1} = GP,
+    """The side test of a block's trial step, vectorised over slots (:func:`screen_grid` for
+    every lane and event): FLAG[k] != 0 where slot k's step ends on another side of an edge or,
+    with ``locate``, may graze one (GR[j, k] = 1: edge j may; from the grid values g_{i-1} = GP,
     g_i = GS, g_{i+1} = G1)."""
     for k in range(nl):
         FLAG[k] = 0.0
     for j in range(G1.shape[0]):
         for k in range(nl):
-            g1 = G1[j, k]
-            s = SIDE[j, k]
-            g0 = GS[j, k]
-            d2 = g1 - 2.0 * g0 + GP[j, k]
-            crossed = (1.0 if g1 > 0.0 else -1.0) != s
-            near = not min(abs(g0), abs(g1)) > GRAZE_BOUND * abs(d2)
-            graze = locate & (crossed | (not s * d2 < 0.0)) & near
+            graze, flagged = screen_grid(G1[j, k], SIDE[j, k], GS[j, k], GP[j, k], locate)
             GR[j, k] = 1.0 if graze else 0.0
-            FLAG[k] += 1.0 if (crossed | graze) else 0.0
+            FLAG[k] += 1.0 if flagged else 0.0
 
 
 @nb.njit(inline="always", **_JIT)

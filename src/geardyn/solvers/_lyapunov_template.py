@@ -98,7 +98,6 @@ from geardyn.solvers._step_core import (  # CORE-IMPORT
     FD_NORM_CAP,
     FUSED,
     GBUF_ROWS,
-    GRAZE_BOUND_STEP,
     GRAZE_ROW,
     STATUS_DIVERGED,
     STATUS_OK,
@@ -123,7 +122,7 @@ from geardyn.solvers._step_core import (  # CORE-IMPORT
     _tuple_source,
     phase_table,
 )
-from geardyn.solvers._step_shared import rk4_comb, rk4_sixth
+from geardyn.solvers._step_shared import rk4_comb, rk4_sixth, screen_lone
 from geardyn.solvers._template_model import events, observe, rhs  # MODEL-IMPORT
 
 # TANGENT-ADAPTERS (a one-form model's tangent forms of its rhs: see .kernels)
@@ -482,7 +481,7 @@ def _rows_rk4(nr, Y, Y1, K1, K2, K3, K4, TMP, TS, TM, TE, HR, HH, H6, PT, P, LAN
 
 @nb.njit(inline="always", **_JIT)
 def _rows_screen(nr, G0, G1, GE, GR, FLAG):
-    """:func:`_leaves_side_step` for every row, vectorised: FLAG[r] != 0 where row r's trial
+    """:func:`screen_lone` for every row and event, vectorised: FLAG[r] != 0 where row r's trial
     step ends on another side of an edge than it started (G0, G1: events at the ends) or may
     graze one (GR[j, r] = 1; GE: events at y + h f(t, y))."""
     for r in range(nr):
@@ -490,11 +489,9 @@ def _rows_screen(nr, G0, G1, GE, GR, FLAG):
     for j in range(G1.shape[0]):
         for r in range(nr):
             g0 = G0[j, r]
-            g1 = G1[j, r]
-            crossed = (1.0 if g1 > 0.0 else -1.0) != (1.0 if g0 > 0.0 else -1.0)
-            graze = not min(abs(g0), abs(g1)) > GRAZE_BOUND_STEP * abs(GE[j, r] - g1)
+            graze, flagged = screen_lone(G1[j, r], 1.0 if g0 > 0.0 else -1.0, g0, GE[j, r])
             GR[j, r] = 1.0 if graze else 0.0
-            FLAG[r] += 1.0 if (crossed | graze) else 0.0
+            FLAG[r] += 1.0 if flagged else 0.0
 
 
 @nb.njit(inline="always", **_JIT)
@@ -816,12 +813,11 @@ def _t_screen_rows(g0, g1, ge, GR, l):
 def _ov_t_screen_rows(g0, g1, ge, GR, l):
     lines = ["hit = False"]
     for j in range(len(g0)):
-        lines += [f"a = g0[{j}]", f"b = g1[{j}]",
-                  "crossed = (1.0 if b > 0.0 else -1.0) != (1.0 if a > 0.0 else -1.0)",
-                  f"graze = not min(abs(a), abs(b)) > GRAZE_BOUND_STEP * abs(ge[{j}] - b)",
-                  f"GR[{j * BLOCK} + l] = _pick(graze, 1.0, 0.0)", "hit = hit | crossed | graze"]
+        lines += [f"a = g0[{j}]",
+                  f"graze, fl = screen_lone(g1[{j}], 1.0 if a > 0.0 else -1.0, a, ge[{j}])",
+                  f"GR[{j * BLOCK} + l] = _pick(graze, 1.0, 0.0)", "hit = hit | fl"]
     return _tuple_source("g0, g1, ge, GR, l", [*lines, "return hit"],
-                         {"_pick": _pick, "GRAZE_BOUND_STEP": GRAZE_BOUND_STEP, "BLOCK": BLOCK})
+                         {"_pick": _pick, "screen_lone": screen_lone})
 
 
 if FUSED:

@@ -44,8 +44,6 @@ from geardyn.solvers._step_shared import (  # noqa: F401 - the templates import 
     FD_DELTA,
     FD_NORM_CAP,
     GBUF_ROWS,
-    GRAZE_BOUND,
-    GRAZE_BOUND_STEP,
     GRAZE_ROW,
     GRAZE_TOL,
     MAX_SPLITS,
@@ -78,6 +76,8 @@ from geardyn.solvers._step_shared import (  # noqa: F401 - the templates import 
     rk4_comb,
     rk4_sixth,
     rk4_update,
+    screen_grid,
+    screen_lone,
 )
 from geardyn.solvers._template_model import events, rhs  # MODEL-IMPORT
 
@@ -254,9 +254,8 @@ def _first_crossing(j, side_j, graze, g1j, y0, f0, y1, f1, dt, t, p, ybuf, gbuf,
 @nb.njit(inline="always", **_JIT)
 def _leaves_side_step(r, t0, t1, Y, K1, G0, G1, SIDE, p, ybuf, gbuf, s1, c1):
     """:func:`_leaves_side` for a lone step without history (row r: Y[r] at time t0 to the trial
-    end at t1, K1[r] = f(t0, Y[r]), events G0[r], G1[r] at the ends, sides SIDE[r]): an event may
-    graze when min(|g(t0)|, |g(t1)|) <= GRAZE_BOUND_STEP |a|, a = events(y + h f) - events(y1)
-    = h g'(t0) - (g(t1) - g(t0)) (exact for events linear in the state); one evaluation of
+    end at t1, K1[r] = f(t0, Y[r]), events G0[r], G1[r] at the ends, sides SIDE[r]), each event
+    screened by :func:`screen_lone` from its value at the Euler point y + h f; one evaluation of
     ``events`` (at the end's forcing phase s1, c1). ybuf, gbuf row 1: scratch."""
     h = t1 - t0
     for q in range(Y.shape[1]):
@@ -264,14 +263,12 @@ def _leaves_side_step(r, t0, t1, Y, K1, G0, G1, SIDE, p, ybuf, gbuf, s1, c1):
     _events_i(t1, ybuf, gbuf[1], p, s1, c1)
     out = 0
     for j in range(G1.shape[1]):
-        g1 = G1[r, j]
-        if _side(g1) != SIDE[r, j]:
-            out = 1
-        graze = 0.0
-        if not min(abs(G0[r, j]), abs(g1)) > GRAZE_BOUND_STEP * abs(gbuf[1, j] - g1):
-            graze = 1.0
-            out = max(out, 2)
-        gbuf[GRAZE_ROW, j] = graze
+        graze, flagged = screen_lone(G1[r, j], SIDE[r, j], G0[r, j], gbuf[1, j])
+        gbuf[GRAZE_ROW, j] = 1.0 if graze else 0.0
+        if graze:
+            out = 2
+        elif flagged:
+            out = max(out, 1)
     return out
 
 
@@ -637,16 +634,6 @@ def _pick(cond, a, b):
     return a if cond else b
 
 
-@nb.njit(inline="always", **_JIT)
-def _screen_one(g1, s, g0, gp, locate):
-    """One event of :func:`_lanes_screen`: (graze, flagged)."""
-    d2 = g1 - 2.0 * g0 + gp
-    crossed = (1.0 if g1 > 0.0 else -1.0) != s
-    near = not min(abs(g0), abs(g1)) > GRAZE_BOUND * abs(d2)
-    graze = locate & (crossed | (not s * d2 < 0.0)) & near
-    return graze, crossed | graze
-
-
 def _ix(arr, name, row):
     """Source text of element (row, k) of a block array: ``name[row, k]``, or of its flat view
     (rows of BLOCK slots: constant offsets, so that LLVM sees rows that cannot overlap)."""
@@ -682,11 +669,11 @@ def _ov_t_screen(g1, GS, GP, SIDE, GR, k, locate):
     for j in range(len(g1)):
         gs, gp = _ix(GS, "GS", j), _ix(GP, "GP", j)
         lines += [f"g0 = {gs}",
-                  f"gr, fl = _screen_one(g1[{j}], {_ix(SIDE, 'SIDE', j)}, g0, {gp}, locate)",
+                  f"gr, fl = screen_grid(g1[{j}], {_ix(SIDE, 'SIDE', j)}, g0, {gp}, locate)",
                   f"{_ix(GR, 'GR', j)} = _pick(gr, 1.0, 0.0)", f"{gp} = g0", f"{gs} = g1[{j}]",
                   "hit = hit | fl"]
     return _tuple_source("g1, GS, GP, SIDE, GR, k, locate", [*lines, "return hit"],
-                         {"_screen_one": _screen_one, "_pick": _pick})
+                         {"screen_grid": screen_grid, "_pick": _pick})
 
 
 def _ov_t_stats(GMIN, GMAX, OMAX, OMIN, OSQ, k, g, o, stat):

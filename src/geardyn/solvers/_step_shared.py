@@ -247,32 +247,52 @@ def _keep_start(i, nl, active, G, gbuf):
 
 
 @nb.njit(inline="always", **_JIT)
+def screen_grid(g1, s, g0, gp, locate):
+    """The edge screen of one event at a grid step with history, every kernel's (the one-lane
+    :func:`_leaves_side`, the block's and the fused loop's): (graze, flagged) for the event g1 at
+    the trial step's end, s its side at the start (+-1) and g0, gp its grid values at the start
+    and one step before. The step leaves the side when sign(g1) != s; with ``locate`` it may graze
+    the edge when min(|g0|, |g1|) <= GRAZE_BOUND |d2|, d2 = g1 - 2 g0 + gp, and, unless it left
+    the side, d2 does not bend away from the edge (a dip across the edge bends towards it:
+    curvature of the sign of the side). Branch-free, so that the slot loops vectorise."""
+    d2 = g1 - 2.0 * g0 + gp
+    crossed = (1.0 if g1 > 0.0 else -1.0) != s
+    near = not min(abs(g0), abs(g1)) > GRAZE_BOUND * abs(d2)
+    graze = locate & (crossed | (not s * d2 < 0.0)) & near
+    return graze, crossed | graze
+
+
+@nb.njit(inline="always", **_JIT)
+def screen_lone(g1, s, g0, ge):
+    """The edge screen of one event at a lone step without history (the one-lane
+    :func:`_leaves_side_step`, the Lyapunov rows'): (graze, flagged) for the event g1 at the
+    trial step's end, s its side at the start (+-1), g0 its value at the start and ge at the Euler
+    point y + h f(t0, y). The step leaves the side when sign(g1) != s; it may graze the edge when
+    min(|g0|, |g1|) <= GRAZE_BOUND_STEP |ge - g1| (ge - g1 = h g'(t0) - (g1 - g0), the quadratic
+    part of the event over the step, exact for events linear in the state). Branch-free."""
+    crossed = (1.0 if g1 > 0.0 else -1.0) != s
+    graze = not min(abs(g0), abs(g1)) > GRAZE_BOUND_STEP * abs(ge - g1)
+    return graze, crossed | graze
+
+
+@nb.njit(inline="always", **_JIT)
 def _leaves_side(i, k, G, SIDE, locate, gbuf):
     """Whether the trial grid step i of block row k may leave a side of an edge: 1 if its end
     (events G[k]) lies on another side than its start (SIDE[k]); with ``locate``, 2 if it may
-    graze an edge, so that the step must be checked (:func:`_split_step`); else 0. An event may
-    graze (flag in gbuf row GRAZE_ROW) when min(|g_i|, |g_{i+1}|) <= GRAZE_BOUND |d2|, d2 =
-    g_{i+1} - 2 g_i + g_{i-1}, from the grid values kept in gbuf's history (:func:`_keep_start`;
-    none yet: it may), and, unless the end crossed, d2 does not bend away from the edge. No
-    evaluations of the model: the common step stays cheap."""
+    graze an edge, so that the step must be checked (:func:`_split_step`); else 0. Each event is
+    screened by :func:`screen_grid` (graze flag in gbuf row GRAZE_ROW) from the grid values kept in
+    gbuf's history (:func:`_keep_start`; none yet: it may graze). No evaluations of the model: the
+    common step stays cheap."""
     out = 0
     nb_lanes = (gbuf.shape[0] - GBUF_ROWS) // 2
     r0 = GBUF_ROWS + (i % 2) * nb_lanes + k
     rp = GBUF_ROWS + ((i + 1) % 2) * nb_lanes + k
     for j in range(G.shape[1]):
-        g1 = G[k, j]
-        s = SIDE[k, j]
-        crossed = _side(g1) != s
-        graze = 0.0
-        if locate:
-            g0 = gbuf[r0, j]
-            d2 = g1 - 2.0 * g0 + gbuf[rp, j]
-            # a dip across the edge bends towards it (curvature of the sign of the side)
-            if (crossed or not s * d2 < 0.0) and not min(abs(g0), abs(g1)) > GRAZE_BOUND * abs(d2):
-                graze = 1.0
-                out = 2
-        gbuf[GRAZE_ROW, j] = graze
-        if crossed:
+        graze, flagged = screen_grid(G[k, j], SIDE[k, j], gbuf[r0, j], gbuf[rp, j], locate)
+        gbuf[GRAZE_ROW, j] = 1.0 if graze else 0.0
+        if graze:
+            out = 2
+        elif flagged:
             out = 1 if out == 0 else out
     return out
 
