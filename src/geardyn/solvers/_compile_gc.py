@@ -3,9 +3,8 @@
 numba's compiler allocates millions of objects (IR, types, LLVM IR text), many in reference
 cycles. Python's cyclic collector runs a full collection (every tracked object of the process)
 whenever enough objects have survived into its oldest generation, and the compiler's own live
-objects make each one slow: the gear pair's first use of every analysis (empty cache) ran 28
-full collections, 6.5 of its 57 s of CPU. The young generations hold the compiler's
-short-lived cycles and are still collected as usual.
+objects make each one slow (the measured share is in bench/RESULTS.md). The young generations
+hold the compiler's short-lived cycles and are still collected as usual.
 
 :func:`young_collections` raises the collector's third threshold (full collections per
 collections of the middle generation) to :data:`FULL_EVERY` for the outermost compile inside
