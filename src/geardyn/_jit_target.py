@@ -28,8 +28,8 @@ numba was used before ``import geardyn`` or not, and numba's own ``NUMBA_CPU_NAM
 ``NUMBA_CPU_FEATURES`` still choose the CPU (the attribute only sets the width within it).
 
 The same pass makes the function's code library skip numba's cheap module pipeline before the
-full one (:func:`_full_only`): the full pipeline alone, about 5 % less compile CPU for a model,
-with bitwise the same results (``tests/test_full_only.py``).
+full one (:func:`_full_only`); the full pipeline runs as numba runs it (``tests/test_full_only.py``
+checks which pipelines run and the results against numpy).
 
 The width is part of the cache key of geardyn's functions (:func:`cache_tag`, in the name of
 their cache files, :mod:`geardyn._cache`): kernels compiled at one width are never loaded at
