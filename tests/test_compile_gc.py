@@ -8,7 +8,6 @@ import gc
 import numpy as np
 import pytest
 
-from geardyn.solvers import _compile_gc
 from geardyn.solvers._compile_gc import FULL_EVERY, young_collections
 
 
@@ -27,7 +26,7 @@ def test_raised_inside_restored_after_and_reentrant(thresholds):
             assert gc.get_threshold() == (500, 7, FULL_EVERY)
         assert gc.get_threshold() == (500, 7, FULL_EVERY)
     assert gc.get_threshold() == (500, 7, 3)
-    assert _compile_gc._DEPTH[0] == 0
+    assert young_collections.depth == 0
 
 
 def test_restored_on_errors_and_a_higher_threshold_kept(thresholds):
@@ -54,7 +53,7 @@ def test_a_geardyn_compile_runs_with_it_and_leaves_the_process_as_it_was(thresho
     original = kernels.young_collections
 
     def watching():
-        seen.append(_compile_gc._DEPTH[0])
+        seen.append(young_collections.depth)
         return original()
 
     @nb.njit

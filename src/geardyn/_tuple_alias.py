@@ -13,31 +13,27 @@ function (as an inlined helper does) is taken for a dead local, and its store is
 arrays in tuples and unpack them in inlined helpers: the sweep's count of steps at the split
 limit (``unresolved``) was lost that way in the fused block loop.
 
-:func:`tuple_aliases` registers, for the compiles inside it (geardyn's pipelines enter it, see
+:func:`tuple_aliases` installs, for the compiles inside it (geardyn's pipelines enter it, see
 :class:`geardyn._jit_target.WidthCompiler`), an alias-analysis extension that links the
 result of those tuple operations with their operands, so such a store is live wherever the
-tuple (the argument) is. Other code compiled by numba in the process is analysed as numba does.
+tuple (the argument) is, and removes it when the outermost of them returns (a
+:func:`geardyn._scoped_patch.scoped_patch` guard). Other code compiled by numba in the process
+is analysed as numba does.
 The extension only adds aliases: it removes nothing and changes no store that numba keeps.
 """
 
 from __future__ import annotations
 
-import threading
 from collections.abc import Callable, Iterator
-from contextlib import contextmanager
 from typing import Any
 
 from numba.core import ir, ir_utils
 
+from geardyn._scoped_patch import scoped_patch
+
 #: The IR expressions whose result may hold (or be) an array of their operands.
 TUPLE_OPS = frozenset({"exhaust_iter", "build_tuple", "getiter", "iternext", "pair_first",
                        "typed_getitem"})
-
-_DEPTH = threading.local()
-
-
-def _active() -> bool:
-    return getattr(_DEPTH, "n", 0) > 0
 
 
 def _link(lhs: str, rhs: str, alias_map: dict[str, set[str]], arg_aliases: set[str]) -> None:
@@ -59,7 +55,7 @@ def _make_extension(previous: Callable[..., Any] | None) -> Callable[..., Any]:
         if previous is not None:
             previous(instr, args, typemap, func_ir, alias_map, arg_aliases)
         expr = instr.value
-        if not (_active() and isinstance(expr, ir.Expr) and expr.op in TUPLE_OPS):
+        if not (tuple_aliases.depth and isinstance(expr, ir.Expr) and expr.op in TUPLE_OPS):
             return
         lhs = instr.target.name
         if ir_utils.is_immutable_type(lhs, typemap):
@@ -68,23 +64,20 @@ def _make_extension(previous: Callable[..., Any] | None) -> Callable[..., Any]:
             if not ir_utils.is_immutable_type(var.name, typemap):
                 _link(lhs, var.name, alias_map, arg_aliases)
 
-    extension.geardyn_tuple_alias = True  # type: ignore[attr-defined]
     return extension
 
 
-def _register() -> None:
-    """Install the extension for ``ir.Assign`` once (after any other one, which still runs)."""
-    current = ir_utils.alias_analysis_extensions.get(ir.Assign)
-    if current is None or not getattr(current, "geardyn_tuple_alias", False):
-        ir_utils.alias_analysis_extensions[ir.Assign] = _make_extension(current)
-
-
-@contextmanager
+@scoped_patch
 def tuple_aliases() -> Iterator[None]:
-    """numba's alias analysis follows tuples (see above) for the compiles run inside."""
-    _register()
-    _DEPTH.n = getattr(_DEPTH, "n", 0) + 1
-    try:
-        yield
-    finally:
-        _DEPTH.n -= 1
+    """numba's alias analysis follows tuples (see above) for the compiles run inside: the
+    extension is installed in numba's table (after any other one for ``ir.Assign``, which still
+    runs) by the outermost entry and the table restored by the last exit (re-entrant)."""
+    table = ir_utils.alias_analysis_extensions
+    previous = table.get(ir.Assign)
+    table[ir.Assign] = ours = _make_extension(previous)
+    yield
+    if table.get(ir.Assign) is ours:  # an extension registered meanwhile keeps its place
+        if previous is None:
+            del table[ir.Assign]
+        else:
+            table[ir.Assign] = previous

@@ -8,35 +8,28 @@ hold the compiler's short-lived cycles and are still collected as usual.
 
 :func:`young_collections` raises the collector's third threshold (full collections per
 collections of the middle generation) to :data:`FULL_EVERY` for the outermost compile inside
-it and restores the process's thresholds when that compile returns; code outside geardyn's
-compiles collects as before. Entered under numba's compiler lock (one compile at a time).
+it and restores the process's thresholds when that compile returns (a
+:func:`geardyn._scoped_patch.scoped_patch` guard); code outside geardyn's compiles collects as
+before. Entered under numba's compiler lock (one compile at a time).
 """
 
 from __future__ import annotations
 
 import gc
 from collections.abc import Iterator
-from contextlib import contextmanager
+
+from geardyn._scoped_patch import scoped_patch
 
 #: The collector's third threshold during a compile (Python's default is 10).
 FULL_EVERY = 100
 
-_DEPTH = [0]
 
-
-@contextmanager
+@scoped_patch
 def young_collections() -> Iterator[None]:
     """Full collections at most every :data:`FULL_EVERY` middle-generation collections inside
-    (re-entrant; the outermost entry sets and restores the thresholds)."""
-    saved = None
-    if _DEPTH[0] == 0:
-        saved = gc.get_threshold()
-        if saved[0] > 0:  # a threshold of 0 disables the collector: left as it is
-            gc.set_threshold(saved[0], saved[1], max(saved[2], FULL_EVERY))
-    _DEPTH[0] += 1
-    try:
-        yield
-    finally:
-        _DEPTH[0] -= 1
-        if saved is not None:
-            gc.set_threshold(*saved)
+    (re-entrant; the outermost entry sets the thresholds, the last exit restores them)."""
+    saved = gc.get_threshold()
+    if saved[0] > 0:  # a threshold of 0 disables the collector: left as it is
+        gc.set_threshold(saved[0], saved[1], max(saved[2], FULL_EVERY))
+    yield
+    gc.set_threshold(*saved)

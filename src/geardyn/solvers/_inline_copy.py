@@ -30,12 +30,13 @@ from __future__ import annotations
 
 import copy as _copy
 from collections.abc import Iterator
-from contextlib import contextmanager
 from typing import Any
 
 from numba.core import bytecode as _bytecode
 from numba.core import inline_closurecall as _icc
 from numba.core import ir as _ir
+
+from geardyn._scoped_patch import scoped_patch
 
 
 class _SharedBlockCopy:
@@ -58,7 +59,6 @@ class _SharedBlockCopy:
 _SHIM = _SharedBlockCopy()
 _ORIGINAL = _icc.InlineWorker.inline_ir
 _ORIGINAL_UNTYPED = _icc.InlineWorker.run_untyped_passes
-_DEPTH = [0]
 #: Untyped IR per (function, flags the untyped pipeline reads), for the outermost compile.
 _UNTYPED: dict[tuple, Any] = {}
 
@@ -92,21 +92,15 @@ def _inline_ir(self: Any, *args: Any, **kwargs: Any) -> Any:
         _SHIM.memos = saved
 
 
-@contextmanager
+@scoped_patch
 def block_copy() -> Iterator[None]:
     """numba's ``inline_ir`` with the shared block copy inside (re-entrant; to be entered under
     numba's compiler lock, so that no other thread compiles meanwhile)."""
-    if _DEPTH[0] == 0:
-        _icc.copy = _SHIM
-        _icc.InlineWorker.inline_ir = _inline_ir
-        _icc.InlineWorker.run_untyped_passes = _run_untyped_passes
-    _DEPTH[0] += 1
-    try:
-        yield
-    finally:
-        _DEPTH[0] -= 1
-        if _DEPTH[0] == 0:
-            _UNTYPED.clear()
-            _icc.InlineWorker.run_untyped_passes = _ORIGINAL_UNTYPED
-            _icc.InlineWorker.inline_ir = _ORIGINAL
-            _icc.copy = _copy
+    worker = _icc.InlineWorker
+    saved = _icc.copy, worker.inline_ir, worker.run_untyped_passes
+    _icc.copy = _SHIM
+    worker.inline_ir = _inline_ir
+    worker.run_untyped_passes = _run_untyped_passes
+    yield
+    _UNTYPED.clear()
+    _icc.copy, worker.inline_ir, worker.run_untyped_passes = saved

@@ -28,7 +28,6 @@ import tempfile
 import types
 import warnings
 from collections.abc import Iterator
-from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
@@ -38,6 +37,7 @@ from numba.core.compiler_lock import global_compiler_lock
 
 import geardyn.core.dual  # noqa: F401 - its overloads installed before any kernel compiles
 from geardyn._cache import cache_root
+from geardyn._scoped_patch import scoped_patch
 from geardyn.core.kernel_source import KernelSource
 from geardyn.core.one_form import adapters as one_form_adapters
 from geardyn.core.one_form import tangent_adapters
@@ -85,7 +85,6 @@ _COMPILE_LOCK = global_compiler_lock
 
 #: geardyn's own numbering of the functions it compiles: (pid, counter from a random base).
 _UIDS: list = [None, None]
-_UID_DEPTH = [0]
 
 
 def _uid_counter() -> itertools.count:
@@ -95,26 +94,20 @@ def _uid_counter() -> itertools.count:
     return _UIDS[1]
 
 
-@contextmanager
+@scoped_patch
 def unique_names() -> Iterator[None]:
     """Number the functions compiled inside (numba's ``FunctionIdentity`` ids, part of every
     compiled symbol's and environment's name) from a random base of this process, and restore
-    numba's own numbering afterwards; to be entered under numba's compiler lock. numba counts
-    from 1 in every process, so the same function compiled early in two processes gets the
-    same names; cached kernels from several processes, loaded into one, would define the same
-    symbols, and the entry of a shared function called from Python can read another copy's
-    environment (numba's "'descr' is NULL"). From a random base per process, code compiled in
-    different processes shares no name."""
+    numba's own numbering afterwards (re-entrant); to be entered under numba's compiler lock.
+    numba counts from 1 in every process, so the same function compiled early in two processes
+    gets the same names; cached kernels from several processes, loaded into one, would define
+    the same symbols, and the entry of a shared function called from Python can read another
+    copy's environment (numba's "'descr' is NULL"). From a random base per process, code
+    compiled in different processes shares no name."""
     ident = numba.core.bytecode.FunctionIdentity
-    if _UID_DEPTH[0] == 0:
-        saved, ident._unique_ids = ident._unique_ids, _uid_counter()
-    _UID_DEPTH[0] += 1
-    try:
-        yield
-    finally:
-        _UID_DEPTH[0] -= 1
-        if _UID_DEPTH[0] == 0:
-            ident._unique_ids = saved
+    saved, ident._unique_ids = ident._unique_ids, _uid_counter()
+    yield
+    ident._unique_ids = saved
 
 
 def _quiet_compile(dispatcher: Any, cached: bool = False) -> None:
