@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from geardyn.core.settings import forget_deprecations
+from geardyn.core.moved import forget_deprecations
 
 
 @pytest.fixture(autouse=True)

@@ -251,7 +251,7 @@ def test_every_deprecated_keyword_warns_once_per_process():
     """warn_deprecated serves every deprecated keyword (simulate's here): the first call
     warns, the same keywords again do not (other values alike), other keywords do; after
     forget_deprecations (what tests/conftest.py does before each test) it warns again."""
-    from geardyn.core.settings import forget_deprecations
+    from geardyn.core.moved import forget_deprecations
 
     g = geardyn.GearPair(zeta=0.05, kappa=0.0, Fm=0.1, Fa=0.05)
     with warnings.catch_warnings(record=True) as record:

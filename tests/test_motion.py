@@ -108,14 +108,13 @@ def test_chaotic_gear_pair_is_chaotic():
     assert motion_classes(np.array([period]), lam, err, duration)[0] == "chaotic"
 
 
-def test_the_retired_chaos_threshold_warns_once_and_keeps_its_value(monkeypatch):
+def test_the_retired_chaos_threshold_warns_once_and_keeps_its_value():
     """``geardyn.reproduction.motion.LYAPUNOV_CHAOS`` (no label uses it) answers with its
     former value and one DeprecationWarning saying why."""
     import warnings
 
     import geardyn.reproduction.motion as rm
 
-    monkeypatch.setattr(rm, "_warned", set())
     with pytest.warns(DeprecationWarning, match="LYAPUNOV_CHAOS is deprecated: no label"):
         assert rm.LYAPUNOV_CHAOS == 2.0e-3
     with warnings.catch_warnings():

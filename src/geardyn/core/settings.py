@@ -14,6 +14,8 @@ from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
+from geardyn.core.moved import warn_once
+
 #: States beyond this magnitude count as diverged.
 DEFAULT_BOUND = 1.0e6
 #: Default relative tolerance of the period classifier (see geardyn.analysis.periodicity).
@@ -257,29 +259,16 @@ def _shown(value: Any) -> str:
     return f"<{math.prod(shape)} values>" if shape else repr(value.item())
 
 
-#: The deprecations warned in this process: (function, its deprecated keywords).
-_WARNED: set[tuple[str, tuple[str, ...]]] = set()
-
-
 def warn_deprecated(where: str, keywords: Iterable[str], replacements: Sequence[str],
                     stacklevel: int) -> None:
-    """One DeprecationWarning, once per process for each function and set of keywords:
-    ``where``'s ``keywords`` are deprecated, pass the ``replacements`` (``stacklevel``: the
-    public function's caller, seen from the caller of this function)."""
-    import warnings
-
+    """One DeprecationWarning, once per process for each function and set of keywords
+    (:func:`geardyn.core.moved.warn_once`): ``where``'s ``keywords`` are deprecated, pass the
+    ``replacements`` (``stacklevel``: the public function's caller, seen from the caller of
+    this function)."""
     keywords = tuple(keywords)
-    if (where, keywords) in _WARNED:
-        return
-    _WARNED.add((where, keywords))
-    warnings.warn(f"{where}({', '.join(f'{k}=' for k in keywords)}) is deprecated: pass "
-                  f"{', '.join(replacements)}", DeprecationWarning, stacklevel=stacklevel + 1)
-
-
-def forget_deprecations() -> None:
-    """Let every deprecation of :func:`warn_deprecated` warn again (for tests: each test sees
-    the process as fresh)."""
-    _WARNED.clear()
+    warn_once(("keywords", where, keywords),
+              f"{where}({', '.join(f'{k}=' for k in keywords)}) is deprecated: pass "
+              f"{', '.join(replacements)}", stacklevel=stacklevel + 1)
 
 
 # ----------------------------------------------------------------------------- analyses

@@ -27,7 +27,6 @@ from __future__ import annotations
 
 import functools
 import math
-import warnings
 from collections.abc import Sequence
 
 import numpy as np
@@ -37,6 +36,7 @@ from geardyn.core.coefficients import CoefficientLayout
 from geardyn.core.inputs import by_name, rederived
 from geardyn.core.kernel_source import KernelSource
 from geardyn.core.model import Model, unique_rows
+from geardyn.core.moved import warn_once
 from geardyn.errors import ParameterError
 from geardyn.models import catt_kernels as ck
 from geardyn.models.catt_reduced import reduced_kernel
@@ -134,9 +134,10 @@ class CATTDevice(Model):
         one_form: bool | None = None,
     ):
         if one_form is not None:
-            warnings.warn("CATTDevice(one_form=...) chooses nothing and will be removed: the "
-                          "reduced form always runs its one form (geardyn.models.catt_reduced)",
-                          DeprecationWarning, stacklevel=2)
+            warn_once(("keywords", "CATTDevice", ("one_form",)),
+                      "CATTDevice(one_form=...) chooses nothing and will be removed: the "
+                      "reduced form always runs its one form (geardyn.models.catt_reduced)",
+                      stacklevel=2)
         if interpretation not in INTERPRETATIONS:
             raise ValueError(
                 f"interpretation must be one of {', '.join(INTERPRETATIONS)};"
@@ -194,8 +195,8 @@ class CATTDevice(Model):
     def one_form(self) -> bool:
         """Deprecated: whether the device runs a one form (the reduced form always does, the
         general one never)."""
-        warnings.warn("CATTDevice.one_form is deprecated: the reduced form always runs its one "
-                      "form", DeprecationWarning, stacklevel=2)
+        warn_once(("attribute", "CATTDevice.one_form"), "CATTDevice.one_form is deprecated: "
+                  "the reduced form always runs its one form", stacklevel=2)
         return self.kernel.one_form is not None
 
     # ------------------------------------------------------------------ coefficient vector
@@ -339,9 +340,9 @@ class CATTDevice(Model):
         a sweep of it (the reduced form's lanes, whose size N does not change) is deprecated
         (a DeprecationWarning) and still computed."""
         if name == "N":
-            warnings.warn("sweeping N (a count, not a swept input of CATTDevice) is deprecated:"
-                          " build one model per number of planet sets", DeprecationWarning,
-                          stacklevel=2)
+            warn_once(("sweep", "CATTDevice", "N"), "sweeping N (a count, not a swept input of "
+                      "CATTDevice) is deprecated: build one model per number of planet sets",
+                      stacklevel=2)
         else:
             self._refuse_unswept(name, values)
         values = np.asarray(values, dtype=float).ravel()

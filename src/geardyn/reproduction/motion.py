@@ -12,13 +12,12 @@ separates chaos from quasi-periodic motion.
 
 from __future__ import annotations
 
-import warnings
 from typing import Any
 
 import numpy as np
 
 from geardyn.analysis import motion as _motion
-from geardyn.core.moved import moved
+from geardyn.core.moved import moved, warn_once
 
 __all__ = ["intervals", "is_nonperiodic", "motion_labels"]
 
@@ -33,7 +32,6 @@ _moved = moved(__name__, dict.fromkeys(
 _RETIRED: dict[str, tuple[float, str]] = {
     "LYAPUNOV_CHAOS": (2.0e-3, "no label uses a fixed chaos threshold: the exponent's "
                                "uncertainty decides (geardyn.analysis.motion)")}
-_warned: set[str] = set()
 
 
 def __getattr__(name: str) -> Any:
@@ -41,10 +39,8 @@ def __getattr__(name: str) -> Any:
     if name not in _RETIRED:
         return _moved(name)
     value, why = _RETIRED[name]
-    if name not in _warned:
-        _warned.add(name)
-        warnings.warn(f"{__name__}.{name} is deprecated: {why}", DeprecationWarning,
-                      stacklevel=2)
+    warn_once(("retired", __name__, name), f"{__name__}.{name} is deprecated: {why}",
+              stacklevel=2)
     return value
 
 
