@@ -119,3 +119,33 @@ def test_settings_option_names_are_spelled_nowhere_else():
             continue
         for m in pattern.finditer(path.read_text()):
             assert m.group(1) is not None and m.group(1) not in names, (path.name, m.group(0))
+
+
+def _options_named(option: str) -> dict[str, typer.core.click.Option]:
+    """Every command's option whose long name is ``option`` (command -> option)."""
+    out = {}
+    for name, command in _commands().items():
+        for p in command.params:
+            if option in getattr(p, "opts", ()):
+                out[name] = p
+    return out
+
+
+def test_the_shared_switches_are_declared_once():
+    """``--quiet`` (no progress bar) and ``--yes`` mean the same on every command that has
+    them: one name, short form and help each (``geardyn dynamic-factor --quiet``, which drops
+    a summary line, has its own help)."""
+    from geardyn.cli.common import QuietOption, YesOption
+
+    quiet = typing.get_args(QuietOption)[1]
+    yes = typing.get_args(YesOption)[1]
+    found = _options_named("--quiet")
+    assert len(found) >= 8
+    for name, p in found.items():
+        assert p.opts + p.secondary_opts == ["--quiet", "-q"], name
+        if name != "dynamic-factor":
+            assert p.help == quiet.help, name
+    found = _options_named("--yes")
+    assert {"map", "basins", "frc", "bifurcation"} <= set(found)
+    for name, p in found.items():
+        assert p.opts == ["--yes"] and p.help == yes.help, name

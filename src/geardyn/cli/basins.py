@@ -26,6 +26,7 @@ from geardyn.cli.common import (
     InterpretationOption,
     NetCDFOutOption,
     PlotOption,
+    QuietOption,
     StepsOption,
     YesOption,
     check_count,
@@ -72,7 +73,7 @@ def basins_command(
                                "(0: none).")
     ] = 0,
     interpretation: InterpretationOption = None,
-    quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No progress bar.")] = False,
+    quiet: QuietOption = False,
     yes: YesOption = False,
     out: NetCDFOutOption = None,
     plot: PlotOption = None,

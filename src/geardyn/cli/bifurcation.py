@@ -36,6 +36,7 @@ from geardyn.cli.common import (
     InterpretationOption,
     NetCDFOutOption,
     PlotOption,
+    QuietOption,
     SamplesOption,
     StepsOption,
     TransientOption,
@@ -257,9 +258,7 @@ def bifurcation_command(
     state: Annotated[
         str | None, typer.Option(help="State drawn (default: the study's plot_state).")
     ] = None,
-    quiet: Annotated[
-        bool, typer.Option("--quiet", "-q", help="No progress bar.")
-    ] = False,
+    quiet: QuietOption = False,
     yes: YesOption = False,
     out: NetCDFOutOption = None,
     plot: PlotOption = None,

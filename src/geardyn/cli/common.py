@@ -130,6 +130,7 @@ YesOption = Annotated[
     bool, typer.Option("--yes", help="Run even when the estimated memory or time exceeds the "
                                       "limits.")
 ]
+QuietOption = Annotated[bool, typer.Option("--quiet", "-q", help="No progress bar.")]
 NetCDFOutOption = Annotated[Path | None, typer.Option(help="NetCDF file to write (.nc).")]
 PlotOption = Annotated[Path | None, typer.Option(help="Figure to write (.png, .pdf or .svg).")]
 

@@ -36,6 +36,7 @@ from geardyn.cli.common import (
     MaxPointsOption,
     NetCDFOutOption,
     PlotOption,
+    QuietOption,
     StepsOption,
     check_count,
     check_plot_path,
@@ -204,7 +205,7 @@ def continue_command(
     ] = None,
     mesh: Annotated[str | None, typer.Option(help="Mesh drawn (default: the first).")] = None,
     interpretation: InterpretationOption = None,
-    quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No progress bar.")] = False,
+    quiet: QuietOption = False,
     out: NetCDFOutOption = None,
     plot: PlotOption = None,
 ) -> None:

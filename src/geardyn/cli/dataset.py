@@ -27,7 +27,7 @@ import typer
 from pydantic import ValidationError
 from rich.markup import escape
 
-from geardyn.cli.common import load_study_source, make_parents
+from geardyn.cli.common import QuietOption, load_study_source, make_parents
 from geardyn.errors import ParameterError, StudyError
 from geardyn.io.study_models import STUDY_MODELS, StudyModel
 
@@ -165,7 +165,7 @@ def dataset_command(
     chunk: Annotated[int | None, typer.Option(
         help="Conditions per chunk (default: dataset.chunk, else about 20 per process).")
     ] = None,
-    quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No progress bar.")] = False,
+    quiet: QuietOption = False,
 ) -> None:
     """Labelled fault data: the study's model (a spur pair, a planetary set built from
     geometry, a gear train) over [dataset]'s faults x speeds x torques x noise seeds, the

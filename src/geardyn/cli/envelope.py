@@ -21,7 +21,7 @@ from typing import Annotated
 
 import typer
 
-from geardyn.cli.common import load_study_source, study_run_settings
+from geardyn.cli.common import QuietOption, load_study_source, study_run_settings
 from geardyn.errors import ParameterError
 
 __all__ = ["envelope_command", "load_curve", "parse_plane_axis", "register"]
@@ -75,7 +75,7 @@ def envelope_command(
     ] = None,
     resolution: Annotated[int | None, typer.Option(help="Grid points per axis of the regions.")
                           ] = None,
-    quiet: Annotated[bool, typer.Option("--quiet", help="No progress bar.")] = False,
+    quiet: QuietOption = False,
 ) -> None:
     """The contact regions (contact kept, one- and two-sided impacts) of a plane, from the
     grazing curves of a mesh's flanks; coexisting and period-doubled regions from given fold

@@ -32,6 +32,7 @@ from geardyn.cli.common import (
     InterpretationOption,
     NetCDFOutOption,
     PlotOption,
+    QuietOption,
     StepsOption,
     YesOption,
     check_count,
@@ -80,7 +81,7 @@ def frc_command(
                                              "curves; repeatable.")
     ] = None,
     interpretation: InterpretationOption = None,
-    quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No progress bar.")] = False,
+    quiet: QuietOption = False,
     yes: YesOption = False,
     out: NetCDFOutOption = None,
     plot: PlotOption = None,

@@ -30,6 +30,7 @@ from geardyn.cli.common import (
     MEMORY_FRACTION,  # noqa: F401 (documented here: the limits a map is refused above)
     TIME_LIMIT_S,  # noqa: F401
     StepsOption,
+    YesOption,
     check_count,
     load_study_source,
     refuse_if_costly,
@@ -100,9 +101,7 @@ def map_command(
         str | None, typer.Option(help="Dask scheduler address (tcp://host:port): run there.")
     ] = None,
     chunk: Annotated[int | None, typer.Option(help="Grid points per task (default: auto).")] = None,
-    yes: Annotated[
-        bool, typer.Option("--yes", help="Run even when the estimate exceeds the limits.")
-    ] = False,
+    yes: YesOption = False,
 ) -> None:
     """Map the steady motion (period, contact-loss regime, Lyapunov exponent) over two
     parameters; save it (NetCDF, or a resumable Zarr store) and plot it."""

@@ -27,7 +27,7 @@ from typing import Annotated
 
 import typer
 
-from geardyn.cli.common import run_option, stderr_console
+from geardyn.cli.common import QuietOption, run_option, stderr_console
 from geardyn.errors import ParameterError
 
 __all__ = ["register", "reproduce_command"]
@@ -85,7 +85,7 @@ def reproduce_command(
     basins: Annotated[int, typer.Option(
         help="Also the basins of attraction (N x N initial conditions) where a case's up and "
              "down sweeps disagree while periodic (0: none).")] = 0,
-    quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No progress bar.")] = False,
+    quiet: QuietOption = False,
 ) -> None:
     """Recompute the paper's bifurcation diagrams (swept up and down) and write a report that
     checks every claim of the paper against the data."""

@@ -30,6 +30,7 @@ from geardyn.cli.common import (
     InterpretationOption,
     NetCDFOutOption,
     PlotOption,
+    QuietOption,
     check_plot_path,
     load_study_source,
     make_parents,
@@ -72,7 +73,7 @@ def runup_command(
     = None,
     harmonics: Annotated[int | None, typer.Option(help="Order rays drawn (default 4).")] = None,
     interpretation: InterpretationOption = None,
-    quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No progress bar.")] = False,
+    quiet: QuietOption = False,
     out: NetCDFOutOption = None,
     plot: PlotOption = None,
     order_map: Annotated[Path | None, typer.Option(
