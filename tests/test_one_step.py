@@ -138,3 +138,115 @@ def test_lone_step_screen_flags_every_graze_within_the_step():
         assert screen(-g1, 1.0, g0, ge)[1]
     # a straight event far from the edge: nothing flagged
     assert screen(3.0, 1.0, 2.0, 3.0) == (False, False)
+
+
+def _solver_hits(pattern: re.Pattern[str]) -> set[str]:
+    """The solver modules (kernel templates and their shared parts) with a line that matches."""
+    return {path.name for path in sorted((SRC / "solvers").glob("*.py"))
+            if any(pattern.search(line) for line in path.read_text().splitlines())}
+
+
+#: A statistics update written out: a running minimum or maximum of a statistic's array element
+#: (or of a generated element ``{e}``, or of lo / hi) and a running sum of squares ``x + v * v``.
+EXTREME = re.compile(r"(?:\b(?:min|max)|\{op\})\((?:[A-Z]{4}\[|\{e\}|lo,|hi,)")
+SQUARE = re.compile(r"\+ (\w+) \* \1\b")
+
+
+def test_the_statistics_update_is_written_once():
+    assert _solver_hits(EXTREME) == {"_step_shared.py"}
+    assert _solver_hits(SQUARE) == {"_step_shared.py"}
+    # the patterns find the kernels' former spellings
+    for line in ("GMIN[j, k] = min(GMIN[j, k], g) if STAT[k] else GMIN[j, k]",
+                 "OMAX[j, k] = max(OMAX[j, k], v) if STAT[k] else OMAX[j, k]",
+                 "GMAX[j, k] = max(GMAX[j, k], g)",
+                 'lines.append(f"{e} = _pick(stat, {op}({e}, g[{j}]), {e})")'):
+        assert EXTREME.search(line), line
+    for line in ("OSQ[j, k] = OSQ[j, k] + v * v if STAT[k] else OSQ[j, k]",
+                 'lines.append(f"{e} = _pick(stat, {e} + v * v, {e})")'):
+        assert SQUARE.search(line), line
+    # every layout updates through them: the fused loop's generated helper, the block loop, the
+    # out-of-line slot
+    solvers = SRC / "solvers"
+    assert (solvers / "_step_core.py").read_text().count('"stat_') >= 3
+    text = (solvers / "_kernel_template.py").read_text()
+    assert text.count("stat_min(") >= 3 and text.count("stat_max(") >= 3
+    assert text.count("stat_square(") >= 1
+
+
+#: A finite-difference tangent step written out: the perturbation's size (``FD_DELTA * ...``),
+#: a row's offset e (s v) and the difference quotient's 0.5 / e.
+FD_SIZE = re.compile(r"FD_DELTA \*")
+FD_OFFSET = re.compile(r"\* \((?:S\[[^\]]*\]|sq|s) \* ")
+FD_QUOTIENT = re.compile(r"\b0\.5 / [A-Za-z]")
+
+
+def test_the_tangent_step_is_written_once():
+    for pattern in (FD_SIZE, FD_OFFSET, FD_QUOTIENT):
+        assert _solver_hits(pattern) == {"_step_shared.py"}, pattern
+    # the patterns find the kernels' former spellings
+    assert FD_SIZE.search("NY[l] = FD_DELTA * (1.0 + min(math.sqrt(NY[l]), FD_NORM_CAP))")
+    for line in ("d = e * (S[q] * Z[j, q])", "d = E[j, l] * (sq * ZT[j, q, l])",
+                 'lines = [f"d{q} = e * (S[{q}] * v[{q}])" for q in range(n)]'):
+        assert FD_OFFSET.search(line), line
+    for line in ("inv = 0.5 / E[j]", "v = ((ya - yb) * (0.5 / e)) * iq"):
+        assert FD_QUOTIENT.search(line), line
+    # the one-lane step (Lyapunov, monodromy), the row blocks, the fused lanes and the flagged
+    # lanes build and read back their rows through them
+    solvers = SRC / "solvers"
+    core = (solvers / "_step_core.py").read_text()
+    lyap = (solvers / "_lyapunov_template.py").read_text()
+    for name in ("fd_scale(", "fd_size(", "fd_rows(", "fd_tangent("):
+        assert core.count(name) >= 1 and lyap.count(name) >= 2, name
+    assert "_tangent_step(" in (solvers / "_monodromy_template.py").read_text()
+
+
+def _shared_py(name):
+    """A compiled function of :mod:`._step_shared` as Python, its calls of ``_pick`` too (the
+    compiled functions are not called from Python, see :func:`phase_table_values`)."""
+    fn = getattr(_step_shared, name).py_func
+    glb = dict(fn.__globals__, _pick=_step_shared._pick.py_func)
+    return type(fn)(fn.__code__, glb, fn.__name__, fn.__defaults__, fn.__closure__)
+
+
+def test_statistics_update_matches_numpy():
+    rng = np.random.default_rng(36)
+    v = rng.standard_normal(500) * np.logspace(-3, 3, 500)
+    stat = rng.random(500) < 0.7
+    lo, hi, sq = np.inf, -np.inf, 0.0
+    smin, smax, ssq = (_shared_py(n) for n in ("stat_min", "stat_max", "stat_square"))
+    for x, s in zip(v, stat, strict=True):
+        lo, hi, sq = smin(lo, x, s), smax(hi, x, s), ssq(sq, x, s)
+    assert lo == v[stat].min() and hi == v[stat].max()
+    assert np.isclose(sq, np.sum(v[stat] ** 2), rtol=1e-13)
+    assert smin(1.0, -2.0, False) == 1.0 and smax(1.0, 2.0, False) == 1.0
+    assert ssq(1.0, 2.0, False) == 1.0
+
+
+def test_tangent_rows_difference_a_linear_map_exactly():
+    # rows y +- e s v (fd_scale, fd_size, fd_rows) stepped by a linear map A and read back
+    # (fd_tangent): A v, to the rounding of the difference (~eps / FD_DELTA)
+    scale, size, rows, tangent = (_shared_py(n) for n in ("fd_scale", "fd_size", "fd_rows",
+                                                          "fd_tangent"))
+    rng = np.random.default_rng(37)
+    for _ in range(200):
+        n = int(rng.integers(1, 6))
+        A = rng.standard_normal((n, n))
+        s = 10.0 ** rng.uniform(-2, 2, n)
+        y = rng.standard_normal(n) * s
+        v = rng.standard_normal(n)
+        e, ok = size(scale(float(np.sum((y / s) ** 2))), float(np.sum(v * v)))
+        assert ok and np.isclose(e * np.linalg.norm(v),
+                                 _step_shared.FD_DELTA * (1.0 + np.linalg.norm(y / s)))
+        pairs = [rows(y[q], e, s[q], v[q], ok) for q in range(n)]
+        ya = A @ np.array([a for a, _ in pairs])
+        yb = A @ np.array([b for _, b in pairs])
+        got = np.array([tangent(ya[q], yb[q], e, 1.0 / s[q]) for q in range(n)])
+        want = (A @ (s * v)) / s
+        assert np.allclose(got, want, rtol=1e-7, atol=1e-7 * np.abs(want).max())
+    # a lost vector (zero or not finite): no perturbation, a NaN tangent
+    for vv in (0.0, np.inf, np.nan):
+        with np.errstate(divide="ignore", invalid="ignore"):  # (compiled: no check, as numpy)
+            e, ok = size(np.float64(1e-6), vv)
+        assert not ok and np.isnan(e)
+        assert rows(2.0, e, 1.0, 1.0, ok) == (2.0, 2.0)
+        assert np.isnan(tangent(1.0, 0.5, e, 1.0))

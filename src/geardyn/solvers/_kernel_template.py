@@ -74,7 +74,14 @@ from geardyn.solvers._step_core import (  # CORE-IMPORT
     phase_rotate,
     phase_table,
 )
-from geardyn.solvers._step_shared import rk4_comb, rk4_sixth, screen_grid
+from geardyn.solvers._step_shared import (
+    rk4_comb,
+    rk4_sixth,
+    screen_grid,
+    stat_max,
+    stat_min,
+    stat_square,
+)
 from geardyn.solvers._sweep_books import (  # compiled once for every model
     _alloc,
     _chained,
@@ -740,16 +747,16 @@ def _block_run_soa(q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch):
         for j in range(n_ev):
             for k in range(nl):
                 g = GS[j, k]
-                GMIN[j, k] = min(GMIN[j, k], g) if STAT[k] else GMIN[j, k]
-                GMAX[j, k] = max(GMAX[j, k], g) if STAT[k] else GMAX[j, k]
+                GMIN[j, k] = stat_min(GMIN[j, k], g, STAT[k])
+                GMAX[j, k] = stat_max(GMAX[j, k], g, STAT[k])
         if n_obs > 0:  # at the grid point just reached: TT and the step's end phase (SE, CE)
             _observe_lanes(TT, Y, O, PT, P, LANE, nl, SE, CE, SC, ybuf, ob)
             for j in range(n_obs):
                 for k in range(nl):
                     v = O[j, k]
-                    OMAX[j, k] = max(OMAX[j, k], v) if STAT[k] else OMAX[j, k]
-                    OMIN[j, k] = min(OMIN[j, k], v) if STAT[k] else OMIN[j, k]
-                    OSQ[j, k] = OSQ[j, k] + v * v if STAT[k] else OSQ[j, k]
+                    OMAX[j, k] = stat_max(OMAX[j, k], v, STAT[k])
+                    OMIN[j, k] = stat_min(OMIN[j, k], v, STAT[k])
+                    OSQ[j, k] = stat_square(OSQ[j, k], v, STAT[k])
         due = False
         for k in range(nl):
             MSK[k] = STAT[k] & (STEP[k] >= DUE[k])
@@ -906,8 +913,8 @@ def _slot_out(k, G1, SE, CE, TABS, lanes, cfg, out, blk, slots, scratch):
     n_stat[k] += 1
     for j in range(G1.shape[0]):
         g = G1[j, k]
-        GMIN[j, k] = min(GMIN[j, k], g)
-        GMAX[j, k] = max(GMAX[j, k], g)
+        GMIN[j, k] = stat_min(GMIN[j, k], g, True)
+        GMAX[j, k] = stat_max(GMAX[j, k], g, True)
     o = _observe_l(T0B[k] + step * HB[k], _t_load(Y, k), PT, k, SE[k], CE[k], FORM_GENERAL)
     _t_stats(GMIN, GMAX, OMAX, OMIN, OSQ, k, (), o, True)
     if step < DUE[k]:

@@ -69,8 +69,6 @@ Numerics
 
 from __future__ import annotations
 
-import math
-
 import numba as nb
 import numpy as np
 
@@ -94,8 +92,6 @@ from geardyn.solvers._step_core import (  # CORE-IMPORT
     _JIT,
     _JIT_NOALIAS,
     BLOCK,
-    FD_DELTA,
-    FD_NORM_CAP,
     FUSED,
     GBUF_ROWS,
     GRAZE_ROW,
@@ -122,7 +118,15 @@ from geardyn.solvers._step_core import (  # CORE-IMPORT
     _tuple_source,
     phase_table,
 )
-from geardyn.solvers._step_shared import rk4_comb, rk4_sixth, screen_lone
+from geardyn.solvers._step_shared import (
+    fd_rows,
+    fd_scale,
+    fd_size,
+    fd_tangent,
+    rk4_comb,
+    rk4_sixth,
+    screen_lone,
+)
 from geardyn.solvers._template_model import events, observe, rhs  # MODEL-IMPORT
 
 # TANGENT-ADAPTERS (a one-form model's tangent forms of its rhs: see .kernels)
@@ -400,8 +404,8 @@ def _fill_phase(nr, IDX, S_TAB, C_TAB, PH):
 @nb.njit(inline="always", **_JIT)
 def _fd_setup(nl, m, ZT, S, IS, Y, E, OK, NY):
     """The rows of a grid step from the lanes' states and tangent vectors (ZT[j, q, l]), as in
-    :func:`_tangent_step`: slot 2 k the state, slots 2 j - 2 and 2 j - 1 y +- e S v_j with
-    e |v_j| = FD_DELTA (1 + min(|y / S|, FD_NORM_CAP)); E[j, l] = e (NaN for a lost vector,
+    :func:`_tangent_step`: slot 2 k the state, slots 2 j - 2 and 2 j - 1 y +- e S v_j
+    (:func:`fd_scale`, :func:`fd_size`, :func:`fd_rows`); E[j, l] = e (NaN for a lost vector,
     whose rows follow the state; OK[j, l] False)."""
     ns = ZT.shape[1]
     last = 2 * (m - 1)
@@ -412,7 +416,7 @@ def _fd_setup(nl, m, ZT, S, IS, Y, E, OK, NY):
             zq = ZT[0, q, l] * IS[q]
             NY[l] += zq * zq
     for l in range(nl):
-        NY[l] = FD_DELTA * (1.0 + min(math.sqrt(NY[l]), FD_NORM_CAP))  # the scale
+        NY[l] = fd_scale(NY[l])  # the perturbation's size
     for q in range(ns):
         for l in range(nl):
             Y[q, last * nl + l] = ZT[0, q, l]
@@ -423,17 +427,12 @@ def _fd_setup(nl, m, ZT, S, IS, Y, E, OK, NY):
             for l in range(nl):
                 E[j, l] += ZT[j, q, l] * ZT[j, q, l]
         for l in range(nl):
-            nv = math.sqrt(E[j, l])
-            ok = nv > 0.0 and math.isfinite(nv)
-            OK[j, l] = ok
-            E[j, l] = NY[l] / nv if ok else np.nan
+            E[j, l], OK[j, l] = fd_size(NY[l], E[j, l])
         for q in range(ns):
             sq = S[q]
             for l in range(nl):
-                z0 = ZT[0, q, l]
-                d = E[j, l] * (sq * ZT[j, q, l])
-                Y[q, (2 * j - 2) * nl + l] = z0 + d if OK[j, l] else z0
-                Y[q, (2 * j - 1) * nl + l] = z0 - d if OK[j, l] else z0
+                Y[q, (2 * j - 2) * nl + l], Y[q, (2 * j - 1) * nl + l] = fd_rows(
+                    ZT[0, q, l], E[j, l], sq, ZT[j, q, l], OK[j, l])
 
 
 @nb.njit(inline="always", **_JIT)
@@ -446,9 +445,8 @@ def _fd_combine(nl, m, ZT, IS, Y, E, ACT):
         for q in range(ns):
             iq = IS[q]
             for l in range(nl):
-                e = E[j, l]
-                v = ((Y[q, (2 * j - 2) * nl + l] - Y[q, (2 * j - 1) * nl + l]) * (0.5 / e)) * iq
-                v = v if math.isfinite(e) else np.nan
+                v = fd_tangent(Y[q, (2 * j - 2) * nl + l], Y[q, (2 * j - 1) * nl + l], E[j, l],
+                               iq)
                 ZT[j, q, l] = v if ACT[l] else ZT[j, q, l]
     for q in range(ns):
         for l in range(nl):
@@ -689,12 +687,12 @@ def _t_dot(y):
 
 
 def _t_fd_rows(z0, v, S, e, ok):
-    """The two perturbed rows z0 + e (S v) and z0 - e (S v) (z0 where not ok), as tuples."""
+    """The two perturbed rows z0 + e (S v) and z0 - e (S v) (z0 where not ok), as tuples
+    (:func:`fd_rows` elementwise)."""
 
 
 def _t_fd_tangent(ya, yb, e, IS):
-    """((ya - yb) (0.5 / e)) IS, elementwise: the new tangent vector (NaN where e is not
-    finite)."""
+    """The new tangent vector from the rows' ends ya, yb (:func:`fd_tangent` elementwise)."""
 
 
 def _ov_t_dot_scaled(y, IS):
@@ -709,18 +707,16 @@ def _ov_t_dot(y):
 
 def _ov_t_fd_rows(z0, v, S, e, ok):
     n = len(z0)
-    lines = [f"d{q} = e * (S[{q}] * v[{q}])" for q in range(n)]
-    plus = "".join(f"_pick(ok, z0[{q}] + d{q}, z0[{q}]), " for q in range(n))
-    minus = "".join(f"_pick(ok, z0[{q}] - d{q}, z0[{q}]), " for q in range(n))
+    lines = [f"a{q}, b{q} = fd_rows(z0[{q}], e, S[{q}], v[{q}], ok)" for q in range(n)]
+    plus = "".join(f"a{q}, " for q in range(n))
+    minus = "".join(f"b{q}, " for q in range(n))
     return _tuple_source("z0, v, S, e, ok", [*lines, f"return ({plus}), ({minus})"],
-                         {"_pick": _pick})
+                         {"fd_rows": fd_rows})
 
 
 def _ov_t_fd_tangent(ya, yb, e, IS):
-    terms = "".join(f"_pick(fin, ((ya[{q}] - yb[{q}]) * (0.5 / e)) * IS[{q}], np.nan), "
-                    for q in range(len(ya)))
-    return _tuple_source("ya, yb, e, IS", ["fin = math.isfinite(e)", f"return ({terms})"],
-                         {"_pick": _pick, "math": math, "np": np})
+    terms = "".join(f"fd_tangent(ya[{q}], yb[{q}], e, IS[{q}]), " for q in range(len(ya)))
+    return _tuple_source("ya, yb, e, IS", [f"return ({terms})"], {"fd_tangent": fd_tangent})
 
 
 if FUSED:
@@ -762,10 +758,7 @@ def _lyap_fused_steps(form, i, nl, Z0, Z1, S, IS, PT, T0L, HL, HHL, H6L, PH, ACT
     for l in range(nl):  # the rows' starts: the state and its neighbours z0 +- e S v
         z0 = _t_load(Z0, l)
         v = _t_load(Z1, l)
-        ny = FD_DELTA * (1.0 + min(math.sqrt(_t_dot_scaled(z0, IS)), FD_NORM_CAP))
-        nv = math.sqrt(_t_dot(v))
-        ok = (nv > 0.0) & math.isfinite(nv)
-        e = _pick(ok, ny / nv, np.nan)
+        e, ok = fd_size(fd_scale(_t_dot_scaled(z0, IS)), _t_dot(v))
         ya, yb = _t_fd_rows(z0, v, S, e, ok)
         _t_store(YA, l, ya, ya, True)
         _t_store(YB, l, yb, yb, True)
@@ -862,10 +855,9 @@ def _lyap_flagged(i, nl, first, P, Z0, Z1, IS, T0L, HL, OMEGA, NPL, ACT, ROWS, E
             for q in range(ns):
                 Y[q * BLOCK + l] = ys[q]
         e = EL[l]
-        fin = math.isfinite(e)
         for q in range(ns):
-            v = ((ROWS[0][q * BLOCK + l] - ROWS[1][q * BLOCK + l]) * (0.5 / e)) * IS[q]
-            Z1[q * BLOCK + l] = v if fin else np.nan
+            Z1[q * BLOCK + l] = fd_tangent(ROWS[0][q * BLOCK + l], ROWS[1][q * BLOCK + l], e,
+                                           IS[q])
         for q in range(ns):
             Z0[q * BLOCK + l] = ROWS[2][q * BLOCK + l]
 

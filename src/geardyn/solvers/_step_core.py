@@ -30,8 +30,6 @@ costs about 9 evaluations of the model's rhs and 8 of its events (``bench/crossi
 
 from __future__ import annotations
 
-import math
-
 import numba as nb
 import numpy as np
 
@@ -41,8 +39,6 @@ from geardyn.solvers._step_shared import (  # noqa: F401 - the templates import 
     BLOCK,
     BRACKET_TOL,
     CONFIRM_TOL,
-    FD_DELTA,
-    FD_NORM_CAP,
     GBUF_ROWS,
     GRAZE_ROW,
     GRAZE_TOL,
@@ -65,11 +61,16 @@ from geardyn.solvers._step_shared import (  # noqa: F401 - the templates import 
     _padded,
     _phase_at,
     _phase_in,
+    _pick,
     _quadratic_roots,
     _side,
     _sincos_small,
     cubic_extrema,
     event_buffer,
+    fd_rows,
+    fd_scale,
+    fd_size,
+    fd_tangent,
     phase_increments,
     phase_rotate,
     phase_table,
@@ -78,6 +79,9 @@ from geardyn.solvers._step_shared import (  # noqa: F401 - the templates import 
     rk4_update,
     screen_grid,
     screen_lone,
+    stat_max,
+    stat_min,
+    stat_square,
 )
 from geardyn.solvers._template_model import events, rhs  # MODEL-IMPORT
 
@@ -513,7 +517,9 @@ def _tangent_step(i, t0, Z, S, IS, p, h, omega, n_per, s_tab, c_tab, n_ev, YP, E
                   SIDE, G0, G1, W, gbuf, NCR, UNRES):
     """Advance the state y (row 0 of Z) by one grid step and each tangent vector v (rows 1..,
     in the scaled coordinates z = y / S; IS = 1 / S) by the derivative of that step map:
-    (Phi(y + e S v) - Phi(y - e S v)) / (2 e S). The 2 k + 1 states are the rows of YP
+    (Phi(y + e S v) - Phi(y - e S v)) / (2 e S), the rows built and read back by the shared
+    tangent helpers (:func:`fd_scale`, :func:`fd_size`, :func:`fd_rows`, :func:`fd_tangent`, as
+    every Lyapunov layout does). The 2 k + 1 states are the rows of YP
     (tangent j: rows 2 j - 2 and 2 j - 1; the state: the last row), stepped by
     :func:`_rows_step` (row r's crossings counted in NCR[r], its split-limit steps in UNRES[r]).
     Returns False where a tangent vector was lost (zero or not finite: its rows NaN from here).
@@ -524,38 +530,24 @@ def _tangent_step(i, t0, Z, S, IS, p, h, omega, n_per, s_tab, c_tab, n_ev, YP, E
     for q in range(ns):
         zq = Z[0, q] * IS[q]
         ny += zq * zq
-    scale = FD_DELTA * (1.0 + min(math.sqrt(ny), FD_NORM_CAP))
+    scale = fd_scale(ny)
     last = 2 * (m - 1)
     for q in range(ns):
         YP[last, q] = Z[0, q]
     for j in range(1, m):
-        nv = 0.0
+        vv = 0.0
         for q in range(ns):
-            nv += Z[j, q] * Z[j, q]
-        nv = math.sqrt(nv)
-        if not (nv > 0.0 and math.isfinite(nv)):
-            E[j] = np.nan  # lost: its rows just follow the state
-            alive = False
-            for q in range(ns):
-                YP[2 * j - 2, q] = Z[0, q]
-                YP[2 * j - 1, q] = Z[0, q]
-            continue
-        e = scale / nv
+            vv += Z[j, q] * Z[j, q]
+        e, ok = fd_size(scale, vv)
         E[j] = e
+        alive = alive & ok  # a lost vector: its rows just follow the state
         for q in range(ns):
-            d = e * (S[q] * Z[j, q])
-            YP[2 * j - 2, q] = Z[0, q] + d
-            YP[2 * j - 1, q] = Z[0, q] - d
+            YP[2 * j - 2, q], YP[2 * j - 1, q] = fd_rows(Z[0, q], e, S[q], Z[j, q], ok)
     _rows_step(i, t0, YP, p, h, omega, n_per, s_tab, c_tab, n_ev, K, TMP, Y1, SIDE, G0, G1, W,
                gbuf, NCR, UNRES)
     for j in range(1, m):
-        if not math.isfinite(E[j]):
-            for q in range(ns):
-                Z[j, q] = np.nan
-            continue
-        inv = 0.5 / E[j]
         for q in range(ns):
-            Z[j, q] = ((YP[2 * j - 2, q] - YP[2 * j - 1, q]) * inv) * IS[q]
+            Z[j, q] = fd_tangent(YP[2 * j - 2, q], YP[2 * j - 1, q], E[j], IS[q])
     for q in range(ns):
         Z[0, q] = YP[last, q]
     return alive
@@ -627,13 +619,6 @@ def _t_hermite(y0, f0, y1, f1, h00, h10, h01, h11):
     """The cubic Hermite combination h00 y0 + h10 f0 + h01 y1 + h11 f1, elementwise."""
 
 
-@nb.njit(**_JIT)
-def _pick(cond, a, b):
-    """a if cond else b, a select (a call, inlined by LLVM: numba's inliner would leave the
-    generated tuple helpers with phi variables it then warns about)."""
-    return a if cond else b
-
-
 def _ix(arr, name, row):
     """Source text of element (row, k) of a block array: ``name[row, k]``, or of its flat view
     (rows of BLOCK slots: constant offsets, so that LLVM sees rows that cannot overlap)."""
@@ -679,17 +664,18 @@ def _ov_t_screen(g1, GS, GP, SIDE, GR, k, locate):
 def _ov_t_stats(GMIN, GMAX, OMAX, OMIN, OSQ, k, g, o, stat):
     lines = ["pass"]
     for j in range(len(g)):
-        for name, op in (("GMIN", "min"), ("GMAX", "max")):
-            e = _ix(GMIN, name, j)
-            lines.append(f"{e} = _pick(stat, {op}({e}, g[{j}]), {e})")
+        for arr, name, update in ((GMIN, "GMIN", "stat_min"), (GMAX, "GMAX", "stat_max")):
+            e = _ix(arr, name, j)
+            lines.append(f"{e} = {update}({e}, g[{j}], stat)")
     for j in range(len(o)):
         lines.append(f"v = o[{j}]")
-        for name, op in (("OMAX", "max"), ("OMIN", "min")):
-            e = _ix(OMAX, name, j)
-            lines.append(f"{e} = _pick(stat, {op}({e}, v), {e})")
-        e = _ix(OSQ, "OSQ", j)
-        lines.append(f"{e} = _pick(stat, {e} + v * v, {e})")
-    return _tuple_source("GMIN, GMAX, OMAX, OMIN, OSQ, k, g, o, stat", lines, {"_pick": _pick})
+        for arr, name, update in ((OMAX, "OMAX", "stat_max"), (OMIN, "OMIN", "stat_min"),
+                                  (OSQ, "OSQ", "stat_square")):
+            e = _ix(arr, name, j)
+            lines.append(f"{e} = {update}({e}, v, stat)")
+    return _tuple_source("GMIN, GMAX, OMAX, OMIN, OSQ, k, g, o, stat", lines,
+                         {"stat_min": stat_min, "stat_max": stat_max,
+                          "stat_square": stat_square})
 
 
 def _ov_t_healthy(y, bound):

@@ -3,10 +3,13 @@
 The RK4 combination of a step's stages, the split step's constants, the forcing-phase table and
 its rotations, the phase at a fraction of a grid step, the cubic Hermite weights, the cubic of an
 edge function along a step and its extrema, the sides of the edges and the block screen that flags
-a step, the events' scratch buffer. A model's generated core module (:mod:`._step_core`) imports
-them beside the functions that evaluate the model (the split step, its root finders, the rows of
-a lane), which it compiles with the model's functions inlined; the sweep's and the Lyapunov
-kernels' bookkeeping (:mod:`._sweep_books`, :mod:`._lyapunov_books`) imports them too.
+a step, the events' scratch buffer, the statistics update of a grid point (:func:`stat_min`,
+:func:`stat_max`, :func:`stat_square`) and the finite-difference tangent step's rows and their
+read-back (:func:`fd_scale`, :func:`fd_size`, :func:`fd_rows`, :func:`fd_tangent`). A model's
+generated core module (:mod:`._step_core`) imports them beside the functions that evaluate the
+model (the split step, its root finders, the rows of a lane), which it compiles with the model's
+functions inlined; the sweep's and the Lyapunov kernels' bookkeeping (:mod:`._sweep_books`,
+:mod:`._lyapunov_books`) imports them too.
 """
 
 from __future__ import annotations
@@ -149,6 +152,78 @@ def rk4_comb(y, h6, k1, k2, k3, k4):
     that sums its stages as they come (the split path's :func:`_rk4_stages`: one call site of
     the model for three stages) adds them in this order and ends with :func:`rk4_update`."""
     return rk4_update(y, h6, k1 + 2.0 * k2 + 2.0 * k3 + k4)
+
+
+@nb.njit(**_JIT)
+def _pick(cond, a, b):
+    """a if cond else b, a select (a call, inlined by LLVM: numba's inliner would leave the
+    generated tuple helpers with phi variables it then warns about, and the fused loops take
+    more instructions with the select inlined by numba)."""
+    return a if cond else b
+
+
+@nb.njit(inline="always", **_JIT)
+def stat_min(lo, v, stat):
+    """The statistics update of a running minimum lo by the value v at a grid point (the
+    sweep's GMIN of an edge function, OMIN of an observable): min(lo, v) where ``stat``, else
+    lo. With :func:`stat_max` and :func:`stat_square` every kernel's statistics update (the
+    fused loop's generated ``_t_stats``, the block loop's, the out-of-line slot's): selects of
+    values computed unconditionally (:func:`_pick`, no branch), so that the slot loops
+    vectorise; one statement per statistic, each a load, the select and a store (the
+    paper's fused sweep loop: 765 instructions so; 826 with numba's ``x if stat else y`` in
+    place of ``_pick``, 789 with an element's statistics updated by one call, see
+    ``bench/fused_loop.py --asm``)."""
+    return _pick(stat, min(lo, v), lo)
+
+
+@nb.njit(inline="always", **_JIT)
+def stat_max(hi, v, stat):
+    """The running maximum hi by v where ``stat`` (GMAX, OMAX; see :func:`stat_min`)."""
+    return _pick(stat, max(hi, v), hi)
+
+
+@nb.njit(inline="always", **_JIT)
+def stat_square(sq, v, stat):
+    """The running sum of squares sq by v where ``stat``: sq + v v (OSQ; see
+    :func:`stat_min`)."""
+    return _pick(stat, sq + v * v, sq)
+
+
+@nb.njit(inline="always", **_JIT)
+def fd_scale(ny):
+    """The size e |v| of the finite-difference perturbation of every tangent step (Lyapunov
+    rows, monodromy columns; one lane, row blocks or fused lanes) from ny = |y / s|^2 (the
+    state in the scaled coordinates, summed from 0.0 in the order of the states):
+    FD_DELTA (1 + min(|y / s|, FD_NORM_CAP))."""
+    return FD_DELTA * (1.0 + min(math.sqrt(ny), FD_NORM_CAP))
+
+
+@nb.njit(inline="always", **_JIT)
+def fd_size(scale, vv):
+    """(e, ok) of a tangent vector v with vv = |v|^2 (summed from 0.0 in the order of the
+    states) and the perturbation size ``scale`` (:func:`fd_scale`): e = scale / |v|; a lost
+    vector (|v| zero or not finite) gets e = NaN and ok False (its rows follow the state).
+    The tangent helpers select by :func:`_pick`, as the statistics do (the fused Lyapunov
+    loop: 2009 instructions so, 2018 with numba's ``x if ok else y``)."""
+    nv = math.sqrt(vv)
+    ok = (nv > 0.0) & math.isfinite(nv)
+    return _pick(ok, scale / nv, np.nan), ok
+
+
+@nb.njit(inline="always", **_JIT)
+def fd_rows(z0, e, s, v, ok):
+    """One state component of a tangent vector's two perturbed rows: z0 + e (s v) and
+    z0 - e (s v) (s: the state's scale), z0 for both where not ``ok`` (:func:`fd_size`)."""
+    d = e * (s * v)
+    return _pick(ok, z0 + d, z0), _pick(ok, z0 - d, z0)
+
+
+@nb.njit(inline="always", **_JIT)
+def fd_tangent(ya, yb, e, inv_s):
+    """One component of the stepped tangent vector from its rows' ends ya, yb (the rows of
+    :func:`fd_rows` stepped): ((ya - yb) (0.5 / e)) / s, with inv_s = 1 / s; NaN where e is not
+    finite (a lost vector)."""
+    return _pick(math.isfinite(e), ((ya - yb) * (0.5 / e)) * inv_s, np.nan)
 
 
 @nb.njit(inline="always", **_JIT)
