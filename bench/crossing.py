@@ -5,7 +5,8 @@ split path (start state, trial end, sides, end events, graze flags), by a one-la
 that mirrors the trajectory kernel; then replays exactly those calls of ``_split_step`` many
 times, for the old revision's step core (``--old``) and the working tree's, alternating, and
 reports the median over the rounds (CPU time of this process, so that other processes on a
-shared machine do not count): ns per split call, ns per located crossing (crossings the
+shared machine do not count; the calls made without reference counting, as the kernels make
+them): ns per split call, ns per located crossing (crossings the
 calls located), and, for scale, ns per scalar evaluation of the model's ``rhs`` and ``events``.
 The largest difference of the states after the split, old against new, is printed too (the
 located crossing moves by round-off, not more).
@@ -108,19 +109,15 @@ def drivers(mod):
                 y[:] = y1
         return n
 
-    @nb.njit
-    def replay(P, H, OM, NPER, lane, recs_i, recs_y, recs_g, recs_ph, n_rep, out):
-        """Call the split on every record n_rep times; returns (crossings, unresolved)."""
+    @nb.njit(_nrt=False)
+    def replay_calls(P, H, OM, NPER, lane, recs_i, recs_y, recs_g, recs_ph, n_rep, out, y, y1,
+                     side, g1, ncross, work, ybuf, gbuf):
+        """The split calls of :func:`replay`, without reference counting, as the kernels call
+        the split (their ``_finish_flagged``, ``_lyap_flagged``: ``_nrt=False``); with it, the
+        views passed (``P[k]``, ``recs_ph[r]``) cost four atomic counter updates a call, about
+        85 ns here, which the kernels do not pay."""
         ns = recs_y.shape[2]
         n_ev = recs_g.shape[2]
-        work = np.zeros((9, ns))
-        ybuf = np.zeros(ns)
-        gbuf = event_buffer(0, n_ev)
-        y = np.zeros(ns)
-        y1 = np.zeros(ns)
-        side = np.ones(n_ev, np.int64)
-        g1 = np.zeros(n_ev)
-        ncross = np.zeros(n_ev, np.int64)
         unres = 0
         for _ in range(n_rep):
             for r in range(recs_i.size):
@@ -136,6 +133,23 @@ def drivers(mod):
                                     side, g1, ncross, work, ybuf, gbuf)
                 for q in range(ns):
                     out[r, q] = y[q]
+        return unres
+
+    @nb.njit
+    def replay(P, H, OM, NPER, lane, recs_i, recs_y, recs_g, recs_ph, n_rep, out):
+        """Call the split on every record n_rep times; returns (crossings, unresolved)."""
+        ns = recs_y.shape[2]
+        n_ev = recs_g.shape[2]
+        work = np.zeros((9, ns))
+        ybuf = np.zeros(ns)
+        gbuf = event_buffer(0, n_ev)
+        y = np.zeros(ns)
+        y1 = np.zeros(ns)
+        side = np.ones(n_ev, np.int64)
+        g1 = np.zeros(n_ev)
+        ncross = np.zeros(n_ev, np.int64)
+        unres = replay_calls(P, H, OM, NPER, lane, recs_i, recs_y, recs_g, recs_ph, n_rep, out,
+                             y, y1, side, g1, ncross, work, ybuf, gbuf)
         return ncross.sum(), unres
 
     @nb.njit
