@@ -7,7 +7,9 @@ times, for the old revision's step core (``--old``) and the working tree's, alte
 reports the median over the rounds (CPU time of this process, so that other processes on a
 shared machine do not count; the calls made without reference counting, as the kernels make
 them): ns per split call, ns per located crossing (crossings the
-calls located), and, for scale, ns per scalar evaluation of the model's ``rhs`` and ``events``.
+calls located), the working tree's ns per call of the calls with an edge flagged as a possible
+graze and of the others, and, for scale, ns per scalar evaluation of the model's ``rhs`` and
+``events``.
 The largest difference of the states after the split, old against new, is printed too (the
 located crossing moves by round-off, not more).
 
@@ -198,6 +200,27 @@ def collect(model, omegas, periods_skip, periods, n_ev, per_lane, record):
             np.concatenate(ry), np.concatenate(rg), np.concatenate(rph))
 
 
+def by_kind(replay, data, n_rep: int, rounds: int) -> dict[str, float]:
+    """ns per split call (median of ``rounds``) of the recorded calls with an edge flagged as a
+    possible graze and of the others (a crossing only where an end's side differs)."""
+    graze = np.any(data[7][:, 2] != 0.0, axis=1)
+    out = {}
+    for kind, sel in (("graze-flagged", graze), ("not graze-flagged", ~graze)):
+        idx = np.flatnonzero(sel)
+        if idx.size == 0:
+            continue
+        sub = [*data[:4], *(np.ascontiguousarray(a[idx]) for a in data[4:9])]
+        res = np.zeros((idx.size, data[6].shape[2]))
+        reps = max(1, n_rep * data[5].size // idx.size // 2)
+        times = []
+        for _ in range(rounds):
+            t = time.process_time()
+            replay(*sub, reps, res)
+            times.append(time.process_time() - t)
+        out[kind] = statistics.median(times) / (idx.size * reps) * 1e9
+    return out
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--rounds", type=int, default=7)
@@ -258,6 +281,9 @@ def main() -> None:
         t_rhs, t_ev = (statistics.median(trhs[key]) / 100_000 * 1e9 for key in trhs)
         print(f"| {name} | new/old | | | {ratio:.3f} | | |")
         print(f"|  {grazing} of the {n_rec} calls have an edge flagged as a possible graze |")
+        print("|  new, by kind: " + "; ".join(
+            f"{kind} {ns:.0f} ns/call" for kind, ns in by_kind(drv["new"][1], data, n_rep,
+                                                               args.rounds).items()) + " |")
         print(f"|  scale: one scalar rhs {t_rhs:.1f} ns, one events {t_ev:.1f} ns; max rel. "
               f"state difference after the split, new - old: {diff:.1e} |")
     if args.write:
