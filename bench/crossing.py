@@ -5,8 +5,11 @@ split path (start state, trial end, sides, end events, graze flags), by a one-la
 that mirrors the trajectory kernel; then replays exactly those calls of ``_split_step`` many
 times, for the old revision's step core (``--old``) and the working tree's, alternating, and
 reports the median over the rounds (CPU time of this process, so that other processes on a
-shared machine do not count): ns per split call, ns per located crossing (crossings the
-calls located), and, for scale, ns per scalar evaluation of the model's ``rhs`` and ``events``.
+shared machine do not count; the calls made without reference counting, as the kernels make
+them): ns per split call, ns per located crossing (crossings the
+calls located), the working tree's ns per call of the calls with an edge flagged as a possible
+graze and of the others, and, for scale, ns per scalar evaluation of the model's ``rhs`` and
+``events``.
 The largest difference of the states after the split, old against new, is printed too (the
 located crossing moves by round-off, not more).
 
@@ -108,19 +111,15 @@ def drivers(mod):
                 y[:] = y1
         return n
 
-    @nb.njit
-    def replay(P, H, OM, NPER, lane, recs_i, recs_y, recs_g, recs_ph, n_rep, out):
-        """Call the split on every record n_rep times; returns (crossings, unresolved)."""
+    @nb.njit(_nrt=False)
+    def replay_calls(P, H, OM, NPER, lane, recs_i, recs_y, recs_g, recs_ph, n_rep, out, y, y1,
+                     side, g1, ncross, work, ybuf, gbuf):
+        """The split calls of :func:`replay`, without reference counting, as the kernels call
+        the split (their ``_finish_flagged``, ``_lyap_flagged``: ``_nrt=False``); with it, the
+        views passed (``P[k]``, ``recs_ph[r]``) cost four atomic counter updates a call, about
+        85 ns here, which the kernels do not pay."""
         ns = recs_y.shape[2]
         n_ev = recs_g.shape[2]
-        work = np.zeros((9, ns))
-        ybuf = np.zeros(ns)
-        gbuf = event_buffer(0, n_ev)
-        y = np.zeros(ns)
-        y1 = np.zeros(ns)
-        side = np.ones(n_ev, np.int64)
-        g1 = np.zeros(n_ev)
-        ncross = np.zeros(n_ev, np.int64)
         unres = 0
         for _ in range(n_rep):
             for r in range(recs_i.size):
@@ -136,6 +135,23 @@ def drivers(mod):
                                     side, g1, ncross, work, ybuf, gbuf)
                 for q in range(ns):
                     out[r, q] = y[q]
+        return unres
+
+    @nb.njit
+    def replay(P, H, OM, NPER, lane, recs_i, recs_y, recs_g, recs_ph, n_rep, out):
+        """Call the split on every record n_rep times; returns (crossings, unresolved)."""
+        ns = recs_y.shape[2]
+        n_ev = recs_g.shape[2]
+        work = np.zeros((9, ns))
+        ybuf = np.zeros(ns)
+        gbuf = event_buffer(0, n_ev)
+        y = np.zeros(ns)
+        y1 = np.zeros(ns)
+        side = np.ones(n_ev, np.int64)
+        g1 = np.zeros(n_ev)
+        ncross = np.zeros(n_ev, np.int64)
+        unres = replay_calls(P, H, OM, NPER, lane, recs_i, recs_y, recs_g, recs_ph, n_rep, out,
+                             y, y1, side, g1, ncross, work, ybuf, gbuf)
         return ncross.sum(), unres
 
     @nb.njit
@@ -182,6 +198,27 @@ def collect(model, omegas, periods_skip, periods, n_ev, per_lane, record):
         lane.append(np.full(n, k))
     return (P, H, omegas, nper.astype(np.int64), np.concatenate(lane), np.concatenate(ri),
             np.concatenate(ry), np.concatenate(rg), np.concatenate(rph))
+
+
+def by_kind(replay, data, n_rep: int, rounds: int) -> dict[str, float]:
+    """ns per split call (median of ``rounds``) of the recorded calls with an edge flagged as a
+    possible graze and of the others (a crossing only where an end's side differs)."""
+    graze = np.any(data[7][:, 2] != 0.0, axis=1)
+    out = {}
+    for kind, sel in (("graze-flagged", graze), ("not graze-flagged", ~graze)):
+        idx = np.flatnonzero(sel)
+        if idx.size == 0:
+            continue
+        sub = [*data[:4], *(np.ascontiguousarray(a[idx]) for a in data[4:9])]
+        res = np.zeros((idx.size, data[6].shape[2]))
+        reps = max(1, n_rep * data[5].size // idx.size // 2)
+        times = []
+        for _ in range(rounds):
+            t = time.process_time()
+            replay(*sub, reps, res)
+            times.append(time.process_time() - t)
+        out[kind] = statistics.median(times) / (idx.size * reps) * 1e9
+    return out
 
 
 def main() -> None:
@@ -244,6 +281,9 @@ def main() -> None:
         t_rhs, t_ev = (statistics.median(trhs[key]) / 100_000 * 1e9 for key in trhs)
         print(f"| {name} | new/old | | | {ratio:.3f} | | |")
         print(f"|  {grazing} of the {n_rec} calls have an edge flagged as a possible graze |")
+        print("|  new, by kind: " + "; ".join(
+            f"{kind} {ns:.0f} ns/call" for kind, ns in by_kind(drv["new"][1], data, n_rep,
+                                                               args.rounds).items()) + " |")
         print(f"|  scale: one scalar rhs {t_rhs:.1f} ns, one events {t_ev:.1f} ns; max rel. "
               f"state difference after the split, new - old: {diff:.1e} |")
     if args.write:

@@ -143,20 +143,34 @@ def _illinois(j, side_j, a, fa, b, fb, y0, f0, y1, f1, dt, t, p, ybuf, g, pc):
 
 
 @nb.njit(inline="always", **_JIT)
-def _cubic_locate(j, side_j, c0, c1, c2, c3, b, fb, y0, f0, y1, f1, dt, t, p, ybuf, g, pc):
+def _cubic_locate(j, side_j, c0, c1, c2, c3, b, fb, v1, v2, y0, f0, y1, f1, dt, t, p, ybuf, g,
+                  pc):
     """Fraction in (0, b] of the step where event j leaves side side_j, given the cubic
     c0 + c1 x + c2 x^2 + c3 x^3 of the event along the step's interpolant (exact for an event
     affine in time and state) and a bracket [0, b] that holds exactly one crossing (the start
-    taken as on side side_j; fb: the model's event at b, off the side).
+    taken as on side side_j; fb: the model's event at b, off the side); v1, v2: the event at
+    1/3 and 2/3 of the step.
 
-    Newton's method on the cubic, safeguarded by the bracket (no model evaluations), then one
+    Newton's method on the cubic from the secant of the third of the step where the sign
+    changes (of [0, b] where b < 1), safeguarded by the bracket (no model evaluations), then one
     evaluation of the model's event at the root: it is taken when the event there is within
     CONFIRM_TOL of the step from its crossing (always, up to round-off, for affine events);
     otherwise the model's events take over (:func:`_illinois`, bracket narrowed)."""
     a = 0.0
     hi = b
     fa = _forced(c0, side_j)
-    x = (a * fb - b * fa) / (fb - fa) if fb != fa else 0.5 * b
+    lo = a
+    flo = fa
+    up = b
+    fup = fb
+    if b == 1.0:  # (selects, no branches: where the sign changes is unpredictable)
+        o1 = _side(v1) != side_j
+        o2 = _side(v2) != side_j
+        lo = 0.0 if o1 else (1.0 / 3.0 if o2 else 2.0 / 3.0)
+        flo = fa if o1 else (v1 if o2 else v2)
+        up = 1.0 / 3.0 if o1 else (2.0 / 3.0 if o2 else 1.0)
+        fup = v1 if o1 else (v2 if o2 else fb)
+    x = (lo * fup - up * flo) / (fup - flo) if fup != flo else 0.5 * (lo + up)
     if not (a < x < b):
         x = 0.5 * (a + b)
     for _ in range(60):
@@ -251,8 +265,8 @@ def _first_crossing(j, side_j, graze, g1j, y0, f0, y1, f1, dt, t, p, ybuf, gbuf,
     if b == 1.0 and _side(g1j) == side_j:
         return 2.0
     c0, c1, c2, c3 = _cubic_coeffs(v0, v1, v2, g1j)
-    return _cubic_locate(j, side_j, c0, c1, c2, c3, b, gb, y0, f0, y1, f1, dt, t, p, ybuf, gsc,
-                         pc)
+    return _cubic_locate(j, side_j, c0, c1, c2, c3, b, gb, v1, v2, y0, f0, y1, f1, dt, t, p,
+                         ybuf, gsc, pc)
 
 
 @nb.njit(inline="always", **_JIT)
