@@ -29,6 +29,7 @@ from geardyn.cli.common import (
     StepsOption,
     YesOption,
     check_count,
+    check_omega,
     check_plot_path,
     check_run_cost,
     load_study_source,
@@ -36,7 +37,6 @@ from geardyn.cli.common import (
     run_option,
     run_options,
     study_run_settings,
-    usable_omega,
     write_outputs,
 )
 from geardyn.errors import ParameterError, StudyError
@@ -91,8 +91,7 @@ def basins_command(
         om = study_omega(s, base)
     if om is None:
         raise StudyError("--omega: not given, and the study has no run.omega")
-    if not usable_omega(om):
-        raise ParameterError("--omega", om, "must be a positive finite number")
+    check_omega("--omega", om)
     if out is not None and out.suffix.lower() != ".nc":
         raise ParameterError("--out", str(out), "suffix must be .nc (NetCDF)")
     check_plot_path("--plot", plot)

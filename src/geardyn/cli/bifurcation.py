@@ -41,6 +41,7 @@ from geardyn.cli.common import (
     TransientOption,
     YesOption,
     check_count,
+    check_omega,
     check_plot_path,
     check_run_cost,
     load_study_source,
@@ -274,10 +275,9 @@ def bifurcation_command(
     s = load_study_source(study)
     sweep = s.sweep
     name = param or (sweep.param if sweep is not None else "Omega")
+    if omega is not None:  # [run].omega: the same rule, when the study was read
+        check_omega("--omega", omega)
     om = omega if omega is not None else s.run.omega
-    if om is not None and not usable_omega(om):
-        raise ParameterError("--omega", om, "must be a positive finite number (with a finite "
-                             "period)")
     interp = interpretation.value if interpretation is not None else None
     model = build_model(s, interpretation=interp, omega=om)
     _check_param_name(model, name)

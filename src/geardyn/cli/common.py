@@ -7,7 +7,6 @@ fast; command modules import it instead of :mod:`geardyn.cli.main`.
 
 from __future__ import annotations
 
-import math
 import os
 import sys
 import tomllib
@@ -167,9 +166,20 @@ def check_plot_path(option: str, path: Path | None) -> None:
 
 
 def usable_omega(value: float) -> bool:
-    """True for a forcing frequency that is positive, finite, and whose period 2 pi / Omega is
-    finite too (5e-324 is positive, but its period overflows)."""
-    return math.isfinite(value) and value > 0 and math.isfinite(2 * math.pi / value)
+    """:func:`geardyn.core.settings.usable_omega` (the rule of ``[run].omega`` too)."""
+    from geardyn.core.settings import usable_omega as rule
+
+    return rule(value)
+
+
+def check_omega(option: str, value: float) -> None:
+    """Refuse a forcing frequency ``value`` that breaks the rule of ``[run].omega``
+    (:data:`geardyn.core.settings.OMEGA_RULE`): a :class:`~geardyn.ParameterError` naming
+    ``option``."""
+    from geardyn.core.settings import OMEGA_RULE, usable_omega
+
+    if not usable_omega(value):
+        raise ParameterError(option, value, OMEGA_RULE)
 
 
 def run_settings(options: dict[str, tuple[str, Any]]):
