@@ -55,10 +55,17 @@ def test_the_explorer_and_the_study_file_accept_the_same_continuations(value):
         assert message.startswith("continuation:") and repr(value) in message
 
 
-def test_the_command_lines_interpretations_are_the_study_files():
+def test_the_command_lines_choices_are_the_study_files():
+    """``--interpretation`` and ``--continuation`` (enumerations kept in the light CLI
+    modules) offer exactly the values the study file accepts."""
+    from geardyn.cli.bifurcation import Continuation
+
     assert tuple(m.value for m in Interpretation) == INTERPRETATIONS
+    assert tuple(m.value for m in Continuation) == CONTINUATIONS
     for value in INTERPRETATIONS:
         assert _accepted_by_study_file("study", "interpretation", value)
+    for value in CONTINUATIONS:
+        assert _accepted_by_study_file("sweep", "continuation", value)
 
 
 PAPER_BASE = """
@@ -175,3 +182,36 @@ def test_a_study_omega_without_a_period_is_refused_as_the_study_key(tmp_path):
     result = CliRunner().invoke(app, ["simulate", str(path)])
     assert result.exit_code != 0
     assert "run.omega" in result.output and "--omega" not in result.output
+
+
+#: Values of the gear pair's inputs on both sides of their ranges (Omega, zeta, backlash
+#: >= 0; |kappa| < 1, which keeps the mesh stiffness 1 + kappa cos(...) positive).
+GEAR_PAIR_VALUES = [("Omega", -1e-9, False), ("Omega", 0.0, True), ("zeta", -0.01, False),
+                    ("zeta", 0.0, True), ("kappa", -1.0, False), ("kappa", -0.999, True),
+                    ("kappa", 0.999, True), ("kappa", 1.0, False), ("backlash", -1e-12, False),
+                    ("backlash", 0.0, True), ("Fm", float("inf"), False),
+                    ("Fa", float("nan"), False), ("kappa_phase", -7.0, True)]
+
+
+@pytest.mark.parametrize("name, value, valid", GEAR_PAIR_VALUES)
+def test_the_gear_pairs_constructor_with_params_and_study_file_agree(name, value, valid):
+    """The constructor, ``with_params`` and a ``gear_pair`` study's ``[params]`` accept or
+    refuse the same value, each naming the input."""
+    outcomes = []
+    for enter in (lambda: geardyn.GearPair(**{name: value}),
+                  lambda: geardyn.GearPair().with_params(**{name: value})):
+        try:
+            enter()
+            outcomes.append(True)
+        except ParameterError as exc:
+            assert exc.field == name
+            outcomes.append(False)
+    if name != "Omega":  # a study's Omega is [run].omega (its own rule, above)
+        doc = {"study": {"name": "gp", "model": "gear_pair"}, "params": {name: value}}
+        try:
+            Study.model_validate(doc)
+            outcomes.append(True)
+        except ValidationError as exc:
+            assert exc.errors()[0]["loc"] == ("params", name)
+            outcomes.append(False)
+    assert outcomes == [valid] * len(outcomes)
