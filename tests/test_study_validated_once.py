@@ -215,3 +215,29 @@ def test_the_gear_pairs_constructor_with_params_and_study_file_agree(name, value
             assert exc.errors()[0]["loc"] == ("params", name)
             outcomes.append(False)
     assert outcomes == [valid] * len(outcomes)
+
+
+@pytest.mark.parametrize("command, table, key", [
+    (["bifurcation"], "run", "periods"), (["frc"], "run", "periods"),
+    (["map", "--x", "Omega:1:1.5:2", "--y", "xi1:0.01:0.3:2"], "run", "periods"),
+    (["basins", "--omega", "1.1", "--x", "X_sq:-1:1:2", "--y", "V_sq:-1:1:2"], "run",
+     "periods")])
+def test_too_few_samples_are_refused_naming_the_study_key_they_came_from(tmp_path, command,
+                                                                         table, key):
+    """RunSettings takes one sample; a command that classifies periods needs two, and its
+    refusal names where the one came from (the study's key, not ``--samples``)."""
+    import tomli_w
+    from typer.testing import CliRunner
+
+    from geardyn.cli.main import app
+
+    doc = builtin_study("paper_fig3").to_toml_dict()
+    doc["sweep"].pop("samples", None)
+    doc.setdefault(table, {})[key] = 1
+    path = tmp_path / "one_sample.toml"
+    path.write_text(tomli_w.dumps(doc))
+    result = CliRunner().invoke(app, [command[0], str(path), *command[1:], "--out",
+                                      str(tmp_path / "x.nc")])
+    assert result.exit_code != 0 and not (tmp_path / "x.nc").exists()
+    assert f"{table}.{key}" in result.output and "--samples" not in result.output
+    assert ">= 2" in result.output

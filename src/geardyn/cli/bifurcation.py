@@ -301,10 +301,9 @@ def bifurcation_command(
     run = study_run_settings(
         s, run_options(transient=transient, samples=samples, steps_per_period=steps_per_period,
                        converge=converge, continued_transient=continued_transient),
-        sweep=True, omega=lambda: _lowest_omega(model, name, (start, stop), hold))
+        sweep=True, omega=lambda: _lowest_omega(model, name, (start, stop), hold),
+        least={"samples": (2, "the period needs two")})
     tr, n_samples, spp = run.transient, run.samples, run.steps_per_period
-    if n_samples < 2:
-        raise ParameterError("--samples", n_samples, "must be >= 2 (the period needs two)")
     if converge is not None and not converge < 1:
         raise ParameterError("--converge", converge, "must be a tolerance in (0, 1)")
     if continued_transient is not None and cont == "none":  # [run]'s: for continued sweeps

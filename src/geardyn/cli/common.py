@@ -193,13 +193,23 @@ def run_settings(options: dict[str, tuple[str, Any]]):
 
 def study_run_settings(study, options: dict[str, tuple[str, Any]], *, sweep: bool = False,
                        omega: float | Callable[[], float | None] | None = None,
-                       defaults: dict[str, Any] | None = None):
+                       defaults: dict[str, Any] | None = None,
+                       least: dict[str, tuple[int, str]] | None = None):
     """The :class:`~geardyn.RunSettings` of a command that runs a study: every field from the
     command-line ``options`` (field -> (option name, value or None)), else the study's
     ``[run]`` table, else the command's ``defaults``, as
     :meth:`geardyn.io.toml.Study.run_settings` reads them (``sweep``, ``omega``: there). An
-    invalid value is a one-line error naming the option or the study key it came from."""
-    return study.run_settings(sweep=sweep, omega=omega, given=options, defaults=defaults)
+    invalid value is a one-line error naming the option or the study key it came from; so is a
+    value below what the command needs (``least``: field -> (least value, why), e.g. a period
+    classification's two samples)."""
+    run = study.run_settings(sweep=sweep, omega=omega, given=options, defaults=defaults)
+    for field, (minimum, why) in (least or {}).items():
+        value = getattr(run, field)
+        if value < minimum:
+            sources = study.run_sources(options, sweep=sweep, omega=omega, defaults=defaults)
+            where = sources.get(field, (field, value))[0]
+            raise ParameterError(where, value, f"must be >= {minimum}" + (f" ({why})" * bool(why)))
+    return run
 
 
 def settings_from_options(kind: type, options: dict[str, tuple[str, Any]]):

@@ -246,7 +246,7 @@ def _usable_omega(value: float) -> float:
 
 #: A forcing frequency Omega (``[run].omega``): the rule every ``--omega`` reads too
 #: (:func:`geardyn.core.settings.usable_omega`).
-Omega = Annotated[Real, AfterValidator(_usable_omega)]
+ForcingFrequency = Annotated[Real, AfterValidator(_usable_omega)]
 
 #: ``[sweep].continuation``: where each point of a sweep starts (:class:`SweepSettings`); the
 #: explorer's and the command line's choices are :data:`CONTINUATIONS`.
@@ -302,7 +302,7 @@ def _run_table_fields() -> dict[str, Any]:
     import typing
 
     hints = typing.get_type_hints(Settings)
-    out: dict[str, Any] = {"omega": (Omega | None, Field(
+    out: dict[str, Any] = {"omega": (ForcingFrequency | None, Field(
         None, description="mesh frequency Omega = omega/omega_n"))}
     for f in dataclasses.fields(Settings):
         extra = dict(RUN_TABLE_EXTRAS.get(f.name, {}))
