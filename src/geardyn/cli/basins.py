@@ -30,6 +30,7 @@ from geardyn.cli.common import (
     StepsOption,
     YesOption,
     check_count,
+    check_omega,
     check_plot_path,
     check_run_cost,
     load_study_source,
@@ -37,7 +38,6 @@ from geardyn.cli.common import (
     run_option,
     run_options,
     study_run_settings,
-    usable_omega,
     write_outputs,
 )
 from geardyn.errors import ParameterError, StudyError
@@ -92,8 +92,7 @@ def basins_command(
         om = study_omega(s, base)
     if om is None:
         raise StudyError("--omega: not given, and the study has no run.omega")
-    if not usable_omega(om):
-        raise ParameterError("--omega", om, "must be a positive finite number")
+    check_omega("--omega", om)
     if out is not None and out.suffix.lower() != ".nc":
         raise ParameterError("--out", str(out), "suffix must be .nc (NetCDF)")
     check_plot_path("--plot", plot)
@@ -106,16 +105,13 @@ def basins_command(
         raise ParameterError("--y", y, "must name another state than --x")
     if samples is not None:
         check_count("--samples", samples)
-        if samples < 2:
-            raise ParameterError("--samples", samples, "must be >= 2")
     # basins' own defaults: convergence CONVERGE, samples enough for the longest period
     options = run_options(transient=transient, samples=samples,
                           steps_per_period=steps_per_period, converge=converge)
     first = study_run_settings(s, options, omega=om, defaults={"converge": CONVERGE})
     run = study_run_settings(s, options, omega=om, defaults={
-        "converge": CONVERGE, "samples": SAMPLES_PER_PERIOD * first.max_period + 2})
-    if run.samples < 2:
-        raise ParameterError("run.periods", run.samples, "must be >= 2")
+        "converge": CONVERGE, "samples": SAMPLES_PER_PERIOD * first.max_period + 2},
+        least={"samples": (2, "the period needs two")})
     tr, n_samples, spp = run.transient, run.samples, run.steps_per_period
     lanes = x_axis[3] * y_axis[3]
     check_run_cost(model, lanes, [om], 10 * tr, n_samples, spp, False, yes=yes,

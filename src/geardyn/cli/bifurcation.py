@@ -42,6 +42,7 @@ from geardyn.cli.common import (
     TransientOption,
     YesOption,
     check_count,
+    check_omega,
     check_plot_path,
     check_run_cost,
     load_study_source,
@@ -273,10 +274,9 @@ def bifurcation_command(
     s = load_study_source(study)
     sweep = s.sweep
     name = param or (sweep.param if sweep is not None else "Omega")
+    if omega is not None:  # [run].omega: the same rule, when the study was read
+        check_omega("--omega", omega)
     om = omega if omega is not None else s.run.omega
-    if om is not None and not usable_omega(om):
-        raise ParameterError("--omega", om, "must be a positive finite number (with a finite "
-                             "period)")
     interp = interpretation.value if interpretation is not None else None
     model = build_model(s, interpretation=interp, omega=om)
     _check_param_name(model, name)
@@ -300,10 +300,9 @@ def bifurcation_command(
     run = study_run_settings(
         s, run_options(transient=transient, samples=samples, steps_per_period=steps_per_period,
                        converge=converge, continued_transient=continued_transient),
-        sweep=True, omega=lambda: _lowest_omega(model, name, (start, stop), hold))
+        sweep=True, omega=lambda: _lowest_omega(model, name, (start, stop), hold),
+        least={"samples": (2, "the period needs two")})
     tr, n_samples, spp = run.transient, run.samples, run.steps_per_period
-    if n_samples < 2:
-        raise ParameterError("--samples", n_samples, "must be >= 2 (the period needs two)")
     if converge is not None and not converge < 1:
         raise ParameterError("--converge", converge, "must be a tolerance in (0, 1)")
     if continued_transient is not None and cont == "none":  # [run]'s: for continued sweeps

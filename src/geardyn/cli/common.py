@@ -7,7 +7,6 @@ fast; command modules import it instead of :mod:`geardyn.cli.main`.
 
 from __future__ import annotations
 
-import math
 import os
 import sys
 import tomllib
@@ -168,9 +167,20 @@ def check_plot_path(option: str, path: Path | None) -> None:
 
 
 def usable_omega(value: float) -> bool:
-    """True for a forcing frequency that is positive, finite, and whose period 2 pi / Omega is
-    finite too (5e-324 is positive, but its period overflows)."""
-    return math.isfinite(value) and value > 0 and math.isfinite(2 * math.pi / value)
+    """:func:`geardyn.core.settings.usable_omega` (the rule of ``[run].omega`` too)."""
+    from geardyn.core.settings import usable_omega as rule
+
+    return rule(value)
+
+
+def check_omega(option: str, value: float) -> None:
+    """Refuse a forcing frequency ``value`` that breaks the rule of ``[run].omega``
+    (:data:`geardyn.core.settings.OMEGA_RULE`): a :class:`~geardyn.ParameterError` naming
+    ``option``."""
+    from geardyn.core.settings import OMEGA_RULE, usable_omega
+
+    if not usable_omega(value):
+        raise ParameterError(option, value, OMEGA_RULE)
 
 
 def run_settings(options: dict[str, tuple[str, Any]]):
@@ -184,13 +194,23 @@ def run_settings(options: dict[str, tuple[str, Any]]):
 
 def study_run_settings(study, options: dict[str, tuple[str, Any]], *, sweep: bool = False,
                        omega: float | Callable[[], float | None] | None = None,
-                       defaults: dict[str, Any] | None = None):
+                       defaults: dict[str, Any] | None = None,
+                       least: dict[str, tuple[int, str]] | None = None):
     """The :class:`~geardyn.RunSettings` of a command that runs a study: every field from the
     command-line ``options`` (field -> (option name, value or None)), else the study's
     ``[run]`` table, else the command's ``defaults``, as
     :meth:`geardyn.io.toml.Study.run_settings` reads them (``sweep``, ``omega``: there). An
-    invalid value is a one-line error naming the option or the study key it came from."""
-    return study.run_settings(sweep=sweep, omega=omega, given=options, defaults=defaults)
+    invalid value is a one-line error naming the option or the study key it came from; so is a
+    value below what the command needs (``least``: field -> (least value, why), e.g. a period
+    classification's two samples)."""
+    run = study.run_settings(sweep=sweep, omega=omega, given=options, defaults=defaults)
+    for field, (minimum, why) in (least or {}).items():
+        value = getattr(run, field)
+        if value < minimum:
+            sources = study.run_sources(options, sweep=sweep, omega=omega, defaults=defaults)
+            where = sources.get(field, (field, value))[0]
+            raise ParameterError(where, value, f"must be >= {minimum}" + (f" ({why})" * bool(why)))
+    return run
 
 
 def settings_from_options(kind: type, options: dict[str, tuple[str, Any]]):

@@ -39,6 +39,7 @@ from geardyn.cli.common import (
     QuietOption,
     StepsOption,
     check_count,
+    check_omega,
     check_plot_path,
     load_study_source,
     make_parents,
@@ -48,7 +49,6 @@ from geardyn.cli.common import (
     settings_from_options,
     stderr_console,
     study_run_settings,
-    usable_omega,
     write_outputs,
 )
 from geardyn.errors import ParameterError, StudyError
@@ -225,9 +225,9 @@ def continue_command(
     s = load_study_source(study)
     sweep = s.sweep
     name = param or (sweep.param if sweep is not None else "Omega")
+    if omega is not None:  # [run].omega: the same rule, when the study was read
+        check_omega("--omega", omega)
     om = omega if omega is not None else s.run.omega
-    if om is not None and not usable_omega(om):
-        raise ParameterError("--omega", om, "must be a positive finite number")
     if range_ is not None:
         start, stop = parse_span(range_)
         range_text = range_

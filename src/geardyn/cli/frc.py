@@ -126,11 +126,9 @@ def frc_command(
     run = study_run_settings(
         s, run_options(transient=transient, samples=samples, steps_per_period=steps_per_period,
                        converge=converge, continued_transient=continued_transient),
-        sweep=True, omega=min(start, stop))
+        sweep=True, omega=min(start, stop), least={"samples": (2, "the period needs two")})
     tr, n_samples, spp = run.transient, run.samples, run.steps_per_period
     check_count("--samples", n_samples)
-    if n_samples < 2:
-        raise ParameterError("--samples", n_samples, "must be >= 2 (the period needs two)")
     omegas = np.linspace(start, stop, min(num, ESTIMATE_POINTS))  # Omega, evenly spaced
     check_run_cost(model, 2 * num, omegas,
                    tr if run.converge is None else run.transient_limit, n_samples, spp,

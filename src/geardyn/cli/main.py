@@ -51,6 +51,7 @@ from geardyn.cli.common import (
     StepsOption,
     YesOption,
     check_count,
+    check_omega,
     check_plot_path,
     check_run_cost,
     load_study_source,
@@ -59,7 +60,6 @@ from geardyn.cli.common import (
     run_options,
     stderr_console,
     study_run_settings,
-    usable_omega,
 )
 from geardyn.core.status import Status
 from geardyn.errors import ParameterError, StudyError
@@ -355,9 +355,7 @@ def simulate(
         om = study_omega(s, base)
     if om is None:
         raise StudyError("--omega: not given, and the study has no run.omega")
-    if not usable_omega(om):
-        raise ParameterError("--omega", om, "must be a positive finite number (with a finite "
-                             "period)")
+    check_omega("--omega", om)
     check_plot_path("--plot", plot)
     run = study_run_settings(s, {**run_options(transient=transient,
                                                steps_per_period=steps_per_period),

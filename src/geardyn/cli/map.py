@@ -123,8 +123,6 @@ def map_command(
                           ("--steps-per-period", steps_per_period)):
         if count is not None:
             check_count(option, count)
-    if samples is not None and samples < 2:
-        raise ParameterError("--samples", samples, "must be >= 2")
     run_settings(run_options(transient=transient, steps_per_period=steps_per_period))
     s = load_study_source(study)
     model = build_model(s, interpretation=interpretation)
@@ -155,10 +153,9 @@ def map_command(
     low = [min(a[0], a[1]) for a in forcing]
     run = study_run_settings(s, run_options(transient=transient, samples=samples,
                                             steps_per_period=steps_per_period),
-                             omega=low[0] if low else model.omega)
+                             omega=low[0] if low else model.omega,
+                             least={"samples": (2, "a map classifies periods")})
     tr, n_samples, spp = run.transient, run.samples, run.steps_per_period
-    if n_samples < 2:
-        raise ParameterError("run.periods", n_samples, "a map needs >= 2 samples per point")
     lanes = x_axis[3] * y_axis[3]
     omega_axis = forcing[0] if forcing else None
     omegas = (np.linspace(omega_axis[0], omega_axis[1], min(omega_axis[2], ESTIMATE_POINTS))

@@ -28,6 +28,17 @@ MIN_STEPS = 4
 INTEGRATOR = "RK4, fixed step aligned to the forcing period"
 
 
+#: What a forcing frequency Omega must be (:func:`usable_omega`): the rule of the study file's
+#: ``[run].omega`` and of every command's ``--omega``.
+OMEGA_RULE = "must be a positive finite number (with a finite period)"
+
+
+def usable_omega(value: float) -> bool:
+    """True for a forcing frequency that is positive, finite, and whose period 2 pi / Omega is
+    finite too (5e-324 is positive, but its period overflows)."""
+    return math.isfinite(value) and value > 0 and math.isfinite(2 * math.pi / value)
+
+
 class SettingsError(ValueError):
     """An invalid run setting; the message names the field and the value."""
 

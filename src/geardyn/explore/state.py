@@ -31,12 +31,8 @@ from geardyn.core.model import Model
 from geardyn.errors import ParameterError
 from geardyn.gears.faults import FAULT_KINDS
 from geardyn.io.study_models import STUDY_MODELS, StudyModel, study_model
-from geardyn.io.toml import (
-    FaultTable,
-    PaperBase,
-    PlanetaryGearSetParams,
-    Study,
-)
+from geardyn.io.toml import CONTINUATIONS, FaultTable, Study, is_paper_base
+from geardyn.models.derived import INTERPRETATIONS
 from geardyn.models.planetary_stiffness import COAST_FLANKS, STIFFNESS_METHODS
 
 __all__ = ["CONTINUATIONS", "GEOMETRY_KEYS", "INTERPRETATIONS", "MAIN_PARAMS",
@@ -61,8 +57,6 @@ PLANETARY_GEOMETRY_KEYS = ("params.geometry.stiffness", "params.geometry.coast",
                            "params.geometry.stiffness_options.sun_bore_radius",
                            "params.geometry.stiffness_options.planet_bore_radius",
                            "params.geometry.stiffness_options.ring_rim_radius")
-INTERPRETATIONS = ("consistent", "carrier-only", "as-printed")
-CONTINUATIONS = ("none", "up", "down")
 
 
 @dataclass(frozen=True)
@@ -188,10 +182,22 @@ def _geometry_tables(study: Study) -> tuple[tuple[str, ...], str, list[FaultTabl
         return GEOMETRY_KEYS, "faults", list(study.faults or [])
     if study.train is not None and study.train.faults:
         return (), "train.faults", [FaultTable(**t) for t in study.train.faults]
-    geometry = getattr(study.params, "geometry", None)
-    if isinstance(study.params, PlanetaryGearSetParams) and geometry is not None:
-        return PLANETARY_GEOMETRY_KEYS, "params.geometry.faults", list(geometry.faults or [])
+    table = study_model(study.study.model).geometry
+    geometry = _attribute_path(study, key_path(table)) if table else None
+    if geometry is not None:
+        keys = tuple(k for k in PLANETARY_GEOMETRY_KEYS if k.startswith(table + "."))
+        return keys, f"{table}.faults", list(geometry.faults or [])
     return (), "", []
+
+
+def _attribute_path(study: Study, path: tuple[str | int, ...]) -> Any:
+    """The value at the study-file key ``path`` of the validated ``study`` (None where a
+    table on the way is absent)."""
+    target: Any = study
+    for part in path:
+        target = (target.get(part) if isinstance(target, dict)
+                  else getattr(target, str(part), None))
+    return target
 
 
 def _fault_table(study: Study, path: tuple[str | int, ...]) -> FaultTable | None:
@@ -400,10 +406,7 @@ class ExplorerState:
             return declared[name].default
         if path[0] == "gears":
             return study.gears.value(str(path[1]), str(path[2]))[0]  # type: ignore[union-attr]
-        target: Any = study
-        for part in path:
-            target = (target.get(part) if isinstance(target, dict)
-                      else getattr(target, str(part), None))
+        target = _attribute_path(study, path)
         return "" if target is None else target
 
     def _with_overrides(self, overrides: dict[str, float | str]) -> Study:
@@ -422,7 +425,7 @@ class ExplorerState:
         params = self.study.params
         if not self.model_kind.paper_device:  # [params] names the kind's declared inputs
             doc["params"].update(changes)
-        elif isinstance(params, PaperBase):  # base = "paper", changes by the paper's names
+        elif is_paper_base(params):  # base = "paper", changes by the paper's names
             doc["params"]["changes"] = {**doc["params"].get("changes", {}), **changes}
         else:  # the device's PlanetaryParams in full
             doc["params"] = params.replace(**changes).model_dump(exclude_none=True)

@@ -99,6 +99,10 @@ class StudyModel:
     ``dataset``
         What ``geardyn dataset`` needs of the study (:class:`DatasetFaults`; None: it takes
         none of the kind).
+    ``geometry``
+        The table of ``[params]`` a model of the kind may be built from (a dotted path,
+        ``"params.geometry"``; "" none): where the study has it, the explorer offers its
+        controls and those of its ``[[<geometry>.faults]]``.
     """
 
     name: str
@@ -115,6 +119,7 @@ class StudyModel:
     spur_pair_gears: bool = False
     explore_given_only: bool = False
     dataset: DatasetFaults | None = None
+    geometry: str = ""
 
     def __post_init__(self) -> None:
         if self.params_view not in PARAMS_VIEWS:
@@ -158,7 +163,7 @@ STUDY_MODELS: dict[str, StudyModel] = {m.name: m for m in (
                spur_pair_gears=True,
                dataset=DatasetFaults("[[faults]]", "gears")),
     StudyModel("planetary", "PlanetaryGearSetParams", "PlanetaryGearSet", PLANETARY_INPUTS,
-               "planetary_example", "modes", plot_state="u_s",
+               "planetary_example", "modes", plot_state="u_s", geometry="params.geometry",
                dataset=DatasetFaults(
                    "[[params.geometry.faults]]", "model", needs="params.geometry",
                    refusal="geardyn dataset takes a planetary set built from [params.geometry]"

@@ -115,10 +115,11 @@ import tomllib
 from collections.abc import Callable, Mapping
 from importlib import resources
 from pathlib import Path
-from typing import Annotated, Any, ClassVar, Literal
+from typing import Annotated, Any, ClassVar, Literal, get_args
 
 import tomli_w
 from pydantic import (
+    AfterValidator,
     BaseModel,
     BeforeValidator,
     ConfigDict,
@@ -139,8 +140,10 @@ from geardyn.core.settings import (
     DEFAULT_MAX_PERIOD,
     DEFAULT_TOL,
     FIELDS,
+    OMEGA_RULE,
     SettingsError,
     settings_from_named,
+    usable_omega,
 )
 from geardyn.core.settings import RunSettings as Settings
 from geardyn.errors import ParameterError, StudyError
@@ -166,6 +169,7 @@ from geardyn.io.params_table import Quantity, params_table
 from geardyn.io.runup_table import RunupTable
 from geardyn.io.study_models import STUDY_MODELS, StudyModel, study_model
 from geardyn.io.train_table import TrainTable
+from geardyn.models.derived import Interpretation
 from geardyn.models.gear_pair_coefficients import GEAR_PAIR
 from geardyn.models.params import PAPER_NAMES, Angle, Length, PlanetaryParams, Real, Whole
 from geardyn.models.planetary_coefficients import INPUTS as PLANETARY_INPUTS
@@ -226,13 +230,28 @@ class StudyInfo(BaseModel):
     model: Model = Field("catt", description="catt (the paper's device), gear_pair, "
                          "planetary (Lin & Parker gear set) or spur_pair (the SI pair of "
                          "[gears] on its potential-energy stiffness)")
-    interpretation: Literal["consistent", "carrier-only", "as-printed"] = Field(
+    interpretation: Interpretation = Field(
         "consistent", description="how to read the paper's ambiguous formulas (catt only)"
     )
     plot_state: str | None = Field(
         None, description="coordinate shown in figures; default X_sq (catt) or x (gear_pair)"
     )
 
+
+def _usable_omega(value: float) -> float:
+    if not usable_omega(value):
+        raise ValueError(OMEGA_RULE)
+    return value
+
+
+#: A forcing frequency Omega (``[run].omega``): the rule every ``--omega`` reads too
+#: (:func:`geardyn.core.settings.usable_omega`).
+ForcingFrequency = Annotated[Real, AfterValidator(_usable_omega)]
+
+#: ``[sweep].continuation``: where each point of a sweep starts (:class:`SweepSettings`); the
+#: explorer's and the command line's choices are :data:`CONTINUATIONS`.
+Continuation = Literal["none", "up", "down"]
+CONTINUATIONS: tuple[str, ...] = get_args(Continuation)
 
 #: The ``[run]`` table's name of a :class:`geardyn.RunSettings` field where it differs.
 RUN_TABLE_NAMES: dict[str, str] = {"samples": "periods"}
@@ -283,8 +302,8 @@ def _run_table_fields() -> dict[str, Any]:
     import typing
 
     hints = typing.get_type_hints(Settings)
-    out: dict[str, Any] = {"omega": (Real | None, Field(
-        None, gt=0, description="mesh frequency Omega = omega/omega_n"))}
+    out: dict[str, Any] = {"omega": (ForcingFrequency | None, Field(
+        None, description="mesh frequency Omega = omega/omega_n"))}
     for f in dataclasses.fields(Settings):
         extra = dict(RUN_TABLE_EXTRAS.get(f.name, {}))
         default = extra.pop("default", None)
@@ -381,7 +400,7 @@ class SweepSettings(BaseModel):
     start: Real
     stop: Real
     num: Whole = Field(ge=2, description="number of parameter values")
-    continuation: Literal["none", "up", "down"] = Field(
+    continuation: Continuation = Field(
         "none", description="none, up or down: start each point from the previous one's state"
     )
     samples: Whole | None = Field(None, ge=2, description="forcing periods recorded per value")
@@ -409,8 +428,19 @@ class PaperBase(BaseModel):
     base: Literal["paper"]
     changes: dict[str, Any] = Field(default_factory=dict)
 
+    _device: PlanetaryParams | None = PrivateAttr(None)
+
     def resolve(self) -> PlanetaryParams:
+        """The paper's device with the changes (built from the changes each call)."""
         return PlanetaryParams.paper(**self.changes)
+
+    @property
+    def device(self) -> PlanetaryParams:
+        """The paper's device with the changes, checked once (when the study file is read, or
+        at the first call), errors naming ``params.changes.<name>``."""
+        if self._device is None:
+            self._device = _resolve_paper(self.model_dump())[1]
+        return self._device
 
 
 def study_table(name: str, block: CoefficientBlock, doc: str) -> type[BaseModel]:
@@ -869,7 +899,21 @@ def _resolve_paper(data: dict[str, Any]) -> tuple[PaperBase, PlanetaryParams]:
             return ("params", *loc)
 
         raise _relocated(exc, loc_of) from None
+    spec._device = params
     return spec, params
+
+
+def is_paper_base(params: Mapping[str, Any] | BaseModel) -> bool:
+    """True where a paper device's ``[params]`` (a table or its validated form) is the
+    ``base = "paper"`` form (:class:`PaperBase`: changes by the paper's names), False for the
+    device in full (:class:`~geardyn.models.params.PlanetaryParams`)."""
+    return isinstance(params, PaperBase) or (isinstance(params, Mapping) and "base" in params)
+
+
+def device_params(params: BaseModel) -> PlanetaryParams:
+    """The paper device of a ``catt`` study's ``[params]``: the table itself (the device in
+    full) or the paper's device with the table's changes (``base = "paper"``, checked once)."""
+    return params.device if isinstance(params, PaperBase) else params  # type: ignore[return-value]
 
 
 class Study(BaseModel):
@@ -1004,7 +1048,7 @@ class Study(BaseModel):
         # an unknown kind is read as the paper's device (study.model's own check names it)
         declared = STUDY_MODELS.get(kind) if isinstance(kind, str) else None
         declared = declared or STUDY_MODELS["catt"]
-        if declared.paper_device and "base" in raw:
+        if declared.paper_device and is_paper_base(raw):
             out["params"] = _resolve_paper(raw)[0]
             return out
         target = params_class(declared)
@@ -1026,10 +1070,8 @@ class Study(BaseModel):
             raise ValueError(
                 f"study.model is {self.study.model!r} but [params] holds {holds.label} parameters"
             )
-        if isinstance(self.params, PaperBase):
-            self._planetary = _resolve_paper(self.params.model_dump())[1]
-        elif isinstance(self.params, PlanetaryParams):
-            self._planetary = self.params
+        if holds.paper_device:
+            self._planetary = device_params(self.params)
         return self
 
     def _check_gears(self) -> None:

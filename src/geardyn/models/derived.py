@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, fields
-from typing import Literal
+from typing import Literal, get_args
 
 import numpy as np
 
@@ -34,7 +34,7 @@ from geardyn.models.params import PlanetaryParams
 Interpretation = Literal["consistent", "carrier-only", "as-printed"]
 #: The names of the three interpretations of the paper's formulas (docs/model.md), the default
 #: first.
-INTERPRETATIONS: tuple[str, ...] = ("consistent", "carrier-only", "as-printed")
+INTERPRETATIONS: tuple[str, ...] = get_args(Interpretation)
 
 
 def _d(name: str, meaning: str, *inputs: str, unit: str = "1",

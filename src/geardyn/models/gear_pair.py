@@ -22,6 +22,7 @@ from geardyn.core.coefficients import CoefficientLayout
 from geardyn.core.kernel_source import KernelSource
 from geardyn.core.model import Model
 from geardyn.core.one_form import OneForm
+from geardyn.errors import ParameterError
 from geardyn.models.elements import dead_zone
 from geardyn.models.gear_pair_coefficients import GEAR_PAIR
 
@@ -95,20 +96,12 @@ class GearPair(Model):
                  backlash: float = 1.0):
         values = dict(Omega=Omega, zeta=zeta, kappa=kappa, Fm=Fm, Fa=Fa,
                       kappa_phase=kappa_phase, error_phase=error_phase, backlash=backlash)
-        for key, v in values.items():
-            if not isinstance(v, int | float) or isinstance(v, bool) or not math.isfinite(v):
-                raise ValueError(f"{key}: must be a finite number (got {v!r})")
-        if zeta < 0:
-            raise ValueError(f"zeta: damping ratio must be >= 0 (got {zeta!r})")
-        if not abs(kappa) < 1:
-            raise ValueError(f"kappa: |kappa| must be < 1 to keep the stiffness positive "
-                             f"(got {kappa!r})")
-        if backlash < 0:
-            raise ValueError(f"backlash: must be >= 0 (got {backlash!r})")
-        if Omega < 0:
-            raise ValueError(f"Omega: must be >= 0 (got {Omega!r})")
+        for key, v in values.items():  # finite and in the declared range (|kappa| < 1: k > 0)
+            if isinstance(v, str):
+                raise ParameterError(key, v, "must be a number")
+            values[key] = GEAR_PAIR[key].check(key, v)
         self.params = _LAYOUT.fill_derived(np.array(
-            [float(values[k]) for k in self.param_names[:COS_K]] + [0.0] * len(DERIVED)))
+            [values[k] for k in self.param_names[:COS_K]] + [0.0] * len(DERIVED)))
         self.coefficient_layout = _LAYOUT
         self.omega_index = OMEGA
         self.kernel = _KERNEL

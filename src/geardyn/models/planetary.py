@@ -230,6 +230,24 @@ def _per_planet(field: str, value: Any, n: int, kind: str, minimum: float | None
     return np.array([_si(f"{field}[{i}]", v, kind, minimum) for i, v in enumerate(vals)])
 
 
+def _series_inputs(contact_ratio: Any, harmonics: Any) -> tuple[float, int]:
+    """The rectangular waveform's contact ratio (1 < eps < 2) and its series' harmonics (a
+    whole number from 1 to 200), checked: a :class:`~geardyn.ParameterError` naming the input
+    (every model with a rectangular stiffness waveform reads them here)."""
+    if not isinstance(contact_ratio, int | float) or not 1.0 < contact_ratio < 2.0:
+        raise ParameterError("contact_ratio", contact_ratio, "must be between 1 and 2")
+    return float(contact_ratio), _harmonics(harmonics)
+
+
+def _harmonics(harmonics: Any) -> int:
+    """The harmonics of a stiffness series: a whole number from 1 to 200 (a
+    :class:`~geardyn.ParameterError` naming ``harmonics`` for any other)."""
+    if isinstance(harmonics, bool) or not isinstance(harmonics, int) \
+            or not 1 <= harmonics <= 200:
+        raise ParameterError("harmonics", harmonics, "must be an integer from 1 to 200")
+    return harmonics
+
+
 def _waveform(field: str, waveform: Any, rel: np.ndarray, phase: np.ndarray, contact_ratio: float,
               harmonics: int, order: int = 1) -> np.ndarray:
     """Relative Fourier coefficients (meshes, 2 nh) [a_1, b_1, a_2, ...] of k(theta) - 1 per
@@ -518,14 +536,10 @@ class PlanetaryGearSet(Model):
             minimum = 0.0 if kind in ("length", "dimensionless") else None
             per[f] = _per_planet(f, self.inputs[f], n, kind, minimum)
         both = lambda f: np.concatenate([per[f"sun_{f}"], per[f"ring_{f}"]])  # noqa: E731
-        if not isinstance(contact_ratio, int | float) or not 1.0 < contact_ratio < 2.0:
-            raise ParameterError("contact_ratio", contact_ratio, "must be between 1 and 2")
-        if isinstance(harmonics, bool) or not isinstance(harmonics, int) \
-                or not 1 <= harmonics <= 200:
-            raise ParameterError("harmonics", harmonics, "must be an integer from 1 to 200")
+        contact_ratio, harmonics = _series_inputs(contact_ratio, harmonics)
         self.mesh_phase = both("mesh_phase")
         self.fourier = _waveforms("waveform", waveform, both("stiffness_fluctuation"),
-                                 self.mesh_phase, float(contact_ratio), harmonics,
+                                 self.mesh_phase, contact_ratio, harmonics,
                                  self.mesh_order)
         if not isinstance(stiffness_gaps, bool):
             raise ParameterError("stiffness_gaps", stiffness_gaps, "must be true or false")
@@ -777,9 +791,7 @@ class PlanetaryGearSet(Model):
         if placement is not None and method != "potential_energy":
             raise ParameterError("faults", placement.describe(), "need stiffness="
                                  "'potential_energy' (the ISO waves know no teeth)")
-        if isinstance(harmonics, bool) or not isinstance(harmonics, int) \
-                or not 1 <= harmonics <= 200:
-            raise ParameterError("harmonics", harmonics, "must be an integer from 1 to 200")
+        _harmonics(harmonics)  # before the geometry's stiffness is computed with it
         held_member = _held(held, tuple(kw.get("fixed", ())))
         phases = geometry.phases_turning(_sun_turns(held_member))
         revolution = None

@@ -62,6 +62,7 @@ from geardyn.models.planetary import (
     _clean,
     _flank_index,
     _minimum_relative_stiffness,
+    _series_inputs,
     _waveform,
     planetary_layout,
 )
@@ -217,11 +218,7 @@ class TrainModel(PlanetaryGearSet):
         self.reference_mesh = self._reference(reference_mesh)
         self._kinematic_orders = self._orders()
         self.fixed = tuple(train.fixed)
-        if isinstance(harmonics, bool) or not isinstance(harmonics, int) \
-                or not 1 <= harmonics <= 200:
-            raise ParameterError("harmonics", harmonics, "must be an integer from 1 to 200")
-        if not isinstance(contact_ratio, int | float) or not 1.0 < contact_ratio < 2.0:
-            raise ParameterError("contact_ratio", contact_ratio, "must be between 1 and 2")
+        contact_ratio, harmonics = _series_inputs(contact_ratio, harmonics)
         self.phase_source = "given"
         if mesh_phase is None:  # from the geometry where the train has it
             known = self._phases_known()

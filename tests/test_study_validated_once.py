@@ -1,0 +1,243 @@
+"""A setting or parameter is validated once, where it enters, by one declared rule: the
+explorer's and the command line's choices are the study file's (the same value accepted or
+refused by both), a ``base = "paper"`` table is resolved once, the geometry a kind is built from
+is declared, and every model with a rectangular stiffness waveform checks its contact ratio and
+harmonics by one rule."""
+
+from __future__ import annotations
+
+import math
+from unittest import mock
+
+import pytest
+from pydantic import ValidationError
+
+import geardyn
+from geardyn.cli.common import Interpretation
+from geardyn.cli.errors import format_error
+from geardyn.errors import ParameterError
+from geardyn.explore.state import CONTINUATIONS, INTERPRETATIONS, ExplorerState, key_path
+from geardyn.io.study_models import STUDY_MODELS
+from geardyn.io.toml import PaperBase, Study, builtin_study, load_study, params_class
+from geardyn.models.params import PlanetaryParams
+from geardyn.study import build_model
+
+#: Values tried on both sides: every declared one and near misses.
+CANDIDATES = (*INTERPRETATIONS, *CONTINUATIONS, "carrier_only", "As-printed", "sideways", "",
+              "true")
+
+
+def _accepted_by_study_file(table: str, key: str, value: str) -> bool:
+    doc = builtin_study("paper_fig3").to_toml_dict()
+    doc[table][key] = value
+    try:
+        Study.model_validate(doc)
+    except ValidationError:
+        return False
+    return True
+
+
+@pytest.mark.parametrize("value", CANDIDATES)
+def test_the_explorer_and_the_study_file_accept_the_same_interpretations(value):
+    state = ExplorerState(builtin_study("paper_fig3"), "paper_fig3", describe_error=format_error)
+    message = state.set_interpretation(value)
+    assert (message is None) == _accepted_by_study_file("study", "interpretation", value)
+    if message is not None:  # the refusal names the setting and the value
+        assert message.startswith("interpretation:") and repr(value) in message
+
+
+@pytest.mark.parametrize("value", CANDIDATES)
+def test_the_explorer_and_the_study_file_accept_the_same_continuations(value):
+    state = ExplorerState(builtin_study("paper_fig3"), "paper_fig3", describe_error=format_error)
+    message = state.set_continuation(value)
+    assert (message is None) == _accepted_by_study_file("sweep", "continuation", value)
+    if message is not None:
+        assert message.startswith("continuation:") and repr(value) in message
+
+
+def test_the_command_lines_choices_are_the_study_files():
+    """``--interpretation`` and ``--continuation`` (enumerations kept in the light CLI
+    modules) offer exactly the values the study file accepts."""
+    from geardyn.cli.bifurcation import Continuation
+
+    assert tuple(m.value for m in Interpretation) == INTERPRETATIONS
+    assert tuple(m.value for m in Continuation) == CONTINUATIONS
+    for value in INTERPRETATIONS:
+        assert _accepted_by_study_file("study", "interpretation", value)
+    for value in CONTINUATIONS:
+        assert _accepted_by_study_file("sweep", "continuation", value)
+
+
+PAPER_BASE = """
+[study]
+name = "changed"
+[params]
+base = "paper"
+[params.changes]
+backlash = 1e-4
+xi1 = 0.07
+"""
+
+
+def test_a_paper_base_table_is_resolved_once_and_as_the_paper_says():
+    paper = PlanetaryParams.paper
+    with mock.patch.object(PlanetaryParams, "paper", side_effect=paper) as spy:
+        study = load_study(PAPER_BASE)
+    assert spy.call_count == 1
+    expected = PlanetaryParams.paper(backlash=1e-4, xi1=0.07)  # the device, built directly
+    assert study.planetary_params == expected
+    assert isinstance(study.params, PaperBase) and study.params.device is study.planetary_params
+
+
+def test_a_paper_base_given_as_an_object_is_checked_as_a_file_is():
+    ok = Study(params=PaperBase(base="paper", changes={"backlash": 1e-4, "xi1": 0.07}))
+    assert ok.planetary_params == load_study(PAPER_BASE).planetary_params
+    with pytest.raises(ValidationError) as err:  # an invalid change names its key
+        Study(params=PaperBase(base="paper", changes={"xi1": -1.0}))
+    assert err.value.errors()[0]["loc"][:3] == ("params", "changes", "xi1")
+    with pytest.raises(ValidationError) as err:
+        load_study(PAPER_BASE.replace("xi1 = 0.07", "xi1 = -1.0"))
+    assert err.value.errors()[0]["loc"][:3] == ("params", "changes", "xi1")
+
+
+@pytest.mark.parametrize("kind", [m for m in STUDY_MODELS.values() if m.geometry])
+def test_a_declared_geometry_table_is_a_table_of_the_kinds_params(kind):
+    path = key_path(kind.geometry)
+    assert path[0] == "params" and len(path) == 2
+    assert path[1] in params_class(kind).model_fields
+
+
+def _planetary(**kw) -> geardyn.Model:
+    M = geardyn.Member
+    return geardyn.PlanetaryGearSet(
+        n_planets=3, sun=M(0.4, 0.39, 1e8, 0.0, radius=0.03), ring=M(2.35, 3.0, 1e8, 1e9),
+        carrier=M(5.43, 6.29, 1e8, 0.0), planet=M(0.66, 0.61, 1e8),
+        sun_mesh_stiffness=5e8, ring_mesh_stiffness=5e8, sun_backlash="2 um",
+        ring_backlash="1 um", modal_damping=0.02, sun_torque=50.0, **kw)
+
+
+def _train(**kw) -> geardyn.Model:
+    doc = builtin_study("two_stage_train").to_toml_dict()
+    doc["params"].update(kw)
+    return build_model(Study.model_validate(doc))
+
+
+@pytest.mark.parametrize("field, value", [
+    ("harmonics", 0), ("harmonics", 1), ("harmonics", 200), ("harmonics", 201),
+    ("contact_ratio", 1.0), ("contact_ratio", 1.001), ("contact_ratio", 1.999),
+    ("contact_ratio", 2.0)])
+def test_the_planetary_set_and_a_gear_train_check_the_waveform_inputs_alike(field, value):
+    """The same value is accepted or refused (naming the field) by both models, and the
+    refusal is the declared range: 1 < contact_ratio < 2, 1 <= harmonics <= 200."""
+    inside = 1 <= value <= 200 if field == "harmonics" else 1.0 < value < 2.0
+    for build in (_planetary, _train):
+        if inside:
+            assert isinstance(build(**{field: value}), geardyn.Model)
+        else:
+            with pytest.raises(ParameterError) as err:
+                build(**{field: value})
+            assert err.value.field.rpartition(".")[2] == field and err.value.value == value
+
+
+OMEGAS = (5e-324, 1e-310, 1e-300, 0.0, -1.0, 1.0, 1e308, float("inf"), float("nan"))
+
+
+@pytest.mark.parametrize("omega", OMEGAS)
+def test_the_study_file_and_the_option_accept_the_same_omega(omega):
+    """``[run].omega`` and ``--omega`` are one rule: the same value accepted or refused by both,
+    the refusal naming where it came from; the rule is that the period 2 pi / Omega is a
+    positive finite number (computed here, independently)."""
+    from geardyn.cli.common import check_omega
+
+    period = 2 * math.pi / omega if omega != 0 else math.inf
+    usable = math.isfinite(omega) and math.isfinite(period) and period > 0
+    doc = builtin_study("paper_fig3").to_toml_dict()
+    doc["run"]["omega"] = omega
+    try:
+        Study.model_validate(doc)
+        by_study = True
+    except ValidationError as exc:
+        assert exc.errors()[0]["loc"] == ("run", "omega")
+        by_study = False
+    try:
+        check_omega("--omega", omega)
+        by_option = True
+    except ParameterError as exc:
+        assert exc.field == "--omega"
+        by_option = False
+    assert by_study == by_option == usable
+
+
+def test_a_study_omega_without_a_period_is_refused_as_the_study_key(tmp_path):
+    """The CLI names the study key, not ``--omega``, for a study's unusable ``[run].omega``."""
+    import tomli_w
+    from typer.testing import CliRunner
+
+    from geardyn.cli.main import app
+
+    doc = builtin_study("paper_fig3").to_toml_dict()
+    doc["run"]["omega"] = 5e-324
+    path = tmp_path / "tiny.toml"
+    path.write_text(tomli_w.dumps(doc))
+    result = CliRunner().invoke(app, ["simulate", str(path)])
+    assert result.exit_code != 0
+    assert "run.omega" in result.output and "--omega" not in result.output
+
+
+#: Values of the gear pair's inputs on both sides of their ranges (Omega, zeta, backlash
+#: >= 0; |kappa| < 1, which keeps the mesh stiffness 1 + kappa cos(...) positive).
+GEAR_PAIR_VALUES = [("Omega", -1e-9, False), ("Omega", 0.0, True), ("zeta", -0.01, False),
+                    ("zeta", 0.0, True), ("kappa", -1.0, False), ("kappa", -0.999, True),
+                    ("kappa", 0.999, True), ("kappa", 1.0, False), ("backlash", -1e-12, False),
+                    ("backlash", 0.0, True), ("Fm", float("inf"), False),
+                    ("Fa", float("nan"), False), ("kappa_phase", -7.0, True)]
+
+
+@pytest.mark.parametrize("name, value, valid", GEAR_PAIR_VALUES)
+def test_the_gear_pairs_constructor_with_params_and_study_file_agree(name, value, valid):
+    """The constructor, ``with_params`` and a ``gear_pair`` study's ``[params]`` accept or
+    refuse the same value, each naming the input."""
+    outcomes = []
+    for enter in (lambda: geardyn.GearPair(**{name: value}),
+                  lambda: geardyn.GearPair().with_params(**{name: value})):
+        try:
+            enter()
+            outcomes.append(True)
+        except ParameterError as exc:
+            assert exc.field == name
+            outcomes.append(False)
+    if name != "Omega":  # a study's Omega is [run].omega (its own rule, above)
+        doc = {"study": {"name": "gp", "model": "gear_pair"}, "params": {name: value}}
+        try:
+            Study.model_validate(doc)
+            outcomes.append(True)
+        except ValidationError as exc:
+            assert exc.errors()[0]["loc"] == ("params", name)
+            outcomes.append(False)
+    assert outcomes == [valid] * len(outcomes)
+
+
+@pytest.mark.parametrize("command, table, key", [
+    (["bifurcation"], "run", "periods"), (["frc"], "run", "periods"),
+    (["map", "--x", "Omega:1:1.5:2", "--y", "xi1:0.01:0.3:2"], "run", "periods"),
+    (["basins", "--omega", "1.1", "--x", "X_sq:-1:1:2", "--y", "V_sq:-1:1:2"], "run",
+     "periods")])
+def test_too_few_samples_are_refused_naming_the_study_key_they_came_from(tmp_path, command,
+                                                                         table, key):
+    """RunSettings takes one sample; a command that classifies periods needs two, and its
+    refusal names where the one came from (the study's key, not ``--samples``)."""
+    import tomli_w
+    from typer.testing import CliRunner
+
+    from geardyn.cli.main import app
+
+    doc = builtin_study("paper_fig3").to_toml_dict()
+    doc["sweep"].pop("samples", None)
+    doc.setdefault(table, {})[key] = 1
+    path = tmp_path / "one_sample.toml"
+    path.write_text(tomli_w.dumps(doc))
+    result = CliRunner().invoke(app, [command[0], str(path), *command[1:], "--out",
+                                      str(tmp_path / "x.nc")])
+    assert result.exit_code != 0 and not (tmp_path / "x.nc").exists()
+    assert f"{table}.{key}" in result.output and "--samples" not in result.output
+    assert ">= 2" in result.output
