@@ -21,7 +21,7 @@ from geardyn.solvers._step_shared import _JIT, STATUS_DIVERGED, STATUS_OK, phase
 _LAST, _CUR, _NTR, _NST, _TOTAL, _NBK, _DUE = range(7)
 
 
-@nb.njit(**_JIT)
+@nb.njit(_nrt=False, **_JIT)  # it allocates nothing
 def _orthonormalise(Z, logs, add):
     """Modified Gram-Schmidt on the tangent rows 1.. of Z; writes the log of R's diagonal to logs
     when ``add``. Returns False if a vector vanished or is not finite."""
@@ -47,7 +47,7 @@ def _orthonormalise(Z, logs, add):
     return True
 
 
-@nb.njit(**_JIT)
+@nb.njit(_nrt=False, **_JIT)  # it allocates nothing
 def _stretch_logs(Z, C, logs):
     """The logs of R's diagonal that orthonormalising Z's tangent rows would give now (the
     stretch since the last renormalisation), computed on the copy C: Z is left as it is."""
@@ -149,7 +149,7 @@ def _lanes_init(first, nl, k, Y0, NPER, n_transient, n_steps, renorm_every, n_bl
     return IST, ENDS, BLK, ACC, Zl, Cl, logs, max_total
 
 
-@nb.njit(**_JIT)
+@nb.njit(_nrt=False, **_JIT)  # it allocates nothing
 def _lane_due(IST, l, renorm, ENDS):
     """The next step at which lane l needs its bookkeeping: a renormalisation (every
     ``renorm`` steps, at the end of the transient, at the end) or the end of a block of the
@@ -176,7 +176,7 @@ def _lane_books(step, first, nl, k, renorm, bound, ZT, Zl, Cl, logs, IST, ENDS, 
     return nxt
 
 
-@nb.njit(**_JIT)
+@nb.njit(_nrt=False, **_JIT)  # it allocates nothing
 def _lane_books_core(step, first, nl, k, renorm, bound, ZT, Zl, Cl, logs, IST, ENDS, BLK, ACC,
                      ACT, ACTR, status):
     """The bookkeeping of the block's lanes due at this step, as in :func:`_run`:

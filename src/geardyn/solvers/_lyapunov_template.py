@@ -168,7 +168,7 @@ if VARIATIONAL:
             y1[q] = rk4_comb(y[q], h6, KS[0, q], KS[1, q], KS[2, q], KS[3, q])
             w1[q] = rk4_comb(w[q], h6, KV[0, q], KV[1, q], KV[2, q], KV[3, q])
 
-    @nb.njit(**_JIT)
+    @nb.njit(_nrt=False, **_JIT)  # it allocates nothing
     def _var_step(i, t0, Z, S, IS, p, h, omega, n_per, s_tab, c_tab, n_ev, YP, E, K, TMP,
                   Y1, SIDE, G0, G1, W, gbuf, NCR, UNRES, VW):
         """Advance the state y (row 0 of Z) by grid step i and each tangent vector v (rows 1..,
@@ -1146,7 +1146,7 @@ if VARIATIONAL:
         return n_flag
 
 
-@nb.njit(**_JIT)
+@nb.njit(_nrt=False, **_JIT)  # it allocates nothing: no reference counting of its views
 def _var_flagged(i, nl, first, n_ev, P, Z0, Z1, S, IS, T0L, HL, OMEGA, NPL, IDX, S_TAB, C_TAB,
                  FLAG, UNRR, FDL, fd):
     """The flagged lanes of step i (:func:`_var_fused_steps`) by the difference rows, each as

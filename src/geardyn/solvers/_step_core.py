@@ -472,7 +472,7 @@ def _split_step(i, t0, y, y_trial, p, h, omega, n_per, sa, ca, s_end, c_end, sid
     return 1
 
 
-@nb.njit(**_JIT)
+@nb.njit(_nrt=False, **_JIT)  # it allocates nothing: no reference counting of its views
 def _rows_step(i, t0, Y, p, h, omega, n_per, s_tab, c_tab, n_ev, K, TMP, Y1, SIDE, G0, G1, W,
                gbuf, NCR, UNRES):
     """Advance every row of Y (independent states of one lane, e.g. a state and its
@@ -526,7 +526,7 @@ def _rows_step(i, t0, Y, p, h, omega, n_per, s_tab, c_tab, n_ev, K, TMP, Y1, SID
                 Y[r, q] = Y1[r, q]
 
 
-@nb.njit(**_JIT)
+@nb.njit(_nrt=False, **_JIT)  # it allocates nothing: no reference counting of its views
 def _tangent_step(i, t0, Z, S, IS, p, h, omega, n_per, s_tab, c_tab, n_ev, YP, E, K, TMP, Y1,
                   SIDE, G0, G1, W, gbuf, NCR, UNRES):
     """Advance the state y (row 0 of Z) by one grid step and each tangent vector v (rows 1..,
