@@ -10,10 +10,11 @@ phase table, the cubic of an edge function, the block screen) is in :mod:`._step
 compiled once for every model, and imported here.
 
 Edge location: a step that leaves a side of an edge (a zero of ``events``) is split at the
-crossing, located on the cubic Hermite interpolant of the step (error O(h^4) in the crossing
-time: Newton's method on the event's cubic along it, :func:`_cubic_locate`, checked on the model's
-event once), and integrated in sub-steps, so every RK4 stage sees a smooth
-right-hand side and the method keeps 4th order. A step leaves a side when its end lies on the
+crossing and integrated in sub-steps, so every RK4 stage sees a smooth right-hand side and
+the method keeps 4th order. The crossing is located on the cubic Hermite interpolant of the
+trial step by Newton's method on the event's cubic along it (:func:`_cubic_locate`), checked
+on the model's event once; the trial step straddled the edge, so the point found lies O(h^3)
+off it (the right-hand side is continuous there). A step leaves a side when its end lies on the
 other side, or when it grazes the edge: crosses it twice (or any even number of times) inside the
 step. A graze is found from the interior extrema of the edge function along the interpolant
 (:func:`_first_crossing`); the first crossing of a step is always the one located. A step is split
@@ -238,7 +239,7 @@ def _first_crossing(j, side_j, graze, g1j, y0, f0, y1, f1, dt, t, p, ybuf, gbuf,
     scratch row.
 
     Along the interpolant an event that is affine in time and state is exactly the cubic
-    through those four values (in general: to the interpolant's O(h^4)). With ``graze``, an
+    through those four values (in general: to the interpolant's error). With ``graze``, an
     interior extremum of that cubic beyond the edge (by more than GRAZE_TOL of the event's size
     over the step), confirmed by the event on the interpolant there, has a crossing before it:
     the orbit grazes the edge (an even number of crossings in the step) or crosses it several
