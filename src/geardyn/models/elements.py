@@ -20,39 +20,63 @@ def dead_zone(x, b):
 
 
 @nb.njit(inline="always", **_JIT)
-def harmonic_factor(p, f, nh, s, c):
-    """1 + sum_{j=1..nh} p[f+2(j-1)] cos(j theta) + p[f+2(j-1)+1] sin(j theta): a relative mesh
-    stiffness from its Fourier coefficients at row ``f`` of the coefficient vector ``p``, for
-    the phase theta with sin ``s`` and cos ``c`` (harmonics by the angle-addition recurrence,
-    no libm call); 1 for nh = 0. Clipped at 0: a series that rings below 0 where the mesh has
-    no pair in contact (a missing tooth) carries no force there; a positive value is returned
-    unchanged (bitwise)."""
+def harmonic_turn(ch, sh, c, s):
+    """(cos, sin) of (h + 1) theta from those of h theta (``ch``, ``sh``) and of theta (``c``,
+    ``s``) by angle addition: the one recurrence of every stiffness series (no libm call)."""
+    return ch * c - sh * s, sh * c + ch * s
+
+
+@nb.njit(inline="always", **_JIT)
+def harmonic_clip(v):
+    """A series' value ``v`` (1 + its harmonic sum) clipped at 0: a series that rings below 0
+    where the mesh has no pair in contact (a missing tooth) carries no force there; a positive
+    value is returned unchanged (bitwise)."""
+    return v if v > 0.0 else 0.0
+
+
+@nb.njit(inline="always", **_JIT)
+def harmonic_series(at, a, k, f, nh, s, c):
+    """1 + sum_{j=1..nh} a_j cos(j theta) + b_j sin(j theta), clipped at 0
+    (:func:`harmonic_clip`), for the phase theta with sin ``s`` and cos ``c``; 1 for nh = 0.
+    The coefficients a_1, b_1, .., a_nh, b_nh are ``at(a, k, f)``, ``at(a, k, f + 1)``, ..
+    (``at`` an inlined getter: :func:`harmonic_factor`'s 1-D vector, :func:`harmonic_factor_lane`'s
+    lane column); the harmonics by :func:`harmonic_turn`."""
     if nh == 0:
         return 1.0
-    acc = p[f] * c + p[f + 1] * s
+    acc = at(a, k, f) * c + at(a, k, f + 1) * s
     ch = c
     sh = s
     for h in range(1, nh):
-        ch, sh = ch * c - sh * s, sh * c + ch * s
-        acc += p[f + 2 * h] * ch + p[f + 2 * h + 1] * sh
-    v = 1.0 + acc
-    return v if v > 0.0 else 0.0
+        ch, sh = harmonic_turn(ch, sh, c, s)
+        acc += at(a, k, f + 2 * h) * ch + at(a, k, f + 2 * h + 1) * sh
+    return harmonic_clip(1.0 + acc)
+
+
+@nb.njit(inline="always", **_JIT)
+def _entry(p, k, i):
+    """p[i] (``k`` unused): :func:`harmonic_series`' getter of a 1-D coefficient vector."""
+    return p[i]
+
+
+@nb.njit(inline="always", **_JIT)
+def _lane_entry(PT, k, i):
+    """PT[i, k]: :func:`harmonic_series`' getter of lane ``k`` of lane-major coefficients."""
+    return PT[i, k]
+
+
+@nb.njit(inline="always", **_JIT)
+def harmonic_factor(p, f, nh, s, c):
+    """1 + sum_{j=1..nh} p[f+2(j-1)] cos(j theta) + p[f+2(j-1)+1] sin(j theta): a relative mesh
+    stiffness from its Fourier coefficients at row ``f`` of the coefficient vector ``p``, for
+    the phase theta with sin ``s`` and cos ``c``, clipped at 0 (:func:`harmonic_series`)."""
+    return harmonic_series(_entry, p, 0, f, nh, s, c)
 
 
 @nb.njit(inline="always", **_JIT)
 def harmonic_factor_lane(PT, k, f, nh, s, c):
     """:func:`harmonic_factor` of lane ``k`` of the lane-major coefficients ``PT`` (rows f..),
     the same operations in the same order (bitwise the same value)."""
-    if nh == 0:
-        return 1.0
-    acc = PT[f, k] * c + PT[f + 1, k] * s
-    ch = c
-    sh = s
-    for h in range(1, nh):
-        ch, sh = ch * c - sh * s, sh * c + ch * s
-        acc += PT[f + 2 * h, k] * ch + PT[f + 2 * h + 1, k] * sh
-    v = 1.0 + acc
-    return v if v > 0.0 else 0.0
+    return harmonic_series(_lane_entry, PT, k, f, nh, s, c)
 
 
 def harmonic_factors(h, n_meshes, s, c):
@@ -63,8 +87,9 @@ def harmonic_factors(h, n_meshes, s, c):
     functions, ``h`` a static slice of its coefficients, ``n_meshes`` a constant): the number
     of harmonics follows from the tuple's length, and the series is written out term by term
     (the same operations in the same order as :func:`harmonic_factor`, so the same bits; the
-    harmonics' cos and sin by the one recurrence for every mesh), with no loop and no libm call,
-    so that a lane loop over it vectorises."""
+    harmonics' cos and sin by one :func:`harmonic_turn` for every mesh, each sum clipped by
+    :func:`harmonic_clip`), with no loop and no libm call, so that a lane loop over it
+    vectorises."""
     raise NotImplementedError("harmonic_factors is compiled code's (numba) only")
 
 
@@ -84,12 +109,11 @@ def _harmonic_factors(h, n_meshes, s, c):
         lines += [f"    a{j} = h[{2 * nh * j}] * c + h[{2 * nh * j + 1}] * s" for j in range(m)]
         lines += ["    ch = c", "    sh = s"]
         for q in range(1, nh):
-            lines.append("    ch, sh = ch * c - sh * s, sh * c + ch * s")
+            lines.append("    ch, sh = harmonic_turn(ch, sh, c, s)")
             lines += [f"    a{j} += h[{2 * nh * j + 2 * q}] * ch + h[{2 * nh * j + 2 * q + 1}] * sh"
                       for j in range(m)]
         lines += [f"    v{j} = 1.0 + a{j}" for j in range(m)]
-        lines.append("    return (" + "".join(f"v{j} if v{j} > 0.0 else 0.0, "
-                                             for j in range(m)) + ")")
-    env: dict = {}
+        lines.append("    return (" + "".join(f"harmonic_clip(v{j}), " for j in range(m)) + ")")
+    env: dict = {"harmonic_turn": harmonic_turn, "harmonic_clip": harmonic_clip}
     exec(compile("\n".join(lines) + "\n", "<harmonic_factors>", "exec"), env)
     return env["impl"]

@@ -40,6 +40,7 @@ from geardyn.errors import ParameterError
 from geardyn.gears.faults import BrokenTooth
 from geardyn.gears.iso6336_kv import KvMeshGroup, planetary_reduced_masses
 from geardyn.models import planetary_kernels as pk
+from geardyn.models.elements import dead_zone
 from geardyn.models.modal import frequency_groups
 from geardyn.models.planetary_coefficients import (
     CARRIER_SPEED,
@@ -1752,7 +1753,7 @@ class PlanetaryGearSet(Model):
             d = b[f:f + n] @ X
             two = self.params[pk.TWO_FLANK] != 0.0
             kf = b[pk.M_KFC] if two and d < -b[pk.M_B] else b[pk.M_KF]
-            out[m] = kf * (d - min(max(d, -b[pk.M_B]), b[pk.M_B]))
+            out[m] = kf * dead_zone.py_func(d, b[pk.M_B])  # plain Python: nothing to compile
             j = int(b[pk.M_RADIAL])
             if j:  # a radial contact: its component of kf (1 - b / r) (x, y)
                 other = self.params[lay["mesh"] + (m + j) * lay["block"]:][:lay["block"]]

@@ -71,7 +71,7 @@ import numba as nb
 import numpy as np
 
 from geardyn._jit_target import WidthCompiler
-from geardyn.models.elements import dead_zone, harmonic_factor
+from geardyn.models.elements import dead_zone, harmonic_clip, harmonic_factor, harmonic_turn
 from geardyn.models.planetary_coefficients import HEADER as HEADER_BLOCK
 from geardyn.models.planetary_coefficients import MESH
 
@@ -334,12 +334,11 @@ def _stepped_factor(p, f, nh, step, s, c):
     sh = s
     nxt = step - 1
     for h in range(1, nh):
-        ch, sh = ch * c - sh * s, sh * c + ch * s
+        ch, sh = harmonic_turn(ch, sh, c, s)
         if h == nxt:
             acc += p[f + 2 * h] * ch + p[f + 2 * h + 1] * sh
             nxt += step
-    v = 1.0 + acc
-    return v if v > 0.0 else 0.0
+    return harmonic_clip(1.0 + acc)
 
 
 @nb.njit(inline="always", **_JIT)
@@ -438,8 +437,8 @@ def _mesh_forces_shared(y, out, p, n, nm, nh, mesh, bs, mz, s, c):
     """The mesh forces into out[:nm]: :func:`_mesh_force` of every mesh with one harmonic
     recurrence for all (the same operations per mesh, each mesh's sum to its own harmonic
     count :func:`_harmonics` over the multiples of its step :func:`_step`; the relative
-    stiffnesses first, in out, clipped at 0 as
-    :func:`~geardyn.models.elements.harmonic_factor`)."""
+    stiffnesses first, in out, clipped at 0 by
+    :func:`~geardyn.models.elements.harmonic_clip`)."""
     for m in range(nm):
         out[m] = 1.0
     if nh > 0:
@@ -451,7 +450,7 @@ def _mesh_forces_shared(y, out, p, n, nm, nh, mesh, bs, mz, s, c):
         ch = c
         sh = s
         for h in range(1, top):
-            ch, sh = ch * c - sh * s, sh * c + ch * s
+            ch, sh = harmonic_turn(ch, sh, c, s)
             for m in range(nm):
                 o = mesh + m * bs
                 st = _step(p, o)
@@ -459,8 +458,7 @@ def _mesh_forces_shared(y, out, p, n, nm, nh, mesh, bs, mz, s, c):
                     f = o + MESH_FIXED + 2 * h
                     out[m] += p[f] * ch + p[f + 1] * sh
         for m in range(nm):
-            v = 1.0 + out[m]
-            out[m] = v if v > 0.0 else 0.0  # clipped at 0 as harmonic_factor
+            out[m] = harmonic_clip(1.0 + out[m])
     for m in range(nm):
         o = mesh + m * bs
         q = mz + m * 3 * MESH_NZ
@@ -571,13 +569,13 @@ def _lanes_offsets(PT):
 @nb.njit(inline="always", **_JIT)
 def _lanes_stiffness(PT, nl, S, C, SC, rb, mesh, bs, nh, nm, first, top, uniform):
     """:func:`~geardyn.models.elements.harmonic_factor` of every mesh m into PT[rb + m] (the
-    harmonic recurrence in SC rows 0, 1), the same operations in the same order, clipped at 0
-    alike; ``first``: the offset of the coefficients in a mesh block (``MESH_FIXED``: the drive
-    flank's). Each mesh's sum runs to the block's count over the multiples of the block's step
-    (lane 0's ``harmonics`` and ``harmonic_step`` entries, :func:`_lanes_prepare_harmonics`;
-    ``top``: the largest count, ``uniform``: every count ``top`` and every step 1, the loop
-    then checks neither); a stepped mesh's next harmonic in its ``harmonic_next`` entry of lane
-    0 (no division in the loop)."""
+    harmonic recurrence :func:`~geardyn.models.elements.harmonic_turn` in SC rows 0, 1), the same
+    operations in the same order, clipped at 0 alike; ``first``: the offset of the coefficients in
+    a mesh block (``MESH_FIXED``: the drive flank's). Each mesh's sum runs to the block's count
+    over the multiples of the block's step (lane 0's ``harmonics`` and ``harmonic_step`` entries,
+    :func:`_lanes_prepare_harmonics`; ``top``: the largest count, ``uniform``: every count ``top``
+    and every step 1, the loop then checks neither); a stepped mesh's next harmonic in its
+    ``harmonic_next`` entry of lane 0 (no division in the loop)."""
     if nh == 0:
         for m in range(nm):
             for k in range(nl):
@@ -594,10 +592,7 @@ def _lanes_stiffness(PT, nl, S, C, SC, rb, mesh, bs, nh, nm, first, top, uniform
         SC[1, k] = S[k]
     for h in range(1, top):
         for k in range(nl):
-            ch = SC[0, k]
-            sh = SC[1, k]
-            SC[0, k] = ch * C[k] - sh * S[k]
-            SC[1, k] = sh * C[k] + ch * S[k]
+            SC[0, k], SC[1, k] = harmonic_turn(SC[0, k], SC[1, k], C[k], S[k])
         for m in range(nm):
             if not uniform:
                 o = mesh + m * bs
@@ -612,8 +607,7 @@ def _lanes_stiffness(PT, nl, S, C, SC, rb, mesh, bs, nh, nm, first, top, uniform
                 PT[rb + m, k] += PT[f, k] * SC[0, k] + PT[f + 1, k] * SC[1, k]
     for m in range(nm):
         for k in range(nl):
-            v = 1.0 + PT[rb + m, k]
-            PT[rb + m, k] = v if v > 0.0 else 0.0
+            PT[rb + m, k] = harmonic_clip(1.0 + PT[rb + m, k])
 
 
 @nb.njit(inline="always", **_JIT)
@@ -1039,10 +1033,11 @@ def _own_phases_lane(PT, k, t, s, c, r, nm, mesh, bs):
 
 @nb.njit(inline="always", **_JIT)
 def _lanes_own_stiffness(PT, nl, rs, rc, out, f, nh, step, x):
-    """:func:`~geardyn.models.elements.harmonic_factor_lane` of the coefficients at row f for
-    every lane at the phase whose sin and cos are in rows rs and rc, into row out (the harmonic
-    recurrence in rows x, x + 1): the same operations in the same order, clipped at 0 alike;
-    past the first harmonic only the multiples of ``step`` added (:func:`_stepped_factor`)."""
+    """:func:`~geardyn.models.elements.harmonic_factor_lane` of the coefficients at row f for every
+    lane at the phase whose sin and cos are in rows rs and rc, into row out (the harmonic
+    recurrence :func:`~geardyn.models.elements.harmonic_turn` in rows x, x + 1): the same
+    operations in the same order, clipped at 0 alike; past the first harmonic only the multiples of
+    ``step`` added (:func:`_stepped_factor`)."""
     if nh == 0:
         for k in range(nl):
             PT[out, k] = 1.0
@@ -1054,18 +1049,14 @@ def _lanes_own_stiffness(PT, nl, rs, rc, out, f, nh, step, x):
         PT[x + 1, k] = PT[rs, k]
     for h in range(1, nh):
         for k in range(nl):
-            ch = PT[x, k]
-            sh = PT[x + 1, k]
-            PT[x, k] = ch * PT[rc, k] - sh * PT[rs, k]
-            PT[x + 1, k] = sh * PT[rc, k] + ch * PT[rs, k]
+            PT[x, k], PT[x + 1, k] = harmonic_turn(PT[x, k], PT[x + 1, k], PT[rc, k], PT[rs, k])
         if h + 1 != nxt:
             continue
         nxt += step
         for k in range(nl):
             PT[out, k] += PT[f + 2 * h, k] * PT[x, k] + PT[f + 2 * h + 1, k] * PT[x + 1, k]
     for k in range(nl):
-        v = 1.0 + PT[out, k]
-        PT[out, k] = v if v > 0.0 else 0.0
+        PT[out, k] = harmonic_clip(1.0 + PT[out, k])
 
 
 @nb.njit(inline="always", **_JIT)

@@ -11,6 +11,7 @@ import numba as nb
 
 from geardyn._jit_target import WidthCompiler
 from geardyn.core.kernel_source import FORM_GENERAL, KernelSource
+from geardyn.models.elements import harmonic_turn
 from geardyn.models.spur_pair_coefficients import HEADER
 
 _JIT = {"cache": True, "error_model": "numpy", "boundscheck": False,
@@ -46,7 +47,7 @@ def flank_stiffness(PT, k, o, n, s, c):
     chains (h = 4 m + 1 .. 4 m + 4, each turned by 4 theta per m) so that the rotations overlap
     instead of waiting on one another."""
     c2, s2 = c * c - s * s, 2.0 * c * s
-    c3, s3 = c2 * c - s2 * s, s2 * c + c2 * s
+    c3, s3 = harmonic_turn(c2, s2, c, s)
     c4, s4 = c2 * c2 - s2 * s2, 2.0 * c2 * s2
     ca, sa, cb, sb, cc, sc, cd, sd = c, s, c2, s2, c3, s3, c4, s4
     acc0, acc1, acc2, acc3 = PT[o, k], 0.0, 0.0, 0.0
@@ -56,10 +57,10 @@ def flank_stiffness(PT, k, o, n, s, c):
         acc1 += PT[q + 2, k] * cb + PT[q + 3, k] * sb
         acc2 += PT[q + 4, k] * cc + PT[q + 5, k] * sc
         acc3 += PT[q + 6, k] * cd + PT[q + 7, k] * sd
-        ca, sa = ca * c4 - sa * s4, sa * c4 + ca * s4
-        cb, sb = cb * c4 - sb * s4, sb * c4 + cb * s4
-        cc, sc = cc * c4 - sc * s4, sc * c4 + cc * s4
-        cd, sd = cd * c4 - sd * s4, sd * c4 + cd * s4
+        ca, sa = harmonic_turn(ca, sa, c4, s4)
+        cb, sb = harmonic_turn(cb, sb, c4, s4)
+        cc, sc = harmonic_turn(cc, sc, c4, s4)
+        cd, sd = harmonic_turn(cd, sd, c4, s4)
         q += 8
     r = n % 4  # the last harmonics: chains a, b, c continue where they stand
     if r > 0:
@@ -95,7 +96,7 @@ def rotate_power(n, s, c):
     bc, bs = c, s
     while n > 0:
         if n & 1:
-            rc, rs = rc * bc - rs * bs, rs * bc + rc * bs
+            rc, rs = harmonic_turn(rc, rs, bc, bs)
         bc, bs = bc * bc - bs * bs, 2.0 * bc * bs
         n >>= 1
     return rc, rs

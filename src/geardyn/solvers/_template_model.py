@@ -9,6 +9,7 @@ from __future__ import annotations
 import numba as nb
 
 from geardyn._jit_target import WidthCompiler
+from geardyn.models.elements import dead_zone
 
 _JIT = {"cache": True, "error_model": "numpy", "boundscheck": False,
         "pipeline_class": WidthCompiler}
@@ -18,7 +19,7 @@ _JIT = {"cache": True, "error_model": "numpy", "boundscheck": False,
 def rhs(t, y, dy, p, s, c):
     x = y[0]
     b = p[1]
-    g = x - b if x > b else (x + b if x < -b else 0.0)
+    g = dead_zone(x, b)
     dy[0] = y[1]
     dy[1] = -p[2] * y[1] - g + p[3] * s
 
