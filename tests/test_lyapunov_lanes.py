@@ -33,7 +33,7 @@ def _lanes(model, omegas, n_per, periods_tr, periods_st, y0, t0):
     n_st = np.asarray(periods_st, np.int64) * n_per
     # a writable copy: a read-only Y0 (np.broadcast_to of a full array) would compile the
     # one-lane kernel once more for that argument type
-    Y0 = np.array(np.broadcast_to(y0, (omegas.size, model.n_states)), dtype=float)
+    Y0 = np.array(np.broadcast_to(y0, (omegas.size, model.n_states)), dtype=float, order="C")
     T0 = np.ascontiguousarray(t0, dtype=float)
     return P, Y0, T0, H, np.ascontiguousarray(omegas, dtype=float), n_tr, n_st, n_per
 
