@@ -1,8 +1,9 @@
 """The one-lane-at-a-time Lyapunov lanes, the reference of the lane blocks: every lane by the
-rows of ``lyapunov_single`` (the kernel module's ``_run``, k = 1), the lanes of each grid in
-parallel. Built for a model's Lyapunov kernel module (``kernels_for(model.kernel,
-"lyapunov")``) from its ``_run`` and ``phase_table``; the parallel loop here is compiled once
-per kernel module and process (not cached), ``_run`` is the module's own (cached there)."""
+rows of ``lyapunov_single`` (the kernel module's ``_run``, k = 1), the lanes of each grid one
+after the other. Built for a model's Lyapunov kernel module (``kernels_for(model.kernel,
+"lyapunov")``) from its ``_run`` and ``phase_table``; the loop here is compiled once per kernel
+module and process (not cached; a plain loop, as numba's parallel loop compiles several times
+longer), ``_run`` is the module's own (cached there)."""
 
 from __future__ import annotations
 
@@ -12,11 +13,11 @@ import numba as nb
 import numpy as np
 
 _SOURCE = '''
-@nb.njit(parallel=True, error_model="numpy", boundscheck=False)
+@nb.njit(error_model="numpy", boundscheck=False)
 def lanes_rows(P, Y0, scale, T0, H, OMEGA, n_per, n_transient, n_steps, renorm_every, bound,
                out, err, unres, status, fd_steps, n_ev, n_blocks, variational):
-    """Largest exponent of every lane (row of P, Y0; n_per steps per period), in parallel over
-    lanes, one lane at a time (the rows of lyapunov_single); the arguments as the kernel
+    """Largest exponent of every lane (row of P, Y0; n_per steps per period), one lane at a
+    time (the rows of lyapunov_single); the arguments as the kernel
     module's lyapunov_lanes takes them, out, err, unres, status and fd_steps filled."""
     L, ns = Y0.shape
     forced = False
@@ -24,7 +25,7 @@ def lanes_rows(P, Y0, scale, T0, H, OMEGA, n_per, n_transient, n_steps, renorm_e
         if OMEGA[lane] != 0.0:
             forced = True
     s_tab, c_tab = phase_table(n_per, forced)
-    for lane in nb.prange(L):
+    for lane in range(L):
         ex, er, _nb, st, un, fd = _run(P[lane], Y0[lane], scale, T0[lane], H[lane],
                                        OMEGA[lane], n_per, s_tab, c_tab, n_transient[lane],
                                        n_steps[lane], renorm_every, np.int64(1), bound,
@@ -51,7 +52,7 @@ def _compiled(kern: types.ModuleType):
 
 def rows_for(kern: types.ModuleType):
     """``kern.lyapunov_lanes`` (same arguments, same outputs) one lane at a time: the lanes of
-    each grid (n_per: one for all lanes or one per lane) in parallel, each by the rows of
+    each grid (n_per: one for all lanes or one per lane) one after the other, each by the rows of
     ``kern.lyapunov_single``."""
     lanes_rows = _compiled(kern)
 

@@ -31,23 +31,29 @@ def _lanes(model, omegas, n_per, periods_tr, periods_st, y0, t0):
     H = 2.0 * np.pi / omegas / n_per
     n_tr = np.asarray(periods_tr, np.int64) * n_per
     n_st = np.asarray(periods_st, np.int64) * n_per
-    Y0 = np.ascontiguousarray(np.broadcast_to(y0, (omegas.size, model.n_states)), dtype=float)
+    # a writable copy: a read-only Y0 (np.broadcast_to of a full array) would compile the
+    # one-lane kernel once more for that argument type
+    Y0 = np.array(np.broadcast_to(y0, (omegas.size, model.n_states)), dtype=float, order="C")
     T0 = np.ascontiguousarray(t0, dtype=float)
     return P, Y0, T0, H, np.ascontiguousarray(omegas, dtype=float), n_tr, n_st, n_per
 
 
-def _reference(kern, model, args, renorm, k, bound=1e6):
-    """Each lane through the one-lane kernel (lyapunov_single), as lyapunov() runs it."""
+def _reference(kern, model, args, renorm, k, bound=1e6, variational=False):
+    """Each lane through the one-lane kernel (lyapunov_single), as lyapunov() runs it (every
+    argument given, with lyapunov()'s types: the kernel it compiled is loaded, not another
+    overload compiled)."""
     P, Y0, T0, H, OM, n_tr, n_st, n_per = args
     scale = np.ones(model.n_states)
-    res = [kern.lyapunov_single(P[i], Y0[i], scale, T0[i], H[i], OM[i], n_per[i], n_tr[i], n_st[i],
-                                renorm, k, bound, model.n_events, 16) for i in range(len(P))]
+    res = [kern.lyapunov_single(P[i], Y0[i], scale, float(T0[i]), float(H[i]), float(OM[i]),
+                                int(n_per[i]), int(n_tr[i]), int(n_st[i]), renorm, k,
+                                float(bound), model.n_events, 16, bool(variational))
+           for i in range(len(P))]
     return (np.array([r[0] for r in res]), np.array([r[1] for r in res]),
             np.array([r[2] for r in res]), np.array([r[3] for r in res]),
             np.array([r[4] for r in res]))
 
 
-def _blocks(kern, model, args, renorm, k, block_rows, n_ev=None, bound=1e6):
+def _blocks(kern, model, args, renorm, k, block_rows, n_ev=None, bound=1e6, variational=False):
     P, Y0, T0, H, OM, n_tr, n_st, n_per = args
     L = len(P)
     out, err = np.full((L, k), -1.0), np.full((L, k), -1.0)
@@ -55,7 +61,8 @@ def _blocks(kern, model, args, renorm, k, block_rows, n_ev=None, bound=1e6):
     unres = np.full(L, -1, np.int64)
     kern.lyapunov_block_lanes(P, Y0, np.ones(model.n_states), T0, H, OM, n_per, n_tr, n_st,
                               renorm, k, bound, out, err, used, status, unres,
-                              model.n_events if n_ev is None else n_ev, 16, block_rows, 2)
+                              model.n_events if n_ev is None else n_ev, 16, block_rows, 2,
+                              variational)
     return out, err, used, status, unres
 
 
@@ -64,12 +71,17 @@ def _assert_bitwise(got, ref):
         assert np.array_equal(g, r, equal_nan=True), (g, r)
 
 
-@pytest.mark.parametrize(("k", "load"), [(1, False), (4, False), (1, True)])
-def test_catt_blocks_bitwise_equal_to_one_lane_kernel(k, load):
+@pytest.mark.parametrize(("k", "load", "variational"),
+                         [(1, False, True), (4, False, False), (1, True, True)])
+def test_catt_blocks_bitwise_equal_to_one_lane_kernel(k, load, variational):
     # the reduced paper device at Omegas with and without contact loss, lanes with their own
     # grid, transient, measuring window, start time and state; renorm 7 so that blocks of the
     # measuring window end between renormalisations. k = 1 runs the fused block (the model's
-    # lane-scalar form: quiet, or with the load fluctuating), k = 4 the row blocks.
+    # lane-scalar form: quiet, or with the load fluctuating) with the variational tangent (what
+    # lyapunov() and lyapunov_lanes() run on this one-form model, whose kernels the warm-up
+    # and the sweep's exponent test compile; the fused block of difference rows, the path of
+    # ``tangent="difference"``, is the gear pair's test below, in FORM_QUIET), k = 4 the row
+    # blocks.
     model = (geardyn.CATTDevice(geardyn.PlanetaryParams.paper(
         xi1=0.05, xi2=0.05, B1="100 N m", B2="100 N m", Lambda=0.1)) if load
         else paper_device())
@@ -84,20 +96,21 @@ def test_catt_blocks_bitwise_equal_to_one_lane_kernel(k, load):
     args = _lanes(model, om, [48, 64, 48, 40, 64, 48, 56], [3, 0, 5, 2, 4, 1, 6],
                   [12, 9, 7, 16, 5, 11, 3], y0,
                   rng.uniform(0.0, 50.0, om.size))
-    ref = _reference(kern, model, args, 7, k)
+    ref = _reference(kern, model, args, 7, k, variational=variational)
     assert np.all(ref[3] == 0) and np.all(np.isfinite(ref[0]))
     for rows in (64, 2 * k + 1, 1000):  # several lanes per block, one, all
-        _assert_bitwise(_blocks(kern, model, args, 7, k, rows), ref)
+        _assert_bitwise(_blocks(kern, model, args, 7, k, rows, variational=variational), ref)
     # edges matter in these lanes (contact is lost): without locating them the exponents differ
-    plain = _blocks(kern, model, args, 7, k, 64, n_ev=0)
+    plain = _blocks(kern, model, args, 7, k, 64, n_ev=0, variational=variational)
     assert not np.array_equal(plain[0], ref[0])
     # a lane that leaves the bound is marked diverged, the others untouched: lane 2 starts
     # far out (its first health check fails), the others stay within 50
     far = (args[0], args[1].copy(), *args[2:])
     far[1][2] *= 100.0
-    ref = _reference(kern, model, far, 7, k, bound=50.0)
+    ref = _reference(kern, model, far, 7, k, bound=50.0, variational=variational)
     assert ref[3][2] == 1 and np.all(np.delete(ref[3], 2) == 0), ref[3]
-    _assert_bitwise(_blocks(kern, model, far, 7, k, 64, bound=50.0), ref)
+    _assert_bitwise(_blocks(kern, model, far, 7, k, 64, bound=50.0, variational=variational),
+                    ref)
 
 
 def test_gear_pair_blocks_bitwise_equal_with_a_diverged_lane():
