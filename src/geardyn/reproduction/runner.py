@@ -37,12 +37,14 @@ DIRECTIONS: tuple[str, str] = ("up", "down")
 #: progress(stage, done, total): ``stage`` names the case, interpretation and sweep direction.
 Progress = Callable[[str, int, int], None]
 
-#: Points of each sweep per kernel call while progress is reported (without progress: the whole
-#: sweep in one call). Any segment gives bitwise the same points
+#: Points of each sweep per kernel call where progress is reported or several threads share the
+#: calls (in a worker process, one thread and no progress: the whole sweep in one call). Any
+#: segment gives bitwise the same points
 #: (:func:`~geardyn.analysis.continuation.continue_branches`); a longer one leaves fewer slots
-#: idle at the calls' ends (the paper's consistent cases on one thread: 0.72x the CPU time of
-#: 64-point segments with each 1000-point sweep in one call, 0.78x in segments of 250).
-PROGRESS_SEGMENT = 250
+#: idle at the calls' ends (12 of the paper's 1000-point sweeps on one thread, each whole in
+#: one call: 0.53x the CPU time of 64-point segments), a shorter one rebalances the threads at
+#: every call.
+SEGMENT = 250
 
 
 @dataclass(frozen=True)
@@ -176,8 +178,10 @@ def _sweeps(tasks: list[tuple[Case, str, str]], settings: ReproductionSettings,
     """The sweeps ``(case, interpretation, direction)``, continued together (their points
     advance as lanes of one kernel call; see :func:`geardyn.analysis.bifurcation.continued_sweeps`),
     then each classified, with Lyapunov exponents where no period is found. A unit of work:
-    the arguments pickle, for worker processes. Each kernel call runs every sweep whole, or
-    :data:`PROGRESS_SEGMENT` points of each when ``progress`` is given."""
+    the arguments pickle, for worker processes. Each kernel call runs every sweep whole on one
+    thread without ``progress``, else :data:`SEGMENT` points of each."""
+    import numba
+
     start = time.perf_counter()
     plans = []
     for case, interp, direction in tasks:
@@ -200,8 +204,8 @@ def _sweeps(tasks: list[tuple[Case, str, str]], settings: ReproductionSettings,
     for i, (_, _r, run) in enumerate(plans):
         groups.setdefault(shared_settings(run), []).append(i)
     for members in groups.values():
-        segment = (PROGRESS_SEGMENT if progress is not None
-                   else max(np.size(plans[i][0].values) for i in members))
+        whole = progress is None and numba.get_num_threads() == 1
+        segment = max(np.size(plans[i][0].values) for i in members) if whole else SEGMENT
         done = continued_sweeps([plans[i][0] for i in members], plans[members[0]][2],
                                 progress=tick, segment=segment)
         for i, ds in zip(members, done, strict=True):
