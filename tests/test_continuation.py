@@ -23,7 +23,10 @@ def device():
     return geardyn.CATTDevice(geardyn.PlanetaryParams.paper(xi1=0.1, xi2=0.1))
 
 
-def test_branches_continued_together_equal_each_alone(device):
+@pytest.mark.parametrize("segment", [2, 64])
+def test_branches_continued_together_equal_each_alone(device, segment):
+    """Sweeps continued together, ``segment`` points of each per kernel call, equal each sweep
+    alone (bifurcation with continuation), whatever the segment."""
     om = np.linspace(0.6, 1.6, 7)
     stiffer = geardyn.CATTDevice(geardyn.PlanetaryParams.paper(xi1=0.2, xi2=0.2))
     pair = geardyn.GearPair(zeta=0.05)  # another kernel: its own group
@@ -36,7 +39,11 @@ def test_branches_continued_together_equal_each_alone(device):
               ContinuedSweep(stiffer, "Omega", om[:4], "down",
                              run=geardyn.RunSettings(transient=200.0)),
               ContinuedSweep(pair, "Omega", om, "up", run=geardyn.RunSettings(transient=100.0))]
-    together = continued_sweeps(sweeps, run=geardyn.RunSettings(samples=6, converge=1e-8))
+    calls = []
+    together = continued_sweeps(sweeps, run=geardyn.RunSettings(samples=6, converge=1e-8),
+                                segment=segment, progress=lambda d, t: calls.append(d))
+    # progress before each kernel call and once at the end, in each of the two kernel groups
+    assert len(calls) == 2 * (-(-om.size // segment) + 1)
     for sw, ds in zip(sweeps, together, strict=True):
         run = geardyn.RunSettings(transient=sw.transient, samples=6, converge=1e-8,
                                   transient_max=sw.transient_max,

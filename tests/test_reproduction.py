@@ -415,6 +415,18 @@ def test_worker_processes_give_the_serial_result(tmp_path):
         one, two = (load_dataset(tmp_path / d / name) for d in ("one", "two"))
         assert one.identical(two)
 
+    # one pool of processes for the sweeps and then the files, as the command line runs them
+    from geardyn.reproduction.runner import worker_pool
+
+    with worker_pool(2) as pool:
+        pooled = run_cases(cases, ["consistent"], settings, workers=2, pool=pool)
+        write_report(pooled, tmp_path / "pool", jobs=2, pool=pool)
+    for key, ds in serial.items():
+        np.testing.assert_array_equal(ds["poincare"].values, pooled[key]["poincare"].values)
+    assert sorted(p.name for p in (tmp_path / "pool").iterdir()) == names
+    for name in pngs:
+        assert (tmp_path / "one" / name).read_bytes() == (tmp_path / "pool" / name).read_bytes()
+
 
 def test_reproduce_refuses_bad_input(capsys):
     from geardyn.cli.main import main

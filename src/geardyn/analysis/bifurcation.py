@@ -11,7 +11,7 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-from geardyn.analysis.continuation import Branch, continue_branches
+from geardyn.analysis.continuation import SEGMENT, Branch, continue_branches
 from geardyn.analysis.dataset import sweep_dataset
 from geardyn.analysis.lanes import (
     has_mesh_forces,
@@ -250,6 +250,7 @@ def continued_sweeps(
     run: RunSettings | None = None,
     *,
     progress: Callable[[int, int], None] | None = None,
+    segment: int = SEGMENT,
     **settings: Any,
 ) -> list[xr.Dataset]:
     """Several sweeps by continuation at once (up and down, several studies): the datasets of
@@ -264,9 +265,12 @@ def continued_sweeps(
     its transients (``transient``, ``continued_transient``, ``transient_max``) and
     ``steps_per_period`` from it; any other field of it set to other than its default and
     ``run``'s value is a TypeError naming both values. Each dataset records the settings it
-    ran with in its attributes."""
+    ran with in its attributes. ``segment``: points of each sweep per kernel call (see
+    :func:`~geardyn.analysis.continuation.continue_branches`; ``progress`` is called once per
+    call): a longer segment leaves fewer slots idle at the calls' ends; the results are bitwise
+    the same whatever it is."""
     run = resolve_run(run, settings, aliases=ALIASES, where="continued_sweeps")
-    return [ds for ds, _ in _continued(sweeps, run, progress)]
+    return [ds for ds, _ in _continued(sweeps, run, progress, segment)]
 
 
 def shared_settings(run: RunSettings) -> tuple[tuple[str, Any], ...]:
@@ -295,7 +299,7 @@ def _sweep_run(sw: ContinuedSweep, run: RunSettings) -> RunSettings:
 
 
 def _continued(sweeps: Sequence[ContinuedSweep], run: RunSettings,
-               progress: Callable[[int, int], None] | None
+               progress: Callable[[int, int], None] | None, segment: int = SEGMENT
                ) -> list[tuple[xr.Dataset, LaneResults]]:
     """continued_sweeps, with each sweep's lane results (in value order: final states and
     times)."""
@@ -327,7 +331,8 @@ def _continued(sweeps: Sequence[ContinuedSweep], run: RunSettings,
             if progress is not None:
                 progress(offset + d, total)
 
-        runs = continue_branches([prepared[i][3] for i in members], run, tick)
+        runs = continue_branches([prepared[i][3] for i in members], run, tick,
+                                 segment=segment)
         for i, r in zip(members, runs, strict=True):
             results[i] = r
             done += r.status.size

@@ -101,6 +101,7 @@ def reproduce_command(
         run_cases,
         write_report,
     )
+    from geardyn.reproduction.runner import worker_pool
 
     if all_cases == (case is not None):
         raise ParameterError("CASE", case, "give one figure case or --all, not both or neither")
@@ -121,21 +122,22 @@ def reproduce_command(
     settings = ReproductionSettings(num=resolution, transient=transient, samples=samples)
     out.mkdir(parents=True, exist_ok=True)
 
-    start = time.perf_counter()
-    with _progress(not quiet and sys.stderr.isatty()) as callback:
-        results = run_cases(cases, interps, settings, callback, workers=workers)
-    swept = time.perf_counter() - start
-    command = "geardyn reproduce " + ("--all" if all_cases else cases[0].name) + (
-        f" --interpretation {interpretation.value}"
-        + (f" --resolution {resolution}" if resolution else "")
-        + (f" --transient {transient:g}" if transient is not None else "")
-        + (f" --samples {samples}" if samples else "")
-        + (f" --basins {basins}" if basins else "")
-        + (f" --verdicts {verdicts}" if verdicts is not None else ""))
-    with stderr_console().status("writing figures, data and the report"
-                                 + (" (and the basins of attraction)" if basins else "")):
-        paths = write_report(results, out, command=command, figures=figures, basins=basins,
-                             jobs=workers)
+    with worker_pool(workers) as pool:  # the sweeps' processes then write the case files
+        start = time.perf_counter()
+        with _progress(not quiet and sys.stderr.isatty()) as callback:
+            results = run_cases(cases, interps, settings, callback, workers=workers, pool=pool)
+        swept = time.perf_counter() - start
+        command = "geardyn reproduce " + ("--all" if all_cases else cases[0].name) + (
+            f" --interpretation {interpretation.value}"
+            + (f" --resolution {resolution}" if resolution else "")
+            + (f" --transient {transient:g}" if transient is not None else "")
+            + (f" --samples {samples}" if samples else "")
+            + (f" --basins {basins}" if basins else "")
+            + (f" --verdicts {verdicts}" if verdicts is not None else ""))
+        with stderr_console().status("writing figures, data and the report"
+                                     + (" (and the basins of attraction)" if basins else "")):
+            paths = write_report(results, out, command=command, figures=figures,
+                                 basins=basins, jobs=workers, pool=pool)
     for interp in interps:
         found = evaluate({c: ds for (c, i), ds in results.items() if i == interp})
         counts: dict[str, int] = {}

@@ -7,8 +7,10 @@ only lays them out and writes files.
 
 from __future__ import annotations
 
+import contextlib
 import datetime as _dt
 from collections.abc import Mapping
+from concurrent.futures import Executor
 from pathlib import Path
 
 import xarray as xr
@@ -295,35 +297,39 @@ def _unresolved_warning(doc: Document, results: Results) -> None:
                  "resting on those points are less certain; a finer step resolves them.")
 
 
-def _write_all_case_files(results: Results, out: Path, jobs: int
+def _write_all_case_files(results: Results, out: Path, jobs: int,
+                          pool: Executor | None = None
                           ) -> dict[tuple[str, str], dict[str, Path]]:
     """:func:`write_case_files` for every result, in ``jobs`` worker processes when > 1 (the
-    figures are most of a report's time: ~0.3 s each, two per case). The files do not depend
-    on the process that writes them."""
-    if jobs <= 1 or len(results) < 2:
+    figures are most of a report's time: ~0.3 s each, two per case), those of ``pool`` where
+    given. The files do not depend on the process that writes them."""
+    if (jobs <= 1 and pool is None) or len(results) < 2:
         return {key: write_case_files(ds, out) for key, ds in results.items()}
-    import multiprocessing
-    from concurrent.futures import ProcessPoolExecutor
+    from geardyn.reproduction.runner import worker_pool
 
-    ctx = multiprocessing.get_context("spawn")  # no fork of numba's thread pool
-    with ProcessPoolExecutor(max_workers=min(jobs, len(results)), mp_context=ctx) as pool:
+    with contextlib.ExitStack() as stack:
+        if pool is None:
+            pool = stack.enter_context(worker_pool(min(jobs, len(results))))
         futures = {key: pool.submit(write_case_files, ds, out) for key, ds in results.items()}
         return {key: fut.result() for key, fut in futures.items()}
 
 
 def write_report(results: Results, out: Path, command: str = "geardyn reproduce",
-                 figures: bool = True, basins: int = 0, jobs: int = 1) -> dict[str, Path]:
+                 figures: bool = True, basins: int = 0, jobs: int = 1,
+                 pool: Executor | None = None) -> dict[str, Path]:
     """Write every case's files, the report and the verdict table (``verdicts.md``, see
     :mod:`geardyn.reproduction.verdicts`) under ``out``; returns the paths of the report
     (``"markdown"``, ``"html"``) and of the table (``"verdicts"``). ``basins`` > 0: also the
     basins of attraction (``basins`` x ``basins`` initial conditions) of every case whose up
     and down sweeps disagree while periodic (``basins-<case>-<interpretation>.nc|png``).
     ``jobs`` > 1: the case files (data and figures) are written by that many worker
-    processes."""
+    processes; ``pool``: by those processes (e.g.
+    :func:`~geardyn.reproduction.runner.worker_pool`'s,
+    which ran the sweeps)."""
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     if figures:
-        written = _write_all_case_files(results, out, jobs)
+        written = _write_all_case_files(results, out, jobs, pool)
     else:
         written = {key: {"data": save_dataset(ds, out / f"{_file_stem(*key)}.nc")}
                    for key, ds in results.items()}

@@ -9,8 +9,10 @@ labels of :mod:`geardyn.reproduction.motion`).
 
 from __future__ import annotations
 
+import contextlib
 import time
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Iterator
+from concurrent.futures import Executor
 from dataclasses import asdict, dataclass
 
 import numpy as np
@@ -28,12 +30,21 @@ from geardyn.reproduction.motion import motion_labels
 from geardyn.study import build_model
 
 __all__ = ["DIRECTIONS", "ReproductionSettings", "branch_lyapunov", "run_case", "run_cases",
-           "sweep_values"]
+           "sweep_values", "worker_pool"]
 
 DIRECTIONS: tuple[str, str] = ("up", "down")
 
 #: progress(stage, done, total): ``stage`` names the case, interpretation and sweep direction.
 Progress = Callable[[str, int, int], None]
+
+#: Points of each sweep per kernel call where progress is reported or several threads share the
+#: calls (in a worker process, one thread and no progress: the whole sweep in one call). Any
+#: segment gives bitwise the same points
+#: (:func:`~geardyn.analysis.continuation.continue_branches`); a longer one leaves fewer slots
+#: idle at the calls' ends (12 of the paper's 1000-point sweeps on one thread, each whole in
+#: one call: 0.53x the CPU time of 64-point segments), a shorter one rebalances the threads at
+#: every call.
+SEGMENT = 250
 
 
 @dataclass(frozen=True)
@@ -167,7 +178,10 @@ def _sweeps(tasks: list[tuple[Case, str, str]], settings: ReproductionSettings,
     """The sweeps ``(case, interpretation, direction)``, continued together (their points
     advance as lanes of one kernel call; see :func:`geardyn.analysis.bifurcation.continued_sweeps`),
     then each classified, with Lyapunov exponents where no period is found. A unit of work:
-    the arguments pickle, for worker processes."""
+    the arguments pickle, for worker processes. Each kernel call runs every sweep whole on one
+    thread without ``progress``, else :data:`SEGMENT` points of each."""
+    import numba
+
     start = time.perf_counter()
     plans = []
     for case, interp, direction in tasks:
@@ -190,8 +204,10 @@ def _sweeps(tasks: list[tuple[Case, str, str]], settings: ReproductionSettings,
     for i, (_, _r, run) in enumerate(plans):
         groups.setdefault(shared_settings(run), []).append(i)
     for members in groups.values():
+        whole = progress is None and numba.get_num_threads() == 1
+        segment = max(np.size(plans[i][0].values) for i in members) if whole else SEGMENT
         done = continued_sweeps([plans[i][0] for i in members], plans[members[0]][2],
-                                progress=tick)
+                                progress=tick, segment=segment)
         for i, ds in zip(members, done, strict=True):
             swept[i] = ds
     joint = time.perf_counter() - start
@@ -314,17 +330,35 @@ def _one_thread() -> None:
     numba.set_num_threads(1)
 
 
+@contextlib.contextmanager
+def worker_pool(workers: int) -> Iterator[Executor | None]:
+    """``workers`` spawned worker processes with one numba thread each, for :func:`run_cases`
+    and then :func:`~geardyn.reproduction.report.write_report` (one start-up for both); None
+    when ``workers`` <= 1."""
+    if workers <= 1:
+        yield None
+        return
+    import multiprocessing
+    from concurrent.futures import ProcessPoolExecutor
+
+    ctx = multiprocessing.get_context("spawn")  # no fork of numba's thread pool
+    with ProcessPoolExecutor(max_workers=workers, mp_context=ctx,
+                             initializer=_one_thread) as pool:
+        yield pool
+
+
 def run_cases(cases: Iterable[Case], interpretations: Iterable[str],
               settings: ReproductionSettings | None = None,
-              progress: Progress | None = None, workers: int = 1
-              ) -> dict[tuple[str, str], xr.Dataset]:
+              progress: Progress | None = None, workers: int = 1,
+              pool: Executor | None = None) -> dict[tuple[str, str], xr.Dataset]:
     """:func:`run_case` for every case and interpretation, keyed ``(case name,
     interpretation)``; cases with the same dynamics (Figs. 3 and 6, ...) run once.
 
     All sweeps (two per distinct case) are continued together, their points advancing as the
     lanes of one kernel call on all numba threads. ``workers`` > 1 splits them into that many
     groups, each continued in its own worker process with one thread (a group waits at each
-    point for its slowest lane, so a few independent groups keep the cores busier). Lanes do not
+    point for its slowest lane, so a few independent groups keep the cores busier); ``pool``:
+    the processes to use (from :func:`worker_pool`; None: started here). Lanes do not
     interact, so the results are bitwise those of a serial run, whatever the grouping."""
     settings = settings or ReproductionSettings()
     cases = list(cases)
@@ -343,12 +377,11 @@ def run_cases(cases: Iterable[Case], interpretations: Iterable[str],
                             tasks, strict=True):
             parts[task] = ds
     else:
-        import multiprocessing
-        from concurrent.futures import ProcessPoolExecutor, as_completed
+        from concurrent.futures import as_completed
 
-        ctx = multiprocessing.get_context("spawn")  # no fork of numba's thread pool
-        with ProcessPoolExecutor(max_workers=len(groups), mp_context=ctx,
-                                 initializer=_one_thread) as pool:
+        with contextlib.ExitStack() as stack:
+            if pool is None:
+                pool = stack.enter_context(worker_pool(len(groups)))
             futures = {pool.submit(_sweeps, [(*first[k], d) for k, d in g], settings): g
                        for g in groups}
             finished = 0
