@@ -241,3 +241,26 @@ def test_too_few_samples_are_refused_naming_the_study_key_they_came_from(tmp_pat
     assert result.exit_code != 0 and not (tmp_path / "x.nc").exists()
     assert f"{table}.{key}" in result.output and "--samples" not in result.output
     assert ">= 2" in result.output
+
+
+#: ``geardyn reproduce``'s options and the ReproductionSettings fields they set, with values
+#: the settings refuse (one rule for both).
+REPRODUCE_REFUSED = [("--resolution", "num", 1), ("--samples", "samples", 0),
+                     ("--transient", "transient", math.inf), ("--transient", "transient", -1.0)]
+
+
+@pytest.mark.parametrize(("option", "field", "value"), REPRODUCE_REFUSED)
+def test_reproduce_refuses_what_its_settings_refuse(tmp_path, option, field, value):
+    from typer.testing import CliRunner
+
+    from geardyn.cli.main import app
+    from geardyn.reproduction import ReproductionSettings
+
+    with pytest.raises(ValueError, match=rf"^{field} must be "):
+        ReproductionSettings(**{field: value})
+    result = CliRunner().invoke(app, ["reproduce", "fig3", option, str(value), "--no-figures",
+                                      "--jobs", "1", "--out", str(tmp_path / "out")])
+    assert result.exit_code != 0 and not (tmp_path / "out").exists()
+    assert result.output.strip().count("\n") == 0  # one line
+    assert option in result.output and repr(value) in result.output
+    assert "Traceback" not in result.output and field + " must" not in result.output

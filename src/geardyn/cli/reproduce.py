@@ -27,7 +27,13 @@ from typing import Annotated
 
 import typer
 
-from geardyn.cli.common import QuietOption, run_option, stderr_console
+from geardyn.cli.common import (
+    QuietOption,
+    run_option,
+    run_options,
+    settings_from_options,
+    stderr_console,
+)
 from geardyn.errors import ParameterError
 
 __all__ = ["register", "reproduce_command"]
@@ -108,18 +114,13 @@ def reproduce_command(
     cases = paper_cases() if all_cases else [get_case(case)]  # type: ignore[arg-type]
     interps = (list(INTERPRETATIONS) if interpretation == InterpretationChoice.all
                else [interpretation.value])
-    if resolution is not None and resolution < 2:
-        raise ParameterError("--resolution", resolution, "must be >= 2")
-    if samples is not None and samples < 2:
-        raise ParameterError("--samples", samples, "must be >= 2")
-    if transient is not None and not transient >= 0:
-        raise ParameterError("--transient", transient, "must be >= 0")
     if not 0 <= basins <= 1000:
         raise ParameterError("--basins", basins, "must be a grid size in 0..1000")
     if jobs is not None and jobs < 1:
         raise ParameterError("--jobs", jobs, "must be >= 1")
     workers = jobs or os.cpu_count() or 1
-    settings = ReproductionSettings(num=resolution, transient=transient, samples=samples)
+    settings = settings_from_options(ReproductionSettings, {
+        "num": ("--resolution", resolution), **run_options(transient=transient, samples=samples)})
     out.mkdir(parents=True, exist_ok=True)
 
     with worker_pool(workers) as pool:  # the sweeps' processes then write the case files

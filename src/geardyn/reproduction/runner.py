@@ -82,21 +82,21 @@ class ReproductionSettings:
         checks = (("num", self.num, 2), ("samples", self.samples, 2))
         for name, value, least in checks:
             if value is not None and value < least:
-                raise ValueError(f"{name}: must be >= {least} (got {value!r})")
+                raise ValueError(f"{name} must be >= {least} (got {value!r})")
         if self.converge is not None and not (np.isfinite(self.converge) and self.converge > 0):
-            raise ValueError(f"converge: must be a tolerance > 0 or None (got {self.converge!r})")
+            raise ValueError(f"converge must be a tolerance > 0 or None (got {self.converge!r})")
         for name in ("transient", "min_transient", "lyapunov_transient"):
             value = getattr(self, name)
             if value is not None and not (np.isfinite(value) and value >= 0):
-                raise ValueError(f"{name}: must be a finite time >= 0 (got {value!r})")
+                raise ValueError(f"{name} must be a finite time >= 0 (got {value!r})")
         for name in ("lyapunov_z", "lyapunov_floor"):
             value = getattr(self, name)
             if not (np.isfinite(value) and value >= 0):
-                raise ValueError(f"{name}: must be finite and >= 0 (got {value!r})")
+                raise ValueError(f"{name} must be finite and >= 0 (got {value!r})")
         for name in ("lyapunov_duration", "lyapunov_screen"):
             value = getattr(self, name)
             if not (np.isfinite(value) and value > 0):
-                raise ValueError(f"{name}: must be a finite time > 0 (got {value!r})")
+                raise ValueError(f"{name} must be a finite time > 0 (got {value!r})")
 
     def run_settings(self, case: Case) -> RunSettings:
         """The :class:`~geardyn.RunSettings` of ``case``'s sweeps (by continuation:
