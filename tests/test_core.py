@@ -132,7 +132,7 @@ def test_lane_plan_incommensurate_section_and_bad_lanes():
     plan = LanePlan.build(_Forced(), P, RunSettings(transient=0.0, steps_per_period=16))
     assert plan.sample_every.tolist() == [1] and plan.commensurate.tolist() == [False]
     assert plan.transient_periods.tolist() == [0]
-    with pytest.raises(ValueError, match="Omega must be positive and finite"):
+    with pytest.raises(ValueError, match="Omega: must be a positive finite number"):
         LanePlan.build(_Forced(), np.array([[0.0, np.nan, 1.0]]), RunSettings())
     with pytest.raises(ValueError, match=r"steps_per_period must be >= 4 \(got 3\)"):
         LanePlan.build(_Forced(), P, RunSettings(), LaneSettings(steps_per_period=[3]))

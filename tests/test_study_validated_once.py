@@ -264,3 +264,55 @@ def test_reproduce_refuses_what_its_settings_refuse(tmp_path, option, field, val
     assert result.output.strip().count("\n") == 0  # one line
     assert option in result.output and repr(value) in result.output
     assert "Traceback" not in result.output and field + " must" not in result.output
+
+
+def _omega_entry_points():
+    """Each library entry point that takes a forcing frequency, as ``call(omega)``."""
+    import numpy as np
+
+    from geardyn.analysis.basins import basins
+    from geardyn.analysis.map2d import estimate_map
+    from geardyn.analysis.orbits import shooting_problem
+    from geardyn.core.plan import LanePlan
+
+    pair = geardyn.GearPair()
+
+    def params(w):
+        p = np.array(pair.params, dtype=float)
+        p[pair.omega_index] = w
+        return p
+
+    problem = shooting_problem(pair, 1.0)
+    return {
+        "LanePlan.build": lambda w: LanePlan.build(pair, params(w)[None, :],
+                                                   geardyn.RunSettings()),
+        "basins": lambda w: basins(pair, w, None, None),
+        "estimate_map": lambda w: estimate_map(pair, 1, [w], 10.0, 4),
+        "ShootingProblem.with_params": lambda w: problem.with_params(params(w)),
+        # the model itself refuses -1, nan and inf as its Omega coefficient (naming Omega)
+        "lyapunov": lambda w: geardyn.lyapunov(pair.with_omega(w)),
+        "simulate": lambda w: geardyn.simulate(pair, w),
+    }
+
+
+#: Entry points where Omega = 0 is the autonomous model, not a refusal.
+AUTONOMOUS_AT_ZERO = {"lyapunov", "simulate"}
+
+
+@pytest.mark.parametrize("omega", [0.0, -1.0, math.nan, math.inf, 5e-324])
+@pytest.mark.parametrize("entry", sorted(_omega_entry_points()))
+def test_every_entry_point_refuses_an_unusable_omega_by_one_rule(entry, omega):
+    """Omega > 0 with a finite period 2 pi / Omega (5e-324 is positive but its period
+    overflows), the rule of ``[run].omega`` and ``--omega``: the same ParameterError (a
+    ValueError) naming Omega at every entry point."""
+    from geardyn.core.settings import OMEGA_RULE
+
+    if omega == 0.0 and entry in AUTONOMOUS_AT_ZERO:
+        pytest.skip("Omega = 0 is the autonomous model here")
+    with pytest.raises(ParameterError) as caught:
+        _omega_entry_points()[entry](omega)
+    exc = caught.value
+    assert exc.field.lower() == "omega" and isinstance(exc, ValueError)
+    assert not (0 < omega < math.inf and math.isfinite(2 * math.pi / omega))  # all unusable
+    by_model = entry == "lyapunov" and not (omega > 0 and math.isfinite(omega))
+    assert exc.reason == OMEGA_RULE or by_model, exc

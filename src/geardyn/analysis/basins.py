@@ -41,7 +41,7 @@ from geardyn.analysis.lanes import CONTACT_LABELS, has_mesh_forces, lane_variabl
 from geardyn.analysis.periodicity import APERIODIC, UNBOUNDED, classify_period
 from geardyn.core.model import Model
 from geardyn.core.results import finish
-from geardyn.core.settings import RunSettings, resolve_run
+from geardyn.core.settings import RunSettings, check_omega, resolve_run
 from geardyn.core.status import Status, status_attrs
 from geardyn.execution.executor import default_chunk, run_chunks
 from geardyn.solvers.ensemble import run_lanes
@@ -283,8 +283,7 @@ def basins(
     if not (match_tol > 0 and chaos_tol > 0):
         raise ValueError("match_tol and chaos_tol must be > 0")
     om = float(model.omega if omega is None else omega)
-    if not (np.isfinite(om) and om > 0):
-        raise ValueError(f"omega must be positive and finite (got {omega!r})")
+    check_omega(om, "omega")
     m = model.with_omega(om)
     names = list(m.state_names)
     xn, xv = grid_axis(x, "x", names)

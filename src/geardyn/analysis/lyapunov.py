@@ -32,6 +32,7 @@ from geardyn.core.settings import (
     LYAPUNOV_TRANSIENT_PERIODS,
     LyapunovSettings,
     RunSettings,
+    check_omega,
     replacement,
     resolve_run,
     resolve_settings,
@@ -325,8 +326,7 @@ def lyapunov(
         lanes = LaneSettings(t0=t0, ladder=False, interval=_autonomous_step(steps_per_period, dt),
                              steps_per_period=1)
     else:
-        if not (om > 0 and math.isfinite(om)):
-            raise ValueError(f"omega must be a positive finite number (got {om!r})")
+        check_omega(om)
         if dt is not None:
             raise ValueError("dt applies to autonomous models; give steps_per_period instead")
         lanes = LaneSettings(t0=t0, ladder=False, sample_every=1)

@@ -37,7 +37,7 @@ from geardyn.core.plan import (
     periods_covering,
 )
 from geardyn.core.results import finish
-from geardyn.core.settings import LyapunovSettings, RunSettings, resolve_run
+from geardyn.core.settings import LyapunovSettings, RunSettings, check_omega, resolve_run
 from geardyn.core.status import Status
 from geardyn.execution.executor import default_chunk, run_chunks
 from geardyn.solvers.ensemble import busy_lanes, run_lanes
@@ -308,8 +308,7 @@ def estimate_map(model: Model, lanes: int, omegas: Sequence[float] | np.ndarray,
     False: one lane on its own (a simulation).
     """
     om = np.asarray(omegas, dtype=float).ravel()
-    if om.size == 0 or not np.all(np.isfinite(om) & (om > 0)):
-        raise ValueError("Omega must be positive and finite")
+    check_omega(om)
     per_lane = float(np.mean(_steps_per_lane(model, om, transient, samples, steps_per_period)))
     steps = lanes * per_lane
     share = busy_lanes(lanes) / lanes if blocks and lanes > 0 else 1.0  # vectors left idle

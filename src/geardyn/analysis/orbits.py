@@ -61,6 +61,7 @@ from geardyn.core.settings import (
     NEWTON_TOL,
     NewtonSettings,
     RunSettings,
+    check_omega,
     resolve_settings,
 )
 from geardyn.core.status import Status, status_meaning
@@ -194,8 +195,7 @@ class ShootingProblem:
         ValueError where the forcings have no common period."""
         p = np.ascontiguousarray(params, dtype=float).copy()
         om = float(p[self.model.omega_index])
-        if not (math.isfinite(om) and om > 0):
-            raise ValueError(f"Omega must be > 0 (got {om!r})")
+        check_omega(om)
         every, ok = lane_section(self.model, p[None, :], np.array([om]), self.section_limit)
         if not ok[0]:
             raise ValueError(f"at Omega={om:g} the forcings have no common period")
@@ -252,8 +252,9 @@ def problem_with_steps(model: Model, omega: float | None, period: int,
     if omega is not None:
         model = model.with_omega(float(omega))
     om = model.omega
-    if model.omega_index is None or not (math.isfinite(om) and om > 0):
-        raise ValueError(f"periodic_orbit needs a forced model with Omega > 0 (got {om!r})")
+    if model.omega_index is None:
+        raise ValueError("periodic_orbit needs a periodically forced model")
+    check_omega(om)
     if isinstance(period, bool) or int(period) != period or period < 1:
         raise ValueError(f"period must be a whole number >= 1 (got {period!r})")
     P = np.atleast_2d(model.params)

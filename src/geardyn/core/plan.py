@@ -18,7 +18,7 @@ from typing import Any
 import numpy as np
 
 from geardyn.core.section import MAX_COMMON_PERIODS, common_section
-from geardyn.core.settings import MIN_STEPS, RunSettings, replacement, warn_deprecated
+from geardyn.core.settings import MIN_STEPS, RunSettings, check_omega, replacement, warn_deprecated
 
 #: Fewest RK4 steps per forcing period of the step rule.
 MIN_STEPS_PER_PERIOD = 64
@@ -160,14 +160,11 @@ def lane_section(model: Any, P: np.ndarray, omega: np.ndarray,
 
 def lane_omega(model: Any, P: np.ndarray) -> np.ndarray:
     """Omega of each lane (a copy of its column of ``P``); ValueError unless every lane is
-    periodically forced at a positive, finite frequency."""
+    periodically forced at a usable frequency (:func:`~geardyn.core.settings.check_omega`)."""
     if model.omega_index is None:
         raise ValueError("run_lanes needs a periodically forced model (it samples once a period)")
     omega = P[:, model.omega_index].copy()
-    good = np.isfinite(omega) & (omega > 0)
-    if not np.all(good):
-        raise ValueError(f"Omega must be positive and finite in every lane "
-                         f"(got {omega[~good][0]!r})")
+    check_omega(omega)
     return omega
 
 

@@ -39,6 +39,27 @@ def usable_omega(value: float) -> bool:
     return math.isfinite(value) and value > 0 and math.isfinite(2 * math.pi / value)
 
 
+def check_omega(value: Any, name: str = "Omega") -> None:
+    """A :class:`~geardyn.errors.ParameterError` (a ValueError) naming ``name`` and the first
+    value (of a number or an array of them) that is not :func:`usable_omega`."""
+    from geardyn.errors import ParameterError
+
+    for w in _as_floats(value):
+        if not usable_omega(w):
+            raise ParameterError(name, w, OMEGA_RULE)
+
+
+def _as_floats(value: Any) -> list[float]:
+    if isinstance(value, numbers.Real):
+        return [float(value)]
+    import numpy as np
+
+    values = np.asarray(value, dtype=float).ravel().tolist()
+    if not values:
+        raise ValueError("Omega: no values given")
+    return values
+
+
 class SettingsError(ValueError):
     """An invalid run setting; the message names the field and the value."""
 

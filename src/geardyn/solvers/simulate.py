@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import math
 from typing import Any
 
 import numpy as np
@@ -12,7 +11,7 @@ from geardyn.core.model import Model
 from geardyn.core.moved import moved
 from geardyn.core.plan import LanePlan, LaneSettings
 from geardyn.core.results import finish
-from geardyn.core.settings import INTEGRATOR, RunSettings, resolve_run
+from geardyn.core.settings import INTEGRATOR, RunSettings, check_omega, resolve_run
 from geardyn.core.status import Status, status_meaning
 from geardyn.solvers.kernels import kernels_for
 
@@ -69,6 +68,8 @@ def simulate(
     periods, bound = run.samples, run.bound
     locate_edges = run.locate_edges
     if omega is not None:
+        if float(omega) != 0.0:  # 0: the autonomous model
+            check_omega(float(omega), "omega")
         model = model.with_omega(float(omega))
     om = model.omega
     if om == 0.0:
@@ -76,8 +77,7 @@ def simulate(
             raise ValueError("an autonomous model needs sample_interval > 0")
         lanes = LaneSettings(ladder=False, interval=float(sample_interval))
     else:
-        if not math.isfinite(om) or om < 0:
-            raise ValueError(f"omega must be a positive finite number (got {om!r})")
+        check_omega(om)
         lanes = LaneSettings(ladder=False, sample_every=1)
     plan = LanePlan.build(model, np.asarray(model.params, dtype=float)[None, :], run, lanes)
     period, n, h = float(plan.period[0]), int(plan.steps_per_period[0]), float(plan.step[0])
