@@ -51,10 +51,10 @@ from geardyn.cli.common import (
     run_options,
     stderr_console,
     study_run_settings,
-    usable_omega,
     write_outputs,
 )
 from geardyn.core.results import SCHEMAS
+from geardyn.core.settings import usable_omega
 from geardyn.errors import ParameterError, StudyError
 from geardyn.study import build_model, study_omega
 

@@ -166,21 +166,13 @@ def check_plot_path(option: str, path: Path | None) -> None:
         raise ParameterError(option, str(path), f"suffix must be one of {PLOT_SUFFIXES}")
 
 
-def usable_omega(value: float) -> bool:
-    """:func:`geardyn.core.settings.usable_omega` (the rule of ``[run].omega`` too)."""
-    from geardyn.core.settings import usable_omega as rule
-
-    return rule(value)
-
-
 def check_omega(option: str, value: float) -> None:
     """Refuse a forcing frequency ``value`` that breaks the rule of ``[run].omega``
-    (:data:`geardyn.core.settings.OMEGA_RULE`): a :class:`~geardyn.ParameterError` naming
+    (:func:`geardyn.core.settings.check_omega`): a :class:`~geardyn.ParameterError` naming
     ``option``."""
-    from geardyn.core.settings import OMEGA_RULE, usable_omega
+    from geardyn.core.settings import check_omega as rule
 
-    if not usable_omega(value):
-        raise ParameterError(option, value, OMEGA_RULE)
+    rule(value, option)
 
 
 def run_settings(options: dict[str, tuple[str, Any]]):

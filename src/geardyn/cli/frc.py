@@ -43,9 +43,9 @@ from geardyn.cli.common import (
     run_option,
     run_options,
     study_run_settings,
-    usable_omega,
     write_outputs,
 )
+from geardyn.core.settings import usable_omega
 from geardyn.errors import ParameterError, StudyError
 from geardyn.study import build_model
 

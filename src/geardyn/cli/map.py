@@ -38,8 +38,8 @@ from geardyn.cli.common import (
     run_options,
     run_settings,
     study_run_settings,
-    usable_omega,
 )
+from geardyn.core.settings import usable_omega
 from geardyn.errors import ParameterError, StudyError
 from geardyn.study import build_model
 
