@@ -41,9 +41,8 @@ Progress = Callable[[str, int, int], None]
 #: calls (in a worker process, one thread and no progress: the whole sweep in one call). Any
 #: segment gives bitwise the same points
 #: (:func:`~geardyn.analysis.continuation.continue_branches`); a longer one leaves fewer slots
-#: idle at the calls' ends (12 of the paper's 1000-point sweeps on one thread, each whole in
-#: one call: 0.53x the CPU time of 64-point segments), a shorter one rebalances the threads at
-#: every call.
+#: idle at the calls' ends, a shorter one rebalances the threads at every call (measured in
+#: bench/RESULTS.md).
 SEGMENT = 250
 
 
