@@ -271,8 +271,12 @@ def _omega_entry_points():
     import numpy as np
 
     from geardyn.analysis.basins import basins
+    from geardyn.analysis.frc import frequency_response
+    from geardyn.analysis.lyapunov import lyapunov_lanes
     from geardyn.analysis.map2d import estimate_map
     from geardyn.analysis.orbits import shooting_problem
+    from geardyn.analysis.runup import steady_record
+    from geardyn.analysis.spectrum import amplitude_spectrum
     from geardyn.core.plan import LanePlan
 
     pair = geardyn.GearPair()
@@ -289,12 +293,17 @@ def _omega_entry_points():
         "basins": lambda w: basins(pair, w, None, None),
         "estimate_map": lambda w: estimate_map(pair, 1, [w], 10.0, 4),
         "ShootingProblem.with_params": lambda w: problem.with_params(params(w)),
-        # the model itself refuses -1, nan and inf as its Omega coefficient (naming Omega)
         "lyapunov": lambda w: geardyn.lyapunov(pair.with_omega(w)),
         "simulate": lambda w: geardyn.simulate(pair, w),
+        "lyapunov_lanes": lambda w: lyapunov_lanes(pair, params(w)[None, :]),
+        "frequency_response": lambda w: frequency_response(pair, [w, 1.0]),
+        "amplitude_spectrum": lambda w: amplitude_spectrum(np.ones(8), dt=0.1, omega=w),
+        "steady_record": lambda w: steady_record(pair.with_omega(w), 4, 1.0),
     }
 
 
+#: Entry points given a model made by ``with_omega`` (which refuses -1, nan and inf itself).
+BUILT_BY_WITH_OMEGA = {"lyapunov", "steady_record"}
 #: Entry points where Omega = 0 is the autonomous model, not a refusal.
 AUTONOMOUS_AT_ZERO = {"lyapunov", "simulate"}
 
@@ -314,5 +323,62 @@ def test_every_entry_point_refuses_an_unusable_omega_by_one_rule(entry, omega):
     exc = caught.value
     assert exc.field.lower() == "omega" and isinstance(exc, ValueError)
     assert not (0 < omega < math.inf and math.isfinite(2 * math.pi / omega))  # all unusable
-    by_model = entry == "lyapunov" and not (omega > 0 and math.isfinite(omega))
+    by_model = entry in BUILT_BY_WITH_OMEGA and not (omega > 0 and math.isfinite(omega))
     assert exc.reason == OMEGA_RULE or by_model, exc
+
+
+@pytest.mark.parametrize("omega", [0.0, -1.0, 5e-324])
+@pytest.mark.parametrize("where", ["continuation", "grazing"])
+def test_continuation_leaves_its_domain_where_omega_breaks_the_one_rule(where, omega):
+    """A branch or a grazing curve that moves Omega leaves its valid region at an Omega the
+    rule refuses (5e-324 included: positive, but its period overflows), saying the rule."""
+    from geardyn.analysis.arclength import OutsideDomain
+    from geardyn.analysis.branch import _Invalid, _Tracer
+    from geardyn.analysis.grazing import GrazingProblem
+    from geardyn.analysis.orbits import shooting_problem
+    from geardyn.core.settings import OMEGA_RULE
+
+    pair = geardyn.GearPair()
+    if where == "continuation":
+        tracer = _Tracer(pair, "Omega", 1, 1.0, None, None, 1e-9, 12)
+        with pytest.raises(_Invalid) as caught:
+            tracer.params_at(omega)
+    else:
+        gp = GrazingProblem(pair, "Omega", "zeta", 0, shooting_problem(pair, 1.0), 1.0, 1.0)
+        with pytest.raises(OutsideDomain) as caught:
+            gp.params_at(omega, 0.05)
+    assert OMEGA_RULE in str(caught.value)
+
+
+@pytest.mark.parametrize("command", [
+    ["map", "--x", "Omega:{w}:1.5:2", "--y", "xi1:0.01:0.3:2"],
+    ["bifurcation", "--param", "Omega", "--range", "{w}:1.5:2"],
+    ["frc", "--param", "Omega", "--range", "{w}:1.5:2"]])
+@pytest.mark.parametrize("omega", [-1.0, 5e-324])
+def test_every_command_refuses_an_omega_range_by_the_one_rule(tmp_path, command, omega):
+    """An Omega axis or range with an unusable end: the one rule's words, naming the option."""
+    from typer.testing import CliRunner
+
+    from geardyn.cli.main import app
+    from geardyn.core.settings import OMEGA_RULE
+
+    path = tmp_path / "fig3.toml"
+    import tomli_w
+
+    path.write_text(tomli_w.dumps(builtin_study("paper_fig3").to_toml_dict()))
+    args = [a.format(w=omega) for a in command]
+    result = CliRunner().invoke(app, [args[0], str(path), *args[1:], "--out",
+                                      str(tmp_path / "x.nc")])
+    assert result.exit_code != 0 and not (tmp_path / "x.nc").exists()
+    assert OMEGA_RULE in result.output and "Traceback" not in result.output
+    assert ("--x" if command[0] == "map" else "--range") in result.output
+
+
+@pytest.mark.parametrize("ends", [(-1.0, 1.0), (5e-324, 1.0)])
+def test_the_explorer_refuses_an_omega_window_by_the_one_rule(ends):
+    from geardyn.core.settings import OMEGA_RULE
+
+    state = ExplorerState(builtin_study("paper_fig3"), "paper_fig3", describe_error=format_error)
+    assert state.param == "Omega"
+    before = state.window
+    assert OMEGA_RULE in state.zoom(*ends) and state.window == before

@@ -69,10 +69,12 @@ from geardyn.analysis.orbits import (
 from geardyn.core.model import Model
 from geardyn.core.plan import default_steps_per_period
 from geardyn.core.settings import (
+    OMEGA_RULE,
     PARAM_STEP_REL,
     ContinuationSettings,
     RunSettings,
     resolve_settings,
+    usable_omega,
 )
 
 #: Most corrector iterations per step.
@@ -223,9 +225,8 @@ class _Tracer:
             return hit
         if not math.isfinite(p):
             raise _Invalid(f"{self.param} is not finite")
-        if self.param == "Omega":
-            if not p > 0:
-                raise _Invalid(f"Omega must be > 0 (got {p:.8g})")
+        if self.param == "Omega" and not usable_omega(p):
+            raise _Invalid(f"Omega {OMEGA_RULE} (got {p:.8g})")
         if self.param == "Omega" and self.model.omega_is_entry:
             P = self.model.params.astype(float).copy()
             P[self.model.omega_index] = p

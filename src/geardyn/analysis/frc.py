@@ -58,7 +58,7 @@ from geardyn.analysis.bifurcation import ContinuedSweep, continued_sweeps
 from geardyn.analysis.dataset import model_attrs
 from geardyn.core.model import Model
 from geardyn.core.results import finish
-from geardyn.core.settings import RunSettings, resolve_run
+from geardyn.core.settings import RunSettings, check_omega, resolve_run
 from geardyn.core.status import Status, status_attrs
 from geardyn.solvers.kernels import kernels_for
 
@@ -223,8 +223,9 @@ def frequency_response(
     run = resolve_run(run, settings, aliases={"tol": "period_tol"},
                       where="frequency_response")
     om = np.sort(np.asarray(omega, dtype=float).ravel())
-    if om.size < 2 or not np.all(np.isfinite(om) & (om > 0)):
-        raise ValueError("omega: give at least 2 positive finite forcing frequencies")
+    if om.size < 2:
+        raise ValueError("omega: give at least 2 forcing frequencies")
+    check_omega(om, "omega")
     if np.any(np.diff(om) <= 0):
         raise ValueError("omega: the frequencies must be distinct")
     if not model.meshes:

@@ -65,7 +65,7 @@ from geardyn.analysis.orbits import (
 )
 from geardyn.core.plan import default_steps_per_period
 from geardyn.core.results import finish
-from geardyn.core.settings import PARAM_STEP_REL, RunSettings
+from geardyn.core.settings import OMEGA_RULE, PARAM_STEP_REL, RunSettings, usable_omega
 from geardyn.solvers.kernels import kernels_for
 
 if TYPE_CHECKING:
@@ -135,8 +135,8 @@ class GrazingProblem:
         if not (math.isfinite(X) and math.isfinite(Y)):
             raise OutsideDomain(f"{self.x}={X!r}, {self.y}={Y!r} is not finite")
         for name, v in ((self.x, X), (self.y, Y)):
-            if name == "Omega" and not v > 0:
-                raise OutsideDomain(f"Omega must be > 0 (got {v:.8g})")
+            if name == "Omega" and not usable_omega(v):
+                raise OutsideDomain(f"Omega {OMEGA_RULE} (got {v:.8g})")
         try:
             P = np.asarray(self.model.lane_params_grid(self.x, [X], self.y, [Y])[0], float)
         except (ValueError, KeyError) as err:

@@ -413,6 +413,8 @@ def lyapunov_lanes(
     L = P.shape[0]
     if P.shape[1] != model.params.size:
         raise ValueError(f"P must have {model.params.size} columns (got {P.shape[1]})")
+    if model.omega_index is not None:
+        check_omega(P[:, model.omega_index])
     if not np.all(np.isfinite(P)):
         raise ValueError("P must be finite")
     if y0 is None:
@@ -433,8 +435,6 @@ def lyapunov_lanes(
     else:
         if dt is not None:
             raise ValueError("dt applies to autonomous models; give steps_per_period instead")
-        if not np.all(P[:, model.omega_index] > 0):
-            raise ValueError("every lane needs a forcing frequency Omega > 0")
         lanes = LaneSettings(t0=T0, sample_every=1)
     plan = LanePlan.build(model, P, run, lanes)
     OMEGA, H, n_per = plan.omega, plan.step, plan.steps_per_period

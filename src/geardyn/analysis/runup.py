@@ -27,7 +27,7 @@ from geardyn.analysis.frc import physical_axes
 from geardyn.core.model import Model
 from geardyn.core.plan import default_steps_at
 from geardyn.core.results import finish
-from geardyn.core.settings import DEFAULT_BOUND
+from geardyn.core.settings import DEFAULT_BOUND, check_omega
 from geardyn.core.status import Status, status_meaning
 from geardyn.errors import ParameterError
 from geardyn.solvers.kernels import kernels_for
@@ -446,8 +446,7 @@ def steady_record(model: Model, samples: int, sample_rate: float, *, transient: 
     shortened to the largest step that divides the sample interval, so every sample is a grid
     point (no interpolation)."""
     om = float(model.omega)
-    if not (math.isfinite(om) and om > 0.0):
-        raise ParameterError("Omega", om, "a steady record needs a forcing frequency > 0")
+    check_omega(om)
     n = steps_per_period or int(default_steps_at(model, np.array([om]))[0])
     h = 2.0 * math.pi / (om * n)
     dt = 1.0 / sample_rate

@@ -21,6 +21,8 @@ import math
 import numpy as np
 import xarray as xr
 
+from geardyn.core.settings import check_omega
+
 __all__ = ["amplitude_spectrum", "label_peaks", "time_series"]
 
 
@@ -61,8 +63,9 @@ def _as_signal(data, state, dt, omega):
         raise ValueError(f"signal: expected one coordinate over time (got shape {x.shape})")
     if dt is None or not (math.isfinite(dt) and dt > 0):
         raise ValueError(f"dt: a positive sampling interval is needed (got {dt!r})")
-    if omega is None or not (math.isfinite(omega) and omega > 0):
-        raise ValueError(f"omega: the mesh frequency must be a positive number (got {omega!r})")
+    if omega is None:
+        raise ValueError("omega: the mesh frequency is needed (not given, not in the attrs)")
+    check_omega(omega, "omega")
     return x, float(dt), float(omega), attrs
 
 

@@ -54,7 +54,7 @@ from geardyn.cli.common import (
     write_outputs,
 )
 from geardyn.core.results import SCHEMAS
-from geardyn.core.settings import usable_omega
+from geardyn.core.settings import OMEGA_RULE, usable_omega
 from geardyn.errors import ParameterError, StudyError
 from geardyn.study import build_model, study_omega
 
@@ -145,9 +145,10 @@ def _check_param_values(model, param: str, ends: tuple[float, float], range_text
         if not np.all(np.isfinite(P)):
             raise StudyError(f"--range: {param} = {value:g} in {range_text!r} makes the model's"
                              " coefficients infinite (the value is too extreme)")
-        if model.omega_index is not None and not usable_omega(P[0, model.omega_index]):
-            raise StudyError(f"--range: Omega = {value:g} in {range_text!r}: must be > 0 (with "
-                             "a finite period)")
+        w = P[0, model.omega_index] if model.omega_index is not None else 1.0
+        if not usable_omega(w):
+            what = "" if param == "Omega" else f" at {param} = {value:g}"
+            raise ParameterError("--range", range_text, f"Omega = {w:g}{what}: {OMEGA_RULE}")
 
 
 def _lowest_omega(model, param: str, ends: tuple[float, float], hold: str) -> float | None:

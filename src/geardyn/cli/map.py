@@ -32,6 +32,7 @@ from geardyn.cli.common import (
     StepsOption,
     YesOption,
     check_count,
+    check_omega,
     load_study_source,
     refuse_if_costly,
     run_option,
@@ -39,7 +40,6 @@ from geardyn.cli.common import (
     run_settings,
     study_run_settings,
 )
-from geardyn.core.settings import usable_omega
 from geardyn.errors import ParameterError, StudyError
 from geardyn.study import build_model
 
@@ -139,9 +139,8 @@ def map_command(
             raise ParameterError(option, f"{name}:{start}:{stop}", format_error(exc)) from None
         if model.omega_index is None:
             raise ParameterError("study", s.study.name, "a map needs a forced model")
-        if name == "Omega" and not all(usable_omega(w) for w in ends[:, model.omega_index]):
-            raise ParameterError(option, f"{start}:{stop}", "Omega must be > 0 (with a finite "
-                                 "period)")
+        if name == "Omega":
+            check_omega(option, ends[:, model.omega_index])
         if not np.all(np.isfinite(ends)):
             raise ParameterError(option, f"{name}:{start}:{stop}", "an end of the axis makes the"
                                  " model's coefficients infinite (a value is too extreme)")

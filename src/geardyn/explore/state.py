@@ -28,6 +28,7 @@ from typing import Any
 import numpy as np
 
 from geardyn.core.model import Model
+from geardyn.core.settings import OMEGA_RULE, usable_omega
 from geardyn.errors import ParameterError
 from geardyn.gears.faults import FAULT_KINDS
 from geardyn.io.study_models import STUDY_MODELS, StudyModel, study_model
@@ -492,8 +493,8 @@ class ExplorerState:
         if not (math.isfinite(lo) and math.isfinite(hi)) or lo == hi:
             return f"window: needs two different finite ends (got {start!r}, {stop!r})"
         lo, hi = _rounded(lo, hi)
-        if self.param == "Omega" and lo <= 0:
-            return f"window: Omega must stay positive (got {lo:g})"
+        if self.param == "Omega" and not usable_omega(lo):
+            return f"window: Omega {OMEGA_RULE} (got {lo:g})"
         new = Window(lo, hi, self.window.num)
         if self.param != "Omega":
             try:

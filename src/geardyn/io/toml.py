@@ -366,7 +366,7 @@ class _RunTableRules(BaseModel):
         ``omega`` the lowest forcing frequency Omega of the run (a StudyError without it)."""
         if self.transient_periods is None:
             return self.transient
-        if omega is None or not (math.isfinite(omega) and omega > 0):
+        if omega is None or not usable_omega(omega):
             raise StudyError(f"run.transient_periods: needs the run's forcing frequency Omega "
                              f"(got {omega!r})")
         return self.transient_periods * 2.0 * math.pi / omega
