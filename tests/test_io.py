@@ -192,7 +192,7 @@ def test_study_round_trip_is_lossless(tmp_path, study):
          "sweep.num: Input should be greater than or equal to 2 (got 1)"),
         ('[params]\nbase = "paper"\n[sweep]\nstart = 1\nstop = 4\nnum = 3\n'
          'continuation = "sideways"\n',
-         "sweep.continuation: Input should be 'none', 'up' or 'down' (got 'sideways')"),
+         "sweep.continuation: must be one of none, up, down (got 'sideways')"),
         ('[params]\nbase = "paper"\n[sweep]\nstart = 1\nstop = 4\nnum = 3\nsamples = 1\n',
          "sweep.samples: Input should be greater than or equal to 2 (got 1)"),
         ('[params]\nbase = "paper"\n[sweep]\nstart = 1\nstop = 1\nnum = 3\n',

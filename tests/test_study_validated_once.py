@@ -56,12 +56,9 @@ def test_the_explorer_and_the_study_file_accept_the_same_continuations(value):
 
 
 def test_the_command_lines_choices_are_the_study_files():
-    """``--interpretation`` and ``--continuation`` (enumerations kept in the light CLI
-    modules) offer exactly the values the study file accepts."""
-    from geardyn.cli.bifurcation import Continuation
-
+    """``--interpretation`` (an enumeration kept in the light CLI modules) offers exactly the
+    values the study file accepts, and so do ``--continuation``'s."""
     assert tuple(m.value for m in Interpretation) == INTERPRETATIONS
-    assert tuple(m.value for m in Continuation) == CONTINUATIONS
     for value in INTERPRETATIONS:
         assert _accepted_by_study_file("study", "interpretation", value)
     for value in CONTINUATIONS:
@@ -382,3 +379,87 @@ def test_the_explorer_refuses_an_omega_window_by_the_one_rule(ends):
     assert state.param == "Omega"
     before = state.window
     assert OMEGA_RULE in state.zoom(*ends) and state.window == before
+
+
+
+class _Accepted(Exception):
+    """Raised where a command goes on past its checks (nothing runs)."""
+
+
+def _continuation_refusals(tmp_path):
+    """Each entry point that takes a sweep's continuation, as ``call(value)``: None where it
+    accepts the value, else its refusal as the one line the user sees."""
+    import tomli_w
+    from typer.testing import CliRunner
+
+    from geardyn.cli.main import app
+
+    path = tmp_path / "fig3.toml"
+    path.write_text(tomli_w.dumps(builtin_study("paper_fig3").to_toml_dict()))
+
+    def refusal(call):
+        try:
+            call()
+        except ValueError as err:
+            return format_error(err)
+        return None
+
+    def study_file(value):
+        doc = builtin_study("paper_fig3").to_toml_dict()
+        doc["sweep"]["continuation"] = value
+        Study.model_validate(doc)
+
+    def library(value):
+        try:  # no values: refused after the continuation is taken (nothing runs)
+            geardyn.bifurcation(geardyn.GearPair(), "Omega", [], continuation=value)
+        except ParameterError:
+            raise
+        except ValueError:
+            return
+
+    def command(name):
+        def call(value):
+            with mock.patch(f"geardyn.cli.{name}.load_study_source", side_effect=_Accepted):
+                result = CliRunner().invoke(app, [name, str(path), "--continuation", value])
+            if isinstance(result.exception, _Accepted):
+                return None
+            assert result.exit_code == 2 and result.output.count("\n") == 1, result.output
+            return result.output.strip()
+        return call
+
+    def explorer(value):
+        state = ExplorerState(builtin_study("paper_fig3"), "paper_fig3",
+                              describe_error=format_error)
+        return state.set_continuation(value)
+
+    return {"study file": lambda v: refusal(lambda: study_file(v)),
+            "bifurcation()": lambda v: refusal(lambda: library(v)),
+            "geardyn bifurcation": command("bifurcation"),
+            "geardyn explore": command("explore"),
+            "explorer": explorer}
+
+
+@pytest.mark.parametrize("value", ["sideways", "Up", "", *CONTINUATIONS])
+def test_every_entry_point_takes_a_continuation_by_one_vocabulary(tmp_path, value):
+    """[sweep].continuation, bifurcation(), --continuation of both commands and the explorer:
+    each listed value accepted everywhere, anything else refused everywhere in the same words
+    (each naming its own field)."""
+    from geardyn.core.settings import CONTINUATION_RULE, SWEEP_CONTINUATIONS
+
+    refusals = {where: call(value) for where, call in _continuation_refusals(tmp_path).items()}
+    if value in SWEEP_CONTINUATIONS:
+        assert refusals == dict.fromkeys(refusals)
+    else:
+        said = {where: msg[msg.index(": must") + 2:] for where, msg in refusals.items()}
+        assert said == dict.fromkeys(said, f"{CONTINUATION_RULE} (got {value!r})")
+
+
+def test_the_continuation_options_list_the_vocabulary():
+    from typer.testing import CliRunner
+
+    from geardyn.cli.main import app
+    from geardyn.core.settings import SWEEP_CONTINUATIONS
+
+    for name in ("bifurcation", "explore"):
+        result = CliRunner().invoke(app, [name, "--help"], env={"COLUMNS": "200"})
+        assert "[" + "|".join(SWEEP_CONTINUATIONS) + "]" in result.output

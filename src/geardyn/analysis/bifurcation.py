@@ -25,8 +25,15 @@ from geardyn.analysis.lyapunov import (
 from geardyn.analysis.motion import averaging_time, motion_variable
 from geardyn.core.model import Model
 from geardyn.core.plan import forcing_period
-from geardyn.core.settings import LyapunovSettings, RunSettings, resolve_run
+from geardyn.core.settings import (
+    SWEEP_DIRECTIONS,
+    LyapunovSettings,
+    RunSettings,
+    check_continuation,
+    resolve_run,
+)
 from geardyn.core.status import Status
+from geardyn.errors import ParameterError
 from geardyn.execution.executor import lane_results, run_chunks, run_lanes_task
 from geardyn.solvers.ensemble import LaneResults
 from geardyn.solvers.kernels import kernels_for
@@ -96,9 +103,10 @@ def bifurcation(
         period of the excitations when the model has a second one at a commensurate frequency
         (``section_periods``; see :func:`geardyn.core.section.common_section`).
     continuation
-        ``None``: every point starts from ``y0``; ``"up"``/``"down"``: each point starts from the
-        final state of the previous one in ascending/descending order (shows hysteresis; see
-        :mod:`geardyn.analysis.continuation`).
+        ``None`` or ``"none"``: every point starts from ``y0``; ``"up"``/``"down"``: each point
+        starts from the final state of the previous one in ascending/descending order (shows
+        hysteresis; see :mod:`geardyn.analysis.continuation`); one of
+        :data:`~geardyn.core.settings.SWEEP_CONTINUATIONS`.
     continued_transient
         With continuation: the (minimum) transient of a continued point, which starts next to
         its attractor (default ``transient``; the first point always gets ``transient``).
@@ -145,9 +153,9 @@ def bifurcation(
     :func:`geardyn.analysis.motion.motion_classes`).
     """
     run = resolve_run(run, settings, aliases=ALIASES, where="bifurcation")
+    if continuation is not None and check_continuation(continuation) == "none":
+        continuation = None
     values = _check_values(values)
-    if continuation not in (None, "up", "down"):
-        raise ValueError(f"continuation must be None, 'up' or 'down' (got {continuation!r})")
     if starts < 1 or (starts > 1 and continuation):
         raise ValueError("starts must be >= 1, and 1 with continuation")
     if continuation and (client is not None or store is not None):
@@ -305,8 +313,9 @@ def _continued(sweeps: Sequence[ContinuedSweep], run: RunSettings,
     times)."""
     prepared = []
     for sw in sweeps:
-        if sw.direction not in ("up", "down"):
-            raise ValueError(f"direction must be 'up' or 'down' (got {sw.direction!r})")
+        if sw.direction not in SWEEP_DIRECTIONS:
+            raise ParameterError("direction", sw.direction,
+                                 "must be one of " + ", ".join(SWEEP_DIRECTIONS))
         values = _check_values(sw.values)
         order = np.argsort(values, kind="stable")
         if sw.direction == "down":

@@ -41,10 +41,12 @@ from geardyn.cli.common import (
     StepsOption,
     TransientOption,
     YesOption,
+    check_continuation,
     check_count,
     check_omega,
     check_plot_path,
     check_run_cost,
+    continuation_option,
     load_study_source,
     make_parents,
     run_option,
@@ -54,22 +56,15 @@ from geardyn.cli.common import (
     write_outputs,
 )
 from geardyn.core.results import SCHEMAS
-from geardyn.core.settings import OMEGA_RULE, usable_omega
+from geardyn.core.settings import OMEGA_RULE, SWEEP_DIRECTIONS, usable_omega
 from geardyn.errors import ParameterError, StudyError
 from geardyn.study import build_model, study_omega
 
 __all__ = ["bifurcation_command", "parse_range", "plot_command", "register"]
 
 
-class Continuation(StrEnum):
-    none = "none"
-    up = "up"
-    down = "down"
-
-
-class SweepDirection(StrEnum):
-    up = "up"
-    down = "down"
+#: The sweep a reproduction case file's figure draws.
+SweepDirection = StrEnum("SweepDirection", [(d, d) for d in SWEEP_DIRECTIONS])
 
 
 def parse_range(text: str, option: str = "--range") -> tuple[float, float, int]:
@@ -230,9 +225,9 @@ def bifurcation_command(
                                      " a spur pair's speed in its params.speed_unit."),
     ] = None,
     continuation: Annotated[
-        Continuation | None,
-        typer.Option(help="none: every point from the same start; up/down: each from the "
-                          "previous point's final state (default: sweep.continuation)."),
+        str | None,
+        continuation_option("none: every point from the same start; up/down: each from the "
+                            "previous point's final state (default: sweep.continuation)."),
     ] = None,
     lyapunov: Annotated[
         bool | None,
@@ -272,6 +267,7 @@ def bifurcation_command(
     """
     import numpy as np
 
+    check_continuation(continuation)
     s = load_study_source(study)
     sweep = s.sweep
     name = param or (sweep.param if sweep is not None else "Omega")
@@ -295,7 +291,7 @@ def bifurcation_command(
         raise StudyError(f"--omega: not given, and a sweep of {name} needs a fixed Omega "
                          "(or [run].omega in the study)")
     _check_param_values(model, name, (start, stop), range_text)
-    cont = (continuation.value if continuation is not None
+    cont = (continuation if continuation is not None
             else sweep.continuation if sweep is not None else "none")
     lyap = lyapunov if lyapunov is not None else bool(sweep is not None and sweep.lyapunov)
     run = study_run_settings(

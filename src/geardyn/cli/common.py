@@ -166,6 +166,23 @@ def check_plot_path(option: str, path: Path | None) -> None:
         raise ParameterError(option, str(path), f"suffix must be one of {PLOT_SUFFIXES}")
 
 
+def continuation_option(help: str) -> Any:
+    """``--continuation``: its choices are :data:`geardyn.core.settings.SWEEP_CONTINUATIONS`,
+    checked in the command by :func:`check_continuation` (the rule of every entry point)."""
+    from geardyn.core.settings import SWEEP_CONTINUATIONS
+
+    return typer.Option("--continuation", metavar="[" + "|".join(SWEEP_CONTINUATIONS) + "]",
+                        help=help)
+
+
+def check_continuation(value: str | None) -> str | None:
+    """``--continuation``'s value (None: not given), refused as every entry point refuses it
+    (:func:`geardyn.core.settings.check_continuation`)."""
+    from geardyn.core.settings import check_continuation as rule
+
+    return None if value is None else rule(value, "--continuation")
+
+
 def check_omega(option: str, value: float) -> None:
     """Refuse a forcing frequency ``value`` that breaks the rule of ``[run].omega``
     (:func:`geardyn.core.settings.check_omega`): a :class:`~geardyn.ParameterError` naming

@@ -14,7 +14,12 @@ from typing import Annotated
 
 import typer
 
-from geardyn.cli.common import InterpretationOption, load_study_source
+from geardyn.cli.common import (
+    InterpretationOption,
+    check_continuation,
+    continuation_option,
+    load_study_source,
+)
 
 __all__ = ["explore_command", "register"]
 
@@ -34,7 +39,7 @@ def explore_command(
                                "makes the explorer reachable from the network).")
     ] = "127.0.0.1",
     continuation: Annotated[
-        str | None, typer.Option(help="none, up or down (default: the study's).")
+        str | None, continuation_option("Where each point starts (default: the study's).")
     ] = None,
     interpretation: InterpretationOption = None,
     save_dir: Annotated[
@@ -49,15 +54,12 @@ def explore_command(
     change parameters (a local Bokeh server; prints its address)."""
     from geardyn.cli.bifurcation import parse_range
     from geardyn.cli.errors import format_error
-    from geardyn.errors import ParameterError
     from geardyn.explore.server import serve
-    from geardyn.explore.state import CONTINUATIONS, ExplorerState, Window
+    from geardyn.explore.state import ExplorerState, Window
 
+    check_continuation(continuation)
     s = load_study_source(study)
     window = Window(*parse_range(range_)) if range_ is not None else None
-    if continuation is not None and continuation not in CONTINUATIONS:
-        raise ParameterError("--continuation", continuation,
-                             f"must be one of {', '.join(CONTINUATIONS)}")
     interp = interpretation.value if interpretation is not None else None
     from geardyn.cli.envelope import load_curve
 

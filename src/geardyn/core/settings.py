@@ -49,6 +49,26 @@ def check_omega(value: Any, name: str = "Omega") -> None:
             raise ParameterError(name, w, OMEGA_RULE)
 
 
+#: The directions a sweep by continuation goes in the swept parameter.
+SWEEP_DIRECTIONS: tuple[str, ...] = ("up", "down")
+#: Where each point of a parameter sweep starts: "none", every point from the same start;
+#: "up"/"down", each from the previous point's final state (``[sweep].continuation``,
+#: ``--continuation``, the explorer, :func:`geardyn.bifurcation`).
+SWEEP_CONTINUATIONS: tuple[str, ...] = ("none", *SWEEP_DIRECTIONS)
+#: What a sweep's continuation must be (:func:`check_continuation`).
+CONTINUATION_RULE = "must be one of " + ", ".join(SWEEP_CONTINUATIONS)
+
+
+def check_continuation(value: Any, name: str = "continuation") -> str:
+    """``value`` where it is one of :data:`SWEEP_CONTINUATIONS`; else a
+    :class:`~geardyn.errors.ParameterError` (a ValueError) naming ``name``."""
+    from geardyn.errors import ParameterError
+
+    if not (isinstance(value, str) and value in SWEEP_CONTINUATIONS):
+        raise ParameterError(name, value, CONTINUATION_RULE)
+    return value
+
+
 def _as_floats(value: Any) -> list[float]:
     if isinstance(value, numbers.Real):
         return [float(value)]

@@ -28,7 +28,7 @@ from typing import Any
 import numpy as np
 
 from geardyn.core.model import Model
-from geardyn.core.settings import OMEGA_RULE, usable_omega
+from geardyn.core.settings import OMEGA_RULE, check_continuation, usable_omega
 from geardyn.errors import ParameterError
 from geardyn.gears.faults import FAULT_KINDS
 from geardyn.io.study_models import STUDY_MODELS, StudyModel, study_model
@@ -469,9 +469,10 @@ class ExplorerState:
         return self._apply(self.overrides, value)
 
     def set_continuation(self, value: str) -> str | None:
-        if value not in CONTINUATIONS:
-            return f"continuation: must be one of {', '.join(CONTINUATIONS)} (got {value!r})"
-        self.continuation = value
+        try:
+            self.continuation = check_continuation(value)
+        except ParameterError as err:
+            return str(err)
         return None
 
     def _apply(self, overrides: dict[str, float | str], interpretation: str | None

@@ -115,7 +115,7 @@ import tomllib
 from collections.abc import Callable, Mapping
 from importlib import resources
 from pathlib import Path
-from typing import Annotated, Any, ClassVar, Literal, get_args
+from typing import Annotated, Any, ClassVar, Literal
 
 import tomli_w
 from pydantic import (
@@ -141,7 +141,9 @@ from geardyn.core.settings import (
     DEFAULT_TOL,
     FIELDS,
     OMEGA_RULE,
+    SWEEP_CONTINUATIONS,
     SettingsError,
+    check_continuation,
     settings_from_named,
     usable_omega,
 )
@@ -248,10 +250,18 @@ def _usable_omega(value: float) -> float:
 #: (:func:`geardyn.core.settings.usable_omega`).
 ForcingFrequency = Annotated[Real, AfterValidator(_usable_omega)]
 
-#: ``[sweep].continuation``: where each point of a sweep starts (:class:`SweepSettings`); the
-#: explorer's and the command line's choices are :data:`CONTINUATIONS`.
-Continuation = Literal["none", "up", "down"]
-CONTINUATIONS: tuple[str, ...] = get_args(Continuation)
+def _sweep_continuation(value: Any) -> Any:
+    try:
+        return check_continuation(value)
+    except ParameterError as err:
+        raise ValueError(err.reason) from None
+
+
+#: ``[sweep].continuation``: where each point of a sweep starts (:class:`SweepSettings`), one
+#: of :data:`~geardyn.core.settings.SWEEP_CONTINUATIONS`, refused by the rule every entry point
+#: reads (:func:`~geardyn.core.settings.check_continuation`).
+Continuation = Annotated[Literal[SWEEP_CONTINUATIONS], BeforeValidator(_sweep_continuation)]
+CONTINUATIONS: tuple[str, ...] = SWEEP_CONTINUATIONS
 
 #: The ``[run]`` table's name of a :class:`geardyn.RunSettings` field where it differs.
 RUN_TABLE_NAMES: dict[str, str] = {"samples": "periods"}
