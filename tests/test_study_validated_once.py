@@ -463,3 +463,81 @@ def test_the_continuation_options_list_the_vocabulary():
     for name in ("bifurcation", "explore"):
         result = CliRunner().invoke(app, [name, "--help"], env={"COLUMNS": "200"})
         assert "[" + "|".join(SWEEP_CONTINUATIONS) + "]" in result.output
+
+
+def _refused(build) -> bool:
+    """Whether ``build()`` refuses its input (a study's ValidationError or a ParameterError)."""
+    try:
+        build()
+    except (ValidationError, ParameterError):
+        return True
+    return False
+
+
+def _count_entry_points(field: str):
+    """Each entry point that takes ``n_planets`` or a stiffness series' ``harmonics``, as
+    ``build(value)``."""
+    from geardyn.trains import Gear, Inertia, planetary_stage
+
+    def study(name, **params):
+        doc = builtin_study(name).to_toml_dict()
+        if doc["params"].pop("geometry", None) is not None:  # a set of given stiffnesses
+            doc["params"]["sun"]["radius"] = 0.03
+            doc["params"].update(sun_mesh_stiffness=5e8, ring_mesh_stiffness=5e8)
+        doc["params"].update(params)
+        return lambda: build_model(Study.model_validate(doc))
+
+    def catt(**changes):
+        data = PlanetaryParams.paper().model_dump()
+        for path, value in changes.items():
+            *head, key = path.split(".")
+            target = data
+            for part in head:
+                target = target[part]
+            target[key] = value
+        return lambda: PlanetaryParams.model_validate(data)
+
+    if field == "n_planets":
+        def stage(n):
+            return lambda: planetary_stage(
+                sun=Gear("sun", 1e-3, 1.0, 0.03, n_teeth=20),
+                ring=Gear("ring", 1e-1, 5.0, 0.09, n_teeth=60),
+                carrier=Inertia("carrier", 1e-2, 2.0), planet=Gear("p", 1e-4, 0.5, 0.03,
+                                                                   n_teeth=20),
+                n_planets=n, pin_stiffness=1e8, sun_mesh_stiffness=5e8,
+                ring_mesh_stiffness=5e8, sun_pressure_angle=0.4, ring_pressure_angle=0.4)
+        return {"PlanetaryGearSet": lambda n: lambda: _planetary_with(n_planets=n),
+                "planetary study": lambda n: study("planetary_example", n_planets=n),
+                "CATT study": lambda n: catt(n_planets=n),
+                "planetary_stage": stage}
+    rectangular = {"waveform": "rectangular"}
+    return {"PlanetaryGearSet": lambda h: lambda: _planetary_with(harmonics=h, **rectangular),
+            "planetary study": lambda h: study("planetary_example", harmonics=h, **rectangular),
+            "train study": lambda h: study("two_stage_train", harmonics=h, **rectangular),
+            "CATT study": lambda h: catt(**{"sun_mesh.waveform": "rectangular",
+                                            "sun_mesh.harmonics": h})}
+
+
+def _planetary_with(**kw) -> geardyn.Model:
+    M = geardyn.Member
+    return geardyn.PlanetaryGearSet(**{
+        "n_planets": 3, "sun": M(0.4, 0.39, 1e8, 0.0, radius=0.03), "ring": M(2.35, 3.0, 1e8, 1e9),
+        "carrier": M(5.43, 6.29, 1e8, 0.0), "planet": M(0.66, 0.61, 1e8),
+        "sun_mesh_stiffness": 5e8, "ring_mesh_stiffness": 5e8, **kw})
+
+
+@pytest.mark.parametrize("field, value", [
+    ("n_planets", 0), ("n_planets", 1), ("n_planets", 32), ("n_planets", 33), ("n_planets", 64),
+    ("n_planets", 65), ("harmonics", 0), ("harmonics", 1), ("harmonics", 200),
+    ("harmonics", 201)])
+def test_every_entry_point_takes_a_count_within_one_declared_limit(field, value):
+    """n_planets and a stiffness series' harmonics have one declared range each (the counts
+    N_PLANETS and HARMONICS): every constructor and study table accepts or refuses alike."""
+    from geardyn.models.planetary_coefficients import HARMONICS, N_PLANETS
+
+    declared = {"n_planets": N_PLANETS, "harmonics": HARMONICS}[field]
+    inside = declared.minimum <= value <= declared.maximum
+    refused = {where: _refused(make(value)) for where, make in _count_entry_points(field).items()}
+    assert refused == dict.fromkeys(refused, not inside)
+    assert (declared.minimum, declared.maximum) == {"n_planets": (1, 32),
+                                                    "harmonics": (1, 200)}[field]

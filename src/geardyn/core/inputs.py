@@ -41,6 +41,7 @@ from __future__ import annotations
 
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -83,18 +84,18 @@ class PhysicalInput:
     ``of``, e.g. ``"from_geometry"``).
 
     ``kind`` one of :data:`INPUT_KINDS` (``unit_kind`` the SI kind of each value of a
-    ``"pair"``), ``form`` one of :data:`FORMS`; ``default`` :data:`REQUIRED` or the value
-    (None: derived or left out, see ``meaning``); ``coefficient`` the declared coefficient the
-    input sets directly, whose range applies, or ``minimum`` (inclusive); ``choices`` the
+    ``"pair"``), ``form`` one of :data:`FORMS`; ``default`` :data:`REQUIRED` or the value (None:
+    derived or left out, see ``meaning``); ``coefficient`` the declared coefficient the input
+    sets directly, whose range applies, or ``minimum``/``maximum`` (inclusive); ``choices`` the
     values of a ``"choice"``; ``table`` the name of a ``"table"`` input's nested table;
-    ``alternative`` the input that stands for this one (a required input the study may leave
-    out where it gives that one: the study table's default is then None and the model's builder
-    says which is missing); ``study`` False for a constructor keyword a study's ``[params]`` does
-    not take (``meaning`` says where it comes from); ``swept`` whether a sweep takes it by name
-    (a number of one of :data:`SWEPT_KINDS` in one of :data:`SWEPT_FORMS`); ``unit`` the unit
-    a plain number, a sweep's values and its axis are in where it is not the kind's SI unit
-    (e.g. ``"rpm"``); ``explore`` whether the explorer offers the input as a control (a number,
-    a count or a choice of the study's ``[params]``, where the study gives it one value), in
+    ``alternative`` the input that stands for this one (a required input the study may leave out
+    where it gives that one: the study table's default is then None and the model's builder says
+    which is missing); ``study`` False for a constructor keyword a study's ``[params]`` does not
+    take (``meaning`` says where it comes from); ``swept`` whether a sweep takes it by name (a
+    number of one of :data:`SWEPT_KINDS` in one of :data:`SWEPT_FORMS`); ``unit`` the unit a
+    plain number, a sweep's values and its axis are in where it is not the kind's SI unit (e.g.
+    ``"rpm"``); ``explore`` whether the explorer offers the input as a control (a number, a
+    count or a choice of the study's ``[params]``, where the study gives it one value), in
     declared order."""
 
     name: str
@@ -106,6 +107,7 @@ class PhysicalInput:
     unit_kind: str | None = None
     choices: tuple[str, ...] = ()
     minimum: float | None = None
+    maximum: float | None = None
     table: str | None = None
     of: str = "__init__"
     alternative: str | None = None
@@ -155,13 +157,29 @@ class PhysicalInput:
 
     def bounds(self) -> dict[str, float]:
         """The admissible range (pydantic's ``ge``/``gt``/... keywords): the declared
-        coefficient's range, or ``minimum``."""
+        coefficient's range, or ``minimum``/``maximum``."""
         c = self.coefficient
         if c is None:
-            return {} if self.minimum is None else {"ge": self.minimum}
+            return {k: v for k, v in (("ge", self.minimum), ("le", self.maximum))
+                    if v is not None}
         return {k: v for k, v in (("ge", c.minimum), ("le", c.maximum),
                                   ("gt", c.exclusive_minimum), ("lt", c.exclusive_maximum))
                 if v is not None}
+
+    def count(self, value: Any) -> int:
+        """``value``, a count (a whole number, not a bool) within ``minimum``/``maximum``: what
+        the study file's schema takes too; else a :class:`~geardyn.ParameterError` naming the
+        input."""
+        from geardyn.errors import ParameterError
+
+        lo, hi = self.minimum, self.maximum
+        if isinstance(value, bool) or not isinstance(value, int | np.integer) \
+                or (lo is not None and value < lo) or (hi is not None and value > hi):
+            span = (f"from {lo:g} to {hi:g}" if lo is not None and hi is not None
+                    else f">= {lo:g}" if lo is not None else f"<= {hi:g}" if hi is not None
+                    else "")
+            raise ParameterError(self.name, value, f"must be a whole number {span}".strip())
+        return int(value)
 
 
 def by_name(inputs: Iterable[PhysicalInput]) -> dict[str, PhysicalInput]:

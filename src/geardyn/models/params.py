@@ -26,6 +26,7 @@ from pydantic import (
 
 from geardyn.core.inputs import PhysicalInput
 from geardyn.errors import ParameterError, UnknownParameterError
+from geardyn.models.planetary_coefficients import HARMONICS, N_PLANETS
 from geardyn.units import to_si
 
 _CONFIG = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False, validate_default=True)
@@ -154,7 +155,8 @@ class Mesh(BaseModel):
     stiffness_phase: Angle = Field(0.0, description="stiffness phase varphi [rad]")
     waveform: Literal["sine", "rectangular"] = "sine"
     contact_ratio: Real = Field(1.6, gt=1.0, lt=2.0, description="contact ratio (rectangular)")
-    harmonics: Whole = Field(25, ge=1, le=200, description="Fourier terms of the rectangular wave")
+    harmonics: Whole = Field(25, **HARMONICS.bounds(),
+                             description="Fourier terms of the rectangular wave")
     backlash: Clearance = Field(description="backlash half-width b [m]")
     error: Clearance = Field(description="meshing error amplitude E [m]")
     error_phase: Angle = Field(0.0, description="meshing error phase phi [rad]")
@@ -293,7 +295,7 @@ class PlanetaryParams(BaseModel):
 
     model_config = _CONFIG
 
-    n_planets: Whole = Field(4, ge=1, le=64, description="number of planet sets N")
+    n_planets: Whole = Field(4, **N_PLANETS.bounds(), description="number of planet sets N")
     sun: Gear
     inside_planet: Gear
     outside_planet: Gear

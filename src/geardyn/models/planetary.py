@@ -46,11 +46,13 @@ from geardyn.models.planetary_coefficients import (
     CARRIER_SPEED,
     CENTRAL,
     FORCES,
+    HARMONICS,
     HEADER,
     INPUTS,
     MATRICES,
     MESH,
     MESH_ROW,
+    N_PLANETS,
     coast_harmonics_block,
     harmonics_block,
     structure_entry,
@@ -232,21 +234,19 @@ def _per_planet(field: str, value: Any, n: int, kind: str, minimum: float | None
 
 
 def _series_inputs(contact_ratio: Any, harmonics: Any) -> tuple[float, int]:
-    """The rectangular waveform's contact ratio (1 < eps < 2) and its series' harmonics (a
-    whole number from 1 to 200), checked: a :class:`~geardyn.ParameterError` naming the input
-    (every model with a rectangular stiffness waveform reads them here)."""
+    """The rectangular waveform's contact ratio (1 < eps < 2) and its series' harmonics
+    (:data:`~geardyn.models.planetary_coefficients.HARMONICS`), checked: a
+    :class:`~geardyn.ParameterError` naming the input (every model with a rectangular stiffness
+    waveform reads them here)."""
     if not isinstance(contact_ratio, int | float) or not 1.0 < contact_ratio < 2.0:
         raise ParameterError("contact_ratio", contact_ratio, "must be between 1 and 2")
     return float(contact_ratio), _harmonics(harmonics)
 
 
 def _harmonics(harmonics: Any) -> int:
-    """The harmonics of a stiffness series: a whole number from 1 to 200 (a
+    """The harmonics of a stiffness series, within the declared range of :data:`HARMONICS` (a
     :class:`~geardyn.ParameterError` naming ``harmonics`` for any other)."""
-    if isinstance(harmonics, bool) or not isinstance(harmonics, int) \
-            or not 1 <= harmonics <= 200:
-        raise ParameterError("harmonics", harmonics, "must be an integer from 1 to 200")
-    return harmonics
+    return HARMONICS.count(harmonics)
 
 
 def _waveform(field: str, waveform: Any, rel: np.ndarray, phase: np.ndarray, contact_ratio: float,
@@ -496,10 +496,7 @@ class PlanetaryGearSet(Model):
                  length_scale: Any = 1e-6, stiffness_gaps: bool = False):
         self.inputs: dict[str, Any] = {k: v for k, v in locals().items()
                                        if k not in ("self", "__class__")}
-        if isinstance(n_planets, bool) or not isinstance(n_planets, int | np.integer) \
-                or not 1 <= n_planets <= 32:
-            raise ParameterError("n_planets", n_planets, "must be an integer from 1 to 32")
-        n = int(n_planets)
+        n = N_PLANETS.count(n_planets)
         fixed = tuple(fixed)
         for f in fixed:
             if f not in CENTRAL:

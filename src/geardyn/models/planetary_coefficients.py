@@ -123,6 +123,17 @@ def coast_harmonics_block(nh: int) -> CoefficientBlock:
 CENTRAL = ("carrier", "ring", "sun")
 #: The stiffness waveforms a study names (the constructor also takes Fourier coefficients).
 WAVEFORMS = ("sine", "rectangular")
+#: Most planets of a planetary stage, and most harmonics of a stiffness series: the limits of
+#: every model, study table and builder that takes ``n_planets`` or ``harmonics`` (read from
+#: :data:`N_PLANETS` and :data:`HARMONICS`).
+MAX_PLANETS = 32
+MAX_HARMONICS = 200
+#: The counts ``n_planets`` and ``harmonics`` (of a rectangular waveform's stiffness series),
+#: declared once with their ranges (:meth:`~geardyn.core.inputs.PhysicalInput.count`).
+N_PLANETS = PhysicalInput("n_planets", "count", "number of planets N", 3, minimum=1,
+                          maximum=MAX_PLANETS)
+HARMONICS = PhysicalInput("harmonics", "count", "harmonics of the rectangular waveform's series",
+                          9, minimum=1, maximum=MAX_HARMONICS)
 
 
 def _member(name: str, what: str) -> PhysicalInput:
@@ -135,7 +146,7 @@ def _member(name: str, what: str) -> PhysicalInput:
 #: (:data:`geardyn.io.toml.PlanetaryGearSetParams`), and they are the constructor's keywords
 #: (``geometry`` and ``held`` those of :meth:`~geardyn.PlanetaryGearSet.from_geometry`).
 INPUTS: tuple[PhysicalInput, ...] = (
-    PhysicalInput("n_planets", "count", "number of planets N", 3),
+    N_PLANETS,
     PhysicalInput("sun_pressure_angle", "angle", "pressure angle of the sun-planet meshes "
                   "[rad, or e.g. \"24.6 deg\"]", "24.6 deg", swept=True),
     PhysicalInput("ring_pressure_angle", "angle", "pressure angle of the ring-planet meshes "
@@ -164,7 +175,7 @@ INPUTS: tuple[PhysicalInput, ...] = (
                   "\"rectangular\" (contact_ratio, harmonics)", "sine", choices=WAVEFORMS),
     PhysicalInput("contact_ratio", "number", "contact ratio of the rectangular waveform", 1.6,
                   swept=True),
-    PhysicalInput("harmonics", "count", "harmonics of the rectangular waveform's series", 9),
+    HARMONICS,
     PhysicalInput("sun_coast_stiffness", "stiffness", "mean coast-flank stiffness of the "
                   "sun-planet meshes [N/m] (None: the drive flank's); not a study key: "
                   "from_geometry sets it", None, form="per_planet", study=False, swept=True),

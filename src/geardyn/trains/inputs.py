@@ -6,8 +6,10 @@ generated (:data:`geardyn.io.toml.TrainModelParams`)."""
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 from geardyn.core.inputs import PhysicalInput
-from geardyn.models.planetary_coefficients import WAVEFORMS
+from geardyn.models.planetary_coefficients import HARMONICS, WAVEFORMS
 from geardyn.models.planetary_stiffness import COAST_FLANKS
 
 #: The inputs (SI numbers or unit strings; "per mesh": one value for every mesh or
@@ -38,7 +40,7 @@ INPUTS: tuple[PhysicalInput, ...] = (
                   "\"rectangular\" (contact_ratio, harmonics)", "sine", choices=WAVEFORMS),
     PhysicalInput("contact_ratio", "number", "contact ratio of the rectangular waveform", 1.6,
                   swept=True),
-    PhysicalInput("harmonics", "count", "harmonics of the stiffness series", 9),
+    replace(HARMONICS, meaning="harmonics of the stiffness series"),
     PhysicalInput("mesh_phase", "angle", "rad of the mesh cycle, per mesh or \"geometry\"; "
                   "default: from the geometry where every meshing gear has it, else 0", None,
                   form="per_mesh", swept=True),

@@ -8,6 +8,7 @@ from dataclasses import dataclass, replace
 from typing import Any
 
 from geardyn.errors import ParameterError
+from geardyn.models.planetary_coefficients import N_PLANETS
 from geardyn.trains.elements import Bearing, Gear, Inertia, Mesh, Shaft
 from geardyn.trains.train import resolve_mesh
 from geardyn.units import si_value
@@ -65,8 +66,7 @@ def planetary_stage(*, sun: Gear, ring: Gear, carrier: Inertia, planet: Gear, n_
     radius) and, in a compound stage, ``ring_planet_bore_radius``; the sun-planet meshes take
     (sun's, planet's), the planet-ring meshes (planet's or ring planet's, ring's) as their
     ``bore_radius`` pair."""
-    if isinstance(n_planets, bool) or not isinstance(n_planets, int) or not 1 <= n_planets <= 32:
-        raise ParameterError("n_planets", n_planets, "must be a whole number from 1 to 32")
+    n_planets = N_PLANETS.count(n_planets)
     if planet_angles is None:
         psi = [2.0 * math.pi * i / n_planets for i in range(n_planets)]
     else:
