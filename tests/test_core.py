@@ -148,11 +148,11 @@ def test_default_steps_per_period_rule_by_hand():
 
 # ---------------------------------------------------------------------------- status
 def test_status_codes_equal_the_kernel_constants():
-    from geardyn.solvers import _step_core
+    from geardyn.solvers import _step_shared
 
-    assert Status.OK == _step_core.STATUS_OK == 0
-    assert Status.DIVERGED == _step_core.STATUS_DIVERGED == 1
-    assert Status.SPLIT_LIMIT == _step_core.STATUS_SPLIT_LIMIT == 2
+    assert Status.OK == _step_shared.STATUS_OK == 0
+    assert Status.DIVERGED == _step_shared.STATUS_DIVERGED == 1
+    assert Status.SPLIT_LIMIT == _step_shared.STATUS_SPLIT_LIMIT == 2
     assert status_meaning().startswith("0 ok, 1 diverged")
     assert Status.DIVERGED.message.startswith("diverged")
 

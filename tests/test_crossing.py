@@ -14,6 +14,7 @@ from scipy.integrate import solve_ivp
 
 import geardyn
 from _reference_step import step_pieces
+from geardyn.solvers._step_shared import GBUF_ROWS
 from geardyn.solvers.kernels import kernels_for
 
 ZETA, KAPPA, FM, OMEGA = 0.05, 0.2, 0.1, 0.9
@@ -48,7 +49,7 @@ def located(k, p, om, y0, h, j=0):
     g1 = np.zeros(n_ev)
     k.events(h, y1, g1, p, *sc[2])
     pc = (*sc[0], om * h, 0, 0.0, 1.0)  # the step's forcing phase (_step_core._phase_in)
-    ybuf, gbuf = np.zeros(y0.size), np.zeros((k.GBUF_ROWS, n_ev))
+    ybuf, gbuf = np.zeros(y0.size), np.zeros((GBUF_ROWS, n_ev))
     step.interpolant_events(y0, f0, y1, f1, h, 0.0, p, ybuf, gbuf, pc)
     side = 1 if gbuf[0, j] > 0 else -1
     theta = step.first_crossing(j, side, g1[j], y0, f0, y1, f1, h, 0.0, p, ybuf, gbuf, pc)

@@ -15,6 +15,7 @@ from scipy.integrate import solve_ivp
 import geardyn
 from _reference_step import step_pieces
 from geardyn.solvers import _step_core as core
+from geardyn.solvers._step_shared import GBUF_ROWS, NO_PHASE
 from geardyn.solvers.ensemble import run_lanes
 
 ZETA, FM, B, OMEGA = 0.05, 0.1, 1.0, 0.8
@@ -34,9 +35,9 @@ def _core_step(roots_of_x_minus_b, scale=1.0):
     p = np.array([1.0, b, 0.0, 0.0])
     y0, y1 = np.array([b + val[0], 0.0]), np.array([b + val[1], 0.0])
     f0, f1 = np.array([der[0], 0.0]), np.array([der[1], 0.0])
-    ybuf, gbuf, g1 = np.zeros(2), np.zeros((core.GBUF_ROWS, 2)), np.zeros(2)
+    ybuf, gbuf, g1 = np.zeros(2), np.zeros((GBUF_ROWS, 2)), np.zeros(2)
     core.events(1.0, y1, g1, p, 0.0, 1.0)
-    pc = core.NO_PHASE
+    pc = NO_PHASE
     step = step_pieces(core)
     step.interpolant_events(y0, f0, y1, f1, 1.0, 0.0, p, ybuf, gbuf, pc)
     side = 1 if gbuf[0, 0] > 0 else -1

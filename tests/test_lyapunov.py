@@ -566,7 +566,7 @@ def test_split_limit_is_reported():
     finite-difference neighbours each cross all the levels in the first step) and the lane's
     status is SPLIT_LIMIT, in the one-lane and in the lane-block kernel; 10 levels are located
     cleanly. The field is smooth, so the exponents stay those of x' = 1, y' = -y."""
-    from geardyn.solvers._step_core import MAX_SPLITS
+    from geardyn.solvers._step_shared import MAX_SPLITS
 
     assert 10 < MAX_SPLITS < N_LEVELS
     run = dict(y0=[0.0, 1.0], run=RunSettings(transient=0.0),

@@ -162,7 +162,7 @@ def test_busy_lanes_are_the_slots_the_schedule_fills(threads):
     """The lanes' worth of time of a run: every thread's share (as the kernels' schedule deals
     the lanes) in whole vectors of SIMD_SLOTS, times the threads (the speed is measured with
     SIMD_SLOTS lanes per thread)."""
-    from geardyn.solvers._step_core import SIMD_SLOTS
+    from geardyn.solvers._step_shared import SIMD_SLOTS
     from geardyn.solvers.ensemble import _schedule
 
     for lanes in (1, 2, 7, 8, 9, 16, 17, 100, 1000):

@@ -74,7 +74,7 @@ def _lanes(model, omega, b):
 def test_the_levels_are_crossed_in_one_step_twice_per_period():
     """The premise of the counts below, from the analytic motion: the levels lie between the
     grid points at the passages, at most one grid step apart, and more than MAX_SPLITS."""
-    from geardyn.solvers._step_core import MAX_SPLITS
+    from geardyn.solvers._step_shared import MAX_SPLITS
 
     assert len(LEVELS) > MAX_SPLITS
     step = 2.0 * math.pi / RUN.steps_per_period

@@ -1,7 +1,7 @@
 """Numerical outcomes of an integration, as one enumeration shared by the kernels and Python.
 
 The compiled kernels write these codes (their constants ``STATUS_OK``, ``STATUS_DIVERGED`` and
-``STATUS_SPLIT_LIMIT`` in ``solvers/_step_core.py`` equal the values here; a test checks it).
+``STATUS_SPLIT_LIMIT`` in ``solvers/_step_shared.py`` equal the values here; a test checks it).
 Steps that reached the edge-location split limit are always counted (``unresolved``); the
 Lyapunov kernels also mark such a lane :attr:`Status.SPLIT_LIMIT` (its exponent is kept but
 rests on steps integrated unsplit across an edge), while a sweep lane keeps its status and

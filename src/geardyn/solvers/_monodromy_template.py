@@ -32,12 +32,14 @@ import numpy as np
 
 from geardyn.solvers._step_core import (  # CORE-IMPORT
     _JIT,
+    _rows_step,
+    _tangent_step,
+)
+from geardyn.solvers._step_shared import (
     GBUF_ROWS,
     STATUS_DIVERGED,
     STATUS_OK,
     _healthy,
-    _rows_step,
-    _tangent_step,
     phase_table,
 )
 from geardyn.solvers._template_model import events, observe, rhs  # MODEL-IMPORT

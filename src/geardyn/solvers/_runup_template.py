@@ -39,17 +39,19 @@ import numpy as np
 
 from geardyn.solvers._step_core import (  # CORE-IMPORT
     _JIT,
+    _events_i,
+    _rhs_i,
+    _rk4_stages,
+    _split_step,
+)
+from geardyn.solvers._step_shared import (
     GBUF_ROWS,
     STATUS_DIVERGED,
     STATUS_OK,
-    _events_i,
     _healthy,
     _keep_start,
     _leaves_side,
-    _rhs_i,
-    _rk4_stages,
     _side,
-    _split_step,
 )
 from geardyn.solvers._sweep_books import _alloc  # compiled once for every model
 from geardyn.solvers._template_model import events, observe, rhs  # MODEL-IMPORT

@@ -8,8 +8,8 @@ a step, the events' scratch buffer, the statistics update of a grid point (:func
 read-back (:func:`fd_scale`, :func:`fd_size`, :func:`fd_rows`, :func:`fd_tangent`). A model's
 generated core module (:mod:`._step_core`) imports them beside the functions that evaluate the
 model (the split step, its root finders, the rows of a lane), which it compiles with the model's
-functions inlined; the sweep's and the Lyapunov kernels' bookkeeping (:mod:`._sweep_books`,
-:mod:`._lyapunov_books`) imports them too.
+functions inlined; the kernel templates and the sweep's and the Lyapunov kernels' bookkeeping
+(:mod:`._sweep_books`, :mod:`._lyapunov_books`) import them from here too.
 """
 
 from __future__ import annotations

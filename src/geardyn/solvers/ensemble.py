@@ -327,7 +327,7 @@ def busy_lanes(lanes: int, threads: int | None = None) -> int:
     threads: 16). Equal to ``lanes`` when they fill the vectors of every thread."""
     import numba
 
-    from geardyn.solvers._step_core import SIMD_SLOTS
+    from geardyn.solvers._step_shared import SIMD_SLOTS
 
     threads = max(1, int(threads or numba.get_num_threads()))
     lanes = max(1, int(lanes))
