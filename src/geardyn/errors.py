@@ -25,6 +25,16 @@ class StudyError(GeardynError, ValueError):
     """A study file cannot be read or holds something geardyn does not understand."""
 
 
+class GeardynWarning(UserWarning):
+    """Base class of every warning geardyn issues (filter them by it)."""
+
+
+class SlowPathWarning(GeardynWarning):
+    """A model runs its sweeps on a slower kernel path than it could; the message names what to
+    declare for the fast one (once per model class, see
+    :func:`geardyn.core.kernel_source.warn_slow_path`)."""
+
+
 class UnknownParameterError(ParameterError, KeyError):
     """A parameter name that is not known; also a ``KeyError`` (a lookup by name failed)."""
 

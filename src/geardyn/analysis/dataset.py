@@ -31,8 +31,9 @@ from geardyn.solvers.ensemble import LaneResults
 
 def model_attrs(model: Model) -> dict[str, object]:
     """The attributes every sweep and map records about its model: ``interpretation`` and the
-    natural frequency ``omega_n`` (rad/s), where the model has them."""
-    return dict(model.dataset_attrs())
+    natural frequency ``omega_n`` (rad/s), where the model has them, and the sweep kernels'
+    ``kernel_path`` (:data:`~geardyn.core.kernel_source.KERNEL_PATHS`)."""
+    return {**model.dataset_attrs(), "kernel_path": model.kernel.kernel_path}
 
 
 def param_attrs(model: Model, name: str) -> dict[str, str]:

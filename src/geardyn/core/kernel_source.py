@@ -16,8 +16,8 @@ from typing import Any
 from geardyn.core import _noop
 from geardyn.core.one_form import OneForm
 
-__all__ = ["FORM_GENERAL", "FORM_LOAD", "FORM_QUIET", "LANE_FORMS", "KernelSource",
-           "events_take_phase"]
+__all__ = ["FORM_GENERAL", "FORM_LOAD", "FORM_QUIET", "KERNEL_PATHS", "LANE_FORMS",
+           "KernelSource", "events_take_phase", "warn_slow_path"]
 
 #: The lane forms of a model's lane-scalar functions (``rhs_lane(..., form)``): the sweep kernel
 #: compiles its fused step loop once per form, with ``form`` a constant there, and runs a queue
@@ -28,6 +28,14 @@ __all__ = ["FORM_GENERAL", "FORM_LOAD", "FORM_QUIET", "LANE_FORMS", "KernelSourc
 #: FORM_GENERAL unused.
 FORM_GENERAL, FORM_QUIET, FORM_LOAD = 0, 1, 2
 LANE_FORMS = 3
+
+#: How the sweep kernels step a block of lanes, fastest first (:attr:`KernelSource.kernel_path`,
+#: a dataset's ``kernel_path`` attribute): ``"lane-form"``, one fused loop over the block with
+#: the model's lane-scalar functions (the one form, or ``<rhs>_lane`` twins); ``"lane-block"``,
+#: the model's lane-block functions (``<rhs>_lanes``); ``"per-lane"``, its array function one
+#: lane at a time (a plain ``rhs(t, y, dydt, p)``: several times slower on a sweep).
+KERNEL_PATHS = ("lane-form", "lane-block", "per-lane")
+_SLOW_WARNED: set[type] = set()
 
 
 @dataclass(frozen=True)
@@ -44,6 +52,16 @@ class KernelSource:
     #: Set where the functions are in the one form (:mod:`geardyn.core.one_form`):
     #: ``rhs(t, y, p, s, c) -> tuple`` etc.; the generated kernel writes every layout from them.
     one_form: OneForm | None = None
+
+    @property
+    def kernel_path(self) -> str:
+        """The sweep kernels' path for these functions, one of :data:`KERNEL_PATHS` (what the
+        generated core module decides from the functions it is given)."""
+        if self.one_form is not None:
+            return "lane-form"
+        funcs = self.functions()
+        return ("lane-form" if "rhs_lane" in funcs else
+                "lane-block" if "rhs_lanes" in funcs else "per-lane")
 
     def functions(self) -> dict[str, Any]:
         if self.one_form is not None:
@@ -64,6 +82,25 @@ class KernelSource:
             funcs.update(_lane_functions(funcs))
             funcs.update(_lane_scalar_functions(funcs))
         return funcs
+
+
+def warn_slow_path(model: Any) -> None:
+    """A :class:`~geardyn.errors.SlowPathWarning`, once per model class, where ``model`` runs
+    its sweeps on the ``"per-lane"`` path (:data:`KERNEL_PATHS`) because its functions are a
+    user's plain ones (``plain``), naming what to declare for the fast one."""
+    import warnings
+
+    from geardyn.errors import SlowPathWarning
+
+    kind, source = type(model), getattr(model, "kernel", None)
+    if (not isinstance(source, KernelSource) or not source.plain or kind in _SLOW_WARNED
+            or source.kernel_path != "per-lane"):
+        return
+    _SLOW_WARNED.add(kind)
+    warnings.warn(f"{model.name} ({kind.__name__}) runs its sweeps one lane at a time (a plain "
+                  "rhs(t, y, dydt, p): several times slower); declare it in the one form, "
+                  "UserModel.from_one_form(...) (docs/model.md), for the vectorised path",
+                  SlowPathWarning, stacklevel=3)
 
 
 def events_take_phase(events: Any) -> bool:

@@ -17,6 +17,7 @@ from typing import Any
 
 import numpy as np
 
+from geardyn.core.kernel_source import warn_slow_path
 from geardyn.core.section import MAX_COMMON_PERIODS, common_section
 from geardyn.core.settings import MIN_STEPS, RunSettings, check_omega, replacement, warn_deprecated
 
@@ -344,6 +345,8 @@ class LanePlan:
             raise TypeError(f"lanes must be a LaneSettings (got {type(lanes).__name__})")
         P = np.atleast_2d(P)
         L = P.shape[0]
+        if L > 1:
+            warn_slow_path(model)
         if lanes.interval is not None:
             omega, period = np.zeros(L), np.full(L, lanes.interval)
             every, commensurate = np.ones(L, np.int64), np.ones(L, bool)

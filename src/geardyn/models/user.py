@@ -4,7 +4,9 @@ The way to write one is the one form (:meth:`UserModel.from_one_form`, see
 :mod:`geardyn.core.one_form`): the physics once, per lane, as tuple-valued functions that read
 the coefficients by name; it runs on the same vectorised path as the built-in models and may
 declare its meshes. The constructor's plain ``rhs(t, y, dydt, p)`` (writing dydt in place) is
-the legacy form: it runs on the generic per-lane path, several times slower on a sweep.
+the legacy form: it runs on the generic per-lane path, several times slower on a sweep (a
+:class:`~geardyn.errors.SlowPathWarning` says so once; a sweep's ``kernel_path`` attribute
+records it).
 
 A one-form model declares its coefficients as a built-in does (``coefficients=``: a
 :class:`~geardyn.core.coefficients.Coefficient` per parameter, with unit, meaning and range):
