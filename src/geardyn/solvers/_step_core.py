@@ -147,9 +147,10 @@ def _illinois(j, side_j, a, fa, b, fb, y0, f0, y1, f1, dt, t, p, ybuf, g, pc):
 @nb.njit(inline="always", **_JIT)
 def _inverse_cubic(v0, v1, v2, v3):
     """The zero of the inverse cubic interpolant through (v0, 0), (v1, 1/3), (v2, 2/3), (v3, 1)
-    (Lagrange's form): where along the step the cubic through the four equally spaced values
-    vanishes, exactly where the fraction is a cubic in the value; not finite or not in (0, 1)
-    where the values are not monotone."""
+    (Lagrange's form): an estimate of where along the step the cubic through the four equally
+    spaced values vanishes, exact where the fraction is a cubic in the value; not finite where
+    two values coincide, and of no meaning where they are not monotone (the caller keeps it
+    only inside the third of the step where the sign changes)."""
     return -((v0 * v2 * v3) / (3.0 * ((v1 - v0) * (v1 - v2) * (v1 - v3)))
              + (2.0 * (v0 * v1 * v3)) / (3.0 * ((v2 - v0) * (v2 - v1) * (v2 - v3)))
              + (v0 * v1 * v2) / ((v3 - v0) * (v3 - v1) * (v3 - v2)))
