@@ -76,6 +76,17 @@ def test_cubic_extrema_of_a_known_cubic():
     assert math.isnan(th2) and math.isnan(e2)
 
 
+
+def test_inverse_cubic_of_a_known_inverse():
+    # theta(v) = 0.4 + 1.1 v - 0.3 v^2 + 0.2 v^3 (monotone): the values v_i where it takes
+    # theta = 0, 1/3, 2/3, 1 (numpy's roots); the zero of the inverse interpolant is theta(0)
+    q = [0.2, -0.3, 1.1, 0.4]
+    v = [next(r.real for r in np.roots(np.polysub(q, [th])) if abs(r.imag) < 1e-12)
+         for th in (0.0, 1 / 3, 2 / 3, 1.0)]
+    assert core._inverse_cubic(*v) == pytest.approx(0.4, abs=1e-14)
+    # an edge function that is not monotone over the step: no zero inside the step's thirds
+    assert not 0.0 < core._inverse_cubic(-1.0, 0.5, -0.2, 0.3) < 1.0 / 3.0
+
 # --- a grazing orbit of the gear pair against DOP853 --------------------------------------------
 
 def _steady(fa: float) -> np.ndarray:

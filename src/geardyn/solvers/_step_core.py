@@ -12,7 +12,7 @@ compiled once for every model, and imported here.
 Edge location: a step that leaves a side of an edge (a zero of ``events``) is split at the
 crossing and integrated in sub-steps, so every RK4 stage sees a smooth right-hand side and
 the method keeps 4th order. The crossing is located on the cubic Hermite interpolant of the
-trial step by Newton's method on the event's cubic along it (:func:`_cubic_locate`), checked
+trial step by Halley's method on the event's cubic along it (:func:`_cubic_locate`), checked
 on the model's event once; the trial step straddled the edge, so the point found lies O(h^3)
 off it (the right-hand side is continuous there). A step leaves a side when its end lies on the
 other side, or when it grazes the edge: crosses it twice (or any even number of times) inside the
@@ -42,6 +42,7 @@ from geardyn.solvers._step_shared import (
     CONFIRM_TOL,
     GRAZE_ROW,
     GRAZE_TOL,
+    HALLEY_TOL,
     MAX_SPLITS,
     ROOT_TOL,
     SIMULTANEOUS,
@@ -126,6 +127,18 @@ def _illinois(j, side_j, a, fa, b, fb, y0, f0, y1, f1, dt, t, p, ybuf, g, pc):
 
 
 @nb.njit(inline="always", **_JIT)
+def _inverse_cubic(v0, v1, v2, v3):
+    """The zero of the inverse cubic interpolant through (v0, 0), (v1, 1/3), (v2, 2/3), (v3, 1)
+    (Lagrange's form): an estimate of where along the step the cubic through the four equally
+    spaced values vanishes, exact where the fraction is a cubic in the value; not finite where
+    two values coincide, and of no meaning where they are not monotone (the caller keeps it
+    only inside the third of the step where the sign changes)."""
+    return -((v0 * v2 * v3) / (3.0 * ((v1 - v0) * (v1 - v2) * (v1 - v3)))
+             + (2.0 * (v0 * v1 * v3)) / (3.0 * ((v2 - v0) * (v2 - v1) * (v2 - v3)))
+             + (v0 * v1 * v2) / ((v3 - v0) * (v3 - v1) * (v3 - v2)))
+
+
+@nb.njit(inline="always", **_JIT)
 def _cubic_locate(j, side_j, c0, c1, c2, c3, b, fb, v1, v2, y0, f0, y1, f1, dt, t, p, ybuf, g,
                   pc):
     """Fraction in (0, b] of the step where event j leaves side side_j, given the cubic
@@ -134,11 +147,13 @@ def _cubic_locate(j, side_j, c0, c1, c2, c3, b, fb, v1, v2, y0, f0, y1, f1, dt, 
     taken as on side side_j; fb: the model's event at b, off the side); v1, v2: the event at
     1/3 and 2/3 of the step.
 
-    Newton's method on the cubic from the secant of the third of the step where the sign
-    changes (of [0, b] where b < 1), safeguarded by the bracket (no model evaluations), then one
-    evaluation of the model's event at the root: it is taken when the event there is within
-    CONFIRM_TOL of the step from its crossing (always, up to round-off, for affine events);
-    otherwise the model's events take over (:func:`_illinois`, bracket narrowed)."""
+    Halley's method on the cubic, safeguarded by the bracket (no model evaluations), from the
+    inverse cubic interpolation of the four values (:func:`_inverse_cubic`) where it falls in the
+    third of the step where the sign changes, else from the secant of that third (of [0, b]
+    where b < 1); then one evaluation of the model's event at the root: it is taken when the
+    event there is within CONFIRM_TOL of the step from its crossing (always, up to round-off,
+    for affine events); otherwise the model's events take over (:func:`_illinois`, bracket
+    narrowed)."""
     a = 0.0
     hi = b
     fa = _forced(c0, side_j)
@@ -154,6 +169,9 @@ def _cubic_locate(j, side_j, c0, c1, c2, c3, b, fb, v1, v2, y0, f0, y1, f1, dt, 
         up = 1.0 / 3.0 if o1 else (2.0 / 3.0 if o2 else 1.0)
         fup = v1 if o1 else (v2 if o2 else fb)
     x = (lo * fup - up * flo) / (fup - flo) if fup != flo else 0.5 * (lo + up)
+    if b == 1.0:
+        xi = _inverse_cubic(fa, v1, v2, fb)
+        x = xi if lo < xi < up else x
     if not (a < x < b):
         x = 0.5 * (a + b)
     for _ in range(60):
@@ -165,13 +183,15 @@ def _cubic_locate(j, side_j, c0, c1, c2, c3, b, fb, v1, v2, y0, f0, y1, f1, dt, 
         else:
             b = x
         dp = (3.0 * c3 * x + 2.0 * c2) * x + c1
-        xn = x - px / dp if dp != 0.0 else 0.5 * (a + b)
-        newton = a < xn < b
-        if not newton:
+        d2 = 6.0 * c3 * x + 2.0 * c2
+        den = 2.0 * dp * dp - px * d2
+        xn = x - 2.0 * px * dp / den if den != 0.0 else 0.5 * (a + b)
+        halley = a < xn < b
+        if not halley:
             xn = 0.5 * (a + b)
         step = abs(xn - x)
         x = xn
-        if (newton and step <= ROOT_TOL) or b - a <= BRACKET_TOL:
+        if (halley and step <= HALLEY_TOL) or b - a <= BRACKET_TOL:
             break
     _hermite(y0, f0, y1, f1, dt, x, ybuf)
     sx, cx = _phase_in(pc, x)

@@ -45,8 +45,13 @@ GRAZE_BOUND_STEP = 0.6
 #: this fraction of the function's size over the step (shallower dips are touching, not crossing).
 GRAZE_TOL = 1e-9
 #: Newton's method on an event's cubic along the step stops after a step (in the fraction of
-#: the step) below this: the error left is about |P''/2P'| ROOT_TOL^2 (quadratic convergence).
+#: the step) below this: the error left is about |P''/2P'| ROOT_TOL^2 (quadratic convergence);
+#: the step cores of other revisions that ``bench/kernel.py`` builds (``old_kernels``) use it.
 ROOT_TOL = 1e-8
+#: Halley's method on an event's cubic along the step (the step core's ``_cubic_locate``) stops
+#: after a step (in the fraction of the step) below this: the error left is about
+#: |(P''/2P')^2 - P'''/6P'| HALLEY_TOL^3 (cubic convergence).
+HALLEY_TOL = 1e-5
 #: ... or, where it bisects, when the bracket is below this.
 BRACKET_TOL = 1e-13
 #: The root of the cubic is taken when the model's event there is within this fraction of the
