@@ -44,7 +44,6 @@ from geardyn.solvers._step_shared import (
     GRAZE_TOL,
     HALLEY_TOL,
     MAX_SPLITS,
-    ROOT_TOL,
     SIMULTANEOUS,
     _cubic_coeffs,
     _forced,
