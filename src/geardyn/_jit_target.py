@@ -48,6 +48,7 @@ from numba.core.compiler_machinery import LoweringPass, register_pass
 from numba.core.runtime.nrtopt import remove_redundant_nrt_refct
 from numba.core.typed_passes import AnnotateTypes
 
+from geardyn import _lazy_code
 from geardyn._tuple_alias import tuple_aliases
 
 #: The environment variable that chooses the vector width.
@@ -136,6 +137,8 @@ class VectorWidthPass(LoweringPass):
             state.library = state.targetctx.codegen().create_library(
                 state.func_id.func_qualname)
             state.library.enable_object_caching()
+        if _lazy_code.scope.depth == 1:  # the outermost geardyn function: called from Python
+            _lazy_code.mark_outermost(state.library)
         _full_only(state.library)
         if ATTRIBUTE is not None:
             _mark(state.library, ATTRIBUTE)
@@ -149,7 +152,7 @@ class WidthCompiler(Compiler):
     that its dead-code elimination keeps the stores into arrays passed in tuples."""
 
     def _compile_core(self) -> Any:
-        with tuple_aliases():
+        with tuple_aliases(), _lazy_code.scope():
             return super()._compile_core()
 
     def define_pipelines(self) -> list:
