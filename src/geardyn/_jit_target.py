@@ -29,7 +29,9 @@ numba was used before ``import geardyn`` or not, and numba's own ``NUMBA_CPU_NAM
 
 The same pass makes the function's code library skip numba's cheap module pipeline before the
 full one (:func:`_full_only`); the full pipeline runs as numba runs it (``tests/test_full_only.py``
-checks which pipelines run and the results against numpy).
+checks which pipelines run and the results against numpy). A function compiled inside another
+geardyn compile gets its machine code when first needed (:mod:`geardyn._lazy_code`, whose
+guard :class:`WidthCompiler` enters); the outermost one, as numba does.
 
 The width is part of the cache key of geardyn's functions (:func:`cache_tag`, in the name of
 their cache files, :mod:`geardyn._cache`): kernels compiled at one width are never loaded at

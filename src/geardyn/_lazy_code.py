@@ -1,33 +1,36 @@
-"""Machine code of a nested geardyn function emitted when it is first needed, not at its compile.
+"""Machine code of a function compiled inside a geardyn compile emitted when first needed.
 
 numba compiles a function called by another numba function (a callee, compiled while its caller
-is typed) into a code library of its own, emits that library's machine code (LLVM's code
-generator, the larger part of LLVM's time) and makes its Python entry point; the caller then
-links the callee's optimised LLVM IR into its own library and emits its own machine code, with
-its own copy of the callee. A callee's own machine code serves only a call from Python (and a
-later-loaded caller's call that LLVM did not inline, which binds to the first definition of the
-symbol in numba's engine). In geardyn's compiles most functions are callees of the kernels.
+is typed: geardyn's split step and slot work, numba's own helpers such as ``np.empty``'s) into a
+code library of its own, emits that library's machine code (LLVM's code generator) and makes
+its Python entry point; the caller then links the callee's optimised LLVM IR into its own
+library and emits its own machine code, with its own copy of the callee. A callee's own machine
+code serves a call from Python, and a call that LLVM did not inline in a caller emitted later
+in the same process (numba's engine binds it to the first definition of the symbol; in a
+process that loads the caller from the cache, to the caller's own copy).
 
-:func:`defer` (applied by :class:`geardyn._jit_target.VectorWidthPass` to a geardyn function
-compiled inside another geardyn compile) makes the function's library stop before its machine
-code when it is finalised: it is linked, optimised and ready to be linked into callers as
-numba does it, and its machine code is emitted on first need (:func:`_materialise`):
+Inside a geardyn compile (:func:`scope`, entered by :class:`geardyn._jit_target.WidthCompiler`)
+every function compiled for it except the outermost one (:func:`mark_outermost`, the one Python
+calls) is deferred (:func:`defer`): its library is linked and optimised as numba does it, ready
+to be linked into callers, and stops before the machine code, which is emitted on first need
+(:func:`_materialise`):
 
 * its Python entry point is a stand-in of numba's kind (a compiled wrapper calling
   :func:`_resolve`) until it is first called from Python, which emits the machine code and
   calls the function's own wrapper from then on;
 * its environment (numba's per-function object, read by the function's code and by every
-  caller's inlined copy of it) is put in place at once, in a module of its own that defines the
-  environment's symbol (:func:`_set_env`), so that callers emitted before the function read it
-  as numba's own code would;
+  caller's inlined copy of it) is put in place before any code compiled with it can run, in a
+  module that defines the environment symbols of the compile's deferred functions
+  (:func:`_flush_envs`), so that callers read it as numba's own code would;
 * numba's cache stores the library as numba's ``bitcode`` kind (the optimised module; numba
   emits its machine code when it loads it) until its machine code exists, then as numba's
   ``object`` kind; a ``bitcode`` entry loaded inside a geardyn compile is deferred again.
 
-Callers are compiled from the same optimised IR as before, so their machine code is the same.
-The patches of numba's CPU context and codegen class (:func:`scope`) are held only while a
-geardyn function compiles (a :func:`geardyn._scoped_patch.scoped_patch` guard entered by
-:class:`geardyn._jit_target.WidthCompiler`); the deferred libraries carry their own methods.
+Callers are compiled from the same optimised IR as before, so their machine code is the same;
+their calls that LLVM did not inline bind to their own copy, as in a process that loads them
+from the cache. numba's CPU context and codegen are patched only inside :func:`scope` (a
+:func:`geardyn._scoped_patch.scoped_patch` guard); the deferred libraries carry their own
+methods.
 """
 
 from __future__ import annotations
@@ -52,8 +55,10 @@ _SERIALIZE_OBJECT = _codegen.CPUCodeLibrary.serialize_using_object_code
 
 #: Per stand-in entry point (keyed by ``id`` of its ``__self__``): what :func:`_resolve` needs.
 _ENTRIES: dict[int, list] = {}
+#: Environment symbols to define and set (:func:`_flush_envs`): name -> (codegen, environment).
+_PENDING_ENVS: dict[str, tuple] = {}
 #: The libraries defining environment symbols ahead of their function's machine code.
-_ENV_LIBRARIES: dict[str, Any] = {}
+_ENV_LIBRARIES: list = []
 #: The stand-in wrapper's machine code (its library and address), made on first use.
 _STUB: list = []
 
@@ -110,21 +115,36 @@ def _materialise(library: Any) -> None:
 
 
 def _set_env(codegen: Any, name: str, env: Any) -> None:
-    """numba's ``set_env``: the environment symbol ``name`` points to ``env``. Where no module
-    in the engine defines the symbol yet, a module of its own defines it first (numba's
-    ``common`` global, which every later module's definition binds to)."""
-    engine = codegen._engine
-    address = engine.get_global_value_address(name)
-    if not address:
-        with global_compiler_lock:
-            library = codegen.create_library(f"geardyn_env_{name}")
-            module = ll.parse_assembly(f'@"{name}" = common global i8* null\n')
-            module.name = library.name
-            library.add_llvm_module(module)
-            library.finalize()
-            _ENV_LIBRARIES[name] = library
-            address = engine.get_global_value_address(name)
-    (ctypes.c_void_p * 1).from_address(address)[0] = ctypes.c_void_p(id(env))
+    """numba's ``set_env``: the environment symbol ``name`` points to ``env``. A symbol that no
+    module in the engine defines yet waits for :func:`_flush_envs`."""
+    address = codegen._engine.get_global_value_address(name)
+    if address:
+        (ctypes.c_void_p * 1).from_address(address)[0] = ctypes.c_void_p(id(env))
+    else:
+        _PENDING_ENVS[name] = (codegen, env)
+
+
+def _flush_envs() -> None:
+    """Define the environment symbols waiting since :func:`_set_env` in one module of their
+    own (numba's ``common`` globals: a module emitted later that defines one binds to it, and a
+    module emitted earlier keeps its own, which is then the one set) and set them. Runs before
+    any code compiled meanwhile can run: when the outermost compile returns, and before a call
+    through a stand-in entry point."""
+    with global_compiler_lock:
+        if not _PENDING_ENVS:
+            return
+        items = list(_PENDING_ENVS.items())
+        _PENDING_ENVS.clear()
+        codegen = items[0][1][0]
+        library = codegen.create_library(f"geardyn_envs_{len(_ENV_LIBRARIES)}")
+        module = ll.parse_assembly("".join(f'@"{name}" = common global i8* null\n'
+                                           for name, _ in items))
+        module.name = library.name
+        library.add_llvm_module(module)
+        library.finalize()
+        _ENV_LIBRARIES.append(library)
+        for name, (owner, env) in items:
+            _set_env(owner, name, env)
 
 
 def _resolve(closure: Any, args: tuple) -> Any:
@@ -134,6 +154,7 @@ def _resolve(closure: Any, args: tuple) -> Any:
     if entry[4] is None:
         context, library, fndesc, env = entry[:4]
         entry[4] = _ORIGINAL_GET_EXECUTABLE(context, library, fndesc, env)
+    _flush_envs()
     return entry[4](*args)
 
 
@@ -207,4 +228,5 @@ def scope() -> Iterator[None]:
     jit.unserialize_library = _unserialize_library
     jit.set_env = _set_env_method
     yield
+    _flush_envs()
     context.get_executable, jit.unserialize_library, jit.set_env = saved
