@@ -147,6 +147,21 @@ def _dual_typing(variational: bool, ls: LyapunovSettings) -> Iterator[None]:
                              "'difference'") from exc
 
 
+#: The argument types the variational kernels' ``rhs_tangent`` (t, y, v, dy, dv, p, s, c; see
+#: :func:`geardyn.core.one_form.tangent_adapters`) is called with in the Lyapunov kernel.
+_TANGENT_SIGNATURE = ("(float64, float64[::1], float64[::1], float64[::1], float64[::1], "
+                      "float64[::1], float64, float64)")
+
+
+def _check_duals(model: Model, variational: bool, ls: LyapunovSettings) -> None:
+    """Where the tangent is variational, the model's tangent form of its rhs compiled alone
+    first (as the kernel calls it; cached like the kernel's functions), so that a one-form rhs
+    the dual numbers cannot take is refused (:func:`_dual_typing`) before any kernel compiles."""
+    if variational:
+        with _dual_typing(True, ls):
+            kernels_for(model.kernel, "lyapunov").rhs_tangent.compile(_TANGENT_SIGNATURE)
+
+
 def lyapunov_tangent(variational: bool) -> str:
     """The ``tangent`` attribute of a Lyapunov result: how its tangent vectors were advanced."""
     if variational:
@@ -313,6 +328,7 @@ def lyapunov(
     in_periods = _periods_transient(model, run, keywords)
     run, ls = _lyapunov_run(run, settings, keywords, "lyapunov")
     variational = lyapunov_variational(model, ls)
+    _check_duals(model, variational, ls)
     steps_per_period, bound = run.steps_per_period, run.bound
     dt, renorm_every, n_blocks = ls.dt, ls.renorm_every, ls.n_blocks
     duration, rule = _duration(model, ls)
@@ -406,6 +422,7 @@ def lyapunov_lanes(
     in_periods = _periods_transient(model, run, keywords)
     run, ls = _lyapunov_run(run, settings, keywords, "lyapunov_lanes")
     variational = lyapunov_variational(model, ls)
+    _check_duals(model, variational, ls)
     steps_per_period, bound = run.steps_per_period, run.bound
     dt, renorm_every, n_blocks = ls.dt, ls.renorm_every, ls.n_blocks
     duration, _ = _duration(model, ls)
