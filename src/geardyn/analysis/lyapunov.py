@@ -40,6 +40,7 @@ from geardyn.core.settings import (
 )
 from geardyn.core.status import Status
 from geardyn.errors import ParameterError
+from geardyn.solvers.compile_share import signature_types
 from geardyn.solvers.kernels import kernels_for
 
 #: The defaults' earlier names here (deprecated): those of :mod:`geardyn.core.settings`.
@@ -148,9 +149,11 @@ def _dual_typing(variational: bool, ls: LyapunovSettings) -> Iterator[None]:
 
 
 #: The argument types the variational kernels' ``rhs_tangent`` (t, y, v, dy, dv, p, s, c; see
-#: :func:`geardyn.core.one_form.tangent_adapters`) is called with in the Lyapunov kernel.
-_TANGENT_SIGNATURE = ("(float64, float64[::1], float64[::1], float64[::1], float64[::1], "
-                      "float64[::1], float64, float64)")
+#: :func:`geardyn.core.one_form.tangent_adapters`) is called with in the Lyapunov kernel (a
+#: tuple of types: numba keys its disk cache by the signature as given, so that a text would
+#: miss the kernel's cached compile).
+_TANGENT_SIGNATURE = signature_types("(float64, float64[::1], float64[::1], float64[::1], "
+                                     "float64[::1], float64[::1], float64, float64)")
 
 
 def _check_duals(model: Model, variational: bool, ls: LyapunovSettings) -> None:
