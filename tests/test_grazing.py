@@ -5,9 +5,9 @@ results (``unresolved_steps``)."""
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
-import numba as nb
 import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
@@ -17,6 +17,7 @@ from _reference_step import step_pieces
 from geardyn.solvers import _step_core as core
 from geardyn.solvers._step_shared import GBUF_ROWS, NO_PHASE
 from geardyn.solvers.ensemble import run_lanes
+from levels_model import B_BELOW, RUN, levels_model
 
 ZETA, FM, B, OMEGA = 0.05, 0.1, 1.0, 0.8
 PERIODS = 6
@@ -209,40 +210,24 @@ def test_grazing_crossings_and_contact_agree_with_dop853(grazing_sweep):
 
 # --- a step the split limit cannot resolve shows in every result ---------------------------------
 
-N_EDGES = 2 * core.MAX_SPLITS
-
-
-@nb.njit(cache=True)
-def _ramp_rhs(t, y, dy, p):
-    dy[0] = 1.0
-
-
-@nb.njit(cache=True)
-def _ramp_events(t, y, g, p):
-    for j in range(g.size):
-        g[j] = y[0] - p[1] * (j + 1)
-
-
 def test_unresolved_steps_reach_every_result():
-    """x' = 1 runs through N_EDGES edges x = c (j + 1) within its first step: more crossings
-    than the split limit, so that step falls back unsplit; every result must say so."""
-    h = 1.0 / 64
-    model = geardyn.UserModel(_ramp_rhs, 1, [2 * math.pi, 0.5 * h / N_EDGES],
-                              param_names=["Omega", "c"], events=_ramp_events,
-                              n_events=N_EDGES)
-    ds = geardyn.simulate(model,
-                          run=geardyn.RunSettings(transient=0.0, samples=1, steps_per_period=64))
-    assert ds.attrs["unresolved_steps"] == 1
-    sw = geardyn.bifurcation(model, "c", [0.5 * h / N_EDGES, 2 * h],
-                             run=geardyn.RunSettings(transient=0.0, samples=2, steps_per_period=64))
-    np.testing.assert_array_equal(sw["unresolved_steps"].values, [1, 0])
-    two = geardyn.bifurcation(model, "c", [0.5 * h / N_EDGES],
-                              run=geardyn.RunSettings(transient=0.0, samples=2,
-                                                      steps_per_period=64), starts=2, spread=0.0)
-    assert int(two["unresolved_steps"].values[0]) == 2  # both starts
-    mp = geardyn.map2d(model, ("c", [0.5 * h / N_EDGES, 2 * h]), ("Omega", [2 * math.pi]),
-                       run=geardyn.RunSettings(transient=0.0, samples=2, steps_per_period=64))
-    np.testing.assert_array_equal(mp["unresolved_steps"].values, [[1, 0]])
+    """The model of tests/levels_model.py crosses more levels than the split limit inside one
+    grid step twice per forcing period (analytic motion), so each such step falls back unsplit;
+    every result must say so, lane by lane: 2 per period run, 0 in a lane whose x stays below
+    the levels (B_BELOW)."""
+    model = levels_model()
+    run = dataclasses.replace(RUN, transient=0.0, samples=2)
+    per_run = 2 * run.samples  # two steps per period at the limit, samples periods run
+    ds = geardyn.simulate(model.with_params(Omega=1.1), run=run)
+    assert ds.attrs["transient_periods"] == 0 and ds.attrs["periods"] == run.samples
+    assert ds.attrs["unresolved_steps"] == per_run
+    sw = geardyn.bifurcation(model.with_params(Omega=1.1), "B", [0.0, B_BELOW], run=run)
+    np.testing.assert_array_equal(sw["unresolved_steps"].values, [per_run, 0])
+    two = geardyn.bifurcation(model.with_params(Omega=1.1), "B", [0.0], run=run, starts=2,
+                              spread=0.0)
+    assert int(two["unresolved_steps"].values[0]) == 2 * per_run  # both starts
+    mp = geardyn.map2d(model, ("B", [0.0, B_BELOW]), ("Omega", [1.1]), run=run)
+    np.testing.assert_array_equal(mp["unresolved_steps"].values, [[per_run, 0]])
 
 
 def test_reproduction_report_counts_unresolved_steps(tmp_path):

@@ -5,6 +5,7 @@ nor after a first run (geardyn's compile-time warning filters are scoped to its 
 
 from __future__ import annotations
 
+import functools
 import json
 import os
 import subprocess
@@ -76,9 +77,17 @@ def _run(code: str, env: dict[str, str], *args: str) -> object:
     return json.loads(out.stdout.strip().splitlines()[-1])
 
 
+@functools.cache
+def _dependencies(mode: str) -> list[str]:
+    """The modules of :data:`_DEPENDENCIES` under the caller's settings less :data:`_SETTINGS`,
+    one probe per mode for every test here: a module that geardyn imported only under another
+    width or cache setting would not be imported before the probe's first state, so its
+    import-time changes would show as geardyn's (a failure, not a change hidden)."""
+    return _run(_DEPENDENCIES, {}, mode)
+
+
 def _states(env: dict[str, str], mode: str) -> dict:
-    dependencies = _run(_DEPENDENCIES, env, mode)
-    return _run(_PROBE, env, mode, json.dumps(dependencies))
+    return _run(_PROBE, env, mode, json.dumps(_dependencies(mode)))
 
 
 def _changes(a: dict, b: dict) -> dict:

@@ -212,9 +212,25 @@ def atan_rhs(t, y, p, s, c):
     return (y[1], -p.k * math.atan2(y[0], 1.0) - 0.1 * y[1] + p.F * c)
 
 
-def test_a_rhs_the_duals_cannot_take_is_named():
+def test_a_rhs_the_duals_cannot_take_is_named(monkeypatch):
+    """Refused naming ``settings.tangent``, numba's typing error (the operation) chained, by the
+    tangent form alone: no function of the model's Lyapunov kernel or step core is compiled
+    first (no compile-ahead helper: it would compile the core's split step meanwhile)."""
+    from geardyn.solvers.kernels import CORE
+
+    monkeypatch.setenv("GEARDYN_COMPILE_AHEAD", "0")
     m = geardyn.UserModel.from_one_form(atan_rhs, params={"k": 1.0, "F": 0.2, "Omega": 1.1},
                                         states=("x", "v"), initial_state=(0.1, 0.0))
     with pytest.raises(geardyn.errors.ParameterError, match="settings.tangent") as info:
         geardyn.lyapunov(m, settings=geardyn.LyapunovSettings(duration=20.0))
     assert "atan2" in str(info.value.__cause__)
+    with pytest.raises(geardyn.errors.ParameterError, match="settings.tangent") as info:
+        geardyn.lyapunov_lanes(m, m.lane_params("Omega", [1.1]),
+                               settings=geardyn.LyapunovSettings(duration=20.0))
+    assert "atan2" in str(info.value.__cause__)
+    compiled = [f"{mod.__name__}.{name}" for mod in (kernels_for(m.kernel, "lyapunov"),
+                                                     kernels_for(m.kernel, CORE))
+                for name, fn in vars(mod).items()
+                if isinstance(fn, nb.core.registry.CPUDispatcher)
+                and fn.py_func.__module__ == mod.__name__ and fn.overloads]
+    assert compiled == []

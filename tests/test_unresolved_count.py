@@ -1,9 +1,8 @@
 """The count of steps that reached the edge-split limit (``unresolved``) is kept by every path.
 
-A one-form model whose coordinate x = sin(Omega t) + B (1 - cos(Omega t)) crosses 18 close
-levels (switching functions x - L_j, L_j in [0.05, 0.072]) within one grid step twice per
-forcing period: more distinct crossings than the split limit (MAX_SPLITS = 16), so every such
-step falls back unsplit and counts once. The expected count is 2 per period run, from the
+The one-form model of tests/levels_model.py crosses 18 close levels within one grid step twice
+per forcing period: more distinct crossings than the split limit (MAX_SPLITS = 16), so every
+such step falls back unsplit and counts once. The expected count is 2 per period run, from the
 analytic motion (x' does not depend on x). The sweep's fused block loop is checked in its three
 lane forms (FORM_QUIET: B = 0; FORM_LOAD: B != 0; FORM_GENERAL: a chain of lanes of both), and
 the one-lane path (``simulate``, the trajectory kernel). numba's dead-code elimination dropped
@@ -13,7 +12,6 @@ the fused loop's store of this count (an array unpacked from a tuple argument, s
 
 from __future__ import annotations
 
-import dataclasses
 import math
 
 import numba as nb
@@ -23,45 +21,10 @@ from numba.extending import overload
 
 import geardyn
 from geardyn._jit_target import WidthCompiler
-from geardyn.core.one_form import loud
 from geardyn.solvers.ensemble import run_lanes
 from geardyn.solvers.kernels import kernels_for
+from levels_model import B_BELOW, LEVELS, RUN, levels_model
 
-#: The levels: closer than one grid step of x at the passages through them (x' = Omega there).
-LEVELS = tuple(0.05 + 0.00125 * j for j in range(18))
-L = LEVELS
-
-
-@nb.njit(cache=True)
-def levels_rhs(t, y, p, s, c):
-    """x' = Omega (cos + B sin): x = sin(Omega t) + B (1 - cos(Omega t)) from x(0) = 0."""
-    v = c
-    if loud(p):
-        v += p.B * s
-    return (p.Omega * v,)
-
-
-@nb.njit(cache=True)
-def levels_events(t, y, p, s, c):
-    x = y[0]
-    return (x - L[0], x - L[1], x - L[2], x - L[3], x - L[4], x - L[5], x - L[6], x - L[7],
-            x - L[8], x - L[9], x - L[10], x - L[11], x - L[12], x - L[13], x - L[14],
-            x - L[15], x - L[16], x - L[17])
-
-
-def levels_model() -> geardyn.UserModel:
-    """The model above, B a quiet coefficient (lanes with B = 0 take FORM_QUIET)."""
-    model = geardyn.UserModel.from_one_form(
-        levels_rhs, params={"Omega": 1.0, "B": 0.0}, states=("x",), events=levels_events,
-        event_names=tuple(f"x-L{j}" for j in range(len(LEVELS))), name="levels")
-    form = dataclasses.replace(model.kernel.one_form, quiet=("B",))
-    model.kernel = dataclasses.replace(model.kernel, one_form=form)
-    return model
-
-
-#: 32 steps per period: each passage through the levels (Omega t within 0.08 of 0 or pi, B <=
-#: 0.01) lies inside one grid step.
-RUN = geardyn.RunSettings(transient=20.0, samples=6, steps_per_period=32, locate_edges=True)
 OMEGAS = np.array([0.8, 1.1, 1.4, 1.7])
 
 
@@ -87,6 +50,9 @@ def test_the_levels_are_crossed_in_one_step_twice_per_period():
             assert up.size == 1 and down.size == 1
             assert 0.0 < up[0] < step  # in the first grid step of a period
             assert math.pi - step < down[0] < math.pi  # in the step ending at half a period
+    # B_BELOW (tests/test_grazing.py's lane without crossings): x stays below every level
+    x = np.sin(theta) + B_BELOW * (1.0 - np.cos(theta))
+    assert x.max() < min(LEVELS)
 
 
 def test_sweep_counts_every_step_at_the_split_limit_in_each_lane_form():

@@ -40,6 +40,7 @@ from geardyn.core.settings import (
 )
 from geardyn.core.status import Status
 from geardyn.errors import ParameterError
+from geardyn.solvers.compile_share import signature_types
 from geardyn.solvers.kernels import kernels_for
 
 #: The defaults' earlier names here (deprecated): those of :mod:`geardyn.core.settings`.
@@ -145,6 +146,23 @@ def _dual_typing(variational: bool, ls: LyapunovSettings) -> Iterator[None]:
                              "the model's one-form rhs does not take dual numbers (an operation "
                              "geardyn.core.dual lacks: see the chained error); give "
                              "'difference'") from exc
+
+
+#: The argument types the variational kernels' ``rhs_tangent`` (t, y, v, dy, dv, p, s, c; see
+#: :func:`geardyn.core.one_form.tangent_adapters`) is called with in the Lyapunov kernel (a
+#: tuple of types: numba keys its disk cache by the signature as given, so that a text would
+#: miss the kernel's cached compile).
+_TANGENT_SIGNATURE = signature_types("(float64, float64[::1], float64[::1], float64[::1], "
+                                     "float64[::1], float64[::1], float64, float64)")
+
+
+def _check_duals(model: Model, variational: bool, ls: LyapunovSettings) -> None:
+    """Where the tangent is variational, the model's tangent form of its rhs compiled alone
+    first (as the kernel calls it; cached like the kernel's functions), so that a one-form rhs
+    the dual numbers cannot take is refused (:func:`_dual_typing`) before any kernel compiles."""
+    if variational:
+        with _dual_typing(True, ls):
+            kernels_for(model.kernel, "lyapunov").rhs_tangent.compile(_TANGENT_SIGNATURE)
 
 
 def lyapunov_tangent(variational: bool) -> str:
@@ -313,6 +331,7 @@ def lyapunov(
     in_periods = _periods_transient(model, run, keywords)
     run, ls = _lyapunov_run(run, settings, keywords, "lyapunov")
     variational = lyapunov_variational(model, ls)
+    _check_duals(model, variational, ls)
     steps_per_period, bound = run.steps_per_period, run.bound
     dt, renorm_every, n_blocks = ls.dt, ls.renorm_every, ls.n_blocks
     duration, rule = _duration(model, ls)
@@ -406,6 +425,7 @@ def lyapunov_lanes(
     in_periods = _periods_transient(model, run, keywords)
     run, ls = _lyapunov_run(run, settings, keywords, "lyapunov_lanes")
     variational = lyapunov_variational(model, ls)
+    _check_duals(model, variational, ls)
     steps_per_period, bound = run.steps_per_period, run.bound
     dt, renorm_every, n_blocks = ls.dt, ls.renorm_every, ls.n_blocks
     duration, _ = _duration(model, ls)
