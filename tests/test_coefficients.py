@@ -298,11 +298,13 @@ def test_capabilities_are_declared_not_probed():
     probed = _Probed(user_model().kernel.rhs, n_states=2, params=[1.0, 0.1],
                      param_names=("Omega", "zeta"))
     assert probed.capabilities == Capabilities()
-    assert model_attrs(probed) == {}  # the old hasattr probes recorded omega_n = 123
+    # the old hasattr probes recorded omega_n = 123; only the engine's own kernel path is added
+    assert model_attrs(probed) == {"kernel_path": "per-lane"}
     assert physical_axes(probed, np.array([1.0])) is None
     assert deflection_units(probed) == {"units": "1"}
     device = MODELS["catt-reduced"]
-    assert model_attrs(device) == {"interpretation": "consistent", "omega_n": device.omega_n}
+    assert model_attrs(device) == {"interpretation": "consistent", "omega_n": device.omega_n,
+                                   "kernel_path": "lane-form"}
     assert device.capabilities.frequency_scale and device.capabilities.paper_device
     axes = physical_axes(MODELS["dimensional"], np.array([2 * math.pi * 26.0]))
     assert axes is not None and axes["mesh_frequency"][0][0] == pytest.approx(26.0)

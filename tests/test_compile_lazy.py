@@ -20,6 +20,7 @@ import pytest
 
 import geardyn
 from geardyn.core.kernel_source import FORM_GENERAL, FORM_LOAD, FORM_QUIET
+from geardyn.solvers import _step_shared
 from geardyn.solvers.kernels import TEMPLATES, kernels_for
 
 
@@ -40,8 +41,12 @@ def test_templates_share_one_core_module_per_model():
     model = geardyn.GearPair(Omega=1.3, kappa=0.2, Fa=0.2)
     mods = [kernels_for(model.kernel, t) for t in TEMPLATES if t != "core"]
     core = kernels_for(model.kernel, "core")
-    for name in ("_split_step", "_rows_step", "phase_table", "_rk4_stages"):
+    for name in ("_split_step", "_rows_step", "_rk4_stages"):
         assert all(getattr(m, name) is getattr(core, name) for m in mods), name
+    # the model-independent step functions: one for every model, from where they are defined
+    shared = _step_shared.phase_table
+    assert any(hasattr(m, "phase_table") for m in mods)
+    assert all(getattr(m, "phase_table", shared) is shared for m in mods)
     # and another model has its own
     other = kernels_for(paper_device().kernel, "core")
     assert other is not core and other._split_step is not core._split_step

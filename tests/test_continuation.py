@@ -121,7 +121,7 @@ def test_fast_load_fluctuation_sets_the_step():
 
 
 @pytest.mark.parametrize("sweep,message", [
-    (dict(direction="sideways"), "direction must be 'up' or 'down'"),
+    (dict(direction="sideways"), "direction: must be one of up, down"),
     (dict(values=[]), "values: give at least one"),
     (dict(values=[0.5, float("nan")]), "values: must be finite"),
 ])
