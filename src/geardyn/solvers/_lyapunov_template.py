@@ -95,20 +95,27 @@ from geardyn.solvers._step_core import (  # CORE-IMPORT
     FUSED,
     GBUF_ROWS,
     GRAZE_ROW,
+    MAX_SPLITS,
+    SIMULTANEOUS,
     STATUS_DIVERGED,
     STATUS_OK,
     STATUS_SPLIT_LIMIT,
     _events_columns,
     _events_i,
     _events_l,
+    _first_crossing,
     _healthy,
+    _interpolant_events,
     _lane_form,
     _leaves_side_step,
     _padded,
+    _phase_at,
     _pick,
     _rhs_columns,
     _rhs_l,
     _side,
+    _split_copy,
+    _split_rhs,
     _split_step,
     _t_axpy,
     _t_comb,
@@ -168,9 +175,349 @@ if VARIATIONAL:
             y1[q] = rk4_comb(y[q], h6, KS[0, q], KS[1, q], KS[2, q], KS[3, q])
             w1[q] = rk4_comb(w[q], h6, KV[0, q], KV[1, q], KV[2, q], KV[3, q])
 
+    # A split step's tangent: the state is split at its crossings as :func:`_split_step` splits
+    # it (the same operations: the same state, bitwise) and each tangent vector w follows its
+    # sub-steps by the variational RK4, the Jacobian of every stage taken on the sides of the
+    # sub-step (forced: a stage point that lies beyond an edge, by the O(h^3) of the crossing
+    # found on the trial step's interpolant, is moved back onto its side along the orbit,
+    # :func:`_side_point`); at each split point x, where the orbit's numerical crossing lies
+    # g(x) / g'(x) before or after x (g the edge crossed, g' its rate along the orbit), the
+    # tangent is moved to it: w -= (g / g') (J_before - J_after) w (:func:`_var_correct`).
+    # Together O(h^4), as the unsplit steps (bench/split_tangent_order.py). A step where this
+    # is ill-posed (two edges crossed at once, a point that cannot be moved onto its side within
+    # FORCE_SPAN, the split limit) is taken by the difference rows (:func:`_tangent_step`) and
+    # counted. Scratch VX (9 + 7 (m - 1) rows of the state's size): 0 the state, 1 its trial,
+    # 2 a stage point, 3 a forced point, 4 a discarded f, 5-8 the stages' f, then per tangent
+    # vector j from 9 + 7 j: w, its trial, a stage's w, the stages' J w; VG (3 rows of the
+    # events' size): events, events, each event's margin.
+
+    #: A point moved onto a side lies there by FORCE_MARGIN max(|g0|, |g1|) (g0, g1 the event at
+    #: the grid step's start and trial end).
+    FORCE_MARGIN = 2.0 ** -30
+    #: The step along f, as a fraction of the grid step, of an event's rate along the orbit.
+    RATE_STEP = 2.0 ** -18
+    #: The furthest a point is moved along the orbit onto a side, and the longest shift g / g'
+    #: of a split point, as fractions of the grid step; beyond, the difference rows.
+    FORCE_SPAN = 0.25
+
+    @nb.njit(_nrt=False, **_JIT)  # it allocates nothing: no reference counting of its views
+    def _side_point(ts, ys, fs, ss, cs, p, side, jx, want_x, M, h, g, g2, TP):
+        """A point near the stage point ys (time ts, phase ss, cs, f(ys) = fs) on the sides
+        ``side`` of every event (event jx, where >= 0, on side want_x instead) into TP: ys
+        itself where it lies there, else ys + tau fs, the one event off its side moved to
+        within its margin M (tau from the event's rate along fs). Returns (ok, moved); not ok
+        where two events lie off their sides or tau exceeds FORCE_SPAN h."""
+        ns = ys.size
+        _events_i(ts, ys, g, p, ss, cs)
+        bad = -1
+        nbad = 0
+        for j in range(M.size):
+            want = want_x if j == jx else side[j]
+            if _side(g[j]) != want:
+                bad = j
+                nbad += 1
+        if nbad == 0:
+            for q in range(ns):
+                TP[q] = ys[q]
+            return True, False
+        if nbad > 1:
+            return False, False
+        want = want_x if bad == jx else side[bad]
+        tau0 = RATE_STEP * h
+        for q in range(ns):
+            TP[q] = ys[q] + tau0 * fs[q]
+        _events_i(ts, TP, g2, p, ss, cs)
+        tau = (want * M[bad] - g[bad]) / ((g2[bad] - g[bad]) / tau0)
+        if not abs(tau) <= FORCE_SPAN * h:
+            return False, False
+        for q in range(ns):
+            TP[q] = ys[q] + tau * fs[q]
+        _events_i(ts, TP, g2, p, ss, cs)
+        for j in range(M.size):
+            want = want_x if j == jx else side[j]
+            if _side(g2[j]) != want:
+                return False, False
+        return True, True
+
+    @nb.njit(_nrt=False, **_JIT)  # it allocates nothing: no reference counting of its views
+    def _var_sub(ys, k1, hs, t, tm, sm, cm, te, se, ce, s1, c1, p, side, m1, h, trial, VX, VG):
+        """One RK4 sub-step of size hs from ys (time t, phase s1, c1, f(ys) = k1; middle stages
+        at tm, sm, cm, the last at te, se, ce) of the state, as :func:`_rk4_stages` takes it
+        (the same operations), into VX[1] (``trial``) or VX[0], and of each tangent vector
+        (VX[9 + 7 j]) into its trial row or in place, every stage's J w on the sides ``side``
+        (:func:`_side_point`). Returns False where a stage could not be put on its sides."""
+        ns = ys.size
+        TMP = VX[2]
+        TP = VX[3]
+        FB = VX[4]
+        KS = VX[5:9]
+        g = VG[0]
+        g2 = VG[1]
+        M = VG[2]
+        out = VX[1] if trial else VX[0]
+        hh = 0.5 * hs
+        ok, moved = _side_point(t, ys, k1, s1, c1, p, side, -1, 0, M, h, g, g2, TP)
+        for j in range(m1):
+            b = 9 + 7 * j
+            _rhs_t(t, TP, VX[b], FB, VX[b + 3], p, s1, c1)
+        for q in range(ns):
+            KS[0, q] = k1[q]
+        for st in range(1, 4):
+            a = hs if st == 3 else hh
+            ts = tm
+            ss = sm
+            cs = cm
+            if st == 3:
+                ts = te
+                ss = se
+                cs = ce
+            for q in range(ns):
+                TMP[q] = ys[q] + a * KS[st - 1, q]
+            for j in range(m1):
+                b = 9 + 7 * j
+                for q in range(ns):
+                    VX[b + 2, q] = VX[b, q] + a * VX[b + 2 + st, q]
+            _rhs_t(ts, TMP, VX[11], KS[st], VX[12 + st], p, ss, cs)
+            ok_s, moved = _side_point(ts, TMP, KS[st], ss, cs, p, side, -1, 0, M, h, g, g2, TP)
+            ok = ok & ok_s
+            for j in range(m1):
+                if j > 0 or moved:
+                    b = 9 + 7 * j
+                    _rhs_t(ts, TP, VX[b + 2], FB, VX[b + 3 + st], p, ss, cs)
+        h6 = rk4_sixth(hs)
+        for q in range(ns):
+            out[q] = rk4_comb(ys[q], h6, KS[0, q], KS[1, q], KS[2, q], KS[3, q])
+        for j in range(m1):
+            b = 9 + 7 * j
+            wo = VX[b + 1] if trial else VX[b]
+            for q in range(ns):
+                wo[q] = rk4_comb(VX[b, q], h6, VX[b + 3, q], VX[b + 4, q], VX[b + 5, q],
+                                 VX[b + 6, q])
+        return ok
+
+    @nb.njit(_nrt=False, **_JIT)  # it allocates nothing: no reference counting of its views
+    def _var_correct(t, x, f, u, s, c, p, side, jx, m1, h, pc, VX, VG):
+        """Each tangent vector (VX[9 + 7 j]) moved from the split point x (time t, the fraction
+        u of grid step, phase s, c, f(x) = f) to the orbit's crossing of event jx (just
+        crossed: side[jx] is the side after it): w -= (g / g') (J_before - J_after) w, g the
+        event at x, g' its rate along the orbit (a forward difference over RATE_STEP h, the
+        phase by angle addition), J_before and J_after at x on either side of the edge
+        (:func:`_side_point`). Returns False where |g / g'| > FORCE_SPAN h or a side cannot
+        be forced."""
+        sa, ca, wh, i_mod = pc
+        ns = x.size
+        TMP = VX[2]
+        TP = VX[3]
+        FB = VX[4]
+        g = VG[0]
+        g2 = VG[1]
+        M = VG[2]
+        _events_i(t, x, g, p, s, c)
+        gx = g[jx]
+        tau0 = RATE_STEP * h
+        for q in range(ns):
+            TMP[q] = x[q] + tau0 * f[q]
+        s2, c2 = _phase_at(sa, ca, wh, i_mod, u + RATE_STEP)
+        _events_i(t + tau0, TMP, g2, p, s2, c2)
+        shift = gx / ((g2[jx] - gx) / tau0)
+        if not abs(shift) <= FORCE_SPAN * h:
+            return False
+        after = side[jx]
+        ok, moved = _side_point(t, x, f, s, c, p, side, jx, -after, M, h, g, g2, TP)
+        if not ok:
+            return False
+        for j in range(m1):
+            b = 9 + 7 * j
+            _rhs_t(t, TP, VX[b], FB, VX[b + 2], p, s, c)
+        ok, moved = _side_point(t, x, f, s, c, p, side, jx, after, M, h, g, g2, TP)
+        if not ok:
+            return False
+        for j in range(m1):
+            b = 9 + 7 * j
+            _rhs_t(t, TP, VX[b], FB, VX[b + 3], p, s, c)
+            for q in range(ns):
+                VX[b, q] = VX[b, q] - shift * (VX[b + 2, q] - VX[b + 3, q])
+        return True
+
+    @nb.njit(_nrt=False, **_JIT)  # it allocates nothing: no reference counting of its views
+    def _var_split(i, t0, m1, p, h, omega, n_per, sa, ca, s_end, c_end, side, g1, ncross, work,
+                   gbuf, VX, VG):
+        """:func:`_split_step` of the state in VX[0] (its unsplit trial in VX[1], the tangent
+        vectors' unforced trials in their trial rows), operation for operation, with the tangent
+        vectors carried through its sub-steps (:func:`_var_sub`) and moved at each split point
+        (:func:`_var_correct`; see above). Returns 0 when done (state and tangent vectors in
+        VX[0] and their rows), 1 where the step is to be taken by the difference rows."""
+        n_ev = g1.size
+        ns = VX.shape[1]
+        y = VX[0]
+        y_trial = VX[1]
+        k1 = work[0]
+        f1 = work[5]
+        ystart = work[6]
+        ybuf = work[8]
+        g0 = gbuf[0]
+        gsc = gbuf[1]
+        g13 = gbuf[3]
+        g23 = gbuf[4]
+        u = 0.0
+        i_mod = i % n_per
+        wh = omega * h
+        pc = (sa, ca, wh, i_mod)
+        t_end = t0 + (i + 1) * h
+        s0 = sa
+        c0 = ca
+        crossed = -1  # the event crossed at the split point y (corrected at the next start)
+        ok = True
+        finished = False
+        for _ in range(MAX_SPLITS):
+            t = t0 + (i + u) * h
+            dt = (1.0 - u) * h
+            _split_rhs(t, y, k1, p, s0, c0)
+            if crossed >= 0 and not _var_correct(t, y, k1, u, s0, c0, p, side, crossed, m1, h,
+                                                 pc, VX, VG):
+                return 1
+            graze = False
+            need = False
+            for j in range(n_ev):
+                flag = gbuf[GRAZE_ROW, j] != 0.0
+                graze = graze or flag
+                need = need or flag or _side(g1[j]) != side[j]
+            ok = True
+            if u > 0.0:
+                sm, cm = _phase_at(sa, ca, wh, i_mod, 0.5 * (1.0 + u))
+                ok = _var_sub(y, k1, dt, t, t + 0.5 * dt, sm, cm, t + dt, s_end, c_end, s0, c0,
+                              p, side, m1, h, True, VX, VG)
+                _events_i(t_end, y_trial, g1, p, s_end, c_end)
+                need = graze
+                for j in range(n_ev):
+                    need = need or _side(g1[j]) != side[j]
+            if not need:
+                finished = True
+                break
+            _split_rhs(t_end, y_trial, f1, p, s_end, c_end)
+            _split_copy(ystart, y)
+            pcs = (sa, ca, wh, i_mod, u, 1.0 - u)
+            _interpolant_events(ystart, k1, y_trial, f1, dt, t, p, ybuf, g0, g13, g23, pcs)
+            first = -1
+            theta = 2.0
+            for j in range(n_ev):
+                flag = gbuf[GRAZE_ROW, j] != 0.0
+                if flag or _side(g1[j]) != side[j]:
+                    th = _first_crossing(j, side[j], flag, g1[j], ystart, k1, y_trial, f1, dt,
+                                         t, p, ybuf, gbuf, gsc, pcs)
+                else:
+                    th = 2.0
+                gbuf[2, j] = th
+                if th < theta:
+                    theta = th
+                    first = j
+            if first < 0:
+                finished = True
+                break
+            tm = u + 0.5 * theta * (1.0 - u)
+            tu = u + theta * (1.0 - u)
+            sm, cm = _phase_at(sa, ca, wh, i_mod, tm)
+            s1, c1 = _phase_at(sa, ca, wh, i_mod, tu)
+            hs = theta * dt
+            if not _var_sub(ystart, k1, hs, t, t + 0.5 * hs, sm, cm, t + hs, s1, c1, s0, c0,
+                            p, side, m1, h, False, VX, VG):
+                return 1
+            n_cross = 0
+            for j in range(n_ev):
+                if gbuf[2, j] <= theta + SIMULTANEOUS:
+                    side[j] = -side[j]
+                    ncross[j] += 1
+                    n_cross += 1
+                    crossed = j
+            if n_cross != 1:
+                return 1
+            s0 = s1
+            c0 = c1
+            u = tu
+            if u >= 1.0:
+                _events_i(t_end, y, g1, p, s_end, c_end)
+                t = t0 + (i + u) * h
+                _split_rhs(t, y, k1, p, s0, c0)
+                if not _var_correct(t, y, k1, u, s0, c0, p, side, crossed, m1, h, pc, VX, VG):
+                    return 1
+                return 0
+        if not finished:
+            return 1  # the split limit: the difference rows take the step (and count it)
+        # the (rest of the) step's trial taken: the first's tangent unforced, as an unsplit
+        # step's; a later one's forced onto the sides after the crossing
+        if not ok:
+            return 1
+        for q in range(ns):
+            y[q] = y_trial[q]
+        for j in range(m1):
+            b = 9 + 7 * j
+            for q in range(ns):
+                VX[b, q] = VX[b + 1, q]
+        return 0
+
+    @nb.njit(_nrt=False, **_JIT)  # it allocates nothing: no reference counting of its views
+    def _var_split_lane(i, t0, Z, S, IS, p, h, omega, n_per, s_tab, c_tab, n_ev, YP, E, K, TMP,
+                        Y1, SIDE, G0, G1, W, gbuf, NCR, UNRES, VX, VG):
+        """Grid step i of one lane (state Z[0], tangent vectors Z[1..] in z = y / S) whose
+        variational trial leaves a side of an edge or may graze one: the trial and its screen
+        redone (as :func:`_var_step` takes them), the state split at its crossings and the
+        tangent vectors carried through the sub-steps (:func:`_var_split`); where that is
+        ill-posed, the step by the difference rows (:func:`_tangent_step`). Returns 1 where
+        the step took the difference rows, else 0. Scratch as :func:`_var_step`'s, VX, VG (see
+        above)."""
+        m, ns = Z.shape
+        m1 = m - 1
+        t = t0 + i * h
+        hh = 0.5 * h
+        j0 = 2 * (i % n_per)
+        y = VX[0]
+        for q in range(ns):
+            y[q] = Z[0, q]
+        for j in range(m1):
+            b = 9 + 7 * j
+            for q in range(ns):
+                VX[b, q] = S[q] * Z[j + 1, q]
+            _var_trial(t, hh, h, y, VX[b], p, s_tab[j0], c_tab[j0], s_tab[j0 + 1],
+                       c_tab[j0 + 1], s_tab[j0 + 2], c_tab[j0 + 2], VX[5:9], VX[b + 3:b + 7],
+                       VX[2], VX[b + 2], VX[1], VX[b + 1])
+        for q in range(ns):
+            YP[0, q] = y[q]
+            K[0, 0, q] = VX[5, q]
+        _events_i(t, y, G0[0], p, s_tab[j0], c_tab[j0])
+        for j in range(n_ev):
+            SIDE[0, j] = _side(G0[0, j])
+        _events_i(t + h, VX[1], G1[0], p, s_tab[j0 + 2], c_tab[j0 + 2])
+        code = 0
+        if _leaves_side_step(0, t, t + h, YP, K[0], G0, G1, SIDE, p, W[8], gbuf,
+                             s_tab[j0 + 2], c_tab[j0 + 2]):
+            for j in range(n_ev):
+                VG[2, j] = FORCE_MARGIN * max(abs(G0[0, j]), abs(G1[0, j]))
+            code = _var_split(i, t0, m1, p, h, omega, n_per, s_tab[j0], c_tab[j0],
+                              s_tab[j0 + 2], c_tab[j0 + 2], SIDE[0], G1[0], NCR[0], W, gbuf,
+                              VX, VG)
+        else:
+            for q in range(ns):
+                y[q] = VX[1, q]
+            for j in range(m1):
+                b = 9 + 7 * j
+                for q in range(ns):
+                    VX[b, q] = VX[b + 1, q]
+        if code:
+            _tangent_step(i, t0, Z, S, IS, p, h, omega, n_per, s_tab, c_tab, n_ev, YP, E, K,
+                          TMP, Y1, SIDE, G0, G1, W, gbuf, NCR, UNRES)
+            return 1
+        for j in range(m1):
+            b = 9 + 7 * j
+            for q in range(ns):
+                Z[j + 1, q] = VX[b, q] * IS[q]
+        for q in range(ns):
+            Z[0, q] = y[q]
+        return 0
+
     @nb.njit(_nrt=False, **_JIT)  # it allocates nothing
     def _var_step(i, t0, Z, S, IS, p, h, omega, n_per, s_tab, c_tab, n_ev, YP, E, K, TMP,
-                  Y1, SIDE, G0, G1, W, gbuf, NCR, UNRES, VW):
+                  Y1, SIDE, G0, G1, W, gbuf, NCR, UNRES, VW,
+                  VX, VG):
         """Advance the state y (row 0 of Z) by grid step i and each tangent vector v (rows 1..,
         in z = y / S) by the exact derivative of the RK4 step map: the variational RK4
         (:func:`_var_trial`, w = S v). A step whose state leaves a side of an edge (or may graze
@@ -205,9 +552,9 @@ if VARIATIONAL:
             _events_i(t + h, Y1[last], G1[last], p, s_tab[j0 + 2], c_tab[j0 + 2])
             if _leaves_side_step(last, t, t + h, YP, K[0], G0, G1, SIDE, p, W[8], gbuf,
                                  s_tab[j0 + 2], c_tab[j0 + 2]):
-                _tangent_step(i, t0, Z, S, IS, p, h, omega, n_per, s_tab, c_tab, n_ev, YP, E,
-                              K, TMP, Y1, SIDE, G0, G1, W, gbuf, NCR, UNRES)
-                return 1
+                return _var_split_lane(i, t0, Z, S, IS, p, h, omega, n_per, s_tab, c_tab,
+                                       n_ev, YP, E, K, TMP, Y1, SIDE, G0, G1, W, gbuf, NCR,
+                                       UNRES, VX, VG)
         for j in range(1, m):
             for q in range(ns):
                 Z[j, q] = WN[j, q] * IS[q]
@@ -218,7 +565,15 @@ if VARIATIONAL:
 else:
     @nb.njit(**_JIT)
     def _var_step(i, t0, Z, S, IS, p, h, omega, n_per, s_tab, c_tab, n_ev, YP, E, K, TMP,
-                  Y1, SIDE, G0, G1, W, gbuf, NCR, UNRES, VW):
+                  Y1, SIDE, G0, G1, W, gbuf, NCR, UNRES, VW, VX, VG):
+        """A model without tangent forms has no variational step (its callers refuse)."""
+        if n_ev >= 0:
+            raise ValueError("this model has no tangent form of its rhs (no one form)")
+        return 0
+
+    @nb.njit(**_JIT)
+    def _var_split_lane(i, t0, Z, S, IS, p, h, omega, n_per, s_tab, c_tab, n_ev, YP, E, K, TMP,
+                        Y1, SIDE, G0, G1, W, gbuf, NCR, UNRES, VX, VG):
         """A model without tangent forms has no variational step (its callers refuse)."""
         if n_ev >= 0:
             raise ValueError("this model has no tangent form of its rhs (no one form)")
@@ -264,6 +619,8 @@ def _run(p, y0, S, t0, h, omega, n_per, s_tab, c_tab, n_transient, n_steps, reno
     blk = np.zeros((nbk, k))  # log stretch per block of the measuring window
     C = np.zeros((m, ns))
     VW = np.zeros((10 + m, ns))
+    VX = np.zeros((9 + 7 * k, ns))
+    VG = np.zeros((3, ne))
     n_fd = 0
     out = np.full(k, np.nan)
     err = np.full(k, np.nan)
@@ -281,7 +638,7 @@ def _run(p, y0, S, t0, h, omega, n_per, s_tab, c_tab, n_transient, n_steps, reno
     for i in range(total):
         if variational:
             n_fd += _var_step(i, t0, Z, S, IS, p, h, omega, n_per, s_tab, c_tab, n_ev, YP, E, K,
-                              TMP, Y1, SIDE, G0, G1, W, gbuf, NCR, UNRES, VW)
+                              TMP, Y1, SIDE, G0, G1, W, gbuf, NCR, UNRES, VW, VX, VG)
         else:
             _tangent_step(i, t0, Z, S, IS, p, h, omega, n_per, s_tab, c_tab, n_ev, YP, E, K,
                           TMP, Y1, SIDE, G0, G1, W, gbuf, NCR, UNRES)
@@ -1152,7 +1509,7 @@ def _var_flagged(i, nl, first, n_ev, P, Z0, Z1, S, IS, T0L, HL, OMEGA, NPL, IDX,
     """The flagged lanes of step i (:func:`_var_fused_steps`) by the difference rows, each as
     :func:`_var_step` takes such a step (:func:`_tangent_step` from the lane's state and
     tangent vector; its rows' split-limit steps into UNRR[l], the step counted in FDL[l])."""
-    Zl, YP, E, K, TMP, Y1, SIDE, G0, G1, W, gbuf, NCR, UNRES = fd
+    Zl, YP, E, K, TMP, Y1, SIDE, G0, G1, W, gbuf, NCR, UNRES, VX, VG = fd
     ns = Zl.shape[1]
     for l in range(nl):
         if FLAG[l] == 0.0:
@@ -1164,13 +1521,14 @@ def _var_flagged(i, nl, first, n_ev, P, Z0, Z1, S, IS, T0L, HL, OMEGA, NPL, IDX,
         off = IDX[l] - 2 * (i % NPL[l])  # the lane's phase table in S_TAB, C_TAB
         for r in range(UNRES.size):
             UNRES[r] = 0
-        _tangent_step(i, T0L[l], Zl, S, IS, P[lane], HL[l], OMEGA[lane], NPL[l], S_TAB[off:],
-                      C_TAB[off:], n_ev, YP, E, K, TMP, Y1, SIDE, G0, G1, W, gbuf, NCR, UNRES)
+        fd_l = _var_split_lane(i, T0L[l], Zl, S, IS, P[lane], HL[l], OMEGA[lane], NPL[l],
+                               S_TAB[off:], C_TAB[off:], n_ev, YP, E, K, TMP, Y1, SIDE, G0, G1,
+                               W, gbuf, NCR, UNRES, VX, VG)
         for q in range(ns):
             Z0[q * BLOCK + l] = Zl[0, q]
             Z1[q * BLOCK + l] = Zl[1, q]
         UNRR[l] += UNRES.sum()
-        FDL[l] += 1
+        FDL[l] += fd_l
 
 
 @nb.njit(inline="always", **_JIT)
@@ -1252,7 +1610,8 @@ def _lyap_block_var(form, first, nl, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB,
     fd = (np.zeros((2, ns)), np.zeros((3, ns)), np.zeros(2), np.zeros((4, 3, ns)),
           np.zeros((3, ns)), np.zeros((3, ns)), np.ones((3, ne), np.int64), np.zeros((3, ne)),
           np.zeros((3, ne)), np.zeros((9, ns)), np.zeros((GBUF_ROWS, ne)),
-          np.zeros((3, ne), np.int64), np.zeros(3, np.int64))
+          np.zeros((3, ne), np.int64), np.zeros(3, np.int64), np.zeros((16, ns)),
+          np.zeros((3, ne)))
     lanes = (Z0, Z1, ZT, T0L, HL, HHL, H6L, IDX, NPL, ENDL, PH, ACT, ACTR, FLAG, GR, UNRR, FDL)
     books = (IST, ENDS, BLK, ACC, Zl, Cl, logs)
     args = (first, nl, n_ev, max_total, due, renorm, bound, P, OMEGA, H, S, IS, PT, lanes, books,
