@@ -38,8 +38,18 @@ Numerics
   J w (dual numbers through the one form's rhs, :mod:`geardyn.core.dual`). That is the exact
   derivative of the RK4 step map (not a difference quotient of it), and the state is bitwise
   the difference rows' state row. A step whose state leaves a side of an edge (or may graze
-  one) is split at the crossing; that step is taken by the difference rows above (each row
-  split at its own crossing), and counted (``fd_steps``). No saltation term is needed across
+  one) is split at the crossing, the state as :func:`_split_step` splits it (the same
+  operations), and each tangent vector follows the state's sub-steps by the variational RK4,
+  every stage's J w taken on the sides of its sub-step (a stage point that lies beyond the
+  edge, by the O(h^3) of a crossing found on the trial step's interpolant, moved back onto its
+  side along f); at each split point x the tangent is moved to where the numerical orbit
+  crosses the edge, w -= (g(x) / g'(x)) (J_before - J_after) w (g the edge crossed, g' its rate
+  along the orbit, J on either side of it): without that the tangent switches sides O(h^3)
+  early or late at every crossing and the exponent is O(h^3), with it O(h^4)
+  (``bench/split_tangent_order.py``, ``tests/test_lyapunov_variational.py``). A split step
+  where that is ill-posed (two edges crossed at once, a point that cannot be put on its side
+  within a quarter step, the split limit) is taken by the difference rows above (each row
+  split at its own crossing) and counted (``fd_steps``). No saltation term is needed across
   an edge: the vector field is continuous there (the dead zone), so the flow is C^1, and
   ``min``/``max`` in the model give the derivative of the side they pick.
 * Every ``renorm_every`` steps (and at the end of the transient and of the run) the tangent
@@ -200,6 +210,16 @@ if VARIATIONAL:
     #: of a split point, as fractions of the grid step; beyond, the difference rows.
     FORCE_SPAN = 0.25
 
+    @nb.njit(inline="always", **_JIT)
+    def _off_sides(ts, ys, ss, cs, p, side, M, g):
+        """The number of events off their sides ``side`` at the point ys (time ts, phase ss,
+        cs; the events into g; M: one entry per event)."""
+        _events_i(ts, ys, g, p, ss, cs)
+        n = 0
+        for j in range(M.size):
+            n += 1 if _side(g[j]) != side[j] else 0
+        return n
+
     @nb.njit(_nrt=False, **_JIT)  # it allocates nothing: no reference counting of its views
     def _side_point(ts, ys, fs, ss, cs, p, side, jx, want_x, M, h, g, g2, TP):
         """A point near the stage point ys (time ts, phase ss, cs, f(ys) = fs) on the sides
@@ -256,10 +276,16 @@ if VARIATIONAL:
         M = VG[2]
         out = VX[1] if trial else VX[0]
         hh = 0.5 * hs
-        ok, moved = _side_point(t, ys, k1, s1, c1, p, side, -1, 0, M, h, g, g2, TP)
-        for j in range(m1):
-            b = 9 + 7 * j
-            _rhs_t(t, TP, VX[b], FB, VX[b + 3], p, s1, c1)
+        ok = True
+        if _off_sides(t, ys, s1, c1, p, side, M, g) == 0:
+            for j in range(m1):
+                b = 9 + 7 * j
+                _rhs_t(t, ys, VX[b], FB, VX[b + 3], p, s1, c1)
+        else:
+            ok, moved = _side_point(t, ys, k1, s1, c1, p, side, -1, 0, M, h, g, g2, TP)
+            for j in range(m1):
+                b = 9 + 7 * j
+                _rhs_t(t, TP, VX[b], FB, VX[b + 3], p, s1, c1)
         for q in range(ns):
             KS[0, q] = k1[q]
         for st in range(1, 4):
@@ -278,10 +304,15 @@ if VARIATIONAL:
                 for q in range(ns):
                     VX[b + 2, q] = VX[b, q] + a * VX[b + 2 + st, q]
             _rhs_t(ts, TMP, VX[11], KS[st], VX[12 + st], p, ss, cs)
-            ok_s, moved = _side_point(ts, TMP, KS[st], ss, cs, p, side, -1, 0, M, h, g, g2, TP)
-            ok = ok & ok_s
-            for j in range(m1):
-                if j > 0 or moved:
+            if _off_sides(ts, TMP, ss, cs, p, side, M, g) == 0:
+                for j in range(1, m1):
+                    b = 9 + 7 * j
+                    _rhs_t(ts, TMP, VX[b + 2], FB, VX[b + 3 + st], p, ss, cs)
+            else:
+                ok_s, moved = _side_point(ts, TMP, KS[st], ss, cs, p, side, -1, 0, M, h, g, g2,
+                                          TP)
+                ok = ok & ok_s
+                for j in range(m1):
                     b = 9 + 7 * j
                     _rhs_t(ts, TP, VX[b + 2], FB, VX[b + 3 + st], p, ss, cs)
         h6 = rk4_sixth(hs)
@@ -346,7 +377,8 @@ if VARIATIONAL:
         vectors' unforced trials in their trial rows), operation for operation, with the tangent
         vectors carried through its sub-steps (:func:`_var_sub`) and moved at each split point
         (:func:`_var_correct`; see above). Returns 0 when done (state and tangent vectors in
-        VX[0] and their rows), 1 where the step is to be taken by the difference rows."""
+        VX[0] and their rows), 1 where the step is to be taken by the difference rows, 2 where
+        no crossing was found (the step is its unsplit trial, VX[1])."""
         n_ev = g1.size
         ns = VX.shape[1]
         y = VX[0]
@@ -443,8 +475,10 @@ if VARIATIONAL:
                 return 0
         if not finished:
             return 1  # the split limit: the difference rows take the step (and count it)
-        # the (rest of the) step's trial taken: the first's tangent unforced, as an unsplit
-        # step's; a later one's forced onto the sides after the crossing
+        if u == 0.0:
+            return 2  # no crossing: the trial, its tangent unforced as an unsplit step's
+        # the rest of the step's trial taken, its tangent forced onto the sides after the
+        # crossing
         if not ok:
             return 1
         for q in range(ns):
@@ -459,12 +493,13 @@ if VARIATIONAL:
     def _var_split_lane(i, t0, Z, S, IS, p, h, omega, n_per, s_tab, c_tab, n_ev, YP, E, K, TMP,
                         Y1, SIDE, G0, G1, W, gbuf, NCR, UNRES, VX, VG):
         """Grid step i of one lane (state Z[0], tangent vectors Z[1..] in z = y / S) whose
-        variational trial leaves a side of an edge or may graze one: the trial and its screen
-        redone (as :func:`_var_step` takes them), the state split at its crossings and the
-        tangent vectors carried through the sub-steps (:func:`_var_split`); where that is
-        ill-posed, the step by the difference rows (:func:`_tangent_step`). Returns 1 where
-        the step took the difference rows, else 0. Scratch as :func:`_var_step`'s, VX, VG (see
-        above)."""
+        variational trial leaves a side of an edge or may graze one (the caller's screen: the
+        state's trial in VX[1], the events at the step's start and the trial's end in G0[0],
+        G1[0], their sides at the start in SIDE[0], the graze flags in gbuf[GRAZE_ROW]): the
+        state split at its crossings and the tangent vectors carried through the sub-steps
+        (:func:`_var_split`); where that is ill-posed, the step by the difference rows
+        (:func:`_tangent_step`). Returns 1 where the step took the difference rows, else 0.
+        Scratch as :func:`_var_step`'s, VX, VG (see above)."""
         m, ns = Z.shape
         m1 = m - 1
         t = t0 + i * h
@@ -477,31 +512,21 @@ if VARIATIONAL:
             b = 9 + 7 * j
             for q in range(ns):
                 VX[b, q] = S[q] * Z[j + 1, q]
-            _var_trial(t, hh, h, y, VX[b], p, s_tab[j0], c_tab[j0], s_tab[j0 + 1],
-                       c_tab[j0 + 1], s_tab[j0 + 2], c_tab[j0 + 2], VX[5:9], VX[b + 3:b + 7],
-                       VX[2], VX[b + 2], VX[1], VX[b + 1])
-        for q in range(ns):
-            YP[0, q] = y[q]
-            K[0, 0, q] = VX[5, q]
-        _events_i(t, y, G0[0], p, s_tab[j0], c_tab[j0])
         for j in range(n_ev):
-            SIDE[0, j] = _side(G0[0, j])
-        _events_i(t + h, VX[1], G1[0], p, s_tab[j0 + 2], c_tab[j0 + 2])
-        code = 0
-        if _leaves_side_step(0, t, t + h, YP, K[0], G0, G1, SIDE, p, W[8], gbuf,
-                             s_tab[j0 + 2], c_tab[j0 + 2]):
-            for j in range(n_ev):
-                VG[2, j] = FORCE_MARGIN * max(abs(G0[0, j]), abs(G1[0, j]))
-            code = _var_split(i, t0, m1, p, h, omega, n_per, s_tab[j0], c_tab[j0],
-                              s_tab[j0 + 2], c_tab[j0 + 2], SIDE[0], G1[0], NCR[0], W, gbuf,
-                              VX, VG)
-        else:
-            for q in range(ns):
-                y[q] = VX[1, q]
+            VG[2, j] = FORCE_MARGIN * max(abs(G0[0, j]), abs(G1[0, j]))
+        code = _var_split(i, t0, m1, p, h, omega, n_per, s_tab[j0], c_tab[j0], s_tab[j0 + 2],
+                          c_tab[j0 + 2], SIDE[0], G1[0], NCR[0], W, gbuf, VX, VG)
+        if code == 2:  # the unsplit trial: the tangent vectors by the variational trial
             for j in range(m1):
                 b = 9 + 7 * j
+                _var_trial(t, hh, h, y, VX[b], p, s_tab[j0], c_tab[j0], s_tab[j0 + 1],
+                           c_tab[j0 + 1], s_tab[j0 + 2], c_tab[j0 + 2], VX[5:9],
+                           VX[b + 3:b + 7], VX[2], VX[b + 2], VX[1], VX[b + 1])
                 for q in range(ns):
                     VX[b, q] = VX[b + 1, q]
+            for q in range(ns):
+                y[q] = VX[1, q]
+            code = 0
         if code:
             _tangent_step(i, t0, Z, S, IS, p, h, omega, n_per, s_tab, c_tab, n_ev, YP, E, K,
                           TMP, Y1, SIDE, G0, G1, W, gbuf, NCR, UNRES)
@@ -522,9 +547,9 @@ if VARIATIONAL:
         in z = y / S) by the exact derivative of the RK4 step map: the variational RK4
         (:func:`_var_trial`, w = S v). A step whose state leaves a side of an edge (or may graze
         one; :func:`_leaves_side_step`, as :func:`_rows_step` screens it) is split at the
-        crossing: that step is redone by :func:`_tangent_step` (the state split as everywhere,
-        the tangent vectors by the difference rows through their own splits). Returns 1 where
-        the step took the difference rows, else 0. VW: scratch, (2 m + 10, ns)."""
+        crossing, the tangent vectors through its sub-steps (:func:`_var_split_lane`). Returns 1
+        where the step took the difference rows, else 0. VW: scratch, (2 m + 10, ns); VX, VG:
+        :func:`_var_split`'s."""
         m, ns = Z.shape
         t = t0 + i * h
         hh = 0.5 * h
@@ -552,6 +577,12 @@ if VARIATIONAL:
             _events_i(t + h, Y1[last], G1[last], p, s_tab[j0 + 2], c_tab[j0 + 2])
             if _leaves_side_step(last, t, t + h, YP, K[0], G0, G1, SIDE, p, W[8], gbuf,
                                  s_tab[j0 + 2], c_tab[j0 + 2]):
+                for q in range(ns):
+                    VX[1, q] = Y1[last, q]
+                for j in range(n_ev):
+                    G0[0, j] = G0[last, j]
+                    G1[0, j] = G1[last, j]
+                    SIDE[0, j] = SIDE[last, j]
                 return _var_split_lane(i, t0, Z, S, IS, p, h, omega, n_per, s_tab, c_tab,
                                        n_ev, YP, E, K, TMP, Y1, SIDE, G0, G1, W, gbuf, NCR,
                                        UNRES, VX, VG)
@@ -590,8 +621,9 @@ def _run(p, y0, S, t0, h, omega, n_per, s_tab, c_tab, n_transient, n_steps, reno
     of grid steps whose tangent vectors took the difference rows of one
     lane, started at time t0 (forcing phase zero there); tangent vectors in the
     coordinates y / S (S: the state scale). ``variational``: the tangent vectors by the
-    variational RK4 (:func:`_var_step`; split steps by the difference rows), else by the
-    difference rows (:func:`_tangent_step`) at every step."""
+    variational RK4 (:func:`_var_step`; split steps through the sub-steps, by the difference
+    rows only where that is ill-posed), else by the difference rows (:func:`_tangent_step`) at
+    every step."""
     ns = y0.size
     IS = np.empty(ns)
     for q in range(ns):
@@ -693,8 +725,9 @@ def lyapunov_single(p, y0, scale, t0, h, omega, n_per, n_transient, n_steps, ren
     STATUS_DIVERGED); ``unresolved``: grid steps of the state or a perturbed row that reached
     the split limit (MAX_SPLITS) and fell back unsplit, the status then STATUS_SPLIT_LIMIT
     (exponents kept) unless diverged; ``fd_steps``: the grid steps whose tangent vectors took
-    the difference rows (every step, or with ``variational`` the split ones: see
-    :func:`_var_step`; ``variational`` needs the model's tangent forms, :data:`VARIATIONAL`).
+    the difference rows (every step, or with ``variational`` the split steps where carrying
+    the tangent through the sub-steps is ill-posed: see :func:`_var_split_lane`;
+    ``variational`` needs the model's tangent forms, :data:`VARIATIONAL`).
     Returns (exponents, stderr, blocks, status, unresolved, fd_steps).
     """
     s_tab, c_tab = phase_table(n_per, omega != 0.0)
@@ -1427,8 +1460,9 @@ def _lyap_block_local(form, lo, hi, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TA
 # vector together, the RK4 stages of the pair (y, w = S v) from the lane-scalar tangent form
 # ``rhs_lane_tangent`` (f and J w in one inlined call; :func:`_var_row_trial`), then screens the
 # state's trial as the fused loop does and commits the unflagged lanes. A flagged lane (its state
-# leaves a side of an edge or may graze one) is finished out of line by the difference rows
-# (:func:`_tangent_step`, as :func:`_var_step` does it for one lane). Each lane's arithmetic is
+# leaves a side of an edge or may graze one) is finished out of line, split with its tangent
+# through the sub-steps (:func:`_var_split_lane`, as :func:`_var_step` does it for one lane; the
+# difference rows where that is ill-posed). Each lane's arithmetic is
 # that of :func:`_var_step`, operation for operation: the exponents are bitwise those of
 # :func:`lyapunov_single` with ``variational``.
 
@@ -1472,12 +1506,13 @@ if VARIATIONAL:
 
     @nb.njit(inline="always", **_JIT)
     def _var_fused_steps(form, i, nl, locate, Z0, Z1, S, IS, PT, T0L, HL, HHL, H6L, PH, ACT,
-                         FLAG, GR):
+                         FLAG, GR, Y1F):
         """Grid step i of every lane of the block (see above): Z0, Z1 the state and the
         tangent vector (flat rows of BLOCK lanes), committed where the lane is active and its
         state's trial unflagged (``locate``: the edges screened; GR: the graze flags, a row of
-        BLOCK per switching function of the model); FLAG[l] = 1 where an active lane is flagged.
-        Returns the number of flagged lanes."""
+        BLOCK per switching function of the model); FLAG[l] = 1 where an active lane is flagged,
+        the state's trial into Y1F (as Z0) for :func:`_var_flagged`. Returns the number of
+        flagged lanes."""
         P0, P1, P2, P3, P4, P5 = PH
         n_flag = 0
         for l in range(nl):
@@ -1498,6 +1533,7 @@ if VARIATIONAL:
             keep = act & (not hit)
             _t_store(Z1, l, _t_unscale(w1, IS), v, keep)
             _t_store(Z0, l, y1, y, keep)
+            _t_store(Y1F, l, y1, y1, True)
             FLAG[l] = 1.0 if flagged else 0.0
             n_flag += 1 if flagged else 0
         return n_flag
@@ -1505,10 +1541,11 @@ if VARIATIONAL:
 
 @nb.njit(_nrt=False, **_JIT)  # it allocates nothing: no reference counting of its views
 def _var_flagged(i, nl, first, n_ev, P, Z0, Z1, S, IS, T0L, HL, OMEGA, NPL, IDX, S_TAB, C_TAB,
-                 FLAG, UNRR, FDL, fd):
-    """The flagged lanes of step i (:func:`_var_fused_steps`) by the difference rows, each as
-    :func:`_var_step` takes such a step (:func:`_tangent_step` from the lane's state and
-    tangent vector; its rows' split-limit steps into UNRR[l], the step counted in FDL[l])."""
+                 FLAG, UNRR, FDL, GR, Y1F, fd):
+    """The flagged lanes of step i (:func:`_var_fused_steps`), each as :func:`_var_step`
+    takes such a step (:func:`_var_split_lane` from the lane's state and tangent vector; the
+    split-limit steps of the difference rows it may fall back to into UNRR[l], such a step
+    counted in FDL[l])."""
     Zl, YP, E, K, TMP, Y1, SIDE, G0, G1, W, gbuf, NCR, UNRES, VX, VG = fd
     ns = Zl.shape[1]
     for l in range(nl):
@@ -1521,6 +1558,18 @@ def _var_flagged(i, nl, first, n_ev, P, Z0, Z1, S, IS, T0L, HL, OMEGA, NPL, IDX,
         off = IDX[l] - 2 * (i % NPL[l])  # the lane's phase table in S_TAB, C_TAB
         for r in range(UNRES.size):
             UNRES[r] = 0
+        # the screen of the fused loop's trial (as :func:`_var_step` screens it)
+        p = P[lane]
+        h = HL[l]
+        t = T0L[l] + i * h
+        j0 = IDX[l]
+        _events_i(t, Zl[0], G0[0], p, S_TAB[j0], C_TAB[j0])
+        for j in range(n_ev):
+            SIDE[0, j] = _side(G0[0, j])
+            gbuf[GRAZE_ROW, j] = GR[j * BLOCK + l]
+        for q in range(ns):
+            VX[1, q] = Y1F[q * BLOCK + l]
+        _events_i(t + h, VX[1], G1[0], p, S_TAB[j0 + 2], C_TAB[j0 + 2])
         fd_l = _var_split_lane(i, T0L[l], Zl, S, IS, P[lane], HL[l], OMEGA[lane], NPL[l],
                                S_TAB[off:], C_TAB[off:], n_ev, YP, E, K, TMP, Y1, SIDE, G0, G1,
                                W, gbuf, NCR, UNRES, VX, VG)
@@ -1536,7 +1585,8 @@ def _lyap_var_run(form, first, nl, n_ev, max_total, due, renorm, bound, P, OMEGA
                   lanes, books, out, err, used, status, scratch, fd):
     """The time loop of a variational block (see above): every grid step of the block's lanes,
     their flagged lanes out of line, their bookkeeping where due (:func:`_lane_books`)."""
-    (Z0, Z1, ZT, T0L, HL, HHL, H6L, IDX, NPL, ENDL, PH, ACT, ACTR, FLAG, GR, UNRR, FDL) = lanes
+    (Z0, Z1, ZT, T0L, HL, HHL, H6L, IDX, NPL, ENDL, PH, ACT, ACTR, FLAG, GR, UNRR, FDL,
+     Y1F) = lanes
     IST, ENDS, BLK, ACC, Zl, Cl, logs = books
     S_TAB, C_TAB = scratch
     nv = _padded(nl)
@@ -1553,10 +1603,10 @@ def _lyap_var_run(form, first, nl, n_ev, max_total, due, renorm, bound, P, OMEGA
                 PH[2 * d][l] = S_TAB[j + d]
                 PH[2 * d + 1][l] = C_TAB[j + d]
         n_flag = _var_fused_steps(form, i, nv, locate, Z0, Z1, S, IS, PT, T0L, HL, HHL, H6L,
-                                  PH, ACT, FLAG, GR)
+                                  PH, ACT, FLAG, GR, Y1F)
         if n_flag > 0:
             _var_flagged(i, nl, first, n_ev, P, Z0, Z1, S, IS, T0L, HL, OMEGA, NPL, IDX, S_TAB,
-                         C_TAB, FLAG, UNRR, FDL, fd)
+                         C_TAB, FLAG, UNRR, FDL, GR, Y1F, fd)
         for l in range(nl):
             IDX[l] = IDX[l] + 2 if IDX[l] + 2 < ENDL[l] else IDX[l] + 2 - 2 * NPL[l]
         step = i + 1
@@ -1595,7 +1645,8 @@ def _lyap_block_var(form, first, nl, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB,
                     status, unres, fd_steps):
     """:func:`_lyap_block` with k = 1 by the variational block of lane form ``form`` (nl <=
     BLOCK lanes): per lane what :func:`_run` with ``variational`` computes, bitwise; the
-    lanes' steps by the difference rows into fd_steps[lane]."""
+    lanes' steps by the difference rows (split steps where carrying the tangent through the
+    sub-steps is ill-posed) into fd_steps[lane]."""
     ns = Y0.shape[1]
     (IS, ZT, Z0, Z1, PT, T0L, HL, HHL, H6L, IDX, NPL, ENDL, PH, ACT, ACTR, FLAG, IST, ENDS, BLK,
      ACC, Zl, Cl, logs, max_total, renorm, due) = _fused_block_start(
@@ -1612,7 +1663,9 @@ def _lyap_block_var(form, first, nl, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB,
           np.zeros((3, ne)), np.zeros((9, ns)), np.zeros((GBUF_ROWS, ne)),
           np.zeros((3, ne), np.int64), np.zeros(3, np.int64), np.zeros((16, ns)),
           np.zeros((3, ne)))
-    lanes = (Z0, Z1, ZT, T0L, HL, HHL, H6L, IDX, NPL, ENDL, PH, ACT, ACTR, FLAG, GR, UNRR, FDL)
+    Y1F = np.zeros(ns * BLOCK)  # the states' trials (flat rows of BLOCK lanes, as Z0)
+    lanes = (Z0, Z1, ZT, T0L, HL, HHL, H6L, IDX, NPL, ENDL, PH, ACT, ACTR, FLAG, GR, UNRR, FDL,
+             Y1F)
     books = (IST, ENDS, BLK, ACC, Zl, Cl, logs)
     args = (first, nl, n_ev, max_total, due, renorm, bound, P, OMEGA, H, S, IS, PT, lanes, books,
             out, err, used, status, (S_TAB, C_TAB), fd)
