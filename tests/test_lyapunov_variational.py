@@ -249,6 +249,64 @@ def _lanes(model, oms, n_per, n_tr, n_st, variational, rows=False, n_ev=None):
     return P, Y0, H, out, err, un, st, fd
 
 
+_STATES_SOURCE = """
+@nb.njit(error_model="numpy", boundscheck=False)
+def states(p, y0, h, omega, n_per, n_steps, n_ev):
+    ns = y0.size
+    ne = max(n_ev, 1)
+    s_tab, c_tab = phase_table(n_per, omega != 0.0)
+    Z = np.zeros((2, ns))
+    R = np.zeros((2, ns))
+    for q in range(ns):
+        Z[0, q] = y0[q]
+        R[0, q] = y0[q]
+        Z[1, q] = 0.1 + (1.0 if q == 0 else 0.0)
+        R[1, q] = Z[1, q]
+    S = np.ones(ns)
+    scratch = [(np.zeros((3, ns)), np.zeros(2), np.zeros((4, 3, ns)), np.zeros((3, ns)),
+                np.zeros((3, ns)), np.ones((3, ne), np.int64), np.zeros((3, ne)),
+                np.zeros((3, ne)), np.zeros((9, ns)), np.zeros((GBUF_ROWS, ne)),
+                np.zeros((3, ne), np.int64), np.zeros(3, np.int64)) for _ in range(2)]
+    VW = np.zeros((12, ns))
+    VX = np.zeros((16, ns))
+    VG = np.zeros((3, ne))
+    YP, E, K, TMP, Y1, SIDE, G0, G1, W, gbuf, NCR, UNRES = scratch[0]
+    YPr, Er, Kr, TMPr, Y1r, SIDEr, G0r, G1r, Wr, gbufr, NCRr, UNRESr = scratch[1]
+    apart = 0
+    fd = 0
+    for i in range(n_steps):
+        fd += _var_step(i, 0.0, Z, S, S, p, h, omega, n_per, s_tab, c_tab, n_ev, YP, E, K, TMP,
+                        Y1, SIDE, G0, G1, W, gbuf, NCR, UNRES, VW, VX, VG)
+        _tangent_step(i, 0.0, R, S, S, p, h, omega, n_per, s_tab, c_tab, n_ev, YPr, Er, Kr,
+                      TMPr, Y1r, SIDEr, G0r, G1r, Wr, gbufr, NCRr, UNRESr)
+        for q in range(ns):
+            if Z[0, q] != R[0, q]:
+                apart += 1
+                break
+    return apart, NCR[0].sum(), NCRr[2].sum(), fd
+"""
+
+
+@pytest.mark.parametrize("case", ["gear pair", "device 1.0"])
+def test_split_tangent_leaves_the_state_bitwise_the_rows(case):
+    """The variational step (the state split as every kernel splits it, the tangent carried
+    through the sub-steps) and the difference rows' state row give the same states, bitwise,
+    at every grid step of a run with edge crossings."""
+    model = ORDER_CASES[case][0]()
+    kern = kernels_for(model.kernel, "lyapunov")
+    env = {"nb": nb, "np": np}
+    env.update({n: getattr(kern, n) for n in ("_var_step", "_tangent_step", "phase_table",
+                                               "GBUF_ROWS")})
+    exec(compile(_STATES_SOURCE, "<split tangent states>", "exec"), env)
+    om = model.params[model.omega_index]
+    n_per = 64
+    apart, crossings, crossings_rows, fd = env["states"](
+        np.ascontiguousarray(model.params), model.initial_state(), 2 * math.pi / om / n_per, om,
+        n_per, 30 * n_per, model.n_events)
+    assert apart == 0 and fd == 0
+    assert crossings == crossings_rows > 30
+
+
 def test_variational_lanes_are_bitwise_the_one_lane_kernel():
     """The variational block (lanes of different lengths and grids side by side) and the
     one-lane-at-a-time rows give each lane's exponent, error, counts and status of
