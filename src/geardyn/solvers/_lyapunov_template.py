@@ -489,7 +489,7 @@ if VARIATIONAL:
                 VX[b, q] = VX[b + 1, q]
         return 0
 
-    @nb.njit(inline="always", **_JIT)  # (its callers: the one-lane step, the flagged lanes)
+    @nb.njit(_nrt=False, **_JIT)  # it allocates nothing: no reference counting of its views
     def _var_split_lane(i, t0, Z, S, IS, p, h, omega, n_per, s_tab, c_tab, n_ev, YP, E, K, TMP,
                         Y1, SIDE, G0, G1, W, gbuf, NCR, UNRES, VX, VG):
         """Grid step i of one lane (state Z[0], tangent vectors Z[1..] in z = y / S) whose
