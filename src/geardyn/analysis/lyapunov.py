@@ -77,7 +77,9 @@ class LyapunovEstimate:
     scale, :meth:`geardyn.Model.lyapunov_duration`);
     ``tangent``: how the tangent vectors were advanced (:func:`lyapunov_tangent`) and
     ``difference_steps`` the grid steps that took the finite-difference rows (all with
-    ``"difference"``; with ``"variational"`` those split at an edge crossing)."""
+    ``"difference"``; with ``"variational"`` the split steps where carrying the tangent through
+    the sub-steps is ill-posed: two edges crossed at once, the split limit, a stage that cannot
+    be put on its side)."""
 
     value: float | np.ndarray
     stderr: float | np.ndarray
@@ -151,8 +153,8 @@ def lyapunov_tangent(variational: bool) -> str:
     """The ``tangent`` attribute of a Lyapunov result: how its tangent vectors were advanced."""
     if variational:
         return ("variational: the exact derivative of the RK4 step map (dual numbers through "
-                "the model's one form); a step split at an edge crossing by central "
-                "differences of its step map")
+                "the model's one form); a step split at an edge crossing through its sub-steps, "
+                "moved to the orbit's crossing at each split point")
     return "difference: central differences of the RK4 step map at every step"
 
 
