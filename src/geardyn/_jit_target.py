@@ -29,7 +29,9 @@ numba was used before ``import geardyn`` or not, and numba's own ``NUMBA_CPU_NAM
 
 The same pass makes the function's code library skip numba's cheap module pipeline before the
 full one (:func:`_full_only`); the full pipeline runs as numba runs it (``tests/test_full_only.py``
-checks which pipelines run and the results against numpy).
+checks which pipelines run and the results against numpy). A function compiled inside another
+geardyn compile gets its machine code when first needed (:mod:`geardyn._lazy_code`, whose
+guard :class:`WidthCompiler` enters); the outermost one, as numba does.
 
 The width is part of the cache key of geardyn's functions (:func:`cache_tag`, in the name of
 their cache files, :mod:`geardyn._cache`): kernels compiled at one width are never loaded at
@@ -48,6 +50,7 @@ from numba.core.compiler_machinery import LoweringPass, register_pass
 from numba.core.runtime.nrtopt import remove_redundant_nrt_refct
 from numba.core.typed_passes import AnnotateTypes
 
+from geardyn import _lazy_code
 from geardyn._tuple_alias import tuple_aliases
 
 #: The environment variable that chooses the vector width.
@@ -136,6 +139,8 @@ class VectorWidthPass(LoweringPass):
             state.library = state.targetctx.codegen().create_library(
                 state.func_id.func_qualname)
             state.library.enable_object_caching()
+        if _lazy_code.scope.depth == 1:  # the outermost geardyn function: called from Python
+            _lazy_code.mark_outermost(state.library)
         _full_only(state.library)
         if ATTRIBUTE is not None:
             _mark(state.library, ATTRIBUTE)
@@ -149,7 +154,7 @@ class WidthCompiler(Compiler):
     that its dead-code elimination keeps the stores into arrays passed in tuples."""
 
     def _compile_core(self) -> Any:
-        with tuple_aliases():
+        with tuple_aliases(), _lazy_code.scope():
             return super()._compile_core()
 
     def define_pipelines(self) -> list:
