@@ -277,15 +277,15 @@ if VARIATIONAL:
         out = VX[1] if trial else VX[0]
         hh = 0.5 * hs
         ok = True
-        if _off_sides(t, ys, s1, c1, p, side, M, g) == 0:
-            for j in range(m1):
-                b = 9 + 7 * j
-                _rhs_t(t, ys, VX[b], FB, VX[b + 3], p, s1, c1)
-        else:
-            ok, moved = _side_point(t, ys, k1, s1, c1, p, side, -1, 0, M, h, g, g2, TP)
-            for j in range(m1):
-                b = 9 + 7 * j
-                _rhs_t(t, TP, VX[b], FB, VX[b + 3], p, s1, c1)
+        pt = ys  # each call site of the rhs's tangent form is a copy of it: one per stage kind
+        if _off_sides(t, ys, s1, c1, p, side, M, g) != 0:
+            # np.int64: literal arguments would compile _side_point once more
+            ok, moved = _side_point(t, ys, k1, s1, c1, p, side, np.int64(-1), np.int64(0), M, h,
+                                    g, g2, TP)
+            pt = TP
+        for j in range(m1):
+            b = 9 + 7 * j
+            _rhs_t(t, pt, VX[b], FB, VX[b + 3], p, s1, c1)
         for q in range(ns):
             KS[0, q] = k1[q]
         for st in range(1, 4):
@@ -304,17 +304,17 @@ if VARIATIONAL:
                 for q in range(ns):
                     VX[b + 2, q] = VX[b, q] + a * VX[b + 2 + st, q]
             _rhs_t(ts, TMP, VX[11], KS[st], VX[12 + st], p, ss, cs)
-            if _off_sides(ts, TMP, ss, cs, p, side, M, g) == 0:
-                for j in range(1, m1):
-                    b = 9 + 7 * j
-                    _rhs_t(ts, TMP, VX[b + 2], FB, VX[b + 3 + st], p, ss, cs)
-            else:
-                ok_s, moved = _side_point(ts, TMP, KS[st], ss, cs, p, side, -1, 0, M, h, g, g2,
-                                          TP)
+            pt = TMP
+            j_lo = 1  # tangent 0's J w at TMP came with the stage's f
+            if _off_sides(ts, TMP, ss, cs, p, side, M, g) != 0:
+                ok_s, moved = _side_point(ts, TMP, KS[st], ss, cs, p, side, np.int64(-1),
+                                          np.int64(0), M, h, g, g2, TP)
                 ok = ok & ok_s
-                for j in range(m1):
-                    b = 9 + 7 * j
-                    _rhs_t(ts, TP, VX[b + 2], FB, VX[b + 3 + st], p, ss, cs)
+                pt = TP
+                j_lo = 0
+            for j in range(j_lo, m1):
+                b = 9 + 7 * j
+                _rhs_t(ts, pt, VX[b + 2], FB, VX[b + 3 + st], p, ss, cs)
         h6 = rk4_sixth(hs)
         for q in range(ns):
             out[q] = rk4_comb(ys[q], h6, KS[0, q], KS[1, q], KS[2, q], KS[3, q])
@@ -354,20 +354,17 @@ if VARIATIONAL:
         if not abs(shift) <= FORCE_SPAN * h:
             return False
         after = side[jx]
-        ok, moved = _side_point(t, x, f, s, c, p, side, jx, -after, M, h, g, g2, TP)
-        if not ok:
-            return False
-        for j in range(m1):
-            b = 9 + 7 * j
-            _rhs_t(t, TP, VX[b], FB, VX[b + 2], p, s, c)
-        ok, moved = _side_point(t, x, f, s, c, p, side, jx, after, M, h, g, g2, TP)
-        if not ok:
-            return False
-        for j in range(m1):
-            b = 9 + 7 * j
-            _rhs_t(t, TP, VX[b], FB, VX[b + 3], p, s, c)
-            for q in range(ns):
-                VX[b, q] = VX[b, q] - shift * (VX[b + 2, q] - VX[b + 3, q])
+        for sd in range(2):  # J_before w into VX[b + 2], then J_after w into VX[b + 3]
+            ok, moved = _side_point(t, x, f, s, c, p, side, jx, after if sd else -after, M, h,
+                                    g, g2, TP)
+            if not ok:
+                return False
+            for j in range(m1):
+                b = 9 + 7 * j
+                _rhs_t(t, TP, VX[b], FB, VX[b + 2 + sd], p, s, c)
+                if sd:
+                    for q in range(ns):
+                        VX[b, q] = VX[b, q] - shift * (VX[b + 2, q] - VX[b + 3, q])
         return True
 
     @nb.njit(_nrt=False, **_JIT)  # it allocates nothing: no reference counting of its views
@@ -405,8 +402,9 @@ if VARIATIONAL:
             t = t0 + (i + u) * h
             dt = (1.0 - u) * h
             _split_rhs(t, y, k1, p, s0, c0)
-            if crossed >= 0 and not _var_correct(t, y, k1, u, s0, c0, p, side, crossed, m1, h,
-                                                 pc, VX, VG):
+            # np.int64: a literal (crossed = -1) would compile _var_correct once more
+            if crossed >= 0 and not _var_correct(t, y, k1, u, s0, c0, p, side,
+                                                 np.int64(crossed), m1, h, pc, VX, VG):
                 return 1
             graze = False
             need = False
@@ -418,7 +416,7 @@ if VARIATIONAL:
             if u > 0.0:
                 sm, cm = _phase_at(sa, ca, wh, i_mod, 0.5 * (1.0 + u))
                 ok = _var_sub(y, k1, dt, t, t + 0.5 * dt, sm, cm, t + dt, s_end, c_end, s0, c0,
-                              p, side, m1, h, True, VX, VG)
+                              p, side, m1, h, bool(True), VX, VG)  # noqa: UP018 (see below)
                 _events_i(t_end, y_trial, g1, p, s_end, c_end)
                 need = graze
                 for j in range(n_ev):
@@ -451,8 +449,9 @@ if VARIATIONAL:
             sm, cm = _phase_at(sa, ca, wh, i_mod, tm)
             s1, c1 = _phase_at(sa, ca, wh, i_mod, tu)
             hs = theta * dt
+            # bool(): a literal True / False would compile _var_sub once for each
             if not _var_sub(ystart, k1, hs, t, t + 0.5 * hs, sm, cm, t + hs, s1, c1, s0, c0,
-                            p, side, m1, h, False, VX, VG):
+                            p, side, m1, h, bool(False), VX, VG):  # noqa: UP018
                 return 1
             n_cross = 0
             for j in range(n_ev):
@@ -470,7 +469,8 @@ if VARIATIONAL:
                 _events_i(t_end, y, g1, p, s_end, c_end)
                 t = t0 + (i + u) * h
                 _split_rhs(t, y, k1, p, s0, c0)
-                if not _var_correct(t, y, k1, u, s0, c0, p, side, crossed, m1, h, pc, VX, VG):
+                if not _var_correct(t, y, k1, u, s0, c0, p, side, np.int64(crossed), m1, h, pc,
+                                    VX, VG):
                     return 1
                 return 0
         if not finished:
