@@ -170,16 +170,27 @@ if VARIATIONAL:
         the rhs's tangent form: f and J w at each stage); KS[0] is the state's k1. y1 is
         bitwise :func:`_rows_step`'s trial (the same operations)."""
         ns = y.size
-        _rhs_t(t, y, w, KS[0], KV[0], p, s0, c0)
-        for st in range(1, 4):
-            a = h if st == 3 else hh
-            for q in range(ns):
-                TMP[q] = y[q] + a * KS[st - 1, q]
-                TV[q] = w[q] + a * KV[st - 1, q]
-            if st < 3:
-                _rhs_t(t + hh, TMP, TV, KS[st], KV[st], p, s1, c1)
-            else:
-                _rhs_t(t + h, TMP, TV, KS[st], KV[st], p, s2, c2)
+        for st in range(4):  # one call site of the rhs's tangent form (an inlined copy each)
+            yi = y
+            wi = w
+            ts = t
+            ss = s0
+            cs = c0
+            if st > 0:
+                a = h if st == 3 else hh
+                for q in range(ns):
+                    TMP[q] = y[q] + a * KS[st - 1, q]
+                    TV[q] = w[q] + a * KV[st - 1, q]
+                yi = TMP
+                wi = TV
+                ts = t + hh
+                ss = s1
+                cs = c1
+                if st == 3:
+                    ts = t + h
+                    ss = s2
+                    cs = c2
+            _rhs_t(ts, yi, wi, KS[st], KV[st], p, ss, cs)
         h6 = rk4_sixth(h)
         for q in range(ns):
             y1[q] = rk4_comb(y[q], h6, KS[0, q], KS[1, q], KS[2, q], KS[3, q])
@@ -277,37 +288,43 @@ if VARIATIONAL:
         out = VX[1] if trial else VX[0]
         hh = 0.5 * hs
         ok = True
-        pt = ys  # each call site of the rhs's tangent form is a copy of it: one per stage kind
-        if _off_sides(t, ys, s1, c1, p, side, M, g) != 0:
-            # np.int64: literal arguments would compile _side_point once more
-            ok, moved = _side_point(t, ys, k1, s1, c1, p, side, np.int64(-1), np.int64(0), M, h,
-                                    g, g2, TP)
-            pt = TP
-        for j in range(m1):
-            b = 9 + 7 * j
-            _rhs_t(t, pt, VX[b], FB, VX[b + 3], p, s1, c1)
+        # one call site of the rhs's tangent form for the tangent vectors (each site is an
+        # inlined copy of it), one for a stage's f; stage 0 at ys (its w copied to the stage row)
         for q in range(ns):
             KS[0, q] = k1[q]
-        for st in range(1, 4):
+        for st in range(4):
             a = hs if st == 3 else hh
-            ts = tm
-            ss = sm
-            cs = cm
+            ts = t
+            ss = s1
+            cs = c1
             if st == 3:
                 ts = te
                 ss = se
                 cs = ce
-            for q in range(ns):
-                TMP[q] = ys[q] + a * KS[st - 1, q]
-            for j in range(m1):
-                b = 9 + 7 * j
+            elif st > 0:
+                ts = tm
+                ss = sm
+                cs = cm
+            pt = ys
+            j_lo = 0
+            if st == 0:
+                for j in range(m1):
+                    b = 9 + 7 * j
+                    for q in range(ns):
+                        VX[b + 2, q] = VX[b, q]
+            else:
                 for q in range(ns):
-                    VX[b + 2, q] = VX[b, q] + a * VX[b + 2 + st, q]
-            _rhs_t(ts, TMP, VX[11], KS[st], VX[12 + st], p, ss, cs)
-            pt = TMP
-            j_lo = 1  # tangent 0's J w at TMP came with the stage's f
-            if _off_sides(ts, TMP, ss, cs, p, side, M, g) != 0:
-                ok_s, moved = _side_point(ts, TMP, KS[st], ss, cs, p, side, np.int64(-1),
+                    TMP[q] = ys[q] + a * KS[st - 1, q]
+                for j in range(m1):
+                    b = 9 + 7 * j
+                    for q in range(ns):
+                        VX[b + 2, q] = VX[b, q] + a * VX[b + 2 + st, q]
+                _rhs_t(ts, TMP, VX[11], KS[st], VX[12 + st], p, ss, cs)
+                pt = TMP
+                j_lo = 1  # tangent 0's J w at TMP came with the stage's f
+            if _off_sides(ts, pt, ss, cs, p, side, M, g) != 0:
+                # np.int64: literal arguments would compile _side_point once more
+                ok_s, moved = _side_point(ts, pt, KS[st], ss, cs, p, side, np.int64(-1),
                                           np.int64(0), M, h, g, g2, TP)
                 ok = ok & ok_s
                 pt = TP
