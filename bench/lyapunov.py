@@ -1,20 +1,19 @@
 """Lyapunov kernel benchmark: the variational tangent against the difference rows, in one run.
 
 Workload: the paper's device (Tables 1-2, consistent interpretation, reduced model (written in the
-one form), xi1 = xi2 = 0.05), ``--lanes`` values of Omega in
-[``--lo``, ``--hi``], the largest exponent (k = 1, as ``bifurcation(..., lyapunov=True)``
-computes it) over ``--transient`` + ``--duration`` time units at the default steps per period,
-with edge location, through ``geardyn.lyapunov_lanes`` (the lane blocks) with
-``LyapunovSettings(tangent=...)``: ``variational`` (the state and its tangent vector stepped
-together, J v from dual numbers through the one form; a step split at an edge by the difference
-rows) and ``difference`` (per lane the state and two perturbed rows, central differences of the
-step map), alternately, in this process. Reports per method: warm wall time and CPU time
-(medians of ``--repeat``), ns per lane-step per thread (one lane-step: one grid step of one lane
-with its tangent vector; wall time x threads / lane-steps, and CPU time / lane-steps), the ratio
-of the two, the largest difference of the exponents (relative to their error), the CPU time of
-each without edge location (``n_ev = 0``: the stepping alone; the difference rows then run the
-row blocks) and whether the variational blocks are bitwise the one-lane-at-a-time rows
-(``tests/_lyapunov_rows.py``).
+one form), xi1 = xi2 = 0.05), ``--lanes`` values of Omega in [``--lo``, ``--hi``], the largest
+exponent (k = 1, as ``bifurcation(..., lyapunov=True)`` computes it) over ``--transient`` +
+``--duration`` time units at the default steps per period, with edge location, through
+``geardyn.lyapunov_lanes`` (the lane blocks) with ``LyapunovSettings(tangent=...)``: ``variational``
+(the state and its tangent vector stepped together, J v from dual numbers through the one form; a
+step split at an edge with the tangent through its sub-steps, corrected at each split point) and
+``difference`` (per lane the state and two perturbed rows, central differences of the step map),
+alternately, in this process. Reports per method: warm wall time and CPU time (medians of
+``--repeat``), ns per lane-step per thread (one lane-step: one grid step of one lane with its
+tangent vector; wall time x threads / lane-steps, and CPU time / lane-steps), the ratio of the two,
+the largest difference of the exponents (relative to their error), the CPU time of each without edge
+location (``n_ev = 0``: the stepping alone; the difference rows then run the row blocks) and whether
+the variational blocks are bitwise the one-lane-at-a-time rows (``tests/_lyapunov_rows.py``).
 
     .venv/bin/python bench/lyapunov.py [--repeat 3] [--lanes 42] [--threads N]
 """

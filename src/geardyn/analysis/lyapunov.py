@@ -78,7 +78,9 @@ class LyapunovEstimate:
     scale, :meth:`geardyn.Model.lyapunov_duration`);
     ``tangent``: how the tangent vectors were advanced (:func:`lyapunov_tangent`) and
     ``difference_steps`` the grid steps that took the finite-difference rows (all with
-    ``"difference"``; with ``"variational"`` those split at an edge crossing)."""
+    ``"difference"``; with ``"variational"`` the split steps where carrying the tangent through
+    the sub-steps is ill-posed: two edges crossed at once, the split limit, a stage that cannot
+    be put on its side)."""
 
     value: float | np.ndarray
     stderr: float | np.ndarray
@@ -169,8 +171,8 @@ def lyapunov_tangent(variational: bool) -> str:
     """The ``tangent`` attribute of a Lyapunov result: how its tangent vectors were advanced."""
     if variational:
         return ("variational: the exact derivative of the RK4 step map (dual numbers through "
-                "the model's one form); a step split at an edge crossing by central "
-                "differences of its step map")
+                "the model's one form); a step split at an edge crossing through its sub-steps, "
+                "moved to the orbit's crossing at each split point")
     return "difference: central differences of the RK4 step map at every step"
 
 
@@ -361,10 +363,23 @@ def lyapunov(
     kern = kernels_for(model.kernel, "lyapunov")
     p = np.ascontiguousarray(model.params, dtype=float)
     n_ev = model.n_events if run.locate_edges else 0
+    scale = _state_scale(model)
     with _dual_typing(variational, ls):
-        ex, er, used, code, unres, n_fd = kern.lyapunov_single(
-            p, y, _state_scale(model), t0, h, om, n_per, n_tr, n_st, renorm, k, float(bound),
-            n_ev, n_blk, variational)
+        if variational and k == 1:
+            # one lane of the variational lane blocks (bitwise lyapunov_single's): the kernels
+            # lyapunov_lanes and bifurcation(..., lyapunov=True) use, not a one-lane copy
+            ex, er = np.full((1, k), np.nan), np.full((1, k), np.nan)
+            used, code, unres, n_fd = (np.zeros(1, np.int64) for _ in range(4))
+            kern.lyapunov_block_lanes(
+                p[None, :], y[None, :], scale, np.array([t0]), np.array([h]),
+                np.array([float(om)]), np.array([n_per], np.int64), np.array([n_tr], np.int64),
+                np.array([n_st], np.int64), renorm, k, float(bound), ex, er, used, code, unres,
+                n_ev, n_blk, kern.BLOCK_ROWS, 1, True, n_fd)
+            ex, er, used, code, unres, n_fd = ex[0], er[0], used[0], code[0], unres[0], n_fd[0]
+        else:
+            ex, er, used, code, unres, n_fd = kern.lyapunov_single(
+                p, y, scale, t0, h, om, n_per, n_tr, n_st, renorm, k, float(bound), n_ev,
+                n_blk, variational)
     status = Status(int(code))
     ex = np.asarray(ex, dtype=float)
     er = np.asarray(er, dtype=float)

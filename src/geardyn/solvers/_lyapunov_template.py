@@ -38,8 +38,18 @@ Numerics
   J w (dual numbers through the one form's rhs, :mod:`geardyn.core.dual`). That is the exact
   derivative of the RK4 step map (not a difference quotient of it), and the state is bitwise
   the difference rows' state row. A step whose state leaves a side of an edge (or may graze
-  one) is split at the crossing; that step is taken by the difference rows above (each row
-  split at its own crossing), and counted (``fd_steps``). No saltation term is needed across
+  one) is split at the crossing, the state as :func:`_split_step` splits it (the same
+  operations), and each tangent vector follows the state's sub-steps by the variational RK4,
+  every stage's J w taken on the sides of its sub-step (a stage point that lies beyond the
+  edge, by the O(h^3) of a crossing found on the trial step's interpolant, moved back onto its
+  side along f); at each split point x the tangent is moved to where the numerical orbit
+  crosses the edge, w -= (g(x) / g'(x)) (J_before - J_after) w (g the edge crossed, g' its rate
+  along the orbit, J on either side of it): without that the tangent switches sides O(h^3)
+  early or late at every crossing and the exponent is O(h^3), with it O(h^4)
+  (``bench/split_tangent_order.py``, ``tests/test_lyapunov_variational.py``). A split step
+  where that is ill-posed (two edges crossed at once, a point that cannot be put on its side
+  within a quarter step, the split limit) is taken by the difference rows above (each row
+  split at its own crossing) and counted (``fd_steps``). No saltation term is needed across
   an edge: the vector field is continuous there (the dead zone), so the flow is C^1, and
   ``min``/``max`` in the model give the derivative of the side they pick.
 * Every ``renorm_every`` steps (and at the end of the transient and of the run) the tangent
@@ -96,10 +106,14 @@ from geardyn.solvers._step_core import (  # CORE-IMPORT
     _events_columns,
     _events_i,
     _events_l,
+    _first_crossing,
+    _interpolant_events,
     _lane_form,
     _leaves_side_step,
     _rhs_columns,
     _rhs_l,
+    _split_copy,
+    _split_rhs,
     _split_step,
     _t_axpy,
     _t_comb,
@@ -111,11 +125,14 @@ from geardyn.solvers._step_core import (  # CORE-IMPORT
 from geardyn.solvers._step_shared import (
     BLOCK,
     GBUF_ROWS,
+    MAX_SPLITS,
+    SIMULTANEOUS,
     STATUS_DIVERGED,
     STATUS_OK,
     STATUS_SPLIT_LIMIT,
     _healthy,
     _padded,
+    _phase_at,
     _pick,
     _side,
     fd_rows,
@@ -153,31 +170,403 @@ if VARIATIONAL:
         the rhs's tangent form: f and J w at each stage); KS[0] is the state's k1. y1 is
         bitwise :func:`_rows_step`'s trial (the same operations)."""
         ns = y.size
-        _rhs_t(t, y, w, KS[0], KV[0], p, s0, c0)
-        for st in range(1, 4):
-            a = h if st == 3 else hh
-            for q in range(ns):
-                TMP[q] = y[q] + a * KS[st - 1, q]
-                TV[q] = w[q] + a * KV[st - 1, q]
-            if st < 3:
-                _rhs_t(t + hh, TMP, TV, KS[st], KV[st], p, s1, c1)
-            else:
-                _rhs_t(t + h, TMP, TV, KS[st], KV[st], p, s2, c2)
+        for st in range(4):  # one call site of the rhs's tangent form (an inlined copy each)
+            yi = y
+            wi = w
+            ts = t
+            ss = s0
+            cs = c0
+            if st > 0:
+                a = h if st == 3 else hh
+                for q in range(ns):
+                    TMP[q] = y[q] + a * KS[st - 1, q]
+                    TV[q] = w[q] + a * KV[st - 1, q]
+                yi = TMP
+                wi = TV
+                ts = t + hh
+                ss = s1
+                cs = c1
+                if st == 3:
+                    ts = t + h
+                    ss = s2
+                    cs = c2
+            _rhs_t(ts, yi, wi, KS[st], KV[st], p, ss, cs)
         h6 = rk4_sixth(h)
         for q in range(ns):
             y1[q] = rk4_comb(y[q], h6, KS[0, q], KS[1, q], KS[2, q], KS[3, q])
             w1[q] = rk4_comb(w[q], h6, KV[0, q], KV[1, q], KV[2, q], KV[3, q])
 
+    # A split step's tangent: the state is split at its crossings as :func:`_split_step` splits
+    # it (the same operations: the same state, bitwise) and each tangent vector w follows its
+    # sub-steps by the variational RK4, the Jacobian of every stage taken on the sides of the
+    # sub-step (forced: a stage point that lies beyond an edge, by the O(h^3) of the crossing
+    # found on the trial step's interpolant, is moved back onto its side along the orbit,
+    # :func:`_side_point`); at each split point x, where the orbit's numerical crossing lies
+    # g(x) / g'(x) before or after x (g the edge crossed, g' its rate along the orbit), the
+    # tangent is moved to it: w -= (g / g') (J_before - J_after) w (:func:`_var_correct`).
+    # Together O(h^4), as the unsplit steps (bench/split_tangent_order.py). A step where this
+    # is ill-posed (two edges crossed at once, a point that cannot be moved onto its side within
+    # FORCE_SPAN, the split limit) is taken by the difference rows (:func:`_tangent_step`) and
+    # counted. Scratch VX (9 + 7 (m - 1) rows of the state's size): 0 the state, 1 its trial,
+    # 2 a stage point, 3 a forced point, 4 a discarded f, 5-8 the stages' f, then per tangent
+    # vector j from 9 + 7 j: w, its trial, a stage's w, the stages' J w; VG (3 rows of the
+    # events' size): events, events, each event's margin.
+
+    #: A point moved onto a side lies there by FORCE_MARGIN max(|g0|, |g1|) (g0, g1 the event at
+    #: the grid step's start and trial end).
+    FORCE_MARGIN = 2.0 ** -30
+    #: The step along f, as a fraction of the grid step, of an event's rate along the orbit.
+    RATE_STEP = 2.0 ** -18
+    #: The furthest a point is moved along the orbit onto a side, and the longest shift g / g'
+    #: of a split point, as fractions of the grid step; beyond, the difference rows.
+    FORCE_SPAN = 0.25
+
+    @nb.njit(inline="always", **_JIT)
+    def _off_sides(ts, ys, ss, cs, p, side, M, g):
+        """The number of events off their sides ``side`` at the point ys (time ts, phase ss,
+        cs; the events into g; M: one entry per event)."""
+        _events_i(ts, ys, g, p, ss, cs)
+        n = 0
+        for j in range(M.size):
+            n += 1 if _side(g[j]) != side[j] else 0
+        return n
+
+    @nb.njit(_nrt=False, **_JIT)  # it allocates nothing: no reference counting of its views
+    def _side_point(ts, ys, fs, ss, cs, p, side, jx, want_x, M, h, g, g2, TP):
+        """A point near the stage point ys (time ts, phase ss, cs, f(ys) = fs) on the sides
+        ``side`` of every event (event jx, where >= 0, on side want_x instead) into TP: ys
+        itself where it lies there, else ys + tau fs, the one event off its side moved to
+        within its margin M (tau from the event's rate along fs). Returns (ok, moved); not ok
+        where two events lie off their sides or tau exceeds FORCE_SPAN h."""
+        ns = ys.size
+        _events_i(ts, ys, g, p, ss, cs)
+        bad = -1
+        nbad = 0
+        for j in range(M.size):
+            want = want_x if j == jx else side[j]
+            if _side(g[j]) != want:
+                bad = j
+                nbad += 1
+        if nbad == 0:
+            for q in range(ns):
+                TP[q] = ys[q]
+            return True, False
+        if nbad > 1:
+            return False, False
+        want = want_x if bad == jx else side[bad]
+        tau0 = RATE_STEP * h
+        for q in range(ns):
+            TP[q] = ys[q] + tau0 * fs[q]
+        _events_i(ts, TP, g2, p, ss, cs)
+        tau = (want * M[bad] - g[bad]) / ((g2[bad] - g[bad]) / tau0)
+        if not abs(tau) <= FORCE_SPAN * h:
+            return False, False
+        for q in range(ns):
+            TP[q] = ys[q] + tau * fs[q]
+        _events_i(ts, TP, g2, p, ss, cs)
+        for j in range(M.size):
+            want = want_x if j == jx else side[j]
+            if _side(g2[j]) != want:
+                return False, False
+        return True, True
+
+    @nb.njit(_nrt=False, **_JIT)  # it allocates nothing: no reference counting of its views
+    def _var_sub(ys, k1, hs, t, tm, sm, cm, te, se, ce, s1, c1, p, side, m1, h, trial, VX, VG):
+        """One RK4 sub-step of size hs from ys (time t, phase s1, c1, f(ys) = k1; middle stages
+        at tm, sm, cm, the last at te, se, ce) of the state, as :func:`_rk4_stages` takes it
+        (the same operations), into VX[1] (``trial``) or VX[0], and of each tangent vector
+        (VX[9 + 7 j]) into its trial row or in place, every stage's J w on the sides ``side``
+        (:func:`_side_point`). Returns False where a stage could not be put on its sides."""
+        ns = ys.size
+        TMP = VX[2]
+        TP = VX[3]
+        FB = VX[4]
+        KS = VX[5:9]
+        g = VG[0]
+        g2 = VG[1]
+        M = VG[2]
+        out = VX[1] if trial else VX[0]
+        hh = 0.5 * hs
+        ok = True
+        # one call site of the rhs's tangent form for the tangent vectors (each site is an
+        # inlined copy of it), one for a stage's f; stage 0 at ys (its w copied to the stage row)
+        for q in range(ns):
+            KS[0, q] = k1[q]
+        for st in range(4):
+            a = hs if st == 3 else hh
+            ts = t
+            ss = s1
+            cs = c1
+            if st == 3:
+                ts = te
+                ss = se
+                cs = ce
+            elif st > 0:
+                ts = tm
+                ss = sm
+                cs = cm
+            pt = ys
+            j_lo = 0
+            if st == 0:
+                for j in range(m1):
+                    b = 9 + 7 * j
+                    for q in range(ns):
+                        VX[b + 2, q] = VX[b, q]
+            else:
+                for q in range(ns):
+                    TMP[q] = ys[q] + a * KS[st - 1, q]
+                for j in range(m1):
+                    b = 9 + 7 * j
+                    for q in range(ns):
+                        VX[b + 2, q] = VX[b, q] + a * VX[b + 2 + st, q]
+                _rhs_t(ts, TMP, VX[11], KS[st], VX[12 + st], p, ss, cs)
+                pt = TMP
+                j_lo = 1  # tangent 0's J w at TMP came with the stage's f
+            if _off_sides(ts, pt, ss, cs, p, side, M, g) != 0:
+                # np.int64: literal arguments would compile _side_point once more
+                ok_s, moved = _side_point(ts, pt, KS[st], ss, cs, p, side, np.int64(-1),
+                                          np.int64(0), M, h, g, g2, TP)
+                ok = ok & ok_s
+                pt = TP
+                j_lo = 0
+            for j in range(j_lo, m1):
+                b = 9 + 7 * j
+                _rhs_t(ts, pt, VX[b + 2], FB, VX[b + 3 + st], p, ss, cs)
+        h6 = rk4_sixth(hs)
+        for q in range(ns):
+            out[q] = rk4_comb(ys[q], h6, KS[0, q], KS[1, q], KS[2, q], KS[3, q])
+        for j in range(m1):
+            b = 9 + 7 * j
+            wo = VX[b + 1] if trial else VX[b]
+            for q in range(ns):
+                wo[q] = rk4_comb(VX[b, q], h6, VX[b + 3, q], VX[b + 4, q], VX[b + 5, q],
+                                 VX[b + 6, q])
+        return ok
+
+    @nb.njit(_nrt=False, **_JIT)  # it allocates nothing: no reference counting of its views
+    def _var_correct(t, x, f, u, s, c, p, side, jx, m1, h, pc, VX, VG):
+        """Each tangent vector (VX[9 + 7 j]) moved from the split point x (time t, the fraction
+        u of grid step, phase s, c, f(x) = f) to the orbit's crossing of event jx (just
+        crossed: side[jx] is the side after it): w -= (g / g') (J_before - J_after) w, g the
+        event at x, g' its rate along the orbit (a forward difference over RATE_STEP h, the
+        phase by angle addition), J_before and J_after at x on either side of the edge
+        (:func:`_side_point`). Returns False where |g / g'| > FORCE_SPAN h or a side cannot
+        be forced."""
+        sa, ca, wh, i_mod = pc
+        ns = x.size
+        TMP = VX[2]
+        TP = VX[3]
+        FB = VX[4]
+        g = VG[0]
+        g2 = VG[1]
+        M = VG[2]
+        _events_i(t, x, g, p, s, c)
+        gx = g[jx]
+        tau0 = RATE_STEP * h
+        for q in range(ns):
+            TMP[q] = x[q] + tau0 * f[q]
+        s2, c2 = _phase_at(sa, ca, wh, i_mod, u + RATE_STEP)
+        _events_i(t + tau0, TMP, g2, p, s2, c2)
+        shift = gx / ((g2[jx] - gx) / tau0)
+        if not abs(shift) <= FORCE_SPAN * h:
+            return False
+        after = side[jx]
+        for sd in range(2):  # J_before w into VX[b + 2], then J_after w into VX[b + 3]
+            ok, moved = _side_point(t, x, f, s, c, p, side, jx, after if sd else -after, M, h,
+                                    g, g2, TP)
+            if not ok:
+                return False
+            for j in range(m1):
+                b = 9 + 7 * j
+                _rhs_t(t, TP, VX[b], FB, VX[b + 2 + sd], p, s, c)
+                if sd:
+                    for q in range(ns):
+                        VX[b, q] = VX[b, q] - shift * (VX[b + 2, q] - VX[b + 3, q])
+        return True
+
+    @nb.njit(_nrt=False, **_JIT)  # it allocates nothing: no reference counting of its views
+    def _var_split(i, t0, m1, p, h, omega, n_per, sa, ca, s_end, c_end, side, g1, ncross, work,
+                   gbuf, VX, VG):
+        """:func:`_split_step` of the state in VX[0] (its unsplit trial in VX[1], the tangent
+        vectors' unforced trials in their trial rows), operation for operation, with the tangent
+        vectors carried through its sub-steps (:func:`_var_sub`) and moved at each split point
+        (:func:`_var_correct`; see above). Returns 0 when done (state and tangent vectors in
+        VX[0] and their rows), 1 where the step is to be taken by the difference rows, 2 where
+        no crossing was found (the step is its unsplit trial, VX[1])."""
+        n_ev = g1.size
+        ns = VX.shape[1]
+        y = VX[0]
+        y_trial = VX[1]
+        k1 = work[0]
+        f1 = work[5]
+        ystart = work[6]
+        ybuf = work[8]
+        g0 = gbuf[0]
+        gsc = gbuf[1]
+        g13 = gbuf[3]
+        g23 = gbuf[4]
+        u = 0.0
+        i_mod = i % n_per
+        wh = omega * h
+        pc = (sa, ca, wh, i_mod)
+        t_end = t0 + (i + 1) * h
+        s0 = sa
+        c0 = ca
+        crossed = -1  # the event crossed at the split point y (corrected at the next start)
+        ok = True
+        finished = False
+        for _ in range(MAX_SPLITS):
+            t = t0 + (i + u) * h
+            dt = (1.0 - u) * h
+            _split_rhs(t, y, k1, p, s0, c0)
+            # np.int64: a literal (crossed = -1) would compile _var_correct once more
+            if crossed >= 0 and not _var_correct(t, y, k1, u, s0, c0, p, side,
+                                                 np.int64(crossed), m1, h, pc, VX, VG):
+                return 1
+            graze = False
+            need = False
+            for j in range(n_ev):
+                flag = gbuf[GRAZE_ROW, j] != 0.0
+                graze = graze or flag
+                need = need or flag or _side(g1[j]) != side[j]
+            ok = True
+            if u > 0.0:
+                sm, cm = _phase_at(sa, ca, wh, i_mod, 0.5 * (1.0 + u))
+                ok = _var_sub(y, k1, dt, t, t + 0.5 * dt, sm, cm, t + dt, s_end, c_end, s0, c0,
+                              p, side, m1, h, bool(True), VX, VG)  # noqa: UP018 (see below)
+                _events_i(t_end, y_trial, g1, p, s_end, c_end)
+                need = graze
+                for j in range(n_ev):
+                    need = need or _side(g1[j]) != side[j]
+            if not need:
+                finished = True
+                break
+            _split_rhs(t_end, y_trial, f1, p, s_end, c_end)
+            _split_copy(ystart, y)
+            pcs = (sa, ca, wh, i_mod, u, 1.0 - u)
+            _interpolant_events(ystart, k1, y_trial, f1, dt, t, p, ybuf, g0, g13, g23, pcs)
+            first = -1
+            theta = 2.0
+            for j in range(n_ev):
+                flag = gbuf[GRAZE_ROW, j] != 0.0
+                if flag or _side(g1[j]) != side[j]:
+                    th = _first_crossing(j, side[j], flag, g1[j], ystart, k1, y_trial, f1, dt,
+                                         t, p, ybuf, gbuf, gsc, pcs)
+                else:
+                    th = 2.0
+                gbuf[2, j] = th
+                if th < theta:
+                    theta = th
+                    first = j
+            if first < 0:
+                finished = True
+                break
+            tm = u + 0.5 * theta * (1.0 - u)
+            tu = u + theta * (1.0 - u)
+            sm, cm = _phase_at(sa, ca, wh, i_mod, tm)
+            s1, c1 = _phase_at(sa, ca, wh, i_mod, tu)
+            hs = theta * dt
+            # bool(): a literal True / False would compile _var_sub once for each
+            if not _var_sub(ystart, k1, hs, t, t + 0.5 * hs, sm, cm, t + hs, s1, c1, s0, c0,
+                            p, side, m1, h, bool(False), VX, VG):  # noqa: UP018
+                return 1
+            n_cross = 0
+            for j in range(n_ev):
+                if gbuf[2, j] <= theta + SIMULTANEOUS:
+                    side[j] = -side[j]
+                    ncross[j] += 1
+                    n_cross += 1
+                    crossed = j
+            if n_cross != 1:
+                return 1
+            s0 = s1
+            c0 = c1
+            u = tu
+            if u >= 1.0:
+                _events_i(t_end, y, g1, p, s_end, c_end)
+                t = t0 + (i + u) * h
+                _split_rhs(t, y, k1, p, s0, c0)
+                if not _var_correct(t, y, k1, u, s0, c0, p, side, np.int64(crossed), m1, h, pc,
+                                    VX, VG):
+                    return 1
+                return 0
+        if not finished:
+            return 1  # the split limit: the difference rows take the step (and count it)
+        if u == 0.0:
+            return 2  # no crossing: the trial, its tangent unforced as an unsplit step's
+        # the rest of the step's trial taken, its tangent forced onto the sides after the
+        # crossing
+        if not ok:
+            return 1
+        for q in range(ns):
+            y[q] = y_trial[q]
+        for j in range(m1):
+            b = 9 + 7 * j
+            for q in range(ns):
+                VX[b, q] = VX[b + 1, q]
+        return 0
+
+    @nb.njit(_nrt=False, **_JIT)  # it allocates nothing: no reference counting of its views
+    def _var_split_lane(i, t0, Z, S, IS, p, h, omega, n_per, s_tab, c_tab, n_ev, YP, E, K, TMP,
+                        Y1, SIDE, G0, G1, W, gbuf, NCR, UNRES, VX, VG):
+        """Grid step i of one lane (state Z[0], tangent vectors Z[1..] in z = y / S) whose
+        variational trial leaves a side of an edge or may graze one (the caller's screen: the
+        state's trial in VX[1], the events at the step's start and the trial's end in G0[0],
+        G1[0], their sides at the start in SIDE[0], the graze flags in gbuf[GRAZE_ROW]): the
+        state split at its crossings and the tangent vectors carried through the sub-steps
+        (:func:`_var_split`); where that is ill-posed, the step by the difference rows
+        (:func:`_tangent_step`). Returns 1 where the step took the difference rows, else 0.
+        Scratch as :func:`_var_step`'s, VX, VG (see above)."""
+        m, ns = Z.shape
+        m1 = m - 1
+        t = t0 + i * h
+        hh = 0.5 * h
+        j0 = 2 * (i % n_per)
+        y = VX[0]
+        for q in range(ns):
+            y[q] = Z[0, q]
+        for j in range(m1):
+            b = 9 + 7 * j
+            for q in range(ns):
+                VX[b, q] = S[q] * Z[j + 1, q]
+        for j in range(n_ev):
+            VG[2, j] = FORCE_MARGIN * max(abs(G0[0, j]), abs(G1[0, j]))
+        code = _var_split(i, t0, m1, p, h, omega, n_per, s_tab[j0], c_tab[j0], s_tab[j0 + 2],
+                          c_tab[j0 + 2], SIDE[0], G1[0], NCR[0], W, gbuf, VX, VG)
+        if code == 2:  # the unsplit trial: the tangent vectors by the variational trial
+            for j in range(m1):
+                b = 9 + 7 * j
+                _var_trial(t, hh, h, y, VX[b], p, s_tab[j0], c_tab[j0], s_tab[j0 + 1],
+                           c_tab[j0 + 1], s_tab[j0 + 2], c_tab[j0 + 2], VX[5:9],
+                           VX[b + 3:b + 7], VX[2], VX[b + 2], VX[1], VX[b + 1])
+                for q in range(ns):
+                    VX[b, q] = VX[b + 1, q]
+            for q in range(ns):
+                y[q] = VX[1, q]
+            code = 0
+        if code:
+            _tangent_step(i, t0, Z, S, IS, p, h, omega, n_per, s_tab, c_tab, n_ev, YP, E, K,
+                          TMP, Y1, SIDE, G0, G1, W, gbuf, NCR, UNRES)
+            return 1
+        for j in range(m1):
+            b = 9 + 7 * j
+            for q in range(ns):
+                Z[j + 1, q] = VX[b, q] * IS[q]
+        for q in range(ns):
+            Z[0, q] = y[q]
+        return 0
+
     @nb.njit(_nrt=False, **_JIT)  # it allocates nothing
     def _var_step(i, t0, Z, S, IS, p, h, omega, n_per, s_tab, c_tab, n_ev, YP, E, K, TMP,
-                  Y1, SIDE, G0, G1, W, gbuf, NCR, UNRES, VW):
+                  Y1, SIDE, G0, G1, W, gbuf, NCR, UNRES, VW,
+                  VX, VG):
         """Advance the state y (row 0 of Z) by grid step i and each tangent vector v (rows 1..,
         in z = y / S) by the exact derivative of the RK4 step map: the variational RK4
         (:func:`_var_trial`, w = S v). A step whose state leaves a side of an edge (or may graze
         one; :func:`_leaves_side_step`, as :func:`_rows_step` screens it) is split at the
-        crossing: that step is redone by :func:`_tangent_step` (the state split as everywhere,
-        the tangent vectors by the difference rows through their own splits). Returns 1 where
-        the step took the difference rows, else 0. VW: scratch, (2 m + 10, ns)."""
+        crossing, the tangent vectors through its sub-steps (:func:`_var_split_lane`). Returns 1
+        where the step took the difference rows, else 0. VW: scratch, (2 m + 10, ns); VX, VG:
+        :func:`_var_split`'s."""
         m, ns = Z.shape
         t = t0 + i * h
         hh = 0.5 * h
@@ -205,9 +594,15 @@ if VARIATIONAL:
             _events_i(t + h, Y1[last], G1[last], p, s_tab[j0 + 2], c_tab[j0 + 2])
             if _leaves_side_step(last, t, t + h, YP, K[0], G0, G1, SIDE, p, W[8], gbuf,
                                  s_tab[j0 + 2], c_tab[j0 + 2]):
-                _tangent_step(i, t0, Z, S, IS, p, h, omega, n_per, s_tab, c_tab, n_ev, YP, E,
-                              K, TMP, Y1, SIDE, G0, G1, W, gbuf, NCR, UNRES)
-                return 1
+                for q in range(ns):
+                    VX[1, q] = Y1[last, q]
+                for j in range(n_ev):
+                    G0[0, j] = G0[last, j]
+                    G1[0, j] = G1[last, j]
+                    SIDE[0, j] = SIDE[last, j]
+                return _var_split_lane(i, t0, Z, S, IS, p, h, omega, n_per, s_tab, c_tab,
+                                       n_ev, YP, E, K, TMP, Y1, SIDE, G0, G1, W, gbuf, NCR,
+                                       UNRES, VX, VG)
         for j in range(1, m):
             for q in range(ns):
                 Z[j, q] = WN[j, q] * IS[q]
@@ -218,7 +613,15 @@ if VARIATIONAL:
 else:
     @nb.njit(**_JIT)
     def _var_step(i, t0, Z, S, IS, p, h, omega, n_per, s_tab, c_tab, n_ev, YP, E, K, TMP,
-                  Y1, SIDE, G0, G1, W, gbuf, NCR, UNRES, VW):
+                  Y1, SIDE, G0, G1, W, gbuf, NCR, UNRES, VW, VX, VG):
+        """A model without tangent forms has no variational step (its callers refuse)."""
+        if n_ev >= 0:
+            raise ValueError("this model has no tangent form of its rhs (no one form)")
+        return 0
+
+    @nb.njit(**_JIT)
+    def _var_split_lane(i, t0, Z, S, IS, p, h, omega, n_per, s_tab, c_tab, n_ev, YP, E, K, TMP,
+                        Y1, SIDE, G0, G1, W, gbuf, NCR, UNRES, VX, VG):
         """A model without tangent forms has no variational step (its callers refuse)."""
         if n_ev >= 0:
             raise ValueError("this model has no tangent form of its rhs (no one form)")
@@ -235,8 +638,9 @@ def _run(p, y0, S, t0, h, omega, n_per, s_tab, c_tab, n_transient, n_steps, reno
     of grid steps whose tangent vectors took the difference rows of one
     lane, started at time t0 (forcing phase zero there); tangent vectors in the
     coordinates y / S (S: the state scale). ``variational``: the tangent vectors by the
-    variational RK4 (:func:`_var_step`; split steps by the difference rows), else by the
-    difference rows (:func:`_tangent_step`) at every step."""
+    variational RK4 (:func:`_var_step`; split steps through the sub-steps, by the difference
+    rows only where that is ill-posed), else by the difference rows (:func:`_tangent_step`) at
+    every step."""
     ns = y0.size
     IS = np.empty(ns)
     for q in range(ns):
@@ -264,6 +668,8 @@ def _run(p, y0, S, t0, h, omega, n_per, s_tab, c_tab, n_transient, n_steps, reno
     blk = np.zeros((nbk, k))  # log stretch per block of the measuring window
     C = np.zeros((m, ns))
     VW = np.zeros((10 + m, ns))
+    VX = np.zeros((9 + 7 * k, ns))
+    VG = np.zeros((3, ne))
     n_fd = 0
     out = np.full(k, np.nan)
     err = np.full(k, np.nan)
@@ -281,7 +687,7 @@ def _run(p, y0, S, t0, h, omega, n_per, s_tab, c_tab, n_transient, n_steps, reno
     for i in range(total):
         if variational:
             n_fd += _var_step(i, t0, Z, S, IS, p, h, omega, n_per, s_tab, c_tab, n_ev, YP, E, K,
-                              TMP, Y1, SIDE, G0, G1, W, gbuf, NCR, UNRES, VW)
+                              TMP, Y1, SIDE, G0, G1, W, gbuf, NCR, UNRES, VW, VX, VG)
         else:
             _tangent_step(i, t0, Z, S, IS, p, h, omega, n_per, s_tab, c_tab, n_ev, YP, E, K,
                           TMP, Y1, SIDE, G0, G1, W, gbuf, NCR, UNRES)
@@ -336,8 +742,9 @@ def lyapunov_single(p, y0, scale, t0, h, omega, n_per, n_transient, n_steps, ren
     STATUS_DIVERGED); ``unresolved``: grid steps of the state or a perturbed row that reached
     the split limit (MAX_SPLITS) and fell back unsplit, the status then STATUS_SPLIT_LIMIT
     (exponents kept) unless diverged; ``fd_steps``: the grid steps whose tangent vectors took
-    the difference rows (every step, or with ``variational`` the split ones: see
-    :func:`_var_step`; ``variational`` needs the model's tangent forms, :data:`VARIATIONAL`).
+    the difference rows (every step, or with ``variational`` the split steps where carrying
+    the tangent through the sub-steps is ill-posed: see :func:`_var_split_lane`;
+    ``variational`` needs the model's tangent forms, :data:`VARIATIONAL`).
     Returns (exponents, stderr, blocks, status, unresolved, fd_steps).
     """
     s_tab, c_tab = phase_table(n_per, omega != 0.0)
@@ -1070,8 +1477,9 @@ def _lyap_block_local(form, lo, hi, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TA
 # vector together, the RK4 stages of the pair (y, w = S v) from the lane-scalar tangent form
 # ``rhs_lane_tangent`` (f and J w in one inlined call; :func:`_var_row_trial`), then screens the
 # state's trial as the fused loop does and commits the unflagged lanes. A flagged lane (its state
-# leaves a side of an edge or may graze one) is finished out of line by the difference rows
-# (:func:`_tangent_step`, as :func:`_var_step` does it for one lane). Each lane's arithmetic is
+# leaves a side of an edge or may graze one) is finished out of line, split with its tangent
+# through the sub-steps (:func:`_var_split_lane`, as :func:`_var_step` does it for one lane; the
+# difference rows where that is ill-posed). Each lane's arithmetic is
 # that of :func:`_var_step`, operation for operation: the exponents are bitwise those of
 # :func:`lyapunov_single` with ``variational``.
 
@@ -1115,12 +1523,13 @@ if VARIATIONAL:
 
     @nb.njit(inline="always", **_JIT)
     def _var_fused_steps(form, i, nl, locate, Z0, Z1, S, IS, PT, T0L, HL, HHL, H6L, PH, ACT,
-                         FLAG, GR):
+                         FLAG, GR, Y1F):
         """Grid step i of every lane of the block (see above): Z0, Z1 the state and the
         tangent vector (flat rows of BLOCK lanes), committed where the lane is active and its
         state's trial unflagged (``locate``: the edges screened; GR: the graze flags, a row of
-        BLOCK per switching function of the model); FLAG[l] = 1 where an active lane is flagged.
-        Returns the number of flagged lanes."""
+        BLOCK per switching function of the model); FLAG[l] = 1 where an active lane is flagged,
+        the state's trial into Y1F (as Z0) for :func:`_var_flagged`. Returns the number of
+        flagged lanes."""
         P0, P1, P2, P3, P4, P5 = PH
         n_flag = 0
         for l in range(nl):
@@ -1141,6 +1550,7 @@ if VARIATIONAL:
             keep = act & (not hit)
             _t_store(Z1, l, _t_unscale(w1, IS), v, keep)
             _t_store(Z0, l, y1, y, keep)
+            _t_store(Y1F, l, y1, y1, True)
             FLAG[l] = 1.0 if flagged else 0.0
             n_flag += 1 if flagged else 0
         return n_flag
@@ -1148,11 +1558,12 @@ if VARIATIONAL:
 
 @nb.njit(_nrt=False, **_JIT)  # it allocates nothing: no reference counting of its views
 def _var_flagged(i, nl, first, n_ev, P, Z0, Z1, S, IS, T0L, HL, OMEGA, NPL, IDX, S_TAB, C_TAB,
-                 FLAG, UNRR, FDL, fd):
-    """The flagged lanes of step i (:func:`_var_fused_steps`) by the difference rows, each as
-    :func:`_var_step` takes such a step (:func:`_tangent_step` from the lane's state and
-    tangent vector; its rows' split-limit steps into UNRR[l], the step counted in FDL[l])."""
-    Zl, YP, E, K, TMP, Y1, SIDE, G0, G1, W, gbuf, NCR, UNRES = fd
+                 FLAG, UNRR, FDL, GR, Y1F, fd):
+    """The flagged lanes of step i (:func:`_var_fused_steps`), each as :func:`_var_step`
+    takes such a step (:func:`_var_split_lane` from the lane's state and tangent vector; the
+    split-limit steps of the difference rows it may fall back to into UNRR[l], such a step
+    counted in FDL[l])."""
+    Zl, YP, E, K, TMP, Y1, SIDE, G0, G1, W, gbuf, NCR, UNRES, VX, VG = fd
     ns = Zl.shape[1]
     for l in range(nl):
         if FLAG[l] == 0.0:
@@ -1164,13 +1575,26 @@ def _var_flagged(i, nl, first, n_ev, P, Z0, Z1, S, IS, T0L, HL, OMEGA, NPL, IDX,
         off = IDX[l] - 2 * (i % NPL[l])  # the lane's phase table in S_TAB, C_TAB
         for r in range(UNRES.size):
             UNRES[r] = 0
-        _tangent_step(i, T0L[l], Zl, S, IS, P[lane], HL[l], OMEGA[lane], NPL[l], S_TAB[off:],
-                      C_TAB[off:], n_ev, YP, E, K, TMP, Y1, SIDE, G0, G1, W, gbuf, NCR, UNRES)
+        # the screen of the fused loop's trial (as :func:`_var_step` screens it)
+        p = P[lane]
+        h = HL[l]
+        t = T0L[l] + i * h
+        j0 = IDX[l]
+        _events_i(t, Zl[0], G0[0], p, S_TAB[j0], C_TAB[j0])
+        for j in range(n_ev):
+            SIDE[0, j] = _side(G0[0, j])
+            gbuf[GRAZE_ROW, j] = GR[j * BLOCK + l]
+        for q in range(ns):
+            VX[1, q] = Y1F[q * BLOCK + l]
+        _events_i(t + h, VX[1], G1[0], p, S_TAB[j0 + 2], C_TAB[j0 + 2])
+        fd_l = _var_split_lane(i, T0L[l], Zl, S, IS, P[lane], HL[l], OMEGA[lane], NPL[l],
+                               S_TAB[off:], C_TAB[off:], n_ev, YP, E, K, TMP, Y1, SIDE, G0, G1,
+                               W, gbuf, NCR, UNRES, VX, VG)
         for q in range(ns):
             Z0[q * BLOCK + l] = Zl[0, q]
             Z1[q * BLOCK + l] = Zl[1, q]
         UNRR[l] += UNRES.sum()
-        FDL[l] += 1
+        FDL[l] += fd_l
 
 
 @nb.njit(inline="always", **_JIT)
@@ -1178,7 +1602,8 @@ def _lyap_var_run(form, first, nl, n_ev, max_total, due, renorm, bound, P, OMEGA
                   lanes, books, out, err, used, status, scratch, fd):
     """The time loop of a variational block (see above): every grid step of the block's lanes,
     their flagged lanes out of line, their bookkeeping where due (:func:`_lane_books`)."""
-    (Z0, Z1, ZT, T0L, HL, HHL, H6L, IDX, NPL, ENDL, PH, ACT, ACTR, FLAG, GR, UNRR, FDL) = lanes
+    (Z0, Z1, ZT, T0L, HL, HHL, H6L, IDX, NPL, ENDL, PH, ACT, ACTR, FLAG, GR, UNRR, FDL,
+     Y1F) = lanes
     IST, ENDS, BLK, ACC, Zl, Cl, logs = books
     S_TAB, C_TAB = scratch
     nv = _padded(nl)
@@ -1195,10 +1620,10 @@ def _lyap_var_run(form, first, nl, n_ev, max_total, due, renorm, bound, P, OMEGA
                 PH[2 * d][l] = S_TAB[j + d]
                 PH[2 * d + 1][l] = C_TAB[j + d]
         n_flag = _var_fused_steps(form, i, nv, locate, Z0, Z1, S, IS, PT, T0L, HL, HHL, H6L,
-                                  PH, ACT, FLAG, GR)
+                                  PH, ACT, FLAG, GR, Y1F)
         if n_flag > 0:
             _var_flagged(i, nl, first, n_ev, P, Z0, Z1, S, IS, T0L, HL, OMEGA, NPL, IDX, S_TAB,
-                         C_TAB, FLAG, UNRR, FDL, fd)
+                         C_TAB, FLAG, UNRR, FDL, GR, Y1F, fd)
         for l in range(nl):
             IDX[l] = IDX[l] + 2 if IDX[l] + 2 < ENDL[l] else IDX[l] + 2 - 2 * NPL[l]
         step = i + 1
@@ -1237,7 +1662,8 @@ def _lyap_block_var(form, first, nl, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB,
                     status, unres, fd_steps):
     """:func:`_lyap_block` with k = 1 by the variational block of lane form ``form`` (nl <=
     BLOCK lanes): per lane what :func:`_run` with ``variational`` computes, bitwise; the
-    lanes' steps by the difference rows into fd_steps[lane]."""
+    lanes' steps by the difference rows (split steps where carrying the tangent through the
+    sub-steps is ill-posed) into fd_steps[lane]."""
     ns = Y0.shape[1]
     (IS, ZT, Z0, Z1, PT, T0L, HL, HHL, H6L, IDX, NPL, ENDL, PH, ACT, ACTR, FLAG, IST, ENDS, BLK,
      ACC, Zl, Cl, logs, max_total, renorm, due) = _fused_block_start(
@@ -1252,8 +1678,11 @@ def _lyap_block_var(form, first, nl, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB,
     fd = (np.zeros((2, ns)), np.zeros((3, ns)), np.zeros(2), np.zeros((4, 3, ns)),
           np.zeros((3, ns)), np.zeros((3, ns)), np.ones((3, ne), np.int64), np.zeros((3, ne)),
           np.zeros((3, ne)), np.zeros((9, ns)), np.zeros((GBUF_ROWS, ne)),
-          np.zeros((3, ne), np.int64), np.zeros(3, np.int64))
-    lanes = (Z0, Z1, ZT, T0L, HL, HHL, H6L, IDX, NPL, ENDL, PH, ACT, ACTR, FLAG, GR, UNRR, FDL)
+          np.zeros((3, ne), np.int64), np.zeros(3, np.int64), np.zeros((16, ns)),
+          np.zeros((3, ne)))
+    Y1F = np.zeros(ns * BLOCK)  # the states' trials (flat rows of BLOCK lanes, as Z0)
+    lanes = (Z0, Z1, ZT, T0L, HL, HHL, H6L, IDX, NPL, ENDL, PH, ACT, ACTR, FLAG, GR, UNRR, FDL,
+             Y1F)
     books = (IST, ENDS, BLK, ACC, Zl, Cl, logs)
     args = (first, nl, n_ev, max_total, due, renorm, bound, P, OMEGA, H, S, IS, PT, lanes, books,
             out, err, used, status, (S_TAB, C_TAB), fd)
