@@ -144,7 +144,7 @@ def test_the_study_file_and_the_option_accept_the_same_omega(omega):
     """``[run].omega`` and ``--omega`` are one rule: the same value accepted or refused by both,
     the refusal naming where it came from; the rule is that the period 2 pi / Omega is a
     positive finite number (computed here, independently)."""
-    from geardyn.cli.common import check_omega
+    from geardyn.core.settings import check_omega  # the rule every --omega option calls
 
     period = 2 * math.pi / omega if omega != 0 else math.inf
     usable = math.isfinite(omega) and math.isfinite(period) and period > 0
@@ -157,7 +157,7 @@ def test_the_study_file_and_the_option_accept_the_same_omega(omega):
         assert exc.errors()[0]["loc"] == ("run", "omega")
         by_study = False
     try:
-        check_omega("--omega", omega)
+        check_omega(omega, "--omega")
         by_option = True
     except ParameterError as exc:
         assert exc.field == "--omega"

@@ -58,7 +58,7 @@ from geardyn.analysis.bifurcation import ContinuedSweep, continued_sweeps
 from geardyn.analysis.dataset import model_attrs
 from geardyn.core.model import Model
 from geardyn.core.results import finish
-from geardyn.core.settings import RunSettings, check_omega, resolve_run
+from geardyn.core.settings import SWEEP_DIRECTIONS, RunSettings, check_omega, resolve_run
 from geardyn.core.status import Status, status_attrs
 from geardyn.solvers.kernels import kernels_for
 
@@ -66,7 +66,7 @@ __all__ = ["BAND_TOL", "JUMP_TOL", "SWEEPS", "frequency_response", "mesh_deflect
            "physical_axes"]
 
 #: The two sweeps, in the order of the ``sweep`` dimension.
-SWEEPS = ("up", "down")
+SWEEPS = SWEEP_DIRECTIONS
 #: Relative change of dte_rms at a band's edge that counts as a jump.
 JUMP_TOL = 0.1
 #: Relative difference of dte_rms between the sweeps that counts as hysteresis.

@@ -30,7 +30,6 @@ from geardyn.cli.common import (
     StepsOption,
     YesOption,
     check_count,
-    check_omega,
     check_plot_path,
     check_run_cost,
     load_study_source,
@@ -40,6 +39,7 @@ from geardyn.cli.common import (
     study_run_settings,
     write_outputs,
 )
+from geardyn.core.settings import check_omega
 from geardyn.errors import ParameterError, StudyError
 from geardyn.io.study_models import study_model
 from geardyn.study import build_model, study_omega
@@ -92,7 +92,7 @@ def basins_command(
         om = study_omega(s, base)
     if om is None:
         raise StudyError("--omega: not given, and the study has no run.omega")
-    check_omega("--omega", om)
+    check_omega(om, "--omega")
     if out is not None and out.suffix.lower() != ".nc":
         raise ParameterError("--out", str(out), "suffix must be .nc (NetCDF)")
     check_plot_path("--plot", plot)

@@ -43,7 +43,6 @@ from geardyn.cli.common import (
     YesOption,
     check_continuation,
     check_count,
-    check_omega,
     check_plot_path,
     check_run_cost,
     continuation_option,
@@ -56,7 +55,7 @@ from geardyn.cli.common import (
     write_outputs,
 )
 from geardyn.core.results import SCHEMAS
-from geardyn.core.settings import OMEGA_RULE, SWEEP_DIRECTIONS, usable_omega
+from geardyn.core.settings import OMEGA_RULE, SWEEP_DIRECTIONS, check_omega, usable_omega
 from geardyn.errors import ParameterError, StudyError
 from geardyn.study import build_model, study_omega
 
@@ -272,7 +271,7 @@ def bifurcation_command(
     sweep = s.sweep
     name = param or (sweep.param if sweep is not None else "Omega")
     if omega is not None:  # [run].omega: the same rule, when the study was read
-        check_omega("--omega", omega)
+        check_omega(omega, "--omega")
     om = omega if omega is not None else s.run.omega
     interp = interpretation.value if interpretation is not None else None
     model = build_model(s, interpretation=interp, omega=om)

@@ -183,15 +183,6 @@ def check_continuation(value: str | None) -> str | None:
     return None if value is None else rule(value, "--continuation")
 
 
-def check_omega(option: str, value: float) -> None:
-    """Refuse a forcing frequency ``value`` that breaks the rule of ``[run].omega``
-    (:func:`geardyn.core.settings.check_omega`): a :class:`~geardyn.ParameterError` naming
-    ``option``."""
-    from geardyn.core.settings import check_omega as rule
-
-    rule(value, option)
-
-
 def run_settings(options: dict[str, tuple[str, Any]]):
     """The :class:`~geardyn.RunSettings` of command-line options alone (see
     :func:`settings_from_options`); a command that reads a study takes

@@ -39,7 +39,6 @@ from geardyn.cli.common import (
     QuietOption,
     StepsOption,
     check_count,
-    check_omega,
     check_plot_path,
     load_study_source,
     make_parents,
@@ -219,14 +218,14 @@ def continue_command(
         _check_state,
         _stderr_is_terminal,
     )
-    from geardyn.core.settings import ContinuationSettings
+    from geardyn.core.settings import ContinuationSettings, check_omega
     from geardyn.plotting.branch import QUANTITIES
 
     s = load_study_source(study)
     sweep = s.sweep
     name = param or (sweep.param if sweep is not None else "Omega")
     if omega is not None:  # [run].omega: the same rule, when the study was read
-        check_omega("--omega", omega)
+        check_omega(omega, "--omega")
     om = omega if omega is not None else s.run.omega
     if range_ is not None:
         start, stop = parse_span(range_)

@@ -36,7 +36,6 @@ from geardyn.cli.common import (
     StepsOption,
     YesOption,
     check_count,
-    check_omega,
     check_plot_path,
     check_run_cost,
     load_study_source,
@@ -46,6 +45,7 @@ from geardyn.cli.common import (
     study_run_settings,
     write_outputs,
 )
+from geardyn.core.settings import check_omega
 from geardyn.errors import ParameterError, StudyError
 from geardyn.study import build_model
 
@@ -107,7 +107,7 @@ def frc_command(
     else:
         why = "the study has no [sweep]" if sweep is None else f"the study sweeps {sweep.param}"
         raise StudyError(f"--range: not given, and {why}, not {name}")
-    check_omega("--range", [start, stop])
+    check_omega([start, stop], "--range")
     if out is not None and out.suffix.lower() != ".nc":
         raise ParameterError("--out", str(out), "suffix must be .nc (NetCDF)")
     check_plot_path("--plot", plot)

@@ -51,7 +51,6 @@ from geardyn.cli.common import (
     StepsOption,
     YesOption,
     check_count,
-    check_omega,
     check_plot_path,
     check_run_cost,
     load_study_source,
@@ -61,6 +60,7 @@ from geardyn.cli.common import (
     stderr_console,
     study_run_settings,
 )
+from geardyn.core.settings import check_omega
 from geardyn.core.status import Status
 from geardyn.errors import ParameterError, StudyError
 from geardyn.io.study_models import study_model
@@ -355,7 +355,7 @@ def simulate(
         om = study_omega(s, base)
     if om is None:
         raise StudyError("--omega: not given, and the study has no run.omega")
-    check_omega("--omega", om)
+    check_omega(om, "--omega")
     check_plot_path("--plot", plot)
     run = study_run_settings(s, {**run_options(transient=transient,
                                                steps_per_period=steps_per_period),

@@ -32,7 +32,6 @@ from geardyn.cli.common import (
     StepsOption,
     YesOption,
     check_count,
-    check_omega,
     load_study_source,
     refuse_if_costly,
     run_option,
@@ -40,6 +39,7 @@ from geardyn.cli.common import (
     run_settings,
     study_run_settings,
 )
+from geardyn.core.settings import check_omega
 from geardyn.errors import ParameterError, StudyError
 from geardyn.study import build_model
 
@@ -140,7 +140,7 @@ def map_command(
         if model.omega_index is None:
             raise ParameterError("study", s.study.name, "a map needs a forced model")
         if name == "Omega":
-            check_omega(option, ends[:, model.omega_index])
+            check_omega(ends[:, model.omega_index], option)
         if not np.all(np.isfinite(ends)):
             raise ParameterError(option, f"{name}:{start}:{stop}", "an end of the axis makes the"
                                  " model's coefficients infinite (a value is too extreme)")

@@ -24,7 +24,7 @@ from geardyn.analysis.motion import LYAPUNOV_FLOOR, LYAPUNOV_Z, exponent_sign, r
 from geardyn.core.model import Model
 from geardyn.core.plan import default_steps_at, lane_section
 from geardyn.core.results import finish
-from geardyn.core.settings import LyapunovSettings, RunSettings
+from geardyn.core.settings import SWEEP_DIRECTIONS, LyapunovSettings, RunSettings
 from geardyn.reproduction.cases import Case
 from geardyn.reproduction.motion import motion_labels
 from geardyn.study import build_model
@@ -32,7 +32,7 @@ from geardyn.study import build_model
 __all__ = ["DIRECTIONS", "ReproductionSettings", "branch_lyapunov", "run_case", "run_cases",
            "sweep_values", "worker_pool"]
 
-DIRECTIONS: tuple[str, str] = ("up", "down")
+DIRECTIONS: tuple[str, ...] = SWEEP_DIRECTIONS
 
 #: progress(stage, done, total): ``stage`` names the case, interpretation and sweep direction.
 Progress = Callable[[str, int, int], None]
