@@ -193,10 +193,11 @@ if VARIATIONAL:
             y1[q] = rk4_comb(y[q], h6, KS[0, q], KS[1, q], KS[2, q], KS[3, q])
             w1[q] = rk4_comb(w[q], h6, KV[0, q], KV[1, q], KV[2, q], KV[3, q])
 
-    # A split step's tangent: the state is split at its crossings as :func:`_split_step` splits
-    # it (the same operations: the same state, bitwise) and each tangent vector w follows its
-    # sub-steps by the variational RK4, the Jacobian of every stage taken on the sides of the
-    # sub-step (forced: a stage point that lies beyond an edge, by the O(h^3) of the crossing
+    # A split step's tangent: the state is split at its crossings by the split step itself
+    # (:func:`_split_run`, :func:`_split_step`'s body, with this tangent's hooks: the same
+    # operations, the same state, bitwise) and each tangent vector w follows its sub-steps by
+    # the variational RK4 (:func:`_var_sub`), the Jacobian of every stage taken on the sides of
+    # the sub-step (forced: a stage point that lies beyond an edge, by the O(h^3) of the crossing
     # found on the trial step's interpolant, is moved back onto its side along the orbit,
     # :func:`_side_point`); at each split point x, where the orbit's numerical crossing lies
     # g(x) / g'(x) before or after x (g the edge crossed, g' its rate along the orbit), the
