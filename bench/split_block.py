@@ -21,7 +21,16 @@ split on the same calls alternating with it, CPU time, median of ``--rounds``: n
 and per located crossing, the fraction of calls that fell back, and whether every state,
 side, end event and crossing count is bitwise the scalar split's.
 
+Variants (``--variants``): ``general``, the scalar split's arithmetic (the rhs in
+``FORM_GENERAL``, both of the forcing phase's polynomials computed and selected); ``short``,
+the phase's short polynomials alone (every lane's |Omega h| <= 0.1; the others fall back);
+``quiet``, short and the rhs in ``FORM_QUIET`` (the paper lanes' form: bitwise the same
+results is checked here, not guaranteed by construction). A batch's lanes are the flagged
+calls of different lanes (round-robin); idle lanes of a batch of fewer than eight compute a
+copy of its first lane, masked.
+
     .venv/bin/python bench/split_block.py [--rounds 7] [--batch 1,2,4,8] [--lanes 16]
+                                          [--variants general,short,quiet] [--models catt,pair]
 """
 
 from __future__ import annotations
@@ -426,8 +435,10 @@ def build(mod, ns: int, ne: int, short: bool = False, form: str = "FORM_GENERAL"
 
 
 def replayers(mod, rows, n_rows, split_block, ns, ne, npar, small):
-    """(replay_batched) : the recorded calls in batches of B, gathered into W, split together,
-    the fallback lanes by _split_step."""
+    """(run_batches, run_scalar): the recorded calls in batches of B gathered into W (the
+    rows of :func:`source`), split together (``split_block``), the lanes that fall back by
+    ``_split_step``; and the calls one by one by ``_split_step``. Both write every call's
+    state, sides, end events and crossings located into the output arrays."""
     split = mod._split_step
     gr_row = mod.GRAZE_ROW
 
