@@ -1,9 +1,10 @@
 """The batched split (bench/split_block.py) inside the sweep: the paper workload
 (bench/bifurcation.py's) run through a variant of the generated kernel module whose flagged
-slots wait (parked) until ``--pending`` of them, or every running lane of the block, are
-flagged, then split together, eight at a time; against the kernel as it is, alternating in one
-process, CPU time of one thread, median of ``--repeat``; and whether the two give bitwise the
-same dataset.
+slots wait (parked) until ``--pending`` of them are flagged, then the largest multiple of
+eight of them are split together, eight at a time (all of them where every running lane of
+the block is parked, and before the block compacts); against the kernel as it is,
+alternating in one process, CPU time of one thread, median of ``--repeat``; and whether the
+two give bitwise the same dataset.
 
 A flagged slot is parked out of line (``_slots_out``): its trial end, events and their
 history, graze flags, phase and clock are kept in block rows the fused loop does not use (K1,
@@ -103,7 +104,42 @@ SLOTS = ("(STAT, MSK, ACT, END, LANE, STEP, PHASE, NPER, OFF, HB, T0B, n_end, n_
          "next_sample, DUE, n_stat, n_ring) = slots")
 
 
-def helpers(rows: dict, small: float, pending: int) -> str:
+#: ``--freeze``: the fused loop leaves an inactive slot's clock, phase, trial end, events'
+#: history and graze flags as they are (selects), so that parking copies nothing.
+FREEZE_LOOP = [
+    ("        hit = _t_screen(g1, GS, GP, SIDE, GR, k, locate)\n",
+     "        hit = _t_screen_act(g1, GS, GP, SIDE, GR, k, locate, ACT[k])\n"),
+    ("        _t_store(Y1, k, y1, y1, True)\n",
+     "        _t_store(Y1, k, y1, _t_load(Y1, k), act)\n"),
+    ("        SE[k] = se\n        CE[k] = ce\n",
+     "        SE[k] = _pick(act, se, SE[k])\n        CE[k] = _pick(act, ce, CE[k])\n"),
+    ("        STEP[k] = st1\n        PHASE[k] = ph1\n",
+     "        STEP[k] = _pick(act, st1, st)\n        PHASE[k] = _pick(act, ph1, ph)\n"),
+]
+FREEZE_SCREEN = '''
+
+def _t_screen_act(g1, GS, GP, SIDE, GR, k, locate, act):
+    """_t_screen, the history and graze flags kept where not ``act``."""
+
+
+def _ov_t_screen_act(g1, GS, GP, SIDE, GR, k, locate, act):
+    lines = ["hit = False"]
+    for j in range(len(g1)):
+        gs, gp, gr = _ix(GS, "GS", j), _ix(GP, "GP", j), _ix(GR, "GR", j)
+        lines += ["g0 = " + gs,
+                  f"gr, fl = screen_grid(g1[{j}], {_ix(SIDE, 'SIDE', j)}, g0, {gp}, locate)",
+                  f"{gr} = _pick(act, _pick(gr, 1.0, 0.0), {gr})",
+                  f"{gp} = _pick(act, g0, {gp})", f"{gs} = _pick(act, g1[{j}], g0)",
+                  "hit = hit | fl"]
+    return _tuple_source("g1, GS, GP, SIDE, GR, k, locate, act", [*lines, "return hit"],
+                         {"screen_grid": screen_grid, "_pick": _pick})
+
+
+nb.extending.overload(_t_screen_act, inline="always")(_ov_t_screen_act)
+'''
+
+
+def helpers(rows: dict, small: float, pending: int, freeze: bool = False) -> str:
     """The park and flush functions (text for the kernel module)."""
 
     def r(name):
@@ -119,6 +155,10 @@ def _park(k, blk, slots):
     """Park flagged slot k: its trial end, events, history, graze flags, phase, clock kept."""
     {BLK}
     {SLOTS}
+    if {freeze}:
+        ACT[k] = False
+        SC[2, k] = 1.0
+        return
     for q in range(Y1.shape[0]):
         K1[q, k] = Y1[q, k]
     for j in range(GS.shape[0]):
@@ -158,6 +198,11 @@ def _flush(nl, GSx, SE, CE, TABS, lanes, cfg, out, blk, slots, scratch, force):
     for k in range(nl):
         if SC[2, k] != 0.0 and n < take:
             SC[2, k] = 0.0
+            ACT[k] = True
+            marked[n] = k
+            n += 1
+            if {freeze}:
+                continue
             for q in range(ns):
                 Y1[q, k] = K1[q, k]
             for j in range(ne):
@@ -168,9 +213,6 @@ def _flush(nl, GSx, SE, CE, TABS, lanes, cfg, out, blk, slots, scratch, force):
             PH[3][k] = TMP[1, k]
             STEP[k] = np.int64(K4[0, k])
             PHASE[k] = np.int64(K4[1, k])
-            ACT[k] = True
-            marked[n] = k
-            n += 1
     for b0 in range(0, n, 8):
         nb_ = min(8, n - b0)
         for mm in range(8):
@@ -229,7 +271,8 @@ def _flush(nl, GSx, SE, CE, TABS, lanes, cfg, out, blk, slots, scratch, force):
 '''
 
 
-def variant_source(source: str, ns: int, ne: int, pending: int, short: bool, form: str) -> str:
+def variant_source(source: str, ns: int, ne: int, pending: int, short: bool, form: str,
+                   freeze: bool = False) -> str:
     """The kernel module's text with the batched split and the parking of flagged slots."""
     text, rows = split_block.source(ns, ne, short, form)
     small = 0.1 if short else 0.8
@@ -240,9 +283,10 @@ def variant_source(source: str, ns: int, ne: int, pending: int, short: bool, for
         "from geardyn.core.kernel_source import FORM_QUIET\n"
         "from geardyn.solvers._step_shared import (BRACKET_TOL, CONFIRM_TOL, GRAZE_TOL, "
         "HALLEY_TOL, _cubic_at, _cubic_coeffs, _forced, _hermite_weights, _pick)\n"
-        f"SB_ROWS = {n_rows}\n" + text + helpers(rows, small, pending))
+        f"SB_ROWS = {n_rows}\n" + text + helpers(rows, small, pending, freeze)
+        + (FREEZE_SCREEN if freeze else ""))
     edits = [(SLOTS_OUT_OLD, SLOTS_OUT_NEW), (RUN_OLD, RUN_NEW), (COMPACT_OLD, COMPACT_NEW),
-             (INIT_OLD, INIT_NEW), (SCRATCH_OLD, SCRATCH_NEW)]
+             (INIT_OLD, INIT_NEW), (SCRATCH_OLD, SCRATCH_NEW), *(FREEZE_LOOP if freeze else [])]
     out = source
     for old, new in edits:
         if out.count(old) != 1:
@@ -318,6 +362,9 @@ def main() -> None:
                     help="the phase's short polynomials alone (lanes with |Omega h| > 0.1 "
                          "fall back)")
     ap.add_argument("--gear-pair", action="store_true")
+    ap.add_argument("--freeze", action="store_true",
+                    help="the fused loop keeps an inactive slot's clock, phase, trial end and "
+                         "events (selects), so that parking a slot copies nothing")
     ap.add_argument("--nosplit", action="store_true",
                     help="each variant also without the split (a flagged step committed, its "
                          "crossings counted at its end: wrong results, for the cost split)")
@@ -346,7 +393,7 @@ def main() -> None:
         for name in names:
             kind = name.split("+")[0]
             text = source if kind == "base" else variant_source(
-                source, ns, ne, int(kind[7:]), args.short, form)
+                source, ns, ne, int(kind[7:]), args.short, form, args.freeze)
             if name.endswith("+nosplit"):
                 text = nosplit(text, kind)
             mods[name] = module(text, name, Path(tmp))
