@@ -13,10 +13,15 @@ fused loop leaves its state alone (it runs its lane, commits nothing and flags n
 enough are parked (and before the block compacts) they are restored and split together
 (``split_block``; the lanes that fall back by ``_finish_flagged``), then their bookkeeping is
 done as before (``_slot_out``). The fused loop is unchanged. The wait costs the parked slots'
-vector lanes in the fused loop.
+vector lanes in the fused loop. ``--freeze``: the fused loop itself keeps an inactive slot's
+clock, phase, trial end, events' history and graze flags (selects), so that parking and
+restoring a slot copies nothing (a free slot's clock then stays too). ``--nosplit``: each
+variant also without any split (bench/fused_loop.py's ``nosplit``: wrong results), so that
+the split's share and the parking's can be told apart.
 
     .venv/bin/python bench/split_insitu.py [--pending 8,4] [--repeat 5] [--points 1000]
-                                           [--form quiet] [--short] [--gear-pair] [--nosplit]
+                                           [--form quiet] [--short] [--freeze] [--nosplit]
+                                           [--gear-pair]
 """
 
 from __future__ import annotations
