@@ -688,11 +688,11 @@ def _lanes_cached_stiffness(PT, nl, S, C, SC, cache, mesh, bs, nh, nm, two):
     b = cache + 1 + e * width
     top, uniform = _lanes_prepare_harmonics(PT, nl, cache + 1 + CACHE_ENTRIES * width + 1, mesh,
                                             bs, nh, nm)
-    _lanes_stiffness(PT, nl, S, C, SC, b + 2, mesh, bs, nh, nm, MESH_FIXED, top, uniform)
-    if two:
-        n = int(PT[N_DOF, 0])
-        _lanes_stiffness(PT, nl, S, C, SC, b + 2 + nm, mesh, bs, nh, nm, coast_offset(n, nh),
-                         top, uniform)
+    n = int(PT[N_DOF, 0])
+    for flank in range(2 if two else 1):  # one call site: one compile, one copy
+        first = MESH_FIXED if flank == 0 else coast_offset(n, nh)
+        _lanes_stiffness(PT, nl, S, C, SC, b + 2 + flank * nm, mesh, bs, nh, nm, first, top,
+                         uniform)
     for k in range(nl):
         PT[b, k] = S[k]
         PT[b + 1, k] = C[k]
@@ -834,7 +834,8 @@ def planetary_rhs_lanes(T, Y, DY, PT, nl, S, C, SC):
             r = g + 2 + 2 * ng + e
             for k in range(nl):
                 DY[i, k] -= (PT[g, k] * PT[r, k]) * Y[j, k]
-    _lanes_meshes(T, Y, DY, PT, nl, S, C, SC, True)
+    # bool(): a literal True / False would compile _lanes_meshes once for each
+    _lanes_meshes(T, Y, DY, PT, nl, S, C, SC, bool(True))  # noqa: UP018
 
 
 @nb.njit(**_JIT_BODY)
@@ -996,7 +997,7 @@ def planetary_events_lanes(T, Y, G, PT, nl, S, C):
 @nb.njit(**_JIT_LANES)
 def planetary_observe_lanes(T, Y, O, PT, nl, S, C, SC):
     """:func:`planetary_observe` for lanes 0..nl-1 of a block (O: one row per mesh)."""
-    _lanes_meshes(T, Y, O, PT, nl, S, C, SC, False)
+    _lanes_meshes(T, Y, O, PT, nl, S, C, SC, bool(False))  # noqa: UP018
 
 
 # ---------------------------------------------------------------------------------------------
@@ -1133,11 +1134,10 @@ def _lanes_own_phases(T, PT, nl, S, C, own, n, nh, nm, mesh, bs, chk):
             continue
         hm = int(PT[o + M_NH, 0])
         hs = int(PT[o + M_HSTEP, 0])
-        _lanes_own_stiffness(PT, nl, r + m, r + nm + m, r + 2 * nm + m, o + MESH_FIXED, hm, hs,
-                             x)
-        if two:
-            _lanes_own_stiffness(PT, nl, r + m, r + nm + m, r + 3 * nm + m,
-                                 o + coast_offset(n, nh), hm, hs, x)
+        for flank in range(2 if two else 1):  # one call site: one compile, one copy
+            first = MESH_FIXED if flank == 0 else coast_offset(n, nh)
+            _lanes_own_stiffness(PT, nl, r + m, r + nm + m, r + (2 + flank) * nm + m, o + first,
+                                 hm, hs, x)
     PT[own, 0] = e
     return r
 
