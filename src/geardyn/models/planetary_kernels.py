@@ -834,11 +834,10 @@ def planetary_rhs_lanes(T, Y, DY, PT, nl, S, C, SC):
             r = g + 2 + 2 * ng + e
             for k in range(nl):
                 DY[i, k] -= (PT[g, k] * PT[r, k]) * Y[j, k]
-    # bool(): a literal True / False would compile _lanes_meshes once for each
-    _lanes_meshes(T, Y, DY, PT, nl, S, C, SC, bool(True))  # noqa: UP018
+    _lanes_meshes(T, Y, DY, PT, nl, S, C, SC, True)
 
 
-@nb.njit(**_JIT_BODY)
+@nb.njit(inline="always", **_JIT)
 def _lanes_meshes(T, Y, DY, PT, nl, S, C, SC, apply):
     """The mesh forces of lanes 0..nl-1 of a block, each subtracted from the accelerations DY
     through its mesh's G (``apply``: :func:`planetary_rhs_lanes`) or written to row m of DY
@@ -997,7 +996,7 @@ def planetary_events_lanes(T, Y, G, PT, nl, S, C):
 @nb.njit(**_JIT_LANES)
 def planetary_observe_lanes(T, Y, O, PT, nl, S, C, SC):
     """:func:`planetary_observe` for lanes 0..nl-1 of a block (O: one row per mesh)."""
-    _lanes_meshes(T, Y, O, PT, nl, S, C, SC, bool(False))  # noqa: UP018
+    _lanes_meshes(T, Y, O, PT, nl, S, C, SC, False)
 
 
 # ---------------------------------------------------------------------------------------------
