@@ -451,6 +451,29 @@ def replayers(mod, rows, n_rows, split_block, ns, ne, npar, small):
         r("U")
     RACT, RFB = r("ACT"), r("FB")
 
+    @nb.njit(inline="always")
+    def replay_one(r_, P, H, OM, NPER, lane, recs_i, recs_y, recs_g, recs_ph, out_y, out_s,
+                   out_g, out_nc, y, y1, side, g1, ncross, work, ybuf, gbuf):
+        """Recorded call r_ through the scalar split step, its results into row r_ of out_*."""
+        k = lane[r_]
+        for q in range(ns):
+            y[q] = recs_y[r_, 0, q]
+            y1[q] = recs_y[r_, 1, q]
+        for j in range(ne):
+            side[j] = int(recs_g[r_, 0, j])
+            g1[j] = recs_g[r_, 1, j]
+            gbuf[gr_row, j] = recs_g[r_, 2, j]
+            ncross[j] = 0
+        split(recs_i[r_], 0.0, y, y1, P[k], H[k], OM[k], NPER[k], recs_ph[r_, 0],
+              recs_ph[r_, 1], recs_ph[r_, 2], recs_ph[r_, 3], side, g1, ncross, work, ybuf,
+              gbuf)
+        for q in range(ns):
+            out_y[r_, q] = y[q]
+        for j in range(ne):
+            out_s[r_, j] = side[j]
+            out_g[r_, j] = g1[j]
+            out_nc[r_, j] = ncross[j]
+
     @nb.njit(_nrt=False)
     def run_batches(P, H, OM, NPER, lane, order, B, recs_i, recs_y, recs_g, recs_ph, n_rep,
                     out_y, out_s, out_g, out_nc, W, PTb, y, y1, side, g1, ncross, work, ybuf,
@@ -496,24 +519,9 @@ def replayers(mod, rows, n_rows, split_block, ns, ne, npar, small):
                     r_ = order[b0 + mm]
                     if W[RFB + mm] != 0.0:
                         n_fb += 1
-                        k = lane[r_]
-                        for q in range(ns):
-                            y[q] = recs_y[r_, 0, q]
-                            y1[q] = recs_y[r_, 1, q]
-                        for j in range(ne):
-                            side[j] = int(recs_g[r_, 0, j])
-                            g1[j] = recs_g[r_, 1, j]
-                            gbuf[gr_row, j] = recs_g[r_, 2, j]
-                            ncross[j] = 0
-                        split(recs_i[r_], 0.0, y, y1, P[k], H[k], OM[k], NPER[k],
-                              recs_ph[r_, 0], recs_ph[r_, 1], recs_ph[r_, 2], recs_ph[r_, 3],
-                              side, g1, ncross, work, ybuf, gbuf)
-                        for q in range(ns):
-                            out_y[r_, q] = y[q]
-                        for j in range(ne):
-                            out_s[r_, j] = side[j]
-                            out_g[r_, j] = g1[j]
-                            out_nc[r_, j] = ncross[j]
+                        replay_one(r_, P, H, OM, NPER, lane, recs_i, recs_y, recs_g, recs_ph,
+                                   out_y, out_s, out_g, out_nc, y, y1, side, g1, ncross, work,
+                                   ybuf, gbuf)
                     else:
                         for q in range(ns):
                             out_y[r_, q] = W[RY + q * NV + mm]
@@ -528,24 +536,8 @@ def replayers(mod, rows, n_rows, split_block, ns, ne, npar, small):
                    out_s, out_g, out_nc, y, y1, side, g1, ncross, work, ybuf, gbuf):
         for _ in range(n_rep):
             for r_ in order:
-                k = lane[r_]
-                for q in range(ns):
-                    y[q] = recs_y[r_, 0, q]
-                    y1[q] = recs_y[r_, 1, q]
-                for j in range(ne):
-                    side[j] = int(recs_g[r_, 0, j])
-                    g1[j] = recs_g[r_, 1, j]
-                    gbuf[gr_row, j] = recs_g[r_, 2, j]
-                    ncross[j] = 0
-                split(recs_i[r_], 0.0, y, y1, P[k], H[k], OM[k], NPER[k], recs_ph[r_, 0],
-                      recs_ph[r_, 1], recs_ph[r_, 2], recs_ph[r_, 3], side, g1, ncross, work,
-                      ybuf, gbuf)
-                for q in range(ns):
-                    out_y[r_, q] = y[q]
-                for j in range(ne):
-                    out_s[r_, j] = side[j]
-                    out_g[r_, j] = g1[j]
-                    out_nc[r_, j] = ncross[j]
+                replay_one(r_, P, H, OM, NPER, lane, recs_i, recs_y, recs_g, recs_ph, out_y,
+                           out_s, out_g, out_nc, y, y1, side, g1, ncross, work, ybuf, gbuf)
         return 0
 
     return run_batches, run_scalar
