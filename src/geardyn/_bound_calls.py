@@ -1,15 +1,31 @@
-"""Calls of big callees bound to one copy of their machine code per process (prototype).
+"""Calls of big callees bound to one copy of their machine code per process.
 
 numba links the optimised LLVM IR of every function a caller calls into the caller's module
-(``linkonce_odr``), so each caller optimises and emits its own copy of it. A callee whose own
-function is big (:data:`MIN_INSTRUCTIONS`, LLVM inlines none of them) is instead declared in
-its caller's module, with the function, return and argument attributes of its optimised
-definition (so that the caller's optimisation knows what the linked copy told it), and the
-call is bound by numba's engine (MCJIT resolves symbols across the modules added to it) to
-the callee's one compiled copy, emitted before the caller's.
+(``linkonce_odr``), so each caller optimises the callee's body again and emits its own copy of
+its machine code. A geardyn function whose own optimised function is big
+(:data:`MIN_INSTRUCTIONS`) is instead declared in its geardyn callers' modules, with the
+function, return and argument attributes of its optimised definition (what the linked copy
+told the caller's optimisation), and the call is bound by numba's engine (MCJIT resolves
+symbols across the modules added to it) to the callee's one compiled copy, emitted before the
+caller's (:mod:`geardyn._lazy_code` defers it until then).
 
-Applied to geardyn's functions only (:func:`prepare`, called by
-:class:`geardyn._jit_target.VectorWidthPass` on each library it creates).
+numba's cache: a caller's object code then references the callee's symbol, so the caller's
+``reload_init`` (callables numba runs before it loads the code of a cached function) holds a
+:class:`Loader` of every bound symbol its module declares: the callee's object code, loaded
+unless the process defines the symbol already (the callee's own entry loaded or compiled
+first: geardyn numbers its symbols per process, so the same symbol is the same code). A
+callee loaded from the cache as numba's deferred ``bitcode`` kind is bound too
+(:func:`_register`); one cached as object code is linked (:func:`register_loaded`).
+
+A bound callee's module is optimised twice (:data:`REOPTIMISE`), as a linked copy is (once in
+its own module, once more in each caller's): optimised once, the reduced CATT device's sweep
+block ran the paper workload 1.19x slower.
+
+Only geardyn's functions are changed (:func:`prepare`, called by
+:class:`geardyn._jit_target.VectorWidthPass` on each library it creates; no process-wide
+patch); a plain numba function calling a geardyn function links it as numba does.
+``GEARDYN_BIND=0`` (environment, read at import) switches the binding off and
+``GEARDYN_BIND_MIN`` sets :data:`MIN_INSTRUCTIONS` (the benchmarks' and tests' knobs).
 """
 
 from __future__ import annotations
@@ -23,8 +39,14 @@ import llvmlite.binding as ll
 
 from geardyn import _lazy_code
 
-#: A callee's own function with at least this many LLVM instructions is bound, not linked.
-MIN_INSTRUCTIONS = int(os.environ.get("GEARDYN_BIND_MIN", "1000"))
+#: A callee's own function with at least this many LLVM instructions (after its own
+#: optimisation) is bound, not linked. In the gear pair's and the planetary set's compiles LLVM
+#: called, never inlined, every geardyn function that big; below it, it inlined some (the
+#: planetary set's ``_rhs_body``, 1017 instructions, into its one caller: LLVM inlines a
+#: ``linkonce_odr`` function with one call whatever its size).
+MIN_INSTRUCTIONS = int(os.environ.get("GEARDYN_BIND_MIN", "1100"))
+#: A bound callee's module is optimised twice (``GEARDYN_BIND_REOPT=0``: once).
+REOPTIMISE = os.environ.get("GEARDYN_BIND_REOPT", "1") != "0"
 #: ``GEARDYN_BIND=0`` switches the binding off (A/B measurements).
 ENABLED = os.environ.get("GEARDYN_BIND", "1") != "0"
 
@@ -36,12 +58,15 @@ _LINKAGE = {"internal", "private", "external", "linkonce_odr", "linkonce", "weak
             "dso_local", "hidden", "protected", "default", "available_externally"}
 
 
-def _size(fn: Any) -> int:
+def _at_least(fn: Any, count: int) -> bool:
+    """Whether ``fn`` (a defined llvmlite binding function) has ``count`` instructions."""
     n = 0
     for block in fn.blocks:
         for _ in block.instructions:
             n += 1
-    return n
+            if n >= count:
+                return True
+    return False
 
 
 def _declaration(fn: Any) -> tuple[list[str], list[str], list[list[str]]]:
@@ -70,7 +95,7 @@ def _big(module: Any, linkage: Any) -> list:
     return [fn for fn in module.functions
             if not fn.is_declaration and fn.linkage == linkage
             and not fn.name.startswith(("cpython.", "cfunc.", "_ZN7cpython", "_ZN5cfunc"))
-            and _size(fn) >= MIN_INSTRUCTIONS]
+            and _at_least(fn, MIN_INSTRUCTIONS)]
 
 
 def _bind(library: Any, fn: Any, entry: Any) -> None:
@@ -90,20 +115,12 @@ def _register(library: Any) -> None:
         _bind(library, fn, library)
 
 
-def register_loaded(library: Any, serialized: tuple) -> None:
-    """``library`` was loaded from numba's cache as object code (``serialized``, numba's
-    ``object`` kind), every function it defines now in numba's engine: callers bind to those
-    big enough (each with a :class:`Loader` of ``serialized``)."""
+def register_loaded(library: Any) -> None:
+    """``library`` was loaded from numba's cache as object code (numba's ``object`` kind: a
+    function compiled as the outermost one, optimised once, such as the split step compiled
+    ahead in a helper process): its callers link it, as numba does, and optimise it once more
+    (bound, its code would be the once-optimised one)."""
     library._geardyn_bound = False
-    if not ENABLED:
-        return
-    module = library._shared_module
-    big = _big(module, ll.Linkage.linkonce_odr)
-    if big:
-        deps = tuple(_loader(name) for name in _bound_declarations(module))
-        envs = _envs(module)
-        for fn in big:
-            _bind(library, fn, Loader(fn.name, serialized, deps, envs))
 
 
 def _envs(module: Any) -> tuple:
@@ -217,6 +234,11 @@ def _finalize(library: Any) -> None:
             keep.append(lib)
     library._linking_libraries = keep
     type(library).finalize(library)
+    if REOPTIMISE and _lazy_code.is_pending(library) and _big(library._final_module,
+                                                            ll.Linkage.external):
+        # a callee (its code not emitted yet) that will be bound: optimised once more, as
+        # numba's linking optimises a linked copy once more in each caller
+        library._optimize_final_module()
     for name in _bound_declarations(library._final_module):
         library._reload_init.add(_loader(name))
     _register(library)

@@ -215,7 +215,7 @@ def _unserialize_library(self: Any, serialized: tuple) -> Any:
     name, kind, data = serialized
     if kind != "bitcode":
         library = _ORIGINAL_UNSERIALIZE(self, serialized)
-        _bound_calls.register_loaded(library, serialized)
+        _bound_calls.register_loaded(library)
         return library
     library = self.create_library(name)
     library.enable_object_caching()
