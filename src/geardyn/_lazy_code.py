@@ -7,7 +7,8 @@ its Python entry point; the caller then links the callee's optimised LLVM IR int
 library and emits its own machine code, with its own copy of the callee. A callee's own machine
 code serves a call from Python, and a call that LLVM did not inline in a caller emitted later
 in the same process (numba's engine binds it to the first definition of the symbol; in a
-process that loads the caller from the cache, to the caller's own copy).
+process that loads the caller from the cache, to the caller's own copy). A big callee is
+declared in its callers instead, and bound to its own machine code (:mod:`geardyn._bound_calls`).
 
 Inside a geardyn compile (:func:`scope`, entered by :class:`geardyn._jit_target.WidthCompiler`)
 every function compiled for it except the outermost one (:func:`mark_outermost`, the one Python
