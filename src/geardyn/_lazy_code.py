@@ -7,7 +7,8 @@ its Python entry point; the caller then links the callee's optimised LLVM IR int
 library and emits its own machine code, with its own copy of the callee. A callee's own machine
 code serves a call from Python, and a call that LLVM did not inline in a caller emitted later
 in the same process (numba's engine binds it to the first definition of the symbol; in a
-process that loads the caller from the cache, to the caller's own copy).
+process that loads the caller from the cache, to the caller's own copy). A big callee is
+declared in its callers instead, and bound to its own machine code (:mod:`geardyn._bound_calls`).
 
 Inside a geardyn compile (:func:`scope`, entered by :class:`geardyn._jit_target.WidthCompiler`)
 every function compiled for it except the outermost one (:func:`mark_outermost`, the one Python
@@ -110,6 +111,9 @@ def _materialise(library: Any) -> None:
     with global_compiler_lock:
         if library._geardyn_pending:
             library._geardyn_pending = False
+            symbols = getattr(library, "_geardyn_symbols", ())
+            if symbols and all(map(library.codegen._engine.is_symbol_defined, symbols)):
+                return  # its code loaded already (geardyn._bound_calls.Loader): that copy serves
             library._dynamic_globals = []  # numba's step collects them again
             _FINALIZE_FINAL_MODULE(library)
 
@@ -207,14 +211,19 @@ def _set_env_method(self: Any, env_name: str, env: Any) -> None:
 def _unserialize_library(self: Any, serialized: tuple) -> Any:
     """numba's ``unserialize_library``; a ``bitcode`` entry (a deferred library, see
     :func:`defer`) is deferred again."""
+    from geardyn import _bound_calls
+
     name, kind, data = serialized
     if kind != "bitcode":
-        return _ORIGINAL_UNSERIALIZE(self, serialized)
+        library = _ORIGINAL_UNSERIALIZE(self, serialized)
+        _bound_calls.register_loaded(library)
+        return library
     library = self.create_library(name)
     library.enable_object_caching()
     defer(library)
     library._final_module = ll.parse_bitcode(data)
     library._finalize_final_module()
+    _bound_calls._register(library)
     return library
 
 
