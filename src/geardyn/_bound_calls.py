@@ -254,3 +254,7 @@ def prepare(library: Any) -> None:
 
     library.add_ir_module = add_ir_module
     library.finalize = lambda: _finalize(library)
+
+
+_lazy_code.ON_LOADED[0] = register_loaded
+_lazy_code.ON_DEFERRED[0] = _register

@@ -58,6 +58,17 @@ _SERIALIZE_OBJECT = _codegen.CPUCodeLibrary.serialize_using_object_code
 _ENTRIES: dict[int, list] = {}
 #: Environment symbols to define and set (:func:`_flush_envs`): name -> (codegen, environment).
 _PENDING_ENVS: dict[str, tuple] = {}
+
+
+def _ignore(library: Any) -> None:
+    """No-op: the default of :data:`ON_LOADED` and :data:`ON_DEFERRED`."""
+
+
+#: Called with each library loaded from numba's cache as object code, and with each loaded as
+#: deferred optimised IR (one-item lists, so that :mod:`geardyn._bound_calls`, which imports
+#: this module, sets them at its import: its ``register_loaded`` and ``_register``).
+ON_LOADED: list = [_ignore]
+ON_DEFERRED: list = [_ignore]
 #: The libraries defining environment symbols ahead of their function's machine code.
 _ENV_LIBRARIES: list = []
 #: The stand-in wrapper's machine code (its library and address), made on first use.
@@ -211,19 +222,17 @@ def _set_env_method(self: Any, env_name: str, env: Any) -> None:
 def _unserialize_library(self: Any, serialized: tuple) -> Any:
     """numba's ``unserialize_library``; a ``bitcode`` entry (a deferred library, see
     :func:`defer`) is deferred again."""
-    from geardyn import _bound_calls
-
     name, kind, data = serialized
     if kind != "bitcode":
         library = _ORIGINAL_UNSERIALIZE(self, serialized)
-        _bound_calls.register_loaded(library)
+        ON_LOADED[0](library)
         return library
     library = self.create_library(name)
     library.enable_object_caching()
     defer(library)
     library._final_module = ll.parse_bitcode(data)
     library._finalize_final_module()
-    _bound_calls._register(library)
+    ON_DEFERRED[0](library)
     return library
 
 
