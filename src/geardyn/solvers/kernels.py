@@ -17,6 +17,7 @@ process.
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 import importlib.util
 import inspect
@@ -291,9 +292,18 @@ def _replace_import(text: str, new_line: str) -> str:
     return "\n".join(lines) + "\n"
 
 
-def kernels_for(source: KernelSource, template: str = "rk4") -> types.ModuleType:
+def kernels_for(source: KernelSource, template: str = "rk4") -> Any:
     """The kernel module of ``template`` for a model's functions (built, written and imported on
-    first use, then kept for the process)."""
+    first use, then kept for the process). A model that declares the ``"pointer"`` path
+    (:mod:`._pointer_kernels`) gets the trajectory and sweep kernels compiled once for every
+    model, bound to its functions' addresses, and its functions inlined in the other
+    templates."""
+    if source.path == "pointer":
+        from geardyn.solvers import _pointer_kernels
+
+        if template == "rk4":
+            return _pointer_kernels.pointer_kernels(source, kernels_for(_pointer_kernels.SOURCE))
+        source = dataclasses.replace(source, path=None)
     funcs = source.functions()
     key = (template, source.plain, source.one_form, *funcs, *(id(f) for f in funcs.values()))
     if key in _LOADED:
