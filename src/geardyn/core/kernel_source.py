@@ -57,14 +57,16 @@ class KernelSource:
     #: Set where the functions are in the one form (:mod:`geardyn.core.one_form`):
     #: ``rhs(t, y, p, s, c) -> tuple`` etc.; the generated kernel writes every layout from them.
     one_form: OneForm | None = None
-    #: A declared kernel path (one of :data:`DECLARED_PATHS`; a one form only), else None: the
+    #: A declared kernel path (one of :data:`DECLARED_PATHS`; a one form without ``quiet``
+    #: coefficients only: the pointer path's trial step takes one lane form), else None: the
     #: path follows from the functions (:attr:`kernel_path`).
     path: str | None = None
 
     def __post_init__(self) -> None:
-        if self.path is not None and (self.path not in DECLARED_PATHS or self.one_form is None):
-            raise ValueError(f"kernel path {self.path!r}: a model in the one form may declare "
-                             f"{', '.join(map(repr, DECLARED_PATHS))}")
+        if self.path is not None and (self.path not in DECLARED_PATHS or self.one_form is None
+                                      or self.one_form.quiet):
+            raise ValueError(f"kernel path {self.path!r}: a model in the one form without quiet "
+                             f"coefficients may declare {', '.join(map(repr, DECLARED_PATHS))}")
 
     @property
     def kernel_path(self) -> str:

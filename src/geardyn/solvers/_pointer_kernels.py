@@ -4,12 +4,14 @@ On the ``"pointer"`` path (:data:`~geardyn.core.kernel_source.KERNEL_PATHS`, dec
 model: ``UserModel.from_one_form(..., kernel_path="pointer")``) the trajectory and sweep
 kernels (template ``"rk4"``) are those of :mod:`._pointer_model`: the same text for every
 model, so compiled and cached once for all of them. The model's part is a small generated
-module (:func:`model_part`): the one form's array and lane-block layouts
-(:func:`geardyn.core.one_form.adapters`) compiled as C callbacks, whose addresses are appended
-to every coefficient row the kernels receive (:class:`PointerKernels`). The sweep runs the
-lane-block (structure-of-arrays) block loop, the model called once per stage for a block of
-slots; a flagged step's split and a trajectory's steps call the array forms one lane at a
-time. The arithmetic is the inlined path's: results are bitwise the same.
+module (:func:`model_part`): the one form's array forms
+(:func:`geardyn.core.one_form.adapters`), its fused trial step on a block of slots and its own
+split step (that of its core module, :mod:`._step_core`) compiled as C callbacks, whose
+addresses are appended to every coefficient row the kernels receive (:class:`PointerKernels`).
+The sweep (:mod:`._pointer_template`) calls the trial step once per grid step for a block of
+slots and the split step for a flagged slot; a trajectory calls the array forms one lane at a
+time (its split step too: the shared one). The arithmetic is the inlined path's: results are
+bitwise the same.
 
 The other templates (Lyapunov, monodromy, run-up) of a pointer model are the inlined ones
 (:func:`geardyn.solvers.kernels.kernels_for` takes the model's functions inlined for them).
@@ -252,13 +254,18 @@ def sweep_module(shared: types.ModuleType) -> types.ModuleType:
 
 
 class PointerKernels:
-    """A pointer model's trajectory and sweep kernels: those of :data:`SOURCE` (compiled once
-    for every model) with the model's callback addresses appended to every coefficient row.
-    Other attributes (constants such as ``BLOCK``) are the shared module's."""
+    """A pointer model's trajectory and sweep kernels (``trajectory``, ``sweep``, ``rhs``,
+    ``events``, ``observe``): those of :data:`SOURCE` (compiled once for every model) with the
+    model's callback addresses appended to every coefficient row. Any other attribute is that
+    of the model's inlined ``"rk4"`` kernel module (``inlined``: made on first use, its
+    functions compiled on their first call), so that no function of the shared modules is
+    called without the addresses."""
 
-    def __init__(self, shared: types.ModuleType, part: types.ModuleType):
+    def __init__(self, shared: types.ModuleType, part: types.ModuleType,
+                 inlined: KernelSource):
         self._shared = shared
         self._sweep = sweep_module(shared)
+        self._inlined = inlined
         self.part = part
         self.addresses = np.array([float(cb.address) for cb in part.CALLBACKS])
         if self.addresses.size != N_ADDRESSES or not np.all(self.addresses < 2.0 ** 53):
@@ -286,7 +293,11 @@ class PointerKernels:
         self._sweep.sweep(lanes._replace(P=self.rows(lanes.P)), cfg, work_queues, out)
 
     def __getattr__(self, name: str) -> Any:
-        return getattr(self._shared, name)
+        if name.startswith("__"):
+            raise AttributeError(name)
+        from geardyn.solvers.kernels import kernels_for
+
+        return getattr(kernels_for(self._inlined), name)
 
 
 def pointer_kernels(source: KernelSource, shared: types.ModuleType) -> PointerKernels:
@@ -295,5 +306,6 @@ def pointer_kernels(source: KernelSource, shared: types.ModuleType) -> PointerKe
     funcs = source.functions()
     key = (source.one_form, *funcs, *(id(f) for f in funcs.values()))
     if key not in _KERNELS:
-        _KERNELS[key] = PointerKernels(shared, model_part(source))
+        _KERNELS[key] = PointerKernels(shared, model_part(source),
+                                       dataclasses.replace(source, path=None))
     return _KERNELS[key]

@@ -14,9 +14,10 @@ Each grid step of a block (:func:`_p_steps`) is the fused step of
 (the model's ``c_trial``: the four RK4 stages with the state in registers, the events and the
 observables at the trial's end, written to Y1, G1, O), then the screen, the commit, the clocks
 and the statistics as loops over slots. Flagged slots and bookkeeping are done out of line
-(:func:`_p_slots_out`) as on the fused path, the split step calling the model's array forms
-through their addresses. The operations are those of the fused loop, in the same order: the
-results are bitwise the same.
+(:func:`_p_slots_out`) as on the fused path; a flagged step's split is the model's own split
+step (its core module's ``_split_step``, compiled with the model inlined), called through its
+address. The operations are those of the fused loop, in the same order: the results are bitwise
+the same.
 """
 
 from __future__ import annotations
