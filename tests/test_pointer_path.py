@@ -18,6 +18,7 @@ from geardyn.core.kernel_source import KERNEL_PATHS, KernelSource
 from geardyn.errors import ParameterError
 from geardyn.solvers.ensemble import LaneResults, run_lanes
 from geardyn.solvers.kernels import kernels_for
+from geardyn.testing import check_model
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "examples"))
 from duffing_model import duffing_one  # noqa: E402
@@ -112,3 +113,8 @@ def test_the_kernel_path_is_checked_naming_the_field():
         gear_pair(**COEFFS, kernel_path="fast")
     with pytest.raises(ValueError, match="one form"):
         KernelSource(geardyn.GearPair().kernel.rhs, path="pointer")
+
+
+def test_a_pointer_model_keeps_the_model_contract():
+    report = check_model(gear_pair(**COEFFS, Omega=1.3, kernel_path="pointer"))
+    assert report.ok, str(report)

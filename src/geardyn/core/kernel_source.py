@@ -34,9 +34,10 @@ LANE_FORMS = 3
 #: the model's lane-scalar functions (the one form, or ``<rhs>_lane`` twins); ``"lane-block"``,
 #: the model's lane-block functions (``<rhs>_lanes``); ``"per-lane"``, its array function one
 #: lane at a time (a plain ``rhs(t, y, dydt, p)``: several times slower on a sweep);
-#: ``"pointer"``, declared by a one-form model (``KernelSource.path``): the lane-block loop
-#: compiled once for every model, calling the model's functions, compiled alone, through their
-#: addresses (:mod:`geardyn.solvers._pointer_kernels`: seconds of compile, not tens).
+#: ``"pointer"``, declared by a one-form model (``KernelSource.path``): a fused block loop
+#: compiled once for every model, calling the model's part (its trial step for a block of
+#: slots, its split step, its functions; compiled alone) through their addresses
+#: (:mod:`geardyn.solvers._pointer_kernels`: seconds of the model's own compile, not tens).
 KERNEL_PATHS = ("lane-form", "lane-block", "per-lane", "pointer")
 #: The kernel paths a model may declare (``KernelSource.path``).
 DECLARED_PATHS = ("pointer",)
