@@ -99,10 +99,10 @@ def test_models_of_other_sizes_run_on_the_same_compiled_kernels():
     assert kp._sweep is kd._sweep and kp._shared is kd._shared and kp.part is not kd.part
     run = geardyn.RunSettings(transient=60.0, samples=4, steps_per_period=64)
     run_lanes(pair, pair.lane_params("Omega", [0.9, 1.1]), pair.initial_state(), run=run)
-    compiled = len(kp._sweep._p_worker.signatures)
+    compiled = len(kp._sweep._sweep_worker_form0.signatures)
     om = np.array([0.9, 1.2, 1.5])
     r = run_lanes(duff, duff.lane_params("Omega", om), duff.initial_state(), run=run)
-    assert len(kd._sweep._p_worker.signatures) == compiled
+    assert len(kd._sweep._sweep_worker_form0.signatures) == compiled
     ref = run_lanes(inlined, inlined.lane_params("Omega", om), inlined.initial_state(), run=run)
     for name in LaneResults.__dataclass_fields__:
         np.testing.assert_array_equal(getattr(r, name), getattr(ref, name), err_msg=name)

@@ -1,14 +1,14 @@
 """Calls of a model's compiled part through its address (the ``"pointer"`` kernel path).
 
 A model on the pointer path compiles its functions alone, as C callbacks (``numba.cfunc``,
-:mod:`._pointer_parts`); the step machinery that calls them is compiled once for every model
+:mod:`._pointer_kernels`); the step machinery that calls them is compiled once for every model
 (:mod:`._pointer_model`, :mod:`._pointer_template`) and calls them through addresses that
 travel as data (the last :data:`N_ADDRESSES` entries of every coefficient row, whole numbers
 held exactly as float64), so that its cached code holds no address of a process. The two
 intrinsics here are the calls: :func:`call_array` (one lane, the array form) and
-:func:`call_trial` (a block of slots' fused trial step); each costs one indirect call and no
-inlining, and gives bitwise the results of the model's functions inlined (the same
-arithmetic).
+:func:`call_flat` (any arguments flattened: the fused step of a block of slots, the split
+step); each costs one indirect call and no inlining, and gives bitwise the results of the
+model's functions inlined (the same arithmetic).
 """
 
 from __future__ import annotations
@@ -19,25 +19,16 @@ from llvmlite import ir
 from numba import types
 from numba.extending import intrinsic
 
-__all__ = ["ARRAY_SIG", "N_ADDRESSES", "SPLIT_ARGS", "TRIAL_ROWS", "TRIAL_SIG", "call_array",
-           "call_flat", "call_trial", "flat_signature"]
+__all__ = ["ARRAY_SIG", "N_ADDRESSES", "SPLIT_ARGS", "STEP_ARGS", "call_array", "call_flat",
+           "flat_signature"]
 
 _F8P = types.CPointer(types.float64)
 #: The C signature of a model function in array form ``f(t, y, out, p, s, c)``, its arrays as
 #: (data pointer, length): ``(t, y, ny, out, nout, p, np, s, c) -> None``.
 ARRAY_SIG = types.void(types.float64, _F8P, types.intp, _F8P, types.intp, _F8P, types.intp,
                        types.float64, types.float64)
-#: The C signature of a model's fused trial step on a block of slots (``_trial_block`` of
-#: :mod:`._pointer_kernels`' generated part), its arrays C-contiguous blocks of ``ld`` slots:
-#: ``(X, Y, Y1, G1, O, PT, ld, npt, nl) -> None``; X: the slots' times, step and phases
-#: (:data:`TRIAL_ROWS` rows), Y the start states, Y1, G1, O: the trial's end state, events and
-#: observables there, PT: ``npt`` coefficient rows.
-TRIAL_SIG = types.void(_F8P, _F8P, _F8P, _F8P, _F8P, _F8P, types.intp, types.intp, types.intp)
-#: The rows of a trial's X: start, middle and end time, h, h / 6, sin and cos of the forcing
-#: phase at the start, middle and end.
-TRIAL_ROWS = 11
 #: The addresses at the end of a coefficient row: the array forms of rhs, events, observe,
-#: the fused trial step, the split step (:data:`SPLIT_ARGS`).
+#: the fused step (:data:`STEP_ARGS`), the split step (:data:`SPLIT_ARGS`).
 N_ADDRESSES = 5
 #: The numba types of the split step's arguments (``_split_step`` of a model's core module,
 #: :mod:`._step_core`), which its C callback takes flattened (:func:`flat_signature`).
@@ -45,6 +36,16 @@ SPLIT_ARGS = (types.int64, types.float64, types.float64[::1], types.float64[::1]
               types.float64[::1], types.float64, types.float64, types.int64, types.float64,
               types.float64, types.float64, types.float64, types.int64[::1], types.float64[::1],
               types.int64[::1], types.float64[:, ::1], types.float64[::1], types.float64[:, ::1])
+_F, _I, _B = types.float64[::1], types.int64[::1], types.boolean[::1]
+#: The numba types of the fused step's arguments (``_fused_steps`` of a model's ``"rk4"``
+#: kernel module, :mod:`._kernel_template`), its tuples unpacked, which its C callback takes
+#: flattened: nl, locate, bound, Y, Y1, PT, SE, CE, H6, FLAG; the events (GS, GP, GR, SIDE),
+#: the statistics (GMIN, GMAX, OMAX, OMIN, OSQ), the slots (STAT, MSK, ACT, END, LANE, STEP,
+#: PHASE, NPER, OFF, HB, T0B, n_end, n_tr, next_sample, DUE, n_stat, n_ring), the phase
+#: increments (4) and phases (4); the block arrays as their flat views (see ``_fused_run``).
+STEP_ARGS = (types.int64, types.boolean, types.float64, _F, _F, types.float64[:, ::1],
+             *(_F,) * 4, *(_F,) * 4, *(_F,) * 5, *(_B,) * 4, *(_I,) * 5, _F, _F, *(_I,) * 6,
+             *(_F,) * 4, *(_F,) * 4)
 
 
 def _is_c(ty: Any, ndim: int) -> bool:
@@ -79,34 +80,6 @@ def call_array(typingctx, addr, t, y, out, p, s, c):
         a64 = context.cast(builder, a, signature.args[0], types.int64)
         builder.call(builder.inttoptr(a64, fty.as_pointer()),
                      [scal[0], *flat, scal[1], scal[2]])
-        return context.get_dummy_value()
-
-    return sig, codegen
-
-
-@intrinsic
-def call_trial(typingctx, addr, X, Y, Y1, G1, O, PT, nl):
-    """Call the :data:`TRIAL_SIG` callback at ``addr`` as ``f(X, Y, Y1, G1, O, PT, nl)``:
-    2-d C-contiguous float64 arrays of the same slots (their last dimension, Y's, is the
-    block's ``ld``)."""
-    if not isinstance(addr, types.Integer) or not isinstance(nl, types.Integer):
-        return None
-    if not all(_is_c(a, 2) for a in (X, Y, Y1, G1, O, PT)):
-        return None
-    sig = types.void(addr, X, Y, Y1, G1, O, PT, nl)
-
-    def codegen(context, builder, signature, args):
-        ty = signature.args
-        dp = ir.DoubleType().as_pointer()
-        ip = context.get_value_type(types.intp)
-        fty = ir.FunctionType(ir.VoidType(), [dp] * 6 + [ip, ip, ip])
-        arrs = [_data(context, builder, ty[k], args[k]) for k in range(1, 7)]
-        ld = builder.extract_value(arrs[1].shape, 1)
-        npt = builder.extract_value(arrs[5].shape, 0)
-        nn = context.cast(builder, args[7], ty[7], types.intp)
-        a64 = context.cast(builder, args[0], ty[0], types.int64)
-        builder.call(builder.inttoptr(a64, fty.as_pointer()),
-                     [a.data for a in arrs] + [ld, npt, nn])
         return context.get_dummy_value()
 
     return sig, codegen

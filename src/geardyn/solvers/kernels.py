@@ -292,6 +292,25 @@ def _replace_import(text: str, new_line: str) -> str:
     return "\n".join(lines) + "\n"
 
 
+def load_generated(name: str, code: str) -> types.ModuleType:
+    """The generated module ``name`` of text ``code``: written to the kernel cache folder (once;
+    atomically, so that concurrent processes never see half a file), imported and registered in
+    ``sys.modules`` (so that another generated module can import it by name)."""
+    folder = cache_dir()
+    folder.mkdir(parents=True, exist_ok=True)
+    path = folder / f"{name}.py"
+    if not path.exists():
+        fd, tmp = tempfile.mkstemp(dir=folder, suffix=".tmp")
+        with os.fdopen(fd, "w") as fh:
+            fh.write(code)
+        os.replace(tmp, path)
+    spec = importlib.util.spec_from_file_location(name, path)
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[name] = module
+    spec.loader.exec_module(module)
+    return module
+
+
 def kernels_for(source: KernelSource, template: str = "rk4") -> Any:
     """The kernel module of ``template`` for a model's functions (built, written and imported on
     first use, then kept for the process). A model that declares the ``"pointer"`` path
@@ -312,20 +331,7 @@ def kernels_for(source: KernelSource, template: str = "rk4") -> Any:
     text = _template_text(template, source, "user_events" in funcs, core)
     if all(_importable(f) for f in funcs.values()):
         code = _replace_import(text, _import_line(funcs))
-        digest = _source_digest(code, funcs)
-        name = f"geardyn_{template}_{digest}"
-        folder = cache_dir()
-        folder.mkdir(parents=True, exist_ok=True)
-        path = folder / f"{name}.py"
-        if not path.exists():
-            fd, tmp = tempfile.mkstemp(dir=folder, suffix=".tmp")
-            with os.fdopen(fd, "w") as fh:
-                fh.write(code)
-            os.replace(tmp, path)  # atomic: concurrent processes never see half a file
-        spec = importlib.util.spec_from_file_location(name, path)
-        module = importlib.util.module_from_spec(spec)
-        sys.modules[name] = module
-        spec.loader.exec_module(module)
+        module = load_generated(f"geardyn_{template}_{_source_digest(code, funcs)}", code)
     else:
         code = _replace_import(text, "pass  " + _IMPORT_MARK).replace(
             "_CACHE = True", "_CACHE = False"
