@@ -17,10 +17,11 @@ from typing import Any
 
 from llvmlite import ir
 from numba import types
+from numba.core import cgutils
 from numba.extending import intrinsic
 
-__all__ = ["ARRAY_SIG", "N_ADDRESSES", "SPLIT_ARGS", "STEP_ARGS", "call_array", "call_flat",
-           "flat_signature"]
+__all__ = ["ARRAY_SIG", "N_ADDRESSES", "SPLIT_ARGS", "STEP_ARGS", "c_array", "call_array",
+           "call_flat", "flat_signature"]
 
 _F8P = types.CPointer(types.float64)
 #: The C signature of a model function in array form ``f(t, y, out, p, s, c)``, its arrays as
@@ -132,3 +133,35 @@ def call_flat(typingctx, addr, args):
         return builder.call(builder.inttoptr(a64, fty.as_pointer()), values)
 
     return sig, codegen
+
+
+@intrinsic
+def c_array(typingctx, ptr, shape):
+    """The C-contiguous array of the data pointer ``ptr`` and ``shape`` (an integer, or a
+    tuple of them), owned by no one: ``numba.carray`` without its call and without reference
+    counting, so that a callback compiled with ``_nrt=False`` rebuilds its array arguments at
+    no cost (with reference counting, the ~40 arrays of the fused step cost more than a block
+    step of a model's arithmetic)."""
+    if not isinstance(ptr, types.CPointer):
+        return None
+    dims = [shape] if isinstance(shape, types.Integer) else list(shape)
+    if not dims or not all(isinstance(d, types.Integer) for d in dims):
+        return None
+    aty = types.Array(ptr.dtype, len(dims), "C")
+
+    def codegen(context, builder, signature, args):
+        p, sh = args
+        vals = [sh] if len(dims) == 1 else cgutils.unpack_tuple(builder, sh, len(dims))
+        intp = context.get_value_type(types.intp)
+        shapes = [context.cast(builder, v, d, types.intp) for v, d in zip(vals, dims, strict=True)]
+        size = context.get_abi_sizeof(context.get_data_type(ptr.dtype))
+        itemsize = ir.Constant(intp, size)
+        strides = [itemsize]
+        for n in reversed(shapes[1:]):
+            strides.insert(0, builder.mul(strides[0], n))
+        arr = context.make_array(aty)(context, builder)
+        context.populate_array(arr, data=builder.bitcast(p, arr.data.type), shape=shapes,
+                               strides=strides, itemsize=itemsize, meminfo=None)
+        return arr._getvalue()
+
+    return aty(ptr, shape), codegen

@@ -56,6 +56,7 @@ from geardyn.core.kernel_source import FORM_GENERAL as _FORM_GENERAL
 from geardyn.solvers._pointer_calls import ARRAY_SIG as _ARRAY_SIG
 from geardyn.solvers._pointer_calls import SPLIT_ARGS as _SPLIT_ARGS
 from geardyn.solvers._pointer_calls import STEP_ARGS as _STEP_ARGS
+from geardyn.solvers._pointer_calls import c_array as _c_array
 from geardyn.solvers._pointer_calls import flat_signature as _flat_signature
 
 _CACHE = True
@@ -72,20 +73,6 @@ class _NoAlias(WidthCompiler):
 '''
 
 _PART_TAIL = '''
-
-@nb.njit(cache=_CACHE, error_model="numpy", boundscheck=False, pipeline_class=_NoAlias,
-         _nrt=False)
-def _steps(nl, locate, bound, Y, Y1, PT, SE, CE, H6, FLAG, GS, GP, GR, SIDE, GMIN, GMAX, OMAX,
-           OMIN, OSQ, STAT, MSK, ACT, END, LANE, STEP, PHASE, NPER, OFF, HB, T0B, n_end, n_tr,
-           next_sample, DUE, n_stat, n_ring, AH, BH, AD, BD, SB, CB, SN, CN):
-    """The model's fused step of a block of slots (its "rk4" module's _fused_steps, in the lane
-    form FORM_GENERAL), compiled as the sweep's block loop is (noalias arrays, no reference
-    counting: the loop is vectorised only so); returns the number of slots marked."""
-    return _model_steps(_FORM_GENERAL, nl, locate, bound, Y, Y1, PT, SE, CE, H6, FLAG,
-                        (GS, GP, GR, SIDE), (GMIN, GMAX, OMAX, OMIN, OSQ),
-                        (STAT, MSK, ACT, END, LANE, STEP, PHASE, NPER, OFF, HB, T0B, n_end, n_tr,
-                         next_sample, DUE, n_stat, n_ring), (AH, BH, AD, BD), (SB, CB, SN, CN))[1]
-
 
 @nb.cfunc(_ARRAY_SIG, **_JIT)
 def c_rhs(t, y, ny, out, nout, p, npar, s, c):
@@ -107,11 +94,12 @@ def c_observe(t, y, ny, out, nout, p, npar, s, c):
 _CALLBACKS = "c_rhs, c_events, c_observe, c_step, c_split"
 
 
-def _flat_cfunc(name: str, target: str, arg_types: tuple, sig: str) -> str:
-    """The text of a C callback ``name`` that calls ``target`` with the arguments
-    ``arg_types`` flattened (:func:`._pointer_calls.flat_signature`: an array as its data
-    pointer and shape, rebuilt with ``nb.carray``; a boolean as an integer); ``sig``: the
-    text of its signature."""
+def _flat_cfunc(name: str, call: Any, arg_types: tuple, sig: str, jit: str = "_JIT") -> str:
+    """The text of a C callback ``name`` of the arguments ``arg_types`` flattened
+    (:func:`._pointer_calls.flat_signature`: an array as its data pointer and shape, rebuilt
+    with :func:`._pointer_calls.c_array`; a boolean as an integer) that returns ``call(values)``
+    (the text of the call of the arguments' texts), compiled without reference counting;
+    ``sig``, ``jit``: the text of its signature and of its compile options."""
     from numba import types
 
     params, values = [], []
@@ -122,11 +110,25 @@ def _flat_cfunc(name: str, target: str, arg_types: tuple, sig: str) -> str:
             dims = [f"{a}_{d}" for d in range(ty.ndim)]
             params += dims
             shape = dims[0] if ty.ndim == 1 else "(" + ", ".join(dims) + ")"
-            values.append(f"nb.carray({a}, {shape})")
+            values.append(f"_c_array({a}, {shape})")
         else:
             values.append(f"{a} != 0" if isinstance(ty, types.Boolean) else a)
-    return (f"\n\n@nb.cfunc({sig}, **_JIT)\ndef {name}({', '.join(params)}):\n"
-            f"    return {target}({', '.join(values)})\n")
+    return (f"\n\n@nb.cfunc({sig}, _nrt=False, **{jit})\ndef {name}({', '.join(params)}):\n"
+            f"    return {call(values)}\n")
+
+
+def _step_call(v: list[str]) -> str:
+    """The model's fused step of a block of slots (its ``"rk4"`` module's ``_fused_steps``, in
+    the lane form FORM_GENERAL) of the flat arguments v (:data:`._pointer_calls.STEP_ARGS`),
+    its tuples regrouped: the number of slots marked. Its callback (``c_step``) is compiled as
+    the sweep's block loop is: noalias arrays, no reference counting (the loop is vectorised
+    only so), the step inlined (a call of ~40 arrays by value costs a block step's
+    arithmetic)."""
+    def tup(a: int, b: int) -> str:
+        return "(" + ", ".join(v[a:b]) + ")"
+
+    return (f"_model_steps(_FORM_GENERAL, {', '.join(v[:10])}, {tup(10, 14)}, {tup(14, 19)}, "
+            f"{tup(19, 36)}, {tup(36, 40)}, {tup(40, 44)})[1]")
 
 
 _PARTS: dict[tuple, types.ModuleType] = {}
@@ -141,8 +143,10 @@ def _part_text(source: KernelSource, core: str, steps: str) -> str:
     return (_PART_HEAD + f"from {core} import _split_step as _core_split\n"
             + f"from {steps} import _fused_steps as _model_steps\n"
             + "\n# MODEL-IMPORT\n" + adapters(source.one_form) + _PART_TAIL
-            + _flat_cfunc("c_step", "_steps", STEP_ARGS, "_flat_signature(_STEP_ARGS)")
-            + _flat_cfunc("c_split", "_core_split", SPLIT_ARGS, "_flat_signature(_SPLIT_ARGS)")
+            + _flat_cfunc("c_step", _step_call, STEP_ARGS, "_flat_signature(_STEP_ARGS)",
+                          '{**_JIT, "pipeline_class": _NoAlias}')
+            + _flat_cfunc("c_split", lambda v: f"_core_split({', '.join(v)})", SPLIT_ARGS,
+                          "_flat_signature(_SPLIT_ARGS)")
             + f"\n\n#: The callbacks in the order of their addresses in a coefficient row.\n"
             f"CALLBACKS = ({_CALLBACKS})\n")
 
