@@ -52,7 +52,6 @@ step compiled as C callbacks."""
 import numba as nb
 
 from geardyn._jit_target import WidthCompiler
-from geardyn.core.kernel_source import FORM_GENERAL as _FORM_GENERAL
 from geardyn.solvers._pointer_calls import ARRAY_SIG as _ARRAY_SIG
 from geardyn.solvers._pointer_calls import SPLIT_ARGS as _SPLIT_ARGS
 from geardyn.solvers._pointer_calls import STEP_ARGS as _STEP_ARGS
@@ -119,15 +118,16 @@ def _flat_cfunc(name: str, call: Any, arg_types: tuple, sig: str, jit: str = "_J
 
 def _step_call(v: list[str]) -> str:
     """The model's fused step of a block of slots (its ``"rk4"`` module's ``_fused_steps``, in
-    the lane form FORM_GENERAL) of the flat arguments v (:data:`._pointer_calls.STEP_ARGS`),
-    its tuples regrouped: the number of slots marked. Its callback (``c_step``) is compiled as
-    the sweep's block loop is: noalias arrays, no reference counting (the loop is vectorised
-    only so), the step inlined (a call of ~40 arrays by value costs a block step's
-    arithmetic)."""
+    its one lane form ``_ONE_FORM``, FORM_QUIET: a pointer model has no quiet coefficients, so
+    its lanes take that form on the inlined path too) of the flat arguments v
+    (:data:`._pointer_calls.STEP_ARGS`), its tuples regrouped: the number of slots marked.
+    Its callback (``c_step``) is compiled as the sweep's block loop is: noalias arrays, no
+    reference counting (the loop is vectorised only so), the step inlined (a call of ~40
+    arrays by value costs a block step's arithmetic)."""
     def tup(a: int, b: int) -> str:
         return "(" + ", ".join(v[a:b]) + ")"
 
-    return (f"_model_steps(_FORM_GENERAL, {', '.join(v[:10])}, {tup(10, 14)}, {tup(14, 19)}, "
+    return (f"_model_steps(_ONE_FORM, {', '.join(v[:10])}, {tup(10, 14)}, {tup(14, 19)}, "
             f"{tup(19, 36)}, {tup(36, 40)}, {tup(40, 44)})[1]")
 
 
