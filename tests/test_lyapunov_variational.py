@@ -420,3 +420,32 @@ def test_a_rhs_the_duals_cannot_take_is_named(monkeypatch):
                 if isinstance(fn, nb.core.registry.CPUDispatcher)
                 and fn.py_func.__module__ == mod.__name__ and fn.overloads]
     assert compiled == []
+
+
+def test_split_limit_takes_the_difference_rows_counted():
+    """A variational step that reaches the split limit (the levels model of
+    tests/levels_model.py: 18 levels crossed within one grid step twice per forcing period, more
+    than MAX_SPLITS) is taken by the difference rows and counted, never silently: from the
+    analytic motion, 2 such steps per period run in ``difference_steps``, each of the rows
+    (the state and its two neighbours) at the limit in ``unresolved``, the status SPLIT_LIMIT;
+    in the one-lane kernel and in the fused lane blocks alike. x' does not depend on x, so the
+    exponent is 0 (to the rows' rounding)."""
+    from levels_model import RUN, levels_model
+
+    model = levels_model()
+    kern = kernels_for(model.kernel, "lyapunov")
+    assert kern.VARIATIONAL and kern.FUSED
+    n_per, n_tr, n_m = RUN.steps_per_period, 2, 10
+    steps = 2 * (n_tr + n_m)
+    om = 1.1
+    p = np.ascontiguousarray(model.with_params(Omega=om).params)
+    out = kern.lyapunov_single(p, model.initial_state(), np.ones(1), 0.0, 2 * math.pi / om / n_per,
+                               om, n_per, n_tr * n_per, n_m * n_per, 10, 1, 1e6, model.n_events,
+                               16, True)
+    assert (out[3], out[4], out[5]) == (2, 3 * steps, steps)  # STATUS_SPLIT_LIMIT
+    assert abs(out[0][0]) < 5e-8
+    oms = np.array([0.8, 1.1, 1.4])
+    _, _, _, exps, _, unres, status, fd = _lanes(model, oms, n_per, n_tr * n_per,
+                                                 np.full(3, n_m * n_per), True)
+    assert fd.tolist() == [steps] * 3 and unres.tolist() == [3 * steps] * 3
+    assert status.tolist() == [2] * 3 and np.all(np.abs(exps) < 5e-8)

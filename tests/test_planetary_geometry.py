@@ -170,6 +170,35 @@ def test_bad_geometry_and_inputs_name_the_field():
     assert e.value.field == "geometry"
 
 
+@pytest.mark.parametrize("n", [0, 33, 3.0, True])
+def test_the_gear_formulas_take_the_planet_counts_the_set_takes(n):
+    """equally_spaced, mesh_phases and planetary_reduced_masses refuse a planet count outside
+    1..32 (or not whole) naming the field, as PlanetaryGearSet does."""
+    with pytest.raises(ParameterError) as model:
+        geardyn.PlanetaryGearSet(n_planets=n, sun_mesh_stiffness=1e8, ring_mesh_stiffness=1e8,
+                                 **MEMBERS)
+    with pytest.raises(ParameterError) as spaced:
+        g.equally_spaced(n)
+    with pytest.raises(ParameterError) as masses:
+        g.planetary_reduced_masses(1e-3, 1e-4, 0.02, 0.02, n, 0.02)
+    assert model.value.field == spaced.value.field == masses.value.field == "n_planets"
+    if isinstance(n, int) and not isinstance(n, bool):
+        with pytest.raises(ParameterError) as angles:  # the count of given angles too
+            g.mesh_phases(25, 71, np.zeros(n))
+        assert angles.value.field == "planet_angles"
+
+
+def test_the_gear_formulas_take_32_planets():
+    """32 planets (the largest count): 32 angles 2 pi k / 32, and the sun-planet reduced mass
+    m_P* m_S* / (32 m_P* + m_S*) per mm of face width computed here."""
+    assert np.array_equal(g.equally_spaced(32), 2.0 * np.pi * np.arange(32) / 32)
+    ms, mp = 1e-3 / 0.02 ** 2, 1e-4 / 0.03 ** 2
+    sun, ring = g.planetary_reduced_masses(1e-3, 1e-4, 0.02, 0.03, np.int64(32), 0.02)
+    assert math.isclose(sun, mp * ms / (32 * mp + ms) / 20.0, rel_tol=1e-15)
+    assert math.isclose(ring, mp / 20.0, rel_tol=1e-15)
+    assert len(g.mesh_phases(32, 96, 32).sun) == 32
+
+
 def test_builtin_study_builds_from_its_geometry():
     """planetary_example: [params.geometry] gives the same set as from_geometry here; a
     mesh stiffness next to the geometry, or none without it, names params.<field>."""

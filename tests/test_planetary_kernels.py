@@ -123,6 +123,40 @@ def test_rotating_lanes_reproduce_single_simulations_bitwise(name, values):
         np.testing.assert_array_equal(r.samples[j], ds["poincare"].values[1:])
 
 
+@pytest.mark.parametrize("kw", [{}, {"sun_coast_stiffness": 3e8, "ring_coast_stiffness": 4e8}])
+def test_lane_block_functions_equal_the_per_lane_functions_bitwise(kw):
+    """rhs_lanes, events_lanes and observe_lanes on a block of lanes (Omega differs per lane;
+    states on both sides of the dead zones, the coast flank in contact where there is one)
+    give each lane exactly what the per-lane functions give it: two separate codes (the
+    lane-block mesh work shared by the right-hand side and the observables, the per-lane mesh
+    forces shared by theirs)."""
+    gs = busy_set(**kw)
+    P = gs.lane_params("Omega", gs.params[pk.OMEGA] * np.array([0.7, 1.0, 1.3, 1.9, 2.2]))
+    nl = P.shape[0]
+    rng = np.random.default_rng(11)
+    Y = np.ascontiguousarray(gs.initial_state()[:, None]
+                             + rng.normal(0.0, 5.0, (gs.initial_state().size, nl)))
+    T = rng.uniform(0.0, 40.0, nl)
+    S, C = np.sin(P[:, pk.OMEGA] * T), np.cos(P[:, pk.OMEGA] * T)
+    nm = int(P[0, pk.N_MESH])
+    PT = np.ascontiguousarray(P.T)
+    DY, G, O = np.empty_like(Y), np.empty((2 * nm, nl)), np.empty((nm, nl))
+    pk.planetary_rhs_lanes(T, Y, DY, PT, nl, S, C, np.zeros((8, nl)))
+    pk.planetary_events_lanes(T, Y, G, PT, nl, S, C)
+    pk.planetary_observe_lanes(T, Y, O, PT, nl, S, C, np.zeros((8, nl)))
+    assert np.any(G[1::2] < 0.0) and np.any(G[0::2] > 0.0)  # both sides of the dead zones
+    assert (P[0, pk.TWO_FLANK] != 0.0) == bool(kw)
+    for k in range(nl):
+        p, y = P[k].copy(), Y[:, k].copy()
+        dy, g, o = np.empty_like(y), np.empty(2 * nm), np.empty(nm)
+        pk.planetary_rhs(T[k], y, dy, p, S[k], C[k])
+        pk.planetary_events(T[k], y, g, p, S[k], C[k])
+        pk.planetary_observe(T[k], y, o, p, S[k], C[k])
+        np.testing.assert_array_equal(DY[:, k], dy)
+        np.testing.assert_array_equal(G[:, k], g)
+        np.testing.assert_array_equal(O[:, k], o)
+
+
 def test_raw_override_outside_the_structure_is_refused():
     gs = busy_set()
     names = gs.dof_names()

@@ -27,7 +27,10 @@ def _defined(module: str) -> set[str]:
 def _private_solver_imports():
     """(file, module, name) of every ``from geardyn.solvers._x import name`` in src and tests."""
     for path in sorted([*(ROOT / "src").rglob("*.py"), *(ROOT / "tests").rglob("*.py")]):
-        for node in ast.walk(ast.parse(path.read_text())):
+        text = path.read_text()
+        if "geardyn.solvers._" not in text:  # no such import: nothing to parse
+            continue
+        for node in ast.walk(ast.parse(text)):
             if (isinstance(node, ast.ImportFrom) and node.module
                     and node.module.startswith("geardyn.solvers._")
                     and (ROOT / "src" / (node.module.replace(".", "/") + ".py")).exists()):

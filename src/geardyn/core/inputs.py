@@ -226,3 +226,14 @@ def one_value(value: object) -> bool:
     """Whether an input's value is one value (a number, a unit string or None), not one per
     planet or mesh (a list, a tuple, an array or a mapping) nor a flag."""
     return not isinstance(value, bool | Mapping | list | tuple | np.ndarray)
+
+
+#: Most planets of a planetary stage: the limit of every model, study table, builder and gear
+#: formula that takes ``n_planets`` (read from :data:`N_PLANETS`).
+MAX_PLANETS = 32
+#: The count ``n_planets``, declared once with its range (:meth:`PhysicalInput.count`): read by
+#: the planetary models, trains and study tables, and by the planetary gear formulas
+#: (:func:`geardyn.gears.phasing.equally_spaced`,
+#: :func:`geardyn.gears.iso6336_kv.planetary_reduced_masses`) below them.
+N_PLANETS = PhysicalInput("n_planets", "count", "number of planets N", 3, minimum=1,
+                          maximum=MAX_PLANETS)

@@ -45,6 +45,7 @@ from typing import Any
 
 import numpy as np
 
+from geardyn.core.inputs import N_PLANETS
 from geardyn.errors import ParameterError
 from geardyn.gears.helical import HelicalMesh
 from geardyn.gears.iso6336 import N_PER_MM_UM, iso6336_stiffness
@@ -178,8 +179,7 @@ def planetary_reduced_masses(sun_inertia: float, planet_inertia: float, sun_base
     ms = _positive("sun_inertia", sun_inertia) / _positive("sun_base_radius", sun_base_radius) ** 2
     mp = _positive("planet_inertia", planet_inertia) \
         / _positive("planet_base_radius", planet_base_radius) ** 2
-    if isinstance(n_planets, bool) or not isinstance(n_planets, int | np.integer) or n_planets < 1:
-        raise ParameterError("n_planets", n_planets, "must be a whole number >= 1")
+    n_planets = N_PLANETS.count(n_planets)
     return mp * ms / (n_planets * mp + ms) / b, mp / b
 
 

@@ -37,6 +37,7 @@ from functools import cached_property
 
 import numpy as np
 
+from geardyn.core.inputs import N_PLANETS
 from geardyn.errors import ParameterError
 from geardyn.gears.geometry import GearMesh, SpurGear
 from geardyn.gears.iso6336 import ISOStiffness, iso6336_stiffness
@@ -47,10 +48,9 @@ ASSEMBLY_TOL = 1e-6
 
 
 def equally_spaced(n_planets: int) -> np.ndarray:
-    """psi_n = 2 pi (n - 1) / N [rad]."""
-    if isinstance(n_planets, bool) or not isinstance(n_planets, numbers.Integral) \
-            or n_planets < 1:
-        raise ParameterError("n_planets", n_planets, "must be a whole number >= 1")
+    """psi_n = 2 pi (n - 1) / N [rad]; ``n_planets`` within :data:`~geardyn.core.inputs.N_PLANETS`'s
+    range."""
+    n_planets = N_PLANETS.count(n_planets)
     return 2.0 * np.pi * np.arange(n_planets) / n_planets
 
 
@@ -93,8 +93,9 @@ def mesh_phases(sun_teeth: int, ring_teeth: int, planet_angles: np.ndarray | int
     for name, z in (("sun_teeth", sun_teeth), ("ring_teeth", ring_teeth)):
         if isinstance(z, bool) or not isinstance(z, numbers.Integral) or z < 5:
             raise ParameterError(name, z, "must be a whole number >= 5")
-    if angles.size < 1:
-        raise ParameterError("planet_angles", planet_angles, "need at least one planet")
+    if not N_PLANETS.minimum <= angles.size <= N_PLANETS.maximum:
+        raise ParameterError("planet_angles", planet_angles,
+                             f"need {N_PLANETS.minimum:g} to {N_PLANETS.maximum:g} planets")
     _check_assembly(sun_teeth, ring_teeth, angles)
     rel = sun_turns * (angles - angles[0])
     sun_ring = sun_turns * sun_ring_phase  # the planet turning the other way: -gamma_rs

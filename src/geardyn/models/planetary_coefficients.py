@@ -7,7 +7,7 @@ and workspace the kernel reads. The set's physical inputs are declared here too 
 from __future__ import annotations
 
 from geardyn.core.coefficients import Coefficient, CoefficientBlock
-from geardyn.core.inputs import PhysicalInput
+from geardyn.core.inputs import N_PLANETS, PhysicalInput
 
 
 def _d(name: str, unit: str, meaning: str, *inputs: str, constant: str | None = None
@@ -123,15 +123,12 @@ def coast_harmonics_block(nh: int) -> CoefficientBlock:
 CENTRAL = ("carrier", "ring", "sun")
 #: The stiffness waveforms a study names (the constructor also takes Fourier coefficients).
 WAVEFORMS = ("sine", "rectangular")
-#: Most planets of a planetary stage, and most harmonics of a stiffness series: the limits of
-#: every model, study table and builder that takes ``n_planets`` or ``harmonics`` (read from
-#: :data:`N_PLANETS` and :data:`HARMONICS`).
-MAX_PLANETS = 32
+#: Most harmonics of a stiffness series: the limit of every model, study table and builder that
+#: takes ``harmonics`` (read from :data:`HARMONICS`; the planet count's range is
+#: :data:`geardyn.core.inputs.N_PLANETS`, which the gear formulas below the models read too).
 MAX_HARMONICS = 200
-#: The counts ``n_planets`` and ``harmonics`` (of a rectangular waveform's stiffness series),
-#: declared once with their ranges (:meth:`~geardyn.core.inputs.PhysicalInput.count`).
-N_PLANETS = PhysicalInput("n_planets", "count", "number of planets N", 3, minimum=1,
-                          maximum=MAX_PLANETS)
+#: The count ``harmonics`` (of a rectangular waveform's stiffness series), declared once with
+#: its range (:meth:`~geardyn.core.inputs.PhysicalInput.count`).
 HARMONICS = PhysicalInput("harmonics", "count", "harmonics of the rectangular waveform's series",
                           9, minimum=1, maximum=MAX_HARMONICS)
 

@@ -106,14 +106,13 @@ from geardyn.solvers._step_core import (  # CORE-IMPORT
     _events_columns,
     _events_i,
     _events_l,
-    _first_crossing,
-    _interpolant_events,
     _lane_form,
     _leaves_side_step,
     _rhs_columns,
     _rhs_l,
     _split_copy,
     _split_rhs,
+    _split_run,
     _split_step,
     _t_axpy,
     _t_comb,
@@ -125,8 +124,6 @@ from geardyn.solvers._step_core import (  # CORE-IMPORT
 from geardyn.solvers._step_shared import (
     BLOCK,
     GBUF_ROWS,
-    MAX_SPLITS,
-    SIMULTANEOUS,
     STATUS_DIVERGED,
     STATUS_OK,
     STATUS_SPLIT_LIMIT,
@@ -196,10 +193,11 @@ if VARIATIONAL:
             y1[q] = rk4_comb(y[q], h6, KS[0, q], KS[1, q], KS[2, q], KS[3, q])
             w1[q] = rk4_comb(w[q], h6, KV[0, q], KV[1, q], KV[2, q], KV[3, q])
 
-    # A split step's tangent: the state is split at its crossings as :func:`_split_step` splits
-    # it (the same operations: the same state, bitwise) and each tangent vector w follows its
-    # sub-steps by the variational RK4, the Jacobian of every stage taken on the sides of the
-    # sub-step (forced: a stage point that lies beyond an edge, by the O(h^3) of the crossing
+    # A split step's tangent: the state is split at its crossings by the split step itself
+    # (:func:`_split_run`, :func:`_split_step`'s body, with this tangent's hooks: the same
+    # operations, the same state, bitwise) and each tangent vector w follows its sub-steps by
+    # the variational RK4 (:func:`_var_sub`), the Jacobian of every stage taken on the sides of
+    # the sub-step (forced: a stage point that lies beyond an edge, by the O(h^3) of the crossing
     # found on the trial step's interpolant, is moved back onto its side along the orbit,
     # :func:`_side_point`); at each split point x, where the orbit's numerical crossing lies
     # g(x) / g'(x) before or after x (g the edge crossed, g' its rate along the orbit), the
@@ -271,12 +269,16 @@ if VARIATIONAL:
         return True, True
 
     @nb.njit(_nrt=False, **_JIT)  # it allocates nothing: no reference counting of its views
-    def _var_sub(ys, k1, hs, t, tm, sm, cm, te, se, ce, s1, c1, p, side, m1, h, trial, VX, VG):
-        """One RK4 sub-step of size hs from ys (time t, phase s1, c1, f(ys) = k1; middle stages
-        at tm, sm, cm, the last at te, se, ce) of the state, as :func:`_rk4_stages` takes it
-        (the same operations), into VX[1] (``trial``) or VX[0], and of each tangent vector
-        (VX[9 + 7 j]) into its trial row or in place, every stage's J w on the sides ``side``
-        (:func:`_side_point`). Returns False where a stage could not be put on its sides."""
+    def _var_sub(tan, ys, k1, hs, t, tm, sm, cm, te, se, ce, s1, c1, p, side, h, trial, out,
+                 work):
+        """The split step's sub-step hook (:func:`_split_run`) of the variational tangent
+        ``tan`` = (m1, VX, VG): one RK4 sub-step of size hs from ys (time t, phase s1, c1,
+        f(ys) = k1; middle stages at tm, sm, cm, the last at te, se, ce) of the state, as
+        :func:`_rk4_stages` takes it (the same operations), into out, and of each of the m1
+        tangent vectors (VX[9 + 7 j]) into its trial row (``trial``) or in place, every stage's
+        J w on the sides ``side`` (:func:`_side_point`). Returns False where a stage could not
+        be put on its sides."""
+        m1, VX, VG = tan
         ns = ys.size
         TMP = VX[2]
         TP = VX[3]
@@ -285,7 +287,6 @@ if VARIATIONAL:
         g = VG[0]
         g2 = VG[1]
         M = VG[2]
-        out = VX[1] if trial else VX[0]
         hh = 0.5 * hs
         ok = True
         # one call site of the rhs's tangent form for the tangent vectors (each site is an
@@ -384,127 +385,50 @@ if VARIATIONAL:
                         VX[b, q] = VX[b, q] - shift * (VX[b + 2, q] - VX[b + 3, q])
         return True
 
+    @nb.njit(inline="always", **_JIT)
+    def _var_at_split(tan, t, y, k1, u, s, c, p, side, jx, h, pc, fresh):
+        """The split step's correction hook (:func:`_split_run`) of the variational tangent
+        ``tan`` = (m1, VX, VG): :func:`_var_correct` at the split point y just after the
+        crossing of event jx (``fresh``: k1 = f(y) computed first)."""
+        m1, VX, VG = tan
+        if fresh:
+            _split_rhs(t, y, k1, p, s, c)
+        # np.int64: a literal would compile _var_correct once more
+        return _var_correct(t, y, k1, u, s, c, p, side, np.int64(jx), m1, h, pc, VX, VG)
+
+    @nb.njit(inline="always", **_JIT)
+    def _var_finish(tan, u, ok, y, y_trial):
+        """The split step's end hook (:func:`_split_run`) of the variational tangent ``tan`` =
+        (m1, VX, VG) on the trial of the (sub-)step from the fraction u: 2 where no crossing was
+        found (u = 0: the step is its unsplit trial, VX[1], y untouched); else the state and
+        the tangent vectors from their trial rows (the rest of the step after the crossing,
+        its tangent forced onto the sides after it), 0, or 1 where that sub-step refused."""
+        if u == 0.0:
+            return 2
+        if not ok:
+            return 1
+        m1, VX, VG = tan
+        _split_copy(y, y_trial)
+        for j in range(m1):
+            b = 9 + 7 * j
+            for q in range(y.size):
+                VX[b, q] = VX[b + 1, q]
+        return 0
+
     @nb.njit(_nrt=False, **_JIT)  # it allocates nothing: no reference counting of its views
     def _var_split(i, t0, m1, p, h, omega, n_per, sa, ca, s_end, c_end, side, g1, ncross, work,
                    gbuf, VX, VG):
         """:func:`_split_step` of the state in VX[0] (its unsplit trial in VX[1], the tangent
-        vectors' unforced trials in their trial rows), operation for operation, with the tangent
-        vectors carried through its sub-steps (:func:`_var_sub`) and moved at each split point
-        (:func:`_var_correct`; see above). Returns 0 when done (state and tangent vectors in
-        VX[0] and their rows), 1 where the step is to be taken by the difference rows, 2 where
+        vectors' unforced trials in their trial rows): the same split step
+        (:func:`_split_run`, operation for operation) with the m1 tangent vectors carried
+        through its sub-steps (:func:`_var_sub`) and moved at each split point
+        (:func:`_var_at_split`; see above). Returns 0 when done (state and tangent vectors in
+        VX[0] and their rows), 1 where the step is to be taken by the difference rows (a split
+        point that crosses more than one edge, a hook that refused, the split limit), 2 where
         no crossing was found (the step is its unsplit trial, VX[1])."""
-        n_ev = g1.size
-        ns = VX.shape[1]
-        y = VX[0]
-        y_trial = VX[1]
-        k1 = work[0]
-        f1 = work[5]
-        ystart = work[6]
-        ybuf = work[8]
-        g0 = gbuf[0]
-        gsc = gbuf[1]
-        g13 = gbuf[3]
-        g23 = gbuf[4]
-        u = 0.0
-        i_mod = i % n_per
-        wh = omega * h
-        pc = (sa, ca, wh, i_mod)
-        t_end = t0 + (i + 1) * h
-        s0 = sa
-        c0 = ca
-        crossed = -1  # the event crossed at the split point y (corrected at the next start)
-        ok = True
-        finished = False
-        for _ in range(MAX_SPLITS):
-            t = t0 + (i + u) * h
-            dt = (1.0 - u) * h
-            _split_rhs(t, y, k1, p, s0, c0)
-            # np.int64: a literal (crossed = -1) would compile _var_correct once more
-            if crossed >= 0 and not _var_correct(t, y, k1, u, s0, c0, p, side,
-                                                 np.int64(crossed), m1, h, pc, VX, VG):
-                return 1
-            graze = False
-            need = False
-            for j in range(n_ev):
-                flag = gbuf[GRAZE_ROW, j] != 0.0
-                graze = graze or flag
-                need = need or flag or _side(g1[j]) != side[j]
-            ok = True
-            if u > 0.0:
-                sm, cm = _phase_at(sa, ca, wh, i_mod, 0.5 * (1.0 + u))
-                ok = _var_sub(y, k1, dt, t, t + 0.5 * dt, sm, cm, t + dt, s_end, c_end, s0, c0,
-                              p, side, m1, h, bool(True), VX, VG)  # noqa: UP018 (see below)
-                _events_i(t_end, y_trial, g1, p, s_end, c_end)
-                need = graze
-                for j in range(n_ev):
-                    need = need or _side(g1[j]) != side[j]
-            if not need:
-                finished = True
-                break
-            _split_rhs(t_end, y_trial, f1, p, s_end, c_end)
-            _split_copy(ystart, y)
-            pcs = (sa, ca, wh, i_mod, u, 1.0 - u)
-            _interpolant_events(ystart, k1, y_trial, f1, dt, t, p, ybuf, g0, g13, g23, pcs)
-            first = -1
-            theta = 2.0
-            for j in range(n_ev):
-                flag = gbuf[GRAZE_ROW, j] != 0.0
-                if flag or _side(g1[j]) != side[j]:
-                    th = _first_crossing(j, side[j], flag, g1[j], ystart, k1, y_trial, f1, dt,
-                                         t, p, ybuf, gbuf, gsc, pcs)
-                else:
-                    th = 2.0
-                gbuf[2, j] = th
-                if th < theta:
-                    theta = th
-                    first = j
-            if first < 0:
-                finished = True
-                break
-            tm = u + 0.5 * theta * (1.0 - u)
-            tu = u + theta * (1.0 - u)
-            sm, cm = _phase_at(sa, ca, wh, i_mod, tm)
-            s1, c1 = _phase_at(sa, ca, wh, i_mod, tu)
-            hs = theta * dt
-            # bool(): a literal True / False would compile _var_sub once for each
-            if not _var_sub(ystart, k1, hs, t, t + 0.5 * hs, sm, cm, t + hs, s1, c1, s0, c0,
-                            p, side, m1, h, bool(False), VX, VG):  # noqa: UP018
-                return 1
-            n_cross = 0
-            for j in range(n_ev):
-                if gbuf[2, j] <= theta + SIMULTANEOUS:
-                    side[j] = -side[j]
-                    ncross[j] += 1
-                    n_cross += 1
-                    crossed = j
-            if n_cross != 1:
-                return 1
-            s0 = s1
-            c0 = c1
-            u = tu
-            if u >= 1.0:
-                _events_i(t_end, y, g1, p, s_end, c_end)
-                t = t0 + (i + u) * h
-                _split_rhs(t, y, k1, p, s0, c0)
-                if not _var_correct(t, y, k1, u, s0, c0, p, side, np.int64(crossed), m1, h, pc,
-                                    VX, VG):
-                    return 1
-                return 0
-        if not finished:
-            return 1  # the split limit: the difference rows take the step (and count it)
-        if u == 0.0:
-            return 2  # no crossing: the trial, its tangent unforced as an unsplit step's
-        # the rest of the step's trial taken, its tangent forced onto the sides after the
-        # crossing
-        if not ok:
-            return 1
-        for q in range(ns):
-            y[q] = y_trial[q]
-        for j in range(m1):
-            b = 9 + 7 * j
-            for q in range(ns):
-                VX[b, q] = VX[b + 1, q]
-        return 0
+        return _split_run(i, t0, VX[0], VX[1], p, h, omega, n_per, sa, ca, s_end, c_end, side,
+                          g1, ncross, work, work[8], gbuf, (m1, VX, VG), _var_sub,
+                          _var_at_split, _var_finish, True)
 
     @nb.njit(_nrt=False, **_JIT)  # it allocates nothing: no reference counting of its views
     def _var_split_lane(i, t0, Z, S, IS, p, h, omega, n_per, s_tab, c_tab, n_ev, YP, E, K, TMP,

@@ -372,13 +372,143 @@ def _split_copy(dst, src):
         dst[q] = src[q]
 
 
+@nb.njit(inline="always", **_JIT)
+def _plain_sub(tan, ys, k1, hs, t, tm, sm, cm, te, se, ce, s0, c0, p, side, h, trial, out, work):
+    """The split step's sub-step of a plain run (no tangent, ``tan`` None): RK4 of size hs from
+    ys (f(ys) = k1; middle stages at tm, phase sm, cm, the last at te, se, ce) into out
+    (:func:`_rk4_stages`, scratch rows 1, 2, 4 of work). True: nothing to refuse."""
+    _rk4_stages(ys, hs, tm, p, sm, cm, te, p, se, ce, k1, work[1], work[2], work[4], out)
+    return True
+
+
+@nb.njit(inline="always", **_JIT)
+def _plain_correct(tan, t, y, k1, u, s, c, p, side, jx, h, pc, fresh):
+    """The split step's correction at a split point of a plain run: none (True)."""
+    return True
+
+
+@nb.njit(inline="always", **_JIT)
+def _plain_finish(tan, u, ok, y, y_trial):
+    """The split step's end on the trial of the (sub-)step from the fraction u of a plain run:
+    y = y_trial; 0."""
+    _split_copy(y, y_trial)
+    return 0
+
+
+@nb.njit(inline="always", **_JIT)
+def _split_run(i, t0, y, y_trial, p, h, omega, n_per, sa, ca, s_end, c_end, side, g1, ncross,
+               work, ybuf, gbuf, tan, sub, correct, finish, single):
+    """The split step (:func:`_split_step`), with an optional tangent carried through it:
+    ``tan`` (None for a plain run) is handed to three hooks, ``sub`` (a sub-step of the state
+    from ys into out, ``trial`` where it runs to the grid point; False: ill-posed),
+    ``correct`` (at a split point, just after the crossing of event jx; ``fresh``: k1 = f(y)
+    is to be computed there first; False: ill-posed) and ``finish`` (the step ends on the
+    trial of the (sub-)step from the fraction u: its return value is the step's); ``single``:
+    a split point must cross exactly one edge (else 1). A plain run's hooks
+    (:func:`_plain_sub`, :func:`_plain_correct`, :func:`_plain_finish`, ``single`` False) are
+    inlined to the plain step's operations; the Lyapunov kernel's variational tangent passes
+    its own (``_var_split``). Returns 1 where the split limit was reached (y = y_trial, the
+    sides those of g1) or a hook refused, else the finish hook's value or 0."""
+    n_ev = g1.size
+    k1 = work[0]
+    f1 = work[5]
+    ystart = work[6]
+    g0 = gbuf[0]
+    gsc = gbuf[1]
+    g13 = gbuf[3]
+    g23 = gbuf[4]
+    u = 0.0  # fraction of the grid step done
+    i_mod = i % n_per
+    wh = omega * h
+    pc = (sa, ca, wh, i_mod)
+    t_end = t0 + (i + 1) * h
+    s0 = sa
+    c0 = ca
+    crossed = -1  # the event crossed at the split point y (corrected at the next start)
+    for _ in range(MAX_SPLITS):
+        t = t0 + (i + u) * h
+        dt = (1.0 - u) * h
+        _split_rhs(t, y, k1, p, s0, c0)
+        if crossed >= 0 and not correct(tan, t, y, k1, u, s0, c0, p, side, crossed, h, pc,
+                                        False):
+            return 1
+        graze = False
+        need = False
+        for j in range(n_ev):
+            flag = gbuf[GRAZE_ROW, j] != 0.0
+            graze = graze or flag
+            need = need or flag or _side(g1[j]) != side[j]
+        ok = True
+        if u > 0.0:
+            sm, cm = _phase_at(sa, ca, wh, i_mod, 0.5 * (1.0 + u))
+            # bool(): a literal True / False would compile a hook once for each
+            ok = sub(tan, y, k1, dt, t, t + 0.5 * dt, sm, cm, t + dt, s_end, c_end, s0, c0, p,
+                     side, h, bool(True), y_trial, work)  # noqa: UP018
+            _events_i(t_end, y_trial, g1, p, s_end, c_end)
+            need = graze
+            for j in range(n_ev):
+                need = need or _side(g1[j]) != side[j]
+        if not need:
+            return finish(tan, u, ok, y, y_trial)
+        _split_rhs(t_end, y_trial, f1, p, s_end, c_end)
+        _split_copy(ystart, y)
+        pcs = (sa, ca, wh, i_mod, u, 1.0 - u)
+        _interpolant_events(ystart, k1, y_trial, f1, dt, t, p, ybuf, g0, g13, g23, pcs)
+        first = -1
+        theta = 2.0
+        for j in range(n_ev):
+            flag = gbuf[GRAZE_ROW, j] != 0.0
+            if flag or _side(g1[j]) != side[j]:
+                th = _first_crossing(j, side[j], flag, g1[j], ystart, k1, y_trial, f1, dt, t,
+                                     p, ybuf, gbuf, gsc, pcs)
+            else:
+                th = 2.0
+            gbuf[2, j] = th
+            if th < theta:
+                theta = th
+                first = j
+        if first < 0:
+            return finish(tan, u, ok, y, y_trial)
+        tm = u + 0.5 * theta * (1.0 - u)
+        tu = u + theta * (1.0 - u)
+        sm, cm = _phase_at(sa, ca, wh, i_mod, tm)
+        s1, c1 = _phase_at(sa, ca, wh, i_mod, tu)
+        hs = theta * dt
+        if not sub(tan, ystart, k1, hs, t, t + 0.5 * hs, sm, cm, t + hs, s1, c1, s0, c0, p,
+                   side, h, bool(False), y, work):  # noqa: UP018
+            return 1
+        n_cross = 0
+        for j in range(n_ev):
+            if gbuf[2, j] <= theta + SIMULTANEOUS:
+                side[j] = -side[j]
+                ncross[j] += 1
+                n_cross += 1
+                crossed = j
+        if single and n_cross != 1:
+            return 1
+        s0 = s1
+        c0 = c1
+        u = tu
+        if u >= 1.0:
+            _events_i(t_end, y, g1, p, s_end, c_end)
+            if not correct(tan, t0 + (i + u) * h, y, k1, u, s0, c0, p, side, crossed, h, pc,
+                           True):
+                return 1
+            return 0
+    _split_copy(y, y_trial)
+    for j in range(n_ev):
+        side[j] = _side(g1[j])
+    return 1
+
+
 @nb.njit(_nrt=False, **_JIT)  # it allocates nothing: no reference counting of its views
 def _split_step(i, t0, y, y_trial, p, h, omega, n_per, sa, ca, s_end, c_end, side, g1, ncross,
                 work, ybuf, gbuf):
-    """Finish grid step i of one lane with edge crossings located; y holds the start, and
-    y_trial/g1 the unsplit trial step; gbuf has GBUF_ROWS rows, row GRAZE_ROW flagging the
-    events that may graze (set by the caller's prefilter: those get :func:`_first_crossing`,
-    the others a crossing only where the end's side differs). Returns 1 if the split limit was
+    """Finish grid step i of one lane with edge crossings located (:func:`_split_run` with a
+    plain run's hooks, no tangent); y holds the start, and y_trial/g1 the unsplit trial step;
+    gbuf has GBUF_ROWS rows, row GRAZE_ROW flagging the events that may graze (set by the
+    caller's prefilter: those get :func:`_first_crossing`, the others a crossing only where the
+    end's side differs). Returns 1 if the split limit was
     reached, else 0.
 
     Per (sub-)step to check: f at its start (the RK4's k1) and end, the events at 0, 1/3, 2/3
@@ -394,84 +524,9 @@ def _split_step(i, t0, y, y_trial, p, h, omega, n_per, sa, ca, s_end, c_end, sid
     the caller's phase-table values (:func:`phase_table`), so a split sees the phases of the
     unsplit step, bitwise, and calls no libm for them. work: 7 rows of the
     state's size."""
-    n_ev = g1.size
-    ns = y.size
-    k1 = work[0]
-    kst = work[1]
-    acc = work[2]
-    tmp = work[4]
-    f1 = work[5]
-    ystart = work[6]
-    g0 = gbuf[0]
-    gsc = gbuf[1]
-    g13 = gbuf[3]
-    g23 = gbuf[4]
-    u = 0.0  # fraction of the grid step done
-    i_mod = i % n_per
-    wh = omega * h
-    t_end = t0 + (i + 1) * h
-    s0 = sa
-    c0 = ca
-    for _ in range(MAX_SPLITS):
-        t = t0 + (i + u) * h
-        dt = (1.0 - u) * h
-        _split_rhs(t, y, k1, p, s0, c0)
-        graze = False
-        need = False
-        for j in range(n_ev):
-            flag = gbuf[GRAZE_ROW, j] != 0.0
-            graze = graze or flag
-            need = need or flag or _side(g1[j]) != side[j]
-        if u > 0.0:
-            sm, cm = _phase_at(sa, ca, wh, i_mod, 0.5 * (1.0 + u))
-            _rk4_stages(y, dt, t + 0.5 * dt, p, sm, cm, t + dt, p, s_end, c_end, k1, kst, acc,
-                        tmp, y_trial)
-            _events_i(t_end, y_trial, g1, p, s_end, c_end)
-            need = graze
-            for j in range(n_ev):
-                need = need or _side(g1[j]) != side[j]
-        if not need:
-            _split_copy(y, y_trial)
-            return 0
-        _split_rhs(t_end, y_trial, f1, p, s_end, c_end)
-        _split_copy(ystart, y)
-        pc = (sa, ca, wh, i_mod, u, 1.0 - u)
-        _interpolant_events(ystart, k1, y_trial, f1, dt, t, p, ybuf, g0, g13, g23, pc)
-        first = -1
-        theta = 2.0
-        for j in range(n_ev):
-            flag = gbuf[GRAZE_ROW, j] != 0.0
-            if flag or _side(g1[j]) != side[j]:
-                th = _first_crossing(j, side[j], flag, g1[j], ystart, k1, y_trial, f1, dt, t,
-                                     p, ybuf, gbuf, gsc, pc)
-            else:
-                th = 2.0
-            gbuf[2, j] = th
-            if th < theta:
-                theta = th
-                first = j
-        if first < 0:
-            _split_copy(y, y_trial)
-            return 0
-        tm = u + 0.5 * theta * (1.0 - u)
-        tu = u + theta * (1.0 - u)
-        sm, cm = _phase_at(sa, ca, wh, i_mod, tm)
-        s0, c0 = _phase_at(sa, ca, wh, i_mod, tu)
-        hs = theta * dt
-        _rk4_stages(ystart, hs, t + 0.5 * hs, p, sm, cm, t + hs, p, s0, c0, k1, kst, acc, tmp, y)
-        for j in range(n_ev):
-            if gbuf[2, j] <= theta + SIMULTANEOUS:
-                side[j] = -side[j]
-                ncross[j] += 1
-        u = tu
-        if u >= 1.0:
-            _events_i(t_end, y, g1, p, s_end, c_end)
-            return 0
-    for q in range(ns):
-        y[q] = y_trial[q]
-    for j in range(n_ev):
-        side[j] = _side(g1[j])
-    return 1
+    return _split_run(i, t0, y, y_trial, p, h, omega, n_per, sa, ca, s_end, c_end, side, g1,
+                      ncross, work, ybuf, gbuf, None, _plain_sub, _plain_correct, _plain_finish,
+                      False)
 
 
 @nb.njit(_nrt=False, **_JIT)  # it allocates nothing: no reference counting of its views
