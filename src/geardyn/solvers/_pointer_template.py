@@ -5,9 +5,9 @@ The pointer path's sweep module (:func:`._pointer_kernels.sweep_module`) is the 
 :mod:`._kernel_template` bound to the pointer model (:mod:`._pointer_model`, whose functions call
 the callbacks a coefficient row names) with the text below the ``POINTER-HOOKS`` line appended:
 its definitions replace the template's of the same names, so that the block loop
-(``_fused_run``), the bookkeeping out of line (``_slots_out``, ``_slot_out``,
-``_finish_flagged``), the lane loading and the workers are the template's own, and only these
-differ:
+(``_fused_run``), the bookkeeping of the marked slots (``_slots_out``, ``_slot_out``,
+``_finish_flagged``), the lane loading and the workers are the template's own text, and only
+these differ:
 
 * ``_fused_steps``: a grid step of every slot is the model's own fused step (its inlined
   ``"rk4"`` module's ``_fused_steps``, compiled with the model as a C callback, see
@@ -16,6 +16,12 @@ differ:
   through its address;
 * ``_start_sides``, ``_slot_observe``: the events at a lane's start and the observables at a
   grid point out of line through the model's array forms (the pointer model's);
+* ``_slots_out``: the template's, inlined in the block loop instead of called. A call passes
+  its ~80 arrays by value (~620 words pushed); after the callback, those pushes took ~1.2 us
+  a call (~0.14 us in the inlined sweep, the same count; the cause is not measured: perf
+  samples only, no hardware counters), ~2.9 ns per lane-step of bench/pointer_path.py's sweep,
+  where ~15% of the block steps call it. The block loop's hot part is the callback here, so
+  the inlined bookkeeping crowds nothing;
 * ``FUSED``: the sweep takes the fused block loop.
 
 The generated module is the same text for every model; its operations are those of the inlined
@@ -29,7 +35,7 @@ from __future__ import annotations
 import numba as nb
 import numpy as np
 
-from geardyn.solvers._kernel_template import _JIT, events, observe
+from geardyn.solvers._kernel_template import _JIT, _slots_out, events, observe
 
 # POINTER-HOOKS: the text below is appended to the template's (see the module docstring)
 from geardyn.solvers._pointer_calls import N_ADDRESSES, call_flat
@@ -50,6 +56,11 @@ def _fused_steps(form, nl, locate, bound, Y, Y1, PT, SE, CE, H6, FLAG, G, ST, sl
     n_out = call_flat(addr, (nl, locate, bound, Y, Y1, PT, SE, CE, H6, FLAG) + G + ST + slots
                       + ROT + PH)
     return n_out, n_out
+
+
+#: The bookkeeping of the marked slots (the template's ``_slots_out``) inlined in the block loop
+#: (see the module docstring).
+_slots_out = nb.njit(inline="always", **_JIT)(_slots_out.py_func)
 
 
 @nb.njit(inline="always", **_JIT)
