@@ -19,9 +19,12 @@ these differ:
 * ``_slots_out``: the template's, inlined in the block loop instead of called. A call passes
   its ~80 arrays by value (~620 words pushed); after the callback, those pushes took ~1.2 us
   a call (~0.14 us in the inlined sweep, the same count; the cause is not measured: perf
-  samples only, no hardware counters), ~2.9 ns per lane-step of bench/pointer_path.py's sweep,
+  samples only, no hardware counters), ~3 ns per lane-step of bench/pointer_path.py's sweep,
   where ~15% of the block steps call it. The block loop's hot part is the callback here, so
-  the inlined bookkeeping crowds nothing;
+  the inlined bookkeeping crowds nothing; inlined in the template's own block loop, where the
+  fused step is inlined too, it made the paper workload 2.9x slower (bench/ab_paper.py, one run;
+  GearPair's sweep 0.84-0.88x
+  its time, the one form inlined 1.06-1.09x), so the template calls it;
 * ``FUSED``: the sweep takes the fused block loop.
 
 The generated module is the same text for every model; its operations are those of the inlined
