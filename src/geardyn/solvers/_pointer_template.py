@@ -23,8 +23,8 @@ these differ:
   where ~15% of the block steps call it. The block loop's hot part is the callback here, so
   the inlined bookkeeping crowds nothing; inlined in the template's own block loop, where the
   fused step is inlined too, it made the paper workload 2.9x slower (bench/ab_paper.py, one run;
-  GearPair's sweep 0.84-0.88x
-  its time, the one form inlined 1.06-1.09x), so the template calls it;
+  GearPair's sweep 0.84-0.88x its time, the one form inlined 1.06-1.09x), so the template
+  calls it;
 * ``FUSED``: the sweep takes the fused block loop.
 
 The generated module is the same text for every model; its operations are those of the inlined
