@@ -1,12 +1,16 @@
 """The pointer kernel path (``UserModel.from_one_form(..., kernel_path="pointer")``): the
 trajectory and sweep kernels compiled once for every model, the model's functions compiled alone
 and called through their addresses. Its results are those of the inlined path bit for bit (the
-gear pair against ``GearPair`` and against the same one form inlined) and within the integrator's
-error of DOP853; models of other sizes run on the same compiled kernels."""
+gear pair against ``GearPair`` and against the same one form inlined; also in a fresh process
+that loads the callbacks and kernels from numba's cache) and within the integrator's error of
+DOP853; models of other sizes run on the same compiled kernels."""
 
 from __future__ import annotations
 
+import json
 import math
+import os
+import subprocess
 import sys
 from pathlib import Path
 
@@ -118,3 +122,66 @@ def test_the_kernel_path_is_checked_naming_the_field():
 def test_a_pointer_model_keeps_the_model_contract():
     report = check_model(gear_pair(**COEFFS, Omega=1.3, kernel_path="pointer"))
     assert report.ok, str(report)
+
+
+#: A fresh process on the pointer path: argv[1] the examples folder, argv[2] the lanes' rows
+#: (.npy), argv[3] the results (.npz). Prints JSON: the cache hits of the part's callbacks and
+#: of the sweep's and trajectory's entries, the bound callees their loaders brought.
+_FRESH = """
+import json, sys
+import numpy as np
+sys.path.insert(0, sys.argv[1])
+import geardyn
+from geardyn import _bound_calls
+from geardyn.solvers.ensemble import LaneResults, run_lanes
+from geardyn.solvers.kernels import kernels_for
+from gear_pair_model import gear_pair
+
+m = gear_pair(zeta=0.05, kappa=0.2, Fm=0.1, Fa=0.2, kernel_path="pointer")
+run = geardyn.RunSettings(transient=300.0, samples=6, steps_per_period=64)
+r = run_lanes(m, np.load(sys.argv[2]), m.initial_state(), run=run)
+s = geardyn.simulate(m.with_omega(0.9), run=geardyn.RunSettings(transient=50.0, samples=5))
+out = {name: getattr(r, name) for name in LaneResults.__dataclass_fields__}
+out.update({"sim_" + name: s[name].values for name in ("x", "v", "F", "poincare")})
+np.savez(sys.argv[3], **out)
+k = kernels_for(m.kernel)
+sweeps = [f for f in vars(k._sweep).values() if hasattr(f, "stats") and f.signatures
+          and f.py_func.__module__ == k._sweep.__name__]
+print(json.dumps({"callbacks": [cb.cache_hits for cb in k.part.CALLBACKS],
+                  "sweep": sum(sum(f.stats.cache_hits.values()) for f in sweeps),
+                  "compiled": sum(sum(f.stats.cache_misses.values()) for f in sweeps),
+                  "trajectory": sum(k._shared.trajectory.stats.cache_hits.values()),
+                  "loaded": len(_bound_calls._LOADED), "bind": _bound_calls.ENABLED}))
+"""
+
+
+def test_a_fresh_process_loads_the_pointer_path_from_the_cache(tmp_path):
+    """A second process loads the model's C callbacks and the shared sweep and trajectory from
+    numba's cache (bound callees brought by their callers' loaders) and gets GearPair's results
+    bit for bit."""
+    pair = geardyn.GearPair(**COEFFS)
+    pointer = gear_pair(**COEFFS, kernel_path="pointer")
+    run = geardyn.RunSettings(transient=300.0, samples=6, steps_per_period=64)
+    run_lanes(pointer, _rows(pointer), pointer.initial_state(), run=run)  # cached here
+    geardyn.simulate(pointer.with_omega(0.9), run=geardyn.RunSettings(transient=50.0, samples=5))
+    np.save(tmp_path / "rows.npy", _rows(pointer))
+    env = {k: v for k, v in os.environ.items() if k != "NUMBA_CACHE_DIR"}
+    env["PYTHONPATH"] = os.pathsep.join([str(Path(geardyn.__file__).parents[1]),
+                                         env.get("PYTHONPATH", "")])
+    examples = Path(__file__).resolve().parent.parent / "examples"
+    out = subprocess.run([sys.executable, "-c", _FRESH, str(examples), str(tmp_path / "rows.npy"),
+                          str(tmp_path / "out.npz")], env=env, capture_output=True, text=True,
+                         timeout=900)
+    assert out.returncode == 0, out.stderr[-3000:]
+    hits = json.loads(out.stdout.strip().splitlines()[-1])
+    assert hits["callbacks"] == [1] * 5 and hits["trajectory"] >= 1, hits
+    assert hits["sweep"] >= 1 and hits["compiled"] == 0, hits
+    assert hits["loaded"] >= 1 or not hits["bind"], hits  # bound callees (the block run, ...)
+    got = np.load(tmp_path / "out.npz")
+    ref = run_lanes(pair, _rows(pair), pair.initial_state(), run=run)
+    for name in LaneResults.__dataclass_fields__:
+        np.testing.assert_array_equal(got[name], getattr(ref, name), err_msg=name)
+    sim = geardyn.simulate(pair.with_omega(0.9), run=geardyn.RunSettings(transient=50.0,
+                                                                         samples=5))
+    for name in ("x", "v", "F", "poincare"):
+        np.testing.assert_array_equal(got["sim_" + name], sim[name].values, err_msg=name)

@@ -4,28 +4,27 @@ On the ``"pointer"`` path (:data:`~geardyn.core.kernel_source.KERNEL_PATHS`, dec
 model: ``UserModel.from_one_form(..., kernel_path="pointer")``) the trajectory and sweep
 kernels (template ``"rk4"``) are those of :mod:`._pointer_model`: the same text for every
 model, so compiled and cached once for all of them. The model's part is a small generated
-module (:func:`model_part`): the one form's array forms
+module (:func:`part_text`): the one form's array forms
 (:func:`geardyn.core.one_form.adapters`), its fused step on a block of slots (``_fused_steps``
 of its inlined ``"rk4"`` module, :mod:`._kernel_template`) and its split step (that of its
 core module, :mod:`._step_core`) compiled as C callbacks, whose addresses are appended to
 every coefficient row the kernels receive (:class:`PointerKernels`). The sweep
-(:func:`sweep_module`: the ``"rk4"`` template's text with :mod:`._pointer_template`'s hooks) is
+(:func:`sweep_text`: the ``"rk4"`` template's text with :mod:`._pointer_template`'s hooks) is
 the inlined sweep's block loop and bookkeeping, calling the fused step once per block step and
 the split step for a flagged slot; a trajectory calls the array forms one lane at a time (its
 split step too: the shared one). The arithmetic is the inlined path's: results are bitwise
 the same.
 
-The other templates (Lyapunov, monodromy, run-up) of a pointer model are the inlined ones
-(:func:`geardyn.solvers.kernels.kernels_for` takes the model's functions inlined for them).
+This module gives the texts and the kernels' wrapper; :func:`geardyn.solvers.kernels.kernels_for`
+writes, imports and keeps the modules (as it does every generated module) and takes the model's
+functions inlined for its other templates (Lyapunov, monodromy, run-up).
 """
 
 from __future__ import annotations
 
-import dataclasses
-import importlib.util
-import sys
+import inspect
 import types
-import warnings
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -34,7 +33,7 @@ from geardyn.core.kernel_source import KernelSource
 from geardyn.core.one_form import adapters
 from geardyn.solvers._pointer_calls import N_ADDRESSES
 
-__all__ = ["PointerKernels", "SOURCE", "model_part", "pointer_kernels", "sweep_module"]
+__all__ = ["PointerKernels", "SOURCE", "part_text", "sweep_text"]
 
 
 def _source() -> KernelSource:
@@ -131,11 +130,7 @@ def _step_call(v: list[str]) -> str:
             f"{tup(19, 36)}, {tup(36, 40)}, {tup(40, 44)})[1]")
 
 
-_PARTS: dict[tuple, types.ModuleType] = {}
-_KERNELS: dict[tuple, PointerKernels] = {}
-
-
-def _part_text(source: KernelSource, core: str, steps: str) -> str:
+def part_text(source: KernelSource, core: str, steps: str) -> str:
     """The text of the model's part; ``core``, ``steps``: the names of the model's core module
     (its split step) and of its inlined ``"rk4"`` kernel module (its fused step)."""
     from geardyn.solvers._pointer_calls import SPLIT_ARGS, STEP_ARGS
@@ -151,102 +146,32 @@ def _part_text(source: KernelSource, core: str, steps: str) -> str:
             f"CALLBACKS = ({_CALLBACKS})\n")
 
 
-def _compiling():
-    """The context of geardyn's compiles (:func:`geardyn.solvers.kernels._quiet_compile`): the
-    compiler lock, this process's function names, numba's warnings about its IR silenced."""
-    import contextlib
+def sweep_text(shared: str) -> str:
+    """The text of the pointer path's sweep: ``shared`` (the text of the ``"rk4"`` kernel module
+    of :data:`SOURCE`) with :mod:`._pointer_template`'s hooks appended (the text below its
+    ``POINTER-HOOKS`` line); the same text for every model, compiled once."""
+    from geardyn.solvers import _pointer_template
 
-    from geardyn.solvers import kernels as K
-
-    stack = contextlib.ExitStack()
-    for ctx in (K._COMPILE_LOCK, K.unique_names(), K.block_copy(), K.young_collections(),
-                warnings.catch_warnings()):
-        stack.enter_context(ctx)
-    for category in K.QUIET_WARNINGS:
-        warnings.filterwarnings("ignore", category=category)
-    return stack
-
-
-def _write_module(prefix: str, code: str, digest: str) -> types.ModuleType:
-    """The module ``<prefix>_<digest>`` of text ``code`` (:func:`.kernels.load_generated`),
-    once per process."""
-    from geardyn.solvers import kernels as K
-
-    name = f"{prefix}_{digest}"
-    return sys.modules[name] if name in sys.modules else K.load_generated(name, code)
-
-
-def model_part(source: KernelSource) -> types.ModuleType:
-    """The generated module of a one-form model's C callbacks (``CALLBACKS``), written to the
-    kernel cache and imported (compiled, or loaded from numba's cache) on first use."""
-    from geardyn.solvers import kernels as K
-
-    if source.one_form is None:
-        raise ValueError("the pointer kernel path needs a model in the one form")
-    funcs = source.functions()
-    key = (source.one_form, *funcs, *(id(f) for f in funcs.values()))
-    if key in _PARTS:
-        return _PARTS[key]
-    inlined = dataclasses.replace(source, path=None)
-    core = K.kernels_for(inlined, K.CORE).__name__
-    text = _part_text(source, core, K.kernels_for(inlined).__name__)
-    with _compiling():
-        if all(K._importable(f) for f in funcs.values()):
-            code = K._replace_import(text, K._import_line(funcs))
-            module = _write_module("geardyn_pointer", code, K._source_digest(code, funcs))
-        else:
-            code = K._replace_import(text, "pass  " + K._IMPORT_MARK).replace(
-                "_CACHE = True", "_CACHE = False")
-            module = types.ModuleType(f"geardyn_pointer_inmemory_{len(_PARTS)}")
-            module.__dict__.update(funcs)
-            exec(compile(code, module.__name__, "exec"), module.__dict__)
-    _PARTS[key] = module
-    return module
-
-
-def sweep_module(shared: types.ModuleType) -> types.ModuleType:
-    """The pointer path's sweep: the ``"rk4"`` template's text bound to :data:`SOURCE` (that of
-    ``shared``, its kernel module) with :mod:`._pointer_template`'s hooks appended (the text
-    below its ``POINTER-HOOKS`` line); the same text for every model, compiled once."""
-    import hashlib
-    import inspect
-
-    import numba
-
-    from geardyn.solvers import _pointer_calls, _pointer_template
-    from geardyn.solvers import kernels as K
-
-    funcs = SOURCE.functions()
-    core = K.kernels_for(SOURCE, K.CORE).__name__
-    text = K._template_text("rk4", SOURCE, "user_events" in funcs, core)
     hooks = inspect.getsource(_pointer_template).split("\n# POINTER-HOOKS", 1)
-    if len(hooks) != 2 or shared.__name__ != K.kernels_for(SOURCE).__name__:
-        raise RuntimeError("pointer sweep: the hooks' marker or the shared module is not found")
-    code = (K._replace_import(text, K._import_line(funcs)) + "\n\n# POINTER-HOOKS"
-            + hooks[1])
-    h = hashlib.sha256(code.encode())
-    h.update(numba.__version__.encode())
-    for mod in (_pointer_calls, *map(importlib.import_module, K.SHARED_MODULES)):
-        h.update(open(mod.__file__, "rb").read())
-    module = _write_module("geardyn_pointer_sweep", code, h.hexdigest()[:20])
-    if not getattr(module, "_geardyn_quiet", False):
-        K._quiet_module(module)
-        module._geardyn_quiet = True
-    return module
+    if len(hooks) != 2:
+        raise RuntimeError("pointer sweep: the hooks' marker is not found")
+    return shared + "\n\n# POINTER-HOOKS" + hooks[1]
 
 
 class PointerKernels:
     """A pointer model's trajectory and sweep kernels (``trajectory``, ``sweep``, ``rhs``,
     ``events``, ``observe``): those of :data:`SOURCE` (compiled once for every model) with the
     model's callback addresses appended to every coefficient row. Any other attribute is that
-    of the model's inlined ``"rk4"`` kernel module (``inlined``: made on first use, its
+    of the model's inlined ``"rk4"`` kernel module (``inlined()``: made on first use, its
     functions compiled on their first call), so that no function of the shared modules is
-    called without the addresses."""
+    called without the addresses. ``shared``, ``sweep``, ``part``: the kernel module of
+    :data:`SOURCE`, the pointer sweep's (:func:`sweep_text`), the model's part
+    (:func:`part_text`)."""
 
-    def __init__(self, shared: types.ModuleType, part: types.ModuleType,
-                 inlined: KernelSource):
+    def __init__(self, shared: types.ModuleType, sweep: types.ModuleType,
+                 part: types.ModuleType, inlined: Callable[[], types.ModuleType]):
         self._shared = shared
-        self._sweep = sweep_module(shared)
+        self._sweep = sweep
         self._inlined = inlined
         self.part = part
         self.addresses = np.array([float(cb.address) for cb in part.CALLBACKS])
@@ -275,19 +200,6 @@ class PointerKernels:
         self._sweep.sweep(lanes._replace(P=self.rows(lanes.P)), cfg, work_queues, out)
 
     def __getattr__(self, name: str) -> Any:
-        if name.startswith("__"):
+        if name.startswith("__") or name == "_inlined":
             raise AttributeError(name)
-        from geardyn.solvers.kernels import kernels_for
-
-        return getattr(kernels_for(self._inlined), name)
-
-
-def pointer_kernels(source: KernelSource, shared: types.ModuleType) -> PointerKernels:
-    """The :class:`PointerKernels` of a one-form model's functions (kept for the process);
-    ``shared``: the kernel module of :data:`SOURCE` (template ``"rk4"``)."""
-    funcs = source.functions()
-    key = (source.one_form, *funcs, *(id(f) for f in funcs.values()))
-    if key not in _KERNELS:
-        _KERNELS[key] = PointerKernels(shared, model_part(source),
-                                       dataclasses.replace(source, path=None))
-    return _KERNELS[key]
+        return getattr(self._inlined(), name)

@@ -1,7 +1,7 @@
 """The sweep of the pointer kernel path: the inlined sweep's text with the model's parts called
 through their addresses, compiled once for every model.
 
-The pointer path's sweep module (:func:`._pointer_kernels.sweep_module`) is the text of
+The pointer path's sweep module (:func:`._pointer_kernels.sweep_text`) is the text of
 :mod:`._kernel_template` bound to the pointer model (:mod:`._pointer_model`, whose functions call
 the callbacks a coefficient row names) with the text below the ``POINTER-HOOKS`` line appended:
 its definitions replace the template's of the same names, so that the block loop
@@ -38,8 +38,11 @@ from __future__ import annotations
 import numba as nb
 import numpy as np
 
-from geardyn.solvers._kernel_template import _JIT, _slots_out, events, observe
+from geardyn.solvers._kernel_template import _slots_out
+from geardyn.solvers._step_core import _JIT
+from geardyn.solvers._template_model import events, observe
 
+# isort: split
 # POINTER-HOOKS: the text below is appended to the template's (see the module docstring)
 from geardyn.solvers._pointer_calls import N_ADDRESSES, call_flat
 from geardyn.solvers._step_shared import _pick, stat_max, stat_min, stat_square
