@@ -221,9 +221,11 @@ def _emit(library: Any) -> None:
         _lazy_code._materialise(library)
 
 
-def _finalize(library: Any) -> None:
+def _finalize(library: Any, reload_init: list) -> None:
     """numba's ``finalize`` with bound callees declared, not linked, and emitted first; the
-    :class:`Loader` of every bound symbol the final module declares in its ``reload_init``."""
+    :class:`Loader` of every bound symbol the final module declares in its ``reload_init`` and
+    in its compile's ``reload_init`` list (what numba's cache saves: a ``cfunc`` is finalized
+    after its compile result took that list, when the cache serialises it)."""
     keep = []
     for lib in library._linking_libraries:
         lib._ensure_finalized()
@@ -241,11 +243,13 @@ def _finalize(library: Any) -> None:
         library._optimize_final_module()
     for name in _bound_declarations(library._final_module):
         library._reload_init.add(_loader(name))
+    reload_init.extend(f for f in library._reload_init if f not in reload_init)
     _register(library)
 
 
-def prepare(library: Any) -> None:
-    """Make ``library`` (a geardyn function's numba code library) declare its bound callees."""
+def prepare(library: Any, reload_init: list) -> None:
+    """Make ``library`` (a geardyn function's numba code library) declare its bound callees;
+    ``reload_init`` is its compile's list of numba's reload callables (``state.reload_init``)."""
     add = library.add_ir_module
 
     def add_ir_module(ir_module: Any) -> None:
@@ -253,7 +257,7 @@ def prepare(library: Any) -> None:
         add(ir_module)
 
     library.add_ir_module = add_ir_module
-    library.finalize = lambda: _finalize(library)
+    library.finalize = lambda: _finalize(library, reload_init)
 
 
 _lazy_code.ON_LOADED[0] = register_loaded
