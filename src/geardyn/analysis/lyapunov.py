@@ -44,7 +44,7 @@ from geardyn.core.settings import (
 from geardyn.core.status import Status
 from geardyn.errors import ParameterError
 from geardyn.solvers.compile_share import signature_types
-from geardyn.solvers.kernels import kernels_for
+from geardyn.solvers.kernels import compile_tangent, kernels_for
 
 #: The defaults' earlier names here (deprecated): those of :mod:`geardyn.core.settings`.
 __getattr__ = moved(__name__, {
@@ -163,11 +163,12 @@ _TANGENT_SIGNATURE = signature_types("(float64, float64[::1], float64[::1], floa
 
 def _check_duals(model: Model, variational: bool, ls: LyapunovSettings) -> None:
     """Where the tangent is variational, the model's tangent form of its rhs compiled alone
-    first (as the kernel calls it; cached like the kernel's functions), so that a one-form rhs
+    first (as the kernel calls it; cached like the kernel's functions; a pointer model's
+    Lyapunov callbacks, :func:`geardyn.solvers.kernels.compile_tangent`), so that a one-form rhs
     the dual numbers cannot take is refused (:func:`_dual_typing`) before any kernel compiles."""
     if variational:
         with _dual_typing(True, ls):
-            kernels_for(model.kernel, "lyapunov").rhs_tangent.compile(_TANGENT_SIGNATURE)
+            compile_tangent(model.kernel, _TANGENT_SIGNATURE)
 
 
 def lyapunov_tangent(variational: bool) -> str:

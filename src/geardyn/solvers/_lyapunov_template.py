@@ -1580,6 +1580,13 @@ def _lyap_var_form2(first, nl, n_ev, max_total, due, renorm, bound, P, OMEGA, H,
                   IS, PT, lanes, books, out, err, used, status, scratch, fd)
 
 
+# POINTER-HOOK: the pointer path (:mod:`._pointer_lyapunov`) replaces this definition
+@nb.njit(inline="always", **_JIT)
+def _n_switching(Z0, PT):
+    """The model's number of switching functions (of its lane form's events)."""
+    return len(_events_l(0.0, _t_load(Z0, 0), PT, 0, 0.0, 1.0))
+
+
 @nb.njit(inline="always", **_JIT)
 def _lyap_block_var(form, first, nl, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
                     n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err, used,
@@ -1598,7 +1605,7 @@ def _lyap_block_var(form, first, nl, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB,
     FDL = np.zeros(BLOCK, np.int64)
     # the graze flags of every switching function of the model (screened even where n_ev = 0,
     # then ignored: no branch in the lane loop)
-    GR = np.zeros(max(len(_events_l(0.0, _t_load(Z0, 0), PT, 0, 0.0, 1.0)), 1) * BLOCK)
+    GR = np.zeros(max(_n_switching(Z0, PT), 1) * BLOCK)
     fd = (np.zeros((2, ns)), np.zeros((3, ns)), np.zeros(2), np.zeros((4, 3, ns)),
           np.zeros((3, ns)), np.zeros((3, ns)), np.ones((3, ne), np.int64), np.zeros((3, ne)),
           np.zeros((3, ne)), np.zeros((9, ns)), np.zeros((GBUF_ROWS, ne)),

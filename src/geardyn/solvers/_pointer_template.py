@@ -1,7 +1,7 @@
 """The sweep of the pointer kernel path: the inlined sweep's text with the model's parts called
 through their addresses, compiled once for every model.
 
-The pointer path's sweep module (:func:`._pointer_kernels.sweep_text`) is the text of
+The pointer path's sweep module (:func:`._pointer_kernels.hooked_text`) is the text of
 :mod:`._kernel_template` bound to the pointer model (:mod:`._pointer_model`, whose functions call
 the callbacks a coefficient row names) with the text below the ``POINTER-HOOKS`` line appended:
 its definitions replace the template's of the same names, so that the block loop

@@ -325,12 +325,15 @@ def load_generated(name: str, code: str) -> types.ModuleType:
 def kernels_for(source: KernelSource, template: str = "rk4") -> Any:
     """The kernel module of ``template`` for a model's functions (built, written and imported on
     first use, then kept for the process). A model that declares the ``"pointer"`` path
-    (:mod:`._pointer_kernels`) gets the trajectory and sweep kernels compiled once for every
-    model, bound to its functions' addresses (:func:`_pointer_path`), and its functions inlined
-    in the other templates."""
+    (:mod:`._pointer_kernels`) gets the trajectory and sweep kernels and the variational
+    Lyapunov lane blocks compiled once for every model, bound to its callbacks' addresses
+    (:func:`_pointer_path`, :func:`_pointer_lyapunov`), and its functions inlined in the other
+    templates."""
     if source.path == "pointer":
         if template == "rk4":
             return _pointer_path(source)
+        if template == "lyapunov":
+            return _pointer_lyapunov(source)
         source = dataclasses.replace(source, path=None)
     funcs = source.functions()
     key = (template, source.plain, source.one_form, *funcs, *(id(f) for f in funcs.values()))
@@ -338,17 +341,7 @@ def kernels_for(source: KernelSource, template: str = "rk4") -> Any:
         return _LOADED[key]
     core = kernels_for(source, CORE).__name__ if template != CORE else None
     text = _template_text(template, source, "user_events" in funcs, core)
-    if all(_importable(f) for f in funcs.values()):
-        code = _replace_import(text, _import_line(funcs))
-        module = load_generated(f"geardyn_{template}_{_source_digest(code, funcs)}", code)
-    else:
-        code = _replace_import(text, "pass  " + _IMPORT_MARK).replace(
-            "_CACHE = True", "_CACHE = False"
-        )
-        module = types.ModuleType(f"geardyn_{template}_inmemory_{len(_LOADED)}")
-        sys.modules[module.__name__] = module  # (the model's other kernel modules import its core)
-        module.__dict__.update(funcs)
-        exec(compile(code, module.__name__, "exec"), module.__dict__)
+    module = _generated(f"geardyn_{template}", text, funcs)
     _quiet_module(module)
     _LOADED[key] = module
     _quiet_shared()
@@ -358,10 +351,33 @@ def kernels_for(source: KernelSource, template: str = "rk4") -> Any:
     return module
 
 
+def _generated(prefix: str, text: str, funcs: dict[str, Any], reuse: bool = False
+               ) -> types.ModuleType:
+    """The generated module of a template's ``text`` for a model's functions ``funcs``:
+    ``<prefix>_<digest>``, written to the cache folder and imported with their import line
+    (:func:`load_generated`; ``reuse``: the module of that name already imported, if any), or,
+    where a function cannot be imported by name, ``<prefix>_inmemory_<n>``, built in memory with
+    the functions in its namespace and numba's cache off (compiled once per process). Either is
+    registered in ``sys.modules`` (the model's other kernel modules import its core)."""
+    if all(_importable(f) for f in funcs.values()):
+        code = _replace_import(text, _import_line(funcs))
+        name = f"{prefix}_{_source_digest(code, funcs)}"
+        if reuse and name in sys.modules:
+            return sys.modules[name]
+        return load_generated(name, code)
+    code = _replace_import(text, "pass  " + _IMPORT_MARK).replace("_CACHE = True",
+                                                                   "_CACHE = False")
+    module = types.ModuleType(f"{prefix}_inmemory_{len(_LOADED)}")
+    sys.modules[module.__name__] = module
+    module.__dict__.update(funcs)
+    exec(compile(code, module.__name__, "exec"), module.__dict__)
+    return module
+
+
 def _pointer_path(source: KernelSource) -> pointer.PointerKernels:
     """The :class:`._pointer_kernels.PointerKernels` of a one-form model on the pointer path
     (kept for the process): the ``"rk4"`` kernels of :data:`._pointer_kernels.SOURCE`, the
-    pointer sweep (:func:`_pointer_sweep`) and the model's part, whose C callbacks compile as
+    pointer sweep (:func:`_pointer_hooked`) and the model's part, whose C callbacks compile as
     it is imported (or load from numba's cache)."""
     if source.one_form is None:
         raise ValueError("the pointer kernel path needs a model in the one form")
@@ -373,35 +389,66 @@ def _pointer_path(source: KernelSource) -> pointer.PointerKernels:
     text = pointer.part_text(source, kernels_for(inlined, CORE).__name__,
                              kernels_for(inlined).__name__)
     with _compiling():
-        if all(_importable(f) for f in funcs.values()):
-            code = _replace_import(text, _import_line(funcs))
-            name = f"geardyn_pointer_{_source_digest(code, funcs)}"
-            part = sys.modules[name] if name in sys.modules else load_generated(name, code)
-        else:
-            code = _replace_import(text, "pass  " + _IMPORT_MARK).replace(
-                "_CACHE = True", "_CACHE = False")
-            part = types.ModuleType(f"geardyn_pointer_inmemory_{len(_LOADED)}")
-            part.__dict__.update(funcs)
-            exec(compile(code, part.__name__, "exec"), part.__dict__)
+        part = _generated("geardyn_pointer", text, funcs, reuse=True)
+    from geardyn.solvers import _pointer_template
+
     shared = kernels_for(pointer.SOURCE)
-    _LOADED[key] = pointer.PointerKernels(shared, _pointer_sweep(), part,
-                                          lambda: kernels_for(inlined))
+    _LOADED[key] = pointer.PointerKernels(shared, _pointer_hooked("rk4", _pointer_template),
+                                          part, lambda: kernels_for(inlined))
     return _LOADED[key]
 
 
-def _pointer_sweep() -> types.ModuleType:
-    """The pointer path's sweep module (:func:`._pointer_kernels.sweep_text`): the ``"rk4"``
-    module's text of :data:`._pointer_kernels.SOURCE` with the hooks; its name hashes the text,
-    numba's version and the sources of :mod:`._pointer_calls` and :data:`SHARED_MODULES`."""
+def _pointer_lyapunov(source: KernelSource) -> pointer.PointerLyapunov:
+    """The :class:`._pointer_kernels.PointerLyapunov` of a one-form model on the pointer path
+    (kept for the process): the variational lane blocks of the pointer path's Lyapunov module
+    (:func:`_pointer_hooked`) and the model's part (:func:`._pointer_kernels.lyapunov_part_text`:
+    its C callbacks compile as it is imported, on first use), its other Lyapunov kernels
+    inlined."""
+    funcs = source.functions()
+    key = ("pointer-lyapunov", source.one_form, *funcs, *(id(f) for f in funcs.values()))
+    if key in _LOADED:
+        return _LOADED[key]
+    inlined = dataclasses.replace(source, path=None)
+
+    def part() -> types.ModuleType:
+        text = pointer.lyapunov_part_text(source, kernels_for(inlined, "lyapunov").__name__)
+        with _compiling():
+            return _generated("geardyn_pointer_lyapunov", text, funcs, reuse=True)
+
+    from geardyn.solvers import _pointer_lyapunov as hooks
+
+    _LOADED[key] = pointer.PointerLyapunov(_pointer_hooked("lyapunov", hooks), part,
+                                           lambda: kernels_for(inlined, "lyapunov"))
+    return _LOADED[key]
+
+
+def compile_tangent(source: KernelSource, signature: Any) -> None:
+    """Compile a one-form model's tangent form of its rhs as its variational Lyapunov kernels
+    take it (numba's TypingError where its one form does not take dual numbers): a pointer
+    model's Lyapunov callbacks (:func:`_pointer_lyapunov`, which its lane blocks call), any
+    other model's ``rhs_tangent`` alone, of ``signature``."""
+    kern = kernels_for(source, "lyapunov")
+    if isinstance(kern, pointer.PointerLyapunov):
+        kern.part  # noqa: B018 - imported: its callbacks compiled
+    else:
+        kern.rhs_tangent.compile(signature)
+
+
+def _pointer_hooked(template: str, hooks: types.ModuleType) -> types.ModuleType:
+    """The pointer path's module of ``template`` (:func:`._pointer_kernels.hooked_text`): the
+    template's module of :data:`._pointer_kernels.SOURCE` with the ``hooks`` module's hooks;
+    its name hashes the text, numba's version and the sources of :mod:`._pointer_calls` and
+    :data:`SHARED_MODULES`."""
     funcs = pointer.SOURCE.functions()
     core = kernels_for(pointer.SOURCE, CORE).__name__
-    text = _template_text("rk4", pointer.SOURCE, "user_events" in funcs, core)
-    code = pointer.sweep_text(_replace_import(text, _import_line(funcs)))
+    text = _template_text(template, pointer.SOURCE, "user_events" in funcs, core)
+    code = pointer.hooked_text(_replace_import(text, _import_line(funcs)), hooks)
     h = hashlib.sha256(code.encode())
     h.update(numba.__version__.encode())
     for mod in (_pointer_calls, *map(importlib.import_module, SHARED_MODULES)):
         h.update(Path(mod.__file__).read_bytes())
-    name = f"geardyn_pointer_sweep_{h.hexdigest()[:20]}"
+    prefix = "sweep" if template == "rk4" else template
+    name = f"geardyn_pointer_{prefix}_{h.hexdigest()[:20]}"
     if name not in sys.modules:
         _quiet_module(load_generated(name, code))
     return sys.modules[name]
