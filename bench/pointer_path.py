@@ -19,7 +19,15 @@ located) of ``GearPair``, the one form inlined and on the pointer path, on one t
 seconds per lane-step (median of ``--repeat``, the rows alternating), and whether the points
 are bitwise ``GearPair``'s.
 
-    .venv/bin/python bench/pointer_path.py [--compile [--analyses all]] [--speed] [--repeat 7]
+Lyapunov speed (``--lyapunov``): ``lyapunov_lanes`` (the variational lane blocks, k = 1, as
+``bifurcation(..., lyapunov=True)`` runs them) of the same three on 64 Omega in [0.2, 3.0], 128
+steps per period, edges located, 100 time units of transient and 400 measured, one thread: CPU
+seconds per lane-step (one grid step of one lane with its tangent vector; the steps of the whole
+forcing periods the transient and the window cover), median of ``--repeat``, the rows
+alternating, and whether the exponents are bitwise ``GearPair``'s.
+
+    .venv/bin/python bench/pointer_path.py [--compile [--analyses all]] [--speed] [--lyapunov]
+        [--repeat 7]
 """
 
 from __future__ import annotations
@@ -172,18 +180,62 @@ def speed_figures(repeat: int) -> None:
               f"points bitwise GearPair's: {same}")
 
 
+def lyapunov_figures(repeat: int) -> None:
+    import numba
+
+    numba.set_num_threads(1)
+    import numpy as np
+
+    import geardyn
+    from geardyn.core.plan import forcing_period, periods_covering
+
+    sys.path.insert(0, str(EXAMPLES))
+    from gear_pair_model import gear_pair
+
+    coeffs = dict(zeta=0.05, kappa=0.2, Fm=0.1, Fa=0.2)
+    models = {"GearPair": geardyn.GearPair(**coeffs), "one form inlined": gear_pair(**coeffs),
+              "one form, pointer path": gear_pair(**coeffs, kernel_path="pointer")}
+    omegas = np.linspace(0.2, 3.0, 64)
+    transient, duration, n_per = 100.0, 400.0, 128
+    run = geardyn.RunSettings(transient=transient, steps_per_period=n_per)
+    ls = geardyn.LyapunovSettings(duration=duration)
+    steps = sum((periods_covering(transient, T) + max(1, periods_covering(duration, T))) * n_per
+                for T in forcing_period(omegas))
+
+    def exponents(m):
+        return geardyn.lyapunov_lanes(m, m.lane_params("Omega", omegas), run=run, settings=ls)
+
+    first = {name: exponents(m) for name, m in models.items()}
+    cpu: dict[str, list[float]] = {name: [] for name in models}
+    for _ in range(repeat):
+        for name, m in models.items():
+            c = time.process_time()
+            exponents(m)
+            cpu[name].append(time.process_time() - c)
+    base = None
+    for name in models:
+        per = statistics.median(cpu[name]) / steps * 1e9
+        base = base or per
+        same = np.array_equal(first[name], first["GearPair"], equal_nan=True)
+        print(f"{name:24s} {per:6.2f} ns CPU per lane-step (one thread, lyapunov_lanes)  "
+              f"{per / base:5.3f}x  exponents bitwise GearPair's: {same}")
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--compile", action="store_true")
     ap.add_argument("--speed", action="store_true")
+    ap.add_argument("--lyapunov", action="store_true")
     ap.add_argument("--repeat", type=int, default=7)
     ap.add_argument("--analyses", default="simulate,sweep",
                     help="with --compile: the analyses timed (comma-separated, or all)")
     a = ap.parse_args(argv)
-    if not (a.compile or a.speed):
-        a.compile = a.speed = True
+    if not (a.compile or a.speed or a.lyapunov):
+        a.compile = a.speed = a.lyapunov = True
     if a.speed:
         speed_figures(a.repeat)
+    if a.lyapunov:
+        lyapunov_figures(a.repeat)
     if a.compile:
         compile_figures(ALL if a.analyses == "all" else tuple(a.analyses.split(",")))
     return 0

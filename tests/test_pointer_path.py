@@ -1,9 +1,10 @@
 """The pointer kernel path (``UserModel.from_one_form(..., kernel_path="pointer")``): the
-trajectory and sweep kernels compiled once for every model, the model's functions compiled alone
-and called through their addresses. Its results are those of the inlined path bit for bit (the
-gear pair against ``GearPair`` and against the same one form inlined; also in a fresh process
-that loads the callbacks and kernels from numba's cache) and within the integrator's error of
-DOP853; models of other sizes run on the same compiled kernels."""
+trajectory and sweep kernels and the variational Lyapunov lane blocks compiled once for every
+model, the model's functions compiled alone and called through their addresses. Its results are
+those of the inlined path bit for bit (the gear pair against ``GearPair`` and against the same
+one form inlined; also in a fresh process that loads the callbacks and kernels from numba's
+cache), within the integrator's error of DOP853 and, for an exponent, of the analytic one of a
+linear limit; models of other sizes run on the same compiled kernels."""
 
 from __future__ import annotations
 
@@ -20,6 +21,7 @@ import pytest
 import geardyn
 from geardyn.core.kernel_source import KERNEL_PATHS, KernelSource
 from geardyn.errors import ParameterError
+from geardyn.solvers._pointer_kernels import PointerLyapunov
 from geardyn.solvers.ensemble import LaneResults, run_lanes
 from geardyn.solvers.kernels import kernels_for
 from geardyn.testing import check_model
@@ -124,6 +126,66 @@ def test_a_pointer_model_keeps_the_model_contract():
     assert report.ok, str(report)
 
 
+#: The Lyapunov runs of the tests: short, from the lanes' start states (impacting lanes among
+#: them: their flagged lanes split with the tangent vector).
+LYAP_RUN = geardyn.RunSettings(transient=60.0, steps_per_period=64)
+LYAP = geardyn.LyapunovSettings(duration=120.0)
+
+
+def _exponents(m: geardyn.Model) -> tuple[np.ndarray, ...]:
+    return geardyn.lyapunov_lanes(m, _rows(m), run=LYAP_RUN, settings=LYAP, with_status=True)
+
+
+def test_the_pointer_lyapunov_lane_blocks_equal_the_inlined_one_form_bitwise():
+    """``lyapunov_lanes``, ``geardyn.lyapunov`` (k = 1) and ``bifurcation(..., lyapunov=True)``
+    on the pointer path (the shared lane blocks calling the model's variational step and flagged
+    lanes through their addresses): bitwise those of the same one form inlined, the variational
+    tangent, impacting lanes among them."""
+    inlined, pointer = gear_pair(**COEFFS), gear_pair(**COEFFS, kernel_path="pointer")
+    kern = kernels_for(pointer.kernel, "lyapunov")
+    assert isinstance(kern, PointerLyapunov)
+    got, ref = _exponents(pointer), _exponents(inlined)
+    for name, a, b in zip(("exponents", "stderr", "unresolved", "status"), got, ref,
+                          strict=True):
+        np.testing.assert_array_equal(a, b, err_msg=name)
+    assert np.all(np.isfinite(got[0])) and np.all(got[3] == 0)
+    assert kern._shared._lyap_var_worker_form0.signatures  # the shared lane blocks ran
+    lanes = run_lanes(pointer, _rows(pointer), pointer.initial_state(),
+                      run=LYAP_RUN.replace(samples=4))
+    assert lanes.crossings.sum() > 0  # impacting lanes: flagged lanes split with the tangent
+    one = [geardyn.lyapunov(m.with_omega(0.9), run=LYAP_RUN, settings=LYAP, with_error=True)
+           for m in (pointer, inlined)]
+    assert one[0] == one[1] and one[0].tangent.startswith("variational")
+    om = np.linspace(0.6, 2.4, 4)
+    run = geardyn.RunSettings(transient=60.0, samples=8, steps_per_period=64)
+    a = geardyn.bifurcation(pointer, "Omega", om, run=run, lyapunov=True)
+    b = geardyn.bifurcation(inlined, "Omega", om, run=run, lyapunov=True)
+    for name in ("lyapunov", "lyapunov_err", "lyapunov_unresolved"):
+        np.testing.assert_array_equal(a[name].values, b[name].values, err_msg=name)
+
+
+def test_a_model_without_events_gets_its_exponent_on_the_same_lane_blocks():
+    """The unforced Duffing oscillator (no switching functions) at its stable equilibrium
+    x = 1 on the pointer path: the largest exponent is -delta / 2, that of its linearisation
+    x'' + delta x' + 2 (x - 1) = 0 (underdamped), to the finite window's O(1 / T); on the gear
+    pair's compiled lane blocks (its own compile is its callbacks: none of its inlined Lyapunov
+    lane blocks compiled)."""
+    pair = gear_pair(**COEFFS, kernel_path="pointer")
+    geardyn.lyapunov_lanes(pair, _rows(pair)[:2], run=LYAP_RUN, settings=LYAP)
+    kp = kernels_for(pair.kernel, "lyapunov")
+    compiled = len(kp._shared._lyap_var_worker_form0.signatures)
+    duff = _duffing("pointer").with_params(gamma=0.0)
+    kd = kernels_for(duff.kernel, "lyapunov")
+    assert kd._shared is kp._shared and kd.part is not kp.part and kd.part.N_SWITCHING == 0
+    delta = duff.coefficients().delta
+    out = geardyn.lyapunov_lanes(duff, duff.lane_params("Omega", [0.7, 1.2]), y0=(1.0, 0.0),
+                                 run=geardyn.RunSettings(transient=50.0, steps_per_period=64),
+                                 settings=geardyn.LyapunovSettings(duration=2000.0))
+    np.testing.assert_allclose(out, -0.5 * delta, atol=2e-3)
+    assert len(kd._shared._lyap_var_worker_form0.signatures) == compiled
+    assert not kd._inlined()._lyap_var_worker_form1.signatures
+
+
 #: A fresh process on the pointer path: argv[1] the examples folder, argv[2] the lanes' rows
 #: (.npy), argv[3] the results (.npz). Prints JSON: the cache hits of the part's callbacks and
 #: of the sweep's and trajectory's entries, the bound callees their loaders brought.
@@ -141,13 +203,24 @@ m = gear_pair(zeta=0.05, kappa=0.2, Fm=0.1, Fa=0.2, kernel_path="pointer")
 run = geardyn.RunSettings(transient=300.0, samples=6, steps_per_period=64)
 r = run_lanes(m, np.load(sys.argv[2]), m.initial_state(), run=run)
 s = geardyn.simulate(m.with_omega(0.9), run=geardyn.RunSettings(transient=50.0, samples=5))
+e = geardyn.lyapunov_lanes(m, np.load(sys.argv[2]),
+                           run=geardyn.RunSettings(transient=60.0, steps_per_period=64),
+                           settings=geardyn.LyapunovSettings(duration=120.0), with_status=True)
 out = {name: getattr(r, name) for name in LaneResults.__dataclass_fields__}
 out.update({"sim_" + name: s[name].values for name in ("x", "v", "F", "poincare")})
+out.update({f"lyapunov_{i}": v for i, v in enumerate(e)})
 np.savez(sys.argv[3], **out)
+kl = kernels_for(m.kernel, "lyapunov")
+blocks = [f for f in vars(kl._shared).values() if hasattr(f, "stats")
+          and f.py_func.__module__ == kl._shared.__name__]
 k = kernels_for(m.kernel)
 sweeps = [f for f in vars(k._sweep).values() if hasattr(f, "stats") and f.signatures
           and f.py_func.__module__ == k._sweep.__name__]
 print(json.dumps({"callbacks": [cb.cache_hits for cb in k.part.CALLBACKS],
+                  "lyapunov_callbacks": [cb.cache_hits for cb in kl.part.CALLBACKS],
+                  "lane_blocks": sum(sum(f.stats.cache_hits.values()) for f in blocks),
+                  "lane_blocks_compiled": sum(sum(f.stats.cache_misses.values())
+                                              for f in blocks),
                   "sweep": sum(sum(f.stats.cache_hits.values()) for f in sweeps),
                   "compiled": sum(sum(f.stats.cache_misses.values()) for f in sweeps),
                   "trajectory": sum(k._shared.trajectory.stats.cache_hits.values()),
@@ -164,6 +237,7 @@ def test_a_fresh_process_loads_the_pointer_path_from_the_cache(tmp_path):
     run = geardyn.RunSettings(transient=300.0, samples=6, steps_per_period=64)
     run_lanes(pointer, _rows(pointer), pointer.initial_state(), run=run)  # cached here
     geardyn.simulate(pointer.with_omega(0.9), run=geardyn.RunSettings(transient=50.0, samples=5))
+    exponents = _exponents(pointer)
     np.save(tmp_path / "rows.npy", _rows(pointer))
     env = {k: v for k, v in os.environ.items() if k != "NUMBA_CACHE_DIR"}
     env["PYTHONPATH"] = os.pathsep.join([str(Path(geardyn.__file__).parents[1]),
@@ -176,6 +250,8 @@ def test_a_fresh_process_loads_the_pointer_path_from_the_cache(tmp_path):
     hits = json.loads(out.stdout.strip().splitlines()[-1])
     assert hits["callbacks"] == [1] * 5 and hits["trajectory"] >= 1, hits
     assert hits["sweep"] >= 1 and hits["compiled"] == 0, hits
+    assert hits["lyapunov_callbacks"] == [1] * 2, hits
+    assert hits["lane_blocks"] >= 1 and hits["lane_blocks_compiled"] == 0, hits
     assert hits["loaded"] >= 1 or not hits["bind"], hits  # bound callees (the block run, ...)
     got = np.load(tmp_path / "out.npz")
     ref = run_lanes(pair, _rows(pair), pair.initial_state(), run=run)
@@ -185,3 +261,5 @@ def test_a_fresh_process_loads_the_pointer_path_from_the_cache(tmp_path):
                                                                          samples=5))
     for name in ("x", "v", "F", "poincare"):
         np.testing.assert_array_equal(got["sim_" + name], sim[name].values, err_msg=name)
+    for i, ref in enumerate(exponents):
+        np.testing.assert_array_equal(got[f"lyapunov_{i}"], ref, err_msg=f"lyapunov {i}")
