@@ -20,7 +20,7 @@ from numba import types
 from numba.core import cgutils
 from numba.extending import intrinsic
 
-__all__ = ["ARRAY_SIG", "N_ADDRESSES", "N_LYAPUNOV", "SPLIT_ARGS", "STEP_ARGS", "VAR_FLAGGED_ARGS",
+__all__ = ["ARRAY_SIG", "N_ADDRESSES", "N_LYAPUNOV", "SPLIT_ARGS", "STEP_ARGS", "TANGENT_ARGS",
            "VAR_STEP_ARGS", "c_array", "call_array", "call_flat", "flat_signature"]
 
 _F8P = types.CPointer(types.float64)
@@ -48,25 +48,20 @@ STEP_ARGS = (types.int64, types.boolean, types.float64, _F, _F, types.float64[:,
              *(_F,) * 4, *(_F,) * 4, *(_F,) * 5, *(_B,) * 4, *(_I,) * 5, _F, _F, *(_I,) * 6,
              *(_F,) * 4, *(_F,) * 4)
 
-_F2, _F3, _I2 = types.float64[:, ::1], types.float64[:, :, ::1], types.int64[:, ::1]
-#: The entries at the end of a coefficient row of the pointer path's Lyapunov lane blocks
-#: (:mod:`._pointer_lyapunov`): the model's number of switching functions, the addresses of its
-#: variational step of a block of lanes (:data:`VAR_STEP_ARGS`) and of its flagged lanes
-#: (:data:`VAR_FLAGGED_ARGS`).
+#: The entries before the :data:`N_ADDRESSES` at the end of a coefficient row of the pointer
+#: path's Lyapunov lane blocks (:mod:`._pointer_lyapunov`): the model's number of switching
+#: functions, the addresses of its variational step of a block of lanes
+#: (:data:`VAR_STEP_ARGS`) and of the tangent form of its rhs (:data:`TANGENT_ARGS`).
 N_LYAPUNOV = 3
 #: The numba types of the variational step's arguments (``_var_fused_steps`` of a model's
 #: ``"lyapunov"`` kernel module, :mod:`._lyapunov_template`, in its lane form: without
 #: ``form``), its tuple of phases unpacked: i, nl, locate, Z0, Z1, S, IS, PT, T0L, HL, HHL, H6L,
 #: the phases (6), ACT, FLAG, GR, Y1F.
-VAR_STEP_ARGS = (types.int64, types.int64, types.boolean, *(_F,) * 4, _F2, *(_F,) * 4,
-                 *(_F,) * 6, _B, _F, _F, _F)
-#: The numba types of the flagged lanes' arguments (``_var_flagged`` of a model's
-#: ``"lyapunov"`` kernel module), its scratch tuple unpacked: i, nl, first, n_ev, P, Z0, Z1, S,
-#: IS, T0L, HL, OMEGA, NPL, IDX, S_TAB, C_TAB, FLAG, UNRR, FDL, GR, Y1F; the scratch (Zl, YP, E,
-#: K, TMP, Y1, SIDE, G0, G1, W, gbuf, NCR, UNRES, VX, VG).
-VAR_FLAGGED_ARGS = (*(types.int64,) * 4, _F2, *(_F,) * 7, _I, _I, _F, _F, _F, _I, _I, _F, _F,
-                    _F2, _F2, _F, _F3, _F2, _F2, _I2, _F2, _F2, _F2, _F2, _I2, _I, _F2, _F2)
-
+VAR_STEP_ARGS = (types.int64, types.int64, types.boolean, *(_F,) * 4, types.float64[:, ::1],
+                 *(_F,) * 4, *(_F,) * 6, _B, _F, _F, _F)
+#: The numba types of the arguments of a model's tangent form of its rhs, ``rhs_tangent(t, y, v,
+#: dy, dv, p, s, c)`` (:func:`geardyn.core.one_form.tangent_adapters`).
+TANGENT_ARGS = (types.float64, *(_F,) * 5, types.float64, types.float64)
 
 def _is_c(ty: Any, ndim: int) -> bool:
     return (isinstance(ty, types.Array) and ty.ndim == ndim and ty.dtype == types.float64

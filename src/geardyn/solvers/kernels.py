@@ -401,9 +401,9 @@ def _pointer_path(source: KernelSource) -> pointer.PointerKernels:
 def _pointer_lyapunov(source: KernelSource) -> pointer.PointerLyapunov:
     """The :class:`._pointer_kernels.PointerLyapunov` of a one-form model on the pointer path
     (kept for the process): the variational lane blocks of the pointer path's Lyapunov module
-    (:func:`_pointer_hooked`) and the model's part (:func:`._pointer_kernels.lyapunov_part_text`:
-    its C callbacks compile as it is imported, on first use), its other Lyapunov kernels
-    inlined."""
+    (:func:`_pointer_hooked`: the tangent form and the array forms of :mod:`._pointer_model`)
+    and the model's part (:func:`._pointer_kernels.lyapunov_part_text`: its C callbacks compile
+    as it is imported, on first use), its other Lyapunov kernels inlined."""
     funcs = source.functions()
     key = ("pointer-lyapunov", source.one_form, *funcs, *(id(f) for f in funcs.values()))
     if key in _LOADED:
@@ -411,7 +411,8 @@ def _pointer_lyapunov(source: KernelSource) -> pointer.PointerLyapunov:
     inlined = dataclasses.replace(source, path=None)
 
     def part() -> types.ModuleType:
-        text = pointer.lyapunov_part_text(source, kernels_for(inlined, "lyapunov").__name__)
+        text = pointer.lyapunov_part_text(source, kernels_for(inlined, CORE).__name__,
+                                          kernels_for(inlined, "lyapunov").__name__)
         with _compiling():
             return _generated("geardyn_pointer_lyapunov", text, funcs, reuse=True)
 
@@ -437,15 +438,18 @@ def compile_tangent(source: KernelSource, signature: Any) -> None:
 def _pointer_hooked(template: str, hooks: types.ModuleType) -> types.ModuleType:
     """The pointer path's module of ``template`` (:func:`._pointer_kernels.hooked_text`): the
     template's module of :data:`._pointer_kernels.SOURCE` with the ``hooks`` module's hooks;
-    its name hashes the text, numba's version and the sources of :mod:`._pointer_calls` and
-    :data:`SHARED_MODULES`."""
+    its name hashes the text, numba's version and the sources of :mod:`._pointer_calls`,
+    :mod:`._pointer_model` and :data:`SHARED_MODULES`."""
     funcs = pointer.SOURCE.functions()
     core = kernels_for(pointer.SOURCE, CORE).__name__
     text = _template_text(template, pointer.SOURCE, "user_events" in funcs, core)
+    if _TANGENT_MARK in text:  # the pointer model's tangent form: the model's through its address
+        text = _splice_tangent(text, pointer.TANGENT_IMPORT)
     code = pointer.hooked_text(_replace_import(text, _import_line(funcs)), hooks)
     h = hashlib.sha256(code.encode())
     h.update(numba.__version__.encode())
-    for mod in (_pointer_calls, *map(importlib.import_module, SHARED_MODULES)):
+    for mod in (_pointer_calls, pointer.SOURCE_MODULE,
+                *map(importlib.import_module, SHARED_MODULES)):
         h.update(Path(mod.__file__).read_bytes())
     prefix = "sweep" if template == "rk4" else template
     name = f"geardyn_pointer_{prefix}_{h.hexdigest()[:20]}"
