@@ -250,7 +250,7 @@ def test_a_fresh_process_loads_the_pointer_path_from_the_cache(tmp_path):
     hits = json.loads(out.stdout.strip().splitlines()[-1])
     assert hits["callbacks"] == [1] * 5 and hits["trajectory"] >= 1, hits
     assert hits["sweep"] >= 1 and hits["compiled"] == 0, hits
-    assert hits["lyapunov_callbacks"] == [1] * 2, hits
+    assert hits["lyapunov_callbacks"] == [1] * 5, hits
     assert hits["lane_blocks"] >= 1 and hits["lane_blocks_compiled"] == 0, hits
     assert hits["loaded"] >= 1 or not hits["bind"], hits  # bound callees (the block run, ...)
     got = np.load(tmp_path / "out.npz")

@@ -275,10 +275,11 @@ class UserModel(Model):
         kernel_path
             ``"lane-form"`` (default): every kernel compiled with the model's functions
             inlined (the fastest run, tens of seconds of compile); ``"pointer"``: the
-            trajectory and sweep kernels compiled once for every model and calling the model's
-            functions, compiled alone as C callbacks, through their addresses (seconds of
-            compile; :mod:`geardyn.solvers._pointer_kernels`); the other analyses inlined as
-            with ``"lane-form"``. Recorded as a sweep's ``kernel_path`` attribute.
+            trajectory and sweep kernels and the variational Lyapunov lane blocks compiled once
+            for every model and calling the model's functions, compiled alone as C callbacks,
+            through their addresses (seconds of compile;
+            :mod:`geardyn.solvers._pointer_kernels`); the other analyses inlined as with
+            ``"lane-form"``. Recorded as a sweep's ``kernel_path`` attribute.
         """
         if kernel_path not in ("lane-form", "pointer"):
             raise ParameterError("kernel_path", kernel_path, "'lane-form' or 'pointer'")

@@ -414,7 +414,7 @@ def _pointer_lyapunov(source: KernelSource) -> pointer.PointerLyapunov:
         text = pointer.lyapunov_part_text(source, kernels_for(inlined, CORE).__name__,
                                           kernels_for(inlined, "lyapunov").__name__)
         with _compiling():
-            return _generated("geardyn_pointer_lyapunov", text, funcs, reuse=True)
+            return _generated("geardyn_pointer_lyapunov_part", text, funcs, reuse=True)
 
     from geardyn.solvers import _pointer_lyapunov as hooks
 
