@@ -15,6 +15,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numba
 import numpy as np
 import pytest
 
@@ -184,6 +185,27 @@ def test_a_model_without_events_gets_its_exponent_on_the_same_lane_blocks():
     np.testing.assert_allclose(out, -0.5 * delta, atol=2e-3)
     assert len(kd._shared._lyap_var_worker_form0.signatures) == compiled
     assert not kd._inlined()._lyap_var_worker_form1.signatures
+
+
+@numba.njit(cache=True)
+def atan_rhs(t, y, p, s, c):
+    """A one-form rhs with an operation the dual numbers lack (atan2)."""
+    return (y[1], -p.k * math.atan2(y[0], 1.0) - 0.1 * y[1] + p.F * c)
+
+
+def test_a_rhs_the_duals_cannot_take_is_named_on_the_pointer_path():
+    """The model's Lyapunov part (its tangent callbacks) compiles first and is refused naming
+    ``settings.tangent``, numba's typing error (the operation) chained, on every call (no
+    half-made part kept)."""
+    m = geardyn.UserModel.from_one_form(atan_rhs, params={"k": 1.0, "F": 0.2, "Omega": 1.1},
+                                        states=("x", "v"), initial_state=(0.1, 0.0),
+                                        kernel_path="pointer")
+    for _ in range(2):
+        with pytest.raises(ParameterError, match="settings.tangent") as info:
+            geardyn.lyapunov_lanes(m, m.lane_params("Omega", [1.1]),
+                                   settings=geardyn.LyapunovSettings(duration=20.0))
+        assert "atan2" in str(info.value.__cause__)
+    assert kernels_for(m.kernel, "lyapunov")._part is None
 
 
 #: A fresh process on the pointer path: argv[1] the examples folder, argv[2] the lanes' rows

@@ -306,7 +306,8 @@ def _replace_import(text: str, new_line: str) -> str:
 def load_generated(name: str, code: str) -> types.ModuleType:
     """The generated module ``name`` of text ``code``: written to the kernel cache folder (once;
     atomically, so that concurrent processes never see half a file), imported and registered in
-    ``sys.modules`` (so that another generated module can import it by name)."""
+    ``sys.modules`` (so that another generated module can import it by name; not where its
+    import fails)."""
     folder = cache_dir()
     folder.mkdir(parents=True, exist_ok=True)
     path = folder / f"{name}.py"
@@ -318,7 +319,11 @@ def load_generated(name: str, code: str) -> types.ModuleType:
     spec = importlib.util.spec_from_file_location(name, path)
     module = importlib.util.module_from_spec(spec)
     sys.modules[name] = module
-    spec.loader.exec_module(module)
+    try:
+        spec.loader.exec_module(module)
+    except BaseException:  # (a C callback that does not compile): no half-made module kept
+        del sys.modules[name]
+        raise
     return module
 
 
