@@ -327,10 +327,13 @@ def kernels_for(source: KernelSource, template: str = "rk4") -> Any:
     (:mod:`._pointer_kernels`) gets the trajectory and sweep kernels compiled once for every
     model, bound to its functions' addresses (:func:`_pointer_path`), and its functions inlined
     in the other templates."""
-    # the dual numbers' overloads, installed (numba's typing refreshed) before a kernel compiles;
-    # here, not at import: a process that runs no kernel (a command-line error, ``--help``) does
-    # not pay numba's target set-up
-    import geardyn.core.dual  # noqa: F401
+    if "geardyn.core.dual" not in sys.modules:
+        # the dual numbers' overloads, installed (numba's typing refreshed) before a kernel
+        # compiles, under numba's compiler lock (no compile of another thread sees them
+        # half-registered); here, not at import: a process that runs no kernel (a command-line
+        # error, ``--help``) does not pay numba's target set-up
+        with global_compiler_lock:
+            import geardyn.core.dual  # noqa: F401
 
     if source.path == "pointer":
         if template == "rk4":
