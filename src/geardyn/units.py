@@ -17,8 +17,10 @@ from __future__ import annotations
 import math
 import re
 from functools import lru_cache
+from typing import TYPE_CHECKING
 
-import pint
+if TYPE_CHECKING:
+    import pint
 
 #: The SI unit of each kind of quantity geardyn accepts (pint notation).
 SI_UNITS: dict[str, str] = {
@@ -63,7 +65,10 @@ def _check_quantity_text(text: str) -> None:
 
 @lru_cache(maxsize=1)
 def registry() -> pint.UnitRegistry:
-    """The unit registry shared by geardyn (created once, on first use)."""
+    """The unit registry shared by geardyn (created once, on first use; pint is imported then, so
+    that a process that parses no unit string does not pay its import)."""
+    import pint
+
     return pint.UnitRegistry()
 
 
@@ -88,6 +93,8 @@ def to_si(value: object, kind: str) -> float:
         raise ValueError("empty quantity string")
     _check_quantity_text(text)
     ureg = registry()
+    import pint
+
     try:
         q = ureg.Quantity(text)
     except Exception as exc:  # pint raises several types for bad strings
@@ -119,6 +126,8 @@ def si_value(field: str, value: object, kind: str, minimum: float | None = None,
 
 def _magnitude(q: pint.Quantity, text: str, unit: str) -> float:
     """``q`` in ``unit`` (pint's conversion), rounded to 15 significant digits."""
+    import pint
+
     try:
         magnitude = _real(q.to(unit or "dimensionless").magnitude, text, unit)
     except pint.DimensionalityError:

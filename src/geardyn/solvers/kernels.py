@@ -37,7 +37,6 @@ import numba
 import numba.core.bytecode
 from numba.core.compiler_lock import global_compiler_lock
 
-import geardyn.core.dual  # noqa: F401 - its overloads installed before any kernel compiles
 from geardyn._cache import cache_root
 from geardyn._scoped_patch import scoped_patch
 from geardyn.core.kernel_source import KernelSource
@@ -334,6 +333,14 @@ def kernels_for(source: KernelSource, template: str = "rk4") -> Any:
     Lyapunov lane blocks compiled once for every model, bound to its callbacks' addresses
     (:func:`_pointer_path`, :func:`_pointer_lyapunov`), and its functions inlined in the other
     templates."""
+    if "geardyn.core.dual" not in sys.modules:
+        # the dual numbers' overloads, installed (numba's typing refreshed) before a kernel
+        # compiles, under numba's compiler lock (no compile of another thread sees them
+        # half-registered); here, not at import: a process that runs no kernel (a command-line
+        # error, ``--help``) does not pay numba's target set-up
+        with global_compiler_lock:
+            import geardyn.core.dual  # noqa: F401
+
     if source.path == "pointer":
         if template == "rk4":
             return _pointer_path(source)
