@@ -15,7 +15,10 @@ Lyapunov, monodromy), the lane-block form ``rhs_lanes(T, Y, DY, PT, nl, S, C, SC
 row blocks) and the lane-scalar form ``rhs_lane(t, y, PT, k, s, c, form)`` (the sweep's fused
 step loop), and so for ``events`` and ``observe``. The one form's functions are inlined into
 each (numba IR inlining); a lane's named tuple is built from the coefficient vector there, its
-unused fields never loaded.
+unused fields never loaded. The lane-scalar forms of ``rhs`` and ``observe`` (and the tangent
+form ``rhs_lane_tangent``) call one compiled function per lane form (``_rhs_lane_one``; with
+``quiet`` coefficients one per form, see :func:`_forms`), which LLVM inlines where it is called
+(``forceinline``): numba types the one form once for them, not at every call site.
 
 Every lane takes the lane form FORM_QUIET: the fused loop vectorises wherever the functions call
 no libm routine per lane (a model precomputes cos/sin of a coefficient as coefficients of its
@@ -268,6 +271,11 @@ def adapters(form: OneForm) -> str:
                             "    return",
                             *blk_body]
             lane_body = [f"return {call}(t, y, _coef_lane(PT, k), s, c)"]
+            if not quiet and name != "events":  # compiled once (see _forms)
+                text += (f"\n\n@nb.njit(forceinline=True, **_JIT)\ndef _{name}_lane_one"
+                         f"(t, y, PT, k, s, c):\n"
+                         f"    return {call}(t, y, _coef_lane(PT, k), s, c)\n")
+                lane_body = [f"return _{name}_lane_one(t, y, PT, k, s, c)"]
             if quiet and name != "events":  # the form's own compiled function (see _forms)
                 lane_body = ["if form == _ONE_FORM:",
                              f"    return _{name}_lane_quiet(t, y, PT, k, s, c)",
@@ -353,7 +361,10 @@ def tangent_adapters(form: OneForm) -> str:
                      "if form == _ONE_LOUD:",
                      "    return _rhs_tangent_lane_loud(t, y, v, PT, k, s, c)",
                      "return _rhs_tangent_lane_general(t, y, v, PT, k, s, c)"]
-    else:
-        lane_body = [f"return _tangent_parts(_one_rhs(t, {duals}, _coef_lane(PT, k), s, c))"]
+    else:  # compiled once and inlined by LLVM where it is called (as ``rhs_lane``)
+        out += (f"\n\n@nb.njit(forceinline=True, **_JIT)\ndef _rhs_tangent_lane_one"
+                f"(t, y, v, PT, k, s, c):\n    return _tangent_parts(_one_rhs(t, {duals}, "
+                f"_coef_lane(PT, k), s, c))\n")
+        lane_body = ["return _rhs_tangent_lane_one(t, y, v, PT, k, s, c)"]
     out += _fn("rhs_lane_tangent(t, y, v, PT, k, s, c, form)", lane_body, inline=True)
     return out
