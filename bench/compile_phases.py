@@ -4,7 +4,8 @@ Runs ``bench/compile.py``'s analyses of one model (a conformance case) in this p
 empty private cache, with timers around each numba compiler pass (``PassManager._runPass``)
 and around the LLVM work numba does inside the lowering pass: the LLVM IR's parse and
 function-level passes (``add_ir_module``), the linking of callee libraries into a caller
-(``finalize``'s ``link_in``), the module passes (cheap, then full O3), machine code
+(``finalize``'s ``link_in``), the module passes (numba's cheap then full O3; geardyn's
+functions: the full one only, :func:`geardyn._jit_target._full_only`), machine code
 (``finalize_object``), the CPython and C wrappers' lowering, and the cache's writes. Each
 phase's figure is exclusive: the time of phases nested in it (a callee compiled during a
 caller's type inference) is its own. CPU seconds of the process (``time.process_time``).
@@ -114,6 +115,16 @@ def install(emitted: bool = False) -> None:
     lw.create_cfunc_wrapper = _timed("lower cfunc wrapper")(lw.create_cfunc_wrapper)
     caching.Cache.save_overload = _timed("cache save_overload")(caching.Cache.save_overload)
     caching.Cache.load_overload = _timed("cache load_overload")(caching.Cache.load_overload)
+    from geardyn import _jit_target  # after the patches above (geardyn._lazy_code keeps them)
+
+    full_only = _jit_target._full_only
+
+    def timed_full_only(library):  # geardyn's own module pipeline, set on each library
+        full_only(library)
+        library._optimize_final_module = _timed(
+            f"llvm module passes (geardyn, full) {_kind(library)}")(
+            library._optimize_final_module)
+    _jit_target._full_only = timed_full_only
 
 
 def _record_overloads() -> list:
