@@ -15,6 +15,7 @@ kernel module's ``lyapunov_lanes``, one lane at a time)."""
 from __future__ import annotations
 
 import hashlib
+import importlib
 import importlib.util
 import os
 import sys
@@ -22,6 +23,7 @@ import tempfile
 import types
 from pathlib import Path
 
+import numba as nb
 import numpy as np
 
 _HEAD = '''
@@ -210,18 +212,17 @@ def reference_for(kern: types.ModuleType) -> types.ModuleType:
     cached = getattr(kern, "__file__", None) is not None
     text = (_HEAD.format(kern=kern.__name__) + f"\nCACHE_REF = {cached}\n" + _SOURCE)
     if cached:
-        from geardyn.solvers import _lyapunov_books as books
-        from geardyn.solvers import _step_shared as shared
-        from geardyn.solvers.kernels import cache_dir
+        from geardyn.solvers import kernels
 
-        h = hashlib.sha256(text.encode())
-        for dep in (books, shared):  # numba's cache checks only the module's own file
-            h.update(Path(dep.__file__).read_bytes())
-        digest = h.hexdigest()[:16]
-        name = f"geardyn_lyapref_{digest}"
-        path = cache_dir() / f"{name}.py"
+        h = hashlib.sha256(text.encode() + nb.__version__.encode())
+        for shared in kernels.SHARED_MODULES:  # numba's cache checks only the module's own file
+            h.update(Path(importlib.import_module(shared).__file__).read_bytes())
+        name = f"geardyn_lyapref_{h.hexdigest()[:20]}"
+        folder = kernels.cache_dir()
+        folder.mkdir(parents=True, exist_ok=True)
+        path = folder / f"{name}.py"
         if not path.exists():
-            fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".tmp")
+            fd, tmp = tempfile.mkstemp(dir=folder, suffix=".tmp")
             with os.fdopen(fd, "w") as fh:
                 fh.write(text)
             os.replace(tmp, path)  # atomic: concurrent test workers never see half a file
@@ -232,6 +233,9 @@ def reference_for(kern: types.ModuleType) -> types.ModuleType:
     else:
         module = types.ModuleType(f"{kern.__name__}_lyapref")
         exec(compile(text, module.__name__, "exec"), module.__dict__)
+    from geardyn.solvers import kernels
+
+    kernels._quiet_module(module)  # compiled as geardyn's kernels are (names, lock, warnings)
     _BOUND[kern.__name__] = module
     return module
 

@@ -3,8 +3,8 @@
 Every test worker (pytest-xdist) is a separate process, and numba compiles a kernel in the first
 process that needs it and finds no cached copy; two workers that start on the same model compile
 its kernels twice, side by side, one core each. This script compiles each built-in model's
-kernels that the tests use (``WARM``: sweep, trajectory, Lyapunov lane blocks (one lane or
-several), monodromy, run-up), and those of the user models the tests share (``tests/shared_models.py``), in
+kernels that the tests use (``WARM``: sweep, trajectory, Lyapunov lane blocks, monodromy,
+run-up), and those of the user models the tests share (``tests/shared_models.py``), in
 its own process, the models spread over ``--jobs`` processes (longest first, ``COST``), through
 the public API with the argument types the tests use, so that the workers load them from the
 on-disk cache instead (a worker that needs a kernel the other is compiling waits for it,
