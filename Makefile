@@ -41,10 +41,14 @@ demo: $(STAMP)
 # collection (whole files, in order) and takes half of the other's remaining tests when it runs
 # out, so that a file's tests, which share its test models' kernels, mostly run in one worker
 # (with --dist load they alternate, and a worker waits, idle, for the kernel the other compiles).
+# Both steps keep the two cores busy, so the helper process that compiles a new model's split
+# step ahead (GEARDYN_COMPILE_AHEAD, docs/engine.md) is off here: it would only add its start-up
+# (an import of geardyn, ~2.7 s CPU) to each new model's compile (the cold warm-up's 10 helpers:
+# 348 -> 321 s CPU, measured on the 2-core machine).
 test: $(STAMP)
 	$(BIN)/ruff check src tests examples bench
-	$(BIN)/python tests/warm_kernels.py --jobs 2
-	$(BIN)/python -m pytest -n 2 --dist worksteal -q --durations=15
+	GEARDYN_COMPILE_AHEAD=0 $(BIN)/python tests/warm_kernels.py --jobs 2
+	GEARDYN_COMPILE_AHEAD=0 $(BIN)/python -m pytest -n 2 --dist worksteal -q --durations=15
 
 # The long studies only (marked @pytest.mark.slow; pyproject's addopts keep them out of
 # `make test`, and this -m replaces that selection): results bitwise the same at 512- and

@@ -60,7 +60,30 @@ def _kind(library) -> str:
     return "|" + library.name
 
 
-def install() -> None:
+#: With ``--asm-emitted``: per function (its name without geardyn's per-process number), the
+#: digests of its machine code in every module numba's engine emitted.
+EMITTED: dict[str, set] = defaultdict(set)
+_UID = re.compile(r"B[0-9]+v[0-9]+")
+
+
+def _record_emitted(finalize):
+    """Wrap ``_finalize_final_module`` (numba emits the module's machine code there): each
+    function's assembly, from a clone of the module (the emission changes the module's IR)."""
+    @functools.wraps(finalize)
+    def inner(self):
+        from numba.core import codegen
+
+        asm = str(self._codegen._tm.emit_assembly(self._final_module.clone()))
+        if isinstance(self, codegen.JITCodeLibrary):
+            for name, body in _functions(asm):
+                lines = [_LOCAL.sub(r".\1", _SYMBOL.sub("SYM", s)) for s in body]
+                digest = hashlib.sha256("\n".join(lines).encode()).hexdigest()[:20]
+                EMITTED[_UID.sub("Bv", name)].add(digest)
+        return finalize(self)
+    return inner
+
+
+def install(emitted: bool = False) -> None:
     from numba.core import caching, codegen, compiler_machinery, lowering
 
     pm = compiler_machinery.PassManager
@@ -76,7 +99,7 @@ def install() -> None:
         lib._optimize_final_module)
     lib._finalize_final_module = _timed(
         lambda self: f"llvm machine code (finalize_object) {_kind(self)}")(
-        lib._finalize_final_module)
+        _record_emitted(lib._finalize_final_module) if emitted else lib._finalize_final_module)
     lib._get_module_for_linking = _timed("llvm clone for linking")(lib._get_module_for_linking)
     ll_mod = type(codegen.ll.parse_assembly(""))
     orig_link = ll_mod.link_in
@@ -162,13 +185,17 @@ def main(argv=None) -> int:
                          "symbol names left out), to compare two trees' machine code")
     ap.add_argument("--asm-dump", type=Path, default=None,
                     help="with --asm: also write each function's assembly (names replaced) here")
+    ap.add_argument("--asm-emitted", type=Path, default=None,
+                    help="write the digests of each function's machine code as numba's engine "
+                         "emitted it, in whichever module (JSON; slows the compile), for "
+                         "bench/bound_calls.py")
     ap.add_argument("--analyses", nargs="*", default=None,
                     help="only these of bench/compile.py's analyses (default: all)")
     args = ap.parse_args(argv)
     if "GEARDYN_CACHE_DIR" not in os.environ:
         os.environ["GEARDYN_CACHE_DIR"] = tempfile.mkdtemp(prefix="gdc_phases_")
     os.environ["GEARDYN_COMPILE_AHEAD"] = "0"
-    install()
+    install(emitted=args.asm_emitted is not None)
     compiled = _record_overloads()
     t0 = time.process_time()
     import compile as cb
@@ -198,6 +225,9 @@ def main(argv=None) -> int:
     for name, (s, n) in sorted(lib_rows.items(), key=lambda kv: -kv[1][0])[:args.top]:
         print(f"{s:8.2f} s {n:6d}  {name}")
     print(f"{sum(v[0] for v in TOTALS.values()):8.2f} s in the phases above")
+    if args.asm_emitted is not None:
+        args.asm_emitted.write_text(json.dumps({k: sorted(v) for k, v in EMITTED.items()},
+                                               indent=1, sort_keys=True))
     if args.asm is not None:
         dump = None
         if args.asm_dump is not None:

@@ -40,6 +40,19 @@ from _reference_step import step_pieces  # noqa: E402
 from kernel import old_kernels  # noqa: E402
 
 
+@nb.njit(inline="always")
+def load_record(r, recs_y, recs_g, y, y1, side, g1, gbuf, graze_row):
+    """Recorded split call ``r`` into the split step's arguments: the state before and after
+    the trial step (``y``, ``y1``), the event sides, end events and the graze row."""
+    for q in range(recs_y.shape[2]):
+        y[q] = recs_y[r, 0, q]
+        y1[q] = recs_y[r, 1, q]
+    for j in range(recs_g.shape[2]):
+        side[j] = int(recs_g[r, 0, j])
+        g1[j] = recs_g[r, 1, j]
+        gbuf[graze_row, j] = recs_g[r, 2, j]
+
+
 def drivers(mod):
     """(record, replay, rhs_loop) njit functions bound to a kernel module's step core."""
     rhs, events = mod.rhs, mod.events
@@ -119,18 +132,11 @@ def drivers(mod):
         views passed (``P[k]``, ``recs_ph[r]``) cost four atomic counter updates a call, about
         85 ns here, which the kernels do not pay."""
         ns = recs_y.shape[2]
-        n_ev = recs_g.shape[2]
         unres = 0
         for _ in range(n_rep):
             for r in range(recs_i.size):
                 k = lane[r]
-                for q in range(ns):
-                    y[q] = recs_y[r, 0, q]
-                    y1[q] = recs_y[r, 1, q]
-                for j in range(n_ev):
-                    side[j] = int(recs_g[r, 0, j])
-                    g1[j] = recs_g[r, 1, j]
-                    gbuf[graze_row, j] = recs_g[r, 2, j]
+                load_record(r, recs_y, recs_g, y, y1, side, g1, gbuf, graze_row)
                 unres += split_call(recs_i[r], y, y1, P[k], H[k], OM[k], NPER[k], recs_ph[r],
                                     side, g1, ncross, work, ybuf, gbuf)
                 for q in range(ns):

@@ -48,7 +48,7 @@ import geardyn
 from geardyn.solvers import kernels as kmod
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from crossing import collect, drivers  # noqa: E402
+from crossing import collect, drivers, load_record  # noqa: E402
 
 #: Lanes of a batch (one AVX-512 register of doubles).
 NV = 8
@@ -456,13 +456,8 @@ def replayers(mod, rows, n_rows, split_block, ns, ne, npar, small):
                    out_g, out_nc, y, y1, side, g1, ncross, work, ybuf, gbuf):
         """Recorded call r_ through the scalar split step, its results into row r_ of out_*."""
         k = lane[r_]
-        for q in range(ns):
-            y[q] = recs_y[r_, 0, q]
-            y1[q] = recs_y[r_, 1, q]
+        load_record(r_, recs_y, recs_g, y, y1, side, g1, gbuf, gr_row)
         for j in range(ne):
-            side[j] = int(recs_g[r_, 0, j])
-            g1[j] = recs_g[r_, 1, j]
-            gbuf[gr_row, j] = recs_g[r_, 2, j]
             ncross[j] = 0
         split(recs_i[r_], 0.0, y, y1, P[k], H[k], OM[k], NPER[k], recs_ph[r_, 0],
               recs_ph[r_, 1], recs_ph[r_, 2], recs_ph[r_, 3], side, g1, ncross, work, ybuf,

@@ -44,8 +44,10 @@ def pair_force(t, y, p, s, c):
     return (stiffness * _dead_zone(y[0], p.b) + 2.0 * p.zeta * y[1],)
 
 
-def gear_pair(zeta=0.05, kappa=0.0, Fm=0.1, Fa=0.05, Omega=1.0, phi_k=0.0, phi_e=0.0, b=1.0):
-    """The gear pair as a geardyn.UserModel in the one form, with its mesh declared."""
+def gear_pair(zeta=0.05, kappa=0.0, Fm=0.1, Fa=0.05, Omega=1.0, phi_k=0.0, phi_e=0.0, b=1.0,
+              kernel_path="lane-form"):
+    """The gear pair as a geardyn.UserModel in the one form, with its mesh declared
+    (kernel_path: "pointer" for the kernels compiled once for every model)."""
     return geardyn.UserModel.from_one_form(
         pair_rhs,
         params=dict(Omega=Omega, zeta=zeta, kappa=kappa, Fm=Fm, Fa=Fa, phi_k=phi_k,
@@ -60,4 +62,5 @@ def gear_pair(zeta=0.05, kappa=0.0, Fm=0.1, Fa=0.05, Omega=1.0, phi_k=0.0, phi_e
         initial_state=lambda p: (p.Fm + math.copysign(p.b, p.Fm) if p.Fm else 0.0, 0.0),
         natural_frequency=1.0,
         name="gear pair (user)",
+        kernel_path=kernel_path,
     )

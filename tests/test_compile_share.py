@@ -107,7 +107,10 @@ print(json.dumps({"helpers": len(helpers), "codes": [p.returncode for p in helpe
 
 
 def _run(tmp_path: Path, **env: str) -> dict:
-    environ = {k: v for k, v in os.environ.items() if k != "NUMBA_CACHE_DIR"}
+    """The script in a fresh process, with an empty cache and the helper on (``make test``
+    switches it off for the suite)."""
+    environ = {k: v for k, v in os.environ.items()
+               if k not in ("NUMBA_CACHE_DIR", compile_share.ENV)}
     environ.update(GEARDYN_CACHE_DIR=str(tmp_path), PYTHONPATH=os.pathsep.join(
         [str(TESTS), *sys.path]), **env)
     out = subprocess.run([sys.executable, "-c", _SCRIPT], env=environ,

@@ -26,10 +26,11 @@ LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
     # (atomic writes, attribute encoding), the packaged study files (data only), the kernels'
     # vector width (their compiler pipeline), the cache folder (keyed by that width), the guard of
     # the process-wide patches held during geardyn's compiles, the deferred machine code of nested
-    # callees
+    # callees, the calls of big callees bound to one copy
     ("base", ("geardyn._version", "geardyn.errors", "geardyn.files", "geardyn.units",
               "geardyn.studies", "geardyn._jit_target", "geardyn._tuple_alias",
-              "geardyn._scoped_patch", "geardyn._lazy_code", "geardyn._cache")),
+              "geardyn._scoped_patch", "geardyn._lazy_code", "geardyn._bound_calls",
+              "geardyn._cache")),
     # the model interface, the kernel source, run settings, the lane plan, the section, status
     ("core", ("geardyn.core",)),
     # gear geometry, ISO 6336 stiffness, stiffness waves, planetary mesh phasing (pure numpy)

@@ -4,13 +4,14 @@ functions evaluates them, with the state and the stages in registers (``_split_r
 those of the split on the model's array functions. The reference here is the same reduced CATT
 device through the general model's array functions (``catt_kernels.catt_rhs``, one planet set
 in the coefficient vector), which have no lane forms, so its kernel takes the generic path
-(structure-of-arrays blocks, the array forms of the split's helpers)."""
+(structure-of-arrays blocks, the array forms of the split's helpers): the general model's own
+kernel functions, so that its kernels are those the general model and
+tests/test_catt_one_form.py compile."""
 
 from __future__ import annotations
 
 import copy
 
-import numba as nb
 import numpy as np
 
 import geardyn
@@ -20,25 +21,10 @@ from geardyn.solvers.ensemble import run_lanes
 from geardyn.solvers.kernels import kernels_for
 
 
-@nb.njit(cache=True)
-def _rhs(t, y, dy, p, s, c):
-    ck.catt_rhs(t, y, dy, p, s, c)
-
-
-@nb.njit(cache=True)
-def _events(t, y, g, p, s, c):
-    ck.catt_events(t, y, g, p, s, c)
-
-
-@nb.njit(cache=True)
-def _observe(t, y, out, p, s, c):
-    ck.catt_observe(t, y, out, p, s, c)
-
-
 def test_the_split_in_the_lane_form_equals_the_array_form_bitwise():
     model = geardyn.CATTDevice(geardyn.PlanetaryParams.paper(xi1=0.05, xi2=0.05))
     generic = copy.copy(model)
-    generic.kernel = KernelSource(_rhs, _events, _observe)
+    generic.kernel = KernelSource(ck.catt_rhs, ck.catt_events, ck.catt_observe)
     assert kernels_for(model.kernel).FUSED
     assert not kernels_for(generic.kernel).FUSED
     omegas = np.array([0.6, 1.1, 1.7, 2.3, 2.9, 3.5])  # contact lost in most of them

@@ -48,6 +48,9 @@ WARM = {
     # the user models the tests share (tests/shared_models.py)
     "oscillator": ("trajectory", "sweep", "lyapunov", "orbit"),
     "Lorenz": ("lyapunov", "lanes"),
+    # the pointer path's kernels (once for every model) and the gear pair's part
+    # (tests/test_pointer_path.py)
+    "pointer": ("trajectory", "sweep"),
 }
 
 #: CPU seconds of each case's warm-up with an empty cache (2-core AMD EPYC machine, two jobs, the
@@ -58,7 +61,7 @@ WARM = {
 COST = {
     "PlanetaryGearSet": 137, "SpurPair": 55, "GearPair": 48, "CATTDevice-reduced": 44,
     "CATTDevice-general": 27, "oscillator": 25, "UserModel-one-form": 24, "Lorenz": 19,
-    "DimensionalCATT": 16, "UserModel": 14, "TrainModel": 1,
+    "DimensionalCATT": 16, "UserModel": 14, "TrainModel": 1, "pointer": 30,
 }
 
 
@@ -68,13 +71,19 @@ def _shared(case: str) -> tuple:
 
     from shared_models import lorenz, oscillator
 
+    if case == "pointer":
+        sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "examples"))
+        from gear_pair_model import gear_pair
+
+        model = gear_pair(zeta=0.05, kappa=0.2, Fm=0.1, Fa=0.2, kernel_path="pointer")
+        return model, model.initial_state()
     if case == "Lorenz":
         return lorenz(), np.ones(3)
     return oscillator(zeta=0.05, F=1.0, Omega=1.3), np.zeros(2)
 
 
 #: The shared test models warmed besides the conformance cases.
-SHARED = ("oscillator", "Lorenz")
+SHARED = ("oscillator", "Lorenz", "pointer")
 
 
 def _warm(case: str) -> tuple[str, float]:

@@ -50,7 +50,7 @@ from numba.core.compiler_machinery import LoweringPass, register_pass
 from numba.core.runtime.nrtopt import remove_redundant_nrt_refct
 from numba.core.typed_passes import AnnotateTypes
 
-from geardyn import _lazy_code
+from geardyn import _bound_calls, _lazy_code
 from geardyn._tuple_alias import tuple_aliases
 
 #: The environment variable that chooses the vector width.
@@ -142,6 +142,7 @@ class VectorWidthPass(LoweringPass):
         if _lazy_code.scope.depth == 1:  # the outermost geardyn function: called from Python
             _lazy_code.mark_outermost(state.library)
         _full_only(state.library)
+        _bound_calls.prepare(state.library, state.reload_init)
         if ATTRIBUTE is not None:
             _mark(state.library, ATTRIBUTE)
         return True

@@ -7,7 +7,8 @@ its Python entry point; the caller then links the callee's optimised LLVM IR int
 library and emits its own machine code, with its own copy of the callee. A callee's own machine
 code serves a call from Python, and a call that LLVM did not inline in a caller emitted later
 in the same process (numba's engine binds it to the first definition of the symbol; in a
-process that loads the caller from the cache, to the caller's own copy).
+process that loads the caller from the cache, to the caller's own copy). A big callee is
+declared in its callers instead, and bound to its own machine code (:mod:`geardyn._bound_calls`).
 
 Inside a geardyn compile (:func:`scope`, entered by :class:`geardyn._jit_target.WidthCompiler`)
 every function compiled for it except the outermost one (:func:`mark_outermost`, the one Python
@@ -57,6 +58,17 @@ _SERIALIZE_OBJECT = _codegen.CPUCodeLibrary.serialize_using_object_code
 _ENTRIES: dict[int, list] = {}
 #: Environment symbols to define and set (:func:`_flush_envs`): name -> (codegen, environment).
 _PENDING_ENVS: dict[str, tuple] = {}
+
+
+def _ignore(library: Any) -> None:
+    """No-op: the default of :data:`ON_LOADED` and :data:`ON_DEFERRED`."""
+
+
+#: Called with each library loaded from numba's cache as object code, and with each loaded as
+#: deferred optimised IR (one-item lists, so that :mod:`geardyn._bound_calls`, which imports
+#: this module, sets them at its import: its ``register_loaded`` and ``_register``).
+ON_LOADED: list = [_ignore]
+ON_DEFERRED: list = [_ignore]
 #: The libraries defining environment symbols ahead of their function's machine code.
 _ENV_LIBRARIES: list = []
 #: The stand-in wrapper's machine code (its library and address), made on first use.
@@ -110,6 +122,9 @@ def _materialise(library: Any) -> None:
     with global_compiler_lock:
         if library._geardyn_pending:
             library._geardyn_pending = False
+            symbols = getattr(library, "_geardyn_symbols", ())
+            if symbols and all(map(library.codegen._engine.is_symbol_defined, symbols)):
+                return  # its code loaded already (geardyn._bound_calls.Loader): that copy serves
             library._dynamic_globals = []  # numba's step collects them again
             _FINALIZE_FINAL_MODULE(library)
 
@@ -209,12 +224,15 @@ def _unserialize_library(self: Any, serialized: tuple) -> Any:
     :func:`defer`) is deferred again."""
     name, kind, data = serialized
     if kind != "bitcode":
-        return _ORIGINAL_UNSERIALIZE(self, serialized)
+        library = _ORIGINAL_UNSERIALIZE(self, serialized)
+        ON_LOADED[0](library)
+        return library
     library = self.create_library(name)
     library.enable_object_caching()
     defer(library)
     library._final_module = ll.parse_bitcode(data)
     library._finalize_final_module()
+    ON_DEFERRED[0](library)
     return library
 
 

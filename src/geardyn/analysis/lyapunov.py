@@ -1,9 +1,12 @@
 """Lyapunov exponents of any geardyn model from its tangent (variational) equations.
 
-The state and k tangent vectors are integrated by fixed-step RK4 on the main solver's grid, the
-tangent dynamics J(t, y) v coming from a central finite difference of the model's ``rhs``; the
-vectors are re-orthonormalised (modified Gram-Schmidt) every ``renorm_every`` steps and the logs
-of the stretching factors averaged (Benettin et al. 1980). Each exponent has a standard error from
+The state and k tangent vectors are integrated by fixed-step RK4 on the main solver's grid. A
+model written in the one form advances them by the exact derivative of the RK4 step map (dual
+numbers through its one-form ``rhs``: the variational tangent); any other model, or
+``LyapunovSettings(tangent="difference")``, by central differences of the step map
+(:func:`lyapunov_variational`, :func:`lyapunov_tangent`). The vectors are re-orthonormalised
+(modified Gram-Schmidt) every ``renorm_every`` steps and the logs of the stretching factors
+averaged (Benettin et al. 1980). Each exponent has a standard error from
 the spread of its block averages over the run. See ``docs/lyapunov.md`` and the kernel template
 :mod:`geardyn.solvers._lyapunov_template`.
 """

@@ -16,8 +16,8 @@ from typing import Any
 from geardyn.core import _noop
 from geardyn.core.one_form import OneForm
 
-__all__ = ["FORM_GENERAL", "FORM_LOAD", "FORM_QUIET", "KERNEL_PATHS", "LANE_FORMS",
-           "KernelSource", "events_take_phase", "warn_slow_path"]
+__all__ = ["DECLARED_PATHS", "FORM_GENERAL", "FORM_LOAD", "FORM_QUIET", "KERNEL_PATHS",
+           "LANE_FORMS", "KernelSource", "events_take_phase", "warn_slow_path"]
 
 #: The lane forms of a model's lane-scalar functions (``rhs_lane(..., form)``): the sweep kernel
 #: compiles its fused step loop once per form, with ``form`` a constant there, and runs a queue
@@ -33,8 +33,14 @@ LANE_FORMS = 3
 #: a dataset's ``kernel_path`` attribute): ``"lane-form"``, one fused loop over the block with
 #: the model's lane-scalar functions (the one form, or ``<rhs>_lane`` twins); ``"lane-block"``,
 #: the model's lane-block functions (``<rhs>_lanes``); ``"per-lane"``, its array function one
-#: lane at a time (a plain ``rhs(t, y, dydt, p)``: several times slower on a sweep).
-KERNEL_PATHS = ("lane-form", "lane-block", "per-lane")
+#: lane at a time (a plain ``rhs(t, y, dydt, p)``: several times slower on a sweep);
+#: ``"pointer"``, declared by a one-form model (``KernelSource.path``): a fused block loop
+#: compiled once for every model, calling the model's part (its trial step for a block of
+#: slots, its split step, its functions; compiled alone) through their addresses
+#: (:mod:`geardyn.solvers._pointer_kernels`: seconds of the model's own compile, not tens).
+KERNEL_PATHS = ("lane-form", "lane-block", "per-lane", "pointer")
+#: The kernel paths a model may declare (``KernelSource.path``).
+DECLARED_PATHS = ("pointer",)
 _SLOW_WARNED: set[type] = set()
 
 
@@ -52,11 +58,24 @@ class KernelSource:
     #: Set where the functions are in the one form (:mod:`geardyn.core.one_form`):
     #: ``rhs(t, y, p, s, c) -> tuple`` etc.; the generated kernel writes every layout from them.
     one_form: OneForm | None = None
+    #: A declared kernel path (one of :data:`DECLARED_PATHS`; a one form without ``quiet``
+    #: coefficients only: the pointer path's trial step takes one lane form), else None: the
+    #: path follows from the functions (:attr:`kernel_path`).
+    path: str | None = None
+
+    def __post_init__(self) -> None:
+        if self.path is not None and (self.path not in DECLARED_PATHS or self.one_form is None
+                                      or self.one_form.quiet):
+            raise ValueError(f"kernel path {self.path!r}: a model in the one form without quiet "
+                             f"coefficients may declare {', '.join(map(repr, DECLARED_PATHS))}")
 
     @property
     def kernel_path(self) -> str:
-        """The sweep kernels' path for these functions, one of :data:`KERNEL_PATHS` (what the
-        generated core module decides from the functions it is given)."""
+        """The sweep kernels' path for these functions, one of :data:`KERNEL_PATHS`: the
+        declared one (:attr:`path`), else what the generated core module decides from the
+        functions it is given."""
+        if self.path is not None:
+            return self.path
         if self.one_form is not None:
             return "lane-form"
         funcs = self.functions()

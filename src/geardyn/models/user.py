@@ -212,6 +212,7 @@ class UserModel(Model):
         period: float | None = None,
         name: str = "UserModel",
         natural_frequency: float | Callable[[np.ndarray], float] | None = None,
+        kernel_path: str = "lane-form",
     ) -> UserModel:
         """A model written in the one form (:mod:`geardyn.core.one_form`).
 
@@ -271,7 +272,16 @@ class UserModel(Model):
             zeros).
         period, name, natural_frequency
             As in the constructor.
+        kernel_path
+            ``"lane-form"`` (default): every kernel compiled with the model's functions
+            inlined (the fastest run, tens of seconds of compile); ``"pointer"``: the
+            trajectory and sweep kernels compiled once for every model and calling the model's
+            functions, compiled alone as C callbacks, through their addresses (seconds of
+            compile; :mod:`geardyn.solvers._pointer_kernels`); the other analyses inlined as
+            with ``"lane-form"``. Recorded as a sweep's ``kernel_path`` attribute.
         """
+        if kernel_path not in ("lane-form", "pointer"):
+            raise ParameterError("kernel_path", kernel_path, "'lane-form' or 'pointer'")
         _check_compiled(rhs, events, observe)
         entries = _declarations(params, derived or {}, coefficients)
         names = [c.name for c in entries]
@@ -301,7 +311,8 @@ class UserModel(Model):
             model._declare_dynamic_factor(dynamic_factor)
         model._initial = initial_state
         model.kernel = KernelSource(rhs, events, observe, one_form=OneForm(
-            model.param_names, model.n_states, model.n_events, model.n_observables))
+            model.param_names, model.n_states, model.n_events, model.n_observables),
+            path=None if kernel_path == "lane-form" else kernel_path)
         return model
 
     def coefficients(self, p: np.ndarray | None = None) -> Any:

@@ -915,12 +915,29 @@ def _slot_out(k, G1, SE, CE, TABS, lanes, cfg, out, blk, slots, scratch):
         g = G1[j, k]
         GMIN[j, k] = stat_min(GMIN[j, k], g, True)
         GMAX[j, k] = stat_max(GMAX[j, k], g, True)
-    o = _observe_l(T0B[k] + step * HB[k], _t_load(Y, k), PT, k, SE[k], CE[k], FORM_GENERAL)
-    _t_stats(GMIN, GMAX, OMAX, OMIN, OSQ, k, (), o, True)
+    _slot_observe(k, T0B[k] + step * HB[k], SE[k], CE[k], Y, PT, (GMIN, GMAX, OMAX, OMIN, OSQ),
+                  lanes, cfg, slots, scratch)
     if step < DUE[k]:
         return False
     return _slot_sample_i(k, Y, LANE, STEP, n_end, n_tr, next_sample, DUE, ACT, END, GMIN, GMAX,
                         OMAX, OMIN, OSQ, n_stat, lanes, cfg, out)
+
+
+@nb.njit(inline="always", **_JIT)
+def _slot_observe(k, t, s, c, Y, PT, ST, lanes, cfg, slots, scratch):
+    """The observables' statistics (ST: OMAX, OMIN, OSQ of GMIN, GMAX, OMAX, OMIN, OSQ) of slot
+    k at the grid point reached (time t, forcing phase s, c) in :func:`_slot_out`: the model's
+    lane-scalar ``observe`` (:mod:`._pointer_template` replaces it)."""
+    o = _observe_l(t, _t_load(Y, k), PT, k, s, c, FORM_GENERAL)
+    _t_stats(ST[0], ST[1], ST[2], ST[3], ST[4], k, (), o, True)
+
+
+@nb.njit(inline="always", **_JIT)
+def _start_sides(k, lane, TT, Y, PT, GS, SIDE, SE, CE, lanes, cfg, scratch):
+    """The events at the start of lane ``lane`` (loaded into slot k) into GS[:, k], their sides
+    into SIDE[:, k], in :func:`_fused_run`: the model's lane-scalar ``events``
+    (:mod:`._pointer_template` replaces it)."""
+    _t_side(GS, SIDE, k, _events_l(TT[k], _t_load(Y, k), PT, k, SE[k], CE[k]))
 
 
 @nb.njit(inline="always", **_JIT)
@@ -967,7 +984,7 @@ def _fused_run(form, q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch):
                 CE[k] = C_TAB[OFF[k]]
                 ROT[0][k], ROT[1][k], ROT[2][k], ROT[3][k] = phase_increments(NPER[k])
                 H6[k] = rk4_sixth(HB[k])
-                _t_side(GS, SIDE, k, _events_l(TT[k], _t_load(Y, k), PT, k, SE[k], CE[k]))
+                _start_sides(k, lane, TT, Y, PT, GS, SIDE, SE, CE, lanes, cfg, scratch)
         if n_act == 0:
             break
         if nxt >= q1 and _padded(n_act) < nv:  # the queue is out: no slot empties for a lane

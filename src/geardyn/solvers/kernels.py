@@ -17,6 +17,8 @@ process.
 
 from __future__ import annotations
 
+import contextlib
+import dataclasses
 import hashlib
 import importlib.util
 import inspect
@@ -41,7 +43,8 @@ from geardyn._scoped_patch import scoped_patch
 from geardyn.core.kernel_source import KernelSource
 from geardyn.core.one_form import adapters as one_form_adapters
 from geardyn.core.one_form import tangent_adapters
-from geardyn.solvers import compile_share
+from geardyn.solvers import _pointer_calls, compile_share
+from geardyn.solvers import _pointer_kernels as pointer
 from geardyn.solvers._compile_gc import young_collections
 from geardyn.solvers._inline_copy import block_copy
 
@@ -120,13 +123,22 @@ def _quiet_compile(dispatcher: Any, cached: bool = False) -> None:
         dispatcher.compile)
 
     def compile(sig: Any) -> Any:
-        with (_COMPILE_LOCK, unique_names(), block_copy(), young_collections(),
-              warnings.catch_warnings()):
-            for category in QUIET_WARNINGS:
-                warnings.filterwarnings("ignore", category=category)
+        with _compiling():
             return compile_(sig)
 
     dispatcher.compile = compile
+
+
+@contextlib.contextmanager
+def _compiling() -> Iterator[None]:
+    """The context of geardyn's compiles: the compiler lock, this process's function names
+    (:func:`unique_names`), the block copy (:func:`._inline_copy.block_copy`), the collector's
+    thresholds (:func:`._compile_gc.young_collections`), :data:`QUIET_WARNINGS` ignored."""
+    with (_COMPILE_LOCK, unique_names(), block_copy(), young_collections(),
+          warnings.catch_warnings()):
+        for category in QUIET_WARNINGS:
+            warnings.filterwarnings("ignore", category=category)
+        yield
 
 
 def _quiet_module(module: types.ModuleType) -> None:
@@ -291,9 +303,35 @@ def _replace_import(text: str, new_line: str) -> str:
     return "\n".join(lines) + "\n"
 
 
-def kernels_for(source: KernelSource, template: str = "rk4") -> types.ModuleType:
+def load_generated(name: str, code: str) -> types.ModuleType:
+    """The generated module ``name`` of text ``code``: written to the kernel cache folder (once;
+    atomically, so that concurrent processes never see half a file), imported and registered in
+    ``sys.modules`` (so that another generated module can import it by name)."""
+    folder = cache_dir()
+    folder.mkdir(parents=True, exist_ok=True)
+    path = folder / f"{name}.py"
+    if not path.exists():
+        fd, tmp = tempfile.mkstemp(dir=folder, suffix=".tmp")
+        with os.fdopen(fd, "w") as fh:
+            fh.write(code)
+        os.replace(tmp, path)
+    spec = importlib.util.spec_from_file_location(name, path)
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[name] = module
+    spec.loader.exec_module(module)
+    return module
+
+
+def kernels_for(source: KernelSource, template: str = "rk4") -> Any:
     """The kernel module of ``template`` for a model's functions (built, written and imported on
-    first use, then kept for the process)."""
+    first use, then kept for the process). A model that declares the ``"pointer"`` path
+    (:mod:`._pointer_kernels`) gets the trajectory and sweep kernels compiled once for every
+    model, bound to its functions' addresses (:func:`_pointer_path`), and its functions inlined
+    in the other templates."""
+    if source.path == "pointer":
+        if template == "rk4":
+            return _pointer_path(source)
+        source = dataclasses.replace(source, path=None)
     funcs = source.functions()
     key = (template, source.plain, source.one_form, *funcs, *(id(f) for f in funcs.values()))
     if key in _LOADED:
@@ -302,20 +340,7 @@ def kernels_for(source: KernelSource, template: str = "rk4") -> types.ModuleType
     text = _template_text(template, source, "user_events" in funcs, core)
     if all(_importable(f) for f in funcs.values()):
         code = _replace_import(text, _import_line(funcs))
-        digest = _source_digest(code, funcs)
-        name = f"geardyn_{template}_{digest}"
-        folder = cache_dir()
-        folder.mkdir(parents=True, exist_ok=True)
-        path = folder / f"{name}.py"
-        if not path.exists():
-            fd, tmp = tempfile.mkstemp(dir=folder, suffix=".tmp")
-            with os.fdopen(fd, "w") as fh:
-                fh.write(code)
-            os.replace(tmp, path)  # atomic: concurrent processes never see half a file
-        spec = importlib.util.spec_from_file_location(name, path)
-        module = importlib.util.module_from_spec(spec)
-        sys.modules[name] = module
-        spec.loader.exec_module(module)
+        module = load_generated(f"geardyn_{template}_{_source_digest(code, funcs)}", code)
     else:
         code = _replace_import(text, "pass  " + _IMPORT_MARK).replace(
             "_CACHE = True", "_CACHE = False"
@@ -331,6 +356,55 @@ def kernels_for(source: KernelSource, template: str = "rk4") -> types.ModuleType
         # the split step (every template's scalar path) compiles in a helper process meanwhile
         compile_share.compile_ahead(sys.modules[core], AHEAD)
     return module
+
+
+def _pointer_path(source: KernelSource) -> pointer.PointerKernels:
+    """The :class:`._pointer_kernels.PointerKernels` of a one-form model on the pointer path
+    (kept for the process): the ``"rk4"`` kernels of :data:`._pointer_kernels.SOURCE`, the
+    pointer sweep (:func:`_pointer_sweep`) and the model's part, whose C callbacks compile as
+    it is imported (or load from numba's cache)."""
+    if source.one_form is None:
+        raise ValueError("the pointer kernel path needs a model in the one form")
+    funcs = source.functions()
+    key = ("pointer", source.one_form, *funcs, *(id(f) for f in funcs.values()))
+    if key in _LOADED:
+        return _LOADED[key]
+    inlined = dataclasses.replace(source, path=None)
+    text = pointer.part_text(source, kernels_for(inlined, CORE).__name__,
+                             kernels_for(inlined).__name__)
+    with _compiling():
+        if all(_importable(f) for f in funcs.values()):
+            code = _replace_import(text, _import_line(funcs))
+            name = f"geardyn_pointer_{_source_digest(code, funcs)}"
+            part = sys.modules[name] if name in sys.modules else load_generated(name, code)
+        else:
+            code = _replace_import(text, "pass  " + _IMPORT_MARK).replace(
+                "_CACHE = True", "_CACHE = False")
+            part = types.ModuleType(f"geardyn_pointer_inmemory_{len(_LOADED)}")
+            part.__dict__.update(funcs)
+            exec(compile(code, part.__name__, "exec"), part.__dict__)
+    shared = kernels_for(pointer.SOURCE)
+    _LOADED[key] = pointer.PointerKernels(shared, _pointer_sweep(), part,
+                                          lambda: kernels_for(inlined))
+    return _LOADED[key]
+
+
+def _pointer_sweep() -> types.ModuleType:
+    """The pointer path's sweep module (:func:`._pointer_kernels.sweep_text`): the ``"rk4"``
+    module's text of :data:`._pointer_kernels.SOURCE` with the hooks; its name hashes the text,
+    numba's version and the sources of :mod:`._pointer_calls` and :data:`SHARED_MODULES`."""
+    funcs = pointer.SOURCE.functions()
+    core = kernels_for(pointer.SOURCE, CORE).__name__
+    text = _template_text("rk4", pointer.SOURCE, "user_events" in funcs, core)
+    code = pointer.sweep_text(_replace_import(text, _import_line(funcs)))
+    h = hashlib.sha256(code.encode())
+    h.update(numba.__version__.encode())
+    for mod in (_pointer_calls, *map(importlib.import_module, SHARED_MODULES)):
+        h.update(Path(mod.__file__).read_bytes())
+    name = f"geardyn_pointer_sweep_{h.hexdigest()[:20]}"
+    if name not in sys.modules:
+        _quiet_module(load_generated(name, code))
+    return sys.modules[name]
 
 
 #: The core functions :func:`kernels_for` has compiled ahead (:func:`.compile_share.compile_ahead`)
