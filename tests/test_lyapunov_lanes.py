@@ -131,6 +131,26 @@ def test_gear_pair_blocks_bitwise_equal_with_a_diverged_lane():
                 _assert_bitwise(_blocks(kern, model, args, 10, k, rows), ref)
 
 
+def test_variational_spectrum_slots_bitwise_in_one_pass_and_several():
+    # the variational block's slots are (lane, tangent vector) pairs: 40 lanes of k = 2 in one
+    # block are 80 slots, more than a pass takes (64: two passes, the state committed by the
+    # last), 12 lanes a block (24 slots, one pass), one lane a block (2 slots); a diverged lane
+    # among them (its slots leave the pass with it)
+    model = geardyn.GearPair(**IMPACTING)
+    kern = kernels_for(model.kernel, "lyapunov")
+    om = np.linspace(0.6, 2.2, 40)
+    rng = np.random.default_rng(5)
+    y0 = model.initial_state() + rng.uniform(-0.3, 0.3, (om.size, 2))
+    y0[7] = [1e9, 0.0]
+    args = _lanes(model, om, 32, rng.integers(0, 8, om.size), rng.integers(5, 20, om.size), y0,
+                  rng.uniform(0.0, 5.0, om.size))
+    ref = _reference(kern, model, args, 10, 2, variational=True)
+    assert ref[3][7] == 1 and np.all(np.delete(ref[3], 7) == 0)
+    assert np.all(np.isfinite(np.delete(ref[0], 7, axis=0)))
+    for rows in (1000, 64, 5):
+        _assert_bitwise(_blocks(kern, model, args, 10, 2, rows, variational=True), ref)
+
+
 def test_generic_lane_path_general_catt_model():
     # the general CATT model has no lane-block functions: the rows are evaluated one by one
     model = paper_device(reduced=False)

@@ -762,12 +762,38 @@ def _lyap_block(first, nl, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF, n
     for l in range(nl):
         if ACT[l]:
             due = min(due, IST[l, _DUE])
+    # one lane of fewer rows than ROW_PAD (or a model without lane-block functions, whose rows
+    # the block evaluates one by one): its rows by the scalar rows step (:func:`_tangent_step`,
+    # the monodromy's; the same arithmetic), not a block mostly of padding
+    one = nl == 1 and (ROW_PAD == 1 or nr < ROW_PAD)
+    n1 = nr if one else 1
+    Zs = ZT.reshape((m, ns)) if one else np.zeros((m, ns))  # (nl = 1: ZT itself)
+    YPs = np.zeros((n1, ns))
+    Es = np.zeros(m)
+    Ks = np.zeros((4, n1, ns))
+    TMPs = np.zeros((n1, ns))
+    Y1s = np.zeros((n1, ns))
+    SIDEs = np.ones((n1, ne), np.int64)
+    G0s = np.zeros((n1, ne))
+    G1s = np.zeros((n1, ne))
+    NCRs = np.zeros((n1, ne), np.int64)
+    UNRs = np.zeros(n1, np.int64)
+    s_one, c_one, p_one = S_TAB[OFF[first]:], C_TAB[OFF[first]:], P[first]
+    t_one, h_one, om_one, np_one = T0[first], H[first], OMEGA[first], NPER[first]
     for i in range(max_total):
         live = False
         for l in range(nl):
             live = live or ACT[l]
         if not live:
             break
+        if one:
+            _tangent_step(i, t_one, Zs, S, IS, p_one, h_one, om_one, np_one, s_one, c_one, n_ev,
+                          YPs, Es, Ks, TMPs, Y1s, SIDEs, G0s, G1s, W, gbuf, NCRs, UNRs)
+            step = i + 1
+            if step >= due:  # (the lane's result after the loop)
+                due = _lane_books_core(step, first, nl, k, renorm, bound, ZT, Zl, Cl, logs, IST,
+                                       ENDS, BLK, ACC, ACT, ACTR, status)
+            continue
         _fd_setup(nl, m, ZT, S, IS, Y, E, OK, NY)
         for r in range(nrp):
             t = T0R[r] + i * HR[r]
@@ -796,11 +822,15 @@ def _lyap_block(first, nl, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF, n
         if step >= due:
             due = _lane_books(step, first, nl, k, renorm, bound, ZT, Zl, Cl, logs, IST, ENDS, BLK,
                               ACC, ACT, ACTR, H, out, err, used, status)
+    if one and status[first] != STATUS_DIVERGED:
+        _lane_result(0, first, k, IST[0, _NST], H[first], ENDS, IST[0, _NBK], BLK, ACC, out, err,
+                     used)
     for l in range(nl):  # the split-limit steps of each lane's rows (slots nl apart)
         lane = first + l
         u = 0
         for slot in range(2 * k + 1):
             u += UNRR[slot * nl + l]
+        u += UNRs.sum()  # (one lane)
         unres[lane] = u
         fd_steps[lane] = IST[l, _LAST]  # the steps run (each by the difference rows)
         if u > 0 and status[lane] == STATUS_OK:
@@ -1222,8 +1252,9 @@ def _lyap_block_local(form, lo, hi, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TA
 # through the sub-steps (:func:`_var_split_lane`, as one lane's variational step does it; the
 # difference rows where that is ill-posed). Each lane's arithmetic is
 # that of one lane's variational step, operation for operation: the exponents are bitwise those
-# of the lane stepped alone (the tests' reference). With k tangent vectors a grid step is k passes
-# of the loop, one per tangent vector (:func:`_lyap_var_run`).
+# of the lane stepped alone (the tests' reference). With k tangent vectors the loop's slots are
+# pairs of a lane and one of its tangent vectors, so that a grid step is one pass of the loop over
+# nl k slots (:func:`_lyap_var_run`).
 
 
 def _t_scale(v, S):
@@ -1341,25 +1372,29 @@ def _var_flagged(i, nl, first, n_ev, P, ZT, S, IS, T0L, HL, OMEGA, NPL, IDX, S_T
 
 
 @nb.njit(_nrt=False, **_JIT)  # it allocates nothing
-def _var_swap(ZT, j, Z1, ZX, save):
-    """Tangent vector j (ZT[j], j >= 2) into the fused loop's tangent row Z1 (ZT[1]), tangent
-    vector 1 first saved in ZX where ``save``; j = 1: tangent vector 1 back from ZX."""
-    n = Z1.size
-    if save:
-        for r in range(n):
-            ZX[r] = Z1[r]
-    src = ZX if j == 1 else ZT[j].reshape(n)
-    for r in range(n):
-        Z1[r] = src[r]
+def _var_load(ZT, Z1, nl, j_lo, kk):
+    """Tangent vectors j_lo + 1 .. j_lo + kk of the block's lanes into the fused loop's slots:
+    vector j_lo + 1 + jj of lane l (ZT[j_lo + 1 + jj, :, l]) at slot s = jj nl + l of the
+    tangent row Z1, and the lane's state (ZT[0, :, l]) copied to slot s of the state row ZT[0]
+    (slots 0..nl-1 are the lanes' own)."""
+    ns = ZT.shape[1]
+    for jj in range(kk):
+        for q in range(ns):
+            for l in range(nl):
+                s = jj * nl + l
+                Z1[q * BLOCK + s] = ZT[j_lo + 1 + jj, q, l]
+                ZT[0, q, s] = ZT[0, q, l]
 
 
 @nb.njit(_nrt=False, **_JIT)  # it allocates nothing
-def _var_unswap(ZT, j, Z1):
-    """The fused loop's tangent row Z1 back into tangent vector j (ZT[j], j >= 2)."""
-    n = Z1.size
-    dst = ZT[j].reshape(n)
-    for r in range(n):
-        dst[r] = Z1[r]
+def _var_store(ZT, Z1, nl, j_lo, kk):
+    """The fused loop's slots back into tangent vectors j_lo + 1 .. j_lo + kk of the block's
+    lanes (:func:`_var_load`)."""
+    ns = ZT.shape[1]
+    for jj in range(kk):
+        for q in range(ns):
+            for l in range(nl):
+                ZT[j_lo + 1 + jj, q, l] = Z1[q * BLOCK + jj * nl + l]
 
 
 @nb.njit(inline="always", **_JIT)
@@ -1367,16 +1402,22 @@ def _lyap_var_run(form, first, nl, n_ev, max_total, due, renorm, bound, P, OMEGA
                   lanes, books, out, err, used, status, scratch, fd):
     """The time loop of a variational block (see above): every grid step of the block's lanes,
     their flagged lanes out of line, their bookkeeping where due (:func:`_lane_books`). With k
-    tangent vectors (ZT[1..k]) a step is k passes of the fused loop over the lanes, one per
-    tangent vector (each through the tangent row Z1, :func:`_var_swap`; tangent vector 1 last,
-    which commits the state): the state's trial is computed in each, the same operations, as
-    one lane's RK4 step of the state and one tangent vector is."""
+    tangent vectors (ZT[1..k]) the fused loop's slots are pairs of a lane and one of its
+    tangent vectors (slot jj nl + l: lane l with tangent vector j_lo + 1 + jj, its state
+    copied there, :func:`_var_load`), kp = min(k, BLOCK // nl) vectors per pass, so that a
+    lane's k vectors advance together in one pass (more passes only where nl k > BLOCK; the
+    last commits the states): each slot computes its lane's state trial, the same operations,
+    as one lane's RK4 step of the state and one tangent vector does. The slots' columns (PT,
+    clocks, phases, ACT) are their lanes' (:func:`_lyap_block_var`)."""
     (Z0, Z1, ZT, T0L, HL, HHL, H6L, IDX, NPL, ENDL, PH, ACT, ACTR, FLAG, GR, UNRR, FDL,
      Y1F, ZX) = lanes
     k = ZT.shape[0] - 1
+    kp = min(k, BLOCK // nl)
+    n_pass = (k + kp - 1) // kp
+    n_slot = nl * kp
+    Zt = ZX if k > 1 else Z1  # the slots' tangent row (k = 1: tangent vector 1 in place)
     IST, ENDS, BLK, ACC, Zl, Cl, logs = books
     S_TAB, C_TAB = scratch
-    nv = _padded(nl)
     locate = n_ev > 0
     for i in range(max_total):
         live = False
@@ -1384,29 +1425,32 @@ def _lyap_var_run(form, first, nl, n_ev, max_total, due, renorm, bound, P, OMEGA
             live = live | ACT[l]
         if not live:
             break
-        for l in range(nl):
+        for l in range(n_slot):
             j = IDX[l]
             for d in range(3):
                 PH[2 * d][l] = S_TAB[j + d]
                 PH[2 * d + 1][l] = C_TAB[j + d]
         n_flag = 0
-        for jj in range(k):  # tangent vectors 2..k, then 1 (one call site of the fused loop)
-            j = jj + 2 if jj < k - 1 else 1
+        for g in range(n_pass):  # one call site of the fused loop
+            j_lo = g * kp
+            kk = min(kp, k - j_lo)
             if k > 1:
-                _var_swap(ZT, j, Z1, ZX, jj == 0)
-            n_flag = _var_fused_steps(form, i, nv, locate, j == 1, Z0, Z1, S, IS, PT, T0L, HL,
-                                      HHL, H6L, PH, ACT, FLAG, GR, Y1F)
-            if j > 1:
-                _var_unswap(ZT, j, Z1)
+                _var_load(ZT, Zt, nl, j_lo, kk)
+            n_flag = _var_fused_steps(form, i, _padded(nl * kk), locate, g == n_pass - 1, Z0,
+                                      Zt, S, IS, PT, T0L, HL, HHL, H6L, PH, ACT, FLAG, GR, Y1F)
+            if k > 1:
+                _var_store(ZT, Zt, nl, j_lo, kk)
         if n_flag > 0:
             _var_flagged(i, nl, first, n_ev, P, ZT, S, IS, T0L, HL, OMEGA, NPL, IDX, S_TAB,
                          C_TAB, FLAG, UNRR, FDL, GR, Y1F, fd)
-        for l in range(nl):
+        for l in range(n_slot):
             IDX[l] = IDX[l] + 2 if IDX[l] + 2 < ENDL[l] else IDX[l] + 2 - 2 * NPL[l]
         step = i + 1
         if step >= due:
             due = _lane_books_core(step, first, nl, k, renorm, bound, ZT, Zl, Cl, logs, IST,
                                    ENDS, BLK, ACC, ACT, ACTR, status)
+            for s in range(nl, n_slot):
+                ACT[s] = ACT[s % nl]
 
 
 @nb.njit(_nrt=False, **_JIT_NOALIAS)
@@ -1460,8 +1504,12 @@ def _lyap_block_var(form, first, nl, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_T
           np.zeros((nr, ne)), np.zeros((nr, ne)), np.zeros((9, ns)), np.zeros((GBUF_ROWS, ne)),
           np.zeros((nr, ne), np.int64), np.zeros(nr, np.int64), np.zeros((9 + 7 * k, ns)),
           np.zeros((3, ne)))
-    Y1F = np.zeros(ns * BLOCK)  # the states' trials (flat rows of BLOCK lanes, as Z0)
-    ZX = np.zeros(ns * BLOCK)  # tangent vector 1 while the others pass (:func:`_var_swap`)
+    Y1F = np.zeros(ns * BLOCK)  # the states' trials (flat rows of BLOCK slots, as Z0)
+    ZX = np.zeros(ns * BLOCK)  # the slots' tangent vectors where k > 1 (:func:`_var_load`)
+    for s in range(nl, nl * min(k, BLOCK // nl)):  # the slots of tangent vectors 2..: lane s % nl
+        _set_column(s, first + s % nl, P, T0, H, NPER, OFF, PT, T0L, HL, HHL, H6L, NPL, IDX,
+                    ENDL)
+        ACT[s] = ACT[s % nl]
     lanes = (Z0, Z1, ZT, T0L, HL, HHL, H6L, IDX, NPL, ENDL, PH, ACT, ACTR, FLAG, GR, UNRR, FDL,
              Y1F, ZX)
     books = (IST, ENDS, BLK, ACC, Zl, Cl, logs)
