@@ -684,6 +684,42 @@ def _set_column(r, lane, P, T0, H, NPER, OFF, PT, T0R, HR, HH, H6, NPR, IDX, END
 
 
 @nb.njit(**_JIT)
+def _lyap_one(first, max_total, due, renorm, bound, P, S, IS, T0, H, OMEGA, NPER, S_TAB, C_TAB,
+              OFF, n_ev, ZT, IST, ENDS, BLK, ACC, ACT, ACTR, Zl, Cl, logs, status, W, gbuf):
+    """:func:`_lyap_block`'s time loop for one lane (ZT[:, :, 0], nl = 1): its 2 k + 1 rows
+    by the scalar rows step (:func:`_tangent_step`, as the monodromy steps its rows; the
+    arithmetic of the block's rows), its bookkeeping where due (:func:`_lane_books_core`).
+    Returns the steps of its rows that reached the split limit."""
+    m, ns = Zl.shape
+    k = m - 1
+    nr = 2 * k + 1
+    ne = gbuf.shape[1]
+    Z = ZT.reshape((m, ns))
+    YP = np.zeros((nr, ns))
+    E = np.zeros(m)
+    K = np.zeros((4, nr, ns))
+    TMP = np.zeros((nr, ns))
+    Y1 = np.zeros((nr, ns))
+    SIDE = np.ones((nr, ne), np.int64)
+    G0 = np.zeros((nr, ne))
+    G1 = np.zeros((nr, ne))
+    NCR = np.zeros((nr, ne), np.int64)
+    UNRES = np.zeros(nr, np.int64)
+    s_tab, c_tab, p = S_TAB[OFF[first]:], C_TAB[OFF[first]:], P[first]
+    t0, h, omega, n_per = T0[first], H[first], OMEGA[first], NPER[first]
+    for i in range(max_total):
+        if not ACT[0]:
+            break
+        _tangent_step(i, t0, Z, S, IS, p, h, omega, n_per, s_tab, c_tab, n_ev, YP, E, K, TMP,
+                      Y1, SIDE, G0, G1, W, gbuf, NCR, UNRES)
+        step = i + 1
+        if step >= due:
+            due = _lane_books_core(step, first, 1, k, renorm, bound, ZT, Zl, Cl, logs, IST,
+                                   ENDS, BLK, ACC, ACT, ACTR, status)
+    return UNRES.sum()
+
+
+@nb.njit(**_JIT)
 def _lyap_block(first, nl, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF, n_transient,
                 n_steps, renorm_every, bound, n_ev, n_blocks, out, err, used, status, unres,
                 fd_steps):
@@ -763,37 +799,20 @@ def _lyap_block(first, nl, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF, n
         if ACT[l]:
             due = min(due, IST[l, _DUE])
     # one lane of fewer rows than ROW_PAD (or a model without lane-block functions, whose rows
-    # the block evaluates one by one): its rows by the scalar rows step (:func:`_tangent_step`,
-    # the monodromy's; the same arithmetic), not a block mostly of padding
+    # the block evaluates one by one): its rows by the scalar rows step (:func:`_lyap_one`),
+    # not a block mostly of padding
     one = nl == 1 and (ROW_PAD == 1 or nr < ROW_PAD)
-    n1 = nr if one else 1
-    Zs = ZT.reshape((m, ns)) if one else np.zeros((m, ns))  # (nl = 1: ZT itself)
-    YPs = np.zeros((n1, ns))
-    Es = np.zeros(m)
-    Ks = np.zeros((4, n1, ns))
-    TMPs = np.zeros((n1, ns))
-    Y1s = np.zeros((n1, ns))
-    SIDEs = np.ones((n1, ne), np.int64)
-    G0s = np.zeros((n1, ne))
-    G1s = np.zeros((n1, ne))
-    NCRs = np.zeros((n1, ne), np.int64)
-    UNRs = np.zeros(n1, np.int64)
-    s_one, c_one, p_one = S_TAB[OFF[first]:], C_TAB[OFF[first]:], P[first]
-    t_one, h_one, om_one, np_one = T0[first], H[first], OMEGA[first], NPER[first]
-    for i in range(max_total):
+    u_one = 0
+    if one:
+        u_one = _lyap_one(first, max_total, due, renorm, bound, P, S, IS, T0, H, OMEGA, NPER,
+                          S_TAB, C_TAB, OFF, n_ev, ZT, IST, ENDS, BLK, ACC, ACT, ACTR, Zl, Cl,
+                          logs, status, W, gbuf)
+    for i in range(0 if one else max_total):
         live = False
         for l in range(nl):
             live = live or ACT[l]
         if not live:
             break
-        if one:
-            _tangent_step(i, t_one, Zs, S, IS, p_one, h_one, om_one, np_one, s_one, c_one, n_ev,
-                          YPs, Es, Ks, TMPs, Y1s, SIDEs, G0s, G1s, W, gbuf, NCRs, UNRs)
-            step = i + 1
-            if step >= due:  # (the lane's result after the loop)
-                due = _lane_books_core(step, first, nl, k, renorm, bound, ZT, Zl, Cl, logs, IST,
-                                       ENDS, BLK, ACC, ACT, ACTR, status)
-            continue
         _fd_setup(nl, m, ZT, S, IS, Y, E, OK, NY)
         for r in range(nrp):
             t = T0R[r] + i * HR[r]
@@ -830,7 +849,7 @@ def _lyap_block(first, nl, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF, n
         u = 0
         for slot in range(2 * k + 1):
             u += UNRR[slot * nl + l]
-        u += UNRs.sum()  # (one lane)
+        u += u_one
         unres[lane] = u
         fd_steps[lane] = IST[l, _LAST]  # the steps run (each by the difference rows)
         if u > 0 and status[lane] == STATUS_OK:
@@ -1415,7 +1434,7 @@ def _lyap_var_run(form, first, nl, n_ev, max_total, due, renorm, bound, P, OMEGA
     kp = min(k, BLOCK // nl)
     n_pass = (k + kp - 1) // kp
     n_slot = nl * kp
-    Zt = ZX if k > 1 else Z1  # the slots' tangent row (k = 1: tangent vector 1 in place)
+    nv = _padded(n_slot)  # (a last pass of fewer vectors runs the others' slots idly again)
     IST, ENDS, BLK, ACC, Zl, Cl, logs = books
     S_TAB, C_TAB = scratch
     locate = n_ev > 0
@@ -1435,11 +1454,11 @@ def _lyap_var_run(form, first, nl, n_ev, max_total, due, renorm, bound, P, OMEGA
             j_lo = g * kp
             kk = min(kp, k - j_lo)
             if k > 1:
-                _var_load(ZT, Zt, nl, j_lo, kk)
-            n_flag = _var_fused_steps(form, i, _padded(nl * kk), locate, g == n_pass - 1, Z0,
-                                      Zt, S, IS, PT, T0L, HL, HHL, H6L, PH, ACT, FLAG, GR, Y1F)
+                _var_load(ZT, ZX, nl, j_lo, kk)
+            n_flag = _var_fused_steps(form, i, nv, locate, g == n_pass - 1, Z0, ZX, S, IS, PT,
+                                      T0L, HL, HHL, H6L, PH, ACT, FLAG, GR, Y1F)
             if k > 1:
-                _var_store(ZT, Zt, nl, j_lo, kk)
+                _var_store(ZT, ZX, nl, j_lo, kk)
         if n_flag > 0:
             _var_flagged(i, nl, first, n_ev, P, ZT, S, IS, T0L, HL, OMEGA, NPL, IDX, S_TAB,
                          C_TAB, FLAG, UNRR, FDL, GR, Y1F, fd)
@@ -1505,7 +1524,8 @@ def _lyap_block_var(form, first, nl, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_T
           np.zeros((nr, ne), np.int64), np.zeros(nr, np.int64), np.zeros((9 + 7 * k, ns)),
           np.zeros((3, ne)))
     Y1F = np.zeros(ns * BLOCK)  # the states' trials (flat rows of BLOCK slots, as Z0)
-    ZX = np.zeros(ns * BLOCK)  # the slots' tangent vectors where k > 1 (:func:`_var_load`)
+    # the slots' tangent row: ZT[1] itself where k = 1, else its own (:func:`_var_load`)
+    ZX = Z1 if k == 1 else np.zeros(ns * BLOCK)
     for s in range(nl, nl * min(k, BLOCK // nl)):  # the slots of tangent vectors 2..: lane s % nl
         _set_column(s, first + s % nl, P, T0, H, NPER, OFF, PT, T0L, HL, HHL, H6L, NPL, IDX,
                     ENDL)
