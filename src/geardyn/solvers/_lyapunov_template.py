@@ -1472,6 +1472,66 @@ def _lyap_var_run(form, first, nl, n_ev, max_total, due, renorm, bound, P, OMEGA
                 ACT[s] = ACT[s % nl]
 
 
+@nb.njit(inline="always", **_JIT)
+def _lyap_var_run1(form, first, nl, n_ev, max_total, due, renorm, bound, P, OMEGA, H, S, IS, PT,
+                   lanes, books, out, err, used, status, scratch, fd):
+    """:func:`_lyap_var_run` with one tangent vector (k = 1): the lanes are the fused loop's
+    slots, their tangent row ZT[1] itself, one call of the fused loop per grid step, the state
+    committed with it (no passes, no slots of other tangent vectors)."""
+    (Z0, Z1, ZT, T0L, HL, HHL, H6L, IDX, NPL, ENDL, PH, ACT, ACTR, FLAG, GR, UNRR, FDL,
+     Y1F, ZX) = lanes
+    IST, ENDS, BLK, ACC, Zl, Cl, logs = books
+    S_TAB, C_TAB = scratch
+    nv = _padded(nl)
+    locate = n_ev > 0
+    for i in range(max_total):
+        live = False
+        for l in range(nl):
+            live = live | ACT[l]
+        if not live:
+            break
+        for l in range(nl):
+            j = IDX[l]
+            for d in range(3):
+                PH[2 * d][l] = S_TAB[j + d]
+                PH[2 * d + 1][l] = C_TAB[j + d]
+        n_flag = _var_fused_steps(form, i, nv, locate, True, Z0, Z1, S, IS, PT, T0L, HL, HHL,
+                                  H6L, PH, ACT, FLAG, GR, Y1F)
+        if n_flag > 0:
+            _var_flagged(i, nl, first, n_ev, P, ZT, S, IS, T0L, HL, OMEGA, NPL, IDX, S_TAB,
+                         C_TAB, FLAG, UNRR, FDL, GR, Y1F, fd)
+        for l in range(nl):
+            IDX[l] = IDX[l] + 2 if IDX[l] + 2 < ENDL[l] else IDX[l] + 2 - 2 * NPL[l]
+        step = i + 1
+        if step >= due:
+            due = _lane_books_core(step, first, nl, 1, renorm, bound, ZT, Zl, Cl, logs, IST,
+                                   ENDS, BLK, ACC, ACT, ACTR, status)
+
+
+@nb.njit(_nrt=False, **_JIT_NOALIAS)
+def _lyap_var1_form0(first, nl, n_ev, max_total, due, renorm, bound, P, OMEGA, H, S, IS, PT,
+                     lanes, books, out, err, used, status, scratch, fd):
+    """:func:`_lyap_var_run1` in the lane form FORM_GENERAL (a block of mixed forms)."""
+    _lyap_var_run1(FORM_GENERAL, first, nl, n_ev, max_total, due, renorm, bound, P, OMEGA, H,
+                   S, IS, PT, lanes, books, out, err, used, status, scratch, fd)
+
+
+@nb.njit(_nrt=False, **_JIT_NOALIAS)
+def _lyap_var1_form1(first, nl, n_ev, max_total, due, renorm, bound, P, OMEGA, H, S, IS, PT,
+                     lanes, books, out, err, used, status, scratch, fd):
+    """:func:`_lyap_var_run1` in the lane form FORM_QUIET."""
+    _lyap_var_run1(FORM_QUIET, first, nl, n_ev, max_total, due, renorm, bound, P, OMEGA, H,
+                   S, IS, PT, lanes, books, out, err, used, status, scratch, fd)
+
+
+@nb.njit(_nrt=False, **_JIT_NOALIAS)
+def _lyap_var1_form2(first, nl, n_ev, max_total, due, renorm, bound, P, OMEGA, H, S, IS, PT,
+                     lanes, books, out, err, used, status, scratch, fd):
+    """:func:`_lyap_var_run1` in the lane form FORM_LOAD."""
+    _lyap_var_run1(FORM_LOAD, first, nl, n_ev, max_total, due, renorm, bound, P, OMEGA, H,
+                   S, IS, PT, lanes, books, out, err, used, status, scratch, fd)
+
+
 @nb.njit(_nrt=False, **_JIT_NOALIAS)
 def _lyap_var_form0(first, nl, n_ev, max_total, due, renorm, bound, P, OMEGA, H, S, IS, PT,
                     lanes, books, out, err, used, status, scratch, fd):
@@ -1542,7 +1602,14 @@ def _lyap_block_var(form, first, nl, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_T
     books = (IST, ENDS, BLK, ACC, Zl, Cl, logs)
     args = (first, nl, n_ev, max_total, due, renorm, bound, P, OMEGA, H, S, IS, PT, lanes, books,
             out, err, used, status, (S_TAB, C_TAB), fd)
-    if form == FORM_QUIET:
+    if k == 1:  # main's k = 1 time loop: one fused-loop call per step, no passes
+        if form == FORM_QUIET:
+            _lyap_var1_form1(*args)
+        elif form == FORM_LOAD:
+            _lyap_var1_form2(*args)
+        else:
+            _lyap_var1_form0(*args)
+    elif form == FORM_QUIET:
         _lyap_var_form1(*args)
     elif form == FORM_LOAD:
         _lyap_var_form2(*args)
