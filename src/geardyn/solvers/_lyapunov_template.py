@@ -95,6 +95,7 @@ from geardyn.solvers._lyapunov_books import (  # compiled once for every model
     _block_tables,
     _lane_books,
     _lane_books_core,
+    _lane_books_inline,
     _lane_result,
     _lanes_init,
 )
@@ -688,24 +689,31 @@ def _lyap_one(first, max_total, due, renorm, bound, P, S, IS, T0, H, OMEGA, NPER
               OFF, n_ev, ZT, IST, ENDS, BLK, ACC, ACT, ACTR, Zl, Cl, logs, status, W, gbuf):
     """:func:`_lyap_block`'s time loop for one lane (ZT[:, :, 0], nl = 1): its 2 k + 1 rows
     by the scalar rows step (:func:`_tangent_step`, as the monodromy steps its rows; the
-    arithmetic of the block's rows), its bookkeeping where due (:func:`_lane_books_core`).
-    Returns the steps of its rows that reached the split limit."""
+    arithmetic of the block's rows), its bookkeeping where due (:func:`_lane_books_core`,
+    inlined: :func:`_lyap_one_loop`). Returns the steps of its rows that reached the split
+    limit."""
     m, ns = Zl.shape
     k = m - 1
     nr = 2 * k + 1
     ne = gbuf.shape[1]
-    Z = ZT.reshape((m, ns))
-    YP = np.zeros((nr, ns))
-    E = np.zeros(m)
-    K = np.zeros((4, nr, ns))
-    TMP = np.zeros((nr, ns))
-    Y1 = np.zeros((nr, ns))
-    SIDE = np.ones((nr, ne), np.int64)
-    G0 = np.zeros((nr, ne))
-    G1 = np.zeros((nr, ne))
-    NCR = np.zeros((nr, ne), np.int64)
-    UNRES = np.zeros(nr, np.int64)
-    s_tab, c_tab, p = S_TAB[OFF[first]:], C_TAB[OFF[first]:], P[first]
+    rows = (ZT.reshape((m, ns)), np.zeros((nr, ns)), np.zeros(m), np.zeros((4, nr, ns)),
+            np.zeros((nr, ns)), np.zeros((nr, ns)), np.ones((nr, ne), np.int64),
+            np.zeros((nr, ne)), np.zeros((nr, ne)), np.zeros((nr, ne), np.int64),
+            np.zeros(nr, np.int64))
+    return _lyap_one_loop(first, max_total, due, renorm, bound, P, S, IS, T0, H, OMEGA, NPER,
+                          S_TAB[OFF[first]:], C_TAB[OFF[first]:], n_ev, ZT, IST, ENDS, BLK, ACC,
+                          ACT, ACTR, Zl, Cl, logs, status, W, gbuf, rows)
+
+
+@nb.njit(_nrt=False, **_JIT)  # it allocates nothing
+def _lyap_one_loop(first, max_total, due, renorm, bound, P, S, IS, T0, H, OMEGA, NPER, s_tab,
+                   c_tab, n_ev, ZT, IST, ENDS, BLK, ACC, ACT, ACTR, Zl, Cl, logs, status, W,
+                   gbuf, rows):
+    """:func:`_lyap_one`'s loop (rows: Z, the lane's rows as ZT's view, and the scratch of
+    :func:`_tangent_step`)."""
+    Z, YP, E, K, TMP, Y1, SIDE, G0, G1, NCR, UNRES = rows
+    k = Z.shape[0] - 1
+    p = P[first]
     t0, h, omega, n_per = T0[first], H[first], OMEGA[first], NPER[first]
     for i in range(max_total):
         if not ACT[0]:
@@ -714,8 +722,8 @@ def _lyap_one(first, max_total, due, renorm, bound, P, S, IS, T0, H, OMEGA, NPER
                       Y1, SIDE, G0, G1, W, gbuf, NCR, UNRES)
         step = i + 1
         if step >= due:
-            due = _lane_books_core(step, first, 1, k, renorm, bound, ZT, Zl, Cl, logs, IST,
-                                   ENDS, BLK, ACC, ACT, ACTR, status)
+            due = _lane_books_inline(step, first, 1, k, renorm, bound, ZT, Zl, Cl, logs, IST,
+                                     ENDS, BLK, ACC, ACT, ACTR, status)
     return UNRES.sum()
 
 
