@@ -1572,13 +1572,15 @@ def _n_switching(Z0, PT):
 
 
 @nb.njit(inline="always", **_JIT)
-def _lyap_block_var(form, first, nl, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
+def _lyap_block_var(form, one, first, nl, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
                     n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err, used,
                     status, unres, fd_steps):
     """:func:`_lyap_block` (k tangent vectors) by the variational block of lane form ``form``
-    (nl <= BLOCK lanes): per lane the exponents of the variational RK4 (tangent vectors through
-    the split sub-steps); the lanes' steps by the difference rows (split steps where carrying
-    the tangent through the sub-steps is ill-posed) into fd_steps[lane]."""
+    (nl <= BLOCK lanes; ``one``: k = 1, a constant of each worker, so that a worker compiles
+    the k = 1 time loop or the spectrum's, not both): per lane the exponents of the
+    variational RK4 (tangent vectors through the split sub-steps); the lanes' steps by the
+    difference rows (split steps where carrying the tangent through the sub-steps is
+    ill-posed) into fd_steps[lane]."""
     ns = Y0.shape[1]
     (IS, ZT, Z0, Z1, PT, T0L, HL, HHL, H6L, IDX, NPL, ENDL, PH, ACT, ACTR, FLAG, IST, ENDS, BLK,
      ACC, Zl, Cl, logs, max_total, renorm, due) = _fused_block_start(
@@ -1610,7 +1612,7 @@ def _lyap_block_var(form, first, nl, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_T
     books = (IST, ENDS, BLK, ACC, Zl, Cl, logs)
     args = (first, nl, n_ev, max_total, due, renorm, bound, P, OMEGA, H, S, IS, PT, lanes, books,
             out, err, used, status, (S_TAB, C_TAB), fd)
-    if k == 1:  # main's k = 1 time loop: one fused-loop call per step, no passes
+    if one:  # the k = 1 time loop: one fused-loop call per step, no passes
         if form == FORM_QUIET:
             _lyap_var1_form1(*args)
         elif form == FORM_LOAD:
@@ -1635,13 +1637,13 @@ def _lyap_block_var(form, first, nl, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_T
 
 
 @nb.njit(inline="always", **_JIT)
-def _lyap_var_worker(b, n_blk, k, form, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
+def _lyap_var_worker(b, n_blk, k, form, one, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
                      n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err, used,
                      status, unres, fd_steps):
     """Block b of n_blk of :func:`lyapunov_block_lanes` with ``variational`` (lanes lo..hi-1,
     :func:`_block_lanes`), on copies of its inputs and outputs (as :func:`_lyap_block_local`);
-    ``form``: the lane form of the block (:func:`_block_form`), a constant of each worker
-    below, so that a worker compiles its form's fused loop alone."""
+    ``form``: the lane form of the block (:func:`_block_form`), ``one``: k = 1, constants of
+    each worker below, so that a worker compiles its form's fused loop and time loop alone."""
     lo, hi = _block_lanes(b, n_blk, Y0.shape[0])
     n = hi - lo
     if n <= 0:
@@ -1652,9 +1654,9 @@ def _lyap_var_worker(b, n_blk, k, form, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_T
     st = np.zeros(n, np.int64)
     un = np.zeros(n, np.int64)
     fs = np.zeros(n, np.int64)
-    _lyap_block_var(form, 0, n, k, P[lo:hi].copy(), Y0[lo:hi].copy(), S.copy(), T0[lo:hi].copy(),
-                    H[lo:hi].copy(), OMEGA[lo:hi].copy(), NPER[lo:hi].copy(), S_TAB.copy(),
-                    C_TAB.copy(), OFF[lo:hi].copy(), n_transient[lo:hi].copy(),
+    _lyap_block_var(form, one, 0, n, k, P[lo:hi].copy(), Y0[lo:hi].copy(), S.copy(),
+                    T0[lo:hi].copy(), H[lo:hi].copy(), OMEGA[lo:hi].copy(), NPER[lo:hi].copy(),
+                    S_TAB.copy(), C_TAB.copy(), OFF[lo:hi].copy(), n_transient[lo:hi].copy(),
                     n_steps[lo:hi].copy(), renorm_every, bound, n_ev, n_blocks, o, e, u, st, un,
                     fs)
     for i in range(n):
@@ -1671,36 +1673,69 @@ def _lyap_var_worker(b, n_blk, k, form, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_T
 def _lyap_var_worker_form0(b, n_blk, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
                            n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err,
                            used, status, unres, fd_steps):
-    """:func:`_lyap_var_worker` in the lane form FORM_GENERAL."""
-    _lyap_var_worker(b, n_blk, k, FORM_GENERAL, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
-                     n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err, used,
-                     status, unres, fd_steps)
+    """:func:`_lyap_var_worker` with k = 1 in the lane form FORM_GENERAL."""
+    _lyap_var_worker(b, n_blk, k, FORM_GENERAL, True, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB,
+                     OFF, n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err,
+                     used, status, unres, fd_steps)
 
 
 @nb.njit(nogil=True, **_JIT)
 def _lyap_var_worker_form1(b, n_blk, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
                            n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err,
                            used, status, unres, fd_steps):
-    """:func:`_lyap_var_worker` in the lane form FORM_QUIET."""
-    _lyap_var_worker(b, n_blk, k, FORM_QUIET, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
-                     n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err, used,
-                     status, unres, fd_steps)
+    """:func:`_lyap_var_worker` with k = 1 in the lane form FORM_QUIET."""
+    _lyap_var_worker(b, n_blk, k, FORM_QUIET, True, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB,
+                     OFF, n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err,
+                     used, status, unres, fd_steps)
 
 
 @nb.njit(nogil=True, **_JIT)
 def _lyap_var_worker_form2(b, n_blk, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
                            n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err,
                            used, status, unres, fd_steps):
-    """:func:`_lyap_var_worker` in the lane form FORM_LOAD."""
-    _lyap_var_worker(b, n_blk, k, FORM_LOAD, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
-                     n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err, used,
-                     status, unres, fd_steps)
+    """:func:`_lyap_var_worker` with k = 1 in the lane form FORM_LOAD."""
+    _lyap_var_worker(b, n_blk, k, FORM_LOAD, True, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB,
+                     OFF, n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err,
+                     used, status, unres, fd_steps)
+
+
+@nb.njit(nogil=True, **_JIT)
+def _lyap_spec_worker_form0(b, n_blk, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
+                           n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err,
+                           used, status, unres, fd_steps):
+    """:func:`_lyap_var_worker` with k > 1 tangent vectors in the lane form FORM_GENERAL."""
+    _lyap_var_worker(b, n_blk, k, FORM_GENERAL, False, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB,
+                     OFF, n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err,
+                     used, status, unres, fd_steps)
+
+
+@nb.njit(nogil=True, **_JIT)
+def _lyap_spec_worker_form1(b, n_blk, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
+                           n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err,
+                           used, status, unres, fd_steps):
+    """:func:`_lyap_var_worker` with k > 1 tangent vectors in the lane form FORM_QUIET."""
+    _lyap_var_worker(b, n_blk, k, FORM_QUIET, False, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB,
+                     OFF, n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err,
+                     used, status, unres, fd_steps)
+
+
+@nb.njit(nogil=True, **_JIT)
+def _lyap_spec_worker_form2(b, n_blk, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
+                           n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err,
+                           used, status, unres, fd_steps):
+    """:func:`_lyap_var_worker` with k > 1 tangent vectors in the lane form FORM_LOAD."""
+    _lyap_var_worker(b, n_blk, k, FORM_LOAD, False, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB,
+                     OFF, n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err,
+                     used, status, unres, fd_steps)
 
 
 #: The variational block workers by the lane form of their block, each compiled on its first
 #: call.
 _VAR_WORKERS = {FORM_GENERAL: _lyap_var_worker_form0, FORM_QUIET: _lyap_var_worker_form1,
                 FORM_LOAD: _lyap_var_worker_form2}
+#: The same for k > 1 tangent vectors (a spectrum).
+_SPEC_WORKERS = {FORM_GENERAL: _lyap_spec_worker_form0, FORM_QUIET: _lyap_spec_worker_form1,
+                 FORM_LOAD: _lyap_spec_worker_form2}
 
 
 @nb.njit(**_JIT)
@@ -1746,9 +1781,10 @@ def lyapunov_block_lanes(P, Y0, scale, T0, H, OMEGA, NPER, n_transient, n_steps,
     fds = np.zeros(P_w.shape[0], np.int64) if fd_steps is None else fd_steps
     if variational:
         forms = _var_block_forms(P_w, i64(n_blk))
+        workers = _VAR_WORKERS if k == 1 else _SPEC_WORKERS
 
         def var_block(b, *rest):
-            _VAR_WORKERS[int(forms[b])](b, *rest, fds)
+            workers[int(forms[b])](b, *rest, fds)
 
         run_workers(var_block, int(n_blk), args)
         return
