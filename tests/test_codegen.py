@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from _lyapunov_rows import one_lane
 from conformance_cases import IDS, cases
 from geardyn.analysis.lyapunov import lyapunov_variational
 from geardyn.core.plan import default_steps_per_period
@@ -136,11 +137,11 @@ def test_generated_lyapunov_exponents_sum_to_the_divergence(all_cases, case):
     n, h, steps = _grid(model, periods=1)
     p = np.ascontiguousarray(model.params)
     scale = np.ascontiguousarray(model.state_scale, dtype=float)
-    # every argument given, with the types geardyn.lyapunov passes: the kernel it compiled (and
-    # tests/warm_kernels.py warmed) is loaded, not another overload compiled
-    exps, _, _, status, _, _ = k.lyapunov_single(p, y0, scale, 0.0, h, model.omega, n, 0,
-                                              steps, 8, model.n_states, DEFAULT_BOUND,
-                                              model.n_events, 16, lyapunov_variational(model))
+    # one lane of the lane blocks with n_states tangent vectors, as geardyn.lyapunov(...,
+    # spectrum=True) runs it
+    exps, _, _, status, _, _ = one_lane(k, p, y0, scale, 0.0, h, model.omega, n, 0, steps, 8,
+                                        model.n_states, DEFAULT_BOUND, model.n_events, 16,
+                                        lyapunov_variational(model))
     assert status == 0
     tr = _trace(model, y0)
     assert abs(np.sum(exps) - tr) <= 1e-6 * abs(tr), (np.sum(exps), tr)

@@ -68,9 +68,10 @@ pair = geardyn.GearPair(Omega=1.3, kappa=0.2, Fa=0.2)
 dev = geardyn.CATTDevice(geardyn.PlanetaryParams.paper(xi1=0.05, xi2=0.05))
 sweep = ["trajectory", "_sweep_worker", "_sweep_worker_form0", "_sweep_worker_form1",
          "_sweep_worker_form2"]
-lyap = ["lyapunov_single", "_lyap_block_worker", "_lyap_block_worker_form1",
+lyap = ["_lyap_block_worker", "_lyap_block_worker_form1",
         "_lyap_block_worker_form2", "_lyap_var_worker_form0", "_lyap_var_worker_form1",
-        "_lyap_var_worker_form2"]
+        "_lyap_var_worker_form2", "_lyap_spec_worker_form0", "_lyap_spec_worker_form1",
+        "_lyap_spec_worker_form2"]
 out = {}
 geardyn.simulate(pair, omega=1.3, run=geardyn.RunSettings(transient=0.0, samples=2))
 out["simulate"] = census(pair, "rk4", sweep)
@@ -120,13 +121,14 @@ def test_sweep_compiles_the_lane_forms_its_lanes_take_only(census):
 
 def test_lyapunov_lanes_compile_the_lane_form_they_take_only(census):
     """The Lyapunov lane blocks of FORM_QUIET lanes of the paper's device (a one-form model:
-    the variational tangent) run that form's variational fused loop only (not the other
-    forms' copies, nor the difference-row blocks, nor the one-lane kernel)."""
+    the variational tangent, k = 1) run that form's variational fused loop only (not the other
+    forms' copies, nor the spectrum's k > 1 workers, nor the difference-row blocks)."""
     c = census["lanes"]
     assert census["lanes_finite"]
     assert c["_lyap_var_worker_form1"] == 1, c
     for n in ("_lyap_var_worker_form0", "_lyap_var_worker_form2", "_lyap_block_worker",
-              "_lyap_block_worker_form1", "_lyap_block_worker_form2", "lyapunov_single"):
+              "_lyap_block_worker_form1", "_lyap_block_worker_form2", "_lyap_spec_worker_form0",
+              "_lyap_spec_worker_form1", "_lyap_spec_worker_form2"):
         assert c[n] == 0, (n, c)
     assert FORM_LOAD != FORM_QUIET != FORM_GENERAL
 
@@ -135,7 +137,7 @@ def test_lyapunov_lanes_of_a_model_without_a_one_form_compile_its_lane_form_only
     """The Lyapunov lanes of a model without a one form (the general N-set CATT kernel: its
     lanes take FORM_GENERAL, no fused loop, no variational tangent) run the difference-row
     block worker of FORM_GENERAL only: not the fused loops of the other forms, not the
-    variational workers, not the one-lane kernel."""
+    variational workers."""
     model = geardyn.CATTDevice(geardyn.PlanetaryParams.paper(xi1=0.05, xi2=0.05), reduced=False)
     assert model.kernel.one_form is None
     assert _lane_forms(model, model.lane_params("Omega", np.linspace(0.8, 1.6, 4))) == {
@@ -144,5 +146,6 @@ def test_lyapunov_lanes_of_a_model_without_a_one_form_compile_its_lane_form_only
     assert census["general_finite"]
     assert c["_lyap_block_worker"] == 1, c
     for n in ("_lyap_block_worker_form1", "_lyap_block_worker_form2", "_lyap_var_worker_form0",
-              "_lyap_var_worker_form1", "_lyap_var_worker_form2", "lyapunov_single"):
+              "_lyap_var_worker_form1", "_lyap_var_worker_form2", "_lyap_spec_worker_form0",
+              "_lyap_spec_worker_form1", "_lyap_spec_worker_form2"):
         assert c[n] == 0, (n, c)

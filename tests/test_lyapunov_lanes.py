@@ -1,5 +1,6 @@
 """The Lyapunov kernel on lane blocks (rows of many lanes in one structure-of-arrays block)
-against the one-lane kernel it replaces: exponents, errors, blocks and status bitwise equal."""
+against the tests' one-lane reference (``tests/_lyapunov_rows.py``: the model's scalar steps one
+lane at a time): exponents, errors, blocks, status and counts bitwise equal."""
 
 from __future__ import annotations
 
@@ -9,7 +10,7 @@ import numpy as np
 import pytest
 
 import geardyn
-from _lyapunov_rows import rows_for
+from _lyapunov_rows import reference_for, rows_for
 from geardyn.analysis import lyapunov as lyap_mod
 from geardyn.solvers.kernels import kernels_for
 from shared_models import lorenz_rhs as _lorenz  # one Lorenz kernel for the tests
@@ -39,18 +40,18 @@ def _lanes(model, omegas, n_per, periods_tr, periods_st, y0, t0):
 
 
 def _reference(kern, model, args, renorm, k, bound=1e6, variational=False):
-    """Each lane through the one-lane kernel (lyapunov_single), as lyapunov() runs it (every
-    argument given, with lyapunov()'s types: the kernel it compiled is loaded, not another
-    overload compiled)."""
+    """Each lane through the tests' one-lane reference (``reference_for(kern).lyapunov_single``):
+    (exponents, errors, blocks, status, unresolved, steps by the difference rows)."""
     P, Y0, T0, H, OM, n_tr, n_st, n_per = args
     scale = np.ones(model.n_states)
-    res = [kern.lyapunov_single(P[i], Y0[i], scale, float(T0[i]), float(H[i]), float(OM[i]),
-                                int(n_per[i]), int(n_tr[i]), int(n_st[i]), renorm, k,
-                                float(bound), model.n_events, 16, bool(variational))
+    single = reference_for(kern).lyapunov_single
+    res = [single(P[i], Y0[i], scale, float(T0[i]), float(H[i]), float(OM[i]), int(n_per[i]),
+                  int(n_tr[i]), int(n_st[i]), renorm, k, float(bound), model.n_events, 16,
+                  bool(variational))
            for i in range(len(P))]
     return (np.array([r[0] for r in res]), np.array([r[1] for r in res]),
             np.array([r[2] for r in res]), np.array([r[3] for r in res]),
-            np.array([r[4] for r in res]))
+            np.array([r[4] for r in res]), np.array([r[5] for r in res]))
 
 
 def _blocks(kern, model, args, renorm, k, block_rows, n_ev=None, bound=1e6, variational=False):
@@ -58,12 +59,12 @@ def _blocks(kern, model, args, renorm, k, block_rows, n_ev=None, bound=1e6, vari
     L = len(P)
     out, err = np.full((L, k), -1.0), np.full((L, k), -1.0)
     used, status = np.full(L, -1, np.int64), np.full(L, -1, np.int64)
-    unres = np.full(L, -1, np.int64)
+    unres, fd = np.full(L, -1, np.int64), np.full(L, -1, np.int64)
     kern.lyapunov_block_lanes(P, Y0, np.ones(model.n_states), T0, H, OM, n_per, n_tr, n_st,
                               renorm, k, bound, out, err, used, status, unres,
                               model.n_events if n_ev is None else n_ev, 16, block_rows, 2,
-                              variational)
-    return out, err, used, status, unres
+                              variational, fd)
+    return out, err, used, status, unres, fd
 
 
 def _assert_bitwise(got, ref):
@@ -72,7 +73,8 @@ def _assert_bitwise(got, ref):
 
 
 @pytest.mark.parametrize(("k", "load", "variational"),
-                         [(1, False, True), (4, False, False), (1, True, True)])
+                         [(1, False, True), (4, False, False), (1, True, True),
+                          (4, False, True)])
 def test_catt_blocks_bitwise_equal_to_one_lane_kernel(k, load, variational):
     # the reduced paper device at Omegas with and without contact loss, lanes with their own
     # grid, transient, measuring window, start time and state; renorm 7 so that blocks of the
@@ -81,7 +83,8 @@ def test_catt_blocks_bitwise_equal_to_one_lane_kernel(k, load, variational):
     # lyapunov() and lyapunov_lanes() run on this one-form model, whose kernels the warm-up
     # and the sweep's exponent test compile; the fused block of difference rows, the path of
     # ``tangent="difference"``, is the gear pair's test below, in FORM_QUIET), k = 4 the row
-    # blocks.
+    # blocks; k = 4 with the variational tangent the spectrum of lyapunov(..., spectrum=True):
+    # the variational block, a pass of its fused loop per tangent vector.
     model = (geardyn.CATTDevice(geardyn.PlanetaryParams.paper(
         xi1=0.05, xi2=0.05, B1="100 N m", B2="100 N m", Lambda=0.1)) if load
         else paper_device())
@@ -126,6 +129,26 @@ def test_gear_pair_blocks_bitwise_equal_with_a_diverged_lane():
             assert ref[3][2] == 1 and np.all(np.isnan(ref[0][2]))  # diverged
             for rows in (64, 5):
                 _assert_bitwise(_blocks(kern, model, args, 10, k, rows), ref)
+
+
+def test_variational_spectrum_slots_bitwise_in_one_pass_and_several():
+    # the variational block's slots are (lane, tangent vector) pairs: 40 lanes of k = 2 in one
+    # block are 80 slots, more than a pass takes (64: two passes, the state committed by the
+    # last), 12 lanes a block (24 slots, one pass), one lane a block (2 slots); a diverged lane
+    # among them (its slots leave the pass with it)
+    model = geardyn.GearPair(**IMPACTING)
+    kern = kernels_for(model.kernel, "lyapunov")
+    om = np.linspace(0.6, 2.2, 40)
+    rng = np.random.default_rng(5)
+    y0 = model.initial_state() + rng.uniform(-0.3, 0.3, (om.size, 2))
+    y0[7] = [1e9, 0.0]
+    args = _lanes(model, om, 32, rng.integers(0, 8, om.size), rng.integers(5, 20, om.size), y0,
+                  rng.uniform(0.0, 5.0, om.size))
+    ref = _reference(kern, model, args, 10, 2, variational=True)
+    assert ref[3][7] == 1 and np.all(np.delete(ref[3], 7) == 0)
+    assert np.all(np.isfinite(np.delete(ref[0], 7, axis=0)))
+    for rows in (1000, 64, 5):
+        _assert_bitwise(_blocks(kern, model, args, 10, 2, rows, variational=True), ref)
 
 
 def test_generic_lane_path_general_catt_model():

@@ -14,7 +14,7 @@ import pytest
 from scipy.integrate import solve_ivp
 
 import geardyn
-from _lyapunov_rows import rows_for
+from _lyapunov_rows import one_lane, reference_for, rows_for
 from geardyn.solvers.kernels import kernels_for
 
 #: A period-1 orbit with contact loss (two crossings per period), and a chaotic one.
@@ -71,9 +71,8 @@ def _kernel_exponent(model, n_per, n_tr_periods, n_periods, variational):
     kern = kernels_for(model.kernel, "lyapunov")
     om = model.params[model.omega_index]
     h = 2 * math.pi / om / n_per
-    out = kern.lyapunov_single(np.ascontiguousarray(model.params), model.initial_state(),
-                               np.ones(2), 0.0, h, om, n_per, n_tr_periods * n_per,
-                               n_periods * n_per, 10, 1, 1e6, 2, 16, variational)
+    out = one_lane(kern, model.params, model.initial_state(), np.ones(2), 0.0, h, om, n_per,
+                   n_tr_periods * n_per, n_periods * n_per, 10, 1, 1e6, 2, 16, variational)
     return out
 
 
@@ -185,9 +184,9 @@ def _errors(model, reference, v0, n_tr, n_m, steps):
     out = {}
     for n_per in steps:
         h = 2 * math.pi / om / n_per
-        res = [kern.lyapunov_single(np.ascontiguousarray(model.params), model.initial_state(),
-                                    np.ones(model.n_states), 0.0, h, om, n_per, n_tr * n_per,
-                                    n_m * n_per, 10, 1, 1e6, model.n_events, 16, var)
+        res = [one_lane(kern, model.params, model.initial_state(), np.ones(model.n_states), 0.0,
+                        h, om, n_per, n_tr * n_per, n_m * n_per, 10, 1, 1e6, model.n_events, 16,
+                        var)
                for var in (True, False)]
         assert res[0][3] == 0 and res[1][3] == 0
         out[n_per] = (abs(res[0][0][0] - ref), abs(res[1][0][0] - ref), res[0][5])
@@ -295,8 +294,8 @@ def test_split_tangent_leaves_the_state_bitwise_the_rows(case):
     model = ORDER_CASES[case][0]()
     kern = kernels_for(model.kernel, "lyapunov")
     env = {"nb": nb, "np": np}
-    env.update({n: getattr(kern, n) for n in ("_var_step", "_tangent_step", "phase_table",
-                                               "GBUF_ROWS")})
+    env.update({n: getattr(kern, n) for n in ("_tangent_step", "phase_table", "GBUF_ROWS")})
+    env["_var_step"] = reference_for(kern)._var_step
     exec(compile(_STATES_SOURCE, "<split tangent states>", "exec"), env)
     om = model.params[model.omega_index]
     n_per = 64
@@ -317,9 +316,9 @@ def test_variational_lanes_are_bitwise_the_one_lane_kernel():
     n_st = np.array([30, 40, 25, 35, 20]) * n_per
     P, Y0, H, out, err, un, st, fd = _lanes(model, oms, n_per, n_tr, n_st, True)
     rows = _lanes(model, oms, n_per, n_tr, n_st, True, rows=True)
-    kern = kernels_for(model.kernel, "lyapunov")
+    ref = reference_for(kernels_for(model.kernel, "lyapunov"))
     for lane in range(oms.size):
-        ex, er, _, status, unres, n_fd = kern.lyapunov_single(
+        ex, er, _, status, unres, n_fd = ref.lyapunov_single(
             P[lane].copy(), Y0[lane].copy(), np.ones(2), 0.0, H[lane], oms[lane], n_per, n_tr,
             int(n_st[lane]), 10, 1, 1e6, 2, 16, True)
         got = (out[lane], err[lane], un[lane], st[lane], fd[lane])
@@ -329,7 +328,7 @@ def test_variational_lanes_are_bitwise_the_one_lane_kernel():
     # without edge location (n_ev = 0: no screen, no split) too
     P, Y0, H, out0, err0, un0, st0, fd0 = _lanes(model, oms, n_per, n_tr, n_st, True, n_ev=0)
     for lane in range(oms.size):
-        ex, er, _, status, unres, n_fd = kern.lyapunov_single(
+        ex, er, _, status, unres, n_fd = ref.lyapunov_single(
             P[lane].copy(), Y0[lane].copy(), np.ones(2), 0.0, H[lane], oms[lane], n_per, n_tr,
             int(n_st[lane]), 10, 1, 1e6, 0, 16, True)
         assert (out0[lane], err0[lane], un0[lane], st0[lane], fd0[lane]) == (
@@ -439,9 +438,8 @@ def test_split_limit_takes_the_difference_rows_counted():
     steps = 2 * (n_tr + n_m)
     om = 1.1
     p = np.ascontiguousarray(model.with_params(Omega=om).params)
-    out = kern.lyapunov_single(p, model.initial_state(), np.ones(1), 0.0, 2 * math.pi / om / n_per,
-                               om, n_per, n_tr * n_per, n_m * n_per, 10, 1, 1e6, model.n_events,
-                               16, True)
+    out = one_lane(kern, p, model.initial_state(), np.ones(1), 0.0, 2 * math.pi / om / n_per, om,
+                   n_per, n_tr * n_per, n_m * n_per, 10, 1, 1e6, model.n_events, 16, True)
     assert (out[3], out[4], out[5]) == (2, 3 * steps, steps)  # STATUS_SPLIT_LIMIT
     assert abs(out[0][0]) < 5e-8
     oms = np.array([0.8, 1.1, 1.4])

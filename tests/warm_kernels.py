@@ -3,8 +3,8 @@
 Every test worker (pytest-xdist) is a separate process, and numba compiles a kernel in the first
 process that needs it and finds no cached copy; two workers that start on the same model compile
 its kernels twice, side by side, one core each. This script compiles each built-in model's
-kernels that the tests use (``WARM``: sweep, trajectory, Lyapunov lanes and single lane,
-monodromy, run-up), and those of the user models the tests share (``tests/shared_models.py``), in
+kernels that the tests use (``WARM``: sweep, trajectory, Lyapunov lane blocks, monodromy,
+run-up), and those of the user models the tests share (``tests/shared_models.py``), in
 its own process, the models spread over ``--jobs`` processes (longest first, ``COST``), through
 the public API with the argument types the tests use, so that the workers load them from the
 on-disk cache instead (a worker that needs a kernel the other is compiling waits for it,
@@ -28,7 +28,9 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 #: What the default test suite runs on each conformance case and shared test model (so that the
 #: warm-up compiles no kernel that the tests would not): sweep = bifurcation, trajectory =
-#: simulate, lyapunov = one lane, lanes = Lyapunov lane blocks, orbit = the monodromy kernel,
+#: simulate, lyapunov = one lane of the Lyapunov lane blocks, lanes = lyapunov_lanes on two
+#: lanes (the same block workers, where their lanes take the same lane form), orbit = the
+#: monodromy kernel,
 #: runup = the run-up kernel (run-ups, fault datasets; tests in both workers use those of the gear
 #: pair, the spur pair and the planetary set, whose models share these cases' kernels).
 #: The one-form gear pair's and the train's (the planetary set's) Lyapunov lane blocks are left

@@ -368,22 +368,17 @@ def lyapunov(
     p = np.ascontiguousarray(model.params, dtype=float)
     n_ev = model.n_events if run.locate_edges else 0
     scale = _state_scale(model)
+    # one lane of the lane blocks (the kernels of lyapunov_lanes and bifurcation(...,
+    # lyapunov=True)), with k tangent vectors
+    ex, er = np.full((1, k), np.nan), np.full((1, k), np.nan)
+    used, code, unres, n_fd = (np.zeros(1, np.int64) for _ in range(4))
     with _dual_typing(variational, ls):
-        if variational and k == 1:
-            # one lane of the variational lane blocks (bitwise lyapunov_single's): the kernels
-            # lyapunov_lanes and bifurcation(..., lyapunov=True) use, not a one-lane copy
-            ex, er = np.full((1, k), np.nan), np.full((1, k), np.nan)
-            used, code, unres, n_fd = (np.zeros(1, np.int64) for _ in range(4))
-            kern.lyapunov_block_lanes(
-                p[None, :], y[None, :], scale, np.array([t0]), np.array([h]),
-                np.array([float(om)]), np.array([n_per], np.int64), np.array([n_tr], np.int64),
-                np.array([n_st], np.int64), renorm, k, float(bound), ex, er, used, code, unres,
-                n_ev, n_blk, kern.BLOCK_ROWS, 1, True, n_fd)
-            ex, er, used, code, unres, n_fd = ex[0], er[0], used[0], code[0], unres[0], n_fd[0]
-        else:
-            ex, er, used, code, unres, n_fd = kern.lyapunov_single(
-                p, y, scale, t0, h, om, n_per, n_tr, n_st, renorm, k, float(bound), n_ev,
-                n_blk, variational)
+        kern.lyapunov_block_lanes(
+            p[None, :], y[None, :], scale, np.array([t0]), np.array([h]), np.array([float(om)]),
+            np.array([n_per], np.int64), np.array([n_tr], np.int64), np.array([n_st], np.int64),
+            renorm, k, float(bound), ex, er, used, code, unres, n_ev, n_blk, kern.BLOCK_ROWS, 1,
+            variational, n_fd)
+    ex, er, used, code, unres, n_fd = ex[0], er[0], used[0], code[0], unres[0], n_fd[0]
     status = Status(int(code))
     ex = np.asarray(ex, dtype=float)
     er = np.asarray(er, dtype=float)

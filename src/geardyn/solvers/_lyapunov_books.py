@@ -243,6 +243,11 @@ def _lane_books_core(step, first, nl, k, renorm, bound, ZT, Zl, Cl, logs, IST, E
     return nxt
 
 
+#: :func:`_lane_books_core` inlined into its caller (one lane's time loop, where a call of it at
+#: each renormalisation costs more than its arithmetic).
+_lane_books_inline = nb.njit(inline="always", _nrt=False, **_JIT)(_lane_books_core.py_func)
+
+
 @nb.njit(**_JIT)
 def _lane_result(l, lane, k, n_steps, h, ENDS, nbk, BLK, ACC, out, err, used):
     """The exponents and standard errors of lane l at its end (as :func:`_run` returns them)."""

@@ -69,12 +69,16 @@ Numerics
   (:func:`_block_stderr`). The exponent itself is summed as before, untouched.
 * A lane whose state leaves ``|y| <= bound`` (checked at each renormalisation) or whose tangent
   vectors stop being finite is marked diverged (status 1) and its exponents are NaN.
-* Cost per step: (2 k + 1) RK4 steps for k tangent vectors by the difference rows; one
-  RK4 step of the state and its tangent vector (f and J w in one inlined call) by the
-  variational tangent, k = 1. They are independent integrations
-  of one grid step, so they run as the rows of one lockstep block (their RK4 stages interleaved,
-  the model's functions inlined once), which overlaps their dependency chains; each row's
-  arithmetic is that of a lone step, so the result does not depend on it.
+* Cost per step: (2 k + 1) RK4 steps for k tangent vectors by the difference rows; k RK4 steps
+  of the state and a tangent vector (f and J w in one inlined call) by the variational tangent.
+  They are independent integrations of one grid step, so they run as the rows of one lockstep
+  block (their RK4 stages interleaved, the model's functions inlined once), which overlaps
+  their dependency chains; each row's arithmetic is that of a lone step, so the result does not
+  depend on it.
+* Every run is lanes of the lane blocks (:func:`lyapunov_block_lanes`: one lane for
+  :func:`geardyn.lyapunov`, its spectrum with k = n tangent vectors); there is no one-lane
+  kernel. The tests' reference steps one lane at a time by the scalar steps
+  (``tests/_lyapunov_rows.py``), against which the blocks are bitwise.
 """
 
 from __future__ import annotations
@@ -85,17 +89,15 @@ import numpy as np
 from geardyn.core.kernel_source import FORM_GENERAL, FORM_LOAD, FORM_QUIET
 from geardyn.solvers._lyapunov_books import (  # compiled once for every model
     _DUE,
+    _LAST,
     _NBK,
     _NST,
-    _block_bounds,
-    _block_stderr,
     _block_tables,
     _lane_books,
     _lane_books_core,
+    _lane_books_inline,
     _lane_result,
     _lanes_init,
-    _orthonormalise,
-    _stretch_logs,
 )
 from geardyn.solvers._parallel import run_workers
 from geardyn.solvers._step_core import (  # CORE-IMPORT
@@ -107,7 +109,6 @@ from geardyn.solvers._step_core import (  # CORE-IMPORT
     _events_i,
     _events_l,
     _lane_form,
-    _leaves_side_step,
     _rhs_columns,
     _rhs_l,
     _split_copy,
@@ -127,7 +128,6 @@ from geardyn.solvers._step_shared import (
     STATUS_DIVERGED,
     STATUS_OK,
     STATUS_SPLIT_LIMIT,
-    _healthy,
     _padded,
     _phase_at,
     _pick,
@@ -147,13 +147,13 @@ from geardyn.solvers._template_model import events, observe, rhs  # MODEL-IMPORT
 
 # the model interface names are part of the template's namespace (the generated copy re-binds
 # them); only rhs and events are used here
-__all__ = ["BLOCK_ROWS", "events", "lyapunov_block_lanes", "lyapunov_lanes", "lyapunov_single",
-           "observe", "phase_table", "rhs"]
+__all__ = ["BLOCK_ROWS", "events", "lyapunov_block_lanes", "lyapunov_lanes", "observe",
+           "phase_table", "rhs"]
 
 
 #: Whether the model has the tangent forms of its rhs (a one-form model: ``rhs_tangent``,
 #: ``rhs_lane_tangent``, see :func:`geardyn.core.one_form.tangent_adapters`), so that its
-#: tangent vectors can be stepped by the variational RK4 (:func:`_var_step`).
+#: tangent vectors can be stepped by the variational RK4 (:func:`_var_trial`).
 VARIATIONAL = "rhs_tangent" in globals()
 
 
@@ -440,7 +440,7 @@ if VARIATIONAL:
         state split at its crossings and the tangent vectors carried through the sub-steps
         (:func:`_var_split`); where that is ill-posed, the step by the difference rows
         (:func:`_tangent_step`). Returns 1 where the step took the difference rows, else 0.
-        Scratch as :func:`_var_step`'s, VX, VG (see above)."""
+        Scratch: one lane's difference rows (:func:`_tangent_step`), VX, VG (see above)."""
         m, ns = Z.shape
         m1 = m - 1
         t = t0 + i * h
@@ -480,69 +480,7 @@ if VARIATIONAL:
             Z[0, q] = y[q]
         return 0
 
-    @nb.njit(_nrt=False, **_JIT)  # it allocates nothing
-    def _var_step(i, t0, Z, S, IS, p, h, omega, n_per, s_tab, c_tab, n_ev, YP, E, K, TMP,
-                  Y1, SIDE, G0, G1, W, gbuf, NCR, UNRES, VW,
-                  VX, VG):
-        """Advance the state y (row 0 of Z) by grid step i and each tangent vector v (rows 1..,
-        in z = y / S) by the exact derivative of the RK4 step map: the variational RK4
-        (:func:`_var_trial`, w = S v). A step whose state leaves a side of an edge (or may graze
-        one; :func:`_leaves_side_step`, as :func:`_rows_step` screens it) is split at the
-        crossing, the tangent vectors through its sub-steps (:func:`_var_split_lane`). Returns 1
-        where the step took the difference rows, else 0. VW: scratch, (2 m + 10, ns); VX, VG:
-        :func:`_var_split`'s."""
-        m, ns = Z.shape
-        t = t0 + i * h
-        hh = 0.5 * h
-        j0 = 2 * (i % n_per)
-        last = 2 * (m - 1)
-        y = YP[last]
-        for q in range(ns):
-            y[q] = Z[0, q]
-        KS = VW[0:4]
-        KV = VW[4:8]
-        TV = VW[8]
-        w = VW[9]
-        WN = VW[10:10 + m]  # the trial's tangent vectors (in z), row j for tangent j
-        for j in range(1, m):
-            for q in range(ns):
-                w[q] = S[q] * Z[j, q]
-            _var_trial(t, hh, h, y, w, p, s_tab[j0], c_tab[j0], s_tab[j0 + 1], c_tab[j0 + 1],
-                       s_tab[j0 + 2], c_tab[j0 + 2], KS, KV, TMP[last], TV, Y1[last], WN[j])
-        if n_ev > 0:
-            for q in range(ns):
-                K[0, last, q] = KS[0, q]
-            _events_i(t, y, G0[last], p, s_tab[j0], c_tab[j0])
-            for j in range(n_ev):
-                SIDE[last, j] = _side(G0[last, j])
-            _events_i(t + h, Y1[last], G1[last], p, s_tab[j0 + 2], c_tab[j0 + 2])
-            if _leaves_side_step(last, t, t + h, YP, K[0], G0, G1, SIDE, p, W[8], gbuf,
-                                 s_tab[j0 + 2], c_tab[j0 + 2]):
-                for q in range(ns):
-                    VX[1, q] = Y1[last, q]
-                for j in range(n_ev):
-                    G0[0, j] = G0[last, j]
-                    G1[0, j] = G1[last, j]
-                    SIDE[0, j] = SIDE[last, j]
-                return _var_split_lane(i, t0, Z, S, IS, p, h, omega, n_per, s_tab, c_tab,
-                                       n_ev, YP, E, K, TMP, Y1, SIDE, G0, G1, W, gbuf, NCR,
-                                       UNRES, VX, VG)
-        for j in range(1, m):
-            for q in range(ns):
-                Z[j, q] = WN[j, q] * IS[q]
-        for q in range(ns):
-            Z[0, q] = Y1[last, q]
-        return 0
-
 else:
-    @nb.njit(**_JIT)
-    def _var_step(i, t0, Z, S, IS, p, h, omega, n_per, s_tab, c_tab, n_ev, YP, E, K, TMP,
-                  Y1, SIDE, G0, G1, W, gbuf, NCR, UNRES, VW, VX, VG):
-        """A model without tangent forms has no variational step (its callers refuse)."""
-        if n_ev >= 0:
-            raise ValueError("this model has no tangent form of its rhs (no one form)")
-        return 0
-
     @nb.njit(**_JIT)
     def _var_split_lane(i, t0, Z, S, IS, p, h, omega, n_per, s_tab, c_tab, n_ev, YP, E, K, TMP,
                         Y1, SIDE, G0, G1, W, gbuf, NCR, UNRES, VX, VG):
@@ -550,133 +488,6 @@ else:
         if n_ev >= 0:
             raise ValueError("this model has no tangent form of its rhs (no one form)")
         return 0
-
-
-@nb.njit(**_JIT)
-def _run(p, y0, S, t0, h, omega, n_per, s_tab, c_tab, n_transient, n_steps, renorm_every, k,
-         bound, n_ev, n_blocks, variational):
-    """Exponents (sum of logs / measured time), their standard errors (from up to ``n_blocks``
-    blocks of whole forcing periods of the measuring window), the number of blocks, the
-    status (STATUS_SPLIT_LIMIT where a step of any row reached the split limit, the exponents
-    kept; STATUS_DIVERGED, exponents NaN), the number of such steps (all rows) and the number
-    of grid steps whose tangent vectors took the difference rows of one
-    lane, started at time t0 (forcing phase zero there); tangent vectors in the
-    coordinates y / S (S: the state scale). ``variational``: the tangent vectors by the
-    variational RK4 (:func:`_var_step`; split steps through the sub-steps, by the difference
-    rows only where that is ill-posed), else by the difference rows (:func:`_tangent_step`) at
-    every step."""
-    ns = y0.size
-    IS = np.empty(ns)
-    for q in range(ns):
-        IS[q] = 1.0 / S[q]
-    m = k + 1
-    Z = np.zeros((m, ns))
-    W = np.zeros((9, ns))
-    nr = 2 * k + 1
-    YP = np.zeros((nr, ns))
-    E = np.zeros(m)  # the perturbation size of each tangent vector in this step
-    K = np.zeros((4, nr, ns))
-    TMP = np.zeros((nr, ns))
-    Y1 = np.zeros((nr, ns))
-    ne = max(n_ev, 1)
-    SIDE = np.ones((nr, ne), np.int64)
-    G0 = np.zeros((nr, ne))
-    G1 = np.zeros((nr, ne))
-    gbuf = np.zeros((GBUF_ROWS, ne))
-    NCR = np.zeros((nr, ne), np.int64)
-    UNRES = np.zeros(nr, np.int64)
-    acc = np.zeros(k)
-    logs = np.zeros(k)
-    ends = _block_bounds(max(n_steps, 1), n_per, n_blocks)
-    nbk = ends.size
-    blk = np.zeros((nbk, k))  # log stretch per block of the measuring window
-    C = np.zeros((m, ns))
-    VW = np.zeros((10 + m, ns))
-    VX = np.zeros((9 + 7 * k, ns))
-    VG = np.zeros((3, ne))
-    n_fd = 0
-    out = np.full(k, np.nan)
-    err = np.full(k, np.nan)
-    for q in range(ns):
-        Z[0, q] = y0[q]
-    # generic, orthonormalised start vectors: e_j + 0.1 (1, ..., 1)
-    for j in range(1, m):
-        for q in range(ns):
-            Z[j, q] = 0.1 + (1.0 if q == j - 1 else 0.0)
-    _orthonormalise(Z, logs, False)
-    renorm = max(renorm_every, 1)
-    total = n_transient + n_steps
-    since = 0
-    cur = 0  # the block being measured
-    for i in range(total):
-        if variational:
-            n_fd += _var_step(i, t0, Z, S, IS, p, h, omega, n_per, s_tab, c_tab, n_ev, YP, E, K,
-                              TMP, Y1, SIDE, G0, G1, W, gbuf, NCR, UNRES, VW, VX, VG)
-        else:
-            _tangent_step(i, t0, Z, S, IS, p, h, omega, n_per, s_tab, c_tab, n_ev, YP, E, K,
-                          TMP, Y1, SIDE, G0, G1, W, gbuf, NCR, UNRES)
-            n_fd += 1
-        since += 1
-        step = i + 1
-        measure = step > n_transient
-        if since == renorm or step == n_transient or step == total:
-            since = 0
-            if not _healthy(Z[0], bound):
-                return out, err, 0, STATUS_DIVERGED, UNRES.sum(), n_fd
-            if not _orthonormalise(Z, logs, measure):
-                return out, err, 0, STATUS_DIVERGED, UNRES.sum(), n_fd
-            if measure:
-                for j in range(k):
-                    acc[j] += logs[j]
-                    blk[cur, j] += logs[j]
-            if measure and step - n_transient == ends[cur]:
-                cur += 1
-        elif measure and step - n_transient == ends[cur]:
-            # a block ends between renormalisations: its share of the running stretch, on a
-            # copy (the exponent's own arithmetic is untouched)
-            _stretch_logs(Z, C, logs)
-            for j in range(k):
-                blk[cur, j] += logs[j]
-                blk[cur + 1, j] -= logs[j]
-            cur += 1
-    unres = UNRES.sum()
-    status = STATUS_SPLIT_LIMIT if unres > 0 else STATUS_OK
-    if n_steps <= 0:
-        return out, err, 0, status, unres, n_fd
-    tm = n_steps * h
-    for j in range(k):
-        out[j] = acc[j] / tm
-    _block_stderr(blk, ends, h, err)
-    return out, err, nbk, status, unres, n_fd
-
-
-@nb.njit(**_JIT)
-def lyapunov_single(p, y0, scale, t0, h, omega, n_per, n_transient, n_steps, renorm_every, k,
-                    bound, n_ev=0, n_blocks=16, variational=False):
-    """The k leading Lyapunov exponents (per unit time of the model) of one parameter set.
-
-    ``scale``: the characteristic scale of each state (``Model.state_scale``, positive; ones give
-    the unscaled kernel); the tangent vectors live in y / scale. Grid: step h (= 2 pi /
-    (omega n_per) for a forced model); the state y0 is given at time t0,
-    where the forcing phase is zero; ``n_transient`` steps are discarded and ``n_steps``
-    measured. ``n_ev``: the model's number of switching functions, whose crossings are located
-    inside a step (0: none located). Returns (exponents[k], stderr[k], blocks, status,
-    unresolved): the standard errors from ``n_blocks`` blocks of the measuring window
-    (:func:`_block_stderr`; ``blocks`` of them used); exponents are NaN if diverged (status
-    STATUS_DIVERGED); ``unresolved``: grid steps of the state or a perturbed row that reached
-    the split limit (MAX_SPLITS) and fell back unsplit, the status then STATUS_SPLIT_LIMIT
-    (exponents kept) unless diverged; ``fd_steps``: the grid steps whose tangent vectors took
-    the difference rows (every step, or with ``variational`` the split steps where carrying
-    the tangent through the sub-steps is ill-posed: see :func:`_var_split_lane`;
-    ``variational`` needs the model's tangent forms, :data:`VARIATIONAL`).
-    Returns (exponents, stderr, blocks, status, unresolved, fd_steps).
-    """
-    s_tab, c_tab = phase_table(n_per, omega != 0.0)
-    # copies and int64 casts: a read-only array, a literal or an omitted argument would compile
-    # _run once more for each such caller
-    return _run(p.copy(), y0.copy(), scale.copy(), t0, h, omega, n_per, s_tab, c_tab,
-                n_transient, n_steps, renorm_every, np.int64(k), bound, np.int64(n_ev),
-                np.int64(n_blocks), bool(variational))
 
 
 # ---------------------------------------------------------------------------------------------
@@ -692,9 +503,9 @@ def lyapunov_single(p, y0, scale, t0, h, omega, n_per, n_transient, n_steps, ren
 # lie nl apart. Each row gets its own coefficients (PT[:, r]), times and forcing phase (SP[r],
 # CP[r]). A row whose trial step leaves a side of an edge (or may graze one) is finished on the
 # scalar path (:func:`_split_step`). Gram-Schmidt, the block statistics and the health check run per
-# lane, at its renormalisations, on a gathered copy with the functions of the one-lane kernel. Every
+# lane, at its renormalisations, on a gathered copy with the one-lane functions of the books. Every
 # row's arithmetic is that of :func:`_rows_step`, operation for operation (no fastmath), so results
-# are bitwise those of :func:`lyapunov_single`, whatever the blocking, position or thread.
+# are bitwise those of one lane stepped alone, whatever the blocking, position or thread.
 
 #: Most rows of a lane block (lanes of 2 k + 1 rows each; at least one lane).
 BLOCK_ROWS = 64
@@ -874,11 +685,55 @@ def _set_column(r, lane, P, T0, H, NPER, OFF, PT, T0R, HR, HH, H6, NPR, IDX, END
 
 
 @nb.njit(**_JIT)
+def _lyap_one(first, max_total, due, renorm, bound, P, S, IS, T0, H, OMEGA, NPER, S_TAB, C_TAB,
+              OFF, n_ev, ZT, IST, ENDS, BLK, ACC, ACT, ACTR, Zl, Cl, logs, status, W, gbuf):
+    """:func:`_lyap_block`'s time loop for one lane (ZT[:, :, 0], nl = 1): its 2 k + 1 rows
+    by the scalar rows step (:func:`_tangent_step`, as the monodromy steps its rows; the
+    arithmetic of the block's rows), its bookkeeping where due (:func:`_lane_books_core`,
+    inlined: :func:`_lyap_one_loop`). Returns the steps of its rows that reached the split
+    limit."""
+    m, ns = Zl.shape
+    k = m - 1
+    nr = 2 * k + 1
+    ne = gbuf.shape[1]
+    rows = (ZT.reshape((m, ns)), np.zeros((nr, ns)), np.zeros(m), np.zeros((4, nr, ns)),
+            np.zeros((nr, ns)), np.zeros((nr, ns)), np.ones((nr, ne), np.int64),
+            np.zeros((nr, ne)), np.zeros((nr, ne)), np.zeros((nr, ne), np.int64),
+            np.zeros(nr, np.int64))
+    return _lyap_one_loop(first, max_total, due, renorm, bound, P, S, IS, T0, H, OMEGA, NPER,
+                          S_TAB[OFF[first]:], C_TAB[OFF[first]:], n_ev, ZT, IST, ENDS, BLK, ACC,
+                          ACT, ACTR, Zl, Cl, logs, status, W, gbuf, rows)
+
+
+@nb.njit(_nrt=False, **_JIT)  # it allocates nothing
+def _lyap_one_loop(first, max_total, due, renorm, bound, P, S, IS, T0, H, OMEGA, NPER, s_tab,
+                   c_tab, n_ev, ZT, IST, ENDS, BLK, ACC, ACT, ACTR, Zl, Cl, logs, status, W,
+                   gbuf, rows):
+    """:func:`_lyap_one`'s loop (rows: Z, the lane's rows as ZT's view, and the scratch of
+    :func:`_tangent_step`)."""
+    Z, YP, E, K, TMP, Y1, SIDE, G0, G1, NCR, UNRES = rows
+    k = Z.shape[0] - 1
+    p = P[first]
+    t0, h, omega, n_per = T0[first], H[first], OMEGA[first], NPER[first]
+    for i in range(max_total):
+        if not ACT[0]:
+            break
+        _tangent_step(i, t0, Z, S, IS, p, h, omega, n_per, s_tab, c_tab, n_ev, YP, E, K, TMP,
+                      Y1, SIDE, G0, G1, W, gbuf, NCR, UNRES)
+        step = i + 1
+        if step >= due:
+            due = _lane_books_inline(step, first, 1, k, renorm, bound, ZT, Zl, Cl, logs, IST,
+                                     ENDS, BLK, ACC, ACT, ACTR, status)
+    return UNRES.sum()
+
+
+@nb.njit(**_JIT)
 def _lyap_block(first, nl, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF, n_transient,
-                n_steps, renorm_every, bound, n_ev, n_blocks, out, err, used, status, unres):
+                n_steps, renorm_every, bound, n_ev, n_blocks, out, err, used, status, unres,
+                fd_steps):
     """The k leading exponents of lanes first..first+nl-1 (lane with NPER[lane] steps per
     period, its phase table at S_TAB, C_TAB[OFF[lane]:]), their rows in one block (see above);
-    per lane what :func:`_run` computes for it, into out[lane], err[lane], used[lane],
+    per lane the exponents of its difference rows, into out[lane], err[lane], used[lane],
     status[lane], unres[lane]. (A block of a model's lane form takes the fused loop instead:
     :func:`_block_path`.)"""
     ns = Y0.shape[1]
@@ -951,7 +806,16 @@ def _lyap_block(first, nl, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF, n
     for l in range(nl):
         if ACT[l]:
             due = min(due, IST[l, _DUE])
-    for i in range(max_total):
+    # one lane of fewer rows than ROW_PAD (or a model without lane-block functions, whose rows
+    # the block evaluates one by one): its rows by the scalar rows step (:func:`_lyap_one`),
+    # not a block mostly of padding
+    one = nl == 1 and (ROW_PAD == 1 or nr < ROW_PAD)
+    u_one = 0
+    if one:
+        u_one = _lyap_one(first, max_total, due, renorm, bound, P, S, IS, T0, H, OMEGA, NPER,
+                          S_TAB, C_TAB, OFF, n_ev, ZT, IST, ENDS, BLK, ACC, ACT, ACTR, Zl, Cl,
+                          logs, status, W, gbuf)
+    for i in range(0 if one else max_total):
         live = False
         for l in range(nl):
             live = live or ACT[l]
@@ -985,12 +849,17 @@ def _lyap_block(first, nl, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF, n
         if step >= due:
             due = _lane_books(step, first, nl, k, renorm, bound, ZT, Zl, Cl, logs, IST, ENDS, BLK,
                               ACC, ACT, ACTR, H, out, err, used, status)
+    if one and status[first] != STATUS_DIVERGED:
+        _lane_result(0, first, k, IST[0, _NST], H[first], ENDS, IST[0, _NBK], BLK, ACC, out, err,
+                     used)
     for l in range(nl):  # the split-limit steps of each lane's rows (slots nl apart)
         lane = first + l
         u = 0
         for slot in range(2 * k + 1):
             u += UNRR[slot * nl + l]
+        u += u_one
         unres[lane] = u
+        fd_steps[lane] = IST[l, _LAST]  # the steps run (each by the difference rows)
         if u > 0 and status[lane] == STATUS_OK:
             status[lane] = STATUS_SPLIT_LIMIT
 
@@ -1255,18 +1124,18 @@ def _block_form(P, first, nl):
 
 
 @nb.njit(inline="always", **_JIT)
-def _fused_block_start(first, nl, P, Y0, S, T0, H, NPER, OFF, n_transient, n_steps,
+def _fused_block_start(first, nl, k, P, Y0, S, T0, H, NPER, OFF, n_transient, n_steps,
                        renorm_every, n_blocks, out, err, used, status):
-    """The start of a fused Lyapunov block of k = 1 (:func:`_lyap_block_fused`,
-    :func:`_lyap_block_var`; nl <= BLOCK lanes): the inverse scale IS, the state and tangent
-    columns (ZT and its rows Z0, Z1), the lanes' coefficients, clocks, phase-table indices and
-    phases, the activity and flag columns, the lanes' books (:func:`_lanes_init`), the
-    renormalisation interval and the first due step."""
+    """The start of a fused Lyapunov block of k tangent vectors (:func:`_lyap_block_fused`,
+    k = 1; :func:`_lyap_block_var`; nl <= BLOCK lanes): the inverse scale IS, the state and
+    tangent columns (ZT and its rows Z0, Z1: the state and the first tangent vector), the lanes'
+    coefficients, clocks, phase-table indices and phases, the activity and flag columns, the
+    lanes' books (:func:`_lanes_init`), the renormalisation interval and the first due step."""
     ns = Y0.shape[1]
     IS = np.empty(ns)
     for q in range(ns):
         IS[q] = 1.0 / S[q]
-    ZT = np.zeros((2, ns, BLOCK))
+    ZT = np.zeros((k + 1, ns, BLOCK))
     Z0 = ZT[0].reshape(ns * BLOCK)
     Z1 = ZT[1].reshape(ns * BLOCK)
     PT = np.zeros((P.shape[1], BLOCK))
@@ -1280,9 +1149,9 @@ def _fused_block_start(first, nl, P, Y0, S, T0, H, NPER, OFF, n_transient, n_ste
     PH6 = np.zeros((6, BLOCK))
     PH = (PH6[0], PH6[1], PH6[2], PH6[3], PH6[4], PH6[5])
     ACT = np.zeros(BLOCK, np.bool_)
-    ACTR = np.zeros(3 * nl, np.bool_)  # (written by _lane_books; unused here)
+    ACTR = np.zeros((2 * k + 1) * nl, np.bool_)  # (written by _lane_books; unused here)
     FLAG = np.zeros(BLOCK)
-    IST, ENDS, BLK, ACC, Zl, Cl, logs, max_total = _lanes_init(first, nl, 1, Y0, NPER,
+    IST, ENDS, BLK, ACC, Zl, Cl, logs, max_total = _lanes_init(first, nl, k, Y0, NPER,
                                                                 n_transient, n_steps,
                                                                 renorm_every, n_blocks, out,
                                                                 err, used, status, ZT, ACT)
@@ -1300,15 +1169,15 @@ def _fused_block_start(first, nl, P, Y0, S, T0, H, NPER, OFF, n_transient, n_ste
 @nb.njit(inline="always", **_JIT)
 def _lyap_block_fused(form, first, nl, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
                       n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err, used,
-                      status, unres):
+                      status, unres, fd_steps):
     """:func:`_lyap_block` with k = 1 in the fused loop of lane form ``form`` (FORM_QUIET or
     FORM_LOAD, a constant: one form compiled per caller; nl <= BLOCK lanes): the same
     results, bitwise."""
     ns = Y0.shape[1]
     (IS, ZT, Z0, Z1, PT, T0L, HL, HHL, H6L, IDX, NPL, ENDL, PH, ACT, ACTR, FLAG, IST, ENDS, BLK,
      ACC, Zl, Cl, logs, max_total, renorm, due) = _fused_block_start(
-        first, nl, P, Y0, S, T0, H, NPER, OFF, n_transient, n_steps, renorm_every, n_blocks, out,
-        err, used, status)
+        first, nl, 1, P, Y0, S, T0, H, NPER, OFF, n_transient, n_steps, renorm_every, n_blocks,
+        out, err, used, status)
     EL = np.zeros(BLOCK)
     UNRR = np.zeros(3 * BLOCK, np.int64)
     R6 = np.zeros((6, ns * BLOCK))
@@ -1335,6 +1204,7 @@ def _lyap_block_fused(form, first, nl, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TA
         lane = first + l
         u = UNRR[l] + UNRR[BLOCK + l] + UNRR[2 * BLOCK + l]
         unres[lane] = u
+        fd_steps[lane] = IST[l, _LAST]  # the steps run (each by the difference rows)
         if u > 0 and status[lane] == STATUS_OK:
             status[lane] = STATUS_SPLIT_LIMIT
 
@@ -1343,26 +1213,28 @@ def _lyap_block_fused(form, first, nl, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TA
 
 @nb.njit(**_JIT)
 def _lyap_block_form1(first, nl, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF, n_transient,
-                      n_steps, renorm_every, bound, n_ev, n_blocks, out, err, used, status, unres):
+                      n_steps, renorm_every, bound, n_ev, n_blocks, out, err, used, status, unres,
+                      fd_steps):
     """:func:`_lyap_block_fused` in the lane form FORM_QUIET (k = 1)."""
     _lyap_block_fused(FORM_QUIET, first, nl, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
                       n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err, used,
-                      status, unres)
+                      status, unres, fd_steps)
 
 
 @nb.njit(**_JIT)
 def _lyap_block_form2(first, nl, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF, n_transient,
-                      n_steps, renorm_every, bound, n_ev, n_blocks, out, err, used, status, unres):
+                      n_steps, renorm_every, bound, n_ev, n_blocks, out, err, used, status, unres,
+                      fd_steps):
     """:func:`_lyap_block_fused` in the lane form FORM_LOAD (k = 1)."""
     _lyap_block_fused(FORM_LOAD, first, nl, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
                       n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err, used,
-                      status, unres)
+                      status, unres, fd_steps)
 
 
 @nb.njit(inline="always", **_JIT)
 def _lyap_block_local(form, lo, hi, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
                       n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err, used,
-                      status, unres):
+                      status, unres, fd_steps):
     """:func:`_lyap_block` (``form`` FORM_GENERAL), or the fused loop of lane form ``form``
     (a constant), for lanes lo..hi-1 on copies of their inputs and outputs, so that
     the block's thread touches no shared array while it steps (the reference counts of arrays
@@ -1373,19 +1245,20 @@ def _lyap_block_local(form, lo, hi, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TA
     u = np.zeros(n, np.int64)
     st = np.zeros(n, np.int64)
     un = np.zeros(n, np.int64)
+    fs = np.zeros(n, np.int64)
     Pb, Y0b, Sb, T0b = P[lo:hi].copy(), Y0[lo:hi].copy(), S.copy(), T0[lo:hi].copy()
     Hb, OMb, NPb, OFb = H[lo:hi].copy(), OMEGA[lo:hi].copy(), NPER[lo:hi].copy(), OFF[lo:hi].copy()
     STb, CTb = S_TAB.copy(), C_TAB.copy()
     NTb, NSb = n_transient[lo:hi].copy(), n_steps[lo:hi].copy()
     if form == FORM_QUIET:
         _lyap_block_form1(0, n, k, Pb, Y0b, Sb, T0b, Hb, OMb, NPb, STb, CTb, OFb, NTb, NSb,
-                          renorm_every, bound, n_ev, n_blocks, o, e, u, st, un)
+                          renorm_every, bound, n_ev, n_blocks, o, e, u, st, un, fs)
     elif form == FORM_LOAD:
         _lyap_block_form2(0, n, k, Pb, Y0b, Sb, T0b, Hb, OMb, NPb, STb, CTb, OFb, NTb, NSb,
-                          renorm_every, bound, n_ev, n_blocks, o, e, u, st, un)
+                          renorm_every, bound, n_ev, n_blocks, o, e, u, st, un, fs)
     else:
         _lyap_block(0, n, k, Pb, Y0b, Sb, T0b, Hb, OMb, NPb, STb, CTb, OFb, NTb, NSb,
-                    renorm_every, bound, n_ev, n_blocks, o, e, u, st, un)
+                    renorm_every, bound, n_ev, n_blocks, o, e, u, st, un, fs)
     for i in range(n):
         for j in range(k):
             out[lo + i, j] = o[i, j]
@@ -1393,19 +1266,22 @@ def _lyap_block_local(form, lo, hi, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TA
         used[lo + i] = u[i]
         status[lo + i] = st[i]
         unres[lo + i] = un[i]
+        fd_steps[lo + i] = fs[i]
 
 
 # ---------------------------------------------------------------------------------------------
-# The variational block (k = 1, a model with the tangent forms of its rhs: :data:`VARIATIONAL`):
+# The variational block (a model with the tangent forms of its rhs: :data:`VARIATIONAL`):
 # one loop over the block's lanes per grid step advances each lane's state and its tangent
 # vector together, the RK4 stages of the pair (y, w = S v) from the lane-scalar tangent form
 # ``rhs_lane_tangent`` (f and J w in one inlined call; :func:`_var_row_trial`), then screens the
 # state's trial as the fused loop does and commits the unflagged lanes. A flagged lane (its state
 # leaves a side of an edge or may graze one) is finished out of line, split with its tangent
-# through the sub-steps (:func:`_var_split_lane`, as :func:`_var_step` does it for one lane; the
+# through the sub-steps (:func:`_var_split_lane`, as one lane's variational step does it; the
 # difference rows where that is ill-posed). Each lane's arithmetic is
-# that of :func:`_var_step`, operation for operation: the exponents are bitwise those of
-# :func:`lyapunov_single` with ``variational``.
+# that of one lane's variational step, operation for operation: the exponents are bitwise those
+# of the lane stepped alone (the tests' reference). With k tangent vectors the loop's slots are
+# pairs of a lane and one of its tangent vectors, so that a grid step is one pass of the loop over
+# nl k slots (:func:`_lyap_var_run`).
 
 
 def _t_scale(v, S):
@@ -1446,14 +1322,15 @@ if VARIATIONAL:
                 _events_l(te, _t_axpy(y, hd, k1), PT, l, s2, c2))
 
     @nb.njit(inline="always", **_JIT)
-    def _var_fused_steps(form, i, nl, locate, Z0, Z1, S, IS, PT, T0L, HL, HHL, H6L, PH, ACT,
-                         FLAG, GR, Y1F):
-        """Grid step i of every lane of the block (see above): Z0, Z1 the state and the
-        tangent vector (flat rows of BLOCK lanes), committed where the lane is active and its
-        state's trial unflagged (``locate``: the edges screened; GR: the graze flags, a row of
-        BLOCK per switching function of the model); FLAG[l] = 1 where an active lane is flagged,
-        the state's trial into Y1F (as Z0) for :func:`_var_flagged`. Returns the number of
-        flagged lanes."""
+    def _var_fused_steps(form, i, nl, locate, commit, Z0, Z1, S, IS, PT, T0L, HL, HHL, H6L, PH,
+                         ACT, FLAG, GR, Y1F):
+        """Grid step i of every lane of the block (see above): Z0, Z1 the state and a tangent
+        vector (flat rows of BLOCK lanes), the tangent vector committed where the lane is
+        active and its state's trial unflagged, the state too where ``commit`` (the last
+        tangent vector of the step; ``locate``: the edges screened; GR: the graze flags, a row
+        of BLOCK per switching function of the model); FLAG[l] = 1 where an active lane is
+        flagged, the state's trial into Y1F (as Z0) for :func:`_var_flagged`. Returns the
+        number of flagged lanes."""
         P0, P1, P2, P3, P4, P5 = PH
         n_flag = 0
         for l in range(nl):
@@ -1473,7 +1350,7 @@ if VARIATIONAL:
             flagged = act & hit
             keep = act & (not hit)
             _t_store(Z1, l, _t_unscale(w1, IS), v, keep)
-            _t_store(Z0, l, y1, y, keep)
+            _t_store(Z0, l, y1, y, keep & commit)
             _t_store(Y1F, l, y1, y1, True)
             FLAG[l] = 1.0 if flagged else 0.0
             n_flag += 1 if flagged else 0
@@ -1481,25 +1358,25 @@ if VARIATIONAL:
 
 
 @nb.njit(_nrt=False, **_JIT)  # it allocates nothing: no reference counting of its views
-def _var_flagged(i, nl, first, n_ev, P, Z0, Z1, S, IS, T0L, HL, OMEGA, NPL, IDX, S_TAB, C_TAB,
+def _var_flagged(i, nl, first, n_ev, P, ZT, S, IS, T0L, HL, OMEGA, NPL, IDX, S_TAB, C_TAB,
                  FLAG, UNRR, FDL, GR, Y1F, fd):
-    """The flagged lanes of step i (:func:`_var_fused_steps`), each as :func:`_var_step`
-    takes such a step (:func:`_var_split_lane` from the lane's state and tangent vector; the
-    split-limit steps of the difference rows it may fall back to into UNRR[l], such a step
-    counted in FDL[l])."""
+    """The flagged lanes of step i (:func:`_var_fused_steps`: their states and tangent vectors
+    in ZT[:, :, l] still at the step's start), each split with its tangent vectors through the
+    sub-steps (:func:`_var_split_lane`; the split-limit steps of the difference rows it may
+    fall back to into UNRR[l], such a step counted in FDL[l])."""
     Zl, YP, E, K, TMP, Y1, SIDE, G0, G1, W, gbuf, NCR, UNRES, VX, VG = fd
-    ns = Zl.shape[1]
+    m, ns = Zl.shape
     for l in range(nl):
         if FLAG[l] == 0.0:
             continue
         lane = first + l
-        for q in range(ns):
-            Zl[0, q] = Z0[q * BLOCK + l]
-            Zl[1, q] = Z1[q * BLOCK + l]
+        for j in range(m):
+            for q in range(ns):
+                Zl[j, q] = ZT[j, q, l]
         off = IDX[l] - 2 * (i % NPL[l])  # the lane's phase table in S_TAB, C_TAB
         for r in range(UNRES.size):
             UNRES[r] = 0
-        # the screen of the fused loop's trial (as :func:`_var_step` screens it)
+        # the screen of the fused loop's trial (as one lane's variational step screens it)
         p = P[lane]
         h = HL[l]
         t = T0L[l] + i * h
@@ -1514,20 +1391,103 @@ def _var_flagged(i, nl, first, n_ev, P, Z0, Z1, S, IS, T0L, HL, OMEGA, NPL, IDX,
         fd_l = _var_split_lane(i, T0L[l], Zl, S, IS, P[lane], HL[l], OMEGA[lane], NPL[l],
                                S_TAB[off:], C_TAB[off:], n_ev, YP, E, K, TMP, Y1, SIDE, G0, G1,
                                W, gbuf, NCR, UNRES, VX, VG)
-        for q in range(ns):
-            Z0[q * BLOCK + l] = Zl[0, q]
-            Z1[q * BLOCK + l] = Zl[1, q]
+        for j in range(m):
+            for q in range(ns):
+                ZT[j, q, l] = Zl[j, q]
         UNRR[l] += UNRES.sum()
         FDL[l] += fd_l
+
+
+@nb.njit(_nrt=False, **_JIT)  # it allocates nothing
+def _var_load(ZT, Z1, nl, j_lo, kk):
+    """Tangent vectors j_lo + 1 .. j_lo + kk of the block's lanes into the fused loop's slots:
+    vector j_lo + 1 + jj of lane l (ZT[j_lo + 1 + jj, :, l]) at slot s = jj nl + l of the
+    tangent row Z1, and the lane's state (ZT[0, :, l]) copied to slot s of the state row ZT[0]
+    (slots 0..nl-1 are the lanes' own)."""
+    ns = ZT.shape[1]
+    for jj in range(kk):
+        for q in range(ns):
+            for l in range(nl):
+                s = jj * nl + l
+                Z1[q * BLOCK + s] = ZT[j_lo + 1 + jj, q, l]
+                ZT[0, q, s] = ZT[0, q, l]
+
+
+@nb.njit(_nrt=False, **_JIT)  # it allocates nothing
+def _var_store(ZT, Z1, nl, j_lo, kk):
+    """The fused loop's slots back into tangent vectors j_lo + 1 .. j_lo + kk of the block's
+    lanes (:func:`_var_load`)."""
+    ns = ZT.shape[1]
+    for jj in range(kk):
+        for q in range(ns):
+            for l in range(nl):
+                ZT[j_lo + 1 + jj, q, l] = Z1[q * BLOCK + jj * nl + l]
 
 
 @nb.njit(inline="always", **_JIT)
 def _lyap_var_run(form, first, nl, n_ev, max_total, due, renorm, bound, P, OMEGA, H, S, IS, PT,
                   lanes, books, out, err, used, status, scratch, fd):
     """The time loop of a variational block (see above): every grid step of the block's lanes,
-    their flagged lanes out of line, their bookkeeping where due (:func:`_lane_books`)."""
+    their flagged lanes out of line, their bookkeeping where due (:func:`_lane_books`). With k
+    tangent vectors (ZT[1..k]) the fused loop's slots are pairs of a lane and one of its
+    tangent vectors (slot jj nl + l: lane l with tangent vector j_lo + 1 + jj, its state
+    copied there, :func:`_var_load`), kp = min(k, BLOCK // nl) vectors per pass, so that a
+    lane's k vectors advance together in one pass (more passes only where nl k > BLOCK; the
+    last commits the states): each slot computes its lane's state trial, the same operations,
+    as one lane's RK4 step of the state and one tangent vector does. The slots' columns (PT,
+    clocks, phases, ACT) are their lanes' (:func:`_lyap_block_var`)."""
     (Z0, Z1, ZT, T0L, HL, HHL, H6L, IDX, NPL, ENDL, PH, ACT, ACTR, FLAG, GR, UNRR, FDL,
-     Y1F) = lanes
+     Y1F, ZX) = lanes
+    k = ZT.shape[0] - 1
+    kp = min(k, BLOCK // nl)
+    n_pass = (k + kp - 1) // kp
+    n_slot = nl * kp
+    nv = _padded(n_slot)  # (a last pass of fewer vectors runs the others' slots idly again)
+    IST, ENDS, BLK, ACC, Zl, Cl, logs = books
+    S_TAB, C_TAB = scratch
+    locate = n_ev > 0
+    for i in range(max_total):
+        live = False
+        for l in range(nl):
+            live = live | ACT[l]
+        if not live:
+            break
+        for l in range(n_slot):
+            j = IDX[l]
+            for d in range(3):
+                PH[2 * d][l] = S_TAB[j + d]
+                PH[2 * d + 1][l] = C_TAB[j + d]
+        n_flag = 0
+        for g in range(n_pass):  # one call site of the fused loop
+            j_lo = g * kp
+            kk = min(kp, k - j_lo)
+            if k > 1:
+                _var_load(ZT, ZX, nl, j_lo, kk)
+            n_flag = _var_fused_steps(form, i, nv, locate, g == n_pass - 1, Z0, ZX, S, IS, PT,
+                                      T0L, HL, HHL, H6L, PH, ACT, FLAG, GR, Y1F)
+            if k > 1:
+                _var_store(ZT, ZX, nl, j_lo, kk)
+        if n_flag > 0:
+            _var_flagged(i, nl, first, n_ev, P, ZT, S, IS, T0L, HL, OMEGA, NPL, IDX, S_TAB,
+                         C_TAB, FLAG, UNRR, FDL, GR, Y1F, fd)
+        for l in range(n_slot):
+            IDX[l] = IDX[l] + 2 if IDX[l] + 2 < ENDL[l] else IDX[l] + 2 - 2 * NPL[l]
+        step = i + 1
+        if step >= due:
+            due = _lane_books_core(step, first, nl, k, renorm, bound, ZT, Zl, Cl, logs, IST,
+                                   ENDS, BLK, ACC, ACT, ACTR, status)
+            for s in range(nl, n_slot):
+                ACT[s] = ACT[s % nl]
+
+
+@nb.njit(inline="always", **_JIT)
+def _lyap_var_run1(form, first, nl, n_ev, max_total, due, renorm, bound, P, OMEGA, H, S, IS, PT,
+                   lanes, books, out, err, used, status, scratch, fd):
+    """:func:`_lyap_var_run` with one tangent vector (k = 1): the lanes are the fused loop's
+    slots, their tangent row ZT[1] itself, one call of the fused loop per grid step, the state
+    committed with it (no passes, no slots of other tangent vectors)."""
+    (Z0, Z1, ZT, T0L, HL, HHL, H6L, IDX, NPL, ENDL, PH, ACT, ACTR, FLAG, GR, UNRR, FDL,
+     Y1F, ZX) = lanes
     IST, ENDS, BLK, ACC, Zl, Cl, logs = books
     S_TAB, C_TAB = scratch
     nv = _padded(nl)
@@ -1543,10 +1503,10 @@ def _lyap_var_run(form, first, nl, n_ev, max_total, due, renorm, bound, P, OMEGA
             for d in range(3):
                 PH[2 * d][l] = S_TAB[j + d]
                 PH[2 * d + 1][l] = C_TAB[j + d]
-        n_flag = _var_fused_steps(form, i, nv, locate, Z0, Z1, S, IS, PT, T0L, HL, HHL, H6L,
-                                  PH, ACT, FLAG, GR, Y1F)
+        n_flag = _var_fused_steps(form, i, nv, locate, True, Z0, Z1, S, IS, PT, T0L, HL, HHL,
+                                  H6L, PH, ACT, FLAG, GR, Y1F)
         if n_flag > 0:
-            _var_flagged(i, nl, first, n_ev, P, Z0, Z1, S, IS, T0L, HL, OMEGA, NPL, IDX, S_TAB,
+            _var_flagged(i, nl, first, n_ev, P, ZT, S, IS, T0L, HL, OMEGA, NPL, IDX, S_TAB,
                          C_TAB, FLAG, UNRR, FDL, GR, Y1F, fd)
         for l in range(nl):
             IDX[l] = IDX[l] + 2 if IDX[l] + 2 < ENDL[l] else IDX[l] + 2 - 2 * NPL[l]
@@ -1554,6 +1514,30 @@ def _lyap_var_run(form, first, nl, n_ev, max_total, due, renorm, bound, P, OMEGA
         if step >= due:
             due = _lane_books_core(step, first, nl, 1, renorm, bound, ZT, Zl, Cl, logs, IST,
                                    ENDS, BLK, ACC, ACT, ACTR, status)
+
+
+@nb.njit(_nrt=False, **_JIT_NOALIAS)
+def _lyap_var1_form0(first, nl, n_ev, max_total, due, renorm, bound, P, OMEGA, H, S, IS, PT,
+                     lanes, books, out, err, used, status, scratch, fd):
+    """:func:`_lyap_var_run1` in the lane form FORM_GENERAL (a block of mixed forms)."""
+    _lyap_var_run1(FORM_GENERAL, first, nl, n_ev, max_total, due, renorm, bound, P, OMEGA, H,
+                   S, IS, PT, lanes, books, out, err, used, status, scratch, fd)
+
+
+@nb.njit(_nrt=False, **_JIT_NOALIAS)
+def _lyap_var1_form1(first, nl, n_ev, max_total, due, renorm, bound, P, OMEGA, H, S, IS, PT,
+                     lanes, books, out, err, used, status, scratch, fd):
+    """:func:`_lyap_var_run1` in the lane form FORM_QUIET."""
+    _lyap_var_run1(FORM_QUIET, first, nl, n_ev, max_total, due, renorm, bound, P, OMEGA, H,
+                   S, IS, PT, lanes, books, out, err, used, status, scratch, fd)
+
+
+@nb.njit(_nrt=False, **_JIT_NOALIAS)
+def _lyap_var1_form2(first, nl, n_ev, max_total, due, renorm, bound, P, OMEGA, H, S, IS, PT,
+                     lanes, books, out, err, used, status, scratch, fd):
+    """:func:`_lyap_var_run1` in the lane form FORM_LOAD."""
+    _lyap_var_run1(FORM_LOAD, first, nl, n_ev, max_total, due, renorm, bound, P, OMEGA, H,
+                   S, IS, PT, lanes, books, out, err, used, status, scratch, fd)
 
 
 @nb.njit(_nrt=False, **_JIT_NOALIAS)
@@ -1588,36 +1572,54 @@ def _n_switching(Z0, PT):
 
 
 @nb.njit(inline="always", **_JIT)
-def _lyap_block_var(form, first, nl, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
+def _lyap_block_var(form, one, first, nl, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
                     n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err, used,
                     status, unres, fd_steps):
-    """:func:`_lyap_block` with k = 1 by the variational block of lane form ``form`` (nl <=
-    BLOCK lanes): per lane what :func:`_run` with ``variational`` computes, bitwise; the
-    lanes' steps by the difference rows (split steps where carrying the tangent through the
-    sub-steps is ill-posed) into fd_steps[lane]."""
+    """:func:`_lyap_block` (k tangent vectors) by the variational block of lane form ``form``
+    (nl <= BLOCK lanes; ``one``: k = 1, a constant of each worker, so that a worker compiles
+    the k = 1 time loop or the spectrum's, not both): per lane the exponents of the
+    variational RK4 (tangent vectors through the split sub-steps); the lanes' steps by the
+    difference rows (split steps where carrying the tangent through the sub-steps is
+    ill-posed) into fd_steps[lane]."""
     ns = Y0.shape[1]
     (IS, ZT, Z0, Z1, PT, T0L, HL, HHL, H6L, IDX, NPL, ENDL, PH, ACT, ACTR, FLAG, IST, ENDS, BLK,
      ACC, Zl, Cl, logs, max_total, renorm, due) = _fused_block_start(
-        first, nl, P, Y0, S, T0, H, NPER, OFF, n_transient, n_steps, renorm_every, n_blocks, out,
-        err, used, status)
+        first, nl, k, P, Y0, S, T0, H, NPER, OFF, n_transient, n_steps, renorm_every, n_blocks,
+        out, err, used, status)
+    m, nr = k + 1, 2 * k + 1
     ne = max(n_ev, 1)
     UNRR = np.zeros(BLOCK, np.int64)
     FDL = np.zeros(BLOCK, np.int64)
     # the graze flags of every switching function of the model (screened even where n_ev = 0,
     # then ignored: no branch in the lane loop)
     GR = np.zeros(max(_n_switching(Z0, PT), 1) * BLOCK)
-    fd = (np.zeros((2, ns)), np.zeros((3, ns)), np.zeros(2), np.zeros((4, 3, ns)),
-          np.zeros((3, ns)), np.zeros((3, ns)), np.ones((3, ne), np.int64), np.zeros((3, ne)),
-          np.zeros((3, ne)), np.zeros((9, ns)), np.zeros((GBUF_ROWS, ne)),
-          np.zeros((3, ne), np.int64), np.zeros(3, np.int64), np.zeros((16, ns)),
+    # one lane's scratch (:func:`_var_flagged`): its state and tangent vectors, the 2 k + 1
+    # difference rows (:func:`_tangent_step`), the split's VX and VG (:func:`_var_split`)
+    fd = (np.zeros((m, ns)), np.zeros((nr, ns)), np.zeros(m), np.zeros((4, nr, ns)),
+          np.zeros((nr, ns)), np.zeros((nr, ns)), np.ones((nr, ne), np.int64),
+          np.zeros((nr, ne)), np.zeros((nr, ne)), np.zeros((9, ns)), np.zeros((GBUF_ROWS, ne)),
+          np.zeros((nr, ne), np.int64), np.zeros(nr, np.int64), np.zeros((9 + 7 * k, ns)),
           np.zeros((3, ne)))
-    Y1F = np.zeros(ns * BLOCK)  # the states' trials (flat rows of BLOCK lanes, as Z0)
+    Y1F = np.zeros(ns * BLOCK)  # the states' trials (flat rows of BLOCK slots, as Z0)
+    # the slots' tangent row: ZT[1] itself where k = 1, else its own (:func:`_var_load`)
+    ZX = Z1 if k == 1 else np.zeros(ns * BLOCK)
+    for s in range(nl, nl * min(k, BLOCK // nl)):  # the slots of tangent vectors 2..: lane s % nl
+        _set_column(s, first + s % nl, P, T0, H, NPER, OFF, PT, T0L, HL, HHL, H6L, NPL, IDX,
+                    ENDL)
+        ACT[s] = ACT[s % nl]
     lanes = (Z0, Z1, ZT, T0L, HL, HHL, H6L, IDX, NPL, ENDL, PH, ACT, ACTR, FLAG, GR, UNRR, FDL,
-             Y1F)
+             Y1F, ZX)
     books = (IST, ENDS, BLK, ACC, Zl, Cl, logs)
     args = (first, nl, n_ev, max_total, due, renorm, bound, P, OMEGA, H, S, IS, PT, lanes, books,
             out, err, used, status, (S_TAB, C_TAB), fd)
-    if form == FORM_QUIET:
+    if one:  # the k = 1 time loop: one fused-loop call per step, no passes
+        if form == FORM_QUIET:
+            _lyap_var1_form1(*args)
+        elif form == FORM_LOAD:
+            _lyap_var1_form2(*args)
+        else:
+            _lyap_var1_form0(*args)
+    elif form == FORM_QUIET:
         _lyap_var_form1(*args)
     elif form == FORM_LOAD:
         _lyap_var_form2(*args)
@@ -1626,7 +1628,7 @@ def _lyap_block_var(form, first, nl, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB,
     for l in range(nl):
         lane = first + l
         if status[lane] != STATUS_DIVERGED:
-            _lane_result(l, lane, 1, IST[l, _NST], H[lane], ENDS, IST[l, _NBK], BLK, ACC, out,
+            _lane_result(l, lane, k, IST[l, _NST], H[lane], ENDS, IST[l, _NBK], BLK, ACC, out,
                          err, used)
         unres[lane] = UNRR[l]
         fd_steps[lane] = FDL[l]
@@ -1635,31 +1637,32 @@ def _lyap_block_var(form, first, nl, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB,
 
 
 @nb.njit(inline="always", **_JIT)
-def _lyap_var_worker(b, n_blk, form, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
+def _lyap_var_worker(b, n_blk, k, form, one, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
                      n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err, used,
                      status, unres, fd_steps):
     """Block b of n_blk of :func:`lyapunov_block_lanes` with ``variational`` (lanes lo..hi-1,
     :func:`_block_lanes`), on copies of its inputs and outputs (as :func:`_lyap_block_local`);
-    ``form``: the lane form of the block (:func:`_block_form`), a constant of each worker
-    below, so that a worker compiles its form's fused loop alone."""
+    ``form``: the lane form of the block (:func:`_block_form`), ``one``: k = 1, constants of
+    each worker below, so that a worker compiles its form's fused loop and time loop alone."""
     lo, hi = _block_lanes(b, n_blk, Y0.shape[0])
     n = hi - lo
     if n <= 0:
         return
-    o = np.full((n, 1), np.nan)
-    e = np.full((n, 1), np.nan)
+    o = np.full((n, k), np.nan)
+    e = np.full((n, k), np.nan)
     u = np.zeros(n, np.int64)
     st = np.zeros(n, np.int64)
     un = np.zeros(n, np.int64)
     fs = np.zeros(n, np.int64)
-    _lyap_block_var(form, 0, n, P[lo:hi].copy(), Y0[lo:hi].copy(), S.copy(), T0[lo:hi].copy(),
-                    H[lo:hi].copy(), OMEGA[lo:hi].copy(), NPER[lo:hi].copy(), S_TAB.copy(),
-                    C_TAB.copy(), OFF[lo:hi].copy(), n_transient[lo:hi].copy(),
+    _lyap_block_var(form, one, 0, n, k, P[lo:hi].copy(), Y0[lo:hi].copy(), S.copy(),
+                    T0[lo:hi].copy(), H[lo:hi].copy(), OMEGA[lo:hi].copy(), NPER[lo:hi].copy(),
+                    S_TAB.copy(), C_TAB.copy(), OFF[lo:hi].copy(), n_transient[lo:hi].copy(),
                     n_steps[lo:hi].copy(), renorm_every, bound, n_ev, n_blocks, o, e, u, st, un,
                     fs)
     for i in range(n):
-        out[lo + i, 0] = o[i, 0]
-        err[lo + i, 0] = e[i, 0]
+        for j in range(k):
+            out[lo + i, j] = o[i, j]
+            err[lo + i, j] = e[i, j]
         used[lo + i] = u[i]
         status[lo + i] = st[i]
         unres[lo + i] = un[i]
@@ -1667,39 +1670,72 @@ def _lyap_var_worker(b, n_blk, form, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB,
 
 
 @nb.njit(nogil=True, **_JIT)
-def _lyap_var_worker_form0(b, n_blk, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
+def _lyap_var_worker_form0(b, n_blk, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
                            n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err,
                            used, status, unres, fd_steps):
-    """:func:`_lyap_var_worker` in the lane form FORM_GENERAL."""
-    _lyap_var_worker(b, n_blk, FORM_GENERAL, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
-                     n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err, used,
-                     status, unres, fd_steps)
+    """:func:`_lyap_var_worker` with k = 1 in the lane form FORM_GENERAL."""
+    _lyap_var_worker(b, n_blk, k, FORM_GENERAL, True, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB,
+                     OFF, n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err,
+                     used, status, unres, fd_steps)
 
 
 @nb.njit(nogil=True, **_JIT)
-def _lyap_var_worker_form1(b, n_blk, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
+def _lyap_var_worker_form1(b, n_blk, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
                            n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err,
                            used, status, unres, fd_steps):
-    """:func:`_lyap_var_worker` in the lane form FORM_QUIET."""
-    _lyap_var_worker(b, n_blk, FORM_QUIET, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
-                     n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err, used,
-                     status, unres, fd_steps)
+    """:func:`_lyap_var_worker` with k = 1 in the lane form FORM_QUIET."""
+    _lyap_var_worker(b, n_blk, k, FORM_QUIET, True, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB,
+                     OFF, n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err,
+                     used, status, unres, fd_steps)
 
 
 @nb.njit(nogil=True, **_JIT)
-def _lyap_var_worker_form2(b, n_blk, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
+def _lyap_var_worker_form2(b, n_blk, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
                            n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err,
                            used, status, unres, fd_steps):
-    """:func:`_lyap_var_worker` in the lane form FORM_LOAD."""
-    _lyap_var_worker(b, n_blk, FORM_LOAD, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
-                     n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err, used,
-                     status, unres, fd_steps)
+    """:func:`_lyap_var_worker` with k = 1 in the lane form FORM_LOAD."""
+    _lyap_var_worker(b, n_blk, k, FORM_LOAD, True, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB,
+                     OFF, n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err,
+                     used, status, unres, fd_steps)
+
+
+@nb.njit(nogil=True, **_JIT)
+def _lyap_spec_worker_form0(b, n_blk, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
+                           n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err,
+                           used, status, unres, fd_steps):
+    """:func:`_lyap_var_worker` with k > 1 tangent vectors in the lane form FORM_GENERAL."""
+    _lyap_var_worker(b, n_blk, k, FORM_GENERAL, False, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB,
+                     OFF, n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err,
+                     used, status, unres, fd_steps)
+
+
+@nb.njit(nogil=True, **_JIT)
+def _lyap_spec_worker_form1(b, n_blk, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
+                           n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err,
+                           used, status, unres, fd_steps):
+    """:func:`_lyap_var_worker` with k > 1 tangent vectors in the lane form FORM_QUIET."""
+    _lyap_var_worker(b, n_blk, k, FORM_QUIET, False, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB,
+                     OFF, n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err,
+                     used, status, unres, fd_steps)
+
+
+@nb.njit(nogil=True, **_JIT)
+def _lyap_spec_worker_form2(b, n_blk, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
+                           n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err,
+                           used, status, unres, fd_steps):
+    """:func:`_lyap_var_worker` with k > 1 tangent vectors in the lane form FORM_LOAD."""
+    _lyap_var_worker(b, n_blk, k, FORM_LOAD, False, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB,
+                     OFF, n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err,
+                     used, status, unres, fd_steps)
 
 
 #: The variational block workers by the lane form of their block, each compiled on its first
 #: call.
 _VAR_WORKERS = {FORM_GENERAL: _lyap_var_worker_form0, FORM_QUIET: _lyap_var_worker_form1,
                 FORM_LOAD: _lyap_var_worker_form2}
+#: The same for k > 1 tangent vectors (a spectrum).
+_SPEC_WORKERS = {FORM_GENERAL: _lyap_spec_worker_form0, FORM_QUIET: _lyap_spec_worker_form1,
+                 FORM_LOAD: _lyap_spec_worker_form2}
 
 
 @nb.njit(**_JIT)
@@ -1721,16 +1757,17 @@ def lyapunov_block_lanes(P, Y0, scale, T0, H, OMEGA, NPER, n_transient, n_steps,
     rows (2 k + 1 per lane, at least one lane), consecutive lanes in a block, blocks in
     parallel (threads, :func:`geardyn.solvers._parallel.run_workers`). Other arguments as in
     :func:`lyapunov_lanes`; fills out[L, k], err[L, k] (NaN where diverged), used[L] (blocks
-    of the standard error), status[L] and unres[L] (steps at the split limit; see
-    :func:`_run`). Each lane's result is bitwise that of :func:`lyapunov_single` with the same
-    arguments, whatever the lanes beside it, ``block_rows`` and ``min_blocks`` (see
-    :func:`_block_count`). ``variational`` (k = 1, a model with :data:`VARIATIONAL`): the
-    tangent vectors by the variational block (bitwise :func:`lyapunov_single` with
-    ``variational``), the steps each lane took by the difference rows into ``fd_steps[L]``
-    where given."""
-    if variational and not (VARIATIONAL and k == 1):
-        raise ValueError("the variational tangent needs k = 1 and a model with the tangent "
-                         "forms of its rhs (a one-form model)")
+    of the standard error), status[L] (STATUS_OK, STATUS_DIVERGED, or STATUS_SPLIT_LIMIT where
+    a step of any of the lane's rows reached the split limit, the exponents kept) and unres[L]
+    (such steps). Each lane's result is bitwise that of the lane stepped alone, whatever the
+    lanes beside it, ``block_rows`` and ``min_blocks`` (see :func:`_block_count`).
+    ``variational`` (a model with :data:`VARIATIONAL`): the tangent vectors by the variational
+    block. ``fd_steps[L]``, where given: the grid steps each lane took by the difference rows
+    (every step it ran, or with ``variational`` the split steps where carrying the tangent
+    through the sub-steps is ill-posed)."""
+    if variational and not VARIATIONAL:
+        raise ValueError("the variational tangent needs a model with the tangent forms of its "
+                         "rhs (a one-form model)")
     # writable contiguous copies and int64 casts: a read-only array or another integer type
     # would compile the block kernel once more for each such caller
     i64 = np.int64
@@ -1741,19 +1778,20 @@ def lyapunov_block_lanes(P, Y0, scale, T0, H, OMEGA, NPER, n_transient, n_steps,
     args = (i64(n_blk), i64(k), P_w, Y0_w, scale_w, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
             n_transient, n_steps, renorm_every, bound, i64(n_ev), i64(n_blocks), out, err, used,
             status, unres)
+    fds = np.zeros(P_w.shape[0], np.int64) if fd_steps is None else fd_steps
     if variational:
-        fds = np.zeros(P_w.shape[0], np.int64) if fd_steps is None else fd_steps
         forms = _var_block_forms(P_w, i64(n_blk))
+        workers = _VAR_WORKERS if k == 1 else _SPEC_WORKERS
 
-        def var_block(b, n_blk, k, *rest):
-            _VAR_WORKERS[int(forms[b])](b, n_blk, *rest, fds)
+        def var_block(b, *rest):
+            workers[int(forms[b])](b, *rest, fds)
 
         run_workers(var_block, int(n_blk), args)
         return
     paths = _block_paths(P_w, n_blk, i64(k), i64(n_ev))
 
     def block(b, *args):
-        _BLOCK_WORKERS[int(paths[b])](b, *args)
+        _BLOCK_WORKERS[int(paths[b])](b, *args, fds)
 
     run_workers(block, int(n_blk), args)
 
@@ -1785,36 +1823,36 @@ def _block_paths(P, n_blk, k, n_ev):
 @nb.njit(nogil=True, **_JIT)
 def _lyap_block_worker(b, n_blk, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF, n_transient,
                        n_steps, renorm_every, bound, n_ev, n_blocks, out, err, used, status,
-                       unres):
+                       unres, fd_steps):
     """Block b of n_blk of :func:`lyapunov_block_lanes` (:func:`_block_lanes`) through the row
     block (:func:`_lyap_block_local`)."""
     lo, hi = _block_lanes(b, n_blk, Y0.shape[0])
     if hi > lo:
         _lyap_block_local(FORM_GENERAL, lo, hi, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB,
                           OFF, n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out,
-                          err, used, status, unres)
+                          err, used, status, unres, fd_steps)
 
 
 @nb.njit(nogil=True, **_JIT)
 def _lyap_block_worker_form1(b, n_blk, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
                              n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err,
-                             used, status, unres):
+                             used, status, unres, fd_steps):
     """:func:`_lyap_block_worker` through the fused loop in the lane form FORM_QUIET."""
     lo, hi = _block_lanes(b, n_blk, Y0.shape[0])
     _lyap_block_local(FORM_QUIET, lo, hi, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
                       n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err, used,
-                      status, unres)
+                      status, unres, fd_steps)
 
 
 @nb.njit(nogil=True, **_JIT)
 def _lyap_block_worker_form2(b, n_blk, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
                              n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err,
-                             used, status, unres):
+                             used, status, unres, fd_steps):
     """:func:`_lyap_block_worker` through the fused loop in the lane form FORM_LOAD."""
     lo, hi = _block_lanes(b, n_blk, Y0.shape[0])
     _lyap_block_local(FORM_LOAD, lo, hi, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
                       n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err, used,
-                      status, unres)
+                      status, unres, fd_steps)
 
 
 #: The Lyapunov block workers by path (:func:`_block_paths`), each compiled on its first call.
@@ -1827,18 +1865,17 @@ def lyapunov_lanes(P, Y0, scale, T0, H, OMEGA, n_per, n_transient, n_steps, reno
                    variational=False, fd_steps=None):
     """Largest exponent of every lane (row of P, Y0), the lanes in blocks in parallel
     (:func:`lyapunov_block_lanes` with k = 1, lanes ordered by their step count so that a
-    block's lanes end together; bitwise each lane's :func:`lyapunov_single`, as the tests'
-    one-lane-at-a-time reference, ``tests/_lyapunov_rows.py``, shows).
+    block's lanes end together; bitwise each lane stepped alone, as the tests' one-lane
+    reference, ``tests/_lyapunov_rows.py``, shows).
 
-    scale: the state scale (one vector for all lanes, as in :func:`lyapunov_single`); T0: start
-    time (forcing phase zero there, as in :func:`lyapunov_single`) per lane; H, OMEGA:
-    step and forcing frequency per lane; n_per: steps per period, one for all lanes or one per
-    lane; n_transient, n_steps: per-lane step counts (int arrays); n_ev and n_blocks as in
-    :func:`lyapunov_single`. Fills out[L] and err[L] (the standard error; NaN for diverged
-    lanes) and, where given, unresolved[L] (steps at the split limit) and status[L] (see
-    :func:`_run`). ``variational``: the tangent vectors by the variational block (see
-    :func:`lyapunov_block_lanes`; bitwise :func:`lyapunov_single` with ``variational``), the
-    steps each lane took by the difference rows into ``fd_steps[L]`` where given.
+    scale: the state scale (one vector for all lanes); T0: start time (forcing phase zero
+    there) per lane; H, OMEGA: step and forcing frequency per lane; n_per: steps per period,
+    one for all lanes or one per lane; n_transient, n_steps: per-lane step counts (int arrays);
+    n_ev: the model's number of switching functions located inside a step (0: none); n_blocks:
+    the blocks of the measuring window for the standard error. Fills out[L] and err[L] (the
+    standard error; NaN for diverged lanes) and, where given, unresolved[L], status[L] and
+    fd_steps[L] (see :func:`lyapunov_block_lanes`). ``variational``: the tangent vectors by
+    the variational block.
     """
     L = Y0.shape[0]
     nper = np.ascontiguousarray(np.broadcast_to(np.asarray(n_per, np.int64), (L,)))
