@@ -17,9 +17,6 @@ from __future__ import annotations
 import hashlib
 import importlib
 import importlib.util
-import os
-import sys
-import tempfile
 import types
 from pathlib import Path
 
@@ -217,19 +214,8 @@ def reference_for(kern: types.ModuleType) -> types.ModuleType:
         h = hashlib.sha256(text.encode() + nb.__version__.encode())
         for shared in kernels.SHARED_MODULES:  # numba's cache checks only the module's own file
             h.update(Path(importlib.import_module(shared).__file__).read_bytes())
-        name = f"geardyn_lyapref_{h.hexdigest()[:20]}"
-        folder = kernels.cache_dir()
-        folder.mkdir(parents=True, exist_ok=True)
-        path = folder / f"{name}.py"
-        if not path.exists():
-            fd, tmp = tempfile.mkstemp(dir=folder, suffix=".tmp")
-            with os.fdopen(fd, "w") as fh:
-                fh.write(text)
-            os.replace(tmp, path)  # atomic: concurrent test workers never see half a file
-        spec = importlib.util.spec_from_file_location(name, path)
-        module = importlib.util.module_from_spec(spec)
-        sys.modules[name] = module
-        spec.loader.exec_module(module)
+        # written atomically to the kernel cache folder and imported, as the kernels are
+        module = kernels.load_generated(f"geardyn_lyapref_{h.hexdigest()[:20]}", text)
     else:
         module = types.ModuleType(f"{kern.__name__}_lyapref")
         exec(compile(text, module.__name__, "exec"), module.__dict__)
