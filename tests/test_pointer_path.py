@@ -1,4 +1,4 @@
-"""The pointer kernel path (``UserModel.from_one_form(..., kernel_path="pointer")``): the
+"""The pointer kernel path (``UserModel.from_one_form``'s default, ``kernel_path="pointer"``): the
 trajectory and sweep kernels and the variational Lyapunov lane blocks compiled once for every
 model, the model's functions compiled alone and called through their addresses. Its results are
 those of the inlined path bit for bit (the gear pair against ``GearPair`` and against the same
@@ -52,7 +52,7 @@ def _duffing(kernel_path: str = "lane-form") -> geardyn.UserModel:
 
 
 def test_the_pointer_path_equals_gear_pair_and_the_inlined_one_form_bitwise():
-    pair, inlined = geardyn.GearPair(**COEFFS), gear_pair(**COEFFS)
+    pair, inlined = geardyn.GearPair(**COEFFS), gear_pair(**COEFFS, kernel_path="lane-form")
     pointer = gear_pair(**COEFFS, kernel_path="pointer")
     assert pointer.kernel.kernel_path == "pointer" in KERNEL_PATHS
     run = geardyn.RunSettings(transient=300.0, samples=6, steps_per_period=64)
@@ -86,7 +86,7 @@ def test_the_pointer_path_agrees_with_dop853():
     run = geardyn.RunSettings(transient=0.0, samples=4, steps_per_period=512)
     for om in (0.8, 1.7):
         pointer = gear_pair(**coeffs, Omega=om, kernel_path="pointer")
-        twin = gear_pair(**coeffs, Omega=om)
+        twin = gear_pair(**coeffs, Omega=om, kernel_path="lane-form")
         T = 2.0 * math.pi / om
         ref = geardyn.reference_solution(twin, twin.initial_state(), T * np.arange(1, 5))
         ds = geardyn.simulate(pointer, run=run)
@@ -113,6 +113,19 @@ def test_models_of_other_sizes_run_on_the_same_compiled_kernels():
     ref = run_lanes(inlined, inlined.lane_params("Omega", om), inlined.initial_state(), run=run)
     for name in LaneResults.__dataclass_fields__:
         np.testing.assert_array_equal(getattr(r, name), getattr(ref, name), err_msg=name)
+
+
+def test_the_pointer_path_is_the_one_forms_default_and_lane_form_the_opt_out():
+    """``from_one_form`` without ``kernel_path`` takes the pointer path; ``"lane-form"``
+    inlines the model's functions in every kernel; a sweep records which ran."""
+    default = geardyn.UserModel.from_one_form(
+        duffing_one, params={"delta": 0.3, "gamma": 0.1, "Omega": 1.2}, states=("x", "v"))
+    assert default.kernel.kernel_path == "pointer"
+    assert _duffing().kernel.kernel_path == "lane-form"
+    run = geardyn.RunSettings(transient=0.0, samples=2, steps_per_period=64)
+    for m, path in ((default, "pointer"), (_duffing(), "lane-form")):
+        ds = geardyn.bifurcation(m, "Omega", [1.1, 1.3], run=run)
+        assert ds.attrs["kernel_path"] == path
 
 
 def test_the_kernel_path_is_checked_naming_the_field():
@@ -142,7 +155,8 @@ def test_the_pointer_lyapunov_lane_blocks_equal_the_inlined_one_form_bitwise():
     on the pointer path (the shared lane blocks calling the model's variational step and flagged
     lanes through their addresses): bitwise those of the same one form inlined, the variational
     tangent, impacting lanes among them."""
-    inlined, pointer = gear_pair(**COEFFS), gear_pair(**COEFFS, kernel_path="pointer")
+    inlined = gear_pair(**COEFFS, kernel_path="lane-form")
+    pointer = gear_pair(**COEFFS, kernel_path="pointer")
     kern = kernels_for(pointer.kernel, "lyapunov")
     assert isinstance(kern, PointerLyapunov)
     got, ref = _exponents(pointer), _exponents(inlined)
