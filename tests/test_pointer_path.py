@@ -179,6 +179,56 @@ def test_the_pointer_lyapunov_lane_blocks_equal_the_inlined_one_form_bitwise():
         np.testing.assert_array_equal(a[name].values, b[name].values, err_msg=name)
 
 
+def _spectra(m: geardyn.Model, block_rows: int) -> tuple[np.ndarray, ...]:
+    """Both exponents (k = 2) of 40 lanes (:data:`LANES` five times) of the variational lane
+    blocks of ``m`` (``lyapunov_block_lanes``, as ``geardyn.lyapunov(..., spectrum=True)``
+    calls them for one lane), blocks of ``block_rows`` rows (2 k + 1 a lane)."""
+    kern = kernels_for(m.kernel, "lyapunov")
+    P = np.tile(_rows(m), (5, 1))
+    L, k, n_per = P.shape[0], 2, 64
+    omega = np.ascontiguousarray(P[:, m.omega_index])
+    n_tr = np.round(LYAP_RUN.transient * omega / (2.0 * math.pi)).astype(np.int64) * n_per
+    n_st = np.full(L, 20 * n_per, np.int64)
+    out, err = np.full((L, k), np.nan), np.full((L, k), np.nan)
+    used, status, unres, n_fd = (np.zeros(L, np.int64) for _ in range(4))
+    kern.lyapunov_block_lanes(P, np.tile(m.initial_state(), (L, 1)), np.ones(2), np.zeros(L),
+                              2.0 * math.pi / omega / n_per, omega, np.full(L, n_per, np.int64),
+                              n_tr, n_st, 10, k, 1e6, out, err, used, status, unres,
+                              m.n_events, 4, block_rows, 1, True, n_fd)
+    return out, err, used, status, unres, n_fd
+
+
+def test_the_pointer_lyapunov_spectrum_equals_the_inlined_one_form_bitwise():
+    """Spectra (k = 2 tangent vectors) on the pointer path: the shared lane blocks' spectrum
+    workers, the model's variational step called once per pass of a block step, bitwise those
+    of the same one form inlined, whatever the blocks (one pass of the lanes' 2 vectors, or two
+    passes where 40 lanes of 2 vectors outnumber a block's 64 slots), impacting lanes among
+    them (split steps with the tangent vectors); no inlined spectrum worker compiled for it.
+    ``geardyn.lyapunov(..., spectrum=True)`` too."""
+    inlined = gear_pair(**COEFFS, kernel_path="lane-form")
+    pointer = gear_pair(**COEFFS, kernel_path="pointer")
+    kern = kernels_for(pointer.kernel, "lyapunov")
+    workers = [f"_lyap_spec_worker_form{j}" for j in range(3)]
+
+    def compiled(module) -> int:
+        return sum(len(getattr(module, name).signatures) for name in workers)
+
+    before = compiled(kern._inlined())
+    got = [_spectra(pointer, rows) for rows in (64, 200)]  # 12 lanes a block; 40 in one
+    assert compiled(kern._inlined()) == before and compiled(kern._shared) > 0
+    ref = _spectra(inlined, 64)
+    for g in got:
+        for name, a, b in zip(("exponents", "stderr", "used", "status", "unresolved",
+                               "difference steps"), g, ref, strict=True):
+            np.testing.assert_array_equal(a, b, err_msg=name)
+    assert np.all(np.isfinite(ref[0])) and np.all(ref[3] == 0)
+    one = [geardyn.lyapunov(m.with_omega(0.9), spectrum=True, run=LYAP_RUN, settings=LYAP,
+                            with_error=True) for m in (pointer, inlined)]
+    np.testing.assert_array_equal(one[0].value, one[1].value)
+    np.testing.assert_array_equal(one[0].stderr, one[1].stderr)
+    assert one[0].tangent.startswith("variational") and one[0].value.shape == (2,)
+
+
 def test_a_model_without_events_gets_its_exponent_on_the_same_lane_blocks():
     """The unforced Duffing oscillator (no switching functions) at its stable equilibrium
     x = 1 on the pointer path: the largest exponent is -delta / 2, that of its linearisation
