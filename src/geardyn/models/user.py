@@ -275,8 +275,9 @@ class UserModel(Model):
         kernel_path
             ``"pointer"`` (default): the trajectory and sweep kernels and the variational
             Lyapunov lane blocks are compiled once for every model and call the model's
-            functions, compiled alone as C callbacks, through their addresses (seconds of
-            compile per model; :mod:`geardyn.solvers._pointer_kernels`); the other analyses
+            functions, compiled alone as C callbacks, through their addresses (a model's own
+            compile about a third of the inlined path's, ``bench/pointer_path.py``;
+            :mod:`geardyn.solvers._pointer_kernels`); the other analyses
             (the difference tangent, the monodromy of periodic orbits and continuation, the
             run-up) compile with the model's functions inlined. ``"lane-form"``: every kernel
             compiled with the model's functions inlined (tens of seconds of compile per model;
