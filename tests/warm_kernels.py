@@ -59,12 +59,14 @@ WARM = {
 #: machine shared; the run-up kernels' share estimated from the tests that compiled them: gear
 #: pair ~10, planetary set ~19, spur pair ~3). The first case of a process also compiles the
 #: kernels' shared functions; the train shares the planetary set's kernels (it runs after it);
-#: the one-form gear pair's: the pointer path's kernels (~40 s, estimated from
-#: bench/pointer_path.py) and its parts and monodromy.
+#: the one-form gear pair's (the pointer path's kernels, its parts, spectrum workers and
+#: monodromy) scaled from the two cases it replaces (the one form inlined, 24, and its pointer
+#: path's trajectory and sweep, 30): 88.5 s CPU against their 101.7 s, measured side by side on
+#: empty caches at load ~5.
 #: The cases start longest first, so that the two processes end together.
 COST = {
     "PlanetaryGearSet": 137, "SpurPair": 55, "GearPair": 48, "CATTDevice-reduced": 44,
-    "CATTDevice-general": 27, "oscillator": 25, "UserModel-one-form": 55, "Lorenz": 19,
+    "CATTDevice-general": 27, "oscillator": 25, "UserModel-one-form": 47, "Lorenz": 19,
     "DimensionalCATT": 16, "UserModel": 14, "TrainModel": 1,
 }
 
