@@ -14,11 +14,17 @@ each compiled function (its own compile, those it compiles in turn subtracted), 
 The split step is not compiled ahead in a helper process here (``GEARDYN_COMPILE_AHEAD=0``), so
 that the process's CPU seconds are the whole compile.
 
-    .venv/bin/python bench/compile.py [--models GearPair UserModel] [--primer UserModel] [--top 8]
+    .venv/bin/python bench/compile.py [--models GearPair UserModel] [--primer GearPair] [--top 8]
                                       [--json F] [--write]
 
 ``--primer CASE`` runs that case first on each empty cache, so that a model's figure is its own
-compile with the shared modules (compiled once for every model) already cached.
+compile with what every model shares already cached: with ``GearPair`` the shared modules;
+with ``Duffing-one-form`` (a one-form user model on the pointer path, the default of
+``UserModel.from_one_form``: the Duffing oscillator of examples/duffing_model.py, another model
+than the conformance case) also the pointer path's kernels, compiled once for every pointer
+model, so that ``UserModel-one-form``'s figure is its own compile (the row
+``compile-UserModel-one-form-own``); primed by ``GearPair`` it is the first pointer model's,
+the pointer kernels included.
 
 ``--write`` replaces the ``compile-*`` rows of bench/RESULTS.md's current-figures table
 (``--from-json F``: those of an earlier run's ``--json F``, without measuring again). Cold
@@ -108,13 +114,34 @@ def _exclusive(buffer) -> dict[str, list]:
     return dict(out)
 
 
+def _duffing() -> tuple:
+    """The primer ``Duffing-one-form``: the forced Duffing oscillator of
+    examples/duffing_model.py as a one-form user model (the pointer path, the default), and its
+    start state."""
+    import numpy as np
+
+    import geardyn
+
+    sys.path.insert(0, str(HERE.parent / "examples"))
+    from duffing_model import duffing_one
+
+    model = geardyn.UserModel.from_one_form(
+        duffing_one, params={"delta": 0.3, "gamma": 0.1, "Omega": 1.2}, states=("x", "v"),
+        initial_state=(1.0, 0.0), natural_frequency=2.0 ** 0.5, name="Duffing")
+    return model, np.array([1.0, 0.0])
+
+
+#: Cases besides the conformance cases (primers).
+EXTRA_CASES = {"Duffing-one-form": _duffing}
+
+
 def child(case: str) -> dict:
     """Run every analysis once in this process; their CPU and wall seconds, and compile events."""
     t_wall = time.perf_counter()
     import geardyn  # noqa: F401
     from conformance_cases import cases
 
-    model, y0 = cases()[case]
+    model, y0 = EXTRA_CASES[case]() if case in EXTRA_CASES else cases()[case]
     # import: the process's CPU so far (interpreter, numba, geardyn, the model)
     rows = {"import": (time.process_time(), time.perf_counter() - t_wall, {}, "")}
     for name, fn in _runs(model, y0).items():
@@ -187,7 +214,7 @@ def record(case: str, cold: dict, warm: dict, primer: str | None = None) -> None
     if primer is None:
         key, what, flag = f"compile-{case}", "empty cache", ""
     else:
-        key, what, flag = (f"compile-{case}-own", f"shared modules cached (by {primer})",
+        key, what, flag = (f"compile-{case}-own", f"shared kernels cached (by {primer})",
                            f" --primer {primer}")
     results.record(
         key, f"first use of every analysis, {what}: <= {target:.0f} s CPU",
@@ -207,7 +234,9 @@ def main(argv: list[str] | None = None) -> int:
                     help="report (and --write) the rows of an earlier run's --json instead")
     ap.add_argument("--primer", default=None,
                     help="a case run first on the empty cache (its figures discarded), so that "
-                         "each model's figure is its own compile with the shared modules cached")
+                         "each model's figure is its own compile with the shared kernels cached "
+                         "(GearPair: the shared modules; Duffing-one-form, a pointer model: the "
+                         "pointer path's kernels too)")
     ap.add_argument("--child", default=None, help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
     if args.child:

@@ -155,7 +155,8 @@ def speed_figures(repeat: int) -> None:
     from gear_pair_model import gear_pair
 
     coeffs = dict(zeta=0.05, kappa=0.2, Fm=0.1, Fa=0.2)
-    models = {"GearPair": geardyn.GearPair(**coeffs), "one form inlined": gear_pair(**coeffs),
+    models = {"GearPair": geardyn.GearPair(**coeffs),
+              "one form inlined": gear_pair(**coeffs, kernel_path="lane-form"),
               "one form, pointer path": gear_pair(**coeffs, kernel_path="pointer")}
     omegas = np.linspace(0.2, 3.0, 400)
     run = geardyn.RunSettings(transient=500.0 * math.pi, samples=100, steps_per_period=128)
@@ -193,7 +194,8 @@ def lyapunov_figures(repeat: int) -> None:
     from gear_pair_model import gear_pair
 
     coeffs = dict(zeta=0.05, kappa=0.2, Fm=0.1, Fa=0.2)
-    models = {"GearPair": geardyn.GearPair(**coeffs), "one form inlined": gear_pair(**coeffs),
+    models = {"GearPair": geardyn.GearPair(**coeffs),
+              "one form inlined": gear_pair(**coeffs, kernel_path="lane-form"),
               "one form, pointer path": gear_pair(**coeffs, kernel_path="pointer")}
     omegas = np.linspace(0.2, 3.0, 64)
     transient, duration, n_per = 100.0, 400.0, 128

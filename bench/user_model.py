@@ -1,18 +1,19 @@
 """A user's model on the fast path: the gear pair written as a one-form ``UserModel``
-(examples/gear_pair_model.py) against the built-in ``GearPair``, in ns per lane-step of a sweep.
+(examples/gear_pair_model.py; its default kernel path, the pointer path) against the built-in
+``GearPair``, in ns per lane-step of a sweep.
 
 Workload: bench/peers.py's sweep (``GearPair(zeta=0.05, kappa=0.2, Fm=0.1, Fa=0.2)``, 400
 values of Omega in [0.2, 3], a transient of 500 pi time units rounded up to whole periods, 100
 sampled periods) at 128 steps per period with edges located, through
 :func:`geardyn.solvers.ensemble.run_lanes` (the sweep kernel). Rows: ``GearPair``, the one-form
-``UserModel`` (with ``--pointer`` also on the pointer kernel path, ``kernel_path="pointer"``)
-and, with ``--legacy``, the same equations as a legacy plain ``UserModel``
-(``rhs(t, y, dy, p)``, the generic path; its kernels compile in this process). Wall time: the
-median of ``--repeat`` warm runs, the rows timed round-robin; ns per lane-step = wall time x
-threads / grid steps integrated (``steps`` of the result). The Poincare points of the rows are
-compared bit for bit with GearPair's.
+``UserModel`` on its default kernel path (with ``--inlined`` also with its functions inlined,
+``kernel_path="lane-form"``) and, with ``--legacy``, the same equations as a legacy plain
+``UserModel`` (``rhs(t, y, dy, p)``, the generic path; its kernels compile in this process).
+Wall time: the median of ``--repeat`` warm runs, the rows timed round-robin; ns per lane-step =
+wall time x threads / grid steps integrated (``steps`` of the result). The Poincare points of
+the rows are compared bit for bit with GearPair's.
 
-    .venv/bin/python bench/user_model.py [--repeat 5] [--points 400] [--legacy] [--pointer]
+    .venv/bin/python bench/user_model.py [--repeat 5] [--points 400] [--legacy] [--inlined]
                                          [--write]
 
 On a tree without ``UserModel.from_one_form`` only the GearPair row runs (the figure to compare
@@ -62,14 +63,14 @@ def _legacy_events(t, y, g, p):
     g[1] = y[0] + p[7]
 
 
-def _models(legacy: bool, pointer: bool = False) -> dict[str, geardyn.Model]:
+def _models(legacy: bool, inlined: bool = False) -> dict[str, geardyn.Model]:
     pair = geardyn.GearPair(**COEFFS)
     out: dict[str, geardyn.Model] = {"GearPair": pair}
     if hasattr(geardyn.UserModel, "from_one_form"):
         from gear_pair_model import gear_pair
         out["UserModel (one form)"] = gear_pair(**COEFFS)
-        if pointer:
-            out["UserModel (pointer)"] = gear_pair(**COEFFS, kernel_path="pointer")
+        if inlined:
+            out["UserModel (lane-form)"] = gear_pair(**COEFFS, kernel_path="lane-form")
     if legacy:
         out["UserModel (legacy plain)"] = geardyn.UserModel(
             _legacy_rhs, 2, pair.params[:8], param_names=pair.param_names[:8],
@@ -88,12 +89,12 @@ def main() -> None:
     ap.add_argument("--repeat", type=int, default=5)
     ap.add_argument("--points", type=int, default=400)
     ap.add_argument("--legacy", action="store_true")
-    ap.add_argument("--pointer", action="store_true",
-                    help="also the one form on the pointer kernel path (kernel_path='pointer')")
+    ap.add_argument("--inlined", action="store_true",
+                    help="also the one form with its functions inlined (kernel_path='lane-form')")
     ap.add_argument("--write", action="store_true")
     a = ap.parse_args()
     omegas = np.linspace(0.2, 3.0, a.points)
-    models = _models(a.legacy, a.pointer)
+    models = _models(a.legacy, a.inlined)
     threads = nb.get_num_threads()
     first = {}
     for name, m in models.items():  # compile (or load) and keep the first run's results
@@ -115,13 +116,14 @@ def main() -> None:
         same = np.array_equal(first[name].samples, ref.samples, equal_nan=True)
         dev = float(np.nanmax(np.abs(first[name].samples - ref.samples)))
         print(f"{name:26s} {wall:7.3f} s  {per[name]:6.2f} ns/lane-step  "
-              f"points bitwise equal to GearPair: {same} (max dev {dev:.1e})")
+              f"points bitwise equal to GearPair: {same} (max dev {dev:.1e}; kernel path "
+              f"{models[name].kernel.kernel_path})")
     if "UserModel (one form)" in per:
         ratio = per["UserModel (one form)"] / per["GearPair"]
         print(f"one-form UserModel / GearPair: {ratio:.3f}")
-        if "UserModel (pointer)" in per:
-            print(f"pointer-path UserModel / GearPair: "
-                  f"{per['UserModel (pointer)'] / per['GearPair']:.3f}")
+        if "UserModel (lane-form)" in per:
+            print(f"one-form UserModel inlined / GearPair: "
+                  f"{per['UserModel (lane-form)'] / per['GearPair']:.3f}")
         if "UserModel (legacy plain)" in per:
             print(f"legacy UserModel / GearPair: "
                   f"{per['UserModel (legacy plain)'] / per['GearPair']:.2f}")

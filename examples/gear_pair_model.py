@@ -45,9 +45,10 @@ def pair_force(t, y, p, s, c):
 
 
 def gear_pair(zeta=0.05, kappa=0.0, Fm=0.1, Fa=0.05, Omega=1.0, phi_k=0.0, phi_e=0.0, b=1.0,
-              kernel_path="lane-form"):
+              kernel_path="pointer"):
     """The gear pair as a geardyn.UserModel in the one form, with its mesh declared
-    (kernel_path: "pointer" for the kernels compiled once for every model)."""
+    (kernel_path: "pointer", the default, for the kernels compiled once for every model;
+    "lane-form" for every kernel compiled with the model's functions inlined)."""
     return geardyn.UserModel.from_one_form(
         pair_rhs,
         params=dict(Omega=Omega, zeta=zeta, kappa=kappa, Fm=Fm, Fa=Fa, phi_k=phi_k,

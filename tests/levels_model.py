@@ -48,10 +48,12 @@ def levels_events(t, y, p, s, c):
 
 
 def levels_model() -> geardyn.UserModel:
-    """The model above, B a quiet coefficient (lanes with B = 0 take FORM_QUIET)."""
+    """The model above, B a quiet coefficient (lanes with B = 0 take FORM_QUIET; quiet
+    coefficients take the lane forms of the inlined path, ``kernel_path="lane-form"``)."""
     model = geardyn.UserModel.from_one_form(
         levels_rhs, params={"Omega": 1.0, "B": 0.0}, states=("x",), events=levels_events,
-        event_names=tuple(f"x-L{j}" for j in range(len(LEVELS))), name="levels")
+        event_names=tuple(f"x-L{j}" for j in range(len(LEVELS))), name="levels",
+        kernel_path="lane-form")
     form = dataclasses.replace(model.kernel.one_form, quiet=("B",))
     model.kernel = dataclasses.replace(model.kernel, one_form=form)
     return model

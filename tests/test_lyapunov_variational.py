@@ -400,12 +400,14 @@ def atan_rhs(t, y, p, s, c):
 def test_a_rhs_the_duals_cannot_take_is_named(monkeypatch):
     """Refused naming ``settings.tangent``, numba's typing error (the operation) chained, by the
     tangent form alone: no function of the model's Lyapunov kernel or step core is compiled
-    first (no compile-ahead helper: it would compile the core's split step meanwhile)."""
+    first (no compile-ahead helper: it would compile the core's split step meanwhile); on the
+    inlined path (tests/test_pointer_path.py: the pointer path's)."""
     from geardyn.solvers.kernels import CORE
 
     monkeypatch.setenv("GEARDYN_COMPILE_AHEAD", "0")
     m = geardyn.UserModel.from_one_form(atan_rhs, params={"k": 1.0, "F": 0.2, "Omega": 1.1},
-                                        states=("x", "v"), initial_state=(0.1, 0.0))
+                                        states=("x", "v"), initial_state=(0.1, 0.0),
+                                        kernel_path="lane-form")
     with pytest.raises(geardyn.errors.ParameterError, match="settings.tangent") as info:
         geardyn.lyapunov(m, settings=geardyn.LyapunovSettings(duration=20.0))
     assert "atan2" in str(info.value.__cause__)

@@ -1,4 +1,4 @@
-"""The pointer kernel path (``UserModel.from_one_form(..., kernel_path="pointer")``): the
+"""The pointer kernel path (``UserModel.from_one_form``'s default, ``kernel_path="pointer"``): the
 trajectory and sweep kernels and the variational Lyapunov lane blocks compiled once for every
 model, the model's functions compiled alone and called through their addresses. Its results are
 those of the inlined path bit for bit (the gear pair against ``GearPair`` and against the same
@@ -52,7 +52,7 @@ def _duffing(kernel_path: str = "lane-form") -> geardyn.UserModel:
 
 
 def test_the_pointer_path_equals_gear_pair_and_the_inlined_one_form_bitwise():
-    pair, inlined = geardyn.GearPair(**COEFFS), gear_pair(**COEFFS)
+    pair, inlined = geardyn.GearPair(**COEFFS), gear_pair(**COEFFS, kernel_path="lane-form")
     pointer = gear_pair(**COEFFS, kernel_path="pointer")
     assert pointer.kernel.kernel_path == "pointer" in KERNEL_PATHS
     run = geardyn.RunSettings(transient=300.0, samples=6, steps_per_period=64)
@@ -86,7 +86,7 @@ def test_the_pointer_path_agrees_with_dop853():
     run = geardyn.RunSettings(transient=0.0, samples=4, steps_per_period=512)
     for om in (0.8, 1.7):
         pointer = gear_pair(**coeffs, Omega=om, kernel_path="pointer")
-        twin = gear_pair(**coeffs, Omega=om)
+        twin = gear_pair(**coeffs, Omega=om, kernel_path="lane-form")
         T = 2.0 * math.pi / om
         ref = geardyn.reference_solution(twin, twin.initial_state(), T * np.arange(1, 5))
         ds = geardyn.simulate(pointer, run=run)
@@ -113,6 +113,19 @@ def test_models_of_other_sizes_run_on_the_same_compiled_kernels():
     ref = run_lanes(inlined, inlined.lane_params("Omega", om), inlined.initial_state(), run=run)
     for name in LaneResults.__dataclass_fields__:
         np.testing.assert_array_equal(getattr(r, name), getattr(ref, name), err_msg=name)
+
+
+def test_the_pointer_path_is_the_one_forms_default_and_lane_form_the_opt_out():
+    """``from_one_form`` without ``kernel_path`` takes the pointer path; ``"lane-form"``
+    inlines the model's functions in every kernel; a sweep records which ran."""
+    default = geardyn.UserModel.from_one_form(
+        duffing_one, params={"delta": 0.3, "gamma": 0.1, "Omega": 1.2}, states=("x", "v"))
+    assert default.kernel.kernel_path == "pointer"
+    assert _duffing().kernel.kernel_path == "lane-form"
+    run = geardyn.RunSettings(transient=0.0, samples=2, steps_per_period=64)
+    for m, path in ((default, "pointer"), (_duffing(), "lane-form")):
+        ds = geardyn.bifurcation(m, "Omega", [1.1, 1.3], run=run)
+        assert ds.attrs["kernel_path"] == path
 
 
 def test_the_kernel_path_is_checked_naming_the_field():
@@ -142,7 +155,8 @@ def test_the_pointer_lyapunov_lane_blocks_equal_the_inlined_one_form_bitwise():
     on the pointer path (the shared lane blocks calling the model's variational step and flagged
     lanes through their addresses): bitwise those of the same one form inlined, the variational
     tangent, impacting lanes among them."""
-    inlined, pointer = gear_pair(**COEFFS), gear_pair(**COEFFS, kernel_path="pointer")
+    inlined = gear_pair(**COEFFS, kernel_path="lane-form")
+    pointer = gear_pair(**COEFFS, kernel_path="pointer")
     kern = kernels_for(pointer.kernel, "lyapunov")
     assert isinstance(kern, PointerLyapunov)
     got, ref = _exponents(pointer), _exponents(inlined)
@@ -163,6 +177,56 @@ def test_the_pointer_lyapunov_lane_blocks_equal_the_inlined_one_form_bitwise():
     b = geardyn.bifurcation(inlined, "Omega", om, run=run, lyapunov=True)
     for name in ("lyapunov", "lyapunov_err", "lyapunov_unresolved"):
         np.testing.assert_array_equal(a[name].values, b[name].values, err_msg=name)
+
+
+def _spectra(m: geardyn.Model, block_rows: int) -> tuple[np.ndarray, ...]:
+    """Both exponents (k = 2) of 40 lanes (:data:`LANES` five times) of the variational lane
+    blocks of ``m`` (``lyapunov_block_lanes``, as ``geardyn.lyapunov(..., spectrum=True)``
+    calls them for one lane), blocks of ``block_rows`` rows (2 k + 1 a lane)."""
+    kern = kernels_for(m.kernel, "lyapunov")
+    P = np.tile(_rows(m), (5, 1))
+    L, k, n_per = P.shape[0], 2, 64
+    omega = np.ascontiguousarray(P[:, m.omega_index])
+    n_tr = np.round(LYAP_RUN.transient * omega / (2.0 * math.pi)).astype(np.int64) * n_per
+    n_st = np.full(L, 20 * n_per, np.int64)
+    out, err = np.full((L, k), np.nan), np.full((L, k), np.nan)
+    used, status, unres, n_fd = (np.zeros(L, np.int64) for _ in range(4))
+    kern.lyapunov_block_lanes(P, np.tile(m.initial_state(), (L, 1)), np.ones(2), np.zeros(L),
+                              2.0 * math.pi / omega / n_per, omega, np.full(L, n_per, np.int64),
+                              n_tr, n_st, 10, k, 1e6, out, err, used, status, unres,
+                              m.n_events, 4, block_rows, 1, True, n_fd)
+    return out, err, used, status, unres, n_fd
+
+
+def test_the_pointer_lyapunov_spectrum_equals_the_inlined_one_form_bitwise():
+    """Spectra (k = 2 tangent vectors) on the pointer path: the shared lane blocks' spectrum
+    workers, the model's variational step called once per pass of a block step, bitwise those
+    of the same one form inlined, whatever the blocks (one pass of the lanes' 2 vectors, or two
+    passes where 40 lanes of 2 vectors outnumber a block's 64 slots), impacting lanes among
+    them (split steps with the tangent vectors); no inlined spectrum worker compiled for it.
+    ``geardyn.lyapunov(..., spectrum=True)`` too."""
+    inlined = gear_pair(**COEFFS, kernel_path="lane-form")
+    pointer = gear_pair(**COEFFS, kernel_path="pointer")
+    kern = kernels_for(pointer.kernel, "lyapunov")
+    workers = [f"_lyap_spec_worker_form{j}" for j in range(3)]
+
+    def compiled(module) -> int:
+        return sum(len(getattr(module, name).signatures) for name in workers)
+
+    before = compiled(kern._inlined())
+    got = [_spectra(pointer, rows) for rows in (64, 200)]  # 12 lanes a block; 40 in one
+    assert compiled(kern._inlined()) == before and compiled(kern._shared) > 0
+    ref = _spectra(inlined, 64)
+    for g in got:
+        for name, a, b in zip(("exponents", "stderr", "used", "status", "unresolved",
+                               "difference steps"), g, ref, strict=True):
+            np.testing.assert_array_equal(a, b, err_msg=name)
+    assert np.all(np.isfinite(ref[0])) and np.all(ref[3] == 0)
+    one = [geardyn.lyapunov(m.with_omega(0.9), spectrum=True, run=LYAP_RUN, settings=LYAP,
+                            with_error=True) for m in (pointer, inlined)]
+    np.testing.assert_array_equal(one[0].value, one[1].value)
+    np.testing.assert_array_equal(one[0].stderr, one[1].stderr)
+    assert one[0].tangent.startswith("variational") and one[0].value.shape == (2,)
 
 
 def test_a_model_without_events_gets_its_exponent_on_the_same_lane_blocks():

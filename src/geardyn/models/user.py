@@ -212,7 +212,7 @@ class UserModel(Model):
         period: float | None = None,
         name: str = "UserModel",
         natural_frequency: float | Callable[[np.ndarray], float] | None = None,
-        kernel_path: str = "lane-form",
+        kernel_path: str = "pointer",
     ) -> UserModel:
         """A model written in the one form (:mod:`geardyn.core.one_form`).
 
@@ -273,13 +273,16 @@ class UserModel(Model):
         period, name, natural_frequency
             As in the constructor.
         kernel_path
-            ``"lane-form"`` (default): every kernel compiled with the model's functions
-            inlined (the fastest run, tens of seconds of compile); ``"pointer"``: the
-            trajectory and sweep kernels and the variational Lyapunov lane blocks compiled once
-            for every model and calling the model's functions, compiled alone as C callbacks,
-            through their addresses (seconds of compile;
-            :mod:`geardyn.solvers._pointer_kernels`); the other analyses inlined as with
-            ``"lane-form"``. Recorded as a sweep's ``kernel_path`` attribute.
+            ``"pointer"`` (default): the trajectory and sweep kernels and the variational
+            Lyapunov lane blocks are compiled once for every model and call the model's
+            functions, compiled alone as C callbacks, through their addresses (a model's own
+            compile about a third of the inlined path's, ``bench/pointer_path.py``;
+            :mod:`geardyn.solvers._pointer_kernels`); the other analyses
+            (the difference tangent, the monodromy of periodic orbits and continuation, the
+            run-up) compile with the model's functions inlined. ``"lane-form"``: every kernel
+            compiled with the model's functions inlined (tens of seconds of compile per model;
+            the results are bitwise the same). Recorded as a sweep's ``kernel_path``
+            attribute.
         """
         if kernel_path not in ("lane-form", "pointer"):
             raise ParameterError("kernel_path", kernel_path, "'lane-form' or 'pointer'")
