@@ -176,6 +176,90 @@ def _lane_books(step, first, nl, k, renorm, bound, ZT, Zl, Cl, logs, IST, ENDS, 
     return nxt
 
 
+@nb.njit(inline="always", **_JIT)
+def _due_now(IST, ENDS, l, step, renorm):
+    """What lane l, due at this step, does (the books): (measure: past its transient, c: the
+    block being measured, renormalise, block_end: a block of the measuring window ends)."""
+    n_tr = IST[l, _NTR]
+    measure = step > n_tr
+    c = IST[l, _CUR]
+    renormalise = step - IST[l, _LAST] == renorm or step == n_tr or step == IST[l, _TOTAL]
+    return measure, c, renormalise, measure and step - n_tr == ENDS[l, c]
+
+
+@nb.njit(inline="always", **_JIT)
+def _renorm_one(Y, V, W, l, bound, logs, add):
+    """The renormalisation of lane l's one tangent vector (k = 1) in place: its state Y and
+    tangent vector V (flat rows, element q of lane l at q W + l), the state's health
+    (|y| <= bound) and :func:`_orthonormalise`'s arithmetic for one vector (the same
+    operations, bitwise). Returns False where the state is out of bound or the vector vanished
+    or is not finite (Y, V untouched)."""
+    ns = Y.size // W
+    healthy = True
+    for q in range(ns):
+        healthy = healthy and abs(Y[q * W + l]) <= bound  # False for NaN too
+    if not healthy:
+        return False
+    r = 0.0
+    for q in range(ns):
+        r += V[q * W + l] * V[q * W + l]
+    r = math.sqrt(r)
+    if not (r > 0.0 and math.isfinite(r)):
+        return False
+    if add:
+        logs[0] = math.log(r)
+    inv = 1.0 / r
+    for q in range(ns):
+        V[q * W + l] *= inv
+    return True
+
+
+@nb.njit(inline="always", **_JIT)
+def _lane_books_one(step, first, nl, renorm, bound, Z0, Z1, Zl, Cl, logs, IST, ENDS, BLK, ACC,
+                    ACT, status):
+    """:func:`_lane_books_core` with one tangent vector (k = 1) on the fused loop's rows Z0 (the
+    lanes' states) and Z1 (their tangent vectors; element q of lane l at q BLOCK + l), inlined
+    into the loop's function: that function declares its arrays ``noalias``, so the books
+    reach the rows through the loop's own arrays, not through ZT (a view of the same memory).
+    The same operations, bitwise (ACTR is not kept: the variational block does not use it).
+    Returns the next step at which a lane is due."""
+    ns = Zl.shape[1]
+    W = Z0.size // ns
+    nxt = np.iinfo(np.int64).max
+    for l in range(nl):
+        if not ACT[l]:
+            continue
+        if IST[l, _DUE] == step:
+            measure, c, renormalise, block_end = _due_now(IST, ENDS, l, step, renorm)
+            if renormalise:
+                IST[l, _LAST] = step
+                if not _renorm_one(Z0, Z1, W, l, bound, logs, measure):
+                    ACT[l] = False
+                    status[first + l] = STATUS_DIVERGED
+                    continue
+                if measure:
+                    ACC[l, 0] += logs[0]
+                    BLK[l, c, 0] += logs[0]
+                if block_end:
+                    IST[l, _CUR] = c + 1
+            elif block_end:
+                # a block ends between renormalisations: its share of the running stretch, on
+                # a copy
+                for q in range(ns):
+                    Zl[0, q] = Z0[q * W + l]
+                    Zl[1, q] = Z1[q * W + l]
+                _stretch_logs(Zl, Cl, logs)
+                BLK[l, c, 0] += logs[0]
+                BLK[l, c + 1, 0] -= logs[0]
+                IST[l, _CUR] = c + 1
+            if step == IST[l, _TOTAL]:
+                ACT[l] = False
+                continue
+            IST[l, _DUE] = _lane_due(IST, l, renorm, ENDS)
+        nxt = min(nxt, IST[l, _DUE])
+    return nxt
+
+
 @nb.njit(_nrt=False, **_JIT)  # it allocates nothing
 def _lane_books_core(step, first, nl, k, renorm, bound, ZT, Zl, Cl, logs, IST, ENDS, BLK, ACC,
                      ACT, ACTR, status):
@@ -193,29 +277,32 @@ def _lane_books_core(step, first, nl, k, renorm, bound, ZT, Zl, Cl, logs, IST, E
             continue
         if IST[l, _DUE] == step:
             lane = first + l
-            n_tr = IST[l, _NTR]
-            measure = step > n_tr
-            c = IST[l, _CUR]
-            renormalise = (step - IST[l, _LAST] == renorm or step == n_tr
-                           or step == IST[l, _TOTAL])
-            block_end = measure and step - n_tr == ENDS[l, c]
-            if renormalise or block_end:
+            measure, c, renormalise, block_end = _due_now(IST, ENDS, l, step, renorm)
+            one = renormalise and k == 1  # in place, no gathered copy (:func:`_renorm_one`)
+            if (renormalise or block_end) and not one:
                 for j in range(m):
                     for q in range(ns):
                         Zl[j, q] = ZT[j, q, l]
             if renormalise:
                 IST[l, _LAST] = step
-                healthy = True
-                for q in range(ns):
-                    healthy = healthy and abs(Zl[0, q]) <= bound  # False for NaN too
-                if not healthy or not _orthonormalise(Zl, logs, measure):
+                if one:
+                    nw = ZT.shape[2]
+                    ok = _renorm_one(ZT[0].reshape(ns * nw), ZT[1].reshape(ns * nw), nw, l,
+                                     bound, logs, measure)
+                else:
+                    ok = True
+                    for q in range(ns):
+                        ok = ok and abs(Zl[0, q]) <= bound  # False for NaN too
+                    ok = ok and _orthonormalise(Zl, logs, measure)
+                if not ok:
                     ACT[l] = False
                     status[lane] = STATUS_DIVERGED
                     changed = True
                     continue
-                for j in range(m):
-                    for q in range(ns):
-                        ZT[j, q, l] = Zl[j, q]
+                if not one:
+                    for j in range(m):
+                        for q in range(ns):
+                            ZT[j, q, l] = Zl[j, q]
                 if measure:
                     for j in range(k):
                         ACC[l, j] += logs[j]

@@ -96,6 +96,7 @@ from geardyn.solvers._lyapunov_books import (  # compiled once for every model
     _lane_books,
     _lane_books_core,
     _lane_books_inline,
+    _lane_books_one,
     _lane_result,
     _lanes_init,
 )
@@ -136,6 +137,8 @@ from geardyn.solvers._step_shared import (
     fd_scale,
     fd_size,
     fd_tangent,
+    phase_increments,
+    phase_rotate,
     phase_table,
     rk4_comb,
     rk4_sixth,
@@ -1323,15 +1326,19 @@ if VARIATIONAL:
 
     @nb.njit(inline="always", **_JIT)
     def _var_fused_steps(form, i, nl, locate, commit, Z0, Z1, S, IS, PT, T0L, HL, HHL, H6L, PH,
-                         ACT, FLAG, GR, Y1F):
+                         IDX, ENDL, ACT, FLAG, GR, Y1F):
         """Grid step i of every lane of the block (see above): Z0, Z1 the state and a tangent
         vector (flat rows of BLOCK lanes), the tangent vector committed where the lane is
         active and its state's trial unflagged, the state too where ``commit`` (the last
         tangent vector of the step; ``locate``: the edges screened; GR: the graze flags, a row
         of BLOCK per switching function of the model); FLAG[l] = 1 where an active lane is
         flagged, the state's trial into Y1F (as Z0) for :func:`_var_flagged`. Returns the
-        number of flagged lanes."""
-        P0, P1, P2, P3, P4, P5 = PH
+        number of flagged lanes. PH: each lane's forcing phase at the step's start (sin, cos)
+        and its increments (:func:`_var_phases`): the phases at the step's middle and end are
+        the start's rotated (:func:`phase_rotate`), the period's end (IDX + 2 = ENDL) exactly
+        (0, 1), as the lane's phase table has them, bitwise, without gathers from the tables;
+        the end becomes the next step's start where ``commit``."""
+        PS, PC, AH, BH, AD, BD = PH
         n_flag = 0
         for l in range(nl):
             y = _t_load(Z0, l)
@@ -1342,7 +1349,16 @@ if VARIATIONAL:
             tm = ts + hh
             te = ts + h
             hd = te - ts
-            ph = (P0[l], P1[l], P2[l], P3[l], P4[l], P5[l])
+            s0 = PS[l]
+            c0 = PC[l]
+            s1, c1 = phase_rotate(s0, c0, AH[l], BH[l])
+            s2, c2 = phase_rotate(s0, c0, AD[l], BD[l])
+            end = IDX[l] + 2 == ENDL[l]  # the period's end, as in the table
+            s2 = _pick(end, 0.0, s2)
+            c2 = _pick(end, 1.0, c2)
+            PS[l] = _pick(commit, s2, s0)
+            PC[l] = _pick(commit, c2, c0)
+            ph = (s0, c0, s1, c1, s2, c2)
             y1, w1, g0, g1, ge = _var_row_trial(form, y, _t_scale(v, S), PT, l, ts, tm, te, hh,
                                                 h, H6L[l], hd, ph)
             hit = _t_screen_rows(g0, g1, ge, GR, l) & locate  # (no branch in the lane loop)
@@ -1452,11 +1468,6 @@ def _lyap_var_run(form, first, nl, n_ev, max_total, due, renorm, bound, P, OMEGA
             live = live | ACT[l]
         if not live:
             break
-        for l in range(n_slot):
-            j = IDX[l]
-            for d in range(3):
-                PH[2 * d][l] = S_TAB[j + d]
-                PH[2 * d + 1][l] = C_TAB[j + d]
         n_flag = 0
         for g in range(n_pass):  # one call site of the fused loop
             j_lo = g * kp
@@ -1464,7 +1475,7 @@ def _lyap_var_run(form, first, nl, n_ev, max_total, due, renorm, bound, P, OMEGA
             if k > 1:
                 _var_load(ZT, ZX, nl, j_lo, kk)
             n_flag = _var_fused_steps(form, i, nv, locate, g == n_pass - 1, Z0, ZX, S, IS, PT,
-                                      T0L, HL, HHL, H6L, PH, ACT, FLAG, GR, Y1F)
+                                      T0L, HL, HHL, H6L, PH, IDX, ENDL, ACT, FLAG, GR, Y1F)
             if k > 1:
                 _var_store(ZT, ZX, nl, j_lo, kk)
         if n_flag > 0:
@@ -1498,22 +1509,17 @@ def _lyap_var_run1(form, first, nl, n_ev, max_total, due, renorm, bound, P, OMEG
             live = live | ACT[l]
         if not live:
             break
-        for l in range(nl):
-            j = IDX[l]
-            for d in range(3):
-                PH[2 * d][l] = S_TAB[j + d]
-                PH[2 * d + 1][l] = C_TAB[j + d]
         n_flag = _var_fused_steps(form, i, nv, locate, True, Z0, Z1, S, IS, PT, T0L, HL, HHL,
-                                  H6L, PH, ACT, FLAG, GR, Y1F)
+                                  H6L, PH, IDX, ENDL, ACT, FLAG, GR, Y1F)
         if n_flag > 0:
             _var_flagged(i, nl, first, n_ev, P, ZT, S, IS, T0L, HL, OMEGA, NPL, IDX, S_TAB,
                          C_TAB, FLAG, UNRR, FDL, GR, Y1F, fd)
         for l in range(nl):
             IDX[l] = IDX[l] + 2 if IDX[l] + 2 < ENDL[l] else IDX[l] + 2 - 2 * NPL[l]
         step = i + 1
-        if step >= due:
-            due = _lane_books_core(step, first, nl, 1, renorm, bound, ZT, Zl, Cl, logs, IST,
-                                   ENDS, BLK, ACC, ACT, ACTR, status)
+        if step >= due:  # (inlined, on Z0 and Z1: no call of ~100 words at most steps)
+            due = _lane_books_one(step, first, nl, renorm, bound, Z0, Z1, Zl, Cl, logs, IST,
+                                  ENDS, BLK, ACC, ACT, status)
 
 
 @nb.njit(_nrt=False, **_JIT_NOALIAS)
@@ -1564,6 +1570,26 @@ def _lyap_var_form2(first, nl, n_ev, max_total, due, renorm, bound, P, OMEGA, H,
                   IS, PT, lanes, books, out, err, used, status, scratch, fd)
 
 
+@nb.njit(inline="always", **_JIT)
+def _var_phases(n, IDX, NPL, S_TAB, C_TAB, PH):
+    """The variational loop's phase rows PH (:func:`_var_fused_steps`) of slots 0..n-1 at their
+    start (phase-table index IDX): sin and cos there, and the increments of half a grid step and
+    of a whole one (:func:`phase_increments` of the slot's steps per period; zero where the
+    tables are unforced, (0, 1) throughout, which the rotation keeps)."""
+    PS, PC, AH, BH, AD, BD = PH
+    for l in range(n):
+        j = IDX[l]
+        PS[l] = S_TAB[j]
+        PC[l] = C_TAB[j]
+        ah, bh, ad, bd = 0.0, 0.0, 0.0, 0.0
+        if S_TAB[j + 1] != 0.0:  # a forced table (its half step is off zero)
+            ah, bh, ad, bd = phase_increments(NPL[l])
+        AH[l] = ah
+        BH[l] = bh
+        AD[l] = ad
+        BD[l] = bd
+
+
 # POINTER-HOOK: the pointer path (:mod:`._pointer_lyapunov`) replaces this definition
 @nb.njit(inline="always", **_JIT)
 def _n_switching(Z0, PT):
@@ -1607,6 +1633,7 @@ def _lyap_block_var(form, one, first, nl, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB
         _set_column(s, first + s % nl, P, T0, H, NPER, OFF, PT, T0L, HL, HHL, H6L, NPL, IDX,
                     ENDL)
         ACT[s] = ACT[s % nl]
+    _var_phases(nl * min(k, BLOCK // nl), IDX, NPL, S_TAB, C_TAB, PH)
     lanes = (Z0, Z1, ZT, T0L, HL, HHL, H6L, IDX, NPL, ENDL, PH, ACT, ACTR, FLAG, GR, UNRR, FDL,
              Y1F, ZX)
     books = (IST, ENDS, BLK, ACC, Zl, Cl, logs)

@@ -50,11 +50,11 @@ def _n_switching(Z0, PT):
 
 @nb.njit(inline="always", **_JIT)
 def _var_fused_steps(form, i, nl, locate, commit, Z0, Z1, S, IS, PT, T0L, HL, HHL, H6L, PH,
-                     ACT, FLAG, GR, Y1F):
+                     IDX, ENDL, ACT, FLAG, GR, Y1F):
     """The model's variational step of every lane of the block (its ``_var_fused_steps`` in
     its lane form, the arguments flattened: :data:`._pointer_calls.VAR_STEP_ARGS`), called
     through its address (the second Lyapunov entry of lane 0's coefficients: every lane of a
     block is of the one model); the number of flagged lanes."""
     addr = np.int64(PT[PT.shape[0] - _LYAPUNOV_AT + 1, 0])
     return call_flat(addr, (i, nl, locate, commit, Z0, Z1, S, IS, PT, T0L, HL, HHL, H6L) + PH
-                     + (ACT, FLAG, GR, Y1F))
+                     + (IDX, ENDL, ACT, FLAG, GR, Y1F))

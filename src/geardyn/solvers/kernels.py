@@ -443,7 +443,7 @@ def compile_tangent(source: KernelSource, signature: Any) -> None:
     kern = kernels_for(source, "lyapunov")
     if isinstance(kern, pointer.PointerLyapunov):
         kern.part  # noqa: B018 - imported: its callbacks compiled
-    else:
+    elif tuple(signature) not in kern.rhs_tangent.overloads:  # (compiled: no compile's locks)
         kern.rhs_tangent.compile(signature)
 
 
