@@ -16,7 +16,7 @@ from __future__ import annotations
 import os
 import threading
 from collections.abc import Callable
-from concurrent.futures import ThreadPoolExecutor
+from concurrent.futures import ThreadPoolExecutor, wait
 from typing import Any
 
 import numba
@@ -43,11 +43,15 @@ def run_workers(worker: Callable[..., Any], n: int, args: tuple, threads: int | 
                 ) -> None:
     """``worker(w, *args)`` for w in 0..n-1 on up to ``threads`` threads (default numba's thread
     count, :func:`numba.get_num_threads` of the calling thread), each thread taking the next
-    index when it is free; one index or one thread: in the calling thread."""
+    index when it is free; one index or one thread: in the calling thread. A worker's error is
+    raised once every worker has returned."""
     threads = max(1, min(int(threads or numba.get_num_threads()), n))
     if threads == 1:
         for w in range(n):
             worker(w, *args)
         return
-    for _ in _pool(threads).map(lambda w: worker(w, *args), range(n)):
-        pass
+    pool = _pool(threads)
+    futures = [pool.submit(worker, w, *args) for w in range(n)]
+    wait(futures)  # every worker done (none left writing its outputs) before any error is raised
+    for future in futures:
+        future.result()
