@@ -1,10 +1,11 @@
 """The pointer kernel path (``UserModel.from_one_form``'s default, ``kernel_path="pointer"``): the
-trajectory and sweep kernels and the variational Lyapunov lane blocks compiled once for every
-model, the model's functions compiled alone and called through their addresses. Its results are
-those of the inlined path bit for bit (the gear pair against ``GearPair`` and against the same
-one form inlined; also in a fresh process that loads the callbacks and kernels from numba's
-cache), within the integrator's error of DOP853 and, for an exponent, of the analytic one of a
-linear limit; models of other sizes run on the same compiled kernels."""
+trajectory and sweep kernels, the variational Lyapunov lane blocks and the period map (periodic
+orbits, continuation) compiled once for every model, the model's functions compiled alone and
+called through their addresses. Its results are those of the inlined path bit for bit (the gear
+pair against ``GearPair`` and against the same one form inlined; also in a fresh process that
+loads the callbacks and kernels from numba's cache), within the integrator's error of DOP853
+and, for an exponent, of the analytic one of a linear limit; models of other sizes run on the
+same compiled kernels."""
 
 from __future__ import annotations
 
@@ -22,7 +23,7 @@ import pytest
 import geardyn
 from geardyn.core.kernel_source import KERNEL_PATHS, KernelSource
 from geardyn.errors import ParameterError
-from geardyn.solvers._pointer_kernels import PointerLyapunov
+from geardyn.solvers._pointer_kernels import PointerLyapunov, PointerMonodromy
 from geardyn.solvers.ensemble import LaneResults, run_lanes
 from geardyn.solvers.kernels import kernels_for
 from geardyn.testing import check_model
@@ -229,6 +230,44 @@ def test_the_pointer_lyapunov_spectrum_equals_the_inlined_one_form_bitwise():
     assert one[0].tangent.startswith("variational") and one[0].value.shape == (2,)
 
 
+#: The orbit fields compared bit for bit.
+ORBIT_FIELDS = ("x", "states", "monodromy", "multipliers", "eigenvectors", "observables",
+                "crossings", "residuals", "trace_integral", "event_min", "event_max")
+#: A short continuation of the gear pair's period-1 orbit (impacting: two mesh crossings).
+CONTINUATION = dict(param="Omega", start=0.85, stop=1.0,
+                    settings=geardyn.ContinuationSettings(max_points=8))
+
+
+def _orbits(m: geardyn.Model) -> tuple:
+    """Periodic orbits (impacting and not) and a short continuation of ``m``."""
+    orbits = [geardyn.periodic_orbit(m.with_omega(om)) for om in (0.8, 1.1, 1.6)]
+    return orbits, geardyn.continuation(m, **CONTINUATION)
+
+
+def test_the_pointer_periodic_orbit_and_continuation_equal_the_inlined_one_form_bitwise():
+    """``periodic_orbit`` (Newton shooting on the period map and its monodromy) and
+    ``continuation`` on the pointer path (the shared period map calling the model's array
+    forms through their addresses): bitwise those of the same one form inlined."""
+    inlined = gear_pair(**COEFFS, kernel_path="lane-form")
+    pointer = gear_pair(**COEFFS, kernel_path="pointer")
+    kern = kernels_for(pointer.kernel, "monodromy")
+    assert isinstance(kern, PointerMonodromy)
+    assert not isinstance(kernels_for(inlined.kernel, "monodromy"), PointerMonodromy)
+    (got, branch), (ref, ref_branch) = _orbits(pointer), _orbits(inlined)
+    for a, b in zip(got, ref, strict=True):
+        assert a.status == b.status == 0 and a.iterations == b.iterations
+        for name in ORBIT_FIELDS:
+            np.testing.assert_array_equal(getattr(a, name), getattr(b, name), err_msg=name)
+    assert sum(int(o.crossings.sum()) for o in got) > 0  # impacting orbits among them
+    assert kern._shared.period_map.signatures  # the shared period map ran
+    assert branch.sizes["point"] > 2 and int(branch["mesh_crossings"].sum()) > 0
+    assert list(branch.data_vars) == list(ref_branch.data_vars)
+    for name in branch.data_vars:
+        np.testing.assert_array_equal(branch[name].values, ref_branch[name].values,
+                                      err_msg=name)
+    np.testing.assert_array_equal(branch["Omega"].values, ref_branch["Omega"].values)
+
+
 def test_a_model_without_events_gets_its_exponent_on_the_same_lane_blocks():
     """The unforced Duffing oscillator (no switching functions) at its stable equilibrium
     x = 1 on the pointer path: the largest exponent is -delta / 2, that of its linearisation
@@ -274,7 +313,8 @@ def test_a_rhs_the_duals_cannot_take_is_named_on_the_pointer_path():
 
 #: A fresh process on the pointer path: argv[1] the examples folder, argv[2] the lanes' rows
 #: (.npy), argv[3] the results (.npz). Prints JSON: the cache hits of the part's callbacks and
-#: of the sweep's and trajectory's entries, the bound callees their loaders brought.
+#: of the sweep's, trajectory's and period map's entries, the bound callees their loaders
+#: brought.
 _FRESH = """
 import json, sys
 import numpy as np
@@ -295,6 +335,11 @@ e = geardyn.lyapunov_lanes(m, np.load(sys.argv[2]),
 out = {name: getattr(r, name) for name in LaneResults.__dataclass_fields__}
 out.update({"sim_" + name: s[name].values for name in ("x", "v", "F", "poincare")})
 out.update({f"lyapunov_{i}": v for i, v in enumerate(e)})
+o = geardyn.periodic_orbit(m.with_omega(0.8))
+b = geardyn.continuation(m, "Omega", 0.85, 1.0,
+                         settings=geardyn.ContinuationSettings(max_points=8))
+out.update({"orbit_" + name: getattr(o, name) for name in ("x", "states", "monodromy")})
+out.update({"branch_" + name: b[name].values for name in ("section_point", "multiplier_abs")})
 np.savez(sys.argv[3], **out)
 kl = kernels_for(m.kernel, "lyapunov")
 blocks = [f for f in vars(kl._shared).values() if hasattr(f, "stats")
@@ -302,7 +347,10 @@ blocks = [f for f in vars(kl._shared).values() if hasattr(f, "stats")
 k = kernels_for(m.kernel)
 sweeps = [f for f in vars(k._sweep).values() if hasattr(f, "stats") and f.signatures
           and f.py_func.__module__ == k._sweep.__name__]
+km = kernels_for(m.kernel, "monodromy")._shared
 print(json.dumps({"callbacks": [cb.cache_hits for cb in k.part.CALLBACKS],
+                  "period_map": sum(km.period_map.stats.cache_hits.values()),
+                  "period_map_compiled": sum(km.period_map.stats.cache_misses.values()),
                   "lyapunov_callbacks": [cb.cache_hits for cb in kl.part.CALLBACKS],
                   "lane_blocks": sum(sum(f.stats.cache_hits.values()) for f in blocks),
                   "lane_blocks_compiled": sum(sum(f.stats.cache_misses.values())
@@ -315,15 +363,17 @@ print(json.dumps({"callbacks": [cb.cache_hits for cb in k.part.CALLBACKS],
 
 
 def test_a_fresh_process_loads_the_pointer_path_from_the_cache(tmp_path):
-    """A second process loads the model's C callbacks and the shared sweep and trajectory from
-    numba's cache (bound callees brought by their callers' loaders) and gets GearPair's results
-    bit for bit."""
+    """A second process loads the model's C callbacks and the shared sweep, trajectory and
+    period map from numba's cache (bound callees brought by their callers' loaders) and gets
+    GearPair's results bit for bit (the orbit's and the branch's: this process's)."""
     pair = geardyn.GearPair(**COEFFS)
     pointer = gear_pair(**COEFFS, kernel_path="pointer")
     run = geardyn.RunSettings(transient=300.0, samples=6, steps_per_period=64)
     run_lanes(pointer, _rows(pointer), pointer.initial_state(), run=run)  # cached here
     geardyn.simulate(pointer.with_omega(0.9), run=geardyn.RunSettings(transient=50.0, samples=5))
     exponents = _exponents(pointer)
+    orbit = geardyn.periodic_orbit(pointer.with_omega(0.8))
+    branch = geardyn.continuation(pointer, **CONTINUATION)
     np.save(tmp_path / "rows.npy", _rows(pointer))
     env = {k: v for k, v in os.environ.items() if k != "NUMBA_CACHE_DIR"}
     env["PYTHONPATH"] = os.pathsep.join([str(Path(geardyn.__file__).parents[1]),
@@ -339,6 +389,7 @@ def test_a_fresh_process_loads_the_pointer_path_from_the_cache(tmp_path):
     assert hits["lyapunov_callbacks"] == [1] * 5, hits
     assert hits["lane_blocks"] >= 1 and hits["lane_blocks_compiled"] == 0, hits
     assert hits["loaded"] >= 1 or not hits["bind"], hits  # bound callees (the block run, ...)
+    assert hits["period_map"] >= 1 and hits["period_map_compiled"] == 0, hits
     got = np.load(tmp_path / "out.npz")
     ref = run_lanes(pair, _rows(pair), pair.initial_state(), run=run)
     for name in LaneResults.__dataclass_fields__:
@@ -349,3 +400,7 @@ def test_a_fresh_process_loads_the_pointer_path_from_the_cache(tmp_path):
         np.testing.assert_array_equal(got["sim_" + name], sim[name].values, err_msg=name)
     for i, ref in enumerate(exponents):
         np.testing.assert_array_equal(got[f"lyapunov_{i}"], ref, err_msg=f"lyapunov {i}")
+    for name in ("x", "states", "monodromy"):
+        np.testing.assert_array_equal(got["orbit_" + name], getattr(orbit, name), err_msg=name)
+    for name in ("section_point", "multiplier_abs"):
+        np.testing.assert_array_equal(got["branch_" + name], branch[name].values, err_msg=name)

@@ -37,9 +37,10 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 #: run loads them (~25 s CPU). The one-form gear pair (examples/gear_pair_model.py) takes the
 #: pointer path, the one form's default: its cases compile the pointer path's kernels (once for
 #: every pointer model: the trajectory, the sweep, the variational lane blocks, k = 1 and the
-#: spectrum's, which tests/test_one_form.py, test_codegen.py and test_pointer_path.py load) and
-#: its parts; the same one form inlined (``kernel_path="lane-form"``) is loaded by
-#: tests/test_pointer_path.py's references alone (one worker): not warmed.
+#: spectrum's, which tests/test_one_form.py, test_codegen.py and test_pointer_path.py load, and
+#: the period map of orbits and continuation) and its parts; the same one form inlined
+#: (``kernel_path="lane-form"``) is loaded by tests/test_pointer_path.py's references alone (one
+#: worker): not warmed.
 WARM = {
     "CATTDevice-reduced": ("trajectory", "sweep", "lyapunov", "lanes", "orbit"),
     "CATTDevice-general": ("trajectory", "lyapunov", "lanes", "orbit"),

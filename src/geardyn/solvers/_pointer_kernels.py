@@ -16,12 +16,15 @@ split step too: the shared one). The variational Lyapunov lane blocks (template
 ``"lyapunov"``, :mod:`._pointer_lyapunov`'s hooks) are so too: the model's part of them
 (:func:`lyapunov_part_text`, imported on their first use) is its variational step of a block of
 lanes, the tangent form of its rhs and its array forms as C callbacks
-(:class:`PointerLyapunov`). The arithmetic is the inlined path's: results are bitwise the same.
+(:class:`PointerLyapunov`). The period map and its monodromy (template ``"monodromy"``) are
+the template bound to :data:`SOURCE` too, with the addresses of the model's array forms
+(:class:`PointerMonodromy`): the model compiles nothing of its own for a periodic orbit or a
+continuation. The arithmetic is the inlined path's: results are bitwise the same.
 
 This module gives the texts and the kernels' wrappers; :func:`geardyn.solvers.kernels.kernels_for`
 writes, imports and keeps the modules (as it does every generated module) and takes the model's
 functions inlined for its other templates (the difference tangent and spectra of Lyapunov,
-monodromy, run-up).
+run-up).
 """
 
 from __future__ import annotations
@@ -37,8 +40,8 @@ from geardyn.core.kernel_source import KernelSource
 from geardyn.core.one_form import adapters
 from geardyn.solvers._pointer_calls import N_ADDRESSES, N_LYAPUNOV
 
-__all__ = ["PointerKernels", "PointerLyapunov", "SOURCE", "hooked_text", "lyapunov_part_text",
-           "part_text"]
+__all__ = ["PointerKernels", "PointerLyapunov", "PointerMonodromy", "SOURCE", "hooked_text",
+           "lyapunov_part_text", "part_text"]
 
 
 def _source() -> KernelSource:
@@ -243,6 +246,8 @@ class PointerKernels:
     def rows(self, P: np.ndarray) -> np.ndarray:
         """The coefficient rows ``P`` (one row or a matrix) with the addresses appended."""
         P = np.asarray(P, dtype=float)
+        if P.ndim == 1:  # one row (a call per point of an orbit's read-back): no broadcast
+            return np.concatenate((P, self.addresses))
         tail = np.broadcast_to(self.addresses, (*P.shape[:-1], N_ADDRESSES))
         return np.ascontiguousarray(np.concatenate((P, tail), axis=-1))
 
@@ -326,5 +331,28 @@ class PointerLyapunov:
 
     def __getattr__(self, name: str) -> Any:
         if name.startswith("__") or name in ("_inlined", "_part", "_shared", "_load_part"):
+            raise AttributeError(name)
+        return getattr(self._inlined(), name)
+
+
+class PointerMonodromy:
+    """A pointer model's period map and monodromy (``period_map``): that of the ``"monodromy"``
+    module of :data:`SOURCE` (``shared``, compiled once for every model: its tangent rows
+    evaluate the model through its array forms, one call per row and stage) on the coefficient
+    row with the model's callback addresses appended (``kernels``: its
+    :class:`PointerKernels`). Any other attribute is that of the model's inlined
+    ``"monodromy"`` module (``inlined()``, made on first use)."""
+
+    def __init__(self, shared: types.ModuleType, kernels: PointerKernels,
+                 inlined: Callable[[], types.ModuleType]):
+        self._shared = shared
+        self._kernels = kernels
+        self._inlined = inlined
+
+    def period_map(self, p: np.ndarray, *args: Any) -> Any:
+        return self._shared.period_map(self._kernels.rows(p), *args)
+
+    def __getattr__(self, name: str) -> Any:
+        if name.startswith("__") or name in ("_inlined", "_shared", "_kernels"):
             raise AttributeError(name)
         return getattr(self._inlined(), name)

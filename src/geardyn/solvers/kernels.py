@@ -329,10 +329,10 @@ def load_generated(name: str, code: str) -> types.ModuleType:
 def kernels_for(source: KernelSource, template: str = "rk4") -> Any:
     """The kernel module of ``template`` for a model's functions (built, written and imported on
     first use, then kept for the process). A model that declares the ``"pointer"`` path
-    (:mod:`._pointer_kernels`) gets the trajectory and sweep kernels and the variational
-    Lyapunov lane blocks compiled once for every model, bound to its callbacks' addresses
-    (:func:`_pointer_path`, :func:`_pointer_lyapunov`), and its functions inlined in the other
-    templates."""
+    (:mod:`._pointer_kernels`) gets the trajectory and sweep kernels, the variational
+    Lyapunov lane blocks and the period map compiled once for every model, bound to its
+    callbacks' addresses (:func:`_pointer_path`, :func:`_pointer_lyapunov`,
+    :func:`_pointer_monodromy`), and its functions inlined in the other templates."""
     if "geardyn.core.dual" not in sys.modules:
         # the dual numbers' overloads, installed (numba's typing refreshed) before a kernel
         # compiles, under numba's compiler lock (no compile of another thread sees them
@@ -346,6 +346,8 @@ def kernels_for(source: KernelSource, template: str = "rk4") -> Any:
             return _pointer_path(source)
         if template == "lyapunov":
             return _pointer_lyapunov(source)
+        if template == "monodromy":
+            return _pointer_monodromy(source)
         source = dataclasses.replace(source, path=None)
     funcs = source.functions()
     key = (template, source.plain, source.one_form, *funcs, *(id(f) for f in funcs.values()))
@@ -432,6 +434,21 @@ def _pointer_lyapunov(source: KernelSource) -> pointer.PointerLyapunov:
 
     _LOADED[key] = pointer.PointerLyapunov(_pointer_hooked("lyapunov", hooks), part,
                                            lambda: kernels_for(inlined, "lyapunov"))
+    return _LOADED[key]
+
+
+def _pointer_monodromy(source: KernelSource) -> pointer.PointerMonodromy:
+    """The :class:`._pointer_kernels.PointerMonodromy` of a one-form model on the pointer path
+    (kept for the process): the ``"monodromy"`` module of :data:`._pointer_kernels.SOURCE`
+    with the addresses of the model's part (:func:`_pointer_path`'s), its other monodromy
+    names inlined."""
+    funcs = source.functions()
+    key = ("pointer-monodromy", source.one_form, *funcs, *(id(f) for f in funcs.values()))
+    if key not in _LOADED:
+        inlined = dataclasses.replace(source, path=None)
+        _LOADED[key] = pointer.PointerMonodromy(
+            kernels_for(pointer.SOURCE, "monodromy"), _pointer_path(source),
+            lambda: kernels_for(inlined, "monodromy"))
     return _LOADED[key]
 
 
