@@ -11,8 +11,8 @@ model (the split step, its root finders, the rows of a lane), which it compiles 
 functions inlined; the kernel templates and the sweep's and the Lyapunov kernels' bookkeeping
 (:mod:`._sweep_books`, :mod:`._lyapunov_books`) import them from here too.
 
-The helpers of the split path that it calls at many sites (the side of an edge, the forcing
-phase at a fraction of a step and its polynomials) are compiled once per argument types and
+The helpers of the split path that it calls at many sites (the forcing phase at a fraction of
+a step and its polynomials) are compiled once per argument types and
 inlined by LLVM (``forceinline``, without reference counting: they allocate nothing), not copied
 into every call site by numba's frontend; the arithmetic is the same (bitwise equal).
 """
@@ -236,7 +236,7 @@ def fd_tangent(ya, yb, e, inv_s):
     return _pick(math.isfinite(e), ((ya - yb) * (0.5 / e)) * inv_s, np.nan)
 
 
-@nb.njit(forceinline=True, _nrt=False, **_JIT)
+@nb.njit(inline="always", **_JIT)
 def _side(x):
     return 1 if x > 0.0 else -1
 
