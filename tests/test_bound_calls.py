@@ -206,3 +206,21 @@ def test_geardyn_callers_declare_and_plain_numba_links(monkeypatch):
     assert geardyn_caller(a) == plain_caller(a)
     assert _defines(geardyn_caller, "_body") == [False]  # declared, bound to the one copy
     assert False not in _defines(plain_caller, "_body")  # numba's linked copy (or inlined)
+
+
+_forced = numba.njit(forceinline=True, _nrt=False, pipeline_class=WidthCompiler)(_body)
+
+
+def _call_forced(a):
+    out = np.empty_like(a)
+    return _forced(a, out) + out[0]
+
+
+def test_a_forceinline_callee_is_inlined_not_bound(monkeypatch):
+    """A callee marked ``forceinline`` (LLVM's ``alwaysinline``) is never bound, however big:
+    its geardyn callers link it and LLVM inlines it (a declaration could not be inlined)."""
+    monkeypatch.setattr(_bound_calls, "MIN_INSTRUCTIONS", 1)
+    a = np.linspace(0.0, 3.0, 17)
+    caller = numba.njit(pipeline_class=WidthCompiler)(_call_forced)
+    np.testing.assert_allclose(caller(a), np.sum(np.cos(a)) + np.cos(a[0]), rtol=1e-12)
+    assert _defines(caller, "_body") == []  # inlined: neither declared nor defined

@@ -91,10 +91,12 @@ def _declaration(fn: Any) -> tuple[list[str], list[str], list[list[str]]]:
 
 def _big(module: Any, linkage: Any) -> list:
     """The functions ``module`` defines with ``linkage`` (wrappers left out) that are big
-    enough to be bound."""
+    enough to be bound; not those marked to be inlined at every call site (numba's
+    ``forceinline``: LLVM's ``alwaysinline``), which their callers link and inline."""
     return [fn for fn in module.functions
             if not fn.is_declaration and fn.linkage == linkage
             and not fn.name.startswith(("cpython.", "cfunc.", "_ZN7cpython", "_ZN5cfunc"))
+            and not any(b"alwaysinline" in attrs.split() for attrs in fn.attributes)
             and _at_least(fn, MIN_INSTRUCTIONS)]
 
 

@@ -367,7 +367,7 @@ def _block_tables(OMEGA, NPER, k, block_rows, min_blocks):
     of the lane's) and the number of blocks (:func:`_block_count`) of
     :func:`lyapunov_block_lanes`."""
     L = OMEGA.shape[0]
-    forced = False
+    forced = bool(False)  # noqa: UP018 - not a literal: phase_table compiled once
     for lane in range(L):
         if OMEGA[lane] != 0.0:
             forced = True

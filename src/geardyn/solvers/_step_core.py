@@ -83,9 +83,14 @@ _events_i = nb.njit(forceinline=True, _nrt=False, **_JIT)(events.py_func)
 # The split path (a step with a located crossing: :func:`_split_step`, :func:`_rk4_stages` and
 # the root finders) inlines them too; a model with lane-scalar functions takes those there
 # instead, the state in registers (see :func:`_split_rhs` and the FUSED block below).
+# The split path's helpers that it calls at several sites (the interpolant and its events, the
+# first crossing, the RK4 sub-step, the rhs and copies of the split path) are compiled the same
+# way, so that numba types each once per argument types, not once per call site in each split
+# step (the plain one and the Lyapunov kernel's variational one); LLVM inlines them, the same
+# arithmetic (bitwise equal).
 
 
-@nb.njit(inline="always", **_JIT)
+@nb.njit(forceinline=True, _nrt=False, **_JIT)
 def _hermite(y0, f0, y1, f1, dt, theta, out):
     """Cubic Hermite interpolant of a step of length dt at fraction theta."""
     h00, h10, h01, h11 = _hermite_weights(dt, theta)
@@ -217,7 +222,7 @@ def _beyond(th, e, j, side_j, tol, y0, f0, y1, f1, dt, t, p, ybuf, g, pc):
     return ge if _side(ge) != side_j and abs(ge) > tol else np.nan
 
 
-@nb.njit(inline="always", **_JIT)
+@nb.njit(forceinline=True, _nrt=False, **_JIT)
 def _interpolant_events(y0, f0, y1, f1, dt, t, p, ybuf, g0, g13, g23, pc):
     """The events along a step's cubic Hermite interpolant (start y0, end y1, derivatives f0, f1,
     length dt, from time t; forcing phase pc, see :func:`_phase_in`) at theta = 0, 1/3, 2/3
@@ -232,7 +237,7 @@ def _interpolant_events(y0, f0, y1, f1, dt, t, p, ybuf, g0, g13, g23, pc):
     _events_i(t + 2.0 / 3.0 * dt, ybuf, g23, p, sx, cx)
 
 
-@nb.njit(inline="always", **_JIT)
+@nb.njit(forceinline=True, _nrt=False, **_JIT)
 def _first_crossing(j, side_j, graze, g1j, y0, f0, y1, f1, dt, t, p, ybuf, gbuf, gsc, pc):
     """Fraction in (0, 1] of the step where event j first leaves side side_j along the step's
     cubic Hermite interpolant, or 2.0 if it stays on its side. g1j: the event at the end; gbuf
@@ -292,7 +297,7 @@ def _leaves_side_step(r, t0, t1, Y, K1, G0, G1, SIDE, p, ybuf, gbuf, s1, c1):
     return out
 
 
-@nb.njit(inline="always", **_JIT)
+@nb.njit(forceinline=True, _nrt=False, **_JIT)
 def _rk4_stages(y, h, tm, pm, sm, cm, te, pe, se, ce, k1, kst, acc, tmp, out):
     """One classic RK4 step of size h from y into out, k1 (the rhs at the step's start) given:
     the middle stages at time tm with coefficients pm and forcing phase sm, cm, the last at te
@@ -358,14 +363,14 @@ def _events_columns(T, Y, G, PT, P, LANE, nl, S, C, ybuf, gb):
             G[j, k] = gb[j]
 
 
-@nb.njit(inline="always", **_JIT)
+@nb.njit(forceinline=True, _nrt=False, **_JIT)
 def _split_rhs(t, y, out, p, s, c):
     """The model's rhs f(t, y) into out, on the split path (for a model with lane-scalar
     functions: the lane form, see below)."""
     _rhs_i(t, y, out, p, s, c)
 
 
-@nb.njit(inline="always", **_JIT)
+@nb.njit(forceinline=True, _nrt=False, **_JIT)
 def _split_copy(dst, src):
     """dst[:] = src, on the split path (see :func:`_split_rhs`)."""
     for q in range(src.size):
@@ -796,16 +801,16 @@ if "rhs_lane" in globals():  # the model's lane-scalar functions (see .kernels)
     # element by element. With the array loops LLVM loaded a freshly stored state or stage as
     # one vector, which no store can forward to (a stall of ~15 cycles each, ~1/5 of a split,
     # see bench/perf_map.py); the same arithmetic (bitwise equal).
-    @nb.njit(inline="always", **_JIT)
+    @nb.njit(forceinline=True, _nrt=False, **_JIT)
     def _split_rhs(t, y, out, p, s, c):  # noqa: F811 - the lane form of the generic one
         v = _rhs_l(t, _t_get(y), p[None, :].T, 0, s, c, FORM_GENERAL)
         _t_put(out, v)
 
-    @nb.njit(inline="always", **_JIT)
+    @nb.njit(forceinline=True, _nrt=False, **_JIT)
     def _split_copy(dst, src):  # noqa: F811
         _t_put(dst, _t_get(src))
 
-    @nb.njit(inline="always", **_JIT)
+    @nb.njit(forceinline=True, _nrt=False, **_JIT)
     def _rk4_stages(y, h, tm, pm, sm, cm, te, pe, se, ce, k1, kst, acc, tmp, out):  # noqa: F811
         ptm = pm[None, :].T  # PT[j, 0] = p[j]: the lane functions' coefficient layout, a view
         pte = pe[None, :].T
@@ -817,7 +822,7 @@ if "rhs_lane" in globals():  # the model's lane-scalar functions (see .kernels)
         k4 = _rhs_l(te, _t_axpy(yt, h, k3), pte, 0, se, ce, FORM_GENERAL)
         _t_put(out, _t_comb(yt, rk4_sixth(h), k1t, k2, k3, k4))
 
-    @nb.njit(inline="always", **_JIT)
+    @nb.njit(forceinline=True, _nrt=False, **_JIT)
     def _hermite(y0, f0, y1, f1, dt, theta, out):  # noqa: F811
         h00, h10, h01, h11 = _hermite_weights(dt, theta)
         _t_put(out, _t_hermite(_t_get(y0), _t_get(f0), _t_get(y1), _t_get(f1), h00, h10, h01,
