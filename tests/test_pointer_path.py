@@ -80,6 +80,24 @@ def test_the_pointer_path_equals_gear_pair_and_the_inlined_one_form_bitwise():
         np.testing.assert_array_equal(sb[name].values, sa[name].values, err_msg=name)
 
 
+@pytest.mark.parametrize(("omega", "periods"), [(0.9, 400), (1.3, 2000)])
+def test_a_long_located_trajectory_of_the_pointer_path_equals_the_inlined_ones_bitwise(omega,
+                                                                                      periods):
+    """``simulate`` of the pointer model with its edges located, over many periods of impacts
+    (split steps): bitwise GearPair's and the one form inlined's, every recorded column, the
+    crossings counted and the unresolved steps."""
+    models = [geardyn.GearPair(**COEFFS), gear_pair(**COEFFS, kernel_path="lane-form"),
+              gear_pair(**COEFFS, kernel_path="pointer")]
+    run = geardyn.RunSettings(transient=0.0, samples=periods, steps_per_period=128,
+                              locate_edges=True)
+    a, b, c = (geardyn.simulate(m.with_omega(omega), run=run) for m in models)
+    assert c["edge_crossings"].values.sum() > 10  # impacts: the split step ran
+    for ref in (a, b):
+        for name in ("x", "v", "F", "poincare", "edge_crossings"):
+            np.testing.assert_array_equal(c[name].values, ref[name].values, err_msg=name)
+        assert c.attrs["unresolved_steps"] == ref.attrs["unresolved_steps"]
+
+
 def test_the_pointer_path_agrees_with_dop853():
     """Simulation and sweep lanes of an impacting gear pair against DOP853 at tight tolerance
     (on the same one form inlined: the reference does not go through the pointer path)."""
@@ -357,7 +375,7 @@ print(json.dumps({"callbacks": [cb.cache_hits for cb in k.part.CALLBACKS],
                                               for f in blocks),
                   "sweep": sum(sum(f.stats.cache_hits.values()) for f in sweeps),
                   "compiled": sum(sum(f.stats.cache_misses.values()) for f in sweeps),
-                  "trajectory": sum(k._shared.trajectory.stats.cache_hits.values()),
+                  "trajectory": sum(k._sweep.trajectory.stats.cache_hits.values()),
                   "loaded": len(_bound_calls._LOADED), "bind": _bound_calls.ENABLED}))
 """
 

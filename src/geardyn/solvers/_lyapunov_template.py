@@ -1373,6 +1373,25 @@ if VARIATIONAL:
         return n_flag
 
 
+@nb.njit(inline="always", **_JIT)
+def _var_steps(form, i, stop, n_adv, nl, locate, commit, Z0, Z1, S, IS, PT, T0L, HL, HHL, H6L,
+               PH, IDX, ENDL, ACT, FLAG, GR, Y1F, NPL):
+    """Grid steps i, i + 1, .. of every lane of the block (:func:`_var_fused_steps`, its
+    arguments from nl on) up to the first with a flagged lane or step stop - 1, the phase
+    indices IDX of lanes 0..n_adv-1 advanced after each step but that last one; returns that
+    last step (its flagged lanes in FLAG). Steps stop - 1 at the latest: the caller's
+    bookkeeping, due at step stop, and a lane's end change nothing here (ACT)."""
+    j = i
+    while True:
+        n_flag = _var_fused_steps(form, j, nl, locate, commit, Z0, Z1, S, IS, PT, T0L, HL, HHL,
+                                  H6L, PH, IDX, ENDL, ACT, FLAG, GR, Y1F)
+        if n_flag > 0 or j + 1 >= stop:
+            return j
+        for l in range(n_adv):
+            IDX[l] = IDX[l] + 2 if IDX[l] + 2 < ENDL[l] else IDX[l] + 2 - 2 * NPL[l]
+        j += 1
+
+
 @nb.njit(_nrt=False, **_JIT)  # it allocates nothing: no reference counting of its views
 def _var_flagged(i, nl, first, n_ev, P, ZT, S, IS, T0L, HL, OMEGA, NPL, IDX, S_TAB, C_TAB,
                  FLAG, UNRR, FDL, GR, Y1F, fd):
@@ -1503,14 +1522,19 @@ def _lyap_var_run1(form, first, nl, n_ev, max_total, due, renorm, bound, P, OMEG
     S_TAB, C_TAB = scratch
     nv = _padded(nl)
     locate = n_ev > 0
-    for i in range(max_total):
+    i = 0
+    while i < max_total:
         live = False
         for l in range(nl):
             live = live | ACT[l]
         if not live:
             break
-        n_flag = _var_fused_steps(form, i, nv, locate, True, Z0, Z1, S, IS, PT, T0L, HL, HHL,
-                                  H6L, PH, IDX, ENDL, ACT, FLAG, GR, Y1F)
+        # the steps up to the next flagged one or bookkeeping, in one call
+        i = _var_steps(form, i, min(max_total, max(due, i + 1)), nl, nv, locate, True, Z0, Z1,
+                       S, IS, PT, T0L, HL, HHL, H6L, PH, IDX, ENDL, ACT, FLAG, GR, Y1F, NPL)
+        n_flag = 0
+        for l in range(nl):
+            n_flag += 1 if FLAG[l] != 0.0 else 0
         if n_flag > 0:
             _var_flagged(i, nl, first, n_ev, P, ZT, S, IS, T0L, HL, OMEGA, NPL, IDX, S_TAB,
                          C_TAB, FLAG, UNRR, FDL, GR, Y1F, fd)
@@ -1520,6 +1544,7 @@ def _lyap_var_run1(form, first, nl, n_ev, max_total, due, renorm, bound, P, OMEG
         if step >= due:  # (inlined, on Z0 and Z1: no call of ~100 words at most steps)
             due = _lane_books_one(step, first, nl, renorm, bound, Z0, Z1, Zl, Cl, logs, IST,
                                   ENDS, BLK, ACC, ACT, status)
+        i = step
 
 
 @nb.njit(_nrt=False, **_JIT_NOALIAS)

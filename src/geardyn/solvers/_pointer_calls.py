@@ -53,12 +53,13 @@ STEP_ARGS = (types.int64, types.boolean, types.float64, _F, _F, types.float64[:,
 #: functions, the addresses of its variational step of a block of lanes
 #: (:data:`VAR_STEP_ARGS`) and of the tangent form of its rhs (:data:`TANGENT_ARGS`).
 N_LYAPUNOV = 3
-#: The numba types of the variational step's arguments (``_var_fused_steps`` of a model's
+#: The numba types of the variational steps' arguments (``_var_steps`` of a model's
 #: ``"lyapunov"`` kernel module, :mod:`._lyapunov_template`, in its lane form: without
-#: ``form``), its tuple of phases unpacked: i, nl, locate, commit, Z0, Z1, S, IS, PT, T0L, HL,
-#: HHL, H6L, the phases and their increments (6), IDX, ENDL, ACT, FLAG, GR, Y1F.
-VAR_STEP_ARGS = (types.int64, types.int64, types.boolean, types.boolean, *(_F,) * 4,
-                 types.float64[:, ::1], *(_F,) * 4, *(_F,) * 6, _I, _I, _B, _F, _F, _F)
+#: ``form``), its tuple of phases unpacked: i, stop, n_adv, nl, locate, commit, Z0, Z1, S, IS,
+#: PT, T0L, HL, HHL, H6L, the phases and their increments (6), IDX, ENDL, ACT, FLAG, GR, Y1F,
+#: NPL.
+VAR_STEP_ARGS = (*(types.int64,) * 4, types.boolean, types.boolean, *(_F,) * 4,
+                 types.float64[:, ::1], *(_F,) * 4, *(_F,) * 6, _I, _I, _B, _F, _F, _F, _I)
 #: The numba types of the arguments of a model's tangent form of its rhs, ``rhs_tangent(t, y, v,
 #: dy, dv, p, s, c)`` (:func:`geardyn.core.one_form.tangent_adapters`).
 TANGENT_ARGS = (types.float64, *(_F,) * 5, types.float64, types.float64)

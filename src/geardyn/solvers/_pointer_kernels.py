@@ -11,15 +11,15 @@ core module, :mod:`._step_core`) compiled as C callbacks, whose addresses are ap
 every coefficient row the kernels receive (:class:`PointerKernels`). The sweep
 (:func:`hooked_text`: the ``"rk4"`` template's text with :mod:`._pointer_template`'s hooks) is
 the inlined sweep's block loop and bookkeeping, calling the fused step once per block step and
-the split step for a flagged slot; a trajectory calls the array forms one lane at a time (its
-split step too: the shared one). The variational Lyapunov lane blocks (template
-``"lyapunov"``, :mod:`._pointer_lyapunov`'s hooks) are so too: the model's part of them
-(:func:`lyapunov_part_text`, imported on their first use) is its variational step of a block of
-lanes, the tangent form of its rhs and its array forms as C callbacks
-(:class:`PointerLyapunov`). The period map and its monodromy (template ``"monodromy"``) are
-the template bound to :data:`SOURCE` too, with the addresses of the model's array forms
-(:class:`PointerMonodromy`): the model compiles nothing of its own for a periodic orbit or a
-continuation. The arithmetic is the inlined path's: results are bitwise the same.
+the split step for a flagged slot; the trajectory (one lane, the template's text in the same
+module) calls the array forms for its stages and the model's split step for a flagged step. The
+variational Lyapunov lane blocks (template ``"lyapunov"``, :mod:`._pointer_lyapunov`'s hooks)
+are as the sweep: the model's part of them (:func:`lyapunov_part_text`, imported on their first
+use) is its variational steps of a block of lanes, the tangent form of its rhs and its array
+forms as C callbacks (:class:`PointerLyapunov`). The period map and its monodromy (template
+``"monodromy"``) are the template bound to :data:`SOURCE`, with the addresses of the model's
+array forms (:class:`PointerMonodromy`): the model compiles nothing of its own for a periodic
+orbit or a continuation. The arithmetic is the inlined path's: results are bitwise the same.
 
 This module gives the texts and the kernels' wrappers; :func:`geardyn.solvers.kernels.kernels_for`
 writes, imports and keeps the modules (as it does every generated module) and takes the model's
@@ -37,7 +37,6 @@ from typing import Any
 import numpy as np
 
 from geardyn.core.kernel_source import KernelSource
-from geardyn.core.one_form import adapters
 from geardyn.solvers._pointer_calls import N_ADDRESSES, N_LYAPUNOV
 
 __all__ = ["PointerKernels", "PointerLyapunov", "PointerMonodromy", "SOURCE", "hooked_text",
@@ -145,12 +144,15 @@ def _step_call(v: list[str]) -> str:
 
 def part_text(source: KernelSource, core: str, steps: str) -> str:
     """The text of the model's part; ``core``, ``steps``: the names of the model's core module
-    (its split step) and of its inlined ``"rk4"`` kernel module (its fused step)."""
+    (its split step and array forms, those of its trajectory too) and of its inlined ``"rk4"``
+    kernel module (its fused step)."""
     from geardyn.solvers._pointer_calls import SPLIT_ARGS, STEP_ARGS
 
     return (_PART_HEAD + f"from {core} import _split_step as _core_split\n"
+            + f"from {core} import events, observe, rhs\n"
+            + "from geardyn.core.kernel_source import FORM_QUIET as _ONE_FORM\n"
             + f"from {steps} import _fused_steps as _model_steps\n"
-            + "\n# MODEL-IMPORT\n" + adapters(source.one_form) + _PART_TAIL
+            + "\n# MODEL-IMPORT\n" + _PART_TAIL
             + _flat_cfunc("c_step", _step_call, STEP_ARGS, "_flat_signature(_STEP_ARGS)",
                           '{**_JIT, "pipeline_class": _NoAlias}')
             + _flat_cfunc("c_split", lambda v: f"_core_split({', '.join(v)})", SPLIT_ARGS,
@@ -160,13 +162,13 @@ def part_text(source: KernelSource, core: str, steps: str) -> str:
 
 
 def _var_step_call(v: list[str]) -> str:
-    """The model's variational step of a block of lanes (its ``"lyapunov"`` module's
-    ``_var_fused_steps`` in its lane form ``_ONE_FORM``) of the flat arguments v
-    (:data:`._pointer_calls.VAR_STEP_ARGS`), its phases regrouped: the number of flagged lanes.
-    Its callback (``c_var_step``) is compiled as the lane blocks' time loop is: noalias arrays,
-    no reference counting, the step inlined."""
-    return (f"_model_var_steps(_ONE_FORM, {', '.join(v[:13])}, ({', '.join(v[13:19])}), "
-            f"{', '.join(v[19:])})")
+    """The model's variational steps of a block of lanes (its ``"lyapunov"`` module's
+    ``_var_steps`` in its lane form ``_ONE_FORM``: the steps up to the next flagged one or
+    bookkeeping) of the flat arguments v (:data:`._pointer_calls.VAR_STEP_ARGS`), its phases
+    regrouped: the last step done. Its callback (``c_var_step``) is compiled as the lane
+    blocks' time loop is: noalias arrays, no reference counting, the steps inlined."""
+    return (f"_model_var_steps(_ONE_FORM, {', '.join(v[:15])}, ({', '.join(v[15:21])}), "
+            f"{', '.join(v[21:])})")
 
 
 _LYAPUNOV_PART_HEAD = '''"""A model's part of the pointer path's Lyapunov lane blocks (generated by
@@ -188,7 +190,7 @@ def _zero(_):
 
 def lyapunov_part_text(source: KernelSource, core: str, lyapunov: str) -> str:
     """The text of the model's part of the pointer path's Lyapunov lane blocks
-    (:mod:`._pointer_lyapunov`): its variational step of a block of lanes (from its inlined
+    (:mod:`._pointer_lyapunov`): its variational steps of a block of lanes (from its inlined
     ``"lyapunov"`` kernel module, ``lyapunov``: its name), the tangent form of its rhs (that
     module's ``rhs_tangent``) and its array forms (its core module's, ``core``), compiled as C
     callbacks (``CALLBACKS``, in the order of their addresses in a coefficient row), and its
@@ -197,7 +199,7 @@ def lyapunov_part_text(source: KernelSource, core: str, lyapunov: str) -> str:
     from geardyn.solvers._pointer_calls import TANGENT_ARGS, VAR_STEP_ARGS
 
     head = _LYAPUNOV_PART_HEAD + _PART_HEAD.split('"""', 2)[2]
-    return (head + f"from {lyapunov} import _var_fused_steps as _model_var_steps\n"
+    return (head + f"from {lyapunov} import _var_steps as _model_var_steps\n"
             + f"from {lyapunov} import rhs_tangent as _model_rhs_tangent\n"
             + f"from {core} import events, observe, rhs\n"
             + "\n# MODEL-IMPORT\n" + _LYAPUNOV_PART + _PART_TAIL
@@ -225,11 +227,12 @@ def hooked_text(shared: str, hooks: types.ModuleType) -> str:
 
 class PointerKernels:
     """A pointer model's trajectory and sweep kernels (``trajectory``, ``sweep``, ``rhs``,
-    ``events``, ``observe``): those of :data:`SOURCE` (compiled once for every model) with the
-    model's callback addresses appended to every coefficient row. Any other attribute is that
-    of the model's inlined ``"rk4"`` kernel module (``inlined()``: made on first use, its
-    functions compiled on their first call), so that no function of the shared modules is
-    called without the addresses. ``shared``, ``sweep``, ``part``: the kernel module of
+    ``events``, ``observe``): those of :data:`SOURCE` (compiled once for every model; the
+    trajectory and the sweep those of the pointer sweep's module, whose split step is the
+    model's) with the model's callback addresses appended to every coefficient row. Any other
+    attribute is that of the model's inlined ``"rk4"`` kernel module (``inlined()``: made on
+    first use, its functions compiled on their first call), so that no function of the shared
+    modules is called without the addresses. ``shared``, ``sweep``, ``part``: the kernel module of
     :data:`SOURCE`, the pointer sweep's (:func:`hooked_text`), the model's part
     (:func:`part_text`)."""
 
@@ -252,7 +255,9 @@ class PointerKernels:
         return np.ascontiguousarray(np.concatenate((P, tail), axis=-1))
 
     def trajectory(self, p: np.ndarray, *args: Any) -> Any:
-        return self._shared.trajectory(self.rows(p), *args)
+        """The pointer sweep module's trajectory: its flagged steps the model's own split step
+        (the sweep's hook), its stages the model's array forms through their addresses."""
+        return self._sweep.trajectory(self.rows(p), *args)
 
     def rhs(self, t, y, dy, p, s, c) -> None:
         self._shared.rhs(t, y, dy, self.rows(p), s, c)

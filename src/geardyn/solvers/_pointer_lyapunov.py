@@ -10,10 +10,13 @@ names, so that the variational lane blocks (``lyapunov_lanes``, ``lyapunov_block
 step with the tangent carried through the sub-steps, the difference rows where that is
 ill-posed) are the template's own text, and only these differ:
 
-* ``_var_fused_steps``: a grid step of every lane of the block, state and tangent vector, is the
-  model's own (its inlined ``"lyapunov"`` module's ``_var_fused_steps`` in its lane form,
-  compiled with the model as a C callback, :func:`._pointer_kernels.lyapunov_part_text`),
-  called through its address once per block step;
+* ``_var_steps``: the grid steps of every lane of the block, state and tangent vector, up to
+  the next flagged step or bookkeeping, are the model's own (its inlined ``"lyapunov"``
+  module's ``_var_steps`` in its lane form, compiled with the model as a C callback,
+  :func:`._pointer_kernels.lyapunov_part_text`), called through its address once per such
+  run of steps (one tangent vector: up to the renormalisation interval's steps a call);
+  ``_var_fused_steps`` (several tangent vectors, a pass of them per call) is that callback of
+  one step;
 * ``_n_switching``: the model's number of switching functions (the size of the graze flags'
   rows), read from the coefficients.
 
@@ -49,12 +52,26 @@ def _n_switching(Z0, PT):
 
 
 @nb.njit(inline="always", **_JIT)
+def _var_steps(form, i, stop, n_adv, nl, locate, commit, Z0, Z1, S, IS, PT, T0L, HL, HHL, H6L,
+               PH, IDX, ENDL, ACT, FLAG, GR, Y1F, NPL):
+    """The model's variational steps of every lane of the block (its ``_var_steps`` in its
+    lane form, the arguments flattened: :data:`._pointer_calls.VAR_STEP_ARGS`: the steps up to
+    the next flagged one or bookkeeping), called through its address (the second Lyapunov
+    entry of lane 0's coefficients: every lane of a block is of the one model); the last step
+    done."""
+    addr = np.int64(PT[PT.shape[0] - _LYAPUNOV_AT + 1, 0])
+    return call_flat(addr, (i, stop, n_adv, nl, locate, commit, Z0, Z1, S, IS, PT, T0L, HL, HHL,
+                            H6L) + PH + (IDX, ENDL, ACT, FLAG, GR, Y1F, NPL))
+
+
+@nb.njit(inline="always", **_JIT)
 def _var_fused_steps(form, i, nl, locate, commit, Z0, Z1, S, IS, PT, T0L, HL, HHL, H6L, PH,
                      IDX, ENDL, ACT, FLAG, GR, Y1F):
-    """The model's variational step of every lane of the block (its ``_var_fused_steps`` in
-    its lane form, the arguments flattened: :data:`._pointer_calls.VAR_STEP_ARGS`), called
-    through its address (the second Lyapunov entry of lane 0's coefficients: every lane of a
-    block is of the one model); the number of flagged lanes."""
-    addr = np.int64(PT[PT.shape[0] - _LYAPUNOV_AT + 1, 0])
-    return call_flat(addr, (i, nl, locate, commit, Z0, Z1, S, IS, PT, T0L, HL, HHL, H6L) + PH
-                     + (IDX, ENDL, ACT, FLAG, GR, Y1F))
+    """The model's variational step i of every lane of the block (:func:`_var_steps` of the
+    one step); the number of flagged lanes."""
+    _var_steps(form, i, i + 1, 0, nl, locate, commit, Z0, Z1, S, IS, PT, T0L, HL, HHL, H6L, PH,
+               IDX, ENDL, ACT, FLAG, GR, Y1F, IDX)
+    n_flag = 0
+    for l in range(nl):
+        n_flag += 1 if FLAG[l] != 0.0 else 0
+    return n_flag
