@@ -1481,22 +1481,30 @@ def _lyap_var_run(form, first, nl, n_ev, max_total, due, renorm, bound, P, OMEGA
     IST, ENDS, BLK, ACC, Zl, Cl, logs = books
     S_TAB, C_TAB = scratch
     locate = n_ev > 0
-    for i in range(max_total):
+    i = 0
+    while i < max_total:
         live = False
         for l in range(nl):
             live = live | ACT[l]
         if not live:
             break
-        n_flag = 0
+        # one pass: the steps up to the next flagged one or bookkeeping in one call (each slot
+        # steps its own copy of its lane's state, the same operations); several: one step
+        stop = min(max_total, max(due, i + 1)) if n_pass == 1 else i + 1
+        last = i
         for g in range(n_pass):  # one call site of the fused loop
             j_lo = g * kp
             kk = min(kp, k - j_lo)
             if k > 1:
                 _var_load(ZT, ZX, nl, j_lo, kk)
-            n_flag = _var_fused_steps(form, i, nv, locate, g == n_pass - 1, Z0, ZX, S, IS, PT,
-                                      T0L, HL, HHL, H6L, PH, IDX, ENDL, ACT, FLAG, GR, Y1F)
+            last = _var_steps(form, i, stop, n_slot, nv, locate, g == n_pass - 1, Z0, ZX, S,
+                              IS, PT, T0L, HL, HHL, H6L, PH, IDX, ENDL, ACT, FLAG, GR, Y1F, NPL)
             if k > 1:
                 _var_store(ZT, ZX, nl, j_lo, kk)
+        i = last
+        n_flag = 0
+        for l in range(nl):
+            n_flag += 1 if FLAG[l] != 0.0 else 0
         if n_flag > 0:
             _var_flagged(i, nl, first, n_ev, P, ZT, S, IS, T0L, HL, OMEGA, NPL, IDX, S_TAB,
                          C_TAB, FLAG, UNRR, FDL, GR, Y1F, fd)
@@ -1508,6 +1516,7 @@ def _lyap_var_run(form, first, nl, n_ev, max_total, due, renorm, bound, P, OMEGA
                                    ENDS, BLK, ACC, ACT, ACTR, status)
             for s in range(nl, n_slot):
                 ACT[s] = ACT[s % nl]
+        i = step
 
 
 @nb.njit(inline="always", **_JIT)

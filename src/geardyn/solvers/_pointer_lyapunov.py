@@ -14,9 +14,8 @@ ill-posed) are the template's own text, and only these differ:
   the next flagged step or bookkeeping, are the model's own (its inlined ``"lyapunov"``
   module's ``_var_steps`` in its lane form, compiled with the model as a C callback,
   :func:`._pointer_kernels.lyapunov_part_text`), called through its address once per such
-  run of steps (one tangent vector: up to the renormalisation interval's steps a call);
-  ``_var_fused_steps`` (several tangent vectors, a pass of them per call) is that callback of
-  one step;
+  run of steps (up to the renormalisation interval's steps a call; one step a call where a
+  block's tangent vectors take several passes);
 * ``_n_switching``: the model's number of switching functions (the size of the graze flags'
   rows), read from the coefficients.
 
@@ -63,15 +62,3 @@ def _var_steps(form, i, stop, n_adv, nl, locate, commit, Z0, Z1, S, IS, PT, T0L,
     return call_flat(addr, (i, stop, n_adv, nl, locate, commit, Z0, Z1, S, IS, PT, T0L, HL, HHL,
                             H6L) + PH + (IDX, ENDL, ACT, FLAG, GR, Y1F, NPL))
 
-
-@nb.njit(inline="always", **_JIT)
-def _var_fused_steps(form, i, nl, locate, commit, Z0, Z1, S, IS, PT, T0L, HL, HHL, H6L, PH,
-                     IDX, ENDL, ACT, FLAG, GR, Y1F):
-    """The model's variational step i of every lane of the block (:func:`_var_steps` of the
-    one step); the number of flagged lanes."""
-    _var_steps(form, i, i + 1, 0, nl, locate, commit, Z0, Z1, S, IS, PT, T0L, HL, HHL, H6L, PH,
-               IDX, ENDL, ACT, FLAG, GR, Y1F, IDX)
-    n_flag = 0
-    for l in range(nl):
-        n_flag += 1 if FLAG[l] != 0.0 else 0
-    return n_flag
