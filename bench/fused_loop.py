@@ -12,7 +12,7 @@ with lines replaced (checked, so a template change that moves them fails loudly)
 
 ``base``: the loop as it is; ``nostats``: without the observables and statistics;
 ``noscreen``: without the side test and graze screen (nothing flagged); ``nobook``: without the
-health check and due test; ``fission``: the statistics in a loop of their own after the
+health check and due test; ``fission``: the statistics in a loop of their own before the
 step loop; ``phasefuse``: the phase rotations in the step loop (no loop of their own);
 ``alwaysout``: the out-of-line call at every block step; ``screenonly``: the screen
 computed and stored, nothing flagged; ``nograze`` (with edge location): the graze screen off,
