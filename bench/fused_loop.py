@@ -12,7 +12,7 @@ with lines replaced (checked, so a template change that moves them fails loudly)
 
 ``base``: the loop as it is; ``nostats``: without the observables and statistics;
 ``noscreen``: without the side test and graze screen (nothing flagged); ``nobook``: without the
-health check and due test; ``fission``: the statistics in a loop of their own after the
+health check and due test; ``fission``: the statistics in a loop of their own before the
 step loop; ``phasefuse``: the phase rotations in the step loop (no loop of their own);
 ``alwaysout``: the out-of-line call at every block step; ``screenonly``: the screen
 computed and stored, nothing flagged; ``nograze`` (with edge location): the graze screen off,
@@ -65,23 +65,26 @@ from geardyn.solvers.kernels import kernels_for
 
 #: variant part -> (line of the generated kernel, its replacement)
 EDITS = {
-    "nostats": [("        o = _observe_l(te, y1, PT, k, se, ce, form)\n", ""),
-                ("        _t_stats(GMIN, GMAX, OMAX, OMIN, OSQ, k, g1, o, stat)\n", "")],
+    "nostats": [("        o = _observe_l(t0b + st * h, y, PT, k, SE[k], CE[k], form)\n", ""),
+                ("        _t_stats(GMIN, GMAX, OMAX, OMIN, OSQ, k, _t_like(GS, k, g1), o, pend)\n",
+                 "")],
     "noscreen": [("        hit = _t_screen(g1, GS, GP, SIDE, GR, k, locate)\n",
                   "        hit = False\n")],
     "nobook": [("        due = act & (((ph1 == 0) & (not _t_healthy(y1, bound))) | "
                 "(st1 >= DUE[k]))\n", "        due = False\n")],
-    # the statistics in a loop of their own after the step loop (the events from GS, the end
-    # state from Y1; the loop-fission layout; for a model with as many events as states)
-    "fission": [("        o = _observe_l(te, y1, PT, k, se, ce, form)\n"
-                 "        _t_stats(GMIN, GMAX, OMAX, OMIN, OSQ, k, g1, o, stat)\n",
-                 "        STAT[k] = stat\n"),
-                ("    return n_flag, n_out\n",
+    # the statistics in a loop of their own before the step loop (the loop-fission layout; the
+    # events from GS, the state from Y, the phase from SE, CE: the step's start)
+    "fission": [("        o = _observe_l(t0b + st * h, y, PT, k, SE[k], CE[k], form)\n"
+                 "        _t_stats(GMIN, GMAX, OMAX, OMIN, OSQ, k, _t_like(GS, k, g1), o, pend)\n",
+                 ""),
+                ("    n_flag = 0\n    n_out = 0\n",
                  "    for k in range(nl):\n"
-                 "        te = T0B[k] + STEP[k] * HB[k]\n"
-                 "        o = _observe_l(te, _t_load(Y1, k), PT, k, SE[k], CE[k], form)\n"
-                 "        _t_stats(GMIN, GMAX, OMAX, OMIN, OSQ, k, _t_load(GS, k), o, STAT[k])\n"
-                 "    return n_flag, n_out\n")],
+                 "        pend = STAT[k] & ACT[k]\n"
+                 "        o = _observe_l(T0B[k] + STEP[k] * HB[k], _t_load(Y, k), PT, k, SE[k], "
+                 "CE[k], form)\n"
+                 "        _t_stats(GMIN, GMAX, OMAX, OMIN, OSQ, k, _t_like(GS, k, "
+                 "_events_l(0.0, _t_load(Y, k), PT, k, SE[k], CE[k])), o, pend)\n"
+                 "    n_flag = 0\n    n_out = 0\n")],
     # the slots' phase rotations left out (the phase at the step's start used throughout:
     # wrong results, the loads and stores kept): what rotating a phase per slot costs
     "norotate": [("        sb, cb = phase_rotate(s0, c0, AH[k], BH[k])\n"

@@ -54,6 +54,7 @@ from geardyn.solvers._step_core import (  # CORE-IMPORT
     _t_axpy,
     _t_comb,
     _t_healthy,
+    _t_like,
     _t_load,
     _t_screen,
     _t_side,
@@ -621,6 +622,7 @@ def _load_slot(k, lane, lanes, cfg, sched, out, blk, slots, GP):
     n_g = GP.shape[0]
     n_o = O.shape[0]
     ACT[k] = True
+    STAT[k] = False  # (the fused loop: no statistics pending)
     LANE[k] = lane
     STEP[k] = 0
     PHASE[k] = 0
@@ -777,8 +779,11 @@ def _fused_steps(form, nl, locate, bound, Y, Y1, PT, SE, CE, H6, FLAG, G, ST, sl
     of BLOCK slots, see :func:`_flat`): the trial into Y1, committed into Y
     where the slot is active and unflagged; the events' history shifted (GP = g_i, GS =
     g_{i+1}), graze flags into GR; the slots'
-    clocks advanced, SE, CE the phase at the grid point reached; the statistics of the slots
-    that sample and need nothing out of line. FLAG[k] = 1 where slot k's step is flagged,
+    clocks advanced, SE, CE the phase at the grid point reached. The statistics of a grid
+    point are taken at the start of the step that leaves it, where STAT[k] (set by the step
+    that reached it: the slot samples and has no bookkeeping due there; a flagged step's
+    point too, its split done out of line in between), with the observables at the point k1
+    is taken at. FLAG[k] = 1 where slot k's step is flagged,
     MSK[k] where it is flagged or has bookkeeping due (see :func:`_slot_out`: a sample, the
     transient's end or the lane's, or a period's start where the state is out of ``bound`` or
     not finite; a healthy period's start is done here). ``form``: a
@@ -828,6 +833,13 @@ def _fused_steps(form, nl, locate, bound, Y, Y1, PT, SE, CE, H6, FLAG, G, ST, sl
         k4 = _rhs_l(te, _t_axpy(y, h, k3), PT, k, se, ce, form)
         y1 = _t_comb(y, H6[k], k1, k2, k3, k4)
         g1 = _events_l(te, y1, PT, k, se, ce)
+        # the statistics of the grid point the last step reached (this step's start), where
+        # STAT[k]: its events GS (before the screen shifts them), its observables at the
+        # point k1 is taken at (the same inputs as k1: shared arithmetic)
+        pend = STAT[k] & ACT[k]
+        o = _observe_l(t0b + st * h, y, PT, k, SE[k], CE[k], form)
+        _t_stats(GMIN, GMAX, OMAX, OMIN, OSQ, k, _t_like(GS, k, g1), o, pend)
+        n_stat[k] += 1 if pend else 0
         hit = _t_screen(g1, GS, GP, SIDE, GR, k, locate)
         act = ACT[k]
         flagged = act & hit
@@ -842,10 +854,9 @@ def _fused_steps(form, nl, locate, bound, Y, Y1, PT, SE, CE, H6, FLAG, G, ST, sl
         PHASE[k] = ph1
         # a period's start needs the health check out of line only where it fails (NaN too)
         due = act & (((ph1 == 0) & (not _t_healthy(y1, bound))) | (st1 >= DUE[k]))
-        stat = act & (st1 > n_tr[k]) & (not hit) & (not due)
-        o = _observe_l(te, y1, PT, k, se, ce, form)
-        _t_stats(GMIN, GMAX, OMAX, OMIN, OSQ, k, g1, o, stat)
-        n_stat[k] += 1 if stat else 0
+        # the grid point reached is sampled at the next step's start (a flagged step's too,
+        # after its split out of line); one with bookkeeping due, out of line (_slot_out)
+        STAT[k] = act & (st1 > n_tr[k]) & (not due)
         FLAG[k] = 1.0 if flagged else 0.0
         mark = flagged | due
         MSK[k] = mark
@@ -885,8 +896,9 @@ def _slots_out(nl, G1, SE, CE, TABS, lanes, cfg, out, blk, slots, scratch):
 def _slot_out(k, G1, SE, CE, TABS, lanes, cfg, out, blk, slots, scratch):
     """Slot k's step out of line (marked by :func:`_fused_steps`): a flagged step finished on
     the scalar path (:func:`_finish_flagged`), the bookkeeping of a period's start
-    (:func:`_slot_check`), the statistics at the grid point reached, the sample and the end
-    (:func:`_slot_sample`), in the order of the other paths. G1: the events at the grid point
+    (:func:`_slot_check`), the statistics at the grid point reached (unless STAT[k]: the
+    next step's start takes them), the sample and the end (:func:`_slot_sample`), in the order
+    of the other paths. G1: the events at the grid point
     reached (the block's GS, see :func:`_fused_steps`). Returns True when the lane has ended."""
     P, Y0, H, OMEGA, T0, n_transient, n_transient_max, sample_every = lanes
     locate = cfg[3]
@@ -908,6 +920,8 @@ def _slot_out(k, G1, SE, CE, TABS, lanes, cfg, out, blk, slots, scratch):
                               out)
         if gone:
             return True
+    if STAT[k]:  # a flagged step's grid point: sampled at the next step's start (_fused_steps)
+        return False
     if step <= n_tr[k]:
         return False
     n_stat[k] += 1

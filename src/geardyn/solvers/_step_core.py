@@ -637,9 +637,11 @@ def _tangent_step(i, t0, Z, S, IS, p, h, omega, n_per, s_tab, c_tab, n_ev, YP, E
 # commit, the clocks and the statistics; nothing but the block's state goes through memory, and
 # LLVM vectorises the loop over slots. Slots whose step was flagged (a side left or a possible
 # graze) or that have bookkeeping due (a period's start, a sample, the end) are finished out of
-# line (:func:`_slot_out`), their statistics there too. The arithmetic of every lane is that of
-# the scalar kernel, operation for operation (no fastmath), so results are bitwise those of the
-# other paths. The tuple helpers below are written out per tuple length when numba types them.
+# line (:func:`_slot_out`); a grid point's statistics are taken in the loop at the start of the
+# next step (a flagged step's point too, after its split), out of line where bookkeeping is
+# due there. The arithmetic of every lane is that of the scalar kernel, operation for
+# operation (no fastmath), so results are bitwise those of the other paths. The tuple helpers
+# below are written out per tuple length when numba types them.
 
 
 def _tuple_source(args, lines, scope=None):
@@ -656,6 +658,10 @@ def _t_load(Y, k):
 
 def _t_store(Y, k, y, keep, cond):
     """Y[q, k] = y[q] if cond else keep[q]."""
+
+
+def _t_like(G, k, like):
+    """(G[0, k], .., G[len(like) - 1, k]): a slot's column of as many rows as ``like`` has."""
 
 
 def _t_axpy(y, a, x):
@@ -705,6 +711,11 @@ def _ov_t_load(Y, k):
     n = globals()["LANE_NS"]
     return _tuple_source("Y, k", ["return (" + "".join(f"{_ix(Y, 'Y', q)}, " for q in range(n))
                                   + ")"])
+
+
+def _ov_t_like(G, k, like):
+    return _tuple_source("G, k, like", ["return (" + "".join(f"{_ix(G, 'G', j)}, "
+                                                            for j in range(len(like))) + ")"])
 
 
 def _ov_t_store(Y, k, y, keep, cond):
@@ -790,7 +801,8 @@ if "rhs_lane" in globals():  # the model's lane-scalar functions (see .kernels)
     _lane_form = rhs_lane_form  # noqa: F821
     #: The state size of the model's lane-scalar functions (``<rhs>_lane_states``).
     LANE_NS = int(_rhs_l.py_func.__globals__[_rhs_l.py_func.__name__ + "_states"])
-    for _stub, _impl in ((_t_load, _ov_t_load), (_t_store, _ov_t_store), (_t_axpy, _ov_t_axpy),
+    for _stub, _impl in ((_t_load, _ov_t_load), (_t_like, _ov_t_like), (_t_store, _ov_t_store),
+                         (_t_axpy, _ov_t_axpy),
                          (_t_comb, _ov_t_comb), (_t_screen, _ov_t_screen),
                          (_t_stats, _ov_t_stats), (_t_side, _ov_t_side),
                          (_t_healthy, _ov_t_healthy), (_t_get, _ov_t_get), (_t_put, _ov_t_put),
