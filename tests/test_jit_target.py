@@ -128,17 +128,12 @@ def test_each_mode_names_its_attribute():
     assert jt.attribute_for("native") is None
 
 
-@pytest.mark.parametrize("cpu", [None, INTEL_TUNED])
-@pytest.mark.parametrize("mode", ["512", "256", "native"])
-def test_geardyns_functions_get_the_width_and_nothing_else_does(tmp_path, mode, cpu):
-    """In a fresh interpreter, with this CPU's own tuning and with Intel's (``prefer-256-bit``),
-    numba used before geardyn: ``import geardyn`` leaves numba's CPU settings alone; geardyn's
-    function carries the attribute of the mode; with AVX-512 its machine code has zmm
-    registers at 512 bits, none at 256, and at ``native`` what plain numba's has, and plain
-    numba's code keeps LLVM's choice for the CPU."""
-    if cpu and not _has_avx512():
-        pytest.skip("the Intel tuning needs an AVX-512 host")
-    got = _probe(tmp_path, mode, cpu)
+def _check_width(got: dict, mode: str, cpu: str | None) -> None:
+    """What a probe that compiled geardyn's function (no cache hit) shows for ``mode`` on the
+    CPU tuning ``cpu``: ``import geardyn`` left numba's CPU settings alone; geardyn's function
+    carries the attribute of the mode; with AVX-512 its machine code has zmm registers at 512
+    bits, none at 256, and at ``native`` what plain numba's has, and plain numba's code keeps
+    LLVM's choice for the CPU."""
     assert got["settings_kept"] and not got["hit"]
     attribute = jt.attribute_for(mode)
     if attribute is None:
@@ -152,18 +147,35 @@ def test_geardyns_functions_get_the_width_and_nothing_else_does(tmp_path, mode, 
         assert got["asm_zmm"] == expected
 
 
+#: The (mode, CPU tuning) pairs probed on their own; 512 and 256 bits on Intel's tuning are
+#: probed by the cache test below, whose first two runs on an empty cache compile them.
+_WIDTH_CASES = [("512", None), ("256", None), ("native", None), ("native", INTEL_TUNED)]
+
+
+@pytest.mark.parametrize(("mode", "cpu"), _WIDTH_CASES)
+def test_geardyns_functions_get_the_width_and_nothing_else_does(tmp_path, mode, cpu):
+    """In a fresh interpreter, with this CPU's own tuning and with Intel's (``prefer-256-bit``),
+    numba used before geardyn: see :func:`_check_width`."""
+    if cpu and not _has_avx512():
+        pytest.skip("the Intel tuning needs an AVX-512 host")
+    _check_width(_probe(tmp_path, mode, cpu), mode, cpu)
+
+
 @pytest.mark.parametrize("numba_cache_dir", [False, True])
 def test_cached_code_keeps_its_width_and_each_width_has_its_own_entries(tmp_path,
                                                                         numba_cache_dir):
     """Two widths take turns on one cache (geardyn's, or numba's ``NUMBA_CACHE_DIR``): each
-    compiles its own code the first time and loads it the second, and the code loaded from the
-    cache has zmm registers at 512 bits and none at 256 (Intel's tuning: 256 bits otherwise)."""
+    compiles its own code the first time (with the width of :func:`_check_width`, on Intel's
+    tuning) and loads it the second, and the code loaded from the cache has zmm registers at
+    512 bits and none at 256 (Intel's tuning: 256 bits otherwise)."""
     if not _has_avx512():
         pytest.skip("needs an AVX-512 host")
     env = {"NUMBA_CACHE_DIR": str(tmp_path / "numba-own")} if numba_cache_dir else {}
     runs = [(mode, _probe(tmp_path, mode, INTEL_TUNED, **env))
             for mode in ("512", "256", "512", "256")]
     assert [r["hit"] for _, r in runs] == [False, False, True, True]
+    for mode, got in runs[:2]:
+        _check_width(got, mode, INTEL_TUNED)
     if numba_cache_dir:
         assert Path(runs[0][1]["cache"]).is_relative_to(tmp_path / "numba-own")
     names = sorted(p.name for p in Path(runs[0][1]["cache"]).glob("width_probe.axpy-*.nbi"))
