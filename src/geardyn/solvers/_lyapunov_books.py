@@ -13,7 +13,7 @@ import math
 import numba as nb
 import numpy as np
 
-from geardyn.solvers._step_shared import _JIT, STATUS_DIVERGED, STATUS_OK, phase_table
+from geardyn.solvers._step_shared import _JIT, STATUS_DIVERGED, STATUS_OK, phase_table_values
 
 #: Columns of the per-lane integer state of a block (IST): the step of the last
 #: renormalisation, the block being measured, transient and measured steps, their total, the
@@ -352,8 +352,7 @@ def _lane_result(l, lane, k, n_steps, h, ENDS, nbk, BLK, ACC, out, err, used):
     used[lane] = nbk
 
 
-@nb.njit(**_JIT)
-def _block_count(L, k, block_rows, min_blocks):
+def _block_count(L: int, k: int, block_rows: int, min_blocks: int) -> int:
     """Blocks for L lanes of 2 k + 1 rows: at most ``block_rows`` rows each (at least one
     lane), at least ``min_blocks`` (e.g. one per thread) while there are lanes; lanes are dealt
     out evenly (block b: lanes b L // n to (b + 1) L // n)."""
@@ -361,27 +360,23 @@ def _block_count(L, k, block_rows, min_blocks):
     return max((L + per - 1) // per, min(L, min_blocks))
 
 
-@nb.njit(**_JIT)
-def _block_tables(OMEGA, NPER, k, block_rows, min_blocks):
+def _block_tables(OMEGA: np.ndarray, NPER: np.ndarray, k: int, block_rows: int,
+                  min_blocks: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, int]:
     """The lanes' phase tables (one per grid, concatenated: S_TAB, C_TAB; OFF[lane]: the start
     of the lane's) and the number of blocks (:func:`_block_count`) of
-    :func:`lyapunov_block_lanes`."""
+    :func:`lyapunov_block_lanes`: orchestration, run by the interpreter (the tables from
+    :func:`phase_table_values`, bitwise the compiled tables)."""
     L = OMEGA.shape[0]
-    forced = bool(False)  # noqa: UP018 - not a literal: phase_table compiled once
-    for lane in range(L):
-        if OMEGA[lane] != 0.0:
-            forced = True
+    forced = bool(np.any(OMEGA != 0.0))
     grids = np.unique(NPER)
     starts = np.zeros(grids.size + 1, np.int64)
+    starts[1:] = np.cumsum(2 * grids + 1)
+    S_TAB = np.zeros(int(starts[-1]))
+    C_TAB = np.ones(int(starts[-1]))
     for g in range(grids.size):
-        starts[g + 1] = starts[g] + 2 * grids[g] + 1
-    S_TAB = np.zeros(starts[-1])
-    C_TAB = np.ones(starts[-1])
-    for g in range(grids.size):
-        s_tab, c_tab = phase_table(grids[g], forced)
+        s_tab, c_tab = phase_table_values(int(grids[g]), forced)
         S_TAB[starts[g]:starts[g + 1]] = s_tab
         C_TAB[starts[g]:starts[g + 1]] = c_tab
-    OFF = np.zeros(L, np.int64)
-    for lane in range(L):
-        OFF[lane] = starts[np.searchsorted(grids, NPER[lane])]
-    return S_TAB, C_TAB, OFF, _block_count(L, k, block_rows, min_blocks)
+    OFF = starts[np.searchsorted(grids, NPER)].astype(np.int64)
+    return S_TAB, C_TAB, OFF, np.int64(_block_count(int(L), int(k), int(block_rows),
+                                                    int(min_blocks)))

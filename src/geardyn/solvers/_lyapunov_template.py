@@ -1531,7 +1531,9 @@ def _lyap_var_run1(form, first, nl, n_ev, max_total, due, renorm, bound, P, OMEG
     S_TAB, C_TAB = scratch
     nv = _padded(nl)
     locate = n_ev > 0
-    i = 0
+    # np.int64: a literal 0 (the loop's index before type inference unifies it) would compile
+    # the flagged lanes' split chain (_var_flagged .. _rows_step) once more
+    i = np.int64(0)
     while i < max_total:
         live = False
         for l in range(nl):
