@@ -5,7 +5,6 @@ model in seconds (``SpurPair``: 2000 s would be ~10^5-10^6 forcing periods, hour
 from __future__ import annotations
 
 import math
-import time
 
 import numpy as np
 import pytest
@@ -28,13 +27,10 @@ def test_spur_pair_default_is_200_forcing_periods(spur):
     # the declared scale first: a model without it (the old default of 2000 s) fails here,
     # before a run of hours
     assert spur.lyapunov_duration() == (None, f"default: {LYAPUNOV_PERIODS} forcing periods")
-    t0 = time.perf_counter()
     est = lyapunov(spur, with_error=True)
-    elapsed = time.perf_counter() - t0
     assert LYAPUNOV_PERIODS == 200
     assert est.duration == pytest.approx(200 * period, rel=1e-12)
     assert est.duration_rule == "default: 200 forcing periods"
-    assert elapsed < 60.0
     # the same window given explicitly (199.5 periods round up to 200), the default transient
     # of 20 forcing periods too: the same bits
     explicit = lyapunov(spur, run=RunSettings(transient=19.5 * period),

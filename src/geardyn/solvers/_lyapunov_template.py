@@ -1481,7 +1481,7 @@ def _lyap_var_run(form, first, nl, n_ev, max_total, due, renorm, bound, P, OMEGA
     IST, ENDS, BLK, ACC, Zl, Cl, logs = books
     S_TAB, C_TAB = scratch
     locate = n_ev > 0
-    i = 0
+    i = np.int64(0)  # (not a literal 0: one typing of the flagged lanes' split chain)
     while i < max_total:
         live = False
         for l in range(nl):
