@@ -38,6 +38,7 @@ import numba.core.bytecode
 from numba.core.compiler_lock import global_compiler_lock
 
 from geardyn._cache import cache_root
+from geardyn._frame_room import call_with_room
 from geardyn._scoped_patch import scoped_patch
 from geardyn.core.kernel_source import KernelSource
 from geardyn.core.one_form import adapters as one_form_adapters
@@ -123,7 +124,7 @@ def _quiet_compile(dispatcher: Any, cached: bool = False) -> None:
 
     def compile(sig: Any) -> Any:
         with _compiling():
-            return compile_(sig)
+            return call_with_room(compile_, sig)
 
     dispatcher.compile = compile
 
