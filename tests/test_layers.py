@@ -30,7 +30,7 @@ LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
     ("base", ("geardyn._version", "geardyn.errors", "geardyn.files", "geardyn.units",
               "geardyn.studies", "geardyn._jit_target", "geardyn._tuple_alias",
               "geardyn._scoped_patch", "geardyn._lazy_code", "geardyn._bound_calls",
-              "geardyn._cache")),
+              "geardyn._frame_room", "geardyn._cache")),
     # the model interface, the kernel source, run settings, the lane plan, the section, status
     ("core", ("geardyn.core",)),
     # gear geometry, ISO 6336 stiffness, stiffness waves, planetary mesh phasing (pure numpy)
