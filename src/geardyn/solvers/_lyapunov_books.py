@@ -57,7 +57,7 @@ def _stretch_logs(Z, C, logs):
             C[j, q] = Z[j, q]
     for j in range(1, m):
         logs[j - 1] = np.nan
-    _orthonormalise(C, logs, True)
+    _orthonormalise(C, logs, np.bool_(True))  # np.bool_: see _lanes_init
 
 
 @nb.njit(**_JIT)
@@ -142,7 +142,8 @@ def _lanes_init(first, nl, k, Y0, NPER, n_transient, n_steps, renorm_every, n_bl
         for j in range(1, m):
             for q in range(ns):
                 Zl[j, q] = 0.1 + (1.0 if q == j - 1 else 0.0)
-        _orthonormalise(Zl, logs, False)
+        # np.bool_: a literal flag would compile _orthonormalise once more (once per flag)
+        _orthonormalise(Zl, logs, np.bool_(False))
         for j in range(m):
             for q in range(ns):
                 ZT[j, q, l] = Zl[j, q]
