@@ -510,6 +510,9 @@ else:
 # row's arithmetic is that of :func:`_rows_step`, operation for operation (no fastmath), so results
 # are bitwise those of one lane stepped alone, whatever the blocking, position or thread.
 
+#: The path of a block of one lane of fewer rows than ROW_PAD (:func:`_lyap_block_one`),
+#: beside the lane forms' paths (FORM_GENERAL: the row block, FORM_QUIET, FORM_LOAD).
+PATH_ONE = 3
 #: Most rows of a lane block (lanes of 2 k + 1 rows each; at least one lane).
 BLOCK_ROWS = 64
 #: The rows of a block are padded to a multiple of this (see :func:`_lyap_block`): LLVM
@@ -734,6 +737,28 @@ def _lyap_one_loop(first, max_total, due, renorm, bound, P, S, IS, T0, H, OMEGA,
 def _lyap_block(first, nl, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF, n_transient,
                 n_steps, renorm_every, bound, n_ev, n_blocks, out, err, used, status, unres,
                 fd_steps):
+    """:func:`_lyap_block_rows` for any block."""
+    _lyap_block_rows(FORM_GENERAL, first, nl, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
+                     n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err, used,
+                     status, unres, fd_steps)
+
+
+@nb.njit(**_JIT)
+def _lyap_block_one(first, nl, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF, n_transient,
+                    n_steps, renorm_every, bound, n_ev, n_blocks, out, err, used, status, unres,
+                    fd_steps):
+    """:func:`_lyap_block_rows` for a block of one lane of fewer rows than ROW_PAD (or of a
+    model without lane-block functions): :func:`_lyap_one`'s scalar rows only, without the row
+    block's loop (not compiled)."""
+    _lyap_block_rows(PATH_ONE, first, nl, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
+                     n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err, used,
+                     status, unres, fd_steps)
+
+
+@nb.njit(inline="always", **_JIT)
+def _lyap_block_rows(path, first, nl, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
+                     n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err, used,
+                     status, unres, fd_steps):
     """The k leading exponents of lanes first..first+nl-1 (lane with NPER[lane] steps per
     period, its phase table at S_TAB, C_TAB[OFF[lane]:]), their rows in one block (see above);
     per lane the exponents of its difference rows, into out[lane], err[lane], used[lane],
@@ -812,46 +837,54 @@ def _lyap_block(first, nl, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF, n
     # one lane of fewer rows than ROW_PAD (or a model without lane-block functions, whose rows
     # the block evaluates one by one): its rows by the scalar rows step (:func:`_lyap_one`),
     # not a block mostly of padding
-    one = nl == 1 and (ROW_PAD == 1 or nr < ROW_PAD)
-    u_one = 0
-    if one:
+    # (``path`` PATH_ONE, a constant: the caller's block is such a lane, the loop below is
+    # not compiled)
+    if path == PATH_ONE:
+        one = True
         u_one = _lyap_one(first, max_total, due, renorm, bound, P, S, IS, T0, H, OMEGA, NPER,
                           S_TAB, C_TAB, OFF, n_ev, ZT, IST, ENDS, BLK, ACC, ACT, ACTR, Zl, Cl,
                           logs, status, W, gbuf)
-    for i in range(0 if one else max_total):
-        live = False
-        for l in range(nl):
-            live = live or ACT[l]
-        if not live:
-            break
-        _fd_setup(nl, m, ZT, S, IS, Y, E, OK, NY)
-        for r in range(nrp):
-            t = T0R[r] + i * HR[r]
-            TS[r] = t
-            TM[r] = t + HH[r]
-            TE[r] = t + HR[r]
-            HD[r] = TE[r] - t
-        _fill_phase(nrp, IDX, S_TAB, C_TAB, PH)
-        if n_ev > 0:
-            _rows_events(TS, Y, G0, PT, P, LANE, nrp, PH[0], PH[1], ybuf, gb)
-        _rows_rk4(nrp, Y, Y1, K1, K2, K3, K4, TMP, TS, TM, TE, HR, HH, H6, PT, P, LANE, PH, SC,
-                  ybuf, dbuf)
-        if n_ev > 0:
-            _rows_events(TE, Y1, G1, PT, P, LANE, nrp, PH[4], PH[5], ybuf, gb)
-            for q in range(ns):
-                for r in range(nrp):
-                    TMP[q, r] = Y[q, r] + HD[r] * K1[q, r]
-            _rows_events(TE, TMP, GE, PT, P, LANE, nrp, PH[4], PH[5], ybuf, gb)
-            _rows_screen(nrp, G0, G1, GE, GR, FLAG)
-        _rows_commit(i, nrp, NPR, Y, Y1, G0, G1, GR, FLAG, ACTR, P, LANE, T0R, HR, OMEGA, ys,
-                     y1s, sides, g1s, ncross, W, gbuf, UNRR, PH)
-        _fd_combine(nl, m, ZT, IS, Y, E, ACT)
-        for r in range(nrp):  # the next step's phase index: 2 (i + 1 mod n_per) from the start
-            IDX[r] = IDX[r] + 2 if IDX[r] + 2 < END[r] else IDX[r] + 2 - 2 * NPR[r]
-        step = i + 1
-        if step >= due:
-            due = _lane_books(step, first, nl, k, renorm, bound, ZT, Zl, Cl, logs, IST, ENDS, BLK,
-                              ACC, ACT, ACTR, H, out, err, used, status)
+    else:
+        one = nl == 1 and (ROW_PAD == 1 or nr < ROW_PAD)
+        u_one = 0
+        if one:
+            u_one = _lyap_one(first, max_total, due, renorm, bound, P, S, IS, T0, H, OMEGA,
+                              NPER, S_TAB, C_TAB, OFF, n_ev, ZT, IST, ENDS, BLK, ACC, ACT, ACTR,
+                              Zl, Cl, logs, status, W, gbuf)
+        for i in range(0 if one else max_total):
+            live = False
+            for l in range(nl):
+                live = live or ACT[l]
+            if not live:
+                break
+            _fd_setup(nl, m, ZT, S, IS, Y, E, OK, NY)
+            for r in range(nrp):
+                t = T0R[r] + i * HR[r]
+                TS[r] = t
+                TM[r] = t + HH[r]
+                TE[r] = t + HR[r]
+                HD[r] = TE[r] - t
+            _fill_phase(nrp, IDX, S_TAB, C_TAB, PH)
+            if n_ev > 0:
+                _rows_events(TS, Y, G0, PT, P, LANE, nrp, PH[0], PH[1], ybuf, gb)
+            _rows_rk4(nrp, Y, Y1, K1, K2, K3, K4, TMP, TS, TM, TE, HR, HH, H6, PT, P, LANE, PH, SC,
+                      ybuf, dbuf)
+            if n_ev > 0:
+                _rows_events(TE, Y1, G1, PT, P, LANE, nrp, PH[4], PH[5], ybuf, gb)
+                for q in range(ns):
+                    for r in range(nrp):
+                        TMP[q, r] = Y[q, r] + HD[r] * K1[q, r]
+                _rows_events(TE, TMP, GE, PT, P, LANE, nrp, PH[4], PH[5], ybuf, gb)
+                _rows_screen(nrp, G0, G1, GE, GR, FLAG)
+            _rows_commit(i, nrp, NPR, Y, Y1, G0, G1, GR, FLAG, ACTR, P, LANE, T0R, HR, OMEGA, ys,
+                         y1s, sides, g1s, ncross, W, gbuf, UNRR, PH)
+            _fd_combine(nl, m, ZT, IS, Y, E, ACT)
+            for r in range(nrp):  # the next step's phase index: 2 (i + 1 mod n_per) from the start
+                IDX[r] = IDX[r] + 2 if IDX[r] + 2 < END[r] else IDX[r] + 2 - 2 * NPR[r]
+            step = i + 1
+            if step >= due:
+                due = _lane_books(step, first, nl, k, renorm, bound, ZT, Zl, Cl, logs, IST,
+                                  ENDS, BLK, ACC, ACT, ACTR, H, out, err, used, status)
     if one and status[first] != STATUS_DIVERGED:
         _lane_result(0, first, k, IST[0, _NST], H[first], ENDS, IST[0, _NBK], BLK, ACC, out, err,
                      used)
@@ -1259,6 +1292,9 @@ def _lyap_block_local(form, lo, hi, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TA
     elif form == FORM_LOAD:
         _lyap_block_form2(0, n, k, Pb, Y0b, Sb, T0b, Hb, OMb, NPb, STb, CTb, OFb, NTb, NSb,
                           renorm_every, bound, n_ev, n_blocks, o, e, u, st, un, fs)
+    elif form == PATH_ONE:
+        _lyap_block_one(0, n, k, Pb, Y0b, Sb, T0b, Hb, OMb, NPb, STb, CTb, OFb, NTb, NSb,
+                        renorm_every, bound, n_ev, n_blocks, o, e, u, st, un, fs)
     else:
         _lyap_block(0, n, k, Pb, Y0b, Sb, T0b, Hb, OMb, NPb, STb, CTb, OFb, NTb, NSb,
                     renorm_every, bound, n_ev, n_blocks, o, e, u, st, un, fs)
@@ -1869,9 +1905,13 @@ def _block_lanes(b, n_blk, L):
 def _block_paths(P, n_blk, k, n_ev):
     """The path of each block of :func:`lyapunov_block_lanes`: the fused loop of the lane form
     its lanes all take (FORM_QUIET, FORM_LOAD: a model with lane-scalar functions, k = 1,
-    switching functions, at most BLOCK lanes), else FORM_GENERAL (the row block,
-    :func:`_lyap_block`)."""
+    switching functions, at most BLOCK lanes), else PATH_ONE (one lane of fewer rows than
+    ROW_PAD, :func:`_lyap_block_one`) or FORM_GENERAL (the row block, :func:`_lyap_block`)."""
     paths = np.full(n_blk, FORM_GENERAL, np.int64)
+    for b in range(n_blk):
+        lo, hi = _block_lanes(b, n_blk, P.shape[0])
+        if hi - lo == 1 and (ROW_PAD == 1 or 2 * k + 1 < ROW_PAD):
+            paths[b] = PATH_ONE
     if not FUSED:
         return paths
     for b in range(n_blk):
@@ -1918,9 +1958,20 @@ def _lyap_block_worker_form2(b, n_blk, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C
                       status, unres, fd_steps)
 
 
+@nb.njit(nogil=True, **_JIT)
+def _lyap_block_worker_one(b, n_blk, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
+                           n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err,
+                           used, status, unres, fd_steps):
+    """:func:`_lyap_block_worker` for a block of one lane of few rows (PATH_ONE)."""
+    lo, hi = _block_lanes(b, n_blk, Y0.shape[0])
+    _lyap_block_local(PATH_ONE, lo, hi, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
+                      n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err, used,
+                      status, unres, fd_steps)
+
+
 #: The Lyapunov block workers by path (:func:`_block_paths`), each compiled on its first call.
 _BLOCK_WORKERS = {FORM_GENERAL: _lyap_block_worker, FORM_QUIET: _lyap_block_worker_form1,
-                  FORM_LOAD: _lyap_block_worker_form2}
+                  FORM_LOAD: _lyap_block_worker_form2, PATH_ONE: _lyap_block_worker_one}
 
 
 def lyapunov_lanes(P, Y0, scale, T0, H, OMEGA, n_per, n_transient, n_steps, renorm_every, bound,
