@@ -844,14 +844,10 @@ def _lyap_block_rows(path, first, nl, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_
         u_one = _lyap_one(first, max_total, due, renorm, bound, P, S, IS, T0, H, OMEGA, NPER,
                           S_TAB, C_TAB, OFF, n_ev, ZT, IST, ENDS, BLK, ACC, ACT, ACTR, Zl, Cl,
                           logs, status, W, gbuf)
-    else:
-        one = nl == 1 and (ROW_PAD == 1 or nr < ROW_PAD)
+    else:  # (never such a lane: :func:`_block_paths` gives it PATH_ONE)
+        one = False
         u_one = 0
-        if one:
-            u_one = _lyap_one(first, max_total, due, renorm, bound, P, S, IS, T0, H, OMEGA,
-                              NPER, S_TAB, C_TAB, OFF, n_ev, ZT, IST, ENDS, BLK, ACC, ACT, ACTR,
-                              Zl, Cl, logs, status, W, gbuf)
-        for i in range(0 if one else max_total):
+        for i in range(max_total):
             live = False
             for l in range(nl):
                 live = live or ACT[l]
