@@ -63,7 +63,9 @@ from geardyn.solvers._step_core import (  # CORE-IMPORT
 )
 from geardyn.solvers._step_shared import (
     BLOCK,
+    INNER,
     MAX_SPLITS,
+    OUTER,
     SIMULTANEOUS,
     STATUS_DIVERGED,
     STATUS_OK,
@@ -92,13 +94,14 @@ from geardyn.solvers._sweep_books import (  # compiled once for every model
 )
 from geardyn.solvers._template_model import events, observe, rhs  # MODEL-IMPORT
 
-_observe_i = nb.njit(forceinline=True, _nrt=False, **_JIT)(observe.py_func)  # (as ._step_core's)
+# (as ._step_core's)
+_observe_i = nb.njit(forceinline=True, _nrt=False, **_JIT, **INNER)(observe.py_func)
 
 __all__ = ["BLOCK", "MAX_SPLITS", "SIMULTANEOUS", "events", "observe", "phase_table", "rhs",
            "sweep", "trajectory"]
 
 
-@nb.njit(**_JIT)
+@nb.njit(**_JIT, **INNER)
 def _rhs_block(T, Y, DY, P, first, nl, active, s, c):
     """rhs of the active rows of 0..nl-1 (lanes first..) at times T; the model's rhs inlined,
     once per block."""
@@ -107,14 +110,14 @@ def _rhs_block(T, Y, DY, P, first, nl, active, s, c):
             _rhs_i(T[k], Y[k], DY[k], P[first + k], s, c)
 
 
-@nb.njit(**_JIT)
+@nb.njit(**_JIT, **INNER)
 def _events_block(T, Y, G, P, first, nl, active, s, c):
     for k in range(nl):
         if active[k]:
             _events_i(T[k], Y[k], G[k], P[first + k], s, c)
 
 
-@nb.njit(**_JIT)
+@nb.njit(**_JIT, **INNER)
 def _block_step(i, first, nl, active, Y, Y1, K1, K2, K3, K4, TMP, TT, G, SIDE, P, H, OMEGA, T0,
                 n_per, sa, ca, sb, cb, se, ce, locate, NCROSS, UNRES, work, ybuf, gbuf):
     """Advance the active lanes of first..first+nl-1 (rows 0..nl-1 of the block arrays) by grid
@@ -172,7 +175,7 @@ def _block_step(i, first, nl, active, Y, Y1, K1, K2, K3, K4, TMP, TT, G, SIDE, P
             Y[k, q] = Y1[k, q]
 
 
-@nb.njit(**_JIT)
+@nb.njit(**_JIT, **OUTER)
 def trajectory(p, y0, h, omega, n_per, i0, n_steps, stride, locate, bound, n_ev, n_obs):
     """Integrate one lane from grid point i0 (time i0 h) for n_steps grid steps, recording every
     stride-th grid point.
@@ -375,7 +378,7 @@ def _lanes_finish(STEP, nl, NPER, Y, Y1, G1, GR, SIDE, FLAG, ACT, P, LANE, HB, T
                             NCROSS, UNRES, ys, y1s, sides, g1s, work, ybuf, gbuf, TABS, OFF)
 
 
-@nb.njit(_nrt=False, **_JIT)
+@nb.njit(_nrt=False, **_JIT, **INNER)
 def _finish_flagged(k, i, NPER, Y, Y1, G1, GR, SIDE, P, LANE, HB, T0B, OMEGA, locate, NCROSS,
                     UNRES, ys, y1s, sides, g1s, work, ybuf, gbuf, TABS, OFF):
     """Finish slot k's flagged trial step (grid step i) on the scalar path: the crossings located
@@ -424,7 +427,7 @@ def _advance(nl, STEP, PHASE, NPER):
         PHASE[k] = 0 if ph == NPER[k] else ph
 
 
-@nb.njit(nogil=True, **_JIT)
+@nb.njit(nogil=True, **_JIT, **OUTER)
 def _sweep_worker(w, lanes, cfg, sched, out):
     """Worker w of :func:`sweep`: its queue of lanes through one block of refilling slots
     (:func:`_block_run_soa`; a model without lane-scalar functions)."""
@@ -436,7 +439,7 @@ def _sweep_worker(w, lanes, cfg, sched, out):
 
 # One worker per lane form (a model with lane-scalar functions), each compiled on its first call:
 # a sweep compiles the fused loop of the forms its lanes take only (see :func:`sweep`).
-@nb.njit(nogil=True, **_JIT)
+@nb.njit(nogil=True, **_JIT, **OUTER)
 def _sweep_worker_form0(w, lanes, cfg, sched, out):
     """Worker w of :func:`sweep`: the entries of its queue in lane form FORM_GENERAL through
     one block of refilling slots (:func:`_block_run_form0`)."""
@@ -446,7 +449,7 @@ def _sweep_worker_form0(w, lanes, cfg, sched, out):
         _block_run_form0(q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch)
 
 
-@nb.njit(nogil=True, **_JIT)
+@nb.njit(nogil=True, **_JIT, **OUTER)
 def _sweep_worker_form1(w, lanes, cfg, sched, out):
     """:func:`_sweep_worker_form0` in the lane form FORM_QUIET."""
     q0, q1, nl, nw = _worker_span(w, cfg, sched)
@@ -455,7 +458,7 @@ def _sweep_worker_form1(w, lanes, cfg, sched, out):
         _block_run_form1(q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch)
 
 
-@nb.njit(nogil=True, **_JIT)
+@nb.njit(nogil=True, **_JIT, **OUTER)
 def _sweep_worker_form2(w, lanes, cfg, sched, out):
     """:func:`_sweep_worker_form0` in the lane form FORM_LOAD."""
     q0, q1, nl, nw = _worker_span(w, cfg, sched)
@@ -464,7 +467,7 @@ def _sweep_worker_form2(w, lanes, cfg, sched, out):
         _block_run_form2(q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch)
 
 
-@nb.njit(**_JIT)
+@nb.njit(**_JIT, **OUTER)
 def _forms_present(P, sched):
     """present[w, f]: whether worker w's queue holds an entry of lane form f
     (:func:`_entry_form`)."""
@@ -660,7 +663,7 @@ def _load_slot(k, lane, lanes, cfg, sched, out, blk, slots, GP):
     return 1 if n_tr[k] == 0 else 0  # no transient: it samples from step 0
 
 
-@nb.njit(_nrt=False, **_JIT)
+@nb.njit(_nrt=False, **_JIT, **INNER)
 def _block_run_soa(q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch):
     """The block loop of :func:`_sweep_worker` (its arrays allocated there). Compiled without
     reference counting (``_nrt=False``: it allocates nothing), so that passing the block's
@@ -870,7 +873,7 @@ _finish_flagged_i = nb.njit(inline="always", **_JIT)(_finish_flagged.py_func)
 _slot_sample_i = nb.njit(inline="always", **_JIT)(_slot_sample.py_func)
 
 
-@nb.njit(_nrt=False, **_JIT)
+@nb.njit(_nrt=False, **_JIT, **INNER)
 def _slots_out(nl, G1, SE, CE, TABS, lanes, cfg, out, blk, slots, scratch):
     """:func:`_slot_out` for every marked slot (MSK), in one call per block step (a call
     passes every block array by value: one per slot cost a fifth of the run). The marked slots
@@ -1018,19 +1021,19 @@ def _fused_run(form, q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch):
 
 # One compiled copy of the loop per lane form (a second copy in the same function, or a branch
 # around it, stops LLVM's alias analysis).
-@nb.njit(_nrt=False, **_JIT_NOALIAS)
+@nb.njit(_nrt=False, **_JIT_NOALIAS, **INNER)
 def _block_run_form0(q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch):
     """:func:`_fused_run` in the model's general lane form (FORM_GENERAL)."""
     _fused_run(FORM_GENERAL, q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch)
 
 
-@nb.njit(_nrt=False, **_JIT_NOALIAS)
+@nb.njit(_nrt=False, **_JIT_NOALIAS, **INNER)
 def _block_run_form1(q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch):
     """:func:`_fused_run` in the lane form FORM_QUIET."""
     _fused_run(FORM_QUIET, q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch)
 
 
-@nb.njit(_nrt=False, **_JIT_NOALIAS)
+@nb.njit(_nrt=False, **_JIT_NOALIAS, **INNER)
 def _block_run_form2(q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch):
     """:func:`_fused_run` in the lane form FORM_LOAD."""
     _fused_run(FORM_LOAD, q0, q1, nl, lanes, cfg, sched, out, blk, slots, scratch)

@@ -43,6 +43,7 @@ from geardyn.solvers._step_shared import (
     GRAZE_ROW,
     GRAZE_TOL,
     HALLEY_TOL,
+    INNER,
     MAX_SPLITS,
     SIMULTANEOUS,
     _cubic_coeffs,
@@ -78,8 +79,8 @@ _JIT = {"cache": _CACHE, "error_model": "numpy", "boundscheck": False,
 # and type the model's IR anew at each call site (the bulk of a big model's compile).
 # Without reference counting, as inlined into the split step (``_nrt=False``; a model's
 # functions allocate nothing).
-_rhs_i = nb.njit(forceinline=True, _nrt=False, **_JIT)(rhs.py_func)
-_events_i = nb.njit(forceinline=True, _nrt=False, **_JIT)(events.py_func)
+_rhs_i = nb.njit(forceinline=True, _nrt=False, **_JIT, **INNER)(rhs.py_func)
+_events_i = nb.njit(forceinline=True, _nrt=False, **_JIT, **INNER)(events.py_func)
 # The split path (a step with a located crossing: :func:`_split_step`, :func:`_rk4_stages` and
 # the root finders) inlines them too; a model with lane-scalar functions takes those there
 # instead, the state in registers (see :func:`_split_rhs` and the FUSED block below).
@@ -90,7 +91,7 @@ _events_i = nb.njit(forceinline=True, _nrt=False, **_JIT)(events.py_func)
 # arithmetic (bitwise equal).
 
 
-@nb.njit(forceinline=True, _nrt=False, **_JIT)
+@nb.njit(forceinline=True, _nrt=False, **_JIT, **INNER)
 def _hermite(y0, f0, y1, f1, dt, theta, out):
     """Cubic Hermite interpolant of a step of length dt at fraction theta."""
     h00, h10, h01, h11 = _hermite_weights(dt, theta)
@@ -98,7 +99,7 @@ def _hermite(y0, f0, y1, f1, dt, theta, out):
         out[q] = h00 * y0[q] + h10 * f0[q] + h01 * y1[q] + h11 * f1[q]
 
 
-@nb.njit(**_JIT)
+@nb.njit(**_JIT, **INNER)
 def _illinois(j, side_j, a, fa, b, fb, y0, f0, y1, f1, dt, t, p, ybuf, g, pc):
     """Illinois root finding of event j (the model's, on the step's interpolant) in the
     bracket [a, b]: fa on side side_j, fb off it. Returns the bracket's end off the side.
@@ -209,7 +210,7 @@ def _cubic_locate(j, side_j, c0, c1, c2, c3, b, fb, v1, v2, y0, f0, y1, f1, dt, 
                      g, pc)
 
 
-@nb.njit(**_JIT)
+@nb.njit(**_JIT, **INNER)
 def _beyond(th, e, j, side_j, tol, y0, f0, y1, f1, dt, t, p, ybuf, g, pc):
     """The event j on the interpolant at th if the cubic's value e there and it both lie beyond
     the edge (off side side_j, by more than tol); else NaN. g: scratch row."""
@@ -222,7 +223,7 @@ def _beyond(th, e, j, side_j, tol, y0, f0, y1, f1, dt, t, p, ybuf, g, pc):
     return ge if _side(ge) != side_j and abs(ge) > tol else np.nan
 
 
-@nb.njit(forceinline=True, _nrt=False, **_JIT)
+@nb.njit(forceinline=True, _nrt=False, **_JIT, **INNER)
 def _interpolant_events(y0, f0, y1, f1, dt, t, p, ybuf, g0, g13, g23, pc):
     """The events along a step's cubic Hermite interpolant (start y0, end y1, derivatives f0, f1,
     length dt, from time t; forcing phase pc, see :func:`_phase_in`) at theta = 0, 1/3, 2/3
@@ -237,7 +238,7 @@ def _interpolant_events(y0, f0, y1, f1, dt, t, p, ybuf, g0, g13, g23, pc):
     _events_i(t + 2.0 / 3.0 * dt, ybuf, g23, p, sx, cx)
 
 
-@nb.njit(forceinline=True, _nrt=False, **_JIT)
+@nb.njit(forceinline=True, _nrt=False, **_JIT, **INNER)
 def _first_crossing(j, side_j, graze, g1j, y0, f0, y1, f1, dt, t, p, ybuf, gbuf, gsc, pc):
     """Fraction in (0, 1] of the step where event j first leaves side side_j along the step's
     cubic Hermite interpolant, or 2.0 if it stays on its side. g1j: the event at the end; gbuf
@@ -297,7 +298,7 @@ def _leaves_side_step(r, t0, t1, Y, K1, G0, G1, SIDE, p, ybuf, gbuf, s1, c1):
     return out
 
 
-@nb.njit(forceinline=True, _nrt=False, **_JIT)
+@nb.njit(forceinline=True, _nrt=False, **_JIT, **INNER)
 def _rk4_stages(y, h, tm, pm, sm, cm, te, pe, se, ce, k1, kst, acc, tmp, out):
     """One classic RK4 step of size h from y into out, k1 (the rhs at the step's start) given:
     the middle stages at time tm with coefficients pm and forcing phase sm, cm, the last at te
@@ -363,14 +364,14 @@ def _events_columns(T, Y, G, PT, P, LANE, nl, S, C, ybuf, gb):
             G[j, k] = gb[j]
 
 
-@nb.njit(forceinline=True, _nrt=False, **_JIT)
+@nb.njit(forceinline=True, _nrt=False, **_JIT, **INNER)
 def _split_rhs(t, y, out, p, s, c):
     """The model's rhs f(t, y) into out, on the split path (for a model with lane-scalar
     functions: the lane form, see below)."""
     _rhs_i(t, y, out, p, s, c)
 
 
-@nb.njit(forceinline=True, _nrt=False, **_JIT)
+@nb.njit(forceinline=True, _nrt=False, **_JIT, **INNER)
 def _split_copy(dst, src):
     """dst[:] = src, on the split path (see :func:`_split_rhs`)."""
     for q in range(src.size):
@@ -506,7 +507,7 @@ def _split_run(i, t0, y, y_trial, p, h, omega, n_per, sa, ca, s_end, c_end, side
     return 1
 
 
-@nb.njit(_nrt=False, **_JIT)  # it allocates nothing: no reference counting of its views
+@nb.njit(_nrt=False, **_JIT, **INNER)  # it allocates nothing: no reference counting
 def _split_step(i, t0, y, y_trial, p, h, omega, n_per, sa, ca, s_end, c_end, side, g1, ncross,
                 work, ybuf, gbuf):
     """Finish grid step i of one lane with edge crossings located (:func:`_split_run` with a
@@ -534,7 +535,7 @@ def _split_step(i, t0, y, y_trial, p, h, omega, n_per, sa, ca, s_end, c_end, sid
                       False)
 
 
-@nb.njit(_nrt=False, **_JIT)  # it allocates nothing: no reference counting of its views
+@nb.njit(_nrt=False, **_JIT, **INNER)  # it allocates nothing: no reference counting
 def _rows_step(i, t0, Y, p, h, omega, n_per, s_tab, c_tab, n_ev, K, TMP, Y1, SIDE, G0, G1, W,
                gbuf, NCR, UNRES):
     """Advance every row of Y (independent states of one lane, e.g. a state and its
@@ -588,7 +589,7 @@ def _rows_step(i, t0, Y, p, h, omega, n_per, s_tab, c_tab, n_ev, K, TMP, Y1, SID
                 Y[r, q] = Y1[r, q]
 
 
-@nb.njit(_nrt=False, **_JIT)  # it allocates nothing: no reference counting of its views
+@nb.njit(_nrt=False, **_JIT, **INNER)  # it allocates nothing: no reference counting
 def _tangent_step(i, t0, Z, S, IS, p, h, omega, n_per, s_tab, c_tab, n_ev, YP, E, K, TMP, Y1,
                   SIDE, G0, G1, W, gbuf, NCR, UNRES):
     """Advance the state y (row 0 of Z) by one grid step and each tangent vector v (rows 1..,
@@ -813,16 +814,16 @@ if "rhs_lane" in globals():  # the model's lane-scalar functions (see .kernels)
     # element by element. With the array loops LLVM loaded a freshly stored state or stage as
     # one vector, which no store can forward to (a stall of ~15 cycles each, ~1/5 of a split,
     # see bench/perf_map.py); the same arithmetic (bitwise equal).
-    @nb.njit(forceinline=True, _nrt=False, **_JIT)
+    @nb.njit(forceinline=True, _nrt=False, **_JIT, **INNER)
     def _split_rhs(t, y, out, p, s, c):  # noqa: F811 - the lane form of the generic one
         v = _rhs_l(t, _t_get(y), p[None, :].T, 0, s, c, FORM_GENERAL)
         _t_put(out, v)
 
-    @nb.njit(forceinline=True, _nrt=False, **_JIT)
+    @nb.njit(forceinline=True, _nrt=False, **_JIT, **INNER)
     def _split_copy(dst, src):  # noqa: F811
         _t_put(dst, _t_get(src))
 
-    @nb.njit(forceinline=True, _nrt=False, **_JIT)
+    @nb.njit(forceinline=True, _nrt=False, **_JIT, **INNER)
     def _rk4_stages(y, h, tm, pm, sm, cm, te, pe, se, ce, k1, kst, acc, tmp, out):  # noqa: F811
         ptm = pm[None, :].T  # PT[j, 0] = p[j]: the lane functions' coefficient layout, a view
         pte = pe[None, :].T
@@ -834,7 +835,7 @@ if "rhs_lane" in globals():  # the model's lane-scalar functions (see .kernels)
         k4 = _rhs_l(te, _t_axpy(yt, h, k3), pte, 0, se, ce, FORM_GENERAL)
         _t_put(out, _t_comb(yt, rk4_sixth(h), k1t, k2, k3, k4))
 
-    @nb.njit(forceinline=True, _nrt=False, **_JIT)
+    @nb.njit(forceinline=True, _nrt=False, **_JIT, **INNER)
     def _hermite(y0, f0, y1, f1, dt, theta, out):  # noqa: F811
         h00, h10, h01, h11 = _hermite_weights(dt, theta)
         _t_put(out, _t_hermite(_t_get(y0), _t_get(f0), _t_get(y1), _t_get(f1), h00, h10, h01,

@@ -30,6 +30,14 @@ from geardyn._jit_target import WidthCompiler
 _CACHE = True
 _JIT = {"cache": _CACHE, "error_model": "numpy", "boundscheck": False,
         "pipeline_class": WidthCompiler}
+#: Options of a function that only compiled code calls (never Python): no Python or C entry
+#: point is made for it. Its arguments are the block's tuples of ~60 arrays, whose unboxing
+#: wrapper cost more compile time than the function (~0.25 s CPU each); a call from Python
+#: would find no entry point.
+INNER = {"no_cpython_wrapper": True, "no_cfunc_wrapper": True}
+#: Options of a function that Python calls but no compiled code takes as a C callback: no C
+#: entry point is made for it (numba makes one for every function by default).
+OUTER = {"no_cfunc_wrapper": True}
 MAX_SPLITS = 16
 SIMULTANEOUS = 1e-9
 #: Rows of the events scratch buffer ``gbuf`` that :func:`_split_step` needs (events at the start,

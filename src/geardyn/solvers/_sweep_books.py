@@ -13,7 +13,7 @@ from __future__ import annotations
 import numba as nb
 import numpy as np
 
-from geardyn.solvers._step_shared import _JIT, STATUS_DIVERGED, STATUS_OK, event_buffer
+from geardyn.solvers._step_shared import _JIT, INNER, STATUS_DIVERGED, STATUS_OK, event_buffer
 
 #: A difference of section points below this fraction of the tolerance counts as settled
 #: whatever its contraction rate (the rate of differences at round-off level is noise).
@@ -85,11 +85,13 @@ def _healthy_lane(Y, k, bound):
     return True
 
 
-@nb.njit(inline="always", **_JIT)
+@nb.njit(_nrt=False, **_JIT, **INNER)
 def _write_out(k, lane, n_ev, n_obs, n_tr, GMIN, GMAX, OMAX, OMIN, OSQ, n_stat, status,
                transient_steps, gmin, gmax, omax, omin, orms, STEP, steps):
     """The statistics of the lane that has ended in slot k, to its outputs; its grid steps
-    added to ``steps[lane]`` (a count of the work done: a lane run twice would show)."""
+    added to ``steps[lane]`` (a count of the work done: a lane run twice would show). Called,
+    not inlined: once per lane, from two sites of the bookkeeping that the block loops inline
+    (a copy each cost compile time)."""
     transient_steps[lane] = n_tr[k]
     steps[lane] += STEP[k]
     for j in range(n_ev):
@@ -104,7 +106,7 @@ def _write_out(k, lane, n_ev, n_obs, n_tr, GMIN, GMAX, OMAX, OMIN, OSQ, n_stat, 
             orms[lane, j] = np.nan
 
 
-@nb.njit(_nrt=False, **_JIT)
+@nb.njit(_nrt=False, **_JIT, **INNER)
 def _chained(k, lanes, cfg, sched, out, slots):
     """The lane that follows the one that has just ended in slot k on its chain
     (``sched.chain``: a sweep by continuation, each point starting where the one before
@@ -144,30 +146,22 @@ def _chained(k, lanes, cfg, sched, out, slots):
     return succ
 
 
-@nb.njit(_nrt=False, **_JIT)
+@nb.njit(_nrt=False, **_JIT, **INNER)
 def _slot_check(k, Y, R, D, ys, LANE, STEP, PHASE, n_end, n_tr, next_sample, DUE, n_ring, ACT,
                 END, GMIN, GMAX, OMAX, OMIN, OSQ, n_stat, lanes, cfg, out):
     """Slot k at the start of a period or at its due step (see :func:`_sweep_worker`): its
     health (at a period's start or the lane's end; a diverged lane ends here) and the end of its
     transient. Returns (ended, change of the count of sampling slots)."""
     n_transient_max, sample_every = lanes[6], lanes[7]
-    conv_tol, n_samples, bound, n_ev, n_obs = cfg[0], cfg[2], cfg[4], cfg[5], cfg[6]
+    conv_tol, bound, n_ev, n_obs = cfg[0], cfg[4], cfg[5], cfg[6]
     (samples, final, status, gmin, gmax, ncross, omax, omin, orms, unresolved, transient_steps,
      converged, steps) = out
-    ns = Y.shape[0]
     lane = LANE[k]
     step = STEP[k]
     if (PHASE[k] == 0 or step == n_end[k]) and not _healthy_lane(Y, k, bound):
-        status[lane] = STATUS_DIVERGED
-        ACT[k] = False
-        END[k] = True
-        for r in range(n_samples):
-            for q in range(ns):
-                samples[lane, r, q] = np.nan
-        for q in range(ns):
-            final[lane, q] = np.nan
-        _write_out(k, lane, n_ev, n_obs, n_tr, GMIN, GMAX, OMAX, OMIN, OSQ, n_stat, status,
-                   transient_steps, gmin, gmax, omax, omin, orms, STEP, steps)
+        _diverged(k, lane, n_ev, n_obs, n_tr, ACT, END, GMIN, GMAX, OMAX, OMIN, OSQ, n_stat,
+                  STEP, samples, final, status, transient_steps, gmin, gmax, omax, omin, orms,
+                  steps)
         return True, -1 if step > n_tr[k] else 0
     d_samp = 0
     if step == n_tr[k]:
@@ -178,7 +172,24 @@ def _slot_check(k, Y, R, D, ys, LANE, STEP, PHASE, n_end, n_tr, next_sample, DUE
     return False, d_samp
 
 
-@nb.njit(_nrt=False, **_JIT)
+@nb.njit(_nrt=False, **_JIT, **INNER)
+def _diverged(k, lane, n_ev, n_obs, n_tr, ACT, END, GMIN, GMAX, OMAX, OMIN, OSQ, n_stat, STEP,
+              samples, final, status, transient_steps, gmin, gmax, omax, omin, orms, steps):
+    """Slot k's lane has diverged (:func:`_slot_check`): it ends there, its samples and final
+    state NaN, its statistics written out. Called, not inlined (once per diverged lane)."""
+    status[lane] = STATUS_DIVERGED
+    ACT[k] = False
+    END[k] = True
+    for r in range(samples.shape[1]):
+        for q in range(samples.shape[2]):
+            samples[lane, r, q] = np.nan
+    for q in range(final.shape[1]):
+        final[lane, q] = np.nan
+    _write_out(k, lane, n_ev, n_obs, n_tr, GMIN, GMAX, OMAX, OMIN, OSQ, n_stat, status,
+               transient_steps, gmin, gmax, omax, omin, orms, STEP, steps)
+
+
+@nb.njit(_nrt=False, **_JIT, **INNER)
 def _slot_sample(k, Y, LANE, STEP, n_end, n_tr, next_sample, DUE, ACT, END, GMIN, GMAX, OMAX,
                  OMIN, OSQ, n_stat, lanes, cfg, out):
     """Slot k (sampling) at its due step: the section sample, the lane's end. Returns True
@@ -207,12 +218,13 @@ def _slot_sample(k, Y, LANE, STEP, n_end, n_tr, next_sample, DUE, ACT, END, GMIN
     return True
 
 
-@nb.njit(inline="always", **_JIT)
+@nb.njit(_nrt=False, **_JIT, **INNER)
 def _transient_end(k, lane, Y, ys, R, D, n_ring, n_tr, n_end, next_sample, conv_tol, converged,
                    sample_every, n_transient_max, ncross, n_ev):
     """Slot k's lane has reached the end of its transient: with the convergence test on and the
     lane not settled yet (:func:`_settled`), one more section period of transient (up to the
-    limit); else the sampled stretch starts (its crossing counts from 0)."""
+    limit); else the sampled stretch starts (its crossing counts from 0). Called, not inlined
+    (once per lane, or per section period of a transient extended by the convergence test)."""
     if conv_tol > 0.0 and converged[lane] == 0:
         every = sample_every[lane]
         for q in range(ys.size):
@@ -233,7 +245,7 @@ def _transient_end(k, lane, Y, ys, R, D, n_ring, n_tr, n_end, next_sample, conv_
         ncross[lane, j] = 0
 
 
-@nb.njit(_nrt=False, **_JIT)
+@nb.njit(_nrt=False, **_JIT, **INNER)
 def _compact(nv, n_act, blk, slots):
     """Move the running lanes of slots n_act.. (n_act: the number of running lanes) of the
     fused loop's nv slots into the free slots below n_act, so that the loop can run over
