@@ -94,8 +94,7 @@ from geardyn.solvers._sweep_books import (  # compiled once for every model
 )
 from geardyn.solvers._template_model import events, observe, rhs  # MODEL-IMPORT
 
-# (as ._step_core's)
-_observe_i = nb.njit(forceinline=True, _nrt=False, **_JIT, **INNER)(observe.py_func)
+_observe_i = nb.njit(forceinline=True, _nrt=False, **_JIT)(observe.py_func)  # (as ._step_core's)
 
 __all__ = ["BLOCK", "MAX_SPLITS", "SIMULTANEOUS", "events", "observe", "phase_table", "rhs",
            "sweep", "trajectory"]

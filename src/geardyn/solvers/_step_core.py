@@ -79,8 +79,8 @@ _JIT = {"cache": _CACHE, "error_model": "numpy", "boundscheck": False,
 # and type the model's IR anew at each call site (the bulk of a big model's compile).
 # Without reference counting, as inlined into the split step (``_nrt=False``; a model's
 # functions allocate nothing).
-_rhs_i = nb.njit(forceinline=True, _nrt=False, **_JIT, **INNER)(rhs.py_func)
-_events_i = nb.njit(forceinline=True, _nrt=False, **_JIT, **INNER)(events.py_func)
+_rhs_i = nb.njit(forceinline=True, _nrt=False, **_JIT)(rhs.py_func)
+_events_i = nb.njit(forceinline=True, _nrt=False, **_JIT)(events.py_func)
 # The split path (a step with a located crossing: :func:`_split_step`, :func:`_rk4_stages` and
 # the root finders) inlines them too; a model with lane-scalar functions takes those there
 # instead, the state in registers (see :func:`_split_rhs` and the FUSED block below).

@@ -31,9 +31,12 @@ _CACHE = True
 _JIT = {"cache": _CACHE, "error_model": "numpy", "boundscheck": False,
         "pipeline_class": WidthCompiler}
 #: Options of a function that only compiled code calls (never Python): no Python or C entry
-#: point is made for it. Its arguments are the block's tuples of ~60 arrays, whose unboxing
-#: wrapper cost more compile time than the function (~0.25 s CPU each); a call from Python
-#: would find no entry point.
+#: point is made for it (numba makes both for every function it compiles, a callee too). The
+#: sweep's bookkeeping takes the block's tuples of ~60 arrays, whose unboxing wrapper cost more
+#: compile time than the function (~0.25 s CPU each). A call from Python would find no entry
+#: point. Not for a function compiled from another's ``py_func`` (the model's ``_rhs_i`` and
+#: the like): numba's cache keys an entry by the Python function and signature, not the
+#: options, so the other, called from Python, could load the entry without one.
 INNER = {"no_cpython_wrapper": True, "no_cfunc_wrapper": True}
 #: Options of a function that Python calls but no compiled code takes as a C callback: no C
 #: entry point is made for it (numba makes one for every function by default).
