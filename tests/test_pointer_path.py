@@ -173,8 +173,10 @@ def test_the_pointer_lyapunov_lane_blocks_equal_the_inlined_one_form_bitwise():
     """``lyapunov_lanes``, ``geardyn.lyapunov`` (k = 1) and ``bifurcation(..., lyapunov=True)``
     on the pointer path (the shared lane blocks calling the model's variational step and flagged
     lanes through their addresses): bitwise those of the same one form inlined, the variational
-    tangent, impacting lanes among them."""
-    inlined = gear_pair(**COEFFS, kernel_path="lane-form")
+    tangent, impacting lanes among them. The inlined one form is the built-in gear pair's (the
+    same physics, bitwise the user's one form: the sweep and trajectory tests above), whose
+    lane blocks the warm-up compiles."""
+    inlined = geardyn.GearPair(**COEFFS)
     pointer = gear_pair(**COEFFS, kernel_path="pointer")
     kern = kernels_for(pointer.kernel, "lyapunov")
     assert isinstance(kern, PointerLyapunov)
@@ -223,8 +225,9 @@ def test_the_pointer_lyapunov_spectrum_equals_the_inlined_one_form_bitwise():
     of the same one form inlined, whatever the blocks (one pass of the lanes' 2 vectors, or two
     passes where 40 lanes of 2 vectors outnumber a block's 64 slots), impacting lanes among
     them (split steps with the tangent vectors); no inlined spectrum worker compiled for it.
-    ``geardyn.lyapunov(..., spectrum=True)`` too."""
-    inlined = gear_pair(**COEFFS, kernel_path="lane-form")
+    ``geardyn.lyapunov(..., spectrum=True)`` too. The inlined one form is the built-in gear
+    pair's, as above (its spectrum workers are those tests/test_one_form.py compiles)."""
+    inlined = geardyn.GearPair(**COEFFS)
     pointer = gear_pair(**COEFFS, kernel_path="pointer")
     kern = kernels_for(pointer.kernel, "lyapunov")
     workers = [f"_lyap_spec_worker_form{j}" for j in range(3)]

@@ -117,9 +117,13 @@ _JIT_LANES = {**_JIT, "_nrt": False}
 #: called, not inlined, and without reference counting (they allocate nothing), so that each
 #: is compiled once per argument types and appears once in a kernel, however many call sites
 #: the kernel templates inline the entry points at (the kernels inline ``planetary_rhs`` and
-#: ``planetary_events`` at every call site: a call of the body each). The lane-block mesh
-#: loop (:func:`_lanes_meshes`) stays inlined: called, ``planetary_rhs_lanes`` was slower.
-_JIT_BODY = _JIT_LANES
+#: ``planetary_events`` at every call site: a call of the body each). ``forceinline`` False
+#: explicitly: numba's flag is inherited from the compile a function is first compiled in,
+#: and the templates compile the entry points with it (LLVM's ``alwaysinline``), which would
+#: make LLVM inline a body at every call site of every kernel function (the split step's
+#: ~14 copies of the right-hand side). The lane-block mesh loop (:func:`_lanes_meshes`) stays
+#: inlined: called, ``planetary_rhs_lanes`` was slower.
+_JIT_BODY = {**_JIT_LANES, "forceinline": False}
 
 
 def layout(n: int, n_mesh: int, nh: int, nk: int = 0, ng: int = 0) -> dict[str, int]:
