@@ -288,6 +288,8 @@ def adapters(form: OneForm) -> str:
         form_arg = "" if name == "events" else ", form"
         text += _fn(f"{name}_lane(t, y, PT, k, s, c{form_arg})", lane_body, inline=True)
     text += f"\n\n#: The state size of the lane-scalar forms.\nrhs_lane_states = {ns}\n"
+    text += (f"#: The number of switching functions (the size of ``events_lane``'s tuple).\n"
+             f"events_lane_count = {form.n_events}\n")
     if quiet:
         text += _fn("rhs_lane_form(PT, k)", [
             f"if {_quiet_test(form, 'PT[{q}, k]')}:", "    return _ONE_FORM",

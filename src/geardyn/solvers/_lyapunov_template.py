@@ -1155,14 +1155,17 @@ def _block_form(P, first, nl):
     return form
 
 
-@nb.njit(inline="always", **_JIT)
+@nb.njit(**_JIT)
 def _fused_block_start(first, nl, k, P, Y0, S, T0, H, NPER, OFF, n_transient, n_steps,
                        renorm_every, n_blocks, out, err, used, status):
     """The start of a fused Lyapunov block of k tangent vectors (:func:`_lyap_block_fused`,
     k = 1; :func:`_lyap_block_var`; nl <= BLOCK lanes): the inverse scale IS, the state and
     tangent columns (ZT and its rows Z0, Z1: the state and the first tangent vector), the lanes'
     coefficients, clocks, phase-table indices and phases, the activity and flag columns, the
-    lanes' books (:func:`_lanes_init`), the renormalisation interval and the first due step."""
+    lanes' books (:func:`_lanes_init`), the renormalisation interval and the first due step.
+    Compiled on its own (not inlined in each worker: numba's compile time grows faster than a
+    function's size), once for both fused blocks and every lane form (integer arguments
+    int64, not literals)."""
     ns = Y0.shape[1]
     IS = np.empty(ns)
     for q in range(ns):
@@ -1208,8 +1211,8 @@ def _lyap_block_fused(form, first, nl, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TA
     ns = Y0.shape[1]
     (IS, ZT, Z0, Z1, PT, T0L, HL, HHL, H6L, IDX, NPL, ENDL, PH, ACT, ACTR, FLAG, IST, ENDS, BLK,
      ACC, Zl, Cl, logs, max_total, renorm, due) = _fused_block_start(
-        first, nl, 1, P, Y0, S, T0, H, NPER, OFF, n_transient, n_steps, renorm_every, n_blocks,
-        out, err, used, status)
+        np.int64(first), np.int64(nl), np.int64(1), P, Y0, S, T0, H, NPER, OFF, n_transient,
+        n_steps, renorm_every, n_blocks, out, err, used, status)
     EL = np.zeros(BLOCK)
     UNRR = np.zeros(3 * BLOCK, np.int64)
     R6 = np.zeros((6, ns * BLOCK))
@@ -1424,6 +1427,47 @@ def _var_steps(form, i, stop, n_adv, nl, locate, commit, Z0, Z1, S, IS, PT, T0L,
         j += 1
 
 
+@nb.njit(_nrt=False, **_JIT_NOALIAS)
+def _var_steps_form0(i, stop, n_adv, nl, locate, commit, Z0, Z1, S, IS, PT, T0L, HL, HHL, H6L,
+                     PH, IDX, ENDL, ACT, FLAG, GR, Y1F, NPL):
+    """:func:`_var_steps` in the lane form FORM_GENERAL (compiled on its own, noalias)."""
+    return _var_steps(FORM_GENERAL, i, stop, n_adv, nl, locate, commit, Z0, Z1, S, IS, PT, T0L,
+                      HL, HHL, H6L, PH, IDX, ENDL, ACT, FLAG, GR, Y1F, NPL)
+
+
+@nb.njit(_nrt=False, **_JIT_NOALIAS)
+def _var_steps_form1(i, stop, n_adv, nl, locate, commit, Z0, Z1, S, IS, PT, T0L, HL, HHL, H6L,
+                     PH, IDX, ENDL, ACT, FLAG, GR, Y1F, NPL):
+    """:func:`_var_steps` in the lane form FORM_QUIET."""
+    return _var_steps(FORM_QUIET, i, stop, n_adv, nl, locate, commit, Z0, Z1, S, IS, PT, T0L,
+                      HL, HHL, H6L, PH, IDX, ENDL, ACT, FLAG, GR, Y1F, NPL)
+
+
+@nb.njit(_nrt=False, **_JIT_NOALIAS)
+def _var_steps_form2(i, stop, n_adv, nl, locate, commit, Z0, Z1, S, IS, PT, T0L, HL, HHL, H6L,
+                     PH, IDX, ENDL, ACT, FLAG, GR, Y1F, NPL):
+    """:func:`_var_steps` in the lane form FORM_LOAD."""
+    return _var_steps(FORM_LOAD, i, stop, n_adv, nl, locate, commit, Z0, Z1, S, IS, PT, T0L,
+                      HL, HHL, H6L, PH, IDX, ENDL, ACT, FLAG, GR, Y1F, NPL)
+
+
+@nb.njit(inline="always", **_JIT)
+def _var_steps_of(form, i, stop, n_adv, nl, locate, commit, Z0, Z1, S, IS, PT, T0L, HL, HHL,
+                  H6L, PH, IDX, ENDL, ACT, FLAG, GR, Y1F, NPL):
+    """:func:`_var_steps` of lane form ``form`` (a constant), compiled on its own
+    (:func:`_var_steps_form1`, ...): the time loops of one tangent vector and of a spectrum
+    call the same compiled fused loop, and each time loop compiles apart from it (numba's
+    compile time grows faster than a function's size)."""
+    if form == FORM_QUIET:
+        return _var_steps_form1(i, stop, n_adv, nl, locate, commit, Z0, Z1, S, IS, PT, T0L, HL,
+                                HHL, H6L, PH, IDX, ENDL, ACT, FLAG, GR, Y1F, NPL)
+    if form == FORM_LOAD:
+        return _var_steps_form2(i, stop, n_adv, nl, locate, commit, Z0, Z1, S, IS, PT, T0L, HL,
+                                HHL, H6L, PH, IDX, ENDL, ACT, FLAG, GR, Y1F, NPL)
+    return _var_steps_form0(i, stop, n_adv, nl, locate, commit, Z0, Z1, S, IS, PT, T0L, HL,
+                            HHL, H6L, PH, IDX, ENDL, ACT, FLAG, GR, Y1F, NPL)
+
+
 @nb.njit(_nrt=False, **_JIT)  # it allocates nothing: no reference counting of its views
 def _var_flagged(i, nl, first, n_ev, P, ZT, S, IS, T0L, HL, OMEGA, NPL, IDX, S_TAB, C_TAB,
                  FLAG, UNRR, FDL, GR, Y1F, fd):
@@ -1529,8 +1573,9 @@ def _lyap_var_run(form, first, nl, n_ev, max_total, due, renorm, bound, P, OMEGA
             kk = min(kp, k - j_lo)
             if k > 1:
                 _var_load(ZT, ZX, nl, j_lo, kk)
-            last = _var_steps(form, i, stop, n_slot, nv, locate, g == n_pass - 1, Z0, ZX, S,
-                              IS, PT, T0L, HL, HHL, H6L, PH, IDX, ENDL, ACT, FLAG, GR, Y1F, NPL)
+            last = _var_steps_of(form, i, stop, n_slot, nv, locate, g == n_pass - 1, Z0, ZX,
+                                 S, IS, PT, T0L, HL, HHL, H6L, PH, IDX, ENDL, ACT, FLAG, GR, Y1F,
+                                 NPL)
             if k > 1:
                 _var_store(ZT, ZX, nl, j_lo, kk)
         i = last
@@ -1573,8 +1618,10 @@ def _lyap_var_run1(form, first, nl, n_ev, max_total, due, renorm, bound, P, OMEG
         if not live:
             break
         # the steps up to the next flagged one or bookkeeping, in one call
-        i = _var_steps(form, i, min(max_total, max(due, i + 1)), nl, nv, locate, True, Z0, Z1,
-                       S, IS, PT, T0L, HL, HHL, H6L, PH, IDX, ENDL, ACT, FLAG, GR, Y1F, NPL)
+        # (np.bool_: a literal True would compile the fused loop apart from the spectrum's)
+        i = _var_steps_of(form, i, min(max_total, max(due, i + 1)), nl, nv, locate,
+                          np.bool_(True), Z0, Z1, S, IS, PT, T0L, HL, HHL, H6L, PH, IDX, ENDL,
+                          ACT, FLAG, GR, Y1F, NPL)
         n_flag = 0
         for l in range(nl):
             n_flag += 1 if FLAG[l] != 0.0 else 0
@@ -1658,11 +1705,23 @@ def _var_phases(n, IDX, NPL, S_TAB, C_TAB, PH):
         BD[l] = bd
 
 
+#: The model's number of switching functions where its lane forms state it (a one form's
+#: ``events_lane_count``, :func:`geardyn.core.one_form.adapters`), else None.
+_N_SWITCHING = _events_l.py_func.__globals__.get("events_lane_count") if FUSED else None
+
+
 # POINTER-HOOK: the pointer path (:mod:`._pointer_lyapunov`) replaces this definition
-@nb.njit(inline="always", **_JIT)
-def _n_switching(Z0, PT):
-    """The model's number of switching functions (of its lane form's events)."""
-    return len(_events_l(0.0, _t_load(Z0, 0), PT, 0, 0.0, 1.0))
+if _N_SWITCHING is None:
+    @nb.njit(inline="always", **_JIT)
+    def _n_switching(Z0, PT):
+        """The model's number of switching functions (of its lane form's events)."""
+        return len(_events_l(0.0, _t_load(Z0, 0), PT, 0, 0.0, 1.0))
+else:
+    @nb.njit(inline="always", **_JIT)
+    def _n_switching(Z0, PT):
+        """The model's number of switching functions (its lane forms' count: the events are
+        not inlined here to count them)."""
+        return np.int64(_N_SWITCHING)
 
 
 @nb.njit(inline="always", **_JIT)
@@ -1678,8 +1737,8 @@ def _lyap_block_var(form, one, first, nl, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB
     ns = Y0.shape[1]
     (IS, ZT, Z0, Z1, PT, T0L, HL, HHL, H6L, IDX, NPL, ENDL, PH, ACT, ACTR, FLAG, IST, ENDS, BLK,
      ACC, Zl, Cl, logs, max_total, renorm, due) = _fused_block_start(
-        first, nl, k, P, Y0, S, T0, H, NPER, OFF, n_transient, n_steps, renorm_every, n_blocks,
-        out, err, used, status)
+        np.int64(first), np.int64(nl), np.int64(k), P, Y0, S, T0, H, NPER, OFF, n_transient,
+        n_steps, renorm_every, n_blocks, out, err, used, status)
     m, nr = k + 1, 2 * k + 1
     ne = max(n_ev, 1)
     UNRR = np.zeros(BLOCK, np.int64)
