@@ -21,6 +21,14 @@ numba names them), which ``inline_ir`` copies again before it changes anything. 
 untyped pipeline depends only on the function, its globals (fixed during a compile) and those
 flags, so the inlined code is the same.
 
+numba types an ``overload(..., inline="always")`` by compiling its implementation for the
+argument types (``Dispatcher.get_call_template``, run for its side effect: a ``literally`` in
+the implementation must dispatch first), lowering and optimising it too, then types the
+implementation's IR once more for the inlining and never uses the compiled function. An
+implementation marked :data:`INLINE_ONLY` (geardyn's tuple helpers, which take no literal
+arguments) is not compiled inside geardyn's compiles: the inlined IR and its types are the
+same, so the compiled code is the same.
+
 It is installed only inside geardyn's own compiles (:func:`block_copy`, entered under numba's
 compiler lock by :func:`geardyn.solvers.kernels._quiet_compile`); numba outside them is
 untouched.
@@ -33,6 +41,8 @@ from collections.abc import Iterator
 from typing import Any
 
 from numba.core import bytecode as _bytecode
+from numba.core import dispatcher as _dispatcher
+from numba.core import typing as _typing
 from numba.core import inline_closurecall as _icc
 from numba.core import ir as _ir
 
@@ -59,6 +69,10 @@ class _SharedBlockCopy:
 _SHIM = _SharedBlockCopy()
 _ORIGINAL = _icc.InlineWorker.inline_ir
 _ORIGINAL_UNTYPED = _icc.InlineWorker.run_untyped_passes
+#: Attribute of an ``overload(..., inline="always")`` implementation (the Python function it
+#: returns) that takes no literal arguments: typed, not compiled, for its inlining.
+INLINE_ONLY = "_geardyn_inline_only"
+_ORIGINAL_TEMPLATE = _dispatcher.Dispatcher.get_call_template
 #: Untyped IR per (function, flags the untyped pipeline reads), for the outermost compile.
 _UNTYPED: dict[tuple, Any] = {}
 
@@ -84,6 +98,18 @@ def _run_untyped_passes(self: Any, func: Any, enable_ssa: bool = False) -> Any:
     return ir
 
 
+def _get_call_template(self: Any, args: Any, kws: Any) -> Any:
+    """numba's ``get_call_template`` without the compile for an :data:`INLINE_ONLY`
+    implementation (its caller, the overload's typing, takes only the folded argument types)."""
+    if not getattr(self.py_func, INLINE_ONLY, False):
+        return _ORIGINAL_TEMPLATE(self, args, kws)
+    pysig, args = self._compiler.fold_argument_types(args, kws)
+    name = self.py_func.__name__
+    template = _typing.make_concrete_template(f"CallTemplate({name})", key=name,
+                                              signatures=self.nopython_signatures)
+    return template, pysig, args, {}
+
+
 def _inline_ir(self: Any, *args: Any, **kwargs: Any) -> Any:
     saved, _SHIM.memos = _SHIM.memos, {}  # a fresh memo per inlined call site
     try:
@@ -94,13 +120,17 @@ def _inline_ir(self: Any, *args: Any, **kwargs: Any) -> Any:
 
 @scoped_patch
 def block_copy() -> Iterator[None]:
-    """numba's ``inline_ir`` with the shared block copy inside (re-entrant; to be entered under
+    """numba's ``inline_ir`` with the shared block copy inside, its untyped pipeline kept per
+    function, :data:`INLINE_ONLY` implementations typed, not compiled (re-entrant; to be entered under
     numba's compiler lock, so that no other thread compiles meanwhile)."""
     worker = _icc.InlineWorker
-    saved = _icc.copy, worker.inline_ir, worker.run_untyped_passes
+    disp = _dispatcher.Dispatcher
+    saved = _icc.copy, worker.inline_ir, worker.run_untyped_passes, disp.get_call_template
     _icc.copy = _SHIM
     worker.inline_ir = _inline_ir
     worker.run_untyped_passes = _run_untyped_passes
+    disp.get_call_template = _get_call_template
     yield
     _UNTYPED.clear()
-    _icc.copy, worker.inline_ir, worker.run_untyped_passes = saved
+    (_icc.copy, worker.inline_ir, worker.run_untyped_passes,
+     disp.get_call_template) = saved

@@ -646,11 +646,15 @@ def _tangent_step(i, t0, Z, S, IS, p, h, omega, n_per, s_tab, c_tab, n_ev, YP, E
 
 
 def _tuple_source(args, lines, scope=None):
-    """A Python function ``f(args)`` with the body ``lines`` (for the overloads below)."""
+    """A Python function ``f(args)`` with the body ``lines`` (for the overloads below), marked
+    to be typed, not compiled, for its inlining (:data:`._inline_copy.INLINE_ONLY`: it takes
+    no literal arguments)."""
     text = f"def _f({args}):\n" + "".join(f"    {line}\n" for line in lines)
     env = dict(scope or {})
     exec(compile(text, "<geardyn-lane-tuples>", "exec"), env)
-    return env["_f"]
+    fn = env["_f"]
+    fn._geardyn_inline_only = True
+    return fn
 
 
 def _t_load(Y, k):
