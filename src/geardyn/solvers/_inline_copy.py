@@ -29,7 +29,17 @@ implementation marked :data:`INLINE_ONLY` (geardyn's tuple helpers, which take n
 arguments) is not compiled inside geardyn's compiles: the inlined IR and its types are the
 same, so the compiled code is the same.
 
-It is installed only inside geardyn's own compiles (:func:`block_copy`, entered under numba's
+numba keeps an overload's implementation per argument types and per the whole set of flags
+of the function being compiled (``_OverloadFunctionTemplate._get_impl``), so a builtin such as
+``max`` or ``np.zeros`` is compiled anew for every combination of flags among its callers
+(geardyn's differ in ``no_cpython_wrapper``, ``noalias``, ``forceinline``, ...). The
+implementation's compile takes from its caller's flags only those numba's CPU target
+inherits (``CPUTargetOptions.finalize``: ``nrt``, ``fastmath``, ``error_model``,
+``forceinline``); inside geardyn's compiles (:func:`overload_keys`) the implementation is
+kept per those, so callers that differ in other flags share it: the same implementation,
+compiled with the same flags.
+
+They are installed only inside geardyn's own compiles (:func:`block_copy`, entered under numba's
 compiler lock by :func:`geardyn.solvers.kernels._quiet_compile`); numba outside them is
 untouched.
 """
@@ -42,9 +52,11 @@ from typing import Any
 
 from numba.core import bytecode as _bytecode
 from numba.core import dispatcher as _dispatcher
-from numba.core import typing as _typing
 from numba.core import inline_closurecall as _icc
 from numba.core import ir as _ir
+from numba.core import targetconfig as _targetconfig
+from numba.core import typing as _typing
+from numba.core.typing import templates as _templates
 
 from geardyn._scoped_patch import scoped_patch
 
@@ -110,6 +122,42 @@ def _get_call_template(self: Any, args: Any, kws: Any) -> Any:
     return template, pysig, args, {}
 
 
+#: The flags an overload's implementation inherits from its caller's compile (numba's
+#: ``CPUTargetOptions.finalize``).
+INHERITED_FLAGS = ("nrt", "fastmath", "error_model", "forceinline")
+_ORIGINAL_GET_IMPL = _templates._OverloadFunctionTemplate._get_impl
+
+
+def _inherited(flags: Any) -> Any:
+    """The values of :data:`INHERITED_FLAGS` in ``flags`` (hashable), None without flags."""
+    if flags is None:
+        return None
+    return tuple(frozenset(v.flags) if n == "fastmath" else v
+                 for n, v in ((n, getattr(flags, n)) for n in INHERITED_FLAGS))
+
+
+def _get_impl(self: Any, args: Any, kws: Any) -> Any:
+    """numba's ``_OverloadFunctionTemplate._get_impl`` with the implementation kept per the
+    flags it inherits (:data:`INHERITED_FLAGS`), not per all of the caller's flags."""
+    flags = _targetconfig.ConfigStack.top_or_none()
+    cache_key = self.context, tuple(args), tuple(kws.items()), _inherited(flags)
+    try:
+        return self._impl_cache[cache_key]
+    except KeyError:
+        pass
+    return self._build_impl(cache_key, args, kws)
+
+
+@scoped_patch
+def overload_keys() -> Iterator[None]:
+    """Overload implementations kept per the flags they inherit (re-entrant; to be entered
+    under numba's compiler lock)."""
+    template = _templates._OverloadFunctionTemplate
+    saved, template._get_impl = template._get_impl, _get_impl
+    yield
+    template._get_impl = saved
+
+
 def _inline_ir(self: Any, *args: Any, **kwargs: Any) -> Any:
     saved, _SHIM.memos = _SHIM.memos, {}  # a fresh memo per inlined call site
     try:
@@ -121,8 +169,8 @@ def _inline_ir(self: Any, *args: Any, **kwargs: Any) -> Any:
 @scoped_patch
 def block_copy() -> Iterator[None]:
     """numba's ``inline_ir`` with the shared block copy inside, its untyped pipeline kept per
-    function, :data:`INLINE_ONLY` implementations typed, not compiled (re-entrant; to be entered under
-    numba's compiler lock, so that no other thread compiles meanwhile)."""
+    function, :data:`INLINE_ONLY` implementations typed, not compiled (re-entrant; to be
+    entered under numba's compiler lock, so that no other thread compiles meanwhile)."""
     worker = _icc.InlineWorker
     disp = _dispatcher.Dispatcher
     saved = _icc.copy, worker.inline_ir, worker.run_untyped_passes, disp.get_call_template

@@ -46,7 +46,7 @@ from geardyn.core.one_form import tangent_adapters
 from geardyn.solvers import _pointer_calls, compile_share
 from geardyn.solvers import _pointer_kernels as pointer
 from geardyn.solvers._compile_gc import young_collections
-from geardyn.solvers._inline_copy import block_copy
+from geardyn.solvers._inline_copy import block_copy, overload_keys
 
 _IMPORT_MARK = "# MODEL-IMPORT"
 _CORE_MARK = "# CORE-IMPORT"
@@ -132,9 +132,10 @@ def _quiet_compile(dispatcher: Any, cached: bool = False) -> None:
 @contextlib.contextmanager
 def _compiling() -> Iterator[None]:
     """The context of geardyn's compiles: the compiler lock, this process's function names
-    (:func:`unique_names`), the block copy (:func:`._inline_copy.block_copy`), the collector's
+    (:func:`unique_names`), the block copy (:func:`._inline_copy.block_copy`), overload
+    implementations kept per inherited flags (:func:`._inline_copy.overload_keys`), the collector's
     thresholds (:func:`._compile_gc.young_collections`), :data:`QUIET_WARNINGS` ignored."""
-    with (_COMPILE_LOCK, unique_names(), block_copy(), young_collections(),
+    with (_COMPILE_LOCK, unique_names(), block_copy(), overload_keys(), young_collections(),
           warnings.catch_warnings()):
         for category in QUIET_WARNINGS:
             warnings.filterwarnings("ignore", category=category)
