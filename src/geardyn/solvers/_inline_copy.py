@@ -37,7 +37,9 @@ implementation's compile takes from its caller's flags only those numba's CPU ta
 inherits (``CPUTargetOptions.finalize``: ``nrt``, ``fastmath``, ``error_model``,
 ``forceinline``); inside geardyn's compiles (:func:`overload_keys`) the implementation is
 kept per those, so callers that differ in other flags share it: the same implementation,
-compiled with the same flags.
+compiled with the same flags. It is compiled without a C entry point (``no_cfunc_wrapper``, as
+it already is without a Python one): compiled code calls an implementation, never C (a
+wrapper cost about as much as a small implementation's own lowering).
 
 They are installed only inside geardyn's own compiles (:func:`block_copy`, entered under numba's
 compiler lock by :func:`geardyn.solvers.kernels._quiet_compile`); numba outside them is
@@ -148,14 +150,28 @@ def _get_impl(self: Any, args: Any, kws: Any) -> Any:
     return self._build_impl(cache_key, args, kws)
 
 
+def _get_jit_decorator(self: Any) -> Any:
+    """numba's jit decorator of an overload's implementation, without a C entry point unless
+    the overload asks for one."""
+    jitter = _ORIGINAL_JIT_DECORATOR(self)
+
+    def decorator(**options: Any) -> Any:
+        return jitter(**{"no_cfunc_wrapper": True, **options})
+    return decorator
+
+
+_ORIGINAL_JIT_DECORATOR = _templates._OverloadFunctionTemplate._get_jit_decorator
+
+
 @scoped_patch
 def overload_keys() -> Iterator[None]:
-    """Overload implementations kept per the flags they inherit (re-entrant; to be entered
-    under numba's compiler lock)."""
+    """Overload implementations kept per the flags they inherit, compiled without a C entry
+    point (re-entrant; to be entered under numba's compiler lock)."""
     template = _templates._OverloadFunctionTemplate
-    saved, template._get_impl = template._get_impl, _get_impl
+    saved = template._get_impl, template._get_jit_decorator
+    template._get_impl, template._get_jit_decorator = _get_impl, _get_jit_decorator
     yield
-    template._get_impl = saved
+    template._get_impl, template._get_jit_decorator = saved
 
 
 def _inline_ir(self: Any, *args: Any, **kwargs: Any) -> Any:

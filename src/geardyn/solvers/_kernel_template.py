@@ -592,7 +592,7 @@ def _next_lane(k, nxt, q1, lanes, cfg, sched, out, slots, form):
     return -1, nxt
 
 
-@nb.njit(_nrt=False, **_JIT)
+@nb.njit(_nrt=False, **_JIT, **INNER)
 def _entry_form(P, chain, lane):
     """The lane form of a queue entry: that of the lane and of every lane chained after it if
     they agree, else FORM_GENERAL (``rhs_lane_form``; FORM_GENERAL without lane forms)."""

@@ -849,7 +849,7 @@ else:
     LANE_NS = 0
     _rhs_l = _events_l = _observe_l = None
 
-    @nb.njit(**_JIT)
+    @nb.njit(**_JIT, **INNER)
     def _lane_form(PT, k):
         return FORM_GENERAL
 

@@ -110,7 +110,7 @@ def phase_rotate(s, c, alpha, beta):
     return s - (alpha * s - beta * c), c - (alpha * c + beta * s)
 
 
-@nb.njit(**_JIT)
+@nb.njit(**_JIT, **OUTER)
 def phase_table(n_per, forced):
     """sin and cos of the forcing phase at the 2 n_per + 1 half-step points of one period (the
     points pi k / n_per), by the rotations that the sweep's fused step loop applies to a
@@ -175,7 +175,7 @@ def rk4_comb(y, h6, k1, k2, k3, k4):
     return rk4_update(y, h6, k1 + 2.0 * k2 + 2.0 * k3 + k4)
 
 
-@nb.njit(**_JIT)
+@nb.njit(**_JIT, **INNER)
 def _pick(cond, a, b):
     """a if cond else b, a select (a call, inlined by LLVM: numba's inliner would leave the
     generated tuple helpers with phi variables it then warns about, and the fused loops take
@@ -304,7 +304,7 @@ def _cubic_at(s, v0, d1, d2, d3):
     return v0 + s * (d1 + (s - 1.0) * (0.5 * d2 + (s - 2.0) / 6.0 * d3))
 
 
-@nb.njit(**_JIT)
+@nb.njit(**_JIT, **OUTER)
 def cubic_extrema(v0, v1, v2, v3):
     """The cubic through (0, v0), (1/3, v1), (2/3, v2), (1, v3): its stationary points in (0, 1)
     and its values there, as (theta1, value1, theta2, value2), theta1 < theta2; NaN for a point
@@ -321,7 +321,7 @@ def cubic_extrema(v0, v1, v2, v3):
     return (r1 / 3.0, _cubic_at(r1, v0, d1, d2, d3), r2 / 3.0, _cubic_at(r2, v0, d1, d2, d3))
 
 
-@nb.njit(**_JIT)
+@nb.njit(**_JIT, **OUTER)
 def event_buffer(nb_lanes, n_ev):
     """The events scratch buffer of a block of nb_lanes lanes: GBUF_ROWS rows for
     :func:`_split_step`, then two rows per lane for the grid values of the events at even and at
@@ -393,7 +393,7 @@ def _leaves_side(i, k, G, SIDE, locate, gbuf):
     return out
 
 
-@nb.njit(forceinline=True, _nrt=False, **_JIT)
+@nb.njit(forceinline=True, _nrt=False, **_JIT, **INNER)
 def _sincos_small(d):
     """sin d, cos d for |d| <= SMALL_ANGLE, no libm call: Taylor polynomials to d^9 and d^10
     for |d| <= 0.1, else to d^17 and d^18 (truncation below 1e-18 either way)."""
@@ -413,7 +413,7 @@ def _sincos_small(d):
     return sn, cs
 
 
-@nb.njit(forceinline=True, _nrt=False, **_JIT)
+@nb.njit(forceinline=True, _nrt=False, **_JIT, **INNER)
 def _phase_at(sa, ca, wh, i_mod, x):
     """sin and cos of the forcing phase wh (i_mod + x) at the fraction x in [0, 1] of grid step
     i_mod, from those at its start (sa, ca) by angle addition (libm only for long steps)."""
@@ -425,7 +425,7 @@ def _phase_at(sa, ca, wh, i_mod, x):
     return math.sin(a), math.cos(a)
 
 
-@nb.njit(forceinline=True, _nrt=False, **_JIT)
+@nb.njit(forceinline=True, _nrt=False, **_JIT, **INNER)
 def _phase_in(pc, x):
     """sin and cos of the forcing phase at the fraction x of a (sub-)step of the split path:
     pc = (sa, ca, wh, i_mod, u, span), the sub-step from the fraction u of grid step i_mod
@@ -439,7 +439,7 @@ def _phase_in(pc, x):
 NO_PHASE = (0.0, 1.0, 0.0, 0, 0.0, 1.0)
 
 
-@nb.njit(**_JIT)
+@nb.njit(**_JIT, **OUTER)
 def _healthy(y, bound):
     for q in range(y.size):
         v = y[q]

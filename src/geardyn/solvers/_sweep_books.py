@@ -13,14 +13,21 @@ from __future__ import annotations
 import numba as nb
 import numpy as np
 
-from geardyn.solvers._step_shared import _JIT, INNER, STATUS_DIVERGED, STATUS_OK, event_buffer
+from geardyn.solvers._step_shared import (
+    _JIT,
+    INNER,
+    OUTER,
+    STATUS_DIVERGED,
+    STATUS_OK,
+    event_buffer,
+)
 
 #: A difference of section points below this fraction of the tolerance counts as settled
 #: whatever its contraction rate (the rate of differences at round-off level is noise).
 CONV_ROUNDOFF = 1.0e-3
 
 
-@nb.njit(**_JIT)
+@nb.njit(**_JIT, **OUTER)
 def _alloc(nb_lanes, ns, n_ev):
     Y = np.zeros((nb_lanes, ns))
     work = np.zeros((7, ns))
@@ -29,7 +36,7 @@ def _alloc(nb_lanes, ns, n_ev):
             work, np.zeros(ns), event_buffer(nb_lanes, n_ev))
 
 
-@nb.njit(**_JIT)
+@nb.njit(**_JIT, **OUTER)
 def _section_diffs(y, R, n, D):
     """Record the differences of the new section point y (the n-th, counting from 0) to the
     ring R of earlier ones: D[n % len(D), k - 1] = max_q |y_q - x_{n-k,q}| for k = 1 ..
@@ -44,7 +51,7 @@ def _section_diffs(y, R, n, D):
         D[row, k - 1] = d
 
 
-@nb.njit(**_JIT)
+@nb.njit(**_JIT, **OUTER)
 def _settled(y, D, n, tol):
     """True when the section point y (the n-th) is estimated within tol (1 + max |y|) of a
     period-k orbit for some k <= depth = D.shape[1]: with the differences d_j = |x_j - x_{j-k}|
