@@ -89,6 +89,7 @@ from geardyn.solvers._sweep_books import (  # compiled once for every model
     _alloc,
     _chained,
     _compact,
+    _full,
     _slot_check,
     _slot_sample,
 )
@@ -186,16 +187,19 @@ def trajectory(p, y0, h, omega, n_per, i0, n_steps, stride, locate, bound, n_ev,
     s_tab, c_tab = phase_table(n_per, omega != 0.0)
     Y, Y1, K1, K2, K3, K4, TMP, TT, G, SIDE, work, ybuf, gbuf = _alloc(1, ns, n_ev)
     P = p.reshape((1, p.size))
-    H = np.array([h])
-    OM = np.array([omega])
+    H = np.zeros(1)
+    H[0] = h
+    OM = np.zeros(1)
+    OM[0] = omega
     T0 = np.zeros(1)
     NCROSS = np.zeros((1, max(n_ev, 1)), np.int64)
     UNRES = np.zeros(1, np.int64)
-    ACTIVE = np.ones(1, np.bool_)
+    ACTIVE = np.zeros(1, np.bool_)
+    ACTIVE[0] = True
     n_rec = n_steps // stride + 1
-    out_y = np.full((n_rec, ns), np.nan)
-    out_o = np.full((n_rec, max(n_obs, 1)), np.nan)
-    out_g = np.full((n_rec, max(n_ev, 1)), np.nan)
+    out_y = _full((n_rec, ns), np.nan)
+    out_o = _full((n_rec, max(n_obs, 1)), np.nan)
+    out_g = _full((n_rec, max(n_ev, 1)), np.nan)
     for q in range(ns):
         Y[0, q] = y0[q]
     j0 = 2 * (i0 % n_per)
@@ -521,26 +525,28 @@ def _block_arrays(nw, lanes, cfg):
     PH6 = np.zeros((4, nw))
     PH = (PH6[0], PH6[1], PH6[2], PH6[3])
     TT = np.zeros(nw)
-    GP = np.full((n_g, nw), np.nan)  # events at the grid points i - 1, i, i + 1
+    GP = _full((n_g, nw), np.nan)  # events at the grid points i - 1, i, i + 1
     GS = np.zeros((n_g, nw))
     G1 = np.zeros((n_g, nw))
     GR = np.zeros((n_g, nw))
-    SIDE = np.ones((n_g, nw))
+    SIDE = _full((n_g, nw), 1.0)
     FLAG = np.zeros(nw)
-    GMIN = np.full((n_g, nw), np.inf)
-    GMAX = np.full((n_g, nw), -np.inf)
+    GMIN = _full((n_g, nw), np.inf)
+    GMAX = _full((n_g, nw), -np.inf)
     O = np.zeros((n_o, nw))
-    OMAX = np.full((n_o, nw), -np.inf)
-    OMIN = np.full((n_o, nw), np.inf)
+    OMAX = _full((n_o, nw), -np.inf)
+    OMIN = _full((n_o, nw), np.inf)
     OSQ = np.zeros((n_o, nw))
     STAT = np.zeros(nw, np.bool_)
     MSK = np.zeros(nw, np.bool_)  # slots with bookkeeping due
     ACT = np.zeros(nw, np.bool_)
-    END = np.ones(nw, np.bool_)  # slots to (re)fill
+    END = np.zeros(nw, np.bool_)  # slots to (re)fill
+    END[:] = True
     LANE = np.zeros(nw, np.int64)
     STEP = np.zeros(nw, np.int64)
     PHASE = np.zeros(nw, np.int64)
-    NPER = np.ones(nw, np.int64)
+    NPER = np.zeros(nw, np.int64)
+    NPER[:] = 1
     OFF = np.zeros(nw, np.int64)
     HB = np.zeros(nw)
     T0B = np.zeros(nw)
@@ -554,7 +560,8 @@ def _block_arrays(nw, lanes, cfg):
     ys = np.zeros(ns)
     y1s = np.zeros(ns)
     dbuf = np.zeros(ns)
-    sides = np.ones(n_g, np.int64)
+    sides = np.zeros(n_g, np.int64)
+    sides[:] = 1
     g1s = np.zeros(n_g)
     gb = np.zeros(n_g)
     ob = np.zeros(n_o)

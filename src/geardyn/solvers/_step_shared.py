@@ -119,7 +119,8 @@ def phase_table(n_per, forced):
     that reads the table (the one-lane and block kernels, the Lyapunov and monodromy kernels)
     sees the phases of the fused loop, bitwise. Unforced: (0, 1) throughout."""
     s = np.zeros(2 * n_per + 1)
-    c = np.ones(2 * n_per + 1)
+    c = np.zeros(2 * n_per + 1)
+    c[:] = 1.0
     if forced:
         ah, bh, ad, bd = phase_increments(n_per)
         for p in range(n_per):

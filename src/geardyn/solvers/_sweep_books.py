@@ -27,13 +27,25 @@ from geardyn.solvers._step_shared import (
 CONV_ROUNDOFF = 1.0e-3
 
 
+@nb.njit(inline="always", **_JIT)
+def _full(shape, value):
+    """A new float array of ``shape`` filled with ``value``: ``np.zeros`` filled in place, so
+    that the kernels' allocations compile numba's implementations of ``np.zeros`` only (each
+    of ``np.full``, ``np.ones`` and ``np.zeros`` is compiled per shape and dtype it is used
+    with)."""
+    a = np.zeros(shape)
+    a[...] = value
+    return a
+
+
 @nb.njit(**_JIT, **OUTER)
 def _alloc(nb_lanes, ns, n_ev):
     Y = np.zeros((nb_lanes, ns))
     work = np.zeros((7, ns))
+    SIDE = np.zeros((nb_lanes, n_ev), np.int64)
+    SIDE[...] = 1
     return (Y, Y.copy(), Y.copy(), Y.copy(), Y.copy(), Y.copy(), Y.copy(), np.zeros(nb_lanes),
-            np.zeros((nb_lanes, n_ev)), np.ones((nb_lanes, n_ev), np.int64),
-            work, np.zeros(ns), event_buffer(nb_lanes, n_ev))
+            np.zeros((nb_lanes, n_ev)), SIDE, work, np.zeros(ns), event_buffer(nb_lanes, n_ev))
 
 
 @nb.njit(**_JIT, **OUTER)
