@@ -19,7 +19,9 @@ callee loaded from the cache as numba's deferred ``bitcode`` kind is bound too
 
 A bound callee's module is optimised twice (:data:`REOPTIMISE`), as a linked copy is (once in
 its own module, once more in each caller's): optimised once, the reduced CATT device's sweep
-block ran the paper workload 1.19x slower.
+block ran the paper workload 1.19x slower. A cold callee marked by :func:`optimise_once` (the
+sweep's out-of-line slot work) is optimised once: its second optimisation cost compile time
+for no measurable speed.
 
 Only geardyn's functions are changed (:func:`prepare`, called by
 :class:`geardyn._jit_target.VectorWidthPass` on each library it creates; no process-wide
@@ -49,6 +51,18 @@ MIN_INSTRUCTIONS = int(os.environ.get("GEARDYN_BIND_MIN", "1100"))
 REOPTIMISE = os.environ.get("GEARDYN_BIND_REOPT", "1") != "0"
 #: ``GEARDYN_BIND=0`` switches the binding off (A/B measurements).
 ENABLED = os.environ.get("GEARDYN_BIND", "1") != "0"
+
+#: The attribute of a Python function whose compiled code, bound, is optimised once
+#: (:func:`optimise_once`).
+ONCE = "_geardyn_optimise_once"
+
+
+def optimise_once(dispatcher: Any) -> Any:
+    """Mark ``dispatcher`` (a numba function, cold: called out of a hot loop's line) to be
+    optimised once where it is bound, not twice (:data:`REOPTIMISE`); returns it."""
+    setattr(dispatcher.py_func, ONCE, True)
+    return dispatcher
+
 
 #: symbol -> (return attributes, function attributes, [attributes per argument])
 DECLS: dict[str, tuple[list[str], list[str], list[list[str]]]] = {}
@@ -238,8 +252,9 @@ def _finalize(library: Any, reload_init: list) -> None:
             keep.append(lib)
     library._linking_libraries = keep
     type(library).finalize(library)
-    if REOPTIMISE and _lazy_code.is_pending(library) and _big(library._final_module,
-                                                            ll.Linkage.external):
+    if (REOPTIMISE and not getattr(library, "_geardyn_once", False)
+            and _lazy_code.is_pending(library)
+            and _big(library._final_module, ll.Linkage.external)):
         # a callee (its code not emitted yet) that will be bound: optimised once more, as
         # numba's linking optimises a linked copy once more in each caller
         library._optimize_final_module()
@@ -249,9 +264,11 @@ def _finalize(library: Any, reload_init: list) -> None:
     _register(library)
 
 
-def prepare(library: Any, reload_init: list) -> None:
+def prepare(library: Any, reload_init: list, func: Any = None) -> None:
     """Make ``library`` (a geardyn function's numba code library) declare its bound callees;
-    ``reload_init`` is its compile's list of numba's reload callables (``state.reload_init``)."""
+    ``reload_init`` is its compile's list of numba's reload callables (``state.reload_init``),
+    ``func`` the Python function compiled (marked by :func:`optimise_once` or not)."""
+    library._geardyn_once = bool(getattr(func, ONCE, False))
     add = library.add_ir_module
 
     def add_ir_module(ir_module: Any) -> None:

@@ -142,7 +142,7 @@ class VectorWidthPass(LoweringPass):
         if _lazy_code.scope.depth == 1:  # the outermost geardyn function: called from Python
             _lazy_code.mark_outermost(state.library)
         _full_only(state.library)
-        _bound_calls.prepare(state.library, state.reload_init)
+        _bound_calls.prepare(state.library, state.reload_init, state.func_id.func)
         if ATTRIBUTE is not None:
             _mark(state.library, ATTRIBUTE)
         return True

@@ -34,6 +34,7 @@ from __future__ import annotations
 import numba as nb
 import numpy as np
 
+from geardyn._bound_calls import optimise_once
 from geardyn.core.kernel_source import FORM_GENERAL, FORM_LOAD, FORM_QUIET, LANE_FORMS
 from geardyn.solvers._parallel import run_workers
 from geardyn.solvers._step_core import (  # CORE-IMPORT
@@ -879,6 +880,7 @@ _finish_flagged_i = nb.njit(inline="always", **_JIT)(_finish_flagged.py_func)
 _slot_sample_i = nb.njit(inline="always", **_JIT)(_slot_sample.py_func)
 
 
+@optimise_once  # cold: optimised once where bound (see geardyn._bound_calls)
 @nb.njit(_nrt=False, **_JIT, **INNER)
 def _slots_out(nl, G1, SE, CE, TABS, lanes, cfg, out, blk, slots, scratch):
     """:func:`_slot_out` for every marked slot (MSK), in one call per block step (a call
