@@ -198,6 +198,11 @@ def _stores(target: str, n: int) -> list[str]:
     return [f"{target.format(q=q)} = v[{q}]" for q in range(n)] or ["pass"]
 
 
+#: The decorator of a lane function compiled once and inlined by LLVM where it is called
+#: (``forceinline``); compiled code calls it, never C (no C entry point: it cost compile time).
+_LANE_DECO = "@nb.njit(forceinline=True, no_cfunc_wrapper=True, **_JIT)"
+
+
 def _fn(head: str, body: list[str], inline: bool = False) -> str:
     deco = "@nb.njit(inline=\"always\", **_JIT)" if inline else "@nb.njit(**_JIT)"
     return f"\n\n{deco}\ndef {head}:\n" + "".join(f"    {line}\n" for line in body)
@@ -272,7 +277,7 @@ def adapters(form: OneForm) -> str:
                             *blk_body]
             lane_body = [f"return {call}(t, y, _coef_lane(PT, k), s, c)"]
             if not quiet and name != "events":  # compiled once (see _forms)
-                text += (f"\n\n@nb.njit(forceinline=True, **_JIT)\ndef _{name}_lane_one"
+                text += (f"\n\n{_LANE_DECO}\ndef _{name}_lane_one"
                          f"(t, y, PT, k, s, c):\n"
                          f"    return {call}(t, y, _coef_lane(PT, k), s, c)\n")
                 lane_body = [f"return _{name}_lane_one(t, y, PT, k, s, c)"]
@@ -313,7 +318,7 @@ def _forms(form: OneForm) -> str:
             continue
         kinds = (("quiet", "_coef_quiet"), ("loud", "_coef_loud"), ("general", "_coef_lane"))
         for kind, coef in kinds:
-            text += f"\n\n@nb.njit(forceinline=True, **_JIT)\ndef _{name}_lane_{kind}" \
+            text += f"\n\n{_LANE_DECO}\ndef _{name}_lane_{kind}" \
                     f"(t, y, PT, k, s, c):\n    return _one_{name}(t, y, {coef}(PT, k), s, c)\n"
     return text
 
@@ -354,7 +359,7 @@ def tangent_adapters(form: OneForm) -> str:
     if quiet:
         for kind, coef in (("quiet", "_coef_quiet"), ("loud", "_coef_loud"),
                            ("general", "_coef_lane")):
-            out += (f"\n\n@nb.njit(forceinline=True, **_JIT)\ndef _rhs_tangent_lane_{kind}"
+            out += (f"\n\n{_LANE_DECO}\ndef _rhs_tangent_lane_{kind}"
                     f"(t, y, v, PT, k, s, c):\n    return _tangent_parts(_one_rhs(t, {duals}, "
                     f"{coef}(PT, k), s, c))\n")
         # the lane forms as in ``rhs_lane`` (FORM_GENERAL: ``loud`` tested by lane)
@@ -364,7 +369,7 @@ def tangent_adapters(form: OneForm) -> str:
                      "    return _rhs_tangent_lane_loud(t, y, v, PT, k, s, c)",
                      "return _rhs_tangent_lane_general(t, y, v, PT, k, s, c)"]
     else:  # compiled once and inlined by LLVM where it is called (as ``rhs_lane``)
-        out += (f"\n\n@nb.njit(forceinline=True, **_JIT)\ndef _rhs_tangent_lane_one"
+        out += (f"\n\n{_LANE_DECO}\ndef _rhs_tangent_lane_one"
                 f"(t, y, v, PT, k, s, c):\n    return _tangent_parts(_one_rhs(t, {duals}, "
                 f"_coef_lane(PT, k), s, c))\n")
         lane_body = ["return _rhs_tangent_lane_one(t, y, v, PT, k, s, c)"]

@@ -16,7 +16,6 @@ import numpy as np
 from geardyn.solvers._step_shared import (
     _JIT,
     INNER,
-    OUTER,
     STATUS_DIVERGED,
     STATUS_OK,
     event_buffer,
@@ -38,7 +37,7 @@ def _full(shape, value):
     return a
 
 
-@nb.njit(**_JIT, **OUTER)
+@nb.njit(**_JIT, **INNER)
 def _alloc(nb_lanes, ns, n_ev):
     Y = np.zeros((nb_lanes, ns))
     work = np.zeros((7, ns))
@@ -48,7 +47,7 @@ def _alloc(nb_lanes, ns, n_ev):
             np.zeros((nb_lanes, n_ev)), SIDE, work, np.zeros(ns), event_buffer(nb_lanes, n_ev))
 
 
-@nb.njit(**_JIT, **OUTER)
+@nb.njit(**_JIT, **INNER)
 def _section_diffs(y, R, n, D):
     """Record the differences of the new section point y (the n-th, counting from 0) to the
     ring R of earlier ones: D[n % len(D), k - 1] = max_q |y_q - x_{n-k,q}| for k = 1 ..
@@ -63,7 +62,7 @@ def _section_diffs(y, R, n, D):
         D[row, k - 1] = d
 
 
-@nb.njit(**_JIT, **OUTER)
+@nb.njit(**_JIT, **INNER)
 def _settled(y, D, n, tol):
     """True when the section point y (the n-th) is estimated within tol (1 + max |y|) of a
     period-k orbit for some k <= depth = D.shape[1]: with the differences d_j = |x_j - x_{j-k}|
