@@ -9,12 +9,14 @@ import re
 import numba as nb
 import numpy as np
 import pytest
+from numba.core import dispatcher
 from numba.core import inline_closurecall as icc
 from numba.core.compiler import run_frontend
 from numba.core.compiler_lock import global_compiler_lock
+from numba.core.typing import templates
 
 from geardyn.solvers import _inline_copy
-from geardyn.solvers._inline_copy import block_copy
+from geardyn.solvers._inline_copy import block_copy, overload_keys
 
 _SOURCE = '''
 @nb.njit(inline="always")
@@ -42,8 +44,12 @@ def _caller():
 
 
 def _numba_untouched() -> bool:
+    template = templates._OverloadFunctionTemplate
     return (icc.copy is copy and icc.InlineWorker.inline_ir is _inline_copy._ORIGINAL
             and icc.InlineWorker.run_untyped_passes is _inline_copy._ORIGINAL_UNTYPED
+            and dispatcher.Dispatcher.get_call_template is _inline_copy._ORIGINAL_TEMPLATE
+            and template._get_impl is _inline_copy._ORIGINAL_GET_IMPL
+            and template._get_jit_decorator is _inline_copy._ORIGINAL_JIT_DECORATOR
             and not _inline_copy._UNTYPED)
 
 
@@ -150,4 +156,111 @@ def test_geardyns_compiles_leave_numba_untouched():
 
     geardyn.simulate(oscillator(zeta=0.1, F=1.0, Omega=1.3), y0=np.zeros(2),
                      run=geardyn.RunSettings(transient=0.0, samples=2))
+    assert _numba_untouched()
+
+
+
+def _counting(predicate):
+    """A context manager counting numba's compiles (``add_overload``) of the dispatchers for
+    which ``predicate(dispatcher)``; yields the list of their compile results."""
+    import contextlib
+
+    @contextlib.contextmanager
+    def counting():
+        counted = []
+        add = dispatcher.Dispatcher.add_overload
+
+        def add_overload(self, cres):
+            if predicate(self):
+                counted.append(cres)
+            return add(self, cres)
+
+        dispatcher.Dispatcher.add_overload = add_overload
+        try:
+            yield counted
+        finally:
+            dispatcher.Dispatcher.add_overload = add
+    return counting()
+
+
+def _stub_unguarded(x):
+    """An overload target (typed outside the guard)."""
+
+
+def _stub_guarded(x):
+    """An overload target (typed inside the guard)."""
+
+
+def _inline_only(stub, made):
+    def implementation(x):
+        def impl(x):
+            return x * x + 1.0
+        setattr(impl, _inline_copy.INLINE_ONLY, True)
+        made.append(impl)
+        return impl
+
+    nb.extending.overload(stub, inline="always")(implementation)
+
+    @nb.njit
+    def caller(x):
+        return stub(x) - 2.0 * stub(0.5 * x)
+    return caller
+
+
+def test_an_inline_only_overload_is_typed_not_compiled_and_gives_the_same_results():
+    want = (3.0 * 3.0 + 1.0) - 2.0 * (1.5 * 1.5 + 1.0)
+    made = []
+    outside = _inline_only(_stub_unguarded, made)
+    with _counting(lambda d: d.py_func in made) as counted:
+        assert outside(3.0) == want
+    assert counted  # numba compiles the implementation it inlines
+    made.clear()
+    inside = _inline_only(_stub_guarded, made)
+    with _counting(lambda d: d.py_func in made) as counted:
+        with global_compiler_lock, block_copy():
+            assert inside(3.0) == want
+    assert made and not counted  # typed for the inlining, not compiled
+    assert _numba_untouched()
+
+
+_MAX_CALLERS = """
+@nb.njit(no_cfunc_wrapper=True)
+def a(x, y):
+    return max(x, y) + np.int16(1)
+
+
+@nb.njit(no_cfunc_wrapper=True, no_cpython_wrapper=True)
+def b(x, y):
+    return max(x, y) + np.int16(2)
+
+
+@nb.njit
+def c(x, y):
+    return b(x, y) + max(y, x)
+"""
+
+
+def _max_compiles(guarded: bool, dtype) -> int:
+    """Compiles of numba's ``max`` for callers that differ only in their entry points (flags
+    the implementation does not inherit)."""
+    scope = {"nb": nb, "np": np}
+    exec(compile(_MAX_CALLERS, "<test_overload_keys>", "exec"), scope)  # noqa: S102 (fixed text)
+    x, y = dtype(1), dtype(3)
+    with _counting(lambda d: d.py_func.__qualname__.startswith("ol_max")) as counted:
+        with global_compiler_lock:
+            if guarded:
+                with overload_keys():
+                    got = (scope["a"](x, y), scope["c"](x, y))
+            else:
+                got = (scope["a"](x, y), scope["c"](x, y))
+    assert got == (4, 8)
+    return len(counted)
+
+
+def test_overload_implementations_are_kept_per_inherited_flags():
+    """numba compiles ``max`` once per caller's flags; inside the guard once per the flags it
+    inherits (the same for all three callers). Argument types no other test uses, so that
+    numba has compiled ``max`` for them in neither way before."""
+    assert _max_compiles(guarded=False, dtype=np.int16) >= 2
+    assert _max_compiles(guarded=True, dtype=np.uint16) == 1
     assert _numba_untouched()
