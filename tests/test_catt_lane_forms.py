@@ -56,10 +56,23 @@ def test_load_sin_beyond_the_exact_range_errs_by_the_arguments_own_rounding():
 
 
 def _device(**changes):
-    return geardyn.CATTDevice(geardyn.PlanetaryParams.paper(xi1=0.1, xi2=0.1, **changes))
+    """The paper's device with the paper's parameters ``changes``; ``harmonics``: the terms of
+    both meshes' stiffness series (of a rectangular ``waveform``)."""
+    harmonics = changes.pop("harmonics", None)
+    params = geardyn.PlanetaryParams.paper(xi1=0.1, xi2=0.1, **changes)
+    if harmonics is not None:
+        data = params.model_dump()
+        for mesh in ("sun_mesh", "planet_mesh"):
+            data[mesh]["harmonics"] = harmonics
+        params = geardyn.PlanetaryParams.model_validate(data)
+    return geardyn.CATTDevice(params)
 
 
 _LOAD = {"B1": "100 N m", "B2": "100 N m", "Lambda": 0.1}
+#: A rectangular stiffness waveform of 3 harmonics: a series of several terms written out, its
+#: own one form (the default 25 terms compile about eight times the code of each lane-scalar
+#: function; tests/test_lyapunov_lanes.py checks their lane-block functions).
+_RECT = {"waveform": "rectangular", "harmonics": 3}
 
 
 def _assert_lanes_equal_simulate(models, omegas, steps=48):
@@ -90,12 +103,12 @@ def _form(model):
 
 def test_each_lane_form_equals_the_one_lane_path_bitwise():
     """Quiet lanes take FORM_QUIET, fluctuating ones FORM_LOAD, with any number of stiffness
-    harmonics (the rectangular waveform's 25: its own one form, the series written out). The
-    fused loop is the same template for every one form; the rectangular device's own
+    harmonics (a rectangular waveform's, :data:`_RECT`: its own one form, the series written
+    out). The fused loop is the same template for every one form; the rectangular device's own
     functions (every layout, each lane form) are compared bit for bit with the general model's
     array form in tests/test_catt_one_form.py, without compiling its kernels here."""
     quiet, load = _device(), _device(**_LOAD)
-    rect = _device(waveform="rectangular")
+    rect = _device(**_RECT)
     assert (_form(quiet), _form(load), _form(rect)) == (FORM_QUIET, FORM_LOAD, FORM_QUIET)
     _assert_lanes_equal_simulate([load], _OMEGAS)
     # quiet and fluctuating lanes in one queue run in the general form: still the same results

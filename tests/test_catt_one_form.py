@@ -25,13 +25,9 @@ from geardyn.models.catt_reduced import coefficient_names
 from geardyn.models.elements import harmonic_factors
 from geardyn.solvers.ensemble import run_lanes
 from geardyn.solvers.kernels import kernels_for
-from test_catt_lane_forms import _LOAD
+from test_catt_lane_forms import _LOAD, _RECT, _device
 
 _OMEGAS = np.array([0.7, 1.3, 2.2, 3.1, 0.45])
-
-
-def _device(**changes):
-    return geardyn.CATTDevice(geardyn.PlanetaryParams.paper(xi1=0.1, xi2=0.1, **changes))
 
 
 def _gen(model):
@@ -68,8 +64,8 @@ def test_one_form_keyword_is_deprecated_and_chooses_nothing():
         assert m.one_form and not m.general().one_form
 
 
-_DEVICES = {"quiet": {}, "load": _LOAD, "rectangular": {"waveform": "rectangular"},
-            "rectangular-load": {"waveform": "rectangular", **_LOAD},
+_DEVICES = {"quiet": {}, "load": _LOAD, "rectangular": _RECT,
+            "rectangular-load": {**_RECT, **_LOAD},
             "load-outside-only": {"B1": "100 N m", "Lambda": 0.3, "psi1": 0.4}}
 
 

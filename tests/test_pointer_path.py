@@ -2,10 +2,12 @@
 trajectory and sweep kernels, the variational Lyapunov lane blocks and the period map (periodic
 orbits, continuation) compiled once for every model, the model's functions compiled alone and
 called through their addresses. Its results are those of the inlined path bit for bit (the gear
-pair against ``GearPair`` and against the same one form inlined; also in a fresh process that
-loads the callbacks and kernels from numba's cache), within the integrator's error of DOP853
-and, for an exponent, of the analytic one of a linear limit; models of other sizes run on the
-same compiled kernels."""
+pair against ``GearPair``, the same physics in a one form inlined, whose kernels the warm-up
+compiles; the Duffing oscillator against its own one form inlined, ``kernel_path="lane-form"``;
+also in a fresh process that loads the callbacks and kernels from numba's cache), within the
+integrator's error of DOP853 and, for an exponent, of the analytic one of a linear limit;
+models of other sizes run on the same compiled kernels. The user gear pair's sweep lanes and
+bifurcation diagram against GearPair's are in tests/test_one_form.py."""
 
 from __future__ import annotations
 
@@ -52,26 +54,18 @@ def _duffing(kernel_path: str = "lane-form") -> geardyn.UserModel:
         kernel_path=kernel_path)
 
 
-def test_the_pointer_path_equals_gear_pair_and_the_inlined_one_form_bitwise():
-    pair, inlined = geardyn.GearPair(**COEFFS), gear_pair(**COEFFS, kernel_path="lane-form")
+def test_the_pointer_path_equals_gear_pair_bitwise():
+    """Sweep lanes (impacting among them) and ``simulate`` of the user gear pair on the pointer
+    path: bitwise GearPair's (the one form inlined), every result field of the lanes (the
+    bifurcation diagram of the same lanes is compared in tests/test_one_form.py)."""
+    pair = geardyn.GearPair(**COEFFS)
     pointer = gear_pair(**COEFFS, kernel_path="pointer")
     assert pointer.kernel.kernel_path == "pointer" in KERNEL_PATHS
     run = geardyn.RunSettings(transient=300.0, samples=6, steps_per_period=64)
-    results = [run_lanes(m, _rows(m), m.initial_state(), run=run)
-               for m in (pair, inlined, pointer)]
-    assert results[2].crossings.sum() > 0  # flagged steps: the split step ran
-    for ref in results[:2]:
-        for name in LaneResults.__dataclass_fields__:
-            np.testing.assert_array_equal(getattr(results[2], name), getattr(ref, name),
-                                          err_msg=name)
-    om = np.linspace(0.5, 2.5, 9)
-    a = geardyn.bifurcation(pair, "Omega", om, run=geardyn.RunSettings(transient=200.0,
-                                                                       samples=10))
-    b = geardyn.bifurcation(pointer, "Omega", om, run=geardyn.RunSettings(transient=200.0,
-                                                                          samples=10))
-    assert b.attrs["kernel_path"] == "pointer"
-    for name in ("poincare", "contact", "force_peak", "force_rms", "dynamic_factor"):
-        np.testing.assert_array_equal(b[name].values, a[name].values, err_msg=name)
+    ref, got = (run_lanes(m, _rows(m), m.initial_state(), run=run) for m in (pair, pointer))
+    assert got.crossings.sum() > 0  # flagged steps: the split step ran
+    for name in LaneResults.__dataclass_fields__:
+        np.testing.assert_array_equal(getattr(got, name), getattr(ref, name), err_msg=name)
     sa = geardyn.simulate(pair.with_omega(0.9), run=geardyn.RunSettings(transient=50.0,
                                                                         samples=5))
     sb = geardyn.simulate(pointer.with_omega(0.9), run=geardyn.RunSettings(transient=50.0,
@@ -81,31 +75,30 @@ def test_the_pointer_path_equals_gear_pair_and_the_inlined_one_form_bitwise():
 
 
 @pytest.mark.parametrize(("omega", "periods"), [(0.9, 400), (1.3, 2000)])
-def test_a_long_located_trajectory_of_the_pointer_path_equals_the_inlined_ones_bitwise(omega,
+def test_a_long_located_trajectory_of_the_pointer_path_equals_gear_pairs_bitwise(omega,
                                                                                       periods):
     """``simulate`` of the pointer model with its edges located, over many periods of impacts
-    (split steps): bitwise GearPair's and the one form inlined's, every recorded column, the
+    (split steps): bitwise GearPair's (the one form inlined), every recorded column, the
     crossings counted and the unresolved steps."""
-    models = [geardyn.GearPair(**COEFFS), gear_pair(**COEFFS, kernel_path="lane-form"),
-              gear_pair(**COEFFS, kernel_path="pointer")]
+    models = [geardyn.GearPair(**COEFFS), gear_pair(**COEFFS, kernel_path="pointer")]
     run = geardyn.RunSettings(transient=0.0, samples=periods, steps_per_period=128,
                               locate_edges=True)
-    a, b, c = (geardyn.simulate(m.with_omega(omega), run=run) for m in models)
+    ref, c = (geardyn.simulate(m.with_omega(omega), run=run) for m in models)
     assert c["edge_crossings"].values.sum() > 10  # impacts: the split step ran
-    for ref in (a, b):
-        for name in ("x", "v", "F", "poincare", "edge_crossings"):
-            np.testing.assert_array_equal(c[name].values, ref[name].values, err_msg=name)
-        assert c.attrs["unresolved_steps"] == ref.attrs["unresolved_steps"]
+    for name in ("x", "v", "F", "poincare", "edge_crossings"):
+        np.testing.assert_array_equal(c[name].values, ref[name].values, err_msg=name)
+    assert c.attrs["unresolved_steps"] == ref.attrs["unresolved_steps"]
 
 
 def test_the_pointer_path_agrees_with_dop853():
     """Simulation and sweep lanes of an impacting gear pair against DOP853 at tight tolerance
-    (on the same one form inlined: the reference does not go through the pointer path)."""
-    coeffs = dict(zeta=0.05, kappa=0.2, Fm=0.1, Fa=0.1, phi_k=0.9, phi_e=-0.4)
+    (on GearPair's functions, the same physics: the reference does not go through the pointer
+    path)."""
+    coeffs = dict(zeta=0.05, kappa=0.2, Fm=0.1, Fa=0.1)
     run = geardyn.RunSettings(transient=0.0, samples=4, steps_per_period=512)
     for om in (0.8, 1.7):
-        pointer = gear_pair(**coeffs, Omega=om, kernel_path="pointer")
-        twin = gear_pair(**coeffs, Omega=om, kernel_path="lane-form")
+        pointer = gear_pair(**coeffs, phi_k=0.9, phi_e=-0.4, Omega=om, kernel_path="pointer")
+        twin = geardyn.GearPair(**coeffs, kappa_phase=0.9, error_phase=-0.4, Omega=om)
         T = 2.0 * math.pi / om
         ref = geardyn.reference_solution(twin, twin.initial_state(), T * np.arange(1, 5))
         ds = geardyn.simulate(pointer, run=run)
@@ -116,9 +109,11 @@ def test_the_pointer_path_agrees_with_dop853():
 
 
 def test_models_of_other_sizes_run_on_the_same_compiled_kernels():
-    """A model without events or observables (the Duffing oscillator) on the pointer path:
-    bitwise its inlined sweep, on the gear pair's compiled sweep and trajectory (no new
-    compile of the shared kernels)."""
+    """A model without events or observables (the Duffing oscillator) on the pointer path, on
+    the gear pair's compiled sweep (no new compile of the shared kernels): its sweep lanes
+    bitwise the same one form inlined (``kernel_path="lane-form"``), run lane by lane by the
+    inlined trajectory kernel (a lane of an inlined sweep is its trajectory bit for bit:
+    tests/test_catt_lane_forms.py; the Duffing oscillator's inlined sweep is not compiled)."""
     pair = gear_pair(**COEFFS, kernel_path="pointer")
     duff, inlined = _duffing("pointer"), _duffing()
     kp, kd = kernels_for(pair.kernel), kernels_for(duff.kernel)
@@ -129,20 +124,24 @@ def test_models_of_other_sizes_run_on_the_same_compiled_kernels():
     om = np.array([0.9, 1.2, 1.5])
     r = run_lanes(duff, duff.lane_params("Omega", om), duff.initial_state(), run=run)
     assert len(kd._sweep._sweep_worker_form0.signatures) == compiled
-    ref = run_lanes(inlined, inlined.lane_params("Omega", om), inlined.initial_state(), run=run)
-    for name in LaneResults.__dataclass_fields__:
-        np.testing.assert_array_equal(getattr(r, name), getattr(ref, name), err_msg=name)
+    assert np.all(r.status == geardyn.Status.OK)
+    for j, w in enumerate(om):
+        ref = geardyn.simulate(inlined, omega=float(w), run=run)
+        assert ref.attrs["status"] == geardyn.Status.OK
+        np.testing.assert_array_equal(r.samples[j], ref["poincare"].values[1:], err_msg=str(w))
+        np.testing.assert_array_equal(r.final[j], ref["poincare"].values[-1], err_msg=str(w))
 
 
 def test_the_pointer_path_is_the_one_forms_default_and_lane_form_the_opt_out():
     """``from_one_form`` without ``kernel_path`` takes the pointer path; ``"lane-form"``
-    inlines the model's functions in every kernel; a sweep records which ran."""
+    inlines the model's functions in every kernel; a sweep records which ran (the inlined one
+    form's record: GearPair's sweep, whose kernels the warm-up compiles)."""
     default = geardyn.UserModel.from_one_form(
         duffing_one, params={"delta": 0.3, "gamma": 0.1, "Omega": 1.2}, states=("x", "v"))
     assert default.kernel.kernel_path == "pointer"
     assert _duffing().kernel.kernel_path == "lane-form"
     run = geardyn.RunSettings(transient=0.0, samples=2, steps_per_period=64)
-    for m, path in ((default, "pointer"), (_duffing(), "lane-form")):
+    for m, path in ((default, "pointer"), (geardyn.GearPair(), "lane-form")):
         ds = geardyn.bifurcation(m, "Omega", [1.1, 1.3], run=run)
         assert ds.attrs["kernel_path"] == path
 
@@ -226,7 +225,7 @@ def test_the_pointer_lyapunov_spectrum_equals_the_inlined_one_form_bitwise():
     passes where 40 lanes of 2 vectors outnumber a block's 64 slots), impacting lanes among
     them (split steps with the tangent vectors); no inlined spectrum worker compiled for it.
     ``geardyn.lyapunov(..., spectrum=True)`` too. The inlined one form is the built-in gear
-    pair's, as above (its spectrum workers are those tests/test_one_form.py compiles)."""
+    pair's, as above (its spectrum workers compiled for this test alone)."""
     inlined = geardyn.GearPair(**COEFFS)
     pointer = gear_pair(**COEFFS, kernel_path="pointer")
     kern = kernels_for(pointer.kernel, "lyapunov")
@@ -265,11 +264,12 @@ def _orbits(m: geardyn.Model) -> tuple:
     return orbits, geardyn.continuation(m, **CONTINUATION)
 
 
-def test_the_pointer_periodic_orbit_and_continuation_equal_the_inlined_one_form_bitwise():
+def test_the_pointer_periodic_orbit_and_continuation_equal_gear_pairs_bitwise():
     """``periodic_orbit`` (Newton shooting on the period map and its monodromy) and
     ``continuation`` on the pointer path (the shared period map calling the model's array
-    forms through their addresses): bitwise those of the same one form inlined."""
-    inlined = gear_pair(**COEFFS, kernel_path="lane-form")
+    forms through their addresses): bitwise those of the one form inlined (GearPair's, whose
+    monodromy kernel the warm-up compiles)."""
+    inlined = geardyn.GearPair(**COEFFS)
     pointer = gear_pair(**COEFFS, kernel_path="pointer")
     kern = kernels_for(pointer.kernel, "monodromy")
     assert isinstance(kern, PointerMonodromy)

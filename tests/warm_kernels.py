@@ -39,8 +39,9 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 #: every pointer model: the trajectory, the sweep, the variational lane blocks, k = 1 and the
 #: spectrum's, which tests/test_one_form.py, test_codegen.py and test_pointer_path.py load, and
 #: the period map of orbits and continuation) and its parts; the same one form inlined
-#: (``kernel_path="lane-form"``) is loaded by tests/test_pointer_path.py's references alone (one
-#: worker): not warmed.
+#: (``kernel_path="lane-form"``) is compiled by no test (tests/test_pointer_path.py compares the
+#: pointer path with GearPair's kernels, warmed here, and the Duffing oscillator's pointer sweep
+#: with its inlined trajectory, one worker): not warmed.
 WARM = {
     "CATTDevice-reduced": ("trajectory", "sweep", "lyapunov", "lanes", "orbit"),
     "CATTDevice-general": ("trajectory", "lyapunov", "lanes", "orbit"),
