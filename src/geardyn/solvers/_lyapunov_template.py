@@ -126,6 +126,8 @@ from geardyn.solvers._step_core import (  # CORE-IMPORT
 from geardyn.solvers._step_shared import (
     BLOCK,
     GBUF_ROWS,
+    INNER,
+    OUTER,
     STATUS_DIVERGED,
     STATUS_OK,
     STATUS_SPLIT_LIMIT,
@@ -232,7 +234,7 @@ if VARIATIONAL:
             n += 1 if _side(g[j]) != side[j] else 0
         return n
 
-    @nb.njit(_nrt=False, **_JIT)  # it allocates nothing: no reference counting of its views
+    @nb.njit(_nrt=False, **_JIT, **INNER)  # it allocates nothing: no reference counting
     def _side_point(ts, ys, fs, ss, cs, p, side, jx, want_x, M, h, g, g2, TP):
         """A point near the stage point ys (time ts, phase ss, cs, f(ys) = fs) on the sides
         ``side`` of every event (event jx, where >= 0, on side want_x instead) into TP: ys
@@ -271,7 +273,7 @@ if VARIATIONAL:
                 return False, False
         return True, True
 
-    @nb.njit(_nrt=False, **_JIT)  # it allocates nothing: no reference counting of its views
+    @nb.njit(_nrt=False, **_JIT, **INNER)  # it allocates nothing: no reference counting
     def _var_sub(tan, ys, k1, hs, t, tm, sm, cm, te, se, ce, s1, c1, p, side, h, trial, out,
                  work):
         """The split step's sub-step hook (:func:`_split_run`) of the variational tangent
@@ -347,7 +349,7 @@ if VARIATIONAL:
                                  VX[b + 6, q])
         return ok
 
-    @nb.njit(_nrt=False, **_JIT)  # it allocates nothing: no reference counting of its views
+    @nb.njit(_nrt=False, **_JIT, **INNER)  # it allocates nothing: no reference counting
     def _var_correct(t, x, f, u, s, c, p, side, jx, m1, h, pc, VX, VG):
         """Each tangent vector (VX[9 + 7 j]) moved from the split point x (time t, the fraction
         u of grid step, phase s, c, f(x) = f) to the orbit's crossing of event jx (just
@@ -418,7 +420,7 @@ if VARIATIONAL:
                 VX[b, q] = VX[b + 1, q]
         return 0
 
-    @nb.njit(_nrt=False, **_JIT)  # it allocates nothing: no reference counting of its views
+    @nb.njit(_nrt=False, **_JIT, **INNER)  # it allocates nothing: no reference counting
     def _var_split(i, t0, m1, p, h, omega, n_per, sa, ca, s_end, c_end, side, g1, ncross, work,
                    gbuf, VX, VG):
         """:func:`_split_step` of the state in VX[0] (its unsplit trial in VX[1], the tangent
@@ -433,7 +435,7 @@ if VARIATIONAL:
                           g1, ncross, work, work[8], gbuf, (m1, VX, VG), _var_sub,
                           _var_at_split, _var_finish, True)
 
-    @nb.njit(_nrt=False, **_JIT)  # it allocates nothing: no reference counting of its views
+    @nb.njit(_nrt=False, **_JIT, **INNER)  # it allocates nothing: no reference counting
     def _var_split_lane(i, t0, Z, S, IS, p, h, omega, n_per, s_tab, c_tab, n_ev, YP, E, K, TMP,
                         Y1, SIDE, G0, G1, W, gbuf, NCR, UNRES, VX, VG):
         """Grid step i of one lane (state Z[0], tangent vectors Z[1..] in z = y / S) whose
@@ -484,7 +486,7 @@ if VARIATIONAL:
         return 0
 
 else:
-    @nb.njit(**_JIT)
+    @nb.njit(**_JIT, **INNER)
     def _var_split_lane(i, t0, Z, S, IS, p, h, omega, n_per, s_tab, c_tab, n_ev, YP, E, K, TMP,
                         Y1, SIDE, G0, G1, W, gbuf, NCR, UNRES, VX, VG):
         """A model without tangent forms has no variational step (its callers refuse)."""
@@ -690,7 +692,7 @@ def _set_column(r, lane, P, T0, H, NPER, OFF, PT, T0R, HR, HH, H6, NPR, IDX, END
     END[r] = OFF[lane] + 2 * NPER[lane]
 
 
-@nb.njit(**_JIT)
+@nb.njit(**_JIT, **INNER)
 def _lyap_one(first, max_total, due, renorm, bound, P, S, IS, T0, H, OMEGA, NPER, S_TAB, C_TAB,
               OFF, n_ev, ZT, IST, ENDS, BLK, ACC, ACT, ACTR, Zl, Cl, logs, status, W, gbuf):
     """:func:`_lyap_block`'s time loop for one lane (ZT[:, :, 0], nl = 1): its 2 k + 1 rows
@@ -711,7 +713,7 @@ def _lyap_one(first, max_total, due, renorm, bound, P, S, IS, T0, H, OMEGA, NPER
                           ACT, ACTR, Zl, Cl, logs, status, W, gbuf, rows)
 
 
-@nb.njit(_nrt=False, **_JIT)  # it allocates nothing
+@nb.njit(_nrt=False, **_JIT, **INNER)  # it allocates nothing
 def _lyap_one_loop(first, max_total, due, renorm, bound, P, S, IS, T0, H, OMEGA, NPER, s_tab,
                    c_tab, n_ev, ZT, IST, ENDS, BLK, ACC, ACT, ACTR, Zl, Cl, logs, status, W,
                    gbuf, rows):
@@ -733,7 +735,7 @@ def _lyap_one_loop(first, max_total, due, renorm, bound, P, S, IS, T0, H, OMEGA,
     return UNRES.sum()
 
 
-@nb.njit(**_JIT)
+@nb.njit(**_JIT, **INNER)
 def _lyap_block(first, nl, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF, n_transient,
                 n_steps, renorm_every, bound, n_ev, n_blocks, out, err, used, status, unres,
                 fd_steps):
@@ -743,7 +745,7 @@ def _lyap_block(first, nl, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF, n
                      status, unres, fd_steps)
 
 
-@nb.njit(**_JIT)
+@nb.njit(**_JIT, **INNER)
 def _lyap_block_one(first, nl, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF, n_transient,
                     n_steps, renorm_every, bound, n_ev, n_blocks, out, err, used, status, unres,
                     fd_steps):
@@ -1049,7 +1051,7 @@ if FUSED:
     nb.extending.overload(_t_screen_rows, inline="always")(_ov_t_screen_rows)
 
 
-@nb.njit(_nrt=False, **_JIT)
+@nb.njit(_nrt=False, **_JIT, **INNER)
 def _lyap_flagged(i, nl, first, P, Z0, Z1, IS, T0L, HL, OMEGA, NPL, ACT, ROWS, EV, FLAG, EL,
                   UNRR, PH, scratch):
     """The flagged lanes of step i out of line: each row whose trial is flagged finished on the
@@ -1128,7 +1130,7 @@ def _lyap_fused_run(form, first, nl, max_total, due, renorm, bound, P, OMEGA, H,
                                    ENDS, BLK, ACC, ACT, ACTR, status)
 
 
-@nb.njit(_nrt=False, **_JIT_NOALIAS)
+@nb.njit(_nrt=False, **_JIT_NOALIAS, **INNER)
 def _lyap_run_form1(first, nl, max_total, due, renorm, bound, P, OMEGA, H, S, IS, PT, lanes,
                     rows, books, out, err, used, status, scratch):
     """:func:`_lyap_fused_run` in the lane form FORM_QUIET (compiled on its own, noalias)."""
@@ -1136,7 +1138,7 @@ def _lyap_run_form1(first, nl, max_total, due, renorm, bound, P, OMEGA, H, S, IS
                     PT, lanes, rows, books, out, err, used, status, scratch)
 
 
-@nb.njit(_nrt=False, **_JIT_NOALIAS)
+@nb.njit(_nrt=False, **_JIT_NOALIAS, **INNER)
 def _lyap_run_form2(first, nl, max_total, due, renorm, bound, P, OMEGA, H, S, IS, PT, lanes,
                     rows, books, out, err, used, status, scratch):
     """:func:`_lyap_fused_run` in the lane form FORM_LOAD."""
@@ -1144,7 +1146,7 @@ def _lyap_run_form2(first, nl, max_total, due, renorm, bound, P, OMEGA, H, S, IS
                     PT, lanes, rows, books, out, err, used, status, scratch)
 
 
-@nb.njit(**_JIT)
+@nb.njit(**_JIT, **INNER)
 def _block_form(P, first, nl):
     """The lane form every lane of the block takes (``rhs_lane_form``), else FORM_GENERAL."""
     PTq = P.T
@@ -1155,7 +1157,7 @@ def _block_form(P, first, nl):
     return form
 
 
-@nb.njit(**_JIT)
+@nb.njit(**_JIT, **INNER)
 def _fused_block_start(first, nl, k, P, Y0, S, T0, H, NPER, OFF, n_transient, n_steps,
                        renorm_every, n_blocks, out, err, used, status):
     """The start of a fused Lyapunov block of k tangent vectors (:func:`_lyap_block_fused`,
@@ -1246,7 +1248,7 @@ def _lyap_block_fused(form, first, nl, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TA
 
 
 
-@nb.njit(**_JIT)
+@nb.njit(**_JIT, **INNER)
 def _lyap_block_form1(first, nl, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF, n_transient,
                       n_steps, renorm_every, bound, n_ev, n_blocks, out, err, used, status, unres,
                       fd_steps):
@@ -1256,7 +1258,7 @@ def _lyap_block_form1(first, nl, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, 
                       status, unres, fd_steps)
 
 
-@nb.njit(**_JIT)
+@nb.njit(**_JIT, **INNER)
 def _lyap_block_form2(first, nl, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF, n_transient,
                       n_steps, renorm_every, bound, n_ev, n_blocks, out, err, used, status, unres,
                       fd_steps):
@@ -1427,7 +1429,7 @@ def _var_steps(form, i, stop, n_adv, nl, locate, commit, Z0, Z1, S, IS, PT, T0L,
         j += 1
 
 
-@nb.njit(_nrt=False, **_JIT_NOALIAS)
+@nb.njit(_nrt=False, **_JIT_NOALIAS, **INNER)
 def _var_steps_form0(i, stop, n_adv, nl, locate, commit, Z0, Z1, S, IS, PT, T0L, HL, HHL, H6L,
                      PH, IDX, ENDL, ACT, FLAG, GR, Y1F, NPL):
     """:func:`_var_steps` in the lane form FORM_GENERAL (compiled on its own, noalias)."""
@@ -1435,7 +1437,7 @@ def _var_steps_form0(i, stop, n_adv, nl, locate, commit, Z0, Z1, S, IS, PT, T0L,
                       HL, HHL, H6L, PH, IDX, ENDL, ACT, FLAG, GR, Y1F, NPL)
 
 
-@nb.njit(_nrt=False, **_JIT_NOALIAS)
+@nb.njit(_nrt=False, **_JIT_NOALIAS, **INNER)
 def _var_steps_form1(i, stop, n_adv, nl, locate, commit, Z0, Z1, S, IS, PT, T0L, HL, HHL, H6L,
                      PH, IDX, ENDL, ACT, FLAG, GR, Y1F, NPL):
     """:func:`_var_steps` in the lane form FORM_QUIET."""
@@ -1443,7 +1445,7 @@ def _var_steps_form1(i, stop, n_adv, nl, locate, commit, Z0, Z1, S, IS, PT, T0L,
                       HL, HHL, H6L, PH, IDX, ENDL, ACT, FLAG, GR, Y1F, NPL)
 
 
-@nb.njit(_nrt=False, **_JIT_NOALIAS)
+@nb.njit(_nrt=False, **_JIT_NOALIAS, **INNER)
 def _var_steps_form2(i, stop, n_adv, nl, locate, commit, Z0, Z1, S, IS, PT, T0L, HL, HHL, H6L,
                      PH, IDX, ENDL, ACT, FLAG, GR, Y1F, NPL):
     """:func:`_var_steps` in the lane form FORM_LOAD."""
@@ -1468,7 +1470,7 @@ def _var_steps_of(form, i, stop, n_adv, nl, locate, commit, Z0, Z1, S, IS, PT, T
                             HHL, H6L, PH, IDX, ENDL, ACT, FLAG, GR, Y1F, NPL)
 
 
-@nb.njit(_nrt=False, **_JIT)  # it allocates nothing: no reference counting of its views
+@nb.njit(_nrt=False, **_JIT, **INNER)  # it allocates nothing: no reference counting of its views
 def _var_flagged(i, nl, first, n_ev, P, ZT, S, IS, T0L, HL, OMEGA, NPL, IDX, S_TAB, C_TAB,
                  FLAG, UNRR, FDL, GR, Y1F, fd):
     """The flagged lanes of step i (:func:`_var_fused_steps`: their states and tangent vectors
@@ -1509,7 +1511,7 @@ def _var_flagged(i, nl, first, n_ev, P, ZT, S, IS, T0L, HL, OMEGA, NPL, IDX, S_T
         FDL[l] += fd_l
 
 
-@nb.njit(_nrt=False, **_JIT)  # it allocates nothing
+@nb.njit(_nrt=False, **_JIT, **INNER)  # it allocates nothing
 def _var_load(ZT, Z1, nl, j_lo, kk):
     """Tangent vectors j_lo + 1 .. j_lo + kk of the block's lanes into the fused loop's slots:
     vector j_lo + 1 + jj of lane l (ZT[j_lo + 1 + jj, :, l]) at slot s = jj nl + l of the
@@ -1524,7 +1526,7 @@ def _var_load(ZT, Z1, nl, j_lo, kk):
                 ZT[0, q, s] = ZT[0, q, l]
 
 
-@nb.njit(_nrt=False, **_JIT)  # it allocates nothing
+@nb.njit(_nrt=False, **_JIT, **INNER)  # it allocates nothing
 def _var_store(ZT, Z1, nl, j_lo, kk):
     """The fused loop's slots back into tangent vectors j_lo + 1 .. j_lo + kk of the block's
     lanes (:func:`_var_load`)."""
@@ -1637,7 +1639,7 @@ def _lyap_var_run1(form, first, nl, n_ev, max_total, due, renorm, bound, P, OMEG
         i = step
 
 
-@nb.njit(_nrt=False, **_JIT_NOALIAS)
+@nb.njit(_nrt=False, **_JIT_NOALIAS, **INNER)
 def _lyap_var1_form0(first, nl, n_ev, max_total, due, renorm, bound, P, OMEGA, H, S, IS, PT,
                      lanes, books, out, err, used, status, scratch, fd):
     """:func:`_lyap_var_run1` in the lane form FORM_GENERAL (a block of mixed forms)."""
@@ -1645,7 +1647,7 @@ def _lyap_var1_form0(first, nl, n_ev, max_total, due, renorm, bound, P, OMEGA, H
                    S, IS, PT, lanes, books, out, err, used, status, scratch, fd)
 
 
-@nb.njit(_nrt=False, **_JIT_NOALIAS)
+@nb.njit(_nrt=False, **_JIT_NOALIAS, **INNER)
 def _lyap_var1_form1(first, nl, n_ev, max_total, due, renorm, bound, P, OMEGA, H, S, IS, PT,
                      lanes, books, out, err, used, status, scratch, fd):
     """:func:`_lyap_var_run1` in the lane form FORM_QUIET."""
@@ -1653,7 +1655,7 @@ def _lyap_var1_form1(first, nl, n_ev, max_total, due, renorm, bound, P, OMEGA, H
                    S, IS, PT, lanes, books, out, err, used, status, scratch, fd)
 
 
-@nb.njit(_nrt=False, **_JIT_NOALIAS)
+@nb.njit(_nrt=False, **_JIT_NOALIAS, **INNER)
 def _lyap_var1_form2(first, nl, n_ev, max_total, due, renorm, bound, P, OMEGA, H, S, IS, PT,
                      lanes, books, out, err, used, status, scratch, fd):
     """:func:`_lyap_var_run1` in the lane form FORM_LOAD."""
@@ -1661,7 +1663,7 @@ def _lyap_var1_form2(first, nl, n_ev, max_total, due, renorm, bound, P, OMEGA, H
                    S, IS, PT, lanes, books, out, err, used, status, scratch, fd)
 
 
-@nb.njit(_nrt=False, **_JIT_NOALIAS)
+@nb.njit(_nrt=False, **_JIT_NOALIAS, **INNER)
 def _lyap_var_form0(first, nl, n_ev, max_total, due, renorm, bound, P, OMEGA, H, S, IS, PT,
                     lanes, books, out, err, used, status, scratch, fd):
     """:func:`_lyap_var_run` in the lane form FORM_GENERAL (a block of mixed forms)."""
@@ -1669,7 +1671,7 @@ def _lyap_var_form0(first, nl, n_ev, max_total, due, renorm, bound, P, OMEGA, H,
                   IS, PT, lanes, books, out, err, used, status, scratch, fd)
 
 
-@nb.njit(_nrt=False, **_JIT_NOALIAS)
+@nb.njit(_nrt=False, **_JIT_NOALIAS, **INNER)
 def _lyap_var_form1(first, nl, n_ev, max_total, due, renorm, bound, P, OMEGA, H, S, IS, PT,
                     lanes, books, out, err, used, status, scratch, fd):
     """:func:`_lyap_var_run` in the lane form FORM_QUIET."""
@@ -1677,7 +1679,7 @@ def _lyap_var_form1(first, nl, n_ev, max_total, due, renorm, bound, P, OMEGA, H,
                   IS, PT, lanes, books, out, err, used, status, scratch, fd)
 
 
-@nb.njit(_nrt=False, **_JIT_NOALIAS)
+@nb.njit(_nrt=False, **_JIT_NOALIAS, **INNER)
 def _lyap_var_form2(first, nl, n_ev, max_total, due, renorm, bound, P, OMEGA, H, S, IS, PT,
                     lanes, books, out, err, used, status, scratch, fd):
     """:func:`_lyap_var_run` in the lane form FORM_LOAD."""
@@ -1823,7 +1825,7 @@ def _lyap_var_worker(b, n_blk, k, form, one, P, Y0, S, T0, H, OMEGA, NPER, S_TAB
         fd_steps[lo + i] = fs[i]
 
 
-@nb.njit(nogil=True, **_JIT)
+@nb.njit(nogil=True, **_JIT, **OUTER)
 def _lyap_var_worker_form0(b, n_blk, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
                            n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err,
                            used, status, unres, fd_steps):
@@ -1833,7 +1835,7 @@ def _lyap_var_worker_form0(b, n_blk, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_T
                      used, status, unres, fd_steps)
 
 
-@nb.njit(nogil=True, **_JIT)
+@nb.njit(nogil=True, **_JIT, **OUTER)
 def _lyap_var_worker_form1(b, n_blk, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
                            n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err,
                            used, status, unres, fd_steps):
@@ -1843,7 +1845,7 @@ def _lyap_var_worker_form1(b, n_blk, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_T
                      used, status, unres, fd_steps)
 
 
-@nb.njit(nogil=True, **_JIT)
+@nb.njit(nogil=True, **_JIT, **OUTER)
 def _lyap_var_worker_form2(b, n_blk, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
                            n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err,
                            used, status, unres, fd_steps):
@@ -1853,7 +1855,7 @@ def _lyap_var_worker_form2(b, n_blk, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_T
                      used, status, unres, fd_steps)
 
 
-@nb.njit(nogil=True, **_JIT)
+@nb.njit(nogil=True, **_JIT, **OUTER)
 def _lyap_spec_worker_form0(b, n_blk, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
                            n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err,
                            used, status, unres, fd_steps):
@@ -1863,7 +1865,7 @@ def _lyap_spec_worker_form0(b, n_blk, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_
                      used, status, unres, fd_steps)
 
 
-@nb.njit(nogil=True, **_JIT)
+@nb.njit(nogil=True, **_JIT, **OUTER)
 def _lyap_spec_worker_form1(b, n_blk, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
                            n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err,
                            used, status, unres, fd_steps):
@@ -1873,7 +1875,7 @@ def _lyap_spec_worker_form1(b, n_blk, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_
                      used, status, unres, fd_steps)
 
 
-@nb.njit(nogil=True, **_JIT)
+@nb.njit(nogil=True, **_JIT, **OUTER)
 def _lyap_spec_worker_form2(b, n_blk, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
                            n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err,
                            used, status, unres, fd_steps):
@@ -1892,7 +1894,7 @@ _SPEC_WORKERS = {FORM_GENERAL: _lyap_spec_worker_form0, FORM_QUIET: _lyap_spec_w
                  FORM_LOAD: _lyap_spec_worker_form2}
 
 
-@nb.njit(**_JIT)
+@nb.njit(**_JIT, **OUTER)
 def _var_block_forms(P, n_blk):
     """The lane form of each block of :func:`lyapunov_block_lanes` (:func:`_block_form`)."""
     forms = np.full(n_blk, FORM_GENERAL, np.int64)
@@ -1956,7 +1958,7 @@ def _block_lanes(b, n_blk, L):
     return np.int64(b * L // n_blk), np.int64((b + 1) * L // n_blk)
 
 
-@nb.njit(**_JIT)
+@nb.njit(**_JIT, **OUTER)
 def _block_paths(P, n_blk, k, n_ev):
     """The path of each block of :func:`lyapunov_block_lanes`: the fused loop of the lane form
     its lanes all take (FORM_QUIET, FORM_LOAD: a model with lane-scalar functions, k = 1,
@@ -1978,7 +1980,7 @@ def _block_paths(P, n_blk, k, n_ev):
     return paths
 
 
-@nb.njit(nogil=True, **_JIT)
+@nb.njit(nogil=True, **_JIT, **OUTER)
 def _lyap_block_worker(b, n_blk, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF, n_transient,
                        n_steps, renorm_every, bound, n_ev, n_blocks, out, err, used, status,
                        unres, fd_steps):
@@ -1991,7 +1993,7 @@ def _lyap_block_worker(b, n_blk, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, 
                           err, used, status, unres, fd_steps)
 
 
-@nb.njit(nogil=True, **_JIT)
+@nb.njit(nogil=True, **_JIT, **OUTER)
 def _lyap_block_worker_form1(b, n_blk, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
                              n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err,
                              used, status, unres, fd_steps):
@@ -2002,7 +2004,7 @@ def _lyap_block_worker_form1(b, n_blk, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C
                       status, unres, fd_steps)
 
 
-@nb.njit(nogil=True, **_JIT)
+@nb.njit(nogil=True, **_JIT, **OUTER)
 def _lyap_block_worker_form2(b, n_blk, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
                              n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err,
                              used, status, unres, fd_steps):
@@ -2013,7 +2015,7 @@ def _lyap_block_worker_form2(b, n_blk, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C
                       status, unres, fd_steps)
 
 
-@nb.njit(nogil=True, **_JIT)
+@nb.njit(nogil=True, **_JIT, **OUTER)
 def _lyap_block_worker_one(b, n_blk, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
                            n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err,
                            used, status, unres, fd_steps):
