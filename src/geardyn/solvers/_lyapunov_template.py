@@ -165,12 +165,27 @@ VARIATIONAL = "rhs_tangent" in globals()
 if VARIATIONAL:
     _rhs_t = rhs_tangent  # noqa: F821
 
+    @nb.njit(forceinline=False, _nrt=False, **_JIT, **INNER)
+    def _rhs_t_call(t, y, v, dy, dv, p, s, c):
+        """The rhs's tangent form called, not inlined (``rhs_tangent`` is compiled to be inlined
+        by LLVM where it is called): the split step's sites, rarely run, take one copy of it,
+        not one each (LLVM's time on the callers). The same operations, bitwise."""
+        _rhs_t(t, y, v, dy, dv, p, s, c)
+
     @nb.njit(inline="always", **_JIT)
     def _var_trial(t, hh, h, y, w, p, s0, c0, s1, c1, s2, c2, KS, KV, TMP, TV, y1, w1):
         """The variational RK4 trial of one grid step: the state y into y1 and the tangent w
         (in y) into w1 = (dPhi/dy) w, Phi the RK4 step map (the stages of the pair (y, w) by
         the rhs's tangent form: f and J w at each stage); KS[0] is the state's k1. y1 is
         bitwise :func:`_rows_step`'s trial (the same operations)."""
+        _var_trial_of(_rhs_t, t, hh, h, y, w, p, s0, c0, s1, c1, s2, c2, KS, KV, TMP, TV, y1,
+                      w1)
+
+    @nb.njit(inline="always", **_JIT)
+    def _var_trial_of(rhs_t, t, hh, h, y, w, p, s0, c0, s1, c1, s2, c2, KS, KV, TMP, TV, y1,
+                      w1):
+        """:func:`_var_trial` with the rhs's tangent form ``rhs_t`` (``_rhs_t``, inlined, or
+        ``_rhs_t_call``, called)."""
         ns = y.size
         for st in range(4):  # one call site of the rhs's tangent form (an inlined copy each)
             yi = y
@@ -192,7 +207,7 @@ if VARIATIONAL:
                     ts = t + h
                     ss = s2
                     cs = c2
-            _rhs_t(ts, yi, wi, KS[st], KV[st], p, ss, cs)
+            rhs_t(ts, yi, wi, KS[st], KV[st], p, ss, cs)
         h6 = rk4_sixth(h)
         for q in range(ns):
             y1[q] = rk4_comb(y[q], h6, KS[0, q], KS[1, q], KS[2, q], KS[3, q])
@@ -294,8 +309,8 @@ if VARIATIONAL:
         M = VG[2]
         hh = 0.5 * hs
         ok = True
-        # one call site of the rhs's tangent form for the tangent vectors (each site is an
-        # inlined copy of it), one for a stage's f; stage 0 at ys (its w copied to the stage row)
+        # one call site of the rhs's tangent form for the tangent vectors, one for a stage's f
+        # (called, :func:`_rhs_t_call`); stage 0 at ys (its w copied to the stage row)
         for q in range(ns):
             KS[0, q] = k1[q]
         for st in range(4):
@@ -325,7 +340,7 @@ if VARIATIONAL:
                     b = 9 + 7 * j
                     for q in range(ns):
                         VX[b + 2, q] = VX[b, q] + a * VX[b + 2 + st, q]
-                _rhs_t(ts, TMP, VX[11], KS[st], VX[12 + st], p, ss, cs)
+                _rhs_t_call(ts, TMP, VX[11], KS[st], VX[12 + st], p, ss, cs)
                 pt = TMP
                 j_lo = 1  # tangent 0's J w at TMP came with the stage's f
             if _off_sides(ts, pt, ss, cs, p, side, M, g) != 0:
@@ -337,7 +352,7 @@ if VARIATIONAL:
                 j_lo = 0
             for j in range(j_lo, m1):
                 b = 9 + 7 * j
-                _rhs_t(ts, pt, VX[b + 2], FB, VX[b + 3 + st], p, ss, cs)
+                _rhs_t_call(ts, pt, VX[b + 2], FB, VX[b + 3 + st], p, ss, cs)
         h6 = rk4_sixth(hs)
         for q in range(ns):
             out[q] = rk4_comb(ys[q], h6, KS[0, q], KS[1, q], KS[2, q], KS[3, q])
@@ -384,7 +399,7 @@ if VARIATIONAL:
                 return False
             for j in range(m1):
                 b = 9 + 7 * j
-                _rhs_t(t, TP, VX[b], FB, VX[b + 2 + sd], p, s, c)
+                _rhs_t_call(t, TP, VX[b], FB, VX[b + 2 + sd], p, s, c)
                 if sd:
                     for q in range(ns):
                         VX[b, q] = VX[b, q] - shift * (VX[b + 2, q] - VX[b + 3, q])
@@ -465,9 +480,9 @@ if VARIATIONAL:
         if code == 2:  # the unsplit trial: the tangent vectors by the variational trial
             for j in range(m1):
                 b = 9 + 7 * j
-                _var_trial(t, hh, h, y, VX[b], p, s_tab[j0], c_tab[j0], s_tab[j0 + 1],
-                           c_tab[j0 + 1], s_tab[j0 + 2], c_tab[j0 + 2], VX[5:9],
-                           VX[b + 3:b + 7], VX[2], VX[b + 2], VX[1], VX[b + 1])
+                _var_trial_of(_rhs_t_call, t, hh, h, y, VX[b], p, s_tab[j0], c_tab[j0],
+                              s_tab[j0 + 1], c_tab[j0 + 1], s_tab[j0 + 2], c_tab[j0 + 2],
+                              VX[5:9], VX[b + 3:b + 7], VX[2], VX[b + 2], VX[1], VX[b + 1])
                 for q in range(ns):
                     VX[b, q] = VX[b + 1, q]
             for q in range(ns):
@@ -1511,6 +1526,13 @@ def _var_flagged(i, nl, first, n_ev, P, ZT, S, IS, T0L, HL, OMEGA, NPL, IDX, S_T
         FDL[l] += fd_l
 
 
+#: :func:`_var_flagged` inlined into the k = 1 time loop (:func:`_lyap_var_run1`): that loop's
+#: function is then big enough to be bound, not linked, in the worker that calls it
+#: (:mod:`geardyn._bound_calls`), so the worker does not optimise it, its fused loop and the
+#: flagged lanes' code once more.
+_var_flagged_inline = nb.njit(inline="always", _nrt=False, **_JIT)(_var_flagged.py_func)
+
+
 @nb.njit(_nrt=False, **_JIT, **INNER)  # it allocates nothing
 def _var_load(ZT, Z1, nl, j_lo, kk):
     """Tangent vectors j_lo + 1 .. j_lo + kk of the block's lanes into the fused loop's slots:
@@ -1628,8 +1650,8 @@ def _lyap_var_run1(form, first, nl, n_ev, max_total, due, renorm, bound, P, OMEG
         for l in range(nl):
             n_flag += 1 if FLAG[l] != 0.0 else 0
         if n_flag > 0:
-            _var_flagged(i, nl, first, n_ev, P, ZT, S, IS, T0L, HL, OMEGA, NPL, IDX, S_TAB,
-                         C_TAB, FLAG, UNRR, FDL, GR, Y1F, fd)
+            _var_flagged_inline(i, nl, first, n_ev, P, ZT, S, IS, T0L, HL, OMEGA, NPL, IDX, S_TAB,
+                                C_TAB, FLAG, UNRR, FDL, GR, Y1F, fd)
         for l in range(nl):
             IDX[l] = IDX[l] + 2 if IDX[l] + 2 < ENDL[l] else IDX[l] + 2 - 2 * NPL[l]
         step = i + 1
