@@ -1526,10 +1526,9 @@ def _var_flagged(i, nl, first, n_ev, P, ZT, S, IS, T0L, HL, OMEGA, NPL, IDX, S_T
         FDL[l] += fd_l
 
 
-#: :func:`_var_flagged` inlined into the k = 1 time loop (:func:`_lyap_var_run1`): that loop's
-#: function is then big enough to be bound, not linked, in the worker that calls it
-#: (:mod:`geardyn._bound_calls`), so the worker does not optimise it, its fused loop and the
-#: flagged lanes' code once more.
+#: :func:`_var_flagged` inlined into the k = 1 time loop (:func:`_lyap_var_run1`), not compiled
+#: on its own (a function of its own is linked, and optimised once more, into each caller's
+#: module: the time loop's and its worker's).
 _var_flagged_inline = nb.njit(inline="always", _nrt=False, **_JIT)(_var_flagged.py_func)
 
 
