@@ -13,7 +13,13 @@ import math
 import numba as nb
 import numpy as np
 
-from geardyn.solvers._step_shared import _JIT, STATUS_DIVERGED, STATUS_OK, phase_table_values
+from geardyn.solvers._step_shared import (
+    _JIT,
+    INNER,
+    STATUS_DIVERGED,
+    STATUS_OK,
+    phase_table_values,
+)
 
 #: Columns of the per-lane integer state of a block (IST): the step of the last
 #: renormalisation, the block being measured, transient and measured steps, their total, the
@@ -21,7 +27,7 @@ from geardyn.solvers._step_shared import _JIT, STATUS_DIVERGED, STATUS_OK, phase
 _LAST, _CUR, _NTR, _NST, _TOTAL, _NBK, _DUE = range(7)
 
 
-@nb.njit(_nrt=False, **_JIT)  # it allocates nothing
+@nb.njit(_nrt=False, **_JIT, **INNER)  # it allocates nothing
 def _orthonormalise(Z, logs, add):
     """Modified Gram-Schmidt on the tangent rows 1.. of Z; writes the log of R's diagonal to logs
     when ``add``. Returns False if a vector vanished or is not finite."""
@@ -47,7 +53,7 @@ def _orthonormalise(Z, logs, add):
     return True
 
 
-@nb.njit(_nrt=False, **_JIT)  # it allocates nothing
+@nb.njit(_nrt=False, **_JIT, **INNER)  # it allocates nothing
 def _stretch_logs(Z, C, logs):
     """The logs of R's diagonal that orthonormalising Z's tangent rows would give now (the
     stretch since the last renormalisation), computed on the copy C: Z is left as it is."""
@@ -60,7 +66,7 @@ def _stretch_logs(Z, C, logs):
     _orthonormalise(C, logs, np.bool_(True))  # np.bool_: see _lanes_init
 
 
-@nb.njit(**_JIT)
+@nb.njit(**_JIT, **INNER)
 def _block_bounds(n_steps, n_per, n_blocks):
     """Ends of the blocks of the measuring window (measured steps): whole forcing periods
     (``n_per`` steps; one step for an autonomous model, n_per = 1), as equal as they divide, at
@@ -74,7 +80,7 @@ def _block_bounds(n_steps, n_per, n_blocks):
     return ends
 
 
-@nb.njit(**_JIT)
+@nb.njit(**_JIT, **INNER)
 def _block_stderr(blk, ends, h, err):
     """Standard error of each exponent from its blocks: blk[b, j] (log stretch in block b),
     block b ending at measured step ends[b]. With rates r_b = blk[b] / T_b, weights T_b and
@@ -101,7 +107,7 @@ def _block_stderr(blk, ends, h, err):
         err[j] = math.sqrt(ss * n / (n - 1)) / tt
 
 
-@nb.njit(**_JIT)
+@nb.njit(**_JIT, **INNER)
 def _lanes_init(first, nl, k, Y0, NPER, n_transient, n_steps, renorm_every, n_blocks, out, err,
                 used, status, ZT, ACT):
     """A Lyapunov block's per-lane start (both block kernels): outputs cleared, step counts,
@@ -150,7 +156,7 @@ def _lanes_init(first, nl, k, Y0, NPER, n_transient, n_steps, renorm_every, n_bl
     return IST, ENDS, BLK, ACC, Zl, Cl, logs, max_total
 
 
-@nb.njit(_nrt=False, **_JIT)  # it allocates nothing
+@nb.njit(_nrt=False, **_JIT, **INNER)  # it allocates nothing
 def _lane_due(IST, l, renorm, ENDS):
     """The next step at which lane l needs its bookkeeping: a renormalisation (every
     ``renorm`` steps, at the end of the transient, at the end) or the end of a block of the
@@ -163,7 +169,7 @@ def _lane_due(IST, l, renorm, ENDS):
     return due
 
 
-@nb.njit(**_JIT)
+@nb.njit(**_JIT, **INNER)
 def _lane_books(step, first, nl, k, renorm, bound, ZT, Zl, Cl, logs, IST, ENDS, BLK, ACC, ACT,
                 ACTR, H, out, err, used, status):
     """:func:`_lane_books_core`, then the result of every lane that ended well at this step
@@ -261,7 +267,7 @@ def _lane_books_one(step, first, nl, renorm, bound, Z0, Z1, Zl, Cl, logs, IST, E
     return nxt
 
 
-@nb.njit(_nrt=False, **_JIT)  # it allocates nothing
+@nb.njit(_nrt=False, **_JIT, **INNER)  # it allocates nothing
 def _lane_books_core(step, first, nl, k, renorm, bound, ZT, Zl, Cl, logs, IST, ENDS, BLK, ACC,
                      ACT, ACTR, status):
     """The bookkeeping of the block's lanes due at this step, as in :func:`_run`:
@@ -336,7 +342,7 @@ def _lane_books_core(step, first, nl, k, renorm, bound, ZT, Zl, Cl, logs, IST, E
 _lane_books_inline = nb.njit(inline="always", _nrt=False, **_JIT)(_lane_books_core.py_func)
 
 
-@nb.njit(**_JIT)
+@nb.njit(**_JIT, **INNER)
 def _lane_result(l, lane, k, n_steps, h, ENDS, nbk, BLK, ACC, out, err, used):
     """The exponents and standard errors of lane l at its end (as :func:`_run` returns them)."""
     if n_steps <= 0:

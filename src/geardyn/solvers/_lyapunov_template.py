@@ -126,6 +126,8 @@ from geardyn.solvers._step_core import (  # CORE-IMPORT
 from geardyn.solvers._step_shared import (
     BLOCK,
     GBUF_ROWS,
+    INNER,
+    OUTER,
     STATUS_DIVERGED,
     STATUS_OK,
     STATUS_SPLIT_LIMIT,
@@ -163,12 +165,27 @@ VARIATIONAL = "rhs_tangent" in globals()
 if VARIATIONAL:
     _rhs_t = rhs_tangent  # noqa: F821
 
+    @nb.njit(forceinline=False, _nrt=False, **_JIT, **INNER)
+    def _rhs_t_call(t, y, v, dy, dv, p, s, c):
+        """The rhs's tangent form called, not inlined (``rhs_tangent`` is compiled to be inlined
+        by LLVM where it is called): the split step's sites, rarely run, take one copy of it,
+        not one each (LLVM's time on the callers). The same operations, bitwise."""
+        _rhs_t(t, y, v, dy, dv, p, s, c)
+
     @nb.njit(inline="always", **_JIT)
     def _var_trial(t, hh, h, y, w, p, s0, c0, s1, c1, s2, c2, KS, KV, TMP, TV, y1, w1):
         """The variational RK4 trial of one grid step: the state y into y1 and the tangent w
         (in y) into w1 = (dPhi/dy) w, Phi the RK4 step map (the stages of the pair (y, w) by
         the rhs's tangent form: f and J w at each stage); KS[0] is the state's k1. y1 is
         bitwise :func:`_rows_step`'s trial (the same operations)."""
+        _var_trial_of(_rhs_t, t, hh, h, y, w, p, s0, c0, s1, c1, s2, c2, KS, KV, TMP, TV, y1,
+                      w1)
+
+    @nb.njit(inline="always", **_JIT)
+    def _var_trial_of(rhs_t, t, hh, h, y, w, p, s0, c0, s1, c1, s2, c2, KS, KV, TMP, TV, y1,
+                      w1):
+        """:func:`_var_trial` with the rhs's tangent form ``rhs_t`` (``_rhs_t``, inlined, or
+        ``_rhs_t_call``, called)."""
         ns = y.size
         for st in range(4):  # one call site of the rhs's tangent form (an inlined copy each)
             yi = y
@@ -190,7 +207,7 @@ if VARIATIONAL:
                     ts = t + h
                     ss = s2
                     cs = c2
-            _rhs_t(ts, yi, wi, KS[st], KV[st], p, ss, cs)
+            rhs_t(ts, yi, wi, KS[st], KV[st], p, ss, cs)
         h6 = rk4_sixth(h)
         for q in range(ns):
             y1[q] = rk4_comb(y[q], h6, KS[0, q], KS[1, q], KS[2, q], KS[3, q])
@@ -232,7 +249,7 @@ if VARIATIONAL:
             n += 1 if _side(g[j]) != side[j] else 0
         return n
 
-    @nb.njit(_nrt=False, **_JIT)  # it allocates nothing: no reference counting of its views
+    @nb.njit(_nrt=False, **_JIT, **INNER)  # it allocates nothing: no reference counting
     def _side_point(ts, ys, fs, ss, cs, p, side, jx, want_x, M, h, g, g2, TP):
         """A point near the stage point ys (time ts, phase ss, cs, f(ys) = fs) on the sides
         ``side`` of every event (event jx, where >= 0, on side want_x instead) into TP: ys
@@ -271,7 +288,7 @@ if VARIATIONAL:
                 return False, False
         return True, True
 
-    @nb.njit(_nrt=False, **_JIT)  # it allocates nothing: no reference counting of its views
+    @nb.njit(_nrt=False, **_JIT, **INNER)  # it allocates nothing: no reference counting
     def _var_sub(tan, ys, k1, hs, t, tm, sm, cm, te, se, ce, s1, c1, p, side, h, trial, out,
                  work):
         """The split step's sub-step hook (:func:`_split_run`) of the variational tangent
@@ -292,8 +309,8 @@ if VARIATIONAL:
         M = VG[2]
         hh = 0.5 * hs
         ok = True
-        # one call site of the rhs's tangent form for the tangent vectors (each site is an
-        # inlined copy of it), one for a stage's f; stage 0 at ys (its w copied to the stage row)
+        # one call site of the rhs's tangent form for the tangent vectors, one for a stage's f
+        # (called, :func:`_rhs_t_call`); stage 0 at ys (its w copied to the stage row)
         for q in range(ns):
             KS[0, q] = k1[q]
         for st in range(4):
@@ -323,7 +340,7 @@ if VARIATIONAL:
                     b = 9 + 7 * j
                     for q in range(ns):
                         VX[b + 2, q] = VX[b, q] + a * VX[b + 2 + st, q]
-                _rhs_t(ts, TMP, VX[11], KS[st], VX[12 + st], p, ss, cs)
+                _rhs_t_call(ts, TMP, VX[11], KS[st], VX[12 + st], p, ss, cs)
                 pt = TMP
                 j_lo = 1  # tangent 0's J w at TMP came with the stage's f
             if _off_sides(ts, pt, ss, cs, p, side, M, g) != 0:
@@ -335,7 +352,7 @@ if VARIATIONAL:
                 j_lo = 0
             for j in range(j_lo, m1):
                 b = 9 + 7 * j
-                _rhs_t(ts, pt, VX[b + 2], FB, VX[b + 3 + st], p, ss, cs)
+                _rhs_t_call(ts, pt, VX[b + 2], FB, VX[b + 3 + st], p, ss, cs)
         h6 = rk4_sixth(hs)
         for q in range(ns):
             out[q] = rk4_comb(ys[q], h6, KS[0, q], KS[1, q], KS[2, q], KS[3, q])
@@ -347,7 +364,7 @@ if VARIATIONAL:
                                  VX[b + 6, q])
         return ok
 
-    @nb.njit(_nrt=False, **_JIT)  # it allocates nothing: no reference counting of its views
+    @nb.njit(_nrt=False, **_JIT, **INNER)  # it allocates nothing: no reference counting
     def _var_correct(t, x, f, u, s, c, p, side, jx, m1, h, pc, VX, VG):
         """Each tangent vector (VX[9 + 7 j]) moved from the split point x (time t, the fraction
         u of grid step, phase s, c, f(x) = f) to the orbit's crossing of event jx (just
@@ -382,7 +399,7 @@ if VARIATIONAL:
                 return False
             for j in range(m1):
                 b = 9 + 7 * j
-                _rhs_t(t, TP, VX[b], FB, VX[b + 2 + sd], p, s, c)
+                _rhs_t_call(t, TP, VX[b], FB, VX[b + 2 + sd], p, s, c)
                 if sd:
                     for q in range(ns):
                         VX[b, q] = VX[b, q] - shift * (VX[b + 2, q] - VX[b + 3, q])
@@ -418,7 +435,7 @@ if VARIATIONAL:
                 VX[b, q] = VX[b + 1, q]
         return 0
 
-    @nb.njit(_nrt=False, **_JIT)  # it allocates nothing: no reference counting of its views
+    @nb.njit(_nrt=False, **_JIT, **INNER)  # it allocates nothing: no reference counting
     def _var_split(i, t0, m1, p, h, omega, n_per, sa, ca, s_end, c_end, side, g1, ncross, work,
                    gbuf, VX, VG):
         """:func:`_split_step` of the state in VX[0] (its unsplit trial in VX[1], the tangent
@@ -433,7 +450,7 @@ if VARIATIONAL:
                           g1, ncross, work, work[8], gbuf, (m1, VX, VG), _var_sub,
                           _var_at_split, _var_finish, True)
 
-    @nb.njit(_nrt=False, **_JIT)  # it allocates nothing: no reference counting of its views
+    @nb.njit(_nrt=False, **_JIT, **INNER)  # it allocates nothing: no reference counting
     def _var_split_lane(i, t0, Z, S, IS, p, h, omega, n_per, s_tab, c_tab, n_ev, YP, E, K, TMP,
                         Y1, SIDE, G0, G1, W, gbuf, NCR, UNRES, VX, VG):
         """Grid step i of one lane (state Z[0], tangent vectors Z[1..] in z = y / S) whose
@@ -463,9 +480,9 @@ if VARIATIONAL:
         if code == 2:  # the unsplit trial: the tangent vectors by the variational trial
             for j in range(m1):
                 b = 9 + 7 * j
-                _var_trial(t, hh, h, y, VX[b], p, s_tab[j0], c_tab[j0], s_tab[j0 + 1],
-                           c_tab[j0 + 1], s_tab[j0 + 2], c_tab[j0 + 2], VX[5:9],
-                           VX[b + 3:b + 7], VX[2], VX[b + 2], VX[1], VX[b + 1])
+                _var_trial_of(_rhs_t_call, t, hh, h, y, VX[b], p, s_tab[j0], c_tab[j0],
+                              s_tab[j0 + 1], c_tab[j0 + 1], s_tab[j0 + 2], c_tab[j0 + 2],
+                              VX[5:9], VX[b + 3:b + 7], VX[2], VX[b + 2], VX[1], VX[b + 1])
                 for q in range(ns):
                     VX[b, q] = VX[b + 1, q]
             for q in range(ns):
@@ -484,7 +501,7 @@ if VARIATIONAL:
         return 0
 
 else:
-    @nb.njit(**_JIT)
+    @nb.njit(**_JIT, **INNER)
     def _var_split_lane(i, t0, Z, S, IS, p, h, omega, n_per, s_tab, c_tab, n_ev, YP, E, K, TMP,
                         Y1, SIDE, G0, G1, W, gbuf, NCR, UNRES, VX, VG):
         """A model without tangent forms has no variational step (its callers refuse)."""
@@ -690,7 +707,7 @@ def _set_column(r, lane, P, T0, H, NPER, OFF, PT, T0R, HR, HH, H6, NPR, IDX, END
     END[r] = OFF[lane] + 2 * NPER[lane]
 
 
-@nb.njit(**_JIT)
+@nb.njit(**_JIT, **INNER)
 def _lyap_one(first, max_total, due, renorm, bound, P, S, IS, T0, H, OMEGA, NPER, S_TAB, C_TAB,
               OFF, n_ev, ZT, IST, ENDS, BLK, ACC, ACT, ACTR, Zl, Cl, logs, status, W, gbuf):
     """:func:`_lyap_block`'s time loop for one lane (ZT[:, :, 0], nl = 1): its 2 k + 1 rows
@@ -711,7 +728,7 @@ def _lyap_one(first, max_total, due, renorm, bound, P, S, IS, T0, H, OMEGA, NPER
                           ACT, ACTR, Zl, Cl, logs, status, W, gbuf, rows)
 
 
-@nb.njit(_nrt=False, **_JIT)  # it allocates nothing
+@nb.njit(_nrt=False, **_JIT, **INNER)  # it allocates nothing
 def _lyap_one_loop(first, max_total, due, renorm, bound, P, S, IS, T0, H, OMEGA, NPER, s_tab,
                    c_tab, n_ev, ZT, IST, ENDS, BLK, ACC, ACT, ACTR, Zl, Cl, logs, status, W,
                    gbuf, rows):
@@ -733,7 +750,7 @@ def _lyap_one_loop(first, max_total, due, renorm, bound, P, S, IS, T0, H, OMEGA,
     return UNRES.sum()
 
 
-@nb.njit(**_JIT)
+@nb.njit(**_JIT, **INNER)
 def _lyap_block(first, nl, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF, n_transient,
                 n_steps, renorm_every, bound, n_ev, n_blocks, out, err, used, status, unres,
                 fd_steps):
@@ -743,7 +760,7 @@ def _lyap_block(first, nl, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF, n
                      status, unres, fd_steps)
 
 
-@nb.njit(**_JIT)
+@nb.njit(**_JIT, **INNER)
 def _lyap_block_one(first, nl, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF, n_transient,
                     n_steps, renorm_every, bound, n_ev, n_blocks, out, err, used, status, unres,
                     fd_steps):
@@ -1049,7 +1066,7 @@ if FUSED:
     nb.extending.overload(_t_screen_rows, inline="always")(_ov_t_screen_rows)
 
 
-@nb.njit(_nrt=False, **_JIT)
+@nb.njit(_nrt=False, **_JIT, **INNER)
 def _lyap_flagged(i, nl, first, P, Z0, Z1, IS, T0L, HL, OMEGA, NPL, ACT, ROWS, EV, FLAG, EL,
                   UNRR, PH, scratch):
     """The flagged lanes of step i out of line: each row whose trial is flagged finished on the
@@ -1128,7 +1145,7 @@ def _lyap_fused_run(form, first, nl, max_total, due, renorm, bound, P, OMEGA, H,
                                    ENDS, BLK, ACC, ACT, ACTR, status)
 
 
-@nb.njit(_nrt=False, **_JIT_NOALIAS)
+@nb.njit(_nrt=False, **_JIT_NOALIAS, **INNER)
 def _lyap_run_form1(first, nl, max_total, due, renorm, bound, P, OMEGA, H, S, IS, PT, lanes,
                     rows, books, out, err, used, status, scratch):
     """:func:`_lyap_fused_run` in the lane form FORM_QUIET (compiled on its own, noalias)."""
@@ -1136,7 +1153,7 @@ def _lyap_run_form1(first, nl, max_total, due, renorm, bound, P, OMEGA, H, S, IS
                     PT, lanes, rows, books, out, err, used, status, scratch)
 
 
-@nb.njit(_nrt=False, **_JIT_NOALIAS)
+@nb.njit(_nrt=False, **_JIT_NOALIAS, **INNER)
 def _lyap_run_form2(first, nl, max_total, due, renorm, bound, P, OMEGA, H, S, IS, PT, lanes,
                     rows, books, out, err, used, status, scratch):
     """:func:`_lyap_fused_run` in the lane form FORM_LOAD."""
@@ -1144,7 +1161,7 @@ def _lyap_run_form2(first, nl, max_total, due, renorm, bound, P, OMEGA, H, S, IS
                     PT, lanes, rows, books, out, err, used, status, scratch)
 
 
-@nb.njit(**_JIT)
+@nb.njit(**_JIT, **INNER)
 def _block_form(P, first, nl):
     """The lane form every lane of the block takes (``rhs_lane_form``), else FORM_GENERAL."""
     PTq = P.T
@@ -1155,7 +1172,7 @@ def _block_form(P, first, nl):
     return form
 
 
-@nb.njit(**_JIT)
+@nb.njit(**_JIT, **INNER)
 def _fused_block_start(first, nl, k, P, Y0, S, T0, H, NPER, OFF, n_transient, n_steps,
                        renorm_every, n_blocks, out, err, used, status):
     """The start of a fused Lyapunov block of k tangent vectors (:func:`_lyap_block_fused`,
@@ -1246,7 +1263,7 @@ def _lyap_block_fused(form, first, nl, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TA
 
 
 
-@nb.njit(**_JIT)
+@nb.njit(**_JIT, **INNER)
 def _lyap_block_form1(first, nl, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF, n_transient,
                       n_steps, renorm_every, bound, n_ev, n_blocks, out, err, used, status, unres,
                       fd_steps):
@@ -1256,7 +1273,7 @@ def _lyap_block_form1(first, nl, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, 
                       status, unres, fd_steps)
 
 
-@nb.njit(**_JIT)
+@nb.njit(**_JIT, **INNER)
 def _lyap_block_form2(first, nl, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF, n_transient,
                       n_steps, renorm_every, bound, n_ev, n_blocks, out, err, used, status, unres,
                       fd_steps):
@@ -1427,7 +1444,7 @@ def _var_steps(form, i, stop, n_adv, nl, locate, commit, Z0, Z1, S, IS, PT, T0L,
         j += 1
 
 
-@nb.njit(_nrt=False, **_JIT_NOALIAS)
+@nb.njit(_nrt=False, **_JIT_NOALIAS, **INNER)
 def _var_steps_form0(i, stop, n_adv, nl, locate, commit, Z0, Z1, S, IS, PT, T0L, HL, HHL, H6L,
                      PH, IDX, ENDL, ACT, FLAG, GR, Y1F, NPL):
     """:func:`_var_steps` in the lane form FORM_GENERAL (compiled on its own, noalias)."""
@@ -1435,7 +1452,7 @@ def _var_steps_form0(i, stop, n_adv, nl, locate, commit, Z0, Z1, S, IS, PT, T0L,
                       HL, HHL, H6L, PH, IDX, ENDL, ACT, FLAG, GR, Y1F, NPL)
 
 
-@nb.njit(_nrt=False, **_JIT_NOALIAS)
+@nb.njit(_nrt=False, **_JIT_NOALIAS, **INNER)
 def _var_steps_form1(i, stop, n_adv, nl, locate, commit, Z0, Z1, S, IS, PT, T0L, HL, HHL, H6L,
                      PH, IDX, ENDL, ACT, FLAG, GR, Y1F, NPL):
     """:func:`_var_steps` in the lane form FORM_QUIET."""
@@ -1443,7 +1460,7 @@ def _var_steps_form1(i, stop, n_adv, nl, locate, commit, Z0, Z1, S, IS, PT, T0L,
                       HL, HHL, H6L, PH, IDX, ENDL, ACT, FLAG, GR, Y1F, NPL)
 
 
-@nb.njit(_nrt=False, **_JIT_NOALIAS)
+@nb.njit(_nrt=False, **_JIT_NOALIAS, **INNER)
 def _var_steps_form2(i, stop, n_adv, nl, locate, commit, Z0, Z1, S, IS, PT, T0L, HL, HHL, H6L,
                      PH, IDX, ENDL, ACT, FLAG, GR, Y1F, NPL):
     """:func:`_var_steps` in the lane form FORM_LOAD."""
@@ -1468,7 +1485,7 @@ def _var_steps_of(form, i, stop, n_adv, nl, locate, commit, Z0, Z1, S, IS, PT, T
                             HHL, H6L, PH, IDX, ENDL, ACT, FLAG, GR, Y1F, NPL)
 
 
-@nb.njit(_nrt=False, **_JIT)  # it allocates nothing: no reference counting of its views
+@nb.njit(_nrt=False, **_JIT, **INNER)  # it allocates nothing: no reference counting of its views
 def _var_flagged(i, nl, first, n_ev, P, ZT, S, IS, T0L, HL, OMEGA, NPL, IDX, S_TAB, C_TAB,
                  FLAG, UNRR, FDL, GR, Y1F, fd):
     """The flagged lanes of step i (:func:`_var_fused_steps`: their states and tangent vectors
@@ -1509,7 +1526,13 @@ def _var_flagged(i, nl, first, n_ev, P, ZT, S, IS, T0L, HL, OMEGA, NPL, IDX, S_T
         FDL[l] += fd_l
 
 
-@nb.njit(_nrt=False, **_JIT)  # it allocates nothing
+#: :func:`_var_flagged` inlined into the k = 1 time loop (:func:`_lyap_var_run1`), not compiled
+#: on its own (a function of its own is linked, and optimised once more, into each caller's
+#: module: the time loop's and its worker's).
+_var_flagged_inline = nb.njit(inline="always", _nrt=False, **_JIT)(_var_flagged.py_func)
+
+
+@nb.njit(_nrt=False, **_JIT, **INNER)  # it allocates nothing
 def _var_load(ZT, Z1, nl, j_lo, kk):
     """Tangent vectors j_lo + 1 .. j_lo + kk of the block's lanes into the fused loop's slots:
     vector j_lo + 1 + jj of lane l (ZT[j_lo + 1 + jj, :, l]) at slot s = jj nl + l of the
@@ -1524,7 +1547,7 @@ def _var_load(ZT, Z1, nl, j_lo, kk):
                 ZT[0, q, s] = ZT[0, q, l]
 
 
-@nb.njit(_nrt=False, **_JIT)  # it allocates nothing
+@nb.njit(_nrt=False, **_JIT, **INNER)  # it allocates nothing
 def _var_store(ZT, Z1, nl, j_lo, kk):
     """The fused loop's slots back into tangent vectors j_lo + 1 .. j_lo + kk of the block's
     lanes (:func:`_var_load`)."""
@@ -1626,8 +1649,8 @@ def _lyap_var_run1(form, first, nl, n_ev, max_total, due, renorm, bound, P, OMEG
         for l in range(nl):
             n_flag += 1 if FLAG[l] != 0.0 else 0
         if n_flag > 0:
-            _var_flagged(i, nl, first, n_ev, P, ZT, S, IS, T0L, HL, OMEGA, NPL, IDX, S_TAB,
-                         C_TAB, FLAG, UNRR, FDL, GR, Y1F, fd)
+            _var_flagged_inline(i, nl, first, n_ev, P, ZT, S, IS, T0L, HL, OMEGA, NPL, IDX, S_TAB,
+                                C_TAB, FLAG, UNRR, FDL, GR, Y1F, fd)
         for l in range(nl):
             IDX[l] = IDX[l] + 2 if IDX[l] + 2 < ENDL[l] else IDX[l] + 2 - 2 * NPL[l]
         step = i + 1
@@ -1637,7 +1660,7 @@ def _lyap_var_run1(form, first, nl, n_ev, max_total, due, renorm, bound, P, OMEG
         i = step
 
 
-@nb.njit(_nrt=False, **_JIT_NOALIAS)
+@nb.njit(_nrt=False, **_JIT_NOALIAS, **INNER)
 def _lyap_var1_form0(first, nl, n_ev, max_total, due, renorm, bound, P, OMEGA, H, S, IS, PT,
                      lanes, books, out, err, used, status, scratch, fd):
     """:func:`_lyap_var_run1` in the lane form FORM_GENERAL (a block of mixed forms)."""
@@ -1645,7 +1668,7 @@ def _lyap_var1_form0(first, nl, n_ev, max_total, due, renorm, bound, P, OMEGA, H
                    S, IS, PT, lanes, books, out, err, used, status, scratch, fd)
 
 
-@nb.njit(_nrt=False, **_JIT_NOALIAS)
+@nb.njit(_nrt=False, **_JIT_NOALIAS, **INNER)
 def _lyap_var1_form1(first, nl, n_ev, max_total, due, renorm, bound, P, OMEGA, H, S, IS, PT,
                      lanes, books, out, err, used, status, scratch, fd):
     """:func:`_lyap_var_run1` in the lane form FORM_QUIET."""
@@ -1653,7 +1676,7 @@ def _lyap_var1_form1(first, nl, n_ev, max_total, due, renorm, bound, P, OMEGA, H
                    S, IS, PT, lanes, books, out, err, used, status, scratch, fd)
 
 
-@nb.njit(_nrt=False, **_JIT_NOALIAS)
+@nb.njit(_nrt=False, **_JIT_NOALIAS, **INNER)
 def _lyap_var1_form2(first, nl, n_ev, max_total, due, renorm, bound, P, OMEGA, H, S, IS, PT,
                      lanes, books, out, err, used, status, scratch, fd):
     """:func:`_lyap_var_run1` in the lane form FORM_LOAD."""
@@ -1661,7 +1684,7 @@ def _lyap_var1_form2(first, nl, n_ev, max_total, due, renorm, bound, P, OMEGA, H
                    S, IS, PT, lanes, books, out, err, used, status, scratch, fd)
 
 
-@nb.njit(_nrt=False, **_JIT_NOALIAS)
+@nb.njit(_nrt=False, **_JIT_NOALIAS, **INNER)
 def _lyap_var_form0(first, nl, n_ev, max_total, due, renorm, bound, P, OMEGA, H, S, IS, PT,
                     lanes, books, out, err, used, status, scratch, fd):
     """:func:`_lyap_var_run` in the lane form FORM_GENERAL (a block of mixed forms)."""
@@ -1669,7 +1692,7 @@ def _lyap_var_form0(first, nl, n_ev, max_total, due, renorm, bound, P, OMEGA, H,
                   IS, PT, lanes, books, out, err, used, status, scratch, fd)
 
 
-@nb.njit(_nrt=False, **_JIT_NOALIAS)
+@nb.njit(_nrt=False, **_JIT_NOALIAS, **INNER)
 def _lyap_var_form1(first, nl, n_ev, max_total, due, renorm, bound, P, OMEGA, H, S, IS, PT,
                     lanes, books, out, err, used, status, scratch, fd):
     """:func:`_lyap_var_run` in the lane form FORM_QUIET."""
@@ -1677,7 +1700,7 @@ def _lyap_var_form1(first, nl, n_ev, max_total, due, renorm, bound, P, OMEGA, H,
                   IS, PT, lanes, books, out, err, used, status, scratch, fd)
 
 
-@nb.njit(_nrt=False, **_JIT_NOALIAS)
+@nb.njit(_nrt=False, **_JIT_NOALIAS, **INNER)
 def _lyap_var_form2(first, nl, n_ev, max_total, due, renorm, bound, P, OMEGA, H, S, IS, PT,
                     lanes, books, out, err, used, status, scratch, fd):
     """:func:`_lyap_var_run` in the lane form FORM_LOAD."""
@@ -1823,7 +1846,7 @@ def _lyap_var_worker(b, n_blk, k, form, one, P, Y0, S, T0, H, OMEGA, NPER, S_TAB
         fd_steps[lo + i] = fs[i]
 
 
-@nb.njit(nogil=True, **_JIT)
+@nb.njit(nogil=True, **_JIT, **OUTER)
 def _lyap_var_worker_form0(b, n_blk, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
                            n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err,
                            used, status, unres, fd_steps):
@@ -1833,7 +1856,7 @@ def _lyap_var_worker_form0(b, n_blk, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_T
                      used, status, unres, fd_steps)
 
 
-@nb.njit(nogil=True, **_JIT)
+@nb.njit(nogil=True, **_JIT, **OUTER)
 def _lyap_var_worker_form1(b, n_blk, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
                            n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err,
                            used, status, unres, fd_steps):
@@ -1843,7 +1866,7 @@ def _lyap_var_worker_form1(b, n_blk, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_T
                      used, status, unres, fd_steps)
 
 
-@nb.njit(nogil=True, **_JIT)
+@nb.njit(nogil=True, **_JIT, **OUTER)
 def _lyap_var_worker_form2(b, n_blk, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
                            n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err,
                            used, status, unres, fd_steps):
@@ -1853,7 +1876,7 @@ def _lyap_var_worker_form2(b, n_blk, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_T
                      used, status, unres, fd_steps)
 
 
-@nb.njit(nogil=True, **_JIT)
+@nb.njit(nogil=True, **_JIT, **OUTER)
 def _lyap_spec_worker_form0(b, n_blk, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
                            n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err,
                            used, status, unres, fd_steps):
@@ -1863,7 +1886,7 @@ def _lyap_spec_worker_form0(b, n_blk, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_
                      used, status, unres, fd_steps)
 
 
-@nb.njit(nogil=True, **_JIT)
+@nb.njit(nogil=True, **_JIT, **OUTER)
 def _lyap_spec_worker_form1(b, n_blk, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
                            n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err,
                            used, status, unres, fd_steps):
@@ -1873,7 +1896,7 @@ def _lyap_spec_worker_form1(b, n_blk, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_
                      used, status, unres, fd_steps)
 
 
-@nb.njit(nogil=True, **_JIT)
+@nb.njit(nogil=True, **_JIT, **OUTER)
 def _lyap_spec_worker_form2(b, n_blk, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
                            n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err,
                            used, status, unres, fd_steps):
@@ -1892,7 +1915,7 @@ _SPEC_WORKERS = {FORM_GENERAL: _lyap_spec_worker_form0, FORM_QUIET: _lyap_spec_w
                  FORM_LOAD: _lyap_spec_worker_form2}
 
 
-@nb.njit(**_JIT)
+@nb.njit(**_JIT, **OUTER)
 def _var_block_forms(P, n_blk):
     """The lane form of each block of :func:`lyapunov_block_lanes` (:func:`_block_form`)."""
     forms = np.full(n_blk, FORM_GENERAL, np.int64)
@@ -1956,7 +1979,7 @@ def _block_lanes(b, n_blk, L):
     return np.int64(b * L // n_blk), np.int64((b + 1) * L // n_blk)
 
 
-@nb.njit(**_JIT)
+@nb.njit(**_JIT, **OUTER)
 def _block_paths(P, n_blk, k, n_ev):
     """The path of each block of :func:`lyapunov_block_lanes`: the fused loop of the lane form
     its lanes all take (FORM_QUIET, FORM_LOAD: a model with lane-scalar functions, k = 1,
@@ -1978,7 +2001,7 @@ def _block_paths(P, n_blk, k, n_ev):
     return paths
 
 
-@nb.njit(nogil=True, **_JIT)
+@nb.njit(nogil=True, **_JIT, **OUTER)
 def _lyap_block_worker(b, n_blk, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF, n_transient,
                        n_steps, renorm_every, bound, n_ev, n_blocks, out, err, used, status,
                        unres, fd_steps):
@@ -1991,7 +2014,7 @@ def _lyap_block_worker(b, n_blk, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, 
                           err, used, status, unres, fd_steps)
 
 
-@nb.njit(nogil=True, **_JIT)
+@nb.njit(nogil=True, **_JIT, **OUTER)
 def _lyap_block_worker_form1(b, n_blk, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
                              n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err,
                              used, status, unres, fd_steps):
@@ -2002,7 +2025,7 @@ def _lyap_block_worker_form1(b, n_blk, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C
                       status, unres, fd_steps)
 
 
-@nb.njit(nogil=True, **_JIT)
+@nb.njit(nogil=True, **_JIT, **OUTER)
 def _lyap_block_worker_form2(b, n_blk, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
                              n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err,
                              used, status, unres, fd_steps):
@@ -2013,7 +2036,7 @@ def _lyap_block_worker_form2(b, n_blk, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C
                       status, unres, fd_steps)
 
 
-@nb.njit(nogil=True, **_JIT)
+@nb.njit(nogil=True, **_JIT, **OUTER)
 def _lyap_block_worker_one(b, n_blk, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB, C_TAB, OFF,
                            n_transient, n_steps, renorm_every, bound, n_ev, n_blocks, out, err,
                            used, status, unres, fd_steps):
