@@ -45,6 +45,7 @@ from geardyn.solvers._step_shared import (
     HALLEY_TOL,
     INNER,
     MAX_SPLITS,
+    OUTER,
     SIMULTANEOUS,
     _cubic_coeffs,
     _forced,
@@ -849,7 +850,7 @@ else:
     LANE_NS = 0
     _rhs_l = _events_l = _observe_l = None
 
-    @nb.njit(**_JIT, **INNER)
+    @nb.njit(**_JIT, **OUTER)  # tests call it from Python
     def _lane_form(PT, k):
         return FORM_GENERAL
 
