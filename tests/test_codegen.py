@@ -23,9 +23,10 @@ from geardyn.solvers.kernels import SHARED_MODULES, TEMPLATES, cache_dir, kernel
 from geardyn.solvers.reference import reference_solution
 
 #: Modules a generated kernel may import besides the model's own (the shared modules: kernel
-#: code that does not evaluate the model, compiled once for every model).
+#: code that does not evaluate the model, compiled once for every model; the compile settings
+#: of geardyn._jit_target and geardyn._bound_calls).
 _ALLOWED = {"__future__", "math", "numba", "numpy", "llvmlite", "geardyn._jit_target",
-            "geardyn.core._noop",
+            "geardyn._bound_calls", "geardyn.core._noop",
             "geardyn.core.kernel_source", "geardyn.core.one_form", "geardyn.core.dual",
             "geardyn.solvers._parallel",
             *SHARED_MODULES}
