@@ -204,7 +204,7 @@ def trajectory(p, y0, h, omega, n_per, i0, n_steps, stride, locate, bound, n_ev,
     for q in range(ns):
         Y[0, q] = y0[q]
     j0 = 2 * (i0 % n_per)
-    events(i0 * h, Y[0], G[0], p, s_tab[j0], c_tab[j0])
+    _events_i(i0 * h, Y[0], G[0], p, s_tab[j0], c_tab[j0])
     for j in range(n_ev):
         SIDE[0, j] = _side(G[0, j])
     status = STATUS_OK
@@ -222,7 +222,7 @@ def trajectory(p, y0, h, omega, n_per, i0, n_steps, stride, locate, bound, n_ev,
                 for q in range(n_obs):
                     out_o[r, q] = obuf[q]
             if n_ev > 0:
-                events(t, Y[0], gbuf[0], p, s_tab[j0], c_tab[j0])
+                _events_i(t, Y[0], gbuf[0], p, s_tab[j0], c_tab[j0])
                 for q in range(n_ev):
                     out_g[r, q] = gbuf[0, q]
         if i == i0 + n_steps:
@@ -568,7 +568,7 @@ def _block_arrays(nw, lanes, cfg):
     ob = np.zeros(n_o)
     work = np.zeros((7, ns))
     ybuf = np.zeros(ns)
-    gbuf = event_buffer(0, n_ev)
+    gbuf = event_buffer(np.int64(0), n_ev)  # (int64 as _alloc's: one compile)
     marked = np.zeros(nw, np.int64)  # the marked slots of a block step (_slots_out)
     HW3 = np.zeros((3, ns, nw))  # h/2, h, h/6 per (state, slot)
     FL = (Y.reshape(ns * nw), Y1.reshape(ns * nw), K1.reshape(ns * nw), K2.reshape(ns * nw),
@@ -936,10 +936,11 @@ def _slot_out(k, G1, SE, CE, TABS, lanes, cfg, out, blk, slots, scratch):
     if step <= n_tr[k]:
         return False
     n_stat[k] += 1
+    on = bool(True)  # noqa: UP018 - not a literal: the statistics' selects compile once
     for j in range(G1.shape[0]):
         g = G1[j, k]
-        GMIN[j, k] = stat_min(GMIN[j, k], g, True)
-        GMAX[j, k] = stat_max(GMAX[j, k], g, True)
+        GMIN[j, k] = stat_min(GMIN[j, k], g, on)
+        GMAX[j, k] = stat_max(GMAX[j, k], g, on)
     _slot_observe(k, T0B[k] + step * HB[k], SE[k], CE[k], Y, PT, (GMIN, GMAX, OMAX, OMIN, OSQ),
                   lanes, cfg, slots, scratch)
     if step < DUE[k]:
@@ -954,7 +955,7 @@ def _slot_observe(k, t, s, c, Y, PT, ST, lanes, cfg, slots, scratch):
     k at the grid point reached (time t, forcing phase s, c) in :func:`_slot_out`: the model's
     lane-scalar ``observe`` (:mod:`._pointer_template` replaces it)."""
     o = _observe_l(t, _t_load(Y, k), PT, k, s, c, FORM_GENERAL)
-    _t_stats(ST[0], ST[1], ST[2], ST[3], ST[4], k, (), o, True)
+    _t_stats(ST[0], ST[1], ST[2], ST[3], ST[4], k, (), o, bool(True))  # noqa: UP018
 
 
 @nb.njit(inline="always", **_JIT)

@@ -815,13 +815,19 @@ if "rhs_lane" in globals():  # the model's lane-scalar functions (see .kernels)
                          (_t_hermite, _ov_t_hermite)):
         nb.extending.overload(_stub, inline="always")(_impl)
 
+    #: The lane index of a split's one-lane coefficient view (``p[:, None]``, PT[j, 0] = p[j]):
+    #: an int64 and a C-layout view, the argument types of the fused loop's calls, so that the
+    #: model's lane-scalar functions compile once (a literal 0 and the transposed view
+    #: ``p[None, :].T``, F layout, compiled a second copy of the model's rhs).
+    _K0 = np.int64(0)
+
     # The split path in the lane form: the state and the stages in registers, read and written
     # element by element. With the array loops LLVM loaded a freshly stored state or stage as
     # one vector, which no store can forward to (a stall of ~15 cycles each, ~1/5 of a split,
     # see bench/perf_map.py); the same arithmetic (bitwise equal).
     @nb.njit(forceinline=True, _nrt=False, **_JIT, **INNER)
     def _split_rhs(t, y, out, p, s, c):  # noqa: F811 - the lane form of the generic one
-        v = _rhs_l(t, _t_get(y), p[None, :].T, 0, s, c, FORM_GENERAL)
+        v = _rhs_l(t, _t_get(y), p[:, None], _K0, s, c, FORM_GENERAL)
         _t_put(out, v)
 
     @nb.njit(forceinline=True, _nrt=False, **_JIT, **INNER)
@@ -830,14 +836,14 @@ if "rhs_lane" in globals():  # the model's lane-scalar functions (see .kernels)
 
     @nb.njit(forceinline=True, _nrt=False, **_JIT, **INNER)
     def _rk4_stages(y, h, tm, pm, sm, cm, te, pe, se, ce, k1, kst, acc, tmp, out):  # noqa: F811
-        ptm = pm[None, :].T  # PT[j, 0] = p[j]: the lane functions' coefficient layout, a view
-        pte = pe[None, :].T
+        ptm = pm[:, None]  # PT[j, 0] = p[j]: the lane functions' coefficient layout, a view
+        pte = pe[:, None]
         yt = _t_get(y)
         k1t = _t_get(k1)
         hh = 0.5 * h
-        k2 = _rhs_l(tm, _t_axpy(yt, hh, k1t), ptm, 0, sm, cm, FORM_GENERAL)
-        k3 = _rhs_l(tm, _t_axpy(yt, hh, k2), ptm, 0, sm, cm, FORM_GENERAL)
-        k4 = _rhs_l(te, _t_axpy(yt, h, k3), pte, 0, se, ce, FORM_GENERAL)
+        k2 = _rhs_l(tm, _t_axpy(yt, hh, k1t), ptm, _K0, sm, cm, FORM_GENERAL)
+        k3 = _rhs_l(tm, _t_axpy(yt, hh, k2), ptm, _K0, sm, cm, FORM_GENERAL)
+        k4 = _rhs_l(te, _t_axpy(yt, h, k3), pte, _K0, se, ce, FORM_GENERAL)
         _t_put(out, _t_comb(yt, rk4_sixth(h), k1t, k2, k3, k4))
 
     @nb.njit(forceinline=True, _nrt=False, **_JIT, **INNER)

@@ -43,8 +43,9 @@ def _alloc(nb_lanes, ns, n_ev):
     work = np.zeros((7, ns))
     SIDE = np.zeros((nb_lanes, n_ev), np.int64)
     SIDE[...] = 1
+    gbuf = event_buffer(np.int64(nb_lanes), n_ev)  # int64 (not a literal): one compile
     return (Y, Y.copy(), Y.copy(), Y.copy(), Y.copy(), Y.copy(), Y.copy(), np.zeros(nb_lanes),
-            np.zeros((nb_lanes, n_ev)), SIDE, work, np.zeros(ns), event_buffer(nb_lanes, n_ev))
+            np.zeros((nb_lanes, n_ev)), SIDE, work, np.zeros(ns), gbuf)
 
 
 @nb.njit(**_JIT, **INNER)
