@@ -121,9 +121,12 @@ _JIT_LANES = {**_JIT, "_nrt": False}
 #: explicitly: numba's flag is inherited from the compile a function is first compiled in,
 #: and the templates compile the entry points with it (LLVM's ``alwaysinline``), which would
 #: make LLVM inline a body at every call site of every kernel function (the split step's
-#: ~14 copies of the right-hand side). The lane-block mesh loop (:func:`_lanes_meshes`) stays
-#: inlined: called, ``planetary_rhs_lanes`` was slower.
+#: ~14 copies of the right-hand side).
 _JIT_BODY = {**_JIT_LANES, "forceinline": False}
+#: The lane-block mesh loop (:func:`_lanes_meshes`): typed and lowered once, for both its
+#: callers (``planetary_rhs_lanes``, ``planetary_observe_lanes``), and inlined by LLVM into
+#: each (``forceinline``; called, ``planetary_rhs_lanes`` was slower).
+_JIT_INL = {**_JIT_LANES, "forceinline": True}
 
 
 def layout(n: int, n_mesh: int, nh: int, nk: int = 0, ng: int = 0) -> dict[str, int]:
@@ -839,16 +842,19 @@ def planetary_rhs_lanes(T, Y, DY, PT, nl, S, C, SC):
             r = g + 2 + 2 * ng + e
             for k in range(nl):
                 DY[i, k] -= (PT[g, k] * PT[r, k]) * Y[j, k]
-    _lanes_meshes(T, Y, DY, PT, nl, S, C, SC, True)
+    _lanes_meshes(T, Y, DY, PT, nl, S, C, SC, bool(nl >= 0))
 
 
-@nb.njit(inline="always", **_JIT)
+@nb.njit(**_JIT_INL)
 def _lanes_meshes(T, Y, DY, PT, nl, S, C, SC, apply):
     """The mesh forces of lanes 0..nl-1 of a block, each subtracted from the accelerations DY
     through its mesh's G (``apply``: :func:`planetary_rhs_lanes`) or written to row m of DY
     (:func:`planetary_observe_lanes`); the relative stiffnesses from the block's caches
-    (:func:`_lanes_cached_stiffness`, :func:`_lanes_own_phases`). Inlined (``apply`` a
-    constant there): called, the right-hand side's mesh loop ran 1.13-1.26x slower."""
+    (:func:`_lanes_cached_stiffness`, :func:`_lanes_own_phases`). Inlined by LLVM (``_JIT_INL``):
+    called, the right-hand side's mesh loop ran 1.13-1.26x slower. The callers pass ``apply``
+    as a value computed at run time (``bool(nl >= 0)``, ``bool(nl < 0)``: True and False, and
+    either does nothing for nl = 0), not a constant, which numba would type as a literal and
+    compile this function for each."""
     n, nm, nh, mesh, bs, st, mz = _lanes_offsets(PT)
     two = False
     for k in range(nl):
@@ -1002,7 +1008,7 @@ def planetary_events_lanes(T, Y, G, PT, nl, S, C):
 @nb.njit(**_JIT_LANES)
 def planetary_observe_lanes(T, Y, O, PT, nl, S, C, SC):
     """:func:`planetary_observe` for lanes 0..nl-1 of a block (O: one row per mesh)."""
-    _lanes_meshes(T, Y, O, PT, nl, S, C, SC, False)
+    _lanes_meshes(T, Y, O, PT, nl, S, C, SC, bool(nl < 0))
 
 
 # ---------------------------------------------------------------------------------------------
