@@ -64,6 +64,31 @@ def optimise_once(dispatcher: Any) -> Any:
     return dispatcher
 
 
+#: The attribute of a Python function whose compiled code is bound whatever its size
+#: (:func:`always_bind`).
+ALWAYS = "_geardyn_always_bind"
+
+
+def always_bind(dispatcher: Any) -> Any:
+    """Mark ``dispatcher`` (a numba function) to be bound in its callers whatever its size, not
+    linked into each (where it is below :data:`MIN_INSTRUCTIONS`): a function called at few
+    sites, rarely (a loop called once per run of steps), that several callers would otherwise
+    each optimise again; returns it."""
+    setattr(dispatcher.py_func, ALWAYS, True)
+    _ALWAYS_NAMES.add(dispatcher.py_func.__qualname__)
+    return dispatcher
+
+
+#: The names of the functions marked by :func:`always_bind` (numba names a function's library
+#: by them: a library loaded from numba's cache has no compile to say it).
+_ALWAYS_NAMES: set[str] = set()
+
+
+def _always(library: Any) -> bool:
+    """Whether ``library``'s function is bound whatever its size (:func:`always_bind`)."""
+    return getattr(library, "_geardyn_always", library.name in _ALWAYS_NAMES)
+
+
 #: symbol -> (return attributes, function attributes, [attributes per argument])
 DECLS: dict[str, tuple[list[str], list[str], list[list[str]]]] = {}
 
@@ -103,15 +128,16 @@ def _declaration(fn: Any) -> tuple[list[str], list[str], list[list[str]]]:
     return ret, fattrs, args
 
 
-def _big(module: Any, linkage: Any) -> list:
+def _big(module: Any, linkage: Any, always: bool = False) -> list:
     """The functions ``module`` defines with ``linkage`` (wrappers left out) that are big
-    enough to be bound; not those marked to be inlined at every call site (numba's
-    ``forceinline``: LLVM's ``alwaysinline``), which their callers link and inline."""
+    enough to be bound (any size with ``always``: :func:`always_bind`); not those marked to be
+    inlined at every call site (numba's ``forceinline``: LLVM's ``alwaysinline``), which their
+    callers link and inline."""
     return [fn for fn in module.functions
             if not fn.is_declaration and fn.linkage == linkage
             and not fn.name.startswith(("cpython.", "cfunc.", "_ZN7cpython", "_ZN5cfunc"))
             and not any(b"alwaysinline" in attrs.split() for attrs in fn.attributes)
-            and _at_least(fn, MIN_INSTRUCTIONS)]
+            and (always or _at_least(fn, MIN_INSTRUCTIONS))]
 
 
 def _bind(library: Any, fn: Any, entry: Any) -> None:
@@ -127,7 +153,8 @@ def _register(library: Any) -> None:
     if hasattr(library, "_geardyn_bound"):
         return
     library._geardyn_bound = False
-    for fn in _big(library._final_module, ll.Linkage.external) if ENABLED else ():
+    for fn in (_big(library._final_module, ll.Linkage.external, _always(library)) if ENABLED
+               else ()):
         _bind(library, fn, library)
 
 
@@ -254,7 +281,7 @@ def _finalize(library: Any, reload_init: list) -> None:
     type(library).finalize(library)
     if (REOPTIMISE and not getattr(library, "_geardyn_once", False)
             and _lazy_code.is_pending(library)
-            and _big(library._final_module, ll.Linkage.external)):
+            and _big(library._final_module, ll.Linkage.external, _always(library))):
         # a callee (its code not emitted yet) that will be bound: optimised once more, as
         # numba's linking optimises a linked copy once more in each caller
         library._optimize_final_module()
@@ -267,8 +294,10 @@ def _finalize(library: Any, reload_init: list) -> None:
 def prepare(library: Any, reload_init: list, func: Any = None) -> None:
     """Make ``library`` (a geardyn function's numba code library) declare its bound callees;
     ``reload_init`` is its compile's list of numba's reload callables (``state.reload_init``),
-    ``func`` the Python function compiled (marked by :func:`optimise_once` or not)."""
+    ``func`` the Python function compiled (marked by :func:`optimise_once`,
+    :func:`always_bind` or not)."""
     library._geardyn_once = bool(getattr(func, ONCE, False))
+    library._geardyn_always = bool(getattr(func, ALWAYS, False))
     add = library.add_ir_module
 
     def add_ir_module(ir_module: Any) -> None:

@@ -86,6 +86,7 @@ from __future__ import annotations
 import numba as nb
 import numpy as np
 
+from geardyn._bound_calls import always_bind, optimise_once
 from geardyn.core.kernel_source import FORM_GENERAL, FORM_LOAD, FORM_QUIET
 from geardyn.solvers._lyapunov_books import (  # compiled once for every model
     _DUE,
@@ -435,6 +436,7 @@ if VARIATIONAL:
                 VX[b, q] = VX[b + 1, q]
         return 0
 
+    @optimise_once  # cold: optimised once where bound (see geardyn._bound_calls)
     @nb.njit(_nrt=False, **_JIT, **INNER)  # it allocates nothing: no reference counting
     def _var_split(i, t0, m1, p, h, omega, n_per, sa, ca, s_end, c_end, side, g1, ncross, work,
                    gbuf, VX, VG):
@@ -450,6 +452,7 @@ if VARIATIONAL:
                           g1, ncross, work, work[8], gbuf, (m1, VX, VG), _var_sub,
                           _var_at_split, _var_finish, True)
 
+    @optimise_once  # cold: optimised once where bound (see geardyn._bound_calls)
     @nb.njit(_nrt=False, **_JIT, **INNER)  # it allocates nothing: no reference counting
     def _var_split_lane(i, t0, Z, S, IS, p, h, omega, n_per, s_tab, c_tab, n_ev, YP, E, K, TMP,
                         Y1, SIDE, G0, G1, W, gbuf, NCR, UNRES, VX, VG):
@@ -1172,6 +1175,7 @@ def _block_form(P, first, nl):
     return form
 
 
+@optimise_once  # cold: optimised once where bound (see geardyn._bound_calls)
 @nb.njit(**_JIT, **INNER)
 def _fused_block_start(first, nl, k, P, Y0, S, T0, H, NPER, OFF, n_transient, n_steps,
                        renorm_every, n_blocks, out, err, used, status):
@@ -1444,6 +1448,7 @@ def _var_steps(form, i, stop, n_adv, nl, locate, commit, Z0, Z1, S, IS, PT, T0L,
         j += 1
 
 
+@always_bind  # one copy for every time loop (see geardyn._bound_calls)
 @nb.njit(_nrt=False, **_JIT_NOALIAS, **INNER)
 def _var_steps_form0(i, stop, n_adv, nl, locate, commit, Z0, Z1, S, IS, PT, T0L, HL, HHL, H6L,
                      PH, IDX, ENDL, ACT, FLAG, GR, Y1F, NPL):
@@ -1452,6 +1457,7 @@ def _var_steps_form0(i, stop, n_adv, nl, locate, commit, Z0, Z1, S, IS, PT, T0L,
                       HL, HHL, H6L, PH, IDX, ENDL, ACT, FLAG, GR, Y1F, NPL)
 
 
+@always_bind  # one copy for every time loop (see geardyn._bound_calls)
 @nb.njit(_nrt=False, **_JIT_NOALIAS, **INNER)
 def _var_steps_form1(i, stop, n_adv, nl, locate, commit, Z0, Z1, S, IS, PT, T0L, HL, HHL, H6L,
                      PH, IDX, ENDL, ACT, FLAG, GR, Y1F, NPL):
@@ -1460,6 +1466,7 @@ def _var_steps_form1(i, stop, n_adv, nl, locate, commit, Z0, Z1, S, IS, PT, T0L,
                       HL, HHL, H6L, PH, IDX, ENDL, ACT, FLAG, GR, Y1F, NPL)
 
 
+@always_bind  # one copy for every time loop (see geardyn._bound_calls)
 @nb.njit(_nrt=False, **_JIT_NOALIAS, **INNER)
 def _var_steps_form2(i, stop, n_adv, nl, locate, commit, Z0, Z1, S, IS, PT, T0L, HL, HHL, H6L,
                      PH, IDX, ENDL, ACT, FLAG, GR, Y1F, NPL):
