@@ -225,37 +225,29 @@ def test_a_forceinline_callee_is_inlined_not_bound(monkeypatch):
     np.testing.assert_allclose(caller(a), np.sum(np.cos(a)) + np.cos(a[0]), rtol=1e-12)
     assert _defines(caller, "_body") == []  # inlined: neither declared nor defined
 
-
-
-def _tiny(a, out):
+def _body_marked(a, out):  # _body's body: always_bind marks a Python function, not a copy
     s = 0.0
     for i in range(a.size):
-        s += np.sin(a[i])
+        s += np.cos(a[i])
         out[i] = s
     return s
 
 
-def _tiny_marked(a, out):  # _tiny's body, marked by always_bind below
-    s = 0.0
-    for i in range(a.size):
-        s += np.sin(a[i])
-        out[i] = s
-    return s
+# A dispatcher of _body of its own: compiled here with the default MIN_INSTRUCTIONS (_inner is
+# compiled bound by the test that lowers it).
+_body_linked = numba.njit(_nrt=False, pipeline_class=WidthCompiler)(_body)
+_body_bound = _bound_calls.always_bind(
+    numba.njit(_nrt=False, pipeline_class=WidthCompiler)(_body_marked))
 
 
-_tiny_linked = numba.njit(_nrt=False, pipeline_class=WidthCompiler)(_tiny)
-_tiny_bound = _bound_calls.always_bind(
-    numba.njit(_nrt=False, pipeline_class=WidthCompiler)(_tiny_marked))
-
-
-def _call_tiny_linked(a):
+def _call_body_linked(a):
     out = np.empty_like(a)
-    return _tiny_linked(a, out) + out[0]
+    return _body_linked(a, out) + out[0]
 
 
-def _call_tiny_bound(a):
+def _call_body_bound(a):
     out = np.empty_like(a)
-    return _tiny_bound(a, out) + out[0]
+    return _body_bound(a, out) + out[0]
 
 
 def test_an_always_bind_callee_is_bound_whatever_its_size():
@@ -265,16 +257,16 @@ def test_an_always_bind_callee_is_bound_whatever_its_size():
     compile to mark it) is recognised by its function's name."""
     assert _bound_calls.MIN_INSTRUCTIONS > 100
     a = np.linspace(0.0, 3.0, 17)
-    bound = numba.njit(pipeline_class=WidthCompiler)(_call_tiny_bound)
-    linked = numba.njit(pipeline_class=WidthCompiler)(_call_tiny_linked)
-    want = np.sum(np.sin(a)) + np.sin(a[0])
+    bound = numba.njit(pipeline_class=WidthCompiler)(_call_body_bound)
+    linked = numba.njit(pipeline_class=WidthCompiler)(_call_body_linked)
+    want = np.sum(np.cos(a)) + np.cos(a[0])
     np.testing.assert_allclose(bound(a), want, rtol=1e-12)
     assert bound(a) == linked(a)
-    assert _defines(bound, "_tiny_marked") == [False]  # declared: bound
-    assert False not in _defines(linked, "_tiny")  # linked (or inlined)
+    assert _defines(bound, "_body_marked") == [False]  # declared: bound
+    assert False not in _defines(linked, "_body")  # linked (or inlined)
 
     class Loaded:  # a library as numba's cache loads it: its name, no compile's mark
-        name = _tiny_marked.__qualname__
+        name = _body_marked.__qualname__
     assert _bound_calls._always(Loaded())
-    Loaded.name = _tiny.__qualname__
+    Loaded.name = _body.__qualname__
     assert not _bound_calls._always(Loaded())
