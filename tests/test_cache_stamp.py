@@ -5,6 +5,7 @@ to a helper they inline (the dead zone) or to a module whose constants they free
 from __future__ import annotations
 
 import os
+import shutil
 import textwrap
 from pathlib import Path
 
@@ -117,4 +118,38 @@ def test_each_files_facts_are_kept_in_the_cache_for_its_state(tmp_path, monkeypa
     # no writable cache (its folder would be below a file): computed, nothing kept
     (tmp_path / "file").write_text("")
     assert stamp_with("file/cache") == edited
+    gc._facts.cache_clear()
+
+
+def test_stamp_of_a_kernel_is_the_same_in_a_copy_and_follows_edits(tmp_path, monkeypatch):
+    """A generated kernel module's stamp names its files relative to the folders that move with
+    them (the kernel module relative to the kernels folder, the package's files relative to the
+    package), so a copy of the cache and of the package at other paths, even with new file times
+    (``cp -r``), has the same stamp; an edit in the copy, of the kernel module or of a package
+    module it imports, changes it."""
+    def stamp(where: str) -> bytes:
+        """The stamp of the kernel module of the tree ``where``, as a new process takes it."""
+        monkeypatch.setattr(gc, "PACKAGE_DIR", tmp_path / where / "geardyn")
+        monkeypatch.setenv("GEARDYN_CACHE_DIR", str(tmp_path / where / "cache"))
+        gc._facts.cache_clear()
+        kernel = tmp_path / where / "cache" / "kernels" / "geardyn_rk4_0123.py"
+        assert gc.is_geardyn_file(kernel)
+        return source_stamp(kernel)
+
+    _package(tmp_path / "one")
+    kernels = tmp_path / "one" / "cache" / "kernels"
+    kernels.mkdir(parents=True)
+    (kernels / "geardyn_rk4_0123.py").write_text(
+        "from geardyn.models.helpers import dead_zone\n\n\ndef f(x):\n    return dead_zone(x)\n")
+    first = stamp("one")
+    shutil.copytree(tmp_path / "one", tmp_path / "two", copy_function=shutil.copyfile)
+    assert stamp("two") == first
+    helpers = tmp_path / "two" / "geardyn" / "models" / "helpers.py"
+    helpers.write_text(helpers.read_text().replace("x - consts.B", "x + consts.B"))
+    edited = stamp("two")
+    assert edited != first
+    kernel = tmp_path / "two" / "cache" / "kernels" / "geardyn_rk4_0123.py"
+    kernel.write_text(kernel.read_text().replace("dead_zone(x)\n", "dead_zone(x) + 1.0\n"))
+    assert stamp("two") not in (first, edited)
+    assert stamp("one") == first
     gc._facts.cache_clear()

@@ -10,8 +10,9 @@ geardyn changes no numba setting and no environment variable for this: it regist
 locator (:class:`GeardynCacheLocator`, first in numba's list of locators) that answers only for
 geardyn's own functions (files in the geardyn package and the generated kernels); every other
 function keeps numba's own locators. Where ``NUMBA_CACHE_DIR`` is set, it keeps geardyn's code
-there, in numba's own layout. The names of the cache files carry the vector width the code was
-compiled at (:func:`geardyn._jit_target.cache_tag`), so that each width has its own entries.
+there, in numba's own layout (the generated kernels' in one folder, below). The names of the
+cache files carry the vector width the code was compiled at
+(:func:`geardyn._jit_target.cache_tag`), so that each width has its own entries.
 numba picks the locator of a function when it is decorated, so this module runs before geardyn
 defines any numba function. Subprocesses that import geardyn (test workers, Dask workers)
 register it too. Where ``NUMBA_CACHE_LOCATOR_CLASSES`` is set, numba uses only the classes it
@@ -26,6 +27,27 @@ transitively: an edit to any of them recompiles the function rather than loading
 Each file's digest and imports are kept in ``stamps/`` for the file's state (times, size,
 inode; as Python keeps a module's bytecode for its source's), so that a process (each test
 worker, each ``geardyn`` command) reads them instead of parsing every module at import.
+
+A cache folder can be copied or moved (into a Docker image, a CI cache, another machine's home,
+a Dask worker's folder; ``cp -r`` or ``cp -a``, file times kept or not) and is reused there: the
+generated kernel modules' compiled code is kept in one folder below numba's cache folder,
+``numba/kernels`` (:data:`KERNELS_SUBPATH`), whatever the cache's path (a kernel module's name
+is a hash of its code), and their stamp names each file relative to the folder that moves with
+it (:func:`stamp_name`: the kernel module relative to ``kernels/``, the package's files relative
+to the package), and hashes its code, not its times. The memos of ``stamps/`` are kept by a
+file's path and state: in a copy those of the kernel modules (new paths, new states) are not
+found, and each is parsed once again. The
+package's own functions are kept by the path of their folder, as numba keeps them, so that two
+checkouts of geardyn sharing one cache each keep their own entries (where their code differs,
+one entry per function would be compiled again at each switch). What recompiles, in a copy as
+in the original: another geardyn or numba version, an edited model or geardyn module (the
+kernel's name or its stamp), another CPU or vector width (numba's index and
+:func:`geardyn._jit_target.cache_tag`), and the package's own functions where the package is at
+another path, where they are called (the kernels hold their code and still load: a simulation
+on a copied cache with the package copied elsewhere compiled nothing). Where
+``NUMBA_CACHE_DIR`` is set, the kernels' code is in its ``kernels`` folder: every geardyn cache
+that uses that numba folder shares it (safe: the names are hashes of the code), and it stays
+valid where only ``$GEARDYN_CACHE_DIR`` is moved; copy both folders to take it along.
 """
 
 from __future__ import annotations
@@ -68,12 +90,33 @@ def numba_cache_dir(environ: Mapping[str, str] | None = None) -> Path:
     return Path(env.get(NUMBA_ENV) or cache_root(env) / "numba")
 
 
+def kernels_dir() -> Path:
+    """The folder of the generated kernel modules, absolute: ``cache_root()/kernels``."""
+    return Path(os.path.abspath(cache_root() / "kernels"))
+
+
 def is_geardyn_file(py_file: str | os.PathLike[str]) -> bool:
     """Whether ``py_file`` is geardyn's: in the geardyn package or a generated kernel module
-    (``cache_root()/kernels``)."""
+    (:func:`kernels_dir`)."""
     path = Path(os.path.abspath(py_file))
-    return any(path.is_relative_to(folder)
-               for folder in (PACKAGE_DIR, Path(os.path.abspath(cache_root() / "kernels"))))
+    return any(path.is_relative_to(folder) for folder in (PACKAGE_DIR, kernels_dir()))
+
+
+def is_kernel_file(py_file: str | os.PathLike[str]) -> bool:
+    """Whether ``py_file`` is a generated kernel module (in :func:`kernels_dir`)."""
+    return Path(os.path.abspath(py_file)).is_relative_to(kernels_dir())
+
+
+def stamp_name(path: Path) -> str:
+    """The name :func:`source_stamp` gives the absolute file ``path``: relative to the folder
+    that moves with it, so that the stamp does not change where the folder is copied or moved:
+    ``kernels/<file>`` for a generated kernel module (relative to :func:`kernels_dir`),
+    ``geardyn/<file>`` for a file of the package (relative to :data:`PACKAGE_DIR`); any other
+    file by its absolute path."""
+    for prefix, folder in (("kernels", kernels_dir()), ("geardyn", PACKAGE_DIR)):
+        if path.is_relative_to(folder):
+            return f"{prefix}/{path.relative_to(folder).as_posix()}"
+    return path.as_posix()
 
 
 def _module_file(name: str) -> Path | None:
@@ -188,27 +231,43 @@ def dependency_files(py_file: str | os.PathLike[str]) -> tuple[Path, ...]:
 
 def source_stamp(py_file: str | os.PathLike[str]) -> bytes:
     """numba's stamp of a cached function of ``py_file``: the code of ``py_file`` and of its
-    :func:`dependency_files` (:func:`_facts`), so its cached code is loaded only while
-    none of them changed but in comments and docstrings."""
+    :func:`dependency_files` (:func:`_facts`), each named by :func:`stamp_name`, so its cached
+    code is loaded only while none of them changed but in comments and docstrings, and is
+    loaded where the cache folder (or the package) was copied or moved with the same code."""
     h = hashlib.sha256()
     for path in dependency_files(py_file):
         st = os.stat(path)
-        h.update(str(path.relative_to(path.anchor)).encode())
+        h.update(stamp_name(path).encode() + b"\0")
         h.update(_facts(path, _state(st))[0])
     return h.digest()
+
+
+#: The folder (below numba's cache folder) of the generated kernel modules' compiled code.
+KERNELS_SUBPATH = "kernels"
 
 
 class GeardynCacheLocator(caching.UserProvidedCacheLocator):
     """numba's cache locator for geardyn's functions: the layout of numba's own
     ``NUMBA_CACHE_DIR`` locator, rooted at numba's ``NUMBA_CACHE_DIR`` where set, else at
-    :func:`numba_cache_dir`; the vector width in the file names. It declines (numba's other
-    locators decide) for any other file."""
+    :func:`numba_cache_dir`; the vector width in the file names. The package's functions are
+    kept by their folder's path, as numba keeps them (two checkouts of geardyn sharing one
+    cache each keep their own entries); the generated kernel modules' in one folder,
+    :data:`KERNELS_SUBPATH`, whatever the path of the cache (their names are hashes of their
+    code). It declines (numba's other locators decide) for any other file."""
 
     def __init__(self, py_func, py_file):  # noqa: ANN001 (numba's signature)
         self._py_file = py_file
         self._lineno = py_func.__code__.co_firstlineno
         self._cache_path = os.path.join(config.CACHE_DIR or str(numba_cache_dir()),
                                         self.get_suitable_cache_subpath(py_file))
+
+    @classmethod
+    def get_suitable_cache_subpath(cls, py_file: str) -> str:
+        """:data:`KERNELS_SUBPATH` for a generated kernel module, else numba's (the name and a
+        hash of the path of the file's folder)."""
+        if is_kernel_file(py_file):
+            return KERNELS_SUBPATH
+        return super().get_suitable_cache_subpath(py_file)
 
     def get_source_stamp(self) -> bytes:
         """:func:`source_stamp` of the function's file (numba's own: of the file alone)."""

@@ -9,8 +9,9 @@ model's step machinery, :mod:`._step_core`, is one such module per model, ``core
 model's other kernel modules import: compiled once per model, not once per template; what does
 not depend on the model, :data:`SHARED_MODULES`, is ordinary modules, compiled once for every
 model); numba
-caches the compiled code in ``$NUMBA_CACHE_DIR`` (default ``$GEARDYN_CACHE_DIR/numba``, see
-:mod:`geardyn._cache`), and a second run does not recompile. Functions that cannot be
+caches the compiled code in ``$NUMBA_CACHE_DIR`` (default ``$GEARDYN_CACHE_DIR/numba``; the
+kernels' in its ``kernels`` folder, whatever the cache's path, see :mod:`geardyn._cache`), and a
+second run, or a run on a copy of the cache folder, does not recompile. Functions that cannot be
 imported by name (defined in ``__main__`` or a notebook) get an in-memory kernel, compiled once per
 process.
 """
