@@ -113,7 +113,14 @@ def stamp_name(path: Path) -> str:
     ``kernels/<file>`` for a generated kernel module (relative to :func:`kernels_dir`),
     ``geardyn/<file>`` for a file of the package (relative to :data:`PACKAGE_DIR`); any other
     file by its absolute path."""
-    for prefix, folder in (("kernels", kernels_dir()), ("geardyn", PACKAGE_DIR)):
+    return _stamp_name(path, kernels_dir(), PACKAGE_DIR)
+
+
+@functools.cache
+def _stamp_name(path: Path, kernels: Path, package: Path) -> str:
+    """:func:`stamp_name` of ``path`` for the kernels folder ``kernels`` and the package folder
+    ``package`` (kept: every cached function's stamp names the same files)."""
+    for prefix, folder in (("kernels", kernels), ("geardyn", package)):
         if path.is_relative_to(folder):
             return f"{prefix}/{path.relative_to(folder).as_posix()}"
     return path.as_posix()
@@ -235,9 +242,10 @@ def source_stamp(py_file: str | os.PathLike[str]) -> bytes:
     code is loaded only while none of them changed but in comments and docstrings, and is
     loaded where the cache folder (or the package) was copied or moved with the same code."""
     h = hashlib.sha256()
+    kernels = kernels_dir()
     for path in dependency_files(py_file):
         st = os.stat(path)
-        h.update(stamp_name(path).encode() + b"\0")
+        h.update(_stamp_name(path, kernels, PACKAGE_DIR).encode() + b"\0")
         h.update(_facts(path, _state(st))[0])
     return h.digest()
 
