@@ -36,15 +36,14 @@ is a hash of its code), and their stamp names each file relative to the folder t
 it (:func:`stamp_name`: the kernel module relative to ``kernels/``, the package's files relative
 to the package), and hashes its code, not its times. The memos of ``stamps/`` are kept by a
 file's path and state: in a copy those of the kernel modules (new paths, new states) are not
-found, and each is parsed once again. The
-package's own functions are kept by the path of their folder, as numba keeps them, so that two
-checkouts of geardyn sharing one cache each keep their own entries (where their code differs,
-one entry per function would be compiled again at each switch). What recompiles, in a copy as
-in the original: another geardyn or numba version, an edited model or geardyn module (the
-kernel's name or its stamp), another CPU or vector width (numba's index and
-:func:`geardyn._jit_target.cache_tag`), and the package's own functions where the package is at
-another path, where they are called (the kernels hold their code and still load: a simulation
-on a copied cache with the package copied elsewhere compiled nothing). Where
+found, and each is parsed once again. The package's own functions are kept by the path of their
+folder, as numba keeps them, so that two checkouts of geardyn sharing one cache each keep their
+own entries (where their code differs, one entry per function would be compiled again at each
+switch). What recompiles, in a copy as in the original: another geardyn or numba version, an
+edited model or geardyn module (the kernel's name or its stamp), another CPU or vector width
+(numba's index and :func:`geardyn._jit_target.cache_tag`), and the package's own functions where
+the package is at another path, where they are called (the kernels hold their code and still
+load: a simulation on a copied cache with the package copied elsewhere compiled nothing). Where
 ``NUMBA_CACHE_DIR`` is set, the kernels' code is in its ``kernels`` folder: every geardyn cache
 that uses that numba folder shares it (safe: the names are hashes of the code), and it stays
 valid where only ``$GEARDYN_CACHE_DIR`` is moved; copy both folders to take it along.
