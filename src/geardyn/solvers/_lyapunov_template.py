@@ -1667,6 +1667,7 @@ def _lyap_var_run1(form, first, nl, n_ev, max_total, due, renorm, bound, P, OMEG
         i = step
 
 
+@optimise_once  # its own code runs per flagged step or bookkeeping (see _bound_calls)
 @nb.njit(_nrt=False, **_JIT_NOALIAS, **INNER)
 def _lyap_var1_form0(first, nl, n_ev, max_total, due, renorm, bound, P, OMEGA, H, S, IS, PT,
                      lanes, books, out, err, used, status, scratch, fd):
@@ -1675,6 +1676,7 @@ def _lyap_var1_form0(first, nl, n_ev, max_total, due, renorm, bound, P, OMEGA, H
                    S, IS, PT, lanes, books, out, err, used, status, scratch, fd)
 
 
+@optimise_once  # its own code runs per flagged step or bookkeeping (see _bound_calls)
 @nb.njit(_nrt=False, **_JIT_NOALIAS, **INNER)
 def _lyap_var1_form1(first, nl, n_ev, max_total, due, renorm, bound, P, OMEGA, H, S, IS, PT,
                      lanes, books, out, err, used, status, scratch, fd):
@@ -1683,6 +1685,7 @@ def _lyap_var1_form1(first, nl, n_ev, max_total, due, renorm, bound, P, OMEGA, H
                    S, IS, PT, lanes, books, out, err, used, status, scratch, fd)
 
 
+@optimise_once  # its own code runs per flagged step or bookkeeping (see _bound_calls)
 @nb.njit(_nrt=False, **_JIT_NOALIAS, **INNER)
 def _lyap_var1_form2(first, nl, n_ev, max_total, due, renorm, bound, P, OMEGA, H, S, IS, PT,
                      lanes, books, out, err, used, status, scratch, fd):
@@ -1794,21 +1797,28 @@ def _lyap_block_var(form, one, first, nl, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB
     lanes = (Z0, Z1, ZT, T0L, HL, HHL, H6L, IDX, NPL, ENDL, PH, ACT, ACTR, FLAG, GR, UNRR, FDL,
              Y1F, ZX)
     books = (IST, ENDS, BLK, ACC, Zl, Cl, logs)
-    args = (first, nl, n_ev, max_total, due, renorm, bound, P, OMEGA, H, S, IS, PT, lanes, books,
-            out, err, used, status, (S_TAB, C_TAB), fd)
+    scratch = (S_TAB, C_TAB)
+    # the arguments written out at each call (a tuple of them unpacked by *args: numba's
+    # reference counting and unpacking of its ~50 arrays made the worker's IR ~10 % longer)
     if one:  # the k = 1 time loop: one fused-loop call per step, no passes
         if form == FORM_QUIET:
-            _lyap_var1_form1(*args)
+            _lyap_var1_form1(first, nl, n_ev, max_total, due, renorm, bound, P, OMEGA, H, S, IS,
+                             PT, lanes, books, out, err, used, status, scratch, fd)
         elif form == FORM_LOAD:
-            _lyap_var1_form2(*args)
+            _lyap_var1_form2(first, nl, n_ev, max_total, due, renorm, bound, P, OMEGA, H, S, IS,
+                             PT, lanes, books, out, err, used, status, scratch, fd)
         else:
-            _lyap_var1_form0(*args)
+            _lyap_var1_form0(first, nl, n_ev, max_total, due, renorm, bound, P, OMEGA, H, S, IS,
+                             PT, lanes, books, out, err, used, status, scratch, fd)
     elif form == FORM_QUIET:
-        _lyap_var_form1(*args)
+        _lyap_var_form1(first, nl, n_ev, max_total, due, renorm, bound, P, OMEGA, H, S, IS,
+                        PT, lanes, books, out, err, used, status, scratch, fd)
     elif form == FORM_LOAD:
-        _lyap_var_form2(*args)
+        _lyap_var_form2(first, nl, n_ev, max_total, due, renorm, bound, P, OMEGA, H, S, IS,
+                        PT, lanes, books, out, err, used, status, scratch, fd)
     else:
-        _lyap_var_form0(*args)
+        _lyap_var_form0(first, nl, n_ev, max_total, due, renorm, bound, P, OMEGA, H, S, IS,
+                        PT, lanes, books, out, err, used, status, scratch, fd)
     for l in range(nl):
         lane = first + l
         if status[lane] != STATUS_DIVERGED:
