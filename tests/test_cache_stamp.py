@@ -144,6 +144,12 @@ def test_stamp_of_a_kernel_is_the_same_in_a_copy_and_follows_edits(tmp_path, mon
     first = stamp("one")
     shutil.copytree(tmp_path / "one", tmp_path / "two", copy_function=shutil.copyfile)
     assert stamp("two") == first
+    # the cache moved to a folder that sorts on the other side of the package's
+    shutil.copytree(tmp_path / "one" / "cache", tmp_path / "z" / "cache")
+    monkeypatch.setattr(gc, "PACKAGE_DIR", tmp_path / "one" / "geardyn")
+    monkeypatch.setenv("GEARDYN_CACHE_DIR", str(tmp_path / "z" / "cache"))
+    gc._facts.cache_clear()
+    assert source_stamp(tmp_path / "z" / "cache" / "kernels" / "geardyn_rk4_0123.py") == first
     helpers = tmp_path / "two" / "geardyn" / "models" / "helpers.py"
     helpers.write_text(helpers.read_text().replace("x - consts.B", "x + consts.B"))
     edited = stamp("two")

@@ -239,13 +239,16 @@ def source_stamp(py_file: str | os.PathLike[str]) -> bytes:
     """numba's stamp of a cached function of ``py_file``: the code of ``py_file`` and of its
     :func:`dependency_files` (:func:`_facts`), each named by :func:`stamp_name`, so its cached
     code is loaded only while none of them changed but in comments and docstrings, and is
-    loaded where the cache folder (or the package) was copied or moved with the same code."""
+    loaded where the cache folder (or the package) was copied or moved with the same code. The
+    files are taken in the order of their names (their absolute paths' order changes where the
+    cache moves to the other side of the package)."""
     h = hashlib.sha256()
     kernels = kernels_dir()
-    for path in dependency_files(py_file):
-        st = os.stat(path)
-        h.update(_stamp_name(path, kernels, PACKAGE_DIR).encode() + b"\0")
-        h.update(_facts(path, _state(st))[0])
+    named = sorted((_stamp_name(path, kernels, PACKAGE_DIR), path)
+                   for path in dependency_files(py_file))
+    for name, path in named:
+        h.update(name.encode() + b"\0")
+        h.update(_facts(path, _state(os.stat(path)))[0])
     return h.digest()
 
 
