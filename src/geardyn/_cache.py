@@ -106,19 +106,14 @@ def is_kernel_file(py_file: str | os.PathLike[str]) -> bool:
     return Path(os.path.abspath(py_file)).is_relative_to(kernels_dir())
 
 
-def stamp_name(path: Path) -> str:
+@functools.cache
+def stamp_name(path: Path, kernels: Path, package: Path) -> str:
     """The name :func:`source_stamp` gives the absolute file ``path``: relative to the folder
     that moves with it, so that the stamp does not change where the folder is copied or moved:
-    ``kernels/<file>`` for a generated kernel module (relative to :func:`kernels_dir`),
-    ``geardyn/<file>`` for a file of the package (relative to :data:`PACKAGE_DIR`); any other
-    file by its absolute path."""
-    return _stamp_name(path, kernels_dir(), PACKAGE_DIR)
-
-
-@functools.cache
-def _stamp_name(path: Path, kernels: Path, package: Path) -> str:
-    """:func:`stamp_name` of ``path`` for the kernels folder ``kernels`` and the package folder
-    ``package`` (kept: every cached function's stamp names the same files)."""
+    ``kernels/<file>`` for a generated kernel module (relative to ``kernels``, the
+    :func:`kernels_dir`), ``geardyn/<file>`` for a file of the package (relative to
+    ``package``, the :data:`PACKAGE_DIR`); any other file by its absolute path. Kept per
+    argument: every cached function's stamp names the same files."""
     for prefix, folder in (("kernels", kernels), ("geardyn", package)):
         if path.is_relative_to(folder):
             return f"{prefix}/{path.relative_to(folder).as_posix()}"
@@ -244,7 +239,7 @@ def source_stamp(py_file: str | os.PathLike[str]) -> bytes:
     cache moves to the other side of the package)."""
     h = hashlib.sha256()
     kernels = kernels_dir()
-    named = sorted((_stamp_name(path, kernels, PACKAGE_DIR), path)
+    named = sorted((stamp_name(path, kernels, PACKAGE_DIR), path)
                    for path in dependency_files(py_file))
     for name, path in named:
         h.update(name.encode() + b"\0")
