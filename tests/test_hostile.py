@@ -539,24 +539,32 @@ def test_limits_refuse_and_yes_overrides(monkeypatch, limit, fragment):
 
 
 def test_console_script_exit_status_and_no_traceback(workdir):
-    """A handful of real runs of the installed console script: status 2, one line, no
-    traceback."""
+    """Real runs of the installed console script: status 2, one line, no traceback; a study
+    that does not load and an option refused, each in a process of its own (every process
+    imports geardyn, ~5 s CPU); the other calls, whose code past the entry point is the same,
+    through the same command in this process."""
     exe = Path(sys.executable).with_name("geardyn")
     if not exe.exists():
         pytest.skip("the geardyn console script is not installed next to this interpreter")
     garbage = study_file(workdir, b"\xff\xfe\x00garbage\x80")
     calls = [
         (["params", "show", str(garbage)], str(garbage)),
-        (["simulate", "paper_fig3", "--omega", "nan"], "--omega"),
         (["bifurcation", "paper_fig3", "--range", "0.1:4:1000000000", "-q"], "--range"),
+        (["simulate", "paper_fig3", "--omega", "nan"], "--omega"),
         (["map", "paper_fig3", "--x", "Omega:0.1:4:100000", "--y", "xi:0.01:0.3:100000",
           "--out", str(workdir / "m.nc")], "--x/--y"),
     ]
     procs = [(subprocess.Popen([str(exe), *args], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                               text=True), fragment) for args, fragment in calls]
-    for proc, fragment in procs:
+                               text=True), fragment) for args, fragment in calls[:2]]
+    results = []
+    for proc, _ in procs:
         _, err = proc.communicate(timeout=300)
-        assert proc.returncode == 2, (proc.args, err)
+        results.append((proc.returncode, err))
+    for args, _ in calls[2:]:
+        code, _, err = invoke(args)
+        results.append((code, err))
+    for (code, err), (args, fragment) in zip(results, calls, strict=True):
+        assert code == 2, (args, err)
         assert "Traceback" not in err
         lines = err.strip().splitlines()
         assert len(lines) == 1 and lines[0].startswith("error: ") and fragment in lines[0], err
