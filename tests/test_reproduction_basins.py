@@ -73,7 +73,10 @@ def test_velocity_pairs_and_the_report_line():
 
 def test_reproduce_with_basins_writes_them_into_the_report(tmp_path, capsys, monkeypatch):
     """The plumbing of ``--basins N``: each case's basins (here a stand-in computed on the gear
-    pair, cheap) written beside the case and shown in the report with its line."""
+    pair, cheap) written beside the case and shown in the report with its line. One process
+    (``--jobs 1``, as tests/test_reproduction.py's pipeline test): the basins are computed in
+    the command's own process whatever the jobs (the worker processes' sweeps:
+    tests/test_reproduction.py)."""
     import geardyn
     import geardyn.reproduction.basins as rb
     from geardyn.cli.main import main
@@ -92,7 +95,7 @@ def test_reproduce_with_basins_writes_them_into_the_report(tmp_path, capsys, mon
     out = tmp_path / "rep"
     with pytest.raises(SystemExit) as info:
         main(["reproduce", "fig5", "--resolution", "3", "--transient", "300", "--samples", "8",
-              "--out", str(out), "--quiet", "--basins", "3"])
+              "--out", str(out), "--quiet", "--basins", "3", "--jobs", "1"])
     assert info.value.code == 0, capsys.readouterr().err
     assert asked == [("fig5", "consistent", 3)]
     assert (out / "basins-fig5-consistent.png").exists()
