@@ -3,7 +3,7 @@ generated layout gives the bits of the general model's hand-written array form
 (:func:`~geardyn.models.catt_kernels.catt_rhs` with one planet set); lanes with the load quiet
 take FORM_QUIET (the load term compiled away), lanes with it fluctuating FORM_LOAD (no test of
 the load), any number of stiffness harmonics; every lane's result is bitwise that of the
-one-lane path (``simulate``) and of a sweep through the general model's array functions."""
+one-lane path (``simulate``) and of the general model's array functions run lane by lane."""
 
 from __future__ import annotations
 
