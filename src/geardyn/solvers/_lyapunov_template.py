@@ -1798,8 +1798,8 @@ def _lyap_block_var(form, one, first, nl, k, P, Y0, S, T0, H, OMEGA, NPER, S_TAB
              Y1F, ZX)
     books = (IST, ENDS, BLK, ACC, Zl, Cl, logs)
     scratch = (S_TAB, C_TAB)
-    # the arguments written out at each call (a tuple of them unpacked by *args: numba's
-    # reference counting and unpacking of its ~50 arrays made the worker's IR ~10 % longer)
+    # the arguments written out at each call: a tuple of them unpacked by *args would add
+    # numba's reference counting and unpacking of its ~50 arrays to the worker's IR
     if one:  # the k = 1 time loop: one fused-loop call per step, no passes
         if form == FORM_QUIET:
             _lyap_var1_form1(first, nl, n_ev, max_total, due, renorm, bound, P, OMEGA, H, S, IS,
